@@ -1,0 +1,1 @@
+"""pytest plugin for sdi12-conform (options, fixtures, markers, report hooks)."""

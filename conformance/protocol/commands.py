@@ -1,0 +1,312 @@
+"""The SDI-12 command grammar of v1.3 and v1.4: parse and format every command form.
+
+A :class:`Command` is a value; :func:`parse_command` turns wire text into one or raises
+:class:`CommandError` with a reason, and :meth:`Command.text` gives the canonical wire text.
+The same grammar serves the master engine (what to send), the emulator (what it heard) and the
+recorder-role judges (was the recorder's command well formed).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, replace
+from enum import StrEnum
+
+ADDRESS_CHARS = "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+WILDCARD = "?"
+
+
+class Kind(StrEnum):
+    """Command families; the value is a short stable name used in transcripts and reports."""
+
+    ACKNOWLEDGE = "a!"
+    QUERY_ADDRESS = "?!"
+    IDENTIFY = "aI!"
+    CHANGE_ADDRESS = "aAb!"
+    MEASURE = "aM!"
+    VERIFY = "aV!"
+    CONCURRENT = "aC!"
+    HIGH_VOLUME_ASCII = "aHA!"
+    HIGH_VOLUME_BINARY = "aHB!"
+    CONTINUOUS = "aR!"
+    DATA = "aD!"
+    BINARY_DATA = "aDB!"
+    IDENTIFY_MEASUREMENT = "aI<m>!"
+    METADATA = "aI<m>_nnn!"
+    EXTENDED = "aX!"
+
+
+#: Commands that start a measurement and so replace the data buffer (R-4.4.5-10).
+MEASUREMENT_KINDS = frozenset(
+    {Kind.MEASURE, Kind.VERIFY, Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY}
+)
+#: Measurements answered with a service request when ttt > 0 (R-4.4.6-02, decision A5).
+SERVICE_REQUEST_KINDS = frozenset({Kind.MEASURE, Kind.VERIFY})
+#: Measurements that run concurrently: no service request, not aborted by a break (R-4.4.7-05).
+CONCURRENT_KINDS = frozenset({Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
+#: Kinds that an identify-measurement or metadata command may describe.
+DESCRIBABLE_KINDS = MEASUREMENT_KINDS | {Kind.CONTINUOUS}
+
+
+class CommandError(ValueError):
+    """Text that is not a well-formed SDI-12 command; ``reason`` says why, for a finding."""
+
+    def __init__(self, text: str, reason: str) -> None:
+        super().__init__(f"{text!r}: {reason}")
+        self.text = text
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class Command:
+    """One SDI-12 command.
+
+    ``group`` is the measurement group (0 for plain ``aM!``/``aC!``, 1-9 for ``aM1!``...) or the
+    continuous index of ``aRn!``; ``index`` is the data index of ``aDn!``/``aDBn!``;
+    ``target`` is the measurement an identify or metadata command describes; ``param`` is
+    the metadata value index (``_001`` -> 1); ``body`` is the text between the address and
+    ``!`` of an extended command.
+    """
+
+    address: str
+    kind: Kind
+    crc: bool = False
+    group: int = 0
+    index: int = 0
+    new_address: str = ""
+    target: Command | None = None
+    param: int = 0
+    body: str = ""
+
+    # -- classification -------------------------------------------------------------------
+    @property
+    def starts_measurement(self) -> bool:
+        return self.kind in MEASUREMENT_KINDS
+
+    @property
+    def is_concurrent(self) -> bool:
+        return self.kind in CONCURRENT_KINDS
+
+    @property
+    def returns_crc(self) -> bool:
+        """Whether replies tied to this command carry a CRC (HA/HB always do)."""
+        return self.crc or self.kind in (Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY)
+
+    def with_address(self, address: str) -> Command:
+        return replace(self, address=address)
+
+    # -- formatting -----------------------------------------------------------------------
+    def _measurement_code(self) -> str:
+        """``M``, ``MC3``, ``CC``, ``HA``, ``R0``, ``RC5``: the letters after the address."""
+        crc = "C" if self.crc else ""
+        match self.kind:
+            case Kind.MEASURE:
+                return "M" + crc + (str(self.group) if self.group else "")
+            case Kind.CONCURRENT:
+                return "C" + crc + (str(self.group) if self.group else "")
+            case Kind.VERIFY:
+                return "V"
+            case Kind.HIGH_VOLUME_ASCII:
+                return "HA"
+            case Kind.HIGH_VOLUME_BINARY:
+                return "HB"
+            case Kind.CONTINUOUS:
+                return "R" + crc + str(self.group)
+        raise ValueError(f"{self.kind} has no measurement code")
+
+    @property
+    def code(self) -> str:
+        """The command text without address and ``!`` (``M1``, ``D12``, ``IMC_003``...)."""
+        match self.kind:
+            case Kind.ACKNOWLEDGE | Kind.QUERY_ADDRESS:
+                return ""
+            case Kind.IDENTIFY:
+                return "I"
+            case Kind.CHANGE_ADDRESS:
+                return "A" + self.new_address
+            case Kind.DATA:
+                return f"D{self.index}"
+            case Kind.BINARY_DATA:
+                return f"DB{self.index}"
+            case Kind.IDENTIFY_MEASUREMENT:
+                assert self.target is not None
+                return "I" + self.target._measurement_code()
+            case Kind.METADATA:
+                assert self.target is not None
+                return f"I{self.target._measurement_code()}_{self.param:03d}"
+            case Kind.EXTENDED:
+                return self.body
+        return self._measurement_code()
+
+    def text(self) -> str:
+        """Canonical wire text, e.g. ``0MC1!``."""
+        return f"{self.address}{self.code}!"
+
+    def encode(self) -> bytes:
+        return self.text().encode("ascii")
+
+    def __str__(self) -> str:
+        return self.text()
+
+
+# -- constructors, so callers never spell wire text by hand --------------------------------
+def acknowledge(a: str) -> Command:
+    return Command(a, Kind.ACKNOWLEDGE)
+
+
+def query_address() -> Command:
+    return Command(WILDCARD, Kind.QUERY_ADDRESS)
+
+
+def identify(a: str) -> Command:
+    return Command(a, Kind.IDENTIFY)
+
+
+def change_address(a: str, b: str) -> Command:
+    return Command(a, Kind.CHANGE_ADDRESS, new_address=b)
+
+
+def measure(a: str, group: int = 0, crc: bool = False) -> Command:
+    return Command(a, Kind.MEASURE, crc=crc, group=group)
+
+
+def concurrent(a: str, group: int = 0, crc: bool = False) -> Command:
+    return Command(a, Kind.CONCURRENT, crc=crc, group=group)
+
+
+def verify(a: str) -> Command:
+    return Command(a, Kind.VERIFY)
+
+
+def high_volume_ascii(a: str) -> Command:
+    return Command(a, Kind.HIGH_VOLUME_ASCII)
+
+
+def high_volume_binary(a: str) -> Command:
+    return Command(a, Kind.HIGH_VOLUME_BINARY)
+
+
+def continuous(a: str, index: int, crc: bool = False) -> Command:
+    return Command(a, Kind.CONTINUOUS, crc=crc, group=index)
+
+
+def data(a: str, index: int) -> Command:
+    return Command(a, Kind.DATA, index=index)
+
+
+def binary_data(a: str, index: int) -> Command:
+    return Command(a, Kind.BINARY_DATA, index=index)
+
+
+def identify_measurement(target: Command) -> Command:
+    if target.kind not in MEASUREMENT_KINDS:
+        raise ValueError(f"no identify form for {target}")
+    return Command(target.address, Kind.IDENTIFY_MEASUREMENT, target=target)
+
+
+def metadata(target: Command, param: int) -> Command:
+    if target.kind not in DESCRIBABLE_KINDS:
+        raise ValueError(f"no metadata form for {target}")
+    return Command(target.address, Kind.METADATA, target=target, param=param)
+
+
+def extended(a: str, body: str) -> Command:
+    return Command(a, Kind.EXTENDED, body=body)
+
+
+# -- parsing -------------------------------------------------------------------------------
+_NUMBER = r"(0|[1-9][0-9]{0,2})"  # 0..999, no leading zeros (R-5.1-02)
+_MEASUREMENT = re.compile(r"(?P<letter>M|C)(?P<crc>C?)(?P<group>[1-9]?)|(?P<v>V)|H(?P<hv>[AB])")
+_CONTINUOUS = re.compile(r"R(?P<crc>C?)(?P<group>[0-9])")
+_BASIC_LETTERS = frozenset("MVCDRIAH")
+
+
+def _parse_measurement(address: str, code: str, allow_continuous: bool) -> Command | None:
+    """Parse ``M``, ``MC1``, ``V``, ``CC``, ``HA``... (and ``R0``/``RC0`` if allowed)."""
+    m = _MEASUREMENT.fullmatch(code)
+    if m:
+        if m["v"]:
+            return verify(address)
+        if m["hv"]:
+            return Command(
+                address, Kind.HIGH_VOLUME_ASCII if m["hv"] == "A" else Kind.HIGH_VOLUME_BINARY
+            )
+        kind = Kind.MEASURE if m["letter"] == "M" else Kind.CONCURRENT
+        return Command(address, kind, crc=bool(m["crc"]), group=int(m["group"] or 0))
+    if allow_continuous:
+        r = _CONTINUOUS.fullmatch(code)
+        if r:
+            return continuous(address, int(r["group"]), crc=bool(r["crc"]))
+    return None
+
+
+def _leading_zero_reason(code: str) -> str | None:
+    m = re.fullmatch(r"(DB|D|M|MC|C|CC|R|RC)(0[0-9]+)", code)
+    if m:
+        return f"index {m[2]} has a leading zero"
+    return None
+
+
+def parse_command(text: str | bytes, *, allow_wildcard: bool = False) -> Command:
+    """Parse one command (``!`` included). Raises :class:`CommandError` with the reason.
+
+    ``allow_wildcard`` admits ``?`` as the address of commands other than ``?!``
+    (R-4.4.3-02: a sensor may accept it); by default only ``?!`` may use it.
+    """
+    if isinstance(text, bytes):
+        try:
+            text = text.decode("ascii")
+        except UnicodeDecodeError:
+            raise CommandError(repr(text), "contains a non-ASCII byte") from None
+    if not text:
+        raise CommandError(text, "empty")
+    bad = next((c for c in text if not 0x20 <= ord(c) <= 0x7E), None)
+    if bad is not None:
+        raise CommandError(text, f"contains non-printable character 0x{ord(bad):02X}")
+    if not text.endswith("!"):
+        raise CommandError(text, "does not end with '!'")
+    if "!" in text[:-1]:
+        raise CommandError(text, "'!' appears before the end")
+    address, code = text[0], text[1:-1]
+    if address == "!":
+        raise CommandError(text, "no address")
+    if address == WILDCARD:
+        if code == "":
+            return query_address()
+        if not allow_wildcard:
+            raise CommandError(text, "'?' is a wildcard only in '?!'")
+    elif address not in ADDRESS_CHARS:
+        raise CommandError(text, f"bad address {address!r}")
+    if code == "":
+        return acknowledge(address)
+    if code == "I":
+        return identify(address)
+    if code[0] not in _BASIC_LETTERS:
+        return extended(address, code)
+    reason = _leading_zero_reason(code)
+    if reason:
+        raise CommandError(text, reason)
+    if code[0] == "A":
+        if len(code) != 2:
+            raise CommandError(text, "change address takes exactly one new address")
+        if code[1] not in ADDRESS_CHARS:
+            raise CommandError(text, f"bad new address {code[1]!r}")
+        return change_address(address, code[1])
+    if m := re.fullmatch(r"D(B?)" + _NUMBER, code):
+        return (binary_data if m[1] else data)(address, int(m[2]))
+    if code[0] == "I":
+        body, _, param = code[1:].partition("_")
+        target = _parse_measurement(address, body, allow_continuous=True)
+        if target is None:
+            raise CommandError(text, f"unknown identify form 'I{body}'")
+        if "_" not in code:
+            if target.kind == Kind.CONTINUOUS:
+                raise CommandError(text, "continuous commands have no identify form")
+            return identify_measurement(target)
+        if not re.fullmatch(r"[0-9]{3}", param):
+            raise CommandError(text, f"metadata index {param!r} is not three digits")
+        return metadata(target, int(param))
+    command = _parse_measurement(address, code, allow_continuous=True)
+    if command is None:
+        raise CommandError(text, f"unknown command form {code!r}")
+    return command

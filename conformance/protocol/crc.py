@@ -1,0 +1,55 @@
+"""SDI-12 CRC-16 (R-4.4.12-05): CRC-16/ARC, reflected polynomial 0xA001, init 0, no final XOR.
+
+Two encodings exist: three printable characters for ASCII replies (R-4.4.12-06) and two raw
+bytes, low byte first, for high-volume binary packets (R-5.2-03).
+"""
+
+from __future__ import annotations
+
+
+def _table() -> tuple[int, ...]:
+    table = []
+    for byte in range(256):
+        crc = byte
+        for _ in range(8):
+            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
+        table.append(crc)
+    return tuple(table)
+
+
+_TABLE = _table()
+
+
+def crc16(data: bytes | str) -> int:
+    """CRC-16/ARC of ``data`` (text is taken as ASCII)."""
+    if isinstance(data, str):
+        data = data.encode("ascii", "surrogateescape")
+    crc = 0
+    for byte in data:
+        crc = (crc >> 8) ^ _TABLE[(crc ^ byte) & 0xFF]
+    return crc
+
+
+def encode_ascii(crc: int) -> str:
+    """The three CRC characters of R-4.4.12-06 (each 0x40..0x7F)."""
+    return "".join(chr(0x40 | ((crc >> shift) & 0x3F)) for shift in (12, 6, 0))
+
+
+def ascii_crc(text: str) -> str:
+    """The three CRC characters for ``text`` (address through the last value, no CR LF)."""
+    return encode_ascii(crc16(text))
+
+
+def encode_binary(crc: int) -> bytes:
+    """The two CRC bytes of a high-volume binary packet, low byte first (R-5.2-03)."""
+    return bytes((crc & 0xFF, crc >> 8))
+
+
+def binary_crc(packet: bytes) -> bytes:
+    """The two CRC bytes for a binary packet's address, size, type and payload."""
+    return encode_binary(crc16(packet))
+
+
+def is_crc_char(char: str) -> bool:
+    """CRC characters are 0x40..0x7F; no value character (``+-.0-9``) is in that range."""
+    return len(char) == 1 and 0x40 <= ord(char) <= 0x7F

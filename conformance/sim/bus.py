@@ -1,0 +1,166 @@
+"""An in-process SDI-12 bus on a virtual clock.
+
+The clock moves only when the tool waits, writes or breaks, and then jumps straight to the
+next thing that happens, so a measurement announcing ttt=999 takes milliseconds of wall time.
+Each character takes exactly one 10-bit frame (8.33 ms); breaks last what was asked; every
+event is stamped exactly (uncertainty 0).
+
+Devices on the bus are sans-I/O: they hear breaks and characters as stamped events and offer
+the characters they want to send, each with its start time (:class:`BusDevice`). A device's
+plans may change when it hears something (a break cancels a pending service request), so the
+bus only ever asks for the *next* character and commits it once its time has come.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from typing import Protocol
+
+from ..links.base import Link, LinkInfo, StopCondition
+from ..protocol.timing import CHAR_TIME
+from ..transcript import DUT, TOOL, Event, EventKind, Transcript
+
+
+@dataclass(frozen=True, slots=True)
+class Frame:
+    """A character a device wants on the wire: its start time and its 8 wire bits."""
+
+    start: float
+    wire: int
+
+
+class BusDevice(Protocol):
+    """A simulated device (sensor emulator, or a simulated recorder)."""
+
+    name: str
+
+    def on_break(self, start: float, end: float) -> None: ...
+
+    def on_char(self, wire: int, start: float, end: float) -> None: ...
+
+    def next_frame(self) -> Frame | None:
+        """The next character this device will send, if nothing else happens first."""
+
+    def pop_frame(self) -> Frame:
+        """Commit the character :meth:`next_frame` offered; it is now on the wire."""
+
+
+class VirtualClock:
+    def __init__(self, start: float = 0.0) -> None:
+        self.now = start
+
+    def advance_to(self, time: float) -> None:
+        if time > self.now:
+            self.now = time
+
+
+class SimBus:
+    """The wire: devices plus the tool's link, sharing one virtual clock and transcript."""
+
+    def __init__(self, devices: list[BusDevice] | None = None) -> None:
+        self.clock = VirtualClock()
+        self.devices: list[BusDevice] = list(devices or [])
+        self.transcript = Transcript()
+        self.rx: deque[Event] = deque()  # device characters the tool has not read yet
+
+    def attach(self, device: BusDevice) -> None:
+        self.devices.append(device)
+
+    def _next(self) -> tuple[BusDevice, Frame] | None:
+        best: tuple[BusDevice, Frame] | None = None
+        for device in self.devices:
+            frame = device.next_frame()
+            if frame is not None and (best is None or frame.start < best[1].start):
+                best = (device, frame)
+        return best
+
+    def advance(self, time: float) -> None:
+        """Let devices transmit everything that starts before ``time``, then set the clock."""
+        while (nxt := self._next()) is not None and nxt[1].start < time:
+            self._commit(*nxt)
+        self.clock.advance_to(time)
+
+    def step(self, limit: float) -> Event | None:
+        """Commit the next device character if it starts before ``limit``."""
+        nxt = self._next()
+        if nxt is None or nxt[1].start >= limit:
+            return None
+        return self._commit(*nxt)
+
+    def _commit(self, device: BusDevice, frame: Frame) -> Event:
+        device.pop_frame()
+        start = max(frame.start, self.clock.now)
+        end = start + CHAR_TIME
+        origin = DUT if len(self.devices) == 1 else device.name
+        event = self.transcript.add(Event(EventKind.CHAR, origin, start, end, wire=frame.wire))
+        for other in self.devices:
+            if other is not device:
+                other.on_char(frame.wire, start, end)
+        self.clock.advance_to(end)
+        self.rx.append(event)
+        return event
+
+    # tool-side actions
+    def tool_break(self, duration: float) -> Event:
+        self.advance(self.clock.now)
+        start, end = self.clock.now, self.clock.now + duration
+        event = self.transcript.add(Event(EventKind.BREAK, TOOL, start, end))
+        self.advance(end)  # devices that were talking keep talking (contention is theirs)
+        for device in self.devices:
+            device.on_break(start, end)
+        return event
+
+    def tool_char(self, wire: int, start: float) -> Event:
+        self.advance(start)
+        start = self.clock.now
+        end = start + CHAR_TIME
+        event = self.transcript.add(Event(EventKind.CHAR, TOOL, start, end, wire=wire))
+        for device in self.devices:
+            device.on_char(wire, start, end)
+        self.clock.advance_to(end)
+        return event
+
+
+class SimLink(Link):
+    """The tool's end of a :class:`SimBus`."""
+
+    def __init__(self, bus: SimBus) -> None:
+        self.bus = bus
+        self.transcript = bus.transcript
+        self.info = LinkInfo(kind="sim", virtual_time=True)
+
+    def now(self) -> float:
+        return self.bus.clock.now
+
+    def send_break(self, duration: float) -> Event:
+        return self.bus.tool_break(duration)
+
+    def write(self, wire: bytes, gap: float = 0.0) -> list[Event]:
+        events = []
+        time = self.now()
+        for byte in wire:
+            event = self.bus.tool_char(byte, time)
+            events.append(event)
+            time = event.end + gap
+        return events
+
+    def wait_until(self, time: float) -> None:
+        self.bus.advance(time)
+
+    def receive(
+        self, deadline: float, until: StopCondition | None = None, idle: float | None = None
+    ) -> list[Event]:
+        got: list[Event] = []
+        while True:
+            if self.bus.rx:
+                got.append(self.bus.rx.popleft())
+                if until is not None and until(got):
+                    return got
+                continue
+            limit = deadline
+            if idle is not None and got:
+                limit = min(limit, got[-1].end + idle)
+            if self.bus.step(limit) is None:
+                self.bus.clock.advance_to(max(limit, self.now()))
+                return got

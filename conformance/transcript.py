@@ -1,0 +1,121 @@
+"""Timestamped bus events: the only thing links produce and the only thing judges read.
+
+Every character on the wire is one :class:`Event` holding the 8 bits between its start and
+stop bit (``wire``). For a 7E1 character bit 7 is the even-parity bit; for an 8N1 byte of a
+high-volume binary packet all 8 bits are data. Keeping the raw bits lets the same record be
+decoded either way (requirements.md implementation notes) and lets a parity fault show up as
+evidence instead of vanishing inside a UART.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Iterator
+from dataclasses import asdict, dataclass, field
+from enum import StrEnum
+from typing import Any
+
+
+class EventKind(StrEnum):
+    BREAK = "break"
+    CHAR = "char"
+    NOTE = "note"
+
+
+TOOL = "tool"  # the side this program plays (recorder in the sensor role)
+DUT = "dut"  # the device under test
+
+
+def parity_bit(char7: int) -> int:
+    """Even parity bit for a 7-bit character."""
+    return bin(char7 & 0x7F).count("1") & 1
+
+
+def to_wire_7e1(char7: int) -> int:
+    """The 8 bits a 7E1 frame carries between start and stop bit."""
+    return (char7 & 0x7F) | (parity_bit(char7) << 7)
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """One thing that happened on the bus, stamped in seconds on the link's clock.
+
+    ``start``/``end`` of a character are its start-bit leading edge and stop-bit end; of a
+    break, the spacing's start and end. ``uncertainty`` is the link's stamp uncertainty.
+    """
+
+    kind: EventKind
+    origin: str
+    start: float
+    end: float
+    wire: int = 0
+    text: str = ""
+    uncertainty: float = 0.0
+
+    @property
+    def char7(self) -> int:
+        return self.wire & 0x7F
+
+    @property
+    def parity_ok(self) -> bool:
+        return (self.wire >> 7) == parity_bit(self.wire)
+
+    @property
+    def duration(self) -> float:
+        return self.end - self.start
+
+    def to_json(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["kind"] = str(self.kind)
+        return d
+
+
+def decode_7e1(events: Iterable[Event]) -> str:
+    """Text of 7E1 characters (parity stripped; see :func:`parity_errors`)."""
+    return "".join(chr(e.char7) for e in events if e.kind is EventKind.CHAR)
+
+
+def decode_8n1(events: Iterable[Event]) -> bytes:
+    return bytes(e.wire for e in events if e.kind is EventKind.CHAR)
+
+
+def parity_errors(events: Iterable[Event]) -> list[Event]:
+    return [e for e in events if e.kind is EventKind.CHAR and not e.parity_ok]
+
+
+def escape(data: str | bytes) -> str:
+    """Printable rendering of wire text: ``<CR><LF>``, ``<0x02>``... for evidence lines."""
+    if isinstance(data, bytes):
+        data = data.decode("latin-1")
+    names = {"\r": "<CR>", "\n": "<LF>", "\x02": "<STX>", "\x03": "<ETX>"}
+    return "".join(
+        names.get(c, c if 0x20 <= ord(c) <= 0x7E else f"<0x{ord(c):02X}>") for c in data
+    )
+
+
+@dataclass
+class Transcript:
+    """The ordered events a link recorded. Append-only; slices of it are judged."""
+
+    events: list[Event] = field(default_factory=list)
+
+    def add(self, event: Event) -> Event:
+        self.events.append(event)
+        return event
+
+    def note(self, time: float, text: str) -> Event:
+        return self.add(Event(EventKind.NOTE, TOOL, time, time, text=text))
+
+    def __iter__(self) -> Iterator[Event]:
+        return iter(self.events)
+
+    def __len__(self) -> int:
+        return len(self.events)
+
+    def since(self, index: int) -> list[Event]:
+        return self.events[index:]
+
+    def write_jsonl(self, path: str) -> None:
+        with open(path, "w", encoding="utf-8") as fh:
+            for event in self.events:
+                fh.write(json.dumps(event.to_json()) + "\n")
