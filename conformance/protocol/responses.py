@@ -21,7 +21,7 @@ from conformance.protocol.commands import (
     Command,
     Kind,
 )
-from conformance.protocol.crc import ascii_crc, is_crc_char
+from conformance.protocol.crc import crc16, encode_ascii, is_crc_char
 from conformance.protocol.values import Violation, check_value, errors, split_values
 from conformance.transcript import escape
 
@@ -56,6 +56,12 @@ IDENT_MIN, IDENT_MAX = 20, 33  # R-4.4.2-01: a + ll + 8 + 6 + 3 + 0..13
 def _digits(text: str, width: int) -> bool:
     """Exactly ``width`` ASCII decimal digits (str.isdigit alone admits other scripts)."""
     return len(text) == width and text.isascii() and text.isdigit()
+
+
+def _ascii_crc(text: str) -> str:
+    """The CRC characters due for ``text``, for untrusted input: characters beyond Latin-1
+    (which no 7-bit line carries) become '?' instead of raising as crc.ascii_crc would."""
+    return encode_ascii(crc16(text.encode("latin-1", "replace")))
 
 
 def _has_errors(violations: list[Violation]) -> bool:
@@ -340,7 +346,7 @@ def _check_crc(body: str, crc: str) -> tuple[bool, list[Violation]]:
                 f"CRC '{escape(crc)}' cannot be an encoded CRC-16 (first character above 'O')",
             )
         )
-    want = ascii_crc(body[: -len(crc)])
+    want = _ascii_crc(body[: -len(crc)])
     if crc != want:
         found.append(
             Violation(
@@ -488,7 +494,7 @@ def parse_metadata_reply(
             found.append(Violation("R-6.2-02", f"reply '{escape(body)}' lacks the CRC"))
     if len(text) == 1:
         return MetadataReply(address, [], True, crc, crc_ok, found)
-    if not crc_expected and len(text) == 1 + CRC_LEN and ascii_crc(address) == text[1:]:
+    if not crc_expected and len(text) == 1 + CRC_LEN and _ascii_crc(address) == text[1:]:
         found.append(
             Violation("R-6.2-05", f"invalid-index reply '{escape(body)}' carries an unasked CRC")
         )
