@@ -81,9 +81,15 @@ def decode_values(dtype: DataType, payload: bytes) -> list[int | float]:
 
 
 def build_packet(address: str, dtype: DataType, values: list[int | float]) -> bytes:
-    """A complete, correct packet, as a conforming sensor sends it (R-5.2-02/-03)."""
+    """A complete, correct packet, as a conforming sensor sends it (R-5.2-02/-03).
+
+    ValueError for anything a conforming sensor could not send: a bad address, a value out of
+    the type's range, more than 1000 payload bytes, or no values under a non-zero type.
+    """
     if len(address) != 1 or address not in ADDRESS_CHARS:
         raise ValueError(f"bad address {address!r}")
+    if not values and dtype is not DataType.INVALID:
+        raise ValueError("a packet without values must be the type-0 empty packet (R-5.2-06)")
     payload = encode_values(DataType(dtype), values)
     if len(payload) > MAX_PAYLOAD:
         raise ValueError(f"payload of {len(payload)} bytes exceeds {MAX_PAYLOAD}")
@@ -107,7 +113,8 @@ def packet_length(prefix: bytes) -> int | None:
 @dataclass(frozen=True)
 class BinaryPacket:
     """A parsed packet. ``dtype`` is the raw code when it is not a valid :class:`DataType`;
-    ``values`` is empty when the payload cannot be decoded."""
+    ``payload`` is the bytes between header and CRC as received; ``values`` is empty unless
+    the packet is framed by its size field and its payload fits the type."""
 
     address: str
     size: int
@@ -150,8 +157,10 @@ def parse_binary_packet(data: bytes, expected_address: str | None = None) -> Bin
     size = int.from_bytes(data[1:3], "little") if len(data) >= 3 else 0
     code = data[3] if len(data) >= HEADER_LEN else 0
     dtype: DataType | int = DataType(code) if code <= DataType.FLOAT64 else code
-    payload = data[HEADER_LEN : HEADER_LEN + size]
-    if len(data) >= EMPTY_LEN and len(data) != EMPTY_LEN + size:
+    framed = len(data) == EMPTY_LEN + size
+    # Keep what actually sits between header and CRC as evidence, whatever the size field says.
+    payload = data[HEADER_LEN : max(HEADER_LEN, len(data) - CRC_LEN)]
+    if len(data) >= EMPTY_LEN and not framed:
         found.append(
             Violation(
                 "R-5.2-02",
@@ -184,6 +193,6 @@ def parse_binary_packet(data: bytes, expected_address: str | None = None) -> Bin
                 f"payload of {size} bytes is not a whole number of {dtype.name} values",
             )
         )
-    elif len(payload) == size:
+    elif framed:
         values = decode_values(dtype, payload)
     return BinaryPacket(address, size, dtype, bytes(payload), crc_ok, values, found)
