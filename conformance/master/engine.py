@@ -1,0 +1,414 @@
+"""The master engine: the tool's own data recorder, correct per section 7, that only records.
+
+In the sensor role it is the stimulus that drives the device under test; in the recorder role
+it is the "golden recorder" that other recorders are compared with. Either way it sends what a
+correct recorder sends (breaks, retries, service-request waits, D0..Dn collection) and hands
+back :mod:`~conformance.master.records` with every attempt, leaving every verdict to judges.
+It talks to the bus only through the :class:`~conformance.links.base.Link` API, so it runs the
+same on the virtual-time sim bus and on a serial port, and every read is bounded by a
+deadline so a silent or babbling device can never hang it.
+"""
+
+from __future__ import annotations
+
+from ..links.base import Link
+from ..protocol import commands as cmds
+from ..protocol.binary import packet_length
+from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind
+from ..protocol.timing import (
+    CHAR_TIME,
+    NO_BREAK_WINDOW,
+    RETRY_AFTER_BREAK,
+    RETRY_MAX,
+    RETRY_MIN,
+    TOLERANCE,
+)
+from ..protocol.values import split_values
+from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, to_wire_7e1
+from . import validity
+from .policy import Policy
+from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
+
+#: Data-index ceiling per measurement family: D0..D9, or D0..D999 after HA/HB (R-5.1-04).
+_HIGH_VOLUME = (Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY)
+
+
+class Master:
+    """Drives a :class:`Link` as an SDI-12 data recorder and returns records.
+
+    ``address`` is the default sensor address for the conveniences (:meth:`identify`...).
+    """
+
+    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
+        self.link = link
+        self.policy = policy or Policy()
+        self.address = address
+        self.last_address: str | None = None  # address of the last command sent
+        self.last_break_end = float("-inf")
+        # Whether D replies for each address carry a CRC: set by the last accepted
+        # measurement reply, used when a D command is sent on its own.
+        self._crc_pending: dict[str, bool] = {}
+
+    # -- single commands -------------------------------------------------------------------
+    def transact(
+        self,
+        command: Command | str,
+        *,
+        binary: bool = False,
+        force_break: bool = False,
+        retries: bool = True,
+        expect_reply: bool = True,
+        crc: bool | None = None,
+    ) -> Exchange:
+        """Send ``command`` with the break and retry rules of section 7 and record it all.
+
+        ``binary`` reads the reply as an 8N1 packet (``aDBn!``). ``retries=False`` or
+        ``expect_reply=False`` sends once (observation cases: silence may be the point).
+        ``crc`` says whether a D reply carries a CRC; None takes it from the last measurement
+        this engine started at that address.
+        """
+        if isinstance(command, str):
+            command = cmds.parse_command(command)
+        text = command.text()
+        if crc is None and command.kind in (Kind.DATA, Kind.BINARY_DATA):
+            crc = self._crc_pending.get(command.address)
+        wire = bytes(to_wire_7e1(ord(c)) for c in text)
+        exchange = Exchange(command, text, [], binary=binary, expect_reply=expect_reply)
+        repeat = retries and expect_reply
+        sequences = self.policy.sequences if repeat else 1
+        per_sequence = self.policy.retries_per_sequence if repeat else 0
+        for sequence in range(sequences):
+            # R-7.2-04: every repeated sequence starts again with a break.
+            brk: bool | None = True if (force_break or sequence > 0) else None
+            for retry in range(per_sequence + 1):
+                if retry:
+                    self.link.wait_until(self._retry_time(exchange, sequence, per_sequence))
+                attempt = self._attempt(
+                    wire,
+                    text[0],
+                    command,
+                    brk=brk if retry == 0 else None,
+                    binary=binary,
+                    crc=crc,
+                )
+                attempt.sequence, attempt.retry = sequence, retry
+                exchange.attempts.append(attempt)
+                if attempt.ok:
+                    self._note_accepted(command)
+                    return exchange
+        return exchange
+
+    def raw(
+        self,
+        text: str | bytes,
+        *,
+        break_first: bool | None = None,
+        gap: float = 0.0,
+        parity: bool = True,
+        binary: bool = False,
+    ) -> Exchange:
+        """Send arbitrary characters once (malformed commands, foreign addresses, partial
+        commands with a ``gap`` of marking between characters) and record what came back.
+
+        ``parity`` adds even parity to each 7-bit character; False sends the bytes as given
+        (wrong parity on purpose). ``break_first`` None applies the usual break rules to the
+        first character as address; True/False forces or suppresses the break.
+        """
+        data = text.encode("latin-1") if isinstance(text, str) else text
+        wire = bytes(to_wire_7e1(b) if parity else b for b in data)
+        shown = data.decode("latin-1")
+        try:
+            command: Command | None = cmds.parse_command(shown)
+        except CommandError:
+            command = None
+        address = chr(data[0] & 0x7F) if data else ""
+        attempt = self._attempt(wire, address, command, brk=break_first, binary=binary, gap=gap)
+        return Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
+
+    def send_break(self) -> Event:
+        """A break of ``policy.break_duration`` then ``policy.post_break_marking`` of marking
+        (R-7.0-02, R-7.0-06), after letting the DUT release the line (R-7.0-11)."""
+        self.link.wait_until(self._earliest_transmit())
+        event = self.link.send_break(self.policy.break_duration)
+        self.last_break_end = event.end
+        self.link.wait(self.policy.post_break_marking)
+        return event
+
+    # -- conveniences ----------------------------------------------------------------------
+    def acknowledge(self, address: str | None = None) -> Exchange:
+        return self.transact(cmds.acknowledge(address or self.address))
+
+    def identify(self, address: str | None = None) -> Exchange:
+        return self.transact(cmds.identify(address or self.address))
+
+    def query_address(self) -> Exchange:
+        return self.transact(cmds.query_address())
+
+    def change_address(self, new: str, address: str | None = None) -> Exchange:
+        exchange = self.transact(cmds.change_address(address or self.address, new))
+        if exchange.ok and (address or self.address) == self.address:
+            self.address = new
+        return exchange
+
+    # -- measurements ----------------------------------------------------------------------
+    def measure(self, command: Command, *, collect: bool = True, wait: str = "auto") -> Measurement:
+        """Start a measurement, wait for its data, and (``collect``) read D0.. / DB0...
+
+        ``wait``: "auto" follows the standard (service request for M/V, ttt for C/HA/HB);
+        "ttt" waits the full ttt even for M/V (ignoring a service request but recording it);
+        "none" does not wait at all (probing early D commands).
+        """
+        if not command.starts_measurement:
+            raise ValueError(f"{command} does not start a measurement")
+        if wait not in ("auto", "ttt", "none"):
+            raise ValueError(f"unknown wait mode {wait!r}")
+        start = self.transact(command)
+        m = Measurement(command, start)
+        if not start.ok:
+            return m
+        parsed = validity.parse_start_reply(start.reply_text, validity.count_digits(command))
+        assert parsed is not None  # an accepted reply has the atttn shape
+        m.ttt, m.count = parsed
+        m.reply_end = start.reply_events[-1].end
+        if m.ttt > 0 and wait != "none":
+            self._wait_for_data(m, service_request=wait == "auto" and _raises_sr(command))
+        if collect:
+            self.collect(m)
+        return m
+
+    def collect(
+        self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
+    ) -> Measurement:
+        """Read D0, D1, ... (DB0, DB1, ... after HB) until ``m.count`` values are in.
+
+        Stops on an invalid reply (after retries), an empty reply (aborted measurement,
+        R-4.4.8-05), the empty binary packet (R-5.2-08) or the last index the command family
+        allows (D9, or D999 after HA/HB without leading zeros, R-5.1-04). Continues after the
+        last index already collected, so it can be called again. ``force_break`` for the first
+        D command defaults to "ttt ran out without a service request" (R-4.4.5-05).
+        """
+        if m.count is None:
+            return m
+        address = m.command.address
+        limit = 999 if m.command.kind in _HIGH_VOLUME else 9
+        if max_index is not None:
+            limit = min(limit, max_index)
+        crc = m.command.returns_crc
+        if force_break is None:
+            force_break = bool(m.ttt) and m.service_request_end is None
+        index = len(m.data)
+        while index <= limit and m.value_count < m.count:
+            if m.binary:
+                exchange = self.transact(
+                    cmds.binary_data(address, index), binary=True, force_break=force_break
+                )
+            else:
+                exchange = self.transact(
+                    cmds.data(address, index), force_break=force_break, crc=crc
+                )
+            force_break = False
+            m.data.append(exchange)
+            if not exchange.ok or not self._take_values(m, exchange, crc):
+                break
+            index += 1
+        return m
+
+    def abort(self, m: Measurement, command: Command | str | None = None) -> Event | Exchange:
+        """Abort ``m`` on purpose: with a break (R-4.4.5.1-01) or with ``command`` sent to the
+        sensor (a concurrent abort, R-4.4.7.1-01). Recorded in ``m.aborted_by``."""
+        if command is None:
+            m.aborted_by = "break"
+            return self.send_break()
+        exchange = self.transact(command)
+        m.aborted_by = exchange.text
+        return exchange
+
+    # -- internals -------------------------------------------------------------------------
+    def _note_accepted(self, command: Command) -> None:
+        if command.starts_measurement:
+            self._crc_pending[command.address] = command.returns_crc
+
+    def _take_values(self, m: Measurement, exchange: Exchange, crc: bool) -> bool:
+        """Add an accepted D/DB reply's values to ``m``; False if it held none (stop)."""
+        if m.binary:
+            packet = exchange.reply_bytes
+            m.packets.append(packet)
+            count = validity.packet_value_count(packet)
+            m.binary_value_count += count
+            return count > 0
+        values = split_values(validity.data_values_text(exchange.reply_text, crc))
+        m.values.extend(values)
+        return bool(values)
+
+    def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+        """Wait out ttt, recording every DUT character; with ``service_request`` stop at the
+        first ``a<CR><LF>`` (R-4.4.5-04, R-4.4.6). Keeps listening ``late_sr_grace`` past ttt
+        so a late service request is evidence, not a miss."""
+        assert m.reply_end is not None and m.ttt is not None
+        ready = m.reply_end + m.ttt
+        if not service_request:
+            m.waited_events.extend(self.link.receive(ready + self.policy.ttt_margin))
+            m.service_request_end = _service_request_end(m.waited_events, m.command.address)
+            return
+        deadline = ready + max(self.policy.late_sr_grace, self.policy.ttt_margin)
+        while self.link.now() < deadline:
+            got = self.link.receive(deadline, until=validity.ends_line)
+            m.waited_events.extend(got)
+            end = _service_request_end(m.waited_events, m.command.address)
+            if end is not None:
+                m.service_request_end = end
+                return
+            if not got:
+                return
+
+    def _earliest_transmit(self) -> float:
+        """Now, or later if the DUT may still hold the line after its last character."""
+        last_dut = _last_dut_char_end(self.link)
+        return max(self.link.now(), last_dut + self.policy.turnaround)
+
+    def _needs_break(self, address: str, at: float) -> bool:
+        """R-7.0-17 / R-7.1-01: break for a new address or after > 87 ms of marking."""
+        if self.last_address is None or address != self.last_address:
+            return True
+        window = NO_BREAK_WINDOW - self.policy.window_margin - self.link.info.timing_uncertainty
+        return at - self.link.last_activity() > window
+
+    def _transmit(
+        self, wire: bytes, address: str, brk: bool | None, gap: float
+    ) -> tuple[Event | None, list[Event]]:
+        at = self._earliest_transmit()
+        break_event = None
+        if brk or (brk is None and self._needs_break(address, at)):
+            break_event = self.send_break()
+        else:
+            self.link.wait_until(at)
+        events = self.link.write(wire, gap)  # gap 0: back to back, R-7.0-13
+        self.last_address = address
+        return break_event, events
+
+    def _attempt(
+        self,
+        wire: bytes,
+        address: str,
+        command: Command | None,
+        *,
+        brk: bool | None,
+        binary: bool,
+        crc: bool | None = None,
+        gap: float = 0.0,
+    ) -> Attempt:
+        stray = self.link.receive(self.link.now())  # queued chatter is not this reply
+        break_event, sent = self._transmit(wire, address, brk, gap)
+        command_end = sent[-1].end if sent else self.link.now()
+        reply, state = self._listen(command_end, binary)
+        if state is None:
+            state = self._judge_reply(reply, command, address, command_end, binary, crc)
+        return Attempt(break_event, sent, reply, state, self.link.now(), stray_events=stray)
+
+    def _listen(self, command_end: float, binary: bool) -> tuple[list[Event], str | None]:
+        """Read one reply: the first start bit within ``first_char_timeout``, then until CR LF
+        (or the packet's size says it is complete), marking for ``reply_idle``, or
+        ``max_reply_chars``. Returns the characters and NO_REPLY/IDLE/TOO_LONG, or None when
+        the reply finished and needs checking."""
+        p = self.policy
+        first = self.link.receive(command_end + p.first_char_timeout, until=lambda got: True)
+        if not first:
+            return [], NO_REPLY
+        limit = p.max_binary_bytes if binary else p.max_reply_chars
+
+        def finished(chars: list[Event]) -> bool:
+            if binary:
+                length = packet_length(decode_8n1(chars))
+                return length is not None and len(chars) >= length
+            return validity.ends_line(chars)
+
+        def done(more: list[Event]) -> bool:
+            chars = first + more
+            return len(chars) >= limit or finished(chars)
+
+        # Hard bound even for a DUT that trickles characters just inside reply_idle. Each read
+        # also ends reply_idle after the last character so far: the link's own idle rule only
+        # starts once that read has received something.
+        deadline = first[0].start + limit * (CHAR_TIME + p.reply_idle)
+        chars = first
+        while not done(chars[len(first) :]):
+            until_idle = min(deadline, chars[-1].end + p.reply_idle)
+            more = self.link.receive(
+                until_idle,
+                until=lambda m, have=chars: done(have[len(first) :] + m),
+                idle=p.reply_idle,
+            )
+            if not more:
+                break
+            chars = chars + more
+        if finished(chars):
+            return chars, None
+        return chars, TOO_LONG if len(chars) >= limit else IDLE
+
+    def _judge_reply(
+        self,
+        reply: list[Event],
+        command: Command | None,
+        address: str,
+        command_end: float,
+        binary: bool,
+        crc: bool | None,
+    ) -> str:
+        if binary:
+            why = validity.check_packet(reply, address=address, command_end=command_end)
+        else:
+            gap_limit = CHAR_TIME + TOLERANCE + self.link.info.timing_uncertainty
+            why = validity.check_ascii(
+                command,
+                reply,
+                address=address,
+                command_end=command_end,
+                gap_limit=gap_limit,
+                crc_expected=crc,
+            )
+        return OK if why is None else f"invalid: {why}"
+
+    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+        """When the next retry (no break) starts, per R-7.2-02/03/06.
+
+        ``retry_gap`` after the end of the invalid reply (it must have finished) or of the
+        first-character timeout; never sooner than 16.67 ms after the command's last stop bit;
+        for no reply never later than 87 ms after it. The last retry of a sequence is pushed
+        past 100 ms after the break if no earlier retry was, so a sensor that needs its full
+        100 ms to wake still gets one try. With fewer than two retries that can exceed the 87
+        ms window; the break rule then puts a break in front (R-7.0-17) rather than break it.
+        """
+        p = self.policy
+        prev = exchange.last
+        assert prev.command_end is not None
+        base = prev.reply_events[-1].end if prev.reply_events else prev.end
+        time = max(prev.command_end + RETRY_MIN + p.window_margin, base + p.retry_gap)
+        if not prev.reply_events:
+            time = min(time, prev.command_end + RETRY_MAX - p.window_margin)
+        retries = [a for a in exchange.attempts if a.sequence == sequence and a.retry > 0]
+        is_last = len(retries) + 1 == per_sequence
+        wake = self.last_break_end + RETRY_AFTER_BREAK + p.window_margin
+        if is_last and not any(a.command_events[0].start > wake for a in retries):
+            time = max(time, wake)
+        return max(time, self.link.now())
+
+
+def _raises_sr(command: Command) -> bool:
+    """M family and V answer with a service request (R-4.4.6-02, decision A5)."""
+    return command.kind in SERVICE_REQUEST_KINDS
+
+
+def _service_request_end(events: list[Event], address: str) -> float | None:
+    """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
+    for i in range(2, len(events)):
+        tail = events[i - 2 : i + 1]
+        if decode_7e1(tail) == f"{address}\r\n" and all(e.parity_ok for e in tail):
+            return tail[-1].end
+    return None
+
+
+def _last_dut_char_end(link: Link) -> float:
+    for event in reversed(link.transcript.events):
+        if event.kind is EventKind.CHAR and event.origin != TOOL:
+            return event.end
+    return float("-inf")

@@ -1,0 +1,189 @@
+"""The engine's own, deliberately loose, idea of a "valid reply" (section 7.2).
+
+A recorder must retry on an invalid reply (bad format, parity, framing, CRC, contention,
+R-7.2-05) and stop retrying once a valid one is in. That decision needs a validity test, but
+it is *not* the conformance verdict: judges apply the full response grammar with requirement
+IDs. Here a reply only has to be recognisably the answer to the command (address, CR LF,
+parity, CRC where one is due, the rough shape of the reply) so that the engine neither
+retries a merely imperfect reply nor accepts garbage as data.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..protocol.binary import EMPTY_LEN, DataType, packet_length, type_size
+from ..protocol.commands import ADDRESS_CHARS, Command, Kind
+from ..protocol.crc import ascii_crc, binary_crc, is_crc_char
+from ..transcript import Event, decode_7e1, decode_8n1, escape
+
+CRLF = "\r\n"
+_TYPE_CODES = frozenset(int(t) for t in DataType)  # R-5.2.1-01: codes above 10 are invalid
+_VALUES = re.compile(r"([+-][0-9.]+)*")
+
+#: ttt + count digits of each measurement reply: atttn, atttnn, atttnnn.
+_COUNT_DIGITS = {
+    Kind.MEASURE: 1,
+    Kind.VERIFY: 1,
+    Kind.CONCURRENT: 2,
+    Kind.HIGH_VOLUME_ASCII: 3,
+    Kind.HIGH_VOLUME_BINARY: 3,
+}
+
+
+def count_digits(command: Command) -> int:
+    """n/nn/nnn width of the reply to a measurement (or identify-measurement) command."""
+    kind = command.target.kind if command.target is not None else command.kind
+    return _COUNT_DIGITS[kind]
+
+
+def parse_start_reply(text: str, digits: int) -> tuple[int, int] | None:
+    """``(ttt, count)`` from ``atttn<CR><LF>`` (or nn/nnn); None if it is not that shape."""
+    m = re.fullmatch(rf".([0-9]{{3}})([0-9]{{{digits}}})\r\n", text, flags=re.DOTALL)
+    return (int(m[1]), int(m[2])) if m else None
+
+
+def ends_line(events: list[Event]) -> bool:
+    """The characters so far end in CR LF (7-bit, parity ignored)."""
+    return len(events) >= 2 and events[-2].char7 == 0x0D and events[-1].char7 == 0x0A
+
+
+def packet_value_count(data: bytes) -> int:
+    """Values inside a complete packet: payload size over the type's size (0 if unusable)."""
+    length = packet_length(data)
+    if length is None or len(data) < length or data[3] not in _TYPE_CODES:
+        return 0
+    size = type_size(data[3])
+    return (length - EMPTY_LEN) // size if size else 0
+
+
+def split_crc(body: str, crc_expected: bool | None) -> tuple[str, str | None]:
+    """Cut a trailing 3-character CRC off ``body`` (address + values [+ CRC]).
+
+    ``crc_expected`` None means "not known" (a D command sent on its own): a CRC is then
+    taken off only if the last three characters can only be CRC characters.
+    """
+    tail = body[-3:]
+    has_crc = len(body) >= 4 and all(is_crc_char(c) for c in tail)
+    if crc_expected or (crc_expected is None and has_crc):
+        return body[:-3], tail
+    return body, None
+
+
+def data_values_text(reply: str, crc_expected: bool | None) -> str:
+    """The ``<values>`` part of a D/R reply: address, CRC and CR LF removed."""
+    body = reply[:-2] if reply.endswith(CRLF) else reply
+    return split_crc(body, crc_expected)[0][1:]
+
+
+def _reply_address(command: Command) -> str | None:
+    """The address the reply must start with; None means any address character."""
+    if command.kind is Kind.QUERY_ADDRESS:
+        return None
+    if command.kind is Kind.CHANGE_ADDRESS:
+        return command.new_address
+    return command.address
+
+
+def _crc_problem(body: str, crc_expected: bool | None) -> str | None:
+    checked, crc = split_crc(body, crc_expected)
+    if crc is None:
+        if crc_expected is False and any(is_crc_char(c) for c in body[1:]):
+            return "unexpected CRC characters"
+        return None
+    if len(body) < 4:
+        return "missing CRC"
+    if crc != ascii_crc(checked):
+        return f"CRC {escape(crc)} should be {escape(ascii_crc(checked))}"
+    return None
+
+
+def _shape_problem(command: Command, body: str, crc_expected: bool | None) -> str | None:
+    """Loose reply shape per command family (the full grammar is the judges' business)."""
+    kind, rest = command.kind, body[1:]
+    if kind in (Kind.ACKNOWLEDGE, Kind.QUERY_ADDRESS, Kind.CHANGE_ADDRESS):
+        return None if rest == "" else "expected the address alone"
+    if kind is Kind.IDENTIFY:
+        return None if re.match(r"[0-9]{2}", rest) else "no 2-digit version after the address"
+    if command.starts_measurement or kind is Kind.IDENTIFY_MEASUREMENT:
+        digits = 3 + count_digits(command)
+        return (
+            None
+            if re.fullmatch(rf"[0-9]{{{digits}}}", rest)
+            else f"not {digits} digits after the address"
+        )
+    if kind in (Kind.DATA, Kind.CONTINUOUS):
+        crc = command.crc if kind is Kind.CONTINUOUS else crc_expected
+        problem = _crc_problem(body, crc)
+        if problem:
+            return problem
+        if not _VALUES.fullmatch(split_crc(body, crc)[0][1:]):
+            return "values are not sign-separated numbers"
+        return None
+    if kind is Kind.METADATA:
+        assert command.target is not None
+        crc = command.target.returns_crc
+        problem = _crc_problem(body, crc)
+        if problem:
+            return problem
+        fields = split_crc(body, crc)[0][1:]
+        ok = fields == "" or (fields.startswith(",") and fields.endswith(";"))
+        return None if ok else "not ',field,...;'"
+    return None  # extended commands: address and CR LF are all the standard fixes
+
+
+def check_ascii(
+    command: Command | None,
+    events: list[Event],
+    *,
+    address: str,
+    command_end: float,
+    gap_limit: float,
+    crc_expected: bool | None = None,
+) -> str | None:
+    """Why a finished 7E1 reply is invalid (R-7.2-05), or None if the engine accepts it.
+
+    ``address`` is used when the command could not be parsed (raw probes).
+    """
+    if events and events[0].start < command_end:
+        return "bus contention (reply started during the command)"
+    bad = next((i for i, e in enumerate(events) if not e.parity_ok), None)
+    if bad is not None:
+        return f"parity error in character {bad + 1}"
+    for i in range(1, len(events)):
+        gap = events[i].start - events[i - 1].end
+        if gap > gap_limit:
+            return f"{gap * 1e3:.2f} ms of marking inside the reply"
+    text = decode_7e1(events)
+    if not text.endswith(CRLF):
+        return "no CR LF at the end"
+    body = text[:-2]
+    if not body:
+        return "no address"
+    if any(not 0x20 <= ord(c) <= 0x7E for c in body):
+        return "non-printable character in the reply"
+    expected = _reply_address(command) if command is not None else address
+    if expected is None and body[0] not in ADDRESS_CHARS:
+        return f"{escape(body[0])} is not an address character"
+    if expected is not None and body[0] != expected:
+        return f"reply from address {escape(body[0])}, expected {escape(expected)}"
+    return _shape_problem(command, body, crc_expected) if command is not None else None
+
+
+def check_packet(events: list[Event], *, address: str, command_end: float) -> str | None:
+    """Why a finished 8N1 ``aDBn!`` reply is invalid, or None (R-5.2-02/03, R-5.2-08)."""
+    if events and events[0].start < command_end:
+        return "bus contention (reply started during the command)"
+    data = decode_8n1(events)
+    length = packet_length(data)
+    if length is None or len(data) < length:
+        return f"packet cut short after {len(data)} bytes"
+    if len(data) > length:
+        return f"{len(data) - length} bytes after the packet"
+    if chr(data[0]) != address:
+        return f"packet from address {escape(data[:1])}, expected {escape(address)}"
+    if data[3] not in _TYPE_CODES:
+        return f"data type {data[3]} is not defined"
+    if binary_crc(data[:-2]) != data[-2:]:
+        return "binary CRC mismatch"
+    return None
