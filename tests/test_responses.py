@@ -13,6 +13,7 @@ from conformance.protocol.responses import (
     Violation,
     check_address,
     check_address_reply,
+    check_change_address_reply,
     check_measurement_count,
     expected_value_limit,
     is_service_request,
@@ -93,6 +94,14 @@ def test_check_address_reply(requirement: str) -> None:
     assert ids(check_address_reply("5", "0", requirement)) == ["R-4.3-01"]
     assert ids(check_address_reply("01", "0", requirement)) == [requirement]
     assert requirement in ids(check_address_reply("", "0", requirement))
+
+
+def test_check_change_address_reply() -> None:
+    assert check_change_address_reply("3", "0", "3") == []
+    assert check_change_address_reply("0", "0", "3") == []  # refused: old address comes back
+    assert ids(check_change_address_reply("5", "0", "3")) == ["R-4.4.4-01"]
+    assert ids(check_change_address_reply("3\r", "0", "3")) == ["R-4.4.4-01"]
+    assert ids(check_change_address_reply("#", "0", "3")) == ["R-4.3-04"]
 
 
 def test_service_request() -> None:

@@ -31,6 +31,7 @@ __all__ = [
     "split_line",
     "check_address",
     "check_address_reply",
+    "check_change_address_reply",
     "is_service_request",
     "Identification",
     "parse_ident",
@@ -126,6 +127,21 @@ def check_address_reply(body: str, expected: str | None, requirement: str) -> li
     if len(body) != 1:
         found.append(
             Violation(requirement, f"reply '{escape(body)}' is not a single address character")
+        )
+    return found
+
+
+def check_change_address_reply(body: str, old: str, new: str) -> list[Violation]:
+    """``aAb!`` answers with the new address, or with the old one if the change failed
+    (R-4.4.4-01); whether it really changed is for a follow-up ``?!`` to show."""
+    found = check_address_reply(body, None, "R-4.4.4-01")
+    if len(body) == 1 and not found and body not in (old, new):
+        found.append(
+            Violation(
+                "R-4.4.4-01",
+                f"aAb! reply '{escape(body)}' is neither the new address '{escape(new)}' "
+                f"nor the old one '{escape(old)}'",
+            )
         )
     return found
 
