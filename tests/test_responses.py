@@ -14,6 +14,7 @@ from conformance.protocol.responses import (
     check_address,
     check_address_reply,
     check_change_address_reply,
+    check_data_sequence,
     check_measurement_count,
     expected_value_limit,
     is_service_request,
@@ -412,6 +413,35 @@ def test_parse_data_reply_for_measurements() -> None:
         parse_data_reply_for("0+1", c.high_volume_binary("0"))
     with pytest.raises(ValueError):
         parse_data_reply_for("0+1", c.identify("0"))
+
+
+def _replies(*bodies: str) -> list:
+    return [parse_data_reply(b, crc_expected=False, limit=75) for b in bodies]
+
+
+def test_data_sequence_clean() -> None:
+    assert check_data_sequence(_replies("0+1+2", "0+3"), 3, limit=4) == []
+    assert check_data_sequence(_replies("0+1"), 1, limit=35) == []
+    assert check_data_sequence([], 0, limit=35) == []
+
+
+@pytest.mark.parametrize(("announced", "bodies"), [(3, ("0+1+2",)), (1, ("0+1", "0+2"))])
+def test_data_sequence_count(announced: int, bodies: tuple[str, ...]) -> None:
+    assert ids(check_data_sequence(_replies(*bodies), announced, limit=2)) == ["R-4.4.8-03"]
+
+
+def test_data_sequence_split_value() -> None:
+    found = check_data_sequence(_replies("0+1.2", "034+5"), 2, limit=35)
+    # the cut-off tail also counts as a token of its own, so the total is off as well
+    assert ids(found) == ["R-4.4.8-03", "R-4.4.8.3-01"] and not found[1].warning
+
+
+def test_data_sequence_room_left_is_a_warning() -> None:
+    found = check_data_sequence(_replies("0+3.14", "0+2.718", "0+1.414"), 3, limit=35)
+    assert ids(found) == ["R-4.4.8.3-03", "R-4.4.8.3-03"]
+    assert all(v.warning for v in found)
+    assert check_data_sequence(_replies("0+3.14", "0+2.718"), 2, limit=10) == []
+    assert ids(check_data_sequence(_replies("0+3.14", "0+2.718"), 2, limit=11)) == ["R-4.4.8.3-03"]
 
 
 finite = st.floats(min_value=-9_999_999, max_value=9_999_999, allow_nan=False)

@@ -43,6 +43,7 @@ __all__ = [
     "DataReply",
     "parse_data_reply",
     "parse_data_reply_for",
+    "check_data_sequence",
     "expected_value_limit",
     "MetadataReply",
     "parse_metadata_reply",
@@ -459,6 +460,41 @@ def parse_data_reply_for(
         limit_requirement=limit_req,
         crc_requirement=crc_req,
     )
+
+
+def check_data_sequence(replies: list[DataReply], announced: int, limit: int) -> list[Violation]:
+    """Rules that span the D0, D1, ... replies of one measurement.
+
+    R-4.4.8-03: the values add up to the announced count. R-4.4.8.3-01: a later reply whose
+    text starts without a sign continues a value cut off in the reply before. R-4.4.8.3-03
+    (a warning): a reply left room for the next reply's first value.
+    """
+    found = []
+    total = sum(len(r.values) for r in replies)
+    if total != announced:
+        found.append(
+            Violation("R-4.4.8-03", f"{total} values were returned for {announced} announced")
+        )
+    for index, (before, after) in enumerate(zip(replies, replies[1:], strict=False), start=1):
+        if not after.values:
+            continue
+        first = after.values[0]
+        if first[0] not in "+-":
+            found.append(
+                Violation(
+                    "R-4.4.8.3-01",
+                    f"D{index} starts with '{escape(first)}', the rest of a split value",
+                )
+            )
+        elif before.values and len(before.values_text) + len(first) <= limit:
+            found.append(
+                Violation(
+                    "R-4.4.8.3-03",
+                    f"D{index - 1} had room for '{escape(first)}' returned by D{index}",
+                    warning=True,
+                )
+            )
+    return found
 
 
 # -- aI..._nnn! ----------------------------------------------------------------------------
