@@ -258,3 +258,37 @@ def test_change_address_follows_the_sensor():
     master, _ = rig(ScriptedSensor({"0A3!": ["3\r\n"]}))
     ex = master.change_address("3")
     assert ex.ok and master.address == "3"
+
+
+# -- multi-line extended replies (4.4.13.1, decision A10) ---------------------------------------
+def test_multiline_text_read_across_line_pauses_until_etx():
+    line1 = Burst("0\x02First line.\r\n")
+    line2 = Burst("Second line.\r\n\x03", at=line1.end_offset + 0.120)
+    master, _ = rig(ScriptedSensor({"0XHELP!": [[line1, line2]]}))
+    ex = master.transact("0XHELP!")
+    assert ex.ok and len(ex.attempts) == 1
+    assert ex.reply_text == "0\x02First line.\r\nSecond line.\r\n\x03"
+
+
+def test_multiline_text_ends_when_next_line_is_over_150_ms_late():
+    line1 = Burst("0\x02First line.\r\n")
+    line2 = Burst("Late line.\r\n\x03", at=line1.end_offset + 0.200)
+    master, _ = rig(ScriptedSensor({"0XHELP!": [[line1, line2]]}, break_cancels=False))
+    ex = master.transact("0XHELP!")
+    assert ex.ok and ex.reply_text == "0\x02First line.\r\n"
+    assert ex.end - ex.reply_events[-1].end >= 0.150
+
+
+def test_stx_is_plain_garbage_for_non_extended_commands():
+    master, _ = rig(ScriptedSensor({"0I!": ["0\x0213\r\n"]}))
+    ex = master.transact("0I!", retries=False)
+    assert ex.last.reason == "invalid: non-printable character in the reply"
+
+
+def test_db_command_on_its_own_is_read_as_a_binary_packet():
+    from conformance.protocol.binary import DataType, build_packet
+
+    packet = build_packet("0", DataType.INT8, [-1, -2])
+    master, _ = rig(ScriptedSensor({"0DB0!": [packet]}))
+    ex = master.transact("0DB0!")
+    assert ex.binary and ex.ok and ex.reply_bytes == packet

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from ..links.base import Link
 from ..protocol import commands as cmds
-from ..protocol.binary import packet_length
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind
 from ..protocol.timing import (
     CHAR_TIME,
@@ -24,8 +23,9 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..protocol.values import split_values
-from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, to_wire_7e1
+from ..transcript import TOOL, Event, EventKind, decode_7e1, to_wire_7e1
 from . import validity
+from .framing import Framing
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
 
@@ -54,7 +54,7 @@ class Master:
         self,
         command: Command | str,
         *,
-        binary: bool = False,
+        binary: bool | None = None,
         force_break: bool = False,
         retries: bool = True,
         expect_reply: bool = True,
@@ -62,14 +62,17 @@ class Master:
     ) -> Exchange:
         """Send ``command`` with the break and retry rules of section 7 and record it all.
 
-        ``binary`` reads the reply as an 8N1 packet (``aDBn!``). ``retries=False`` or
-        ``expect_reply=False`` sends once (observation cases: silence may be the point).
+        ``binary`` reads the reply as an 8N1 packet; None does so for ``aDBn!`` only.
+        ``retries=False`` or ``expect_reply=False`` sends once (observation cases: silence
+        may be the point).
         ``crc`` says whether a D reply carries a CRC; None takes it from the last measurement
         this engine started at that address.
         """
         if isinstance(command, str):
             command = cmds.parse_command(command)
         text = command.text()
+        if binary is None:
+            binary = command.kind is Kind.BINARY_DATA
         if crc is None and command.kind in (Kind.DATA, Kind.BINARY_DATA):
             crc = self._crc_pending.get(command.address)
         wire = bytes(to_wire_7e1(ord(c)) for c in text)
@@ -300,50 +303,47 @@ class Master:
         stray = self.link.receive(self.link.now())  # queued chatter is not this reply
         break_event, sent = self._transmit(wire, address, brk, gap)
         command_end = sent[-1].end if sent else self.link.now()
-        reply, state = self._listen(command_end, binary)
+        p = self.policy
+        framing = Framing(
+            idle=p.reply_idle,
+            max_chars=p.max_binary_bytes if binary else p.max_reply_chars,
+            binary=binary,
+            multiline=not binary and (command is None or command.kind is Kind.EXTENDED),
+            max_text_chars=p.max_text_chars,
+        )
+        reply, state = self._listen(command_end, framing)
         if state is None:
-            state = self._judge_reply(reply, command, address, command_end, binary, crc)
+            state = self._judge_reply(reply, command, address, command_end, framing, crc)
         return Attempt(break_event, sent, reply, state, self.link.now(), stray_events=stray)
 
-    def _listen(self, command_end: float, binary: bool) -> tuple[list[Event], str | None]:
-        """Read one reply: the first start bit within ``first_char_timeout``, then until CR LF
-        (or the packet's size says it is complete), marking for ``reply_idle``, or
-        ``max_reply_chars``. Returns the characters and NO_REPLY/IDLE/TOO_LONG, or None when
-        the reply finished and needs checking."""
-        p = self.policy
-        first = self.link.receive(command_end + p.first_char_timeout, until=lambda got: True)
+    def _listen(self, command_end: float, framing: Framing) -> tuple[list[Event], str | None]:
+        """Read one reply: the first start bit within ``first_char_timeout``, then until the
+        framing says it is complete, the line marks for the framing's window, or the DUT has
+        sent too much. Returns the characters and NO_REPLY/IDLE/TOO_LONG, or None when the
+        reply finished and needs checking. Every read has a deadline."""
+        first = self.link.receive(
+            command_end + self.policy.first_char_timeout, until=lambda got: True
+        )
         if not first:
             return [], NO_REPLY
-        limit = p.max_binary_bytes if binary else p.max_reply_chars
-
-        def finished(chars: list[Event]) -> bool:
-            if binary:
-                length = packet_length(decode_8n1(chars))
-                return length is not None and len(chars) >= length
-            return validity.ends_line(chars)
-
-        def done(more: list[Event]) -> bool:
-            chars = first + more
-            return len(chars) >= limit or finished(chars)
-
-        # Hard bound even for a DUT that trickles characters just inside reply_idle. Each read
-        # also ends reply_idle after the last character so far: the link's own idle rule only
-        # starts once that read has received something.
-        deadline = first[0].start + limit * (CHAR_TIME + p.reply_idle)
+        deadline = framing.deadline(first[0])
         chars = first
-        while not done(chars[len(first) :]):
-            until_idle = min(deadline, chars[-1].end + p.reply_idle)
+        while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
+            # Each read ends a window after the last character so far: the link's own idle
+            # rule only starts once that read has received something.
             more = self.link.receive(
-                until_idle,
-                until=lambda m, have=chars: done(have[len(first) :] + m),
-                idle=p.reply_idle,
+                min(deadline, chars[-1].end + framing.window(chars)),
+                until=lambda m, have=chars: framing.stop(have + m),
+                idle=framing.idle,
             )
             if not more:
+                if framing.at_line_end(chars):
+                    return chars, None  # no next line within 150 ms: the text is complete
                 break
             chars = chars + more
-        if finished(chars):
+        if framing.finished(chars):
             return chars, None
-        return chars, TOO_LONG if len(chars) >= limit else IDLE
+        return chars, TOO_LONG if len(chars) >= framing.limit(chars) else IDLE
 
     def _judge_reply(
         self,
@@ -351,10 +351,10 @@ class Master:
         command: Command | None,
         address: str,
         command_end: float,
-        binary: bool,
+        framing: Framing,
         crc: bool | None,
     ) -> str:
-        if binary:
+        if framing.binary:
             why = validity.check_packet(reply, address=address, command_end=command_end)
         else:
             gap_limit = CHAR_TIME + TOLERANCE + self.link.info.timing_uncertainty
@@ -365,6 +365,7 @@ class Master:
                 command_end=command_end,
                 gap_limit=gap_limit,
                 crc_expected=crc,
+                multiline=framing.is_text(reply),
             )
         return OK if why is None else f"invalid: {why}"
 

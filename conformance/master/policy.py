@@ -35,6 +35,8 @@ class Policy:
     # Bounds so a babbling DUT cannot hang the engine.
     max_reply_chars: int = 300
     max_binary_bytes: int = 1010
+    # Multi-line extended replies (a<STX>...<ETX>, 4.4.13.1) may be long help texts.
+    max_text_chars: int = 4000
     # Where inside the 16.67-87 ms retry window the retry goes: this long after the end of
     # the invalid reply or of the first-character timeout (R-7.2-02, R-7.2-06).
     retry_gap: float = 25e-3

@@ -18,6 +18,7 @@ from ..protocol.crc import ascii_crc, binary_crc, is_crc_char
 from ..transcript import Event, decode_7e1, decode_8n1, escape
 
 CRLF = "\r\n"
+STX, ETX = 0x02, 0x03  # multi-line text markers (4.4.13.1)
 _TYPE_CODES = frozenset(int(t) for t in DataType)  # R-5.2.1-01: codes above 10 are invalid
 _VALUES = re.compile(r"([+-][0-9.]+)*")
 
@@ -140,10 +141,12 @@ def check_ascii(
     command_end: float,
     gap_limit: float,
     crc_expected: bool | None = None,
+    multiline: bool = False,
 ) -> str | None:
     """Why a finished 7E1 reply is invalid (R-7.2-05), or None if the engine accepts it.
 
-    ``address`` is used when the command could not be parsed (raw probes).
+    ``address`` is used when the command could not be parsed (raw probes). ``multiline``:
+    an ``a<STX>...<CR><LF><ETX>`` text, where the pauses between lines are allowed.
     """
     if events and events[0].start < command_end:
         return "bus contention (reply started during the command)"
@@ -151,10 +154,14 @@ def check_ascii(
     if bad is not None:
         return f"parity error in character {bad + 1}"
     for i in range(1, len(events)):
+        if multiline and events[i - 1].char7 == 0x0A:
+            continue  # between lines: up to 150 ms (R-4.4.13.1-03), judged elsewhere
         gap = events[i].start - events[i - 1].end
         if gap > gap_limit:
             return f"{gap * 1e3:.2f} ms of marking inside the reply"
     text = decode_7e1(events)
+    if multiline:
+        return _text_problem(text, address if command is None else command.address)
     if not text.endswith(CRLF):
         return "no CR LF at the end"
     body = text[:-2]
@@ -168,6 +175,24 @@ def check_ascii(
     if expected is not None and body[0] != expected:
         return f"reply from address {escape(body[0])}, expected {escape(expected)}"
     return _shape_problem(command, body, crc_expected) if command is not None else None
+
+
+def _text_problem(text: str, address: str) -> str | None:
+    """A multi-line text: address, STX, lines ending CR LF, ETX after the last one.
+
+    A text whose ETX never came is still accepted once 150 ms passed after a complete line:
+    the recorder then concludes that no more lines follow (R-4.4.13.1-04); the missing ETX is
+    the judges' finding, not a reason to ask again.
+    """
+    body = text[:-1] if text.endswith(CRLF + chr(ETX)) else text
+    if not body.endswith(CRLF):
+        return "multi-line text does not end in CR LF"
+    if text[0] != address:
+        return f"reply from address {escape(text[0])}, expected {escape(address)}"
+    lines = body[2:-2].split(CRLF)
+    if any(not 0x20 <= ord(c) <= 0x7E for line in lines for c in line):
+        return "non-printable character in the text"
+    return None
 
 
 def check_packet(events: list[Event], *, address: str, command_end: float) -> str | None:

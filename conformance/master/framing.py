@@ -1,0 +1,63 @@
+"""Where a reply ends: CR LF, a binary packet's size field, or a multi-line text's ETX.
+
+Reading a reply is "receive until the reply is complete, the line goes quiet, or the DUT has
+sent too much". What "complete" and "quiet" mean depends on the reply's framing, kept here so
+the engine's read loop stays one loop for all three kinds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..protocol.binary import packet_length
+from ..protocol.timing import MULTILINE_GAP_MAX, TOLERANCE
+from ..transcript import Event, decode_8n1
+from .validity import ETX, STX, ends_line
+
+
+@dataclass(frozen=True)
+class Framing:
+    """How to frame one reply.
+
+    ``binary``: an 8N1 packet framed by its size field (R-5.2-02, R-5.2-08).
+    ``multiline``: an ``a<STX>`` reply may run over several lines until ETX; after a line's
+    CR LF the next line may take up to 150 ms to start (R-4.4.13.1-03/04, decision A10).
+    """
+
+    idle: float  # marking after a character that ends an unfinished reply
+    max_chars: int
+    binary: bool = False
+    multiline: bool = False
+    max_text_chars: int = 0
+
+    def is_text(self, chars: list[Event]) -> bool:
+        """A multi-line text reply: STX right after the address."""
+        return self.multiline and len(chars) >= 2 and chars[1].char7 == STX
+
+    def limit(self, chars: list[Event]) -> int:
+        return max(self.max_chars, self.max_text_chars) if self.is_text(chars) else self.max_chars
+
+    def finished(self, chars: list[Event]) -> bool:
+        if self.binary:
+            length = packet_length(decode_8n1(chars))
+            return length is not None and len(chars) >= length
+        if self.is_text(chars):
+            return chars[-1].char7 == ETX
+        return ends_line(chars)
+
+    def at_line_end(self, chars: list[Event]) -> bool:
+        """Between lines of a multi-line text: the next line has 150 ms to start."""
+        return self.is_text(chars) and ends_line(chars)
+
+    def window(self, chars: list[Event]) -> float:
+        """How long the line may mark after the last character before the read stops."""
+        return MULTILINE_GAP_MAX + TOLERANCE if self.at_line_end(chars) else self.idle
+
+    def stop(self, chars: list[Event]) -> bool:
+        """Where one receive call returns so the loop can pick the next window."""
+        return len(chars) >= self.limit(chars) or self.finished(chars) or self.at_line_end(chars)
+
+    def deadline(self, first: Event) -> float:
+        """Hard bound for a DUT that trickles characters just inside each window."""
+        per_char = first.duration + max(self.idle, MULTILINE_GAP_MAX if self.multiline else 0.0)
+        return first.start + max(self.max_chars, self.max_text_chars) * per_char
