@@ -62,12 +62,22 @@ def test_late_service_request_is_recorded_and_answered():
 
 
 def test_wait_ttt_ignores_but_records_the_service_request():
-    script = {"0M!": [then_sr("00031\r\n", after=0.5)], "0D0!": ["0+2\r\n"]}
+    # The SR comes just before ttt: answering it would need no break, waiting out ttt does.
+    script = {"0M!": [then_sr("00031\r\n", after=2.95)], "0D0!": ["0+2\r\n"]}
     master, _ = rig(ScriptedSensor(script))
     m = master.measure(cmds.measure("0"), wait="ttt")
     assert m.service_request_end is not None
     d0 = first_d(m)
     assert d0.break_event is not None and d0.break_event.start >= m.reply_end + 3
+
+
+def test_wait_none_probes_d0_at_once():
+    script = {"0M!": ["00101\r\n"], "0D0!": ["0\r\n"]}
+    master, _ = rig(ScriptedSensor(script))
+    m = master.measure(cmds.measure("0"), wait="none")
+    d0 = first_d(m)
+    assert d0.break_event is None
+    assert d0.command_events[0].start - m.reply_end < NO_BREAK_WINDOW
 
 
 def test_concurrent_waits_ttt_records_chatter_then_breaks():

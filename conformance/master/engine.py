@@ -173,10 +173,15 @@ class Master:
         assert parsed is not None  # an accepted reply has the atttn shape
         m.ttt, m.count = parsed
         m.reply_end = start.reply_events[-1].end
+        use_sr = wait == "auto" and _raises_sr(command)
         if m.ttt > 0 and wait != "none":
-            self._wait_for_data(m, service_request=wait == "auto" and _raises_sr(command))
+            self._wait_for_data(m, service_request=use_sr)
         if collect:
-            self.collect(m)
+            # D0 goes without a forced break only right after an answered service request
+            # (R-7.1-01), for ttt = 0, or when probing early; after ttt it gets a break.
+            waited_out = m.ttt > 0 and wait != "none"
+            answered_sr = use_sr and m.service_request_end is not None
+            self.collect(m, force_break=waited_out and not answered_sr)
         return m
 
     def collect(
