@@ -72,7 +72,8 @@ def test_build_packet_rejections() -> None:
         build_packet("0", DataType.INT16, [])  # size 0 must be the type-0 empty packet
     with pytest.raises(ValueError):
         build_packet("0", DataType.UINT8, [0] * 1001)  # R-5.2-04
-    assert len(build_packet("0", DataType.UINT8, [0] * 1000)) == 1006
+    largest = build_packet("0", DataType.UINT8, [0] * 1000)
+    assert len(largest) == 1006 and parse_binary_packet(largest).violations == []
     assert len(build_packet("0", DataType.FLOAT64, [0.0] * 125)) == 1006
 
 
