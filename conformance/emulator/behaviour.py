@@ -1,0 +1,84 @@
+"""The emulator's tunable behaviour: section 7 timing numbers and behaviour switches.
+
+Every knob a fault can turn lives here with its conforming default, so the emulator's code
+reads one object instead of asking "is fault X active?" all over the place, and a fault is
+mostly a set of overrides (see :mod:`conformance.emulator.faults`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..protocol.timing import (
+    MARKING_AFTER_BREAK,
+    PARTIAL_COMMAND_GAP,
+    STANDBY_MARKING,
+    TOLERANCE,
+)
+
+#: Spacing at least this long is a break. R-7.0-03 forbids seeing a break under 6.5 ms and
+#: R-7.0-04 demands one above 12 ms; 9 ms sits in the middle, clear of both tolerances.
+BREAK_THRESHOLD = 9e-3
+#: First response start bit after the command's last stop bit: 8.33 ms of marking plus a
+#: margin (window 7.93..15.40 ms, R-7.0-09/10).
+REPLY_DELAY = 9.0e-3
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    # -- receiving (section 7) ---------------------------------------------------------------
+    break_threshold: float = BREAK_THRESHOLD
+    # Marking needed after a break before a start bit counts as an address (R-7.0-05). The
+    # lower tolerance edge, so a recorder that waits exactly 8.33 ms is never refused.
+    address_marking: float = MARKING_AFTER_BREAK - TOLERANCE
+    # Time after a break before the sensor can see start bits at all (R-7.0-07 allows 100 ms).
+    wake_delay: float = 0.0
+    # Marking inside a command that drops it (R-AppB-01), again at the lower tolerance edge.
+    partial_gap: float = PARTIAL_COMMAND_GAP - TOLERANCE
+    standby_marking: float = STANDBY_MARKING  # R-7.0-15
+    standby_after_foreign: bool = True  # R-7.0-14
+    standby_after_reply: bool = False  # True breaks R-7.0-16
+    standby_after_service_request: bool = False  # True breaks R-7.1-02
+    # -- transmitting ------------------------------------------------------------------------
+    reply_delay: float = REPLY_DELAY
+    char_gap: float = 0.0  # marking between reply characters (R-7.0-12)
+    # -- addressing --------------------------------------------------------------------------
+    answer_foreign: bool = False  # answer a!/aI! for any address (breaks R-4.0-01)
+    answer_query: bool = True
+    apply_address_change: bool = True
+    answer_old_address: bool = False
+    # -- service requests --------------------------------------------------------------------
+    service_request: bool = True
+    service_request_late: float | None = None  # send it this long after ttt instead
+    service_request_on_ttt_zero: bool = False
+    service_request_on_concurrent: bool = False
+    service_request_on_identify: bool = False
+    chatter_before_service_request: bool = False
+    # -- aborts ------------------------------------------------------------------------------
+    break_aborts_measure: bool = True  # R-4.4.5.1-01
+    abort_keeps_old_data: bool = False  # True breaks R-4.4.5.1-02 / R-4.4.7.1-02
+    deaf_after_abort: bool = False
+    break_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
+    foreign_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
+    command_aborts_concurrent: bool = True  # R-4.4.7.1-01
+    # -- data buffer -------------------------------------------------------------------------
+    clear_on_break_after_read: bool = False
+    clear_after_read: bool = False
+    clear_on_standby_after_read: bool = False
+    identify_clears_data: bool = False
+    # -- data replies ------------------------------------------------------------------------
+    limit_measure: int = 35  # <values> characters per D reply after M/V (R-4.4-05)
+    limit_concurrent: int = 75  # after C (R-4.4-05)
+    limit_high_volume: int = 75  # after HA (R-5.1-03)
+    limit_continuous: int = 75  # R replies (R-4.4.8.1-01)
+    pack_slack: int = 0  # values left out of each full M/V reply (R-4.4.8.3-03)
+    split_values: bool = False  # fill M/V replies to the limit, cutting a value
+    drop_all_values: bool = False  # a completed measurement holds no values
+    max_data_index: int = 999  # highest D index served after HA (R-5.1-02)
+    # -- other commands ----------------------------------------------------------------------
+    continuous_needs_r0: bool = False
+    answer_undefined_measure: bool = True
+    answer_undefined_concurrent: bool = True
+    answer_identify_measurement: bool = True
+    metadata_invalid_reply: bool = True
+    empty_packet: bool = True

@@ -1,0 +1,95 @@
+"""A reply under construction, and how it becomes wire frames.
+
+The emulator first describes a reply (its kind, the text up to where a CRC would go, whether a
+CRC follows, the terminator) and only then encodes it. Faults rewrite the description between
+those two steps, so a fault that corrupts values still gets a CRC computed over the corrupted
+text (the corruption is the only deviation), while a CRC fault can set the CRC text itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+from ..protocol.commands import Command
+from ..protocol.crc import ascii_crc, binary_crc
+from ..transcript import to_wire_7e1
+
+
+class ReplyKind(StrEnum):
+    ACKNOWLEDGE = "ack"  # a!
+    ADDRESS = "address"  # ?!
+    IDENTIFICATION = "ident"  # aI!
+    CHANGE_ADDRESS = "change-address"  # aAb!
+    START = "start"  # atttn / atttnn / atttnnn after a measurement command
+    IDENTIFY = "identify"  # the same shape after an identify-measurement command
+    SERVICE_REQUEST = "service-request"
+    CHATTER = "chatter"  # only ever sent by a fault
+    DATA = "data"  # aDn!
+    CONTINUOUS = "continuous"  # aRn! / aRCn!
+    METADATA = "metadata"  # aI<m>_nnn!
+    EXTENDED = "extended"
+    BINARY = "binary"  # aDBn! packet (8N1)
+
+
+@dataclass
+class BinaryParts:
+    """A high-volume binary packet before encoding (R-5.2-02): fields kept apart for faults."""
+
+    address: int
+    dtype: int
+    payload: bytes
+    crc: bytes | None = None  # None: the correct CRC, low byte first (R-5.2-03)
+
+    def encode(self) -> bytes:
+        head = bytes([self.address]) + len(self.payload).to_bytes(2, "little")
+        head += bytes([self.dtype])
+        crc = self.crc if self.crc is not None else binary_crc(head + self.payload)
+        return head + self.payload + crc
+
+
+@dataclass
+class Reply:
+    """One reply of the emulator.
+
+    ``command`` is what it answers (None for service requests); ``source`` is the measurement
+    command behind data, start and identify replies; ``digits`` the count width of start and
+    identify replies (1, 2 or 3); ``repeat`` how often this D page was sent before (so a fault
+    can make repeats differ). ``crc_text`` set by a fault replaces the computed CRC.
+    ``flip_parity`` lists character positions sent with the wrong parity bit.
+    """
+
+    kind: ReplyKind
+    body: str
+    command: Command | None = None
+    source: Command | None = None
+    crc: bool = False
+    crc_text: str | None = None
+    end: str = "\r\n"
+    digits: int = 0
+    repeat: int = 0
+    binary: BinaryParts | None = None
+    flip_parity: tuple[int, ...] = field(default=())
+
+    @property
+    def address(self) -> str:
+        return self.body[:1]
+
+    def text(self) -> str:
+        """Everything sent, as text (ASCII replies only)."""
+        crc = ""
+        if self.crc_text is not None:
+            crc = self.crc_text
+        elif self.crc:
+            crc = ascii_crc(self.body)
+        return self.body + crc + self.end
+
+    def wires(self) -> list[int]:
+        """The 8 wire bits of each frame: 7E1 for ASCII (R-4.1-02), raw 8N1 bytes for HB."""
+        if self.binary is not None:
+            return list(self.binary.encode())
+        frames = [to_wire_7e1(ord(c)) for c in self.text()]
+        for index in self.flip_parity:
+            if -len(frames) <= index < len(frames):
+                frames[index] ^= 0x80
+        return frames

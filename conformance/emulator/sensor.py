@@ -1,0 +1,475 @@
+"""The reference SDI-12 sensor: a sans-I/O state machine driven only by stamped bus events.
+
+The emulator never reads a clock. It hears breaks and characters with their start and end
+times (seconds on whatever clock the driver uses: the sim bus's virtual clock, or a real-time
+RFC 2217 server later) and offers its own output as frames with start times. Every idle-time
+rule of section 7 (standby after 100 ms of marking, 8.33 ms after a break, partial commands) is
+therefore computed from the gaps between stamps when the next stamp arrives.
+
+Line model:
+- A fresh emulator is in standby; only a break wakes it.
+- Spacing of at least ``break_threshold`` (9 ms) is a break; shorter spacing is noise that
+  spoils a command being received but wakes nothing (R-7.0-03/04).
+- The first character after a break must start at least 8.33 ms (-0.40) after it, otherwise
+  that command is ignored (R-7.0-05).
+- Line activity is any character on the wire (including the emulator's own) or a break.
+  100 ms of marking since the last activity means standby (R-7.0-15); a command for another
+  address means standby at once (R-7.0-14). Standby is left only through a break; sending a
+  service request also leaves the sensor listening, so ``aD0!`` may follow it without a
+  break (R-7.1-02).
+- Inside a command, 8.33 ms (-0.40) of marking before the next character drops the partial
+  command; that character starts a new one (R-AppB-01).
+
+Measurement model: any valid command for this sensor that arrives while a measurement is
+running aborts it (R-4.4.7.1-01 for C/HA/HB; for M/V it can only happen without a break in
+the 100 ms after ``atttn``). A break aborts M/V before its service request (R-4.4.5.1-01)
+but not C/HA/HB (R-4.4.7-05). Aborted or still-running measurements answer D with the empty
+reply, never partial data (decision A3).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from math import inf
+
+from ..protocol.binary import DataType, encode_values
+from ..protocol.commands import (
+    SERVICE_REQUEST_KINDS,
+    Command,
+    CommandError,
+    Kind,
+    parse_command,
+)
+from ..protocol.timing import CHAR_TIME
+from ..sim.bus import Frame
+from ..transcript import parity_bit
+from .faults import compose
+from .measurement import DataSet, Run, complete, empty_data
+from .profile import MeasurementSpec, Profile
+from .replies import BinaryParts, Reply, ReplyKind
+from .transmitter import Transmission, Transmitter
+
+#: Commands a v1.3 sensor does not know; it stays silent to them.
+V14_ONLY = frozenset(
+    {
+        Kind.HIGH_VOLUME_ASCII,
+        Kind.HIGH_VOLUME_BINARY,
+        Kind.BINARY_DATA,
+        Kind.IDENTIFY_MEASUREMENT,
+        Kind.METADATA,
+    }
+)
+_MAX_COMMAND = 64  # a command longer than this is noise; drop it rather than grow forever
+_COUNT_DIGITS = {
+    Kind.MEASURE: 1,
+    Kind.VERIFY: 1,
+    Kind.CONCURRENT: 2,
+    Kind.HIGH_VOLUME_ASCII: 3,
+    Kind.HIGH_VOLUME_BINARY: 3,
+}
+
+
+class SensorEmulator:
+    """A conforming SDI-12 sensor (v1.4, or v1.3 by profile) on a :class:`SimBus`-like driver.
+
+    ``faults`` names entries of :data:`conformance.emulator.faults.FAULTS`; they are applied in
+    order (later settings win, rewrites chain).
+    """
+
+    def __init__(self, profile: Profile, faults: Sequence[str] = (), name: str = "sensor") -> None:
+        self.name = name
+        self.faults = compose(faults)
+        self.profile = self.faults.apply_profile(profile)
+        self.behaviour = self.faults.behaviour
+        self.address = self.profile.address
+        self._old_addresses: set[str] = set()
+        self._tx = Transmitter()
+        # line state
+        self._awake = False
+        self._last_activity = -inf
+        self._wake_at = -inf
+        self._break_end: float | None = None
+        self._buf: list[str] = []
+        self._buf_start = 0.0
+        self._buf_end = 0.0
+        self._buf_invalid = False
+        self._buf_foreign = False
+        self._quiet_until = -inf
+        self._deaf = False
+        # measurement state
+        self._run: Run | None = None
+        self._data: DataSet | None = None
+        self._previous: DataSet | None = None
+        self._last_command: Command | None = None
+
+    # -- introspection (tests, CLI) ----------------------------------------------------------
+    @property
+    def data(self) -> DataSet | None:
+        """The data buffer (None before the first measurement or while one runs)."""
+        return self._data
+
+    @property
+    def running(self) -> Run | None:
+        return self._run
+
+    def awake(self, now: float) -> bool:
+        """Whether a command starting at ``now`` without a break would be heard."""
+        reference = max(self._last_activity, self._wake_at)
+        return self._awake and now >= self._wake_at and now - reference < self._standby_limit
+
+    @property
+    def _standby_limit(self) -> float:
+        return self.behaviour.standby_marking
+
+    # -- BusDevice: input --------------------------------------------------------------------
+    def on_break(self, start: float, end: float) -> None:
+        b = self.behaviour
+        self._settle(start)
+        idle_before = start - max(self._last_activity, self._wake_at) >= self._standby_limit
+        if end - start < b.break_threshold:
+            # too short for a break: noise on the line that ruins a command in progress
+            self._last_activity = max(self._last_activity, end)
+            if self._buf:
+                self._buf_invalid = True
+            return
+        if idle_before or not self._awake:
+            self._entered_standby()
+        self._deaf = False
+        run = self._run
+        if run is not None:
+            aborts = b.break_aborts_concurrent if run.concurrent else b.break_aborts_measure
+            if aborts:
+                self._abort()
+        # a break silences the sensor; only the service request of a still-running
+        # measurement survives it
+        running = self._run is not None
+        self._tx.cancel(
+            lambda t: running and t.reply.kind is ReplyKind.SERVICE_REQUEST and t.sent == 0
+        )
+        data = self._data
+        if b.clear_on_break_after_read and data is not None and data.fully_read:
+            self._data = data.emptied()
+        self._awake = True
+        self._wake_at = end + b.wake_delay
+        self._break_end = end
+        self._last_activity = end
+        self._buf = []
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        b = self.behaviour
+        self._settle(start)
+        heard = self._hear(start)
+        self._last_activity = max(self._last_activity, end)
+        if not heard:
+            self._buf = []
+            return
+        char7 = wire & 0x7F
+        char = chr(char7)
+        if self._buf and start - self._buf_end >= b.partial_gap:
+            self._buf = []  # R-AppB-01: marking inside a command drops it
+        if not self._buf:
+            self._begin_command(char, start)
+            if not self._awake:
+                return
+        self._buf.append(char)
+        self._buf_end = end
+        if (wire >> 7) != parity_bit(char7):
+            self._buf_invalid = True  # a parity error spoils the command
+        if char == "!":
+            text, invalid, begun = "".join(self._buf), self._buf_invalid, self._buf_start
+            foreign = self._buf_foreign
+            self._buf = []
+            if not invalid:
+                self._command(text, begun, end, foreign)
+        elif len(self._buf) > _MAX_COMMAND:
+            self._buf = []
+
+    def _hear(self, start: float) -> bool:
+        """Apply the idle rules at a start bit; False if the sensor cannot hear it."""
+        if start < self._wake_at:
+            return False  # still waking up after the break
+        reference = max(self._last_activity, self._wake_at)
+        if self._awake and start - reference >= self._standby_limit:
+            self._awake = False  # R-7.0-15: 100 ms of marking
+            self._entered_standby()
+        return self._awake
+
+    def _begin_command(self, char: str, start: float) -> None:
+        b = self.behaviour
+        early = self._break_end is not None and start - self._break_end < b.address_marking
+        self._break_end = None
+        self._buf_invalid = early  # R-7.0-05: an address this soon after a break is not seen
+        self._buf_start = start
+        self._buf_foreign = not self._addressed(char)
+        if not self._buf_foreign:
+            return
+        run = self._run
+        if run is not None and run.concurrent and b.foreign_aborts_concurrent:
+            self._abort()
+        if b.standby_after_foreign and not b.answer_foreign:
+            self._awake = False  # R-7.0-14
+            self._entered_standby()
+
+    def _addressed(self, char: str) -> bool:
+        if char in (self.address, "?"):
+            return True
+        return self.behaviour.answer_old_address and char in self._old_addresses
+
+    # -- BusDevice: output -------------------------------------------------------------------
+    def next_frame(self) -> Frame | None:
+        return self._tx.next_frame()
+
+    def pop_frame(self) -> Frame:
+        frame, item = self._tx.pop_frame()
+        self._last_activity = max(self._last_activity, frame.start + CHAR_TIME)
+        if item.done:
+            kind = item.reply.kind
+            if kind is ReplyKind.SERVICE_REQUEST:
+                self._awake = not self.behaviour.standby_after_service_request
+            elif kind is not ReplyKind.CHATTER and self.behaviour.standby_after_reply:
+                self._awake = False
+        return frame
+
+    # -- measurement bookkeeping -------------------------------------------------------------
+    def _settle(self, now: float) -> None:
+        """Turn a running measurement into data once its ready time has passed."""
+        run = self._run
+        if run is not None and run.ready_at <= now:
+            self._data = complete(run, self.behaviour)
+            self._run = None
+
+    def _abort(self) -> None:
+        run = self._run
+        if run is None:
+            return
+        self._run = None
+        self._tx.cancel_kind(ReplyKind.SERVICE_REQUEST)
+        self._tx.cancel_kind(ReplyKind.CHATTER)
+        if self.behaviour.abort_keeps_old_data:
+            self._data = self._previous
+        else:
+            self._data = empty_data(run.command)
+        if self.behaviour.deaf_after_abort:
+            self._deaf = True
+
+    def _entered_standby(self) -> None:
+        data = self._data
+        if self.behaviour.clear_on_standby_after_read and data is not None and data.fully_read:
+            self._data = data.emptied()
+
+    # -- commands ----------------------------------------------------------------------------
+    def _command(self, text: str, start: float, end: float, foreign: bool) -> None:
+        b = self.behaviour
+        try:
+            cmd = parse_command(text)
+        except CommandError:
+            return  # decision A12: silence to what is not a command
+        at = end + b.reply_delay
+        if foreign:
+            if b.answer_foreign and cmd.kind in (Kind.ACKNOWLEDGE, Kind.IDENTIFY):
+                self._dispatch(cmd, at)
+                if b.standby_after_foreign:
+                    self._awake = False
+            return
+        if cmd.address == "?" and cmd.kind is not Kind.QUERY_ADDRESS:
+            return  # R-4.4.3-02: the wildcard is accepted only in ?!
+        if start < self._quiet_until or self._deaf:
+            return
+        if cmd.kind is Kind.QUERY_ADDRESS and not b.answer_query:
+            return
+        if not self.profile.v14 and cmd.kind in V14_ONLY:
+            return
+        run = self._run
+        if run is not None and (not run.concurrent or b.command_aborts_concurrent):
+            self._abort()  # R-4.4.7.1-01 (and M/V heard without a break)
+        self._dispatch(cmd, at)
+        self._last_command = cmd
+
+    def _dispatch(self, cmd: Command, at: float) -> None:
+        a = cmd.address if cmd.address != "?" else self.address
+        match cmd.kind:
+            case Kind.ACKNOWLEDGE:
+                self._send(Reply(ReplyKind.ACKNOWLEDGE, a, command=cmd), at)
+            case Kind.QUERY_ADDRESS:
+                self._send(Reply(ReplyKind.ADDRESS, a, command=cmd), at)
+            case Kind.IDENTIFY:
+                body = a + self.profile.identification()
+                self._send(Reply(ReplyKind.IDENTIFICATION, body, command=cmd), at)
+            case Kind.CHANGE_ADDRESS:
+                self._change_address(cmd, at)
+            case Kind.DATA:
+                self._data_reply(cmd, at)
+            case Kind.BINARY_DATA:
+                self._binary_reply(cmd, at)
+            case Kind.CONTINUOUS:
+                self._continuous(cmd, at)
+            case Kind.IDENTIFY_MEASUREMENT:
+                self._identify_measurement(cmd, at)
+            case Kind.METADATA:
+                self._metadata(cmd, at)
+            case Kind.EXTENDED:
+                text = self.profile.extended.get(cmd.body)
+                if text is not None:
+                    self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
+            case _:
+                self._start_measurement(cmd, at)
+
+    def _send(self, reply: Reply, at: float) -> Transmission | None:
+        rewritten = self.faults.rewrite(reply)
+        if rewritten is None:
+            return None
+        return self._tx.schedule(rewritten, at, self.behaviour.char_gap)
+
+    def _change_address(self, cmd: Command, at: float) -> None:
+        old, new = self.address, cmd.new_address
+        if not self.profile.address_settable:
+            new = old
+        elif self.behaviour.apply_address_change:
+            self.address = new
+            if old != new:
+                self._old_addresses.add(old)
+        sent = self._send(Reply(ReplyKind.CHANGE_ADDRESS, new, command=cmd), at)
+        if sent is not None:
+            self._quiet_until = sent.end + self.profile.address_change_quiet
+
+    # -- measurements ------------------------------------------------------------------------
+    def _answers(self, cmd: Command, spec: MeasurementSpec | None) -> bool:
+        """Whether a measurement (or its identify form) gets a reply at all."""
+        if spec is not None or not cmd.group:
+            return True
+        if cmd.kind is Kind.MEASURE:
+            return self.behaviour.answer_undefined_measure
+        if cmd.kind is Kind.CONCURRENT:
+            return self.behaviour.answer_undefined_concurrent
+        return True
+
+    def _start_reply(
+        self, cmd: Command, target: Command, spec: MeasurementSpec | None, kind: ReplyKind
+    ) -> Reply:
+        digits = _COUNT_DIGITS[target.kind]
+        ttt, count = (spec.ttt, spec.count) if spec is not None else (0, 0)
+        body = f"{cmd.address}{ttt:03d}{count:0{digits}d}"
+        return Reply(kind, body, command=cmd, source=target, digits=digits)
+
+    def _start_measurement(self, cmd: Command, at: float) -> None:
+        b = self.behaviour
+        spec = self.profile.spec_for(cmd)
+        if not self._answers(cmd, spec):
+            return
+        sent = self._send(self._start_reply(cmd, cmd, spec, ReplyKind.START), at)
+        if sent is None:
+            return
+        self._previous = self._data
+        self._data = None
+        delay = spec.ready_delay if spec is not None else 0.0
+        run = Run(cmd, spec, sent.end + delay)
+        if spec is None or spec.ttt == 0:
+            self._data = complete(run, b)  # R-4.4.5-03: ready at once
+            sr_kind = cmd.kind in SERVICE_REQUEST_KINDS
+            if spec is not None and sr_kind and b.service_request_on_ttt_zero:
+                self._service_request(cmd, sent.end + b.reply_delay)
+            return
+        self._run = run
+        wants_sr = cmd.kind in SERVICE_REQUEST_KINDS or (
+            cmd.is_concurrent and b.service_request_on_concurrent
+        )
+        if not wants_sr or not b.service_request:
+            return
+        sr_at = run.ready_at
+        if b.service_request_late is not None and cmd.kind in SERVICE_REQUEST_KINDS:
+            sr_at = sent.end + spec.ttt + b.service_request_late
+        if b.chatter_before_service_request:
+            chatter = Reply(ReplyKind.CHATTER, cmd.address + "BUSY", source=cmd)
+            self._send(chatter, (sent.end + run.ready_at) / 2)
+        self._service_request(cmd, sr_at)
+
+    def _service_request(self, source: Command, at: float) -> None:
+        self._send(Reply(ReplyKind.SERVICE_REQUEST, source.address, source=source), at)
+
+    def _identify_measurement(self, cmd: Command, at: float) -> None:
+        b = self.behaviour
+        target = cmd.target
+        assert target is not None
+        spec = self.profile.spec_for(target)
+        if not b.answer_identify_measurement or not self._answers(target, spec):
+            return
+        sent = self._send(self._start_reply(cmd, target, spec, ReplyKind.IDENTIFY), at)
+        if b.identify_clears_data and self._data is not None:
+            self._data = self._data.emptied()
+        if (
+            sent is not None
+            and b.service_request_on_identify
+            and spec is not None
+            and spec.ttt > 0
+            and target.kind in SERVICE_REQUEST_KINDS
+        ):
+            self._service_request(cmd, sent.end + spec.ready_delay)
+
+    # -- data --------------------------------------------------------------------------------
+    def _data_reply(self, cmd: Command, at: float) -> None:
+        b = self.behaviour
+        data = self._data
+        if data is None:
+            # nothing measured yet, or still measuring: no data (decision A3)
+            data = empty_data(self._run.command if self._run else None)
+        high_volume = data.source is not None and data.source.kind is Kind.HIGH_VOLUME_ASCII
+        limit = min(data.max_index, b.max_data_index) if high_volume else data.max_index
+        if cmd.index > limit:
+            return  # D10+ exists only after HA; silence otherwise (decision A12)
+        page = "" if data.binary or cmd.index >= len(data.pages) else data.pages[cmd.index]
+        repeat = data.note_read(cmd.index) if page else 0
+        reply = Reply(
+            ReplyKind.DATA,
+            cmd.address + page,
+            command=cmd,
+            source=data.source,
+            crc=data.crc,
+            repeat=repeat,
+        )
+        self._send(reply, at)
+        if b.clear_after_read and data is self._data and data.fully_read:
+            self._data = data.emptied()
+
+    def _binary_reply(self, cmd: Command, at: float) -> None:
+        data = self._data
+        address = ord(cmd.address)
+        if data is not None and data.binary and cmd.index < len(data.packets):
+            dtype, values = data.packets[cmd.index]
+            payload = encode_values(DataType(dtype), values)
+            data.note_read(cmd.index)
+            parts = BinaryParts(address, dtype, payload)
+        elif self.behaviour.empty_packet:
+            parts = BinaryParts(address, 0, b"")  # R-5.2-06
+        else:
+            return
+        source = data.source if data is not None else None
+        reply = Reply(ReplyKind.BINARY, cmd.address, command=cmd, source=source, binary=parts)
+        self._send(reply, at)
+
+    def _continuous(self, cmd: Command, at: float) -> None:
+        spec = self.profile.spec_for(cmd)
+        last = self._last_command
+        if (
+            self.behaviour.continuous_needs_r0
+            and cmd.group > 0
+            and not (last is not None and last.kind is Kind.CONTINUOUS and last.group == 0)
+        ):
+            spec = None
+        values = "".join(spec.values) if spec is not None else ""
+        reply = Reply(
+            ReplyKind.CONTINUOUS, cmd.address + values, command=cmd, source=cmd, crc=cmd.crc
+        )
+        self._send(reply, at)
+
+    def _metadata(self, cmd: Command, at: float) -> None:
+        target = cmd.target
+        assert target is not None
+        spec = self.profile.spec_for(target)
+        index = cmd.param
+        body = cmd.address
+        if spec is not None and 1 <= index <= min(spec.count, len(spec.metadata)):
+            body += "," + ",".join(spec.metadata[index - 1]) + ";"
+        elif not self.behaviour.metadata_invalid_reply:
+            return
+        reply = Reply(ReplyKind.METADATA, body, command=cmd, source=target, crc=target.returns_crc)
+        self._send(reply, at)

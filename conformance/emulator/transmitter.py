@@ -1,0 +1,80 @@
+"""The emulator's output side: replies scheduled at a start time, offered frame by frame.
+
+The bus asks for the next frame and commits it when its time comes; until then plans can
+change (a break cancels a pending service request), which is why output is a queue of
+scheduled transmissions rather than something pushed onto the wire.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ..protocol.timing import CHAR_TIME
+from ..sim.bus import Frame
+from .replies import Reply, ReplyKind
+
+
+@dataclass
+class Transmission:
+    """One reply's frames, the start of the first one and the marking between them."""
+
+    reply: Reply
+    start: float
+    wires: list[int]
+    gap: float
+    sent: int = 0
+
+    def frame_start(self, index: int) -> float:
+        return self.start + index * (CHAR_TIME + self.gap)
+
+    @property
+    def end(self) -> float:
+        """End of the last stop bit."""
+        return self.frame_start(len(self.wires) - 1) + CHAR_TIME
+
+    @property
+    def done(self) -> bool:
+        return self.sent >= len(self.wires)
+
+
+class Transmitter:
+    """Scheduled transmissions; never two at once (a later one waits for the earlier)."""
+
+    def __init__(self) -> None:
+        self.queue: list[Transmission] = []
+
+    def schedule(self, reply: Reply, start: float, gap: float) -> Transmission:
+        wires = reply.wires()
+        for other in self.queue:
+            if other.start <= start < other.end + CHAR_TIME:
+                start = other.end + CHAR_TIME
+        item = Transmission(reply, start, wires, gap)
+        self.queue.append(item)
+        self.queue.sort(key=lambda t: t.start)
+        return item
+
+    def cancel(self, keep: Callable[[Transmission], bool] | None = None) -> None:
+        """Drop pending output (all of it, or what ``keep`` rejects)."""
+        self.queue = [t for t in self.queue if keep is not None and keep(t)]
+
+    def cancel_kind(self, kind: ReplyKind) -> None:
+        self.cancel(lambda t: t.reply.kind is not kind or t.sent > 0)
+
+    def next_frame(self) -> Frame | None:
+        if not self.queue:
+            return None
+        item = self.queue[0]
+        return Frame(item.frame_start(item.sent), item.wires[item.sent])
+
+    def pop_frame(self) -> tuple[Frame, Transmission]:
+        item = self.queue[0]
+        frame = Frame(item.frame_start(item.sent), item.wires[item.sent])
+        item.sent += 1
+        if item.done:
+            self.queue.pop(0)
+        return frame, item
+
+    @property
+    def busy(self) -> bool:
+        return bool(self.queue)
