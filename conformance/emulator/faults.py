@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, fields, replace
 from types import MappingProxyType
 from typing import Any
 
-from ..protocol.binary import DataType
+from ..protocol.binary import DataType, type_size
 from ..protocol.commands import Kind
 from ..protocol.crc import ascii_crc, binary_crc
 from .behaviour import Behaviour
@@ -237,8 +237,10 @@ def _binary_first_packet(change: Callable[[Reply], None]) -> Callable[[Reply], N
 
 
 def _pad_payload(reply: Reply) -> None:
+    """One stray byte after the values of a multi-byte type (an int8 payload cannot show it)."""
     assert reply.binary is not None
-    reply.binary.payload += b"\x00"
+    if reply.binary.payload and type_size(reply.binary.dtype) > 1:
+        reply.binary.payload += b"\x00"
 
 
 def _invalid_type(reply: Reply) -> None:
@@ -775,9 +777,9 @@ def _faults() -> list[Fault]:
         # -- high-volume binary -------------------------------------------------------------------
         Fault(
             "binary-payload-not-multiple",
-            "DB0's payload has one byte more than its values need.",
+            "Packets of multi-byte types carry one stray byte after their values.",
             ("R-5.2-05",),
-            rewrite=_binary(_binary_first_packet(_pad_payload)),
+            rewrite=_binary(_pad_payload),
         ),
         Fault(
             "binary-invalid-type",

@@ -24,7 +24,9 @@ Number = int | float
 
 
 def _values(raw: Sequence[str | Number]) -> tuple[str, ...]:
-    return tuple(format_value(v) for v in raw)
+    """Numbers become clean value strings; strings are kept as given, so a fault can put a
+    malformed value on the wire (the default profiles are checked for clean values by tests)."""
+    return tuple(v if isinstance(v, str) else format_value(v) for v in raw)
 
 
 @dataclass(frozen=True)
@@ -39,8 +41,8 @@ class Packet:
 class MeasurementSpec:
     """One measurement group.
 
-    ``values`` are SDI-12 value strings (numbers are converted once, here, so the emulator
-    sends exactly what the profile shows). ``ttt`` is the announced time in seconds;
+    ``values`` are SDI-12 value strings, sent exactly as given (numbers are converted once,
+    here). ``ttt`` is the announced time in seconds;
     ``ready_after`` is when, counted from the end of the ``atttn`` reply, the data are ready
     (and the service request of M/V goes out); it must be below ``ttt`` because the whole
     service request has to fit before ttt expires (R-4.4.6-04). ``metadata`` holds the field
