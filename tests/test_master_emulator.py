@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.links.base import Link
 from conformance.master import Master
 from conformance.protocol import commands as cmds
 
@@ -14,17 +13,15 @@ if not hasattr(emulator, "sim_sensor"):
     pytest.skip("conformance.emulator.sim_sensor is not there yet", allow_module_level=True)
 
 
-def _link_of(built: object) -> Link:
-    """``sim_sensor()`` builds bus + link + emulator; find the link in what it returns."""
-    if isinstance(built, Link):
-        return built
-    parts = list(built) if isinstance(built, tuple) else list(vars(built).values())
-    return next(part for part in parts if isinstance(part, Link))
-
-
 @pytest.fixture
 def master() -> Master:
-    return Master(_link_of(emulator.sim_sensor()))
+    _, link, _ = emulator.sim_sensor()
+    return Master(link)
+
+
+def master_with(*faults: str) -> Master:
+    _, link, _ = emulator.sim_sensor(faults=faults)
+    return Master(link)
 
 
 def single_attempts(*exchanges) -> bool:
@@ -66,3 +63,36 @@ def test_foreign_address_stays_silent(master):
     master.acknowledge()
     probe = master.raw("9!")
     assert not probe.answered
+
+
+# -- observer role: faulty sensors leave evidence, the engine still finishes -----------------
+def test_wrong_crc_is_retried_every_time_and_collection_stops():
+    m = master_with("wrong-crc").measure(cmds.measure("0", crc=True))
+    assert m.start.ok and len(m.data) == 1
+    assert len(m.data[0].attempts) == 9
+    assert all("CRC" in a.reason for a in m.data[0].attempts)
+
+
+def test_parity_error_triggers_retries():
+    ex = master_with("parity-error").acknowledge()
+    assert any(a.reason.startswith("invalid: parity error") for a in ex.attempts)
+
+
+def test_missing_service_request_falls_back_to_break_at_ttt():
+    m = master_with("no-service-request").measure(cmds.measure("0"))
+    assert m.ttt and m.service_request_end is None
+    d0 = m.data[0].attempts[0]
+    assert d0.break_event is not None and d0.break_event.start >= m.reply_end + m.ttt
+    assert m.complete
+
+
+def test_late_service_request_is_evidence():
+    m = master_with("late-service-request").measure(cmds.measure("0"))
+    assert m.service_request_end is not None
+    assert m.service_request_end > m.reply_end + m.ttt
+    assert m.complete
+
+
+def test_sensor_needing_the_full_wake_time_is_reached_by_the_late_retry():
+    ex = master_with("slow-wake").acknowledge()
+    assert ex.ok and [a.reason for a in ex.attempts] == ["no reply", "no reply", "ok"]
