@@ -127,7 +127,11 @@ class SensorEmulator:
         self._settle(start)
         idle_before = start - max(self._last_activity, self._wake_at) >= self._standby_limit
         if end - start < b.break_threshold:
-            # too short for a break: noise on the line that ruins a command in progress
+            # too short for a break: noise on the line that ruins a command in progress;
+            # the marking before it may already have sent the sensor to standby (R-7.0-15)
+            if self._awake and idle_before:
+                self._awake = False
+                self._entered_standby()
             self._last_activity = max(self._last_activity, end)
             if self._buf:
                 self._buf_invalid = True

@@ -28,6 +28,7 @@ class Frame:
 
     start: float
     wire: int
+    duration: float = CHAR_TIME  # one 10-bit frame; a device at the wrong baud rate differs
 
 
 class BusDevice(Protocol):
@@ -91,7 +92,7 @@ class SimBus:
     def _commit(self, device: BusDevice, frame: Frame) -> Event:
         device.pop_frame()
         start = max(frame.start, self.clock.now)
-        end = start + CHAR_TIME
+        end = start + frame.duration
         origin = DUT if len(self.devices) == 1 else device.name
         event = self.transcript.add(Event(EventKind.CHAR, origin, start, end, wire=frame.wire))
         for other in self.devices:

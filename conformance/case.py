@@ -1,0 +1,89 @@
+"""The ``case`` fixture object: how a conformance case records findings and evidence.
+
+A case names its requirement IDs with ``@pytest.mark.requirements(...)``, runs or reuses a
+stimulus, hands the records to judges and adds their findings here. This object enforces the
+contract: a finding must be about one of the case's requirements, and a rule that the DUT's
+claimed version does not bind becomes N/A instead of a verdict.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from .catalog import requirement
+from .master.records import Exchange, Measurement
+from .results import CaseRecord
+from .transcript import Event
+from .verdicts import Finding, Verdict, not_applicable
+
+
+class Case:
+    def __init__(self, record: CaseRecord, version: Any = None) -> None:
+        self.record = record
+        self._version = version  # callable returning "13"/"14"/None, resolved lazily
+
+    @property
+    def requirements(self) -> tuple[str, ...]:
+        return self.record.requirements
+
+    def expect(self, text: str) -> None:
+        """What a conforming device does here, in one sentence, for the report."""
+        self.record.expectation = text
+
+    def add(self, *findings: Finding) -> None:
+        self.extend(findings)
+
+    def extend(self, findings: Iterable[Finding]) -> None:
+        version = self._version() if callable(self._version) else self._version
+        for f in findings:
+            f.test = f.test or self.record.nodeid
+            if f.requirement not in self.record.requirements:
+                f = Finding(
+                    f.requirement,
+                    Verdict.ERROR,
+                    f"case bug: finding for {f.requirement}, which the case does not declare "
+                    f"({f.detail})",
+                    test=self.record.nodeid,
+                )
+            elif version and not requirement(f.requirement).applies_to_version(version):
+                f = not_applicable(
+                    f.requirement,
+                    f"rule binds SDI-12 v1.4 only; the DUT claims v{version[0]}.{version[1]}",
+                    test=self.record.nodeid,
+                )
+            self.record.findings.append(f)
+
+    def not_applicable(self, reason: str, requirements: Iterable[str] | None = None) -> None:
+        for rid in requirements or self.record.requirements:
+            self.add(not_applicable(rid, reason))
+
+    def evidence(self, label: str, record: Any) -> None:
+        """Attach the wire events behind a record (Exchange, Measurement or events)."""
+        self.record.evidence.append((label, events_of(record)))
+
+
+def events_of(record: Any) -> list[Event]:
+    """Every bus event behind an Exchange, a Measurement, or a list of them, in time order."""
+    if record is None:
+        return []
+    if isinstance(record, Event):
+        return [record]
+    if isinstance(record, Exchange):
+        found: list[Event] = []
+        for a in record.attempts:
+            found += a.stray_events
+            if a.break_event is not None:
+                found.append(a.break_event)
+            found += a.command_events + a.reply_events
+        return sorted(found, key=lambda e: e.start)
+    if isinstance(record, Measurement):
+        found = events_of(record.start) + list(record.waited_events)
+        for ex in record.data:
+            found += events_of(ex)
+        return sorted(found, key=lambda e: e.start)
+    if isinstance(record, (list, tuple)):
+        if all(isinstance(e, Event) for e in record):
+            return list(record)
+        return sorted((e for r in record for e in events_of(r)), key=lambda e: e.start)
+    raise TypeError(f"no events in {type(record).__name__}")

@@ -1,0 +1,249 @@
+"""``sdi12-conform``: run the conformance suite against a device and gate CI on the verdict.
+
+Exit codes (documented in the README): 0 compliant, 1 non-compliant, 2 interrupted or
+incomplete, 3 internal error, 4 usage error, 5 no device answered.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import sys
+from importlib import resources
+from pathlib import Path
+
+from rich.console import Console
+
+from . import __version__
+
+EXIT_COMPLIANT, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_USAGE, EXIT_NO_DEVICE = (
+    0,
+    1,
+    2,
+    3,
+    4,
+    5,
+)
+
+EXAMPLES = """\
+examples:
+  sdi12-conform --port sim --role sensor                  judge the built-in simulated sensor
+  sdi12-conform --port 'sim://?faults=no-service-request' run against a faulty simulated sensor
+  sdi12-conform --port sim --sdi-version 1.3 -k crc       only cases matching 'crc', v1.3 rules
+  sdi12-conform list                                       the requirement catalog with coverage
+  sdi12-conform faults                                     the emulator faults and what they break
+
+exit codes: 0 compliant, 1 non-compliant, 2 interrupted/incomplete, 3 internal error,
+            4 usage error, 5 no device answered
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sdi12-conform",
+        description="SDI-12 (v1.3/v1.4) conformance test suite: judges a sensor or a data "
+        "recorder against every testable requirement and writes HTML, JSON and JUnit reports.",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--version", action="version", version=f"sdi12-conform {__version__}")
+    p.add_argument(
+        "--port",
+        default="sim",
+        help="sim, sim://?faults=a,b&version=1.3, or a serial port / pyserial URL",
+    )
+    p.add_argument(
+        "--role",
+        default="sensor",
+        choices=("sensor", "recorder"),
+        help="what the device under test is (default: sensor)",
+    )
+    p.add_argument("--address", help="DUT address (default: the declaration, else ask with ?!)")
+    p.add_argument("--sdi-version", help="force the rule set, 1.3 or 1.4 (default: from aI!)")
+    p.add_argument("--declaration", help="TOML file declaring the DUT's address and features")
+    p.add_argument("--report-dir", help="output folder (default: reports/<date>-<role>)")
+    p.add_argument("--strict", action="store_true", help="WARN (SHOULD violations) fails too")
+    p.add_argument(
+        "--timing-uncertainty-ms",
+        type=float,
+        help="override the link's declared timestamp uncertainty",
+    )
+    p.add_argument("-k", dest="keyword", help="only cases matching this pytest -k expression")
+    p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
+    return p
+
+
+def run_suite(args: argparse.Namespace, console: Console) -> int:
+    from .declaration import DeclarationError, load_declaration, normalise_version
+    from .ports import PortError, is_sim, parse_sim
+
+    if args.role == "recorder":
+        console.print(
+            "the recorder role is not implemented in this version; use --role sensor", style="red"
+        )
+        return EXIT_USAGE
+    try:
+        if args.sdi_version:
+            normalise_version(args.sdi_version)
+        if args.declaration:
+            load_declaration(args.declaration)
+        if is_sim(args.port):
+            from .ports import open_sim
+
+            open_sim(parse_sim(args.port))  # validate faults/parameters before pytest starts
+    except (DeclarationError, PortError) as exc:
+        console.print(f"error: {exc}", style="red", markup=False)
+        return EXIT_USAGE
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
+    report_dir.mkdir(parents=True, exist_ok=True)
+    ini = resources.files("conformance") / "suite.ini"
+    pytest_args = [
+        "-c",
+        str(ini),
+        "--rootdir",
+        str(Path.cwd()),
+        "-p",
+        "no:cacheprovider",
+        "--pyargs",
+        f"testcases.{args.role}",
+        "--sdi12-port",
+        args.port,
+        "--sdi12-role",
+        args.role,
+        "--sdi12-report-dir",
+        str(report_dir),
+        f"--html={report_dir / 'report.html'}",
+        "--self-contained-html",
+        f"--junitxml={report_dir / 'junit.xml'}",
+        "-o",
+        "junit_family=xunit2",
+    ]
+    for flag, value in (
+        ("--sdi12-address", args.address),
+        ("--sdi12-version", args.sdi_version),
+        ("--sdi12-declaration", args.declaration),
+    ):
+        if value:
+            pytest_args += [flag, value]
+    if args.timing_uncertainty_ms is not None:
+        pytest_args += ["--sdi12-timing-uncertainty-ms", str(args.timing_uncertainty_ms)]
+    if args.strict:
+        pytest_args.append("--sdi12-strict")
+    if args.keyword:
+        pytest_args += ["-k", args.keyword]
+    plugins: list[object] = []
+    if args.verbose:
+        pytest_args.append("-v")
+    else:
+        from .reports.console import ProgressPlugin
+
+        pytest_args += ["-p", "no:terminal"]
+        plugins.append(ProgressPlugin(console))
+
+    import pytest
+
+    code = pytest.main(pytest_args, plugins=plugins)
+    verdicts = report_dir / "verdicts.json"
+    if code == 5 and not verdicts.exists():  # pytest: no tests collected (e.g. -k matched none)
+        console.print("no conformance case matched the selection", style="red")
+        return EXIT_USAGE
+    if not verdicts.exists():
+        console.print(
+            f"the suite did not run (pytest exit {int(code)}); rerun with -v", style="red"
+        )
+        return EXIT_INTERNAL if int(code) == 3 else EXIT_USAGE
+    data = json.loads(verdicts.read_text(encoding="utf-8"))
+    from .reports.console import print_summary
+
+    print_summary(console, data, str(report_dir))
+    return exit_code(data, int(code))
+
+
+def exit_code(data: dict, pytest_code: int) -> int:
+    verdict = data["summary"]["verdict"]
+    if pytest_code == EXIT_NO_DEVICE and not data["run"]["complete"]:
+        return EXIT_NO_DEVICE
+    if verdict == "NON-COMPLIANT":
+        return EXIT_NON_COMPLIANT
+    if verdict == "COMPLIANT":
+        return EXIT_COMPLIANT
+    if data["summary"]["counts"].get("ERROR"):
+        return EXIT_INTERNAL
+    return EXIT_INCOMPLETE
+
+
+def cmd_list(argv: list[str], console: Console) -> int:
+    p = argparse.ArgumentParser(
+        prog="sdi12-conform list", description="the requirement catalog with coverage"
+    )
+    p.add_argument("--role", default="sensor", choices=("sensor", "recorder"))
+    args = p.parse_args(argv)
+    from rich.table import Table
+
+    from .coverage import coverage_rows
+
+    table = Table(title=f"requirements, {args.role} role")
+    for col in ("ID", "level", "testable", "cases / why not", "requirement"):
+        table.add_column(col, overflow="fold")
+    rows = coverage_rows(args.role)
+    for row in rows:
+        table.add_row(
+            row.id,
+            row.level,
+            "yes" if row.testable else "no",
+            "\n".join(row.cases) if row.testable else row.reason,
+            row.statement,
+        )
+    console.print(table)
+    covered = sum(1 for r in rows if r.testable and r.cases)
+    testable = sum(1 for r in rows if r.testable)
+    console.print(
+        f"{covered}/{testable} testable requirements covered by a case; "
+        f"{len(rows) - testable} untestable for this role",
+        highlight=False,
+    )
+    return EXIT_COMPLIANT
+
+
+def cmd_faults(argv: list[str], console: Console) -> int:
+    p = argparse.ArgumentParser(
+        prog="sdi12-conform faults",
+        description="the emulator's faults and the requirements each breaks",
+    )
+    p.parse_args(argv)
+    from rich.table import Table
+
+    from .emulator import FAULTS
+
+    table = Table(title=f"{len(FAULTS)} emulator faults (use sim://?faults=NAME[,NAME])")
+    table.add_column("fault")
+    table.add_column("violates")
+    table.add_column("what it does", overflow="fold")
+    for name, fault in sorted(FAULTS.items()):
+        table.add_row(name, " ".join(fault.violates), fault.description)
+    console.print(table)
+    return EXIT_COMPLIANT
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    console = Console(stderr=False)
+    try:
+        if argv and argv[0] == "list":
+            return cmd_list(argv[1:], console)
+        if argv and argv[0] == "faults":
+            return cmd_faults(argv[1:], console)
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as exc:
+            return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
+        return run_suite(args, console)
+    except KeyboardInterrupt:
+        console.print("interrupted", style="yellow")
+        return EXIT_INCOMPLETE
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,161 @@
+"""Judges for single command/reply exchanges: a!, aI!, ?!, aAb!, silence where silence is due,
+answers where an answer is due, and the continuous (R) commands.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from ..case import events_of
+from ..master.records import Exchange
+from ..protocol.crc import ascii_crc
+from ..protocol.responses import (
+    Identification,
+    check_address_reply,
+    check_data_sequence,
+    parse_data_reply_for,
+    parse_ident,
+    split_line,
+)
+from ..transcript import escape
+
+__all__ = ["ascii_crc", "escape", "events_of", "failed", "passed", "warned"]
+from ..verdicts import Finding, Verdict, failed, passed, warned
+from .measurements import data_reply_ids
+from .tally import Tally
+
+
+def shown(ex: Exchange) -> str:
+    """``0I! -> '0I13VENDOR..<CR><LF>'`` for evidence lines."""
+    reply = escape(ex.reply_text) if ex.answered else "(silence)"
+    return f"{escape(ex.text)} -> '{reply}'"
+
+
+def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Finding:
+    """``a!`` and ``?!``: the reply is the address and CR LF, nothing else."""
+    if not ex.answered:
+        return failed(rid, f"{what}: no reply", evidence=[shown(ex)])
+    body, framing = split_line(ex.reply_text)
+    problems = [v for v in framing if v.requirement == "R-4.2-03"]
+    problems += check_address_reply(body, expected, rid)
+    if problems:
+        return failed(
+            rid, f"{what}: " + "; ".join(v.message for v in problems), evidence=[shown(ex)]
+        )
+    return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)])
+
+
+def identification(ex: Exchange, address: str) -> tuple[Identification | None, list[Finding]]:
+    ids = ("R-4.4.2-01", "R-4.4.2-02")
+    if not ex.answered:
+        return None, [failed(rid, "aI! got no reply", evidence=[shown(ex)]) for rid in ids]
+    body, framing = split_line(ex.reply_text)
+    ident = parse_ident(body, expected_address=address)
+    tally = Tally(ids)
+    tally.observe(escape(ex.text), [v for v in ident.violations + framing if v.requirement in ids])
+    ok = {
+        "R-4.4.2-01": f"fields: version '{ident.version}', vendor '{escape(ident.vendor)}', "
+        f"model '{escape(ident.model)}', sensor version "
+        f"'{escape(ident.sensor_version)}', optional '{escape(ident.optional)}'",
+        "R-4.4.2-02": f"claims SDI-12 v{escape(ident.version[:1])}.{escape(ident.version[1:])}",
+    }
+    return ident, tally.findings(ok)
+
+
+def silent(
+    rid: str,
+    exchanges: Iterable[Exchange],
+    why: str,
+    *,
+    should: bool = False,
+    decision: str | None = None,
+) -> Finding:
+    """Each exchange must have drawn no reply (foreign address, standby, partial command)."""
+    exchanges = list(exchanges)
+    answered = [ex for ex in exchanges if ex.answered]
+    if answered:
+        make = warned if should else failed
+        return make(
+            rid,
+            f"answered although {why}: " + "; ".join(shown(e) for e in answered[:3]),
+            evidence=[shown(e) for e in answered],
+            decision=decision,
+        )
+    return passed(
+        rid,
+        f"stayed silent ({why}) to {len(exchanges)} command(s): "
+        + ", ".join(escape(e.text) for e in exchanges),
+        decision=decision,
+    )
+
+
+def answered(
+    rid: str, exchanges: Iterable[Exchange], why: str, *, first_attempt: bool = False
+) -> Finding:
+    """Each exchange must have drawn a reply (on its first transmission, if asked)."""
+    exchanges = list(exchanges)
+    missing = [
+        ex
+        for ex in exchanges
+        if not (ex.attempts[0].reply_events if first_attempt else ex.answered)
+    ]
+    if missing:
+        how = "on the first transmission " if first_attempt else ""
+        return failed(
+            rid,
+            f"no reply {how}although {why}: " + "; ".join(escape(e.text) for e in missing[:5]),
+            evidence=[shown(e) for e in missing],
+        )
+    return passed(
+        rid,
+        f"answered ({why}): "
+        + ", ".join(shown(e) for e in exchanges[:4])
+        + (f" (+{len(exchanges) - 4} more)" if len(exchanges) > 4 else ""),
+    )
+
+
+def continuous(
+    exchanges: dict[int, tuple[Exchange, Exchange]], ids: Iterable[str]
+) -> list[Finding]:
+    """R0..R9 / RC0..RC9 replies: format like D replies, <=75 characters, CRC on RC, and the
+    empty reply for an index the sensor does not serve (R-4.4.8.1-01/-03)."""
+    tally = Tally(ids)
+    unsupported = 0
+    for _index, pair in sorted(exchanges.items()):
+        for ex in pair:
+            label = escape(ex.text)
+            if not ex.answered or ex.command is None:
+                tally.fail("R-4.4.8.1-01", label, f"{label} got no reply")
+                continue
+            crc = ex.command.crc
+            body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
+            reply = parse_data_reply_for(body, ex.command, expected_address=ex.command.address)
+            ids_here = [i for i in data_reply_ids(ex.command) if i != "R-4.4.8-01"]
+            tally.observe(
+                label,
+                framing + [v for v in reply.violations if v.requirement != "R-4.4.8-01"],
+                ids=ids_here + ["R-4.4.8.1-01"],
+            )
+            if not reply.values:
+                unsupported += 1
+                tally.observe(label, ids=["R-4.4.8.1-03"])
+                expected = 1 + (3 if crc else 0)
+                if len(body) != expected or (crc and not reply.crc_ok):
+                    tally.fail(
+                        "R-4.4.8.1-03",
+                        label,
+                        f"unsupported {label} answered '{escape(ex.reply_text)}', not "
+                        f"'a{'<CRC>' if crc else ''}<CR><LF>'",
+                    )
+            tally.observe(
+                label,
+                check_data_sequence([reply], len(reply.values), 75),
+                ids=["R-4.4.8.3-01"] if "R-4.4.8.3-01" in tally.ids else [],
+            )
+    if not unsupported:
+        tally.not_applicable("R-4.4.8.1-03", "every R0..R9 returned values; no unsupported index")
+    return tally.findings()
+
+
+def na(rid: str, reason: str) -> Finding:
+    return Finding(rid, Verdict.NA, reason)

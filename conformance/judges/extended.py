@@ -1,0 +1,103 @@
+"""Judges for extended commands (4.4.13) and multi-line text (4.4.13.1, decision A10)."""
+
+from __future__ import annotations
+
+from ..master.records import Exchange
+from ..protocol.timing import INTER_CHAR_GAP_MAX, MULTILINE_GAP_MAX
+from ..transcript import Event, escape
+from ..verdicts import Finding
+from .tally import Tally
+from .timing import judge_window
+
+STX, ETX, LF = 0x02, 0x03, 0x0A
+LINE_MAX = 75
+
+
+def is_multiline(ex: Exchange) -> bool:
+    return ex.answered and ex.reply_text[1:2] == "\x02"
+
+
+def extended_replies(exchanges: list[Exchange], address: str) -> list[Finding]:
+    tally = Tally(("R-4.4.13-01", "R-4.4.13-02"))
+    for ex in exchanges:
+        label = escape(ex.text)
+        tally.observe(label, ids=["R-4.4.13-02"])
+        if ex.text[1:2] != "X":
+            tally.fail("R-4.4.13-02", label, f"{label} does not use the aX...! form", warning=True)
+        if not ex.answered:
+            continue  # an extended command may be unknown to the sensor: silence is allowed
+        tally.observe(label, ids=["R-4.4.13-01"])
+        text = ex.reply_text.rstrip("\x03") if is_multiline(ex) else ex.reply_text
+        if not text.startswith(address) or not text.endswith("\r\n"):
+            tally.fail(
+                "R-4.4.13-01",
+                label,
+                f"reply '{escape(ex.reply_text)}' does not run from the address to CR LF",
+            )
+    return tally.findings()
+
+
+def lines(events: list[Event]) -> list[list[Event]]:
+    """Split a multi-line reply into lines, each ending with its LF."""
+    out: list[list[Event]] = [[]]
+    for e in events:
+        out[-1].append(e)
+        if e.char7 == LF:
+            out.append([])
+    return [line for line in out if line]
+
+
+def multiline(exchanges: list[Exchange], address: str, uncertainty: float) -> list[Finding]:
+    ids = ("R-4.4.13.1-01", "R-4.4.13.1-02", "R-4.4.13.1-03")
+    tally = Tally(ids)
+    timing: list[Finding] = []
+    for ex in exchanges:
+        label = escape(ex.text)
+        tally.observe(label)
+        events = ex.reply_events
+        text = ex.reply_text
+        if not (text.startswith(address + "\x02") and text.endswith("\r\n\x03")):
+            tally.fail(
+                "R-4.4.13.1-01",
+                label,
+                f"reply '{escape(text[:20])}...{escape(text[-6:])}' is not framed "
+                "a<STX>...<CR><LF><ETX>",
+            )
+        body_lines = lines([e for e in events if e.char7 != ETX])
+        for n, line in enumerate(body_lines, 1):
+            content = "".join(chr(e.char7) for e in line).rstrip("\r\n")
+            if n == 1:
+                content = content[2:]  # address and STX do not count
+            if len(content) > LINE_MAX:
+                tally.fail(
+                    "R-4.4.13.1-02",
+                    label,
+                    f"line {n} has {len(content)} characters (at most {LINE_MAX})",
+                )
+            for a, b in zip(line, line[1:], strict=False):
+                gap = b.start - a.end
+                if gap - uncertainty > INTER_CHAR_GAP_MAX:
+                    tally.fail(
+                        "R-4.4.13.1-03",
+                        label,
+                        f"line {n} has a {gap * 1e3:.2f} ms gap between characters",
+                    )
+        for before, after in zip(body_lines, body_lines[1:], strict=False):
+            timing.append(
+                judge_window(
+                    "R-4.4.13.1-03",
+                    "marking between lines",
+                    after[0].start - before[-1].end,
+                    uncertainty,
+                    high=MULTILINE_GAP_MAX,
+                    evidence=[label],
+                )
+            )
+    findings = tally.findings()
+    worst = max(timing, key=lambda f: f.verdict.rank, default=None)
+    if worst is not None:
+        findings = [
+            worst if f.requirement == "R-4.4.13.1-03" and worst.verdict.rank > f.verdict.rank else f
+            for f in findings
+        ]
+    return findings

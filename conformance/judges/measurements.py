@@ -1,0 +1,282 @@
+"""Judges for measurements: the atttn-type reply, the wait (service request or silence) and the
+data collection (D or DB replies). One pass over the records yields violations for every rule
+they bear on; each case keeps the requirement IDs it names (one stimulus, many judges).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from ..master.records import Exchange, Measurement
+from ..protocol.binary import parse_binary_packet
+from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
+from ..protocol.responses import (
+    DataReply,
+    check_data_sequence,
+    check_measurement_count,
+    expected_value_limit,
+    parse_data_reply_for,
+    parse_measurement_reply_for,
+    split_line,
+)
+from ..protocol.timing import TOLERANCE
+from ..protocol.values import Violation, check_value
+from ..transcript import Event, decode_7e1, escape
+from ..verdicts import Finding
+from .tally import Tally
+from .wire import runs
+
+SR_MARGIN_MIN = 1.0  # s: R-4.4.5-09 margin always tolerated (SR transmission, clock drift)
+SR_MARGIN_FRACTION = 0.25  # of ttt: beyond this much slack, ttt is "more than a small margin"
+
+
+def where(m: Measurement | Exchange | Command) -> str:
+    if isinstance(m, Measurement):
+        return m.command.text()
+    if isinstance(m, Exchange):
+        return escape(m.text)
+    return m.text()
+
+
+def is_concurrent(m: Measurement) -> bool:
+    return m.command.kind in CONCURRENT_KINDS
+
+
+def raises_sr(m: Measurement) -> bool:
+    return m.command.kind in SERVICE_REQUEST_KINDS
+
+
+# -- the measurement reply ---------------------------------------------------------------------
+def reply_violations(m: Measurement, version: str) -> list[Violation]:
+    if not m.start.answered:
+        return []
+    body, framing = split_line(m.start.reply_text)
+    reply = parse_measurement_reply_for(body, m.command, expected_address=m.command.address)
+    return framing + reply.violations + check_measurement_count(reply, m.command, version)
+
+
+# -- the wait -------------------------------------------------------------------------------
+def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
+    """Index of the first run shaped like a service request (address ... CR LF)."""
+    for i, run in enumerate(runs_):
+        text = decode_7e1(run)
+        if text.startswith(address) and text.endswith("\r\n"):
+            return i
+    return None
+
+
+def wait_violations(m: Measurement, tally: Tally) -> None:
+    """Service-request rules (R-4.4.6-*, R-4.4.5-08/09) and the quiet rules of concurrent
+    measurements (R-4.4.6-05, R-4.4.7-04, R-5.3-01)."""
+    label = where(m)
+    if m.ttt is None or not m.start.answered:
+        return
+    chunks = runs(list(m.waited_events))
+    address = m.command.address
+    if raises_sr(m) and m.ttt > 0:
+        sr = _sr_run(chunks, address)
+        tally.observe(label, ids=["R-4.4.6-02", "R-4.4.5-08"])
+        if sr is None:
+            tally.fail(
+                "R-4.4.6-02",
+                label,
+                f"no service request within ttt={m.ttt} s (the recorder had to wait it "
+                "out and break)",
+            )
+        before = chunks if sr is None else chunks[:sr]
+        if before:
+            tally.fail(
+                "R-4.4.5-08",
+                label,
+                f"sent '{escape(decode_7e1(before[0]))}' between its reply and the service request",
+            )
+        if sr is not None and m.reply_end is not None:
+            text = decode_7e1(chunks[sr])
+            tally.observe(label, ids=["R-4.4.6-01", "R-4.4.6-04", "R-4.4.5-09"])
+            if text != f"{address}\r\n":
+                tally.fail(
+                    "R-4.4.6-01",
+                    label,
+                    f"service request '{escape(text)}' is not '{address}<CR><LF>'",
+                )
+            elapsed = chunks[sr][-1].end - m.reply_end
+            if elapsed > m.ttt + TOLERANCE:
+                tally.fail(
+                    "R-4.4.6-04",
+                    label,
+                    f"service request completed {elapsed:.3f} s after the reply, "
+                    f"past ttt={m.ttt} s",
+                )
+            slack = m.ttt - elapsed
+            allowed = max(SR_MARGIN_MIN, SR_MARGIN_FRACTION * m.ttt)
+            if slack > allowed:
+                tally.fail(
+                    "R-4.4.5-09",
+                    label,
+                    f"service request came {elapsed:.2f} s after the reply, {slack:.2f} s "
+                    f"before ttt={m.ttt} s (more than the {allowed:.2f} s margin this "
+                    "tool tolerates)",
+                    warning=True,
+                )
+    if is_concurrent(m):
+        tally.observe(
+            label,
+            ids=["R-4.4.6-05", "R-5.3-01"]
+            if m.command.kind is not Kind.CONCURRENT
+            else ["R-4.4.6-05", "R-4.4.7-04"],
+        )
+        sr = _sr_run(chunks, address)
+        if sr is not None:
+            msg = f"sent a service request '{escape(decode_7e1(chunks[sr]))}' after {label}"
+            tally.fail("R-4.4.6-05", label, msg)
+            tally.fail("R-5.3-01", label, msg)
+        if chunks and m.command.kind is Kind.CONCURRENT:
+            tally.fail(
+                "R-4.4.7-04",
+                label,
+                f"sent '{escape(decode_7e1(chunks[0]))}' before it was asked for data",
+            )
+
+
+# -- the data -------------------------------------------------------------------------------
+def data_violations(m: Measurement, tally: Tally) -> None:
+    if m.command.kind is Kind.HIGH_VOLUME_BINARY:
+        _binary_violations(m, tally)
+    else:
+        _ascii_violations(m, tally)
+
+
+def _ascii_violations(m: Measurement, tally: Tally) -> None:
+    label = where(m)
+    if m.count is None or not m.data:
+        return
+    replies: list[DataReply] = []
+    limit = expected_value_limit(m.command)
+    for ex in m.data:
+        dlabel = f"{label} {where(ex)}"
+        if not ex.answered:
+            tally.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
+            if m.command.kind is Kind.HIGH_VOLUME_ASCII:
+                tally.fail("R-5.1-02", dlabel, f"no reply to {where(ex)} after aHA!")
+            break
+        body, framing = split_line(ex.reply_text, crc_positions=3 if m.command.returns_crc else 0)
+        reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
+        tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
+        replies.append(reply)
+    seq = check_data_sequence(replies, m.count, limit)
+    _drop_split_fragments(replies, seq, tally, label)
+    tally.observe(
+        label,
+        seq,
+        ids=[
+            "R-4.4.8-03",
+            "R-4.4.8.3-01",
+            "R-4.4.8.3-03",
+            "R-4.4.8-01",
+            "R-4.4.8.3-02",
+            "R-4.4.8-04",
+        ],
+    )
+    if m.count >= 1 and m.aborted_by is None:
+        if replies and not replies[0].values:
+            tally.fail(
+                "R-4.4.8-04", label, f"D0 returned no values although {m.count} were announced"
+            )
+        seen_empty = None
+        for i, r in enumerate(replies):
+            if not r.values and seen_empty is None:
+                seen_empty = i
+            elif r.values and seen_empty is not None:
+                tally.fail(
+                    "R-4.4.8.3-02",
+                    label,
+                    f"D{seen_empty} was empty but D{i} returned values: groups out of order",
+                )
+                break
+    if m.command.kind is Kind.HIGH_VOLUME_ASCII:
+        tally.observe(label, ids=["R-5.1-02"])
+
+
+def data_reply_ids(command: Command) -> list[str]:
+    """The rules one ASCII D (or R) reply is checked against, given what asked for it."""
+    ids = ["R-4.4.8-01", "R-4.4.8-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"]
+    if command.kind is Kind.HIGH_VOLUME_ASCII:
+        return ids + ["R-5.1-03", "R-4.4.12-05", "R-4.4.12-06"]
+    if command.kind is Kind.CONTINUOUS:
+        ids.append("R-4.4.8.1-01")
+    else:
+        ids.append("R-4.4-05")
+    if command.returns_crc:
+        return ids + ["R-4.4.12-02", "R-4.4.12-05", "R-4.4.12-06"]
+    return ids + ["R-4.4.12-03"]
+
+
+def _drop_split_fragments(
+    replies: list[DataReply], seq: list[Violation], tally: Tally, label: str
+) -> None:
+    """A value split across two replies is an R-4.4.8.3-01 fault; its unsigned tail is not
+    also a grammar fault of R-4.4.8-02 when the two halves make a valid value."""
+    for v in seq:
+        if v.requirement != "R-4.4.8.3-01":
+            continue
+        for before, after in zip(replies, replies[1:], strict=False):
+            if after.values and after.values[0][0] not in "+-" and before.values:
+                joined = before.values[-1] + after.values[0]
+                if not [x for x in check_value(joined) if not x.warning]:
+                    fragment = f"'{escape(after.values[0])}'"
+                    bucket = tally.violations.get("R-4.4.8-02", [])
+                    bucket[:] = [b for b in bucket if fragment not in b[1].message]
+
+
+def _binary_violations(m: Measurement, tally: Tally) -> None:
+    label = where(m)
+    if m.count is None:
+        return
+    total = 0
+    ids = ["R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2.1-01", "R-4.1-03"]
+    saw_empty = False
+    for ex in m.data:
+        dlabel = f"{label} {where(ex)}"
+        if not ex.answered:
+            tally.fail("R-5.2-02", dlabel, f"no packet returned for {where(ex)}")
+            return
+        packet = parse_binary_packet(ex.reply_bytes, expected_address=m.command.address)
+        tally.observe(dlabel, packet.violations, ids=ids)
+        if packet.is_empty:
+            saw_empty = True
+            break
+        total += len(packet.values)
+    tally.observe(label, ids=["R-5.2-07"])
+    if total != m.count:
+        tally.fail("R-5.2-07", label, f"packets held {total} values for {m.count} announced")
+    tally.observe(label, ids=["R-5.2-06"]) if saw_empty else None
+
+
+def judge(
+    measurements: Iterable[Measurement],
+    ids: Iterable[str],
+    version: str,
+    ok: dict[str, str] | str = "conforms",
+) -> list[Finding]:
+    """Findings for ``ids`` over ``measurements``: reply, wait and data rules together."""
+    tally = Tally(ids)
+    for m in measurements:
+        tally.observe(
+            where(m),
+            reply_violations(m, version),
+            ids=[i for i in _reply_ids(m) if m.start.answered],
+        )
+        wait_violations(m, tally)
+        data_violations(m, tally)
+    return tally.findings(ok)
+
+
+def _reply_ids(m: Measurement) -> list[str]:
+    kind = m.command.kind
+    if kind in (Kind.MEASURE, Kind.VERIFY):
+        return ["R-4.4.5-01", "R-4.4.5-02", "R-4.2-02", "R-4.2-03"]
+    if kind is Kind.CONCURRENT:
+        return ["R-4.4.7-01", "R-4.4.7-02", "R-4.4.7-03", "R-4.2-02", "R-4.2-03"]
+    if kind is Kind.HIGH_VOLUME_ASCII:
+        return ["R-5.1-01", "R-4.2-02", "R-4.2-03"]
+    return ["R-5.2-01", "R-4.2-02", "R-4.2-03"]

@@ -1,0 +1,90 @@
+"""Judges for the v1.4 identify-measurement and metadata commands (section 6)."""
+
+from __future__ import annotations
+
+import re
+
+from ..master.records import Exchange, Measurement
+from ..protocol.responses import parse_measurement_reply_for, parse_metadata_reply, split_line
+from ..transcript import escape
+from ..verdicts import Finding
+from .tally import Tally
+
+SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
+
+
+def identify_matches(pairs: list[tuple[Exchange, Measurement]]) -> list[Finding]:
+    """R-6.1-02 with decision A9: same shape and count as the measurement's own reply; a
+    different ttt is only a warning."""
+    tally = Tally(("R-6.1-02",))
+    tally.decision("R-6.1-02", "A9")
+    for ident, m in pairs:
+        label = escape(ident.text)
+        if not ident.answered or not m.start.answered or ident.command is None:
+            continue
+        tally.observe(label)
+        a, _ = split_line(ident.reply_text)
+        b, _ = split_line(m.start.reply_text)
+        pa = parse_measurement_reply_for(a, ident.command)
+        pb = parse_measurement_reply_for(b, m.command)
+        if pa.violations or len(a) != len(b):
+            tally.fail(
+                "R-6.1-02", label, f"'{escape(a)}' is not shaped like {m.command}'s '{escape(b)}'"
+            )
+        elif pa.count != pb.count:
+            tally.fail("R-6.1-02", label, f"announces {pa.count} values, {m.command} {pb.count}")
+        elif pa.ttt != pb.ttt:
+            tally.fail(
+                "R-6.1-02", label, f"ttt {pa.ttt} differs from {m.command}'s {pb.ttt}", warning=True
+            )
+    return tally.findings("same reply as the measurement command")
+
+
+def records(exchanges: list[tuple[Exchange, bool, bool]], ids: tuple[str, ...]) -> list[Finding]:
+    """Metadata replies: each item is (exchange, crc expected, index expected valid)."""
+    tally = Tally(ids)
+    for ex, crc, valid in exchanges:
+        label = escape(ex.text)
+        if not ex.answered:
+            rid = "R-6.2-07" if valid else "R-6.2-05"
+            tally.fail(rid, label, f"{label} got no reply")
+            tally.fail("R-6.2-01", label, f"{label} got no reply")
+            continue
+        body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
+        reply = parse_metadata_reply(body, crc_expected=crc, expected_address=ex.text[0])
+        tally.observe(label, framing, ids=["R-6.2-01"])
+        if valid:
+            tally.observe(
+                label,
+                reply.violations,
+                ids=["R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2.2-01", "R-6.2-07", "R-6.2.1-01"],
+            )
+            if reply.invalid_index:
+                tally.fail(
+                    "R-6.2-07",
+                    label,
+                    f"{label} answered the invalid-index reply for an "
+                    "index inside the announced count",
+                )
+            elif reply.fields and not SHORT_ID.fullmatch(reply.fields[0]):
+                tally.fail(
+                    "R-6.2.1-01",
+                    label,
+                    f"field 1 '{escape(reply.fields[0])}' is neither "
+                    "a SHEF code nor a short identifier",
+                    warning=True,
+                )
+        else:
+            tally.observe(
+                label,
+                [v for v in reply.violations if v.requirement == "R-6.2-05"],
+                ids=["R-6.2-05"],
+            )
+            if not reply.invalid_index:
+                tally.fail(
+                    "R-6.2-05",
+                    label,
+                    f"invalid index answered '{escape(body)}' instead "
+                    f"of 'a{'<CRC>' if crc else ''}<CR><LF>'",
+                )
+    return tally.findings()

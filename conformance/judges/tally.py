@@ -1,0 +1,97 @@
+"""Collect violations for a fixed set of requirements over many observations, then give one
+finding per requirement.
+
+Judges look at many replies (every D reply of every measurement, say). A reader wants one
+line per requirement: how many observations, and the first few that broke the rule.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from ..protocol.values import Violation
+from ..verdicts import Finding, Verdict
+
+SHOWN = 3  # offending observations quoted per finding
+
+
+class Tally:
+    """Observations and violations for ``ids``; anything else given to it is ignored.
+
+    ``where`` labels say which exchange an observation came from (``0MC!``, ``0D1!``...).
+    """
+
+    def __init__(self, ids: Iterable[str]) -> None:
+        self.ids = tuple(ids)
+        self.observed: dict[str, list[str]] = {rid: [] for rid in self.ids}
+        self.violations: dict[str, list[tuple[str, Violation]]] = {rid: [] for rid in self.ids}
+        self.na: dict[str, str] = {}
+        self.decisions: dict[str, str] = {}
+
+    def observe(
+        self, where: str, violations: Iterable[Violation] = (), ids: Iterable[str] | None = None
+    ) -> None:
+        """One observation bearing on ``ids`` (default: all of this tally's IDs)."""
+        for rid in self.ids if ids is None else ids:
+            if rid in self.observed:
+                self.observed[rid].append(where)
+        for v in violations:
+            if v.requirement in self.violations:
+                self.violations[v.requirement].append((where, v))
+
+    def fail(self, rid: str, where: str, message: str, *, warning: bool = False) -> None:
+        self.observe(where, [Violation(rid, message, warning)], ids=[rid])
+
+    def not_applicable(self, rid: str, reason: str) -> None:
+        self.na.setdefault(rid, reason)
+
+    def decision(self, rid: str, label: str) -> None:
+        self.decisions[rid] = label
+
+    def findings(self, ok: dict[str, str] | str = "conforms") -> list[Finding]:
+        result = []
+        for rid in self.ids:
+            seen = self.observed[rid]
+            bad = self.violations[rid]
+            decision = self.decisions.get(rid)
+            if bad:
+                hard = [b for b in bad if not b[1].warning]
+                verdict = Verdict.FAIL if hard else Verdict.WARN
+                shown = (hard or bad)[:SHOWN]
+                more = len(hard or bad) - len(shown)
+                detail = "; ".join(f"{w}: {v.message}" for w, v in shown)
+                if more:
+                    detail += f" (+{more} more)"
+                result.append(
+                    Finding(
+                        rid,
+                        verdict,
+                        detail,
+                        decision=decision,
+                        evidence=[f"{len(seen)} observation(s)"],
+                    )
+                )
+            elif rid in self.na and not seen:
+                result.append(Finding(rid, Verdict.NA, self.na[rid], decision=decision))
+            elif not seen:
+                result.append(
+                    Finding(
+                        rid,
+                        Verdict.INCONCLUSIVE,
+                        "nothing was observed that this rule could be judged on",
+                    )
+                )
+            else:
+                text = ok if isinstance(ok, str) else ok.get(rid, "conforms")
+                listed = ", ".join(dict.fromkeys(seen))
+                if len(listed) > 160:
+                    listed = listed[:157] + "..."
+                result.append(
+                    Finding(
+                        rid,
+                        Verdict.PASS,
+                        f"{text} ({len(seen)} checked: {listed})",
+                        decision=decision,
+                    )
+                )
+        return result

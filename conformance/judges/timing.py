@@ -1,0 +1,66 @@
+"""Timing as metrology (design.md section 4): a measured interval with its uncertainty
+against a limit, giving PASS, FAIL or an honest INCONCLUSIVE.
+
+PASS only when the whole interval ``measured +/- uncertainty`` lies inside the allowed window
+(widened by the spec's tolerance), FAIL only when the whole interval lies outside it.
+"""
+
+from __future__ import annotations
+
+from ..protocol.timing import TOLERANCE
+from ..verdicts import Finding, Verdict
+
+
+def judge_window(
+    requirement: str,
+    what: str,
+    measured: float,
+    uncertainty: float,
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    tolerance: float = TOLERANCE,
+    should: bool = False,
+    evidence: list[str] | None = None,
+    decision: str | None = None,
+) -> Finding:
+    """Judge ``measured`` (s) against ``[low - tol, high + tol]``.
+
+    ``should`` turns a definite violation into WARN (a SHOULD rule or a lenient decision).
+    """
+    lo = None if low is None else low - tolerance
+    hi = None if high is None else high + tolerance
+    m_lo, m_hi = measured - uncertainty, measured + uncertainty
+    inside = (lo is None or m_lo >= lo) and (hi is None or m_hi <= hi)
+    outside = (lo is not None and m_hi < lo) or (hi is not None and m_lo > hi)
+    if inside:
+        verdict = Verdict.PASS
+    elif outside:
+        verdict = Verdict.WARN if should else Verdict.FAIL
+    else:
+        verdict = Verdict.INCONCLUSIVE
+    limit = _describe_limit(lo, hi)
+    detail = f"{what}: {measured * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} ms, allowed {limit}"
+    if verdict is Verdict.INCONCLUSIVE:
+        detail += " (the uncertainty straddles the limit)"
+    limit_ms = (hi if hi is not None else lo) or 0.0
+    return Finding(
+        requirement,
+        verdict,
+        detail,
+        measured_ms=round(measured * 1e3, 3),
+        limit_ms=round(limit_ms * 1e3, 3),
+        uncertainty_ms=round(uncertainty * 1e3, 3),
+        evidence=list(evidence or []),
+        decision=decision,
+    )
+
+
+def _describe_limit(lo: float | None, hi: float | None) -> str:
+    if lo is not None and hi is not None:
+        return f"{lo * 1e3:.2f}..{hi * 1e3:.2f} ms"
+    if hi is not None:
+        return f"≤ {hi * 1e3:.2f} ms"
+    if lo is not None:
+        return f"≥ {lo * 1e3:.2f} ms"
+    return "any"

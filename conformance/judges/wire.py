@@ -1,0 +1,323 @@
+"""Judges over the whole transcript: response timing, character gaps, framing of every reply.
+
+The transcript is cut into segments: a command the tool sent (with the break before it, if
+any), the DUT's reply to it (the run of characters that starts soon after the command), and
+anything the DUT sent later before the tool spoke again (service requests, chatter).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from ..protocol.commands import CommandError, Kind, parse_command
+from ..protocol.timing import (
+    CHAR_TIME,
+    INTER_CHAR_GAP_MAX,
+    NO_BREAK_WINDOW,
+    RESPONSE_START_MAX,
+    RESPONSE_START_MIN,
+    TOLERANCE,
+)
+from ..transcript import TOOL, Event, EventKind, escape
+from ..verdicts import Finding, Verdict
+from .timing import judge_window
+
+REPLY_SEARCH = NO_BREAK_WINDOW  # a DUT run starting later than this is not a reply
+RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
+
+
+@dataclass
+class Segment:
+    break_event: Event | None
+    command: list[Event]
+    reply: list[Event] = field(default_factory=list)
+    later: list[Event] = field(default_factory=list)
+
+    @property
+    def text(self) -> str:
+        return "".join(chr(e.char7) for e in self.command)
+
+    @property
+    def command_end(self) -> float:
+        return self.command[-1].end
+
+    @property
+    def binary_reply(self) -> bool:
+        """Replies to aDBn! are 8N1 packets, exempt from 7E1 and CR LF rules."""
+        try:
+            return parse_command(self.text).kind is Kind.BINARY_DATA
+        except CommandError:
+            return False
+
+    @property
+    def multiline(self) -> bool:
+        """A reply starting ``a<STX>`` is multi-line text (decision A10)."""
+        return len(self.reply) > 1 and self.reply[1].char7 == 0x02
+
+
+def segments(events: Iterable[Event]) -> list[Segment]:
+    result: list[Segment] = []
+    pending_break: Event | None = None
+    current: Segment | None = None
+    for e in events:
+        if e.kind is EventKind.NOTE:
+            continue
+        if e.origin == TOOL:
+            if e.kind is EventKind.BREAK:
+                pending_break, current = e, None
+                continue
+            if current is None or current.reply or current.later or current.text.endswith("!"):
+                current = Segment(pending_break, [e])
+                result.append(current)
+                pending_break = None
+            else:
+                current.command.append(e)
+            continue
+        if current is None:
+            continue  # DUT chatter before any command
+        _place_dut_char(current, e)
+    return result
+
+
+def _place_dut_char(seg: Segment, e: Event) -> None:
+    if seg.later:
+        seg.later.append(e)
+        return
+    if not seg.reply:
+        if e.start - seg.command_end <= REPLY_SEARCH:
+            seg.reply.append(e)
+        else:
+            seg.later.append(e)
+        return
+    last = seg.reply[-1]
+    ended = not seg.binary_reply and not seg.multiline and last.char7 == 0x0A
+    if ended or e.start - last.end > RUN_GAP:
+        seg.later.append(e)
+    else:
+        seg.reply.append(e)
+
+
+def runs(events: list[Event]) -> list[list[Event]]:
+    """Split DUT characters into runs separated by more than :data:`RUN_GAP` of marking."""
+    out: list[list[Event]] = []
+    for e in events:
+        if out and e.start - out[-1][-1].end <= RUN_GAP:
+            out[-1].append(e)
+        else:
+            out.append([e])
+    return out
+
+
+# -- timing ---------------------------------------------------------------------------------
+def _combine(rid: str, findings: list[Finding], what: str) -> Finding:
+    """One finding per requirement: the worst observation, with the range of all of them."""
+    if not findings:
+        return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
+    worst = max(findings, key=lambda f: (f.verdict.rank, abs(f.measured_ms or 0)))
+    values = [f.measured_ms for f in findings if f.measured_ms is not None]
+    span = f"{len(findings)} {what}s, {min(values):.2f}..{max(values):.2f} ms" if values else ""
+    if worst.verdict is Verdict.PASS:
+        detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"
+    else:
+        detail = f"{worst.detail} [{worst.evidence[0] if worst.evidence else ''}]; {span}"
+    return Finding(
+        rid,
+        worst.verdict,
+        detail,
+        measured_ms=worst.measured_ms,
+        limit_ms=worst.limit_ms,
+        uncertainty_ms=worst.uncertainty_ms,
+        evidence=worst.evidence,
+    )
+
+
+def judge_response_start(segs: list[Segment], uncertainty: float) -> list[Finding]:
+    """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply."""
+    early, late = [], []
+    for seg in segs:
+        if not seg.reply:
+            continue
+        delay = seg.reply[0].start - seg.command_end
+        where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
+        early.append(
+            judge_window(
+                "R-7.0-09",
+                "first response start bit after the command",
+                delay,
+                uncertainty,
+                low=CHAR_TIME,
+                tolerance=TOLERANCE,
+                evidence=where,
+            )
+        )
+        late.append(
+            judge_window(
+                "R-7.0-10",
+                "first response start bit after the command",
+                delay,
+                uncertainty,
+                high=RESPONSE_START_MAX,
+                evidence=where,
+            )
+        )
+    _ = RESPONSE_START_MIN  # = CHAR_TIME - TOLERANCE, the derived window's lower edge
+    return [_combine("R-7.0-09", early, "reply"), _combine("R-7.0-10", late, "reply")]
+
+
+def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
+    """Every marking gap between consecutive characters of one DUT run, with its context."""
+    gaps = []
+    for seg in segs:
+        for run in runs(seg.reply) + runs(seg.later):
+            for a, b in zip(run, run[1:], strict=False):
+                gaps.append((b.start - a.end, f"in reply to {escape(seg.text)}"))
+    return gaps
+
+
+def judge_gaps(segs: list[Segment], uncertainty: float) -> list[Finding]:
+    """R-7.0-12: at most 1.66 ms of marking between characters (no tolerance), and R-7.0-01:
+    a gap inside the ±0.40 ms band above 1.66 ms uses a tolerance the rule does not grant."""
+    findings = [
+        judge_window(
+            "R-7.0-12",
+            "marking between response characters",
+            gap,
+            uncertainty,
+            high=INTER_CHAR_GAP_MAX,
+            tolerance=0.0,
+            evidence=[where],
+        )
+        for gap, where in reply_gaps(segs)
+    ]
+    gap_finding = _combine("R-7.0-12", findings, "character gap")
+    tol = []
+    for gap, where in reply_gaps(segs):
+        if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
+            tol.append(
+                Finding(
+                    "R-7.0-01",
+                    Verdict.FAIL,
+                    f"gap of {gap * 1e3:.2f} ms relies on the ±0.40 ms tolerance, "
+                    "which the 1.66 ms character gap does not have",
+                    evidence=[where],
+                    measured_ms=round(gap * 1e3, 3),
+                    limit_ms=1.66,
+                )
+            )
+    if tol:
+        tolerance_finding = tol[0]
+        tolerance_finding.detail += f" ({len(tol)} such gap(s))"
+    elif findings:
+        tolerance_finding = Finding(
+            "R-7.0-01",
+            Verdict.PASS,
+            f"{len(findings)} character gaps: none leans on a tolerance the rule does not grant; "
+            "±0.40 ms applied to every other limit",
+        )
+    else:
+        tolerance_finding = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no character gap observed")
+    return [gap_finding, tolerance_finding]
+
+
+def judge_bit_rate(segs: list[Segment], uncertainty: float) -> Finding:
+    """R-4.1-01 (decision A14: 1200 baud ±2%). Back-to-back characters start one frame apart,
+    so the shortest start-to-start spacing inside a reply is at least one frame (8.17 ms at
+    +2%). A shorter spacing proves the rate too high. A rate too low cannot be told apart from
+    an allowed inter-character gap unless some characters come back to back (spacing within
+    the ±2% band), so without such a pair the verdict is INCONCLUSIVE, never a guess."""
+    spacings = []
+    for seg in segs:
+        for run in runs(seg.reply) + runs(seg.later):
+            spacings += [(b.start - a.start, seg.text) for a, b in zip(run, run[1:], strict=False)]
+    if not spacings:
+        return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character reply observed")
+    shortest, text = min(spacings)
+    low, high = CHAR_TIME * 0.98, CHAR_TIME * 1.02
+    where = [f"in reply to {escape(text)}"]
+    if shortest + 2 * uncertainty < low:
+        return judge_window(
+            "R-4.1-01",
+            "shortest character start-to-start spacing",
+            shortest,
+            2 * uncertainty,
+            low=low,
+            tolerance=0.0,
+            evidence=where,
+            decision="A14",
+        )
+    finding = judge_window(
+        "R-4.1-01",
+        "shortest character start-to-start spacing",
+        shortest,
+        2 * uncertainty,
+        low=low,
+        high=high,
+        tolerance=0.0,
+        evidence=where,
+        decision="A14",
+    )
+    if finding.verdict is Verdict.FAIL:  # too slow or gapped: not decidable, see docstring
+        finding.verdict = Verdict.INCONCLUSIVE
+        finding.detail += " (no back-to-back characters: rate and gaps cannot be separated)"
+    baud = 10 / shortest if shortest > 0 else float("inf")
+    finding.detail += f"; about {baud:.0f} baud from {len(spacings)} spacings"
+    return finding
+
+
+# -- framing of every reply -------------------------------------------------------------------
+def _reply_address(seg: Segment) -> str | None:
+    """The address a reply to this command must start with (None: any address)."""
+    text = seg.text
+    if text == "?!" or len(text) < 2:
+        return None
+    if len(text) == 4 and text[1] == "A" and text.endswith("!"):
+        return None  # aAb!: the new address, or the old one if the change failed
+    return text[0]
+
+
+def judge_framing(segs: list[Segment]) -> list[Finding]:
+    """R-4.1-02 (7E1 parity), R-4.2-02 (printable), R-4.2-03 (>= 3 chars, CR LF), R-4.3-01
+    (the responding sensor's address first) over every ASCII reply and service request."""
+    from ..protocol.responses import split_line  # local: wire must not depend on parsers
+    from .tally import Tally
+
+    tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
+    last_address = None
+    for seg in segs:
+        if seg.reply:
+            last_address = seg.reply[0].char7
+        if seg.binary_reply:
+            chunks = runs(seg.later)
+        else:
+            chunks = ([seg.reply] if seg.reply else []) + runs(seg.later)
+        for n, chunk in enumerate(chunks):
+            label = f"{'reply to' if n == 0 and seg.reply else 'later, after'} {escape(seg.text)}"
+            bad = [e for e in chunk if not e.parity_ok]
+            tally.observe(label, ids=["R-4.1-02"])
+            if bad:
+                tally.fail(
+                    "R-4.1-02",
+                    label,
+                    f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
+                )
+            text = "".join(chr(e.char7) for e in chunk)
+            if seg.multiline and n == 0:
+                text = text.replace("\x02", "").rstrip("\x03")  # decision A10
+            crc_positions = (
+                3 if len(text) >= 6 and all(0x40 <= ord(c) <= 0x7F for c in text[-5:-2]) else 0
+            )
+            body, framing = split_line(text, crc_positions=crc_positions)
+            tally.observe(label, framing, ids=["R-4.2-02", "R-4.2-03"])
+            expected = _reply_address(seg) if n == 0 and seg.reply else None
+            if n > 0 or not seg.reply:  # unsolicited: a service request from the sensor
+                expected = chr(last_address) if last_address else None
+            tally.observe(label, ids=["R-4.3-01"])
+            if expected and body[:1] != expected:
+                tally.fail(
+                    "R-4.3-01",
+                    label,
+                    f"reply '{escape(text)}' starts with "
+                    f"'{escape(body[:1])}', not the address '{expected}'",
+                )
+    return tally.findings()

@@ -1,0 +1,75 @@
+"""Turn a ``--port`` string into a link.
+
+``sim`` / ``sim://?faults=a,b&version=1.3&address=0`` is the built-in simulated bus with the
+reference sensor emulator on it (virtual time, exact stamps). Every other string is handed to
+the real-link layer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from urllib.parse import parse_qs, urlsplit
+
+from .links.base import Link
+
+
+class PortError(ValueError):
+    """A port string the tool cannot use; the message says what to do instead."""
+
+
+@dataclass
+class SimSpec:
+    faults: tuple[str, ...] = ()
+    version: str = "14"
+    address: str = "0"
+    extra: dict[str, str] = field(default_factory=dict)
+
+
+def is_sim(port: str) -> bool:
+    return port == "sim" or port.startswith("sim://") or port.startswith("sim:")
+
+
+def parse_sim(port: str) -> SimSpec:
+    """Parse ``sim://?faults=no-service-request,wrong-crc&version=1.3&address=5``."""
+    query = urlsplit(port).query if "://" in port or "?" in port else ""
+    params = {k: v[-1] for k, v in parse_qs(query, keep_blank_values=True).items()}
+    spec = SimSpec()
+    if "faults" in params:
+        spec.faults = tuple(f.strip() for f in params.pop("faults").split(",") if f.strip())
+    if "version" in params:
+        digits = params.pop("version").replace(".", "")
+        if digits not in ("13", "14"):
+            raise PortError(f"sim version must be 1.3 or 1.4, not {digits!r}")
+        spec.version = digits
+    if "address" in params:
+        spec.address = params.pop("address")
+    if params:
+        raise PortError(
+            f"unknown sim parameters {sorted(params)} (known: faults, version, address)"
+        )
+    return spec
+
+
+def open_sim(spec: SimSpec) -> tuple[Link, list[object]]:
+    """Build the simulated bus with one reference emulator; returns the link and the devices."""
+    from .emulator import FAULTS, default_profile, sim_sensor
+    from .protocol.commands import ADDRESS_CHARS
+
+    unknown = [f for f in spec.faults if f not in FAULTS]
+    if unknown:
+        raise PortError(
+            f"unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the known ones"
+        )
+    if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
+        raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
+    profile = replace(default_profile(spec.version), address=spec.address)
+    _bus, link, emulator = sim_sensor(profile, faults=spec.faults)
+    return link, [emulator]
+
+
+def open_port(port: str) -> tuple[Link, list[object]]:
+    if is_sim(port):
+        return open_sim(parse_sim(port))
+    from .links.factory import open_real_link
+
+    return open_real_link(port), []

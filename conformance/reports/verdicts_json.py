@@ -1,0 +1,100 @@
+"""``verdicts.json`` (contract ``sdi12-conform/verdicts/1``) and ``transcript.jsonl``.
+
+Keep the shape stable: CI jobs and other tools script against it. Add keys, never rename.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from ..results import counts
+from ..run import TOOL, ConformanceRun
+
+SCHEMA = "sdi12-conform/verdicts/1"
+
+
+def dut_block(run: ConformanceRun) -> dict[str, Any]:
+    session = run.session
+    ident = session.identity if session else None
+    raw = None
+    if session and session.ident_exchange is not None and session.ident_exchange.answered:
+        raw = session.ident_exchange.reply_text
+    version = session.version if session else None
+    return {
+        "address": session.address if session else run.options.address,
+        "identification": raw,
+        "sdi12_version": f"{version[0]}.{version[1]}" if version else None,
+        "vendor": ident.vendor if ident else None,
+        "model": ident.model if ident else None,
+        "firmware": ident.sensor_version if ident else None,
+        "serial": ident.optional if ident else None,
+        "assumptions": list(session.assumptions) if session else [],
+        "declaration": run.declaration.source if run.declaration else None,
+    }
+
+
+def build(run: ConformanceRun) -> dict[str, Any]:
+    results = run.results or []
+    return {
+        "schema": SCHEMA,
+        "tool": dict(TOOL),
+        "run": {
+            "started": run.started,
+            "finished": run.finished,
+            "role": run.options.role,
+            "port": run.options.port,
+            "link": run.link_description(),
+            "strict": run.options.strict,
+            "complete": run.complete,
+            "stop_reason": run.stop_reason or None,
+        },
+        "dut": dut_block(run),
+        "summary": {"verdict": run.verdict, "counts": counts(results)},
+        "requirements": [
+            {
+                "id": r.requirement.id,
+                "clause": r.requirement.clause,
+                "level": r.requirement.level,
+                "statement": r.requirement.statement,
+                "testable": r.requirement.testable(run.options.role),
+                "verdict": str(r.verdict),
+                "tests": r.tests,
+                "findings": [_finding(f) for f in r.findings],
+            }
+            for r in results
+        ],
+        "tests": [
+            {
+                "id": c.nodeid,
+                "verdict": str(c.verdict),
+                "requirements": list(c.requirements),
+                "duration_s": round(c.duration, 4),
+            }
+            for c in run.cases
+        ],
+    }
+
+
+def _finding(f: Any) -> dict[str, Any]:
+    return {
+        "test": f.test,
+        "verdict": str(f.verdict),
+        "detail": f.detail,
+        "measured_ms": f.measured_ms,
+        "limit_ms": f.limit_ms,
+        "uncertainty_ms": f.uncertainty_ms,
+        "evidence": f.evidence,
+        "decision": f.decision,
+    }
+
+
+def write(run: ConformanceRun, directory: Path) -> Path:
+    path = directory / "verdicts.json"
+    path.write_text(json.dumps(build(run), indent=2, ensure_ascii=False), encoding="utf-8")
+    if run.link is not None:
+        run.link.transcript.write_jsonl(str(directory / "transcript.jsonl"))
+    else:
+        (directory / "transcript.jsonl").write_text("", encoding="utf-8")
+    return path

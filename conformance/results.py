@@ -1,0 +1,105 @@
+"""From per-case findings to per-requirement verdicts and the overall verdict (design.md 3).
+
+Pure functions over records; the plugin feeds them and the reports read them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .catalog import Requirement, for_role
+from .transcript import Event
+from .verdicts import Finding, Verdict, worst
+
+COMPLIANT = "COMPLIANT"
+NON_COMPLIANT = "NON-COMPLIANT"
+INCOMPLETE = "INCOMPLETE"
+
+
+@dataclass
+class CaseRecord:
+    """What one conformance case did: its findings and the wire evidence behind them."""
+
+    nodeid: str
+    name: str
+    requirements: tuple[str, ...]
+    description: str = ""
+    expectation: str = ""
+    findings: list[Finding] = field(default_factory=list)
+    evidence: list[tuple[str, list[Event]]] = field(default_factory=list)
+    duration: float = 0.0
+    verdict: Verdict = Verdict.NA
+
+    def summarise(self) -> Verdict:
+        self.verdict = worst((f.verdict for f in self.findings), default=Verdict.ERROR)
+        return self.verdict
+
+
+@dataclass
+class RequirementResult:
+    requirement: Requirement
+    verdict: Verdict
+    findings: list[Finding]
+    tests: list[str]
+
+    @property
+    def one_line(self) -> str:
+        """The evidence line a reader sees first: the finding that set the verdict."""
+        for f in self.findings:
+            if f.verdict is self.verdict:
+                return f.detail
+        return ""
+
+
+def aggregate(role: str, cases: list[CaseRecord]) -> list[RequirementResult]:
+    """Every catalog requirement of ``role`` with the worst verdict of its findings.
+
+    A testable requirement that no case judged is INCONCLUSIVE (a hole in the certificate,
+    never a silent PASS); an untestable one is N/A with the reason it cannot be tested here.
+    """
+    by_id: dict[str, list[Finding]] = {}
+    tests: dict[str, list[str]] = {}
+    for case in cases:
+        for f in case.findings:
+            by_id.setdefault(f.requirement, []).append(f)
+        for rid in case.requirements:
+            tests.setdefault(rid, []).append(case.nodeid)
+    results = []
+    for req in for_role(role):
+        findings = by_id.get(req.id, [])
+        if not req.testable(role):
+            reason = req.untestable_reason or "not testable by this tool"
+            findings = [Finding(req.id, Verdict.NA, f"untestable here: {reason}")]
+        elif not findings:
+            findings = [Finding(req.id, Verdict.INCONCLUSIVE, "no case judged this requirement")]
+        verdict = worst(f.verdict for f in findings)
+        results.append(
+            RequirementResult(req, verdict, findings, sorted(set(tests.get(req.id, []))))
+        )
+    return results
+
+
+def overall(results: list[RequirementResult], *, strict: bool, complete: bool) -> str:
+    verdicts = {r.verdict for r in results}
+    if Verdict.FAIL in verdicts or (strict and Verdict.WARN in verdicts):
+        return NON_COMPLIANT
+    if not complete or Verdict.ERROR in verdicts:
+        return INCOMPLETE
+    return COMPLIANT
+
+
+def counts(results: list[RequirementResult]) -> dict[str, int]:
+    tally = {
+        str(v): 0
+        for v in (
+            Verdict.PASS,
+            Verdict.FAIL,
+            Verdict.WARN,
+            Verdict.INCONCLUSIVE,
+            Verdict.NA,
+            Verdict.ERROR,
+        )
+    }
+    for r in results:
+        tally[str(r.verdict)] += 1
+    return tally

@@ -1,0 +1,138 @@
+"""One conformance run: options, the link, the session, the case records, and the outputs.
+
+Created by the plugin at configure time; the link is opened lazily by the first case that needs
+the DUT, so `pytest --pyargs testcases` with nothing selected never touches a port.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from . import __version__
+from .declaration import Declaration, load_declaration, normalise_version
+from .links.base import Link
+from .ports import is_sim, open_port
+from .results import CaseRecord, RequirementResult, aggregate, overall
+from .sensor_session import SensorSession
+
+
+@dataclass
+class RunOptions:
+    port: str = "sim"
+    role: str = "sensor"
+    address: str | None = None
+    version: str | None = None
+    declaration: str | None = None
+    report_dir: str | None = None
+    strict: bool = False
+    timing_uncertainty_ms: float | None = None
+
+    @classmethod
+    def from_config(cls, config: Any) -> RunOptions:
+        get = config.getoption
+        return cls(
+            port=get("sdi12_port"),
+            role=get("sdi12_role"),
+            address=get("sdi12_address"),
+            version=get("sdi12_version"),
+            declaration=get("sdi12_declaration"),
+            report_dir=get("sdi12_report_dir"),
+            strict=get("sdi12_strict"),
+            timing_uncertainty_ms=get("sdi12_timing_uncertainty_ms"),
+        )
+
+
+def now_iso() -> str:
+    return dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
+
+
+@dataclass
+class ConformanceRun:
+    options: RunOptions
+    started: str = field(default_factory=now_iso)
+    finished: str | None = None
+    cases: list[CaseRecord] = field(default_factory=list)
+    link: Link | None = None
+    devices: list[object] = field(default_factory=list)
+    session: SensorSession | None = None
+    complete: bool = True
+    stop_reason: str = ""
+    declaration: Declaration | None = None
+    results: list[RequirementResult] | None = None
+    verdict: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.options.declaration:
+            self.declaration = load_declaration(self.options.declaration)
+
+    @property
+    def active(self) -> bool:
+        """Whether any conformance case ran (the plugin stays silent for ordinary tests)."""
+        return bool(self.cases)
+
+    def open_link(self) -> Link:
+        if self.link is None:
+            self.link, self.devices = open_port(self.options.port)
+        return self.link
+
+    def sensor_session(self) -> SensorSession:
+        if self.session is None:
+            uncertainty = self.options.timing_uncertainty_ms
+            session = SensorSession(
+                self.open_link(),
+                address=self.options.address,
+                declaration=self.declaration,
+                forced_version=normalise_version(self.options.version)
+                if self.options.version
+                else None,
+                timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
+            )
+            self.session = session
+            session.discover()
+        return self.session
+
+    @property
+    def dut_version(self) -> str | None:
+        return self.session.version if self.session else None
+
+    def finish(self, complete: bool) -> list[RequirementResult]:
+        self.complete = self.complete and complete
+        self.finished = now_iso()
+        self.results = aggregate(self.options.role, self.cases)
+        self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
+        return self.results
+
+    def report_dir(self) -> Path:
+        if self.options.report_dir:
+            path = Path(self.options.report_dir)
+        else:
+            stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+            path = Path("reports") / f"{stamp}-{self.options.role}"
+            self.options.report_dir = str(path)
+        path.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def link_description(self) -> dict[str, Any]:
+        info = self.link.info if self.link else None
+        uncertainty = self.session.uncertainty if self.session else None
+        if info is None:
+            return {
+                "kind": "sim" if is_sim(self.options.port) else "unknown",
+                "can_break": None,
+                "timing_uncertainty_ms": None,
+            }
+        return {
+            "kind": info.kind,
+            "can_break": info.can_break,
+            "timing_uncertainty_ms": round((uncertainty or 0.0) * 1000, 3),
+        }
+
+    def close(self) -> None:
+        if self.link is not None:
+            self.link.close()
+
+
+TOOL = {"name": "sdi12-conform", "version": __version__}

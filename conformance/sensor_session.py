@@ -1,0 +1,246 @@
+"""The sensor under test as the sensor-role cases see it.
+
+One master engine on one link, the identity read from ``aI!``, the declaration, and a cache of
+stimuli: each exchange (say one ``aMC!`` with its service request and D replies) runs once and
+is judged by every case that bears on it ("one stimulus, many judges"). Cases that need a
+fresh state (aborts, address change) ask for a ``fresh`` stimulus explicitly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+from .address_change import AddressChanger
+from .declaration import Declaration
+from .links.base import Link
+from .master.engine import Master
+from .master.records import Exchange, Measurement
+from .protocol import commands as cmd
+from .protocol.commands import Command, parse_command
+from .protocol.responses import Identification, parse_ident, split_line
+from .transcript import Event
+
+T = TypeVar("T")
+
+
+@dataclass
+class Sweep:
+    exchanges: list[Exchange]
+    refused: list[str]
+    restore_note: str
+
+
+@dataclass
+class InvalidAddressAttempt:
+    exchanges: list[Exchange]
+    accepted: bool
+
+
+class NoDeviceAnswered(RuntimeError):
+    """Nothing answered at the address: a wiring/power/address problem, not a verdict."""
+
+
+class SensorSession:
+    def __init__(
+        self,
+        link: Link,
+        *,
+        address: str | None = None,
+        declaration: Declaration | None = None,
+        forced_version: str | None = None,
+        timing_uncertainty: float | None = None,
+    ) -> None:
+        self.link = link
+        self.master = Master(link)
+        self.declaration = declaration or Declaration()
+        self.requested_address = address or self.declaration.address
+        self.address = self.requested_address or "0"
+        self.forced_version = forced_version or self.declaration.sdi12_version
+        self.uncertainty = (
+            link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
+        )
+        self.identity: Identification | None = None
+        self.ident_exchange: Exchange | None = None
+        self.assumptions: list[str] = []
+        self.address_notes: list[str] = []  # what every address change left behind
+        self._cache: dict[Any, Any] = {}
+
+    # -- discovery ----------------------------------------------------------------------------
+    def discover(self) -> None:
+        """Find the address (``?!`` if none was given) and read ``aI!`` to pick the rule set."""
+        if self.requested_address is None:
+            ex = self.master.query_address()
+            body, _ = split_line(ex.reply_text)
+            if ex.answered and len(body) == 1 and body in cmd.ADDRESS_CHARS:
+                self.address = body
+                self.assumptions.append(f"address {body!r} found with ?! (one sensor on the bus)")
+            else:
+                self.assumptions.append("no answer to ?!; assuming address '0'")
+        ex = self.master.identify(self.address)
+        self.ident_exchange = ex
+        if not ex.answered:
+            ack = self.master.acknowledge(self.address)
+            if not ack.answered:
+                raise NoDeviceAnswered(
+                    f"no device answered at address {self.address!r} (a! and aI! got no reply "
+                    "after retries). Check wiring and power, or try ?! with one sensor on the bus."
+                )
+        body, _ = split_line(ex.reply_text)
+        self.identity = parse_ident(body, expected_address=self.address) if ex.answered else None
+        if self.forced_version:
+            self.assumptions.append(
+                f"rule set v{self.forced_version[0]}.{self.forced_version[1]} "
+                "forced by the user/declaration"
+            )
+
+    @property
+    def version(self) -> str:
+        """The rule set: forced > the ``ll`` of ``aI!`` > v1.4 (newest) as an assumption."""
+        if self.forced_version:
+            return self.forced_version
+        if self.identity and self.identity.version in ("13", "14"):
+            return self.identity.version
+        if "version" not in self._cache:
+            self._cache["version"] = True
+            self.assumptions.append("aI! gave no usable version; judging against v1.4")
+        return "14"
+
+    @property
+    def is_v14(self) -> bool:
+        return self.version >= "14"
+
+    # -- cached stimuli ------------------------------------------------------------------------
+    def once(self, key: Any, make: Callable[[], T]) -> T:
+        if key not in self._cache:
+            self._cache[key] = make()
+        return self._cache[key]
+
+    def command(self, code: str) -> Command:
+        """``"MC1"`` -> the parsed command for this DUT's address."""
+        return parse_command(f"{self.address}{code}!")
+
+    def exchange(self, code: str, *, binary: bool = False) -> Exchange:
+        """The cached reply to one command (``"I"``, ``"R0"``, ``"IMC_001"``...)."""
+        return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
+
+    def fresh_exchange(self, code: str, *, binary: bool = False, **kw: Any) -> Exchange:
+        return self.master.transact(self.command(code), binary=binary, **kw)
+
+    def measurement(self, code: str) -> Measurement:
+        """The cached full measurement for ``"M"``, ``"MC"``, ``"C9"``, ``"HA"``, ``"HB"``..."""
+        return self.once(("m", code), lambda: self.fresh_measurement(code))
+
+    def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
+        return self.master.measure(self.command(code), **kw)
+
+    def feature(self, name: str) -> bool | None:
+        return self.declaration.feature(name)
+
+    def listen(self, duration: float) -> list[Event]:
+        """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""
+        return self.link.receive(self.link.now() + duration)
+
+    def probe(
+        self,
+        text: str,
+        *,
+        break_s: float | None,
+        marking_s: float = 9e-3,
+        gap: float = 0.0,
+        idle_before: float = 0.0,
+    ) -> Exchange:
+        """Send ``text`` once with a hand-made wake-up: ``idle_before`` s of marking, then a
+        spacing of ``break_s`` (None: no break at all), then ``marking_s`` of marking.
+        Timing cases use it to present breaks and markings near the section 7 thresholds."""
+        if idle_before:
+            self.listen(idle_before)
+        if break_s is not None:
+            self.link.send_break(break_s)
+            self.link.wait(marking_s)
+        return self.master.raw(text, break_first=False, gap=gap)
+
+    # -- address changes (always restored) -------------------------------------------------
+    def address_change_supported(self) -> bool:
+        """Declared, or found out with one change to a spare address and back."""
+        declared = self.feature("address_change")
+        if declared is not None:
+            return declared
+        return self.once("address-change", self._discover_address_change)
+
+    def spare_address(self) -> str:
+        return next(a for a in "9876543210" if a != self.address)
+
+    def _discover_address_change(self) -> bool:
+        changer = AddressChanger(self.master, self.address)
+        try:
+            took = changer.change(self.spare_address()).took
+        finally:
+            self.address_notes.append(changer.restore())
+        self.assumptions.append(
+            "address change (aAb!) "
+            + ("supported" if took else "not supported")
+            + ", found by trying it"
+        )
+        return took
+
+    def address_sweep(self, targets: str) -> Sweep:
+        """Change to each address in ``targets`` and back; restore whatever happens."""
+        changer = AddressChanger(self.master, self.address)
+        refused = []
+        try:
+            for target in targets:
+                if target == self.address:
+                    continue
+                outcome = changer.change(target)
+                if not outcome.took or outcome.answered_after is None:
+                    refused.append(target)
+                note = changer.restore()
+                if not changer.restored:
+                    break
+        finally:
+            note = changer.restore()
+            self.address_notes.append(note)
+        return Sweep(changer.exchanges, refused, note)
+
+    def try_invalid_address(self, bad: str) -> InvalidAddressAttempt:
+        """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it."""
+        changer = AddressChanger(self.master, self.address)
+        try:
+            ex = self.master.raw(f"{self.address}A{bad}!", break_first=True)
+            changer.exchanges.append(ex)
+            body, _ = split_line(ex.reply_text)
+            accepted = ex.answered and body == bad
+        finally:
+            self.address_notes.append(changer.restore())
+        return InvalidAddressAttempt(changer.exchanges, accepted)
+
+    def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
+        """Start ``command``, send ``disturb`` (after a break) while it runs, wait out ttt,
+        then break and collect: how concurrent measurements are tested for (non-)aborts."""
+        m = self.master.measure(command, collect=False, wait="none")
+        self.listen(0.05)
+        poke = self.master.raw(disturb, break_first=True)
+        if m.reply_end is not None and m.ttt:
+            self.link.wait_until(m.reply_end + m.ttt + self.master.policy.ttt_margin)
+        self.master.collect(m, force_break=True)
+        return m, poke
+
+    def family(self, codes: tuple[str, ...]) -> list[Measurement]:
+        """Cached measurements for every command code of a family (``M_FAMILY``...)."""
+        return [self.measurement(code) for code in codes]
+
+    def defined(self, codes: tuple[str, ...]) -> list[Measurement]:
+        """The measurements of ``codes`` that announced at least one value."""
+        return [m for m in self.family(codes) if m.count]
+
+    def supports(self, code: str) -> bool:
+        """Whether ``aHA!``/``aHB!`` (or a numbered group) announces values at all."""
+        return bool(self.measurement(code).count)
+
+
+# -- what the suite asks of every sensor -------------------------------------------------------
+M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in range(1, 10)), "V")
+C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
+HV_FAMILY = ("HA", "HB")

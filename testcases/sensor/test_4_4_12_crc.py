@@ -1,0 +1,84 @@
+"""Section 4.4.12: the CRC variants (aMC!, aCC!, aRC!) and the CRC itself."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as xjudge
+from conformance.judges import measurements as judge
+from conformance.sensor_session import C_FAMILY, M_FAMILY
+from conformance.verdicts import Finding, passed, warned
+
+requirements = pytest.mark.requirements
+CRC_CODES = tuple(c for c in M_FAMILY + C_FAMILY if c[:2] in ("MC", "CC"))
+PLAIN_CODES = tuple(c for c in M_FAMILY + C_FAMILY if c not in CRC_CODES)
+
+
+def _with_continuous(sensor, ids) -> list[Finding]:
+    """Findings over the D replies of every measurement plus the R/RC replies."""
+    ms = sensor.defined(M_FAMILY + C_FAMILY)
+    found = judge.judge(ms, ids, sensor.version)
+    pairs = {i: (sensor.exchange(f"R{i}"), sensor.exchange(f"RC{i}")) for i in range(10)}
+    more = {f.requirement: f for f in xjudge.continuous(pairs, ids)}
+    merged = []
+    for f in found:
+        other = more.get(f.requirement)
+        if other is not None and other.verdict.rank > f.verdict.rank:
+            merged.append(other)
+        else:
+            merged.append(f)
+    return merged
+
+
+@requirements("R-4.4.12-01")
+def test_crc_commands_supported(sensor, case):
+    """A sensor claiming v1.3 or later answers aMC!, aMC1..9!, aCC!, aCC1..9! and aRC0..9!."""
+    case.expect("a reply to each CRC-variant command")
+    exchanges = [sensor.measurement(c).start for c in CRC_CODES]
+    exchanges += [sensor.exchange(f"RC{i}") for i in range(10)]
+    case.evidence("CRC-variant commands", exchanges)
+    case.add(xjudge.answered("R-4.4.12-01", exchanges, "CRC variants are mandatory from v1.3"))
+
+
+@requirements("R-4.4.12-02", "R-4.4.12-03")
+def test_crc_presence(sensor, case):
+    """D replies after a CRC variant, and RC replies, end with 3 CRC characters; replies to
+    the plain commands carry none."""
+    case.expect("3 CRC characters before CR LF exactly where a CRC was asked for")
+    case.evidence("D replies and R/RC replies", sensor.defined(M_FAMILY + C_FAMILY))
+    case.extend(_with_continuous(sensor, case.requirements))
+
+
+@requirements("R-4.4.12-05", "R-4.4.12-06")
+def test_crc_value_and_encoding(sensor, case):
+    """The CRC is CRC-16/ARC over the reply from the address up to the CRC, sent as three
+    characters 0x40 | 6-bit groups."""
+    case.expect("recomputed CRC equals the 3 characters sent")
+    case.evidence("D replies and R/RC replies", sensor.defined(CRC_CODES))
+    case.extend(_with_continuous(sensor, case.requirements))
+
+
+@requirements("R-4.4.12-04")
+def test_crc_variant_same_measurement(sensor, case):
+    """A CRC variant takes the same measurement as its plain twin (same count)."""
+    case.expect("aMC! announces the same n as aM!, aCC! the same nn as aC!, and so on")
+    pairs = []
+    for plain in PLAIN_CODES:
+        if plain == "V":
+            continue
+        twin = plain[0] + "C" + plain[1:]
+        pairs.append((sensor.measurement(plain), sensor.measurement(twin)))
+    case.evidence("plain and CRC measurement replies", [x.start for p in pairs for x in p])
+    differ = [(a, b) for a, b in pairs if a.count != b.count]
+    if differ:
+        case.add(
+            warned(
+                "R-4.4.12-04",
+                "; ".join(
+                    f"{a.command} announced {a.count} but {b.command} {b.count}"
+                    for a, b in differ[:3]
+                ),
+            )
+        )
+    else:
+        case.add(passed("R-4.4.12-04", f"{len(pairs)} plain/CRC pairs announce the same counts"))

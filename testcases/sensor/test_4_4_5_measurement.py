@@ -1,0 +1,189 @@
+"""Sections 4.4.5-4.4.6: aM!-type measurements, service requests, aborts, the data buffer."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import measurements as judge
+from conformance.judges.exchanges import shown
+from conformance.judges.wire import runs
+from conformance.protocol.responses import split_line
+from conformance.sensor_session import C_FAMILY, HV_FAMILY, M_FAMILY
+from conformance.transcript import decode_7e1, escape
+from conformance.verdicts import failed, passed, warned
+
+requirements = pytest.mark.requirements
+SR_FAMILY = M_FAMILY  # decision A5: the whole M family and V raise service requests
+
+
+@requirements("R-4.4.5-01", "R-4.4.5-02")
+def test_measurement_reply(sensor, case):
+    """aM!, aMC!, aM1..9!, aMC1..9!, aV! answer atttn; a defined measurement has n of 1..9."""
+    case.expect(
+        "'atttn<CR><LF>' with 3 digits of seconds and 1 digit of count; n >= 1 for "
+        "aM!/aMC!/aV! (decision A1: 0 only for an undefined group)"
+    )
+    ms = sensor.family(SR_FAMILY)
+    case.evidence("M-family replies", [m.start for m in ms])
+    case.extend(judge.judge(ms, case.requirements, sensor.version))
+
+
+@requirements("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")
+def test_service_request(sensor, case):
+    """With ttt > 0 the sensor sends 'a<CR><LF>' when data are ready, before ttt runs out, and
+    nothing else meanwhile."""
+    case.expect(
+        "exactly 'a<CR><LF>', complete within ttt s of the reply (decision A6), no "
+        "other character before it; ttt not much longer than needed"
+    )
+    ms = [m for m in sensor.family(SR_FAMILY) if m.ttt]
+    case.evidence("measurements with ttt > 0", ms)
+    if not ms:
+        case.not_applicable("no M-family measurement announced ttt > 0")
+        return
+    case.extend(judge.judge(ms, case.requirements, sensor.version))
+
+
+@requirements("R-4.4.6-03", "R-4.4.5-03")
+def test_ttt_zero(sensor, case):
+    """With ttt = 000 there is no service request and aD0! returns the data at once."""
+    case.expect("silence after 'a000n', then values from an immediate aD0!")
+    zero = [
+        code
+        for code in SR_FAMILY
+        if sensor.measurement(code).ttt == 0 and sensor.measurement(code).count
+    ]
+    if not zero:
+        case.not_applicable("no measurement announced ttt = 000 with values")
+        return
+    code = zero[0]
+    start = sensor.fresh_exchange(code)
+    quiet = sensor.listen(0.5)
+    d0 = sensor.fresh_exchange("D0")
+    case.evidence(f"{code} with ttt 000, 0.5 s of listening, D0", [start, quiet, d0])
+    if quiet:
+        case.add(
+            failed(
+                "R-4.4.6-03",
+                f"sent '{escape(decode_7e1(quiet))}' after "
+                f"'{escape(start.reply_text)}' announced ttt = 000",
+            )
+        )
+    else:
+        case.add(passed("R-4.4.6-03", f"no service request in 0.5 s after {shown(start)}"))
+    body, _ = split_line(d0.reply_text)
+    if d0.answered and len(body) > 1 and body[1] in "+-":
+        case.add(passed("R-4.4.5-03", f"data ready at once: {shown(d0)}"))
+    else:
+        case.add(failed("R-4.4.5-03", f"aD0! right after ttt = 000 gave no values: {shown(d0)}"))
+
+
+@requirements("R-4.4.6-05")
+def test_no_service_request_after_concurrent(sensor, case):
+    """C, CC, Cn, CCn, HA and HB are never followed by a service request."""
+    case.expect("no 'a<CR><LF>' between the atttnn/atttnnn reply and the D command")
+    ms = [m for m in sensor.family(C_FAMILY + HV_FAMILY) if m.ttt]
+    case.evidence("concurrent measurements", ms)
+    if not ms:
+        case.not_applicable("no concurrent measurement announced ttt > 0")
+        return
+    case.extend(judge.judge(ms, case.requirements, sensor.version))
+
+
+@requirements("R-4.4.5-10")
+def test_data_retained(sensor, case):
+    """Data stay readable, unchanged, across a break, standby and non-measuring commands."""
+    case.expect("the same D replies before and after: break, >100 ms idle, aI!, a!, break")
+    m = next((m for m in sensor.defined(("M", "MC", "V")) if m.complete), None)
+    if m is None:
+        case.add(failed("R-4.4.5-10", "no M-type measurement delivered its data to compare"))
+        return
+    fresh = sensor.fresh_measurement(m.command.text()[1:-1])
+    before = [ex.reply_text for ex in fresh.data]
+    sensor.listen(0.2)
+    sensor.master.send_break()
+    sensor.fresh_exchange("I")
+    sensor.fresh_exchange("")
+    sensor.listen(0.2)
+    again = [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
+    case.evidence(
+        "measurement, then break/standby/aI!/a!, then the D commands again", [fresh, *again]
+    )
+    after = [ex.reply_text for ex in again]
+    if before != after:
+        diff = next(
+            i for i, (x, y) in enumerate(zip(before, after + [""] * 10, strict=False)) if x != y
+        )
+        case.add(
+            failed(
+                "R-4.4.5-10",
+                f"D{diff} changed from '{escape(before[diff])}' to "
+                f"'{escape(after[diff]) if diff < len(after) else '(nothing)'}'",
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-4.4.5-10", f"{len(after)} D replies identical after break, standby and aI!/a!"
+            )
+        )
+
+
+@requirements("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03")
+def test_break_aborts_measurement(sensor, case):
+    """A break before the service request aborts an M measurement; D0 then has no values and
+    the sensor takes a new measurement normally."""
+    case.expect(
+        "no service request after the break; aD0! answers 'a[<CRC>]<CR><LF>'; a new aM! works"
+    )
+    candidates = [m for m in sensor.family(("M", "MC", *M_FAMILY[2:])) if m.ttt and m.count]
+    if not candidates:
+        case.not_applicable("no M-type measurement with ttt > 0 to abort")
+        return
+    target = candidates[0]
+    code = target.command.text()[1:-1]
+    start = sensor.fresh_exchange(code)
+    sensor.listen(min(0.05, target.ttt / 10))
+    brk = sensor.master.send_break()
+    waited = sensor.listen(target.ttt + 0.5)
+    d0 = sensor.fresh_exchange("D0", crc=target.command.crc)
+    again = sensor.fresh_measurement(code)
+    case.evidence(
+        f"{code}, break, wait past ttt, D0, then {code} again", [start, [brk], waited, d0, again]
+    )
+    srs = [r for r in runs(waited) if decode_7e1(r) == f"{sensor.address}\r\n"]
+    if srs:
+        case.add(
+            failed(
+                "R-4.4.5.1-01",
+                "service request arrived after the break: the measurement was not aborted",
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-4.4.5.1-01",
+                f"no service request in the {target.ttt + 0.5:.1f} s after the break",
+            )
+        )
+    body, _ = split_line(d0.reply_text)
+    expected = 1 + (3 if target.command.crc else 0)
+    if d0.answered and len(body) == expected and body[0] == sensor.address:
+        case.add(passed("R-4.4.5.1-02", f"D0 after the abort: {shown(d0)}", decision="A3"))
+    else:
+        case.add(
+            warned(
+                "R-4.4.5.1-02",
+                f"D0 after the abort should hold no values: {shown(d0)}",
+                decision="A3",
+            )
+        )
+    if again.complete:
+        case.add(passed("R-4.4.5.1-03", f"the next {code} delivered {again.value_count} values"))
+    else:
+        case.add(
+            failed(
+                "R-4.4.5.1-03",
+                f"after the abort {code} delivered {again.value_count} of {again.count} values",
+            )
+        )

@@ -1,0 +1,131 @@
+"""Section 4.4.7: concurrent measurements (aC!, aCC!, aC1..9!, aCC1..9!)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as xjudge
+from conformance.judges import measurements as judge
+from conformance.protocol.responses import split_line
+from conformance.sensor_session import C_FAMILY
+from conformance.verdicts import failed, passed, warned
+
+requirements = pytest.mark.requirements
+
+
+@requirements("R-4.4.7-01", "R-4.4.7-02", "R-4.4.7-03")
+def test_concurrent_reply(sensor, case):
+    """Concurrent commands answer atttnn; aC! measures for real; nn fits the claimed version."""
+    case.expect("'atttnn<CR><LF>'; aC! is not 'a00000'; nn <= 20 under v1.3 (decision A2 warns)")
+    ms = sensor.family(C_FAMILY)
+    case.evidence("C-family replies", [m.start for m in ms])
+    case.extend(judge.judge(ms, case.requirements, sensor.version))
+
+
+@requirements("R-4.4.7-04")
+def test_quiet_during_concurrent(sensor, case):
+    """Between its atttnn reply and the aD0! the sensor sends nothing."""
+    case.expect("no character from the sensor while the concurrent measurement runs")
+    ms = [m for m in sensor.family(C_FAMILY) if m.ttt]
+    case.evidence("concurrent measurements with ttt > 0", ms)
+    if not ms:
+        case.not_applicable("no concurrent measurement announced ttt > 0")
+        return
+    case.extend(judge.judge(ms, case.requirements, sensor.version))
+
+
+@requirements("R-4.4.7-08")
+def test_concurrent_supported(sensor, case):
+    """A sensor claiming v1.2 or later (every ll this tool knows) answers aC!."""
+    case.expect("a valid 'atttnn' reply to aC!")
+    m = sensor.measurement("C")
+    case.evidence("aC!", m.start)
+    body, _ = split_line(m.start.reply_text)
+    if m.start.answered and m.count is not None and len(body) == 6:
+        case.add(passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'"))
+    else:
+        case.add(failed("R-4.4.7-08", f"aC! not supported: {xjudge.shown(m.start)}"))
+
+
+def _running_concurrent(sensor):
+    """A defined concurrent measurement with ttt >= 1, to be disturbed while it runs."""
+    return next((m for m in sensor.family(("C", "CC", *C_FAMILY[2:])) if m.ttt and m.count), None)
+
+
+@requirements("R-4.4.7-05")
+def test_concurrent_survives_break_and_other_traffic(sensor, case):
+    """A break and a command to another address do not abort a running concurrent
+    measurement (decision A4)."""
+    case.expect("all announced values delivered after a break and a foreign-address command")
+    target = _running_concurrent(sensor)
+    if target is None:
+        case.not_applicable("no concurrent measurement with ttt > 0")
+        return
+    code = target.command.text()[1:-1]
+    other = sensor.spare_address()
+    m, poke = sensor.disturbed_measurement(target.command, f"{other}I!")
+    case.evidence(f"{code} with a break and {other}I! while it ran", [m, poke])
+    if m.complete:
+        case.add(
+            passed(
+                "R-4.4.7-05",
+                f"{code} delivered all {m.count} values after a break and {other}I!",
+                decision="A4",
+            )
+        )
+    else:
+        case.add(
+            failed(
+                "R-4.4.7-05",
+                f"{code} delivered {m.value_count} of {m.count} values "
+                f"after a break and {other}I! (aborted?)",
+                decision="A4",
+            )
+        )
+
+
+@requirements("R-4.4.7.1-01", "R-4.4.7.1-02")
+def test_own_command_aborts_concurrent(sensor, case):
+    """A valid command to the sensor itself aborts a running concurrent measurement; its D
+    replies are then empty."""
+    case.expect("after aI! during the measurement, aD0! answers 'a[<CRC>]<CR><LF>'")
+    target = next((m for m in sensor.family(("CC", "C", *C_FAMILY[2:])) if m.ttt and m.count), None)
+    if target is None:
+        case.not_applicable("no concurrent measurement with ttt > 0")
+        return
+    code = target.command.text()[1:-1]
+    m, poke = sensor.disturbed_measurement(target.command, f"{sensor.address}I!")
+    case.evidence(f"{code} interrupted by {sensor.address}I!", [m, poke])
+    d0 = m.data[0] if m.data else None
+    if d0 is None or not d0.answered:
+        case.add(failed("R-4.4.7.1-02", "aD0! after the interruption got no reply"))
+        case.not_applicable("no D0 reply to judge", ["R-4.4.7.1-01"])
+        return
+    body, _ = split_line(d0.reply_text)
+    expected = 1 + (3 if target.command.crc else 0)
+    if m.value_count:
+        case.add(
+            warned(
+                "R-4.4.7.1-01",
+                f"{code} was not aborted by {sensor.address}I!: {xjudge.shown(d0)}",
+                decision="A3",
+            )
+        )
+        case.not_applicable("the measurement was not aborted", ["R-4.4.7.1-02"])
+    else:
+        case.add(passed("R-4.4.7.1-01", f"{code} aborted by {sensor.address}I!", decision="A3"))
+        if (
+            len(body) == expected
+            and body[:1] == sensor.address
+            and (expected == 1 or body[1:] == xjudge.ascii_crc(body[:1]))
+        ):
+            case.add(passed("R-4.4.7.1-02", f"empty reply {xjudge.shown(d0)}"))
+        else:
+            case.add(
+                warned(
+                    "R-4.4.7.1-02",
+                    f"after the abort expected "
+                    f"'a{'<CRC>' if expected > 1 else ''}<CR><LF>', got "
+                    f"{xjudge.shown(d0)}",
+                )
+            )

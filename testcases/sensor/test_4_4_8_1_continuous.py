@@ -1,0 +1,55 @@
+"""Section 4.4.8.1: continuous measurements aR0..aR9! and aRC0..aRC9!."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as judge
+from conformance.protocol.responses import split_line
+from conformance.verdicts import failed, passed
+
+requirements = pytest.mark.requirements
+
+
+def continuous_pairs(sensor):
+    return {i: (sensor.exchange(f"R{i}"), sensor.exchange(f"RC{i}")) for i in range(10)}
+
+
+@requirements("R-4.4.8.1-01", "R-4.4.8.1-03")
+def test_continuous_replies(sensor, case):
+    """R and RC replies come at once, formatted like D replies with at most 75 value
+    characters, RC with a CRC; an index the sensor does not serve gets the empty reply."""
+    case.expect("'a<values>[<CRC>]<CR><LF>', or 'a<CR><LF>' / 'a<CRC><CR><LF>' (e.g. '0AP@')")
+    pairs = continuous_pairs(sensor)
+    case.evidence("aR0..aR9!, aRC0..aRC9!", [ex for pair in pairs.values() for ex in pair])
+    case.extend(judge.continuous(pairs, case.requirements))
+
+
+@requirements("R-4.4.8.1-02")
+def test_continuous_independent(sensor, case):
+    """Each Rn stands alone: asking for Rn first, straight after waking, still gives data."""
+    case.expect("the same kind of reply to aRn! whether or not R0..R(n-1) came first")
+    served = [
+        i
+        for i, (ex, _) in continuous_pairs(sensor).items()
+        if i > 0 and len(split_line(ex.reply_text)[0]) > 1
+    ]
+    if not served:
+        case.not_applicable("the sensor serves no continuous index above R0")
+        return
+    index = served[-1]
+    sensor.listen(0.2)  # standby, so the next command starts a fresh conversation
+    sensor.master.send_break()
+    sensor.fresh_exchange("I")
+    ex = sensor.fresh_exchange(f"R{index}")
+    case.evidence(f"aI! then aR{index}! with no lower R first", [ex])
+    body, _ = split_line(ex.reply_text)
+    if ex.answered and len(body) > 1 and body[1] in "+-":
+        case.add(passed("R-4.4.8.1-02", f"R{index} alone: {judge.shown(ex)}"))
+    else:
+        case.add(
+            failed(
+                "R-4.4.8.1-02",
+                f"R{index} without the lower indices first gave no values: {judge.shown(ex)}",
+            )
+        )

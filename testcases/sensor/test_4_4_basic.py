@@ -1,0 +1,143 @@
+"""Section 4.4.1-4.4.4: a!, aI!, aAb!, and an answer to every basic command (Table 5)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.address_change import AddressChanger
+from conformance.judges import exchanges as judge
+from conformance.protocol.responses import check_change_address_reply, split_line
+from conformance.protocol.timing import ADDRESS_CHANGE_QUIET, TOLERANCE
+from conformance.sensor_session import C_FAMILY, M_FAMILY
+from conformance.verdicts import failed, passed
+
+requirements = pytest.mark.requirements
+
+
+@requirements("R-4.4.1-01")
+def test_acknowledge_active(sensor, case):
+    """a! returns exactly the address and CR LF."""
+    case.expect(f"'{sensor.address}<CR><LF>'")
+    ex = sensor.exchange("")
+    case.evidence("a!", ex)
+    case.add(judge.reply_only_address(ex, sensor.address, "R-4.4.1-01", "a!"))
+
+
+@requirements("R-4.4.2-01", "R-4.4.2-02")
+def test_identification(sensor, case):
+    """aI! returns address, version, vendor, model, sensor version, optional field, CR LF."""
+    case.expect("a + ll + 8-char vendor + 6-char model + 3-char version + 0..13 optional chars")
+    ex = sensor.exchange("I")
+    case.evidence("aI!", ex)
+    _, findings = judge.identification(ex, sensor.address)
+    case.extend(findings)
+
+
+BASIC = (
+    "",
+    "I",
+    *M_FAMILY,
+    *C_FAMILY,
+    *(f"D{i}" for i in range(10)),
+    *(f"R{i}" for i in range(10)),
+    *(f"RC{i}" for i in range(10)),
+)
+
+
+@requirements("R-4.4-01")
+def test_every_basic_command_is_answered(sensor, case):
+    """Every command of Table 5 draws a reply (the format of each is judged by its own rule)."""
+    case.expect("a reply to each basic command; aAb! is judged in the address-change case")
+    exchanges = []
+    for code in BASIC:
+        if code in M_FAMILY or code in C_FAMILY:
+            exchanges.append(sensor.measurement(code).start)
+        else:
+            exchanges.append(sensor.exchange(code))
+    exchanges.append(sensor.once("query", sensor.master.query_address))
+    case.evidence("Table 5 commands", exchanges)
+    case.add(judge.answered("R-4.4-01", exchanges, "it is a basic command"))
+
+
+@requirements("R-4.4.4-01", "R-4.4.4-02", "R-4.4.4-03")
+def test_change_address(sensor, case):
+    """aAb! moves the sensor to b, it answers there (after at most 1 s) and no longer at a."""
+    case.expect(
+        "reply 'b<CR><LF>'; answers at b within 1 s; silent at the old address; "
+        "the original address is restored afterwards"
+    )
+    if not sensor.address_change_supported():
+        case.not_applicable("the sensor's address is not software-settable")
+        return
+    original, target = sensor.address, sensor.spare_address()
+    changer = AddressChanger(sensor.master, original)
+    try:
+        outcome = changer.change(target)
+        old = None
+        if outcome.took and outcome.answered_after is not None:
+            old = sensor.master.raw(f"{original}!", break_first=True)
+            changer.exchanges.append(old)
+    finally:
+        note = changer.restore()
+        sensor.address_notes.append(note)
+    case.evidence("address change and restore", changer.exchanges)
+    body, _ = split_line(outcome.request.reply_text)
+    problems = check_change_address_reply(body, original, target)
+    if not outcome.request.answered:
+        case.add(failed("R-4.4.4-01", f"{original}A{target}! got no reply"))
+    elif problems or not outcome.took:
+        msg = "; ".join(v.message for v in problems) or "the sensor kept its old address"
+        case.add(failed("R-4.4.4-01", f"{msg} ({note})"))
+    else:
+        case.add(
+            passed("R-4.4.4-01", f"answered '{judge.escape(outcome.request.reply_text)}'; {note}")
+        )
+    if not outcome.took:
+        case.not_applicable(
+            "the change did not happen, so what follows it cannot be judged",
+            ["R-4.4.4-02", "R-4.4.4-03"],
+        )
+        return
+    after = outcome.answered_after
+    if after is None:
+        case.add(
+            failed(
+                "R-4.4.4-03",
+                f"never answered at the new address '{target}' within "
+                f"{ADDRESS_CHANGE_QUIET + 3:.0f} s",
+            )
+        )
+        case.not_applicable("no answer at the new address to time", ["R-4.4.4-02"])
+        return
+    if after > ADDRESS_CHANGE_QUIET + TOLERANCE + 0.25:  # one poll interval of slack
+        case.add(
+            failed(
+                "R-4.4.4-02",
+                f"ignored its new address for {after:.2f} s, more than "
+                "the 1 s allowed after a change",
+                measured_ms=after * 1e3,
+                limit_ms=1000.0,
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-4.4.4-02",
+                f"answered at the new address {after:.3f} s after the "
+                "change (1 s of silence is allowed)",
+            )
+        )
+    if old is not None and old.answered:
+        case.add(
+            failed(
+                "R-4.4.4-03", f"still answered at the old address '{original}' ({judge.shown(old)})"
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-4.4.4-03",
+                f"answered only at '{target}' after the change "
+                "(keeping it over a power cycle is not tested: no power control)",
+            )
+        )

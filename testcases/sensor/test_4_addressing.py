@@ -1,0 +1,122 @@
+"""Section 4.0-4.3 and 4.4.3: addresses, foreign addresses, the ?! query."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as judge
+from conformance.protocol.commands import ADDRESS_CHARS
+from conformance.verdicts import failed, inconclusive, passed
+
+requirements = pytest.mark.requirements
+
+
+def spare_addresses(own: str, count: int = 3) -> list[str]:
+    """Addresses that are not the DUT's, for the foreign-address probes."""
+    return [a for a in "0123456789" if a != own][:count]
+
+
+@requirements("R-4.0-01")
+def test_foreign_addresses_are_ignored(sensor, case):
+    """Commands for other addresses, each after a break, must draw no reply."""
+    case.expect("silence to a!, aI! and aM! sent to addresses the sensor does not have")
+    probes = []
+    for other in spare_addresses(sensor.address):
+        for code in ("", "I", "M"):
+            probes.append(sensor.master.raw(f"{other}{code}!", break_first=True))
+    case.evidence("foreign-address probes", probes)
+    case.add(judge.silent("R-4.0-01", probes, "the command was for another address"))
+
+
+@requirements("R-4.4.3-01")
+def test_query_address(sensor, case):
+    """?! returns the sensor's address, whatever it is."""
+    case.expect(f"'{sensor.address}<CR><LF>'")
+    ex = sensor.once("query", sensor.master.query_address)
+    case.evidence("?!", ex)
+    case.add(judge.reply_only_address(ex, sensor.address, "R-4.4.3-01", "?!"))
+
+
+@requirements("R-4.4.3-02")
+def test_wildcard_with_other_commands(sensor, case):
+    """A sensor may accept ? with other commands; if it answers ?I!, it answers correctly."""
+    case.expect("silence, or the same identification as aI!")
+    ex = sensor.master.raw("?I!", break_first=True)
+    ident = sensor.exchange("I")
+    case.evidence("?I!", ex)
+    if not ex.answered:
+        case.add(
+            passed("R-4.4.3-02", "no reply to ?I! (allowed: ? with other commands is optional)")
+        )
+    elif ex.reply_text == ident.reply_text:
+        case.add(passed("R-4.4.3-02", "?I! answered like aI!"))
+    else:
+        case.add(
+            failed(
+                "R-4.4.3-02",
+                f"?I! answered '{judge.escape(ex.reply_text)}', unlike "
+                f"aI! '{judge.escape(ident.reply_text)}'",
+            )
+        )
+
+
+@requirements("R-4.3-02")
+def test_factory_address(sensor, case):
+    """A sensor as shipped answers at address 0."""
+    case.expect("address 0 on a unit fresh from the factory")
+    fresh = sensor.declaration.factory_fresh
+    if sensor.address == "0":
+        case.add(passed("R-4.3-02", "the sensor is at address 0"))
+    elif fresh:
+        case.add(
+            failed("R-4.3-02", f"declared fresh from the factory but at address '{sensor.address}'")
+        )
+    else:
+        case.add(
+            inconclusive(
+                "R-4.3-02",
+                f"the sensor is at '{sensor.address}'; it may have "
+                "been re-addressed (declare factory_fresh = true to judge)",
+            )
+        )
+
+
+@requirements("R-4.3-03", "R-4.3-04")
+def test_address_range(sensor, case):
+    """A sensor with a settable address takes each of 0-9, and refuses a non-address."""
+    case.expect(
+        "aAb! accepted for b = 0..9 (restored afterwards); a character that is not an "
+        "address is refused"
+    )
+    if not sensor.address_change_supported():
+        case.not_applicable("the sensor's address is not software-settable")
+        return
+    sweep = sensor.address_sweep("0123456789")
+    case.evidence("address sweep", sweep.exchanges)
+    refused = sweep.refused
+    if refused:
+        case.add(failed("R-4.3-03", "refused or lost address(es) " + ", ".join(refused)))
+    else:
+        case.add(
+            passed(
+                "R-4.3-03", f"accepted every address 0-9 and answered there; {sweep.restore_note}"
+            )
+        )
+    bad = sensor.try_invalid_address("$")
+    case.evidence("aA$!", bad.exchanges)
+    if bad.accepted:
+        case.add(
+            failed(
+                "R-4.3-04",
+                "took '$' as its address (decision A17: only 0-9, A-Z, a-z)",
+                decision="A17",
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-4.3-04",
+                f"refused '$' as an address; {len(ADDRESS_CHARS)} characters are addresses",
+                decision="A17",
+            )
+        )

@@ -1,0 +1,148 @@
+"""Section 5 (v1.4): high-volume ASCII (aHA!) and binary (aHB!, aDBn!) measurements."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as xjudge
+from conformance.judges import measurements as judge
+from conformance.protocol.binary import parse_binary_packet
+from conformance.protocol.responses import split_line
+from conformance.verdicts import failed, passed, warned
+
+requirements = pytest.mark.requirements
+
+
+def _unsupported(case, sensor, code):
+    if sensor.supports(code):
+        return False
+    case.not_applicable(f"a{code}! announced no values: high-volume {code} not supported")
+    return True
+
+
+@requirements("R-5.4-02")
+def test_high_volume_optional(sensor, case):
+    """A v1.4 sensor without high-volume support answers aHA!/aHB! with a000000."""
+    case.expect("'atttnnn' if supported, else 'a000000<CR><LF>'")
+    starts = [sensor.measurement(c).start for c in ("HA", "HB")]
+    case.evidence("aHA!, aHB!", starts)
+    odd = []
+    for ex in starts:
+        body, _ = split_line(ex.reply_text)
+        if not ex.answered or (body[4:7] == "000" and body[1:] != "000000"):
+            odd.append(ex)
+    if odd:
+        case.add(
+            warned(
+                "R-5.4-02",
+                "without high-volume support expected 'a000000': "
+                + "; ".join(xjudge.shown(e) for e in odd),
+            )
+        )
+    else:
+        case.add(passed("R-5.4-02", "; ".join(xjudge.shown(e) for e in starts)))
+
+
+@requirements("R-5.1-01", "R-5.1-02", "R-5.1-03")
+def test_high_volume_ascii(sensor, case):
+    """aHA! answers atttnnn; data come from aD0..aD999! (no leading zeros) with at most 75
+    value characters a reply and always a CRC."""
+    case.expect("'atttnnn'; D replies with CRC, <= 75 value chars, past D9 when needed")
+    m = sensor.measurement("HA")
+    case.evidence("aHA! and its D replies", m)
+    if _unsupported(case, sensor, "HA"):
+        return
+    case.extend(judge.judge([m], case.requirements, sensor.version))
+
+
+@requirements(
+    "R-5.2-01", "R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2-07", "R-5.2.1-01", "R-4.1-03"
+)
+def test_high_volume_binary(sensor, case):
+    """aHB! answers atttnnn; aDBn! packets: 8N1 address, size, type, payload, CRC LSB first;
+    one type a packet; payload a whole number of values, at most 1000 bytes; nnn values in
+    all."""
+    case.expect("packets that parse, with correct CRC, adding up to nnn values")
+    m = sensor.measurement("HB")
+    case.evidence("aHB! and its DB packets", m)
+    if _unsupported(case, sensor, "HB"):
+        return
+    case.extend(judge.judge([m], case.requirements, sensor.version))
+
+
+@requirements("R-5.2-06")
+def test_empty_packet_past_data(sensor, case):
+    """aDBn! past the data returns the 6-byte empty packet (size 0, type 0)."""
+    case.expect("address, 00 00, 00, CRC: 6 bytes")
+    if _unsupported(case, sensor, "HB"):
+        return
+    m = sensor.measurement("HB")
+    beyond = len(m.data)
+    ex = sensor.fresh_exchange(f"DB{beyond}")
+    case.evidence(f"aDB{beyond}! past the data", ex)
+    packet = parse_binary_packet(ex.reply_bytes, expected_address=sensor.address)
+    if ex.answered and packet.is_empty and len(ex.reply_bytes) == 6 and packet.crc_ok:
+        case.add(
+            passed("R-5.2-06", f"aDB{beyond}! returned the empty packet {ex.reply_bytes.hex(' ')}")
+        )
+    else:
+        case.add(
+            failed(
+                "R-5.2-06",
+                f"aDB{beyond}! returned "
+                f"'{ex.reply_bytes.hex(' ') or '(nothing)'}', not the empty packet",
+            )
+        )
+
+
+@requirements("R-5.3-01")
+def test_high_volume_is_concurrent(sensor, case):
+    """HA/HB behave as concurrent measurements: no service request, not disturbed by a break
+    and other traffic, aborted by a valid command to the sensor itself."""
+    case.expect("no SR; all values after a break + foreign command; none after an own aI!")
+    codes = [c for c in ("HA", "HB") if sensor.supports(c)]
+    if not codes:
+        case.not_applicable("no high-volume support")
+        return
+    ms = [sensor.measurement(c) for c in codes]
+    case.extend(
+        judge.judge([m for m in ms if m.ttt], case.requirements, sensor.version)
+        if any(m.ttt for m in ms)
+        else []
+    )
+    for code in codes:
+        target = sensor.measurement(code)
+        if not target.ttt:
+            continue
+        other = sensor.spare_address()
+        kept, poke1 = sensor.disturbed_measurement(target.command, f"{other}I!")
+        stopped, poke2 = sensor.disturbed_measurement(target.command, f"{sensor.address}I!")
+        case.evidence(
+            f"{code}: break + {other}I!, then {sensor.address}I!, while running",
+            [kept, poke1, stopped, poke2],
+        )
+        if not kept.complete:
+            case.add(
+                failed(
+                    "R-5.3-01",
+                    f"a{code}! lost its data after a break and {other}I! "
+                    f"({kept.value_count} of {kept.count} values)",
+                )
+            )
+        elif stopped.value_count:
+            case.add(
+                failed(
+                    "R-5.3-01",
+                    f"a{code}! was not aborted by {sensor.address}I! "
+                    f"({stopped.value_count} values still delivered)",
+                )
+            )
+        else:
+            case.add(
+                passed(
+                    "R-5.3-01",
+                    f"a{code}! survived a break and {other}I!, and {sensor.address}I! aborted it",
+                )
+            )
+    if not case.record.findings:
+        case.not_applicable("no high-volume measurement with ttt > 0 to disturb")

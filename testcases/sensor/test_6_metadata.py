@@ -1,0 +1,169 @@
+"""Section 6 (v1.4): identify-measurement commands and parameter metadata."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as xjudge
+from conformance.judges import metadata as judge
+from conformance.judges.tally import Tally
+from conformance.protocol.commands import Kind
+from conformance.sensor_session import C_FAMILY, HV_FAMILY, M_FAMILY
+from conformance.transcript import decode_7e1, escape
+from conformance.verdicts import failed, passed
+
+requirements = pytest.mark.requirements
+DESCRIBED = M_FAMILY + C_FAMILY + HV_FAMILY
+META_IDS = ("R-6.2-01", "R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2-07", "R-6.2.1-01", "R-6.2.2-01")
+
+
+def identify(sensor, code):
+    return sensor.exchange(f"I{code}")
+
+
+@requirements("R-6.1-01")
+def test_identify_measurement_answered(sensor, case):
+    """A v1.4 sensor answers every identify-measurement command (aIM! ... aIHB!)."""
+    case.expect("a reply to each of the 43 identify forms")
+    exchanges = [identify(sensor, code) for code in DESCRIBED]
+    case.evidence("identify-measurement commands", exchanges)
+    case.add(xjudge.answered("R-6.1-01", exchanges, "v1.4 makes them mandatory"))
+
+
+@requirements("R-6.1-02")
+def test_identify_matches_measurement(sensor, case):
+    """Each identify reply equals the reply of the command without the I (decision A9)."""
+    case.expect("same atttn/atttnn/atttnnn shape and count; a ttt difference only warns")
+    pairs = [(identify(sensor, code), sensor.measurement(code)) for code in DESCRIBED]
+    case.evidence("identify replies", [p[0] for p in pairs])
+    case.extend(judge.identify_matches(pairs))
+
+
+@requirements("R-6.1-03")
+def test_identify_starts_nothing(sensor, case):
+    """An identify command starts no measurement: no service request, earlier data intact."""
+    case.expect("no character after aIM!/aIC!/aIHA!; the D replies read before still come back")
+    m = next((m for m in sensor.defined(("M", "MC", "V")) if m.complete), None)
+    if m is None:
+        case.add(failed("R-6.1-03", "no completed measurement to protect"))
+        return
+    fresh = sensor.fresh_measurement(m.command.text()[1:-1])
+    before = [ex.reply_text for ex in fresh.data]
+    pokes = [sensor.fresh_exchange(f"I{code}") for code in ("M", "C", "HA", "V")]
+    heard = sensor.listen(max((sensor.measurement(c).ttt or 0) for c in ("M", "V")) + 0.5)
+    again = [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
+    case.evidence(
+        "measurement, identify commands, listening, D again", [fresh, *pokes, heard, *again]
+    )
+    after = [ex.reply_text for ex in again]
+    if heard:
+        case.add(
+            failed(
+                "R-6.1-03",
+                f"sent '{escape(decode_7e1(heard))}' after identify commands (a service request?)",
+            )
+        )
+    elif before != after:
+        case.add(
+            failed(
+                "R-6.1-03",
+                "identify commands changed the data: "
+                f"'{escape(''.join(before))}' became '{escape(''.join(after))}'",
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-6.1-03", f"{len(pokes)} identify commands: no service request, data unchanged"
+            )
+        )
+
+
+def _metadata_plan(sensor):
+    """(exchange, crc expected, index valid) for every index of every described command."""
+    plan = []
+    for code in DESCRIBED:
+        m = sensor.measurement(code)
+        if not m.count:
+            continue
+        crc = m.command.returns_crc
+        count = m.count
+        indices = range(1, count + 1)
+        if code[:2] in ("MC", "CC"):  # the CRC twin describes the same values: ends suffice
+            indices = sorted({1, count})
+        for i in indices:
+            plan.append((sensor.exchange(f"I{code}_{i:03d}"), crc, True))
+    return plan
+
+
+@requirements(*META_IDS)
+def test_parameter_metadata(sensor, case):
+    """Metadata replies 'a,field1,field2[,...];[CRC]' for every announced value: printable
+    fields without ',' or ';', at most 75 characters through ';', units always present."""
+    case.expect("one well-formed record per value index 1..n of every measurement")
+    plan = _metadata_plan(sensor)
+    case.evidence("metadata commands", [p[0] for p in plan])
+    if not plan:
+        case.not_applicable("no measurement announces values")
+        return
+    case.extend(judge.records(plan, case.requirements))
+
+
+@requirements("R-6.2-05")
+def test_metadata_invalid_index(sensor, case):
+    """Index 000 and an index above the count get 'a<CR><LF>' (or 'a<CRC><CR><LF>')."""
+    case.expect("the invalid-index reply, with a CRC where the command carries one")
+    plan = []
+    for code in ("M", "MC", "C", "CC", "HA", "HB", "M9", "C9"):
+        m = sensor.measurement(code)
+        crc = m.command.returns_crc
+        plan.append((sensor.exchange(f"I{code}_000"), crc, False))
+        plan.append((sensor.exchange(f"I{code}_{(m.count or 0) + 1:03d}"), crc, False))
+    case.evidence("metadata with invalid indices", [p[0] for p in plan])
+    case.extend(judge.records(plan, ("R-6.2-05",)))
+
+
+@requirements("R-6.2-06")
+def test_continuous_metadata(sensor, case):
+    """For each continuous command, aIRn_001!, _002!, ... answer in turn, ended by the
+    invalid-index reply."""
+    case.expect("records 001..k, then the invalid-index reply")
+    tally = Tally(("R-6.2-06",))
+    evidence = []
+    for i in range(10):
+        r = sensor.exchange(f"R{i}")
+        served = r.answered and len(r.reply_text.rstrip("\r\n")) > 1
+        if not served:
+            continue
+        for code, crc in ((f"R{i}", False), (f"RC{i}", True)):
+            seq = []
+            for index in range(1, 100):
+                ex = sensor.exchange(f"I{code}_{index:03d}")
+                seq.append(ex)
+                body = ex.reply_text.rstrip("\r\n")
+                if not ex.answered or "," not in body:
+                    break
+            evidence += seq
+            label = f"aI{code}_nnn!"
+            tally.observe(label)
+            last = seq[-1]
+            if len(seq) == 1:
+                tally.fail("R-6.2-06", label, f"no record for {escape(seq[0].text)}")
+            elif not last.answered:
+                tally.fail(
+                    "R-6.2-06",
+                    label,
+                    f"{escape(last.text)} got no reply instead of the invalid-index reply",
+                )
+            elif "," in last.reply_text:
+                tally.fail("R-6.2-06", label, "no invalid-index reply after 99 records")
+            elif crc and len(last.reply_text.rstrip("\r\n")) != 4:
+                tally.fail(
+                    "R-6.2-06", label, f"end reply '{escape(last.reply_text)}' lacks the CRC"
+                )
+    case.evidence("continuous metadata", evidence)
+    if not evidence:
+        case.not_applicable("the sensor serves no continuous measurement")
+        return
+    case.extend(tally.findings("records in turn, closed by the invalid-index reply"))
+    _ = Kind

@@ -1,0 +1,256 @@
+"""Section 7: breaks, the marking after them, standby, and commands without a break.
+
+Each case builds its wake-up by hand (idle, spacing, marking) near a threshold, then judges
+whether the sensor answered, using the durations the link actually achieved and its timing
+uncertainty: a threshold straddled by the uncertainty gives INCONCLUSIVE, never a guess.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import exchanges as judge
+from conformance.protocol.timing import (
+    BREAK_ALWAYS,
+    BREAK_NEVER,
+    MARKING_AFTER_BREAK,
+    NO_BREAK_WINDOW,
+    STANDBY_MARKING,
+    TOLERANCE,
+    WAKE_LIMIT,
+)
+from conformance.transcript import EventKind
+from conformance.verdicts import failed, inconclusive, passed, warned
+
+requirements = pytest.mark.requirements
+STANDBY = 0.15  # s of marking that puts any sensor in standby before a probe
+
+
+def _break_of(sensor, ex):
+    """The break event just before the probe's command (hand-made, so from the transcript)."""
+    first = ex.attempts[0].command_events[0]
+    for e in reversed(sensor.link.transcript.events):
+        if e.kind is EventKind.BREAK and e.end <= first.start:
+            return e
+    return None
+
+
+def _marking_before(ex, since: float) -> float:
+    return ex.attempts[0].command_events[0].start - since
+
+
+@requirements("R-7.0-03")
+def test_short_spacing_is_not_a_break(sensor, case):
+    """Spacing shorter than 6.5 ms never wakes a sleeping sensor."""
+    case.expect("silence to a command after a 5 ms spacing pulse")
+    ex = sensor.probe(f"{sensor.address}!", break_s=5e-3, idle_before=STANDBY)
+    pulse = _break_of(sensor, ex)
+    case.evidence("5 ms pulse, 9 ms marking, a!", [pulse, *judge.events_of(ex)])
+    u = sensor.uncertainty
+    if pulse.duration + u >= BREAK_NEVER - TOLERANCE:
+        case.add(
+            inconclusive(
+                "R-7.0-03",
+                f"the link made a {pulse.duration * 1e3:.2f} ms "
+                "pulse; too close to 6.5 ms to judge",
+            )
+        )
+    else:
+        case.add(
+            judge.silent(
+                "R-7.0-03", [ex], f"a {pulse.duration * 1e3:.2f} ms spacing is not a break"
+            )
+        )
+
+
+@requirements("R-7.0-04")
+def test_break_just_over_12ms_wakes(sensor, case):
+    """Spacing longer than 12 ms is always a break."""
+    case.expect("a reply to a! after a 12.6 ms break")
+    ex = sensor.probe(f"{sensor.address}!", break_s=12.6e-3, idle_before=STANDBY)
+    brk = _break_of(sensor, ex)
+    case.evidence("12.6 ms break, a!", [brk, *judge.events_of(ex)])
+    if brk.duration - sensor.uncertainty <= BREAK_ALWAYS + TOLERANCE:
+        case.add(
+            inconclusive(
+                "R-7.0-04",
+                f"achieved break {brk.duration * 1e3:.2f} ms ± "
+                f"{sensor.uncertainty * 1e3:.2f} is not surely above 12.4 ms",
+            )
+        )
+    else:
+        case.add(
+            judge.answered("R-7.0-04", [ex], f"a {brk.duration * 1e3:.2f} ms break must wake it")
+        )
+
+
+@requirements("R-7.0-05")
+def test_marking_after_break(sensor, case):
+    """After a break the sensor looks for its address once 8.33 ms of marking have passed:
+    it answers a command sent then, and (decision A18) ignores one sent sooner."""
+    case.expect("a reply after 9 ms of marking; silence (else a warning) after 2 ms")
+    ok = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=9e-3, idle_before=STANDBY)
+    soon = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=2e-3, idle_before=STANDBY)
+    case.evidence("break + 9 ms marking + a!, then break + 2 ms marking + a!", [ok, soon])
+    brk = _break_of(sensor, ok)
+    marking = _marking_before(ok, brk.end)
+    if marking - sensor.uncertainty < MARKING_AFTER_BREAK:
+        case.add(
+            inconclusive(
+                "R-7.0-05", f"marking {marking * 1e3:.2f} ms is not surely 8.33 ms or more"
+            )
+        )
+        return
+    found = judge.answered(
+        "R-7.0-05",
+        [ok],
+        f"{marking * 1e3:.2f} ms of marking followed the break",
+        first_attempt=True,
+    )
+    if found.verdict.name == "FAIL":
+        case.add(found)
+        return
+    quick = _marking_before(soon, _break_of(sensor, soon).end)
+    if soon.answered and quick + sensor.uncertainty < MARKING_AFTER_BREAK - TOLERANCE:
+        case.add(
+            warned(
+                "R-7.0-05",
+                f"answered a command that began {quick * 1e3:.2f} ms after "
+                "the break, before 8.33 ms of marking",
+                decision="A18",
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-7.0-05",
+                f"answered after {marking * 1e3:.2f} ms of marking, "
+                f"ignored a command {quick * 1e3:.2f} ms after the break",
+                decision="A18",
+            )
+        )
+
+
+@requirements("R-7.0-07")
+def test_ready_within_100ms_of_break(sensor, case):
+    """Within 100 ms of a break the sensor can take a command: one sent 90 ms after it."""
+    case.expect("a reply to a! whose start bit comes 90 ms after the break")
+    ex = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=77e-3, idle_before=STANDBY)
+    brk = _break_of(sensor, ex)
+    since = ex.attempts[0].command_events[0].start - brk.start
+    case.evidence("break, 77 ms marking, a!", [brk, *judge.events_of(ex)])
+    if since + sensor.uncertainty > WAKE_LIMIT + TOLERANCE:
+        case.add(inconclusive("R-7.0-07", f"command began {since * 1e3:.2f} ms after the break"))
+    else:
+        case.add(
+            judge.answered(
+                "R-7.0-07",
+                [ex],
+                f"the command began {since * 1e3:.2f} ms after the break",
+                first_attempt=True,
+            )
+        )
+
+
+@requirements("R-7.0-14")
+def test_standby_after_foreign_command(sensor, case):
+    """After a command for another address the sensor ignores its own address without a
+    new break."""
+    case.expect("silence to a! sent, without a break, right after a command to another sensor")
+    other = sensor.spare_address()
+    sensor.probe(f"{other}!", break_s=13e-3, idle_before=STANDBY)
+    ex = sensor.master.raw(f"{sensor.address}!", break_first=False)
+    case.evidence(f"break, {other}!, then a! with no break", [ex])
+    case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby"))
+
+
+@requirements("R-7.0-15")
+def test_standby_after_100ms(sensor, case):
+    """After more than 100 ms of marking the sensor ignores a command without a break."""
+    case.expect("silence to a! sent 115 ms after the last reply, without a break")
+    first = sensor.probe(f"{sensor.address}!", break_s=13e-3, idle_before=STANDBY)
+    if not first.answered:
+        case.add(inconclusive("R-7.0-15", "the sensor did not answer the wake-up a!"))
+        return
+    sensor.listen(0.115)
+    ex = sensor.master.raw(f"{sensor.address}!", break_first=False)
+    idle = _marking_before(ex, first.last.reply_events[-1].end)
+    case.evidence("a!, 115 ms of marking, a! with no break", [first, ex])
+    if idle - sensor.uncertainty <= STANDBY_MARKING + TOLERANCE:
+        case.add(
+            inconclusive("R-7.0-15", f"marking {idle * 1e3:.2f} ms is not surely over 100.4 ms")
+        )
+    else:
+        case.add(
+            judge.silent("R-7.0-15", [ex], f"{idle * 1e3:.2f} ms of marking put it in standby")
+        )
+
+
+@requirements("R-7.0-16")
+def test_follow_up_without_break(sensor, case):
+    """An awake sensor answers its address without a break while the line has marked for
+    less than 87 ms."""
+    case.expect("a reply to aI! sent 20 ms after the reply to a!, with no break")
+    first = sensor.probe(f"{sensor.address}!", break_s=13e-3, idle_before=STANDBY)
+    if not first.answered:
+        case.add(inconclusive("R-7.0-16", "the sensor did not answer the wake-up a!"))
+        return
+    sensor.listen(0.02)
+    ex = sensor.master.raw(f"{sensor.address}I!", break_first=False)
+    idle = _marking_before(ex, first.last.reply_events[-1].end)
+    case.evidence("a!, 20 ms marking, aI! with no break", [first, ex])
+    if idle + sensor.uncertainty >= NO_BREAK_WINDOW - TOLERANCE:
+        case.add(inconclusive("R-7.0-16", f"marking {idle * 1e3:.2f} ms is not surely under 87 ms"))
+    else:
+        case.add(judge.answered("R-7.0-16", [ex], f"only {idle * 1e3:.2f} ms of marking"))
+
+
+@requirements("R-7.1-02")
+def test_data_after_service_request_without_break(sensor, case):
+    """After its service request the sensor answers an aD0! sent within 87 ms, no break."""
+    case.expect("a reply to the first aD0! after the service request")
+    m = next(
+        (
+            m
+            for m in sensor.defined(("M", "MC", "V", "M1", "M2"))
+            if m.ttt and m.service_request_end is not None and m.data
+        ),
+        None,
+    )
+    if m is None:
+        case.not_applicable("no measurement produced a service request to follow")
+        return
+    d0 = m.data[0]
+    first = d0.attempts[0]
+    case.evidence(f"{m.command} service request and D0", m)
+    gap = first.command_events[0].start - m.service_request_end
+    if first.break_event is not None or gap + sensor.uncertainty >= NO_BREAK_WINDOW:
+        case.add(
+            inconclusive("R-7.1-02", "the tool's aD0! was not sent within 87 ms without a break")
+        )
+    elif first.reply_events:
+        case.add(
+            passed(
+                "R-7.1-02", f"aD0! {gap * 1e3:.2f} ms after the service request, no break: answered"
+            )
+        )
+    else:
+        case.add(
+            failed(
+                "R-7.1-02", f"aD0! {gap * 1e3:.2f} ms after the service request, no break: no reply"
+            )
+        )
+
+
+@requirements("R-AppB-01")
+def test_partial_command_dropped(sensor, case):
+    """A command interrupted by 8.33 ms or more of marking is dropped (decision A18: a reply
+    is only a warning)."""
+    case.expect("silence to 'aI!' sent with 10 ms of marking between its characters")
+    ex = sensor.probe(f"{sensor.address}I!", break_s=13e-3, gap=10e-3, idle_before=STANDBY)
+    case.evidence("aI! with 10 ms gaps", [ex])
+    case.add(
+        judge.silent(
+            "R-AppB-01", [ex], "its characters were 10 ms apart", should=True, decision="A18"
+        )
+    )

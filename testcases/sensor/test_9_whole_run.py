@@ -1,0 +1,42 @@
+"""Rules judged over every reply of the run (this module runs last): character framing and
+printability, CR LF endings, the responding address, response start window, character gaps.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import wire
+
+requirements = pytest.mark.requirements
+
+
+def _segments(sensor):
+    return wire.segments(sensor.link.transcript.events)
+
+
+@requirements("R-7.0-09", "R-7.0-10")
+def test_response_start_window(sensor, case):
+    """Every reply's first start bit comes 7.93 to 15.40 ms after the command's last stop bit."""
+    case.expect("8.33 ms (-0.40) <= delay <= 15.0 ms (+0.40), for every reply of the run")
+    case.extend(wire.judge_response_start(_segments(sensor), sensor.uncertainty))
+
+
+@requirements("R-7.0-12", "R-7.0-01")
+def test_character_gaps(sensor, case):
+    """No more than 1.66 ms of marking between the characters of a reply (no tolerance)."""
+    case.expect("every inter-character gap of every reply <= 1.66 ms")
+    case.extend(wire.judge_gaps(_segments(sensor), sensor.uncertainty))
+
+
+@requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")
+def test_reply_framing(sensor, case):
+    """Every reply is 1200 baud 7E1 (except aDBn! packets), printable, at least 3 characters
+    ending in CR LF, and starts with the address of the sensor that answers."""
+    case.expect(
+        "even parity and printable characters in every ASCII reply; CR LF at the end; "
+        "the address first"
+    )
+    segs = _segments(sensor)
+    case.add(wire.judge_bit_rate(segs, sensor.uncertainty))
+    case.extend(wire.judge_framing(segs))
