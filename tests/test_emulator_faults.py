@@ -723,3 +723,16 @@ def test_later_setting_wins_and_unknown_names_fail():
     assert compose(["response-too-early", "response-too-late"]).behaviour.reply_delay == 20e-3
     with pytest.raises(KeyError, match="no-such-fault"):
         compose(["no-such-fault"])
+
+
+def test_slow_wake_does_not_take_the_tail_of_a_command():
+    """Waking in the middle of ``0D0!`` must not turn its tail into ``0!``; the retry works."""
+    rig = Rig(faults=("slow-wake",))
+    rig.wake(marking=0.12)  # past the wake-up time
+    rig.send("0M1!")
+    assert decode_7e1(rig.listen()) == "00002\r\n"
+    rig.wake(marking=0.1e-3)
+    rig.wait(0.095)
+    rig.send("0D0!")  # '0' and 'D' fall in the wake-up time, '0!' after it
+    assert rig.listen(timeout=0.03) == []
+    assert rig.ask("0D0!", brk=False).body == "0" + M1_VALUES

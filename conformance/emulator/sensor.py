@@ -88,6 +88,7 @@ class SensorEmulator:
         self._awake = False
         self._last_activity = -inf
         self._wake_at = -inf
+        self._waking = False  # woke up after a delay and has not taken a command yet
         self._break_end: float | None = None
         self._buf: list[str] = []
         self._buf_start = 0.0
@@ -155,6 +156,7 @@ class SensorEmulator:
             self._data = data.emptied()
         self._awake = True
         self._wake_at = end + b.wake_delay
+        self._waking = b.wake_delay > 0
         self._break_end = end
         self._last_activity = end
         self._buf = []
@@ -162,6 +164,7 @@ class SensorEmulator:
     def on_char(self, wire: int, start: float, end: float) -> None:
         b = self.behaviour
         self._settle(start)
+        previous = self._last_activity
         heard = self._hear(start)
         self._last_activity = max(self._last_activity, end)
         if not heard:
@@ -172,7 +175,11 @@ class SensorEmulator:
         if self._buf and start - self._buf_end >= b.partial_gap:
             self._buf = []  # R-AppB-01: marking inside a command drops it
         if not self._buf:
-            self._begin_command(char, start)
+            # a sensor that woke up while characters were flowing has caught the tail of a
+            # command: like after a break, it needs marking before it takes an address
+            mid_stream = self._waking and start - previous < b.address_marking
+            self._waking = False
+            self._begin_command(char, start, mid_stream)
             if not self._awake:
                 return
         self._buf.append(char)
@@ -198,13 +205,16 @@ class SensorEmulator:
             self._entered_standby()
         return self._awake
 
-    def _begin_command(self, char: str, start: float) -> None:
+    def _begin_command(self, char: str, start: float, mid_stream: bool = False) -> None:
         b = self.behaviour
         early = self._break_end is not None and start - self._break_end < b.address_marking
         self._break_end = None
-        self._buf_invalid = early  # R-7.0-05: an address this soon after a break is not seen
+        # R-7.0-05: an address this soon after a break is not seen
+        self._buf_invalid = early or mid_stream
         self._buf_start = start
-        self._buf_foreign = not self._addressed(char)
+        # a character the sensor could not take as an address says nothing about who is
+        # addressed, so it neither selects nor deselects the sensor
+        self._buf_foreign = not (self._buf_invalid or self._addressed(char))
         if not self._buf_foreign:
             return
         run = self._run
