@@ -13,9 +13,12 @@ A :class:`Fault` changes the emulator through up to three hooks:
 suite run against the faulty emulator must FAIL (or WARN, for SHOULD rules and lenient
 decisions such as A18) exactly these IDs. Conventions used when choosing them:
 
-- R-4.4-01 ("a well-formed answer to every basic command") is declared only where a basic
-  command gets no answer at all; a malformed answer is declared under the specific format
-  rule (R-4.4.5-01, R-4.4.8-02, ...).
+- Where the catalogue has a rule for the specific reply type, a fault declares that rule and
+  not the general one that also covers it: HA data over 75 characters is R-5.1-03 (not also
+  R-4.4-05), R data over 75 is R-4.4.8.1-01, a D reply without CR LF is R-4.2-03 (not also
+  the D format rule R-4.4.8-01), a metadata record without units is R-6.2.2-01.
+- R-4.4-01 ("a well-formed answer to every basic command") is declared, next to the specific
+  rule, only where a basic command gets no answer at all.
 - Rewrites of ``atttn`` replies apply to the identify form too, so R-6.1-02 (identify reply
   equals the command's reply) stays intact unless the fault is about that rule.
 - A fault applies to the default v1.4 profile unless ``version`` says otherwise.
@@ -280,6 +283,13 @@ def _units_dropped(spec: MeasurementSpec) -> MeasurementSpec:
     return replace(spec, metadata=tuple(fields[:1] for fields in spec.metadata))
 
 
+def _long_continuous(spec: MeasurementSpec) -> MeasurementSpec:
+    """R0 with 82 value characters; metadata grows along so only the length deviates."""
+    extra = ("+1234.567",) * 8
+    metadata = (*spec.metadata, *(("XL", " ") for _ in extra))
+    return replace(spec, values=spec.values + extra, metadata=metadata)
+
+
 def _crc_twin(profile: Profile) -> Profile:
     plain = profile.measurements["M"]
     twin = replace(plain, values=plain.values[:-1], metadata=plain.metadata[:-1])
@@ -406,14 +416,14 @@ def _faults() -> list[Fault]:
         Fault(
             "high-volume-values-over-75",
             "D replies after HA pack up to 81 value characters.",
-            ("R-5.1-03", "R-4.4-05"),
+            ("R-5.1-03",),
             settings={"limit_high_volume": 81},
         ),
         Fault(
             "continuous-over-75",
             "aR0!/aRC0! return 82 value characters.",
-            ("R-4.4.8.1-01", "R-4.4-05"),
-            profile=_with_spec("R0", lambda s: replace(s, values=s.values + ("+1234.567",) * 8)),
+            ("R-4.4.8.1-01",),
+            profile=_with_spec("R0", _long_continuous),
         ),
         Fault(
             "split-value",
@@ -430,7 +440,7 @@ def _faults() -> list[Fault]:
         Fault(
             "missing-crlf",
             "D replies end without CR LF.",
-            ("R-4.2-03", "R-4.4.8-01"),
+            ("R-4.2-03",),
             rewrite=_only(_DATA, _set(end="")),
         ),
         Fault(
@@ -731,7 +741,7 @@ def _faults() -> list[Fault]:
         Fault(
             "metadata-missing-units",
             "Metadata records of aM! values carry only field 1 (no units field).",
-            ("R-6.2.2-01", "R-6.2-02"),
+            ("R-6.2.2-01",),
             profile=_with_spec("M", _units_dropped),
         ),
         Fault(
