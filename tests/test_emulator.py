@@ -430,6 +430,8 @@ def test_standby_after_100_ms_of_marking(rig):
     _wait_after(rig, answer, 0.086)
     answer = rig.ask("0!", brk=False)
     assert answer.text == "0\r\n"  # R-7.0-16
+    assert rig.emulator.awake(answer.events[-1].end + 0.099)
+    assert not rig.emulator.awake(answer.events[-1].end + 0.1005)
     _wait_after(rig, answer, 0.1005)
     assert rig.ask("0!", brk=False).events == []  # R-7.0-15
     assert rig.ask("0!").text == "0\r\n"

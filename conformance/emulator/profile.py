@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from ..protocol.binary import DataType, type_size
+from ..protocol.binary import DataType
 from ..protocol.commands import ADDRESS_CHARS, Command, Kind
 from ..protocol.values import format_value
 
@@ -260,8 +260,3 @@ def default_profile(version: str = "14") -> Profile:
     else:
         raise ValueError(f"no default profile for version {version!r}")
     return Profile(version=version, measurements=measurements, extended={"XSN": "EMU-0001"})
-
-
-def hb_payload_sizes(spec: MeasurementSpec) -> list[int]:
-    """Payload bytes of each packet (what R-5.2-04 limits to 1000)."""
-    return [type_size(p.dtype) * len(p.values) for p in spec.packets]

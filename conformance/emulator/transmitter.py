@@ -74,7 +74,3 @@ class Transmitter:
         if item.done:
             self.queue.pop(0)
         return frame, item
-
-    @property
-    def busy(self) -> bool:
-        return bool(self.queue)
