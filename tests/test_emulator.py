@@ -533,3 +533,11 @@ def test_default_profiles_are_conforming_data():
                 assert spec.count <= 20
             for value in spec.values:
                 assert split_values(value) == [value] and check_value(value) == [], value
+
+
+def test_short_spacing_after_standby_does_not_keep_the_sensor_awake(rig):
+    answer = rig.ask("0!")
+    _wait_after(rig, answer, 0.101)  # standby by now (R-7.0-15)
+    rig.wake(duration=5e-3)  # noise, not a break (R-7.0-03)
+    rig.send("0!")
+    assert rig.listen() == []
