@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from urllib.parse import parse_qs, urlsplit
 
+from .declaration import Declaration
 from .links.base import Link
 
 
@@ -65,6 +66,22 @@ def open_sim(spec: SimSpec) -> tuple[Link, list[object]]:
     profile = replace(default_profile(spec.version), address=spec.address)
     _bus, link, emulator = sim_sensor(profile, faults=spec.faults)
     return link, [emulator]
+
+
+def sim_declaration(emulator: object) -> Declaration:
+    """What the simulated sensor's maker would declare: its profile, as the emulator runs it.
+
+    Extended commands are opt-in on real devices; the simulated one declares its own, so the
+    suite exercises them. Only a sensor at address 0 is taken as fresh from the factory.
+    """
+    profile = emulator.profile  # type: ignore[attr-defined]
+    return Declaration(
+        address=profile.address,
+        features={"address_change": bool(profile.address_settable)},
+        extended=tuple(profile.extended),
+        factory_fresh=profile.address == "0",
+        source="built-in (the simulated sensor's profile)",
+    )
 
 
 def open_port(port: str) -> tuple[Link, list[object]]:

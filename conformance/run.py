@@ -14,7 +14,7 @@ from typing import Any
 from . import __version__
 from .declaration import Declaration, load_declaration, normalise_version
 from .links.base import Link
-from .ports import is_sim, open_port
+from .ports import is_sim, open_port, sim_declaration
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .sensor_session import SensorSession
 
@@ -81,8 +81,11 @@ class ConformanceRun:
     def sensor_session(self) -> SensorSession:
         if self.session is None:
             uncertainty = self.options.timing_uncertainty_ms
+            link = self.open_link()
+            if self.declaration is None and self.devices:
+                self.declaration = sim_declaration(self.devices[0])
             session = SensorSession(
-                self.open_link(),
+                link,
                 address=self.options.address,
                 declaration=self.declaration,
                 forced_version=normalise_version(self.options.version)

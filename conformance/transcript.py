@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Iterator
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
@@ -65,9 +65,15 @@ class Event:
         return self.end - self.start
 
     def to_json(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["kind"] = str(self.kind)
-        return d
+        return {
+            "kind": str(self.kind),
+            "origin": self.origin,
+            "start": self.start,
+            "end": self.end,
+            "wire": self.wire,
+            "text": self.text,
+            "uncertainty": self.uncertainty,
+        }
 
 
 def decode_7e1(events: Iterable[Event]) -> str:

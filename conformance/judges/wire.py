@@ -33,27 +33,24 @@ class Segment:
     command: list[Event]
     reply: list[Event] = field(default_factory=list)
     later: list[Event] = field(default_factory=list)
-
-    @property
-    def text(self) -> str:
-        return "".join(chr(e.char7) for e in self.command)
+    text: str = ""  # the command as text, filled in by :func:`segments`
+    binary_reply: bool = False  # replies to aDBn! are 8N1 packets (no 7E1, no CR LF)
 
     @property
     def command_end(self) -> float:
         return self.command[-1].end
 
     @property
-    def binary_reply(self) -> bool:
-        """Replies to aDBn! are 8N1 packets, exempt from 7E1 and CR LF rules."""
-        try:
-            return parse_command(self.text).kind is Kind.BINARY_DATA
-        except CommandError:
-            return False
-
-    @property
     def multiline(self) -> bool:
         """A reply starting ``a<STX>`` is multi-line text (decision A10)."""
         return len(self.reply) > 1 and self.reply[1].char7 == 0x02
+
+
+def _is_binary_data(text: str) -> bool:
+    try:
+        return parse_command(text).kind is Kind.BINARY_DATA
+    except CommandError:
+        return False
 
 
 def segments(events: Iterable[Event]) -> list[Segment]:
@@ -68,11 +65,13 @@ def segments(events: Iterable[Event]) -> list[Segment]:
                 pending_break, current = e, None
                 continue
             if current is None or current.reply or current.later or current.text.endswith("!"):
-                current = Segment(pending_break, [e])
+                current = Segment(pending_break, [e], text=chr(e.char7))
                 result.append(current)
                 pending_break = None
             else:
                 current.command.append(e)
+                current.text += chr(e.char7)
+            current.binary_reply = current.text.endswith("!") and _is_binary_data(current.text)
             continue
         if current is None:
             continue  # DUT chatter before any command
@@ -91,7 +90,7 @@ def _place_dut_char(seg: Segment, e: Event) -> None:
             seg.later.append(e)
         return
     last = seg.reply[-1]
-    ended = not seg.binary_reply and not seg.multiline and last.char7 == 0x0A
+    ended = not seg.binary_reply and last.char7 == 0x0A and not seg.multiline
     if ended or e.start - last.end > RUN_GAP:
         seg.later.append(e)
     else:

@@ -1,0 +1,95 @@
+"""The fault-detection matrix: the suite's own quality metric (design.md 5).
+
+For every emulator fault, run the whole sensor suite against the faulty emulator and compare
+the requirements that came out FAIL or WARN with the ones the fault declares it breaks. A fault
+caught by exactly its requirements is a rule proven twice; anything else is a false verdict or
+an untested rule.
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import tempfile
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+BAD = ("FAIL", "WARN")
+
+
+@dataclass(frozen=True)
+class MatrixRow:
+    fault: str
+    declared: tuple[str, ...]
+    flagged: tuple[str, ...]  # FAIL or WARN requirements
+    verdict: str  # the run's overall verdict
+    other: tuple[str, ...]  # INCONCLUSIVE or ERROR requirements, for the reader
+
+    @property
+    def missed(self) -> tuple[str, ...]:
+        return tuple(r for r in self.declared if r not in self.flagged)
+
+    @property
+    def extra(self) -> tuple[str, ...]:
+        return tuple(r for r in self.flagged if r not in self.declared)
+
+    @property
+    def exact(self) -> bool:
+        return not self.missed and not self.extra
+
+
+def run_once(port: str, extra: tuple[str, ...] = ()) -> dict:
+    """Run the sensor suite in this process against ``port``; return verdicts.json."""
+    import pytest
+
+    with tempfile.TemporaryDirectory(prefix="sdi12-matrix-") as tmp:
+        args = [
+            "-c",
+            str(resources.files("conformance") / "suite.ini"),
+            "--rootdir",
+            tmp,
+            "-p",
+            "no:cacheprovider",
+            "-p",
+            "no:terminal",
+            "-p",
+            "no:html",
+            "--pyargs",
+            "testcases.sensor",
+            "--sdi12-port",
+            port,
+            "--sdi12-report-dir",
+            tmp,
+            *extra,
+        ]
+        pytest.main(args)
+        return json.loads((Path(tmp) / "verdicts.json").read_text(encoding="utf-8"))
+
+
+def _row(item: tuple[str, tuple[str, ...], str, tuple[str, ...]]) -> MatrixRow:
+    fault, declared, version, extra = item
+    data = run_once(f"sim://?faults={fault}&version={version}", extra)
+    flagged = tuple(r["id"] for r in data["requirements"] if r["verdict"] in BAD)
+    other = tuple(
+        f"{r['id']}={r['verdict']}"
+        for r in data["requirements"]
+        if r["verdict"] in ("INCONCLUSIVE", "ERROR")
+    )
+    return MatrixRow(fault, declared, flagged, data["summary"]["verdict"], other)
+
+
+def fault_matrix(faults: list[str] | None = None, processes: int = 2) -> list[MatrixRow]:
+    """One row per fault (all of them by default), run ``processes`` at a time."""
+    from .emulator import FAULTS
+
+    names = faults or sorted(FAULTS)
+    items = [
+        (n, tuple(FAULTS[n].violates), getattr(FAULTS[n], "version", None) or "14", ())
+        for n in names
+    ]
+    if processes <= 1:
+        return [_row(i) for i in items]
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(processes) as pool:
+        return pool.map(_row, items, chunksize=1)
