@@ -52,11 +52,11 @@ class AddressChanger:
         link = self.master.link
         start = outcome.request.end
         while link.now() - start < ADDRESS_CHANGE_QUIET + LATE_LIMIT:
-            poll = self.master.transact(f"{self.current}!", retries=False)
+            poll = self.master.transact(f"{self.current}!")  # with retries: a slow waker
             outcome.polls.append(poll)
             self.exchanges.append(poll)
             if poll.answered:
-                outcome.answered_after = poll.last.command_events[0].start - start
+                outcome.answered_after = poll.last.command_events[0].start - start  # answered try
                 return
             link.wait(POLL_INTERVAL)
 
@@ -67,6 +67,13 @@ class AddressChanger:
             return f"address restored to '{self.original}'"
         outcome = self.change(self.original)
         self.restored = outcome.took and outcome.answered_after is not None
+        if not self.restored:  # the change back failed: maybe it never left the original
+            check = self.master.transact(f"{self.original}!")
+            self.exchanges.append(check)
+            if check.answered:
+                self.current = self.original
+                self.restored = True
+                return f"the sensor answers at its original address '{self.original}'"
         if self.restored:
             return f"address restored to '{self.original}'"
         return (

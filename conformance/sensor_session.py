@@ -216,12 +216,18 @@ class SensorSession:
             self.address_notes.append(changer.restore())
         return InvalidAddressAttempt(changer.exchanges, accepted)
 
-    def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
-        """Start ``command``, send ``disturb`` (after a break) while it runs, wait out ttt,
-        then break and collect: how concurrent measurements are tested for (non-)aborts."""
+    def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement,
+                                                                               Exchange]:
+        """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and
+        collect: how concurrent measurements are tested for (non-)aborts. A disturbance for
+        the sensor's own address is sent with retries, so it is surely heard (its reply is
+        the proof); one for another address is sent once, after a break."""
         m = self.master.measure(command, collect=False, wait="none")
         self.listen(0.05)
-        poke = self.master.raw(disturb, break_first=True)
+        if disturb[:1] == self.address:
+            poke = self.master.transact(disturb)
+        else:
+            poke = self.master.raw(disturb, break_first=True)
         if m.reply_end is not None and m.ttt:
             self.link.wait_until(m.reply_end + m.ttt + self.master.policy.ttt_margin)
         self.master.collect(m, force_break=True)

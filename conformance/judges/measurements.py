@@ -57,12 +57,14 @@ def reply_violations(m: Measurement, version: str) -> list[Violation]:
 
 # -- the wait -------------------------------------------------------------------------------
 def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
-    """Index of the first run shaped like a service request (address ... CR LF)."""
-    for i, run in enumerate(runs_):
-        text = decode_7e1(run)
-        if text.startswith(address) and text.endswith("\r\n"):
-            return i
-    return None
+    """Index of the service request: the first run that is exactly ``a<CR><LF>``, else the
+    first run shaped like one (address ... CR LF), which R-4.4.6-01 then judges malformed."""
+    texts = [decode_7e1(run) for run in runs_]
+    exact = next((i for i, t in enumerate(texts) if t == f"{address}\r\n"), None)
+    if exact is not None:
+        return exact
+    return next((i for i, t in enumerate(texts) if t.startswith(address) and
+                 t.endswith("\r\n")), None)
 
 
 def wait_violations(m: Measurement, tally: Tally) -> None:
@@ -234,7 +236,7 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
         return
     total = 0
     ids = ["R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2.1-01", "R-4.1-03"]
-    saw_empty = False
+    countable = True
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
         if not ex.answered:
@@ -243,13 +245,14 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
         packet = parse_binary_packet(ex.reply_bytes, expected_address=m.command.address)
         tally.observe(dlabel, packet.violations, ids=ids)
         if packet.is_empty:
-            saw_empty = True
             break
+        if any(v.requirement in ("R-5.2.1-01", "R-5.2-05") for v in packet.violations):
+            countable = False  # values of an unknown type or a ragged payload: uncountable
         total += len(packet.values)
-    tally.observe(label, ids=["R-5.2-07"])
-    if total != m.count:
-        tally.fail("R-5.2-07", label, f"packets held {total} values for {m.count} announced")
-    tally.observe(label, ids=["R-5.2-06"]) if saw_empty else None
+    if countable:
+        tally.observe(label, ids=["R-5.2-07"])
+        if total != m.count:
+            tally.fail("R-5.2-07", label, f"packets held {total} values for {m.count} announced")
 
 
 def judge(

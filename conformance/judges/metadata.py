@@ -22,11 +22,13 @@ def identify_matches(pairs: list[tuple[Exchange, Measurement]]) -> list[Finding]
         label = escape(ident.text)
         if not ident.answered or not m.start.answered or ident.command is None:
             continue
-        tally.observe(label)
         a, _ = split_line(ident.reply_text)
         b, _ = split_line(m.start.reply_text)
         pa = parse_measurement_reply_for(a, ident.command)
         pb = parse_measurement_reply_for(b, m.command)
+        if pb.violations:
+            continue  # the measurement's own reply is malformed: its rule judges that
+        tally.observe(label)
         if pa.violations or len(a) != len(b):
             tally.fail(
                 "R-6.1-02", label, f"'{escape(a)}' is not shaped like {m.command}'s '{escape(b)}'"

@@ -33,6 +33,7 @@ class Segment:
     command: list[Event]
     reply: list[Event] = field(default_factory=list)
     later: list[Event] = field(default_factory=list)
+    contention: list[Event] = field(default_factory=list)  # DUT talked over the command
     text: str = ""  # the command as text, filled in by :func:`segments`
     binary_reply: bool = False  # replies to aDBn! are 8N1 packets (no 7E1, no CR LF)
 
@@ -75,6 +76,9 @@ def segments(events: Iterable[Event]) -> list[Segment]:
             continue
         if current is None:
             continue  # DUT chatter before any command
+        if not current.text.endswith("!") or e.start < current.command_end:
+            current.contention.append(e)  # not a reply: it overlapped the command
+            continue
         _place_dut_char(current, e)
     return result
 

@@ -167,10 +167,11 @@ class Master:
             raise ValueError(f"unknown wait mode {wait!r}")
         start = self.transact(command)
         m = Measurement(command, start)
-        if not start.ok:
-            return m
         parsed = validity.parse_start_reply(start.reply_text, validity.count_digits(command))
-        assert parsed is not None  # an accepted reply has the atttn shape
+        if parsed is None or not (start.ok or self.policy.salvage):
+            return m
+        if not start.ok:
+            self._note_accepted(command)  # salvaged: D replies follow this measurement
         m.ttt, m.count = parsed
         m.reply_end = start.reply_events[-1].end
         use_sr = wait == "auto" and _raises_sr(command)
@@ -216,7 +217,8 @@ class Master:
                 )
             force_break = False
             m.data.append(exchange)
-            if not exchange.ok or not self._take_values(m, exchange, crc):
+            usable = exchange.ok or (self.policy.salvage and exchange.answered)
+            if not usable or not self._take_values(m, exchange, crc):
                 break
             index += 1
         return m
@@ -244,7 +246,10 @@ class Master:
             count = validity.packet_value_count(packet)
             m.binary_value_count += count
             return count > 0
-        values = split_values(validity.data_values_text(exchange.reply_text, crc))
+        text = validity.data_values_text(exchange.reply_text, crc)
+        if not exchange.ok:  # salvaged: keep only what reads as values (no stray CRC, spaces)
+            text = text.rstrip("".join(map(chr, range(0x40, 0x80)))).strip()
+        values = split_values(text)
         m.values.extend(values)
         return bool(values)
 

@@ -48,6 +48,11 @@ class Policy:
     # Extra wait past ttt before breaking for D0 without a service request (R-4.4.5-04,
     # R-4.4.7-06 say "at least ttt").
     ttt_margin: float = 5e-3
+    # Observer mode (sensor role): when every retry still drew an invalid reply, read what
+    # the last one holds (ttt/count, values, packet values) and carry on, so one broken rule
+    # (a wrong CRC, a missing CR LF) leaves evidence for its own judge instead of starving
+    # every other judge of data. The golden recorder does not salvage.
+    salvage: bool = True
 
     def __post_init__(self) -> None:
         if self.first_char_timeout + self.window_margin >= 87e-3:
@@ -59,7 +64,12 @@ class Policy:
     def golden(cls) -> Policy:
         """The recorder as the standard describes it: 8.33 ms marking inside a reply ends
         it (R-7.2-05) and D0 follows ttt without extra grace (R-4.4.5-05)."""
-        return cls(reply_idle=CHAR_TIME + TOLERANCE, late_sr_grace=0.0, first_char_timeout=20e-3)
+        return cls(
+            reply_idle=CHAR_TIME + TOLERANCE,
+            late_sr_grace=0.0,
+            first_char_timeout=20e-3,
+            salvage=False,
+        )
 
     def but(self, **changes: object) -> Policy:
         """A copy with some fields changed (``Policy().but(sequences=1)``)."""

@@ -71,10 +71,10 @@ def test_change_address(sensor, case):
         return
     original, target = sensor.address, sensor.spare_address()
     changer = AddressChanger(sensor.master, original)
+    old = None
     try:
         outcome = changer.change(target)
-        old = None
-        if outcome.took and outcome.answered_after is not None:
+        if outcome.took:
             old = sensor.master.raw(f"{original}!", break_first=True)
             changer.exchanges.append(old)
     finally:
@@ -83,22 +83,24 @@ def test_change_address(sensor, case):
     case.evidence("address change and restore", changer.exchanges)
     body, _ = split_line(outcome.request.reply_text)
     problems = check_change_address_reply(body, original, target)
+    after = outcome.answered_after
+    stayed = old is not None and old.answered
     if not outcome.request.answered:
-        case.add(failed("R-4.4.4-01", f"{original}A{target}! got no reply"))
+        case.add(failed("R-4.4.4-01", f"{original}A{target}! got no reply ({note})"))
     elif problems or not outcome.took:
         msg = "; ".join(v.message for v in problems) or "the sensor kept its old address"
         case.add(failed("R-4.4.4-01", f"{msg} ({note})"))
+    elif after is None and stayed:
+        case.add(failed("R-4.4.4-01", f"replied '{target}' but stayed at '{original}' ({note})"))
     else:
-        case.add(
-            passed("R-4.4.4-01", f"answered '{judge.escape(outcome.request.reply_text)}'; {note}")
-        )
+        reply = judge.escape(outcome.request.reply_text)
+        case.add(passed("R-4.4.4-01", f"answered '{reply}'; {note}"))
     if not outcome.took:
         case.not_applicable(
             "the change did not happen, so what follows it cannot be judged",
             ["R-4.4.4-02", "R-4.4.4-03"],
         )
         return
-    after = outcome.answered_after
     if after is None:
         case.add(
             failed(
@@ -127,7 +129,7 @@ def test_change_address(sensor, case):
                 "change (1 s of silence is allowed)",
             )
         )
-    if old is not None and old.answered:
+    if stayed:
         case.add(
             failed(
                 "R-4.4.4-03", f"still answered at the old address '{original}' ({judge.shown(old)})"

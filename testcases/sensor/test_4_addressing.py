@@ -11,9 +11,11 @@ from conformance.verdicts import failed, inconclusive, passed
 requirements = pytest.mark.requirements
 
 
-def spare_addresses(own: str, count: int = 3) -> list[str]:
-    """Addresses that are not the DUT's, for the foreign-address probes."""
-    return [a for a in "0123456789" if a != own][:count]
+def spare_addresses(sensor, count: int = 3) -> list[str]:
+    """Addresses that are not the DUT's, for the foreign-address probes: the spare address
+    the address-change cases use first (a sensor must not keep answering it), then others."""
+    spare = sensor.spare_address()
+    return [spare] + [a for a in "0123456789" if a not in (sensor.address, spare)][: count - 1]
 
 
 @requirements("R-4.0-01")
@@ -21,7 +23,7 @@ def test_foreign_addresses_are_ignored(sensor, case):
     """Commands for other addresses, each after a break, must draw no reply."""
     case.expect("silence to a!, aI! and aM! sent to addresses the sensor does not have")
     probes = []
-    for other in spare_addresses(sensor.address):
+    for other in spare_addresses(sensor):
         for code in ("", "I", "M"):
             probes.append(sensor.master.raw(f"{other}{code}!", break_first=True))
     case.evidence("foreign-address probes", probes)
