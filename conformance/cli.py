@@ -92,6 +92,10 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             from .ports import open_sim
 
             open_sim(parse_sim(args.port))  # validate faults/parameters before pytest starts
+        else:
+            from .ports import open_port
+
+            open_port(args.port)[0].close()  # a port that cannot be opened is a usage error
     except (DeclarationError, PortError) as exc:
         console.print(f"error: {exc}", style="red", markup=False)
         return EXIT_USAGE

@@ -181,8 +181,8 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     run = run_of(session.config)
-    if not run.active and run.session is None:
-        return
+    if not run.active and run.session is None and not run.stop_reason:
+        return  # no conformance case ran: an ordinary test session
     interrupted = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, 3, 4)
     if interrupted and not run.stop_reason:
         run.stop_reason = "run interrupted"

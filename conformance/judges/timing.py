@@ -10,6 +10,8 @@ from __future__ import annotations
 from ..protocol.timing import TOLERANCE
 from ..verdicts import Finding, Verdict
 
+EPSILON = 1e-9  # s: a value exactly on a limit is inside it, whatever float rounding says
+
 
 def judge_window(
     requirement: str,
@@ -28,8 +30,8 @@ def judge_window(
 
     ``should`` turns a definite violation into WARN (a SHOULD rule or a lenient decision).
     """
-    lo = None if low is None else low - tolerance
-    hi = None if high is None else high + tolerance
+    lo = None if low is None else low - tolerance - EPSILON
+    hi = None if high is None else high + tolerance + EPSILON
     m_lo, m_hi = measured - uncertainty, measured + uncertainty
     inside = (lo is None or m_lo >= lo) and (hi is None or m_hi <= hi)
     outside = (lo is not None and m_hi < lo) or (hi is not None and m_lo > hi)

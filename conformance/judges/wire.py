@@ -287,13 +287,14 @@ def judge_framing(segs: list[Segment]) -> list[Finding]:
 
     tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
     last_address = None
-    for seg in segs:
+    for i, seg in enumerate(segs):
         if seg.reply:
             last_address = seg.reply[0].char7
-        if seg.binary_reply:
-            chunks = runs(seg.later)
-        else:
-            chunks = ([seg.reply] if seg.reply else []) + runs(seg.later)
+        # unsolicited characters cut off by the next command collided with it: what is left
+        # of them says nothing about framing (the collision is judged by the rule it breaks)
+        later = [] if i + 1 < len(segs) and segs[i + 1].contention else runs(seg.later)
+        reply = [seg.reply] if seg.reply and not seg.binary_reply else []
+        chunks = reply + later
         for n, chunk in enumerate(chunks):
             label = f"{'reply to' if n == 0 and seg.reply else 'later, after'} {escape(seg.text)}"
             bad = [e for e in chunk if not e.parity_ok]
@@ -307,8 +308,11 @@ def judge_framing(segs: list[Segment]) -> list[Finding]:
             text = "".join(chr(e.char7) for e in chunk)
             if seg.multiline and n == 0:
                 text = text.replace("\x02", "").rstrip("\x03")  # decision A10
+            stripped = text.rstrip("\r\n")
             crc_positions = (
-                3 if len(text) >= 6 and all(0x40 <= ord(c) <= 0x7F for c in text[-5:-2]) else 0
+                3
+                if len(stripped) >= 4 and all(0x40 <= ord(c) <= 0x7F for c in stripped[-3:])
+                else 0
             )
             body, framing = split_line(text, crc_positions=crc_positions)
             tally.observe(label, framing, ids=["R-4.2-02", "R-4.2-03"])

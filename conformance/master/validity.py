@@ -124,7 +124,7 @@ def _shape_problem(command: Command, body: str, crc_expected: bool | None) -> st
     if kind is Kind.METADATA:
         assert command.target is not None
         crc = command.target.returns_crc
-        problem = _crc_problem(body, crc)
+        problem = _crc_problem(body, crc) if crc else None  # fields may hold any letters
         if problem:
             return problem
         fields = split_crc(body, crc)[0][1:]
@@ -167,7 +167,11 @@ def check_ascii(
     body = text[:-2]
     if not body:
         return "no address"
-    if any(not 0x20 <= ord(c) <= 0x7E for c in body):
+    crc_from = len(body) - 3 if crc_expected or (crc_expected is None and len(body) >= 4) else None
+    if any(
+        not 0x20 <= ord(c) <= 0x7E and not (c == "\x7f" and crc_from is not None and i >= crc_from)
+        for i, c in enumerate(body)
+    ):  # CRC characters 2 and 3 may legally be 0x7F (R-4.2-02)
         return "non-printable character in the reply"
     expected = _reply_address(command) if command is not None else address
     if expected is None and body[0] not in ADDRESS_CHARS:
