@@ -34,8 +34,11 @@ class AddressChanger:
         self.current = original
         self.exchanges: list[Exchange] = []
         self.restored: bool | None = None
+        self.tried: list[str] = []  # addresses the sensor may have been moved to
 
     def change(self, new: str, *, wait_for_answer: bool = True) -> ChangeOutcome:
+        if new != self.original:
+            self.tried.append(new)
         ex = self.master.change_address(new, address=self.current)
         self.exchanges.append(ex)
         body, _ = split_line(ex.reply_text)
@@ -61,22 +64,36 @@ class AddressChanger:
             link.wait(POLL_INTERVAL)
 
     def restore(self) -> str:
-        """Put the sensor back at its original address; returns a note for the report."""
-        if self.current == self.original:
-            self.restored = True
-            return f"address restored to '{self.original}'"
-        outcome = self.change(self.original)
-        self.restored = outcome.took and outcome.answered_after is not None
-        if not self.restored:  # the change back failed: maybe it never left the original
-            check = self.master.transact(f"{self.original}!")
-            self.exchanges.append(check)
-            if check.answered:
-                self.current = self.original
-                self.restored = True
-                return f"the sensor answers at its original address '{self.original}'"
-        if self.restored:
-            return f"address restored to '{self.original}'"
+        """Put the sensor back at its original address and check that it answers there;
+        returns a note for the report. A change whose reply was unclear may still have
+        happened, so every address tried is asked to move back until the original answers."""
+        if self.current != self.original:
+            self.change(self.original, wait_for_answer=False)
+        if self._answers(self.original):
+            self.current, self.restored = self.original, True
+            return f"address restored to '{self.original}' (it answers there)"
+        for tried in dict.fromkeys(self.tried):
+            if tried == self.original:
+                continue
+            self.current = tried
+            self.change(self.original, wait_for_answer=False)  # its reply may lie: check
+            if self._answers(self.original):
+                self.current, self.restored = self.original, True
+                return f"address restored to '{self.original}' from '{tried}'"
+        self.restored = False
         return (
-            f"COULD NOT restore the address: the sensor may be left at '{self.current}' "
-            f"(it was '{self.original}')"
+            f"COULD NOT restore the address: the sensor does not answer at "
+            f"'{self.original}' (tried moving it back from {', '.join(self.tried)})"
         )
+
+    def _answers(self, address: str) -> bool:
+        """Whether the sensor answers at ``address``, allowing it the 1 s of deafness that
+        may follow a change (R-4.4.4-02)."""
+        link = self.master.link
+        give_up = link.now() + ADDRESS_CHANGE_QUIET + 0.5
+        while True:
+            check = self.master.transact(f"{address}!")
+            self.exchanges.append(check)
+            if check.answered or link.now() >= give_up:
+                return check.answered
+            link.wait(POLL_INTERVAL)

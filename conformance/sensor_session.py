@@ -121,11 +121,11 @@ class SensorSession:
         """``"MC1"`` -> the parsed command for this DUT's address."""
         return parse_command(f"{self.address}{code}!")
 
-    def exchange(self, code: str, *, binary: bool = False) -> Exchange:
+    def exchange(self, code: str, *, binary: bool | None = None) -> Exchange:
         """The cached reply to one command (``"I"``, ``"R0"``, ``"IMC_001"``...)."""
         return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
 
-    def fresh_exchange(self, code: str, *, binary: bool = False, **kw: Any) -> Exchange:
+    def fresh_exchange(self, code: str, *, binary: bool | None = None, **kw: Any) -> Exchange:
         return self.master.transact(self.command(code), binary=binary, **kw)
 
     def measurement(self, code: str) -> Measurement:
@@ -170,7 +170,13 @@ class SensorSession:
         return self.once("address-change", self._discover_address_change)
 
     def spare_address(self) -> str:
+        """The address the address-change cases move the sensor to (and back from)."""
         return next(a for a in "9876543210" if a != self.address)
+
+    def foreign_address(self) -> str:
+        """An address for "traffic to another sensor": one no address-change case ever gives
+        the DUT, so even a sensor that keeps answering its old addresses is not addressed."""
+        return next(a for a in "zyx" if a != self.address)
 
     def _discover_address_change(self) -> bool:
         changer = AddressChanger(self.master, self.address)
@@ -208,6 +214,7 @@ class SensorSession:
         """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it."""
         changer = AddressChanger(self.master, self.address)
         try:
+            changer.tried.append(bad)  # if it took the bad address, restore moves it back
             ex = self.master.raw(f"{self.address}A{bad}!", break_first=True)
             changer.exchanges.append(ex)
             body, _ = split_line(ex.reply_text)
@@ -216,8 +223,7 @@ class SensorSession:
             self.address_notes.append(changer.restore())
         return InvalidAddressAttempt(changer.exchanges, accepted)
 
-    def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement,
-                                                                               Exchange]:
+    def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
         """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and
         collect: how concurrent measurements are tested for (non-)aborts. A disturbance for
         the sensor's own address is sent with retries, so it is surely heard (its reply is

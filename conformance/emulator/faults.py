@@ -466,7 +466,7 @@ def _faults() -> list[Fault]:
         Fault(
             "extended-no-crlf",
             "The extended command's reply ends without CR LF.",
-            ("R-4.4.13-01",),
+            ("R-4.4.13-01", "R-4.2-03"),
             rewrite=_only([ReplyKind.EXTENDED], _set(end="")),
         ),
         # -- CRC ---------------------------------------------------------------------------------
@@ -515,7 +515,7 @@ def _faults() -> list[Fault]:
         Fault(
             "unsupported-rc-without-crc",
             "aRCn! for an unsupported n answers 'a<CR><LF>' instead of 'a<CRC><CR><LF>'.",
-            ("R-4.4.8.1-03",),
+            ("R-4.4.8.1-03", "R-4.4.12-02"),
             rewrite=_when(
                 lambda r: r.kind is ReplyKind.CONTINUOUS and r.crc and not _has_values(r),
                 _set(crc=False),
@@ -570,7 +570,7 @@ def _faults() -> list[Fault]:
         Fault(
             "concurrent-service-request",
             "C/CC/Cn/HA/HB send a service request when their data are ready.",
-            ("R-4.4.6-05", "R-4.4.7-04"),
+            ("R-4.4.6-05", "R-4.4.7-04", "R-5.3-01"),
             settings={"service_request_on_concurrent": True},
         ),
         Fault(
@@ -601,7 +601,7 @@ def _faults() -> list[Fault]:
         Fault(
             "abort-keeps-old-data",
             "After an abort, D returns the data of the measurement before the aborted one.",
-            ("R-4.4.5.1-02", "R-4.4.7.1-02"),
+            ("R-4.4.5.1-02", "R-4.4.7.1-02", "R-4.4.7.1-01", "R-5.3-01"),
             settings={"abort_keeps_old_data": True},
         ),
         Fault(
@@ -614,19 +614,19 @@ def _faults() -> list[Fault]:
         Fault(
             "break-aborts-concurrent",
             "A break aborts a running C/CC/HA/HB measurement (D then returns nothing).",
-            ("R-4.4.7-05",),
+            ("R-4.4.7-05", "R-5.3-01"),
             settings={"break_aborts_concurrent": True},
         ),
         Fault(
             "foreign-command-aborts-concurrent",
             "A command to another address aborts a running C/CC/HA/HB measurement.",
-            ("R-4.4.7-05",),
+            ("R-4.4.7-05", "R-5.3-01"),
             settings={"foreign_aborts_concurrent": True},
         ),
         Fault(
             "concurrent-not-aborted",
             "A valid command to the sensor does not abort its running concurrent measurement.",
-            ("R-4.4.7.1-01",),
+            ("R-4.4.7.1-01", "R-4.4.7.1-02", "R-5.3-01"),
             settings={"command_aborts_concurrent": False},
         ),
         # -- data buffer -------------------------------------------------------------------------
@@ -657,14 +657,14 @@ def _faults() -> list[Fault]:
         Fault(
             "identify-clears-buffer",
             "Identify-measurement commands (aIM!, aIC!...) empty the data buffer.",
-            ("R-6.1-03", "R-4.4.5-10"),
+            ("R-6.1-03",),
             settings={"identify_clears_data": True},
         ),
         # -- addressing --------------------------------------------------------------------------
         Fault(
             "answers-foreign-address",
             "a! and aI! are answered for every address (with that address), then standby.",
-            ("R-4.0-01",),
+            ("R-4.0-01", "R-4.4.4-03"),
             settings={"answer_foreign": True},
         ),
         Fault(
@@ -676,7 +676,7 @@ def _faults() -> list[Fault]:
         Fault(
             "address-change-not-applied",
             "aAb! answers b but the sensor keeps its old address.",
-            ("R-4.4.4-01", "R-4.4.4-03"),
+            ("R-4.4.4-01", "R-4.4.4-03", "R-4.3-03"),
             settings={"apply_address_change": False},
         ),
         Fault(
@@ -688,7 +688,7 @@ def _faults() -> list[Fault]:
         Fault(
             "address-change-wrong-reply",
             "aAb! changes the address but answers with the old one.",
-            ("R-4.4.4-01",),
+            ("R-4.4.4-01", "R-4.3-03"),
             rewrite=_only(
                 [ReplyKind.CHANGE_ADDRESS],
                 lambda r: replace(r, body=r.command.address if r.command else r.body),
@@ -710,19 +710,19 @@ def _faults() -> list[Fault]:
         Fault(
             "d0-empty",
             "Completed measurements hold no values: D0 answers 'a<CR><LF>'.",
-            ("R-4.4.8-04", "R-4.4.8-03"),
+            ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
             settings={"drop_all_values": True},
         ),
         Fault(
             "undefined-measure-silent",
             "Undefined aMn!/aMCn! get no answer instead of a0000.",
-            ("R-4.4.9-01", "R-4.4.9-02", "R-4.4-01"),
+            ("R-4.4.9-01", "R-4.4.9-02", "R-4.4-01", "R-4.4.12-01", "R-6.1-01"),
             settings={"answer_undefined_measure": False},
         ),
         Fault(
             "undefined-concurrent-silent",
             "Undefined aCn!/aCCn! get no answer instead of a00000.",
-            ("R-4.4.10-01", "R-4.4.10-02", "R-4.4-01"),
+            ("R-4.4.10-01", "R-4.4.10-02", "R-4.4-01", "R-4.4.12-01", "R-6.1-01"),
             settings={"answer_undefined_concurrent": False},
         ),
         Fault(
@@ -869,7 +869,7 @@ def _faults() -> list[Fault]:
         Fault(
             "slow-wake",
             "The sensor needs 110 ms after a break before it can see a start bit.",
-            ("R-7.0-07",),
+            ("R-7.0-07", "R-7.0-05"),
             settings={"wake_delay": 110e-3},
         ),
         Fault(

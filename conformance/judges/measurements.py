@@ -63,8 +63,9 @@ def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
     exact = next((i for i, t in enumerate(texts) if t == f"{address}\r\n"), None)
     if exact is not None:
         return exact
-    return next((i for i, t in enumerate(texts) if t.startswith(address) and
-                 t.endswith("\r\n")), None)
+    return next(
+        (i for i, t in enumerate(texts) if t.startswith(address) and t.endswith("\r\n")), None
+    )
 
 
 def wait_violations(m: Measurement, tally: Tally) -> None:

@@ -174,6 +174,8 @@ def check_ascii(
     ):  # CRC characters 2 and 3 may legally be 0x7F (R-4.2-02)
         return "non-printable character in the reply"
     expected = _reply_address(command) if command is not None else address
+    if command is not None and command.kind is Kind.CHANGE_ADDRESS and body[0] == command.address:
+        expected = command.address  # aAb! refused: the old address is a valid reply too
     if expected is None and body[0] not in ADDRESS_CHARS:
         return f"{escape(body[0])} is not an address character"
     if expected is not None and body[0] != expected:

@@ -69,6 +69,7 @@ def test_crc_variant_same_measurement(sensor, case):
         twin = plain[0] + "C" + plain[1:]
         pairs.append((sensor.measurement(plain), sensor.measurement(twin)))
     case.evidence("plain and CRC measurement replies", [x.start for p in pairs for x in p])
+    pairs = [(a, b) for a, b in pairs if a.count is not None and b.count is not None]
     differ = [(a, b) for a, b in pairs if a.count != b.count]
     if differ:
         case.add(

@@ -78,7 +78,7 @@ def test_empty_packet_past_data(sensor, case):
     case.expect("address, 00 00, 00, CRC: 6 bytes")
     if _unsupported(case, sensor, "HB"):
         return
-    m = sensor.measurement("HB")
+    m = sensor.fresh_measurement("HB")  # the DB indices refer to the latest measurement
     beyond = len(m.data)
     ex = sensor.fresh_exchange(f"DB{beyond}")
     case.evidence(f"aDB{beyond}! past the data", ex)
@@ -113,7 +113,7 @@ def test_high_volume_is_concurrent(sensor, case):
         code = baseline.command.text()[1:-1]
         if not baseline.ttt or not baseline.value_count:
             continue
-        other = sensor.spare_address()
+        other = sensor.foreign_address()
         kept, poke1 = sensor.disturbed_measurement(baseline.command, f"{other}I!")
         stopped, poke2 = sensor.disturbed_measurement(baseline.command, f"{sensor.address}I!")
         case.evidence(

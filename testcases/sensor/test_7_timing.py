@@ -39,10 +39,17 @@ def _marking_before(ex, since: float) -> float:
     return ex.attempts[0].command_events[0].start - since
 
 
+def _awake(sensor):
+    """Wake the sensor the way a recorder does (break, a!, retries) and return that exchange:
+    its last reply proves the sensor is awake, whatever it needed to wake up."""
+    sensor.listen(STANDBY)
+    return sensor.master.transact(f"{sensor.address}!", force_break=True)
+
+
 def _asleep(sensor):
     """Put the sensor in standby by both routes (a command for another address, then more
     than 100 ms of marking), so a sensor that ignores one of them still sleeps."""
-    sensor.probe(f"{sensor.spare_address()}!", break_s=13e-3, marking_s=50e-3)
+    sensor.probe(f"{sensor.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
     sensor.listen(STANDBY)
 
 
@@ -187,11 +194,11 @@ def test_standby_after_foreign_command(sensor, case):
     """After a command for another address the sensor ignores its own address without a
     new break."""
     case.expect("a! answered; then, with no break, b! (another sensor) and a!: silence")
-    awake = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=50e-3, idle_before=STANDBY)
+    awake = _awake(sensor)
     if not awake.answered:
         case.add(inconclusive("R-7.0-14", "the sensor did not answer the wake-up a!"))
         return
-    other = sensor.spare_address()
+    other = sensor.foreign_address()
     sensor.listen(0.02)
     foreign = sensor.master.raw(f"{other}!", break_first=False)
     ex = sensor.master.raw(f"{sensor.address}!", break_first=False)
@@ -203,7 +210,7 @@ def test_standby_after_foreign_command(sensor, case):
 def test_standby_after_100ms(sensor, case):
     """After more than 100 ms of marking the sensor ignores a command without a break."""
     case.expect("silence to a! sent 115 ms after the last reply, without a break")
-    first = sensor.probe(f"{sensor.address}!", break_s=13e-3, idle_before=STANDBY)
+    first = _awake(sensor)
     if not first.answered:
         case.add(inconclusive("R-7.0-15", "the sensor did not answer the wake-up a!"))
         return
@@ -226,7 +233,7 @@ def test_follow_up_without_break(sensor, case):
     """An awake sensor answers its address without a break while the line has marked for
     less than 87 ms."""
     case.expect("a reply to aI! sent 20 ms after the reply to a!, with no break")
-    first = sensor.probe(f"{sensor.address}!", break_s=13e-3, idle_before=STANDBY)
+    first = _awake(sensor)
     if not first.answered:
         case.add(inconclusive("R-7.0-16", "the sensor did not answer the wake-up a!"))
         return
