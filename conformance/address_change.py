@@ -90,7 +90,7 @@ class AddressChanger:
         """Whether the sensor answers at ``address``, allowing it the 1 s of deafness that
         may follow a change (R-4.4.4-02)."""
         link = self.master.link
-        give_up = link.now() + ADDRESS_CHANGE_QUIET + 0.5
+        give_up = link.now() + ADDRESS_CHANGE_QUIET + LATE_LIMIT
         while True:
             check = self.master.transact(f"{address}!")
             self.exchanges.append(check)

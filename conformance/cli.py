@@ -95,7 +95,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         else:
             from .ports import open_port
 
-            open_port(args.port)[0].close()  # a port that cannot be opened is a usage error
+            open_port(args.port).link.close()  # a port that cannot be opened: a usage error
     except (DeclarationError, PortError) as exc:
         console.print(f"error: {exc}", style="red", markup=False)
         return EXIT_USAGE

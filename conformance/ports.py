@@ -26,6 +26,13 @@ class SimSpec:
     extra: dict[str, str] = field(default_factory=dict)
 
 
+@dataclass
+class OpenedPort:
+    link: Link
+    devices: list[object] = field(default_factory=list)
+    declaration: Declaration | None = None  # what a simulated device declares about itself
+
+
 def is_sim(port: str) -> bool:
     return port == "sim" or port.startswith("sim://") or port.startswith("sim:")
 
@@ -51,8 +58,8 @@ def parse_sim(port: str) -> SimSpec:
     return spec
 
 
-def open_sim(spec: SimSpec) -> tuple[Link, list[object]]:
-    """Build the simulated bus with one reference emulator; returns the link and the devices."""
+def open_sim(spec: SimSpec) -> OpenedPort:
+    """Build the simulated bus with one reference emulator on it."""
     from .emulator import FAULTS, default_profile, sim_sensor
     from .protocol.commands import ADDRESS_CHARS
 
@@ -65,28 +72,28 @@ def open_sim(spec: SimSpec) -> tuple[Link, list[object]]:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
     profile = replace(default_profile(spec.version), address=spec.address)
     _bus, link, emulator = sim_sensor(profile, faults=spec.faults)
-    return link, [emulator]
+    return OpenedPort(link, [emulator], sim_declaration(emulator, spec))
 
 
-def sim_declaration(emulator: object) -> Declaration:
+def sim_declaration(emulator: object, spec: SimSpec) -> Declaration:
     """What the simulated sensor's maker would declare: its profile, as the emulator runs it.
 
     Extended commands are opt-in on real devices; the simulated one declares its own, so the
-    suite exercises them. Only a sensor at address 0 is taken as fresh from the factory.
+    suite exercises them. The address is left to discovery (``?!``); a sensor asked for at
+    address 0 is a unit fresh from the factory.
     """
     profile = emulator.profile  # type: ignore[attr-defined]
     return Declaration(
-        address=profile.address,
         features={"address_change": bool(profile.address_settable)},
         extended=tuple(profile.extended),
-        factory_fresh=profile.address == "0",
+        factory_fresh=spec.address == "0",
         source="built-in (the simulated sensor's profile)",
     )
 
 
-def open_port(port: str) -> tuple[Link, list[object]]:
+def open_port(port: str) -> OpenedPort:
     if is_sim(port):
         return open_sim(parse_sim(port))
     from .links.factory import open_real_link
 
-    return open_real_link(port), []
+    return OpenedPort(open_real_link(port))

@@ -14,7 +14,7 @@ from typing import Any
 from . import __version__
 from .declaration import Declaration, load_declaration, normalise_version
 from .links.base import Link
-from .ports import is_sim, open_port, sim_declaration
+from .ports import is_sim, open_port
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .sensor_session import SensorSession
 
@@ -75,15 +75,16 @@ class ConformanceRun:
 
     def open_link(self) -> Link:
         if self.link is None:
-            self.link, self.devices = open_port(self.options.port)
+            opened = open_port(self.options.port)
+            self.link, self.devices = opened.link, opened.devices
+            if self.declaration is None:
+                self.declaration = opened.declaration
         return self.link
 
     def sensor_session(self) -> SensorSession:
         if self.session is None:
             uncertainty = self.options.timing_uncertainty_ms
             link = self.open_link()
-            if self.declaration is None and self.devices:
-                self.declaration = sim_declaration(self.devices[0])
             session = SensorSession(
                 link,
                 address=self.options.address,

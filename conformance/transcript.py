@@ -94,9 +94,7 @@ def escape(data: str | bytes) -> str:
     if isinstance(data, bytes):
         data = data.decode("latin-1")
     names = {"\r": "<CR>", "\n": "<LF>", "\x02": "<STX>", "\x03": "<ETX>"}
-    return "".join(
-        names.get(c, c if 0x20 <= ord(c) <= 0x7E else f"<0x{ord(c):02X}>") for c in data
-    )
+    return "".join(names.get(c, c if 0x20 <= ord(c) <= 0x7E else f"<0x{ord(c):02X}>") for c in data)
 
 
 @dataclass

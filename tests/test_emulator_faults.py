@@ -23,7 +23,7 @@ from conformance.protocol.responses import (
     parse_metadata_reply,
 )
 from conformance.protocol.timing import RESPONSE_START_MAX, RESPONSE_START_MIN, TOLERANCE
-from conformance.transcript import decode_7e1
+from conformance.transcript import Event, decode_7e1
 
 M_VALUES = "+22.15+1013.2+45.7"
 M1_VALUES = "+12.61+3.3"
@@ -666,6 +666,155 @@ CHECKS: dict[str, Callable[[Rig], None]] = {
     "stays-awake-after-foreign": check_stays_awake_after_foreign,
     "v13-concurrent-over-20": check_v13_concurrent_over_20,
 }
+
+
+# -- faults added with the sensor-role coverage ------------------------------------------------
+def check_fast_baud(rig: Rig) -> None:
+    answer = rig.ask("0I!")
+    assert all(e.duration == pytest.approx(10 / 1300) for e in answer.events)
+
+
+def check_factory_address_not_zero(rig: Rig) -> None:
+    assert rig.ask("?!").body == "1"
+
+
+def check_accepts_invalid_address(rig: Rig) -> None:
+    assert rig.ask("0A$!").body == "$"
+    assert silent(rig.ask("0!"))  # it really moved
+
+
+def check_wildcard_wrong_reply(rig: Rig) -> None:
+    assert rig.ask("?I!").body == "0"
+
+
+def check_address_change_deaf_2s(rig: Rig) -> None:
+    assert rig.ask("0A9!").body == "9"
+    rig.wait(1.2)
+    assert silent(rig.ask("9!"))
+    rig.wait(1.0)
+    assert rig.ask("9!").body == "9"
+
+
+def check_ttt_overstated(rig: Rig) -> None:
+    start, follow = rig.measure("0M!")
+    assert start.body == "00103" and decode_7e1(follow) == "0\r\n"
+    assert follow[-1].end - start.events[-1].end < 2.0
+
+
+def check_concurrent_unsupported(rig: Rig) -> None:
+    assert silent(rig.ask("0C!"))
+    assert rig.ask("0CC!").body == "000320"
+
+
+def check_groups_start_at_d1(rig: Rig) -> None:
+    rig.measure("0M!")
+    assert rig.ask("0D0!").body == "0"
+    assert rig.ask("0D1!").body == "0" + M_VALUES
+
+
+def check_verify_no_service_request(rig: Rig) -> None:
+    start, follow = rig.measure("0V!")
+    assert int(start.body[1:4]) > 0 and follow == []
+
+
+def check_crc_wrong_encoding(rig: Rig) -> None:
+    rig.measure("0MC!")
+    body = rig.ask("0D0!").body
+    assert body[-3:] == "".join(chr(ord(c) | 0x20) for c in ascii_crc(body[:-3]))
+    assert "R-4.4.12-06" in requirements_of(body, "0MC!")
+
+
+def check_extended_not_x(rig: Rig) -> None:
+    assert silent(rig.ask("0XSN!"))
+    assert rig.ask("0ZSN!").body == "0EMU-0001"
+
+
+def _help_lines(rig: Rig) -> tuple[str, list[Event]]:
+    rig.wake()
+    rig.send("0XHELP!")
+    events = rig.listen(2.0, idle=0.4)
+    return decode_7e1(events), events
+
+
+def check_multiline_no_etx(rig: Rig) -> None:
+    text, _ = _help_lines(rig)
+    assert text.startswith("0\x02") and text.endswith("\r\n") and "\x03" not in text
+
+
+def check_multiline_long_line(rig: Rig) -> None:
+    text, _ = _help_lines(rig)
+    assert "L" * 80 + "\r\n\x03" in text
+
+
+def check_multiline_slow_lines(rig: Rig) -> None:
+    _, events = _help_lines(rig)
+    gaps = [
+        b.start - a.end
+        for a, b in zip(events, events[1:], strict=False)
+        if a.char7 == 0x0A and b.char7 != 0x03  # between lines, not the ETX after the last
+    ]
+    assert gaps and min(gaps) > 0.15
+
+
+def check_high_volume_binary_two_digit_count(rig: Rig) -> None:
+    assert len(rig.ask("0HB!").body) == 6
+
+
+def check_binary_size_big_endian(rig: Rig) -> None:
+    data = packet(rig, 0)
+    assert data[1] == 0 and data[2] == len(data) - 6
+
+
+def check_high_volume_unsupported_silent(rig: Rig) -> None:
+    assert silent(rig.ask("0HA!")) and silent(rig.ask("0HB!"))
+
+
+def check_metadata_silent(rig: Rig) -> None:
+    assert silent(rig.ask("0IM_001!"))
+
+
+def check_metadata_semicolon_in_field(rig: Rig) -> None:
+    body = rig.ask("0IM_001!").body
+    assert ";x," in body
+    assert "R-6.2-03" in {
+        v.requirement for v in parse_metadata_reply(body, crc_expected=False).violations
+    }
+
+
+def check_metadata_long_identifier(rig: Rig) -> None:
+    assert rig.ask("0IM_001!").body.startswith("0,LONGIDENTIFIER,")
+
+
+def check_inter_char_gap_tolerance(rig: Rig) -> None:
+    gaps = rig.ask("0I!").gaps
+    assert gaps and all(g == pytest.approx(1.9e-3) for g in gaps)
+
+
+CHECKS.update(
+    {
+        "fast-baud": check_fast_baud,
+        "factory-address-not-zero": check_factory_address_not_zero,
+        "accepts-invalid-address": check_accepts_invalid_address,
+        "wildcard-wrong-reply": check_wildcard_wrong_reply,
+        "address-change-deaf-2s": check_address_change_deaf_2s,
+        "ttt-overstated": check_ttt_overstated,
+        "concurrent-unsupported": check_concurrent_unsupported,
+        "groups-start-at-d1": check_groups_start_at_d1,
+        "verify-no-service-request": check_verify_no_service_request,
+        "crc-wrong-encoding": check_crc_wrong_encoding,
+        "extended-not-x": check_extended_not_x,
+        "multiline-no-etx": check_multiline_no_etx,
+        "multiline-long-line": check_multiline_long_line,
+        "multiline-slow-lines": check_multiline_slow_lines,
+        "high-volume-binary-two-digit-count": check_high_volume_binary_two_digit_count,
+        "binary-size-big-endian": check_binary_size_big_endian,
+        "high-volume-unsupported-silent": check_high_volume_unsupported_silent,
+        "metadata-silent": check_metadata_silent,
+        "metadata-semicolon-in-field": check_metadata_semicolon_in_field,
+        "metadata-long-identifier": check_metadata_long_identifier,
+        "inter-char-gap-tolerance": check_inter_char_gap_tolerance,
+    }
+)
 
 
 def test_every_fault_has_a_check():

@@ -273,7 +273,10 @@ def test_multiline_text_read_across_line_pauses_until_etx():
 def test_multiline_text_ends_when_next_line_is_over_150_ms_late():
     line1 = Burst("0\x02First line.\r\n")
     line2 = Burst("Late line.\r\n\x03", at=line1.end_offset + 0.200)
-    master, _ = rig(ScriptedSensor({"0XHELP!": [[line1, line2]]}, break_cancels=False))
+    master, _ = rig(
+        ScriptedSensor({"0XHELP!": [[line1, line2]]}, break_cancels=False),
+        policy=Policy.golden(),  # the recorder's 150 ms (an observer waits longer)
+    )
     ex = master.transact("0XHELP!")
     assert ex.ok and ex.reply_text == "0\x02First line.\r\n"
     assert ex.end - ex.reply_events[-1].end >= 0.150

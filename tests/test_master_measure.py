@@ -6,6 +6,7 @@ import time
 
 from test_master_fakes import Burst, ScriptedSensor, rig, then_sr, with_crc
 
+from conformance.master.policy import Policy
 from conformance.master.records import Measurement
 from conformance.protocol import commands as cmds
 from conformance.protocol.binary import DataType, build_packet, empty_packet
@@ -157,9 +158,16 @@ def test_binary_packet_with_bad_crc_is_retried():
 
 def test_empty_d_reply_stops_collection():
     script = {"0M!": ["00003\r\n"], "0D0!": ["0\r\n"]}
-    master, _ = rig(ScriptedSensor(script))
+    master, _ = rig(ScriptedSensor(script), policy=Policy.golden())
     m = master.measure(cmds.measure("0"))
     assert len(m.data) == 1 and m.data[0].ok and m.values == [] and not m.complete
+
+
+def test_observer_looks_one_index_past_an_empty_reply():
+    script = {"0M!": ["00003\r\n"], "0D0!": ["0\r\n"], "0D1!": ["0+1+2+3\r\n"]}
+    master, _ = rig(ScriptedSensor(script))
+    m = master.measure(cmds.measure("0"))
+    assert [ex.text for ex in m.data] == ["0D0!", "0D1!"] and m.values == ["+1", "+2", "+3"]
 
 
 def test_invalid_start_reply_gives_no_collection():

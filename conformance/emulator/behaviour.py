@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..protocol.timing import (
+    CHAR_TIME,
     MARKING_AFTER_BREAK,
     PARTIAL_COMMAND_GAP,
     STANDBY_MARKING,
@@ -42,10 +43,16 @@ class Behaviour:
     # -- transmitting ------------------------------------------------------------------------
     reply_delay: float = REPLY_DELAY
     char_gap: float = 0.0  # marking between reply characters (R-7.0-12)
+    char_time: float = CHAR_TIME  # one 10-bit frame: 1200 baud (R-4.1-01)
+    line_gap: float = 20e-3  # marking between the lines of multi-line text (R-4.4.13.1-03)
+    line_limit: int | None = None  # cut multi-line text lines to this (None: as written)
+    etx: bool = True  # ETX after the last line of multi-line text (R-4.4.13.1-01)
     # -- addressing --------------------------------------------------------------------------
     answer_foreign: bool = False  # answer a!/aI! for any address (breaks R-4.0-01)
     answer_query: bool = True
     apply_address_change: bool = True
+    accept_any_new_address: bool = False  # take aA$! too (breaks R-4.3-04, decision A17)
+    wildcard_answer: bool = False  # answer ?I! and the like with a bare address (R-4.4.3-02)
     answer_old_address: bool = False
     # -- service requests --------------------------------------------------------------------
     service_request: bool = True
@@ -75,6 +82,7 @@ class Behaviour:
     split_values: bool = False  # fill M/V replies to the limit, cutting a value
     drop_all_values: bool = False  # a completed measurement holds no values
     max_data_index: int = 999  # highest D index served after HA (R-5.1-02)
+    groups_from_d1: bool = False  # M/V data start at D1, D0 empty (R-4.4.8.3-02)
     # -- other commands ----------------------------------------------------------------------
     continuous_needs_r0: bool = False
     answer_undefined_measure: bool = True

@@ -256,6 +256,96 @@ def _parity_address(reply: Reply) -> None:
     reply.binary.address |= 0x80
 
 
+# -- helpers for the faults added with the sensor-role coverage --------------------------------
+def _plain_c(reply: Reply) -> bool:
+    cmd = reply.command
+    return (
+        reply.kind is ReplyKind.START
+        and cmd is not None
+        and cmd.kind is Kind.CONCURRENT
+        and not cmd.crc
+        and cmd.group == 0
+    )
+
+
+def _verify_sr(reply: Reply) -> bool:
+    return reply.kind is ReplyKind.SERVICE_REQUEST and _source_kind(reply) is Kind.VERIFY
+
+
+def _crc_high_bits(reply: Reply) -> Reply:
+    """The three CRC characters with 0x60 instead of 0x40 or'ed in (R-4.4.12-06)."""
+    if not reply.crc:
+        return reply
+    good = ascii_crc(reply.body)
+    return replace(reply, crc_text="".join(chr(ord(c) | 0x20) for c in good))
+
+
+def _hb_start(reply: Reply) -> bool:
+    return _measure_family(reply, 3) and _source_kind(reply) is Kind.HIGH_VOLUME_BINARY
+
+
+def _hv_start(reply: Reply) -> bool:
+    return reply.kind is ReplyKind.START and _source_kind(reply) in (
+        Kind.HIGH_VOLUME_ASCII,
+        Kind.HIGH_VOLUME_BINARY,
+    )
+
+
+def _size_big_endian(reply: Reply) -> None:
+    assert reply.binary is not None
+    reply.binary.size_order = "big"
+
+
+def _metadata_field(change: Callable[[list[str]], None]) -> Rewrite:
+    """Rewrite the fields of metadata records (not the invalid-index replies)."""
+
+    def rewrite(reply: Reply) -> Reply:
+        if reply.kind is not ReplyKind.METADATA or "," not in reply.body:
+            return reply
+        head, _, rest = reply.body.partition(",")
+        fields = rest.rstrip(";").split(",")
+        change(fields)
+        return replace(reply, body=head + "," + ",".join(fields) + ";")
+
+    return rewrite
+
+
+def _semicolon_in_units(fields: list[str]) -> None:
+    fields[1] = fields[1] + ";x"
+
+
+def _long_identifier(fields: list[str]) -> None:
+    fields[0] = "LONGIDENTIFIER"
+
+
+def _without_high_volume(profile: Profile) -> Profile:
+    keep = {k: v for k, v in profile.measurements.items() if k not in ("HA", "HB")}
+    return replace(profile, measurements=keep)
+
+
+def _rename_extended(profile: Profile) -> Profile:
+    """Extended commands without the recommended X (still not a basic command letter)."""
+    return replace(profile, extended={"Z" + k[1:]: v for k, v in profile.extended.items()})
+
+
+def _long_help_line(profile: Profile) -> Profile:
+    extended = dict(profile.extended)
+    extended["XHELP"] = extended["XHELP"] + "\n" + "L" * 80
+    return replace(profile, extended=extended)
+
+
+def _overstated_ttt(spec: MeasurementSpec) -> MeasurementSpec:
+    return replace(spec, ttt=10)
+
+
+def _fresh_address_one(profile: Profile) -> Profile:
+    return replace(profile, address="1")
+
+
+def _address_quiet_2s(profile: Profile) -> Profile:
+    return replace(profile, address_change_quiet=2.0)
+
+
 # -- profile helpers ---------------------------------------------------------------------------
 def _with_spec(key: str, change: Callable[[MeasurementSpec], MeasurementSpec]) -> ProfileTransform:
     def transform(profile: Profile) -> Profile:
@@ -901,6 +991,135 @@ def _faults() -> list[Fault]:
             "A command to another address does not send the sensor to standby.",
             ("R-7.0-14",),
             settings={"standby_after_foreign": False},
+        ),
+        # -- faults that complete the sensor-role coverage ---------------------------------------
+        Fault(
+            "fast-baud",
+            "Replies go out at 1300 baud: each character takes 7.69 ms instead of 8.33 ms.",
+            ("R-4.1-01",),
+            settings={"char_time": 10 / 1300},
+        ),
+        Fault(
+            "factory-address-not-zero",
+            "The sensor ships at address 1 instead of 0 (the simulated unit is fresh).",
+            ("R-4.3-02",),
+            profile=_fresh_address_one,
+        ),
+        Fault(
+            "accepts-invalid-address",
+            "aA$! makes '$' the sensor's address (only 0-9, A-Z, a-z are addresses).",
+            ("R-4.3-04",),
+            settings={"accept_any_new_address": True},
+        ),
+        Fault(
+            "wildcard-wrong-reply",
+            "?I! and other wildcard commands are answered with a bare address.",
+            ("R-4.4.3-02",),
+            settings={"wildcard_answer": True},
+        ),
+        Fault(
+            "address-change-deaf-2s",
+            "After aAb! the sensor ignores every command for 2 s (1 s is allowed).",
+            ("R-4.4.4-02",),
+            profile=_address_quiet_2s,
+        ),
+        Fault(
+            "ttt-overstated",
+            "aM! announces ttt = 10 s but the data are ready (and the SR sent) after 1.5 s.",
+            ("R-4.4.5-09",),
+            profile=_with_spec("M", _overstated_ttt),
+        ),
+        Fault(
+            "concurrent-unsupported",
+            "aC! gets no answer (the CRC and numbered variants still work).",
+            ("R-4.4.7-08", "R-4.4-01"),
+            rewrite=_when(_plain_c, _silence),
+        ),
+        Fault(
+            "groups-start-at-d1",
+            "M/V data start at D1; D0 answers with no values.",
+            ("R-4.4.8.3-02", "R-4.4.8-04", "R-4.4.5-03"),
+            settings={"groups_from_d1": True},
+        ),
+        Fault(
+            "verify-no-service-request",
+            "aV! never sends its service request (aM! does).",
+            ("R-4.4.6-02", "R-4.4.11-01"),
+            rewrite=_when(_verify_sr, _silence),
+        ),
+        Fault(
+            "crc-wrong-encoding",
+            "CRC characters are or'ed with 0x60 instead of 0x40.",
+            ("R-4.4.12-06",),
+            rewrite=_crc_high_bits,
+        ),
+        Fault(
+            "extended-not-x",
+            "Extended commands are named aZ...! instead of the recommended aX...!.",
+            ("R-4.4.13-02",),
+            profile=_rename_extended,
+        ),
+        Fault(
+            "multiline-no-etx",
+            "Multi-line text ends without the ETX after the last CR LF.",
+            ("R-4.4.13.1-01",),
+            settings={"etx": False},
+        ),
+        Fault(
+            "multiline-long-line",
+            "A line of the multi-line help text has 80 characters (75 allowed).",
+            ("R-4.4.13.1-02",),
+            profile=_long_help_line,
+        ),
+        Fault(
+            "multiline-slow-lines",
+            "Lines of multi-line text come 200 ms apart (150 ms allowed).",
+            ("R-4.4.13.1-03",),
+            settings={"line_gap": 0.2},
+        ),
+        Fault(
+            "high-volume-binary-two-digit-count",
+            "aHB! replies give a 2-digit count (atttnn instead of atttnnn).",
+            ("R-5.2-01",),
+            rewrite=_when(_hb_start, lambda r: replace(r, body=r.body[:4] + r.body[5:])),
+        ),
+        Fault(
+            "binary-size-big-endian",
+            "The payload size field of HB packets is sent high byte first.",
+            ("R-5.2-02",),
+            rewrite=_binary(_size_big_endian),
+        ),
+        Fault(
+            "high-volume-unsupported-silent",
+            "A sensor without HA/HB stays silent to aHA!/aHB! instead of answering a000000.",
+            ("R-5.4-02",),
+            profile=_without_high_volume,
+            rewrite=_when(_hv_start, _silence),
+        ),
+        Fault(
+            "metadata-silent",
+            "Parameter metadata commands (aIM_001! ...) get no answer.",
+            ("R-6.2-01", "R-6.2-05", "R-6.2-06", "R-6.2-07"),
+            rewrite=_only([ReplyKind.METADATA], _silence),
+        ),
+        Fault(
+            "metadata-semicolon-in-field",
+            "The units field of metadata records contains a ';'.",
+            ("R-6.2-03",),
+            rewrite=_metadata_field(_semicolon_in_units),
+        ),
+        Fault(
+            "metadata-long-identifier",
+            "Field 1 of metadata records is a 14-character name, not a SHEF code.",
+            ("R-6.2.1-01",),
+            rewrite=_metadata_field(_long_identifier),
+        ),
+        Fault(
+            "inter-char-gap-tolerance",
+            "1.9 ms of marking between reply characters: inside 1.66 + 0.40 ms, but that gap "
+            "has no tolerance.",
+            ("R-7.0-12", "R-7.0-01"),
+            settings={"char_gap": 1.9e-3},
         ),
         # -- version specific --------------------------------------------------------------------
         Fault(

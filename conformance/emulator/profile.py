@@ -245,6 +245,20 @@ def _v13_measurements() -> dict[str, MeasurementSpec]:
     return {**{k: full[k] for k in keep}, "C1": c1}
 
 
+#: Extended commands of the built-in sensor: a one-line serial number, and a multi-line help
+#: text (v1.4 2023, 4.4.13.1) whose lines are at most 75 characters.
+EXTENDED = {
+    "XSN": "EMU-0001",
+    "XHELP": "\n".join(
+        (
+            "CONFORM EMU001 reference SDI-12 sensor emulator",
+            "aXSN! serial number; aXHELP! this text",
+            "Measurements: M M1 M2 V C C9 R0 R1 HA HB",
+        )
+    ),
+}
+
+
 def default_profile(version: str = "14") -> Profile:
     """The built-in sensor: every command family of ``version`` with realistic values.
 
@@ -259,4 +273,5 @@ def default_profile(version: str = "14") -> Profile:
         measurements = _v13_measurements()
     else:
         raise ValueError(f"no default profile for version {version!r}")
-    return Profile(version=version, measurements=measurements, extended={"XSN": "EMU-0001"})
+    extended = dict(EXTENDED) if version == "14" else {"XSN": EXTENDED["XSN"]}
+    return Profile(version=version, measurements=measurements, extended=extended)

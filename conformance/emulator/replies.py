@@ -40,9 +40,11 @@ class BinaryParts:
     dtype: int
     payload: bytes
     crc: bytes | None = None  # None: the correct CRC, low byte first (R-5.2-03)
+    size_order: str = "little"  # the size field's byte order (R-5.2-02 says LSB first)
 
     def encode(self) -> bytes:
-        head = bytes([self.address]) + len(self.payload).to_bytes(2, "little")
+        order = "big" if self.size_order == "big" else "little"
+        head = bytes([self.address]) + len(self.payload).to_bytes(2, order)
         head += bytes([self.dtype])
         crc = self.crc if self.crc is not None else binary_crc(head + self.payload)
         return head + self.payload + crc

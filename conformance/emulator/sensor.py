@@ -40,7 +40,6 @@ from ..protocol.commands import (
     Kind,
     parse_command,
 )
-from ..protocol.timing import CHAR_TIME
 from ..sim.bus import Frame
 from ..transcript import parity_bit
 from .faults import compose
@@ -235,7 +234,7 @@ class SensorEmulator:
 
     def pop_frame(self) -> Frame:
         frame, item = self._tx.pop_frame()
-        self._last_activity = max(self._last_activity, frame.start + CHAR_TIME)
+        self._last_activity = max(self._last_activity, frame.start + frame.duration)
         if item.done:
             kind = item.reply.kind
             if kind is ReplyKind.SERVICE_REQUEST:
@@ -277,6 +276,7 @@ class SensorEmulator:
         try:
             cmd = parse_command(text)
         except CommandError:
+            self._non_command(text, end, foreign)
             return  # decision A12: silence to what is not a command
         at = end + b.reply_delay
         if foreign:
@@ -323,16 +323,51 @@ class SensorEmulator:
                 self._metadata(cmd, at)
             case Kind.EXTENDED:
                 text = self.profile.extended.get(cmd.body)
-                if text is not None:
+                if text is not None and "\n" in text:
+                    self._multiline(cmd, a, text.split("\n"), at)
+                elif text is not None:
                     self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
             case _:
                 self._start_measurement(cmd, at)
+
+    def _non_command(self, text: str, end: float, foreign: bool) -> None:
+        """What only a faulty sensor does with text that is not a command: take a character
+        that is no address as its new address, or answer a wildcard it should not."""
+        b = self.behaviour
+        at = end + b.reply_delay
+        if b.wildcard_answer and text[:1] == "?" and text != "?!":
+            self._send(Reply(ReplyKind.ACKNOWLEDGE, self.address), at)
+        elif (
+            b.accept_any_new_address
+            and not foreign
+            and len(text) == 4
+            and text[0] == self.address
+            and text[1] == "A"
+            and text[3] == "!"
+        ):
+            self._old_addresses.add(self.address)
+            self.address = text[2]
+            self._send(Reply(ReplyKind.CHANGE_ADDRESS, text[2]), at)
+
+    def _multiline(self, cmd: Command, address: str, lines: list[str], at: float) -> None:
+        """Multi-line text (4.4.13.1, decision A10): 'a<STX>' before the first line, CR LF
+        after each, ETX after the last; lines ``line_gap`` apart, no CRC."""
+        b = self.behaviour
+        for n, line in enumerate(lines):
+            body = (address + "\x02" if n == 0 else "") + line[: b.line_limit]
+            last = n == len(lines) - 1
+            end = "\r\n\x03" if last and b.etx else "\r\n"
+            sent = self._send(Reply(ReplyKind.EXTENDED, body, command=cmd, end=end), at)
+            if sent is None:
+                return
+            at = sent.end + b.line_gap
 
     def _send(self, reply: Reply, at: float) -> Transmission | None:
         rewritten = self.faults.rewrite(reply)
         if rewritten is None:
             return None
-        return self._tx.schedule(rewritten, at, self.behaviour.char_gap)
+        b = self.behaviour
+        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time)
 
     def _change_address(self, cmd: Command, at: float) -> None:
         old, new = self.address, cmd.new_address
@@ -430,8 +465,16 @@ class SensorEmulator:
         limit = min(data.max_index, b.max_data_index) if high_volume else data.max_index
         if cmd.index > limit:
             return  # D10+ exists only after HA; silence otherwise (decision A12)
-        page = "" if data.binary or cmd.index >= len(data.pages) else data.pages[cmd.index]
-        repeat = data.note_read(cmd.index) if page else 0
+        index = cmd.index
+        if (
+            b.groups_from_d1
+            and data.source is not None
+            and data.source.kind in (Kind.MEASURE, Kind.VERIFY)
+        ):
+            index -= 1  # a faulty sensor that starts its groups at D1
+        in_range = 0 <= index < len(data.pages)
+        page = "" if data.binary or not in_range else data.pages[index]
+        repeat = data.note_read(index) if page else 0
         reply = Reply(
             ReplyKind.DATA,
             cmd.address + page,

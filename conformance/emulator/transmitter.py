@@ -24,14 +24,18 @@ class Transmission:
     wires: list[int]
     gap: float
     sent: int = 0
+    char_time: float = CHAR_TIME  # one frame; differs only for a sensor at the wrong baud rate
 
     def frame_start(self, index: int) -> float:
-        return self.start + index * (CHAR_TIME + self.gap)
+        return self.start + index * (self.char_time + self.gap)
+
+    def frame(self, index: int) -> Frame:
+        return Frame(self.frame_start(index), self.wires[index], self.char_time)
 
     @property
     def end(self) -> float:
         """End of the last stop bit."""
-        return self.frame_start(len(self.wires) - 1) + CHAR_TIME
+        return self.frame_start(len(self.wires) - 1) + self.char_time
 
     @property
     def done(self) -> bool:
@@ -44,12 +48,14 @@ class Transmitter:
     def __init__(self) -> None:
         self.queue: list[Transmission] = []
 
-    def schedule(self, reply: Reply, start: float, gap: float) -> Transmission:
+    def schedule(
+        self, reply: Reply, start: float, gap: float, char_time: float = CHAR_TIME
+    ) -> Transmission:
         wires = reply.wires()
         for other in self.queue:
             if other.start <= start < other.end + CHAR_TIME:
                 start = other.end + CHAR_TIME
-        item = Transmission(reply, start, wires, gap)
+        item = Transmission(reply, start, wires, gap, char_time=char_time)
         self.queue.append(item)
         self.queue.sort(key=lambda t: t.start)
         return item
@@ -65,11 +71,11 @@ class Transmitter:
         if not self.queue:
             return None
         item = self.queue[0]
-        return Frame(item.frame_start(item.sent), item.wires[item.sent])
+        return item.frame(item.sent)
 
     def pop_frame(self) -> tuple[Frame, Transmission]:
         item = self.queue[0]
-        frame = Frame(item.frame_start(item.sent), item.wires[item.sent])
+        frame = item.frame(item.sent)
         item.sent += 1
         if item.done:
             self.queue.pop(0)

@@ -247,8 +247,8 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
         tally.observe(dlabel, packet.violations, ids=ids)
         if packet.is_empty:
             break
-        if any(v.requirement in ("R-5.2.1-01", "R-5.2-05") for v in packet.violations):
-            countable = False  # values of an unknown type or a ragged payload: uncountable
+        if any(v.requirement in ("R-5.2.1-01", "R-5.2-05", "R-5.2-02") for v in packet.violations):
+            countable = False  # unknown type, ragged payload or broken framing: uncountable
         total += len(packet.values)
     if countable:
         tally.observe(label, ids=["R-5.2-07"])

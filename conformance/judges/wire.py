@@ -174,6 +174,8 @@ def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     for seg in segs:
         for run in runs(seg.reply) + runs(seg.later):
             for a, b in zip(run, run[1:], strict=False):
+                if seg.multiline and a.char7 == 0x0A:
+                    continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
                 gaps.append((b.start - a.end, f"in reply to {escape(seg.text)}"))
     return gaps
 
@@ -306,8 +308,12 @@ def judge_framing(segs: list[Segment]) -> list[Finding]:
                     f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
                 )
             text = "".join(chr(e.char7) for e in chunk)
-            if seg.multiline and n == 0:
-                text = text.replace("\x02", "").rstrip("\x03")  # decision A10
+            if seg.multiline and n == 0:  # decision A10: each line is framed on its own
+                lines = text.replace("\x02", "", 1).rstrip("\x03").split("\r\n")
+                for line in lines[:-1]:
+                    tally.observe(label, split_line(line + "\r\n")[1], ids=["R-4.2-02", "R-4.2-03"])
+                if lines[-1] == "":  # complete: the checks below look at the first line
+                    text = lines[0] + "\r\n"
             stripped = text.rstrip("\r\n")
             crc_positions = (
                 3

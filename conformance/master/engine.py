@@ -206,6 +206,7 @@ class Master:
         if force_break is None:
             force_break = bool(m.ttt) and m.service_request_end is None
         index = len(m.data)
+        probed_past_empty = False
         while index <= limit and m.value_count < m.count:
             if m.binary:
                 exchange = self.transact(
@@ -218,8 +219,19 @@ class Master:
             force_break = False
             m.data.append(exchange)
             usable = exchange.ok or (self.policy.salvage and exchange.answered)
-            if not usable or not self._take_values(m, exchange, crc):
+            if not usable:
                 break
+            if not self._take_values(m, exchange, crc):
+                # An empty reply ends collection (R-4.4.8-05). An observer looks one index
+                # further, once, so a sensor whose groups start late leaves evidence.
+                if (
+                    not self.policy.salvage
+                    or probed_past_empty
+                    or m.binary
+                    or m.aborted_by is not None
+                ):
+                    break
+                probed_past_empty = True
             index += 1
         return m
 
@@ -320,6 +332,7 @@ class Master:
             binary=binary,
             multiline=not binary and (command is None or command.kind is Kind.EXTENDED),
             max_text_chars=p.max_text_chars,
+            line_wait=p.line_wait,
         )
         reply, state = self._listen(command_end, framing)
         if state is None:

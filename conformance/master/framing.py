@@ -29,6 +29,7 @@ class Framing:
     binary: bool = False
     multiline: bool = False
     max_text_chars: int = 0
+    line_wait: float = MULTILINE_GAP_MAX + TOLERANCE  # for the next line of multi-line text
 
     def is_text(self, chars: list[Event]) -> bool:
         """A multi-line text reply: STX right after the address."""
@@ -51,7 +52,7 @@ class Framing:
 
     def window(self, chars: list[Event]) -> float:
         """How long the line may mark after the last character before the read stops."""
-        return MULTILINE_GAP_MAX + TOLERANCE if self.at_line_end(chars) else self.idle
+        return self.line_wait if self.at_line_end(chars) else self.idle
 
     def stop(self, chars: list[Event]) -> bool:
         """Where one receive call returns so the loop can pick the next window."""
@@ -59,5 +60,5 @@ class Framing:
 
     def deadline(self, first: Event) -> float:
         """Hard bound for a DUT that trickles characters just inside each window."""
-        per_char = first.duration + max(self.idle, MULTILINE_GAP_MAX if self.multiline else 0.0)
+        per_char = first.duration + max(self.idle, self.line_wait if self.multiline else 0.0)
         return first.start + max(self.max_chars, self.max_text_chars) * per_char

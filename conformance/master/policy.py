@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ..protocol.timing import CHAR_TIME, TOLERANCE
+from ..protocol.timing import CHAR_TIME, MULTILINE_GAP_MAX, TOLERANCE
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,9 @@ class Policy:
     # R-7.2-03/04: retries per sequence, and how many break+command+retries sequences.
     retries_per_sequence: int = 2
     sequences: int = 3
+    # Wait for the next line of multi-line text (R-4.4.13.1-04 says 150 ms; an observer waits
+    # longer so lines that come late are evidence, not lost).
+    line_wait: float = 0.5
     # Listen this long past ttt for a late service request before breaking for D0.
     late_sr_grace: float = 0.5
     # Extra wait past ttt before breaking for D0 without a service request (R-4.4.5-04,
@@ -69,6 +72,7 @@ class Policy:
             late_sr_grace=0.0,
             first_char_timeout=20e-3,
             salvage=False,
+            line_wait=MULTILINE_GAP_MAX + TOLERANCE,
         )
 
     def but(self, **changes: object) -> Policy:

@@ -176,8 +176,12 @@ def parse_binary_packet(data: bytes, expected_address: str | None = None) -> Bin
                 f"{binary_crc(data[:-CRC_LEN]).hex(' ')} computed over the packet",
             )
         )
-    if size > MAX_PAYLOAD:
-        found.append(Violation("R-5.2-04", f"payload size {size} exceeds {MAX_PAYLOAD} bytes"))
+    if (framed and size > MAX_PAYLOAD) or len(payload) > MAX_PAYLOAD:
+        # an unframed packet's size field is not evidence of its payload (R-5.2-02 says so)
+        shown_size = size if framed else len(payload)
+        found.append(
+            Violation("R-5.2-04", f"payload size {shown_size} exceeds {MAX_PAYLOAD} bytes")
+        )
     values: list[int | float] = []
     if not isinstance(dtype, DataType):
         found.append(Violation("R-5.2.1-01", f"data type code {code} is not defined (0-10)"))

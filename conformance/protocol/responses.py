@@ -356,15 +356,16 @@ def _crc_suffix_len(text: str) -> int:
 def _check_crc(body: str, crc: str) -> tuple[bool, list[Violation]]:
     """Compare a three-character CRC with the one computed over the text before it."""
     found = []
+    want = _ascii_crc(body[: -len(crc)])
     if not 0x40 <= ord(crc[0]) <= 0x4F:
+        # not an encoding of any CRC-16: the encoding is wrong, its value cannot be compared
         found.append(
             Violation(
                 "R-4.4.12-06",
                 f"CRC '{escape(crc)}' cannot be an encoded CRC-16 (first character above 'O')",
             )
         )
-    want = _ascii_crc(body[: -len(crc)])
-    if crc != want:
+    elif crc != want:
         found.append(
             Violation(
                 "R-4.4.12-05",

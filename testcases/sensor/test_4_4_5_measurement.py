@@ -198,11 +198,26 @@ def test_break_aborts_measurement(sensor, case):
     if not again.start.answered:
         case.add(failed("R-4.4.5.1-03", f"after the abort {code} got no reply"))
     elif not first.reply_events:
-        case.add(failed("R-4.4.5.1-03", f"ignored the {code} sent right after the aborting "
-                        "break (it answered only a retry)"))
+        case.add(
+            failed(
+                "R-4.4.5.1-03",
+                f"ignored the {code} sent right after the aborting "
+                "break (it answered only a retry)",
+            )
+        )
     elif again.value_count < target.value_count:
-        case.add(failed("R-4.4.5.1-03", f"after the abort {code} delivered "
-                        f"{again.value_count} values, {target.value_count} before it"))
+        case.add(
+            failed(
+                "R-4.4.5.1-03",
+                f"after the abort {code} delivered "
+                f"{again.value_count} values, {target.value_count} before it",
+            )
+        )
     else:
-        case.add(passed("R-4.4.5.1-03", f"the {code} sent right after the aborting break "
-                        f"worked as before ({again.value_count} values)"))
+        case.add(
+            passed(
+                "R-4.4.5.1-03",
+                f"the {code} sent right after the aborting break "
+                f"worked as before ({again.value_count} values)",
+            )
+        )
