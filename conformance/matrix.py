@@ -25,6 +25,7 @@ class MatrixRow:
     flagged: tuple[str, ...]  # FAIL or WARN requirements
     verdict: str  # the run's overall verdict
     other: tuple[str, ...]  # INCONCLUSIVE or ERROR requirements, for the reader
+    failed: tuple[str, ...] = ()  # the FAIL ones among the flagged
 
     @property
     def missed(self) -> tuple[str, ...]:
@@ -76,7 +77,8 @@ def _row(item: tuple[str, tuple[str, ...], str, tuple[str, ...]]) -> MatrixRow:
         for r in data["requirements"]
         if r["verdict"] in ("INCONCLUSIVE", "ERROR")
     )
-    return MatrixRow(fault, declared, flagged, data["summary"]["verdict"], other)
+    failed = tuple(r["id"] for r in data["requirements"] if r["verdict"] == "FAIL")
+    return MatrixRow(fault, declared, flagged, data["summary"]["verdict"], other, failed)
 
 
 def fault_matrix(faults: list[str] | None = None, processes: int = 2) -> list[MatrixRow]:

@@ -790,8 +790,15 @@ def check_inter_char_gap_tolerance(rig: Rig) -> None:
     assert gaps and all(g == pytest.approx(1.9e-3) for g in gaps)
 
 
+def check_m2_later_data_silent(rig: Rig) -> None:
+    rig.measure("0M2!")
+    assert rig.ask("0D0!").body.startswith("0+")
+    assert silent(rig.ask("0D1!"))
+
+
 CHECKS.update(
     {
+        "m2-later-data-silent": check_m2_later_data_silent,
         "fast-baud": check_fast_baud,
         "factory-address-not-zero": check_factory_address_not_zero,
         "accepts-invalid-address": check_accepts_invalid_address,

@@ -10,16 +10,23 @@ from conformance.run import ConformanceRun, RunOptions
 from conformance.transcript import DUT, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
 
-HOSTILE = ['<script>alert(1)</script>', '"><img src=x onerror=alert(1)>']
+HOSTILE = ["<script>alert(1)</script>", '"><img src=x onerror=alert(1)>']
 
 
 def hostile_run() -> ConformanceRun:
     run = ConformanceRun(RunOptions())
-    ident = SimpleNamespace(vendor=HOSTILE[0], model=HOSTILE[1], sensor_version="<b>",
-                            optional="</table>", version="14")
+    ident = SimpleNamespace(
+        vendor=HOSTILE[0], model=HOSTILE[1], sensor_version="<b>", optional="</table>", version="14"
+    )
     exchange = SimpleNamespace(answered=True, reply_text="014" + HOSTILE[0] + HOSTILE[1] + "\r\n")
-    run.session = SimpleNamespace(identity=ident, ident_exchange=exchange, version="14",
-                                  address="0", assumptions=[HOSTILE[1]], uncertainty=0.0)
+    run.session = SimpleNamespace(
+        identity=ident,
+        ident_exchange=exchange,
+        version="14",
+        address="0",
+        assumptions=[HOSTILE[1]],
+        uncertainty=0.0,
+    )
     run.finish(complete=True)
     return run
 
@@ -33,11 +40,14 @@ def test_header_escapes_the_identification():
 
 
 def test_case_evidence_escapes_findings_and_wire_text():
-    record = CaseRecord("t::x", "x", ("R-4.4.2-01",), description=HOSTILE[0],
-                        expectation=HOSTILE[1])
+    record = CaseRecord(
+        "t::x", "x", ("R-4.4.2-01",), description=HOSTILE[0], expectation=HOSTILE[1]
+    )
     record.findings.append(Finding("R-4.4.2-01", Verdict.FAIL, HOSTILE[1], evidence=[HOSTILE[0]]))
-    wire = [Event(EventKind.CHAR, DUT, i * 0.00833, (i + 1) * 0.00833,
-                  wire=to_wire_7e1(ord(c))) for i, c in enumerate(HOSTILE[1])]
+    wire = [
+        Event(EventKind.CHAR, DUT, i * 0.00833, (i + 1) * 0.00833, wire=to_wire_7e1(ord(c)))
+        for i, c in enumerate(HOSTILE[1])
+    ]
     record.evidence.append(("reply", wire))
     page = html.case_html(record)
     for bad in HOSTILE:

@@ -110,8 +110,7 @@ def test_should_rule_turns_a_violation_into_warn():
 
 
 def transcript_of(*exchanges: Exchange) -> list[Event]:
-    events = [e for ex in exchanges for a in ex.attempts for e in a.command_events +
-              a.reply_events]
+    events = [e for ex in exchanges for a in ex.attempts for e in a.command_events + a.reply_events]
     return sorted(events, key=lambda e: e.start)
 
 
@@ -133,8 +132,9 @@ def test_characters_talking_over_a_command_are_contention_not_a_reply():
 
 def test_gaps_judged_without_tolerance_and_tolerance_misuse_flagged():
     tight = exchange("0!", "", 0.0)
-    tight.attempts[0].reply_events = chars("0123\r\n", tight.last.command_end + 9e-3, DUT,
-                                           gap=1.9e-3)
+    tight.attempts[0].reply_events = chars(
+        "0123\r\n", tight.last.command_end + 9e-3, DUT, gap=1.9e-3
+    )
     found = verdicts(wire.judge_gaps(wire.segments(transcript_of(tight)), 0.0))
     assert found == {"R-7.0-12": Verdict.FAIL, "R-7.0-01": Verdict.FAIL}
     far = exchange("0!", "", 0.0)
@@ -152,15 +152,23 @@ def test_bit_rate_too_fast_fails_but_slow_is_never_guessed():
     ]
     assert wire.judge_bit_rate(wire.segments(transcript_of(fast)), 0.0).verdict is Verdict.FAIL
     gapped = exchange("0!", "", 0.0)
-    gapped.attempts[0].reply_events = chars("0123", gapped.last.command_end + 9e-3, DUT,
-                                            gap=1e-3)
-    assert (wire.judge_bit_rate(wire.segments(transcript_of(gapped)), 0.0).verdict
-            is Verdict.INCONCLUSIVE)
+    gapped.attempts[0].reply_events = chars("0123", gapped.last.command_end + 9e-3, DUT, gap=1e-3)
+    assert (
+        wire.judge_bit_rate(wire.segments(transcript_of(gapped)), 0.0).verdict
+        is Verdict.INCONCLUSIVE
+    )
 
 
 def test_aggregation_worst_finding_untestable_and_unjudged():
-    case = CaseRecord("t::a", "a", ("R-4.4.1-01",), findings=[
-        Finding("R-4.4.1-01", Verdict.PASS, "ok"), Finding("R-4.4.1-01", Verdict.WARN, "hm")])
+    case = CaseRecord(
+        "t::a",
+        "a",
+        ("R-4.4.1-01",),
+        findings=[
+            Finding("R-4.4.1-01", Verdict.PASS, "ok"),
+            Finding("R-4.4.1-01", Verdict.WARN, "hm"),
+        ],
+    )
     results = {r.requirement.id: r for r in aggregate("sensor", [case])}
     assert results["R-4.4.1-01"].verdict is Verdict.WARN
     assert results["R-3.1-01"].verdict is Verdict.NA  # electrical: untestable here
@@ -169,8 +177,9 @@ def test_aggregation_worst_finding_untestable_and_unjudged():
 
 
 def test_overall_verdict():
-    case = CaseRecord("t::a", "a", ("R-4.4.1-01",),
-                      findings=[Finding("R-4.4.1-01", Verdict.WARN, "hm")])
+    case = CaseRecord(
+        "t::a", "a", ("R-4.4.1-01",), findings=[Finding("R-4.4.1-01", Verdict.WARN, "hm")]
+    )
     results = aggregate("sensor", [case])
     assert overall(results, strict=False, complete=True) == COMPLIANT
     assert overall(results, strict=True, complete=True) == NON_COMPLIANT

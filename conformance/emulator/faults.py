@@ -257,6 +257,26 @@ def _parity_address(reply: Reply) -> None:
 
 
 # -- helpers for the faults added with the sensor-role coverage --------------------------------
+def _one_line_extended(reply: Reply) -> bool:
+    return (
+        reply.kind is ReplyKind.EXTENDED
+        and reply.command is not None
+        and (reply.command.body == "XSN")
+    )
+
+
+def _later_m2_data(reply: Reply) -> bool:
+    source, cmd = reply.source, reply.command
+    return (
+        reply.kind is ReplyKind.DATA
+        and source is not None
+        and cmd is not None
+        and source.kind is Kind.MEASURE
+        and source.group == 2
+        and cmd.index >= 1
+    )
+
+
 def _plain_c(reply: Reply) -> bool:
     cmd = reply.command
     return (
@@ -555,9 +575,9 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "extended-no-crlf",
-            "The extended command's reply ends without CR LF.",
+            "The one-line extended command's reply (aXSN!) ends without CR LF.",
             ("R-4.4.13-01", "R-4.2-03"),
-            rewrite=_only([ReplyKind.EXTENDED], _set(end="")),
+            rewrite=_when(_one_line_extended, _set(end="")),
         ),
         # -- CRC ---------------------------------------------------------------------------------
         Fault(
@@ -993,6 +1013,12 @@ def _faults() -> list[Fault]:
             settings={"standby_after_foreign": False},
         ),
         # -- faults that complete the sensor-role coverage ---------------------------------------
+        Fault(
+            "m2-later-data-silent",
+            "After aM2!/aMC2! the sensor answers aD0! but not aD1! and later.",
+            ("R-4.4.8-01", "R-4.4.8-03"),
+            rewrite=_when(_later_m2_data, _silence),
+        ),
         Fault(
             "fast-baud",
             "Replies go out at 1300 baud: each character takes 7.69 ms instead of 8.33 ms.",

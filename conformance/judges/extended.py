@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..master.records import Exchange
-from ..protocol.timing import INTER_CHAR_GAP_MAX, MULTILINE_GAP_MAX
+from ..protocol.timing import MULTILINE_GAP_MAX
 from ..transcript import Event, escape
 from ..verdicts import Finding
 from .tally import Tally
@@ -74,14 +74,7 @@ def multiline(exchanges: list[Exchange], address: str, uncertainty: float) -> li
                     label,
                     f"line {n} has {len(content)} characters (at most {LINE_MAX})",
                 )
-            for a, b in zip(line, line[1:], strict=False):
-                gap = b.start - a.end
-                if gap - uncertainty > INTER_CHAR_GAP_MAX:
-                    tally.fail(
-                        "R-4.4.13.1-03",
-                        label,
-                        f"line {n} has a {gap * 1e3:.2f} ms gap between characters",
-                    )
+            # character gaps inside a line are the general rule's (R-7.0-12, whole run)
         for before, after in zip(body_lines, body_lines[1:], strict=False):
             timing.append(
                 judge_window(

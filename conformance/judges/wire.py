@@ -25,6 +25,7 @@ from .timing import judge_window
 
 REPLY_SEARCH = NO_BREAK_WINDOW  # a DUT run starting later than this is not a reply
 RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
+LINE_RUN_GAP = 1.0  # a late next line of multi-line text still belongs to its reply
 
 
 @dataclass
@@ -95,7 +96,9 @@ def _place_dut_char(seg: Segment, e: Event) -> None:
         return
     last = seg.reply[-1]
     ended = not seg.binary_reply and last.char7 == 0x0A and not seg.multiline
-    if ended or e.start - last.end > RUN_GAP:
+    # the next line of multi-line text may come late (R-4.4.13.1-03 judges how late)
+    allowed = LINE_RUN_GAP if seg.multiline and last.char7 == 0x0A else RUN_GAP
+    if ended or e.start - last.end > allowed:
         seg.later.append(e)
     else:
         seg.reply.append(e)
@@ -274,8 +277,8 @@ def judge_bit_rate(segs: list[Segment], uncertainty: float) -> Finding:
 def _reply_address(seg: Segment) -> str | None:
     """The address a reply to this command must start with (None: any address)."""
     text = seg.text
-    if text == "?!" or len(text) < 2:
-        return None
+    if text.startswith("?") or len(text) < 2:
+        return None  # a wildcard: the sensor answers with its own address
     if len(text) == 4 and text[1] == "A" and text.endswith("!"):
         return None  # aAb!: the new address, or the old one if the change failed
     return text[0]

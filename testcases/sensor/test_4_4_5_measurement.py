@@ -194,15 +194,17 @@ def test_break_aborts_measurement(sensor, case):
                     decision="A3",
                 )
             )
-    first = again.start.attempts[0]
+    # heard without another break: the first transmission or a retry of the same sequence
+    # (a sensor slow to wake after the break is R-7.0-05/07's business, not this rule's)
+    unbroken = [a for a in again.start.attempts if a.sequence == 0]
     if not again.start.answered:
         case.add(failed("R-4.4.5.1-03", f"after the abort {code} got no reply"))
-    elif not first.reply_events:
+    elif not any(a.reply_events for a in unbroken):
         case.add(
             failed(
                 "R-4.4.5.1-03",
                 f"ignored the {code} sent right after the aborting "
-                "break (it answered only a retry)",
+                "break (it answered only after another break)",
             )
         )
     elif again.value_count < target.value_count:
