@@ -41,6 +41,7 @@ class RequirementResult:
     verdict: Verdict
     findings: list[Finding]
     tests: list[str]
+    judged: bool = True  # False: testable, but no case of this run looked at it
 
     @property
     def one_line(self) -> str:
@@ -73,8 +74,9 @@ def aggregate(role: str, cases: list[CaseRecord]) -> list[RequirementResult]:
         elif not findings:
             findings = [Finding(req.id, Verdict.INCONCLUSIVE, "no case judged this requirement")]
         verdict = worst(f.verdict for f in findings)
+        judged = not (req.testable(role) and req.id not in by_id)
         results.append(
-            RequirementResult(req, verdict, findings, sorted(set(tests.get(req.id, []))))
+            RequirementResult(req, verdict, findings, sorted(set(tests.get(req.id, []))), judged)
         )
     return results
 
@@ -83,8 +85,8 @@ def overall(results: list[RequirementResult], *, strict: bool, complete: bool) -
     verdicts = {r.verdict for r in results}
     if Verdict.FAIL in verdicts or (strict and Verdict.WARN in verdicts):
         return NON_COMPLIANT
-    if not complete or Verdict.ERROR in verdicts:
-        return INCOMPLETE
+    if not complete or Verdict.ERROR in verdicts or not all(r.judged for r in results):
+        return INCOMPLETE  # interrupted, the tool failed, or cases were left out (-k)
     return COMPLIANT
 
 

@@ -107,6 +107,12 @@ class ConformanceRun:
         self.finished = now_iso()
         self.results = aggregate(self.options.role, self.cases)
         self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
+        unjudged = sum(1 for r in self.results if not r.judged)
+        if unjudged and not self.stop_reason:
+            self.stop_reason = (
+                f"{unjudged} testable requirement(s) not judged in this run "
+                "(cases left out by the selection?)"
+            )
         return self.results
 
     def report_dir(self) -> Path:

@@ -1,0 +1,201 @@
+"""Property-based exploration of a sensor: random sequences of valid commands, foreign
+addresses, malformed commands, breaks and pauses, with invariants checked after every step.
+
+A hypothesis state machine drives the master engine. It is derandomised, so every run sends
+the same sequences (a certificate must be reproducible), and it never shrinks: a sensor keeps
+state between examples (its data buffer, its address), so replaying a shorter sequence is not
+the same experiment, and on real hardware a shrinking storm costs minutes of bus time. Each
+invariant names the requirement it protects; the first broken one ends the exploration and
+its step log becomes the evidence.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from hypothesis import HealthCheck, Phase, settings
+from hypothesis import strategies as st
+from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
+
+from .master.records import Exchange
+from .protocol.crc import is_crc_char
+from .protocol.responses import parse_data_reply, split_line
+from .sensor_session import SensorSession
+from .transcript import escape
+
+#: Commands the exploration sends to the sensor's own address. Any next command aborts a
+#: running measurement and pauses stay under 0.25 s, so no service request arrives unasked
+#: inside another exchange.
+OWN = ("", "I", "M", "MC", "C", "CC", "D0", "R0", "RC0")
+FOREIGN_FORMS = ("", "I", "M", "D0", "C")
+JUNK = st.text(alphabet=st.sampled_from("MDCRIVXAB0123456789+-._#"), min_size=1, max_size=6)
+IDS = ("R-4.0-01", "R-4.3-01", "R-4.2-03", "R-4.4.12-05", "R-4.4.12-06", "R-4.4.5-10")
+
+
+class InvariantBroken(AssertionError):
+    def __init__(self, requirement: str, message: str) -> None:
+        super().__init__(f"{requirement}: {message}")
+        self.requirement = requirement
+        self.message = message
+
+
+@dataclass
+class Exploration:
+    """What the exploration did: steps, exchanges, and the invariant that broke (if any)."""
+
+    steps: int = 0
+    log: list[str] = field(default_factory=list)
+    exchanges: list[Exchange] = field(default_factory=list)
+    broken: InvariantBroken | None = None
+    failing_sequence: list[str] = field(default_factory=list)
+    checked: dict[str, int] = field(default_factory=lambda: {rid: 0 for rid in IDS})
+
+
+def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Exploration:
+    record = Exploration()
+    address = sensor.address
+    foreign = [a for a in "9zy" if a != address]
+
+    class SensorMachine(RuleBasedStateMachine):
+        def __init__(self) -> None:
+            super().__init__()
+            self.trail: list[str] = []
+            self.last_d0: str | None = None  # D0 reply since the last measurement command
+            sensor.master.send_break()
+
+        def _note(self, text: str) -> None:
+            self.trail.append(text)
+            record.steps += 1
+
+        def _send(self, code: str) -> Exchange:
+            ex = sensor.master.transact(f"{address}{code}!")
+            record.exchanges.append(ex)
+            self._note(f"{escape(ex.text)} -> '{escape(ex.reply_text)}'")
+            return ex
+
+        @rule(code=st.sampled_from(OWN))
+        def own_command(self, code: str) -> None:
+            ex = self._send(code)
+            if code in ("M", "MC", "C", "CC"):
+                self.last_d0 = None  # a new measurement may change the data
+            if not ex.answered:
+                return
+            self._check_framing(ex)
+            if code.startswith("D"):
+                self._check_crc(ex)
+            if code == "D0":
+                self._check_repeat(ex)
+
+        @rule(index=st.sampled_from(("0", "0", "1")))
+        def read_data(self, index: str) -> None:
+            """D replies, the place where the CRC and buffer invariants bite."""
+            self.own_command(f"D{index}")
+
+        @rule(other=st.sampled_from(foreign), code=st.sampled_from(FOREIGN_FORMS))
+        def foreign_command(self, other: str, code: str) -> None:
+            ex = sensor.master.raw(f"{other}{code}!", break_first=True)
+            record.exchanges.append(ex)
+            self._note(f"{escape(ex.text)} (foreign) -> '{escape(ex.reply_text)}'")
+            record.checked["R-4.0-01"] += 1
+            if ex.answered:
+                raise InvariantBroken(
+                    "R-4.0-01",
+                    f"answered {escape(ex.text)}, a command for "
+                    f"address '{other}', with '{escape(ex.reply_text)}'",
+                )
+
+        @rule(junk=JUNK)
+        def malformed_command(self, junk: str) -> None:
+            ex = sensor.master.raw(f"{address}{junk}!", break_first=None)
+            record.exchanges.append(ex)
+            self._note(f"{escape(ex.text)} (malformed?) -> '{escape(ex.reply_text)}'")
+            if ex.answered:  # decision A12: silence or any well-framed reply is fine
+                self._check_framing(ex)
+
+        @rule()
+        def brk(self) -> None:
+            sensor.master.send_break()
+            self._note("break")
+
+        @rule(seconds=st.sampled_from((0.01, 0.05, 0.12, 0.25)))
+        def pause(self, seconds: float) -> None:
+            sensor.listen(seconds)
+            self._note(f"pause {seconds * 1e3:.0f} ms")
+
+        def _check_framing(self, ex: Exchange) -> None:
+            body, framing = split_line(ex.reply_text)
+            record.checked["R-4.2-03"] += 1
+            record.checked["R-4.3-01"] += 1
+            if [v for v in framing if v.requirement == "R-4.2-03"]:
+                raise InvariantBroken(
+                    "R-4.2-03",
+                    f"reply to {escape(ex.text)} '{escape(ex.reply_text)}' does not end in CR LF",
+                )
+            if body[:1] != address:
+                raise InvariantBroken(
+                    "R-4.3-01",
+                    f"reply to {escape(ex.text)} starts with '{escape(body[:1])}', not '{address}'",
+                )
+
+        def _check_crc(self, ex: Exchange) -> None:
+            body, _ = split_line(ex.reply_text)
+            if len(body) < 4 or not all(is_crc_char(c) for c in body[-3:]):
+                return  # no CRC claimed: presence is judged by the D-reply cases
+            reply = parse_data_reply(body, crc_expected=True, limit=75)
+            for rid in ("R-4.4.12-05", "R-4.4.12-06"):
+                record.checked[rid] += 1
+                bad = [v for v in reply.violations if v.requirement == rid]
+                if bad:
+                    raise InvariantBroken(rid, f"reply to {escape(ex.text)}: {bad[0].message}")
+
+        def _check_repeat(self, ex: Exchange) -> None:
+            record.checked["R-4.4.5-10"] += 1
+            if self.last_d0 is not None and ex.reply_text != self.last_d0:
+                raise InvariantBroken(
+                    "R-4.4.5-10",
+                    f"D0 gave '{escape(self.last_d0)}', then "
+                    f"'{escape(ex.reply_text)}' with no measurement between",
+                )
+            self.last_d0 = ex.reply_text
+
+        def teardown(self) -> None:
+            record.log.append(" ; ".join(self.trail))
+            record.failing_sequence = list(self.trail)
+
+    try:
+        run_state_machine_as_test(
+            SensorMachine,
+            settings=settings(
+                max_examples=examples,
+                stateful_step_count=steps,
+                derandomize=True,
+                database=None,
+                deadline=None,
+                phases=[Phase.generate],
+                report_multiple_bugs=False,
+                suppress_health_check=list(HealthCheck),
+                print_blob=False,
+            ),
+        )
+    except BaseException as exc:  # hypothesis may wrap the failure; find ours inside
+        broken = _first_broken(exc)
+        if broken is None:
+            raise
+        record.broken = broken
+    return record
+
+
+def _first_broken(exc: BaseException | None) -> InvariantBroken | None:
+    """The :class:`InvariantBroken` inside ``exc`` (itself, a group member, or a cause)."""
+    seen: set[int] = set()
+    stack = [exc]
+    while stack:
+        item = stack.pop(0)
+        if item is None or id(item) in seen:
+            continue
+        seen.add(id(item))
+        if isinstance(item, InvariantBroken):
+            return item
+        stack.extend(getattr(item, "exceptions", ()))
+        stack.extend((item.__cause__, item.__context__))
+    return None
