@@ -247,6 +247,27 @@ class SensorSession:
         """The measurements of ``codes`` that announced at least one value."""
         return [m for m in self.family(codes) if m.count]
 
+    def declared_count(self, code: str) -> int | None:
+        """The value count the declaration promises for ``code`` (its CRC twin shares it)."""
+        counts = self.declaration.measurements
+        if code in counts:
+            return counts[code]
+        plain = code[0] + code[2:] if code[1:2] == "C" and code[0] in "MC" else code
+        return counts.get(plain)
+
+    def check_declared_counts(self, codes: tuple[str, ...]) -> list[str]:
+        """Where the sensor announces another count than declared: noted for the report."""
+        notes = []
+        for code in codes:
+            want = self.declared_count(code)
+            got = self.measurement(code).count
+            if want is not None and got != want:
+                notes.append(f"declared {code} = {want} values, the sensor announced {got}")
+        for note in notes:
+            if note not in self.assumptions:
+                self.assumptions.append(note)
+        return notes
+
     def supports(self, code: str) -> bool:
         """Whether ``aHA!``/``aHB!`` (or a numbered group) announces values at all."""
         return bool(self.measurement(code).count)

@@ -26,6 +26,18 @@ def test_measurement_reply(sensor, case):
     ms = sensor.family(SR_FAMILY)
     case.evidence("M-family replies", [m.start for m in ms])
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    sensor.check_declared_counts(SR_FAMILY)
+    for m in ms:  # a group the declaration defines must not announce zero values
+        code = m.command.text()[1:-1]
+        if sensor.declared_count(code) and m.count == 0:
+            case.add(
+                failed(
+                    "R-4.4.5-02",
+                    f"{code} is declared with {sensor.declared_count(code)} "
+                    "values but announced none",
+                    decision="A1",
+                )
+            )
 
 
 @requirements("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")

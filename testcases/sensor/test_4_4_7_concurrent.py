@@ -18,6 +18,7 @@ def test_concurrent_reply(sensor, case):
     """Concurrent commands answer atttnn; aC! measures for real; nn fits the claimed version."""
     case.expect("'atttnn<CR><LF>'; aC! is not 'a00000'; nn <= 20 under v1.3 (decision A2 warns)")
     ms = sensor.family(C_FAMILY)
+    sensor.check_declared_counts(C_FAMILY)
     case.evidence("C-family replies", [m.start for m in ms])
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 

@@ -23,6 +23,14 @@ def test_continuous_replies(sensor, case):
     pairs = continuous_pairs(sensor)
     case.evidence("aR0..aR9!, aRC0..aRC9!", [ex for pair in pairs.values() for ex in pair])
     case.extend(judge.continuous(pairs, case.requirements))
+    served = [i for i, (ex, _) in pairs.items() if len(split_line(ex.reply_text)[0]) > 1]
+    if sensor.feature("continuous") and not served:
+        case.add(
+            failed(
+                "R-4.4.8.1-01",
+                "declared to support continuous measurements, but aR0!..aR9! returned no values",
+            )
+        )
 
 
 @requirements("R-4.4.8.1-02")

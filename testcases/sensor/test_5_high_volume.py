@@ -13,11 +13,27 @@ from conformance.verdicts import failed, inconclusive, passed, warned
 requirements = pytest.mark.requirements
 
 
+FEATURE = {"HA": "high_volume_ascii", "HB": "high_volume_binary"}
+FORMAT_RULE = {"HA": "R-5.1-01", "HB": "R-5.2-01"}
+
+
 def _unsupported(case, sensor, code):
-    """N/A only for a well-formed 'no values' reply; a malformed reply is judged as support."""
+    """N/A only for a well-formed 'no values' reply; a malformed reply is judged as support.
+    A sensor declared to support the command must not answer 'no values'."""
     m = sensor.measurement(code)
     if m.count or (m.start.answered and m.count is None):
         return False
+    if sensor.feature(FEATURE[code]) and FORMAT_RULE[code] in case.requirements:
+        case.add(
+            failed(
+                FORMAT_RULE[code],
+                f"declared to support a{code}! but it answered {xjudge.shown(m.start)}",
+            )
+        )
+        case.not_applicable(
+            "no high-volume data to judge", [r for r in case.requirements if r != FORMAT_RULE[code]]
+        )
+        return True
     case.not_applicable(f"a{code}! announced no values: high-volume {code} not supported")
     return True
 
