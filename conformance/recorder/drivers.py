@@ -1,0 +1,122 @@
+"""How the recorder under test is made to act on a scenario's request.
+
+Three ways, one interface (``act(scenario, request, link) -> RecorderOutput``):
+
+- :class:`InProcess`: a Python callable ``(request, link) -> RecorderOutput`` runs on the
+  tool's link. This is how the golden recorder (and any recorder logic written in Python) is
+  judged on the virtual-time bus, where nothing outside the process can reach the line.
+- :class:`Trigger`: a shell command run once per scenario, with the request in environment
+  variables (``SDI12_SCENARIO``, ``SDI12_TASK``, ``SDI12_COMMANDS``, ``SDI12_REQUEST``,
+  ``SDI12_TIMEOUT_S``), for a logger driven from CI. Its stdout is kept as the recorder's own
+  account of what it logged.
+- :class:`Interactive`: a prompt telling the operator what to make the logger do, answered by
+  Enter (or an empty line) or left to time out.
+
+Trigger and Interactive need the played sensors served in real time on a real port while the
+logger acts; the session refuses them where that is impossible (the simulated bus).
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol, TextIO
+
+from ..links.base import Link
+from .request import RecorderOutput, Request
+
+#: Longest trigger output kept as evidence (the DUT's words are untrusted and unbounded).
+MAX_OUTPUT = 4000
+
+
+class RecorderDriverError(RuntimeError):
+    """The recorder could not be made to act (trigger failed, timed out, no operator)."""
+
+
+class Driver(Protocol):
+    kind: str
+    needs_real_time: bool
+
+    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput: ...
+
+
+@dataclass
+class InProcess:
+    """A recorder program in this process (the golden recorder by default)."""
+
+    program: Callable[[Request, Link], RecorderOutput]
+    kind: str = "in-process"
+    needs_real_time: bool = False
+
+    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+        return self.program(request, link)
+
+
+@dataclass
+class Trigger:
+    """``command`` run through the shell per scenario, bounded by ``timeout`` seconds."""
+
+    command: str
+    timeout: float = 120.0
+    kind: str = "trigger"
+    needs_real_time: bool = True
+
+    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+        env = {**os.environ, **request.environment(scenario, self.timeout)}
+        try:
+            done = subprocess.run(
+                self.command,
+                shell=True,
+                env=env,
+                capture_output=True,
+                text=True,
+                timeout=self.timeout,
+                check=False,
+            )
+        except subprocess.TimeoutExpired as exc:
+            raise RecorderDriverError(
+                f"trigger did not finish within {self.timeout:g} s: {self.command}"
+            ) from exc
+        if done.returncode != 0:
+            raise RecorderDriverError(
+                f"trigger exited with {done.returncode}: {done.stderr.strip()[:200]}"
+            )
+        out = RecorderOutput()
+        text = done.stdout[:MAX_OUTPUT].strip()
+        if text:
+            out.notes.append(text)
+        return out
+
+
+@dataclass
+class Interactive:
+    """Asks an operator to make the logger act, and waits for Enter up to ``timeout`` s."""
+
+    timeout: float = 300.0
+    prompt_out: TextIO = field(default_factory=lambda: sys.stdout)
+    answer_in: TextIO = field(default_factory=lambda: sys.stdin)
+    kind: str = "interactive"
+    needs_real_time: bool = True
+
+    def prompt(self, scenario: str, request: Request) -> str:
+        return (
+            f"\n[recorder scenario {scenario}] Make the data recorder {request.sentence()}.\n"
+            f"Press Enter when it has finished (you may type a note first); "
+            f"{self.timeout:g} s until this scenario is abandoned: "
+        )
+
+    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+        self.prompt_out.write(self.prompt(scenario, request))
+        self.prompt_out.flush()
+        ready, _, _ = select.select([self.answer_in], [], [], self.timeout)
+        if not ready:
+            raise RecorderDriverError(f"no answer from the operator within {self.timeout:g} s")
+        note = self.answer_in.readline()
+        out = RecorderOutput()
+        if note.strip():
+            out.notes.append(note.strip()[:MAX_OUTPUT])
+        return out

@@ -1,0 +1,161 @@
+"""The recorder under test as the recorder-role cases see it: the scenario runner.
+
+One bus for the whole run: before each scenario the played sensors are put on it, the
+recorder is made to act on the scenario's request, and the slice of the transcript it left is
+kept with what the recorder said it logged. Each scenario runs at most once per run; every case
+that needs it judges the same slice.
+
+On ``--port sim`` the bus is the virtual-time :class:`SimBus`, the recorder runs in this
+process on the tool's :class:`SimLink` (the golden recorder unless ``recorder=`` names another
+callable), and its side of the wire has origin ``tool``. Real ports need the played sensors
+served in real time (the emulate driver of issue 5), which this version does not have yet.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ..links.base import Link
+from ..ports import PortError, is_sim, parse_sim
+from ..sim.bus import Frame, SimBus, SimLink
+from ..transcript import TOOL, Event
+from .drivers import Driver, InProcess, RecorderDriverError
+from .faults import RECORDER_FAULTS, faulty_recorder
+from .played import build_sensors
+from .request import RecorderOutput
+from .scenarios import SCENARIOS, Scenario
+
+#: Marking left after a recorder finished, so late sensor output is on record and the next
+#: scenario starts on a quiet line with every sensor in standby.
+SETTLE = 1.0
+
+
+class LineMonitor:
+    """A silent device on the sim bus. With it the bus names every sensor by its own name
+    (``sensor0``...) even when one sensor plays alone, instead of calling it the DUT: in the
+    recorder role the DUT is the recorder."""
+
+    name = "monitor"
+
+    def on_break(self, start: float, end: float) -> None:
+        """Hears breaks; keeps nothing (the transcript has them)."""
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        """Hears characters; keeps nothing."""
+
+    def next_frame(self) -> Frame | None:
+        return None
+
+    def pop_frame(self) -> Frame:
+        raise RuntimeError("the line monitor never transmits")
+
+
+@dataclass
+class ScenarioRun:
+    """What one scenario left: its transcript slice and the recorder's own account."""
+
+    scenario: Scenario
+    events: list[Event]
+    output: RecorderOutput
+    error: str | None = None
+    played: tuple[object, ...] = ()
+
+    def expected_values(self, address: str, code: str) -> tuple[str, ...]:
+        """The values the played sensor at ``address`` holds for measurement ``code``."""
+        for device in self.played:
+            if getattr(device, "address", None) == address:
+                spec = device.profile.measurements.get(code)  # type: ignore[attr-defined]
+                return spec.values if spec is not None else ()
+        return ()
+
+
+def load_program(path: str) -> Callable:
+    """``package.module:callable`` -> the callable (a recorder program or a factory)."""
+    module, _, name = path.partition(":")
+    if not module or not name:
+        raise PortError(f"recorder program {path!r} is not 'package.module:callable'")
+    try:
+        obj = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError) as exc:
+        raise PortError(f"cannot load recorder program {path!r}: {exc}") from exc
+    return obj
+
+
+class RecorderSession:
+    """Runs scenarios against the recorder under test and keeps their records."""
+
+    def __init__(
+        self,
+        port: str,
+        *,
+        version: str = "14",
+        driver: Driver | None = None,
+        timing_uncertainty: float | None = None,
+    ) -> None:
+        if not is_sim(port):
+            raise PortError(
+                f"port {port!r}: the recorder role needs the played sensors served in real "
+                "time on a real port, which this version cannot do yet; use --port sim"
+            )
+        spec = parse_sim(port)
+        faults = tuple(f for f in spec.extra.get("recorder-faults", "").split(",") if f)
+        unknown = [f for f in faults if f not in RECORDER_FAULTS]
+        if unknown or len(faults) > 1:
+            known = ", ".join(sorted(RECORDER_FAULTS))
+            raise PortError(f"recorder-faults takes one of: {known} (got {','.join(faults)})")
+        if driver is None:
+            program = spec.extra.get("recorder")
+            driver = InProcess(load_program(program)() if program else faulty_recorder(faults))
+        elif driver.needs_real_time:
+            raise PortError(
+                f"a {driver.kind} recorder acts outside this process and cannot reach the "
+                "simulated bus; it needs a real port served in real time (not available yet)"
+            )
+        self.driver = driver
+        self.faults = faults
+        self.bus = SimBus([LineMonitor()])
+        self.link: Link = SimLink(self.bus)
+        self.version = version
+        self.uncertainty = (
+            self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
+        )
+        self.recorder_origins = frozenset({TOOL})
+        self.runs: dict[str, ScenarioRun] = {}
+        # what the reports' DUT block reads (shared with the sensor session's shape)
+        self.address = None
+        self.identity = None
+        self.ident_exchange = None
+        self.assumptions = [
+            f"recorder claims SDI-12 v{version[0]}.{version[1]}",
+            f"recorder driven {driver.kind}"
+            + (f" (golden recorder with fault {faults[0]})" if faults else ""),
+        ]
+
+    @property
+    def is_v14(self) -> bool:
+        return self.version >= "14"
+
+    def run(self, name: str) -> ScenarioRun:
+        """The scenario's record, running it the first time it is asked for."""
+        if name not in self.runs:
+            self.runs[name] = self._run(SCENARIOS[name])
+        return self.runs[name]
+
+    def _run(self, scenario: Scenario) -> ScenarioRun:
+        played = build_sensors(scenario.sensors)
+        self.bus.devices[:] = [LineMonitor(), *played]
+        self.bus.rx.clear()
+        transcript = self.link.transcript
+        first = len(transcript)
+        transcript.note(self.link.now(), f"scenario {scenario.name}: {scenario.describe()}")
+        error = None
+        try:
+            output = self.driver.act(scenario.name, scenario.request, self.link)
+        except RecorderDriverError as exc:
+            output, error = RecorderOutput(), str(exc)
+        self.bus.advance(self.link.now() + SETTLE)
+        self.bus.rx.clear()
+        events = [e for e in transcript.since(first)]
+        return ScenarioRun(scenario, events, output, error, tuple(played))
