@@ -33,6 +33,8 @@ examples:
   sdi12-conform --port sim --sdi-version 1.3 -k crc       only cases matching 'crc', v1.3 rules
   sdi12-conform list                                       the requirement catalog with coverage
   sdi12-conform faults                                     the emulator faults and what they break
+  sdi12-conform matrix                                     run the fault-detection matrix
+  sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
 
 exit codes: 0 compliant, 1 non-compliant, 2 interrupted/incomplete, 3 internal error,
             4 usage error, 5 no device answered
@@ -169,6 +171,8 @@ def exit_code(data: dict, pytest_code: int) -> int:
     verdict = data["summary"]["verdict"]
     if pytest_code == EXIT_NO_DEVICE and not data["run"]["complete"]:
         return EXIT_NO_DEVICE
+    if pytest_code in (EXIT_INCOMPLETE, EXIT_INTERNAL) and not data["run"]["complete"]:
+        return pytest_code  # Ctrl-C (pytest's 2) or the link failed mid-run (3)
     if verdict == "NON-COMPLIANT":
         return EXIT_NON_COMPLIANT
     if verdict == "COMPLIANT":
@@ -231,6 +235,35 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT
 
 
+def cmd_matrix(argv: list[str], console: Console) -> int:
+    """Run the fault-detection matrix and print it: every emulator fault against the suite."""
+    p = argparse.ArgumentParser(
+        prog="sdi12-conform matrix",
+        description="run the sensor suite against every emulator fault and show which "
+        "requirements each one made FAIL or WARN (exit 1 if any fault is not caught exactly)",
+    )
+    p.add_argument("--faults", help="comma-separated fault names (default: all)")
+    p.add_argument("--jobs", type=int, default=2, help="parallel runs (default 2)")
+    args = p.parse_args(argv)
+    from rich.table import Table
+
+    from .matrix import fault_matrix
+
+    names = [f for f in (args.faults or "").split(",") if f] or None
+    rows = fault_matrix(names, processes=args.jobs)
+    table = Table(title="fault-detection matrix (sensor role)")
+    for col in ("fault", "declared", "FAIL/WARN", "caught"):
+        table.add_column(col, overflow="fold")
+    for r in rows:
+        caught = "exactly" if r.exact else f"missed {' '.join(r.missed)} extra {' '.join(r.extra)}"
+        style = "" if r.exact else "bold red"
+        table.add_row(r.fault, " ".join(r.declared), " ".join(r.flagged), caught, style=style)
+    console.print(table)
+    exact = sum(r.exact for r in rows)
+    console.print(f"{exact}/{len(rows)} faults caught by exactly their requirements")
+    return EXIT_COMPLIANT if exact == len(rows) else EXIT_NON_COMPLIANT
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     console = Console(stderr=False)
@@ -239,6 +272,12 @@ def main(argv: list[str] | None = None) -> int:
             return cmd_list(argv[1:], console)
         if argv and argv[0] == "faults":
             return cmd_faults(argv[1:], console)
+        if argv and argv[0] == "matrix":
+            return cmd_matrix(argv[1:], console)
+        if argv and argv[0] == "emulate":
+            from .emulate.command import emulate_main
+
+            return emulate_main(argv[1:])
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:
