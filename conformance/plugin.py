@@ -13,6 +13,7 @@ import pytest
 
 from .case import Case
 from .links.base import LinkError
+from .links.errors import BreakUnsupported
 from .ports import PortError
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
@@ -89,7 +90,13 @@ def sensor(sdi12_run: ConformanceRun) -> SensorSession:
     except NoDeviceAnswered as exc:
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
-        pytest.exit(str(exc), returncode=EXIT_NO_DEVICE)
+        link = sdi12_run.link
+        if link is not None and not link.info.can_break:
+            sdi12_run.stop_reason += (
+                f" This {link.info.kind} link cannot send breaks, so a sensor in standby "
+                "cannot be woken through it; use a serial port or rfc2217://."
+            )
+        pytest.exit(sdi12_run.stop_reason, returncode=EXIT_NO_DEVICE)
     except PortError as exc:
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
@@ -135,9 +142,14 @@ def pytest_runtest_call(item: pytest.Item):
         result = yield
     except (pytest.skip.Exception, pytest.fail.Exception, pytest.exit.Exception, KeyboardInterrupt):
         raise
-    except LinkError as exc:
+    except BreakUnsupported as exc:  # the case needs a break of its own making
+        _inconclusive(record, f"this case presents its own breaks and the link cannot: {exc}")
+        pytest.skip(f"INCONCLUSIVE: the link cannot send breaks ({exc})")
+    except LinkError as exc:  # the port failed: stop the run, keep the report (exit 3)
         _error(record, f"link failed: {exc}")
-        raise
+        run.complete = False
+        run.stop_reason = f"link failed: {exc}"
+        pytest.exit(f"link failed: {exc}", returncode=3)
     except Exception as exc:  # the tool failed: ERROR, never hidden as a FAIL or a PASS
         _error(record, f"tool error: {type(exc).__name__}: {exc}")
         raise
@@ -158,6 +170,14 @@ def pytest_runtest_call(item: pytest.Item):
         reasons = sorted({f.detail for f in record.findings if f.verdict is verdict})
         pytest.skip(f"{verdict}: {'; '.join(reasons)}")
     return result
+
+
+def _inconclusive(record: CaseRecord, detail: str) -> None:
+    judged = {f.requirement for f in record.findings}
+    for rid in record.requirements:
+        if rid not in judged:
+            record.findings.append(Finding(rid, Verdict.INCONCLUSIVE, detail, test=record.nodeid))
+    record.summarise()
 
 
 def _error(record: CaseRecord, detail: str) -> None:

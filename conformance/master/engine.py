@@ -12,6 +12,7 @@ deadline so a silent or babbling device can never hang it.
 from __future__ import annotations
 
 from ..links.base import Link
+from ..links.errors import BreakUnsupported
 from ..protocol import commands as cmds
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind
 from ..protocol.timing import (
@@ -304,7 +305,10 @@ class Master:
         at = self._earliest_transmit()
         break_event = None
         if brk or (brk is None and self._needs_break(address, at)):
-            break_event = self.send_break()
+            try:
+                break_event = self.send_break()
+            except BreakUnsupported:  # socket://: the link noted it; the command goes alone
+                self.link.wait_until(at)
         else:
             self.link.wait_until(at)
         events = self.link.write(wire, gap)  # gap 0: back to back, R-7.0-13

@@ -9,6 +9,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from ..links.bus_time import bus_time
 from ..results import counts
 from ..run import TOOL, ConformanceRun
 
@@ -32,7 +33,24 @@ def dut_block(run: ConformanceRun) -> dict[str, Any]:
         "serial": ident.optional if ident else None,
         "assumptions": list(session.assumptions) if session else [],
         "declaration": run.declaration.source if run.declaration else None,
+        # whether every address change was undone (design.md 7: leave the DUT as found)
+        "address_notes": list(session.address_notes) if session else [],
     }
+
+
+def bus_block(run: ConformanceRun) -> dict[str, Any]:
+    """Bus-time lower bound next to the time the run took on the link's clock (wall time on
+    a real link; virtual time on the sim bus, where ``wall_s`` is null)."""
+    link = run.link
+    if link is None:
+        return {"bus_lower_bound_s": None, "wall_s": None, "efficiency": None}
+    figures: dict[str, Any] = bus_time(link.transcript.events).to_json()
+    elapsed = link.now()
+    figures["link_clock_s"] = round(elapsed, 3)
+    figures["wall_s"] = None if link.info.virtual_time else round(elapsed, 3)
+    lower = figures["bus_lower_bound_s"]
+    figures["efficiency"] = round(lower / elapsed, 3) if elapsed > 0 else None
+    return figures
 
 
 def build(run: ConformanceRun) -> dict[str, Any]:
@@ -49,6 +67,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             "strict": run.options.strict,
             "complete": run.complete,
             "stop_reason": run.stop_reason or None,
+            "bus": bus_block(run),
         },
         "dut": dut_block(run),
         "summary": {"verdict": run.verdict, "counts": counts(results)},

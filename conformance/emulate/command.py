@@ -1,0 +1,147 @@
+"""``sdi12-conform emulate``: the reference sensor on a real port, in real time.
+
+Serves the same emulator as ``--port sim`` (profile version, address, faults: the parameters
+of a ``sim://`` URL) either as an RFC 2217 server on a TCP port, as raw bytes on a TCP port
+(what ``socket://`` speaks; no breaks), or on a serial port. A recorder, or this tool with
+``--port rfc2217://HOST:PORT``, then talks to it as to a sensor on a bus.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import threading
+from dataclasses import replace
+
+from ..ports import PortError, parse_sim
+from .realtime import RealTimeLine
+from .servers import TcpEmulatorServer, serve_serial
+
+EXIT_OK, EXIT_USAGE = 0, 4
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sdi12-conform emulate",
+        description="Serve the reference SDI-12 sensor emulator in real time (1200 baud "
+        "pacing, section 7 timing) on a TCP port or a serial port.",
+        epilog="examples:\n"
+        "  sdi12-conform emulate --listen 127.0.0.1:4001\n"
+        "  sdi12-conform --port rfc2217://127.0.0.1:4001     (in another shell)\n"
+        "  sdi12-conform emulate --listen 127.0.0.1:4001 --faults no-service-request\n"
+        "  sdi12-conform emulate --serial /dev/ttyUSB1 --version 1.3 --address 5",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    where = p.add_mutually_exclusive_group(required=True)
+    where.add_argument("--listen", metavar="HOST:PORT", help="serve on TCP (port 0: any free)")
+    where.add_argument("--serial", metavar="PORT", help="serve on a serial port or pyserial URL")
+    p.add_argument(
+        "--raw",
+        action="store_true",
+        help="with --listen: plain bytes (socket://) instead of RFC 2217; carries no breaks",
+    )
+    p.add_argument("--version", dest="sdi_version", default="1.4", help="1.3 or 1.4 (default)")
+    p.add_argument("--address", default="0", help="the sensor's address (default 0)")
+    p.add_argument("--faults", default="", help="comma-separated fault names (see `faults`)")
+    return p
+
+
+def make_device(version: str, address: str, faults: str) -> object:
+    """The emulator a ``sim://?version=..&address=..&faults=..`` URL would put on the bus,
+    validated the same way (raises :class:`PortError` with the reason)."""
+    from urllib.parse import urlencode
+
+    from ..emulator import FAULTS, SensorEmulator, default_profile
+    from ..protocol.commands import ADDRESS_CHARS
+
+    spec = parse_sim("sim://?" + urlencode({"version": version, "address": address}))
+    names = tuple(f.strip() for f in faults.split(",") if f.strip())
+    unknown = [f for f in names if f not in FAULTS]
+    if unknown:
+        raise PortError(
+            f"unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the known ones"
+        )
+    if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
+        raise PortError(f"address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
+    profile = replace(default_profile(spec.version), address=spec.address)
+    return SensorEmulator(profile, names)
+
+
+def _host_port(text: str) -> tuple[str, int]:
+    host, sep, port = text.rpartition(":")
+    if not sep or not port.isdigit():
+        raise PortError(f"--listen wants HOST:PORT (for example 127.0.0.1:4001), not {text!r}")
+    return host.strip("[]") or "127.0.0.1", int(port)
+
+
+def _say(message: str) -> None:
+    print(message, flush=True)  # a supervising process reads the URL line at once
+
+
+def emulate_main(argv: list[str], print_line=_say) -> int:
+    """Parse ``argv`` (after ``emulate``), serve until Ctrl-C or SIGTERM; exit code."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:
+        return EXIT_OK if exc.code == 0 else EXIT_USAGE
+    try:
+        device = make_device(args.sdi_version, args.address, args.faults)
+        if args.raw and not args.listen:
+            raise PortError("--raw applies to --listen only")
+    except PortError as exc:
+        print_line(f"error: {exc}")
+        return EXIT_USAGE
+    faults = args.faults or "none"
+    what = f"reference sensor v{args.sdi_version}, address {args.address}, faults: {faults}"
+    if args.listen:
+        return _serve_tcp(device, args, what, print_line)
+    return _serve_port(device, args.serial, what, print_line)
+
+
+def _serve_tcp(device: object, args: argparse.Namespace, what: str, print_line) -> int:
+    try:
+        host, port = _host_port(args.listen)
+        line = RealTimeLine(device, lambda _data: None).start()  # type: ignore[arg-type]
+        server = TcpEmulatorServer(line, host, port, rfc2217_protocol=not args.raw, log=print_line)
+    except (PortError, OSError) as exc:
+        print_line(f"error: cannot listen on {args.listen}: {exc}")
+        return EXIT_USAGE
+    print_line(f"serving the {what} on {server.url} (Ctrl-C stops)")
+    _stop_on_sigterm(server.stop)
+    try:
+        server.serve()
+    except KeyboardInterrupt:
+        print_line("stopped")
+    finally:
+        line.stop()
+    return EXIT_OK
+
+
+def _serve_port(device: object, port_name: str, what: str, print_line) -> int:
+    import serial
+
+    try:
+        port = serial.serial_for_url(port_name, baudrate=1200, timeout=0.1)
+    except (serial.SerialException, OSError, ValueError) as exc:
+        print_line(f"error: cannot open {port_name}: {exc}")
+        return EXIT_USAGE
+    line = RealTimeLine(device, port.write, deliver_at_end=False).start()  # type: ignore[arg-type]
+    stopped = threading.Event()
+    _stop_on_sigterm(stopped.set)
+    print_line(f"serving the {what} on {port_name} at 1200 baud (Ctrl-C stops)")
+    try:
+        serve_serial(line, port, stopped)
+    except KeyboardInterrupt:
+        print_line("stopped")
+    except serial.SerialException as exc:
+        print_line(f"error: the port failed: {exc}")
+    finally:
+        line.stop()
+        port.close()
+    return EXIT_OK
+
+
+def _stop_on_sigterm(stop) -> None:
+    """A service manager's SIGTERM ends the server like Ctrl-C (main thread only)."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, lambda _sig, _frame: stop())

@@ -1,0 +1,113 @@
+"""How much bus time a run could not have avoided, from its transcript.
+
+On a real-time link every millisecond the tool spends is a millisecond of the user's bench
+time, so the run reports the least time any recorder would have needed for the same
+exchanges next to the wall time it took. The lower bound is the union of:
+
+- every frame on the wire (8.33 ms each, either side) and every break as held;
+- the 8.33 ms of marking that must follow each break (R-7.0-06);
+- every stretch of marking that ended with the DUT starting to talk: its response delays,
+  its service-request waits, its gaps inside a reply (the DUT's time, not the tool's);
+- the ttt a measurement announced, counted from the end of its ``atttn`` reply, when the
+  tool had to wait it out (no service request cut it short).
+
+Anything beyond that (retry spacing, listening windows for silence, patience past limits,
+scheduling latency) is the tool's overhead.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from ..master import validity
+from ..protocol.commands import CommandError, parse_command
+from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK
+from ..transcript import TOOL, Event, EventKind, decode_7e1
+
+
+@dataclass(frozen=True)
+class BusTime:
+    lower_bound: float  # s the exchanges needed at the very least
+    span: float  # s from the first to the last event on the wire
+    frames: int
+    breaks: int
+
+    def to_json(self) -> dict[str, float | int]:
+        return {
+            "bus_lower_bound_s": round(self.lower_bound, 3),
+            "bus_span_s": round(self.span, 3),
+            "frames": self.frames,
+            "breaks": self.breaks,
+        }
+
+
+def bus_time(events: Iterable[Event]) -> BusTime:
+    wire = [e for e in events if e.kind is not EventKind.NOTE]
+    if not wire:
+        return BusTime(0.0, 0.0, 0, 0)
+    wire.sort(key=lambda e: e.start)
+    spans: list[tuple[float, float]] = []
+    frames = breaks = 0
+    for e in wire:
+        if e.kind is EventKind.BREAK:
+            breaks += 1
+            spans.append((e.start, e.end + MARKING_AFTER_BREAK))
+        else:
+            frames += 1
+            spans.append((e.start, e.start + CHAR_TIME))
+    previous_end = wire[0].end
+    for e in wire[1:]:
+        if e.kind is EventKind.CHAR and e.origin != TOOL and e.start > previous_end:
+            spans.append((previous_end, e.start))  # the DUT chose when to talk
+        previous_end = max(previous_end, e.end)
+    spans += _announced_waits(wire)
+    return BusTime(_union(spans), wire[-1].end - wire[0].start, frames, breaks)
+
+
+def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
+    """[end of ``atttn``, end + ttt] for each measurement the DUT started."""
+    waits = []
+    command: list[Event] = []
+    reply: list[Event] = []
+    for e in [*wire, None]:
+        new_command = e is not None and e.origin == TOOL and e.kind is EventKind.CHAR
+        if e is None or (new_command and (reply or decode_7e1(command).endswith("!"))):
+            text = decode_7e1(command)
+            try:
+                cmd = parse_command(text)
+            except CommandError:
+                cmd = None
+            if cmd is not None and cmd.starts_measurement and reply:
+                parsed = validity.parse_start_reply(decode_7e1(reply), validity.count_digits(cmd))
+                if parsed is not None and parsed[0] > 0:
+                    waits.append((reply[-1].end, reply[-1].end + parsed[0]))
+            command, reply = [], []
+        if e is None:
+            break
+        if e.kind is EventKind.BREAK:
+            command, reply = [], []
+        elif e.origin == TOOL:
+            command.append(e)
+        elif command and decode_7e1(command).endswith("!") and not _line_done(reply):
+            reply.append(e)
+    return waits
+
+
+def _line_done(reply: list[Event]) -> bool:
+    return len(reply) >= 2 and decode_7e1(reply[-2:]) == "\r\n"
+
+
+def _union(spans: list[tuple[float, float]]) -> float:
+    total = 0.0
+    current_start = current_end = None
+    for start, end in sorted(spans):
+        if current_end is None or start > current_end:
+            if current_end is not None:
+                total += current_end - current_start
+            current_start, current_end = start, end
+        else:
+            current_end = max(current_end, end)
+    if current_end is not None:
+        total += current_end - current_start
+    return total
