@@ -64,7 +64,7 @@ def test_a_fault_makes_the_run_non_compliant(tmp_path):
         (("--sdi-version", "1.7"), "unsupported SDI-12 version"),
         (("--declaration", "/nonexistent.toml"), "does not exist"),
         (("--role", "recorder"), "recorder role is not implemented"),
-        (("--port", "/dev/ttyUSB9"), "built-in simulated bus"),
+        (("--port", "/dev/ttyUSB9"), "serial port /dev/ttyUSB9 does not exist"),
         (("--bogus",), "unrecognized arguments"),
     ],
 )
