@@ -1,0 +1,266 @@
+"""The real-link layer: arrival stamps, parity kept on the wire, bounded reads, breaks as
+achieved, links without breaks, ports that fail to open or vanish. Only loopback I/O (pty,
+loop://, 127.0.0.1); every test is bounded."""
+
+from __future__ import annotations
+
+import errno
+import os
+import socket
+import threading
+import time
+
+import pytest
+
+from conformance.emulate.realtime import RealTimeLine
+from conformance.emulate.servers import TcpEmulatorServer
+from conformance.links.errors import BreakUnsupported, PortUnavailable, PortVanished
+from conformance.links.factory import _explain, open_real_link, port_kind
+from conformance.links.stamps import MAX_LEAD, chunk_frames
+from conformance.master.engine import Master
+from conformance.ports import PortError, open_port
+from conformance.protocol.timing import CHAR_TIME
+from conformance.transcript import EventKind, to_wire_7e1
+
+pty_only = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal")
+
+
+# -- arrival stamps ---------------------------------------------------------------------------
+def test_a_lone_byte_ended_when_it_arrived():
+    assert chunk_frames(1, 1.0, 0.0) == [(1.0 - CHAR_TIME, 1.0)]
+
+
+def test_a_chunk_is_taken_as_back_to_back_frames_ending_at_arrival():
+    frames = chunk_frames(3, 1.0, 0.0)
+    assert frames[-1][1] == pytest.approx(1.0)
+    for (_, end), (start, _) in zip(frames, frames[1:], strict=False):
+        assert start == pytest.approx(end)
+
+
+def test_no_frame_starts_before_the_previous_one_ended():
+    # the previous byte was stamped late; this one came on time: no overlap, no false gap
+    frames = chunk_frames(1, 1.0, floor=1.0 - CHAR_TIME + 0.003)
+    assert frames[0][0] == pytest.approx(1.0 - CHAR_TIME + 0.003)
+
+
+def test_a_flood_overlaps_rather_than_running_into_the_future():
+    frames = chunk_frames(1000, 1.0, floor=0.99)
+    assert frames[-1][1] <= 1.0 + MAX_LEAD + 1e-9
+    assert frames[0][0] < 0.99  # more bytes than 1200 baud could carry: visibly overlapping
+
+
+# -- port kinds and open errors ---------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("port", "kind"),
+    [
+        ("/dev/ttyUSB0", "serial"),
+        ("COM3", "serial"),
+        ("rfc2217://127.0.0.1:4001", "rfc2217"),
+        ("socket://10.0.0.2:7000", "socket"),
+        ("loop://", "loop"),
+    ],
+)
+def test_port_kinds(port, kind):
+    assert port_kind(port) == kind
+
+
+def test_missing_device_is_a_port_error_with_what_to_do():
+    with pytest.raises(PortError) as caught:
+        open_port("/dev/ttyUSB-sdi12-missing")
+    assert isinstance(caught.value, PortUnavailable)
+    assert "does not exist" in str(caught.value) and "--port sim" in str(caught.value)
+
+
+def test_permission_and_busy_messages_say_what_to_do():
+    denied = _explain("/dev/ttyUSB0", "serial", OSError(errno.EACCES, "Permission denied"))
+    assert "dialout" in denied
+    busy = _explain("/dev/ttyUSB0", "serial", OSError(errno.EBUSY, "Device or resource busy"))
+    assert "busy" in busy
+
+
+def test_nobody_listening_is_a_port_error():
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        free = probe.getsockname()[1]
+    with pytest.raises(PortUnavailable, match="Is the server running"):
+        open_real_link(f"rfc2217://127.0.0.1:{free}")
+
+
+# -- reading and writing ----------------------------------------------------------------------
+def test_loop_link_keeps_the_raw_bits_and_declares_no_break():
+    link = open_real_link("loop://")
+    try:
+        assert link.info.kind == "loop" and not link.info.can_break
+        good, bad = to_wire_7e1(ord("0")), to_wire_7e1(ord("0")) ^ 0x80
+        link.write(bytes([good, bad]))
+        got = link.receive(link.now() + 0.2, until=lambda chars: len(chars) == 2)
+        assert [e.wire for e in got] == [good, bad]
+        assert [e.parity_ok for e in got] == [True, False]
+        assert all(e.end - e.start == pytest.approx(CHAR_TIME) for e in got)
+    finally:
+        link.close()
+
+
+def test_receive_on_a_silent_line_is_bounded_by_its_deadline():
+    link = open_real_link("loop://")
+    try:
+        started = time.monotonic()
+        assert link.receive(link.now() + 0.05) == []
+        took = time.monotonic() - started
+        assert 0.05 <= took < 0.05 + CHAR_TIME + link.info.timing_uncertainty + 0.05
+        started = time.monotonic()
+        assert link.receive(link.now() - 1.0) == []  # a passed deadline: what is queued, now
+        assert time.monotonic() - started < 0.01
+    finally:
+        link.close()
+
+
+def test_write_with_a_gap_spaces_the_characters():
+    link = open_real_link("loop://")
+    try:
+        events = link.write(b"0I!", gap=0.010)
+        starts = [e.start for e in events]
+        gaps = [b - a - CHAR_TIME for a, b in zip(starts, starts[1:], strict=False)]
+        assert all(0.0095 <= g < 0.015 for g in gaps), gaps
+    finally:
+        link.close()
+
+
+@pty_only
+def test_wrong_parity_from_a_serial_device_is_kept_as_evidence():
+    controller, device = os.openpty()
+    link = open_real_link(os.ttyname(device))
+    try:
+        assert link.info.kind == "serial" and link.info.can_break
+        os.write(controller, bytes([to_wire_7e1(ord("0")) ^ 0x80]))
+        got = link.receive(link.now() + 0.5, until=lambda chars: True)
+        assert len(got) == 1 and not got[0].parity_ok
+    finally:
+        link.close()
+        os.close(controller)
+        os.close(device)
+
+
+@pty_only
+def test_uart_break_records_the_duration_it_held():
+    controller, device = os.openpty()
+    link = open_real_link(os.ttyname(device))
+    try:
+        event = link.send_break(13e-3)
+        assert event.kind is EventKind.BREAK
+        assert 13e-3 <= event.duration < 16e-3
+        assert "break_condition" in event.text and "held" in event.text
+    finally:
+        link.close()
+        os.close(controller)
+        os.close(device)
+
+
+# -- links without breaks; a port that vanishes -------------------------------------------------
+class _OneShotServer:
+    """Accepts one TCP client, records what it sends, and hangs up when told."""
+
+    def __init__(self) -> None:
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.port = self.listener.getsockname()[1]
+        self.received = bytearray()
+        self.hang_up = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        conn, _ = self.listener.accept()
+        conn.settimeout(0.02)
+        with conn:
+            while not self.hang_up.is_set():
+                try:
+                    data = conn.recv(100)
+                except TimeoutError:
+                    continue
+                if not data:
+                    break
+                self.received += data
+        self.listener.close()
+
+
+def test_socket_link_cannot_break_and_the_engine_sends_anyway():
+    server = _OneShotServer()
+    link = open_real_link(f"socket://127.0.0.1:{server.port}")
+    try:
+        assert link.info.kind == "socket" and not link.info.can_break
+        with pytest.raises(BreakUnsupported):
+            link.send_break(13e-3)
+        exchange = Master(link).transact("0!", retries=False)
+        assert exchange.attempts[0].break_event is None
+        assert not exchange.answered
+        notes = [e.text for e in link.transcript if e.kind is EventKind.NOTE]
+        assert notes and all("no break" in n for n in notes)
+        deadline = time.monotonic() + 1
+        while len(server.received) < 2 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert bytes(b & 0x7F for b in server.received) == b"0!"
+    finally:
+        server.hang_up.set()
+        link.close()
+
+
+def test_a_vanishing_port_raises_from_the_next_call_within_a_bound():
+    server = _OneShotServer()
+    link = open_real_link(f"socket://127.0.0.1:{server.port}")
+    try:
+        server.hang_up.set()
+        server.thread.join(timeout=1)
+        started = time.monotonic()
+        with pytest.raises(PortVanished, match="failed during the run"):
+            link.receive(link.now() + 2.0)
+        assert time.monotonic() - started < 1.0
+    finally:
+        link.close()
+
+
+# -- RFC 2217 breaks --------------------------------------------------------------------------
+class _BreakRecorder:
+    """A bus device that only notes the breaks it hears (start, end)."""
+
+    name = "recorder"
+
+    def __init__(self) -> None:
+        self.breaks: list[tuple[float, float]] = []
+        self.chars: list[int] = []
+
+    def on_break(self, start: float, end: float) -> None:
+        self.breaks.append((start, end))
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        self.chars.append(wire)
+
+    def next_frame(self):
+        return None
+
+    def pop_frame(self):
+        raise AssertionError("never offers a frame")
+
+
+def test_rfc2217_break_is_short_and_seen_by_the_server_as_held():
+    device = _BreakRecorder()
+    line = RealTimeLine(device, lambda data: None).start()
+    server = TcpEmulatorServer(line, "127.0.0.1", 0)
+    serving = threading.Thread(target=server.serve, daemon=True)
+    serving.start()
+    link = open_real_link(server.url)
+    try:
+        assert link.info.kind == "rfc2217" and link.info.can_break
+        event = link.send_break(13e-3)
+        assert 13e-3 <= event.duration < 15e-3, event
+        assert "SET_CONTROL" in event.text
+        link.wait(0.02)
+        deadline = time.monotonic() + 1
+        while not device.breaks and time.monotonic() < deadline:
+            time.sleep(0.005)
+        ((start, end),) = device.breaks
+        assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+    finally:
+        link.close()
+        server.stop()
+        serving.join(timeout=2)
+        line.stop()
