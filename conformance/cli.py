@@ -31,6 +31,9 @@ examples:
   sdi12-conform --port sim --role sensor                  judge the built-in simulated sensor
   sdi12-conform --port 'sim://?faults=no-service-request' run against a faulty simulated sensor
   sdi12-conform --port sim --sdi-version 1.3 -k crc       only cases matching 'crc', v1.3 rules
+  sdi12-conform --port sim --role recorder                 judge the golden recorder (sim)
+  sdi12-conform --port 'sim://?recorder-faults=no-retries' --role recorder
+                                                           a faulty golden recorder
   sdi12-conform list                                       the requirement catalog with coverage
   sdi12-conform faults                                     the emulator faults and what they break
   sdi12-conform matrix                                     run the fault-detection matrix
@@ -71,6 +74,11 @@ def build_parser() -> argparse.ArgumentParser:
         type=float,
         help="override the link's declared timestamp uncertainty",
     )
+    p.add_argument(
+        "--trigger",
+        help="recorder role: shell command run per scenario with the request in SDI12_* "
+        "environment variables, or 'interactive' to prompt an operator",
+    )
     p.add_argument("-k", dest="keyword", help="only cases matching this pytest -k expression")
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p
@@ -80,17 +88,16 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .declaration import DeclarationError, load_declaration, normalise_version
     from .ports import PortError, is_sim, parse_sim
 
-    if args.role == "recorder":
-        console.print(
-            "the recorder role is not implemented in this version; use --role sensor", style="red"
-        )
-        return EXIT_USAGE
     try:
         if args.sdi_version:
             normalise_version(args.sdi_version)
         if args.declaration:
             load_declaration(args.declaration)
-        if is_sim(args.port):
+        if args.role == "recorder":
+            from .recorder.session import check_port
+
+            check_port(args.port, args.trigger)  # the port and recorder before pytest starts
+        elif is_sim(args.port):
             from .ports import open_sim
 
             open_sim(parse_sim(args.port))  # validate faults/parameters before pytest starts
@@ -130,6 +137,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         ("--sdi12-address", args.address),
         ("--sdi12-version", args.sdi_version),
         ("--sdi12-declaration", args.declaration),
+        ("--sdi12-trigger", args.trigger),
     ):
         if value:
             pytest_args += [flag, value]

@@ -15,6 +15,7 @@ from .case import Case
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
 from .ports import PortError
+from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
 from .sensor_session import NoDeviceAnswered, SensorSession
@@ -51,6 +52,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         action="store_true",
         default=False,
         help="treat WARN (SHOULD violations) as non-compliance",
+    )
+    group.addoption(
+        "--sdi12-trigger",
+        default=None,
+        help="recorder role: shell command run per scenario (or 'interactive' to prompt)",
     )
     group.addoption(
         "--sdi12-timing-uncertainty-ms",

@@ -51,9 +51,13 @@ def parse_sim(port: str) -> SimSpec:
         spec.version = digits
     if "address" in params:
         spec.address = params.pop("address")
+    for key in ("recorder-faults", "recorder"):  # recorder role: the recorder under test
+        if key in params:
+            spec.extra[key] = params.pop(key)
     if params:
         raise PortError(
-            f"unknown sim parameters {sorted(params)} (known: faults, version, address)"
+            f"unknown sim parameters {sorted(params)} "
+            "(known: faults, version, address, recorder-faults, recorder)"
         )
     return spec
 

@@ -29,6 +29,7 @@ class RunOptions:
     report_dir: str | None = None
     strict: bool = False
     timing_uncertainty_ms: float | None = None
+    trigger: str | None = None  # recorder role: shell command (or "interactive") per scenario
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
@@ -42,6 +43,7 @@ class RunOptions:
             report_dir=get("sdi12_report_dir"),
             strict=get("sdi12_strict"),
             timing_uncertainty_ms=get("sdi12_timing_uncertainty_ms"),
+            trigger=get("sdi12_trigger"),
         )
 
 
@@ -57,7 +59,7 @@ class ConformanceRun:
     cases: list[CaseRecord] = field(default_factory=list)
     link: Link | None = None
     devices: list[object] = field(default_factory=list)
-    session: SensorSession | None = None
+    session: Any = None  # SensorSession, or RecorderSession in the recorder role
     complete: bool = True
     stop_reason: str = ""
     declaration: Declaration | None = None
@@ -96,6 +98,25 @@ class ConformanceRun:
             )
             self.session = session
             session.discover()
+        return self.session
+
+    def recorder_session(self) -> Any:
+        """The recorder role's scenario runner (conformance.recorder.session)."""
+        if self.session is None:
+            from .recorder.session import RecorderSession, driver_for
+
+            opts = self.options
+            declared = self.declaration.sdi12_version if self.declaration else None
+            version = normalise_version(opts.version) if opts.version else declared or "14"
+            driver = driver_for(opts.trigger)
+            uncertainty = opts.timing_uncertainty_ms
+            self.session = RecorderSession(
+                opts.port,
+                version=version,
+                driver=driver,
+                timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
+            )
+            self.link = self.session.link
         return self.session
 
     @property

@@ -17,11 +17,12 @@ import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..judges.recorder import Line, merge_lines, read_line
 from ..links.base import Link
 from ..ports import PortError, is_sim, parse_sim
 from ..sim.bus import Frame, SimBus, SimLink
 from ..transcript import TOOL, Event
-from .drivers import Driver, InProcess, RecorderDriverError
+from .drivers import Driver, InProcess, Interactive, RecorderDriverError, Trigger
 from .faults import RECORDER_FAULTS, faulty_recorder
 from .played import build_sensors
 from .request import RecorderOutput
@@ -127,6 +128,7 @@ class RecorderSession:
         self.address = None
         self.identity = None
         self.ident_exchange = None
+        self.address_notes: list[str] = []  # the recorder role changes no DUT address
         self.assumptions = [
             f"recorder claims SDI-12 v{version[0]}.{version[1]}",
             f"recorder driven {driver.kind}"
@@ -136,6 +138,22 @@ class RecorderSession:
     @property
     def is_v14(self) -> bool:
         return self.version >= "14"
+
+    def is_recorder(self, event: Event) -> bool:
+        return event.origin in self.recorder_origins
+
+    def applies(self, name: str) -> bool:
+        """Whether the scenario binds this recorder (v1.4-only ones need a v1.4 claim)."""
+        return self.is_v14 or not SCENARIOS[name].v14
+
+    def applicable(self) -> list[str]:
+        return [name for name in SCENARIOS if self.applies(name)]
+
+    def line(self, *names: str) -> Line:
+        """The scenarios' transcripts read as the recorder's transmissions, one part each."""
+        return merge_lines(
+            [read_line(self.run(n).events, self.is_recorder, part=i) for i, n in enumerate(names)]
+        )
 
     def run(self, name: str) -> ScenarioRun:
         """The scenario's record, running it the first time it is asked for."""
@@ -157,5 +175,18 @@ class RecorderSession:
             output, error = RecorderOutput(), str(exc)
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
-        events = [e for e in transcript.since(first)]
+        events = transcript.since(first)
         return ScenarioRun(scenario, events, output, error, tuple(played))
+
+
+def driver_for(trigger: str | None) -> Driver | None:
+    """``--trigger``: None (in-process recorder), ``interactive``, or a shell command."""
+    if trigger == "interactive":
+        return Interactive()
+    return Trigger(trigger) if trigger else None
+
+
+def check_port(port: str, trigger: str | None = None) -> None:
+    """Raise :class:`PortError` now, before a run starts, if the recorder role cannot use
+    ``port`` with ``trigger`` (unknown recorder fault, real port, external recorder on sim)."""
+    RecorderSession(port, driver=driver_for(trigger))

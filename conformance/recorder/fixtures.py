@@ -1,0 +1,23 @@
+"""The ``recorder`` session fixture of the pytest plugin (recorder-role cases use it)."""
+
+from __future__ import annotations
+
+import pytest
+
+from ..ports import PortError
+from .session import RecorderSession
+
+EXIT_USAGE = 4
+
+
+@pytest.fixture(scope="session")
+def recorder(sdi12_run) -> RecorderSession:  # noqa: ANN001 - the plugin's ConformanceRun
+    """The recorder under test (recorder role): the scenario runner, created once per run."""
+    if sdi12_run.options.role != "recorder":
+        pytest.skip("recorder-role case; this run judges a sensor")
+    try:
+        return sdi12_run.recorder_session()
+    except PortError as exc:
+        sdi12_run.complete = False
+        sdi12_run.stop_reason = str(exc)
+        pytest.exit(str(exc), returncode=EXIT_USAGE)

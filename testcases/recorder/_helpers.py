@@ -1,0 +1,39 @@
+"""What the recorder cases share: picking scenarios and attaching their transcripts."""
+
+from __future__ import annotations
+
+from conformance.case import Case
+from conformance.judges.recorder import Line
+from conformance.recorder.scenarios import SCENARIOS
+from conformance.recorder.session import RecorderSession
+
+
+def line_of(recorder: RecorderSession, case: Case, *names: str) -> Line | None:
+    """Run the scenarios (the applicable ones), attach their wire logs, and read them.
+
+    None (with N/A findings) when none applies to the recorder's claimed version. A scenario
+    the recorder could not be made to act on is a hole in the certificate: INCONCLUSIVE.
+    """
+    chosen = [n for n in names if recorder.applies(n)]
+    if not chosen:
+        case.not_applicable("these scenarios need a recorder claiming SDI-12 v1.4")
+        return None
+    for name in chosen:
+        run = recorder.run(name)
+        case.evidence(f"scenario {name}: {SCENARIOS[name].describe()}", run.events)
+        if run.error:
+            from conformance.verdicts import inconclusive
+
+            case.add(*(inconclusive(r, f"scenario {name}: {run.error}") for r in case.requirements))
+    return recorder.line(*chosen)
+
+
+def logged(recorder: RecorderSession, name: str) -> dict[str, list[str]] | None:
+    """What the recorder says it logged in a scenario (None when it says nothing)."""
+    out = recorder.run(name).output
+    return out.logged or None
+
+
+def relayed(recorder: RecorderSession, name: str) -> dict[str, str] | None:
+    out = recorder.run(name).output
+    return out.relayed or None

@@ -1,0 +1,31 @@
+"""Section 4.4.7: concurrent measurements across sensors, and how many values a recorder keeps."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import recorder as judge
+
+from ._helpers import line_of
+
+requirements = pytest.mark.requirements
+
+
+@requirements("R-4.4.7-06", "R-4.4.7-08")
+def test_concurrent_measurements(recorder, case):
+    """Two sensors measure at once: each one's data are asked for only after its ttt, and the
+    recorder uses aC! and collects every value."""
+    case.expect("first data command to each sensor at least ttt after its 'atttnn' reply")
+    line = line_of(recorder, case, "concurrent-two", "concurrent-99", "families")
+    taken = judge.measurements(line, recorder.uncertainty)
+    case.extend(judge.judge_concurrent_waits(taken, recorder.uncertainty))
+    case.extend(f for f in judge.judge_concurrent_storage(taken) if f.requirement == "R-4.4.7-08")
+
+
+@requirements("R-4.4.7-07")
+def test_ninety_nine_values(recorder, case):
+    """A concurrent measurement of 99 values: at least 20 stored (2000 text), ideally all."""
+    case.expect("all 99 values read through D0..D9 (fewer than 20: FAIL; fewer than 99: WARN)")
+    line = line_of(recorder, case, "concurrent-99")
+    taken = judge.measurements(line, recorder.uncertainty)
+    case.extend(f for f in judge.judge_concurrent_storage(taken) if f.requirement == "R-4.4.7-07")

@@ -1,0 +1,20 @@
+"""Section 4.4.8: D0..Dn continuation, and issuing a measurement again after an empty reply."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import recorder as judge
+
+from ._helpers import line_of
+
+requirements = pytest.mark.requirements
+
+
+@requirements("R-4.4.8-05")
+def test_data_continuation(recorder, case):
+    """The recorder reads D0, D1, D2... until every announced value is in, and issues the
+    measurement again when a D reply comes back valid but empty."""
+    case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
+    line = line_of(recorder, case, "d0-to-d2", "empty-data", "concurrent-99", "families")
+    case.extend(judge.judge_data_collection(judge.measurements(line, recorder.uncertainty)))

@@ -1,0 +1,32 @@
+"""Section 7.2: retries after no reply, an invalid reply, a bad CRC or a pause in the reply."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import recorder as judge
+
+from ._helpers import line_of
+
+requirements = pytest.mark.requirements
+RETRY_SCENARIOS = (
+    "silent-twice",
+    "silent-six",
+    "bad-crc-once",
+    "parity-once",
+    "pause-once",
+    "format-once",
+)
+
+
+@requirements("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-7.2-06")
+def test_retries(recorder, case):
+    """Silent, garbled, paused and bad-CRC replies are retried inside the section 7.2 windows,
+    in up to three break+command+retries sequences."""
+    case.expect(
+        "retry 16.67-87 ms after an unanswered command, two retries per sequence with one "
+        "more than 100 ms after the break, three sequences before giving up (SHOULD), a retry "
+        "for every invalid reply, only after that reply ended"
+    )
+    line = line_of(recorder, case, *RETRY_SCENARIOS)
+    case.extend(judge.judge_retries(line, recorder.uncertainty))

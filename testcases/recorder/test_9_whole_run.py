@@ -1,0 +1,47 @@
+"""Rules judged over every transmission of every scenario (this module runs last): breaks and
+the marking after them, command characters, character gaps, the bit rate, the 87 ms rule."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges import recorder as judge
+
+from ._helpers import line_of
+
+requirements = pytest.mark.requirements
+
+
+def _everything(recorder, case):
+    return line_of(recorder, case, *recorder.applicable())
+
+
+@requirements("R-7.0-02", "R-7.0-06")
+def test_breaks(recorder, case):
+    """Every break lasts at least 12 ms and is followed by at least 8.33 ms of marking."""
+    case.expect("break >= 12 ms (-0.40); marking before the command >= 8.33 ms (-0.40)")
+    case.extend(judge.judge_breaks(_everything(recorder, case), recorder.uncertainty))
+
+
+@requirements("R-7.0-17")
+def test_break_when_due(recorder, case):
+    """A break before every command to a new sensor and after more than 87 ms of marking."""
+    case.expect("commands without a break only to the same sensor within 87 ms (+0.40)")
+    found = judge.judge_break_rules(_everything(recorder, case), recorder.uncertainty)
+    case.extend(f for f in found if f.requirement == "R-7.0-17")
+
+
+@requirements("R-4.2-01", "R-4.4-04", "R-4.3-01")
+def test_command_text(recorder, case):
+    """Commands are printable, start with an address and end with their only '!'."""
+    case.expect("printable ASCII; the address first; '!' last and nowhere else")
+    case.extend(judge.judge_command_text(_everything(recorder, case)))
+
+
+@requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")
+def test_character_timing(recorder, case):
+    """At most 1.66 ms between command characters (no tolerance), at 1200 baud."""
+    case.expect("every gap inside a command <= 1.66 ms; characters one 8.33 ms frame apart")
+    line = _everything(recorder, case)
+    case.extend(judge.judge_character_gaps(line, recorder.uncertainty))
+    case.add(judge.judge_bit_rate(line, recorder.uncertainty))
