@@ -70,6 +70,10 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "requirements(*ids): the requirement IDs a conformance case judges"
     )
+    config.addinivalue_line(
+        "markers",
+        "needs(*capabilities): link capabilities a case needs: break, unsolicited, binary",
+    )
     config.stash[RUN] = ConformanceRun(RunOptions.from_config(config))
     if config.pluginmanager.hasplugin("html"):
         from .reports import html
@@ -119,7 +123,31 @@ def case(request: pytest.FixtureRequest, sdi12_run: ConformanceRun) -> Case:
     record = request.node.stash.get(CASE, None)
     if record is None:
         raise pytest.UsageError(f"{request.node.nodeid} uses `case` without @requirements")
+    lacking = missing_capabilities(request.node, sdi12_run)
+    if lacking:  # the link cannot do what the case needs: an honest INCONCLUSIVE, not a verdict
+        reason = f"the {sdi12_run.link.info.kind} link cannot {' or '.join(lacking)}"
+        for rid in record.requirements:
+            record.findings.append(Finding(rid, Verdict.INCONCLUSIVE, reason, test=record.nodeid))
+        record.summarise()
+        sdi12_run.cases.append(record)
+        pytest.skip(f"INCONCLUSIVE: {reason}")
     return Case(record, version=lambda: sdi12_run.dut_version)
+
+
+#: ``@pytest.mark.needs(...)`` names -> (LinkInfo attribute, what a reader is told it lacks)
+CAPABILITIES = {
+    "break": ("can_break", "send breaks"),
+    "unsolicited": ("passes_unsolicited", "pass unsolicited bytes (service requests)"),
+    "binary": ("binary", "pass 8N1 binary packets"),
+}
+
+
+def missing_capabilities(item: pytest.Item, run: ConformanceRun) -> list[str]:
+    marker = item.get_closest_marker("needs")
+    if marker is None or run.link is None:
+        return []
+    info = run.link.info
+    return [CAPABILITIES[n][1] for n in marker.args if not getattr(info, CAPABILITIES[n][0])]
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

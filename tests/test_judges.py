@@ -184,3 +184,20 @@ def test_overall_verdict():
     assert overall(results, strict=False, complete=True) == COMPLIANT
     assert overall(results, strict=True, complete=True) == NON_COMPLIANT
     assert overall(results, strict=False, complete=False) == INCOMPLETE
+
+
+def test_cases_needing_what_the_link_lacks_are_inconclusive():
+    from types import SimpleNamespace
+
+    from conformance.links.base import LinkInfo
+    from conformance.plugin import missing_capabilities
+
+    item = SimpleNamespace(
+        get_closest_marker=lambda name: (
+            SimpleNamespace(args=("break", "unsolicited")) if name == "needs" else None
+        )
+    )
+    socket_like = SimpleNamespace(link=SimpleNamespace(info=LinkInfo("socket", can_break=False)))
+    assert missing_capabilities(item, socket_like) == ["send breaks"]
+    sim = SimpleNamespace(link=SimpleNamespace(info=LinkInfo("sim")))
+    assert missing_capabilities(item, sim) == []

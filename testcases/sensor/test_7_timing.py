@@ -23,6 +23,7 @@ from conformance.transcript import EventKind
 from conformance.verdicts import failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
+pytestmark = pytest.mark.needs("break")
 STANDBY = 0.15  # s of marking that puts any sensor in standby before a probe
 
 
