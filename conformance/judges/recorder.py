@@ -48,6 +48,10 @@ from .timing import judge_window
 
 IsRecorder = Callable[[Event], bool]
 
+#: Marking after a ``!`` that starts a new command; anything sooner (``0M!!``) is still part
+#: of the one before, so a ``!`` in the middle of a command is seen (R-4.4-04).
+_NEW_COMMAND = MARKING_AFTER_BREAK - TOLERANCE
+
 #: A recorder reacts to a service request (or to ttt running out) with aD0! within this long.
 #: The standard says "when it arrives"; the tool allows half a second for a logger's own work
 #: and fails only a recorder that visibly waits for something else (a tool decision).
@@ -164,7 +168,9 @@ def read_line(
             if e.kind is EventKind.BREAK:
                 breaks.append(e)
                 pending, current = e, None
-            elif current is None or current.heard or current.text.endswith("!"):
+            elif current is None or (
+                current.text.endswith("!") and e.start - current.end >= _NEW_COMMAND
+            ):
                 current = Sent(pending, [e], part=part)
                 sent.append(current)
                 pending = None
@@ -897,17 +903,8 @@ def judge_retries(line: Line, uncertainty: float) -> list[Finding]:
                             )
                         )
                 elif follower is not None:
-                    before = [e for e in a.sent.heard if e.start < follower.sent.start]
                     ends.append(
-                        judge_window(
-                            "R-7.2-06",
-                            "retry after the end of the invalid reply",
-                            follower.sent.start - (before[-1].end if before else a.sent.end),
-                            uncertainty,
-                            low=0.0,
-                            tolerance=0.0,
-                            evidence=[f"{_at(follower.sent)} after {a.problem}"],
-                        )
+                        _retry_after_reply(line, a.sent, follower.sent, a.problem, uncertainty)
                     )
             if any(a.problem is None for a in seq) or not gave_up:
                 continue
@@ -951,6 +948,25 @@ def judge_retries(line: Line, uncertainty: float) -> list[Finding]:
         combine("R-7.2-03", third, "unanswered sequence"),
         combine("R-7.2-06", ends, "retry after an invalid reply"),
     ]
+
+
+def _retry_after_reply(
+    line: Line, sent: Sent, retry: Sent, problem: str | None, uncertainty: float
+) -> Finding:
+    """R-7.2-06: marking between the end of the invalid reply and the retry; negative when
+    the sensor was still sending as the recorder took the line again."""
+    mine = {id(c) for s in line.sent for c in s.chars}
+    reply = [c for c in line.chars if id(c) not in mine and sent.end <= c.start < retry.end]
+    reply_end = max((c.end for c in reply), default=sent.end)
+    return judge_window(
+        "R-7.2-06",
+        "retry after the end of the invalid reply",
+        retry.start - reply_end,
+        uncertainty,
+        low=0.0,
+        tolerance=0.0,
+        evidence=[f"{_at(retry)} after {problem}"],
+    )
 
 
 def _last_break_before(line: Line, sent: Sent) -> Event | None:

@@ -144,12 +144,15 @@ _SCENARIOS = (
     ),
     Scenario(
         "transparent",
-        "host commands passed through: basic, extended, multi-line, identify and metadata",
+        "host commands passed through: basic and extended",
         (_s(),),
-        Request(
-            Task.TRANSPARENT,
-            ("0I!", "0XSN!", "0XHELP!", "0IM!", "0IM_001!", "0IHA_001!", "0IHB!"),
-        ),
+        Request(Task.TRANSPARENT, ("0!", "0I!", "0XSN!")),
+    ),
+    Scenario(
+        "transparent-v14",
+        "host commands passed through: multi-line text, identify and metadata (v1.4)",
+        (_s(),),
+        Request(Task.TRANSPARENT, ("0XHELP!", "0IM!", "0IM_001!", "0IHA_001!", "0IHB!")),
         v14=True,
     ),
     Scenario(

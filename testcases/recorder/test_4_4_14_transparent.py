@@ -17,8 +17,10 @@ def test_transparent_mode(recorder, case):
     """Host commands (basic, extended, identify, metadata) go out unchanged after a break and
     their replies are relayed unchanged."""
     case.expect("each host command on the wire exactly as typed, after a break; replies relayed")
-    names = [n for n in ("transparent", "multiline-no-etx") if recorder.applies(n)]
-    line = line_of(recorder, case, "transparent", "multiline-no-etx")
+    names = [
+        n for n in ("transparent", "transparent-v14", "multiline-no-etx") if recorder.applies(n)
+    ]
+    line = line_of(recorder, case, *names)
     if line is None:
         return
     asked = [c for n in names for c in SCENARIOS[n].request.commands]

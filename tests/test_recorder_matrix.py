@@ -1,0 +1,65 @@
+"""The recorder role's quality metric (design.md 5): the golden recorder is COMPLIANT with
+every testable recorder requirement judged definitely, and every faulty golden recorder is
+caught by exactly the requirements it declares."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.catalog import for_role
+from conformance.recorder.faults import RECORDER_FAULTS
+from conformance.recorder.matrix import recorder_matrix, run_recorder_suite
+
+
+def test_golden_recorder_is_compliant_with_no_fail_warn_or_inconclusive():
+    data = run_recorder_suite("sim")
+    assert data["summary"]["verdict"] == "COMPLIANT"
+    counts = data["summary"]["counts"]
+    assert counts["FAIL"] == counts["WARN"] == counts["INCONCLUSIVE"] == counts["ERROR"] == 0
+    judged = [r for r in data["requirements"] if r["testable"]]
+    assert len(judged) == len([r for r in for_role("recorder") if r.testable("recorder")]) == 36
+    assert all(r["verdict"] in ("PASS", "N/A") for r in judged)
+    # on the virtual-time bus every timing finding is definite, with zero uncertainty
+    timed = [f for r in judged for f in r["findings"] if f["measured_ms"] is not None]
+    assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
+
+
+def test_v13_recorder_leaves_the_v14_rules_not_applicable():
+    data = run_recorder_suite("sim", ("--sdi12-version", "1.3"))
+    assert data["summary"]["verdict"] == "COMPLIANT"
+    verdicts = {r["id"]: r["verdict"] for r in data["requirements"]}
+    for rid in ("R-5.1-04", "R-5.2-08", "R-5.4-01", "R-6.3-01", "R-4.4.13.1-04"):
+        assert verdicts[rid] == "N/A", rid
+    assert verdicts["R-4.4.14-01"] == verdicts["R-7.2-03"] == "PASS"
+
+
+@pytest.fixture(scope="module")
+def matrix():
+    return recorder_matrix()
+
+
+def test_every_recorder_fault_is_caught_by_exactly_its_requirements(matrix):
+    wrong = [
+        f"{r.fault}: missed {list(r.missed)}, also flagged {list(r.extra)}"
+        for r in matrix
+        if not r.exact
+    ]
+    assert not wrong, "\n".join(wrong)
+    assert all(r.verdict == "NON-COMPLIANT" for r in matrix)
+    assert len(matrix) == len(RECORDER_FAULTS) >= 11
+
+
+def test_the_faults_named_in_the_issue_exist():
+    assert set(RECORDER_FAULTS) >= {
+        "no-retries",
+        "retry-too-early",
+        "retry-too-late",
+        "no-break-after-87ms",
+        "d0-before-ttt",
+        "ignores-service-request",
+        "stops-after-d0",
+        "leading-zeros-after-d9",
+        "ignores-bad-crc",
+        "short-break",
+        "short-marking",
+    }
