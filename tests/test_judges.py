@@ -181,6 +181,8 @@ def test_overall_verdict():
         "t::a", "a", ("R-4.4.1-01",), findings=[Finding("R-4.4.1-01", Verdict.WARN, "hm")]
     )
     results = aggregate("sensor", [case])
+    assert overall(results, strict=False, complete=True) == INCOMPLETE  # others unjudged
+    results = [r for r in results if r.judged]
     assert overall(results, strict=False, complete=True) == COMPLIANT
     assert overall(results, strict=True, complete=True) == NON_COMPLIANT
     assert overall(results, strict=False, complete=False) == INCOMPLETE
