@@ -1,0 +1,110 @@
+"""The recorder role's machinery: played sensors, drivers, the session and the command line."""
+
+from __future__ import annotations
+
+import io
+import os
+import sys
+
+import pytest
+
+from conformance.cli import main
+from conformance.master import Master, Policy
+from conformance.ports import PortError
+from conformance.protocol.commands import measure
+from conformance.recorder.drivers import Interactive, RecorderDriverError, Trigger
+from conformance.recorder.played import SensorSpec, Spoil
+from conformance.recorder.request import Request, Task
+from conformance.recorder.session import LineMonitor, RecorderSession, check_port
+from conformance.sim.bus import SimBus, SimLink
+
+
+def _bus(spec: SensorSpec) -> Master:
+    bus = SimBus([LineMonitor(), spec.build()])
+    return Master(SimLink(bus), Policy.golden())
+
+
+def test_unheard_sensor_answers_the_third_transmission():
+    ex = _bus(SensorSpec(unheard=2)).transact("0!")
+    assert [a.reason for a in ex.attempts] == ["no reply", "no reply", "ok"]
+
+
+def test_garbled_sensor_spoils_one_reply_only():
+    master = _bus(SensorSpec(spoil=Spoil("crc"), spoil_command="0D0!"))
+    m = master.measure(measure("0", crc=True))
+    first, second = m.data[0].attempts
+    assert "should be" in first.reason and second.ok
+    assert m.values == ["+22.15", "+1013.2", "+45.7"]
+    master = _bus(SensorSpec(spoil=Spoil("parity"), spoil_command="0!"))
+    assert [a.reason[:14] for a in master.transact("0!").attempts] == ["invalid: parit", "ok"]
+
+
+def test_aborting_sensor_gives_an_empty_first_d0():
+    master = _bus(SensorSpec(aborts_once=True))
+    lost = master.measure(measure("0"))
+    assert lost.data[0].reply_text == "0\r\n" and not lost.values
+    again = master.measure(measure("0"))
+    assert again.values == ["+22.15", "+1013.2", "+45.7"]
+
+
+def test_session_runs_each_scenario_once_and_names_the_sensors():
+    session = RecorderSession("sim")
+    run = session.run("two-sensors")
+    assert session.run("two-sensors") is run
+    origins = {e.origin for e in run.events if e.kind == "char"}
+    assert origins == {"tool", "sensor0", "sensor1"}
+    assert run.output.logged["1M!"] == ["+22.15", "+1013.2", "+45.7"]
+
+
+@pytest.mark.parametrize(
+    "port",
+    ["sim://?recorder-faults=nonsense", "sim://?recorder-faults=no-retries,short-break", "COM9"],
+)
+def test_unusable_recorder_ports_are_refused(port):
+    with pytest.raises(PortError):
+        check_port(port)
+
+
+def test_external_recorders_need_a_real_time_bus():
+    with pytest.raises(PortError, match="real port"):
+        check_port("sim", "true")
+    with pytest.raises(PortError, match="real port"):
+        check_port("sim", "interactive")
+
+
+def test_trigger_gets_the_request_and_keeps_its_output():
+    request = Request(Task.MEASURE, ("0M!",))
+    trigger = Trigger('echo "$SDI12_SCENARIO $SDI12_TASK $SDI12_COMMANDS"', timeout=10)
+    out = trigger.act("service-request", request, None)  # type: ignore[arg-type]
+    assert out.notes == ["service-request measure 0M!"]
+    with pytest.raises(RecorderDriverError, match="exited with 3"):
+        Trigger("exit 3").act("x", request, None)  # type: ignore[arg-type]
+    with pytest.raises(RecorderDriverError, match="did not finish"):
+        Trigger(f"{sys.executable} -c 'import time; time.sleep(5)'", timeout=0.2).act(
+            "x",
+            request,
+            None,  # type: ignore[arg-type]
+        )
+
+
+def test_interactive_prompts_and_times_out():
+    request = Request(Task.CONCURRENT, ("0C!", "1C!"))
+    read_fd, write_fd = os.pipe()
+    with os.fdopen(read_fd) as answers, os.fdopen(write_fd, "w") as operator:
+        shown = io.StringIO()
+        driver = Interactive(timeout=0.2, prompt_out=shown, answer_in=answers)
+        with pytest.raises(RecorderDriverError, match="no answer"):
+            driver.act("concurrent-two", request, None)  # type: ignore[arg-type]
+        assert "start these concurrent measurements together" in shown.getvalue()
+        operator.write("logged both\n")
+        operator.flush()
+        assert driver.act("concurrent-two", request, None).notes == ["logged both"]  # type: ignore[arg-type]
+
+
+def test_cli_recorder_role(tmp_path):
+    assert main(["--port", "sim", "--role", "recorder", "--report-dir", str(tmp_path / "a")]) == 0
+    assert (tmp_path / "a" / "report.html").exists()
+    faulty = ["--port", "sim://?recorder-faults=short-break", "--role", "recorder"]
+    assert main([*faulty, "--report-dir", str(tmp_path / "b")]) == 1
+    assert main(["--port", "sim://?recorder-faults=bogus", "--role", "recorder"]) == 4
+    assert main(["--port", "sim", "--role", "recorder", "--trigger", "true"]) == 4
