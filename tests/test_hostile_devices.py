@@ -1,0 +1,280 @@
+"""Hostile devices on a real link: the tool gives findings or a clear error, never a hang or a
+traceback, and always writes its report.
+
+Each device is a small TCP server in this process, reached as ``socket://`` (raw bytes, no
+breaks: a hostile device needs none). It reads the tool's commands (7E1, parity stripped) and
+answers with whatever its behaviour returns. The CLI runs in a subprocess with a timeout, a
+few cases selected, and each test checks its own wall-time bound.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from conformance.protocol.timing import CHAR_TIME
+from conformance.transcript import to_wire_7e1
+
+CASES = "test_acknowledge_active or test_identification or test_short_spacing_is_not_a_break"
+WITH_FRAMING = CASES + " or test_reply_framing"  # R-4.1-02 / R-4.2-02 are judged there
+IDENT = "014HOSTILE HOSTL1001"
+
+
+def seven_e1(text: str) -> bytes:
+    return bytes(to_wire_7e1(ord(c)) for c in text)
+
+
+def polite(command: str) -> str | None:
+    """What a minimal well-behaved sensor at address 0 would say (the base for mangling)."""
+    if command == "?!" or command == "0!":
+        return "0"
+    if command == "0I!":
+        return IDENT
+    return None
+
+
+class HostileDevice:
+    """A ``socket://`` device: ``answer(command, count)`` returns the bytes to send (or None).
+
+    Like a device behind a plain TCP-serial bridge it keeps 1200-baud time: it answers 9 ms
+    after the command's last frame would have ended and sends one byte per frame time.
+    ``paced=False`` dumps its answer at once instead (a flood). ``stream`` (bytes per
+    second) makes it send filler forever after the first command; ``vanish_after`` closes
+    the connection and stops listening after that many commands.
+    """
+
+    def __init__(
+        self,
+        answer: Callable[[str, int], bytes | None],
+        *,
+        stream: float | None = None,
+        vanish_after: int | None = None,
+        paced: bool = True,
+    ) -> None:
+        self.answer = answer
+        self.paced = paced
+        self.stream = stream
+        self.vanish_after = vanish_after
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.listener.settimeout(0.1)
+        self.port = self.listener.getsockname()[1]
+        self.stop = threading.Event()
+        self.commands = 0
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    @property
+    def url(self) -> str:
+        return f"socket://127.0.0.1:{self.port}"
+
+    def _serve(self) -> None:
+        try:
+            while not self.stop.is_set():
+                try:
+                    conn, _ = self.listener.accept()
+                except TimeoutError:
+                    continue
+                with conn:
+                    if self._talk(conn):
+                        return  # vanished: the listener closes too
+        finally:
+            self.listener.close()
+
+    def _talk(self, conn: socket.socket) -> bool:
+        conn.settimeout(0.01)
+        buffer = ""
+        streaming = False
+        while not self.stop.is_set():
+            if streaming:
+                try:
+                    conn.sendall(seven_e1("A"))
+                except OSError:
+                    return False
+                conn.settimeout(1 / self.stream)  # the wait for commands paces the stream
+            try:
+                data = conn.recv(4096)
+            except TimeoutError:
+                continue
+            except OSError:
+                return False
+            if not data:
+                return False
+            for byte in data:
+                buffer += chr(byte & 0x7F)
+                if not buffer.endswith("!"):
+                    continue
+                self.commands += 1
+                command, buffer = buffer, ""
+                reply = self.answer(command, self.commands)
+                if reply:
+                    try:
+                        self._send(conn, reply, len(command))
+                    except OSError:
+                        return False
+                streaming = self.stream is not None
+                if self.vanish_after is not None and self.commands >= self.vanish_after:
+                    return True
+        return False
+
+    def _send(self, conn: socket.socket, reply: bytes, command_chars: int) -> None:
+        if not self.paced:
+            conn.sendall(reply)
+            return
+        time.sleep(command_chars * CHAR_TIME + 0.009)
+        for byte in reply:
+            conn.sendall(bytes([byte]))
+            time.sleep(CHAR_TIME)
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join(timeout=2)
+
+
+def run_cli(
+    url: str, out: Path, bound: float, *extra: str
+) -> tuple[subprocess.CompletedProcess, float]:
+    started = time.monotonic()
+    proc = subprocess.run(
+        [sys.executable, "-m", "conformance.cli", "--port", url, "--report-dir", str(out), *extra],
+        capture_output=True,
+        text=True,
+        timeout=bound,
+    )
+    return proc, time.monotonic() - started
+
+
+def report(out: Path) -> dict:
+    data = json.loads((out / "verdicts.json").read_text())
+    assert (out / "transcript.jsonl").exists()
+    return data
+
+
+def no_traceback(proc: subprocess.CompletedProcess) -> None:
+    assert "Traceback" not in proc.stdout + proc.stderr, proc.stdout + proc.stderr
+
+
+@pytest.fixture
+def device_factory():
+    devices: list[HostileDevice] = []
+
+    def make(*args, **kwargs) -> HostileDevice:
+        device = HostileDevice(*args, **kwargs)
+        devices.append(device)
+        return device
+
+    yield make
+    for device in devices:
+        device.close()
+
+
+def test_silent_device_is_exit_5_with_the_reason(tmp_path, device_factory):
+    device = device_factory(lambda cmd, n: None)
+    proc, took = run_cli(device.url, tmp_path, 60, "-k", CASES)
+    assert proc.returncode == 5, proc.stdout + proc.stderr
+    no_traceback(proc)
+    data = report(tmp_path)
+    assert data["run"]["complete"] is False
+    assert "no device answered" in data["run"]["stop_reason"]
+    assert "cannot send breaks" in data["run"]["stop_reason"]
+    assert took < 30
+
+
+def test_garbage_bytes_give_findings(tmp_path, device_factory):
+    rng = random.Random(5)
+    device = device_factory(
+        lambda cmd, n: bytes(rng.randrange(256) for _ in range(rng.randrange(1, 40)))
+    )
+    proc, took = run_cli(device.url, tmp_path, 120, "-k", CASES)
+    no_traceback(proc)
+    assert proc.returncode in (1, 5), proc.stdout + proc.stderr
+    data = report(tmp_path)
+    if proc.returncode == 1:
+        assert data["summary"]["counts"]["FAIL"] >= 1
+    assert took < 90
+
+
+def test_line_that_never_ends_is_bounded(tmp_path, device_factory):
+    device = device_factory(lambda cmd, n: seven_e1("0"), stream=2000.0, paced=False)
+    proc, took = run_cli(device.url, tmp_path, 150, "-k", "test_acknowledge_active")
+    no_traceback(proc)
+    assert proc.returncode in (1, 5), proc.stdout + proc.stderr
+    data = report(tmp_path)
+    assert data["run"]["finished"]
+    assert took < 120
+
+
+def test_ten_kilobyte_flood_is_bounded(tmp_path, device_factory):
+    flood = seven_e1("0") + bytes(random.Random(1).randrange(256) for _ in range(10_000))
+    device = device_factory(lambda cmd, n: flood if n == 1 else None, paced=False)
+    proc, took = run_cli(device.url, tmp_path, 120, "-k", CASES)
+    no_traceback(proc)
+    assert proc.returncode in (1, 5), proc.stdout + proc.stderr
+    report(tmp_path)
+    assert took < 90
+
+
+def _mangled(transform: Callable[[str], bytes]) -> Callable[[str, int], bytes | None]:
+    def answer(command: str, _count: int) -> bytes | None:
+        text = polite(command)
+        return None if text is None else transform(text + "\r\n")
+
+    return answer
+
+
+def test_wrong_parity_is_a_finding(tmp_path, device_factory):
+    odd = _mangled(lambda text: bytes(b ^ 0x80 for b in seven_e1(text)))
+    device = device_factory(odd)
+    proc, took = run_cli(device.url, tmp_path, 120, "-k", WITH_FRAMING)
+    no_traceback(proc)
+    assert proc.returncode in (1, 5), proc.stdout + proc.stderr
+    data = report(tmp_path)
+    if proc.returncode == 1:
+        failed = {r["id"] for r in data["requirements"] if r["verdict"] == "FAIL"}
+        assert "R-4.1-02" in failed, failed
+    assert took < 90
+
+
+def test_nul_and_other_non_printables_are_findings(tmp_path, device_factory):
+    dirty = _mangled(lambda text: seven_e1(text[:1] + "\x00\x07\x7f" + text[1:]))
+    device = device_factory(dirty)
+    proc, took = run_cli(device.url, tmp_path, 120, "-k", WITH_FRAMING)
+    no_traceback(proc)
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    data = report(tmp_path)
+    assert data["summary"]["counts"]["FAIL"] >= 1
+    assert took < 90
+
+
+def test_answers_from_the_wrong_address_are_findings(tmp_path, device_factory):
+    def other_address(command: str, _count: int) -> bytes | None:
+        text = polite(command)
+        return None if text is None else seven_e1("7" + text[1:] + "\r\n")
+
+    device = device_factory(other_address)
+    proc, took = run_cli(device.url, tmp_path, 120, "-k", CASES, "--address", "0")
+    no_traceback(proc)
+    assert proc.returncode in (1, 5), proc.stdout + proc.stderr
+    data = report(tmp_path)
+    if proc.returncode == 1:
+        assert data["summary"]["counts"]["FAIL"] >= 1
+    assert took < 90
+
+
+def test_port_vanishing_mid_run_is_exit_3_with_the_report(tmp_path, device_factory):
+    device = device_factory(_mangled(seven_e1), vanish_after=5)  # after discovery
+    proc, took = run_cli(device.url, tmp_path, 120, "-k", CASES)
+    no_traceback(proc)
+    assert proc.returncode == 3, proc.stdout + proc.stderr
+    data = report(tmp_path)
+    assert data["run"]["complete"] is False
+    assert "failed during the run" in data["run"]["stop_reason"]
+    assert took < 60
