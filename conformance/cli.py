@@ -294,6 +294,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         console.print("interrupted", style="yellow")
         return EXIT_INCOMPLETE
+    except Exception as exc:  # a bug in the tool: say so plainly, exit 3 for CI
+        console.print(f"internal error: {type(exc).__name__}: {exc}", style="red", markup=False)
+        console.print("please report this with the command line that caused it", style="red")
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

@@ -23,10 +23,14 @@ def case_requirements(role: str) -> dict[str, list[str]]:
             continue
         module = importlib.import_module(f"{package.__name__}.{info.name}")
         module_marks = getattr(module, "pytestmark", [])
+        if not isinstance(module_marks, list):  # a single mark is allowed too
+            module_marks = [module_marks]
         for name, obj in inspect.getmembers(module, inspect.isfunction):
             if not name.startswith("test_") or obj.__module__ != module.__name__:
                 continue
-            marks = list(getattr(obj, "pytestmark", [])) + list(module_marks)
+            marks = list(getattr(obj, "pytestmark", [])) + [
+                getattr(m, "mark", m) for m in module_marks
+            ]
             for mark in marks:
                 if mark.name == "requirements":
                     for rid in mark.args:
