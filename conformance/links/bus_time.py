@@ -8,8 +8,10 @@ exchanges next to the wall time it took. The lower bound is the union of:
 - the 8.33 ms of marking that must follow each break (R-7.0-06);
 - every stretch of marking that ended with the DUT starting to talk: its response delays,
   its service-request waits, its gaps inside a reply (the DUT's time, not the tool's);
-- the ttt a measurement announced, counted from the end of its ``atttn`` reply, when the
-  tool had to wait it out (no service request cut it short).
+- after the DUT's last character, the 7.5 ms it may still hold the line (R-7.0-11); after a
+  command that got no reply, the 16.67 ms before a retry may start (R-7.2-02);
+- the ttt a measurement announced, counted from the end of its ``atttn`` reply up to ttt
+  or the next break (a break before ttt is the tool's choice: an abort, or giving up).
 
 Anything beyond that (retry spacing, listening windows for silence, patience past limits,
 scheduling latency) is the tool's overhead.
@@ -22,7 +24,7 @@ from dataclasses import dataclass
 
 from ..master import validity
 from ..protocol.commands import CommandError, parse_command
-from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK
+from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
 from ..transcript import TOOL, Event, EventKind, decode_7e1
 
 
@@ -56,13 +58,28 @@ def bus_time(events: Iterable[Event]) -> BusTime:
         else:
             frames += 1
             spans.append((e.start, e.start + CHAR_TIME))
-    previous_end = wire[0].end
+    previous = wire[0]
+    previous_end = previous.end
     for e in wire[1:]:
-        if e.kind is EventKind.CHAR and e.origin != TOOL and e.start > previous_end:
-            spans.append((previous_end, e.start))  # the DUT chose when to talk
-        previous_end = max(previous_end, e.end)
+        if e.start > previous_end:
+            spans.append(
+                (previous_end, previous_end + _forced_gap(previous, e, e.start - previous_end))
+            )
+        if e.end >= previous_end:
+            previous, previous_end = e, e.end
     spans += _announced_waits(wire)
     return BusTime(_union(spans), wire[-1].end - wire[0].start, frames, breaks)
+
+
+def _forced_gap(before: Event, after: Event, gap: float) -> float:
+    """How much of the marking between two events no recorder could have skipped."""
+    if after.kind is EventKind.CHAR and after.origin != TOOL:
+        return gap  # the DUT chose when to talk (response delay, service request, gaps)
+    if before.origin != TOOL:
+        return min(gap, RELEASE_LINE)  # the DUT may hold the line after its last stop bit
+    if before.kind is EventKind.CHAR and before.char7 == ord("!"):
+        return min(gap, RETRY_MIN)  # no reply: the earliest a retry may start
+    return 0.0
 
 
 def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
@@ -71,27 +88,40 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     command: list[Event] = []
     reply: list[Event] = []
     for e in [*wire, None]:
-        new_command = e is not None and e.origin == TOOL and e.kind is EventKind.CHAR
-        if e is None or (new_command and (reply or decode_7e1(command).endswith("!"))):
-            text = decode_7e1(command)
-            try:
-                cmd = parse_command(text)
-            except CommandError:
-                cmd = None
-            if cmd is not None and cmd.starts_measurement and reply:
-                parsed = validity.parse_start_reply(decode_7e1(reply), validity.count_digits(cmd))
-                if parsed is not None and parsed[0] > 0:
-                    waits.append((reply[-1].end, reply[-1].end + parsed[0]))
+        ends_exchange = e is None or e.kind is EventKind.BREAK
+        if e is not None and e.origin == TOOL and e.kind is EventKind.CHAR:
+            ends_exchange = bool(reply) or decode_7e1(command).endswith("!")
+        if ends_exchange:
+            wait = _announced_wait(command, reply)
+            if wait is not None:
+                waits.append(wait)
             command, reply = [], []
         if e is None:
-            break
+            continue
         if e.kind is EventKind.BREAK:
-            command, reply = [], []
-        elif e.origin == TOOL:
+            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that
+            waits = [(start, min(end, max(start, e.start))) for start, end in waits]
+            continue
+        if e.origin == TOOL:
             command.append(e)
         elif command and decode_7e1(command).endswith("!") and not _line_done(reply):
             reply.append(e)
     return waits
+
+
+def _announced_wait(command: list[Event], reply: list[Event]) -> tuple[float, float] | None:
+    if not reply:
+        return None
+    try:
+        cmd = parse_command(decode_7e1(command))
+    except CommandError:
+        return None
+    if not cmd.starts_measurement:
+        return None
+    parsed = validity.parse_start_reply(decode_7e1(reply), validity.count_digits(cmd))
+    if parsed is None or parsed[0] == 0:
+        return None
+    return reply[-1].end, reply[-1].end + parsed[0]
 
 
 def _line_done(reply: list[Event]) -> bool:

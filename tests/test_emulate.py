@@ -1,0 +1,225 @@
+"""``sdi12-conform emulate``: the reference sensor served in real time, reached over real OS
+I/O (loopback TCP, a pty), and the CLI judging it end to end over RFC 2217.
+
+The suite over RFC 2217 takes its bus time in real time (about four minutes for every case),
+so CI runs a selection of cases here; ``SDI12_E2E_FULL=1`` adds the full clean run.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+import serial
+
+from conformance.emulate.command import emulate_main, make_device
+from conformance.emulate.process import EmulatorProcess
+from conformance.emulate.realtime import RealTimeLine
+from conformance.emulate.servers import TcpEmulatorServer, serve_serial
+from conformance.links.factory import open_real_link
+from conformance.master.engine import Master
+from conformance.ports import PortError
+from conformance.protocol import commands as cmds
+from conformance.protocol.timing import INTER_CHAR_GAP_MAX, RESPONSE_START_MAX, RESPONSE_START_MIN
+from conformance.transcript import to_wire_7e1
+
+#: Cases that together touch wake-up, identification, a measurement with its service request,
+#: data, and the whole-transcript framing and timing judges.
+SELECTION = (
+    "test_acknowledge_active or test_identification or test_service_request "
+    "or test_measurement_reply or test_reply_framing or test_character_gaps "
+    "or test_response_start_window or test_short_spacing_is_not_a_break "
+    "or test_break_just_over_12ms_wakes or test_follow_up_without_break"
+)
+
+
+# -- in-process: the line and the server ------------------------------------------------------
+@pytest.fixture
+def served():
+    """The reference sensor behind an in-process RFC 2217 server, and a link to it."""
+    line = RealTimeLine(make_device("1.4", "0", ""), lambda data: None).start()
+    server = TcpEmulatorServer(line, "127.0.0.1", 0)
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    link = open_real_link(server.url)
+    yield link
+    link.close()
+    server.stop()
+    thread.join(timeout=2)
+    line.stop()
+
+
+def test_served_sensor_answers_in_the_section_7_window(served):
+    exchange = Master(served).identify("0")
+    assert exchange.ok, exchange.reply_text
+    attempt = exchange.attempts[0]
+    start = attempt.reply_events[0].start - attempt.command_events[-1].end
+    assert RESPONSE_START_MIN - 1e-3 <= start <= RESPONSE_START_MAX, start
+    gaps = [
+        b.start - a.end
+        for a, b in zip(attempt.reply_events, attempt.reply_events[1:], strict=False)
+    ]
+    assert max(gaps) < INTER_CHAR_GAP_MAX, gaps
+
+
+def test_served_sensor_measures_with_a_service_request(served):
+    started = time.monotonic()
+    m = Master(served).measure(cmds.parse_command("0M!"))
+    assert m.values and m.count == len(m.values)
+    assert m.service_request_end is not None
+    assert m.ttt is not None and time.monotonic() - started < m.ttt + 1.5
+
+
+# -- the command line -------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--listen", "127.0.0.1:0", "--faults", "no-such-fault"], "unknown fault"),
+        (["--listen", "127.0.0.1:0", "--version", "2.0"], "1.3 or 1.4"),
+        (["--listen", "127.0.0.1:0", "--address", "$"], "address must be"),
+        (["--listen", "nowhere"], "HOST:PORT"),
+        (["--serial", "/dev/ttyUSB-sdi12-missing"], "cannot open"),
+        (["--serial", "loop://", "--raw"], "--listen only"),
+    ],
+)
+def test_emulate_usage_errors_exit_4(argv, message):
+    said: list[str] = []
+    assert emulate_main(argv, said.append) == 4
+    assert message in " ".join(said)
+
+
+def test_emulate_without_a_place_to_serve_is_a_usage_error():
+    assert emulate_main([], lambda _msg: None) == 4
+
+
+def test_make_device_takes_the_sim_url_parameters():
+    device = make_device("1.3", "5", "no-service-request")
+    assert device.address == "5" and not device.profile.v14
+    with pytest.raises(PortError):
+        make_device("1.4", "0", "no-such-fault")
+
+
+@pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal")
+def test_serial_mode_takes_a_nul_as_the_break():
+    """On a UART a break reads as NUL: the served sensor wakes on it and answers a!."""
+    controller, device_fd = os.openpty()
+    port = serial.serial_for_url(os.ttyname(device_fd), baudrate=1200, timeout=0.02)
+    line = RealTimeLine(make_device("1.4", "0", ""), port.write, deliver_at_end=False).start()
+    stopped = threading.Event()
+    thread = threading.Thread(target=serve_serial, args=(line, port, stopped), daemon=True)
+    thread.start()
+    try:
+        os.write(controller, b"\x00")  # read ~8 ms into a 13 ms break; 9 ms marking follow
+        time.sleep(0.030)
+        os.write(controller, bytes(to_wire_7e1(ord(c)) for c in "0!"))
+        reply = b""
+        deadline = time.monotonic() + 1.0
+        while not reply.endswith(b"\n") and time.monotonic() < deadline:
+            os.set_blocking(controller, False)
+            try:
+                reply += os.read(controller, 16)
+            except BlockingIOError:
+                time.sleep(0.005)
+        assert bytes(b & 0x7F for b in reply) == b"0\r\n"
+    finally:
+        stopped.set()
+        thread.join(timeout=1)
+        line.stop()
+        port.close()
+        os.close(controller)
+        os.close(device_fd)
+
+
+# -- end to end: emulator in one process, the CLI in another ----------------------------------
+def judge(url: str, out: Path, *extra: str, bound: float = 240) -> tuple[int, dict, str]:
+    proc = subprocess.run(
+        [sys.executable, "-m", "conformance.cli", "--port", url, "--report-dir", str(out), *extra],
+        capture_output=True,
+        text=True,
+        timeout=bound,
+    )
+    text = proc.stdout + proc.stderr
+    assert "Traceback" not in text, text
+    return proc.returncode, json.loads((out / "verdicts.json").read_text()), text
+
+
+def verdicts_of(data: dict) -> dict[str, str]:
+    return {r["id"]: r["verdict"] for r in data["requirements"]}
+
+
+@pytest.fixture
+def emulator(request):
+    proc = EmulatorProcess(*getattr(request, "param", ()))
+    yield proc
+    proc.stop()
+
+
+#: judges/wire.py fails a character gap inside 1.66..2.06 ms without the link's uncertainty,
+#: so scheduling jitter on a loaded machine can trip it; reported to the judges' owner.
+JITTER_SENSITIVE = {"R-7.0-01"}
+
+
+def test_clean_emulator_over_rfc2217_has_no_failure(emulator, tmp_path):
+    code, data, text = judge(emulator.url, tmp_path, "-k", SELECTION)
+    verdicts = verdicts_of(data)
+    judged = {r["id"] for r in data["requirements"] if r["tests"]}
+    assert {"R-4.4.1-01", "R-4.4.6-02", "R-7.0-10", "R-7.0-12"} <= judged, text
+    bad = {rid for rid, v in verdicts.items() if v in ("FAIL", "WARN", "ERROR")}
+    assert not bad - JITTER_SENSITIVE, text
+    if not bad:
+        assert code == 2, text  # the selection leaves requirements unjudged: INCOMPLETE
+    link = data["run"]["link"]
+    assert link["kind"] == "rfc2217" and link["can_break"] is True
+    bus = data["run"]["bus"]
+    assert 0 < bus["bus_lower_bound_s"] <= bus["wall_s"]
+    # protocol verdicts are definite; timing ones are PASS or honestly INCONCLUSIVE
+    assert verdicts["R-4.4.1-01"] == verdicts["R-4.4.6-02"] == "PASS", text
+    assert verdicts["R-7.0-10"] in ("PASS", "INCONCLUSIVE"), text
+
+
+def test_clean_emulator_gives_definite_timing_with_a_declared_tight_uncertainty(emulator, tmp_path):
+    """On loopback the stamps are usually far better than the declared 5 ms: a user who
+    knows it may say so, and the response window then comes out PASS."""
+    code, data, text = judge(
+        emulator.url,
+        tmp_path,
+        "-k",
+        "test_identification or test_response_start_window",
+        "--timing-uncertainty-ms",
+        "2",
+    )
+    verdicts = verdicts_of(data)
+    assert data["run"]["link"]["timing_uncertainty_ms"] == 2.0
+    assert verdicts["R-7.0-10"] == "PASS", text
+
+
+@pytest.mark.parametrize(
+    ("emulator", "extra", "expected"),
+    [
+        (("--faults", "no-service-request"), (), {"R-4.4.6-02"}),
+        (("--faults", "parity-error"), (), {"R-4.1-02"}),
+        (("--faults", "service-request-extra-chars"), (), {"R-4.4.6-01"}),
+        # 3 ms gaps need a tighter uncertainty than the declared 5 ms to be a definite FAIL
+        (("--faults", "inter-char-gap"), ("--timing-uncertainty-ms", "1"), {"R-7.0-12"}),
+    ],
+    indirect=["emulator"],
+    ids=["no-service-request", "parity-error", "service-request-extra-chars", "inter-char-gap"],
+)
+def test_faulty_emulator_over_rfc2217_fails_its_requirements(emulator, extra, expected, tmp_path):
+    code, data, text = judge(emulator.url, tmp_path, "-k", SELECTION, *extra)
+    failed = {rid for rid, v in verdicts_of(data).items() if v == "FAIL"}
+    assert code == 1, text
+    assert expected <= failed <= expected | JITTER_SENSITIVE, text
+
+
+@pytest.mark.skipif(not os.environ.get("SDI12_E2E_FULL"), reason="set SDI12_E2E_FULL=1 (~5 min)")
+def test_full_suite_over_rfc2217_is_compliant(emulator, tmp_path):
+    code, data, text = judge(emulator.url, tmp_path, bound=900)
+    assert code == 0, text
+    assert data["summary"]["verdict"] == "COMPLIANT"

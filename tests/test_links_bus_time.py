@@ -1,0 +1,73 @@
+"""The bus-time lower bound a run reports next to its wall time."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.links.bus_time import bus_time
+from conformance.protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
+from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+
+
+class Wire:
+    """Builds a transcript on a clock: breaks, commands, replies, pauses."""
+
+    def __init__(self) -> None:
+        self.t = 0.0
+        self.events: list[Event] = []
+
+    def pause(self, seconds: float) -> Wire:
+        self.t += seconds
+        return self
+
+    def brk(self, seconds: float = 13e-3) -> Wire:
+        self.events.append(Event(EventKind.BREAK, TOOL, self.t, self.t + seconds))
+        self.t += seconds
+        return self
+
+    def send(self, origin: str, text: str) -> Wire:
+        for c in text:
+            wire = to_wire_7e1(ord(c))
+            self.events.append(Event(EventKind.CHAR, origin, self.t, self.t + CHAR_TIME, wire=wire))
+            self.t += CHAR_TIME
+        return self
+
+
+def test_empty_transcript_needs_no_time():
+    assert bus_time([]).lower_bound == 0.0
+
+
+def test_a_plain_exchange_costs_its_frames_break_marking_and_the_dut_delay():
+    w = Wire().brk().pause(9e-3).send(TOOL, "0!").pause(9e-3).send(DUT, "0\r\n")
+    figures = bus_time(w.events)
+    expected = 13e-3 + MARKING_AFTER_BREAK + 5 * CHAR_TIME + 9e-3
+    assert figures.lower_bound == pytest.approx(expected)
+    assert figures.frames == 5 and figures.breaks == 1
+    assert figures.span == pytest.approx(w.t)
+
+
+def test_tool_patience_is_not_counted_but_forced_waits_are():
+    w = Wire().brk().pause(9e-3).send(TOOL, "0!").pause(0.2)  # no reply: only 16.67 ms forced
+    w.send(TOOL, "0!").pause(9e-3).send(DUT, "0\r\n").pause(0.3)  # 7.5 ms line release
+    w.send(TOOL, "0!")
+    lower = bus_time(w.events).lower_bound
+    frames = 9 * CHAR_TIME
+    forced = 13e-3 + MARKING_AFTER_BREAK + RETRY_MIN + 9e-3 + RELEASE_LINE
+    assert lower == pytest.approx(frames + forced)
+
+
+def test_an_announced_measurement_time_is_forced_even_without_a_service_request():
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    reply_end = w.t
+    w.pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    assert lower >= 5.0  # the 5 s ttt counts from the end of the reply
+    assert lower < w.t - reply_end + 0.2  # and is counted once
+
+
+def test_a_service_request_wait_is_the_sensors_time():
+    w = Wire().brk().pause(9e-3).send(TOOL, "0M!").pause(9e-3).send(DUT, "00053\r\n")
+    w.pause(1.5).send(DUT, "0\r\n").pause(20e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    # the 1.5 s until the service request and ttt overlap: counted once, not twice
+    assert 1.5 < lower < 5.0 + 0.2
