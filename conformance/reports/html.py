@@ -1,8 +1,14 @@
 """Everything sdi12-conform adds to the pytest-html report.
 
-The header (DUT identity, link, tool), the overall verdict banner, the sortable and filterable
-requirements table, and per case the expectation, findings and wire transcript. Everything that
-came from the DUT goes through :func:`html.escape` (design.md 7: the device is untrusted).
+A certifier opens the file and must see the overall verdict at once, then what to read first
+(FAIL, ERROR, INCONCLUSIVE and WARN requirements with their reasons), the DUT and run identity,
+and the full requirements table (sortable, filterable). Per case the report shows the
+expectation, the findings, a timing diagram for timing cases and the wire transcript.
+
+pytest-html puts its own title and environment table first and our hook output inside its
+summary section; a few lines of script move our block right under the title so the verdict is
+above the fold (without script the block still shows, just lower). Everything that came from
+the DUT goes through :func:`html.escape` (design.md 7: the device is untrusted).
 """
 
 from __future__ import annotations
@@ -12,47 +18,92 @@ from typing import Any
 
 import pytest
 
-from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, counts
+from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..run import TOOL, ConformanceRun
 from ..transcript import TOOL as TOOL_ORIGIN
 from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
+from ..verdicts import Finding, Verdict
+from .timing_diagram import exchange_behind, timing_svg
 from .verdicts_json import dut_block
+
+# Severity order for the banner, the "read first" list and sorting the verdict column.
+SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
+TIMING_MODULES = ("test_7_timing.py::", "test_9_whole_run.py::")
 
 STYLE = """
 <style>
-.sdi12-banner{font:bold 28px sans-serif;padding:14px 20px;border-radius:6px;margin:10px 0;
+#sdi12-top,#sdi12-top p,.sdi12,.sdi12-case{color:#222}
+#results-table{color:#333}
+.sdi12-banner{font:bold 30px sans-serif;padding:12px 20px;border-radius:6px;margin:10px 0;
   color:#fff}
 .sdi12-banner.ok{background:#2e7d32}.sdi12-banner.bad{background:#c62828}
 .sdi12-banner.incomplete{background:#ef6c00}
-.sdi12-banner small{display:block;font:14px sans-serif;margin-top:4px}
-table.sdi12{border-collapse:collapse;margin:8px 0;font:13px sans-serif}
+.sdi12-banner small{display:block;font:15px sans-serif;margin-top:4px}
+.sdi12-banner .ident{font:13px monospace;opacity:.95}
+.sdi12-cols{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}
+.sdi12-cols h3{font:bold 14px sans-serif;margin:6px 0 2px}
+table.sdi12{border-collapse:collapse;margin:6px 0;font:13px sans-serif}
 table.sdi12 td,table.sdi12 th{border:1px solid #ccc;padding:3px 6px;vertical-align:top;
   text-align:left}
-table.sdi12 th{background:#eee;cursor:pointer}
+table.sdi12 th{background:#eee}
+table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
+#sdi12-requirements thead th{cursor:pointer;user-select:none;position:sticky;top:0}
+#sdi12-requirements thead th::after{content:" ⇅";color:#aaa}
+#sdi12-requirements thead th.asc::after{content:" ▲";color:#333}
+#sdi12-requirements thead th.desc::after{content:" ▼";color:#333}
+#sdi12-requirements td:nth-child(5){max-width:420px}
+.sdi12-controls{font:13px sans-serif;margin:6px 0}
+.sdi12-controls input,.sdi12-controls select{font:13px sans-serif;padding:2px 4px}
 .v-PASS{color:#2e7d32;font-weight:bold}.v-FAIL{color:#c62828;font-weight:bold}
 .v-WARN{color:#b26a00;font-weight:bold}.v-INCONCLUSIVE{color:#6a1b9a;font-weight:bold}
 .v-NA{color:#666}.v-ERROR{color:#fff;background:#c62828;font-weight:bold}
-.sdi12-wire{font:12px monospace;white-space:pre}
+.sdi12-attention li{margin:3px 0;font:13px sans-serif}
+.sdi12-case{font:13px sans-serif}
+.sdi12-case .num{font:12px monospace;white-space:nowrap}
+.sdi12-wire{font:12px monospace;white-space:pre;background:#f7f7f7;border:1px solid #ddd;
+  padding:4px 6px;overflow-x:auto}
 .sdi12-wire .tool{color:#1565c0}.sdi12-wire .dut{color:#2e7d32}.sdi12-wire .brk{color:#b26a00}
+.sdi12-wire .hdr{color:#777}.sdi12-wire .bad{color:#c62828;font-weight:bold}
+.sdi12-diagram{overflow-x:auto;margin:4px 0 8px;border:1px solid #eee;background:#fff}
+.sdi12-wire,.sdi12-diagram{max-width:calc(100vw - 70px)}
+#sdi12-top a,.sdi12-case a{color:#1565c0}
 </style>
 """
 
 SCRIPT = """
 <script>
 (function(){
+  var top=document.getElementById('sdi12-top'), title=document.getElementById('title');
+  if(top&&title){var after=title.nextElementSibling||title;
+    after.parentNode.insertBefore(top,after.nextSibling);}
+  var envh=document.getElementById('environment-header'),env=document.getElementById('environment');
+  var results=document.getElementById('results-table');
+  if(envh&&env&&results){results.parentNode.insertBefore(envh,results.nextSibling);
+    envh.parentNode.insertBefore(env,envh.nextSibling);}
+  var h=document.querySelector('.summary__data h2'); if(h) h.textContent='Test cases';
   var t=document.getElementById('sdi12-requirements'); if(!t) return;
-  var f=document.getElementById('sdi12-filter');
-  f.addEventListener('input',function(){var q=f.value.toLowerCase();
+  var f=document.getElementById('sdi12-filter'), v=document.getElementById('sdi12-verdict-filter');
+  var shown=document.getElementById('sdi12-shown');
+  function apply(){var q=f.value.toLowerCase(), want=v.value, n=0;
     t.querySelectorAll('tbody tr').forEach(function(r){
-      r.style.display=r.textContent.toLowerCase().indexOf(q)>=0?'':'none';});});
-  t.querySelectorAll('th').forEach(function(th,i){th.addEventListener('click',function(){
-    var rows=Array.prototype.slice.call(t.querySelectorAll('tbody tr'));
-    var asc=th.dataset.asc!=='1'; th.dataset.asc=asc?'1':'0';
-    rows.sort(function(a,b){var x=a.cells[i].textContent,y=b.cells[i].textContent;
-      var o={numeric:true};
-      return asc?x.localeCompare(y,undefined,o):y.localeCompare(x,undefined,o);});
+      var ok=r.textContent.toLowerCase().indexOf(q)>=0&&(!want||r.dataset.verdict===want);
+      r.style.display=ok?'':'none'; if(ok) n++;});
+    shown.textContent=n+' of '+t.tBodies[0].rows.length+' requirements shown';}
+  f.addEventListener('input',apply); v.addEventListener('change',apply);
+  document.querySelectorAll('[data-sdi12-show]').forEach(function(a){
+    a.addEventListener('click',function(e){e.preventDefault();v.value=a.dataset.sdi12Show;
+      f.value='';apply();t.scrollIntoView();});});
+  t.querySelectorAll('thead th').forEach(function(th,i){th.addEventListener('click',function(){
+    var rows=Array.prototype.slice.call(t.tBodies[0].rows);
+    var asc=!th.classList.contains('asc');
+    t.querySelectorAll('thead th').forEach(function(h){h.classList.remove('asc','desc');});
+    th.classList.add(asc?'asc':'desc');
+    function key(r){var c=r.cells[i];return c.dataset.sort||c.textContent;}
+    rows.sort(function(a,b){var o=key(a).localeCompare(key(b),undefined,{numeric:true});
+      return asc?o:-o;});
     rows.forEach(function(r){t.tBodies[0].appendChild(r);});});});
+  apply();
 })();
 </script>
 """
@@ -62,59 +113,139 @@ def verdict_class(verdict: str) -> str:
     return "v-NA" if verdict == "N/A" else f"v-{verdict}"
 
 
+def _verdict_cell(verdict: str) -> str:
+    rank = SEVERITY.index(verdict) if verdict in SEVERITY else len(SEVERITY)
+    return f'<td class="{verdict_class(verdict)}" data-sort="{rank}">{escape(verdict)}</td>'
+
+
+def _tally(results: list[RequirementResult]) -> dict[str, int]:
+    tally = dict.fromkeys(SEVERITY, 0)
+    for r in results:
+        tally[str(r.verdict)] = tally.get(str(r.verdict), 0) + 1
+    return tally
+
+
 def banner(run: ConformanceRun) -> str:
+    """The overall verdict, the requirement counts and who was judged, in one block."""
     verdict = run.verdict or "INCOMPLETE"
     css = {COMPLIANT: "ok", NON_COMPLIANT: "bad"}.get(verdict, "incomplete")
-    tally = counts(run.results or [])
-    line = ", ".join(f"{n} {k}" for k, n in tally.items() if n)
-    reason = f" — {escape(run.stop_reason)}" if run.stop_reason else ""
+    results = run.results or []
+    tally = _tally(results)
+    counts = ", ".join(f"{n} {k}" for k, n in tally.items() if n)
+    testable = sum(1 for r in results if r.requirement.testable(run.options.role))
+    line = f"{counts} — {len(results)} requirements, {testable} testable by this tool"
+    if run.stop_reason:
+        line += f" — stopped: {run.stop_reason}"
+    dut = dut_block(run)
+    ident = wire_escape(dut["identification"] or "(no identification)")
+    version = dut["sdi12_version"] or "?"
+    who = (
+        f"{run.options.role} at address {dut['address']}, SDI-12 v{version}: {ident} · "
+        f"port {run.options.port} · {run.finished or run.started}"
+    )
     return (
         f'<div class="sdi12-banner {css}" id="sdi12-verdict">{escape(verdict)}'
-        f"<small>{escape(line)} requirements{reason}</small></div>"
+        f"<small>{escape(line)}</small>"
+        f'<small class="ident">{escape(who)}</small></div>'
     )
 
 
+def _kv_table(title: str, rows: list[tuple[str, object]], table_id: str) -> str:
+    body = "".join(f"<tr><th>{escape(k)}</th><td>{escape(str(v))}</td></tr>" for k, v in rows)
+    table = f'<table class="sdi12 kv" id="{table_id}">{body}</table>'
+    return f"<div><h3>{escape(title)}</h3>{table}</div>"
+
+
 def header(run: ConformanceRun) -> str:
+    """The DUT identity and the run's identity, side by side."""
     dut = dut_block(run)
     link = run.link_description()
-    rows = [
-        ("Tool", f"{TOOL['name']} {TOOL['version']}"),
-        ("Role", run.options.role),
-        ("Port", run.options.port),
-        (
-            "Link",
-            f"{link['kind']}, breaks: {link['can_break']}, "
-            f"timing uncertainty ±{link['timing_uncertainty_ms']} ms",
-        ),
-        ("Started / finished", f"{run.started} / {run.finished}"),
-        ("DUT address", dut["address"]),
+    uncertainty = link["timing_uncertainty_ms"]
+    exact = " (virtual clock: exact)" if link["kind"] == "sim" and not uncertainty else ""
+    breaks = {True: "yes", False: "no", None: "unknown"}[link["can_break"]]
+    device = [
         ("Identification (aI!)", wire_escape(dut["identification"] or "(none)")),
-        ("Claimed SDI-12 version", dut["sdi12_version"]),
-        ("Vendor / model / firmware", f"{dut['vendor']} / {dut['model']} / {dut['firmware']}"),
+        ("Address", dut["address"]),
+        ("Claimed SDI-12 version", dut["sdi12_version"] or "unknown"),
+        ("Vendor", dut["vendor"] or "—"),
+        ("Model", dut["model"] or "—"),
+        ("Firmware (sensor version)", dut["firmware"] or "—"),
+        ("Serial / optional field", dut["serial"] or "—"),
         ("Declaration", dut["declaration"] or "none (features discovered)"),
         ("Assumptions", "; ".join(dut["assumptions"]) or "none"),
-        ("Strict (SHOULD as MUST)", str(run.options.strict)),
-        ("Complete", str(run.complete)),
     ]
-    body = "".join(f"<tr><th>{escape(k)}</th><td>{escape(str(v))}</td></tr>" for k, v in rows)
-    return f'<table class="sdi12" id="sdi12-header">{body}</table>'
+    runrows = [
+        ("Tool", f"{TOOL['name']} {TOOL['version']}"),
+        ("Role judged", run.options.role),
+        ("Port", run.options.port),
+        ("Link", f"{link['kind']}, can send breaks: {breaks}"),
+        ("Timing uncertainty", f"±{uncertainty} ms{exact}"),
+        ("Started", run.started),
+        ("Finished", run.finished or "—"),
+        ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),
+        ("Run complete", "yes" if run.complete else f"no: {run.stop_reason or 'interrupted'}"),
+    ]
+    return (
+        '<div class="sdi12-cols" id="sdi12-header">'
+        + _kv_table("Device under test", device, "sdi12-dut")
+        + _kv_table("Run", runrows, "sdi12-run")
+        + "</div>"
+    )
+
+
+def attention(run: ConformanceRun) -> str:
+    """What a certifier must read first: every requirement that is not a plain PASS or N/A."""
+    results = run.results or []
+    bad = [r for r in results if str(r.verdict) in SEVERITY[:4]]
+    bad.sort(key=lambda r: SEVERITY.index(str(r.verdict)))
+    na = sum(1 for r in results if r.verdict is Verdict.NA)
+    na_link = (
+        f"<p>{na} requirements are N/A (not applicable to this DUT, or not testable by this tool):"
+        ' <a href="#sdi12-requirements" data-sdi12-show="N/A">show them with their reasons</a>.</p>'
+        if na
+        else ""
+    )
+    if not bad:
+        return (
+            '<div id="sdi12-attention"><h3>Read first</h3><p>Nothing: no requirement failed, '
+            f"warned or was left inconclusive.</p>{na_link}</div>"
+        )
+    items = []
+    for r in bad:
+        verdict = str(r.verdict)
+        reasons = [f.detail for f in r.findings if f.verdict is r.verdict]
+        more = f" (+{len(reasons) - 1} more)" if len(reasons) > 1 else ""
+        items.append(
+            f'<li><span class="{verdict_class(verdict)}">{escape(verdict)}</span> '
+            f"<b>{escape(r.requirement.id)}</b> ({escape(r.requirement.level)}): "
+            f"{escape(reasons[0] if reasons else '')}{escape(more)}</li>"
+        )
+    return (
+        f'<div id="sdi12-attention"><h3>Read first ({len(bad)})</h3>'
+        f'<ul class="sdi12-attention">{"".join(items)}</ul>{na_link}</div>'
+    )
 
 
 def requirements_table(run: ConformanceRun) -> str:
     rows = []
     for r in run.results or []:
         req = r.requirement
+        verdict = str(r.verdict)
         tests = "<br>".join(escape(t.split("::")[-1]) for t in r.tests) or "—"
+        extra = len(r.findings) - 1
+        evidence = escape(r.one_line) + (f" <i>(+{extra} findings)</i>" if extra > 0 else "")
         rows.append(
-            f"<tr><td>{escape(req.id)}</td><td>{escape(req.clause)}</td>"
-            f"<td>{escape(req.level)}</td>"
-            f'<td class="{verdict_class(str(r.verdict))}">{escape(str(r.verdict))}</td>'
-            f"<td>{escape(req.statement)}</td><td>{escape(r.one_line)}</td><td>{tests}</td></tr>"
+            f'<tr data-verdict="{escape(verdict)}"><td>{escape(req.id)}</td>'
+            f"<td>{escape(req.clause)}</td><td>{escape(req.level)}</td>{_verdict_cell(verdict)}"
+            f"<td>{escape(req.statement)}</td><td>{evidence}</td><td>{tests}</td></tr>"
         )
+    options = "".join(f'<option value="{escape(v)}">{escape(v)}</option>' for v in SEVERITY)
     return (
         "<h2>Requirements</h2>"
-        '<p>Filter: <input id="sdi12-filter" placeholder="ID, verdict, text..."> '
-        "(click a column heading to sort)</p>"
+        '<div class="sdi12-controls">Filter: <input id="sdi12-filter" '
+        'placeholder="ID, clause, text..." size="28"> Verdict: <select id="sdi12-verdict-filter">'
+        f'<option value="">all</option>{options}</select> <span id="sdi12-shown"></span> '
+        "· click a column heading to sort</div>"
         '<table class="sdi12" id="sdi12-requirements"><thead><tr><th>ID</th><th>Clause</th>'
         "<th>Level</th><th>Verdict</th><th>Requirement</th><th>Evidence</th><th>Tests</th>"
         f"</tr></thead><tbody>{''.join(rows)}</tbody></table>"
@@ -122,28 +253,38 @@ def requirements_table(run: ConformanceRun) -> str:
 
 
 def transcript_html(label: str, events: list[Event]) -> str:
+    """The wire log: one line per break, note or run of characters from one side."""
     if not events:
-        return f"<p><b>{escape(label)}</b>: no bus events</p>"
+        return f"<p><b>Wire: {escape(label)}</b>: no bus events</p>"
     t0 = events[0].start
-    lines = []
+    lines = [
+        f'<span class="hdr">t (ms)     marking  dir          characters   '
+        f"(t = 0 is {t0:.4f} s on the link clock)</span>"
+    ]
+    previous_end: float | None = None
     for group in _group(events):
         first = group[0]
-        at = f"{(first.start - t0) * 1e3:9.2f} ms"
+        at = f"{(first.start - t0) * 1e3:9.2f}"
+        idle = "" if previous_end is None else f"{(first.start - previous_end) * 1e3:.2f}"
+        prefix = f"{at} {idle:>10}  "
         if first.kind is EventKind.BREAK:
-            lines.append(f'<span class="brk">{at}  BREAK {first.duration * 1e3:.2f} ms</span>')
+            lines.append(f'<span class="brk">{prefix}BREAK {first.duration * 1e3:.2f} ms</span>')
         elif first.kind is EventKind.NOTE:
-            lines.append(f"{at}  note  {escape(first.text)}")
+            lines.append(f"{prefix}note  {escape(first.text)}")
         else:
             who = "tool" if first.origin == TOOL_ORIGIN else "dut"
-            arrow = "→" if who == "tool" else "←"
+            arrow = "→ sensor  " if who == "tool" else "← sensor  "
             text = wire_escape(bytes(e.char7 for e in group))
             bad = sum(1 for e in group if not e.parity_ok)
-            parity = f"  [{bad} parity error(s)]" if bad else ""
+            parity = f'  <span class="bad">[{bad} parity error(s)]</span>' if bad else ""
             lines.append(
-                f'<span class="{who}">{at}  {arrow} {who:4} {escape(text)}'
-                f"  ({len(group)} chars, ends {(group[-1].end - t0) * 1e3:.2f} ms){parity}</span>"
+                f'<span class="{who}">{prefix}{arrow}{escape(text)}'
+                f"  ({len(group)} chars, ends {(group[-1].end - t0) * 1e3:.2f})</span>{parity}"
             )
-    return f'<p><b>{escape(label)}</b></p><div class="sdi12-wire">' + "\n".join(lines) + "</div>"
+        if first.kind is not EventKind.NOTE:
+            previous_end = group[-1].end
+    wire = "\n".join(lines)
+    return f'<p><b>Wire: {escape(label)}</b></p><div class="sdi12-wire">{wire}</div>'
 
 
 def _group(events: list[Event]) -> list[list[Event]]:
@@ -163,27 +304,57 @@ def _group(events: list[Event]) -> list[list[Event]]:
     return groups
 
 
-def case_html(record: CaseRecord) -> str:
-    parts = [STYLE]
+def is_timing_case(record: CaseRecord) -> bool:
+    """Cases of section 7 / the whole-run timing module, or any case with a measured time."""
+    return any(f.measured_ms is not None for f in record.findings) or any(
+        m in record.nodeid for m in TIMING_MODULES
+    )
+
+
+def _observation(f: Finding) -> str:
+    text = escape(f.detail)
+    if f.measured_ms is not None:
+        u = f" ± {f.uncertainty_ms:.2f}" if f.uncertainty_ms is not None else ""
+        limit = f", limit {f.limit_ms:.2f} ms" if f.limit_ms is not None else ""
+        text += f'<br><span class="num">measured {f.measured_ms:.2f}{u} ms{limit}</span>'
+    if f.evidence:
+        text += f"<br><i>{escape('; '.join(f.evidence))}</i>"
+    if f.decision:
+        text += f" <i>(decision {escape(f.decision)})</i>"
+    return text
+
+
+def case_html(record: CaseRecord, derived: tuple[str, list[Event]] | None = None) -> str:
+    """One case: what it checks, what a conforming DUT does, what happened, and the wire.
+
+    ``derived`` is evidence the report found for a case that attached none (a whole-run
+    timing case): the exchange behind its worst measurement, cut from the run's transcript.
+    """
+    parts = []
     if record.description:
         parts.append(f"<p><b>Case</b>: {escape(record.description)}</p>")
     if record.expectation:
         parts.append(f"<p><b>Expectation</b>: {escape(record.expectation)}</p>")
     rows = "".join(
-        f'<tr><td>{escape(f.requirement)}</td><td class="{verdict_class(str(f.verdict))}">'
-        f"{escape(str(f.verdict))}</td><td>{escape(f.detail)}"
-        + (f"<br><i>{escape('; '.join(f.evidence))}</i>" if f.evidence else "")
-        + (f" <i>(decision {escape(f.decision)})</i>" if f.decision else "")
-        + "</td></tr>"
+        f"<tr><td>{escape(f.requirement)}</td>{_verdict_cell(str(f.verdict))}"
+        f"<td>{_observation(f)}</td></tr>"
         for f in record.findings
     )
     parts.append(
-        '<table class="sdi12"><tr><th>Requirement</th><th>Verdict</th><th>Observation</th></tr>'
-        f"{rows}</table>"
+        '<p><b>Observation</b></p><table class="sdi12"><tr><th>Requirement</th><th>Verdict</th>'
+        f"<th>Finding</th></tr>{rows}</table>"
     )
-    for label, events in record.evidence:
+    evidence = list(record.evidence) or ([derived] if derived else [])
+    timing = is_timing_case(record)
+    for label, events in evidence:
+        if timing:
+            svg = timing_svg(events, title=label)
+            if svg:
+                parts.append(
+                    f'<p><b>Timing: {escape(label)}</b></p><div class="sdi12-diagram">{svg}</div>'
+                )
         parts.append(transcript_html(label, events))
-    return "".join(parts)
+    return f'<div class="sdi12-case">{"".join(parts)}</div>'
 
 
 class HtmlReportPlugin:
@@ -200,8 +371,9 @@ class HtmlReportPlugin:
     ) -> None:
         if self.run.results is None:
             return
-        prefix.extend([STYLE, banner(self.run), header(self.run)])
-        postfix.extend([requirements_table(self.run), SCRIPT])
+        top = banner(self.run) + header(self.run) + attention(self.run)
+        prefix.extend([STYLE, f'<div id="sdi12-top">{top}{requirements_table(self.run)}</div>'])
+        postfix.append(SCRIPT)
 
     def pytest_html_results_table_header(self, cells: list[str]) -> None:
         cells.insert(1, '<th class="sortable" data-column-type="verdict">Verdict</th>')
@@ -213,6 +385,12 @@ class HtmlReportPlugin:
         cells.insert(1, f'<td class="col-verdict {verdict_class(verdict)}">{escape(verdict)}</td>')
         cells.insert(2, f"<td>{escape(reqs)}</td>")
 
+    def _derived(self, record: CaseRecord) -> tuple[str, list[Event]] | None:
+        """For a timing case without evidence, the run's exchange behind its worst finding."""
+        if record.evidence or not is_timing_case(record) or self.run.link is None:
+            return None
+        return exchange_behind(record.findings, self.run.link.transcript.events)
+
     @pytest.hookimpl(wrapper=True)
     def pytest_runtest_makereport(self, item: Any, call: Any):
         report = yield
@@ -222,5 +400,6 @@ class HtmlReportPlugin:
         if record is not None and report.when == "call":
             from pytest_html import extras
 
-            report.extras = [*getattr(report, "extras", []), extras.html(case_html(record))]
+            html = case_html(record, self._derived(record))
+            report.extras = [*getattr(report, "extras", []), extras.html(html)]
         return report

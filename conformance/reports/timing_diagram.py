@@ -1,0 +1,441 @@
+"""Inline SVG timing diagrams of an exchange, for the timing cases of the HTML report.
+
+A certifier reading "response start 16.2 ms, allowed <= 15.40 ms" wants to *see* the exchange:
+the break, the marking after it, the command characters, the reply characters and the window
+the reply had to start in. The diagram is drawn from the case's wire events (the same ones the
+judges read), so it can never disagree with the verdict. Long idle stretches (a ttt wait, the
+150 ms of marking before a probe) are cut out of the time axis and labelled with their length,
+or a 2 s measurement would squeeze every character into a hair line.
+
+The SVG is self-contained (no script, no external reference) and every text that came from the
+DUT goes through :func:`html.escape`: the device is untrusted (design.md 7).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from html import escape
+from itertools import pairwise
+
+from ..judges.wire import Segment, segments
+from ..protocol.timing import (
+    CHAR_TIME,
+    INTER_CHAR_GAP_MAX,
+    NO_BREAK_WINDOW,
+    RESPONSE_START_MAX,
+    RESPONSE_START_MIN,
+    TOLERANCE,
+)
+from ..transcript import TOOL, Event, EventKind
+from ..transcript import escape as escape_wire
+from ..verdicts import Finding
+
+PX_PER_MS = 3.0  # one 8.33 ms character is 25 px: room for its glyph
+ELIDE_OVER = 0.14  # s: idle stretches longer than this are cut out of the axis
+ELIDED_PX = 48
+LEFT = 64  # px for the lane names
+PAD_BEFORE, PAD_AFTER = 0.004, 0.018  # s around each cluster (the window ends 15.4 ms late)
+MAX_EVENTS = 240  # a diagram is for reading one exchange, not a whole run
+GAP_SHOWN = 0.05e-3  # s: character gaps shorter than this are not annotated
+
+# rows (y of the top edge) and lane height
+Y_LEGEND, Y_TOP_LABEL, Y_TOOL, Y_MID_LABEL, Y_DUT, Y_GAP_LABEL, Y_AXIS = (
+    10,
+    30,
+    36,
+    70,
+    78,
+    110,
+    118,
+)
+LANE_H = 18
+HEIGHT = 146
+
+COLOURS = {
+    "tool": "#1565c0",
+    "dut": "#2e7d32",
+    "break": "#b26a00",
+    "window": "#43a047",
+    "bad": "#c62828",
+    "axis": "#555",
+}
+
+
+@dataclass(frozen=True)
+class _Piece:
+    """A stretch of time drawn linearly, starting at pixel ``x``."""
+
+    start: float
+    end: float
+    x: float
+
+    @property
+    def width(self) -> float:
+        return (self.end - self.start) * 1e3 * PX_PER_MS
+
+
+class Axis:
+    """Piecewise-linear time axis: clusters of activity drawn to scale, idle cut out."""
+
+    def __init__(self, events: Sequence[Event]) -> None:
+        self.t0 = events[0].start
+        clusters: list[list[float]] = []
+        for e in events:
+            if clusters and e.start - clusters[-1][1] <= ELIDE_OVER:
+                clusters[-1][1] = max(clusters[-1][1], e.end)
+            else:
+                clusters.append([e.start, e.end])
+        self.pieces: list[_Piece] = []
+        x = float(LEFT)
+        for i, (start, end) in enumerate(clusters):
+            if i:
+                x += ELIDED_PX
+            piece = _Piece(start - PAD_BEFORE, end + PAD_AFTER, x)
+            self.pieces.append(piece)
+            x += piece.width
+        self.width = x + 12
+
+    def x(self, t: float) -> float:
+        """Pixel of time ``t``; times inside a cut-out stretch clamp to its edges."""
+        for p in self.pieces:
+            if t <= p.end:
+                return p.x + max(0.0, t - p.start) * 1e3 * PX_PER_MS
+        last = self.pieces[-1]
+        return last.x + last.width
+
+    def elisions(self) -> list[tuple[float, float]]:
+        """(pixel, seconds cut out) for each cut in the axis."""
+        return [(b.x - ELIDED_PX / 2, b.start - a.end) for a, b in pairwise(self.pieces)]
+
+
+def _glyph(e: Event) -> str:
+    c = e.char7
+    names = {0x0D: "CR", 0x0A: "LF", 0x02: "STX", 0x03: "ETX", 0x20: "␣"}
+    if c in names:
+        return names[c]
+    return chr(c) if 0x21 <= c <= 0x7E else f"{c:02X}"
+
+
+def _text(
+    x: float, y: float, text: str, *, size: int = 10, anchor: str = "middle", **attrs: str
+) -> str:
+    extra = "".join(f' {k.replace("_", "-")}="{escape(v)}"' for k, v in attrs.items())
+    return (
+        f'<text x="{x:.1f}" y="{y:.1f}" font-size="{size}" text-anchor="{anchor}"{extra}>'
+        f"{escape(text)}</text>"
+    )
+
+
+def _ms(seconds: float) -> str:
+    return f"{seconds * 1e3:.2f} ms"
+
+
+LEGEND = (
+    ("tool", "recorder → sensor"),
+    ("dut", "sensor → recorder"),
+    ("break", "break"),
+    ("window", "reply must start in 7.93–15.40 ms"),
+    ("bad", "out of limits"),
+)
+LEGEND_WIDTH = LEFT + sum(24 + 5.3 * len(label) for _, label in LEGEND)
+
+
+def _legend() -> str:
+    out, x = [], float(LEFT)
+    for key, label in LEGEND:
+        opacity = ' fill-opacity="0.25"' if key == "window" else ""
+        out.append(
+            f'<rect x="{x:.0f}" y="{Y_LEGEND - 8}" width="10" height="9" '
+            f'fill="{COLOURS[key]}"{opacity}/>'
+        )
+        out.append(_text(x + 14, Y_LEGEND, label, size=10, anchor="start"))
+        x += 24 + 5.3 * len(label)
+    return "".join(out)
+
+
+def _lanes(axis: Axis) -> str:
+    out = []
+    for y, name in ((Y_TOOL, "recorder"), (Y_DUT, "sensor")):
+        mid = y + LANE_H / 2
+        out.append(_text(4, mid + 4, name, size=11, anchor="start", font_weight="bold"))
+        out.append(
+            f'<line x1="{LEFT}" y1="{y + LANE_H}" x2="{axis.width - 8:.1f}" y2="{y + LANE_H}" '
+            'stroke="#bbb" stroke-width="1"/>'
+        )
+    return "".join(out)
+
+
+def _axis(axis: Axis) -> str:
+    out = [
+        f'<line x1="{LEFT}" y1="{Y_AXIS}" x2="{axis.width - 8:.1f}" y2="{Y_AXIS}" '
+        f'stroke="{COLOURS["axis"]}"/>'
+    ]
+    for p in axis.pieces:
+        first = int((p.start - axis.t0) * 1e3 // 10 + 1) * 10
+        last_label = -1e9
+        for ms in range(first, int((p.end - axis.t0) * 1e3) + 1, 10):
+            x = p.x + ((axis.t0 + ms / 1e3) - p.start) * 1e3 * PX_PER_MS
+            out.append(
+                f'<line x1="{x:.1f}" y1="{Y_AXIS}" x2="{x:.1f}" y2="{Y_AXIS + 4}" '
+                f'stroke="{COLOURS["axis"]}"/>'
+            )
+            if x - last_label >= 44:
+                out.append(_text(x, Y_AXIS + 15, f"{ms} ms", size=9, fill=COLOURS["axis"]))
+                last_label = x
+    for x, cut in axis.elisions():
+        for dx in (-4, 4):
+            out.append(
+                f'<line x1="{x + dx - 3:.1f}" y1="{Y_TOOL - 4}" x2="{x + dx + 3:.1f}" '
+                f'y2="{Y_AXIS + 4}" stroke="#999" stroke-dasharray="3 2"/>'
+            )
+        label = f"{cut:.2f} s" if cut >= 1 else f"{cut * 1e3:.0f} ms"
+        out.append(
+            f'<rect x="{x - 22:.1f}" y="{Y_MID_LABEL - 19}" width="44" height="24" fill="#fff"/>'
+        )
+        out.append(_text(x, Y_MID_LABEL - 9, "idle", size=9, fill="#666"))
+        out.append(_text(x, Y_MID_LABEL + 1, label, size=9, fill="#666"))
+    return "".join(out)
+
+
+def _char(axis: Axis, e: Event) -> str:
+    who = "tool" if e.origin == TOOL else "dut"
+    y = Y_TOOL if who == "tool" else Y_DUT
+    x0, x1 = axis.x(e.start), axis.x(e.end)
+    stroke = COLOURS["bad"] if not e.parity_ok else "#fff"
+    glyph = _glyph(e)
+    tip = f"{who} {glyph!r} {_ms(e.start - axis.t0)} to {_ms(e.end - axis.t0)}"
+    if not e.parity_ok:
+        tip += " (parity error)"
+    return (
+        f'<g><title>{escape(tip)}</title><rect x="{x0:.1f}" y="{y}" '
+        f'width="{max(1.0, x1 - x0):.1f}" '
+        f'height="{LANE_H}" fill="{COLOURS[who]}" stroke="{stroke}" stroke-width="1"/>'
+        + _text((x0 + x1) / 2, y + 13, glyph, size=11 if len(glyph) == 1 else 7, fill="#fff")
+        + "</g>"
+    )
+
+
+def _break(axis: Axis, e: Event, following: Event | None) -> str:
+    x0, x1 = axis.x(e.start), axis.x(e.end)
+    out = [
+        f"<g><title>{escape('break ' + _ms(e.duration))}</title>"
+        f'<rect x="{x0:.1f}" y="{Y_TOOL}" width="{max(1.0, x1 - x0):.1f}" height="{LANE_H}" '
+        f'fill="{COLOURS["break"]}"/></g>',
+        _text(
+            x0,
+            Y_TOP_LABEL,
+            f"break {_ms(e.duration)}",
+            size=10,
+            anchor="start",
+            fill=COLOURS["break"],
+        ),
+    ]
+    if following is not None and following.start - e.end <= ELIDE_OVER:
+        fx = axis.x(following.start)
+        marking = following.start - e.end
+        out.append(
+            f'<path d="M{x1:.1f},{Y_TOOL + LANE_H + 4} v4 H{fx:.1f} v-4" fill="none" '
+            f'stroke="{COLOURS["break"]}"/>'
+        )
+        out.append(
+            _text(
+                (x1 + fx) / 2,
+                Y_MID_LABEL + 2,
+                f"marking {_ms(marking)}",
+                size=9,
+                fill=COLOURS["break"],
+            )
+        )
+    return "".join(out)
+
+
+def _window(axis: Axis, command_end: float, reply: Event | None) -> str:
+    """The response-start window after a command (R-7.0-09/10) and where the reply began."""
+    lo = command_end + RESPONSE_START_MIN
+    hi = command_end + RESPONSE_START_MAX + TOLERANCE
+    x0, x1 = axis.x(lo), axis.x(hi)
+    out = [
+        f"<g><title>reply start window {_ms(RESPONSE_START_MIN)} to "
+        f"{_ms(RESPONSE_START_MAX + TOLERANCE)} after the command</title>"
+        f'<rect x="{x0:.1f}" y="{Y_DUT - 4}" width="{x1 - x0:.1f}" height="{LANE_H + 8}" '
+        f'fill="{COLOURS["window"]}" fill-opacity="0.22" stroke="{COLOURS["window"]}" '
+        'stroke-dasharray="2 2"/></g>'
+    ]
+    if reply is not None:
+        delay = reply.start - command_end
+        ok = RESPONSE_START_MIN - 1e-9 <= delay <= RESPONSE_START_MAX + TOLERANCE + 1e-9
+        colour = COLOURS["dut"] if ok else COLOURS["bad"]
+        rx = axis.x(reply.start)
+        out.append(
+            f'<line x1="{rx:.1f}" y1="{Y_MID_LABEL - 6}" x2="{rx:.1f}" y2="{Y_DUT + LANE_H}" '
+            f'stroke="{colour}" stroke-width="1.5"/>'
+        )
+        out.append(
+            _text(
+                rx + 3, Y_MID_LABEL - 2, f"reply +{_ms(delay)}", size=9, anchor="start", fill=colour
+            )
+        )
+    return "".join(out)
+
+
+def _gap(axis: Axis, a: Event, b: Event) -> str:
+    gap = b.start - a.end
+    colour = COLOURS["bad"] if gap > INTER_CHAR_GAP_MAX + 1e-9 else COLOURS["axis"]
+    x0, x1 = axis.x(a.end), axis.x(b.start)
+    return (
+        f'<path d="M{x0:.1f},{Y_DUT + LANE_H + 2} v4 H{x1:.1f} v-4" fill="none" '
+        f'stroke="{colour}"/>'
+        + _text((x0 + x1) / 2, Y_GAP_LABEL, f"gap {_ms(gap)}", size=9, fill=colour)
+    )
+
+
+def _marking_before_commands(axis: Axis, events: Sequence[Event]) -> str:
+    """Marking the line carried before each command that no break preceded (the 87 ms and
+    100 ms rules turn on it), drawn above the recorder lane."""
+    out = []
+    for previous, e in pairwise(events):
+        starts_command = e.kind is EventKind.CHAR and e.origin == TOOL
+        if not starts_command or previous.kind is EventKind.BREAK:
+            continue
+        if previous.origin == TOOL and previous.kind is EventKind.CHAR and previous.char7 != 0x21:
+            continue  # inside a command (a gap between its characters is drawn as is)
+        idle = e.start - previous.end
+        if not 2 * CHAR_TIME <= idle <= ELIDE_OVER:
+            continue
+        x0, x1 = axis.x(previous.end), axis.x(e.start)
+        out.append(
+            f'<path d="M{x0:.1f},{Y_TOOL - 2} v-4 H{x1:.1f} v4" fill="none" '
+            f'stroke="{COLOURS["axis"]}"/>'
+        )
+        out.append(_text((x0 + x1) / 2, Y_TOP_LABEL - 3, f"marking {_ms(idle)}", size=9))
+    return "".join(out)
+
+
+def _exchanges(events: Sequence[Event]) -> list[tuple[float, Event | None]]:
+    """(command end, first reply character or None) for each command ending in ``!``."""
+    found = []
+    for i, e in enumerate(events):
+        if not (e.kind is EventKind.CHAR and e.origin == TOOL and e.char7 == ord("!")):
+            continue
+        reply = None
+        for f in events[i + 1 :]:
+            if f.origin == TOOL and f.kind is not EventKind.NOTE:
+                break
+            if f.kind is EventKind.CHAR and f.start - e.end <= NO_BREAK_WINDOW:
+                reply = f
+                break
+        found.append((e.end, reply))
+    return found
+
+
+def _widest_gaps(events: Sequence[Event]) -> list[tuple[Event, Event]]:
+    """Per run of sensor characters, its widest inter-character gap (if worth showing)."""
+    runs: list[list[Event]] = []
+    previous: Event | None = None
+    for e in events:
+        if e.kind is not EventKind.CHAR or e.origin == TOOL:
+            previous = None  # the recorder spoke: the next sensor character starts a new run
+            continue
+        if previous is not None and e.start - previous.end <= 2 * CHAR_TIME:
+            runs[-1].append(e)
+        else:
+            runs.append([e])
+        previous = e
+    out = []
+    for run in runs:
+        if len(run) < 2:
+            continue
+        a, b = max(pairwise(run), key=lambda p: p[1].start - p[0].end)
+        if b.start - a.end >= GAP_SHOWN:
+            out.append((a, b))
+    return out
+
+
+def timing_svg(events: Iterable[Event], title: str = "") -> str:
+    """An inline SVG of ``events`` (breaks and characters; notes are skipped), or "" if none."""
+    drawn = [e for e in events if e.kind is not EventKind.NOTE]
+    drawn.sort(key=lambda e: e.start)
+    if not drawn:
+        return ""
+    note = ""
+    if len(drawn) > MAX_EVENTS:
+        note = f"first {MAX_EVENTS} of {len(drawn)} bus events drawn"
+        drawn = drawn[:MAX_EVENTS]
+    axis = Axis(drawn)
+    parts = [_legend(), _lanes(axis)]
+    for end, reply in _exchanges(drawn):
+        parts.append(_window(axis, end, reply))
+    for i, e in enumerate(drawn):
+        if e.kind is EventKind.BREAK:
+            following = next(
+                (f for f in drawn[i + 1 :] if f.kind is EventKind.CHAR and f.origin == TOOL), None
+            )
+            parts.append(_break(axis, e, following))
+        else:
+            parts.append(_char(axis, e))
+    parts.append(_marking_before_commands(axis, drawn))
+    for a, b in _widest_gaps(drawn):
+        parts.append(_gap(axis, a, b))
+    parts.append(_axis(axis))
+    if note:
+        parts.append(_text(axis.width - 10, HEIGHT - 2, note, size=9, anchor="end", fill="#666"))
+    label = escape(title or "timing diagram")
+    width = max(axis.width, LEGEND_WIDTH)
+    return (
+        f'<svg class="sdi12-timing" xmlns="http://www.w3.org/2000/svg" role="img" '
+        f'aria-label="{label}" width="{width:.0f}" height="{HEIGHT}" '
+        f'viewBox="0 0 {width:.0f} {HEIGHT}" font-family="sans-serif">'
+        f"<title>{label}</title>{''.join(parts)}</svg>"
+    )
+
+
+def _measures(seg: Segment) -> list[float]:
+    """Every interval a timing judge could have measured in one segment, in ms."""
+    out = []
+    if seg.reply:
+        out.append((seg.reply[0].start - seg.command_end) * 1e3)
+    for run in (seg.reply, seg.later):
+        for a, b in pairwise(run):
+            out += [(b.start - a.end) * 1e3, (b.start - a.start) * 1e3]
+    return out
+
+
+_last_cut: tuple[Sequence[Event], int, list[Segment]] | None = None
+
+
+def _cut(events: Sequence[Event]) -> list[Segment]:
+    """:func:`segments` of the run's transcript, cut once for the several whole-run cases."""
+    global _last_cut
+    if _last_cut is None or _last_cut[0] is not events or _last_cut[1] != len(events):
+        _last_cut = (events, len(events), segments(events))
+    return _last_cut[2]
+
+
+def exchange_behind(
+    findings: Sequence[Finding], events: Sequence[Event]
+) -> tuple[str, list[Event]] | None:
+    """The exchange of the run behind a whole-run case's worst timing finding.
+
+    Whole-run cases judge every reply of the transcript and attach no evidence; their finding
+    keeps the worst measured value. The segment holding an interval equal to that value (the
+    first, if several do) is the one a reader needs to see drawn.
+    """
+    timed = [f for f in findings if f.measured_ms is not None]
+    if not timed or not events:
+        return None
+    target = max(timed, key=lambda f: f.verdict.rank)
+    best, distance = None, float("inf")
+    for seg in _cut(events):
+        for m in _measures(seg):
+            if abs(m - target.measured_ms) < distance:
+                best, distance = seg, abs(m - target.measured_ms)
+    if best is None:
+        return None
+    drawn = [best.break_event] if best.break_event else []
+    drawn += best.command + best.reply + best.later[:80]
+    label = (
+        f"the exchange behind {target.requirement}'s {target.verdict} "
+        f"({target.measured_ms:.2f} ms): {escape_wire(best.text)}"
+    )
+    return label, sorted(drawn, key=lambda e: e.start)
