@@ -25,6 +25,7 @@ def hostile_run() -> ConformanceRun:
         version="14",
         address="0",
         assumptions=[HOSTILE[1]],
+        address_notes=[HOSTILE[0]],
         uncertainty=0.0,
     )
     run.finish(complete=True)

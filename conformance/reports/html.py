@@ -156,6 +156,14 @@ def _kv_table(title: str, rows: list[tuple[str, object]], table_id: str) -> str:
     return f"<div><h3>{escape(title)}</h3>{table}</div>"
 
 
+def _counted(notes: list[str]) -> str:
+    """Repeated notes once each, with their count (three restores read as one line)."""
+    seen: dict[str, int] = {}
+    for note in notes:
+        seen[note] = seen.get(note, 0) + 1
+    return "; ".join(n if k == 1 else f"{n} (×{k})" for n, k in seen.items())
+
+
 def header(run: ConformanceRun) -> str:
     """The DUT identity and the run's identity, side by side."""
     dut = dut_block(run)
@@ -173,6 +181,7 @@ def header(run: ConformanceRun) -> str:
         ("Serial / optional field", dut["serial"] or "—"),
         ("Declaration", dut["declaration"] or "none (features discovered)"),
         ("Assumptions", "; ".join(dut["assumptions"]) or "none"),
+        ("Address changes", _counted(dut.get("address_notes") or []) or "none made"),
     ]
     runrows = [
         ("Tool", f"{TOOL['name']} {TOOL['version']}"),
