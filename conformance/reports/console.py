@@ -1,16 +1,23 @@
-"""The console side of a run: live progress while cases run, then a summary from verdicts.json.
+"""The console side of a run: progress while cases run, then a summary from verdicts.json.
 
-Uses rich on a terminal and plain lines otherwise (CI logs, pipes).
+On a terminal a live progress bar shows the case being judged and the tally so far, and each
+case that fails or stays inconclusive is printed above the bar as it happens (a bus run takes
+minutes; nobody should wait for the end to learn the first FAIL). Elsewhere (CI logs, pipes)
+every case gets one plain line, since a log has no cursor to move and is read with grep.
+The summary then gives the verdict, the counts, every FAIL, ERROR, INCONCLUSIVE and WARN with
+a one-line reason, and where the report is.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import pytest
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
+from rich.text import Text
 
 STYLE = {
     "PASS": "green",
@@ -23,10 +30,26 @@ STYLE = {
     "NON-COMPLIANT": "bold white on red",
     "INCOMPLETE": "bold black on yellow",
 }
+SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
+NOTEWORTHY = SEVERITY[:4]  # verdicts a reader must see with their reason
+REASON_WIDTH = 160  # characters of a reason on a plain line
+
+
+def one_line(text: str, width: int = REASON_WIDTH) -> str:
+    """``text`` on one line, cut with an ellipsis: a summary line, not the evidence."""
+    flat = " ".join(text.split())
+    return flat if len(flat) <= width else flat[: width - 3] + "..."
+
+
+def _case_outcome(record: Any) -> tuple[str, str]:
+    """(verdict, reason) of a finished case record: the reason is its worst finding."""
+    verdict = str(record.verdict)
+    worst = next((f for f in record.findings if str(f.verdict) == verdict), None)
+    return verdict, f"{worst.requirement}: {worst.detail}" if worst else ""
 
 
 class ProgressPlugin:
-    """pytest plugin showing which case runs (a bus run can take minutes)."""
+    """pytest plugin reporting each case as it finishes (a bus run can take minutes)."""
 
     def __init__(self, console: Console) -> None:
         self.console = console
@@ -34,6 +57,8 @@ class ProgressPlugin:
         self.task: Any = None
         self.done = 0
         self.total = 0
+        self.tally: dict[str, int] = {}
+        self.outcomes: dict[str, tuple[str, str]] = {}
 
     def pytest_collection_finish(self, session: pytest.Session) -> None:
         self.total = len(session.items)
@@ -43,14 +68,29 @@ class ProgressPlugin:
                 BarColumn(),
                 MofNCompleteColumn(),
                 TimeElapsedColumn(),
-                TextColumn("{task.description}"),
+                TextColumn("{task.fields[tally]}"),
+                TextColumn("[dim]{task.description}"),
                 console=self.console,
                 transient=True,
             )
             self.progress.start()
-            self.task = self.progress.add_task("", total=self.total)
+            self.task = self.progress.add_task("", total=self.total, tally="")
         else:
-            self.console.print(f"running {self.total} conformance cases")
+            self.console.print(f"running {self.total} conformance cases", highlight=False)
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_makereport(self, item: pytest.Item, call: pytest.CallInfo) -> Any:
+        report = yield
+        from ..plugin import CASE
+
+        record = item.stash.get(CASE, None)
+        if report.when == "call" and record is not None:
+            self.outcomes[item.nodeid] = _case_outcome(record)
+        elif report.when == "setup" and not report.passed and item.nodeid not in self.outcomes:
+            # never reached its body: a skipped fixture (wrong role) or a setup error
+            verdict = "N/A" if report.skipped else "ERROR"
+            self.outcomes[item.nodeid] = (verdict, one_line(_short_repr(report)))
+        return report
 
     def pytest_runtest_logstart(self, nodeid: str, location: Any) -> None:
         if self.progress is not None:
@@ -58,58 +98,156 @@ class ProgressPlugin:
 
     def pytest_runtest_logfinish(self, nodeid: str, location: Any) -> None:
         self.done += 1
+        verdict, reason = self.outcomes.get(nodeid, ("", ""))
+        if verdict:
+            self.tally[verdict] = self.tally.get(verdict, 0) + 1
+        name = nodeid.split("::")[-1]
         if self.progress is not None:
-            self.progress.update(self.task, completed=self.done)
+            if verdict in NOTEWORTHY:
+                line = Text.assemble(
+                    (f"{verdict:<12}", STYLE[verdict]), f" {name}  ", (one_line(reason, 200), "")
+                )
+                self.progress.console.print(line, overflow="ellipsis", no_wrap=True)
+            self.progress.update(self.task, completed=self.done, tally=self._tally_text())
+        else:
+            tail = f"  {one_line(reason)}" if verdict in NOTEWORTHY else ""
+            width = len(str(self.total))
+            self.console.print(
+                f"[{self.done:>{width}}/{self.total}] {verdict or '?':<12} {name}{tail}",
+                markup=False,
+                highlight=False,
+                soft_wrap=True,
+            )
+
+    def _tally_text(self) -> str:
+        parts = [f"[{STYLE[v]}]{self.tally[v]} {v}[/]" for v in NOTEWORTHY if self.tally.get(v)]
+        return " ".join(parts)
 
     def pytest_sessionfinish(self, session: pytest.Session) -> None:
         if self.progress is not None:
             self.progress.stop()
 
 
+def _short_repr(report: Any) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple):  # a skip: (path, line, "Skipped: reason")
+        return str(longrepr[2]).removeprefix("Skipped: ")
+    lines = str(getattr(report, "longreprtext", "") or longrepr or "").strip().splitlines()
+    return lines[-1] if lines else "setup failed"
+
+
+def _reason(requirement: dict[str, Any]) -> str:
+    """The finding that set the requirement's verdict (first of them), plus how many more."""
+    same = [f for f in requirement["findings"] if f["verdict"] == requirement["verdict"]]
+    if not same:
+        return ""
+    more = f" (+{len(same) - 1} more findings)" if len(same) > 1 else ""
+    return same[0]["detail"] + more
+
+
+def noteworthy(data: dict[str, Any]) -> list[dict[str, Any]]:
+    """Requirements a reader must look at, worst first."""
+    found = [r for r in data["requirements"] if r["verdict"] in NOTEWORTHY]
+    return sorted(found, key=lambda r: SEVERITY.index(r["verdict"]))
+
+
 def print_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
+    """Verdict, counts, every FAIL/ERROR/INCONCLUSIVE/WARN with its reason, report path."""
+    if console.is_terminal:
+        _rich_summary(console, data, report_dir)
+    else:
+        _plain_summary(console, data, report_dir)
+
+
+def _identity_lines(data: dict[str, Any]) -> list[str]:
+    dut, run = data["dut"], data["run"]
+    ident = (dut.get("identification") or "(no identification)").strip()
+    link = run["link"]
+    uncertainty = link.get("timing_uncertainty_ms")
+    u = f", timing ±{uncertainty} ms" if uncertainty is not None else ""
+    return [
+        f"DUT {dut.get('address')!s} · SDI-12 {dut.get('sdi12_version')} · {ident!r}",
+        f"role {run['role']} · port {run['port']} · link {link['kind']}{u}",
+    ]
+
+
+def _counts_line(data: dict[str, Any]) -> str:
+    counts = data["summary"]["counts"]
+    judged = sum(1 for r in data["requirements"] if r["testable"])
+    untestable = len(data["requirements"]) - judged
+    tally = ", ".join(f"{counts[v]} {v}" for v in SEVERITY if counts.get(v))
+    return (
+        f"{tally}; {judged} testable requirements judged, {untestable} untestable here "
+        "(electrical, inspection or the other role)"
+    )
+
+
+def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
+    def say(text: str) -> None:
+        console.print(text, markup=False, highlight=False, soft_wrap=True)
+
+    say("")
+    for line in _identity_lines(data):
+        say(line)
+    say(_counts_line(data))
+    for r in noteworthy(data):
+        say(f"{r['verdict']:<12} {r['id']}: {one_line(_reason(r))}")
+    if data["run"].get("stop_reason"):
+        say(f"stopped: {data['run']['stop_reason']}")
+    say(f"verdict: {data['summary']['verdict']}")
+    _paths(say, report_dir)
+
+
+def _paths(say: Any, report_dir: str) -> None:
+    directory = Path(report_dir)
+    say(f"report: {directory / 'report.html'}")
+    say(f"        {directory / 'verdicts.json'}, junit.xml, transcript.jsonl beside it")
+
+
+def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
     summary = data["summary"]
     verdict = summary["verdict"]
-    dut = data["dut"]
-    reqs = data["requirements"]
-    judged = [r for r in reqs if r["testable"]]
     console.print()
-    ident = dut.get("identification") or "(no identification)"
-    console.print(
-        f"DUT {dut.get('address')!s} · SDI-12 {dut.get('sdi12_version')} · {ident.strip()!r}",
-        markup=False,
-        highlight=False,
-    )
-    console.print(
-        f"role {data['run']['role']} · port {data['run']['port']} · "
-        f"link {data['run']['link']['kind']}",
-        markup=False,
-        highlight=False,
-    )
+    for line in _identity_lines(data):
+        console.print(line, markup=False, highlight=False)
     table = Table(title="Requirements", show_edge=False)
-    for name in summary["counts"]:
+    for name in SEVERITY:
         table.add_column(name, justify="right", style=STYLE.get(name, ""))
-    table.add_row(*(str(n) for n in summary["counts"].values()))
+    table.add_row(*(str(summary["counts"].get(name, 0)) for name in SEVERITY))
     console.print(table)
-    untestable = len(reqs) - len(judged)
+    judged = sum(1 for r in data["requirements"] if r["testable"])
     console.print(
-        f"{len(judged)} testable requirements judged, {untestable} untestable here "
-        f"(electrical, inspection or the other role)",
+        f"{judged} testable requirements judged, {len(data['requirements']) - judged} "
+        "untestable here (electrical, inspection or the other role)",
         highlight=False,
     )
-    bad = [r for r in reqs if r["verdict"] in ("FAIL", "ERROR", "INCONCLUSIVE", "WARN")]
-    if bad:
-        lines = Table(show_header=True, show_edge=False, title="Findings to read")
-        lines.add_column("verdict")
-        lines.add_column("requirement")
-        lines.add_column("reason", overflow="fold")
-        for r in sorted(
-            bad, key=lambda r: ("ERROR", "FAIL", "INCONCLUSIVE", "WARN").index(r["verdict"])
-        ):
-            reason = next((f["detail"] for f in r["findings"] if f["verdict"] == r["verdict"]), "")
+    rows = noteworthy(data)
+    if rows:
+        lines = Table(show_header=True, show_edge=False, title="Read first")
+        lines.add_column("verdict", no_wrap=True, min_width=12)
+        lines.add_column("requirement", no_wrap=True, min_width=len("R-4.4.13.1-03"))
+        lines.add_column(
+            "reason (one line; the report has the evidence)",
+            no_wrap=True,
+            overflow="ellipsis",
+            ratio=1,
+        )
+        room = max(30, console.width - 36)  # what the two narrow columns and borders leave
+        for r in rows:
             lines.add_row(
-                f"[{STYLE[r['verdict']]}]{r['verdict']}[/]", r["id"], reason.replace("[", "\\[")
+                Text(r["verdict"], style=STYLE[r["verdict"]]),
+                r["id"],
+                Text(one_line(_reason(r), room)),
             )
         console.print(lines)
     if data["run"].get("stop_reason"):
         console.print(f"stopped: {data['run']['stop_reason']}", markup=False)
-    console.print(f"[{STYLE.get(verdict, '')}] {verdict} [/]  report: {report_dir}/report.html")
+    console.print(
+        Text.assemble((f" {verdict} ", STYLE.get(verdict, "")), "  ", _counts_short(summary))
+    )
+    _paths(lambda text: console.print(text, markup=False, highlight=False), report_dir)
+
+
+def _counts_short(summary: dict[str, Any]) -> str:
+    counts = summary["counts"]
+    return ", ".join(f"{counts[v]} {v}" for v in SEVERITY if counts.get(v))
