@@ -52,7 +52,12 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
 #sdi12-requirements thead th::after{content:" ⇅";color:#aaa}
 #sdi12-requirements thead th.asc::after{content:" ▲";color:#333}
 #sdi12-requirements thead th.desc::after{content:" ▼";color:#333}
-#sdi12-requirements td:nth-child(5){max-width:420px}
+#sdi12-requirements th{white-space:nowrap}
+#sdi12-requirements td:nth-child(5){min-width:260px;max-width:420px}
+#sdi12-requirements td:nth-child(6){min-width:260px}
+#sdi12-requirements td:nth-child(7){max-width:260px;font-size:12px}
+.sdi12-legend{font:12px sans-serif;color:#555;margin:2px 0 6px}
+.sdi12-attention .tests{color:#555;font-size:12px}
 .sdi12-controls{font:13px sans-serif;margin:6px 0}
 .sdi12-controls input,.sdi12-controls select{font:13px sans-serif;padding:2px 4px}
 .v-PASS{color:#2e7d32;font-weight:bold}.v-FAIL{color:#c62828;font-weight:bold}
@@ -224,10 +229,13 @@ def attention(run: ConformanceRun) -> str:
         verdict = str(r.verdict)
         reasons = [f.detail for f in r.findings if f.verdict is r.verdict]
         more = f" (+{len(reasons) - 1} more)" if len(reasons) > 1 else ""
+        tests = ", ".join(t.split("::")[-1] for t in r.tests)
         items.append(
             f'<li><span class="{verdict_class(verdict)}">{escape(verdict)}</span> '
             f"<b>{escape(r.requirement.id)}</b> ({escape(r.requirement.level)}): "
-            f"{escape(reasons[0] if reasons else '')}{escape(more)}</li>"
+            f"{escape(reasons[0] if reasons else '')}{escape(more)}"
+            + (f' <span class="tests">[{escape(tests)}]</span>' if tests else "")
+            + "</li>"
         )
     return (
         f'<div id="sdi12-attention"><h3>Read first ({len(bad)})</h3>'
@@ -255,6 +263,9 @@ def requirements_table(run: ConformanceRun) -> str:
         'placeholder="ID, clause, text..." size="28"> Verdict: <select id="sdi12-verdict-filter">'
         f'<option value="">all</option>{options}</select> <span id="sdi12-shown"></span> '
         "· click a column heading to sort</div>"
+        '<p class="sdi12-legend">PASS: met · FAIL: a MUST broken · WARN: a SHOULD broken or an '
+        "ambiguity decided leniently · INCONCLUSIVE: could not be decided (see why) · N/A: not "
+        "applicable to this DUT, or not testable by this tool · ERROR: the tool failed</p>"
         '<table class="sdi12" id="sdi12-requirements"><thead><tr><th>ID</th><th>Clause</th>'
         "<th>Level</th><th>Verdict</th><th>Requirement</th><th>Evidence</th><th>Tests</th>"
         f"</tr></thead><tbody>{''.join(rows)}</tbody></table>"

@@ -435,7 +435,8 @@ def exchange_behind(
     drawn = [best.break_event] if best.break_event else []
     drawn += best.command + best.reply + best.later[:80]
     label = (
-        f"the exchange behind {target.requirement}'s {target.verdict} "
-        f"({target.measured_ms:.2f} ms): {escape_wire(best.text)}"
+        f"{escape_wire(best.text)}, the exchange behind {target.requirement}'s "
+        f"{target.measured_ms:.2f} ms ({target.verdict}; the run's other replies are in "
+        "transcript.jsonl)"
     )
     return label, sorted(drawn, key=lambda e: e.start)

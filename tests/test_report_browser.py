@@ -1,0 +1,157 @@
+"""report.html as a certifier sees it: rendered by headless Chromium, not read as text.
+
+A clean and a faulty run are rendered at a laptop's viewport. The page must load without a
+console error or exception, show the overall verdict without scrolling, show the requirements
+table with every requirement, and let the table be filtered and sorted. Screenshots go to
+``reports/screenshots/`` (git ignores it) for a person to look at.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from report_browser import SCREENSHOTS, Chromium, require_chromium
+
+RUNS = {"clean": ("sim", 0), "faulty": ("sim://?faults=no-service-request", 1)}
+VIEWPORT = (1280, 720)
+
+STATE = """(function(){
+  function box(e){ if(!e) return null; var r=e.getBoundingClientRect(), s=getComputedStyle(e);
+    return {top:r.top, bottom:r.bottom, width:r.width, height:r.height,
+            shown: s.display!=='none' && s.visibility!=='hidden' && r.width>0 && r.height>0}; }
+  var banner=document.getElementById('sdi12-verdict');
+  var table=document.getElementById('sdi12-requirements');
+  return {viewport: innerHeight, banner: box(banner),
+          bannerText: banner ? banner.textContent : '',
+          table: box(table), rows: table ? table.tBodies[0].rows.length : 0,
+          header: (document.getElementById('sdi12-header')||{}).textContent || '',
+          cases: document.querySelectorAll('#results-table tbody.results-table-row').length};
+})()"""
+
+VISIBLE_ROWS = """[...document.querySelectorAll('#sdi12-requirements tbody tr')]
+  .filter(r => r.style.display !== 'none')
+  .map(r => ({id: r.cells[0].textContent, verdict: r.cells[3].textContent}))"""
+
+
+def _run(port: str, out: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "conformance.cli", "--port", port, "--report-dir", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
+@pytest.fixture(scope="module")
+def reports(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    require_chromium()
+    out = {}
+    for name, (port, exit_code) in RUNS.items():
+        directory = tmp_path_factory.mktemp(name)
+        proc = _run(port, directory)
+        assert proc.returncode == exit_code, proc.stdout + proc.stderr
+        out[name] = directory
+    return out
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Chromium]:
+    require_chromium()
+    with Chromium(*VIEWPORT) as chromium:
+        yield chromium
+
+
+@pytest.mark.parametrize("name", sorted(RUNS))
+def test_report_renders_with_the_verdict_above_the_fold(reports, browser, name):
+    directory = reports[name]
+    data = json.loads((directory / "verdicts.json").read_text(encoding="utf-8"))
+    browser.open(directory / "report.html")
+    state = browser.evaluate(STATE)
+    shot = browser.screenshot(SCREENSHOTS / f"report-{name}.png")
+
+    assert browser.log.problems == [], browser.log.problems
+    assert state["banner"]["shown"], state
+    # first thing under the title (pytest-html's environment table must not push it down)
+    assert 0 <= state["banner"]["top"] < 0.2 * state["viewport"], state["banner"]
+    assert state["banner"]["bottom"] <= state["viewport"], state["banner"]
+    assert state["bannerText"].startswith(data["summary"]["verdict"]), state["bannerText"]
+    assert data["dut"]["identification"].strip() in state["header"]
+    assert f"sdi12-conform {data['tool']['version']}" in state["header"]
+    assert state["table"]["shown"]
+    assert state["rows"] == len(data["requirements"])
+    assert state["cases"] == len(data["tests"])
+    assert shot.stat().st_size > 10_000
+
+
+def test_requirements_table_filters_and_sorts(reports, browser):
+    directory = reports["faulty"]
+    data = json.loads((directory / "verdicts.json").read_text(encoding="utf-8"))
+    browser.open(directory / "report.html")
+
+    browser.evaluate(
+        "(function(){var v=document.getElementById('sdi12-verdict-filter'); v.value='FAIL';"
+        " v.dispatchEvent(new Event('change'));})()"
+    )
+    failing = browser.evaluate(VISIBLE_ROWS)
+    assert [r["id"] for r in failing] == [
+        r["id"] for r in data["requirements"] if r["verdict"] == "FAIL"
+    ]
+    assert "1 of" in browser.evaluate("document.getElementById('sdi12-shown').textContent")
+
+    browser.evaluate(
+        "(function(){var v=document.getElementById('sdi12-verdict-filter'); v.value='';"
+        " v.dispatchEvent(new Event('change'));"
+        " var f=document.getElementById('sdi12-filter'); f.value='r-7.0-1';"
+        " f.dispatchEvent(new Event('input'));})()"
+    )
+    matching = browser.evaluate(VISIBLE_ROWS)
+    assert matching and all(r["id"].startswith("R-7.0-1") for r in matching), matching
+
+    browser.evaluate(
+        "(function(){var f=document.getElementById('sdi12-filter'); f.value='';"
+        " f.dispatchEvent(new Event('input'));"
+        " document.querySelectorAll('#sdi12-requirements thead th')[3].click();})()"
+    )
+    by_verdict = [r["verdict"] for r in browser.evaluate(VISIBLE_ROWS)]
+    severity = ["ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A"]
+    assert by_verdict == sorted(by_verdict, key=severity.index), "verdict sort is by severity"
+    assert by_verdict[0] == "FAIL"
+
+    browser.evaluate("document.querySelectorAll('#sdi12-requirements thead th')[0].click()")
+    browser.evaluate("document.querySelectorAll('#sdi12-requirements thead th')[0].click()")
+    ids = [r["id"] for r in browser.evaluate(VISIBLE_ROWS)]
+    assert ids[0] > ids[-1], "a second click sorts descending"
+
+    browser.evaluate("document.querySelector('[data-sdi12-show=\"N/A\"]').click()")
+    shown = browser.evaluate(VISIBLE_ROWS)
+    assert shown and {r["verdict"] for r in shown} == {"N/A"}
+    assert browser.log.problems == []
+
+
+def test_timing_case_shows_its_diagram(reports, browser):
+    """A whole-run timing case attaches no evidence; the report draws the exchange behind
+    its worst measurement, and the SVG renders."""
+    browser.open(reports["faulty"] / "report.html")
+    tbody = (
+        "[...document.querySelectorAll('#results-table tbody')]"
+        ".find(t => t.id.endsWith('::test_response_start_window'))"
+    )
+    browser.evaluate(
+        f"(function(){{var t={tbody}; if (t.querySelector('.extras-row.hidden'))"
+        " t.querySelector('.collapsible td').click();})()"
+    )
+    svg = browser.evaluate(
+        f"(function(){{var s=({tbody}).querySelector('svg.sdi12-timing');"
+        " if(!s) return null; var r=s.getBoundingClientRect();"
+        " return {w:r.width, h:r.height, text:s.textContent};})()"
+    )
+    browser.screenshot(SCREENSHOTS / "timing-case.png", element=tbody)
+    assert svg is not None, "no timing diagram in the expanded case"
+    assert svg["w"] > 300 and svg["h"] > 100
+    assert "reply +" in svg["text"] and "break" in svg["text"]
+    assert browser.log.problems == []
