@@ -1,0 +1,90 @@
+"""The console as a user sees it: plain lines in a CI log, a live display on a terminal.
+
+Both runs go through the real command line in-process, with the console pointed at a buffer
+that either is or is not a terminal.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import re
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+
+from conformance import cli
+from conformance.reports.console import REASON_WIDTH, one_line
+
+FAULTY = "sim://?faults=no-service-request"
+ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+
+
+def run_cli(monkeypatch, tmp_path: Path, port: str, *, terminal: bool) -> tuple[int, str, dict]:
+    buffer = io.StringIO()
+    console = Console(file=buffer, force_terminal=terminal, width=100, color_system="standard")
+    monkeypatch.setattr(cli, "Console", lambda **_: console)
+    code = cli.main(["--port", port, "--report-dir", str(tmp_path)])
+    data = json.loads((tmp_path / "verdicts.json").read_text(encoding="utf-8"))
+    return code, buffer.getvalue(), data
+
+
+def test_plain_output_has_one_line_per_case_and_every_finding_to_read(monkeypatch, tmp_path):
+    code, out, data = run_cli(monkeypatch, tmp_path, FAULTY, terminal=False)
+    assert code == cli.EXIT_NON_COMPLIANT
+    assert "\x1b" not in out, "no escape codes in a log"
+    lines = out.splitlines()
+    total = len(data["tests"])
+    assert lines[0] == f"running {total} conformance cases"
+    progress = [line for line in lines if re.match(rf"\[\s*\d+/{total}\] ", line)]
+    assert len(progress) == total
+    assert any(
+        re.match(r"\[\s*\d+/\d+\] FAIL\s+test_service_request  R-4\.4\.6-02: 0M!", line)
+        for line in progress
+    ), progress
+    assert all(len(line) <= REASON_WIDTH + 60 for line in lines), "reasons stay on one line"
+    for r in data["requirements"]:
+        if r["verdict"] in ("FAIL", "INCONCLUSIVE", "WARN", "ERROR"):
+            assert any(line.startswith(f"{r['verdict']:<12} {r['id']}: ") for line in lines), r
+    assert "verdict: NON-COMPLIANT" in lines
+    assert f"report: {tmp_path / 'report.html'}" in lines
+
+
+def test_plain_output_of_a_clean_run_lists_nothing_to_read(monkeypatch, tmp_path):
+    code, out, data = run_cli(monkeypatch, tmp_path, "sim", terminal=False)
+    assert code == cli.EXIT_COMPLIANT
+    assert not re.search(r"^(FAIL|ERROR|INCONCLUSIVE|WARN) ", out, re.MULTILINE)
+    assert "106 testable requirements judged" in out
+    assert out.rstrip().splitlines()[-3] == "verdict: COMPLIANT"
+
+
+def test_terminal_shows_progress_failures_live_and_a_summary_table(monkeypatch, tmp_path):
+    code, out, data = run_cli(monkeypatch, tmp_path, FAULTY, terminal=True)
+    assert code == cli.EXIT_NON_COMPLIANT
+    assert "judging" in out, "the progress bar was drawn"
+    text = ANSI.sub("", out).replace("\r", "\n")
+    lines = text.splitlines()
+    assert any(line.startswith("FAIL         test_service_request  R-4.4.6-02") for line in lines)
+    assert all(len(line) <= 100 for line in lines), "nothing wraps past the terminal width"
+    assert "Read first" in text
+    failing = [r["id"] for r in data["requirements"] if r["verdict"] in ("FAIL", "INCONCLUSIVE")]
+    for rid in failing:
+        assert re.search(rf"│ {re.escape(rid)}\s+│ \S", text), rid
+    counts = data["summary"]["counts"]
+    order = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
+    tally = ", ".join(f"{counts[v]} {v}" for v in order if counts[v])
+    assert f" NON-COMPLIANT   {tally}" in text
+    assert f"report: {tmp_path / 'report.html'}" in text
+
+
+@pytest.mark.parametrize(
+    ("text", "width", "expected"),
+    [
+        ("short", 10, "short"),
+        ("a\nmulti  line\treason", 40, "a multi line reason"),
+        ("x" * 30, 10, "xxxxxxx..."),
+    ],
+)
+def test_one_line(text, width, expected):
+    assert one_line(text, width) == expected
