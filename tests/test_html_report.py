@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from types import SimpleNamespace
 
-from conformance.reports import html
+from conformance.reports import html, timing_diagram
 from conformance.results import CaseRecord
 from conformance.run import ConformanceRun, RunOptions
-from conformance.transcript import DUT, Event, EventKind, to_wire_7e1
+from conformance.transcript import DUT, TOOL, Event, EventKind, decode_7e1, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
 
 HOSTILE = ["<script>alert(1)</script>", '"><img src=x onerror=alert(1)>']
@@ -61,3 +62,103 @@ def test_requirements_table_and_banner_escape():
     page = html.banner(run) + html.requirements_table(run)
     assert "sdi12-verdict" in page and "sdi12-requirements" in page
     assert "<img" not in page
+
+
+# -- timing diagrams -----------------------------------------------------------------------
+CHAR = 10 / 1200  # one frame, s
+SVG_TAGS = {"svg", "g", "rect", "text", "title", "line", "path"}
+
+
+def chars(
+    origin: str, text: str, start: float, gaps: dict[int, float] | None = None
+) -> list[Event]:
+    """Back-to-back 7E1 characters from ``start``; ``gaps`` adds marking before index i."""
+    out, t = [], start
+    for i, c in enumerate(text):
+        t += (gaps or {}).get(i, 0.0)
+        out.append(Event(EventKind.CHAR, origin, t, t + CHAR, wire=to_wire_7e1(ord(c))))
+        t += CHAR
+    return out
+
+
+def exchange(start: float, command: str, reply: str, delay: float, **kw) -> list[Event]:
+    brk = Event(EventKind.BREAK, TOOL, start, start + 0.013)
+    cmd = chars(TOOL, command, brk.end + 0.009)
+    return [brk, *cmd, *chars(DUT, reply, cmd[-1].end + delay, **kw)]
+
+
+def parse_svg(svg: str) -> ET.Element:
+    root = ET.fromstring(svg)  # well-formed, so no DUT text escaped into markup
+    tags = {el.tag.split("}")[-1] for el in root.iter()}
+    assert tags <= SVG_TAGS, tags
+    return root
+
+
+def red_labels(root: ET.Element) -> set[str]:
+    bad = timing_diagram.COLOURS["bad"]
+    return {
+        el.text or "" for el in root.iter() if el.tag.endswith("text") and el.get("fill") == bad
+    }
+
+
+def texts(root: ET.Element) -> list[str]:
+    return [el.text or "" for el in root.iter() if el.tag.endswith("text")]
+
+
+def test_timing_svg_draws_break_marking_characters_window_and_gap():
+    events = exchange(0.0, "0!", "0\r\n", 0.009) + exchange(
+        2.0, "0D0!", "0+<1\r\n", 0.009, gaps={2: 0.003}
+    )
+    root = parse_svg(timing_diagram.timing_svg(events, title="two exchanges"))
+    labels = texts(root)
+    assert "break 13.00 ms" in labels and "marking 9.00 ms" in labels
+    assert labels.count("reply +9.00 ms") == 2
+    assert "gap 3.00 ms" in labels
+    assert "<" in labels and "CR" in labels and "LF" in labels  # glyphs, escaped in the source
+    assert "idle" in labels and any(t.endswith(" s") and t.startswith("1.9") for t in labels)
+    windows = [r for r in root.iter() if r.get("fill-opacity") == "0.22"]
+    assert len(windows) == 2, "one reply window per command"
+    assert float(root.get("width")) < 1200, "two seconds of idle are cut out of the axis"
+
+
+def test_timing_svg_marks_a_late_reply_and_an_overlong_gap_as_out_of_limits():
+    root = parse_svg(
+        timing_diagram.timing_svg(exchange(0.0, "0!", "0\r\n", 0.020, gaps={1: 0.003}))
+    )
+    assert {"reply +20.00 ms", "gap 3.00 ms"} <= red_labels(root)
+    ok = parse_svg(timing_diagram.timing_svg(exchange(0.0, "0!", "0\r\n", 0.009)))
+    assert red_labels(ok) == set()
+
+
+def test_timing_svg_of_hostile_characters_is_inert():
+    root = parse_svg(timing_diagram.timing_svg(exchange(0.0, "0!", HOSTILE[1], 0.009), HOSTILE[0]))
+    assert root.get("aria-label") == HOSTILE[0]
+    glyphs = "".join(t for t in texts(root) if len(t) == 1)
+    assert glyphs == "0!" + HOSTILE[1].replace(" ", "␣")
+    assert timing_diagram.timing_svg([]) == ""
+
+
+def test_exchange_behind_a_whole_run_finding_is_the_one_measured():
+    events = exchange(0.0, "0!", "0\r\n", 0.009) + exchange(1.0, "0I!", "014X\r\n", 0.0153)
+    finding = Finding("R-7.0-10", Verdict.PASS, "worst", measured_ms=15.3, limit_ms=15.4)
+    label, drawn = timing_diagram.exchange_behind([finding], events)
+    assert label.startswith("0I!, the exchange behind R-7.0-10's 15.30 ms")
+    assert decode_7e1(e for e in drawn if e.origin == DUT) == "014X\r\n"
+    assert drawn[0].kind is EventKind.BREAK
+    assert timing_diagram.exchange_behind([Finding("R-7.0-10", Verdict.PASS, "x")], events) is None
+
+
+def test_case_html_draws_timing_cases_only():
+    events = exchange(0.0, "0!", "0\r\n", 0.009)
+    timing = CaseRecord("test_7_timing.py::test_x", "test_x", ("R-7.0-05",))
+    timing.findings.append(Finding("R-7.0-05", Verdict.PASS, "answered"))
+    timing.evidence.append(("break, a!", events))
+    other = CaseRecord("test_4_4_basic.py::test_y", "test_y", ("R-4.4.1-01",))
+    other.findings.append(Finding("R-4.4.1-01", Verdict.PASS, "answered"))
+    other.evidence.append(("a!", events))
+    assert "<svg" in html.case_html(timing) and "<svg" not in html.case_html(other)
+    derived = ("worst exchange", events)
+    measured = CaseRecord("test_9_whole_run.py::test_z", "test_z", ("R-7.0-10",))
+    measured.findings.append(Finding("R-7.0-10", Verdict.PASS, "ok", measured_ms=9.0))
+    page = html.case_html(measured, derived)
+    assert "<svg" in page and "worst exchange" in page and "measured 9.00 ms" in page
