@@ -251,6 +251,11 @@ def test_nul_and_other_non_printables_are_findings(tmp_path, device_factory):
     assert proc.returncode == 1, proc.stdout + proc.stderr
     data = report(tmp_path)
     assert data["summary"]["counts"]["FAIL"] >= 1
+    # the case that makes its own 5 ms pulse cannot run on socket://: INCONCLUSIVE, said why
+    short_spacing = next(r for r in data["requirements"] if r["id"] == "R-7.0-03")
+    assert short_spacing["verdict"] == "INCONCLUSIVE"
+    detail = short_spacing["findings"][0]["detail"]
+    assert "cannot" in detail and "break" in detail, detail
     assert took < 90
 
 

@@ -28,6 +28,7 @@ from ..protocol.timing import CHAR_TIME
 from ..sim.bus import BusDevice
 
 SPIN = 0.0008  # s: poll the last stretch before a due time instead of oversleeping it
+LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counted as late
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
 
 
@@ -64,6 +65,10 @@ class RealTimeLine:
         self._thread = threading.Thread(target=self._run, name="sdi12-emulated-line", daemon=True)
         self.frames_sent = 0
         self.errors: list[BaseException] = []
+        # how far behind its own schedule the line committed device frames: on a machine too
+        # busy to keep real time the emulated sensor's timing is not what it planned
+        self.worst_lateness = 0.0
+        self.late_frames = 0  # committed more than LATE_NOTICE after their planned start
 
     def now(self) -> float:
         return self._clock()
@@ -104,6 +109,14 @@ class RealTimeLine:
             self._tool_free = end
             self._push(end, lambda s=start, e=end: self.device.on_break(s, e))
             self._cond.notify()
+
+    def timekeeping(self) -> str:
+        """One line for the server log: how well the line kept its schedule so far."""
+        return (
+            f"line kept real time within {self.worst_lateness * 1e3:.1f} ms "
+            f"({self.late_frames} of {self.frames_sent} frames more than "
+            f"{LATE_NOTICE * 1e3:.0f} ms late)"
+        )
 
     def start(self) -> RealTimeLine:
         self._thread.start()
@@ -155,6 +168,9 @@ class RealTimeLine:
                 if frame is None or frame.start > self.now():
                     return
                 self.device.pop_frame()
+                lateness = self.now() - frame.start
+                self.worst_lateness = max(self.worst_lateness, lateness)
+                self.late_frames += lateness > LATE_NOTICE
                 deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
                 self._push(deliver, lambda w=frame.wire: self._emit(w))
             except Exception as exc:  # a device bug must not kill the line silently

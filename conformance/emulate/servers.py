@@ -119,7 +119,7 @@ class TcpEmulatorServer:
                     self._serve_connection(sock)
                 finally:
                     sock.close()
-                    self.log("recorder disconnected")
+                    self.log(f"recorder disconnected; {self.line.timekeeping()}")
                 if once:
                     return
         finally:
