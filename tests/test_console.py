@@ -21,11 +21,13 @@ FAULTY = "sim://?faults=no-service-request"
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
 
-def run_cli(monkeypatch, tmp_path: Path, port: str, *, terminal: bool) -> tuple[int, str, dict]:
+def run_cli(
+    monkeypatch, tmp_path: Path, port: str, *extra: str, terminal: bool
+) -> tuple[int, str, dict]:
     buffer = io.StringIO()
     console = Console(file=buffer, force_terminal=terminal, width=100, color_system="standard")
     monkeypatch.setattr(cli, "Console", lambda **_: console)
-    code = cli.main(["--port", port, "--report-dir", str(tmp_path)])
+    code = cli.main(["--port", port, "--report-dir", str(tmp_path), *extra])
     data = json.loads((tmp_path / "verdicts.json").read_text(encoding="utf-8"))
     return code, buffer.getvalue(), data
 
@@ -76,6 +78,21 @@ def test_terminal_shows_progress_failures_live_and_a_summary_table(monkeypatch, 
     tally = ", ".join(f"{counts[v]} {v}" for v in order if counts[v])
     assert f" NON-COMPLIANT   {tally}" in text
     assert f"report: {tmp_path / 'report.html'}" in text
+
+
+def test_a_selection_says_what_it_left_unjudged_in_one_line(monkeypatch, tmp_path):
+    code, out, data = run_cli(monkeypatch, tmp_path, "sim", "-k", "crc", terminal=False)
+    unjudged = [r["id"] for r in data["requirements"] if r["verdict"] == "INCONCLUSIVE"]
+    testable = sum(1 for r in data["requirements"] if r["testable"])
+    assert code == cli.EXIT_INCOMPLETE and len(unjudged) > 4
+    lines = out.splitlines()
+    grouped = [line for line in lines if line.startswith("INCONCLUSIVE ")]
+    assert grouped == [
+        f"INCONCLUSIVE {len(unjudged)} requirements: no case judged this requirement "
+        f"({', '.join(unjudged[:4])}, ...)"
+    ]
+    assert f"{testable - len(unjudged)} of {testable} testable requirements judged" in out
+    assert "verdict: INCOMPLETE" in lines and any(line.startswith("note: ") for line in lines)
 
 
 @pytest.mark.parametrize(

@@ -162,3 +162,15 @@ def test_case_html_draws_timing_cases_only():
     measured.findings.append(Finding("R-7.0-10", Verdict.PASS, "ok", measured_ms=9.0))
     page = html.case_html(measured, derived)
     assert "<svg" in page and "worst exchange" in page and "measured 9.00 ms" in page
+
+
+def test_read_first_groups_requirements_with_one_reason_and_header_says_why_incomplete():
+    run = ConformanceRun(RunOptions())
+    run.finish(complete=True)  # no case ran: every testable requirement is left unjudged
+    unjudged = [r for r in run.results if r.verdict is Verdict.INCONCLUSIVE]
+    page = html.attention(run)
+    assert page.count("<li>") == 1
+    assert f"{len(unjudged)} requirements: <b>{unjudged[0].requirement.id}, " in page
+    assert "no case judged this requirement" in page
+    assert f"<th>Note</th><td>{run.stop_reason}</td>" in html.header(run)
+    assert f"note: {run.stop_reason}" in html.banner(run)

@@ -33,6 +33,7 @@ STYLE = {
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
 NOTEWORTHY = SEVERITY[:4]  # verdicts a reader must see with their reason
 REASON_WIDTH = 160  # characters of a reason on a plain line
+GROUP_OVER = 4  # more requirements than this with one verdict and reason share one line
 
 
 def one_line(text: str, width: int = REASON_WIDTH) -> str:
@@ -145,10 +146,24 @@ def _reason(requirement: dict[str, Any]) -> str:
     return same[0]["detail"] + more
 
 
-def noteworthy(data: dict[str, Any]) -> list[dict[str, Any]]:
-    """Requirements a reader must look at, worst first."""
-    found = [r for r in data["requirements"] if r["verdict"] in NOTEWORTHY]
-    return sorted(found, key=lambda r: SEVERITY.index(r["verdict"]))
+def noteworthy(data: dict[str, Any]) -> list[tuple[str, str, str]]:
+    """(verdict, requirement(s), reason) a reader must look at, worst first.
+
+    More than :data:`GROUP_OVER` requirements with one verdict and one reason share a line:
+    a ``-k`` run leaves a hundred "not judged", which is one fact, not a hundred.
+    """
+    groups: dict[tuple[str, str], list[str]] = {}
+    for r in data["requirements"]:
+        if r["verdict"] in NOTEWORTHY:
+            groups.setdefault((r["verdict"], _reason(r)), []).append(r["id"])
+    rows = []
+    for (verdict, reason), ids in groups.items():
+        if len(ids) > GROUP_OVER:
+            shown = ", ".join(ids[:GROUP_OVER])
+            rows.append((verdict, f"{len(ids)} requirements", f"{reason} ({shown}, ...)"))
+        else:
+            rows += [(verdict, rid, reason) for rid in ids]
+    return sorted(rows, key=lambda row: SEVERITY.index(row[0]))
 
 
 def print_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
@@ -171,15 +186,23 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
     ]
 
 
+def _coverage(data: dict[str, Any]) -> str:
+    """How many requirements a case judged: all testable ones, unless cases were left out."""
+    testable = [r for r in data["requirements"] if r["testable"]]
+    judged = sum(1 for r in testable if any(f["test"] for f in r["findings"]))
+    untestable = len(data["requirements"]) - len(testable)
+    done = (
+        f"{judged} testable requirements judged"
+        if judged == len(testable)
+        else f"{judged} of {len(testable)} testable requirements judged"
+    )
+    return f"{done}, {untestable} untestable here (electrical, inspection or the other role)"
+
+
 def _counts_line(data: dict[str, Any]) -> str:
     counts = data["summary"]["counts"]
-    judged = sum(1 for r in data["requirements"] if r["testable"])
-    untestable = len(data["requirements"]) - judged
     tally = ", ".join(f"{counts[v]} {v}" for v in SEVERITY if counts.get(v))
-    return (
-        f"{tally}; {judged} testable requirements judged, {untestable} untestable here "
-        "(electrical, inspection or the other role)"
-    )
+    return f"{tally}; {_coverage(data)}"
 
 
 def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
@@ -190,12 +213,17 @@ def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> N
     for line in _identity_lines(data):
         say(line)
     say(_counts_line(data))
-    for r in noteworthy(data):
-        say(f"{r['verdict']:<12} {r['id']}: {one_line(_reason(r))}")
+    for verdict, which, reason in noteworthy(data):
+        say(f"{verdict:<12} {which}: {one_line(reason)}")
     if data["run"].get("stop_reason"):
-        say(f"stopped: {data['run']['stop_reason']}")
+        say(f"{_stop_word(data)}: {data['run']['stop_reason']}")
     say(f"verdict: {data['summary']['verdict']}")
     _paths(say, report_dir)
+
+
+def _stop_word(data: dict[str, Any]) -> str:
+    """A run that ended normally but left requirements unjudged has a note, not a stop."""
+    return "note" if data["run"].get("complete") else "stopped"
 
 
 def _paths(say: Any, report_dir: str) -> None:
@@ -215,12 +243,7 @@ def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> No
         table.add_column(name, justify="right", style=STYLE.get(name, ""))
     table.add_row(*(str(summary["counts"].get(name, 0)) for name in SEVERITY))
     console.print(table)
-    judged = sum(1 for r in data["requirements"] if r["testable"])
-    console.print(
-        f"{judged} testable requirements judged, {len(data['requirements']) - judged} "
-        "untestable here (electrical, inspection or the other role)",
-        highlight=False,
-    )
+    console.print(_coverage(data), highlight=False)
     rows = noteworthy(data)
     if rows:
         lines = Table(show_header=True, show_edge=False, title="Read first")
@@ -232,16 +255,12 @@ def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> No
             overflow="ellipsis",
             ratio=1,
         )
-        room = max(30, console.width - 36)  # what the two narrow columns and borders leave
-        for r in rows:
-            lines.add_row(
-                Text(r["verdict"], style=STYLE[r["verdict"]]),
-                r["id"],
-                Text(one_line(_reason(r), room)),
-            )
+        room = max(30, console.width - 40)  # what the two narrow columns and borders leave
+        for level, which, reason in rows:
+            lines.add_row(Text(level, style=STYLE[level]), which, Text(one_line(reason, room)))
         console.print(lines)
     if data["run"].get("stop_reason"):
-        console.print(f"stopped: {data['run']['stop_reason']}", markup=False)
+        console.print(f"{_stop_word(data)}: {data['run']['stop_reason']}", markup=False)
     console.print(
         Text.assemble((f" {verdict} ", STYLE.get(verdict, "")), "  ", _counts_short(summary))
     )

@@ -140,7 +140,7 @@ def banner(run: ConformanceRun) -> str:
     testable = sum(1 for r in results if r.requirement.testable(run.options.role))
     line = f"{counts} — {len(results)} requirements, {testable} testable by this tool"
     if run.stop_reason:
-        line += f" — stopped: {run.stop_reason}"
+        line += f" — {'note' if run.complete else 'stopped'}: {run.stop_reason}"
     dut = dut_block(run)
     ident = wire_escape(dut["identification"] or "(no identification)")
     version = dut["sdi12_version"] or "?"
@@ -197,8 +197,10 @@ def header(run: ConformanceRun) -> str:
         ("Started", run.started),
         ("Finished", run.finished or "—"),
         ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),
-        ("Run complete", "yes" if run.complete else f"no: {run.stop_reason or 'interrupted'}"),
+        ("Ran to the end", "yes" if run.complete else "no (interrupted or the link failed)"),
     ]
+    if run.stop_reason:
+        runrows.append(("Note" if run.complete else "Stopped because", run.stop_reason))
     return (
         '<div class="sdi12-cols" id="sdi12-header">'
         + _kv_table("Device under test", device, "sdi12-dut")
@@ -224,22 +226,40 @@ def attention(run: ConformanceRun) -> str:
             '<div id="sdi12-attention"><h3>Read first</h3><p>Nothing: no requirement failed, '
             f"warned or was left inconclusive.</p>{na_link}</div>"
         )
-    items = []
-    for r in bad:
-        verdict = str(r.verdict)
-        reasons = [f.detail for f in r.findings if f.verdict is r.verdict]
-        more = f" (+{len(reasons) - 1} more)" if len(reasons) > 1 else ""
-        tests = ", ".join(t.split("::")[-1] for t in r.tests)
-        items.append(
-            f'<li><span class="{verdict_class(verdict)}">{escape(verdict)}</span> '
-            f"<b>{escape(r.requirement.id)}</b> ({escape(r.requirement.level)}): "
-            f"{escape(reasons[0] if reasons else '')}{escape(more)}"
-            + (f' <span class="tests">[{escape(tests)}]</span>' if tests else "")
-            + "</li>"
-        )
+    items = [_attention_item(group) for group in _same_reason(bad)]
     return (
         f'<div id="sdi12-attention"><h3>Read first ({len(bad)})</h3>'
         f'<ul class="sdi12-attention">{"".join(items)}</ul>{na_link}</div>'
+    )
+
+
+def _reason(r: RequirementResult) -> str:
+    reasons = [f.detail for f in r.findings if f.verdict is r.verdict]
+    more = f" (+{len(reasons) - 1} more)" if len(reasons) > 1 else ""
+    return (reasons[0] if reasons else "") + more
+
+
+def _same_reason(results: list[RequirementResult]) -> list[list[RequirementResult]]:
+    """Requirements with one verdict and one reason, together: a `-k` run leaves dozens
+    "not judged", which read better as one line than as a page."""
+    groups: dict[tuple[str, str], list[RequirementResult]] = {}
+    for r in results:
+        groups.setdefault((str(r.verdict), _reason(r)), []).append(r)
+    return list(groups.values())
+
+
+def _attention_item(group: list[RequirementResult]) -> str:
+    verdict = str(group[0].verdict)
+    if len(group) == 1:
+        ids = f"<b>{escape(group[0].requirement.id)}</b> ({escape(group[0].requirement.level)})"
+    else:
+        listed = ", ".join(r.requirement.id for r in group)
+        ids = f"{len(group)} requirements: <b>{escape(listed)}</b>"
+    tests = sorted({t.split("::")[-1] for r in group for t in r.tests})
+    where = f' <span class="tests">[{escape(", ".join(tests))}]</span>' if tests else ""
+    return (
+        f'<li><span class="{verdict_class(verdict)}">{escape(verdict)}</span> {ids}: '
+        f"{escape(_reason(group[0]))}{where}</li>"
     )
 
 
