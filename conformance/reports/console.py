@@ -180,8 +180,12 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
     link = run["link"]
     uncertainty = link.get("timing_uncertainty_ms")
     u = f", timing ±{uncertainty} ms" if uncertainty is not None else ""
+    if run["role"] == "recorder":
+        first = f"DUT data recorder · SDI-12 {dut.get('sdi12_version')}"
+    else:
+        first = f"DUT {dut.get('address')!s} · SDI-12 {dut.get('sdi12_version')} · {ident!r}"
     return [
-        f"DUT {dut.get('address')!s} · SDI-12 {dut.get('sdi12_version')} · {ident!r}",
+        first,
         f"role {run['role']} · port {run['port']} · link {link['kind']}{u}",
     ]
 

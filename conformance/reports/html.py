@@ -141,18 +141,22 @@ def banner(run: ConformanceRun) -> str:
     line = f"{counts} — {len(results)} requirements, {testable} testable by this tool"
     if run.stop_reason:
         line += f" — {'note' if run.complete else 'stopped'}: {run.stop_reason}"
-    dut = dut_block(run)
-    ident = wire_escape(dut["identification"] or "(no identification)")
-    version = dut["sdi12_version"] or "?"
-    who = (
-        f"{run.options.role} at address {dut['address']}, SDI-12 v{version}: {ident} · "
-        f"port {run.options.port} · {run.finished or run.started}"
-    )
+    who = f"{_who(run)} · port {run.options.port} · {run.finished or run.started}"
     return (
         f'<div class="sdi12-banner {css}" id="sdi12-verdict">{escape(verdict)}'
         f"<small>{escape(line)}</small>"
         f'<small class="ident">{escape(who)}</small></div>'
     )
+
+
+def _who(run: ConformanceRun) -> str:
+    """The DUT in one line: a sensor by address and its aI! reply; a recorder by its claim."""
+    dut = dut_block(run)
+    version = dut["sdi12_version"] or "?"
+    if run.options.role == "recorder":
+        return f"data recorder, SDI-12 v{version}"
+    ident = wire_escape(dut["identification"] or "(no identification)")
+    return f"sensor at address {dut['address']}, SDI-12 v{version}: {ident}"
 
 
 def _kv_table(title: str, rows: list[tuple[str, object]], table_id: str) -> str:
@@ -176,18 +180,26 @@ def header(run: ConformanceRun) -> str:
     uncertainty = link["timing_uncertainty_ms"]
     exact = " (virtual clock: exact)" if link["kind"] == "sim" and not uncertainty else ""
     breaks = {True: "yes", False: "no", None: "unknown"}[link["can_break"]]
-    device = [
+    sensor = [
         ("Identification (aI!)", wire_escape(dut["identification"] or "(none)")),
-        ("Address", dut["address"]),
+        ("Address", dut["address"] or "—"),
         ("Claimed SDI-12 version", dut["sdi12_version"] or "unknown"),
         ("Vendor", dut["vendor"] or "—"),
         ("Model", dut["model"] or "—"),
         ("Firmware (sensor version)", dut["firmware"] or "—"),
         ("Serial / optional field", dut["serial"] or "—"),
+    ]
+    recorder = [
+        ("Kind", "data recorder (the tool plays the sensors)"),
+        ("Claimed SDI-12 version", dut["sdi12_version"] or "unknown"),
+    ]
+    device = [
+        *(recorder if run.options.role == "recorder" else sensor),
         ("Declaration", dut["declaration"] or "none (features discovered)"),
         ("Assumptions", "; ".join(dut["assumptions"]) or "none"),
-        ("Address changes", _counted(dut.get("address_notes") or []) or "none made"),
     ]
+    if run.options.role == "sensor":  # the tool only changes a sensor's address
+        device.append(("Address changes", _counted(dut.get("address_notes") or []) or "none made"))
     runrows = [
         ("Tool", f"{TOOL['name']} {TOOL['version']}"),
         ("Role judged", run.options.role),
