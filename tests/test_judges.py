@@ -203,3 +203,13 @@ def test_cases_needing_what_the_link_lacks_are_inconclusive():
     assert missing_capabilities(item, socket_like) == ["send breaks"]
     sim = SimpleNamespace(link=SimpleNamespace(info=LinkInfo("sim")))
     assert missing_capabilities(item, sim) == []
+
+
+def test_tolerance_misuse_needs_the_gap_surely_in_the_band():
+    gapped = exchange("0!", "", 0.0)
+    gapped.attempts[0].reply_events = chars(
+        "0123\r\n", gapped.last.command_end + 9e-3, DUT, gap=1.9e-3
+    )
+    segs = wire.segments(transcript_of(gapped))
+    assert verdicts(wire.judge_gaps(segs, 0.1e-3))["R-7.0-01"] is Verdict.FAIL
+    assert verdicts(wire.judge_gaps(segs, 0.5e-3))["R-7.0-01"] is Verdict.INCONCLUSIVE
