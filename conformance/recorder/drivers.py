@@ -64,9 +64,11 @@ class Trigger:
     timeout: float = 120.0
     kind: str = "trigger"
     needs_real_time: bool = True
+    #: Set by the session: where the recorder connects (``SDI12_PORT``, an rfc2217:// URL).
+    environment: dict[str, str] = field(default_factory=dict)
 
     def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
-        env = {**os.environ, **request.environment(scenario, self.timeout)}
+        env = {**os.environ, **self.environment, **request.environment(scenario, self.timeout)}
         try:
             done = subprocess.run(
                 self.command,
@@ -101,10 +103,15 @@ class Interactive:
     answer_in: TextIO = field(default_factory=lambda: sys.stdin)
     kind: str = "interactive"
     needs_real_time: bool = True
+    #: Set by the session: where the recorder connects (``SDI12_PORT``, an rfc2217:// URL).
+    environment: dict[str, str] = field(default_factory=dict)
 
     def prompt(self, scenario: str, request: Request) -> str:
+        where = self.environment.get("SDI12_PORT")
         return (
-            f"\n[recorder scenario {scenario}] Make the data recorder {request.sentence()}.\n"
+            f"\n[recorder scenario {scenario}] Make the data recorder {request.sentence()}"
+            + (f" (sensors served at {where})" if where else "")
+            + ".\n"
             f"Press Enter when it has finished (you may type a note first); "
             f"{self.timeout:g} s until this scenario is abandoned: "
         )

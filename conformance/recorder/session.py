@@ -7,24 +7,29 @@ that needs it judges the same slice.
 
 On ``--port sim`` the bus is the virtual-time :class:`SimBus`, the recorder runs in this
 process on the tool's :class:`SimLink` (the golden recorder unless ``recorder=`` names another
-callable), and its side of the wire has origin ``tool``. Real ports need the played sensors
-served in real time (the emulate driver of issue 5), which this version does not have yet.
+callable), and its side of the wire has origin ``tool``. On ``--port rfc2217-serve://HOST:PORT``
+the tool serves the played sensors in real time (:mod:`conformance.recorder.realtime`) and the
+recorder connects to them over RFC 2217: the in-process one through a real link opened per
+scenario, an external one (``--trigger``) told where in ``SDI12_PORT``. The transcript is then
+the served line's, as the sensors hear it, in the same form.
 """
 
 from __future__ import annotations
 
 import importlib
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..judges.recorder import Line, merge_lines, read_line
-from ..links.base import Link
+from ..links.base import Link, LinkError
 from ..ports import PortError, is_sim, parse_sim
 from ..sim.bus import Frame, SimBus, SimLink
 from ..transcript import TOOL, Event
 from .drivers import Driver, InProcess, Interactive, RecorderDriverError, Trigger
 from .faults import RECORDER_FAULTS, faulty_recorder
 from .played import build_sensors
+from .realtime import ServedLine, is_served, parse_served
 from .request import RecorderOutput
 from .scenarios import SCENARIOS, Scenario
 
@@ -95,12 +100,14 @@ class RecorderSession:
         driver: Driver | None = None,
         timing_uncertainty: float | None = None,
     ) -> None:
-        if not is_sim(port):
+        served = is_served(port)
+        if not is_sim(port) and not served:
             raise PortError(
-                f"port {port!r}: the recorder role needs the played sensors served in real "
-                "time on a real port, which this version cannot do yet; use --port sim"
+                f"port {port!r}: the recorder role plays the sensors itself: use --port sim "
+                "(virtual time) or --port rfc2217-serve://127.0.0.1:0 (served in real time, "
+                "the recorder connects over RFC 2217)"
             )
-        spec = parse_sim(port)
+        spec = parse_served(port) if served else parse_sim(port)
         faults = tuple(f for f in spec.extra.get("recorder-faults", "").split(",") if f)
         unknown = [f for f in faults if f not in RECORDER_FAULTS]
         if unknown or len(faults) > 1:
@@ -109,15 +116,23 @@ class RecorderSession:
         if driver is None:
             program = spec.extra.get("recorder")
             driver = InProcess(load_program(program)() if program else faulty_recorder(faults))
-        elif driver.needs_real_time:
+        elif driver.needs_real_time and not served:
             raise PortError(
                 f"a {driver.kind} recorder acts outside this process and cannot reach the "
                 "simulated bus; it needs a real port served in real time (not available yet)"
             )
         self.driver = driver
         self.faults = faults
-        self.bus = SimBus([LineMonitor()])
-        self.link: Link = SimLink(self.bus)
+        self.served: ServedLine | None = None
+        if served:
+            self.served = ServedLine(spec, timing_uncertainty)  # type: ignore[arg-type]
+            self.link = self.served  # type: ignore[assignment] - what the reports read
+            environment = getattr(driver, "environment", None)
+            if environment is not None:  # an external recorder is told where to connect
+                environment["SDI12_PORT"] = self.served.url
+        else:
+            self.bus = SimBus([LineMonitor()])
+            self.link: Link = SimLink(self.bus)
         self.version = version
         self.uncertainty = (
             self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
@@ -134,6 +149,11 @@ class RecorderSession:
             f"recorder driven {driver.kind}"
             + (f" (golden recorder with fault {faults[0]})" if faults else ""),
         ]
+        if self.served is not None:
+            self.assumptions.append(
+                f"played sensors served in real time at {self.served.url}; stamps taken on the "
+                f"served line, \u00b1{self.uncertainty * 1e3:g} ms"
+            )
 
     @property
     def is_v14(self) -> bool:
@@ -162,6 +182,8 @@ class RecorderSession:
         return self.runs[name]
 
     def _run(self, scenario: Scenario) -> ScenarioRun:
+        if self.served is not None:
+            return self._run_served(scenario, self.served)
         played = build_sensors(scenario.sensors)
         self.bus.devices[:] = [LineMonitor(), *played]
         self.bus.rx.clear()
@@ -178,6 +200,45 @@ class RecorderSession:
         events = transcript.since(first)
         return ScenarioRun(scenario, events, output, error, tuple(played))
 
+    def _run_served(self, scenario: Scenario, line: ServedLine) -> ScenarioRun:
+        """As :meth:`_run`, in real time: the played sensors go on the served line, the
+        recorder acts (the in-process one over its own RFC 2217 connection), the line
+        settles, and the scenario's slice is what started on it in between."""
+        played = build_sensors(scenario.sensors)
+        line.settle(SETTLE)
+        line.bus.set_devices(played)
+        begin = line.now()
+        line.note(f"scenario {scenario.name}: {scenario.describe()}")
+        error = None
+        try:
+            output = self._act_served(scenario, line)
+        except (RecorderDriverError, LinkError) as exc:
+            output, error = RecorderOutput(), str(exc)
+        line.settle(SETTLE)
+        kept = line.line
+        line.note(f"scenario {scenario.name} done; {kept.timekeeping()}")
+        end = line.now()
+        line.bus.set_devices([])
+        events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
+        return ScenarioRun(scenario, events, output, error, tuple(played))
+
+    def _act_served(self, scenario: Scenario, line: ServedLine) -> RecorderOutput:
+        if self.driver.needs_real_time:  # an external recorder connects to line.url itself
+            return self.driver.act(scenario.name, scenario.request, line)  # type: ignore[arg-type]
+        from ..links.factory import open_real_link
+
+        link = open_real_link(line.url, self.uncertainty)
+        try:
+            return self.driver.act(scenario.name, scenario.request, link)
+        finally:
+            link.close()
+            time.sleep(0.05)  # let the server see the disconnect before the next connection
+
+    def close(self) -> None:
+        """Stop serving (real-time ports); nothing to release on the simulated bus."""
+        if self.served is not None:
+            self.served.close()
+
 
 def driver_for(trigger: str | None) -> Driver | None:
     """``--trigger``: None (in-process recorder), ``interactive``, or a shell command."""
@@ -189,4 +250,4 @@ def driver_for(trigger: str | None) -> Driver | None:
 def check_port(port: str, trigger: str | None = None) -> None:
     """Raise :class:`PortError` now, before a run starts, if the recorder role cannot use
     ``port`` with ``trigger`` (unknown recorder fault, real port, external recorder on sim)."""
-    RecorderSession(port, driver=driver_for(trigger))
+    RecorderSession(port, driver=driver_for(trigger)).close()

@@ -1,0 +1,229 @@
+"""The played sensors served in real time, for a recorder that is outside the virtual bus.
+
+``--port rfc2217-serve://127.0.0.1:0`` (``0``: the OS picks a free port) makes the tool an
+RFC 2217 server: one emulated line (:class:`~conformance.emulate.realtime.RealTimeLine`) with
+a :class:`PlayedBus` on it, which puts every played sensor of the current scenario on that
+line, as the sim bus does. The recorder under test connects as a client (``rfc2217://HOST:PORT``,
+breaks through SET_CONTROL); the golden recorder does so through
+:class:`~conformance.links.serial_link.SerialLink`, once per scenario as a logger woken by
+its schedule would.
+
+The judges read the line as the sensors see it, so the :class:`PlayedBus` keeps the transcript
+in the sim bus's form: the recorder's breaks and characters with origin ``tool``, each sensor's
+characters under its own name, all stamped on the served line's clock with its declared
+uncertainty (what the network between recorder and line, and the scheduling of both ends, may
+add to a stamp). How well the line kept its own schedule is noted after every scenario.
+"""
+
+from __future__ import annotations
+
+import bisect
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from math import inf
+from urllib.parse import parse_qs, urlsplit
+
+from ..emulate.realtime import RealTimeLine
+from ..emulate.servers import TcpEmulatorServer
+from ..links.base import LinkInfo
+from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
+from ..ports import PortError
+from ..sim.bus import BusDevice, Frame
+from ..transcript import TOOL, Event, EventKind, Transcript
+
+SCHEME = "rfc2217-serve"
+#: Keys of the port's query string (as on ``sim://``): a golden-recorder fault, or a recorder
+#: program ``package.module:callable`` run in this process over the served line.
+RECORDER_KEYS = ("recorder-faults", "recorder")
+#: Marking after the recorder finished that counts as a quiet line: every played sensor has
+#: gone to standby (100 ms) and has nothing left to send.
+QUIET = 0.25
+#: Poll period of the settle wait.
+SETTLE_POLL = 0.02
+
+
+def is_served(port: str) -> bool:
+    return port.startswith(f"{SCHEME}://")
+
+
+@dataclass
+class ServeSpec:
+    """Where to serve the played sensors, and the query's recorder options."""
+
+    host: str
+    port: int
+    extra: dict[str, str] = field(default_factory=dict)
+
+
+def parse_served(port: str) -> ServeSpec:
+    """``rfc2217-serve://HOST:PORT?recorder-faults=no-retries`` -> :class:`ServeSpec`."""
+    parts = urlsplit(port)
+    try:
+        number = parts.port
+    except ValueError as exc:
+        raise PortError(f"port {port!r}: {exc}") from exc
+    if not parts.hostname or number is None:
+        raise PortError(f"port {port!r}: write {SCHEME}://HOST:PORT (PORT 0: any free port)")
+    params = {k: v[-1] for k, v in parse_qs(parts.query, keep_blank_values=True).items()}
+    extra = {k: params.pop(k) for k in RECORDER_KEYS if k in params}
+    if params:
+        known = ", ".join(RECORDER_KEYS)
+        raise PortError(f"unknown {SCHEME} parameters {sorted(params)} (known: {known})")
+    return ServeSpec(parts.hostname, number, extra)
+
+
+class PlayedBus:
+    """The played sensors as one device of a real-time line, and the line's transcript.
+
+    The line calls the device methods from its own thread; :meth:`set_devices` and the
+    readers come from the session's thread, so a lock guards the device list and the
+    transcript. Events are kept in order of their start: a recorder character is heard when
+    its stop bit ends, after a sensor character that may have started during it.
+    """
+
+    name = "played-bus"
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self.devices: list[BusDevice] = []
+        self.transcript = Transcript()
+        self._lock = threading.RLock()
+        self._busy = -inf  # end of the last sensor character: the next cannot start before
+        self.last_end = -inf  # end of the last event on the line, whoever sent it
+
+    def set_devices(self, devices: Sequence[BusDevice]) -> None:
+        with self._lock:
+            self.devices = list(devices)
+
+    def add(self, event: Event) -> int:
+        """Insert ``event`` in start order; its index in the transcript."""
+        with self._lock:
+            events = self.transcript.events
+            at = bisect.bisect_right(events, event.start, key=lambda e: e.start)
+            events.insert(at, event)
+            if event.kind is not EventKind.NOTE:
+                self.last_end = max(self.last_end, event.end)
+            return at
+
+    def pending(self) -> bool:
+        """Whether a played sensor still plans to transmit (a late reply, a service request)."""
+        with self._lock:
+            return any(d.next_frame() is not None for d in self.devices)
+
+    # -- BusDevice (the line's thread) --------------------------------------------------------
+    def on_break(self, start: float, end: float) -> None:
+        with self._lock:
+            self.add(Event(EventKind.BREAK, TOOL, start, end, uncertainty=self.uncertainty))
+            for device in self.devices:
+                device.on_break(start, end)
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        with self._lock:
+            event = Event(EventKind.CHAR, TOOL, start, end, wire=wire, uncertainty=self.uncertainty)
+            self.add(event)
+            for device in self.devices:
+                device.on_char(wire, start, end)
+
+    def _next(self) -> tuple[BusDevice, Frame] | None:
+        best: tuple[BusDevice, Frame] | None = None
+        for device in self.devices:
+            frame = device.next_frame()
+            if frame is not None and (best is None or frame.start < best[1].start):
+                best = (device, frame)
+        return best
+
+    def next_frame(self) -> Frame | None:
+        with self._lock:
+            nxt = self._next()
+            return nxt[1] if nxt is not None else None
+
+    def pop_frame(self) -> Frame:
+        """Commit the earliest sensor character; the other sensors hear it (as on the sim bus,
+        a sensor that starts while another transmits is queued behind it)."""
+        with self._lock:
+            nxt = self._next()
+            if nxt is None:
+                raise RuntimeError("no played sensor has a character to send")
+            device, frame = nxt
+            device.pop_frame()
+            start = max(frame.start, self._busy)
+            end = start + frame.duration
+            self._busy = end
+            self.add(
+                Event(
+                    EventKind.CHAR,
+                    device.name,
+                    start,
+                    end,
+                    wire=frame.wire,
+                    uncertainty=self.uncertainty,
+                )
+            )
+            for other in self.devices:
+                if other is not device:
+                    other.on_char(frame.wire, start, end)
+            return Frame(start, frame.wire, frame.duration)
+
+
+class ServedLine:
+    """The tool's end of the served line: what the run's reports read as its link (kind,
+    breaks, uncertainty, transcript, clock). The tool transmits nothing on it itself: the
+    played sensors do, on the line's thread."""
+
+    def __init__(self, spec: ServeSpec, uncertainty: float | None = None) -> None:
+        host = spec.host
+        if uncertainty is None:
+            loopback = _is_loopback(f"x://{host}:0")
+            uncertainty = LOCAL_NET_UNCERTAINTY if loopback else REMOTE_NET_UNCERTAINTY
+        self.info = LinkInfo(kind=SCHEME, can_break=True, timing_uncertainty=uncertainty)
+        self.bus = PlayedBus(uncertainty)
+        self._t0 = time.perf_counter()
+        self.line = RealTimeLine(self.bus, lambda _data: None, clock=self.now)
+        self.log: list[str] = []
+        try:
+            self.server = TcpEmulatorServer(self.line, host, spec.port, log=self.log.append)
+        except OSError as exc:
+            raise PortError(f"cannot serve on {host}:{spec.port}: {exc}") from exc
+        self.line.start()
+        self._thread = threading.Thread(target=self.server.serve, name="sdi12-served", daemon=True)
+        self._thread.start()
+        self._closed = False
+
+    @property
+    def transcript(self) -> Transcript:
+        return self.bus.transcript
+
+    @property
+    def url(self) -> str:
+        """Where a recorder connects (``rfc2217://HOST:PORT`` with the port actually bound)."""
+        return self.server.url
+
+    def now(self) -> float:
+        """The line's clock: seconds since the server started."""
+        return time.perf_counter() - self._t0
+
+    def note(self, text: str) -> None:
+        self.bus.add(Event(EventKind.NOTE, TOOL, self.now(), self.now(), text=text))
+
+    def settle(self, longest: float) -> None:
+        """Wait (at most ``longest`` s) until the line has been quiet for :data:`QUIET` and no
+        played sensor plans to transmit, so late sensor output stays with its scenario."""
+        deadline = time.monotonic() + longest
+        while time.monotonic() < deadline:
+            quiet = self.now() - max(self.bus.last_end, 0.0) >= QUIET
+            if quiet and not self.bus.pending():
+                return
+            time.sleep(SETTLE_POLL)
+
+    def errors(self) -> list[BaseException]:
+        return list(self.line.errors)
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self.server.stop()
+        self._thread.join(timeout=2.0)
+        self.line.stop()
