@@ -9,7 +9,9 @@ What each kind can do, and how far its stamps can be trusted, is decided here on
   usually another process on a shared machine: its scheduling delays of a few ms, and
   ours, land on the stamps), 10 ms across a network;
 - ``socket://host:port``: no breaks; uncertainty as for rfc2217;
-- ``loop://``: no breaks, 1 ms.
+- ``loop://``: no breaks, 1 ms;
+- ``adapter:...`` / ``adapter+URL``: a transparent SDI-12 adapter
+  (:mod:`~conformance.links.adapter_link`): no breaks, no unsolicited bytes, 50 ms.
 
 ``--timing-uncertainty-ms`` overrides the declaration when the user knows better.
 """
@@ -48,6 +50,10 @@ def _is_loopback(port: str) -> bool:
 
 def open_real_link(port: str, timing_uncertainty: float | None = None) -> Link:
     """Open ``port`` at 1200 baud 8N1 (parity in software) and wrap it in a link."""
+    from .adapter_link import is_adapter_port, open_adapter_link
+
+    if is_adapter_port(port):
+        return open_adapter_link(port, timing_uncertainty)
     kind = port_kind(port)
     raw = _open(port, kind)
     breaker: BreakMaker | None = None
