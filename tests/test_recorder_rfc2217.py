@@ -1,0 +1,97 @@
+"""The recorder role over a real link: the tool serves the played sensors in real time on
+loopback (``rfc2217-serve://``) and the golden recorder talks to them over RFC 2217.
+
+The full compliant run plays every scenario in real time (about a minute and a half); the
+fault run selects the retry case only. Timing verdicts may honestly be INCONCLUSIVE under the
+served line's declared 5 ms uncertainty, never a FAIL; if the machine was too busy for the
+served line to keep its own schedule, the run is no evidence and the test skips with figures.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from conformance.cli import main
+from conformance.emulate.realtime import LATE_NOTICE
+from conformance.recorder.drivers import Trigger
+from conformance.recorder.faults import RECORDER_FAULTS
+from conformance.recorder.session import RecorderSession
+
+SERVE = "rfc2217-serve://127.0.0.1:0"
+#: Requirements judged only on times measured on the line (PASS or INCONCLUSIVE when clean).
+TIMING = {"R-7.0-02", "R-7.0-06", "R-7.0-17", "R-7.2-02"}
+
+
+def run(tmp_path: Path, port: str, *extra: str) -> tuple[int, dict, list[dict]]:
+    out = tmp_path / "report"
+    code = main(["--port", port, "--role", "recorder", "--report-dir", str(out), *extra])
+    data = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
+    lines = (out / "transcript.jsonl").read_text(encoding="utf-8").splitlines()
+    return code, data, [json.loads(line) for line in lines]
+
+
+def worst_lateness(events: list[dict]) -> float:
+    """How far (s) the served line fell behind its schedule, from its per-scenario notes."""
+    found = [re.search(r"within ([0-9.]+) ms", e["text"]) for e in events if e["kind"] == "note"]
+    return max((float(m[1]) / 1e3 for m in found if m), default=0.0)
+
+
+def skip_if_line_was_late(events: list[dict], what: object) -> None:
+    late = worst_lateness(events)
+    if late > LATE_NOTICE:
+        pytest.skip(f"served line fell {late * 1e3:.1f} ms behind real time; {what}")
+
+
+def test_golden_recorder_over_rfc2217_is_compliant(tmp_path):
+    code, data, events = run(tmp_path, SERVE)
+    verdicts = {r["id"]: r["verdict"] for r in data["requirements"]}
+    bad = {rid: v for rid, v in verdicts.items() if v in ("FAIL", "WARN", "ERROR")}
+    if bad:
+        skip_if_line_was_late(events, bad)
+    assert not bad, bad
+    assert code == 0 and data["summary"]["verdict"] == "COMPLIANT", data["summary"]
+    link = data["run"]["link"]
+    assert link["kind"] == "rfc2217-serve" and link["can_break"] is True
+    assert link["timing_uncertainty_ms"] == 5.0
+    judged = [r for r in data["requirements"] if r["tests"]]
+    assert {r["id"] for r in judged} >= TIMING
+    # the protocol verdicts are definite over the real link
+    assert verdicts["R-7.2-01"] == verdicts["R-4.4.12-07"] == "PASS", verdicts
+    # the transcript is the sensors' view: the recorder's breaks and characters, and each
+    # played sensor's characters under its own name, stamped with the line's uncertainty
+    kinds = {(e["kind"], e["origin"]) for e in events}
+    assert {("break", "tool"), ("char", "tool"), ("char", "sensor0"), ("char", "sensor1")} <= kinds
+    assert {e["uncertainty"] for e in events if e["kind"] != "note"} == {5e-3}
+    breaks = [e["end"] - e["start"] for e in events if e["kind"] == "break"]
+    assert breaks and all(0.008 < b < 0.030 for b in breaks), breaks  # golden: 13 ms asked
+
+
+def test_recorder_without_retries_fails_its_retry_requirements(tmp_path):
+    port = f"{SERVE}?recorder-faults=no-retries"
+    code, data, events = run(tmp_path, port, "-k", "test_retries")
+    failed = {r["id"] for r in data["requirements"] if r["verdict"] == "FAIL"}
+    assert "R-7.2-01" in failed, data["requirements"]
+    assert failed <= set(RECORDER_FAULTS["no-retries"].violates), failed
+    assert code == 1 and data["summary"]["verdict"] == "NON-COMPLIANT"
+
+
+def test_trigger_is_told_where_the_sensors_are_served():
+    session = RecorderSession(SERVE, driver=Trigger('echo "$SDI12_PORT $SDI12_SCENARIO"', 10))
+    try:
+        record = session.run("service-request")
+    finally:
+        session.close()
+    assert record.error is None
+    assert record.output.notes == [f"{session.served.url} service-request"]
+    assert record.output.notes[0].startswith("rfc2217://127.0.0.1:")
+
+
+@pytest.mark.parametrize(
+    "port", ["rfc2217-serve://127.0.0.1", "rfc2217-serve://127.0.0.1:0?bogus=1", "socket://x:1"]
+)
+def test_unusable_serve_ports_are_usage_errors(port):
+    assert main(["--port", port, "--role", "recorder"]) == 4
