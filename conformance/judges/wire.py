@@ -122,7 +122,8 @@ def _combine(rid: str, findings: list[Finding], what: str) -> Finding:
         return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
     worst = max(findings, key=lambda f: (f.verdict.rank, abs(f.measured_ms or 0)))
     values = [f.measured_ms for f in findings if f.measured_ms is not None]
-    span = f"{len(findings)} {what}s, {min(values):.2f}..{max(values):.2f} ms" if values else ""
+    plural = what[:-1] + "ies" if what.endswith("y") else what + "s"
+    span = f"{len(findings)} {plural}, {min(values):.2f}..{max(values):.2f} ms" if values else ""
     if worst.verdict is Verdict.PASS:
         detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"
     else:
