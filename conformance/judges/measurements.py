@@ -80,6 +80,12 @@ def wait_violations(m: Measurement, tally: Tally) -> None:
         sr = _sr_run(chunks, address)
         tally.observe(label, ids=["R-4.4.6-02", "R-4.4.5-08"])
         if sr is None:
+            for rid in ("R-4.4.6-01", "R-4.4.6-04", "R-4.4.5-09"):
+                tally.unobservable(
+                    rid,
+                    "no service request arrived, so its form and timing cannot be judged "
+                    "(see R-4.4.6-02)",
+                )
             tally.fail(
                 "R-4.4.6-02",
                 label,

@@ -26,6 +26,7 @@ class Tally:
         self.observed: dict[str, list[str]] = {rid: [] for rid in self.ids}
         self.violations: dict[str, list[tuple[str, Violation]]] = {rid: [] for rid in self.ids}
         self.na: dict[str, str] = {}
+        self.why_not: dict[str, str] = {}  # why a rule may end up with nothing to judge
         self.decisions: dict[str, str] = {}
 
     def observe(
@@ -44,6 +45,10 @@ class Tally:
 
     def not_applicable(self, rid: str, reason: str) -> None:
         self.na.setdefault(rid, reason)
+
+    def unobservable(self, rid: str, reason: str) -> None:
+        """Say why ``rid`` could not be observed here (its INCONCLUSIVE reason if nothing is)."""
+        self.why_not.setdefault(rid, reason)
 
     def decision(self, rid: str, label: str) -> None:
         self.decisions[rid] = label
@@ -74,13 +79,10 @@ class Tally:
             elif rid in self.na and not seen:
                 result.append(Finding(rid, Verdict.NA, self.na[rid], decision=decision))
             elif not seen:
-                result.append(
-                    Finding(
-                        rid,
-                        Verdict.INCONCLUSIVE,
-                        "nothing was observed that this rule could be judged on",
-                    )
+                reason = self.why_not.get(
+                    rid, "nothing was observed that this rule could be judged on"
                 )
+                result.append(Finding(rid, Verdict.INCONCLUSIVE, reason))
             else:
                 text = ok if isinstance(ok, str) else ok.get(rid, "conforms")
                 listed = ", ".join(dict.fromkeys(seen))
