@@ -20,7 +20,7 @@ from __future__ import annotations
 import bisect
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from math import inf
 from urllib.parse import parse_qs, urlsplit
@@ -85,8 +85,9 @@ class PlayedBus:
 
     name = "played-bus"
 
-    def __init__(self, uncertainty: float) -> None:
+    def __init__(self, uncertainty: float, clock: Callable[[], float]) -> None:
         self.uncertainty = uncertainty
+        self._clock = clock
         self.devices: list[BusDevice] = []
         self.transcript = Transcript()
         self._lock = threading.RLock()
@@ -141,14 +142,18 @@ class PlayedBus:
 
     def pop_frame(self) -> Frame:
         """Commit the earliest sensor character; the other sensors hear it (as on the sim bus,
-        a sensor that starts while another transmits is queued behind it)."""
+        a sensor that starts while another transmits is queued behind it).
+
+        The line delivers a character at its planned end, or at once when it commits it later
+        than that (a machine too busy to keep real time); the stamp says when it really left,
+        so a stall shows in the transcript as the pause the recorder saw, not as on-time."""
         with self._lock:
             nxt = self._next()
             if nxt is None:
                 raise RuntimeError("no played sensor has a character to send")
             device, frame = nxt
             device.pop_frame()
-            start = max(frame.start, self._busy)
+            start = max(frame.start, self._busy, self._clock() - frame.duration)
             end = start + frame.duration
             self._busy = end
             self.add(
@@ -178,8 +183,8 @@ class ServedLine:
             loopback = _is_loopback(f"x://{host}:0")
             uncertainty = LOCAL_NET_UNCERTAINTY if loopback else REMOTE_NET_UNCERTAINTY
         self.info = LinkInfo(kind=SCHEME, can_break=True, timing_uncertainty=uncertainty)
-        self.bus = PlayedBus(uncertainty)
         self._t0 = time.perf_counter()
+        self.bus = PlayedBus(uncertainty, self.now)
         self.line = RealTimeLine(self.bus, lambda _data: None, clock=self.now)
         self.log: list[str] = []
         try:
