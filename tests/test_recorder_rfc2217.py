@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import json
 import re
+import sys
 from pathlib import Path
 
 import pytest
 
 from conformance.cli import main
 from conformance.emulate.realtime import LATE_NOTICE
+from conformance.judges import recorder as judge
 from conformance.recorder.drivers import Trigger
 from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.recorder.session import RecorderSession
@@ -95,3 +97,23 @@ def test_trigger_is_told_where_the_sensors_are_served():
 )
 def test_unusable_serve_ports_are_usage_errors(port):
     assert main(["--port", port, "--role", "recorder"]) == 4
+
+
+def test_golden_recorder_as_a_separate_process_through_the_trigger():
+    """The golden recorder outside the judging process (``--trigger`` runs
+    ``python -m conformance.recorder.external`` per scenario): its retries of a silent sensor
+    are judged from the served line without a FAIL, and it says what it logged."""
+    trigger = Trigger(f"{sys.executable} -m conformance.recorder.external", 30)
+    session = RecorderSession(SERVE, driver=trigger)
+    try:
+        record = session.run("silent-twice")
+        findings = judge.judge_retries(session.line("silent-twice"), session.uncertainty)
+    finally:
+        session.close()
+    assert record.error is None, record.error
+    assert record.output.notes == ["logged 0M! +22.15 +1013.2 +45.7"]
+    sent = "".join(chr(e.char7) for e in record.events if e.kind == "char" and e.origin == "tool")
+    assert sent.count("0M!") == 3, sent  # two unanswered tries, then the answered one
+    verdicts = {f.requirement: str(f.verdict) for f in findings}
+    assert verdicts.get("R-7.2-01") == "PASS", verdicts
+    assert "FAIL" not in verdicts.values(), verdicts
