@@ -98,6 +98,11 @@ def sim_declaration(emulator: object, spec: SimSpec) -> Declaration:
 def open_port(port: str) -> OpenedPort:
     if is_sim(port):
         return open_sim(parse_sim(port))
+    if port.startswith("rfc2217-serve://"):
+        raise PortError(
+            f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
+            "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
+        )
     from .links.factory import open_real_link
 
     return OpenedPort(open_real_link(port))

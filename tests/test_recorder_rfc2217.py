@@ -117,3 +117,8 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
     verdicts = {f.requirement: str(f.verdict) for f in findings}
     assert verdicts.get("R-7.2-01") == "PASS", verdicts
     assert "FAIL" not in verdicts.values(), verdicts
+
+
+def test_serving_sensors_is_refused_in_the_sensor_role(capsys):
+    assert main(["--port", SERVE, "--role", "sensor"]) == 4
+    assert "--role recorder" in capsys.readouterr().out
