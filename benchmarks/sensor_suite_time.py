@@ -12,33 +12,16 @@ import json
 import statistics
 import tempfile
 import time
-from importlib import resources
 from pathlib import Path
 
 import pytest
 
+from conformance.suite import suite_args
+
 
 def one_run() -> tuple[float, dict, int]:
     with tempfile.TemporaryDirectory(prefix="sdi12-bench-") as tmp:
-        args = [
-            "-c",
-            str(resources.files("conformance") / "suite.ini"),
-            "--rootdir",
-            tmp,
-            "-p",
-            "no:cacheprovider",
-            "-p",
-            "no:terminal",
-            "--pyargs",
-            "testcases.sensor",
-            "--sdi12-port",
-            "sim",
-            "--sdi12-report-dir",
-            tmp,
-            f"--html={tmp}/report.html",
-            "--self-contained-html",
-            f"--junitxml={tmp}/junit.xml",
-        ]
+        args = suite_args("sensor", "sim", tmp, rootdir=tmp)
         started = time.perf_counter()
         pytest.main(args)
         elapsed = time.perf_counter() - started

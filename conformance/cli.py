@@ -10,12 +10,12 @@ import argparse
 import datetime as dt
 import json
 import sys
-from importlib import resources
 from pathlib import Path
 
 from rich.console import Console
 
 from . import __version__
+from .suite import suite_args
 
 EXIT_COMPLIANT, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_USAGE, EXIT_NO_DEVICE = (
     0,
@@ -111,28 +111,9 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
     report_dir.mkdir(parents=True, exist_ok=True)
-    ini = resources.files("conformance") / "suite.ini"
-    pytest_args = [
-        "-c",
-        str(ini),
-        "--rootdir",
-        str(Path.cwd()),
-        "-p",
-        "no:cacheprovider",
-        "--pyargs",
-        f"testcases.{args.role}",
-        "--sdi12-port",
-        args.port,
-        "--sdi12-role",
-        args.role,
-        "--sdi12-report-dir",
-        str(report_dir),
-        f"--html={report_dir / 'report.html'}",
-        "--self-contained-html",
-        f"--junitxml={report_dir / 'junit.xml'}",
-        "-o",
-        "junit_family=xunit2",
-    ]
+    pytest_args = suite_args(
+        args.role, args.port, report_dir, rootdir=Path.cwd(), terminal=args.verbose
+    )
     for flag, value in (
         ("--sdi12-address", args.address),
         ("--sdi12-version", args.sdi_version),
@@ -153,7 +134,6 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     else:
         from .reports.console import ProgressPlugin
 
-        pytest_args += ["-p", "no:terminal"]
         plugins.append(ProgressPlugin(console))
 
     import pytest

@@ -12,8 +12,9 @@ import json
 import multiprocessing
 import tempfile
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
+
+from .suite import suite_args
 
 BAD = ("FAIL", "WARN")
 
@@ -40,45 +41,33 @@ class MatrixRow:
         return not self.missed and not self.extra
 
 
-def run_once(port: str, extra: tuple[str, ...] = ()) -> dict:
-    """Run the sensor suite in this process against ``port``; return verdicts.json."""
+def run_once(port: str, extra: tuple[str, ...] = (), role: str = "sensor") -> dict:
+    """Run the ``role`` suite in this process against ``port``; return verdicts.json."""
     import pytest
 
-    with tempfile.TemporaryDirectory(prefix="sdi12-matrix-") as tmp:
-        args = [
-            "-c",
-            str(resources.files("conformance") / "suite.ini"),
-            "--rootdir",
-            tmp,
-            "-p",
-            "no:cacheprovider",
-            "-p",
-            "no:terminal",
-            "-p",
-            "no:html",
-            "--pyargs",
-            "testcases.sensor",
-            "--sdi12-port",
-            port,
-            "--sdi12-report-dir",
-            tmp,
-            *extra,
-        ]
-        pytest.main(args)
+    with tempfile.TemporaryDirectory(prefix=f"sdi12-{role}-") as tmp:
+        pytest.main([*suite_args(role, port, tmp, rootdir=tmp, html=False), *extra])
         return json.loads((Path(tmp) / "verdicts.json").read_text(encoding="utf-8"))
+
+
+def row_from(fault: str, declared: tuple[str, ...], data: dict) -> MatrixRow:
+    """Compare one run's verdicts with what the fault declares."""
+    reqs = data["requirements"]
+    return MatrixRow(
+        fault,
+        declared,
+        tuple(r["id"] for r in reqs if r["verdict"] in BAD),
+        data["summary"]["verdict"],
+        tuple(
+            f"{r['id']}={r['verdict']}" for r in reqs if r["verdict"] in ("INCONCLUSIVE", "ERROR")
+        ),
+        tuple(r["id"] for r in reqs if r["verdict"] == "FAIL"),
+    )
 
 
 def _row(item: tuple[str, tuple[str, ...], str, tuple[str, ...]]) -> MatrixRow:
     fault, declared, version, extra = item
-    data = run_once(f"sim://?faults={fault}&version={version}", extra)
-    flagged = tuple(r["id"] for r in data["requirements"] if r["verdict"] in BAD)
-    other = tuple(
-        f"{r['id']}={r['verdict']}"
-        for r in data["requirements"]
-        if r["verdict"] in ("INCONCLUSIVE", "ERROR")
-    )
-    failed = tuple(r["id"] for r in data["requirements"] if r["verdict"] == "FAIL")
-    return MatrixRow(fault, declared, flagged, data["summary"]["verdict"], other, failed)
+    return row_from(fault, declared, run_once(f"sim://?faults={fault}&version={version}", extra))
 
 
 def fault_matrix(faults: list[str] | None = None, processes: int = 2) -> list[MatrixRow]:

@@ -1,0 +1,46 @@
+"""How the conformance suite is invoked: one place that builds pytest's arguments.
+
+The CLI, the fault matrices and the benchmark all run the same suite; they differ only in
+which outputs they want, so none of them spells the pytest command line on its own.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+
+def suite_args(
+    role: str,
+    port: str,
+    report_dir: Path | str,
+    *,
+    rootdir: Path | str,
+    html: bool = True,
+    terminal: bool = False,
+) -> list[str]:
+    """pytest arguments for the ``role`` suite against ``port``, reports into ``report_dir``.
+
+    The bundled ``suite.ini`` keeps a project's own pytest settings out of the judged run.
+    ``html`` adds report.html and junit.xml; ``terminal`` keeps pytest's own output.
+    """
+    report_dir = Path(report_dir)
+    args = [
+        "-c", str(resources.files("conformance") / "suite.ini"),
+        "--rootdir", str(rootdir),
+        "-p", "no:cacheprovider",
+        "--pyargs", f"testcases.{role}",
+        "--sdi12-port", port,
+        "--sdi12-role", role,
+        "--sdi12-report-dir", str(report_dir),
+    ]  # fmt: skip
+    if html:
+        args += [
+            f"--html={report_dir / 'report.html'}", "--self-contained-html",
+            f"--junitxml={report_dir / 'junit.xml'}", "-o", "junit_family=xunit2",
+        ]  # fmt: skip
+    else:
+        args += ["-p", "no:html"]
+    if not terminal:
+        args += ["-p", "no:terminal"]
+    return args
