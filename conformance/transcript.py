@@ -85,6 +85,17 @@ def decode_8n1(events: Iterable[Event]) -> bytes:
     return bytes(e.wire for e in events if e.kind is EventKind.CHAR)
 
 
+def text_end(events: list[Event], text: str) -> float | None:
+    """End of the first run of characters spelling ``text`` with good parity (e.g. a service
+    request ``a<CR><LF>``), or None."""
+    n = len(text)
+    for i in range(n - 1, len(events)):
+        tail = events[i - n + 1 : i + 1]
+        if decode_7e1(tail) == text and all(e.parity_ok for e in tail):
+            return tail[-1].end
+    return None
+
+
 def parity_errors(events: Iterable[Event]) -> list[Event]:
     return [e for e in events if e.kind is EventKind.CHAR and not e.parity_ok]
 

@@ -41,9 +41,10 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..protocol.values import split_values
-from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
+from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, escape, text_end
 from ..verdicts import Finding, Verdict
 from .tally import Tally
+from .timing import combine as combine_timing
 from .timing import judge_window
 
 IsRecorder = Callable[[Event], bool]
@@ -198,28 +199,9 @@ def _previous_activity(line: Line, sent: Sent) -> float | None:
 
 
 def combine(rid: str, findings: list[Finding], what: str) -> Finding:
-    """One finding per requirement: the worst observation, with the range of all."""
-    if not findings:
-        return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
-    worst = max(findings, key=lambda f: (f.verdict.rank, -(f.measured_ms or 0)))
-    values = [f.measured_ms for f in findings if f.measured_ms is not None]
-    span = f"{len(findings)} {what}(s), {min(values):.2f}..{max(values):.2f} ms" if values else ""
-    if worst.verdict is Verdict.PASS and ", allowed " in worst.detail:
-        detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"
-    elif worst.verdict is Verdict.PASS:
-        detail = f"{len(findings)} {what}(s) observed; {span + '; ' if span else ''}{worst.detail}"
-    else:
-        where = worst.evidence[0] if worst.evidence else ""
-        detail = f"{worst.detail} [{where}]; {span}"
-    return Finding(
-        rid,
-        worst.verdict,
-        detail,
-        measured_ms=worst.measured_ms,
-        limit_ms=worst.limit_ms,
-        uncertainty_ms=worst.uncertainty_ms,
-        evidence=worst.evidence,
-    )
+    """Recorder limits are mostly minimums (break length, marking, waits): the smallest
+    measurement is the one to show."""
+    return combine_timing(rid, findings, what, smallest_is_worst=True)
 
 
 def _at(sent: Sent) -> str:
@@ -352,11 +334,8 @@ class Taken:
 
 
 def _service_request_end(events: list[Event], address: str) -> float | None:
-    for i in range(2, len(events)):
-        tail = events[i - 2 : i + 1]
-        if decode_7e1(tail) == f"{address}\r\n" and all(e.parity_ok for e in tail):
-            return tail[-1].end
-    return None
+    """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
+    return text_end(events, f"{address}\r\n")
 
 
 def measurements(line: Line, uncertainty: float) -> list[Taken]:

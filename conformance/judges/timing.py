@@ -66,3 +66,38 @@ def _describe_limit(lo: float | None, hi: float | None) -> str:
     if lo is not None:
         return f"≥ {lo * 1e3:.2f} ms"
     return "any"
+
+
+def plural(what: str) -> str:
+    return what[:-1] + "ies" if what.endswith("y") and not what.endswith("ay") else what + "s"
+
+
+def combine(
+    rid: str, findings: list[Finding], what: str, *, smallest_is_worst: bool = False
+) -> Finding:
+    """One finding per requirement out of many observations: the worst verdict (and, among
+    equals, the largest measurement, or the smallest for minimum limits such as a break's
+    length), with the range of all of them, so a reader sees one line per rule."""
+    if not findings:
+        return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
+    sign = -1 if smallest_is_worst else 1
+    worst = max(findings, key=lambda f: (f.verdict.rank, sign * abs(f.measured_ms or 0)))
+    values = [f.measured_ms for f in findings if f.measured_ms is not None]
+    count = f"{len(findings)} {plural(what) if len(findings) != 1 else what}"
+    span = f"{count}, {min(values):.2f}..{max(values):.2f} ms" if values else ""
+    if worst.verdict is Verdict.PASS and ", allowed " in worst.detail:
+        detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"
+    elif worst.verdict is Verdict.PASS:
+        detail = f"{count} observed; {span + '; ' if span else ''}{worst.detail}"
+    else:
+        where = worst.evidence[0] if worst.evidence else ""
+        detail = f"{worst.detail} [{where}]; {span}"
+    return Finding(
+        rid,
+        worst.verdict,
+        detail,
+        measured_ms=worst.measured_ms,
+        limit_ms=worst.limit_ms,
+        uncertainty_ms=worst.uncertainty_ms,
+        evidence=worst.evidence,
+    )

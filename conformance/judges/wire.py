@@ -21,7 +21,7 @@ from ..protocol.timing import (
 )
 from ..transcript import TOOL, Event, EventKind, escape
 from ..verdicts import Finding, Verdict
-from .timing import judge_window
+from .timing import combine, judge_window
 
 REPLY_SEARCH = NO_BREAK_WINDOW  # a DUT run starting later than this is not a reply
 RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
@@ -116,29 +116,6 @@ def runs(events: list[Event]) -> list[list[Event]]:
 
 
 # -- timing ---------------------------------------------------------------------------------
-def _combine(rid: str, findings: list[Finding], what: str) -> Finding:
-    """One finding per requirement: the worst observation, with the range of all of them."""
-    if not findings:
-        return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
-    worst = max(findings, key=lambda f: (f.verdict.rank, abs(f.measured_ms or 0)))
-    values = [f.measured_ms for f in findings if f.measured_ms is not None]
-    plural = what[:-1] + "ies" if what.endswith("y") else what + "s"
-    span = f"{len(findings)} {plural}, {min(values):.2f}..{max(values):.2f} ms" if values else ""
-    if worst.verdict is Verdict.PASS:
-        detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"
-    else:
-        detail = f"{worst.detail} [{worst.evidence[0] if worst.evidence else ''}]; {span}"
-    return Finding(
-        rid,
-        worst.verdict,
-        detail,
-        measured_ms=worst.measured_ms,
-        limit_ms=worst.limit_ms,
-        uncertainty_ms=worst.uncertainty_ms,
-        evidence=worst.evidence,
-    )
-
-
 def judge_response_start(segs: list[Segment], uncertainty: float) -> list[Finding]:
     """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply."""
     early, late = [], []
@@ -169,7 +146,7 @@ def judge_response_start(segs: list[Segment], uncertainty: float) -> list[Findin
             )
         )
     _ = RESPONSE_START_MIN  # = CHAR_TIME - TOLERANCE, the derived window's lower edge
-    return [_combine("R-7.0-09", early, "reply"), _combine("R-7.0-10", late, "reply")]
+    return [combine("R-7.0-09", early, "reply"), combine("R-7.0-10", late, "reply")]
 
 
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
@@ -199,7 +176,7 @@ def judge_gaps(segs: list[Segment], uncertainty: float) -> list[Finding]:
         )
         for gap, where in reply_gaps(segs)
     ]
-    gap_finding = _combine("R-7.0-12", findings, "character gap")
+    gap_finding = combine("R-7.0-12", findings, "character gap")
     tolerance_finding = _judge_tolerance_use(reply_gaps(segs), uncertainty)
     return [gap_finding, tolerance_finding]
 

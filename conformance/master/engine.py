@@ -24,7 +24,7 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..protocol.values import split_values
-from ..transcript import TOOL, Event, EventKind, decode_7e1, to_wire_7e1
+from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
 from . import validity
 from .framing import Framing
 from .policy import Policy
@@ -428,11 +428,7 @@ def _raises_sr(command: Command) -> bool:
 
 def _service_request_end(events: list[Event], address: str) -> float | None:
     """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
-    for i in range(2, len(events)):
-        tail = events[i - 2 : i + 1]
-        if decode_7e1(tail) == f"{address}\r\n" and all(e.parity_ok for e in tail):
-            return tail[-1].end
-    return None
+    return text_end(events, f"{address}\r\n")
 
 
 def _last_dut_char_end(link: Link) -> float:
