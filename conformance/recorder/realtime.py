@@ -30,7 +30,7 @@ from ..emulate.servers import TcpEmulatorServer
 from ..links.base import LinkInfo
 from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
 from ..ports import PortError
-from ..sim.bus import BusDevice, Frame
+from ..sim.bus import BusDevice, Frame, earliest_frame
 from ..transcript import TOOL, Event, EventKind, Transcript
 
 SCHEME = "rfc2217-serve"
@@ -128,12 +128,7 @@ class PlayedBus:
                 device.on_char(wire, start, end)
 
     def _next(self) -> tuple[BusDevice, Frame] | None:
-        best: tuple[BusDevice, Frame] | None = None
-        for device in self.devices:
-            frame = device.next_frame()
-            if frame is not None and (best is None or frame.start < best[1].start):
-                best = (device, frame)
-        return best
+        return earliest_frame(self.devices)
 
     def next_frame(self) -> Frame | None:
         with self._lock:

@@ -47,6 +47,16 @@ class BusDevice(Protocol):
         """Commit the character :meth:`next_frame` offered; it is now on the wire."""
 
 
+def earliest_frame(devices: list[BusDevice]) -> tuple[BusDevice, Frame] | None:
+    """The device whose next character starts first, and that character (None if silent)."""
+    best: tuple[BusDevice, Frame] | None = None
+    for device in devices:
+        frame = device.next_frame()
+        if frame is not None and (best is None or frame.start < best[1].start):
+            best = (device, frame)
+    return best
+
+
 class VirtualClock:
     def __init__(self, start: float = 0.0) -> None:
         self.now = start
@@ -69,12 +79,7 @@ class SimBus:
         self.devices.append(device)
 
     def _next(self) -> tuple[BusDevice, Frame] | None:
-        best: tuple[BusDevice, Frame] | None = None
-        for device in self.devices:
-            frame = device.next_frame()
-            if frame is not None and (best is None or frame.start < best[1].start):
-                best = (device, frame)
-        return best
+        return earliest_frame(self.devices)
 
     def advance(self, time: float) -> None:
         """Let devices transmit everything that starts before ``time``, then set the clock."""
