@@ -72,7 +72,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--timing-uncertainty-ms",
         type=float,
-        help="override the link's declared timestamp uncertainty",
+        help="widen the timestamp uncertainty the link measures (it can never narrow it)",
+    )
+    p.add_argument(
+        "--echo",
+        default="auto",
+        choices=("auto", "on", "off"),
+        help="real links: does the interface echo the tool's own characters "
+        "(default auto: found out on the first transmission)",
+    )
+    p.add_argument(
+        "--direction",
+        default="none",
+        choices=("none", "rts", "dtr"),
+        help="real links: raise this line for exactly the tool's transmissions "
+        "(an RS-485-style transceiver's driver enable)",
     )
     p.add_argument(
         "--trigger",
@@ -104,7 +118,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         else:
             from .ports import open_port
 
-            open_port(args.port).link.close()  # a port that cannot be opened: a usage error
+            # a port that cannot be opened: a usage error
+            open_port(args.port, echo=args.echo, direction=args.direction).link.close()
     except (DeclarationError, PortError) as exc:
         console.print(f"error: {exc}", style="red", markup=False)
         return EXIT_USAGE
@@ -126,6 +141,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         pytest_args += ["--sdi12-timing-uncertainty-ms", str(args.timing_uncertainty_ms)]
     if args.strict:
         pytest_args.append("--sdi12-strict")
+    pytest_args += ["--sdi12-echo", args.echo, "--sdi12-direction", args.direction]
     if args.keyword:
         pytest_args += ["-k", args.keyword]
     plugins: list[object] = []
