@@ -38,6 +38,7 @@ examples:
   sdi12-conform faults                                     the emulator faults and what they break
   sdi12-conform matrix                                     run the fault-detection matrix
   sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
+  sdi12-conform calibrate --port /dev/ttyUSB0              measure the bench's timing first
 
 exit codes: 0 compliant, 1 non-compliant, 2 interrupted/incomplete, 3 internal error,
             4 usage error, 5 no device answered
@@ -282,6 +283,10 @@ def main(argv: list[str] | None = None) -> int:
             from .emulate.command import emulate_main
 
             return emulate_main(argv[1:])
+        if argv and argv[0] == "calibrate":
+            from .calibrate import calibrate_main
+
+            return calibrate_main(argv[1:])
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:

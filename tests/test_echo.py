@@ -138,12 +138,27 @@ def test_combine_local_sets_aside_only_what_irregular_stamps_left_undecided():
     failed = judge_window("R-7.0-10", "start", 25e-3, 3e-3, high=15.4e-3)
     found = combine_local("R-7.0-10", [(passed, False), (undecided, True)], "reply")
     assert found.verdict is Verdict.PASS and "1 reply set aside" in found.detail
-    found = combine_local("R-7.0-10", [(passed, False), (failed, True)], "reply")
-    assert found.verdict is Verdict.FAIL  # a decided FAIL always counts
+    found = combine_local("R-7.0-10", [(passed, False), (failed, True)], "reply", real_time=False)
+    assert found.verdict is Verdict.FAIL  # a decided FAIL on an exact clock always counts
     found = combine_local("R-7.0-10", [(undecided, True)], "reply")
     assert found.verdict is Verdict.INCONCLUSIVE  # nothing left to rest a verdict on
     found = combine_local("R-7.0-10", [(undecided, False)], "reply")
     assert found.verdict is Verdict.INCONCLUSIVE  # undecided with the regular figure: stays
+
+
+def test_one_isolated_deviation_on_a_real_time_link_is_not_a_fail():
+    """A host stall can make one stamp late with no trace; two deviations are a FAIL."""
+    passed = judge_window("R-7.0-12", "gap", 0.0, 1e-3, high=1.66e-3, tolerance=0.0)
+    failed = judge_window("R-7.0-12", "gap", 6e-3, 1e-3, high=1.66e-3, tolerance=0.0)
+    assert failed.verdict is Verdict.FAIL
+    lone = combine_local("R-7.0-12", [(passed, False), (failed, False)], "gap")
+    assert lone.verdict is Verdict.INCONCLUSIVE and "one gap of 2 deviates" in lone.detail
+    twice = combine_local("R-7.0-12", [(passed, False), (failed, False), (failed, False)], "gap")
+    assert twice.verdict is Verdict.FAIL
+    only = combine_local("R-7.0-12", [(failed, False)], "gap")
+    assert only.verdict is Verdict.FAIL  # nothing contradicts the one observation
+    exact = combine_local("R-7.0-12", [(passed, False), (failed, False)], "gap", real_time=False)
+    assert exact.verdict is Verdict.FAIL
 
 
 def test_stamp_uncertainty_is_the_base_or_more():

@@ -37,6 +37,7 @@ from .bench import (
 )
 
 SPIN = 0.0008  # s: poll the last stretch before a due time instead of oversleeping it
+RT_SPIN = 0.0001  # s: the same with a real-time class, whose sleeps end within microseconds
 LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counted as late
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
 
@@ -187,12 +188,13 @@ class RealTimeLine:
 
     def _run(self) -> None:
         self.realtime_priority = realtime_priority(EMULATED_LINE)
+        spin = RT_SPIN if self.realtime_priority else SPIN  # a spinning RT thread starves others
         while not self._stop.is_set():
             with self._cond:
                 nxt = self._next_due()
                 now = self.now()
-                if nxt > now + SPIN:
-                    self._cond.wait(min(nxt - now - SPIN, MAX_IDLE_WAIT))
+                if nxt > now + spin:
+                    self._cond.wait(min(nxt - now - spin, MAX_IDLE_WAIT))
                     continue
             while self.now() < nxt:
                 time.sleep(0)

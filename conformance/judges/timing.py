@@ -40,12 +40,18 @@ def combine_local(
     what: str,
     *,
     smallest_is_worst: bool = False,
+    real_time: bool = True,
 ) -> Finding:
     """:func:`combine` for observations each judged with its own uncertainty, flagged where
-    that was widened by a local irregularity of the link's stamps. An observation that the
-    irregularity alone left undecided says nothing about the DUT: it is set aside (and
-    counted in the detail) instead of making the whole rule INCONCLUSIVE. Decided ones all
-    count; if every observation was set aside the rule stays INCONCLUSIVE."""
+    that was widened by a local irregularity of the link's stamps.
+
+    - An observation that the irregularity alone left undecided says nothing about the DUT:
+      it is set aside (and counted in the detail) instead of making the whole rule
+      INCONCLUSIVE. If every observation was set aside the rule stays INCONCLUSIVE.
+    - On a real-time link (``real_time``) a host that stalls once can make one stamp late
+      with no trace around it; a single deviating observation among others that conform is
+      therefore not enough for a FAIL (INCONCLUSIVE, with the observation), two or more are.
+      On a virtual clock every observation is exact and one is enough."""
     kept = [f for f, tainted in observed if not (tainted and f.verdict is Verdict.INCONCLUSIVE)]
     aside = [f for f, tainted in observed if tainted and f.verdict is Verdict.INCONCLUSIVE]
     worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
@@ -55,7 +61,25 @@ def combine_local(
     )
     if aside and not kept:
         return Finding(rid, Verdict.INCONCLUSIVE, f"every {what} undecided; {note}")
+    failing = [f for f in kept if f.verdict is Verdict.FAIL]
+    isolated = real_time and len(failing) == 1 and len(kept) > 1
+    if isolated:
+        (lone,) = failing
+        kept = [f for f in kept if f is not lone]
     found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
+    if isolated:
+        where = f" [{lone.evidence[0]}]" if lone.evidence else ""
+        found = Finding(
+            rid,
+            Verdict.INCONCLUSIVE,
+            f"one {what} of {len(kept) + 1} deviates: {lone.detail}{where}; every other "
+            f"conforms ({found.detail}). A single late stamp on a real-time link may be a "
+            "stall of the host, not of the device: not decided",
+            measured_ms=lone.measured_ms,
+            limit_ms=lone.limit_ms,
+            uncertainty_ms=lone.uncertainty_ms,
+            evidence=lone.evidence,
+        )
     if aside:
         found.detail += f"; {note}"
     return found

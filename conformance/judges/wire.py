@@ -158,7 +158,11 @@ def judge_response_start(
             )
         )
     _ = RESPONSE_START_MIN  # = CHAR_TIME - TOLERANCE, the derived window's lower edge
-    return [combine_local("R-7.0-09", early, "reply"), combine_local("R-7.0-10", late, "reply")]
+    real = stamps.local is not None
+    return [
+        combine_local("R-7.0-09", early, "reply", real_time=real),
+        combine_local("R-7.0-10", late, "reply", real_time=real),
+    ]
 
 
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
@@ -195,7 +199,9 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
             evidence=[where],
         )
         observed.append((finding, u > stamps.base))
-    gap_finding = combine_local("R-7.0-12", observed, "character gap")
+    gap_finding = combine_local(
+        "R-7.0-12", observed, "character gap", real_time=stamps.local is not None
+    )
     tolerance_finding = _judge_tolerance_use(reply_gaps(segs), stamps.base)
     return [gap_finding, tolerance_finding]
 

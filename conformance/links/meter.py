@@ -78,6 +78,15 @@ class TimingMeter:
     taints: list[Taint] = field(default_factory=list)
     spreads: list[tuple[float, float, float]] = field(default_factory=list)  # start, end, s
 
+    trips: list[float] = field(default_factory=list)  # write-to-echo delays so far
+
+    def typical_round_trip(self) -> float | None:
+        """The median write-to-echo delay so far (None before a few were seen)."""
+        if len(self.trips) < MIN_SPREADS:
+            return None
+        ordered = sorted(self.trips)
+        return ordered[len(ordered) // 2]
+
     def taint(self, start: float, end: float, error: float, why: str) -> None:
         self.taints.append(Taint(start, end, error, why))
 

@@ -29,11 +29,11 @@ from collections import deque
 
 import serial
 
-from ..protocol.timing import CHAR_TIME
+from ..protocol.timing import CHAR_TIME, RESPONSE_START_MAX, RESPONSE_START_MIN
 from ..transcript import DUT, TOOL, Event, EventKind, Transcript
 from .base import Link, LinkInfo, StopCondition
 from .breaks import BaudPulse, BreakMaker
-from .direction import Direction
+from .direction import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
 from .meter import TimingMeter
@@ -43,6 +43,9 @@ from .stamps import chunk_frames, overlap
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
 ECHO_WAIT = 0.1  # s: beyond the latency floor, how long an echo may take to come back
+RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
+RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release
+TURNAROUND_LIMIT = RESPONSE_START_MIN / 2  # s: a later release may swallow a reply's start
 SWITCH_INTERVAL = 2e-4  # s: GIL hand-over while a real link runs (default 5 ms starves readers)
 
 
@@ -76,6 +79,7 @@ class SerialLink(Link):
         self._breaker = breaker
         self._pulse = pulse
         self._direction = direction
+        self._release = TimedRelease(direction, self.now) if direction is not None else None
         self._t0 = time.perf_counter_ns()
         self._cond = threading.Condition()
         self._rx: deque[Event] = deque()  # DUT characters not yet returned by receive()
@@ -85,6 +89,8 @@ class SerialLink(Link):
         # known whether their echo will stand for them (the first transmission on auto)
         self._planned_pending: list[Event] = []
         self._rx_floor = 0.0  # end of the last received frame: the next cannot start before
+        # (floor before it, marking its stamps showed before it, arrival) of the last chunk
+        self._previous_chunk = (0.0, 0.0, float("-inf"))
         self._tx_free = 0.0  # end of the tool's last frame on the wire
         self._failure: BaseException | None = None
         self._closing = threading.Event()
@@ -158,20 +164,43 @@ class SerialLink(Link):
 
     def _frame_ends(self, chunk: bytes, arrival: float) -> list[float]:
         """Stop-bit ends of bytes that reached the host together, and what that shows about
-        the stamps: a batch hides its gaps, a frame pushed past the previous one is an
-        artefact (caller holds the lock)."""
-        first = arrival - len(chunk) * CHAR_TIME
-        if len(chunk) > 1:
-            hidden = (len(chunk) - 1) * CHAR_TIME
-            self.meter.batches.add(hidden, f"{len(chunk)} bytes at once")
-            self.meter.taint(first, arrival, hidden, f"{len(chunk)} bytes reached the host at once")
-        pushed = overlap(len(chunk), arrival, self._rx_floor)
+        the stamps (caller holds the lock).
+
+        Bytes that arrive together, or closer together than one wire can carry them, were
+        held somewhere on the way; when the first of them really ended is then unknown: as
+        early as right after the byte before them. So the marking measured before such a
+        burst, and any gap hidden inside it, may be off by that whole room: the stamps there
+        are tainted by it. A frame pushed past the previous one is an artefact of the same
+        kind (one of the two stamps is wrong by the overlap)."""
+        count = len(chunk)
+        floor = self._rx_floor
+        room = max(0.0, arrival - count * CHAR_TIME - floor)  # marking the stamps show before
+        # a held byte may have left anywhere in the path's latency range before its batch
+        spread = 2 * self.meter.uncertainty()
+        if count > 1:
+            hidden = (count - 1) * CHAR_TIME
+            self.meter.batches.add(hidden, f"{count} bytes at once")
+            self.meter.taint(
+                floor - CHAR_TIME, arrival, room + hidden + spread, f"{count} bytes at once"
+            )
+        prev_floor, prev_room, prev_arrival = self._previous_chunk
+        spacing = arrival - prev_arrival
+        if spacing < count * CHAR_TIME - self.meter.uncertainty():
+            # this chunk came too soon after the previous one: that one was held back
+            self.meter.batches.add(count * CHAR_TIME - spacing, "bytes in a burst")
+            self.meter.taint(
+                prev_floor - CHAR_TIME,
+                arrival,
+                prev_room + count * CHAR_TIME - spacing + spread,
+                "bytes reached the host in a burst",
+            )
+        pushed = overlap(count, arrival, floor)
         if pushed > 0:
             self.meter.artefacts.add(pushed, f"frames overlapping by {pushed * 1e3:.2f} ms")
-            # the previous frame came late, or this one early: both stamps are suspect
-            self.meter.taint(self._rx_floor - 2 * CHAR_TIME, arrival, pushed, "frames overlapped")
-        frames = chunk_frames(len(chunk), arrival, self._rx_floor)
+            self.meter.taint(floor - 2 * CHAR_TIME, arrival, pushed, "frames overlapped")
+        frames = chunk_frames(count, arrival, floor)
         self._rx_floor = frames[-1][1]
+        self._previous_chunk = (floor, room, arrival)
         return [end for _start, end in frames]
 
     def _record(self, heard: Heard) -> None:
@@ -234,7 +263,7 @@ class SerialLink(Link):
             return []
         with self._cond:
             self.echo.expect([Expected(b, CHAR_TIME) for b in wire])
-        self._drive(True)
+        self._drive()
         planned: list[Event] = []
         if gap <= 0:
             start = max(self.now(), self._tx_free)
@@ -252,9 +281,10 @@ class SerialLink(Link):
             else:
                 for e in planned:
                     self.transcript.add(e)
+        self._release_at(planned[-1].end)
         self.wait_until(planned[-1].end)
         events = self._settle_echo(planned, back_to_back=gap <= 0)
-        self._drive(False, planned[-1].end)
+        self._released(planned[-1].end)
         return events
 
     def _planned(self, byte: int, start: float) -> Event:
@@ -313,7 +343,18 @@ class SerialLink(Link):
         if len(chars) > 1 and back_to_back:
             spread = max(offsets) - min(offsets)
             self.meter.spread(chars[0].start, chars[-1].end, spread, f"echo of {text!r}")
-        self.meter.round_trip.add(chars[-1].end - planned[-1].end, f"echo of {text!r}")
+        trip = chars[-1].end - planned[-1].end
+        typical = self.meter.typical_round_trip()
+        self.meter.round_trip.add(trip, f"echo of {text!r}")
+        self.meter.trips.append(trip)
+        if typical is not None and trip - typical > self.meter.uncertainty():
+            # the whole echo came late: the command's end, as heard, is late by that much
+            self.meter.taint(
+                chars[0].start,
+                chars[-1].end + RESPONSE_START_MAX,
+                trip - typical,
+                "the echo of the command came late",
+            )
 
     def _port_write(self, data: bytes) -> None:
         try:
@@ -322,18 +363,48 @@ class SerialLink(Link):
             self._failure = self._failure or exc
             self._check()
 
-    def _drive(self, on: bool, last_stop: float | None = None) -> None:
-        """Raise or release the transmit-enable line (if the bench has one); on release,
-        measure how long after the last stop bit the driver let go."""
+    def _drive(self) -> None:
+        """Raise the transmit-enable line (if the bench has one) before the tool sends."""
         if self._direction is None:
             return
         try:
-            self._direction.set(on)
+            self._direction.set(True)
         except Exception as exc:
             self._failure = self._failure or exc
             self._check()
-        if not on and last_stop is not None:
-            self.meter.turnaround.add(max(0.0, self.now() - last_stop), self._direction.line)
+
+    def _release_at(self, last_stop: float) -> None:
+        """Have the driver released right after the last stop bit (by the timer thread)."""
+        if self._release is not None:
+            self._release.schedule(last_stop + RELEASE_MARGIN)
+
+    def _released(self, last_stop: float) -> None:
+        """Wait for the release and measure the turnaround it added. A release so late that
+        the sensor may already have started its reply means the start of that reply may be
+        lost under the tool's own driver: the stamps there are tainted by it."""
+        if self._release is None or self._direction is None:
+            return
+        try:
+            at = self._release.wait(RELEASE_WAIT)
+        except Exception as exc:
+            self._failure = self._failure or exc
+            self._check()
+            return
+        if at is None:
+            at = self.now()
+            self._direction.set(False)
+        turnaround = max(0.0, at - last_stop)
+        self.meter.turnaround.add(turnaround, self._direction.line)
+        if turnaround > TURNAROUND_LIMIT:
+            with self._cond:
+                self.transcript.note(
+                    at,
+                    f"driver released {turnaround * 1e3:.2f} ms after the last stop bit: the "
+                    "start of a reply may have been lost under it",
+                )
+            self.meter.taint(
+                last_stop, at + RESPONSE_START_MAX, RESPONSE_START_MAX, "late driver release"
+            )
 
     def send_break(self, duration: float) -> Event:
         self._check()
@@ -344,14 +415,15 @@ class SerialLink(Link):
                 self.transcript.note(self.now(), note)
             raise BreakUnsupported(note)
         precise_sleep_until(self.now, self._tx_free)
-        self._drive(True)
+        self._drive()
         if pulse is not None:
             event = self._uart_pulse(pulse, duration)
         else:
             event = self._held_break(duration)
         with self._cond:
             self.transcript.add(event)
-        self._drive(False, event.end)
+        self._release_at(event.end)
+        self._released(event.end)
         return event
 
     def _held_break(self, duration: float) -> Event:
@@ -476,6 +548,8 @@ class SerialLink(Link):
         with contextlib.suppress(Exception):  # closing a vanished port must not mask the result
             self.port.close()
         self._reader.join(timeout=1.0)
+        if self._release is not None:
+            self._release.close()
         sys.setswitchinterval(self._switch_interval)
 
 
