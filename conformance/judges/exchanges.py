@@ -42,7 +42,7 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
         return failed(
             rid, f"{what}: " + "; ".join(v.message for v in problems), evidence=[shown(ex)]
         )
-    return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)])
+    return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)], observed=1)
 
 
 def identification(ex: Exchange, address: str) -> tuple[Identification | None, list[Finding]]:
@@ -86,6 +86,7 @@ def silent(
         f"stayed silent ({why}) to {len(exchanges)} command(s): "
         + ", ".join(escape(e.text) for e in exchanges),
         decision=decision,
+        observed=len(exchanges),
     )
 
 
@@ -111,6 +112,7 @@ def answered(
         f"answered ({why}): "
         + ", ".join(shown(e) for e in exchanges[:4])
         + (f" (+{len(exchanges) - 4} more)" if len(exchanges) > 4 else ""),
+        observed=len(exchanges),
     )
 
 

@@ -461,6 +461,7 @@ def judge_character_gaps(line: Line, uncertainty: float) -> list[Finding]:
             Verdict.PASS,
             f"{len(gaps)} command character gaps, none inside the tolerance band the 1.66 ms "
             "limit does not have; ±0.40 ms applied to every other recorder limit",
+            observed=len(gaps),
         )
     else:
         tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
@@ -550,13 +551,14 @@ def judge_break_rules(line: Line, uncertainty: float) -> list[Finding]:
                     "R-7.1-01",
                     Verdict.PASS,
                     f"a break before {_at(s)} after the service request",
+                    observed=1,
                 )
             )
         previous = s
     return [
         combine("R-7.0-17", rule17, "command without a break")
         if rule17
-        else Finding("R-7.0-17", Verdict.PASS, _all_broke(line)),
+        else Finding("R-7.0-17", Verdict.PASS, _all_broke(line), observed=len(line.sent)),
         combine("R-7.1-01", rule71, "aD0! after a service request"),
     ]
 
@@ -642,6 +644,7 @@ def judge_measure_waits(taken: Sequence[Taken], uncertainty: float) -> list[Find
                     "R-4.4.5-04",
                     Verdict.PASS,
                     f"aD0! only after the service request ({where})",
+                    observed=1,
                 )
             )
         tally.observe(where, ids=["R-4.4.5-05"])
@@ -1012,6 +1015,7 @@ def judge_commands_issued(
         rid,
         Verdict.PASS,
         f"{len(asked)} commands issued and answered: " + " ".join(escape(t) for t in asked),
+        observed=len(asked),
     )
 
 
@@ -1022,11 +1026,21 @@ def judge_addresses(line: Line, uncertainty: float) -> list[Finding]:
     r3 = (
         Finding("R-4.3-03", Verdict.FAIL, f"addresses never polled successfully: {digits}")
         if digits
-        else Finding("R-4.3-03", Verdict.PASS, "sensors at 0-9 each polled and answered")
+        else Finding(
+            "R-4.3-03",
+            Verdict.PASS,
+            "sensors at 0-9 each polled and answered",
+            observed=len(polled),
+        )
     )
     letters = sorted(a for a in polled if a.isalpha())
     r4 = (
-        Finding("R-4.3-04", Verdict.PASS, f"letter addresses used: {' '.join(letters)}")
+        Finding(
+            "R-4.3-04",
+            Verdict.PASS,
+            f"letter addresses used: {' '.join(letters)}",
+            observed=len(letters),
+        )
         if letters
         else Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
     )
@@ -1056,13 +1070,13 @@ def judge_transparent(
         if cmd.kind in (Kind.METADATA, Kind.IDENTIFY_MEASUREMENT):
             ids.append("R-6.3-01")
         unchanged.observe(where, ids=ids)
-        mechanism.observe(where)
         matching = [s for s in line.sent if s.text == text]
         if not matching:
             near = [t for t in sent_texts if t[:1] == text[:1]]
             for rid in ids:
                 unchanged.fail(rid, where, f"not on the wire as typed (sent: {near[:3]})")
             continue
+        mechanism.observe(where)  # only a command that went out shows how it went out
         first = matching[0]
         if first.break_event is None:
             mechanism.fail("R-4.4.14-01", where, "sent without a break to wake the bus")

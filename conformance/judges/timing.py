@@ -55,6 +55,7 @@ def judge_window(
         uncertainty_ms=round(uncertainty * 1e3, 3),
         evidence=list(evidence or []),
         decision=decision,
+        observed=1,  # one measured interval between two observed wire events
     )
 
 
@@ -100,4 +101,5 @@ def combine(
         limit_ms=worst.limit_ms,
         uncertainty_ms=worst.uncertainty_ms,
         evidence=worst.evidence,
+        observed=sum(f.observed for f in findings),
     )

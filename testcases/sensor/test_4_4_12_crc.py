@@ -82,4 +82,10 @@ def test_crc_variant_same_measurement(sensor, case):
             )
         )
     else:
-        case.add(passed("R-4.4.12-04", f"{len(pairs)} plain/CRC pairs announce the same counts"))
+        case.add(
+            passed(
+                "R-4.4.12-04",
+                f"{len(pairs)} plain/CRC pairs announce the same counts",
+                observed=len(pairs),
+            )
+        )

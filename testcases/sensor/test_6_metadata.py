@@ -91,7 +91,9 @@ def test_identify_starts_nothing(sensor, case):
     else:
         case.add(
             passed(
-                "R-6.1-03", f"{len(pokes)} identify commands: no service request, data unchanged"
+                "R-6.1-03",
+                f"{len(pokes)} identify commands: no service request, data unchanged",
+                observed=len(pokes) + len(again),
             )
         )
 

@@ -33,7 +33,11 @@ def test_random_command_sequences(sensor, case):
             continue
         if run.checked[rid]:
             case.add(
-                passed(rid, f"held over {run.checked[rid]} checks in {run.steps} random steps")
+                passed(
+                    rid,
+                    f"held over {run.checked[rid]} checks in {run.steps} random steps",
+                    observed=run.checked[rid],
+                )
             )
         else:
             case.add(inconclusive(rid, f"no step of the {run.steps} exercised it"))
