@@ -76,7 +76,10 @@ def test_short_spacing_is_not_a_break(sensor, case):
     else:
         case.add(
             judge.silent(
-                "R-7.0-03", [ex], f"a {pulse.duration * 1e3:.2f} ms spacing is not a break"
+                "R-7.0-03",
+                [ex],
+                f"a {pulse.duration * 1e3:.2f} ms spacing is not a break",
+                baseline=sensor.exchange("I"),
             )
         )
 
@@ -206,7 +209,7 @@ def test_standby_after_foreign_command(sensor, case):
     foreign = sensor.master.raw(f"{other}!", break_first=False)
     ex = sensor.master.raw(f"{sensor.address}!", break_first=False)
     case.evidence(f"a!, then {other}! and a! with no break", [awake, foreign, ex])
-    case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby"))
+    case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby", baseline=awake))
 
 
 @requirements("R-7.0-15")
@@ -227,7 +230,12 @@ def test_standby_after_100ms(sensor, case):
         )
     else:
         case.add(
-            judge.silent("R-7.0-15", [ex], f"{idle * 1e3:.2f} ms of marking put it in standby")
+            judge.silent(
+                "R-7.0-15",
+                [ex],
+                f"{idle * 1e3:.2f} ms of marking put it in standby",
+                baseline=first,
+            )
         )
 
 
@@ -298,6 +306,11 @@ def test_partial_command_dropped(sensor, case):
     case.evidence("aI! with 10 ms gaps", [ex])
     case.add(
         judge.silent(
-            "R-AppB-01", [ex], "its characters were 10 ms apart", should=True, decision="A18"
+            "R-AppB-01",
+            [ex],
+            "its characters were 10 ms apart",
+            baseline=sensor.exchange("I"),
+            should=True,
+            decision="A18",
         )
     )
