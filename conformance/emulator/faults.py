@@ -59,10 +59,15 @@ class Fault:
     rewrite: Rewrite | None = None
     profile: ProfileTransform | None = None
     version: str = "14"
+    #: Requirements the fault honestly leaves undecided (the description says why); the
+    #: matrix demands exactly these INCONCLUSIVE, so collateral is declared, never ignored.
+    inconclusive: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.violates:
             raise ValueError(f"fault {self.name} declares no requirement")
+        if set(self.violates) & set(self.inconclusive):
+            raise ValueError(f"fault {self.name}: a requirement cannot be broken and undecided")
         unknown = set(self.settings) - _BEHAVIOUR_FIELDS
         if unknown:
             raise ValueError(f"fault {self.name}: unknown settings {sorted(unknown)}")
@@ -367,6 +372,10 @@ def _address_quiet_2s(profile: Profile) -> Profile:
 
 
 # -- profile helpers ---------------------------------------------------------------------------
+def _last_record_dropped(spec: MeasurementSpec) -> MeasurementSpec:
+    return replace(spec, metadata=spec.metadata[:-1])
+
+
 def _with_spec(key: str, change: Callable[[MeasurementSpec], MeasurementSpec]) -> ProfileTransform:
     def transform(profile: Profile) -> Profile:
         measurements = dict(profile.measurements)
@@ -1146,6 +1155,62 @@ def _faults() -> list[Fault]:
             "has no tolerance.",
             ("R-7.0-12", "R-7.0-01"),
             settings={"char_gap": 1.9e-3},
+        ),
+        # -- deviations found on a third-party sensor (issue 10) ----------------------------------
+        Fault(
+            "metadata-crc-sticks",
+            "After a CRC metadata command (aIMC_001!), D replies of later plain measurements "
+            "carry a CRC too.",
+            ("R-4.4.12-03",),
+            settings={"metadata_crc_sticks": True},
+        ),
+        Fault(
+            "undefined-group-keeps-data",
+            "aMn! for an undefined group answers a0000 but leaves the previous measurement's "
+            "values in D0.",
+            ("R-4.4.8-03",),
+            settings={"undefined_group_keeps_data": True},
+        ),
+        Fault(
+            "metadata-r-count-short",
+            "aIR0_nnn! describes one value fewer than aR0! returns.",
+            ("R-6.2-06",),
+            profile=_with_spec("R0", _last_record_dropped),
+        ),
+        Fault(
+            "continuous-overwrites-data",
+            "aRn!/aRCn! share the D buffer: after one, the last measurement's D replies are empty.",
+            ("R-4.4.5-10",),
+            settings={"continuous_overwrites_data": True},
+        ),
+        Fault(
+            "metadata-crc-unasked",
+            "Metadata replies of plain commands (aIM_001!) carry a CRC nobody asked for.",
+            ("R-6.2-02",),
+            rewrite=_when(
+                lambda r: r.kind is ReplyKind.METADATA and not r.crc and _has_values(r),
+                _set(crc=True),
+            ),
+        ),
+        # -- timing just inside the limits (boundary probes, issue 10) --------------------------
+        Fault(
+            "standby-after-40ms",
+            "The sensor drops to standby 40 ms after its last reply, not 100 ms: a follow-up "
+            "without a break at 40..87 ms goes unanswered.",
+            ("R-7.0-16",),
+            settings={"standby_after_reply_marking": 40e-3},
+        ),
+        Fault(
+            "standby-after-60ms",
+            "The sensor drops to standby 60 ms after its last reply, not 100 ms.",
+            ("R-7.0-16",),
+            settings={"standby_after_reply_marking": 60e-3},
+        ),
+        Fault(
+            "standby-after-108ms",
+            "The sensor stays awake for 108 ms of marking (100 ms + 0.40 ms are allowed).",
+            ("R-7.0-15",),
+            settings={"standby_marking": 108e-3},
         ),
         # -- version specific --------------------------------------------------------------------
         Fault(

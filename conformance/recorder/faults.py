@@ -132,6 +132,8 @@ class RecorderFault:
     description: str
     violates: tuple[str, ...]
     make: Callable[[], GoldenRecorder] = field(compare=False)
+    #: collateral INCONCLUSIVEs the fault declares (see the sensor faults' field)
+    inconclusive: tuple[str, ...] = ()
 
 
 _GOLDEN = Policy.golden()
@@ -140,9 +142,11 @@ _FAULTS = (
     RecorderFault(
         "no-retries",
         "Sends each command once: no retry, no repeated sequence, so a silent sensor, a bad "
-        "CRC or a garbled reply ends the job.",
+        "CRC or a garbled reply ends the job. With no retry at all, whether a retry waits for "
+        "an invalid reply to end (R-7.2-06) cannot be seen.",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-4.4.12-07"),
         lambda: GoldenRecorder(_GOLDEN.but(retries_per_sequence=0, sequences=1)),
+        inconclusive=("R-7.2-06",),
     ),
     RecorderFault(
         "retry-too-early",

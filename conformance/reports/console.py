@@ -191,15 +191,20 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
 
 
 def _coverage(data: dict[str, Any]) -> str:
-    """How many requirements a case judged: all testable ones, unless cases were left out."""
+    """How many testable requirements got a verdict on the device (PASS, FAIL or WARN), and
+    how many were N/A (a rule of a version or feature the device does not claim): an N/A is
+    not a judgement, so it is counted apart."""
     testable = [r for r in data["requirements"] if r["testable"]]
-    judged = sum(1 for r in testable if any(f["test"] for f in r["findings"]))
+    judged = sum(1 for r in testable if r["verdict"] in ("PASS", "FAIL", "WARN"))
+    na = sum(1 for r in testable if r["verdict"] == "N/A")
     untestable = len(data["requirements"]) - len(testable)
     done = (
         f"{judged} testable requirements judged"
         if judged == len(testable)
         else f"{judged} of {len(testable)} testable requirements judged"
     )
+    if na:
+        done += f", {na} N/A"
     return f"{done}, {untestable} untestable here (electrical, inspection or the other role)"
 
 
