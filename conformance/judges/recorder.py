@@ -732,11 +732,16 @@ def judge_data_collection(taken: Sequence[Taken]) -> list[Finding]:
     return tally.findings("every announced value collected in order")
 
 
-def judge_concurrent_storage(taken: Sequence[Taken]) -> list[Finding]:
+def judge_concurrent_storage(taken: Sequence[Taken], asked: Sequence[str] = ()) -> list[Finding]:
     """R-4.4.7-07: a concurrent measurement of more than 20 values: at least 20 read and stored
     (the 2000 text's MUST); fewer than announced is a WARN (the capacity should be documented,
-    which the tool cannot see). R-4.4.7-08: the recorder uses aC!-type commands."""
+    which the tool cannot see). R-4.4.7-08: the recorder uses aC!-type commands: each one in
+    ``asked`` (what the scenarios told it to send) must be on the wire."""
     tally = Tally(("R-4.4.7-07", "R-4.4.7-08"))
+    started = {m.start.text for m in taken}
+    for text in asked:
+        if parse_command(text).kind is Kind.CONCURRENT and text not in started:
+            tally.fail("R-4.4.7-08", escape(text), f"asked for {escape(text)}, never sent it")
     for m in taken:
         if m.kind is not Kind.CONCURRENT:
             continue

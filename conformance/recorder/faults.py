@@ -16,12 +16,16 @@ from ..links.base import Link
 from ..master import Master, Measurement, Policy
 from ..master.records import Attempt, Exchange
 from ..master.validity import ends_line
-from ..protocol.commands import Command, Kind
-from ..transcript import decode_7e1
+from ..protocol.commands import Command, Kind, parse_command
+from ..sim.bus import SimLink
+from ..transcript import Event, decode_7e1
 from .golden import GoldenMaster, GoldenRecorder
+from .request import RecorderOutput, Request
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
+LATE_D0 = 95e-3  # s after the service request: past the 87 ms of R-7.1-01
+FAST_CHAR_TIME = 8.0e-3  # s per frame: 1250 baud, 4% fast (A14 allows 2%)
 
 
 class EarlyRetryMaster(GoldenMaster):
@@ -118,6 +122,69 @@ class IgnoresCrcMaster(GoldenMaster):
         return attempt
 
 
+class LateD0AfterServiceRequestMaster(GoldenMaster):
+    """After a service request waits 95 ms, then sends aD0! without a break."""
+
+    _no_break_once = False
+
+    def collect(
+        self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
+    ) -> Measurement:
+        if m.service_request_end is not None and not m.data:
+            self.link.wait_until(m.service_request_end + LATE_D0)
+            self._no_break_once = True
+        return super().collect(m, force_break=force_break, max_index=max_index)
+
+    def _needs_break(self, address: str, at: float) -> bool:
+        if self._no_break_once:
+            self._no_break_once = False
+            return False
+        return super()._needs_break(address, at)
+
+
+class WrongBaudLink:
+    """The recorder's end of the sim bus, sending every character in ``char_time`` instead
+    of 8.33 ms (a recorder at the wrong bit rate); everything else is the link's own."""
+
+    def __init__(self, link: Link, char_time: float) -> None:
+        if not isinstance(link, SimLink):
+            raise TypeError("a wrong bit rate can only be played on the simulated bus")
+        self._link = link
+        self._char_time = char_time
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._link, name)
+
+    def write(self, wire: bytes, gap: float = 0.0) -> list[Event]:
+        events, time = [], self._link.now()
+        for byte in wire:
+            event = self._link.bus.tool_char(byte, time, self._char_time)
+            events.append(event)
+            time = event.end + gap
+        return events
+
+
+@dataclass
+class WrongBaudRecorder(GoldenRecorder):
+    """The golden recorder sending at a bit rate 4% too high (frames of 8.0 ms)."""
+
+    char_time: float = FAST_CHAR_TIME
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        return super().__call__(request, WrongBaudLink(link, self.char_time))  # type: ignore[arg-type]
+
+
+@dataclass
+class LacksCommandsRecorder(GoldenRecorder):
+    """A logger that does not implement some command kinds: asked for them, it skips them."""
+
+    lacks: frozenset[Kind] = frozenset()
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        kept = tuple(t for t in request.commands if parse_command(t).kind not in self.lacks)
+        return super().__call__(replace(request, commands=kept), link)
+
+
 def _is_service_request(events: list, address: str) -> bool:
     return decode_7e1(events[-3:]) == f"{address}\r\n"
 
@@ -204,6 +271,54 @@ _FAULTS = (
         "Breaks last 10 ms (at least 12 ms are due).",
         ("R-7.0-02",),
         lambda: GoldenRecorder(_GOLDEN.but(break_duration=10e-3)),
+    ),
+    RecorderFault(
+        "no-concurrent",
+        "Has no aC!-type commands: asked for aC!, aCn! or aCC!, it sends nothing. With no "
+        "concurrent measurement on the wire, its waits (R-4.4.7-06) and how many of its values "
+        "are stored (R-4.4.7-07) cannot be seen.",
+        ("R-4.4.7-08", "R-4.4-02"),
+        lambda: LacksCommandsRecorder(lacks=frozenset({Kind.CONCURRENT})),
+        inconclusive=("R-4.4.7-06", "R-4.4.7-07"),
+    ),
+    RecorderFault(
+        "no-high-volume",
+        "A v1.4 recorder without aHA!/aHB!: asked for them, it sends nothing. How it would read "
+        "past D9 (R-5.1-04) or binary packets (R-5.2-08) then cannot be seen.",
+        ("R-5.4-01",),
+        lambda: LacksCommandsRecorder(
+            lacks=frozenset({Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
+        ),
+        inconclusive=("R-5.1-04", "R-5.2-08"),
+    ),
+    RecorderFault(
+        "drops-metadata",
+        "Transparent mode drops identify and metadata commands (aIM!, aIM_001!...) instead of "
+        "passing them on.",
+        ("R-6.3-01", "R-4.4.14-02"),
+        lambda: LacksCommandsRecorder(
+            lacks=frozenset({Kind.METADATA, Kind.IDENTIFY_MEASUREMENT})
+        ),
+    ),
+    RecorderFault(
+        "multiline-cut-short",
+        "Takes multi-line text without ETX as finished 50 ms after a line, not 150 ms.",
+        ("R-4.4.13.1-04",),
+        lambda: GoldenRecorder(_GOLDEN.but(line_wait=50e-3)),
+    ),
+    RecorderFault(
+        "late-d0-without-break",
+        f"Sends aD0! {LATE_D0 * 1e3:.0f} ms after the service request without a break (87 ms "
+        "is the limit; after it a break is due, which R-7.0-17 also demands).",
+        ("R-7.1-01", "R-7.0-17"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(LateD0AfterServiceRequestMaster)),
+    ),
+    RecorderFault(
+        "fast-baud",
+        f"Sends at {10 / FAST_CHAR_TIME:.0f} baud: every command character lasts "
+        f"{FAST_CHAR_TIME * 1e3:.2f} ms, not 8.33 ms (decision A14 allows 2%).",
+        ("R-4.1-01",),
+        lambda: WrongBaudRecorder(),
     ),
     RecorderFault(
         "short-marking",
