@@ -277,6 +277,8 @@ def tries(line: Line, uncertainty: float) -> list[Tries]:
     crc = crc_context(line)
     out: list[Tries] = []
     for i, s in enumerate(line.sent):
+        if not s.text.endswith("!"):
+            continue  # no command, so no reply to retry for; R-4.4-04 judges its text
         attempt = Attempt(s, reply_problem(s, crc[i], uncertainty))
         last = out[-1].attempts[-1] if out else None
         if (
@@ -1039,16 +1041,20 @@ def judge_addresses(line: Line, uncertainty: float) -> list[Finding]:
         )
     )
     letters = sorted(a for a in polled if a.isalpha())
-    r4 = (
-        Finding(
+    commands = [s for s in line.sent if s.text.endswith("!")]  # R-4.4-04 judges the rest
+    foreign = sorted({s.address for s in commands if s.address not in ADDRESS_CHARS} - {"?"})
+    if foreign:  # a MAY rule: the Finding caps this at WARN
+        shown = ", ".join(f"'{escape(a)}'" for a in foreign)
+        r4 = Finding("R-4.3-04", Verdict.FAIL, f"addressed {shown}, not an address", decision="A17")
+    elif letters:
+        r4 = Finding(
             "R-4.3-04",
             Verdict.PASS,
             f"letter addresses used: {' '.join(letters)}",
             observed=len(letters),
         )
-        if letters
-        else Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
-    )
+    else:
+        r4 = Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
     return [r3, r4]
 
 

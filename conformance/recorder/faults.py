@@ -20,7 +20,7 @@ from ..protocol.commands import Command, Kind, parse_command
 from ..sim.bus import SimLink
 from ..transcript import Event, decode_7e1
 from .golden import GoldenMaster, GoldenRecorder
-from .request import RecorderOutput, Request
+from .request import RecorderOutput, Request, Task
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
@@ -142,6 +142,24 @@ class LateD0AfterServiceRequestMaster(GoldenMaster):
         return super()._needs_break(address, at)
 
 
+class GappyCommandMaster(GoldenMaster):
+    """Leaves ``gap`` of marking between the characters of every command."""
+
+    gap = 3e-3
+
+    def _transmit(
+        self, wire: bytes, address: str, brk: bool | None, gap: float
+    ) -> tuple[Event | None, list[Event]]:
+        return super()._transmit(wire, address, brk, max(gap, self.gap))
+
+
+class BandGapCommandMaster(GappyCommandMaster):
+    """1.9 ms between command characters: only the ±0.40 ms tolerance the 1.66 ms limit does
+    not have would make it pass."""
+
+    gap = 1.9e-3
+
+
 class WrongBaudLink:
     """The recorder's end of the sim bus, sending every character in ``char_time`` instead
     of 8.33 ms (a recorder at the wrong bit rate); everything else is the link's own."""
@@ -176,13 +194,77 @@ class WrongBaudRecorder(GoldenRecorder):
 
 @dataclass
 class LacksCommandsRecorder(GoldenRecorder):
-    """A logger that does not implement some command kinds: asked for them, it skips them."""
+    """A logger that does not implement some command kinds, or cannot reach some addresses:
+    asked for such commands, it skips them."""
 
     lacks: frozenset[Kind] = frozenset()
+    unreachable: str = ""  # addresses it cannot use (as the addressee or a new address)
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
-        kept = tuple(t for t in request.commands if parse_command(t).kind not in self.lacks)
+        kept = tuple(t for t in request.commands if self._can(parse_command(t)))
         return super().__call__(replace(request, commands=kept), link)
+
+    def _can(self, command: Command) -> bool:
+        targets = {command.address, command.new_address or ""}
+        return command.kind not in self.lacks and not targets & set(self.unreachable)
+
+
+@dataclass
+class RewritingRecorder(GoldenRecorder):
+    """A logger that changes what it is asked to send (``rewrite`` maps the wire text; an
+    empty result is skipped) or adds commands of its own (``extra``, before the job)."""
+
+    rewrite: Callable[[str], str] = field(default=lambda text: text)
+    extra: str = ""  # addresses it polls with a! before the job
+    preamble: str = ""  # text it sends after a break before the job
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        master = self.master_factory(link, self.policy or Policy.golden())
+        for address in self.extra:
+            master.transact(Command(address, Kind.ACKNOWLEDGE), force_break=True)
+        if self.preamble:
+            master.raw(self.preamble, break_first=True)
+        out = super().__call__(replace(request, commands=()), link)
+        for text in request.commands:
+            wire = self.rewrite(text)
+            if not wire:
+                continue
+            if request.task is Task.TRANSPARENT:
+                ex = master.raw(wire, break_first=True)
+                out.relayed[text] = ex.reply_text if ex.answered else ""
+            else:
+                sub = replace(request, commands=(text,))
+                got = super().__call__(sub, link)
+                out.logged.update(got.logged)
+                out.relayed.update(got.relayed)
+        return out
+
+
+@dataclass
+class InterleavingRecorder(GoldenRecorder):
+    """Asked to measure several sensors with aM!, starts them all before collecting any, as
+    if they were concurrent measurements."""
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        if request.task is Task.MEASURE and len({t[:1] for t in request.commands}) > 1:
+            request = replace(request, task=Task.CONCURRENT)
+        return super().__call__(request, link)
+
+
+@dataclass
+class NoBreakTransparentRecorder(GoldenRecorder):
+    """Transparent mode sends each host command as soon as it comes, with no break of its
+    own (the engine still breaks for a new address or after 87 ms of marking)."""
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        if request.task is not Task.TRANSPARENT:
+            return super().__call__(request, link)
+        master = self.master_factory(link, self.policy or Policy.golden())
+        out = RecorderOutput()
+        for text in request.commands:
+            ex = master.transact(parse_command(text))
+            out.relayed[text] = ex.reply_text if ex.answered else ""
+        return out
 
 
 def _is_service_request(events: list, address: str) -> bool:
@@ -319,6 +401,70 @@ _FAULTS = (
         f"{FAST_CHAR_TIME * 1e3:.2f} ms, not 8.33 ms (decision A14 allows 2%).",
         ("R-4.1-01",),
         lambda: WrongBaudRecorder(),
+    ),
+    RecorderFault(
+        "gappy-commands",
+        "Leaves 3 ms of marking between the characters of every command (1.66 ms at most).",
+        ("R-7.0-13",),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(GappyCommandMaster)),
+        inconclusive=("R-4.1-01",),  # no back-to-back characters: rate and gaps inseparable
+    ),
+    RecorderFault(
+        "command-gap-in-tolerance",
+        "Leaves 1.9 ms between command characters: over 1.66 ms, inside the ±0.40 ms that "
+        "this limit does not grant.",
+        ("R-7.0-13", "R-7.0-01"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(BandGapCommandMaster)),
+        inconclusive=("R-4.1-01",),
+    ),
+    RecorderFault(
+        "transparent-no-break",
+        "Transparent mode sends host commands without a break of its own.",
+        ("R-4.4.14-01",),
+        lambda: NoBreakTransparentRecorder(),
+    ),
+    RecorderFault(
+        "transparent-drops-address",
+        "Transparent mode sends extended commands without their address (XSN! for 0XSN!). "
+        "No sensor answers those, so no multi-line text comes whose end R-4.4.13.1-04 judges.",
+        ("R-4.4.13-03", "R-4.4.14-02"),
+        lambda: RewritingRecorder(rewrite=lambda t: t[1:] if t[1:2] == "X" else t),
+        inconclusive=("R-4.4.13.1-04",),
+    ),
+    RecorderFault(
+        "addresses-0-4-only",
+        "Can only use addresses 0-4: commands to sensors at 5-9, or moving one there, are "
+        "skipped.",
+        ("R-4.3-03", "R-4.4-02"),
+        lambda: LacksCommandsRecorder(unreachable="56789"),
+    ),
+    RecorderFault(
+        "polls-dollar",
+        "Before each job it polls '$!', as if '$' were a sensor address.",
+        ("R-4.3-01", "R-4.3-04"),
+        lambda: RewritingRecorder(extra="$"),
+    ),
+    RecorderFault(
+        "talks-over-reply",
+        "Retries as soon as a reply pauses, while the sensor may still be sending (the engine "
+        "without the golden recorder's wait for a quiet line). Its retry collides with the "
+        "rest of the reply, and on the line its characters come apart (R-7.0-13).",
+        ("R-7.2-06", "R-7.0-13"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(Master)),
+    ),
+    RecorderFault(
+        "interleaves-measurements",
+        "Starts aM! on one sensor, then aM! on another before collecting the first one's data: "
+        "it takes the line while the first one's service request may come (R-4.4.5-07) and "
+        "reads its data only after ttt, not on that request (R-4.4.5-05).",
+        ("R-4.4.5-06", "R-4.4.5-07", "R-4.4.5-05"),
+        lambda: InterleavingRecorder(),
+    ),
+    RecorderFault(
+        "crlf-wake-up",
+        "Before each job it sends a break and CR LF, a modem-style wake-up that is no command.",
+        ("R-4.2-01", "R-4.4-04", "R-4.3-01"),
+        lambda: RewritingRecorder(preamble="\r\n"),
     ),
     RecorderFault(
         "short-marking",
