@@ -465,9 +465,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "measure-ttt-two-digits",
-            "M/MC/Mn/V replies give ttt with two digits (atttn becomes attn).",
+            "M/MC/Mn/V replies give ttt with two digits (atttn becomes attn)."
+            " No measurement reply parses, so no data are there for the identify commands to"
+            " disturb (R-6.1-03).",
             ("R-4.4.5-01",),
             rewrite=_start_with(1, lambda body: body[0] + body[2:]),
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "measure-count-zero",
@@ -489,12 +492,15 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "high-volume-two-digit-count",
-            "HA replies give a 2-digit count (atttnn instead of atttnnn).",
+            "HA replies give a 2-digit count (atttnn instead of atttnnn)."
+            " With the count unreadable no D data are asked for, so the aHA! data rules have"
+            " nothing to judge.",
             ("R-5.1-01",),
             rewrite=_when(
                 lambda r: _measure_family(r, 3) and _source_kind(r) is Kind.HIGH_VOLUME_ASCII,
                 lambda r: replace(r, body=r.body[:4] + r.body[5:]),
             ),
+            inconclusive=("R-5.1-02", "R-5.1-03"),
         ),
         Fault(
             "value-missing-sign",
@@ -670,9 +676,12 @@ def _faults() -> list[Fault]:
         # -- service requests --------------------------------------------------------------------
         Fault(
             "no-service-request",
-            "M/MC/Mn/V with ttt > 0 never send a service request (data are ready before ttt).",
+            "M/MC/Mn/V with ttt > 0 never send a service request (data are ready before ttt)."
+            " With no service request its form and timing cannot be judged, nor can a break be"
+            " shown to abort one (R-4.4.5.1-01).",
             ("R-4.4.6-02",),
             settings={"service_request": False},
+            inconclusive=("R-4.4.5-09", "R-4.4.5.1-01", "R-4.4.6-01", "R-4.4.6-04"),
         ),
         Fault(
             "late-service-request",
@@ -694,9 +703,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "service-request-extra-chars",
-            "The service request is 'aSR<CR><LF>' instead of 'a<CR><LF>'.",
+            "The service request is 'aSR<CR><LF>' instead of 'a<CR><LF>'."
+            " The service request is not recognised, so a break cannot be shown to prevent one"
+            " (R-4.4.5.1-01).",
             ("R-4.4.6-01",),
             rewrite=_only([ReplyKind.SERVICE_REQUEST], lambda r: replace(r, body=r.body + "SR")),
+            inconclusive=("R-4.4.5.1-01",),
         ),
         Fault(
             "chatter-before-service-request",
@@ -751,27 +763,39 @@ def _faults() -> list[Fault]:
         # -- data buffer -------------------------------------------------------------------------
         Fault(
             "buffer-cleared-by-break",
-            "Once all D pages were read, the next break empties the data buffer.",
+            "Once all D pages were read, the next break empties the data buffer."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             settings={"clear_on_break_after_read": True},
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "buffer-cleared-after-read",
-            "Once all D pages were read, the buffer is empty (repeated D returns nothing).",
+            "Once all D pages were read, the buffer is empty (repeated D returns nothing)."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             settings={"clear_after_read": True},
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "data-changes-on-repeat",
-            "A repeated Dn returns the last digit changed.",
+            "A repeated Dn returns the last digit changed."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             rewrite=_only(_DATA, _vary_repeat),
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "data-lost-after-standby",
-            "Once all D pages were read, entering standby empties the data buffer.",
+            "Once all D pages were read, entering standby empties the data buffer."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             settings={"clear_on_standby_after_read": True},
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "identify-clears-buffer",
@@ -828,9 +852,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "d0-empty",
-            "Completed measurements hold no values: D0 answers 'a<CR><LF>'.",
+            "Completed measurements hold no values: D0 answers 'a<CR><LF>'."
+            " With no values delivered, neither a disturbed concurrent measurement (R-4.4.7-05)"
+            " nor data the identify commands could disturb (R-6.1-03) can be compared.",
             ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
             settings={"drop_all_values": True},
+            inconclusive=("R-4.4.7-05", "R-6.1-03"),
         ),
         Fault(
             "undefined-measure-silent",
@@ -899,22 +926,28 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "identify-unsupported",
-            "Identify-measurement commands (aIM!, aIC!, aIHA!...) get no answer.",
+            "Identify-measurement commands (aIM!, aIC!, aIHA!...) get no answer."
+            " With no identify reply there is none to compare with the measurement's (R-6.1-02).",
             ("R-6.1-01",),
             settings={"answer_identify_measurement": False},
+            inconclusive=("R-6.1-02",),
         ),
         # -- high-volume binary -------------------------------------------------------------------
         Fault(
             "binary-payload-not-multiple",
-            "Packets of multi-byte types carry one stray byte after their values.",
+            "Packets of multi-byte types carry one stray byte after their values."
+            " No packet reads as values, so none shows how the values are ordered (R-5.2-07).",
             ("R-5.2-05",),
             rewrite=_binary(_pad_payload),
+            inconclusive=("R-5.2-07",),
         ),
         Fault(
             "binary-invalid-type",
-            "DB0's packet carries data type code 11.",
+            "DB0's packet carries data type code 11."
+            " No packet reads as values, so none shows how the values are ordered (R-5.2-07).",
             ("R-5.2.1-01",),
             rewrite=_binary(_binary_first_packet(_invalid_type)),
+            inconclusive=("R-5.2-07",),
         ),
         Fault(
             "binary-no-empty-packet",
@@ -957,9 +990,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "inter-char-gap",
-            "3 ms of marking between reply characters (limit 1.66 ms).",
+            "3 ms of marking between reply characters (limit 1.66 ms)."
+            " No two reply characters come back to back, so the bit rate cannot be told from the"
+            " gaps (R-4.1-01).",
             ("R-7.0-12",),
             settings={"char_gap": 3e-3},
+            inconclusive=("R-4.1-01",),
         ),
         Fault(
             "ignores-short-breaks",
@@ -1114,15 +1150,28 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "high-volume-binary-two-digit-count",
-            "aHB! replies give a 2-digit count (atttnn instead of atttnnn).",
+            "aHB! replies give a 2-digit count (atttnn instead of atttnnn)."
+            " With the count unreadable no packet is asked for, so the packet rules have nothing"
+            " to judge.",
             ("R-5.2-01",),
             rewrite=_when(_hb_start, lambda r: replace(r, body=r.body[:4] + r.body[5:])),
+            inconclusive=(
+                "R-4.1-03",
+                "R-5.2-02",
+                "R-5.2-03",
+                "R-5.2-04",
+                "R-5.2-05",
+                "R-5.2-07",
+                "R-5.2.1-01",
+            ),
         ),
         Fault(
             "binary-size-big-endian",
-            "The payload size field of HB packets is sent high byte first.",
+            "The payload size field of HB packets is sent high byte first."
+            " No packet reads as values, so none shows how the values are ordered (R-5.2-07).",
             ("R-5.2-02",),
             rewrite=_binary(_size_big_endian),
+            inconclusive=("R-5.2-07",),
         ),
         Fault(
             "high-volume-unsupported-silent",
@@ -1133,9 +1182,11 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "metadata-silent",
-            "Parameter metadata commands (aIM_001! ...) get no answer.",
+            "Parameter metadata commands (aIM_001! ...) get no answer."
+            " With no metadata reply, the rules on its contents have nothing to judge.",
             ("R-6.2-01", "R-6.2-05", "R-6.2-06", "R-6.2-07"),
             rewrite=_only([ReplyKind.METADATA], _silence),
+            inconclusive=("R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2.1-01", "R-6.2.2-01"),
         ),
         Fault(
             "metadata-semicolon-in-field",
@@ -1152,9 +1203,12 @@ def _faults() -> list[Fault]:
         Fault(
             "inter-char-gap-tolerance",
             "1.9 ms of marking between reply characters: inside 1.66 + 0.40 ms, but that gap "
-            "has no tolerance.",
+            "has no tolerance."
+            " No two reply characters come back to back, so the bit rate cannot be told from the"
+            " gaps (R-4.1-01).",
             ("R-7.0-12", "R-7.0-01"),
             settings={"char_gap": 1.9e-3},
+            inconclusive=("R-4.1-01",),
         ),
         # -- deviations found on a third-party sensor (issue 10) ----------------------------------
         Fault(
