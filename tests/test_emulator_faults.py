@@ -955,3 +955,20 @@ def test_slow_wake_does_not_take_the_tail_of_a_command():
     rig.send("0D0!")  # '0' and 'D' fall in the wake-up time, '0!' after it
     assert rig.listen(timeout=0.03) == []
     assert rig.ask("0D0!", brk=False).body == "0" + M1_VALUES
+
+
+def test_sim_declares_the_clean_profile_not_the_faulted_one():
+    """Issue 10: on sim a fault is caught from the wire; the tool is never handed the fault's
+    command names, unless the fault says what its maker declares (``declares``)."""
+    from dataclasses import replace
+
+    from conformance.ports import SimSpec, open_sim, sim_declaration
+
+    for name, fault in FAULTS.items():
+        spec = SimSpec(faults=(name,), version=fault.version)
+        clean = replace(default_profile(fault.version), address="0")
+        declared = open_sim(spec).declaration
+        if fault.declares is None:
+            assert declared == sim_declaration(clean, spec), name
+        else:
+            assert declared == sim_declaration(fault.declares(clean), spec), name

@@ -13,7 +13,7 @@ import pytest
 
 import conformance.run as run_module
 from conformance.catalog import catalog, strongest_verdict
-from conformance.emulator import default_profile, sim_sensor
+from conformance.emulator import default_profile
 from conformance.matrix import run_once
 from conformance.ports import OpenedPort, SimSpec, sim_declaration
 from conformance.recorder.matrix import run_recorder_suite
@@ -53,8 +53,8 @@ def test_no_should_or_may_rule_can_fail(rid):
 
 def _silent_bus(port: str) -> OpenedPort:
     """The sim bus with nothing on it that ever transmits, declared like the emulator."""
-    _bus, _link, emulator = sim_sensor(default_profile("14"))
-    return OpenedPort(SimLink(SimBus([LineMonitor()])), [], sim_declaration(emulator, SimSpec()))
+    declared = sim_declaration(default_profile("14"), SimSpec())
+    return OpenedPort(SimLink(SimBus([LineMonitor()])), [], declared)
 
 
 def test_do_nothing_sensor_gets_no_pass(monkeypatch):
@@ -78,3 +78,22 @@ def test_do_nothing_recorder_gets_no_pass(monkeypatch):
     for rid in ("R-4.4.14-01", "R-7.0-17"):
         verdict = next(r for r in data["requirements"] if r["id"] == rid)["verdict"]
         assert verdict == "INCONCLUSIVE", rid
+
+
+def test_a_case_that_could_not_reach_a_rule_does_not_outvote_one_that_judged_it():
+    judged = CaseRecord(
+        "t::crc", "crc", ("R-4.4.12-05",), findings=[passed("R-4.4.12-05", "17 ok", observed=17)]
+    )
+    stopped = CaseRecord(
+        "t::explore",
+        "explore",
+        ("R-4.4.12-05",),
+        findings=[Finding("R-4.4.12-05", Verdict.INCONCLUSIVE, "no step exercised it")],
+    )
+    verdicts = {r.requirement.id: r.verdict for r in aggregate("sensor", [judged, stopped])}
+    assert verdicts["R-4.4.12-05"] is Verdict.PASS
+    # an INCONCLUSIVE that rests on observations (uncertainty across a limit) still counts
+    straddling = Finding("R-4.4.12-05", Verdict.INCONCLUSIVE, "straddles", observed=1)
+    stopped.findings = [straddling]
+    verdicts = {r.requirement.id: r.verdict for r in aggregate("sensor", [judged, stopped])}
+    assert verdicts["R-4.4.12-05"] is Verdict.INCONCLUSIVE

@@ -62,6 +62,10 @@ class Fault:
     #: Requirements the fault honestly leaves undecided (the description says why); the
     #: matrix demands exactly these INCONCLUSIVE, so collateral is declared, never ignored.
     inconclusive: tuple[str, ...] = ()
+    #: What the maker's declaration says where it differs from the clean profile (say, the
+    #: names of its extended commands). On ``sim`` the declaration is the clean profile's:
+    #: a fault is caught from the wire, never from names the tool was handed by the fault.
+    declares: ProfileTransform | None = None
 
     def __post_init__(self) -> None:
         if not self.violates:
@@ -108,6 +112,14 @@ class FaultSet:
             if fault.profile is not None:
                 profile = fault.profile(profile)
         return profile
+
+    def declared_profile(self, clean: Profile) -> Profile:
+        """The profile the maker's declaration describes: the clean one, changed only by
+        what a fault says its maker declares."""
+        for fault in self.faults:
+            if fault.declares is not None:
+                clean = fault.declares(clean)
+        return clean
 
 
 def compose(names: Iterable[str]) -> FaultSet:
@@ -1129,6 +1141,7 @@ def _faults() -> list[Fault]:
             "Extended commands are named aZ...! instead of the recommended aX...!.",
             ("R-4.4.13-02",),
             profile=_rename_extended,
+            declares=_rename_extended,  # its maker lists aZSN!...; the sensor must answer them
         ),
         Fault(
             "multiline-no-etx",
