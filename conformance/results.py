@@ -42,6 +42,7 @@ class RequirementResult:
     findings: list[Finding]
     tests: list[str]
     judged: bool = True  # False: testable, but no case of this run looked at it
+    consequence_of: str | None = None  # a FAILed rule whose deviation probably caused this
 
     @property
     def one_line(self) -> str:

@@ -79,6 +79,7 @@ class Finding:
     evidence: list[str] = field(default_factory=list)
     decision: str | None = None
     observed: int = 0
+    consequence_of: str | None = None  # the root finding's requirement (root_causes.py)
 
     def __post_init__(self) -> None:
         if self.verdict is Verdict.PASS and self.observed < 1:

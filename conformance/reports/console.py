@@ -163,7 +163,15 @@ def noteworthy(data: dict[str, Any]) -> list[tuple[str, str, str]]:
             rows.append((verdict, f"{len(ids)} requirements", f"{reason} ({shown}, ...)"))
         else:
             rows += [(verdict, rid, reason) for rid in ids]
-    return sorted(rows, key=lambda row: SEVERITY.index(row[0]))
+    roots = {r["consequence_of"] for r in data["requirements"] if r.get("consequence_of")}
+    dragged = {r["id"] for r in data["requirements"] if r.get("consequence_of")}
+
+    def first(row: tuple[str, str, str]) -> tuple[int, int]:
+        """Root causes first, then what they drag, then the rest, each worst first."""
+        place = 0 if row[1] in roots else 1 if row[1] in dragged else 2
+        return place, SEVERITY.index(row[0])
+
+    return sorted(rows, key=first)
 
 
 def print_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
