@@ -340,7 +340,9 @@ class Master:
             line_wait=p.line_wait,
         )
         reply, state, collided = self._listen(command_end, framing)
-        if state is None:
+        if collided:  # the DUT talked over the command: it may not have heard it whole
+            state = f"invalid: bus contention ({len(collided)} characters during the command)"
+        elif state is None:
             state = self._judge_reply(reply, command, address, command_end, framing, crc)
         return Attempt(
             break_event, sent, reply, state, self.link.now(), stray_events=stray + collided
