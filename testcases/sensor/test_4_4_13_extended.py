@@ -32,7 +32,7 @@ def test_extended_commands(sensor, case):
     case.extend(judge.extended_replies(exchanges, sensor.address))
 
 
-@pytest.mark.needs("unsolicited")
+@pytest.mark.needs('unsolicited')
 @requirements("R-4.4.13.1-01", "R-4.4.13.1-02", "R-4.4.13.1-03")
 def test_multiline_text(sensor, case):
     """Multi-line replies: STX after the address, ETX after the last CR LF, at most 75

@@ -40,7 +40,7 @@ def test_measurement_reply(sensor, case):
             )
 
 
-@pytest.mark.needs("unsolicited")
+@pytest.mark.needs('unsolicited')
 @requirements("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")
 def test_service_request(sensor, case):
     """With ttt > 0 the sensor sends 'a<CR><LF>' when data are ready, before ttt runs out, and
@@ -57,7 +57,7 @@ def test_service_request(sensor, case):
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
 
-@pytest.mark.needs("unsolicited")
+@pytest.mark.needs('unsolicited')
 @requirements("R-4.4.6-03", "R-4.4.5-03")
 def test_ttt_zero(sensor, case):
     """With ttt = 000 there is no service request and aD0! returns the data at once."""
@@ -98,7 +98,7 @@ def test_ttt_zero(sensor, case):
         case.add(failed("R-4.4.5-03", f"aD0! right after ttt = 000 gave no values: {shown(d0)}"))
 
 
-@pytest.mark.needs("unsolicited")
+@pytest.mark.needs('unsolicited')
 @requirements("R-4.4.6-05")
 def test_no_service_request_after_concurrent(sensor, case):
     """C, CC, Cn, CCn, HA and HB are never followed by a service request."""
@@ -111,7 +111,7 @@ def test_no_service_request_after_concurrent(sensor, case):
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
 
-@pytest.mark.needs("break")
+@pytest.mark.needs('break')
 @requirements("R-4.4.5-10")
 def test_data_retained(sensor, case):
     """Data stay readable, unchanged, across a break, standby and non-measuring commands."""
@@ -153,7 +153,7 @@ def test_data_retained(sensor, case):
         )
 
 
-@pytest.mark.needs("break", "unsolicited")
+@pytest.mark.needs('break', 'unsolicited')
 @requirements("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03")
 def test_break_aborts_measurement(sensor, case):
     """A break before the service request aborts an M measurement; D0 then has no values and

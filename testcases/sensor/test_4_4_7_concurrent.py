@@ -23,7 +23,7 @@ def test_concurrent_reply(sensor, case):
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
 
-@pytest.mark.needs("unsolicited")
+@pytest.mark.needs('unsolicited')
 @requirements("R-4.4.7-04")
 def test_quiet_during_concurrent(sensor, case):
     """Between its atttnn reply and the aD0! the sensor sends nothing."""
@@ -55,7 +55,7 @@ def _running_concurrent(sensor):
     return next((m for m in sensor.family(("C", "CC", *C_FAMILY[2:])) if m.ttt and m.count), None)
 
 
-@pytest.mark.needs("break")
+@pytest.mark.needs('break')
 @requirements("R-4.4.7-05")
 def test_concurrent_survives_break_and_other_traffic(sensor, case):
     """A break and a command to another address do not abort a running concurrent
@@ -90,7 +90,7 @@ def test_concurrent_survives_break_and_other_traffic(sensor, case):
         )
 
 
-@pytest.mark.needs("break")
+@pytest.mark.needs('break')
 @requirements("R-4.4.7.1-01", "R-4.4.7.1-02")
 def test_own_command_aborts_concurrent(sensor, case):
     """A valid command to the sensor itself aborts a running concurrent measurement; its D

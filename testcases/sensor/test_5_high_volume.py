@@ -75,7 +75,7 @@ def test_high_volume_ascii(sensor, case):
     case.extend(judge.judge([m], case.requirements, sensor.version))
 
 
-@pytest.mark.needs("binary")
+@pytest.mark.needs('binary')
 @requirements(
     "R-5.2-01", "R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2-07", "R-5.2.1-01", "R-4.1-03"
 )
@@ -91,7 +91,7 @@ def test_high_volume_binary(sensor, case):
     case.extend(judge.judge([m], case.requirements, sensor.version))
 
 
-@pytest.mark.needs("binary")
+@pytest.mark.needs('binary')
 @requirements("R-5.2-06")
 def test_empty_packet_past_data(sensor, case):
     """aDBn! past the data returns the 6-byte empty packet (size 0, type 0)."""
@@ -121,7 +121,7 @@ def test_empty_packet_past_data(sensor, case):
         )
 
 
-@pytest.mark.needs("break", "unsolicited")
+@pytest.mark.needs('break', 'unsolicited')
 @requirements("R-5.3-01")
 def test_high_volume_is_concurrent(sensor, case):
     """HA/HB behave as concurrent measurements: no service request, not disturbed by a break

@@ -41,7 +41,7 @@ def test_identify_matches_measurement(sensor, case):
     case.extend(judge.identify_matches(pairs))
 
 
-@pytest.mark.needs("unsolicited")
+@pytest.mark.needs('unsolicited')
 @requirements("R-6.1-03")
 def test_identify_starts_nothing(sensor, case):
     """An identify command starts no measurement: no service request, earlier data intact."""

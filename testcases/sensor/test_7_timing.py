@@ -212,9 +212,10 @@ def test_standby_after_foreign_command(sensor, case):
     case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby", baseline=awake))
 
 
-#: How far inside a limit a boundary probe aims, beyond the tolerance and the link's
-#: uncertainty: close enough to tell a limit from a sensor's shortcut (a standby after 40 ms
-#: instead of 100 ms), far enough that stamps on the edge cannot blur the verdict.
+#: How far inside a limit a boundary probe aims, beyond the tolerance and twice the link's
+#: uncertainty (once for the stamps, once for how late a write may leave): close enough to
+#: tell a limit from a sensor's shortcut (a standby after 40 ms instead of 100 ms), far enough
+#: that the probe stays surely inside the limit.
 EDGE_MARGIN = 1.5e-3
 
 
@@ -231,7 +232,7 @@ def test_standby_after_100ms(sensor, case):
     """After more than 100 ms of marking the sensor ignores a command without a break: probed
     just past the limit (by more than tolerance and uncertainty) and well past it (115 ms)."""
     u = sensor.uncertainty
-    edge = STANDBY_MARKING + TOLERANCE + u + EDGE_MARGIN
+    edge = STANDBY_MARKING + TOLERANCE + 2 * u + EDGE_MARGIN
     case.expect(
         f"silence to a! sent {edge * 1e3:.1f} ms and 115 ms after the last reply, without a break"
     )
@@ -269,10 +270,10 @@ def test_standby_after_100ms(sensor, case):
 def test_follow_up_without_break(sensor, case):
     """An awake sensor answers its address without a break while the line has marked for
     less than 87 ms: probed well inside (20 ms) and just inside the limit (87 ms less the
-    tolerance, the link's uncertainty and a margin), so a sensor that drops to standby early
+    tolerance, twice the link's uncertainty and a margin), so a sensor that drops to standby early
     (after 40 or 60 ms, say) cannot pass."""
     u = sensor.uncertainty
-    edge = NO_BREAK_WINDOW - TOLERANCE - u - EDGE_MARGIN
+    edge = NO_BREAK_WINDOW - TOLERANCE - 2 * u - EDGE_MARGIN
     case.expect(
         f"replies to aI! sent 20 ms after the reply to a! and {edge * 1e3:.1f} ms after that "
         "reply, with no break"

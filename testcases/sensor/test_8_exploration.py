@@ -10,7 +10,7 @@ from conformance.verdicts import failed, inconclusive, passed
 requirements = pytest.mark.requirements
 
 
-@pytest.mark.needs("break")
+@pytest.mark.needs('break')
 @requirements(*IDS)
 def test_random_command_sequences(sensor, case):
     """Random sequences of valid, foreign-address and malformed commands, breaks and pauses
