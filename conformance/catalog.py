@@ -30,6 +30,7 @@ __all__ = [
     "decisions",
     "for_role",
     "requirement",
+    "strongest_verdict",
 ]
 
 SCHEMA = "sdi12-conform/catalog/1"
@@ -205,6 +206,14 @@ def for_role(role: str) -> list[Requirement]:
     """Requirements binding a DUT of ``role`` ("sensor"/"recorder"), in catalog order."""
     _check_role(role)
     return [r for r in _load()[0].values() if r.applies_to_role(role)]
+
+
+def strongest_verdict(id: str) -> str:  # noqa: A002 - same argument name as requirement()
+    """The harshest verdict a broken rule can get: "FAIL" for MUST/MUST NOT, "WARN" for
+    SHOULD/MAY (a MAY never fails a device). IDs outside the catalog (unit-test fixtures)
+    keep "FAIL"; the marker check refuses them in real cases."""
+    req = _load()[0].get(id)
+    return "WARN" if req is not None and req.is_should else "FAIL"
 
 
 def decisions() -> dict[str, str]:

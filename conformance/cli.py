@@ -260,7 +260,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     for col in ("fault", "declared", "FAIL/WARN", "caught"):
         table.add_column(col, overflow="fold")
     for r in rows:
-        caught = "exactly" if r.exact else f"missed {' '.join(r.missed)} extra {' '.join(r.extra)}"
+        caught = "exactly" if r.exact else r.explain().split(": ", 1)[1]  # INCONCLUSIVEs too
         style = "" if r.exact else "bold red"
         table.add_row(r.fault, " ".join(r.declared), " ".join(r.flagged), caught, style=style)
     console.print(table)

@@ -21,12 +21,21 @@ BAD = ("FAIL", "WARN")
 
 @dataclass(frozen=True)
 class MatrixRow:
+    """One fault's run against what it declares.
+
+    Exact means: every declared requirement flagged, nothing else flagged, and the
+    INCONCLUSIVE requirements exactly the collateral the fault declares (usually none): a
+    fault that silently leaves other rules undecided is a hole the matrix must show. An
+    ERROR is never exact.
+    """
+
     fault: str
     declared: tuple[str, ...]
     flagged: tuple[str, ...]  # FAIL or WARN requirements
     verdict: str  # the run's overall verdict
     other: tuple[str, ...]  # INCONCLUSIVE or ERROR requirements, for the reader
     failed: tuple[str, ...] = ()  # the FAIL ones among the flagged
+    declared_inconclusive: tuple[str, ...] = ()  # collateral the fault says it leaves open
 
     @property
     def missed(self) -> tuple[str, ...]:
@@ -37,8 +46,45 @@ class MatrixRow:
         return tuple(r for r in self.flagged if r not in self.declared)
 
     @property
+    def inconclusive(self) -> tuple[str, ...]:
+        return tuple(o.split("=")[0] for o in self.other if o.endswith("=INCONCLUSIVE"))
+
+    @property
+    def errors(self) -> tuple[str, ...]:
+        return tuple(o.split("=")[0] for o in self.other if o.endswith("=ERROR"))
+
+    @property
+    def stray_inconclusive(self) -> tuple[str, ...]:
+        return tuple(r for r in self.inconclusive if r not in self.declared_inconclusive)
+
+    @property
+    def missing_inconclusive(self) -> tuple[str, ...]:
+        return tuple(r for r in self.declared_inconclusive if r not in self.inconclusive)
+
+    @property
     def exact(self) -> bool:
-        return not self.missed and not self.extra
+        return not (
+            self.missed
+            or self.extra
+            or self.stray_inconclusive
+            or self.missing_inconclusive
+            or self.errors
+        )
+
+    def explain(self) -> str:
+        """One line naming every way the row is not exact."""
+        parts = [
+            f"{label} {list(ids)}"
+            for label, ids in (
+                ("missed", self.missed),
+                ("also flagged", self.extra),
+                ("undeclared INCONCLUSIVE", self.stray_inconclusive),
+                ("declared INCONCLUSIVE but decided", self.missing_inconclusive),
+                ("ERROR", self.errors),
+            )
+            if ids
+        ]
+        return f"{self.fault}: " + ("; ".join(parts) or "exact")
 
 
 def run_once(port: str, extra: tuple[str, ...] = (), role: str = "sensor") -> dict:
@@ -50,8 +96,11 @@ def run_once(port: str, extra: tuple[str, ...] = (), role: str = "sensor") -> di
         return json.loads((Path(tmp) / "verdicts.json").read_text(encoding="utf-8"))
 
 
-def row_from(fault: str, declared: tuple[str, ...], data: dict) -> MatrixRow:
-    """Compare one run's verdicts with what the fault declares."""
+def row_from(
+    fault: str, declared: tuple[str, ...], data: dict, inconclusive: tuple[str, ...] = ()
+) -> MatrixRow:
+    """Compare one run's verdicts with what the fault declares (``inconclusive``: the
+    collateral INCONCLUSIVEs it declares)."""
     reqs = data["requirements"]
     return MatrixRow(
         fault,
@@ -62,12 +111,16 @@ def row_from(fault: str, declared: tuple[str, ...], data: dict) -> MatrixRow:
             f"{r['id']}={r['verdict']}" for r in reqs if r["verdict"] in ("INCONCLUSIVE", "ERROR")
         ),
         tuple(r["id"] for r in reqs if r["verdict"] == "FAIL"),
+        tuple(inconclusive),
     )
 
 
 def _row(item: tuple[str, tuple[str, ...], str, tuple[str, ...]]) -> MatrixRow:
+    from .emulator import FAULTS
+
     fault, declared, version, extra = item
-    return row_from(fault, declared, run_once(f"sim://?faults={fault}&version={version}", extra))
+    data = run_once(f"sim://?faults={fault}&version={version}", extra)
+    return row_from(fault, declared, data, tuple(FAULTS[fault].inconclusive))
 
 
 def fault_matrix(faults: list[str] | None = None, processes: int = 2) -> list[MatrixRow]:

@@ -8,10 +8,14 @@ the real-link layer.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlsplit
 
 from .declaration import Declaration
 from .links.base import Link
+
+if TYPE_CHECKING:
+    from .emulator.profile import Profile
 
 
 class PortError(ValueError):
@@ -76,17 +80,18 @@ def open_sim(spec: SimSpec) -> OpenedPort:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
     profile = replace(default_profile(spec.version), address=spec.address)
     _bus, link, emulator = sim_sensor(profile, faults=spec.faults)
-    return OpenedPort(link, [emulator], sim_declaration(emulator, spec))
+    declared = emulator.faults.declared_profile(profile)  # the clean profile, not the faulted
+    return OpenedPort(link, [emulator], sim_declaration(declared, spec))
 
 
-def sim_declaration(emulator: object, spec: SimSpec) -> Declaration:
-    """What the simulated sensor's maker would declare: its profile, as the emulator runs it.
+def sim_declaration(profile: Profile, spec: SimSpec) -> Declaration:
+    """What the simulated sensor's maker would declare: its clean profile (a fault is found
+    on the wire, not handed to the tool in the declaration).
 
     Extended commands are opt-in on real devices; the simulated one declares its own, so the
     suite exercises them. The address is left to discovery (``?!``); a sensor asked for at
     address 0 is a unit fresh from the factory.
     """
-    profile = emulator.profile  # type: ignore[attr-defined]
     return Declaration(
         features={"address_change": bool(profile.address_settable)},
         extended=tuple(profile.extended),

@@ -42,6 +42,7 @@ class RequirementResult:
     findings: list[Finding]
     tests: list[str]
     judged: bool = True  # False: testable, but no case of this run looked at it
+    consequence_of: str | None = None  # a FAILed rule whose deviation probably caused this
 
     @property
     def one_line(self) -> str:
@@ -73,12 +74,26 @@ def aggregate(role: str, cases: list[CaseRecord]) -> list[RequirementResult]:
             findings = [Finding(req.id, Verdict.NA, f"untestable here: {reason}")]
         elif not findings:
             findings = [Finding(req.id, Verdict.INCONCLUSIVE, "no case judged this requirement")]
-        verdict = worst(f.verdict for f in findings)
+        verdict = worst(f.verdict for f in counted(findings))
         judged = not (req.testable(role) and req.id not in by_id)
         results.append(
             RequirementResult(req, verdict, findings, sorted(set(tests.get(req.id, []))), judged)
         )
     return results
+
+
+def unreached(finding: Finding) -> bool:
+    """An INCONCLUSIVE that rests on no observation: the case could not reach the rule (an
+    exploration stopped early, a precondition failed). Unlike one over observations (an
+    uncertainty straddling a limit), it says nothing against what another case judged."""
+    return finding.verdict is Verdict.INCONCLUSIVE and finding.observed == 0
+
+
+def counted(findings: list[Finding]) -> list[Finding]:
+    """The findings that set a requirement's verdict: a case that could not reach the rule
+    does not outvote one that judged it (PASS, WARN or FAIL)."""
+    decided = any(f.verdict in (Verdict.PASS, Verdict.WARN, Verdict.FAIL) for f in findings)
+    return [f for f in findings if not (decided and unreached(f))]
 
 
 def overall(results: list[RequirementResult], *, strict: bool, complete: bool) -> str:

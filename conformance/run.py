@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from . import __version__
+from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
 from .links.base import Link
 from .ports import is_sim, open_port
@@ -134,6 +134,7 @@ class ConformanceRun:
         self.finished = now_iso()
         self._recheck_timing()
         self.results = aggregate(self.options.role, self.cases)
+        root_causes.link(self.results)
         self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
         unjudged = sum(1 for r in self.results if not r.judged)
         if unjudged and not self.stop_reason:

@@ -3,6 +3,14 @@
 A finding is one judged fact about one requirement, with evidence. A requirement's verdict is
 the worst of its findings in the order N/A < PASS < WARN < INCONCLUSIVE < FAIL; ERROR (the tool
 failed) is reported apart and never hidden behind another verdict.
+
+Two rules hold for every finding, whichever judge builds it, because they are enforced here,
+where a finding comes into being (issue 10):
+
+- a PASS rests on something observed: a finding says how many exchanges, events or
+  measurements it judged (``observed``); a PASS over none is INCONCLUSIVE, "nothing to judge";
+- a rule's level caps its verdict: a SHOULD or MAY rule that is broken is a WARN, never a
+  FAIL (the catalog's level decides, :func:`conformance.catalog.strongest_verdict`).
 """
 
 from __future__ import annotations
@@ -11,6 +19,11 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from enum import StrEnum
 from typing import Any
+
+from .catalog import strongest_verdict
+
+#: The reason a PASS without any observation behind it became INCONCLUSIVE.
+NOTHING_TO_JUDGE = "nothing to judge"
 
 
 class Verdict(StrEnum):
@@ -52,7 +65,8 @@ class Finding:
 
     ``measured_ms``/``limit_ms``/``uncertainty_ms`` are filled by timing judges; ``evidence``
     holds escaped wire text or other short observations; ``decision`` cites a
-    requirements.md section 5 decision (``"A13"``) that shaped the verdict.
+    requirements.md section 5 decision (``"A13"``) that shaped the verdict. ``observed`` is the
+    number of exchanges, events or measurements the verdict rests on: a PASS needs at least one.
     """
 
     requirement: str
@@ -67,6 +81,16 @@ class Finding:
     # timing findings: how far (ms) the measurement sits from the edge that decided it, so
     # a verdict can be checked again against a larger uncertainty measured later in the run
     margin_ms: float | None = None
+    observed: int = 0
+    consequence_of: str | None = None  # the root finding's requirement (root_causes.py)
+
+    def __post_init__(self) -> None:
+        if self.verdict is Verdict.PASS and self.observed < 1:
+            self.verdict = Verdict.INCONCLUSIVE
+            self.detail = f"{NOTHING_TO_JUDGE}: {self.detail}"
+        if self.verdict is Verdict.FAIL and strongest_verdict(self.requirement) == "WARN":
+            self.verdict = Verdict.WARN
+            self.detail += " (a SHOULD/MAY rule: broken, it is a WARN, never a FAIL)"
 
     def to_json(self) -> dict[str, Any]:
         d = asdict(self)
@@ -74,8 +98,9 @@ class Finding:
         return d
 
 
-def passed(requirement: str, detail: str, **kw: Any) -> Finding:
-    return Finding(requirement, Verdict.PASS, detail, **kw)
+def passed(requirement: str, detail: str, *, observed: int, **kw: Any) -> Finding:
+    """A PASS over ``observed`` exchanges/events/measurements (none: INCONCLUSIVE)."""
+    return Finding(requirement, Verdict.PASS, detail, observed=observed, **kw)
 
 
 def failed(requirement: str, detail: str, **kw: Any) -> Finding:

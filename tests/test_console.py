@@ -105,3 +105,12 @@ def test_a_selection_says_what_it_left_unjudged_in_one_line(monkeypatch, tmp_pat
 )
 def test_one_line(text, width, expected):
     assert one_line(text, width) == expected
+
+
+def test_judged_counts_verdicts_on_the_device_not_na():
+    """Issue 10: a v1.3 run judged 77 rules; the 29 that bind v1.4 only are N/A, said apart."""
+    from conformance.matrix import run_once
+    from conformance.reports.console import _coverage
+
+    line = _coverage(run_once("sim://?version=1.3"))
+    assert line.startswith("77 of 106 testable requirements judged, 29 N/A")

@@ -796,6 +796,69 @@ def check_m2_later_data_silent(rig: Rig) -> None:
     assert silent(rig.ask("0D1!"))
 
 
+def check_metadata_crc_sticks(rig: Rig) -> None:
+    rig.ask("0IMC_001!")
+    d0 = first_data(rig, "0M!")
+    assert "R-4.4.12-03" in requirements_of(d0.body, "0M!")
+
+
+def check_undefined_group_keeps_data(rig: Rig) -> None:
+    rig.measure("0M!")
+    assert rig.ask("0M5!").body == "00000"
+    assert rig.ask("0D0!").body == "0" + M_VALUES
+
+
+def check_metadata_r_count_short(rig: Rig) -> None:
+    assert rig.ask("0R0!").body == "0+22.1+45.6"
+    assert rig.ask("0IR0_001!").body.startswith("0,TA")
+    assert rig.ask("0IR0_002!").body == "0"
+
+
+def check_continuous_overwrites_data(rig: Rig) -> None:
+    assert first_data(rig, "0M!").body == "0" + M_VALUES
+    rig.ask("0R0!")
+    assert rig.ask("0D0!").body == "0"
+
+
+def check_metadata_crc_unasked(rig: Rig) -> None:
+    body = rig.ask("0IM_001!").body
+    assert body[-3:] == ascii_crc(body[:-3])
+    violations = parse_metadata_reply(body, crc_expected=False).violations
+    assert [v.requirement for v in violations] == ["R-6.2-02"]
+
+
+def _follow_up_after(marking: float) -> Callable[[Rig], None]:
+    """A! answered, then aI! without a break after about ``marking`` s of marking (the
+    rig listens 20 ms past the reply): silence is the deviation."""
+
+    def check(rig: Rig) -> None:
+        assert rig.ask("0!").text == "0\r\n"
+        rig.wait(marking - 20e-3)
+        assert silent(rig.ask("0I!", brk=False))
+
+    return check
+
+
+def check_standby_after_108ms(rig: Rig) -> None:
+    assert rig.ask("0!").text == "0\r\n"
+    rig.wait(85e-3)  # about 105 ms of marking: past 100.4 ms, short of 108
+    assert rig.ask("0!", brk=False).text == "0\r\n"
+
+
+CHECKS.update(
+    {
+        "metadata-crc-sticks": check_metadata_crc_sticks,
+        "undefined-group-keeps-data": check_undefined_group_keeps_data,
+        "metadata-r-count-short": check_metadata_r_count_short,
+        "continuous-overwrites-data": check_continuous_overwrites_data,
+        "metadata-crc-unasked": check_metadata_crc_unasked,
+        "standby-after-40ms": _follow_up_after(50e-3),
+        "standby-after-60ms": _follow_up_after(70e-3),
+        "standby-after-108ms": check_standby_after_108ms,
+    }
+)
+
+
 CHECKS.update(
     {
         "m2-later-data-silent": check_m2_later_data_silent,
@@ -892,3 +955,20 @@ def test_slow_wake_does_not_take_the_tail_of_a_command():
     rig.send("0D0!")  # '0' and 'D' fall in the wake-up time, '0!' after it
     assert rig.listen(timeout=0.03) == []
     assert rig.ask("0D0!", brk=False).body == "0" + M1_VALUES
+
+
+def test_sim_declares_the_clean_profile_not_the_faulted_one():
+    """Issue 10: on sim a fault is caught from the wire; the tool is never handed the fault's
+    command names, unless the fault says what its maker declares (``declares``)."""
+    from dataclasses import replace
+
+    from conformance.ports import SimSpec, open_sim, sim_declaration
+
+    for name, fault in FAULTS.items():
+        spec = SimSpec(faults=(name,), version=fault.version)
+        clean = replace(default_profile(fault.version), address="0")
+        declared = open_sim(spec).declaration
+        if fault.declares is None:
+            assert declared == sim_declaration(clean, spec), name
+        else:
+            assert declared == sim_declaration(fault.declares(clean), spec), name

@@ -140,26 +140,31 @@ def test_timing_svg_of_hostile_characters_is_inert():
 
 def test_exchange_behind_a_whole_run_finding_is_the_one_measured():
     events = exchange(0.0, "0!", "0\r\n", 0.009) + exchange(1.0, "0I!", "014X\r\n", 0.0153)
-    finding = Finding("R-7.0-10", Verdict.PASS, "worst", measured_ms=15.3, limit_ms=15.4)
+    finding = Finding(
+        "R-7.0-10", Verdict.PASS, "worst", measured_ms=15.3, limit_ms=15.4, observed=1
+    )
     label, drawn = timing_diagram.exchange_behind([finding], events)
     assert label.startswith("0I!, the exchange behind R-7.0-10's 15.30 ms")
     assert decode_7e1(e for e in drawn if e.origin == DUT) == "014X\r\n"
     assert drawn[0].kind is EventKind.BREAK
-    assert timing_diagram.exchange_behind([Finding("R-7.0-10", Verdict.PASS, "x")], events) is None
+    assert (
+        timing_diagram.exchange_behind([Finding("R-7.0-10", Verdict.PASS, "x", observed=1)], events)
+        is None
+    )
 
 
 def test_case_html_draws_timing_cases_only():
     events = exchange(0.0, "0!", "0\r\n", 0.009)
     timing = CaseRecord("test_7_timing.py::test_x", "test_x", ("R-7.0-05",))
-    timing.findings.append(Finding("R-7.0-05", Verdict.PASS, "answered"))
+    timing.findings.append(Finding("R-7.0-05", Verdict.PASS, "answered", observed=1))
     timing.evidence.append(("break, a!", events))
     other = CaseRecord("test_4_4_basic.py::test_y", "test_y", ("R-4.4.1-01",))
-    other.findings.append(Finding("R-4.4.1-01", Verdict.PASS, "answered"))
+    other.findings.append(Finding("R-4.4.1-01", Verdict.PASS, "answered", observed=1))
     other.evidence.append(("a!", events))
     assert "<svg" in html.case_html(timing) and "<svg" not in html.case_html(other)
     derived = ("worst exchange", events)
     measured = CaseRecord("test_9_whole_run.py::test_z", "test_z", ("R-7.0-10",))
-    measured.findings.append(Finding("R-7.0-10", Verdict.PASS, "ok", measured_ms=9.0))
+    measured.findings.append(Finding("R-7.0-10", Verdict.PASS, "ok", measured_ms=9.0, observed=1))
     page = html.case_html(measured, derived)
     assert "<svg" in page and "worst exchange" in page and "measured 9.00 ms" in page
 

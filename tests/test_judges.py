@@ -165,7 +165,7 @@ def test_aggregation_worst_finding_untestable_and_unjudged():
         "a",
         ("R-4.4.1-01",),
         findings=[
-            Finding("R-4.4.1-01", Verdict.PASS, "ok"),
+            Finding("R-4.4.1-01", Verdict.PASS, "ok", observed=1),
             Finding("R-4.4.1-01", Verdict.WARN, "hm"),
         ],
     )

@@ -205,15 +205,22 @@ def test_late_reply_is_recorded_not_missed():
 
 
 # -- bounded reads ----------------------------------------------------------------------------
-def test_babbling_device_ends_bounded():
-    master, _ = rig(Babbler(10_000, start=0.05))
+@pytest.mark.parametrize(
+    ("start", "first_reason"),
+    [
+        (0.15, TOO_LONG),  # starts after the command: a reply that never ends
+        (0.05, "invalid: bus contention"),  # already talking: never the command's reply
+    ],
+)
+def test_babbling_device_ends_bounded(start, first_reason):
+    master, _ = rig(Babbler(10_000, start=start))
     t0 = time.perf_counter()
     master.link.wait(0.1)
     ex = master.acknowledge()
     assert time.perf_counter() - t0 < 5
     assert not ex.ok
     assert all(len(a.reply_events) <= master.policy.max_reply_chars for a in ex.attempts)
-    assert ex.attempts[0].reason == TOO_LONG
+    assert ex.attempts[0].reason.startswith(first_reason)
     assert len(ex.attempts) == 9
 
 

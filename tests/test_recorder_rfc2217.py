@@ -63,6 +63,8 @@ def test_golden_recorder_over_rfc2217_is_compliant(tmp_path):
     assert {r["id"] for r in judged} >= TIMING
     # the protocol verdicts are definite over the real link
     assert verdicts["R-7.2-01"] == verdicts["R-4.4.12-07"] == "PASS", verdicts
+    # the served line spaces the recorder's bytes itself: no PASS on a rate it never saw
+    assert verdicts["R-4.1-01"] == "INCONCLUSIVE", verdicts
     # the transcript is the sensors' view: the recorder's breaks and characters, and each
     # played sensor's characters under its own name, stamped with the line's uncertainty
     kinds = {(e["kind"], e["origin"]) for e in events}

@@ -45,7 +45,7 @@ def hostile_port(port: str) -> OpenedPort:
     object.__setattr__(profile, "vendor", SCRIPT)
     object.__setattr__(profile, "model", IMG)
     _bus, link, emulator = sim_sensor(profile)
-    return OpenedPort(link, [emulator], sim_declaration(emulator, SimSpec()))
+    return OpenedPort(link, [emulator], sim_declaration(emulator.profile, SimSpec()))
 
 
 @pytest.fixture(scope="module")

@@ -546,3 +546,11 @@ def test_metadata_empty_units_field_is_a_warning() -> None:
 def test_metadata_address() -> None:
     reply = parse_metadata_reply("1,PR,mm;", crc_expected=False, expected_address="0")
     assert ids(reply.violations) == ["R-4.3-01"]
+
+
+def test_an_unasked_metadata_crc_is_one_violation_not_two():
+    """Issue 10: a CRC on a plain metadata reply is R-6.2-02 once, not also a ';' in a field."""
+    body = "0,TA,degC;"
+    reply = parse_metadata_reply(body + ascii_crc(body), crc_expected=False)
+    assert [v.requirement for v in reply.violations] == ["R-6.2-02"]
+    assert reply.fields == ["TA", "degC"]

@@ -39,6 +39,7 @@ class Behaviour:
     standby_marking: float = STANDBY_MARKING  # R-7.0-15
     standby_after_foreign: bool = True  # R-7.0-14
     standby_after_reply: bool = False  # True breaks R-7.0-16
+    standby_after_reply_marking: float | None = None  # < 87 ms breaks R-7.0-16
     standby_after_service_request: bool = False  # True breaks R-7.1-02
     # -- transmitting ------------------------------------------------------------------------
     reply_delay: float = REPLY_DELAY
@@ -73,6 +74,9 @@ class Behaviour:
     clear_after_read: bool = False
     clear_on_standby_after_read: bool = False
     identify_clears_data: bool = False
+    undefined_group_keeps_data: bool = False  # a0000 for aMn! leaves the old D buffer
+    continuous_overwrites_data: bool = False  # aRn!/aRCn! replace the D buffer
+    metadata_crc_sticks: bool = False  # after aIMC_nnn!, plain D replies carry a CRC
     # -- data replies ------------------------------------------------------------------------
     limit_measure: int = 35  # <values> characters per D reply after M/V (R-4.4-05)
     limit_concurrent: int = 75  # after C (R-4.4-05)

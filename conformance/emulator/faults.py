@@ -59,10 +59,19 @@ class Fault:
     rewrite: Rewrite | None = None
     profile: ProfileTransform | None = None
     version: str = "14"
+    #: Requirements the fault honestly leaves undecided (the description says why); the
+    #: matrix demands exactly these INCONCLUSIVE, so collateral is declared, never ignored.
+    inconclusive: tuple[str, ...] = ()
+    #: What the maker's declaration says where it differs from the clean profile (say, the
+    #: names of its extended commands). On ``sim`` the declaration is the clean profile's:
+    #: a fault is caught from the wire, never from names the tool was handed by the fault.
+    declares: ProfileTransform | None = None
 
     def __post_init__(self) -> None:
         if not self.violates:
             raise ValueError(f"fault {self.name} declares no requirement")
+        if set(self.violates) & set(self.inconclusive):
+            raise ValueError(f"fault {self.name}: a requirement cannot be broken and undecided")
         unknown = set(self.settings) - _BEHAVIOUR_FIELDS
         if unknown:
             raise ValueError(f"fault {self.name}: unknown settings {sorted(unknown)}")
@@ -103,6 +112,14 @@ class FaultSet:
             if fault.profile is not None:
                 profile = fault.profile(profile)
         return profile
+
+    def declared_profile(self, clean: Profile) -> Profile:
+        """The profile the maker's declaration describes: the clean one, changed only by
+        what a fault says its maker declares."""
+        for fault in self.faults:
+            if fault.declares is not None:
+                clean = fault.declares(clean)
+        return clean
 
 
 def compose(names: Iterable[str]) -> FaultSet:
@@ -367,6 +384,10 @@ def _address_quiet_2s(profile: Profile) -> Profile:
 
 
 # -- profile helpers ---------------------------------------------------------------------------
+def _last_record_dropped(spec: MeasurementSpec) -> MeasurementSpec:
+    return replace(spec, metadata=spec.metadata[:-1])
+
+
 def _with_spec(key: str, change: Callable[[MeasurementSpec], MeasurementSpec]) -> ProfileTransform:
     def transform(profile: Profile) -> Profile:
         measurements = dict(profile.measurements)
@@ -456,9 +477,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "measure-ttt-two-digits",
-            "M/MC/Mn/V replies give ttt with two digits (atttn becomes attn).",
+            "M/MC/Mn/V replies give ttt with two digits (atttn becomes attn)."
+            " No measurement reply parses, so no data are there for the identify commands to"
+            " disturb (R-6.1-03).",
             ("R-4.4.5-01",),
             rewrite=_start_with(1, lambda body: body[0] + body[2:]),
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "measure-count-zero",
@@ -480,12 +504,15 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "high-volume-two-digit-count",
-            "HA replies give a 2-digit count (atttnn instead of atttnnn).",
+            "HA replies give a 2-digit count (atttnn instead of atttnnn)."
+            " With the count unreadable no D data are asked for, so the aHA! data rules have"
+            " nothing to judge.",
             ("R-5.1-01",),
             rewrite=_when(
                 lambda r: _measure_family(r, 3) and _source_kind(r) is Kind.HIGH_VOLUME_ASCII,
                 lambda r: replace(r, body=r.body[:4] + r.body[5:]),
             ),
+            inconclusive=("R-5.1-02", "R-5.1-03"),
         ),
         Fault(
             "value-missing-sign",
@@ -661,9 +688,12 @@ def _faults() -> list[Fault]:
         # -- service requests --------------------------------------------------------------------
         Fault(
             "no-service-request",
-            "M/MC/Mn/V with ttt > 0 never send a service request (data are ready before ttt).",
+            "M/MC/Mn/V with ttt > 0 never send a service request (data are ready before ttt)."
+            " With no service request its form and timing cannot be judged, nor can a break be"
+            " shown to abort one (R-4.4.5.1-01).",
             ("R-4.4.6-02",),
             settings={"service_request": False},
+            inconclusive=("R-4.4.5-09", "R-4.4.5.1-01", "R-4.4.6-01", "R-4.4.6-04"),
         ),
         Fault(
             "late-service-request",
@@ -685,9 +715,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "service-request-extra-chars",
-            "The service request is 'aSR<CR><LF>' instead of 'a<CR><LF>'.",
+            "The service request is 'aSR<CR><LF>' instead of 'a<CR><LF>'."
+            " The service request is not recognised, so a break cannot be shown to prevent one"
+            " (R-4.4.5.1-01).",
             ("R-4.4.6-01",),
             rewrite=_only([ReplyKind.SERVICE_REQUEST], lambda r: replace(r, body=r.body + "SR")),
+            inconclusive=("R-4.4.5.1-01",),
         ),
         Fault(
             "chatter-before-service-request",
@@ -742,27 +775,39 @@ def _faults() -> list[Fault]:
         # -- data buffer -------------------------------------------------------------------------
         Fault(
             "buffer-cleared-by-break",
-            "Once all D pages were read, the next break empties the data buffer.",
+            "Once all D pages were read, the next break empties the data buffer."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             settings={"clear_on_break_after_read": True},
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "buffer-cleared-after-read",
-            "Once all D pages were read, the buffer is empty (repeated D returns nothing).",
+            "Once all D pages were read, the buffer is empty (repeated D returns nothing)."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             settings={"clear_after_read": True},
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "data-changes-on-repeat",
-            "A repeated Dn returns the last digit changed.",
+            "A repeated Dn returns the last digit changed."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             rewrite=_only(_DATA, _vary_repeat),
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "data-lost-after-standby",
-            "Once all D pages were read, entering standby empties the data buffer.",
+            "Once all D pages were read, entering standby empties the data buffer."
+            " Data that do not survive a plain re-read leave nothing for the identify commands"
+            " to disturb (R-6.1-03).",
             ("R-4.4.5-10",),
             settings={"clear_on_standby_after_read": True},
+            inconclusive=("R-6.1-03",),
         ),
         Fault(
             "identify-clears-buffer",
@@ -819,9 +864,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "d0-empty",
-            "Completed measurements hold no values: D0 answers 'a<CR><LF>'.",
+            "Completed measurements hold no values: D0 answers 'a<CR><LF>'."
+            " With no values delivered, neither a disturbed concurrent measurement (R-4.4.7-05)"
+            " nor data the identify commands could disturb (R-6.1-03) can be compared.",
             ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
             settings={"drop_all_values": True},
+            inconclusive=("R-4.4.7-05", "R-6.1-03"),
         ),
         Fault(
             "undefined-measure-silent",
@@ -890,22 +938,28 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "identify-unsupported",
-            "Identify-measurement commands (aIM!, aIC!, aIHA!...) get no answer.",
+            "Identify-measurement commands (aIM!, aIC!, aIHA!...) get no answer."
+            " With no identify reply there is none to compare with the measurement's (R-6.1-02).",
             ("R-6.1-01",),
             settings={"answer_identify_measurement": False},
+            inconclusive=("R-6.1-02",),
         ),
         # -- high-volume binary -------------------------------------------------------------------
         Fault(
             "binary-payload-not-multiple",
-            "Packets of multi-byte types carry one stray byte after their values.",
+            "Packets of multi-byte types carry one stray byte after their values."
+            " No packet reads as values, so none shows how the values are ordered (R-5.2-07).",
             ("R-5.2-05",),
             rewrite=_binary(_pad_payload),
+            inconclusive=("R-5.2-07",),
         ),
         Fault(
             "binary-invalid-type",
-            "DB0's packet carries data type code 11.",
+            "DB0's packet carries data type code 11."
+            " No packet reads as values, so none shows how the values are ordered (R-5.2-07).",
             ("R-5.2.1-01",),
             rewrite=_binary(_binary_first_packet(_invalid_type)),
+            inconclusive=("R-5.2-07",),
         ),
         Fault(
             "binary-no-empty-packet",
@@ -948,9 +1002,12 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "inter-char-gap",
-            "3 ms of marking between reply characters (limit 1.66 ms).",
+            "3 ms of marking between reply characters (limit 1.66 ms)."
+            " No two reply characters come back to back, so the bit rate cannot be told from the"
+            " gaps (R-4.1-01).",
             ("R-7.0-12",),
             settings={"char_gap": 3e-3},
+            inconclusive=("R-4.1-01",),
         ),
         Fault(
             "ignores-short-breaks",
@@ -1084,6 +1141,7 @@ def _faults() -> list[Fault]:
             "Extended commands are named aZ...! instead of the recommended aX...!.",
             ("R-4.4.13-02",),
             profile=_rename_extended,
+            declares=_rename_extended,  # its maker lists aZSN!...; the sensor must answer them
         ),
         Fault(
             "multiline-no-etx",
@@ -1105,15 +1163,28 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "high-volume-binary-two-digit-count",
-            "aHB! replies give a 2-digit count (atttnn instead of atttnnn).",
+            "aHB! replies give a 2-digit count (atttnn instead of atttnnn)."
+            " With the count unreadable no packet is asked for, so the packet rules have nothing"
+            " to judge.",
             ("R-5.2-01",),
             rewrite=_when(_hb_start, lambda r: replace(r, body=r.body[:4] + r.body[5:])),
+            inconclusive=(
+                "R-4.1-03",
+                "R-5.2-02",
+                "R-5.2-03",
+                "R-5.2-04",
+                "R-5.2-05",
+                "R-5.2-07",
+                "R-5.2.1-01",
+            ),
         ),
         Fault(
             "binary-size-big-endian",
-            "The payload size field of HB packets is sent high byte first.",
+            "The payload size field of HB packets is sent high byte first."
+            " No packet reads as values, so none shows how the values are ordered (R-5.2-07).",
             ("R-5.2-02",),
             rewrite=_binary(_size_big_endian),
+            inconclusive=("R-5.2-07",),
         ),
         Fault(
             "high-volume-unsupported-silent",
@@ -1124,9 +1195,11 @@ def _faults() -> list[Fault]:
         ),
         Fault(
             "metadata-silent",
-            "Parameter metadata commands (aIM_001! ...) get no answer.",
+            "Parameter metadata commands (aIM_001! ...) get no answer."
+            " With no metadata reply, the rules on its contents have nothing to judge.",
             ("R-6.2-01", "R-6.2-05", "R-6.2-06", "R-6.2-07"),
             rewrite=_only([ReplyKind.METADATA], _silence),
+            inconclusive=("R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2.1-01", "R-6.2.2-01"),
         ),
         Fault(
             "metadata-semicolon-in-field",
@@ -1143,9 +1216,68 @@ def _faults() -> list[Fault]:
         Fault(
             "inter-char-gap-tolerance",
             "1.9 ms of marking between reply characters: inside 1.66 + 0.40 ms, but that gap "
-            "has no tolerance.",
+            "has no tolerance."
+            " No two reply characters come back to back, so the bit rate cannot be told from the"
+            " gaps (R-4.1-01).",
             ("R-7.0-12", "R-7.0-01"),
             settings={"char_gap": 1.9e-3},
+            inconclusive=("R-4.1-01",),
+        ),
+        # -- deviations found on a third-party sensor (issue 10) ----------------------------------
+        Fault(
+            "metadata-crc-sticks",
+            "After a CRC metadata command (aIMC_001!), D replies of later plain measurements "
+            "carry a CRC too.",
+            ("R-4.4.12-03",),
+            settings={"metadata_crc_sticks": True},
+        ),
+        Fault(
+            "undefined-group-keeps-data",
+            "aMn! for an undefined group answers a0000 but leaves the previous measurement's "
+            "values in D0.",
+            ("R-4.4.8-03",),
+            settings={"undefined_group_keeps_data": True},
+        ),
+        Fault(
+            "metadata-r-count-short",
+            "aIR0_nnn! describes one value fewer than aR0! returns.",
+            ("R-6.2-06",),
+            profile=_with_spec("R0", _last_record_dropped),
+        ),
+        Fault(
+            "continuous-overwrites-data",
+            "aRn!/aRCn! share the D buffer: after one, the last measurement's D replies are empty.",
+            ("R-4.4.5-10",),
+            settings={"continuous_overwrites_data": True},
+        ),
+        Fault(
+            "metadata-crc-unasked",
+            "Metadata replies of plain commands (aIM_001!) carry a CRC nobody asked for.",
+            ("R-6.2-02",),
+            rewrite=_when(
+                lambda r: r.kind is ReplyKind.METADATA and not r.crc and _has_values(r),
+                _set(crc=True),
+            ),
+        ),
+        # -- timing just inside the limits (boundary probes, issue 10) --------------------------
+        Fault(
+            "standby-after-40ms",
+            "The sensor drops to standby 40 ms after its last reply, not 100 ms: a follow-up "
+            "without a break at 40..87 ms goes unanswered.",
+            ("R-7.0-16",),
+            settings={"standby_after_reply_marking": 40e-3},
+        ),
+        Fault(
+            "standby-after-60ms",
+            "The sensor drops to standby 60 ms after its last reply, not 100 ms.",
+            ("R-7.0-16",),
+            settings={"standby_after_reply_marking": 60e-3},
+        ),
+        Fault(
+            "standby-after-108ms",
+            "The sensor stays awake for 108 ms of marking (100 ms + 0.40 ms are allowed).",
+            ("R-7.0-15",),
+            settings={"standby_marking": 108e-3},
         ),
         # -- version specific --------------------------------------------------------------------
         Fault(

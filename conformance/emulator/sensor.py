@@ -101,6 +101,8 @@ class SensorEmulator:
         self._data: DataSet | None = None
         self._previous: DataSet | None = None
         self._last_command: Command | None = None
+        self._crc_stuck = False  # only a faulty sensor sets it (metadata_crc_sticks)
+        self._replied_last = False  # the last thing on the line was this sensor's own
 
     # -- introspection (tests, CLI) ----------------------------------------------------------
     @property
@@ -119,6 +121,9 @@ class SensorEmulator:
 
     @property
     def _standby_limit(self) -> float:
+        after_reply = self.behaviour.standby_after_reply_marking
+        if after_reply is not None and self._replied_last:
+            return after_reply  # a faulty sensor: sooner asleep after its own reply
         return self.behaviour.standby_marking
 
     # -- BusDevice: input --------------------------------------------------------------------
@@ -158,6 +163,7 @@ class SensorEmulator:
         self._waking = b.wake_delay > 0
         self._break_end = end
         self._last_activity = end
+        self._replied_last = False
         self._buf = []
 
     def on_char(self, wire: int, start: float, end: float) -> None:
@@ -166,6 +172,7 @@ class SensorEmulator:
         previous = self._last_activity
         heard = self._hear(start)
         self._last_activity = max(self._last_activity, end)
+        self._replied_last = False
         if not heard:
             self._buf = []
             return
@@ -235,6 +242,7 @@ class SensorEmulator:
     def pop_frame(self) -> Frame:
         frame, item = self._tx.pop_frame()
         self._last_activity = max(self._last_activity, frame.start + frame.duration)
+        self._replied_last = True
         if item.done:
             kind = item.reply.kind
             if kind is ReplyKind.SERVICE_REQUEST:
@@ -408,6 +416,8 @@ class SensorEmulator:
         sent = self._send(self._start_reply(cmd, cmd, spec, ReplyKind.START), at)
         if sent is None:
             return
+        if spec is None and b.undefined_group_keeps_data:
+            return  # a faulty sensor: the undefined group leaves the old data readable
         self._previous = self._data
         self._data = None
         delay = spec.ready_delay if spec is not None else 0.0
@@ -480,7 +490,7 @@ class SensorEmulator:
             cmd.address + page,
             command=cmd,
             source=data.source,
-            crc=data.crc,
+            crc=data.crc or self._crc_stuck,
             repeat=repeat,
         )
         self._send(reply, at)
@@ -517,6 +527,9 @@ class SensorEmulator:
             ReplyKind.CONTINUOUS, cmd.address + values, command=cmd, source=cmd, crc=cmd.crc
         )
         self._send(reply, at)
+        shared = spec is not None and self.behaviour.continuous_overwrites_data
+        if shared and self._data is not None:
+            self._data = self._data.emptied()  # a faulty sensor: R shares the D buffer
 
     def _metadata(self, cmd: Command, at: float) -> None:
         target = cmd.target
@@ -530,3 +543,5 @@ class SensorEmulator:
             return
         reply = Reply(ReplyKind.METADATA, body, command=cmd, source=target, crc=target.returns_crc)
         self._send(reply, at)
+        if target.returns_crc and self.behaviour.metadata_crc_sticks:
+            self._crc_stuck = True  # a faulty sensor: the CRC request outlives its command

@@ -20,7 +20,7 @@ from ..protocol.responses import (
 from ..transcript import escape
 
 __all__ = ["ascii_crc", "escape", "events_of", "failed", "passed", "warned"]
-from ..verdicts import Finding, Verdict, failed, passed, warned
+from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .measurements import data_reply_ids
 from .tally import Tally
 
@@ -42,7 +42,7 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
         return failed(
             rid, f"{what}: " + "; ".join(v.message for v in problems), evidence=[shown(ex)]
         )
-    return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)])
+    return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)], observed=1)
 
 
 def identification(ex: Exchange, address: str) -> tuple[Identification | None, list[Finding]]:
@@ -67,11 +67,17 @@ def silent(
     exchanges: Iterable[Exchange],
     why: str,
     *,
+    baseline: Exchange | Iterable[Exchange],
     should: bool = False,
     decision: str | None = None,
 ) -> Finding:
-    """Each exchange must have drawn no reply (foreign address, standby, partial command)."""
+    """Each exchange must have drawn no reply (foreign address, standby, partial command).
+
+    Silence is only evidence from a sensor that was shown to listen: ``baseline`` is the
+    exchange (or exchanges) in which it answered its own address; if it answered none of
+    them, a mute device would "pass", so the verdict is INCONCLUSIVE."""
     exchanges = list(exchanges)
+    controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
     answered = [ex for ex in exchanges if ex.answered]
     if answered:
         make = warned if should else failed
@@ -81,11 +87,19 @@ def silent(
             evidence=[shown(e) for e in answered],
             decision=decision,
         )
+    if not any(ex.answered for ex in controls):
+        return inconclusive(
+            rid,
+            "the sensor answered none of "
+            + ", ".join(escape(ex.text) for ex in controls)
+            + " either, so its silence here shows nothing",
+        )
     return passed(
         rid,
         f"stayed silent ({why}) to {len(exchanges)} command(s): "
         + ", ".join(escape(e.text) for e in exchanges),
         decision=decision,
+        observed=len(exchanges),
     )
 
 
@@ -111,6 +125,7 @@ def answered(
         f"answered ({why}): "
         + ", ".join(shown(e) for e in exchanges[:4])
         + (f" (+{len(exchanges) - 4} more)" if len(exchanges) > 4 else ""),
+        observed=len(exchanges),
     )
 
 

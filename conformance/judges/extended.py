@@ -21,11 +21,12 @@ def extended_replies(exchanges: list[Exchange], address: str) -> list[Finding]:
     tally = Tally(("R-4.4.13-01", "R-4.4.13-02"))
     for ex in exchanges:
         label = escape(ex.text)
+        if not ex.answered:
+            continue  # an extended command may be unknown to the sensor: silence is allowed
+        # only a command the sensor answers shows that it implements that name
         tally.observe(label, ids=["R-4.4.13-02"])
         if ex.text[1:2] != "X":
             tally.fail("R-4.4.13-02", label, f"{label} does not use the aX...! form", warning=True)
-        if not ex.answered:
-            continue  # an extended command may be unknown to the sensor: silence is allowed
         tally.observe(label, ids=["R-4.4.13-01"])
         text = ex.reply_text.rstrip("\x03") if is_multiline(ex) else ex.reply_text
         if not text.startswith(address) or not text.endswith("\r\n"):

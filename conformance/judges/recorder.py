@@ -18,7 +18,6 @@ import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
-from ..master import validity
 from ..protocol.binary import packet_length, parse_binary_packet
 from ..protocol.commands import (
     ADDRESS_CHARS,
@@ -28,6 +27,7 @@ from ..protocol.commands import (
     Kind,
     parse_command,
 )
+from ..protocol.responses import parse_data_reply, parse_measurement_reply_for, split_line
 from ..protocol.timing import (
     BREAK_MIN,
     CHAR_TIME,
@@ -40,9 +40,18 @@ from ..protocol.timing import (
     RETRY_MIN,
     TOLERANCE,
 )
-from ..protocol.values import split_values
 from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, escape, text_end
 from ..verdicts import Finding, Verdict
+from .reply_validity import (
+    ETX,
+    NO_LIMIT,
+    NO_REPLY,
+    STX,
+    Reason,
+    ReplyProblem,
+    check_packet,
+    check_reply,
+)
 from .tally import Tally
 from .timing import combine as combine_timing
 from .timing import judge_window
@@ -125,9 +134,9 @@ class Sent:
         if self.binary:
             length = packet_length(decode_8n1(heard))
             return heard[:length] if length is not None else heard
-        text = len(heard) > 1 and heard[1].char7 == validity.STX
+        text = len(heard) > 1 and heard[1].char7 == STX
         for i, e in enumerate(heard):
-            if text and e.char7 == validity.ETX:
+            if text and e.char7 == ETX:
                 return heard[: i + 1]
             if not text and e.char7 == 0x0A:
                 return heard[: i + 1]
@@ -209,23 +218,18 @@ def _at(sent: Sent) -> str:
 
 
 # -- reply validity (the recorder's view of section 7.2) -------------------------------------
-def reply_problem(sent: Sent, crc_expected: bool | None, uncertainty: float) -> str | None:
-    """Why the sensor's reply to ``sent`` was not a valid reply ("no reply" if none came)."""
-    answer = sent.answer
-    if not answer:
-        return "no reply"
-    command = sent.command
+def reply_problem(sent: Sent, crc_expected: bool | None, uncertainty: float) -> ReplyProblem | None:
+    """Why the sensor's reply to ``sent`` was not a valid reply (:data:`NO_REPLY` if none
+    came), by the judges' own rules (:mod:`.reply_validity`), not the golden recorder's."""
     if sent.binary:
-        return validity.check_packet(answer, address=sent.address, command_end=sent.end)
-    multiline = len(answer) > 1 and answer[1].char7 == validity.STX
-    return validity.check_ascii(
-        command,
-        answer,
+        return check_packet(sent.answer, address=sent.address, command_end=sent.end)
+    return check_reply(
+        sent.command,
+        sent.answer,
         address=sent.address,
         command_end=sent.end,
         gap_limit=CHAR_TIME + TOLERANCE + uncertainty,
         crc_expected=crc_expected,
-        multiline=multiline,
     )
 
 
@@ -244,7 +248,7 @@ def crc_context(line: Line) -> dict[int, bool | None]:
 @dataclass
 class Attempt:
     sent: Sent
-    problem: str | None  # None: valid reply
+    problem: ReplyProblem | None  # None: valid reply
 
     @property
     def retry(self) -> bool:
@@ -277,6 +281,8 @@ def tries(line: Line, uncertainty: float) -> list[Tries]:
     crc = crc_context(line)
     out: list[Tries] = []
     for i, s in enumerate(line.sent):
+        if not s.text.endswith("!"):
+            continue  # no command, so no reply to retry for; R-4.4-04 judges its text
         attempt = Attempt(s, reply_problem(s, crc[i], uncertainty))
         last = out[-1].attempts[-1] if out else None
         if (
@@ -303,7 +309,7 @@ class Taken:
     count: int
     reply_end: float
     service_request_end: float | None
-    data: list[tuple[Sent, str | None]]  # data transmissions to that sensor, with problems
+    data: list[tuple[Sent, ReplyProblem | None]]  # data transmissions, with their problems
     next_start: Sent | None  # the next measurement command to the same sensor, if any
     others: list[Sent]  # transmissions to other sensors before the data were all in
 
@@ -324,13 +330,18 @@ class Taken:
                 packet = parse_binary_packet(decode_8n1(sent.answer))
                 values += [repr(v) for v in packet.values]
             else:
-                text = validity.data_values_text(decode_7e1(sent.answer), self.command.returns_crc)
-                values += split_values(text)
+                values += data_values(sent, self.command)
         return values
 
     @property
     def first_data(self) -> Sent | None:
         return self.data[0][0] if self.data else None
+
+
+def data_values(sent: Sent, measurement: Command) -> list[str]:
+    """The values of a valid D reply to ``sent`` after ``measurement`` (its CRC taken off)."""
+    body, _ = split_line(decode_7e1(sent.answer))
+    return parse_data_reply(body, crc_expected=measurement.returns_crc, limit=NO_LIMIT).values
 
 
 def _service_request_end(events: list[Event], address: str) -> float | None:
@@ -347,12 +358,13 @@ def measurements(line: Line, uncertainty: float) -> list[Taken]:
         cmd = s.command
         if cmd is None or not cmd.starts_measurement or problems[i] is not None:
             continue
-        parsed = validity.parse_start_reply(decode_7e1(s.answer), validity.count_digits(cmd))
-        if parsed is None:
+        body, _ = split_line(decode_7e1(s.answer))
+        parsed = parse_measurement_reply_for(body, cmd)
+        if parsed.ttt is None or parsed.count is None:
             continue
-        ttt, count = parsed
+        ttt, count = parsed.ttt, parsed.count
         sr = _service_request_end(s.after, cmd.address)
-        data: list[tuple[Sent, str | None]] = []
+        data: list[tuple[Sent, ReplyProblem | None]] = []
         others: list[Sent] = []
         nxt: Sent | None = None
         for j in range(i + 1, len(line.sent)):
@@ -461,6 +473,7 @@ def judge_character_gaps(line: Line, uncertainty: float) -> list[Finding]:
             Verdict.PASS,
             f"{len(gaps)} command character gaps, none inside the tolerance band the 1.66 ms "
             "limit does not have; ±0.40 ms applied to every other recorder limit",
+            observed=len(gaps),
         )
     else:
         tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
@@ -550,13 +563,14 @@ def judge_break_rules(line: Line, uncertainty: float) -> list[Finding]:
                     "R-7.1-01",
                     Verdict.PASS,
                     f"a break before {_at(s)} after the service request",
+                    observed=1,
                 )
             )
         previous = s
     return [
         combine("R-7.0-17", rule17, "command without a break")
         if rule17
-        else Finding("R-7.0-17", Verdict.PASS, _all_broke(line)),
+        else Finding("R-7.0-17", Verdict.PASS, _all_broke(line), observed=len(line.sent)),
         combine("R-7.1-01", rule71, "aD0! after a service request"),
     ]
 
@@ -642,6 +656,7 @@ def judge_measure_waits(taken: Sequence[Taken], uncertainty: float) -> list[Find
                     "R-4.4.5-04",
                     Verdict.PASS,
                     f"aD0! only after the service request ({where})",
+                    observed=1,
                 )
             )
         tally.observe(where, ids=["R-4.4.5-05"])
@@ -680,7 +695,7 @@ def judge_concurrent_waits(taken: Sequence[Taken], uncertainty: float) -> list[F
 
 
 # -- judges: collecting data ----------------------------------------------------------------------
-def _collection_end(m: Taken) -> tuple[Sent | None, str | None, bool]:
+def _collection_end(m: Taken) -> tuple[Sent | None, ReplyProblem | None, bool]:
     """The last data transmission, its problem, and whether its valid reply was empty."""
     if not m.data:
         return None, None, False
@@ -690,8 +705,7 @@ def _collection_end(m: Taken) -> tuple[Sent | None, str | None, bool]:
     if sent.binary:
         packet = parse_binary_packet(decode_8n1(sent.answer))
         return sent, None, not packet.values
-    text = validity.data_values_text(decode_7e1(sent.answer), m.command.returns_crc)
-    return sent, None, text == ""
+    return sent, None, not data_values(sent, m.command)
 
 
 def judge_data_collection(taken: Sequence[Taken]) -> list[Finding]:
@@ -729,11 +743,16 @@ def judge_data_collection(taken: Sequence[Taken]) -> list[Finding]:
     return tally.findings("every announced value collected in order")
 
 
-def judge_concurrent_storage(taken: Sequence[Taken]) -> list[Finding]:
+def judge_concurrent_storage(taken: Sequence[Taken], asked: Sequence[str] = ()) -> list[Finding]:
     """R-4.4.7-07: a concurrent measurement of more than 20 values: at least 20 read and stored
     (the 2000 text's MUST); fewer than announced is a WARN (the capacity should be documented,
-    which the tool cannot see). R-4.4.7-08: the recorder uses aC!-type commands."""
+    which the tool cannot see). R-4.4.7-08: the recorder uses aC!-type commands: each one in
+    ``asked`` (what the scenarios told it to send) must be on the wire."""
     tally = Tally(("R-4.4.7-07", "R-4.4.7-08"))
+    started = {m.start.text for m in taken}
+    for text in asked:
+        if parse_command(text).kind is Kind.CONCURRENT and text not in started:
+            tally.fail("R-4.4.7-08", escape(text), f"asked for {escape(text)}, never sent it")
     for m in taken:
         if m.kind is not Kind.CONCURRENT:
             continue
@@ -845,7 +864,7 @@ def judge_retries(line: Line, uncertainty: float) -> list[Finding]:
         # Given up, as opposed to accepted: silence cannot be mistaken for a valid reply, and
         # a command sent again shows the recorder found the reply invalid. A garbled reply
         # sent once may have been accepted: that is R-7.2-05's (and R-4.4.12-07's) finding.
-        gave_up = group.attempts[-1].problem == "no reply" or len(group.attempts) > 1
+        gave_up = group.attempts[-1].problem is NO_REPLY or len(group.attempts) > 1
         if gave_up:
             tally.observe(where, ids=["R-7.2-01"])
         if len(group.attempts) == 1 and gave_up:
@@ -860,7 +879,7 @@ def judge_retries(line: Line, uncertainty: float) -> list[Finding]:
                 follower = nxt or later
                 if follower is None and len(seq) < 3:
                     tally.fail("R-7.2-05", where, f"{a.problem} at {_at(a.sent)}, then no retry")
-                if a.problem == "no reply":
+                if a.problem is NO_REPLY:
                     if nxt is not None:
                         window.append(
                             judge_window(
@@ -930,7 +949,7 @@ def judge_retries(line: Line, uncertainty: float) -> list[Finding]:
 
 
 def _retry_after_reply(
-    line: Line, sent: Sent, retry: Sent, problem: str | None, uncertainty: float
+    line: Line, sent: Sent, retry: Sent, problem: ReplyProblem | None, uncertainty: float
 ) -> Finding:
     """R-7.2-06: marking between the end of the invalid reply and the retry; negative when
     the sensor was still sending as the recorder took the line again."""
@@ -961,7 +980,7 @@ def judge_crc_checked(
     tally = Tally(("R-4.4.12-07",))
     for group in tries(line, uncertainty):
         for k, a in enumerate(group.attempts):
-            if a.problem is None or "should be" not in a.problem:
+            if a.problem is None or a.problem.reason is not Reason.CRC_WRONG:
                 continue
             where = escape(group.text)
             tally.observe(where)
@@ -1012,6 +1031,7 @@ def judge_commands_issued(
         rid,
         Verdict.PASS,
         f"{len(asked)} commands issued and answered: " + " ".join(escape(t) for t in asked),
+        observed=len(asked),
     )
 
 
@@ -1022,14 +1042,28 @@ def judge_addresses(line: Line, uncertainty: float) -> list[Finding]:
     r3 = (
         Finding("R-4.3-03", Verdict.FAIL, f"addresses never polled successfully: {digits}")
         if digits
-        else Finding("R-4.3-03", Verdict.PASS, "sensors at 0-9 each polled and answered")
+        else Finding(
+            "R-4.3-03",
+            Verdict.PASS,
+            "sensors at 0-9 each polled and answered",
+            observed=len(polled),
+        )
     )
     letters = sorted(a for a in polled if a.isalpha())
-    r4 = (
-        Finding("R-4.3-04", Verdict.PASS, f"letter addresses used: {' '.join(letters)}")
-        if letters
-        else Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
-    )
+    commands = [s for s in line.sent if s.text.endswith("!")]  # R-4.4-04 judges the rest
+    foreign = sorted({s.address for s in commands if s.address not in ADDRESS_CHARS} - {"?"})
+    if foreign:  # a MAY rule: the Finding caps this at WARN
+        shown = ", ".join(f"'{escape(a)}'" for a in foreign)
+        r4 = Finding("R-4.3-04", Verdict.FAIL, f"addressed {shown}, not an address", decision="A17")
+    elif letters:
+        r4 = Finding(
+            "R-4.3-04",
+            Verdict.PASS,
+            f"letter addresses used: {' '.join(letters)}",
+            observed=len(letters),
+        )
+    else:
+        r4 = Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
     return [r3, r4]
 
 
@@ -1056,13 +1090,13 @@ def judge_transparent(
         if cmd.kind in (Kind.METADATA, Kind.IDENTIFY_MEASUREMENT):
             ids.append("R-6.3-01")
         unchanged.observe(where, ids=ids)
-        mechanism.observe(where)
         matching = [s for s in line.sent if s.text == text]
         if not matching:
             near = [t for t in sent_texts if t[:1] == text[:1]]
             for rid in ids:
                 unchanged.fail(rid, where, f"not on the wire as typed (sent: {near[:3]})")
             continue
+        mechanism.observe(where)  # only a command that went out shows how it went out
         first = matching[0]
         if first.break_event is None:
             mechanism.fail("R-4.4.14-01", where, "sent without a break to wake the bus")
@@ -1087,7 +1121,7 @@ def judge_multiline_end(
     found: list[Finding] = []
     for i, s in enumerate(line.sent):
         answer = s.answer
-        if len(answer) < 2 or answer[1].char7 != validity.STX or answer[-1].char7 != 0x0A:
+        if len(answer) < 2 or answer[1].char7 != STX or answer[-1].char7 != 0x0A:
             continue
         nxt = line.sent[i + 1] if i + 1 < len(line.sent) else None
         where = [f"text in reply to {_at(s)}"]

@@ -74,6 +74,7 @@ class Tally:
                         detail,
                         decision=decision,
                         evidence=[f"{len(seen)} observation(s)"],
+                        observed=len(seen),
                     )
                 )
             elif rid in self.na and not seen:
@@ -94,6 +95,7 @@ class Tally:
                         Verdict.PASS,
                         f"{text} ({len(seen)} checked: {listed})",
                         decision=decision,
+                        observed=len(seen),
                     )
                 )
         return result

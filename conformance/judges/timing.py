@@ -132,6 +132,7 @@ def judge_window(
         evidence=list(evidence or []),
         decision=decision,
         margin_ms=round(min(distances) * 1e3, 3) if distances else None,
+        observed=1,  # one measured interval between two observed wire events
     )
 
 
@@ -206,4 +207,5 @@ def combine(
         uncertainty_ms=worst.uncertainty_ms,
         evidence=worst.evidence,
         margin_ms=margin,
+        observed=sum(f.observed for f in findings),
     )

@@ -245,6 +245,7 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
         Verdict.PASS,
         f"{len(gaps)} character gaps: none leans on a tolerance the rule does not grant; "
         "±0.40 ms applied to every other limit",
+        observed=len(gaps),
     )
 
 

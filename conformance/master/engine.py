@@ -17,6 +17,7 @@ from ..protocol import commands as cmds
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind
 from ..protocol.timing import (
     CHAR_TIME,
+    INTER_CHAR_GAP_MAX,
     NO_BREAK_WINDOW,
     RETRY_AFTER_BREAK,
     RETRY_MAX,
@@ -338,21 +339,36 @@ class Master:
             max_text_chars=p.max_text_chars,
             line_wait=p.line_wait,
         )
-        reply, state = self._listen(command_end, framing)
-        if state is None:
+        reply, state, collided = self._listen(command_end, framing)
+        if collided:  # the DUT talked over the command: it may not have heard it whole
+            state = f"invalid: bus contention ({len(collided)} characters during the command)"
+        elif state is None:
             state = self._judge_reply(reply, command, address, command_end, framing, crc)
-        return Attempt(break_event, sent, reply, state, self.link.now(), stray_events=stray)
+        return Attempt(
+            break_event, sent, reply, state, self.link.now(), stray_events=stray + collided
+        )
 
-    def _listen(self, command_end: float, framing: Framing) -> tuple[list[Event], str | None]:
+    def _listen(
+        self, command_end: float, framing: Framing
+    ) -> tuple[list[Event], str | None, list[Event]]:
         """Read one reply: the first start bit within ``first_char_timeout``, then until the
         framing says it is complete, the line marks for the framing's window, or the DUT has
-        sent too much. Returns the characters and NO_REPLY/IDLE/TOO_LONG, or None when the
-        reply finished and needs checking. Every read has a deadline."""
-        first = self.link.receive(
-            command_end + self.policy.first_char_timeout, until=lambda got: True
-        )
+        sent too much. Returns the characters, NO_REPLY/IDLE/TOO_LONG (or None when the
+        reply finished and needs checking), and the characters that began before the command
+        ended: they collided with it (a late reply to an earlier transmission, say) and are
+        never this command's answer. Every read has a deadline."""
+        deadline = command_end + self.policy.first_char_timeout
+        collided: list[Event] = []
+        first = self.link.receive(deadline, until=lambda got: True)
+        run_gap = INTER_CHAR_GAP_MAX + TOLERANCE + self.link.info.timing_uncertainty
+        while first and (
+            first[0].start < command_end
+            or (collided and first[0].start - collided[-1].end <= run_gap)  # its tail
+        ):
+            collided += first
+            first = self.link.receive(deadline, until=lambda got: True)
         if not first:
-            return [], NO_REPLY
+            return [], NO_REPLY, collided
         deadline = framing.deadline(first[0])
         chars = first
         while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
@@ -365,12 +381,12 @@ class Master:
             )
             if not more:
                 if framing.at_line_end(chars):
-                    return chars, None  # no next line within 150 ms: the text is complete
+                    return chars, None, collided  # no next line within 150 ms: complete
                 break
             chars = chars + more
         if framing.finished(chars):
-            return chars, None
-        return chars, TOO_LONG if len(chars) >= framing.limit(chars) else IDLE
+            return chars, None, collided
+        return chars, TOO_LONG if len(chars) >= framing.limit(chars) else IDLE, collided
 
     def _judge_reply(
         self,

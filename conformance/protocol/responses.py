@@ -552,6 +552,17 @@ def parse_metadata_reply(
             Violation("R-6.2-05", f"invalid-index reply '{escape(body)}' carries an unasked CRC")
         )
         return MetadataReply(address, [], True, text[1:], True, found)
+    tail = text[-CRC_LEN:]
+    if (
+        not crc_expected
+        and len(text) > 2 + CRC_LEN
+        and text[-CRC_LEN - 1] == ";"
+        and all(is_crc_char(c) for c in tail)
+    ):  # one deviation, one violation: not also a ';' inside a field (R-6.2-03)
+        found.append(
+            Violation("R-6.2-02", f"reply '{escape(body)}' carries a CRC nobody asked for")
+        )
+        text = text[:-CRC_LEN]
     content = text[1:]
     if not content.startswith(","):
         found.append(Violation("R-6.2-02", f"reply '{escape(body)}' has no ',' after the address"))

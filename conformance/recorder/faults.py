@@ -16,12 +16,16 @@ from ..links.base import Link
 from ..master import Master, Measurement, Policy
 from ..master.records import Attempt, Exchange
 from ..master.validity import ends_line
-from ..protocol.commands import Command, Kind
-from ..transcript import decode_7e1
+from ..protocol.commands import Command, Kind, parse_command
+from ..sim.bus import SimLink
+from ..transcript import Event, decode_7e1
 from .golden import GoldenMaster, GoldenRecorder
+from .request import RecorderOutput, Request, Task
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
+LATE_D0 = 95e-3  # s after the service request: past the 87 ms of R-7.1-01
+FAST_CHAR_TIME = 8.0e-3  # s per frame: 1250 baud, 4% fast (A14 allows 2%)
 
 
 class EarlyRetryMaster(GoldenMaster):
@@ -118,6 +122,151 @@ class IgnoresCrcMaster(GoldenMaster):
         return attempt
 
 
+class LateD0AfterServiceRequestMaster(GoldenMaster):
+    """After a service request waits 95 ms, then sends aD0! without a break."""
+
+    _no_break_once = False
+
+    def collect(
+        self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
+    ) -> Measurement:
+        if m.service_request_end is not None and not m.data:
+            self.link.wait_until(m.service_request_end + LATE_D0)
+            self._no_break_once = True
+        return super().collect(m, force_break=force_break, max_index=max_index)
+
+    def _needs_break(self, address: str, at: float) -> bool:
+        if self._no_break_once:
+            self._no_break_once = False
+            return False
+        return super()._needs_break(address, at)
+
+
+class GappyCommandMaster(GoldenMaster):
+    """Leaves ``gap`` of marking between the characters of every command."""
+
+    gap = 3e-3
+
+    def _transmit(
+        self, wire: bytes, address: str, brk: bool | None, gap: float
+    ) -> tuple[Event | None, list[Event]]:
+        return super()._transmit(wire, address, brk, max(gap, self.gap))
+
+
+class BandGapCommandMaster(GappyCommandMaster):
+    """1.9 ms between command characters: only the ±0.40 ms tolerance the 1.66 ms limit does
+    not have would make it pass."""
+
+    gap = 1.9e-3
+
+
+class WrongBaudLink:
+    """The recorder's end of the sim bus, sending every character in ``char_time`` instead
+    of 8.33 ms (a recorder at the wrong bit rate); everything else is the link's own."""
+
+    def __init__(self, link: Link, char_time: float) -> None:
+        if not isinstance(link, SimLink):
+            raise TypeError("a wrong bit rate can only be played on the simulated bus")
+        self._link = link
+        self._char_time = char_time
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._link, name)
+
+    def write(self, wire: bytes, gap: float = 0.0) -> list[Event]:
+        events, time = [], self._link.now()
+        for byte in wire:
+            event = self._link.bus.tool_char(byte, time, self._char_time)
+            events.append(event)
+            time = event.end + gap
+        return events
+
+
+@dataclass
+class WrongBaudRecorder(GoldenRecorder):
+    """The golden recorder sending at a bit rate 4% too high (frames of 8.0 ms)."""
+
+    char_time: float = FAST_CHAR_TIME
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        return super().__call__(request, WrongBaudLink(link, self.char_time))  # type: ignore[arg-type]
+
+
+@dataclass
+class LacksCommandsRecorder(GoldenRecorder):
+    """A logger that does not implement some command kinds, or cannot reach some addresses:
+    asked for such commands, it skips them."""
+
+    lacks: frozenset[Kind] = frozenset()
+    unreachable: str = ""  # addresses it cannot use (as the addressee or a new address)
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        kept = tuple(t for t in request.commands if self._can(parse_command(t)))
+        return super().__call__(replace(request, commands=kept), link)
+
+    def _can(self, command: Command) -> bool:
+        targets = {command.address, command.new_address or ""}
+        return command.kind not in self.lacks and not targets & set(self.unreachable)
+
+
+@dataclass
+class RewritingRecorder(GoldenRecorder):
+    """A logger that changes what it is asked to send (``rewrite`` maps the wire text; an
+    empty result is skipped) or adds commands of its own (``extra``, before the job)."""
+
+    rewrite: Callable[[str], str] = field(default=lambda text: text)
+    extra: str = ""  # addresses it polls with a! before the job
+    preamble: str = ""  # text it sends after a break before the job
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        master = self.master_factory(link, self.policy or Policy.golden())
+        for address in self.extra:
+            master.transact(Command(address, Kind.ACKNOWLEDGE), force_break=True)
+        if self.preamble:
+            master.raw(self.preamble, break_first=True)
+        out = super().__call__(replace(request, commands=()), link)
+        for text in request.commands:
+            wire = self.rewrite(text)
+            if not wire:
+                continue
+            if request.task is Task.TRANSPARENT:
+                ex = master.raw(wire, break_first=True)
+                out.relayed[text] = ex.reply_text if ex.answered else ""
+            else:
+                sub = replace(request, commands=(text,))
+                got = super().__call__(sub, link)
+                out.logged.update(got.logged)
+                out.relayed.update(got.relayed)
+        return out
+
+
+@dataclass
+class InterleavingRecorder(GoldenRecorder):
+    """Asked to measure several sensors with aM!, starts them all before collecting any, as
+    if they were concurrent measurements."""
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        if request.task is Task.MEASURE and len({t[:1] for t in request.commands}) > 1:
+            request = replace(request, task=Task.CONCURRENT)
+        return super().__call__(request, link)
+
+
+@dataclass
+class NoBreakTransparentRecorder(GoldenRecorder):
+    """Transparent mode sends each host command as soon as it comes, with no break of its
+    own (the engine still breaks for a new address or after 87 ms of marking)."""
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        if request.task is not Task.TRANSPARENT:
+            return super().__call__(request, link)
+        master = self.master_factory(link, self.policy or Policy.golden())
+        out = RecorderOutput()
+        for text in request.commands:
+            ex = master.transact(parse_command(text))
+            out.relayed[text] = ex.reply_text if ex.answered else ""
+        return out
+
+
 def _is_service_request(events: list, address: str) -> bool:
     return decode_7e1(events[-3:]) == f"{address}\r\n"
 
@@ -132,6 +281,8 @@ class RecorderFault:
     description: str
     violates: tuple[str, ...]
     make: Callable[[], GoldenRecorder] = field(compare=False)
+    #: collateral INCONCLUSIVEs the fault declares (see the sensor faults' field)
+    inconclusive: tuple[str, ...] = ()
 
 
 _GOLDEN = Policy.golden()
@@ -140,9 +291,11 @@ _FAULTS = (
     RecorderFault(
         "no-retries",
         "Sends each command once: no retry, no repeated sequence, so a silent sensor, a bad "
-        "CRC or a garbled reply ends the job.",
+        "CRC or a garbled reply ends the job. With no retry at all, whether a retry waits for "
+        "an invalid reply to end (R-7.2-06) cannot be seen.",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-4.4.12-07"),
         lambda: GoldenRecorder(_GOLDEN.but(retries_per_sequence=0, sequences=1)),
+        inconclusive=("R-7.2-06",),
     ),
     RecorderFault(
         "retry-too-early",
@@ -200,6 +353,118 @@ _FAULTS = (
         "Breaks last 10 ms (at least 12 ms are due).",
         ("R-7.0-02",),
         lambda: GoldenRecorder(_GOLDEN.but(break_duration=10e-3)),
+    ),
+    RecorderFault(
+        "no-concurrent",
+        "Has no aC!-type commands: asked for aC!, aCn! or aCC!, it sends nothing. With no "
+        "concurrent measurement on the wire, its waits (R-4.4.7-06) and how many of its values "
+        "are stored (R-4.4.7-07) cannot be seen.",
+        ("R-4.4.7-08", "R-4.4-02"),
+        lambda: LacksCommandsRecorder(lacks=frozenset({Kind.CONCURRENT})),
+        inconclusive=("R-4.4.7-06", "R-4.4.7-07"),
+    ),
+    RecorderFault(
+        "no-high-volume",
+        "A v1.4 recorder without aHA!/aHB!: asked for them, it sends nothing. How it would read "
+        "past D9 (R-5.1-04) or binary packets (R-5.2-08) then cannot be seen.",
+        ("R-5.4-01",),
+        lambda: LacksCommandsRecorder(
+            lacks=frozenset({Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
+        ),
+        inconclusive=("R-5.1-04", "R-5.2-08"),
+    ),
+    RecorderFault(
+        "drops-metadata",
+        "Transparent mode drops identify and metadata commands (aIM!, aIM_001!...) instead of "
+        "passing them on.",
+        ("R-6.3-01", "R-4.4.14-02"),
+        lambda: LacksCommandsRecorder(
+            lacks=frozenset({Kind.METADATA, Kind.IDENTIFY_MEASUREMENT})
+        ),
+    ),
+    RecorderFault(
+        "multiline-cut-short",
+        "Takes multi-line text without ETX as finished 50 ms after a line, not 150 ms.",
+        ("R-4.4.13.1-04",),
+        lambda: GoldenRecorder(_GOLDEN.but(line_wait=50e-3)),
+    ),
+    RecorderFault(
+        "late-d0-without-break",
+        f"Sends aD0! {LATE_D0 * 1e3:.0f} ms after the service request without a break (87 ms "
+        "is the limit; after it a break is due, which R-7.0-17 also demands).",
+        ("R-7.1-01", "R-7.0-17"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(LateD0AfterServiceRequestMaster)),
+    ),
+    RecorderFault(
+        "fast-baud",
+        f"Sends at {10 / FAST_CHAR_TIME:.0f} baud: every command character lasts "
+        f"{FAST_CHAR_TIME * 1e3:.2f} ms, not 8.33 ms (decision A14 allows 2%).",
+        ("R-4.1-01",),
+        lambda: WrongBaudRecorder(),
+    ),
+    RecorderFault(
+        "gappy-commands",
+        "Leaves 3 ms of marking between the characters of every command (1.66 ms at most).",
+        ("R-7.0-13",),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(GappyCommandMaster)),
+        inconclusive=("R-4.1-01",),  # no back-to-back characters: rate and gaps inseparable
+    ),
+    RecorderFault(
+        "command-gap-in-tolerance",
+        "Leaves 1.9 ms between command characters: over 1.66 ms, inside the ±0.40 ms that "
+        "this limit does not grant.",
+        ("R-7.0-13", "R-7.0-01"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(BandGapCommandMaster)),
+        inconclusive=("R-4.1-01",),
+    ),
+    RecorderFault(
+        "transparent-no-break",
+        "Transparent mode sends host commands without a break of its own.",
+        ("R-4.4.14-01",),
+        lambda: NoBreakTransparentRecorder(),
+    ),
+    RecorderFault(
+        "transparent-drops-address",
+        "Transparent mode sends extended commands without their address (XSN! for 0XSN!). "
+        "No sensor answers those, so no multi-line text comes whose end R-4.4.13.1-04 judges.",
+        ("R-4.4.13-03", "R-4.4.14-02"),
+        lambda: RewritingRecorder(rewrite=lambda t: t[1:] if t[1:2] == "X" else t),
+        inconclusive=("R-4.4.13.1-04",),
+    ),
+    RecorderFault(
+        "addresses-0-4-only",
+        "Can only use addresses 0-4: commands to sensors at 5-9, or moving one there, are "
+        "skipped.",
+        ("R-4.3-03", "R-4.4-02"),
+        lambda: LacksCommandsRecorder(unreachable="56789"),
+    ),
+    RecorderFault(
+        "polls-dollar",
+        "Before each job it polls '$!', as if '$' were a sensor address.",
+        ("R-4.3-01", "R-4.3-04"),
+        lambda: RewritingRecorder(extra="$"),
+    ),
+    RecorderFault(
+        "talks-over-reply",
+        "Retries as soon as a reply pauses, while the sensor may still be sending (the engine "
+        "without the golden recorder's wait for a quiet line). Its retry collides with the "
+        "rest of the reply, and on the line its characters come apart (R-7.0-13).",
+        ("R-7.2-06", "R-7.0-13"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(Master)),
+    ),
+    RecorderFault(
+        "interleaves-measurements",
+        "Starts aM! on one sensor, then aM! on another before collecting the first one's data: "
+        "it takes the line while the first one's service request may come (R-4.4.5-07) and "
+        "reads its data only after ttt, not on that request (R-4.4.5-05).",
+        ("R-4.4.5-06", "R-4.4.5-07", "R-4.4.5-05"),
+        lambda: InterleavingRecorder(),
+    ),
+    RecorderFault(
+        "crlf-wake-up",
+        "Before each job it sends a break and CR LF, a modem-style wake-up that is no command.",
+        ("R-4.2-01", "R-4.4-04", "R-4.3-01"),
+        lambda: RewritingRecorder(preamble="\r\n"),
     ),
     RecorderFault(
         "short-marking",

@@ -14,7 +14,8 @@ def run_recorder_suite(port: str = "sim", extra: tuple[str, ...] = ()) -> dict:
 
 def recorder_row(fault: str) -> MatrixRow:
     data = run_recorder_suite(f"sim://?recorder-faults={fault}")
-    return row_from(fault, RECORDER_FAULTS[fault].violates, data)
+    spec = RECORDER_FAULTS[fault]
+    return row_from(fault, spec.violates, data, spec.inconclusive)
 
 
 def recorder_matrix(faults: list[str] | None = None) -> list[MatrixRow]:

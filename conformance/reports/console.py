@@ -163,7 +163,15 @@ def noteworthy(data: dict[str, Any]) -> list[tuple[str, str, str]]:
             rows.append((verdict, f"{len(ids)} requirements", f"{reason} ({shown}, ...)"))
         else:
             rows += [(verdict, rid, reason) for rid in ids]
-    return sorted(rows, key=lambda row: SEVERITY.index(row[0]))
+    roots = {r["consequence_of"] for r in data["requirements"] if r.get("consequence_of")}
+    dragged = {r["id"] for r in data["requirements"] if r.get("consequence_of")}
+
+    def first(row: tuple[str, str, str]) -> tuple[int, int]:
+        """Root causes first, then what they drag, then the rest, each worst first."""
+        place = 0 if row[1] in roots else 1 if row[1] in dragged else 2
+        return place, SEVERITY.index(row[0])
+
+    return sorted(rows, key=first)
 
 
 def print_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
@@ -196,15 +204,20 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
 
 
 def _coverage(data: dict[str, Any]) -> str:
-    """How many requirements a case judged: all testable ones, unless cases were left out."""
+    """How many testable requirements got a verdict on the device (PASS, FAIL or WARN), and
+    how many were N/A (a rule of a version or feature the device does not claim): an N/A is
+    not a judgement, so it is counted apart."""
     testable = [r for r in data["requirements"] if r["testable"]]
-    judged = sum(1 for r in testable if any(f["test"] for f in r["findings"]))
+    judged = sum(1 for r in testable if r["verdict"] in ("PASS", "FAIL", "WARN"))
+    na = sum(1 for r in testable if r["verdict"] == "N/A")
     untestable = len(data["requirements"]) - len(testable)
     done = (
         f"{judged} testable requirements judged"
         if judged == len(testable)
         else f"{judged} of {len(testable)} testable requirements judged"
     )
+    if na:
+        done += f", {na} N/A"
     return f"{done}, {untestable} untestable here (electrical, inspection or the other role)"
 
 

@@ -19,6 +19,7 @@ from typing import Any
 import pytest
 
 from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
+from ..root_causes import reading_order
 from ..run import TOOL, ConformanceRun
 from ..transcript import TOOL as TOOL_ORIGIN
 from ..transcript import Event, EventKind
@@ -246,6 +247,7 @@ def attention(run: ConformanceRun) -> str:
     results = run.results or []
     bad = [r for r in results if str(r.verdict) in SEVERITY[:4]]
     bad.sort(key=lambda r: SEVERITY.index(str(r.verdict)))
+    bad = reading_order(bad)  # root causes first, each followed by what it drags
     na = sum(1 for r in results if r.verdict is Verdict.NA)
     na_link = (
         f"<p>{na} requirements are N/A (not applicable to this DUT, or not testable by this tool):"

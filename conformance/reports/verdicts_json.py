@@ -81,6 +81,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "verdict": str(r.verdict),
                 "tests": r.tests,
                 "findings": [_finding(f) for f in r.findings],
+                "consequence_of": r.consequence_of,
             }
             for r in results
         ],
@@ -106,6 +107,8 @@ def _finding(f: Any) -> dict[str, Any]:
         "uncertainty_ms": f.uncertainty_ms,
         "evidence": f.evidence,
         "decision": f.decision,
+        "observed": f.observed,
+        "consequence_of": f.consequence_of,
     }
 
 

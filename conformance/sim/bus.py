@@ -117,10 +117,12 @@ class SimBus:
             device.on_break(start, end)
         return event
 
-    def tool_char(self, wire: int, start: float) -> Event:
+    def tool_char(self, wire: int, start: float, duration: float = CHAR_TIME) -> Event:
+        """The tool's character on the line (``duration``: one frame; other than 8.33 ms only
+        for a faulty recorder at the wrong bit rate)."""
         self.advance(start)
         start = self.clock.now
-        end = start + CHAR_TIME
+        end = start + duration
         event = self.transcript.add(Event(EventKind.CHAR, TOOL, start, end, wire=wire))
         for device in self.devices:
             device.on_char(wire, start, end)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import recorder as judge
+from conformance.recorder.scenarios import SCENARIOS
 
 from ._helpers import line_of
 
@@ -16,10 +17,16 @@ def test_concurrent_measurements(recorder, case):
     """Two sensors measure at once: each one's data are asked for only after its ttt, and the
     recorder uses aC! and collects every value."""
     case.expect("first data command to each sensor at least ttt after its 'atttnn' reply")
-    line = line_of(recorder, case, "concurrent-two", "concurrent-99", "families")
+    names = ("concurrent-two", "concurrent-99", "families")
+    line = line_of(recorder, case, *names)
+    if line is None:
+        return
+    asked = [c for n in names for c in SCENARIOS[n].request.commands]
     taken = judge.measurements(line, recorder.uncertainty)
     case.extend(judge.judge_concurrent_waits(taken, recorder.uncertainty))
-    case.extend(f for f in judge.judge_concurrent_storage(taken) if f.requirement == "R-4.4.7-08")
+    case.extend(
+        f for f in judge.judge_concurrent_storage(taken, asked) if f.requirement == "R-4.4.7-08"
+    )
 
 
 @requirements("R-4.4.7-07")

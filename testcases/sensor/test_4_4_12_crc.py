@@ -49,6 +49,23 @@ def test_crc_presence(sensor, case):
     case.extend(_with_continuous(sensor, case.requirements))
 
 
+@requirements("R-4.4.12-03")
+def test_crc_request_ends_with_its_command(sensor, case):
+    """A CRC asked for on a metadata command (aIMC_001!) is for that reply only: the D
+    replies of a plain aM! after it carry no CRC."""
+    case.expect("aIMC_001!, then aM! and its D replies without a CRC")
+    if not sensor.is_v14:
+        case.not_applicable("metadata commands exist from SDI-12 v1.4 on")
+        return
+    meta = sensor.fresh_exchange("IMC_001")
+    m = sensor.fresh_measurement("M")
+    case.evidence("aIMC_001!, then aM! and its D replies", [meta, m])
+    if not meta.answered:
+        case.add(xjudge.inconclusive("R-4.4.12-03", "aIMC_001! got no reply to follow"))
+        return
+    case.extend(judge.judge([m], case.requirements, sensor.version))
+
+
 @requirements("R-4.4.12-05", "R-4.4.12-06")
 def test_crc_value_and_encoding(sensor, case):
     """The CRC is CRC-16/ARC over the reply from the address up to the CRC, sent as three
@@ -82,4 +99,10 @@ def test_crc_variant_same_measurement(sensor, case):
             )
         )
     else:
-        case.add(passed("R-4.4.12-04", f"{len(pairs)} plain/CRC pairs announce the same counts"))
+        case.add(
+            passed(
+                "R-4.4.12-04",
+                f"{len(pairs)} plain/CRC pairs announce the same counts",
+                observed=len(pairs),
+            )
+        )

@@ -43,7 +43,9 @@ def test_concurrent_supported(sensor, case):
     m = sensor.measurement("C")
     case.evidence("aC!", m.start)
     if m.start.answered and m.start.reply_text[:1] == sensor.address:
-        case.add(passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'"))
+        case.add(
+            passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'", observed=1)
+        )
     else:
         case.add(failed("R-4.4.7-08", f"aC! not supported: {xjudge.shown(m.start)}"))
 
@@ -74,6 +76,7 @@ def test_concurrent_survives_break_and_other_traffic(sensor, case):
                 f"{code} delivered {m.value_count} values after a break "
                 f"and {other}I!, as many as undisturbed",
                 decision="A4",
+                observed=m.value_count,  # none delivered undisturbed either: nothing to judge
             )
         )
     else:
@@ -134,13 +137,21 @@ def test_own_command_aborts_concurrent(sensor, case):
             )
         )
         return
-    case.add(passed("R-4.4.7.1-01", f"{code} aborted by {sensor.address}I!", decision="A3"))
+    case.add(
+        passed(
+            "R-4.4.7.1-01",
+            f"{code} aborted by {sensor.address}I!",
+            decision="A3",
+            observed=2,  # the answered aI! and the empty D0 after it
+        )
+    )
     rest = body[1:]
     if rest == "" or (len(rest) == 3 and all(0x40 <= ord(c) <= 0x7F for c in rest)):
         case.add(
             passed(
                 "R-4.4.7.1-02",
                 f"no values after the abort: {xjudge.shown(d0)} (its CRC is judged by R-4.4.12-05)",
+                observed=1,
             )
         )
     else:

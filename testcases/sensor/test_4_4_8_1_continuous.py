@@ -53,7 +53,7 @@ def test_continuous_independent(sensor, case):
     case.evidence(f"aI! then aR{index}! with no lower R first", [ex])
     body, _ = split_line(ex.reply_text)
     if ex.answered and len(body) > 1 and body[1] in "+-":
-        case.add(passed("R-4.4.8.1-02", f"R{index} alone: {judge.shown(ex)}"))
+        case.add(passed("R-4.4.8.1-02", f"R{index} alone: {judge.shown(ex)}", observed=1))
     else:
         case.add(
             failed(

@@ -5,7 +5,14 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import measurements as judge
+from conformance.judges.exchanges import shown
+from conformance.protocol.responses import (
+    parse_data_reply_for,
+    parse_measurement_reply_for,
+    split_line,
+)
 from conformance.sensor_session import C_FAMILY, M_FAMILY
+from conformance.verdicts import failed, inconclusive, passed
 
 requirements = pytest.mark.requirements
 ASCII_FAMILIES = M_FAMILY + C_FAMILY
@@ -43,3 +50,51 @@ def test_value_grouping(sensor, case):
     ms = sensor.defined(ASCII_FAMILIES)
     case.evidence("every defined measurement", ms)
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+
+
+@requirements("R-4.4.8-03")
+def test_undefined_group_leaves_no_old_values(sensor, case):
+    """After 'a0000' for an undefined aMn!, aD0! returns no values: none were announced, and
+    the previous measurement's must not come back as this one's."""
+    case.expect("a measurement with values, then aMn! -> 'a0000', then aD0! -> 'a<CR><LF>'")
+    undefined = next(
+        (m for m in sensor.family(M_FAMILY) if m.start.answered and m.count == 0), None
+    )
+    filled = next((m for m in sensor.defined(("M", "V", *M_FAMILY)) if m.value_count), None)
+    if undefined is None:
+        case.not_applicable("every aMn! group is defined")
+        return
+    if filled is None:
+        case.add(inconclusive("R-4.4.8-03", "no measurement delivered values to leave behind"))
+        return
+    code = undefined.command.text()[1:-1]
+    before = sensor.fresh_measurement(filled.command.text()[1:-1])
+    start = sensor.fresh_exchange(code)
+    d0 = sensor.fresh_exchange("D0")
+    case.evidence(f"{filled.command}, then {code} and D0", [before, start, d0])
+    body, _ = split_line(d0.reply_text)
+    announced = parse_measurement_reply_for(split_line(start.reply_text)[0], start.command)
+    if not (before.value_count and start.answered and announced.count == 0 and d0.answered):
+        case.add(
+            inconclusive(
+                "R-4.4.8-03",
+                f"needs values first, then 'a0000' and an answered D0: {shown(start)}; "
+                f"{shown(d0)}",
+            )
+        )
+    elif parse_data_reply_for(body, start.command, expected_address=sensor.address).values:
+        case.add(
+            failed(
+                "R-4.4.8-03",
+                f"{shown(start)} announced no values, yet {shown(d0)} returned some "
+                f"(the previous {filled.command}'s?)",
+            )
+        )
+    else:
+        case.add(
+            passed(
+                "R-4.4.8-03",
+                f"{shown(start)} then {shown(d0)}: no values",
+                observed=3,  # the measurement with values, the empty announcement, D0
+            )
+        )

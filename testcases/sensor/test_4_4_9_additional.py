@@ -44,7 +44,11 @@ def _undefined(sensor, codes, rid, expected_tail):
     if odd:
         shown = ", ".join(xjudge.shown(m.start) for m in odd[:3])
         return [warned(rid, f"undefined group answered {shown}; expected 'a{expected_tail}'")]
-    return [passed(rid, f"{len(zero)} undefined group(s) answered 'a{expected_tail}'")]
+    return [
+        passed(
+            rid, f"{len(zero)} undefined group(s) answered 'a{expected_tail}'", observed=len(zero)
+        )
+    ]
 
 
 @requirements("R-4.4.9-02")
@@ -106,5 +110,6 @@ def test_verification(sensor, case):
                 "R-4.4.11-01",
                 f"aV! answered '{xjudge.escape(m.start.reply_text)}' and delivered "
                 f"{m.value_count} value(s); every aM! rule it breaks, aM! breaks too",
+                observed=1 + len(m.data),
             )
         )

@@ -94,7 +94,7 @@ def test_change_address(sensor, case):
         case.add(failed("R-4.4.4-01", f"replied '{target}' but stayed at '{original}' ({note})"))
     else:
         reply = judge.escape(outcome.request.reply_text)
-        case.add(passed("R-4.4.4-01", f"answered '{reply}'; {note}"))
+        case.add(passed("R-4.4.4-01", f"answered '{reply}'; {note}", observed=1))
     if not outcome.took:
         case.not_applicable(
             "the change did not happen, so what follows it cannot be judged",
@@ -127,6 +127,7 @@ def test_change_address(sensor, case):
                 "R-4.4.4-02",
                 f"answered at the new address {after:.3f} s after the "
                 "change (1 s of silence is allowed)",
+                observed=1,
             )
         )
     if stayed:
@@ -141,5 +142,6 @@ def test_change_address(sensor, case):
                 "R-4.4.4-03",
                 f"answered only at '{target}' after the change "
                 "(keeping it over a power cycle is not tested: no power control)",
+                observed=2 if old is not None else 0,  # the new address and the old one
             )
         )

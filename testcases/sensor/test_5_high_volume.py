@@ -58,7 +58,9 @@ def test_high_volume_optional(sensor, case):
             )
         )
     else:
-        case.add(passed("R-5.4-02", "; ".join(xjudge.shown(e) for e in starts)))
+        case.add(
+            passed("R-5.4-02", "; ".join(xjudge.shown(e) for e in starts), observed=len(starts))
+        )
 
 
 @requirements("R-5.1-01", "R-5.1-02", "R-5.1-03")
@@ -110,7 +112,13 @@ def test_empty_packet_past_data(sensor, case):
     if bad:
         case.add(failed("R-5.2-06", "; ".join(bad) + ", not the empty packet"))
     else:
-        case.add(passed("R-5.2-06", "empty packet for " + ", ".join(ex.text for ex in exchanges)))
+        case.add(
+            passed(
+                "R-5.2-06",
+                "empty packet for " + ", ".join(ex.text for ex in exchanges),
+                observed=len(exchanges),
+            )
+        )
 
 
 @pytest.mark.needs('break', 'unsolicited')
@@ -165,6 +173,7 @@ def test_high_volume_is_concurrent(sensor, case):
                 passed(
                     "R-5.3-01",
                     f"a{code}! survived a break and {other}I!, and {sensor.address}I! aborted it",
+                    observed=2,  # the kept and the stopped measurement
                 )
             )
     if not case.record.findings:

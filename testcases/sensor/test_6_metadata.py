@@ -8,6 +8,8 @@ from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata as judge
 from conformance.judges.tally import Tally
 from conformance.protocol.commands import Kind
+from conformance.protocol.responses import split_line
+from conformance.protocol.values import split_values
 from conformance.sensor_session import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed
@@ -91,7 +93,9 @@ def test_identify_starts_nothing(sensor, case):
     else:
         case.add(
             passed(
-                "R-6.1-03", f"{len(pokes)} identify commands: no service request, data unchanged"
+                "R-6.1-03",
+                f"{len(pokes)} identify commands: no service request, data unchanged",
+                observed=len(pokes) + len(again),
             )
         )
 
@@ -145,8 +149,8 @@ def test_metadata_invalid_index(sensor, case):
 @requirements("R-6.2-06")
 def test_continuous_metadata(sensor, case):
     """For each continuous command, aIRn_001!, _002!, ... answer in turn, ended by the
-    invalid-index reply."""
-    case.expect("records 001..k, then the invalid-index reply")
+    invalid-index reply, one record for each value aRn! returns."""
+    case.expect("records 001..k, then the invalid-index reply, k = the values of aRn!")
     tally = Tally(("R-6.2-06",))
     evidence = []
     for i in range(10):
@@ -154,6 +158,8 @@ def test_continuous_metadata(sensor, case):
         served = r.answered and len(r.reply_text.rstrip("\r\n")) > 1
         if not served:
             continue
+        body, _ = split_line(r.reply_text)
+        values = len(split_values(body[1:]))
         for code, crc in ((f"R{i}", False), (f"RC{i}", True)):
             seq = []
             for index in range(1, 100):
@@ -179,6 +185,12 @@ def test_continuous_metadata(sensor, case):
             elif crc and len(last.reply_text.rstrip("\r\n")) != 4:
                 tally.fail(
                     "R-6.2-06", label, f"end reply '{escape(last.reply_text)}' lacks the CRC"
+                )
+            elif len(seq) - 1 != values:
+                tally.fail(
+                    "R-6.2-06",
+                    label,
+                    f"{len(seq) - 1} record(s), but aR{i}! returns {values} value(s)",
                 )
     case.evidence("continuous metadata", evidence)
     if not evidence:

@@ -1,0 +1,98 @@
+"""Root causes: when one deviation drags other findings after it, say so (issue 10).
+
+A sensor slow to wake after a break misses the command that follows the break; a measurement
+a break failed to abort sends its service request over later traffic; a recorder that retries
+over a reply sees its own command come apart on the line. Each later FAIL is real on the
+wire and stays a FAIL, but a reader should fix the first deviation first. So after
+aggregation every FAIL or WARN of a rule that a FAILed rule is known to drag after it is
+linked to that root ("probably a consequence of R-7.0-07 ..."), and the reports list roots
+first. The table is the one place that knows which deviation drags which.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from .results import RequirementResult
+from .verdicts import Verdict
+
+#: root rule -> rules whose violation commonly follows from it, with why (one line each).
+DRAGS: dict[str, tuple[tuple[str, ...], str]] = {
+    # sensor role
+    "R-7.0-07": (
+        ("R-7.0-05", "R-7.0-04", "R-4.4.5.1-03"),
+        "a sensor slow to wake misses a command sent right after the break",
+    ),
+    "R-7.0-10": (
+        ("R-7.0-09", "R-4.2-03", "R-4.3-01", "R-4.4-01", "R-7.0-12"),
+        "a late reply runs into the recorder's retry",
+    ),
+    "R-4.4.5.1-01": (
+        ("R-4.0-01", "R-4.4.6-01", "R-4.4.5.1-02", "R-4.4.5.1-03"),
+        "a measurement the break did not abort still sends its service request later",
+    ),
+    "R-7.0-15": (("R-7.0-14",), "a sensor that never sleeps answers whatever follows"),
+    # recorder role
+    "R-7.2-06": (("R-7.0-13",), "a retry that talks over a reply comes apart on the line"),
+    "R-7.1-01": (("R-7.0-17",), "a late aD0! without a break is also a command without one"),
+    "R-4.4.5-06": (
+        ("R-4.4.5-05", "R-4.4.5-07"),
+        "a recorder that turns to another sensor misses the first one's service request",
+    ),
+}
+
+BAD = (Verdict.FAIL, Verdict.WARN)
+
+
+def link(results: Iterable[RequirementResult]) -> list[RequirementResult]:
+    """Mark every FAIL/WARN that a FAILed root drags after it; return the roots with at
+    least one consequence. Findings keep their verdicts; their detail names the root."""
+    by_id = {r.requirement.id: r for r in results}
+    roots = []
+    for root_id, (dragged, why) in DRAGS.items():
+        root = by_id.get(root_id)
+        if root is None or root.verdict is not Verdict.FAIL:
+            continue
+        anchor = _anchor(root)
+        linked = False
+        for rid in dragged:
+            result = by_id.get(rid)
+            if result is None or result.verdict not in BAD or result.consequence_of:
+                continue
+            result.consequence_of = root_id
+            for f in result.findings:
+                if f.verdict in BAD:
+                    f.consequence_of = root_id
+                    f.detail += f" (probably a consequence of {root_id}{anchor}: {why})"
+            linked = True
+        if linked:
+            roots.append(root)
+    return roots
+
+
+def reading_order(results: Iterable[RequirementResult]) -> list[RequirementResult]:
+    """Roots first, each followed by what it drags; then the rest in the order given."""
+    results = list(results)
+    ids = {r.requirement.id for r in results}
+    roots = [r for r in results if any(c.consequence_of == r.requirement.id for c in results)]
+    ordered: list[RequirementResult] = []
+    for root in roots:
+        ordered.append(root)
+        ordered += [c for c in results if c.consequence_of == root.requirement.id]
+    placed = {r.requirement.id for r in ordered}
+    ordered += [r for r in results if r.requirement.id not in placed]
+    assert {r.requirement.id for r in ordered} == ids
+    return ordered
+
+
+def _anchor(root: RequirementResult) -> str:
+    """ " at t=1.234 s" from the root's FAIL finding when its evidence has a time."""
+    for f in root.findings:
+        if f.verdict is not Verdict.FAIL:
+            continue
+        for line in [f.detail, *f.evidence]:
+            at = line.find("t=")
+            if at >= 0:
+                stamp = line[at:].split()[0].rstrip(",;)]")
+                return f" at {stamp} s" if not stamp.endswith("s") else f" at {stamp}"
+    return ""
