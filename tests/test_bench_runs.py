@@ -20,6 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+from test_verdicts_contract import VALIDATOR
 
 from conformance.emulate.process import EmulatorProcess
 
@@ -110,6 +111,9 @@ def test_clean_emulator_has_no_fail_and_no_warn_behind_the_bench(runs, model):
     bench = data["run"]["link"]["bench"]
     assert bench["echo"] is ("echo" in model), bench
     assert bench["timing"]["reader_lag"]["samples"] > 0
+    document = {k: v for k, v in data.items() if not k.startswith("_")}
+    errors = [e.message for e in VALIDATOR.iter_errors(document)]
+    assert not errors, errors  # a real link's verdicts.json keeps the contract
 
 
 def test_echo_on_a_fast_usb_path_decides_section_7_timing(runs):
