@@ -193,7 +193,7 @@ class SensorSession:
         if idle_before:
             self.listen(idle_before)
         if break_s is not None:
-            self.link.send_break(break_s)
+            self.link.send_break(break_s, exact=True)
             self.link.wait(marking_s)
         return self.master.raw(text, break_first=False, gap=gap)
 

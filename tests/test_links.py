@@ -244,7 +244,7 @@ class _BreakRecorder:
         raise AssertionError("never offers a frame")
 
 
-def _served_break(duration: float) -> tuple[object, tuple[float, float]]:
+def _served_break(duration: float, exact: bool = False) -> tuple[object, tuple[float, float]]:
     """Send one break of ``duration`` over RFC 2217 to a line that records what it heard."""
     device = _BreakRecorder()
     line = RealTimeLine(device, lambda data: None).start()
@@ -254,7 +254,7 @@ def _served_break(duration: float) -> tuple[object, tuple[float, float]]:
     link = open_real_link(server.url)
     try:
         assert link.info.kind == "rfc2217" and link.info.can_break
-        event = link.send_break(duration)
+        event = link.send_break(duration, exact=exact)
         link.wait(0.02)
         deadline = time.monotonic() + 1
         while not device.breaks and time.monotonic() < deadline:
@@ -271,16 +271,44 @@ def _served_break(duration: float) -> tuple[object, tuple[float, float]]:
 def test_rfc2217_short_break_is_a_nul_timed_by_the_uart():
     """A 13 ms break is a NUL at 692 baud: the line holds spacing for exactly 9 bit times,
     whatever the host's sleep did, and the event says so with a tiny length uncertainty."""
-    event, (start, end) = _served_break(13e-3)
+    event, (start, end) = _served_break(13e-3, exact=True)
     assert event.duration == pytest.approx(9 / 692)
     assert "692 baud" in event.text and "SET-BAUDRATE" in event.text
     assert event.length_uncertainty < 0.2e-3 < event.uncertainty
     assert end - start == pytest.approx(9 / 692, abs=1e-9)  # the line's own arithmetic
 
 
+def test_rfc2217_wake_up_break_is_held_by_set_control():
+    """An ordinary wake-up break (not near a threshold) is held with raw SET_CONTROL."""
+    event, (start, end) = _served_break(13e-3)
+    assert 13e-3 <= event.duration < 15e-3, event
+    assert "SET_CONTROL" in event.text
+    assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+
+
+def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
+    """A server that does not take SET-BAUDRATE would send the NUL at 1200 baud (7.5 ms of
+    spacing, not what was asked): the link sees the refusal and holds the break instead."""
+    from conformance.emulate import servers
+
+    class Stubborn(servers.VirtualPort):
+        @property
+        def baudrate(self) -> int:
+            return 1200
+
+        @baudrate.setter
+        def baudrate(self, _value: int) -> None:
+            pass
+
+    monkeypatch.setattr(servers, "VirtualPort", Stubborn)
+    event, (start, end) = _served_break(5e-3, exact=True)
+    assert "SET_CONTROL" in event.text and "baud" not in event.text
+    assert abs((end - start) - event.duration) < 3e-3
+
+
 def test_rfc2217_long_break_is_held_by_set_control():
     """Longer than a NUL at the lowest rate can make: held with raw SET_CONTROL messages."""
-    event, (start, end) = _served_break(100e-3)
+    event, (start, end) = _served_break(100e-3, exact=True)
     assert 100e-3 <= event.duration < 103e-3, event
     assert "SET_CONTROL" in event.text
     assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only

@@ -48,8 +48,12 @@ class Link(ABC):
     def now(self) -> float: ...
 
     @abstractmethod
-    def send_break(self, duration: float) -> Event:
-        """Hold spacing for ``duration`` s; return the break as achieved."""
+    def send_break(self, duration: float, *, exact: bool = False) -> Event:
+        """Hold spacing for ``duration`` s; return the break as achieved.
+
+        ``exact``: the length matters near a threshold (timing cases); a real link then
+        times it with the UART's bit clock where it can (a NUL at a lower bit rate), and
+        otherwise as well as the host can. Ordinary wake-up breaks leave it False."""
 
     @abstractmethod
     def write(self, wire: bytes, gap: float = 0.0) -> list[Event]:

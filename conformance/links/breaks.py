@@ -10,12 +10,14 @@ records the duration it achieved.
 from __future__ import annotations
 
 import struct
+import time
 from typing import Protocol
 
 import serial
 from serial import rfc2217
 
 BAUD = 1200
+CONFIRM_WAIT = 0.5  # s: how long a server has to confirm a bit-rate change
 NUL_SPACING_BITS = 9  # a NUL frame: start bit and 8 zero data bits, then the stop bit
 
 
@@ -58,6 +60,10 @@ class Rfc2217Break:
         self.port.rfc2217_send_subnegotiation(rfc2217.SET_CONTROL, rfc2217.SET_CONTROL_BREAK_OFF)
 
 
+class PulseRefused(RuntimeError):
+    """The far end did not take the bit-rate change a UART-timed pulse needs."""
+
+
 class BaudPulse:
     """Spacing timed by the UART's own bit clock: a NUL sent at a lower bit rate is spacing
     for exactly 9 bit times (1.875 ms at 4800 baud, 12.5 ms at 720), whatever the host's
@@ -87,18 +93,36 @@ class BaudPulse:
     def baud_for(self, duration: float) -> int:
         return round(NUL_SPACING_BITS / duration)
 
-    def send_nul(self, baud: int) -> None:
-        self._rate(baud)
+    def rate(self, baud: int) -> None:
+        """Switch to ``baud``; over RFC 2217, wait until the server confirms it set exactly
+        that rate (a server that ignores the change would send the NUL at 1200 baud: 7.5 ms
+        of spacing instead of the length asked). Raises :class:`PulseRefused`."""
+        if not self.remote:
+            self.port.flush()  # what was queued at the old rate goes out at the old rate
+            self.port.baudrate = baud
+            return
+        setting = self.port._rfc2217_port_settings["baudrate"]
+        deadline = time.monotonic() + CONFIRM_WAIT
+        while setting.state == rfc2217.REQUESTED and time.monotonic() < deadline:
+            time.sleep(0.0005)  # the answer to the last restore first: it must not be ours
+        setting.set(struct.pack("!I", baud))
+        deadline = time.monotonic() + CONFIRM_WAIT
+        while time.monotonic() < deadline:
+            try:
+                if setting.is_ready():
+                    return
+            except ValueError as exc:
+                raise PulseRefused(f"the server set another bit rate than {baud}") from exc
+            time.sleep(0.0005)
+        raise PulseRefused(f"the server did not confirm the bit rate {baud}")
+
+    def send_nul(self) -> None:
         self.port.write(b"\x00")
 
     def restore(self) -> None:
+        """Back to 1200 baud (over RFC 2217 in order with the data: not waited for)."""
         if not self.remote:
             self.port.flush()
-        self._rate(BAUD)
-
-    def _rate(self, baud: int) -> None:
-        if self.remote:
-            self.port.rfc2217_send_subnegotiation(rfc2217.SET_BAUDRATE, struct.pack("!I", baud))
-        else:
-            self.port.flush()  # what was queued at the old rate goes out at the old rate
-            self.port.baudrate = baud
+            self.port.baudrate = BAUD
+            return
+        self.port._rfc2217_port_settings["baudrate"].set(struct.pack("!I", BAUD))

@@ -32,7 +32,7 @@ import serial
 from ..protocol.timing import CHAR_TIME, RESPONSE_START_MAX, RESPONSE_START_MIN
 from ..transcript import DUT, TOOL, Event, EventKind, Transcript
 from .base import Link, LinkInfo, StopCondition
-from .breaks import BaudPulse, BreakMaker
+from .breaks import BaudPulse, BreakMaker, PulseRefused
 from .direction import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
@@ -417,9 +417,10 @@ class SerialLink(Link):
                 last_stop, at + RESPONSE_START_MAX, RESPONSE_START_MAX, "late driver release"
             )
 
-    def send_break(self, duration: float) -> Event:
+    def send_break(self, duration: float, *, exact: bool = False) -> Event:
         self._check()
-        pulse = self._pulse if self._pulse is not None and self._pulse.can_make(duration) else None
+        pulse = self._pulse if exact and self._pulse is not None else None
+        pulse = pulse if pulse is not None and pulse.can_make(duration) else None
         if pulse is None and (self._breaker is None or not self.info.can_break):
             note = f"no break: a {self.info.kind} link cannot hold the line spacing"
             with self._cond:
@@ -427,9 +428,19 @@ class SerialLink(Link):
             raise BreakUnsupported(note)
         precise_sleep_until(self.now, self._tx_free)
         self._drive()
+        event = None
         if pulse is not None:
-            event = self._uart_pulse(pulse, duration)
-        else:
+            try:
+                event = self._uart_pulse(pulse, duration)
+            except PulseRefused as exc:  # the far end does not change its bit rate
+                self._pulse = None
+                with self._cond:
+                    self.transcript.note(
+                        self.now(), f"{exc}: breaks are timed by the host from here on"
+                    )
+                if self._breaker is None:
+                    raise BreakUnsupported(str(exc)) from exc
+        if event is None:
             event = self._held_break(duration)
         with self._cond:
             self.transcript.add(event)
@@ -473,9 +484,10 @@ class SerialLink(Link):
         frame = 10 / baud
         with self._cond:
             self.echo.expect([Expected(0x00, frame)])
+        pulse.rate(baud)  # confirmed by the far end before anything is sent at that rate
         try:
             start = max(self.now(), self._tx_free)
-            pulse.send_nul(baud)
+            pulse.send_nul()
             self._tx_free = start + frame
             precise_sleep_until(self.now, start + frame + pulse.settle)
             with self._cond:  # the echo (if any) must be in before the rate changes back

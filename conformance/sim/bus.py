@@ -141,8 +141,8 @@ class SimLink(Link):
     def now(self) -> float:
         return self.bus.clock.now
 
-    def send_break(self, duration: float) -> Event:
-        return self.bus.tool_break(duration)
+    def send_break(self, duration: float, *, exact: bool = False) -> Event:
+        return self.bus.tool_break(duration)  # a virtual clock is exact either way
 
     def write(self, wire: bytes, gap: float = 0.0) -> list[Event]:
         events = []
