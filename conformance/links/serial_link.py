@@ -36,13 +36,14 @@ from .breaks import BaudPulse, BreakMaker, PulseRefused
 from .direction import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
-from .meter import TimingMeter
+from .meter import ECHO_FLOOR, TimingMeter
 from .priority import READER, realtime_priority
 from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
 ECHO_WAIT = 0.1  # s: beyond the latency floor, how long an echo may take to come back
+BURST_MARGIN = 0.5e-3  # s: arrivals this much closer than latency jitter explains are a burst
 RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
 RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release
 TURNAROUND_LIMIT = RESPONSE_START_MIN / 2  # s: a later release may swallow a reply's start
@@ -175,33 +176,33 @@ class SerialLink(Link):
         count = len(chunk)
         floor = self._rx_floor
         room = max(0.0, arrival - count * CHAR_TIME - floor)  # marking the stamps show before
-        # a held byte may have left anywhere in the path's latency range before its batch
-        spread = 2 * self.meter.uncertainty()
+        # the path's latency range as measured so far: irregularities within it are covered
+        # by the run's regular figure; beyond it they are evidence of their own
+        jitter = max(self.meter.regular(), ECHO_FLOOR)
         if count > 1:
             hidden = (count - 1) * CHAR_TIME
             self.meter.batches.add(hidden, f"{count} bytes at once")
             self.meter.taint(
-                floor - CHAR_TIME, arrival, room + hidden + spread, f"{count} bytes at once"
+                floor - CHAR_TIME, arrival, room + hidden + 2 * jitter, f"{count} bytes at once"
             )
         prev_floor, prev_room, prev_arrival = self._previous_chunk
-        spacing = arrival - prev_arrival
-        if spacing < count * CHAR_TIME - self.meter.uncertainty():
+        early = count * CHAR_TIME - (arrival - prev_arrival)  # how much sooner than a wire can
+        if early > 2 * jitter + BURST_MARGIN:
             # this chunk came too soon after the previous one: that one was held back
-            self.meter.batches.add(count * CHAR_TIME - spacing, "bytes in a burst")
+            self.meter.batches.add(early, "bytes in a burst")
             self.meter.taint(
                 prev_floor - CHAR_TIME,
                 arrival,
-                prev_room + count * CHAR_TIME - spacing + spread,
+                prev_room + early + 2 * jitter,
                 "bytes reached the host in a burst",
             )
         pushed = overlap(count, arrival, floor)
         if pushed > 0:
             self.meter.artefacts.add(pushed, f"frames overlapping by {pushed * 1e3:.2f} ms")
+        if pushed > jitter:
             # the frame is placed after the previous one; where it really was, the path's
             # latency range further hides: its stamps may be off by both
-            self.meter.taint(
-                floor - 2 * CHAR_TIME, arrival, pushed + spread / 2, "frames overlapped"
-            )
+            self.meter.taint(floor - 2 * CHAR_TIME, arrival, pushed + jitter, "frames overlapped")
         frames = chunk_frames(count, arrival, floor)
         self._rx_floor = frames[-1][1]
         self._previous_chunk = (floor, room, arrival)
