@@ -11,11 +11,14 @@ import datetime as dt
 import json
 import sys
 from pathlib import Path
-
-from rich.console import Console
+from typing import TYPE_CHECKING
 
 from . import __version__
+from .interrupts import GUARD
 from .suite import suite_args
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 EXIT_COMPLIANT, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_USAGE, EXIT_NO_DEVICE = (
     0,
@@ -139,7 +142,11 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     import pytest
 
     code = pytest.main(pytest_args, plugins=plugins)
+    interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
     verdicts = report_dir / "verdicts.json"
+    if interrupted and not verdicts.exists():
+        console.print("interrupted before the run started; no report written", style="yellow")
+        return EXIT_INCOMPLETE
     if code == 5 and not verdicts.exists():  # pytest: no tests collected (e.g. -k matched none)
         console.print("no conformance case matched the selection", style="red")
         return EXIT_USAGE
@@ -152,6 +159,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))
+    if interrupted:
+        return EXIT_INCOMPLETE
     return exit_code(data, int(code))
 
 
@@ -253,7 +262,21 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The program (``argv`` None: the process is ours to the end) or an in-process call."""
+    whole_process = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        return _dispatch(argv)
+    finally:
+        if whole_process:
+            GUARD.ignore_from_now()  # a Ctrl-C while Python shuts down must not exit 130
+        else:
+            GUARD.uninstall()
+
+
+def _dispatch(argv: list[str]) -> int:
+    from rich.console import Console
+
     console = Console(stderr=False)
     try:
         if argv and argv[0] == "list":
@@ -266,6 +289,8 @@ def main(argv: list[str] | None = None) -> int:
             from .emulate.command import emulate_main
 
             return emulate_main(argv[1:])
+        GUARD.reset()
+        GUARD.install()  # Ctrl-C from here on: exit 2 with a report saying complete: false
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:

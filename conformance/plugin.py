@@ -12,6 +12,7 @@ import time
 import pytest
 
 from .case import Case
+from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
 from .ports import PortError
@@ -22,6 +23,7 @@ from .sensor_session import NoDeviceAnswered, SensorSession
 from .verdicts import Finding, Verdict
 
 RUN = pytest.StashKey[ConformanceRun]()
+OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
 CASE = pytest.StashKey[CaseRecord]()
 EXIT_NO_DEVICE = 5
 
@@ -151,6 +153,9 @@ def missing_capabilities(item: pytest.Item, run: ConformanceRun) -> list[str]:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if any(item.get_closest_marker("requirements") for item in items) and not GUARD.installed:
+        GUARD.install()  # `pytest --pyargs testcases` on its own: same Ctrl-C policy as the CLI
+        config.stash[OWN_GUARD] = True
     for item in items:
         marker = item.get_closest_marker("requirements")
         if marker is None:
@@ -162,6 +167,15 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             requirements=tuple(marker.args),
             description=" ".join(doc.split()),
         )
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
+    """Ctrl-C stops a case at once (pytest reports INTERRUPTED); outside cases it waits."""
+    if not GUARD.installed or CASE not in item.stash:
+        return (yield)
+    with GUARD.armed():
+        return (yield)
 
 
 @pytest.hookimpl(wrapper=True)
@@ -235,9 +249,14 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     run = run_of(session.config)
+    guarded = GUARD.installed
+    late_interrupt = guarded and GUARD.close()  # from here on Ctrl-C cannot change the run
+    if late_interrupt and not run.stop_reason:
+        run.stop_reason = "run interrupted (Ctrl-C)"
     if not run.active and run.session is None and not run.stop_reason:
         return  # no conformance case ran: an ordinary test session
-    interrupted = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, 3, 4)
+    stopped = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, 3, 4)
+    interrupted = late_interrupt or stopped
     if interrupted and not run.stop_reason:
         run.stop_reason = "run interrupted"
     if session.shouldstop or session.shouldfail:
@@ -247,3 +266,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
     verdicts_json.write(run, run.report_dir())
     run.close()
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    if config.stash.get(OWN_GUARD, False):
+        GUARD.uninstall()
+        GUARD.reset()
