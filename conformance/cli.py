@@ -58,8 +58,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"sdi12-conform {__version__}")
     p.add_argument(
         "--port",
-        default="sim",
-        help="sim, sim://?faults=a,b&version=1.3, or a serial port / pyserial URL",
+        help="a serial port (/dev/ttyUSB0, COM3), a pyserial URL (rfc2217://HOST:PORT), or "
+        "sim / sim://?faults=a,b&version=1.3 for the built-in simulated device "
+        "(default: sim, said loudly when used)",
     )
     p.add_argument(
         "--role",
@@ -90,8 +91,28 @@ def build_parser() -> argparse.ArgumentParser:
 def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .declaration import DeclarationError, load_declaration, normalise_version
     from .ports import PortError, is_sim, parse_sim
+    from .preflight import (
+        UsageError,
+        check_address,
+        check_report_dir,
+        check_role_options,
+        check_uncertainty,
+    )
 
+    if args.port is None:
+        args.port = "sim"
+        console.print(
+            f"note: no --port given: judging the built-in SIMULATED {args.role}, not a real "
+            "device (pass --port /dev/ttyUSB0, COM3 or rfc2217://HOST:PORT for one)",
+            style="bold yellow",
+            markup=False,
+        )
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
     try:
+        check_role_options(args.role, args.port, args.trigger)
+        check_address(args.address)
+        check_uncertainty(args.timing_uncertainty_ms)
         if args.sdi_version:
             normalise_version(args.sdi_version)
         if args.declaration:
@@ -108,12 +129,10 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             from .ports import open_port
 
             open_port(args.port).link.close()  # a port that cannot be opened: a usage error
-    except (DeclarationError, PortError) as exc:
-        console.print(f"error: {exc}", style="red", markup=False)
+        check_report_dir(report_dir)
+    except (DeclarationError, PortError, UsageError) as exc:
+        error(f"error: {exc}")
         return EXIT_USAGE
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
-    report_dir.mkdir(parents=True, exist_ok=True)
     pytest_args = suite_args(
         args.role, args.port, report_dir, rootdir=Path.cwd(), terminal=args.verbose
     )
@@ -145,15 +164,13 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
     verdicts = report_dir / "verdicts.json"
     if interrupted and not verdicts.exists():
-        console.print("interrupted before the run started; no report written", style="yellow")
+        error("interrupted before the run started; no report written")
         return EXIT_INCOMPLETE
     if code == 5 and not verdicts.exists():  # pytest: no tests collected (e.g. -k matched none)
-        console.print("no conformance case matched the selection", style="red")
+        error("error: no conformance case matched the selection")
         return EXIT_USAGE
     if not verdicts.exists():
-        console.print(
-            f"the suite did not run (pytest exit {int(code)}); rerun with -v", style="red"
-        )
+        error(f"error: the suite did not run (pytest exit {int(code)}); rerun with -v")
         return EXIT_INTERNAL if int(code) == 3 else EXIT_USAGE
     data = json.loads(verdicts.read_text(encoding="utf-8"))
     from .reports.console import print_summary
@@ -166,8 +183,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
 def exit_code(data: dict, pytest_code: int) -> int:
     verdict = data["summary"]["verdict"]
-    if pytest_code == EXIT_NO_DEVICE and not data["run"]["complete"]:
-        return EXIT_NO_DEVICE
+    if pytest_code in (EXIT_NO_DEVICE, EXIT_USAGE) and not data["run"]["complete"]:
+        return pytest_code  # nothing answered, or the setup (e.g. a --trigger) cannot work
     if pytest_code in (EXIT_INCOMPLETE, EXIT_INTERNAL) and not data["run"]["complete"]:
         return pytest_code  # Ctrl-C (pytest's 2) or the link failed mid-run (3)
     if verdict == "NON-COMPLIANT":
@@ -223,8 +240,9 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     from .emulator import FAULTS
 
     table = Table(title=f"{len(FAULTS)} emulator faults (use sim://?faults=NAME[,NAME])")
-    table.add_column("fault")
-    table.add_column("violates")
+    width = max(len(name) for name in FAULTS)
+    table.add_column("fault", no_wrap=True, min_width=width)  # a name to type: never cut
+    table.add_column("violates", overflow="fold")
     table.add_column("what it does", overflow="fold")
     for name, fault in sorted(FAULTS.items()):
         table.add_row(name, " ".join(fault.violates), fault.description)
@@ -247,6 +265,18 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     from .matrix import fault_matrix
 
     names = [f for f in (args.faults or "").split(",") if f] or None
+    from .emulator import FAULTS
+
+    unknown = [n for n in names or () if n not in FAULTS]
+    if unknown:
+        error(
+            f"error: unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the "
+            "known ones"
+        )
+        return EXIT_USAGE
+    if args.jobs < 1:
+        error(f"error: --jobs must be 1 or more, not {args.jobs}")
+        return EXIT_USAGE
     rows = fault_matrix(names, processes=args.jobs)
     table = Table(title="fault-detection matrix (sensor role)")
     for col in ("fault", "declared", "FAIL/WARN", "caught"):
@@ -274,10 +304,22 @@ def main(argv: list[str] | None = None) -> int:
             GUARD.uninstall()
 
 
-def _dispatch(argv: list[str]) -> int:
+def make_console(*, stderr: bool = False) -> Console:
+    """A console for results (stdout) or errors (stderr). Off a terminal nothing is wrapped:
+    a log or a pipe gets whole lines (rich would hard-wrap them at 80 columns)."""
     from rich.console import Console
 
-    console = Console(stderr=False)
+    stream = sys.stderr if stderr else sys.stdout
+    return Console(stderr=stderr, soft_wrap=not stream.isatty())
+
+
+def error(text: str) -> None:
+    """One line for the user on stderr (never on stdout, where results and pipes go)."""
+    make_console(stderr=True).print(text, style="red", markup=False, highlight=False)
+
+
+def _dispatch(argv: list[str]) -> int:
+    console = make_console()
     try:
         if argv and argv[0] == "list":
             return cmd_list(argv[1:], console)
@@ -296,12 +338,14 @@ def _dispatch(argv: list[str]) -> int:
         except SystemExit as exc:
             return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
         return run_suite(args, console)
+    except SystemExit as exc:  # argparse of a subcommand: --help (0) or a usage error (2)
+        return EXIT_COMPLIANT if exc.code in (0, None) else EXIT_USAGE
     except KeyboardInterrupt:
-        console.print("interrupted", style="yellow")
+        error("interrupted")
         return EXIT_INCOMPLETE
     except Exception as exc:  # a bug in the tool: say so plainly, exit 3 for CI
-        console.print(f"internal error: {type(exc).__name__}: {exc}", style="red", markup=False)
-        console.print("please report this with the command line that caused it", style="red")
+        error(f"internal error: {type(exc).__name__}: {exc}")
+        error("please report this with the command line that caused it")
         return EXIT_INTERNAL
 
 

@@ -22,6 +22,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .preflight import address_problem
+
 FEATURES = ("address_change", "continuous", "high_volume_ascii", "high_volume_binary")
 
 
@@ -60,8 +62,8 @@ def load_declaration(path: str | Path) -> Declaration:
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise DeclarationError(f"cannot read declaration {path}: {exc}") from None
     address = raw.get("address")
-    if address is not None and (not isinstance(address, str) or len(address) != 1):
-        raise DeclarationError('address must be a single character such as "0"')
+    if address is not None and address_problem(address):
+        raise DeclarationError(f"{path}: address: {address_problem(address)}")
     version = raw.get("sdi12_version")
     features = raw.get("features", {})
     unknown = set(features) - set(FEATURES) - {"extended"}

@@ -16,6 +16,8 @@ from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
 from .ports import PortError
+from .preflight import UsageError, check_address, check_report_dir, check_uncertainty
+from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
@@ -76,7 +78,13 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers",
         "needs(*capabilities): link capabilities a case needs: break, unsolicited, binary",
     )
-    config.stash[RUN] = ConformanceRun(RunOptions.from_config(config))
+    options = RunOptions.from_config(config)
+    try:
+        check_address(options.address, "--sdi12-address")
+        check_uncertainty(options.timing_uncertainty_ms, "--sdi12-timing-uncertainty-ms")
+    except UsageError as exc:
+        raise pytest.UsageError(str(exc)) from None
+    config.stash[RUN] = ConformanceRun(options)
     if config.pluginmanager.hasplugin("html"):
         from .reports import html
 
@@ -152,8 +160,43 @@ def missing_capabilities(item: pytest.Item, run: ConformanceRun) -> list[str]:
     return [CAPABILITIES[n][1] for n in marker.args if not getattr(info, CAPABILITIES[n][0])]
 
 
+def case_role(item: pytest.Item) -> str | None:
+    """The role a conformance case judges, from the session fixture it asks for."""
+    names = getattr(item, "fixturenames", ())
+    return "sensor" if "sensor" in names else "recorder" if "recorder" in names else None
+
+
+def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Deselect the other role's cases; none left for the chosen role is a usage error (a
+    run of skips would end with exit 0 and nothing tested)."""
+    role = config.getoption("sdi12_role")
+    cases = [i for i in items if i.get_closest_marker("requirements")]
+    other = [i for i in cases if case_role(i) not in (None, role)]
+    if not other:
+        return
+    if len(other) == len(cases):
+        found = case_role(other[0])
+        raise pytest.UsageError(
+            f"the selected cases judge a {found} but --sdi12-role is {role}: run "
+            f"`--pyargs testcases.{role}` for a {role}, or pass --sdi12-role {found}"
+        )
+    items[:] = [i for i in items if i not in other]
+    config.hook.pytest_deselected(items=other)
+
+
+def check_reports_writable(config: pytest.Config) -> None:
+    try:
+        check_report_dir(run_of(config).report_dir())
+    except (UsageError, OSError) as exc:
+        raise pytest.UsageError(f"--sdi12-report-dir: {exc}") from None
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    if any(item.get_closest_marker("requirements") for item in items) and not GUARD.installed:
+    if not any(item.get_closest_marker("requirements") for item in items):
+        return  # an ordinary test session
+    keep_role_cases(config, items)
+    check_reports_writable(config)
+    if not GUARD.installed:
         GUARD.install()  # `pytest --pyargs testcases` on its own: same Ctrl-C policy as the CLI
         config.stash[OWN_GUARD] = True
     for item in items:
@@ -193,6 +236,11 @@ def pytest_runtest_call(item: pytest.Item):
     except BreakUnsupported as exc:  # the case needs a break of its own making
         _inconclusive(record, f"this case presents its own breaks and the link cannot: {exc}")
         pytest.skip(f"INCONCLUSIVE: the link cannot send breaks ({exc})")
+    except RecorderSetupError as exc:  # a trigger that cannot work: stop, blame the setup
+        _error(record, f"test setup failed: {exc}")
+        run.complete = False
+        run.stop_reason = f"test setup failed: {exc}"
+        pytest.exit(run.stop_reason, returncode=4)
     except LinkError as exc:  # the port failed: stop the run, keep the report (exit 3)
         _error(record, f"link failed: {exc}")
         run.complete = False

@@ -26,7 +26,7 @@ def run_cli(
 ) -> tuple[int, str, dict]:
     buffer = io.StringIO()
     console = Console(file=buffer, force_terminal=terminal, width=100, color_system="standard")
-    monkeypatch.setattr(cli, "Console", lambda **_: console)
+    monkeypatch.setattr(cli, "make_console", lambda **_: console)
     code = cli.main(["--port", port, "--report-dir", str(tmp_path), *extra])
     data = json.loads((tmp_path / "verdicts.json").read_text(encoding="utf-8"))
     return code, buffer.getvalue(), data

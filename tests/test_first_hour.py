@@ -1,0 +1,205 @@
+"""A newcomer's first hour (issue 12), each item through the command line as a user types it:
+the exit code, the words of the message, no traceback, and the state of the report."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conformance.emulator import FAULTS
+
+EXIT_USAGE = 4
+
+
+def run(*args: str, cwd: Path | None = None, timeout: float = 300) -> subprocess.CompletedProcess:
+    env = {**os.environ, "COLUMNS": "80"}
+    return subprocess.run(
+        [sys.executable, "-m", "conformance.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=cwd,
+        env=env,
+    )
+
+
+def pytest_run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=cwd,
+    )
+
+
+def no_traceback(proc: subprocess.CompletedProcess) -> None:
+    text = proc.stdout + proc.stderr
+    assert "Traceback" not in text and "internal error" not in text, text
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (("--address", "00"), ["'00' is not an SDI-12 address", "0-9, A-Z, a-z"]),
+        (("--address", "$"), ["'$' is not an SDI-12 address", "0-9, A-Z, a-z"]),
+        (("--timing-uncertainty-ms", "-1"), ["0 or more milliseconds"]),
+        (("--port", "rfc2217://"), ["rfc2217://HOST:PORT"]),
+        (("--port", "sim://?version=2.0"), ["1.3 or 1.4, not '2.0'"]),
+        (("--port", "sim://?version=13"), ["1.3 or 1.4, not '13'"]),
+        (("--port", "sim://?faults=wrong-crc", "--role", "recorder"), ["recorder-faults="]),
+        (("--port", "sim://?recorder-faults=no-retries"), ["belongs to the recorder role"]),
+        (("--port", "sim", "--trigger", "true"), ["--role recorder"]),
+        (("--port", "sim", "--role", "recorder", "--trigger", "true"), ["rfc2217-serve://"]),
+    ],
+)
+def test_settings_the_tool_cannot_use_exit_4_before_the_bus(tmp_path, args, words):
+    out = tmp_path / "r"
+    proc = run(*args, "--report-dir", str(out))
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    for word in words:
+        assert word in proc.stderr, proc.stderr
+    assert "I!" not in proc.stdout + proc.stderr  # nothing went onto the bus
+    assert not (out / "verdicts.json").exists()
+    no_traceback(proc)
+
+
+def test_declared_invalid_address_names_file_and_key(tmp_path):
+    declaration = tmp_path / "dut.toml"
+    declaration.write_text('address = "$"\n', encoding="utf-8")
+    proc = run("--port", "sim", "--declaration", str(declaration))
+    assert proc.returncode == EXIT_USAGE
+    assert f"{declaration}: address: '$' is not an SDI-12 address" in proc.stderr
+    no_traceback(proc)
+
+
+def test_a_regular_file_is_not_a_serial_port(tmp_path):
+    port = tmp_path / "not-a-port"
+    port.write_text("", encoding="utf-8")
+    proc = run("--port", str(port), "--report-dir", str(tmp_path / "r"))
+    assert proc.returncode == EXIT_USAGE
+    assert "is not a serial device" in proc.stderr and "ioctl" not in proc.stderr
+    no_traceback(proc)
+
+
+@pytest.mark.parametrize("where", ["file", "proc", "read-only"])
+def test_report_folder_that_cannot_be_written_is_a_usage_error(tmp_path, where):
+    if where == "read-only" and os.geteuid() == 0:
+        pytest.skip("root writes into read-only folders")
+    cwd = tmp_path
+    args: tuple[str, ...] = ("--report-dir", str(tmp_path / "afile"))
+    if where == "file":
+        (tmp_path / "afile").write_text("", encoding="utf-8")
+    elif where == "proc":
+        args = ("--report-dir", "/proc/sdi12-reports")
+    else:
+        cwd = tmp_path / "ro"
+        cwd.mkdir()
+        cwd.chmod(0o555)
+        args = ()  # the default reports/ folder in the working directory
+    proc = run("--port", "sim", *args, cwd=cwd)
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    assert "--report-dir DIR" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    no_traceback(proc)
+
+
+def test_read_only_working_folder_with_reports_elsewhere_runs(tmp_path):
+    (tmp_path / "ro").mkdir()
+    (tmp_path / "ro").chmod(0o555)
+    proc = run("--port", "sim", "-k", "crc", "--report-dir", str(tmp_path / "r"),
+               cwd=tmp_path / "ro")  # fmt: skip
+    assert (tmp_path / "r" / "verdicts.json").exists(), proc.stdout + proc.stderr
+    assert not (tmp_path / "ro" / ".hypothesis").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (("matrix", "--faults", "nonexistent-x"), ["unknown fault(s) nonexistent-x"]),
+        (("matrix", "--jobs", "0"), ["--jobs must be 1 or more"]),
+        (("list", "--bogus"), ["unrecognized arguments"]),
+        (("faults", "--bogus"), ["unrecognized arguments"]),
+        (("matrix", "--bogus"), ["unrecognized arguments"]),
+        (("list", "--role", "neither"), ["invalid choice"]),
+    ],
+)
+def test_subcommand_usage_errors_exit_4_like_the_main_command(args, words):
+    proc = run(*args)
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    for word in words:
+        assert word in proc.stderr
+    no_traceback(proc)
+
+
+def test_faults_never_truncates_a_fault_name():
+    proc = run("faults")
+    assert proc.returncode == 0
+    for name in FAULTS:
+        assert name in proc.stdout, name
+
+
+def test_bare_command_says_loudly_it_judged_the_simulator(tmp_path):
+    proc = run("-k", "crc", cwd=tmp_path)
+    assert "SIMULATED sensor" in proc.stdout and "--port" in proc.stdout
+    assert "not a real device" in proc.stdout
+    helped = run("--help")
+    assert "default: sim" in helped.stdout
+
+
+def test_errors_go_to_stderr_unwrapped_when_piped(tmp_path):
+    proc = run("--port", "sim://?faults=" + "x" * 120, "--report-dir", str(tmp_path))
+    assert proc.returncode == EXIT_USAGE
+    assert proc.stdout == ""
+    assert "x" * 120 in proc.stderr  # one unbroken line, not hard-wrapped at 80 columns
+
+
+def test_plugin_role_case_mismatch_is_an_error_not_60_skips(tmp_path):
+    proc = pytest_run(
+        "--pyargs", "testcases.sensor", "--sdi12-role", "recorder", "--sdi12-port", "sim",
+        "--sdi12-report-dir", str(tmp_path / "r"), cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    assert "judge a sensor but --sdi12-role is recorder" in proc.stdout + proc.stderr
+    assert "skipped" not in proc.stdout
+
+
+def test_plugin_rejects_an_invalid_address(tmp_path):
+    proc = pytest_run(
+        "--pyargs", "testcases.sensor", "--sdi12-address", "00", cwd=tmp_path
+    )  # fmt: skip
+    assert proc.returncode == EXIT_USAGE
+    assert "is not an SDI-12 address" in proc.stdout + proc.stderr
+
+
+def test_a_broken_trigger_is_a_setup_error_not_a_broken_recorder(tmp_path):
+    out = tmp_path / "r"
+    proc = run(
+        "--role", "recorder", "--port", "rfc2217-serve://127.0.0.1:0",
+        "--trigger", "./nonexistent.sh", "--report-dir", str(out), cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    assert "nonexistent.sh: not found" in proc.stdout  # the trigger's own stderr
+    assert "test setup failed" in proc.stdout
+    data = json.loads((out / "verdicts.json").read_text())
+    assert data["run"]["complete"] is False
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    assert data["summary"]["counts"]["FAIL"] == 0
+    no_traceback(proc)
+
+
+def test_a_trigger_that_fails_before_the_recorder_spoke_shows_its_stderr(tmp_path):
+    out = tmp_path / "r"
+    proc = run(
+        "--role", "recorder", "--port", "rfc2217-serve://127.0.0.1:0",
+        "--trigger", "echo logger offline >&2; exit 3", "--report-dir", str(out),
+    )  # fmt: skip
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    assert "exited with 3: logger offline" in proc.stdout
+    data = json.loads((out / "verdicts.json").read_text())
+    assert data["summary"]["counts"]["FAIL"] == 0 and data["run"]["complete"] is False
