@@ -83,7 +83,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="recorder role: shell command run per scenario with the request in SDI12_* "
         "environment variables, or 'interactive' to prompt an operator",
     )
-    p.add_argument("-k", dest="keyword", help="only cases matching this pytest -k expression")
+    p.add_argument(
+        "-k",
+        dest="keyword",
+        help="a partial run: only cases matching this pytest -k expression (exit 0/1 on "
+        "what was selected; the rest is listed as not selected)",
+    )
+    p.add_argument(
+        "--req",
+        action="append",
+        default=[],
+        metavar="ID_OR_CLAUSE",
+        help="a partial run: only cases judging this requirement ID (R-4.4.6-02) or clause "
+        "(4.4.12); repeatable",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p
 
@@ -98,6 +111,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         check_role_options,
         check_uncertainty,
     )
+    from .selection import SelectionError, resolve
 
     if args.port is None:
         args.port = "sim"
@@ -113,6 +127,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         check_role_options(args.role, args.port, args.trigger)
         check_address(args.address)
         check_uncertainty(args.timing_uncertainty_ms)
+        resolve(args.role, args.req)  # --req names requirements the role can test
         if args.sdi_version:
             normalise_version(args.sdi_version)
         if args.declaration:
@@ -130,7 +145,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
             open_port(args.port).link.close()  # a port that cannot be opened: a usage error
         check_report_dir(report_dir)
-    except (DeclarationError, PortError, UsageError) as exc:
+    except (DeclarationError, PortError, UsageError, SelectionError) as exc:
         error(f"error: {exc}")
         return EXIT_USAGE
     pytest_args = suite_args(
@@ -150,6 +165,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         pytest_args.append("--sdi12-strict")
     if args.keyword:
         pytest_args += ["-k", args.keyword]
+    for wanted in args.req:
+        pytest_args += ["--sdi12-req", wanted]
     plugins: list[object] = []
     if args.verbose:
         pytest_args.append("-v")
@@ -167,7 +184,12 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         error("interrupted before the run started; no report written")
         return EXIT_INCOMPLETE
     if code == 5 and not verdicts.exists():  # pytest: no tests collected (e.g. -k matched none)
-        error("error: no conformance case matched the selection")
+        for leftover in ("report.html", "junit.xml"):  # pytest-html's empty page misleads
+            (report_dir / leftover).unlink(missing_ok=True)
+        error(
+            f"error: no conformance case matched -k {args.keyword!r}; "
+            "`sdi12-conform list` shows the cases"
+        )
         return EXIT_USAGE
     if not verdicts.exists():
         error(f"error: the suite did not run (pytest exit {int(code)}); rerun with -v")

@@ -21,6 +21,7 @@ from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
+from .selection import SelectionError, resolve
 from .sensor_session import NoDeviceAnswered, SensorSession
 from .verdicts import Finding, Verdict
 
@@ -61,6 +62,14 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "--sdi12-trigger",
         default=None,
         help="recorder role: shell command run per scenario (or 'interactive' to prompt)",
+    )
+    group.addoption(
+        "--sdi12-req",
+        action="append",
+        default=[],
+        metavar="ID_OR_CLAUSE",
+        help="judge only these requirements: an ID (R-4.4.6-02) or a clause (4.4.12); "
+        "repeatable. A partial run: the rest is listed as not selected",
     )
     group.addoption(
         "--sdi12-timing-uncertainty-ms",
@@ -184,6 +193,46 @@ def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
     config.hook.pytest_deselected(items=other)
 
 
+def keep_selected_requirements(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """``--sdi12-req``: keep the cases that judge one of the named requirements."""
+    run = run_of(config)
+    if not run.options.requirements:
+        return
+    try:
+        wanted = resolve(run.options.role, run.options.requirements)
+    except SelectionError as exc:
+        raise pytest.UsageError(str(exc)) from None
+    dropped = [i for i in items if _requirements_of(i) and not wanted & set(_requirements_of(i))]
+    items[:] = [i for i in items if i not in dropped]
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+    run.selection.how += [f"--req {text}" for text in run.options.requirements]
+
+
+def _requirements_of(item: pytest.Item) -> tuple[str, ...]:
+    marker = item.get_closest_marker("requirements")
+    return tuple(marker.args) if marker else ()
+
+
+def pytest_deselected(items: list[pytest.Item]) -> None:
+    """Cases of the run's role left out by -k or --req make it a partial run."""
+    if not items:
+        return
+    run = run_of(items[0].config)
+    for item in items:
+        if _requirements_of(item) and case_role(item) in (None, run.options.role):
+            run.selection.left_out.update(_requirements_of(item))
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    run = run_of(session.config)
+    for item in session.items:
+        run.selection.kept.update(_requirements_of(item))
+    keyword = session.config.getoption("keyword", "")
+    if run.selection.partial and keyword:
+        run.selection.how.insert(0, f"-k {keyword}")
+
+
 def check_reports_writable(config: pytest.Config) -> None:
     try:
         check_report_dir(run_of(config).report_dir())
@@ -195,6 +244,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if not any(item.get_closest_marker("requirements") for item in items):
         return  # an ordinary test session
     keep_role_cases(config, items)
+    keep_selected_requirements(config, items)
     check_reports_writable(config)
     if not GUARD.installed:
         GUARD.install()  # `pytest --pyargs testcases` on its own: same Ctrl-C policy as the CLI

@@ -16,6 +16,7 @@ from .declaration import Declaration, load_declaration, normalise_version
 from .links.base import Link
 from .ports import is_sim, open_port
 from .results import CaseRecord, RequirementResult, aggregate, overall
+from .selection import Selection
 from .sensor_session import SensorSession
 
 
@@ -30,6 +31,7 @@ class RunOptions:
     strict: bool = False
     timing_uncertainty_ms: float | None = None
     trigger: str | None = None  # recorder role: shell command (or "interactive") per scenario
+    requirements: tuple[str, ...] = ()  # --req: requirement IDs or clauses to judge
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
@@ -44,6 +46,7 @@ class RunOptions:
             strict=get("sdi12_strict"),
             timing_uncertainty_ms=get("sdi12_timing_uncertainty_ms"),
             trigger=get("sdi12_trigger"),
+            requirements=tuple(get("sdi12_req") or ()),
         )
 
 
@@ -65,6 +68,7 @@ class ConformanceRun:
     declaration: Declaration | None = None
     results: list[RequirementResult] | None = None
     verdict: str | None = None
+    selection: Selection = field(default_factory=Selection)  # -k / --req: a partial run
 
     def __post_init__(self) -> None:
         if self.options.declaration:
@@ -126,13 +130,12 @@ class ConformanceRun:
     def finish(self, complete: bool) -> list[RequirementResult]:
         self.complete = self.complete and complete
         self.finished = now_iso()
-        self.results = aggregate(self.options.role, self.cases)
+        self.results = aggregate(self.options.role, self.cases, self.selection.not_selected())
         self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
-        unjudged = sum(1 for r in self.results if not r.judged)
+        unjudged = sum(1 for r in self.results if r.selected and not r.judged)
         if unjudged and not self.stop_reason:
             self.stop_reason = (
-                f"{unjudged} testable requirement(s) not judged in this run "
-                "(cases left out by the selection?)"
+                f"{unjudged} testable requirement(s) of the selected cases not judged"
             )
         return self.results
 

@@ -203,3 +203,63 @@ def test_a_trigger_that_fails_before_the_recorder_spoke_shows_its_stderr(tmp_pat
     assert "exited with 3: logger offline" in proc.stdout
     data = json.loads((out / "verdicts.json").read_text())
     assert data["summary"]["counts"]["FAIL"] == 0 and data["run"]["complete"] is False
+
+
+def test_a_keyword_selection_is_a_partial_run_with_exit_0(tmp_path):
+    out = tmp_path / "r"
+    proc = run("--port", "sim", "-k", "crc", "--report-dir", str(out))
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "partial run" in proc.stdout and "INCONCLUSIVE" not in proc.stdout
+    data = json.loads((out / "verdicts.json").read_text())
+    assert data["summary"]["verdict"] == "COMPLIANT" and data["run"]["partial"] is True
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "partial run" in html and "NOT SELECTED" in html
+
+
+def test_a_partial_run_fails_on_what_it_selected(tmp_path):
+    out = tmp_path / "r"
+    proc = run("--port", "sim://?faults=wrong-crc", "-k", "crc", "--report-dir", str(out))
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "R-4.4.12-05" in proc.stdout and "partial run" in proc.stdout
+
+
+def test_the_readme_declaration_example_with_k_is_not_incomplete(tmp_path):
+    declaration = tmp_path / "dut.toml"
+    declaration.write_text('address = "0"\nsdi12_version = "1.4"\n', encoding="utf-8")
+    proc = run("--port", "sim", "--declaration", str(declaration), "-k", "crc",
+               "--report-dir", str(tmp_path / "r"))  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "INCOMPLETE" not in proc.stdout
+
+
+@pytest.mark.parametrize("wanted", ["R-4.4.6-02", "4.4.12", "r-4.4.6-02"])
+def test_select_by_requirement_id_or_clause(tmp_path, wanted):
+    out = tmp_path / "r"
+    proc = run("--port", "sim", "--req", wanted, "--report-dir", str(out))
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    data = json.loads((out / "verdicts.json").read_text())
+    chosen = [r for r in data["requirements"] if r["selected"] and r["testable"]]
+    if wanted.upper().startswith("R-"):
+        assert wanted.upper() in {r["id"].upper() for r in chosen}
+    else:
+        clause = [r for r in data["requirements"] if r["clause"].startswith("4.4.12")]
+        assert clause and all(r["selected"] for r in clause if r["testable"])
+    assert all(r["verdict"] == "PASS" for r in chosen if r["findings"][0]["test"])
+    assert data["run"]["selection"] == f"--req {wanted}"
+
+
+@pytest.mark.parametrize("wanted", ["9.9", "R-9.9-01"])
+def test_unknown_requirement_is_a_usage_error(tmp_path, wanted):
+    proc = run("--port", "sim", "--req", wanted, "--report-dir", str(tmp_path / "r"))
+    assert proc.returncode == EXIT_USAGE
+    assert f"--req {wanted}: no sensor requirement" in proc.stderr
+    assert "running" not in proc.stdout  # refused before the suite started
+    no_traceback(proc)
+
+
+def test_a_keyword_matching_nothing_leaves_no_empty_report(tmp_path):
+    out = tmp_path / "r"
+    proc = run("--port", "sim", "-k", "no_such_case_anywhere", "--report-dir", str(out))
+    assert proc.returncode == EXIT_USAGE
+    assert "no conformance case matched" in proc.stderr
+    assert not (out / "report.html").exists() and not (out / "verdicts.json").exists()

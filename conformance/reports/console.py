@@ -195,12 +195,27 @@ def _coverage(data: dict[str, Any]) -> str:
     testable = [r for r in data["requirements"] if r["testable"]]
     judged = sum(1 for r in testable if any(f["test"] for f in r["findings"]))
     untestable = len(data["requirements"]) - len(testable)
+    left_out = sum(1 for r in testable if not r.get("selected", True))
     done = (
         f"{judged} testable requirements judged"
         if judged == len(testable)
         else f"{judged} of {len(testable)} testable requirements judged"
     )
+    if data["run"].get("partial"):
+        done = (
+            f"partial run ({data['run'].get('selection')}): {done}, "
+            f"{left_out} not selected"
+        )
     return f"{done}, {untestable} untestable here (electrical, inspection or the other role)"
+
+
+PARTIAL = "partial run: the selected requirements only"
+
+
+def verdict_words(data: dict[str, Any]) -> str:
+    """The overall verdict, and for a partial run that it covers only the selection."""
+    verdict = data["summary"]["verdict"]
+    return f"{verdict} ({PARTIAL})" if data["run"].get("partial") else verdict
 
 
 def _counts_line(data: dict[str, Any]) -> str:
@@ -221,7 +236,7 @@ def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> N
         say(f"{verdict:<12} {which}: {one_line(reason)}")
     if data["run"].get("stop_reason"):
         say(f"{_stop_word(data)}: {data['run']['stop_reason']}")
-    say(f"verdict: {data['summary']['verdict']}")
+    say(f"verdict: {verdict_words(data)}")
     _paths(say, report_dir)
 
 
@@ -266,7 +281,12 @@ def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> No
     if data["run"].get("stop_reason"):
         console.print(f"{_stop_word(data)}: {data['run']['stop_reason']}", markup=False)
     console.print(
-        Text.assemble((f" {verdict} ", STYLE.get(verdict, "")), "  ", _counts_short(summary))
+        Text.assemble(
+            (f" {verdict} ", STYLE.get(verdict, "")),
+            "  ",
+            *([PARTIAL, "  "] if data["run"].get("partial") else []),
+            _counts_short(summary),
+        )
     )
     _paths(lambda text: console.print(text, markup=False, highlight=False), report_dir)
 

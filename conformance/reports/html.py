@@ -115,7 +115,7 @@ SCRIPT = """
 
 
 def verdict_class(verdict: str) -> str:
-    return "v-NA" if verdict == "N/A" else f"v-{verdict}"
+    return "v-NA" if verdict in ("N/A", "NOT SELECTED") else f"v-{verdict}"
 
 
 def _verdict_cell(verdict: str) -> str:
@@ -126,7 +126,8 @@ def _verdict_cell(verdict: str) -> str:
 def _tally(results: list[RequirementResult]) -> dict[str, int]:
     tally = dict.fromkeys(SEVERITY, 0)
     for r in results:
-        tally[str(r.verdict)] = tally.get(str(r.verdict), 0) + 1
+        if r.selected:  # a partial run counts what it selected
+            tally[str(r.verdict)] = tally.get(str(r.verdict), 0) + 1
     return tally
 
 
@@ -139,6 +140,13 @@ def banner(run: ConformanceRun) -> str:
     counts = ", ".join(f"{n} {k}" for k, n in tally.items() if n)
     testable = sum(1 for r in results if r.requirement.testable(run.options.role))
     line = f"{counts} — {len(results)} requirements, {testable} testable by this tool"
+    left_out = sum(1 for r in results if not r.selected)
+    if run.selection.partial:
+        verdict = f"{verdict} · partial run"
+        line += (
+            f" — partial run ({run.selection.describe()}): {left_out} requirements not "
+            "selected; the verdict covers the selected ones only"
+        )
     if run.stop_reason:
         line += f" — {'note' if run.complete else 'stopped'}: {run.stop_reason}"
     who = f"{_who(run)} · port {run.options.port} · {run.finished or run.started}"
@@ -226,7 +234,7 @@ def attention(run: ConformanceRun) -> str:
     results = run.results or []
     bad = [r for r in results if str(r.verdict) in SEVERITY[:4]]
     bad.sort(key=lambda r: SEVERITY.index(str(r.verdict)))
-    na = sum(1 for r in results if r.verdict is Verdict.NA)
+    na = sum(1 for r in results if r.verdict is Verdict.NA and r.selected)
     na_link = (
         f"<p>{na} requirements are N/A (not applicable to this DUT, or not testable by this tool):"
         ' <a href="#sdi12-requirements" data-sdi12-show="N/A">show them with their reasons</a>.</p>'
@@ -279,7 +287,7 @@ def requirements_table(run: ConformanceRun) -> str:
     rows = []
     for r in run.results or []:
         req = r.requirement
-        verdict = str(r.verdict)
+        verdict = str(r.verdict) if r.selected else "NOT SELECTED"
         tests = "<br>".join(escape(t.split("::")[-1]) for t in r.tests) or "—"
         extra = len(r.findings) - 1
         evidence = escape(r.one_line) + (f" <i>(+{extra} findings)</i>" if extra > 0 else "")
@@ -288,7 +296,8 @@ def requirements_table(run: ConformanceRun) -> str:
             f"<td>{escape(req.clause)}</td><td>{escape(req.level)}</td>{_verdict_cell(verdict)}"
             f"<td>{escape(req.statement)}</td><td>{evidence}</td><td>{tests}</td></tr>"
         )
-    options = "".join(f'<option value="{escape(v)}">{escape(v)}</option>' for v in SEVERITY)
+    shown = SEVERITY + (("NOT SELECTED",) if run.selection.partial else ())
+    options = "".join(f'<option value="{escape(v)}">{escape(v)}</option>' for v in shown)
     return (
         "<h2>Requirements</h2>"
         '<div class="sdi12-controls">Filter: <input id="sdi12-filter" '

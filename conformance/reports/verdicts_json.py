@@ -67,6 +67,8 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             "strict": run.options.strict,
             "complete": run.complete,
             "stop_reason": run.stop_reason or None,
+            "partial": run.selection.partial,
+            "selection": run.selection.describe() if run.selection.partial else None,
             "bus": bus_block(run),
         },
         "dut": dut_block(run),
@@ -79,6 +81,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "statement": r.requirement.statement,
                 "testable": r.requirement.testable(run.options.role),
                 "verdict": str(r.verdict),
+                "selected": r.selected,
                 "tests": r.tests,
                 "findings": [_finding(f) for f in r.findings],
             }
