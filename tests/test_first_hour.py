@@ -263,3 +263,26 @@ def test_a_keyword_matching_nothing_leaves_no_empty_report(tmp_path):
     assert proc.returncode == EXIT_USAGE
     assert "no conformance case matched" in proc.stderr
     assert not (out / "report.html").exists() and not (out / "verdicts.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("toml", "words"),
+    [
+        ('adress = "0"\n', ":1: adress: unknown key"),
+        ('address = "0"\nbogus_key = 1\n', ":2: bogus_key: unknown key"),
+        ("[measurements]\nM = 3\nQ = 3\n", ":3: [measurements] Q: not a measurement command"),
+        ('[features]\nhigh_volume_ascii = "yes"\n', ":2: [features] high_volume_ascii: must be"),
+        ("[features]\nteleport = true\n", ":2: [features] teleport: unknown feature"),
+        ("[measurements]\nM = -1\n", ":2: [measurements] M: must be a value count"),
+        ('sdi12_version = "2.0"\n', ":1: sdi12_version: unsupported SDI-12 version"),
+        ("address = 0\n", ":1: address: must be a string"),
+    ],
+)
+def test_declaration_typos_are_refused_with_file_key_and_line(tmp_path, toml, words):
+    declaration = tmp_path / "dut.toml"
+    declaration.write_text(toml, encoding="utf-8")
+    proc = run("--port", "sim", "--declaration", str(declaration),
+               "--report-dir", str(tmp_path / "r"))  # fmt: skip
+    assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
+    assert f"{declaration}{words}" in proc.stderr, proc.stderr
+    no_traceback(proc)
