@@ -284,7 +284,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     args = p.parse_args(argv)
     from rich.table import Table
 
-    from .matrix import fault_matrix
+    from .matrix import MatrixRow, fault_matrix
 
     names = [f for f in (args.faults or "").split(",") if f] or None
     from .emulator import FAULTS
@@ -299,7 +299,14 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     if args.jobs < 1:
         error(f"error: --jobs must be 1 or more, not {args.jobs}")
         return EXIT_USAGE
-    rows = fault_matrix(names, processes=args.jobs)
+    status = make_console(stderr=True)
+
+    def progress(done: int, total: int, row: MatrixRow) -> None:
+        caught = "caught exactly" if row.exact else "NOT caught exactly"
+        status.print(f"[{done}/{total}] {row.fault}: {caught}", markup=False, highlight=False)
+
+    status.print(f"running the sensor suite once per fault, {args.jobs} at a time...")
+    rows = fault_matrix(names, processes=args.jobs, progress=progress)
     table = Table(title="fault-detection matrix (sensor role)")
     for col in ("fault", "declared", "FAIL/WARN", "caught"):
         table.add_column(col, overflow="fold")

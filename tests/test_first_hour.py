@@ -286,3 +286,10 @@ def test_declaration_typos_are_refused_with_file_key_and_line(tmp_path, toml, wo
     assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
     assert f"{declaration}{words}" in proc.stderr, proc.stderr
     no_traceback(proc)
+
+
+def test_matrix_shows_progress_on_stderr_and_the_table_on_stdout():
+    proc = run("matrix", "--faults", "wrong-crc", "--jobs", "1")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "[1/1] wrong-crc: caught exactly" in proc.stderr
+    assert "1/1 faults caught by exactly their requirements" in proc.stdout
