@@ -145,8 +145,9 @@ def test_faults_never_truncates_a_fault_name():
 
 
 def test_bare_command_says_loudly_it_judged_the_simulator(tmp_path):
-    proc = run("-k", "crc", cwd=tmp_path)
+    proc = run("-k", "random", cwd=tmp_path)  # the case that runs hypothesis
     assert "SIMULATED sensor" in proc.stdout and "--port" in proc.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["reports"]  # no .hypothesis/
     assert "not a real device" in proc.stdout
     helped = run("--help")
     assert "default: sim" in helped.stdout
