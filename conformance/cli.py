@@ -149,7 +149,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         error(f"error: {exc}")
         return EXIT_USAGE
     pytest_args = suite_args(
-        args.role, args.port, report_dir, rootdir=Path.cwd(), terminal=args.verbose
+        args.role, args.port, report_dir, terminal=args.verbose
     )
     for flag, value in (
         ("--sdi12-address", args.address),

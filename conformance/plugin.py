@@ -240,6 +240,16 @@ def check_reports_writable(config: pytest.Config) -> None:
         raise pytest.UsageError(f"--sdi12-report-dir: {exc}") from None
 
 
+def stable_id(item: pytest.Item) -> str:
+    """``testcases.sensor.test_4_4_12_crc::test_crc_presence``: the same wherever the suite
+    is installed or run from (pytest's node IDs are relative to its rootdir)."""
+    module = getattr(getattr(item, "module", None), "__name__", None)
+    if module is None:
+        return item.nodeid
+    inner = item.nodeid.split("::", 1)[1] if "::" in item.nodeid else item.name
+    return f"{module}::{inner}"
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     if not any(item.get_closest_marker("requirements") for item in items):
         return  # an ordinary test session
@@ -255,7 +265,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             continue
         doc = (getattr(item, "function", None).__doc__ or "").strip()
         item.stash[CASE] = CaseRecord(
-            nodeid=item.nodeid,
+            nodeid=stable_id(item),
             name=item.name,
             requirements=tuple(marker.args),
             description=" ".join(doc.split()),

@@ -294,3 +294,19 @@ def test_matrix_shows_progress_on_stderr_and_the_table_on_stdout():
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "[1/1] wrong-crc: caught exactly" in proc.stderr
     assert "1/1 faults caught by exactly their requirements" in proc.stdout
+
+
+def test_test_ids_and_junit_classnames_do_not_depend_on_the_working_folder(tmp_path):
+    seen = []
+    for name in ("here", "there/deeper"):
+        cwd = tmp_path / name
+        cwd.mkdir(parents=True)
+        out = tmp_path / f"r-{name.replace('/', '-')}"
+        proc = run("--port", "sim", "-k", "crc", "--report-dir", str(out), cwd=cwd)
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+        ids = [t["id"] for t in json.loads((out / "verdicts.json").read_text())["tests"]]
+        junit = (out / "junit.xml").read_text(encoding="utf-8")
+        seen.append((ids, "testcases.sensor.test_4_4_12_crc" in junit))
+    assert seen[0] == seen[1]
+    assert all(i.startswith("testcases.sensor.test_4_4_12_crc::") for i in seen[0][0])
+    assert seen[0][1]

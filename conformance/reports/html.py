@@ -29,7 +29,7 @@ from .verdicts_json import dut_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
-TIMING_MODULES = ("test_7_timing.py::", "test_9_whole_run.py::")
+TIMING_MODULES = ("test_7_timing", "test_9_whole_run")
 
 STYLE = """
 <style>
@@ -367,8 +367,9 @@ def _group(events: list[Event]) -> list[list[Event]]:
 
 def is_timing_case(record: CaseRecord) -> bool:
     """Cases of section 7 / the whole-run timing module, or any case with a measured time."""
+    module = record.nodeid.split("::")[0].removesuffix(".py").replace("/", ".")
     return any(f.measured_ms is not None for f in record.findings) or any(
-        m in record.nodeid for m in TIMING_MODULES
+        module.rsplit(".", 1)[-1] == m for m in TIMING_MODULES
     )
 
 
