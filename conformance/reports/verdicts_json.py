@@ -23,6 +23,8 @@ def dut_block(run: ConformanceRun) -> dict[str, Any]:
     if session and session.ident_exchange is not None and session.ident_exchange.answered:
         raw = session.ident_exchange.reply_text
     version = session.version if session else None
+    if run.options.role == "sensor" and session and not (ident or session.forced_version):
+        version = None  # nothing answered aI! and nobody forced a rule set: no claim to show
     return {
         "address": session.address if session else run.options.address,
         "identification": raw,
