@@ -79,7 +79,19 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     )
 
 
+def is_conformance_session(config: pytest.Config) -> bool:
+    """Whether this pytest run is the conformance suite (`--pyargs testcases...` or any
+    --sdi12-* option) rather than an ordinary test session the plugin must leave alone."""
+    given = [str(a) for a in config.invocation_params.args]
+    return any(a.startswith("--sdi12-") for a in given) or any(
+        str(a).split("/")[0].split(".")[0] == "testcases" for a in config.args
+    )
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-html reads --self-contained-html
 def pytest_configure(config: pytest.Config) -> None:
+    if is_conformance_session(config) and hasattr(config.option, "self_contained_html"):
+        config.option.self_contained_html = True  # a certificate is one file, no assets/
     config.addinivalue_line(
         "markers", "requirements(*ids): the requirement IDs a conformance case judges"
     )

@@ -310,3 +310,16 @@ def test_test_ids_and_junit_classnames_do_not_depend_on_the_working_folder(tmp_p
     assert seen[0] == seen[1]
     assert all(i.startswith("testcases.sensor.test_4_4_12_crc::") for i in seen[0][0])
     assert seen[0][1]
+
+
+def test_plugin_written_report_is_one_self_contained_file(tmp_path):
+    proc = pytest_run(
+        "--pyargs", "testcases.sensor", "-k", "crc", "--html=rep/report.html",
+        "--sdi12-report-dir", "rep", cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert sorted(p.name for p in (tmp_path / "rep").iterdir()) == [
+        "report.html", "transcript.jsonl", "verdicts.json",
+    ]  # fmt: skip
+    assert "assets/style.css" not in (tmp_path / "rep" / "report.html").read_text()
+    assert not (tmp_path / ".hypothesis").exists()
