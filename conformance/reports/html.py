@@ -73,6 +73,11 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
 .sdi12-diagram{overflow-x:auto;margin:4px 0 8px;border:1px solid #eee;background:#fff}
 .sdi12-wire,.sdi12-diagram{max-width:calc(100vw - 70px)}
 #sdi12-top a,.sdi12-case a{color:#1565c0}
+/* pytest-html's test-log leftovers: a certificate shows verdicts, not a test runner's tally */
+#environment-header,#environment{display:none}
+.filters input[disabled],.filters input[disabled]+span{display:none}
+td.extra:has(.sdi12-case) .logwrapper{display:none}
+tbody.sdi12-target{outline:3px solid #1565c0}
 </style>
 """
 
@@ -86,7 +91,22 @@ SCRIPT = """
   var results=document.getElementById('results-table');
   if(envh&&env&&results){results.parentNode.insertBefore(envh,results.nextSibling);
     envh.parentNode.insertBefore(env,envh.nextSibling);}
-  var h=document.querySelector('.summary__data h2'); if(h) h.textContent='Test cases';
+  var h=document.querySelector('.summary__data h2');
+  if(h) h.textContent='Evidence: the conformance cases';
+  function findCase(name){var hit=null;
+    document.querySelectorAll('#results-table tbody.results-table-row').forEach(function(b){
+      if(b.id&&(b.id===name||b.id.slice(-name.length-2)==='::'+name)) hit=b;});
+    return hit;}
+  function openCase(name){var b=findCase(name); if(!b) return;
+    var closed=b.querySelector('.collapsible > .col-result.collapsed');
+    if(closed){closed.click(); b=findCase(name);}
+    if(!b) return;
+    document.querySelectorAll('tbody.sdi12-target').forEach(function(o){
+      o.classList.remove('sdi12-target');});
+    b.classList.add('sdi12-target'); b.scrollIntoView();}
+  document.addEventListener('click',function(e){
+    var a=e.target.closest&&e.target.closest('a[data-sdi12-case]'); if(!a) return;
+    e.preventDefault(); openCase(a.dataset.sdi12Case);});
   var t=document.getElementById('sdi12-requirements'); if(!t) return;
   var f=document.getElementById('sdi12-filter'), v=document.getElementById('sdi12-verdict-filter');
   var shown=document.getElementById('sdi12-shown');
@@ -276,11 +296,17 @@ def _attention_item(group: list[RequirementResult]) -> str:
         listed = ", ".join(r.requirement.id for r in group)
         ids = f"{len(group)} requirements: <b>{escape(listed)}</b>"
     tests = sorted({t.split("::")[-1] for r in group for t in r.tests})
-    where = f' <span class="tests">[{escape(", ".join(tests))}]</span>' if tests else ""
+    links = ", ".join(case_link(t) for t in tests)
+    where = f' <span class="tests">[evidence: {links}]</span>' if tests else ""
     return (
         f'<li><span class="{verdict_class(verdict)}">{escape(verdict)}</span> {ids}: '
         f"{escape(_reason(group[0]))}{where}</li>"
     )
+
+
+def case_link(name: str) -> str:
+    """A link that opens the case's row in the evidence table below and scrolls to it."""
+    return f'<a href="#" data-sdi12-case="{escape(name)}">{escape(name)}</a>'
 
 
 def requirements_table(run: ConformanceRun) -> str:
@@ -288,7 +314,7 @@ def requirements_table(run: ConformanceRun) -> str:
     for r in run.results or []:
         req = r.requirement
         verdict = str(r.verdict) if r.selected else "NOT SELECTED"
-        tests = "<br>".join(escape(t.split("::")[-1]) for t in r.tests) or "—"
+        tests = "<br>".join(case_link(t.split("::")[-1]) for t in r.tests) or "—"
         extra = len(r.findings) - 1
         evidence = escape(r.one_line) + (f" <i>(+{extra} findings)</i>" if extra > 0 else "")
         rows.append(
