@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -323,3 +324,20 @@ def test_plugin_written_report_is_one_self_contained_file(tmp_path):
     ]  # fmt: skip
     assert "assets/style.css" not in (tmp_path / "rep" / "report.html").read_text()
     assert not (tmp_path / ".hypothesis").exists()
+
+
+@pytest.mark.parametrize("fault", ["no-retries", "ignores-bad-crc"])
+def test_recorder_findings_read_cleanly(tmp_path, fault):
+    out = tmp_path / "r"
+    proc = run("--role", "recorder", "--port", f"sim://?recorder-faults={fault}",
+               "--report-dir", str(out))  # fmt: skip
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    data = json.loads((out / "verdicts.json").read_text())
+    details = [f["detail"] for r in data["requirements"] for f in r["findings"]]
+    for detail in details:
+        assert "[]" not in detail and "(sent: [" not in detail, detail
+        assert not detail.rstrip().endswith(";"), detail
+        parts = [p.strip() for p in detail.split(";")]
+        assert len(parts) == len(set(parts)), f"repeated text: {detail}"
+    crc = [d for d in details if "CRC" in d and "should be" in d]
+    assert all(re.search(r"CRC '.{3}' should be '.{3}'", d) for d in crc), crc

@@ -859,7 +859,8 @@ def judge_retries(line: Line, uncertainty: float) -> list[Finding]:
                 nxt = seq[k + 1] if k + 1 < len(seq) else None
                 follower = nxt or later
                 if follower is None and len(seq) < 3:
-                    tally.fail("R-7.2-05", where, f"{a.problem} at {_at(a.sent)}, then no retry")
+                    when = f"t={a.sent.first_char:.3f} s"  # `where` already names the command
+                    tally.fail("R-7.2-05", where, f"{a.problem} at {when}, then no retry")
                 if a.problem == "no reply":
                     if nxt is not None:
                         window.append(
@@ -1060,8 +1061,13 @@ def judge_transparent(
         matching = [s for s in line.sent if s.text == text]
         if not matching:
             near = [t for t in sent_texts if t[:1] == text[:1]]
+            instead = (
+                f"sent instead: {', '.join(repr(escape(t)) for t in near[:3])}"
+                if near
+                else f"nothing starting with {escape(text[:1])!r} was sent"
+            )
             for rid in ids:
-                unchanged.fail(rid, where, f"not on the wire as typed (sent: {near[:3]})")
+                unchanged.fail(rid, where, f"not on the wire as typed ({instead})")
             continue
         first = matching[0]
         if first.break_event is None:
