@@ -33,7 +33,8 @@ EXAMPLES = """\
 examples:
   sdi12-conform --port sim --role sensor                  judge the built-in simulated sensor
   sdi12-conform --port 'sim://?faults=no-service-request' run against a faulty simulated sensor
-  sdi12-conform --port sim --sdi-version 1.3 -k crc       only cases matching 'crc', v1.3 rules
+  sdi12-conform --port sim --sdi-version 1.3 -k crc       a partial run: cases matching 'crc'
+  sdi12-conform --port /dev/ttyUSB0 --req 4.4.12          a partial run: clause 4.4.12 only
   sdi12-conform --port sim --role recorder                 judge the golden recorder (sim)
   sdi12-conform --port 'sim://?recorder-faults=no-retries' --role recorder
                                                            a faulty golden recorder
@@ -42,8 +43,9 @@ examples:
   sdi12-conform matrix                                     run the fault-detection matrix
   sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
 
-exit codes: 0 compliant, 1 non-compliant, 2 interrupted/incomplete, 3 internal error,
-            4 usage error, 5 no device answered
+exit codes (every subcommand): 0 compliant/success, 1 non-compliant (matrix: a fault not
+  caught exactly), 2 interrupted/incomplete, 3 internal error, 4 usage error, 5 no device
+  answered. Ctrl-C: exit 2 and a report saying complete: false.
 """
 
 
