@@ -6,6 +6,11 @@ incomplete, 3 internal error, 4 usage error, 5 no device answered.
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # `python -m conformance.cli`: Ctrl-C is ours before the imports
+    from conformance.interrupts import GUARD as _EARLY_GUARD
+
+    _EARLY_GUARD.install()
+
 import argparse
 import datetime as dt
 import json
@@ -322,9 +327,15 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT if exact == len(rows) else EXIT_NON_COMPLIANT
 
 
+SUBCOMMANDS = ("list", "faults", "matrix", "emulate")
+
+
 def main(argv: list[str] | None = None) -> int:
     """The program (``argv`` None: the process is ours to the end) or an in-process call."""
     whole_process = argv is None
+    if not whole_process:
+        GUARD.reset()  # an earlier in-process run's interrupt is not this one's
+    GUARD.install()  # first of all: Ctrl-C from here on is recorded, never a traceback
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         return _dispatch(argv)
@@ -352,6 +363,10 @@ def error(text: str) -> None:
 def _dispatch(argv: list[str]) -> int:
     console = make_console()
     try:
+        if argv and argv[0] in SUBCOMMANDS:
+            if GUARD.requested:  # Ctrl-C while the program was starting
+                return EXIT_INCOMPLETE
+            GUARD.uninstall()  # subcommands stop on Ctrl-C at once (emulate runs until it)
         if argv and argv[0] == "list":
             return cmd_list(argv[1:], console)
         if argv and argv[0] == "faults":
@@ -362,8 +377,6 @@ def _dispatch(argv: list[str]) -> int:
             from .emulate.command import emulate_main
 
             return emulate_main(argv[1:])
-        GUARD.reset()
-        GUARD.install()  # Ctrl-C from here on: exit 2 with a report saying complete: false
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:

@@ -75,7 +75,7 @@ def test_declared_invalid_address_names_file_and_key(tmp_path):
     declaration.write_text('address = "$"\n', encoding="utf-8")
     proc = run("--port", "sim", "--declaration", str(declaration))
     assert proc.returncode == EXIT_USAGE
-    assert f"{declaration}: address: '$' is not an SDI-12 address" in proc.stderr
+    assert f"{declaration}:1: address: '$' is not an SDI-12 address" in proc.stderr
     no_traceback(proc)
 
 
