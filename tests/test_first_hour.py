@@ -341,3 +341,12 @@ def test_recorder_findings_read_cleanly(tmp_path, fault):
         assert len(parts) == len(set(parts)), f"repeated text: {detail}"
     crc = [d for d in details if "CRC" in d and "should be" in d]
     assert all(re.search(r"CRC '.{3}' should be '.{3}'", d) for d in crc), crc
+
+
+def test_readme_points_at_what_the_package_ships():
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    assert "../shared" not in readme
+    assert "sdi12-conform list" in readme and "conformance/catalog.json" in readme
+    from importlib import resources
+
+    assert resources.files("conformance").joinpath("catalog.json").is_file()

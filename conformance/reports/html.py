@@ -103,7 +103,7 @@ SCRIPT = """
     if(!b) return;
     document.querySelectorAll('tbody.sdi12-target').forEach(function(o){
       o.classList.remove('sdi12-target');});
-    b.classList.add('sdi12-target'); b.scrollIntoView();}
+    b.classList.add('sdi12-target'); b.scrollIntoView(); window.scrollBy(0,-8);}
   document.addEventListener('click',function(e){
     var a=e.target.closest&&e.target.closest('a[data-sdi12-case]'); if(!a) return;
     e.preventDefault(); openCase(a.dataset.sdi12Case);});

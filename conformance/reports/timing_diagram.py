@@ -150,7 +150,7 @@ LEGEND = (
     ("follow", "after a reply: next command without break ≤ 87 ms; standby after 100 ms"),
     ("bad", "out of limits"),
 )
-LEGEND_WIDTH = LEFT + sum(30 + 6.4 * len(label) for _, label in LEGEND)
+LEGEND_WIDTH = LEFT + sum(30 + 6.2 * len(label) for _, label in LEGEND)
 
 
 def _legend() -> str:
@@ -162,7 +162,7 @@ def _legend() -> str:
             f'fill="{COLOURS[key]}"{opacity}/>'
         )
         out.append(_text(x + 16, Y_LEGEND, label, size=FONT, anchor="start"))
-        x += 30 + 6.4 * len(label)
+        x += 30 + 6.2 * len(label)
     return "".join(out)
 
 
