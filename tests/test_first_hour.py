@@ -90,19 +90,19 @@ def test_a_regular_file_is_not_a_serial_port(tmp_path):
 
 @pytest.mark.parametrize("where", ["file", "proc", "read-only"])
 def test_report_folder_that_cannot_be_written_is_a_usage_error(tmp_path, where):
-    if where == "read-only" and os.geteuid() == 0:
-        pytest.skip("root writes into read-only folders")
     cwd = tmp_path
     args: tuple[str, ...] = ("--report-dir", str(tmp_path / "afile"))
     if where == "file":
         (tmp_path / "afile").write_text("", encoding="utf-8")
     elif where == "proc":
         args = ("--report-dir", "/proc/sdi12-reports")
-    else:
+    else:  # the default reports/ folder in a working directory nobody can write to
         cwd = tmp_path / "ro"
         cwd.mkdir()
         cwd.chmod(0o555)
-        args = ()  # the default reports/ folder in the working directory
+        if os.geteuid() == 0:  # root writes into a 0555 folder; /proc refuses even root
+            cwd = Path("/proc")
+        args = ()
     proc = run("--port", "sim", *args, cwd=cwd)
     assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
     assert "--report-dir DIR" in proc.stderr
