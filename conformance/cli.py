@@ -131,7 +131,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
     try:
-        check_role_options(args.role, args.port, args.trigger)
+        check_role_options(args.role, args.port, args.trigger, args.address)
         check_address(args.address)
         check_uncertainty(args.timing_uncertainty_ms)
         resolve(args.role, args.req)  # --req names requirements the role can test

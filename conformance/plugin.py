@@ -16,7 +16,13 @@ from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
 from .ports import PortError
-from .preflight import UsageError, check_address, check_report_dir, check_uncertainty
+from .preflight import (
+    UsageError,
+    check_address,
+    check_report_dir,
+    check_role_options,
+    check_uncertainty,
+)
 from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .results import CaseRecord
@@ -103,7 +109,8 @@ def pytest_configure(config: pytest.Config) -> None:
     try:
         check_address(options.address, "--sdi12-address")
         check_uncertainty(options.timing_uncertainty_ms, "--sdi12-timing-uncertainty-ms")
-    except UsageError as exc:
+        check_role_options(options.role, options.port, options.trigger, options.address)
+    except (UsageError, PortError) as exc:
         raise pytest.UsageError(str(exc)) from None
     config.stash[RUN] = ConformanceRun(options)
     if config.pluginmanager.hasplugin("html"):

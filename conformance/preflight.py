@@ -40,10 +40,17 @@ def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") 
         raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
 
 
-def check_role_options(role: str, port: str, trigger: str | None) -> None:
+def check_role_options(
+    role: str, port: str, trigger: str | None, address: str | None = None
+) -> None:
     """Settings that only mean something in the other role are mistakes, not no-ops."""
     from .ports import is_sim, parse_sim
 
+    if role == "recorder" and address:
+        raise UsageError(
+            "--address picks the sensor to judge (--role sensor); in the recorder role the "
+            "tool plays the sensors at the addresses its scenarios need"
+        )
     if role == "sensor" and trigger:
         raise UsageError(
             "--trigger makes a data recorder act (--role recorder); a sensor needs no trigger"

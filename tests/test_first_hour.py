@@ -56,6 +56,7 @@ def no_traceback(proc: subprocess.CompletedProcess) -> None:
         (("--port", "sim://?faults=wrong-crc", "--role", "recorder"), ["recorder-faults="]),
         (("--port", "sim://?recorder-faults=no-retries"), ["belongs to the recorder role"]),
         (("--port", "sim", "--trigger", "true"), ["--role recorder"]),
+        (("--role", "recorder", "--address", "3"), ["--address picks the sensor"]),
         (("--port", "sim", "--role", "recorder", "--trigger", "true"), ["rfc2217-serve://"]),
     ],
 )
@@ -169,6 +170,15 @@ def test_plugin_role_case_mismatch_is_an_error_not_60_skips(tmp_path):
     assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
     assert "judge a sensor but --sdi12-role is recorder" in proc.stdout + proc.stderr
     assert "skipped" not in proc.stdout
+
+
+def test_plugin_rejects_the_other_roles_parameters(tmp_path):
+    proc = pytest_run(
+        "--pyargs", "testcases.recorder", "--sdi12-role", "recorder",
+        "--sdi12-port", "sim://?faults=wrong-crc", cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == EXIT_USAGE
+    assert "recorder-faults=" in proc.stdout + proc.stderr
 
 
 def test_plugin_rejects_an_invalid_address(tmp_path):
