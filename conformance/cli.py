@@ -18,9 +18,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from . import __version__
 from .interrupts import GUARD
-from .suite import suite_args
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -62,6 +60,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    from . import __version__  # importlib.metadata: not before Ctrl-C is taken over
+
     p.add_argument("--version", action="version", version=f"sdi12-conform {__version__}")
     p.add_argument(
         "--port",
@@ -155,6 +155,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     except (DeclarationError, PortError, UsageError, SelectionError) as exc:
         error(f"error: {exc}")
         return EXIT_USAGE
+    from .suite import suite_args
+
     pytest_args = suite_args(
         args.role, args.port, report_dir, terminal=args.verbose
     )
