@@ -6,16 +6,22 @@ incomplete, 3 internal error, 4 usage error, 5 no device answered.
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # `python -m conformance.cli`: Ctrl-C is ours before the imports
+    from conformance.interrupts import GUARD as _EARLY_GUARD
+
+    _EARLY_GUARD.install()
+
 import argparse
 import datetime as dt
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from rich.console import Console
+from .interrupts import GUARD
 
-from . import __version__
-from .suite import suite_args
+if TYPE_CHECKING:
+    from rich.console import Console
 
 EXIT_COMPLIANT, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_USAGE, EXIT_NO_DEVICE = (
     0,
@@ -30,7 +36,8 @@ EXAMPLES = """\
 examples:
   sdi12-conform --port sim --role sensor                  judge the built-in simulated sensor
   sdi12-conform --port 'sim://?faults=no-service-request' run against a faulty simulated sensor
-  sdi12-conform --port sim --sdi-version 1.3 -k crc       only cases matching 'crc', v1.3 rules
+  sdi12-conform --port sim --sdi-version 1.3 -k crc       a partial run: cases matching 'crc'
+  sdi12-conform --port /dev/ttyUSB0 --req 4.4.12          a partial run: clause 4.4.12 only
   sdi12-conform --port sim --role recorder                 judge the golden recorder (sim)
   sdi12-conform --port 'sim://?recorder-faults=no-retries' --role recorder
                                                            a faulty golden recorder
@@ -40,8 +47,9 @@ examples:
   sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
   sdi12-conform calibrate --port /dev/ttyUSB0              measure the bench's timing first
 
-exit codes: 0 compliant, 1 non-compliant, 2 interrupted/incomplete, 3 internal error,
-            4 usage error, 5 no device answered
+exit codes (every subcommand): 0 compliant/success, 1 non-compliant (matrix: a fault not
+  caught exactly), 2 interrupted/incomplete, 3 internal error, 4 usage error, 5 no device
+  answered. Ctrl-C: exit 2 and a report saying complete: false.
 """
 
 
@@ -53,11 +61,14 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    from . import __version__  # importlib.metadata: not before Ctrl-C is taken over
+
     p.add_argument("--version", action="version", version=f"sdi12-conform {__version__}")
     p.add_argument(
         "--port",
-        default="sim",
-        help="sim, sim://?faults=a,b&version=1.3, or a serial port / pyserial URL",
+        help="a serial port (/dev/ttyUSB0, COM3), a pyserial URL (rfc2217://HOST:PORT), or "
+        "sim / sim://?faults=a,b&version=1.3 for the built-in simulated device "
+        "(default: sim, said loudly when used)",
     )
     p.add_argument(
         "--role",
@@ -94,7 +105,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="recorder role: shell command run per scenario with the request in SDI12_* "
         "environment variables, or 'interactive' to prompt an operator",
     )
-    p.add_argument("-k", dest="keyword", help="only cases matching this pytest -k expression")
+    p.add_argument(
+        "-k",
+        dest="keyword",
+        help="a partial run: only cases matching this pytest -k expression (exit 0/1 on "
+        "what was selected; the rest is listed as not selected)",
+    )
+    p.add_argument(
+        "--req",
+        action="append",
+        default=[],
+        metavar="ID_OR_CLAUSE",
+        help="a partial run: only cases judging this requirement ID (R-4.4.6-02) or clause "
+        "(4.4.12); repeatable",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p
 
@@ -102,8 +126,30 @@ def build_parser() -> argparse.ArgumentParser:
 def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .declaration import DeclarationError, load_declaration, normalise_version
     from .ports import PortError, is_sim, parse_sim
+    from .preflight import (
+        UsageError,
+        check_address,
+        check_report_dir,
+        check_role_options,
+        check_uncertainty,
+    )
+    from .selection import SelectionError, resolve
 
+    if args.port is None:
+        args.port = "sim"
+        console.print(
+            f"note: no --port given: judging the built-in SIMULATED {args.role}, not a real "
+            "device (pass --port /dev/ttyUSB0, COM3 or rfc2217://HOST:PORT for one)",
+            style="bold yellow",
+            markup=False,
+        )
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
     try:
+        check_role_options(args.role, args.port, args.trigger, args.address)
+        check_address(args.address)
+        check_uncertainty(args.timing_uncertainty_ms)
+        resolve(args.role, args.req)  # --req names requirements the role can test
         if args.sdi_version:
             normalise_version(args.sdi_version)
         if args.declaration:
@@ -121,14 +167,14 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
             # a port that cannot be opened: a usage error
             open_port(args.port, echo=args.echo, direction=args.direction).link.close()
-    except (DeclarationError, PortError) as exc:
-        console.print(f"error: {exc}", style="red", markup=False)
+        check_report_dir(report_dir)
+    except (DeclarationError, PortError, UsageError, SelectionError) as exc:
+        error(f"error: {exc}")
         return EXIT_USAGE
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
-    report_dir.mkdir(parents=True, exist_ok=True)
+    from .suite import suite_args
+
     pytest_args = suite_args(
-        args.role, args.port, report_dir, rootdir=Path.cwd(), terminal=args.verbose
+        args.role, args.port, report_dir, terminal=args.verbose
     )
     for flag, value in (
         ("--sdi12-address", args.address),
@@ -145,6 +191,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     pytest_args += ["--sdi12-echo", args.echo, "--sdi12-direction", args.direction]
     if args.keyword:
         pytest_args += ["-k", args.keyword]
+    for wanted in args.req:
+        pytest_args += ["--sdi12-req", wanted]
     plugins: list[object] = []
     if args.verbose:
         pytest_args.append("-v")
@@ -156,26 +204,35 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     import pytest
 
     code = pytest.main(pytest_args, plugins=plugins)
+    interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
     verdicts = report_dir / "verdicts.json"
+    if interrupted and not verdicts.exists():
+        error("interrupted before the run started; no report written")
+        return EXIT_INCOMPLETE
     if code == 5 and not verdicts.exists():  # pytest: no tests collected (e.g. -k matched none)
-        console.print("no conformance case matched the selection", style="red")
+        for leftover in ("report.html", "junit.xml"):  # pytest-html's empty page misleads
+            (report_dir / leftover).unlink(missing_ok=True)
+        error(
+            f"error: no conformance case matched -k {args.keyword!r}; "
+            "`sdi12-conform list` shows the cases"
+        )
         return EXIT_USAGE
     if not verdicts.exists():
-        console.print(
-            f"the suite did not run (pytest exit {int(code)}); rerun with -v", style="red"
-        )
+        error(f"error: the suite did not run (pytest exit {int(code)}); rerun with -v")
         return EXIT_INTERNAL if int(code) == 3 else EXIT_USAGE
     data = json.loads(verdicts.read_text(encoding="utf-8"))
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))
+    if interrupted:
+        return EXIT_INCOMPLETE
     return exit_code(data, int(code))
 
 
 def exit_code(data: dict, pytest_code: int) -> int:
     verdict = data["summary"]["verdict"]
-    if pytest_code == EXIT_NO_DEVICE and not data["run"]["complete"]:
-        return EXIT_NO_DEVICE
+    if pytest_code in (EXIT_NO_DEVICE, EXIT_USAGE) and not data["run"]["complete"]:
+        return pytest_code  # nothing answered, or the setup (e.g. a --trigger) cannot work
     if pytest_code in (EXIT_INCOMPLETE, EXIT_INTERNAL) and not data["run"]["complete"]:
         return pytest_code  # Ctrl-C (pytest's 2) or the link failed mid-run (3)
     if verdict == "NON-COMPLIANT":
@@ -231,8 +288,9 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     from .emulator import FAULTS
 
     table = Table(title=f"{len(FAULTS)} emulator faults (use sim://?faults=NAME[,NAME])")
-    table.add_column("fault")
-    table.add_column("violates")
+    width = max(len(name) for name in FAULTS)
+    table.add_column("fault", no_wrap=True, min_width=width)  # a name to type: never cut
+    table.add_column("violates", overflow="fold")
     table.add_column("what it does", overflow="fold")
     for name, fault in sorted(FAULTS.items()):
         table.add_row(name, " ".join(fault.violates), fault.description)
@@ -252,10 +310,29 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     args = p.parse_args(argv)
     from rich.table import Table
 
-    from .matrix import fault_matrix
+    from .matrix import MatrixRow, fault_matrix
 
     names = [f for f in (args.faults or "").split(",") if f] or None
-    rows = fault_matrix(names, processes=args.jobs)
+    from .emulator import FAULTS
+
+    unknown = [n for n in names or () if n not in FAULTS]
+    if unknown:
+        error(
+            f"error: unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the "
+            "known ones"
+        )
+        return EXIT_USAGE
+    if args.jobs < 1:
+        error(f"error: --jobs must be 1 or more, not {args.jobs}")
+        return EXIT_USAGE
+    status = make_console(stderr=True)
+
+    def progress(done: int, total: int, row: MatrixRow) -> None:
+        caught = "caught exactly" if row.exact else "NOT caught exactly"
+        status.print(f"[{done}/{total}] {row.fault}: {caught}", markup=False, highlight=False)
+
+    status.print(f"running the sensor suite once per fault, {args.jobs} at a time...")
+    rows = fault_matrix(names, processes=args.jobs, progress=progress)
     table = Table(title="fault-detection matrix (sensor role)")
     for col in ("fault", "declared", "FAIL/WARN", "caught"):
         table.add_column(col, overflow="fold")
@@ -269,10 +346,46 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT if exact == len(rows) else EXIT_NON_COMPLIANT
 
 
+SUBCOMMANDS = ("list", "faults", "matrix", "emulate")
+
+
 def main(argv: list[str] | None = None) -> int:
+    """The program (``argv`` None: the process is ours to the end) or an in-process call."""
+    whole_process = argv is None
+    if not whole_process:
+        GUARD.reset()  # an earlier in-process run's interrupt is not this one's
+    GUARD.install()  # first of all: Ctrl-C from here on is recorded, never a traceback
     argv = list(sys.argv[1:] if argv is None else argv)
-    console = Console(stderr=False)
     try:
+        return _dispatch(argv)
+    finally:
+        if whole_process:
+            GUARD.ignore_from_now()  # a Ctrl-C while Python shuts down must not exit 130
+        else:
+            GUARD.uninstall()
+
+
+def make_console(*, stderr: bool = False) -> Console:
+    """A console for results (stdout) or errors (stderr). Off a terminal nothing is wrapped:
+    a log or a pipe gets whole lines (rich would hard-wrap them at 80 columns)."""
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    return Console(stderr=stderr, soft_wrap=not stream.isatty())
+
+
+def error(text: str) -> None:
+    """One line for the user on stderr (never on stdout, where results and pipes go)."""
+    make_console(stderr=True).print(text, style="red", markup=False, highlight=False)
+
+
+def _dispatch(argv: list[str]) -> int:
+    console = make_console()
+    try:
+        if argv and argv[0] in SUBCOMMANDS:
+            if GUARD.requested:  # Ctrl-C while the program was starting
+                return EXIT_INCOMPLETE
+            GUARD.uninstall()  # subcommands stop on Ctrl-C at once (emulate runs until it)
         if argv and argv[0] == "list":
             return cmd_list(argv[1:], console)
         if argv and argv[0] == "faults":
@@ -292,12 +405,14 @@ def main(argv: list[str] | None = None) -> int:
         except SystemExit as exc:
             return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
         return run_suite(args, console)
+    except SystemExit as exc:  # argparse of a subcommand: --help (0) or a usage error (2)
+        return EXIT_COMPLIANT if exc.code in (0, None) else EXIT_USAGE
     except KeyboardInterrupt:
-        console.print("interrupted", style="yellow")
+        error("interrupted")
         return EXIT_INCOMPLETE
     except Exception as exc:  # a bug in the tool: say so plainly, exit 3 for CI
-        console.print(f"internal error: {type(exc).__name__}: {exc}", style="red", markup=False)
-        console.print("please report this with the command line that caused it", style="red")
+        error(f"internal error: {type(exc).__name__}: {exc}")
+        error("please report this with the command line that caused it")
         return EXIT_INTERNAL
 
 

@@ -18,9 +18,12 @@ Without one the tool discovers what it can and says in the report what it assume
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from .preflight import address_problem
 
 FEATURES = ("address_change", "continuous", "high_volume_ascii", "high_volume_binary")
 
@@ -52,31 +55,90 @@ def normalise_version(text: str) -> str:
     return digits
 
 
+#: top-level keys and their TOML types; [features] and [measurements] are checked apart
+TOP_LEVEL: dict[str, type | tuple[type, ...]] = {
+    "address": str,
+    "sdi12_version": (str, float),
+    "factory_fresh": bool,
+    "features": dict,
+    "measurements": dict,
+}
+MEASUREMENT_CODE = re.compile(r"^(?:[MC]C?[1-9]?|H[AB]|V)$")
+
+
 def load_declaration(path: str | Path) -> Declaration:
+    """Read and check a declaration: an unknown key or a wrong type is refused with the
+    file, the key and its line (a typo silently ignored would change what is judged)."""
     try:
-        raw = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        text = Path(path).read_text(encoding="utf-8")
+        raw = tomllib.loads(text)
     except FileNotFoundError:
         raise DeclarationError(f"declaration file {path} does not exist") from None
-    except (OSError, tomllib.TOMLDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise DeclarationError(f"cannot read declaration {path}: {exc}") from None
+
+    def refuse(table: str | None, key: str, problem: str) -> DeclarationError:
+        where = f"[{table}] {key}" if table else key
+        return DeclarationError(f"{path}:{_line_of(text, table, key)}: {where}: {problem}")
+
+    for key, value in raw.items():
+        if key not in TOP_LEVEL:
+            known = ", ".join(TOP_LEVEL)
+            raise refuse(None, key, f"unknown key (known: {known})")
+        if not isinstance(value, TOP_LEVEL[key]):
+            raise refuse(None, key, f"must be a {_type_name(TOP_LEVEL[key])}, not {value!r}")
     address = raw.get("address")
-    if address is not None and (not isinstance(address, str) or len(address) != 1):
-        raise DeclarationError('address must be a single character such as "0"')
+    if address is not None and address_problem(address):
+        raise refuse(None, "address", address_problem(address) or "")
     version = raw.get("sdi12_version")
+    try:
+        claimed = normalise_version(str(version)) if version is not None else None
+    except DeclarationError as exc:
+        raise refuse(None, "sdi12_version", str(exc)) from None
     features = raw.get("features", {})
-    unknown = set(features) - set(FEATURES) - {"extended"}
-    if unknown:
-        raise DeclarationError(f"unknown features {sorted(unknown)}; known: {list(FEATURES)}")
-    extended = features.get("extended", [])
+    for key, value in features.items():
+        if key == "extended":
+            if not (isinstance(value, list) and all(isinstance(e, str) for e in value)):
+                raise refuse("features", key, 'must be a list of strings, e.g. ["XSN"]')
+        elif key not in FEATURES:
+            known = ", ".join((*FEATURES, "extended"))
+            raise refuse("features", key, f"unknown feature (known: {known})")
+        elif not isinstance(value, bool):
+            raise refuse("features", key, f"must be true or false, not {value!r}")
     measurements = raw.get("measurements", {})
-    if not all(isinstance(v, int) and 0 <= v <= 999 for v in measurements.values()):
-        raise DeclarationError("measurement counts must be integers 0..999")
+    for key, value in measurements.items():
+        if not MEASUREMENT_CODE.match(key):
+            raise refuse("measurements", key, "not a measurement command (M, M1..M9, C, MC1...)")
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 999:
+            raise refuse("measurements", key, f"must be a value count 0..999, not {value!r}")
     return Declaration(
         address=address,
-        sdi12_version=normalise_version(str(version)) if version is not None else None,
-        features={k: bool(v) for k, v in features.items() if k in FEATURES},
-        extended=tuple(str(e) for e in extended),
-        measurements={str(k): int(v) for k, v in measurements.items()},
-        factory_fresh=bool(raw.get("factory_fresh", False)),
+        sdi12_version=claimed,
+        features={k: v for k, v in features.items() if k in FEATURES},
+        extended=tuple(features.get("extended", [])),
+        measurements=dict(measurements),
+        factory_fresh=raw.get("factory_fresh", False),
         source=str(path),
     )
+
+
+def _type_name(kind: type | tuple[type, ...]) -> str:
+    names = {str: "string", float: "number", bool: "true/false", dict: "table", int: "integer"}
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    return " or ".join(names.get(k, k.__name__) for k in kinds)
+
+
+def _line_of(text: str, table: str | None, key: str) -> int | str:
+    """The line that sets ``key`` in ``[table]`` (top level when None); '?' if not found."""
+    current = None
+    pattern = re.compile(rf"^\s*(?:\"{re.escape(key)}\"|{re.escape(key)})\s*=")
+    for number, line in enumerate(text.splitlines(), start=1):
+        header = re.match(r"^\s*\[([^\]]+)\]", line)
+        if header:
+            current = header.group(1).strip()
+            if current == key and table is None:
+                return number
+            continue
+        if current == table and pattern.match(line):
+            return number
+    return "?"

@@ -11,6 +11,9 @@ its step log becomes the evidence.
 
 from __future__ import annotations
 
+import getpass
+import os
+import tempfile
 from dataclasses import dataclass, field
 
 from hypothesis import HealthCheck, Phase, settings
@@ -162,6 +165,7 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             record.log.append(" ; ".join(self.trail))
             record.failing_sequence = list(self.trail)
 
+    keep_hypothesis_out_of_the_working_folder()
     try:
         run_state_machine_as_test(
             SensorMachine,
@@ -199,3 +203,20 @@ def _first_broken(exc: BaseException | None) -> InvariantBroken | None:
         stack.extend(getattr(item, "exceptions", ()))
         stack.extend((item.__cause__, item.__context__))
     return None
+
+
+def keep_hypothesis_out_of_the_working_folder() -> None:
+    """Hypothesis caches (constants, unicode data) in ``./.hypothesis`` even with no example
+    database; a conformance run must leave nothing in the user's folder but its reports.
+    The cache goes to the user's cache folder unless HYPOTHESIS_STORAGE_DIRECTORY says where."""
+    if os.environ.get("HYPOTHESIS_STORAGE_DIRECTORY"):
+        return
+    from hypothesis.configuration import set_hypothesis_home_dir
+
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    home = os.path.join(base, "sdi12-conform", "hypothesis")
+    try:
+        os.makedirs(home, exist_ok=True)
+    except OSError:  # no writable home: a per-user folder under the system's temp folder
+        home = os.path.join(tempfile.gettempdir(), f"sdi12-conform-hypothesis-{getpass.getuser()}")
+    set_hypothesis_home_dir(home)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import multiprocessing
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -119,12 +120,19 @@ def _row(item: tuple[str, tuple[str, ...], str, tuple[str, ...]]) -> MatrixRow:
     from .emulator import FAULTS
 
     fault, declared, version, extra = item
-    data = run_once(f"sim://?faults={fault}&version={version}", extra)
+    dotted = f"{version[0]}.{version[1:]}"  # a fault's "13" is the port's version=1.3
+    data = run_once(f"sim://?faults={fault}&version={dotted}", extra)
     return row_from(fault, declared, data, tuple(FAULTS[fault].inconclusive))
 
 
-def fault_matrix(faults: list[str] | None = None, processes: int = 2) -> list[MatrixRow]:
-    """One row per fault (all of them by default), run ``processes`` at a time."""
+def fault_matrix(
+    faults: list[str] | None = None,
+    processes: int = 2,
+    progress: Callable[[int, int, MatrixRow], None] | None = None,
+) -> list[MatrixRow]:
+    """One row per fault (all of them by default), run ``processes`` at a time;
+    ``progress(done, total, row)`` hears of each row as it arrives (the whole matrix takes
+    minutes)."""
     from .emulator import FAULTS
 
     names = faults or sorted(FAULTS)
@@ -132,8 +140,19 @@ def fault_matrix(faults: list[str] | None = None, processes: int = 2) -> list[Ma
         (n, tuple(FAULTS[n].violates), getattr(FAULTS[n], "version", None) or "14", ())
         for n in names
     ]
+    rows: list[MatrixRow] = []
+
+    def keep(row: MatrixRow) -> None:
+        rows.append(row)
+        if progress is not None:
+            progress(len(rows), len(items), row)
+
     if processes <= 1:
-        return [_row(i) for i in items]
+        for item in items:
+            keep(_row(item))
+        return rows
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(processes) as pool:
-        return pool.map(_row, items, chunksize=1)
+        for row in pool.imap(_row, items, chunksize=1):
+            keep(row)
+    return rows

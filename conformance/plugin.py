@@ -12,16 +12,27 @@ import time
 import pytest
 
 from .case import Case
+from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
 from .ports import PortError
+from .preflight import (
+    UsageError,
+    check_address,
+    check_report_dir,
+    check_role_options,
+    check_uncertainty,
+)
+from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
+from .selection import SelectionError, resolve
 from .sensor_session import NoDeviceAnswered, SensorSession
 from .verdicts import Finding, Verdict
 
 RUN = pytest.StashKey[ConformanceRun]()
+OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
 CASE = pytest.StashKey[CaseRecord]()
 EXIT_NO_DEVICE = 5
 
@@ -59,6 +70,14 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         help="recorder role: shell command run per scenario (or 'interactive' to prompt)",
     )
     group.addoption(
+        "--sdi12-req",
+        action="append",
+        default=[],
+        metavar="ID_OR_CLAUSE",
+        help="judge only these requirements: an ID (R-4.4.6-02) or a clause (4.4.12); "
+        "repeatable. A partial run: the rest is listed as not selected",
+    )
+    group.addoption(
         "--sdi12-timing-uncertainty-ms",
         type=float,
         default=None,
@@ -78,7 +97,19 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     )
 
 
+def is_conformance_session(config: pytest.Config) -> bool:
+    """Whether this pytest run is the conformance suite (`--pyargs testcases...` or any
+    --sdi12-* option) rather than an ordinary test session the plugin must leave alone."""
+    given = [str(a) for a in config.invocation_params.args]
+    return any(a.startswith("--sdi12-") for a in given) or any(
+        str(a).split("/")[0].split(".")[0] == "testcases" for a in config.args
+    )
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-html reads --self-contained-html
 def pytest_configure(config: pytest.Config) -> None:
+    if is_conformance_session(config) and hasattr(config.option, "self_contained_html"):
+        config.option.self_contained_html = True  # a certificate is one file, no assets/
     config.addinivalue_line(
         "markers", "requirements(*ids): the requirement IDs a conformance case judges"
     )
@@ -86,7 +117,14 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers",
         "needs(*capabilities): link capabilities a case needs: break, unsolicited, binary",
     )
-    config.stash[RUN] = ConformanceRun(RunOptions.from_config(config))
+    options = RunOptions.from_config(config)
+    try:
+        check_address(options.address, "--sdi12-address")
+        check_uncertainty(options.timing_uncertainty_ms, "--sdi12-timing-uncertainty-ms")
+        check_role_options(options.role, options.port, options.trigger, options.address)
+    except (UsageError, PortError) as exc:
+        raise pytest.UsageError(str(exc)) from None
+    config.stash[RUN] = ConformanceRun(options)
     if config.pluginmanager.hasplugin("html"):
         from .reports import html
 
@@ -162,18 +200,116 @@ def missing_capabilities(item: pytest.Item, run: ConformanceRun) -> list[str]:
     return [CAPABILITIES[n][1] for n in marker.args if not getattr(info, CAPABILITIES[n][0])]
 
 
+def case_role(item: pytest.Item) -> str | None:
+    """The role a conformance case judges, from the session fixture it asks for."""
+    names = getattr(item, "fixturenames", ())
+    return "sensor" if "sensor" in names else "recorder" if "recorder" in names else None
+
+
+def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Deselect the other role's cases; none left for the chosen role is a usage error (a
+    run of skips would end with exit 0 and nothing tested)."""
+    role = config.getoption("sdi12_role")
+    cases = [i for i in items if i.get_closest_marker("requirements")]
+    other = [i for i in cases if case_role(i) not in (None, role)]
+    if not other:
+        return
+    if len(other) == len(cases):
+        found = case_role(other[0])
+        raise pytest.UsageError(
+            f"the selected cases judge a {found} but --sdi12-role is {role}: run "
+            f"`--pyargs testcases.{role}` for a {role}, or pass --sdi12-role {found}"
+        )
+    items[:] = [i for i in items if i not in other]
+    config.hook.pytest_deselected(items=other)
+
+
+def keep_selected_requirements(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """``--sdi12-req``: keep the cases that judge one of the named requirements."""
+    run = run_of(config)
+    if not run.options.requirements:
+        return
+    try:
+        wanted = resolve(run.options.role, run.options.requirements)
+    except SelectionError as exc:
+        raise pytest.UsageError(str(exc)) from None
+    dropped = [i for i in items if _requirements_of(i) and not wanted & set(_requirements_of(i))]
+    items[:] = [i for i in items if i not in dropped]
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+    run.selection.how += [f"--req {text}" for text in run.options.requirements]
+
+
+def _requirements_of(item: pytest.Item) -> tuple[str, ...]:
+    marker = item.get_closest_marker("requirements")
+    return tuple(marker.args) if marker else ()
+
+
+def pytest_deselected(items: list[pytest.Item]) -> None:
+    """Cases of the run's role left out by -k or --req make it a partial run."""
+    if not items:
+        return
+    run = run_of(items[0].config)
+    for item in items:
+        if _requirements_of(item) and case_role(item) in (None, run.options.role):
+            run.selection.left_out.update(_requirements_of(item))
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    run = run_of(session.config)
+    for item in session.items:
+        run.selection.kept.update(_requirements_of(item))
+    keyword = session.config.getoption("keyword", "")
+    if run.selection.partial and keyword:
+        run.selection.how.insert(0, f"-k {keyword}")
+
+
+def check_reports_writable(config: pytest.Config) -> None:
+    try:
+        check_report_dir(run_of(config).report_dir())
+    except (UsageError, OSError) as exc:
+        raise pytest.UsageError(f"--sdi12-report-dir: {exc}") from None
+
+
+def stable_id(item: pytest.Item) -> str:
+    """``testcases.sensor.test_4_4_12_crc::test_crc_presence``: the same wherever the suite
+    is installed or run from (pytest's node IDs are relative to its rootdir)."""
+    module = getattr(getattr(item, "module", None), "__name__", None)
+    if module is None:
+        return item.nodeid
+    inner = item.nodeid.split("::", 1)[1] if "::" in item.nodeid else item.name
+    return f"{module}::{inner}"
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if not any(item.get_closest_marker("requirements") for item in items):
+        return  # an ordinary test session
+    keep_role_cases(config, items)
+    keep_selected_requirements(config, items)
+    check_reports_writable(config)
+    if not GUARD.installed:
+        GUARD.install()  # `pytest --pyargs testcases` on its own: same Ctrl-C policy as the CLI
+        config.stash[OWN_GUARD] = True
     for item in items:
         marker = item.get_closest_marker("requirements")
         if marker is None:
             continue
         doc = (getattr(item, "function", None).__doc__ or "").strip()
         item.stash[CASE] = CaseRecord(
-            nodeid=item.nodeid,
+            nodeid=stable_id(item),
             name=item.name,
             requirements=tuple(marker.args),
             description=" ".join(doc.split()),
         )
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
+    """Ctrl-C stops a case at once (pytest reports INTERRUPTED); outside cases it waits."""
+    if not GUARD.installed or CASE not in item.stash:
+        return (yield)
+    with GUARD.armed():
+        return (yield)
 
 
 @pytest.hookimpl(wrapper=True)
@@ -191,6 +327,11 @@ def pytest_runtest_call(item: pytest.Item):
     except BreakUnsupported as exc:  # the case needs a break of its own making
         _inconclusive(record, f"this case presents its own breaks and the link cannot: {exc}")
         pytest.skip(f"INCONCLUSIVE: the link cannot send breaks ({exc})")
+    except RecorderSetupError as exc:  # a trigger that cannot work: stop, blame the setup
+        _error(record, f"test setup failed: {exc}")
+        run.complete = False
+        run.stop_reason = f"test setup failed: {exc}"
+        pytest.exit(run.stop_reason, returncode=4)
     except LinkError as exc:  # the port failed: stop the run, keep the report (exit 3)
         _error(record, f"link failed: {exc}")
         run.complete = False
@@ -247,9 +388,14 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     run = run_of(session.config)
+    guarded = GUARD.installed
+    late_interrupt = guarded and GUARD.close()  # from here on Ctrl-C cannot change the run
+    if late_interrupt and not run.stop_reason:
+        run.stop_reason = "run interrupted (Ctrl-C)"
     if not run.active and run.session is None and not run.stop_reason:
         return  # no conformance case ran: an ordinary test session
-    interrupted = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, 3, 4)
+    stopped = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, 3, 4)
+    interrupted = late_interrupt or stopped
     if interrupted and not run.stop_reason:
         run.stop_reason = "run interrupted"
     if session.shouldstop or session.shouldfail:
@@ -259,3 +405,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
     verdicts_json.write(run, run.report_dir())
     run.close()
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    if config.stash.get(OWN_GUARD, False):
+        GUARD.uninstall()
+        GUARD.reset()

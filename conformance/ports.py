@@ -49,10 +49,10 @@ def parse_sim(port: str) -> SimSpec:
     if "faults" in params:
         spec.faults = tuple(f.strip() for f in params.pop("faults").split(",") if f.strip())
     if "version" in params:
-        digits = params.pop("version").replace(".", "")
-        if digits not in ("13", "14"):
-            raise PortError(f"sim version must be 1.3 or 1.4, not {digits!r}")
-        spec.version = digits
+        given = params.pop("version").strip()
+        if given not in ("1.3", "1.4"):
+            raise PortError(f"sim version must be 1.3 or 1.4, not {given!r}")
+        spec.version = given.replace(".", "")
     if "address" in params:
         spec.address = params.pop("address")
     for key in ("recorder-faults", "recorder"):  # recorder role: the recorder under test
@@ -109,6 +109,7 @@ def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> Open
             f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
             "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
         )
+    check_network_url(port)
     from .links.direction import DirectionLine
     from .links.echo import EchoMode
     from .links.factory import open_real_link
@@ -120,3 +121,20 @@ def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> Open
             f"{exc}: --echo is auto, on or off; --direction is rts, dtr or none"
         ) from exc
     return OpenedPort(open_real_link(port, **bench))
+
+
+def check_network_url(port: str) -> None:
+    """``rfc2217://`` / ``socket://`` need HOST:PORT; pyserial's own complaint about a
+    missing one is a TypeError from deep inside it."""
+    scheme = port.split("://", 1)[0].lower() if "://" in port else ""
+    if scheme not in ("rfc2217", "socket"):
+        return
+    parts = urlsplit(port)
+    try:
+        number = parts.port
+    except ValueError:
+        number = None
+    if not parts.hostname or number is None:
+        raise PortError(
+            f"port {port!r}: write {scheme}://HOST:PORT, e.g. {scheme}://127.0.0.1:4001"
+        )

@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .catalog import Requirement, for_role
+from .selection import NOT_SELECTED
 from .transcript import Event
 from .verdicts import Finding, Verdict, worst
 
@@ -43,6 +44,7 @@ class RequirementResult:
     tests: list[str]
     judged: bool = True  # False: testable, but no case of this run looked at it
     consequence_of: str | None = None  # a FAILed rule whose deviation probably caused this
+    selected: bool = True  # False: a partial run (-k, --req) left out every case judging it
 
     @property
     def one_line(self) -> str:
@@ -53,11 +55,15 @@ class RequirementResult:
         return ""
 
 
-def aggregate(role: str, cases: list[CaseRecord]) -> list[RequirementResult]:
+def aggregate(
+    role: str, cases: list[CaseRecord], not_selected: frozenset[str] = frozenset()
+) -> list[RequirementResult]:
     """Every catalog requirement of ``role`` with the worst verdict of its findings.
 
     A testable requirement that no case judged is INCONCLUSIVE (a hole in the certificate,
     never a silent PASS); an untestable one is N/A with the reason it cannot be tested here.
+    One in ``not_selected`` (a partial run left out its cases) is N/A, marked not selected,
+    and counts neither for nor against the verdict.
     """
     by_id: dict[str, list[Finding]] = {}
     tests: dict[str, list[str]] = {}
@@ -72,13 +78,15 @@ def aggregate(role: str, cases: list[CaseRecord]) -> list[RequirementResult]:
         if not req.testable(role):
             reason = req.untestable_reason or "not testable by this tool"
             findings = [Finding(req.id, Verdict.NA, f"untestable here: {reason}")]
+        elif not findings and req.id in not_selected:
+            findings = [Finding(req.id, Verdict.NA, NOT_SELECTED)]
         elif not findings:
             findings = [Finding(req.id, Verdict.INCONCLUSIVE, "no case judged this requirement")]
         verdict = worst(f.verdict for f in counted(findings))
         judged = not (req.testable(role) and req.id not in by_id)
-        results.append(
-            RequirementResult(req, verdict, findings, sorted(set(tests.get(req.id, []))), judged)
-        )
+        selected = judged or req.id not in not_selected
+        tested = sorted(set(tests.get(req.id, [])))
+        results.append(RequirementResult(req, verdict, findings, tested, judged, selected))
     return results
 
 
@@ -100,8 +108,9 @@ def overall(results: list[RequirementResult], *, strict: bool, complete: bool) -
     verdicts = {r.verdict for r in results}
     if Verdict.FAIL in verdicts or (strict and Verdict.WARN in verdicts):
         return NON_COMPLIANT
-    if not complete or Verdict.ERROR in verdicts or not all(r.judged for r in results):
-        return INCOMPLETE  # interrupted, the tool failed, or cases were left out (-k)
+    left_unjudged = any(r.selected and not r.judged for r in results)
+    if not complete or Verdict.ERROR in verdicts or left_unjudged:
+        return INCOMPLETE  # interrupted, the tool failed, or a selected case judged nothing
     return COMPLIANT
 
 
@@ -118,5 +127,6 @@ def counts(results: list[RequirementResult]) -> dict[str, int]:
         )
     }
     for r in results:
-        tally[str(r.verdict)] += 1
+        if r.selected:  # a partial run counts what it selected
+            tally[str(r.verdict)] += 1
     return tally

@@ -16,6 +16,7 @@ from .declaration import Declaration, load_declaration, normalise_version
 from .links.base import Link
 from .ports import is_sim, open_port
 from .results import CaseRecord, RequirementResult, aggregate, overall
+from .selection import Selection
 from .sensor_session import SensorSession
 
 
@@ -32,6 +33,7 @@ class RunOptions:
     trigger: str | None = None  # recorder role: shell command (or "interactive") per scenario
     echo: str = "auto"  # real links: does the interface echo the tool's characters
     direction: str = "none"  # real links: the modem line that enables the tool's driver
+    requirements: tuple[str, ...] = ()  # --req: requirement IDs or clauses to judge
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
@@ -48,6 +50,7 @@ class RunOptions:
             trigger=get("sdi12_trigger"),
             echo=get("sdi12_echo"),
             direction=get("sdi12_direction"),
+            requirements=tuple(get("sdi12_req") or ()),
         )
 
 
@@ -69,6 +72,7 @@ class ConformanceRun:
     declaration: Declaration | None = None
     results: list[RequirementResult] | None = None
     verdict: str | None = None
+    selection: Selection = field(default_factory=Selection)  # -k / --req: a partial run
 
     def __post_init__(self) -> None:
         if self.options.declaration:
@@ -133,14 +137,13 @@ class ConformanceRun:
         self.complete = self.complete and complete
         self.finished = now_iso()
         self._recheck_timing()
-        self.results = aggregate(self.options.role, self.cases)
+        self.results = aggregate(self.options.role, self.cases, self.selection.not_selected())
         root_causes.link(self.results)
         self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
-        unjudged = sum(1 for r in self.results if not r.judged)
+        unjudged = sum(1 for r in self.results if r.selected and not r.judged)
         if unjudged and not self.stop_reason:
             self.stop_reason = (
-                f"{unjudged} testable requirement(s) not judged in this run "
-                "(cases left out by the selection?)"
+                f"{unjudged} testable requirement(s) of the selected cases not judged"
             )
         return self.results
 

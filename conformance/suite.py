@@ -9,13 +9,16 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
+#: the folder that holds the ``testcases`` package (a checkout or site-packages)
+SUITE_ROOT = Path(str(resources.files("testcases"))).parent
+
 
 def suite_args(
     role: str,
     port: str,
     report_dir: Path | str,
     *,
-    rootdir: Path | str,
+    rootdir: Path | str | None = None,
     html: bool = True,
     terminal: bool = False,
 ) -> list[str]:
@@ -23,8 +26,13 @@ def suite_args(
 
     The bundled ``suite.ini`` keeps a project's own pytest settings out of the judged run.
     ``html`` adds report.html and junit.xml; ``terminal`` keeps pytest's own output.
+    ``rootdir`` defaults to the folder holding the ``testcases`` package, so test IDs and
+    JUnit classnames (``testcases.sensor.test_4_4_12_crc``) do not depend on where the tool
+    runs or is installed.
     """
     report_dir = Path(report_dir)
+    if rootdir is None:
+        rootdir = SUITE_ROOT
     args = [
         "-c", str(resources.files("conformance") / "suite.ini"),
         "--rootdir", str(rootdir),

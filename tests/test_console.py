@@ -26,7 +26,7 @@ def run_cli(
 ) -> tuple[int, str, dict]:
     buffer = io.StringIO()
     console = Console(file=buffer, force_terminal=terminal, width=100, color_system="standard")
-    monkeypatch.setattr(cli, "Console", lambda **_: console)
+    monkeypatch.setattr(cli, "make_console", lambda **_: console)
     code = cli.main(["--port", port, "--report-dir", str(tmp_path), *extra])
     data = json.loads((tmp_path / "verdicts.json").read_text(encoding="utf-8"))
     return code, buffer.getvalue(), data
@@ -80,19 +80,18 @@ def test_terminal_shows_progress_failures_live_and_a_summary_table(monkeypatch, 
     assert f"report: {tmp_path / 'report.html'}" in text
 
 
-def test_a_selection_says_what_it_left_unjudged_in_one_line(monkeypatch, tmp_path):
+def test_a_selection_is_a_partial_run_judged_on_what_it_selected(monkeypatch, tmp_path):
     code, out, data = run_cli(monkeypatch, tmp_path, "sim", "-k", "crc", terminal=False)
-    unjudged = [r["id"] for r in data["requirements"] if r["verdict"] == "INCONCLUSIVE"]
+    left_out = [r["id"] for r in data["requirements"] if not r["selected"]]
     testable = sum(1 for r in data["requirements"] if r["testable"])
-    assert code == cli.EXIT_INCOMPLETE and len(unjudged) > 4
-    lines = out.splitlines()
-    grouped = [line for line in lines if line.startswith("INCONCLUSIVE ")]
-    assert grouped == [
-        f"INCONCLUSIVE {len(unjudged)} requirements: no case judged this requirement "
-        f"({', '.join(unjudged[:4])}, ...)"
-    ]
-    assert f"{testable - len(unjudged)} of {testable} testable requirements judged" in out
-    assert "verdict: INCOMPLETE" in lines and any(line.startswith("note: ") for line in lines)
+    assert code == cli.EXIT_COMPLIANT and len(left_out) > 4
+    assert not [r for r in data["requirements"] if r["verdict"] == "INCONCLUSIVE"]
+    assert data["run"]["partial"] is True and data["run"]["selection"] == "-k crc"
+    judged = testable - len(left_out)
+    assert f"partial run (-k crc): {judged} of {testable} testable requirements judged" in out
+    assert f"{len(left_out)} not selected" in out
+    assert "verdict: COMPLIANT (partial run: the selected requirements only)" in out
+    assert sum(data["summary"]["counts"].values()) == len(data["requirements"]) - len(left_out)
 
 
 @pytest.mark.parametrize(

@@ -185,6 +185,8 @@ def test_silent_device_is_exit_5_with_the_reason(tmp_path, device_factory):
     assert data["run"]["complete"] is False
     assert "no device answered" in data["run"]["stop_reason"]
     assert "cannot send breaks" in data["run"]["stop_reason"]
+    assert data["dut"]["sdi12_version"] is None  # nothing answered: no claimed version
+    assert "SDI-12 1.4" not in proc.stdout
     assert took < 30
 
 

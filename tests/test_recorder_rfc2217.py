@@ -123,4 +123,4 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
 
 def test_serving_sensors_is_refused_in_the_sensor_role(capsys):
     assert main(["--port", SERVE, "--role", "sensor"]) == 4
-    assert "--role recorder" in capsys.readouterr().out
+    assert "--role recorder" in capsys.readouterr().err

@@ -66,9 +66,9 @@ def test_unusable_recorder_ports_are_refused(port):
 
 
 def test_external_recorders_need_a_real_time_bus():
-    with pytest.raises(PortError, match="real port"):
+    with pytest.raises(PortError, match="rfc2217-serve:"):
         check_port("sim", "true")
-    with pytest.raises(PortError, match="real port"):
+    with pytest.raises(PortError, match="rfc2217-serve:"):
         check_port("sim", "interactive")
 
 

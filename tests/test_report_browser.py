@@ -155,3 +155,49 @@ def test_timing_case_shows_its_diagram(reports, browser):
     assert svg["w"] > 300 and svg["h"] > 100
     assert "reply +" in svg["text"] and "break" in svg["text"]
     assert browser.log.problems == []
+
+
+LEFTOVERS = """(function(){
+  function shown(e){ if(!e) return false; var r=e.getBoundingClientRect(), s=getComputedStyle(e);
+    return s.display!=='none' && s.visibility!=='hidden' && r.width>0 && r.height>0; }
+  var spans=[...document.querySelectorAll('.filters span')].filter(shown).map(s=>s.textContent);
+  var logs=[...document.querySelectorAll('#results-table tbody.failed .logwrapper')]
+    .filter(l=>l.closest('td').querySelector('.sdi12-case')).filter(shown).length;
+  return {environment: shown(document.getElementById('environment-header')),
+          filters: spans, logs: logs,
+          heading: (document.querySelector('.summary__data h2')||{}).textContent};
+})()"""
+
+TARGET = """(function(){ var b=document.querySelector('tbody.sdi12-target'); if(!b) return null;
+  var r=b.getBoundingClientRect();
+  return {id: b.id, top: r.top, open: !b.querySelector('.extras-row').classList.contains('hidden'),
+          case: !!b.querySelector('.sdi12-case')}; })()"""
+
+
+def test_the_report_is_a_verdict_document_not_a_test_log(reports, browser):
+    """No environment table, no '0 Expected failures, 0 Unexpected passes, 0 Reruns', no grey
+    log box repeating a case's FAIL line next to the case's own findings."""
+    browser.open(reports["faulty"] / "report.html")
+    browser.evaluate("document.getElementById('show_all_details').click()")
+    state = browser.evaluate(LEFTOVERS)
+    assert state["environment"] is False
+    assert state["filters"] and not [f for f in state["filters"] if f.startswith("0 ")]
+    assert state["logs"] == 0
+    assert state["heading"].startswith("Evidence")
+    assert browser.log.problems == []
+
+
+@pytest.mark.parametrize("where", ["#sdi12-attention", "#sdi12-requirements"])
+def test_links_open_the_case_that_holds_the_evidence(reports, browser, where):
+    browser.open(reports["faulty"] / "report.html")
+    name = browser.evaluate(
+        f"(function(){{var a=document.querySelector('{where} a[data-sdi12-case]');"
+        " a.click(); return a.dataset.sdi12Case;})()"
+    )
+    browser.evaluate("new Promise(r => setTimeout(r, 200))")
+    target = browser.evaluate(TARGET)
+    assert target is not None, f"no case opened for {name}"
+    assert target["id"].endswith("::" + name) and target["open"] and target["case"]
+    assert 0 <= target["top"] < VIEWPORT[1], "the case was scrolled into view"
+    browser.screenshot(SCREENSHOTS / f"case-from-{where[1:]}.png")
+    assert browser.log.problems == []

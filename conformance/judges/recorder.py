@@ -1093,8 +1093,13 @@ def judge_transparent(
         matching = [s for s in line.sent if s.text == text]
         if not matching:
             near = [t for t in sent_texts if t[:1] == text[:1]]
+            instead = (
+                f"sent instead: {', '.join(repr(escape(t)) for t in near[:3])}"
+                if near
+                else f"nothing starting with {escape(text[:1])!r} was sent"
+            )
             for rid in ids:
-                unchanged.fail(rid, where, f"not on the wire as typed (sent: {near[:3]})")
+                unchanged.fail(rid, where, f"not on the wire as typed ({instead})")
             continue
         mechanism.observe(where)  # only a command that went out shows how it went out
         first = matching[0]

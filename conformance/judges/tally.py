@@ -62,9 +62,10 @@ class Tally:
             if bad:
                 hard = [b for b in bad if not b[1].warning]
                 verdict = Verdict.FAIL if hard else Verdict.WARN
-                shown = (hard or bad)[:SHOWN]
-                more = len(hard or bad) - len(shown)
-                detail = "; ".join(f"{w}: {v.message}" for w, v in shown)
+                lines = _counted(f"{w}: {v.message}" for w, v in (hard or bad))
+                shown = lines[:SHOWN]
+                more = len(lines) - len(shown)
+                detail = "; ".join(shown)
                 if more:
                     detail += f" (+{more} more)"
                 result.append(
@@ -99,3 +100,12 @@ class Tally:
                     )
                 )
         return result
+
+
+def _counted(lines: Iterable[str]) -> list[str]:
+    """Each distinct line once, with how often it came ("0M!: no reply (×2)"): the same
+    violation in two scenarios is one fact for the reader, not a repeated sentence."""
+    seen: dict[str, int] = {}
+    for line in lines:
+        seen[line] = seen.get(line, 0) + 1
+    return [line if n == 1 else f"{line} (×{n})" for line, n in seen.items()]

@@ -190,8 +190,12 @@ def combine(
     elif worst.verdict is Verdict.PASS:
         detail = f"{count} observed; {span + '; ' if span else ''}{worst.detail}"
     else:
-        where = worst.evidence[0] if worst.evidence else ""
-        detail = f"{worst.detail} [{where}]; {span}"
+        parts = [worst.detail]
+        if worst.evidence and worst.evidence[0] not in worst.detail:
+            parts[0] += f" [{worst.evidence[0]}]"  # where, when the detail does not say it
+        if span:
+            parts.append(span)
+        detail = "; ".join(parts)
     same = [f.margin_ms for f in findings if f.verdict is worst.verdict]
     margins = [m for m in same if m is not None]
     margin = None

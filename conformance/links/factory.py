@@ -162,6 +162,11 @@ def _explain(port: str, kind: str, exc: BaseException) -> str:
             f"permission denied on serial port {port}. Add your user to the group that owns "
             "it (Linux: sudo usermod -aG dialout $USER, then log in again)"
         )
+    if code == errno.ENOTTY or "Inappropriate ioctl" in text:  # pyserial hides the errno
+        return (
+            f"{port} is not a serial device (a regular file?): pass a serial port such as "
+            "/dev/ttyUSB0 or COM3"
+        )
     if code == errno.EBUSY or "busy" in text.lower():
         return f"serial port {port} is busy: close the other program using it"
     return f"cannot open port {port}: {text}"

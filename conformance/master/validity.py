@@ -95,7 +95,7 @@ def _crc_problem(body: str, crc_expected: bool | None) -> str | None:
     if len(body) < 4:
         return "missing CRC"
     if crc != ascii_crc(checked):
-        return f"CRC {escape(crc)} should be {escape(ascii_crc(checked))}"
+        return f"CRC '{escape(crc)}' should be '{escape(ascii_crc(checked))}'"
     return None
 
 

@@ -31,10 +31,17 @@ from .request import RecorderOutput, Request
 
 #: Longest trigger output kept as evidence (the DUT's words are untrusted and unbounded).
 MAX_OUTPUT = 4000
+MAX_STDERR = 600  # a failing trigger's own words, shown to the user as they are
 
 
 class RecorderDriverError(RuntimeError):
     """The recorder could not be made to act (trigger failed, timed out, no operator)."""
+
+
+class RecorderSetupError(RecorderDriverError):
+    """The driver failed and the recorder never spoke: the test setup is broken (a trigger
+    that cannot start, or exits non-zero before making the recorder act), not the recorder.
+    Judging the silent line would blame the recorder for the tool's setup (false FAILs)."""
 
 
 class Driver(Protocol):
@@ -84,8 +91,9 @@ class Trigger:
                 f"trigger did not finish within {self.timeout:g} s: {self.command}"
             ) from exc
         if done.returncode != 0:
+            said = done.stderr.strip()[:MAX_STDERR] or "(nothing on stderr)"
             raise RecorderDriverError(
-                f"trigger exited with {done.returncode}: {done.stderr.strip()[:200]}"
+                f"trigger {self.command!r} exited with {done.returncode}: {said}"
             )
         out = RecorderOutput()
         text = done.stdout[:MAX_OUTPUT].strip()

@@ -25,8 +25,15 @@ from ..judges.recorder import Line, merge_lines, read_line
 from ..links.base import Link, LinkError
 from ..ports import PortError, is_sim, parse_sim
 from ..sim.bus import Frame, SimBus, SimLink
-from ..transcript import TOOL, Event
-from .drivers import Driver, InProcess, Interactive, RecorderDriverError, Trigger
+from ..transcript import TOOL, Event, EventKind
+from .drivers import (
+    Driver,
+    InProcess,
+    Interactive,
+    RecorderDriverError,
+    RecorderSetupError,
+    Trigger,
+)
 from .faults import RECORDER_FAULTS, faulty_recorder
 from .played import build_sensors
 from .realtime import ServedLine, is_served, parse_served
@@ -119,7 +126,8 @@ class RecorderSession:
         elif driver.needs_real_time and not served:
             raise PortError(
                 f"a {driver.kind} recorder acts outside this process and cannot reach the "
-                "simulated bus; it needs a real port served in real time (not available yet)"
+                "simulated bus; serve the played sensors in real time with "
+                "--port rfc2217-serve://127.0.0.1:0 (the recorder connects to SDI12_PORT)"
             )
         self.driver = driver
         self.faults = faults
@@ -198,7 +206,18 @@ class RecorderSession:
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
         events = transcript.since(first)
+        self._check_setup(scenario, events, error)
         return ScenarioRun(scenario, events, output, error, tuple(played))
+
+    def _check_setup(self, scenario: Scenario, events: list[Event], error: str | None) -> None:
+        """A driver that failed while the recorder stayed silent is a setup error: stop."""
+        spoke = any(self.is_recorder(e) for e in events if e.kind is not EventKind.NOTE)
+        if error is None or spoke:
+            return
+        raise RecorderSetupError(
+            f"the {self.driver.kind} could not make the recorder act (scenario "
+            f"{scenario.name}, the recorder sent nothing): {error}"
+        )
 
     def _run_served(self, scenario: Scenario, line: ServedLine) -> ScenarioRun:
         """As :meth:`_run`, in real time: the played sensors go on the served line, the
@@ -220,6 +239,7 @@ class RecorderSession:
         end = line.now()
         line.bus.set_devices([])
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
+        self._check_setup(scenario, events, error)
         return ScenarioRun(scenario, events, output, error, tuple(played))
 
     def _act_served(self, scenario: Scenario, line: ServedLine) -> RecorderOutput:

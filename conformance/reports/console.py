@@ -211,6 +211,7 @@ def _coverage(data: dict[str, Any]) -> str:
     judged = sum(1 for r in testable if r["verdict"] in ("PASS", "FAIL", "WARN"))
     na = sum(1 for r in testable if r["verdict"] == "N/A")
     untestable = len(data["requirements"]) - len(testable)
+    left_out = sum(1 for r in testable if not r.get("selected", True))
     done = (
         f"{judged} testable requirements judged"
         if judged == len(testable)
@@ -218,7 +219,21 @@ def _coverage(data: dict[str, Any]) -> str:
     )
     if na:
         done += f", {na} N/A"
+    if data["run"].get("partial"):
+        done = (
+            f"partial run ({data['run'].get('selection')}): {done}, "
+            f"{left_out} not selected"
+        )
     return f"{done}, {untestable} untestable here (electrical, inspection or the other role)"
+
+
+PARTIAL = "partial run: the selected requirements only"
+
+
+def verdict_words(data: dict[str, Any]) -> str:
+    """The overall verdict, and for a partial run that it covers only the selection."""
+    verdict = data["summary"]["verdict"]
+    return f"{verdict} ({PARTIAL})" if data["run"].get("partial") else verdict
 
 
 def _counts_line(data: dict[str, Any]) -> str:
@@ -239,7 +254,7 @@ def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> N
         say(f"{verdict:<12} {which}: {one_line(reason)}")
     if data["run"].get("stop_reason"):
         say(f"{_stop_word(data)}: {data['run']['stop_reason']}")
-    say(f"verdict: {data['summary']['verdict']}")
+    say(f"verdict: {verdict_words(data)}")
     _paths(say, report_dir)
 
 
@@ -284,7 +299,12 @@ def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> No
     if data["run"].get("stop_reason"):
         console.print(f"{_stop_word(data)}: {data['run']['stop_reason']}", markup=False)
     console.print(
-        Text.assemble((f" {verdict} ", STYLE.get(verdict, "")), "  ", _counts_short(summary))
+        Text.assemble(
+            (f" {verdict} ", STYLE.get(verdict, "")),
+            "  ",
+            *([PARTIAL, "  "] if data["run"].get("partial") else []),
+            _counts_short(summary),
+        )
     )
     _paths(lambda text: console.print(text, markup=False, highlight=False), report_dir)
 

@@ -30,7 +30,7 @@ from .verdicts_json import dut_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
-TIMING_MODULES = ("test_7_timing.py::", "test_9_whole_run.py::")
+TIMING_MODULES = ("test_7_timing", "test_9_whole_run")
 
 STYLE = """
 <style>
@@ -74,6 +74,11 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
 .sdi12-diagram{overflow-x:auto;margin:4px 0 8px;border:1px solid #eee;background:#fff}
 .sdi12-wire,.sdi12-diagram{max-width:calc(100vw - 70px)}
 #sdi12-top a,.sdi12-case a{color:#1565c0}
+/* pytest-html's test-log leftovers: a certificate shows verdicts, not a test runner's tally */
+#environment-header,#environment{display:none}
+.filters input[disabled],.filters input[disabled]+span{display:none}
+td.extra:has(.sdi12-case) .logwrapper{display:none}
+tbody.sdi12-target{outline:3px solid #1565c0}
 </style>
 """
 
@@ -87,7 +92,22 @@ SCRIPT = """
   var results=document.getElementById('results-table');
   if(envh&&env&&results){results.parentNode.insertBefore(envh,results.nextSibling);
     envh.parentNode.insertBefore(env,envh.nextSibling);}
-  var h=document.querySelector('.summary__data h2'); if(h) h.textContent='Test cases';
+  var h=document.querySelector('.summary__data h2');
+  if(h) h.textContent='Evidence: the conformance cases';
+  function findCase(name){var hit=null;
+    document.querySelectorAll('#results-table tbody.results-table-row').forEach(function(b){
+      if(b.id&&(b.id===name||b.id.slice(-name.length-2)==='::'+name)) hit=b;});
+    return hit;}
+  function openCase(name){var b=findCase(name); if(!b) return;
+    var closed=b.querySelector('.collapsible > .col-result.collapsed');
+    if(closed){closed.click(); b=findCase(name);}
+    if(!b) return;
+    document.querySelectorAll('tbody.sdi12-target').forEach(function(o){
+      o.classList.remove('sdi12-target');});
+    b.classList.add('sdi12-target'); b.scrollIntoView(); window.scrollBy(0,-8);}
+  document.addEventListener('click',function(e){
+    var a=e.target.closest&&e.target.closest('a[data-sdi12-case]'); if(!a) return;
+    e.preventDefault(); openCase(a.dataset.sdi12Case);});
   var t=document.getElementById('sdi12-requirements'); if(!t) return;
   var f=document.getElementById('sdi12-filter'), v=document.getElementById('sdi12-verdict-filter');
   var shown=document.getElementById('sdi12-shown');
@@ -116,7 +136,7 @@ SCRIPT = """
 
 
 def verdict_class(verdict: str) -> str:
-    return "v-NA" if verdict == "N/A" else f"v-{verdict}"
+    return "v-NA" if verdict in ("N/A", "NOT SELECTED") else f"v-{verdict}"
 
 
 def _verdict_cell(verdict: str) -> str:
@@ -127,7 +147,8 @@ def _verdict_cell(verdict: str) -> str:
 def _tally(results: list[RequirementResult]) -> dict[str, int]:
     tally = dict.fromkeys(SEVERITY, 0)
     for r in results:
-        tally[str(r.verdict)] = tally.get(str(r.verdict), 0) + 1
+        if r.selected:  # a partial run counts what it selected
+            tally[str(r.verdict)] = tally.get(str(r.verdict), 0) + 1
     return tally
 
 
@@ -140,6 +161,13 @@ def banner(run: ConformanceRun) -> str:
     counts = ", ".join(f"{n} {k}" for k, n in tally.items() if n)
     testable = sum(1 for r in results if r.requirement.testable(run.options.role))
     line = f"{counts} — {len(results)} requirements, {testable} testable by this tool"
+    left_out = sum(1 for r in results if not r.selected)
+    if run.selection.partial:
+        verdict = f"{verdict} · partial run"
+        line += (
+            f" — partial run ({run.selection.describe()}): {left_out} requirements not "
+            "selected; the verdict covers the selected ones only"
+        )
     if run.stop_reason:
         line += f" — {'note' if run.complete else 'stopped'}: {run.stop_reason}"
     who = f"{_who(run)} · port {run.options.port} · {run.finished or run.started}"
@@ -248,7 +276,7 @@ def attention(run: ConformanceRun) -> str:
     bad = [r for r in results if str(r.verdict) in SEVERITY[:4]]
     bad.sort(key=lambda r: SEVERITY.index(str(r.verdict)))
     bad = reading_order(bad)  # root causes first, each followed by what it drags
-    na = sum(1 for r in results if r.verdict is Verdict.NA)
+    na = sum(1 for r in results if r.verdict is Verdict.NA and r.selected)
     na_link = (
         f"<p>{na} requirements are N/A (not applicable to this DUT, or not testable by this tool):"
         ' <a href="#sdi12-requirements" data-sdi12-show="N/A">show them with their reasons</a>.</p>'
@@ -290,19 +318,25 @@ def _attention_item(group: list[RequirementResult]) -> str:
         listed = ", ".join(r.requirement.id for r in group)
         ids = f"{len(group)} requirements: <b>{escape(listed)}</b>"
     tests = sorted({t.split("::")[-1] for r in group for t in r.tests})
-    where = f' <span class="tests">[{escape(", ".join(tests))}]</span>' if tests else ""
+    links = ", ".join(case_link(t) for t in tests)
+    where = f' <span class="tests">[evidence: {links}]</span>' if tests else ""
     return (
         f'<li><span class="{verdict_class(verdict)}">{escape(verdict)}</span> {ids}: '
         f"{escape(_reason(group[0]))}{where}</li>"
     )
 
 
+def case_link(name: str) -> str:
+    """A link that opens the case's row in the evidence table below and scrolls to it."""
+    return f'<a href="#" data-sdi12-case="{escape(name)}">{escape(name)}</a>'
+
+
 def requirements_table(run: ConformanceRun) -> str:
     rows = []
     for r in run.results or []:
         req = r.requirement
-        verdict = str(r.verdict)
-        tests = "<br>".join(escape(t.split("::")[-1]) for t in r.tests) or "—"
+        verdict = str(r.verdict) if r.selected else "NOT SELECTED"
+        tests = "<br>".join(case_link(t.split("::")[-1]) for t in r.tests) or "—"
         extra = len(r.findings) - 1
         evidence = escape(r.one_line) + (f" <i>(+{extra} findings)</i>" if extra > 0 else "")
         rows.append(
@@ -310,7 +344,8 @@ def requirements_table(run: ConformanceRun) -> str:
             f"<td>{escape(req.clause)}</td><td>{escape(req.level)}</td>{_verdict_cell(verdict)}"
             f"<td>{escape(req.statement)}</td><td>{evidence}</td><td>{tests}</td></tr>"
         )
-    options = "".join(f'<option value="{escape(v)}">{escape(v)}</option>' for v in SEVERITY)
+    shown = SEVERITY + (("NOT SELECTED",) if run.selection.partial else ())
+    options = "".join(f'<option value="{escape(v)}">{escape(v)}</option>' for v in shown)
     return (
         "<h2>Requirements</h2>"
         '<div class="sdi12-controls">Filter: <input id="sdi12-filter" '
@@ -380,8 +415,9 @@ def _group(events: list[Event]) -> list[list[Event]]:
 
 def is_timing_case(record: CaseRecord) -> bool:
     """Cases of section 7 / the whole-run timing module, or any case with a measured time."""
+    module = record.nodeid.split("::")[0].removesuffix(".py").replace("/", ".")
     return any(f.measured_ms is not None for f in record.findings) or any(
-        m in record.nodeid for m in TIMING_MODULES
+        module.rsplit(".", 1)[-1] == m for m in TIMING_MODULES
     )
 
 

@@ -25,32 +25,38 @@ from ..protocol.timing import (
     NO_BREAK_WINDOW,
     RESPONSE_START_MAX,
     RESPONSE_START_MIN,
+    STANDBY_MARKING,
     TOLERANCE,
 )
 from ..transcript import TOOL, Event, EventKind
 from ..transcript import escape as escape_wire
 from ..verdicts import Finding
 
-PX_PER_MS = 3.0  # one 8.33 ms character is 25 px: room for its glyph
+PX_PER_MS = 5.0  # one 8.33 ms character is 42 px: room for "CR"/"LF" at reading size
 ELIDE_OVER = 0.14  # s: idle stretches longer than this are cut out of the axis
-ELIDED_PX = 48
-LEFT = 64  # px for the lane names
+ELIDED_PX = 64
+LEFT = 84  # px for the lane names
 PAD_BEFORE, PAD_AFTER = 0.004, 0.018  # s around each cluster (the window ends 15.4 ms late)
 MAX_EVENTS = 240  # a diagram is for reading one exchange, not a whole run
 GAP_SHOWN = 0.05e-3  # s: character gaps shorter than this are not annotated
 
 # rows (y of the top edge) and lane height
-Y_LEGEND, Y_TOP_LABEL, Y_TOOL, Y_MID_LABEL, Y_DUT, Y_GAP_LABEL, Y_AXIS = (
-    10,
-    30,
-    36,
-    70,
-    78,
-    110,
-    118,
+Y_LEGEND, Y_TOP_LABEL, Y_TOOL, Y_MID_LABEL, Y_DUT, Y_GAP_LABEL, Y_LINE, Y_AXIS = (
+    16,
+    46,
+    54,
+    102,
+    114,
+    160,
+    172,
+    212,
 )
-LANE_H = 18
-HEIGHT = 146
+LANE_H = 28
+LINE_H = 12  # the "line after a reply" lane: the 87 ms and 100 ms windows
+HEIGHT = 246
+FONT = 13  # labels; glyphs in the lanes are larger
+#: after a reply the axis keeps this much of the line drawn, so the windows show
+AFTER_REPLY = STANDBY_MARKING + 4e-3
 
 COLOURS = {
     "tool": "#1565c0",
@@ -59,6 +65,7 @@ COLOURS = {
     "window": "#43a047",
     "bad": "#c62828",
     "axis": "#555",
+    "follow": "#7e57c2",
 }
 
 
@@ -78,14 +85,18 @@ class _Piece:
 class Axis:
     """Piecewise-linear time axis: clusters of activity drawn to scale, idle cut out."""
 
-    def __init__(self, events: Sequence[Event]) -> None:
+    def __init__(self, events: Sequence[Event], keep_after: Sequence[float] = ()) -> None:
+        """``keep_after``: times (reply ends) whose next :data:`AFTER_REPLY` s stay drawn."""
         self.t0 = events[0].start
+        spans = sorted(
+            [(e.start, e.end) for e in events] + [(t, t + AFTER_REPLY) for t in keep_after]
+        )
         clusters: list[list[float]] = []
-        for e in events:
-            if clusters and e.start - clusters[-1][1] <= ELIDE_OVER:
-                clusters[-1][1] = max(clusters[-1][1], e.end)
+        for start, end in spans:
+            if clusters and start - clusters[-1][1] <= ELIDE_OVER:
+                clusters[-1][1] = max(clusters[-1][1], end)
             else:
-                clusters.append([e.start, e.end])
+                clusters.append([start, end])
         self.pieces: list[_Piece] = []
         x = float(LEFT)
         for i, (start, end) in enumerate(clusters):
@@ -136,29 +147,31 @@ LEGEND = (
     ("dut", "sensor → recorder"),
     ("break", "break"),
     ("window", "reply must start in 7.93–15.40 ms"),
+    ("follow", "after a reply: next command without break ≤ 87 ms; standby after 100 ms"),
     ("bad", "out of limits"),
 )
-LEGEND_WIDTH = LEFT + sum(24 + 5.3 * len(label) for _, label in LEGEND)
+LEGEND_WIDTH = LEFT + sum(30 + 6.2 * len(label) for _, label in LEGEND)
 
 
 def _legend() -> str:
     out, x = [], float(LEFT)
     for key, label in LEGEND:
-        opacity = ' fill-opacity="0.25"' if key == "window" else ""
+        opacity = ' fill-opacity="0.25"' if key in ("window", "follow") else ""
         out.append(
-            f'<rect x="{x:.0f}" y="{Y_LEGEND - 8}" width="10" height="9" '
+            f'<rect x="{x:.0f}" y="{Y_LEGEND - 10}" width="12" height="11" '
             f'fill="{COLOURS[key]}"{opacity}/>'
         )
-        out.append(_text(x + 14, Y_LEGEND, label, size=10, anchor="start"))
-        x += 24 + 5.3 * len(label)
+        out.append(_text(x + 16, Y_LEGEND, label, size=FONT, anchor="start"))
+        x += 30 + 6.2 * len(label)
     return "".join(out)
 
 
 def _lanes(axis: Axis) -> str:
     out = []
+    out.append(_text(4, Y_LINE + LINE_H - 1, "line idle", size=FONT - 1, anchor="start"))
     for y, name in ((Y_TOOL, "recorder"), (Y_DUT, "sensor")):
         mid = y + LANE_H / 2
-        out.append(_text(4, mid + 4, name, size=11, anchor="start", font_weight="bold"))
+        out.append(_text(4, mid + 5, name, size=14, anchor="start", font_weight="bold"))
         out.append(
             f'<line x1="{LEFT}" y1="{y + LANE_H}" x2="{axis.width - 8:.1f}" y2="{y + LANE_H}" '
             'stroke="#bbb" stroke-width="1"/>'
@@ -180,8 +193,8 @@ def _axis(axis: Axis) -> str:
                 f'<line x1="{x:.1f}" y1="{Y_AXIS}" x2="{x:.1f}" y2="{Y_AXIS + 4}" '
                 f'stroke="{COLOURS["axis"]}"/>'
             )
-            if x - last_label >= 44:
-                out.append(_text(x, Y_AXIS + 15, f"{ms} ms", size=9, fill=COLOURS["axis"]))
+            if x - last_label >= 60:
+                out.append(_text(x, Y_AXIS + 18, f"{ms} ms", size=12, fill=COLOURS["axis"]))
                 last_label = x
     for x, cut in axis.elisions():
         for dx in (-4, 4):
@@ -191,10 +204,10 @@ def _axis(axis: Axis) -> str:
             )
         label = f"{cut:.2f} s" if cut >= 1 else f"{cut * 1e3:.0f} ms"
         out.append(
-            f'<rect x="{x - 22:.1f}" y="{Y_MID_LABEL - 19}" width="44" height="24" fill="#fff"/>'
+            f'<rect x="{x - 30:.1f}" y="{Y_MID_LABEL - 26}" width="60" height="32" fill="#fff"/>'
         )
-        out.append(_text(x, Y_MID_LABEL - 9, "idle", size=9, fill="#666"))
-        out.append(_text(x, Y_MID_LABEL + 1, label, size=9, fill="#666"))
+        out.append(_text(x, Y_MID_LABEL - 12, "idle", size=12, fill="#666"))
+        out.append(_text(x, Y_MID_LABEL + 2, label, size=12, fill="#666"))
     return "".join(out)
 
 
@@ -211,7 +224,7 @@ def _char(axis: Axis, e: Event) -> str:
         f'<g><title>{escape(tip)}</title><rect x="{x0:.1f}" y="{y}" '
         f'width="{max(1.0, x1 - x0):.1f}" '
         f'height="{LANE_H}" fill="{COLOURS[who]}" stroke="{stroke}" stroke-width="1"/>'
-        + _text((x0 + x1) / 2, y + 13, glyph, size=11 if len(glyph) == 1 else 7, fill="#fff")
+        + _text((x0 + x1) / 2, y + 20, glyph, size=16 if len(glyph) == 1 else 13, fill="#fff")
         + "</g>"
     )
 
@@ -226,7 +239,7 @@ def _break(axis: Axis, e: Event, following: Event | None) -> str:
             x0,
             Y_TOP_LABEL,
             f"break {_ms(e.duration)}",
-            size=10,
+            size=FONT,
             anchor="start",
             fill=COLOURS["break"],
         ),
@@ -243,7 +256,7 @@ def _break(axis: Axis, e: Event, following: Event | None) -> str:
                 (x1 + fx) / 2,
                 Y_MID_LABEL + 2,
                 f"marking {_ms(marking)}",
-                size=9,
+                size=FONT - 1,
                 fill=COLOURS["break"],
             )
         )
@@ -273,7 +286,12 @@ def _window(axis: Axis, command_end: float, reply: Event | None) -> str:
         )
         out.append(
             _text(
-                rx + 3, Y_MID_LABEL - 2, f"reply +{_ms(delay)}", size=9, anchor="start", fill=colour
+                rx + 4,
+                Y_MID_LABEL - 2,
+                f"reply +{_ms(delay)}",
+                size=FONT,
+                anchor="start",
+                fill=colour,
             )
         )
     return "".join(out)
@@ -286,7 +304,7 @@ def _gap(axis: Axis, a: Event, b: Event) -> str:
     return (
         f'<path d="M{x0:.1f},{Y_DUT + LANE_H + 2} v4 H{x1:.1f} v-4" fill="none" '
         f'stroke="{colour}"/>'
-        + _text((x0 + x1) / 2, Y_GAP_LABEL, f"gap {_ms(gap)}", size=9, fill=colour)
+        + _text((x0 + x1) / 2, Y_GAP_LABEL, f"gap {_ms(gap)}", size=FONT - 1, fill=colour)
     )
 
 
@@ -308,7 +326,63 @@ def _marking_before_commands(axis: Axis, events: Sequence[Event]) -> str:
             f'<path d="M{x0:.1f},{Y_TOOL - 2} v-4 H{x1:.1f} v4" fill="none" '
             f'stroke="{COLOURS["axis"]}"/>'
         )
-        out.append(_text((x0 + x1) / 2, Y_TOP_LABEL - 3, f"marking {_ms(idle)}", size=9))
+        out.append(_text((x0 + x1) / 2, Y_TOP_LABEL - 4, f"marking {_ms(idle)}", size=FONT - 1))
+    return "".join(out)
+
+
+def _reply_ends(events: Sequence[Event]) -> list[tuple[float, Event | None]]:
+    """(end of a sensor reply, the recorder's next event or None): a reply ends where its
+    last character is followed by a recorder event, or by nothing."""
+    out = []
+    for i, e in enumerate(events):
+        if e.kind is not EventKind.CHAR or e.origin == TOOL:
+            continue
+        later = [f for f in events[i + 1 :] if f.kind is not EventKind.NOTE]
+        if later and later[0].origin != TOOL:
+            continue  # more sensor output follows: not the end of the reply
+        out.append((e.end, later[0] if later else None))
+    return out
+
+
+def _after_reply(axis: Axis, end: float, following: Event | None) -> str:
+    """The line after a reply: up to 87 ms the recorder may send the next command without a
+    break (R-7.0-16/17); after 100 ms of marking the sensor is in standby (R-7.0-15). Drawn
+    as a band with both limits marked, and where the recorder's next event came."""
+    x0 = axis.x(end)
+    x87, x100 = axis.x(end + NO_BREAK_WINDOW), axis.x(end + STANDBY_MARKING)
+    colour = COLOURS["follow"]
+    out = [
+        f"<g><title>after the reply: next command without a break within "
+        f"{_ms(NO_BREAK_WINDOW)}; the sensor is in standby after {_ms(STANDBY_MARKING)} of "
+        f'marking</title><rect x="{x0:.1f}" y="{Y_LINE}" width="{x87 - x0:.1f}" '
+        f'height="{LINE_H}" fill="{colour}" fill-opacity="0.3"/></g>'
+    ]
+    for x, label, anchor in ((x87, "87 ms", "end"), (x100, "100 ms", "start")):
+        out.append(
+            f'<line x1="{x:.1f}" y1="{Y_LINE - 4}" x2="{x:.1f}" y2="{Y_LINE + LINE_H + 4}" '
+            f'stroke="{colour}" stroke-width="2"/>'
+        )
+        dx = -3 if anchor == "end" else 3
+        out.append(
+            _text(x + dx, Y_LINE + LINE_H + 16, label, size=FONT - 1, anchor=anchor, fill=colour)
+        )
+    if following is not None and following.start - end <= AFTER_REPLY:
+        fx = axis.x(following.start)
+        what = "break" if following.kind is EventKind.BREAK else "next command"
+        out.append(
+            f'<line x1="{fx:.1f}" y1="{Y_TOOL}" x2="{fx:.1f}" y2="{Y_LINE + LINE_H}" '
+            f'stroke="{colour}" stroke-dasharray="4 3"/>'
+        )
+        out.append(
+            _text(
+                fx + 3,
+                Y_LINE - 3,
+                f"{what} +{_ms(following.start - end)}",
+                size=FONT - 1,
+                anchor="start",
+                fill=colour,
+            )
+        )
     return "".join(out)
 
 
@@ -362,8 +436,11 @@ def timing_svg(events: Iterable[Event], title: str = "") -> str:
     if len(drawn) > MAX_EVENTS:
         note = f"first {MAX_EVENTS} of {len(drawn)} bus events drawn"
         drawn = drawn[:MAX_EVENTS]
-    axis = Axis(drawn)
+    ends = _reply_ends(drawn)
+    axis = Axis(drawn, [end for end, _next in ends])
     parts = [_legend(), _lanes(axis)]
+    for end, following in ends:
+        parts.append(_after_reply(axis, end, following))
     for end, reply in _exchanges(drawn):
         parts.append(_window(axis, end, reply))
     for i, e in enumerate(drawn):
@@ -379,7 +456,7 @@ def timing_svg(events: Iterable[Event], title: str = "") -> str:
         parts.append(_gap(axis, a, b))
     parts.append(_axis(axis))
     if note:
-        parts.append(_text(axis.width - 10, HEIGHT - 2, note, size=9, anchor="end", fill="#666"))
+        parts.append(_text(axis.width - 10, HEIGHT - 4, note, size=12, anchor="end", fill="#666"))
     label = escape(title or "timing diagram")
     width = max(axis.width, LEGEND_WIDTH)
     return (

@@ -23,6 +23,8 @@ def dut_block(run: ConformanceRun) -> dict[str, Any]:
     if session and session.ident_exchange is not None and session.ident_exchange.answered:
         raw = session.ident_exchange.reply_text
     version = session.version if session else None
+    if run.options.role == "sensor" and session and not (ident or session.forced_version):
+        version = None  # nothing answered aI! and nobody forced a rule set: no claim to show
     return {
         "address": session.address if session else run.options.address,
         "identification": raw,
@@ -67,6 +69,8 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             "strict": run.options.strict,
             "complete": run.complete,
             "stop_reason": run.stop_reason or None,
+            "partial": run.selection.partial,
+            "selection": run.selection.describe() if run.selection.partial else None,
             "bus": bus_block(run),
         },
         "dut": dut_block(run),
@@ -79,6 +83,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "statement": r.requirement.statement,
                 "testable": r.requirement.testable(run.options.role),
                 "verdict": str(r.verdict),
+                "selected": r.selected,
                 "tests": r.tests,
                 "findings": [_finding(f) for f in r.findings],
                 "consequence_of": r.consequence_of,

@@ -1,0 +1,98 @@
+"""Checks of a run's settings before anything goes onto the bus or pytest starts.
+
+A mistake in the settings is the user's to fix, so each check raises :class:`UsageError` with
+one line saying what is wrong and what to type instead; the command line turns it into exit
+4, the pytest plugin into pytest's own usage error. Nothing here touches a port.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from .protocol.commands import ADDRESS_CHARS
+
+ALLOWED_ADDRESSES = "0-9, A-Z, a-z"
+
+
+class UsageError(ValueError):
+    """A setting the tool cannot use; the message says what to do instead."""
+
+
+def address_problem(text: object) -> str | None:
+    """Why ``text`` is not an SDI-12 address (one of 0-9, A-Z, a-z), or None if it is one."""
+    if isinstance(text, str) and len(text) == 1 and text in ADDRESS_CHARS:
+        return None
+    return f"{text!r} is not an SDI-12 address: use one character of {ALLOWED_ADDRESSES}"
+
+
+def check_address(text: str | None, where: str = "--address") -> None:
+    """An invalid address would go onto the bus (``00I!``) and look like a silent device."""
+    problem = None if text is None else address_problem(text)
+    if problem:
+        raise UsageError(f"{where}: {problem}")
+
+
+def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") -> None:
+    """A stamp uncertainty is a non-negative width; a negative one would tighten every limit."""
+    if ms is not None and not ms >= 0:  # `not >=` also rejects NaN
+        raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
+
+
+def check_role_options(
+    role: str, port: str, trigger: str | None, address: str | None = None
+) -> None:
+    """Settings that only mean something in the other role are mistakes, not no-ops."""
+    from .ports import is_sim, parse_sim
+
+    if role == "recorder" and address:
+        raise UsageError(
+            "--address picks the sensor to judge (--role sensor); in the recorder role the "
+            "tool plays the sensors at the addresses its scenarios need"
+        )
+    if role == "sensor" and trigger:
+        raise UsageError(
+            "--trigger makes a data recorder act (--role recorder); a sensor needs no trigger"
+        )
+    if not is_sim(port):
+        return
+    spec = parse_sim(port)
+    if role == "recorder" and spec.faults:
+        raise UsageError(
+            "sim://?faults= breaks the simulated sensor judged in the sensor role; in the "
+            f"recorder role use sim://?recorder-faults=NAME ({_recorder_fault_names()})"
+        )
+    other = sorted(set(spec.extra) & {"recorder-faults", "recorder"})
+    if role == "sensor" and other:
+        raise UsageError(
+            f"sim://?{other[0]}= belongs to the recorder role (--role recorder); "
+            "for a faulty simulated sensor use sim://?faults=NAME"
+        )
+
+
+def check_report_dir(path: Path) -> Path:
+    """Create ``path`` and prove a file can be written there, before a run that would fail
+    only at its end (after minutes on a real bench) with nowhere to put its report."""
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=path)
+        os.close(fd)
+        os.unlink(probe)
+    except FileExistsError:
+        raise UsageError(
+            f"report folder {path} exists as a file; pass a folder with --report-dir DIR"
+        ) from None
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise UsageError(
+            f"cannot write reports to {path} ({reason}); pass a writable folder with "
+            "--report-dir DIR"
+        ) from None
+    return path
+
+
+def _recorder_fault_names() -> str:
+    from .recorder.faults import RECORDER_FAULTS
+
+    return ", ".join(sorted(RECORDER_FAULTS))
