@@ -79,7 +79,7 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
         @rule(code=st.sampled_from(OWN))
         def own_command(self, code: str) -> None:
             ex = self._send(code)
-            if code in ("M", "MC", "C", "CC"):
+            if code[:1] in ("M", "C", "V", "H"):
                 self.last_d0 = None  # a new measurement may change the data
             if not ex.answered:
                 return
@@ -114,6 +114,9 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             self._note(f"{escape(ex.text)} (malformed?) -> '{escape(ex.reply_text)}'")
             if ex.answered:  # decision A12: silence or any well-framed reply is fine
                 self._check_framing(ex)
+                # junk can spell a real command ("M", or "-7!0MC" ending in one): whatever
+                # the sensor accepted may have started a measurement
+                self.last_d0 = None
 
         @rule()
         def brk(self) -> None:
