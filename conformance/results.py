@@ -43,8 +43,8 @@ class RequirementResult:
     findings: list[Finding]
     tests: list[str]
     judged: bool = True  # False: testable, but no case of this run looked at it
-    consequence_of: str | None = None  # a FAILed rule whose deviation probably caused this
     selected: bool = True  # False: a partial run (-k, --req) left out every case judging it
+    consequence_of: str | None = None  # a FAILed rule whose deviation probably caused this
 
     @property
     def one_line(self) -> str:
@@ -86,7 +86,7 @@ def aggregate(
         judged = not (req.testable(role) and req.id not in by_id)
         selected = judged or req.id not in not_selected
         tested = sorted(set(tests.get(req.id, [])))
-        results.append(RequirementResult(req, verdict, findings, tested, judged, selected))
+        results.append(RequirementResult(req, verdict, findings, tested, judged, selected=selected))
     return results
 
 
