@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
 
 from .master.records import Exchange
+from .protocol.commands import CommandError, Kind, parse_command
 from .protocol.crc import is_crc_char
 from .protocol.responses import parse_data_reply, split_line
 from .sensor_session import SensorSession
@@ -31,7 +32,21 @@ from .transcript import escape
 #: inside another exchange.
 OWN = ("", "I", "M", "MC", "C", "CC", "D0", "R0", "RC0")
 FOREIGN_FORMS = ("", "I", "M", "D0", "C")
-JUNK = st.text(alphabet=st.sampled_from("MDCRIVXAB0123456789+-._#"), min_size=1, max_size=6)
+
+
+def _harmless(junk: str) -> bool:
+    """Junk may spell a real command; never one that changes the device: a change of address
+    (``aAb!``) or an extended command (``aX...!``, opt-in only: it may reconfigure a unit)."""
+    try:
+        kind = parse_command(f"0{junk}!").kind
+    except CommandError:
+        return not junk.startswith("X")
+    return kind not in (Kind.CHANGE_ADDRESS, Kind.EXTENDED)
+
+
+JUNK = st.text(alphabet=st.sampled_from("MDCRIVXAB0123456789+-._#"), min_size=1, max_size=6).filter(
+    _harmless
+)
 IDS = ("R-4.0-01", "R-4.3-01", "R-4.2-03", "R-4.4.12-05", "R-4.4.12-06", "R-4.4.5-10")
 
 
@@ -65,6 +80,16 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             self.trail: list[str] = []
             self.last_d0: str | None = None  # D0 reply since the last measurement command
             sensor.master.send_break()
+
+        def _broken(self, requirement: str, message: str) -> InvariantBroken:
+            """The invariant that broke, kept as soon as it is seen: hypothesis replays a
+            failing example to confirm it, and a real device, whose state moved on, may then
+            behave otherwise (hypothesis calls that flaky); the first observation stands."""
+            exc = InvariantBroken(requirement, message)
+            if record.broken is None:
+                record.broken = exc
+                record.failing_sequence = list(self.trail)
+            return exc
 
         def _note(self, text: str) -> None:
             self.trail.append(text)
@@ -101,7 +126,7 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             self._note(f"{escape(ex.text)} (foreign) -> '{escape(ex.reply_text)}'")
             record.checked["R-4.0-01"] += 1
             if ex.answered:
-                raise InvariantBroken(
+                raise self._broken(
                     "R-4.0-01",
                     f"answered {escape(ex.text)}, a command for "
                     f"address '{other}', with '{escape(ex.reply_text)}'",
@@ -133,12 +158,12 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             record.checked["R-4.2-03"] += 1
             record.checked["R-4.3-01"] += 1
             if [v for v in framing if v.requirement == "R-4.2-03"]:
-                raise InvariantBroken(
+                raise self._broken(
                     "R-4.2-03",
                     f"reply to {escape(ex.text)} '{escape(ex.reply_text)}' does not end in CR LF",
                 )
             if body[:1] != address:
-                raise InvariantBroken(
+                raise self._broken(
                     "R-4.3-01",
                     f"reply to {escape(ex.text)} starts with '{escape(body[:1])}', not '{address}'",
                 )
@@ -152,12 +177,12 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
                 record.checked[rid] += 1
                 bad = [v for v in reply.violations if v.requirement == rid]
                 if bad:
-                    raise InvariantBroken(rid, f"reply to {escape(ex.text)}: {bad[0].message}")
+                    raise self._broken(rid, f"reply to {escape(ex.text)}: {bad[0].message}")
 
         def _check_repeat(self, ex: Exchange) -> None:
             record.checked["R-4.4.5-10"] += 1
             if self.last_d0 is not None and ex.reply_text != self.last_d0:
-                raise InvariantBroken(
+                raise self._broken(
                     "R-4.4.5-10",
                     f"D0 gave '{escape(self.last_d0)}', then "
                     f"'{escape(ex.reply_text)}' with no measurement between",
@@ -166,7 +191,8 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
 
         def teardown(self) -> None:
             record.log.append(" ; ".join(self.trail))
-            record.failing_sequence = list(self.trail)
+            if record.broken is None:  # after a break, the sequence that broke it stays
+                record.failing_sequence = list(self.trail)
 
     keep_hypothesis_out_of_the_working_folder()
     try:
@@ -185,8 +211,8 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             ),
         )
     except BaseException as exc:  # hypothesis may wrap the failure; find ours inside
-        broken = _first_broken(exc)
-        if broken is None:
+        broken = record.broken or _first_broken(exc)
+        if broken is None or isinstance(exc, KeyboardInterrupt):
             raise
         record.broken = broken
     return record

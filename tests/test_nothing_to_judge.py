@@ -51,7 +51,7 @@ def test_no_should_or_may_rule_can_fail(rid):
         assert verdict in (Verdict.FAIL, Verdict.NA)
 
 
-def _silent_bus(port: str) -> OpenedPort:
+def _silent_bus(port: str, **_bench: str) -> OpenedPort:
     """The sim bus with nothing on it that ever transmits, declared like the emulator."""
     declared = sim_declaration(default_profile("14"), SimSpec())
     return OpenedPort(SimLink(SimBus([LineMonitor()])), [], declared)

@@ -35,7 +35,7 @@ PAYLOADS = """(function(){
 })()"""
 
 
-def hostile_port(port: str) -> OpenedPort:
+def hostile_port(port: str, **_bench: str) -> OpenedPort:
     """The reference sensor, but its identification and extended replies are markup.
 
     The identification fields are overwritten past the profile's width checks on purpose: a

@@ -42,7 +42,7 @@ from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
-ECHO_WAIT = 0.1  # s: beyond the latency floor, how long an echo may take to come back
+ECHO_WAIT = 0.02  # s: beyond the latency bound, how long an echo may take to come back
 BURST_MARGIN = 0.5e-3  # s: arrivals this much closer than latency jitter explains are a burst
 RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
 RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release

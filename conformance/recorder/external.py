@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import sys
 
+from ..links.echo import EchoMode
 from ..links.factory import open_real_link
 from .faults import faulty_recorder
 from .scenarios import SCENARIOS
@@ -27,7 +28,7 @@ def main(environ: dict[str, str] | None = None) -> int:
         return 2
     fault = env.get("SDI12_RECORDER_FAULT", "")
     program = faulty_recorder((fault,) if fault else ())
-    link = open_real_link(port)
+    link = open_real_link(port, echo=EchoMode.OFF)  # the served line of played sensors
     try:
         output = program(SCENARIOS[scenario].request, link)
     finally:

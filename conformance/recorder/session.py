@@ -245,9 +245,11 @@ class RecorderSession:
     def _act_served(self, scenario: Scenario, line: ServedLine) -> RecorderOutput:
         if self.driver.needs_real_time:  # an external recorder connects to line.url itself
             return self.driver.act(scenario.name, scenario.request, line)  # type: ignore[arg-type]
+        from ..links.echo import EchoMode
         from ..links.factory import open_real_link
 
-        link = open_real_link(line.url, self.uncertainty)
+        # the golden recorder on the served line: no interface in between, nothing echoes
+        link = open_real_link(line.url, self.uncertainty, echo=EchoMode.OFF)
         try:
             return self.driver.act(scenario.name, scenario.request, link)
         finally:
