@@ -103,6 +103,15 @@ def open_port(port: str) -> OpenedPort:
             f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
             "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
         )
+    if port.startswith(("exec:", "unix:")):  # a harness in another process, virtual time
+        from .harness.device import open_sensor_harness
+        from .harness.channel import HarnessError
+        from .links.errors import PortUnavailable
+
+        try:
+            return OpenedPort(open_sensor_harness(port))
+        except HarnessError as exc:
+            raise PortUnavailable(str(exc)) from exc
     from .links.factory import open_real_link
 
     return OpenedPort(open_real_link(port))
