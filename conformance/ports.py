@@ -104,8 +104,8 @@ def open_port(port: str) -> OpenedPort:
             "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
         )
     if port.startswith(("exec:", "unix:")):  # a harness in another process, virtual time
-        from .harness.device import open_sensor_harness
         from .harness.channel import HarnessError
+        from .harness.device import open_sensor_harness
         from .links.errors import PortUnavailable
 
         try:

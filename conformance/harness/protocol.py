@@ -103,7 +103,7 @@ def parse_hello(text: str) -> str:
     if not parts or parts[0] != "hello":
         raise HarnessProtocolError("expected 'hello 1 [name]' as the first reply", text)
     if len(parts) < 2 or parts[1] != str(VERSION):
-        raise HarnessProtocolError(f"harness speaks another protocol version (want {VERSION})", text)
+        raise HarnessProtocolError(f"harness speaks another protocol version, not {VERSION}", text)
     return parts[2] if len(parts) > 2 else ""
 
 
