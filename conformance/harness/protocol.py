@@ -64,8 +64,8 @@ def hello(role: Role) -> str:
     return f"hello {VERSION} {role}"
 
 
-def job(task: str, commands: tuple[str, ...]) -> str:
-    return " ".join(("job", task, *commands))
+def job(now: float, task: str, commands: tuple[str, ...]) -> str:
+    return " ".join(("job", str(us(now)), task, *commands))
 
 
 def line_break(start: float, end: float) -> str:
