@@ -1,0 +1,233 @@
+"""The harness link (``--port exec:`` / ``unix:``): exact verdicts through another process, and
+every way a harness can fail (crash, hang, flood, garbage, early exit) ends as a bounded ERROR
+with the harness's stderr tail, never a traceback, a hang, a verdict about the DUT, or a zombie.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from conformance.harness.channel import HarnessError
+from conformance.harness.device import open_sensor_harness
+from conformance.links.errors import PortUnavailable
+from conformance.matrix import run_once
+from conformance.ports import open_port
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: A sensor harness (the reference sensor) that misbehaves at message number ``AT``.
+MISBEHAVING = textwrap.dedent(
+    """
+    import os, sys, time
+    from pathlib import Path
+    from conformance.emulator import SensorEmulator, default_profile
+
+    MODE, AT = sys.argv[1], int(sys.argv[2])
+    if len(sys.argv) > 3:
+        Path(sys.argv[3]).write_text(str(os.getpid()))
+    sensor = SensorEmulator(default_profile())
+
+    def plan(now):
+        f = sensor.next_frame()
+        return "idle" if f is None else f"tx {max(round(f.start * 1e6), now)} {f.wire:02x}"
+
+    for n, line in enumerate(sys.stdin):
+        word, *fields = line.split()
+        if n == AT:
+            print(f"harness goes {MODE} at message {n}: {line.strip()}", file=sys.stderr)
+            sys.stderr.flush()
+            if MODE == "crash":
+                os.abort()
+            if MODE == "exit":
+                sys.exit(0)
+            if MODE == "hang":
+                time.sleep(3600)
+            if MODE == "flood":
+                while True:
+                    print("idle", flush=True)
+            if MODE == "garbage":
+                print("\\x00\\x7f\\x1b[31mGARBAGE", flush=True)
+            if MODE == "twice":
+                print("idle\\nidle", flush=True)
+            if MODE == "badbyte":
+                print("tx 99999999 1b4", flush=True)
+            continue
+        if word == "hello":
+            print("hello 1 misbehaving", flush=True)
+            continue
+        if word == "bye":
+            break
+        t = [int(x) for x in fields[:2]]
+        if word == "break":
+            sensor.on_break(t[0] / 1e6, t[1] / 1e6)
+        elif word == "char":
+            sensor.on_char(int(fields[2], 16), t[0] / 1e6, t[1] / 1e6)
+        elif word == "sent":
+            sensor.pop_frame()
+        print(plan(t[-1]), flush=True)
+    """
+)
+
+
+@pytest.fixture
+def misbehaving(tmp_path: Path):
+    script = tmp_path / "misbehaving.py"
+    script.write_text(MISBEHAVING)
+
+    def port(mode: str, at: int) -> tuple[str, Path]:
+        pidfile = tmp_path / f"{mode}.pid"
+        return f"exec:{sys.executable} {script} {mode} {at} {pidfile}", pidfile
+
+    return port
+
+
+def reaped(pidfile: Path) -> bool:
+    """The harness process is gone: not running and not a zombie waiting to be collected."""
+    pid = int(pidfile.read_text())
+    return not Path(f"/proc/{pid}").exists()
+
+
+def test_the_python_example_sensor_is_compliant_with_exact_timing():
+    data = run_once(f"exec:{sys.executable} {ROOT / 'examples/python/sensor_harness.py'}")
+    assert data["summary"]["verdict"] == "COMPLIANT"
+    counts = data["summary"]["counts"]
+    assert counts["FAIL"] == counts["ERROR"] == counts["INCONCLUSIVE"] == counts["WARN"] == 0
+    assert data["run"]["link"]["kind"] == "exec"
+    timed = [
+        f for r in data["requirements"] for f in r["findings"] if f["measured_ms"] is not None
+    ]
+    assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
+
+
+@pytest.mark.parametrize(
+    ("mode", "at", "words"),
+    [
+        ("crash", 300, ["killed by signal SIGABRT", "harness goes crash at message 300"]),
+        ("exit", 300, ["closed its output", "exit status 0", "harness goes exit"]),
+        ("garbage", 300, ["not printable ASCII", "GARBAGE"]),
+        ("twice", 300, ["more than one reply"]),
+        ("flood", 300, ["more than one reply"]),
+        ("badbyte", 300, ["not two hex digits", "tx 99999999 1b4"]),
+    ],
+)
+def test_a_failing_harness_ends_the_run_with_an_error_not_a_verdict(misbehaving, mode, at, words):
+    port, pidfile = misbehaving(mode, at)
+    started = time.monotonic()
+    data = run_once(port)
+    assert time.monotonic() - started < 30
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    assert data["run"]["complete"] is False
+    reason = data["run"]["stop_reason"]
+    assert reason.startswith("link failed: harness")
+    for word in words:
+        assert word in reason, reason
+    counts = data["summary"]["counts"]
+    assert counts["FAIL"] == 0 and counts["ERROR"] >= 1  # never a verdict about the DUT
+    assert reaped(pidfile)
+
+
+def test_a_hung_harness_is_stopped_after_the_reply_timeout(misbehaving):
+    port, pidfile = misbehaving("hang", 40)
+    link = open_sensor_harness(port, reply_timeout=0.5)
+    started = time.monotonic()
+    with pytest.raises(HarnessError) as caught:
+        for _ in range(20):
+            link.send_break(0.0125)
+            link.write(b"0!")
+            link.receive(link.now() + 0.1)
+    assert time.monotonic() - started < 5
+    message = str(caught.value)
+    assert "no reply within 0.5 s" in message and "harness goes hang" in message
+    assert "killed by signal SIGTERM" in message
+    link.close()
+    assert reaped(pidfile)
+
+
+def test_a_harness_that_never_answers_hello_is_a_usage_error(tmp_path: Path):
+    script = tmp_path / "silent.py"
+    script.write_text("import sys\nprint('starting up', file=sys.stderr)\nsys.exit(2)\n")
+    with pytest.raises(PortUnavailable) as caught:
+        open_port(f"exec:{sys.executable} {script}")
+    assert "exit status 2" in str(caught.value) and "starting up" in str(caught.value)
+
+
+def test_a_missing_program_is_a_usage_error(tmp_path: Path):
+    with pytest.raises(PortUnavailable, match="cannot start harness"):
+        open_port(f"exec:{tmp_path / 'no-such-harness'}")
+    with pytest.raises(PortUnavailable, match="needs a program"):
+        open_port("exec:")
+
+
+def test_the_harness_is_reaped_after_a_clean_run(misbehaving):
+    port, pidfile = misbehaving("never", 10**9)
+    link = open_sensor_harness(port)
+    link.send_break(0.0125)
+    link.wait(0.009)
+    link.write(b"0!")  # "0!"
+    reply = link.receive(link.now() + 0.1, idle=0.02)
+    assert bytes(e.wire & 0x7F for e in reply) == b"0\r\n"
+    link.close()
+    assert link.device.channel.proc.returncode == 0
+    assert reaped(pidfile)
+
+
+def test_a_unix_socket_harness(tmp_path: Path):
+    """``unix:PATH``: the same protocol from a program that listens on a socket."""
+    path = str(tmp_path / "h.sock")
+    server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    server.bind(path)
+    server.listen(1)
+    seen: list[str] = []
+
+    def serve() -> None:
+        conn, _ = server.accept()
+        with conn, conn.makefile("rw") as stream:
+            for line in stream:
+                seen.append(line.strip())
+                if line.startswith("bye"):
+                    return
+                answer = "hello 1 socket" if line.startswith("hello") else "idle"
+                if line.startswith("char") and line.split()[3] == "21":  # '!': answer '0'
+                    end = int(line.split()[2])
+                    answer = f"tx {end + 9000} 30"
+                stream.write(answer + "\n")
+                stream.flush()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    link = open_port(f"unix:{path}").link
+    link.send_break(0.0125)
+    link.wait(0.009)
+    events = link.write(b"0!")
+    got = link.receive(link.now() + 0.1, idle=0.02)
+    link.close()
+    thread.join(timeout=5)
+    server.close()
+    assert [chr(e.wire & 0x7F) for e in got] == ["0"]
+    assert got[0].start == pytest.approx(events[-1].end + 9e-3, abs=1e-6)
+    assert seen[0] == "hello 1 sensor" and seen[1] == "break 0 12500" and seen[-1] == "bye"
+    assert link.info.kind == "unix" and link.info.timing_uncertainty == 0.0
+
+
+def test_no_harness_process_outlives_the_tests():
+    """No zombie children of this process (a zombie is a child never waited for)."""
+    mine = str(os.getpid())
+    zombies = []
+    for status in Path("/proc").glob("[0-9]*/status"):
+        try:
+            fields = dict(
+                line.split(":\t", 1) for line in status.read_text().splitlines() if ":\t" in line
+            )
+        except OSError:
+            continue
+        if fields.get("PPid", "").strip() == mine and fields.get("State", "").startswith("Z"):
+            zombies.append(status.parent.name)
+    assert not zombies
