@@ -82,6 +82,7 @@ RECORDER = f"exec:{sys.executable} {PY_DIR / 'recorder_harness.py'}"
 def test_the_python_recorder_harness_is_compliant():
     data = run_once(RECORDER, role="recorder")
     assert clean(data), data["summary"]
+    assert data["run"]["link"]["kind"] == "exec"
     judged = [r for r in data["requirements"] if r["testable"]]
     assert len(judged) == 36 and all(r["verdict"] in ("PASS", "N/A") for r in judged)
     timed = [f for r in judged for f in r["findings"] if f["measured_ms"] is not None]

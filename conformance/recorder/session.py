@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from ..harness.device import is_harness_port
 from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
-from ..links.base import Link, LinkError
+from ..links.base import Link, LinkError, LinkInfo
 from ..ports import PortError, SimSpec, is_sim, parse_sim
 from ..sim.bus import Frame, SimBus, SimLink
 from ..transcript import TOOL, Event
@@ -140,6 +140,8 @@ class RecorderSession:
         else:
             self.bus = SimBus([LineMonitor()])
             self.link: Link = SimLink(self.bus)
+            if harness:  # the reports name the harness link, still virtual time
+                self.link.info = LinkInfo(kind=port.partition(":")[0], virtual_time=True)
         self.version = version
         self.uncertainty = (
             self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
