@@ -20,10 +20,22 @@ import time
 from collections import deque
 
 from ..links.base import LinkError
-from .protocol import MAX_LINE, HarnessProtocolError, check_line
+from .protocol import (
+    MAX_LINE,
+    HarnessProtocolError,
+    Plan,
+    Role,
+    check_line,
+    hello,
+    parse_hello,
+    parse_plan,
+    us,
+)
 
 #: Wall time a harness has to answer one message (its own work is microseconds).
 REPLY_TIMEOUT = 5.0
+#: Wall time a harness has to answer ``hello`` (it may load firmware images or models first).
+HELLO_TIMEOUT = 30.0
 #: Wall time a child has to exit after ``bye`` before it is terminated, then killed.
 EXIT_GRACE = 1.0
 #: Stderr kept for the report.
@@ -65,6 +77,11 @@ class Channel:
     def send(self, line: str) -> None:
         if self.closed:
             raise HarnessError(f"harness {self.describe} is closed")
+        if not self._buffer and select.select([self._read_fd], [], [], 0)[0]:
+            chunk = self._read_chunk()  # written since its last answer, unasked
+            if not chunk:
+                raise self.fail("the harness closed its output (exited?)")
+            self._buffer += chunk
         if self._buffer:
             raise self.fail(f"unsolicited output {self._buffer[:80]!r}")
         self.last_sent = line
@@ -73,19 +90,23 @@ class Channel:
         except OSError as exc:
             raise self.fail(f"cannot write to the harness ({exc.strerror or exc})") from exc
 
-    def receive(self) -> str:
-        deadline = time.monotonic() + self.reply_timeout
+    def _read_chunk(self) -> bytes:
+        try:
+            return os.read(self._read_fd, 4096)
+        except OSError as exc:
+            raise self.fail(f"cannot read from the harness ({exc.strerror or exc})") from exc
+
+    def receive(self, timeout: float | None = None) -> str:
+        deadline = time.monotonic() + (self.reply_timeout if timeout is None else timeout)
         while b"\n" not in self._buffer:
             if len(self._buffer) > MAX_LINE:
                 raise self.fail(f"reply longer than {MAX_LINE} characters: {self._buffer[:80]!r}")
             left = deadline - time.monotonic()
             ready = select.select([self._read_fd], [], [], max(left, 0))[0] if left > 0 else []
             if not ready:
-                raise self.fail(f"no reply within {self.reply_timeout:g} s (hung?)")
-            try:
-                chunk = os.read(self._read_fd, 4096)
-            except OSError as exc:
-                raise self.fail(f"cannot read from the harness ({exc.strerror or exc})") from exc
+                waited = self.reply_timeout if timeout is None else timeout
+                raise self.fail(f"no reply within {waited:g} s (hung?)")
+            chunk = self._read_chunk()
             if not chunk:
                 raise self.fail("the harness closed its output (exited?)")
             self._buffer += chunk
@@ -95,12 +116,28 @@ class Channel:
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
 
-    def ask(self, line: str) -> str:
+    def ask(self, line: str, timeout: float | None = None) -> str:
         self.send(line)
-        reply = self.receive()
+        reply = self.receive(timeout)
         if self._buffer:  # more than the one line that answers the message
             raise self.fail(f"more than one reply to {line!r}: also {self._buffer[:80]!r}")
         return reply
+
+    def greet(self, role: Role) -> str:
+        """Exchange hellos (with the longer start-up allowance); the harness's name."""
+        reply = self.ask(hello(role), max(HELLO_TIMEOUT, self.reply_timeout))
+        try:
+            return parse_hello(reply)
+        except HarnessProtocolError as exc:
+            raise self.protocol_error(exc) from exc
+
+    def plan(self, message: str, role: Role, now: float) -> Plan:
+        """Send a line event (``now`` is its time in s) and return the checked plan."""
+        reply = self.ask(message)
+        try:
+            return parse_plan(reply, role, us(now))
+        except HarnessProtocolError as exc:
+            raise self.protocol_error(exc) from exc
 
     def protocol_error(self, exc: HarnessProtocolError) -> HarnessError:
         return self.fail(f"protocol error: {exc.reason}: {exc.line[:MAX_LINE]!r}")

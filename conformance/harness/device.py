@@ -14,7 +14,7 @@ from ..protocol.timing import CHAR_TIME
 from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
 from . import protocol as proto
 from .channel import Channel, ChildChannel, HarnessError, SocketChannel
-from .protocol import HarnessProtocolError, Plan, PlanKind, Role
+from .protocol import Plan, PlanKind, Role
 
 
 class HarnessDevice:
@@ -25,22 +25,10 @@ class HarnessDevice:
         self.channel = channel
         self.clock = clock
         self.plan = Plan(PlanKind.IDLE)
-        self.harness_name = self._hello(channel, Role.SENSOR)
-
-    @staticmethod
-    def _hello(channel: Channel, role: Role) -> str:
-        reply = channel.ask(proto.hello(role))
-        try:
-            return proto.parse_hello(reply)
-        except HarnessProtocolError as exc:
-            raise channel.protocol_error(exc) from exc
+        self.harness_name = channel.greet(Role.SENSOR)
 
     def _tell(self, message: str, now: float) -> None:
-        reply = self.channel.ask(message)
-        try:
-            self.plan = proto.parse_plan(reply, Role.SENSOR, proto.us(now))
-        except HarnessProtocolError as exc:
-            raise self.channel.protocol_error(exc) from exc
+        self.plan = self.channel.plan(message, Role.SENSOR, now)
 
     @property
     def wake_at(self) -> float | None:

@@ -20,7 +20,7 @@ from ..transcript import Event
 from . import protocol as proto
 from .channel import Channel, HarnessError
 from .device import open_channel
-from .protocol import HarnessProtocolError, Plan, PlanKind, Role
+from .protocol import Plan, PlanKind, Role
 
 #: Bus time one job may take (the longest scenario needs a few seconds of it).
 JOB_LIMIT = 600.0
@@ -45,9 +45,9 @@ class HarnessRecorder:
         env = request.environment(scenario, JOB_LIMIT)
         channel = open_channel(self.port, env, self.reply_timeout)
         try:
-            name = self._ask_hello(channel)
+            name = channel.greet(Role.RECORDER)
             first = proto.job(link.now(), str(request.task), request.commands)
-            plan = self._ask(channel, first, link.now())
+            plan = channel.plan(first, Role.RECORDER, link.now())
             ended = self._drive(channel, plan, link)
         finally:
             channel.close(proto.BYE)
@@ -63,27 +63,11 @@ class HarnessRecorder:
         try:
             channel = open_channel(self.port, None, self.reply_timeout)
             try:
-                self._ask_hello(channel)
+                channel.greet(Role.RECORDER)
             finally:
                 channel.close(proto.BYE)
         except HarnessError as exc:
             raise PortUnavailable(str(exc)) from exc
-
-    @staticmethod
-    def _ask_hello(channel: Channel) -> str:
-        reply = channel.ask(proto.hello(Role.RECORDER))
-        try:
-            return proto.parse_hello(reply)
-        except HarnessProtocolError as exc:
-            raise channel.protocol_error(exc) from exc
-
-    @staticmethod
-    def _ask(channel: Channel, message: str, now: float) -> Plan:
-        reply = channel.ask(message)
-        try:
-            return proto.parse_plan(reply, Role.RECORDER, proto.us(now))
-        except HarnessProtocolError as exc:
-            raise channel.protocol_error(exc) from exc
 
     def _drive(self, channel: Channel, plan: Plan, link: Link) -> str:
         """Carry out plans until ``done``; what ended the job, in words."""
@@ -100,7 +84,8 @@ class HarnessRecorder:
             heard = link.receive(deadline, until=_first)
             if heard:
                 got = heard[0]
-                plan = self._ask(channel, proto.heard(got.wire, got.start, got.end), got.end)
+                message = proto.heard(got.wire, got.start, got.end)
+                plan = channel.plan(message, Role.RECORDER, got.end)
                 continue
             if plan.kind is PlanKind.IDLE:
                 return f"idle with a quiet line for {IDLE_END:g} s of bus time"
@@ -112,5 +97,5 @@ class HarnessRecorder:
             else:  # BRK
                 made = link.send_break(proto.seconds(plan.end) - link.now())
                 message = proto.line_break(made.start, made.end)
-            plan = self._ask(channel, message, link.now())
+            plan = channel.plan(message, Role.RECORDER, link.now())
         return "done"
