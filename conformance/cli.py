@@ -56,7 +56,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--port",
         default="sim",
-        help="sim, sim://?faults=a,b&version=1.3, or a serial port / pyserial URL",
+        help="sim, sim://?faults=a,b&version=1.3, a serial port / pyserial URL, "
+        "'exec:PROGRAM ARGS' or unix:PATH (a harness, docs/harness-protocol.md)",
     )
     p.add_argument(
         "--role",

@@ -51,15 +51,35 @@ def c_harness(tmp_path_factory: pytest.TempPathFactory):
 DECLARATION = ("--sdi12-declaration", str(C_DIR / "tiny_sensor.toml"))
 
 
-def test_the_c_sensor_harness_is_compliant(c_harness):
+@pytest.fixture(scope="module")
+def c_run(c_harness) -> tuple[dict, float]:
+    """One run of the clean C harness and its wall time."""
     started = time.monotonic()
     data = run_once(f"exec:{c_harness['clean']}", DECLARATION)
-    elapsed = time.monotonic() - started
+    return data, time.monotonic() - started
+
+
+def findings(data: dict) -> list[tuple]:
+    """Everything a run found, with the measured times: what determinism is checked on."""
+    return [
+        (r["id"], r["verdict"], tuple((f["detail"], f["measured_ms"]) for f in r["findings"]))
+        for r in data["requirements"]
+    ]
+
+
+def test_the_c_sensor_harness_is_compliant(c_run):
+    data, elapsed = c_run
     assert clean(data), data["summary"]
     assert data["dut"]["sdi12_version"] in ("13", "1.3")
     judged = [r for r in data["requirements"] if r["testable"] and r["verdict"] == "PASS"]
     assert len(judged) >= 60
     assert elapsed < 30  # about 3 s on an idle 2-core machine; a hung harness would take longer
+
+
+def test_a_harness_run_is_deterministic(c_harness, c_run):
+    """Virtual time: the same harness gives the same findings, to the microsecond."""
+    again = run_once(f"exec:{c_harness['clean']}", DECLARATION)
+    assert findings(again) == findings(c_run[0])
 
 
 def test_the_faulty_c_sensor_fails_exactly_its_requirement(c_harness):
