@@ -118,9 +118,16 @@ class Channel:
 
     def ask(self, line: str, timeout: float | None = None) -> str:
         self.send(line)
+        return self.answer(timeout)
+
+    def answer(self, timeout: float | None = None) -> str:
+        """The one line answering the message sent last (:meth:`send` then :meth:`answer`
+        lets the caller work while the harness thinks)."""
         reply = self.receive(timeout)
         if self._buffer:  # more than the one line that answers the message
-            raise self.fail(f"more than one reply to {line!r}: also {self._buffer[:80]!r}")
+            raise self.fail(
+                f"more than one reply to {self.last_sent!r}: also {self._buffer[:80]!r}"
+            )
         return reply
 
     def greet(self, role: Role) -> str:
@@ -133,7 +140,12 @@ class Channel:
 
     def plan(self, message: str, role: Role, now: float) -> Plan:
         """Send a line event (``now`` is its time in s) and return the checked plan."""
-        reply = self.ask(message)
+        self.send(message)
+        return self.read_plan(role, now)
+
+    def read_plan(self, role: Role, now: float) -> Plan:
+        """The checked plan answering the line event sent last (at ``now`` s)."""
+        reply = self.answer()
         try:
             return parse_plan(reply, role, us(now))
         except HarnessProtocolError as exc:
