@@ -13,7 +13,7 @@ from typing import Any
 
 from . import __version__
 from .declaration import Declaration, load_declaration, normalise_version
-from .links.base import Link
+from .links.base import Link, LinkError
 from .ports import is_sim, open_port
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .sensor_session import SensorSession
@@ -124,6 +124,7 @@ class ConformanceRun:
         return self.session.version if self.session else None
 
     def finish(self, complete: bool) -> list[RequirementResult]:
+        self._check_link()
         self.complete = self.complete and complete
         self.finished = now_iso()
         self.results = aggregate(self.options.role, self.cases)
@@ -135,6 +136,18 @@ class ConformanceRun:
                 "(cases left out by the selection?)"
             )
         return self.results
+
+    def _check_link(self) -> None:
+        """A link that can vouch for its records only at the end (a harness, whose answers
+        could have fallen out of step) is asked now, before the verdicts are drawn."""
+        check = getattr(self.link, "check_records", None)
+        if check is None:
+            return
+        try:
+            check()
+        except LinkError as exc:
+            self.complete = False
+            self.stop_reason = self.stop_reason or f"link failed: {exc}"
 
     def report_dir(self) -> Path:
         if self.options.report_dir:

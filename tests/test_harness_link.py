@@ -15,8 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from conformance.harness.channel import HarnessError
+from conformance.harness.channel import ChildChannel, HarnessError
 from conformance.harness.device import open_sensor_harness
+from conformance.harness.protocol import Role
 from conformance.links.errors import PortUnavailable
 from conformance.matrix import run_once
 from conformance.ports import open_port
@@ -68,6 +69,9 @@ MISBEHAVING = textwrap.dedent(
             print("hello 1 misbehaving", flush=True)
             continue
         if word == "bye":
+            if MODE == "after-bye":  # one answer too many: the stream was out of step
+                time.sleep(0.2)
+                print("idle", flush=True)
             break
         t = [int(x) for x in fields[:2]]
         if word == "break":
@@ -120,7 +124,7 @@ def test_the_python_example_sensor_is_compliant_with_exact_timing():
         ("twice", 300, ["more than one reply"]),
         ("flood", 300, ["more than one reply"]),
         ("badbyte", 300, ["not two hex digits", "tx 99999999 1b4"]),
-        ("late-extra", 300, ["unsolicited output|more than one reply"]),
+        ("late-extra", 300, ["unsolicited output|more than one reply|out of step"]),
     ],
 )
 def test_a_failing_harness_ends_the_run_with_an_error_not_a_verdict(misbehaving, mode, at, words):
@@ -135,7 +139,47 @@ def test_a_failing_harness_ends_the_run_with_an_error_not_a_verdict(misbehaving,
     for word in words:
         assert any(w in reason for w in word.split("|")), reason
     counts = data["summary"]["counts"]
-    assert counts["FAIL"] == 0 and counts["ERROR"] >= 1  # never a verdict about the DUT
+    if "out of step" not in reason:  # caught mid-run: the run stops at the offending line
+        assert counts["FAIL"] == 0 and counts["ERROR"] >= 1  # never a verdict about the DUT
+    assert reaped(pidfile)
+
+
+def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
+    """A line written unasked while the tool already waits for the next answer is taken as
+    that answer, and the stream is one line late from then on; no single line shows it. The
+    end does: an answer arrives after ``bye``, and the records are not trusted."""
+    script = tmp_path / "late.py"
+    script.write_text(
+        textwrap.dedent(
+            """
+            import sys, time
+            print("hello 1 late", flush=True) if sys.stdin.readline() else None
+            sys.stdin.readline()
+            print("idle", flush=True)
+            time.sleep(0.3)
+            print("idle", flush=True)  # unasked: the tool has sent its next message by now
+            sys.stdin.readline()
+            time.sleep(0.3)
+            print("tx 99 30", flush=True)  # the real answer, one line late
+            sys.stdin.readline()
+            """
+        )
+    )
+    channel = ChildChannel(f"{sys.executable} {script}")
+    channel.greet(Role.SENSOR)
+    assert channel.ask("time 1") == "idle"
+    assert channel.ask("time 2") == "idle"  # the unasked line, read as the answer
+    with pytest.raises(HarnessError, match="out of step"):
+        channel.finish("bye")
+    assert channel.proc.returncode is not None
+
+
+def test_a_run_whose_harness_fell_out_of_step_is_incomplete(misbehaving):
+    """The same at run level: verdicts are not drawn from records read out of step."""
+    port, pidfile = misbehaving("after-bye", 10**9)
+    data = run_once(port, ("-k", "acknowledge"))
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    assert "out of step" in data["run"]["stop_reason"]
     assert reaped(pidfile)
 
 

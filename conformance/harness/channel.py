@@ -154,6 +154,31 @@ class Channel:
     def protocol_error(self, exc: HarnessProtocolError) -> HarnessError:
         return self.fail(f"protocol error: {exc.reason}: {exc.line[:MAX_LINE]!r}")
 
+    def finish(self, farewell: str) -> None:
+        """End a conversation that went well: say ``farewell``, then read until the harness
+        closes its output (at most ``EXIT_GRACE`` s). A line arriving now answers no message:
+        the harness wrote something unasked earlier and every answer since was read against
+        the wrong message, which no check on a single line can see. Raise, so the run's
+        records are not trusted."""
+        if self.closed:
+            return
+        self.send(farewell)
+        leftover = b""
+        deadline = time.monotonic() + EXIT_GRACE
+        while len(leftover) <= MAX_LINE and (left := deadline - time.monotonic()) > 0:
+            if not select.select([self._read_fd], [], [], left)[0]:
+                break
+            chunk = self._read_chunk()
+            if not chunk:
+                break
+            leftover += chunk
+        if leftover:
+            raise self.fail(
+                f"output out of step: {leftover[:80]!r} came after the last answer, so the "
+                "answers were read against the wrong messages (a line written unasked?)"
+            )
+        self.close()
+
     def close(self, farewell: str | None = None) -> None:
         """Say ``farewell`` if still possible, then release the harness (idempotent)."""
         if self.closed:

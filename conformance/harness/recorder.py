@@ -49,6 +49,7 @@ class HarnessRecorder:
             first = proto.job(link.now(), str(request.task), request.commands)
             plan = channel.plan(first, Role.RECORDER, link.now())
             ended = self._drive(channel, plan, link)
+            channel.finish(proto.BYE)
         finally:
             channel.close(proto.BYE)
         out = RecorderOutput()
