@@ -280,3 +280,35 @@ def test_no_harness_process_outlives_the_tests():
         if fields.get("PPid", "").strip() == mine and fields.get("State", "").startswith("Z"):
             zombies.append(status.parent.name)
     assert not zombies
+
+
+def test_a_crashing_recorder_harness_ends_the_run_with_an_error(tmp_path: Path):
+    """Recorder role: the harness breaks the line, then crashes; the run stops with an ERROR
+    naming the crash and the stderr tail, and the process is reaped."""
+    script = tmp_path / "crashing-recorder.py"
+    pidfile = tmp_path / "recorder.pid"
+    script.write_text(
+        textwrap.dedent(
+            f"""
+            import os, sys
+            from pathlib import Path
+            Path({str(pidfile)!r}).write_text(str(os.getpid()))
+            for line in sys.stdin:
+                word, *fields = line.split()
+                if word == "hello":
+                    print("hello 1 crashing-recorder", flush=True)
+                elif word == "job":
+                    now = int(fields[0])
+                    print(f"brk {{now}} {{now + 12500}}", flush=True)
+                else:
+                    print("recorder firmware assertion failed", file=sys.stderr, flush=True)
+                    os.abort()
+            """
+        )
+    )
+    data = run_once(f"exec:{sys.executable} {script}", role="recorder")
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    reason = data["run"]["stop_reason"]
+    assert "SIGABRT" in reason and "recorder firmware assertion failed" in reason
+    assert data["summary"]["counts"]["FAIL"] == 0
+    assert reaped(pidfile)
