@@ -312,3 +312,35 @@ def test_a_crashing_recorder_harness_ends_the_run_with_an_error(tmp_path: Path):
     assert "SIGABRT" in reason and "recorder firmware assertion failed" in reason
     assert data["summary"]["counts"]["FAIL"] == 0
     assert reaped(pidfile)
+
+
+def test_a_unix_socket_recorder_harness_is_judged_per_scenario(tmp_path: Path):
+    """``--role recorder --port unix:PATH``: the tool connects afresh for each scenario; here
+    the golden recorder serves each connection through the Python client."""
+    from conformance.harness.client import serve_recorder
+    from conformance.recorder.faults import faulty_recorder
+
+    path = str(tmp_path / "recorder.sock")
+    server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    server.bind(path)
+    server.listen(4)
+    served: list[int] = []
+
+    def serve() -> None:
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return  # closed: the run is over
+            with conn, conn.makefile("r") as inp, conn.makefile("w") as out:
+                served.append(serve_recorder(faulty_recorder(()), inp, out))
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        data = run_once(f"unix:{path}", role="recorder")
+    finally:
+        server.close()
+    assert data["summary"]["verdict"] == "COMPLIANT", data["summary"]
+    assert data["run"]["link"]["kind"] == "unix"
+    assert len(served) >= 10 and set(served) == {0}  # the probe, then one per scenario
