@@ -117,7 +117,11 @@ def serve_recorder(
         return 2
     link = ClientLink(inp, out)
     link.clock = seconds(int(job[1]))
-    program(Request(Task(job[2]), tuple(job[3:])), link)
+    try:
+        program(Request(Task(job[2]), tuple(job[3:])), link)
+    except LinkError as exc:  # the tool ended the conversation (bye, or closed our input)
+        print(f"job ended by the tool: {exc}", file=sys.stderr)
+        return 0
     out.write("done\n")
     out.flush()
     inp.readline()  # bye
