@@ -23,9 +23,14 @@ COMPILER = shutil.which("cc") or shutil.which("gcc")
 
 
 def clean(data: dict) -> bool:
+    """COMPLIANT with nothing flagged; INCONCLUSIVE only where a harness link cannot see: the
+    bit rate (R-4.1-01), since the tool makes the frames of the bytes a harness names."""
     counts = data["summary"]["counts"]
-    return data["summary"]["verdict"] == "COMPLIANT" and not any(
-        counts[v] for v in ("FAIL", "WARN", "INCONCLUSIVE", "ERROR")
+    unsure = [r["id"] for r in data["requirements"] if r["verdict"] == "INCONCLUSIVE"]
+    return (
+        data["summary"]["verdict"] == "COMPLIANT"
+        and not any(counts[v] for v in ("FAIL", "WARN", "ERROR"))
+        and unsure == ["R-4.1-01"]
     )
 
 
@@ -103,8 +108,8 @@ def test_the_python_recorder_harness_is_compliant():
     data = run_once(RECORDER, role="recorder")
     assert clean(data), data["summary"]
     assert data["run"]["link"]["kind"] == "exec"
-    judged = [r for r in data["requirements"] if r["testable"]]
-    assert len(judged) == 36 and all(r["verdict"] in ("PASS", "N/A") for r in judged)
+    judged = [r for r in data["requirements"] if r["testable"] and r["id"] != "R-4.1-01"]
+    assert len(judged) == 35 and all(r["verdict"] in ("PASS", "N/A") for r in judged)
     timed = [f for r in judged for f in r["findings"] if f["measured_ms"] is not None]
     assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
 

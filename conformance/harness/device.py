@@ -111,7 +111,7 @@ class HarnessLink(SimLink):
     def __init__(self, bus: HarnessBus, device: HarnessDevice, kind: str) -> None:
         super().__init__(bus)
         self.device = device
-        self.info = LinkInfo(kind=kind, virtual_time=True)
+        self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
 
     def check_records(self) -> None:
         """Before the verdicts: end the harness and make sure its answers were in step

@@ -141,7 +141,8 @@ class RecorderSession:
             self.bus = SimBus([LineMonitor()])
             self.link: Link = SimLink(self.bus)
             if harness:  # the reports name the harness link, still virtual time
-                self.link.info = LinkInfo(kind=port.partition(":")[0], virtual_time=True)
+                kind = port.partition(":")[0]
+                self.link.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
         self.version = version
         self.uncertainty = (
             self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty

@@ -6,6 +6,8 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import recorder as judge
+from conformance.links.base import NO_BIT_TIMING
+from conformance.verdicts import inconclusive
 
 from ._helpers import line_of
 
@@ -44,4 +46,7 @@ def test_character_timing(recorder, case):
     case.expect("every gap inside a command <= 1.66 ms; characters one 8.33 ms frame apart")
     line = _everything(recorder, case)
     case.extend(judge.judge_character_gaps(line, recorder.uncertainty))
-    case.add(judge.judge_bit_rate(line, recorder.uncertainty))
+    if recorder.link.info.bit_timing:
+        case.add(judge.judge_bit_rate(line, recorder.uncertainty))
+    else:
+        case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
