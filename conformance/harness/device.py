@@ -25,6 +25,7 @@ class HarnessDevice:
         self.channel = channel
         self.clock = clock
         self._plan = Plan(PlanKind.IDLE)
+        self._start = 0.0  # the plan's time in s
         self._pending: float | None = None  # time of a message whose answer is unread
         self.harness_name = channel.greet(Role.SENSOR)
 
@@ -38,7 +39,11 @@ class HarnessDevice:
     def _collect(self) -> None:
         if self._pending is not None:
             now, self._pending = self._pending, None
-            self._plan = self.channel.read_plan(Role.SENSOR, now)
+            self._plan = plan = self.channel.read_plan(Role.SENSOR, now)
+            # the harness saw ``now`` rounded to the microsecond; when it answers with that
+            # very time it means this instant, not half a microsecond before or after it
+            exact = plan.start == proto.us(now)
+            self._start = now if exact else proto.seconds(plan.start)
 
     @property
     def plan(self) -> Plan:
@@ -47,7 +52,7 @@ class HarnessDevice:
 
     @property
     def wake_at(self) -> float | None:
-        return proto.seconds(self.plan.start) if self.plan.kind is PlanKind.WAIT else None
+        return self._start if self.plan.kind is PlanKind.WAIT else None
 
     def wake(self, now: float) -> None:
         self._tell(proto.time_is(now), now)
@@ -61,7 +66,7 @@ class HarnessDevice:
     def next_frame(self) -> Frame | None:
         if self.plan.kind is not PlanKind.TX:
             return None
-        return Frame(proto.seconds(self.plan.start), self.plan.wire)
+        return Frame(self._start, self.plan.wire)
 
     def pop_frame(self) -> Frame:
         frame = self.next_frame()

@@ -16,12 +16,13 @@ import sys
 from conformance.emulator import SensorEmulator, default_profile
 
 
-def plan(sensor: SensorEmulator, now_us: int) -> str:
-    """The answer to every message: the next character the sensor will send, or idle."""
+def plan(sensor: SensorEmulator) -> str:
+    """The answer to every message: the next character the sensor will send, or idle. A
+    start already past (the sensor was interrupted mid-reply) means: as soon as possible."""
     frame = sensor.next_frame()
     if frame is None:
         return "idle"
-    return f"tx {max(round(frame.start * 1e6), now_us)} {frame.wire:02x}"
+    return f"tx {round(frame.start * 1e6)} {frame.wire:02x}"
 
 
 def main() -> int:
@@ -34,14 +35,13 @@ def main() -> int:
             return 0
         else:
             times = [int(f) for f in fields[:2]]
-            now = times[-1]
             if word == "break":
                 sensor.on_break(times[0] / 1e6, times[1] / 1e6)
             elif word == "char":
                 sensor.on_char(int(fields[2], 16), times[0] / 1e6, times[1] / 1e6)
             elif word == "sent":
                 sensor.pop_frame()  # our character is on the wire; plan the next one
-            answer = plan(sensor, now)
+            answer = plan(sensor)
         print(answer, flush=True)
     return 0
 
