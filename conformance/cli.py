@@ -38,6 +38,7 @@ examples:
   sdi12-conform faults                                     the emulator faults and what they break
   sdi12-conform matrix                                     run the fault-detection matrix
   sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
+  sdi12-conform calibrate --port /dev/ttyUSB0              measure the bench's timing first
 
 exit codes: 0 compliant, 1 non-compliant, 2 interrupted/incomplete, 3 internal error,
             4 usage error, 5 no device answered
@@ -73,7 +74,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--timing-uncertainty-ms",
         type=float,
-        help="override the link's declared timestamp uncertainty",
+        help="widen the timestamp uncertainty the link measures (it can never narrow it)",
+    )
+    p.add_argument(
+        "--echo",
+        default="auto",
+        choices=("auto", "on", "off"),
+        help="real links: does the interface echo the tool's own characters "
+        "(default auto: found out on the first transmission)",
+    )
+    p.add_argument(
+        "--direction",
+        default="none",
+        choices=("none", "rts", "dtr"),
+        help="real links: raise this line for exactly the tool's transmissions "
+        "(an RS-485-style transceiver's driver enable)",
     )
     p.add_argument(
         "--trigger",
@@ -105,7 +120,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         else:
             from .ports import open_port
 
-            open_port(args.port).link.close()  # a port that cannot be opened: a usage error
+            # a port that cannot be opened: a usage error
+            open_port(args.port, echo=args.echo, direction=args.direction).link.close()
     except (DeclarationError, PortError) as exc:
         console.print(f"error: {exc}", style="red", markup=False)
         return EXIT_USAGE
@@ -127,6 +143,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         pytest_args += ["--sdi12-timing-uncertainty-ms", str(args.timing_uncertainty_ms)]
     if args.strict:
         pytest_args.append("--sdi12-strict")
+    pytest_args += ["--sdi12-echo", args.echo, "--sdi12-direction", args.direction]
     if args.keyword:
         pytest_args += ["-k", args.keyword]
     plugins: list[object] = []
@@ -267,6 +284,10 @@ def main(argv: list[str] | None = None) -> int:
             from .emulate.command import emulate_main
 
             return emulate_main(argv[1:])
+        if argv and argv[0] == "calibrate":
+            from .calibrate import calibrate_main
+
+            return calibrate_main(argv[1:])
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:

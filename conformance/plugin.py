@@ -62,7 +62,19 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "--sdi12-timing-uncertainty-ms",
         type=float,
         default=None,
-        help="override the link's declared timestamp uncertainty",
+        help="widen the link's measured timestamp uncertainty (never narrows it)",
+    )
+    group.addoption(
+        "--sdi12-echo",
+        default="auto",
+        choices=("auto", "on", "off"),
+        help="real links: the interface echoes the tool's characters (auto: find out)",
+    )
+    group.addoption(
+        "--sdi12-direction",
+        default="none",
+        choices=("none", "rts", "dtr"),
+        help="real links: raise this line for the tool's transmissions (transceiver enable)",
     )
 
 

@@ -95,7 +95,8 @@ def sim_declaration(emulator: object, spec: SimSpec) -> Declaration:
     )
 
 
-def open_port(port: str) -> OpenedPort:
+def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> OpenedPort:
+    """Open ``port``; ``echo`` and ``direction`` describe a real bench (ignored on sim)."""
     if is_sim(port):
         return open_sim(parse_sim(port))
     if port.startswith("rfc2217-serve://"):
@@ -112,6 +113,14 @@ def open_port(port: str) -> OpenedPort:
             return OpenedPort(open_sensor_harness(port))
         except HarnessError as exc:
             raise PortUnavailable(str(exc)) from exc
+    from .links.direction import DirectionLine
+    from .links.echo import EchoMode
     from .links.factory import open_real_link
 
-    return OpenedPort(open_real_link(port))
+    try:
+        bench = {"echo": EchoMode(echo), "direction": DirectionLine(direction)}
+    except ValueError as exc:
+        raise PortError(
+            f"{exc}: --echo is auto, on or off; --direction is rts, dtr or none"
+        ) from exc
+    return OpenedPort(open_real_link(port, **bench))

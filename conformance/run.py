@@ -30,6 +30,8 @@ class RunOptions:
     strict: bool = False
     timing_uncertainty_ms: float | None = None
     trigger: str | None = None  # recorder role: shell command (or "interactive") per scenario
+    echo: str = "auto"  # real links: does the interface echo the tool's characters
+    direction: str = "none"  # real links: the modem line that enables the tool's driver
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
@@ -44,6 +46,8 @@ class RunOptions:
             strict=get("sdi12_strict"),
             timing_uncertainty_ms=get("sdi12_timing_uncertainty_ms"),
             trigger=get("sdi12_trigger"),
+            echo=get("sdi12_echo"),
+            direction=get("sdi12_direction"),
         )
 
 
@@ -77,7 +81,9 @@ class ConformanceRun:
 
     def open_link(self) -> Link:
         if self.link is None:
-            opened = open_port(self.options.port)
+            opened = open_port(
+                self.options.port, echo=self.options.echo, direction=self.options.direction
+            )
             self.link, self.devices = opened.link, opened.devices
             if self.declaration is None:
                 self.declaration = opened.declaration
@@ -127,6 +133,7 @@ class ConformanceRun:
         self._check_link()
         self.complete = self.complete and complete
         self.finished = now_iso()
+        self._recheck_timing()
         self.results = aggregate(self.options.role, self.cases)
         self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
         unjudged = sum(1 for r in self.results if not r.judged)
@@ -149,6 +156,17 @@ class ConformanceRun:
             self.complete = False
             self.stop_reason = self.stop_reason or f"link failed: {exc}"
 
+    def _recheck_timing(self) -> None:
+        """Timing verdicts must hold for the uncertainty the whole run measured, not only
+        for the figure known when each case judged (real links measure as they go)."""
+        if self.link is None or self.link.info.virtual_time or self.session is None:
+            return
+        from .judges.timing import recheck
+
+        uncertainty = self.session.uncertainty
+        for case in self.cases:
+            recheck(case.findings, uncertainty)
+
     def report_dir(self) -> Path:
         if self.options.report_dir:
             path = Path(self.options.report_dir)
@@ -168,11 +186,15 @@ class ConformanceRun:
                 "can_break": None,
                 "timing_uncertainty_ms": None,
             }
-        return {
+        found: dict[str, Any] = {
             "kind": info.kind,
             "can_break": info.can_break,
             "timing_uncertainty_ms": round((uncertainty or 0.0) * 1000, 3),
         }
+        describe = getattr(self.link, "describe", None)
+        if callable(describe):  # a real bench: echo, how breaks are made, measured timing
+            found["bench"] = describe()
+        return found
 
     def close(self) -> None:
         if self.link is not None:

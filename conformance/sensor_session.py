@@ -14,6 +14,7 @@ from typing import Any, TypeVar
 
 from .address_change import AddressChanger
 from .declaration import Declaration
+from .judges.timing import StampUncertainty
 from .links.base import Link
 from .master.engine import Master
 from .master.records import Exchange, Measurement
@@ -38,6 +39,10 @@ class InvalidAddressAttempt:
     accepted: bool
 
 
+PROBE_ROUNDS = 6  # wake-ups of the bench probe at the start of a real-link run
+PROBE_IDLE = 0.12  # s: marking before each, so each wake-up is from standby
+
+
 class NoDeviceAnswered(RuntimeError):
     """Nothing answered at the address: a wiring/power/address problem, not a verdict."""
 
@@ -58,9 +63,7 @@ class SensorSession:
         self.requested_address = address or self.declaration.address
         self.address = self.requested_address or "0"
         self.forced_version = forced_version or self.declaration.sdi12_version
-        self.uncertainty = (
-            link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
-        )
+        self._widen = timing_uncertainty or 0.0  # the user may widen, never narrow
         self.identity: Identification | None = None
         self.ident_exchange: Exchange | None = None
         self.assumptions: list[str] = []
@@ -89,11 +92,44 @@ class SensorSession:
                 )
         body, _ = split_line(ex.reply_text)
         self.identity = parse_ident(body, expected_address=self.address) if ex.answered else None
+        if not self.link.info.virtual_time:
+            self.probe_bench()
         if self.forced_version:
             self.assumptions.append(
                 f"rule set v{self.forced_version[0]}.{self.forced_version[1]} "
                 "forced by the user/declaration"
             )
+
+    @property
+    def uncertainty(self) -> float:
+        """The timing uncertainty findings use now (s): what the link has measured of its own
+        stamps so far (never less than its declared floor), widened by the user's figure."""
+        measured = getattr(self.link, "timing_uncertainty", None)
+        base = measured() if callable(measured) else self.link.info.timing_uncertainty
+        return max(base, self._widen)
+
+    @property
+    def stamp_uncertainty(self) -> StampUncertainty:
+        """:attr:`uncertainty`, plus where the link saw its own stamps irregular."""
+        local = getattr(self.link, "uncertainty_between", None)
+        return StampUncertainty(self.uncertainty, local if callable(local) else None)
+
+    def probe_bench(self, rounds: int = PROBE_ROUNDS) -> None:
+        """Measure the bench before judging anything (real links): a few wake-ups and
+        acknowledgements put echo, latency and jitter figures in the link's meter, so the
+        first timing finding already rests on a measured uncertainty."""
+        for _ in range(rounds):
+            self.listen(PROBE_IDLE)
+            self.master.transact(f"{self.address}!", force_break=True)
+        self.assumptions.append(f"bench probed ({rounds} wake-ups): {self.bench_summary()}")
+
+    def bench_summary(self) -> str:
+        meter = getattr(self.link, "meter", None)
+        if meter is None:
+            return f"declared ±{self.link.info.timing_uncertainty * 1e3:.2f} ms"
+        echo = getattr(self.link, "echo", None)
+        said = "interface echoes" if echo is not None and echo.echoes else "no echo"
+        return f"{said}; {meter.summary()}"
 
     @property
     def version(self) -> str:

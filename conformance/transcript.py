@@ -51,6 +51,9 @@ class Event:
     wire: int = 0
     text: str = ""
     uncertainty: float = 0.0
+    # of the length of a line state the UART timed (a NUL at another bit rate), when that is
+    # far better known than its position; None: the length is as uncertain as the stamps
+    duration_uncertainty: float | None = None
 
     @property
     def char7(self) -> int:
@@ -73,7 +76,18 @@ class Event:
             "wire": self.wire,
             "text": self.text,
             "uncertainty": self.uncertainty,
-        }
+        } | (
+            {}
+            if self.duration_uncertainty is None
+            else {"duration_uncertainty": self.duration_uncertainty}
+        )
+
+    @property
+    def length_uncertainty(self) -> float:
+        """How well the length ``end - start`` is known (s)."""
+        if self.duration_uncertainty is not None:
+            return self.duration_uncertainty
+        return self.uncertainty
 
 
 def decode_7e1(events: Iterable[Event]) -> str:

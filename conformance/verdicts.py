@@ -64,6 +64,9 @@ class Finding:
     uncertainty_ms: float | None = None
     evidence: list[str] = field(default_factory=list)
     decision: str | None = None
+    # timing findings: how far (ms) the measurement sits from the edge that decided it, so
+    # a verdict can be checked again against a larger uncertainty measured later in the run
+    margin_ms: float | None = None
 
     def to_json(self) -> dict[str, Any]:
         d = asdict(self)

@@ -196,20 +196,40 @@ def test_clean_emulator_over_rfc2217_has_no_failure(emulator, tmp_path):
     assert verdicts["R-7.0-10"] in ("PASS", "INCONCLUSIVE"), text
 
 
-def test_clean_emulator_gives_definite_timing_with_a_declared_tight_uncertainty(emulator, tmp_path):
-    """On loopback the stamps are usually far better than the declared 5 ms: a user who
-    knows it may say so, and the response window then comes out PASS."""
+@pytest.mark.parametrize("emulator", [("--echo",)], indirect=True, ids=["echo"])
+def test_echoing_interface_gives_definite_timing_from_a_measured_uncertainty(emulator, tmp_path):
+    """Behind an interface that echoes, the reply is timed against the echo of the command
+    on the same receive path: the uncertainty is measured (far below the 5 ms declared for
+    loopback without echo) and the response window comes out PASS."""
+    code, data, text = judge(
+        emulator.url, tmp_path, "-k", "test_identification or test_response_start_window"
+    )
+    link = data["run"]["link"]
+    bench = link["bench"]
+    assert bench["echo"] is True and bench["echo_mode"] == "auto", text
+    assert bench["timing"]["reference"] == "echo"
+    assert bench["timing"]["echo_spread"]["samples"] >= 5  # measured, not declared
+    assert link["timing_uncertainty_ms"] < 5.0, link
+    assert verdicts_of(data)["R-7.0-10"] == "PASS", text
+    assert "0I!" not in (data["dut"]["identification"] or ""), "the echo is not the DUT's"
+
+
+def test_timing_uncertainty_option_only_widens(emulator, tmp_path):
+    """``--timing-uncertainty-ms`` may widen what the link measured, never narrow it: 0.01 ms
+    asked over plain loopback RFC 2217 still reports at least the declared 5 ms."""
+    code, data, text = judge(
+        emulator.url, tmp_path, "-k", "test_identification", "--timing-uncertainty-ms", "0.01"
+    )
+    assert data["run"]["link"]["timing_uncertainty_ms"] >= 5.0, text
     code, data, text = judge(
         emulator.url,
-        tmp_path,
+        tmp_path / "wide",
         "-k",
-        "test_identification or test_response_start_window",
+        "test_identification",
         "--timing-uncertainty-ms",
-        "2",
+        "30",
     )
-    verdicts = verdicts_of(data)
-    assert data["run"]["link"]["timing_uncertainty_ms"] == 2.0
-    assert verdicts["R-7.0-10"] == "PASS", text
+    assert data["run"]["link"]["timing_uncertainty_ms"] == 30.0, text
 
 
 @pytest.mark.parametrize(
@@ -218,8 +238,8 @@ def test_clean_emulator_gives_definite_timing_with_a_declared_tight_uncertainty(
         (("--faults", "no-service-request"), (), {"R-4.4.6-02"}),
         (("--faults", "parity-error"), (), {"R-4.1-02"}),
         (("--faults", "service-request-extra-chars"), (), {"R-4.4.6-01"}),
-        # 3 ms gaps need a tighter uncertainty than the declared 5 ms to be a definite FAIL
-        (("--faults", "inter-char-gap"), ("--timing-uncertainty-ms", "1"), {"R-7.0-12"}),
+        # 3 ms gaps need a tighter uncertainty than the declared 5 ms: the echo gives one
+        (("--faults", "inter-char-gap", "--echo"), (), {"R-7.0-12"}),
     ],
     indirect=["emulator"],
     ids=["no-service-request", "parity-error", "service-request-extra-chars", "inter-char-gap"],

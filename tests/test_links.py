@@ -14,6 +14,7 @@ import pytest
 
 from conformance.emulate.realtime import RealTimeLine
 from conformance.emulate.servers import TcpEmulatorServer
+from conformance.links.echo import EchoMode
 from conformance.links.errors import BreakUnsupported, PortUnavailable, PortVanished
 from conformance.links.factory import _explain, open_real_link, port_kind
 from conformance.links.stamps import MAX_LEAD, chunk_frames
@@ -88,7 +89,7 @@ def test_nobody_listening_is_a_port_error():
 
 # -- reading and writing ----------------------------------------------------------------------
 def test_loop_link_keeps_the_raw_bits_and_declares_no_break():
-    link = open_real_link("loop://")
+    link = open_real_link("loop://", echo=EchoMode.OFF)  # loop:// plays a DUT sending them
     try:
         assert link.info.kind == "loop" and not link.info.can_break
         good, bad = to_wire_7e1(ord("0")), to_wire_7e1(ord("0")) ^ 0x80
@@ -116,7 +117,7 @@ def test_receive_on_a_silent_line_is_bounded_by_its_deadline():
 
 
 def test_write_with_a_gap_spaces_the_characters():
-    link = open_real_link("loop://")
+    link = open_real_link("loop://", echo=EchoMode.OFF)  # the stamps of the write itself
     try:
         events = link.write(b"0I!", gap=0.010)
         starts = [e.start for e in events]
@@ -194,7 +195,9 @@ def test_socket_link_cannot_break_and_the_engine_sends_anyway():
         assert exchange.attempts[0].break_event is None
         assert not exchange.answered
         notes = [e.text for e in link.transcript if e.kind is EventKind.NOTE]
-        assert notes and all("no break" in n for n in notes)
+        breaks = [n for n in notes if "no break" in n]
+        echo = "no echo of the tool's characters: the interface does not echo"
+        assert breaks and set(notes) - set(breaks) <= {echo}
         deadline = time.monotonic() + 1
         while len(server.received) < 2 and time.monotonic() < deadline:
             time.sleep(0.01)
@@ -241,7 +244,8 @@ class _BreakRecorder:
         raise AssertionError("never offers a frame")
 
 
-def test_rfc2217_break_is_short_and_seen_by_the_server_as_held():
+def _served_break(duration: float) -> tuple[object, tuple[float, float]]:
+    """Send one break of ``duration`` over RFC 2217 to a line that records what it heard."""
     device = _BreakRecorder()
     line = RealTimeLine(device, lambda data: None).start()
     server = TcpEmulatorServer(line, "127.0.0.1", 0)
@@ -250,17 +254,33 @@ def test_rfc2217_break_is_short_and_seen_by_the_server_as_held():
     link = open_real_link(server.url)
     try:
         assert link.info.kind == "rfc2217" and link.info.can_break
-        event = link.send_break(13e-3)
-        assert 13e-3 <= event.duration < 15e-3, event
-        assert "SET_CONTROL" in event.text
+        event = link.send_break(duration)
         link.wait(0.02)
         deadline = time.monotonic() + 1
         while not device.breaks and time.monotonic() < deadline:
             time.sleep(0.005)
-        ((start, end),) = device.breaks
-        assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+        (heard,) = device.breaks
+        return event, heard
     finally:
         link.close()
         server.stop()
         serving.join(timeout=2)
         line.stop()
+
+
+def test_rfc2217_short_break_is_a_nul_timed_by_the_uart():
+    """A 13 ms break is a NUL at 692 baud: the line holds spacing for exactly 9 bit times,
+    whatever the host's sleep did, and the event says so with a tiny length uncertainty."""
+    event, (start, end) = _served_break(13e-3)
+    assert event.duration == pytest.approx(9 / 692)
+    assert "692 baud" in event.text and "SET-BAUDRATE" in event.text
+    assert event.length_uncertainty < 0.2e-3 < event.uncertainty
+    assert end - start == pytest.approx(9 / 692, abs=1e-9)  # the line's own arithmetic
+
+
+def test_rfc2217_long_break_is_held_by_set_control():
+    """Longer than a NUL at the lowest rate can make: held with raw SET_CONTROL messages."""
+    event, (start, end) = _served_break(100e-3)
+    assert 100e-3 <= event.duration < 103e-3, event
+    assert "SET_CONTROL" in event.text
+    assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only

@@ -10,14 +10,18 @@ from __future__ import annotations
 
 import argparse
 import signal
+import sys
 import threading
 from dataclasses import replace
 
+from ..links.priority import EMULATED_LINE, realtime_priority
 from ..ports import PortError, parse_sim
+from .bench import BenchModel
 from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
 
 EXIT_OK, EXIT_USAGE = 0, 4
+SWITCH_INTERVAL = 2e-4  # s: the GIL hand-over interval while serving (Python's default: 5 ms)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -43,7 +47,52 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", dest="sdi_version", default="1.4", help="1.3 or 1.4 (default)")
     p.add_argument("--address", default="0", help="the sensor's address (default 0)")
     p.add_argument("--faults", default="", help="comma-separated fault names (see `faults`)")
+    bench = p.add_argument_group(
+        "bench models (what a real interface between recorder and line does; default: none)"
+    )
+    bench.add_argument(
+        "--echo",
+        action="store_true",
+        help="the recorder hears its own characters at their stop bit, a break as 0x00",
+    )
+    bench.add_argument(
+        "--usb-latency",
+        type=float,
+        default=0.0,
+        metavar="MS",
+        help="bytes reach the recorder in batches, at each tick of an MS latency timer (FTDI: 16)",
+    )
+    bench.add_argument(
+        "--jitter",
+        type=float,
+        default=0.0,
+        metavar="MS",
+        help="each delivery is delayed a further random 0..MS ms (order kept)",
+    )
+    bench.add_argument(
+        "--require-rts",
+        action="store_true",
+        help="the recorder's characters reach the line only while it raises RTS, and "
+        "the sensor's reply is lost while RTS stays raised",
+    )
+    bench.add_argument("--seed", type=int, default=1, help="seed of the jitter (default 1)")
     return p
+
+
+def bench_model(args: argparse.Namespace) -> BenchModel:
+    """The bench model the options ask for (raises :class:`PortError` on bad figures)."""
+    for name in ("usb_latency", "jitter"):
+        value = getattr(args, name)
+        if not 0 <= value <= 1000:
+            flag = "--" + name.replace("_", "-")
+            raise PortError(f"{flag} must be 0..1000 ms, not {value:g}")
+    return BenchModel(
+        echo=args.echo,
+        usb_latency=args.usb_latency / 1e3,
+        jitter=args.jitter / 1e3,
+        require_rts=args.require_rts,
+        seed=args.seed,
+    )
 
 
 def make_device(version: str, address: str, faults: str) -> object:
@@ -86,22 +135,32 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
         return EXIT_OK if exc.code == 0 else EXIT_USAGE
     try:
         device = make_device(args.sdi_version, args.address, args.faults)
+        bench = bench_model(args)
         if args.raw and not args.listen:
             raise PortError("--raw applies to --listen only")
     except PortError as exc:
         print_line(f"error: {exc}")
         return EXIT_USAGE
     faults = args.faults or "none"
-    what = f"reference sensor v{args.sdi_version}, address {args.address}, faults: {faults}"
+    what = (
+        f"reference sensor v{args.sdi_version}, address {args.address}, faults: {faults}, "
+        f"bench: {bench.describe()}"
+    )
+    # the line's thread must get the interpreter back at once when a frame is due, and no
+    # thread of the server may be preempted while it holds the lock the line needs
+    sys.setswitchinterval(SWITCH_INTERVAL)
+    realtime_priority(EMULATED_LINE)
     if args.listen:
-        return _serve_tcp(device, args, what, print_line)
+        return _serve_tcp(device, args, what, print_line, bench)
     return _serve_port(device, args.serial, what, print_line)
 
 
-def _serve_tcp(device: object, args: argparse.Namespace, what: str, print_line) -> int:
+def _serve_tcp(
+    device: object, args: argparse.Namespace, what: str, print_line, bench: BenchModel
+) -> int:
     try:
         host, port = _host_port(args.listen)
-        line = RealTimeLine(device, lambda _data: None).start()  # type: ignore[arg-type]
+        line = RealTimeLine(device, lambda _data: None, bench=bench).start()  # type: ignore[arg-type]
         server = TcpEmulatorServer(line, host, port, rfc2217_protocol=not args.raw, log=print_line)
     except (PortError, OSError) as exc:
         print_line(f"error: cannot listen on {args.listen}: {exc}")

@@ -24,10 +24,20 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from math import inf
 
+from ..links.priority import EMULATED_LINE, realtime_priority
 from ..protocol.timing import CHAR_TIME
 from ..sim.bus import BusDevice
+from .bench import (
+    BAUD,
+    SAMPLE_STOP,
+    BenchModel,
+    Delivery,
+    spacing_as_received,
+    spacing_runs,
+)
 
 SPIN = 0.0008  # s: poll the last stretch before a due time instead of oversleeping it
+RT_SPIN = 0.0001  # s: the same with a real-time class, whose sleeps end within microseconds
 LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counted as late
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
 
@@ -51,8 +61,14 @@ class RealTimeLine:
         *,
         deliver_at_end: bool = True,
         clock: Callable[[], float] = time.perf_counter,
+        bench: BenchModel | None = None,
     ) -> None:
         self.device = device
+        self.bench = bench or BenchModel()
+        self._delivery = Delivery(self.bench)
+        self._rts = not self.bench.require_rts  # the recorder's transmit enable, as last set
+        self.lost_frames = 0  # device frames the recorder's raised driver swallowed
+        self.realtime_priority = False  # the line's thread got a real-time scheduling class
         self._send = send
         self._deliver_at_end = deliver_at_end
         self._clock = clock
@@ -61,6 +77,7 @@ class RealTimeLine:
         self._seq = itertools.count()
         self._tool_free = -inf  # end of the recorder's last frame on the emulated wire
         self._break_start: float | None = None
+        self._last_spacing = (inf, inf)  # (start, end) of the recorder's last break
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="sdi12-emulated-line", daemon=True)
         self.frames_sent = 0
@@ -79,25 +96,43 @@ class RealTimeLine:
         with self._cond:
             self._send = send
 
-    def tool_bytes(self, data: bytes, at: float | None = None) -> None:
+    def set_rts(self, raised: bool) -> None:
+        """The recorder switched its transmit enable (RFC 2217 SET_CONTROL RTS)."""
+        with self._cond:
+            self._rts = bool(raised)
+
+    def tool_bytes(self, data: bytes, at: float | None = None, baud: int = BAUD) -> None:
         """Recorder bytes that reached the line at ``at``: each takes one frame, back to
-        back behind the previous one; bytes sent while the recorder holds a break are lost."""
+        back behind the previous one; bytes sent while the recorder holds a break, or (with
+        an RTS-switched driver) without RTS raised, are lost. A byte sent at another bit rate
+        is what it is on the wire: its runs of spacing, each heard by the device as a pulse
+        (a NUL at 4800 baud is 1.875 ms of spacing; at 720 baud a 12.5 ms break)."""
         at = self.now() if at is None else at
         with self._cond:
-            if self._break_start is not None:
+            if self._break_start is not None or not self._rts:
                 return
+            frame = 10 / baud if baud else CHAR_TIME
             for wire in data:
                 start = max(at, self._tool_free)
-                end = start + CHAR_TIME
+                end = start + frame
                 self._tool_free = end
-                self._push(end, lambda w=wire, s=start, e=end: self.device.on_char(w, s, e))
+                if abs(baud - BAUD) <= BAUD * 0.02:
+                    self._push(end, lambda w=wire, s=start, e=end: self.device.on_char(w, s, e))
+                else:
+                    for a, b in spacing_runs(wire, baud):
+                        s, e = start + a, start + b
+                        self._push(e, lambda s=s, e=e: self.device.on_break(s, e))
+                if self.bench.echo:  # the recorder's receiver, at its own rate, reads it back
+                    self._push(self._delivery.time(end), lambda w=wire: self._emit(w, echo=True))
             self._cond.notify()
 
     def break_on(self, at: float | None = None) -> None:
         at = self.now() if at is None else at
         with self._cond:
-            if self._break_start is None:
-                self._break_start = max(at, self._tool_free)
+            if self._break_start is None and self._rts:
+                self._break_start = start = max(at, self._tool_free)
+                if self.bench.echo:  # a receiver reads spacing at its stop-bit sample
+                    self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._echo_spacing(s))
 
     def break_off(self, at: float | None = None) -> None:
         at = self.now() if at is None else at
@@ -107,16 +142,34 @@ class RealTimeLine:
                 return
             end = max(at, start)
             self._tool_free = end
+            self._last_spacing = (start, end)
             self._push(end, lambda s=start, e=end: self.device.on_break(s, e))
             self._cond.notify()
 
+    def _echo_spacing(self, start: float) -> None:
+        """The echo of the spacing that began at ``start``, read at its stop-bit sample: a
+        0x00 if the line still spaces (or spaced long enough), else the byte a short pulse
+        makes. Runs on the line's thread at the sample time."""
+        if self._break_start == start:
+            duration = self.now() - start
+        else:
+            s, e = self._last_spacing
+            duration = e - s if s == start else 0.0
+        heard = spacing_as_received(duration)
+        if heard is not None:
+            self._push(self._delivery.time(self.now()), lambda b=heard[0]: self._emit(b, True))
+
     def timekeeping(self) -> str:
         """One line for the server log: how well the line kept its schedule so far."""
-        return (
+        text = (
             f"line kept real time within {self.worst_lateness * 1e3:.1f} ms "
             f"({self.late_frames} of {self.frames_sent} frames more than "
-            f"{LATE_NOTICE * 1e3:.0f} ms late)"
+            f"{LATE_NOTICE * 1e3:.0f} ms late; real-time priority "
+            f"{'on' if self.realtime_priority else 'off'})"
         )
+        if self.lost_frames:
+            text += f"; {self.lost_frames} sensor frames lost under the recorder's raised RTS"
+        return text
 
     def start(self) -> RealTimeLine:
         self._thread.start()
@@ -134,12 +187,14 @@ class RealTimeLine:
         heapq.heappush(self._due, _Due(when, next(self._seq), action))
 
     def _run(self) -> None:
+        self.realtime_priority = realtime_priority(EMULATED_LINE)
+        spin = RT_SPIN if self.realtime_priority else SPIN  # a spinning RT thread starves others
         while not self._stop.is_set():
             with self._cond:
                 nxt = self._next_due()
                 now = self.now()
-                if nxt > now + SPIN:
-                    self._cond.wait(min(nxt - now - SPIN, MAX_IDLE_WAIT))
+                if nxt > now + spin:
+                    self._cond.wait(min(nxt - now - spin, MAX_IDLE_WAIT))
                     continue
             while self.now() < nxt:
                 time.sleep(0)
@@ -171,13 +226,18 @@ class RealTimeLine:
                 lateness = self.now() - frame.start
                 self.worst_lateness = max(self.worst_lateness, lateness)
                 self.late_frames += lateness > LATE_NOTICE
+                if self.bench.require_rts and self._rts:
+                    self.lost_frames += 1  # the recorder's driver still holds the line
+                    return
                 deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
+                if self._deliver_at_end:
+                    deliver = self._delivery.time(deliver)
                 self._push(deliver, lambda w=frame.wire: self._emit(w))
             except Exception as exc:  # a device bug must not kill the line silently
                 self.errors.append(exc)
                 raise
 
-    def _emit(self, wire: int) -> None:
-        self.frames_sent += 1
+    def _emit(self, wire: int, echo: bool = False) -> None:
+        self.frames_sent += not echo
         with contextlib.suppress(OSError):  # the peer left; the device runs on for the next
             self._send(bytes([wire]))

@@ -39,9 +39,19 @@ class VirtualPort:
         self.xonxoff = False
         self.rtscts = False
         self.dtr = True
-        self.rts = True
+        self._rts = not line.bench.require_rts
         self.cts = self.dsr = self.ri = self.cd = False
         self._break = False
+
+    @property
+    def rts(self) -> bool:
+        return self._rts
+
+    @rts.setter
+    def rts(self, value: bool) -> None:
+        """The recorder's transmit enable (an RS-485-style driver on an RTS line)."""
+        self._rts = bool(value)
+        self.line.set_rts(self._rts)
 
     @property
     def break_condition(self) -> bool:
@@ -155,7 +165,7 @@ class TcpEmulatorServer:
                 port.arrival = at
                 # byte by byte: a SET_CONTROL inside the chunk toggles the break in between
                 for byte in manager.filter(data):
-                    self.line.tool_bytes(byte, at)
+                    self.line.tool_bytes(byte, at, port.baudrate)
         finally:
             self.line.set_sender(_discard)
             if port.break_condition:

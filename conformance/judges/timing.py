@@ -7,10 +7,82 @@ PASS only when the whole interval ``measured +/- uncertainty`` lies inside the a
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 from ..protocol.timing import TOLERANCE
 from ..verdicts import Finding, Verdict
 
 EPSILON = 1e-9  # s: a value exactly on a limit is inside it, whatever float rounding says
+
+
+@dataclass(frozen=True)
+class StampUncertainty:
+    """A run's timing uncertainty: ``base`` everywhere, more where the link saw its own
+    stamps irregular (``local(start, end)``, real links; a virtual clock has none)."""
+
+    base: float
+    local: Callable[[float, float], float] | None = None
+
+    def between(self, start: float, end: float) -> float:
+        if self.local is None:
+            return self.base
+        return max(self.base, self.local(start, end))
+
+
+def stamp_uncertainty(u: float | StampUncertainty) -> StampUncertainty:
+    return u if isinstance(u, StampUncertainty) else StampUncertainty(u)
+
+
+def combine_local(
+    rid: str,
+    observed: list[tuple[Finding, bool]],
+    what: str,
+    *,
+    smallest_is_worst: bool = False,
+    real_time: bool = True,
+) -> Finding:
+    """:func:`combine` for observations each judged with its own uncertainty, flagged where
+    that was widened by a local irregularity of the link's stamps.
+
+    - An observation that the irregularity alone left undecided says nothing about the DUT:
+      it is set aside (and counted in the detail) instead of making the whole rule
+      INCONCLUSIVE. If every observation was set aside the rule stays INCONCLUSIVE.
+    - On a real-time link (``real_time``) a host that stalls once can make one stamp late
+      with no trace around it; a single deviating observation among others that conform is
+      therefore not enough for a FAIL (INCONCLUSIVE, with the observation), two or more are.
+      On a virtual clock every observation is exact and one is enough."""
+    kept = [f for f, tainted in observed if not (tainted and f.verdict is Verdict.INCONCLUSIVE)]
+    aside = [f for f, tainted in observed if tainted and f.verdict is Verdict.INCONCLUSIVE]
+    worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
+    note = (
+        f"{len(aside)} {plural(what) if len(aside) != 1 else what} set aside: the link's "
+        f"stamps near them were irregular (±{worst_aside:.2f} ms there)"
+    )
+    if aside and not kept:
+        return Finding(rid, Verdict.INCONCLUSIVE, f"every {what} undecided; {note}")
+    failing = [f for f in kept if f.verdict is Verdict.FAIL]
+    isolated = real_time and len(failing) == 1 and len(kept) > 1
+    if isolated:
+        (lone,) = failing
+        kept = [f for f in kept if f is not lone]
+    found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
+    if isolated:
+        where = f" [{lone.evidence[0]}]" if lone.evidence else ""
+        found = Finding(
+            rid,
+            Verdict.INCONCLUSIVE,
+            f"one {what} of {len(kept) + 1} deviates: {lone.detail}{where}; every other "
+            f"conforms ({found.detail}). A single late stamp on a real-time link may be a "
+            "stall of the host, not of the device: not decided",
+            measured_ms=lone.measured_ms,
+            limit_ms=lone.limit_ms,
+            uncertainty_ms=lone.uncertainty_ms,
+            evidence=lone.evidence,
+        )
+    if aside:
+        found.detail += f"; {note}"
+    return found
 
 
 def judge_window(
@@ -46,6 +118,10 @@ def judge_window(
     if verdict is Verdict.INCONCLUSIVE:
         detail += " (the uncertainty straddles the limit)"
     limit_ms = (hi if hi is not None else lo) or 0.0
+    edges = [measured - lo if lo is not None else None, hi - measured if hi is not None else None]
+    distances = [abs(d) for d in edges if d is not None]
+    if outside:  # decided by the edge it is beyond
+        distances = [-d for d in edges if d is not None and d < 0]
     return Finding(
         requirement,
         verdict,
@@ -55,7 +131,30 @@ def judge_window(
         uncertainty_ms=round(uncertainty * 1e3, 3),
         evidence=list(evidence or []),
         decision=decision,
+        margin_ms=round(min(distances) * 1e3, 3) if distances else None,
     )
+
+
+def recheck(findings: list[Finding], uncertainty: float) -> int:
+    """Judge timing findings again against the run's final measured ``uncertainty`` (s):
+    a PASS, WARN or FAIL whose margin the larger figure no longer clears becomes
+    INCONCLUSIVE (a verdict must hold for every stamp error the run has shown possible).
+    Returns how many changed."""
+    changed = 0
+    u_ms = uncertainty * 1e3
+    for f in findings:
+        if f.margin_ms is None or f.uncertainty_ms is None or u_ms <= f.uncertainty_ms:
+            continue
+        if f.verdict not in (Verdict.PASS, Verdict.WARN, Verdict.FAIL) or f.margin_ms > u_ms:
+            continue
+        f.detail += (
+            f" — but the link's measured uncertainty grew to ±{u_ms:.2f} ms later in the run, "
+            f"more than this {f.margin_ms:.2f} ms margin: not decided"
+        )
+        f.verdict = Verdict.INCONCLUSIVE
+        f.uncertainty_ms = round(u_ms, 3)
+        changed += 1
+    return changed
 
 
 def _describe_limit(lo: float | None, hi: float | None) -> str:
@@ -92,6 +191,12 @@ def combine(
     else:
         where = worst.evidence[0] if worst.evidence else ""
         detail = f"{worst.detail} [{where}]; {span}"
+    same = [f.margin_ms for f in findings if f.verdict is worst.verdict]
+    margins = [m for m in same if m is not None]
+    margin = None
+    if margins and len(margins) == len(same):
+        # every PASS must hold; for a FAIL, one that holds is enough
+        margin = max(margins) if worst.verdict in (Verdict.FAIL, Verdict.WARN) else min(margins)
     return Finding(
         rid,
         worst.verdict,
@@ -100,4 +205,5 @@ def combine(
         limit_ms=worst.limit_ms,
         uncertainty_ms=worst.uncertainty_ms,
         evidence=worst.evidence,
+        margin_ms=margin,
     )

@@ -21,7 +21,7 @@ from ..protocol.timing import (
 )
 from ..transcript import TOOL, Event, EventKind, escape
 from ..verdicts import Finding, Verdict
-from .timing import combine, judge_window
+from .timing import StampUncertainty, combine_local, judge_window, stamp_uncertainty
 
 REPLY_SEARCH = NO_BREAK_WINDOW  # a DUT run starting later than this is not a reply
 RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
@@ -116,68 +116,93 @@ def runs(events: list[Event]) -> list[list[Event]]:
 
 
 # -- timing ---------------------------------------------------------------------------------
-def judge_response_start(segs: list[Segment], uncertainty: float) -> list[Finding]:
-    """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply."""
+def judge_response_start(
+    segs: list[Segment], uncertainty: float | StampUncertainty
+) -> list[Finding]:
+    """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply, each
+    with the uncertainty of the stamps it rests on (the command's last, the reply's first)."""
+    stamps = stamp_uncertainty(uncertainty)
     early, late = [], []
     for seg in segs:
         if not seg.reply:
             continue
         delay = seg.reply[0].start - seg.command_end
+        u = stamps.between(seg.command[-1].start, seg.reply[0].end)
+        tainted = u > stamps.base
         where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
         early.append(
-            judge_window(
-                "R-7.0-09",
-                "first response start bit after the command",
-                delay,
-                uncertainty,
-                low=CHAR_TIME,
-                tolerance=TOLERANCE,
-                evidence=where,
+            (
+                judge_window(
+                    "R-7.0-09",
+                    "first response start bit after the command",
+                    delay,
+                    u,
+                    low=CHAR_TIME,
+                    tolerance=TOLERANCE,
+                    evidence=where,
+                ),
+                tainted,
             )
         )
         late.append(
-            judge_window(
-                "R-7.0-10",
-                "first response start bit after the command",
-                delay,
-                uncertainty,
-                high=RESPONSE_START_MAX,
-                evidence=where,
+            (
+                judge_window(
+                    "R-7.0-10",
+                    "first response start bit after the command",
+                    delay,
+                    u,
+                    high=RESPONSE_START_MAX,
+                    evidence=where,
+                ),
+                tainted,
             )
         )
     _ = RESPONSE_START_MIN  # = CHAR_TIME - TOLERANCE, the derived window's lower edge
-    return [combine("R-7.0-09", early, "reply"), combine("R-7.0-10", late, "reply")]
+    real = stamps.local is not None
+    return [
+        combine_local("R-7.0-09", early, "reply", real_time=real),
+        combine_local("R-7.0-10", late, "reply", real_time=real),
+    ]
 
 
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     """Every marking gap between consecutive characters of one DUT run, with its context."""
+    return [(gap, where) for gap, where, _a, _b in _gaps(segs)]
+
+
+def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event]]:
     gaps = []
     for seg in segs:
         for run in runs(seg.reply) + runs(seg.later):
             for a, b in zip(run, run[1:], strict=False):
                 if seg.multiline and a.char7 == 0x0A:
                     continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
-                gaps.append((b.start - a.end, f"in reply to {escape(seg.text)}"))
+                gaps.append((b.start - a.end, f"in reply to {escape(seg.text)}", a, b))
     return gaps
 
 
-def judge_gaps(segs: list[Segment], uncertainty: float) -> list[Finding]:
+def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[Finding]:
     """R-7.0-12: at most 1.66 ms of marking between characters (no tolerance), and R-7.0-01:
-    a gap inside the ±0.40 ms band above 1.66 ms uses a tolerance the rule does not grant."""
-    findings = [
-        judge_window(
+    a gap inside the ±0.40 ms band above 1.66 ms uses a tolerance the rule does not grant.
+    Each gap carries the uncertainty of the two stamps it rests on."""
+    stamps = stamp_uncertainty(uncertainty)
+    observed = []
+    for gap, where, a, b in _gaps(segs):
+        u = stamps.between(a.start, b.end)
+        finding = judge_window(
             "R-7.0-12",
             "marking between response characters",
             gap,
-            uncertainty,
+            u,
             high=INTER_CHAR_GAP_MAX,
             tolerance=0.0,
             evidence=[where],
         )
-        for gap, where in reply_gaps(segs)
-    ]
-    gap_finding = combine("R-7.0-12", findings, "character gap")
-    tolerance_finding = _judge_tolerance_use(reply_gaps(segs), uncertainty)
+        observed.append((finding, u > stamps.base))
+    gap_finding = combine_local(
+        "R-7.0-12", observed, "character gap", real_time=stamps.local is not None
+    )
+    tolerance_finding = _judge_tolerance_use(reply_gaps(segs), stamps.base)
     return [gap_finding, tolerance_finding]
 
 

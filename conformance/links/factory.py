@@ -13,7 +13,12 @@ What each kind can do, and how far its stamps can be trusted, is decided here on
 - ``adapter:...`` / ``adapter+URL``: a transparent SDI-12 adapter
   (:mod:`~conformance.links.adapter_link`): no breaks, no unsolicited bytes, 50 ms.
 
-``--timing-uncertainty-ms`` overrides the declaration when the user knows better.
+These figures are floors: the link measures what its stamps are worth as the run goes
+(:mod:`~conformance.links.meter`), and ``--timing-uncertainty-ms`` may only widen the result.
+With ``--echo auto`` (the default) the link finds out on its first transmission whether the
+interface echoes the tool's characters; ``--direction rts|dtr`` raises that line for the tool's
+transmissions. Where the port can change its bit rate (a local UART, RFC 2217), breaks and
+short spacing pulses are NULs at a lower rate, timed by the UART.
 """
 
 from __future__ import annotations
@@ -24,8 +29,11 @@ from urllib.parse import urlsplit
 import serial
 
 from .base import Link, LinkInfo
-from .breaks import BreakMaker, Rfc2217Break, UartBreak
+from .breaks import BaudPulse, BreakMaker, Rfc2217Break, UartBreak
+from .direction import Direction, DirectionLine
+from .echo import EchoMode
 from .errors import PortUnavailable
+from .kernel_stamps import stamped_port
 from .serial_link import READ_POLL, SerialLink
 
 BAUD = 1200
@@ -48,15 +56,26 @@ def _is_loopback(port: str) -> bool:
     return host.startswith(LOOPBACK_HOSTS) or host in LOOPBACK_HOSTS
 
 
-def open_real_link(port: str, timing_uncertainty: float | None = None) -> Link:
-    """Open ``port`` at 1200 baud 8N1 (parity in software) and wrap it in a link."""
+def open_real_link(
+    port: str,
+    timing_uncertainty: float | None = None,
+    *,
+    echo: EchoMode = EchoMode.AUTO,
+    direction: DirectionLine = DirectionLine.NONE,
+) -> Link:
+    """Open ``port`` at 1200 baud 8N1 (parity in software) and wrap it in a link.
+
+    ``timing_uncertainty`` (s) only widens what the link measures; it never narrows it."""
     from .adapter_link import is_adapter_port, open_adapter_link
 
     if is_adapter_port(port):
         return open_adapter_link(port, timing_uncertainty)
     kind = port_kind(port)
-    raw = _open(port, kind)
+    raw = _open(port, kind, direction)
     breaker: BreakMaker | None = None
+    pulse: BaudPulse | None = None
+    if kind == "rfc2217" or (kind == "serial" and not _is_pty(port)):
+        pulse = BaudPulse(raw)  # a pseudo-terminal has no bit clock: its NUL is just a byte
     if kind == "serial":
         breaker = UartBreak(raw)
         uncertainty = USB_UNCERTAINTY
@@ -68,31 +87,46 @@ def open_real_link(port: str, timing_uncertainty: float | None = None) -> Link:
         if kind == "rfc2217":
             breaker = Rfc2217Break(raw)
         uncertainty = LOCAL_NET_UNCERTAINTY if _is_loopback(port) else REMOTE_NET_UNCERTAINTY
-    info = LinkInfo(
-        kind=kind,
-        can_break=breaker is not None,
-        timing_uncertainty=uncertainty if timing_uncertainty is None else timing_uncertainty,
+    info = LinkInfo(kind=kind, can_break=breaker is not None, timing_uncertainty=uncertainty)
+    link = SerialLink(
+        raw,
+        info,
+        breaker,
+        name=port,
+        echo=echo,
+        pulse=pulse,
+        direction=None if direction is DirectionLine.NONE else Direction(raw, direction),
     )
-    return SerialLink(raw, info, breaker, name=port)
+    if timing_uncertainty is not None:
+        link.meter.widen_to = timing_uncertainty
+    return link
 
 
-def _open(port: str, kind: str) -> serial.SerialBase:
+def _open(port: str, kind: str, direction: DirectionLine = DirectionLine.NONE) -> serial.SerialBase:
     try:
-        raw = serial.serial_for_url(
+        raw = stamped_port(
             port,
             baudrate=BAUD,
             bytesize=serial.EIGHTBITS,
             parity=serial.PARITY_NONE,
             stopbits=serial.STOPBITS_ONE,
             timeout=READ_POLL,
-            do_not_open=True,
         )
         if kind == "serial":
             raw.write_timeout = OPEN_TIMEOUT  # a stuck UART must not block a write forever
+        if direction is DirectionLine.RTS:
+            raw.rts = False  # the driver stays off until the tool transmits
+        elif direction is DirectionLine.DTR:
+            raw.dtr = False
         raw.open()
     except (serial.SerialException, OSError, ValueError, NotImplementedError) as exc:
         raise PortUnavailable(_explain(port, kind, exc)) from exc
     return raw
+
+
+def _is_pty(port: str) -> bool:
+    """A pseudo-terminal (emulators, socat): bytes without line timing or breaks."""
+    return port.startswith(("/dev/pts/", "/dev/ptmx", "/dev/tty.pty")) or "/pty" in port
 
 
 def _low_latency(raw: serial.SerialBase) -> bool:

@@ -32,3 +32,10 @@ def chunk_frames(
     first = max(arrival - count * char_time, floor)
     first = min(first, arrival + MAX_LEAD - count * char_time)
     return [(first + k * char_time, first + (k + 1) * char_time) for k in range(count)]
+
+
+def overlap(count: int, arrival: float, floor: float, char_time: float = CHAR_TIME) -> float:
+    """How far (s) ``count`` bytes arriving at ``arrival`` would start before the previous
+    frame ended, taken at face value: 0 for possible stamps, else the size of the artefact
+    (a late stamp before, or an early one now) that :func:`chunk_frames` has to correct."""
+    return max(0.0, floor - (arrival - count * char_time))

@@ -180,6 +180,11 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
     link = run["link"]
     uncertainty = link.get("timing_uncertainty_ms")
     u = f", timing ±{uncertainty} ms" if uncertainty is not None else ""
+    bench = link.get("bench")
+    if bench:
+        ref = bench["timing"]["reference"]
+        u += f" (measured, against the {'echo' if ref == 'echo' else 'write time'})"
+        u += ", interface echoes" if bench["echo"] else ""
     if run["role"] == "recorder":
         first = f"DUT data recorder · SDI-12 {dut.get('sdi12_version')}"
     else:

@@ -173,6 +173,25 @@ def _counted(notes: list[str]) -> str:
     return "; ".join(n if k == 1 else f"{n} (×{k})" for n, k in seen.items())
 
 
+def bench_rows(bench: dict[str, Any] | None) -> list[tuple[str, str]]:
+    """What the report says about a real bench: echo, breaks, direction, measured timing."""
+    if not bench:
+        return []
+    echo = "yes" if bench["echo"] else "no"
+    if bench["echo_collisions"] or bench["echo_missing"]:
+        echo += (
+            f" ({bench['echo_collisions']} echoes differed from what was sent: collisions; "
+            f"{bench['echo_missing']} not heard back)"
+        )
+    timing = bench["timing"]
+    return [
+        ("Interface echoes the tool", f"{echo} (--echo {bench['echo_mode']})"),
+        ("Breaks and pulses made", str(bench["breaks"])),
+        ("Transmit enable", str(bench["direction"])),
+        ("Timing measured", str(timing["summary"])),
+    ]
+
+
 def header(run: ConformanceRun) -> str:
     """The DUT identity and the run's identity, side by side."""
     dut = dut_block(run)
@@ -206,6 +225,7 @@ def header(run: ConformanceRun) -> str:
         ("Port", run.options.port),
         ("Link", f"{link['kind']}, can send breaks: {breaks}"),
         ("Timing uncertainty", f"±{uncertainty} ms{exact}"),
+        *bench_rows(link.get("bench")),
         ("Started", run.started),
         ("Finished", run.finished or "—"),
         ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),

@@ -23,14 +23,14 @@ def _segments(sensor):
 def test_response_start_window(sensor, case):
     """Every reply's first start bit comes 7.93 to 15.40 ms after the command's last stop bit."""
     case.expect("8.33 ms (-0.40) <= delay <= 15.0 ms (+0.40), for every reply of the run")
-    case.extend(wire.judge_response_start(_segments(sensor), sensor.uncertainty))
+    case.extend(wire.judge_response_start(_segments(sensor), sensor.stamp_uncertainty))
 
 
 @requirements("R-7.0-12", "R-7.0-01")
 def test_character_gaps(sensor, case):
     """No more than 1.66 ms of marking between the characters of a reply (no tolerance)."""
     case.expect("every inter-character gap of every reply <= 1.66 ms")
-    case.extend(wire.judge_gaps(_segments(sensor), sensor.uncertainty))
+    case.extend(wire.judge_gaps(_segments(sensor), sensor.stamp_uncertainty))
 
 
 @requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")

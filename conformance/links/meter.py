@@ -1,0 +1,196 @@
+"""What a real link's stamps are worth, measured on the run itself (design.md section 4).
+
+A link declares a floor for its timing uncertainty (what it cannot see: the latency of a USB
+chip, of the far end of a network). Everything the run can observe about its own stamps goes
+into a :class:`TimingMeter`, and the uncertainty the judges use is the larger of the floor
+and the worst observation:
+
+- **echo spread**: the tool's own characters leave the UART back to back; where the
+  interface echoes them, the spread of their arrival times about that known spacing is the
+  receive path's jitter, measured;
+- **batches**: bytes that reach the host together hide the gaps between them; a batch of k
+  bytes proves the path's latency varied by at least (k-1) character times;
+- **artefacts**: stamps that are physically impossible (a frame starting before the previous
+  one ended) are link artefacts: their size is a lower bound of the stamps' error;
+- **reader lag**: how late the reader thread woke (kernel stamp against the thread's own, or
+  a timed read's overrun). It only widens the uncertainty where the link's stamps come from
+  the thread (no kernel stamps).
+
+With echo, the DUT's timing is measured against the echoed command on the same receive path
+(the ``echo`` reference), so the path's fixed latency cancels and only its jitter remains;
+without it, against the moment the tool wrote (the ``write`` reference), where the latency
+stays in the declared floor.
+
+Irregularities are also **local**: a machine that stalls for a few milliseconds once in a
+thousand characters makes the stamps around that moment wrong, not every stamp of the run.
+Each artefact, batch and echo spread far beyond the usual one is kept as a *taint* (a time
+span and the error it shows there); :meth:`TimingMeter.between` gives the uncertainty of a
+measurement between two instants: the run's regular figure, or the taint it touches. The
+regular figure is the worst echo spread once such outliers are set aside (they are taints).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+ECHO_FLOOR = 0.25e-3  # s: least uncertainty claimed on one receive path (UART sampling, clocks)
+OUTLIER_FACTOR = 2.0  # an echo spread beyond this many times the 90th percentile...
+OUTLIER_MARGIN = 0.5e-3  # ...plus this is a local stall (a taint), not the path's jitter
+MIN_SPREADS = 10  # fewer echo spreads than this: the worst one is the regular figure
+
+
+@dataclass(frozen=True)
+class Taint:
+    """Stamps between ``start`` and ``end`` (s, link clock) may be off by ``error`` (s)."""
+
+    start: float
+    end: float
+    error: float
+    why: str
+
+
+@dataclass
+class Worst:
+    """The largest of a kind of sample, where it was seen, and how many were taken."""
+
+    value: float = 0.0
+    count: int = 0
+    where: str = ""
+
+    def add(self, value: float, where: str = "") -> None:
+        self.count += 1
+        if value > self.value:
+            self.value, self.where = value, where
+
+
+@dataclass
+class TimingMeter:
+    declared: float  # s: the link's declared floor without echo (latency it cannot see)
+    kernel_stamps: bool = False
+    echo_spread: Worst = field(default_factory=Worst)
+    batches: Worst = field(default_factory=Worst)
+    artefacts: Worst = field(default_factory=Worst)
+    reader_lag: Worst = field(default_factory=Worst)
+    round_trip: Worst = field(default_factory=Worst)  # write call to echo: fixed latency
+    turnaround: Worst = field(default_factory=Worst)  # last stop bit to driver released
+    widen_to: float = 0.0  # s: the user's --timing-uncertainty-ms (may only widen)
+    echo: bool = False  # the run measures against the echo of its own characters
+    taints: list[Taint] = field(default_factory=list)
+    spreads: list[tuple[float, float, float]] = field(default_factory=list)  # start, end, s
+
+    trips: list[float] = field(default_factory=list)  # write-to-echo delays so far
+
+    def typical_round_trip(self) -> float | None:
+        """The median write-to-echo delay so far (None before a few were seen)."""
+        if len(self.trips) < MIN_SPREADS:
+            return None
+        ordered = sorted(self.trips)
+        return ordered[len(ordered) // 2]
+
+    def taint(self, start: float, end: float, error: float, why: str) -> None:
+        self.taints.append(Taint(start, end, error, why))
+
+    def spread(self, start: float, end: float, value: float, where: str) -> None:
+        """An echoed transmission between ``start`` and ``end`` spread by ``value`` (s)."""
+        self.echo_spread.add(value, where)
+        self.spreads.append((start, end, value))
+
+    def regular_spread(self) -> float:
+        """The echo spread the receive path shows when nothing unusual happens: the worst
+        one once outliers (local stalls, kept as taints) are set aside."""
+        values = sorted(v for _s, _e, v in self.spreads)
+        if not values:
+            return 0.0
+        if len(values) < MIN_SPREADS:
+            return values[-1]
+        cut = self._outlier_cut(values)
+        return max(v for v in values if v <= cut)
+
+    def _outlier_cut(self, values: list[float]) -> float:
+        p90 = values[int(0.9 * (len(values) - 1))]
+        return OUTLIER_FACTOR * p90 + OUTLIER_MARGIN
+
+    def between(self, start: float, end: float) -> float:
+        """Uncertainty (s) of a measurement between two instants: the regular figure, or
+        more where the run showed its stamps irregular near them."""
+        u = self.uncertainty()
+        for t in self.taints:
+            if t.start <= end and start <= t.end:
+                u = max(u, t.error)
+        values = sorted(v for _s, _e, v in self.spreads)
+        if len(values) >= MIN_SPREADS:
+            cut = self._outlier_cut(values)
+            for s0, s1, v in self.spreads:
+                if v > cut and s0 <= end and start <= s1:
+                    u = max(u, v)
+        return u
+
+    @property
+    def reference(self) -> str:
+        return "echo" if self.echo else "write"
+
+    def observed(self) -> float:
+        """The worst observed error of a stamp difference anywhere in the run (s)."""
+        seen = [self.echo_spread.value, self.batches.value, self.artefacts.value]
+        if not self.kernel_stamps:
+            seen.append(self.reader_lag.value)
+        return max(seen)
+
+    def regular(self) -> float:
+        """The error every stamp may have, stalls aside (s): the regular echo spread, and
+        the reader's lateness where the stamps are the reader's own."""
+        seen = [self.regular_spread()]
+        if not self.kernel_stamps:
+            seen.append(self.reader_lag.value)
+        return max(seen)
+
+    def uncertainty(self) -> float:
+        """What a timing finding with no local irregularity uses: the floor of the reference,
+        the regular observed error, the user's figure; whichever is largest."""
+        floor = ECHO_FLOOR if self.echo else self.declared
+        return max(floor, self.regular(), self.widen_to)
+
+    def samples(self) -> int:
+        return (
+            self.echo_spread.count
+            + self.batches.count
+            + self.artefacts.count
+            + self.reader_lag.count
+        )
+
+    def summary(self) -> str:
+        """One line for reports: how the figure was arrived at."""
+        u = self.uncertainty()
+        worst = self.observed()
+        text = (
+            f"measured ±{u * 1e3:.2f} ms ({self.samples()} samples, worst {worst * 1e3:.2f} ms; "
+            f"timed against the {'echo of the command' if self.echo else 'write time'}"
+        )
+        floor = ECHO_FLOOR if self.echo else self.declared
+        if u == floor and floor > self.regular():
+            text += f", declared floor {floor * 1e3:.2f} ms"
+        if self.taints:
+            text += f"; {len(self.taints)} local irregularities widen the stamps near them"
+        if self.widen_to and u == self.widen_to:
+            text += ", widened by --timing-uncertainty-ms"
+        return text + ")"
+
+    def to_json(self) -> dict[str, object]:
+        def part(w: Worst) -> dict[str, object]:
+            return {"worst_ms": round(w.value * 1e3, 3), "samples": w.count, "where": w.where}
+
+        return {
+            "reference": self.reference,
+            "uncertainty_ms": round(self.uncertainty() * 1e3, 3),
+            "declared_floor_ms": round((ECHO_FLOOR if self.echo else self.declared) * 1e3, 3),
+            "kernel_stamps": self.kernel_stamps,
+            "echo_spread": part(self.echo_spread),
+            "batches": part(self.batches),
+            "artefacts": part(self.artefacts),
+            "reader_lag": part(self.reader_lag),
+            "round_trip": part(self.round_trip),
+            "turnaround": part(self.turnaround),
+            "regular_ms": round(self.regular() * 1e3, 3),
+            "local_irregularities": len(self.taints),
+            "summary": self.summary(),
+        }

@@ -1,0 +1,39 @@
+"""Real-time scheduling for the threads that stamp or emit bytes.
+
+On a busy machine an ordinary thread may get the CPU milliseconds after its byte arrived or
+was due; the stamps (or the emulated sensor's frames) then carry that delay. Where the OS
+allows it (Linux, as root or with an RTPRIO limit), the threads that read a port or keep an
+emulated line in time ask for a real-time scheduling class, which other processes' ordinary
+work cannot preempt. Where it is refused nothing changes, and the link's measurements show
+what the delays cost.
+
+Only threads that mostly sleep get the class. A real-time thread that computes (the tool's
+judges) would trip the kernel's real-time throttling (95 % of a CPU per second), which then
+stalls every real-time thread on that CPU, the emulated line included, for the rest of the
+period: exactly the late frames this is meant to prevent.
+"""
+
+from __future__ import annotations
+
+import os
+
+# SCHED_RR priorities: all above every ordinary process, far below the kernel's own threads.
+# A thread that stamps bytes outranks one that computes, and an emulated line (a stand-in for
+# a sensor's own hardware) outranks the tool judging it on the same machine: a same-priority
+# thread busy computing would otherwise hold the CPU for a whole round-robin slice (100 ms).
+READER = 20
+EMULATED_LINE = 30
+
+
+def realtime_priority(priority: int = READER) -> bool:
+    """Give the calling thread SCHED_RR; False where the OS refuses (or has no such thing)."""
+    setter = getattr(os, "sched_setscheduler", None)
+    policy = getattr(os, "SCHED_RR", None)
+    if setter is None or policy is None:
+        return False
+    policy |= getattr(os, "SCHED_RESET_ON_FORK", 0)  # a child process starts ordinary
+    try:
+        setter(0, policy, os.sched_param(priority))
+    except (OSError, AttributeError):
+        return False
+    return True
