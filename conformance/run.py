@@ -151,7 +151,7 @@ class ConformanceRun:
         if check is None:
             return
         try:
-            check()
+            check(self.cases)
         except LinkError as exc:
             self.complete = False
             self.stop_reason = self.stop_reason or f"link failed: {exc}"

@@ -58,6 +58,7 @@ class Channel:
         self._write_fd = -1
         self.closed = False
         self.last_sent = ""
+        self.failure: str | None = None  # why the harness failed, once it has
 
     # subclass hooks
     def status(self) -> str:
@@ -70,9 +71,10 @@ class Channel:
         self.close()
         status = self.status()
         after = f" (after the tool sent {self.last_sent!r})" if self.last_sent else ""
-        return HarnessError(
-            f"harness {self.describe}: {reason}{after}" + (f"; {status}" if status else "")
+        self.failure = f"harness {self.describe}: {reason}{after}" + (
+            f"; {status}" if status else ""
         )
+        return HarnessError(self.failure)
 
     def send(self, line: str) -> None:
         if self.closed:

@@ -11,7 +11,9 @@ from __future__ import annotations
 
 from ..links.base import LinkInfo
 from ..protocol.timing import CHAR_TIME
+from ..results import CaseRecord
 from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
+from ..verdicts import Verdict
 from . import protocol as proto
 from .channel import Channel, ChildChannel, HarnessError, SocketChannel
 from .protocol import Plan, PlanKind, Role
@@ -118,16 +120,36 @@ class HarnessLink(SimLink):
         self.device = device
         self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
 
-    def check_records(self) -> None:
+    def check_records(self, cases: list[CaseRecord]) -> None:
         """Before the verdicts: end the harness and make sure its answers were in step
-        (:meth:`Channel.finish`); raises :class:`HarnessError` if they were not."""
-        if self.device.channel.closed:
-            return  # it failed already, and said so
-        self.device.plan  # noqa: B018 - reads an answer still due
-        self.device.channel.finish(proto.BYE)
+        (:meth:`Channel.finish`; raises :class:`HarnessError` if not). A harness that failed
+        at any point may have been out of step for a while before it showed (a line written
+        unasked shifts every answer after it), so no FAIL recorded through it is trusted: each
+        becomes INCONCLUSIVE, saying why. A harness fault is never a verdict about the DUT."""
+        channel = self.device.channel
+        try:
+            if not channel.closed:
+                self.device.plan  # noqa: B018 - reads an answer still due
+                channel.finish(proto.BYE)
+        finally:
+            if channel.failure is not None:
+                distrust_fails(cases, channel.failure)
 
     def close(self) -> None:
         self.device.channel.close(proto.BYE)
+
+
+def distrust_fails(cases: list[CaseRecord], failure: str) -> None:
+    """Turn every FAIL of ``cases`` into INCONCLUSIVE: the harness failed (``failure``)."""
+    for case in cases:
+        changed = False
+        for finding in case.findings:
+            if finding.verdict is Verdict.FAIL:
+                finding.verdict = Verdict.INCONCLUSIVE
+                finding.detail = f"not trusted, the harness failed in this run: {finding.detail}"
+                changed = True
+        if changed:
+            case.summarise()
 
 
 def is_harness_port(port: str) -> bool:
