@@ -197,7 +197,11 @@ class SerialLink(Link):
         pushed = overlap(count, arrival, floor)
         if pushed > 0:
             self.meter.artefacts.add(pushed, f"frames overlapping by {pushed * 1e3:.2f} ms")
-            self.meter.taint(floor - 2 * CHAR_TIME, arrival, pushed, "frames overlapped")
+            # the frame is placed after the previous one; where it really was, the path's
+            # latency range further hides: its stamps may be off by both
+            self.meter.taint(
+                floor - 2 * CHAR_TIME, arrival, pushed + spread / 2, "frames overlapped"
+            )
         frames = chunk_frames(count, arrival, floor)
         self._rx_floor = frames[-1][1]
         self._previous_chunk = (floor, room, arrival)
@@ -286,6 +290,13 @@ class SerialLink(Link):
         events = self._settle_echo(planned, back_to_back=gap <= 0)
         self._released(planned[-1].end)
         return events
+
+    def _tool_char(self, byte: int, start: float) -> Event:
+        """A tool character recorded where the write put it (links without echo)."""
+        event = self._planned(byte, start)
+        with self._cond:
+            self.transcript.add(event)
+        return event
 
     def _planned(self, byte: int, start: float) -> Event:
         """A tool character where the write put it (before any echo says better)."""
