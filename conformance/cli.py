@@ -66,7 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"sdi12-conform {__version__}")
     p.add_argument(
         "--port",
-        help="a serial port (/dev/ttyUSB0, COM3), a pyserial URL (rfc2217://HOST:PORT), or "
+        help="a serial port (/dev/ttyUSB0, COM3), a pyserial URL (rfc2217://HOST:PORT), "
+        "'exec:PROGRAM ARGS' or unix:PATH (a harness, docs/harness-protocol.md), or "
         "sim / sim://?faults=a,b&version=1.3 for the built-in simulated device "
         "(default: sim, said loudly when used)",
     )

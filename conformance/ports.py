@@ -109,6 +109,15 @@ def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> Open
             f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
             "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
         )
+    if port.startswith(("exec:", "unix:")):  # a harness in another process, virtual time
+        from .harness.channel import HarnessError
+        from .harness.device import open_sensor_harness
+        from .links.errors import PortUnavailable
+
+        try:
+            return OpenedPort(open_sensor_harness(port))
+        except HarnessError as exc:
+            raise PortUnavailable(str(exc)) from exc
     check_network_url(port)
     from .links.direction import DirectionLine
     from .links.echo import EchoMode

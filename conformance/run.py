@@ -13,7 +13,7 @@ from typing import Any
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
-from .links.base import Link
+from .links.base import Link, LinkError
 from .ports import is_sim, open_port
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
@@ -134,6 +134,7 @@ class ConformanceRun:
         return self.session.version if self.session else None
 
     def finish(self, complete: bool) -> list[RequirementResult]:
+        self._check_link()
         self.complete = self.complete and complete
         self.finished = now_iso()
         self._recheck_timing()
@@ -146,6 +147,18 @@ class ConformanceRun:
                 f"{unjudged} testable requirement(s) of the selected cases not judged"
             )
         return self.results
+
+    def _check_link(self) -> None:
+        """A link that can vouch for its records only at the end (a harness, whose answers
+        could have fallen out of step) is asked now, before the verdicts are drawn."""
+        check = getattr(self.link, "check_records", None)
+        if check is None:
+            return
+        try:
+            check(self.cases)
+        except LinkError as exc:
+            self.complete = False
+            self.stop_reason = self.stop_reason or f"link failed: {exc}"
 
     def _recheck_timing(self) -> None:
         """Timing verdicts must hold for the uncertainty the whole run measured, not only

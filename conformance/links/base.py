@@ -25,6 +25,16 @@ class LinkInfo:
     binary: bool = True  # 8N1 bytes with no CR LF framing are passed
     timing_uncertainty: float = 0.0  # seconds, on every event stamp
     virtual_time: bool = False
+    #: The DUT's characters come with its own bit timing (baud rate). False on a harness link
+    #: (``exec:``/``unix:``), where the DUT names bytes and the tool makes the frames.
+    bit_timing: bool = True
+
+
+#: Why R-4.1-01 (the bit rate) stays INCONCLUSIVE on a link without ``bit_timing``.
+NO_BIT_TIMING = (
+    "this link carries bytes and the tool makes their 1200-baud frames (a harness: the DUT's "
+    "UART setting is not part of it), so the bit rate is not observed"
+)
 
 
 class LinkError(RuntimeError):

@@ -21,9 +21,11 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..harness.device import is_harness_port
+from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
-from ..links.base import Link, LinkError
-from ..ports import PortError, is_sim, parse_sim
+from ..links.base import Link, LinkError, LinkInfo
+from ..ports import PortError, SimSpec, is_sim, parse_sim
 from ..sim.bus import Frame, SimBus, SimLink
 from ..transcript import TOOL, Event, EventKind
 from .drivers import (
@@ -108,19 +110,24 @@ class RecorderSession:
         timing_uncertainty: float | None = None,
     ) -> None:
         served = is_served(port)
-        if not is_sim(port) and not served:
+        harness = is_harness_port(port)
+        if not is_sim(port) and not served and not harness:
             raise PortError(
                 f"port {port!r}: the recorder role plays the sensors itself: use --port sim "
-                "(virtual time) or --port rfc2217-serve://127.0.0.1:0 (served in real time, "
+                "(virtual time), --port 'exec:PROGRAM ARGS' (a recorder harness, virtual time) "
+                "or --port rfc2217-serve://127.0.0.1:0 (served in real time, "
                 "the recorder connects over RFC 2217)"
             )
-        spec = parse_served(port) if served else parse_sim(port)
+        spec = parse_served(port) if served else SimSpec() if harness else parse_sim(port)
         faults = tuple(f for f in spec.extra.get("recorder-faults", "").split(",") if f)
         unknown = [f for f in faults if f not in RECORDER_FAULTS]
         if unknown or len(faults) > 1:
             known = ", ".join(sorted(RECORDER_FAULTS))
             raise PortError(f"recorder-faults takes one of: {known} (got {','.join(faults)})")
-        if driver is None:
+        if driver is None and harness:
+            driver = HarnessRecorder(port)
+            driver.probe()
+        elif driver is None:
             program = spec.extra.get("recorder")
             driver = InProcess(load_program(program)() if program else faulty_recorder(faults))
         elif driver.needs_real_time and not served:
@@ -141,6 +148,9 @@ class RecorderSession:
         else:
             self.bus = SimBus([LineMonitor()])
             self.link: Link = SimLink(self.bus)
+            if harness:  # the reports name the harness link, still virtual time
+                kind = port.partition(":")[0]
+                self.link.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
         self.version = version
         self.uncertainty = (
             self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty

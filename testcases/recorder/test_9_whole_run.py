@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import recorder as judge
+from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
 
 from ._helpers import line_of
@@ -53,5 +54,7 @@ def test_character_timing(recorder, case):
                 "one frame apart itself: their bit rate cannot be observed here",
             )
         )
+    elif not recorder.link.info.bit_timing:
+        case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
     else:
         case.add(judge.judge_bit_rate(line, recorder.uncertainty))

@@ -1,0 +1,181 @@
+"""A sensor harness on the virtual-time sim bus (``--port exec:...`` / ``unix:...``, role
+sensor): the device under test lives in another process and is told, message by message, what
+happens on the line; its plan (next character, or a wake-up time) is what the bus asks for.
+
+The tool owns the clock, so stamps are exact (uncertainty 0) and a run is deterministic:
+whatever the harness does with wall time (a slow build, a loaded CI machine) cannot show up on
+the wire.
+"""
+
+from __future__ import annotations
+
+from ..links.base import LinkInfo
+from ..protocol.timing import CHAR_TIME
+from ..results import CaseRecord
+from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
+from ..verdicts import Verdict
+from . import protocol as proto
+from .channel import Channel, ChildChannel, HarnessError, SocketChannel
+from .protocol import Plan, PlanKind, Role
+
+
+class HarnessDevice:
+    """:class:`~conformance.sim.bus.BusDevice` whose state machine runs in the harness."""
+
+    def __init__(self, channel: Channel, clock: VirtualClock, name: str = "harness") -> None:
+        self.name = name
+        self.channel = channel
+        self.clock = clock
+        self._plan = Plan(PlanKind.IDLE)
+        self._start = 0.0  # the plan's time in s
+        self._pending: float | None = None  # time of a message whose answer is unread
+        self.harness_name = channel.greet(Role.SENSOR)
+
+    def _tell(self, message: str, now: float) -> None:
+        """Send a line event; its answer is read when the plan is next needed, so the bus
+        does its bookkeeping while the harness works (half the wall time on 2 cores)."""
+        self._collect()
+        self.channel.send(message)
+        self._pending = now
+
+    def _collect(self) -> None:
+        if self._pending is not None:
+            now, self._pending = self._pending, None
+            self._plan = plan = self.channel.read_plan(Role.SENSOR, now)
+            # the harness saw ``now`` rounded to the microsecond; when it answers with that
+            # very time it means this instant, not half a microsecond before or after it
+            exact = plan.start == proto.us(now)
+            self._start = now if exact else proto.seconds(plan.start)
+
+    @property
+    def plan(self) -> Plan:
+        self._collect()
+        return self._plan
+
+    @property
+    def wake_at(self) -> float | None:
+        return self._start if self.plan.kind is PlanKind.WAIT else None
+
+    def wake(self, now: float) -> None:
+        self._tell(proto.time_is(now), now)
+
+    def on_break(self, start: float, end: float) -> None:
+        self._tell(proto.line_break(start, end), end)
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        self._tell(proto.heard(wire, start, end), end)
+
+    def next_frame(self) -> Frame | None:
+        if self.plan.kind is not PlanKind.TX:
+            return None
+        return Frame(self._start, self.plan.wire)
+
+    def pop_frame(self) -> Frame:
+        frame = self.next_frame()
+        if frame is None:
+            raise HarnessError("the bus committed a character the harness did not plan")
+        start = max(frame.start, self.clock.now)  # as SimBus._commit places it
+        self._tell(proto.sent(frame.wire, start, start + CHAR_TIME), start + CHAR_TIME)
+        return frame
+
+
+class HarnessBus(SimBus):
+    """The sim bus, plus wake-ups: a harness that answered ``wait T`` is told ``time T`` when
+    the clock gets there with nothing else on the line first."""
+
+    def _wake_before(self, limit: float) -> bool:
+        """Wake the earliest harness due before ``limit`` (and before the next character)."""
+        due = [(d.wake_at, d) for d in self.devices if getattr(d, "wake_at", None) is not None]
+        if not due:
+            return False
+        when, device = min(due, key=lambda pair: pair[0])
+        nxt = self._next()
+        if when >= limit or (nxt is not None and nxt[1].start < when):
+            return False
+        self.clock.advance_to(when)
+        device.wake(self.clock.now)
+        return True
+
+    def advance(self, time: float) -> None:
+        while True:
+            if self._wake_before(time):
+                continue
+            nxt = self._next()
+            if nxt is None or nxt[1].start >= time:
+                break
+            self._commit(*nxt)
+        self.clock.advance_to(time)
+
+    def step(self, limit: float):  # noqa: ANN201 - as SimBus.step
+        while self._wake_before(limit):
+            pass
+        return super().step(limit)
+
+
+class HarnessLink(SimLink):
+    """The tool's end of a :class:`HarnessBus`; closing it ends the harness."""
+
+    def __init__(self, bus: HarnessBus, device: HarnessDevice, kind: str) -> None:
+        super().__init__(bus)
+        self.device = device
+        self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
+
+    def check_records(self, cases: list[CaseRecord]) -> None:
+        """Before the verdicts: end the harness and make sure its answers were in step
+        (:meth:`Channel.finish`; raises :class:`HarnessError` if not). A harness that failed
+        at any point may have been out of step for a while before it showed (a line written
+        unasked shifts every answer after it), so no FAIL recorded through it is trusted: each
+        becomes INCONCLUSIVE, saying why. A harness fault is never a verdict about the DUT."""
+        channel = self.device.channel
+        try:
+            if not channel.closed:
+                self.device.plan  # noqa: B018 - reads an answer still due
+                channel.finish(proto.BYE)
+        finally:
+            if channel.failure is not None:
+                distrust_fails(cases, channel.failure)
+
+    def close(self) -> None:
+        self.device.channel.close(proto.BYE)
+
+
+def distrust_fails(cases: list[CaseRecord], failure: str) -> None:
+    """Turn every FAIL of ``cases`` into INCONCLUSIVE: the harness failed (``failure``)."""
+    for case in cases:
+        changed = False
+        for finding in case.findings:
+            if finding.verdict is Verdict.FAIL:
+                finding.verdict = Verdict.INCONCLUSIVE
+                finding.detail = f"not trusted, the harness failed in this run: {finding.detail}"
+                changed = True
+        if changed:
+            case.summarise()
+
+
+def is_harness_port(port: str) -> bool:
+    return port.startswith(("exec:", "unix:"))
+
+
+def open_channel(
+    port: str, env: dict[str, str] | None = None, reply_timeout: float | None = None
+) -> Channel:
+    """``exec:PROGRAM ARGS`` starts the program; ``unix:PATH`` connects to a socket."""
+    kind, _, rest = port.partition(":")
+    timeout = {} if reply_timeout is None else {"reply_timeout": reply_timeout}
+    if kind == "exec":
+        return ChildChannel(rest.strip(), env, **timeout)
+    return SocketChannel(rest, **timeout)
+
+
+def open_sensor_harness(port: str, reply_timeout: float | None = None) -> HarnessLink:
+    """The harness named by ``port`` as the one sensor on a virtual-time bus."""
+    channel = open_channel(port, reply_timeout=reply_timeout)
+    bus = HarnessBus()
+    try:
+        device = HarnessDevice(channel, bus.clock)
+    except HarnessError:
+        channel.close()
+        raise
+    bus.attach(device)
+    return HarnessLink(bus, device, port.partition(":")[0])
+

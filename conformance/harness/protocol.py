@@ -1,0 +1,154 @@
+"""The harness line protocol, sans-I/O: formatting the tool's messages, parsing and checking
+the harness's replies (specification: ``docs/harness-protocol.md``).
+
+Times are whole microseconds on the tool's virtual clock, bytes two hex digits (the 8 wire bits
+between start and stop bit). Every check names the offending line, so a harness bug is reported
+as an ERROR of the harness with the line that caused it, never as a verdict about the device.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+VERSION = 1
+#: Longest reply line accepted (a harness that writes more is flooding or writing garbage).
+MAX_LINE = 200
+#: Largest time accepted (about 11.6 days of bus time): beyond it a harness is counting wrong.
+MAX_TIME_US = 10**12
+
+
+class HarnessProtocolError(ValueError):
+    """A reply that breaks the protocol; ``line`` is the offending text (escaped by callers)."""
+
+    def __init__(self, reason: str, line: str) -> None:
+        super().__init__(f"{reason}: {line!r}")
+        self.reason = reason
+        self.line = line
+
+
+class Role(StrEnum):
+    SENSOR = "sensor"
+    RECORDER = "recorder"
+
+
+class PlanKind(StrEnum):
+    TX = "tx"  # transmit one character at ``start``
+    BRK = "brk"  # hold a break from ``start`` to ``end`` (recorder harnesses only)
+    WAIT = "wait"  # nothing before ``start``; tell me when it comes
+    IDLE = "idle"  # nothing until something happens on the line
+    DONE = "done"  # the job is finished (recorder harnesses only)
+
+
+@dataclass(frozen=True, slots=True)
+class Plan:
+    """What the harness will do next if nothing happens on the line first."""
+
+    kind: PlanKind
+    start: int = 0  # us; TX/BRK: when it starts, WAIT: when to wake the harness
+    end: int = 0  # us; BRK only
+    wire: int = 0  # TX only: the 8 wire bits
+
+
+def us(seconds: float) -> int:
+    """A bus time in seconds as the protocol's whole microseconds."""
+    return round(seconds * 1e6)
+
+
+def seconds(micro: int) -> float:
+    return micro / 1e6
+
+
+# the tool's messages (one line each, newline added by the channel)
+def hello(role: Role) -> str:
+    return f"hello {VERSION} {role}"
+
+
+def job(now: float, task: str, commands: tuple[str, ...]) -> str:
+    return " ".join(("job", str(us(now)), task, *commands))
+
+
+def line_break(start: float, end: float) -> str:
+    return f"break {us(start)} {us(end)}"
+
+
+def heard(wire: int, start: float, end: float) -> str:
+    return f"char {us(start)} {us(end)} {wire:02x}"
+
+
+def sent(wire: int, start: float, end: float) -> str:
+    return f"sent {us(start)} {us(end)} {wire:02x}"
+
+
+def time_is(now: float) -> str:
+    return f"time {us(now)}"
+
+
+BYE = "bye"
+
+
+def check_line(raw: bytes) -> str:
+    """The reply as text, or an error if it is too long, not ASCII or holds control bytes."""
+    text = raw.decode("ascii", errors="replace").rstrip("\r")
+    if len(raw) > MAX_LINE:
+        raise HarnessProtocolError(f"reply longer than {MAX_LINE} characters", text[:MAX_LINE])
+    if any(not (32 <= b < 127) for b in raw.rstrip(b"\r")):
+        raise HarnessProtocolError("reply holds bytes that are not printable ASCII", text)
+    return text
+
+
+def parse_hello(text: str) -> str:
+    """The harness's name from its ``hello 1 [name]`` answer."""
+    parts = text.split(maxsplit=2)
+    if not parts or parts[0] != "hello":
+        raise HarnessProtocolError("expected 'hello 1 [name]' as the first reply", text)
+    if len(parts) < 2 or parts[1] != str(VERSION):
+        raise HarnessProtocolError(f"harness speaks another protocol version, not {VERSION}", text)
+    return parts[2] if len(parts) > 2 else ""
+
+
+def _time(field: str, text: str) -> int:
+    if not field.isdigit():
+        raise HarnessProtocolError(f"time {field!r} is not a whole number of microseconds", text)
+    value = int(field)
+    if value > MAX_TIME_US:
+        raise HarnessProtocolError("time beyond 10^12 us (units wrong?)", text)
+    return value
+
+
+def _byte(field: str, text: str) -> int:
+    if len(field) != 2 or any(c not in "0123456789abcdefABCDEF" for c in field):
+        raise HarnessProtocolError(f"byte {field!r} is not two hex digits", text)
+    return int(field, 16)
+
+
+_FIELDS = {"tx": 3, "brk": 3, "wait": 2, "idle": 1, "done": 1}
+
+
+def parse_plan(text: str, role: Role, now: int) -> Plan:
+    """Check one plan reply against the role and the time ``now`` (us) of the message it
+    answers. A ``tx``/``brk`` start before ``now`` means "as soon as the line lets me" (the
+    bus starts it then); a ``wait`` must be later than ``now`` (else the harness would be woken
+    forever without time passing)."""
+    parts = text.split(" ")
+    word = parts[0]
+    if word not in _FIELDS:
+        raise HarnessProtocolError("unknown reply (want tx, wait, idle, brk or done)", text)
+    if len(parts) != _FIELDS[word]:
+        raise HarnessProtocolError(f"'{word}' takes {_FIELDS[word] - 1} field(s)", text)
+    kind = PlanKind(word)
+    if role is Role.SENSOR and kind in (PlanKind.BRK, PlanKind.DONE):
+        raise HarnessProtocolError(f"'{word}' is for recorder harnesses only", text)
+    if kind is PlanKind.TX:
+        return Plan(kind, start=_time(parts[1], text), wire=_byte(parts[2], text))
+    if kind is PlanKind.BRK:
+        start, end = _time(parts[1], text), _time(parts[2], text)
+        if end <= max(start, now):
+            raise HarnessProtocolError("break ends before it starts (or before now)", text)
+        return Plan(kind, start=start, end=end)
+    if kind is PlanKind.WAIT:
+        start = _time(parts[1], text)
+        if start <= now:
+            raise HarnessProtocolError(f"wait time is not after now ({now} us)", text)
+        return Plan(kind, start=start)
+    return Plan(kind)

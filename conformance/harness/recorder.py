@@ -1,0 +1,102 @@
+"""A recorder harness as the recorder under test (``--role recorder --port exec:...``).
+
+Per scenario the harness is started afresh (``unix:`` connects afresh), told the job through
+the protocol (``job TASK COMMAND...``) and the ``SDI12_*`` environment ``--trigger`` also sets,
+and then driven on the tool's own :class:`~conformance.sim.bus.SimLink`, exactly where the
+in-process golden recorder acts: each ``tx``/``brk`` it plans is put on the virtual-time bus
+unless a played sensor's character comes first, in which case the harness hears that first and
+plans again. Its side of the wire has origin ``tool``, so the recorder judges read it as they
+read the golden recorder's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..links.base import Link
+from ..recorder.drivers import RecorderDriverError
+from ..recorder.request import RecorderOutput, Request
+from ..transcript import Event
+from . import protocol as proto
+from .channel import Channel, HarnessError
+from .device import open_channel
+from .protocol import Plan, PlanKind, Role
+
+#: Bus time one job may take (the longest scenario needs a few seconds of it).
+JOB_LIMIT = 600.0
+#: Bus time a harness may stay ``idle`` with nothing on the line before its job counts as over.
+IDLE_END = 10.0
+
+
+def _first(events: list[Event]) -> bool:
+    return True
+
+
+@dataclass
+class HarnessRecorder:
+    """Drives the harness at ``port`` (``exec:...`` or ``unix:...``) once per scenario."""
+
+    port: str
+    reply_timeout: float | None = None
+    kind: str = "harness"
+    needs_real_time: bool = False
+
+    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+        env = request.environment(scenario, JOB_LIMIT)
+        channel = open_channel(self.port, env, self.reply_timeout)
+        try:
+            name = channel.greet(Role.RECORDER)
+            first = proto.job(link.now(), str(request.task), request.commands)
+            plan = channel.plan(first, Role.RECORDER, link.now())
+            ended = self._drive(channel, plan, link)
+            channel.finish(proto.BYE)
+        finally:
+            channel.close(proto.BYE)
+        out = RecorderOutput()
+        out.notes.append(f"harness {name or self.port}: {ended}")
+        return out
+
+    def probe(self) -> None:
+        """Start the harness and exchange hellos once, so a wrong command is a usage error
+        before the run (a :class:`~conformance.ports.PortError`), not an ERROR in it."""
+        from ..links.errors import PortUnavailable
+
+        try:
+            channel = open_channel(self.port, None, self.reply_timeout)
+            try:
+                channel.greet(Role.RECORDER)
+            finally:
+                channel.close(proto.BYE)
+        except HarnessError as exc:
+            raise PortUnavailable(str(exc)) from exc
+
+    def _drive(self, channel: Channel, plan: Plan, link: Link) -> str:
+        """Carry out plans until ``done``; what ended the job, in words."""
+        limit = link.now() + JOB_LIMIT
+        while plan.kind is not PlanKind.DONE:
+            if link.now() > limit:
+                raise RecorderDriverError(
+                    f"recorder harness did not finish its job within {JOB_LIMIT:g} s of bus time"
+                )
+            if plan.kind is PlanKind.IDLE:
+                deadline = link.now() + IDLE_END
+            else:
+                deadline = proto.seconds(plan.start)
+            heard = link.receive(deadline, until=_first)
+            if heard:
+                got = heard[0]
+                message = proto.heard(got.wire, got.start, got.end)
+                plan = channel.plan(message, Role.RECORDER, got.end)
+                continue
+            if plan.kind is PlanKind.IDLE:
+                return f"idle with a quiet line for {IDLE_END:g} s of bus time"
+            if plan.kind is PlanKind.WAIT:
+                message = proto.time_is(link.now())
+            elif plan.kind is PlanKind.TX:
+                done = link.write(bytes([plan.wire]))[0]
+                message = proto.sent(done.wire, done.start, done.end)
+            else:  # BRK
+                made = link.send_break(proto.seconds(plan.end) - link.now())
+                message = proto.line_break(made.start, made.end)
+            plan = channel.plan(message, Role.RECORDER, link.now())
+        return "done"

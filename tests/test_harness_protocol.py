@@ -1,0 +1,108 @@
+"""The harness protocol checker (conformance.harness.protocol): each malformed reply is
+refused with its reason and the offending line; well-formed ones parse to the plan they say."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.harness import protocol as proto
+from conformance.harness.protocol import HarnessProtocolError, Plan, PlanKind, Role
+
+
+@pytest.mark.parametrize(
+    ("text", "role", "plan"),
+    [
+        ("tx 1000 b1", Role.SENSOR, Plan(PlanKind.TX, start=1000, wire=0xB1)),
+        ("tx 10 8D", Role.SENSOR, Plan(PlanKind.TX, start=10, wire=0x8D)),
+        ("tx 0 30", Role.SENSOR, Plan(PlanKind.TX, start=0, wire=0x30)),  # before now: ASAP
+        ("wait 5001", Role.SENSOR, Plan(PlanKind.WAIT, start=5001)),
+        ("idle", Role.SENSOR, Plan(PlanKind.IDLE)),
+        ("brk 5000 17500", Role.RECORDER, Plan(PlanKind.BRK, start=5000, end=17500)),
+        ("done", Role.RECORDER, Plan(PlanKind.DONE)),
+    ],
+)
+def test_well_formed_plans(text, role, plan):
+    assert proto.parse_plan(text, role, now=5000) == plan
+
+
+@pytest.mark.parametrize(
+    ("text", "role", "reason"),
+    [
+        ("transmit 100 30", Role.SENSOR, "unknown reply"),
+        ("", Role.SENSOR, "unknown reply"),
+        ("TX 100 30", Role.SENSOR, "unknown reply"),
+        ("tx 100", Role.SENSOR, "takes 2 field(s)"),
+        ("tx 100 30 31", Role.SENSOR, "takes 2 field(s)"),
+        ("tx  100 30", Role.SENSOR, "takes 2 field(s)"),
+        ("idle now", Role.SENSOR, "takes 0 field(s)"),
+        ("wait", Role.SENSOR, "takes 1 field(s)"),
+        ("tx 1.5 30", Role.SENSOR, "not a whole number of microseconds"),
+        ("tx -5 30", Role.SENSOR, "not a whole number of microseconds"),
+        ("tx 0x10 30", Role.SENSOR, "not a whole number of microseconds"),
+        ("tx 1000000000001 30", Role.SENSOR, "beyond 10^12"),
+        ("tx 100 3", Role.SENSOR, "not two hex digits"),
+        ("tx 100 130", Role.SENSOR, "not two hex digits"),
+        ("tx 100 zz", Role.SENSOR, "not two hex digits"),
+        ("wait 5000", Role.SENSOR, "not after now"),
+        ("wait 10", Role.SENSOR, "not after now"),
+        ("brk 6000 17500", Role.SENSOR, "recorder harnesses only"),
+        ("done", Role.SENSOR, "recorder harnesses only"),
+        ("brk 6000 6000", Role.RECORDER, "ends before it starts"),
+        ("brk 0 4000", Role.RECORDER, "ends before it starts"),
+        ("brk 6000", Role.RECORDER, "takes 2 field(s)"),
+    ],
+)
+def test_malformed_plans_are_refused_with_the_line(text, role, reason):
+    with pytest.raises(HarnessProtocolError) as caught:
+        proto.parse_plan(text, role, now=5000)
+    assert reason in caught.value.reason
+    assert caught.value.line == text
+    assert repr(text) in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("raw", "reason"),
+    [
+        (b"x" * 201, "longer than 200"),
+        (b"tx 100 30\x00", "not printable ASCII"),
+        (b"tx 100 \xb1", "not printable ASCII"),
+        (b"idle\tnow", "not printable ASCII"),
+    ],
+)
+def test_bad_lines_are_refused(raw, reason):
+    with pytest.raises(HarnessProtocolError) as caught:
+        proto.check_line(raw)
+    assert reason in caught.value.reason
+
+
+def test_a_carriage_return_before_the_newline_is_accepted():
+    assert proto.check_line(b"idle\r") == "idle"
+
+
+@pytest.mark.parametrize(
+    ("text", "reason"),
+    [
+        ("hi 1", "expected 'hello 1"),
+        ("hello", "another protocol version"),
+        ("hello 2 future", "another protocol version"),
+        ("idle", "expected 'hello 1"),
+    ],
+)
+def test_bad_hello_is_refused(text, reason):
+    with pytest.raises(HarnessProtocolError) as caught:
+        proto.parse_hello(text)
+    assert reason in caught.value.reason
+
+
+def test_hello_gives_the_harness_name():
+    assert proto.parse_hello("hello 1 my sensor v2") == "my sensor v2"
+    assert proto.parse_hello("hello 1") == ""
+
+
+def test_the_tools_messages():
+    assert proto.hello(Role.SENSOR) == "hello 1 sensor"
+    assert proto.job(1.5, "measure", ("0M!", "1M!")) == "job 1500000 measure 0M! 1M!"
+    assert proto.line_break(0.0, 0.0125) == "break 0 12500"
+    assert proto.heard(0xB1, 0.020333333, 0.028666667) == "char 20333 28667 b1"
+    assert proto.sent(0x0A, 1.0, 1.008333333) == "sent 1000000 1008333 0a"
+    assert proto.time_is(2.25) == "time 2250000"
