@@ -362,7 +362,7 @@ def test_fails_recorded_through_a_harness_that_failed_are_not_trusted(misbehavin
     record = CaseRecord("t::x", "x", ("R-4.4.6-02", "R-4.4.1-01"))
     record.findings = [
         Finding("R-4.4.6-02", Verdict.FAIL, "no service request"),
-        Finding("R-4.4.1-01", Verdict.PASS, "a! answered"),
+        Finding("R-4.4.1-01", Verdict.PASS, "a! answered", observed=1),
     ]
     record.summarise()
     link.send_break(0.0125)
