@@ -14,12 +14,11 @@ import pytest
 
 from conformance.emulator import FAULTS
 from conformance.matrix import row_from, run_once
-
-#: what a harness link never observes: the bit rate (the tool makes the frames itself)
-HARNESS = ("R-4.1-01",)
 from conformance.recorder.faults import RECORDER_FAULTS
 
 ROOT = Path(__file__).resolve().parents[1]
+#: what a harness link never observes: the bit rate (the tool makes the frames itself)
+HARNESS = ("R-4.1-01",)
 C_DIR = ROOT / "examples" / "c"
 PY_DIR = ROOT / "examples" / "python"
 COMPILER = shutil.which("cc") or shutil.which("gcc")
