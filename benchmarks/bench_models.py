@@ -6,7 +6,7 @@ runs ``sdi12-conform --port rfc2217://...`` over it, and prints one Markdown row
 verdict, FAIL/WARN counts, how many section 7 timing requirements got a definite verdict
 (PASS or FAIL), and the uncertainty the run measured. This is the README's bench table.
 
-    python benchmarks/bench_models.py                # every model, 3 at a time (~15 min)
+    python benchmarks/bench_models.py                # every model, 2 at a time (~20 min)
     python benchmarks/bench_models.py echo usb1-echo # some of them
 """
 
@@ -124,7 +124,7 @@ def row(r: dict) -> str:
 
 def main(names: list[str]) -> int:
     chosen = [m for m in MODELS if not names or m.name in names]
-    with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(3) as pool:
+    with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(2) as pool:
         results = list(pool.map(lambda m: run(m, Path(tmp) / m.name), chosen))
     print("| bench model | verdict | FAIL/WARN | section 7 timing decided | measured | wall |")
     print("|---|---|---|---|---|---|")

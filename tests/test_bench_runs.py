@@ -126,7 +126,7 @@ def test_echo_on_a_fast_usb_path_decides_section_7_timing(runs):
     verdicts = _verdicts(data)
     timing = data["run"]["link"]["bench"]["timing"]
     assert timing["reference"] == "echo" and timing["uncertainty_ms"] < 3.0, timing
-    assert data["run"]["link"]["bench"]["breaks"].startswith("UART-timed")
+    assert "UART-timed near thresholds" in data["run"]["link"]["bench"]["breaks"]
     for rid in ("R-7.0-10", "R-7.0-03", "R-7.0-04"):
         assert verdicts[rid] == "PASS", f"{rid}: {verdicts[rid]}\n{data['_text']}"
     for rid in ("R-7.0-09", "R-7.0-12"):

@@ -30,7 +30,7 @@ def test_calibrate_behind_an_echoing_16ms_usb_adapter():
         code, text = calibrate("--port", emulator.url, "--rounds", "4")
     assert code == 0, text
     assert "the interface echoes the tool" in text
-    assert "UART-timed" in text and "kernel" in text
+    assert "UART-timed near thresholds" in text and "kernel" in text
     lines = {line.split()[0]: line for line in text.splitlines() if line.startswith("  R-")}
     assert set(lines) == {rule.rules for rule in RULES}, text
     assert "decided" in lines["R-7.0-03"] and "UART-timed" in lines["R-7.0-03"], text

@@ -550,6 +550,14 @@ class SerialLink(Link):
                 self._check()
                 self._cond.wait(min(limit + grace - now, 0.1))
 
+    def _break_methods(self) -> str:
+        """How this link makes line states, for the report."""
+        held = f"host-timed ({self._breaker.method})" if self._breaker else ""
+        if self._pulse is None:
+            return held or "none (the link cannot hold the line spacing)"
+        pulses = f"UART-timed near thresholds ({self._pulse.method})"
+        return f"{pulses}, wake-ups {held}" if held else pulses
+
     def describe(self) -> dict[str, object]:
         """What the report's link section shows about this bench."""
         found = {
@@ -557,11 +565,7 @@ class SerialLink(Link):
             "echo_mode": str(self.echo.mode),
             "echo_collisions": self.echo.collisions,
             "echo_missing": self.echo.missing,
-            "breaks": (
-                f"UART-timed ({self._pulse.method})"
-                if self._pulse is not None
-                else (f"host-timed ({self._breaker.method})" if self._breaker else "none")
-            ),
+            "breaks": self._break_methods(),
             "direction": self._direction.line if self._direction else "none",
             "realtime_reader": self.realtime_priority,
         }
