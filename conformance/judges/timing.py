@@ -34,6 +34,15 @@ def stamp_uncertainty(u: float | StampUncertainty) -> StampUncertainty:
     return u if isinstance(u, StampUncertainty) else StampUncertainty(u)
 
 
+MIN_DEVIATING = 2  # real-time links: deviating observations a FAIL needs at least...
+MIN_SHARE = 0.05  # ...and at least this share of all observations
+
+
+def sustained(deviating: int, total: int) -> bool:
+    """Whether deviations are frequent enough on a real-time link to be the device's."""
+    return deviating >= MIN_DEVIATING and deviating >= MIN_SHARE * total
+
+
 def combine_local(
     rid: str,
     observed: list[tuple[Finding, bool]],
@@ -48,10 +57,13 @@ def combine_local(
     - An observation that the irregularity alone left undecided says nothing about the DUT:
       it is set aside (and counted in the detail) instead of making the whole rule
       INCONCLUSIVE. If every observation was set aside the rule stays INCONCLUSIVE.
-    - On a real-time link (``real_time``) a host that stalls once can make one stamp late
-      with no trace around it; a single deviating observation among others that conform is
-      therefore not enough for a FAIL (INCONCLUSIVE, with the observation), two or more are.
-      On a virtual clock every observation is exact and one is enough."""
+    - On a real-time link (``real_time``) a host that stalls can make a stamp late with no
+      trace around it (the last character of a reply has no successor to show it); a few
+      deviating observations among many that conform are therefore not enough for a FAIL
+      (INCONCLUSIVE, with the observations): a FAIL needs at least :data:`MIN_DEVIATING` of
+      them and at least :data:`MIN_SHARE` of all. A device that deviates does so again and
+      again; a stalling host does so rarely. On a virtual clock every observation is exact
+      and one is enough."""
     kept = [f for f, tainted in observed if not (tainted and f.verdict is Verdict.INCONCLUSIVE)]
     aside = [f for f, tainted in observed if tainted and f.verdict is Verdict.INCONCLUSIVE]
     worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
@@ -62,24 +74,31 @@ def combine_local(
     if aside and not kept:
         return Finding(rid, Verdict.INCONCLUSIVE, f"every {what} undecided; {note}")
     failing = [f for f in kept if f.verdict is Verdict.FAIL]
-    isolated = real_time and len(failing) == 1 and len(kept) > 1
+    isolated = (
+        real_time
+        and failing
+        and len(failing) < len(kept)
+        and not sustained(len(failing), len(kept))
+    )
     if isolated:
-        (lone,) = failing
-        kept = [f for f in kept if f is not lone]
-    found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
-    if isolated:
+        lone = failing[0]
+        others = [f for f in kept if f.verdict is not Verdict.FAIL]
+        found = combine(rid, others, what, smallest_is_worst=smallest_is_worst)
         where = f" [{lone.evidence[0]}]" if lone.evidence else ""
         found = Finding(
             rid,
             Verdict.INCONCLUSIVE,
-            f"one {what} of {len(kept) + 1} deviates: {lone.detail}{where}; every other "
-            f"conforms ({found.detail}). A single late stamp on a real-time link may be a "
-            "stall of the host, not of the device: not decided",
+            f"{len(failing)} of {len(kept)} {plural(what)} deviate, such as: {lone.detail}"
+            f"{where}; the others conform ({found.detail}). Deviations this rare on a "
+            "real-time link may be stalls of the host, not of the device: not decided",
             measured_ms=lone.measured_ms,
             limit_ms=lone.limit_ms,
             uncertainty_ms=lone.uncertainty_ms,
             evidence=lone.evidence,
+            observed=len(kept),
         )
+    else:
+        found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
         found.detail += f"; {note}"
     return found

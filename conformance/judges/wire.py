@@ -21,7 +21,13 @@ from ..protocol.timing import (
 )
 from ..transcript import TOOL, Event, EventKind, escape
 from ..verdicts import Finding, Verdict
-from .timing import StampUncertainty, combine_local, judge_window, stamp_uncertainty
+from .timing import (
+    StampUncertainty,
+    combine_local,
+    judge_window,
+    stamp_uncertainty,
+    sustained,
+)
 
 REPLY_SEARCH = NO_BREAK_WINDOW  # a DUT run starting later than this is not a reply
 RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
@@ -249,21 +255,40 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
     )
 
 
-def judge_bit_rate(segs: list[Segment], uncertainty: float) -> Finding:
+def judge_bit_rate(segs: list[Segment], uncertainty: float | StampUncertainty) -> Finding:
     """R-4.1-01 (decision A14: 1200 baud ±2%). Back-to-back characters start one frame apart,
     so the shortest start-to-start spacing inside a reply is at least one frame (8.17 ms at
     +2%). A shorter spacing proves the rate too high. A rate too low cannot be told apart from
     an allowed inter-character gap unless some characters come back to back (spacing within
     the ±2% band), so without such a pair the verdict is INCONCLUSIVE, never a guess."""
+    stamps = stamp_uncertainty(uncertainty)
+    uncertainty = stamps.base
     spacings = []
+    fast = []  # spacings surely too short even with the stamps' local uncertainty
     for seg in segs:
         for run in runs(seg.reply) + runs(seg.later):
-            spacings += [(b.start - a.start, seg.text) for a, b in zip(run, run[1:], strict=False)]
+            for a, b in zip(run, run[1:], strict=False):
+                spacings.append((b.start - a.start, seg.text))
+                if b.start - a.start + 2 * stamps.between(a.start, b.end) < CHAR_TIME * 0.98:
+                    fast.append((b.start - a.start, seg.text))
     if not spacings:
         return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character reply observed")
     shortest, text = min(spacings)
     low, high = CHAR_TIME * 0.98, CHAR_TIME * 1.02
     where = [f"in reply to {escape(text)}"]
+    if stamps.local is not None and shortest + 2 * uncertainty < low:
+        if not sustained(len(fast), len(spacings)):  # a few bursts of a stalling host
+            return Finding(
+                "R-4.1-01",
+                Verdict.INCONCLUSIVE,
+                f"{len(fast)} of {len(spacings)} character spacings are shorter than a frame "
+                f"(shortest {shortest * 1e3:.2f} ms); too few, or too near irregular stamps, "
+                "to tell a fast bit rate from bursts of the link",
+                evidence=where,
+                observed=len(spacings),
+            )
+        shortest, text = min(fast)
+        where = [f"in reply to {escape(text)}"]
     if shortest + 2 * uncertainty < low:
         return judge_window(
             "R-4.1-01",

@@ -42,7 +42,8 @@ from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
-ECHO_WAIT = 0.02  # s: beyond the latency bound, how long an echo may take to come back
+ECHO_WAIT = 0.5  # s: beyond the latency bound, how long a known echo may take to come back
+ECHO_WAIT_AUTO = 0.1  # s: the same while auto has not decided (a silent DUT costs it once)
 BURST_MARGIN = 0.5e-3  # s: arrivals this much closer than latency jitter explains are a burst
 RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
 RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release
@@ -316,7 +317,8 @@ class SerialLink(Link):
         the echoed ones, stamped on the receive path, or (no echo) the planned ones."""
         with self._cond:
             if self.echo.listening:
-                deadline = planned[-1].end + self.latency_bound() + ECHO_WAIT
+                wait = ECHO_WAIT if self.echo.decided else ECHO_WAIT_AUTO
+                deadline = planned[-1].end + self.latency_bound() + wait
                 while self.echo.pending and self.echo.listening and self.now() < deadline:
                     self._check()
                     self._cond.wait(min(deadline - self.now(), READ_POLL))
