@@ -47,6 +47,7 @@ def _harmless(junk: str) -> bool:
 JUNK = st.text(alphabet=st.sampled_from("MDCRIVXAB0123456789+-._#"), min_size=1, max_size=6).filter(
     _harmless
 )
+MAX_WAIT_OUT = 3  # s: the longest concurrent measurement the exploration waits out
 IDS = ("R-4.0-01", "R-4.3-01", "R-4.2-03", "R-4.4.12-05", "R-4.4.12-06", "R-4.4.5-10")
 
 
@@ -91,6 +92,16 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
                 record.failing_sequence = list(self.trail)
             return exc
 
+        def _wait_out(self, ex: Exchange) -> None:
+            """A concurrent measurement runs on after its reply: wait its announced time, so
+            anything it sends then (a faulty service request) lands in a pause of its own and
+            is judged by the concurrent cases, not taken for the reply to the next step."""
+            body, _ = split_line(ex.reply_text)
+            ttt = body[1:4]
+            if ttt.isdigit() and int(ttt) > 0:
+                heard = sensor.listen(min(int(ttt), MAX_WAIT_OUT) + 0.05)
+                self._note(f"wait {ttt} s" + (" (heard something)" if heard else ""))
+
         def _note(self, text: str) -> None:
             self.trail.append(text)
             record.steps += 1
@@ -108,6 +119,8 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
                 self.last_d0 = None  # a new measurement may change the data
             if not ex.answered:
                 return
+            if code in ("C", "CC"):
+                self._wait_out(ex)
             self._check_framing(ex)
             if code.startswith("D"):
                 self._check_crc(ex)

@@ -37,6 +37,7 @@ def suite_args(
         "-c", str(resources.files("conformance") / "suite.ini"),
         "--rootdir", str(rootdir),
         "-p", "no:cacheprovider",
+        "-p", "no:benchmark",  # pytest-benchmark, where installed, leaves .benchmarks/ behind
         "--pyargs", f"testcases.{role}",
         "--sdi12-port", port,
         "--sdi12-role", role,

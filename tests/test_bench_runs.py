@@ -150,5 +150,14 @@ def test_without_direction_control_an_rts_driver_swallows_the_reply(runs):
 @pytest.mark.parametrize(("fault", "expected"), FAULTS, ids=[f for f, _ in FAULTS])
 def test_fault_behind_an_echoing_interface_fails_exactly_its_requirement(runs, fault, expected):
     data = runs[fault]
-    failed = {r for r, v in _verdicts(data).items() if v in ("FAIL", "ERROR")}
+    verdicts = _verdicts(data)
+    failed = {r for r, v in verdicts.items() if v in ("FAIL", "ERROR")}
+    assert failed <= expected, f"false FAILs {failed - expected}\n{data['_text']}"
+    undecided = {r for r in expected - failed if verdicts.get(r) == "INCONCLUSIVE"}
+    if undecided and failed | undecided == expected:  # honest, never a false verdict
+        u = data["run"]["link"]["timing_uncertainty_ms"]
+        pytest.skip(
+            f"the machine was too busy for this fault's deviation to be decided: "
+            f"{sorted(undecided)} INCONCLUSIVE at a measured ±{u} ms"
+        )
     assert failed == expected, f"{failed} != {expected}\n{data['_text']}"
