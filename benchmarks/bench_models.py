@@ -21,7 +21,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
-from conformance.emulate.process import EmulatorProcess
+from conformance.emulator_server.process import EmulatorProcess
 
 #: section 7 timing requirements the sensor role judges
 TIMING = (

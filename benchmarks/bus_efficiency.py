@@ -21,7 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from conformance.emulate.process import EmulatorProcess
+from conformance.emulator_server.process import EmulatorProcess
 
 
 def main(argv: list[str] | None = None) -> int:

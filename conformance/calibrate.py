@@ -136,7 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
 def calibrate_main(argv: list[str], say: Callable[[str], None] = print) -> int:
     from .ports import PortError, is_sim, open_port
     from .protocol.commands import ADDRESS_CHARS
-    from .sensor_session import NoDeviceAnswered, SensorSession
+    from .sensor.session import NoDeviceAnswered, SensorSession
 
     try:
         args = build_parser().parse_args(argv)

@@ -12,8 +12,8 @@ from collections.abc import Iterable
 from typing import Any
 
 from .catalog import requirement
-from .master.records import Exchange, Measurement
 from .results import CaseRecord
+from .tool_recorder.records import Exchange, Measurement
 from .transcript import Event
 from .verdicts import Finding, Verdict, not_applicable
 

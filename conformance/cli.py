@@ -394,7 +394,7 @@ def _dispatch(argv: list[str]) -> int:
         if argv and argv[0] == "matrix":
             return cmd_matrix(argv[1:], console)
         if argv and argv[0] == "emulate":
-            from .emulate.command import emulate_main
+            from .emulator_server.command import emulate_main
 
             return emulate_main(argv[1:])
         if argv and argv[0] == "calibrate":

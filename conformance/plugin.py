@@ -28,7 +28,7 @@ from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's sess
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
 from .selection import SelectionError, resolve
-from .sensor_session import NoDeviceAnswered, SensorSession
+from .sensor.session import NoDeviceAnswered, SensorSession
 from .verdicts import Finding, Verdict
 
 RUN = pytest.StashKey[ConformanceRun]()

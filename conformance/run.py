@@ -17,7 +17,7 @@ from .links.base import Link, LinkError
 from .ports import is_sim, open_port
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
-from .sensor_session import SensorSession
+from .sensor.session import SensorSession
 
 
 @dataclass

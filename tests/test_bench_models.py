@@ -1,5 +1,5 @@
 """The emulator's bench models: what echoing, batching, jittery and RTS-switched interfaces do
-to the recorder's view of the line (conformance.emulate.bench and the real-time line)."""
+to the recorder's view of the line (conformance.emulator_server.bench and the real-time line)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,13 @@ import time
 
 import pytest
 
-from conformance.emulate.bench import (
+from conformance.emulator_server.bench import (
     BenchModel,
     Delivery,
     spacing_as_received,
     spacing_runs,
 )
-from conformance.emulate.realtime import RealTimeLine
+from conformance.emulator_server.realtime import RealTimeLine
 from conformance.protocol.timing import CHAR_TIME
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 from test_verdicts_contract import VALIDATOR
 
-from conformance.emulate.process import EmulatorProcess
+from conformance.emulator_server.process import EmulatorProcess
 
 SELECTION = (
     "test_acknowledge_active or test_identification or test_service_request "

@@ -8,7 +8,7 @@ import sys
 import pytest
 
 from conformance.calibrate import RULES, calibrate_main
-from conformance.emulate.process import EmulatorProcess
+from conformance.emulator_server.process import EmulatorProcess
 
 
 def calibrate(*args: str) -> tuple[int, str]:

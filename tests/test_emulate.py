@@ -18,15 +18,15 @@ from pathlib import Path
 import pytest
 import serial
 
-from conformance.emulate.command import emulate_main, make_device
-from conformance.emulate.process import EmulatorProcess
-from conformance.emulate.realtime import LATE_NOTICE, RealTimeLine
-from conformance.emulate.servers import TcpEmulatorServer, serve_serial
+from conformance.emulator_server.command import emulate_main, make_device
+from conformance.emulator_server.process import EmulatorProcess
+from conformance.emulator_server.realtime import LATE_NOTICE, RealTimeLine
+from conformance.emulator_server.servers import TcpEmulatorServer, serve_serial
 from conformance.links.factory import open_real_link
-from conformance.master.engine import Master
 from conformance.ports import PortError
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import INTER_CHAR_GAP_MAX, RESPONSE_START_MAX, RESPONSE_START_MIN
+from conformance.tool_recorder.engine import Master
 from conformance.transcript import to_wire_7e1
 
 #: Cases that together touch wake-up, identification, a measurement with its service request,

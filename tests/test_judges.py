@@ -7,7 +7,6 @@ import pytest
 
 from conformance.judges import measurements, wire
 from conformance.judges.timing import judge_window
-from conformance.master.records import Attempt, Exchange, Measurement
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
 from conformance.results import (
@@ -18,6 +17,7 @@ from conformance.results import (
     aggregate,
     overall,
 )
+from conformance.tool_recorder.records import Attempt, Exchange, Measurement
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict, worst
 

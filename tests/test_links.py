@@ -12,15 +12,15 @@ import time
 
 import pytest
 
-from conformance.emulate.realtime import RealTimeLine
-from conformance.emulate.servers import TcpEmulatorServer
+from conformance.emulator_server.realtime import RealTimeLine
+from conformance.emulator_server.servers import TcpEmulatorServer
 from conformance.links.echo import EchoMode
 from conformance.links.errors import BreakUnsupported, PortUnavailable, PortVanished
 from conformance.links.factory import _explain, open_real_link, port_kind
 from conformance.links.stamps import MAX_LEAD, chunk_frames
-from conformance.master.engine import Master
 from conformance.ports import PortError, open_port
 from conformance.protocol.timing import CHAR_TIME
+from conformance.tool_recorder.engine import Master
 from conformance.transcript import EventKind, to_wire_7e1
 
 pty_only = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal")
@@ -289,7 +289,7 @@ def test_rfc2217_wake_up_break_is_held_by_set_control():
 def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
     """A server that does not take SET-BAUDRATE would send the NUL at 1200 baud (7.5 ms of
     spacing, not what was asked): the link sees the refusal and holds the break instead."""
-    from conformance.emulate import servers
+    from conformance.emulator_server import servers
 
     class Stubborn(servers.VirtualPort):
         @property

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.master import Master
 from conformance.protocol import commands as cmds
+from conformance.tool_recorder import Master
 
 emulator = pytest.importorskip("conformance.emulator")
 if not hasattr(emulator, "sim_sensor"):

@@ -7,8 +7,6 @@ import time
 import pytest
 from test_master_fakes import Babbler, Burst, ScriptedSensor, rig, tool_breaks, with_crc
 
-from conformance.master.policy import Policy
-from conformance.master.records import NO_REPLY, OK, TOO_LONG
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import (
     BREAK_MIN,
@@ -21,6 +19,8 @@ from conformance.protocol.timing import (
     RETRY_MIN,
     TOLERANCE,
 )
+from conformance.tool_recorder.policy import Policy
+from conformance.tool_recorder.records import NO_REPLY, OK, TOO_LONG
 
 ACK = {"0!": ["0\r\n"], "1!": ["1\r\n"], "0I!": ["013VENDOR__MODEL_001\r\n"]}
 

@@ -9,9 +9,9 @@ import time
 import pytest
 
 from conformance.emulator import default_profile, sim_sensor
-from conformance.master import Master
 from conformance.protocol.commands import parse_command
-from conformance.sensor_session import C_FAMILY, HV_FAMILY, M_FAMILY
+from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
+from conformance.tool_recorder import Master
 
 SINGLE = (
     ["0!", "?!", "0I!"]

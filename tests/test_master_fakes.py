@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import pytest
 
-from conformance.master.engine import Master
-from conformance.master.policy import Policy
 from conformance.protocol.crc import ascii_crc
 from conformance.protocol.timing import CHAR_TIME
 from conformance.sim.bus import Frame, SimBus, SimLink
+from conformance.tool_recorder.engine import Master
+from conformance.tool_recorder.policy import Policy
 from conformance.transcript import TOOL, EventKind, to_wire_7e1
 
 REPLY_DELAY = 9e-3  # first response start bit after the command's last stop bit

@@ -6,11 +6,11 @@ import time
 
 from test_master_fakes import Burst, ScriptedSensor, rig, then_sr, with_crc
 
-from conformance.master.policy import Policy
-from conformance.master.records import Measurement
 from conformance.protocol import commands as cmds
 from conformance.protocol.binary import DataType, build_packet, empty_packet
 from conformance.protocol.timing import NO_BREAK_WINDOW
+from conformance.tool_recorder.policy import Policy
+from conformance.tool_recorder.records import Measurement
 
 
 def first_d(m: Measurement):

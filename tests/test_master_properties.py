@@ -7,7 +7,6 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from test_master_fakes import Burst, ScriptedSensor, rig
 
-from conformance.master.policy import Policy
 from conformance.protocol.timing import (
     BREAK_MIN,
     MARKING_AFTER_BREAK,
@@ -17,6 +16,7 @@ from conformance.protocol.timing import (
     RETRY_MIN,
     TOLERANCE,
 )
+from conformance.tool_recorder.policy import Policy
 
 BEHAVIOURS = {
     "silent": (None, False),

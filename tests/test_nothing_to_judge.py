@@ -19,7 +19,7 @@ from conformance.ports import OpenedPort, SimSpec, sim_declaration
 from conformance.recorder.matrix import run_recorder_suite
 from conformance.recorder.session import LineMonitor
 from conformance.results import CaseRecord, aggregate
-from conformance.sensor_session import SensorSession
+from conformance.sensor.session import SensorSession
 from conformance.sim.bus import SimBus, SimLink
 from conformance.verdicts import NOTHING_TO_JUDGE, Finding, Verdict, passed
 

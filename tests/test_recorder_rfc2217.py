@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from conformance.cli import main
-from conformance.emulate.realtime import LATE_NOTICE
+from conformance.emulator_server.realtime import LATE_NOTICE
 from conformance.judges import recorder as judge
 from conformance.recorder.drivers import Trigger
 from conformance.recorder.faults import RECORDER_FAULTS

@@ -9,7 +9,6 @@ import sys
 import pytest
 
 from conformance.cli import main
-from conformance.master import Master, Policy
 from conformance.ports import PortError
 from conformance.protocol.commands import measure
 from conformance.recorder.drivers import Interactive, RecorderDriverError, Trigger
@@ -17,6 +16,7 @@ from conformance.recorder.played import SensorSpec, Spoil
 from conformance.recorder.request import Request, Task
 from conformance.recorder.session import LineMonitor, RecorderSession, check_port
 from conformance.sim.bus import SimBus, SimLink
+from conformance.tool_recorder import Master, Policy
 
 
 def _bus(spec: SensorSpec) -> Master:

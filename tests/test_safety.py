@@ -13,14 +13,14 @@ from dataclasses import replace
 
 import pytest
 
-from conformance.address_change import AddressChanger
 from conformance.case import Case
-from conformance.emulate.process import EmulatorProcess
+from conformance.emulator_server.process import EmulatorProcess
 from conformance.links.factory import open_real_link
-from conformance.master.engine import Master
 from conformance.ports import open_sim, parse_sim
 from conformance.results import CaseRecord
-from conformance.sensor_session import SensorSession
+from conformance.sensor.address_change import AddressChanger
+from conformance.sensor.session import SensorSession
+from conformance.tool_recorder.engine import Master
 from testcases.sensor.test_4_4_basic import test_change_address as change_address_case
 
 

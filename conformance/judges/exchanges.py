@@ -7,7 +7,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from ..case import events_of
-from ..master.records import Exchange
 from ..protocol.crc import ascii_crc
 from ..protocol.responses import (
     Identification,
@@ -17,6 +16,7 @@ from ..protocol.responses import (
     parse_ident,
     split_line,
 )
+from ..tool_recorder.records import Exchange
 from ..transcript import escape
 
 __all__ = ["ascii_crc", "escape", "events_of", "failed", "passed", "warned"]

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..master.records import Exchange
 from ..protocol.timing import MULTILINE_GAP_MAX
+from ..tool_recorder.records import Exchange
 from ..transcript import Event, escape
 from ..verdicts import Finding
 from .tally import Tally

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from ..master.records import Exchange, Measurement
 from ..protocol.binary import parse_binary_packet
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
 from ..protocol.responses import (
@@ -21,6 +20,7 @@ from ..protocol.responses import (
 )
 from ..protocol.timing import TOLERANCE
 from ..protocol.values import Violation, check_value
+from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding
 from .tally import Tally

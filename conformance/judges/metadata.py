@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import re
 
-from ..master.records import Exchange, Measurement
 from ..protocol.responses import parse_measurement_reply_for, parse_metadata_reply, split_line
+from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import escape
 from ..verdicts import Finding
 from .tally import Tally

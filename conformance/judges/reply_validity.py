@@ -2,7 +2,7 @@
 
 A recorder is judged on whether it retried an invalid reply and took a valid one, so the
 judges need a validity rule. It must not be the golden recorder's own
-(:mod:`conformance.master.validity`): a judge that shares the decision code of the reference
+(:mod:`conformance.tool_recorder.validity`): a judge that shares the decision code of the reference
 it is compared with cannot catch that reference's mistakes, and a bug there would pass both.
 So the rules here rest on the response grammar of :mod:`conformance.protocol.responses` and
 :mod:`conformance.protocol.binary`, and every problem carries a :class:`Reason` code: judges

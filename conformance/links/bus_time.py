@@ -22,9 +22,9 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from ..master import validity
 from ..protocol.commands import CommandError, parse_command
 from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
+from ..tool_recorder import validity
 from ..transcript import TOOL, Event, EventKind, decode_7e1
 
 

@@ -13,11 +13,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from ..links.base import Link
-from ..master import Master, Measurement, Policy
-from ..master.records import Attempt, Exchange
-from ..master.validity import ends_line
 from ..protocol.commands import Command, Kind, parse_command
 from ..sim.bus import SimLink
+from ..tool_recorder import Master, Measurement, Policy
+from ..tool_recorder.records import Attempt, Exchange
+from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
 from .golden import GoldenMaster, GoldenRecorder
 from .request import RecorderOutput, Request, Task

@@ -3,7 +3,7 @@
 A recorder program is any callable ``(request, link) -> RecorderOutput``: it receives what the
 scenario asks (:class:`~conformance.recorder.request.Request`) and the bus, does the job the
 way a data logger would, and says what it logged. :class:`GoldenRecorder` does it with the
-tool's own :class:`~conformance.master.Master` under :meth:`Policy.golden`, so it is the
+tool's own :class:`~conformance.tool_recorder.Master` under :meth:`Policy.golden`, so it is the
 reference every recorder judge must find COMPLIANT; its knobs (and the Master subclasses in
 :mod:`conformance.recorder.faults`) make the faulty recorders of the fault-detection matrix.
 
@@ -19,11 +19,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..links.base import Link
-from ..master import Master, Measurement, Policy, validity
-from ..master.records import Exchange
 from ..protocol.binary import parse_binary_packet
 from ..protocol.commands import Command, Kind, parse_command
 from ..protocol.values import split_values
+from ..tool_recorder import Master, Measurement, Policy, validity
+from ..tool_recorder.records import Exchange
 from ..transcript import TOOL, EventKind
 from .request import RecorderOutput, Request, Task
 

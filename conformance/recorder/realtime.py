@@ -1,7 +1,8 @@
 """The played sensors served in real time, for a recorder that is outside the virtual bus.
 
 ``--port rfc2217-serve://127.0.0.1:0`` (``0``: the OS picks a free port) makes the tool an
-RFC 2217 server: one emulated line (:class:`~conformance.emulate.realtime.RealTimeLine`) with
+RFC 2217 server: one emulated line
+(:class:`~conformance.emulator_server.realtime.RealTimeLine`) with
 a :class:`PlayedBus` on it, which puts every played sensor of the current scenario on that
 line, as the sim bus does. The recorder under test connects as a client (``rfc2217://HOST:PORT``,
 breaks through SET_CONTROL); the golden recorder does so through
@@ -25,8 +26,8 @@ from dataclasses import dataclass, field
 from math import inf
 from urllib.parse import parse_qs, urlsplit
 
-from ..emulate.realtime import RealTimeLine
-from ..emulate.servers import TcpEmulatorServer
+from ..emulator_server.realtime import RealTimeLine
+from ..emulator_server.servers import TcpEmulatorServer
 from ..links.base import LinkInfo
 from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
 from ..ports import PortError

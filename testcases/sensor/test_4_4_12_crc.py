@@ -6,7 +6,7 @@ import pytest
 
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
-from conformance.sensor_session import C_FAMILY, M_FAMILY
+from conformance.sensor.session import C_FAMILY, M_FAMILY
 from conformance.verdicts import Finding, passed, warned
 
 requirements = pytest.mark.requirements

@@ -8,7 +8,7 @@ from conformance.judges import measurements as judge
 from conformance.judges.exchanges import shown
 from conformance.judges.wire import runs
 from conformance.protocol.responses import split_line
-from conformance.sensor_session import C_FAMILY, HV_FAMILY, M_FAMILY
+from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed, warned
 

@@ -7,7 +7,7 @@ import pytest
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
 from conformance.protocol.responses import split_line
-from conformance.sensor_session import C_FAMILY
+from conformance.sensor.session import C_FAMILY
 from conformance.verdicts import failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements

@@ -11,7 +11,7 @@ from conformance.protocol.responses import (
     parse_measurement_reply_for,
     split_line,
 )
-from conformance.sensor_session import C_FAMILY, M_FAMILY
+from conformance.sensor.session import C_FAMILY, M_FAMILY
 from conformance.verdicts import failed, inconclusive, passed
 
 requirements = pytest.mark.requirements

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.exploration import IDS, explore
+from conformance.sensor.exploration import IDS, explore
 from conformance.verdicts import failed, inconclusive, passed
 
 requirements = pytest.mark.requirements

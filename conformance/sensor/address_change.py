@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .master.engine import Master
-from .master.records import Exchange
-from .protocol.responses import split_line
-from .protocol.timing import ADDRESS_CHANGE_QUIET
+from ..protocol.responses import split_line
+from ..protocol.timing import ADDRESS_CHANGE_QUIET
+from ..tool_recorder.engine import Master
+from ..tool_recorder.records import Exchange
 
 POLL_INTERVAL = 0.2  # s between "are you there at the new address?" polls
 LATE_LIMIT = 3.0  # s: how long past the 1 s allowance the tool keeps polling for evidence

@@ -12,16 +12,16 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+from ..declaration import Declaration
+from ..judges.timing import StampUncertainty
+from ..links.base import Link
+from ..protocol import commands as cmd
+from ..protocol.commands import Command, parse_command
+from ..protocol.responses import Identification, parse_ident, split_line
+from ..tool_recorder.engine import Master
+from ..tool_recorder.records import Exchange, Measurement
+from ..transcript import Event
 from .address_change import AddressChanger
-from .declaration import Declaration
-from .judges.timing import StampUncertainty
-from .links.base import Link
-from .master.engine import Master
-from .master.records import Exchange, Measurement
-from .protocol import commands as cmd
-from .protocol.commands import Command, parse_command
-from .protocol.responses import Identification, parse_ident, split_line
-from .transcript import Event
 
 T = TypeVar("T")
 

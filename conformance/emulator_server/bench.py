@@ -15,7 +15,8 @@ hardware (issue: real bench):
   raises RTS, and the sensor's reply is lost while RTS is still raised (the recorder's driver
   holds the line).
 
-Everything here is pure arithmetic on times; :class:`~conformance.emulate.realtime.RealTimeLine`
+Everything here is pure arithmetic on times;
+:class:`~conformance.emulator_server.realtime.RealTimeLine`
 calls it.
 """
 

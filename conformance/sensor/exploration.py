@@ -20,12 +20,12 @@ from hypothesis import HealthCheck, Phase, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
 
-from .master.records import Exchange
-from .protocol.commands import CommandError, Kind, parse_command
-from .protocol.crc import is_crc_char
-from .protocol.responses import parse_data_reply, split_line
-from .sensor_session import SensorSession
-from .transcript import escape
+from ..protocol.commands import CommandError, Kind, parse_command
+from ..protocol.crc import is_crc_char
+from ..protocol.responses import parse_data_reply, split_line
+from ..tool_recorder.records import Exchange
+from ..transcript import escape
+from .session import SensorSession
 
 #: Commands the exploration sends to the sensor's own address. Any next command aborts a
 #: running measurement and pauses stay under 0.25 s, so no service request arrives unasked

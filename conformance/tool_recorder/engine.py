@@ -3,7 +3,7 @@
 In the sensor role it is the stimulus that drives the device under test; in the recorder role
 it is the "golden recorder" that other recorders are compared with. Either way it sends what a
 correct recorder sends (breaks, retries, service-request waits, D0..Dn collection) and hands
-back :mod:`~conformance.master.records` with every attempt, leaving every verdict to judges.
+back :mod:`~conformance.tool_recorder.records` with every attempt, leaving every verdict to judges.
 It talks to the bus only through the :class:`~conformance.links.base.Link` API, so it runs the
 same on the virtual-time sim bus and on a serial port, and every read is bounded by a
 deadline so a silent or babbling device can never hang it.
