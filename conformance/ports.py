@@ -13,6 +13,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from .declaration import Declaration
 from .links.base import Link
+from .replay.link import is_replay
 
 if TYPE_CHECKING:
     from .emulator.profile import Profile
@@ -104,6 +105,8 @@ def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> Open
     """Open ``port``; ``echo`` and ``direction`` describe a real bench (ignored on sim)."""
     if is_sim(port):
         return open_sim(parse_sim(port))
+    if is_replay(port):
+        return open_replay(port)
     if port.startswith("rfc2217-serve://"):
         raise PortError(
             f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
@@ -130,6 +133,33 @@ def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> Open
             f"{exc}: --echo is auto, on or off; --direction is rts, dtr or none"
         ) from exc
     return OpenedPort(open_real_link(port, **bench))
+
+
+def open_replay(port: str) -> OpenedPort:
+    """``replay:PATH``: a saved sensor-role run's recorded sensor on the simulated bus."""
+    from .replay.link import open_sensor_replay
+    from .replay.recording import RecordingError
+
+    try:
+        link, recording = open_sensor_replay(port)
+        return OpenedPort(link, declaration=recorded_declaration(recording.original_port))
+    except RecordingError as exc:
+        raise PortError(str(exc)) from exc
+
+
+def recorded_declaration(port: str | None) -> Declaration | None:
+    """What the recorded run's device declared when the tool built it (a simulated sensor
+    declares its clean profile; a replay's, what its own recording's device declared)."""
+    if port is None:
+        return None
+    if is_sim(port):
+        return open_sim(parse_sim(port)).declaration
+    if is_replay(port):
+        from .replay.link import replay_path
+        from .replay.recording import read_recording
+
+        return recorded_declaration(read_recording(replay_path(port)).original_port)
+    return None
 
 
 def check_network_url(port: str) -> None:

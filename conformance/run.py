@@ -7,7 +7,7 @@ the DUT, so `pytest --pyargs testcases` with nothing selected never touches a po
 from __future__ import annotations
 
 import datetime as dt
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +15,7 @@ from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
 from .links.base import Link, LinkError
 from .ports import is_sim, open_port
+from .replay.recording import options_note
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
 from .sensor.session import SensorSession
@@ -91,7 +92,16 @@ class ConformanceRun:
             self.link, self.devices = opened.link, opened.devices
             if self.declaration is None:
                 self.declaration = opened.declaration
+            self.note_options()
         return self.link
+
+    def note_options(self) -> None:
+        """Open the transcript with how this run was made (options and link), so that
+        ``sdi12-conform judge`` can repeat its stimuli exactly when it judges it again."""
+        if self.link is None:
+            return
+        options = asdict(self.options) | {"link": asdict(self.link.info)}
+        self.link.transcript.add(options_note(options, self.link.now()))
 
     def sensor_session(self) -> SensorSession:
         if self.session is None:
@@ -127,6 +137,7 @@ class ConformanceRun:
                 timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
             )
             self.link = self.session.link
+            self.note_options()
         return self.session
 
     @property

@@ -26,6 +26,9 @@ from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
 from ..links.base import Link, LinkError, LinkInfo
 from ..ports import PortError, SimSpec, is_sim, parse_sim
+from ..replay.link import is_replay, open_recorder_replay, replayed_info
+from ..replay.recorder import RecordedRecorder, output_note
+from ..replay.recording import RecordingError
 from ..sim.bus import Frame, SimBus, SimLink
 from ..transcript import TOOL, Event, EventKind
 from .drivers import (
@@ -111,20 +114,34 @@ class RecorderSession:
     ) -> None:
         served = is_served(port)
         harness = is_harness_port(port)
-        if not is_sim(port) and not served and not harness:
+        replay = is_replay(port)
+        if not is_sim(port) and not served and not harness and not replay:
             raise PortError(
                 f"port {port!r}: the recorder role plays the sensors itself: use --port sim "
                 "(virtual time), --port 'exec:PROGRAM ARGS' (a recorder harness, virtual time) "
                 "or --port rfc2217-serve://127.0.0.1:0 (served in real time, "
                 "the recorder connects over RFC 2217)"
             )
-        spec = parse_served(port) if served else SimSpec() if harness else parse_sim(port)
+        spec = (
+            parse_served(port)
+            if served
+            else SimSpec()
+            if harness or replay
+            else parse_sim(port)
+        )
         faults = tuple(f for f in spec.extra.get("recorder-faults", "").split(",") if f)
         unknown = [f for f in faults if f not in RECORDER_FAULTS]
         if unknown or len(faults) > 1:
             known = ", ".join(sorted(RECORDER_FAULTS))
             raise PortError(f"recorder-faults takes one of: {known} (got {','.join(faults)})")
-        if driver is None and harness:
+        recording = None
+        if replay:
+            try:
+                recording = open_recorder_replay(port)
+            except RecordingError as exc:
+                raise PortError(str(exc)) from exc
+            driver = RecordedRecorder(recording.events)
+        elif driver is None and harness:
             driver = HarnessRecorder(port)
             driver.probe()
         elif driver is None:
@@ -151,6 +168,8 @@ class RecorderSession:
             if harness:  # the reports name the harness link, still virtual time
                 kind = port.partition(":")[0]
                 self.link.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
+            if recording is not None:  # a replay: the recorded run's link, as it was
+                self.link.info = replayed_info(recording)
         self.version = version
         self.uncertainty = (
             self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
@@ -213,6 +232,7 @@ class RecorderSession:
             output = self.driver.act(scenario.name, scenario.request, self.link)
         except RecorderDriverError as exc:
             output, error = RecorderOutput(), str(exc)
+        transcript.note(self.link.now(), output_note(scenario.name, output, error))
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
         events = transcript.since(first)
@@ -243,6 +263,7 @@ class RecorderSession:
             output = self._act_served(scenario, line)
         except (RecorderDriverError, LinkError) as exc:
             output, error = RecorderOutput(), str(exc)
+        line.note(output_note(scenario.name, output, error))
         line.settle(SETTLE)
         kept = line.line
         line.note(f"scenario {scenario.name} done; {kept.timekeeping()}")

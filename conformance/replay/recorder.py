@@ -1,0 +1,97 @@
+"""A recorded recorder: the device under test of a saved recorder-role run, played back.
+
+In the recorder role the tool plays the sensors and the recorder under test acts. Judging a
+saved recorder-role run again replays, scenario by scenario, what the recorder sent (each
+scenario's slice is found by name, so the order the cases ask in does not matter) while the
+tool plays its sensors live, as it did. The recorder's own account of a scenario (values it
+logged, replies it relayed, or the driver's failure) is read from the note the session wrote
+after the scenario (:data:`OUTPUT_NOTE`).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from ..links.base import Link
+from ..recorder.drivers import RecorderDriverError
+from ..recorder.request import RecorderOutput, Request
+from ..sim.bus import SimLink
+from ..transcript import TOOL, Event, EventKind
+from .sensor import ReplayDiverged
+
+#: Prefix of the scenario-start note (written by the recorder session).
+SCENARIO_NOTE = "scenario "
+#: Prefix of the note holding the recorder's account of a scenario (JSON).
+OUTPUT_NOTE = "recorder-output "
+
+
+def output_note(name: str, output: RecorderOutput, error: str | None) -> str:
+    """The note text a recorder session writes after scenario ``name``."""
+    found: dict[str, Any] = {
+        "scenario": name,
+        "logged": output.logged,
+        "relayed": output.relayed,
+        "notes": output.notes,
+        "error": error,
+    }
+    return OUTPUT_NOTE + json.dumps(found)
+
+
+class RecordedRecorder:
+    """A recorder driver that acts by replaying a recording's recorder transmissions."""
+
+    kind = "recording"
+    needs_real_time = False
+
+    def __init__(self, events: list[Event]) -> None:
+        # per scenario: when it began, what the recorder sent, its account, when it was done
+        self.slices: dict[str, tuple[float, list[Event], dict[str, Any] | None]] = {}
+        self.done: dict[str, float] = {}
+        current: str | None = None
+        start = 0.0
+        for e in events:
+            if e.kind is EventKind.NOTE and e.text.startswith(SCENARIO_NOTE):
+                name = e.text[len(SCENARIO_NOTE) :].split(":", 1)[0].split(" ", 1)[0]
+                if ":" in e.text:  # "scenario NAME: ..." starts one ("... done; ..." ends it)
+                    current, start = name, e.start
+                    self.slices[name] = (start, [], None)
+                continue
+            if e.kind is EventKind.NOTE and e.text.startswith(OUTPUT_NOTE):
+                found = json.loads(e.text[len(OUTPUT_NOTE) :])
+                name = found.get("scenario")
+                if name in self.slices:
+                    begun, sent, _ = self.slices[name]
+                    self.slices[name] = (begun, sent, found)
+                    self.done[name] = e.start
+                continue
+            if current is not None and e.kind is not EventKind.NOTE and e.origin == TOOL:
+                self.slices[current][1].append(e)
+
+    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+        if scenario not in self.slices:
+            raise ReplayDiverged(
+                f"the recording has no scenario {scenario!r} (it has: "
+                f"{', '.join(self.slices) or 'none'})"
+            )
+        if not isinstance(link, SimLink):
+            raise ReplayDiverged("a recorded recorder replays on the simulated bus only")
+        begun, sent, account = self.slices[scenario]
+        offset = link.now() - begun
+        for e in sent:
+            link.wait_until(e.start + offset)
+            if e.kind is EventKind.BREAK:
+                link.bus.tool_break(e.end - e.start)
+            else:
+                link.bus.tool_char(e.wire, e.start + offset, e.end - e.start)
+        if scenario in self.done:  # the recorder was busy (listening) until then
+            link.wait_until(self.done[scenario] + offset)
+        if account is None:
+            return RecorderOutput()
+        if account.get("error"):
+            raise RecorderDriverError(str(account["error"]))
+        return RecorderOutput(
+            logged={k: list(v) for k, v in (account.get("logged") or {}).items()},
+            relayed=dict(account.get("relayed") or {}),
+            notes=list(account.get("notes") or []),
+        )

@@ -1,0 +1,130 @@
+"""A run's saved ``transcript.jsonl`` read back, with the options the run was made with.
+
+A run writes its transcript as JSON lines (:meth:`conformance.transcript.Transcript.write_jsonl`);
+this module is the other half. The first line of a transcript written since the replay exists
+is a NOTE holding the run's options (``run-options {...}``), so ``sdi12-conform judge`` can
+repeat the run's stimuli exactly (same address discovery, same forced version, same selection)
+without the user remembering them. Older transcripts lack it; then ``verdicts.json`` beside the
+transcript and the command line fill in what they can.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..transcript import TOOL, Event, EventKind
+
+#: Prefix of the NOTE that carries the run's options (first line of a transcript).
+OPTIONS_NOTE = "run-options "
+
+
+class RecordingError(ValueError):
+    """A recording that cannot be judged; the message names the file and what is wrong."""
+
+
+@dataclass
+class Recording:
+    """The events of one saved run and what is known of how it was made."""
+
+    path: Path
+    events: list[Event]
+    options: dict[str, Any] = field(default_factory=dict)  # RunOptions fields, as saved
+    verdicts: dict[str, Any] | None = None  # verdicts.json beside it, when there is one
+
+    @property
+    def role(self) -> str | None:
+        if "role" in self.options:
+            return str(self.options["role"])
+        if self.verdicts:
+            return self.verdicts.get("run", {}).get("role")
+        return None
+
+    @property
+    def original_port(self) -> str | None:
+        if "port" in self.options:
+            return str(self.options["port"])
+        if self.verdicts:
+            return self.verdicts.get("run", {}).get("port")
+        return None
+
+    def wire_events(self) -> list[Event]:
+        return [e for e in self.events if e.kind is not EventKind.NOTE]
+
+
+def options_note(options: dict[str, Any], time: float = 0.0) -> Event:
+    """The NOTE a run writes first, so its transcript can be judged again as it was made."""
+    return Event(EventKind.NOTE, TOOL, time, time, text=OPTIONS_NOTE + json.dumps(options))
+
+
+def event_from_json(row: dict[str, Any]) -> Event:
+    """One ``transcript.jsonl`` line back into an :class:`Event` (KeyError/ValueError if bad)."""
+    return Event(
+        EventKind(row["kind"]),
+        str(row["origin"]),
+        float(row["start"]),
+        float(row["end"]),
+        wire=int(row.get("wire", 0)),
+        text=str(row.get("text", "")),
+        uncertainty=float(row.get("uncertainty", 0.0)),
+        duration_uncertainty=(
+            None if row.get("duration_uncertainty") is None else float(row["duration_uncertainty"])
+        ),
+    )
+
+
+def transcript_path(path: Path) -> Path:
+    """``path`` itself, or the ``transcript.jsonl`` inside a run folder."""
+    return path / "transcript.jsonl" if path.is_dir() else path
+
+
+def read_recording(path: str | Path) -> Recording:
+    """Read a run's transcript (a ``transcript.jsonl`` or the run folder holding it)."""
+    file = transcript_path(Path(path))
+    if not file.exists():
+        raise RecordingError(f"{file}: no such file")
+    events: list[Event] = []
+    options: dict[str, Any] = {}
+    try:
+        with file.open(encoding="utf-8") as fh:
+            for number, line in enumerate(fh, 1):
+                if not line.strip():
+                    continue
+                try:
+                    event = event_from_json(json.loads(line))
+                except (ValueError, KeyError, TypeError) as exc:
+                    raise RecordingError(
+                        f"{file}, line {number}: not a transcript event ({exc.__class__.__name__}:"
+                        f" {exc})"
+                    ) from None
+                if event.kind is EventKind.NOTE and event.text.startswith(OPTIONS_NOTE):
+                    options = _options_from(file, number, event.text[len(OPTIONS_NOTE) :])
+                events.append(event)
+    except UnicodeDecodeError:
+        raise RecordingError(f"{file}: not a text file (a transcript is JSON lines)") from None
+    if not any(e.kind is not EventKind.NOTE for e in events):
+        raise RecordingError(f"{file}: no bus events in it: nothing to judge")
+    return Recording(file, events, options, _verdicts_beside(file))
+
+
+def _options_from(file: Path, number: int, text: str) -> dict[str, Any]:
+    try:
+        found = json.loads(text)
+    except ValueError:
+        raise RecordingError(f"{file}, line {number}: the run-options note is not JSON") from None
+    if not isinstance(found, dict):
+        raise RecordingError(f"{file}, line {number}: the run-options note is not an object")
+    return found
+
+
+def _verdicts_beside(file: Path) -> dict[str, Any] | None:
+    beside = file.with_name("verdicts.json")
+    if not beside.exists():
+        return None
+    try:
+        found = json.loads(beside.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError):
+        return None
+    return found if isinstance(found, dict) else None

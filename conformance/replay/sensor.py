@@ -1,0 +1,91 @@
+"""A recorded sensor: the device under test of a saved sensor-role run, played back.
+
+Judging a saved run again means asking the same questions and getting the recorded answers.
+The tool runs its cases as it did (same stimuli, in the same order: cases ask for what they
+need, and exploration is derandomized), on a simulated bus where the emulator is replaced by
+this device. It follows the tool's transmissions through the recording; every recorded reply is
+offered once all the tool's recorded transmissions before it have been heard again, shifted by
+how late or early the tool is now against the recording (on the sim the shift is zero, so the
+replayed transcript is the recorded one). The judges then see what they saw the first time.
+
+When the tool sends something the recording does not have next, the replay has diverged (the
+tool changed, or the recording is not of this kind of run): :class:`ReplayDiverged` stops the
+run with that said, instead of inventing answers.
+"""
+
+from __future__ import annotations
+
+from ..links.base import LinkError
+from ..sim.bus import Frame
+from ..transcript import TOOL, Event, EventKind, escape
+
+
+class ReplayDiverged(LinkError):
+    """The tool's stimuli no longer follow the recording."""
+
+
+class RecordedSensor:
+    """A :class:`~conformance.sim.bus.BusDevice` that answers from a recording."""
+
+    name = "recording"
+
+    def __init__(self, events: list[Event]) -> None:
+        wire = sorted(
+            (e for e in events if e.kind is not EventKind.NOTE), key=lambda e: (e.start, e.end)
+        )
+        self.tool = [e for e in wire if e.origin == TOOL]
+        self.replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
+        # how many tool events the recording has before each reply character starts
+        self._needs: list[int] = []
+        i = 0
+        for reply in self.replies:
+            while i < len(self.tool) and self.tool[i].start < reply.start:
+                i += 1
+            self._needs.append(i)
+        self.heard = 0  # tool events matched so far
+        self.next_reply = 0
+        self.offset = 0.0  # now minus recorded time, at the last matched tool event
+
+    # -- what the tool does -------------------------------------------------------------------
+    def on_break(self, start: float, end: float) -> None:
+        self._match(EventKind.BREAK, 0, end)
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        self._match(EventKind.CHAR, wire, end)
+
+    def _match(self, kind: EventKind, wire: int, end: float) -> None:
+        if self.heard >= len(self.tool):
+            raise ReplayDiverged(
+                f"replay diverged at {end:.3f} s: the tool sent {_describe(kind, wire)}, "
+                "but the recording ends there"
+            )
+        expected = self.tool[self.heard]
+        if expected.kind is not kind or (kind is EventKind.CHAR and expected.wire != wire):
+            raise ReplayDiverged(
+                f"replay diverged at {end:.3f} s (recorded {expected.start:.3f} s): the tool "
+                f"sent {_describe(kind, wire)}, the recording has "
+                f"{_describe(expected.kind, expected.wire)}"
+            )
+        self.heard += 1
+        self.offset = end - expected.end
+
+    # -- what the recording says the sensor did -------------------------------------------------
+    def next_frame(self) -> Frame | None:
+        if self.next_reply >= len(self.replies):
+            return None
+        if self._needs[self.next_reply] > self.heard:
+            return None  # its question has not been asked yet
+        reply = self.replies[self.next_reply]
+        return Frame(reply.start + self.offset, reply.wire, reply.end - reply.start)
+
+    def pop_frame(self) -> Frame:
+        frame = self.next_frame()
+        assert frame is not None, "the bus pops only a frame that was offered"
+        self.next_reply += 1
+        return frame
+
+
+def _describe(kind: EventKind, wire: int) -> str:
+    if kind is EventKind.BREAK:
+        return "a break"
+    return f"'{escape(chr(wire & 0x7F))}'"
