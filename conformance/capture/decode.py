@@ -21,6 +21,7 @@ from .formats import read_edges, sniff
 from .uart import Decoded, Framing, decode
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
+MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong bit rate
 RECORDER = TOOL  # origin of what the recorder's TX channel shows
 SENSOR = DUT  # origin of the rest of the bus
 
@@ -178,7 +179,7 @@ def _decode_channel(
     bad = out.framing_errors + out.parity_errors + out.glitches
     est = _estimated_baud(prefix, edges.tick_rate)
     off = est is not None and not 0.8 < est / baud < 1.25
-    if out.chars and bad * 5 >= out.chars and (off or bad * 2 > out.chars):
+    if out.chars and bad >= MIN_BAD and bad * 5 >= out.chars and (off or 2 * bad > out.chars):
         hint = f"; the shortest pulses suggest about {est:.0f} baud" if est else ""
         raise CaptureError(
             path,

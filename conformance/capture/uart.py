@@ -191,12 +191,16 @@ def decode(
             wire |= bits[1 + b] << b
         framing_error = bits[-1] == 0
         parity_error = not framing.parity_ok(wire)
-        # glitches: runs inside the frame shorter than half a bit
+        # glitches: pulses inside the frame shorter than half a bit. A pulse also cuts the
+        # bit it lands in into short pieces, so a run of consecutive short runs is one glitch
         glitches = 0
+        short_before = False
         bounds = [s, *inner]
         for a, b2 in zip(bounds, bounds[1:], strict=False):
-            if b2 - a < half:
+            short = b2 - a < half
+            if short and not short_before:
                 glitches += 1
+            short_before = short
         # the bit time from edges that sit on bit boundaries (least squares through the start)
         skk = sdk = 0.0
         kmax = 0
