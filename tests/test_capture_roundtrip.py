@@ -188,3 +188,13 @@ def test_property_text_and_breaks_survive_export(tmp_path, items, fmt, line):
     offset = 0.0 if fmt == "csv" else info.t0
     assert_same(events, d.events, offset, d.uncertainty_s)
     assert d.inverted is line
+
+
+def test_break_cut_by_the_capture_end_is_kept(tmp_path):
+    path = tmp_path / "cut.csv"
+    path.write_text("Time [s],TX\n0.000,1\n0.010,0\n0.030,0\n")
+    d = decode_capture(path)
+    assert [(e.kind, round(e.start, 6), round(e.end, 6)) for e in d.events] == [
+        (EventKind.BREAK, 0.01, 0.03)
+    ]
+    assert d.breaks == 1

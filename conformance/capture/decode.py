@@ -144,7 +144,6 @@ def _decode_channel(
         framing=str(framing),
         notes=notes,
     )
-    end_holder = edges.end
     decoded = decode(
         chain(taken, chunks),
         initial_level=edges.initial_level,
@@ -155,7 +154,7 @@ def _decode_channel(
         t0=edges.t0,
         uncertainty=uncertainty,
         period_ticks=edges.period * edges.tick_rate,
-        end_tick=None,
+        end_tick=edges.end,
     )
     for d in decoded:
         if d.event is not None:
@@ -175,7 +174,6 @@ def _decode_channel(
         out.breaks += d.kind == "break"
         out.pulses += d.kind == "pulse"
         out.glitches += d.kind == "glitch"
-    _ = end_holder  # the capture's end is not needed: a spacing running there is cut
     bad = out.framing_errors + out.parity_errors + out.glitches
     est = _estimated_baud(prefix, edges.tick_rate)
     off = est is not None and not 0.8 < est / baud < 1.25

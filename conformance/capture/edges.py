@@ -25,7 +25,7 @@ EdgeChunks = Iterable[list[int]]
 class Edges:
     """One channel as a starting level plus the ticks at which it toggles.
 
-    ``chunks`` yields lists of strictly increasing ticks and may be consumed once. ``end_tick``
+    ``chunks`` yields lists of strictly increasing ticks and may be consumed once. ``end``
     is the capture's last tick when the format says so (known for .sr only after its chunks were
     read: ``end()`` asks the reader), else the last edge.
     """

@@ -131,7 +131,7 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
         previous: int | None = None
         offset = 0
         for block in session.blocks():
-            levels = ((block >> bit) & 1).astype(np.uint8)
+            levels = block & 1 if bit == 0 else (block >> bit) & 1
             if previous is None and levels.size:
                 first_level.append(int(levels[0]))
             idx, previous = transitions(levels, previous)

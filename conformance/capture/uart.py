@@ -13,7 +13,7 @@ Levels are handled on the UART side (marking = 1). The SDI-12 line itself idles 
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from ..protocol.timing import BREAK_MIN, BREAK_NEVER
@@ -111,15 +111,16 @@ def decode(
     t0: float = 0.0,
     uncertainty: float = 0.0,
     period_ticks: float = 1.0,
-    end_tick: int | None = None,
+    end_tick: Callable[[], int | None] | None = None,
     break_min: float = BREAK_MIN,
     pulse_min: float = BREAK_NEVER,
 ) -> Iterator[Decoded]:
     """Frames, breaks, pulses and glitches in time order, from edge ticks.
 
     ``period_ticks``: how many ticks one sample period spans (the edge position error), used
-    to tell a measured bit rate from rounding. ``end_tick``: where the capture ends, to close
-    a spacing still running there (else it ends at the last edge)."""
+    to tell a measured bit rate from rounding. ``end_tick``: asked, once the edges are
+    exhausted, where the capture ends, to measure a spacing still running there (a break the
+    capture cut); without it such a spacing is dropped."""
     framing = framing or Framing.parse("7E1")
     nbits = framing.bits
     T = tick_rate / baud
@@ -145,7 +146,11 @@ def decode(
             return
         r = cur.peek(1)
         cur.i += 1  # the falling edge is consumed; r (if any) is still ahead
-        r_end = r if r is not None else (end_tick if end_tick is not None else s)
+        if r is not None:
+            r_end = r
+        else:
+            last = end_tick() if end_tick is not None else None
+            r_end = s if last is None else max(s, last)
         length = r_end - s
         if length < half:
             if r is None:
