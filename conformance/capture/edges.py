@@ -9,6 +9,12 @@ Positions are integer *ticks* of the capture's own clock (``tick_rate`` per seco
 index for a sampled capture (.sr), the timescale unit for VCD, nanoseconds for a CSV export. An
 edge at tick ``k`` means tick ``k`` is the first one at the new level, so the true transition
 happened within one sample period before it (``period``).
+
+Transitions in raw sample blocks are found with numpy (:func:`transitions`). Measured on this
+project's loaded 2-core machine, per 4 Mi-sample block: on 1200 baud SDI-12 traffic numpy and
+a pure-Python ``bytes.translate`` + regex scan are about even (25-33 vs 15-28 ms), but on dense
+edges (115200 baud, or a noisy line full of glitches) numpy is 2.5-5x faster (125-240 vs 615
+ms), and noisy field captures are what this package is for.
 """
 
 from __future__ import annotations
