@@ -175,18 +175,38 @@ def decode(
             cur.i += 1
             last_end = r
             continue
-        # a frame: the edges inside it, then the level at each bit centre
-        frame_end = s + nbits * T
+        # a frame: the edges inside it (a slow sender's run a little past the nominal end)
+        frame_end = s + nbits * T * 1.1
         inner: list[int] = []
         k = 0
         while (e := cur.peek(k)) is not None and e < frame_end:
             inner.append(e)
             k += 1
+        # the sender's bit time, fitted edge by edge (least squares through the start edge):
+        # early edges barely drift, so the fit follows a sender several % off the nominal
+        # rate and the bits are then read where that sender put them
+        # (a fit is trusted only where it differs from the nominal bit by more than the edges'
+        # own quantisation allows: at 8 samples a bit, one sample is 12 % of a bit)
+        bt = used = T
+        skk = sdk = 0.0
+        kmax = 0
+        bounds = [s, *inner]
+        for n, e in enumerate(inner, 1):
+            if e - bounds[n - 1] < half or (n < len(inner) and inner[n] - e < half):
+                continue  # an edge of a glitch: no bit boundary
+            d = e - s
+            kk = round(d / used)
+            if 1 <= kk < nbits and abs(d - kk * used) < used / 2:
+                skk += kk * kk
+                sdk += kk * d
+                kmax = max(kmax, kk)
+                bt = sdk / skk
+                used = bt if abs(bt - T) * kmax > 2 * period_ticks else T
         bits = []
         j = 0
         lvl = 0
         for b in range(nbits):
-            centre = s + (b + 0.5) * T
+            centre = s + (b + 0.5) * used
             while j < len(inner) and inner[j] <= centre:
                 lvl ^= 1
                 j += 1
@@ -200,28 +220,15 @@ def decode(
         # bit it lands in into short pieces, so a run of consecutive short runs is one glitch
         glitches = 0
         short_before = False
-        bounds = [s, *inner]
         for a, b2 in zip(bounds, bounds[1:], strict=False):
             short = b2 - a < half
             if short and not short_before:
                 glitches += 1
             short_before = short
-        # the bit time from edges that sit on bit boundaries (least squares through the start)
-        skk = sdk = 0.0
-        kmax = 0
-        for e in inner:
-            d = e - s
-            kk = round(d / T)
-            if 1 <= kk < nbits and abs(d - kk * T) < T / 4:
-                skk += kk * kk
-                sdk += kk * d
-                kmax = max(kmax, kk)
-        bt = sdk / skk if skk else T
         err = (T / bt - 1) * 100 if skk else None
-        used = bt if kmax and abs(bt - T) * kmax > 2 * period_ticks else T
         end = s + nbits * used
         # consume the edges up to the stop bit's centre; a low stop bit runs on to its rise
-        while (e := cur.peek()) is not None and e <= s + stop_centre:
+        while (e := cur.peek()) is not None and e <= s + (nbits - 0.5) * used:
             cur.i += 1
         if framing_error and (e := cur.peek()) is not None:
             cur.i += 1
