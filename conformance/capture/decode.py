@@ -1,0 +1,268 @@
+"""The capture side's one entry point for judging: a file in, transcript events out.
+
+``decode_capture`` reads any supported capture, picks or is told the polarity, decodes frames
+at sample resolution and returns :class:`CaptureDecode`: the events (origin :data:`BUS`, since
+one wire does not say who spoke, unless a second channel carries the recorder's TX), the
+capture's own uncertainty for the judges, and the diagnostics a UART would have hidden.
+Everything a user can get wrong (file, channel, baud, framing) ends as :class:`CaptureError`.
+"""
+
+from __future__ import annotations
+
+import statistics
+from array import array
+from dataclasses import dataclass, field
+from itertools import chain
+
+from ..transcript import DUT, TOOL, Event, EventKind
+from .edges import Edges
+from .errors import CaptureError
+from .formats import read_edges, sniff
+from .uart import Decoded, Framing, decode
+
+PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
+MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong bit rate
+RECORDER = TOOL  # origin of what the recorder's TX channel shows
+SENSOR = DUT  # origin of the rest of the bus
+
+
+@dataclass
+class CaptureDecode:
+    """What a capture holds, decoded. ``problems``: every break, pulse, glitch and frame with
+    a framing or parity error or glitches, in time order (clean characters are counted, not
+    kept twice); ``baud_error_pct``: each character's measured bit-rate error, in event order
+    (NaN where its edges could not tell)."""
+
+    path: str
+    format: str
+    events: list[Event]
+    uncertainty_s: float
+    inverted: bool
+    polarity_detected: bool
+    sample_rate: float
+    channel: str
+    channels: list[str]
+    baud: float
+    framing: str
+    tx_channel: str | None = None
+    chars: int = 0
+    framing_errors: int = 0
+    parity_errors: int = 0
+    glitches: int = 0
+    breaks: int = 0
+    pulses: int = 0
+    baud_error_pct: array = field(default_factory=lambda: array("f"))
+    problems: list[Decoded] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def polarity(self) -> str:
+        """``"uart"`` (idles high: TTL side of a transceiver) or ``"line"`` (the SDI-12 wire
+        itself, idles low)."""
+        return "line" if self.inverted else "uart"
+
+    def baud_error_summary(self) -> tuple[float, float, float] | None:
+        """(min, median, max) of the per-frame bit-rate error in %, or None."""
+        vals = [v for v in self.baud_error_pct if v == v]
+        if not vals:
+            return None
+        return min(vals), statistics.median(vals), max(vals)
+
+
+def _score(decoded: list[Decoded]) -> int:
+    good = sum(d.kind == "char" and not (d.framing_error or d.parity_error) for d in decoded)
+    bad = sum(
+        (d.kind == "char" and (d.framing_error or d.parity_error)) or d.kind == "glitch"
+        for d in decoded
+    )
+    return good - bad
+
+
+def _choose_polarity(
+    edges: Edges, prefix: list[int], baud: float, framing: Framing
+) -> tuple[bool, str]:
+    """Decode the first edges both ways; the polarity that gives clean frames wins, the
+    starting level (idle) decides a tie."""
+    kw = dict(initial_level=edges.initial_level, tick_rate=edges.tick_rate, baud=baud)
+    scores = {
+        inv: _score(list(decode([prefix], invert=inv, framing=framing, **kw)))
+        for inv in (False, True)
+    }
+    if scores[False] != scores[True]:
+        inv = scores[True] > scores[False]
+        return inv, f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames"
+    inv = edges.initial_level == 0
+    return inv, f"polarity {'line (inverted)' if inv else 'UART'} assumed from the idle level"
+
+
+def _estimated_baud(prefix: list[int], tick_rate: float) -> float | None:
+    runs = sorted(b - a for a, b in zip(prefix, prefix[1:], strict=False) if b > a)
+    if len(runs) < 8:
+        return None
+    return tick_rate / runs[len(runs) // 20]  # a low percentile: one bit, not a glitch
+
+
+def _decode_channel(
+    path: str,
+    fmt: str,
+    channel: str | None,
+    invert: bool | None,
+    baud: float,
+    framing: Framing,
+    edge_error: float,
+) -> CaptureDecode:
+    edges = read_edges(path, channel, fmt)
+    chunks = iter(edges.chunks)
+    prefix: list[int] = []
+    taken: list[list[int]] = []
+    while len(prefix) < PROBE_EDGES and (chunk := next(chunks, None)) is not None:
+        taken.append(chunk)
+        prefix.extend(chunk)
+    if not prefix:
+        raise CaptureError(
+            path, f"channel {edges.channel!r} never changes level: no traffic to decode"
+        )
+    notes = list(edges.notes)
+    if invert is None:
+        inverted, why = _choose_polarity(edges, prefix, baud, framing)
+        notes.append(why)
+    else:
+        inverted = invert
+        notes.append(f"polarity {'line (inverted)' if invert else 'UART'} forced")
+    uncertainty = edges.period + edge_error
+    out = CaptureDecode(
+        path=path,
+        format=fmt,
+        events=[],
+        uncertainty_s=uncertainty,
+        inverted=inverted,
+        polarity_detected=invert is None,
+        sample_rate=1.0 / edges.period,
+        channel=edges.channel,
+        channels=edges.channels,
+        baud=baud,
+        framing=str(framing),
+        notes=notes,
+    )
+    decoded = decode(
+        chain(taken, chunks),
+        initial_level=edges.initial_level,
+        tick_rate=edges.tick_rate,
+        invert=inverted,
+        baud=baud,
+        framing=framing,
+        t0=edges.t0,
+        uncertainty=uncertainty,
+        period_ticks=edges.period * edges.tick_rate,
+        end_tick=edges.end,
+    )
+    for d in decoded:
+        if d.event is not None:
+            out.events.append(d.event)
+        if d.kind == "char":
+            out.chars += 1
+            out.framing_errors += d.framing_error
+            out.parity_errors += d.parity_error
+            out.glitches += d.glitches
+            out.baud_error_pct.append(
+                float("nan") if d.baud_error_pct is None else d.baud_error_pct
+            )
+            if d.framing_error or d.parity_error or d.glitches:
+                out.problems.append(d)
+            continue
+        out.problems.append(d)
+        out.breaks += d.kind == "break"
+        out.pulses += d.kind == "pulse"
+        out.glitches += d.kind == "glitch"
+    bad = out.framing_errors + out.parity_errors + out.glitches
+    est = _estimated_baud(prefix, edges.tick_rate)
+    off = est is not None and not 0.8 < est / baud < 1.25
+    if out.chars and bad >= MIN_BAD and bad * 5 >= out.chars and (off or 2 * bad > out.chars):
+        hint = f"; the shortest pulses suggest about {est:.0f} baud" if est else ""
+        raise CaptureError(
+            path,
+            f"{bad} framing/parity errors and glitches in {out.chars} frames on "
+            f"{edges.channel!r} at {baud:g} baud {framing}: wrong bit rate, framing or "
+            f"channel?{hint}",
+        )
+    if not out.events:
+        raise CaptureError(
+            path, f"channel {edges.channel!r} holds only glitches: no frame or break to decode"
+        )
+    return out
+
+
+def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[Event], int]:
+    """The bus events with origin :data:`RECORDER` where the recorder's TX channel shows the
+    same character or break starting within ``tolerance`` seconds, else :data:`SENSOR`; and
+    how many TX events were not seen on the bus."""
+    out: list[Event] = []
+    j = 0
+    matched = 0
+    for ev in bus:
+        while j < len(tx) and tx[j].start < ev.start - tolerance:
+            j += 1
+        hit = (
+            j < len(tx)
+            and abs(tx[j].start - ev.start) <= tolerance
+            and tx[j].kind is ev.kind
+            and (ev.kind is not EventKind.CHAR or tx[j].wire == ev.wire)
+        )
+        if hit:
+            matched += 1
+            j += 1
+        origin = RECORDER if hit else SENSOR
+        out.append(
+            Event(
+                ev.kind,
+                origin,
+                ev.start,
+                ev.end,
+                wire=ev.wire,
+                text=ev.text,
+                uncertainty=ev.uncertainty,
+                duration_uncertainty=ev.duration_uncertainty,
+            )
+        )
+    return out, len(tx) - matched
+
+
+def decode_capture(
+    path: str,
+    *,
+    channel: str | None = None,
+    tx_channel: str | None = None,
+    invert: bool | None = None,
+    baud: float = 1200,
+    framing: str = "7E1",
+    edge_error: float = 0.0,
+) -> CaptureDecode:
+    """Decode ``channel`` of the capture at ``path`` (format detected by content).
+
+    ``invert``: None detects the polarity, True/False forces line/UART levels. ``tx_channel``:
+    the recorder's TX on a second channel; its characters on the bus become origin
+    :data:`RECORDER`, all others :data:`SENSOR` (without it every event is origin
+    :data:`BUS`). ``edge_error``: any extra edge position error (s) of the analyzer's input
+    stage, added to the one-sample-period uncertainty."""
+    path = str(path)
+    try:
+        frame_format = Framing.parse(framing)
+    except ValueError as exc:
+        raise CaptureError(path, str(exc)) from None
+    if baud <= 0:
+        raise CaptureError(path, f"baud {baud} is not a bit rate")
+    fmt = sniff(path)
+    if fmt == "jsonl":
+        raise CaptureError(path, "a transcript, not a capture: read it with read_transcript_jsonl")
+    out = _decode_channel(path, fmt, channel, invert, baud, frame_format, edge_error)
+    if tx_channel is None:
+        return out
+    if tx_channel == out.channel:
+        raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
+    tx = _decode_channel(path, fmt, tx_channel, None, baud, frame_format, edge_error)
+    out.events, unseen = merge_tx(out.events, tx.events, 0.5 / baud + 2 * out.uncertainty_s)
+    out.tx_channel = tx.channel
+    out.notes.append(f"TX channel {tx.channel!r}: {tx.polarity} polarity")
+    if unseen:
+        out.notes.append(f"{unseen} events on the TX channel were not seen on the bus")
+    return out

@@ -1,0 +1,165 @@
+"""sigrok session files (``.sr``), read with the standard library's :mod:`zipfile` only.
+
+A session is a zip archive: ``version`` ("2" for every libsigrok since 0.4), ``metadata`` (an
+INI file: ``samplerate``, ``total probes``, ``probeN`` names, ``unitsize`` bytes per sample,
+``capturefile`` prefix) and the raw samples split into members ``logic-1-1``, ``logic-1-2``, ...
+(probe N is bit N-1 of each little-endian ``unitsize``-byte word). Version 1 sessions kept the
+samples in one member named after ``capturefile``; both are read. Members are decompressed block
+by block, so memory stays a few megabytes whatever the capture's length.
+"""
+
+from __future__ import annotations
+
+import configparser
+import re
+import zipfile
+import zlib
+from collections.abc import Iterator
+
+import numpy as np
+
+from .edges import Edges, transitions
+from .errors import CaptureError
+
+BLOCK_SAMPLES = 1 << 22  # 4 Mi samples per decompressed block: a few MB, whatever the unitsize
+_DTYPES = {1: np.uint8, 2: np.dtype("<u2"), 4: np.dtype("<u4"), 8: np.dtype("<u8")}
+_UNITS = {"": 1, "k": 1e3, "m": 1e6, "g": 1e9}
+
+
+def parse_samplerate(text: str) -> float:
+    """``"625 kHz"``, ``"1 MHz"``, ``"100 Hz"`` or a bare number of Hz."""
+    m = re.fullmatch(r"\s*([0-9.]+)\s*([kKmMgG]?)(?:[hH][zZ])?\s*", text)
+    if not m:
+        raise ValueError(text)
+    return float(m.group(1)) * _UNITS[m.group(2).lower()]
+
+
+class SrSession:
+    """The metadata of one session file, checked, with the zip kept open for reading."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        try:
+            self.zip = zipfile.ZipFile(path)
+        except (zipfile.BadZipFile, OSError, EOFError) as exc:
+            raise CaptureError(path, f"not a readable sigrok session (zip): {exc}") from None
+        names = set(self.zip.namelist())
+        if "metadata" not in names:
+            raise CaptureError(
+                path, "zip archive without a 'metadata' member: not a sigrok session"
+            )
+        ini = configparser.ConfigParser(interpolation=None, strict=False)
+        try:
+            ini.read_string(self.zip.read("metadata").decode("utf-8", "replace"))
+        except (configparser.Error, zipfile.BadZipFile, zlib.error, EOFError) as exc:
+            raise CaptureError(path, f"unreadable 'metadata': {exc}") from None
+        if not ini.has_section("device 1"):
+            raise CaptureError(path, "'metadata' has no [device 1] section")
+        dev = ini["device 1"]
+        try:
+            self.samplerate = parse_samplerate(dev.get("samplerate", ""))
+        except ValueError:
+            raise CaptureError(path, f"bad samplerate {dev.get('samplerate')!r}") from None
+        if self.samplerate <= 0:
+            raise CaptureError(path, "samplerate is zero")
+        self.unitsize = dev.getint("unitsize", fallback=1)
+        if self.unitsize not in _DTYPES:
+            raise CaptureError(path, f"unsupported unitsize {self.unitsize}")
+        prefix = dev.get("capturefile", "logic-1")
+        self.probes: dict[str, int] = {}  # name -> bit
+        for key, value in dev.items():
+            m = re.fullmatch(r"probe(\d+)", key)
+            if m:
+                self.probes[value] = int(m.group(1)) - 1
+        if not self.probes:
+            raise CaptureError(path, "no logic channels (probeN) in 'metadata'")
+        chunked = [n for n in names if re.fullmatch(re.escape(prefix) + r"-\d+", n)]
+        chunked.sort(key=lambda n: int(n.rsplit("-", 1)[1]))
+        self.members = chunked or ([prefix] if prefix in names else [])
+        if not self.members:
+            raise CaptureError(path, f"no sample data ('{prefix}-1', ...) in the archive")
+
+    def blocks(self) -> Iterator[np.ndarray]:
+        """The samples as arrays of ``unitsize`` words, a block at a time, across members."""
+        dtype = _DTYPES[self.unitsize]
+        size = BLOCK_SAMPLES * self.unitsize
+        rest = b""
+        for member in self.members:
+            try:
+                with self.zip.open(member) as fh:
+                    while True:
+                        data = fh.read(size)
+                        if not data:
+                            break
+                        if rest:
+                            data, rest = rest + data, b""
+                        cut = len(data) - len(data) % self.unitsize
+                        data, rest = data[:cut], data[cut:]
+                        yield np.frombuffer(data, dtype=dtype)
+            except (zipfile.BadZipFile, zlib.error, EOFError, OSError) as exc:
+                raise CaptureError(self.path, f"corrupt sample data in '{member}': {exc}") from None
+
+    def busiest_probe(self) -> str:
+        """The probe that changes most in the first block (the one carrying traffic)."""
+        first = next(self.blocks(), None)
+        if first is None:
+            return next(iter(self.probes))
+        counts = {
+            name: int(np.count_nonzero(np.diff((first >> bit) & 1)))
+            for name, bit in self.probes.items()
+        }
+        return max(counts, key=lambda n: counts[n])
+
+
+def read_sr(path: str, channel: str | None = None) -> Edges:
+    """Edges of one probe of a session (``channel`` by name; default the busiest one)."""
+    session = SrSession(path)
+    notes: list[str] = []
+    if channel is None:
+        channel = session.busiest_probe() if len(session.probes) > 1 else next(iter(session.probes))
+        if len(session.probes) > 1:
+            notes.append(f"channel {channel!r} chosen: it changes level most at the start")
+    if channel not in session.probes:
+        raise CaptureError(
+            path, f"no channel {channel!r}; channels present: {', '.join(session.probes)}"
+        )
+    bit = session.probes[channel]
+    total = [0]
+    first_level: list[int] = []
+
+    def chunks() -> Iterator[list[int]]:
+        previous: int | None = None
+        offset = 0
+        for block in session.blocks():
+            levels = block & 1 if bit == 0 else (block >> bit) & 1
+            if previous is None and levels.size:
+                first_level.append(int(levels[0]))
+            idx, previous = transitions(levels, previous)
+            if idx:
+                yield [offset + i for i in idx] if offset else idx
+            offset += levels.size
+        total[0] = offset
+        session.zip.close()
+
+    gen = chunks()
+    # the starting level is needed before any edge: read the first block now
+    first = next(gen, [])
+    if not first_level:
+        raise CaptureError(path, "the session holds no samples")
+
+    def all_chunks() -> Iterator[list[int]]:
+        if first:
+            yield first
+        yield from gen
+
+    return Edges(
+        path=path,
+        channel=channel,
+        channels=list(session.probes),
+        tick_rate=session.samplerate,
+        period=1.0 / session.samplerate,
+        initial_level=first_level[0],
+        chunks=all_chunks(),
+        end=lambda: total[0] or None,
+        notes=notes,
+    )

@@ -1,0 +1,249 @@
+"""Asynchronous serial frames from edges, at the capture's own resolution.
+
+The decoder works as a UART does, but with the whole edge history at hand: every start bit's
+leading edge re-synchronises it, bits are read at their centres from there, and the edges that
+fall inside a frame also say how long its bits really were (the sender's bit rate), which a
+UART cannot report. Spacing longer than a frame is not a character: SDI-12 gives it a meaning
+by length (section 7, R-7.0-02..04): at least 12 ms is a break, 6.5-12 ms a pulse a sensor may
+or may not take for one, so both are reported with their exact length and kept apart.
+
+Levels are handled on the UART side (marking = 1). The SDI-12 line itself idles at 0 V
+(marking = low), so a probe on the bus sees inverted levels: ``invert`` selects which.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+
+from ..protocol.timing import BREAK_MIN, BREAK_NEVER
+from ..transcript import Event, EventKind
+
+BUS = "bus"  # origin of decoded events whose direction is not known yet (one wire)
+SPACING_PULSE = "spacing pulse"  # text of a BREAK event 6.5-12 ms long (R-7.0-03/04)
+
+
+@dataclass(frozen=True)
+class Framing:
+    """Data bits, parity (``"E"``, ``"O"``, ``"N"``), one stop bit; 8 bits between start and
+    stop (the transcript's ``wire``)."""
+
+    data_bits: int
+    parity: str
+
+    @classmethod
+    def parse(cls, text: str) -> Framing:
+        t = text.upper()
+        if len(t) != 3 or not t[0].isdigit() or t[1] not in "EON" or t[2] != "1":
+            raise ValueError(f"framing {text!r}: expected e.g. 7E1, 7O1, 8N1")
+        framing = cls(int(t[0]), t[1])
+        if framing.data_bits + (framing.parity != "N") != 8:
+            raise ValueError(f"framing {text!r}: the wire model holds 8 bits (7E1, 7O1, 8N1)")
+        return framing
+
+    @property
+    def bits(self) -> int:
+        """Bits per frame: start, data, parity, stop."""
+        return 10
+
+    def parity_ok(self, wire: int) -> bool:
+        if self.parity == "N":
+            return True
+        ones = bin(wire & 0xFF).count("1") & 1
+        return ones == (0 if self.parity == "E" else 1)
+
+    def __str__(self) -> str:
+        return f"{self.data_bits}{self.parity}1"
+
+
+@dataclass(slots=True)
+class Decoded:
+    """One thing the decoder found. ``kind``: ``char``, ``break``, ``pulse`` (spacing 6.5-12
+    ms), or ``glitch`` (a pulse shorter than half a bit outside any frame; ``event`` None).
+
+    ``marking_before``: marking (s) since the previous frame's stop bit or break ended (None
+    for the first); ``baud_error_pct``: the frame's own bit rate against the nominal one, from
+    its edges (None when not a char); ``glitches``: pulses shorter than half a bit in it."""
+
+    kind: str
+    event: Event | None
+    start: float
+    end: float
+    framing_error: bool = False
+    parity_error: bool = False
+    baud_error_pct: float | None = None
+    glitches: int = 0
+    marking_before: float | None = None
+
+
+class _Cursor:
+    """Edges from chunks with look-ahead, without ever holding more than a chunk or two."""
+
+    __slots__ = ("buf", "i", "chunks")
+
+    def __init__(self, chunks: Iterable[list[int]]) -> None:
+        self.chunks = iter(chunks)
+        self.buf: list[int] = []
+        self.i = 0
+
+    def has(self, n: int) -> bool:
+        """At least ``n`` edges left from the cursor (reads chunks as needed)."""
+        while len(self.buf) - self.i < n:
+            nxt = next(self.chunks, None)
+            if nxt is None:
+                return False
+            self.buf = self.buf[self.i :] + list(nxt)
+            self.i = 0
+        return True
+
+    def peek(self, k: int = 0) -> int | None:
+        return self.buf[self.i + k] if self.has(k + 1) else None
+
+
+def decode(
+    chunks: Iterable[list[int]],
+    *,
+    initial_level: int,
+    tick_rate: float,
+    invert: bool = False,
+    baud: float = 1200,
+    framing: Framing | None = None,
+    t0: float = 0.0,
+    uncertainty: float = 0.0,
+    period_ticks: float = 1.0,
+    end_tick: Callable[[], int | None] | None = None,
+    break_min: float = BREAK_MIN,
+    pulse_min: float = BREAK_NEVER,
+) -> Iterator[Decoded]:
+    """Frames, breaks, pulses and glitches in time order, from edge ticks.
+
+    ``period_ticks``: how many ticks one sample period spans (the edge position error), used
+    to tell a measured bit rate from rounding. ``end_tick``: asked, once the edges are
+    exhausted, where the capture ends, to measure a spacing still running there (a break the
+    capture cut); without it such a spacing is dropped."""
+    framing = framing or Framing.parse("7E1")
+    nbits = framing.bits
+    T = tick_rate / baud
+    half = T / 2
+    stop_centre = (nbits - 0.5) * T
+    cur = _Cursor(chunks)
+    level = (initial_level & 1) ^ int(invert)
+    last_end: float | None = None  # tick where the previous frame or break ended
+
+    def t(tick: float) -> float:
+        return t0 + tick / tick_rate
+
+    if level == 0:  # the capture starts inside spacing: its start is unknown, skip it
+        first = cur.peek()
+        if first is None:
+            return
+        cur.i += 1
+        level = 1
+        last_end = first
+    while True:
+        s = cur.peek()
+        if s is None:
+            return
+        r = cur.peek(1)
+        cur.i += 1  # the falling edge is consumed; r (if any) is still ahead
+        if r is not None:
+            r_end = r
+        else:
+            last = end_tick() if end_tick is not None else None
+            r_end = s if last is None else max(s, last)
+        length = r_end - s
+        if length < half:
+            if r is None:
+                return  # the capture ends right after a falling edge: nothing to decode
+            cur.i += 1
+            yield Decoded("glitch", None, t(s), t(r))
+            continue
+        if length > stop_centre and length / tick_rate >= pulse_min:
+            kind = "break" if length / tick_rate >= break_min else "pulse"
+            ev = Event(
+                EventKind.BREAK,
+                BUS,
+                t(s),
+                t(r_end),
+                text="" if kind == "break" else SPACING_PULSE,
+                uncertainty=uncertainty,
+            )
+            marking = None if last_end is None else (s - last_end) / tick_rate
+            yield Decoded(kind, ev, ev.start, ev.end, marking_before=marking)
+            if r is None:
+                return
+            cur.i += 1
+            last_end = r
+            continue
+        # a frame: the edges inside it (a slow sender's run a little past the nominal end)
+        frame_end = s + nbits * T * 1.1
+        inner: list[int] = []
+        k = 0
+        while (e := cur.peek(k)) is not None and e < frame_end:
+            inner.append(e)
+            k += 1
+        # the sender's bit time, fitted edge by edge (least squares through the start edge):
+        # early edges barely drift, so the fit follows a sender several % off the nominal
+        # rate and the bits are then read where that sender put them
+        # (a fit is trusted only where it differs from the nominal bit by more than the edges'
+        # own quantisation allows: at 8 samples a bit, one sample is 12 % of a bit)
+        bt = used = T
+        skk = sdk = 0.0
+        kmax = 0
+        bounds = [s, *inner]
+        for n, e in enumerate(inner, 1):
+            if e - bounds[n - 1] < half or (n < len(inner) and inner[n] - e < half):
+                continue  # an edge of a glitch: no bit boundary
+            d = e - s
+            kk = round(d / used)
+            if 1 <= kk < nbits and abs(d - kk * used) < used / 2:
+                skk += kk * kk
+                sdk += kk * d
+                kmax = max(kmax, kk)
+                bt = sdk / skk
+                used = bt if abs(bt - T) * kmax > 2 * period_ticks else T
+        bits = []
+        j = 0
+        lvl = 0
+        for b in range(nbits):
+            centre = s + (b + 0.5) * used
+            while j < len(inner) and inner[j] <= centre:
+                lvl ^= 1
+                j += 1
+            bits.append(lvl)
+        wire = 0
+        for b in range(8):
+            wire |= bits[1 + b] << b
+        framing_error = bits[-1] == 0
+        parity_error = not framing.parity_ok(wire)
+        # glitches: pulses inside the frame shorter than half a bit. A pulse also cuts the
+        # bit it lands in into short pieces, so a run of consecutive short runs is one glitch
+        glitches = 0
+        short_before = False
+        for a, b2 in zip(bounds, bounds[1:], strict=False):
+            short = b2 - a < half
+            if short and not short_before:
+                glitches += 1
+            short_before = short
+        err = (T / bt - 1) * 100 if skk else None
+        end = s + nbits * used
+        # consume the edges up to the stop bit's centre; a low stop bit runs on to its rise
+        while (e := cur.peek()) is not None and e <= s + (nbits - 0.5) * used:
+            cur.i += 1
+        if framing_error and (e := cur.peek()) is not None:
+            cur.i += 1
+            end = max(end, e)
+        ev = Event(EventKind.CHAR, BUS, t(s), t(end), wire=wire, uncertainty=uncertainty)
+        marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
+        last_end = end
+        yield Decoded(
+            "char",
+            ev,
+            ev.start,
+            ev.end,
+            framing_error=framing_error,
+            parity_error=parity_error,
+            baud_error_pct=err,
+            glitches=glitches,
+            marking_before=marking,
+        )
