@@ -230,6 +230,29 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     return exit_code(data, int(code))
 
 
+def cmd_judge(argv: list[str], console: Console) -> int:
+    """``judge FILE``: replay a virtual-time run through the cases, or judge passively."""
+    from .offline.judge import JudgeError, plan
+
+    try:
+        found = plan(argv)
+    except JudgeError as exc:
+        error(f"error: {exc}")
+        return EXIT_USAGE
+    for note in found.notes:
+        console.print(f"note: {note}", markup=False, highlight=False)
+    if found.replay_argv is not None:
+        console.print(
+            f"judging {found.path} by replay: the run's cases ask again, the recording answers",
+            markup=False,
+            highlight=False,
+        )
+        return run_suite(build_parser().parse_args(found.replay_argv), console)
+    from .offline.passive import judge_passively
+
+    return judge_passively(found.passive_argv or [], console)
+
+
 def exit_code(data: dict, pytest_code: int) -> int:
     verdict = data["summary"]["verdict"]
     if pytest_code in (EXIT_NO_DEVICE, EXIT_USAGE) and not data["run"]["complete"]:
@@ -347,7 +370,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT if exact == len(rows) else EXIT_NON_COMPLIANT
 
 
-SUBCOMMANDS = ("list", "faults", "matrix", "emulate")
+SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -397,6 +420,12 @@ def _dispatch(argv: list[str]) -> int:
             from .emulator_server.command import emulate_main
 
             return emulate_main(argv[1:])
+        if argv and argv[0] == "export":
+            from .offline.export import export_main
+
+            return export_main(argv[1:])
+        if argv and argv[0] == "judge":
+            return cmd_judge(argv[1:], console)
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 

@@ -35,6 +35,7 @@ class RunOptions:
     echo: str = "auto"  # real links: does the interface echo the tool's characters
     direction: str = "none"  # real links: the modem line that enables the tool's driver
     requirements: tuple[str, ...] = ()  # --req: requirement IDs or clauses to judge
+    keyword: str | None = None  # -k: the cases selected by name
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
@@ -52,6 +53,7 @@ class RunOptions:
             echo=get("sdi12_echo"),
             direction=get("sdi12_direction"),
             requirements=tuple(get("sdi12_req") or ()),
+            keyword=get("keyword") or None,
         )
 
 

@@ -18,9 +18,9 @@ from conformance.capture import (
     export_events,
     read_transcript_jsonl,
 )
-from conformance.master import Master
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import BIT_TIME, CHAR_TIME
+from conformance.tool_recorder import Master
 from conformance.transcript import DUT, TOOL, Event, EventKind, Transcript, to_wire_7e1
 
 FORMATS = ["sr", "vcd", "csv"]

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..capture.errors import CaptureError
+from ..capture.transcript_io import read_transcript_jsonl
 from ..transcript import TOOL, Event, EventKind
 
 #: Prefix of the NOTE that carries the run's options (first line of a transcript).
@@ -59,22 +61,6 @@ def options_note(options: dict[str, Any], time: float = 0.0) -> Event:
     return Event(EventKind.NOTE, TOOL, time, time, text=OPTIONS_NOTE + json.dumps(options))
 
 
-def event_from_json(row: dict[str, Any]) -> Event:
-    """One ``transcript.jsonl`` line back into an :class:`Event` (KeyError/ValueError if bad)."""
-    return Event(
-        EventKind(row["kind"]),
-        str(row["origin"]),
-        float(row["start"]),
-        float(row["end"]),
-        wire=int(row.get("wire", 0)),
-        text=str(row.get("text", "")),
-        uncertainty=float(row.get("uncertainty", 0.0)),
-        duration_uncertainty=(
-            None if row.get("duration_uncertainty") is None else float(row["duration_uncertainty"])
-        ),
-    )
-
-
 def transcript_path(path: Path) -> Path:
     """``path`` itself, or the ``transcript.jsonl`` inside a run folder."""
     return path / "transcript.jsonl" if path.is_dir() else path
@@ -85,25 +71,15 @@ def read_recording(path: str | Path) -> Recording:
     file = transcript_path(Path(path))
     if not file.exists():
         raise RecordingError(f"{file}: no such file")
-    events: list[Event] = []
-    options: dict[str, Any] = {}
     try:
-        with file.open(encoding="utf-8") as fh:
-            for number, line in enumerate(fh, 1):
-                if not line.strip():
-                    continue
-                try:
-                    event = event_from_json(json.loads(line))
-                except (ValueError, KeyError, TypeError) as exc:
-                    raise RecordingError(
-                        f"{file}, line {number}: not a transcript event ({exc.__class__.__name__}:"
-                        f" {exc})"
-                    ) from None
-                if event.kind is EventKind.NOTE and event.text.startswith(OPTIONS_NOTE):
-                    options = _options_from(file, number, event.text[len(OPTIONS_NOTE) :])
-                events.append(event)
-    except UnicodeDecodeError:
-        raise RecordingError(f"{file}: not a text file (a transcript is JSON lines)") from None
+        events = read_transcript_jsonl(str(file))
+    except CaptureError as exc:
+        raise RecordingError(str(exc)) from None
+    options: dict[str, Any] = {}
+    for number, event in enumerate(events, 1):
+        if event.kind is EventKind.NOTE and event.text.startswith(OPTIONS_NOTE):
+            options = _options_from(file, number, event.text[len(OPTIONS_NOTE) :])
+            break
     if not any(e.kind is not EventKind.NOTE for e in events):
         raise RecordingError(f"{file}: no bus events in it: nothing to judge")
     return Recording(file, events, options, _verdicts_beside(file))

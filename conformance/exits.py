@@ -1,0 +1,22 @@
+"""The exit statuses of every ``sdi12-conform`` subcommand (a contract: CI scripts gate on
+them), and the one way a subcommand tells the user about an error."""
+
+from __future__ import annotations
+
+import sys
+
+EXIT_OK = EXIT_COMPLIANT = 0
+EXIT_NON_COMPLIANT = 1  # matrix: a fault not caught exactly
+EXIT_INCOMPLETE = 2  # interrupted, or verdicts left open
+EXIT_INTERNAL = 3  # a bug in the tool, or the link failed mid-run
+EXIT_USAGE = 4  # an ordinary mistake: bad option, file, port
+EXIT_NO_DEVICE = 5  # nothing answered
+
+
+def say_error(text: str) -> None:
+    """One line for the user on stderr (never on stdout, where results and pipes go)."""
+    from rich.console import Console
+
+    Console(stderr=True, soft_wrap=not sys.stderr.isatty()).print(
+        text, style="red", markup=False, highlight=False
+    )

@@ -1,0 +1,181 @@
+"""``sdi12-conform judge FILE``: verdicts for a recording.
+
+Two ways, chosen by what the file is:
+
+- a ``transcript.jsonl`` (or run folder) of a virtual-time run (sim, harness) is judged by
+  **replay**: the same cases run again and the recording answers them, so the verdicts are the
+  run's own (``--port replay:FILE``);
+- anything else (a logic-analyzer capture, a monitor's transcript, a run over a real link) is
+  judged **passively**: what is on the wire is segmented, its direction inferred where the
+  recording does not say, and every rule that traffic can show is judged.
+
+This module only decides and prepares; the CLI runs the suite (it owns the console and the
+report writing), so the layers keep running one way.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..capture import CaptureError, sniff
+from ..replay.link import VIRTUAL_KINDS
+from ..replay.recording import Recording, RecordingError, read_recording, transcript_path
+
+ROLES = ("sensor", "recorder", "both")
+
+
+class JudgeError(ValueError):
+    """A recording or option ``judge`` cannot use (exit 4, one line, no traceback)."""
+
+
+@dataclass
+class JudgePlan:
+    """What ``judge`` will do: replay a run (``replay_argv`` for the main command) or judge
+    a recording passively (``passive_argv`` for the suite's passive cases)."""
+
+    path: Path
+    kind: str  # "jsonl", "sr", "vcd", "csv"
+    replay_argv: list[str] | None = None
+    passive_argv: list[str] | None = None
+    notes: list[str] = field(default_factory=list)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="sdi12-conform judge",
+        description=(
+            "Judge a recording: a run's transcript.jsonl (or its folder), a sigrok .sr session, "
+            "a Saleae Logic 2 CSV export or a VCD. A virtual-time run is replayed through the "
+            "same cases (the same verdicts); anything else is judged passively."
+        ),
+    )
+    parser.add_argument("file", help="the recording")
+    parser.add_argument(
+        "--role",
+        choices=ROLES,
+        help="whose rules: sensor rules on what the sensors sent, recorder rules on what the "
+        "recorder sent (default: a replayed run's own role; otherwise both)",
+    )
+    parser.add_argument("--address", help="judge only this sensor address")
+    parser.add_argument("--channel", help="capture channel carrying the SDI-12 line")
+    parser.add_argument(
+        "--tx-channel", help="capture channel carrying only the recorder's TX (optional)"
+    )
+    polarity = parser.add_mutually_exclusive_group()
+    polarity.add_argument(
+        "--invert",
+        dest="invert",
+        action="store_true",
+        default=None,
+        help="the capture has the SDI-12 line's levels (marking low); default: detected",
+    )
+    polarity.add_argument(
+        "--no-invert",
+        dest="invert",
+        action="store_false",
+        help="the capture has UART levels (marking high); default: detected",
+    )
+    parser.add_argument("--baud", type=int, default=1200, help="bit rate (default 1200)")
+    parser.add_argument("--report-dir", help="output folder (default: reports/<date>-judge)")
+    parser.add_argument("--strict", action="store_true", help="WARN (SHOULD violations) fails")
+    parser.add_argument(
+        "--sdi-version", help="the rule set, 1.3 or 1.4 (default: from the recording)"
+    )
+    parser.add_argument(
+        "--passive",
+        action="store_true",
+        help="judge a replayable run passively too (what the wire shows, no replay)",
+    )
+    return parser
+
+
+def plan(argv: list[str]) -> JudgePlan:
+    """Parse ``judge``'s arguments and decide how to judge the file (JudgeError if not)."""
+    args = build_parser().parse_args(argv)
+    path = Path(args.file)
+    if path.is_dir():
+        path = transcript_path(path)
+    try:
+        kind = sniff(str(path))
+    except CaptureError as exc:
+        raise JudgeError(str(exc)) from None
+    found = JudgePlan(path, kind)
+    if kind == "jsonl":
+        try:
+            recording = read_recording(path)
+        except RecordingError as exc:
+            raise JudgeError(str(exc)) from None
+        why_not = replay_refused(recording, args)
+        if why_not is None:
+            found.replay_argv = replay_argv(recording, args)
+            return found
+        found.notes.append(f"judged passively: {why_not}")
+    found.passive_argv = passive_argv(path, kind, args)
+    return found
+
+
+def replay_refused(recording: Recording, args: argparse.Namespace) -> str | None:
+    """Why this recording is not replayed (None: it is)."""
+    if args.passive:
+        return "--passive asked for it"
+    link = recording.options.get("link") or {}
+    kind = str(link.get("kind", "")).removeprefix("replay of ")
+    if not recording.options:
+        return "the transcript does not say how its run was made (no run-options note)"
+    if not link.get("virtual_time") or kind not in VIRTUAL_KINDS:
+        return (
+            f"its run was over a {kind or 'real'} link in real time "
+            "(only sim and harness runs replay)"
+        )
+    if args.role and args.role != recording.role:
+        return f"--role {args.role} asked for, the run judged the {recording.role}"
+    if args.address and args.address != recording.options.get("address"):
+        return "--address differs from the run's"
+    return None
+
+
+def replay_argv(recording: Recording, args: argparse.Namespace) -> list[str]:
+    """The main command's arguments that repeat the recorded run against its recording."""
+    saved = recording.options
+    argv = ["--port", f"replay:{recording.path}", "--role", str(saved.get("role", "sensor"))]
+    for flag, key in (
+        ("--address", "address"),
+        ("--sdi-version", "version"),
+        ("--declaration", "declaration"),
+        ("--timing-uncertainty-ms", "timing_uncertainty_ms"),
+        ("-k", "keyword"),
+    ):
+        if saved.get(key) is not None:
+            argv += [flag, str(saved[key])]
+    for wanted in saved.get("requirements") or ():
+        argv += ["--req", str(wanted)]
+    if args.sdi_version:
+        argv += ["--sdi-version", args.sdi_version]
+    if saved.get("strict") or args.strict:
+        argv.append("--strict")
+    if args.report_dir:
+        argv += ["--report-dir", args.report_dir]
+    return argv
+
+
+def passive_argv(path: Path, kind: str, args: argparse.Namespace) -> list[str]:
+    """The passive judging's options (see :mod:`conformance.offline.passive`)."""
+    argv = ["--recording", str(path), "--format", kind, "--role", args.role or "both"]
+    for flag, value in (
+        ("--address", args.address),
+        ("--channel", args.channel),
+        ("--tx-channel", args.tx_channel),
+        ("--sdi-version", args.sdi_version),
+        ("--report-dir", args.report_dir),
+    ):
+        if value is not None:
+            argv += [flag, value]
+    if args.invert is not None:
+        argv.append("--invert" if args.invert else "--no-invert")
+    if args.baud != 1200:
+        argv += ["--baud", str(args.baud)]
+    if args.strict:
+        argv.append("--strict")
+    return argv
