@@ -47,13 +47,16 @@ def export_events(
     sample_rate: float = DEFAULT_SAMPLE_RATE,
     line_polarity: bool = False,
     tool_channel: bool = False,
+    comment: str | None = None,
 ) -> ExportInfo:
     """Write ``events`` as a capture at ``path``.
 
     ``fmt``: ``"sr"``, ``"vcd"`` or ``"csv"`` (default from the extension).
     ``line_polarity``: levels of the SDI-12 wire itself (marking low) instead of the UART side
     (marking high). ``tool_channel``: add a second channel holding only the tool's own
-    transmissions (origin ``tool``), like a capture of the recorder's TX beside the bus."""
+    transmissions (origin ``tool``), like a capture of the recorder's TX beside the bus.
+    ``comment``: one line kept in the file where the format has room for it (a .sr member,
+    a VCD ``$comment``; a CSV has none), read back with :func:`embedded_comment`."""
     path = str(path)
     fmt = (fmt or os.path.splitext(path)[1].lstrip(".")).lower()
     if fmt not in EXPORT_FORMATS:
@@ -75,11 +78,11 @@ def export_events(
         tool = [e for e in wire if e.origin == TOOL]
         channels.append(Channel(TOOL_CHANNEL, idle, edges_of(tool, sample_rate, t0)))
     if fmt == "sr":
-        write_sr(path, channels, sample_rate, total)
+        write_sr(path, channels, sample_rate, total, comment=comment)
     else:
         with open(path, "w", encoding="ascii", newline="\n") as fh:
             if fmt == "vcd":
-                write_vcd(fh, channels, sample_rate, total)
+                write_vcd(fh, channels, sample_rate, total, comment=comment)
             else:
                 write_csv(fh, channels, sample_rate, t0)
     return ExportInfo(

@@ -56,7 +56,18 @@ def _levels(channel: Channel, total: int) -> Iterator[np.ndarray]:
         yield buf[:n]
 
 
-def write_sr(path: str, channels: list[Channel], rate: float, total: int, level: int = 1) -> None:
+#: The .sr member holding an exporter's comment (sigrok ignores members it does not know).
+SR_COMMENT_MEMBER = "sdi12-conform-comment"
+
+
+def write_sr(
+    path: str,
+    channels: list[Channel],
+    rate: float,
+    total: int,
+    level: int = 1,
+    comment: str | None = None,
+) -> None:
     """A sigrok session, version 2 (libsigrok >= 0.4): ``version``, ``metadata`` and the
     samples in ``logic-1-1``, ``logic-1-2``... one byte per sample, channel N on bit N-1.
     ``level``: deflate level (1 is several times faster than the default and the samples are
@@ -71,6 +82,8 @@ def write_sr(path: str, channels: list[Channel], rate: float, total: int, level:
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=level) as zf:
         zf.writestr("version", "2")
         zf.writestr("metadata", metadata)
+        if comment:
+            zf.writestr(SR_COMMENT_MEMBER, comment)
         for n, blocks in enumerate(zip(*streams, strict=True), 1):
             word = blocks[0].copy()
             for bit, b in enumerate(blocks[1:], 1):
@@ -97,11 +110,17 @@ def _timescale(rate: float) -> str:
     raise ValueError(f"VCD needs a sample period of 1, 10 or 100 units; {rate} Hz has none")
 
 
-def write_vcd(fh: TextIO, channels: list[Channel], rate: float, total: int) -> None:
+def write_vcd(
+    fh: TextIO, channels: list[Channel], rate: float, total: int, comment: str | None = None
+) -> None:
     """A VCD with one 1-bit wire per channel, timescale = one sample period."""
     codes = [chr(33 + i) for i in range(len(channels))]
     fh.write(f"$date {datetime.now(UTC):%Y-%m-%d %H:%M:%S} UTC $end\n")
     fh.write("$version sdi12-conform capture export $end\n")
+    if comment:
+        if "$end" in comment or "\n" in comment:
+            raise ValueError("a VCD comment is one line without '$end'")
+        fh.write(f"$comment {comment} $end\n")
     fh.write(f"$timescale {_timescale(rate)} $end\n$scope module sdi12 $end\n")
     for c, code in zip(channels, codes, strict=True):
         fh.write(f"$var wire 1 {code} {c.name} $end\n")

@@ -66,6 +66,7 @@ def export_main(argv: list[str]) -> int:
             sample_rate=args.sample_rate,
             line_polarity=args.line_polarity,
             tool_channel=args.tool_channel,
+            comment=recording.options_text,
         )
     except (ValueError, CaptureError, OSError) as exc:
         say_error(f"error: {output}: {exc}")

@@ -16,12 +16,20 @@ report writing), so the layers keep running one way.
 from __future__ import annotations
 
 import argparse
+import datetime as dt
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..capture import CaptureError, sniff
+from ..capture import BUS, CaptureDecode, CaptureError, decode_capture, embedded_comment, sniff
 from ..replay.link import VIRTUAL_KINDS
-from ..replay.recording import Recording, RecordingError, read_recording, transcript_path
+from ..replay.recording import (
+    Recording,
+    RecordingError,
+    options_from_comment,
+    read_recording,
+    transcript_path,
+    write_recording,
+)
 
 ROLES = ("sensor", "recorder", "both")
 
@@ -84,6 +92,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--sdi-version", help="the rule set, 1.3 or 1.4 (default: from the recording)"
     )
     parser.add_argument(
+        "--run",
+        help="a capture of a run of this tool: that run's folder (or transcript.jsonl), whose "
+        "cases are repeated against the capture (default: the options an export left in it)",
+    )
+    parser.add_argument(
         "--passive",
         action="store_true",
         help="judge a replayable run passively too (what the wire shows, no replay)",
@@ -112,8 +125,88 @@ def plan(argv: list[str]) -> JudgePlan:
             found.replay_argv = replay_argv(recording, args)
             return found
         found.notes.append(f"judged passively: {why_not}")
+    else:
+        capture_replay(found, args)
+        if found.replay_argv is not None:
+            return found
     found.passive_argv = passive_argv(path, kind, args)
     return found
+
+
+def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
+    """Set ``found.replay_argv`` when the capture is of a run of this tool whose cases can be
+    repeated against it: its options come from ``--run`` or from the export's comment, and
+    every character's direction is known (else a note says why it is judged passively)."""
+    path = str(found.path)
+    if args.run:
+        try:
+            options = read_recording(args.run).options
+        except RecordingError as exc:
+            raise JudgeError(f"--run: {exc}") from None
+    else:
+        options = options_from_comment(embedded_comment(path))
+    if not options:
+        found.notes.append("judged passively: the capture does not say which run it is of")
+        return
+    decoded = decode(found.path, args)
+    found.notes.extend(describe_decode(decoded))
+    events = decoded.events
+    unknown = sum(1 for e in events if e.origin == BUS)
+    if unknown:
+        found.notes.append(
+            f"judged passively: the direction of {unknown} character(s) is not known "
+            "(a --tx-channel tells it)"
+        )
+        return
+    report_dir = Path(args.report_dir or default_report_dir(str(options.get("role", "sensor"))))
+    report_dir.mkdir(parents=True, exist_ok=True)
+    decoded_path = report_dir / "capture.jsonl"
+    write_recording(decoded_path, events, options)
+    recording = read_recording(decoded_path)
+    why_not = replay_refused(recording, args)
+    if why_not is not None:
+        found.notes.append(f"judged passively: {why_not}")
+        return
+    args.report_dir = str(report_dir)
+    found.replay_argv = replay_argv(recording, args)
+    found.notes.append(f"decoded capture written to {decoded_path}")
+
+
+def decode(path: Path, args: argparse.Namespace) -> CaptureDecode:
+    try:
+        return decode_capture(
+            str(path),
+            channel=args.channel,
+            tx_channel=args.tx_channel,
+            invert=args.invert,
+            baud=args.baud,
+        )
+    except CaptureError as exc:
+        raise JudgeError(str(exc)) from None
+
+
+def describe_decode(decoded: CaptureDecode) -> list[str]:
+    """What the reader must know about the decoding before trusting verdicts from it."""
+    how = "detected" if decoded.polarity_detected else "forced"
+    said = [
+        f"capture {decoded.format}, channel {decoded.channel!r} at {decoded.sample_rate:g} "
+        f"samples/s: {decoded.chars} characters, {decoded.breaks} breaks, "
+        f"{decoded.pulses} spacing pulses; {decoded.polarity} polarity ({how}); stamps "
+        f"\u00b1{decoded.uncertainty_s * 1e3:.3f} ms",
+    ]
+    problems = decoded.framing_errors + decoded.parity_errors + decoded.glitches
+    if problems:
+        said.append(
+            f"{decoded.framing_errors} framing error(s), {decoded.parity_errors} parity "
+            f"error(s), {decoded.glitches} glitch(es) in the capture"
+        )
+    said.extend(decoded.notes)
+    return said
+
+
+def default_report_dir(role: str) -> Path:
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    return Path("reports") / f"{stamp}-{role}"
 
 
 def replay_refused(recording: Recording, args: argparse.Namespace) -> str | None:

@@ -51,12 +51,14 @@ def recorded_info(recording: Recording) -> LinkInfo:
 def replayed_info(recording: Recording) -> LinkInfo:
     """The link info a replay reports: the recorded one's capabilities, named a replay."""
     base = recorded_info(recording)
+    stamped = max((e.uncertainty for e in recording.events), default=0.0)
     return LinkInfo(
         kind="replay of " + base.kind.removeprefix("replay of "),
         can_break=base.can_break,
         passes_unsolicited=base.passes_unsolicited,
         binary=base.binary,
-        timing_uncertainty=base.timing_uncertainty,
+        # a decoded capture's events carry its sample-period uncertainty: judged with it
+        timing_uncertainty=max(base.timing_uncertainty, stamped),
         virtual_time=True,
         bit_timing=base.bit_timing,
     )

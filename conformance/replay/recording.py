@@ -17,7 +17,7 @@ from typing import Any
 
 from ..capture.errors import CaptureError
 from ..capture.transcript_io import read_transcript_jsonl
-from ..transcript import TOOL, Event, EventKind
+from ..transcript import TOOL, Event, EventKind, Transcript
 
 #: Prefix of the NOTE that carries the run's options (first line of a transcript).
 OPTIONS_NOTE = "run-options "
@@ -52,6 +52,14 @@ class Recording:
             return self.verdicts.get("run", {}).get("port")
         return None
 
+    @property
+    def options_text(self) -> str | None:
+        """The run-options note as written (what an export keeps in the capture), or None."""
+        for e in self.events:
+            if e.kind is EventKind.NOTE and e.text.startswith(OPTIONS_NOTE):
+                return e.text
+        return None
+
     def wire_events(self) -> list[Event]:
         return [e for e in self.events if e.kind is not EventKind.NOTE]
 
@@ -83,6 +91,29 @@ def read_recording(path: str | Path) -> Recording:
     if not any(e.kind is not EventKind.NOTE for e in events):
         raise RecordingError(f"{file}: no bus events in it: nothing to judge")
     return Recording(file, events, options, _verdicts_beside(file))
+
+
+def options_from_comment(text: str | None) -> dict[str, Any]:
+    """The run options an export left in a capture's comment ({} when there are none)."""
+    if not text or not text.startswith(OPTIONS_NOTE):
+        return {}
+    try:
+        found = json.loads(text[len(OPTIONS_NOTE) :])
+    except ValueError:
+        return {}
+    return found if isinstance(found, dict) else {}
+
+
+def write_recording(path: Path, events: list[Event], options: dict[str, Any]) -> None:
+    """A transcript file holding ``events`` opened by the run-options note (a decoded capture
+    made replayable)."""
+    transcript = Transcript()
+    if options:
+        transcript.add(options_note(options, events[0].start if events else 0.0))
+    for e in events:
+        if not (e.kind is EventKind.NOTE and e.text.startswith(OPTIONS_NOTE)):
+            transcript.add(e)
+    transcript.write_jsonl(str(path))
 
 
 def _options_from(file: Path, number: int, text: str) -> dict[str, Any]:
