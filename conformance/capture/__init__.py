@@ -8,7 +8,7 @@
 Every bad input raises :class:`CaptureError` (path + what is wrong), for exit status 4.
 """
 
-from .comments import embedded_comment
+from .comments import embedded_notes
 from .decode import RECORDER, SENSOR, CaptureDecode, decode_capture, merge_tx
 from .errors import CaptureError
 from .export import DEFAULT_SAMPLE_RATE, EXPORT_FORMATS, ExportInfo, export_events
@@ -29,7 +29,7 @@ __all__ = [
     "ExportInfo",
     "Framing",
     "decode_capture",
-    "embedded_comment",
+    "embedded_notes",
     "export_events",
     "merge_tx",
     "read_edges",

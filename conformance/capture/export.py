@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..transcript import TOOL, Event, EventKind
+from .comments import notes_comment
 from .levels import edges_of
 from .writers import Channel, write_csv, write_sr, write_vcd
 
@@ -47,7 +48,7 @@ def export_events(
     sample_rate: float = DEFAULT_SAMPLE_RATE,
     line_polarity: bool = False,
     tool_channel: bool = False,
-    comment: str | None = None,
+    notes: Sequence[Event] = (),
 ) -> ExportInfo:
     """Write ``events`` as a capture at ``path``.
 
@@ -55,8 +56,9 @@ def export_events(
     ``line_polarity``: levels of the SDI-12 wire itself (marking low) instead of the UART side
     (marking high). ``tool_channel``: add a second channel holding only the tool's own
     transmissions (origin ``tool``), like a capture of the recorder's TX beside the bus.
-    ``comment``: one line kept in the file where the format has room for it (a .sr member,
-    a VCD ``$comment``; a CSV has none), read back with :func:`embedded_comment`."""
+    ``notes``: NOTE events kept in the file where the format has room for them (a .sr
+    member, a VCD ``$comment``; a CSV has none), in capture time; read back with
+    :func:`~conformance.capture.comments.embedded_notes`."""
     path = str(path)
     fmt = (fmt or os.path.splitext(path)[1].lstrip(".")).lower()
     if fmt not in EXPORT_FORMATS:
@@ -77,6 +79,7 @@ def export_events(
     if tool_channel:
         tool = [e for e in wire if e.origin == TOOL]
         channels.append(Channel(TOOL_CHANNEL, idle, edges_of(tool, sample_rate, t0)))
+    comment = notes_comment(notes, t0)
     if fmt == "sr":
         write_sr(path, channels, sample_rate, total, comment=comment)
     else:

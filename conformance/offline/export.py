@@ -18,6 +18,7 @@ from ..capture import (
 )
 from ..exits import EXIT_OK, EXIT_USAGE, say_error
 from ..replay.recording import RecordingError, read_recording, transcript_path
+from ..transcript import EventKind
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -66,7 +67,7 @@ def export_main(argv: list[str]) -> int:
             sample_rate=args.sample_rate,
             line_polarity=args.line_polarity,
             tool_channel=args.tool_channel,
-            comment=recording.options_text,
+            notes=[e for e in recording.events if e.kind is EventKind.NOTE],
         )
     except (ValueError, CaptureError, OSError) as exc:
         say_error(f"error: {output}: {exc}")

@@ -20,16 +20,17 @@ import datetime as dt
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..capture import BUS, CaptureDecode, CaptureError, decode_capture, embedded_comment, sniff
+from ..capture import BUS, CaptureDecode, CaptureError, decode_capture, embedded_notes, sniff
 from ..replay.link import VIRTUAL_KINDS
 from ..replay.recording import (
     Recording,
     RecordingError,
-    options_from_comment,
+    options_in,
     read_recording,
     transcript_path,
     write_recording,
 )
+from ..transcript import EventKind
 
 ROLES = ("sensor", "recorder", "both")
 
@@ -135,21 +136,22 @@ def plan(argv: list[str]) -> JudgePlan:
 
 def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
     """Set ``found.replay_argv`` when the capture is of a run of this tool whose cases can be
-    repeated against it: its options come from ``--run`` or from the export's comment, and
-    every character's direction is known (else a note says why it is judged passively)."""
-    path = str(found.path)
+    repeated against it: its options come from ``--run`` or from the notes an export kept in
+    it, and every character's direction is known (else a note says why it is judged
+    passively). The capture is decoded first in any case: a broken one is refused here."""
+    decoded = decode(found.path, args)
+    found.notes.extend(describe_decode(decoded))
     if args.run:
         try:
-            options = read_recording(args.run).options
+            notes = [e for e in read_recording(args.run).events if e.kind is EventKind.NOTE]
         except RecordingError as exc:
             raise JudgeError(f"--run: {exc}") from None
     else:
-        options = options_from_comment(embedded_comment(path))
+        notes = embedded_notes(str(found.path))
+    options = options_in(notes)
     if not options:
         found.notes.append("judged passively: the capture does not say which run it is of")
         return
-    decoded = decode(found.path, args)
-    found.notes.extend(describe_decode(decoded))
     events = decoded.events
     unknown = sum(1 for e in events if e.origin == BUS)
     if unknown:
@@ -161,7 +163,7 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
     report_dir = Path(args.report_dir or default_report_dir(str(options.get("role", "sensor"))))
     report_dir.mkdir(parents=True, exist_ok=True)
     decoded_path = report_dir / "capture.jsonl"
-    write_recording(decoded_path, events, options)
+    write_recording(decoded_path, sorted([*notes, *events], key=lambda e: e.start))
     recording = read_recording(decoded_path)
     why_not = replay_refused(recording, args)
     if why_not is not None:

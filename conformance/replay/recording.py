@@ -52,14 +52,6 @@ class Recording:
             return self.verdicts.get("run", {}).get("port")
         return None
 
-    @property
-    def options_text(self) -> str | None:
-        """The run-options note as written (what an export keeps in the capture), or None."""
-        for e in self.events:
-            if e.kind is EventKind.NOTE and e.text.startswith(OPTIONS_NOTE):
-                return e.text
-        return None
-
     def wire_events(self) -> list[Event]:
         return [e for e in self.events if e.kind is not EventKind.NOTE]
 
@@ -93,27 +85,21 @@ def read_recording(path: str | Path) -> Recording:
     return Recording(file, events, options, _verdicts_beside(file))
 
 
-def options_from_comment(text: str | None) -> dict[str, Any]:
-    """The run options an export left in a capture's comment ({} when there are none)."""
-    if not text or not text.startswith(OPTIONS_NOTE):
-        return {}
-    try:
-        found = json.loads(text[len(OPTIONS_NOTE) :])
-    except ValueError:
-        return {}
-    return found if isinstance(found, dict) else {}
+def options_in(notes: list[Event]) -> dict[str, Any]:
+    """The run options in a run's notes ({} when there are none or they are not readable)."""
+    for e in notes:
+        if e.kind is EventKind.NOTE and e.text.startswith(OPTIONS_NOTE):
+            try:
+                found = json.loads(e.text[len(OPTIONS_NOTE) :])
+            except ValueError:
+                return {}
+            return found if isinstance(found, dict) else {}
+    return {}
 
 
-def write_recording(path: Path, events: list[Event], options: dict[str, Any]) -> None:
-    """A transcript file holding ``events`` opened by the run-options note (a decoded capture
-    made replayable)."""
-    transcript = Transcript()
-    if options:
-        transcript.add(options_note(options, events[0].start if events else 0.0))
-    for e in events:
-        if not (e.kind is EventKind.NOTE and e.text.startswith(OPTIONS_NOTE)):
-            transcript.add(e)
-    transcript.write_jsonl(str(path))
+def write_recording(path: Path, events: list[Event]) -> None:
+    """A transcript file holding ``events`` (a decoded capture with its run's notes)."""
+    Transcript(list(events)).write_jsonl(str(path))
 
 
 def _options_from(file: Path, number: int, text: str) -> dict[str, Any]:
