@@ -68,7 +68,6 @@ class ConformanceRun:
     finished: str | None = None
     cases: list[CaseRecord] = field(default_factory=list)
     link: Link | None = None
-    devices: list[object] = field(default_factory=list)
     session: Any = None  # SensorSession, or RecorderSession in the recorder role
     complete: bool = True
     stop_reason: str = ""
@@ -91,7 +90,7 @@ class ConformanceRun:
             opened = open_port(
                 self.options.port, echo=self.options.echo, direction=self.options.direction
             )
-            self.link, self.devices = opened.link, opened.devices
+            self.link = opened.link
             if self.declaration is None:
                 self.declaration = opened.declaration
             self.note_options()
