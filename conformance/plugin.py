@@ -25,15 +25,16 @@ from .preflight import (
 )
 from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
+from .reports import html, verdicts_json
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
 from .selection import SelectionError, resolve
 from .sensor.session import NoDeviceAnswered, SensorSession
+from .stash import CASE
 from .verdicts import Finding, Verdict
 
 RUN = pytest.StashKey[ConformanceRun]()
 OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
-CASE = pytest.StashKey[CaseRecord]()
 EXIT_NO_DEVICE = 5
 
 
@@ -126,8 +127,6 @@ def pytest_configure(config: pytest.Config) -> None:
         raise pytest.UsageError(str(exc)) from None
     config.stash[RUN] = ConformanceRun(options)
     if config.pluginmanager.hasplugin("html"):
-        from .reports import html
-
         config.pluginmanager.register(html.HtmlReportPlugin(config.stash[RUN]), "sdi12-html")
 
 
@@ -401,8 +400,6 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if session.shouldstop or session.shouldfail:
         run.complete = False
     run.finish(complete=not interrupted)
-    from .reports import verdicts_json
-
     verdicts_json.write(run, run.report_dir())
     run.close()
 

@@ -13,8 +13,10 @@ from typing import Any
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
+from .judges.timing import recheck
 from .links.base import Link, LinkError
 from .ports import is_sim, open_port
+from .recorder.session import RecorderSession, driver_for
 from .replay.recording import options_note
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
@@ -124,8 +126,6 @@ class ConformanceRun:
     def recorder_session(self) -> Any:
         """The recorder role's scenario runner (conformance.recorder.session)."""
         if self.session is None:
-            from .recorder.session import RecorderSession, driver_for
-
             opts = self.options
             declared = self.declaration.sdi12_version if self.declaration else None
             version = normalise_version(opts.version) if opts.version else declared or "14"
@@ -177,8 +177,6 @@ class ConformanceRun:
         for the figure known when each case judged (real links measure as they go)."""
         if self.link is None or self.link.info.virtual_time or self.session is None:
             return
-        from .judges.timing import recheck
-
         uncertainty = self.session.uncertainty
         for case in self.cases:
             recheck(case.findings, uncertainty)

@@ -21,6 +21,7 @@ import pytest
 from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..root_causes import reading_order
 from ..run import TOOL, ConformanceRun
+from ..stash import CASE
 from ..transcript import TOOL as TOOL_ORIGIN
 from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
@@ -504,8 +505,6 @@ class HtmlReportPlugin:
     @pytest.hookimpl(wrapper=True)
     def pytest_runtest_makereport(self, item: Any, call: Any):
         report = yield
-        from ..plugin import CASE
-
         record = item.stash.get(CASE, None)
         if record is not None and report.when == "call":
             from pytest_html import extras
