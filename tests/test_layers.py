@@ -24,27 +24,30 @@ ROOT = Path(__file__).resolve().parent.parent / "conformance"
 #: the package when they serve a higher layer.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # protocol facts and the record of the wire (sans-I/O); process plumbing
-    ("wire", ("", "interrupts", "protocol", "transcript")),
+    ("wire", ("", "interrupts", "exits", "protocol", "transcript")),
     # the requirements, what is declared about the DUT, and what was found
     (
         "requirements",
         ("catalog", "verdicts", "selection", "results", "root_causes", "coverage", "declaration"),
     ),
-    # moving characters and breaks, real and virtual; the registry of link kinds
-    ("links", ("links",)),
-    # devices the tool simulates or hosts on a virtual-time bus
-    ("devices", ("sim", "emulator", "harness")),
+    # moving characters and breaks, real and virtual; the registry of link kinds; reading and
+    # writing logic-analyser captures of the line
+    ("links", ("links", "capture")),
+    # devices the tool simulates, hosts or plays back on a virtual-time bus
+    ("devices", ("sim", "emulator", "harness", "replay")),
     # a --port string opened as a link (every kind); the emulator served on a port
     ("ports", ("ports", "emulator_server")),
     # the tool's own data recorder and the judges of what it recorded
     ("judging", ("tool_recorder", "case", "judges")),
     # the two roles; the recorder harness drives a recorder under test
-    ("roles", ("sensor", "recorder", "harness.recorder", "harness.client")),
-    # one conformance run and what starts one: options, checks, the suite, matrices, calibration
+    ("roles", ("sensor", "recorder", "harness.recorder", "harness.client", "replay.recorder")),
+    # one conformance run and what starts one: options, checks, the suite, matrices, calibration,
+    # judging a saved run again
     (
         "run",
         (
             "run",
+            "offline",
             "options",
             "preflight",
             "stash",
