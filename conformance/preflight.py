@@ -12,27 +12,18 @@ import tempfile
 from pathlib import Path
 
 from .declaration import ALLOWED_ADDRESSES, address_problem
+from .options import UsageError, check_address, check_uncertainty
 from .ports import is_sim, parse_sim
 from .recorder.faults import RECORDER_FAULTS
 
-__all__ = ["ALLOWED_ADDRESSES", "UsageError", "address_problem"]
-
-
-class UsageError(ValueError):
-    """A setting the tool cannot use; the message says what to do instead."""
-
-
-def check_address(text: str | None, where: str = "--address") -> None:
-    """An invalid address would go onto the bus (``00I!``) and look like a silent device."""
-    problem = None if text is None else address_problem(text)
-    if problem:
-        raise UsageError(f"{where}: {problem}")
-
-
-def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") -> None:
-    """A stamp uncertainty is a non-negative width; a negative one would tighten every limit."""
-    if ms is not None and not ms >= 0:  # `not >=` also rejects NaN
-        raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
+__all__ = [
+    "ALLOWED_ADDRESSES",
+    "UsageError",
+    "address_problem",
+    "check_address",
+    "check_role_options",
+    "check_uncertainty",
+]
 
 
 def check_role_options(

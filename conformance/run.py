@@ -15,6 +15,7 @@ from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
 from .judges.timing import recheck
 from .links.base import Link, LinkError
+from .options import run_option_values
 from .ports import is_sim, open_port
 from .recorder.session import RecorderSession, driver_for
 from .replay.recording import options_note
@@ -41,21 +42,8 @@ class RunOptions:
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
-        get = config.getoption
         return cls(
-            port=get("sdi12_port"),
-            role=get("sdi12_role"),
-            address=get("sdi12_address"),
-            version=get("sdi12_version"),
-            declaration=get("sdi12_declaration"),
-            report_dir=get("sdi12_report_dir"),
-            strict=get("sdi12_strict"),
-            timing_uncertainty_ms=get("sdi12_timing_uncertainty_ms"),
-            trigger=get("sdi12_trigger"),
-            echo=get("sdi12_echo"),
-            direction=get("sdi12_direction"),
-            requirements=tuple(get("sdi12_req") or ()),
-            keyword=get("keyword") or None,
+            **run_option_values(config.getoption), keyword=config.getoption("keyword") or None
         )
 
 
