@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 
+from ..catalog import requirement
 from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..root_causes import reading_order
 from ..run import TOOL, ConformanceRun
@@ -31,8 +32,6 @@ from .verdicts_json import dut_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
-TIMING_MODULES = ("test_7_timing", "test_9_whole_run")
-
 STYLE = """
 <style>
 #sdi12-top,#sdi12-top p,.sdi12,.sdi12-case{color:#222}
@@ -415,10 +414,11 @@ def _group(events: list[Event]) -> list[list[Event]]:
 
 
 def is_timing_case(record: CaseRecord) -> bool:
-    """Cases of section 7 / the whole-run timing module, or any case with a measured time."""
-    module = record.nodeid.split("::")[0].removesuffix(".py").replace("/", ".")
+    """A case that judges a requirement the catalog checks by timing (its Check column), or
+    that measured a time: its evidence is drawn as a timing diagram. Where the case is
+    written (its module's name) does not matter."""
     return any(f.measured_ms is not None for f in record.findings) or any(
-        module.rsplit(".", 1)[-1] == m for m in TIMING_MODULES
+        "timing" in requirement(rid).check for rid in record.requirements
     )
 
 
