@@ -321,3 +321,16 @@ def test_rfc2217_long_break_is_held_by_set_control():
     assert 100e-3 <= event.duration < 103e-3, event
     assert "SET_CONTROL" in event.text
     assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+
+
+def test_every_link_kind_claims_its_example_and_the_rest_are_serial_devices():
+    from conformance.links.registry import find, kinds
+
+    registered = {k.name for k in kinds()}
+    assert {"sim", "replay", "exec", "unix", "adapter", "rfc2217", "socket", "loop"} <= registered
+    assert {"serial", "rfc2217-serve"} <= registered
+    for kind in kinds():
+        assert find(kind.example) is kind
+        assert kind.info.kind == kind.name
+    for device in ("COM3", "/dev/ttyUSB0", "spy:///dev/ttyUSB0", "hwgrep://0403:6001", "SIM"):
+        assert find(device).name == "serial"
