@@ -62,49 +62,24 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     from . import __version__  # importlib.metadata: not before Ctrl-C is taken over
+    from .options import add_cli_options
 
     p.add_argument("--version", action="version", version=f"sdi12-conform {__version__}")
-    p.add_argument(
-        "--port",
-        help="a serial port (/dev/ttyUSB0, COM3), a pyserial URL (rfc2217://HOST:PORT), "
-        "'exec:PROGRAM ARGS' or unix:PATH (a harness, docs/harness-protocol.md), or "
-        "sim / sim://?faults=a,b&version=1.3 for the built-in simulated device "
-        "(default: sim, said loudly when used)",
-    )
-    p.add_argument(
-        "--role",
-        default="sensor",
-        choices=("sensor", "recorder"),
-        help="what the device under test is (default: sensor)",
-    )
-    p.add_argument("--address", help="DUT address (default: the declaration, else ask with ?!)")
-    p.add_argument("--sdi-version", help="force the rule set, 1.3 or 1.4 (default: from aI!)")
-    p.add_argument("--declaration", help="TOML file declaring the DUT's address and features")
-    p.add_argument("--report-dir", help="output folder (default: reports/<date>-<role>)")
-    p.add_argument("--strict", action="store_true", help="WARN (SHOULD violations) fails too")
-    p.add_argument(
-        "--timing-uncertainty-ms",
-        type=float,
-        help="widen the timestamp uncertainty the link measures (it can never narrow it)",
-    )
-    p.add_argument(
-        "--echo",
-        default="auto",
-        choices=("auto", "on", "off"),
-        help="real links: does the interface echo the tool's own characters "
-        "(default auto: found out on the first transmission)",
-    )
-    p.add_argument(
-        "--direction",
-        default="none",
-        choices=("none", "rts", "dtr"),
-        help="real links: raise this line for exactly the tool's transmissions "
-        "(an RS-485-style transceiver's driver enable)",
-    )
-    p.add_argument(
-        "--trigger",
-        help="recorder role: shell command run per scenario with the request in SDI12_* "
-        "environment variables, or 'interactive' to prompt an operator",
+    add_cli_options(
+        p,
+        (
+            "port",
+            "role",
+            "address",
+            "sdi-version",
+            "declaration",
+            "report-dir",
+            "strict",
+            "timing-uncertainty-ms",
+            "echo",
+            "direction",
+            "trigger",
+        ),
     )
     p.add_argument(
         "-k",
@@ -112,28 +87,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="a partial run: only cases matching this pytest -k expression (exit 0/1 on "
         "what was selected; the rest is listed as not selected)",
     )
-    p.add_argument(
-        "--req",
-        action="append",
-        default=[],
-        metavar="ID_OR_CLAUSE",
-        help="a partial run: only cases judging this requirement ID (R-4.4.6-02) or clause "
-        "(4.4.12); repeatable",
-    )
+    add_cli_options(p, ("req",))
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p
 
 
 def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .declaration import DeclarationError, load_declaration, normalise_version
+    from .options import UsageError, check_values, cli_values, pytest_args
     from .ports import PortError, is_sim, parse_sim
-    from .preflight import (
-        UsageError,
-        check_address,
-        check_report_dir,
-        check_role_options,
-        check_uncertainty,
-    )
+    from .preflight import check_report_dir, check_role_options
     from .selection import SelectionError, resolve
 
     if args.port is None:
@@ -148,8 +111,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
     try:
         check_role_options(args.role, args.port, args.trigger, args.address)
-        check_address(args.address)
-        check_uncertainty(args.timing_uncertainty_ms)
+        check_values(cli_values(args), plugin=False)
         resolve(args.role, args.req)  # --req names requirements the role can test
         if args.sdi_version:
             normalise_version(args.sdi_version)
@@ -174,29 +136,13 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         return EXIT_USAGE
     from .suite import suite_args
 
-    pytest_args = suite_args(
-        args.role, args.port, report_dir, terminal=args.verbose
-    )
-    for flag, value in (
-        ("--sdi12-address", args.address),
-        ("--sdi12-version", args.sdi_version),
-        ("--sdi12-declaration", args.declaration),
-        ("--sdi12-trigger", args.trigger),
-    ):
-        if value:
-            pytest_args += [flag, value]
-    if args.timing_uncertainty_ms is not None:
-        pytest_args += ["--sdi12-timing-uncertainty-ms", str(args.timing_uncertainty_ms)]
-    if args.strict:
-        pytest_args.append("--sdi12-strict")
-    pytest_args += ["--sdi12-echo", args.echo, "--sdi12-direction", args.direction]
+    argv = suite_args(args.role, args.port, report_dir, terminal=args.verbose)
+    argv += pytest_args(args)  # every run option, as the plugin spells it
     if args.keyword:
-        pytest_args += ["-k", args.keyword]
-    for wanted in args.req:
-        pytest_args += ["--sdi12-req", wanted]
+        argv += ["-k", args.keyword]
     plugins: list[object] = []
     if args.verbose:
-        pytest_args.append("-v")
+        argv.append("-v")
     else:
         from .reports.console import ProgressPlugin
 
@@ -204,7 +150,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
     import pytest
 
-    code = pytest.main(pytest_args, plugins=plugins)
+    code = pytest.main(argv, plugins=plugins)
     interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
     verdicts = report_dir / "verdicts.json"
     if interrupted and not verdicts.exists():

@@ -23,9 +23,20 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .preflight import address_problem
+from .protocol.commands import ADDRESS_CHARS
 
+ALLOWED_ADDRESSES = "0-9, A-Z, a-z"
 FEATURES = ("address_change", "continuous", "high_volume_ascii", "high_volume_binary")
+
+
+def address_problem(text: object) -> str | None:
+    """Why ``text`` is not an SDI-12 address (one of 0-9, A-Z, a-z), or None if it is one.
+
+    Here rather than with the other setting checks (:mod:`~conformance.preflight`) because a
+    declaration is read far below them: the ports that open simulated sensors build one."""
+    if isinstance(text, str) and len(text) == 1 and text in ADDRESS_CHARS:
+        return None
+    return f"{text!r} is not an SDI-12 address: use one character of {ALLOWED_ADDRESSES}"
 
 
 class DeclarationError(ValueError):

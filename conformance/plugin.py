@@ -15,86 +15,26 @@ from .case import Case
 from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
+from .options import UsageError, add_pytest_options, check_values
 from .ports import PortError
-from .preflight import (
-    UsageError,
-    check_address,
-    check_report_dir,
-    check_role_options,
-    check_uncertainty,
-)
+from .preflight import check_report_dir, check_role_options
 from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
+from .reports import html, verdicts_json
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
 from .selection import SelectionError, resolve
 from .sensor.session import NoDeviceAnswered, SensorSession
+from .stash import CASE
 from .verdicts import Finding, Verdict
 
 RUN = pytest.StashKey[ConformanceRun]()
 OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
-CASE = pytest.StashKey[CaseRecord]()
 EXIT_NO_DEVICE = 5
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
-    group = parser.getgroup("sdi12-conform", "SDI-12 conformance")
-    group.addoption(
-        "--sdi12-port",
-        default="sim",
-        help="DUT port: sim, sim://?faults=..., COM3, /dev/ttyUSB0, rfc2217://h:p",
-    )
-    group.addoption(
-        "--sdi12-role",
-        default="sensor",
-        choices=("sensor", "recorder"),
-        help="what the DUT is (the tool plays the other side)",
-    )
-    group.addoption("--sdi12-address", default=None, help="DUT address (default: ask with ?!)")
-    group.addoption(
-        "--sdi12-version",
-        default=None,
-        help="force the rule set (1.3 or 1.4) instead of reading it from aI!",
-    )
-    group.addoption("--sdi12-declaration", default=None, help="DUT declaration (TOML)")
-    group.addoption("--sdi12-report-dir", default=None, help="where verdicts.json etc. go")
-    group.addoption(
-        "--sdi12-strict",
-        action="store_true",
-        default=False,
-        help="treat WARN (SHOULD violations) as non-compliance",
-    )
-    group.addoption(
-        "--sdi12-trigger",
-        default=None,
-        help="recorder role: shell command run per scenario (or 'interactive' to prompt)",
-    )
-    group.addoption(
-        "--sdi12-req",
-        action="append",
-        default=[],
-        metavar="ID_OR_CLAUSE",
-        help="judge only these requirements: an ID (R-4.4.6-02) or a clause (4.4.12); "
-        "repeatable. A partial run: the rest is listed as not selected",
-    )
-    group.addoption(
-        "--sdi12-timing-uncertainty-ms",
-        type=float,
-        default=None,
-        help="widen the link's measured timestamp uncertainty (never narrows it)",
-    )
-    group.addoption(
-        "--sdi12-echo",
-        default="auto",
-        choices=("auto", "on", "off"),
-        help="real links: the interface echoes the tool's characters (auto: find out)",
-    )
-    group.addoption(
-        "--sdi12-direction",
-        default="none",
-        choices=("none", "rts", "dtr"),
-        help="real links: raise this line for the tool's transmissions (transceiver enable)",
-    )
+    add_pytest_options(parser.getgroup("sdi12-conform", "SDI-12 conformance"))
 
 
 def is_conformance_session(config: pytest.Config) -> bool:
@@ -119,15 +59,12 @@ def pytest_configure(config: pytest.Config) -> None:
     )
     options = RunOptions.from_config(config)
     try:
-        check_address(options.address, "--sdi12-address")
-        check_uncertainty(options.timing_uncertainty_ms, "--sdi12-timing-uncertainty-ms")
+        check_values(vars(options), plugin=True)
         check_role_options(options.role, options.port, options.trigger, options.address)
     except (UsageError, PortError) as exc:
         raise pytest.UsageError(str(exc)) from None
     config.stash[RUN] = ConformanceRun(options)
     if config.pluginmanager.hasplugin("html"):
-        from .reports import html
-
         config.pluginmanager.register(html.HtmlReportPlugin(config.stash[RUN]), "sdi12-html")
 
 
@@ -401,8 +338,6 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if session.shouldstop or session.shouldfail:
         run.complete = False
     run.finish(complete=not interrupted)
-    from .reports import verdicts_json
-
     verdicts_json.write(run, run.report_dir())
     run.close()
 

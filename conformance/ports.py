@@ -1,26 +1,33 @@
-"""Turn a ``--port`` string into a link.
+"""Turn a ``--port`` string into a link: every kind of link, looked up in one registry.
 
-``sim`` / ``sim://?faults=a,b&version=1.3&address=0`` is the built-in simulated bus with the
-reference sensor emulator on it (virtual time, exact stamps). Every other string is handed to
-the real-link layer.
+Each kind registers itself with :mod:`~conformance.links.registry` when its module is
+imported; this module imports the built-in ones (:data:`BUILTIN_KINDS`) and registers the three
+it holds itself: ``sim`` / ``sim://?faults=a,b&version=1.3&address=0``, the built-in simulated
+bus with the reference sensor emulator on it (virtual time, exact stamps); ``replay:PATH``, a
+saved run's recorded sensor played back on that bus; and ``rfc2217-serve://``, which the
+sensor role refuses (it serves played sensors to a recorder under test). A new kind of link
+is a module that registers its :class:`LinkKind`, plus its line in :data:`BUILTIN_KINDS`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlsplit
 
 from .declaration import Declaration
-from .links.base import Link
+from .emulator import FAULTS, Profile, default_profile, sim_sensor
+from .harness import device as harness_device
+from .links import adapter_link, factory
+from .links.base import LinkInfo
+from .links.errors import PortError
+from .links.registry import LinkKind, OpenedPort, PortOptions, find, register
+from .protocol.commands import ADDRESS_CHARS
 from .replay.link import is_replay
 
-if TYPE_CHECKING:
-    from .emulator.profile import Profile
+__all__ = ["OpenedPort", "PortError", "SimSpec", "is_sim", "open_port", "open_sim", "parse_sim"]
 
-
-class PortError(ValueError):
-    """A port string the tool cannot use; the message says what to do instead."""
+#: The modules whose kinds of link register themselves on import (besides the three below).
+BUILTIN_KINDS = (factory, adapter_link, harness_device)
 
 
 @dataclass
@@ -29,13 +36,6 @@ class SimSpec:
     version: str = "14"
     address: str = "0"
     extra: dict[str, str] = field(default_factory=dict)
-
-
-@dataclass
-class OpenedPort:
-    link: Link
-    devices: list[object] = field(default_factory=list)
-    declaration: Declaration | None = None  # what a simulated device declares about itself
 
 
 def is_sim(port: str) -> bool:
@@ -69,9 +69,6 @@ def parse_sim(port: str) -> SimSpec:
 
 def open_sim(spec: SimSpec) -> OpenedPort:
     """Build the simulated bus with one reference emulator on it."""
-    from .emulator import FAULTS, default_profile, sim_sensor
-    from .protocol.commands import ADDRESS_CHARS
-
     unknown = [f for f in spec.faults if f not in FAULTS]
     if unknown:
         raise PortError(
@@ -102,37 +99,13 @@ def sim_declaration(profile: Profile, spec: SimSpec) -> Declaration:
 
 
 def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> OpenedPort:
-    """Open ``port``; ``echo`` and ``direction`` describe a real bench (ignored on sim)."""
-    if is_sim(port):
-        return open_sim(parse_sim(port))
-    if is_replay(port):
-        return open_replay(port)
-    if port.startswith("rfc2217-serve://"):
-        raise PortError(
-            f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
-            "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
-        )
-    if port.startswith(("exec:", "unix:")):  # a harness in another process, virtual time
-        from .harness.channel import HarnessError
-        from .harness.device import open_sensor_harness
-        from .links.errors import PortUnavailable
+    """Open ``port`` for the sensor role; ``echo`` and ``direction`` describe a real bench
+    (kinds in virtual time ignore them)."""
+    return find(port).open(port, PortOptions(echo, direction))
 
-        try:
-            return OpenedPort(open_sensor_harness(port))
-        except HarnessError as exc:
-            raise PortUnavailable(str(exc)) from exc
-    check_network_url(port)
-    from .links.direction import DirectionLine
-    from .links.echo import EchoMode
-    from .links.factory import open_real_link
 
-    try:
-        bench = {"echo": EchoMode(echo), "direction": DirectionLine(direction)}
-    except ValueError as exc:
-        raise PortError(
-            f"{exc}: --echo is auto, on or off; --direction is rts, dtr or none"
-        ) from exc
-    return OpenedPort(open_real_link(port, **bench))
+def _open_sim(port: str, options: PortOptions) -> OpenedPort:
+    return open_sim(parse_sim(port))
 
 
 def open_replay(port: str) -> OpenedPort:
@@ -162,18 +135,37 @@ def recorded_declaration(port: str | None) -> Declaration | None:
     return None
 
 
-def check_network_url(port: str) -> None:
-    """``rfc2217://`` / ``socket://`` need HOST:PORT; pyserial's own complaint about a
-    missing one is a TypeError from deep inside it."""
-    scheme = port.split("://", 1)[0].lower() if "://" in port else ""
-    if scheme not in ("rfc2217", "socket"):
-        return
-    parts = urlsplit(port)
-    try:
-        number = parts.port
-    except ValueError:
-        number = None
-    if not parts.hostname or number is None:
-        raise PortError(
-            f"port {port!r}: write {scheme}://HOST:PORT, e.g. {scheme}://127.0.0.1:4001"
-        )
+def _refuse_served(port: str, options: PortOptions) -> OpenedPort:
+    raise PortError(
+        f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
+        "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
+    )
+
+
+SIM = register(
+    LinkKind(
+        "sim",
+        matches=is_sim,
+        open=_open_sim,
+        info=LinkInfo(kind="sim", virtual_time=True),
+        example="sim://?faults=no-service-request&version=1.3",
+    )
+)
+REPLAY = register(
+    LinkKind(
+        "replay",
+        matches=is_replay,
+        open=lambda port, options: open_replay(port),
+        info=LinkInfo(kind="replay", virtual_time=True),
+        example="replay:reports/20250101-120000-sensor",
+    )
+)
+SERVED = register(
+    LinkKind(
+        "rfc2217-serve",
+        matches=lambda port: port.startswith("rfc2217-serve://"),
+        open=_refuse_served,
+        info=LinkInfo(kind="rfc2217-serve"),
+        example="rfc2217-serve://127.0.0.1:0",
+    )
+)

@@ -11,41 +11,25 @@ import os
 import tempfile
 from pathlib import Path
 
-from .protocol.commands import ADDRESS_CHARS
+from .declaration import ALLOWED_ADDRESSES, address_problem
+from .options import UsageError, check_address, check_uncertainty
+from .ports import is_sim, parse_sim
+from .recorder.faults import RECORDER_FAULTS
 
-ALLOWED_ADDRESSES = "0-9, A-Z, a-z"
-
-
-class UsageError(ValueError):
-    """A setting the tool cannot use; the message says what to do instead."""
-
-
-def address_problem(text: object) -> str | None:
-    """Why ``text`` is not an SDI-12 address (one of 0-9, A-Z, a-z), or None if it is one."""
-    if isinstance(text, str) and len(text) == 1 and text in ADDRESS_CHARS:
-        return None
-    return f"{text!r} is not an SDI-12 address: use one character of {ALLOWED_ADDRESSES}"
-
-
-def check_address(text: str | None, where: str = "--address") -> None:
-    """An invalid address would go onto the bus (``00I!``) and look like a silent device."""
-    problem = None if text is None else address_problem(text)
-    if problem:
-        raise UsageError(f"{where}: {problem}")
-
-
-def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") -> None:
-    """A stamp uncertainty is a non-negative width; a negative one would tighten every limit."""
-    if ms is not None and not ms >= 0:  # `not >=` also rejects NaN
-        raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
+__all__ = [
+    "ALLOWED_ADDRESSES",
+    "UsageError",
+    "address_problem",
+    "check_address",
+    "check_role_options",
+    "check_uncertainty",
+]
 
 
 def check_role_options(
     role: str, port: str, trigger: str | None, address: str | None = None
 ) -> None:
     """Settings that only mean something in the other role are mistakes, not no-ops."""
-    from .ports import is_sim, parse_sim
-
     if role == "recorder" and address:
         raise UsageError(
             "--address picks the sensor to judge (--role sensor); in the recorder role the "
@@ -93,6 +77,4 @@ def check_report_dir(path: Path) -> Path:
 
 
 def _recorder_fault_names() -> str:
-    from .recorder.faults import RECORDER_FAULTS
-
     return ", ".join(sorted(RECORDER_FAULTS))

@@ -13,8 +13,11 @@ from typing import Any
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
+from .judges.timing import recheck
 from .links.base import Link, LinkError
+from .options import run_option_values
 from .ports import is_sim, open_port
+from .recorder.session import RecorderSession, driver_for
 from .replay.recording import options_note
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
@@ -39,21 +42,8 @@ class RunOptions:
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
-        get = config.getoption
         return cls(
-            port=get("sdi12_port"),
-            role=get("sdi12_role"),
-            address=get("sdi12_address"),
-            version=get("sdi12_version"),
-            declaration=get("sdi12_declaration"),
-            report_dir=get("sdi12_report_dir"),
-            strict=get("sdi12_strict"),
-            timing_uncertainty_ms=get("sdi12_timing_uncertainty_ms"),
-            trigger=get("sdi12_trigger"),
-            echo=get("sdi12_echo"),
-            direction=get("sdi12_direction"),
-            requirements=tuple(get("sdi12_req") or ()),
-            keyword=get("keyword") or None,
+            **run_option_values(config.getoption), keyword=config.getoption("keyword") or None
         )
 
 
@@ -68,7 +58,6 @@ class ConformanceRun:
     finished: str | None = None
     cases: list[CaseRecord] = field(default_factory=list)
     link: Link | None = None
-    devices: list[object] = field(default_factory=list)
     session: Any = None  # SensorSession, or RecorderSession in the recorder role
     complete: bool = True
     stop_reason: str = ""
@@ -91,7 +80,7 @@ class ConformanceRun:
             opened = open_port(
                 self.options.port, echo=self.options.echo, direction=self.options.direction
             )
-            self.link, self.devices = opened.link, opened.devices
+            self.link = opened.link
             if self.declaration is None:
                 self.declaration = opened.declaration
             self.note_options()
@@ -125,8 +114,6 @@ class ConformanceRun:
     def recorder_session(self) -> Any:
         """The recorder role's scenario runner (conformance.recorder.session)."""
         if self.session is None:
-            from .recorder.session import RecorderSession, driver_for
-
             opts = self.options
             declared = self.declaration.sdi12_version if self.declaration else None
             version = normalise_version(opts.version) if opts.version else declared or "14"
@@ -178,8 +165,6 @@ class ConformanceRun:
         for the figure known when each case judged (real links measure as they go)."""
         if self.link is None or self.link.info.virtual_time or self.session is None:
             return
-        from .judges.timing import recheck
-
         uncertainty = self.session.uncertainty
         for case in self.cases:
             recheck(case.findings, uncertainty)

@@ -91,7 +91,7 @@ class Event:
 
 
 def decode_7e1(events: Iterable[Event]) -> str:
-    """Text of 7E1 characters (parity stripped; see :func:`parity_errors`)."""
+    """Text of 7E1 characters (parity stripped: a frame's parity is ``Event.parity_ok``)."""
     return "".join(chr(e.char7) for e in events if e.kind is EventKind.CHAR)
 
 
@@ -108,10 +108,6 @@ def text_end(events: list[Event], text: str) -> float | None:
         if decode_7e1(tail) == text and all(e.parity_ok for e in tail):
             return tail[-1].end
     return None
-
-
-def parity_errors(events: Iterable[Event]) -> list[Event]:
-    return [e for e in events if e.kind is EventKind.CHAR and not e.parity_ok]
 
 
 def escape(data: str | bytes) -> str:

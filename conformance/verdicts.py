@@ -48,9 +48,6 @@ _RANK = {
     Verdict.ERROR: 5,
 }
 
-ORDER: tuple[Verdict, ...] = tuple(sorted(Verdict, key=lambda v: v.rank))
-
-
 def worst(verdicts: Iterable[Verdict], default: Verdict = Verdict.NA) -> Verdict:
     result = None
     for v in verdicts:

@@ -165,6 +165,13 @@ def test_case_html_draws_timing_cases_only():
     other.findings.append(Finding("R-4.4.1-01", Verdict.PASS, "answered", observed=1))
     other.evidence.append(("a!", events))
     assert "<svg" in html.case_html(timing) and "<svg" not in html.case_html(other)
+    # the catalog decides, not the module's name: a protocol rule in a timing module draws none
+    named = CaseRecord("test_7_timing.py::test_w", "test_w", ("R-4.4.1-01",))
+    named.evidence.append(("a!", events))
+    assert "<svg" not in html.case_html(named)
+    elsewhere = CaseRecord("test_4_4_basic.py::test_v", "test_v", ("R-7.0-05",))
+    elsewhere.evidence.append(("break, a!", events))
+    assert "<svg" in html.case_html(elsewhere)
     derived = ("worst exchange", events)
     measured = CaseRecord("test_9_whole_run.py::test_z", "test_z", ("R-7.0-10",))
     measured.findings.append(Finding("R-7.0-10", Verdict.PASS, "ok", measured_ms=9.0, observed=1))

@@ -15,8 +15,13 @@ import pytest
 from conformance.emulator_server.realtime import RealTimeLine
 from conformance.emulator_server.servers import TcpEmulatorServer
 from conformance.links.echo import EchoMode
-from conformance.links.errors import BreakUnsupported, PortUnavailable, PortVanished
-from conformance.links.factory import _explain, open_real_link, port_kind
+from conformance.links.errors import (
+    BreakUnsupported,
+    PortUnavailable,
+    PortVanished,
+    explain_open_failure,
+)
+from conformance.links.factory import open_real_link, port_kind
 from conformance.links.stamps import MAX_LEAD, chunk_frames
 from conformance.ports import PortError, open_port
 from conformance.protocol.timing import CHAR_TIME
@@ -73,9 +78,13 @@ def test_missing_device_is_a_port_error_with_what_to_do():
 
 
 def test_permission_and_busy_messages_say_what_to_do():
-    denied = _explain("/dev/ttyUSB0", "serial", OSError(errno.EACCES, "Permission denied"))
+    denied = explain_open_failure(
+        "/dev/ttyUSB0", "serial", OSError(errno.EACCES, "Permission denied")
+    )
     assert "dialout" in denied
-    busy = _explain("/dev/ttyUSB0", "serial", OSError(errno.EBUSY, "Device or resource busy"))
+    busy = explain_open_failure(
+        "/dev/ttyUSB0", "serial", OSError(errno.EBUSY, "Device or resource busy")
+    )
     assert "busy" in busy
 
 
@@ -312,3 +321,16 @@ def test_rfc2217_long_break_is_held_by_set_control():
     assert 100e-3 <= event.duration < 103e-3, event
     assert "SET_CONTROL" in event.text
     assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+
+
+def test_every_link_kind_claims_its_example_and_the_rest_are_serial_devices():
+    from conformance.links.registry import find, kinds
+
+    registered = {k.name for k in kinds()}
+    assert {"sim", "replay", "exec", "unix", "adapter", "rfc2217", "socket", "loop"} <= registered
+    assert {"serial", "rfc2217-serve"} <= registered
+    for kind in kinds():
+        assert find(kind.example) is kind
+        assert kind.info.kind == kind.name
+    for device in ("COM3", "/dev/ttyUSB0", "spy:///dev/ttyUSB0", "hwgrep://0403:6001", "SIM"):
+        assert find(device).name == "serial"

@@ -10,6 +10,8 @@ the wire.
 from __future__ import annotations
 
 from ..links.base import LinkInfo
+from ..links.errors import PortUnavailable
+from ..links.registry import LinkKind, OpenedPort, PortOptions, register
 from ..protocol.timing import CHAR_TIME
 from ..results import CaseRecord
 from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
@@ -179,3 +181,25 @@ def open_sensor_harness(port: str, reply_timeout: float | None = None) -> Harnes
     bus.attach(device)
     return HarnessLink(bus, device, port.partition(":")[0])
 
+
+
+def _open_kind(port: str, options: PortOptions) -> OpenedPort:
+    """A sensor harness: virtual time, so the bench options (echo, direction) do not apply."""
+    try:
+        return OpenedPort(open_sensor_harness(port))
+    except HarnessError as exc:
+        raise PortUnavailable(str(exc)) from exc
+
+
+KINDS = tuple(
+    register(
+        LinkKind(
+            name,
+            matches=lambda port, name=name: port.startswith(f"{name}:"),
+            open=_open_kind,
+            info=LinkInfo(kind=name, virtual_time=True, bit_timing=False),
+            example=example,
+        )
+    )
+    for name, example in (("exec", "exec:python3 my_harness.py"), ("unix", "unix:/tmp/dut.sock"))
+)

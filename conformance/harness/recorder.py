@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..links.base import Link
+from ..links.errors import PortUnavailable
 from ..recorder.drivers import RecorderDriverError
 from ..recorder.request import RecorderOutput, Request
 from ..transcript import Event
@@ -59,8 +60,6 @@ class HarnessRecorder:
     def probe(self) -> None:
         """Start the harness and exchange hellos once, so a wrong command is a usage error
         before the run (a :class:`~conformance.ports.PortError`), not an ERROR in it."""
-        from ..links.errors import PortUnavailable
-
         try:
             channel = open_channel(self.port, None, self.reply_timeout)
             try:

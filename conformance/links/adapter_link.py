@@ -26,7 +26,7 @@ uncertainty rule turn timing verdicts INCONCLUSIVE here rather than PASS or FAIL
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from urllib.parse import parse_qs, urlencode, urlsplit, urlunsplit
 
 import serial
@@ -34,7 +34,8 @@ import serial
 from ..protocol.timing import CHAR_TIME
 from ..transcript import DUT, Event, EventKind, to_wire_7e1
 from .base import LinkInfo, StopCondition
-from .errors import PortUnavailable
+from .errors import PortUnavailable, explain_open_failure
+from .registry import LinkKind, OpenedPort, PortOptions, register
 from .serial_link import READ_POLL, SerialLink, precise_sleep_until
 from .stamps import chunk_frames
 
@@ -47,6 +48,15 @@ LINE_IDLE = 0.1  # s: a partial line quiet this long is handed over without its 
 MAX_LINE = 1100  # bytes: a line that never ends is handed over in pieces this long
 TERMINATORS = {"cr": b"\r", "crlf": b"\r\n", "lf": b"\n", "none": b""}
 OPEN_TIMEOUT = 5.0
+#: What a link through an adapter can do: no breaks of its own, no unsolicited bytes, no 8N1
+#: packets, stamps good to 50 ms.
+INFO = LinkInfo(
+    kind="adapter",
+    can_break=False,
+    passes_unsolicited=False,
+    binary=False,
+    timing_uncertainty=ADAPTER_UNCERTAINTY,
+)
 
 
 def is_adapter_port(port: str) -> bool:
@@ -125,11 +135,8 @@ class AdapterLink(SerialLink):
         self._line = bytearray()  # bytes of the line being received, not yet events
         self._line_arrival = 0.0
         self._pending_until: float | None = None  # a command awaits its response line
-        info = LinkInfo(
-            kind="adapter",
-            can_break=False,
-            passes_unsolicited=False,
-            binary=False,
+        info = replace(
+            INFO,
             timing_uncertainty=(
                 ADAPTER_UNCERTAINTY if timing_uncertainty is None else timing_uncertainty
             ),
@@ -216,8 +223,6 @@ class AdapterLink(SerialLink):
 
 def open_adapter_link(port: str, timing_uncertainty: float | None = None) -> AdapterLink:
     """Open an ``adapter`` port string (see the module docstring) as an :class:`AdapterLink`."""
-    from .factory import _explain  # the factory imports this module lazily: no cycle
-
     try:
         spec = parse_adapter_port(port)
     except ValueError as exc:
@@ -236,5 +241,21 @@ def open_adapter_link(port: str, timing_uncertainty: float | None = None) -> Ada
         raw.open()
     except (serial.SerialException, OSError, ValueError, NotImplementedError) as exc:
         inner = spec.url.split("://", 1)[0].lower() if "://" in spec.url else "serial"
-        raise PortUnavailable(_explain(spec.url, inner, exc)) from exc
+        raise PortUnavailable(explain_open_failure(spec.url, inner, exc)) from exc
     return AdapterLink(raw, spec, timing_uncertainty=timing_uncertainty, name=port)
+
+
+def _open_kind(port: str, options: PortOptions) -> OpenedPort:
+    options.modes()  # an unknown --echo/--direction is refused here too, though unused
+    return OpenedPort(open_adapter_link(port, options.timing_uncertainty))
+
+
+KIND = register(
+    LinkKind(
+        "adapter",
+        matches=is_adapter_port,
+        open=_open_kind,
+        info=INFO,
+        example="adapter:///dev/ttyUSB0?baud=9600",
+    )
+)

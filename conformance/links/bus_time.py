@@ -23,8 +23,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from ..protocol.commands import CommandError, parse_command
+from ..protocol.responses import measurement_digits, parse_measurement_reply
 from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
-from ..tool_recorder import validity
 from ..transcript import TOOL, Event, EventKind, decode_7e1
 
 
@@ -118,10 +118,19 @@ def _announced_wait(command: list[Event], reply: list[Event]) -> tuple[float, fl
         return None
     if not cmd.starts_measurement:
         return None
-    parsed = validity.parse_start_reply(decode_7e1(reply), validity.count_digits(cmd))
-    if parsed is None or parsed[0] == 0:
+    ttt = announced_time(decode_7e1(reply), measurement_digits(cmd))
+    if not ttt:
         return None
-    return reply[-1].end, reply[-1].end + parsed[0]
+    return reply[-1].end, reply[-1].end + ttt
+
+
+def announced_time(text: str, digits: int) -> int | None:
+    """ttt of a well-formed ``atttn<CR><LF>`` (nn, nnn by ``digits``), else None."""
+    body = text.removesuffix("\r\n")
+    if body == text or len(body) != 4 + digits:
+        return None
+    shape = parse_measurement_reply(body, digits)
+    return shape.ttt if shape.count is not None else None
 
 
 def _line_done(reply: list[Event]) -> bool:

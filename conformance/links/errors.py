@@ -1,16 +1,22 @@
-"""Why a real link could not do what was asked, as exceptions the layers above can sort.
+"""Why a port or a link could not do what was asked, as exceptions the layers above can sort.
 
-``PortUnavailable`` is both a :class:`~conformance.ports.PortError` (the CLI turns it into a
-usage error, exit 4: the user named a port that cannot be opened) and a
-:class:`~conformance.links.base.LinkError` (code that only knows links still catches it).
-``BreakUnsupported`` lets the master engine send a command without its wake-up break on a
-link that has none, while a case that presents a break of its own becomes INCONCLUSIVE.
+``PortError`` is a port string the tool cannot use; the CLI turns it into a usage error (exit
+4). ``PortUnavailable`` is both a ``PortError`` (the user named a port that cannot be opened)
+and a :class:`~conformance.links.base.LinkError` (code that only knows links still catches
+it). ``BreakUnsupported`` lets the master engine send a command without its wake-up break on
+a link that has none, while a case that presents a break of its own becomes INCONCLUSIVE.
+:func:`explain_open_failure` is the one place that turns pyserial's complaint into advice.
 """
 
 from __future__ import annotations
 
-from ..ports import PortError
+import errno
+
 from .base import LinkError
+
+
+class PortError(ValueError):
+    """A port string the tool cannot use; the message says what to do instead."""
 
 
 class PortUnavailable(PortError, LinkError):
@@ -23,3 +29,33 @@ class PortVanished(LinkError):
 
 class BreakUnsupported(LinkError):
     """This link cannot put a break on the line (``socket://``, ``loop://``)."""
+
+
+def explain_open_failure(port: str, kind: str, exc: BaseException) -> str:
+    """One message that says what went wrong and what to try."""
+    code = getattr(exc, "errno", None)
+    text = str(exc)
+    if kind in ("rfc2217", "socket"):
+        return (
+            f"cannot connect to {port}: {text}. Is the server running and listening there "
+            "(for the emulator: sdi12-conform emulate --listen HOST:PORT)?"
+        )
+    if code == errno.ENOENT or "No such file" in text or "FileNotFoundError" in text:
+        return (
+            f"serial port {port} does not exist. Check the cable and the device name "
+            "(Linux: ls /dev/ttyUSB* /dev/ttyACM*; Windows: COMn in Device Manager), "
+            "or run against the built-in simulated sensor with --port sim"
+        )
+    if code == errno.EACCES or "Permission denied" in text:
+        return (
+            f"permission denied on serial port {port}. Add your user to the group that owns "
+            "it (Linux: sudo usermod -aG dialout $USER, then log in again)"
+        )
+    if code == errno.ENOTTY or "Inappropriate ioctl" in text:  # pyserial hides the errno
+        return (
+            f"{port} is not a serial device (a regular file?): pass a serial port such as "
+            "/dev/ttyUSB0 or COM3"
+        )
+    if code == errno.EBUSY or "busy" in text.lower():
+        return f"serial port {port} is busy: close the other program using it"
+    return f"cannot open port {port}: {text}"

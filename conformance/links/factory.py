@@ -1,4 +1,5 @@
-"""Open a real link from a ``--port`` string: a device path or any pyserial URL.
+"""The link kinds pyserial opens: a device path or any pyserial URL, each registered with
+:mod:`~conformance.links.registry` (the adapter kind is :mod:`~conformance.links.adapter_link`).
 
 What each kind can do, and how far its stamps can be trusted, is decided here once:
 
@@ -23,17 +24,20 @@ short spacing pulses are NULs at a lower rate, timed by the UART.
 
 from __future__ import annotations
 
-import errno
+from collections.abc import Callable
+from dataclasses import replace
 from urllib.parse import urlsplit
 
 import serial
 
+from . import adapter_link
 from .base import Link, LinkInfo
 from .breaks import BaudPulse, BreakMaker, Rfc2217Break, UartBreak
 from .direction import Direction, DirectionLine
 from .echo import EchoMode
-from .errors import PortUnavailable
+from .errors import PortError, PortUnavailable, explain_open_failure
 from .kernel_stamps import stamped_port
+from .registry import LinkKind, OpenedPort, Opener, PortOptions, find, register, scheme_is
 from .serial_link import READ_POLL, SerialLink
 
 BAUD = 1200
@@ -45,15 +49,42 @@ USB_UNCERTAINTY = 16e-3
 OPEN_TIMEOUT = 5.0  # s: an rfc2217/socket server that does not answer is a usage error
 LOOPBACK_HOSTS = ("127.", "localhost", "::1", "[::1]")
 
+#: What a kind's port adds to the raw pyserial port: its break maker, its bit-clock pulse
+#: maker, and the uncertainty floor of its stamps.
+LineSetup = Callable[[serial.SerialBase, str], tuple[BreakMaker | None, BaudPulse | None, float]]
+
 
 def port_kind(port: str) -> str:
-    scheme = port.split("://", 1)[0].lower() if "://" in port else ""
-    return {"rfc2217": "rfc2217", "socket": "socket", "loop": "loop"}.get(scheme, "serial")
+    """The registered kind ``port`` names (``serial`` for a device name)."""
+    return find(port).name
 
 
 def _is_loopback(port: str) -> bool:
     host = urlsplit(port).hostname or ""
     return host.startswith(LOOPBACK_HOSTS) or host in LOOPBACK_HOSTS
+
+
+def _net_uncertainty(port: str) -> float:
+    return LOCAL_NET_UNCERTAINTY if _is_loopback(port) else REMOTE_NET_UNCERTAINTY
+
+
+def _serial_line(raw: serial.SerialBase, port: str):
+    # a pseudo-terminal has no bit clock: its NUL is just a byte
+    pulse = None if _is_pty(port) else BaudPulse(raw)
+    breaker = UartBreak(raw)
+    return breaker, pulse, LOW_LATENCY_UNCERTAINTY if _low_latency(raw) else USB_UNCERTAINTY
+
+
+def _rfc2217_line(raw: serial.SerialBase, port: str):
+    return Rfc2217Break(raw), BaudPulse(raw), _net_uncertainty(port)
+
+
+def _socket_line(raw: serial.SerialBase, port: str):
+    return None, None, _net_uncertainty(port)
+
+
+def _loop_line(raw: serial.SerialBase, port: str):
+    return None, None, LOOP_UNCERTAINTY
 
 
 def open_real_link(
@@ -65,29 +96,37 @@ def open_real_link(
 ) -> Link:
     """Open ``port`` at 1200 baud 8N1 (parity in software) and wrap it in a link.
 
-    ``timing_uncertainty`` (s) only widens what the link measures; it never narrows it."""
-    from .adapter_link import is_adapter_port, open_adapter_link
+    ``timing_uncertainty`` (s) only widens what the link measures; it never narrows it. A
+    port string of a virtual-time kind (``sim``, ``exec:``) is taken as a device name here."""
+    kind = find(port)
+    if kind.info.virtual_time:
+        kind = SERIAL
+    options = PortOptions(echo.value, direction.value, timing_uncertainty)
+    return kind.open(port, options).link
 
-    if is_adapter_port(port):
-        return open_adapter_link(port, timing_uncertainty)
-    kind = port_kind(port)
-    raw = _open(port, kind, direction)
-    breaker: BreakMaker | None = None
-    pulse: BaudPulse | None = None
-    if kind == "rfc2217" or (kind == "serial" and not _is_pty(port)):
-        pulse = BaudPulse(raw)  # a pseudo-terminal has no bit clock: its NUL is just a byte
-    if kind == "serial":
-        breaker = UartBreak(raw)
-        uncertainty = USB_UNCERTAINTY
-        if _low_latency(raw):
-            uncertainty = LOW_LATENCY_UNCERTAINTY
-    elif kind == "loop":
-        uncertainty = LOOP_UNCERTAINTY
-    else:
-        if kind == "rfc2217":
-            breaker = Rfc2217Break(raw)
-        uncertainty = LOCAL_NET_UNCERTAINTY if _is_loopback(port) else REMOTE_NET_UNCERTAINTY
-    info = LinkInfo(kind=kind, can_break=breaker is not None, timing_uncertainty=uncertainty)
+
+def _pyserial_opener(info: LinkInfo, setup: LineSetup) -> Opener:
+    def open_kind(port: str, options: PortOptions) -> OpenedPort:
+        check_network_url(port)
+        echo, direction = options.modes()
+        return OpenedPort(
+            _open_link(port, info, setup, options.timing_uncertainty, echo, direction)
+        )
+
+    return open_kind
+
+
+def _open_link(
+    port: str,
+    kind: LinkInfo,
+    setup: LineSetup,
+    timing_uncertainty: float | None,
+    echo: EchoMode,
+    direction: DirectionLine,
+) -> Link:
+    raw = _open(port, kind.kind, direction)
+    breaker, pulse, uncertainty = setup(raw, port)
+    info = replace(kind, can_break=breaker is not None, timing_uncertainty=uncertainty)
     link = SerialLink(
         raw,
         info,
@@ -100,6 +139,23 @@ def open_real_link(
     if timing_uncertainty is not None:
         link.meter.widen_to = timing_uncertainty
     return link
+
+
+def check_network_url(port: str) -> None:
+    """``rfc2217://`` / ``socket://`` need HOST:PORT; pyserial's own complaint about a
+    missing one is a TypeError from deep inside it."""
+    scheme = port.split("://", 1)[0].lower() if "://" in port else ""
+    if scheme not in ("rfc2217", "socket"):
+        return
+    parts = urlsplit(port)
+    try:
+        number = parts.port
+    except ValueError:
+        number = None
+    if not parts.hostname or number is None:
+        raise PortError(
+            f"port {port!r}: write {scheme}://HOST:PORT, e.g. {scheme}://127.0.0.1:4001"
+        )
 
 
 def _open(port: str, kind: str, direction: DirectionLine = DirectionLine.NONE) -> serial.SerialBase:
@@ -120,7 +176,7 @@ def _open(port: str, kind: str, direction: DirectionLine = DirectionLine.NONE) -
             raw.dtr = False
         raw.open()
     except (serial.SerialException, OSError, ValueError, NotImplementedError) as exc:
-        raise PortUnavailable(_explain(port, kind, exc)) from exc
+        raise PortUnavailable(explain_open_failure(port, kind, exc)) from exc
     return raw
 
 
@@ -142,31 +198,51 @@ def _low_latency(raw: serial.SerialBase) -> bool:
     return True
 
 
-def _explain(port: str, kind: str, exc: BaseException) -> str:
-    """One message that says what went wrong and what to try."""
-    code = getattr(exc, "errno", None)
-    text = str(exc)
-    if kind in ("rfc2217", "socket"):
-        return (
-            f"cannot connect to {port}: {text}. Is the server running and listening there "
-            "(for the emulator: sdi12-conform emulate --listen HOST:PORT)?"
-        )
-    if code == errno.ENOENT or "No such file" in text or "FileNotFoundError" in text:
-        return (
-            f"serial port {port} does not exist. Check the cable and the device name "
-            "(Linux: ls /dev/ttyUSB* /dev/ttyACM*; Windows: COMn in Device Manager), "
-            "or run against the built-in simulated sensor with --port sim"
-        )
-    if code == errno.EACCES or "Permission denied" in text:
-        return (
-            f"permission denied on serial port {port}. Add your user to the group that owns "
-            "it (Linux: sudo usermod -aG dialout $USER, then log in again)"
-        )
-    if code == errno.ENOTTY or "Inappropriate ioctl" in text:  # pyserial hides the errno
-        return (
-            f"{port} is not a serial device (a regular file?): pass a serial port such as "
-            "/dev/ttyUSB0 or COM3"
-        )
-    if code == errno.EBUSY or "busy" in text.lower():
-        return f"serial port {port} is busy: close the other program using it"
-    return f"cannot open port {port}: {text}"
+
+
+def _kind(
+    name: str, setup: LineSetup, info: LinkInfo, example: str, *, fallback: bool = False
+) -> LinkKind:
+    return LinkKind(
+        name,
+        matches=scheme_is(name),
+        open=_pyserial_opener(info, setup),
+        info=info,
+        example=example,
+        fallback=fallback,
+    )
+
+
+_PYSERIAL = tuple(
+    register(kind)
+    for kind in (
+        _kind(
+            "rfc2217",
+            _rfc2217_line,
+            LinkInfo("rfc2217", timing_uncertainty=REMOTE_NET_UNCERTAINTY),
+            "rfc2217://127.0.0.1:4001",
+        ),
+        _kind(
+            "socket",
+            _socket_line,
+            LinkInfo("socket", can_break=False, timing_uncertainty=REMOTE_NET_UNCERTAINTY),
+            "socket://127.0.0.1:4001",
+        ),
+        _kind(
+            "loop",
+            _loop_line,
+            LinkInfo("loop", can_break=False, timing_uncertainty=LOOP_UNCERTAINTY),
+            "loop://",
+        ),
+        # a device name, or any other pyserial URL (spy://, hwgrep://, alt://)
+        _kind(
+            "serial",
+            _serial_line,
+            LinkInfo("serial", timing_uncertainty=USB_UNCERTAINTY),
+            "/dev/ttyUSB0",
+            fallback=True,
+        ),
+    )
+)
+RFC2217, SOCKET, LOOP, SERIAL = _PYSERIAL
+ADAPTER = adapter_link.KIND  # registered by its own module, opened through pyserial too

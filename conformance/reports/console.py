@@ -19,6 +19,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from rich.text import Text
 
+from ..stash import CASE
+
 STYLE = {
     "PASS": "green",
     "FAIL": "bold red",
@@ -82,8 +84,6 @@ class ProgressPlugin:
     @pytest.hookimpl(wrapper=True)
     def pytest_runtest_makereport(self, item: pytest.Item, call: pytest.CallInfo) -> Any:
         report = yield
-        from ..plugin import CASE
-
         record = item.stash.get(CASE, None)
         if report.when == "call" and record is not None:
             self.outcomes[item.nodeid] = _case_outcome(record)

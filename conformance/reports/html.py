@@ -18,9 +18,11 @@ from typing import Any
 
 import pytest
 
+from ..catalog import requirement
 from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..root_causes import reading_order
 from ..run import TOOL, ConformanceRun
+from ..stash import CASE
 from ..transcript import TOOL as TOOL_ORIGIN
 from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
@@ -30,8 +32,6 @@ from .verdicts_json import dut_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
-TIMING_MODULES = ("test_7_timing", "test_9_whole_run")
-
 STYLE = """
 <style>
 #sdi12-top,#sdi12-top p,.sdi12,.sdi12-case{color:#222}
@@ -414,10 +414,11 @@ def _group(events: list[Event]) -> list[list[Event]]:
 
 
 def is_timing_case(record: CaseRecord) -> bool:
-    """Cases of section 7 / the whole-run timing module, or any case with a measured time."""
-    module = record.nodeid.split("::")[0].removesuffix(".py").replace("/", ".")
+    """A case that judges a requirement the catalog checks by timing (its Check column), or
+    that measured a time: its evidence is drawn as a timing diagram. Where the case is
+    written (its module's name) does not matter."""
     return any(f.measured_ms is not None for f in record.findings) or any(
-        module.rsplit(".", 1)[-1] == m for m in TIMING_MODULES
+        "timing" in requirement(rid).check for rid in record.requirements
     )
 
 
@@ -504,8 +505,6 @@ class HtmlReportPlugin:
     @pytest.hookimpl(wrapper=True)
     def pytest_runtest_makereport(self, item: Any, call: Any):
         report = yield
-        from ..plugin import CASE
-
         record = item.stash.get(CASE, None)
         if record is not None and report.when == "call":
             from pytest_html import extras

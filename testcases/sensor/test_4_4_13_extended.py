@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import exchanges as xjudge
 from conformance.judges import extended as judge
 
 requirements = pytest.mark.requirements
@@ -51,4 +50,3 @@ def test_multiline_text(sensor, case):
         return
     case.evidence("multi-line replies", multi)
     case.extend(judge.multiline(multi, sensor.address, sensor.uncertainty))
-    _ = xjudge

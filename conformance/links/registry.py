@@ -1,0 +1,119 @@
+"""The kinds of link a ``--port`` string can name, each with its opener and capabilities.
+
+A kind of link is one module that calls :func:`register` when it is imported: a
+:class:`LinkKind` saying which port strings it takes, what its links can do at best
+(:class:`~conformance.links.base.LinkInfo`) and how to open one. :mod:`conformance.ports`
+imports every built-in kind module, so ``open_port`` sees them all; nothing else chooses
+between kinds. This is python-can's interface table (``can.interfaces.BACKENDS``: a name ->
+the module and class that open it) keyed by the port string instead of a name, because
+SDI-12 benches are named by device paths (``COM3``, ``/dev/ttyUSB0``) as often as by URLs.
+
+Exactly one kind may be the *fallback*: the one a port string belongs to when no other kind
+claims it (a serial device name, or a pyserial URL such as ``spy://`` or ``hwgrep://``).
+Every other port string must be claimed by exactly one kind; two claims are a bug in the
+kinds, found when the port is looked up.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from ..declaration import Declaration
+from .base import Link, LinkInfo
+from .direction import DirectionLine
+from .echo import EchoMode
+from .errors import PortError
+
+
+@dataclass(frozen=True)
+class PortOptions:
+    """What the user said about the bench besides the port (the CLI's --echo, --direction
+    and --timing-uncertainty-ms). Kinds without a real interface ignore them."""
+
+    echo: str = "auto"  # auto, on, off: does the interface echo the tool's own characters
+    direction: str = "none"  # none, rts, dtr: the line that enables the tool's driver
+    timing_uncertainty: float | None = None  # s: only ever widens what the link measures
+
+    def modes(self) -> tuple[EchoMode, DirectionLine]:
+        """``echo`` and ``direction`` for a real interface; PortError if either is unknown."""
+        try:
+            return EchoMode(self.echo), DirectionLine(self.direction)
+        except ValueError as exc:
+            raise PortError(
+                f"{exc}: --echo is auto, on or off; --direction is rts, dtr or none"
+            ) from exc
+
+
+@dataclass
+class OpenedPort:
+    """An opened port: the link, the simulated devices behind it (if the tool made them) and
+    what a simulated device declares about itself."""
+
+    link: Link
+    devices: list[object] = field(default_factory=list)
+    declaration: Declaration | None = None
+
+
+#: Opens ``port`` for the sensor role (the tool is the recorder); raises
+#: :class:`~conformance.links.errors.PortError` for a string it cannot use.
+Opener = Callable[[str, PortOptions], OpenedPort]
+
+
+@dataclass(frozen=True)
+class LinkKind:
+    """One kind of link: which port strings name it, what it can do, how it opens."""
+
+    name: str  # the LinkInfo.kind of the links it opens
+    matches: Callable[[str], bool]  # does this port string name a link of this kind
+    open: Opener
+    info: LinkInfo  # what its links can do at best; an opener may only take away from it
+    example: str  # a port string of this kind, for documentation and tests
+    fallback: bool = False  # takes every port string no other kind claims
+
+
+_KINDS: dict[str, LinkKind] = {}
+
+
+def register(kind: LinkKind) -> LinkKind:
+    """Add ``kind`` (its module calls this on import); a second kind of the same name, or a
+    second fallback, is a programming error."""
+    if kind.name in _KINDS and _KINDS[kind.name] != kind:
+        raise ValueError(f"link kind {kind.name!r} is registered twice")
+    if kind.fallback and any(k.fallback and k.name != kind.name for k in _KINDS.values()):
+        raise ValueError(f"link kind {kind.name!r}: there is a fallback kind already")
+    _KINDS[kind.name] = kind
+    return kind
+
+
+def kinds() -> tuple[LinkKind, ...]:
+    """Every registered kind, in registration order."""
+    return tuple(_KINDS.values())
+
+
+def kind_named(name: str) -> LinkKind:
+    return _KINDS[name]
+
+
+def find(port: str) -> LinkKind:
+    """The kind ``port`` names: the one kind that claims it, else the fallback."""
+    claims = [k for k in _KINDS.values() if not k.fallback and k.matches(port)]
+    if len(claims) > 1:
+        names = ", ".join(k.name for k in claims)
+        raise ValueError(f"port {port!r} is claimed by several link kinds: {names}")
+    if claims:
+        return claims[0]
+    for kind in _KINDS.values():
+        if kind.fallback:
+            return kind
+    raise PortError(f"no kind of link takes port {port!r}")
+
+
+def scheme_of(port: str) -> str:
+    """``rfc2217`` for ``RFC2217://host:4001``; empty for a device name (``COM3``)."""
+    return port.split("://", 1)[0].lower() if "://" in port else ""
+
+
+def scheme_is(scheme: str) -> Callable[[str], bool]:
+    """A matcher for the URLs of one scheme (case-insensitive, as pyserial reads them)."""
+    return lambda port: scheme_of(port) == scheme

@@ -1,0 +1,227 @@
+"""The run's options, spelled once: the command line and the pytest plugin register from here.
+
+Each :class:`Option` holds what both need: the name (``--echo`` on the command line,
+``--sdi12-echo`` in pytest), type, default, choices, help and the check that refuses a value
+the tool cannot use. ``sdi12-conform`` hands its values on to pytest with :func:`pytest_args`,
+and the plugin reads them back into :class:`~conformance.run.RunOptions` with
+:func:`run_option_values`, so an option added to :data:`OPTIONS` reaches the run on both
+paths. Imported by ``sdi12-conform --help``: nothing heavy here.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from .declaration import address_problem
+
+ROLES = ("sensor", "recorder")
+
+
+class UsageError(ValueError):
+    """A setting the tool cannot use; the message says what to do instead."""
+
+
+def check_address(text: str | None, where: str = "--address") -> None:
+    """An invalid address would go onto the bus (``00I!``) and look like a silent device."""
+    problem = None if text is None else address_problem(text)
+    if problem:
+        raise UsageError(f"{where}: {problem}")
+
+
+def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") -> None:
+    """A stamp uncertainty is a non-negative width; a negative one would tighten every limit."""
+    if ms is not None and not ms >= 0:  # `not >=` also rejects NaN
+        raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
+
+
+_UNSET = object()
+
+
+@dataclass(frozen=True)
+class Option:
+    """One option of a conformance run, for both the command line and pytest."""
+
+    name: str  # the command line's, without dashes: "sdi-version" -> --sdi-version
+    field: str  # the RunOptions attribute it sets
+    help: str
+    default: Any = None
+    choices: tuple[str, ...] | None = None
+    type: Callable[[str], Any] | None = None
+    flag: bool = False  # store_true
+    repeat: bool = False  # append: given once per value
+    metavar: str | None = None
+    plugin_name: str | None = None  # pytest's name without "--sdi12-", if not ``name``
+    plugin_help: str | None = None  # where pytest's wording must differ (its default)
+    cli_default: Any = _UNSET  # the command line's default, if not ``default``
+    check: Callable[[Any, str], None] | None = None  # (value, option as typed): UsageError
+
+    @property
+    def cli_flag(self) -> str:
+        return f"--{self.name}"
+
+    @property
+    def plugin_flag(self) -> str:
+        return f"--sdi12-{self.plugin_name or self.name}"
+
+    @property
+    def plugin_dest(self) -> str:
+        return self.plugin_flag.removeprefix("--").replace("-", "_")
+
+    @property
+    def cli_dest(self) -> str:
+        return self.name.replace("-", "_")
+
+    def _kwargs(self, default: Any) -> dict[str, Any]:
+        if self.flag:
+            return {"action": "store_true", "default": bool(default)}
+        kwargs: dict[str, Any] = {"default": [] if self.repeat else default}
+        if self.repeat:
+            kwargs["action"] = "append"
+        for key in ("choices", "type", "metavar"):
+            if getattr(self, key) is not None:
+                kwargs[key] = getattr(self, key)
+        return kwargs
+
+    def add_to_cli(self, parser: argparse.ArgumentParser) -> None:
+        default = self.default if self.cli_default is _UNSET else self.cli_default
+        parser.add_argument(self.cli_flag, help=self.help, **self._kwargs(default))
+
+    def add_to_pytest(self, group: Any) -> None:
+        group.addoption(
+            self.plugin_flag, help=self.plugin_help or self.help, **self._kwargs(self.default)
+        )
+
+
+OPTIONS: tuple[Option, ...] = (
+    Option(
+        "port",
+        "port",
+        "a serial port (/dev/ttyUSB0, COM3), a pyserial URL (rfc2217://HOST:PORT), "
+        "'exec:PROGRAM ARGS' or unix:PATH (a harness, docs/harness-protocol.md), "
+        "replay:PATH (a saved run played back), or "
+        "sim / sim://?faults=a,b&version=1.3 for the built-in simulated device "
+        "(default: sim, said loudly when used)",
+        default="sim",
+        cli_default=None,  # the command line says loudly that it judges the simulated device
+    ),
+    Option(
+        "role",
+        "role",
+        "what the device under test is; the tool plays the other side (default: sensor)",
+        default="sensor",
+        choices=ROLES,
+    ),
+    Option(
+        "address",
+        "address",
+        "DUT address (default: the declaration, else ask with ?!)",
+        check=check_address,
+    ),
+    Option(
+        "sdi-version",
+        "version",
+        "force the rule set, 1.3 or 1.4 (default: from aI!)",
+        plugin_name="version",
+    ),
+    Option("declaration", "declaration", "TOML file declaring the DUT's address and features"),
+    Option(
+        "report-dir",
+        "report_dir",
+        "output folder (default: reports/<date>-<role>)",
+        plugin_help="where verdicts.json, report.html and the transcript go "
+        "(default: reports/<date>-<role>)",
+    ),
+    Option("strict", "strict", "WARN (SHOULD violations) fails too", flag=True),
+    Option(
+        "timing-uncertainty-ms",
+        "timing_uncertainty_ms",
+        "widen the timestamp uncertainty the link measures (it can never narrow it)",
+        type=float,
+        check=check_uncertainty,
+    ),
+    Option(
+        "echo",
+        "echo",
+        "real links: does the interface echo the tool's own characters "
+        "(default auto: found out on the first transmission)",
+        default="auto",
+        choices=("auto", "on", "off"),
+    ),
+    Option(
+        "direction",
+        "direction",
+        "real links: raise this line for exactly the tool's transmissions "
+        "(an RS-485-style transceiver's driver enable)",
+        default="none",
+        choices=("none", "rts", "dtr"),
+    ),
+    Option(
+        "trigger",
+        "trigger",
+        "recorder role: shell command run per scenario with the request in SDI12_* "
+        "environment variables, or 'interactive' to prompt an operator",
+    ),
+    Option(
+        "req",
+        "requirements",
+        "a partial run: only cases judging this requirement ID (R-4.4.6-02) or clause "
+        "(4.4.12); repeatable",
+        repeat=True,
+        metavar="ID_OR_CLAUSE",
+    ),
+)
+
+#: What ``sdi12-conform`` passes to pytest through the suite's own arguments instead.
+PASSED_BY_SUITE = ("port", "role", "report-dir")
+
+
+def add_cli_options(parser: argparse.ArgumentParser, names: Iterable[str]) -> None:
+    """Add the named options (in that order) to the command line's parser."""
+    by_name = {o.name: o for o in OPTIONS}
+    for name in names:
+        by_name[name].add_to_cli(parser)
+
+
+def add_pytest_options(group: Any) -> None:
+    for option in OPTIONS:
+        option.add_to_pytest(group)
+
+
+def check_values(values: dict[str, Any], *, plugin: bool) -> None:
+    """Run each option's own check on ``values`` (RunOptions field -> value)."""
+    for option in OPTIONS:
+        if option.check is not None:
+            where = option.plugin_flag if plugin else option.cli_flag
+            option.check(values.get(option.field), where)
+
+
+def pytest_args(args: argparse.Namespace) -> list[str]:
+    """The command line's values as the plugin's options, for the pytest run it starts."""
+    out: list[str] = []
+    for option in OPTIONS:
+        if option.name in PASSED_BY_SUITE:
+            continue
+        value = getattr(args, option.cli_dest)
+        if option.flag:
+            out += [option.plugin_flag] if value else []
+        elif option.repeat:
+            for each in value:
+                out += [option.plugin_flag, str(each)]
+        elif value is not None and value != "":
+            out += [option.plugin_flag, str(value)]
+    return out
+
+
+def cli_values(args: argparse.Namespace) -> dict[str, Any]:
+    """RunOptions field -> value, from the command line's parsed arguments."""
+    return {option.field: getattr(args, option.cli_dest) for option in OPTIONS}
+
+
+def run_option_values(getoption: Callable[[str], Any]) -> dict[str, Any]:
+    """RunOptions field -> value, read from pytest's parsed options."""
+    values = {option.field: getoption(option.plugin_dest) for option in OPTIONS}
+    values["requirements"] = tuple(values["requirements"] or ())
+    return values
