@@ -10,6 +10,7 @@ after the scenario (:data:`OUTPUT_NOTE`).
 
 from __future__ import annotations
 
+import bisect
 import json
 from typing import Any
 
@@ -48,25 +49,32 @@ class RecordedRecorder:
         # per scenario: when it began, what the recorder sent, its account, when it was done
         self.slices: dict[str, tuple[float, list[Event], dict[str, Any] | None]] = {}
         self.done: dict[str, float] = {}
-        current: str | None = None
-        start = 0.0
+        begins: list[tuple[float, str]] = []
         for e in events:
-            if e.kind is EventKind.NOTE and e.text.startswith(SCENARIO_NOTE):
-                name = e.text[len(SCENARIO_NOTE) :].split(":", 1)[0].split(" ", 1)[0]
-                if ":" in e.text:  # "scenario NAME: ..." starts one ("... done; ..." ends it)
-                    current, start = name, e.start
-                    self.slices[name] = (start, [], None)
+            if e.kind is not EventKind.NOTE:
                 continue
-            if e.kind is EventKind.NOTE and e.text.startswith(OUTPUT_NOTE):
+            if e.text.startswith(SCENARIO_NOTE) and ":" in e.text:
+                # "scenario NAME: ..." starts one ("scenario NAME done; ..." ends it)
+                name = e.text[len(SCENARIO_NOTE) :].split(":", 1)[0].split(" ", 1)[0]
+                begins.append((e.start, name))
+                self.slices[name] = (e.start, [], None)
+            elif e.text.startswith(OUTPUT_NOTE):
                 found = json.loads(e.text[len(OUTPUT_NOTE) :])
                 name = found.get("scenario")
                 if name in self.slices:
                     begun, sent, _ = self.slices[name]
                     self.slices[name] = (begun, sent, found)
                     self.done[name] = e.start
+        # a decoded capture stamps a scenario's first break within a sample of its note, on
+        # either side: an event belongs to the scenario begun by then, give or take that
+        slack = 2 * max((e.uncertainty for e in events), default=0.0) + 1e-6
+        starts = [t for t, _ in begins]
+        for e in events:
+            if e.kind is EventKind.NOTE or e.origin != TOOL:
                 continue
-            if current is not None and e.kind is not EventKind.NOTE and e.origin == TOOL:
-                self.slices[current][1].append(e)
+            i = bisect.bisect_right(starts, e.start + slack) - 1
+            if i >= 0:
+                self.slices[begins[i][1]][1].append(e)
 
     def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
         if scenario not in self.slices:
