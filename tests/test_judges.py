@@ -150,11 +150,12 @@ def test_bit_rate_too_fast_fails_but_slow_is_never_guessed():
         Event(EventKind.CHAR, DUT, t0 + i * 7.7e-3, t0 + (i + 1) * 7.7e-3, wire=0x30)
         for i in range(4)
     ]
-    assert wire.judge_bit_rate(wire.segments(transcript_of(fast)), 0.0).verdict is Verdict.FAIL
+    fast_segs = wire.segments(transcript_of(fast))
+    assert wire.judge_reply_bit_rate(fast_segs, 0.0).verdict is Verdict.FAIL
     gapped = exchange("0!", "", 0.0)
     gapped.attempts[0].reply_events = chars("0123", gapped.last.command_end + 9e-3, DUT, gap=1e-3)
     assert (
-        wire.judge_bit_rate(wire.segments(transcript_of(gapped)), 0.0).verdict
+        wire.judge_reply_bit_rate(wire.segments(transcript_of(gapped)), 0.0).verdict
         is Verdict.INCONCLUSIVE
     )
 

@@ -3,11 +3,18 @@ the deviation it exists for (a judge that cannot fail is a defect)."""
 
 from __future__ import annotations
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
+from conformance.judges.recorder.capabilities import judge_addresses, judge_transparent
+from conformance.judges.recorder.collection import judge_data_collection
+from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
+from conformance.judges.recorder.measurements import observed_measurements
+from conformance.judges.recorder.retries import judge_crc_checked, judge_retries
+from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.protocol.crc import ascii_crc
 from conformance.protocol.timing import CHAR_TIME
 from conformance.transcript import TOOL, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Verdict
+from conformance.view.segments import TranscriptView, read_view
 
 
 class Wire:
@@ -41,8 +48,8 @@ class Wire:
         self.t += ms / 1e3
         return self
 
-    def line(self) -> judge.Line:
-        return judge.read_line(self.events)
+    def line(self) -> TranscriptView:
+        return read_view(self.events)
 
 
 def by_id(findings):
@@ -51,46 +58,46 @@ def by_id(findings):
 
 def test_breaks_and_marking():
     good = Wire().brk().rec("0!").sensor("0\r\n").line()
-    assert {f.verdict for f in judge.judge_breaks(good, 0.0)} == {Verdict.PASS}
-    short = by_id(judge.judge_breaks(Wire().brk(10.0).rec("0!").line(), 0.0))
+    assert {f.verdict for f in judge_breaks(good, 0.0)} == {Verdict.PASS}
+    short = by_id(judge_breaks(Wire().brk(10.0).rec("0!").line(), 0.0))
     assert short["R-7.0-02"].verdict is Verdict.FAIL
     assert short["R-7.0-02"].measured_ms == 10.0
-    early = by_id(judge.judge_breaks(Wire().brk(13.0, 5.0).rec("0!").line(), 0.0))
+    early = by_id(judge_breaks(Wire().brk(13.0, 5.0).rec("0!").line(), 0.0))
     assert early["R-7.0-06"].verdict is Verdict.FAIL
     # a 12 ms break stamped with ±1 ms cannot be told from an 11 ms one
-    unsure = by_id(judge.judge_breaks(Wire().brk(12.0).rec("0!").line(), 1e-3))
+    unsure = by_id(judge_breaks(Wire().brk(12.0).rec("0!").line(), 1e-3))
     assert unsure["R-7.0-02"].verdict is Verdict.INCONCLUSIVE
 
 
 def test_command_text():
-    found = by_id(judge.judge_command_text(Wire().brk().rec("0M!").line()))
+    found = by_id(judge_command_text(Wire().brk().rec("0M!").line()))
     assert {f.verdict for f in found.values()} == {Verdict.PASS}
     w = Wire().brk().rec("0M!!").idle(200).brk().rec("$M!").idle(200).brk().rec("0M")
-    bad = by_id(judge.judge_command_text(w.line()))
+    bad = by_id(judge_command_text(w.line()))
     assert bad["R-4.4-04"].verdict is Verdict.FAIL
     assert "0M!!" in bad["R-4.4-04"].detail and "0M:" in bad["R-4.4-04"].detail
     assert bad["R-4.3-01"].verdict is Verdict.FAIL
-    ctrl = by_id(judge.judge_command_text(Wire().brk().rec("0\x07!").line()))
+    ctrl = by_id(judge_command_text(Wire().brk().rec("0\x07!").line()))
     assert ctrl["R-4.2-01"].verdict is Verdict.FAIL
 
 
 def test_character_gaps_have_no_tolerance():
-    ok = by_id(judge.judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.5).line(), 0.0))
+    ok = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.5).line(), 0.0))
     assert ok["R-7.0-13"].verdict is ok["R-7.0-01"].verdict is Verdict.PASS
-    lean = by_id(judge.judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.9).line(), 0.0))
+    lean = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.9).line(), 0.0))
     assert lean["R-7.0-13"].verdict is lean["R-7.0-01"].verdict is Verdict.FAIL
-    wide = by_id(judge.judge_character_gaps(Wire().brk().rec("0M!", gap_ms=3.0).line(), 0.0))
+    wide = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=3.0).line(), 0.0))
     assert wide["R-7.0-13"].verdict is Verdict.FAIL
     assert wide["R-7.0-01"].verdict is Verdict.PASS
 
 
 def test_break_needed_for_a_new_address_and_after_87_ms():
     ok = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("0I!").line()
-    assert by_id(judge.judge_break_rules(ok, 0.0))["R-7.0-17"].verdict is Verdict.PASS
+    assert by_id(judge_break_rules(ok, 0.0))["R-7.0-17"].verdict is Verdict.PASS
     new = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("1!").line()
-    assert by_id(judge.judge_break_rules(new, 0.0))["R-7.0-17"].verdict is Verdict.FAIL
+    assert by_id(judge_break_rules(new, 0.0))["R-7.0-17"].verdict is Verdict.FAIL
     late = Wire().brk().rec("0!").sensor("0\r\n").idle(95).rec("0I!").line()
-    found = by_id(judge.judge_break_rules(late, 0.0))["R-7.0-17"]
+    found = by_id(judge_break_rules(late, 0.0))["R-7.0-17"]
     assert found.verdict is Verdict.FAIL and found.measured_ms == 95.0
 
 
@@ -102,11 +109,11 @@ def _measurement(wire: Wire, address: str = "0", code: str = "M") -> Wire:
 def test_no_traffic_to_other_sensors_during_a_measurement():
     w = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(9).rec("0D0!")
     w.sensor("0+1+2+3\r\n")
-    taken = judge.measurements(w.line(), 0.0)
-    assert by_id(judge.judge_measure_waits(taken, 0.0))["R-4.4.5-06"].verdict is Verdict.PASS
+    taken = observed_measurements(w.line(), 0.0)
+    assert by_id(judge_measure_waits(taken, 0.0))["R-4.4.5-06"].verdict is Verdict.PASS
     w = _measurement(Wire()).idle(100).brk().rec("1!").sensor("1\r\n", origin="sensor1")
     w.idle(400).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge.judge_measure_waits(judge.measurements(w.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(w.line(), 0.0), 0.0))
     assert found["R-4.4.5-06"].verdict is Verdict.FAIL
     # the recorder also took the line while the service request could still come
     assert found["R-4.4.5-07"].verdict is Verdict.FAIL
@@ -114,11 +121,11 @@ def test_no_traffic_to_other_sensors_during_a_measurement():
 
 def test_d0_before_ttt_and_late_reaction():
     early = _measurement(Wire()).idle(500).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge.judge_measure_waits(judge.measurements(early.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(early.line(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.FAIL
     slow = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(900)
     slow.brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge.judge_measure_waits(judge.measurements(slow.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(slow.line(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.PASS
     assert found["R-4.4.5-05"].verdict is Verdict.FAIL
 
@@ -126,35 +133,35 @@ def test_d0_before_ttt_and_late_reaction():
 def test_empty_reply_must_lead_to_the_measurement_again():
     w = _measurement(Wire()).idle(1100).brk().rec("0D0!").sensor("0\r\n").idle(9).rec("0I!")
     w.sensor("014CONFORM EMU001100\r\n")
-    found = judge.judge_data_collection(judge.measurements(w.line(), 0.0))
+    found = judge_data_collection(observed_measurements(w.line(), 0.0))
     assert found[0].verdict is Verdict.FAIL and "not issued again" in found[0].detail
     w = _measurement(Wire()).idle(1100).brk().rec("0D0!").sensor("0\r\n").idle(9).rec("0M!")
     w.sensor("00013\r\n").idle(1100).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    assert judge.judge_data_collection(judge.measurements(w.line(), 0.0))[0].verdict is Verdict.PASS
+    assert judge_data_collection(observed_measurements(w.line(), 0.0))[0].verdict is Verdict.PASS
 
 
 def test_retry_windows_and_waiting_for_the_invalid_reply():
     early = Wire().brk().rec("0!").idle(12).rec("0!").sensor("0\r\n").line()
-    assert by_id(judge.judge_retries(early, 0.0))["R-7.2-02"].verdict is Verdict.FAIL
+    assert by_id(judge_retries(early, 0.0))["R-7.2-02"].verdict is Verdict.FAIL
     good = Wire().brk().rec("0!").idle(45).rec("0!").sensor("0\r\n").line()
-    found = by_id(judge.judge_retries(good, 0.0))
+    found = by_id(judge_retries(good, 0.0))
     assert found["R-7.2-02"].verdict is found["R-7.2-01"].verdict is Verdict.PASS
     # a long reply with a parity error; the retry starts before that reply ended
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n", parity=False)
     w.t -= 30e-3  # the retry starts while the last characters are still coming
     talked_over = w.rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").line()
-    assert by_id(judge.judge_retries(talked_over, 0.0))["R-7.2-06"].verdict is Verdict.FAIL
+    assert by_id(judge_retries(talked_over, 0.0))["R-7.2-06"].verdict is Verdict.FAIL
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n", parity=False).idle(25)
     waited = w.rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").line()
-    assert by_id(judge.judge_retries(waited, 0.0))["R-7.2-06"].verdict is Verdict.PASS
+    assert by_id(judge_retries(waited, 0.0))["R-7.2-06"].verdict is Verdict.PASS
 
 
 def test_gave_up_too_soon():
     w = Wire().brk().rec("0!").idle(45).rec("0!").idle(45).rec("0!").idle(300)
-    found = by_id(judge.judge_retries(w.line(), 0.0))
+    found = by_id(judge_retries(w.line(), 0.0))
     assert found["R-7.2-04"].verdict is Verdict.WARN  # one sequence of three, not three
     assert found["R-7.2-03"].verdict is Verdict.PASS  # two retries, the last after 100 ms
-    once = by_id(judge.judge_retries(Wire().brk().rec("0!").idle(300).line(), 0.0))
+    once = by_id(judge_retries(Wire().brk().rec("0!").idle(300).line(), 0.0))
     assert once["R-7.2-01"].verdict is once["R-7.2-03"].verdict is Verdict.FAIL
 
 
@@ -164,23 +171,23 @@ def test_crc_mismatch_must_be_retried():
     w = _measurement(Wire(), code="MC").sensor("0\r\n", delay_ms=200).idle(9).rec("0D0!")
     w.sensor(wrong + "\r\n")
     line = w.line()
-    found = judge.judge_crc_checked(line, 0.0, None, [])
+    found = judge_crc_checked(line, 0.0, None, [])
     assert found[0].verdict is Verdict.FAIL
-    found = judge.judge_crc_checked(line, 0.0, {"0MC!": ["+1", "+3"]}, ["+1", "+2"])
+    found = judge_crc_checked(line, 0.0, {"0MC!": ["+1", "+3"]}, ["+1", "+2"])
     assert found[0].verdict is Verdict.FAIL
 
 
 def test_transparent_commands_pass_unchanged():
     w = Wire().brk().rec("0XSN!").sensor("0EMU\r\n")
-    found = by_id(judge.judge_transparent(w.line(), ["0XSN!"], 0.0, {"0XSN!": "0EMU\r\n"}))
+    found = by_id(judge_transparent(w.line(), ["0XSN!"], 0.0, {"0XSN!": "0EMU\r\n"}))
     assert found["R-4.4.14-01"].verdict is found["R-4.4.14-02"].verdict is Verdict.PASS
     assert found["R-4.4.13-03"].verdict is Verdict.PASS
     assert found["R-6.3-01"].verdict is Verdict.INCONCLUSIVE  # no metadata command was asked
     changed = Wire().brk().rec("0XSN1!").sensor("0EMU\r\n").line()
-    found = by_id(judge.judge_transparent(changed, ["0XSN!"], 0.0, None))
+    found = by_id(judge_transparent(changed, ["0XSN!"], 0.0, None))
     assert found["R-4.4.14-02"].verdict is found["R-4.4.13-03"].verdict is Verdict.FAIL
     unbroken = Wire().rec("0XSN!").sensor("0EMU\r\n").line()
-    found = by_id(judge.judge_transparent(unbroken, ["0XSN!"], 0.0, {"0XSN!": "0EM\r\n"}))
+    found = by_id(judge_transparent(unbroken, ["0XSN!"], 0.0, {"0XSN!": "0EM\r\n"}))
     assert found["R-4.4.14-01"].verdict is Verdict.FAIL
 
 
@@ -188,6 +195,6 @@ def test_addresses():
     w = Wire()
     for a in "012345678":
         w.brk().rec(f"{a}!").sensor(f"{a}\r\n", origin=f"sensor{a}").idle(20)
-    found = by_id(judge.judge_addresses(w.line(), 0.0))
+    found = by_id(judge_addresses(w.line(), 0.0))
     assert found["R-4.3-03"].verdict is Verdict.FAIL and "9" in found["R-4.3-03"].detail
     assert found["R-4.3-04"].verdict is Verdict.NA

@@ -18,7 +18,7 @@ import pytest
 
 from conformance.cli import main
 from conformance.emulator_server.realtime import LATE_NOTICE
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.retries import judge_retries
 from conformance.recorder.drivers import Trigger
 from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.recorder.session import RecorderSession
@@ -109,7 +109,7 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
     session = RecorderSession(SERVE, driver=trigger)
     try:
         record = session.run("silent-twice")
-        findings = judge.judge_retries(session.line("silent-twice"), session.uncertainty)
+        findings = judge_retries(session.line("silent-twice"), session.uncertainty)
     finally:
         session.close()
     assert record.error is None, record.error

@@ -1,26 +1,26 @@
-"""Judges over the whole transcript: response timing, character gaps, framing of every reply.
+"""Sensor-role judges over the whole transcript: response timing, character gaps, framing of
+every reply, the sensors' bit rate.
 
-The transcript is cut into segments: a command the tool sent (with the break before it, if
-any), the DUT's reply to it (the run of characters that starts soon after the command), and
-anything the DUT sent later before the tool spoke again (service requests, chatter).
+They read the shared view (:mod:`conformance.view`): each transmission of the recorder, cut
+for timing evidence into the sensor's reply (the run of characters that starts soon after the
+command) and anything it sent later before the recorder spoke again (service requests,
+chatter) (:class:`~conformance.view.runs.Segment`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from dataclasses import dataclass, field
-
-from ..protocol.commands import CommandError, Kind, parse_command
+from ..protocol.responses import split_line
 from ..protocol.timing import (
     CHAR_TIME,
     INTER_CHAR_GAP_MAX,
-    NO_BREAK_WINDOW,
     RESPONSE_START_MAX,
-    RESPONSE_START_MIN,
     TOLERANCE,
 )
-from ..transcript import TOOL, Event, EventKind, escape
+from ..transcript import Event, escape
 from ..verdicts import Finding, Verdict
+from ..view.runs import Segment, runs, segments
+from ..view.segments import expected_reply_address
+from .tally import Tally
 from .timing import (
     StampUncertainty,
     combine_local,
@@ -29,96 +29,18 @@ from .timing import (
     sustained,
 )
 
-REPLY_SEARCH = NO_BREAK_WINDOW  # a DUT run starting later than this is not a reply
-RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
-LINE_RUN_GAP = 1.0  # a late next line of multi-line text still belongs to its reply
-
-
-@dataclass
-class Segment:
-    break_event: Event | None
-    command: list[Event]
-    reply: list[Event] = field(default_factory=list)
-    later: list[Event] = field(default_factory=list)
-    contention: list[Event] = field(default_factory=list)  # DUT talked over the command
-    text: str = ""  # the command as text, filled in by :func:`segments`
-    binary_reply: bool = False  # replies to aDBn! are 8N1 packets (no 7E1, no CR LF)
-
-    @property
-    def command_end(self) -> float:
-        return self.command[-1].end
-
-    @property
-    def multiline(self) -> bool:
-        """A reply starting ``a<STX>`` is multi-line text (decision A10)."""
-        return len(self.reply) > 1 and self.reply[1].char7 == 0x02
-
-
-def _is_binary_data(text: str) -> bool:
-    try:
-        return parse_command(text).kind is Kind.BINARY_DATA
-    except CommandError:
-        return False
-
-
-def segments(events: Iterable[Event]) -> list[Segment]:
-    result: list[Segment] = []
-    pending_break: Event | None = None
-    current: Segment | None = None
-    for e in events:
-        if e.kind is EventKind.NOTE:
-            continue
-        if e.origin == TOOL:
-            if e.kind is EventKind.BREAK:
-                pending_break, current = e, None
-                continue
-            if current is None or current.reply or current.later or current.text.endswith("!"):
-                current = Segment(pending_break, [e], text=chr(e.char7))
-                result.append(current)
-                pending_break = None
-            else:
-                current.command.append(e)
-                current.text += chr(e.char7)
-            current.binary_reply = current.text.endswith("!") and _is_binary_data(current.text)
-            continue
-        if current is None:
-            continue  # DUT chatter before any command
-        if not current.text.endswith("!") or e.start < current.command_end:
-            current.contention.append(e)  # not a reply: it overlapped the command
-            continue
-        _place_dut_char(current, e)
-    return result
-
-
-def _place_dut_char(seg: Segment, e: Event) -> None:
-    if seg.later:
-        seg.later.append(e)
-        return
-    if not seg.reply:
-        if e.start - seg.command_end <= REPLY_SEARCH:
-            seg.reply.append(e)
-        else:
-            seg.later.append(e)
-        return
-    last = seg.reply[-1]
-    ended = not seg.binary_reply and last.char7 == 0x0A and not seg.multiline
-    # the next line of multi-line text may come late (R-4.4.13.1-03 judges how late)
-    allowed = LINE_RUN_GAP if seg.multiline and last.char7 == 0x0A else RUN_GAP
-    if ended or e.start - last.end > allowed:
-        seg.later.append(e)
-    else:
-        seg.reply.append(e)
-
-
-def runs(events: list[Event]) -> list[list[Event]]:
-    """Split DUT characters into runs separated by more than :data:`RUN_GAP` of marking."""
-    out: list[list[Event]] = []
-    for e in events:
-        if out and e.start - out[-1][-1].end <= RUN_GAP:
-            out[-1].append(e)
-        else:
-            out.append([e])
-    return out
+# The cut these judges read lives in the shared view; re-exported for the timing diagram
+# (reports/) and the sensor measurement judges, which import it from here.
+__all__ = [
+    "Segment",
+    "judge_framing",
+    "judge_gaps",
+    "judge_reply_bit_rate",
+    "judge_response_start",
+    "reply_gaps",
+    "runs",
+    "segments",
+]
 
 
 # -- timing ---------------------------------------------------------------------------------
@@ -163,7 +85,6 @@ def judge_response_start(
                 tainted,
             )
         )
-    _ = RESPONSE_START_MIN  # = CHAR_TIME - TOLERANCE, the derived window's lower edge
     real = stamps.local is not None
     return [
         combine_local("R-7.0-09", early, "reply", real_time=real),
@@ -255,7 +176,7 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
     )
 
 
-def judge_bit_rate(segs: list[Segment], uncertainty: float | StampUncertainty) -> Finding:
+def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertainty) -> Finding:
     """R-4.1-01 (decision A14: 1200 baud ±2%). Back-to-back characters start one frame apart,
     so the shortest start-to-start spacing inside a reply is at least one frame (8.17 ms at
     +2%). A shorter spacing proves the rate too high. A rate too low cannot be told apart from
@@ -320,22 +241,9 @@ def judge_bit_rate(segs: list[Segment], uncertainty: float | StampUncertainty) -
 
 
 # -- framing of every reply -------------------------------------------------------------------
-def _reply_address(seg: Segment) -> str | None:
-    """The address a reply to this command must start with (None: any address)."""
-    text = seg.text
-    if text.startswith("?") or len(text) < 2:
-        return None  # a wildcard: the sensor answers with its own address
-    if len(text) == 4 and text[1] == "A" and text.endswith("!"):
-        return None  # aAb!: the new address, or the old one if the change failed
-    return text[0]
-
-
 def judge_framing(segs: list[Segment]) -> list[Finding]:
     """R-4.1-02 (7E1 parity), R-4.2-02 (printable), R-4.2-03 (>= 3 chars, CR LF), R-4.3-01
     (the responding sensor's address first) over every ASCII reply and service request."""
-    from ..protocol.responses import split_line  # local: wire must not depend on parsers
-    from .tally import Tally
-
     tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
     last_address = None
     for i, seg in enumerate(segs):
@@ -371,7 +279,7 @@ def judge_framing(segs: list[Segment]) -> list[Finding]:
             )
             body, framing = split_line(text, crc_positions=crc_positions)
             tally.observe(label, framing, ids=["R-4.2-02", "R-4.2-03"])
-            expected = _reply_address(seg) if n == 0 and seg.reply else None
+            expected = expected_reply_address(seg.text) if n == 0 and seg.reply else None
             if n > 0 or not seg.reply:  # unsolicited: a service request from the sensor
                 expected = chr(last_address) if last_address else None
             tally.observe(label, ids=["R-4.3-01"])

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from conformance.case import Case
-from conformance.judges.recorder import Line
 from conformance.recorder.scenarios import SCENARIOS
 from conformance.recorder.session import RecorderSession
+from conformance.view.segments import TranscriptView
 
 
-def line_of(recorder: RecorderSession, case: Case, *names: str) -> Line | None:
+def line_of(recorder: RecorderSession, case: Case, *names: str) -> TranscriptView | None:
     """Run the scenarios (the applicable ones), attach their wire logs, and read them.
 
     None (with N/A findings) when none applies to the recorder's claimed version. A scenario

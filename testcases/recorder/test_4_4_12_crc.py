@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.retries import judge_crc_checked
 
 from ._helpers import line_of, logged
 
@@ -19,5 +19,5 @@ def test_crc_mismatch_is_retried(recorder, case):
     run = recorder.run("bad-crc-once")
     truth = list(run.expected_values("0", "M"))
     case.extend(
-        judge.judge_crc_checked(line, recorder.uncertainty, logged(recorder, "bad-crc-once"), truth)
+        judge_crc_checked(line, recorder.uncertainty, logged(recorder, "bad-crc-once"), truth)
     )

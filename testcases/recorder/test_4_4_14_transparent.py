@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.capabilities import judge_multiline_end, judge_transparent
 from conformance.recorder.scenarios import SCENARIOS
 
 from ._helpers import line_of, relayed
@@ -27,7 +27,7 @@ def test_transparent_mode(recorder, case):
     reported = {}
     for n in names:
         reported.update(relayed(recorder, n) or {})
-    case.extend(judge.judge_transparent(line, asked, recorder.uncertainty, reported or None))
+    case.extend(judge_transparent(line, asked, recorder.uncertainty, reported or None))
 
 
 @requirements("R-4.4.13.1-04")
@@ -38,4 +38,4 @@ def test_multiline_text_without_etx(recorder, case):
     if line is None:
         return
     reported = relayed(recorder, "multiline-no-etx")
-    case.extend(judge.judge_multiline_end(line, reported, recorder.uncertainty))
+    case.extend(judge_multiline_end(line, reported, recorder.uncertainty))

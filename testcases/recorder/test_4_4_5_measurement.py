@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.breaks import judge_break_rules
+from conformance.judges.recorder.measurements import observed_measurements
+from conformance.judges.recorder.waits import judge_measure_waits
 
 from ._helpers import line_of
 
@@ -23,8 +25,8 @@ def test_waiting_for_the_service_request(recorder, case):
         "until the last D reply"
     )
     line = line_of(recorder, case, *WAIT_SCENARIOS)
-    taken = judge.measurements(line, recorder.uncertainty)
-    case.extend(judge.judge_measure_waits(taken, recorder.uncertainty))
+    taken = observed_measurements(line, recorder.uncertainty)
+    case.extend(judge_measure_waits(taken, recorder.uncertainty))
 
 
 @requirements("R-7.1-01")
@@ -34,6 +36,6 @@ def test_d0_after_service_request(recorder, case):
     line = line_of(recorder, case, "service-request", "two-sensors", "families")
     case.extend(
         f
-        for f in judge.judge_break_rules(line, recorder.uncertainty)
+        for f in judge_break_rules(line, recorder.uncertainty)
         if f.requirement == "R-7.1-01"
     )

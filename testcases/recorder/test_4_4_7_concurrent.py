@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.collection import judge_concurrent_storage
+from conformance.judges.recorder.measurements import observed_measurements
+from conformance.judges.recorder.waits import judge_concurrent_waits
 from conformance.recorder.scenarios import SCENARIOS
 
 from ._helpers import line_of
@@ -22,10 +24,10 @@ def test_concurrent_measurements(recorder, case):
     if line is None:
         return
     asked = [c for n in names for c in SCENARIOS[n].request.commands]
-    taken = judge.measurements(line, recorder.uncertainty)
-    case.extend(judge.judge_concurrent_waits(taken, recorder.uncertainty))
+    taken = observed_measurements(line, recorder.uncertainty)
+    case.extend(judge_concurrent_waits(taken, recorder.uncertainty))
     case.extend(
-        f for f in judge.judge_concurrent_storage(taken, asked) if f.requirement == "R-4.4.7-08"
+        f for f in judge_concurrent_storage(taken, asked) if f.requirement == "R-4.4.7-08"
     )
 
 
@@ -34,5 +36,5 @@ def test_ninety_nine_values(recorder, case):
     """A concurrent measurement of 99 values: at least 20 stored (2000 text), ideally all."""
     case.expect("all 99 values read through D0..D9 (fewer than 20: FAIL; fewer than 99: WARN)")
     line = line_of(recorder, case, "concurrent-99")
-    taken = judge.measurements(line, recorder.uncertainty)
-    case.extend(f for f in judge.judge_concurrent_storage(taken) if f.requirement == "R-4.4.7-07")
+    taken = observed_measurements(line, recorder.uncertainty)
+    case.extend(f for f in judge_concurrent_storage(taken) if f.requirement == "R-4.4.7-07")

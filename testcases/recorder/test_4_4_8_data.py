@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.collection import judge_data_collection
+from conformance.judges.recorder.measurements import observed_measurements
 
 from ._helpers import line_of
 
@@ -17,4 +18,4 @@ def test_data_continuation(recorder, case):
     measurement again when a D reply comes back valid but empty."""
     case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
     line = line_of(recorder, case, "d0-to-d2", "empty-data", "concurrent-99", "families")
-    case.extend(judge.judge_data_collection(judge.measurements(line, recorder.uncertainty)))
+    case.extend(judge_data_collection(observed_measurements(line, recorder.uncertainty)))

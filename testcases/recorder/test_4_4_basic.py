@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.capabilities import judge_addresses, judge_commands_issued
 from conformance.recorder.scenarios import SCENARIOS
 
 from ._helpers import line_of
@@ -20,7 +20,7 @@ def test_every_basic_command_and_family(recorder, case):
     names = ("families", "basic-commands")
     line = line_of(recorder, case, *names)
     asked = [c for n in names for c in SCENARIOS[n].request.commands]
-    case.add(judge.judge_commands_issued(line, asked, recorder.uncertainty))
+    case.add(judge_commands_issued(line, asked, recorder.uncertainty))
 
 
 @requirements("R-4.3-03", "R-4.3-04")
@@ -28,4 +28,4 @@ def test_addresses(recorder, case):
     """Sensors at 0-9 can each be polled; letter addresses are an option."""
     case.expect("a valid exchange with each of the sensors at 0..9 (and A, z if supported)")
     line = line_of(recorder, case, "addresses")
-    case.extend(judge.judge_addresses(line, recorder.uncertainty))
+    case.extend(judge_addresses(line, recorder.uncertainty))

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.collection import judge_high_volume
+from conformance.judges.recorder.measurements import observed_measurements
 
 from ._helpers import line_of
 
@@ -19,5 +20,5 @@ def test_high_volume(recorder, case):
     line = line_of(recorder, case, "high-volume-ascii", "high-volume-binary")
     if line is None:
         return
-    taken = judge.measurements(line, recorder.uncertainty)
-    case.extend(judge.judge_high_volume(taken, recorder.is_v14))
+    taken = observed_measurements(line, recorder.uncertainty)
+    case.extend(judge_high_volume(taken, recorder.is_v14))

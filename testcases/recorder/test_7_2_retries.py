@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.retries import judge_retries
 
 from ._helpers import line_of
 
@@ -29,4 +29,4 @@ def test_retries(recorder, case):
         "for every invalid reply, only after that reply ended"
     )
     line = line_of(recorder, case, *RETRY_SCENARIOS)
-    case.extend(judge.judge_retries(line, recorder.uncertainty))
+    case.extend(judge_retries(line, recorder.uncertainty))

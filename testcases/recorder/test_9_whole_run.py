@@ -5,7 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges import recorder as judge
+from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
+from conformance.judges.recorder.commands import (
+    judge_character_gaps,
+    judge_command_bit_rate,
+    judge_command_text,
+)
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
 
@@ -22,14 +27,14 @@ def _everything(recorder, case):
 def test_breaks(recorder, case):
     """Every break lasts at least 12 ms and is followed by at least 8.33 ms of marking."""
     case.expect("break >= 12 ms (-0.40); marking before the command >= 8.33 ms (-0.40)")
-    case.extend(judge.judge_breaks(_everything(recorder, case), recorder.uncertainty))
+    case.extend(judge_breaks(_everything(recorder, case), recorder.uncertainty))
 
 
 @requirements("R-7.0-17")
 def test_break_when_due(recorder, case):
     """A break before every command to a new sensor and after more than 87 ms of marking."""
     case.expect("commands without a break only to the same sensor within 87 ms (+0.40)")
-    found = judge.judge_break_rules(_everything(recorder, case), recorder.uncertainty)
+    found = judge_break_rules(_everything(recorder, case), recorder.uncertainty)
     case.extend(f for f in found if f.requirement == "R-7.0-17")
 
 
@@ -37,7 +42,7 @@ def test_break_when_due(recorder, case):
 def test_command_text(recorder, case):
     """Commands are printable, start with an address and end with their only '!'."""
     case.expect("printable ASCII; the address first; '!' last and nowhere else")
-    case.extend(judge.judge_command_text(_everything(recorder, case)))
+    case.extend(judge_command_text(_everything(recorder, case)))
 
 
 @requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")
@@ -45,7 +50,7 @@ def test_character_timing(recorder, case):
     """At most 1.66 ms between command characters (no tolerance), at 1200 baud."""
     case.expect("every gap inside a command <= 1.66 ms; characters one 8.33 ms frame apart")
     line = _everything(recorder, case)
-    case.extend(judge.judge_character_gaps(line, recorder.uncertainty))
+    case.extend(judge_character_gaps(line, recorder.uncertainty))
     if recorder.served is not None:  # a PASS here would rest on the server's own spacing
         case.add(
             inconclusive(
@@ -57,4 +62,4 @@ def test_character_timing(recorder, case):
     elif not recorder.link.info.bit_timing:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
     else:
-        case.add(judge.judge_bit_rate(line, recorder.uncertainty))
+        case.add(judge_command_bit_rate(line, recorder.uncertainty))

@@ -43,7 +43,7 @@ def test_reply_framing(sensor, case):
     )
     segs = _segments(sensor)
     if sensor.link.info.bit_timing:
-        case.add(wire.judge_bit_rate(segs, sensor.stamp_uncertainty))
+        case.add(wire.judge_reply_bit_rate(segs, sensor.stamp_uncertainty))
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
     case.extend(wire.judge_framing(segs))

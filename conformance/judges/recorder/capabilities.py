@@ -1,0 +1,167 @@
+"""Judges of what the recorder can do: issue the commands it was asked to (R-4.4-02), poll
+every address (R-4.3-03/04), pass commands through transparently (R-4.4.14-01/02,
+R-4.4.13-03, R-6.3-01), end multi-line text without ETX (R-4.4.13.1-04)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ...protocol.commands import ADDRESS_CHARS, Kind, parse_command
+from ...protocol.timing import MULTILINE_GAP_MAX
+from ...transcript import decode_7e1, escape
+from ...verdicts import Finding, Verdict
+from ...view.segments import TranscriptView
+from ..reply_validity import STX
+from ..tally import Tally
+from ..timing import judge_window
+from .common import combine
+from .measurements import observed_measurements
+from .replies import answered
+
+
+def judge_commands_issued(
+    line: TranscriptView, asked: Sequence[str], uncertainty: float, rid: str = "R-4.4-02"
+) -> Finding:
+    """``rid`` (R-4.4-02 by default): every command the recorder was asked to use went out and
+    drew a valid reply; for measurements, every announced value was read."""
+    missing = [text for text in asked if answered(line, text, uncertainty) is None]
+    taken = {m.start.text: m for m in observed_measurements(line, uncertainty)}
+    short = [
+        f"{escape(t)} ({len(m.values())} of {m.count} values)"
+        for t, m in taken.items()
+        if t in asked and len(m.values()) < m.count
+    ]
+    if missing or short:
+        parts = []
+        if missing:
+            parts.append("never answered validly: " + ", ".join(escape(t) for t in missing))
+        if short:
+            parts.append("data not read: " + ", ".join(short))
+        return Finding(rid, Verdict.FAIL, "; ".join(parts))
+    return Finding(
+        rid,
+        Verdict.PASS,
+        f"{len(asked)} commands issued and answered: " + " ".join(escape(t) for t in asked),
+        observed=len(asked),
+    )
+
+
+def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
+    """R-4.3-03: the recorder polls every address 0-9. R-4.3-04 (MAY): letters as addresses."""
+    polled = {s.address for s in line.transmissions if answered(line, s.text, uncertainty) is s}
+    digits = [a for a in "0123456789" if a not in polled]
+    r3 = (
+        Finding("R-4.3-03", Verdict.FAIL, f"addresses never polled successfully: {digits}")
+        if digits
+        else Finding(
+            "R-4.3-03",
+            Verdict.PASS,
+            "sensors at 0-9 each polled and answered",
+            observed=len(polled),
+        )
+    )
+    letters = sorted(a for a in polled if a.isalpha())
+    commands = [s for s in line.transmissions if s.text.endswith("!")]  # R-4.4-04 judges the rest
+    foreign = sorted({s.address for s in commands if s.address not in ADDRESS_CHARS} - {"?"})
+    if foreign:  # a MAY rule: the Finding caps this at WARN
+        shown = ", ".join(f"'{escape(a)}'" for a in foreign)
+        r4 = Finding("R-4.3-04", Verdict.FAIL, f"addressed {shown}, not an address", decision="A17")
+    elif letters:
+        r4 = Finding(
+            "R-4.3-04",
+            Verdict.PASS,
+            f"letter addresses used: {' '.join(letters)}",
+            observed=len(letters),
+        )
+    else:
+        r4 = Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
+    return [r3, r4]
+
+
+def judge_transparent(
+    line: TranscriptView,
+    asked: Sequence[str],
+    uncertainty: float,
+    relayed: dict[str, str] | None,
+) -> list[Finding]:
+    """R-4.4.14-01: each host command goes out whole, after a break, and (when the recorder
+    reports it) the sensor's reply is relayed unchanged. R-4.4.14-02: basic, extended and
+    metadata commands pass unchanged. R-4.4.13-03: extended commands start with the address
+    and end with ``!``. R-6.3-01: metadata commands pass through (what a recorder that does
+    not understand metadata must at least do)."""
+    mechanism = Tally(("R-4.4.14-01",))
+    unchanged = Tally(("R-4.4.14-02", "R-4.4.13-03", "R-6.3-01"))
+    sent_texts = [s.text for s in line.transmissions]
+    for text in asked:
+        where = escape(text)
+        cmd = parse_command(text)
+        ids = ["R-4.4.14-02"]
+        if cmd.kind is Kind.EXTENDED:
+            ids.append("R-4.4.13-03")
+        if cmd.kind in (Kind.METADATA, Kind.IDENTIFY_MEASUREMENT):
+            ids.append("R-6.3-01")
+        unchanged.observe(where, ids=ids)
+        matching = [s for s in line.transmissions if s.text == text]
+        if not matching:
+            near = [t for t in sent_texts if t[:1] == text[:1]]
+            instead = (
+                f"sent instead: {', '.join(repr(escape(t)) for t in near[:3])}"
+                if near
+                else f"nothing starting with {escape(text[:1])!r} was sent"
+            )
+            for rid in ids:
+                unchanged.fail(rid, where, f"not on the wire as typed ({instead})")
+            continue
+        mechanism.observe(where)  # only a command that went out shows how it went out
+        first = matching[0]
+        if first.break_event is None:
+            mechanism.fail("R-4.4.14-01", where, "sent without a break to wake the bus")
+        if relayed is not None:
+            got = relayed.get(text)
+            want = decode_7e1(matching[-1].reply)
+            if got is not None and got != want:
+                mechanism.fail(
+                    "R-4.4.14-01",
+                    where,
+                    f"relayed '{escape(got[:40])}', the sensor sent '{escape(want[:40])}'",
+                )
+    return [*mechanism.findings("passed through"), *unchanged.findings("passed unchanged")]
+
+
+def judge_multiline_end(
+    line: TranscriptView, relayed: dict[str, str] | None, uncertainty: float
+) -> list[Finding]:
+    """R-4.4.13.1-04 (SHOULD): multi-line text without ETX is complete once no further line
+    starts within 150 ms: the recorder neither talks over a line that may still come nor
+    loses the lines it got."""
+    found: list[Finding] = []
+    for i, s in enumerate(line.transmissions):
+        answer = s.reply
+        if len(answer) < 2 or answer[1].char7 != STX or answer[-1].char7 != 0x0A:
+            continue
+        nxt = line.transmissions[i + 1] if i + 1 < len(line.transmissions) else None
+        where = [f"text in reply to {s.at()}"]
+        if nxt is not None:
+            f = judge_window(
+                "R-4.4.13.1-04",
+                "marking after the last line before the recorder spoke again",
+                nxt.start - answer[-1].end,
+                uncertainty,
+                low=MULTILINE_GAP_MAX,
+                should=True,
+                evidence=where,
+            )
+            found.append(f)
+        if relayed is not None and s.text in relayed:
+            lines = decode_7e1(answer).count("\r\n")
+            got = relayed[s.text].count("\r\n")
+            if got < lines:
+                found.append(
+                    Finding(
+                        "R-4.4.13.1-04",
+                        Verdict.WARN,
+                        f"relayed {got} of {lines} lines",
+                        evidence=where,
+                    )
+                )
+    return [combine("R-4.4.13.1-04", found, "multi-line text without ETX")]

@@ -1,0 +1,153 @@
+"""Judges of data collection: D0, D1, ... in order until every value is in (R-4.4.8-05),
+concurrent storage (R-4.4.7-07/08), high-volume ASCII and binary (R-5.1-04, R-5.2-08,
+R-5.4-01)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ...protocol.binary import parse_binary_packet
+from ...protocol.commands import Kind, parse_command
+from ...transcript import decode_8n1, escape
+from ...verdicts import Finding
+from ...view.segments import Transmission
+from ..tally import Tally
+from .common import MIN_CONCURRENT_STORE
+from .measurements import ObservedMeasurement, collection_end
+
+
+def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]:
+    """R-4.4.8-05: aD0!, aD1!, ... in order until every announced value is in; after a valid
+    empty reply the measurement is issued again. A collection that ended on a reply the
+    recorder found invalid is left to the retry rules (section 7.2)."""
+    tally = Tally(("R-4.4.8-05",))
+    for m in taken:
+        if m.kind is Kind.HIGH_VOLUME_BINARY or not m.count:
+            continue
+        where = escape(m.start.text)
+        tally.observe(where)
+        indices = [d[1] for s, _ in m.data if (d := s.data_index) is not None]
+        order = [i for n, i in enumerate(indices) if n == 0 or indices[n - 1] != i]
+        if order != list(range(len(order))):
+            tally.fail("R-4.4.8-05", where, f"data indices went {order}, not 0, 1, 2, ...")
+            continue
+        have = len(m.values())
+        if have >= m.count:
+            continue
+        last, problem, empty = collection_end(m)
+        if problem is not None:
+            continue
+        if empty:
+            if m.next_start is None or m.next_start.text != m.start.text:
+                tally.fail(
+                    "R-4.4.8-05",
+                    where,
+                    f"{escape(last.text) if last else 'aD0!'} came back empty and the "
+                    "measurement was not issued again",
+                )
+            continue
+        stop = escape(last.text) if last is not None else "the reply"
+        tally.fail("R-4.4.8-05", where, f"stopped after {stop} with {have} of {m.count} values")
+    return tally.findings("every announced value collected in order")
+
+
+def judge_concurrent_storage(
+    taken: Sequence[ObservedMeasurement], asked: Sequence[str] = ()
+) -> list[Finding]:
+    """R-4.4.7-07: a concurrent measurement of more than 20 values: at least 20 read and stored
+    (the 2000 text's MUST); fewer than announced is a WARN (the capacity should be documented,
+    which the tool cannot see). R-4.4.7-08: the recorder uses aC!-type commands: each one in
+    ``asked`` (what the scenarios told it to send) must be on the wire."""
+    tally = Tally(("R-4.4.7-07", "R-4.4.7-08"))
+    started = {m.start.text for m in taken}
+    for text in asked:
+        if parse_command(text).kind is Kind.CONCURRENT and text not in started:
+            tally.fail("R-4.4.7-08", escape(text), f"asked for {escape(text)}, never sent it")
+    for m in taken:
+        if m.kind is not Kind.CONCURRENT:
+            continue
+        where = escape(m.start.text)
+        have = len(m.values())
+        tally.observe(where, ids=["R-4.4.7-08"])
+        if not have and m.count and not _ended_on_problem(m):  # completeness: R-4.4.8-05
+            tally.fail("R-4.4.7-08", where, f"read none of the {m.count} values")
+        if m.count <= MIN_CONCURRENT_STORE:
+            continue
+        tally.observe(where, ids=["R-4.4.7-07"])
+        if have < MIN_CONCURRENT_STORE:
+            tally.fail(
+                "R-4.4.7-07", where, f"read {have} of {m.count} values (at least 20 are due)"
+            )
+        elif have < m.count:
+            tally.fail(
+                "R-4.4.7-07",
+                where,
+                f"read {have} of {m.count} values (fewer than announced)",
+                warning=True,
+            )
+    return tally.findings("values read")
+
+
+def _ended_on_problem(m: ObservedMeasurement) -> bool:
+    return collection_end(m)[1] is not None
+
+
+def judge_high_volume(taken: Sequence[ObservedMeasurement], is_v14: bool) -> list[Finding]:
+    """R-5.1-04: after aHA! data commands go past aD9! as needed, without leading zeros.
+    R-5.2-08: after aHB! aDBn! commands in 7E1, packets checked, collection stops at the empty
+    packet or once every value is in. R-5.4-01: a v1.4 recorder issues aHA! and aHB! and reads
+    their data back."""
+    tally = Tally(("R-5.1-04", "R-5.2-08", "R-5.4-01"))
+    used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
+    for m in taken:
+        if m.kind not in used:
+            continue
+        where = escape(m.start.text)
+        have = len(m.values())
+        used[m.kind] = used[m.kind] or have > 0
+        rid = "R-5.1-04" if m.kind is Kind.HIGH_VOLUME_ASCII else "R-5.2-08"
+        tally.observe(where, ids=[rid])
+        zeros = [s for s, _ in m.data if (d := s.data_index) and d[2] != str(d[1])]
+        if zeros:
+            tally.fail(rid, where, f"{escape(zeros[0].text)} has leading zeros")
+        if m.kind is Kind.HIGH_VOLUME_BINARY:
+            parity = [e for s, _ in m.data for e in s.chars if not e.parity_ok]
+            if parity:
+                tally.fail(rid, where, "a DB command was not sent in 7E1 (parity)")
+            last, problem, empty = collection_end(m)
+            if problem is None and have < m.count and not empty:
+                tally.fail(rid, where, f"stopped with {have} of {m.count} values, no empty packet")
+            extra = _after_done(m)
+            if extra:
+                tally.fail(rid, where, f"{escape(extra.text)} sent after every value was in")
+        else:
+            last, problem, _ = collection_end(m)
+            if problem is None and have < m.count:
+                tally.fail(
+                    rid,
+                    where,
+                    f"stopped at {escape(last.text) if last else 'D0'} with "
+                    f"{have} of {m.count} values",
+                )
+    if is_v14:
+        for kind, ok in used.items():
+            tally.observe(kind.value.replace("a", "", 1), ids=["R-5.4-01"])
+            if not ok:
+                tally.fail("R-5.4-01", str(kind), f"{kind} was not issued or its data not read")
+    else:
+        tally.not_applicable("R-5.4-01", "the recorder does not claim v1.4")
+    return tally.findings("conforms")
+
+
+def _after_done(m: ObservedMeasurement) -> Transmission | None:
+    """A DB command sent after the values were complete (or after the empty packet)."""
+    total = 0
+    for i, (s, problem) in enumerate(m.data):
+        if problem is not None:
+            continue
+        packet = parse_binary_packet(decode_8n1(s.reply))
+        total += len(packet.values)
+        if total >= m.count or not packet.values:
+            later = [t for t, _ in m.data[i + 1 :] if t.text != s.text]
+            return later[0] if later else None
+    return None

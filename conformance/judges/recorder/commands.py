@@ -1,0 +1,108 @@
+"""Judges of the recorder's command characters: printable, ``!`` last, the address first;
+the gaps between them (R-7.0-13, R-7.0-01); their bit rate (R-4.1-01)."""
+
+from __future__ import annotations
+
+from ...protocol.commands import ADDRESS_CHARS
+from ...protocol.timing import CHAR_TIME, INTER_CHAR_GAP_MAX, TOLERANCE
+from ...transcript import escape
+from ...verdicts import Finding, Verdict
+from ...view.segments import TranscriptView
+from ..tally import Tally
+from ..timing import judge_window
+from .common import combine
+
+
+def judge_command_text(line: TranscriptView) -> list[Finding]:
+    """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else; R-4.3-01
+    the first character is the address (``?`` only in ``?!``)."""
+    tally = Tally(("R-4.2-01", "R-4.4-04", "R-4.3-01"))
+    for s in line.transmissions:
+        text, where = s.text, escape(s.text)
+        bad = [c for c in text if not 0x20 <= ord(c) <= 0x7E]
+        tally.observe(where, ids=["R-4.2-01", "R-4.4-04", "R-4.3-01"])
+        if bad:
+            tally.fail("R-4.2-01", where, f"non-printable {escape(''.join(bad))} in the command")
+        if not text.endswith("!") or "!" in text[:-1]:
+            tally.fail("R-4.4-04", where, "'!' is not exactly the last character")
+        first = text[:1]
+        if not (first in ADDRESS_CHARS or text == "?!"):
+            tally.fail("R-4.3-01", where, f"starts with {escape(first)}, not an address")
+    return tally.findings("well formed")
+
+
+def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Finding]:
+    """R-7.0-13: at most 1.66 ms of marking between the characters of a command (no
+    tolerance); R-7.0-01: no gap leans on the ±0.40 ms that this limit does not have."""
+    gaps = [
+        (b.start - a.end, s)
+        for s in line.transmissions
+        for a, b in zip(s.chars, s.chars[1:], strict=False)
+    ]
+    found = [
+        judge_window(
+            "R-7.0-13",
+            "marking between command characters",
+            gap,
+            uncertainty,
+            high=INTER_CHAR_GAP_MAX,
+            tolerance=0.0,
+            evidence=[f"in {s.at()}"],
+        )
+        for gap, s in gaps
+    ]
+    leaning = [
+        (gap, s) for gap, s in gaps if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE
+    ]
+    if leaning:
+        gap, s = leaning[0]
+        tol = Finding(
+            "R-7.0-01",
+            Verdict.FAIL,
+            f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which the "
+            f"1.66 ms character gap does not have ({len(leaning)} such gap(s))",
+            measured_ms=round(gap * 1e3, 3),
+            limit_ms=1.66,
+        )
+    elif gaps:
+        tol = Finding(
+            "R-7.0-01",
+            Verdict.PASS,
+            f"{len(gaps)} command character gaps, none inside the tolerance band the 1.66 ms "
+            "limit does not have; ±0.40 ms applied to every other recorder limit",
+            observed=len(gaps),
+        )
+    else:
+        tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
+    return [combine("R-7.0-13", found, "character gap"), tol]
+
+
+def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:
+    """R-4.1-01 (decision A14, ±2%): back-to-back command characters start one frame apart."""
+    spacings = [
+        (b.start - a.start, s)
+        for s in line.transmissions
+        for a, b in zip(s.chars, s.chars[1:], strict=False)
+    ]
+    if not spacings:
+        return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
+    shortest, s = min(spacings, key=lambda x: x[0])
+    finding = judge_window(
+        "R-4.1-01",
+        "shortest start-to-start spacing of command characters",
+        shortest,
+        2 * uncertainty,
+        low=CHAR_TIME * 0.98,
+        high=CHAR_TIME * 1.02,
+        tolerance=0.0,
+        evidence=[f"in {s.at()}"],
+        decision="A14",
+    )
+    too_slow = shortest - 2 * uncertainty > CHAR_TIME * 1.02
+    if (
+        finding.verdict is Verdict.FAIL and too_slow
+    ):  # a gap, not a rate: see wire.judge_reply_bit_rate
+        finding.verdict = Verdict.INCONCLUSIVE
+        finding.detail += " (no back-to-back characters: rate and gaps cannot be separated)"
+    finding.detail += f"; about {10 / shortest:.0f} baud over {len(spacings)} spacings"
+    return finding

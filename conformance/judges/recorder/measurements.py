@@ -1,0 +1,113 @@
+"""Measurement reconstruction: every measurement the recorder under test started with a
+valid ``atttn``-type reply, the service request, and the data transmissions that followed."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...protocol.binary import parse_binary_packet
+from ...protocol.commands import Command, Kind
+from ...protocol.responses import parse_measurement_reply_for, split_line
+from ...transcript import Event, decode_7e1, decode_8n1, text_end
+from ...view.segments import TranscriptView, Transmission
+from ..reply_validity import ReplyProblem
+from .replies import crc_context, data_values, reply_problem
+
+
+@dataclass
+class ObservedMeasurement:
+    """A measurement the recorder started and what it did until it was done with it."""
+
+    index: int  # position of the starting transmission in line.transmissions
+    start: Transmission
+    command: Command
+    ttt: int
+    count: int
+    reply_end: float
+    service_request_end: float | None
+    data: list[tuple[Transmission, ReplyProblem | None]]  # data transmissions, with their problems
+    next_start: Transmission | None  # the next measurement command to the same sensor, if any
+    others: list[Transmission]  # transmissions to other sensors before the data were all in
+
+    @property
+    def kind(self) -> Kind:
+        return self.command.kind
+
+    def values(self) -> list[str]:
+        """Values of the valid data replies, each index counted once."""
+        seen: set[int] = set()
+        values: list[str] = []
+        for sent, problem in self.data:
+            d = sent.data_index
+            if problem is not None or d is None or d[1] in seen:
+                continue
+            seen.add(d[1])
+            if d[0]:
+                packet = parse_binary_packet(decode_8n1(sent.reply))
+                values += [repr(v) for v in packet.values]
+            else:
+                values += data_values(sent, self.command)
+        return values
+
+    @property
+    def first_data(self) -> Transmission | None:
+        return self.data[0][0] if self.data else None
+
+
+def service_request_end(events: list[Event], address: str) -> float | None:
+    """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
+    return text_end(events, f"{address}\r\n")
+
+
+def observed_measurements(line: TranscriptView, uncertainty: float) -> list[ObservedMeasurement]:
+    """Every measurement the recorder started with a valid ``atttn``-type reply."""
+    crc = crc_context(line)
+    problems = [reply_problem(s, crc[i], uncertainty) for i, s in enumerate(line.transmissions)]
+    taken: list[ObservedMeasurement] = []
+    for i, s in enumerate(line.transmissions):
+        cmd = s.command
+        if cmd is None or not cmd.starts_measurement or problems[i] is not None:
+            continue
+        body, _ = split_line(decode_7e1(s.reply))
+        parsed = parse_measurement_reply_for(body, cmd)
+        if parsed.ttt is None or parsed.count is None:
+            continue
+        ttt, count = parsed.ttt, parsed.count
+        sr = service_request_end(s.after, cmd.address)
+        data: list[tuple[Transmission, ReplyProblem | None]] = []
+        others: list[Transmission] = []
+        nxt: Transmission | None = None
+        for j in range(i + 1, len(line.transmissions)):
+            t = line.transmissions[j]
+            if t.part != s.part:
+                break
+            if t.address != cmd.address:
+                others.append(t)
+                continue
+            tc = t.command
+            if t.data_index is not None:
+                data.append((t, problems[j]))
+                continue
+            if tc is not None and tc.starts_measurement:
+                nxt = t
+            break
+        if data:
+            last = data[-1][0]
+            others = [o for o in others if o.start < last.end]
+        taken.append(
+            ObservedMeasurement(i, s, cmd, ttt, count, s.reply[-1].end, sr, data, nxt, others)
+        )
+    return taken
+
+
+def collection_end(m: ObservedMeasurement) -> tuple[Transmission | None, ReplyProblem | None, bool]:
+    """The last data transmission, its problem, and whether its valid reply was empty."""
+    if not m.data:
+        return None, None, False
+    sent, problem = m.data[-1]
+    if problem is not None:
+        return sent, problem, False
+    if sent.binary:
+        packet = parse_binary_packet(decode_8n1(sent.reply))
+        return sent, None, not packet.values
+    return sent, None, not data_values(sent, m.command)

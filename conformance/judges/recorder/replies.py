@@ -1,0 +1,56 @@
+"""Whether the sensor's reply to each transmission of the recorder under test was valid, by
+the judges' own rules (:mod:`conformance.judges.reply_validity`), and what a valid data reply
+held. Retry and measurement reconstruction both start from these decisions."""
+
+from __future__ import annotations
+
+from ...protocol.commands import Command
+from ...protocol.responses import parse_data_reply, split_line
+from ...protocol.timing import CHAR_TIME, TOLERANCE
+from ...transcript import decode_7e1
+from ...view.segments import TranscriptView, Transmission
+from ..reply_validity import NO_LIMIT, ReplyProblem, check_packet, check_reply
+
+
+def reply_problem(
+    sent: Transmission, crc_expected: bool | None, uncertainty: float
+) -> ReplyProblem | None:
+    """Why the sensor's reply to ``sent`` was not a valid reply (:data:`NO_REPLY` if none
+    came), by the judges' own rules (:mod:`.reply_validity`), not the golden recorder's."""
+    if sent.binary:
+        return check_packet(sent.reply, address=sent.address, command_end=sent.end)
+    return check_reply(
+        sent.command,
+        sent.reply,
+        address=sent.address,
+        command_end=sent.end,
+        gap_limit=CHAR_TIME + TOLERANCE + uncertainty,
+        crc_expected=crc_expected,
+    )
+
+
+def crc_context(line: TranscriptView) -> dict[int, bool | None]:
+    """For each transmission index: whether its reply carries a CRC (D after MC, CC, HA...)."""
+    pending: dict[str, bool] = {}
+    result: dict[int, bool | None] = {}
+    for i, s in enumerate(line.transmissions):
+        cmd = s.command
+        if cmd is not None and cmd.starts_measurement:
+            pending[cmd.address] = cmd.returns_crc
+        result[i] = pending.get(s.address) if s.data_index is not None else None
+    return result
+
+
+def data_values(sent: Transmission, measurement: Command) -> list[str]:
+    """The values of a valid D reply to ``sent`` after ``measurement`` (its CRC taken off)."""
+    body, _ = split_line(decode_7e1(sent.reply))
+    return parse_data_reply(body, crc_expected=measurement.returns_crc, limit=NO_LIMIT).values
+
+
+def answered(line: TranscriptView, text: str, uncertainty: float) -> Transmission | None:
+    """The transmission of ``text`` that drew a valid reply, if any."""
+    crc = crc_context(line)
+    for i, s in enumerate(line.transmissions):
+        if s.text == text and reply_problem(s, crc[i], uncertainty) is None:
+            return s
+    return None

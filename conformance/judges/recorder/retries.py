@@ -1,0 +1,222 @@
+"""Retry reconstruction (section 7.2) and the judges of retries: consecutive transmissions
+of one command text, each with its reply's problem, split into break+command+retries
+sequences."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...protocol.timing import RETRY_AFTER_BREAK, RETRY_MAX, RETRY_MIN
+from ...transcript import escape
+from ...verdicts import Finding, Verdict
+from ...view.segments import TranscriptView, Transmission
+from ..reply_validity import NO_REPLY, Reason, ReplyProblem
+from ..tally import Tally
+from ..timing import judge_window
+from .common import combine
+from .replies import crc_context, reply_problem
+
+
+@dataclass
+class Try:
+    sent: Transmission
+    problem: ReplyProblem | None  # None: valid reply
+
+    @property
+    def retry(self) -> bool:
+        return self.sent.break_event is None
+
+
+@dataclass
+class RetryGroup:
+    """Consecutive transmissions of one command text: the first try and its retries."""
+
+    text: str
+    attempts: list[Try]
+
+    def sequences(self) -> list[list[Try]]:
+        """Split at breaks: each break + command + retries is one sequence (R-7.2-04)."""
+        out: list[list[Try]] = []
+        for a in self.attempts:
+            if not out or a.sent.break_event is not None:
+                out.append([a])
+            else:
+                out[-1].append(a)
+        return out
+
+    @property
+    def succeeded(self) -> bool:
+        return any(a.problem is None for a in self.attempts)
+
+
+def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
+    crc = crc_context(line)
+    out: list[RetryGroup] = []
+    for i, s in enumerate(line.transmissions):
+        if not s.text.endswith("!"):
+            continue  # no command, so no reply to retry for; R-4.4-04 judges its text
+        attempt = Try(s, reply_problem(s, crc[i], uncertainty))
+        last = out[-1].attempts[-1] if out else None
+        if (
+            last is not None
+            and last.sent.part == s.part
+            and last.sent.text == s.text
+            and (last.problem is not None)
+        ):
+            out[-1].attempts.append(attempt)
+        else:
+            out.append(RetryGroup(s.text, [attempt]))
+    return out
+
+
+def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
+    """Section 7.2 over every command whose reply was missing or invalid: R-7.2-01 it was sent
+    again; R-7.2-02 after no reply, a retry without a break 16.67-87 ms after the command;
+    R-7.2-03 a sequence given up had two retries, one more than 100 ms after its break;
+    R-7.2-04 (SHOULD) three sequences before giving up; R-7.2-05 every missing or invalid
+    reply triggered a retry; R-7.2-06 the retry waited for the invalid reply to end."""
+    window: list[Finding] = []
+    third: list[Finding] = []
+    ends: list[Finding] = []
+    tally = Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05"))
+    retried_somewhere = False
+    for group in retry_groups(line, uncertainty):
+        if all(a.problem is None for a in group.attempts):
+            continue
+        where = escape(group.text)
+        tally.observe(where, ids=["R-7.2-05"])
+        retried_somewhere = retried_somewhere or len(group.attempts) > 1
+        # Given up, as opposed to accepted: silence cannot be mistaken for a valid reply, and
+        # a command sent again shows the recorder found the reply invalid. A garbled reply
+        # sent once may have been accepted: that is R-7.2-05's (and R-4.4.12-07's) finding.
+        gave_up = group.attempts[-1].problem is NO_REPLY or len(group.attempts) > 1
+        if gave_up:
+            tally.observe(where, ids=["R-7.2-01"])
+        if len(group.attempts) == 1 and gave_up:
+            tally.fail("R-7.2-01", where, f"not sent again after {group.attempts[0].problem}")
+        sequences = group.sequences()
+        for n, seq in enumerate(sequences):
+            later = sequences[n + 1][0] if n + 1 < len(sequences) else None
+            for k, a in enumerate(seq):
+                if a.problem is None:
+                    continue
+                nxt = seq[k + 1] if k + 1 < len(seq) else None
+                follower = nxt or later
+                if follower is None and len(seq) < 3:
+                    tally.fail("R-7.2-05", where, f"{a.problem} at {a.sent.at()}, then no retry")
+                if a.problem is NO_REPLY:
+                    if nxt is not None:
+                        window.append(
+                            judge_window(
+                                "R-7.2-02",
+                                "retry after no reply",
+                                nxt.sent.first_char - a.sent.end,
+                                uncertainty,
+                                low=RETRY_MIN,
+                                high=RETRY_MAX,
+                                evidence=[nxt.sent.at()],
+                            )
+                        )
+                    elif k == 0:
+                        window.append(
+                            Finding(
+                                "R-7.2-02",
+                                Verdict.FAIL,
+                                f"no retry without a break after no reply to {a.sent.at()}",
+                            )
+                        )
+                elif follower is not None:
+                    ends.append(
+                        _retry_after_reply(line, a.sent, follower.sent, a.problem, uncertainty)
+                    )
+            if any(a.problem is None for a in seq) or not gave_up:
+                continue
+            label = f"{where} sequence {n + 1}"
+            retries = seq[1:]
+            if len(retries) < 2:
+                third.append(
+                    Finding(
+                        "R-7.2-03", Verdict.FAIL, f"{label}: {len(retries)} retries, then no more"
+                    )
+                )
+                continue
+            brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
+            if brk is not None:
+                third.append(
+                    judge_window(
+                        "R-7.2-03",
+                        "latest retry after the end of the break",
+                        max(r.sent.first_char for r in retries) - brk.end,
+                        uncertainty,
+                        low=RETRY_AFTER_BREAK,
+                        evidence=[label],
+                    )
+                )
+        if not group.succeeded and gave_up:
+            tally.observe(where, ids=["R-7.2-04"])
+            if len(sequences) < 3:
+                tally.fail(
+                    "R-7.2-04",
+                    where,
+                    f"gave up after {len(sequences)} break+command+retries sequence(s)",
+                    warning=True,
+                )
+        elif len(sequences) > 1:
+            tally.observe(where, ids=["R-7.2-04"])
+    if retried_somewhere:
+        tally.observe("the run", ids=["R-7.2-01"])
+    return [
+        *tally.findings("retried as due"),
+        combine("R-7.2-02", window, "retry after no reply"),
+        combine("R-7.2-03", third, "unanswered sequence"),
+        combine("R-7.2-06", ends, "retry after an invalid reply"),
+    ]
+
+
+def _retry_after_reply(
+    line: TranscriptView,
+    sent: Transmission,
+    retry: Transmission,
+    problem: ReplyProblem | None,
+    uncertainty: float,
+) -> Finding:
+    """R-7.2-06: marking between the end of the invalid reply and the retry; negative when
+    the sensor was still sending as the recorder took the line again."""
+    mine = {id(c) for s in line.transmissions for c in s.chars}
+    reply = [c for c in line.chars if id(c) not in mine and sent.end <= c.start < retry.end]
+    reply_end = max((c.end for c in reply), default=sent.end)
+    return judge_window(
+        "R-7.2-06",
+        "retry after the end of the invalid reply",
+        retry.start - reply_end,
+        uncertainty,
+        low=0.0,
+        tolerance=0.0,
+        evidence=[f"{retry.at()} after {problem}"],
+    )
+
+
+def judge_crc_checked(
+    line: TranscriptView, uncertainty: float, logged: dict[str, list[str]] | None, truth: list[str]
+) -> list[Finding]:
+    """R-4.4.12-07: a reply whose CRC does not match is treated as invalid: it is retried, and
+    (when the recorder reports what it logged) its values are not logged."""
+    tally = Tally(("R-4.4.12-07",))
+    for group in retry_groups(line, uncertainty):
+        for k, a in enumerate(group.attempts):
+            if a.problem is None or a.problem.reason is not Reason.CRC_WRONG:
+                continue
+            where = escape(group.text)
+            tally.observe(where)
+            if k + 1 >= len(group.attempts):
+                tally.fail("R-4.4.12-07", where, f"accepted a reply whose {a.problem}")
+    if logged is not None and truth:
+        for command, values in logged.items():
+            if values and values != truth[: len(values)]:
+                tally.fail(
+                    "R-4.4.12-07",
+                    escape(command),
+                    f"logged {' '.join(values[:4])}..., the sensor's values are "
+                    f"{' '.join(truth[:4])}...",
+                )
+    return tally.findings("CRC mismatches retried, correct values logged")

@@ -1,0 +1,116 @@
+"""Judges of how the recorder waits for data: the service request or ttt, the line left
+alone, no early data command (R-4.4.5-04..07, R-4.4.7-06)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ...transcript import escape
+from ...verdicts import Finding, Verdict
+from ..tally import Tally
+from ..timing import judge_window
+from .common import CONCURRENT_KINDS, REACTION, SR_KINDS, combine
+from .measurements import ObservedMeasurement
+
+
+def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float) -> list[Finding]:
+    """For aM!-type measurements with ttt > 0: R-4.4.5-04 no aD0! before the service request
+    or ttt; R-4.4.5-07 the line left alone while waiting; R-4.4.5-05 aD0! promptly when the
+    service request comes or ttt runs out (then after a break), and at once for ttt = 0
+    (SHOULD); R-4.4.5-06 no traffic to other sensors until the data are in."""
+    early: list[Finding] = []
+    tally = Tally(("R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07"))
+    for m in taken:
+        if m.kind not in SR_KINDS:
+            continue
+        where = escape(m.start.text)
+        tally.observe(where, ids=["R-4.4.5-06"])
+        for other in m.others:
+            tally.fail(
+                "R-4.4.5-06",
+                where,
+                f"{other.at()} went to another sensor before the data of {where} were in",
+            )
+        first = m.first_data
+        if m.ttt == 0:
+            tally.observe(where, ids=["R-4.4.5-05"])
+            if first is None or first.start - m.reply_end > REACTION:
+                tally.fail(
+                    "R-4.4.5-05",
+                    where,
+                    "ttt = 000 but aD0! did not follow at once",
+                    warning=True,
+                )
+            continue
+        ready = m.reply_end + m.ttt
+        sr = m.service_request_end if m.service_request_end is not None else None
+        waited_until = min(sr, ready) if sr is not None else ready
+        moved = [s for s in m.others if s.start < waited_until] + (
+            [first] if first is not None and first.start < waited_until else []
+        )
+        tally.observe(where, ids=["R-4.4.5-07"])
+        if moved:
+            tally.fail(
+                "R-4.4.5-07",
+                where,
+                f"the recorder took the line {moved[0].start - m.reply_end:.3f} s after the "
+                f"reply, while a service request could still come",
+            )
+        if first is None:
+            tally.fail("R-4.4.5-05", where, "no aD0! after the measurement")
+            continue
+        if sr is None or sr > first.start:
+            early.append(
+                judge_window(
+                    "R-4.4.5-04",
+                    "aD0! (or its break) after the reply, with no service request before it",
+                    first.start - m.reply_end,
+                    uncertainty,
+                    low=float(m.ttt),
+                    evidence=[f"{first.at()} after {where} announced ttt={m.ttt}"],
+                )
+            )
+        else:
+            early.append(
+                Finding(
+                    "R-4.4.5-04",
+                    Verdict.PASS,
+                    f"aD0! only after the service request ({where})",
+                    observed=1,
+                )
+            )
+        tally.observe(where, ids=["R-4.4.5-05"])
+        trigger = sr if sr is not None and sr <= ready else ready
+        delay = first.start - trigger
+        if delay > REACTION:
+            what = "the service request" if trigger == sr else "ttt"
+            tally.fail(
+                "R-4.4.5-05",
+                where,
+                f"aD0! came {delay:.3f} s after {what} (allowed {REACTION} s)",
+            )
+        if trigger != sr and first.break_event is None:
+            tally.fail("R-4.4.5-05", where, "aD0! after ttt ran out, without a break first")
+    return [combine("R-4.4.5-04", early, "wait for data"), *tally.findings()]
+
+
+def judge_concurrent_waits(
+    taken: Sequence[ObservedMeasurement], uncertainty: float
+) -> list[Finding]:
+    """R-4.4.7-06: after a concurrent reply with ttt > 0, no data command to that sensor before
+    ttt (talking to other sensors meanwhile is allowed)."""
+    found = []
+    for m in taken:
+        if m.kind not in CONCURRENT_KINDS or not m.ttt or m.first_data is None:
+            continue
+        found.append(
+            judge_window(
+                "R-4.4.7-06",
+                "first data command (or its break) after the concurrent reply",
+                m.first_data.start - m.reply_end,
+                uncertainty,
+                low=float(m.ttt),
+                evidence=[f"{m.first_data.at()} after {escape(m.start.text)} (ttt={m.ttt})"],
+            )
+        )
+    return [combine("R-4.4.7-06", found, "concurrent wait")]

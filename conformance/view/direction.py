@@ -1,0 +1,264 @@
+"""Who sent what, when the recording does not say: direction inferred from the protocol.
+
+A capture of the single SDI-12 wire has every character but not its sender (origin
+:data:`~.segments.BUS`). The protocol says a lot: only the recorder sends a break, and the
+characters right after one are its command; a command ends in ``!`` and no sensor may talk
+before it does; the reply starts with the addressed sensor's address 7.93-15.4 ms after the
+command; a service request ``a<CR><LF>`` comes after an ``atttn`` announcement; a sensor's line
+ends in CR LF. Each run of characters is read against these cues, and each gets a
+:class:`Direction` saying which cue it rests on. Where no cue settles it the direction stays
+unknown (``side`` None) or, where one reading is likely but not certain, ``sure`` is False and
+``how`` says what is doubtful (two talkers, an address mismatch, a line answering no
+command): never a silent guess.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from ..protocol.binary import packet_length
+from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, Kind, parse_command
+from ..protocol.responses import parse_measurement_reply_for, split_line
+from ..protocol.timing import (
+    MULTILINE_GAP_MAX,
+    NO_BREAK_WINDOW,
+    RESPONSE_START_MAX,
+    RESPONSE_START_MIN,
+    TOLERANCE,
+)
+from ..transcript import Event, EventKind, decode_7e1, decode_8n1, escape
+from .segments import RECORDER, SENSOR, STX, expected_reply_address
+
+#: How long past an announced ttt a service request is still read as one (a late one is a
+#: finding on the sensor, not a reason to doubt who sent it).
+SERVICE_REQUEST_GRACE = 1.0
+
+
+@dataclass(frozen=True)
+class Direction:
+    """Which side sent an event, and the protocol cue that says so."""
+
+    side: str | None  # RECORDER, SENSOR, or None: unknown
+    how: str
+    sure: bool = True
+
+
+@dataclass
+class _State:
+    """What the reading so far implies about the next run."""
+
+    after_break: bool = False
+    last_side: str | None = None
+    last_end: float = float("-inf")
+    command: str = ""  # the recorder's current transmission so far
+    command_end: float = float("-inf")
+    awaiting_reply: bool = False  # a command ended in '!' and nothing answered yet
+    reply: list[Event] = field(default_factory=list)  # the sensor's current message
+    reply_to: str = ""  # the command it answers ("" for unsolicited lines)
+    announced: dict[str, float] = field(default_factory=dict)  # address -> data ready at
+
+
+def _runs(chars: list[Event]) -> list[list[Event]]:
+    """Bursts of one talker: a new run after a ``!`` or an LF (where the other side may take
+    over), after a pause in which a turnaround is possible (7.93 ms), or where a character
+    overlaps the one before (two talkers). Shorter pauses keep one talker's run whole, so a
+    gappy command or reply is still read as one."""
+    out: list[list[Event]] = []
+    for e in chars:
+        if out:
+            prev = out[-1][-1]
+            gap = e.start - prev.end
+            if -1e-9 < gap < RESPONSE_START_MIN and prev.char7 not in (0x21, 0x0A):
+                out[-1].append(e)
+                continue
+        out.append([e])
+    return out
+
+
+def infer_directions(events: Iterable[Event]) -> list[tuple[Event, Direction]]:
+    """A :class:`Direction` for every break and character of ``events`` (notes are left out);
+    the events' own origins are not looked at."""
+    ordered = sorted(
+        (e for e in events if e.kind is not EventKind.NOTE), key=lambda e: (e.start, e.end)
+    )
+    result: list[tuple[Event, Direction]] = []
+    state = _State()
+    pending: list[Event] = []
+
+    def flush() -> None:
+        for run in _runs(pending):
+            direction = _classify(run, state)
+            result.extend((e, direction) for e in run)
+            _advance(state, run, direction)
+        pending.clear()
+
+    for e in ordered:
+        if e.kind is EventKind.BREAK:
+            flush()
+            result.append((e, Direction(RECORDER, "a break: only the recorder sends one")))
+            state.after_break, state.awaiting_reply = True, False
+            state.command, state.reply = "", []
+            state.last_side, state.last_end = RECORDER, e.end
+        elif e.kind is EventKind.CHAR:
+            if pending and e.start < pending[-1].end - 1e-9:
+                flush()  # an overlap: the runs on either side are read one by one
+            pending.append(e)
+    flush()
+    return result
+
+
+def _classify(run: list[Event], s: _State) -> Direction:
+    text = decode_7e1(run)
+    start = run[0].start
+    gap = start - s.last_end
+    overlap = gap < -1e-9
+    shown = escape(text[:12]) + ("..." if len(text) > 12 else "")
+    if overlap:
+        other = SENSOR if s.last_side == RECORDER else RECORDER
+        return Direction(
+            other if s.last_side else None,
+            f"'{shown}' overlaps the {s.last_side or 'line'}'s characters: two talkers",
+            sure=False,
+        )
+    if s.after_break:
+        if text.endswith("!") or "!" not in text:
+            return Direction(RECORDER, f"'{shown}' right after a break: the recorder's")
+        return Direction(RECORDER, f"'{shown}' right after a break", sure=False)
+    if s.last_side == RECORDER and s.command and not s.command.endswith("!"):
+        return Direction(
+            RECORDER, f"'{shown}' continues the recorder's '{escape(s.command)}' (no '!' yet)"
+        )
+    if s.last_side == SENSOR and s.reply and not _message_done(s):
+        if gap < RESPONSE_START_MIN:
+            return Direction(SENSOR, f"'{shown}' continues the sensor's line after {_ms(gap)}")
+        if _is_text(s.reply) and gap <= MULTILINE_GAP_MAX + TOLERANCE:
+            return Direction(SENSOR, f"'{shown}': the next line of multi-line text")
+    if s.awaiting_reply and gap <= NO_BREAK_WINDOW:
+        found = _as_reply(text, shown, gap, s)
+        if found is not None:
+            return found
+    if _looks_like_command(text):
+        if s.last_side == SENSOR and s.reply and not _message_done(s):
+            return Direction(
+                RECORDER,
+                f"'{shown}' has a command's shape, but the sensor's line before it never "
+                "ended: two talkers, or a line that contains a command",
+                sure=False,
+            )
+        return Direction(RECORDER, f"'{shown}' has a command's shape (address ... '!')")
+    sr = _as_service_request(text, start, s)
+    if sr is not None:
+        return sr
+    if text.endswith("\r\n") or text.endswith("\x03"):
+        return Direction(
+            SENSOR, f"'{shown}' ends like a sensor's line but answers no command", sure=False
+        )
+    return Direction(None, f"'{shown}': no protocol cue (not after a break, no '!', no CR LF)")
+
+
+def _as_reply(text: str, shown: str, gap: float, s: _State) -> Direction | None:
+    """The first run after a command ending in '!' within 87 ms: the reply, or a retry."""
+    window = RESPONSE_START_MIN <= gap <= RESPONSE_START_MAX + TOLERANCE
+    when = f"{_ms(gap)} after '{escape(s.command)}'" + (
+        "" if window else " (outside 7.93-15.4 ms)"
+    )
+    if _binary_command(s.command):
+        return Direction(SENSOR, f"a packet answering '{escape(s.command)}', {when}", window)
+    if _looks_like_command(text):
+        return None  # the recorder again: a retry or its next command
+    expected = expected_reply_address(s.command)
+    first = text[:1]
+    if expected is None or first == expected:
+        return Direction(SENSOR, f"reply: '{shown}' starts with the address {when}", window)
+    if text.endswith("\r\n"):
+        return Direction(
+            SENSOR,
+            f"reply? '{shown}' ends in CR LF {when} but starts with '{escape(first)}', "
+            f"not '{expected}': address mismatch",
+            sure=False,
+        )
+    return None
+
+
+def _as_service_request(text: str, start: float, s: _State) -> Direction | None:
+    if len(text) != 3 or text[1:] != "\r\n" or text[0] not in ADDRESS_CHARS:
+        return None
+    ready = s.announced.get(text[0])
+    if ready is None:
+        return Direction(
+            SENSOR, f"'{escape(text)}': a service request's shape, no announcement", sure=False
+        )
+    if start <= ready + SERVICE_REQUEST_GRACE:
+        return Direction(SENSOR, f"service request '{escape(text)}' after the announced ttt")
+    return Direction(SENSOR, f"'{escape(text)}' long after the announced ttt", sure=False)
+
+
+def _advance(s: _State, run: list[Event], d: Direction) -> None:
+    text = decode_7e1(run)
+    s.after_break = False
+    if d.side == RECORDER:
+        if s.last_side != RECORDER or s.command.endswith("!"):
+            s.command = ""
+        s.command += text
+        s.command_end = run[-1].end
+        s.awaiting_reply = s.command.endswith("!")
+        s.reply, s.reply_to = [], ""
+    elif d.side == SENSOR:
+        if s.last_side != SENSOR or _message_done(s):
+            s.reply, s.reply_to = [], s.command if s.awaiting_reply else ""
+        s.reply += run
+        s.awaiting_reply = False
+        _note_announcement(s)
+    s.last_side = d.side or s.last_side
+    s.last_end = max(s.last_end, run[-1].end)
+
+
+def _note_announcement(s: _State) -> None:
+    """An ``atttn``-type reply to a measurement: a service request may follow after ttt."""
+    command = _parse(s.reply_to)
+    if command is None or not command.starts_measurement or not _message_done(s):
+        return
+    body, _ = split_line(decode_7e1(s.reply))
+    parsed = parse_measurement_reply_for(body, command)
+    if parsed.ttt is not None:
+        s.announced[command.address] = s.reply[-1].end + parsed.ttt
+
+
+def _message_done(s: _State) -> bool:
+    if _binary_command(s.reply_to):
+        length = packet_length(decode_8n1(s.reply))
+        return length is not None and len(s.reply) >= length
+    text = decode_7e1(s.reply)
+    if _is_text(s.reply):
+        return text.endswith("\x03")
+    return text.endswith("\n")
+
+
+def _is_text(reply: list[Event]) -> bool:
+    return len(reply) > 1 and reply[1].char7 == STX
+
+
+def _looks_like_command(text: str) -> bool:
+    return (
+        text.endswith("!")
+        and (text[:1] in ADDRESS_CHARS or text[:1] == "?")
+        and "\r" not in text
+        and "\n" not in text
+    )
+
+
+def _binary_command(text: str) -> bool:
+    command = _parse(text)
+    return command is not None and command.kind is Kind.BINARY_DATA
+
+
+def _parse(text: str) -> Command | None:
+    try:
+        return parse_command(text)
+    except CommandError:
+        return None
+
+
+def _ms(seconds: float) -> str:
+    return f"{seconds * 1e3:.2f} ms"

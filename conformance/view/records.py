@@ -1,0 +1,219 @@
+"""The tool recorder's records (:mod:`conformance.tool_recorder.records`) rebuilt from a view.
+
+The sensor judges read :class:`~conformance.tool_recorder.records.Exchange` and
+:class:`~conformance.tool_recorder.records.Measurement` records, which the tool recorder
+writes as it drives the bus. To judge the sensor rules on a recording no tool drove (a
+capture, a saved transcript), the same records are rebuilt here from the wire alone: each
+transmission becomes an attempt; consecutive transmissions of one command whose reply was
+not accepted are its retries (a break starts a new sequence); a measurement command with an
+``atttn`` reply, the sensor's characters while it waited (service request) and the
+``aD0!``.. ``aDn!`` that followed become a measurement.
+
+Whether an attempt's reply was accepted is the tool recorder's own decision
+(:mod:`conformance.tool_recorder.validity`), as in the records it writes live: these are its
+records, read back, not a judge's opinion. What the wire cannot tell is left out and said so:
+``Attempt.end`` (when the recorder stopped listening) is taken as the end of the reply or of
+the first-character timeout.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..protocol.binary import packet_length
+from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, Kind
+from ..protocol.responses import parse_measurement_reply_for, split_line
+from ..protocol.timing import CHAR_TIME, TOLERANCE
+from ..protocol.values import split_values
+from ..tool_recorder import validity
+from ..tool_recorder.policy import Policy
+from ..tool_recorder.records import IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
+from ..transcript import Event, decode_8n1, text_end
+from .segments import TranscriptView, Transmission
+
+
+@dataclass
+class Rebuilt:
+    """The exchanges in wire order (measurement starts and data included) and the
+    measurements they form."""
+
+    exchanges: list[Exchange]
+    measurements: list[Measurement]
+
+
+def rebuild_records(
+    view: TranscriptView, policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Rebuilt:
+    """Exchanges and measurements from ``view``, as the tool recorder would have recorded
+    them with ``policy`` (its reply window and idle rule decide where a reply ends)."""
+    policy = policy or Policy()
+    exchanges: list[Exchange] = []
+    source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
+    crc_pending: dict[str, bool] = {}
+    for t in view.transmissions:
+        command = t.command
+        binary = command is not None and command.kind is Kind.BINARY_DATA
+        crc = crc_pending.get(t.address) if binary or _is_data(command) else None
+        attempt = _attempt(t, command, binary, crc, policy, uncertainty)
+        source[id(attempt)] = t
+        last = exchanges[-1] if exchanges else None
+        if last is not None and last.text == t.text and not last.ok and command is not None:
+            retries = [a for a in last.attempts if a.sequence == last.last.sequence]
+            if t.break_event is None:
+                attempt.sequence, attempt.retry = last.last.sequence, len(retries)
+            else:
+                attempt.sequence = last.last.sequence + 1
+            last.attempts.append(attempt)
+        else:
+            last = Exchange(command, t.text, [attempt], binary=binary)
+            exchanges.append(last)
+        if command is not None and command.starts_measurement and (attempt.ok or policy.salvage):
+            crc_pending[command.address] = command.returns_crc
+    return Rebuilt(exchanges, _measurements(exchanges, source, policy))
+
+
+def _is_data(command: Command | None) -> bool:
+    return command is not None and command.kind is Kind.DATA
+
+
+def _attempt(
+    t: Transmission,
+    command: Command | None,
+    binary: bool,
+    crc: bool | None,
+    policy: Policy,
+    uncertainty: float,
+) -> Attempt:
+    stray = list(t.contention)
+    heard = [e for e in t.heard if e.start >= t.end]
+    reply = _framed(t, heard, policy)
+    if stray:
+        reason = f"invalid: bus contention ({len(stray)} characters during the command)"
+    elif not reply:
+        reason = NO_REPLY
+    elif not _complete(t, reply):
+        reason = IDLE
+    elif binary:
+        why = validity.check_packet(reply, address=t.address, command_end=t.end)
+        reason = OK if why is None else f"invalid: {why}"
+    else:
+        why = validity.check_ascii(
+            command,
+            reply,
+            address=t.address,
+            command_end=t.end,
+            gap_limit=CHAR_TIME + TOLERANCE + uncertainty,
+            crc_expected=crc,
+            multiline=len(reply) > 1 and reply[1].char7 == validity.STX,
+        )
+        reason = OK if why is None else f"invalid: {why}"
+    end = reply[-1].end if reply else t.end + policy.first_char_timeout
+    return Attempt(t.break_event, list(t.chars), reply, reason, end, stray_events=stray)
+
+
+def _framed(t: Transmission, heard: list[Event], policy: Policy) -> list[Event]:
+    """The reply as the tool recorder frames it: the first character within its
+    first-character timeout, then the protocol's framing, cut where the line idled."""
+    if not heard or heard[0].start - t.end > policy.first_char_timeout:
+        return []
+    framed = t.reply
+    for i in range(1, len(framed)):
+        multiline_gap = framed[i - 1].char7 == 0x0A
+        if not multiline_gap and framed[i].start - framed[i - 1].end > policy.reply_idle:
+            return framed[:i]
+    return framed
+
+
+def _complete(t: Transmission, reply: list[Event]) -> bool:
+    if t.binary:
+        length = packet_length(decode_8n1(reply))
+        return length is not None and len(reply) >= length
+    return validity.ends_line(reply) or reply[-1].char7 == validity.ETX
+
+
+def _measurements(
+    exchanges: list[Exchange], source: dict[int, Transmission], policy: Policy
+) -> list[Measurement]:
+    found: list[Measurement] = []
+    for i, ex in enumerate(exchanges):
+        command = ex.command
+        if command is None or not command.starts_measurement:
+            continue
+        m = Measurement(command, ex)
+        found.append(m)
+        if not (ex.ok or policy.salvage) or not ex.reply_events:
+            continue
+        body, _ = split_line(ex.reply_text)
+        parsed = parse_measurement_reply_for(body, command)
+        if parsed.ttt is None or parsed.count is None or not ex.reply_text.endswith("\r\n"):
+            continue
+        m.ttt, m.count = parsed.ttt, parsed.count
+        m.reply_end = ex.reply_events[-1].end
+        if m.ttt > 0:
+            m.waited_events = _waited(m, source[id(ex.last)], policy)
+            m.service_request_end = text_end(m.waited_events, f"{command.address}\r\n")
+        probed_past_empty = False
+        for later in exchanges[i + 1 :]:
+            if not _collects(later, m) or m.value_count >= m.count:
+                break
+            m.data.append(later)
+            if not (later.ok or (policy.salvage and later.answered)):
+                break
+            if not _take_values(m, later):
+                # an observer looks one index past an empty reply, once (as the engine does)
+                if not policy.salvage or probed_past_empty or m.binary:
+                    break
+                probed_past_empty = True
+    return found
+
+
+def _waited(m: Measurement, t: Transmission, policy: Policy) -> list[Event]:
+    """What the tool recorder heard while it waited for the data: the sensor's characters
+    after the reply, up to the service request for M/V (it stops listening there), else until
+    ttt (and its margin) ran out."""
+    assert m.reply_end is not None and m.ttt is not None
+    reply = {id(e) for e in m.start.reply_events}
+    after = [e for e in t.heard if e.start >= t.end and id(e) not in reply]
+    if m.command.kind in SERVICE_REQUEST_KINDS:
+        deadline = m.reply_end + m.ttt + max(policy.late_sr_grace, policy.ttt_margin)
+        waited: list[Event] = []
+        for e in after:
+            if e.end > deadline:
+                break
+            waited.append(e)
+            if text_end(waited, f"{m.command.address}\r\n") is not None:
+                break
+        return waited
+    deadline = m.reply_end + m.ttt + policy.ttt_margin
+    return [e for e in after if e.end <= deadline]
+
+
+def _collects(ex: Exchange, m: Measurement) -> bool:
+    """``ex`` is the next data command of ``m``: same address, the next index."""
+    cmd = ex.command
+    want = Kind.BINARY_DATA if m.binary else Kind.DATA
+    return (
+        cmd is not None
+        and cmd.kind is want
+        and cmd.address == m.command.address
+        and cmd.index == len(m.data)
+    )
+
+
+def _take_values(m: Measurement, ex: Exchange) -> bool:
+    """As the tool recorder does: add a usable D/DB reply's values; False stops."""
+    if m.binary:
+        packet = ex.reply_bytes
+        m.packets.append(packet)
+        count = validity.packet_value_count(packet)
+        m.binary_value_count += count
+        return count > 0
+    text = validity.data_values_text(ex.reply_text, m.command.returns_crc)
+    if not ex.ok:
+        text = text.rstrip("".join(map(chr, range(0x40, 0x80)))).strip()
+    values = split_values(text)
+    m.values.extend(values)
+    return bool(values)
+
+
+__all__ = ["Rebuilt", "rebuild_records"]

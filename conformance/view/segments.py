@@ -1,0 +1,371 @@
+"""The role-neutral view of a transcript: breaks, transmissions of the recorder, the sensors'
+replies and service requests, and the reasons for every split the wire leaves ambiguous.
+
+SDI-12 has one talker in charge, the data recorder, and sensors that speak only when spoken
+to (or, once, with a service request). So whoever produced a transcript (a sensor-role run,
+where the tool is the recorder; a recorder-role run, where the recorder under test drives the
+line; a capture of a bus nobody from this tool drove), it reads the same way: each
+:class:`Transmission` is what the recorder sent after taking the line (the break before it,
+if any, and its characters) plus everything the sensors sent until the recorder acted again.
+Both roles' judges read this one view, so a rule judged on a live run and on a recording rests
+on the same cut of the wire.
+
+Which events are the recorder's is a predicate (``is_recorder``). On the simulated bus the
+recorder, whichever program it is, sends through the tool's own link: its events carry origin
+``tool`` (:func:`on_tool_link`). A capture has origin :data:`BUS` on every event; its
+direction is inferred from the protocol (:mod:`.direction`) and every guess says so.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+
+from ..protocol.binary import packet_length
+from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, parse_command
+from ..protocol.timing import (
+    INTER_CHAR_GAP_MAX,
+    MARKING_AFTER_BREAK,
+    MULTILINE_GAP_MAX,
+    TOLERANCE,
+)
+from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
+
+IsRecorder = Callable[[Event], bool]
+
+#: Origin of an event whose direction the recording does not give (a logic-analyzer capture
+#: of the single SDI-12 wire).
+BUS = "bus"
+#: The two sides of an SDI-12 bus, as the view names them (independent of which program the
+#: tool plays: transcript origins ``tool``/``dut`` say who was on the tool's link, not that).
+RECORDER, SENSOR = "recorder", "sensor"
+
+STX, ETX, LF = 0x02, 0x03, 0x0A
+
+#: Marking after a ``!`` that starts a new transmission; anything sooner (``0M!!``) is still
+#: part of the one before, so a ``!`` in the middle of a command is seen (R-4.4-04).
+NEW_COMMAND = MARKING_AFTER_BREAK - TOLERANCE
+#: A pause inside a 7E1 reply longer than this is worth a reason (R-7.0-12 judges it).
+REPLY_PAUSE = INTER_CHAR_GAP_MAX + TOLERANCE
+
+_DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
+
+
+def on_tool_link(event: Event) -> bool:
+    """Whether ``event`` went out through the tool's own link (origin ``tool``): the tool's
+    recorder in the sensor role, the recorder under test in the recorder role on the sim bus.
+    Either way it is the recorder's side of the bus."""
+    return event.origin == TOOL
+
+
+@dataclass
+class Transmission:
+    """One transmission of the recorder and what the sensors sent until it acted again."""
+
+    break_event: Event | None
+    chars: list[Event]
+    heard: list[Event] = field(default_factory=list)
+    part: int = 0  # which recording of a merged view it belongs to
+
+    @property
+    def text(self) -> str:
+        return decode_7e1(self.chars)
+
+    @property
+    def address(self) -> str:
+        return self.text[:1]
+
+    @property
+    def start(self) -> float:
+        """Where the recorder took the line: the break if there was one."""
+        return (self.break_event or self.chars[0]).start
+
+    @property
+    def first_char(self) -> float:
+        return self.chars[0].start
+
+    @property
+    def end(self) -> float:
+        """End of the last stop bit: every reply and retry window counts from here."""
+        return self.chars[-1].end
+
+    @property
+    def is_command(self) -> bool:
+        """Ends in ``!``: something a sensor may answer (anything else draws no reply)."""
+        return self.text.endswith("!")
+
+    @property
+    def command(self) -> Command | None:
+        try:
+            return parse_command(self.text)
+        except CommandError:
+            return None
+
+    @property
+    def data_index(self) -> tuple[bool, int, str] | None:
+        """``(binary, index, digits)`` of an ``aDn!``/``aDBn!``, leading zeros included."""
+        m = _DATA.match(self.text)
+        return (m[2] == "B", int(m[3]), m[3]) if m else None
+
+    @property
+    def binary(self) -> bool:
+        """The reply is an 8N1 packet (``aDBn!``): no 7E1, no CR LF."""
+        d = self.data_index
+        return d is not None and d[0]
+
+    @property
+    def contention(self) -> list[Event]:
+        """Sensor characters that started before the command ended (two talkers)."""
+        return [e for e in self.heard if e.start < self.end]
+
+    @property
+    def reply(self) -> list[Event]:
+        """The reply proper, framed as the protocol frames it: up to the first LF (7E1), the
+        packet's length (``aDBn!``), or ETX / 150 ms of marking after a line (multi-line
+        text). How long it took to start is the timing rules' question, not the framing's."""
+        heard = [e for e in self.heard if e.start >= self.end]
+        if self.binary:
+            length = packet_length(decode_8n1(heard))
+            return heard[:length] if length is not None else heard
+        text = len(heard) > 1 and heard[1].char7 == STX
+        for i, e in enumerate(heard):
+            if text and e.char7 == ETX:
+                return heard[: i + 1]
+            if not text and e.char7 == LF:
+                return heard[: i + 1]
+            if text and e.char7 == LF:
+                nxt = heard[i + 1] if i + 1 < len(heard) else None
+                if nxt is None or nxt.start - e.end > MULTILINE_GAP_MAX + TOLERANCE:
+                    return heard[: i + 1]
+        return heard
+
+    @property
+    def after(self) -> list[Event]:
+        """What the sensors sent after the reply (service requests, chatter)."""
+        reply = {id(e) for e in self.reply}
+        return [e for e in self.heard if e.start >= self.end and id(e) not in reply]
+
+    def at(self) -> str:
+        """Where it is, for evidence lines."""
+        return f"{escape(self.text)} at t={self.first_char:.3f} s"
+
+
+@dataclass(frozen=True)
+class ServiceRequest:
+    """``a<CR><LF>`` with good parity among what the sensors sent after a reply."""
+
+    address: str
+    events: tuple[Event, ...]
+    after: Transmission  # the transmission whose quiet time it came in
+
+    @property
+    def end(self) -> float:
+        return self.events[-1].end
+
+
+@dataclass(frozen=True)
+class Ambiguity:
+    """A split the wire leaves open, with the reason, so nothing is decided silently."""
+
+    reason: str
+    at: float
+    events: tuple[Event, ...] = ()
+
+    def __str__(self) -> str:
+        return f"t={self.at:.4f} s: {self.reason}"
+
+
+@dataclass
+class TranscriptView:
+    """A recording cut into the recorder's transmissions and what the sensors sent."""
+
+    transmissions: list[Transmission]
+    breaks: list[Event]
+    chars: list[Event]  # every character, both sides, in time order
+    unanswerable: list[Event] = field(default_factory=list)  # sensor chars with no command
+    undirected: list[Event] = field(default_factory=list)  # direction left unknown
+
+    @property
+    def commands(self) -> list[Transmission]:
+        return [t for t in self.transmissions if t.is_command]
+
+    def previous_activity(self, t: Transmission) -> float | None:
+        """End of the last event on the line before ``t`` took it (either side)."""
+        start = t.start
+        ends = [e.end for e in self.chars if e.end <= start]
+        ends += [b.end for b in self.breaks if b.end <= start]
+        return max(ends) if ends else None
+
+    def last_break_before(self, t: Transmission) -> Event | None:
+        before = [b for b in self.breaks if b.end <= t.start]
+        return before[-1] if before else None
+
+    def service_requests(self) -> list[ServiceRequest]:
+        """Every ``a<CR><LF>`` the sensors sent after a reply, in order."""
+        found = []
+        for t in self.transmissions:
+            after = t.after
+            for i in range(len(after) - 2):
+                run = after[i : i + 3]
+                text = decode_7e1(run)
+                if (
+                    text[0] in ADDRESS_CHARS
+                    and text[1:] == "\r\n"
+                    and all(e.parity_ok for e in run)
+                ):
+                    found.append(ServiceRequest(text[0], tuple(run), t))
+        return found
+
+    def ambiguities(self) -> list[Ambiguity]:
+        """Every split the view had to make that the wire alone does not settle."""
+        found: list[Ambiguity] = []
+        for e in self.undirected:
+            found.append(Ambiguity("direction unknown: no protocol cue", e.start, (e,)))
+        if self.unanswerable:
+            first = self.unanswerable[0]
+            found.append(
+                Ambiguity(
+                    f"{len(self.unanswerable)} sensor character(s) with no command to answer "
+                    "(before any command, or right after a break)",
+                    first.start,
+                    tuple(self.unanswerable),
+                )
+            )
+        requests = {id(e) for sr in self.service_requests() for e in sr.events}
+        for t in self.transmissions:
+            found += _transmission_ambiguities(t, requests)
+        return sorted(found, key=lambda a: a.at)
+
+
+def _transmission_ambiguities(t: Transmission, requests: set[int]) -> list[Ambiguity]:
+    found: list[Ambiguity] = []
+    if not t.is_command and t.heard:
+        found.append(
+            Ambiguity(
+                f"{escape(t.text)} has no '!': what the sensors sent after it is no reply",
+                t.end,
+                tuple(t.heard),
+            )
+        )
+        return found
+    if t.contention:
+        found.append(
+            Ambiguity(
+                f"two talkers: {len(t.contention)} sensor character(s) during {t.at()}",
+                t.contention[0].start,
+                tuple(t.contention),
+            )
+        )
+    reply = t.reply
+    if reply and not t.binary:
+        pauses = [
+            (b.start - a.end, a)
+            for a, b in zip(reply, reply[1:], strict=False)
+            if b.start - a.end > REPLY_PAUSE and not (a.char7 == LF and reply[1].char7 == STX)
+        ]
+        if pauses:
+            gap, a = max(pauses, key=lambda p: p[0])
+            found.append(
+                Ambiguity(
+                    f"a gap of {gap * 1e3:.2f} ms inside the reply to {t.at()}: one reply or two",
+                    a.end,
+                    tuple(reply),
+                )
+            )
+        expected = expected_reply_address(t.text)
+        first = chr(reply[0].char7)
+        if expected is not None and first != expected:
+            found.append(
+                Ambiguity(
+                    f"address mismatch: the reply to {t.at()} starts with '{escape(first)}'",
+                    reply[0].start,
+                    tuple(reply),
+                )
+            )
+    chatter = [e for e in t.after if id(e) not in requests]
+    if chatter:
+        found.append(
+            Ambiguity(
+                f"{len(chatter)} sensor character(s) after the reply to {t.at()} that are no "
+                "service request",
+                chatter[0].start,
+                tuple(chatter),
+            )
+        )
+    return found
+
+
+def expected_reply_address(text: str) -> str | None:
+    """The address a reply to the command ``text`` must start with (None: any address: the
+    wildcard ``?!``, or ``aAb!`` whose reply carries the new address, or the old one)."""
+    if text.startswith("?") or len(text) < 2:
+        return None
+    if len(text) == 4 and text[1] == "A" and text.endswith("!"):
+        return None
+    return text[0]
+
+
+def read_view(
+    events: Iterable[Event], is_recorder: IsRecorder | None = None, part: int = 0
+) -> TranscriptView:
+    """Cut ``events`` (one recording; ``part`` numbers it in a merged view) into the view.
+
+    ``is_recorder`` says which events are the recorder's; None: origin ``tool``
+    (:func:`on_tool_link`), or, for events whose origin is :data:`BUS`, the direction
+    inferred from the protocol (:func:`~conformance.view.direction.infer_directions`);
+    characters it cannot place are kept apart in ``undirected``.
+    """
+    ordered = sorted((e for e in events if e.kind is not EventKind.NOTE), key=lambda e: e.start)
+    undirected: list[Event] = []
+    if is_recorder is None:
+        is_recorder = on_tool_link
+        if any(e.origin == BUS for e in ordered):
+            from .direction import infer_directions
+
+            sides = {id(e): d.side for e, d in infer_directions(ordered)}
+            undirected = [e for e in ordered if sides.get(id(e), RECORDER) is None]
+            ordered = [e for e in ordered if sides.get(id(e), RECORDER) is not None]
+
+            def is_recorder(e: Event) -> bool:
+                return (
+                    sides.get(id(e), RECORDER) == RECORDER if e.origin == BUS else on_tool_link(e)
+                )
+
+    transmissions: list[Transmission] = []
+    breaks: list[Event] = []
+    chars: list[Event] = []
+    unanswerable: list[Event] = []
+    pending: Event | None = None
+    current: Transmission | None = None
+    for e in ordered:
+        if e.kind is EventKind.CHAR:
+            chars.append(e)
+        if is_recorder(e):
+            if e.kind is EventKind.BREAK:
+                breaks.append(e)
+                pending, current = e, None
+            elif current is None or (current.is_command and e.start - current.end >= NEW_COMMAND):
+                current = Transmission(pending, [e], part=part)
+                transmissions.append(current)
+                pending = None
+            else:
+                current.chars.append(e)
+        elif e.kind is EventKind.CHAR:
+            if current is not None:
+                current.heard.append(e)
+            else:
+                unanswerable.append(e)
+    return TranscriptView(transmissions, breaks, chars, unanswerable, undirected)
+
+
+def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:
+    """Several recordings judged together; retries and measurements never span two of them
+    (each transmission keeps its ``part``)."""
+    return TranscriptView(
+        [t for v in views for t in v.transmissions],
+        [b for v in views for b in v.breaks],
+        [c for v in views for c in v.chars],
+        [c for v in views for c in v.unanswerable],
+        [c for v in views for c in v.undirected],
+    )
