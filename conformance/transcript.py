@@ -24,6 +24,9 @@ class EventKind(StrEnum):
 
 TOOL = "tool"  # the side this program plays (recorder in the sensor role)
 DUT = "dut"  # the device under test
+#: A recording that does not say who sent it (a logic-analyzer capture of the one wire, a
+#: listen-only monitor): the view infers the direction from the protocol.
+BUS = "bus"
 
 
 def parity_bit(char7: int) -> int:

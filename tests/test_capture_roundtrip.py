@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 from conformance import emulator
 from conformance.capture import (
     BUS,
-    RECORDER,
-    SENSOR,
+    RECORDER_ORIGIN,
+    SENSOR_ORIGIN,
     SPACING_PULSE,
     decode_capture,
     export_events,
@@ -87,9 +87,9 @@ def test_tx_channel_sets_direction(sim_events, tmp_path, fmt):
     export_events(sim_events, path, tool_channel=True, sample_rate=1e6)
     d = decode_capture(path, channel="SDI12", tx_channel="TOOL_TX")
     assert d.tx_channel == "TOOL_TX" and d.channels == ["SDI12", "TOOL_TX"]
-    want = [RECORDER if e.origin == TOOL else SENSOR for e in sim_events]
+    want = [RECORDER_ORIGIN if e.origin == TOOL else SENSOR_ORIGIN for e in sim_events]
     assert [e.origin for e in d.events] == want
-    assert RECORDER == TOOL and SENSOR == DUT
+    assert RECORDER_ORIGIN == TOOL and SENSOR_ORIGIN == DUT
 
 
 def test_transcript_jsonl_reads_back(sim_events, tmp_path):

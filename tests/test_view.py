@@ -16,7 +16,8 @@ from conformance.sim.bus import SimBus, SimLink
 from conformance.tool_recorder import Master, Policy
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.view.direction import infer_directions
-from conformance.view.segments import BUS, RECORDER, SENSOR, read_view
+from conformance.view.segments import read_view
+from conformance.view.sides import BUS, RECORDER, SENSOR
 
 
 class Wire:

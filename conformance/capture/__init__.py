@@ -9,7 +9,7 @@ Every bad input raises :class:`CaptureError` (path + what is wrong), for exit st
 """
 
 from .comments import embedded_notes
-from .decode import RECORDER, SENSOR, CaptureDecode, decode_capture, merge_tx
+from .decode import RECORDER_ORIGIN, SENSOR_ORIGIN, CaptureDecode, decode_capture, merge_tx
 from .errors import CaptureError
 from .export import DEFAULT_SAMPLE_RATE, EXPORT_FORMATS, ExportInfo, export_events
 from .formats import read_edges, sniff
@@ -20,8 +20,8 @@ __all__ = [
     "BUS",
     "DEFAULT_SAMPLE_RATE",
     "EXPORT_FORMATS",
-    "RECORDER",
-    "SENSOR",
+    "RECORDER_ORIGIN",
+    "SENSOR_ORIGIN",
     "SPACING_PULSE",
     "CaptureDecode",
     "CaptureError",

@@ -22,8 +22,8 @@ from .uart import Decoded, Framing, decode
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong bit rate
-RECORDER = TOOL  # origin of what the recorder's TX channel shows
-SENSOR = DUT  # origin of the rest of the bus
+RECORDER_ORIGIN = TOOL  # origin of what the recorder's TX channel shows
+SENSOR_ORIGIN = DUT  # origin of the rest of the bus
 
 
 @dataclass
@@ -193,8 +193,8 @@ def _decode_channel(
 
 
 def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[Event], int]:
-    """The bus events with origin :data:`RECORDER` where the recorder's TX channel shows the
-    same character or break starting within ``tolerance`` seconds, else :data:`SENSOR`; and
+    """The bus events with origin :data:`RECORDER_ORIGIN` where the recorder's TX channel shows the
+    same character or break starting within ``tolerance`` seconds, else :data:`SENSOR_ORIGIN`; and
     how many TX events were not seen on the bus."""
     out: list[Event] = []
     j = 0
@@ -211,7 +211,7 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
         if hit:
             matched += 1
             j += 1
-        origin = RECORDER if hit else SENSOR
+        origin = RECORDER_ORIGIN if hit else SENSOR_ORIGIN
         out.append(
             Event(
                 ev.kind,
@@ -241,7 +241,7 @@ def decode_capture(
 
     ``invert``: None detects the polarity, True/False forces line/UART levels. ``tx_channel``:
     the recorder's TX on a second channel; its characters on the bus become origin
-    :data:`RECORDER`, all others :data:`SENSOR` (without it every event is origin
+    :data:`RECORDER_ORIGIN`, all others :data:`SENSOR_ORIGIN` (without it every event is origin
     :data:`BUS`). ``edge_error``: any extra edge position error (s) of the analyzer's input
     stage, added to the one-sample-period uncertainty."""
     path = str(path)

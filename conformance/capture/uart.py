@@ -17,9 +17,8 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from ..protocol.timing import BREAK_MIN, BREAK_NEVER
-from ..transcript import Event, EventKind
+from ..transcript import BUS, Event, EventKind
 
-BUS = "bus"  # origin of decoded events whose direction is not known yet (one wire)
 SPACING_PULSE = "spacing pulse"  # text of a BREAK event 6.5-12 ms long (R-7.0-03/04)
 
 

@@ -19,7 +19,7 @@ from ..protocol.timing import (
 from ..transcript import Event, escape
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, runs, segments
-from ..view.segments import expected_reply_address
+from ..view.sides import expected_reply_address
 from .tally import Tally
 from .timing import (
     StampUncertainty,

@@ -8,9 +8,6 @@ sensor rules can judge a recording no tool drove.
 """
 
 from .segments import (
-    BUS,
-    RECORDER,
-    SENSOR,
     Ambiguity,
     IsRecorder,
     ServiceRequest,
@@ -20,6 +17,7 @@ from .segments import (
     on_tool_link,
     read_view,
 )
+from .sides import BUS, RECORDER, SENSOR
 
 __all__ = [
     "BUS",

@@ -28,7 +28,7 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..transcript import Event, EventKind, decode_7e1, decode_8n1, escape
-from .segments import RECORDER, SENSOR, STX, expected_reply_address
+from .sides import RECORDER, SENSOR, STX, expected_reply_address
 
 #: How long past an announced ttt a service request is still read as one (a late one is a
 #: finding on the sensor, not a reason to doubt who sent it).

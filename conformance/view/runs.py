@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 from ..protocol.commands import Kind
 from ..protocol.timing import NO_BREAK_WINDOW
 from ..transcript import Event
-from .segments import LF, STX, IsRecorder, Transmission, read_view
+from .segments import IsRecorder, Transmission, read_view
+from .sides import LF, STX
 
 REPLY_SEARCH = NO_BREAK_WINDOW  # a sensor run starting later than this is not a reply
 RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)

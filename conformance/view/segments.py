@@ -31,17 +31,10 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
+from .direction import infer_directions
+from .sides import BUS, ETX, LF, RECORDER, STX, expected_reply_address
 
 IsRecorder = Callable[[Event], bool]
-
-#: Origin of an event whose direction the recording does not give (a logic-analyzer capture
-#: of the single SDI-12 wire).
-BUS = "bus"
-#: The two sides of an SDI-12 bus, as the view names them (independent of which program the
-#: tool plays: transcript origins ``tool``/``dut`` say who was on the tool's link, not that).
-RECORDER, SENSOR = "recorder", "sensor"
-
-STX, ETX, LF = 0x02, 0x03, 0x0A
 
 #: Marking after a ``!`` that starts a new transmission; anything sooner (``0M!!``) is still
 #: part of the one before, so a ``!`` in the middle of a command is seen (R-4.4-04).
@@ -296,16 +289,6 @@ def _transmission_ambiguities(t: Transmission, requests: set[int]) -> list[Ambig
     return found
 
 
-def expected_reply_address(text: str) -> str | None:
-    """The address a reply to the command ``text`` must start with (None: any address: the
-    wildcard ``?!``, or ``aAb!`` whose reply carries the new address, or the old one)."""
-    if text.startswith("?") or len(text) < 2:
-        return None
-    if len(text) == 4 and text[1] == "A" and text.endswith("!"):
-        return None
-    return text[0]
-
-
 def read_view(
     events: Iterable[Event], is_recorder: IsRecorder | None = None, part: int = 0
 ) -> TranscriptView:
@@ -321,8 +304,6 @@ def read_view(
     if is_recorder is None:
         is_recorder = on_tool_link
         if any(e.origin == BUS for e in ordered):
-            from .direction import infer_directions
-
             sides = {id(e): d.side for e, d in infer_directions(ordered)}
             undirected = [e for e in ordered if sides.get(id(e), RECORDER) is None]
             ordered = [e for e in ordered if sides.get(id(e), RECORDER) is not None]
