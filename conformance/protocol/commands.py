@@ -51,8 +51,6 @@ DESCRIBABLE_KINDS = MEASUREMENT_KINDS | {Kind.CONTINUOUS}
 #: High-volume measurements (section 5): their replies always carry a CRC (R-5.1-03,
 #: R-5.2-03) and their start replies a three-digit count (R-5.1-01, R-5.2-01).
 HIGH_VOLUME_KINDS = frozenset({Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
-#: Families with a CRC twin (``aMC!``, ``aCC!``, ``aRCn!``, R-4.4.12-01); V, HA and HB have none.
-CRC_TWIN_KINDS = frozenset({Kind.MEASURE, Kind.CONCURRENT, Kind.CONTINUOUS})
 #: Commands a v1.3 sensor does not know (high volume, identify-measurement, metadata).
 V14_ONLY_KINDS = frozenset(
     {
