@@ -139,12 +139,8 @@ def _text(
     )
 
 
-def _ms(seconds: float) -> str:
-    return f"{seconds * 1e3:.2f} ms"
-
-
-def _ms_whole(seconds: float) -> str:
-    return f"{seconds * 1e3:.0f} ms"
+def _ms(seconds: float, places: int = 2) -> str:
+    return f"{seconds * 1e3:.{places}f} ms"
 
 
 #: Where a reply must start (R-7.0-09/10): the window the diagram shades after a command.
@@ -157,8 +153,8 @@ LEGEND = (
     ("window", f"reply must start in {WINDOW_LO * 1e3:.2f}–{WINDOW_HI * 1e3:.2f} ms"),
     (
         "follow",
-        f"after a reply: next command without break ≤ {_ms_whole(NO_BREAK_WINDOW)}; "
-        f"standby after {_ms_whole(STANDBY_MARKING)}",
+        f"after a reply: next command without break ≤ {_ms(NO_BREAK_WINDOW, 0)}; "
+        f"standby after {_ms(STANDBY_MARKING, 0)}",
     ),
     ("bad", "out of limits"),
 )
@@ -369,8 +365,8 @@ def _after_reply(axis: Axis, end: float, following: Event | None) -> str:
         f'height="{LINE_H}" fill="{colour}" fill-opacity="0.3"/></g>'
     ]
     for x, label, anchor in (
-        (x87, _ms_whole(NO_BREAK_WINDOW), "end"),
-        (x100, _ms_whole(STANDBY_MARKING), "start"),
+        (x87, _ms(NO_BREAK_WINDOW, 0), "end"),
+        (x100, _ms(STANDBY_MARKING, 0), "start"),
     ):
         out.append(
             f'<line x1="{x:.1f}" y1="{Y_LINE - 4}" x2="{x:.1f}" y2="{Y_LINE + LINE_H + 4}" '

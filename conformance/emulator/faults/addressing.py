@@ -1,8 +1,5 @@
 """Faults in addressing: foreign and old addresses, address changes, the factory address
 and the wildcard (4.3, 4.4.3, 4.4.4).
-
-Each tuple below is one run of the registry (see :mod:`conformance.emulator.faults`, which
-assembles them in the order the faults were added).
 """
 
 from __future__ import annotations

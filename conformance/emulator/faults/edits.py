@@ -75,3 +75,12 @@ def with_spec(key: str, change: Callable[[MeasurementSpec], MeasurementSpec]) ->
         return replace(profile, measurements=measurements)
 
     return transform
+
+
+def toggle_crc(kind: ReplyKind, *, crc: bool, values: bool = True) -> Rewrite:
+    """Replies of ``kind`` that carry a CRC (``crc``) or not, with values or without (the
+    bare ``a[<CRC>]`` form), get the opposite: a CRC missing or one nobody asked for."""
+    return when(
+        lambda r: r.kind is kind and bool(r.crc) == crc and has_values(r) == values,
+        set_to(crc=not crc),
+    )

@@ -1,8 +1,4 @@
-"""Faults in high-volume ASCII and binary measurements and their packets (section 5).
-
-Each tuple below is one run of the registry (see :mod:`conformance.emulator.faults`, which
-assembles them in the order the faults were added).
-"""
+"""Faults in high-volume ASCII and binary measurements and their packets (section 5)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
 """Faults in measurements: service requests, aborts, the data buffer, counts and data
 indices (4.4.5 to 4.4.11).
-
-Each tuple below is one run of the registry (see :mod:`conformance.emulator.faults`, which
-assembles them in the order the faults were added).
 """
 
 from __future__ import annotations

@@ -1,8 +1,4 @@
-"""Faults in identify-measurement and metadata replies (section 6).
-
-Each tuple below is one run of the registry (see :mod:`conformance.emulator.faults`, which
-assembles them in the order the faults were added).
-"""
+"""Faults in identify-measurement and metadata replies (section 6)."""
 
 from __future__ import annotations
 
@@ -13,11 +9,10 @@ from ...protocol.commands import Kind
 from ..profile import MeasurementSpec
 from ..replies import Reply, ReplyKind
 from .edits import (
-    has_values,
     only,
-    set_to,
     silence,
     source_kind,
+    toggle_crc,
     when,
     with_spec,
 )
@@ -159,9 +154,6 @@ THIRD_PARTY_CRC: tuple[Fault, ...] = (
         "metadata-crc-unasked",
         "Metadata replies of plain commands (aIM_001!) carry a CRC nobody asked for.",
         ("R-6.2-02",),
-        rewrite=when(
-            lambda r: r.kind is ReplyKind.METADATA and not r.crc and has_values(r),
-            set_to(crc=True),
-        ),
+        rewrite=toggle_crc(ReplyKind.METADATA, crc=False),
     ),
 )

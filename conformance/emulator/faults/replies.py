@@ -1,9 +1,6 @@
 """Faults in the form of replies: identification, reply framing, values and their length,
 the ASCII and binary CRC, extended commands and multi-line text (4.2, 4.4.2, 4.4.8, 4.4.12,
 4.4.13).
-
-Each tuple below is one run of the registry (see :mod:`conformance.emulator.faults`, which
-assembles them in the order the faults were added).
 """
 
 from __future__ import annotations
@@ -17,12 +14,12 @@ from ..profile import MeasurementSpec, Profile
 from ..replies import Reply, ReplyKind
 from .edits import (
     DATA_REPLIES,
-    has_values,
     measure_family,
     only,
     packet_rewrite,
     set_to,
     source_kind,
+    toggle_crc,
     when,
     with_spec,
 )
@@ -315,37 +312,25 @@ CRC: tuple[Fault, ...] = (
         "crc-on-continuous",
         "aRn! replies (no CRC requested) carry a CRC.",
         ("R-4.4.12-03",),
-        rewrite=when(
-            lambda r: r.kind is ReplyKind.CONTINUOUS and not r.crc and has_values(r),
-            set_to(crc=True),
-        ),
+        rewrite=toggle_crc(ReplyKind.CONTINUOUS, crc=False),
     ),
     Fault(
         "continuous-crc-missing",
         "aRCn! replies for supported Rn carry no CRC.",
         ("R-4.4.12-02",),
-        rewrite=when(
-            lambda r: r.kind is ReplyKind.CONTINUOUS and r.crc and has_values(r),
-            set_to(crc=False),
-        ),
+        rewrite=toggle_crc(ReplyKind.CONTINUOUS, crc=True),
     ),
     Fault(
         "unsupported-rc-without-crc",
         "aRCn! for an unsupported n answers 'a<CR><LF>' instead of 'a<CRC><CR><LF>'.",
         ("R-4.4.8.1-03", "R-4.4.12-02"),
-        rewrite=when(
-            lambda r: r.kind is ReplyKind.CONTINUOUS and r.crc and not has_values(r),
-            set_to(crc=False),
-        ),
+        rewrite=toggle_crc(ReplyKind.CONTINUOUS, crc=True, values=False),
     ),
     Fault(
         "metadata-crc-missing",
         "Metadata replies for CRC commands (aIMC_nnn!, aICC_nnn!, aIHA_nnn!...) lack the CRC.",
         ("R-6.2-02",),
-        rewrite=when(
-            lambda r: r.kind is ReplyKind.METADATA and r.crc and has_values(r),
-            set_to(crc=False),
-        ),
+        rewrite=toggle_crc(ReplyKind.METADATA, crc=True),
     ),
     Fault(
         "crc-variant-different-count",

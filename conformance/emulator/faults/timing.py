@@ -1,8 +1,5 @@
 """Faults in section 7 timing: the reply window, character gaps, breaks, wake-up, standby
 and the baud rate, including probes just inside and outside the limits.
-
-Each tuple below is one run of the registry (see :mod:`conformance.emulator.faults`, which
-assembles them in the order the faults were added).
 """
 
 from __future__ import annotations
