@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..protocol.commands import HIGH_VOLUME_DATA_INDEX_MAX
 from ..protocol.timing import (
     CHAR_TIME,
     MARKING_AFTER_BREAK,
@@ -16,6 +17,7 @@ from ..protocol.timing import (
     STANDBY_MARKING,
     TOLERANCE,
 )
+from ..protocol.values import VALUES_MAX, VALUES_MAX_MEASURE
 
 #: Spacing at least this long is a break. R-7.0-03 forbids seeing a break under 6.5 ms and
 #: R-7.0-04 demands one above 12 ms; 9 ms sits in the middle, clear of both tolerances.
@@ -78,14 +80,13 @@ class Behaviour:
     continuous_overwrites_data: bool = False  # aRn!/aRCn! replace the D buffer
     metadata_crc_sticks: bool = False  # after aIMC_nnn!, plain D replies carry a CRC
     # -- data replies ------------------------------------------------------------------------
-    limit_measure: int = 35  # <values> characters per D reply after M/V (R-4.4-05)
-    limit_concurrent: int = 75  # after C (R-4.4-05)
-    limit_high_volume: int = 75  # after HA (R-5.1-03)
-    limit_continuous: int = 75  # R replies (R-4.4.8.1-01)
+    limit_measure: int = VALUES_MAX_MEASURE  # <values> characters per D reply after M/V
+    limit_concurrent: int = VALUES_MAX  # after C (R-4.4-05)
+    limit_high_volume: int = VALUES_MAX  # after HA (R-5.1-03)
     pack_slack: int = 0  # values left out of each full M/V reply (R-4.4.8.3-03)
     split_values: bool = False  # fill M/V replies to the limit, cutting a value
     drop_all_values: bool = False  # a completed measurement holds no values
-    max_data_index: int = 999  # highest D index served after HA (R-5.1-02)
+    max_data_index: int = HIGH_VOLUME_DATA_INDEX_MAX  # highest D index served after HA
     groups_from_d1: bool = False  # M/V data start at D1, D0 empty (R-4.4.8.3-02)
     # -- other commands ----------------------------------------------------------------------
     continuous_needs_r0: bool = False

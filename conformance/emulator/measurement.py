@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..protocol.commands import Command, Kind
+from ..protocol.commands import Command, Kind, data_index_max
 from ..protocol.values import pack_values
 from .behaviour import Behaviour
 from .profile import MeasurementSpec
@@ -51,9 +51,7 @@ class DataSet:
     @property
     def max_index(self) -> int:
         """Highest D index the measurement type allows (D0..D9, or D999 after HA)."""
-        if self.source is not None and self.source.kind is Kind.HIGH_VOLUME_ASCII:
-            return 999
-        return 9
+        return data_index_max(self.source)
 
     @property
     def fully_read(self) -> bool:

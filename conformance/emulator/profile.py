@@ -13,11 +13,11 @@ profile defines the CRC key itself (which only a fault should do, R-4.4.12-04).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 from ..protocol.binary import DataType
-from ..protocol.commands import ADDRESS_CHARS, Command, Kind
+from ..protocol.commands import ADDRESS_CHARS, Command
 from ..protocol.values import format_value
 
 Number = int | float
@@ -86,22 +86,10 @@ class MeasurementSpec:
 
 
 def measurement_key(command: Command, *, crc: bool = False) -> str:
-    """The profile key of the measurement ``command`` starts, describes or reads (``M1``...)."""
+    """The profile key of the measurement ``command`` starts, describes or reads (``M1``...):
+    its measurement code, with the C of a CRC twin only when ``crc`` asks for it."""
     target = command.target if command.target is not None else command
-    letter = {
-        Kind.MEASURE: "M",
-        Kind.CONCURRENT: "C",
-        Kind.CONTINUOUS: "R",
-        Kind.VERIFY: "V",
-        Kind.HIGH_VOLUME_ASCII: "HA",
-        Kind.HIGH_VOLUME_BINARY: "HB",
-    }[target.kind]
-    if target.kind in (Kind.VERIFY, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY):
-        return letter
-    suffix = "C" if crc and target.crc else ""
-    if target.kind is Kind.CONTINUOUS:
-        return f"R{suffix}{target.group}"
-    return letter + suffix + (str(target.group) if target.group else "")
+    return replace(target, crc=crc and target.crc).measurement_code
 
 
 @dataclass(frozen=True)

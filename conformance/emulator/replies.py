@@ -13,6 +13,7 @@ from enum import StrEnum
 
 from ..protocol.commands import Command
 from ..protocol.crc import ascii_crc, binary_crc
+from ..protocol.framing import CRLF
 from ..transcript import to_wire_7e1
 
 
@@ -67,7 +68,7 @@ class Reply:
     source: Command | None = None
     crc: bool = False
     crc_text: str | None = None
-    end: str = "\r\n"
+    end: str = CRLF
     digits: int = 0
     repeat: int = 0
     binary: BinaryParts | None = None

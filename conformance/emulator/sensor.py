@@ -35,11 +35,14 @@ from math import inf
 from ..protocol.binary import DataType, encode_values
 from ..protocol.commands import (
     SERVICE_REQUEST_KINDS,
+    V14_ONLY_KINDS,
     Command,
     CommandError,
     Kind,
+    count_digits,
     parse_command,
 )
+from ..protocol.framing import COMMAND_END, CRLF, STX, TEXT_END
 from ..sim.bus import Frame
 from ..transcript import parity_bit
 from .faults import compose
@@ -48,24 +51,7 @@ from .profile import MeasurementSpec, Profile
 from .replies import BinaryParts, Reply, ReplyKind
 from .transmitter import Transmission, Transmitter
 
-#: Commands a v1.3 sensor does not know; it stays silent to them.
-V14_ONLY = frozenset(
-    {
-        Kind.HIGH_VOLUME_ASCII,
-        Kind.HIGH_VOLUME_BINARY,
-        Kind.BINARY_DATA,
-        Kind.IDENTIFY_MEASUREMENT,
-        Kind.METADATA,
-    }
-)
 _MAX_COMMAND = 64  # a command longer than this is noise; drop it rather than grow forever
-_COUNT_DIGITS = {
-    Kind.MEASURE: 1,
-    Kind.VERIFY: 1,
-    Kind.CONCURRENT: 2,
-    Kind.HIGH_VOLUME_ASCII: 3,
-    Kind.HIGH_VOLUME_BINARY: 3,
-}
 
 
 class SensorEmulator:
@@ -192,7 +178,7 @@ class SensorEmulator:
         self._buf_end = end
         if (wire >> 7) != parity_bit(char7):
             self._buf_invalid = True  # a parity error spoils the command
-        if char == "!":
+        if char == COMMAND_END:
             text, invalid, begun = "".join(self._buf), self._buf_invalid, self._buf_start
             foreign = self._buf_foreign
             self._buf = []
@@ -299,8 +285,8 @@ class SensorEmulator:
             return
         if cmd.kind is Kind.QUERY_ADDRESS and not b.answer_query:
             return
-        if not self.profile.v14 and cmd.kind in V14_ONLY:
-            return
+        if not self.profile.v14 and cmd.kind in V14_ONLY_KINDS:
+            return  # a v1.3 sensor does not know the command: silence
         run = self._run
         if run is not None and (not run.concurrent or b.command_aborts_concurrent):
             self._abort()  # R-4.4.7.1-01 (and M/V heard without a break)
@@ -351,7 +337,7 @@ class SensorEmulator:
             and len(text) == 4
             and text[0] == self.address
             and text[1] == "A"
-            and text[3] == "!"
+            and text[3] == COMMAND_END
         ):
             self._old_addresses.add(self.address)
             self.address = text[2]
@@ -362,9 +348,9 @@ class SensorEmulator:
         after each, ETX after the last; lines ``line_gap`` apart, no CRC."""
         b = self.behaviour
         for n, line in enumerate(lines):
-            body = (address + "\x02" if n == 0 else "") + line[: b.line_limit]
+            body = (address + chr(STX) if n == 0 else "") + line[: b.line_limit]
             last = n == len(lines) - 1
-            end = "\r\n\x03" if last and b.etx else "\r\n"
+            end = TEXT_END if last and b.etx else CRLF
             sent = self._send(Reply(ReplyKind.EXTENDED, body, command=cmd, end=end), at)
             if sent is None:
                 return
@@ -403,7 +389,7 @@ class SensorEmulator:
     def _start_reply(
         self, cmd: Command, target: Command, spec: MeasurementSpec | None, kind: ReplyKind
     ) -> Reply:
-        digits = _COUNT_DIGITS[target.kind]
+        digits = count_digits(target)
         ttt, count = (spec.ttt, spec.count) if spec is not None else (0, 0)
         body = f"{cmd.address}{ttt:03d}{count:0{digits}d}"
         return Reply(kind, body, command=cmd, source=target, digits=digits)

@@ -14,7 +14,7 @@ from enum import IntEnum
 
 from conformance.protocol.commands import ADDRESS_CHARS
 from conformance.protocol.crc import binary_crc
-from conformance.protocol.values import Violation
+from conformance.protocol.values import Checked, Violation
 from conformance.transcript import escape
 
 HEADER_LEN = 4  # address, size low, size high, type
@@ -111,7 +111,7 @@ def packet_length(prefix: bytes) -> int | None:
 
 
 @dataclass(frozen=True)
-class BinaryPacket:
+class BinaryPacket(Checked):
     """A parsed packet. ``dtype`` is the raw code when it is not a valid :class:`DataType`;
     ``payload`` is the bytes between header and CRC as received; ``values`` is empty unless
     the packet is framed by its size field and its payload fits the type."""
@@ -123,10 +123,6 @@ class BinaryPacket:
     crc_ok: bool
     values: list[int | float]
     violations: list[Violation] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not any(not v.warning for v in self.violations)
 
     @property
     def is_empty(self) -> bool:

@@ -9,8 +9,10 @@ recorder-role judges (was the recorder's command well formed).
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from enum import StrEnum
+from types import MappingProxyType
 
 ADDRESS_CHARS = "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
 WILDCARD = "?"
@@ -46,6 +48,33 @@ SERVICE_REQUEST_KINDS = frozenset({Kind.MEASURE, Kind.VERIFY})
 CONCURRENT_KINDS = frozenset({Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
 #: Kinds that an identify-measurement or metadata command may describe.
 DESCRIBABLE_KINDS = MEASUREMENT_KINDS | {Kind.CONTINUOUS}
+#: High-volume measurements (section 5): their replies always carry a CRC (R-5.1-03,
+#: R-5.2-03) and their start replies a three-digit count (R-5.1-01, R-5.2-01).
+HIGH_VOLUME_KINDS = frozenset({Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
+#: Commands a v1.3 sensor does not know (high volume, identify-measurement, metadata).
+V14_ONLY_KINDS = frozenset(
+    {
+        Kind.HIGH_VOLUME_ASCII,
+        Kind.HIGH_VOLUME_BINARY,
+        Kind.BINARY_DATA,
+        Kind.IDENTIFY_MEASUREMENT,
+        Kind.METADATA,
+    }
+)
+#: Count digits of the reply that starts each measurement: ``atttn`` (R-4.4.5-01),
+#: ``atttnn`` (R-4.4.7-01), ``atttnnn`` (R-5.1-01, R-5.2-01).
+COUNT_DIGITS: Mapping[Kind, int] = MappingProxyType(
+    {
+        Kind.MEASURE: 1,
+        Kind.VERIFY: 1,
+        Kind.CONCURRENT: 2,
+        Kind.HIGH_VOLUME_ASCII: 3,
+        Kind.HIGH_VOLUME_BINARY: 3,
+    }
+)
+#: Highest ``aDn!`` index: D0..D9 after M/C/V (R-4.4.8-01), D0..D999 after aHA! (R-5.1-02).
+DATA_INDEX_MAX = 9
+HIGH_VOLUME_DATA_INDEX_MAX = 999
 
 
 class CommandError(ValueError):
@@ -90,12 +119,17 @@ class Command:
     @property
     def returns_crc(self) -> bool:
         """Whether replies tied to this command carry a CRC (HA/HB always do)."""
-        return self.crc or self.kind in (Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY)
+        return self.crc or self.kind in HIGH_VOLUME_KINDS
 
     def with_address(self, address: str) -> Command:
         return replace(self, address=address)
 
     # -- formatting -----------------------------------------------------------------------
+    @property
+    def measurement_code(self) -> str:
+        """``M``, ``MC3``, ``CC``, ``HA``, ``R0``, ``RC5``: the letters after the address."""
+        return self._measurement_code()
+
     def _measurement_code(self) -> str:
         """``M``, ``MC3``, ``CC``, ``HA``, ``R0``, ``RC5``: the letters after the address."""
         crc = "C" if self.crc else ""
@@ -147,6 +181,32 @@ class Command:
 
     def __str__(self) -> str:
         return self.text()
+
+
+def described(command: Command) -> Command:
+    """The measurement an identify-measurement command stands for (R-6.1-02: its reply has
+    the same shape), else ``command`` itself."""
+    if command.kind is Kind.IDENTIFY_MEASUREMENT and command.target is not None:
+        return command.target
+    return command
+
+
+def count_digits(command: Command) -> int:
+    """How many count digits the reply to ``command`` (or to its identify form) carries.
+
+    ValueError for a command that is not answered with ``atttn`` and its wider forms.
+    """
+    kind = described(command).kind
+    if kind not in COUNT_DIGITS:
+        raise ValueError(f"{command} is not answered with atttn")
+    return COUNT_DIGITS[kind]
+
+
+def data_index_max(measurement: Command | None) -> int:
+    """Highest ``aDn!`` index that can hold data of ``measurement`` (R-4.4.8-01, R-5.1-02)."""
+    if measurement is not None and measurement.kind is Kind.HIGH_VOLUME_ASCII:
+        return HIGH_VOLUME_DATA_INDEX_MAX
+    return DATA_INDEX_MAX
 
 
 # -- constructors, so callers never spell wire text by hand --------------------------------

@@ -6,6 +6,8 @@ bytes, low byte first, for high-volume binary packets (R-5.2-03).
 
 from __future__ import annotations
 
+ASCII_CRC_LEN = 3  # R-4.4.12-06: three characters after the last value
+
 
 def _table() -> tuple[int, ...]:
     table = []

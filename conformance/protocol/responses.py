@@ -20,9 +20,20 @@ from conformance.protocol.commands import (
     MEASUREMENT_KINDS,
     Command,
     Kind,
+    count_digits,
+    described,
 )
-from conformance.protocol.crc import crc16, encode_ascii, is_crc_char
-from conformance.protocol.values import Violation, check_value, errors, split_values
+from conformance.protocol.crc import ASCII_CRC_LEN, crc16, encode_ascii, is_crc_char
+from conformance.protocol.framing import CRLF, crc_tail, unprintable
+from conformance.protocol.values import (
+    VALUES_MAX,
+    VALUES_MAX_MEASURE,
+    Checked,
+    Violation,
+    check_value,
+    errors,
+    split_values,
+)
 from conformance.transcript import escape
 
 __all__ = [
@@ -50,7 +61,6 @@ __all__ = [
     "METADATA_MAX_CHARS",
 ]
 
-CRC_LEN = 3
 METADATA_MAX_CHARS = 75  # R-6.2-04 / decision A7: address through ';' inclusive
 IDENT_MIN, IDENT_MAX = 20, 33  # R-4.4.2-01: a + ll + 8 + 6 + 3 + 0..13
 
@@ -66,10 +76,6 @@ def _ascii_crc(text: str) -> str:
     return encode_ascii(crc16(text.encode("latin-1", "replace")))
 
 
-def _has_errors(violations: list[Violation]) -> bool:
-    return any(not v.warning for v in violations)
-
-
 # -- line framing --------------------------------------------------------------------------
 def split_line(raw: str, crc_positions: int = 0) -> tuple[str, list[Violation]]:
     """Strip the final CR LF from ``raw`` and check the framing rules every reply shares.
@@ -80,19 +86,14 @@ def split_line(raw: str, crc_positions: int = 0) -> tuple[str, list[Violation]]:
     terminator (a lone CR or LF at the end) is removed from the body but still reported.
     """
     found: list[Violation] = []
-    if raw.endswith("\r\n"):
+    if raw.endswith(CRLF):
         body = raw[:-2]
         if not body:
             found.append(Violation("R-4.2-03", "reply '<CR><LF>' has no address before CR LF"))
     else:
-        body = raw[:-1] if raw.endswith(("\r", "\n")) else raw
+        body = raw[:-1] if raw.endswith(tuple(CRLF)) else raw
         found.append(Violation("R-4.2-03", f"reply '{escape(raw)}' does not end with CR LF"))
-    exempt_from = len(body) - crc_positions
-    bad = [
-        c
-        for i, c in enumerate(body)
-        if not 0x20 <= ord(c) <= 0x7E and not (c == "\x7f" and i >= exempt_from)
-    ]
+    bad = unprintable(body, crc_positions)
     if bad:
         shown = escape("".join(dict.fromkeys(bad)))
         found.append(
@@ -154,7 +155,7 @@ def is_service_request(body: str, address: str) -> bool:
 
 # -- aI! -----------------------------------------------------------------------------------
 @dataclass(frozen=True)
-class Identification:
+class Identification(Checked):
     """The fields of an ``aI!`` reply; short replies leave the missing fields short or empty."""
 
     address: str
@@ -164,10 +165,6 @@ class Identification:
     sensor_version: str
     optional: str
     violations: list[Violation] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not _has_errors(self.violations)
 
     @property
     def version_number(self) -> int | None:
@@ -204,17 +201,13 @@ def parse_ident(body: str, expected_address: str | None = None) -> Identificatio
 
 # -- atttn / atttnn / atttnnn --------------------------------------------------------------
 @dataclass(frozen=True)
-class MeasurementReply:
+class MeasurementReply(Checked):
     """``atttn``-style reply; ``ttt``/``count`` are None when the field is not all digits."""
 
     address: str
     ttt: int | None
     count: int | None
     violations: list[Violation] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not _has_errors(self.violations)
 
 
 _FORMAT_REQ = {1: "R-4.4.5-01", 2: "R-4.4.7-01", 3: "R-5.1-01"}
@@ -248,30 +241,17 @@ def parse_measurement_reply(
     return MeasurementReply(body[:1], ttt, count, found)
 
 
-def _described(command: Command) -> Command:
-    """The measurement an identify command stands for (R-6.1-02: same reply shape)."""
-    if command.kind is Kind.IDENTIFY_MEASUREMENT and command.target is not None:
-        return command.target
-    return command
-
-
-def measurement_digits(command: Command) -> int:
-    """How many count digits the reply to ``command`` (or to its identify form) carries."""
-    kind = _described(command).kind
-    if kind in (Kind.MEASURE, Kind.VERIFY):
-        return 1
-    if kind is Kind.CONCURRENT:
-        return 2
-    if kind in (Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY):
-        return 3
-    raise ValueError(f"{command} is not answered with atttn")
+#: How many count digits a reply carries: the table lives in
+#: :mod:`conformance.protocol.commands` (``count_digits``), re-exported under the name the
+#: response parsers have always used.
+measurement_digits = count_digits
 
 
 def parse_measurement_reply_for(
     body: str, command: Command, *, expected_address: str | None = None
 ) -> MeasurementReply:
     """:func:`parse_measurement_reply` with digits and requirement taken from ``command``."""
-    target = _described(command)
+    target = described(command)
     req = "R-5.2-01" if target.kind is Kind.HIGH_VOLUME_BINARY else None
     return parse_measurement_reply(
         body, measurement_digits(command), expected_address=expected_address, requirement=req
@@ -289,7 +269,7 @@ def check_measurement_count(
     """
     if reply.count is None:
         return []
-    target = _described(command)
+    target = described(command)
     found = []
     if reply.count == 0 and target.group == 0:
         if target.kind in (Kind.MEASURE, Kind.VERIFY):
@@ -313,7 +293,7 @@ def check_measurement_count(
 
 # -- aDn! / aRn! ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class DataReply:
+class DataReply(Checked):
     """A D or R reply. ``crc`` is the CRC text found (None if none), ``crc_ok`` whether it
     matches the text before it (None when there is no CRC)."""
 
@@ -322,10 +302,6 @@ class DataReply:
     crc: str | None
     crc_ok: bool | None
     violations: list[Violation] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not _has_errors(self.violations)
 
     @property
     def values_text(self) -> str:
@@ -337,11 +313,11 @@ def expected_value_limit(command: Command) -> int:
 
     35 after M/MC/Mn/MCn/V (room for pre-1.2 recorders), 75 after the C family, HA and R.
     """
-    kind = _described(command).kind
+    kind = described(command).kind
     if kind in (Kind.MEASURE, Kind.VERIFY):
-        return 35
+        return VALUES_MAX_MEASURE
     if kind in (Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.CONTINUOUS):
-        return 75
+        return VALUES_MAX
     raise ValueError(f"{command} is not followed by ASCII data replies")
 
 
@@ -400,9 +376,9 @@ def parse_data_reply(
     crc: str | None = None
     crc_ok: bool | None = None
     if crc_expected:
-        if suffix >= CRC_LEN:
-            crc = rest[-CRC_LEN:]
-            rest = rest[:-CRC_LEN]
+        if suffix >= ASCII_CRC_LEN:
+            crc = rest[-ASCII_CRC_LEN:]
+            rest = rest[:-ASCII_CRC_LEN]
             crc_ok, crc_found = _check_crc(body, crc)
             found += crc_found
         else:
@@ -415,7 +391,7 @@ def parse_data_reply(
     elif suffix:
         crc = body[len(body) - suffix :]
         rest = rest[: len(rest) - suffix]
-        if suffix == CRC_LEN:
+        if suffix == ASCII_CRC_LEN:
             crc_ok, _ = _check_crc(body, crc)
         found.append(
             Violation(
@@ -445,7 +421,7 @@ def parse_data_reply_for(
     Picks the limit and CRC expectation and names the most specific requirements: R-5.1-03
     after HA, R-4.4.8.1-01 for R replies, R-4.4-05 / R-4.4.12-02 otherwise.
     """
-    target = _described(command)
+    target = described(command)
     limit_req, crc_req = "R-4.4-05", "R-4.4.12-02"
     if target.kind is Kind.HIGH_VOLUME_ASCII:
         limit_req = crc_req = "R-5.1-03"
@@ -500,7 +476,7 @@ def check_data_sequence(replies: list[DataReply], announced: int, limit: int) ->
 
 # -- aI..._nnn! ----------------------------------------------------------------------------
 @dataclass(frozen=True)
-class MetadataReply:
+class MetadataReply(Checked):
     """A metadata reply ``a,field1,field2[,...];[<CRC>]``; ``invalid_index`` marks the bare
     ``a[<CRC>]`` reply that says the value index does not exist (R-6.2-05)."""
 
@@ -510,10 +486,6 @@ class MetadataReply:
     crc: str | None
     crc_ok: bool | None
     violations: list[Violation] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not _has_errors(self.violations)
 
 
 def parse_metadata_reply(
@@ -533,9 +505,9 @@ def parse_metadata_reply(
     crc: str | None = None
     crc_ok: bool | None = None
     if crc_expected:
-        if len(body) >= 1 + CRC_LEN and all(is_crc_char(c) for c in body[-CRC_LEN:]):
-            crc = body[-CRC_LEN:]
-            text = body[:-CRC_LEN]
+        if crc_tail(body):
+            crc = body[-ASCII_CRC_LEN:]
+            text = body[:-ASCII_CRC_LEN]
             crc_ok, crc_found = _check_crc(body, crc)
             found += crc_found
         elif len(body) == 1:
@@ -547,22 +519,22 @@ def parse_metadata_reply(
             found.append(Violation("R-6.2-02", f"reply '{escape(body)}' lacks the CRC"))
     if len(text) == 1:
         return MetadataReply(address, [], True, crc, crc_ok, found)
-    if not crc_expected and len(text) == 1 + CRC_LEN and _ascii_crc(address) == text[1:]:
+    if not crc_expected and len(text) == 1 + ASCII_CRC_LEN and _ascii_crc(address) == text[1:]:
         found.append(
             Violation("R-6.2-05", f"invalid-index reply '{escape(body)}' carries an unasked CRC")
         )
         return MetadataReply(address, [], True, text[1:], True, found)
-    tail = text[-CRC_LEN:]
+    tail = text[-ASCII_CRC_LEN:]
     if (
         not crc_expected
-        and len(text) > 2 + CRC_LEN
-        and text[-CRC_LEN - 1] == ";"
+        and len(text) > 2 + ASCII_CRC_LEN
+        and text[-ASCII_CRC_LEN - 1] == ";"
         and all(is_crc_char(c) for c in tail)
     ):  # one deviation, one violation: not also a ';' inside a field (R-6.2-03)
         found.append(
             Violation("R-6.2-02", f"reply '{escape(body)}' carries a CRC nobody asked for")
         )
-        text = text[:-CRC_LEN]
+        text = text[:-ASCII_CRC_LEN]
     content = text[1:]
     if not content.startswith(","):
         found.append(Violation("R-6.2-02", f"reply '{escape(body)}' has no ',' after the address"))

@@ -10,7 +10,6 @@ from __future__ import annotations
 BAUD = 1200
 BITS_PER_FRAME = 10  # start + 7 data + parity + stop (7E1), or start + 8 data + stop (8N1)
 CHAR_TIME = BITS_PER_FRAME / BAUD  # 8.333 ms: one character on the wire
-BIT_TIME = 1 / BAUD  # 0.833 ms
 
 TOLERANCE = 0.40e-3  # R-7.0-01: +/-0.40 ms on every limit that does not say otherwise
 
@@ -19,8 +18,7 @@ BREAK_ALWAYS = 12e-3  # R-7.0-04: spacing longer than this is always a break for
 BREAK_NEVER = 6.5e-3  # R-7.0-03: spacing shorter than this is never a break
 MARKING_AFTER_BREAK = CHAR_TIME  # R-7.0-05/06: 8.33 ms of marking after a break
 WAKE_LIMIT = 100e-3  # R-7.0-07: a sensor can detect a start bit within 100 ms of the break
-RESPONSE_MARKING = CHAR_TIME  # R-7.0-09: the sensor marks 8.33 ms before responding
-RESPONSE_START_MIN = CHAR_TIME - TOLERANCE  # 7.93 ms: earliest first response start bit
+RESPONSE_START_MIN = CHAR_TIME - TOLERANCE  # R-7.0-09: 8.33 ms of marking first, so 7.93 ms
 RESPONSE_START_MAX = 15.0e-3  # R-7.0-10: latest first response start bit (+0.40 ms)
 RELEASE_LINE = 7.5e-3  # R-7.0-08/11: release the line after the last stop bit
 INTER_CHAR_GAP_MAX = 1.66e-3  # R-7.0-12/13: marking between characters, no tolerance

@@ -20,9 +20,13 @@ from dataclasses import dataclass
 from conformance.transcript import escape
 
 VALUE_REQ = "R-4.4.8-02"  # sign, 1-7 digits, at most one '.', at most 9 characters
-SPLIT_REQ = "R-4.4.8.3-01"  # a value is never split across two D replies
 MAX_DIGITS = 7
 MAX_CHARS = 9
+#: ``<values>`` characters in one D reply after M/MC/Mn/V (R-4.4-05: room for pre-1.2
+#: recorders) ...
+VALUES_MAX_MEASURE = 35
+#: ... and after the C family and HA, and in an R reply (R-4.4-05, R-5.1-03, R-4.4.8.1-01).
+VALUES_MAX = 75
 
 
 @dataclass(frozen=True)
@@ -36,6 +40,17 @@ class Violation:
     requirement: str
     message: str
     warning: bool = False
+
+
+class Checked:
+    """Mixin of every parse result: ``ok`` when none of its ``violations`` is an error, so
+    a caller (the tool's recorder deciding whether to retry) need not know the rules."""
+
+    violations: list[Violation]
+
+    @property
+    def ok(self) -> bool:
+        return not errors(self.violations)
 
 
 def errors(violations: list[Violation]) -> list[Violation]:

@@ -19,6 +19,7 @@ from html import escape
 from itertools import pairwise
 
 from ..judges.wire import Segment, segments
+from ..protocol.framing import COMMAND_END, CR, ETX, LF, STX
 from ..protocol.timing import (
     CHAR_TIME,
     INTER_CHAR_GAP_MAX,
@@ -122,7 +123,7 @@ class Axis:
 
 def _glyph(e: Event) -> str:
     c = e.char7
-    names = {0x0D: "CR", 0x0A: "LF", 0x02: "STX", 0x03: "ETX", 0x20: "␣"}
+    names = {CR: "CR", LF: "LF", STX: "STX", ETX: "ETX", 0x20: "␣"}
     if c in names:
         return names[c]
     return chr(c) if 0x21 <= c <= 0x7E else f"{c:02X}"
@@ -138,16 +139,23 @@ def _text(
     )
 
 
-def _ms(seconds: float) -> str:
-    return f"{seconds * 1e3:.2f} ms"
+def _ms(seconds: float, places: int = 2) -> str:
+    return f"{seconds * 1e3:.{places}f} ms"
 
+
+#: Where a reply must start (R-7.0-09/10): the window the diagram shades after a command.
+WINDOW_LO, WINDOW_HI = RESPONSE_START_MIN, RESPONSE_START_MAX + TOLERANCE
 
 LEGEND = (
     ("tool", "recorder → sensor"),
     ("dut", "sensor → recorder"),
     ("break", "break"),
-    ("window", "reply must start in 7.93–15.40 ms"),
-    ("follow", "after a reply: next command without break ≤ 87 ms; standby after 100 ms"),
+    ("window", f"reply must start in {WINDOW_LO * 1e3:.2f}–{WINDOW_HI * 1e3:.2f} ms"),
+    (
+        "follow",
+        f"after a reply: next command without break ≤ {_ms(NO_BREAK_WINDOW, 0)}; "
+        f"standby after {_ms(STANDBY_MARKING, 0)}",
+    ),
     ("bad", "out of limits"),
 )
 LEGEND_WIDTH = LEFT + sum(30 + 6.2 * len(label) for _, label in LEGEND)
@@ -265,19 +273,17 @@ def _break(axis: Axis, e: Event, following: Event | None) -> str:
 
 def _window(axis: Axis, command_end: float, reply: Event | None) -> str:
     """The response-start window after a command (R-7.0-09/10) and where the reply began."""
-    lo = command_end + RESPONSE_START_MIN
-    hi = command_end + RESPONSE_START_MAX + TOLERANCE
-    x0, x1 = axis.x(lo), axis.x(hi)
+    x0, x1 = axis.x(command_end + WINDOW_LO), axis.x(command_end + WINDOW_HI)
     out = [
-        f"<g><title>reply start window {_ms(RESPONSE_START_MIN)} to "
-        f"{_ms(RESPONSE_START_MAX + TOLERANCE)} after the command</title>"
+        f"<g><title>reply start window {_ms(WINDOW_LO)} to "
+        f"{_ms(WINDOW_HI)} after the command</title>"
         f'<rect x="{x0:.1f}" y="{Y_DUT - 4}" width="{x1 - x0:.1f}" height="{LANE_H + 8}" '
         f'fill="{COLOURS["window"]}" fill-opacity="0.22" stroke="{COLOURS["window"]}" '
         'stroke-dasharray="2 2"/></g>'
     ]
     if reply is not None:
         delay = reply.start - command_end
-        ok = RESPONSE_START_MIN - 1e-9 <= delay <= RESPONSE_START_MAX + TOLERANCE + 1e-9
+        ok = WINDOW_LO - 1e-9 <= delay <= WINDOW_HI + 1e-9
         colour = COLOURS["dut"] if ok else COLOURS["bad"]
         rx = axis.x(reply.start)
         out.append(
@@ -316,7 +322,8 @@ def _marking_before_commands(axis: Axis, events: Sequence[Event]) -> str:
         starts_command = e.kind is EventKind.CHAR and e.origin == TOOL
         if not starts_command or previous.kind is EventKind.BREAK:
             continue
-        if previous.origin == TOOL and previous.kind is EventKind.CHAR and previous.char7 != 0x21:
+        tool_char = previous.origin == TOOL and previous.kind is EventKind.CHAR
+        if tool_char and previous.char7 != ord(COMMAND_END):
             continue  # inside a command (a gap between its characters is drawn as is)
         idle = e.start - previous.end
         if not 2 * CHAR_TIME <= idle <= ELIDE_OVER:
@@ -357,7 +364,10 @@ def _after_reply(axis: Axis, end: float, following: Event | None) -> str:
         f'marking</title><rect x="{x0:.1f}" y="{Y_LINE}" width="{x87 - x0:.1f}" '
         f'height="{LINE_H}" fill="{colour}" fill-opacity="0.3"/></g>'
     ]
-    for x, label, anchor in ((x87, "87 ms", "end"), (x100, "100 ms", "start")):
+    for x, label, anchor in (
+        (x87, _ms(NO_BREAK_WINDOW, 0), "end"),
+        (x100, _ms(STANDBY_MARKING, 0), "start"),
+    ):
         out.append(
             f'<line x1="{x:.1f}" y1="{Y_LINE - 4}" x2="{x:.1f}" y2="{Y_LINE + LINE_H + 4}" '
             f'stroke="{colour}" stroke-width="2"/>'
@@ -390,7 +400,7 @@ def _exchanges(events: Sequence[Event]) -> list[tuple[float, Event | None]]:
     """(command end, first reply character or None) for each command ending in ``!``."""
     found = []
     for i, e in enumerate(events):
-        if not (e.kind is EventKind.CHAR and e.origin == TOOL and e.char7 == ord("!")):
+        if not (e.kind is EventKind.CHAR and e.origin == TOOL and e.char7 == ord(COMMAND_END)):
             continue
         reply = None
         for f in events[i + 1 :]:

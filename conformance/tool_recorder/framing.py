@@ -10,9 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..protocol.binary import packet_length
+from ..protocol.framing import ETX, is_text
 from ..protocol.timing import MULTILINE_GAP_MAX, TOLERANCE
 from ..transcript import Event, decode_8n1
-from .validity import ETX, STX, ends_line
+from .validity import ends_line
 
 
 @dataclass(frozen=True)
@@ -33,7 +34,7 @@ class Framing:
 
     def is_text(self, chars: list[Event]) -> bool:
         """A multi-line text reply: STX right after the address."""
-        return self.multiline and len(chars) >= 2 and chars[1].char7 == STX
+        return self.multiline and is_text([e.char7 for e in chars[:2]])
 
     def limit(self, chars: list[Event]) -> int:
         return max(self.max_chars, self.max_text_chars) if self.is_text(chars) else self.max_chars

@@ -1,0 +1,113 @@
+"""Named, composable deviations of the reference sensor (the suite's fault-detection matrix).
+
+A :class:`Fault` changes the emulator through up to three hooks:
+
+- ``settings``: overrides of :class:`~conformance.emulator.behaviour.Behaviour` (timing
+  numbers and behaviour switches);
+- ``rewrite``: a transform of each :class:`~conformance.emulator.replies.Reply` before it is
+  encoded (return None to suppress the reply);
+- ``profile``: a transform of the :class:`~conformance.emulator.profile.Profile` (values,
+  counts, metadata), so that value-level faults still go through the normal packing.
+
+``violates`` lists the requirement IDs the fault breaks, and only those: for every fault the
+suite run against the faulty emulator must FAIL (or WARN, for SHOULD rules and lenient
+decisions such as A18) exactly these IDs. Conventions used when choosing them:
+
+- Where the catalogue has a rule for the specific reply type, a fault declares that rule and
+  not the general one that also covers it: HA data over 75 characters is R-5.1-03 (not also
+  R-4.4-05), R data over 75 is R-4.4.8.1-01, a D reply without CR LF is R-4.2-03 (not also
+  the D format rule R-4.4.8-01), a metadata record without units is R-6.2.2-01.
+- R-4.4-01 ("a well-formed answer to every basic command") is declared, next to the specific
+  rule, only where a basic command gets no answer at all.
+- Rewrites of ``atttn`` replies apply to the identify form too, so R-6.1-02 (identify reply
+  equals the command's reply) stays intact unless the fault is about that rule.
+- A fault applies to the default v1.4 profile unless ``version`` says otherwise.
+
+Faults compose: :func:`compose` applies settings in order (the last one wins on a clash),
+chains rewrites in order and applies profile transforms in order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import replace
+from types import MappingProxyType
+from typing import Any
+
+from ..behaviour import Behaviour
+from . import addressing, high_volume, measurements, metadata, replies, timing
+from .model import Fault, FaultSet, ProfileTransform, Rewrite
+
+__all__ = ["FAULTS", "Fault", "FaultSet", "ProfileTransform", "Rewrite", "compose"]
+
+#: The registry in the order its faults were added, which is the order the matrix, the
+#: reports and ``sdi12-conform faults`` list them in: each family module holds its faults in
+#: runs, one per stage of the suite's history that touched the family.
+_RUNS: tuple[tuple[Fault, ...], ...] = (
+    # identification and reply format
+    replies.FORMAT,
+    # CRC
+    replies.CRC,
+    # service requests
+    measurements.SERVICE_REQUESTS,
+    # aborts
+    measurements.ABORTS,
+    # data buffer
+    measurements.DATA_BUFFER,
+    # addressing
+    addressing.ADDRESSING,
+    # counts
+    measurements.COUNTS,
+    # metadata
+    metadata.METADATA,
+    # high-volume binary
+    high_volume.BINARY,
+    # timing
+    timing.TIMING,
+    # faults that complete the sensor-role coverage
+    measurements.COVERAGE_DATA,
+    timing.COVERAGE_BAUD,
+    addressing.COVERAGE,
+    measurements.COVERAGE,
+    replies.COVERAGE,
+    high_volume.COVERAGE,
+    metadata.COVERAGE,
+    timing.COVERAGE_GAP,
+    # deviations found on a third-party sensor (issue 10)
+    replies.THIRD_PARTY,
+    measurements.THIRD_PARTY_GROUPS,
+    metadata.THIRD_PARTY_COUNT,
+    measurements.THIRD_PARTY_BUFFER,
+    metadata.THIRD_PARTY_CRC,
+    # timing just inside the limits (boundary probes, issue 10)
+    timing.BOUNDARIES,
+    # version specific
+    measurements.VERSION_13,
+)
+
+
+def _registry() -> dict[str, Fault]:
+    registry: dict[str, Fault] = {}
+    for run in _RUNS:
+        for fault in run:
+            if fault.name in registry:
+                raise ValueError(f"duplicate fault {fault.name}")
+            registry[fault.name] = fault
+    return registry
+
+
+#: Every fault by name.
+FAULTS: Mapping[str, Fault] = MappingProxyType(_registry())
+
+
+def compose(names: Iterable[str]) -> FaultSet:
+    """The :class:`FaultSet` for fault names (KeyError naming the unknown fault)."""
+    chosen = []
+    settings: dict[str, Any] = {}
+    for name in names:
+        if name not in FAULTS:
+            raise KeyError(f"unknown fault {name!r}")
+        fault = FAULTS[name]
+        chosen.append(fault)
+        settings.update(fault.settings)
+    return FaultSet(tuple(chosen), replace(Behaviour(), **settings))

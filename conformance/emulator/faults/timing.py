@@ -1,0 +1,142 @@
+"""Faults in section 7 timing: the reply window, character gaps, breaks, wake-up, standby
+and the baud rate, including probes just inside and outside the limits.
+"""
+
+from __future__ import annotations
+
+from .model import Fault
+
+#: Timing.
+TIMING: tuple[Fault, ...] = (
+    Fault(
+        "response-too-early",
+        "Replies start 5 ms after the command's last stop bit (limit 7.93 ms).",
+        ("R-7.0-09",),
+        settings={"reply_delay": 5e-3},
+    ),
+    Fault(
+        "response-too-late",
+        "Replies start 20 ms after the command's last stop bit (limit 15.40 ms).",
+        ("R-7.0-10",),
+        settings={"reply_delay": 20e-3},
+    ),
+    Fault(
+        "inter-char-gap",
+        "3 ms of marking between reply characters (limit 1.66 ms)."
+        " No two reply characters come back to back, so the bit rate cannot be told from the"
+        " gaps (R-4.1-01).",
+        ("R-7.0-12",),
+        settings={"char_gap": 3e-3},
+        inconclusive=("R-4.1-01",),
+    ),
+    Fault(
+        "ignores-short-breaks",
+        "Spacing under 12.9 ms is not taken as a break (a 12.5 ms break goes unseen).",
+        ("R-7.0-04",),
+        settings={"break_threshold": 12.9e-3},
+    ),
+    Fault(
+        "wakes-on-short-spacing",
+        "Spacing of 4 ms or more counts as a break, so a 5 ms pulse wakes the sensor.",
+        ("R-7.0-03",),
+        settings={"break_threshold": 4e-3},
+    ),
+    Fault(
+        "early-address",
+        "An address right after the break is accepted (no 8.33 ms of marking needed).",
+        ("R-7.0-05",),
+        settings={"address_marking": 0.0},
+    ),
+    Fault(
+        "late-address-after-break",
+        "After a break the sensor needs 20 ms of marking before it looks for an address.",
+        ("R-7.0-05",),
+        settings={"address_marking": 20e-3},
+    ),
+    Fault(
+        "slow-wake",
+        "The sensor needs 110 ms after a break before it can see a start bit.",
+        ("R-7.0-07", "R-7.0-05"),
+        settings={"wake_delay": 110e-3},
+    ),
+    Fault(
+        "standby-ignored",
+        "The sensor never drops to standby by itself: it answers after any marking.",
+        ("R-7.0-15",),
+        settings={"standby_marking": float("inf")},
+    ),
+    Fault(
+        "no-follow-up-without-break",
+        "After each reply the sensor needs a break again (follow-ups within 87 ms fail).",
+        ("R-7.0-16",),
+        settings={"standby_after_reply": True},
+    ),
+    Fault(
+        "deaf-after-service-request",
+        "After its service request the sensor needs a break before aD0!.",
+        ("R-7.1-02",),
+        settings={"standby_after_service_request": True},
+    ),
+    Fault(
+        "partial-command-accepted",
+        "Marking inside a command never drops it: a command with an 8.33 ms gap is answered.",
+        ("R-AppB-01",),
+        settings={"partial_gap": float("inf")},
+    ),
+    Fault(
+        "stays-awake-after-foreign",
+        "A command to another address does not send the sensor to standby.",
+        ("R-7.0-14",),
+        settings={"standby_after_foreign": False},
+    ),
+)
+
+
+#: Added to complete the sensor-role coverage: the baud rate.
+COVERAGE_BAUD: tuple[Fault, ...] = (
+    Fault(
+        "fast-baud",
+        "Replies go out at 1300 baud: each character takes 7.69 ms instead of 8.33 ms.",
+        ("R-4.1-01",),
+        settings={"char_time": 10 / 1300},
+    ),
+)
+
+
+#: Added to complete the sensor-role coverage: the gap that has no tolerance.
+COVERAGE_GAP: tuple[Fault, ...] = (
+    Fault(
+        "inter-char-gap-tolerance",
+        "1.9 ms of marking between reply characters: inside 1.66 + 0.40 ms, but that gap "
+        "has no tolerance."
+        " No two reply characters come back to back, so the bit rate cannot be told from the"
+        " gaps (R-4.1-01).",
+        ("R-7.0-12", "R-7.0-01"),
+        settings={"char_gap": 1.9e-3},
+        inconclusive=("R-4.1-01",),
+    ),
+)
+
+
+#: Timing just inside the limits (boundary probes, issue 10).
+BOUNDARIES: tuple[Fault, ...] = (
+    Fault(
+        "standby-after-40ms",
+        "The sensor drops to standby 40 ms after its last reply, not 100 ms: a follow-up "
+        "without a break at 40..87 ms goes unanswered.",
+        ("R-7.0-16",),
+        settings={"standby_after_reply_marking": 40e-3},
+    ),
+    Fault(
+        "standby-after-60ms",
+        "The sensor drops to standby 60 ms after its last reply, not 100 ms.",
+        ("R-7.0-16",),
+        settings={"standby_after_reply_marking": 60e-3},
+    ),
+    Fault(
+        "standby-after-108ms",
+        "The sensor stays awake for 108 ms of marking (100 ms + 0.40 ms are allowed).",
+        ("R-7.0-15",),
+        settings={"standby_marking": 108e-3},
+    ),
+)
