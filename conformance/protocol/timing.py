@@ -10,6 +10,7 @@ from __future__ import annotations
 BAUD = 1200
 BITS_PER_FRAME = 10  # start + 7 data + parity + stop (7E1), or start + 8 data + stop (8N1)
 CHAR_TIME = BITS_PER_FRAME / BAUD  # 8.333 ms: one character on the wire
+BIT_TIME = 1 / BAUD  # 0.833 ms: one bit (a capture decoder and a spacing probe count in bits)
 
 TOLERANCE = 0.40e-3  # R-7.0-01: +/-0.40 ms on every limit that does not say otherwise
 
