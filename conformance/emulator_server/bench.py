@@ -26,7 +26,8 @@ import math
 import random
 from dataclasses import dataclass, field
 
-BAUD = 1200
+from ..protocol.timing import BAUD
+
 SAMPLE_STOP = 9.5  # bit times: where a receiver samples the stop bit of a frame
 
 

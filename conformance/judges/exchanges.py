@@ -16,6 +16,7 @@ from ..protocol.responses import (
     parse_ident,
     split_line,
 )
+from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
 from ..transcript import escape
 
@@ -164,7 +165,7 @@ def continuous(
                     )
             tally.observe(
                 label,
-                check_data_sequence([reply], len(reply.values), 75),
+                check_data_sequence([reply], len(reply.values), VALUES_MAX),
                 ids=["R-4.4.8.3-01"] if "R-4.4.8.3-01" in tally.ids else [],
             )
     if not unsupported:

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+from ..protocol.framing import ETX
 from ..protocol.timing import MULTILINE_GAP_MAX
+from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
 from ..transcript import Event, escape
 from ..verdicts import Finding
 from .tally import Tally
 from .timing import judge_window
 
-STX, ETX, LF = 0x02, 0x03, 0x0A
-LINE_MAX = 75
+LF = ord("\n")
+LINE_MAX = VALUES_MAX  # a multi-line text line is held to the longest reply's values part
 
 
 def is_multiline(ex: Exchange) -> bool:

@@ -23,6 +23,7 @@ from enum import StrEnum
 from ..protocol.binary import parse_binary_packet
 from ..protocol.commands import Command, Kind
 from ..protocol.crc import is_crc_char
+from ..protocol.framing import CRLF, ETX, STX
 from ..protocol.responses import (
     check_address,
     parse_data_reply,
@@ -34,8 +35,6 @@ from ..protocol.responses import (
 from ..protocol.values import Violation
 from ..transcript import Event, decode_7e1, decode_8n1, escape
 
-CRLF = "\r\n"
-STX, ETX = 0x02, 0x03  # multi-line text markers (4.4.13.1)
 NO_LIMIT = 10**6  # value-length limits are the sensor's findings, not validity
 
 #: Violations of these rules mean a wrong CRC (value or encoding).

@@ -150,7 +150,7 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
             "gap(s))",
             evidence=[where],
             measured_ms=round(gap * 1e3, 3),
-            limit_ms=1.66,
+            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
             uncertainty_ms=round(uncertainty * 1e3, 3),
         )
     if maybe:
@@ -162,7 +162,7 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
             "in the 1.66..2.06 ms band, where no tolerance applies",
             evidence=[where],
             measured_ms=round(gap * 1e3, 3),
-            limit_ms=1.66,
+            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
             uncertainty_ms=round(uncertainty * 1e3, 3),
         )
     if not gaps:

@@ -31,7 +31,7 @@ from urllib.parse import parse_qs, urlencode, urlsplit, urlunsplit
 
 import serial
 
-from ..protocol.timing import CHAR_TIME
+from ..protocol.timing import BREAK_MIN, CHAR_TIME, MARKING_AFTER_BREAK
 from ..transcript import DUT, Event, EventKind, to_wire_7e1
 from .base import LinkInfo, StopCondition
 from .errors import PortUnavailable, explain_open_failure
@@ -43,7 +43,7 @@ PREFIX = "adapter"
 ADAPTER_UNCERTAINTY = 50e-3  # s: USB batching plus the adapter's own unknown turnaround
 DEFAULT_BAUD = 9600
 DEFAULT_TIMEOUT = 1.0
-DEFAULT_WAKE = 12e-3 + 8.33e-3  # s: the adapter's break plus the marking after it
+DEFAULT_WAKE = BREAK_MIN + MARKING_AFTER_BREAK  # s: the adapter's break plus the marking after it
 LINE_IDLE = 0.1  # s: a partial line quiet this long is handed over without its LF
 MAX_LINE = 1100  # bytes: a line that never ends is handed over in pieces this long
 TERMINATORS = {"cr": b"\r", "crlf": b"\r\n", "lf": b"\n", "none": b""}

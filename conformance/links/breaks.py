@@ -16,7 +16,8 @@ from typing import Protocol
 import serial
 from serial import rfc2217
 
-BAUD = 1200
+from ..protocol.timing import BAUD
+
 CONFIRM_WAIT = 0.5  # s: how long a server has to confirm a bit-rate change
 NUL_SPACING_BITS = 9  # a NUL frame: start bit and 8 zero data bits, then the stop bit
 

@@ -30,6 +30,7 @@ from urllib.parse import urlsplit
 
 import serial
 
+from ..protocol.timing import BAUD
 from . import adapter_link
 from .base import Link, LinkInfo
 from .breaks import BaudPulse, BreakMaker, Rfc2217Break, UartBreak
@@ -40,7 +41,6 @@ from .kernel_stamps import stamped_port
 from .registry import LinkKind, OpenedPort, Opener, PortOptions, find, register, scheme_is
 from .serial_link import READ_POLL, SerialLink
 
-BAUD = 1200
 LOCAL_NET_UNCERTAINTY = 5e-3
 REMOTE_NET_UNCERTAINTY = 10e-3
 LOOP_UNCERTAINTY = 1e-3

@@ -14,7 +14,7 @@ from __future__ import annotations
 from ..links.base import Link
 from ..links.errors import BreakUnsupported
 from ..protocol import commands as cmds
-from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind
+from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind, data_index_max
 from ..protocol.timing import (
     CHAR_TIME,
     INTER_CHAR_GAP_MAX,
@@ -30,9 +30,6 @@ from . import validity
 from .framing import Framing
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
-
-#: Data-index ceiling per measurement family: D0..D9, or D0..D999 after HA/HB (R-5.1-04).
-_HIGH_VOLUME = (Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY)
 
 
 class Master:
@@ -201,7 +198,7 @@ class Master:
         if m.count is None:
             return m
         address = m.command.address
-        limit = 999 if m.command.kind in _HIGH_VOLUME else 9
+        limit = data_index_max(m.command)
         if max_index is not None:
             limit = min(limit, max_index)
         crc = m.command.returns_crc

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ..protocol.timing import CHAR_TIME, MULTILINE_GAP_MAX, TOLERANCE
+from ..protocol.timing import CHAR_TIME, MULTILINE_GAP_MAX, RETRY_MAX, TOLERANCE
 
 
 @dataclass(frozen=True)
@@ -58,7 +58,7 @@ class Policy:
     salvage: bool = True
 
     def __post_init__(self) -> None:
-        if self.first_char_timeout + self.window_margin >= 87e-3:
+        if self.first_char_timeout + self.window_margin >= RETRY_MAX:
             raise ValueError("first_char_timeout leaves no room for a retry within 87 ms")
         if self.retries_per_sequence < 0 or self.sequences < 1:
             raise ValueError("need at least one sequence and no negative retry count")

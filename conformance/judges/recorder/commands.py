@@ -62,7 +62,7 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
             f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which the "
             f"1.66 ms character gap does not have ({len(leaning)} such gap(s))",
             measured_ms=round(gap * 1e3, 3),
-            limit_ms=1.66,
+            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
         )
     elif gaps:
         tol = Finding(
