@@ -67,8 +67,9 @@ def parse_sim(port: str) -> SimSpec:
     return spec
 
 
-def open_sim(spec: SimSpec) -> OpenedPort:
-    """Build the simulated bus with one reference emulator on it."""
+def sim_profile(spec: SimSpec) -> Profile:
+    """The reference emulator's profile a sim URL asks for, its faults and address checked
+    (:class:`PortError` with the reason): the one check ``sim`` and ``emulate`` share."""
     unknown = [f for f in spec.faults if f not in FAULTS]
     if unknown:
         raise PortError(
@@ -76,7 +77,12 @@ def open_sim(spec: SimSpec) -> OpenedPort:
         )
     if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
-    profile = replace(default_profile(spec.version), address=spec.address)
+    return replace(default_profile(spec.version), address=spec.address)
+
+
+def open_sim(spec: SimSpec) -> OpenedPort:
+    """Build the simulated bus with one reference emulator on it."""
+    profile = sim_profile(spec)
     _bus, link, emulator = sim_sensor(profile, faults=spec.faults)
     declared = emulator.faults.declared_profile(profile)  # the clean profile, not the faulted
     return OpenedPort(link, [emulator], sim_declaration(declared, spec))

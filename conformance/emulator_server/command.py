@@ -12,10 +12,9 @@ import argparse
 import signal
 import sys
 import threading
-from dataclasses import replace
 
 from ..links.priority import EMULATED_LINE, realtime_priority
-from ..ports import PortError, parse_sim
+from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
 from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
@@ -100,20 +99,11 @@ def make_device(version: str, address: str, faults: str) -> object:
     validated the same way (raises :class:`PortError` with the reason)."""
     from urllib.parse import urlencode
 
-    from ..emulator import FAULTS, SensorEmulator, default_profile
-    from ..protocol.commands import ADDRESS_CHARS
+    from ..emulator import SensorEmulator
 
-    spec = parse_sim("sim://?" + urlencode({"version": version, "address": address}))
-    names = tuple(f.strip() for f in faults.split(",") if f.strip())
-    unknown = [f for f in names if f not in FAULTS]
-    if unknown:
-        raise PortError(
-            f"unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the known ones"
-        )
-    if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
-        raise PortError(f"address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
-    profile = replace(default_profile(spec.version), address=spec.address)
-    return SensorEmulator(profile, names)
+    query = {"version": version, "address": address, "faults": faults}
+    spec = parse_sim("sim://?" + urlencode(query))
+    return SensorEmulator(sim_profile(spec), spec.faults)
 
 
 def _host_port(text: str) -> tuple[str, int]:

@@ -220,7 +220,7 @@ class Master:
             usable = exchange.ok or (self.policy.salvage and exchange.answered)
             if not usable:
                 break
-            if not self._take_values(m, exchange, crc):
+            if not take_values(m, exchange, crc):
                 # An empty reply ends collection (R-4.4.8-05). An observer looks one index
                 # further, once, so a sensor whose groups start late leaves evidence.
                 if (
@@ -248,21 +248,6 @@ class Master:
     def _note_accepted(self, command: Command) -> None:
         if command.starts_measurement:
             self._crc_pending[command.address] = command.returns_crc
-
-    def _take_values(self, m: Measurement, exchange: Exchange, crc: bool) -> bool:
-        """Add an accepted D/DB reply's values to ``m``; False if it held none (stop)."""
-        if m.binary:
-            packet = exchange.reply_bytes
-            m.packets.append(packet)
-            count = validity.packet_value_count(packet)
-            m.binary_value_count += count
-            return count > 0
-        text = validity.data_values_text(exchange.reply_text, crc)
-        if not exchange.ok:  # salvaged: keep only what reads as values (no stray CRC, spaces)
-            text = text.rstrip("".join(map(chr, range(0x40, 0x80)))).strip()
-        values = split_values(text)
-        m.values.extend(values)
-        return bool(values)
 
     def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
         """Wait out ttt, recording every DUT character; with ``service_request`` stop at the
@@ -449,3 +434,20 @@ def _last_dut_char_end(link: Link) -> float:
         if event.kind is EventKind.CHAR and event.origin != TOOL:
             return event.end
     return float("-inf")
+
+
+def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:
+    """Add an accepted D/DB reply's values to ``m``; False if it held none (stop). The view
+    rebuilds records with the same rule (:mod:`conformance.view.records`)."""
+    if m.binary:
+        packet = exchange.reply_bytes
+        m.packets.append(packet)
+        count = validity.packet_value_count(packet)
+        m.binary_value_count += count
+        return count > 0
+    text = validity.data_values_text(exchange.reply_text, crc)
+    if not exchange.ok:  # salvaged: keep only what reads as values (no stray CRC, spaces)
+        text = text.rstrip("".join(map(chr, range(0x40, 0x80)))).strip()
+    values = split_values(text)
+    m.values.extend(values)
+    return bool(values)

@@ -22,10 +22,11 @@ from dataclasses import dataclass
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, Kind
+from ..protocol.framing import ETX, STX
 from ..protocol.responses import parse_measurement_reply_for, split_line
 from ..protocol.timing import CHAR_TIME, TOLERANCE
-from ..protocol.values import split_values
 from ..tool_recorder import validity
+from ..tool_recorder.engine import take_values
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
 from ..transcript import Event, decode_8n1, text_end
@@ -104,7 +105,7 @@ def _attempt(
             command_end=t.end,
             gap_limit=CHAR_TIME + TOLERANCE + uncertainty,
             crc_expected=crc,
-            multiline=len(reply) > 1 and reply[1].char7 == validity.STX,
+            multiline=len(reply) > 1 and reply[1].char7 == STX,
         )
         reason = OK if why is None else f"invalid: {why}"
     end = reply[-1].end if reply else t.end + policy.first_char_timeout
@@ -128,7 +129,7 @@ def _complete(t: Transmission, reply: list[Event]) -> bool:
     if t.binary:
         length = packet_length(decode_8n1(reply))
         return length is not None and len(reply) >= length
-    return validity.ends_line(reply) or reply[-1].char7 == validity.ETX
+    return validity.ends_line(reply) or reply[-1].char7 == ETX
 
 
 def _measurements(
@@ -159,7 +160,7 @@ def _measurements(
             m.data.append(later)
             if not (later.ok or (policy.salvage and later.answered)):
                 break
-            if not _take_values(m, later):
+            if not take_values(m, later, m.command.returns_crc):
                 # an observer looks one index past an empty reply, once (as the engine does)
                 if not policy.salvage or probed_past_empty or m.binary:
                     break
@@ -198,22 +199,6 @@ def _collects(ex: Exchange, m: Measurement) -> bool:
         and cmd.address == m.command.address
         and cmd.index == len(m.data)
     )
-
-
-def _take_values(m: Measurement, ex: Exchange) -> bool:
-    """As the tool recorder does: add a usable D/DB reply's values; False stops."""
-    if m.binary:
-        packet = ex.reply_bytes
-        m.packets.append(packet)
-        count = validity.packet_value_count(packet)
-        m.binary_value_count += count
-        return count > 0
-    text = validity.data_values_text(ex.reply_text, m.command.returns_crc)
-    if not ex.ok:
-        text = text.rstrip("".join(map(chr, range(0x40, 0x80)))).strip()
-    values = split_values(text)
-    m.values.extend(values)
-    return bool(values)
 
 
 __all__ = ["Rebuilt", "rebuild_records"]
