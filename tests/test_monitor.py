@@ -59,7 +59,8 @@ class Bus:
         for k, c in enumerate(text):
             wire = to_wire_7e1(ord(c)) ^ (0x80 if k == bad_parity else 0)
             end = self.t + CHAR_TIME
-            self.events.append(Event(EventKind.CHAR, BUS, self.t, end, wire=wire, uncertainty=self.u))
+            char = Event(EventKind.CHAR, BUS, self.t, end, wire=wire, uncertainty=self.u)
+            self.events.append(char)
             self.t += CHAR_TIME
 
 
