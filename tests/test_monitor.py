@@ -365,3 +365,32 @@ def test_ctrl_c_stops_the_monitor_writes_the_transcript_and_exits_cleanly(tmp_pa
         assert monitor.returncode in (0, 1, 2), out
     else:
         assert monitor.returncode == 3 and "not in this build" in out, out
+
+
+def test_on_a_terminal_the_lines_are_a_live_table():
+    """A terminal gets rich's live table (listen-only in its title, flags in their column)."""
+    import io
+
+    from rich.console import Console
+
+    from conformance.monitor.command import LISTEN_ONLY, _LiveView
+
+    bus = Bus()
+    bus.brk()
+    bus.send("0I!")
+    bus.send("0\r\n", 25e-3)
+    tracker = LineTracker()
+    tracker.add(bus.events)
+    screen = io.StringIO()
+    console = Console(file=screen, force_terminal=True, width=160, color_system=None)
+    link = open_listen_link("loop://")
+    try:
+        with _LiveView(console, "loop://") as view:
+            assert view.live_on
+            view.show(tracker.poll(bus.t + 1.0), tracker, link)
+    finally:
+        link.close()
+    text = screen.getvalue()
+    assert LISTEN_ONLY in text
+    assert "0I!" in text and "0<CR><LF>" in text and "R-7.0-10" in text
+    assert "3 characters" not in text and "6 characters, 1 breaks, 1 lines" in text
