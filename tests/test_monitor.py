@@ -35,6 +35,7 @@ from conformance.protocol.timing import CHAR_TIME
 from conformance.tool_recorder.engine import Master
 from conformance.tool_recorder.policy import Policy
 from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
+from conformance.verdicts import Verdict
 
 HAS_PASSIVE = importlib.util.find_spec("conformance.offline.passive") is not None
 NO_PASSIVE = "passive judging (conformance.offline.passive) is not merged into this branch yet"
@@ -394,3 +395,24 @@ def test_on_a_terminal_the_lines_are_a_live_table():
     assert LISTEN_ONLY in text
     assert "0I!" in text and "0<CR><LF>" in text and "R-7.0-10" in text
     assert "3 characters" not in text and "6 characters, 1 breaks, 1 lines" in text
+
+
+def test_a_break_read_as_a_nul_never_fails_the_break_length_rules():
+    """A UART says only that the spacing lasted at least a frame: R-7.0-02 (12 ms) and
+    R-7.0-06 (marking after the break's unknown end) cannot FAIL on it, even on precise stamps."""
+    from conformance.judges.recorder.breaks import judge_breaks
+    from conformance.links.listen import UNKNOWN_LENGTH
+    from conformance.view import read_view
+
+    bus = Bus(uncertainty=0.1e-3)
+    bus.events.append(
+        Event(
+            EventKind.BREAK, BUS, 0.0, CHAR_TIME, uncertainty=0.1e-3,
+            duration_uncertainty=UNKNOWN_LENGTH,
+        )
+    )
+    bus.t = CHAR_TIME + 9e-3
+    bus.send("0!")
+    bus.send("0\r\n", 9e-3)
+    verdicts = {f.requirement: f.verdict for f in judge_breaks(read_view(bus.events), 0.1e-3)}
+    assert verdicts == {"R-7.0-02": Verdict.INCONCLUSIVE, "R-7.0-06": Verdict.INCONCLUSIVE}
