@@ -6,8 +6,8 @@ a problem when it happens. These checks are cheap and local: the reply's format 
 it answers (the protocol parsers of :mod:`conformance.protocol.responses`, which name the
 requirement each violation breaks), parity, and when the reply started after the command
 (R-7.0-09/10, judged with the stamps' uncertainty by
-:func:`~conformance.judges.timing.judge_window`, so a doubtful one is shown as doubtful, never
-as a violation). They are hints beside the live view, not verdicts.
+:func:`~conformance.judges.timing.judge_window`: only a start the stamps' uncertainty cannot
+excuse is flagged). They are hints beside the live view, not verdicts.
 """
 
 from __future__ import annotations

@@ -60,8 +60,8 @@ class LineTracker:
     """Turns the events heard so far into shown lines, one poll at a time."""
 
     settle: float = SETTLE
-    events: list[Event] = field(default_factory=list)
-    shown: list[BusLine] = field(default_factory=list)
+    events: list[Event] = field(default_factory=list)  # from the inference's anchor on
+    lines: int = 0  # lines shown so far
     chars: int = 0
     breaks: int = 0
     flagged: int = 0  # shown lines that break a rule
@@ -91,17 +91,20 @@ class LineTracker:
             line = self._line(run, direction)
             new.append(line)
             self._shown_until = run[-1].end
-        self.shown.extend(new)
+        self.lines += len(new)
         self.flagged += sum(1 for line in new if line.flags)
         self._move_anchor()
         return new
 
     def _move_anchor(self) -> None:
-        """Start the next inference at the last break already shown."""
+        """Start the next inference at the last break already shown, and forget the events
+        before it (the transcript on disk keeps them): memory stays bounded however long the
+        monitor runs."""
         for k in range(len(self.events) - 1, self._anchor - 1, -1):
             e = self.events[k]
             if e.kind is EventKind.BREAK and e.end <= self._shown_until + 1e-12:
-                self._anchor = k
+                del self.events[:k]
+                self._anchor = 0
                 return
 
     def _line(self, run: list[Event], d: Direction) -> BusLine:
