@@ -233,6 +233,7 @@ def test_emulate_refuses_a_tap_that_is_not_a_socket_url(capsys):
     ],
 )
 def test_bad_ports_and_options_exit_4_without_a_traceback(argv, capsys, tmp_path):
+    """A port that cannot be opened, a bad option: one line, exit 4; nothing was opened."""
     assert main([*argv, "--report-dir", str(tmp_path / "r")] if len(argv) > 1 else argv) == 4
     captured = capsys.readouterr()
     assert "Traceback" not in captured.out + captured.err
@@ -437,3 +438,14 @@ def test_the_tracker_forgets_what_it_has_shown_so_a_long_watch_stays_small():
         assert [line.who for line in tracker.poll(bus.t)] == ["recorder"] * 2 + ["sensor"]
     assert tracker.lines == 600 and tracker.chars == 1000 and tracker.breaks == 200
     assert len(tracker.events) <= 6  # from the last break shown on
+
+
+def test_a_silent_bus_is_said_to_be_silent_and_leaves_a_transcript(capsys, tmp_path):
+    out = tmp_path / "m"
+    code = main(["monitor", "--port", "loop://", "--duration", "0.3", "--report-dir", str(out)])
+    said = capsys.readouterr()
+    assert said.out.startswith("listen-only: this tool never transmits")
+    assert "nothing was heard on loop://" in said.out
+    lines = (out / "transcript.jsonl").read_text(encoding="utf-8").splitlines()
+    assert [json.loads(s)["kind"] for s in lines] == ["note"]
+    assert code != 0 and "Traceback" not in said.err  # the judge's exit: nothing to judge

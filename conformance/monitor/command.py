@@ -101,9 +101,14 @@ def monitor_main(argv: list[str], console: Console) -> int:
     say(f"{LISTEN_ONLY} (monitoring {args.port} at 1200 baud 7E1)")
     say("a NUL byte (a framing error) is read as a break; directions are inferred")
     say("Ctrl-C " + (f"or {args.duration:g} s end" if args.duration else "ends") + " it")
-    failure = _watch(link, transcript, console, args.duration)
+    failure, heard = _watch(link, transcript, console, args.duration)
     if failure:
         error(f"error: {failure}; what was heard until then is kept")
+    if not heard:
+        say(
+            f"nothing was heard on {args.port}: is it wired to the bus (RX on the data line, "
+            "common ground) and is anything talking?"
+        )
     say(f"transcript written to {transcript}; judging what was seen (--role {args.role})")
     return judge_recording(transcript, args.role, report_dir, args.address, console)
 
@@ -163,8 +168,11 @@ class _Stop:
             signal.signal(sig, handler)  # type: ignore[arg-type]
 
 
-def _watch(link: ListenLink, path: Path, console: Console, duration: float | None) -> str:
-    """Show and record the bus until stopped; returns why it failed ("" if it did not)."""
+def _watch(
+    link: ListenLink, path: Path, console: Console, duration: float | None
+) -> tuple[str, int]:
+    """Show and record the bus until stopped; returns why it failed ("" if it did not) and
+    how many breaks and characters were heard."""
     tracker = LineTracker()
     view = _LiveView(console, link.name)
     failure = ""
@@ -196,7 +204,7 @@ def _watch(link: ListenLink, path: Path, console: Console, duration: float | Non
             tracker.add(rest)
         view.show(tracker.poll(link.now(), final=True), tracker, link)
     link.transcript.write_jsonl(str(path))  # the whole, in order (the same lines as appended)
-    return failure
+    return failure, tracker.chars + tracker.breaks
 
 
 def _append(fh: IO[str], events: list[Event]) -> None:
