@@ -449,3 +449,31 @@ def test_a_silent_bus_is_said_to_be_silent_and_leaves_a_transcript(capsys, tmp_p
     lines = (out / "transcript.jsonl").read_text(encoding="utf-8").splitlines()
     assert [json.loads(s)["kind"] for s in lines] == ["note"]
     assert code != 0 and "Traceback" not in said.err  # the judge's exit: nothing to judge
+
+
+def test_the_tap_reads_spacing_as_a_uart_would():
+    """A held break and a NUL at a low bit rate (a UART-timed break) reach the tap as 0x00; a
+    short spacing pulse as the byte a 1200-baud UART makes of it; characters as they are."""
+    heard: list[tuple[float, bytes]] = []
+    line = RealTimeLine(make_device("1.4", "0", ""), lambda data: None)
+    line.add_tap(lambda data: heard.append((time.perf_counter(), data)))
+    line.start()
+    try:
+        start = line.now()
+        line.break_on(start)
+        time.sleep(0.06)
+        line.break_off()
+        time.sleep(0.05)
+        line.tool_bytes(b"\x00", baud=600)  # 15 ms of spacing, timed by the UART
+        time.sleep(0.05)
+        line.tool_bytes(b"\x00", baud=4800)  # 1.875 ms: too short for a break
+        time.sleep(0.05)
+        line.tool_bytes(bytes([to_wire_7e1(ord(c)) for c in "0!"]))
+        time.sleep(0.1)  # the sensor answers "0<CR><LF>"
+    finally:
+        line.stop()
+    got = b"".join(data for _, data in heard)
+    assert got[:3] == b"\x00\x00\xfe", got
+    assert bytes(b & 0x7F for b in got[3:]) == b"0!0\r\n", got
+    first_at = heard[0][0] - start
+    assert 0.007 < first_at < 0.05, first_at  # read at its stop-bit sample, not at its end

@@ -148,6 +148,7 @@ class RealTimeLine:
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._echo_spacing(s))
                 if self._taps:
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._tap_held(s))
+                    self._cond.notify()  # due before the break ends: wake the line for it
 
     def break_off(self, at: float | None = None) -> None:
         at = self.now() if at is None else at
