@@ -46,6 +46,7 @@ examples:
   sdi12-conform matrix                                     run the fault-detection matrix
   sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
   sdi12-conform calibrate --port /dev/ttyUSB0              measure the bench's timing first
+  sdi12-conform monitor --port /dev/ttyUSB0                listen to a live bus (never transmits)
 
 exit codes (every subcommand): 0 compliant/success, 1 non-compliant (matrix: a fault not
   caught exactly), 2 interrupted/incomplete, 3 internal error, 4 usage error, 5 no device
@@ -316,7 +317,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT if exact == len(rows) else EXIT_NON_COMPLIANT
 
 
-SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export")
+SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -372,6 +373,10 @@ def _dispatch(argv: list[str]) -> int:
             return export_main(argv[1:])
         if argv and argv[0] == "judge":
             return cmd_judge(argv[1:], console)
+        if argv and argv[0] == "monitor":
+            from .monitor.command import monitor_main
+
+            return monitor_main(argv[1:], console)
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 

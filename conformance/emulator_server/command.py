@@ -18,6 +18,7 @@ from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
 from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
+from .tap import TapServer, parse_tap
 
 EXIT_OK, EXIT_USAGE = 0, 4
 SWITCH_INTERVAL = 2e-4  # s: the GIL hand-over interval while serving (Python's default: 5 ms)
@@ -42,6 +43,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--raw",
         action="store_true",
         help="with --listen: plain bytes (socket://) instead of RFC 2217; carries no breaks",
+    )
+    p.add_argument(
+        "--tap",
+        metavar="socket://HOST:PORT",
+        help="also serve a listen-only tap of the line (port 0: any free): its clients hear "
+        "every character on it, the recorder's and the sensor's, a break as 0x00; what they "
+        "send is dropped (for `sdi12-conform monitor`)",
     )
     p.add_argument("--version", dest="sdi_version", default="1.4", help="1.3 or 1.4 (default)")
     p.add_argument("--address", default="0", help="the sensor's address (default 0)")
@@ -128,6 +136,7 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
         bench = bench_model(args)
         if args.raw and not args.listen:
             raise PortError("--raw applies to --listen only")
+        tap_at = parse_tap(args.tap) if args.tap else None
     except PortError as exc:
         print_line(f"error: {exc}")
         return EXIT_USAGE
@@ -140,22 +149,41 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
     # thread of the server may be preempted while it holds the lock the line needs
     sys.setswitchinterval(SWITCH_INTERVAL)
     realtime_priority(EMULATED_LINE)
-    if args.listen:
-        return _serve_tcp(device, args, what, print_line, bench)
-    return _serve_port(device, args.serial, what, print_line)
+    tap = None
+    if tap_at is not None:
+        try:
+            tap = TapServer(*tap_at, log=print_line).start()
+        except OSError as exc:
+            print_line(f"error: cannot listen on {args.tap}: {exc}")
+            return EXIT_USAGE
+    try:
+        if args.listen:
+            return _serve_tcp(device, args, what, print_line, bench, tap)
+        return _serve_port(device, args.serial, what, print_line, tap)
+    finally:
+        if tap is not None:
+            tap.stop()
 
 
 def _serve_tcp(
-    device: object, args: argparse.Namespace, what: str, print_line, bench: BenchModel
+    device: object,
+    args: argparse.Namespace,
+    what: str,
+    print_line,
+    bench: BenchModel,
+    tap: TapServer | None = None,
 ) -> int:
     try:
         host, port = _host_port(args.listen)
-        line = RealTimeLine(device, lambda _data: None, bench=bench).start()  # type: ignore[arg-type]
+        line = RealTimeLine(device, lambda _data: None, bench=bench)  # type: ignore[arg-type]
+        if tap is not None:
+            line.add_tap(tap.send)
+        line.start()
         server = TcpEmulatorServer(line, host, port, rfc2217_protocol=not args.raw, log=print_line)
     except (PortError, OSError) as exc:
         print_line(f"error: cannot listen on {args.listen}: {exc}")
         return EXIT_USAGE
-    print_line(f"serving the {what} on {server.url} (Ctrl-C stops)")
+    print_line(f"serving the {what} on {server.url} (Ctrl-C stops){_tapped(tap)}")
     _stop_on_sigterm(server.stop)
     try:
         server.serve()
@@ -166,7 +194,9 @@ def _serve_tcp(
     return EXIT_OK
 
 
-def _serve_port(device: object, port_name: str, what: str, print_line) -> int:
+def _serve_port(
+    device: object, port_name: str, what: str, print_line, tap: TapServer | None = None
+) -> int:
     import serial
 
     try:
@@ -174,10 +204,13 @@ def _serve_port(device: object, port_name: str, what: str, print_line) -> int:
     except (serial.SerialException, OSError, ValueError) as exc:
         print_line(f"error: cannot open {port_name}: {exc}")
         return EXIT_USAGE
-    line = RealTimeLine(device, port.write, deliver_at_end=False).start()  # type: ignore[arg-type]
+    line = RealTimeLine(device, port.write, deliver_at_end=False)  # type: ignore[arg-type]
+    if tap is not None:
+        line.add_tap(tap.send)
+    line.start()
     stopped = threading.Event()
     _stop_on_sigterm(stopped.set)
-    print_line(f"serving the {what} on {port_name} at 1200 baud (Ctrl-C stops)")
+    print_line(f"serving the {what} on {port_name} at 1200 baud (Ctrl-C stops){_tapped(tap)}")
     try:
         serve_serial(line, port, stopped)
     except KeyboardInterrupt:
@@ -188,6 +221,10 @@ def _serve_port(device: object, port_name: str, what: str, print_line) -> int:
         line.stop()
         port.close()
     return EXIT_OK
+
+
+def _tapped(tap: TapServer | None) -> str:
+    return f"; listen-only tap on {tap.url}" if tap is not None else ""
 
 
 def _stop_on_sigterm(stop) -> None:

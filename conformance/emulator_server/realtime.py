@@ -86,6 +86,9 @@ class RealTimeLine:
         # busy to keep real time the emulated sensor's timing is not what it planned
         self.worst_lateness = 0.0
         self.late_frames = 0  # committed more than LATE_NOTICE after their planned start
+        # listeners on the line itself (``emulate --tap``): every character on the wire, the
+        # recorder's and the sensor's, at its stop bit, as a UART on the bus would read it
+        self._taps: list[Callable[[bytes], None]] = []
 
     def now(self) -> float:
         return self._clock()
@@ -95,6 +98,13 @@ class RealTimeLine:
         """Point the device's output at a new peer (a new client connection)."""
         with self._cond:
             self._send = send
+
+    def add_tap(self, listen: Callable[[bytes], None]) -> None:
+        """Have ``listen`` hear the line as a receiver on the bus would: each character at
+        its stop bit, spacing as the byte a UART reads at its stop-bit sample (a break: 0x00).
+        Called on the line's thread; it must not block."""
+        with self._cond:
+            self._taps.append(listen)
 
     def set_rts(self, raised: bool) -> None:
         """The recorder switched its transmit enable (RFC 2217 SET_CONTROL RTS)."""
@@ -118,10 +128,13 @@ class RealTimeLine:
                 self._tool_free = end
                 if abs(baud - BAUD) <= BAUD * 0.02:
                     self._push(end, lambda w=wire, s=start, e=end: self.device.on_char(w, s, e))
+                    if self._taps:
+                        self._push(end, lambda w=wire: self._tap(w))
                 else:
                     for a, b in spacing_runs(wire, baud):
                         s, e = start + a, start + b
                         self._push(e, lambda s=s, e=e: self.device.on_break(s, e))
+                        self._tap_spacing(s, e - s)
                 if self.bench.echo:  # the recorder's receiver, at its own rate, reads it back
                     self._push(self._delivery.time(end), lambda w=wire: self._emit(w, echo=True))
             self._cond.notify()
@@ -133,6 +146,9 @@ class RealTimeLine:
                 self._break_start = start = max(at, self._tool_free)
                 if self.bench.echo:  # a receiver reads spacing at its stop-bit sample
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._echo_spacing(s))
+                if self._taps:
+                    self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._tap_held(s))
+                    self._cond.notify()  # due before the break ends: wake the line for it
 
     def break_off(self, at: float | None = None) -> None:
         at = self.now() if at is None else at
@@ -150,14 +166,34 @@ class RealTimeLine:
         """The echo of the spacing that began at ``start``, read at its stop-bit sample: a
         0x00 if the line still spaces (or spaced long enough), else the byte a short pulse
         makes. Runs on the line's thread at the sample time."""
-        if self._break_start == start:
-            duration = self.now() - start
-        else:
-            s, e = self._last_spacing
-            duration = e - s if s == start else 0.0
-        heard = spacing_as_received(duration)
+        heard = spacing_as_received(self._spacing_length(start))
         if heard is not None:
             self._push(self._delivery.time(self.now()), lambda b=heard[0]: self._emit(b, True))
+
+    def _spacing_length(self, start: float) -> float:
+        """How long the spacing that began at ``start`` has lasted (line's thread)."""
+        if self._break_start == start:
+            return self.now() - start
+        s, e = self._last_spacing
+        return e - s if s == start else 0.0
+
+    def _tap_held(self, start: float) -> None:
+        """The taps read a held break (SET_CONTROL) at its stop-bit sample, as a UART does."""
+        heard = spacing_as_received(self._spacing_length(start))
+        if heard is not None:
+            self._tap(heard[0])
+
+    def _tap_spacing(self, start: float, length: float) -> None:
+        """Schedule what the taps read of a spacing pulse of known ``length`` (caller holds
+        the lock): the byte a UART makes of it, at its stop-bit sample."""
+        heard = spacing_as_received(length) if self._taps else None
+        if heard is not None:
+            self._push(start + heard[1], lambda b=heard[0]: self._tap(b))
+
+    def _tap(self, wire: int) -> None:
+        for listen in self._taps:
+            with contextlib.suppress(OSError):
+                listen(bytes([wire]))
 
     def timekeeping(self) -> str:
         """One line for the server log: how well the line kept its schedule so far."""
@@ -229,6 +265,8 @@ class RealTimeLine:
                 if self.bench.require_rts and self._rts:
                     self.lost_frames += 1  # the recorder's driver still holds the line
                     return
+                if self._taps:  # on the wire it is whole at its stop bit, whatever the bench
+                    self._push(frame.start + frame.duration, lambda w=frame.wire: self._tap(w))
                 deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
                 if self._deliver_at_end:
                     deliver = self._delivery.time(deliver)

@@ -14,12 +14,14 @@ from .measurements import service_request_end
 def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-02: every break lasts at least 12 ms. R-7.0-06: after a break the recorder marks
     at least 8.33 ms before the first start bit of its command (both ±0.40 ms)."""
+    # a break read by a UART as a NUL (a listen-only monitor) is known to have lasted only
+    # at least a frame: its length, and so where it ended, carries that event's own doubt
     lengths = [
         judge_window(
             "R-7.0-02",
             "break length",
             b.duration,
-            uncertainty,
+            max(uncertainty, b.duration_uncertainty or 0.0),
             low=BREAK_MIN,
             evidence=[f"break at t={b.start:.3f} s"],
         )
@@ -30,7 +32,7 @@ def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
             "R-7.0-06",
             "marking after the break",
             s.first_char - s.break_event.end,
-            uncertainty,
+            max(uncertainty, s.break_event.duration_uncertainty or 0.0),
             low=MARKING_AFTER_BREAK,
             evidence=[f"before {s.at()}"],
         )
