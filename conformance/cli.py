@@ -376,7 +376,7 @@ def _dispatch(argv: list[str]) -> int:
         if argv and argv[0] == "monitor":
             from .monitor.command import monitor_main
 
-            return monitor_main(argv[1:], console)
+            return monitor_main(argv[1:], console, cmd_judge)
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 

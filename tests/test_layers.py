@@ -55,6 +55,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "matrix",
             "recorder.matrix",
             "calibrate",
+            "monitor",
         ),
     ),
     # what a run is rendered as: console, HTML, verdicts.json

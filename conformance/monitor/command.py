@@ -20,9 +20,11 @@ import signal
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from pathlib import Path
 from typing import IO, TYPE_CHECKING
 
+from ..exits import say_error as error
 from ..links.errors import LinkError, PortError
 from ..transcript import BUS, Event
 from .lines import BusLine, LineTracker
@@ -74,10 +76,13 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def monitor_main(argv: list[str], console: Console) -> int:
-    """Parse ``argv`` (after ``monitor``), monitor until Ctrl-C / ``--duration``, judge."""
-    from ..cli import error
+#: How the monitor has what it heard judged: ``judge(argv, console) -> exit code`` with the
+#: ``judge`` subcommand's arguments (the CLI passes its own, so the layers run one way).
+Judge = Callable[[list[str], "Console"], int]
 
+
+def monitor_main(argv: list[str], console: Console, judge: Judge) -> int:
+    """Parse ``argv`` (after ``monitor``), monitor until Ctrl-C / ``--duration``, judge."""
     args = build_parser().parse_args(argv)  # SystemExit: the CLI maps it to 0 / 4
     if args.duration is not None and not args.duration > 0:
         error(f"error: --duration must be more than 0 s, not {args.duration:g}")
@@ -110,20 +115,23 @@ def monitor_main(argv: list[str], console: Console) -> int:
             "common ground) and is anything talking?"
         )
     say(f"transcript written to {transcript}; judging what was seen (--role {args.role})")
-    return judge_recording(transcript, args.role, report_dir, args.address, console)
+    return judge_recording(transcript, args.role, report_dir, args.address, console, judge)
 
 
 def judge_recording(
-    transcript: Path, role: str, report_dir: Path, address: str | None, console: Console
+    transcript: Path,
+    role: str,
+    report_dir: Path,
+    address: str | None,
+    console: Console,
+    judge: Judge,
 ) -> int:
     """The judging step: ``judge`` on the monitor's transcript (exit code: the judge's)."""
-    from ..cli import cmd_judge, error
-
     argv = [str(transcript), "--role", role, "--report-dir", str(report_dir)]
     if address:
         argv += ["--address", address]
     try:
-        return cmd_judge(argv, console)
+        return judge(argv, console)
     except ModuleNotFoundError as exc:
         if exc.name != "conformance.offline.passive":
             raise
