@@ -14,7 +14,15 @@ from __future__ import annotations
 from ..links.base import Link
 from ..links.errors import BreakUnsupported
 from ..protocol import commands as cmds
-from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, CommandError, Kind, data_index_max
+from ..protocol.commands import (
+    DATA_INDEX_MAX,
+    HIGH_VOLUME_DATA_INDEX_MAX,
+    HIGH_VOLUME_KINDS,
+    SERVICE_REQUEST_KINDS,
+    Command,
+    CommandError,
+    Kind,
+)
 from ..protocol.timing import (
     CHAR_TIME,
     INTER_CHAR_GAP_MAX,
@@ -198,7 +206,9 @@ class Master:
         if m.count is None:
             return m
         address = m.command.address
-        limit = data_index_max(m.command)
+        # D0..D9, or D0..D999 / DB0..DB999 after HA/HB (R-5.1-04)
+        high = m.command.kind in HIGH_VOLUME_KINDS
+        limit = HIGH_VOLUME_DATA_INDEX_MAX if high else DATA_INDEX_MAX
         if max_index is not None:
             limit = min(limit, max_index)
         crc = m.command.returns_crc
