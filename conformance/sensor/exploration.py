@@ -23,7 +23,6 @@ from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_a
 from ..protocol.commands import CommandError, Kind, parse_command
 from ..protocol.crc import is_crc_char
 from ..protocol.responses import parse_data_reply, split_line
-from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
 from ..transcript import escape
 from .session import SensorSession
@@ -186,7 +185,7 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             body, _ = split_line(ex.reply_text)
             if len(body) < 4 or not all(is_crc_char(c) for c in body[-3:]):
                 return  # no CRC claimed: presence is judged by the D-reply cases
-            reply = parse_data_reply(body, crc_expected=True, limit=VALUES_MAX)
+            reply = parse_data_reply(body, crc_expected=True, limit=75)
             for rid in ("R-4.4.12-05", "R-4.4.12-06"):
                 record.checked[rid] += 1
                 bad = [v for v in reply.violations if v.requirement == rid]
