@@ -158,7 +158,11 @@ class SensorSession:
         return parse_command(f"{self.address}{code}!")
 
     def exchange(self, code: str, *, binary: bool | None = None) -> Exchange:
-        """The cached reply to one command (``"I"``, ``"R0"``, ``"IMC_001"``...)."""
+        """The cached reply to one command (``"I"``, ``"R0"``, ``"IMC_001"``...).
+
+        ``Rn``/``RCn`` come from :meth:`continuous_pairs`, made as one unit."""
+        if code in CONTINUOUS:
+            self.continuous_pairs()
         return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
 
     def fresh_exchange(self, code: str, *, binary: bool | None = None, **kw: Any) -> Exchange:
@@ -170,6 +174,29 @@ class SensorSession:
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
         return self.master.measure(self.command(code), **kw)
+
+    def continuous_pairs(self) -> dict[int, tuple[Exchange, Exchange]]:
+        """``{n: (aRn!, aRCn!)}`` for n = 0..9, made once as a unit in that order: a sensor's
+        answer to ``aRn!`` may depend on the command before it (R0 first, say), so every case
+        judges the same sequence whichever asks first."""
+        if "continuous" not in self._cache:
+            for i in range(10):
+                for code in (f"R{i}", f"RC{i}"):
+                    self.once(("x", code), lambda c=code: self.fresh_exchange(c))
+            self._cache["continuous"] = True
+        return {i: (self._cache[("x", f"R{i}")], self._cache[("x", f"RC{i}")]) for i in range(10)}
+
+    def standard_stimuli(self) -> list[Exchange | Measurement]:
+        """The stimuli every full run makes (cached, so a full run sends nothing more): ``a!``,
+        ``aI!``, every measurement of :data:`M_FAMILY` and :data:`C_FAMILY` with its D
+        replies, ``aR0!``..``aRC9!`` and the declared extended commands. A case that judges
+        the run's replies as a whole asks for them, so a partial run (``-k``) that selects it
+        judges every kind of reply a full run does."""
+        made: list[Exchange | Measurement] = [self.exchange(""), self.exchange("I")]
+        made += self.family(M_FAMILY + C_FAMILY)
+        made += [ex for pair in self.continuous_pairs().values() for ex in pair]
+        made += [self.exchange(name) for name in self.declaration.extended]
+        return made
 
     def feature(self, name: str) -> bool | None:
         return self.declaration.feature(name)
@@ -313,3 +340,4 @@ class SensorSession:
 M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in range(1, 10)), "V")
 C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
 HV_FAMILY = ("HA", "HB")
+CONTINUOUS = tuple(f"{r}{i}" for i in range(10) for r in ("R", "RC"))
