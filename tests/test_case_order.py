@@ -65,7 +65,15 @@ def differences(default: dict, other: dict) -> list[str]:
 
 
 ORDERS = [("reversed", 0), ("random", 1), ("random", 2)]
+#: the clean sim, a reply-timing fault and a reply-format fault (both judged by whole-run cases)
 SENSOR_PORTS = ["sim", "sim://?faults=response-too-late", "sim://?faults=extended-no-crlf"]
+#: faults whose verdicts once hung on what an earlier case left in the sensor: the aRn! a
+#: sensor answers only after aR0! (the R/RC pairs are one unit now), and the data an aborted
+#: measurement keeps (the abort cases fill the buffer first)
+STATEFUL_PORTS = [
+    "sim://?faults=continuous-needs-r0-first",
+    "sim://?faults=abort-keeps-old-data",
+]
 _defaults: dict[tuple[str, str], dict] = {}
 
 
@@ -83,8 +91,11 @@ def test_whole_run_cases_run_last_whatever_the_order():
     assert data["run"]["partial"] is False
 
 
-@pytest.mark.parametrize("port", SENSOR_PORTS)
-@pytest.mark.parametrize(("how", "seed"), ORDERS)
+@pytest.mark.parametrize(
+    ("port", "how", "seed"),
+    [(p, how, seed) for p in SENSOR_PORTS for how, seed in ORDERS]
+    + [(p, how, seed) for p in STATEFUL_PORTS for how, seed in ORDERS[:2]],
+)
 def test_sensor_verdicts_do_not_depend_on_order(port, how, seed):
     default = default_run("sensor", port)
     other = run_suite("sensor", port, how, seed)

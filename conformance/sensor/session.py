@@ -18,10 +18,10 @@ from ..links.base import Link
 from ..protocol import commands as cmd
 from ..protocol.commands import Command, parse_command
 from ..protocol.responses import Identification, parse_ident, split_line
-from ..tool_recorder.engine import Master
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event
 from .address_change import AddressChanger
+from .buffer_watch import WatchedMaster
 
 T = TypeVar("T")
 
@@ -58,7 +58,7 @@ class SensorSession:
         timing_uncertainty: float | None = None,
     ) -> None:
         self.link = link
-        self.master = Master(link)
+        self.master = WatchedMaster(link)
         self.declaration = declaration or Declaration()
         self.requested_address = address or self.declaration.address
         self.address = self.requested_address or "0"
@@ -197,6 +197,14 @@ class SensorSession:
         made += [ex for pair in self.continuous_pairs().values() for ex in pair]
         made += [self.exchange(name) for name in self.declaration.extended]
         return made
+
+    def fill_data_buffer(self, code: str) -> None:
+        """Make sure the sensor's data buffer holds values: run the measurement ``code`` (one
+        that delivers values) unless the last command the tool sent it was already a D read
+        answered with values. For cases that judge whether an abort emptied the buffer,
+        which must not depend on what the case before them left in it."""
+        if not self.master.buffer_holds_values(self.address):
+            self.fresh_measurement(code)
 
     def feature(self, name: str) -> bool | None:
         return self.declaration.feature(name)
