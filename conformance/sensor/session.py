@@ -176,13 +176,13 @@ class SensorSession:
         return self.master.measure(self.command(code), **kw)
 
     def continuous_pairs(self) -> dict[int, tuple[Exchange, Exchange]]:
-        """``{n: (aRn!, aRCn!)}`` for n = 0..9, made once as a unit in that order: a sensor's
-        answer to ``aRn!`` may depend on the command before it (R0 first, say), so every case
-        judges the same sequence whichever asks first."""
+        """``{n: (aRn!, aRCn!)}`` for n = 0..9, made once as a unit in a fixed order
+        (``aRC0!``..``aRC9!``, then ``aR0!``..``aR9!``: the order a full run has always sent
+        them in): a sensor's answer to ``aRn!`` may depend on the command before it (R0
+        first, say), so every case judges the same sequence whichever asks first."""
         if "continuous" not in self._cache:
-            for i in range(10):
-                for code in (f"R{i}", f"RC{i}"):
-                    self.once(("x", code), lambda c=code: self.fresh_exchange(c))
+            for code in CONTINUOUS:
+                self.once(("x", code), lambda c=code: self.fresh_exchange(c))
             self._cache["continuous"] = True
         return {i: (self._cache[("x", f"R{i}")], self._cache[("x", f"RC{i}")]) for i in range(10)}
 
@@ -199,11 +199,14 @@ class SensorSession:
         return made
 
     def fill_data_buffer(self, code: str) -> None:
-        """Make sure the sensor's data buffer holds values: run the measurement ``code`` (one
-        that delivers values) unless the last command the tool sent it was already a D read
-        answered with values. For cases that judge whether an abort emptied the buffer,
-        which must not depend on what the case before them left in it."""
-        if not self.master.buffer_holds_values(self.address):
+        """Make sure the sensor's data buffer holds values: run the measurement ``code``
+        again unless the last command the tool sent it was already a D read answered with
+        values, or ``code`` delivered none when it was cached (it would fill nothing). For
+        cases that judge whether an abort emptied the buffer, which must not depend on what
+        the case before them left in it."""
+        if self.measurement(code).value_count and not self.master.buffer_holds_values(
+            self.address
+        ):
             self.fresh_measurement(code)
 
     def feature(self, name: str) -> bool | None:
@@ -348,4 +351,4 @@ class SensorSession:
 M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in range(1, 10)), "V")
 C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
 HV_FAMILY = ("HA", "HB")
-CONTINUOUS = tuple(f"{r}{i}" for i in range(10) for r in ("R", "RC"))
+CONTINUOUS = (*(f"RC{i}" for i in range(10)), *(f"R{i}" for i in range(10)))
