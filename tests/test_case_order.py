@@ -131,3 +131,24 @@ def test_recorder_verdicts_do_not_depend_on_order(how, seed):
         other = run_suite("recorder", "sim", how, seed)
         assert other["summary"] == default["summary"]
     assert differences(default, other) == []
+
+
+def test_the_session_knows_when_the_data_buffer_holds_values():
+    """A D read with values fills the buffer; any later command to the sensor makes it
+    unknown again, and then fill_data_buffer measures anew (and only then)."""
+    from conformance.emulator import sim_sensor
+    from conformance.sensor.session import SensorSession
+
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    assert not sensor.master.buffer_holds_values("0")
+    sensor.measurement("M")  # aM!, service request, aD0! with values
+    assert sensor.master.buffer_holds_values("0")
+    sent = len(link.transcript.events)
+    sensor.fill_data_buffer("M")
+    assert len(link.transcript.events) == sent  # already filled: nothing sent
+    sensor.fresh_exchange("I")
+    assert not sensor.master.buffer_holds_values("0")
+    sensor.fill_data_buffer("M")
+    assert sensor.master.buffer_holds_values("0")
+    assert len(link.transcript.events) > sent
