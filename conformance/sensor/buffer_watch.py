@@ -32,12 +32,13 @@ class WatchedMaster(Master):
 
     def buffer_holds_values(self, address: str) -> bool:
         """The last command sent to ``address`` was an ASCII D read answered with values:
-        its buffer holds values now (a break or standby since keeps them, R-4.4.5-10)."""
+        its buffer holds values now (a break or standby since keeps them, R-4.4.5-10).
+        A value has digits and CRC characters never do, so a digit after the address is a
+        value, even one the sensor wrote badly (without its sign, say) or behind a wrong address."""
         command, reply = self.last_sent.get(address, (None, ""))
         body = reply.rstrip("\r\n")
         return (
             command is not None
             and command.kind is Kind.DATA
-            and body[:1] == address
-            and body[1:2] in ("+", "-")
+            and any(c.isdigit() for c in body[1:])
         )
