@@ -11,6 +11,7 @@ import time
 
 import pytest
 
+from . import whole_run
 from .case import Case
 from .interrupts import GUARD
 from .links.base import LinkError
@@ -57,6 +58,9 @@ def pytest_configure(config: pytest.Config) -> None:
         "markers",
         "needs(*capabilities): link capabilities a case needs: break, unsolicited, binary",
     )
+    config.addinivalue_line("markers", whole_run.MARKER_HELP)
+    if not config.pluginmanager.has_plugin("sdi12-whole-run-last"):
+        config.pluginmanager.register(whole_run.WholeRunLast(), "sdi12-whole-run-last")
     options = RunOptions.from_config(config)
     try:
         check_values(vars(options), plugin=True)

@@ -18,10 +18,10 @@ from ..links.base import Link
 from ..protocol import commands as cmd
 from ..protocol.commands import Command, parse_command
 from ..protocol.responses import Identification, parse_ident, split_line
-from ..tool_recorder.engine import Master
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event
 from .address_change import AddressChanger
+from .buffer_watch import WatchedMaster
 
 T = TypeVar("T")
 
@@ -58,7 +58,7 @@ class SensorSession:
         timing_uncertainty: float | None = None,
     ) -> None:
         self.link = link
-        self.master = Master(link)
+        self.master = WatchedMaster(link)
         self.declaration = declaration or Declaration()
         self.requested_address = address or self.declaration.address
         self.address = self.requested_address or "0"
@@ -158,7 +158,11 @@ class SensorSession:
         return parse_command(f"{self.address}{code}!")
 
     def exchange(self, code: str, *, binary: bool | None = None) -> Exchange:
-        """The cached reply to one command (``"I"``, ``"R0"``, ``"IMC_001"``...)."""
+        """The cached reply to one command (``"I"``, ``"R0"``, ``"IMC_001"``...).
+
+        ``Rn``/``RCn`` come from :meth:`continuous_pairs`, made as one unit."""
+        if code in CONTINUOUS:
+            self.continuous_pairs()
         return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
 
     def fresh_exchange(self, code: str, *, binary: bool | None = None, **kw: Any) -> Exchange:
@@ -170,6 +174,40 @@ class SensorSession:
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
         return self.master.measure(self.command(code), **kw)
+
+    def continuous_pairs(self) -> dict[int, tuple[Exchange, Exchange]]:
+        """``{n: (aRn!, aRCn!)}`` for n = 0..9, made once as a unit in a fixed order
+        (``aRC0!``..``aRC9!``, then ``aR0!``..``aR9!``: the order a full run has always sent
+        them in): a sensor's answer to ``aRn!`` may depend on the command before it (R0
+        first, say), so every case judges the same sequence whichever asks first."""
+        if "continuous" not in self._cache:
+            for code in CONTINUOUS:
+                self.once(("x", code), lambda c=code: self.fresh_exchange(c))
+            self._cache["continuous"] = True
+        return {i: (self._cache[("x", f"R{i}")], self._cache[("x", f"RC{i}")]) for i in range(10)}
+
+    def standard_stimuli(self) -> list[Exchange | Measurement]:
+        """The stimuli every full run makes (cached, so a full run sends nothing more): ``a!``,
+        ``aI!``, every measurement of :data:`M_FAMILY` and :data:`C_FAMILY` with its D
+        replies, ``aR0!``..``aRC9!`` and the declared extended commands. A case that judges
+        the run's replies as a whole asks for them, so a partial run (``-k``) that selects it
+        judges every kind of reply a full run does."""
+        made: list[Exchange | Measurement] = [self.exchange(""), self.exchange("I")]
+        made += self.family(M_FAMILY + C_FAMILY)
+        made += [ex for pair in self.continuous_pairs().values() for ex in pair]
+        made += [self.exchange(name) for name in self.declaration.extended]
+        return made
+
+    def fill_data_buffer(self, code: str) -> None:
+        """Make sure the sensor's data buffer holds values: run the measurement ``code``
+        again unless the last command the tool sent it was already a D read answered with
+        values, or ``code`` delivered none when it was cached (it would fill nothing). For
+        cases that judge whether an abort emptied the buffer, which must not depend on what
+        the case before them left in it."""
+        if self.measurement(code).value_count and not self.master.buffer_holds_values(
+            self.address
+        ):
+            self.fresh_measurement(code)
 
     def feature(self, name: str) -> bool | None:
         return self.declaration.feature(name)
@@ -313,3 +351,4 @@ class SensorSession:
 M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in range(1, 10)), "V")
 C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
 HV_FAMILY = ("HA", "HB")
+CONTINUOUS = (*(f"RC{i}" for i in range(10)), *(f"R{i}" for i in range(10)))

@@ -1,5 +1,8 @@
-"""Rules judged over every transmission of every scenario (this module runs last): breaks and
-the marking after them, command characters, character gaps, the bit rate, the 87 ms rule."""
+"""Rules judged over every transmission of every scenario: breaks and the marking after them,
+command characters, character gaps, the bit rate, the 87 ms rule.
+
+Each case asks for every applicable scenario itself (each runs once per run), so it judges
+the same transmissions whatever order or selection the run was given."""
 
 from __future__ import annotations
 

@@ -167,6 +167,7 @@ def test_break_aborts_measurement(sensor, case):
         return
     target = candidates[0]
     code = target.command.text()[1:-1]
+    sensor.fill_data_buffer(code)  # data kept from before the abort must show as values
     start = sensor.fresh_exchange(code)
     sensor.listen(min(0.05, target.ttt / 10))
     brk = sensor.master.send_break()

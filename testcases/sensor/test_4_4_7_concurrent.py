@@ -103,6 +103,7 @@ def test_own_command_aborts_concurrent(sensor, case):
         case.not_applicable("no concurrent measurement with ttt > 0 and values")
         return
     code = target.command.text()[1:-1]
+    sensor.fill_data_buffer(code)  # data kept from before the abort must show as values
     m, poke = sensor.disturbed_measurement(target.command, f"{sensor.address}I!")
     case.evidence(f"{code} interrupted by {sensor.address}I!", [m, poke])
     d0 = m.data[0] if m.data else None

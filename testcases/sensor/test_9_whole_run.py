@@ -1,5 +1,10 @@
-"""Rules judged over every reply of the run (this module runs last): character framing and
-printability, CR LF endings, the responding address, response start window, character gaps.
+"""Rules judged over every reply of the run: character framing and printability, CR LF
+endings, the responding address, response start window, character gaps.
+
+These cases are ``whole_run``: the plugin runs them after every other case, whatever order
+or selection the run was given, so they judge everything the run sent. Each first asks for the
+standard stimuli (cached: a full run has made them all already and sends nothing more), so a
+partial run that selects them still judges every kind of reply a full run would.
 """
 
 from __future__ import annotations
@@ -11,10 +16,12 @@ from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
 
 requirements = pytest.mark.requirements
+pytestmark = pytest.mark.whole_run
 
 
 def _segments(sensor):
-    """The run's transcript cut into segments, once: these cases add no traffic."""
+    """The run's transcript cut into segments, once the standard stimuli are on it."""
+    sensor.standard_stimuli()
     events = sensor.link.transcript.events
     return sensor.once(("segments", len(events)), lambda: wire.segments(events))
 

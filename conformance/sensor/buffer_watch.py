@@ -1,0 +1,44 @@
+"""What the sensor's data buffer is known to hold, from what the tool last sent it.
+
+A case that must tell kept data from cleared data (an aborted measurement whose D replies
+should be empty) needs values in the buffer before it starts: a sensor that wrongly keeps the
+previous data looks conforming when the previous data were empty. What the buffer holds when a
+case starts was left by whichever case ran before it, so such a case asks for a filled buffer
+explicitly; this watch lets the session say "already filled" without sending anything.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..protocol.commands import Command, Kind
+from ..tool_recorder.engine import Master
+from ..tool_recorder.records import Attempt
+from ..transcript import EventKind
+
+
+class WatchedMaster(Master):
+    """The master engine, noting per address the last command sent and its reply."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.last_sent: dict[str, tuple[Command | None, str]] = {}
+
+    def _attempt(self, wire: bytes, address: str, command: Command | None, **kw: Any) -> Attempt:
+        attempt = super()._attempt(wire, address, command, **kw)
+        reply = "".join(chr(e.char7) for e in attempt.reply_events if e.kind is EventKind.CHAR)
+        self.last_sent[address] = (command, reply)
+        return attempt
+
+    def buffer_holds_values(self, address: str) -> bool:
+        """The last command sent to ``address`` was an ASCII D read answered with values:
+        its buffer holds values now (a break or standby since keeps them, R-4.4.5-10).
+        A value has digits and CRC characters never do, so a digit after the address is a
+        value, even one the sensor wrote badly (without its sign, say) or behind a wrong address."""
+        command, reply = self.last_sent.get(address, (None, ""))
+        body = reply.rstrip("\r\n")
+        return (
+            command is not None
+            and command.kind is Kind.DATA
+            and any(c.isdigit() for c in body[1:])
+        )
