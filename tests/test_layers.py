@@ -56,6 +56,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "recorder.matrix",
             "calibrate",
             "monitor",
+            "whole_run",
         ),
     ),
     # what a run is rendered as: console, HTML, verdicts.json
