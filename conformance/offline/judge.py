@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..capture import BUS, CaptureDecode, CaptureError, decode_capture, embedded_notes, sniff
+from ..capture import CaptureDecode, CaptureError, decode_capture, embedded_notes, sniff
 from ..replay.link import VIRTUAL_KINDS
 from ..replay.recording import (
     Recording,
@@ -30,7 +30,9 @@ from ..replay.recording import (
     transcript_path,
     write_recording,
 )
-from ..transcript import EventKind
+from ..transcript import BUS, DUT, TOOL, Event, EventKind
+from ..view.direction import infer_directions
+from ..view.sides import RECORDER, SENSOR
 
 ROLES = ("sensor", "recorder", "both")
 
@@ -152,12 +154,11 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
     if not options:
         found.notes.append("judged passively: the capture does not say which run it is of")
         return
-    events = decoded.events
-    unknown = sum(1 for e in events if e.origin == BUS)
-    if unknown:
+    events, unsettled = directed(decoded.events)
+    if unsettled:
         found.notes.append(
-            f"judged passively: the direction of {unknown} character(s) is not known "
-            "(a --tx-channel tells it)"
+            f"judged passively: the protocol does not settle who sent {unsettled} of the "
+            "capture's characters, and a replay needs every one (a --tx-channel settles it)"
         )
         return
     report_dir = Path(args.report_dir or default_report_dir(str(options.get("role", "sensor"))))
@@ -172,6 +173,28 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
     args.report_dir = str(report_dir)
     found.replay_argv = replay_argv(recording, args)
     found.notes.append(f"decoded capture written to {decoded_path}")
+
+
+def directed(events: list[Event]) -> tuple[list[Event], int]:
+    """``events`` with the direction the protocol implies where the capture does not give it
+    (origin ``tool`` for the recorder's side, ``dut`` for the sensors'), and how many the
+    protocol did not settle for sure. Those are not guessed: a replay needs every direction
+    (a recorder replayed from a wrong one would act as the real one never did), so a capture
+    with any left open is judged passively instead."""
+    if not any(e.origin == BUS for e in events):
+        return events, 0
+    origin = {RECORDER: TOOL, SENSOR: DUT}
+    out: list[Event] = []
+    open_ = 0
+    for e, d in infer_directions(events):
+        if e.origin != BUS:
+            out.append(e)
+        elif d.side is None or not d.sure:
+            open_ += 1
+            out.append(e)
+        else:
+            out.append(replace(e, origin=origin[d.side]))
+    return out, open_
 
 
 def decode(path: Path, args: argparse.Namespace) -> CaptureDecode:
