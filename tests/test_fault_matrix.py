@@ -15,9 +15,6 @@ from conformance.catalog import for_role
 from conformance.emulator import FAULTS
 from conformance.matrix import MatrixRow, fault_matrix, run_once
 
-# The module fixture runs every selected row at once: keep the module on one xdist worker.
-pytestmark = pytest.mark.xdist_group("sensor-fault-matrix")
-
 #: A handful of faults (protocol, CRC, timing) the default fast selection
 #: keeps; every other row carries the ``matrix`` marker and runs in the full run (.ci/run).
 FAST_FAULTS = {"no-service-request", "wrong-crc", "response-too-late"}
