@@ -128,6 +128,7 @@ def test_port_strings_parse_into_url_and_options():
         parse_adapter_port("adapter:COM3?bogus=1")
 
 
+@pytest.mark.realtime
 def test_exchange_through_the_adapter_and_no_break(adapter):
     link = open_real_link(adapter.url)
     try:
@@ -187,6 +188,7 @@ SELECTION = (
 )
 
 
+@pytest.mark.realtime
 def test_cli_judges_protocol_level_requirements_through_the_adapter(adapter, tmp_path):
     code, doc = _run_cli(adapter.url, tmp_path, "-k", SELECTION)
     verdicts = _verdicts(doc)
@@ -203,6 +205,7 @@ def test_cli_judges_protocol_level_requirements_through_the_adapter(adapter, tmp
     assert "uncertainty straddles" in details["R-7.0-09"]
 
 
+@pytest.mark.realtime
 def test_cli_reports_a_fault_served_through_the_adapter(tmp_path):
     fake = FakeAdapter(faults=("ack-trailing-space",))
     try:

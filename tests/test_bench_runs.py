@@ -24,6 +24,9 @@ from test_verdicts_contract import VALIDATOR
 
 from conformance.emulator_server.process import EmulatorProcess
 
+# Real-time emulator processes behind modelled interfaces: run serially (.ci/run).
+pytestmark = pytest.mark.realtime
+
 SELECTION = (
     "test_acknowledge_active or test_identification or test_service_request "
     "or test_response_start_window or test_character_gaps "

@@ -23,6 +23,7 @@ def calibrate(*args: str) -> tuple[int, str]:
     return proc.returncode, text
 
 
+@pytest.mark.realtime
 def test_calibrate_behind_an_echoing_16ms_usb_adapter():
     """The README's example: echo found, breaks UART-timed (so the break rules are decided),
     a 16 ms latency timer leaves the response window and the gap undecided, and says so."""
@@ -38,6 +39,7 @@ def test_calibrate_behind_an_echoing_16ms_usb_adapter():
     assert "a run here would use: measured ±" in text
 
 
+@pytest.mark.realtime
 def test_calibrate_without_echo_keeps_the_declared_floor():
     with EmulatorProcess() as emulator:
         code, text = calibrate("--port", emulator.url, "--rounds", "2")

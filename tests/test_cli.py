@@ -22,12 +22,15 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]
     )
 
 
+# The default selection's CLI run on sim is test_verdicts_contract's clean run (the same
+# command); these two repeat it in the full run only.
 @pytest.fixture(scope="module")
 def clean(tmp_path_factory) -> tuple[subprocess.CompletedProcess[str], Path]:
     out = tmp_path_factory.mktemp("clean")
     return run("--port", "sim", "--role", "sensor", "--report-dir", str(out)), out
 
 
+@pytest.mark.slow
 def test_clean_simulated_sensor_is_compliant(clean):
     proc, out = clean
     assert proc.returncode == 0, proc.stdout + proc.stderr
@@ -36,6 +39,7 @@ def test_clean_simulated_sensor_is_compliant(clean):
         assert (out / name).stat().st_size > 0, name
 
 
+@pytest.mark.slow
 def test_judged_count_equals_testable_sensor_requirements(clean):
     proc, out = clean
     data = json.loads((out / "verdicts.json").read_text())
@@ -47,6 +51,7 @@ def test_judged_count_equals_testable_sensor_requirements(clean):
     assert data["summary"]["counts"]["FAIL"] == data["summary"]["counts"]["WARN"] == 0
 
 
+@pytest.mark.slow
 def test_a_fault_makes_the_run_non_compliant(tmp_path):
     proc = run("--port", "sim://?faults=no-service-request", "--report-dir", str(tmp_path))
     assert proc.returncode == 1, proc.stdout + proc.stderr
@@ -86,6 +91,7 @@ def test_version_and_help():
     assert helped.returncode == 0 and "exit codes" in helped.stdout
 
 
+@pytest.mark.slow
 def test_version_1_3_sensor_is_compliant(tmp_path):
     proc = run("--port", "sim://?version=1.3&address=5", "--report-dir", str(tmp_path))
     assert proc.returncode == 0, proc.stdout

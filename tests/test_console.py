@@ -53,6 +53,7 @@ def test_plain_output_has_one_line_per_case_and_every_finding_to_read(monkeypatc
     assert f"report: {tmp_path / 'report.html'}" in lines
 
 
+@pytest.mark.slow
 def test_plain_output_of_a_clean_run_lists_nothing_to_read(monkeypatch, tmp_path):
     code, out, data = run_cli(monkeypatch, tmp_path, "sim", terminal=False)
     assert code == cli.EXIT_COMPLIANT
@@ -61,6 +62,7 @@ def test_plain_output_of_a_clean_run_lists_nothing_to_read(monkeypatch, tmp_path
     assert out.rstrip().splitlines()[-3] == "verdict: COMPLIANT"
 
 
+@pytest.mark.slow
 def test_terminal_shows_progress_failures_live_and_a_summary_table(monkeypatch, tmp_path):
     code, out, data = run_cli(monkeypatch, tmp_path, FAULTY, terminal=True)
     assert code == cli.EXIT_NON_COMPLIANT
@@ -106,6 +108,7 @@ def test_one_line(text, width, expected):
     assert one_line(text, width) == expected
 
 
+@pytest.mark.slow
 def test_judged_counts_verdicts_on_the_device_not_na():
     """Issue 10: a v1.3 run judged 77 rules; the 29 that bind v1.4 only are N/A, said apart."""
     from conformance.matrix import run_once

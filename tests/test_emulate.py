@@ -55,6 +55,7 @@ def served():
     line.stop()
 
 
+@pytest.mark.realtime
 def test_served_sensor_answers_in_the_section_7_window(served):
     exchange = Master(served).identify("0")
     assert exchange.ok, exchange.reply_text
@@ -71,6 +72,7 @@ def test_served_sensor_answers_in_the_section_7_window(served):
     assert max(gaps) < INTER_CHAR_GAP_MAX + u, gaps
 
 
+@pytest.mark.realtime
 def test_served_sensor_measures_with_a_service_request(served):
     started = time.monotonic()
     m = Master(served).measure(cmds.parse_command("0M!"))
@@ -178,6 +180,7 @@ def unexpected_failures(emulator: EmulatorProcess, unexpected: set[str], text: s
     pytest.fail(f"unexpected FAILs {sorted(unexpected)} (line late by {late}):\n{text}")
 
 
+@pytest.mark.realtime
 def test_clean_emulator_over_rfc2217_has_no_failure(emulator, tmp_path):
     code, data, text = judge(emulator.url, tmp_path, "-k", SELECTION)
     verdicts = verdicts_of(data)
@@ -197,6 +200,7 @@ def test_clean_emulator_over_rfc2217_has_no_failure(emulator, tmp_path):
     assert verdicts["R-7.0-10"] in ("PASS", "INCONCLUSIVE"), text
 
 
+@pytest.mark.realtime
 @pytest.mark.parametrize("emulator", [("--echo",)], indirect=True, ids=["echo"])
 def test_echoing_interface_gives_definite_timing_from_a_measured_uncertainty(emulator, tmp_path):
     """Behind an interface that echoes, the reply is timed against the echo of the command
@@ -215,6 +219,7 @@ def test_echoing_interface_gives_definite_timing_from_a_measured_uncertainty(emu
     assert "0I!" not in (data["dut"]["identification"] or ""), "the echo is not the DUT's"
 
 
+@pytest.mark.realtime
 def test_timing_uncertainty_option_only_widens(emulator, tmp_path):
     """``--timing-uncertainty-ms`` may widen what the link measured, never narrow it: 0.01 ms
     asked over plain loopback RFC 2217 still reports at least the declared 5 ms."""
@@ -233,6 +238,7 @@ def test_timing_uncertainty_option_only_widens(emulator, tmp_path):
     assert data["run"]["link"]["timing_uncertainty_ms"] == 30.0, text
 
 
+@pytest.mark.realtime
 @pytest.mark.parametrize(
     ("emulator", "extra", "expected"),
     [
@@ -253,6 +259,7 @@ def test_faulty_emulator_over_rfc2217_fails_its_requirements(emulator, extra, ex
     unexpected_failures(emulator, failed - expected, text)
 
 
+@pytest.mark.realtime
 @pytest.mark.skipif(not os.environ.get("SDI12_E2E_FULL"), reason="set SDI12_E2E_FULL=1 (~5 min)")
 def test_full_suite_over_rfc2217_is_compliant(emulator, tmp_path):
     code, data, text = judge(emulator.url, tmp_path, bound=900)

@@ -15,6 +15,10 @@ from conformance.catalog import for_role
 from conformance.emulator import FAULTS
 from conformance.matrix import MatrixRow, fault_matrix, run_once
 
+#: A handful of faults (protocol, CRC, timing) the default fast selection
+#: keeps; every other row carries the ``matrix`` marker and runs in the full run (.ci/run).
+FAST_FAULTS = {"no-service-request", "wrong-crc", "response-too-late"}
+
 
 def selected_params(request: pytest.FixtureRequest, name: str) -> list[str]:
     """The values of parameter ``name`` among this module's selected tests."""
@@ -34,7 +38,10 @@ def rows(request: pytest.FixtureRequest) -> dict[str, MatrixRow]:
     return {r.fault: r for r in fault_matrix(wanted, processes=2)}
 
 
-@pytest.mark.parametrize("fault", sorted(FAULTS))
+@pytest.mark.parametrize(
+    "fault",
+    [pytest.param(f, marks=() if f in FAST_FAULTS else pytest.mark.matrix) for f in sorted(FAULTS)],
+)
 def test_fault_is_caught_by_exactly_its_requirements(fault, rows):
     row = rows[fault]
     assert row.exact, row.explain()
@@ -46,7 +53,7 @@ def test_the_matrix_is_large():
     assert len(FAULTS) >= 60
 
 
-@pytest.mark.parametrize("version", ["1.3", "1.4"])
+@pytest.mark.parametrize("version", [pytest.param("1.3", marks=pytest.mark.slow), "1.4"])
 def test_clean_emulator_is_compliant_with_no_fail_or_warn(version):
     data = run_once(f"sim://?version={version}")
     assert data["summary"]["verdict"] == "COMPLIANT"

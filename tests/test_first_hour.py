@@ -14,6 +14,9 @@ import pytest
 
 from conformance.emulator import FAULTS
 
+# Every item runs the CLI in a subprocess as a user would; test_cli keeps one such run by default.
+pytestmark = pytest.mark.slow
+
 EXIT_USAGE = 4
 
 

@@ -16,6 +16,9 @@ from conformance.emulator import FAULTS
 from conformance.matrix import row_from, run_once
 from conformance.recorder.faults import RECORDER_FAULTS
 
+# Compiles the C harness and runs whole suites through harness processes.
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 #: what a harness link never observes: the bit rate (the tool makes the frames itself)
 HARNESS = ("R-4.1-01",)

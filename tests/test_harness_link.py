@@ -105,6 +105,7 @@ def reaped(pidfile: Path) -> bool:
     return not Path(f"/proc/{pid}").exists()
 
 
+@pytest.mark.slow
 def test_the_python_example_sensor_is_compliant_with_exact_timing():
     data = run_once(f"exec:{sys.executable} {ROOT / 'examples/python/sensor_harness.py'}")
     assert data["summary"]["verdict"] == "COMPLIANT"
@@ -121,6 +122,7 @@ def test_the_python_example_sensor_is_compliant_with_exact_timing():
     assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("mode", "at", "words"),
     [
@@ -189,6 +191,7 @@ def test_a_run_whose_harness_fell_out_of_step_is_incomplete(misbehaving):
     assert reaped(pidfile)
 
 
+@pytest.mark.slow
 def test_a_hung_harness_is_stopped_after_the_reply_timeout(misbehaving):
     port, pidfile = misbehaving("hang", 40)
     link = open_sensor_harness(port, reply_timeout=0.5)
@@ -320,6 +323,7 @@ def test_a_crashing_recorder_harness_ends_the_run_with_an_error(tmp_path: Path):
     assert reaped(pidfile)
 
 
+@pytest.mark.slow
 def test_a_unix_socket_recorder_harness_is_judged_per_scenario(tmp_path: Path):
     """``--role recorder --port unix:PATH``: the tool connects afresh for each scenario; here
     the golden recorder serves each connection through the Python client."""

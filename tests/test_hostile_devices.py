@@ -24,6 +24,9 @@ import pytest
 from conformance.protocol.timing import CHAR_TIME
 from conformance.transcript import to_wire_7e1
 
+# Each test runs the CLI in a subprocess against a TCP device (10-50 s each on a busy machine).
+pytestmark = pytest.mark.slow
+
 CASES = "test_acknowledge_active or test_identification or test_short_spacing_is_not_a_break"
 WITH_FRAMING = CASES + " or test_reply_framing"  # R-4.1-02 / R-4.2-02 are judged there
 IDENT = "014HOSTILE HOSTL1001"

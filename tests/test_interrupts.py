@@ -10,6 +10,11 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
+# A sweep of Ctrl-C timed against a measured whole run: minutes, and wall-clock sensitive.
+pytestmark = [pytest.mark.realtime, pytest.mark.slow]
+
 FINISHED_EXIT = 0  # the clean simulated sensor is COMPLIANT
 POINTS = 22
 

@@ -151,6 +151,7 @@ def test_wrong_parity_from_a_serial_device_is_kept_as_evidence():
         os.close(device)
 
 
+@pytest.mark.realtime  # breaks timed by the host: run serially
 @pty_only
 def test_uart_break_records_the_duration_it_held():
     controller, device = os.openpty()
@@ -277,6 +278,7 @@ def _served_break(duration: float, exact: bool = False) -> tuple[object, tuple[f
         line.stop()
 
 
+@pytest.mark.realtime  # breaks timed by the host: run serially
 def test_rfc2217_short_break_is_a_nul_timed_by_the_uart():
     """A 13 ms break is a NUL at 692 baud: the line holds spacing for exactly 9 bit times,
     whatever the host's sleep did, and the event says so with a tiny length uncertainty."""
@@ -287,6 +289,7 @@ def test_rfc2217_short_break_is_a_nul_timed_by_the_uart():
     assert end - start == pytest.approx(9 / 692, abs=1e-9)  # the line's own arithmetic
 
 
+@pytest.mark.realtime  # breaks timed by the host: run serially
 def test_rfc2217_wake_up_break_is_held_by_set_control():
     """An ordinary wake-up break (not near a threshold) is held with raw SET_CONTROL."""
     event, (start, end) = _served_break(13e-3)
@@ -295,6 +298,7 @@ def test_rfc2217_wake_up_break_is_held_by_set_control():
     assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
 
 
+@pytest.mark.realtime  # breaks timed by the host: run serially
 def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
     """A server that does not take SET-BAUDRATE would send the NUL at 1200 baud (7.5 ms of
     spacing, not what was asked): the link sees the refusal and holds the break instead."""
@@ -315,6 +319,7 @@ def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
     assert abs((end - start) - event.duration) < 3e-3
 
 
+@pytest.mark.realtime  # breaks timed by the host: run serially
 def test_rfc2217_long_break_is_held_by_set_control():
     """Longer than a NUL at the lowest rate can make: held with raw SET_CONTROL messages."""
     event, (start, end) = _served_break(100e-3, exact=True)

@@ -57,6 +57,7 @@ def _silent_bus(port: str, **_bench: str) -> OpenedPort:
     return OpenedPort(SimLink(SimBus([LineMonitor()])), [], declared)
 
 
+@pytest.mark.slow
 def test_do_nothing_sensor_gets_no_pass(monkeypatch):
     """Every sensor case runs against a mute line (discovery, which would stop the run, is
     skipped): whatever the cases send, nothing answers, and nothing may PASS."""

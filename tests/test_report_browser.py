@@ -17,6 +17,9 @@ from pathlib import Path
 import pytest
 from report_browser import SCREENSHOTS, Chromium, require_chromium
 
+# Drives headless Chromium.
+pytestmark = pytest.mark.browser
+
 RUNS = {"clean": ("sim", 0), "faulty": ("sim://?faults=no-service-request", 1)}
 VIEWPORT = (1280, 720)
 

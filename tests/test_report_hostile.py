@@ -21,6 +21,9 @@ from conformance import cli
 from conformance.emulator import default_profile, sim_sensor
 from conformance.ports import OpenedPort, SimSpec, sim_declaration
 
+# Renders a hostile report in headless Chromium.
+pytestmark = pytest.mark.browser
+
 SCRIPT = "<script>alert('script')</script>"
 IMG = '"><img src=x onerror=alert("img")>'
 SVG = "<svg/onload=alert('svg')>"

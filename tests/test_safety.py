@@ -76,6 +76,7 @@ def test_a_failed_restore_is_reported_not_hidden(sim_sensor):
     assert changer.restored is False and note.startswith("COULD NOT restore")
 
 
+@pytest.mark.realtime
 def test_ctrl_c_writes_the_partial_report_and_exits_2(tmp_path):
     """SIGINT to the CLI mid-run (over RFC 2217, so the run takes real time)."""
     emulator = EmulatorProcess()

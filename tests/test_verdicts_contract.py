@@ -38,7 +38,10 @@ def load_schema() -> dict[str, Any]:
 VALIDATOR = jsonschema.Draft202012Validator(load_schema())
 
 
-@pytest.fixture(scope="module", params=sorted(RUNS))
+@pytest.fixture(
+    scope="module",
+    params=[pytest.param(k, marks=pytest.mark.slow) if k == "faulty" else k for k in sorted(RUNS)],
+)
 def run(request: pytest.FixtureRequest, tmp_path_factory) -> tuple[str, Path, dict[str, Any]]:
     port, expected_exit = RUNS[request.param]
     out = tmp_path_factory.mktemp(request.param)
