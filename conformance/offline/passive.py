@@ -65,6 +65,13 @@ def no_traffic(port: str) -> str | None:
     return None
 
 
+def forget(port: str) -> None:
+    """Drop the loaded recording once judged (an in-process caller may judge many)."""
+    from .fixtures import _LOADED
+
+    _LOADED.pop(port, None)
+
+
 def judge_passively(argv: list[str], console: Console) -> int:
     """Judge the recording ``argv`` names; the exit code is the worse role's."""
     from ..cli import error, exit_code
@@ -82,9 +89,11 @@ def judge_passively(argv: list[str], console: Console) -> int:
             normalise_version(args.sdi_version)
         why = no_traffic(port)
     except (PortError, DeclarationError) as exc:
+        forget(port)
         error(f"error: {exc}")
         return EXIT_USAGE
     if why is not None:
+        forget(port)
         error(f"error: {why}")
         return EXIT_USAGE
     roles = ROLES if args.role == "both" else (args.role,)
@@ -107,6 +116,7 @@ def judge_passively(argv: list[str], console: Console) -> int:
         console.print(f"{role} rules:", style="bold", markup=False, highlight=False)
         print_summary(console, data, str(report_dir))
         codes[-1] = exit_code(data, code)
+    forget(port)
     order = (EXIT_INTERNAL, EXIT_USAGE, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_COMPLIANT)
     return min(codes, key=lambda c: order.index(c) if c in order else -1)
 
