@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from ..exits import EXIT_COMPLIANT, EXIT_USAGE
 from ..links.errors import PortError
+from ..protocol.commands import Kind
 from ..suite import suite_args
 from ..transcript import EventKind
 from .recording_link import FORMATS, recording_port
@@ -56,13 +57,18 @@ def no_traffic(port: str) -> str | None:
     chars = [e for e in events if e.kind is EventKind.CHAR]
     breaks = [e for e in events if e.kind is EventKind.BREAK]
     view = read_view(events)
-    if not view.transmissions or not any(t.is_command for t in view.transmissions):
-        return (
-            f"no SDI-12 traffic in {link.spec.path}: {len(chars)} character(s), "
-            f"{len(breaks)} break(s) and no command ending in '!'"
-            + ("" if breaks else " (SDI-12 starts every exchange with a break)")
-        )
-    return None
+    commands = [t.command for t in view.transmissions if t.command is not None]
+    # any text ending in '!' parses as an extended command: alone it is no sign of SDI-12
+    if any(c.kind is not Kind.EXTENDED for c in commands) or (commands and breaks):
+        return None
+    bad = sum(1 for e in chars if not e.parity_ok)
+    said = f"no SDI-12 traffic in {link.spec.path}: {len(chars)} character(s), "
+    said += f"{len(breaks)} break(s) and no SDI-12 command (an address, a command, '!')"
+    if not breaks:
+        said += "; SDI-12 starts every exchange with a break"
+    if bad:
+        said += f"; {bad} character(s) fail 7E1 parity (another framing or bit rate?)"
+    return said
 
 
 def forget(port: str) -> None:
