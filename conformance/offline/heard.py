@@ -16,6 +16,8 @@ from ..judges.exchanges import identification
 from ..judges.timing import StampUncertainty
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
 from ..protocol.responses import Identification
+from ..protocol.values import split_values
+from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
 from ..view.records import rebuild_records
 from ..view.runs import Segment
@@ -24,6 +26,9 @@ from .recording_link import RecordingLink
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3
+LAST_INDEX = 9  # aD9!: the last data command after aM!/aC!
+LAST_HV_INDEX = 999  # aD999!/aDB999!: the last after aHA!/aHB!
+EMPTY_PACKET = 6  # bytes of a binary packet holding no value (address, size, type, CRC)
 #: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS).
 NOT_SEEN = "not seen in the recording"
 
@@ -160,7 +165,32 @@ def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     if later[0].address != m.command.address or index is None or index[1] != 0:
         # the records follow a measurement's data only while nothing else comes between
         return later[0].text
+    if not _collected(m):
+        return "the recorder stopped asking for data while values were due"
     return None
+
+
+def _collected(m: Measurement) -> bool:
+    """Whether the recorder asked until the sensor had no more to give (every announced
+    value in, an empty reply or packet, or the last index), as the tool recorder does: a
+    recorder that stopped sooner leaves the count rules without their stimulus."""
+    if not m.data or m.count is None:
+        return False
+    last = m.data[-1]
+    if not last.answered:
+        return True  # a silent data command: the sensor's doing, judged as such
+    if m.binary:
+        if m.binary_value_count >= m.count:
+            return True
+        return len(last.reply_bytes) <= EMPTY_PACKET or last.command is None or (
+            last.command.index is not None and last.command.index >= LAST_HV_INDEX
+        )
+    if m.value_count >= m.count:
+        return True
+    text = validity.data_values_text(last.reply_text, m.command.returns_crc)
+    index = last.command.index if last.command is not None else None
+    limit = LAST_HV_INDEX if m.command.kind is Kind.HIGH_VOLUME_ASCII else LAST_INDEX
+    return not split_values(text) or (index is not None and index >= limit)
 
 
 def _identify(heard: HeardSensors) -> None:
