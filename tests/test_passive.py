@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import jsonschema
 import pytest
 
 from conformance.cli import main
@@ -22,6 +23,7 @@ from conformance.recorder.faults import RECORDER_FAULTS
 
 EXIT_USAGE = 4
 DECIDED = ("PASS", "FAIL", "WARN")
+SCHEMA = Path(__file__).parent.parent / "conformance" / "schemas" / "verdicts-1.json"
 HELLO = Path("/work/shared/captures/hello_world_8n1_1200.sr")
 
 #: faults whose own requirement the recorded traffic shows (b): each must FAIL/WARN passively
@@ -122,6 +124,7 @@ def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, po
     assert main(["judge", str(capture), "--role", role, "--report-dir", str(out)]) in (0, 1, 2)
     assert verdicts(out) == from_transcript
     data = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
+    jsonschema.validate(data, json.loads(SCHEMA.read_text(encoding="utf-8")))
     assert data["run"]["role"] == role
     assert data["run"]["link"]["kind"] == "capture sr"
     assert 0 < data["run"]["link"]["timing_uncertainty_ms"] <= 0.05
