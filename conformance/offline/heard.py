@@ -22,6 +22,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..view.records import rebuild_records
 from ..view.runs import Segment
 from ..view.segments import TranscriptView, read_view
+from .judge import describe_decode
 from .recording_link import RecordingLink
 
 #: ambiguity reasons quoted in the notes (the count is always given)
@@ -37,6 +38,8 @@ def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     """The decode figures and polarity (a capture), and how many splits the view had to make
     that the wire does not settle (direction, framing), with the first few reasons."""
     notes = list(link.notes)
+    if link.decoded is not None:
+        notes += describe_decode(link.decoded)
     found = view.ambiguities()
     if found:
         shown = "; ".join(str(a) for a in found[:AMBIGUITIES_SHOWN])

@@ -71,6 +71,28 @@ def no_traffic(port: str) -> str | None:
     return said
 
 
+def error(text: str) -> None:
+    """One line on stderr, as the CLI's errors are (never on stdout, where results go)."""
+    from rich.console import Console
+
+    Console(stderr=True, soft_wrap=True).print(text, style="red", markup=False, highlight=False)
+
+
+def exit_code(data: dict, pytest_code: int) -> int:
+    """One role's exit code from its verdicts.json, as the CLI gives a run's (``cli``
+    imports this module, so it cannot be imported from there)."""
+    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
+
+    if pytest_code in (EXIT_USAGE, EXIT_INTERNAL) and not data["run"]["complete"]:
+        return pytest_code
+    verdict = data["summary"]["verdict"]
+    if verdict == "NON-COMPLIANT":
+        return EXIT_NON_COMPLIANT
+    if verdict == "COMPLIANT":
+        return EXIT_COMPLIANT
+    return EXIT_INTERNAL if data["summary"]["counts"].get("ERROR") else EXIT_INCOMPLETE
+
+
 def forget(port: str) -> None:
     """Drop the loaded recording once judged (an in-process caller may judge many)."""
     from .fixtures import _LOADED
@@ -80,7 +102,6 @@ def forget(port: str) -> None:
 
 def judge_passively(argv: list[str], console: Console) -> int:
     """Judge the recording ``argv`` names; the exit code is the worse role's."""
-    from ..cli import error, exit_code
     from ..declaration import DeclarationError, normalise_version
     from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
     from ..reports.console import print_summary

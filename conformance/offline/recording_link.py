@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from urllib.parse import parse_qs, unquote, urlsplit
 
-from ..capture import CaptureError, decode_capture
+from ..capture import CaptureDecode, CaptureError, decode_capture
 from ..links.base import LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
@@ -93,8 +93,9 @@ class RecordingLink:
     """A recording standing where a link would: its events, and what they are.
 
     ``uncertainty`` is the recording's own timing uncertainty (s): a capture's stamps, or the
-    largest per-event uncertainty a transcript carries; ``notes`` are the decode figures and
-    anything else a reader of the verdicts needs to know about the recording.
+    largest per-event uncertainty a transcript carries; ``notes`` what a reader of the verdicts
+    needs to know about a transcript; ``decoded`` a capture's decode figures (worded by
+    :func:`conformance.offline.judge.describe_decode`, a layer above this one).
     """
 
     spec: RecordingSpec
@@ -102,6 +103,7 @@ class RecordingLink:
     transcript: Transcript
     uncertainty: float
     notes: list[str] = field(default_factory=list)
+    decoded: CaptureDecode | None = None  # a capture's decode figures (for the notes)
 
     def now(self) -> float:
         events = self.transcript.events
@@ -141,18 +143,12 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
         )
     except CaptureError as exc:
         raise PortError(str(exc)) from None
-    from .judge import describe_decode  # the same words `judge` prints before it decides
-
     info = LinkInfo(
         kind=f"capture {decoded.format}", can_break=False,
         timing_uncertainty=decoded.uncertainty_s,
     )  # fmt: skip
     return RecordingLink(
-        spec,
-        info,
-        Transcript(list(decoded.events)),
-        decoded.uncertainty_s,
-        describe_decode(decoded),
+        spec, info, Transcript(list(decoded.events)), decoded.uncertainty_s, decoded=decoded
     )
 
 
