@@ -39,7 +39,15 @@ SENSOR_SHOWN = [
 ]
 RECORDER_SHOWN = ["retry-too-early", "short-break", "gappy-commands", "d0-before-ttt"]
 #: more of the same, in the slow selection
-SENSOR_MORE = ["fast-baud", "crc-missing", "binary-crc-wrong", "ident-bad-version"]
+SENSOR_MORE = [
+    "fast-baud",
+    "crc-missing",
+    "binary-crc-wrong",
+    "ident-bad-version",
+    "ack-trailing-space",
+    "extended-no-crlf",
+    "multiline-no-etx",
+]
 RECORDER_MORE = ["no-break-after-87ms", "late-d0-without-break", "leading-zeros-after-d9"]
 
 
