@@ -16,6 +16,7 @@ from .case import Case
 from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
+from .offline.fixtures import heard_recorder, heard_sensors  # noqa: F401 - passive cases
 from .options import UsageError, add_pytest_options, check_values
 from .ports import PortError
 from .preflight import check_report_dir, check_role_options
@@ -144,7 +145,9 @@ def missing_capabilities(item: pytest.Item, run: ConformanceRun) -> list[str]:
 def case_role(item: pytest.Item) -> str | None:
     """The role a conformance case judges, from the session fixture it asks for."""
     names = getattr(item, "fixturenames", ())
-    return "sensor" if "sensor" in names else "recorder" if "recorder" in names else None
+    if "sensor" in names or "heard_sensors" in names:
+        return "sensor"
+    return "recorder" if "recorder" in names or "heard_recorder" in names else None
 
 
 def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:

@@ -21,13 +21,14 @@ from .links import adapter_link, factory
 from .links.base import LinkInfo
 from .links.errors import PortError
 from .links.registry import LinkKind, OpenedPort, PortOptions, find, register
+from .offline import recording_link
 from .protocol.commands import ADDRESS_CHARS
 from .replay.link import is_replay
 
 __all__ = ["OpenedPort", "PortError", "SimSpec", "is_sim", "open_port", "open_sim", "parse_sim"]
 
 #: The modules whose kinds of link register themselves on import (besides the three below).
-BUILTIN_KINDS = (factory, adapter_link, harness_device)
+BUILTIN_KINDS = (factory, adapter_link, harness_device, recording_link)
 
 
 @dataclass

@@ -34,7 +34,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # writing logic-analyser captures of the line
     ("links", ("links", "capture")),
     # devices the tool simulates, hosts or plays back on a virtual-time bus
-    ("devices", ("sim", "emulator", "harness", "replay")),
+    ("devices", ("sim", "emulator", "harness", "replay", "offline.recording_link")),
     # a --port string opened as a link (every kind); the emulator served on a port
     ("ports", ("ports", "emulator_server")),
     # the tool's own data recorder and the judges of what it recorded
@@ -64,7 +64,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # pytest's side: options, fixtures, hooks that turn findings into outcomes and reports
     ("plugin", ("plugin",)),
     # the command line
-    ("cli", ("cli",)),
+    ("cli", ("cli", "offline.passive")),
 )
 
 LAYER_OF = {name: rank for rank, (_, names) in enumerate(LAYERS) for name in names}

@@ -69,11 +69,17 @@ def _runs(chars: list[Event]) -> list[list[Event]]:
         if out:
             prev = out[-1][-1]
             gap = e.start - prev.end
-            if -1e-9 < gap < RESPONSE_START_MIN and prev.char7 not in (0x21, 0x0A):
+            if -_slack(prev, e) < gap < RESPONSE_START_MIN and prev.char7 not in (0x21, 0x0A):
                 out[-1].append(e)
                 continue
         out.append([e])
     return out
+
+
+def _slack(a: Event, b: Event) -> float:
+    """How far two stamps may seem to overlap without two talkers: a capture stamps a
+    character's end from its start, so back-to-back characters may overlap by a sample."""
+    return a.uncertainty + b.uncertainty + 1e-9
 
 
 def infer_directions(events: Iterable[Event]) -> list[tuple[Event, Direction]]:
@@ -101,7 +107,7 @@ def infer_directions(events: Iterable[Event]) -> list[tuple[Event, Direction]]:
             state.command, state.reply = "", []
             state.last_side, state.last_end = RECORDER, e.end
         elif e.kind is EventKind.CHAR:
-            if pending and e.start < pending[-1].end - 1e-9:
+            if pending and e.start < pending[-1].end - _slack(pending[-1], e):
                 flush()  # an overlap: the runs on either side are read one by one
             pending.append(e)
     flush()
@@ -112,7 +118,7 @@ def _classify(run: list[Event], s: _State) -> Direction:
     text = decode_7e1(run)
     start = run[0].start
     gap = start - s.last_end
-    overlap = gap < -1e-9
+    overlap = gap < -(2 * run[0].uncertainty + 1e-9)
     shown = escape(text[:12]) + ("..." if len(text) > 12 else "")
     if overlap:
         other = SENSOR if s.last_side == RECORDER else RECORDER

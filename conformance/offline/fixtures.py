@@ -1,0 +1,58 @@
+"""The passive cases' session fixtures: ``heard_sensors`` (the sensor rules) and
+``heard_recorder`` (the recorder rules), both over the run's ``recording:`` port.
+
+The plugin maps a case to its role by the fixture it asks for (``plugin.case_role``), so a
+passive run with ``--sdi12-role sensor`` keeps the sensor-rule cases and aggregates them as
+role ``sensor``, and likewise for the recorder. The recording is loaded once per process
+(``--role both`` runs the suite twice in one process and decodes a capture once).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from ..links.errors import PortError
+from ..run import ConformanceRun
+from .heard import HeardRecorder, HeardSensors, hear_recorder, hear_sensors
+from .recording_link import RecordingLink, is_recording, load_recording, parse_recording
+
+_LOADED: dict[str, RecordingLink] = {}
+
+
+def recording_of(port: str) -> RecordingLink:
+    """The recording a ``recording:`` port names, loaded once (PortError if it cannot be)."""
+    if port not in _LOADED:
+        _LOADED[port] = load_recording(parse_recording(port))
+    return _LOADED[port]
+
+
+def _heard(run: ConformanceRun, role: str):
+    if run.options.role != role:
+        pytest.skip(f"{role}-rule case; this run judges the {run.options.role} rules")
+    if not is_recording(run.options.port):
+        pytest.skip("a passive case judges a recording: --sdi12-port recording:PATH")
+    if run.session is None:
+        try:
+            link = recording_of(run.options.port)
+        except PortError as exc:
+            run.complete = False
+            run.stop_reason = str(exc)
+            pytest.exit(str(exc), returncode=4)
+        run.link = link  # type: ignore[assignment]  # a recording stands where a link would
+        if role == "sensor":
+            run.session = hear_sensors(link, run.options.address, run.options.version)
+        else:
+            run.session = hear_recorder(link, run.options.version)
+    return run.session
+
+
+@pytest.fixture(scope="session")
+def heard_sensors(sdi12_run: ConformanceRun) -> HeardSensors:
+    """What the sensors sent in the recording, as the tool recorder's records."""
+    return _heard(sdi12_run, "sensor")
+
+
+@pytest.fixture(scope="session")
+def heard_recorder(sdi12_run: ConformanceRun) -> HeardRecorder:
+    """What the recorder sent in the recording, as the role-neutral view."""
+    return _heard(sdi12_run, "recorder")

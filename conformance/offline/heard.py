@@ -1,0 +1,228 @@
+"""What a recording shows, read once for the passive cases: the role-neutral view, the tool
+recorder's records rebuilt from it, the rule set, and the notes a reader of the verdicts needs.
+
+:class:`HeardSensors` (sensor rules, on what the sensors sent) and :class:`HeardRecorder`
+(recorder rules, on what the recorder sent) stand where the live sessions stand for the
+reports: ``verdicts.json``'s ``dut`` block reads the same attributes (address, identity,
+version, assumptions), so the passive run's reports have the live run's shape.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..declaration import normalise_version
+from ..judges.exchanges import identification
+from ..judges.timing import StampUncertainty
+from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
+from ..protocol.responses import Identification
+from ..protocol.values import split_values
+from ..tool_recorder import validity
+from ..tool_recorder.records import Exchange, Measurement
+from ..view.records import rebuild_records
+from ..view.runs import Segment
+from ..view.segments import TranscriptView, read_view
+from .judge import describe_decode
+from .recording_link import RecordingLink
+
+#: ambiguity reasons quoted in the notes (the count is always given)
+AMBIGUITIES_SHOWN = 3
+LAST_INDEX = 9  # aD9!: the last data command after aM!/aC!
+LAST_HV_INDEX = 999  # aD999!/aDB999!: the last after aHA!/aHB!
+EMPTY_PACKET = 6  # bytes of a binary packet holding no value (address, size, type, CRC)
+#: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS).
+NOT_SEEN = "not seen in the recording"
+
+
+def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
+    """The decode figures and polarity (a capture), and how many splits the view had to make
+    that the wire does not settle (direction, framing), with the first few reasons."""
+    notes = list(link.notes)
+    if link.decoded is not None:
+        notes += describe_decode(link.decoded)
+    found = view.ambiguities()
+    if found:
+        shown = "; ".join(str(a) for a in found[:AMBIGUITIES_SHOWN])
+        extra = len(found) - AMBIGUITIES_SHOWN
+        more = f" (+{extra} more)" if extra > 0 else ""
+        notes.append(f"{len(found)} ambiguous split(s) in the recording: {shown}{more}")
+    else:
+        notes.append("no ambiguous split in the recording (every direction and reply is clear)")
+    return notes
+
+
+@dataclass
+class Heard:
+    """What both roles' passive cases share: the recording and its view."""
+
+    link: RecordingLink
+    view: TranscriptView
+    forced_version: str | None = None
+    assumptions: list[str] = field(default_factory=list)
+    address: str | None = None
+    identity: Identification | None = None
+    ident_exchange: Exchange | None = None
+    address_notes: list[str] = field(default_factory=list)
+
+    @property
+    def uncertainty(self) -> float:
+        return self.link.uncertainty
+
+    @property
+    def stamp_uncertainty(self) -> StampUncertainty:
+        return StampUncertainty(self.link.uncertainty)
+
+    @property
+    def version(self) -> str:
+        """The rule set: --sdi-version > the ``ll`` of an ``aI!`` reply seen > v1.4 (said)."""
+        if self.forced_version:
+            return self.forced_version
+        if self.identity is not None and self.identity.version in ("13", "14"):
+            return self.identity.version
+        return "14"
+
+    @property
+    def is_v14(self) -> bool:
+        return self.version >= "14"
+
+
+@dataclass
+class HeardSensors(Heard):
+    """The sensor rules' records: every exchange and measurement the recording shows (of
+    sensor ``address`` only, when one was given), and the timing cut of the same traffic."""
+
+    exchanges: list[Exchange] = field(default_factory=list)
+    measurements: list[Measurement] = field(default_factory=list)
+    segments: list[Segment] = field(default_factory=list)
+
+    def of_kind(self, *kinds: Kind, whole: bool = False) -> list[Measurement]:
+        """The recorded measurements of ``kinds``; ``whole``: only those the recorder let
+        run to their data (their wait and data rules are judged only on those)."""
+        return [
+            m
+            for m in self.measurements
+            if m.command.kind in kinds and not (whole and m.aborted_by is not None)
+        ]
+
+    def exchanges_of(self, *kinds: Kind) -> list[Exchange]:
+        return [x for x in self.exchanges if x.command is not None and x.command.kind in kinds]
+
+
+@dataclass
+class HeardRecorder(Heard):
+    """The recorder rules read the whole bus (``--address`` does not narrow them)."""
+
+
+def _mine(address: str | None, text: str) -> bool:
+    return address is None or text[:1] == address
+
+
+def hear_sensors(link: RecordingLink, address: str | None, version: str | None) -> HeardSensors:
+    view = read_view(link.transcript.events)
+    rebuilt = rebuild_records(view, uncertainty=link.uncertainty)
+    heard = HeardSensors(
+        link,
+        view,
+        forced_version=normalise_version(version) if version else None,
+        address=address,
+        exchanges=[x for x in rebuilt.exchanges if _mine(address, x.text)],
+        measurements=[m for m in rebuilt.measurements if _mine(address, m.command.address)],
+        segments=[Segment.of(t) for t in view.transmissions if _mine(address, t.text)],
+    )
+    for m in heard.measurements:
+        m.aborted_by = disturbance(m, view)
+    cut = sum(1 for m in heard.measurements if m.aborted_by is not None)
+    heard.assumptions = recording_notes(link, view)
+    if cut:
+        heard.assumptions.append(
+            f"{cut} recorded measurement(s) interrupted by the recorder (a command before the "
+            "service request or ttt, or no aD0! next): their replies are judged, not their "
+            "waits or data"
+        )
+    if address is not None:
+        heard.assumptions.append(f"sensor rules judged on sensor {address!r} only (--address)")
+    _identify(heard)
+    return heard
+
+
+def disturbance(m: Measurement, view: TranscriptView) -> str | None:
+    """What the recorder did that keeps ``m``'s wait and data from being the sensor's own
+    doing: a transmission or a break before the service request (or ttt) of an aM!-type
+    measurement, or anything but its aD0!/aDB0! as the next transmission (the rebuilt
+    records follow a measurement's data only while nothing else comes between; a concurrent
+    measurement interleaved with another sensor's is left to its reply rules, a conservative
+    choice). None: undisturbed."""
+    if m.reply_end is None or m.ttt is None:
+        return "no usable reply"
+    later = [t for t in view.transmissions if t.start >= m.reply_end]
+    if m.command.kind in SERVICE_REQUEST_KINDS and m.ttt:
+        due = m.service_request_end or m.reply_end + m.ttt
+        early = next((t for t in later if t.start < due), None)
+        if early is not None:
+            return early.text
+        if any(m.reply_end <= b.start < due for b in view.breaks):
+            return "break"  # a break aborts an aM!-type measurement (R-4.4.5-10)
+    if not later:
+        return "nothing more sent"
+    index = later[0].data_index
+    if later[0].address != m.command.address or index is None or index[1] != 0:
+        # the records follow a measurement's data only while nothing else comes between
+        return later[0].text
+    if not _collected(m):
+        return "the recorder stopped asking for data while values were due"
+    return None
+
+
+def _collected(m: Measurement) -> bool:
+    """Whether the recorder asked until the sensor had no more to give (every announced
+    value in, an empty reply or packet, or the last index), as the tool recorder does: a
+    recorder that stopped sooner leaves the count rules without their stimulus."""
+    if not m.data or m.count is None:
+        return False
+    last = m.data[-1]
+    if not last.answered:
+        return True  # a silent data command: the sensor's doing, judged as such
+    if m.binary:
+        if m.binary_value_count >= m.count:
+            return True
+        return len(last.reply_bytes) <= EMPTY_PACKET or last.command is None or (
+            last.command.index is not None and last.command.index >= LAST_HV_INDEX
+        )
+    if m.value_count >= m.count:
+        return True
+    text = validity.data_values_text(last.reply_text, m.command.returns_crc)
+    index = last.command.index if last.command is not None else None
+    limit = LAST_HV_INDEX if m.command.kind is Kind.HIGH_VOLUME_ASCII else LAST_INDEX
+    return not split_values(text) or (index is not None and index >= limit)
+
+
+def _identify(heard: HeardSensors) -> None:
+    """The rule set from an ``aI!`` reply seen (the chosen sensor's, else the first sensor
+    that answered one), unless --sdi-version forced it; v1.4 otherwise, said so."""
+    for ex in heard.exchanges_of(Kind.IDENTIFY):
+        if ex.answered and ex.command is not None:
+            ident, _ = identification(ex, ex.command.address)
+            if ident is not None and ident.version in ("13", "14"):
+                heard.identity, heard.ident_exchange = ident, ex
+                heard.address = heard.address or ex.command.address
+                break
+    if heard.forced_version:
+        heard.assumptions.append(f"rule set v{heard.version[0]}.{heard.version[1]} (--sdi-version)")
+    elif heard.identity is None:
+        heard.assumptions.append("no aI! reply with a usable version seen; judging against v1.4")
+    else:
+        v = heard.identity.version
+        heard.assumptions.append(
+            f"rule set v{v[0]}.{v[1]} from the aI! reply of sensor {heard.address!r}"
+        )
+
+
+def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
+    view = read_view(link.transcript.events)
+    heard = HeardRecorder(
+        link, view, forced_version=normalise_version(version) if version else None
+    )
+    heard.assumptions = recording_notes(link, view)
+    if heard.forced_version is None:
+        heard.assumptions.append("the recorder's SDI-12 version is not on the wire; judging v1.4")
+    return heard

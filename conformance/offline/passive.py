@@ -1,0 +1,167 @@
+"""Passive judging: every rule that traffic alone can show, on a recording no tool drove.
+
+``judge_passively`` checks the recording can be read (a clear one-line error and exit 4 if
+not, or if it holds no SDI-12 traffic), then runs the passive cases (``testcases.passive``)
+once per role over the port ``recording:PATH?...``: the sensor rules aggregate as role
+``sensor``, the recorder rules as role ``recorder``. ``--role both`` writes two report sets,
+``<report-dir>/sensor/`` and ``<report-dir>/recorder/``, prints both verdicts and exits with
+the worse of the two codes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..exits import EXIT_COMPLIANT, EXIT_USAGE
+from ..links.errors import PortError
+from ..protocol.commands import Kind
+from ..suite import suite_args
+from ..transcript import EventKind
+from .recording_link import FORMATS, recording_port
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+ROLES = ("sensor", "recorder")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The options :func:`conformance.offline.judge.passive_argv` writes."""
+    p = argparse.ArgumentParser(prog="sdi12-conform judge (passive)")
+    p.add_argument("--recording", required=True)
+    p.add_argument("--format", choices=FORMATS, required=True)
+    p.add_argument("--role", choices=(*ROLES, "both"), default="both")
+    p.add_argument("--address")
+    p.add_argument("--channel")
+    p.add_argument("--tx-channel")
+    p.add_argument("--sdi-version")
+    p.add_argument("--report-dir")
+    p.add_argument("--invert", dest="invert", action="store_true", default=None)
+    p.add_argument("--no-invert", dest="invert", action="store_false")
+    p.add_argument("--baud", type=int, default=1200)
+    p.add_argument("--strict", action="store_true")
+    return p
+
+
+def no_traffic(port: str) -> str | None:
+    """Why the recording holds nothing to judge (None: it holds SDI-12 traffic)."""
+    from ..view.segments import read_view
+    from .fixtures import recording_of
+
+    link = recording_of(port)
+    events = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]
+    chars = [e for e in events if e.kind is EventKind.CHAR]
+    breaks = [e for e in events if e.kind is EventKind.BREAK]
+    view = read_view(events)
+    commands = [t.command for t in view.transmissions if t.command is not None]
+    # any text ending in '!' parses as an extended command: alone it is no sign of SDI-12
+    if any(c.kind is not Kind.EXTENDED for c in commands) or (commands and breaks):
+        return None
+    bad = sum(1 for e in chars if not e.parity_ok)
+    said = f"no SDI-12 traffic in {link.spec.path}: {len(chars)} character(s), "
+    said += f"{len(breaks)} break(s) and no SDI-12 command (an address, a command, '!')"
+    if not breaks:
+        said += "; SDI-12 starts every exchange with a break"
+    if bad:
+        said += f"; {bad} character(s) fail 7E1 parity (another framing or bit rate?)"
+    return said
+
+
+def error(text: str) -> None:
+    """One line on stderr, as the CLI's errors are (never on stdout, where results go)."""
+    from rich.console import Console
+
+    Console(stderr=True, soft_wrap=True).print(text, style="red", markup=False, highlight=False)
+
+
+def exit_code(data: dict, pytest_code: int) -> int:
+    """One role's exit code from its verdicts.json, as the CLI gives a run's (``cli``
+    imports this module, so it cannot be imported from there)."""
+    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
+
+    if pytest_code in (EXIT_USAGE, EXIT_INTERNAL) and not data["run"]["complete"]:
+        return pytest_code
+    verdict = data["summary"]["verdict"]
+    if verdict == "NON-COMPLIANT":
+        return EXIT_NON_COMPLIANT
+    if verdict == "COMPLIANT":
+        return EXIT_COMPLIANT
+    return EXIT_INTERNAL if data["summary"]["counts"].get("ERROR") else EXIT_INCOMPLETE
+
+
+def forget(port: str) -> None:
+    """Drop the loaded recording once judged (an in-process caller may judge many)."""
+    from .fixtures import _LOADED
+
+    _LOADED.pop(port, None)
+
+
+def judge_passively(argv: list[str], console: Console) -> int:
+    """Judge the recording ``argv`` names; the exit code is the worse role's."""
+    from ..declaration import DeclarationError, normalise_version
+    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
+    from ..reports.console import print_summary
+
+    args = build_parser().parse_args(argv)
+    port = recording_port(
+        args.recording, args.format, channel=args.channel, tx_channel=args.tx_channel,
+        invert=args.invert, baud=args.baud,
+    )  # fmt: skip
+    try:
+        if args.sdi_version:
+            normalise_version(args.sdi_version)
+        why = no_traffic(port)
+    except (PortError, DeclarationError) as exc:
+        forget(port)
+        error(f"error: {exc}")
+        return EXIT_USAGE
+    if why is not None:
+        forget(port)
+        error(f"error: {why}")
+        return EXIT_USAGE
+    roles = ROLES if args.role == "both" else (args.role,)
+    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    base = Path(args.report_dir or Path("reports") / f"{stamp}-passive")
+    console.print(
+        f"judging {args.recording} passively: the rules its traffic can show "
+        f"({' and '.join(roles)} rules)",
+        markup=False,
+        highlight=False,
+    )
+    codes = []
+    for role in roles:
+        report_dir = base / role if len(roles) > 1 else base
+        code = _run_role(role, port, report_dir, args, console)
+        codes.append(code)
+        if code in (EXIT_USAGE, EXIT_INTERNAL) and not (report_dir / "verdicts.json").exists():
+            return code
+        data = json.loads((report_dir / "verdicts.json").read_text(encoding="utf-8"))
+        console.print(f"{role} rules:", style="bold", markup=False, highlight=False)
+        print_summary(console, data, str(report_dir))
+        codes[-1] = exit_code(data, code)
+    forget(port)
+    order = (EXIT_INTERNAL, EXIT_USAGE, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_COMPLIANT)
+    return min(codes, key=lambda c: order.index(c) if c in order else -1)
+
+
+def _run_role(role: str, port: str, report_dir: Path, args, console: Console) -> int:
+    import pytest
+
+    from ..reports.console import ProgressPlugin
+
+    argv = suite_args(role, port, report_dir)
+    argv[argv.index(f"testcases.{role}")] = "testcases.passive"
+    if args.address and role == "sensor":
+        argv += ["--sdi12-address", args.address]
+    if args.sdi_version:
+        argv += ["--sdi12-version", args.sdi_version]
+    if args.strict:
+        argv.append("--sdi12-strict")
+    return int(pytest.main(argv, plugins=[ProgressPlugin(console)]))
+
+
+__all__ = ["EXIT_COMPLIANT", "judge_passively"]

@@ -1,0 +1,173 @@
+"""``recording:PATH?format=sr&channel=D0&tx-channel=D1&invert=1&baud=1200``: a recording as a
+link kind, so the passive cases get their traffic the way every other case does (through the
+run's port), and the reports describe it the way they describe any link.
+
+The "link" never transmits: it is the recording's events, loaded once (a transcript read, a
+capture decoded), with what the reader must know about them (the decode figures, the
+polarity, the stamps' uncertainty). Passive judging reads it through
+:mod:`conformance.offline.fixtures`; the sensor and tool-recorder sessions cannot use it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from urllib.parse import parse_qs, unquote, urlsplit
+
+from ..capture import CaptureDecode, CaptureError, decode_capture
+from ..links.base import LinkInfo
+from ..links.errors import PortError
+from ..links.registry import LinkKind, OpenedPort, PortOptions, register
+from ..replay.recording import RecordingError, read_recording
+from ..transcript import EventKind, Transcript
+
+SCHEME = "recording:"
+FORMATS = ("jsonl", "sr", "vcd", "csv")
+_PARAMS = ("format", "channel", "tx-channel", "invert", "baud")
+
+
+def is_recording(port: str) -> bool:
+    return port.startswith(SCHEME)
+
+
+def recording_port(
+    path: str | Path,
+    fmt: str,
+    *,
+    channel: str | None = None,
+    tx_channel: str | None = None,
+    invert: bool | None = None,
+    baud: int = 1200,
+) -> str:
+    """The port string naming ``path`` read as ``fmt`` with these decoding options."""
+    query = [f"format={fmt}"]
+    if channel is not None:
+        query.append(f"channel={channel}")
+    if tx_channel is not None:
+        query.append(f"tx-channel={tx_channel}")
+    if invert is not None:
+        query.append(f"invert={int(invert)}")
+    if baud != 1200:
+        query.append(f"baud={baud}")
+    return f"{SCHEME}{path}?{'&'.join(query)}"
+
+
+@dataclass
+class RecordingSpec:
+    path: str
+    format: str = "jsonl"
+    channel: str | None = None
+    tx_channel: str | None = None
+    invert: bool | None = None
+    baud: int = 1200
+
+
+def parse_recording(port: str) -> RecordingSpec:
+    """Read ``recording:PATH?...`` (PortError for a parameter it does not know)."""
+    rest = port[len(SCHEME) :]
+    path, _, query = rest.partition("?")
+    params = {k: v[-1] for k, v in parse_qs(query, keep_blank_values=True).items()}
+    unknown = sorted(set(params) - set(_PARAMS))
+    if unknown or not path:
+        raise PortError(
+            f"port {port!r}: recording:PATH takes the parameters {', '.join(_PARAMS)}"
+            + (f", not {', '.join(unknown)}" if unknown else "")
+        )
+    spec = RecordingSpec(unquote(urlsplit(path).path if "://" in path else path))
+    spec.format = params.get("format", "jsonl")
+    if spec.format not in FORMATS:
+        raise PortError(f"recording format must be one of {', '.join(FORMATS)}")
+    spec.channel = params.get("channel")
+    spec.tx_channel = params.get("tx-channel")
+    if "invert" in params:
+        spec.invert = params["invert"] not in ("0", "false", "no")
+    try:
+        spec.baud = int(params.get("baud", "1200"))
+    except ValueError:
+        raise PortError(f"recording baud must be a whole number, not {params['baud']!r}") from None
+    return spec
+
+
+@dataclass
+class RecordingLink:
+    """A recording standing where a link would: its events, and what they are.
+
+    ``uncertainty`` is the recording's own timing uncertainty (s): a capture's stamps, or the
+    largest per-event uncertainty a transcript carries; ``notes`` what a reader of the verdicts
+    needs to know about a transcript; ``decoded`` a capture's decode figures (worded by
+    :func:`conformance.offline.judge.describe_decode`, a layer above this one).
+    """
+
+    spec: RecordingSpec
+    info: LinkInfo
+    transcript: Transcript
+    uncertainty: float
+    notes: list[str] = field(default_factory=list)
+    decoded: CaptureDecode | None = None  # a capture's decode figures (for the notes)
+
+    def now(self) -> float:
+        events = self.transcript.events
+        return max((e.end for e in events), default=0.0)
+
+    def close(self) -> None:
+        """Nothing is open: the recording was read whole (a capture, streamed by its decoder)."""
+
+
+def load_recording(spec: RecordingSpec) -> RecordingLink:
+    """Read or decode the recording (PortError, naming the file, when it cannot be)."""
+    if spec.format == "jsonl":
+        try:
+            recording = read_recording(spec.path)
+        except RecordingError as exc:
+            raise PortError(str(exc)) from None
+        events = [e for e in recording.events if e.kind is not EventKind.NOTE]
+        uncertainty = max((e.uncertainty for e in events), default=0.0)
+        link = (recording.options.get("link") or {}).get("kind")
+        how = f"transcript of a run over a {link} link" if link else "transcript"
+        notes = [
+            f"{how} ({spec.path}): {len(events)} events; stamps \u00b1"
+            f"{uncertainty * 1e3:.3f} ms (the largest any event carries)"
+        ]
+        info = LinkInfo(
+            kind="transcript", can_break=False, timing_uncertainty=uncertainty,
+            bit_timing=_bit_timing(recording.options),
+        )  # fmt: skip
+        return RecordingLink(spec, info, Transcript(list(recording.events)), uncertainty, notes)
+    try:
+        decoded = decode_capture(
+            spec.path,
+            channel=spec.channel,
+            tx_channel=spec.tx_channel,
+            invert=spec.invert,
+            baud=spec.baud,
+        )
+    except CaptureError as exc:
+        raise PortError(str(exc)) from None
+    info = LinkInfo(
+        kind=f"capture {decoded.format}", can_break=False,
+        timing_uncertainty=decoded.uncertainty_s,
+    )  # fmt: skip
+    return RecordingLink(
+        spec, info, Transcript(list(decoded.events)), decoded.uncertainty_s, decoded=decoded
+    )
+
+
+def _bit_timing(options: dict) -> bool:
+    """A harness run's characters were framed by the tool, not the device: no bit timing."""
+    link = options.get("link") or {}
+    return bool(link.get("bit_timing", True))
+
+
+def _open(port: str, options: PortOptions) -> OpenedPort:
+    return OpenedPort(load_recording(parse_recording(port)))  # type: ignore[arg-type]
+
+
+RECORDING = register(
+    LinkKind(
+        "recording",
+        matches=is_recording,
+        open=_open,
+        info=LinkInfo(kind="recording", can_break=False),
+        example="recording:capture.sr?format=sr&channel=D0",
+    )
+)
