@@ -8,7 +8,6 @@ tests run the monitor as a program beside an emulator and the golden recorder ov
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
 import signal
@@ -36,9 +35,6 @@ from conformance.tool_recorder.engine import Master
 from conformance.tool_recorder.policy import Policy
 from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Verdict
-
-HAS_PASSIVE = importlib.util.find_spec("conformance.offline.passive") is not None
-NO_PASSIVE = "passive judging (conformance.offline.passive) is not merged into this branch yet"
 
 
 # -- the lines shown (sans-I/O) ---------------------------------------------------------------
@@ -330,9 +326,6 @@ def test_monitor_shows_and_records_a_golden_recorder_talking_to_the_emulator(tmp
         assert part in text, (part, text)
     assert any(e["kind"] == "break" for e in events)
     assert {e["origin"] for e in events if e["kind"] != "note"} == {"bus"}
-    if not HAS_PASSIVE:
-        assert monitor.returncode == 3 and "not in this build" in out, out
-        pytest.skip(NO_PASSIVE + "; the monitor's own output was checked")
     written = sorted(report.rglob("verdicts.json"))  # --role both: one set per role
     assert written, out
     for path in written:
@@ -369,10 +362,7 @@ def test_ctrl_c_stops_the_monitor_writes_the_transcript_and_exits_cleanly(tmp_pa
     text = "".join(chr(e["wire"] & 0x7F) for e in events if e["kind"] == "char")
     assert text == "0!0\r\n", text
     assert stopped_in < 30
-    if HAS_PASSIVE:
-        assert monitor.returncode in (0, 1, 2), out
-    else:
-        assert monitor.returncode == 3 and "not in this build" in out, out
+    assert monitor.returncode in (0, 1, 2), out
 
 
 def test_on_a_terminal_the_lines_are_a_live_table():

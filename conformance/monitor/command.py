@@ -130,17 +130,7 @@ def judge_recording(
     argv = [str(transcript), "--role", role, "--report-dir", str(report_dir)]
     if address:
         argv += ["--address", address]
-    try:
-        return judge(argv, console)
-    except ModuleNotFoundError as exc:
-        if exc.name != "conformance.offline.passive":
-            raise
-        error(
-            "error: passive judging (conformance.offline.passive) is not in this build; "
-            f"the transcript is kept at {transcript}: judge it later with "
-            f"`sdi12-conform judge {transcript}`"
-        )
-        return EXIT_INTERNAL
+    return judge(argv, console)
 
 
 class _Printer:
