@@ -38,6 +38,7 @@ def suite_args(
         "--rootdir", str(rootdir),
         "-p", "no:cacheprovider",
         "-p", "no:benchmark",  # pytest-benchmark, where installed, leaves .benchmarks/ behind
+        "-p", "no:hypothesispytest",  # its import costs ~2 s a run; the cases use none of it
         "--pyargs", f"testcases.{role}",
         "--sdi12-port", port,
         "--sdi12-role", role,

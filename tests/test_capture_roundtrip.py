@@ -200,6 +200,7 @@ def test_break_cut_by_the_capture_end_is_kept(tmp_path):
     assert d.breaks == 1
 
 
+@pytest.mark.matrix
 def test_every_emulator_fault_round_trips(tmp_path):
     """0I!, 0M!, 0D0! against the emulator with each fault, exported as .sr and decoded: the
     same characters and breaks at the same times (a fast-baud sensor too: its bits are read

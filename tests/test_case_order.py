@@ -83,6 +83,7 @@ def default_run(role: str, port: str) -> dict:
     return _defaults[role, port]
 
 
+@pytest.mark.slow
 def test_whole_run_cases_run_last_whatever_the_order():
     data = run_suite("sensor", "sim", "reversed")
     order = [t["id"] for t in data["tests"]]
@@ -96,6 +97,7 @@ def test_whole_run_cases_run_last_whatever_the_order():
     [(p, how, seed) for p in SENSOR_PORTS for how, seed in ORDERS]
     + [(p, how, seed) for p in STATEFUL_PORTS for how, seed in ORDERS[:2]],
 )
+@pytest.mark.slow
 def test_sensor_verdicts_do_not_depend_on_order(port, how, seed):
     default = default_run("sensor", port)
     other = run_suite("sensor", port, how, seed)
@@ -104,6 +106,7 @@ def test_sensor_verdicts_do_not_depend_on_order(port, how, seed):
     assert other["summary"] == default["summary"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("port", SENSOR_PORTS)
 @pytest.mark.parametrize("k", ["test_9_whole_run", "test_4_4_8_data", "test_4_4_8_data or test_9"])
 def test_sensor_subsets_judge_like_the_full_run(port, k):
@@ -114,6 +117,7 @@ def test_sensor_subsets_judge_like_the_full_run(port, k):
     assert differences(default, subset) == []
 
 
+@pytest.mark.slow
 def test_a_whole_run_case_alone_still_sees_the_faulty_replies():
     """-k test_9 on a sensor whose extended reply lacks CR LF: the whole-run case asks for
     the declared extended commands itself, so the FAIL does not depend on test_4_4_13."""
@@ -122,6 +126,7 @@ def test_a_whole_run_case_alone_still_sees_the_faulty_replies():
     assert verdicts["R-4.2-03"] == "FAIL"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("how", "seed"), [*ORDERS, ("default", 0)])
 def test_recorder_verdicts_do_not_depend_on_order(how, seed):
     default = default_run("recorder", "sim")

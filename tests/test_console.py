@@ -82,6 +82,7 @@ def test_terminal_shows_progress_failures_live_and_a_summary_table(monkeypatch, 
     assert f"report: {tmp_path / 'report.html'}" in text
 
 
+@pytest.mark.slow
 def test_a_selection_is_a_partial_run_judged_on_what_it_selected(monkeypatch, tmp_path):
     code, out, data = run_cli(monkeypatch, tmp_path, "sim", "-k", "crc", terminal=False)
     left_out = [r["id"] for r in data["requirements"] if not r["selected"]]

@@ -17,7 +17,7 @@ from conformance.matrix import MatrixRow, fault_matrix, run_once
 
 #: A handful of faults (protocol, CRC, timing) the default fast selection
 #: keeps; every other row carries the ``matrix`` marker and runs in the full run (.ci/run).
-FAST_FAULTS = {"no-service-request", "wrong-crc", "response-too-late"}
+FAST_FAULTS = {"response-too-late"}
 
 
 def selected_params(request: pytest.FixtureRequest, name: str) -> list[str]:

@@ -54,10 +54,10 @@ def same_verdicts(first: Path, again: Path, *, uncertainty_may_differ: bool = Fa
 @pytest.mark.parametrize(
     ("port", "role"),
     [
-        ("sim", "sensor"),
-        ("sim://?faults=no-service-request", "sensor"),
         ("sim", "recorder"),
-        ("sim://?recorder-faults=retry-too-early", "recorder"),
+        pytest.param("sim", "sensor", marks=pytest.mark.slow),
+        pytest.param("sim://?faults=no-service-request", "sensor", marks=pytest.mark.slow),
+        pytest.param("sim://?recorder-faults=retry-too-early", "recorder", marks=pytest.mark.slow),
     ],
 )
 def test_replayed_transcript_gives_the_runs_verdicts(tmp_path, port, role):
@@ -71,6 +71,7 @@ def test_replayed_transcript_gives_the_runs_verdicts(tmp_path, port, role):
     assert link["kind"] == "replay of sim"
 
 
+@pytest.mark.slow
 def test_a_run_records_how_it_was_made(tmp_path):
     first = live(tmp_path, "sim://?version=1.3")
     recording = read_recording(first)
@@ -79,6 +80,7 @@ def test_a_run_records_how_it_was_made(tmp_path):
     assert recording.role == "sensor"
 
 
+@pytest.mark.slow
 def test_a_replay_that_no_longer_matches_stops_and_says_where(tmp_path):
     """A recorder-role recording cannot answer the sensor cases: the run stops (INCOMPLETE,
     exit 3) naming what the tool sent and what the recording has, never invented answers."""
@@ -91,6 +93,7 @@ def test_a_replay_that_no_longer_matches_stops_and_says_where(tmp_path):
     assert data["summary"]["counts"]["PASS"] == 0
 
 
+@pytest.mark.slow
 def test_capture_of_a_run_gives_its_verdicts(tmp_path):
     """Export to .sr with the tool's TX channel, judge the capture: the run's verdicts, with
     the capture's own uncertainty (one sample period) in the timing figures."""
@@ -108,6 +111,7 @@ def test_capture_of_a_run_gives_its_verdicts(tmp_path):
     assert 0 < link["timing_uncertainty_ms"] <= 0.05  # 10 us samples, measured per edge
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["vcd", "csv"])
 def test_export_formats_open_again(tmp_path, fmt):
     first = live(tmp_path, "sim")
@@ -144,6 +148,7 @@ def test_bad_recordings_are_refused_plainly(tmp_path, capsys, name, content, wor
     assert "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_missing_recording_and_wrong_channel(tmp_path, capsys):
     assert main(["judge", str(tmp_path / "nothing.sr")]) == EXIT_USAGE
     assert "nothing.sr" in capsys.readouterr().err

@@ -219,6 +219,7 @@ sys.exit(1 if failed else 0)
 """
 
 
+@pytest.mark.slow
 def test_every_module_imports_on_its_own():
     """Each module imported first, in a fresh module table (one interpreter, sys.modules
     emptied of ``conformance`` between them): an import that works only because another

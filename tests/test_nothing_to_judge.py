@@ -100,6 +100,7 @@ def test_a_case_that_could_not_reach_a_rule_does_not_outvote_one_that_judged_it(
     assert verdicts["R-4.4.12-05"] is Verdict.INCONCLUSIVE
 
 
+@pytest.mark.slow
 def test_a_break_that_aborts_nothing_is_not_a_pass_without_a_service_request_baseline():
     """Issue 10: a sensor without service requests whose break does not abort aM! must not
     PASS R-4.4.5.1-01 for the mere absence of a service request after the break."""

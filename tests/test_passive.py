@@ -96,12 +96,14 @@ def _check(tmp_path: Path, port: str, role: str, fault: str | None, capsys) -> N
         assert any(v in ("FAIL", "WARN") for v in shown.values()), shown
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fault", [None, *SENSOR_SHOWN])
 def test_sensor_run_judged_passively_agrees(tmp_path, fault, capsys):
     port = "sim" if fault is None else f"sim://?faults={fault}"
     _check(tmp_path, port, "sensor", fault, capsys)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fault", [None, *RECORDER_SHOWN])
 def test_recorder_run_judged_passively_agrees(tmp_path, fault, capsys):
     port = "sim" if fault is None else f"sim://?recorder-faults={fault}"
@@ -122,6 +124,7 @@ def test_more_recorder_faults_judged_passively(tmp_path, fault, capsys):
 
 @pytest.mark.parametrize(("port", "role"), [("sim://?faults=wrong-crc", "sensor"),
                                             ("sim://?recorder-faults=short-break", "recorder")])
+@pytest.mark.slow
 def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, port, role):
     """Exported with no tool channel, every direction is inferred from the protocol."""
     first = live(tmp_path, port, role)
@@ -140,6 +143,7 @@ def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, po
     assert "polarity (detected)" in notes and "ambiguous split" in notes
 
 
+@pytest.mark.slow
 def test_both_roles_write_two_report_sets(tmp_path, capsys):
     first = live(tmp_path, "sim://?faults=wrong-crc", "sensor")
     capsys.readouterr()  # the live run's own summary
@@ -155,6 +159,7 @@ def test_both_roles_write_two_report_sets(tmp_path, capsys):
     assert code == 1  # the worse of the two: the sensor's wrong CRC
 
 
+@pytest.mark.slow
 def test_address_limits_the_sensor_rules(tmp_path):
     """The run's sensor sits at 5 and is moved to 7 and back once (R-4.4.4): judged on sensor
     7 alone, only those few exchanges are judged, and the notes say so."""

@@ -101,6 +101,7 @@ def test_interactive_prompts_and_times_out():
         assert driver.act("concurrent-two", request, None).notes == ["logged both"]  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_cli_recorder_role(tmp_path):
     assert main(["--port", "sim", "--role", "recorder", "--report-dir", str(tmp_path / "a")]) == 0
     assert (tmp_path / "a" / "report.html").exists()

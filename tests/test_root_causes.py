@@ -3,6 +3,8 @@ the findings it drags name it, in verdicts.json, the console and the HTML read-f
 
 from __future__ import annotations
 
+import pytest
+
 from conformance.catalog import requirement
 from conformance.matrix import run_once
 from conformance.recorder.matrix import run_recorder_suite
@@ -58,6 +60,7 @@ def test_a_timing_fault_shows_its_root_first_and_its_collateral_names_it():
     assert _first_rows(data)[:2] == ["R-7.0-07", "R-7.0-05"]
 
 
+@pytest.mark.slow
 def test_a_recorder_retry_over_a_reply_is_the_root_of_its_broken_command():
     data = run_recorder_suite("sim://?recorder-faults=talks-over-reply")
     verdicts = {r["id"]: r for r in data["requirements"]}
