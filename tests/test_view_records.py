@@ -86,3 +86,39 @@ def test_a_fault_that_forces_retries_is_rebuilt_with_its_sequences():
     assert [[(a.sequence, a.retry) for a in e.attempts] for e in rebuilt] == [
         [(a.sequence, a.retry) for a in e.attempts] for e in written
     ]
+
+
+def _session(faults: tuple[str, ...] = ()):
+    from conformance.ports import open_sim, parse_sim
+    from conformance.sensor.session import SensorSession
+
+    query = f"?faults={','.join(faults)}" if faults else ""
+    opened = open_sim(parse_sim(f"sim://{query}"))
+    session = SensorSession(opened.link, declaration=opened.declaration)
+    session.discover()
+    return session
+
+
+@pytest.mark.parametrize("faults", [(), ("missing-crlf",), ("no-service-request",)])
+def test_the_live_session_hands_the_cases_the_views_records(faults):
+    """A live sensor run's cases judge the records the view rebuilds from the wire (the view
+    a recording is judged by), and the view reads every stimulus as the tool recorder did."""
+    session = _session(faults)
+    first = len(session.link.transcript)
+    ex = session.fresh_exchange("I")
+    m = session.fresh_measurement("M")
+    assert session.view_disagreements == 0
+    wire = session.link.transcript.since(first)
+    rebuilt = rebuild_records(read_view(wire), session.master.policy)
+    assert [e.text for e in rebuilt.exchanges][0] == ex.text
+    assert ex.reply_text == rebuilt.exchanges[0].reply_text
+    assert m.values == rebuilt.measurements[0].values and m.ttt == rebuilt.measurements[0].ttt
+    assert not any("the view read otherwise" in a for a in session.assumptions)
+
+
+def test_a_record_the_view_reads_otherwise_is_said_not_hidden():
+    session = _session()
+    made = session.master.transact("0I!")
+    assert session._as_seen(made, None) is made
+    assert session.view_disagreements == 1
+    assert any("the view read otherwise" in a for a in session.assumptions)

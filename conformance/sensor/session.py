@@ -20,9 +20,12 @@ from ..protocol.commands import Command, parse_command
 from ..protocol.responses import Identification, parse_ident, split_line
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event
+from ..view.records import Rebuilt, rebuild_records
+from ..view.segments import read_view
 from .address_change import AddressChanger
 from .buffer_watch import WatchedMaster
 
+R = TypeVar("R", Exchange, Measurement)
 T = TypeVar("T")
 
 
@@ -69,6 +72,7 @@ class SensorSession:
         self.assumptions: list[str] = []
         self.address_notes: list[str] = []  # what every address change left behind
         self._cache: dict[Any, Any] = {}
+        self.view_disagreements = 0  # stimuli whose view record differed (see _as_seen)
 
     # -- discovery ----------------------------------------------------------------------------
     def discover(self) -> None:
@@ -166,14 +170,44 @@ class SensorSession:
         return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
 
     def fresh_exchange(self, code: str, *, binary: bool | None = None, **kw: Any) -> Exchange:
-        return self.master.transact(self.command(code), binary=binary, **kw)
+        first = len(self.link.transcript)
+        made = self.master.transact(self.command(code), binary=binary, **kw)
+        seen = self._rebuilt(first).exchanges
+        return self._as_seen(made, seen[0] if len(seen) == 1 else None)
 
     def measurement(self, code: str) -> Measurement:
         """The cached full measurement for ``"M"``, ``"MC"``, ``"C9"``, ``"HA"``, ``"HB"``..."""
         return self.once(("m", code), lambda: self.fresh_measurement(code))
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
-        return self.master.measure(self.command(code), **kw)
+        first = len(self.link.transcript)
+        made = self.master.measure(self.command(code), **kw)
+        seen = self._rebuilt(first).measurements
+        return self._as_seen(made, seen[0] if len(seen) == 1 else None)
+
+    # -- what the cases judge: the stimulus as the wire shows it -------------------------------
+    def _rebuilt(self, first: int) -> Rebuilt:
+        """The records the role-neutral view rebuilds from what the stimulus left on the wire
+        (the same view offline judging reads), with the tool recorder's own policy."""
+        events = self.link.transcript.since(first)
+        return rebuild_records(read_view(events), self.master.policy, uncertainty=self.uncertainty)
+
+    def _as_seen(self, made: R, seen: R | None) -> R:
+        """The view's record of a stimulus, which the cases judge, so a live run's verdicts
+        rest on the view a recording is judged by. Where the view reads the wire otherwise
+        than the tool recorder did (a different command, another count of exchanges) the
+        tool recorder's record stands and the run's assumptions say so: never a silent
+        difference."""
+        if seen is not None and seen.command == made.command:
+            return seen
+        self.view_disagreements += 1
+        note = (
+            f"{self.view_disagreements} stimulus record(s) the view read otherwise than the "
+            "tool recorder (its record was judged)"
+        )
+        self.assumptions[:] = [a for a in self.assumptions if "the view read otherwise" not in a]
+        self.assumptions.append(note)
+        return made
 
     def continuous_pairs(self) -> dict[int, tuple[Exchange, Exchange]]:
         """``{n: (aRn!, aRCn!)}`` for n = 0..9, made once as a unit in a fixed order
