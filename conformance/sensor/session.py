@@ -198,7 +198,7 @@ class SensorSession:
         than the tool recorder did (a different command, another count of exchanges) the
         tool recorder's record stands and the run's assumptions say so: never a silent
         difference."""
-        if seen is not None and seen.command == made.command:
+        if seen is not None and same_reading(made, seen):
             return seen
         self.view_disagreements += 1
         note = (
@@ -386,3 +386,29 @@ M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in ran
 C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
 HV_FAMILY = ("HA", "HB")
 CONTINUOUS = (*(f"RC{i}" for i in range(10)), *(f"R{i}" for i in range(10)))
+
+
+def _exchange_reading(ex: Exchange) -> tuple[Any, ...]:
+    return (
+        ex.command,
+        ex.text,
+        ex.reply_text,
+        ex.reply_bytes,
+        tuple((a.reason, a.sequence, a.retry, len(a.reply_events)) for a in ex.attempts),
+    )
+
+
+def same_reading(made: Exchange | Measurement, seen: Exchange | Measurement) -> bool:
+    """Whether the view read a stimulus as the tool recorder did: the same command, replies,
+    attempts and, for a measurement, the same ttt, count, values and service request."""
+    if isinstance(made, Exchange) and isinstance(seen, Exchange):
+        return _exchange_reading(made) == _exchange_reading(seen)
+    if isinstance(made, Measurement) and isinstance(seen, Measurement):
+        return (
+            _exchange_reading(made.start) == _exchange_reading(seen.start)
+            and (made.ttt, made.count, made.values, made.packets)
+            == (seen.ttt, seen.count, seen.values, seen.packets)
+            and made.service_request_end == seen.service_request_end
+            and list(map(_exchange_reading, made.data)) == list(map(_exchange_reading, seen.data))
+        )
+    return False
