@@ -24,7 +24,7 @@ from conformance.recorder.faults import RECORDER_FAULTS
 EXIT_USAGE = 4
 DECIDED = ("PASS", "FAIL", "WARN")
 SCHEMA = Path(__file__).parent.parent / "conformance" / "schemas" / "verdicts-1.json"
-HELLO = Path("/work/shared/captures/hello_world_8n1_1200.sr")
+HELLO = Path(__file__).resolve().parents[2] / "shared" / "captures" / "hello_world_8n1_1200.sr"
 
 #: faults whose own requirement the recorded traffic shows (b): each must FAIL/WARN passively
 SENSOR_SHOWN = [
@@ -148,7 +148,7 @@ def test_both_roles_write_two_report_sets(tmp_path, capsys):
     first = live(tmp_path, "sim://?faults=wrong-crc", "sensor")
     capsys.readouterr()  # the live run's own summary
     out = tmp_path / "both"
-    code = main(["judge", str(first), "--passive", "--report-dir", str(out)])
+    code = main(["judge", str(first), "--passive", "--role", "both", "--report-dir", str(out)])
     said = capsys.readouterr().out
     for role in ("sensor", "recorder"):
         assert (out / role / "verdicts.json").exists() and (out / role / "report.html").exists()
@@ -157,6 +157,21 @@ def test_both_roles_write_two_report_sets(tmp_path, capsys):
         assert f"{role} rules:" in said
     assert said.count("verdict: ") == 2
     assert code == 1  # the worse of the two: the sensor's wrong CRC
+
+
+def test_a_run_of_this_tool_is_judged_for_its_device_under_test_by_default(tmp_path, capsys):
+    """A run's recording holds the tool's own stimuli on the other side (short breaks, slow
+    characters, invalid addresses on purpose): by default only the judged role's rules, said."""
+    first = live(tmp_path, "sim://?recorder-faults=short-break", "recorder")
+    capsys.readouterr()
+    out = tmp_path / "default"
+    assert main(["judge", str(first), "--passive", "--report-dir", str(out)]) == 1
+    said = capsys.readouterr().out
+    assert "recorder rules only: the recording is of this tool's recorder run" in said
+    assert not (out / "sensor").exists() and not (out / "recorder").exists()
+    data = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
+    assert data["run"]["role"] == "recorder"
+    assert verdicts(out)["R-7.0-02"] == "FAIL"  # the short break, still judged
 
 
 @pytest.mark.slow

@@ -51,6 +51,10 @@ class JudgePlan:
     replay_argv: list[str] | None = None
     passive_argv: list[str] | None = None
     notes: list[str] = field(default_factory=list)
+    #: the role this tool's run judged, when the recording is of one: judged passively, only
+    #: that role's rules by default (the other side is the tool's own, partly deliberately
+    #: out-of-spec, stimuli; ``--role both`` judges it too)
+    run_role: str | None = None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -67,7 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--role",
         choices=ROLES,
         help="whose rules: sensor rules on what the sensors sent, recorder rules on what the "
-        "recorder sent (default: a replayed run's own role; otherwise both)",
+        "recorder sent (default: the role a run of this tool judged; otherwise both)",
     )
     parser.add_argument("--address", help="judge only this sensor address")
     parser.add_argument("--channel", help="capture channel carrying the SDI-12 line")
@@ -128,11 +132,19 @@ def plan(argv: list[str]) -> JudgePlan:
             found.replay_argv = replay_argv(recording, args)
             return found
         found.notes.append(f"judged passively: {why_not}")
+        if recording.options:
+            found.run_role = recording.role
     else:
         capture_replay(found, args)
         if found.replay_argv is not None:
             return found
-    found.passive_argv = passive_argv(path, kind, args)
+    if args.role is None and found.run_role is not None:
+        other = "recorder" if found.run_role == "sensor" else "sensor"
+        found.notes.append(
+            f"{found.run_role} rules only: the recording is of this tool's {found.run_role} "
+            f"run, whose {other} side is the tool's own stimuli (--role both judges them too)"
+        )
+    found.passive_argv = passive_argv(path, kind, args, found.run_role)
     return found
 
 
@@ -154,6 +166,7 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
     if not options:
         found.notes.append("judged passively: the capture does not say which run it is of")
         return
+    found.run_role = str(options.get("role", "sensor"))
     events, unsettled = directed(decoded.events)
     if unsettled:
         found.notes.append(
@@ -278,9 +291,12 @@ def replay_argv(recording: Recording, args: argparse.Namespace) -> list[str]:
     return argv
 
 
-def passive_argv(path: Path, kind: str, args: argparse.Namespace) -> list[str]:
-    """The passive judging's options (see :mod:`conformance.offline.passive`)."""
-    argv = ["--recording", str(path), "--format", kind, "--role", args.role or "both"]
+def passive_argv(
+    path: Path, kind: str, args: argparse.Namespace, run_role: str | None = None
+) -> list[str]:
+    """The passive judging's options (see :mod:`conformance.offline.passive`); ``run_role``:
+    the default role when the recording is of a run of this tool (else both)."""
+    argv = ["--recording", str(path), "--format", kind, "--role", args.role or run_role or "both"]
     for flag, value in (
         ("--address", args.address),
         ("--channel", args.channel),

@@ -19,6 +19,7 @@ direction is inferred from the protocol (:mod:`.direction`) and every guess says
 from __future__ import annotations
 
 import re
+from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -185,10 +186,31 @@ class TranscriptView:
 
     def previous_activity(self, t: Transmission) -> float | None:
         """End of the last event on the line before ``t`` took it (either side)."""
-        start = t.start
-        ends = [e.end for e in self.chars if e.end <= start]
-        ends += [b.end for b in self.breaks if b.end <= start]
-        return max(ends) if ends else None
+        ends = self._sorted(
+            "_activity_ends", lambda: sorted([e.end for e in self.chars + self.breaks])
+        )
+        i = bisect_right(ends, t.start)
+        return ends[i - 1] if i else None
+
+    def sensor_chars_between(self, start: float, end: float) -> list[Event]:
+        """Characters no transmission of the recorder holds, starting in ``[start, end)``."""
+        mine = self._sorted(
+            "_sensor_chars",
+            lambda: _not_in(self.chars, [c for s in self.transmissions for c in s.chars]),
+        )
+        starts = self._sorted("_sensor_starts", lambda: [c.start for c in mine])
+        return mine[bisect_left(starts, start) : bisect_left(starts, end)]
+
+    def _sorted(self, name: str, build: Callable[[], list]) -> list:
+        """A derived index, built once per view (a field recording holds tens of thousands of
+        transmissions; scanning the line per question made judging quadratic). Rebuilt if the
+        view gained events since."""
+        key = (len(self.chars), len(self.breaks), len(self.transmissions))
+        cached = self.__dict__.get(name)
+        if cached is None or cached[0] != key:
+            cached = (key, build())
+            self.__dict__[name] = cached
+        return cached[1]
 
     def last_break_before(self, t: Transmission) -> Event | None:
         before = [b for b in self.breaks if b.end <= t.start]
@@ -350,3 +372,9 @@ def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:
         [c for v in views for c in v.unanswerable],
         [c for v in views for c in v.undirected],
     )
+
+
+def _not_in(events: list[Event], taken: list[Event]) -> list[Event]:
+    """``events`` without those in ``taken`` (by identity), order kept."""
+    ids = {id(e) for e in taken}
+    return [e for e in events if id(e) not in ids]

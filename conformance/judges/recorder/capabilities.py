@@ -16,7 +16,7 @@ from ..tally import Tally
 from ..timing import judge_window
 from .common import combine
 from .measurements import observed_measurements
-from .replies import answered
+from .replies import first_answered
 
 
 def judge_commands_issued(
@@ -24,7 +24,8 @@ def judge_commands_issued(
 ) -> Finding:
     """``rid`` (R-4.4-02 by default): every command the recorder was asked to use went out and
     drew a valid reply; for measurements, every announced value was read."""
-    missing = [text for text in asked if answered(line, text, uncertainty) is None]
+    first = first_answered(line, uncertainty)
+    missing = [text for text in asked if text not in first]
     taken = {m.start.text: m for m in observed_measurements(line, uncertainty)}
     short = [
         f"{escape(t)} ({len(m.values())} of {m.count} values)"
@@ -48,7 +49,7 @@ def judge_commands_issued(
 
 def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-4.3-03: the recorder polls every address 0-9. R-4.3-04 (MAY): letters as addresses."""
-    polled = {s.address for s in line.transmissions if answered(line, s.text, uncertainty) is s}
+    polled = {s.address for s in first_answered(line, uncertainty).values()}
     digits = [a for a in "0123456789" if a not in polled]
     r3 = (
         Finding("R-4.3-03", Verdict.FAIL, f"addresses never polled successfully: {digits}")

@@ -47,10 +47,14 @@ def data_values(sent: Transmission, measurement: Command) -> list[str]:
     return parse_data_reply(body, crc_expected=measurement.returns_crc, limit=NO_LIMIT).values
 
 
-def answered(line: TranscriptView, text: str, uncertainty: float) -> Transmission | None:
-    """The transmission of ``text`` that drew a valid reply, if any."""
+def first_answered(line: TranscriptView, uncertainty: float) -> dict[str, Transmission]:
+    """For each transmitted text, its first transmission that drew a valid reply (one pass:
+    a field recording holds tens of thousands of transmissions)."""
     crc = crc_context(line)
+    found: dict[str, Transmission] = {}
     for i, s in enumerate(line.transmissions):
-        if s.text == text and reply_problem(s, crc[i], uncertainty) is None:
-            return s
-    return None
+        text = s.text
+        if text not in found and reply_problem(s, crc[i], uncertainty) is None:
+            found[text] = s
+    return found
+

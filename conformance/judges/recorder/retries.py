@@ -182,8 +182,7 @@ def _retry_after_reply(
 ) -> Finding:
     """R-7.2-06: marking between the end of the invalid reply and the retry; negative when
     the sensor was still sending as the recorder took the line again."""
-    mine = {id(c) for s in line.transmissions for c in s.chars}
-    reply = [c for c in line.chars if id(c) not in mine and sent.end <= c.start < retry.end]
+    reply = line.sensor_chars_between(sent.end, retry.end)
     reply_end = max((c.end for c in reply), default=sent.end)
     return judge_window(
         "R-7.2-06",
