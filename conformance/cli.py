@@ -278,6 +278,12 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     )
     p.add_argument("--faults", help="comma-separated fault names (default: all)")
     p.add_argument("--jobs", type=int, default=2, help="parallel runs (default 2)")
+    p.add_argument(
+        "--through-capture",
+        action="store_true",
+        help="also export each fault's run as a sigrok capture and judge that: a row is exact "
+        "only if the capture gives the run's verdicts (about twice the time)",
+    )
     args = p.parse_args(argv)
     from rich.table import Table
 
@@ -303,14 +309,23 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
         status.print(f"[{done}/{total}] {row.fault}: {caught}", markup=False, highlight=False)
 
     status.print(f"running the sensor suite once per fault, {args.jobs} at a time...")
-    rows = fault_matrix(names, processes=args.jobs, progress=progress)
+    if args.through_capture:
+        from .roundtrip import row_through_capture
+
+        rows = fault_matrix(names, args.jobs, progress, row=row_through_capture)
+    else:
+        rows = fault_matrix(names, processes=args.jobs, progress=progress)
     table = Table(title="fault-detection matrix (sensor role)")
-    for col in ("fault", "declared", "FAIL/WARN", "caught"):
+    columns = ("fault", "declared", "FAIL/WARN", "caught")
+    for col in columns + (("through a capture",) if args.through_capture else ()):
         table.add_column(col, overflow="fold")
     for r in rows:
         caught = "exactly" if r.exact else r.explain().split(": ", 1)[1]  # INCONCLUSIVEs too
         style = "" if r.exact else "bold red"
-        table.add_row(r.fault, " ".join(r.declared), " ".join(r.flagged), caught, style=style)
+        cells = [r.fault, " ".join(r.declared), " ".join(r.flagged), caught]
+        if r.capture is not None:
+            cells.append("same verdicts" if not r.capture else f"{len(r.capture)} changed")
+        table.add_row(*cells, style=style)
     console.print(table)
     exact = sum(r.exact for r in rows)
     console.print(f"{exact}/{len(rows)} faults caught by exactly their requirements")

@@ -37,6 +37,8 @@ class MatrixRow:
     other: tuple[str, ...]  # INCONCLUSIVE or ERROR requirements, for the reader
     failed: tuple[str, ...] = ()  # the FAIL ones among the flagged
     declared_inconclusive: tuple[str, ...] = ()  # collateral the fault says it leaves open
+    #: verdicts judging the run through a capture of itself changed (None: not checked)
+    capture: tuple[str, ...] | None = None
 
     @property
     def missed(self) -> tuple[str, ...]:
@@ -70,6 +72,7 @@ class MatrixRow:
             or self.stray_inconclusive
             or self.missing_inconclusive
             or self.errors
+            or self.capture
         )
 
     def explain(self) -> str:
@@ -82,6 +85,7 @@ class MatrixRow:
                 ("undeclared INCONCLUSIVE", self.stray_inconclusive),
                 ("declared INCONCLUSIVE but decided", self.missing_inconclusive),
                 ("ERROR", self.errors),
+                ("changed through a capture", self.capture or ()),
             )
             if ids
         ]
@@ -90,11 +94,20 @@ class MatrixRow:
 
 def run_once(port: str, extra: tuple[str, ...] = (), role: str = "sensor") -> dict:
     """Run the ``role`` suite in this process against ``port``; return verdicts.json."""
+    with tempfile.TemporaryDirectory(prefix=f"sdi12-{role}-") as tmp:
+        return run_into(Path(tmp), port, extra, role)
+
+
+def run_into(
+    report_dir: Path, port: str, extra: tuple[str, ...] = (), role: str = "sensor"
+) -> dict:
+    """Run the ``role`` suite in this process against ``port`` with its reports (no HTML) in
+    ``report_dir``; return verdicts.json."""
     import pytest
 
-    with tempfile.TemporaryDirectory(prefix=f"sdi12-{role}-") as tmp:
-        pytest.main([*suite_args(role, port, tmp, rootdir=tmp, html=False), *extra])
-        return json.loads((Path(tmp) / "verdicts.json").read_text(encoding="utf-8"))
+    report_dir.mkdir(parents=True, exist_ok=True)
+    pytest.main([*suite_args(role, port, report_dir, rootdir=report_dir, html=False), *extra])
+    return json.loads((report_dir / "verdicts.json").read_text(encoding="utf-8"))
 
 
 def row_from(
@@ -116,23 +129,36 @@ def row_from(
     )
 
 
-def _row(item: tuple[str, tuple[str, ...], str, tuple[str, ...]]) -> MatrixRow:
+#: one matrix item: fault, the requirements it declares, its version ("14"), extra arguments
+Item = tuple[str, tuple[str, ...], str, tuple[str, ...]]
+
+
+def fault_port(item: Item) -> str:
+    fault, _, version, _ = item
+    return f"sim://?faults={fault}&version={version[0]}.{version[1:]}"  # "13" is version=1.3
+
+
+def fault_row(item: Item, data: dict) -> MatrixRow:
     from .emulator import FAULTS
 
-    fault, declared, version, extra = item
-    dotted = f"{version[0]}.{version[1:]}"  # a fault's "13" is the port's version=1.3
-    data = run_once(f"sim://?faults={fault}&version={dotted}", extra)
+    fault, declared, _, _ = item
     return row_from(fault, declared, data, tuple(FAULTS[fault].inconclusive))
+
+
+def _row(item: Item) -> MatrixRow:
+    return fault_row(item, run_once(fault_port(item), item[3]))
 
 
 def fault_matrix(
     faults: list[str] | None = None,
     processes: int = 2,
     progress: Callable[[int, int, MatrixRow], None] | None = None,
+    row: Callable[[Item], MatrixRow] = _row,
 ) -> list[MatrixRow]:
     """One row per fault (all of them by default), run ``processes`` at a time;
     ``progress(done, total, row)`` hears of each row as it arrives (the whole matrix takes
-    minutes)."""
+    minutes). ``row`` makes one row from an item in a worker process (a module-level
+    function: :func:`conformance.roundtrip.row_through_capture` adds the capture check)."""
     from .emulator import FAULTS
 
     names = faults or sorted(FAULTS)
@@ -142,17 +168,17 @@ def fault_matrix(
     ]
     rows: list[MatrixRow] = []
 
-    def keep(row: MatrixRow) -> None:
-        rows.append(row)
+    def keep(made: MatrixRow) -> None:
+        rows.append(made)
         if progress is not None:
-            progress(len(rows), len(items), row)
+            progress(len(rows), len(items), made)
 
     if processes <= 1:
         for item in items:
-            keep(_row(item))
+            keep(row(item))
         return rows
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(processes) as pool:
-        for row in pool.imap(_row, items, chunksize=1):
-            keep(row)
+        for made in pool.imap(row, items, chunksize=1):
+            keep(made)
     return rows

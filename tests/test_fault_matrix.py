@@ -1,7 +1,9 @@
 """The suite's own quality metric (design.md 5): every emulator fault is caught by exactly
 the requirements it declares (FAIL/WARN, and INCONCLUSIVE only where the fault declares that
 collateral), the clean emulator is COMPLIANT at v1.3 and v1.4, and every testable sensor
-requirement is exercised by at least one fault.
+requirement is exercised by at least one fault. Every fault's run is also judged through a
+logic-analyzer capture of itself (issue 11: ``export`` to .sr, ``judge`` the capture): the same
+verdicts, or a capture deciding what the live run left INCONCLUSIVE.
 
 One test per fault, so a failure names its fault. The runs themselves are made once per
 module, two at a time, for the faults the session selected (``-k some-fault`` runs one).
@@ -14,6 +16,7 @@ import pytest
 from conformance.catalog import for_role
 from conformance.emulator import FAULTS
 from conformance.matrix import MatrixRow, fault_matrix, run_once
+from conformance.roundtrip import row_through_capture
 
 #: A handful of faults (protocol, CRC, timing) the default fast selection
 #: keeps; every other row carries the ``matrix`` marker and runs in the full run (.ci/run).
@@ -35,7 +38,7 @@ def selected_params(request: pytest.FixtureRequest, name: str) -> list[str]:
 @pytest.fixture(scope="module")
 def rows(request: pytest.FixtureRequest) -> dict[str, MatrixRow]:
     wanted = selected_params(request, "fault")
-    return {r.fault: r for r in fault_matrix(wanted, processes=2)}
+    return {r.fault: r for r in fault_matrix(wanted, processes=2, row=row_through_capture)}
 
 
 @pytest.mark.parametrize(
@@ -44,6 +47,7 @@ def rows(request: pytest.FixtureRequest) -> dict[str, MatrixRow]:
 )
 def test_fault_is_caught_by_exactly_its_requirements(fault, rows):
     row = rows[fault]
+    assert row.capture is not None  # judged through its capture too
     assert row.exact, row.explain()
     # a FAIL makes the run NON-COMPLIANT; a fault of a SHOULD rule only warns
     assert (row.verdict == "NON-COMPLIANT") == bool(row.failed)

@@ -2,7 +2,8 @@
 by replay of its transcript and through a logic-analyzer capture of it; bad recordings are
 refused with the file named and exit 4.
 
-The whole fault matrix through a capture is marked ``matrix`` (minutes); the default selection
+Every sensor and recorder fault goes through a capture in the fault matrices
+(``tests/test_fault_matrix.py``, ``tests/test_recorder_matrix.py``); here the default selection
 keeps one clean and one faulty run per role.
 """
 
@@ -15,8 +16,6 @@ from pathlib import Path
 import pytest
 
 from conformance.cli import main
-from conformance.emulator import FAULTS
-from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.replay.recording import OPTIONS_NOTE, read_recording
 
 EXIT_USAGE = 4
@@ -166,47 +165,5 @@ def test_export_refuses_what_it_cannot_write(tmp_path, capsys):
     assert "no such file" in capsys.readouterr().err
 
 
-#: Sensor faults checked through a capture: the wire-level ones (timing, parity, breaks,
-#: standby, addresses) and one of each reply family. Not every fault yet: fast-baud (a sensor
-#: at 1300 baud) stops the replay of its capture, and a full run of all 121 took longer than
-#: the shared machine allowed; see the issue's closing note.
-CAPTURED_SENSOR_FAULTS = (
-    "binary-address-parity",
-    "early-address",
-    "ignores-short-breaks",
-    "inter-char-gap",
-    "inter-char-gap-tolerance",
-    "late-address-after-break",
-    "multiline-slow-lines",
-    "parity-error",
-    "response-too-early",
-    "slow-wake",
-    "standby-after-108ms",
-    "standby-after-40ms",
-    "standby-after-60ms",
-    "wakes-on-short-spacing",
-)
-
-
-@pytest.mark.matrix
-@pytest.mark.parametrize("fault", CAPTURED_SENSOR_FAULTS)
-def test_sensor_faults_through_a_capture(tmp_path, fault):
-    """Live run, .sr export with the tool's TX channel, judge the capture: the same verdicts."""
-    version = getattr(FAULTS[fault], "version", None) or "14"
-    first = live(tmp_path, f"sim://?faults={fault}&version={version[0]}.{version[1:]}")
-    capture = tmp_path / "run.sr"
-    assert main(["export", str(first), "--to", "sr", "--tool-channel", "-o", str(capture)]) == 0
-    again = tmp_path / "capture"
-    main(["judge", str(capture), "--tx-channel", "TOOL_TX", "--report-dir", str(again)])
-    same_verdicts(first, again, uncertainty_may_differ=True)
-
-
-@pytest.mark.matrix
-@pytest.mark.parametrize("fault", sorted(RECORDER_FAULTS))
-def test_every_recorder_fault_through_a_capture(tmp_path, fault):
-    first = live(tmp_path, f"sim://?recorder-faults={fault}", "recorder")
-    capture = tmp_path / "run.sr"
-    assert main(["export", str(first), "--to", "sr", "--tool-channel", "-o", str(capture)]) == 0
-    again = tmp_path / "capture"
-    main(["judge", str(capture), "--tx-channel", "TOOL_TX", "--report-dir", str(again)])
-    same_verdicts(first, again, uncertainty_may_differ=True)
+# Every sensor and recorder fault through a capture: the fault matrices
+# (tests/test_fault_matrix.py, tests/test_recorder_matrix.py) judge each run through its .sr too.

@@ -128,6 +128,12 @@ def decode(
     cur = _Cursor(chunks)
     level = (initial_level & 1) ^ int(invert)
     last_end: float | None = None  # tick where the previous frame or break ended
+    # the bit time the previous character was read with, when it read cleanly: the next one,
+    # if it follows within a frame's time, is the same sender's (a reply's characters), and
+    # a frame whose only inner edge comes late (0xC0: seven spacing bits, then marking) fits
+    # a fast and a slow sender equally well (6.46 bits at 1300 baud is 6 bits at 1114): the
+    # sender's rate seen a character earlier settles it
+    prior_bt: float | None = None
 
     def t(tick: float) -> float:
         return t0 + tick / tick_rate
@@ -169,6 +175,7 @@ def decode(
             )
             marking = None if last_end is None else (s - last_end) / tick_rate
             yield Decoded(kind, ev, ev.start, ev.end, marking_before=marking)
+            prior_bt = None
             if r is None:
                 return
             cur.i += 1
@@ -186,7 +193,8 @@ def decode(
         # rate and the bits are then read where that sender put them
         # (a fit is trusted only where it differs from the nominal bit by more than the edges'
         # own quantisation allows: at 8 samples a bit, one sample is 12 % of a bit)
-        bt = used = T
+        follows = prior_bt is not None and last_end is not None and s - last_end < nbits * T
+        bt = used = prior_bt if follows and prior_bt is not None else T
         skk = sdk = 0.0
         kmax = 0
         bounds = [s, *inner]
@@ -235,6 +243,7 @@ def decode(
         ev = Event(EventKind.CHAR, BUS, t(s), t(end), wire=wire, uncertainty=uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
+        prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity
         yield Decoded(
             "char",
             ev,

@@ -100,11 +100,13 @@ def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
 def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event]]:
     gaps = []
     for seg in segs:
+        where = ""
         for run in runs(seg.reply) + runs(seg.later):
             for a, b in zip(run, run[1:], strict=False):
                 if seg.multiline and a.char7 == 0x0A:
                     continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
-                gaps.append((b.start - a.end, f"in reply to {escape(seg.text)}", a, b))
+                where = where or f"in reply to {escape(seg.text)}"
+                gaps.append((b.start - a.end, where, a, b))
     return gaps
 
 

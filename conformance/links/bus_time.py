@@ -90,7 +90,7 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     for e in [*wire, None]:
         ends_exchange = e is None or e.kind is EventKind.BREAK
         if e is not None and e.origin == TOOL and e.kind is EventKind.CHAR:
-            ends_exchange = bool(reply) or decode_7e1(command).endswith("!")
+            ends_exchange = bool(reply) or _ends_command(command)
         if ends_exchange:
             wait = _announced_wait(command, reply)
             if wait is not None:
@@ -104,7 +104,7 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
             continue
         if e.origin == TOOL:
             command.append(e)
-        elif command and decode_7e1(command).endswith("!") and not _line_done(reply):
+        elif _ends_command(command) and not _line_done(reply):
             reply.append(e)
     return waits
 
@@ -133,8 +133,14 @@ def announced_time(text: str, digits: int) -> int | None:
     return shape.ttt if shape.count is not None else None
 
 
+def _ends_command(command: list[Event]) -> bool:
+    """The tool's characters so far end in ``!`` (only characters are ever collected: the
+    last one decides, without decoding the whole command for every event)."""
+    return bool(command) and command[-1].char7 == ord("!")
+
+
 def _line_done(reply: list[Event]) -> bool:
-    return len(reply) >= 2 and decode_7e1(reply[-2:]) == "\r\n"
+    return len(reply) >= 2 and reply[-2].char7 == ord("\r") and reply[-1].char7 == ord("\n")
 
 
 def _union(spans: list[tuple[float, float]]) -> float:

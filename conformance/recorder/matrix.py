@@ -3,21 +3,9 @@ recorder suite, compared with the requirements the fault declares (design.md 5).
 
 from __future__ import annotations
 
-from ..matrix import MatrixRow, row_from, run_once
-from .faults import RECORDER_FAULTS
+from ..matrix import run_once
 
 
 def run_recorder_suite(port: str = "sim", extra: tuple[str, ...] = ()) -> dict:
     """Run the recorder suite in this process against ``port``; return verdicts.json."""
     return run_once(port, extra, role="recorder")
-
-
-def recorder_row(fault: str) -> MatrixRow:
-    data = run_recorder_suite(f"sim://?recorder-faults={fault}")
-    spec = RECORDER_FAULTS[fault]
-    return row_from(fault, spec.violates, data, spec.inconclusive)
-
-
-def recorder_matrix(faults: list[str] | None = None) -> list[MatrixRow]:
-    """One row per recorder fault (all by default); each run takes about a second."""
-    return [recorder_row(name) for name in faults or sorted(RECORDER_FAULTS)]

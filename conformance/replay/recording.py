@@ -72,7 +72,7 @@ def read_recording(path: str | Path) -> Recording:
     if not file.exists():
         raise RecordingError(f"{file}: no such file")
     try:
-        events = read_transcript_jsonl(str(file))
+        events = _read_events(file)
     except CaptureError as exc:
         raise RecordingError(str(exc)) from None
     options: dict[str, Any] = {}
@@ -83,6 +83,22 @@ def read_recording(path: str | Path) -> Recording:
     if not any(e.kind is not EventKind.NOTE for e in events):
         raise RecordingError(f"{file}: no bus events in it: nothing to judge")
     return Recording(file, events, options, _verdicts_beside(file))
+
+
+#: the last few transcripts read, by (path, mtime, size): one judging reads its recording up
+#: to four times (plan, port check, replay link, plugin), and an hour of bus is 10^6 lines
+_READ: dict[tuple[str, int, int], tuple[Event, ...]] = {}
+
+
+def _read_events(file: Path) -> list[Event]:
+    """The transcript's events (a fresh list each call; the events themselves are frozen)."""
+    st = file.stat()
+    key = (str(file.resolve()), st.st_mtime_ns, st.st_size)
+    if key not in _READ:
+        if len(_READ) >= 2:
+            _READ.pop(next(iter(_READ)))
+        _READ[key] = tuple(read_transcript_jsonl(str(file)))
+    return list(_READ[key])
 
 
 def options_in(notes: list[Event]) -> dict[str, Any]:

@@ -64,7 +64,14 @@ class Transmission:
 
     @property
     def text(self) -> str:
-        return decode_7e1(self.chars)
+        # asked for tens of times per transmission by the judges: decoded once per length
+        # (characters are only ever appended while the view is cut)
+        n = len(self.chars)
+        cached = self.__dict__.get("_text")
+        if cached is None or cached[0] != n:
+            cached = (n, decode_7e1(self.chars))
+            self.__dict__["_text"] = cached
+        return cached[1]
 
     @property
     def address(self) -> str:

@@ -1,0 +1,91 @@
+"""A run judged again through a logic-analyzer capture of itself (issue 11's round trip).
+
+The run's transcript is exported as a sigrok session with the tool's TX on a second channel,
+the capture is decoded at sample resolution and its cases are replayed against it, exactly as
+a user's ``sdi12-conform export`` + ``sdi12-conform judge`` would. The verdicts must be the
+live run's: a capture may decide what the live link left INCONCLUSIVE, never the reverse and
+never another decided verdict. The fault matrices run every fault this way (``--through-
+capture``), so the decoder, the direction handling and the replay are proven on every rule.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+from .matrix import Item, MatrixRow, fault_port, fault_row, row_from, run_into
+
+DECIDED = ("PASS", "FAIL", "WARN", "N/A")
+
+
+class RoundTripError(RuntimeError):
+    """The export or the judging did not produce verdicts (the text says what it printed)."""
+
+
+def judged_through_capture(run_dir: Path, work: Path) -> dict:
+    """Export the run in ``run_dir`` to ``work/run.sr``, judge that capture into
+    ``work/capture/`` and return its verdicts.json (``run.link.kind`` says whether it was a
+    replay: a capture judged passively is a difference the caller reports)."""
+    from .cli import main
+
+    work.mkdir(parents=True, exist_ok=True)
+    capture = work / "run.sr"
+    again = work / "capture"
+    said = io.StringIO()
+    with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+        code = main(["export", str(run_dir), "--to", "sr", "--tool-channel", "-o", str(capture)])
+        if code == 0:
+            main(["judge", str(capture), "--tx-channel", "TOOL_TX", "--report-dir", str(again)])
+    verdicts = again / "verdicts.json"
+    if not verdicts.exists():
+        raise RoundTripError(f"{run_dir}: no verdicts from its capture: {said.getvalue()[-600:]}")
+    return json.loads(verdicts.read_text(encoding="utf-8"))
+
+
+def verdict_changes(live: dict, again: dict) -> tuple[str, ...]:
+    """Where judging the capture changed the live run's verdicts: ``R-x: PASS -> FAIL``, plus
+    one entry if the capture was not replayed. A capture deciding a requirement the live run
+    left INCONCLUSIVE is no change (the capture's timing can be better than the link's)."""
+    kind = str(again["run"]["link"].get("kind", ""))
+    changes = [] if kind.startswith("replay") else [f"capture judged by {kind!r}, not replayed"]
+    before = {r["id"]: r["verdict"] for r in live["requirements"]}
+    after = {r["id"]: r["verdict"] for r in again["requirements"]}
+    for rid in sorted(before.keys() | after.keys()):
+        a, b = before.get(rid, "absent"), after.get(rid, "absent")
+        if a != b and not (a == "INCONCLUSIVE" and b in DECIDED):
+            changes.append(f"{rid}: {a} -> {b}")
+    return tuple(changes)
+
+
+def capture_changes(run_dir: Path, live: dict, work: Path) -> tuple[str, ...]:
+    """:func:`verdict_changes` of the run in ``run_dir`` judged through its capture; an
+    export or judging that fails is itself a change (never an exception in a matrix)."""
+    try:
+        return verdict_changes(live, judged_through_capture(run_dir, work))
+    except RoundTripError as exc:
+        return (str(exc),)
+
+
+def row_through_capture(item: Item) -> MatrixRow:
+    """A sensor fault's matrix row (:func:`conformance.matrix.fault_matrix`'s ``row``) with
+    its run also judged through a capture of itself."""
+    with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
+        live_dir = Path(tmp) / "live"
+        data = run_into(live_dir, fault_port(item), item[3])
+        return replace(fault_row(item, data), capture=capture_changes(live_dir, data, Path(tmp)))
+
+
+def recorder_row_through_capture(fault: str) -> MatrixRow:
+    """A recorder fault's matrix row with its run also judged through a capture of itself."""
+    from .recorder.faults import RECORDER_FAULTS
+
+    spec = RECORDER_FAULTS[fault]
+    with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
+        live_dir = Path(tmp) / "live"
+        data = run_into(live_dir, f"sim://?recorder-faults={fault}", role="recorder")
+        row = row_from(fault, spec.violates, data, spec.inconclusive)
+        return replace(row, capture=capture_changes(live_dir, data, Path(tmp)))
