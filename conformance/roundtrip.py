@@ -10,40 +10,55 @@ capture``), so the decoder, the direction handling and the replay are proven on 
 
 from __future__ import annotations
 
-import contextlib
-import io
-import json
+import argparse
 import tempfile
 from dataclasses import replace
 from pathlib import Path
 
 from .matrix import Item, MatrixRow, fault_port, fault_row, row_from, run_into
+from .options import OPTIONS, add_cli_options, pytest_args
+from .transcript import EventKind
 
 DECIDED = ("PASS", "FAIL", "WARN", "N/A")
 
 
 class RoundTripError(RuntimeError):
-    """The export or the judging did not produce verdicts (the text says what it printed)."""
+    """The export or the judging could not give verdicts (the text says why)."""
 
 
 def judged_through_capture(run_dir: Path, work: Path) -> dict:
-    """Export the run in ``run_dir`` to ``work/run.sr``, judge that capture into
-    ``work/capture/`` and return its verdicts.json (``run.link.kind`` says whether it was a
-    replay: a capture judged passively is a difference the caller reports)."""
-    from .cli import main
+    """Export the run in ``run_dir`` to ``work/run.sr`` (the tool's TX on a second channel),
+    judge that capture as ``sdi12-conform judge`` does (decoded, directions from the TX
+    channel, the run's cases replayed against it; no HTML) into ``work/capture/`` and return
+    its verdicts.json. A capture the judging would take passively raises, with the reason."""
+    from .capture.errors import CaptureError
+    from .capture.export import TOOL_CHANNEL, export_events
+    from .offline.judge import JudgeError, plan
+    from .replay.recording import RecordingError, read_recording
 
     work.mkdir(parents=True, exist_ok=True)
     capture = work / "run.sr"
     again = work / "capture"
-    said = io.StringIO()
-    with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
-        code = main(["export", str(run_dir), "--to", "sr", "--tool-channel", "-o", str(capture)])
-        if code == 0:
-            main(["judge", str(capture), "--tx-channel", "TOOL_TX", "--report-dir", str(again)])
-    verdicts = again / "verdicts.json"
-    if not verdicts.exists():
-        raise RoundTripError(f"{run_dir}: no verdicts from its capture: {said.getvalue()[-600:]}")
-    return json.loads(verdicts.read_text(encoding="utf-8"))
+    try:
+        recording = read_recording(run_dir)
+        notes = [e for e in recording.events if e.kind is EventKind.NOTE]
+        export_events(recording.events, str(capture), "sr", tool_channel=True, notes=notes)
+        found = plan([str(capture), "--tx-channel", TOOL_CHANNEL, "--report-dir", str(again)])
+    except (RecordingError, CaptureError, JudgeError, ValueError) as exc:
+        raise RoundTripError(f"{run_dir}: {exc}") from None
+    if found.replay_argv is None:
+        raise RoundTripError(f"{run_dir}: its capture would be judged passively: {found.notes}")
+    args = _replay_parser().parse_args(found.replay_argv)
+    extra = pytest_args(args) + (["-k", args.keyword] if args.keyword else [])
+    return run_into(again, args.port, tuple(extra), args.role)
+
+
+def _replay_parser() -> argparse.ArgumentParser:
+    """The main command's run options (the replay's arguments are spelled as its own)."""
+    parser = argparse.ArgumentParser(add_help=False)
+    add_cli_options(parser, [o.name for o in OPTIONS])
+    parser.add_argument("-k", dest="keyword")
+    return parser
 
 
 def verdict_changes(live: dict, again: dict) -> tuple[str, ...]:

@@ -240,6 +240,8 @@ def decode(
         if framing_error and (e := cur.peek()) is not None:
             cur.i += 1
             end = max(end, e)
+        elif (e := cur.peek()) is not None and e < end:
+            end = e  # the next start bit came first: this stop bit ended there (back to back)
         ev = Event(EventKind.CHAR, BUS, t(s), t(end), wire=wire, uncertainty=uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end

@@ -20,6 +20,10 @@ from ..protocol.timing import BIT_TIME, CHAR_TIME
 from ..sim.bus import Frame
 from ..transcript import TOOL, Event, EventKind, escape
 
+#: a frame's start meaning "as soon as the line is free" (the bus starts a frame at the later
+#: of its start and the end of what is on the line)
+LINE_FREE = float("-inf")
+
 
 class ReplayDiverged(LinkError):
     """The tool's stimuli no longer follow the recording."""
@@ -77,7 +81,26 @@ class RecordedSensor:
         if self._needs[self.next_reply] > self.heard:
             return None  # its question has not been asked yet
         reply = self.replies[self.next_reply]
-        return Frame(reply.start + self.offset, reply.wire, reply.end - reply.start)
+        start = reply.start + self.offset
+        before = self._just_before(reply)
+        if before is not None and abs(reply.start - before.end) <= (
+            reply.uncertainty + before.uncertainty
+        ):
+            # back to back with what was on the line before it, within what the recording can
+            # tell (a capture's edges sit on its sample grid): it goes the moment the line is
+            # free, so it wins the line against the tool's next frame, as recorded (else the
+            # order of frames that touch could turn on a few microseconds of quantization)
+            start = LINE_FREE
+        return Frame(start, reply.wire, reply.end - reply.start)
+
+    def _just_before(self, reply: Event) -> Event | None:
+        """The recorded event that ended last before ``reply``: the tool's last matched one
+        or the previous reply character."""
+        found = [self.tool[self.heard - 1]] if self.heard else []
+        if self.next_reply:
+            found.append(self.replies[self.next_reply - 1])
+        found = [e for e in found if e.start < reply.start]
+        return max(found, key=lambda e: e.end, default=None)
 
     def pop_frame(self) -> Frame:
         frame = self.next_frame()

@@ -201,9 +201,12 @@ class TranscriptView:
 
     def sensor_chars_between(self, start: float, end: float) -> list[Event]:
         """Characters no transmission of the recorder holds, starting in ``[start, end)``."""
-        mine = self._sorted(
+        mine = self._sorted(  # by start: a merged view's parts need not be in time order
             "_sensor_chars",
-            lambda: _not_in(self.chars, [c for s in self.transmissions for c in s.chars]),
+            lambda: sorted(
+                _not_in(self.chars, [c for s in self.transmissions for c in s.chars]),
+                key=lambda c: c.start,
+            ),
         )
         starts = self._sorted("_sensor_starts", lambda: [c.start for c in mine])
         return mine[bisect_left(starts, start) : bisect_left(starts, end)]
