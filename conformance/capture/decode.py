@@ -9,9 +9,10 @@ Everything a user can get wrong (file, channel, baud, framing) ends as :class:`C
 
 from __future__ import annotations
 
+import os
 import statistics
 from array import array
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import chain
 
 from ..transcript import DUT, TOOL, Event, EventKind
@@ -227,6 +228,12 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
     return out, len(tx) - matched
 
 
+#: the last capture decoded, by file identity and settings: ``judge`` decodes a capture to
+#: decide whether it can be replayed, and passive judging reads the same decode again (an
+#: hour of 1 MHz samples is tens of seconds to decode; one decode is kept, not a history)
+_LAST: tuple[tuple, CaptureDecode] | None = None
+
+
 def decode_capture(
     path: str,
     *,
@@ -244,7 +251,34 @@ def decode_capture(
     :data:`RECORDER_ORIGIN`, all others :data:`SENSOR_ORIGIN` (without it every event is origin
     :data:`BUS`). ``edge_error``: any extra edge position error (s) of the analyzer's input
     stage, added to the one-sample-period uncertainty."""
+    global _LAST
     path = str(path)
+    try:
+        st = os.stat(path)
+        key: tuple | None = (
+            os.path.realpath(path), st.st_mtime_ns, st.st_size,
+            channel, tx_channel, invert, baud, framing, edge_error,
+        )  # fmt: skip
+    except OSError:
+        key = None  # the decoding below says what is wrong with the file
+    if key is not None and _LAST is not None and _LAST[0] == key:
+        kept = _LAST[1]
+        return replace(kept, events=list(kept.events), notes=list(kept.notes))
+    out = _decode_capture(path, channel, tx_channel, invert, baud, framing, edge_error)
+    if key is not None:
+        _LAST = (key, replace(out, events=list(out.events), notes=list(out.notes)))
+    return out
+
+
+def _decode_capture(
+    path: str,
+    channel: str | None,
+    tx_channel: str | None,
+    invert: bool | None,
+    baud: float,
+    framing: str,
+    edge_error: float,
+) -> CaptureDecode:
     try:
         frame_format = Framing.parse(framing)
     except ValueError as exc:
