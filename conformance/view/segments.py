@@ -22,6 +22,7 @@ import re
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, parse_command
@@ -53,6 +54,9 @@ def on_tool_link(event: Event) -> bool:
     return event.origin == TOOL
 
 
+T = TypeVar("T")
+
+
 @dataclass
 class Transmission:
     """One transmission of the recorder and what the sensors sent until it acted again."""
@@ -66,12 +70,7 @@ class Transmission:
     def text(self) -> str:
         # asked for tens of times per transmission by the judges: decoded once per length
         # (characters are only ever appended while the view is cut)
-        n = len(self.chars)
-        cached = self.__dict__.get("_text")
-        if cached is None or cached[0] != n:
-            cached = (n, decode_7e1(self.chars))
-            self.__dict__["_text"] = cached
-        return cached[1]
+        return _memo(self, "_text", len(self.chars), lambda: decode_7e1(self.chars))
 
     @property
     def address(self) -> str:
@@ -201,13 +200,13 @@ class TranscriptView:
 
     def sensor_chars_between(self, start: float, end: float) -> list[Event]:
         """Characters no transmission of the recorder holds, starting in ``[start, end)``."""
-        mine = self._sorted(  # by start: a merged view's parts need not be in time order
-            "_sensor_chars",
-            lambda: sorted(
-                _not_in(self.chars, [c for s in self.transmissions for c in s.chars]),
-                key=lambda c: c.start,
-            ),
-        )
+
+        def build() -> list[Event]:
+            taken = {id(c) for s in self.transmissions for c in s.chars}
+            # by start: a merged view's parts need not be in time order
+            return sorted((c for c in self.chars if id(c) not in taken), key=lambda c: c.start)
+
+        mine = self._sorted("_sensor_chars", build)
         starts = self._sorted("_sensor_starts", lambda: [c.start for c in mine])
         return mine[bisect_left(starts, start) : bisect_left(starts, end)]
 
@@ -215,12 +214,9 @@ class TranscriptView:
         """A derived index, built once per view (a field recording holds tens of thousands of
         transmissions; scanning the line per question made judging quadratic). Rebuilt if the
         view gained events since."""
-        key = (len(self.chars), len(self.breaks), len(self.transmissions))
-        cached = self.__dict__.get(name)
-        if cached is None or cached[0] != key:
-            cached = (key, build())
-            self.__dict__[name] = cached
-        return cached[1]
+        return _memo(
+            self, name, (len(self.chars), len(self.breaks), len(self.transmissions)), build
+        )
 
     def last_break_before(self, t: Transmission) -> Event | None:
         before = [b for b in self.breaks if b.end <= t.start]
@@ -384,7 +380,11 @@ def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:
     )
 
 
-def _not_in(events: list[Event], taken: list[Event]) -> list[Event]:
-    """``events`` without those in ``taken`` (by identity), order kept."""
-    ids = {id(e) for e in taken}
-    return [e for e in events if id(e) not in ids]
+def _memo(owner: object, name: str, key: object, build: Callable[[], T]) -> T:
+    """``build()``, kept in ``owner`` under ``name`` while ``key`` (the sizes it was built
+    from: the view only ever grows while it is cut) stays the same."""
+    cached = owner.__dict__.get(name)
+    if cached is None or cached[0] != key:
+        cached = (key, build())
+        owner.__dict__[name] = cached
+    return cached[1]
