@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from .judges.wire import reply_char_pairs
 from .links.meter import TimingMeter
 from .protocol.timing import (
     BREAK_ALWAYS,
@@ -25,6 +26,7 @@ from .protocol.timing import (
     RESPONSE_START_MAX,
     TOLERANCE,
 )
+from .view.runs import Segment, segments
 
 EXIT_OK, EXIT_USAGE, EXIT_NO_DEVICE = 0, 4, 5
 SYSFS_SERIAL = Path("/sys/bus/usb-serial/devices")
@@ -39,6 +41,20 @@ class Decidable:
     what: str
     margin: float
     uart_timed: bool = False  # the margin is on a line state the UART times, if it can
+    # what the probe itself measured of this kind: the spans (start, end, s) each such
+    # measurement rests on, so the prediction uses the uncertainty the judges would give
+    # each one (the run's regular figure, or more where the stamps were irregular near it)
+    observed: Callable[[list[Segment]], list[tuple[float, float]]] | None = None
+
+
+def _reply_starts(segs: list[Segment]) -> list[tuple[float, float]]:
+    """The command's last character to the reply's first: what R-7.0-09/-10 rest on."""
+    return [(s.command[-1].start, s.reply[0].end) for s in segs if s.reply and s.command]
+
+
+def _reply_pairs(segs: list[Segment]) -> list[tuple[float, float]]:
+    """Consecutive reply characters: what a gap or a character spacing rests on."""
+    return [(a.start, b.end) for a, b in reply_char_pairs(segs)]
 
 
 RULES = (
@@ -46,8 +62,14 @@ RULES = (
         "R-7.0-09/-10",
         "response window, a reply in its middle",
         (RESPONSE_START_MAX - (CHAR_TIME - TOLERANCE)) / 2,
+        observed=_reply_starts,
     ),
-    Decidable("R-7.0-12/-01", "character gap of a back-to-back reply", INTER_CHAR_GAP_MAX),
+    Decidable(
+        "R-7.0-12/-01",
+        "character gap of a back-to-back reply",
+        INTER_CHAR_GAP_MAX,
+        observed=_reply_pairs,
+    ),
     Decidable(
         "R-7.0-05", "8.33 ms marking after a break (probed at 9 ms)", 9e-3 - MARKING_AFTER_BREAK
     ),
@@ -57,7 +79,9 @@ RULES = (
     Decidable(
         "R-7.0-04", "12.6 ms break wakes", 12.6e-3 - BREAK_ALWAYS - TOLERANCE, uart_timed=True
     ),
-    Decidable("R-4.1-01", "1200 baud ±2 % from character spacing", 0.17e-3 / 2),
+    Decidable(
+        "R-4.1-01", "1200 baud ±2 % from character spacing", 0.17e-3 / 2, observed=_reply_pairs
+    ),
 )
 
 
@@ -106,17 +130,46 @@ def report(
                 "(bytes then reach the host within 1 ms instead of up to "
                 f"{timer} ms)"
             )
-    u = meter.uncertainty()
     lines.append(f"a run here would use: {meter.summary()}")
+    segs = segments(link.transcript.events)  # type: ignore[attr-defined]
     for rule in RULES:
-        error = length_error if (rule.uart_timed and uart_timed) else u
-        verdict = "decided" if error < rule.margin else "INCONCLUSIVE"
-        how = " (UART-timed)" if rule.uart_timed and uart_timed else ""
-        lines.append(
-            f"  {rule.rules:<13} {verdict:<12} {rule.what}: needs < ±{rule.margin * 1e3:.2f} ms,"
-            f" has ±{error * 1e3:.2f} ms{how}"
-        )
+        lines.append(_prediction(rule, meter, segs, uart_timed, length_error))
     return lines
+
+
+def _prediction(
+    rule: Decidable, meter: TimingMeter, segs: list[Segment], uart_timed: bool, length: float
+) -> str:
+    """One rule's line: decided, partly decided or INCONCLUSIVE, and the uncertainty it has.
+
+    Where the probe measured this kind of interval, each measurement gets the uncertainty the
+    judges would give it (:meth:`TimingMeter.between`): a link that batches bytes shows a
+    small regular figure between its batches and a large one inside them, and only the
+    probe's own measurements tell how often a run would meet which."""
+    head = f"  {rule.rules:<13} "
+    needs = f"{rule.what}: needs < ±{rule.margin * 1e3:.2f} ms"
+    if rule.uart_timed and uart_timed:
+        verdict = "decided" if length < rule.margin else "INCONCLUSIVE"
+        return f"{head}{verdict:<12} {needs}, has ±{length * 1e3:.2f} ms (UART-timed)"
+    spans = rule.observed(segs) if rule.observed else []
+    if not spans:
+        u = meter.uncertainty()
+        verdict = "decided" if u < rule.margin else "INCONCLUSIVE"
+        return f"{head}{verdict:<12} {needs}, has ±{u * 1e3:.2f} ms"
+    errors = sorted(meter.between(start, end) for start, end in spans)
+    decided = sum(1 for e in errors if e < rule.margin)
+    if decided == len(errors):
+        verdict = "decided"
+    elif decided:
+        verdict = "partly"
+    else:
+        verdict = "INCONCLUSIVE"
+    typical, worst = errors[len(errors) // 2], errors[-1]
+    return (
+        f"{head}{verdict:<12} {needs}, has ±{typical * 1e3:.2f} ms typically, "
+        f"±{worst * 1e3:.2f} ms at worst ({decided} of {len(errors)} measured in the probe "
+        "decidable)"
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -116,6 +116,17 @@ def test_meter_with_echo_uses_the_measured_spread_and_sets_stalls_aside_locally(
     assert meter.observed() == pytest.approx(7e-3)
 
 
+def test_meter_sets_no_spread_aside_as_a_stall_before_it_has_enough_of_them():
+    """A calibrate probe's 16 echoes behind a 16 ms latency timer: one 7.7 ms spread among
+    fifteen of 0 ms is that bench's jitter (the phase of the timer's tick), not a stall."""
+    meter = TimingMeter(5e-3, echo=True)
+    for k in range(15):
+        meter.spread(k, k + 0.03, 0.0, "echo")
+    meter.spread(20.0, 20.03, 7.7e-3, "echo across a tick")
+    assert meter.uncertainty() == pytest.approx(7.7e-3)
+    assert meter.between(3.0, 3.01) == pytest.approx(7.7e-3)
+
+
 def test_meter_taints_widen_only_where_they_are():
     meter = TimingMeter(5e-3, echo=True)
     meter.taint(10.0, 10.02, 4e-3, "frames overlapped")

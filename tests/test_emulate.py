@@ -13,6 +13,8 @@ import subprocess
 import sys
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -165,31 +167,82 @@ def emulator(request):
     proc.stop()
 
 
-def unexpected_failures(emulator: EmulatorProcess, unexpected: set[str], text: str) -> None:
+@dataclass
+class Served:
+    """One end-to-end run: the CLI's exit code, verdicts.json, its output, and how far the
+    served line fell behind real time (None: the emulator did not say)."""
+
+    code: int
+    data: dict
+    text: str
+    late: float | None
+
+
+#: The end-to-end runs, each an emulator (its options) judged by the CLI (its options). They
+#: go side by side (mostly waiting on their 1200-baud lines) like ``test_bench_runs``; the
+#: inter-character-gap fault behind an echo is one of that module's runs.
+E2E: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "clean": ((), ("-k", SELECTION)),
+    "echo": (("--echo",), ("-k", "test_identification or test_response_start_window")),
+    "narrowed": ((), ("-k", "test_identification", "--timing-uncertainty-ms", "0.01")),
+    "widened": ((), ("-k", "test_identification", "--timing-uncertainty-ms", "30")),
+    "no-service-request": (
+        ("--faults", "no-service-request"),
+        ("-k", "test_service_request"),
+    ),
+    "parity-error": (("--faults", "parity-error"), ("-k", "test_reply_framing")),
+    "service-request-extra-chars": (
+        ("--faults", "service-request-extra-chars"),
+        ("-k", "test_service_request"),
+    ),
+}
+PARALLEL = 3
+
+
+def _serve_and_judge(name: str, out: Path) -> Served:
+    serve, extra = E2E[name]
+    emulator = EmulatorProcess(*serve)
+    try:
+        code, data, text = judge(emulator.url, out, *extra)
+        late = emulator.worst_lateness()
+    finally:
+        emulator.stop()
+    return Served(code, data, text, late)
+
+
+@pytest.fixture(scope="module")
+def e2e(tmp_path_factory) -> dict[str, Served]:
+    base = tmp_path_factory.mktemp("e2e")
+    with ThreadPoolExecutor(PARALLEL) as pool:
+        futures = {name: pool.submit(_serve_and_judge, name, base / name) for name in E2E}
+        return {name: f.result() for name, f in futures.items()}
+
+
+def unexpected_failures(run: Served, unexpected: set[str]) -> None:
     """Fail on FAILs nobody expected, unless the served line itself could not keep real
     time: on a machine that busy a late frame is the host's doing, not the sensor's, and the
     run's timing is no evidence either way (skipped, with the figures)."""
     if not unexpected:
         return
-    late = emulator.worst_lateness()
-    if late is not None and late > LATE_NOTICE:
+    if run.late is not None and run.late > LATE_NOTICE:
         pytest.skip(
             f"the machine was too busy to keep real time: the served line fell "
-            f"{late * 1e3:.1f} ms behind its schedule; unexpected {sorted(unexpected)}"
+            f"{run.late * 1e3:.1f} ms behind its schedule; unexpected {sorted(unexpected)}"
         )
-    pytest.fail(f"unexpected FAILs {sorted(unexpected)} (line late by {late}):\n{text}")
+    pytest.fail(f"unexpected FAILs {sorted(unexpected)} (line late by {run.late}):\n{run.text}")
 
 
 @pytest.mark.realtime
-def test_clean_emulator_over_rfc2217_has_no_failure(emulator, tmp_path):
-    code, data, text = judge(emulator.url, tmp_path, "-k", SELECTION)
+def test_clean_emulator_over_rfc2217_has_no_failure(e2e):
+    run = e2e["clean"]
+    data, text = run.data, run.text
     verdicts = verdicts_of(data)
     judged = {r["id"] for r in data["requirements"] if r["tests"]}
     assert {"R-4.4.1-01", "R-4.4.6-02", "R-7.0-10", "R-7.0-12"} <= judged, text
     bad = {rid for rid, v in verdicts.items() if v in ("FAIL", "WARN", "ERROR")}
-    unexpected_failures(emulator, bad, text)
+    unexpected_failures(run, bad)
     if not bad:
-        assert code == 0, text  # nothing failed in what the selection judged: partial run
+        assert run.code == 0, text  # nothing failed in what the selection judged: partial run
         assert data["run"]["partial"] is True
     link = data["run"]["link"]
     assert link["kind"] == "rfc2217" and link["can_break"] is True
@@ -201,14 +254,11 @@ def test_clean_emulator_over_rfc2217_has_no_failure(emulator, tmp_path):
 
 
 @pytest.mark.realtime
-@pytest.mark.parametrize("emulator", [("--echo",)], indirect=True, ids=["echo"])
-def test_echoing_interface_gives_definite_timing_from_a_measured_uncertainty(emulator, tmp_path):
+def test_echoing_interface_gives_definite_timing_from_a_measured_uncertainty(e2e):
     """Behind an interface that echoes, the reply is timed against the echo of the command
     on the same receive path: the uncertainty is measured (far below the 5 ms declared for
     loopback without echo) and the response window comes out PASS."""
-    code, data, text = judge(
-        emulator.url, tmp_path, "-k", "test_identification or test_response_start_window"
-    )
+    data, text = e2e["echo"].data, e2e["echo"].text
     link = data["run"]["link"]
     bench = link["bench"]
     assert bench["echo"] is True and bench["echo_mode"] == "auto", text
@@ -220,49 +270,32 @@ def test_echoing_interface_gives_definite_timing_from_a_measured_uncertainty(emu
 
 
 @pytest.mark.realtime
-def test_timing_uncertainty_option_only_widens(emulator, tmp_path):
+def test_timing_uncertainty_option_only_widens(e2e):
     """``--timing-uncertainty-ms`` may widen what the link measured, never narrow it: 0.01 ms
     asked over plain loopback RFC 2217 still reports at least the declared 5 ms."""
-    code, data, text = judge(
-        emulator.url, tmp_path, "-k", "test_identification", "--timing-uncertainty-ms", "0.01"
-    )
-    assert data["run"]["link"]["timing_uncertainty_ms"] >= 5.0, text
-    code, data, text = judge(
-        emulator.url,
-        tmp_path / "wide",
-        "-k",
-        "test_identification",
-        "--timing-uncertainty-ms",
-        "30",
-    )
-    assert data["run"]["link"]["timing_uncertainty_ms"] == 30.0, text
+    narrowed, widened = e2e["narrowed"], e2e["widened"]
+    assert narrowed.data["run"]["link"]["timing_uncertainty_ms"] >= 5.0, narrowed.text
+    assert widened.data["run"]["link"]["timing_uncertainty_ms"] == 30.0, widened.text
 
 
 @pytest.mark.realtime
 @pytest.mark.parametrize(
-    ("emulator", "extra", "expected"),
+    ("fault", "expected"),
     [
-        (("--faults", "no-service-request"), ("-k", "test_service_request"), {"R-4.4.6-02"}),
-        (("--faults", "parity-error"), ("-k", "test_reply_framing"), {"R-4.1-02"}),
-        (
-            ("--faults", "service-request-extra-chars"),
-            ("-k", "test_service_request"),
-            {"R-4.4.6-01"},
-        ),
-        # 3 ms gaps need a tighter uncertainty than the declared 5 ms: the echo gives one
-        (("--faults", "inter-char-gap", "--echo"), ("-k", "test_character_gaps"), {"R-7.0-12"}),
+        ("no-service-request", {"R-4.4.6-02"}),
+        ("parity-error", {"R-4.1-02"}),
+        ("service-request-extra-chars", {"R-4.4.6-01"}),
     ],
-    indirect=["emulator"],
-    ids=["no-service-request", "parity-error", "service-request-extra-chars", "inter-char-gap"],
+    ids=["no-service-request", "parity-error", "service-request-extra-chars"],
 )
-def test_faulty_emulator_over_rfc2217_fails_its_requirements(emulator, extra, expected, tmp_path):
+def test_faulty_emulator_over_rfc2217_fails_its_requirements(e2e, fault, expected):
     """Each fault with the cases that judge its rule (the clean run above covers the wider
     selection; the sim's fault matrix checks every fault's collateral exactly)."""
-    code, data, text = judge(emulator.url, tmp_path, *extra)
-    failed = {rid for rid, v in verdicts_of(data).items() if v == "FAIL"}
-    assert code == 1, text
-    assert expected <= failed, text
-    unexpected_failures(emulator, failed - expected, text)
+    run = e2e[fault]
+    failed = {rid for rid, v in verdicts_of(run.data).items() if v == "FAIL"}
+    assert run.code == 1, run.text
+    assert expected <= failed, run.text
+    unexpected_failures(run, failed - expected)
 
 
 @pytest.mark.realtime
@@ -270,6 +303,6 @@ def test_faulty_emulator_over_rfc2217_fails_its_requirements(emulator, extra, ex
 def test_full_suite_over_rfc2217_is_compliant(emulator, tmp_path):
     code, data, text = judge(emulator.url, tmp_path, bound=900)
     failed = {rid for rid, v in verdicts_of(data).items() if v in ("FAIL", "ERROR")}
-    unexpected_failures(emulator, failed, text)
+    unexpected_failures(Served(code, data, text, emulator.worst_lateness()), failed)
     if not failed:
         assert code == 0 and data["summary"]["verdict"] == "COMPLIANT", text

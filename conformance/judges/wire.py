@@ -37,6 +37,7 @@ __all__ = [
     "judge_gaps",
     "judge_reply_bit_rate",
     "judge_response_start",
+    "reply_char_pairs",
     "reply_gaps",
     "runs",
     "segments",
@@ -95,6 +96,11 @@ def judge_response_start(
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     """Every marking gap between consecutive characters of one DUT run, with its context."""
     return [(gap, where) for gap, where, _a, _b in _gaps(segs)]
+
+
+def reply_char_pairs(segs: list[Segment]) -> list[tuple[Event, Event]]:
+    """The consecutive character pairs :func:`judge_gaps` measures a gap between."""
+    return [(a, b) for _gap, _where, a, b in _gaps(segs)]
 
 
 def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event]]:

@@ -36,7 +36,12 @@ from dataclasses import dataclass, field
 ECHO_FLOOR = 0.25e-3  # s: least uncertainty claimed on one receive path (UART sampling, clocks)
 OUTLIER_FACTOR = 2.0  # an echo spread beyond this many times the 90th percentile...
 OUTLIER_MARGIN = 0.5e-3  # ...plus this is a local stall (a taint), not the path's jitter
-MIN_SPREADS = 10  # fewer echo spreads than this: the worst one is the regular figure
+MIN_SPREADS = 10  # fewer round trips than this: no typical one yet
+# Fewer echo spreads than this: the worst one is the regular figure. Setting the top tenth
+# aside as stalls needs enough spreads for a tenth to be rare: a 16 ms latency timer makes
+# a command's echo spread 0 or 7.7 ms by the phase of its tick, and in a 16-spread probe one
+# or two 7.7 ms spreads are that bench's jitter, not a stall.
+MIN_FOR_OUTLIERS = 30
 
 
 @dataclass(frozen=True)
@@ -101,7 +106,7 @@ class TimingMeter:
         values = sorted(v for _s, _e, v in self.spreads)
         if not values:
             return 0.0
-        if len(values) < MIN_SPREADS:
+        if len(values) < MIN_FOR_OUTLIERS:
             return values[-1]
         cut = self._outlier_cut(values)
         return max(v for v in values if v <= cut)
@@ -118,7 +123,7 @@ class TimingMeter:
             if t.start <= end and start <= t.end:
                 u = max(u, t.error)
         values = sorted(v for _s, _e, v in self.spreads)
-        if len(values) >= MIN_SPREADS:
+        if len(values) >= MIN_FOR_OUTLIERS:
             cut = self._outlier_cut(values)
             for s0, s1, v in self.spreads:
                 if v > cut and s0 <= end and start <= s1:
