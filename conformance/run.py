@@ -13,7 +13,8 @@ from typing import Any
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
-from .judges.timing import recheck
+from .emulator_server.realtime import LATE_NOTICE
+from .judges.timing import recheck, undecide_after_late_line
 from .links.base import Link, LinkError
 from .options import run_option_values
 from .ports import is_sim, open_port
@@ -138,6 +139,7 @@ class ConformanceRun:
         self.complete = self.complete and complete
         self.finished = now_iso()
         self._recheck_timing()
+        self._guard_served_line()
         self.results = aggregate(self.options.role, self.cases, self.selection.not_selected())
         root_causes.link(self.results)
         self.verdict = overall(self.results, strict=self.options.strict, complete=self.complete)
@@ -168,6 +170,19 @@ class ConformanceRun:
         uncertainty = self.session.uncertainty
         for case in self.cases:
             recheck(case.findings, uncertainty)
+
+    def _guard_served_line(self) -> None:
+        """Recorder role on a served line (``rfc2217-serve://``): if the line this tool kept
+        in real time fell behind its schedule, no FAIL or WARN of the run can be trusted to
+        be the recorder's own (a false FAIL is what a busy host would otherwise give)."""
+        served = getattr(self.session, "served", None)
+        if served is None:
+            return
+        late = served.line.worst_lateness
+        if late <= LATE_NOTICE:
+            return
+        for case in self.cases:
+            undecide_after_late_line(case.findings, late, LATE_NOTICE)
 
     def report_dir(self) -> Path:
         if self.options.report_dir:

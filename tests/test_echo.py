@@ -9,6 +9,7 @@ from conformance.judges.timing import (
     combine_local,
     judge_window,
     recheck,
+    undecide_after_late_line,
 )
 from conformance.links.echo import EchoMode, EchoTracker, Expected, is_spacing_echo
 from conformance.links.meter import ECHO_FLOOR, TimingMeter
@@ -185,3 +186,17 @@ def test_recheck_undoes_verdicts_a_larger_final_uncertainty_no_longer_supports()
     assert recheck([close, far], 2e-3) == 1
     assert close.verdict is Verdict.INCONCLUSIVE and far.verdict is Verdict.PASS
     assert "grew to ±2.00 ms" in close.detail
+
+
+def test_a_served_line_that_fell_behind_leaves_no_fail_standing():
+    """The recorder role on a line this tool serves in real time: when the host made the
+    played sensors late, a FAIL may be the recorder's right reaction to a late sensor."""
+    from conformance.verdicts import Finding
+
+    failed = Finding("R-4.4.8-05", Verdict.FAIL, "stopped reading before every value was in")
+    warned = Finding("R-7.2-02", Verdict.WARN, "retried early")
+    passed = Finding("R-7.2-01", Verdict.PASS, "retried", observed=1)
+    assert undecide_after_late_line([failed, warned, passed], 7.8e-3, 2e-3) == 2
+    assert failed.verdict is warned.verdict is Verdict.INCONCLUSIVE
+    assert passed.verdict is Verdict.PASS  # what the recorder did right stays right
+    assert "fell 7.8 ms behind" in failed.detail

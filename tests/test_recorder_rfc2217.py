@@ -56,9 +56,15 @@ def test_golden_recorder_over_rfc2217_is_compliant(tmp_path):
     code, data, events = run(tmp_path, SERVE)
     verdicts = {r["id"]: r["verdict"] for r in data["requirements"]}
     bad = {rid: v for rid, v in verdicts.items() if v in ("FAIL", "WARN", "ERROR")}
-    if bad:
-        skip_if_line_was_late(events, bad)
+    # never a FAIL, even when the host was too busy: a late served line makes them INCONCLUSIVE
     assert not bad, bad
+    undecided = [
+        r["id"]
+        for r in data["requirements"]
+        if any("served line fell" in f["detail"] for f in r["findings"])
+    ]
+    if undecided:
+        skip_if_line_was_late(events, f"undecided because of it: {undecided}")
     assert code == 0 and data["summary"]["verdict"] == "COMPLIANT", data["summary"]
     link = data["run"]["link"]
     assert link["kind"] == "rfc2217-serve" and link["can_break"] is True
@@ -83,6 +89,8 @@ def test_recorder_without_retries_fails_its_retry_requirements(tmp_path):
     port = f"{SERVE}?recorder-faults=no-retries"
     code, data, events = run(tmp_path, port, "-k", "test_retries")
     failed = {r["id"] for r in data["requirements"] if r["verdict"] == "FAIL"}
+    if "R-7.2-01" not in failed:
+        skip_if_line_was_late(events, "the missing retries undecided because of it")
     assert "R-7.2-01" in failed, data["requirements"]
     assert failed <= set(RECORDER_FAULTS["no-retries"].violates), failed
     assert code == 1 and data["summary"]["verdict"] == "NON-COMPLIANT"

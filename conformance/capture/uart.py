@@ -96,6 +96,9 @@ class _Cursor:
         return True
 
     def peek(self, k: int = 0) -> int | None:
+        j = self.i + k
+        if j < len(self.buf):  # the common case, without a call: the decoder peeks per edge
+            return self.buf[j]
         return self.buf[self.i + k] if self.has(k + 1) else None
 
 

@@ -13,7 +13,7 @@ import signal
 import sys
 import threading
 
-from ..links.priority import EMULATED_LINE, realtime_priority
+from ..links.priority import EMULATED_LINE, SWITCH_INTERVAL, realtime_priority
 from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
 from .realtime import RealTimeLine
@@ -21,7 +21,6 @@ from .servers import TcpEmulatorServer, serve_serial
 from .tap import TapServer, parse_tap
 
 EXIT_OK, EXIT_USAGE = 0, 4
-SWITCH_INTERVAL = 2e-4  # s: the GIL hand-over interval while serving (Python's default: 5 ms)
 
 
 def build_parser() -> argparse.ArgumentParser:

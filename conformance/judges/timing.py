@@ -177,6 +177,26 @@ def recheck(findings: list[Finding], uncertainty: float) -> int:
     return changed
 
 
+def undecide_after_late_line(findings: list[Finding], late: float, allowed: float) -> int:
+    """A line this tool served in real time fell ``late`` s behind its schedule (more than
+    ``allowed``): the played sensors answered later than planned, and what the recorder did
+    next (a retry, a timeout, a reading order) may be its right reaction to that, not a
+    deviation of its own. Every FAIL and WARN becomes INCONCLUSIVE, saying so. Returns how
+    many changed."""
+    changed = 0
+    for f in findings:
+        if f.verdict not in (Verdict.FAIL, Verdict.WARN):
+            continue
+        f.detail += (
+            f" — but the served line fell {late * 1e3:.1f} ms behind its schedule in this run "
+            f"(more than {allowed * 1e3:.0f} ms: the host was too busy), so the played sensors "
+            "may have answered late and the recorder may have reacted to that: not decided"
+        )
+        f.verdict = Verdict.INCONCLUSIVE
+        changed += 1
+    return changed
+
+
 def _describe_limit(lo: float | None, hi: float | None) -> str:
     if lo is not None and hi is not None:
         return f"{lo * 1e3:.2f}..{hi * 1e3:.2f} ms"

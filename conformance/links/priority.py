@@ -23,6 +23,9 @@ import os
 # thread busy computing would otherwise hold the CPU for a whole round-robin slice (100 ms).
 READER = 20
 EMULATED_LINE = 30
+# The GIL hand-over interval while a real-time thread runs in the process (Python's default,
+# 5 ms, lets a computing thread keep a reader or an emulated line waiting that long).
+SWITCH_INTERVAL = 2e-4
 
 
 def realtime_priority(priority: int = READER) -> bool:

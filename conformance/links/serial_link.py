@@ -37,7 +37,7 @@ from .direction import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
 from .meter import ECHO_FLOOR, TimingMeter
-from .priority import READER, realtime_priority
+from .priority import READER, SWITCH_INTERVAL, realtime_priority
 from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
@@ -48,7 +48,6 @@ BURST_MARGIN = 0.5e-3  # s: arrivals this much closer than latency jitter explai
 RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
 RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release
 TURNAROUND_LIMIT = RESPONSE_START_MIN / 2  # s: a later release may swallow a reply's start
-SWITCH_INTERVAL = 2e-4  # s: GIL hand-over while a real link runs (default 5 ms starves readers)
 
 
 def precise_sleep_until(clock_now, target: float) -> None:

@@ -19,6 +19,7 @@ add to a stamp). How well the line kept its own schedule is noted after every sc
 from __future__ import annotations
 
 import bisect
+import sys
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -30,6 +31,7 @@ from ..emulator_server.realtime import RealTimeLine
 from ..emulator_server.servers import TcpEmulatorServer
 from ..links.base import LinkInfo
 from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
+from ..links.priority import SWITCH_INTERVAL
 from ..ports import PortError
 from ..sim.bus import BusDevice, Frame, earliest_frame
 from ..transcript import TOOL, Event, EventKind, Transcript
@@ -187,6 +189,10 @@ class ServedLine:
             self.server = TcpEmulatorServer(self.line, host, spec.port, log=self.log.append)
         except OSError as exc:
             raise PortError(f"cannot serve on {host}:{spec.port}: {exc}") from exc
+        # the line's thread must get the interpreter back at once when a frame is due, also
+        # while the golden recorder is between scenarios and this process judges or reports
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
         self.line.start()
         self._thread = threading.Thread(target=self.server.serve, name="sdi12-served", daemon=True)
         self._thread.start()
@@ -228,3 +234,4 @@ class ServedLine:
         self.server.stop()
         self._thread.join(timeout=2.0)
         self.line.stop()
+        sys.setswitchinterval(self._switch_interval)
