@@ -277,6 +277,7 @@ def _stop(proc: subprocess.Popen) -> None:
 
 
 @pytest.mark.realtime
+@pytest.mark.quiet
 def test_monitor_shows_and_records_a_golden_recorder_talking_to_the_emulator(tmp_path):
     emulator, url, tap = _start_emulator()
     report = tmp_path / "monitor"
