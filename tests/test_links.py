@@ -125,6 +125,7 @@ def test_receive_on_a_silent_line_is_bounded_by_its_deadline():
         link.close()
 
 
+@pytest.mark.realtime  # host-timed gaps: a starved process stretches them
 def test_write_with_a_gap_spaces_the_characters():
     link = open_real_link("loop://", echo=EchoMode.OFF)  # the stamps of the write itself
     try:

@@ -193,6 +193,7 @@ def _read_for(sock: socket.socket, seconds: float) -> bytes:
     return got
 
 
+@pytest.mark.realtime  # a served line in this process: a starved one answers late
 def test_the_tap_hears_both_sides_and_ignores_what_listeners_send(tapped):
     link, tap = tapped
     host, port = tap.address
@@ -203,8 +204,12 @@ def test_the_tap_hears_both_sides_and_ignores_what_listeners_send(tapped):
         heard = _read_for(listener, 0.5)
     assert exchange.ok, exchange.reply_text
     text = bytes(b & 0x7F for b in heard)
-    assert text.startswith(b"\x000I!0"), heard  # the break (a NUL), the command, the reply
-    assert text[4:].decode() == exchange.reply_text
+    # the break (a NUL) and the command, once or again when a busy machine made the reply
+    # late and the recorder retried, then the reply
+    reply = exchange.reply_text.encode()
+    assert text.endswith(reply), heard
+    tries = text[: -len(reply)]
+    assert tries and tries == b"\x000I!" * (len(tries) // 4), heard
     assert b"0X!" not in text and b"junk" not in text
     assert tap.ignored_bytes == 8
     on_line = "".join(chr(e.char7) for e in link.transcript if e.kind is EventKind.CHAR)
