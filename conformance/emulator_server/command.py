@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import argparse
 import signal
-import sys
 import threading
 
-from ..links.priority import EMULATED_LINE, SWITCH_INTERVAL, realtime_priority
+from ..links.priority import EMULATED_LINE, quick_gil_handover, realtime_priority
 from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
 from .realtime import RealTimeLine
@@ -146,7 +145,7 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
     )
     # the line's thread must get the interpreter back at once when a frame is due, and no
     # thread of the server may be preempted while it holds the lock the line needs
-    sys.setswitchinterval(SWITCH_INTERVAL)
+    quick_gil_handover()  # for the life of the process
     realtime_priority(EMULATED_LINE)
     tap = None
     if tap_at is not None:

@@ -16,6 +16,7 @@ period: exactly the late frames this is meant to prevent.
 from __future__ import annotations
 
 import os
+import sys
 
 # SCHED_RR priorities: all above every ordinary process, far below the kernel's own threads.
 # A thread that stamps bytes outranks one that computes, and an emulated line (a stand-in for
@@ -26,6 +27,14 @@ EMULATED_LINE = 30
 # The GIL hand-over interval while a real-time thread runs in the process (Python's default,
 # 5 ms, lets a computing thread keep a reader or an emulated line waiting that long).
 SWITCH_INTERVAL = 2e-4
+
+
+def quick_gil_handover() -> float:
+    """Lower the interpreter's switch interval to :data:`SWITCH_INTERVAL` (never raise it) for
+    as long as a real-time thread runs here; returns the interval to put back afterwards."""
+    previous = sys.getswitchinterval()
+    sys.setswitchinterval(min(previous, SWITCH_INTERVAL))
+    return previous
 
 
 def realtime_priority(priority: int = READER) -> bool:

@@ -37,7 +37,7 @@ from .direction import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
 from .meter import ECHO_FLOOR, TimingMeter
-from .priority import READER, SWITCH_INTERVAL, realtime_priority
+from .priority import READER, quick_gil_handover, realtime_priority
 from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
@@ -101,8 +101,7 @@ class SerialLink(Link):
         self.meter = TimingMeter(info.timing_uncertainty, kernel_stamps=tape is not None)
         self.echo = EchoTracker(echo)
         self.meter.echo = self.echo.echoes
-        self._switch_interval = sys.getswitchinterval()
-        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
+        self._switch_interval = quick_gil_handover()
         self._reader = threading.Thread(target=self._read_loop, name=f"sdi12-rx {self.name}")
         self._reader.daemon = True
         self._reader.start()

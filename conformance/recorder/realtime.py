@@ -31,7 +31,7 @@ from ..emulator_server.realtime import RealTimeLine
 from ..emulator_server.servers import TcpEmulatorServer
 from ..links.base import LinkInfo
 from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
-from ..links.priority import SWITCH_INTERVAL
+from ..links.priority import quick_gil_handover
 from ..ports import PortError
 from ..sim.bus import BusDevice, Frame, earliest_frame
 from ..transcript import TOOL, Event, EventKind, Transcript
@@ -191,8 +191,7 @@ class ServedLine:
             raise PortError(f"cannot serve on {host}:{spec.port}: {exc}") from exc
         # the line's thread must get the interpreter back at once when a frame is due, also
         # while the golden recorder is between scenarios and this process judges or reports
-        self._switch_interval = sys.getswitchinterval()
-        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
+        self._switch_interval = quick_gil_handover()
         self.line.start()
         self._thread = threading.Thread(target=self.server.serve, name="sdi12-served", daemon=True)
         self._thread.start()
