@@ -4,7 +4,8 @@ answers where an answer is due, and the continuous (R) commands.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
+from typing import Protocol
 
 from ..case import events_of
 from ..protocol.crc import ascii_crc
@@ -101,6 +102,63 @@ def silent(
         + ", ".join(escape(e.text) for e in exchanges),
         decision=decision,
         observed=len(exchanges),
+    )
+
+
+class ControlledProbe(Protocol):
+    """A one-off probe and the ``a!`` control sent the same way right after it
+    (:class:`conformance.sensor.session.HeardProbe`)."""
+
+    probe: Exchange
+    marking: float | None
+
+    @property
+    def listening(self) -> bool: ...
+
+
+def silent_while_listening(
+    rid: str,
+    probes: Sequence[ControlledProbe],
+    why: str,
+    *,
+    should: bool = False,
+    decision: str | None = None,
+) -> Finding:
+    """Each probe must have drawn no reply; a silent probe counts only where the sensor
+    answered the control sent the same way right after it (it was listening then). An
+    answer is evidence whatever the control did; silence with every control unanswered is
+    INCONCLUSIVE, "precondition not met"."""
+    answered = [p.probe for p in probes if p.probe.answered]
+    if answered:
+        make = warned if should else failed
+        return make(
+            rid,
+            f"answered although {why}: " + "; ".join(shown(e) for e in answered[:3]),
+            evidence=[f"{shown(e)} at t={e.attempts[0].end:.3f} s" for e in answered],
+            decision=decision,
+            observed=len(answered),
+        )
+    heard = [p for p in probes if p.listening]
+    if not heard:
+        return inconclusive(
+            rid,
+            "precondition not met: the sensor answered none of the a! controls sent like its "
+            f"probes (one break, then once), so its silence to {len(probes)} probe(s) shows "
+            "nothing",
+            evidence=[shown(p.probe) for p in probes[:3]],
+        )
+    aside = len(probes) - len(heard)
+    marking = heard[0].marking
+    way = f" after {marking * 1e3:.0f} ms of marking" if marking is not None else ""
+    return passed(
+        rid,
+        f"stayed silent ({why}) to {len(heard)} command(s) sent once after a break{way}, "
+        "each followed by an a! sent the same way that it answered: "
+        + ", ".join(escape(p.probe.text) for p in heard)
+        + (f"; {aside} probe(s) set aside (their control went unanswered)" if aside else ""),
+        decision=decision,
+        evidence=[shown(p.probe) for p in heard[:3]],
+        observed=2 * len(heard),
     )
 
 

@@ -40,10 +40,40 @@ class Sweep:
 class InvalidAddressAttempt:
     exchanges: list[Exchange]
     accepted: bool
+    #: an ``a!`` at the old address sent the same way right after it was answered: the
+    #: sensor was listening, so its silence to ``aA<bad>!`` is a refusal, not deafness
+    listening: bool = True
+
+
+@dataclass
+class HeardProbe:
+    """A command sent once after a break (its answer, or its silence, is the point) and the
+    control that follows it: an ``a!`` sent the same way (a break, the same marking, once).
+
+    Silence is evidence only from a sensor shown to be listening at that moment: a sensor
+    that needs longer than the probe gave it to wake (R-7.0-05) misses the probe and the
+    control alike, and its silence then shows nothing."""
+
+    probe: Exchange
+    control: Exchange | None  # None: no marking made the sensor hear a one-shot a!
+    marking: float | None
+
+    @property
+    def listening(self) -> bool:
+        return self.control is not None and self.control.answered
+
+    @property
+    def exchanges(self) -> list[Exchange]:
+        return [self.probe] + ([self.control] if self.control is not None else [])
 
 
 PROBE_ROUNDS = 6  # wake-ups of the bench probe at the start of a real-link run
 PROBE_IDLE = 0.12  # s: marking before each, so each wake-up is from standby
+#: Marking after a break (s) with which a one-shot ``a!`` is tried, shortest first, until the
+#: sensor answers: the way one-off probes are then sent (:meth:`SensorSession.hearing_marking`).
+#: The first is the tool recorder's own; the last lies past the 100 ms standby limit, which
+#: is sound because every probe is checked by a control sent the same way.
+HEARING_MARKINGS = (9e-3, 25e-3, 50e-3, 85e-3, 120e-3)
 
 
 class NoDeviceAnswered(RuntimeError):
@@ -269,6 +299,44 @@ class SensorSession:
             self.link.wait(marking_s)
         return self.master.raw(text, break_first=False, gap=gap)
 
+    # -- one-off probes, sent the way the sensor was shown to hear -----------------------------
+    def hearing_marking(self) -> float | None:
+        """The marking after a break with which the sensor answers a one-shot ``a!``: the
+        shortest of :data:`HEARING_MARKINGS` that worked (found once, from standby), or None
+        if none did. One-off probes (foreign addresses, malformed commands) are sent with it,
+        so a sensor that is slow to wake (a fault of R-7.0-05 judged elsewhere) still hears
+        them and the rules they are about get judged. It is found at :attr:`address`: a case
+        that moves the sensor elsewhere asks for it before the move."""
+        return self.once("hearing-marking", self._find_hearing_marking)
+
+    def _find_hearing_marking(self) -> float | None:
+        for marking in HEARING_MARKINGS:
+            self.listen(PROBE_IDLE)
+            ex = self.master.raw(f"{self.address}!", break_first=True, marking=marking)
+            if ex.answered:
+                if marking != HEARING_MARKINGS[0]:
+                    self.assumptions.append(
+                        f"a one-shot {self.address}! after a break was first answered with "
+                        f"{marking * 1e3:.0f} ms of marking after it; one-off probes are sent so"
+                    )
+                return marking
+        self.assumptions.append(
+            f"no one-shot {self.address}! after a break was answered with any marking up to "
+            f"{HEARING_MARKINGS[-1] * 1e3:.0f} ms: silence to one-off probes is not judged"
+        )
+        return None
+
+    def heard_probe(self, text: str, *, control_address: str | None = None) -> HeardProbe:
+        """Send ``text`` once after a break with :meth:`hearing_marking`, then the control:
+        ``a!`` (at ``control_address``, default the sensor's) sent the same way."""
+        marking = self.hearing_marking()
+        probe = self.master.raw(text, break_first=True, marking=marking)
+        control = None
+        if marking is not None:
+            address = control_address or self.address
+            control = self.master.raw(f"{address}!", break_first=True, marking=marking)
+        return HeardProbe(probe, control, marking)
+
     # -- address changes (always restored) -------------------------------------------------
     def address_change_supported(self) -> bool:
         """Declared, or found out with one change to a spare address and back."""
@@ -323,25 +391,27 @@ class SensorSession:
         changer = AddressChanger(self.master, self.address)
         try:
             changer.tried.append(bad)  # if it took the bad address, restore moves it back
-            ex = self.master.raw(f"{self.address}A{bad}!", break_first=True)
-            changer.exchanges.append(ex)
-            body, _ = split_line(ex.reply_text)
-            accepted = ex.answered and body == bad
+            heard = self.heard_probe(f"{self.address}A{bad}!")
+            changer.exchanges.extend(heard.exchanges)
+            body, _ = split_line(heard.probe.reply_text)
+            accepted = heard.probe.answered and body == bad
         finally:
             self.address_notes.append(changer.restore())
-        return InvalidAddressAttempt(changer.exchanges, accepted)
+        return InvalidAddressAttempt(changer.exchanges, accepted, heard.listening)
 
     def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
         """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and
         collect: how concurrent measurements are tested for (non-)aborts. A disturbance for
         the sensor's own address is sent with retries, so it is surely heard (its reply is
-        the proof); one for another address is sent once, after a break."""
+        the proof); one for another address is sent once, after a break with the marking the
+        sensor was shown to hear (:meth:`hearing_marking`; none known: the default)."""
+        marking = self.hearing_marking()  # found before the measurement: its a! would abort it
         m = self.master.measure(command, collect=False, wait="none")
         self.listen(0.05)
         if disturb[:1] == self.address:
             poke = self.master.transact(disturb)
         else:
-            poke = self.master.raw(disturb, break_first=True)
+            poke = self.master.raw(disturb, break_first=True, marking=marking)
         if m.reply_end is not None and m.ttt:
             self.link.wait_until(m.reply_end + m.ttt + self.master.policy.ttt_margin)
         self.master.collect(m, force_break=True)

@@ -116,13 +116,16 @@ class Master:
         gap: float = 0.0,
         parity: bool = True,
         binary: bool = False,
+        marking: float | None = None,
     ) -> Exchange:
         """Send arbitrary characters once (malformed commands, foreign addresses, partial
         commands with a ``gap`` of marking between characters) and record what came back.
 
         ``parity`` adds even parity to each 7-bit character; False sends the bytes as given
         (wrong parity on purpose). ``break_first`` None applies the usual break rules to the
-        first character as address; True/False forces or suppresses the break.
+        first character as address; True/False forces or suppresses the break. ``marking``
+        replaces ``policy.post_break_marking`` after that break (a probe sent the way the
+        sensor was shown to hear, :meth:`SensorSession.hearing_marking`).
         """
         data = text.encode("latin-1") if isinstance(text, str) else text
         wire = bytes(to_wire_7e1(b) if parity else b for b in data)
@@ -132,16 +135,19 @@ class Master:
         except CommandError:
             command = None
         address = chr(data[0] & 0x7F) if data else ""
-        attempt = self._attempt(wire, address, command, brk=break_first, binary=binary, gap=gap)
+        attempt = self._attempt(
+            wire, address, command, brk=break_first, binary=binary, gap=gap, marking=marking
+        )
         return Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
 
-    def send_break(self) -> Event:
-        """A break of ``policy.break_duration`` then ``policy.post_break_marking`` of marking
-        (R-7.0-02, R-7.0-06), after letting the DUT release the line (R-7.0-11)."""
+    def send_break(self, marking: float | None = None) -> Event:
+        """A break of ``policy.break_duration`` then ``policy.post_break_marking`` (or
+        ``marking``) of marking (R-7.0-02, R-7.0-06), after letting the DUT release the line
+        (R-7.0-11)."""
         self.link.wait_until(self._earliest_transmit())
         event = self.link.send_break(self.policy.break_duration)
         self.last_break_end = event.end
-        self.link.wait(self.policy.post_break_marking)
+        self.link.wait(self.policy.post_break_marking if marking is None else marking)
         return event
 
     # -- conveniences ----------------------------------------------------------------------
@@ -293,13 +299,13 @@ class Master:
         return at - self.link.last_activity() > window
 
     def _transmit(
-        self, wire: bytes, address: str, brk: bool | None, gap: float
+        self, wire: bytes, address: str, brk: bool | None, gap: float, marking: float | None
     ) -> tuple[Event | None, list[Event]]:
         at = self._earliest_transmit()
         break_event = None
         if brk or (brk is None and self._needs_break(address, at)):
             try:
-                break_event = self.send_break()
+                break_event = self.send_break(marking)
             except BreakUnsupported:  # socket://: the link noted it; the command goes alone
                 self.link.wait_until(at)
         else:
@@ -318,9 +324,10 @@ class Master:
         binary: bool,
         crc: bool | None = None,
         gap: float = 0.0,
+        marking: float | None = None,
     ) -> Attempt:
         stray = self.link.receive(self.link.now())  # queued chatter is not this reply
-        break_event, sent = self._transmit(wire, address, brk, gap)
+        break_event, sent = self._transmit(wire, address, brk, gap, marking)
         command_end = sent[-1].end if sent else self.link.now()
         p = self.policy
         framing = Framing(

@@ -22,13 +22,15 @@ def spare_addresses(sensor, count: int = 3) -> list[str]:
 def test_foreign_addresses_are_ignored(sensor, case):
     """Commands for other addresses, each after a break, must draw no reply."""
     case.expect("silence to a!, aI! and aM! sent to addresses the sensor does not have")
-    probes = []
-    for other in spare_addresses(sensor):
-        for code in ("", "I", "M"):
-            probes.append(sensor.master.raw(f"{other}{code}!", break_first=True))
-    case.evidence("foreign-address probes", probes)
-    own = sensor.exchange("I")
-    case.add(judge.silent("R-4.0-01", probes, "the command was for another address", baseline=own))
+    probes = [
+        sensor.heard_probe(f"{other}{code}!")
+        for other in spare_addresses(sensor)
+        for code in ("", "I", "M")
+    ]
+    case.evidence("foreign-address probes, each with its a! control", [p.exchanges for p in probes])
+    case.add(
+        judge.silent_while_listening("R-4.0-01", probes, "the command was for another address")
+    )
 
 
 @requirements("R-4.4.3-01")
@@ -44,19 +46,25 @@ def test_query_address(sensor, case):
 def test_wildcard_with_other_commands(sensor, case):
     """A sensor may accept ? with other commands; if it answers ?I!, it answers correctly."""
     case.expect("silence, or the same identification as aI!")
-    ex = sensor.master.raw("?I!", break_first=True)
+    heard = sensor.heard_probe("?I!")
+    ex = heard.probe
     ident = sensor.exchange("I")
-    case.evidence("?I!", ex)
-    if not ex.answered and not ident.answered:
+    case.evidence("?I! and its a! control", heard.exchanges)
+    if not ex.answered and not (ident.answered and heard.listening):
         case.add(
-            inconclusive("R-4.4.3-02", "aI! got no reply either, so silence to ?I! says nothing")
+            inconclusive(
+                "R-4.4.3-02",
+                "precondition not met: the a! sent like ?I! (one break, then once) or aI! got "
+                "no reply, so silence to ?I! says nothing",
+            )
         )
     elif not ex.answered:
         case.add(
             passed(
                 "R-4.4.3-02",
-                "no reply to ?I! (allowed: ? with other commands is optional)",
-                observed=2,  # the silence to ?I! and the answered aI! that makes it mean something
+                "no reply to ?I! (allowed: ? with other commands is optional); the a! sent "
+                "the same way right after it was answered",
+                observed=2,  # the silence to ?I! and the answered control that gives it meaning
             )
         )
     elif ex.reply_text == ident.reply_text:
@@ -131,6 +139,14 @@ def test_address_range(sensor, case):
                 "shows nothing",
             )
         )
+    elif not bad.accepted and not bad.listening:
+        case.add(
+            inconclusive(
+                "R-4.3-04",
+                "precondition not met: the a! sent like aA$! (one break, then once) got no "
+                "reply, so the silence to aA$! shows nothing",
+            )
+        )
     elif bad.accepted:
         case.add(
             failed(
@@ -143,7 +159,8 @@ def test_address_range(sensor, case):
         case.add(
             passed(
                 "R-4.3-04",
-                f"refused '$' as an address; {len(ADDRESS_CHARS)} characters are addresses",
+                f"refused '$' as an address (and answered the a! sent the same way after it); "
+                f"{len(ADDRESS_CHARS)} characters are addresses",
                 decision="A17",
                 observed=len(bad.exchanges),
             )

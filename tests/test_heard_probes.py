@@ -1,0 +1,99 @@
+"""Silence is evidence only from a sensor shown to be listening (issue 18).
+
+One-off probes whose point is silence (foreign addresses, ``aA$!``, ``?I!``, the old address
+after ``aAb!``) used to go out once, 9 ms after a break. A sensor that needs longer to wake
+(a fault of R-7.0-05, judged there) never heard them, and its silence PASSed the rules the
+probes are about, in the same run that FAILed R-7.0-05 for that slowness. Now each probe is
+sent with the marking a one-shot ``a!`` was shown to need, and is followed by an ``a!`` control
+sent the same way: silence counts only where the control was answered.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from conformance.emulator import sim_sensor
+from conformance.judges.exchanges import silent_while_listening
+from conformance.matrix import run_once
+from conformance.sensor.session import HEARING_MARKINGS, HeardProbe, SensorSession
+from conformance.verdicts import Verdict
+
+
+def verdict(data: dict, rid: str) -> str:
+    return next(r["verdict"] for r in data["requirements"] if r["id"] == rid)
+
+
+def test_a_slow_waking_sensor_that_takes_a_bad_address_is_caught():
+    """Before: aA$! 9 ms after the break went unheard by a sensor needing 20 ms, and
+    R-4.3-04 PASSed ("refused '$'") although the sensor takes '$' when it hears it."""
+    data = run_once(
+        "sim://?faults=late-address-after-break,accepts-invalid-address",
+        ("-k", "test_address_range"),
+    )
+    assert verdict(data, "R-4.3-04") == "WARN"  # a MAY rule: broken, a WARN
+
+
+def test_a_slow_waking_sensor_that_answers_foreign_addresses_is_caught():
+    """Before: every foreign-address probe went unheard by a sensor that needs 110 ms to
+    wake, and R-4.0-01 PASSed."""
+    data = run_once(
+        "sim://?faults=slow-wake,answers-foreign-address",
+        ("-k", "test_foreign_addresses_are_ignored"),
+    )
+    assert verdict(data, "R-4.0-01") == "FAIL"
+
+
+def test_the_clean_sensor_is_heard_at_the_recorder_s_own_marking():
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    assert sensor.hearing_marking() == HEARING_MARKINGS[0]
+    heard = sensor.heard_probe("9!")
+    assert not heard.probe.answered and heard.listening
+    assert not any("one-shot" in a for a in sensor.assumptions)
+
+
+def test_a_sensor_deaf_to_every_one_shot_command_leaves_silence_unjudged():
+    """A sensor that hears nothing within 250 ms of a break: no marking works, the probes'
+    silence is INCONCLUSIVE "precondition not met", never a PASS."""
+    bus, link, emulator = sim_sensor()
+    emulator.behaviour = replace(emulator.behaviour, wake_delay=0.25)
+    sensor = SensorSession(link, address="0")
+    assert sensor.hearing_marking() is None
+    assert any("not judged" in a for a in sensor.assumptions)
+    probes = [sensor.heard_probe(f"{other}!") for other in "12"]
+    assert all(p.control is None and not p.listening for p in probes)
+    finding = silent_while_listening("R-4.0-01", probes, "another address")
+    assert finding.verdict is Verdict.INCONCLUSIVE
+    assert "precondition not met" in finding.detail
+
+
+@pytest.mark.parametrize(
+    "controls, want",
+    [((True, True), "PASS"), ((False, True), "PASS"), ((False, False), "INCONCLUSIVE")],
+)
+def test_silence_counts_only_where_the_control_was_answered(controls, want):
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    silent = sensor.master.raw("9!", break_first=True)
+    answered = sensor.master.raw("0!", break_first=True)
+    unanswered = sensor.master.raw("8!", break_first=True)
+    probes = [HeardProbe(silent, answered if ok else unanswered, 9e-3) for ok in controls]
+    finding = silent_while_listening("R-4.0-01", probes, "another address")
+    assert str(finding.verdict) == want
+    if want == "PASS":
+        assert finding.observed == 2 * sum(controls)
+        assert ("set aside" in finding.detail) == (not all(controls))
+
+
+def test_an_answer_to_a_probe_fails_whatever_its_control_did():
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    wrong = sensor.master.raw("0!", break_first=True)  # stands in for an answered probe
+    silent = sensor.master.raw("8!", break_first=True)
+    finding = silent_while_listening(
+        "R-4.0-01", [HeardProbe(wrong, silent, 9e-3)], "another address"
+    )
+    assert finding.verdict is Verdict.FAIL
+    assert finding.observed == 1 and finding.evidence
