@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 from urllib.parse import parse_qs, urlsplit
 
 from .declaration import Declaration
-from .emulator import FAULTS, Profile, default_profile, sim_sensor
+from .emulator import FAULTS, CompositionError, Profile, compose, default_profile, sim_sensor
 from .harness import device as harness_device
 from .links import adapter_link, factory
 from .links.base import LinkInfo
@@ -78,7 +78,14 @@ def sim_profile(spec: SimSpec) -> Profile:
         )
     if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
-    return replace(default_profile(spec.version), address=spec.address)
+    profile = replace(default_profile(spec.version), address=spec.address)
+    try:
+        misfits = compose(spec.faults).misfits(profile)
+    except CompositionError as exc:
+        raise PortError(f"sim faults cannot be combined: {exc}") from None
+    if misfits:
+        raise PortError("; ".join(misfits))
+    return profile
 
 
 def open_sim(spec: SimSpec) -> OpenedPort:

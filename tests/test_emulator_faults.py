@@ -938,8 +938,11 @@ def test_rewrites_chain_in_order():
     assert body[:-3] == "0" + M1_VALUES and body[-3:] != ascii_crc("0" + M1_VALUES)
 
 
-def test_later_setting_wins_and_unknown_names_fail():
-    assert compose(["response-too-early", "response-too-late"]).behaviour.reply_delay == 20e-3
+def test_clashing_settings_are_refused_and_unknown_names_fail():
+    from conformance.emulator import CompositionError
+
+    with pytest.raises(CompositionError, match="reply_delay"):
+        compose(["response-too-early", "response-too-late"])
     with pytest.raises(KeyError, match="no-such-fault"):
         compose(["no-such-fault"])
 
