@@ -899,6 +899,19 @@ def test_fault_deviates(name):
     CHECKS[name](rig)
 
 
+# -- faults seen in real firmware (issue 18) ---------------------------------------------------
+def check_unknown_command_text(rig: Rig) -> None:
+    assert rig.ask("0R9!").text == "0UNKN\r\n"  # unsupported: must be 0<CR><LF>
+    assert rig.ask("0RC9!").text == "0UNKN\r\n"  # must be 0<CRC><CR><LF>
+    assert rig.ask("0XNOPE!").text == "0UNKN\r\n"  # unknown extended command (A12)
+    assert rig.ask("0Q!").text == "0UNKN\r\n"  # no command at all (A12)
+    assert rig.ask("1Q!").events == []  # another address's text stays unanswered
+    assert rig.ask("0R0!").body == "0+22.1+45.6"  # supported R is unchanged
+
+
+CHECKS["unknown-command-text"] = check_unknown_command_text
+
+
 @pytest.mark.parametrize("name", sorted(FAULTS))
 def test_clean_emulator_does_not_show_the_deviation(name):
     """The check must fail without the fault, or it could not tell the fault apart."""

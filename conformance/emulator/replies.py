@@ -26,6 +26,7 @@ class ReplyKind(StrEnum):
     IDENTIFY = "identify"  # the same shape after an identify-measurement command
     SERVICE_REQUEST = "service-request"
     CHATTER = "chatter"  # only ever sent by a fault
+    UNKNOWN = "unknown"  # a fault's text for what the sensor does not know (aUNKN)
     DATA = "data"  # aDn!
     CONTINUOUS = "continuous"  # aRn! / aRCn!
     METADATA = "metadata"  # aI<m>_nnn!
@@ -64,15 +65,15 @@ class BinaryParts:
 class Reply:
     """One reply of the emulator.
 
-    ``command`` is what it answers (None for service requests); ``source`` is the measurement
-    command behind data, start and identify replies; ``digits`` the count width of start and
-    identify replies (1, 2 or 3); ``repeat`` how often this D page was sent before (so a fault
-    can make repeats differ). A fault spoils the CRC of a reply that carries one (``crc``) by
-``crc_shift`` (added to the last character's six bits) or ``crc_high`` (the bits or'ed into
-each character instead of 0x40), both applied to the CRC of the final body when encoding:
-so the two compose in either order, a later rewrite of the body keeps the CRC spoiled (not
-stale), and a fault that drops the CRC drops a spoiled one too.
-    ``flip_parity`` lists character positions sent with the wrong parity bit.
+        ``command`` is what it answers (None for service requests); ``source`` is the measurement
+        command behind data, start and identify replies; ``digits`` the count width of start and
+        identify replies (1, 2 or 3); ``repeat`` how often this D page was sent before (so a fault
+        can make repeats differ). A fault spoils the CRC of a reply that carries one (``crc``) by
+    ``crc_shift`` (added to the last character's six bits) or ``crc_high`` (the bits or'ed into
+    each character instead of 0x40), both applied to the CRC of the final body when encoding:
+    so the two compose in either order, a later rewrite of the body keeps the CRC spoiled (not
+    stale), and a fault that drops the CRC drops a spoiled one too.
+        ``flip_parity`` lists character positions sent with the wrong parity bit.
     """
 
     kind: ReplyKind

@@ -114,6 +114,14 @@ class FaultSet:
         return tuple(f.name for f in self.faults)
 
     @property
+    def behaviour_settings(self) -> dict[str, Any]:
+        """The settings the faults override (the rest of :attr:`behaviour` is the default)."""
+        merged: dict[str, Any] = {}
+        for fault in self.faults:
+            merged.update(fault.settings)
+        return merged
+
+    @property
     def violates(self) -> tuple[str, ...]:
         seen: dict[str, None] = {}
         for fault in self.faults:
