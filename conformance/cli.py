@@ -266,6 +266,16 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     for name, fault in sorted(FAULTS.items()):
         table.add_row(name, " ".join(fault.violates), fault.description)
     console.print(table)
+    from .emulator.profiles import PROFILES
+
+    profiles = Table(title=f"{len(PROFILES)} firmware profiles (use sim://?profile=NAME)")
+    profiles.add_column("profile", no_wrap=True, min_width=max(len(n) for n in PROFILES))
+    profiles.add_column("faults", overflow="fold")
+    profiles.add_column("what real firmware does", overflow="fold")
+    for name, profile in PROFILES.items():
+        quirks = [f"{k}={v}" for k, v in profile.quirks.items()]
+        profiles.add_row(name, " ".join((*profile.faults, *quirks)), profile.description)
+    console.print(profiles)
     return EXIT_COMPLIANT
 
 

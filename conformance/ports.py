@@ -15,7 +15,8 @@ from dataclasses import dataclass, field, replace
 from urllib.parse import parse_qs, urlsplit
 
 from .declaration import Declaration
-from .emulator import FAULTS, Profile, default_profile, sim_sensor
+from .emulator import FAULTS, CompositionError, Profile, compose, default_profile, sim_sensor
+from .emulator.profiles import PROFILES, profile_settings
 from .harness import device as harness_device
 from .links import adapter_link, factory
 from .links.base import LinkInfo
@@ -34,6 +35,7 @@ BUILTIN_KINDS = (factory, adapter_link, harness_device, recording_link)
 @dataclass
 class SimSpec:
     faults: tuple[str, ...] = ()
+    profiles: tuple[str, ...] = ()  # firmware profiles (conformance.emulator.profiles)
     version: str = "14"
     address: str = "0"
     extra: dict[str, str] = field(default_factory=dict)
@@ -50,6 +52,8 @@ def parse_sim(port: str) -> SimSpec:
     spec = SimSpec()
     if "faults" in params:
         spec.faults = tuple(f.strip() for f in params.pop("faults").split(",") if f.strip())
+    if "profile" in params:
+        spec.profiles = tuple(p.strip() for p in params.pop("profile").split(",") if p.strip())
     if "version" in params:
         given = params.pop("version").strip()
         if given not in ("1.3", "1.4"):
@@ -63,7 +67,7 @@ def parse_sim(port: str) -> SimSpec:
     if params:
         raise PortError(
             f"unknown sim parameters {sorted(params)} "
-            "(known: faults, version, address, recorder-faults, recorder)"
+            "(known: faults, profile, version, address, recorder-faults, recorder)"
         )
     return spec
 
@@ -71,6 +75,12 @@ def parse_sim(port: str) -> SimSpec:
 def sim_profile(spec: SimSpec) -> Profile:
     """The reference emulator's profile a sim URL asks for, its faults and address checked
     (:class:`PortError` with the reason): the one check ``sim`` and ``emulate`` share."""
+    unknown_profiles = [p for p in spec.profiles if p not in PROFILES]
+    if unknown_profiles:
+        raise PortError(
+            f"unknown profile(s) {', '.join(unknown_profiles)}; "
+            "`sdi12-conform faults` lists the known ones"
+        )
     unknown = [f for f in spec.faults if f not in FAULTS]
     if unknown:
         raise PortError(
@@ -78,13 +88,26 @@ def sim_profile(spec: SimSpec) -> Profile:
         )
     if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
-    return replace(default_profile(spec.version), address=spec.address)
+    profile = replace(default_profile(spec.version), address=spec.address)
+    try:
+        misfits = compose(all_faults(spec)).misfits(profile)
+    except CompositionError as exc:
+        raise PortError(f"sim faults cannot be combined: {exc}") from None
+    if misfits:
+        raise PortError("; ".join(misfits))
+    return profile
+
+
+def all_faults(spec: SimSpec) -> tuple[str, ...]:
+    """The faults of the URL's firmware profiles, then its own ``faults=``."""
+    return (*profile_settings(spec.profiles)[0], *spec.faults)
 
 
 def open_sim(spec: SimSpec) -> OpenedPort:
     """Build the simulated bus with one reference emulator on it."""
     profile = sim_profile(spec)
-    _bus, link, emulator = sim_sensor(profile, faults=spec.faults)
+    quirks = profile_settings(spec.profiles)[1]
+    _bus, link, emulator = sim_sensor(profile, faults=all_faults(spec), quirks=quirks)
     declared = emulator.faults.declared_profile(profile)  # the clean profile, not the faulted
     return OpenedPort(link, [emulator], sim_declaration(declared, spec))
 

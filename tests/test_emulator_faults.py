@@ -899,6 +899,19 @@ def test_fault_deviates(name):
     CHECKS[name](rig)
 
 
+# -- faults seen in real firmware (issue 18) ---------------------------------------------------
+def check_unknown_command_text(rig: Rig) -> None:
+    assert rig.ask("0R9!").text == "0UNKN\r\n"  # unsupported: must be 0<CR><LF>
+    assert rig.ask("0RC9!").text == "0UNKN\r\n"  # must be 0<CRC><CR><LF>
+    assert rig.ask("0XNOPE!").text == "0UNKN\r\n"  # unknown extended command (A12)
+    assert rig.ask("0Q!").text == "0UNKN\r\n"  # no command at all (A12)
+    assert rig.ask("1Q!").events == []  # another address's text stays unanswered
+    assert rig.ask("0R0!").body == "0+22.1+45.6"  # supported R is unchanged
+
+
+CHECKS["unknown-command-text"] = check_unknown_command_text
+
+
 @pytest.mark.parametrize("name", sorted(FAULTS))
 def test_clean_emulator_does_not_show_the_deviation(name):
     """The check must fail without the fault, or it could not tell the fault apart."""
@@ -938,8 +951,11 @@ def test_rewrites_chain_in_order():
     assert body[:-3] == "0" + M1_VALUES and body[-3:] != ascii_crc("0" + M1_VALUES)
 
 
-def test_later_setting_wins_and_unknown_names_fail():
-    assert compose(["response-too-early", "response-too-late"]).behaviour.reply_delay == 20e-3
+def test_clashing_settings_are_refused_and_unknown_names_fail():
+    from conformance.emulator import CompositionError
+
+    with pytest.raises(CompositionError, match="reply_delay"):
+        compose(["response-too-early", "response-too-late"])
     with pytest.raises(KeyError, match="no-such-fault"):
         compose(["no-such-fault"])
 

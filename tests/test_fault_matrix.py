@@ -41,10 +41,22 @@ def rows(request: pytest.FixtureRequest) -> dict[str, MatrixRow]:
     return {r.fault: r for r in fault_matrix(wanted, processes=2, row=row_through_capture)}
 
 
-@pytest.mark.parametrize(
-    "fault",
-    [pytest.param(f, marks=() if f in FAST_FAULTS else pytest.mark.matrix) for f in sorted(FAULTS)],
-)
+#: Faults whose row the judges do not yet get exact, with what goes wrong: strict, so the row
+#: must be taken out of here the moment the judges are fixed (issue 18, part 5).
+AWAITING_JUDGES = {
+    "unknown-command-text": "support read from the aUNKN text: R-4.4.8.1-02, R-4.4.12-03, "
+    "R-4.4.12-05, R-6.2-06 flagged, R-4.4.12-02 (aRC9! answered without a CRC) missed",
+}
+
+
+def _marks(fault: str) -> list[pytest.MarkDecorator]:
+    marks = [] if fault in FAST_FAULTS else [pytest.mark.matrix]
+    if fault in AWAITING_JUDGES:
+        marks.append(pytest.mark.xfail(reason=AWAITING_JUDGES[fault], strict=True))
+    return marks
+
+
+@pytest.mark.parametrize("fault", [pytest.param(f, marks=_marks(f)) for f in sorted(FAULTS)])
 def test_fault_is_caught_by_exactly_its_requirements(fault, rows):
     row = rows[fault]
     assert row.capture is not None  # judged through its capture too

@@ -1,7 +1,7 @@
 """The reference SDI-12 sensor emulator (sans-I/O), its profiles and its named faults."""
 
 from .behaviour import Behaviour
-from .faults import FAULTS, Fault, FaultSet, compose
+from .faults import FAULTS, CompositionError, Fault, FaultSet, compose
 from .profile import MeasurementSpec, Packet, Profile, default_profile
 from .replies import Reply, ReplyKind
 from .sensor import SensorEmulator
@@ -10,6 +10,7 @@ from .sim import sim_sensor
 __all__ = [
     "FAULTS",
     "Behaviour",
+    "CompositionError",
     "Fault",
     "FaultSet",
     "MeasurementSpec",

@@ -95,3 +95,6 @@ class Behaviour:
     answer_identify_measurement: bool = True
     metadata_invalid_reply: bool = True
     empty_packet: bool = True
+    # the text (after the address) a faulty sensor answers unknown and unsupported commands
+    # with, such as "UNKN", instead of silence (decision A12) or the unsupported form
+    unknown_reply: str | None = None

@@ -29,8 +29,10 @@ reply, never partial data (decision A3).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from math import inf
+from typing import Any
 
 from ..protocol.binary import DataType, encode_values
 from ..protocol.commands import (
@@ -45,6 +47,7 @@ from ..protocol.commands import (
 from ..protocol.framing import COMMAND_END, CRLF, STX, TEXT_END
 from ..sim.bus import Frame
 from ..transcript import parity_bit
+from .behaviour import Behaviour
 from .faults import compose
 from .measurement import DataSet, Run, complete, empty_data
 from .profile import MeasurementSpec, Profile
@@ -61,11 +64,19 @@ class SensorEmulator:
     order (later settings win, rewrites chain).
     """
 
-    def __init__(self, profile: Profile, faults: Sequence[str] = (), name: str = "sensor") -> None:
+    def __init__(
+        self,
+        profile: Profile,
+        faults: Sequence[str] = (),
+        name: str = "sensor",
+        quirks: Mapping[str, Any] | None = None,
+    ) -> None:
         self.name = name
         self.faults = compose(faults)
         self.profile = self.faults.apply_profile(profile)
-        self.behaviour = self.faults.behaviour
+        # legal quirks of a firmware profile first, so that a fault's deviation still shows
+        base = replace(Behaviour(), **dict(quirks or {}))
+        self.behaviour = replace(base, **dict(self.faults.behaviour_settings))
         self.address = self.profile.address
         self._old_addresses: set[str] = set()
         self._tx = Transmitter()
@@ -321,8 +332,18 @@ class SensorEmulator:
                     self._multiline(cmd, a, text.split("\n"), at)
                 elif text is not None:
                     self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
+                else:
+                    self._unknown(a, at, cmd)
             case _:
                 self._start_measurement(cmd, at)
+
+    def _unknown(self, address: str, at: float, cmd: Command | None = None) -> bool:
+        """A faulty sensor's text for a command it does not know (True if it sent one)."""
+        text = self.behaviour.unknown_reply
+        if text is None:
+            return False
+        self._send(Reply(ReplyKind.UNKNOWN, address + text, command=cmd), at)
+        return True
 
     def _non_command(self, text: str, end: float, foreign: bool) -> None:
         """What only a faulty sensor does with text that is not a command: take a character
@@ -342,6 +363,8 @@ class SensorEmulator:
             self._old_addresses.add(self.address)
             self.address = text[2]
             self._send(Reply(ReplyKind.CHANGE_ADDRESS, text[2]), at)
+        elif not foreign and text[:1] == self.address:
+            self._unknown(self.address, at)
 
     def _multiline(self, cmd: Command, address: str, lines: list[str], at: float) -> None:
         """Multi-line text (4.4.13.1, decision A10): 'a<STX>' before the first line, CR LF
@@ -508,6 +531,8 @@ class SensorEmulator:
             and not (last is not None and last.kind is Kind.CONTINUOUS and last.group == 0)
         ):
             spec = None
+        if spec is None and self._unknown(cmd.address, at, cmd):
+            return
         values = "".join(spec.values) if spec is not None else ""
         reply = Reply(
             ReplyKind.CONTINUOUS, cmd.address + values, command=cmd, source=cmd, crc=cmd.crc

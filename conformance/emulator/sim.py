@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 from ..sim.bus import SimBus, SimLink
 from .profile import Profile, default_profile
@@ -10,10 +11,14 @@ from .sensor import SensorEmulator
 
 
 def sim_sensor(
-    profile: Profile | None = None, faults: Sequence[str] = ()
+    profile: Profile | None = None,
+    faults: Sequence[str] = (),
+    quirks: Mapping[str, Any] | None = None,
 ) -> tuple[SimBus, SimLink, SensorEmulator]:
     """A :class:`SimBus` with one :class:`SensorEmulator` (default v1.4 profile) attached,
-    and the tool's :class:`SimLink` to it. Used by tests and by ``--port sim``."""
-    emulator = SensorEmulator(profile if profile is not None else default_profile(), faults)
+    and the tool's :class:`SimLink` to it (``quirks``: a firmware profile's legal settings).
+    Used by tests and by ``--port sim``."""
+    chosen = profile if profile is not None else default_profile()
+    emulator = SensorEmulator(chosen, faults, quirks=quirks)
     bus = SimBus([emulator])
     return bus, SimLink(bus), emulator

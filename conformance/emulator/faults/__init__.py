@@ -23,8 +23,11 @@ decisions such as A18) exactly these IDs. Conventions used when choosing them:
   equals the command's reply) stays intact unless the fault is about that rule.
 - A fault applies to the default v1.4 profile unless ``version`` says otherwise.
 
-Faults compose: :func:`compose` applies settings in order (the last one wins on a clash),
-chains rewrites in order and applies profile transforms in order.
+Faults compose: :func:`compose` merges their settings, chains their rewrites and applies
+their profile transforms. A set is refused (:class:`CompositionError`) where two faults set
+one knob to different values or one declares that it ``masks`` the other; otherwise the
+result does not depend on the order and each member's deviation still shows on the wire
+(tests/test_fault_composition.py checks every pair whose hooks touch the same thing).
 """
 
 from __future__ import annotations
@@ -35,10 +38,20 @@ from types import MappingProxyType
 from typing import Any
 
 from ..behaviour import Behaviour
-from . import addressing, high_volume, measurements, metadata, replies, timing
-from .model import Fault, FaultSet, ProfileTransform, Rewrite
+from . import addressing, firmware, high_volume, measurements, metadata, replies, timing
+from .model import CompositionError, Fault, FaultSet, ProfileTransform, Rewrite, clash
 
-__all__ = ["FAULTS", "Fault", "FaultSet", "ProfileTransform", "Rewrite", "compose"]
+__all__ = [
+    "FAULTS",
+    "CompositionError",
+    "Fault",
+    "FaultSet",
+    "ProfileTransform",
+    "Rewrite",
+    "clash",
+    "compose",
+    "conflicts",
+]
 
 #: The registry in the order its faults were added, which is the order the matrix, the
 #: reports and ``sdi12-conform faults`` list them in: each family module holds its faults in
@@ -83,6 +96,8 @@ _RUNS: tuple[tuple[Fault, ...], ...] = (
     timing.BOUNDARIES,
     # version specific
     measurements.VERSION_13,
+    # deviations of real firmware the multi-deviation profiles need (issue 18)
+    firmware.FIRMWARE,
 )
 
 
@@ -100,14 +115,32 @@ def _registry() -> dict[str, Fault]:
 FAULTS: Mapping[str, Fault] = MappingProxyType(_registry())
 
 
-def compose(names: Iterable[str]) -> FaultSet:
-    """The :class:`FaultSet` for fault names (KeyError naming the unknown fault)."""
+def conflicts(names: Iterable[str]) -> list[str]:
+    """Why the named faults cannot be composed (one line per clashing pair; empty if they
+    can). KeyError naming an unknown fault."""
     chosen = []
-    settings: dict[str, Any] = {}
     for name in names:
         if name not in FAULTS:
             raise KeyError(f"unknown fault {name!r}")
-        fault = FAULTS[name]
-        chosen.append(fault)
+        chosen.append(FAULTS[name])
+    reasons = []
+    for i, first in enumerate(chosen):
+        for second in chosen[i + 1 :]:
+            reason = clash(first, second)
+            if reason is not None:
+                reasons.append(reason)
+    return reasons
+
+
+def compose(names: Iterable[str]) -> FaultSet:
+    """The :class:`FaultSet` for fault names (KeyError naming the unknown fault,
+    :class:`CompositionError` naming a pair that cannot be composed)."""
+    names = tuple(dict.fromkeys(names))
+    reasons = conflicts(names)
+    if reasons:
+        raise CompositionError("; ".join(reasons))
+    chosen = tuple(FAULTS[name] for name in names)
+    settings: dict[str, Any] = {}
+    for fault in chosen:
         settings.update(fault.settings)
-    return FaultSet(tuple(chosen), replace(Behaviour(), **settings))
+    return FaultSet(chosen, replace(Behaviour(), **settings))

@@ -85,6 +85,7 @@ BINARY: tuple[Fault, ...] = (
         ("R-5.2-05",),
         rewrite=packet_rewrite(_pad_payload),
         inconclusive=("R-5.2-07",),
+        needs=("HB",),
     ),
     Fault(
         "binary-invalid-type",
@@ -93,24 +94,28 @@ BINARY: tuple[Fault, ...] = (
         ("R-5.2.1-01",),
         rewrite=packet_rewrite(_binary_first_packet(_invalid_type)),
         inconclusive=("R-5.2-07",),
+        needs=("HB",),
     ),
     Fault(
         "binary-no-empty-packet",
         "aDBn! past the data gets no answer instead of the 6-byte empty packet.",
         ("R-5.2-06",),
         settings={"empty_packet": False},
+        needs=("HB",),
     ),
     Fault(
         "binary-payload-over-1000",
         "HB adds an eleventh packet of 501 uint16 values: 1002 payload bytes.",
         ("R-5.2-04",),
         profile=with_spec("HB", _big_packet),
+        replaces="the count aHB! announces against the values its packets deliver",
     ),
     Fault(
         "binary-address-parity",
         "The address byte of DB packets carries a parity bit in bit 7 (not 8N1).",
         ("R-4.1-03",),
         rewrite=packet_rewrite(_parity_address),
+        needs=("HB",),
     ),
     Fault(
         "binary-fewer-values",
@@ -119,6 +124,7 @@ BINARY: tuple[Fault, ...] = (
         profile=with_spec(
             "HB", lambda s: replace(s, announced=s.count + 1, metadata=_extra_meta(s))
         ),
+        replaces="the count aHB! announces against the values its packets deliver",
     ),
 )
 
@@ -141,6 +147,7 @@ COVERAGE: tuple[Fault, ...] = (
             "R-5.2-07",
             "R-5.2.1-01",
         ),
+        needs=("HB",),
     ),
     Fault(
         "binary-size-big-endian",
@@ -149,6 +156,7 @@ COVERAGE: tuple[Fault, ...] = (
         ("R-5.2-02",),
         rewrite=packet_rewrite(_size_big_endian),
         inconclusive=("R-5.2-07",),
+        needs=("HB",),
     ),
     Fault(
         "high-volume-unsupported-silent",
@@ -156,5 +164,14 @@ COVERAGE: tuple[Fault, ...] = (
         ("R-5.4-02",),
         profile=_without_high_volume,
         rewrite=when(_hv_start, silence),
+        masks=dict.fromkeys(
+            (
+                "binary-fewer-values",
+                "binary-payload-over-1000",
+                "high-volume-binary-two-digit-count",
+            ),
+            "a sensor without HA and HB has no high-volume reply or packet to spoil",
+        ),
+        needs=("v1.4",),
     ),
 )

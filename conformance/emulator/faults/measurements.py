@@ -118,6 +118,7 @@ SERVICE_REQUESTS: tuple[Fault, ...] = (
         "aIM!/aIV! (and numbered forms) are followed by a service request as if measuring.",
         ("R-6.1-03",),
         settings={"service_request_on_identify": True},
+        needs=("v1.4",),
     ),
 )
 
@@ -206,6 +207,7 @@ DATA_BUFFER: tuple[Fault, ...] = (
         "Identify-measurement commands (aIM!, aIC!...) empty the data buffer.",
         ("R-6.1-03",),
         settings={"identify_clears_data": True},
+        needs=("v1.4",),
     ),
 )
 
@@ -217,12 +219,14 @@ COUNTS: tuple[Fault, ...] = (
         "aM! announces 3 values but D returns 2.",
         ("R-4.4.8-03",),
         profile=with_spec("M", lambda s: replace(s, values=s.values[:-1], announced=3)),
+        replaces="the count aM! announces against the values it delivers",
     ),
     Fault(
         "more-values-than-announced",
         "aM! announces 3 values but D returns 4.",
         ("R-4.4.8-03",),
         profile=with_spec("M", lambda s: replace(s, values=(*s.values, "+1"), announced=3)),
+        replaces="the count aM! announces against the values it delivers",
     ),
     Fault(
         "d0-empty",
@@ -250,6 +254,7 @@ COUNTS: tuple[Fault, ...] = (
         "After HA, aD10! and higher get no answer, so values past D9 cannot be read.",
         ("R-5.1-02", "R-4.4.8-03"),
         settings={"max_data_index": 9},
+        needs=("HA",),
     ),
     Fault(
         "continuous-needs-r0-first",
@@ -331,5 +336,6 @@ VERSION_13: tuple[Fault, ...] = (
         ("R-4.4.7-03",),
         profile=with_spec("C", _v13_wide_concurrent),
         version="13",
+        replaces="the values of aC!",
     ),
 )

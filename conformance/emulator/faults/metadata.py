@@ -51,6 +51,8 @@ def _last_record_dropped(spec: MeasurementSpec) -> MeasurementSpec:
 
 
 def _long_record(spec: MeasurementSpec) -> MeasurementSpec:
+    if not spec.metadata:
+        return spec  # no record to lengthen (another fault removed the values)
     first = spec.metadata[0]
     return replace(spec, metadata=((*first, "x" * 70), *spec.metadata[1:]))
 
@@ -66,18 +68,21 @@ METADATA: tuple[Fault, ...] = (
         "Metadata records of aM! values carry only field 1 (no units field).",
         ("R-6.2.2-01",),
         profile=with_spec("M", _units_dropped),
+        replaces="the fields of the metadata records of aM!",
     ),
     Fault(
         "metadata-too-long",
         "The metadata record of aM!'s first value is over 75 characters.",
         ("R-6.2-04",),
         profile=with_spec("M", _long_record),
+        replaces="the fields of the metadata records of aM!",
     ),
     Fault(
         "metadata-no-invalid-index-reply",
         "Metadata commands for index 000 or past the count get no answer.",
         ("R-6.2-05", "R-6.2-06"),
         settings={"metadata_invalid_reply": False},
+        needs=("v1.4",),
     ),
     Fault(
         "metadata-missing-record",
@@ -94,12 +99,14 @@ METADATA: tuple[Fault, ...] = (
             ),
             lambda r: replace(r, body=r.body[0]),
         ),
+        needs=("v1.4",),
     ),
     Fault(
         "identify-reply-differs",
         "Identify-measurement replies announce a different count than the command does.",
         ("R-6.1-02",),
         rewrite=only([ReplyKind.IDENTIFY], lambda r: replace(r, body=_bump_count(r.body))),
+        needs=("v1.4",),
     ),
     Fault(
         "identify-unsupported",
@@ -108,6 +115,7 @@ METADATA: tuple[Fault, ...] = (
         ("R-6.1-01",),
         settings={"answer_identify_measurement": False},
         inconclusive=("R-6.1-02",),
+        needs=("v1.4",),
     ),
 )
 
@@ -121,18 +129,30 @@ COVERAGE: tuple[Fault, ...] = (
         ("R-6.2-01", "R-6.2-05", "R-6.2-06", "R-6.2-07"),
         rewrite=only([ReplyKind.METADATA], silence),
         inconclusive=("R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2.1-01", "R-6.2.2-01"),
+        masks=dict.fromkeys(
+            (
+                "metadata-crc-missing",
+                "metadata-crc-unasked",
+                "metadata-long-identifier",
+                "metadata-semicolon-in-field",
+            ),
+            "metadata commands get no answer, so no metadata reply shows the deviation",
+        ),
+        needs=("v1.4",),
     ),
     Fault(
         "metadata-semicolon-in-field",
         "The units field of metadata records contains a ';'.",
         ("R-6.2-03",),
         rewrite=_metadata_field(_semicolon_in_units),
+        needs=("v1.4",),
     ),
     Fault(
         "metadata-long-identifier",
         "Field 1 of metadata records is a 14-character name, not a SHEF code.",
         ("R-6.2.1-01",),
         rewrite=_metadata_field(_long_identifier),
+        needs=("v1.4",),
     ),
 )
 
@@ -155,5 +175,6 @@ THIRD_PARTY_CRC: tuple[Fault, ...] = (
         "Metadata replies of plain commands (aIM_001!) carry a CRC nobody asked for.",
         ("R-6.2-02",),
         rewrite=toggle_crc(ReplyKind.METADATA, crc=False),
+        needs=("v1.4",),
     ),
 )

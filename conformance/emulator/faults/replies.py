@@ -9,7 +9,6 @@ from collections.abc import Callable, Iterable
 from dataclasses import replace
 
 from ...protocol.commands import Kind
-from ...protocol.crc import ascii_crc, binary_crc
 from ..profile import MeasurementSpec, Profile
 from ..replies import Reply, ReplyKind
 from .edits import (
@@ -42,8 +41,7 @@ def _after(kinds: Iterable[Kind], *, crc: bool | None = None) -> Callable[[Reply
 
 
 def _wrong_crc(reply: Reply) -> Reply:
-    good = ascii_crc(reply.body)
-    return replace(reply, crc_text=good[:2] + chr(0x40 | ((ord(good[2]) + 1) & 0x3F)))
+    return replace(reply, crc_shift=reply.crc_shift + 1)
 
 
 def _start_with(digits: int, change: Callable[[str], str]) -> Rewrite:
@@ -57,23 +55,12 @@ def _start_with(digits: int, change: Callable[[str], str]) -> Rewrite:
 
 def _binary_crc_wrong(reply: Reply) -> None:
     assert reply.binary is not None
-    parts = reply.binary
-    good = _packet_crc(parts.address, parts.dtype, parts.payload)
-    parts.crc = bytes((good[0] ^ 0x01, good[1]))
+    reply.binary.crc_flip ^= 0x01
 
 
 def _binary_crc_swapped(reply: Reply) -> None:
     assert reply.binary is not None
-    parts = reply.binary
-    good = _packet_crc(parts.address, parts.dtype, parts.payload)
-    if good[0] == good[1]:  # swapping would change nothing; flip a bit so it still shows
-        good = bytes((good[0] ^ 0x01, good[1]))
-    parts.crc = bytes((good[1], good[0]))
-
-
-def _packet_crc(address: int, dtype: int, payload: bytes) -> bytes:
-    head = bytes([address]) + len(payload).to_bytes(2, "little") + bytes([dtype])
-    return binary_crc(head + payload)
+    reply.binary.crc_swap = True
 
 
 def _one_line_extended(reply: Reply) -> bool:
@@ -86,10 +73,7 @@ def _one_line_extended(reply: Reply) -> bool:
 
 def _crc_high_bits(reply: Reply) -> Reply:
     """The three CRC characters with 0x60 instead of 0x40 or'ed in (R-4.4.12-06)."""
-    if not reply.crc:
-        return reply
-    good = ascii_crc(reply.body)
-    return replace(reply, crc_text="".join(chr(ord(c) | 0x20) for c in good))
+    return replace(reply, crc_high=0x60) if reply.crc else reply
 
 
 def _rename_extended(profile: Profile) -> Profile:
@@ -98,20 +82,26 @@ def _rename_extended(profile: Profile) -> Profile:
 
 
 def _long_help_line(profile: Profile) -> Profile:
+    """One 80-character line more in the multi-line help text, whatever its command is
+    named (so a fault renaming the commands composes with this one in either order)."""
     extended = dict(profile.extended)
-    extended["XHELP"] = extended["XHELP"] + "\n" + "L" * 80
+    name = next((k for k, text in extended.items() if "\n" in text), "XHELP")
+    extended[name] = extended[name] + "\n" + "L" * 80  # KeyError: a sensor without one
     return replace(profile, extended=extended)
 
 
 def _first_value(new: str) -> Callable[[MeasurementSpec], MeasurementSpec]:
-    return lambda spec: replace(spec, values=(new, *spec.values[1:]))
+    """Replace the first value; a measurement without values keeps none (it has no first
+    value to spoil, and inventing one would undo the fault that removed them)."""
+    return lambda spec: replace(spec, values=(new, *spec.values[1:])) if spec.values else spec
 
 
 def _long_continuous(spec: MeasurementSpec) -> MeasurementSpec:
-    """R0 with 82 value characters; metadata grows along so only the length deviates."""
+    """R0 with 82 value characters; metadata grows along so only the length deviates. The
+    extra values go first, so a fault that drops R0's last record composes in either order."""
     extra = ("+1234.567",) * 8
-    metadata = (*spec.metadata, *(("XL", " ") for _ in extra))
-    return replace(spec, values=spec.values + extra, metadata=metadata)
+    metadata = (*(("XL", " ") for _ in extra), *spec.metadata)
+    return replace(spec, values=extra + spec.values, metadata=metadata)
 
 
 def _crc_twin(profile: Profile) -> Profile:
@@ -127,12 +117,14 @@ FORMAT: tuple[Fault, ...] = (
         "aI! carries a 14-character optional field, making the reply 34 characters.",
         ("R-4.4.2-01",),
         rewrite=only([ReplyKind.IDENTIFICATION], lambda r: replace(r, body=r.body + "EXTRA.ME")),
+        replaces="the length of the aI! reply",
     ),
     Fault(
         "ident-truncated",
         "aI! stops after the model field: sensor version and optional field are missing.",
         ("R-4.4.2-01",),
         rewrite=only([ReplyKind.IDENTIFICATION], lambda r: replace(r, body=r.body[:17])),
+        replaces="the length of the aI! reply",
     ),
     Fault(
         "ident-bad-version",
@@ -162,6 +154,15 @@ FORMAT: tuple[Fault, ...] = (
         "aM!/aMC! announce n = 0 for the defined measurement and deliver no values.",
         ("R-4.4.5-02",),
         profile=with_spec("M", lambda s: replace(s, values=(), metadata=())),
+        replaces="the count aM! announces against the values it delivers",
+        masks={
+            **dict.fromkeys(
+                ("value-missing-sign", "value-eight-digits", "value-ten-chars", "value-two-points"),
+                "aM! without values has no first value to spoil",
+            ),
+            "metadata-missing-units": "aM! without values has no metadata record",
+            "metadata-too-long": "aM! without values has no metadata record",
+        },
     ),
     Fault(
         "concurrent-three-digit-count",
@@ -174,6 +175,7 @@ FORMAT: tuple[Fault, ...] = (
         "aC!/aCC! answer a00000 (no values) for the plain concurrent measurement.",
         ("R-4.4.7-02",),
         profile=with_spec("C", lambda s: replace(s, values=(), metadata=(), ttt=0)),
+        replaces="the values of aC!",
     ),
     Fault(
         "high-volume-two-digit-count",
@@ -186,30 +188,35 @@ FORMAT: tuple[Fault, ...] = (
             lambda r: replace(r, body=r.body[:4] + r.body[5:]),
         ),
         inconclusive=("R-5.1-02", "R-5.1-03"),
+        needs=("HA",),
     ),
     Fault(
         "value-missing-sign",
         "The first value of aM! has no sign ('22.15' instead of '+22.15').",
         ("R-4.4.8-02",),
         profile=with_spec("M", _first_value("22.15")),
+        replaces="the first value of aM!",
     ),
     Fault(
         "value-eight-digits",
         "The first value of aM! has eight digits ('+12345678').",
         ("R-4.4.8-02",),
         profile=with_spec("M", _first_value("+12345678")),
+        replaces="the first value of aM!",
     ),
     Fault(
         "value-ten-chars",
         "The first value of aM! is ten characters long ('+12345.678').",
         ("R-4.4.8-02",),
         profile=with_spec("M", _first_value("+12345.678")),
+        replaces="the first value of aM!",
     ),
     Fault(
         "value-two-points",
         "The first value of aM! has two decimal points ('+22.1.5').",
         ("R-4.4.8-02",),
         profile=with_spec("M", _first_value("+22.1.5")),
+        replaces="the first value of aM!",
     ),
     Fault(
         "values-over-35",
@@ -228,6 +235,7 @@ FORMAT: tuple[Fault, ...] = (
         "D replies after HA pack up to 81 value characters.",
         ("R-5.1-03",),
         settings={"limit_high_volume": 81},
+        needs=("HA",),
     ),
     Fault(
         "continuous-over-75",
@@ -301,6 +309,7 @@ CRC: tuple[Fault, ...] = (
         "D replies after HA carry no CRC.",
         ("R-5.1-03",),
         rewrite=when(_after([Kind.HIGH_VOLUME_ASCII]), set_to(crc=False)),
+        needs=("HA",),
     ),
     Fault(
         "crc-on-plain",
@@ -331,6 +340,7 @@ CRC: tuple[Fault, ...] = (
         "Metadata replies for CRC commands (aIMC_nnn!, aICC_nnn!, aIHA_nnn!...) lack the CRC.",
         ("R-6.2-02",),
         rewrite=toggle_crc(ReplyKind.METADATA, crc=True),
+        needs=("v1.4",),
     ),
     Fault(
         "crc-variant-different-count",
@@ -343,12 +353,14 @@ CRC: tuple[Fault, ...] = (
         "High-volume binary packets carry a wrong CRC.",
         ("R-5.2-03",),
         rewrite=packet_rewrite(_binary_crc_wrong),
+        needs=("HB",),
     ),
     Fault(
         "binary-crc-big-endian",
         "High-volume binary packets send the CRC high byte first.",
         ("R-5.2-03",),
         rewrite=packet_rewrite(_binary_crc_swapped),
+        needs=("HB",),
     ),
 )
 
@@ -373,6 +385,7 @@ COVERAGE: tuple[Fault, ...] = (
         "Multi-line text ends without the ETX after the last CR LF.",
         ("R-4.4.13.1-01",),
         settings={"etx": False},
+        needs=("XHELP",),
     ),
     Fault(
         "multiline-long-line",
@@ -385,6 +398,7 @@ COVERAGE: tuple[Fault, ...] = (
         "Lines of multi-line text come 200 ms apart (150 ms allowed).",
         ("R-4.4.13.1-03",),
         settings={"line_gap": 0.2},
+        needs=("XHELP",),
     ),
 )
 
@@ -397,5 +411,6 @@ THIRD_PARTY: tuple[Fault, ...] = (
         "carry a CRC too.",
         ("R-4.4.12-03",),
         settings={"metadata_crc_sticks": True},
+        needs=("v1.4",),
     ),
 )
