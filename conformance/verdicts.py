@@ -9,6 +9,9 @@ where a finding comes into being (issue 10):
 
 - a PASS rests on something observed: a finding says how many exchanges, events or
   measurements it judged (``observed``); a PASS over none is INCONCLUSIVE, "nothing to judge";
+- so does a FAIL or a WARN (issue 18): it names at least one observation (``observed >= 1``)
+  and carries at least one evidence line (the escaped wire text it rests on); one without
+  either is INCONCLUSIVE, "nothing under it", saying which was missing;
 - a rule's level caps its verdict: a SHOULD or MAY rule that is broken is a WARN, never a
   FAIL (the catalog's level decides, :func:`conformance.catalog.strongest_verdict`).
 """
@@ -24,6 +27,8 @@ from .catalog import strongest_verdict
 
 #: The reason a PASS without any observation behind it became INCONCLUSIVE.
 NOTHING_TO_JUDGE = "nothing to judge"
+#: The reason a FAIL or WARN without an observation or evidence line became INCONCLUSIVE.
+NOTHING_UNDER_IT = "nothing under it"
 
 
 class Verdict(StrEnum):
@@ -63,7 +68,8 @@ class Finding:
     ``measured_ms``/``limit_ms``/``uncertainty_ms`` are filled by timing judges; ``evidence``
     holds escaped wire text or other short observations; ``decision`` cites a
     requirements.md section 5 decision (``"A13"``) that shaped the verdict. ``observed`` is the
-    number of exchanges, events or measurements the verdict rests on: a PASS needs at least one.
+    number of exchanges, events or measurements the verdict rests on: a PASS needs at least one,
+    and a FAIL or WARN needs at least one and an evidence line.
     """
 
     requirement: str
@@ -85,6 +91,21 @@ class Finding:
         if self.verdict is Verdict.PASS and self.observed < 1:
             self.verdict = Verdict.INCONCLUSIVE
             self.detail = f"{NOTHING_TO_JUDGE}: {self.detail}"
+        if self.verdict in (Verdict.FAIL, Verdict.WARN):
+            missing = [
+                what
+                for what, lacking in (
+                    ("no observation counted", self.observed < 1),
+                    ("no evidence line", not self.evidence),
+                )
+                if lacking
+            ]
+            if missing:
+                self.detail = (
+                    f"{NOTHING_UNDER_IT} ({' and '.join(missing)}): would be "
+                    f"{self.verdict}: {self.detail}"
+                )
+                self.verdict = Verdict.INCONCLUSIVE
         if self.verdict is Verdict.FAIL and strongest_verdict(self.requirement) == "WARN":
             self.verdict = Verdict.WARN
             self.detail += " (a SHOULD/MAY rule: broken, it is a WARN, never a FAIL)"
@@ -101,10 +122,12 @@ def passed(requirement: str, detail: str, *, observed: int, **kw: Any) -> Findin
 
 
 def failed(requirement: str, detail: str, **kw: Any) -> Finding:
+    """A FAIL: pass ``observed`` and ``evidence`` (without them it is INCONCLUSIVE)."""
     return Finding(requirement, Verdict.FAIL, detail, **kw)
 
 
 def warned(requirement: str, detail: str, **kw: Any) -> Finding:
+    """A WARN: pass ``observed`` and ``evidence`` (without them it is INCONCLUSIVE)."""
     return Finding(requirement, Verdict.WARN, detail, **kw)
 
 

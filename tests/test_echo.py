@@ -147,7 +147,7 @@ def test_user_figure_widens_never_narrows():
 def test_combine_local_sets_aside_only_what_irregular_stamps_left_undecided():
     passed = judge_window("R-7.0-10", "start", 10e-3, 1e-3, high=15.4e-3)
     undecided = judge_window("R-7.0-10", "start", 14e-3, 3e-3, high=15.4e-3)
-    failed = judge_window("R-7.0-10", "start", 25e-3, 3e-3, high=15.4e-3)
+    failed = judge_window("R-7.0-10", "start", 25e-3, 3e-3, high=15.4e-3, evidence=["0!"])
     found = combine_local("R-7.0-10", [(passed, False), (undecided, True)], "reply")
     assert found.verdict is Verdict.PASS and "1 reply set aside" in found.detail
     found = combine_local("R-7.0-10", [(passed, False), (failed, True)], "reply", real_time=False)
@@ -161,7 +161,9 @@ def test_combine_local_sets_aside_only_what_irregular_stamps_left_undecided():
 def test_one_isolated_deviation_on_a_real_time_link_is_not_a_fail():
     """A host stall can make one stamp late with no trace; two deviations are a FAIL."""
     passed = judge_window("R-7.0-12", "gap", 0.0, 1e-3, high=1.66e-3, tolerance=0.0)
-    failed = judge_window("R-7.0-12", "gap", 6e-3, 1e-3, high=1.66e-3, tolerance=0.0)
+    failed = judge_window(
+        "R-7.0-12", "gap", 6e-3, 1e-3, high=1.66e-3, tolerance=0.0, evidence=["0I!"]
+    )
     assert failed.verdict is Verdict.FAIL
     lone = combine_local("R-7.0-12", [(passed, False), (failed, False)], "gap")
     assert lone.verdict is Verdict.INCONCLUSIVE and "1 of 2 gaps deviate" in lone.detail
@@ -193,8 +195,10 @@ def test_a_served_line_that_fell_behind_leaves_no_fail_standing():
     played sensors late, a FAIL may be the recorder's right reaction to a late sensor."""
     from conformance.verdicts import Finding
 
-    failed = Finding("R-4.4.8-05", Verdict.FAIL, "stopped reading before every value was in")
-    warned = Finding("R-7.2-02", Verdict.WARN, "retried early")
+    failed = Finding(
+        "R-4.4.8-05", Verdict.FAIL, "stopped reading", observed=1, evidence=["0D0!"]
+    )
+    warned = Finding("R-7.2-02", Verdict.WARN, "retried early", observed=1, evidence=["0M!"])
     passed = Finding("R-7.2-01", Verdict.PASS, "retried", observed=1)
     assert undecide_after_late_line([failed, warned, passed], 7.8e-3, 2e-3) == 2
     assert failed.verdict is warned.verdict is Verdict.INCONCLUSIVE

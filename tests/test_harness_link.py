@@ -365,7 +365,7 @@ def test_fails_recorded_through_a_harness_that_failed_are_not_trusted(misbehavin
     link = open_sensor_harness(port)
     record = CaseRecord("t::x", "x", ("R-4.4.6-02", "R-4.4.1-01"))
     record.findings = [
-        Finding("R-4.4.6-02", Verdict.FAIL, "no service request"),
+        Finding("R-4.4.6-02", Verdict.FAIL, "no service request", observed=1, evidence=["0M!"]),
         Finding("R-4.4.1-01", Verdict.PASS, "a! answered", observed=1),
     ]
     record.summarise()

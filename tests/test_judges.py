@@ -99,13 +99,15 @@ def test_chatter_before_the_service_request_is_not_taken_for_it():
     ],
 )
 def test_timing_window_with_uncertainty(measured, uncertainty, expected):
-    found = judge_window("R-7.0-10", "start", measured, uncertainty, high=15e-3)
+    found = judge_window(
+        "R-7.0-10", "start", measured, uncertainty, high=15e-3, evidence=["reply to 0!"]
+    )
     assert found.verdict is expected
     assert found.uncertainty_ms == pytest.approx(uncertainty * 1e3)
 
 
 def test_should_rule_turns_a_violation_into_warn():
-    found = judge_window("R-4.4.5-09", "x", 5.0, 0.0, high=1.0, should=True)
+    found = judge_window("R-4.4.5-09", "x", 5.0, 0.0, high=1.0, should=True, evidence=["0M!"])
     assert found.verdict is Verdict.WARN
 
 
@@ -167,7 +169,7 @@ def test_aggregation_worst_finding_untestable_and_unjudged():
         ("R-4.4.1-01",),
         findings=[
             Finding("R-4.4.1-01", Verdict.PASS, "ok", observed=1),
-            Finding("R-4.4.1-01", Verdict.WARN, "hm"),
+            Finding("R-4.4.1-01", Verdict.WARN, "hm", observed=1, evidence=["0! -> '0 '"]),
         ],
     )
     results = {r.requirement.id: r for r in aggregate("sensor", [case])}
@@ -179,7 +181,10 @@ def test_aggregation_worst_finding_untestable_and_unjudged():
 
 def test_overall_verdict():
     case = CaseRecord(
-        "t::a", "a", ("R-4.4.1-01",), findings=[Finding("R-4.4.1-01", Verdict.WARN, "hm")]
+        "t::a",
+        "a",
+        ("R-4.4.1-01",),
+        findings=[Finding("R-4.4.1-01", Verdict.WARN, "hm", observed=1, evidence=["0!"])],
     )
     results = aggregate("sensor", [case])
     assert overall(results, strict=False, complete=True) == INCOMPLETE  # others unjudged

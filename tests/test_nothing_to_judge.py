@@ -37,7 +37,7 @@ def test_no_should_or_may_rule_can_fail(rid):
     """Over the whole catalog: a broken SHOULD/MAY rule is at most a WARN, on the finding and
     in the requirement's aggregated verdict; a MUST rule keeps its FAIL."""
     req = catalog()[rid]
-    f = Finding(rid, Verdict.FAIL, "broken")
+    f = Finding(rid, Verdict.FAIL, "broken", observed=1, evidence=["0! -> '(silence)'"])
     record = CaseRecord("t::a", "a", (rid,), findings=[f])
     role = "recorder" if req.role == "recorder" else "sensor"
     verdict = {r.requirement.id: r.verdict for r in aggregate(role, [record])}[rid]

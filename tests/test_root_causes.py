@@ -15,7 +15,8 @@ from conformance.verdicts import Finding, Verdict
 
 
 def result(rid: str, verdict: Verdict, detail: str = "x") -> RequirementResult:
-    return RequirementResult(requirement(rid), verdict, [Finding(rid, verdict, detail)], [])
+    found = Finding(rid, verdict, detail, observed=1, evidence=[detail])
+    return RequirementResult(requirement(rid), verdict, [found], [])
 
 
 def test_a_failed_root_names_itself_in_what_it_drags():

@@ -19,9 +19,19 @@ from ..protocol.responses import (
 )
 from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
-from ..transcript import escape
+from ..transcript import Event, decode_7e1, escape
 
-__all__ = ["ascii_crc", "escape", "events_of", "failed", "passed", "warned"]
+__all__ = [
+    "ascii_crc",
+    "cite",
+    "cited",
+    "escape",
+    "events_of",
+    "failed",
+    "heard",
+    "passed",
+    "warned",
+]
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .measurements import data_reply_ids
 from .tally import Tally
@@ -33,16 +43,37 @@ def shown(ex: Exchange) -> str:
     return f"{escape(ex.text)} -> '{reply}'"
 
 
+def cited(ex: Exchange) -> str:
+    """``t=1.2345 s: 0I! -> '0I13VENDOR..<CR><LF>'``: an evidence line naming the exchange a
+    FAIL or WARN rests on, with the time its command began (issue 18)."""
+    return f"t={ex.start:.4f} s: {shown(ex)}"
+
+
+def cite(exchanges: Iterable[Exchange]) -> list[str]:
+    """Evidence lines for ``exchanges`` (:func:`cited`)."""
+    return [cited(ex) for ex in exchanges]
+
+
+def heard(events: list[Event], what: str) -> str:
+    """``t=1.2345 s: service request '0<CR><LF>'``: an evidence line for characters heard
+    outside any exchange (a service request, stray bytes), with when they began."""
+    start = f"t={events[0].start:.4f} s: " if events else ""
+    return f"{start}{what} '{escape(decode_7e1(events))}'"
+
+
 def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Finding:
     """``a!`` and ``?!``: the reply is the address and CR LF, nothing else."""
     if not ex.answered:
-        return failed(rid, f"{what}: no reply", evidence=[shown(ex)])
+        return failed(rid, f"{what}: no reply", evidence=[cited(ex)], observed=1)
     body, framing = split_line(ex.reply_text)
     problems = [v for v in framing if v.requirement == "R-4.2-03"]
     problems += check_address_reply(body, expected, rid)
     if problems:
         return failed(
-            rid, f"{what}: " + "; ".join(v.message for v in problems), evidence=[shown(ex)]
+            rid,
+            f"{what}: " + "; ".join(v.message for v in problems),
+            evidence=[cited(ex)],
+            observed=1,
         )
     return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)], observed=1)
 
@@ -50,7 +81,9 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
 def identification(ex: Exchange, address: str) -> tuple[Identification | None, list[Finding]]:
     ids = ("R-4.4.2-01", "R-4.4.2-02")
     if not ex.answered:
-        return None, [failed(rid, "aI! got no reply", evidence=[shown(ex)]) for rid in ids]
+        return None, [
+            failed(rid, "aI! got no reply", evidence=[cited(ex)], observed=1) for rid in ids
+        ]
     body, framing = split_line(ex.reply_text)
     ident = parse_ident(body, expected_address=address)
     tally = Tally(ids)
@@ -86,8 +119,9 @@ def silent(
         return make(
             rid,
             f"answered although {why}: " + "; ".join(shown(e) for e in answered[:3]),
-            evidence=[shown(e) for e in answered],
+            evidence=cite(answered),
             decision=decision,
+            observed=len(exchanges),
         )
     if not any(ex.answered for ex in controls):
         return inconclusive(
@@ -177,7 +211,8 @@ def answered(
         return failed(
             rid,
             f"no reply {how}although {why}: " + "; ".join(escape(e.text) for e in missing[:5]),
-            evidence=[shown(e) for e in missing],
+            evidence=cite(missing),
+            observed=len(exchanges),
         )
     return passed(
         rid,

@@ -74,7 +74,8 @@ class Tally:
                         verdict,
                         detail,
                         decision=decision,
-                        evidence=[f"{len(seen)} observation(s)"],
+                        evidence=[*dict.fromkeys(w for w, _ in (hard or bad))][:SHOWN]
+                        + [f"{len(seen)} observation(s)"],
                         observed=len(seen),
                     )
                 )

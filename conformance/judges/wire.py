@@ -156,7 +156,8 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
             f"gap of {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} relies on the ±0.40 ms "
             f"tolerance, which the 1.66 ms character gap does not have ({len(sure)} such "
             "gap(s))",
-            evidence=[where],
+            evidence=[where for _, where in sure[:5]],
+            observed=len(gaps),
             measured_ms=round(gap * 1e3, 3),
             limit_ms=INTER_CHAR_GAP_MAX * 1e3,
             uncertainty_ms=round(uncertainty * 1e3, 3),

@@ -126,7 +126,14 @@ def _timing_flags(command_last: Event, first: Event) -> list[Flag]:
         ("R-7.0-10", None, RESPONSE_START_MAX, "later than 15.40 ms"),
     ):
         finding = judge_window(
-            req, "reply start", delay, u, low=low, high=high, tolerance=TOLERANCE
+            req,
+            "reply start",
+            delay,
+            u,
+            low=low,
+            high=high,
+            tolerance=TOLERANCE,
+            evidence=[f"reply start at t={first.start:.4f} s"],
         )
         if finding.verdict is Verdict.FAIL:
             flags.append(

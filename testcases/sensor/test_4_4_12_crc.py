@@ -96,6 +96,8 @@ def test_crc_variant_same_measurement(sensor, case):
                     f"{a.command} announced {a.count} but {b.command} {b.count}"
                     for a, b in differ[:3]
                 ),
+                evidence=xjudge.cite(x.start for pair in differ for x in pair),
+                observed=len(pairs),
             )
         )
     else:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import measurements as judge
-from conformance.judges.exchanges import shown
+from conformance.judges.exchanges import cite, cited, heard, shown
 from conformance.judges.wire import runs
 from conformance.protocol.responses import split_line
 from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
@@ -36,6 +36,8 @@ def test_measurement_reply(sensor, case):
                     f"{code} is declared with {sensor.declared_count(code)} "
                     "values but announced none",
                     decision="A1",
+                    evidence=[cited(m.start)],
+                    observed=1,
                 )
             )
 
@@ -81,6 +83,8 @@ def test_ttt_zero(sensor, case):
                 "R-4.4.6-03",
                 f"sent '{escape(decode_7e1(quiet))}' after "
                 f"'{escape(start.reply_text)}' announced ttt = 000",
+                evidence=[cited(start), heard(quiet, "then, unasked")],
+                observed=1,
             )
         )
     else:
@@ -95,7 +99,14 @@ def test_ttt_zero(sensor, case):
     if d0.answered and len(body) > 1 and body[1] in "+-":
         case.add(passed("R-4.4.5-03", f"data ready at once: {shown(d0)}", observed=1))
     else:
-        case.add(failed("R-4.4.5-03", f"aD0! right after ttt = 000 gave no values: {shown(d0)}"))
+        case.add(
+            failed(
+                "R-4.4.5-03",
+                f"aD0! right after ttt = 000 gave no values: {shown(d0)}",
+                evidence=[cited(start), cited(d0)],
+                observed=1,
+            )
+        )
 
 
 @pytest.mark.needs('unsolicited')
@@ -141,6 +152,8 @@ def test_data_retained(sensor, case):
                 "R-4.4.5-10",
                 f"D{diff} changed from '{escape(before[diff])}' to "
                 f"'{escape(after[diff]) if diff < len(after) else '(nothing)'}'",
+                evidence=cite(fresh.data[diff : diff + 1] + again[diff : diff + 1]),
+                observed=len(before),
             )
         )
     else:
@@ -200,6 +213,8 @@ def test_break_aborts_measurement(sensor, case):
             failed(
                 "R-4.4.5.1-01",
                 "a service request arrived after the break: the measurement was not aborted",
+                evidence=[cited(start), f"t={brk.start:.4f} s: break", heard(srs[0], "then")],
+                observed=2,  # the undisturbed service request and the one after the break
             )
         )
         case.not_applicable("the measurement was not aborted", ["R-4.4.5.1-02"])
@@ -230,19 +245,30 @@ def test_break_aborts_measurement(sensor, case):
                     "R-4.4.5.1-02",
                     f"D0 after the abort should hold no values: {shown(d0)}",
                     decision="A3",
+                    evidence=[f"t={brk.start:.4f} s: break", cited(d0)],
+                    observed=1,
                 )
             )
     # heard without another break: the first transmission or a retry of the same sequence
     # (a sensor slow to wake after the break is R-7.0-05/07's business, not this rule's)
     unbroken = [a for a in again.start.attempts if a.sequence == 0]
     if not again.start.answered:
-        case.add(failed("R-4.4.5.1-03", f"after the abort {code} got no reply"))
+        case.add(
+            failed(
+                "R-4.4.5.1-03",
+                f"after the abort {code} got no reply",
+                evidence=[f"t={brk2.start:.4f} s: break", cited(again.start)],
+                observed=1,
+            )
+        )
     elif not any(a.reply_events for a in unbroken):
         case.add(
             failed(
                 "R-4.4.5.1-03",
                 f"ignored the {code} sent right after the aborting "
                 "break (it answered only after another break)",
+                evidence=[f"t={brk2.start:.4f} s: break", cited(again.start)],
+                observed=1,
             )
         )
     elif again.value_count < target.value_count:
@@ -251,6 +277,8 @@ def test_break_aborts_measurement(sensor, case):
                 "R-4.4.5.1-03",
                 f"after the abort {code} delivered "
                 f"{again.value_count} values, {target.value_count} before it",
+                evidence=cite([target.start, *target.data, again.start, *again.data]),
+                observed=2,
             )
         )
     else:

@@ -47,7 +47,14 @@ def test_concurrent_supported(sensor, case):
             passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'", observed=1)
         )
     else:
-        case.add(failed("R-4.4.7-08", f"aC! not supported: {xjudge.shown(m.start)}"))
+        case.add(
+            failed(
+                "R-4.4.7-08",
+                f"aC! not supported: {xjudge.shown(m.start)}",
+                evidence=[xjudge.cited(m.start)],
+                observed=1,
+            )
+        )
 
 
 def _running_concurrent(sensor):
@@ -94,6 +101,8 @@ def test_concurrent_survives_break_and_other_traffic(sensor, case):
                 f"{code} delivered {m.value_count} values after a break "
                 f"and {other}I!, {target.value_count} undisturbed (aborted?)",
                 decision="A4",
+                evidence=xjudge.cite([m.start, poke, *m.data]),
+                observed=2,  # the undisturbed measurement and the disturbed one
             )
         )
 
@@ -136,6 +145,8 @@ def test_own_command_aborts_concurrent(sensor, case):
                 "R-4.4.7.1-01",
                 f"{code} still delivered values after {sensor.address}I!: {seen}",
                 decision="A3",
+                evidence=xjudge.cite([m.start, poke, d0]),
+                observed=1,
             )
         )
         case.add(
@@ -143,6 +154,8 @@ def test_own_command_aborts_concurrent(sensor, case):
                 "R-4.4.7.1-02",
                 f"D0 after the interruption should be empty: {seen} "
                 "(the sensor either did not abort or kept its data)",
+                evidence=xjudge.cite([poke, d0]),
+                observed=1,
             )
         )
         return
@@ -168,5 +181,7 @@ def test_own_command_aborts_concurrent(sensor, case):
             warned(
                 "R-4.4.7.1-02",
                 f"after the abort expected 'a[<CRC>]<CR><LF>', got {xjudge.shown(d0)}",
+                evidence=xjudge.cite([poke, d0]),
+                observed=1,
             )
         )

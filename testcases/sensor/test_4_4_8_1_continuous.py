@@ -29,6 +29,8 @@ def test_continuous_replies(sensor, case):
             failed(
                 "R-4.4.8.1-01",
                 "declared to support continuous measurements, but aR0!..aR9! returned no values",
+                evidence=judge.cite(ex for ex, _ in pairs.values()),
+                observed=len(pairs),
             )
         )
 
@@ -59,5 +61,7 @@ def test_continuous_independent(sensor, case):
             failed(
                 "R-4.4.8.1-02",
                 f"R{index} without the lower indices first gave no values: {judge.shown(ex)}",
+                evidence=[judge.cited(ex)],
+                observed=1,
             )
         )

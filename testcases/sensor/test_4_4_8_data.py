@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import measurements as judge
-from conformance.judges.exchanges import shown
+from conformance.judges.exchanges import cite, shown
 from conformance.protocol.responses import (
     parse_data_reply_for,
     parse_measurement_reply_for,
@@ -88,6 +88,8 @@ def test_undefined_group_leaves_no_old_values(sensor, case):
                 "R-4.4.8-03",
                 f"{shown(start)} announced no values, yet {shown(d0)} returned some "
                 f"(the previous {filled.command}'s?)",
+                evidence=cite([start, d0]),
+                observed=1,
             )
         )
     else:

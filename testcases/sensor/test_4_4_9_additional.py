@@ -43,7 +43,14 @@ def _undefined(sensor, codes, rid, expected_tail):
     odd = [m for m in zero if split_line(m.start.reply_text)[0][1:] != expected_tail] + silent
     if odd:
         shown = ", ".join(xjudge.shown(m.start) for m in odd[:3])
-        return [warned(rid, f"undefined group answered {shown}; expected 'a{expected_tail}'")]
+        return [
+            warned(
+                rid,
+                f"undefined group answered {shown}; expected 'a{expected_tail}'",
+                evidence=xjudge.cite(m.start for m in odd),
+                observed=len(zero) + len(silent),
+            )
+        ]
     return [
         passed(
             rid, f"{len(zero)} undefined group(s) answered 'a{expected_tail}'", observed=len(zero)
@@ -75,7 +82,11 @@ def test_verification(sensor, case):
     m = sensor.measurement("V")
     case.evidence("aV!", m)
     if not m.start.answered:
-        case.add(xjudge.failed("R-4.4.11-01", "aV! got no reply"))
+        case.add(
+            xjudge.failed(
+                "R-4.4.11-01", "aV! got no reply", evidence=[xjudge.cited(m.start)], observed=1
+            )
+        )
         return
     ids = [
         "R-4.4.5-01",
@@ -102,6 +113,9 @@ def test_verification(sensor, case):
                 "R-4.4.11-01",
                 "aV! breaks rules aM! keeps: "
                 + "; ".join(f"{rid}: {as_v[rid].detail}" for rid in differ[:3]),
+                evidence=[xjudge.cited(m.start), xjudge.cited(reference.start)]
+                + [line for rid in differ for line in as_v[rid].evidence],
+                observed=2,  # aV! and the aM! it is compared with
             )
         )
     else:

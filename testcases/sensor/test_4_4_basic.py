@@ -90,13 +90,28 @@ def test_change_address(sensor, case):
     problems = check_change_address_reply(body, original, target)
     after = outcome.answered_after
     stayed = old is not None and old.answered
+    request = [judge.cited(outcome.request)]
     if not outcome.request.answered:
-        case.add(failed("R-4.4.4-01", f"{original}A{target}! got no reply ({note})"))
+        case.add(
+            failed(
+                "R-4.4.4-01",
+                f"{original}A{target}! got no reply ({note})",
+                evidence=request,
+                observed=1,
+            )
+        )
     elif problems or not outcome.took:
         msg = "; ".join(v.message for v in problems) or "the sensor kept its old address"
-        case.add(failed("R-4.4.4-01", f"{msg} ({note})"))
+        case.add(failed("R-4.4.4-01", f"{msg} ({note})", evidence=request, observed=1))
     elif after is None and stayed:
-        case.add(failed("R-4.4.4-01", f"replied '{target}' but stayed at '{original}' ({note})"))
+        case.add(
+            failed(
+                "R-4.4.4-01",
+                f"replied '{target}' but stayed at '{original}' ({note})",
+                evidence=request + judge.cite([*outcome.polls[-1:], old]),
+                observed=2,  # the change and the answer at the old address
+            )
+        )
     else:
         reply = judge.escape(outcome.request.reply_text)
         case.add(passed("R-4.4.4-01", f"answered '{reply}'; {note}", observed=1))
@@ -112,6 +127,8 @@ def test_change_address(sensor, case):
                 "R-4.4.4-03",
                 f"never answered at the new address '{target}' within "
                 f"{ADDRESS_CHANGE_QUIET + 3:.0f} s",
+                evidence=request + judge.cite(outcome.polls[-1:]),
+                observed=1 + len(outcome.polls),
             )
         )
         case.not_applicable("no answer at the new address to time", ["R-4.4.4-02"])
@@ -124,6 +141,8 @@ def test_change_address(sensor, case):
                 "the 1 s allowed after a change",
                 measured_ms=after * 1e3,
                 limit_ms=1000.0,
+                evidence=request + judge.cite(outcome.polls[-1:]),
+                observed=1 + len(outcome.polls),
             )
         )
     else:
@@ -138,7 +157,10 @@ def test_change_address(sensor, case):
     if stayed:
         case.add(
             failed(
-                "R-4.4.4-03", f"still answered at the old address '{original}' ({judge.shown(old)})"
+                "R-4.4.4-03",
+                f"still answered at the old address '{original}' ({judge.shown(old)})",
+                evidence=request + [judge.cited(old)],
+                observed=1,
             )
         )
     elif heard is None or not heard.listening:

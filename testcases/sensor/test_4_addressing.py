@@ -75,6 +75,8 @@ def test_wildcard_with_other_commands(sensor, case):
                 "R-4.4.3-02",
                 f"?I! answered '{judge.escape(ex.reply_text)}', unlike "
                 f"aI! '{judge.escape(ident.reply_text)}'",
+                evidence=judge.cite([ex, ident]),
+                observed=2,
             )
         )
 
@@ -92,9 +94,14 @@ def test_factory_address(sensor, case):
             )
         else:
             case.add(inconclusive("R-4.3-02", "nothing answered at address 0 (aI!)"))
-    elif fresh:
+    elif fresh and (own := sensor.exchange("I")).answered:
         case.add(
-            failed("R-4.3-02", f"declared fresh from the factory but at address '{sensor.address}'")
+            failed(
+                "R-4.3-02",
+                f"declared fresh from the factory but at address '{sensor.address}'",
+                evidence=[judge.cited(own)],
+                observed=1,
+            )
         )
     else:
         case.add(
@@ -120,7 +127,15 @@ def test_address_range(sensor, case):
     case.evidence("address sweep", sweep.exchanges)
     refused = sweep.refused
     if refused:
-        case.add(failed("R-4.3-03", "refused or lost address(es) " + ", ".join(refused)))
+        asked = [ex for ex in sweep.exchanges if any(f"A{r}!" in ex.text for r in refused)]
+        case.add(
+            failed(
+                "R-4.3-03",
+                "refused or lost address(es) " + ", ".join(refused),
+                evidence=judge.cite(asked or sweep.exchanges),
+                observed=len(sweep.exchanges),
+            )
+        )
     else:
         case.add(
             passed(
@@ -153,6 +168,8 @@ def test_address_range(sensor, case):
                 "R-4.3-04",
                 "took '$' as its address (decision A17: only 0-9, A-Z, a-z)",
                 decision="A17",
+                evidence=judge.cite(bad.exchanges),
+                observed=len(bad.exchanges),
             )
         )
     else:

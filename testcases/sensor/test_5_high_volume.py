@@ -28,6 +28,8 @@ def _unsupported(case, sensor, code):
             failed(
                 FORMAT_RULE[code],
                 f"declared to support a{code}! but it answered {xjudge.shown(m.start)}",
+                evidence=[xjudge.cited(m.start)],
+                observed=1,
             )
         )
         case.not_applicable(
@@ -55,6 +57,8 @@ def test_high_volume_optional(sensor, case):
                 "R-5.4-02",
                 "without high-volume support expected 'a000000': "
                 + "; ".join(xjudge.shown(e) for e in odd),
+                evidence=xjudge.cite(odd),
+                observed=len(starts),
             )
         )
     else:
@@ -108,9 +112,16 @@ def test_empty_packet_past_data(sensor, case):
     for ex in exchanges:
         packet = parse_binary_packet(ex.reply_bytes, expected_address=sensor.address)
         if not (ex.answered and packet.is_empty and len(ex.reply_bytes) == 6):  # CRC: R-5.2-03
-            bad.append(f"{ex.text} returned '{ex.reply_bytes.hex(' ') or '(nothing)'}'")
+            bad.append((ex, f"{ex.text} returned '{ex.reply_bytes.hex(' ') or '(nothing)'}'"))
     if bad:
-        case.add(failed("R-5.2-06", "; ".join(bad) + ", not the empty packet"))
+        case.add(
+            failed(
+                "R-5.2-06",
+                "; ".join(line for _, line in bad) + ", not the empty packet",
+                evidence=[f"t={ex.start:.4f} s: {line}" for ex, line in bad],
+                observed=len(exchanges),
+            )
+        )
     else:
         case.add(
             passed(
@@ -151,6 +162,8 @@ def test_high_volume_is_concurrent(sensor, case):
                     "R-5.3-01",
                     f"a{code}! delivered {kept.value_count} values after a "
                     f"break and {other}I!, {baseline.value_count} undisturbed",
+                    evidence=xjudge.cite([baseline.start, kept.start, poke1, *kept.data]),
+                    observed=2,  # the undisturbed measurement and the disturbed one
                 )
             )
         elif sensor.hearing_marking() is None:
@@ -174,6 +187,8 @@ def test_high_volume_is_concurrent(sensor, case):
                     "R-5.3-01",
                     f"a{code}! was not aborted by {sensor.address}I! "
                     f"({stopped.value_count} values still delivered)",
+                    evidence=xjudge.cite([stopped.start, poke2, *stopped.data]),
+                    observed=1,
                 )
             )
         else:

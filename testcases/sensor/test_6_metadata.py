@@ -72,6 +72,8 @@ def test_identify_starts_nothing(sensor, case):
             failed(
                 "R-6.1-03",
                 f"sent '{escape(decode_7e1(heard))}' after identify commands (a service request?)",
+                evidence=xjudge.cite(pokes) + [xjudge.heard(heard, "then, unasked")],
+                observed=len(pokes),
             )
         )
     elif [ex.reply_text for ex in fresh.data] != before:
@@ -88,6 +90,8 @@ def test_identify_starts_nothing(sensor, case):
                 "R-6.1-03",
                 "identify commands changed the data: "
                 f"'{escape(''.join(before))}' became '{escape(''.join(after))}'",
+                evidence=xjudge.cite([*control, *pokes, *again]),
+                observed=len(before) + len(after),
             )
         )
     else:

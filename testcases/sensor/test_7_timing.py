@@ -10,6 +10,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import exchanges as judge
+from conformance.judges.timing import not_listening
 from conformance.protocol.timing import (
     BREAK_ALWAYS,
     BREAK_NEVER,
@@ -99,6 +100,8 @@ def test_break_just_over_12ms_wakes(sensor, case):
         sensor.listen(delay)
         tries.append(sensor.master.raw(f"{sensor.address}!", break_first=False))
     case.evidence("12.6 ms break, a! and retries", [brk, *tries])
+    marking = _marking_before(tries[0], brk.end)
+    unheard = not_listening("R-7.0-04", marking, sensor.uncertainty)
     if brk.duration - brk.length_uncertainty <= BREAK_ALWAYS + TOLERANCE:
         case.add(
             inconclusive(
@@ -116,12 +119,17 @@ def test_break_just_over_12ms_wakes(sensor, case):
                 observed=len(tries),
             )
         )
+    elif unheard is not None:  # silence from a sensor that may lawfully be asleep again
+        case.add(unheard)
     else:
         case.add(
             failed(
                 "R-7.0-04",
                 f"no reply to a! or {len(tries) - 1} retries after a "
-                f"{brk.duration * 1e3:.2f} ms break",
+                f"{brk.duration * 1e3:.2f} ms break and {marking * 1e3:.2f} ms of marking",
+                evidence=[f"t={brk.start:.4f} s: {brk.duration * 1e3:.2f} ms break"]
+                + judge.cite(tries),
+                observed=len(tries),
             )
         )
 
@@ -143,6 +151,10 @@ def test_marking_after_break(sensor, case):
             )
         )
         return
+    unheard = not_listening("R-7.0-05", marking, sensor.uncertainty)
+    if unheard is not None and not ok.attempts[0].reply_events:
+        case.add(unheard)  # an unanswered command the sensor need no longer have heard
+        return
     found = judge.answered(
         "R-7.0-05",
         [ok],
@@ -160,6 +172,17 @@ def test_marking_after_break(sensor, case):
                 f"answered a command that began {quick * 1e3:.2f} ms after "
                 "the break, before 8.33 ms of marking",
                 decision="A18",
+                evidence=[judge.cited(soon)],
+                observed=1,
+            )
+        )
+    elif quick - sensor.uncertainty >= MARKING_AFTER_BREAK - TOLERANCE:
+        case.add(  # the early probe landed late: its silence says nothing about decision A18
+            passed(
+                "R-7.0-05",
+                f"answered after {marking * 1e3:.2f} ms of marking (the early command went out "
+                f"{quick * 1e3:.2f} ms after the break, not early: not judged)",
+                observed=1,
             )
         )
     else:
@@ -334,7 +357,13 @@ def test_data_after_service_request_without_break(sensor, case):
     else:
         case.add(
             failed(
-                "R-7.1-02", f"aD0! {gap * 1e3:.2f} ms after the service request, no break: no reply"
+                "R-7.1-02",
+                f"aD0! {gap * 1e3:.2f} ms after the service request, no break: no reply",
+                evidence=[
+                    f"t={m.service_request_end:.4f} s: service request ended",
+                    judge.cited(d0),
+                ],
+                observed=1,
             )
         )
 

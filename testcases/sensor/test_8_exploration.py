@@ -26,6 +26,7 @@ def test_random_command_sequences(sensor, case):
                 run.broken.requirement,
                 run.broken.message,
                 evidence=[f"failing sequence (last steps): {seq}"],
+                observed=max(len(run.exchanges), 1),  # the step that broke it, at least
             )
         )
     # silence to foreign addresses is evidence only from a sensor that answered its own

@@ -62,6 +62,7 @@ def judge_break_rules(line: TranscriptView, uncertainty: float) -> list[Finding]
                         Verdict.FAIL,
                         f"no break before {s.at()}, a new sensor ({who})",
                         evidence=where,
+                        observed=1,
                     )
                 )
             else:

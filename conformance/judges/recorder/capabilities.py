@@ -14,7 +14,7 @@ from ...view.segments import TranscriptView
 from ..reply_validity import STX
 from ..tally import Tally
 from ..timing import judge_window
-from .common import combine
+from .common import combine, record_of
 from .measurements import observed_measurements
 from .replies import first_answered
 
@@ -38,7 +38,14 @@ def judge_commands_issued(
             parts.append("never answered validly: " + ", ".join(escape(t) for t in missing))
         if short:
             parts.append("data not read: " + ", ".join(short))
-        return Finding(rid, Verdict.FAIL, "; ".join(parts))
+        return Finding(
+            rid,
+            Verdict.FAIL,
+            "; ".join(parts),
+            evidence=record_of(line.transmissions, missing)
+            + [m.start.at() for t, m in taken.items() if t in asked and len(m.values()) < m.count],
+            observed=len(line.transmissions),
+        )
     return Finding(
         rid,
         Verdict.PASS,
@@ -52,7 +59,13 @@ def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
     polled = {s.address for s in first_answered(line, uncertainty).values()}
     digits = [a for a in "0123456789" if a not in polled]
     r3 = (
-        Finding("R-4.3-03", Verdict.FAIL, f"addresses never polled successfully: {digits}")
+        Finding(
+            "R-4.3-03",
+            Verdict.FAIL,
+            f"addresses never polled successfully: {digits}",
+            evidence=record_of(line.transmissions, [f"{a}!" for a in digits]),
+            observed=len(line.transmissions),
+        )
         if digits
         else Finding(
             "R-4.3-03",
@@ -66,7 +79,14 @@ def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
     foreign = sorted({s.address for s in commands if s.address not in ADDRESS_CHARS} - {"?"})
     if foreign:  # a MAY rule: the Finding caps this at WARN
         shown = ", ".join(f"'{escape(a)}'" for a in foreign)
-        r4 = Finding("R-4.3-04", Verdict.FAIL, f"addressed {shown}, not an address", decision="A17")
+        r4 = Finding(
+            "R-4.3-04",
+            Verdict.FAIL,
+            f"addressed {shown}, not an address",
+            decision="A17",
+            evidence=[s.at() for s in commands if s.address in foreign][:8],
+            observed=sum(1 for s in commands if s.address in foreign),
+        )
     elif letters:
         r4 = Finding(
             "R-4.3-04",
@@ -163,6 +183,7 @@ def judge_multiline_end(
                         Verdict.WARN,
                         f"relayed {got} of {lines} lines",
                         evidence=where,
+                        observed=1,
                     )
                 )
     return [combine("R-4.4.13.1-04", found, "multi-line text without ETX")]

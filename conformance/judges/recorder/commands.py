@@ -63,6 +63,8 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
             f"1.66 ms character gap does not have ({len(leaning)} such gap(s))",
             measured_ms=round(gap * 1e3, 3),
             limit_ms=INTER_CHAR_GAP_MAX * 1e3,
+            evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in leaning[:5]],
+            observed=len(gaps),
         )
     elif gaps:
         tol = Finding(

@@ -4,7 +4,9 @@ tool's decisions on how long a recorder may take."""
 from __future__ import annotations
 
 from ...protocol.commands import SERVICE_REQUEST_KINDS, Kind
+from ...transcript import escape
 from ...verdicts import Finding
+from ...view.segments import Transmission
 from ..timing import combine as combine_timing
 
 #: A recorder reacts to a service request (or to ttt running out) with aD0! within this long.
@@ -16,6 +18,25 @@ MIN_CONCURRENT_STORE = 20
 #: Measurements that end their wait with a service request (M family, V).
 SR_KINDS = SERVICE_REQUEST_KINDS
 CONCURRENT_KINDS = (Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY)
+
+
+def record_of(transmissions: list[Transmission], texts: list[str] | None = None) -> list[str]:
+    """Evidence for a finding about what the recorder did not do (issue 18): the transmissions
+    of ``texts`` it made (each with its time), or, if it made none of them, the span of what
+    it did transmit, which is the observation the absence rests on."""
+    wanted = set(texts or [])
+    cited = [t.at() for t in transmissions if t.text in wanted]
+    if cited:
+        return cited[:8]
+    if not transmissions:
+        return ["the recorder transmitted nothing"]
+    first, last = transmissions[0], transmissions[-1]
+    sent = sorted({escape(t.text) for t in transmissions})
+    return [
+        f"{len(transmissions)} transmissions from t={first.first_char:.3f} s to "
+        f"t={last.first_char:.3f} s, of {len(sent)} kinds: " + " ".join(sent[:20])
+        + (" ..." if len(sent) > 20 else "")
+    ]
 
 
 def combine(rid: str, findings: list[Finding], what: str) -> Finding:

@@ -123,6 +123,9 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                                 "R-7.2-02",
                                 Verdict.FAIL,
                                 f"no retry without a break after no reply to {a.sent.at()}",
+                                evidence=[a.sent.at()]
+                                + ([f"next: {later.sent.at()}"] if later is not None else []),
+                                observed=1,
                             )
                         )
                 elif follower is not None:
@@ -136,7 +139,11 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
             if len(retries) < 2:
                 third.append(
                     Finding(
-                        "R-7.2-03", Verdict.FAIL, f"{label}: {len(retries)} retries, then no more"
+                        "R-7.2-03",
+                        Verdict.FAIL,
+                        f"{label}: {len(retries)} retries, then no more",
+                        evidence=[a.sent.at() for a in seq],
+                        observed=len(seq),
                     )
                 )
                 continue
