@@ -31,7 +31,26 @@ DRAGS: dict[str, tuple[tuple[str, ...], str]] = {
         ("R-4.0-01", "R-4.4.6-01", "R-4.4.5.1-02", "R-4.4.5.1-03"),
         "a measurement the break did not abort still sends its service request later",
     ),
-    "R-7.0-15": (("R-7.0-14",), "a sensor that never sleeps answers whatever follows"),
+    "R-7.0-15": (
+        ("R-7.0-14", "R-7.0-03"),
+        "a sensor that never sleeps answers whatever follows, a short pulse included",
+    ),
+    "R-4.4.7-02": (("R-4.4.7-08",), "an aC! answered 'a00000' starts no measurement"),
+    # an unknown-command text (issue 18): text where an empty reply or silence is due
+    "R-4.4.8.1-03": (
+        (
+            "R-4.4.5-01",
+            "R-4.4.7-01",
+            "R-4.4.11-01",
+            "R-4.4.8.1-01",
+            "R-4.4.8.1-02",
+            "R-4.4.12-03",
+            "R-4.4.12-05",
+            "R-6.2-06",
+        ),
+        "a sensor that answers what it does not serve with text of its own (such as 'aUNKN')"
+        " gives that text to every command it does not serve",
+    ),
     # recorder role
     "R-7.2-06": (("R-7.0-13",), "a retry that talks over a reply comes apart on the line"),
     "R-7.1-01": (("R-7.0-17",), "a late aD0! without a break is also a command without one"),

@@ -95,3 +95,6 @@ class Behaviour:
     answer_identify_measurement: bool = True
     metadata_invalid_reply: bool = True
     empty_packet: bool = True
+    #: Text (after the address) a faulty firmware sends instead of the empty reply or the
+    #: silence the reference gives a command it does not serve ("" for the reference).
+    unknown_reply: str = ""

@@ -321,6 +321,8 @@ class SensorEmulator:
                     self._multiline(cmd, a, text.split("\n"), at)
                 elif text is not None:
                     self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
+                else:
+                    self._unknown(cmd, at)
             case _:
                 self._start_measurement(cmd, at)
 
@@ -342,6 +344,15 @@ class SensorEmulator:
             self._old_addresses.add(self.address)
             self.address = text[2]
             self._send(Reply(ReplyKind.CHANGE_ADDRESS, text[2]), at)
+
+    def _unknown(self, cmd: Command, at: float) -> bool:
+        """A command the sensor does not serve: a faulty firmware answers it with text of
+        its own (``unknown_reply``) where the reference is silent or empty. True if sent."""
+        text = self.behaviour.unknown_reply
+        if not text:
+            return False
+        self._send(Reply(ReplyKind.CHATTER, cmd.address + text, command=cmd), at)
+        return True
 
     def _multiline(self, cmd: Command, address: str, lines: list[str], at: float) -> None:
         """Multi-line text (4.4.13.1, decision A10): 'a<STX>' before the first line, CR LF
@@ -397,7 +408,7 @@ class SensorEmulator:
     def _start_measurement(self, cmd: Command, at: float) -> None:
         b = self.behaviour
         spec = self.profile.spec_for(cmd)
-        if not self._answers(cmd, spec):
+        if not self._answers(cmd, spec) or (spec is None and self._unknown(cmd, at)):
             return
         sent = self._send(self._start_reply(cmd, cmd, spec, ReplyKind.START), at)
         if sent is None:
@@ -460,6 +471,7 @@ class SensorEmulator:
         high_volume = data.source is not None and data.source.kind is Kind.HIGH_VOLUME_ASCII
         limit = min(data.max_index, b.max_data_index) if high_volume else data.max_index
         if cmd.index > limit:
+            self._unknown(cmd, at)
             return  # D10+ exists only after HA; silence otherwise (decision A12)
         index = cmd.index
         if (
@@ -508,6 +520,8 @@ class SensorEmulator:
             and not (last is not None and last.kind is Kind.CONTINUOUS and last.group == 0)
         ):
             spec = None
+        if spec is None and self._unknown(cmd, at):
+            return
         values = "".join(spec.values) if spec is not None else ""
         reply = Reply(
             ReplyKind.CONTINUOUS, cmd.address + values, command=cmd, source=cmd, crc=cmd.crc

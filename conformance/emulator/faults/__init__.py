@@ -35,7 +35,7 @@ from types import MappingProxyType
 from typing import Any
 
 from ..behaviour import Behaviour
-from . import addressing, high_volume, measurements, metadata, replies, timing
+from . import addressing, firmware_replies, high_volume, measurements, metadata, replies, timing
 from .model import Fault, FaultSet, ProfileTransform, Rewrite
 
 __all__ = ["FAULTS", "Fault", "FaultSet", "ProfileTransform", "Rewrite", "compose"]
@@ -83,6 +83,8 @@ _RUNS: tuple[tuple[Fault, ...], ...] = (
     timing.BOUNDARIES,
     # version specific
     measurements.VERSION_13,
+    # what real firmware answers where the reference is silent (issue 18)
+    firmware_replies.FIRMWARE_REPLIES,
 )
 
 

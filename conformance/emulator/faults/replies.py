@@ -171,8 +171,9 @@ FORMAT: tuple[Fault, ...] = (
     ),
     Fault(
         "concurrent-zero",
-        "aC!/aCC! answer a00000 (no values) for the plain concurrent measurement.",
-        ("R-4.4.7-02",),
+        "aC!/aCC! answer a00000 (no values) for the plain concurrent measurement: no"
+        " measurement, so aC! is not supported either.",
+        ("R-4.4.7-02", "R-4.4.7-08"),
         profile=with_spec("C", lambda s: replace(s, values=(), metadata=(), ttt=0)),
     ),
     Fault(
