@@ -84,9 +84,30 @@ def link(results: Iterable[RequirementResult]) -> list[RequirementResult]:
                     f.consequence_of = root_id
                     f.detail += f" (probably a consequence of {root_id}{anchor}: {why})"
             linked = True
+        linked = _link_preconditions(by_id.values(), root_id, anchor) or linked
         if linked:
             roots.append(root)
+    for r in by_id.values():  # a precondition tied to a root that did not FAIL names none
+        for f in r.findings:
+            if f.verdict is Verdict.INCONCLUSIVE and f.consequence_of != r.consequence_of:
+                f.consequence_of = None
     return roots
+
+
+def _link_preconditions(results: Iterable[RequirementResult], root_id: str, anchor: str) -> bool:
+    """An INCONCLUSIVE whose case named ``root_id`` as the reason its precondition failed
+    (the sensor never shown in standby, say) is linked to that FAILed root too."""
+    linked = False
+    for result in results:
+        if result.verdict is not Verdict.INCONCLUSIVE or result.consequence_of:
+            continue
+        tied = [f for f in result.findings if f.consequence_of == root_id]
+        if tied:
+            result.consequence_of = root_id
+            for f in tied:
+                f.detail += f" (probably a consequence of {root_id}{anchor})"
+            linked = True
+    return linked
 
 
 def reading_order(results: Iterable[RequirementResult]) -> list[RequirementResult]:

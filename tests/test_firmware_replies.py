@@ -59,3 +59,18 @@ def test_a00000_to_ac_is_not_support():
     for rid in ("R-4.4.7-01", "R-4.4.7-03"):
         for f in v[rid]["findings"]:
             assert "0C!," not in f["detail"] and "0CC!," not in f["detail"], rid
+
+
+def test_pulse_needs_a_sensor_shown_in_standby():
+    """Before: a sensor that never sleeps answered after the 5 ms pulse, R-7.0-03 FAIL with
+    no link; the pulse judges only a sensor shown in standby."""
+    v = _verdicts("sim://?faults=never-standby")
+    assert v["R-7.0-15"]["verdict"] == "FAIL"
+    assert v["R-7.0-03"]["verdict"] == "INCONCLUSIVE"
+    assert v["R-7.0-03"]["consequence_of"] == "R-7.0-15"
+    assert "precondition not met" in v["R-7.0-03"]["findings"][0]["detail"]
+
+
+def test_pulse_still_fails_a_sensor_in_standby_that_wakes_on_it():
+    v = _verdicts("sim://?faults=wakes-on-short-spacing")
+    assert v["R-7.0-03"]["verdict"] == "FAIL"

@@ -9,6 +9,15 @@ from .model import Fault
 #: Replies of real firmware to what it does not serve (issue 18).
 FIRMWARE_REPLIES: tuple[Fault, ...] = (
     Fault(
+        "never-standby",
+        "The sensor never drops to standby, neither after 100 ms of marking nor after a"
+        " command for another address: it answers after any marking, a 5 ms pulse included."
+        " The pulse test needs a sensor shown in standby (R-7.0-03: precondition not met).",
+        ("R-7.0-15", "R-7.0-14"),
+        settings={"standby_marking": float("inf"), "standby_after_foreign": False},
+        inconclusive=("R-7.0-03",),
+    ),
+    Fault(
         "unknown-command-text",
         "Every command the sensor does not serve (aR2..aR9!, aRC2..aRC9!, undefined aMn!/aCn!,"
         " an undeclared extended command, aDn! beyond the data) is answered 'aUNKN<CR><LF>'"
