@@ -887,6 +887,35 @@ CHECKS.update(
 )
 
 
+def check_never_standby(rig: Rig) -> None:
+    rig.ask("0!")
+    rig.send("1!")
+    rig.wait(1.0)
+    assert rig.ask("0!", brk=False).text == "0\r\n"
+
+
+def check_unknown_command_text(rig: Rig) -> None:
+    assert rig.ask("0R5!").text == "0UNKN\r\n"
+    assert rig.ask("0M7!").text == "0UNKN\r\n"
+    assert rig.ask("0XNOPE!").text == "0UNKN\r\n"
+
+
+def check_abort_sends_zero_reply(rig: Rig) -> None:
+    rig.ask("0M!")
+    rig.wait(0.5)
+    rig.wake()
+    assert decode_7e1(rig.line(2.0)) == "00000\r\n"
+
+
+CHECKS.update(
+    {
+        "never-standby": check_never_standby,
+        "unknown-command-text": check_unknown_command_text,
+        "abort-sends-zero-reply": check_abort_sends_zero_reply,
+    }
+)
+
+
 def test_every_fault_has_a_check():
     assert set(CHECKS) == set(FAULTS)
     assert len(FAULTS) >= 60

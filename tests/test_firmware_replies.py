@@ -74,3 +74,13 @@ def test_pulse_needs_a_sensor_shown_in_standby():
 def test_pulse_still_fails_a_sensor_in_standby_that_wakes_on_it():
     v = _verdicts("sim://?faults=wakes-on-short-spacing")
     assert v["R-7.0-03"]["verdict"] == "FAIL"
+
+
+def test_text_after_an_abort_is_no_service_request():
+    """Before: '00000' sent unasked after the break FAILed R-4.4.5.1-01 "a service request
+    arrived after the break" (its first '0' read as one); a service request is exactly
+    a<CR><LF>, and the text breaks the rule against sending unasked."""
+    v = _verdicts("sim://?faults=abort-sends-zero-reply")
+    assert v["R-4.4.5.1-01"]["verdict"] == "PASS"
+    assert v["R-4.4.5-08"]["verdict"] == "FAIL"
+    assert any("unasked" in f["detail"] for f in v["R-4.4.5-08"]["findings"])

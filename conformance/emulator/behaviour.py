@@ -68,6 +68,9 @@ class Behaviour:
     break_aborts_measure: bool = True  # R-4.4.5.1-01
     abort_keeps_old_data: bool = False  # True breaks R-4.4.5.1-02 / R-4.4.7.1-02
     deaf_after_abort: bool = False
+    #: Text (after the address) a faulty firmware sends unasked when a measurement a break
+    #: aborted would have been ready ("" for the reference: nothing).
+    abort_reply: str = ""
     break_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
     foreign_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
     command_aborts_concurrent: bool = True  # R-4.4.7.1-01

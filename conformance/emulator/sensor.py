@@ -89,6 +89,7 @@ class SensorEmulator:
         self._last_command: Command | None = None
         self._crc_stuck = False  # only a faulty sensor sets it (metadata_crc_sticks)
         self._replied_last = False  # the last thing on the line was this sensor's own
+        self._report: Transmission | None = None  # only a faulty sensor sets it (abort_reply)
 
     # -- introspection (tests, CLI) ----------------------------------------------------------
     @property
@@ -139,7 +140,10 @@ class SensorEmulator:
         # measurement survives it
         running = self._run is not None
         self._tx.cancel(
-            lambda t: running and t.reply.kind is ReplyKind.SERVICE_REQUEST and t.sent == 0
+            lambda t: (
+                (running and t.reply.kind is ReplyKind.SERVICE_REQUEST and t.sent == 0)
+                or t is self._report
+            )  # what a faulty firmware says of the measurement it aborted
         )
         data = self._data
         if b.clear_on_break_after_read and data is not None and data.fully_read:
@@ -258,6 +262,11 @@ class SensorEmulator:
             self._data = empty_data(run.command)
         if self.behaviour.deaf_after_abort:
             self._deaf = True
+        if self.behaviour.abort_reply:
+            text = run.command.address + self.behaviour.abort_reply
+            self._report = self._send(
+                Reply(ReplyKind.CHATTER, text, source=run.command), run.ready_at
+            )
 
     def _entered_standby(self) -> None:
         data = self._data
@@ -407,6 +416,7 @@ class SensorEmulator:
 
     def _start_measurement(self, cmd: Command, at: float) -> None:
         b = self.behaviour
+        self._tx.cancel(lambda t: not (t.reply.kind is ReplyKind.CHATTER and t.sent == 0))
         spec = self.profile.spec_for(cmd)
         if not self._answers(cmd, spec) or (spec is None and self._unknown(cmd, at)):
             return

@@ -26,4 +26,11 @@ FIRMWARE_REPLIES: tuple[Fault, ...] = (
         ("R-4.4.8.1-03", "R-4.4.5-01", "R-4.4.7-01"),
         settings={"unknown_reply": "UNKN"},
     ),
+    Fault(
+        "abort-sends-zero-reply",
+        "After a break aborts its measurement, the sensor sends 'a0000<CR><LF>' unasked when"
+        " the measurement would have been ready (no service request: the abort itself holds).",
+        ("R-4.4.5-08",),
+        settings={"abort_reply": "0000"},
+    ),
 )
