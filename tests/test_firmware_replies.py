@@ -84,3 +84,28 @@ def test_text_after_an_abort_is_no_service_request():
     assert v["R-4.4.5.1-01"]["verdict"] == "PASS"
     assert v["R-4.4.5-08"]["verdict"] == "FAIL"
     assert any("unasked" in f["detail"] for f in v["R-4.4.5-08"]["findings"])
+
+
+def test_malformed_address_change_is_followed_not_blamed(monkeypatch):
+    """Before: a sensor that took the malformed '0A1M!' as '0A1!' answered '1' and the
+    exploration broke R-4.3-01 ("starts with '1', not the address"); decision A12 makes a
+    reply to a malformed command informative, and the tool follows and undoes the change."""
+    from dataclasses import replace
+
+    from hypothesis import strategies as st
+
+    from conformance.ports import open_sim, parse_sim
+    from conformance.sensor import exploration
+    from conformance.sensor.session import SensorSession
+
+    opened = open_sim(parse_sim("sim"))
+    device = opened.devices[0]
+    device.behaviour = replace(device.behaviour, address_change_ignores_tail=True)
+    session = SensorSession(opened.link, declaration=opened.declaration)
+    session.discover()
+    monkeypatch.setattr(exploration, "JUNK", st.just("A1M"))
+    record = exploration.explore(session, examples=2, steps=4)
+    assert record.broken is None
+    assert any("decision A12" in line for line in record.log)
+    assert device.address == "0"
+    assert any("restored" in note for note in session.address_notes)

@@ -57,6 +57,7 @@ class Behaviour:
     accept_any_new_address: bool = False  # take aA$! too (breaks R-4.3-04, decision A17)
     wildcard_answer: bool = False  # answer ?I! and the like with a bare address (R-4.4.3-02)
     answer_old_address: bool = False
+    address_change_ignores_tail: bool = False  # take aAbX..! as aAb! (real firmware, A12)
     # -- service requests --------------------------------------------------------------------
     service_request: bool = True
     service_request_late: float | None = None  # send it this long after ttt instead

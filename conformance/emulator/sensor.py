@@ -34,6 +34,7 @@ from math import inf
 
 from ..protocol.binary import DataType, encode_values
 from ..protocol.commands import (
+    ADDRESS_CHARS,
     SERVICE_REQUEST_KINDS,
     V14_ONLY_KINDS,
     Command,
@@ -349,6 +350,13 @@ class SensorEmulator:
             and text[0] == self.address
             and text[1] == "A"
             and text[3] == COMMAND_END
+        ) or (
+            b.address_change_ignores_tail
+            and not foreign
+            and len(text) > 4
+            and text[0] == self.address
+            and text[1] == "A"
+            and text[2] in ADDRESS_CHARS
         ):
             self._old_addresses.add(self.address)
             self.address = text[2]
