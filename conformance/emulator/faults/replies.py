@@ -165,8 +165,11 @@ FORMAT: tuple[Fault, ...] = (
     ),
     Fault(
         "concurrent-three-digit-count",
-        "C/CC/Cn replies give a 3-digit count (atttnnn instead of atttnn).",
+        "C/CC/Cn replies give a 3-digit count (atttnnn instead of atttnn)."
+        " No concurrent reply has a readable count, so its bound (R-4.4.7-03) has nothing"
+        " to judge.",
         ("R-4.4.7-01",),
+        inconclusive=("R-4.4.7-03",),
         rewrite=_start_with(2, lambda body: body[:4] + "0" + body[4:]),
     ),
     Fault(
