@@ -31,7 +31,26 @@ DRAGS: dict[str, tuple[tuple[str, ...], str]] = {
         ("R-4.0-01", "R-4.4.6-01", "R-4.4.5.1-02", "R-4.4.5.1-03"),
         "a measurement the break did not abort still sends its service request later",
     ),
-    "R-7.0-15": (("R-7.0-14",), "a sensor that never sleeps answers whatever follows"),
+    "R-7.0-15": (
+        ("R-7.0-14", "R-7.0-03"),
+        "a sensor that never sleeps answers whatever follows, a short pulse included",
+    ),
+    "R-4.4.7-02": (("R-4.4.7-08",), "an aC! answered 'a00000' starts no measurement"),
+    # an unknown-command text (issue 18): text where an empty reply or silence is due
+    "R-4.4.8.1-03": (
+        (
+            "R-4.4.5-01",
+            "R-4.4.7-01",
+            "R-4.4.11-01",
+            "R-4.4.8.1-01",
+            "R-4.4.8.1-02",
+            "R-4.4.12-03",
+            "R-4.4.12-05",
+            "R-6.2-06",
+        ),
+        "a sensor that answers what it does not serve with text of its own (such as 'aUNKN')"
+        " gives that text to every command it does not serve",
+    ),
     # recorder role
     "R-7.2-06": (("R-7.0-13",), "a retry that talks over a reply comes apart on the line"),
     "R-7.1-01": (("R-7.0-17",), "a late aD0! without a break is also a command without one"),
@@ -65,9 +84,30 @@ def link(results: Iterable[RequirementResult]) -> list[RequirementResult]:
                     f.consequence_of = root_id
                     f.detail += f" (probably a consequence of {root_id}{anchor}: {why})"
             linked = True
+        linked = _link_preconditions(by_id.values(), root_id, anchor) or linked
         if linked:
             roots.append(root)
+    for r in by_id.values():  # a precondition tied to a root that did not FAIL names none
+        for f in r.findings:
+            if f.verdict is Verdict.INCONCLUSIVE and f.consequence_of != r.consequence_of:
+                f.consequence_of = None
     return roots
+
+
+def _link_preconditions(results: Iterable[RequirementResult], root_id: str, anchor: str) -> bool:
+    """An INCONCLUSIVE whose case named ``root_id`` as the reason its precondition failed
+    (the sensor never shown in standby, say) is linked to that FAILed root too."""
+    linked = False
+    for result in results:
+        if result.verdict is not Verdict.INCONCLUSIVE or result.consequence_of:
+            continue
+        tied = [f for f in result.findings if f.consequence_of == root_id]
+        if tied:
+            result.consequence_of = root_id
+            for f in tied:
+                f.detail += f" (probably a consequence of {root_id}{anchor})"
+            linked = True
+    return linked
 
 
 def reading_order(results: Iterable[RequirementResult]) -> list[RequirementResult]:

@@ -43,10 +43,7 @@ def rows(request: pytest.FixtureRequest) -> dict[str, MatrixRow]:
 
 #: Faults whose row the judges do not yet get exact, with what goes wrong: strict, so the row
 #: must be taken out of here the moment the judges are fixed (issue 18, part 5).
-AWAITING_JUDGES = {
-    "unknown-command-text": "support read from the aUNKN text: R-4.4.8.1-02, R-4.4.12-03, "
-    "R-4.4.12-05, R-6.2-06 flagged, R-4.4.12-02 (aRC9! answered without a CRC) missed",
-}
+AWAITING_JUDGES: dict[str, str] = {}
 
 
 def _marks(fault: str) -> list[pytest.MarkDecorator]:

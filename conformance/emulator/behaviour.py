@@ -57,6 +57,7 @@ class Behaviour:
     accept_any_new_address: bool = False  # take aA$! too (breaks R-4.3-04, decision A17)
     wildcard_answer: bool = False  # answer ?I! and the like with a bare address (R-4.4.3-02)
     answer_old_address: bool = False
+    address_change_ignores_tail: bool = False  # take aAbX..! as aAb! (real firmware, A12)
     # -- service requests --------------------------------------------------------------------
     service_request: bool = True
     service_request_late: float | None = None  # send it this long after ttt instead
@@ -68,6 +69,9 @@ class Behaviour:
     break_aborts_measure: bool = True  # R-4.4.5.1-01
     abort_keeps_old_data: bool = False  # True breaks R-4.4.5.1-02 / R-4.4.7.1-02
     deaf_after_abort: bool = False
+    #: Text (after the address) a faulty firmware sends unasked when a measurement a break
+    #: aborted would have been ready ("" for the reference: nothing).
+    abort_reply: str = ""
     break_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
     foreign_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
     command_aborts_concurrent: bool = True  # R-4.4.7.1-01
@@ -95,6 +99,6 @@ class Behaviour:
     answer_identify_measurement: bool = True
     metadata_invalid_reply: bool = True
     empty_packet: bool = True
-    # the text (after the address) a faulty sensor answers unknown and unsupported commands
-    # with, such as "UNKN", instead of silence (decision A12) or the unsupported form
-    unknown_reply: str | None = None
+    #: Text (after the address) a faulty firmware sends instead of the empty reply or the
+    #: silence the reference gives a command it does not serve ("" for the reference).
+    unknown_reply: str = ""

@@ -36,6 +36,7 @@ from typing import Any
 
 from ..protocol.binary import DataType, encode_values
 from ..protocol.commands import (
+    ADDRESS_CHARS,
     SERVICE_REQUEST_KINDS,
     V14_ONLY_KINDS,
     Command,
@@ -100,6 +101,7 @@ class SensorEmulator:
         self._last_command: Command | None = None
         self._crc_stuck = False  # only a faulty sensor sets it (metadata_crc_sticks)
         self._replied_last = False  # the last thing on the line was this sensor's own
+        self._report: Transmission | None = None  # only a faulty sensor sets it (abort_reply)
 
     # -- introspection (tests, CLI) ----------------------------------------------------------
     @property
@@ -150,7 +152,10 @@ class SensorEmulator:
         # measurement survives it
         running = self._run is not None
         self._tx.cancel(
-            lambda t: running and t.reply.kind is ReplyKind.SERVICE_REQUEST and t.sent == 0
+            lambda t: (
+                (running and t.reply.kind is ReplyKind.SERVICE_REQUEST and t.sent == 0)
+                or t is self._report
+            )  # what a faulty firmware says of the measurement it aborted
         )
         data = self._data
         if b.clear_on_break_after_read and data is not None and data.fully_read:
@@ -269,6 +274,11 @@ class SensorEmulator:
             self._data = empty_data(run.command)
         if self.behaviour.deaf_after_abort:
             self._deaf = True
+        if self.behaviour.abort_reply:
+            text = run.command.address + self.behaviour.abort_reply
+            self._report = self._send(
+                Reply(ReplyKind.CHATTER, text, source=run.command), run.ready_at
+            )
 
     def _entered_standby(self) -> None:
         data = self._data
@@ -333,17 +343,9 @@ class SensorEmulator:
                 elif text is not None:
                     self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
                 else:
-                    self._unknown(a, at, cmd)
+                    self._unknown(cmd, at)
             case _:
                 self._start_measurement(cmd, at)
-
-    def _unknown(self, address: str, at: float, cmd: Command | None = None) -> bool:
-        """A faulty sensor's text for a command it does not know (True if it sent one)."""
-        text = self.behaviour.unknown_reply
-        if text is None:
-            return False
-        self._send(Reply(ReplyKind.UNKNOWN, address + text, command=cmd), at)
-        return True
 
     def _non_command(self, text: str, end: float, foreign: bool) -> None:
         """What only a faulty sensor does with text that is not a command: take a character
@@ -359,12 +361,26 @@ class SensorEmulator:
             and text[0] == self.address
             and text[1] == "A"
             and text[3] == COMMAND_END
+        ) or (
+            b.address_change_ignores_tail
+            and not foreign
+            and len(text) > 4
+            and text[0] == self.address
+            and text[1] == "A"
+            and text[2] in ADDRESS_CHARS
         ):
             self._old_addresses.add(self.address)
             self.address = text[2]
             self._send(Reply(ReplyKind.CHANGE_ADDRESS, text[2]), at)
-        elif not foreign and text[:1] == self.address:
-            self._unknown(self.address, at)
+
+    def _unknown(self, cmd: Command, at: float) -> bool:
+        """A command the sensor does not serve: a faulty firmware answers it with text of
+        its own (``unknown_reply``) where the reference is silent or empty. True if sent."""
+        text = self.behaviour.unknown_reply
+        if not text:
+            return False
+        self._send(Reply(ReplyKind.CHATTER, cmd.address + text, command=cmd), at)
+        return True
 
     def _multiline(self, cmd: Command, address: str, lines: list[str], at: float) -> None:
         """Multi-line text (4.4.13.1, decision A10): 'a<STX>' before the first line, CR LF
@@ -419,8 +435,9 @@ class SensorEmulator:
 
     def _start_measurement(self, cmd: Command, at: float) -> None:
         b = self.behaviour
+        self._tx.cancel(lambda t: not (t.reply.kind is ReplyKind.CHATTER and t.sent == 0))
         spec = self.profile.spec_for(cmd)
-        if not self._answers(cmd, spec):
+        if not self._answers(cmd, spec) or (spec is None and self._unknown(cmd, at)):
             return
         sent = self._send(self._start_reply(cmd, cmd, spec, ReplyKind.START), at)
         if sent is None:
@@ -483,6 +500,7 @@ class SensorEmulator:
         high_volume = data.source is not None and data.source.kind is Kind.HIGH_VOLUME_ASCII
         limit = min(data.max_index, b.max_data_index) if high_volume else data.max_index
         if cmd.index > limit:
+            self._unknown(cmd, at)
             return  # D10+ exists only after HA; silence otherwise (decision A12)
         index = cmd.index
         if (
@@ -531,7 +549,7 @@ class SensorEmulator:
             and not (last is not None and last.kind is Kind.CONTINUOUS and last.group == 0)
         ):
             spec = None
-        if spec is None and self._unknown(cmd.address, at, cmd):
+        if spec is None and self._unknown(cmd, at):
             return
         values = "".join(spec.values) if spec is not None else ""
         reply = Reply(

@@ -34,6 +34,7 @@ __all__ = [
 ]
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .measurements import data_reply_ids
+from .support import text_instead_of_values
 from .tally import Tally
 
 
@@ -237,6 +238,16 @@ def continuous(
                 tally.fail("R-4.4.8.1-01", label, f"{label} got no reply")
                 continue
             crc = ex.command.crc
+            if text_instead_of_values(ex, crc):
+                # no values and no CRC to judge: only the empty-reply rule speaks
+                unsupported += 1
+                tally.fail(
+                    "R-4.4.8.1-03",
+                    label,
+                    f"unsupported {label} answered '{escape(ex.reply_text)}' (text, not "
+                    f"'a{'<CRC>' if crc else ''}<CR><LF>')",
+                )
+                continue
             body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
             reply = parse_data_reply_for(body, ex.command, expected_address=ex.command.address)
             ids_here = [i for i in data_reply_ids(ex.command) if i != "R-4.4.8-01"]

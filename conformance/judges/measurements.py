@@ -286,6 +286,11 @@ def _reply_ids(m: Measurement) -> list[str]:
     if kind in (Kind.MEASURE, Kind.VERIFY):
         return ["R-4.4.5-01", "R-4.4.5-02", "R-4.2-02", "R-4.2-03"]
     if kind is Kind.CONCURRENT:
+        if not m.count:
+            # no count to bound (R-4.4.7-03); a00000 to plain aC!/aCC! is no answer of the
+            # kind (R-4.4.7-02 judges it), so its format stands for nothing either
+            plain_zero = m.count == 0 and m.command.group == 0
+            return [*([] if plain_zero else ["R-4.4.7-01"]), "R-4.4.7-02", "R-4.2-02", "R-4.2-03"]
         return ["R-4.4.7-01", "R-4.4.7-02", "R-4.4.7-03", "R-4.2-02", "R-4.2-03"]
     if kind is Kind.HIGH_VOLUME_ASCII:
         return ["R-5.1-01", "R-4.2-02", "R-4.2-03"]

@@ -20,11 +20,12 @@ from hypothesis import HealthCheck, Phase, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
 
-from ..protocol.commands import CommandError, Kind, parse_command
+from ..protocol.commands import ADDRESS_CHARS, CommandError, Kind, parse_command
 from ..protocol.crc import is_crc_char
 from ..protocol.responses import parse_data_reply, split_line
 from ..tool_recorder.records import Exchange
 from ..transcript import escape
+from .address_change import AddressChanger
 from .session import SensorSession
 
 #: Commands the exploration sends to the sensor's own address. Any next command aborts a
@@ -160,6 +161,10 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             record.exchanges.append(ex)
             self._note(f"{escape(ex.text)} (malformed?) -> '{escape(ex.reply_text)}'")
             if ex.answered:  # decision A12: silence or any well-framed reply is fine
+                moved = moved_by_malformed(junk, ex.reply_text, address)
+                if moved is not None:
+                    self._follow_address_change(moved)
+                    return
                 self._check_framing(ex)
                 # junk can spell a real command ("M", or "-7!0MC" ending in one): whatever
                 # the sensor accepted may have started a measurement
@@ -174,6 +179,18 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
         def pause(self, seconds: float) -> None:
             sensor.listen(seconds)
             self._note(f"pause {seconds * 1e3:.0f} ms")
+
+        def _follow_address_change(self, moved: str) -> None:
+            """The sensor read the malformed command as ``aAb!`` and now answers at
+            ``moved``: informative under decision A12, not a reply from the wrong address;
+            put it back, so every later step talks to the address it has."""
+            changer = AddressChanger(sensor.master, address)
+            changer.current = moved
+            changer.tried.append(moved)
+            note = changer.restore()
+            record.exchanges += changer.exchanges
+            sensor.address_notes.append(note)
+            self._note(f"taken as a change to address '{moved}' (decision A12); {note}")
 
         def _check_framing(self, ex: Exchange) -> None:
             body, framing = split_line(ex.reply_text)
@@ -238,6 +255,15 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
             raise
         record.broken = broken
     return record
+
+
+def moved_by_malformed(junk: str, reply: str, address: str) -> str | None:
+    """The new address a sensor reports when it took the malformed ``a<junk>!`` as an
+    address change (``0A1M!`` read as ``0A1!``, answered ``1``), else None."""
+    body, _ = split_line(reply)
+    if junk[:1] == "A" and len(body) == 1 and body != address and body in ADDRESS_CHARS:
+        return body if junk[1:2] == body else None
+    return None
 
 
 def _first_broken(exc: BaseException | None) -> InvariantBroken | None:

@@ -7,7 +7,7 @@ import pytest
 from conformance.judges import measurements as judge
 from conformance.judges.exchanges import cite, cited, heard, shown
 from conformance.judges.wire import runs
-from conformance.protocol.responses import split_line
+from conformance.protocol.responses import is_service_request, split_line
 from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed, warned
@@ -42,7 +42,7 @@ def test_measurement_reply(sensor, case):
             )
 
 
-@pytest.mark.needs('unsolicited')
+@pytest.mark.needs("unsolicited")
 @requirements("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")
 def test_service_request(sensor, case):
     """With ttt > 0 the sensor sends 'a<CR><LF>' when data are ready, before ttt runs out, and
@@ -59,7 +59,7 @@ def test_service_request(sensor, case):
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
 
-@pytest.mark.needs('unsolicited')
+@pytest.mark.needs("unsolicited")
 @requirements("R-4.4.6-03", "R-4.4.5-03")
 def test_ttt_zero(sensor, case):
     """With ttt = 000 there is no service request and aD0! returns the data at once."""
@@ -109,7 +109,7 @@ def test_ttt_zero(sensor, case):
         )
 
 
-@pytest.mark.needs('unsolicited')
+@pytest.mark.needs("unsolicited")
 @requirements("R-4.4.6-05")
 def test_no_service_request_after_concurrent(sensor, case):
     """C, CC, Cn, CCn, HA and HB are never followed by a service request."""
@@ -122,7 +122,7 @@ def test_no_service_request_after_concurrent(sensor, case):
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
 
-@pytest.mark.needs('break')
+@pytest.mark.needs("break")
 @requirements("R-4.4.5-10")
 def test_data_retained(sensor, case):
     """Data stay readable, unchanged, across a break, standby and non-measuring commands."""
@@ -166,8 +166,8 @@ def test_data_retained(sensor, case):
         )
 
 
-@pytest.mark.needs('break', 'unsolicited')
-@requirements("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03")
+@pytest.mark.needs("break", "unsolicited")
+@requirements("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03", "R-4.4.5-08")
 def test_break_aborts_measurement(sensor, case):
     """A break before the service request aborts an M measurement; D0 then has no values and
     the sensor takes a new measurement normally."""
@@ -194,11 +194,23 @@ def test_break_aborts_measurement(sensor, case):
         f"{code}, break, wait past ttt, D0; then {code}, break and {code} at once",
         [start, [brk], waited, d0, [brk2], again],
     )
-    srs = [
-        r
-        for r in runs(waited)
-        if decode_7e1(r).startswith(sensor.address) and decode_7e1(r).endswith("\r\n")
-    ]
+    sent = [decode_7e1(r) for r in runs(waited)]
+    # a service request is exactly a<CR><LF> (R-4.4.6-01); other text after the break is
+    # the sensor talking unasked, not a measurement carrying on
+    srs = [t for t in sent if is_service_request(t.removesuffix("\r\n"), sensor.address)]
+    unasked = [t for t in sent if t not in srs]
+    if unasked:
+        case.add(
+            failed(
+                "R-4.4.5-08",
+                f"after the break aborted {code} the sensor sent "
+                + ", ".join(f"'{escape(t)}'" for t in unasked)
+                + " unasked",
+                evidence=[f"'{escape(t)}'" for t in unasked],
+            )
+        )
+    else:
+        case.not_applicable("nothing arrived unasked after the break", ["R-4.4.5-08"])
     if target.service_request_end is None:
         case.add(
             inconclusive(

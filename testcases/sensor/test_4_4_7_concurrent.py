@@ -6,6 +6,7 @@ import pytest
 
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
+from conformance.judges.support import serves_measurement
 from conformance.protocol.responses import split_line
 from conformance.sensor.session import C_FAMILY
 from conformance.verdicts import failed, inconclusive, passed, warned
@@ -23,7 +24,7 @@ def test_concurrent_reply(sensor, case):
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
 
-@pytest.mark.needs('unsolicited')
+@pytest.mark.needs("unsolicited")
 @requirements("R-4.4.7-04")
 def test_quiet_during_concurrent(sensor, case):
     """Between its atttnn reply and the aD0! the sensor sends nothing."""
@@ -42,9 +43,18 @@ def test_concurrent_supported(sensor, case):
     case.expect("a reply to aC! (its format is judged by R-4.4.7-01)")
     m = sensor.measurement("C")
     case.evidence("aC!", m.start)
-    if m.start.answered and m.start.reply_text[:1] == sensor.address:
+    # a malformed reply still answers aC! (R-4.4.7-01 judges its form); a00000 does not
+    tried = serves_measurement(m) or (m.start.answered and m.count is None)
+    if tried and m.start.reply_text[:1] == sensor.address:
         case.add(
             passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'", observed=1)
+        )
+    elif m.start.answered and m.count == 0:
+        case.add(
+            failed(
+                "R-4.4.7-08",
+                f"aC! answered {xjudge.shown(m.start)}: zero values, no measurement started",
+            )
         )
     else:
         case.add(
@@ -62,7 +72,7 @@ def _running_concurrent(sensor):
     return next((m for m in sensor.family(("C", "CC", *C_FAMILY[2:])) if m.ttt and m.count), None)
 
 
-@pytest.mark.needs('break')
+@pytest.mark.needs("break")
 @requirements("R-4.4.7-05")
 def test_concurrent_survives_break_and_other_traffic(sensor, case):
     """A break and a command to another address do not abort a running concurrent
@@ -107,7 +117,7 @@ def test_concurrent_survives_break_and_other_traffic(sensor, case):
         )
 
 
-@pytest.mark.needs('break')
+@pytest.mark.needs("break")
 @requirements("R-4.4.7.1-01", "R-4.4.7.1-02")
 def test_own_command_aborts_concurrent(sensor, case):
     """A valid command to the sensor itself aborts a running concurrent measurement; its D

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import exchanges as judge
-from conformance.protocol.responses import split_line
+from conformance.judges.support import serves_continuous
 from conformance.verdicts import failed, passed
 
 requirements = pytest.mark.requirements
@@ -23,7 +23,7 @@ def test_continuous_replies(sensor, case):
     pairs = continuous_pairs(sensor)
     case.evidence("aR0..aR9!, aRC0..aRC9!", [ex for pair in pairs.values() for ex in pair])
     case.extend(judge.continuous(pairs, case.requirements))
-    served = [i for i, (ex, _) in pairs.items() if len(split_line(ex.reply_text)[0]) > 1]
+    served = [i for i, (ex, _) in pairs.items() if serves_continuous(ex)]
     if sensor.feature("continuous") and not served:
         case.add(
             failed(
@@ -42,7 +42,7 @@ def test_continuous_independent(sensor, case):
     served = [
         i
         for i, (ex, _) in continuous_pairs(sensor).items()
-        if i > 0 and len(split_line(ex.reply_text)[0]) > 1
+        if i > 0 and serves_continuous(ex)
     ]
     if not served:
         case.not_applicable("the sensor serves no continuous index above R0")
@@ -53,8 +53,7 @@ def test_continuous_independent(sensor, case):
     sensor.fresh_exchange("I")
     ex = sensor.fresh_exchange(f"R{index}")
     case.evidence(f"aI! then aR{index}! with no lower R first", [ex])
-    body, _ = split_line(ex.reply_text)
-    if ex.answered and len(body) > 1 and body[1] in "+-":
+    if serves_continuous(ex):
         case.add(passed("R-4.4.8.1-02", f"R{index} alone: {judge.shown(ex)}", observed=1))
     else:
         case.add(

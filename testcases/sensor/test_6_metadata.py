@@ -6,6 +6,7 @@ import pytest
 
 from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata as judge
+from conformance.judges.support import serves_continuous
 from conformance.judges.tally import Tally
 from conformance.protocol.commands import Kind
 from conformance.protocol.responses import split_line
@@ -159,8 +160,7 @@ def test_continuous_metadata(sensor, case):
     evidence = []
     for i in range(10):
         r = sensor.exchange(f"R{i}")
-        served = r.answered and len(r.reply_text.rstrip("\r\n")) > 1
-        if not served:
+        if not serves_continuous(r):
             continue
         body, _ = split_line(r.reply_text)
         values = len(split_values(body[1:]))

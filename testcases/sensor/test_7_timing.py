@@ -60,10 +60,27 @@ def test_short_spacing_is_not_a_break(sensor, case):
     """Spacing shorter than 6.5 ms never wakes a sleeping sensor."""
     case.expect("silence to a command after a 5 ms spacing pulse")
     _asleep(sensor)
+    # precondition: the pulse can only be judged on a sensor shown to be in standby, one
+    # that ignores a command without a break after more than 100 ms of marking
+    check = sensor.master.raw(f"{sensor.address}!", break_first=False)
+    if check.answered:
+        case.evidence("sensor put to sleep, then a! with no break", [check])
+        case.add(
+            inconclusive(
+                "R-7.0-03",
+                "precondition not met: the sensor was not shown in standby (it answered a! "
+                f"without a break after {STANDBY * 1e3:.0f} ms of marking: "
+                f"{judge.shown(check)})",
+                evidence=[judge.shown(check)],
+                consequence_of="R-7.0-15",
+            )
+        )
+        return
     ex = sensor.probe(f"{sensor.address}!", break_s=5e-3)
     pulse = _break_of(sensor, ex)
     case.evidence(
-        "sensor put to sleep, 5 ms pulse, 9 ms marking, a!", [pulse, *judge.events_of(ex)]
+        "sensor put to sleep, a! with no break ignored, 5 ms pulse, 9 ms marking, a!",
+        [*judge.events_of(check), pulse, *judge.events_of(ex)],
     )
     u = max(pulse.length_uncertainty, 0.0)  # a UART-timed pulse's length is known far better
     if pulse.duration + u >= BREAK_NEVER - TOLERANCE:
@@ -272,9 +289,7 @@ def test_standby_after_100ms(sensor, case):
         case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
         if idle - u <= STANDBY_MARKING + TOLERANCE:
             case.add(
-                inconclusive(
-                    "R-7.0-15", f"marking {idle * 1e3:.2f} ms is not surely over 100.4 ms"
-                )
+                inconclusive("R-7.0-15", f"marking {idle * 1e3:.2f} ms is not surely over 100.4 ms")
             )
             return
         probes.append((ex, idle))
@@ -322,6 +337,7 @@ def test_follow_up_without_break(sensor, case):
         last = ex
     shown = " and ".join(f"{idle * 1e3:.2f} ms" for _, idle in probes)
     case.add(judge.answered("R-7.0-16", [ex for ex, _ in probes], f"after {shown} of marking"))
+
 
 @requirements("R-7.1-02")
 def test_data_after_service_request_without_break(sensor, case):

@@ -38,7 +38,7 @@ from types import MappingProxyType
 from typing import Any
 
 from ..behaviour import Behaviour
-from . import addressing, firmware, high_volume, measurements, metadata, replies, timing
+from . import addressing, firmware_replies, high_volume, measurements, metadata, replies, timing
 from .model import CompositionError, Fault, FaultSet, ProfileTransform, Rewrite, clash
 
 __all__ = [
@@ -96,8 +96,8 @@ _RUNS: tuple[tuple[Fault, ...], ...] = (
     timing.BOUNDARIES,
     # version specific
     measurements.VERSION_13,
-    # deviations of real firmware the multi-deviation profiles need (issue 18)
-    firmware.FIRMWARE,
+    # what real firmware answers where the reference is silent (issue 18)
+    firmware_replies.FIRMWARE_REPLIES,
 )
 
 

@@ -166,14 +166,18 @@ FORMAT: tuple[Fault, ...] = (
     ),
     Fault(
         "concurrent-three-digit-count",
-        "C/CC/Cn replies give a 3-digit count (atttnnn instead of atttnn).",
+        "C/CC/Cn replies give a 3-digit count (atttnnn instead of atttnn)."
+        " No concurrent reply has a readable count, so its bound (R-4.4.7-03) has nothing"
+        " to judge.",
         ("R-4.4.7-01",),
+        inconclusive=("R-4.4.7-03",),
         rewrite=_start_with(2, lambda body: body[:4] + "0" + body[4:]),
     ),
     Fault(
         "concurrent-zero",
-        "aC!/aCC! answer a00000 (no values) for the plain concurrent measurement.",
-        ("R-4.4.7-02",),
+        "aC!/aCC! answer a00000 (no values) for the plain concurrent measurement: no"
+        " measurement, so aC! is not supported either.",
+        ("R-4.4.7-02", "R-4.4.7-08"),
         profile=with_spec("C", lambda s: replace(s, values=(), metadata=(), ttt=0)),
         replaces="the values of aC!",
     ),

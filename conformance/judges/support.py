@@ -1,0 +1,57 @@
+"""Whether the sensor serves a command, read from a well-formed answer of that command's
+kind only (issue 18).
+
+Real firmware answers what it does not understand with text of its own (``5UNKN``), and
+some answers ``aC!`` with ``a00000``. Neither is support: a reply longer than the address is
+not yet values, and a start reply that announces nothing starts no measurement. Every case
+that asks "is this served?" asks here, so one error text cannot switch a feature on in one
+case while another calls it unsupported.
+"""
+
+from __future__ import annotations
+
+from ..protocol.responses import split_line
+from ..protocol.values import check_value, split_values
+from ..tool_recorder.records import Exchange, Measurement
+
+SIGNS = "+-"
+
+
+def values_of(ex: Exchange) -> list[str]:
+    """The well-formed values of an R/RC/D reply: the text after the address, without a
+    CRC, cut at the signs; empty when the reply has none or is not values at all."""
+    if not ex.answered:
+        return []
+    body, _ = split_line(ex.reply_text)
+    rest = body[1:]
+    start = next((i for i, c in enumerate(rest) if c in SIGNS), None)
+    if start != 0:
+        return []  # nothing, or text before the first sign: not a values reply
+    end = len(rest)
+    while end > 0 and 0x40 <= ord(rest[end - 1]) <= 0x7F:
+        end -= 1  # a CRC, which values never contain
+    values = split_values(rest[:end])
+    return values if all(not check_value(v) for v in values) else []
+
+
+def serves_continuous(ex: Exchange) -> bool:
+    """An ``aRn!`` is served only when its reply carries at least one well-formed value."""
+    return bool(values_of(ex))
+
+
+def text_instead_of_values(ex: Exchange, crc: bool = False) -> bool:
+    """A reply that is neither values nor the empty form (``a`` or ``a<CRC>``): the text a
+    firmware sends to what it does not serve, on which no value or CRC format can be judged."""
+    if not ex.answered:
+        return False
+    body, _ = split_line(ex.reply_text)
+    rest = body[1:]
+    if not rest or any(c in SIGNS for c in rest):
+        return False
+    return not (crc and len(rest) == 3)
+
+
+def serves_measurement(m: Measurement) -> bool:
+    """A measurement command is served when its start reply is well formed and announces
+    at least one value (``a00000`` to ``aC!`` starts no measurement, R-4.4.7-02)."""
+    return m.start.answered and m.count is not None and m.count > 0 and m.ttt is not None
