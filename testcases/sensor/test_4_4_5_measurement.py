@@ -207,6 +207,7 @@ def test_break_aborts_measurement(sensor, case):
                 + ", ".join(f"'{escape(t)}'" for t in unasked)
                 + " unasked",
                 evidence=[f"'{escape(t)}'" for t in unasked],
+                observed=len(unasked),
             )
         )
     else:

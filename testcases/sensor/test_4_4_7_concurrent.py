@@ -54,6 +54,8 @@ def test_concurrent_supported(sensor, case):
             failed(
                 "R-4.4.7-08",
                 f"aC! answered {xjudge.shown(m.start)}: zero values, no measurement started",
+                evidence=[xjudge.cited(m.start)],
+                observed=1,
             )
         )
     else:
