@@ -36,6 +36,19 @@ class Interaction:
         return self.members <= set(combination)
 
 
-#: No interaction is declared yet: the first measurement (notes/combos-result.md) found the
-#: unexplained rows to be tool defects being fixed, not combinations that change the truth.
-INTERACTIONS: tuple[Interaction, ...] = ()
+#: Only combinations whose truth differs from the union; every other unexplained row of the
+#: measurement (notes/combos-result.md) is a tool defect, listed there, not declared here.
+INTERACTIONS: tuple[Interaction, ...] = (
+    Interaction(
+        frozenset({"no-service-request", "verify-no-service-request"}),
+        "no-service-request already silences aM!'s service request too, so aV! behaves like"
+        " aM! and R-4.4.11-01 holds; the missing request is one deviation, R-4.4.6-02's.",
+        removes=("R-4.4.11-01",),
+    ),
+    Interaction(
+        frozenset({"undefined-group-keeps-data", "undefined-measure-silent"}),
+        "an undefined aMn! gets no answer at all, so no a0000 is ever followed by the stale D0"
+        " values, and the defined groups' counts rightly hold R-4.4.8-03.",
+        removes=("R-4.4.8-03",),
+    ),
+)
