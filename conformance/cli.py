@@ -294,7 +294,18 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
         help="also export each fault's run as a sigrok capture and judge that: a row is exact "
         "only if the capture gives the run's verdicts (about twice the time)",
     )
+    p.add_argument(
+        "--combinations",
+        type=int,
+        metavar="N",
+        help="instead of single faults, run N combinations of faults drawn by a seeded sampler "
+        "(exit 1 if any has a FAIL/WARN outside its members' requirements or a missed FAIL)",
+    )
+    p.add_argument("--size", type=int, choices=(2, 3), default=2, help="faults per combination")
+    p.add_argument("--seed", type=int, help="the sampler's seed (the same list for the same seed)")
     args = p.parse_args(argv)
+    if args.combinations is not None:
+        return _combination_matrix(args, console)
     from rich.table import Table
 
     from .matrix import MatrixRow, fault_matrix
@@ -340,6 +351,47 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     exact = sum(r.exact for r in rows)
     console.print(f"{exact}/{len(rows)} faults caught by exactly their requirements")
     return EXIT_COMPLIANT if exact == len(rows) else EXIT_NON_COMPLIANT
+
+
+def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
+    """``matrix --combinations N``: per combination its unexplained rows, then totals."""
+    from .combinations import DEFAULT_SEED, ComboRow, combination_matrix, sample
+
+    if args.combinations < 1 or args.jobs < 1:
+        error("error: --combinations and --jobs must be 1 or more")
+        return EXIT_USAGE
+    combos = sample(args.combinations, args.size, DEFAULT_SEED if args.seed is None else args.seed)
+    status = make_console(stderr=True)
+
+    def progress(done: int, total: int, row: ComboRow) -> None:
+        status.print(f"[{done}/{total}] {row.explain()}", markup=False, highlight=False)
+
+    status.print(f"running the sensor suite once per combination, {args.jobs} at a time...")
+    rows = combination_matrix(combos, args.jobs, progress)
+    for r in rows:
+        if r.clean:
+            continue
+        console.print(",".join(r.faults), markup=False, highlight=False)
+        for label, found in (
+            ("unexpected", r.unexpected),
+            ("missed FAIL", r.missed),
+            ("ERROR", r.errors),
+        ):
+            for f in found:
+                console.print(
+                    f"  {label}: {f.requirement} {f.verdict}: {f.detail}",
+                    markup=False,
+                    highlight=False,
+                )
+    unexpected = sum(len(r.unexpected) for r in rows)
+    missed = sum(len(r.missed) for r in rows)
+    errors = sum(len(r.errors) for r in rows)
+    clean = sum(r.clean for r in rows)
+    console.print(
+        f"{clean}/{len(rows)} combinations clean; {unexpected} unexpected FAIL/WARN, "
+        f"{missed} missed FAIL, {errors} ERROR"
+    )
+    return EXIT_COMPLIANT if clean == len(rows) else EXIT_NON_COMPLIANT
 
 
 SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor")

@@ -53,6 +53,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "stash",
             "suite",
             "matrix",
+            "combinations",
             "recorder.matrix",
             "calibrate",
             "monitor",

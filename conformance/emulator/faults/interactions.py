@@ -1,0 +1,54 @@
+"""Declared interactions between emulator faults, as data (issue 18, part 7).
+
+A combination of faults is expected to be caught by the union of its members' ``violates``;
+an :class:`Interaction` records where the combination genuinely changes what a correct tool
+must say (one member hides another's deviation, or the two together break a further rule).
+Each entry names its members, what it adds or removes, and why in one sentence. An entry is
+never added to make a combination row pass: only where a correct tool's verdicts differ.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Interaction:
+    """What a set of faults does together that the members alone do not explain."""
+
+    members: frozenset[str]
+    reason: str
+    #: requirements the combination may FAIL/WARN beyond the members' ``violates``
+    adds: tuple[str, ...] = ()
+    #: members' requirements a correct tool may PASS or leave undecided in the combination
+    #: (the deviation is masked; a PASS there is no missed FAIL)
+    removes: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if len(self.members) < 2:
+            raise ValueError("an interaction needs two or more member faults")
+        if not self.reason.strip():
+            raise ValueError(f"interaction {sorted(self.members)} gives no reason")
+        if not (self.adds or self.removes):
+            raise ValueError(f"interaction {sorted(self.members)} changes nothing")
+
+    def applies(self, combination: tuple[str, ...]) -> bool:
+        return self.members <= set(combination)
+
+
+#: Only combinations whose truth differs from the union; every other unexplained row of the
+#: measurement (notes/combos-result.md) is a tool defect, listed there, not declared here.
+INTERACTIONS: tuple[Interaction, ...] = (
+    Interaction(
+        frozenset({"no-service-request", "verify-no-service-request"}),
+        "no-service-request already silences aM!'s service request too, so aV! behaves like"
+        " aM! and R-4.4.11-01 holds; the missing request is one deviation, R-4.4.6-02's.",
+        removes=("R-4.4.11-01",),
+    ),
+    Interaction(
+        frozenset({"undefined-group-keeps-data", "undefined-measure-silent"}),
+        "an undefined aMn! gets no answer at all, so no a0000 is ever followed by the stale D0"
+        " values, and the defined groups' counts rightly hold R-4.4.8-03.",
+        removes=("R-4.4.8-03",),
+    ),
+)
