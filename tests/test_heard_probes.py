@@ -97,3 +97,44 @@ def test_an_answer_to_a_probe_fails_whatever_its_control_did():
     )
     assert finding.verdict is Verdict.FAIL
     assert finding.observed == 1 and finding.evidence
+
+
+# -- partial and hidden devices: only total silence is "no device" (issue 18) ----------------
+def test_a_sensor_that_wakes_only_on_long_breaks_is_judged_with_them():
+    """Before: a sensor that takes only spacing of 30 ms or more as a break got exit 5, "no
+    device answered"; now the tool tries longer breaks and goes on with the one it hears."""
+    _, link, emulator = sim_sensor()
+    emulator.behaviour = replace(emulator.behaviour, break_threshold=25e-3)
+    sensor = SensorSession(link)
+    sensor.discover()
+    assert sensor.master.policy.break_duration == 30e-3
+    assert sensor.identity is not None and sensor.ident_exchange.answered
+    assert any("30 ms" in a for a in sensor.assumptions)
+
+
+def test_a_sensor_that_answers_only_the_query_is_judged_on_what_it_does():
+    """Before: a device answering ?! but not a! or aI! ended the run with exit 5 and nothing
+    judged; now the run goes on (a! unanswered is then its case's FAIL)."""
+    from conformance.emulator.faults import FaultSet
+    from conformance.emulator.replies import ReplyKind
+
+    class Mute(FaultSet):
+        def rewrite(self, reply):  # a! and aI! unanswered, everything else as usual
+            mute = (ReplyKind.ACKNOWLEDGE, ReplyKind.IDENTIFICATION)
+            return None if reply.kind in mute else super().rewrite(reply)
+
+    _, link, emulator = sim_sensor()
+    emulator.faults = Mute(emulator.faults.faults, emulator.behaviour)
+    sensor = SensorSession(link, address="0")
+    sensor.discover()
+    assert sensor.identity is None
+    assert any("?! was answered" in a for a in sensor.assumptions)
+
+
+def test_total_silence_is_still_no_device():
+    from conformance.sensor.session import NoDeviceAnswered
+
+    _, link, emulator = sim_sensor()
+    emulator.behaviour = replace(emulator.behaviour, break_threshold=1.0)
+    with pytest.raises(NoDeviceAnswered, match="100 ms"):
+        SensorSession(link, address="0").discover()
