@@ -15,13 +15,12 @@ Combinations are drawn by a seeded sampler, so a seed names the same list every 
 
 from __future__ import annotations
 
-import multiprocessing
 import random
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from .emulator.faults.interactions import INTERACTIONS, Interaction
-from .matrix import BAD, run_once
+from .matrix import BAD, run_once, run_rows
 
 #: the seed CI and the CLI use unless told otherwise
 DEFAULT_SEED = 18
@@ -158,22 +157,7 @@ def combination_matrix(
 ) -> list[ComboRow]:
     """One row per combination, ``processes`` at a time (spawned workers, like
     :func:`conformance.matrix.fault_matrix`)."""
-    rows: list[ComboRow] = []
-
-    def keep(made: ComboRow) -> None:
-        rows.append(made)
-        if progress is not None:
-            progress(len(rows), len(combinations), made)
-
-    if processes <= 1:
-        for combo in combinations:
-            keep(combo_row(combo))
-        return rows
-    ctx = multiprocessing.get_context("spawn")
-    with ctx.Pool(processes) as pool:
-        for made in pool.imap(combo_row, combinations, chunksize=1):
-            keep(made)
-    return rows
+    return run_rows(combinations, combo_row, processes, progress)
 
 
 #: The CI selection: 27 pairs (seed 18) and 9 triples (seed 19), prefixes of the lists the

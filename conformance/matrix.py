@@ -11,11 +11,15 @@ from __future__ import annotations
 import json
 import multiprocessing
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 from .suite import suite_args
+
+ItemT = TypeVar("ItemT")
+RowT = TypeVar("RowT")
 
 BAD = ("FAIL", "WARN")
 
@@ -166,19 +170,31 @@ def fault_matrix(
         (n, tuple(FAULTS[n].violates), getattr(FAULTS[n], "version", None) or "14", ())
         for n in names
     ]
-    rows: list[MatrixRow] = []
+    return run_rows(items, row, processes, progress)
 
-    def keep(made: MatrixRow) -> None:
+
+def run_rows(
+    items: Sequence[ItemT],
+    make: Callable[[ItemT], RowT],
+    processes: int,
+    progress: Callable[[int, int, RowT], None] | None = None,
+) -> list[RowT]:
+    """``make(item)`` for each item, ``processes`` at a time in spawned workers (each run is
+    a whole pytest session: a fresh process keeps runs apart), in the items' order;
+    ``progress(done, total, row)`` hears of each row as it arrives."""
+    rows: list[RowT] = []
+
+    def keep(made: RowT) -> None:
         rows.append(made)
         if progress is not None:
             progress(len(rows), len(items), made)
 
     if processes <= 1:
         for item in items:
-            keep(row(item))
+            keep(make(item))
         return rows
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(processes) as pool:
-        for made in pool.imap(row, items, chunksize=1):
+        for made in pool.imap(make, items, chunksize=1):
             keep(made)
     return rows

@@ -49,20 +49,15 @@ def test_concurrent_supported(sensor, case):
         case.add(
             passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'", observed=1)
         )
-    elif m.start.answered and m.count == 0:
-        case.add(
-            failed(
-                "R-4.4.7-08",
-                f"aC! answered {xjudge.shown(m.start)}: zero values, no measurement started",
-                evidence=[xjudge.cited(m.start)],
-                observed=1,
-            )
-        )
     else:
+        seen = xjudge.shown(m.start)
+        zero = m.start.answered and m.count == 0
         case.add(
             failed(
                 "R-4.4.7-08",
-                f"aC! not supported: {xjudge.shown(m.start)}",
+                f"aC! answered {seen}: zero values, no measurement started"
+                if zero
+                else f"aC! not supported: {seen}",
                 evidence=[xjudge.cited(m.start)],
                 observed=1,
             )
