@@ -170,6 +170,11 @@ class SensorEmulator:
 
     def on_char(self, wire: int, start: float, end: float) -> None:
         b = self.behaviour
+        report = self._report
+        if report is not None and report.sent == 0:
+            # the firmware reports an aborted measurement only to a line left quiet
+            self._tx.cancel(lambda t: t is not report)
+            self._report = None
         self._settle(start)
         previous = self._last_activity
         heard = self._hear(start)

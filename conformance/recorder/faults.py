@@ -148,9 +148,9 @@ class GappyCommandMaster(GoldenMaster):
     gap = 3e-3
 
     def _transmit(
-        self, wire: bytes, address: str, brk: bool | None, gap: float
+        self, wire: bytes, address: str, brk: bool | None, gap: float, marking: float | None
     ) -> tuple[Event | None, list[Event]]:
-        return super()._transmit(wire, address, brk, max(gap, self.gap))
+        return super()._transmit(wire, address, brk, max(gap, self.gap), marking)
 
 
 class BandGapCommandMaster(GappyCommandMaster):

@@ -194,7 +194,9 @@ def test_break_aborts_measurement(sensor, case):
         f"{code}, break, wait past ttt, D0; then {code}, break and {code} at once",
         [start, [brk], waited, d0, [brk2], again],
     )
-    sent = [decode_7e1(r) for r in runs(waited)]
+    sent_runs = runs(waited)
+    sent = [decode_7e1(r) for r in sent_runs]
+    text_of = dict(zip(sent, sent_runs, strict=True))  # evidence: the events of a text
     # a service request is exactly a<CR><LF> (R-4.4.6-01); other text after the break is
     # the sensor talking unasked, not a measurement carrying on
     srs = [t for t in sent if is_service_request(t.removesuffix("\r\n"), sensor.address)]
@@ -226,7 +228,11 @@ def test_break_aborts_measurement(sensor, case):
             failed(
                 "R-4.4.5.1-01",
                 "a service request arrived after the break: the measurement was not aborted",
-                evidence=[cited(start), f"t={brk.start:.4f} s: break", heard(srs[0], "then")],
+                evidence=[
+                    cited(start),
+                    f"t={brk.start:.4f} s: break",
+                    heard(text_of[srs[0]], "then"),
+                ],
                 observed=2,  # the undisturbed service request and the one after the break
             )
         )

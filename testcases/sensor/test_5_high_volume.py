@@ -199,5 +199,17 @@ def test_high_volume_is_concurrent(sensor, case):
                     observed=2,  # the kept and the stopped measurement
                 )
             )
+    disturbed = any(m.ttt and m.value_count for m in ms)
     if not case.record.findings:
         case.not_applicable("no high-volume measurement with ttt > 0 and values to disturb")
+    elif not disturbed:
+        # the service-request half alone is not the rule: traffic and aborts went unjudged
+        case.add(
+            inconclusive(
+                "R-5.3-01",
+                "no HA/HB measurement with ttt > 0 delivered values, so whether a break, "
+                "other traffic or an own command disturbs one cannot be judged",
+                observed=len(ms),  # the measurements that delivered none: it outweighs the
+                evidence=[xjudge.shown(m.start) for m in ms],  # service-request half's PASS
+            )
+        )

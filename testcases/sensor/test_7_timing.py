@@ -55,26 +55,34 @@ def _asleep(sensor):
     sensor.listen(STANDBY)
 
 
+def _shown_asleep(sensor, case, rid: str):
+    """Put the sensor to sleep and show it: a spacing rule can only be judged on a sensor in
+    standby, one that ignores a command without a break after more than 100 ms of marking.
+    Returns that ignored ``a!``, or None with ``rid`` INCONCLUSIVE "precondition not met"
+    (linked to R-7.0-15, the rule a sensor that never sleeps breaks)."""
+    _asleep(sensor)
+    check = sensor.master.raw(f"{sensor.address}!", break_first=False)
+    if not check.answered:
+        return check
+    case.evidence("sensor put to sleep, then a! with no break", [check])
+    case.add(
+        inconclusive(
+            rid,
+            "precondition not met: the sensor was not shown in standby (it answered a! "
+            f"without a break after {STANDBY * 1e3:.0f} ms of marking: {judge.shown(check)})",
+            evidence=[judge.shown(check)],
+            consequence_of="R-7.0-15",
+        )
+    )
+    return None
+
+
 @requirements("R-7.0-03")
 def test_short_spacing_is_not_a_break(sensor, case):
     """Spacing shorter than 6.5 ms never wakes a sleeping sensor."""
     case.expect("silence to a command after a 5 ms spacing pulse")
-    _asleep(sensor)
-    # precondition: the pulse can only be judged on a sensor shown to be in standby, one
-    # that ignores a command without a break after more than 100 ms of marking
-    check = sensor.master.raw(f"{sensor.address}!", break_first=False)
-    if check.answered:
-        case.evidence("sensor put to sleep, then a! with no break", [check])
-        case.add(
-            inconclusive(
-                "R-7.0-03",
-                "precondition not met: the sensor was not shown in standby (it answered a! "
-                f"without a break after {STANDBY * 1e3:.0f} ms of marking: "
-                f"{judge.shown(check)})",
-                evidence=[judge.shown(check)],
-                consequence_of="R-7.0-15",
-            )
-        )
+    check = _shown_asleep(sensor, case, "R-7.0-03")
+    if check is None:
         return
     ex = sensor.probe(f"{sensor.address}!", break_s=5e-3)
     pulse = _break_of(sensor, ex)
@@ -108,7 +116,9 @@ def test_break_just_over_12ms_wakes(sensor, case):
     (the command is repeated without a break as a recorder's retries would be, so a sensor
     that is merely slow to wake is judged by R-7.0-05/07, not here)."""
     case.expect("a reply to a! or one of its retries after a 12.6 ms break")
-    _asleep(sensor)
+    check = _shown_asleep(sensor, case, "R-7.0-04")
+    if check is None:
+        return
     tries = [sensor.probe(f"{sensor.address}!", break_s=12.6e-3)]
     brk = _break_of(sensor, tries[0])
     for delay in (0.04, 0.06):  # retries 16.67..87 ms apart, the last > 100 ms after the break
@@ -116,7 +126,7 @@ def test_break_just_over_12ms_wakes(sensor, case):
             break
         sensor.listen(delay)
         tries.append(sensor.master.raw(f"{sensor.address}!", break_first=False))
-    case.evidence("12.6 ms break, a! and retries", [brk, *tries])
+    case.evidence("a! with no break ignored, 12.6 ms break, a! and retries", [check, brk, *tries])
     marking = _marking_before(tries[0], brk.end)
     unheard = not_listening("R-7.0-04", marking, sensor.uncertainty)
     if brk.duration - brk.length_uncertainty <= BREAK_ALWAYS + TOLERANCE:

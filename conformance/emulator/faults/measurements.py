@@ -231,11 +231,12 @@ COUNTS: tuple[Fault, ...] = (
     Fault(
         "d0-empty",
         "Completed measurements hold no values: D0 answers 'a<CR><LF>'."
-        " With no values delivered, neither a disturbed concurrent measurement (R-4.4.7-05)"
+        " With no values delivered, neither a disturbed concurrent or high-volume measurement"
+        " (R-4.4.7-05, R-5.3-01)"
         " nor data the identify commands could disturb (R-6.1-03) can be compared.",
         ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
         settings={"drop_all_values": True},
-        inconclusive=("R-4.4.7-05", "R-6.1-03"),
+        inconclusive=("R-4.4.7-05", "R-6.1-03", "R-5.3-01"),
     ),
     Fault(
         "undefined-measure-silent",
