@@ -44,10 +44,6 @@ READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() p
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
 ECHO_WAIT = 0.5  # s: beyond the latency bound, how long a known echo may take to come back
 ECHO_WAIT_AUTO = 0.1  # s: the same while auto has not decided (a silent DUT costs it once)
-#: s: the same for the echo of a UART-timed pulse. The command after it is aimed a few ms
-#: past the pulse: a lost echo must not hold it for ECHO_WAIT (issue 18: 0.5 s, the command
-#: landed 522 ms after the break, when a compliant sensor sleeps again).
-PULSE_ECHO_WAIT = 10e-3
 BURST_MARGIN = 0.5e-3  # s: arrivals this much closer than latency jitter explains are a burst
 RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
 RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release
@@ -495,8 +491,11 @@ class SerialLink(Link):
             pulse.send_nul()
             self._tx_free = start + frame
             precise_sleep_until(self.now, start + frame + pulse.settle)
-            with self._cond:  # the echo (if any) must be in before the rate changes back
-                deadline = start + frame + self.latency_bound() + PULSE_ECHO_WAIT
+            # the echo (if any) must be in before the rate changes back: read at the usual
+            # rate it would be a stray character. A lost echo costs ECHO_WAIT; the probe that
+            # needed the pulse then lands late and is sent again (SensorSession.probe).
+            with self._cond:
+                deadline = start + frame + self.latency_bound() + ECHO_WAIT
                 while self.echo.pending and self.echo.echoes and self.now() < deadline:
                     self._cond.wait(min(deadline - self.now(), READ_POLL))
             pulse.restore()
