@@ -12,8 +12,6 @@ if __name__ == "__main__":  # `python -m conformance.cli`: Ctrl-C is ours before
     _EARLY_GUARD.install()
 
 import argparse
-import datetime as dt
-import json
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -94,10 +92,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def run_suite(args: argparse.Namespace, console: Console) -> int:
+    from . import report_folder
     from .declaration import DeclarationError, load_declaration, normalise_version
-    from .options import UsageError, check_values, cli_values, pytest_args
+    from .options import UsageError, check_values, cli_values
     from .ports import PortError, is_sim, parse_sim
     from .preflight import check_report_dir, check_role_options
+    from .report_folder import new_report_dir
     from .selection import SelectionError, resolve
 
     if args.port is None:
@@ -108,8 +108,6 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             style="bold yellow",
             markup=False,
         )
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-{args.role}")
     try:
         check_role_options(args.role, args.port, args.trigger, args.address)
         check_values(cli_values(args), plugin=False)
@@ -131,11 +129,23 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
             # a port that cannot be opened: a usage error
             open_port(args.port, echo=args.echo, direction=args.direction).link.close()
+        # a folder of this run's own: a new one, or the named one unless a live run holds it
+        report_dir = Path(args.report_dir) if args.report_dir else new_report_dir(args.role)
         check_report_dir(report_dir)
+        report_folder.acquire(report_dir)
     except (DeclarationError, PortError, UsageError, SelectionError) as exc:
         error(f"error: {exc}")
         return EXIT_USAGE
-    from .suite import suite_args
+    try:
+        return _run_pytest(args, report_dir, console)
+    finally:
+        report_folder.release(report_dir)
+
+
+def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) -> int:
+    """The suite in this process; the summary and exit code from its own results."""
+    from .options import pytest_args
+    from .suite import run_in_process, suite_args
 
     argv = suite_args(args.role, args.port, report_dir, terminal=args.verbose)
     argv += pytest_args(args)  # every run option, as the plugin spells it
@@ -149,15 +159,12 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
         plugins.append(ProgressPlugin(console))
 
-    import pytest
-
-    code = pytest.main(argv, plugins=plugins)
+    code, data = run_in_process(argv, plugins)
     interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
-    verdicts = report_dir / "verdicts.json"
-    if interrupted and not verdicts.exists():
+    if interrupted and data is None:
         error("interrupted before the run started; no report written")
         return EXIT_INCOMPLETE
-    if code == 5 and not verdicts.exists():  # pytest: no tests collected (e.g. -k matched none)
+    if code == 5 and data is None:  # pytest: no tests collected (e.g. -k matched none)
         for leftover in ("report.html", "junit.xml"):  # pytest-html's empty page misleads
             (report_dir / leftover).unlink(missing_ok=True)
         error(
@@ -165,16 +172,15 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             "`sdi12-conform list` shows the cases"
         )
         return EXIT_USAGE
-    if not verdicts.exists():
-        error(f"error: the suite did not run (pytest exit {int(code)}); rerun with -v")
-        return EXIT_INTERNAL if int(code) == 3 else EXIT_USAGE
-    data = json.loads(verdicts.read_text(encoding="utf-8"))
+    if data is None:
+        error(f"error: the suite did not run (pytest exit {code}); rerun with -v")
+        return EXIT_INTERNAL if code == 3 else EXIT_USAGE
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))
     if interrupted:
         return EXIT_INCOMPLETE
-    return exit_code(data, int(code))
+    return exit_code(data, code)
 
 
 def cmd_judge(argv: list[str], console: Console) -> int:

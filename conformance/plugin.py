@@ -8,10 +8,11 @@ own; it stays inert in test runs that contain no conformance case.
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import pytest
 
-from . import whole_run
+from . import report_folder, whole_run
 from .case import Case
 from .interrupts import GUARD
 from .links.base import LinkError
@@ -32,6 +33,7 @@ from .verdicts import Finding, Verdict
 
 RUN = pytest.StashKey[ConformanceRun]()
 OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
+LOCKED = pytest.StashKey[Path]()  # the report folder this run holds (report_folder.acquire)
 EXIT_NO_DEVICE = 5
 
 
@@ -209,10 +211,14 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 
 
 def check_reports_writable(config: pytest.Config) -> None:
+    """The report folder is writable and this run's alone (another run still writing there
+    is refused), until :func:`pytest_unconfigure` lets it go."""
     try:
-        check_report_dir(run_of(config).report_dir())
+        path = check_report_dir(run_of(config).report_dir())
+        report_folder.acquire(path)
     except (UsageError, OSError) as exc:
         raise pytest.UsageError(f"--sdi12-report-dir: {exc}") from None
+    config.stash[LOCKED] = path
 
 
 def stable_id(item: pytest.Item) -> str:
@@ -350,6 +356,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
+    locked = config.stash.get(LOCKED, None)
+    if locked is not None:
+        report_folder.release(locked)
     if config.stash.get(OWN_GUARD, False):
         GUARD.uninstall()
         GUARD.reset()

@@ -20,6 +20,7 @@ from .options import run_option_values
 from .ports import is_sim, open_port
 from .recorder.session import RecorderSession, driver_for
 from .replay.recording import options_note
+from .report_folder import new_report_dir
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
 from .sensor.session import SensorSession
@@ -66,6 +67,7 @@ class ConformanceRun:
     results: list[RequirementResult] | None = None
     verdict: str | None = None
     selection: Selection = field(default_factory=Selection)  # -k / --req: a partial run
+    document: dict[str, Any] | None = None  # verdicts.json as written: the CLI reads this
 
     def __post_init__(self) -> None:
         if self.options.declaration:
@@ -185,13 +187,13 @@ class ConformanceRun:
             undecide_after_late_line(case.findings, late, LATE_NOTICE)
 
     def report_dir(self) -> Path:
+        """The run's folder: the one named, or a new one of its own (never another run's)."""
         if self.options.report_dir:
             path = Path(self.options.report_dir)
+            path.mkdir(parents=True, exist_ok=True)
         else:
-            stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-            path = Path("reports") / f"{stamp}-{self.options.role}"
+            path = new_report_dir(self.options.role)
             self.options.report_dir = str(path)
-        path.mkdir(parents=True, exist_ok=True)
         return path
 
     def link_description(self) -> dict[str, Any]:

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import datetime as dt
 import json
 import signal
 import threading
@@ -24,8 +23,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, TYPE_CHECKING
 
+from .. import report_folder
 from ..exits import say_error as error
 from ..links.errors import LinkError, PortError
+from ..options import UsageError
+from ..report_folder import new_report_dir
 from ..transcript import BUS, Event
 from .lines import BusLine, LineTracker
 
@@ -87,13 +89,20 @@ def monitor_main(argv: list[str], console: Console, judge: Judge) -> int:
     if args.duration is not None and not args.duration > 0:
         error(f"error: --duration must be more than 0 s, not {args.duration:g}")
         return EXIT_USAGE
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    report_dir = Path(args.report_dir or Path("reports") / f"{stamp}-monitor")
     try:
+        report_dir = Path(args.report_dir) if args.report_dir else new_report_dir("monitor")
         report_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        error(f"error: cannot use --report-dir {report_dir}: {exc}")
+        report_folder.acquire(report_dir)  # no other run writes here while this one listens
+    except (OSError, UsageError) as exc:
+        error(f"error: cannot use --report-dir {args.report_dir or 'reports/'}: {exc}")
         return EXIT_USAGE
+    try:
+        return _monitor(args, report_dir, console, judge)
+    finally:
+        report_folder.release(report_dir)
+
+
+def _monitor(args: argparse.Namespace, report_dir: Path, console: Console, judge: Judge) -> int:
     from ..links.listen import open_listen_link
 
     try:

@@ -16,7 +16,6 @@ report writing), so the layers keep running one way.
 from __future__ import annotations
 
 import argparse
-import datetime as dt
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -243,8 +242,10 @@ def describe_decode(decoded: CaptureDecode) -> list[str]:
 
 
 def default_report_dir(role: str) -> Path:
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    return Path("reports") / f"{stamp}-{role}"
+    """A new folder of this judging's own (see :func:`conformance.report_folder.new_report_dir`)."""
+    from ..report_folder import new_report_dir
+
+    return new_report_dir(role)
 
 
 def replay_refused(recording: Recording, args: argparse.Namespace) -> str | None:

@@ -11,14 +11,13 @@ the worse of the two codes.
 from __future__ import annotations
 
 import argparse
-import datetime as dt
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..exits import EXIT_COMPLIANT, EXIT_USAGE
 from ..links.errors import PortError
 from ..protocol.commands import Kind
+from ..report_folder import new_report_dir
 from ..suite import suite_args
 from ..transcript import EventKind
 from .recording_link import FORMATS, recording_port
@@ -124,8 +123,7 @@ def judge_passively(argv: list[str], console: Console) -> int:
         error(f"error: {why}")
         return EXIT_USAGE
     roles = ROLES if args.role == "both" else (args.role,)
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    base = Path(args.report_dir or Path("reports") / f"{stamp}-passive")
+    base = Path(args.report_dir) if args.report_dir else new_report_dir("passive")
     console.print(
         f"judging {args.recording} passively: the rules its traffic can show "
         f"({' and '.join(roles)} rules)",
@@ -135,11 +133,13 @@ def judge_passively(argv: list[str], console: Console) -> int:
     codes = []
     for role in roles:
         report_dir = base / role if len(roles) > 1 else base
-        code = _run_role(role, port, report_dir, args, console)
+        code, data = _run_role(role, port, report_dir, args, console)
         codes.append(code)
-        if code in (EXIT_USAGE, EXIT_INTERNAL) and not (report_dir / "verdicts.json").exists():
-            return code
-        data = json.loads((report_dir / "verdicts.json").read_text(encoding="utf-8"))
+        if data is None:  # the role's run wrote no verdicts (its own, never a file's)
+            if code in (EXIT_USAGE, EXIT_INTERNAL):
+                return code
+            error(f"error: the {role} rules were not judged (pytest exit {code})")
+            return EXIT_INTERNAL
         console.print(f"{role} rules:", style="bold", markup=False, highlight=False)
         print_summary(console, data, str(report_dir))
         codes[-1] = exit_code(data, code)
@@ -148,10 +148,11 @@ def judge_passively(argv: list[str], console: Console) -> int:
     return min(codes, key=lambda c: order.index(c) if c in order else -1)
 
 
-def _run_role(role: str, port: str, report_dir: Path, args, console: Console) -> int:
-    import pytest
-
+def _run_role(
+    role: str, port: str, report_dir: Path, args, console: Console
+) -> tuple[int, dict | None]:
     from ..reports.console import ProgressPlugin
+    from ..suite import run_in_process
 
     argv = suite_args(role, port, report_dir)
     argv[argv.index(f"testcases.{role}")] = "testcases.passive"
@@ -161,7 +162,7 @@ def _run_role(role: str, port: str, report_dir: Path, args, console: Console) ->
         argv += ["--sdi12-version", args.sdi_version]
     if args.strict:
         argv.append("--sdi12-strict")
-    return int(pytest.main(argv, plugins=[ProgressPlugin(console)]))
+    return run_in_process(argv, [ProgressPlugin(console)])
 
 
 __all__ = ["EXIT_COMPLIANT", "judge_passively"]

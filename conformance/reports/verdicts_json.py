@@ -119,7 +119,8 @@ def _finding(f: Any) -> dict[str, Any]:
 
 def write(run: ConformanceRun, directory: Path) -> Path:
     path = directory / "verdicts.json"
-    path.write_text(json.dumps(build(run), indent=2, ensure_ascii=False), encoding="utf-8")
+    run.document = build(run)  # what the command line prints and exits on: this run's own
+    path.write_text(json.dumps(run.document, indent=2, ensure_ascii=False), encoding="utf-8")
     if run.link is not None:
         run.link.transcript.write_jsonl(str(directory / "transcript.jsonl"))
     else:
