@@ -51,8 +51,23 @@ def _case_outcome(record: Any) -> tuple[str, str]:
     return verdict, f"{worst.requirement}: {worst.detail}" if worst else ""
 
 
+#: what the bar says while the session fixture finds the device (and a real link measures
+#: its bench): the first case can take a minute there, and a silent bar looks frozen
+SETTING_UP = {
+    "sensor": "finding the sensor, probing the bench",
+    "recorder": "starting the recorder's scenario runner",
+}
+REFRESH_PER_SECOND = 4  # the bar repaints on a timer, so its clock ticks through a slow case
+
+
 class ProgressPlugin:
-    """pytest plugin reporting each case as it finishes (a bus run can take minutes)."""
+    """pytest plugin reporting each case as it finishes (a bus run can take minutes).
+
+    On a terminal the bar is drawn from ``pytest_configure`` on (before the cases are even
+    collected, which takes seconds) and repainted on rich's timer, so its clock ticks and
+    it names what runs: collecting, the device being found, the case being judged. It counts
+    cases; the summary afterwards counts requirements, and each says which.
+    """
 
     def __init__(self, console: Console) -> None:
         self.console = console
@@ -62,24 +77,44 @@ class ProgressPlugin:
         self.total = 0
         self.tally: dict[str, int] = {}
         self.outcomes: dict[str, tuple[str, str]] = {}
+        self.current = ""
+
+    def pytest_configure(self, config: pytest.Config) -> None:
+        if not self.console.is_terminal or self.progress is not None:
+            return
+        self.progress = Progress(
+            TextColumn("[bold]judging"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("cases"),
+            TimeElapsedColumn(),
+            TextColumn("{task.fields[tally]}"),
+            TextColumn("[dim]{task.description}"),
+            console=self.console,
+            transient=True,
+            auto_refresh=True,
+            refresh_per_second=REFRESH_PER_SECOND,
+        )
+        self.progress.start()
+        self.task = self.progress.add_task("collecting the cases", total=None, tally="")
 
     def pytest_collection_finish(self, session: pytest.Session) -> None:
         self.total = len(session.items)
-        if self.console.is_terminal:
-            self.progress = Progress(
-                TextColumn("[bold]judging"),
-                BarColumn(),
-                MofNCompleteColumn(),
-                TimeElapsedColumn(),
-                TextColumn("{task.fields[tally]}"),
-                TextColumn("[dim]{task.description}"),
-                console=self.console,
-                transient=True,
-            )
-            self.progress.start()
-            self.task = self.progress.add_task("", total=self.total, tally="")
+        if self.progress is not None:
+            self.progress.update(self.task, total=self.total, description="")
         else:
             self.console.print(f"running {self.total} conformance cases", highlight=False)
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_fixture_setup(self, fixturedef: Any, request: Any) -> Any:
+        doing = SETTING_UP.get(fixturedef.argname)
+        if doing is None or self.progress is None:
+            return (yield)
+        self.progress.update(self.task, description=f"{self.current}: {doing}")
+        try:
+            return (yield)
+        finally:
+            self.progress.update(self.task, description=self.current)
 
     @pytest.hookimpl(wrapper=True)
     def pytest_runtest_makereport(self, item: pytest.Item, call: pytest.CallInfo) -> Any:
@@ -94,8 +129,9 @@ class ProgressPlugin:
         return report
 
     def pytest_runtest_logstart(self, nodeid: str, location: Any) -> None:
+        self.current = nodeid.split("::")[-1]
         if self.progress is not None:
-            self.progress.update(self.task, description=nodeid.split("::")[-1])
+            self.progress.update(self.task, description=self.current)
 
     def pytest_runtest_logfinish(self, nodeid: str, location: Any) -> None:
         self.done += 1
@@ -121,12 +157,20 @@ class ProgressPlugin:
             )
 
     def _tally_text(self) -> str:
+        """The cases' verdicts so far ("cases: 2 FAIL"), never to be read as requirements."""
         parts = [f"[{STYLE[v]}]{self.tally[v]} {v}[/]" for v in NOTEWORTHY if self.tally.get(v)]
-        return " ".join(parts)
+        return f"(cases: {' '.join(parts)})" if parts else ""
 
     def pytest_sessionfinish(self, session: pytest.Session) -> None:
+        self._stop()
+
+    def pytest_unconfigure(self, config: pytest.Config) -> None:
+        self._stop()  # a usage error ends the run before any session finishes
+
+    def _stop(self) -> None:
         if self.progress is not None:
             self.progress.stop()
+            self.progress = None
 
 
 def _short_repr(report: Any) -> str:
