@@ -270,6 +270,7 @@ def pytest_runtest_call(item: pytest.Item):
     run = run_of(item.config)
     run.cases.append(record)
     started = time.perf_counter()
+    first_event = 0 if whole_run.is_whole_run(item) else _transcript_length(run)
     try:
         result = yield
     except (pytest.skip.Exception, pytest.fail.Exception, pytest.exit.Exception, KeyboardInterrupt):
@@ -292,6 +293,7 @@ def pytest_runtest_call(item: pytest.Item):
         raise
     finally:
         record.duration = time.perf_counter() - started
+        record.window = (first_event, _transcript_length(run))
     verdict = record.summarise()
     if not record.findings:
         _error(record, "case produced no finding (a check that cannot fail is a defect)")
@@ -307,6 +309,10 @@ def pytest_runtest_call(item: pytest.Item):
         reasons = sorted({f.detail for f in record.findings if f.verdict is verdict})
         pytest.skip(f"{verdict}: {'; '.join(reasons)}")
     return result
+
+
+def _transcript_length(run: ConformanceRun) -> int:
+    return len(run.link.transcript) if run.link is not None else 0
 
 
 def _inconclusive(record: CaseRecord, detail: str) -> None:

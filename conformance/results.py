@@ -30,6 +30,9 @@ class CaseRecord:
     evidence: list[tuple[str, list[Event]]] = field(default_factory=list)
     duration: float = 0.0
     verdict: Verdict = Verdict.NA
+    # the transcript events (positions lo..hi-1) the case's run added; a whole-run case's
+    # starts at 0, since it judges all of them (reports.evidence looks exchanges up there)
+    window: tuple[int, int] | None = None
 
     def summarise(self) -> Verdict:
         self.verdict = worst((f.verdict for f in self.findings), default=Verdict.ERROR)

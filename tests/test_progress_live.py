@@ -15,7 +15,7 @@ from conformance.reports.console import ProgressPlugin
 
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
-SLOW_CASES = '''
+SLOW_CASES = """
 import time
 import pytest
 
@@ -29,7 +29,7 @@ def test_first_case(sensor):
 
 def test_slow_case(sensor):
     time.sleep(2.2)  # a case that waits on a slow link
-'''
+"""
 
 
 class Frames:

@@ -27,6 +27,7 @@ from ..transcript import TOOL as TOOL_ORIGIN
 from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
+from .evidence import NEEDS_EVIDENCE, Locator, WireRef
 from .timing_diagram import exchange_behind, timing_svg
 from .verdicts_json import dut_block
 
@@ -71,6 +72,9 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
   padding:4px 6px;overflow-x:auto}
 .sdi12-wire .tool{color:#1565c0}.sdi12-wire .dut{color:#2e7d32}.sdi12-wire .brk{color:#b26a00}
 .sdi12-wire .hdr{color:#777}.sdi12-wire .bad{color:#c62828;font-weight:bold}
+.sdi12-wire .hit{background:#fff3c4;font-weight:bold}
+.sdi12-where{border-left:4px solid #c62828;padding:2px 0 2px 10px;margin:8px 0}
+.sdi12-where.WARN{border-color:#f9a825}.sdi12-where.INCONCLUSIVE{border-color:#8e24aa}
 .sdi12-diagram{overflow-x:auto;margin:4px 0 8px;border:1px solid #eee;background:#fff}
 .sdi12-wire,.sdi12-diagram{max-width:calc(100vw - 70px)}
 #sdi12-top a,.sdi12-case a{color:#1565c0}
@@ -361,8 +365,9 @@ def requirements_table(run: ConformanceRun) -> str:
     )
 
 
-def transcript_html(label: str, events: list[Event]) -> str:
-    """The wire log: one line per break, note or run of characters from one side."""
+def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = frozenset()) -> str:
+    """The wire log: one line per break, note or run of characters from one side; lines
+    holding a ``marked`` event (the exchange a finding rests on) are highlighted with ▶."""
     if not events:
         return f"<p><b>Wire: {escape(label)}</b>: no bus events</p>"
     t0 = events[0].start
@@ -376,6 +381,11 @@ def transcript_html(label: str, events: list[Event]) -> str:
         at = f"{(first.start - t0) * 1e3:9.2f}"
         idle = "" if previous_end is None else f"{(first.start - previous_end) * 1e3:.2f}"
         prefix = f"{at} {idle:>10}  "
+        if marked:
+            hit = any(e in marked for e in group)
+            prefix = ("▶ " if hit else "  ") + prefix
+            if hit:
+                lines.append(None)  # placeholder: the next line gets the highlight
         if first.kind is EventKind.BREAK:
             lines.append(f'<span class="brk">{prefix}BREAK {first.duration * 1e3:.2f} ms</span>')
         elif first.kind is EventKind.NOTE:
@@ -392,8 +402,58 @@ def transcript_html(label: str, events: list[Event]) -> str:
             )
         if first.kind is not EventKind.NOTE:
             previous_end = group[-1].end
-    wire = "\n".join(lines)
+    wire = "\n".join(_highlighted(lines))
     return f'<p><b>Wire: {escape(label)}</b></p><div class="sdi12-wire">{wire}</div>'
+
+
+def _highlighted(lines: list[str | None]) -> list[str]:
+    """The lines with each one after a ``None`` placeholder wrapped as a hit."""
+    out: list[str] = []
+    hit = False
+    for line in lines:
+        if line is None:
+            hit = True
+            continue
+        out.append(f'<span class="hit">{line}</span>' if hit else line)
+        hit = False
+    return out
+
+
+CONTEXT_LINES = 2  # wire lines shown before and after the exchange a finding rests on
+CASE_EXCERPT = 24  # events of a case's whole traffic shown (the rest: transcript.jsonl)
+
+
+def where_html(findings: list[Finding], ref: WireRef, events: list[Event], timing: bool) -> str:
+    """The wire lines around the exchange ``findings`` rest on, with times, that exchange
+    highlighted (and drawn, for a timing case): the FAIL is shown where it happened."""
+    worst = max((f.verdict for f in findings), key=lambda v: v.rank)
+    rids = ", ".join(dict.fromkeys(f.requirement for f in findings))
+    span = events[ref.first : ref.last + 1]
+    if ref.exchange is None:
+        what = "the case's own traffic (no single exchange named or measured)"
+        shown = span[:CASE_EXCERPT]
+        more = len(span) - len(shown)
+        tail = f"; {more} more events in transcript.jsonl" if more > 0 else ""
+        marked: frozenset[Event] = frozenset()
+    else:
+        what = f"the exchange {wire_escape(ref.exchange)} (found by {ref.how})"
+        before = _group(events[max(0, ref.first - 60) : ref.first])[-CONTEXT_LINES:]
+        after = _group(events[ref.last + 1 : ref.last + 61])[:CONTEXT_LINES]
+        shown = [e for g in before for e in g] + span + [e for g in after for e in g]
+        tail = ""
+        marked = frozenset(span)
+    head = (
+        f"<p><b>Where: {escape(rids)} {escape(str(worst))}</b> rests on {escape(what)}: "
+        f"transcript.jsonl events {ref.first}–{ref.last}, t = {ref.start_s:.4f}–"
+        f"{ref.end_s:.4f} s on the link clock{escape(tail)}</p>"
+    )
+    parts = [head]
+    if timing and ref.exchange is not None:
+        svg = timing_svg(span, title=ref.exchange)
+        if svg:
+            parts.append(f'<div class="sdi12-diagram">{svg}</div>')
+    parts.append(transcript_html(f"around {ref.exchange or 'the case'}", shown, marked))
+    return f'<div class="sdi12-where {escape(str(worst))}">{"".join(parts)}</div>'
 
 
 def _group(events: list[Event]) -> list[list[Event]]:
@@ -435,11 +495,17 @@ def _observation(f: Finding) -> str:
     return text
 
 
-def case_html(record: CaseRecord, derived: tuple[str, list[Event]] | None = None) -> str:
+def case_html(
+    record: CaseRecord,
+    derived: tuple[str, list[Event]] | None = None,
+    where: str = "",
+) -> str:
     """One case: what it checks, what a conforming DUT does, what happened, and the wire.
 
     ``derived`` is evidence the report found for a case that attached none (a whole-run
     timing case): the exchange behind its worst measurement, cut from the run's transcript.
+    ``where`` (:func:`where_html`) shows the exchange each FAIL, WARN or INCONCLUSIVE rests
+    on, right under the findings and before any other evidence.
     """
     parts = []
     if record.description:
@@ -455,7 +521,8 @@ def case_html(record: CaseRecord, derived: tuple[str, list[Event]] | None = None
         '<p><b>Observation</b></p><table class="sdi12"><tr><th>Requirement</th><th>Verdict</th>'
         f"<th>Finding</th></tr>{rows}</table>"
     )
-    evidence = list(record.evidence) or ([derived] if derived else [])
+    parts.append(where)
+    evidence = list(record.evidence) or ([derived] if derived and not where else [])
     timing = is_timing_case(record)
     for label, events in evidence:
         if timing:
@@ -473,6 +540,7 @@ class HtmlReportPlugin:
 
     def __init__(self, run: ConformanceRun) -> None:
         self.run = run
+        self._locator: Locator | None = None
 
     def pytest_html_report_title(self, report: Any) -> None:
         report.title = f"SDI-12 conformance report ({self.run.options.role})"
@@ -496,6 +564,22 @@ class HtmlReportPlugin:
         cells.insert(1, f'<td class="col-verdict {verdict_class(verdict)}">{escape(verdict)}</td>')
         cells.insert(2, f"<td>{escape(reqs)}</td>")
 
+    def _where(self, record: CaseRecord) -> str:
+        """Per exchange, the FAIL/WARN/INCONCLUSIVE findings of the case resting on it."""
+        if self.run.link is None:
+            return ""
+        events = self.run.link.transcript.events
+        if self._locator is None or self._locator.events is not events:
+            self._locator = Locator(events)
+        grouped: dict[WireRef, list[Finding]] = {}
+        for f in record.findings:
+            if f.verdict in NEEDS_EVIDENCE:
+                ref = self._locator.locate(f, record)
+                if ref is not None:
+                    grouped.setdefault(ref, []).append(f)
+        timing = is_timing_case(record)
+        return "".join(where_html(fs, ref, events, timing) for ref, fs in grouped.items())
+
     def _derived(self, record: CaseRecord) -> tuple[str, list[Event]] | None:
         """For a timing case without evidence, the run's exchange behind its worst finding."""
         if record.evidence or not is_timing_case(record) or self.run.link is None:
@@ -509,6 +593,6 @@ class HtmlReportPlugin:
         if record is not None and report.when == "call":
             from pytest_html import extras
 
-            html = case_html(record, self._derived(record))
+            html = case_html(record, self._derived(record), self._where(record))
             report.extras = [*getattr(report, "extras", []), extras.html(html)]
         return report

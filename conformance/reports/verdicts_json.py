@@ -12,6 +12,7 @@ from typing import Any
 from ..links.bus_time import bus_time
 from ..results import counts
 from ..run import TOOL, ConformanceRun
+from .evidence import WireRef, wire_refs
 
 SCHEMA = "sdi12-conform/verdicts/1"
 
@@ -57,6 +58,7 @@ def bus_block(run: ConformanceRun) -> dict[str, Any]:
 
 def build(run: ConformanceRun) -> dict[str, Any]:
     results = run.results or []
+    refs = wire_refs(run.cases, run.link.transcript.events) if run.link is not None else {}
     return {
         "schema": SCHEMA,
         "tool": dict(TOOL),
@@ -85,7 +87,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "verdict": str(r.verdict),
                 "selected": r.selected,
                 "tests": r.tests,
-                "findings": [_finding(f) for f in r.findings],
+                "findings": [_finding(f, refs.get(id(f))) for f in r.findings],
                 "consequence_of": r.consequence_of,
             }
             for r in results
@@ -102,7 +104,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
     }
 
 
-def _finding(f: Any) -> dict[str, Any]:
+def _finding(f: Any, wire: WireRef | None = None) -> dict[str, Any]:
     return {
         "test": f.test,
         "verdict": str(f.verdict),
@@ -114,6 +116,8 @@ def _finding(f: Any) -> dict[str, Any]:
         "decision": f.decision,
         "observed": f.observed,
         "consequence_of": f.consequence_of,
+        # FAIL/WARN/INCONCLUSIVE: the exchange it rests on, as transcript.jsonl positions
+        "wire": wire.to_json() if wire is not None else None,
     }
 
 

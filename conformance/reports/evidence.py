@@ -1,0 +1,180 @@
+"""Where on the wire a finding rests: a reference from a FAIL, WARN or INCONCLUSIVE finding to
+the transcript events of the exchange behind it.
+
+A report once showed, beside an R-4.2-03 FAIL on ``0D3!``, the ``?!`` exchange another rule of
+the case had attached, and sent the reader to transcript.jsonl for the rest. So the exchange is
+looked up per finding, from what the finding itself says, in this order of trust:
+
+1. the commands its evidence lines (then its detail) name, e.g. ``reply to 0D3!``;
+2. among those (or, if it names none, among every exchange searched), the one holding an
+   interval equal to the value a timing finding measured;
+3. otherwise the case's own traffic as a whole (an INCONCLUSIVE that no exchange exercised
+   rests on what the case did, all of it).
+
+Exchanges are searched first in the events the case attached, then in the traffic made while
+the case ran, then in the run's traffic up to the case's end (a case may judge a reply the
+session cached from an earlier case). The reference gives the events' positions in the
+transcript (0-based: the lines of transcript.jsonl) and their times on the link clock, so a
+script can cut the same exchange out of transcript.jsonl the report draws.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from ..results import CaseRecord
+from ..transcript import Event, EventKind
+from ..verdicts import Finding, Verdict
+from ..view.runs import Segment, segments
+
+#: the verdicts a reader must be able to check against the wire
+NEEDS_EVIDENCE = (Verdict.FAIL, Verdict.WARN, Verdict.INCONCLUSIVE)
+MEASURE_MATCH_MS = 0.05  # a measured value matches an interval this close (rounding)
+LATER_SHOWN = 40  # characters after a reply kept in an exchange (what the line did next)
+STAMP = re.compile(r"\bt=(\d+(?:\.\d+)?) ?s\b")  # an evidence line's time on the link clock
+COMMAND = re.compile(r"[0-9A-Za-z?]\w*!")  # text naming a command, e.g. "reply to 0D3!"
+
+
+@dataclass(frozen=True)
+class WireRef:
+    """Transcript events ``first..last`` (inclusive), from ``start_s`` to ``end_s``."""
+
+    first: int
+    last: int
+    start_s: float
+    end_s: float
+    exchange: str | None  # the command of the exchange; None: the case's traffic as a whole
+    how: str  # "command", "measured", "command and measured" or "case"
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "transcript_events": [self.first, self.last],
+            "start_s": round(self.start_s, 6),
+            "end_s": round(self.end_s, 6),
+            "exchange": self.exchange,
+            "located_by": self.how,
+        }
+
+
+def _named(command: str, text: str) -> bool:
+    """Whether ``text`` names ``command`` as a whole (``0M!`` is not in ``10M!``)."""
+    at = text.find(command)
+    while at >= 0:
+        if at == 0 or not text[at - 1].isalnum():
+            return True
+        at = text.find(command, at + 1)
+    return False
+
+
+def _distance(seg: Segment, t: float) -> float:
+    """How far (s) the instant ``t`` lies outside the exchange ``seg`` (0: within it)."""
+    events = _exchange_events(seg)
+    start, end = min(e.start for e in events), max(e.end for e in events)
+    return max(start - t, t - end, 0.0)
+
+
+def _measures(seg: Segment) -> list[float]:
+    from .timing_diagram import _measures as measures
+
+    return measures(seg)
+
+
+def _exchange_events(seg: Segment) -> list[Event]:
+    found = [seg.break_event] if seg.break_event else []
+    return found + seg.contention + seg.command + seg.reply + seg.later[:LATER_SHOWN]
+
+
+class Locator:
+    """Finds the exchange behind each finding in one run's transcript ``events`` (a list the
+    link may still be appending to: positions are indexed as it grows)."""
+
+    def __init__(self, events: Sequence[Event]) -> None:
+        self.events = events
+        self.position: dict[Event, int] = {}
+        self._indexed = 0
+        self._cuts: dict[tuple[int, int], list[Segment]] = {}
+
+    def _index(self) -> None:
+        for i in range(self._indexed, len(self.events)):
+            self.position.setdefault(self.events[i], i)
+        self._indexed = len(self.events)
+
+    def _segments(self, lo: int, hi: int) -> list[Segment]:
+        """The exchanges among events ``lo..hi-1`` (cut once per range: a whole run's cut
+        takes a fifth of a second)."""
+        key = (lo, hi)
+        if key not in self._cuts:
+            if len(self._cuts) > 64:
+                self._cuts.clear()
+            self._cuts[key] = [s for s in segments(self.events[lo:hi]) if s.command]
+        return self._cuts[key]
+
+    def _ref(self, events: Sequence[Event], exchange: str | None, how: str) -> WireRef | None:
+        placed = sorted(self.position[e] for e in events if e in self.position)
+        wire = [self.events[i] for i in placed if self.events[i].kind is not EventKind.NOTE]
+        if not wire:
+            return None
+        return WireRef(
+            placed[0], placed[-1], min(e.start for e in wire), max(e.end for e in wire),
+            exchange, how,
+        )  # fmt: skip
+
+    def _pick(self, finding: Finding, segs: list[Segment]) -> tuple[Segment, str] | None:
+        lines = [*finding.evidence, finding.detail]
+        named: list[Segment] = []
+        for line in lines:  # the evidence lines' commands first, in their order
+            seen = {id(n) for n in named}
+            named += [s for s in segs if s.text and _named(s.text, line) and id(s) not in seen]
+        stamps = [float(t) for line in lines for t in STAMP.findall(line)]
+        if stamps and named:  # "reply to ?! at t=0.0387 s": the one nearest that time first
+            named.sort(key=lambda s: min(_distance(s, t) for t in stamps))
+        if finding.measured_ms is not None:
+            pool = named or segs
+            scored = [
+                (min(abs(m - finding.measured_ms) for m in _measures(s)), s)
+                for s in pool
+                if _measures(s)
+            ]
+            if scored:
+                distance, best = min(scored, key=lambda p: p[0])
+                if distance <= MEASURE_MATCH_MS:
+                    return best, "command and measured" if named else "measured"
+        return (named[0], "command") if named else None
+
+    def locate(self, finding: Finding, record: CaseRecord) -> WireRef | None:
+        """The exchange ``finding`` (of ``record``'s case) rests on, or None (no wire)."""
+        self._index()
+        lo, hi = record.window if record.window else (0, len(self.events))
+        attached = sorted(
+            {self.position[e] for _, evs in record.evidence for e in evs if e in self.position}
+        )
+        pools = []
+        if attached:
+            pools.append((attached[0], attached[-1] + 1))
+        pools.append((lo, hi))
+        if lo > 0 and COMMAND.search(" ".join([*finding.evidence, finding.detail])):
+            pools.append((0, hi))  # a reply the session cached from an earlier case
+        for a, b in pools:
+            found = self._pick(finding, self._segments(a, b))
+            if found:
+                seg, how = found
+                return self._ref(_exchange_events(seg), seg.text, how)
+        # no exchange named or measured: the case's own traffic (none known: no reference)
+        own = self.events[lo:hi] if record.window else []
+        return self._ref(own or [self.events[i] for i in attached], None, "case")
+
+
+def wire_refs(cases: Sequence[CaseRecord], events: Sequence[Event]) -> dict[int, WireRef]:
+    """``id(finding)`` -> its reference, for every finding that needs evidence."""
+    locator = Locator(events)
+    found: dict[int, WireRef] = {}
+    for record in cases:
+        for f in record.findings:
+            if f.verdict in NEEDS_EVIDENCE:
+                ref = locator.locate(f, record)
+                if ref is not None:
+                    found[id(f)] = ref
+    return found
