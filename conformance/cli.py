@@ -145,7 +145,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) -> int:
     """The suite in this process; the summary and exit code from its own results."""
     from .options import pytest_args
-    from .suite import run_in_process, suite_args
+    from .plugin import run_in_process
+    from .suite import suite_args
 
     argv = suite_args(args.role, args.port, report_dir, terminal=args.verbose)
     argv += pytest_args(args)  # every run option, as the plugin spells it

@@ -368,3 +368,22 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     if config.stash.get(OWN_GUARD, False):
         GUARD.uninstall()
         GUARD.reset()
+
+
+class _RunOf:
+    """A pytest plugin that keeps hold of the run the conformance plugin made, so the caller
+    reads the verdicts from memory (a file on disk could be another run's)."""
+
+    def __init__(self) -> None:
+        self.run = None
+
+    def pytest_configure(self, config: pytest.Config) -> None:
+        self.run = config.stash.get(RUN, None)
+
+
+def run_in_process(argv: list[str], plugins: list[object] | None = None) -> tuple[int, dict | None]:
+    """``pytest.main(argv)`` in this process: its exit status and the run's verdicts.json
+    document as it was written (None: the run wrote none, e.g. a usage error)."""
+    held = _RunOf()
+    code = int(pytest.main(argv, plugins=[*(plugins or []), held]))
+    return code, getattr(held.run, "document", None)

@@ -55,26 +55,3 @@ def suite_args(
     if not terminal:
         args += ["-p", "no:terminal"]
     return args
-
-
-class _RunOf:
-    """A pytest plugin that keeps hold of the run the conformance plugin made, so the caller
-    reads the verdicts from memory (a file on disk could be another run's)."""
-
-    def __init__(self) -> None:
-        self.run = None
-
-    def pytest_configure(self, config) -> None:  # noqa: ANN001 - pytest.Config, lazily
-        from .plugin import RUN
-
-        self.run = config.stash.get(RUN, None)
-
-
-def run_in_process(argv: list[str], plugins: list[object] = ()) -> tuple[int, dict | None]:
-    """``pytest.main(argv)`` in this process: its exit status and the run's verdicts.json
-    document as it was written (None: the run wrote none, e.g. a usage error)."""
-    import pytest
-
-    held = _RunOf()
-    code = int(pytest.main(argv, plugins=[*plugins, held]))
-    return code, getattr(held.run, "document", None)

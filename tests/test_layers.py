@@ -58,6 +58,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "calibrate",
             "monitor",
             "whole_run",
+            "report_folder",
         ),
     ),
     # what a run is rendered as: console, HTML, verdicts.json

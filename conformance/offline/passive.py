@@ -151,8 +151,8 @@ def judge_passively(argv: list[str], console: Console) -> int:
 def _run_role(
     role: str, port: str, report_dir: Path, args, console: Console
 ) -> tuple[int, dict | None]:
+    from ..plugin import run_in_process
     from ..reports.console import ProgressPlugin
-    from ..suite import run_in_process
 
     argv = suite_args(role, port, report_dir)
     argv[argv.index(f"testcases.{role}")] = "testcases.passive"
