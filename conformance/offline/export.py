@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..atomic import atomic_path
 from ..capture import (
     DEFAULT_SAMPLE_RATE,
     EXPORT_FORMATS,
@@ -60,15 +61,16 @@ def export_main(argv: list[str]) -> int:
         return EXIT_USAGE
     output = Path(args.output or transcript_path(Path(args.run)).with_name(f"capture.{args.to}"))
     try:
-        info = export_events(
-            recording.events,
-            str(output),
-            args.to,
-            sample_rate=args.sample_rate,
-            line_polarity=args.line_polarity,
-            tool_channel=args.tool_channel,
-            notes=[e for e in recording.events if e.kind is EventKind.NOTE],
-        )
+        with atomic_path(output) as partial:  # a Ctrl-C leaves no truncated capture
+            info = export_events(
+                recording.events,
+                str(partial),
+                args.to,
+                sample_rate=args.sample_rate,
+                line_polarity=args.line_polarity,
+                tool_channel=args.tool_channel,
+                notes=[e for e in recording.events if e.kind is EventKind.NOTE],
+            )
     except (ValueError, CaptureError, OSError) as exc:
         say_error(f"error: {output}: {exc}")
         return EXIT_USAGE
