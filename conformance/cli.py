@@ -179,13 +179,16 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
 def cmd_judge(argv: list[str], console: Console) -> int:
     """``judge FILE``: replay a virtual-time run through the cases, or judge passively."""
-    from .offline.judge import JudgeError, plan
+    from .offline.judge import JudgeError, capture_replay_stopped, plan
 
     try:
         found = plan(argv)
     except JudgeError as exc:
         error(f"error: {exc}")
         return EXIT_USAGE
+    if GUARD.requested:  # Ctrl-C while the recording was read and decoded
+        error("interrupted before judging started; no report written")
+        return EXIT_INCOMPLETE
     for note in found.notes:
         console.print(f"note: {note}", markup=False, highlight=False)
     if found.replay_argv is not None:
@@ -194,7 +197,12 @@ def cmd_judge(argv: list[str], console: Console) -> int:
             markup=False,
             highlight=False,
         )
-        return run_suite(build_parser().parse_args(found.replay_argv), console)
+        code = run_suite(build_parser().parse_args(found.replay_argv), console)
+        why = capture_replay_stopped(found, found.replay_argv) if code == EXIT_INTERNAL else None
+        if why is not None:
+            console.print(f"note: {why}", markup=False, highlight=False)
+            return EXIT_INCOMPLETE
+        return code
     from .offline.passive import judge_passively
 
     return judge_passively(found.passive_argv or [], console)

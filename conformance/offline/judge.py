@@ -313,3 +313,28 @@ def passive_argv(
     if args.strict:
         argv.append("--strict")
     return argv
+
+
+def capture_replay_stopped(plan_: JudgePlan, argv: list[str]) -> str | None:
+    """Why a capture's replay stopped because the capture, not the tool, went astray (None:
+    it did not). A capture comes from outside: damaged, cut, or decoded on a wrong channel or
+    polarity, it stops following its run; that leaves the run incomplete (exit 2), where a
+    run's own transcript.jsonl diverging is the tool's failure (exit 3)."""
+    import json
+
+    from ..replay.sensor import DIVERGED
+
+    if plan_.kind == "jsonl" or "--report-dir" not in argv:
+        return None
+    verdicts = Path(argv[argv.index("--report-dir") + 1]) / "verdicts.json"
+    try:
+        reason = json.loads(verdicts.read_text(encoding="utf-8"))["run"]["stop_reason"] or ""
+    except (OSError, ValueError, KeyError):
+        return None
+    if DIVERGED not in reason:
+        return None
+    return (
+        f"{plan_.path} stops following the run it is of ({reason.split(': ', 1)[-1]}): "
+        "is it damaged, or decoded on the wrong --channel or polarity? The verdicts up to "
+        "there stand; the rest is not judged"
+    )
