@@ -54,11 +54,20 @@ exit codes (every subcommand): 0 compliant/success, 1 non-compliant (matrix: a f
 """
 
 
+def subcommands_text() -> str:
+    """The subcommands, for the main help and for a mistyped one."""
+    width = max(len(name) for name in SUBCOMMAND_HELP)
+    rows = "".join(f"  {name:<{width}}  {what}\n" for name, what in SUBCOMMAND_HELP.items())
+    return "subcommands (sdi12-conform SUBCOMMAND --help for each):\n" + rows
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sdi12-conform",
+        usage="%(prog)s [options]  |  %(prog)s SUBCOMMAND ...",
         description="SDI-12 (v1.3/v1.4) conformance test suite: judges a sensor or a data "
-        "recorder against every testable requirement and writes HTML, JSON and JUnit reports.",
+        "recorder against every testable requirement and writes HTML, JSON and JUnit "
+        "reports.\n\n" + subcommands_text(),
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -133,7 +142,10 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             open_port(args.port, echo=args.echo, direction=args.direction).link.close()
         check_report_dir(report_dir)
     except (DeclarationError, PortError, UsageError, SelectionError) as exc:
-        error(f"error: {exc}")
+        from .links.errors import PortMissing
+
+        also = f", or judge the built-in simulated {args.role} with --port sim"
+        error(f"error: {exc}{also if isinstance(exc, PortMissing) else ''}")
         return EXIT_USAGE
     from .suite import suite_args
 
@@ -227,7 +239,12 @@ def cmd_list(argv: list[str], console: Console) -> int:
     p = argparse.ArgumentParser(
         prog="sdi12-conform list", description="the requirement catalog with coverage"
     )
-    p.add_argument("--role", default="sensor", choices=("sensor", "recorder"))
+    p.add_argument(
+        "--role",
+        default="sensor",
+        choices=("sensor", "recorder"),
+        help="whose requirements: the sensor's (default) or the data recorder's",
+    )
     args = p.parse_args(argv)
     from rich.table import Table
 
@@ -261,8 +278,21 @@ def cmd_faults(argv: list[str], console: Console) -> int:
         prog="sdi12-conform faults",
         description="the emulator's faults and the requirements each breaks",
     )
-    p.parse_args(argv)
+    p.add_argument(
+        "--role",
+        default="sensor",
+        choices=("sensor", "recorder"),
+        help="the simulated sensor's faults and firmware profiles (default), or the golden "
+        "recorder's faults (sim://?recorder-faults=NAME with --role recorder)",
+    )
+    args = p.parse_args(argv)
     from rich.table import Table
+
+    if args.role == "recorder":
+        from .fault_tables import recorder_faults_table
+
+        console.print(recorder_faults_table())
+        return EXIT_COMPLIANT
 
     from .emulator import FAULTS
 
@@ -323,9 +353,11 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
 
     unknown = [n for n in names or () if n not in FAULTS]
     if unknown:
+        from .suggest import did_you_mean
+
         error(
-            f"error: unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the "
-            "known ones"
+            f"error: unknown fault(s) {', '.join(unknown)}{did_you_mean(unknown, FAULTS)}; "
+            "`sdi12-conform faults` lists the known ones"
         )
         return EXIT_USAGE
     if args.jobs < 1:
@@ -405,6 +437,17 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
 #: The subcommands that stop at once on Ctrl-C (KeyboardInterrupt: exit 2, outputs whole or
 #: absent); ``judge`` runs the suite, whose interrupts the guard turns into a partial report.
 SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor", "calibrate")
+#: what the main --help says of each subcommand (`sdi12-conform SUBCOMMAND --help`: the rest)
+SUBCOMMAND_HELP = {
+    "judge": "judge a recording: a run's transcript.jsonl or folder, a .sr, .vcd or .csv",
+    "export": "write a saved run as a logic-analyzer capture (.sr, .vcd, .csv)",
+    "list": "the requirement catalog with coverage (--role recorder: the recorder's)",
+    "faults": "the emulator faults and what they break (--role recorder: the recorder's)",
+    "matrix": "run the fault-detection matrix",
+    "emulate": "serve the simulated sensor in real time over RFC 2217, TCP or a serial port",
+    "monitor": "listen to a live bus (never transmits) and judge what was heard",
+    "calibrate": "measure a real bench's timing before a long run",
+}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -468,6 +511,15 @@ def _dispatch(argv: list[str]) -> int:
             from .calibrate import calibrate_main
 
             return calibrate_main(argv[1:])
+        if argv and not argv[0].startswith("-"):  # a word where a subcommand goes
+            from .suggest import did_you_mean
+
+            error(
+                f"error: no subcommand {argv[0]!r}{did_you_mean(argv[:1], SUBCOMMAND_HELP)}; "
+                "the main command takes options only (sdi12-conform --help)"
+            )
+            error(subcommands_text().rstrip())
+            return EXIT_USAGE
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:

@@ -26,6 +26,18 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sdi12-conform export",
         description="Write a saved run's transcript as a logic-analyzer capture.",
+        epilog="examples:\n"
+        "  sdi12-conform export reports/20250101-120000-sensor --to sr\n"
+        "                       capture.sr beside the run's transcript, for PulseView\n"
+        "  sdi12-conform export reports/20250101-120000-sensor --to csv -o run.csv\n"
+        "                       a Logic 2-style CSV\n"
+        "  sdi12-conform export RUN --to vcd --line-polarity --tool-channel\n"
+        "                       the wire's levels, and the tool's TX on its own channel\n"
+        "  sdi12-conform judge reports/20250101-120000-sensor/capture.sr\n"
+        "                       judge the capture: the run's verdicts again\n"
+        "\nCtrl-C leaves no partial file: the capture is written under a temporary name "
+        "and renamed when whole.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("run", help="a run folder or its transcript.jsonl")
     parser.add_argument("--to", choices=EXPORT_FORMATS, required=True, help="capture format")

@@ -36,6 +36,23 @@ from ..view.sides import RECORDER, SENSOR
 
 ROLES = ("sensor", "recorder", "both")
 
+JUDGE_EXAMPLES = """\
+examples:
+  sdi12-conform judge reports/20250101-120000-sensor      a saved sim run, by replay
+  sdi12-conform export reports/20250101-120000-sensor --to sr
+  sdi12-conform judge reports/20250101-120000-sensor/capture.sr
+                                                          its capture: the run's verdicts
+  sdi12-conform judge field.sr --channel D0 --role sensor  a field capture, passively
+  sdi12-conform judge logic2.csv --channel SDI12 --tx-channel RTX
+                                                          a Logic 2 export with the
+                                                          recorder's TX on its own probe
+  sdi12-conform judge reports/20250101-120000-monitor/transcript.jsonl
+                                                          what a monitor heard
+
+exit codes: 0 compliant, 1 non-compliant, 2 interrupted or incomplete (rules the recording
+  cannot show), 4 a recording or option that cannot be used.
+"""
+
 
 class JudgeError(ValueError):
     """A recording or option ``judge`` cannot use (exit 4, one line, no traceback)."""
@@ -65,6 +82,8 @@ def build_parser() -> argparse.ArgumentParser:
             "a Saleae Logic 2 CSV export or a VCD. A virtual-time run is replayed through the "
             "same cases (the same verdicts); anything else is judged passively."
         ),
+        epilog=JUDGE_EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("file", help="the recording")
     parser.add_argument(
