@@ -184,6 +184,14 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))
+    from .run_notes import req_pulled_in, version_mismatch
+
+    for note in (
+        req_pulled_in(data, resolve(args.role, args.req) if args.req else set(), args.req or []),
+        version_mismatch(data, args.sdi_version),
+    ):
+        if note:
+            console.print(f"note: {note}", style="yellow", markup=False, highlight=False)
     if interrupted:
         return EXIT_INCOMPLETE
     return exit_code(data, int(code))

@@ -128,3 +128,38 @@ def test_a_watch_that_ended_as_asked_with_nothing_broken_exits_0(tmp_path):
         _verdicts(tmp_path / name / "sensor", **kw)
         assert heard_as_asked(tmp_path / name, said.append) == 2, name
     assert heard_as_asked(tmp_path / "none", said.append) == 2
+
+
+# -- counts and notes: one vocabulary ----------------------------------------------------------
+def test_a_partial_run_counts_what_it_selected_once(capsys, tmp_path):
+    """Seen: "2 of 106 judged, 104 N/A, 104 not selected" (the 104 counted twice); and
+    "running 1 conformance cases"."""
+    code, text = run(capsys, "--port", "sim", "-k", "identification", "--report-dir", str(tmp_path))
+    assert code == 0, text
+    assert "running 1 conformance case\n" in text
+    assert "2 selected testable requirements judged; 104 of 106 not selected" in text, text
+    assert "104 N/A" not in text
+
+
+def test_a_req_says_why_it_judged_more_and_a_forced_version_says_it_differs(capsys, tmp_path):
+    code, text = run(
+        capsys,
+        "--port", "sim://?version=1.3", "--sdi-version", "1.4", "--req", "R-4.4.6-02",
+        "--report-dir", str(tmp_path),
+    )  # fmt: skip
+    flat = " ".join(text.split())
+    assert "--req R-4.4.6-02 names 1 requirement(s); 5 were judged" in flat, text
+    assert "also judge 4 other(s)" in flat and "a case runs whole" in flat
+    assert "--sdi-version 1.4 judged the device by the v1.4 rules, but its aI! reports v1.3" in flat
+
+
+def test_a_summary_before_the_sensor_was_found_says_so():
+    """Seen after an early Ctrl-C: "DUT None · SDI-12 None"."""
+    from conformance.reports.console import _identity_lines
+
+    data = {
+        "dut": {"address": None, "sdi12_version": None, "identification": None},
+        "run": {"role": "sensor", "port": "sim", "link": {"kind": "sim"}},
+    }
+    first = _identity_lines(data)[0]
+    assert "None" not in first and "not found yet" in first
