@@ -171,7 +171,7 @@ def heard_as_asked(report_dir: Path, say: Callable[[str], None]) -> int:
             return EXIT_INCOMPLETE
     open_ = sum(d["summary"]["counts"].get("INCONCLUSIVE", 0) for d in found)
     say(
-        f"monitoring complete: no rule broken in what was heard; {open_} requirement(s) "
+        f"monitoring complete: no FAIL in what was heard; {open_} requirement(s) "
         "INCONCLUSIVE (not seen on this bus or not decidable from it), listed in the report"
     )
     return EXIT_OK
