@@ -180,8 +180,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--port", required=True, help="serial port or pyserial URL (not sim)")
     p.add_argument("--address", help="the sensor's address (default: ask with ?!)")
-    p.add_argument("--echo", default="auto", choices=("auto", "on", "off"))
-    p.add_argument("--direction", default="none", choices=("none", "rts", "dtr"))
+    from .options import add_cli_options
+
+    add_cli_options(p, ("echo", "direction"))  # the main command's, help text and all
     p.add_argument("--rounds", type=int, default=10, help="wake-ups to time (default 10)")
     return p
 

@@ -52,11 +52,20 @@ exit codes (every subcommand): 0 compliant/success, 1 non-compliant (matrix: a f
 """
 
 
+def subcommands_text() -> str:
+    """The subcommands, for the main help and for a mistyped one."""
+    width = max(len(name) for name in SUBCOMMAND_HELP)
+    rows = "".join(f"  {name:<{width}}  {what}\n" for name, what in SUBCOMMAND_HELP.items())
+    return "subcommands (sdi12-conform SUBCOMMAND --help for each):\n" + rows
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sdi12-conform",
+        usage="%(prog)s [options]  |  %(prog)s SUBCOMMAND ...",
         description="SDI-12 (v1.3/v1.4) conformance test suite: judges a sensor or a data "
-        "recorder against every testable requirement and writes HTML, JSON and JUnit reports.",
+        "recorder against every testable requirement and writes HTML, JSON and JUnit "
+        "reports.\n\n" + subcommands_text(),
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -134,7 +143,10 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         check_report_dir(report_dir)
         report_folder.acquire(report_dir)
     except (DeclarationError, PortError, UsageError, SelectionError) as exc:
-        error(f"error: {exc}")
+        from .links.errors import PortMissing
+
+        also = f", or judge the built-in simulated {args.role} with --port sim"
+        error(f"error: {exc}{also if isinstance(exc, PortMissing) else ''}")
         return EXIT_USAGE
     try:
         return _run_pytest(args, report_dir, console)
@@ -146,6 +158,7 @@ def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) ->
     """The suite in this process; the summary and exit code from its own results."""
     from .options import pytest_args
     from .plugin import run_in_process
+    from .selection import resolve
     from .suite import suite_args
 
     argv = suite_args(args.role, args.port, report_dir, terminal=args.verbose)
@@ -179,6 +192,14 @@ def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) ->
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))
+    from .run_notes import req_pulled_in, version_mismatch
+
+    for note in (
+        req_pulled_in(data, resolve(args.role, args.req) if args.req else set(), args.req or []),
+        version_mismatch(data, args.sdi_version),
+    ):
+        if note:
+            console.print(f"note: {note}", style="yellow", markup=False, highlight=False)
     if interrupted:
         return EXIT_INCOMPLETE
     return exit_code(data, code)
@@ -186,13 +207,16 @@ def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) ->
 
 def cmd_judge(argv: list[str], console: Console) -> int:
     """``judge FILE``: replay a virtual-time run through the cases, or judge passively."""
-    from .offline.judge import JudgeError, plan
+    from .offline.judge import JudgeError, capture_replay_stopped, plan
 
     try:
         found = plan(argv)
     except JudgeError as exc:
         error(f"error: {exc}")
         return EXIT_USAGE
+    if GUARD.requested:  # Ctrl-C while the recording was read and decoded
+        error("interrupted before judging started; no report written")
+        return EXIT_INCOMPLETE
     for note in found.notes:
         console.print(f"note: {note}", markup=False, highlight=False)
     if found.replay_argv is not None:
@@ -201,7 +225,12 @@ def cmd_judge(argv: list[str], console: Console) -> int:
             markup=False,
             highlight=False,
         )
-        return run_suite(build_parser().parse_args(found.replay_argv), console)
+        code = run_suite(build_parser().parse_args(found.replay_argv), console)
+        why = capture_replay_stopped(found, found.replay_argv) if code == EXIT_INTERNAL else None
+        if why is not None:
+            console.print(f"note: {why}", markup=False, highlight=False)
+            return EXIT_INCOMPLETE
+        return code
     from .offline.passive import judge_passively
 
     return judge_passively(found.passive_argv or [], console)
@@ -226,7 +255,12 @@ def cmd_list(argv: list[str], console: Console) -> int:
     p = argparse.ArgumentParser(
         prog="sdi12-conform list", description="the requirement catalog with coverage"
     )
-    p.add_argument("--role", default="sensor", choices=("sensor", "recorder"))
+    p.add_argument(
+        "--role",
+        default="sensor",
+        choices=("sensor", "recorder"),
+        help="whose requirements: the sensor's (default) or the data recorder's",
+    )
     args = p.parse_args(argv)
     from rich.table import Table
 
@@ -260,8 +294,21 @@ def cmd_faults(argv: list[str], console: Console) -> int:
         prog="sdi12-conform faults",
         description="the emulator's faults and the requirements each breaks",
     )
-    p.parse_args(argv)
+    p.add_argument(
+        "--role",
+        default="sensor",
+        choices=("sensor", "recorder"),
+        help="the simulated sensor's faults and firmware profiles (default), or the golden "
+        "recorder's faults (sim://?recorder-faults=NAME with --role recorder)",
+    )
+    args = p.parse_args(argv)
     from rich.table import Table
+
+    if args.role == "recorder":
+        from .fault_tables import recorder_faults_table
+
+        console.print(recorder_faults_table())
+        return EXIT_COMPLIANT
 
     from .emulator import FAULTS
 
@@ -322,9 +369,11 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
 
     unknown = [n for n in names or () if n not in FAULTS]
     if unknown:
+        from .suggest import did_you_mean
+
         error(
-            f"error: unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the "
-            "known ones"
+            f"error: unknown fault(s) {', '.join(unknown)}{did_you_mean(unknown, FAULTS)}; "
+            "`sdi12-conform faults` lists the known ones"
         )
         return EXIT_USAGE
     if args.jobs < 1:
@@ -401,7 +450,20 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
     return EXIT_COMPLIANT if clean == len(rows) else EXIT_NON_COMPLIANT
 
 
-SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor")
+#: The subcommands that stop at once on Ctrl-C (KeyboardInterrupt: exit 2, outputs whole or
+#: absent); ``judge`` runs the suite, whose interrupts the guard turns into a partial report.
+SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor", "calibrate")
+#: what the main --help says of each subcommand (`sdi12-conform SUBCOMMAND --help`: the rest)
+SUBCOMMAND_HELP = {
+    "judge": "judge a recording: a run's transcript.jsonl or folder, a .sr, .vcd or .csv",
+    "export": "write a saved run as a logic-analyzer capture (.sr, .vcd, .csv)",
+    "list": "the requirement catalog with coverage (--role recorder: the recorder's)",
+    "faults": "the emulator faults and what they break (--role recorder: the recorder's)",
+    "matrix": "run the fault-detection matrix",
+    "emulate": "serve the simulated sensor in real time over RFC 2217, TCP or a serial port",
+    "monitor": "listen to a live bus (never transmits) and judge what was heard",
+    "calibrate": "measure a real bench's timing before a long run",
+}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -465,6 +527,15 @@ def _dispatch(argv: list[str]) -> int:
             from .calibrate import calibrate_main
 
             return calibrate_main(argv[1:])
+        if argv and not argv[0].startswith("-"):  # a word where a subcommand goes
+            from .suggest import did_you_mean
+
+            error(
+                f"error: no subcommand {argv[0]!r}{did_you_mean(argv[:1], SUBCOMMAND_HELP)}; "
+                "the main command takes options only (sdi12-conform --help)"
+            )
+            error(subcommands_text().rstrip())
+            return EXIT_USAGE
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:

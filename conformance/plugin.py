@@ -23,6 +23,7 @@ from .ports import PortError
 from .preflight import check_report_dir, check_role_options
 from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
+from .replay.sensor import RecordingEnded
 from .reports import html, verdicts_json
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions
@@ -105,6 +106,10 @@ def sensor(sdi12_run: ConformanceRun) -> SensorSession:
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
         pytest.exit(str(exc), returncode=4)
+    except RecordingEnded as exc:  # a replayed capture cut short before discovery ended
+        sdi12_run.complete = False
+        sdi12_run.stop_reason = str(exc)
+        pytest.exit(str(exc), returncode=2)
     except LinkError as exc:
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
@@ -283,6 +288,11 @@ def pytest_runtest_call(item: pytest.Item):
         run.complete = False
         run.stop_reason = f"test setup failed: {exc}"
         pytest.exit(run.stop_reason, returncode=4)
+    except RecordingEnded as exc:  # a replayed capture cut short: the rest is left open
+        _inconclusive(record, str(exc))
+        run.complete = False
+        run.stop_reason = str(exc)
+        pytest.exit(run.stop_reason, returncode=2)
     except LinkError as exc:  # the port failed: stop the run, keep the report (exit 3)
         _error(record, f"link failed: {exc}")
         run.complete = False

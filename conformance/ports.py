@@ -25,6 +25,7 @@ from .links.registry import LinkKind, OpenedPort, PortOptions, find, register
 from .offline import recording_link
 from .protocol.commands import ADDRESS_CHARS
 from .replay.link import is_replay
+from .suggest import did_you_mean
 
 __all__ = ["OpenedPort", "PortError", "SimSpec", "is_sim", "open_port", "open_sim", "parse_sim"]
 
@@ -78,13 +79,15 @@ def sim_profile(spec: SimSpec) -> Profile:
     unknown_profiles = [p for p in spec.profiles if p not in PROFILES]
     if unknown_profiles:
         raise PortError(
-            f"unknown profile(s) {', '.join(unknown_profiles)}; "
+            f"unknown profile(s) {', '.join(unknown_profiles)}"
+            f"{did_you_mean(unknown_profiles, PROFILES)}; "
             "`sdi12-conform faults` lists the known ones"
         )
     unknown = [f for f in spec.faults if f not in FAULTS]
     if unknown:
         raise PortError(
-            f"unknown fault(s) {', '.join(unknown)}; `sdi12-conform faults` lists the known ones"
+            f"unknown fault(s) {', '.join(unknown)}{did_you_mean(unknown, FAULTS)}; "
+            "`sdi12-conform faults` lists the known ones"
         )
     if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")

@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent / "conformance"
 #: the package when they serve a higher layer.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # protocol facts and the record of the wire (sans-I/O); process plumbing
-    ("wire", ("", "interrupts", "exits", "protocol", "transcript")),
+    ("wire", ("", "interrupts", "exits", "atomic", "suggest", "protocol", "transcript")),
     # the requirements, what is declared about the DUT, and what was found
     (
         "requirements",
@@ -62,11 +62,11 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
         ),
     ),
     # what a run is rendered as: console, HTML, verdicts.json
-    ("reports", ("reports",)),
+    ("reports", ("reports", "run_notes")),
     # pytest's side: options, fixtures, hooks that turn findings into outcomes and reports
     ("plugin", ("plugin",)),
     # the command line
-    ("cli", ("cli", "offline.passive", "roundtrip")),
+    ("cli", ("cli", "offline.passive", "roundtrip", "fault_tables")),
 )
 
 LAYER_OF = {name: rank for rank, (_, names) in enumerate(LAYERS) for name in names}

@@ -17,6 +17,7 @@ from conformance.emulator_server.servers import TcpEmulatorServer
 from conformance.links.echo import EchoMode
 from conformance.links.errors import (
     BreakUnsupported,
+    PortMissing,
     PortUnavailable,
     PortVanished,
     explain_open_failure,
@@ -73,8 +74,8 @@ def test_port_kinds(port, kind):
 def test_missing_device_is_a_port_error_with_what_to_do():
     with pytest.raises(PortError) as caught:
         open_port("/dev/ttyUSB-sdi12-missing")
-    assert isinstance(caught.value, PortUnavailable)
-    assert "does not exist" in str(caught.value) and "--port sim" in str(caught.value)
+    assert isinstance(caught.value, PortMissing)  # the main command adds "--port sim"
+    assert "does not exist" in str(caught.value) and "ls /dev/ttyUSB*" in str(caught.value)
 
 
 def test_permission_and_busy_messages_say_what_to_do():

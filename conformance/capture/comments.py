@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 from ..transcript import TOOL, Event, EventKind
 from .formats import sniff
+from .sigrok import ZIP_DAMAGE
 from .writers import SR_COMMENT_MEMBER
 
 PREFIX = "sdi12-conform-notes "
@@ -46,7 +47,7 @@ def _comment(path: str) -> str | None:
                 if SR_COMMENT_MEMBER not in zf.namelist():
                     return None
                 return zf.read(SR_COMMENT_MEMBER).decode("utf-8", errors="replace")
-        except (zipfile.BadZipFile, OSError):
+        except ZIP_DAMAGE:  # a damaged note member: the capture says nothing of its run
             return None
     if fmt == "vcd":
         with open(path, encoding="utf-8", errors="replace") as fh:

@@ -21,6 +21,19 @@ import numpy as np
 from .edges import Edges, transitions
 from .errors import CaptureError
 
+#: What Python's zipfile raises for a damaged archive or member: besides the obvious, an
+#: unknown compression method (NotImplementedError), an "encrypted" flag (RuntimeError), a
+#: mangled header field (ValueError): all the file's fault, none the tool's.
+ZIP_DAMAGE = (
+    zipfile.BadZipFile,
+    zlib.error,
+    EOFError,
+    OSError,
+    NotImplementedError,
+    RuntimeError,
+    ValueError,
+)
+
 BLOCK_SAMPLES = 1 << 22  # 4 Mi samples per decompressed block: a few MB, whatever the unitsize
 _DTYPES = {1: np.uint8, 2: np.dtype("<u2"), 4: np.dtype("<u4"), 8: np.dtype("<u8")}
 _UNITS = {"": 1, "k": 1e3, "m": 1e6, "g": 1e9}
@@ -41,7 +54,7 @@ class SrSession:
         self.path = path
         try:
             self.zip = zipfile.ZipFile(path)
-        except (zipfile.BadZipFile, OSError, EOFError) as exc:
+        except ZIP_DAMAGE as exc:
             raise CaptureError(path, f"not a readable sigrok session (zip): {exc}") from None
         names = set(self.zip.namelist())
         if "metadata" not in names:
@@ -51,7 +64,7 @@ class SrSession:
         ini = configparser.ConfigParser(interpolation=None, strict=False)
         try:
             ini.read_string(self.zip.read("metadata").decode("utf-8", "replace"))
-        except (configparser.Error, zipfile.BadZipFile, zlib.error, EOFError) as exc:
+        except (configparser.Error, *ZIP_DAMAGE) as exc:
             raise CaptureError(path, f"unreadable 'metadata': {exc}") from None
         if not ini.has_section("device 1"):
             raise CaptureError(path, "'metadata' has no [device 1] section")
@@ -96,7 +109,7 @@ class SrSession:
                         cut = len(data) - len(data) % self.unitsize
                         data, rest = data[:cut], data[cut:]
                         yield np.frombuffer(data, dtype=dtype)
-            except (zipfile.BadZipFile, zlib.error, EOFError, OSError) as exc:
+            except ZIP_DAMAGE as exc:
                 raise CaptureError(self.path, f"corrupt sample data in '{member}': {exc}") from None
 
     def busiest_probe(self) -> str:

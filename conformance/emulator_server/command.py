@@ -19,7 +19,8 @@ from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
 from .tap import TapServer, parse_tap
 
-EXIT_OK, EXIT_USAGE = 0, 4
+EXIT_OK, EXIT_INTERRUPTED, EXIT_USAGE = 0, 2, 4
+PORT_MAX = 65535
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -116,6 +117,8 @@ def _host_port(text: str) -> tuple[str, int]:
     host, sep, port = text.rpartition(":")
     if not sep or not port.isdigit():
         raise PortError(f"--listen wants HOST:PORT (for example 127.0.0.1:4001), not {text!r}")
+    if int(port) > PORT_MAX:
+        raise PortError(f"--listen port must be 0..{PORT_MAX} (0: any free), not {port}")
     return host.strip("[]") or "127.0.0.1", int(port)
 
 
@@ -135,6 +138,8 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
         if args.raw and not args.listen:
             raise PortError("--raw applies to --listen only")
         tap_at = parse_tap(args.tap) if args.tap else None
+        if args.listen:
+            _host_port(args.listen)  # a port out of range is a usage error, before serving
     except PortError as exc:
         print_line(f"error: {exc}")
         return EXIT_USAGE
@@ -183,13 +188,15 @@ def _serve_tcp(
         return EXIT_USAGE
     print_line(f"serving the {what} on {server.url} (Ctrl-C stops){_tapped(tap)}")
     _stop_on_sigterm(server.stop)
+    code = EXIT_OK
     try:
         server.serve()
-    except KeyboardInterrupt:
-        print_line("stopped")
+    except KeyboardInterrupt:  # Ctrl-C: exit 2, as every subcommand (SIGTERM: 0)
+        print_line("stopped: interrupted")
+        code = EXIT_INTERRUPTED
     finally:
         line.stop()
-    return EXIT_OK
+    return code
 
 
 def _serve_port(
@@ -209,16 +216,18 @@ def _serve_port(
     stopped = threading.Event()
     _stop_on_sigterm(stopped.set)
     print_line(f"serving the {what} on {port_name} at 1200 baud (Ctrl-C stops){_tapped(tap)}")
+    code = EXIT_OK
     try:
         serve_serial(line, port, stopped)
-    except KeyboardInterrupt:
-        print_line("stopped")
+    except KeyboardInterrupt:  # Ctrl-C: exit 2, as every subcommand (SIGTERM: 0)
+        print_line("stopped: interrupted")
+        code = EXIT_INTERRUPTED
     except serial.SerialException as exc:
         print_line(f"error: the port failed: {exc}")
     finally:
         line.stop()
         port.close()
-    return EXIT_OK
+    return code
 
 
 def _tapped(tap: TapServer | None) -> str:

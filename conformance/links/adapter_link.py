@@ -34,7 +34,7 @@ import serial
 from ..protocol.timing import BREAK_MIN, CHAR_TIME, MARKING_AFTER_BREAK
 from ..transcript import DUT, Event, EventKind, to_wire_7e1
 from .base import LinkInfo, StopCondition
-from .errors import PortUnavailable, explain_open_failure
+from .errors import PortUnavailable, unavailable
 from .registry import LinkKind, OpenedPort, PortOptions, register
 from .serial_link import READ_POLL, SerialLink, precise_sleep_until
 from .stamps import chunk_frames
@@ -241,7 +241,7 @@ def open_adapter_link(port: str, timing_uncertainty: float | None = None) -> Ada
         raw.open()
     except (serial.SerialException, OSError, ValueError, NotImplementedError) as exc:
         inner = spec.url.split("://", 1)[0].lower() if "://" in spec.url else "serial"
-        raise PortUnavailable(explain_open_failure(spec.url, inner, exc)) from exc
+        raise unavailable(spec.url, inner, exc) from exc
     return AdapterLink(raw, spec, timing_uncertainty=timing_uncertainty, name=port)
 
 

@@ -11,6 +11,7 @@ a link that has none, while a case that presents a break of its own becomes INCO
 from __future__ import annotations
 
 import errno
+import re
 
 from .base import LinkError
 
@@ -23,12 +24,39 @@ class PortUnavailable(PortError, LinkError):
     """The port could not be opened (missing, busy, no permission, nobody listening)."""
 
 
+class PortMissing(PortUnavailable):
+    """No device by that name. The main command adds that ``--port sim`` runs without one;
+    the subcommands that refuse sim (monitor, calibrate) do not suggest it."""
+
+
+#: what a ``--port`` that was meant as a pyserial URL starts with
+URL_SCHEMES = ("rfc2217", "socket", "loop", "spy", "hwgrep", "alt", "sim", "exec", "unix")
+
+
 class PortVanished(LinkError):
     """The port went away during the run (cable pulled, server stopped)."""
 
 
 class BreakUnsupported(LinkError):
     """This link cannot put a break on the line (``socket://``, ``loop://``)."""
+
+
+def unavailable(port: str, kind: str, exc: BaseException) -> PortUnavailable:
+    """The exception for a port that could not be opened: :class:`PortMissing` when there is
+    no such device, else :class:`PortUnavailable`; either with the advice."""
+    message = explain_open_failure(port, kind, exc)
+    if message.startswith("serial port ") and "does not exist" in message:
+        return PortMissing(message)
+    return PortUnavailable(message)
+
+
+def url_typo(port: str) -> str | None:
+    """The URL a port that is no device was probably meant as (``rfc2217//HOST:PORT``,
+    ``socket:/HOST:PORT``), or None if it does not look like one."""
+    found = re.match(r"([A-Za-z][A-Za-z0-9]*)[:/]+(.+)", port)
+    if "://" in port or found is None or found[1].lower() not in URL_SCHEMES:
+        return None
+    return f"{found[1].lower()}://{found[2]}"
 
 
 def explain_open_failure(port: str, kind: str, exc: BaseException) -> str:
@@ -41,10 +69,15 @@ def explain_open_failure(port: str, kind: str, exc: BaseException) -> str:
             "(for the emulator: sdi12-conform emulate --listen HOST:PORT)?"
         )
     if code == errno.ENOENT or "No such file" in text or "FileNotFoundError" in text:
+        meant = url_typo(port)
+        if meant is not None:
+            return (
+                f"port {port!r} does not exist as a device, and it is not a URL: a URL is "
+                f"written SCHEME://HOST:PORT (did you mean {meant}?)"
+            )
         return (
             f"serial port {port} does not exist. Check the cable and the device name "
-            "(Linux: ls /dev/ttyUSB* /dev/ttyACM*; Windows: COMn in Device Manager), "
-            "or run against the built-in simulated sensor with --port sim"
+            "(Linux: ls /dev/ttyUSB* /dev/ttyACM*; Windows: COMn in Device Manager)"
         )
     if code == errno.EACCES or "Permission denied" in text:
         return (

@@ -36,7 +36,7 @@ from .base import Link, LinkInfo
 from .breaks import BaudPulse, BreakMaker, Rfc2217Break, UartBreak
 from .direction import Direction, DirectionLine
 from .echo import EchoMode
-from .errors import PortError, PortUnavailable, explain_open_failure
+from .errors import PortError, unavailable
 from .kernel_stamps import stamped_port
 from .registry import LinkKind, OpenedPort, Opener, PortOptions, find, register, scheme_is
 from .serial_link import READ_POLL, SerialLink
@@ -176,7 +176,7 @@ def _open(port: str, kind: str, direction: DirectionLine = DirectionLine.NONE) -
             raw.dtr = False
         raw.open()
     except (serial.SerialException, OSError, ValueError, NotImplementedError) as exc:
-        raise PortUnavailable(explain_open_failure(port, kind, exc)) from exc
+        raise unavailable(port, kind, exc) from exc
     return raw
 
 

@@ -5,9 +5,11 @@ test tool may take charge of the bus. The monitor is one more receiver on the wi
 the port listen-only (:mod:`conformance.links.listen`: nothing is ever written, no break, no
 modem line changed), shows each line of traffic as it is heard (direction inferred from the
 protocol, time since the line before, any rule the line visibly breaks), and appends every
-event to ``transcript.jsonl`` as it goes, so a crash keeps what was heard. Ctrl-C (or
-``--duration``) ends it; what was seen is then judged passively by ``judge`` on that
-transcript, and the judge's exit code is the monitor's.
+event to ``transcript.jsonl`` as it goes, so a crash keeps what was heard. ``--duration`` (or
+SIGTERM) ends it; what was seen is then judged passively by ``judge`` on that transcript, and
+the judge's exit code is the monitor's, except that rules the bus never exercised do not make
+a watch that ended as asked "incomplete". Ctrl-C stops it at once, as it stops every
+subcommand: the transcript kept whole, nothing judged, exit 2.
 """
 
 from __future__ import annotations
@@ -24,7 +26,9 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING
 
 from .. import report_folder
+from ..atomic import atomic_path
 from ..exits import say_error as error
+from ..interrupts import GUARD
 from ..links.errors import LinkError, PortError
 from ..options import UsageError
 from ..report_folder import new_report_dir
@@ -36,7 +40,7 @@ if TYPE_CHECKING:
 
     from ..links.listen import ListenLink
 
-EXIT_USAGE, EXIT_INCOMPLETE, EXIT_INTERNAL = 4, 2, 3
+EXIT_OK, EXIT_USAGE, EXIT_INCOMPLETE, EXIT_INTERNAL = 0, 4, 2, 3
 POLL = 0.05  # s: how often new bytes are taken from the reader and lines shown
 FLUSH_EVERY = 1.0  # s: the transcript on disk is at most this far behind the bus
 LIVE_ROWS = 40  # lines the live view keeps on screen
@@ -49,7 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sdi12-conform monitor",
         description="Listen to a live SDI-12 bus (never transmits), show its traffic line by "
         "line with direction, timing and any rule a line breaks, write transcript.jsonl, "
-        "and judge what was seen when it ends (Ctrl-C or --duration).",
+        "and judge what was seen when it ends (--duration, or SIGTERM). Ctrl-C stops at "
+        "once (exit 2) and keeps the transcript unjudged.",
         epilog="examples:\n"
         "  sdi12-conform monitor --port /dev/ttyUSB0\n"
         "  sdi12-conform monitor --port socket://127.0.0.1:4002 --duration 60 --role sensor\n"
@@ -72,7 +77,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--report-dir", help="where transcript.jsonl and the reports go")
     p.add_argument(
-        "--duration", type=float, metavar="S", help="stop after S seconds (default: Ctrl-C)"
+        "--duration",
+        type=float,
+        metavar="S",
+        help="stop after S seconds and judge what was heard (exit 0 if no rule was broken; "
+        "default: until SIGTERM)",
     )
     p.add_argument("--address", help="judge only the sensor at this address")
     return p
@@ -114,8 +123,17 @@ def _monitor(args: argparse.Namespace, report_dir: Path, console: Console, judge
     say = _Printer(console)
     say(f"{LISTEN_ONLY} (monitoring {args.port} at 1200 baud 7E1)")
     say("a NUL byte (a framing error) is read as a break; directions are inferred")
-    say("Ctrl-C " + (f"or {args.duration:g} s end" if args.duration else "ends") + " it")
-    failure, heard = _watch(link, transcript, console, args.duration)
+    if args.duration:
+        say(f"{args.duration:g} s end it and judge what was heard; Ctrl-C stops it at once")
+    else:
+        say("SIGTERM ends it and judges what was heard; Ctrl-C stops it at once")
+    failure, heard, interrupted = _watch(link, transcript, console, args.duration)
+    if interrupted:
+        say(
+            f"stopped: interrupted (Ctrl-C), not judged; transcript written to {transcript} "
+            f"(judge it with: sdi12-conform judge {transcript} --role {args.role})"
+        )
+        return EXIT_INCOMPLETE
     if failure:
         error(f"error: {failure}; what was heard until then is kept")
     if not heard:
@@ -124,7 +142,11 @@ def _monitor(args: argparse.Namespace, report_dir: Path, console: Console, judge
             "common ground) and is anything talking?"
         )
     say(f"transcript written to {transcript}; judging what was seen (--role {args.role})")
-    return judge_recording(transcript, args.role, report_dir, args.address, console, judge)
+    GUARD.install()  # a Ctrl-C while judging: the judge's partial report and exit 2
+    code = judge_recording(transcript, args.role, report_dir, args.address, console, judge)
+    if code == EXIT_INCOMPLETE and not GUARD.requested and not failure:
+        return heard_as_asked(report_dir, say)
+    return code
 
 
 def judge_recording(
@@ -142,6 +164,28 @@ def judge_recording(
     return judge(argv, console)
 
 
+def heard_as_asked(report_dir: Path, say: Callable[[str], None]) -> int:
+    """The exit code of a watch that ended as asked and whose judging left rules open.
+
+    A bus shows only what its recorder and sensors happened to do: rules nothing exercised
+    are INCONCLUSIVE, and the judge calls that INCOMPLETE (exit 2, as for an interrupted
+    run). The monitoring itself was complete, so when every role's run completed with no
+    FAIL and no ERROR the monitor says so and exits 0; the reports keep every INCONCLUSIVE."""
+    found = [json.loads(p.read_text(encoding="utf-8")) for p in report_dir.rglob("verdicts.json")]
+    if not found:
+        return EXIT_INCOMPLETE
+    for data in found:
+        counts = data["summary"]["counts"]
+        if not data["run"]["complete"] or counts.get("FAIL") or counts.get("ERROR"):
+            return EXIT_INCOMPLETE
+    open_ = sum(d["summary"]["counts"].get("INCONCLUSIVE", 0) for d in found)
+    say(
+        f"monitoring complete: no FAIL in what was heard; {open_} requirement(s) "
+        "INCONCLUSIVE (not seen on this bus or not decidable from it), listed in the report"
+    )
+    return EXIT_OK
+
+
 class _Printer:
     """One plain line on the console, flushed (a pipe reader sees it at once)."""
 
@@ -155,10 +199,13 @@ class _Printer:
 
 
 class _Stop:
-    """Ctrl-C and SIGTERM end the watch (not the program: the judging still runs)."""
+    """SIGTERM ends the watch (the judging still runs); Ctrl-C ends it as interrupted (the
+    transcript is kept whole, nothing is judged, exit 2: Ctrl-C means the same to every
+    subcommand)."""
 
     def __init__(self) -> None:
         self.event = threading.Event()
+        self.interrupted = False
         self._saved: list[tuple[int, object]] = []
 
     def __enter__(self) -> _Stop:
@@ -167,7 +214,8 @@ class _Stop:
                 self._saved.append((sig, signal.signal(sig, self._handle)))
         return self
 
-    def _handle(self, _sig: int, _frame: object) -> None:
+    def _handle(self, sig: int, _frame: object) -> None:
+        self.interrupted = self.interrupted or sig == signal.SIGINT
         self.event.set()
 
     def __exit__(self, *_exc: object) -> None:
@@ -177,9 +225,9 @@ class _Stop:
 
 def _watch(
     link: ListenLink, path: Path, console: Console, duration: float | None
-) -> tuple[str, int]:
-    """Show and record the bus until stopped; returns why it failed ("" if it did not) and
-    how many breaks and characters were heard."""
+) -> tuple[str, int, bool]:
+    """Show and record the bus until stopped; returns why it failed ("" if it did not), how
+    many breaks and characters were heard, and whether Ctrl-C stopped it."""
     tracker = LineTracker()
     view = _LiveView(console, link.name)
     failure = ""
@@ -210,8 +258,9 @@ def _watch(
             _append(fh, rest)
             tracker.add(rest)
         view.show(tracker.poll(link.now(), final=True), tracker, link)
-    link.transcript.write_jsonl(str(path))  # the whole, in order (the same lines as appended)
-    return failure, tracker.chars + tracker.breaks
+    with atomic_path(path) as whole:  # the whole, in order (the same lines as appended)
+        link.transcript.write_jsonl(str(whole))
+    return failure, tracker.chars + tracker.breaks, stop.interrupted
 
 
 def _append(fh: IO[str], events: list[Event]) -> None:
@@ -234,9 +283,7 @@ class _LiveView:
         if self.live_on:
             from rich.live import Live
 
-            self._live = Live(
-                self._render(None, None), console=self.console, refresh_per_second=8
-            )
+            self._live = Live(self._render(None, None), console=self.console, refresh_per_second=8)
             self._live.__enter__()
         return self
 
@@ -257,7 +304,7 @@ class _LiveView:
         from rich.table import Table
 
         table = Table(
-            title=f"{LISTEN_ONLY} \u2014 {self.port}, 1200 baud 7E1 (Ctrl-C ends and judges)",
+            title=f"{LISTEN_ONLY} \u2014 {self.port}, 1200 baud 7E1 (Ctrl-C stops)",
             expand=True,
         )
         for col, kw in (

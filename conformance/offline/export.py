@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..atomic import atomic_path
 from ..capture import (
     DEFAULT_SAMPLE_RATE,
     EXPORT_FORMATS,
@@ -25,6 +26,18 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sdi12-conform export",
         description="Write a saved run's transcript as a logic-analyzer capture.",
+        epilog="examples:\n"
+        "  sdi12-conform export reports/20250101-120000-sensor --to sr\n"
+        "                       capture.sr beside the run's transcript, for PulseView\n"
+        "  sdi12-conform export reports/20250101-120000-sensor --to csv -o run.csv\n"
+        "                       a Logic 2-style CSV\n"
+        "  sdi12-conform export RUN --to vcd --line-polarity --tool-channel\n"
+        "                       the wire's levels, and the tool's TX on its own channel\n"
+        "  sdi12-conform judge reports/20250101-120000-sensor/capture.sr\n"
+        "                       judge the capture: the run's verdicts again\n"
+        "\nCtrl-C leaves no partial file: the capture is written under a temporary name "
+        "and renamed when whole.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("run", help="a run folder or its transcript.jsonl")
     parser.add_argument("--to", choices=EXPORT_FORMATS, required=True, help="capture format")
@@ -60,15 +73,16 @@ def export_main(argv: list[str]) -> int:
         return EXIT_USAGE
     output = Path(args.output or transcript_path(Path(args.run)).with_name(f"capture.{args.to}"))
     try:
-        info = export_events(
-            recording.events,
-            str(output),
-            args.to,
-            sample_rate=args.sample_rate,
-            line_polarity=args.line_polarity,
-            tool_channel=args.tool_channel,
-            notes=[e for e in recording.events if e.kind is EventKind.NOTE],
-        )
+        with atomic_path(output) as partial:  # a Ctrl-C leaves no truncated capture
+            info = export_events(
+                recording.events,
+                str(partial),
+                args.to,
+                sample_rate=args.sample_rate,
+                line_polarity=args.line_polarity,
+                tool_channel=args.tool_channel,
+                notes=[e for e in recording.events if e.kind is EventKind.NOTE],
+            )
     except (ValueError, CaptureError, OSError) as exc:
         say_error(f"error: {output}: {exc}")
         return EXIT_USAGE

@@ -35,6 +35,23 @@ from ..view.sides import RECORDER, SENSOR
 
 ROLES = ("sensor", "recorder", "both")
 
+JUDGE_EXAMPLES = """\
+examples:
+  sdi12-conform judge reports/20250101-120000-sensor      a saved sim run, by replay
+  sdi12-conform export reports/20250101-120000-sensor --to sr
+  sdi12-conform judge reports/20250101-120000-sensor/capture.sr
+                                                          its capture: the run's verdicts
+  sdi12-conform judge field.sr --channel D0 --role sensor  a field capture, passively
+  sdi12-conform judge logic2.csv --channel SDI12 --tx-channel RTX
+                                                          a Logic 2 export with the
+                                                          recorder's TX on its own probe
+  sdi12-conform judge reports/20250101-120000-monitor/transcript.jsonl
+                                                          what a monitor heard
+
+exit codes: 0 compliant, 1 non-compliant, 2 interrupted or incomplete (rules the recording
+  cannot show), 4 a recording or option that cannot be used.
+"""
+
 
 class JudgeError(ValueError):
     """A recording or option ``judge`` cannot use (exit 4, one line, no traceback)."""
@@ -64,6 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
             "a Saleae Logic 2 CSV export or a VCD. A virtual-time run is replayed through the "
             "same cases (the same verdicts); anything else is judged passively."
         ),
+        epilog=JUDGE_EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("file", help="the recording")
     parser.add_argument(
@@ -314,3 +333,28 @@ def passive_argv(
     if args.strict:
         argv.append("--strict")
     return argv
+
+
+def capture_replay_stopped(plan_: JudgePlan, argv: list[str]) -> str | None:
+    """Why a capture's replay stopped because the capture, not the tool, went astray (None:
+    it did not). A capture comes from outside: damaged, cut, or decoded on a wrong channel or
+    polarity, it stops following its run; that leaves the run incomplete (exit 2), where a
+    run's own transcript.jsonl diverging is the tool's failure (exit 3)."""
+    import json
+
+    from ..replay.sensor import DIVERGED
+
+    if plan_.kind == "jsonl" or "--report-dir" not in argv:
+        return None
+    verdicts = Path(argv[argv.index("--report-dir") + 1]) / "verdicts.json"
+    try:
+        reason = json.loads(verdicts.read_text(encoding="utf-8"))["run"]["stop_reason"] or ""
+    except (OSError, ValueError, KeyError):
+        return None
+    if DIVERGED not in reason:
+        return None
+    return (
+        f"{plan_.path} stops following the run it is of ({reason.split(': ', 1)[-1]}): "
+        "is it damaged, or decoded on the wrong --channel or polarity? The verdicts up to "
+        "there stand; the rest is not judged"
+    )

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..exits import EXIT_COMPLIANT, EXIT_USAGE
+from ..interrupts import GUARD
 from ..links.errors import PortError
 from ..protocol.commands import Kind
 from ..report_folder import new_report_dir
@@ -82,8 +83,8 @@ def exit_code(data: dict, pytest_code: int) -> int:
     imports this module, so it cannot be imported from there)."""
     from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
 
-    if pytest_code in (EXIT_USAGE, EXIT_INTERNAL) and not data["run"]["complete"]:
-        return pytest_code
+    if pytest_code in (EXIT_USAGE, EXIT_INTERNAL, EXIT_INCOMPLETE) and not data["run"]["complete"]:
+        return pytest_code  # the setup failed, the tool failed, or Ctrl-C (pytest's 2)
     verdict = data["summary"]["verdict"]
     if verdict == "NON-COMPLIANT":
         return EXIT_NON_COMPLIANT
@@ -135,6 +136,9 @@ def judge_passively(argv: list[str], console: Console) -> int:
         report_dir = base / role if len(roles) > 1 else base
         code, data = _run_role(role, port, report_dir, args, console)
         codes.append(code)
+        if GUARD.requested and data is None:  # Ctrl-C before this role wrote its verdicts
+            forget(port)
+            return EXIT_INCOMPLETE
         if data is None:  # the role's run wrote no verdicts (its own, never a file's)
             if code in (EXIT_USAGE, EXIT_INTERNAL):
                 return code
@@ -143,6 +147,10 @@ def judge_passively(argv: list[str], console: Console) -> int:
         console.print(f"{role} rules:", style="bold", markup=False, highlight=False)
         print_summary(console, data, str(report_dir))
         codes[-1] = exit_code(data, code)
+        if GUARD.requested:  # Ctrl-C: this role's report says so; the next one is not begun
+            forget(port)
+            GUARD.close()
+            return EXIT_INCOMPLETE
     forget(port)
     order = (EXIT_INTERNAL, EXIT_USAGE, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_COMPLIANT)
     return min(codes, key=lambda c: order.index(c) if c in order else -1)

@@ -30,6 +30,7 @@ from ..replay.link import is_replay, open_recorder_replay, replayed_info
 from ..replay.recorder import RecordedRecorder, output_note
 from ..replay.recording import RecordingError
 from ..sim.bus import Frame, SimBus, SimLink
+from ..suggest import did_you_mean
 from ..transcript import TOOL, Event, EventKind
 from .drivers import (
     Driver,
@@ -133,7 +134,11 @@ class RecorderSession:
         unknown = [f for f in faults if f not in RECORDER_FAULTS]
         if unknown or len(faults) > 1:
             known = ", ".join(sorted(RECORDER_FAULTS))
-            raise PortError(f"recorder-faults takes one of: {known} (got {','.join(faults)})")
+            hint = did_you_mean(unknown, RECORDER_FAULTS)
+            raise PortError(
+                f"recorder-faults takes one of: {known} (got {','.join(faults)}){hint}; "
+                "`sdi12-conform faults --role recorder` describes them"
+            )
         recording = None
         if replay:
             try:

@@ -25,8 +25,17 @@ from ..transcript import TOOL, Event, EventKind, escape
 LINE_FREE = float("-inf")
 
 
+#: how every divergence's message starts (a report's stop reason names it)
+DIVERGED = "replay diverged"
+
+
 class ReplayDiverged(LinkError):
     """The tool's stimuli no longer follow the recording."""
+
+
+class RecordingEnded(ReplayDiverged):
+    """The recording stops before the run it records did (a capture cut short): what it
+    holds is judged, the rest is left open (an incomplete run, exit 2, not a tool failure)."""
 
 
 class RecordedSensor:
@@ -60,14 +69,14 @@ class RecordedSensor:
 
     def _match(self, kind: EventKind, wire: int, end: float, length: float = 0.0) -> None:
         if self.heard >= len(self.tool):
-            raise ReplayDiverged(
-                f"replay diverged at {end:.3f} s: the tool sent {_describe(kind, wire)}, "
-                "but the recording ends there"
+            raise RecordingEnded(
+                f"the recording ends at {end:.3f} s, before its run did (cut short?): the "
+                f"tool sent {_describe(kind, wire)} there and nothing more was recorded"
             )
         expected = self.tool[self.heard]
         if not same_action(expected, kind, wire, length):
             raise ReplayDiverged(
-                f"replay diverged at {end:.3f} s (recorded {expected.start:.3f} s): the tool "
+                f"{DIVERGED} at {end:.3f} s (recorded {expected.start:.3f} s): the tool "
                 f"sent {_describe(kind, wire)}, the recording has "
                 f"{_describe(expected.kind, expected.wire)}"
             )

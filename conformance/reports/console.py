@@ -103,7 +103,7 @@ class ProgressPlugin:
         if self.progress is not None:
             self.progress.update(self.task, total=self.total, description="")
         else:
-            self.console.print(f"running {self.total} conformance cases", highlight=False)
+            self.console.print(f"running {plural(self.total, 'conformance case')}", highlight=False)
 
     @pytest.hookimpl(wrapper=True)
     def pytest_fixture_setup(self, fixturedef: Any, request: Any) -> Any:
@@ -237,14 +237,22 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
         ref = bench["timing"]["reference"]
         u += f" (measured, against the {'echo' if ref == 'echo' else 'write time'})"
         u += ", interface echoes" if bench["echo"] else ""
+    version = dut.get("sdi12_version") or "not known (the run stopped before aI!)"
     if run["role"] == "recorder":
-        first = f"DUT data recorder · SDI-12 {dut.get('sdi12_version')}"
+        first = f"DUT data recorder · SDI-12 {version}"
+    elif dut.get("address") is None:  # stopped before the sensor was found
+        first = "DUT not found yet (the run stopped before ?! or aI! answered)"
     else:
-        first = f"DUT {dut.get('address')!s} · SDI-12 {dut.get('sdi12_version')} · {ident!r}"
+        first = f"DUT {dut.get('address')!s} · SDI-12 {version} · {ident!r}"
     return [
         first,
         f"role {run['role']} · port {run['port']} · link {link['kind']}{u}",
     ]
+
+
+def plural(n: int, word: str) -> str:
+    """``1 conformance case``, ``2 conformance cases``."""
+    return f"{n} {word}{'' if n == 1 else 's'}"
 
 
 def _coverage(data: dict[str, Any]) -> str:
@@ -252,21 +260,26 @@ def _coverage(data: dict[str, Any]) -> str:
     how many were N/A (a rule of a version or feature the device does not claim): an N/A is
     not a judgement, so it is counted apart."""
     testable = [r for r in data["requirements"] if r["testable"]]
-    judged = sum(1 for r in testable if r["verdict"] in ("PASS", "FAIL", "WARN"))
-    na = sum(1 for r in testable if r["verdict"] == "N/A")
     untestable = len(data["requirements"]) - len(testable)
-    left_out = sum(1 for r in testable if not r.get("selected", True))
+    partial = data["run"].get("partial")
+    # a partial run counts what it selected, as the verdict counts do: a requirement left
+    # out is "not selected", never also N/A or unjudged
+    counted = [r for r in testable if r.get("selected", True)] if partial else testable
+    judged = sum(1 for r in counted if r["verdict"] in ("PASS", "FAIL", "WARN"))
+    na = sum(1 for r in counted if r["verdict"] == "N/A")
+    what = "selected testable requirements" if partial else "testable requirements"
     done = (
-        f"{judged} testable requirements judged"
-        if judged == len(testable)
-        else f"{judged} of {len(testable)} testable requirements judged"
+        f"{judged} {what} judged"
+        if judged == len(counted)
+        else f"{judged} of {len(counted)} {what} judged"
     )
     if na:
         done += f", {na} N/A"
-    if data["run"].get("partial"):
+    if partial:
+        left_out = len(testable) - len(counted)
         done = (
-            f"partial run ({data['run'].get('selection')}): {done}, "
-            f"{left_out} not selected"
+            f"partial run ({data['run'].get('selection')}): {done}; "
+            f"{left_out} of {len(testable)} not selected"
         )
     return f"{done}, {untestable} untestable here (electrical, inspection or the other role)"
 

@@ -1,0 +1,191 @@
+"""Ctrl-C means one thing to every subcommand: exit 2 soon after, and every output it writes
+(a report folder, a capture, a transcript) either whole or not there.
+
+Each test starts the subcommand as a user would (a subprocess), waits until it is working,
+sends SIGINT and measures how long it took to exit. (The main command's own sweep is in
+test_interrupts.py and test_safety.py.)
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from conformance.cli import main
+from conformance.emulator_server.process import EmulatorProcess
+
+#: "within a second" on an idle machine; the shared CI machine gets headroom for its load
+STOP_WITHIN = 5.0
+
+
+def start(*argv: str) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, "-m", "conformance.cli", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+
+
+def wait_for(proc: subprocess.Popen[str], marker: str, timeout: float = 60) -> str:
+    """Read the output until a line holds ``marker`` (the subcommand is at work)."""
+    seen = []
+    deadline = time.monotonic() + timeout
+    assert proc.stdout is not None
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        seen.append(line)
+        if marker in line:
+            return "".join(seen)
+    proc.kill()
+    raise AssertionError(f"{marker!r} never shown:\n{''.join(seen)}")
+
+
+def interrupt(proc: subprocess.Popen[str]) -> tuple[int, str, float]:
+    """SIGINT now; the exit code, the rest of the output and the seconds it took to exit."""
+    began = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=120)
+    return proc.returncode, out, time.monotonic() - began
+
+
+def assert_stopped(code: int, out: str, took: float) -> None:
+    assert code == 2, out
+    assert "Traceback" not in out and "KeyboardInterrupt" not in out, out
+    assert took < STOP_WITHIN, f"{took:.2f} s to stop\n{out}"
+
+
+@pytest.fixture(scope="module")
+def a_run(tmp_path_factory) -> Path:
+    """A saved clean simulated run (one case keeps it quick)."""
+    run = tmp_path_factory.mktemp("run") / "run"
+    assert main(["--port", "sim", "--report-dir", str(run), "-k", "test_identification"]) == 0
+    return run
+
+
+@pytest.fixture(scope="module")
+def a_whole_run(tmp_path_factory) -> Path:
+    """A saved whole clean simulated run: a capture of it takes the judge seconds."""
+    run = tmp_path_factory.mktemp("whole") / "run"
+    assert main(["--port", "sim", "--report-dir", str(run)]) == 0
+    return run
+
+
+@pytest.mark.slow
+def test_judge_stops_at_ctrl_c_and_judges_no_other_role(a_whole_run, tmp_path, capsys):
+    """Seen: the sensor role's judging was stopped, then the recorder role's ran to its end
+    and the judge exited 1. Now the first role's report says it was stopped, no second
+    report is begun, exit 2."""
+    capture = tmp_path / "run.vcd"
+    assert main(["export", str(a_whole_run), "--to", "vcd", "-o", str(capture)]) == 0
+    capsys.readouterr()
+    report = tmp_path / "judged"
+    proc = start("judge", str(capture), "--passive", "--role", "both", "--report-dir", str(report))
+    wait_for(proc, "[ 2/")  # the sensor role's cases are running
+    code, out, took = interrupt(proc)
+    assert_stopped(code, out, took)
+    assert "recorder rules:" not in out, out
+    assert not (report / "recorder").exists(), out
+    sensor = json.loads((report / "sensor" / "verdicts.json").read_text())
+    assert sensor["run"]["complete"] is False
+
+
+@pytest.mark.slow
+def test_export_stopped_leaves_no_capture(a_whole_run, tmp_path):
+    """Seen: exit 2 and a truncated 1.1 MB .vcd at the output path. Now nothing is there
+    (nor a temporary file beside it)."""
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    output = out_dir / "capture.vcd"
+    # ten times the default rate: the export takes seconds, Ctrl-C lands inside it
+    proc = start("export", str(a_whole_run), "--to", "vcd", "-o", str(output),
+                 "--sample-rate", "1e6")  # fmt: skip
+    time.sleep(0.3)
+    deadline = time.monotonic() + 60
+    while not list(out_dir.iterdir()) and time.monotonic() < deadline:
+        time.sleep(0.05)  # the export has begun writing
+    code, out, took = interrupt(proc)
+    assert_stopped(code, out, took)
+    assert list(out_dir.iterdir()) == [], out
+
+
+def test_an_interrupted_export_keeps_an_earlier_capture_and_leaves_no_part(
+    a_run, tmp_path, monkeypatch
+):
+    """In process: the writer is interrupted halfway; the file that was at the output path
+    stays as it was and no partial file is left beside it."""
+    from conformance.capture import writers
+
+    output = tmp_path / "capture.vcd"
+    output.write_text("an earlier capture\n")
+    real = writers.write_vcd
+
+    def write_half_then_ctrl_c(fh, *args, **kwargs):
+        fh.write("$comment half a capture $end\n")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("conformance.capture.export.write_vcd", write_half_then_ctrl_c)
+    assert main(["export", str(a_run), "--to", "vcd", "-o", str(output)]) == 2
+    assert output.read_text() == "an earlier capture\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["capture.vcd"]
+    monkeypatch.setattr("conformance.capture.export.write_vcd", real)
+    assert main(["export", str(a_run), "--to", "vcd", "-o", str(output)]) == 0
+    assert output.read_text().startswith("$")
+    assert [p.name for p in tmp_path.iterdir()] == ["capture.vcd"]
+
+
+def test_monitor_stops_at_ctrl_c_keeps_the_transcript_and_judges_nothing(tmp_path):
+    """Seen: Ctrl-C ended the watch, then judging ran (seconds) and its code was the
+    monitor's. Now exit 2 at once, the transcript whole, no verdicts, and the command that
+    judges it printed."""
+    report = tmp_path / "monitor"
+    proc = start("monitor", "--port", "loop://", "--report-dir", str(report))
+    wait_for(proc, "Ctrl-C stops it at once")
+    time.sleep(0.3)
+    code, out, took = interrupt(proc)
+    assert_stopped(code, out, took)
+    lines = (report / "transcript.jsonl").read_text().splitlines()
+    assert lines and all(json.loads(line) for line in lines)
+    assert not list(report.rglob("verdicts.json")), out
+    assert f"sdi12-conform judge {report / 'transcript.jsonl'}" in out, out
+
+
+def test_emulate_stops_at_ctrl_c_with_exit_2():
+    """Seen: exit 0 on Ctrl-C (as if it had ended as asked); SIGTERM still ends it with 0."""
+    proc = start("emulate", "--listen", "127.0.0.1:0")
+    wait_for(proc, "serving the reference sensor")
+    code, out, took = interrupt(proc)
+    assert_stopped(code, out, took)
+    proc = start("emulate", "--listen", "127.0.0.1:0")
+    wait_for(proc, "serving the reference sensor")
+    proc.terminate()
+    assert proc.wait(timeout=30) == 0
+
+
+@pytest.mark.slow
+def test_matrix_stops_at_ctrl_c_with_exit_2():
+    proc = start("matrix", "--faults", "no-service-request,wrong-crc,abort-keeps-old-data")
+    wait_for(proc, "running the sensor suite once per fault")
+    time.sleep(1.0)  # the workers are running cases
+    code, out, took = interrupt(proc)
+    assert_stopped(code, out, took)
+    assert "faults caught by exactly their requirements" not in out, out
+
+
+@pytest.mark.realtime
+def test_calibrate_stops_at_ctrl_c_with_exit_2():
+    """Seen: "stopping at the next safe point", then the whole probe ran and exit 0."""
+    with EmulatorProcess() as emulator:
+        proc = start("calibrate", "--port", emulator.url, "--rounds", "1000")
+        time.sleep(3.0)  # start-up, discovery, into the probe's rounds
+        code, out, took = interrupt(proc)
+    assert_stopped(code, out, took)
+    assert "a run here would use" not in out, out
