@@ -27,7 +27,7 @@ from ..transcript import TOOL as TOOL_ORIGIN
 from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
-from .timing_diagram import exchange_behind, timing_svg
+from .timing_diagram import exchange_behind, timing_svg, wire_title
 from .verdicts_json import dut_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
@@ -462,7 +462,8 @@ def case_html(record: CaseRecord, derived: tuple[str, list[Event]] | None = None
             svg = timing_svg(events, title=label)
             if svg:
                 parts.append(
-                    f'<p><b>Timing: {escape(label)}</b></p><div class="sdi12-diagram">{svg}</div>'
+                    f"<p><b>Timing: {escape(wire_title(label, events))}</b></p>"
+                    f'<div class="sdi12-diagram">{svg}</div>'
                 )
         parts.append(transcript_html(label, events))
     return f'<div class="sdi12-case">{"".join(parts)}</div>'
