@@ -208,3 +208,18 @@ def test_a_diagram_title_states_the_marking_it_draws():
     record.findings.append(Finding("R-7.0-07", Verdict.PASS, "answered", measured_ms=9.0))
     page = html.case_html(record)
     assert "Timing: break, 77 ms marking, a! (drawn as on the wire:" in page
+
+
+def test_the_result_cell_carries_the_verdict_and_ids_do_not_wrap():
+    """Issue 19: pytest-html's Result cell said "Skipped" for INCONCLUSIVE and N/A. The cell
+    keeps pytest's outcome as its text (pytest-html's filters read it) and draws the verdict."""
+    plugin = html.HtmlReportPlugin(SimpleNamespace())
+    header = ['<th class="sortable" data-column-type="result">Result</th>', "<th>Test</th>"]
+    plugin.pytest_html_results_table_header(header)
+    assert header[0].endswith(">Verdict</th>") and header[1] == "<th>Requirements</th>"
+    report = SimpleNamespace(sdi12_verdict="N/A", sdi12_requirements=("R-7.1-02", "R-4.0-01"))
+    cells = ['<td class="col-result">Skipped</td>', '<td class="col-testId">t</td>']
+    plugin.pytest_html_results_table_row(report, cells)
+    assert cells[0] == ('<td class="col-result sdi12-verdict v-NA" data-verdict="N/A">Skipped</td>')
+    assert cells[1].count('<span class="sdi12-rid">') == 2
+    assert "td.col-result.sdi12-verdict::before{content:attr(data-verdict)" in html.STYLE
