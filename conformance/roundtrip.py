@@ -28,11 +28,12 @@ class RoundTripError(RuntimeError):
 
 def judged_through_capture(run_dir: Path, work: Path) -> dict:
     """Export the run in ``run_dir`` to ``work/run.sr`` (the tool's TX on a second channel),
-    judge that capture as ``sdi12-conform judge`` does (decoded, directions from the TX
-    channel, the run's cases replayed against it; no HTML) into ``work/capture/`` and return
-    its verdicts.json. A capture the judging would take passively raises, with the reason."""
+    judge that capture as ``sdi12-conform judge capture.sr`` does (decoded, directions from
+    the TX channel the export named in it, the run's cases replayed against it; no HTML)
+    into ``work/capture/`` and return its verdicts.json. A capture the judging would take
+    passively raises, with the reason."""
     from .capture.errors import CaptureError
-    from .capture.export import TOOL_CHANNEL, export_events
+    from .capture.export import export_events
     from .offline.judge import JudgeError, plan
     from .replay.recording import RecordingError, read_recording
 
@@ -43,7 +44,8 @@ def judged_through_capture(run_dir: Path, work: Path) -> dict:
         recording = read_recording(run_dir)
         notes = [e for e in recording.events if e.kind is EventKind.NOTE]
         export_events(recording.events, str(capture), "sr", tool_channel=True, notes=notes)
-        found = plan([str(capture), "--tx-channel", TOOL_CHANNEL, "--report-dir", str(again)])
+        # no --tx-channel: judge reads which channel is the tool's from the capture itself
+        found = plan([str(capture), "--report-dir", str(again)])
     except (RecordingError, CaptureError, JudgeError, ValueError) as exc:
         raise RoundTripError(f"{run_dir}: {exc}") from None
     if found.replay_argv is None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import subprocess
 import sys
 import threading
@@ -306,3 +307,26 @@ def test_full_suite_over_rfc2217_is_compliant(emulator, tmp_path):
     unexpected_failures(Served(code, data, text, emulator.worst_lateness()), failed)
     if not failed:
         assert code == 0 and data["summary"]["verdict"] == "COMPLIANT", text
+
+
+def test_the_connection_log_counts_the_connections_own_frames():
+    """Issue 19: the log a recorder's disconnect writes gave the line's life totals ("17 of
+    19335 frames"), read as the connection's. It counts this connection's frames and says so;
+    the line's totals say they are totals."""
+    line = RealTimeLine(make_device("1.4", "0", ""), lambda data: None)
+    for _ in range(3):
+        line._emit(0x30)  # frames of earlier connections
+    line.late_frames, line.worst_lateness = 1, 0.020
+    logged: list[str] = []
+    server = TcpEmulatorServer(line, "127.0.0.1", 0, rfc2217_protocol=False, log=logged.append)
+    thread = threading.Thread(target=server.serve, kwargs={"once": True}, daemon=True)
+    thread.start()
+    with socket.create_connection(server.address):
+        pass
+    thread.join(timeout=5)
+    said = logged[-1]
+    assert "during this connection" in said, said
+    assert "of the 0 sensor frames it sent, 0 went out more than" in said, said
+    assert "within 0.0 ms" in said, said
+    total = line.timekeeping()
+    assert "since the line started" in total and "of the 3 sensor frames" in total, total

@@ -137,7 +137,7 @@ def test_timing_svg_marks_a_late_reply_and_an_overlong_gap_as_out_of_limits():
 
 def test_timing_svg_of_hostile_characters_is_inert():
     root = parse_svg(timing_diagram.timing_svg(exchange(0.0, "0!", HOSTILE[1], 0.009), HOSTILE[0]))
-    assert root.get("aria-label") == HOSTILE[0]
+    assert root.get("aria-label").startswith(HOSTILE[0] + " (drawn as on the wire: break")
     glyphs = "".join(t for t in texts(root) if len(t) == 1)
     assert glyphs == "0!" + HOSTILE[1].replace(" ", "␣")
     assert timing_diagram.timing_svg([]) == ""
@@ -191,3 +191,35 @@ def test_read_first_groups_requirements_with_one_reason_and_header_says_why_inco
     assert "no case judged this requirement" in page
     assert f"<th>Note</th><td>{run.stop_reason}</td>" in html.header(run)
     assert f"note: {run.stop_reason}" in html.banner(run)
+
+
+def test_a_diagram_title_states_the_marking_it_draws():
+    """Issue 19: a diagram titled "break, 77 ms marking, a!" drew 89.05 ms of marking (the
+    link's latency). The title keeps the case's words and says what is drawn."""
+    brk = Event(EventKind.BREAK, TOOL, 1.0, 1.013)
+    command = 1.013 + 0.08905
+    events = [brk, *exchange(command - 0.022, "0!", "0\r\n", 0.009)[1:]]  # its own break dropped
+    assert events[1].kind is EventKind.CHAR and abs(events[1].start - command) < 1e-9
+    title = timing_diagram.wire_title("break, 77 ms marking, a!", events)
+    assert "marking 89.05 ms" in title and "break 13.00 ms" in title, title
+    root = parse_svg(timing_diagram.timing_svg(events, title="break, 77 ms marking, a!"))
+    assert "marking 89.05 ms" in root.get("aria-label")
+    record = CaseRecord("t::r", "r", ("R-7.0-07",), evidence=[("break, 77 ms marking, a!", events)])
+    record.findings.append(Finding("R-7.0-07", Verdict.PASS, "answered", measured_ms=9.0))
+    page = html.case_html(record)
+    assert "Timing: break, 77 ms marking, a! (drawn as on the wire:" in page
+
+
+def test_the_result_cell_carries_the_verdict_and_ids_do_not_wrap():
+    """Issue 19: pytest-html's Result cell said "Skipped" for INCONCLUSIVE and N/A. The cell
+    keeps pytest's outcome as its text (pytest-html's filters read it) and draws the verdict."""
+    plugin = html.HtmlReportPlugin(SimpleNamespace())
+    header = ['<th class="sortable" data-column-type="result">Result</th>', "<th>Test</th>"]
+    plugin.pytest_html_results_table_header(header)
+    assert header[0].endswith(">Verdict</th>") and header[1] == "<th>Requirements</th>"
+    report = SimpleNamespace(sdi12_verdict="N/A", sdi12_requirements=("R-7.1-02", "R-4.0-01"))
+    cells = ['<td class="col-result">Skipped</td>', '<td class="col-testId">t</td>']
+    plugin.pytest_html_results_table_row(report, cells)
+    assert cells[0] == ('<td class="col-result sdi12-verdict v-NA" data-verdict="N/A">Skipped</td>')
+    assert cells[1].count('<span class="sdi12-rid">') == 2
+    assert "td.col-result.sdi12-verdict::before{content:attr(data-verdict)" in html.STYLE

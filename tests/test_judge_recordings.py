@@ -118,7 +118,7 @@ def test_export_formats_open_again(tmp_path, fmt):
     assert main(["export", str(first), "--to", fmt, "-o", str(out)]) == 0
     text = out.read_text(encoding="ascii")
     if fmt == "vcd":
-        assert "$comment sdi12-conform-notes" in text  # the run's options travel with the capture
+        assert "$comment sdi12-conform-capture" in text  # the run's options travel with it
     else:
         assert text.startswith("Time [s],SDI12")
 

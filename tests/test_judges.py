@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import measurements, wire
-from conformance.judges.timing import judge_window
+from conformance.judges.timing import StampUncertainty, judge_window
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
 from conformance.results import (
@@ -160,6 +160,24 @@ def test_bit_rate_too_fast_fails_but_slow_is_never_guessed():
         wire.judge_reply_bit_rate(wire.segments(transcript_of(gapped)), 0.0).verdict
         is Verdict.INCONCLUSIVE
     )
+
+
+@pytest.mark.parametrize("spacing", [0.0, 1e-8, 2e-3])
+def test_bit_rate_from_stamps_no_character_can_have_is_undecided(spacing):
+    """Issue 19: behind the echo bench one read stamped two characters together and the
+    detail said "about 1000000628 baud" / "about inf baud": such a spacing is the stamps',
+    not a rate (and no FAIL either)."""
+    burst = exchange("0!", "", 0.0)
+    t0 = burst.last.command_end + 9e-3
+    burst.attempts[0].reply_events = [
+        Event(EventKind.CHAR, DUT, t0 + i * spacing, t0 + i * spacing + CHAR_TIME, wire=0x30)
+        for i in range(4)
+    ]
+    segs = wire.segments(transcript_of(burst))
+    for stamps in (5e-3, StampUncertainty(0.5e-3, lambda a, b: 5e-3)):
+        found = wire.judge_reply_bit_rate(segs, stamps)
+        assert found.verdict is Verdict.INCONCLUSIVE, found
+        assert "baud" not in found.detail.replace("1200-baud", "")  # no figure of a rate
 
 
 def test_aggregation_worst_finding_untestable_and_unjudged():

@@ -204,3 +204,34 @@ def test_links_open_the_case_that_holds_the_evidence(reports, browser, where):
     assert 0 <= target["top"] < VIEWPORT[1], "the case was scrolled into view"
     browser.screenshot(SCREENSHOTS / f"case-from-{where[1:]}.png")
     assert browser.log.problems == []
+
+
+DRAWN = """(function(){
+  var cells=[...document.querySelectorAll('#results-table tbody.results-table-row td.col-result')];
+  function shown(c){return getComputedStyle(c,'::before').content.replace(/^"|"$/g,'');}
+  var ids=[...document.querySelectorAll('#results-table .sdi12-rid')];
+  var credit=[...document.querySelectorAll('p')].filter(p=>/generated on/.test(p.textContent));
+  return {shown: cells.map(shown), text: cells.map(c=>getComputedStyle(c).fontSize),
+          count: (document.querySelector('.run-count')||{}).textContent,
+          credit: credit.map(p=>p.textContent),
+          wrapped: ids.filter(s=>s.getClientRects().length>1).map(s=>s.textContent)};
+})()"""
+
+
+def test_the_cases_table_speaks_verdicts_and_counts_cases(reports, browser):
+    """Issue 19: the Result column said "Skipped" for INCONCLUSIVE and N/A, the count said
+    "60 tests took" beside 62 cases, the credit was pytest-html's, and a requirement ID
+    wrapped inside itself. The screenshot is for a person to look at."""
+    browser.open(reports["faulty"] / "report.html")
+    browser.evaluate("document.getElementById('results-table').scrollIntoView()")
+    browser.screenshot(SCREENSHOTS / "cases-table.png")
+    state = browser.evaluate(DRAWN)
+    data = json.loads((reports["faulty"] / "verdicts.json").read_text(encoding="utf-8"))
+    assert set(state["shown"]) <= {"PASS", "FAIL", "WARN", "INCONCLUSIVE", "N/A", "ERROR"}
+    assert {"FAIL", "INCONCLUSIVE", "PASS"} <= set(state["shown"]), state["shown"]
+    assert set(state["text"]) == {"0px"}  # pytest's outcome word is not drawn
+    assert state["count"].startswith(f"{len(state['shown'])} conformance cases took")
+    assert len(state["shown"]) == len(data["tests"])  # every case, skipped-by-pytest ones too
+    assert state["credit"] and state["credit"][0].startswith("Report by sdi12-conform ")
+    assert state["wrapped"] == []
+    assert browser.log.problems == []

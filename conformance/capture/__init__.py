@@ -8,7 +8,7 @@
 Every bad input raises :class:`CaptureError` (path + what is wrong), for exit status 4.
 """
 
-from .comments import embedded_notes
+from .comments import CaptureMeta, embedded_meta, embedded_notes
 from .decode import RECORDER_ORIGIN, SENSOR_ORIGIN, CaptureDecode, decode_capture, merge_tx
 from .errors import CaptureError
 from .export import DEFAULT_SAMPLE_RATE, EXPORT_FORMATS, ExportInfo, export_events
@@ -24,11 +24,13 @@ __all__ = [
     "SENSOR_ORIGIN",
     "SPACING_PULSE",
     "CaptureDecode",
+    "CaptureMeta",
     "CaptureError",
     "Decoded",
     "ExportInfo",
     "Framing",
     "decode_capture",
+    "embedded_meta",
     "embedded_notes",
     "export_events",
     "merge_tx",

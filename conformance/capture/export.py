@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..transcript import TOOL, Event, EventKind
-from .comments import notes_comment
+from .comments import capture_comment
 from .levels import edges_of
 from .writers import Channel, write_csv, write_sr, write_vcd
 
@@ -56,9 +56,9 @@ def export_events(
     ``line_polarity``: levels of the SDI-12 wire itself (marking low) instead of the UART side
     (marking high). ``tool_channel``: add a second channel holding only the tool's own
     transmissions (origin ``tool``), like a capture of the recorder's TX beside the bus.
-    ``notes``: NOTE events kept in the file where the format has room for them (a .sr
-    member, a VCD ``$comment``; a CSV has none), in capture time; read back with
-    :func:`~conformance.capture.comments.embedded_notes`."""
+    ``notes``: NOTE events kept in the file (a .sr member, a VCD ``$comment``, a CSV comment
+    line), in capture time, with which channel is the bus and which the tool's; read back
+    with :func:`~conformance.capture.comments.embedded_meta`."""
     path = str(path)
     fmt = (fmt or os.path.splitext(path)[1].lstrip(".")).lower()
     if fmt not in EXPORT_FORMATS:
@@ -79,7 +79,10 @@ def export_events(
     if tool_channel:
         tool = [e for e in wire if e.origin == TOOL]
         channels.append(Channel(TOOL_CHANNEL, idle, edges_of(tool, sample_rate, t0)))
-    comment = notes_comment(notes, t0)
+    # a CSV keeps the transcript's clock, so its notes keep their own times
+    comment = capture_comment(
+        notes, 0.0 if fmt == "csv" else t0, BUS_CHANNEL, TOOL_CHANNEL if tool_channel else None
+    )
     if fmt == "sr":
         write_sr(path, channels, sample_rate, total, comment=comment)
     else:
@@ -87,7 +90,7 @@ def export_events(
             if fmt == "vcd":
                 write_vcd(fh, channels, sample_rate, total, comment=comment)
             else:
-                write_csv(fh, channels, sample_rate, t0)
+                write_csv(fh, channels, sample_rate, t0, comment=comment)
     return ExportInfo(
         path, fmt, sample_rate, t0, total, tuple(c.name for c in channels), line_polarity
     )

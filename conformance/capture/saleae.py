@@ -14,6 +14,7 @@ from collections.abc import Iterator
 
 from .edges import Edges
 from .errors import CaptureError
+from .writers import CSV_COMMENT_LEADER
 
 NS = 1_000_000_000
 CHUNK_ROWS = 4096
@@ -21,12 +22,13 @@ PERIOD_SAMPLE_EDGES = 2000  # edges used to estimate the sample period
 
 
 def _rows(path: str) -> Iterator[tuple[int, list[str]]]:
-    """(line number, fields) of each non-empty line, without loading the file."""
+    """(line number, fields) of each non-empty line that is not a comment (an export's own
+    metadata line, :mod:`.comments`), without loading the file."""
     try:
         with open(path, encoding="utf-8", errors="strict", newline="") as fh:
             for number, line in enumerate(fh, 1):
                 line = line.strip()
-                if line:
+                if line and not line.startswith(CSV_COMMENT_LEADER):
                     yield number, [f.strip().strip('"') for f in line.split(",")]
     except UnicodeDecodeError:
         raise CaptureError(path, "not text: binary data in a CSV export") from None

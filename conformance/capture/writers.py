@@ -56,6 +56,9 @@ def _levels(channel: Channel, total: int) -> Iterator[np.ndarray]:
         yield buf[:n]
 
 
+#: What leads a CSV comment line (PulseView's CSV import skips such lines by default).
+CSV_COMMENT_LEADER = ";"
+
 #: The .sr member holding an exporter's comment (sigrok ignores members it does not know).
 SR_COMMENT_MEMBER = "sdi12-conform-comment"
 
@@ -140,11 +143,19 @@ def write_vcd(
         fh.write(f"#{total}\n")
 
 
-def write_csv(fh: TextIO, channels: list[Channel], rate: float, t0: float) -> None:
+def write_csv(
+    fh: TextIO, channels: list[Channel], rate: float, t0: float, comment: str | None = None
+) -> None:
     """Saleae Logic 2 digital export: ``Time [s],<names>``, a row at the start and at every
-    change, times in seconds with nanosecond digits (the transcript's own clock)."""
+    change, times in seconds with nanosecond digits (the transcript's own clock).
+    ``comment``: one line written after the header behind :data:`CSV_COMMENT_LEADER` (the
+    format has no other place for what the export knows about itself)."""
     levels = [c.idle for c in channels]
     fh.write("Time [s]," + ",".join(c.name for c in channels) + "\n")
+    if comment:
+        if "\n" in comment:
+            raise ValueError("a CSV comment is one line")
+        fh.write(f"{CSV_COMMENT_LEADER} {comment}\n")
 
     def row(tick: int) -> str:
         return f"{t0 + tick / rate:.9f}," + ",".join(map(str, levels)) + "\n"

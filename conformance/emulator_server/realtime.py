@@ -42,6 +42,16 @@ LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counte
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
 
 
+@dataclass(frozen=True)
+class LineTally:
+    """The line's counts at one moment (:meth:`RealTimeLine.mark`), so a log can report a
+    stretch of its life rather than the running totals."""
+
+    frames_sent: int
+    late_frames: int
+    lost_frames: int
+
+
 @dataclass(order=True)
 class _Due:
     """Something the line must do at ``time``; ``seq`` keeps equal times in arrival order."""
@@ -86,6 +96,7 @@ class RealTimeLine:
         # busy to keep real time the emulated sensor's timing is not what it planned
         self.worst_lateness = 0.0
         self.late_frames = 0  # committed more than LATE_NOTICE after their planned start
+        self._stretch_worst = 0.0  # worst lateness since the last mark()
         # listeners on the line itself (``emulate --tap``): every character on the wire, the
         # recorder's and the sensor's, at its stop bit, as a UART on the bus would read it
         self._taps: list[Callable[[bytes], None]] = []
@@ -195,16 +206,31 @@ class RealTimeLine:
             with contextlib.suppress(OSError):
                 listen(bytes([wire]))
 
-    def timekeeping(self) -> str:
-        """One line for the server log: how well the line kept its schedule so far."""
+    def mark(self) -> LineTally:
+        """Start a stretch (a connection, a scenario) that :meth:`timekeeping` then reports
+        on alone: the counts so far, and the stretch's worst lateness restarted."""
+        with self._cond:
+            self._stretch_worst = 0.0
+            return LineTally(self.frames_sent, self.late_frames, self.lost_frames)
+
+    def timekeeping(self, since: LineTally | None = None, during: str = "this stretch") -> str:
+        """One line for a log: how well the line kept its schedule since ``since`` (from
+        :meth:`mark`, named ``during``; None: since it started), with what the counts
+        count. Issue 19: the per-connection log gave the line's life totals ("17 of 19335
+        frames"), which read as the connection's own."""
+        start = since or LineTally(0, 0, 0)
+        worst = self.worst_lateness if since is None else self._stretch_worst
+        sent = self.frames_sent - start.frames_sent
+        late = self.late_frames - start.late_frames
+        lost = self.lost_frames - start.lost_frames
+        scope = "since the line started" if since is None else f"during {during}"
         text = (
-            f"line kept real time within {self.worst_lateness * 1e3:.1f} ms "
-            f"({self.late_frames} of {self.frames_sent} frames more than "
-            f"{LATE_NOTICE * 1e3:.0f} ms late; real-time priority "
-            f"{'on' if self.realtime_priority else 'off'})"
+            f"line kept real time within {worst * 1e3:.1f} ms {scope}: of the {sent} "
+            f"sensor frames it sent, {late} went out more than {LATE_NOTICE * 1e3:.0f} ms "
+            f"late (real-time priority {'on' if self.realtime_priority else 'off'})"
         )
-        if self.lost_frames:
-            text += f"; {self.lost_frames} sensor frames lost under the recorder's raised RTS"
+        if lost:
+            text += f"; {lost} sensor frames lost under the recorder's raised RTS"
         return text
 
     def start(self) -> RealTimeLine:
@@ -261,6 +287,7 @@ class RealTimeLine:
                 self.device.pop_frame()
                 lateness = self.now() - frame.start
                 self.worst_lateness = max(self.worst_lateness, lateness)
+                self._stretch_worst = max(self._stretch_worst, lateness)
                 self.late_frames += lateness > LATE_NOTICE
                 if self.bench.require_rts and self._rts:
                     self.lost_frames += 1  # the recorder's driver still holds the line

@@ -125,11 +125,13 @@ class TcpEmulatorServer:
                     continue
                 self.connections += 1
                 self.log(f"recorder connected from {peer[0]}:{peer[1]}")
+                since = self.line.mark()
                 try:
                     self._serve_connection(sock)
                 finally:
                     sock.close()
-                    self.log(f"recorder disconnected; {self.line.timekeeping()}")
+                    kept = self.line.timekeeping(since, "this connection")
+                    self.log(f"recorder disconnected; {kept}")
                 if once:
                     return
         finally:

@@ -185,6 +185,11 @@ def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> F
     )
 
 
+#: A start-to-start spacing below half a frame (twice the nominal rate) is no character a
+#: 1200-baud UART receives: on a link with uncertain stamps it is the stamping's, not a rate.
+IMPOSSIBLE_SPACING = CHAR_TIME / 2
+
+
 def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertainty) -> Finding:
     """R-4.1-01 (decision A14: 1200 baud ±2%). Back-to-back characters start one frame apart,
     so the shortest start-to-start spacing inside a reply is at least one frame (8.17 ms at
@@ -219,6 +224,16 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
             )
         shortest, text = min(fast)
         where = [f"in reply to {escape(text)}"]
+    if shortest < IMPOSSIBLE_SPACING and (uncertainty > 0 or stamps.local is not None):
+        return Finding(
+            "R-4.1-01",
+            Verdict.INCONCLUSIVE,
+            f"the link's stamps put two reply characters {shortest * 1e3:.3f} ms apart, "
+            "shorter than any character a 1200-baud receiver can frame: the stamps (a burst "
+            "of one read), not the sensor, made that spacing, and it is no bit rate; undecided",
+            evidence=where,
+            observed=len(spacings),
+        )
     if shortest + 2 * uncertainty < low:
         return judge_window(
             "R-4.1-01",

@@ -58,8 +58,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--tool-channel",
-        action="store_true",
-        help="add a channel holding only the tool's transmissions (like a recorder TX probe)",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="a second channel TOOL_TX holding only the tool's transmissions, like a TX "
+        "probe beside the bus (default on: `judge` then knows who sent every character and "
+        "gives the run's verdicts back; --no-tool-channel writes the bus alone)",
     )
     return parser
 

@@ -19,7 +19,16 @@ import argparse
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..capture import CaptureDecode, CaptureError, decode_capture, embedded_notes, sniff
+from ..capture import (
+    CaptureDecode,
+    CaptureError,
+    CaptureMeta,
+    decode_capture,
+    embedded_meta,
+    read_edges,
+    sniff,
+)
+from ..capture.export import TOOL_CHANNEL
 from ..replay.link import VIRTUAL_KINDS
 from ..replay.recording import (
     Recording,
@@ -171,20 +180,24 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
     repeated against it: its options come from ``--run`` or from the notes an export kept in
     it, and every character's direction is known (else a note says why it is judged
     passively). The capture is decoded first in any case: a broken one is refused here."""
-    decoded = decode(found.path, args)
-    found.notes.extend(describe_decode(decoded))
+    meta = embedded_meta(str(found.path))
     if args.run:
         try:
             notes = [e for e in read_recording(args.run).events if e.kind is EventKind.NOTE]
         except RecordingError as exc:
             raise JudgeError(f"--run: {exc}") from None
     else:
-        notes = embedded_notes(str(found.path))
+        notes = meta.notes
     options = options_in(notes)
+    tool_tx = tool_channel(meta, args, found.path) if options else None
+    decoded = decode(found.path, args, tool_tx)
+    found.notes.extend(describe_decode(decoded))
     if not options:
         found.notes.append("judged passively: the capture does not say which run it is of")
         return
     found.run_role = str(options.get("role", "sensor"))
+    if tool_tx and found.run_role == "sensor":
+        args.tx_channel = tool_tx  # the tool was the recorder: its TX is the recorder's
     events, unsettled = directed(decoded.events)
     if unsettled:
         found.notes.append(
@@ -228,12 +241,34 @@ def directed(events: list[Event]) -> tuple[list[Event], int]:
     return out, open_
 
 
-def decode(path: Path, args: argparse.Namespace) -> CaptureDecode:
+def tool_channel(meta: CaptureMeta, args: argparse.Namespace, path: Path) -> str | None:
+    """The channel holding only the tool's own transmissions in a capture of a run of this
+    tool: ``--tx-channel``, else the one the export named (no option to repeat), else one
+    named as the export names it. None when the bus channel asked for is that one."""
+    if args.tx_channel:
+        return args.tx_channel
+    tool = meta.tool_channel or TOOL_CHANNEL
+    if args.channel == tool or (meta.tool_channel is None and not has_channel(path, tool)):
+        return None
+    return tool
+
+
+def has_channel(path: Path, name: str) -> bool:
+    """Whether the capture at ``path`` has a channel ``name``."""
+    try:
+        return name in read_edges(str(path), None).channels
+    except CaptureError:
+        return False
+
+
+def decode(path: Path, args: argparse.Namespace, tx_channel: str | None = None) -> CaptureDecode:
+    """``path`` decoded; ``tx_channel``: the tool's own TX (default ``--tx-channel``), whose
+    characters are the tool's (origin ``tool``, whatever side it played)."""
     try:
         return decode_capture(
             str(path),
             channel=args.channel,
-            tx_channel=args.tx_channel,
+            tx_channel=tx_channel or args.tx_channel,
             invert=args.invert,
             baud=args.baud,
         )

@@ -261,6 +261,7 @@ class RecorderSession:
         played = build_sensors(scenario.sensors)
         line.settle(SETTLE)
         line.bus.set_devices(played)
+        since = line.line.mark()
         begin = line.now()
         line.note(f"scenario {scenario.name}: {scenario.describe()}")
         error = None
@@ -271,7 +272,7 @@ class RecorderSession:
         line.note(output_note(scenario.name, output, error))
         line.settle(SETTLE)
         kept = line.line
-        line.note(f"scenario {scenario.name} done; {kept.timekeeping()}")
+        line.note(f"scenario {scenario.name} done; {kept.timekeeping(since, 'the scenario')}")
         end = line.now()
         line.bus.set_devices([])
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]

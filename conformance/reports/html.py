@@ -28,7 +28,7 @@ from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, Locator, WireRef
-from .timing_diagram import exchange_behind, timing_svg
+from .timing_diagram import exchange_behind, timing_svg, wire_title
 from .verdicts_json import dut_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
@@ -83,10 +83,18 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
 .filters input[disabled],.filters input[disabled]+span{display:none}
 td.extra:has(.sdi12-case) .logwrapper{display:none}
 tbody.sdi12-target{outline:3px solid #1565c0}
+/* the Result cell draws the verdict; its text stays pytest's outcome for pytest-html's filters */
+td.col-result.sdi12-verdict{font-size:0;white-space:nowrap}
+td.col-result.sdi12-verdict::before{content:attr(data-verdict);font-size:13px}
+td.col-result.sdi12-verdict::after{font-size:12px;font-weight:normal;color:#555}
+td.sdi12-verdict.v-PASS{color:#2e7d32}td.sdi12-verdict.v-FAIL{color:#c62828}
+td.sdi12-verdict.v-WARN{color:#b26a00}td.sdi12-verdict.v-INCONCLUSIVE{color:#6a1b9a}
+td.sdi12-verdict.v-NA{color:#666}td.sdi12-verdict.v-ERROR{color:#fff}
+.sdi12-rid,#sdi12-requirements td:first-child,table.sdi12 td:first-child{white-space:nowrap}
 </style>
 """
 
-SCRIPT = """
+SCRIPT = r"""
 <script>
 (function(){
   var top=document.getElementById('sdi12-top'), title=document.getElementById('title');
@@ -96,6 +104,16 @@ SCRIPT = """
   var results=document.getElementById('results-table');
   if(envh&&env&&results){results.parentNode.insertBefore(envh,results.nextSibling);
     envh.parentNode.insertBefore(env,envh.nextSibling);}
+  if(top&&top.dataset.cases){
+    var rc=document.querySelector('.run-count');
+    if(rc) rc.textContent=rc.textContent.replace(/^\d+ tests? took/,
+      top.dataset.cases+' conformance cases took');
+    var credit=document.querySelector('a[href*="pypi/pytest-html"]'), p=credit&&credit.parentNode;
+    var when=p&&p.textContent.match(/generated on (.+?) at (\S+)/);
+    if(p&&when){var v=p.textContent.match(/v(\d\S*)\s*$/);
+      p.textContent='Report by '+top.dataset.madeBy+', generated on '+when[1]+' at '+when[2]+
+        ' (page layout: ';
+      p.appendChild(credit); p.appendChild(document.createTextNode((v?' v'+v[1]:'')+')'));}}
   var h=document.querySelector('.summary__data h2');
   if(h) h.textContent='Evidence: the conformance cases';
   function findCase(name){var hit=null;
@@ -529,7 +547,8 @@ def case_html(
             svg = timing_svg(events, title=label)
             if svg:
                 parts.append(
-                    f'<p><b>Timing: {escape(label)}</b></p><div class="sdi12-diagram">{svg}</div>'
+                    f"<p><b>Timing: {escape(wire_title(label, events))}</b></p>"
+                    f'<div class="sdi12-diagram">{svg}</div>'
                 )
         parts.append(transcript_html(label, events))
     return f'<div class="sdi12-case">{"".join(parts)}</div>'
@@ -551,18 +570,37 @@ class HtmlReportPlugin:
         if self.run.results is None:
             return
         top = banner(self.run) + header(self.run) + attention(self.run)
-        prefix.extend([STYLE, f'<div id="sdi12-top">{top}{requirements_table(self.run)}</div>'])
+        made_by = escape(f"{TOOL['name']} {TOOL['version']}")
+        prefix.extend(
+            [
+                STYLE,
+                f'<div id="sdi12-top" data-cases="{len(self.run.cases)}" '
+                f'data-made-by="{made_by}">{top}{requirements_table(self.run)}</div>',
+            ]
+        )
         postfix.append(SCRIPT)
 
     def pytest_html_results_table_header(self, cells: list[str]) -> None:
-        cells.insert(1, '<th class="sortable" data-column-type="verdict">Verdict</th>')
-        cells.insert(2, "<th>Requirements</th>")
+        cells[0] = cells[0].replace(">Result<", ">Verdict<")
+        cells.insert(1, "<th>Requirements</th>")
 
     def pytest_html_results_table_row(self, report: Any, cells: list[str]) -> None:
+        """pytest-html's Result cell shows the case's verdict, not pytest's outcome ("Skipped"
+        for INCONCLUSIVE and N/A, issue 19). The outcome stays the cell's text, which
+        pytest-html's filters and sorting read; the stylesheet draws ``data-verdict``."""
         verdict = getattr(report, "sdi12_verdict", "")
-        reqs = " ".join(getattr(report, "sdi12_requirements", ()))
-        cells.insert(1, f'<td class="col-verdict {verdict_class(verdict)}">{escape(verdict)}</td>')
-        cells.insert(2, f"<td>{escape(reqs)}</td>")
+        if verdict:
+            cells[0] = cells[0].replace(
+                '<td class="col-result">',
+                f'<td class="col-result sdi12-verdict {verdict_class(verdict)}" '
+                f'data-verdict="{escape(verdict)}">',
+                1,
+            )
+        reqs = "".join(
+            f'<span class="sdi12-rid">{escape(r)}</span> '
+            for r in getattr(report, "sdi12_requirements", ())
+        )
+        cells.insert(1, f"<td>{reqs.rstrip()}</td>")
 
     def _where(self, record: CaseRecord) -> str:
         """Per exchange, the FAIL/WARN/INCONCLUSIVE findings of the case resting on it."""

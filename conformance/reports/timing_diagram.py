@@ -436,6 +436,29 @@ def _widest_gaps(events: Sequence[Event]) -> list[tuple[Event, Event]]:
     return out
 
 
+def wire_title(title: str, events: Iterable[Event]) -> str:
+    """``title`` with what the diagram draws of each break and the marking after it, as the
+    wire had them. A case's label names its stimulus as asked ("break, 77 ms marking, a!"),
+    and a link's latency can put other figures on the wire (89.05 ms); a title that states
+    only the asked figure reads as a diagram that contradicts it (issue 19)."""
+    drawn = sorted((e for e in events if e.kind is not EventKind.NOTE), key=lambda e: e.start)
+    said = []
+    for i, e in enumerate(drawn):
+        if e.kind is not EventKind.BREAK:
+            continue
+        command = next((f for f in drawn[i + 1 :] if f.kind is EventKind.CHAR), None)
+        if command is not None and command.origin == TOOL and command.start - e.end <= ELIDE_OVER:
+            said.append(f"break {_ms(e.duration)}, marking {_ms(command.start - e.end)}")
+    if not said:
+        return title
+    more = f" and {len(said) - WIRE_TITLE_BREAKS} more" if len(said) > WIRE_TITLE_BREAKS else ""
+    drawn_text = "; ".join(said[:WIRE_TITLE_BREAKS]) + more
+    return f"{title} (drawn as on the wire: {drawn_text})" if title else drawn_text
+
+
+WIRE_TITLE_BREAKS = 3  # breaks a title spells out
+
+
 def timing_svg(events: Iterable[Event], title: str = "") -> str:
     """An inline SVG of ``events`` (breaks and characters; notes are skipped), or "" if none."""
     drawn = [e for e in events if e.kind is not EventKind.NOTE]
@@ -467,7 +490,7 @@ def timing_svg(events: Iterable[Event], title: str = "") -> str:
     parts.append(_axis(axis))
     if note:
         parts.append(_text(axis.width - 10, HEIGHT - 4, note, size=12, anchor="end", fill="#666"))
-    label = escape(title or "timing diagram")
+    label = escape(wire_title(title, drawn) or "timing diagram")
     width = max(axis.width, LEGEND_WIDTH)
     return (
         f'<svg class="sdi12-timing" xmlns="http://www.w3.org/2000/svg" role="img" '
