@@ -174,6 +174,9 @@ class EchoTracker:
             if free and found:  # some echo came back, and another byte in this one's place
                 garbled[free[0]] = k
                 lower = free[0]
+        talked_over = bool(garbled) or any(
+            first < pos < last and pos not in at for pos in range(len(window))
+        )
         out: list[Heard] = []
         for pos, (byte, end) in enumerate(window):
             if pos in at:
@@ -188,7 +191,10 @@ class EchoTracker:
                 # the tool's character was sent all the same; what the line carried is the DUT's
                 out.append(Heard("tool", want.byte or 0, end, want))
                 out.append(Heard("dut", byte, end, note=note, collided=True))
-            elif first < pos < last:
+            elif first < pos < last or (pos < first and talked_over):
+                # between the echoes, the DUT talked over the tool; before them, in a window
+                # that shows it did, the byte may be the tool's own that the echo of the same
+                # value (taken as latest) stands for: either way no text of the DUT's
                 self.collisions += 1
                 note = (
                     f"{_show(byte)} came between the echoes of the tool's own characters "
