@@ -27,6 +27,10 @@ DUT = "dut"  # the device under test
 #: A recording that does not say who sent it (a logic-analyzer capture of the one wire, a
 #: listen-only monitor): the view infers the direction from the protocol.
 BUS = "bus"
+#: The ``text`` of a DUT character an echoing interface returned between the echoes of the
+#: tool's own characters: two talkers on the line. It is contention evidence, never the DUT's
+#: reply text, and never cuts a reply (issue 18).
+COLLISION = "collision"
 
 
 def parity_bit(char7: int) -> int:

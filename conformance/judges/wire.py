@@ -18,7 +18,7 @@ from ..protocol.timing import (
 )
 from ..transcript import Event, escape
 from ..verdicts import Finding, Verdict
-from ..view.runs import Segment, runs, segments
+from ..view.runs import Segment, frames, runs, segments
 from ..view.sides import expected_reply_address
 from .tally import Tally
 from .timing import (
@@ -107,7 +107,8 @@ def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event]]:
     gaps = []
     for seg in segs:
         where = ""
-        for run in runs(seg.reply) + runs(seg.later):
+        # the whole reply, however long a gap inside it: a gap is R-7.0-12's evidence
+        for run in [seg.reply, *runs(seg.later)]:
             for a, b in zip(run, run[1:], strict=False):
                 if seg.multiline and a.char7 == 0x0A:
                     continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
@@ -201,7 +202,7 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
     spacings = []
     fast = []  # spacings surely too short even with the stamps' local uncertainty
     for seg in segs:
-        for run in runs(seg.reply) + runs(seg.later):
+        for run in [seg.reply, *runs(seg.later)]:
             for a, b in zip(run, run[1:], strict=False):
                 spacings.append((b.start - a.start, seg.text))
                 if b.start - a.start + 2 * stamps.between(a.start, b.end) < CHAR_TIME * 0.98:
@@ -265,21 +266,33 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
 
 
 # -- framing of every reply -------------------------------------------------------------------
-def judge_framing(segs: list[Segment]) -> list[Finding]:
+def judge_framing(
+    segs: list[Segment], uncertainty: float | StampUncertainty = 0.0
+) -> list[Finding]:
     """R-4.1-02 (7E1 parity), R-4.2-02 (printable), R-4.2-03 (>= 3 chars, CR LF), R-4.3-01
-    (the responding sensor's address first) over every ASCII reply and service request."""
+    (the responding sensor's address first) over every ASCII reply and service request.
+
+    A reply is framed by its protocol end, never by a gap (:class:`Segment`); unsolicited
+    characters after it are framed at each LF, and at a gap only where it is surely there
+    given the stamps' ``uncertainty``. What the tool's next transmission talked over (the
+    DUT's characters meeting it: ``contention``) is no DUT's text, and the part before it
+    was cut by the tool, not by the DUT: neither is judged here."""
+    stamps = stamp_uncertainty(uncertainty)
     tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
     last_address = None
     for i, seg in enumerate(segs):
         if seg.reply:
             last_address = seg.reply[0].char7
-        # unsolicited characters cut off by the next command collided with it: what is left
-        # of them says nothing about framing (the collision is judged by the rule it breaks)
-        later = [] if i + 1 < len(segs) and segs[i + 1].contention else runs(seg.later)
-        reply = [seg.reply] if seg.reply and not seg.binary_reply else []
+        # characters cut off by the next transmission collided with it: what is left of
+        # them says nothing about framing (the collision is judged by the rule it breaks)
+        cut = i + 1 < len(segs) and bool(segs[i + 1].contention)
+        later = [] if cut else frames(seg.later, stamps.between)
+        tool_cut = cut and not seg.reply_ended and not seg.later  # the tool spoke over it
+        reply = [seg.reply] if seg.reply and not seg.binary_reply and not tool_cut else []
         chunks = reply + later
         for n, chunk in enumerate(chunks):
-            label = f"{'reply to' if n == 0 and seg.reply else 'later, after'} {escape(seg.text)}"
+            is_reply = n == 0 and bool(reply)
+            label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
             bad = [e for e in chunk if not e.parity_ok]
             tally.observe(label, ids=["R-4.1-02"])
             if bad:
@@ -289,7 +302,7 @@ def judge_framing(segs: list[Segment]) -> list[Finding]:
                     f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
                 )
             text = "".join(chr(e.char7) for e in chunk)
-            if seg.multiline and n == 0:  # decision A10: each line is framed on its own
+            if seg.multiline and is_reply:  # decision A10: each line is framed on its own
                 lines = text.replace("\x02", "", 1).rstrip("\x03").split("\r\n")
                 for line in lines[:-1]:
                     tally.observe(label, split_line(line + "\r\n")[1], ids=["R-4.2-02", "R-4.2-03"])
@@ -303,8 +316,8 @@ def judge_framing(segs: list[Segment]) -> list[Finding]:
             )
             body, framing = split_line(text, crc_positions=crc_positions)
             tally.observe(label, framing, ids=["R-4.2-02", "R-4.2-03"])
-            expected = expected_reply_address(seg.text) if n == 0 and seg.reply else None
-            if n > 0 or not seg.reply:  # unsolicited: a service request from the sensor
+            expected = expected_reply_address(seg.text) if is_reply else None
+            if not is_reply:  # unsolicited: a service request from the sensor
                 expected = chr(last_address) if last_address else None
             tally.observe(label, ids=["R-4.3-01"])
             if expected and body[:1] != expected:

@@ -44,8 +44,9 @@ class Heard:
     origin: str
     byte: int
     end: float  # s: arrival stamp
-    expected: Expected | None = None  # what it echoes (tool), or what it collided with (dut)
+    expected: Expected | None = None  # what it echoes (tool)
     note: str = ""
+    collided: bool = False  # the DUT's, received between echoes of the tool's characters
 
 
 class EchoTracker:
@@ -58,6 +59,7 @@ class EchoTracker:
         self.echoes = mode is EchoMode.ON
         self._pending: deque[Expected] = deque()
         self._held: list[Heard] = []  # matched while auto has not decided yet
+        self._window: list[tuple[int, float]] = []  # received while a decided echo is due
         self._chars_expected = 0  # characters in the transmission that decides auto
         self.collisions = 0
         self.missing = 0
@@ -81,7 +83,8 @@ class EchoTracker:
 
     def heard(self, byte: int, end: float) -> list[Heard]:
         """Sort one received byte; returns what to record now, in order (bytes held while
-        auto decides come out together once it has)."""
+        auto decides, or while a decided echo is still coming back, come out together once
+        they are sorted)."""
         while self._pending and self.listening:
             want = self._pending[0]
             if want.byte is None:  # spacing: echoed as a zero-prefix byte, or not at all
@@ -89,25 +92,30 @@ class EchoTracker:
                 if is_spacing_echo(byte):
                     return self._matched(Heard("tool", byte, end, want))
                 continue
-            if byte == want.byte:
-                self._pending.popleft()
-                return self._matched(Heard("tool", byte, end, want))
             if not self.decided:
+                if byte == want.byte:
+                    self._pending.popleft()
+                    return self._matched(Heard("tool", byte, end, want))
                 return self._decide(False, [Heard("dut", byte, end)])
-            self._pending.popleft()
-            self.collisions += 1
-            note = (
-                f"echo differs: the tool sent {_show(want.byte)}, the line carried "
-                f"{_show(byte)} (a collision: the DUT talked over the tool)"
-            )
-            # the tool's character was sent all the same; what the line carried is the DUT's
-            return [Heard("tool", want.byte, end, want), Heard("dut", byte, end, want, note)]
+            if want.byte == 0x00 and not self._window:  # a UART-timed pulse: one NUL alone
+                self._pending.popleft()
+                if is_spacing_echo(byte):
+                    return [Heard("tool", byte, end, want)]
+                self.collisions += 1
+                note = (
+                    f"echo differs: the tool sent a NUL pulse, the line carried {_show(byte)} "
+                    "(a collision: the DUT talked over the tool)"
+                )
+                return [Heard("tool", 0x00, end, want), Heard("dut", byte, end, note=note)]
+            return self._window_add(byte, end)
         return [Heard("dut", byte, end)]
 
     def expire(self) -> list[str]:
         """The time for the pending echoes is over: notes on what never came back (and, for
         auto, the decision)."""
         notes: list[str] = []
+        if self._window:
+            self._held = self._sort_window()
         missing = [e for e in self._pending if e.byte is not None]
         self._pending.clear()
         if not self.decided:
@@ -121,11 +129,84 @@ class EchoTracker:
         return notes
 
     def release(self) -> list[Heard]:
-        """Bytes held while deciding (when the decision came from :meth:`expire`)."""
+        """Bytes held while deciding or while the echo was coming back (when
+        :meth:`expire` ended the wait)."""
         held, self._held = self._held, []
         return held
 
     # -- internals ------------------------------------------------------------------------------
+    def _window_add(self, byte: int, end: float) -> list[Heard]:
+        """Hold a byte received while the tool's characters are still coming back; sort the
+        held bytes once the echo of the last one is among them.
+
+        A receiver hands bytes over in wire order, but not one by one: behind a USB latency
+        timer, the end of the DUT's previous reply and the echo of the tool's next command
+        reach the host in one batch. Taking each byte for an echo or not as it came mistook
+        the DUT's late characters for echoes that differed, and then the real echoes for the
+        DUT's (issue 18: ``'3!'`` judged as a reply). Held until the last expected character
+        is in, the echo is found as the latest bytes that spell what the tool sent, in order:
+        whatever came before it left the DUT before the tool spoke, whatever falls between
+        its characters is the DUT talking over the tool."""
+        self._window.append((byte, end))
+        chars = [e for e in self._pending if e.byte is not None]
+        if byte != chars[-1].byte:
+            return []
+        return self._sort_window()
+
+    def _sort_window(self) -> list[Heard]:
+        """Sort the held bytes into echoes and the DUT's. An expected character not found
+        where it belongs was garbled by a collision if some other byte came in its place (the
+        tool sent it all the same), else it stays pending (:meth:`expire` counts it
+        missing)."""
+        window, self._window = self._window, []
+        expected = [e for e in self._pending if e.byte is not None]
+        found = _alignment(window, expected)  # index in expected -> position in window
+        at = {pos: k for k, pos in found.items()}
+        first, last = min(at, default=len(window)), max(at, default=-1)
+        garbled: dict[int, int] = {}  # position in window -> index in expected
+        lower = -1
+        for k in range(len(expected)):
+            if k in found:
+                lower = found[k]
+                continue
+            upper = min((found[j] for j in found if j > k), default=len(window))
+            free = [p for p in range(lower + 1, upper) if p not in at]
+            if free and found:  # some echo came back, and another byte in this one's place
+                garbled[free[0]] = k
+                lower = free[0]
+        talked_over = bool(garbled) or any(
+            first < pos < last and pos not in at for pos in range(len(window))
+        )
+        out: list[Heard] = []
+        for pos, (byte, end) in enumerate(window):
+            if pos in at:
+                out.append(Heard("tool", byte, end, expected[at[pos]]))
+            elif pos in garbled:
+                want = expected[garbled[pos]]
+                self.collisions += 1
+                note = (
+                    f"echo differs: the tool sent {_show(want.byte)}, the line carried "
+                    f"{_show(byte)} (a collision: the DUT talked over the tool)"
+                )
+                # the tool's character was sent all the same; what the line carried is the DUT's
+                out.append(Heard("tool", want.byte or 0, end, want))
+                out.append(Heard("dut", byte, end, note=note, collided=True))
+            elif first < pos < last or (pos < first and talked_over):
+                # between the echoes, the DUT talked over the tool; before them, in a window
+                # that shows it did, the byte may be the tool's own that the echo of the same
+                # value (taken as latest) stands for: either way no text of the DUT's
+                self.collisions += 1
+                note = (
+                    f"{_show(byte)} came between the echoes of the tool's own characters "
+                    "(a collision: the DUT talked over the tool)"
+                )
+                out.append(Heard("dut", byte, end, note=note, collided=True))
+            else:
+                out.append(Heard("dut", byte, end))
+        done = set(found) | set(garbled.values())
+        self._pending = deque(e for k, e in enumerate(expected) if k not in done)
+        return out
+
     def _matched(self, heard: Heard) -> list[Heard]:
         if self.decided:
             return [heard]
@@ -142,6 +223,22 @@ class EchoTracker:
             self._pending.clear()
             held = [Heard("dut", h.byte, h.end) for h in held]
         return held + then
+
+
+def _alignment(window: list[tuple[int, float]], expected: list[Expected]) -> dict[int, int]:
+    """Where in ``window`` each of ``expected`` came back (its index -> position): the
+    latest positions that spell them in order, found from the last one back. Latest, because
+    the DUT's bytes that precede an echo left the line before it: the tool's first character
+    is the last byte of its value before the second one's echo, and so on. One not found
+    before the next one's position is left out (the line garbled or lost it)."""
+    out: dict[int, int] = {}
+    i = len(window) - 1
+    for k in range(len(expected) - 1, -1, -1):
+        pos = next((p for p in range(i, -1, -1) if window[p][0] == expected[k].byte), None)
+        if pos is not None:
+            out[k] = pos
+            i = pos - 1
+    return out
 
 
 def _show(byte: int | None) -> str:

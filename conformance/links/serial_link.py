@@ -30,7 +30,7 @@ from collections import deque
 import serial
 
 from ..protocol.timing import CHAR_TIME, RESPONSE_START_MAX, RESPONSE_START_MIN
-from ..transcript import DUT, TOOL, Event, EventKind, Transcript
+from ..transcript import COLLISION, DUT, TOOL, Event, EventKind, Transcript
 from .base import Link, LinkInfo, StopCondition
 from .breaks import BaudPulse, BreakMaker, PulseRefused
 from .direction import Direction, TimedRelease
@@ -241,10 +241,12 @@ class SerialLink(Link):
             heard.end - CHAR_TIME,
             heard.end,
             wire=heard.byte,
+            text=COLLISION if heard.collided else "",
             uncertainty=self.meter.uncertainty(),
         )
         self.transcript.add(event)
-        self._rx.append(event)
+        if not heard.collided:  # what met the tool's own characters is no reply to read
+            self._rx.append(event)
 
     def _check(self) -> None:
         """Raise if the port failed (called with or without the lock; reads one attribute)."""

@@ -2,27 +2,34 @@
 
 A :class:`~.segments.Transmission` frames its reply as the protocol does (to the LF, ETX or
 packet length): what a recorder must take as the answer. The whole-run timing and framing
-rules ask something else: every character a sensor sent, grouped so each character gap is
-measured inside one talker's run. A :class:`Segment` regroups a transmission's characters
-that way: the reply is the run that starts within 87 ms of the command and goes on while
-characters follow within :data:`RUN_GAP` (a late next line of multi-line text within
-:data:`LINE_RUN_GAP`); everything later is ``later`` (service requests, chatter), and what
-overlapped the command is ``contention``. Both cuts come from the one segmentation.
+rules regroup a transmission's characters so each is judged where it belongs: a
+:class:`Segment`'s reply is the run that starts within 87 ms of the command and goes on to
+its protocol end (the LF; ETX or a late line of multi-line text beyond :data:`LINE_RUN_GAP`;
+a binary packet's length), whatever gaps lie inside it: a gap is evidence for the
+character-gap rule only, and a gap on stamps the link saw irregular may not be there at all
+(issue 18: a reply cut at its stamps' gaps became three "replies" with framing FAILs).
+Everything later is ``later`` (service requests, chatter), and what overlapped the command,
+or came back between the echoes of its characters (:data:`~conformance.transcript.COLLISION`),
+is ``contention``: never the DUT's reply text. Both cuts come from the one segmentation.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
+from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
 from ..protocol.timing import NO_BREAK_WINDOW
-from ..transcript import Event
+from ..transcript import COLLISION, Event, decode_8n1
 from .segments import IsRecorder, Transmission, read_view
-from .sides import LF, STX
+from .sides import ETX, LF, STX
+
+#: How a gap's stamps are worth where it lies: ``(start, end) -> uncertainty`` (s).
+GapUncertainty = Callable[[float, float], float]
 
 REPLY_SEARCH = NO_BREAK_WINDOW  # a sensor run starting later than this is not a reply
-RUN_GAP = 0.05  # characters closer than this belong to one run (lenient, for evidence)
+RUN_GAP = 0.05  # unsolicited characters closer than this belong to one run (evidence only)
 LINE_RUN_GAP = 1.0  # a late next line of multi-line text still belongs to its reply
 
 
@@ -47,6 +54,18 @@ class Segment:
         """A reply starting ``a<STX>`` is multi-line text (decision A10)."""
         return len(self.reply) > 1 and self.reply[1].char7 == STX
 
+    @property
+    def reply_ended(self) -> bool:
+        """The reply reached its protocol end: LF (single line), ETX (multi-line text), the
+        packet's length (``aDBn!``)."""
+        if not self.reply:
+            return False
+        if self.binary_reply:
+            length = packet_length(decode_8n1(self.reply))
+            return length is not None and len(self.reply) >= length
+        last = self.reply[-1].char7
+        return last == ETX if self.multiline else last == LF
+
     @classmethod
     def of(cls, t: Transmission) -> Segment:
         cmd = t.command if t.is_command else None
@@ -57,7 +76,7 @@ class Segment:
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
         )
         for e in t.heard:
-            if not t.is_command or e.start < t.end:
+            if not t.is_command or e.start < t.end or e.text == COLLISION:
                 seg.contention.append(e)  # not a reply: it overlapped the command
             else:
                 _place(seg, e)
@@ -72,13 +91,12 @@ def _place(seg: Segment, e: Event) -> None:
         (seg.reply if e.start - seg.command_end <= REPLY_SEARCH else seg.later).append(e)
         return
     last = seg.reply[-1]
-    ended = not seg.binary_reply and last.char7 == LF and not seg.multiline
     # the next line of multi-line text may come late (R-4.4.13.1-03 judges how late)
-    allowed = LINE_RUN_GAP if seg.multiline and last.char7 == LF else RUN_GAP
-    if ended or e.start - last.end > allowed:
+    late_line = seg.multiline and last.char7 == LF and e.start - last.end > LINE_RUN_GAP
+    if seg.reply_ended or late_line:
         seg.later.append(e)
     else:
-        seg.reply.append(e)
+        seg.reply.append(e)  # a gap never ends a reply: R-7.0-12 judges it
 
 
 def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> list[Segment]:
@@ -94,4 +112,21 @@ def runs(events: list[Event]) -> list[list[Event]]:
             out[-1].append(e)
         else:
             out.append([e])
+    return out
+
+
+def frames(events: list[Event], uncertainty: GapUncertainty | None = None) -> list[list[Event]]:
+    """Split unsolicited sensor characters (service requests, chatter) as a recorder frames
+    them: after each LF, and at a gap surely longer than :data:`RUN_GAP` given the stamps'
+    ``uncertainty`` there (one the link's irregular stamps may have made is no gap)."""
+    out: list[list[Event]] = []
+    for e in events:
+        if out:
+            prev = out[-1][-1]
+            gap = e.start - prev.end
+            u = uncertainty(prev.start, e.end) if uncertainty is not None else 0.0
+            if prev.char7 != LF and gap - u <= RUN_GAP:
+                out[-1].append(e)
+                continue
+        out.append([e])
     return out

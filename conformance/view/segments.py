@@ -32,7 +32,7 @@ from ..protocol.timing import (
     MULTILINE_GAP_MAX,
     TOLERANCE,
 )
-from ..transcript import TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
+from ..transcript import COLLISION, TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
 from .direction import infer_directions
 from .sides import BUS, ETX, LF, RECORDER, STX, expected_reply_address
 
@@ -116,15 +116,16 @@ class Transmission:
 
     @property
     def contention(self) -> list[Event]:
-        """Sensor characters that started before the command ended (two talkers)."""
-        return [e for e in self.heard if e.start < self.end]
+        """Sensor characters that started before the command ended, or came back between the
+        echoes of its characters (two talkers): never part of a reply."""
+        return [e for e in self.heard if e.start < self.end or e.text == COLLISION]
 
     @property
     def reply(self) -> list[Event]:
         """The reply proper, framed as the protocol frames it: up to the first LF (7E1), the
         packet's length (``aDBn!``), or ETX / 150 ms of marking after a line (multi-line
         text). How long it took to start is the timing rules' question, not the framing's."""
-        heard = [e for e in self.heard if e.start >= self.end]
+        heard = [e for e in self.heard if e.start >= self.end and e.text != COLLISION]
         if self.binary:
             length = packet_length(decode_8n1(heard))
             return heard[:length] if length is not None else heard
@@ -144,7 +145,11 @@ class Transmission:
     def after(self) -> list[Event]:
         """What the sensors sent after the reply (service requests, chatter)."""
         reply = {id(e) for e in self.reply}
-        return [e for e in self.heard if e.start >= self.end and id(e) not in reply]
+        return [
+            e
+            for e in self.heard
+            if e.start >= self.end and id(e) not in reply and e.text != COLLISION
+        ]
 
     def at(self) -> str:
         """Where it is, for evidence lines."""

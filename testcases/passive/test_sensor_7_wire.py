@@ -46,7 +46,7 @@ def test_reply_framing(heard_sensors, case):
         )
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
-    case.extend(unseen(wire.judge_framing(segs)))
+    case.extend(unseen(wire.judge_framing(segs, heard_sensors.stamp_uncertainty)))
 
 
 @requirements("R-4.4.2-01", "R-4.4.2-02")

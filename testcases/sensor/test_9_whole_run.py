@@ -53,4 +53,4 @@ def test_reply_framing(sensor, case):
         case.add(wire.judge_reply_bit_rate(segs, sensor.stamp_uncertainty))
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
-    case.extend(wire.judge_framing(segs))
+    case.extend(wire.judge_framing(segs, sensor.stamp_uncertainty))

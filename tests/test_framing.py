@@ -1,0 +1,185 @@
+"""Framing from CR LF (issue 18, part 9): a reply ends at its protocol end, never at a gap; a
+gap is evidence for R-7.0-12 only, undecided on tainted stamps; the tool's own echoed
+characters, and the DUT's that met them, never count as the DUT's reply text."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import pytest
+
+from conformance.judges import wire
+from conformance.judges.timing import StampUncertainty
+from conformance.links.echo import EchoMode, EchoTracker, Expected
+from conformance.links.factory import open_real_link
+from conformance.protocol.timing import CHAR_TIME
+from conformance.transcript import COLLISION, DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.verdicts import Verdict
+from conformance.view.segments import read_view
+
+GAP = 60e-3  # s: longer than the old 50 ms run gap, so the old cut split the reply here
+
+
+def _chars(origin: str, text: str, start: float, gap_after: dict[int, float] | None = None):
+    out, t = [], start
+    for k, c in enumerate(text):
+        out.append(Event(EventKind.CHAR, origin, t, t + CHAR_TIME, wire=to_wire_7e1(ord(c))))
+        t += CHAR_TIME + (gap_after or {}).get(k, 0.0)
+    return out
+
+
+def _gapped_reply(reply: str = "0+1.23+4.56\r\n", at: int = 5) -> tuple[list[Event], float]:
+    """``0D0!`` and its reply with :data:`GAP` of marking after character ``at``; returns the
+    events and where the gap starts."""
+    cmd = _chars(TOOL, "0D0!", 0.0)
+    start = cmd[-1].end + 10e-3
+    rep = _chars(DUT, reply, start, {at: GAP})
+    return cmd + rep, rep[at].end
+
+
+def _verdicts(findings):
+    return {f.requirement: f for f in findings}
+
+
+def _tainted_near(at: float, u: float = 65e-3) -> StampUncertainty:
+    """Stamps the link saw irregular (a batch, a lagging reader) around ``at``."""
+    return StampUncertainty(0.5e-3, lambda s, e: u if s <= at + GAP and e >= at else 0.0)
+
+
+def test_a_reply_with_a_gap_on_tainted_stamps_is_one_reply_and_the_gap_is_undecided():
+    events, gap_at = _gapped_reply()
+    stamps = _tainted_near(gap_at)
+    (seg,) = wire.segments(events)
+    assert "".join(chr(e.char7) for e in seg.reply) == "0+1.23+4.56\r\n"
+    assert seg.later == []
+    framing = _verdicts(wire.judge_framing([seg], stamps))
+    assert framing["R-4.2-03"].verdict is Verdict.PASS
+    assert framing["R-4.3-01"].verdict is Verdict.PASS
+    gaps = _verdicts(wire.judge_gaps([seg], stamps))["R-7.0-12"]
+    assert gaps.verdict is not Verdict.FAIL
+    assert "set aside" in gaps.detail
+
+
+def test_a_real_gap_inside_a_reply_fails_the_gap_rule_only():
+    """On exact stamps the same gap is the DUT's: R-7.0-12 FAILs (the old cut never measured
+    it, and blamed the framing), while the reply's framing conforms."""
+    events, _ = _gapped_reply()
+    segs = wire.segments(events)
+    assert _verdicts(wire.judge_gaps(segs, 0.0))["R-7.0-12"].verdict is Verdict.FAIL
+    framing = _verdicts(wire.judge_framing(segs, 0.0))
+    assert framing["R-4.2-03"].verdict is Verdict.PASS
+    assert framing["R-4.3-01"].verdict is Verdict.PASS
+
+
+def test_a_service_request_split_by_tainted_stamps_is_one_frame():
+    cmd = _chars(TOOL, "0M!", 0.0)
+    ack = _chars(DUT, "00012\r\n", cmd[-1].end + 10e-3)
+    sr = _chars(DUT, "0\r\n", ack[-1].end + 2.0, {0: GAP})
+    stamps = _tainted_near(sr[0].end)
+    framing = _verdicts(wire.judge_framing(wire.segments(cmd + ack + sr), stamps))
+    assert framing["R-4.2-03"].verdict is Verdict.PASS
+    assert framing["R-4.3-01"].verdict is Verdict.PASS
+
+
+def test_a_binary_reply_ends_at_its_packet_length_not_at_a_gap():
+    cmd = _chars(TOOL, "0DB0!", 0.0)
+    packet = bytes([ord("0"), 2, 0, 1, 0x34, 0x12, 0xAA, 0xBB])  # size 2: 8 bytes in all
+    t, rep = cmd[-1].end + 10e-3, []
+    for k, b in enumerate(packet):
+        rep.append(Event(EventKind.CHAR, DUT, t, t + CHAR_TIME, wire=b))
+        t += CHAR_TIME + (GAP if k == 3 else 0.0)
+    extra = _chars(DUT, "0\r\n", t + 5e-3)
+    (seg,) = wire.segments(cmd + rep + extra)
+    assert seg.reply == rep and seg.reply_ended
+    assert seg.later == extra
+
+
+# -- echoes ---------------------------------------------------------------------------------
+def _wire(text: str) -> list[int]:
+    return [to_wire_7e1(ord(c)) for c in text]
+
+
+def _expect(text: str) -> list[Expected]:
+    return [Expected(b, CHAR_TIME) for b in _wire(text)]
+
+
+def test_the_dut_s_late_bytes_before_an_echo_stay_the_dut_s():
+    """Behind a USB latency timer the end of a reply and the echo of the next command come in
+    one batch: the reply's bytes are the DUT's, the echo the tool's, no collision (the old
+    sorting took the reply's bytes for differing echoes, then the echo for the DUT's)."""
+    tracker = EchoTracker(EchoMode.ON)
+    tracker.expect(_expect("0D1!"))
+    got = []
+    for k, b in enumerate(_wire("14.250\r\n") + _wire("0D1!")):
+        got += tracker.heard(b, k * CHAR_TIME)
+    assert [(h.origin, chr(h.byte & 0x7F)) for h in got] == [
+        *(("dut", c) for c in "14.250\r\n"),
+        *(("tool", c) for c in "0D1!"),
+    ]
+    assert tracker.collisions == 0 and tracker.pending == 0
+    assert not any(h.collided for h in got)
+
+
+def test_the_dut_s_bytes_between_echoes_are_collisions_never_echoes():
+    tracker = EchoTracker(EchoMode.ON)
+    tracker.expect(_expect("0D0!"))
+    got = []
+    for k, b in enumerate(_wire("00D\r0\n!")):  # the tool's 0D0! and the DUT's 0<CR><LF>
+        got += tracker.heard(b, k * CHAR_TIME)
+    tool = "".join(chr(h.byte & 0x7F) for h in got if h.origin == "tool")
+    dut = [(chr(h.byte & 0x7F), h.collided) for h in got if h.origin == "dut"]
+    assert tool == "0D0!"
+    assert dut == [("0", True), ("\r", True), ("\n", True)]  # one 0 of the two is the tool's
+    assert tracker.collisions == 3
+
+
+@pytest.fixture
+def echoing_link():
+    """loop:// is an interface that hears itself: what the tool writes comes back."""
+    link = open_real_link("loop://", echo=EchoMode.ON)
+    try:
+        yield link
+    finally:
+        link.close()
+
+
+def _write_with_dut(link, dut_interleaved: bytes, wire_bytes: bytes) -> list[Event]:
+    """The tool writes ``wire_bytes`` while the DUT's bytes meet them on the line: the loop
+    returns ``dut_interleaved``, the tool's bytes and the DUT's in line order."""
+    original = link._port_write
+    link._port_write = lambda data: original(dut_interleaved)
+    try:
+        return link.write(wire_bytes)
+    finally:
+        link._port_write = original
+
+
+def test_behind_echo_a_dut_talking_over_the_command_is_contention_not_a_reply(echoing_link):
+    """A measurement the break did not abort: its service request meets the tool's next
+    command on an echoing line. The DUT's bytes are contention (marked, never read as a
+    reply), the tool's echo is its command, and the reply framing holds no FAIL."""
+    link = echoing_link
+    line = bytes(_wire("00D\r0\n!"))  # 0D0! with the DUT's 0<CR><LF> between its characters
+    sent = _write_with_dut(link, line, bytes(_wire("0D0!")))
+    assert "".join(chr(e.char7) for e in sent) == "0D0!"
+    time.sleep(2 * CHAR_TIME)
+    assert link.receive(link.now()) == []  # the collided bytes are no reply to read
+    link.port.write(bytes(_wire("0+1.5\r\n")))  # the DUT's reply to 0D0!
+    reply = link.receive(link.now() + 1.0, until=lambda got: len(got) == 7)
+    assert sorted(chr(e.char7) for e in reply) == sorted("0+1.5\r\n")
+    # loop:// hands bytes over faster than a wire: stamp them as a 1200 baud line would, in
+    # the order the link recorded them, to read the view
+    recorded = [e for e in link.transcript.events if e.kind is EventKind.CHAR]
+    events = [
+        replace(e, start=k * CHAR_TIME, end=(k + 1) * CHAR_TIME) for k, e in enumerate(recorded)
+    ]
+    collided = [e for e in events if e.origin == DUT and e.text == COLLISION]
+    assert "".join(chr(e.char7) for e in collided) == "0\r\n"
+    view = read_view(events)
+    (t,) = view.commands
+    assert t.text == "0D0!" and t.contention  # two talkers, said
+    assert {id(e) for e in t.contention} <= {id(e) for e in collided}
+    assert "".join(chr(e.char7) for e in t.reply) == "0+1.5\r\n"
+    framing = wire.judge_framing(wire.segments(events), 0.0)
+    assert not [f for f in framing if f.verdict is Verdict.FAIL], framing
