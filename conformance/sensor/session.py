@@ -8,15 +8,15 @@ fresh state (aborts, address change) ask for a ``fresh`` stimulus explicitly.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from ..declaration import Declaration
-from ..judges.timing import StampUncertainty
+from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
 from ..protocol import commands as cmd
-from ..protocol.commands import Command, parse_command
+from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..protocol.responses import Identification, parse_ident, split_line
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, escape
@@ -79,6 +79,20 @@ HEARING_MARKINGS = (9e-3, 25e-3, 50e-3, 85e-3, 120e-3)
 PROBE_LATE = 20e-3  # s
 PROBE_TRIES = 3
 
+
+#: Commands a whole-run judge may have sent again to confirm a rare deviation in their
+#: replies (:meth:`SensorSession.reprobe`): they change nothing in the sensor, no measurement
+#: starts and no address moves, so the repeats leave the run as it was.
+REPROBE_KINDS = frozenset(
+    {
+        Kind.ACKNOWLEDGE,
+        Kind.IDENTIFY,
+        Kind.DATA,
+        Kind.CONTINUOUS,
+        Kind.IDENTIFY_MEASUREMENT,
+        Kind.METADATA,
+    }
+)
 
 #: Breaks (s) tried before a device that ignored the usual 13 ms break is called absent.
 LONGER_BREAKS = (30e-3, 60e-3, 100e-3)
@@ -315,6 +329,32 @@ class SensorSession:
 
     def feature(self, name: str) -> bool | None:
         return self.declaration.feature(name)
+
+    def reprobe(self, commands: Iterable[str], times: int = REPROBE_TIMES) -> list[Exchange]:
+        """Send each of ``commands`` ``times`` times again (once per run and command), the
+        way a recorder sends it, so a judge that found a rare deviation in its reply on a
+        real-time link sees whether it recurs at the same place (issue 18): a device's does,
+        a stalling host's does not. The repeats are on the transcript like any exchange, and
+        the judge reads them there. A command that is not this sensor's or of a kind that
+        changes its state (:data:`REPROBE_KINDS`) is not sent; the judge stays undecided."""
+        made: list[Exchange] = []
+        for text in commands:
+            made += self.once(("reprobe", text), lambda t=text: self._reprobe(t, times))
+        return made
+
+    def _reprobe(self, text: str, times: int) -> list[Exchange]:
+        try:
+            command = parse_command(text)
+        except CommandError:
+            return []
+        if command.address != self.address or command.kind not in REPROBE_KINDS:
+            return []
+        self.link.transcript.note(
+            self.link.now(),
+            f"re-probe: {escape(text)} sent {times} times again to see whether a rare "
+            "deviation in its reply recurs at the same place",
+        )
+        return [self.master.transact(command) for _ in range(times)]
 
     def listen(self, duration: float) -> list[Event]:
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""

@@ -1,0 +1,153 @@
+"""Confirmation probes (issue 18, part 8): a rare deviation on a real-time link is decided by
+where it falls, after the suite sent the same command again; a timed probe that misses the
+window it aimed at is sent again until it lands.
+
+A real-time link is modelled on the simulated bus: the link declares a stamp uncertainty of
+``U`` and, optionally, a host that stalls at random makes one character's stamps late by
+``STALL`` now and then (seeded), as a reader thread that was not scheduled does.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import replace
+
+import pytest
+
+from conformance.case import Case
+from conformance.judges.timing import (
+    CONFIRM_OBSERVATIONS,
+    combine_local,
+    deviation_pattern,
+    judge_window,
+)
+from conformance.ports import open_sim, parse_sim
+from conformance.results import CaseRecord
+from conformance.sensor.session import SensorSession
+from conformance.transcript import DUT, EventKind
+from conformance.verdicts import Verdict
+from testcases.sensor.test_9_whole_run import test_character_gaps as gaps_case
+from testcases.sensor.test_9_whole_run import test_response_start_window as start_case
+
+U = 1.2e-3  # s: the stamp uncertainty of an echoing USB interface (issue 18: ± 1.21 ms)
+STALL = 3.5e-3  # s: how late a stalled host stamps a character
+
+
+def _real_time_session(
+    faults: str = "", *, stalls: float = 0.0, seed: int = 7, stalled: frozenset[int] = frozenset()
+) -> SensorSession:
+    """A session on the simulated bus whose link looks like a real-time one: a measured
+    uncertainty of ``U``, a local-uncertainty hook (so the judges take it as real time), and
+    a share ``stalls`` of the sensor's characters (or those numbered in ``stalled``, counted
+    from 0) stamped ``STALL`` late."""
+    opened = open_sim(parse_sim(f"sim://?faults={faults}" if faults else "sim"))
+    link = opened.link
+    link.timing_uncertainty = lambda: U
+    link.uncertainty_between = lambda start, end: U
+    rng = random.Random(seed)
+    add = link.transcript.add
+    count = {"dut": 0}
+
+    def stamped(event):
+        if event.kind is not EventKind.CHAR or event.origin != DUT:
+            return add(event)
+        number = count["dut"]
+        count["dut"] += 1
+        late = rng.random() < stalls or number in stalled
+        if late:
+            event = replace(event, start=event.start + STALL, end=event.end + STALL)
+        return add(event)
+
+    link.transcript.add = stamped
+    session = SensorSession(link, declaration=opened.declaration)
+    session.discover()
+    return session
+
+
+def _judged(case_fn, session: SensorSession, rid: str):
+    record = CaseRecord(case_fn.__name__, case_fn.__name__, (rid, "R-7.0-01"))
+    case_fn(session, Case(record))
+    return {f.requirement: f for f in record.findings}, record
+
+
+def _reprobes(session: SensorSession) -> list[str]:
+    return [e.text for e in session.link.transcript.events if e.text.startswith("re-probe")]
+
+
+@pytest.mark.parametrize("stalls", [0.0, 0.004])
+def test_a_gap_recurring_in_every_ident_reply_fails_on_a_real_time_link(stalls):
+    """Seen: one 4 ms gap at the same place of every aI! reply came out INCONCLUSIVE as
+    a possible host stall. The suite sends aI! again and the recurring gap FAILs."""
+    session = _real_time_session("ident-pause", stalls=stalls)
+    found, record = _judged(gaps_case, session, "R-7.0-12")
+    gap = found["R-7.0-12"]
+    assert gap.verdict is Verdict.FAIL, gap.detail
+    assert "recur at the same point" in gap.detail and "reply to 0I!, character 6" in gap.detail
+    assert gap.evidence and gap.observed >= 1
+    assert any("0I!" in text for text in _reprobes(session))
+    assert any(label.startswith("re-probed 0I!") for label, _ in record.evidence)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_random_stalls_alone_are_no_fail(seed):
+    """A host that stalls at random makes a few gaps deviate at places that do not recur:
+    the repeats of those commands conform, so no FAIL (set aside where the repeats tell)."""
+    session = _real_time_session(stalls=0.004, seed=seed)
+    found, _ = _judged(gaps_case, session, "R-7.0-12")
+    assert found["R-7.0-12"].verdict is not Verdict.FAIL, found["R-7.0-12"].detail
+    starts, _ = _judged(start_case, session, "R-7.0-09")
+    assert all(f.verdict is not Verdict.FAIL for f in starts.values())
+
+
+def test_a_stall_the_repeats_do_not_reproduce_is_set_aside_and_the_rest_passes():
+    """One stall in the first aI! reply (the sensor's 11th character: ``?!`` took 3): aI! is
+    sent again, its repeats conform at that place, so the deviation is set aside as a stall,
+    named in the detail, and the rule rests on the rest."""
+    session = _real_time_session(stalled=frozenset({10}))
+    found, _ = _judged(gaps_case, session, "R-7.0-12")
+    gap = found["R-7.0-12"]
+    assert gap.verdict is Verdict.PASS, gap.detail
+    assert "1 deviating character gap set aside as stalls of the host" in gap.detail
+    assert "1 of 12 at reply to 0I!" in gap.detail
+    assert _reprobes(session) == [
+        "re-probe: 0I! sent 10 times again to see whether a rare deviation in its reply "
+        "recurs at the same place"
+    ]
+
+
+def test_the_clean_sensor_on_a_real_time_link_is_not_reprobed():
+    session = _real_time_session()
+    found, _ = _judged(gaps_case, session, "R-7.0-12")
+    assert found["R-7.0-12"].verdict is Verdict.PASS
+    assert not _reprobes(session)
+
+
+def _gap(ms: float, where: str):
+    return judge_window(
+        "R-7.0-12", "gap", ms * 1e-3, 1e-3, high=1.66e-3, tolerance=0.0, evidence=[where]
+    )
+
+
+def test_deviation_pattern_tells_a_recurring_place_from_a_lone_one():
+    ok, bad = _gap(0.0, "in reply to 0I!"), _gap(4.0, "in reply to 0I!")
+    n = CONFIRM_OBSERVATIONS
+    recurring = [(bad, ("0I!", 6))] * n + [(ok, ("0!", 1))] * 200
+    assert set(deviation_pattern(recurring).recurring) == {("0I!", 6)}
+    lone = [(bad, ("0I!", 6))] + [(ok, ("0I!", 6))] * (n - 1) + [(ok, ("0!", 1))] * 200
+    pattern = deviation_pattern(lone)
+    assert set(pattern.not_reproduced) == {("0I!", 6)} and not pattern.recurring
+    few = [(bad, ("0I!", 6)), (bad, ("0I!", 6))] + [(ok, ("0!", 1))] * 200
+    assert deviation_pattern(few).commands == ["0I!"]  # two of two: observe it again first
+
+
+def test_combine_local_decides_few_deviations_by_their_place():
+    ok, bad = _gap(0.0, "in reply to 0!"), _gap(4.0, "in reply to 0I!")
+    base = [(ok, False, ("0!", 1))] * 300
+    recurring = base + [(bad, False, ("0I!", 6))] * 12
+    assert combine_local("R-7.0-12", recurring, "gap").verdict is Verdict.FAIL
+    stall = base + [(bad, False, ("0I!", 6))] + [(ok, False, ("0I!", 6))] * 11
+    found = combine_local("R-7.0-12", stall, "gap")
+    assert found.verdict is Verdict.PASS and "set aside as stalls" in found.detail
+    unplaced = base + [(bad, False, ("0I!", 6))] * 2
+    assert combine_local("R-7.0-12", unplaced, "gap").verdict is Verdict.INCONCLUSIVE
+    assert combine_local("R-7.0-12", unplaced, "gap", real_time=False).verdict is Verdict.FAIL
