@@ -332,15 +332,37 @@ def test_follow_up_without_break(sensor, case):
         return
     last, probes = first, []
     for marking in (0.02, edge):
-        ex, idle = _after_marking(
-            sensor, last.last.reply_events[-1].end, marking, f"{sensor.address}I!"
-        )
-        case.evidence(f"{idle * 1e3:.2f} ms marking, aI! with no break", [last, ex])
-        if idle + u >= NO_BREAK_WINDOW - TOLERANCE:
+
+        def attempt(n, marking=marking, after=last):
+            if n:  # a follow-up that missed may have found the sensor asleep: wake it again
+                after = _awake(sensor)
+            if not after.answered:
+                return after, None
+            ex, idle = _after_marking(
+                sensor, after.last.reply_events[-1].end, marking, f"{sensor.address}I!"
+            )
+            case.evidence(f"{idle * 1e3:.2f} ms marking, aI! with no break", [after, ex])
+            return ex, idle
+
+        def miss(sent):
+            _ex, idle = sent
+            if idle is None:
+                return "the wake-up a! before it went unanswered"
+            if idle + u >= NO_BREAK_WINDOW - TOLERANCE:
+                return f"it went out after {idle * 1e3:.2f} ms of marking, not surely under 87 ms"
+            return None
+
+        aimed = sensor.aim(f"follow-up aI! after {marking * 1e3:.1f} ms", attempt, miss)
+        if aimed.landed is None:
             case.add(
-                inconclusive("R-7.0-16", f"marking {idle * 1e3:.2f} ms is not surely under 87 ms")
+                inconclusive(
+                    "R-7.0-16",
+                    f"the follow-up aimed at {marking * 1e3:.1f} ms of marking never went out "
+                    f"surely under 87 ms: {miss(aimed.last)}{aimed.missed}",
+                )
             )
             return
+        ex, idle = aimed.landed
         probes.append((ex, idle))
         if not ex.answered:
             break  # the next probe would be timed from a reply that never came
