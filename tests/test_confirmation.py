@@ -29,6 +29,7 @@ from conformance.sim.bus import SimLink
 from conformance.transcript import DUT, EventKind
 from conformance.verdicts import Verdict
 from testcases.sensor.test_7_timing import test_follow_up_without_break as follow_up_case
+from testcases.sensor.test_7_timing import test_ready_within_100ms_of_break as wake_case
 from testcases.sensor.test_9_whole_run import test_character_gaps as gaps_case
 from testcases.sensor.test_9_whole_run import test_response_start_window as start_case
 
@@ -217,3 +218,27 @@ def test_a_follow_up_that_never_lands_is_inconclusive_saying_so(monkeypatch):
     found = _follow_up(session)
     assert found.verdict is Verdict.INCONCLUSIVE
     assert f"none of {PROBE_TRIES} tries landed" in found.detail, found.detail
+
+
+def test_a_slow_waker_fails_r_7_0_07_though_the_first_probe_went_out_past_100ms(monkeypatch):
+    """The same for R-7.0-07's a! 90 ms after a break: the first goes out 12 ms late (past
+    100 ms, where it proves nothing), the second lands, and a sensor that needs 110 ms to
+    wake FAILs on it."""
+    original = SimLink.write
+    count = {"n": 0}
+
+    def write(self, wire, gap=0.0):
+        breaks = [e for e in self.transcript.events if e.kind is EventKind.BREAK]
+        quiet = self.now() - breaks[-1].end if breaks else 0.0
+        if 0.07 < quiet < 0.08 and count["n"] < 1:
+            count["n"] += 1
+            self.wait_until(self.now() + 12e-3)
+        return original(self, wire, gap)
+
+    session = _sim_session("slow-wake")
+    monkeypatch.setattr(SimLink, "write", write)
+    record = CaseRecord(wake_case.__name__, wake_case.__name__, ("R-7.0-07",))
+    wake_case(session, Case(record))
+    (found,) = record.findings
+    assert count["n"] == 1
+    assert found.verdict is Verdict.FAIL, found.detail
