@@ -126,6 +126,9 @@ def test_the_clean_sensor_on_a_real_time_link_is_not_reprobed():
     assert not _reprobes(session)
 
 
+IDENT = "014SDI12EMU...\r\n"  # the reply text part of a place (any one reply)
+
+
 def _gap(ms: float, where: str):
     return judge_window(
         "R-7.0-12", "gap", ms * 1e-3, 1e-3, high=1.66e-3, tolerance=0.0, evidence=[where]
@@ -135,24 +138,25 @@ def _gap(ms: float, where: str):
 def test_deviation_pattern_tells_a_recurring_place_from_a_lone_one():
     ok, bad = _gap(0.0, "in reply to 0I!"), _gap(4.0, "in reply to 0I!")
     n = CONFIRM_OBSERVATIONS
-    recurring = [(bad, ("0I!", 6))] * n + [(ok, ("0!", 1))] * 200
-    assert set(deviation_pattern(recurring).recurring) == {("0I!", 6)}
-    lone = [(bad, ("0I!", 6))] + [(ok, ("0I!", 6))] * (n - 1) + [(ok, ("0!", 1))] * 200
-    pattern = deviation_pattern(lone)
-    assert set(pattern.not_reproduced) == {("0I!", 6)} and not pattern.recurring
-    few = [(bad, ("0I!", 6)), (bad, ("0I!", 6))] + [(ok, ("0!", 1))] * 200
+    here, rest = ("0I!", IDENT, 6), [(ok, ("0!", "0\r\n", 1))] * 200
+    assert set(deviation_pattern([(bad, here)] * n + rest).recurring) == {here}
+    pattern = deviation_pattern([(bad, here)] + [(ok, here)] * (n - 1) + rest)
+    assert set(pattern.not_reproduced) == {here} and not pattern.recurring
+    few = [(bad, here), (bad, here)] + rest
     assert deviation_pattern(few).commands == ["0I!"]  # two of two: observe it again first
+    other = [(bad, here)] + [(ok, ("0I!", "0other\r\n", 6))] * n + rest
+    assert deviation_pattern(other).commands == ["0I!"]  # other replies do not confirm it
 
 
 def test_combine_local_decides_few_deviations_by_their_place():
     ok, bad = _gap(0.0, "in reply to 0!"), _gap(4.0, "in reply to 0I!")
-    base = [(ok, False, ("0!", 1))] * 300
-    recurring = base + [(bad, False, ("0I!", 6))] * 12
+    base = [(ok, False, ("0!", "0\r\n", 1))] * 300
+    recurring = base + [(bad, False, ("0I!", IDENT, 6))] * 12
     assert combine_local("R-7.0-12", recurring, "gap").verdict is Verdict.FAIL
-    stall = base + [(bad, False, ("0I!", 6))] + [(ok, False, ("0I!", 6))] * 11
+    stall = base + [(bad, False, ("0I!", IDENT, 6))] + [(ok, False, ("0I!", IDENT, 6))] * 11
     found = combine_local("R-7.0-12", stall, "gap")
     assert found.verdict is Verdict.PASS and "set aside as stalls" in found.detail
-    unplaced = base + [(bad, False, ("0I!", 6))] * 2
+    unplaced = base + [(bad, False, ("0I!", IDENT, 6))] * 2
     assert combine_local("R-7.0-12", unplaced, "gap").verdict is Verdict.INCONCLUSIVE
     assert combine_local("R-7.0-12", unplaced, "gap", real_time=False).verdict is Verdict.FAIL
 

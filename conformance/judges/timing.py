@@ -63,9 +63,11 @@ CONFIRM_OBSERVATIONS = 6
 #: How often a whole-run case sends a command again to confirm a deviation in its reply.
 REPROBE_TIMES = 10
 
-#: Where an observation fell: the command whose reply it is in and the position in that
-#: reply (a character index; 0 for the reply's start). None: no place known.
-Place = tuple[str, int]
+#: Where an observation fell: the command, the reply it is in (its text: the same command
+#: may read other data another time, and only the same reply shows the same point again)
+#: and the position in that reply (a character index; 0 for the reply's start). None: no
+#: place known.
+Place = tuple[str, str, int]
 Observation = tuple[Finding, bool] | tuple[Finding, bool, Place | None]
 
 
@@ -138,7 +140,7 @@ def _aside(f: Finding, tainted: bool) -> bool:
 
 
 def _where(place: Place) -> str:
-    command, index = place
+    command, _reply, index = place
     return f"reply to {command}" + (f", character {index}" if index else "")
 
 

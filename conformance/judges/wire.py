@@ -86,7 +86,7 @@ def _start_observations(
         u = stamps.between(seg.command[-1].start, seg.reply[0].end)
         tainted = u > stamps.base
         where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
-        place: Place = (seg.text, 0)
+        place: Place = (seg.text, _text(seg), 0)
         early.append(
             (
                 judge_window(
@@ -119,6 +119,11 @@ def _start_observations(
     return early, late
 
 
+def _text(seg: Segment) -> str:
+    """All the sensor sent after the command, as text: part of an observation's place."""
+    return "".join(chr(e.char7) for e in seg.reply + seg.later)
+
+
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     """Every marking gap between consecutive characters of one DUT run, with its context."""
     return [(gap, where) for gap, where, _a, _b, _p in _gaps(segs)]
@@ -135,13 +140,14 @@ def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event, Place]]:
     gaps = []
     for seg in segs:
         where = ""
+        text = _text(seg)
         first = 0  # index of the run's first character in all the sensor sent after it
         for run in runs(seg.reply) + runs(seg.later):
             for k, (a, b) in enumerate(zip(run, run[1:], strict=False), start=first + 1):
                 if seg.multiline and a.char7 == 0x0A:
                     continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
                 where = where or f"in reply to {escape(seg.text)}"
-                gaps.append((b.start - a.end, where, a, b, (seg.text, k)))
+                gaps.append((b.start - a.end, where, a, b, (seg.text, text, k)))
             first += len(run)
     return gaps
 
