@@ -900,6 +900,15 @@ def check_unknown_command_text(rig: Rig) -> None:
     assert rig.ask("0XNOPE!").text == "0UNKN\r\n"
 
 
+def check_ident_pause(rig: Rig) -> None:
+    """One 4 ms gap, before the seventh character of every aI! reply, and nowhere else."""
+    for _ in range(2):
+        gaps = rig.ask("0I!").gaps
+        assert gaps[5] == pytest.approx(4e-3)
+        assert all(g == pytest.approx(0.0) for i, g in enumerate(gaps) if i != 5)
+    assert all(g == pytest.approx(0.0) for g in rig.ask("0!").gaps)
+
+
 def check_abort_sends_zero_reply(rig: Rig) -> None:
     rig.ask("0M!")
     rig.wait(0.5)
@@ -912,6 +921,7 @@ CHECKS.update(
         "never-standby": check_never_standby,
         "unknown-command-text": check_unknown_command_text,
         "abort-sends-zero-reply": check_abort_sends_zero_reply,
+        "ident-pause": check_ident_pause,
     }
 )
 

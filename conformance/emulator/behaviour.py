@@ -46,6 +46,10 @@ class Behaviour:
     # -- transmitting ------------------------------------------------------------------------
     reply_delay: float = REPLY_DELAY
     char_gap: float = 0.0  # marking between reply characters (R-7.0-12)
+    #: Extra marking before one character of every aI! reply (R-7.0-12): a firmware that
+    #: pauses at the same point of the same reply, as it fetches the next field, say.
+    ident_pause: float = 0.0
+    ident_pause_at: int = 6  # the index of the character the pause comes before
     char_time: float = CHAR_TIME  # one 10-bit frame: 1200 baud (R-4.1-01)
     line_gap: float = 20e-3  # marking between the lines of multi-line text (R-4.4.13.1-03)
     line_limit: int | None = None  # cut multi-line text lines to this (None: as written)

@@ -405,7 +405,10 @@ class SensorEmulator:
         if rewritten is None:
             return None
         b = self.behaviour
-        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time)
+        pause = b.ident_pause if rewritten.kind is ReplyKind.IDENTIFICATION else 0.0
+        return self._tx.schedule(
+            rewritten, at, b.char_gap, b.char_time, pause=(b.ident_pause_at, pause)
+        )
 
     def _change_address(self, cmd: Command, at: float) -> None:
         old, new = self.address, cmd.new_address

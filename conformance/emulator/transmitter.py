@@ -25,9 +25,13 @@ class Transmission:
     gap: float
     sent: int = 0
     char_time: float = CHAR_TIME  # one frame; differs only for a sensor at the wrong baud rate
+    #: (index, s): extra marking before the frame at that index (a fault's pause in a reply)
+    pause: tuple[int, float] = (0, 0.0)
 
     def frame_start(self, index: int) -> float:
-        return self.start + index * (self.char_time + self.gap)
+        at, extra = self.pause
+        held = extra if 0 < at <= index else 0.0
+        return self.start + index * (self.char_time + self.gap) + held
 
     def frame(self, index: int) -> Frame:
         return Frame(self.frame_start(index), self.wires[index], self.char_time)
@@ -49,13 +53,19 @@ class Transmitter:
         self.queue: list[Transmission] = []
 
     def schedule(
-        self, reply: Reply, start: float, gap: float, char_time: float = CHAR_TIME
+        self,
+        reply: Reply,
+        start: float,
+        gap: float,
+        char_time: float = CHAR_TIME,
+        *,
+        pause: tuple[int, float] = (0, 0.0),
     ) -> Transmission:
         wires = reply.wires()
         for other in self.queue:
             if other.start <= start < other.end + CHAR_TIME:
                 start = other.end + CHAR_TIME
-        item = Transmission(reply, start, wires, gap, char_time=char_time)
+        item = Transmission(reply, start, wires, gap, char_time=char_time, pause=pause)
         self.queue.append(item)
         self.queue.sort(key=lambda t: t.start)
         return item

@@ -57,6 +57,18 @@ def stamp_uncertainty(u: float | StampUncertainty) -> StampUncertainty:
 
 MIN_DEVIATING = 2  # real-time links: deviating observations a FAIL needs at least...
 MIN_SHARE = 0.05  # ...and at least this share of all observations
+#: Observations of one place (the same command's reply, the same character) that decide
+#: whether a rare deviation there recurs: fewer leave it to be re-probed (issue 18).
+CONFIRM_OBSERVATIONS = 6
+#: How often a whole-run case sends a command again to confirm a deviation in its reply.
+REPROBE_TIMES = 10
+
+#: Where an observation fell: the command, the reply it is in (its text: the same command
+#: may read other data another time, and only the same reply shows the same point again)
+#: and the position in that reply (a character index; 0 for the reply's start). None: no
+#: place known.
+Place = tuple[str, str, int]
+Observation = tuple[Finding, bool] | tuple[Finding, bool, Place | None]
 
 
 def sustained(deviating: int, total: int) -> bool:
@@ -64,29 +76,103 @@ def sustained(deviating: int, total: int) -> bool:
     return deviating >= MIN_DEVIATING and deviating >= MIN_SHARE * total
 
 
+@dataclass(frozen=True)
+class Pattern:
+    """Where a real-time link's few deviating observations fall (issue 18). A host that
+    stalls does so at random moments; a device deviates at the same point of the same reply.
+    Per place with a deviation, once it was observed :data:`CONFIRM_OBSERVATIONS` times or
+    more: ``recurring`` (at least :data:`MIN_DEVIATING` deviations there and at least half
+    of its observations: the device's) or ``not_reproduced`` (a single one: a stall); else
+    ``unconfirmed`` (too few observations of that place to tell, or several deviations but
+    fewer than half: the command wants re-probing, or stays undecided)."""
+
+    recurring: dict[Place, tuple[int, int]]
+    not_reproduced: dict[Place, tuple[int, int]]
+    unconfirmed: dict[Place | None, tuple[int, int]]
+
+    @property
+    def commands(self) -> list[str]:
+        """The commands to send again, in first-seen order."""
+        return list(dict.fromkeys(p[0] for p in self.unconfirmed if p is not None))
+
+
+def deviation_pattern(observed: list[tuple[Finding, Place | None]]) -> Pattern:
+    """:class:`Pattern` of the FAILing observations among ``observed``."""
+    counts: dict[Place | None, list[int]] = {}
+    for finding, place in observed:
+        seen = counts.setdefault(place, [0, 0])
+        seen[1] += 1
+        seen[0] += finding.verdict is Verdict.FAIL
+    recurring, stalls, unconfirmed = {}, {}, {}
+    for place, (bad, total) in counts.items():
+        if not bad:
+            continue
+        if place is None or total < CONFIRM_OBSERVATIONS:
+            unconfirmed[place] = (bad, total)
+        elif bad >= MIN_DEVIATING and 2 * bad >= total:
+            recurring[place] = (bad, total)
+        elif bad < MIN_DEVIATING:
+            stalls[place] = (bad, total)
+        else:
+            unconfirmed[place] = (bad, total)
+    return Pattern(recurring, stalls, unconfirmed)
+
+
+def _places(observed: list[Observation]) -> list[tuple[Finding, bool, Place | None]]:
+    return [(o[0], o[1], o[2] if len(o) > 2 else None) for o in observed]  # type: ignore[misc]
+
+
+def to_confirm(observed: list[Observation], *, real_time: bool = True) -> list[str]:
+    """The commands whose replies hold a rare deviation :func:`combine_local` cannot yet
+    place: the session sends each again (:data:`REPROBE_TIMES`) and the judge runs again over
+    the repeats. Empty on a virtual clock, or when the deviations are not rare."""
+    if not real_time:
+        return []
+    kept = [(f, p) for f, tainted, p in _places(observed) if not _aside(f, tainted)]
+    failing = sum(f.verdict is Verdict.FAIL for f, _ in kept)
+    if not failing or failing == len(kept) or sustained(failing, len(kept)):
+        return []
+    return deviation_pattern(kept).commands
+
+
+def _aside(f: Finding, tainted: bool) -> bool:
+    return tainted and f.verdict is Verdict.INCONCLUSIVE
+
+
+def _where(place: Place) -> str:
+    command, _reply, index = place
+    return f"reply to {command}" + (f", character {index}" if index else "")
+
+
 def combine_local(
     rid: str,
-    observed: list[tuple[Finding, bool]],
+    observed: list[Observation],
     what: str,
     *,
     smallest_is_worst: bool = False,
     real_time: bool = True,
 ) -> Finding:
     """:func:`combine` for observations each judged with its own uncertainty, flagged where
-    that was widened by a local irregularity of the link's stamps.
+    that was widened by a local irregularity of the link's stamps, and optionally placed
+    (``(finding, tainted, place)``: which command's reply, which character).
 
     - An observation that the irregularity alone left undecided says nothing about the DUT:
       it is set aside (and counted in the detail) instead of making the whole rule
       INCONCLUSIVE. If every observation was set aside the rule stays INCONCLUSIVE.
     - On a real-time link (``real_time``) a host that stalls can make a stamp late with no
       trace around it (the last character of a reply has no successor to show it); a few
-      deviating observations among many that conform are therefore not enough for a FAIL
-      (INCONCLUSIVE, with the observations): a FAIL needs at least :data:`MIN_DEVIATING` of
-      them and at least :data:`MIN_SHARE` of all. A device that deviates does so again and
-      again; a stalling host does so rarely. On a virtual clock every observation is exact
-      and one is enough."""
-    kept = [f for f, tainted in observed if not (tainted and f.verdict is Verdict.INCONCLUSIVE)]
-    aside = [f for f, tainted in observed if tainted and f.verdict is Verdict.INCONCLUSIVE]
+      deviating observations among many that conform are therefore decided by where they
+      fall (:func:`deviation_pattern`): recurring at the same place, they are the device's
+      and judged as measured (FAIL); alone at a place observed often enough otherwise, they
+      are host stalls and set aside (named in the detail); where the place was not observed
+      often enough to tell, the rule is INCONCLUSIVE (the session re-probes those commands,
+      :func:`to_confirm`, and the judge runs again over the repeats). Many deviations
+      (:func:`sustained`) are a FAIL as they are. On a virtual clock every observation is
+      exact and one is enough."""
+    placed = _places(observed)
+    kept_placed = [(f, p) for f, tainted, p in placed if not _aside(f, tainted)]
+    kept = [f for f, _ in kept_placed]
+    aside = [f for f, tainted, _ in placed if _aside(f, tainted)]
     worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
     note = (
         f"{len(aside)} {plural(what) if len(aside) != 1 else what} set aside: the link's "
@@ -102,27 +188,68 @@ def combine_local(
         and not sustained(len(failing), len(kept))
     )
     if isolated:
-        lone = failing[0]
-        others = [f for f in kept if f.verdict is not Verdict.FAIL]
-        found = combine(rid, others, what, smallest_is_worst=smallest_is_worst)
-        where = f" [{lone.evidence[0]}]" if lone.evidence else ""
-        found = Finding(
-            rid,
-            Verdict.INCONCLUSIVE,
-            f"{len(failing)} of {len(kept)} {plural(what)} deviate, such as: {lone.detail}"
-            f"{where}; the others conform ({found.detail}). Deviations this rare on a "
-            "real-time link may be stalls of the host, not of the device: not decided",
-            measured_ms=lone.measured_ms,
-            limit_ms=lone.limit_ms,
-            uncertainty_ms=lone.uncertainty_ms,
-            evidence=lone.evidence,
-            observed=len(kept),
-        )
+        found = _by_place(rid, kept_placed, what, smallest_is_worst)
     else:
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
         found.detail += f"; {note}"
     return found
+
+
+def _by_place(
+    rid: str,
+    kept: list[tuple[Finding, Place | None]],
+    what: str,
+    smallest_is_worst: bool,
+) -> Finding:
+    """The few deviations of :func:`combine_local` on a real-time link, decided by place."""
+    pattern = deviation_pattern(kept)
+    failing = [f for f, _ in kept if f.verdict is Verdict.FAIL]
+    if pattern.recurring:
+        device = [f for f, p in kept if f.verdict is not Verdict.FAIL or p in pattern.recurring]
+        found = combine(rid, device, what, smallest_is_worst=smallest_is_worst)
+        said = "; ".join(
+            f"{bad} of {total} at {_where(p)}" for p, (bad, total) in pattern.recurring.items()
+        )
+        found.detail += (
+            f"; the deviations recur at the same point of the same reply ({said}): the "
+            "device's, not stalls of the host, which fall at random"
+        )
+        others = len(failing) - sum(bad for bad, _ in pattern.recurring.values())
+        if others:
+            found.detail += f"; {others} other deviating {plural(what)} not counted"
+        return found
+    if not pattern.unconfirmed:
+        rest = [f for f, _ in kept if f.verdict is not Verdict.FAIL]
+        found = combine(rid, rest, what, smallest_is_worst=smallest_is_worst)
+        lone = failing[0]
+        said = "; ".join(
+            f"{bad} of {total} at {_where(p)}"
+            for p, (bad, total) in pattern.not_reproduced.items()
+        )
+        found.detail += (
+            f"; {len(failing)} deviating {plural(what) if len(failing) != 1 else what} set "
+            f"aside as stalls of the host, such as {lone.detail}: each alone at its place, "
+            f"not reproduced when that reply was observed again ({said})"
+        )
+        return found
+    lone = failing[0]
+    others = [f for f, _ in kept if f.verdict is not Verdict.FAIL]
+    rest = combine(rid, others, what, smallest_is_worst=smallest_is_worst)
+    where = f" [{lone.evidence[0]}]" if lone.evidence else ""
+    return Finding(
+        rid,
+        Verdict.INCONCLUSIVE,
+        f"{len(failing)} of {len(kept)} {plural(what)} deviate, such as: {lone.detail}"
+        f"{where}; the others conform ({rest.detail}). Deviations this rare on a "
+        "real-time link may be stalls of the host, not of the device, and they were not "
+        "observed again at the same place often enough to tell: not decided",
+        measured_ms=lone.measured_ms,
+        limit_ms=lone.limit_ms,
+        uncertainty_ms=lone.uncertainty_ms,
+        evidence=lone.evidence,
+        observed=len(kept),
+    )
 
 
 def judge_window(

@@ -22,17 +22,21 @@ from ..view.runs import Segment, frames, runs, segments
 from ..view.sides import expected_reply_address
 from .tally import Tally
 from .timing import (
+    Observation,
+    Place,
     StampUncertainty,
     combine_local,
     judge_window,
     stamp_uncertainty,
     sustained,
+    to_confirm,
 )
 
 # The cut these judges read lives in the shared view; re-exported for the timing diagram
 # (reports/) and the sensor measurement judges, which import it from here.
 __all__ = [
     "Segment",
+    "gaps_to_confirm",
     "judge_framing",
     "judge_gaps",
     "judge_reply_bit_rate",
@@ -41,6 +45,7 @@ __all__ = [
     "reply_gaps",
     "runs",
     "segments",
+    "starts_to_confirm",
 ]
 
 
@@ -51,7 +56,29 @@ def judge_response_start(
     """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply, each
     with the uncertainty of the stamps it rests on (the command's last, the reply's first)."""
     stamps = stamp_uncertainty(uncertainty)
-    early, late = [], []
+    early, late = _start_observations(segs, stamps)
+    real = stamps.local is not None
+    return [
+        combine_local("R-7.0-09", early, "reply", real_time=real),
+        combine_local("R-7.0-10", late, "reply", real_time=real),
+    ]
+
+
+def starts_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[str]:
+    """The commands whose replies :func:`judge_response_start` wants observed again: rare
+    deviations on a real-time link not yet placed (:func:`~.timing.to_confirm`)."""
+    stamps = stamp_uncertainty(uncertainty)
+    early, late = _start_observations(segs, stamps)
+    real = stamps.local is not None
+    both = to_confirm(early, real_time=real) + to_confirm(late, real_time=real)
+    return list(dict.fromkeys(both))
+
+
+def _start_observations(
+    segs: list[Segment], stamps: StampUncertainty
+) -> tuple[list[Observation], list[Observation]]:
+    early: list[Observation] = []
+    late: list[Observation] = []
     for seg in segs:
         if not seg.reply:
             continue
@@ -59,6 +86,7 @@ def judge_response_start(
         u = stamps.between(seg.command[-1].start, seg.reply[0].end)
         tainted = u > stamps.base
         where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
+        place: Place = (seg.text, _text(seg), 0)
         early.append(
             (
                 judge_window(
@@ -71,6 +99,7 @@ def judge_response_start(
                     evidence=where,
                 ),
                 tainted,
+                place,
             )
         )
         late.append(
@@ -84,36 +113,43 @@ def judge_response_start(
                     evidence=where,
                 ),
                 tainted,
+                place,
             )
         )
-    real = stamps.local is not None
-    return [
-        combine_local("R-7.0-09", early, "reply", real_time=real),
-        combine_local("R-7.0-10", late, "reply", real_time=real),
-    ]
+    return early, late
+
+
+def _text(seg: Segment) -> str:
+    """All the sensor sent after the command, as text: part of an observation's place."""
+    return "".join(chr(e.char7) for e in seg.reply + seg.later)
 
 
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     """Every marking gap between consecutive characters of one DUT run, with its context."""
-    return [(gap, where) for gap, where, _a, _b in _gaps(segs)]
+    return [(gap, where) for gap, where, _a, _b, _p in _gaps(segs)]
 
 
 def reply_char_pairs(segs: list[Segment]) -> list[tuple[Event, Event]]:
     """The consecutive character pairs :func:`judge_gaps` measures a gap between."""
-    return [(a, b) for _gap, _where, a, b in _gaps(segs)]
+    return [(a, b) for _gap, _where, a, b, _p in _gaps(segs)]
 
 
-def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event]]:
+def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event, Place]]:
+    """Each gap with its place: the command and the index of the character after the gap
+    among everything the sensor sent after it (where a device's own gap recurs)."""
     gaps = []
     for seg in segs:
         where = ""
+        text = _text(seg)
+        first = 0  # index of the run's first character in all the sensor sent after it
         # the whole reply, however long a gap inside it: a gap is R-7.0-12's evidence
         for run in [seg.reply, *runs(seg.later)]:
-            for a, b in zip(run, run[1:], strict=False):
+            for k, (a, b) in enumerate(zip(run, run[1:], strict=False), start=first + 1):
                 if seg.multiline and a.char7 == 0x0A:
                     continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
                 where = where or f"in reply to {escape(seg.text)}"
-                gaps.append((b.start - a.end, where, a, b))
+                gaps.append((b.start - a.end, where, a, b, (seg.text, text, k)))
+            first += len(run)
     return gaps
 
 
@@ -122,8 +158,26 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
     a gap inside the ±0.40 ms band above 1.66 ms uses a tolerance the rule does not grant.
     Each gap carries the uncertainty of the two stamps it rests on."""
     stamps = stamp_uncertainty(uncertainty)
-    observed = []
-    for gap, where, a, b in _gaps(segs):
+    gap_finding = combine_local(
+        "R-7.0-12",
+        _gap_observations(segs, stamps),
+        "character gap",
+        real_time=stamps.local is not None,
+    )
+    tolerance_finding = _judge_tolerance_use(reply_gaps(segs), stamps.base)
+    return [gap_finding, tolerance_finding]
+
+
+def gaps_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[str]:
+    """The commands whose replies :func:`judge_gaps` wants observed again: rare deviating
+    gaps on a real-time link not yet placed (:func:`~.timing.to_confirm`)."""
+    stamps = stamp_uncertainty(uncertainty)
+    return to_confirm(_gap_observations(segs, stamps), real_time=stamps.local is not None)
+
+
+def _gap_observations(segs: list[Segment], stamps: StampUncertainty) -> list[Observation]:
+    observed: list[Observation] = []
+    for gap, where, a, b, place in _gaps(segs):
         u = stamps.between(a.start, b.end)
         finding = judge_window(
             "R-7.0-12",
@@ -134,12 +188,8 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
             tolerance=0.0,
             evidence=[where],
         )
-        observed.append((finding, u > stamps.base))
-    gap_finding = combine_local(
-        "R-7.0-12", observed, "character gap", real_time=stamps.local is not None
-    )
-    tolerance_finding = _judge_tolerance_use(reply_gaps(segs), stamps.base)
-    return [gap_finding, tolerance_finding]
+        observed.append((finding, u > stamps.base, place))
+    return observed
 
 
 def _judge_tolerance_use(gaps: list[tuple[float, str]], uncertainty: float) -> Finding:

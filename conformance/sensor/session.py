@@ -8,15 +8,15 @@ fresh state (aborts, address change) ask for a ``fresh`` stimulus explicitly.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar
 
 from ..declaration import Declaration
-from ..judges.timing import StampUncertainty
+from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
 from ..protocol import commands as cmd
-from ..protocol.commands import Command, parse_command
+from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..protocol.responses import Identification, parse_ident, split_line
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, escape
@@ -67,6 +67,30 @@ class HeardProbe:
         return [self.probe] + ([self.control] if self.control is not None else [])
 
 
+@dataclass
+class Aimed(Generic[T]):
+    """A timed probe sent until it landed in the window it aimed at (:meth:`SensorSession.aim`):
+    every try in order, and the one that landed (None: none did in the tries allowed)."""
+
+    tries: list[T]
+    landed: T | None
+
+    @property
+    def last(self) -> T:
+        """What the case judges: the try that landed, else the last one (whose case then
+        says it missed)."""
+        return self.landed if self.landed is not None else self.tries[-1]
+
+    @property
+    def missed(self) -> str:
+        """For a detail: how many tries went out, when more than one did."""
+        if len(self.tries) == 1:
+            return ""
+        if self.landed is None:
+            return f" (none of {len(self.tries)} tries landed in the window it aimed at)"
+        return f" (try {len(self.tries)}: the earlier missed the window they aimed at)"
+
+
 PROBE_ROUNDS = 6  # wake-ups of the bench probe at the start of a real-link run
 PROBE_IDLE = 0.12  # s: marking before each, so each wake-up is from standby
 #: Marking after a break (s) with which a one-shot ``a!`` is tried, shortest first, until the
@@ -75,10 +99,25 @@ PROBE_IDLE = 0.12  # s: marking before each, so each wake-up is from standby
 #: is sound because every probe is checked by a control sent the same way.
 HEARING_MARKINGS = (9e-3, 25e-3, 50e-3, 85e-3, 120e-3)
 #: A hand-made wake-up whose break came back this much past the marking it aims at (a lost
-#: echo, a stalled host) is sent again rather than judged (issue 18), at most PROBE_TRIES times.
+#: echo, a stalled host) is sent again rather than judged (issue 18), at most PROBE_TRIES times;
+#: so is a timed probe of a case that landed outside the window it aimed at (:meth:`aim`).
 PROBE_LATE = 20e-3  # s
-PROBE_TRIES = 3
+PROBE_TRIES = 5
 
+
+#: Commands a whole-run judge may have sent again to confirm a rare deviation in their
+#: replies (:meth:`SensorSession.reprobe`): they change nothing in the sensor, no measurement
+#: starts and no address moves, so the repeats leave the run as it was.
+REPROBE_KINDS = frozenset(
+    {
+        Kind.ACKNOWLEDGE,
+        Kind.IDENTIFY,
+        Kind.DATA,
+        Kind.CONTINUOUS,
+        Kind.IDENTIFY_MEASUREMENT,
+        Kind.METADATA,
+    }
+)
 
 #: Breaks (s) tried before a device that ignored the usual 13 ms break is called absent.
 LONGER_BREAKS = (30e-3, 60e-3, 100e-3)
@@ -316,6 +355,32 @@ class SensorSession:
     def feature(self, name: str) -> bool | None:
         return self.declaration.feature(name)
 
+    def reprobe(self, commands: Iterable[str], times: int = REPROBE_TIMES) -> list[Exchange]:
+        """Send each of ``commands`` ``times`` times again (once per run and command), the
+        way a recorder sends it, so a judge that found a rare deviation in its reply on a
+        real-time link sees whether it recurs at the same place (issue 18): a device's does,
+        a stalling host's does not. The repeats are on the transcript like any exchange, and
+        the judge reads them there. A command that is not this sensor's or of a kind that
+        changes its state (:data:`REPROBE_KINDS`) is not sent; the judge stays undecided."""
+        made: list[Exchange] = []
+        for text in commands:
+            made += self.once(("reprobe", text), lambda t=text: self._reprobe(t, times))
+        return made
+
+    def _reprobe(self, text: str, times: int) -> list[Exchange]:
+        try:
+            command = parse_command(text)
+        except CommandError:
+            return []
+        if command.address != self.address or command.kind not in REPROBE_KINDS:
+            return []
+        self.link.transcript.note(
+            self.link.now(),
+            f"re-probe: {escape(text)} sent {times} times again to see whether a rare "
+            "deviation in its reply recurs at the same place",
+        )
+        return [self.master.transact(command) for _ in range(times)]
+
     def listen(self, duration: float) -> list[Event]:
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""
         return self.link.receive(self.link.now() + duration)
@@ -333,25 +398,55 @@ class SensorSession:
         spacing of ``break_s`` (None: no break at all), then ``marking_s`` of marking.
         Timing cases use it to present breaks and markings near the section 7 thresholds.
         A break whose sending overran the aimed marking by more than ``PROBE_LATE`` (an
-        echo that never came back) is sent again: the probe lands where it aimed or, after
-        ``PROBE_TRIES``, goes out late and its case judges the marking it got."""
+        echo that never came back) is sent again (:meth:`aim`): the probe lands where it
+        aimed or, after ``PROBE_TRIES``, goes out late and its case judges the marking it got."""
         if idle_before:
             self.listen(idle_before)
         if break_s is not None:
-            for tries in range(1, PROBE_TRIES + 1):
-                brk = self.link.send_break(break_s, exact=True)
-                aim = brk.end + marking_s  # the marking runs from the break's end, not from
-                late = self.link.now() - aim  # when the link returned from sending it
-                if late <= PROBE_LATE or tries == PROBE_TRIES:
-                    break
-                self.link.transcript.note(
-                    self.link.now(),
-                    f"probe {text!r}: the break came back {late * 1e3:.2f} ms past the "
-                    f"{marking_s * 1e3:.2f} ms of marking it aimed at; sent again",
+
+            def send(tries: int) -> Event:
+                if tries:
+                    self.listen(max(idle_before, PROBE_IDLE))  # from standby, as the first was
+                return self.link.send_break(break_s, exact=True)
+
+            def late(brk: Event) -> str | None:
+                # the marking runs from the break's end, not from when the link returned
+                over = self.link.now() - (brk.end + marking_s)
+                if over <= PROBE_LATE:
+                    return None
+                return (
+                    f"the break came back {over * 1e3:.2f} ms past the "
+                    f"{marking_s * 1e3:.2f} ms of marking it aimed at"
                 )
-                self.listen(max(idle_before, PROBE_IDLE))  # from standby, as the first was
-            self.link.wait_until(aim)
+
+            brk = self.aim(f"probe {text!r}", send, late).last
+            self.link.wait_until(brk.end + marking_s)
         return self.master.raw(text, break_first=False, gap=gap)
+
+    def aim(
+        self,
+        what: str,
+        attempt: Callable[[int], T],
+        miss: Callable[[T], str | None],
+        *,
+        tries: int = PROBE_TRIES,
+    ) -> Aimed[T]:
+        """Make a timed probe until it lands in the window it aims at (issue 18): behind an
+        echoing interface or a stalled host a probe meant for 83 ms of marking may go out at
+        98 ms, where it proves nothing about the rule it was for. ``attempt(n)`` makes try
+        ``n`` (from 0; a later try puts the sensor back in the state the first needed);
+        ``miss`` says how a try missed, or None when it landed. At most ``tries`` tries; each
+        miss is a note on the transcript, and the verdict rests on the try that landed."""
+        made: list[T] = []
+        for n in range(tries):
+            got = attempt(n)
+            made.append(got)
+            why = miss(got)
+            if why is None:
+                return Aimed(made, got)
+            then = "sent again" if n + 1 < tries else f"no more tries ({tries})"
+            self.link.transcript.note(self.link.now(), f"{what}: {why}; {then}")
+        return Aimed(made, None)
 
     # -- one-off probes, sent the way the sensor was shown to hear -----------------------------
     def hearing_marking(self) -> float | None:

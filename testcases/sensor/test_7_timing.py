@@ -84,19 +84,32 @@ def test_short_spacing_is_not_a_break(sensor, case):
     check = _shown_asleep(sensor, case, "R-7.0-03")
     if check is None:
         return
-    ex = sensor.probe(f"{sensor.address}!", break_s=5e-3)
-    pulse = _break_of(sensor, ex)
+
+    def attempt(n):
+        if n:  # a pulse that came out too long may have woken it
+            _asleep(sensor)
+        ex = sensor.probe(f"{sensor.address}!", break_s=5e-3)
+        return ex, _break_of(sensor, ex)
+
+    def miss(sent):
+        pulse = sent[1]
+        u = max(pulse.length_uncertainty, 0.0)  # a UART-timed pulse's length is known far better
+        if pulse.duration + u >= BREAK_NEVER - TOLERANCE:
+            return f"the link made a {pulse.duration * 1e3:.2f} ms pulse, too close to 6.5 ms"
+        return None
+
+    aimed = sensor.aim("5 ms spacing pulse", attempt, miss)
+    ex, pulse = aimed.last
     case.evidence(
         "sensor put to sleep, a! with no break ignored, 5 ms pulse, 9 ms marking, a!",
         [*judge.events_of(check), pulse, *judge.events_of(ex)],
     )
-    u = max(pulse.length_uncertainty, 0.0)  # a UART-timed pulse's length is known far better
-    if pulse.duration + u >= BREAK_NEVER - TOLERANCE:
+    if aimed.landed is None:
         case.add(
             inconclusive(
                 "R-7.0-03",
                 f"the link made a {pulse.duration * 1e3:.2f} ms "
-                "pulse; too close to 6.5 ms to judge",
+                f"pulse; too close to 6.5 ms to judge{aimed.missed}",
             )
         )
     else:
@@ -119,7 +132,23 @@ def test_break_just_over_12ms_wakes(sensor, case):
     check = _shown_asleep(sensor, case, "R-7.0-04")
     if check is None:
         return
-    tries = [sensor.probe(f"{sensor.address}!", break_s=12.6e-3)]
+
+    def attempt(n):
+        if n:  # the try that missed may have woken it
+            _asleep(sensor)
+        return sensor.probe(f"{sensor.address}!", break_s=12.6e-3)
+
+    def miss(ex):
+        brk = _break_of(sensor, ex)
+        if brk.duration - brk.length_uncertainty <= BREAK_ALWAYS + TOLERANCE:
+            return f"the break came out {brk.duration * 1e3:.2f} ms, not surely above 12.4 ms"
+        marking = _marking_before(ex, brk.end)
+        if not ex.answered and not_listening("R-7.0-04", marking, sensor.uncertainty):
+            return f"a! went out after {marking * 1e3:.2f} ms of marking, not surely in 100 ms"
+        return None
+
+    aimed = sensor.aim("12.6 ms break", attempt, miss)
+    tries = [aimed.last]
     brk = _break_of(sensor, tries[0])
     for delay in (0.04, 0.06):  # retries 16.67..87 ms apart, the last > 100 ms after the break
         if tries[-1].answered:
@@ -134,7 +163,8 @@ def test_break_just_over_12ms_wakes(sensor, case):
             inconclusive(
                 "R-7.0-04",
                 f"achieved break {brk.duration * 1e3:.2f} ms ± "
-                f"{brk.length_uncertainty * 1e3:.2f} is not surely above 12.4 ms",
+                f"{brk.length_uncertainty * 1e3:.2f} is not surely above 12.4 ms"
+                + aimed.missed,
             )
         )
     elif any(t.answered for t in tries):
@@ -147,6 +177,7 @@ def test_break_just_over_12ms_wakes(sensor, case):
             )
         )
     elif unheard is not None:  # silence from a sensor that may lawfully be asleep again
+        unheard.detail += aimed.missed
         case.add(unheard)
     else:
         case.add(
@@ -166,20 +197,47 @@ def test_marking_after_break(sensor, case):
     """After a break the sensor looks for its address once 8.33 ms of marking have passed:
     it answers a command sent then, and (decision A18) ignores one sent sooner."""
     case.expect("a reply after 9 ms of marking; silence (else a warning) after 2 ms")
-    ok = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=9e-3, idle_before=STANDBY)
-    soon = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=2e-3, idle_before=STANDBY)
+
+    def after(marking_s):
+        return lambda _n: sensor.probe(
+            f"{sensor.address}!", break_s=13e-3, marking_s=marking_s, idle_before=STANDBY
+        )
+
+    def marking_of(ex):
+        return _marking_before(ex, _break_of(sensor, ex).end)
+
+    def miss_ok(ex):
+        marking = marking_of(ex)
+        if marking - sensor.uncertainty < MARKING_AFTER_BREAK:
+            return f"a! went out after {marking * 1e3:.2f} ms of marking, not surely 8.33 ms"
+        heard = ex.attempts[0].reply_events
+        if not heard and not_listening("R-7.0-05", marking, sensor.uncertainty):
+            return f"a! went out after {marking * 1e3:.2f} ms of marking, not within 100 ms"
+        return None
+
+    def miss_soon(ex):
+        quick = marking_of(ex)
+        if quick - sensor.uncertainty >= MARKING_AFTER_BREAK - TOLERANCE:
+            return f"a! went out {quick * 1e3:.2f} ms after the break, not early"
+        return None
+
+    aimed = sensor.aim("a! after 9 ms of marking", after(9e-3), miss_ok)
+    ok = aimed.last
+    soon = sensor.aim("a! after 2 ms of marking", after(2e-3), miss_soon).last
     case.evidence("break + 9 ms marking + a!, then break + 2 ms marking + a!", [ok, soon])
     brk = _break_of(sensor, ok)
     marking = _marking_before(ok, brk.end)
     if marking - sensor.uncertainty < MARKING_AFTER_BREAK:
         case.add(
             inconclusive(
-                "R-7.0-05", f"marking {marking * 1e3:.2f} ms is not surely 8.33 ms or more"
+                "R-7.0-05",
+                f"marking {marking * 1e3:.2f} ms is not surely 8.33 ms or more{aimed.missed}",
             )
         )
         return
     unheard = not_listening("R-7.0-05", marking, sensor.uncertainty)
     if unheard is not None and not ok.attempts[0].reply_events:
+        unheard.detail += aimed.missed
         case.add(unheard)  # an unanswered command the sensor need no longer have heard
         return
     found = judge.answered(
@@ -228,12 +286,33 @@ def test_marking_after_break(sensor, case):
 def test_ready_within_100ms_of_break(sensor, case):
     """Within 100 ms of a break the sensor can take a command: one sent 90 ms after it."""
     case.expect("a reply to a! whose start bit comes 90 ms after the break")
-    ex = sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=77e-3, idle_before=STANDBY)
+
+    def since_break(ex):
+        return ex.attempts[0].command_events[0].start - _break_of(sensor, ex).start
+
+    def miss(ex):
+        since = since_break(ex)
+        if since + sensor.uncertainty > WAKE_LIMIT + TOLERANCE:
+            return f"a! began {since * 1e3:.2f} ms after the break, not surely within 100 ms"
+        return None
+
+    aimed = sensor.aim(
+        "a! 90 ms after a break",
+        lambda _n: sensor.probe(
+            f"{sensor.address}!", break_s=13e-3, marking_s=77e-3, idle_before=STANDBY
+        ),
+        miss,
+    )
+    ex = aimed.last
     brk = _break_of(sensor, ex)
-    since = ex.attempts[0].command_events[0].start - brk.start
+    since = since_break(ex)
     case.evidence("break, 77 ms marking, a!", [brk, *judge.events_of(ex)])
-    if since + sensor.uncertainty > WAKE_LIMIT + TOLERANCE:
-        case.add(inconclusive("R-7.0-07", f"command began {since * 1e3:.2f} ms after the break"))
+    if aimed.landed is None:
+        case.add(
+            inconclusive(
+                "R-7.0-07", f"command began {since * 1e3:.2f} ms after the break{aimed.missed}"
+            )
+        )
     else:
         case.add(
             judge.answered(
@@ -288,18 +367,41 @@ def test_standby_after_100ms(sensor, case):
     )
     probes, wakes = [], []
     for marking in (edge, 0.115):
-        first = _awake(sensor)
+
+        def attempt(_n, marking=marking):
+            first = _awake(sensor)
+            if not first.answered:
+                return first, None, None
+            ex, idle = _after_marking(
+                sensor, first.last.reply_events[-1].end, marking, f"{sensor.address}!"
+            )
+            case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
+            return first, ex, idle
+
+        def miss(sent):
+            _first, _ex, idle = sent
+            if idle is None:
+                return "the wake-up a! went unanswered"
+            if idle - u <= STANDBY_MARKING + TOLERANCE:
+                return f"a! went out after {idle * 1e3:.2f} ms of marking, not surely over 100.4"
+            return None
+
+        aimed = sensor.aim(f"a! after {marking * 1e3:.1f} ms of marking", attempt, miss)
+        first, ex, idle = aimed.last
         wakes.append(first)
-        if not first.answered:
-            case.add(inconclusive("R-7.0-15", "the sensor did not answer the wake-up a!"))
-            return
-        ex, idle = _after_marking(
-            sensor, first.last.reply_events[-1].end, marking, f"{sensor.address}!"
-        )
-        case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
-        if idle - u <= STANDBY_MARKING + TOLERANCE:
+        if idle is None:
             case.add(
-                inconclusive("R-7.0-15", f"marking {idle * 1e3:.2f} ms is not surely over 100.4 ms")
+                inconclusive(
+                    "R-7.0-15", f"the sensor did not answer the wake-up a!{aimed.missed}"
+                )
+            )
+            return
+        if aimed.landed is None:
+            case.add(
+                inconclusive(
+                    "R-7.0-15",
+                    f"marking {idle * 1e3:.2f} ms is not surely over 100.4 ms{aimed.missed}",
+                )
             )
             return
         probes.append((ex, idle))
@@ -332,15 +434,37 @@ def test_follow_up_without_break(sensor, case):
         return
     last, probes = first, []
     for marking in (0.02, edge):
-        ex, idle = _after_marking(
-            sensor, last.last.reply_events[-1].end, marking, f"{sensor.address}I!"
-        )
-        case.evidence(f"{idle * 1e3:.2f} ms marking, aI! with no break", [last, ex])
-        if idle + u >= NO_BREAK_WINDOW - TOLERANCE:
+
+        def attempt(n, marking=marking, after=last):
+            if n:  # a follow-up that missed may have found the sensor asleep: wake it again
+                after = _awake(sensor)
+            if not after.answered:
+                return after, None
+            ex, idle = _after_marking(
+                sensor, after.last.reply_events[-1].end, marking, f"{sensor.address}I!"
+            )
+            case.evidence(f"{idle * 1e3:.2f} ms marking, aI! with no break", [after, ex])
+            return ex, idle
+
+        def miss(sent):
+            _ex, idle = sent
+            if idle is None:
+                return "the wake-up a! before it went unanswered"
+            if idle + u >= NO_BREAK_WINDOW - TOLERANCE:
+                return f"it went out after {idle * 1e3:.2f} ms of marking, not surely under 87 ms"
+            return None
+
+        aimed = sensor.aim(f"follow-up aI! after {marking * 1e3:.1f} ms", attempt, miss)
+        if aimed.landed is None:
             case.add(
-                inconclusive("R-7.0-16", f"marking {idle * 1e3:.2f} ms is not surely under 87 ms")
+                inconclusive(
+                    "R-7.0-16",
+                    f"the follow-up aimed at {marking * 1e3:.1f} ms of marking never went out "
+                    f"surely under 87 ms: {miss(aimed.last)}{aimed.missed}",
+                )
             )
             return
+        ex, idle = aimed.landed
         probes.append((ex, idle))
         if not ex.answered:
             break  # the next probe would be timed from a reply that never came

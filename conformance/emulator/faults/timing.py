@@ -30,6 +30,14 @@ TIMING: tuple[Fault, ...] = (
         inconclusive=("R-4.1-01",),
     ),
     Fault(
+        "ident-pause",
+        "4 ms of marking before the seventh character of every aI! reply, the rest of the "
+        "reply back to back (limit 1.66 ms): a deviation that recurs at the same point of the "
+        "same reply, as a firmware that fetches its next field mid-reply makes.",
+        ("R-7.0-12",),
+        settings={"ident_pause": 4e-3, "ident_pause_at": 6},
+    ),
+    Fault(
         "ignores-short-breaks",
         "Spacing under 12.9 ms is not taken as a break (a 12.5 ms break goes unseen).",
         ("R-7.0-04",),
