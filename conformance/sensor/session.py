@@ -328,17 +328,21 @@ class SensorSession:
         marking_s: float = 9e-3,
         gap: float = 0.0,
         idle_before: float = 0.0,
+        collide: bool = False,
     ) -> Exchange:
         """Send ``text`` once with a hand-made wake-up: ``idle_before`` s of marking, then a
         spacing of ``break_s`` (None: no break at all), then ``marking_s`` of marking.
         Timing cases use it to present breaks and markings near the section 7 thresholds.
         A break whose sending overran the aimed marking by more than ``PROBE_LATE`` (an
         echo that never came back) is sent again: the probe lands where it aimed or, after
-        ``PROBE_TRIES``, goes out late and its case judges the marking it got."""
+        ``PROBE_TRIES``, goes out late and its case judges the marking it got. The break
+        waits for a quiet line like every transmission of the tool
+        (:meth:`Master.clear_to_send`); ``collide`` sends it into a talking DUT on purpose."""
         if idle_before:
             self.listen(idle_before)
         if break_s is not None:
             for tries in range(1, PROBE_TRIES + 1):
+                self.master.clear_to_send(collide=collide)
                 brk = self.link.send_break(break_s, exact=True)
                 aim = brk.end + marking_s  # the marking runs from the break's end, not from
                 late = self.link.now() - aim  # when the link returned from sending it
@@ -351,7 +355,7 @@ class SensorSession:
                 )
                 self.listen(max(idle_before, PROBE_IDLE))  # from standby, as the first was
             self.link.wait_until(aim)
-        return self.master.raw(text, break_first=False, gap=gap)
+        return self.master.raw(text, break_first=False, gap=gap, collide=collide)
 
     # -- one-off probes, sent the way the sensor was shown to hear -----------------------------
     def hearing_marking(self) -> float | None:
