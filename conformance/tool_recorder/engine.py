@@ -177,12 +177,12 @@ class Master:
         at most ``policy.max_hold``; then the tool transmits anyway, with a NOTE. Nothing is
         read off the link here: what the DUT sent stays queued for whoever reads next (the
         attempt's stray characters, or a case waiting for a service request). ``collide``:
-        transmit at the usual earliest moment without listening (a probe that means to talk
-        into the DUT). Collisions that happened anyway are noted (:meth:`note_collisions`)."""
-        self.link.wait_until(self._earliest_transmit())
+        transmit now, without listening or the turnaround (a probe that means to talk into
+        the DUT). Collisions that happened anyway are noted (:meth:`note_collisions`)."""
         self.note_collisions()
         if collide:
             return self.link.now()
+        self.link.wait_until(self._earliest_transmit())
         began = self.link.now()
         uncertainty = self.link.info.timing_uncertainty
         look = 0.0 if _own_break_last(self.link) else uncertainty
