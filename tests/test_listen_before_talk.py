@@ -158,3 +158,5 @@ def test_the_prompt_service_request_firmware_runs_clean_with_no_collision(tmp_pa
     assert link["collisions"] == 0 and link["talk_holds"] > 0
     events = read_transcript_jsonl(str(tmp_path / "transcript.jsonl"))
     assert collisions(events) == [] and collision_notes(events) == []
+    page = (tmp_path / "report.html").read_text(encoding="utf-8")
+    assert f"{link['talk_holds']} transmissions held until the DUT was quiet; 0 collisions" in page
