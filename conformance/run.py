@@ -210,6 +210,11 @@ class ConformanceRun:
             "can_break": info.can_break,
             "timing_uncertainty_ms": round((uncertainty or 0.0) * 1000, 3),
         }
+        master = getattr(self.session, "master", None)
+        if master is not None:  # the sensor role: the tool's recorder drove the line
+            master.note_collisions()
+            found["collisions"] = master.collisions
+            found["talk_holds"] = master.holds
         describe = getattr(self.link, "describe", None)
         if callable(describe):  # a real bench: echo, how breaks are made, measured timing
             found["bench"] = describe()

@@ -78,6 +78,13 @@ PROFILES: Mapping[str, FirmwareProfile] = MappingProxyType(
                 quirks={"reply_delay": 15.0e-3},
             ),
             FirmwareProfile(
+                "prompt-sr",
+                "Measures at once yet announces ttt = 001 for M and V: the service request"
+                " follows the atttn reply after 8.4 ms (legal, R-4.4.6-02/04), where a"
+                " recorder that does not listen before it talks starts its next break into it.",
+                quirks={"prompt_service_request": 8.4e-3},
+            ),
+            FirmwareProfile(
                 "d1-only",
                 "Puts the data of M/V only on D1; D0 answers with no values.",
                 ("groups-start-at-d1",),

@@ -444,7 +444,7 @@ class SensorEmulator:
     def _start_measurement(self, cmd: Command, at: float) -> None:
         b = self.behaviour
         self._tx.cancel(lambda t: not (t.reply.kind is ReplyKind.CHATTER and t.sent == 0))
-        spec = self.profile.spec_for(cmd)
+        spec = self._timed(cmd, self.profile.spec_for(cmd))
         if not self._answers(cmd, spec) or (spec is None and self._unknown(cmd, at)):
             return
         sent = self._send(self._start_reply(cmd, cmd, spec, ReplyKind.START), at)
@@ -476,6 +476,16 @@ class SensorEmulator:
             self._send(chatter, (sent.end + run.ready_at) / 2)
         self._service_request(cmd, sr_at)
 
+    def _timed(self, cmd: Command, spec: MeasurementSpec | None) -> MeasurementSpec | None:
+        """``spec`` with the timing the behaviour plays: ttt = 001 and data ready after
+        ``prompt_service_request`` for an M/V measurement with ttt > 0 when that is set."""
+        prompt = self.behaviour.prompt_service_request
+        if spec is None or not spec.ttt or prompt is None:
+            return spec
+        if cmd.kind not in SERVICE_REQUEST_KINDS:
+            return spec
+        return replace(spec, ttt=1, ready_after=prompt)
+
     def _service_request(self, source: Command, at: float) -> None:
         self._send(Reply(ReplyKind.SERVICE_REQUEST, source.address, source=source), at)
 
@@ -483,7 +493,7 @@ class SensorEmulator:
         b = self.behaviour
         target = cmd.target
         assert target is not None
-        spec = self.profile.spec_for(target)
+        spec = self._timed(target, self.profile.spec_for(target))
         if not b.answer_identify_measurement or not self._answers(target, spec):
             return
         sent = self._send(self._start_reply(cmd, target, spec, ReplyKind.IDENTIFY), at)

@@ -243,6 +243,20 @@ def bench_rows(bench: dict[str, Any] | None) -> list[tuple[str, str]]:
     ]
 
 
+def _talk_rows(link: dict[str, Any]) -> list[tuple[str, str]]:
+    """Listen before talk (sensor role): how often the tool waited for the DUT to finish,
+    and the collisions that happened anyway (never evidence against the DUT)."""
+    if "collisions" not in link:
+        return []
+    return [
+        (
+            "Listen before talk",
+            f"{link['talk_holds']} transmissions held until the DUT was quiet; "
+            f"{link['collisions']} collisions (noted in the transcript)",
+        )
+    ]
+
+
 def header(run: ConformanceRun) -> str:
     """The DUT identity and the run's identity, side by side."""
     dut = dut_block(run)
@@ -277,6 +291,7 @@ def header(run: ConformanceRun) -> str:
         ("Link", f"{link['kind']}, can send breaks: {breaks}"),
         ("Timing uncertainty", f"±{uncertainty} ms{exact}"),
         *bench_rows(link.get("bench")),
+        *_talk_rows(link),
         ("Started", run.started),
         ("Finished", run.finished or "—"),
         ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),

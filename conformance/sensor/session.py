@@ -393,13 +393,16 @@ class SensorSession:
         marking_s: float = 9e-3,
         gap: float = 0.0,
         idle_before: float = 0.0,
+        collide: bool = False,
     ) -> Exchange:
         """Send ``text`` once with a hand-made wake-up: ``idle_before`` s of marking, then a
         spacing of ``break_s`` (None: no break at all), then ``marking_s`` of marking.
         Timing cases use it to present breaks and markings near the section 7 thresholds.
         A break whose sending overran the aimed marking by more than ``PROBE_LATE`` (an
         echo that never came back) is sent again (:meth:`aim`): the probe lands where it
-        aimed or, after ``PROBE_TRIES``, goes out late and its case judges the marking it got."""
+        aimed or, after ``PROBE_TRIES``, goes out late and its case judges the marking it got.
+        The break waits for a quiet line like every transmission of the tool
+        (:meth:`Master.clear_to_send`); ``collide`` sends it into a talking DUT on purpose."""
         if idle_before:
             self.listen(idle_before)
         if break_s is not None:
@@ -407,6 +410,7 @@ class SensorSession:
             def send(tries: int) -> Event:
                 if tries:
                     self.listen(max(idle_before, PROBE_IDLE))  # from standby, as the first was
+                self.master.clear_to_send(collide=collide)
                 return self.link.send_break(break_s, exact=True)
 
             def late(brk: Event) -> str | None:
@@ -421,7 +425,7 @@ class SensorSession:
 
             brk = self.aim(f"probe {text!r}", send, late).last
             self.link.wait_until(brk.end + marking_s)
-        return self.master.raw(text, break_first=False, gap=gap)
+        return self.master.raw(text, break_first=False, gap=gap, collide=collide)
 
     def aim(
         self,

@@ -11,6 +11,8 @@ deadline so a silent or babbling device can never hang it.
 
 from __future__ import annotations
 
+import contextlib
+
 from ..links.base import Link
 from ..links.errors import BreakUnsupported
 from ..protocol import commands as cmds
@@ -35,6 +37,7 @@ from ..protocol.timing import (
 from ..protocol.values import split_values
 from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
 from . import validity
+from .contention import HOLD_PREFIX, collisions
 from .framing import Framing
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
@@ -55,6 +58,11 @@ class Master:
         # Whether D replies for each address carry a CRC: set by the last accepted
         # measurement reply, used when a D command is sent on its own.
         self._crc_pending: dict[str, bool] = {}
+        self.holds = 0  # transmissions held back while the DUT was talking (listen before talk)
+        self.hold_overruns = 0  # holds cut short by ``policy.max_hold``
+        self.collisions = 0  # tool transmissions that overlapped DUT characters (noted)
+        self._scanned = 0  # transcript events already looked at for collisions
+        self._collided: set[tuple[float, float]] = set()  # tool events already noted
 
     # -- single commands -------------------------------------------------------------------
     def transact(
@@ -117,6 +125,7 @@ class Master:
         parity: bool = True,
         binary: bool = False,
         marking: float | None = None,
+        collide: bool = False,
     ) -> Exchange:
         """Send arbitrary characters once (malformed commands, foreign addresses, partial
         commands with a ``gap`` of marking between characters) and record what came back.
@@ -125,7 +134,9 @@ class Master:
         (wrong parity on purpose). ``break_first`` None applies the usual break rules to the
         first character as address; True/False forces or suppresses the break. ``marking``
         replaces ``policy.post_break_marking`` after that break (a probe sent the way the
-        sensor was shown to hear, :meth:`SensorSession.hearing_marking`).
+        sensor was shown to hear, :meth:`SensorSession.hearing_marking`). ``collide``
+        transmits without listening first (:meth:`clear_to_send`): only for a probe that means
+        to talk into the DUT.
         """
         data = text.encode("latin-1") if isinstance(text, str) else text
         wire = bytes(to_wire_7e1(b) if parity else b for b in data)
@@ -136,15 +147,85 @@ class Master:
             command = None
         address = chr(data[0] & 0x7F) if data else ""
         attempt = self._attempt(
-            wire, address, command, brk=break_first, binary=binary, gap=gap, marking=marking
+            wire,
+            address,
+            command,
+            brk=break_first,
+            binary=binary,
+            gap=gap,
+            marking=marking,
+            collide=collide,
         )
         return Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
 
-    def send_break(self, marking: float | None = None) -> Event:
+    def send_break(self, marking: float | None = None, *, collide: bool = False) -> Event:
         """A break of ``policy.break_duration`` then ``policy.post_break_marking`` (or
-        ``marking``) of marking (R-7.0-02, R-7.0-06), after letting the DUT release the line
-        (R-7.0-11)."""
+        ``marking``) of marking (R-7.0-02, R-7.0-06), once the DUT has released the line
+        (R-7.0-11) and is not talking (:meth:`clear_to_send`; ``collide`` skips that)."""
+        self.clear_to_send(collide=collide)
+        return self._break(marking)
+
+    def clear_to_send(self, *, collide: bool = False) -> float:
+        """Listen before talk: wait until the tool may drive the line, and return when.
+
+        A real recorder's UART sees the DUT's start bits; this one sees the DUT's characters
+        as the link delivers them, up to ``timing_uncertainty`` late, so before it transmits
+        it takes in what arrives until then (not after the tool's own break: the line has been
+        the tool's since, and a timed probe's marking must not grow). While the DUT's last
+        character ended less than ``policy.turnaround`` ago (R-7.0-11; longer than any gap
+        inside a reply) the transmission is held. A DUT that keeps talking is waited out for
+        at most ``policy.max_hold``; then the tool transmits anyway, with a NOTE. Nothing is
+        read off the link here: what the DUT sent stays queued for whoever reads next (the
+        attempt's stray characters, or a case waiting for a service request). ``collide``:
+        transmit now, without listening or the turnaround (a probe that means to talk into
+        the DUT). Collisions that happened anyway are noted (:meth:`note_collisions`)."""
+        self.note_collisions()
+        if collide:
+            return self.link.now()
         self.link.wait_until(self._earliest_transmit())
+        began = self.link.now()
+        uncertainty = self.link.info.timing_uncertainty
+        look = 0.0 if _own_break_last(self.link) else uncertainty
+        held = False
+        while True:
+            if look:
+                self.link.wait_until(self.link.now() + look)
+            clear = self._earliest_transmit()
+            now = self.link.now()
+            if clear <= now:
+                break
+            if now - began >= self.policy.max_hold:
+                self.hold_overruns += 1
+                self.link.transcript.note(
+                    now,
+                    f"{HOLD_PREFIX}the DUT was still transmitting after {(now - began) * 1e3:.0f}"
+                    f" ms of holding (bound {self.policy.max_hold * 1e3:.0f} ms); the tool "
+                    "transmits into it",
+                )
+                break
+            held = True
+            self.link.wait_until(min(clear, began + self.policy.max_hold))
+            look = uncertainty
+        self.holds += held
+        return self.link.now()
+
+    def note_collisions(self) -> int:
+        """Add a collision NOTE for each tool transmission that overlapped DUT characters
+        since the last look (:mod:`~conformance.tool_recorder.contention`); returns how many
+        transmissions collided so far."""
+        events = self.link.transcript.events
+        window = events[max(0, self._scanned - _COLLISION_LOOKBACK) :]
+        self._scanned = len(events)
+        for collision in collisions(window):
+            spans = {(e.start, e.end) for e in collision.tool}
+            if spans & self._collided:
+                continue
+            self._collided |= spans
+            self.collisions += 1
+            self.link.transcript.note(collision.start, collision.note_text())
+        return self.collisions
+
+    def _break(self, marking: float | None) -> Event:
         event = self.link.send_break(self.policy.break_duration)
         self.last_break_end = event.end
         self.link.wait(self.policy.post_break_marking if marking is None else marking)
@@ -299,20 +380,27 @@ class Master:
         return at - self.link.last_activity() > window
 
     def _transmit(
-        self, wire: bytes, address: str, brk: bool | None, gap: float, marking: float | None
-    ) -> tuple[Event | None, list[Event]]:
-        at = self._earliest_transmit()
+        self,
+        wire: bytes,
+        address: str,
+        brk: bool | None,
+        gap: float,
+        marking: float | None,
+        collide: bool,
+    ) -> tuple[Event | None, list[Event], list[Event]]:
+        """Listen before talk, then the break (if due) and the command. Also returns the DUT
+        characters that came before it (a service request the hold waited out): queued
+        chatter, never this command's reply."""
+        at = self.clear_to_send(collide=collide)
+        stray = self.link.receive(at)
         break_event = None
         if brk or (brk is None and self._needs_break(address, at)):
-            try:
-                break_event = self.send_break(marking)
-            except BreakUnsupported:  # socket://: the link noted it; the command goes alone
-                self.link.wait_until(at)
-        else:
-            self.link.wait_until(at)
+            # socket://: the link noted it; the command goes alone
+            with contextlib.suppress(BreakUnsupported):
+                break_event = self._break(marking)
         events = self.link.write(wire, gap)  # gap 0: back to back, R-7.0-13
         self.last_address = address
-        return break_event, events
+        return break_event, events, stray
 
     def _attempt(
         self,
@@ -325,9 +413,9 @@ class Master:
         crc: bool | None = None,
         gap: float = 0.0,
         marking: float | None = None,
+        collide: bool = False,
     ) -> Attempt:
-        stray = self.link.receive(self.link.now())  # queued chatter is not this reply
-        break_event, sent = self._transmit(wire, address, brk, gap, marking)
+        break_event, sent, stray = self._transmit(wire, address, brk, gap, marking, collide)
         command_end = sent[-1].end if sent else self.link.now()
         p = self.policy
         framing = Framing(
@@ -339,6 +427,8 @@ class Master:
             line_wait=p.line_wait,
         )
         reply, state, collided = self._listen(command_end, framing)
+        if collided:
+            self.note_collisions()
         if collided:  # the DUT talked over the command: it may not have heard it whole
             state = f"invalid: bus contention ({len(collided)} characters during the command)"
         elif state is None:
@@ -444,6 +534,19 @@ def _raises_sr(command: Command) -> bool:
 def _service_request_end(events: list[Event], address: str) -> float | None:
     """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
     return text_end(events, f"{address}\r\n")
+
+
+#: Events before the last look that a collision scan takes again, so a transmission whose
+#: DUT characters arrived after the look is still seen whole.
+_COLLISION_LOOKBACK = 64
+
+
+def _own_break_last(link: Link) -> bool:
+    """Whether the last thing on the wire is the tool's own break (its marking follows)."""
+    for event in reversed(link.transcript.events):
+        if event.kind is not EventKind.NOTE:
+            return event.kind is EventKind.BREAK and event.origin == TOOL
+    return False
 
 
 def _last_dut_char_end(link: Link) -> float:

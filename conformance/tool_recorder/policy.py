@@ -25,6 +25,10 @@ class Policy:
     # Marking the engine leaves after the DUT's last character before it drives the line:
     # the DUT may hold the line for 7.5 ms (+0.4) after its last stop bit (R-7.0-11).
     turnaround: float = 9e-3
+    # Listen before talk: the longest the engine holds a break or command while the DUT keeps
+    # the line active (a babbling DUT must not hang the tool); past it the engine transmits
+    # anyway and says so in a NOTE. Longer than any legal reply (75 values: 0.7 s).
+    max_hold: float = 1.0
     # Wait for the first reply start bit. The spec's limit is 15.4 ms (R-7.0-10); the engine
     # listens longer so a late reply is recorded (and judged late) rather than missed. Must
     # stay below RETRY_MAX so a retry can still follow within 87 ms.
