@@ -30,6 +30,9 @@ class CaseRecord:
     evidence: list[tuple[str, list[Event]]] = field(default_factory=list)
     duration: float = 0.0
     verdict: Verdict = Verdict.NA
+    #: declared precondition code -> "met" or the "precondition not met: ..." text, for each
+    #: one the case checked (conformance/preconditions.py)
+    preconditions: dict[str, str] = field(default_factory=dict)
 
     def summarise(self) -> Verdict:
         self.verdict = worst((f.verdict for f in self.findings), default=Verdict.ERROR)

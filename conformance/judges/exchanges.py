@@ -173,15 +173,12 @@ def silent_while_listening(
             decision=decision,
             observed=len(answered),
         )
+    from ..preconditions import listening  # it cites exchanges with this module's helpers
+
+    unmet = listening(probes)
+    if unmet is not None:
+        return unmet.finding(rid)
     heard = [p for p in probes if p.listening]
-    if not heard:
-        return inconclusive(
-            rid,
-            "precondition not met: the sensor answered none of the a! controls sent like its "
-            f"probes (one break, then once), so its silence to {len(probes)} probe(s) shows "
-            "nothing",
-            evidence=[shown(p.probe) for p in probes[:3]],
-        )
     aside = len(probes) - len(heard)
     marking = heard[0].marking
     way = f" after {marking * 1e3:.0f} ms of marking" if marking is not None else ""

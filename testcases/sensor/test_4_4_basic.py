@@ -15,6 +15,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.1-01")
+@pytest.mark.preconditions("none")
 def test_acknowledge_active(sensor, case):
     """a! returns exactly the address and CR LF."""
     case.expect(f"'{sensor.address}<CR><LF>'")
@@ -24,6 +25,7 @@ def test_acknowledge_active(sensor, case):
 
 
 @requirements("R-4.4.2-01", "R-4.4.2-02")
+@pytest.mark.preconditions("none")
 def test_identification(sensor, case):
     """aI! returns address, version, vendor, model, sensor version, optional field, CR LF."""
     case.expect("a + ll + 8-char vendor + 6-char model + 3-char version + 0..13 optional chars")
@@ -45,6 +47,7 @@ BASIC = (
 
 
 @requirements("R-4.4-01")
+@pytest.mark.preconditions("none")
 def test_every_basic_command_is_answered(sensor, case):
     """Every command of Table 5 draws a reply (the format of each is judged by its own rule)."""
     case.expect("a reply to each basic command; aAb! is judged in the address-change case")
@@ -60,6 +63,7 @@ def test_every_basic_command_is_answered(sensor, case):
 
 
 @requirements("R-4.4.4-01", "R-4.4.4-02", "R-4.4.4-03")
+@pytest.mark.preconditions("supported", address=("R-4.4.4-02",), listening=("R-4.4.4-03",))
 def test_change_address(sensor, case):
     """aAb! moves the sensor to b, it answers there (after at most 1 s) and no longer at a."""
     case.expect(

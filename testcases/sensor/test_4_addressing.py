@@ -19,6 +19,7 @@ def spare_addresses(sensor, count: int = 3) -> list[str]:
 
 
 @requirements("R-4.0-01")
+@pytest.mark.preconditions("listening")
 def test_foreign_addresses_are_ignored(sensor, case):
     """Commands for other addresses, each after a break, must draw no reply."""
     case.expect("silence to a!, aI! and aM! sent to addresses the sensor does not have")
@@ -34,6 +35,7 @@ def test_foreign_addresses_are_ignored(sensor, case):
 
 
 @requirements("R-4.4.3-01")
+@pytest.mark.preconditions("none")
 def test_query_address(sensor, case):
     """?! returns the sensor's address, whatever it is."""
     case.expect(f"'{sensor.address}<CR><LF>'")
@@ -43,6 +45,7 @@ def test_query_address(sensor, case):
 
 
 @requirements("R-4.4.3-02")
+@pytest.mark.preconditions("listening")
 def test_wildcard_with_other_commands(sensor, case):
     """A sensor may accept ? with other commands; if it answers ?I!, it answers correctly."""
     case.expect("silence, or the same identification as aI!")
@@ -82,6 +85,7 @@ def test_wildcard_with_other_commands(sensor, case):
 
 
 @requirements("R-4.3-02")
+@pytest.mark.preconditions("none")
 def test_factory_address(sensor, case):
     """A sensor as shipped answers at address 0."""
     case.expect("address 0 on a unit fresh from the factory")
@@ -114,6 +118,7 @@ def test_factory_address(sensor, case):
 
 
 @requirements("R-4.3-03", "R-4.3-04")
+@pytest.mark.preconditions("supported", listening=("R-4.3-04",))
 def test_address_range(sensor, case):
     """A sensor with a settable address takes each of 0-9, and refuses a non-address."""
     case.expect(
