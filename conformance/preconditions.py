@@ -160,6 +160,18 @@ def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     )
 
 
+def heard_one_shot(marking: float | None, what: str) -> Unmet | None:
+    """A one-off command for another address is heard only by a sensor shown to answer a
+    one-shot ``a!`` after a break (:meth:`SensorSession.hearing_marking`, ``marking``; None:
+    no marking worked), so its silence or its effect shows nothing otherwise."""
+    if marking is not None:
+        return None
+    return Unmet(
+        "listening",
+        f"the sensor answered no one-shot a! after a break, so it may not have heard {what}",
+    )
+
+
 def awake(marking: float, uncertainty: float) -> Unmet | None:
     """A command went out while a compliant sensor must still be listening: less than 100 ms
     of marking (less the tolerance and the link's uncertainty) after the break."""

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.protocol.responses import check_change_address_reply, split_line
 from conformance.protocol.timing import ADDRESS_CHANGE_QUIET, TOLERANCE
 from conformance.sensor.address_change import AddressChanger
 from conformance.sensor.session import C_FAMILY, M_FAMILY
-from conformance.verdicts import failed, inconclusive, passed
+from conformance.verdicts import failed, passed
 
 requirements = pytest.mark.requirements
 
@@ -168,13 +169,15 @@ def test_change_address(sensor, case):
             )
         )
     elif heard is None or not heard.listening:
-        case.add(
-            inconclusive(
-                "R-4.4.4-03",
-                f"precondition not met: no a! at '{target}' sent like the probe of the old "
-                f"address '{original}' (one break, then once) was answered, so the silence "
-                "at the old address shows nothing",
-            )
+        case.requires(
+            "listening",
+            precondition.Unmet(
+                "listening",
+                f"no a! at '{target}' sent like the probe of the old address '{original}' "
+                "(one break, then once) was answered, so the silence at the old address "
+                "shows nothing",
+                tuple(judge.cite(heard.exchanges)) if heard is not None else (),
+            ),
         )
     else:
         case.add(

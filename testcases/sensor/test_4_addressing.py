@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.protocol.commands import ADDRESS_CHARS
 from conformance.verdicts import failed, inconclusive, passed
@@ -53,14 +54,13 @@ def test_wildcard_with_other_commands(sensor, case):
     ex = heard.probe
     ident = sensor.exchange("I")
     case.evidence("?I! and its a! control", heard.exchanges)
-    if not ex.answered and not (ident.answered and heard.listening):
-        case.add(
-            inconclusive(
-                "R-4.4.3-02",
-                "precondition not met: the a! sent like ?I! (one break, then once) or aI! got "
-                "no reply, so silence to ?I! says nothing",
-            )
+    deaf = precondition.listening([heard])
+    if not ident.answered:
+        deaf = precondition.Unmet(
+            "listening", "aI! got no reply, so silence to ?I! says nothing", (judge.shown(ident),)
         )
+    if not ex.answered and deaf is not None:
+        case.requires("listening", deaf)
     elif not ex.answered:
         case.add(
             passed(
@@ -160,12 +160,15 @@ def test_address_range(sensor, case):
             )
         )
     elif not bad.accepted and not bad.listening:
-        case.add(
-            inconclusive(
-                "R-4.3-04",
-                "precondition not met: the a! sent like aA$! (one break, then once) got no "
-                "reply, so the silence to aA$! shows nothing",
-            )
+        control = bad.exchanges[-1:] if len(bad.exchanges) > 1 else []
+        case.requires(
+            "listening",
+            precondition.Unmet(
+                "listening",
+                "the a! sent like aA$! (one break, then once) got no reply, so the silence "
+                "to aA$! shows nothing",
+                tuple(judge.cite(control)),
+            ),
         )
     elif bad.accepted:
         case.add(
