@@ -135,6 +135,9 @@ def test_pending_from_the_wire():
 
 def _abort(port: str) -> dict[str, dict]:
     data = run_once(port, ("-k", "test_break_aborts_measurement"))
+    (test,) = data["tests"]
+    checked = test["preconditions"]  # verdicts.json says which held and why one did not
+    assert set(checked) <= {"pending", "aborted"} and "pending" in checked, checked
     return {r["id"]: r for r in data["requirements"]}
 
 
