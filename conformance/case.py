@@ -19,7 +19,7 @@ from .tool_recorder.records import Exchange, Measurement
 from .transcript import Event
 from .verdicts import Finding, Verdict, not_applicable
 
-if TYPE_CHECKING:  # preconditions cite exchanges through judges, which import this module
+if TYPE_CHECKING:
     from .preconditions import Declaration, Unmet
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Protocol
 
-from .judges.exchanges import cited, heard, shown
+from .judges.cite import cited, heard, shown
 from .judges.support import serves_measurement
 from .protocol.timing import STANDBY_MARKING, TOLERANCE
 from .tool_recorder.records import Exchange, Measurement

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..preconditions import awake
 from ..protocol.timing import STANDBY_MARKING, TOLERANCE
 from ..verdicts import Finding, Verdict
 
@@ -21,8 +22,6 @@ def not_listening(rid: str, marking: float, uncertainty: float) -> Finding | Non
     :func:`conformance.preconditions.awake`): the command went out while a compliant sensor
     must still be listening. INCONCLUSIVE naming the measured marking when it did not; None
     when the precondition holds."""
-    from ..preconditions import awake  # preconditions reach the judges that import this
-
     unmet = awake(marking, uncertainty)
     if unmet is None:
         return None
