@@ -2,14 +2,16 @@
 
 A case names its requirement IDs with ``@pytest.mark.requirements(...)``, runs or reuses a
 stimulus, hands the records to judges and adds their findings here. This object enforces the
-contract: a finding must be about one of the case's requirements, and a rule that the DUT's
-claimed version does not bind becomes N/A instead of a verdict.
+contract: a finding must be about one of the case's requirements, a rule that the DUT's
+claimed version does not bind becomes N/A instead of a verdict, and a requirement whose
+declared precondition the wire did not show (:meth:`Case.requires`) is INCONCLUSIVE whatever
+the case goes on to find about it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .catalog import requirement
 from .results import CaseRecord
@@ -17,11 +19,25 @@ from .tool_recorder.records import Exchange, Measurement
 from .transcript import Event
 from .verdicts import Finding, Verdict, not_applicable
 
+if TYPE_CHECKING:
+    from .preconditions import Declaration, Unmet
+
+
+#: Verdicts about the device, which a precondition the wire did not show voids.
+JUDGED = (Verdict.PASS, Verdict.WARN, Verdict.FAIL)
+
 
 class Case:
-    def __init__(self, record: CaseRecord, version: Any = None) -> None:
+    def __init__(
+        self,
+        record: CaseRecord,
+        version: Any = None,
+        preconditions: Declaration | None = None,
+    ) -> None:
         self.record = record
         self._version = version  # callable returning "13"/"14"/None, resolved lazily
+        self.preconditions = preconditions  # None: the case declared nothing
+        self._blocked: dict[str, Unmet] = {}  # requirement -> the precondition that failed
 
     @property
     def requirements(self) -> tuple[str, ...]:
@@ -33,6 +49,39 @@ class Case:
 
     def add(self, *findings: Finding) -> None:
         self.extend(findings)
+
+    def requires(self, code: str, unmet: Unmet | None) -> bool:
+        """Apply the outcome of a declared precondition's check
+        (:mod:`conformance.preconditions`): True when it held. When it did not, every
+        requirement it guards is INCONCLUSIVE "precondition not met: <code>: ..." with the
+        evidence, and a PASS, WARN or FAIL for it, found before or after, is dropped. A code
+        the case did not declare is a case bug (ERROR), so a declaration cannot lag its code."""
+        guarded = self.preconditions.guarded(code) if self.preconditions else ()
+        if not guarded:
+            for rid in self.record.requirements:
+                self.record.findings.append(
+                    Finding(
+                        rid,
+                        Verdict.ERROR,
+                        f"case bug: precondition {code!r} checked but not declared",
+                        test=self.record.nodeid,
+                    )
+                )
+            return unmet is None
+        self.record.preconditions[code] = "met" if unmet is None else unmet.text
+        if unmet is None:
+            return True
+        for rid in guarded:
+            if rid in self._blocked:
+                continue
+            self._blocked[rid] = unmet
+            self.record.findings = [
+                f
+                for f in self.record.findings
+                if not (f.requirement == rid and f.verdict in JUDGED)
+            ]
+            self._append(unmet.finding(rid))
+        return False
 
     def extend(self, findings: Iterable[Finding]) -> None:
         version = self._version() if callable(self._version) else self._version
@@ -52,7 +101,13 @@ class Case:
                     f"rule binds SDI-12 v1.4 only; the DUT claims v{version[0]}.{version[1]}",
                     test=self.record.nodeid,
                 )
-            self.record.findings.append(f)
+            elif f.requirement in self._blocked and f.verdict in JUDGED:
+                continue  # its precondition failed: the INCONCLUSIVE saying so stands
+            self._append(f)
+
+    def _append(self, f: Finding) -> None:
+        f.test = f.test or self.record.nodeid
+        self.record.findings.append(f)
 
     def not_applicable(self, reason: str, requirements: Iterable[str] | None = None) -> None:
         for rid in requirements or self.record.requirements:

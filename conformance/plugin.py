@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from . import report_folder, whole_run
+from . import preconditions, report_folder, whole_run
 from .case import Case
 from .interrupts import GUARD
 from .links.base import LinkError
@@ -63,6 +63,7 @@ def pytest_configure(config: pytest.Config) -> None:
         "needs(*capabilities): link capabilities a case needs: break, unsolicited, binary",
     )
     config.addinivalue_line("markers", whole_run.MARKER_HELP)
+    config.addinivalue_line("markers", preconditions.MARKER_HELP)
     if not config.pluginmanager.has_plugin("sdi12-whole-run-last"):
         config.pluginmanager.register(whole_run.WholeRunLast(), "sdi12-whole-run-last")
     options = RunOptions.from_config(config)
@@ -130,7 +131,11 @@ def case(request: pytest.FixtureRequest, sdi12_run: ConformanceRun) -> Case:
         record.summarise()
         sdi12_run.cases.append(record)
         pytest.skip(f"INCONCLUSIVE: {reason}")
-    return Case(record, version=lambda: sdi12_run.dut_version)
+    try:
+        declared = preconditions.declared(request.node, record.requirements)
+    except preconditions.PreconditionError as exc:
+        raise pytest.UsageError(f"{request.node.nodeid}: {exc}") from None
+    return Case(record, version=lambda: sdi12_run.dut_version, preconditions=declared)
 
 
 #: ``@pytest.mark.needs(...)`` names -> (LinkInfo attribute, what a reader is told it lacks)

@@ -33,6 +33,9 @@ class CaseRecord:
     # the transcript events (positions lo..hi-1) the case's run added; a whole-run case's
     # starts at 0, since it judges all of them (reports.evidence looks exchanges up there)
     window: tuple[int, int] | None = None
+    #: declared precondition code -> "met" or the "precondition not met: ..." text, for each
+    #: one the case checked (conformance/preconditions.py)
+    preconditions: dict[str, str] = field(default_factory=dict)
 
     def summarise(self) -> Verdict:
         self.verdict = worst((f.verdict for f in self.findings), default=Verdict.ERROR)

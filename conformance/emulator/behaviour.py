@@ -75,6 +75,9 @@ class Behaviour:
     service_request_on_concurrent: bool = False
     service_request_on_identify: bool = False
     chatter_before_service_request: bool = False
+    #: A quirk: every M/V measurement with ttt > 0 is ready this long (s) after its reply,
+    #: however long its ttt (legal: the service request may come any time before ttt).
+    ready_after: float | None = None
     # -- aborts ------------------------------------------------------------------------------
     break_aborts_measure: bool = True  # R-4.4.5.1-01
     abort_keeps_old_data: bool = False  # True breaks R-4.4.5.1-02 / R-4.4.7.1-02

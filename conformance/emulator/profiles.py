@@ -85,6 +85,13 @@ PROFILES: Mapping[str, FirmwareProfile] = MappingProxyType(
                 quirks={"prompt_service_request": 8.4e-3},
             ),
             FirmwareProfile(
+                "quick-ready",
+                "Finishes every M/V measurement 20 ms after its atttn reply, whatever ttt says:"
+                " the service request comes long before ttt (legal, though R-4.4.5-09 may"
+                " warn), so a break sent after it finds nothing to abort.",
+                quirks={"ready_after": 20e-3},
+            ),
+            FirmwareProfile(
                 "d1-only",
                 "Puts the data of M/V only on D1; D0 answers with no values.",
                 ("groups-start-at-d1",),

@@ -455,6 +455,9 @@ class SensorEmulator:
         self._previous = self._data
         self._data = None
         delay = spec.ready_delay if spec is not None else 0.0
+        quick = b.ready_after if cmd.kind in SERVICE_REQUEST_KINDS else None
+        if spec is not None and spec.ttt and quick is not None:
+            delay = min(delay, quick)  # a quirk: ready long before ttt
         run = Run(cmd, spec, sent.end + delay)
         if spec is None or spec.ttt == 0:
             self._data = complete(run, b)  # R-4.4.5-03: ready at once

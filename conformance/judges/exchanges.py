@@ -5,7 +5,6 @@ answers where an answer is due, and the continuous (R) commands.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from typing import Protocol
 
 from ..case import events_of
 from ..protocol.crc import ascii_crc
@@ -19,7 +18,7 @@ from ..protocol.responses import (
 )
 from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
-from ..transcript import Event, decode_7e1, escape
+from ..transcript import escape
 
 __all__ = [
     "ascii_crc",
@@ -32,34 +31,12 @@ __all__ = [
     "passed",
     "warned",
 ]
+from ..preconditions import ControlledProbe, listening
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
+from .cite import cite, cited, heard, shown
 from .measurements import data_reply_ids
 from .support import text_instead_of_values
 from .tally import Tally
-
-
-def shown(ex: Exchange) -> str:
-    """``0I! -> '0I13VENDOR..<CR><LF>'`` for evidence lines."""
-    reply = escape(ex.reply_text) if ex.answered else "(silence)"
-    return f"{escape(ex.text)} -> '{reply}'"
-
-
-def cited(ex: Exchange) -> str:
-    """``t=1.2345 s: 0I! -> '0I13VENDOR..<CR><LF>'``: an evidence line naming the exchange a
-    FAIL or WARN rests on, with the time its command began (issue 18)."""
-    return f"t={ex.start:.4f} s: {shown(ex)}"
-
-
-def cite(exchanges: Iterable[Exchange]) -> list[str]:
-    """Evidence lines for ``exchanges`` (:func:`cited`)."""
-    return [cited(ex) for ex in exchanges]
-
-
-def heard(events: list[Event], what: str) -> str:
-    """``t=1.2345 s: service request '0<CR><LF>'``: an evidence line for characters heard
-    outside any exchange (a service request, stray bytes), with when they began."""
-    start = f"t={events[0].start:.4f} s: " if events else ""
-    return f"{start}{what} '{escape(decode_7e1(events))}'"
 
 
 def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Finding:
@@ -140,17 +117,6 @@ def silent(
     )
 
 
-class ControlledProbe(Protocol):
-    """A one-off probe and the ``a!`` control sent the same way right after it
-    (:class:`conformance.sensor.session.HeardProbe`)."""
-
-    probe: Exchange
-    marking: float | None
-
-    @property
-    def listening(self) -> bool: ...
-
-
 def silent_while_listening(
     rid: str,
     probes: Sequence[ControlledProbe],
@@ -173,15 +139,10 @@ def silent_while_listening(
             decision=decision,
             observed=len(answered),
         )
+    unmet = listening(probes)
+    if unmet is not None:
+        return unmet.finding(rid)
     heard = [p for p in probes if p.listening]
-    if not heard:
-        return inconclusive(
-            rid,
-            "precondition not met: the sensor answered none of the a! controls sent like its "
-            f"probes (one break, then once), so its silence to {len(probes)} probe(s) shows "
-            "nothing",
-            evidence=[shown(p.probe) for p in probes[:3]],
-        )
     aside = len(probes) - len(heard)
     marking = heard[0].marking
     way = f" after {marking * 1e3:.0f} ms of marking" if marking is not None else ""

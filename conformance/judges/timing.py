@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..preconditions import awake
 from ..protocol.timing import STANDBY_MARKING, TOLERANCE
 from ..verdicts import Finding, Verdict
 
@@ -17,24 +18,18 @@ EPSILON = 1e-9  # s: a value exactly on a limit is inside it, whatever float rou
 
 
 def not_listening(rid: str, marking: float, uncertainty: float) -> Finding | None:
-    """The precondition of a silence-based FAIL on a wake-up or break rule (issue 18): the
-    command went out while a compliant sensor must still be listening, i.e. less than 100 ms
-    of marking (less the tolerance and the link's uncertainty) after the break. After that a
-    compliant sensor is back in standby and its silence proves nothing: INCONCLUSIVE, naming
-    the measured marking. None when the precondition holds."""
-    if marking + uncertainty < STANDBY_MARKING - TOLERANCE:
+    """The precondition of a silence-based FAIL on a wake-up or break rule (issue 18,
+    :func:`conformance.preconditions.awake`): the command went out while a compliant sensor
+    must still be listening. INCONCLUSIVE naming the measured marking when it did not; None
+    when the precondition holds."""
+    unmet = awake(marking, uncertainty)
+    if unmet is None:
         return None
-    return Finding(
-        rid,
-        Verdict.INCONCLUSIVE,
-        f"precondition not met: the command went out {marking * 1e3:.2f} ms ± "
-        f"{uncertainty * 1e3:.2f} ms of marking after the break, not surely within the "
-        f"{STANDBY_MARKING * 1e3:.0f} ms after which a compliant sensor is back in standby, "
-        "so its silence proves nothing",
-        measured_ms=round(marking * 1e3, 3),
-        limit_ms=round(STANDBY_MARKING * 1e3, 3),
-        uncertainty_ms=round(uncertainty * 1e3, 3),
-    )
+    found = unmet.finding(rid)
+    found.measured_ms = round(marking * 1e3, 3)
+    found.limit_ms = round(STANDBY_MARKING * 1e3, 3)
+    found.uncertainty_ms = round(uncertainty * 1e3, 3)
+    return found
 
 
 @dataclass(frozen=True)

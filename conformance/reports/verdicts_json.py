@@ -98,6 +98,8 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "verdict": str(c.verdict),
                 "requirements": list(c.requirements),
                 "duration_s": round(c.duration, 4),
+                # each declared precondition the case checked: "met" or why not
+                "preconditions": dict(c.preconditions),
             }
             for c in run.cases
         ],

@@ -23,6 +23,7 @@ def _taken(heard):
 
 
 @requirements("R-4.4.5-04", "R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07")
+@pytest.mark.preconditions("heard")
 def test_waiting_for_the_service_request(heard_recorder, case):
     """After 'atttn' the recorder leaves the line alone until the service request or ttt,
     then asks for aD0! at once, and talks to no other sensor until the data are in."""
@@ -32,6 +33,7 @@ def test_waiting_for_the_service_request(heard_recorder, case):
 
 
 @requirements("R-4.4.7-06")
+@pytest.mark.preconditions("heard")
 def test_concurrent_waits(heard_recorder, case):
     """After a concurrent reply, no data command to that sensor before ttt."""
     case.expect("first data command to each sensor at least ttt after its 'atttnn' reply")
@@ -40,6 +42,7 @@ def test_concurrent_waits(heard_recorder, case):
 
 
 @requirements("R-4.4.8-05")
+@pytest.mark.preconditions("heard")
 def test_data_continuation(heard_recorder, case):
     """D0, D1, D2... until every announced value is in; the measurement again after an empty
     D reply."""
@@ -48,6 +51,7 @@ def test_data_continuation(heard_recorder, case):
 
 
 @requirements("R-5.1-04", "R-5.2-08")
+@pytest.mark.preconditions("heard")
 def test_high_volume(heard_recorder, case):
     """Recorded aHA! data are read past D9 without leading zeros; aHB! packets until every
     value (or the empty packet) is in. (Whether a v1.4 recorder issues both, R-5.4-01, is a
@@ -58,6 +62,7 @@ def test_high_volume(heard_recorder, case):
 
 
 @requirements("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-7.2-06")
+@pytest.mark.preconditions("heard")
 def test_retries(heard_recorder, case):
     """Recorded retries after no reply or an invalid one come inside the section 7.2 windows."""
     case.expect("retry 16.67-87 ms after an unanswered command; up to three sequences")
@@ -65,6 +70,7 @@ def test_retries(heard_recorder, case):
 
 
 @requirements("R-4.3-03", "R-4.3-04")
+@pytest.mark.preconditions("heard")
 def test_addresses(heard_recorder, case):
     """Sensors at 0-9 polled (a PASS only when the recording shows all ten answering);
     anything addressed is an address."""

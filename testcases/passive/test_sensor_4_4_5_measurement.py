@@ -14,6 +14,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.5-01", "R-4.4.5-02")
+@pytest.mark.preconditions("heard")
 def test_measurement_reply(heard_sensors, case):
     """Every recorded aM!/aMn!/aMC!/aV! is answered 'atttn' (n >= 1 for a defined group)."""
     case.expect("'atttn<CR><LF>' to each recorded aM!-type command")
@@ -23,6 +24,7 @@ def test_measurement_reply(heard_sensors, case):
 
 
 @requirements("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")
+@pytest.mark.preconditions("heard")
 def test_service_request(heard_sensors, case):
     """After 'atttn' with ttt > 0 the sensor sends 'a<CR><LF>' within ttt, nothing else."""
     case.expect("exactly 'a<CR><LF>' within ttt of the reply; ttt not much longer than needed")
@@ -32,6 +34,7 @@ def test_service_request(heard_sensors, case):
 
 
 @requirements("R-4.4.7-01", "R-4.4.7-02", "R-4.4.7-03")
+@pytest.mark.preconditions("heard")
 def test_concurrent_reply(heard_sensors, case):
     """Every recorded aC!/aCn!/aCC! is answered 'atttnn'."""
     case.expect("'atttnn<CR><LF>' to each recorded aC!-type command")

@@ -15,6 +15,7 @@ ASCII = (Kind.MEASURE, Kind.VERIFY, Kind.CONCURRENT)
 
 
 @requirements("R-4.4.8-01", "R-4.4.8-02", "R-4.4-05")
+@pytest.mark.preconditions("heard")
 def test_data_replies(heard_sensors, case):
     """Recorded D replies are address + values [+ CRC] + CR LF, values well formed and within
     the 35/75-character limit."""
@@ -25,6 +26,7 @@ def test_data_replies(heard_sensors, case):
 
 
 @requirements("R-4.4.8-03", "R-4.4.8-04")
+@pytest.mark.preconditions("heard")
 def test_announced_values_delivered(heard_sensors, case):
     """The recorded D replies add up to the announced count; D0 is not empty when due."""
     case.expect("D0, D1, ... return exactly the announced number of values")
@@ -34,6 +36,7 @@ def test_announced_values_delivered(heard_sensors, case):
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")
+@pytest.mark.preconditions("heard")
 def test_value_grouping(heard_sensors, case):
     """No value split over two replies; groups in order from D0; replies filled (SHOULD)."""
     case.expect("every D reply starts with a sign; no empty Dk before a Dk+1 with values")
@@ -43,6 +46,7 @@ def test_value_grouping(heard_sensors, case):
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03", "R-4.4.12-05", "R-4.4.12-06")
+@pytest.mark.preconditions("heard")
 def test_crc(heard_sensors, case):
     """Data after a CRC measurement carry a correct CRC, encoded in 3 characters; data after
     a plain one carry none."""
@@ -53,6 +57,7 @@ def test_crc(heard_sensors, case):
 
 
 @requirements("R-5.1-01", "R-5.1-02", "R-5.1-03")
+@pytest.mark.preconditions("heard")
 def test_high_volume_ascii(heard_sensors, case):
     """A recorded aHA! is answered 'atttnnn' and its data read past D9 as needed."""
     case.expect("'atttnnn<CR><LF>'; D replies of up to 75 characters with CRC")
@@ -65,6 +70,7 @@ def test_high_volume_ascii(heard_sensors, case):
     "R-5.2-01", "R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2-07", "R-5.2.1-01",
     "R-4.1-03",
 )  # fmt: skip
+@pytest.mark.preconditions("heard")
 def test_high_volume_binary(heard_sensors, case):
     """A recorded aHB! is answered 'atttnnn' and its DB packets are well formed and hold the
     announced number of values."""

@@ -22,6 +22,7 @@ def _by_address(exchanges):
 
 
 @requirements("R-4.4.1-01")
+@pytest.mark.preconditions("heard")
 def test_acknowledge_active(heard_sensors, case):
     """Every recorded reply to a! is the address alone, then CR LF."""
     case.expect("'a<CR><LF>' to each answered a!")
@@ -35,6 +36,7 @@ def test_acknowledge_active(heard_sensors, case):
 
 
 @requirements("R-4.4.13-01", "R-4.4.13-02")
+@pytest.mark.preconditions("heard")
 def test_extended_commands(heard_sensors, case):
     """Replies to recorded extended commands run from the address to CR LF; the commands the
     sensor answers take the aX...! form (SHOULD)."""
@@ -49,6 +51,7 @@ def test_extended_commands(heard_sensors, case):
 
 
 @requirements("R-4.4.13.1-01", "R-4.4.13.1-02", "R-4.4.13.1-03")
+@pytest.mark.preconditions("heard")
 def test_multiline_text(heard_sensors, case):
     """Recorded multi-line replies: STX after the address, ETX after the last CR LF, at most
     75 characters a line, lines at most 150 ms apart."""

@@ -18,6 +18,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-7.0-09", "R-7.0-10")
+@pytest.mark.preconditions("heard")
 def test_response_start_window(heard_sensors, case):
     """Every recorded reply starts 7.93 to 15.40 ms after the command's last stop bit."""
     case.expect("8.33 ms (-0.40) <= delay <= 15.0 ms (+0.40), for every recorded reply")
@@ -26,6 +27,7 @@ def test_response_start_window(heard_sensors, case):
 
 
 @requirements("R-7.0-12", "R-7.0-01")
+@pytest.mark.preconditions("heard")
 def test_character_gaps(heard_sensors, case):
     """No more than 1.66 ms of marking between the characters of a recorded reply."""
     case.expect("every inter-character gap of every recorded reply <= 1.66 ms")
@@ -35,6 +37,7 @@ def test_character_gaps(heard_sensors, case):
 
 
 @requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")
+@pytest.mark.preconditions("heard")
 def test_reply_framing(heard_sensors, case):
     """Every recorded reply is 1200 baud 7E1 (but aDBn! packets), printable, ends in CR LF
     and starts with the address of the sensor that answers."""
@@ -50,6 +53,7 @@ def test_reply_framing(heard_sensors, case):
 
 
 @requirements("R-4.4.2-01", "R-4.4.2-02")
+@pytest.mark.preconditions("heard")
 def test_identification(heard_sensors, case):
     """A recorded aI! reply has the identification fields and a valid version."""
     case.expect("'allccccccccmmmmmmvvvxxx...<CR><LF>' to each recorded aI!")

@@ -12,6 +12,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.12-07")
+@pytest.mark.preconditions("recorder")
 def test_crc_mismatch_is_retried(recorder, case):
     """A D0 reply whose CRC does not match its values is retried, and its values not logged."""
     case.expect("0D0! sent again after the reply with the wrong CRC; the true values logged")

@@ -13,6 +13,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.14-01", "R-4.4.14-02", "R-4.4.13-03", "R-6.3-01")
+@pytest.mark.preconditions("recorder")
 def test_transparent_mode(recorder, case):
     """Host commands (basic, extended, identify, metadata) go out unchanged after a break and
     their replies are relayed unchanged."""
@@ -31,6 +32,7 @@ def test_transparent_mode(recorder, case):
 
 
 @requirements("R-4.4.13.1-04")
+@pytest.mark.preconditions("recorder")
 def test_multiline_text_without_etx(recorder, case):
     """Multi-line text that ends without ETX is complete once 150 ms pass with no new line."""
     case.expect("the recorder waits 150 ms after the last line, then goes on; all lines relayed")

@@ -15,6 +15,7 @@ WAIT_SCENARIOS = ("service-request", "no-service-request", "ttt-zero", "two-sens
 
 
 @requirements("R-4.4.5-04", "R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07")
+@pytest.mark.preconditions("recorder")
 def test_waiting_for_the_service_request(recorder, case):
     """After 'atttn' the recorder leaves the line alone until the service request or ttt,
     then asks for aD0! at once (after a break when ttt ran out), and talks to no other sensor
@@ -30,6 +31,7 @@ def test_waiting_for_the_service_request(recorder, case):
 
 
 @requirements("R-7.1-01")
+@pytest.mark.preconditions("recorder")
 def test_d0_after_service_request(recorder, case):
     """aD0! may follow a service request without a break only within 87 ms."""
     case.expect("aD0! within 87 ms (+0.40) of the service request, or a break first")

@@ -15,6 +15,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.7-06", "R-4.4.7-08")
+@pytest.mark.preconditions("recorder")
 def test_concurrent_measurements(recorder, case):
     """Two sensors measure at once: each one's data are asked for only after its ttt, and the
     recorder uses aC! and collects every value."""
@@ -32,6 +33,7 @@ def test_concurrent_measurements(recorder, case):
 
 
 @requirements("R-4.4.7-07")
+@pytest.mark.preconditions("recorder")
 def test_ninety_nine_values(recorder, case):
     """A concurrent measurement of 99 values: at least 20 stored (2000 text), ideally all."""
     case.expect("all 99 values read through D0..D9 (fewer than 20: FAIL; fewer than 99: WARN)")

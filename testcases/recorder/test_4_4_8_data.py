@@ -13,6 +13,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.8-05")
+@pytest.mark.preconditions("recorder")
 def test_data_continuation(recorder, case):
     """The recorder reads D0, D1, D2... until every announced value is in, and issues the
     measurement again when a D reply comes back valid but empty."""

@@ -13,6 +13,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4-02")
+@pytest.mark.preconditions("recorder")
 def test_every_basic_command_and_family(recorder, case):
     """The recorder issues the basic commands (?!, a!, aI!, aAb!) and logs data from aM!,
     aMn!, aMC!, aV!, aC!, aCn!, aCC!, aRn! and aRCn!."""
@@ -24,6 +25,7 @@ def test_every_basic_command_and_family(recorder, case):
 
 
 @requirements("R-4.3-03", "R-4.3-04")
+@pytest.mark.preconditions("recorder")
 def test_addresses(recorder, case):
     """Sensors at 0-9 can each be polled; letter addresses are an option."""
     case.expect("a valid exchange with each of the sensors at 0..9 (and A, z if supported)")

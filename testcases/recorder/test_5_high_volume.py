@@ -13,6 +13,7 @@ requirements = pytest.mark.requirements
 
 
 @requirements("R-5.1-04", "R-5.2-08", "R-5.4-01")
+@pytest.mark.preconditions("recorder")
 def test_high_volume(recorder, case):
     """aHA! data are read through D14 without leading zeros; aHB! packets are read in 8N1
     until every value (or the empty packet) is in; a v1.4 recorder supports both."""

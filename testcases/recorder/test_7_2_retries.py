@@ -20,6 +20,7 @@ RETRY_SCENARIOS = (
 
 
 @requirements("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-7.2-06")
+@pytest.mark.preconditions("recorder")
 def test_retries(recorder, case):
     """Silent, garbled, paused and bad-CRC replies are retried inside the section 7.2 windows,
     in up to three break+command+retries sequences."""

@@ -27,6 +27,7 @@ def _everything(recorder, case):
 
 
 @requirements("R-7.0-02", "R-7.0-06")
+@pytest.mark.preconditions("recorder")
 def test_breaks(recorder, case):
     """Every break lasts at least 12 ms and is followed by at least 8.33 ms of marking."""
     case.expect("break >= 12 ms (-0.40); marking before the command >= 8.33 ms (-0.40)")
@@ -34,6 +35,7 @@ def test_breaks(recorder, case):
 
 
 @requirements("R-7.0-17")
+@pytest.mark.preconditions("recorder")
 def test_break_when_due(recorder, case):
     """A break before every command to a new sensor and after more than 87 ms of marking."""
     case.expect("commands without a break only to the same sensor within 87 ms (+0.40)")
@@ -42,6 +44,7 @@ def test_break_when_due(recorder, case):
 
 
 @requirements("R-4.2-01", "R-4.4-04", "R-4.3-01")
+@pytest.mark.preconditions("recorder")
 def test_command_text(recorder, case):
     """Commands are printable, start with an address and end with their only '!'."""
     case.expect("printable ASCII; the address first; '!' last and nowhere else")
@@ -49,6 +52,7 @@ def test_command_text(recorder, case):
 
 
 @requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")
+@pytest.mark.preconditions("recorder")
 def test_character_timing(recorder, case):
     """At most 1.66 ms between command characters (no tolerance), at 1200 baud."""
     case.expect("every gap inside a command <= 1.66 ms; characters one 8.33 ms frame apart")

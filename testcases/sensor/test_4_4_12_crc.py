@@ -31,6 +31,7 @@ def _with_continuous(sensor, ids) -> list[Finding]:
 
 
 @requirements("R-4.4.12-01")
+@pytest.mark.preconditions("none")
 def test_crc_commands_supported(sensor, case):
     """A sensor claiming v1.3 or later answers aMC!, aMC1..9!, aCC!, aCC1..9! and aRC0..9!."""
     case.expect("a reply to each CRC-variant command")
@@ -41,6 +42,7 @@ def test_crc_commands_supported(sensor, case):
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03")
+@pytest.mark.preconditions("supported")
 def test_crc_presence(sensor, case):
     """D replies after a CRC variant, and RC replies, end with 3 CRC characters; replies to
     the plain commands carry none."""
@@ -50,6 +52,7 @@ def test_crc_presence(sensor, case):
 
 
 @requirements("R-4.4.12-03")
+@pytest.mark.preconditions("supported")
 def test_crc_request_ends_with_its_command(sensor, case):
     """A CRC asked for on a metadata command (aIMC_001!) is for that reply only: the D
     replies of a plain aM! after it carry no CRC."""
@@ -67,6 +70,7 @@ def test_crc_request_ends_with_its_command(sensor, case):
 
 
 @requirements("R-4.4.12-05", "R-4.4.12-06")
+@pytest.mark.preconditions("supported")
 def test_crc_value_and_encoding(sensor, case):
     """The CRC is CRC-16/ARC over the reply from the address up to the CRC, sent as three
     characters 0x40 | 6-bit groups."""
@@ -76,6 +80,7 @@ def test_crc_value_and_encoding(sensor, case):
 
 
 @requirements("R-4.4.12-04")
+@pytest.mark.preconditions("supported")
 def test_crc_variant_same_measurement(sensor, case):
     """A CRC variant takes the same measurement as its plain twin (same count)."""
     case.expect("aMC! announces the same n as aM!, aCC! the same nn as aC!, and so on")

@@ -15,6 +15,7 @@ def declared(sensor):
 
 
 @requirements("R-4.4.13-01", "R-4.4.13-02")
+@pytest.mark.preconditions("supported")
 def test_extended_commands(sensor, case):
     """Replies to extended commands start with the address and end with CR LF; the commands
     take the aX...! form (SHOULD)."""
@@ -33,6 +34,7 @@ def test_extended_commands(sensor, case):
 
 @pytest.mark.needs('unsolicited')
 @requirements("R-4.4.13.1-01", "R-4.4.13.1-02", "R-4.4.13.1-03")
+@pytest.mark.preconditions("supported")
 def test_multiline_text(sensor, case):
     """Multi-line replies: STX after the address, ETX after the last CR LF, at most 75
     characters a line, no CRC, lines at most 150 ms apart (decision A10)."""

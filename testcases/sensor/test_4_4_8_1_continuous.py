@@ -16,6 +16,7 @@ def continuous_pairs(sensor):
 
 
 @requirements("R-4.4.8.1-01", "R-4.4.8.1-03")
+@pytest.mark.preconditions("supported")
 def test_continuous_replies(sensor, case):
     """R and RC replies come at once, formatted like D replies with at most 75 value
     characters, RC with a CRC; an index the sensor does not serve gets the empty reply."""
@@ -36,6 +37,7 @@ def test_continuous_replies(sensor, case):
 
 
 @requirements("R-4.4.8.1-02")
+@pytest.mark.preconditions("supported")
 def test_continuous_independent(sensor, case):
     """Each Rn stands alone: asking for Rn first, straight after waking, still gives data."""
     case.expect("the same kind of reply to aRn! whether or not R0..R(n-1) came first")

@@ -19,6 +19,7 @@ ASCII_FAMILIES = M_FAMILY + C_FAMILY
 
 
 @requirements("R-4.4.8-01", "R-4.4.8-02", "R-4.4-05")
+@pytest.mark.preconditions("buffered")
 def test_data_replies(sensor, case):
     """D replies are address + values [+ CRC] + CR LF; values are well formed; the values
     part stays within 35 characters after M-type commands and 75 after C-type ones."""
@@ -32,6 +33,7 @@ def test_data_replies(sensor, case):
 
 
 @requirements("R-4.4.8-03", "R-4.4.8-04")
+@pytest.mark.preconditions("supported")
 def test_announced_values_delivered(sensor, case):
     """The D replies add up to the announced count; D0 is not empty when values are due."""
     case.expect("D0, D1, ... return exactly n (or nn, nnn after aHA!) values in all")
@@ -41,6 +43,7 @@ def test_announced_values_delivered(sensor, case):
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")
+@pytest.mark.preconditions("buffered")
 def test_value_grouping(sensor, case):
     """No value split over two replies; groups in order from D0; replies filled (SHOULD)."""
     case.expect(
@@ -53,6 +56,7 @@ def test_value_grouping(sensor, case):
 
 
 @requirements("R-4.4.8-03")
+@pytest.mark.preconditions("buffered")
 def test_undefined_group_leaves_no_old_values(sensor, case):
     """After 'a0000' for an undefined aMn!, aD0! returns no values: none were announced, and
     the previous measurement's must not come back as this one's."""

@@ -15,6 +15,7 @@ CN = tuple(f"C{i}" for i in range(1, 10)) + tuple(f"CC{i}" for i in range(1, 10)
 
 
 @requirements("R-4.4.9-01")
+@pytest.mark.preconditions("none")
 def test_additional_m_answered(sensor, case):
     """Every aM1..aM9! and aMC1..aMC9! gets a reply, defined or not."""
     case.expect("a reply to each of the 18 commands")
@@ -24,6 +25,7 @@ def test_additional_m_answered(sensor, case):
 
 
 @requirements("R-4.4.10-01")
+@pytest.mark.preconditions("none")
 def test_additional_c_answered(sensor, case):
     """Every aC1..aC9! and aCC1..aCC9! gets a reply, defined or not."""
     case.expect("a reply to each of the 18 commands")
@@ -59,6 +61,7 @@ def _undefined(sensor, codes, rid, expected_tail):
 
 
 @requirements("R-4.4.9-02")
+@pytest.mark.preconditions("none")
 def test_undefined_m_group(sensor, case):
     """An undefined aMn! answers a0000."""
     case.expect("'a0000<CR><LF>' for a group the sensor does not define")
@@ -67,6 +70,7 @@ def test_undefined_m_group(sensor, case):
 
 
 @requirements("R-4.4.10-02")
+@pytest.mark.preconditions("none")
 def test_undefined_c_group(sensor, case):
     """An undefined aCn! answers a00000."""
     case.expect("'a00000<CR><LF>' for a group the sensor does not define")
@@ -75,6 +79,7 @@ def test_undefined_c_group(sensor, case):
 
 
 @requirements("R-4.4.11-01")
+@pytest.mark.preconditions("supported")
 def test_verification(sensor, case):
     """aV! behaves like aM!: atttn, service request when ttt > 0, D replies of at most 35
     value characters in D format."""

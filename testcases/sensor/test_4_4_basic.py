@@ -4,17 +4,19 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.protocol.responses import check_change_address_reply, split_line
 from conformance.protocol.timing import ADDRESS_CHANGE_QUIET, TOLERANCE
 from conformance.sensor.address_change import AddressChanger
 from conformance.sensor.session import C_FAMILY, M_FAMILY
-from conformance.verdicts import failed, inconclusive, passed
+from conformance.verdicts import failed, passed
 
 requirements = pytest.mark.requirements
 
 
 @requirements("R-4.4.1-01")
+@pytest.mark.preconditions("none")
 def test_acknowledge_active(sensor, case):
     """a! returns exactly the address and CR LF."""
     case.expect(f"'{sensor.address}<CR><LF>'")
@@ -24,6 +26,7 @@ def test_acknowledge_active(sensor, case):
 
 
 @requirements("R-4.4.2-01", "R-4.4.2-02")
+@pytest.mark.preconditions("none")
 def test_identification(sensor, case):
     """aI! returns address, version, vendor, model, sensor version, optional field, CR LF."""
     case.expect("a + ll + 8-char vendor + 6-char model + 3-char version + 0..13 optional chars")
@@ -45,6 +48,7 @@ BASIC = (
 
 
 @requirements("R-4.4-01")
+@pytest.mark.preconditions("none")
 def test_every_basic_command_is_answered(sensor, case):
     """Every command of Table 5 draws a reply (the format of each is judged by its own rule)."""
     case.expect("a reply to each basic command; aAb! is judged in the address-change case")
@@ -60,6 +64,7 @@ def test_every_basic_command_is_answered(sensor, case):
 
 
 @requirements("R-4.4.4-01", "R-4.4.4-02", "R-4.4.4-03")
+@pytest.mark.preconditions("supported", address=("R-4.4.4-02",), listening=("R-4.4.4-03",))
 def test_change_address(sensor, case):
     """aAb! moves the sensor to b, it answers there (after at most 1 s) and no longer at a."""
     case.expect(
@@ -164,13 +169,15 @@ def test_change_address(sensor, case):
             )
         )
     elif heard is None or not heard.listening:
-        case.add(
-            inconclusive(
-                "R-4.4.4-03",
-                f"precondition not met: no a! at '{target}' sent like the probe of the old "
-                f"address '{original}' (one break, then once) was answered, so the silence "
-                "at the old address shows nothing",
-            )
+        case.requires(
+            "listening",
+            precondition.Unmet(
+                "listening",
+                f"no a! at '{target}' sent like the probe of the old address '{original}' "
+                "(one break, then once) was answered, so the silence at the old address "
+                "shows nothing",
+                tuple(judge.cite(heard.exchanges)) if heard is not None else (),
+            ),
         )
     else:
         case.add(

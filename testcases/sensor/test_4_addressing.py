@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.protocol.commands import ADDRESS_CHARS
 from conformance.verdicts import failed, inconclusive, passed
@@ -19,6 +20,7 @@ def spare_addresses(sensor, count: int = 3) -> list[str]:
 
 
 @requirements("R-4.0-01")
+@pytest.mark.preconditions("listening")
 def test_foreign_addresses_are_ignored(sensor, case):
     """Commands for other addresses, each after a break, must draw no reply."""
     case.expect("silence to a!, aI! and aM! sent to addresses the sensor does not have")
@@ -34,6 +36,7 @@ def test_foreign_addresses_are_ignored(sensor, case):
 
 
 @requirements("R-4.4.3-01")
+@pytest.mark.preconditions("none")
 def test_query_address(sensor, case):
     """?! returns the sensor's address, whatever it is."""
     case.expect(f"'{sensor.address}<CR><LF>'")
@@ -43,6 +46,7 @@ def test_query_address(sensor, case):
 
 
 @requirements("R-4.4.3-02")
+@pytest.mark.preconditions("listening")
 def test_wildcard_with_other_commands(sensor, case):
     """A sensor may accept ? with other commands; if it answers ?I!, it answers correctly."""
     case.expect("silence, or the same identification as aI!")
@@ -50,14 +54,13 @@ def test_wildcard_with_other_commands(sensor, case):
     ex = heard.probe
     ident = sensor.exchange("I")
     case.evidence("?I! and its a! control", heard.exchanges)
-    if not ex.answered and not (ident.answered and heard.listening):
-        case.add(
-            inconclusive(
-                "R-4.4.3-02",
-                "precondition not met: the a! sent like ?I! (one break, then once) or aI! got "
-                "no reply, so silence to ?I! says nothing",
-            )
+    deaf = precondition.listening([heard])
+    if not ident.answered:
+        deaf = precondition.Unmet(
+            "listening", "aI! got no reply, so silence to ?I! says nothing", (judge.shown(ident),)
         )
+    if not ex.answered and deaf is not None:
+        case.requires("listening", deaf)
     elif not ex.answered:
         case.add(
             passed(
@@ -82,6 +85,7 @@ def test_wildcard_with_other_commands(sensor, case):
 
 
 @requirements("R-4.3-02")
+@pytest.mark.preconditions("none")
 def test_factory_address(sensor, case):
     """A sensor as shipped answers at address 0."""
     case.expect("address 0 on a unit fresh from the factory")
@@ -114,6 +118,7 @@ def test_factory_address(sensor, case):
 
 
 @requirements("R-4.3-03", "R-4.3-04")
+@pytest.mark.preconditions("supported", listening=("R-4.3-04",))
 def test_address_range(sensor, case):
     """A sensor with a settable address takes each of 0-9, and refuses a non-address."""
     case.expect(
@@ -155,12 +160,15 @@ def test_address_range(sensor, case):
             )
         )
     elif not bad.accepted and not bad.listening:
-        case.add(
-            inconclusive(
-                "R-4.3-04",
-                "precondition not met: the a! sent like aA$! (one break, then once) got no "
-                "reply, so the silence to aA$! shows nothing",
-            )
+        control = bad.exchanges[-1:] if len(bad.exchanges) > 1 else []
+        case.requires(
+            "listening",
+            precondition.Unmet(
+                "listening",
+                "the a! sent like aA$! (one break, then once) got no reply, so the silence "
+                "to aA$! shows nothing",
+                tuple(judge.cite(control)),
+            ),
         )
     elif bad.accepted:
         case.add(

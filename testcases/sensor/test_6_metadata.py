@@ -25,6 +25,7 @@ def identify(sensor, code):
 
 
 @requirements("R-6.1-01")
+@pytest.mark.preconditions("none")
 def test_identify_measurement_answered(sensor, case):
     """A v1.4 sensor answers every identify-measurement command (aIM! ... aIHB!)."""
     case.expect("a reply to each of the 43 identify forms")
@@ -34,6 +35,7 @@ def test_identify_measurement_answered(sensor, case):
 
 
 @requirements("R-6.1-02")
+@pytest.mark.preconditions("supported")
 def test_identify_matches_measurement(sensor, case):
     """Each identify reply equals the reply of the command without the I (decision A9)."""
     case.expect("same atttn/atttnn/atttnnn shape and count; a ttt difference only warns")
@@ -44,6 +46,7 @@ def test_identify_matches_measurement(sensor, case):
 
 @pytest.mark.needs('unsolicited')
 @requirements("R-6.1-03")
+@pytest.mark.preconditions("buffered")
 def test_identify_starts_nothing(sensor, case):
     """An identify command starts no measurement: no service request, earlier data intact."""
     case.expect("no character after aIM!/aIC!/aIHA!; the D replies read before still come back")
@@ -123,6 +126,7 @@ def _metadata_plan(sensor):
 
 
 @requirements(*META_IDS)
+@pytest.mark.preconditions("supported")
 def test_parameter_metadata(sensor, case):
     """Metadata replies 'a,field1,field2[,...];[CRC]' for every announced value: printable
     fields without ',' or ';', at most 75 characters through ';', units always present."""
@@ -136,6 +140,7 @@ def test_parameter_metadata(sensor, case):
 
 
 @requirements("R-6.2-05")
+@pytest.mark.preconditions("supported")
 def test_metadata_invalid_index(sensor, case):
     """Index 000 and an index above the count get 'a<CR><LF>' (or 'a<CRC><CR><LF>')."""
     case.expect("the invalid-index reply, with a CRC where the command carries one")
@@ -152,6 +157,7 @@ def test_metadata_invalid_index(sensor, case):
 
 
 @requirements("R-6.2-06")
+@pytest.mark.preconditions("supported")
 def test_continuous_metadata(sensor, case):
     """For each continuous command, aIRn_001!, _002!, ... answer in turn, ended by the
     invalid-index reply, one record for each value aRn! returns."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.judges.timing import not_listening
 from conformance.protocol.timing import (
@@ -55,33 +56,27 @@ def _asleep(sensor):
     sensor.listen(STANDBY)
 
 
-def _shown_asleep(sensor, case, rid: str):
+def _shown_asleep(sensor, case):
     """Put the sensor to sleep and show it: a spacing rule can only be judged on a sensor in
     standby, one that ignores a command without a break after more than 100 ms of marking.
-    Returns that ignored ``a!``, or None with ``rid`` INCONCLUSIVE "precondition not met"
+    Returns that ignored ``a!``, or None with the case's "standby" precondition not met
     (linked to R-7.0-15, the rule a sensor that never sleeps breaks)."""
     _asleep(sensor)
     check = sensor.master.raw(f"{sensor.address}!", break_first=False)
-    if not check.answered:
+    unmet = precondition.standby(check, STANDBY)
+    if unmet is None:
         return check
     case.evidence("sensor put to sleep, then a! with no break", [check])
-    case.add(
-        inconclusive(
-            rid,
-            "precondition not met: the sensor was not shown in standby (it answered a! "
-            f"without a break after {STANDBY * 1e3:.0f} ms of marking: {judge.shown(check)})",
-            evidence=[judge.shown(check)],
-            consequence_of="R-7.0-15",
-        )
-    )
+    case.requires("standby", unmet)
     return None
 
 
 @requirements("R-7.0-03")
+@pytest.mark.preconditions("standby")
 def test_short_spacing_is_not_a_break(sensor, case):
     """Spacing shorter than 6.5 ms never wakes a sleeping sensor."""
     case.expect("silence to a command after a 5 ms spacing pulse")
-    check = _shown_asleep(sensor, case, "R-7.0-03")
+    check = _shown_asleep(sensor, case)
     if check is None:
         return
 
@@ -124,12 +119,13 @@ def test_short_spacing_is_not_a_break(sensor, case):
 
 
 @requirements("R-7.0-04")
+@pytest.mark.preconditions("standby", "awake")
 def test_break_just_over_12ms_wakes(sensor, case):
     """Spacing longer than 12 ms is always a break: after a 12.6 ms break the sensor answers
     (the command is repeated without a break as a recorder's retries would be, so a sensor
     that is merely slow to wake is judged by R-7.0-05/07, not here)."""
     case.expect("a reply to a! or one of its retries after a 12.6 ms break")
-    check = _shown_asleep(sensor, case, "R-7.0-04")
+    check = _shown_asleep(sensor, case)
     if check is None:
         return
 
@@ -193,6 +189,7 @@ def test_break_just_over_12ms_wakes(sensor, case):
 
 
 @requirements("R-7.0-05")
+@pytest.mark.preconditions("awake")
 def test_marking_after_break(sensor, case):
     """After a break the sensor looks for its address once 8.33 ms of marking have passed:
     it answers a command sent then, and (decision A18) ignores one sent sooner."""
@@ -283,6 +280,7 @@ def test_marking_after_break(sensor, case):
 
 
 @requirements("R-7.0-07")
+@pytest.mark.preconditions("awake")
 def test_ready_within_100ms_of_break(sensor, case):
     """Within 100 ms of a break the sensor can take a command: one sent 90 ms after it."""
     case.expect("a reply to a! whose start bit comes 90 ms after the break")
@@ -325,6 +323,7 @@ def test_ready_within_100ms_of_break(sensor, case):
 
 
 @requirements("R-7.0-14")
+@pytest.mark.preconditions("awake")
 def test_standby_after_foreign_command(sensor, case):
     """After a command for another address the sensor ignores its own address without a
     new break."""
@@ -357,6 +356,7 @@ def _after_marking(sensor, last_end: float, marking: float, text: str):
 
 
 @requirements("R-7.0-15")
+@pytest.mark.preconditions("awake")
 def test_standby_after_100ms(sensor, case):
     """After more than 100 ms of marking the sensor ignores a command without a break: probed
     just past the limit (by more than tolerance and uncertainty) and well past it (115 ms)."""
@@ -417,6 +417,7 @@ def test_standby_after_100ms(sensor, case):
 
 
 @requirements("R-7.0-16")
+@pytest.mark.preconditions("awake")
 def test_follow_up_without_break(sensor, case):
     """An awake sensor answers its address without a break while the line has marked for
     less than 87 ms: probed well inside (20 ms) and just inside the limit (87 ms less the
@@ -474,6 +475,7 @@ def test_follow_up_without_break(sensor, case):
 
 
 @requirements("R-7.1-02")
+@pytest.mark.preconditions("supported")
 def test_data_after_service_request_without_break(sensor, case):
     """After its service request the sensor answers an aD0! sent within 87 ms, no break."""
     case.expect("a reply to the first aD0! after the service request")
@@ -519,6 +521,7 @@ def test_data_after_service_request_without_break(sensor, case):
 
 
 @requirements("R-AppB-01")
+@pytest.mark.preconditions("awake")
 def test_partial_command_dropped(sensor, case):
     """A command interrupted by 8.33 ms or more of marking is dropped (decision A18: a reply
     is only a warning)."""

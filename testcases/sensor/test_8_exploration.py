@@ -12,6 +12,7 @@ requirements = pytest.mark.requirements
 
 @pytest.mark.needs('break')
 @requirements(*IDS)
+@pytest.mark.preconditions("listening", "address")
 def test_random_command_sequences(sensor, case):
     """Random sequences of valid, foreign-address and malformed commands, breaks and pauses
     (derandomised): the sensor never answers another address, frames every reply, gets every

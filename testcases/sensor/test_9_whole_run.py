@@ -40,6 +40,7 @@ def _confirmed(sensor, case, wanted):
 
 
 @requirements("R-7.0-09", "R-7.0-10")
+@pytest.mark.preconditions("none")
 def test_response_start_window(sensor, case):
     """Every reply's first start bit comes 7.93 to 15.40 ms after the command's last stop bit."""
     case.expect("8.33 ms (-0.40) <= delay <= 15.0 ms (+0.40), for every reply of the run")
@@ -48,6 +49,7 @@ def test_response_start_window(sensor, case):
 
 
 @requirements("R-7.0-12", "R-7.0-01")
+@pytest.mark.preconditions("none")
 def test_character_gaps(sensor, case):
     """No more than 1.66 ms of marking between the characters of a reply (no tolerance)."""
     case.expect("every inter-character gap of every reply <= 1.66 ms")
@@ -56,6 +58,7 @@ def test_character_gaps(sensor, case):
 
 
 @requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")
+@pytest.mark.preconditions("address")
 def test_reply_framing(sensor, case):
     """Every reply is 1200 baud 7E1 (except aDBn! packets), printable, at least 3 characters
     ending in CR LF, and starts with the address of the sensor that answers."""

@@ -75,10 +75,17 @@ SERVICE_REQUESTS: tuple[Fault, ...] = (
         "no-service-request",
         "M/MC/Mn/V with ttt > 0 never send a service request (data are ready before ttt)."
         " With no service request its form and timing cannot be judged, nor can a break be"
-        " shown to abort one (R-4.4.5.1-01).",
+        " shown to abort one (R-4.4.5.1-01) and what follows an abort (-02, -03) be judged.",
         ("R-4.4.6-02",),
         settings={"service_request": False},
-        inconclusive=("R-4.4.5-09", "R-4.4.5.1-01", "R-4.4.6-01", "R-4.4.6-04"),
+        inconclusive=(
+            "R-4.4.5-09",
+            "R-4.4.5.1-01",
+            "R-4.4.5.1-02",
+            "R-4.4.5.1-03",
+            "R-4.4.6-01",
+            "R-4.4.6-04",
+        ),
     ),
     Fault(
         "late-service-request",
@@ -102,10 +109,10 @@ SERVICE_REQUESTS: tuple[Fault, ...] = (
         "service-request-extra-chars",
         "The service request is 'aSR<CR><LF>' instead of 'a<CR><LF>'."
         " The service request is not recognised, so a break cannot be shown to prevent one"
-        " (R-4.4.5.1-01).",
+        " (R-4.4.5.1-01), nor what follows an abort be judged (-02, -03).",
         ("R-4.4.6-01",),
         rewrite=only([ReplyKind.SERVICE_REQUEST], lambda r: replace(r, body=r.body + "SR")),
-        inconclusive=("R-4.4.5.1-01",),
+        inconclusive=("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03"),
     ),
     Fault(
         "chatter-before-service-request",
@@ -127,9 +134,11 @@ SERVICE_REQUESTS: tuple[Fault, ...] = (
 ABORTS: tuple[Fault, ...] = (
     Fault(
         "break-does-not-abort-measure",
-        "A break during M/V keeps the measurement running; SR and data follow as usual.",
+        "A break during M/V keeps the measurement running; SR and data follow as usual."
+        " With no abort shown, what follows an abort (R-4.4.5.1-02, -03) cannot be judged.",
         ("R-4.4.5.1-01",),
         settings={"break_aborts_measure": False},
+        inconclusive=("R-4.4.5.1-02", "R-4.4.5.1-03"),
     ),
     Fault(
         "abort-keeps-old-data",

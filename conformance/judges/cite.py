@@ -1,0 +1,34 @@
+"""Evidence lines naming exchanges and heard characters (issue 18: a FAIL or WARN names the
+observations it rests on). Apart from the judges so that the precondition checks, which the
+judges and the case object use, cite the wire the same way without importing either."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from ..tool_recorder.records import Exchange
+from ..transcript import Event, decode_7e1, escape
+
+
+def shown(ex: Exchange) -> str:
+    """``0I! -> '0I13VENDOR..<CR><LF>'`` for evidence lines."""
+    reply = escape(ex.reply_text) if ex.answered else "(silence)"
+    return f"{escape(ex.text)} -> '{reply}'"
+
+
+def cited(ex: Exchange) -> str:
+    """``t=1.2345 s: 0I! -> '0I13VENDOR..<CR><LF>'``: an evidence line naming the exchange a
+    FAIL or WARN rests on, with the time its command began (issue 18)."""
+    return f"t={ex.start:.4f} s: {shown(ex)}"
+
+
+def cite(exchanges: Iterable[Exchange]) -> list[str]:
+    """Evidence lines for ``exchanges`` (:func:`cited`)."""
+    return [cited(ex) for ex in exchanges]
+
+
+def heard(events: list[Event], what: str) -> str:
+    """``t=1.2345 s: service request '0<CR><LF>'``: an evidence line for characters heard
+    outside any exchange (a service request, stray bytes), with when they began."""
+    start = f"t={events[0].start:.4f} s: " if events else ""
+    return f"{start}{what} '{escape(decode_7e1(events))}'"

@@ -1,0 +1,269 @@
+"""Declared preconditions: what the wire must show before a case may judge (issue 18).
+
+A verdict about a device rests on a state of that device: awake when a silence is judged, a
+measurement still running when a break is to abort it, values in the buffer when they are to
+be compared. When the wire does not show that state, a PASS or a FAIL would be about nothing,
+so the requirement is INCONCLUSIVE, "precondition not met: <code>: ...", with the events that
+show why. Every case declares its preconditions (``@pytest.mark.preconditions``, read by
+:func:`declared`), each with a reason code of :data:`CODES`; the checks over transcript
+events and records live here, in one place, and :meth:`conformance.case.Case.requires`
+applies their outcome, so no case rebuilds the rule or its wording.
+
+The marker: ``@preconditions("supported", pending=("R-4.4.5.1-01",))``. A positional code
+guards every requirement of the case; a keyword code guards the requirements it names. A case
+that genuinely needs nothing beyond a device answering at its address declares ``"none"``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, Protocol
+
+from .judges.cite import cited, heard, shown
+from .judges.support import serves_measurement
+from .protocol.timing import STANDBY_MARKING, TOLERANCE
+from .tool_recorder.records import Exchange, Measurement
+from .transcript import TOOL, Event, decode_7e1, escape
+from .verdicts import Finding, inconclusive
+
+MARKER = "preconditions"
+MARKER_HELP = (
+    "preconditions(*codes, **code_to_requirements): what the wire must show before the case "
+    "judges (conformance/preconditions.py CODES); 'none' if nothing"
+)
+
+#: Every reason code, with what the wire must show for it to hold.
+CODES: Mapping[str, str] = MappingProxyType(
+    {
+        "none": "nothing beyond a device that answers at its address",
+        "listening": "the sensor was listening when a probe whose silence is judged went out:"
+        " it answered an a! sent the same way (one break, the same marking, once)",
+        "awake": "a command whose silence is judged went out while a compliant sensor must"
+        " still be awake: less than 100 ms of marking after the break",
+        "standby": "the sensor was shown in standby: it ignored an a! sent without a break"
+        " after more than 100 ms of marking",
+        "pending": "the measurement was still running when the break or command meant to"
+        " disturb it started: no service request or other text before it, ttt not elapsed",
+        "aborted": "the abort the rule is about was shown: no service request after the break"
+        " of a measurement that raises one undisturbed",
+        "buffered": "the data buffer held values to compare or to lose",
+        "supported": "the feature was shown served by a well-formed answer of its own kind"
+        " (judges/support.py), or declared so",
+        "address": "the address judged against is the one the sensor has now",
+        "recorder": "the recorder was made to act in the scenario the rule is about",
+        "heard": "the traffic the rule is about was heard on the line (a passive run judges"
+        " only what it overheard; none heard is INCONCLUSIVE, never a PASS)",
+    }
+)
+
+
+class PreconditionError(ValueError):
+    """A declaration that names an unknown code or a requirement the case does not judge."""
+
+
+@dataclass(frozen=True)
+class Unmet:
+    """A precondition the wire did not show: its code, why, and the evidence lines."""
+
+    code: str
+    detail: str
+    evidence: tuple[str, ...] = ()
+    #: the rule whose deviation probably removed the precondition (root_causes.py links it)
+    consequence_of: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.code not in CODES:
+            raise PreconditionError(f"unknown precondition {self.code!r}")
+
+    @property
+    def text(self) -> str:
+        return f"precondition not met: {self.code}: {self.detail}"
+
+    def finding(self, rid: str) -> Finding:
+        return inconclusive(
+            rid, self.text, evidence=list(self.evidence), consequence_of=self.consequence_of
+        )
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """A case's declared preconditions: code -> the requirements it guards."""
+
+    guards: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+
+    @property
+    def declared(self) -> bool:
+        return bool(self.guards)
+
+    def guarded(self, code: str) -> tuple[str, ...]:
+        return self.guards.get(code, ())
+
+    def covered(self) -> set[str]:
+        return {rid for rids in self.guards.values() for rid in rids}
+
+
+def declaration(
+    args: Iterable[str], kwargs: Mapping[str, Iterable[str]], requirements: Sequence[str]
+) -> Declaration:
+    """Build and check a declaration from the marker's arguments (PreconditionError if it
+    names an unknown code or a requirement the case does not judge)."""
+    guards: dict[str, tuple[str, ...]] = {}
+    for code in args:
+        guards[code] = tuple(requirements)
+    for code, rids in kwargs.items():
+        rids = (rids,) if isinstance(rids, str) else tuple(rids)
+        guards[code] = tuple(dict.fromkeys(guards.get(code, ()) + rids))
+    unknown = sorted(set(guards) - set(CODES))
+    if unknown:
+        raise PreconditionError(f"unknown precondition code(s) {unknown}; known: {sorted(CODES)}")
+    stray = sorted({r for rids in guards.values() for r in rids} - set(requirements))
+    if stray:
+        raise PreconditionError(f"preconditions guard {stray}, which the case does not judge")
+    if "none" in guards and len(guards) > 1:
+        raise PreconditionError("'none' cannot stand beside other preconditions")
+    return Declaration(MappingProxyType(guards))
+
+
+def declared(item: Any, requirements: Sequence[str]) -> Declaration:
+    """The declaration on a pytest item (an empty one when it has no marker)."""
+    marker = item.get_closest_marker(MARKER)
+    if marker is None:
+        return Declaration()
+    return declaration(marker.args, marker.kwargs, requirements)
+
+
+# -- the checks, from the wire --------------------------------------------------------------
+
+
+class ControlledProbe(Protocol):
+    """A one-off probe and the ``a!`` control sent the same way right after it."""
+
+    probe: Exchange
+    marking: float | None
+
+    @property
+    def listening(self) -> bool: ...
+
+
+def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
+    """Silence to one-off probes counts only where the sensor answered the control sent the
+    same way right after one of them."""
+    if any(p.listening for p in probes):
+        return None
+    return Unmet(
+        "listening",
+        "the sensor answered none of the a! controls sent like its probes (one break, then "
+        f"once), so its silence to {len(probes)} probe(s) shows nothing",
+        tuple(shown(p.probe) for p in probes[:3]),
+    )
+
+
+def heard_one_shot(marking: float | None, what: str) -> Unmet | None:
+    """A one-off command for another address is heard only by a sensor shown to answer a
+    one-shot ``a!`` after a break (:meth:`SensorSession.hearing_marking`, ``marking``; None:
+    no marking worked), so its silence or its effect shows nothing otherwise."""
+    if marking is not None:
+        return None
+    return Unmet(
+        "listening",
+        f"the sensor answered no one-shot a! after a break, so it may not have heard {what}",
+    )
+
+
+def awake(marking: float, uncertainty: float) -> Unmet | None:
+    """A command went out while a compliant sensor must still be listening: less than 100 ms
+    of marking (less the tolerance and the link's uncertainty) after the break."""
+    if marking + uncertainty < STANDBY_MARKING - TOLERANCE:
+        return None
+    return Unmet(
+        "awake",
+        f"the command went out {marking * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} ms of marking "
+        f"after the break, not surely within the {STANDBY_MARKING * 1e3:.0f} ms after which a "
+        "compliant sensor is back in standby, so its silence proves nothing",
+        (f"{marking * 1e3:.2f} ms of marking after the break",),
+    )
+
+
+def standby(check: Exchange, marking: float) -> Unmet | None:
+    """The sensor is in standby when it ignored ``check``, an ``a!`` sent without a break
+    after ``marking`` s of marking; one that answered it never sleeps (R-7.0-15)."""
+    if not check.answered:
+        return None
+    return Unmet(
+        "standby",
+        "the sensor was not shown in standby (it answered a! without a break after "
+        f"{marking * 1e3:.0f} ms of marking: {shown(check)})",
+        (shown(check),),
+        consequence_of="R-7.0-15",
+    )
+
+
+def pending(
+    start: Exchange, ttt: float, before: list[Event], disturbance: Event, what: str = "break"
+) -> Unmet | None:
+    """The measurement ``start`` began was still running when ``disturbance`` (a break or the
+    first event of a command) started: it was answered, nothing came from the sensor between
+    its reply and the disturbance (a service request means the data were ready), and ttt had
+    not run out."""
+    if not start.answered:
+        return Unmet("pending", f"the measurement never started: {shown(start)}", (cited(start),))
+    sent = [e for e in before if e.origin != TOOL and e.start < disturbance.start]
+    when = f"t={disturbance.start:.4f} s: {what}"
+    if sent:
+        return Unmet(
+            "pending",
+            f"the sensor had finished before the {what} (it sent "
+            f"'{escape(decode_7e1(sent))}' first), so nothing was left to abort",
+            (cited(start), heard(sent, "then"), when),
+        )
+    reply_end = start.attempts[-1].reply_events[-1].end if start.attempts[-1].reply_events else None
+    if reply_end is not None and disturbance.start - reply_end >= ttt:
+        return Unmet(
+            "pending",
+            f"the {what} came {disturbance.start - reply_end:.3f} s after the reply, when "
+            f"ttt ({ttt:g} s) had already run out",
+            (cited(start), when),
+        )
+    return None
+
+
+def aborted(undisturbed: Measurement, service_requests_after: list[list[Event]]) -> Unmet | None:
+    """An abort is shown when the measurement raises a service request undisturbed and none
+    came after the break (``service_requests_after``: the ones heard, as events)."""
+    if undisturbed.service_request_end is None:
+        return Unmet(
+            "aborted",
+            f"the undisturbed {undisturbed.command.text()[1:-1]} raised no service request "
+            "either, so its absence after the break proves no abort",
+            (cited(undisturbed.start),),
+        )
+    if service_requests_after:
+        return Unmet(
+            "aborted",
+            "the break aborted nothing: a service request followed it",
+            (heard(service_requests_after[0], "service request after the break"),),
+        )
+    return None
+
+
+def buffered(m: Measurement | None, what: str = "measurement") -> Unmet | None:
+    """The buffer holds values when a measurement delivered at least one."""
+    if m is not None and m.value_count:
+        return None
+    evidence = (cited(m.start),) if m is not None else ()
+    return Unmet("buffered", f"no {what} delivered values to compare", evidence)
+
+
+def supported(m: Measurement, what: str | None = None) -> Unmet | None:
+    """A measurement command is served when its start reply is well formed and announces a
+    value (:func:`conformance.judges.support.serves_measurement`)."""
+    if serves_measurement(m):
+        return None
+    name = what or m.command.text()
+    return Unmet(
+        "supported",
+        f"{name} was not shown served (no well-formed reply announcing values): {shown(m.start)}",
+        (cited(m.start),),
+    )
