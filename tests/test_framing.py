@@ -183,3 +183,39 @@ def test_behind_echo_a_dut_talking_over_the_command_is_contention_not_a_reply(ec
     assert "".join(chr(e.char7) for e in t.reply) == "0+1.5\r\n"
     framing = wire.judge_framing(wire.segments(events), 0.0)
     assert not [f for f in framing if f.verdict is Verdict.FAIL], framing
+
+
+def test_the_tail_of_a_frame_that_met_the_command_is_no_reply():
+    """A service request that began during ``0D!`` and ended after it (the simulated bus
+    queues its next characters behind the tool's): '<CR><LF>' is contention, not a reply to
+    ``0D!`` (before: R-4.2-03/R-4.3-01 FAIL and a 0 ms R-7.0-09 FAIL on quick-ready)."""
+    cmd = _chars(TOOL, "0D", 0.0)
+    sr0 = _chars(DUT, "0", cmd[-1].end)  # the sensor's service request starts
+    bang = _chars(TOOL, "!", sr0[0].end)
+    tail = _chars(DUT, "\r\n", bang[0].end)  # queued behind the tool's '!'
+    reply = _chars(DUT, "0+1\r\n", tail[-1].end + 9e-3)
+    (t,) = read_view(cmd + sr0 + bang + tail + reply).transmissions
+    assert [chr(e.char7) for e in t.contention] == ["0", "\r", "\n"]
+    assert "".join(chr(e.char7) for e in t.reply) == "0+1\r\n"
+    (seg,) = wire.segments(cmd + sr0 + bang + tail + reply)
+    assert len(seg.contention) == 3 and seg.reply[0] is reply[0]
+
+
+@pytest.mark.parametrize("profile", ["quick-ready", "prompt-sr"])
+def test_a_sensor_whose_service_request_comes_early_draws_no_fail(profile, tmp_path):
+    """Both legal profiles send their service request long before ttt; whatever the tool's
+    next command meets, no FAIL rests on it (quick-ready FAILed R-4.2-03, R-4.3-01 and
+    R-7.0-09 on collided service requests before)."""
+    import json
+    import subprocess
+    import sys
+
+    out = tmp_path / "r"
+    subprocess.run(
+        [sys.executable, "-m", "conformance.cli", "--port", f"sim://?profile={profile}",
+         "--report-dir", str(out)],
+        capture_output=True, text=True, timeout=300, check=False,
+    )  # fmt: skip
+    data = json.loads((out / "verdicts.json").read_text())
+    bad = {r["id"]: r["verdict"] for r in data["requirements"] if r["verdict"] == "FAIL"}
+    assert not bad, bad

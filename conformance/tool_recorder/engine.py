@@ -452,7 +452,13 @@ class Master:
         run_gap = INTER_CHAR_GAP_MAX + TOLERANCE + self.link.info.timing_uncertainty
         while first and (
             first[0].start < command_end
-            or (collided and first[0].start - collided[-1].end <= run_gap)  # its tail
+            # its tail, up to its LF: counted from the later of its last character and the
+            # command (a bus that queued the sensor's frame behind the command delays it)
+            or (
+                collided
+                and collided[-1].char7 != 0x0A
+                and first[0].start - max(collided[-1].end, command_end) <= run_gap
+            )
         ):
             collided += first
             first = self.link.receive(deadline, until=lambda got: True)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
 from ..protocol.timing import NO_BREAK_WINDOW
-from ..transcript import COLLISION, Event, decode_8n1
+from ..transcript import Event, decode_8n1
 from .segments import IsRecorder, Transmission, read_view
 from .sides import ETX, LF, STX
 
@@ -75,9 +75,10 @@ class Segment:
             text=t.text,
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
         )
+        clash = {id(e) for e in t.contention}
         for e in t.heard:
-            if not t.is_command or e.start < t.end or e.text == COLLISION:
-                seg.contention.append(e)  # not a reply: it overlapped the command
+            if not t.is_command or id(e) in clash:
+                seg.contention.append(e)  # not a reply: it met the command (or its tail did)
             else:
                 _place(seg, e)
         return seg

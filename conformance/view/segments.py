@@ -118,14 +118,15 @@ class Transmission:
     def contention(self) -> list[Event]:
         """Sensor characters that started before the command ended, or came back between the
         echoes of its characters (two talkers): never part of a reply."""
-        return [e for e in self.heard if e.start < self.end or e.text == COLLISION]
+        return collided(self.heard, self.end)
 
     @property
     def reply(self) -> list[Event]:
         """The reply proper, framed as the protocol frames it: up to the first LF (7E1), the
         packet's length (``aDBn!``), or ETX / 150 ms of marking after a line (multi-line
         text). How long it took to start is the timing rules' question, not the framing's."""
-        heard = [e for e in self.heard if e.start >= self.end and e.text != COLLISION]
+        clash = {id(e) for e in self.contention}
+        heard = [e for e in self.heard if id(e) not in clash]
         if self.binary:
             length = packet_length(decode_8n1(heard))
             return heard[:length] if length is not None else heard
@@ -144,16 +145,37 @@ class Transmission:
     @property
     def after(self) -> list[Event]:
         """What the sensors sent after the reply (service requests, chatter)."""
-        reply = {id(e) for e in self.reply}
-        return [
-            e
-            for e in self.heard
-            if e.start >= self.end and id(e) not in reply and e.text != COLLISION
-        ]
+        taken = {id(e) for e in self.reply} | {id(e) for e in self.contention}
+        return [e for e in self.heard if id(e) not in taken]
 
     def at(self) -> str:
         """Where it is, for evidence lines."""
         return f"{escape(self.text)} at t={self.first_char:.3f} s"
+
+
+def collided(heard: list[Event], end: float) -> list[Event]:
+    """The sensor characters that met a tool transmission ending at ``end``: those that
+    started before it ended or came back between its echoes (two talkers), and the rest of a
+    frame that began that way: characters that follow the last collided one within a
+    character gap (widened by both stamps' uncertainty) until its LF. A service request that
+    started during the tool's command ends after it; that tail is no reply (issue 18)."""
+    out: list[Event] = []
+    prev: Event | None = None  # the character before ``e``, when it collided
+    for e in heard:
+        met = e.start < end or e.text == COLLISION
+        tail = prev is not None and prev.char7 != LF and _follows(prev, e, end)
+        if met or tail:
+            out.append(e)
+        prev = e if met or tail else None
+    return out
+
+
+def _follows(last: Event, e: Event, end: float) -> bool:
+    """``e`` goes on from ``last`` within a character gap, counted from the later of ``last``
+    and the tool's transmission (a bus that queued the sensor's frame behind the tool's
+    characters delays it, and the simulated one does)."""
+    allowed = INTER_CHAR_GAP_MAX + TOLERANCE + last.uncertainty + e.uncertainty
+    return e.start - max(last.end, end) <= allowed
 
 
 @dataclass(frozen=True)
