@@ -148,9 +148,27 @@ class GappyCommandMaster(GoldenMaster):
     gap = 3e-3
 
     def _transmit(
-        self, wire: bytes, address: str, brk: bool | None, gap: float, marking: float | None
-    ) -> tuple[Event | None, list[Event]]:
-        return super()._transmit(wire, address, brk, max(gap, self.gap), marking)
+        self,
+        wire: bytes,
+        address: str,
+        brk: bool | None,
+        gap: float,
+        marking: float | None,
+        collide: bool,
+    ) -> tuple[Event | None, list[Event], list[Event]]:
+        return super()._transmit(wire, address, brk, max(gap, self.gap), marking, collide)
+
+
+class TalksOverMaster(Master):
+    """The engine without any wait for a quiet line: neither the golden recorder's drain
+    before a retry nor the engine's own listen before talk. It keeps only the turnaround
+    after the last sensor character it has already seen, as the engine did before it
+    listened (a retry goes out while the rest of a paused reply is still arriving)."""
+
+    def clear_to_send(self, *, collide: bool = False) -> float:
+        self.note_collisions()
+        self.link.wait_until(self._earliest_transmit())
+        return self.link.now()
 
 
 class BandGapCommandMaster(GappyCommandMaster):
@@ -450,7 +468,7 @@ _FAULTS = (
         "without the golden recorder's wait for a quiet line). Its retry collides with the "
         "rest of the reply, and on the line its characters come apart (R-7.0-13).",
         ("R-7.2-06", "R-7.0-13"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(Master)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(TalksOverMaster)),
     ),
     RecorderFault(
         "interleaves-measurements",

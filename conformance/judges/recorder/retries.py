@@ -104,7 +104,9 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                 follower = nxt or later
                 if follower is None and len(seq) < 3:
                     tally.fail("R-7.2-05", where, f"{a.problem} at {a.sent.at()}, then no retry")
-                if a.problem is NO_REPLY:
+                # "no reply" times a retry from a quiet line: sensor characters that met the
+                # command (the recorder talked over them) leave that window undecided
+                if a.problem is NO_REPLY and not a.sent.contention:
                     if nxt is not None:
                         window.append(
                             judge_window(
