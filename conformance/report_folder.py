@@ -27,15 +27,21 @@ def new_report_dir(kind: str, base: Path | str = "reports") -> Path:
     """A new, empty folder ``base/STAMP-kind`` (``-2``, ``-3``... when that name is taken),
     created by this call: no other run, in this process or another, gets the same one."""
     base = Path(base)
-    base.mkdir(parents=True, exist_ok=True)
     stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    for n in range(1, 10_000):
-        path = base / (f"{stamp}-{kind}" if n == 1 else f"{stamp}-{kind}-{n}")
-        try:
-            path.mkdir()
-        except FileExistsError:
-            continue
-        return path
+    try:
+        base.mkdir(parents=True, exist_ok=True)
+        for n in range(1, 10_000):
+            path = base / (f"{stamp}-{kind}" if n == 1 else f"{stamp}-{kind}-{n}")
+            try:
+                path.mkdir()
+            except FileExistsError:
+                continue
+            return path
+    except OSError as exc:  # a working directory nobody may write to: the user's to fix
+        raise UsageError(
+            f"cannot create a report folder under {base.resolve()}: {exc.strerror or exc}; "
+            "pass --report-dir DIR"
+        ) from exc
     raise UsageError(f"no free report folder name under {base}; pass --report-dir DIR")
 
 

@@ -132,7 +132,8 @@ def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, po
     first = live(tmp_path, port, role)
     from_transcript = passive(first, role, tmp_path / "transcript")
     capture = tmp_path / "run.sr"
-    assert main(["export", str(first), "--to", "sr", "-o", str(capture)]) == 0
+    export = ["export", str(first), "--to", "sr", "-o", str(capture), "--no-tool-channel"]
+    assert main(export) == 0
     out = tmp_path / "capture"
     assert main(["judge", str(capture), "--role", role, "--report-dir", str(out)]) in (0, 1, 2)
     assert verdicts(out) == from_transcript

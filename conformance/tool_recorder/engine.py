@@ -42,6 +42,11 @@ from .framing import Framing
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
 
+#: After this many holds that reached ``max_hold`` (a DUT that never goes quiet), later holds
+#: are bounded by the turnaround: waiting a second before every command of the run would
+#: only make a babbling device's run hundreds of seconds longer, never quieter.
+OVERRUNS_BEFORE_SHORT = 3
+
 
 class Master:
     """Drives a :class:`Link` as an SDI-12 data recorder and returns records.
@@ -194,17 +199,22 @@ class Master:
             now = self.link.now()
             if clear <= now:
                 break
-            if now - began >= self.policy.max_hold:
+            # a DUT that never went quiet in OVERRUNS_BEFORE_SHORT holds is not waited out
+            # for the whole bound again: each later hold lasts the turnaround only
+            bound = self.policy.max_hold
+            if self.hold_overruns >= OVERRUNS_BEFORE_SHORT:
+                bound = min(bound, self.policy.turnaround)
+            if now - began >= bound:
                 self.hold_overruns += 1
                 self.link.transcript.note(
                     now,
                     f"{HOLD_PREFIX}the DUT was still transmitting after {(now - began) * 1e3:.0f}"
-                    f" ms of holding (bound {self.policy.max_hold * 1e3:.0f} ms); the tool "
+                    f" ms of holding (bound {bound * 1e3:.0f} ms); the tool "
                     "transmits into it",
                 )
                 break
             held = True
-            self.link.wait_until(min(clear, began + self.policy.max_hold))
+            self.link.wait_until(min(clear, began + bound))
             look = uncertainty
         self.holds += held
         return self.link.now()
