@@ -293,6 +293,13 @@ def _held_within_its_uncertainty(event, asked: float) -> None:
         )
 
 
+def _heard_as_stamped(event, heard: float) -> None:
+    """The line held the break as long as the event says, within the uncertainty the event
+    itself declares (both ends are stamped by one busy host: a fixed few ms would be a
+    figure of this machine, not of the link)."""
+    assert abs(heard - event.duration) <= event.uncertainty, (heard, event)
+
+
 @pytest.mark.realtime  # breaks timed by the host: run serially
 def test_rfc2217_short_break_is_a_nul_timed_by_the_uart():
     """A 13 ms break is a NUL at 692 baud: the line holds spacing for exactly 9 bit times,
@@ -311,7 +318,7 @@ def test_rfc2217_wake_up_break_is_held_by_set_control():
     assert event.duration >= 13e-3, event
     _held_within_its_uncertainty(event, 13e-3)
     assert "SET_CONTROL" in event.text
-    assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+    _heard_as_stamped(event, end - start)
 
 
 @pytest.mark.realtime  # breaks timed by the host: run serially
@@ -332,7 +339,7 @@ def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
     monkeypatch.setattr(servers, "VirtualPort", Stubborn)
     event, (start, end) = _served_break(5e-3, exact=True)
     assert "SET_CONTROL" in event.text and "baud" not in event.text
-    assert abs((end - start) - event.duration) < 3e-3
+    _heard_as_stamped(event, end - start)
 
 
 @pytest.mark.realtime  # breaks timed by the host: run serially
@@ -342,7 +349,7 @@ def test_rfc2217_long_break_is_held_by_set_control():
     assert event.duration >= 100e-3, event
     _held_within_its_uncertainty(event, 100e-3)
     assert "SET_CONTROL" in event.text
-    assert abs((end - start) - event.duration) < 3e-3  # loopback jitter only
+    _heard_as_stamped(event, end - start)
 
 
 def test_every_link_kind_claims_its_example_and_the_rest_are_serial_devices():
