@@ -194,3 +194,19 @@ def test_refusal_names_the_holder(tmp_path, live_pid):
     (tmp_path / report_folder.LOCK_NAME).write_text(f"{live_pid}\n")
     with pytest.raises(UsageError, match=f"pid {live_pid}"):
         report_folder.acquire(tmp_path)
+
+
+def test_judge_writes_nothing_into_a_folder_a_live_run_holds(tmp_path, live_pid, capsys):
+    """``judge capture.sr --report-dir HELD`` refuses before decoding into it (the decoded
+    capture.jsonl used to be written there first)."""
+    run = tmp_path / "run"
+    assert main(["--port", "sim", *QUICK, "--report-dir", str(run)]) == 0
+    capture = tmp_path / "run.sr"
+    assert main(["export", str(run), "--to", "sr", "-o", str(capture)]) == 0
+    held = tmp_path / "held"
+    held.mkdir()
+    (held / report_folder.LOCK_NAME).write_text(f"{live_pid}\n")
+    capsys.readouterr()
+    assert main(["judge", str(capture), "--report-dir", str(held)]) == 4
+    assert f"holds a run in progress (pid {live_pid})" in capsys.readouterr().err
+    assert sorted(p.name for p in held.iterdir()) == [report_folder.LOCK_NAME]

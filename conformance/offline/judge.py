@@ -29,6 +29,7 @@ from ..capture import (
     sniff,
 )
 from ..capture.export import TOOL_CHANNEL
+from ..preflight import UsageError, check_report_dir
 from ..replay.link import VIRTUAL_KINDS
 from ..replay.recording import (
     Recording,
@@ -38,6 +39,7 @@ from ..replay.recording import (
     transcript_path,
     write_recording,
 )
+from ..report_folder import held
 from ..transcript import BUS, DUT, TOOL, Event, EventKind
 from ..view.direction import infer_directions
 from ..view.sides import RECORDER, SENSOR
@@ -206,9 +208,13 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
         )
         return
     report_dir = Path(args.report_dir or default_report_dir(str(options.get("role", "sensor"))))
-    report_dir.mkdir(parents=True, exist_ok=True)
     decoded_path = report_dir / "capture.jsonl"
-    write_recording(decoded_path, sorted([*notes, *events], key=lambda e: e.start))
+    try:  # nothing is written into a folder another live run holds (issue 19)
+        check_report_dir(report_dir)
+        with held(report_dir):
+            write_recording(decoded_path, sorted([*notes, *events], key=lambda e: e.start))
+    except UsageError as exc:
+        raise JudgeError(str(exc)) from None
     recording = read_recording(decoded_path)
     why_not = replay_refused(recording, args)
     if why_not is not None:
