@@ -219,3 +219,21 @@ def test_a_sensor_whose_service_request_comes_early_draws_no_fail(profile, tmp_p
     data = json.loads((out / "verdicts.json").read_text())
     bad = {r["id"]: r["verdict"] for r in data["requirements"] if r["verdict"] == "FAIL"}
     assert not bad, bad
+
+
+def test_a_reply_after_a_cut_collided_frame_is_kept_on_an_uncertain_link():
+    """A collided frame whose LF was lost: the genuine reply that starts 9 ms after the
+    command is not taken for its tail on a ±5 ms link (the allowance once added both stamps'
+    uncertainty, 12.06 ms, and swallowed it); the view and the tool's recorder use one rule."""
+    u = 5e-3
+
+    def unsure(events):
+        return [replace(e, uncertainty=u) for e in events]
+
+    cmd = unsure(_chars(TOOL, "0D", 0.0))
+    sr = unsure(_chars(DUT, "0\r", cmd[-1].end - 2 * CHAR_TIME))  # its LF never came
+    bang = unsure(_chars(TOOL, "!", cmd[-1].end))
+    reply = unsure(_chars(DUT, "0+1\r\n", bang[0].end + 9e-3))
+    (t,) = read_view(cmd + sr + bang + reply).transmissions
+    assert "".join(chr(e.char7) for e in t.reply) == "0+1\r\n"
+    assert [chr(e.char7) for e in t.contention] == ["0", "\r"]

@@ -27,7 +27,6 @@ from ..protocol.commands import (
 )
 from ..protocol.timing import (
     CHAR_TIME,
-    INTER_CHAR_GAP_MAX,
     NO_BREAK_WINDOW,
     RETRY_AFTER_BREAK,
     RETRY_MAX,
@@ -36,6 +35,7 @@ from ..protocol.timing import (
 )
 from ..protocol.values import split_values
 from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
+from ..view.segments import continues_frame
 from . import validity
 from .contention import HOLD_PREFIX, collisions
 from .framing import Framing
@@ -459,16 +459,11 @@ class Master:
         deadline = command_end + self.policy.first_char_timeout
         collided: list[Event] = []
         first = self.link.receive(deadline, until=lambda got: True)
-        run_gap = INTER_CHAR_GAP_MAX + TOLERANCE + self.link.info.timing_uncertainty
+        slack = self.link.info.timing_uncertainty
         while first and (
             first[0].start < command_end
-            # its tail, up to its LF: counted from the later of its last character and the
-            # command (a bus that queued the sensor's frame behind the command delays it)
-            or (
-                collided
-                and collided[-1].char7 != 0x0A
-                and first[0].start - max(collided[-1].end, command_end) <= run_gap
-            )
+            # its tail, up to its LF (the view's rule, so the live read and the judges agree)
+            or (collided and continues_frame(collided[-1], first[0], command_end, slack))
         ):
             collided += first
             first = self.link.receive(deadline, until=lambda got: True)

@@ -163,19 +163,25 @@ def collided(heard: list[Event], end: float) -> list[Event]:
     prev: Event | None = None  # the character before ``e``, when it collided
     for e in heard:
         met = e.start < end or e.text == COLLISION
-        tail = prev is not None and prev.char7 != LF and _follows(prev, e, end)
+        tail = prev is not None and continues_frame(
+            prev, e, end, max(prev.uncertainty, e.uncertainty)
+        )
         if met or tail:
             out.append(e)
         prev = e if met or tail else None
     return out
 
 
-def _follows(last: Event, e: Event, end: float) -> bool:
-    """``e`` goes on from ``last`` within a character gap, counted from the later of ``last``
-    and the tool's transmission (a bus that queued the sensor's frame behind the tool's
-    characters delays it, and the simulated one does)."""
-    allowed = INTER_CHAR_GAP_MAX + TOLERANCE + last.uncertainty + e.uncertainty
-    return e.start - max(last.end, end) <= allowed
+def continues_frame(last: Event, e: Event, end: float, slack: float) -> bool:
+    """``e`` goes on from ``last``, a frame that met a tool transmission ending at ``end`` and
+    has not reached its LF: within a character gap (plus ``slack``, the stamps' uncertainty)
+    counted from the later of ``last`` and the transmission (a bus that queued the sensor's
+    frame behind the tool's characters delays it, and the simulated one does). The one rule
+    for that tail, in the view and in the tool's recorder (which reads it live). The slack is
+    one stamp uncertainty, not two: consecutive stamps of one link share its offset, and a
+    wider allowance would take a genuine reply 8.33 ms later for the tail on a ±5 ms link."""
+    allowed = INTER_CHAR_GAP_MAX + TOLERANCE + slack
+    return last.char7 != LF and e.start - max(last.end, end) <= allowed
 
 
 @dataclass(frozen=True)
