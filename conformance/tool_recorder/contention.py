@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 from ..protocol.timing import CHAR_TIME
 from ..transcript import TOOL, Event, EventKind
+from ..view.runs import runs
 
 #: Start of the NOTE text that marks a collision.
 COLLISION_PREFIX = "collision: "
@@ -57,16 +58,6 @@ def _overlap(a: Event, b: Event) -> bool:
     return a.start + slack < b.end and b.start + slack < a.end
 
 
-def _transmissions(tool: list[Event]) -> list[list[Event]]:
-    groups: list[list[Event]] = []
-    for event in tool:
-        if groups and event.start - groups[-1][-1].end <= _SAME_TRANSMISSION:
-            groups[-1].append(event)
-        else:
-            groups.append([event])
-    return groups
-
-
 def collisions(events: Iterable[Event]) -> list[Collision]:
     """Every tool transmission that overlaps DUT characters, oldest first (pure: stamps only).
 
@@ -77,7 +68,7 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
     dut = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
     found: list[Collision] = []
     k = 0
-    for group in _transmissions(tool):
+    for group in runs(tool, _SAME_TRANSMISSION):
         begin, end = group[0].start, max(e.end for e in group)
         while k < len(dut) and dut[k].end <= begin - CHAR_TIME:
             k += 1

@@ -105,11 +105,12 @@ def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> 
     return [Segment.of(t) for t in read_view(events, is_recorder).transmissions]
 
 
-def runs(events: list[Event]) -> list[list[Event]]:
-    """Split sensor characters into runs separated by more than :data:`RUN_GAP` of marking."""
+def runs(events: list[Event], gap: float = RUN_GAP) -> list[list[Event]]:
+    """Split characters into runs separated by more than ``gap`` of marking (sensor runs by
+    default; the tool's transmissions with a shorter gap, :mod:`~..tool_recorder.contention`)."""
     out: list[list[Event]] = []
     for e in events:
-        if out and e.start - out[-1][-1].end <= RUN_GAP:
+        if out and e.start - out[-1][-1].end <= gap:
             out[-1].append(e)
         else:
             out.append([e])
