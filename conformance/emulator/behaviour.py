@@ -64,12 +64,13 @@ class Behaviour:
     address_change_ignores_tail: bool = False  # take aAbX..! as aAb! (real firmware, A12)
     # -- service requests --------------------------------------------------------------------
     service_request: bool = True
-    #: Firmware that measures at once yet announces ttt > 0: the M family and V announce
-    #: ttt = 001 and have their data (and service request) ready this long after the
-    #: ``atttn`` reply; None plays the profile's timing. Legal (R-4.4.6-02/04, and within
-    #: R-4.4.5-09's margin); issue 18 saw such a request 8.4 ms after the reply, where a
-    #: recorder that does not listen before it talks starts its next break into it.
-    prompt_service_request: float | None = None
+    #: Firmware that measures at once yet announces a short ttt: the M family and V announce
+    #: this ttt (s, e.g. 1 for ``001``) when theirs is > 0; with :attr:`ready_after` their
+    #: data (and service request) come that long after the ``atttn`` reply. Legal
+    #: (R-4.4.6-02/04, and within R-4.4.5-09's margin); issue 18 saw a request 8.4 ms after
+    #: the reply, where a recorder that does not listen before it talks starts its next break
+    #: into it.
+    announce_ttt: int | None = None
     service_request_late: float | None = None  # send it this long after ttt instead
     service_request_on_ttt_zero: bool = False
     service_request_on_concurrent: bool = False

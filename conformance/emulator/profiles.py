@@ -82,7 +82,7 @@ PROFILES: Mapping[str, FirmwareProfile] = MappingProxyType(
                 "Measures at once yet announces ttt = 001 for M and V: the service request"
                 " follows the atttn reply after 8.4 ms (legal, R-4.4.6-02/04), where a"
                 " recorder that does not listen before it talks starts its next break into it.",
-                quirks={"prompt_service_request": 8.4e-3},
+                quirks={"announce_ttt": 1, "ready_after": 8.4e-3},
             ),
             FirmwareProfile(
                 "quick-ready",

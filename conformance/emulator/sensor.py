@@ -480,14 +480,15 @@ class SensorEmulator:
         self._service_request(cmd, sr_at)
 
     def _timed(self, cmd: Command, spec: MeasurementSpec | None) -> MeasurementSpec | None:
-        """``spec`` with the timing the behaviour plays: ttt = 001 and data ready after
-        ``prompt_service_request`` for an M/V measurement with ttt > 0 when that is set."""
-        prompt = self.behaviour.prompt_service_request
-        if spec is None or not spec.ttt or prompt is None:
+        """``spec`` with the ttt the behaviour announces (``announce_ttt``) for an M/V
+        measurement with ttt > 0 when that is set; ready at that ttt unless ``ready_after``
+        makes it sooner (:meth:`_measure`)."""
+        announce = self.behaviour.announce_ttt
+        if spec is None or not spec.ttt or announce is None:
             return spec
         if cmd.kind not in SERVICE_REQUEST_KINDS:
             return spec
-        return replace(spec, ttt=1, ready_after=prompt)
+        return replace(spec, ttt=announce, ready_after=None)
 
     def _service_request(self, source: Command, at: float) -> None:
         self._send(Reply(ReplyKind.SERVICE_REQUEST, source.address, source=source), at)
