@@ -165,6 +165,49 @@ def test_gave_up_too_soon():
     assert once["R-7.2-01"].verdict is once["R-7.2-03"].verdict is Verdict.FAIL
 
 
+def test_repeats_with_a_new_break_are_no_retries():
+    """Issue 20: a logger that only repeats break + command passed "implements retries" and
+    "whole sequence repeated" on those repeats."""
+    w = Wire().brk().rec("0!").idle(300).brk().rec("0!").idle(300).brk().rec("0!")
+    found = by_id(judge_retries(w.sensor("0\r\n").line(), 0.0))
+    assert found["R-7.2-01"].verdict is Verdict.FAIL
+    assert "only after a new break" in found["R-7.2-01"].detail
+    assert found["R-7.2-02"].verdict is found["R-7.2-05"].verdict is Verdict.FAIL
+    assert found["R-7.2-04"].verdict is Verdict.INCONCLUSIVE  # a SHOULD never fails
+    assert "no retry in it" in found["R-7.2-04"].detail
+    # a parity error, then a break and the command again 1288 ms later: no retry to time
+    w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5\r\n", parity=False).idle(1288)
+    found = by_id(judge_retries(w.brk().rec("0D0!").sensor("0+1.5+2.5\r\n").line(), 0.0))
+    assert found["R-7.2-06"].verdict is Verdict.INCONCLUSIVE
+    assert "new sequence" in found["R-7.2-06"].detail
+    assert found["R-7.2-01"].verdict is found["R-7.2-05"].verdict is Verdict.FAIL
+
+
+def test_a_resend_after_the_retry_window_is_no_retry():
+    # aD0! again without a break after a 1.5 s poll timeout: the sensor is in standby
+    w = Wire().brk().rec("0D0!").idle(1500).rec("0D0!").sensor("0+1+2\r\n")
+    found = by_id(judge_retries(w.line(), 0.0))
+    assert found["R-7.2-01"].verdict is Verdict.FAIL and "standby" in found["R-7.2-01"].detail
+    assert found["R-7.2-02"].verdict is Verdict.FAIL
+    # 95 ms: still heard as a retry, but late; a PASS of R-7.2-01 needs one inside 87 ms
+    w = Wire().brk().rec("0!").idle(95).rec("0!").sensor("0\r\n")
+    found = by_id(judge_retries(w.line(), 0.0))
+    assert found["R-7.2-02"].verdict is Verdict.FAIL
+    assert found["R-7.2-01"].verdict is Verdict.INCONCLUSIVE
+    # 86.5 ms stamped ±1 ms may be past the window: no PASS on it either
+    w = Wire().brk().rec("0!").idle(86.5).rec("0!").sensor("0\r\n")
+    assert by_id(judge_retries(w.line(), 1e-3))["R-7.2-01"].verdict is not Verdict.PASS
+
+
+def test_a_repeated_sequence_with_retries_passes_the_should():
+    w = Wire()
+    for _ in range(2):
+        w.brk().rec("0!").idle(45).rec("0!").idle(45).rec("0!").idle(300)
+    found = by_id(judge_retries(w.brk().rec("0!").sensor("0\r\n").line(), 0.0))
+    assert found["R-7.2-04"].verdict is found["R-7.2-01"].verdict is Verdict.PASS
+    assert found["R-7.2-03"].verdict is found["R-7.2-05"].verdict is Verdict.PASS
+
+
 def test_crc_mismatch_must_be_retried():
     body = "0+1+2"
     wrong = body + ascii_crc("0+1+3")

@@ -26,6 +26,7 @@ EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 fo
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
 LATE_D0 = 95e-3  # s after the service request: past the 87 ms of R-7.1-01
 FAST_CHAR_TIME = 8.0e-3  # s per frame: 1250 baud, 4% fast (A14 allows 2%)
+POLL_TIMEOUT = 1.5  # s a logger library waited for a reply before it tried again (issue 20)
 
 
 class EarlyRetryMaster(GoldenMaster):
@@ -119,6 +120,21 @@ class IgnoresCrcMaster(GoldenMaster):
         attempt = super()._attempt(*args, **kw)  # type: ignore[arg-type]
         if "should be" in attempt.reason:  # the engine's words for a CRC mismatch
             attempt = replace(attempt, reason="ok")
+        return attempt
+
+
+class BreakEveryTryMaster(GoldenMaster):
+    """Never retries: after an unanswered or invalid reply it waits out a poll timeout, then
+    sends a break and the command again (what a widely used logger library was seen to do,
+    issue 20). With ``retries_per_sequence=0`` every repeat is such a new sequence."""
+
+    _failed: tuple[bytes, float] | None = None  # the wire text that failed, and when
+
+    def _attempt(self, wire: bytes, *args: object, **kw: object) -> Attempt:
+        if self._failed is not None and self._failed[0] == wire:
+            self.link.wait_until(self._failed[1] + POLL_TIMEOUT)
+        attempt = super()._attempt(wire, *args, **kw)  # type: ignore[arg-type]
+        self._failed = None if attempt.ok else (wire, self.link.now())
         return attempt
 
 
@@ -314,6 +330,20 @@ _FAULTS = (
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-4.4.12-07"),
         lambda: GoldenRecorder(_GOLDEN.but(retries_per_sequence=0, sequences=1)),
         inconclusive=("R-7.2-06",),
+    ),
+    RecorderFault(
+        "retries-with-break",
+        f"Never retries without a break: after no reply or an invalid one it waits "
+        f"{POLL_TIMEOUT} s, then sends a break and the command again, three times in all. "
+        "Those repeats are new sequences, not retries: no retry is seen (R-7.2-01/-02/-05), no "
+        "sequence has its two retries (R-7.2-03), and with no break+command+retries sequence "
+        "on the wire whether it would repeat one (R-7.2-04, SHOULD) or wait for an invalid "
+        "reply to end before a retry (R-7.2-06) cannot be seen.",
+        ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05"),
+        lambda: GoldenRecorder(
+            _GOLDEN.but(retries_per_sequence=0, sequences=3), _with_master(BreakEveryTryMaster)
+        ),
+        inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
     RecorderFault(
         "retry-too-early",
