@@ -374,7 +374,9 @@ _FAULTS = (
     ),
     RecorderFault(
         "ignores-service-request",
-        "Waits the full ttt after aM!/aV! even when the service request came long before.",
+        "Waits the full ttt after aM!/aV! even when the service request came long before. The "
+        "standard gives no figure for how soon aD0! follows the request (and lets a recorder "
+        "wait the whole ttt), so past the tool's 0.5 s this is a WARN (decision T1).",
         ("R-4.4.5-05",),
         lambda: GoldenRecorder(_GOLDEN, wait="ttt"),
     ),

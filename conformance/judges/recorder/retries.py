@@ -34,6 +34,8 @@ from .replies import crc_context, reply_problem
 STANDBY = STANDBY_MARKING + TOLERANCE
 #: Latest start of a retry (R-7.2-02: 87 ms, +0.40 ms) that a PASS may rest on.
 WINDOW = RETRY_MAX + TOLERANCE
+#: The catalog decision that says what counts as a retry (and cites these two figures).
+RETRY_DECISION = "T2"
 
 
 @dataclass
@@ -246,12 +248,23 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                 f"{where} was repeated {len(sequences)} times, each time a new sequence with "
                 "no retry in it: no break+command+retries sequence was seen to repeat",
             )
-    return [
-        *tally.findings("retried as due"),
+    for rid in tally.ids:
+        tally.decision(rid, RETRY_DECISION)
+    ok = {
+        "R-7.2-01": f"retried without a break within {RETRY_MAX * 1e3:.0f} ms of the line going "
+        f"quiet (decision {RETRY_DECISION})",
+        "R-7.2-04": "a break+command+retries sequence that drew no valid reply was repeated",
+        "R-7.2-05": "retried as due",
+    }
+    found = [
+        *tally.findings(ok),
         combine("R-7.2-02", window, "retry after no reply"),
         combine("R-7.2-03", third, "unanswered sequence"),
         _waited(ends, restarted),
     ]
+    for f in found[len(tally.ids) :]:
+        f.decision = RETRY_DECISION
+    return found
 
 
 def _waited(ends: list[Finding], restarted: list[str]) -> Finding:
