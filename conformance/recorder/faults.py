@@ -138,6 +138,24 @@ class BreakEveryTryMaster(GoldenMaster):
         return attempt
 
 
+class ResendAfterTimeoutMaster(GoldenMaster):
+    """Retries without a break, but only after a poll timeout: by then the sensor has been in
+    standby for over a second and takes the command as no retry (issue 20's "D0 sent again
+    after a 1.5 s poll timeout")."""
+
+    _late = False
+
+    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+        self._late = True
+        return max(exchange.last.end + POLL_TIMEOUT, self.link.now())
+
+    def _needs_break(self, address: str, at: float) -> bool:
+        if self._late:
+            self._late = False
+            return False
+        return super()._needs_break(address, at)
+
+
 class LateD0AfterServiceRequestMaster(GoldenMaster):
     """After a service request waits 95 ms, then sends aD0! without a break."""
 
@@ -343,6 +361,16 @@ _FAULTS = (
         lambda: GoldenRecorder(
             _GOLDEN.but(retries_per_sequence=0, sequences=3), _with_master(BreakEveryTryMaster)
         ),
+        inconclusive=("R-7.2-04", "R-7.2-06"),
+    ),
+    RecorderFault(
+        "resends-after-timeout",
+        f"Sends a command again without a break only {POLL_TIMEOUT} s after no reply or an "
+        "invalid one, long after the sensor's 100 ms to standby: not a retry (R-7.2-01/-02/"
+        "-05), no sequence with two retries (R-7.2-03), and a command after 87 ms of marking "
+        "without a break (R-7.0-17).",
+        ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05", "R-7.0-17"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(ResendAfterTimeoutMaster)),
         inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
     RecorderFault(
