@@ -217,5 +217,7 @@ def strongest_verdict(id: str) -> str:  # noqa: A002 - same argument name as req
 
 
 def decisions() -> dict[str, str]:
-    """Requirements.md section 5 decisions: label ("A1".."A18") -> one-line summary."""
+    """Decisions, label -> one-line summary: requirements.md section 5's ("A1".."A18"), then
+    the tool's own ("T1".. : allowances and readings the standard does not give, each with
+    its reason and figure, cited in the findings they shape)."""
     return dict(_load()[1])

@@ -26,6 +26,9 @@ SPEC = Path(__file__).resolve().parents[2] / "shared" / "spec" / "requirements.m
 MAX_SIMILARITY = 0.80
 MAX_STATEMENT_CHARS = 160
 DECISION_LABELS = [f"A{i}" for i in range(1, 19)]
+#: The tool's own decisions (issue 20): tolerances and readings the standard does not give,
+#: after section 5's, each with its reason; a requirement they shape carries their label.
+TOOL_DECISIONS = ["T1", "T2"]
 
 
 # --------------------------------------------------------------------------- spec parsing
@@ -135,7 +138,7 @@ def test_decisions_cover_section_5(spec_rows: list[dict[str, str]]) -> None:
     blocks = re.split(r"^\* \*\*(A\d+)\.", text, flags=re.M)
     named = {blocks[i]: blocks[i + 1] for i in range(1, len(blocks) - 1, 2)}
     assert list(named) == DECISION_LABELS
-    assert list(cat.decisions()) == DECISION_LABELS
+    assert list(cat.decisions()) == DECISION_LABELS + TOOL_DECISIONS
     reqs = cat.catalog()
     # A requirement ID written into a decision's text must carry that decision's label.
     for label, body in named.items():
@@ -152,9 +155,20 @@ def test_decisions_cover_section_5(spec_rows: list[dict[str, str]]) -> None:
 
 def test_schema_and_top_level(raw: dict[str, Any]) -> None:
     assert raw["schema"] == cat.SCHEMA == "sdi12-conform/catalog/1"
-    assert list(raw["decisions"]) == DECISION_LABELS
+    assert list(raw["decisions"]) == DECISION_LABELS + TOOL_DECISIONS
     for label, summary in raw["decisions"].items():
         assert summary and "\n" not in summary, label
+
+
+def test_tool_decisions_state_their_figures_and_bind_what_they_name() -> None:
+    """A tolerance of the tool's own is a stated decision: its figure in its text, and every
+    requirement it names carries its label (so findings on it can cite it)."""
+    reqs = cat.catalog()
+    for label in TOOL_DECISIONS:
+        text = cat.decisions()[label]
+        assert re.search(r"\d+(\.\d+)? (ms|s)\b", text), label
+        for rid in re.findall(r"R-[\w.]+-\d\d", text):
+            assert label in reqs[rid].decisions, f"{rid} should reference {label}"
 
 
 def test_no_duplicate_ids(raw: dict[str, Any]) -> None:

@@ -85,7 +85,7 @@ class Tally:
                 reason = self.why_not.get(
                     rid, "nothing was observed that this rule could be judged on"
                 )
-                result.append(Finding(rid, Verdict.INCONCLUSIVE, reason))
+                result.append(Finding(rid, Verdict.INCONCLUSIVE, reason, decision=decision))
             else:
                 text = ok if isinstance(ok, str) else ok.get(rid, "conforms")
                 listed = ", ".join(dict.fromkeys(seen))

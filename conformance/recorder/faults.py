@@ -26,6 +26,7 @@ EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 fo
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
 LATE_D0 = 95e-3  # s after the service request: past the 87 ms of R-7.1-01
 FAST_CHAR_TIME = 8.0e-3  # s per frame: 1250 baud, 4% fast (A14 allows 2%)
+POLL_TIMEOUT = 1.5  # s a logger library waited for a reply before it tried again (issue 20)
 
 
 class EarlyRetryMaster(GoldenMaster):
@@ -120,6 +121,39 @@ class IgnoresCrcMaster(GoldenMaster):
         if "should be" in attempt.reason:  # the engine's words for a CRC mismatch
             attempt = replace(attempt, reason="ok")
         return attempt
+
+
+class BreakEveryTryMaster(GoldenMaster):
+    """Never retries: after an unanswered or invalid reply it waits out a poll timeout, then
+    sends a break and the command again (what a widely used logger library was seen to do,
+    issue 20). With ``retries_per_sequence=0`` every repeat is such a new sequence."""
+
+    _failed: tuple[bytes, float] | None = None  # the wire text that failed, and when
+
+    def _attempt(self, wire: bytes, *args: object, **kw: object) -> Attempt:
+        if self._failed is not None and self._failed[0] == wire:
+            self.link.wait_until(self._failed[1] + POLL_TIMEOUT)
+        attempt = super()._attempt(wire, *args, **kw)  # type: ignore[arg-type]
+        self._failed = None if attempt.ok else (wire, self.link.now())
+        return attempt
+
+
+class ResendAfterTimeoutMaster(GoldenMaster):
+    """Retries without a break, but only after a poll timeout: by then the sensor has been in
+    standby for over a second and takes the command as no retry (issue 20's "D0 sent again
+    after a 1.5 s poll timeout")."""
+
+    _late = False
+
+    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+        self._late = True
+        return max(exchange.last.end + POLL_TIMEOUT, self.link.now())
+
+    def _needs_break(self, address: str, at: float) -> bool:
+        if self._late:
+            self._late = False
+            return False
+        return super()._needs_break(address, at)
 
 
 class LateD0AfterServiceRequestMaster(GoldenMaster):
@@ -316,6 +350,30 @@ _FAULTS = (
         inconclusive=("R-7.2-06",),
     ),
     RecorderFault(
+        "retries-with-break",
+        f"Never retries without a break: after no reply or an invalid one it waits "
+        f"{POLL_TIMEOUT} s, then sends a break and the command again, three times in all. "
+        "Those repeats are new sequences, not retries: no retry is seen (R-7.2-01/-02/-05), no "
+        "sequence has its two retries (R-7.2-03), and with no break+command+retries sequence "
+        "on the wire whether it would repeat one (R-7.2-04, SHOULD) or wait for an invalid "
+        "reply to end before a retry (R-7.2-06) cannot be seen.",
+        ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05"),
+        lambda: GoldenRecorder(
+            _GOLDEN.but(retries_per_sequence=0, sequences=3), _with_master(BreakEveryTryMaster)
+        ),
+        inconclusive=("R-7.2-04", "R-7.2-06"),
+    ),
+    RecorderFault(
+        "resends-after-timeout",
+        f"Sends a command again without a break only {POLL_TIMEOUT} s after no reply or an "
+        "invalid one, long after the sensor's 100 ms to standby: not a retry (R-7.2-01/-02/"
+        "-05), no sequence with two retries (R-7.2-03), and a command after 87 ms of marking "
+        "without a break (R-7.0-17).",
+        ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05", "R-7.0-17"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(ResendAfterTimeoutMaster)),
+        inconclusive=("R-7.2-04", "R-7.2-06"),
+    ),
+    RecorderFault(
         "retry-too-early",
         f"The first retry after no reply starts {EARLY_RETRY * 1e3:.0f} ms after the command.",
         ("R-7.2-02",),
@@ -344,7 +402,9 @@ _FAULTS = (
     ),
     RecorderFault(
         "ignores-service-request",
-        "Waits the full ttt after aM!/aV! even when the service request came long before.",
+        "Waits the full ttt after aM!/aV! even when the service request came long before. The "
+        "standard gives no figure for how soon aD0! follows the request (and lets a recorder "
+        "wait the whole ttt), so past the tool's 0.5 s this is a WARN (decision T1).",
         ("R-4.4.5-05",),
         lambda: GoldenRecorder(_GOLDEN, wait="ttt"),
     ),

@@ -10,9 +10,19 @@ from ...view.segments import Transmission
 from ..timing import combine as combine_timing
 
 #: A recorder reacts to a service request (or to ttt running out) with aD0! within this long.
-#: The standard says "when it arrives"; the tool allows half a second for a logger's own work
-#: and fails only a recorder that visibly waits for something else (a tool decision).
+#: The standard gives no figure (and lets a recorder wait the whole ttt), so this is the tool's
+#: allowance for a logger's own work, catalog decision T1: a later aD0! is a WARN citing it,
+#: never a FAIL on its own.
 REACTION = 0.5
+REACTION_DECISION = "T1"
+
+
+def beyond_reaction(delay: float, what: str) -> str:
+    """The words of a WARN for an aD0! ``delay`` s after ``what``: the figure and whose it is."""
+    return (
+        f"aD0! came {delay:.3f} s after {what}, later than the {REACTION} s the tool allows "
+        f"(decision {REACTION_DECISION}: the standard gives no figure, so not a FAIL)"
+    )
 #: Values a recorder must be able to store from one concurrent measurement (R-4.4.7-07, 2000).
 MIN_CONCURRENT_STORE = 20
 #: Measurements that end their wait with a service request (M family, V).

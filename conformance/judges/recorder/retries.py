@@ -1,12 +1,25 @@
 """Retry reconstruction (section 7.2) and the judges of retries: consecutive transmissions
 of one command text, each with its reply's problem, split into break+command+retries
-sequences."""
+sequences.
+
+A retry, as section 7.2 defines it, is the same command sent again without a break while the
+sensor is still awake. A break and the command again is a new sequence, not a retry; so is the
+command sent again without a break after the sensor's 100 ms to standby (R-7.0-15: it cannot
+hear it as a retry). A PASS of R-7.2-01, R-7.2-04 or R-7.2-06 rests only on retries inside
+the 87 ms window of R-7.2-02 (a logger that only ever repeats break + command, or re-sends
+after a long poll timeout, must not pass "implements retries")."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ...protocol.timing import RETRY_AFTER_BREAK, RETRY_MAX, RETRY_MIN
+from ...protocol.timing import (
+    RETRY_AFTER_BREAK,
+    RETRY_MAX,
+    RETRY_MIN,
+    STANDBY_MARKING,
+    TOLERANCE,
+)
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
@@ -16,15 +29,47 @@ from ..timing import judge_window
 from .common import combine
 from .replies import crc_context, reply_problem
 
+#: Marking after which a sensor is in standby (R-7.0-15, +0.40 ms): a command sent again
+#: without a break after longer than this is not a retry but a new try without its break.
+STANDBY = STANDBY_MARKING + TOLERANCE
+#: Latest start of a retry (R-7.2-02: 87 ms, +0.40 ms) that a PASS may rest on.
+WINDOW = RETRY_MAX + TOLERANCE
+#: The catalog decision that says what counts as a retry (and cites these two figures).
+RETRY_DECISION = "T2"
+
 
 @dataclass
 class Try:
     sent: Transmission
     problem: ReplyProblem | None  # None: valid reply
+    #: marking (s) between the line's last activity and this transmission, for one that
+    #: follows a try of the same command; None for the first try
+    quiet: float | None = None
 
     @property
     def retry(self) -> bool:
-        return self.sent.break_event is None
+        """The same command again, without a break, while the sensor is still awake."""
+        return self.sent.break_event is None and self.quiet is not None and self.quiet <= STANDBY
+
+    def in_window(self, uncertainty: float) -> bool:
+        """A retry that started within 87 ms of the line going quiet, for every stamp error
+        the run allows: the only kind a PASS of R-7.2-01/04/06 may rest on."""
+        return self.retry and self.quiet is not None and self.quiet + uncertainty <= WINDOW
+
+    def instead(self, nxt: Try | None) -> str:
+        """What the recorder did after this unanswered or invalid try, when it did not retry."""
+        if nxt is None:
+            return "not sent again"
+        later = f"{nxt.sent.start - self.sent.end:.3f} s later"
+        if nxt.sent.break_event is not None:
+            return f"sent again only after a new break, {later} (a new sequence, not a retry)"
+        return (
+            f"sent again without a break {later}, after the sensor's "
+            f"{STANDBY_MARKING * 1e3:.0f} ms to standby (not a retry)"
+        )
+
+    def after(self) -> str:
+        return f"after {self.problem} to {self.sent.at()}"
 
 
 @dataclass
@@ -35,10 +80,11 @@ class RetryGroup:
     attempts: list[Try]
 
     def sequences(self) -> list[list[Try]]:
-        """Split at breaks: each break + command + retries is one sequence (R-7.2-04)."""
+        """Split where a try is no retry (a break, or after standby): each break + command +
+        retries is one sequence (R-7.2-04)."""
         out: list[list[Try]] = []
         for a in self.attempts:
-            if not out or a.sent.break_event is not None:
+            if not out or not a.retry:
                 out.append([a])
             else:
                 out[-1].append(a)
@@ -47,6 +93,9 @@ class RetryGroup:
     @property
     def succeeded(self) -> bool:
         return any(a.problem is None for a in self.attempts)
+
+    def real_retries(self, uncertainty: float) -> list[Try]:
+        return [a for a in self.attempts if a.in_window(uncertainty)]
 
 
 def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
@@ -63,6 +112,8 @@ def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
             and last.sent.text == s.text
             and (last.problem is not None)
         ):
+            before = line.previous_activity(s)
+            attempt.quiet = s.first_char - (last.sent.end if before is None else before)
             out[-1].attempts.append(attempt)
         else:
             out.append(RetryGroup(s.text, [attempt]))
@@ -70,30 +121,41 @@ def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
 
 
 def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
-    """Section 7.2 over every command whose reply was missing or invalid: R-7.2-01 it was sent
-    again; R-7.2-02 after no reply, a retry without a break 16.67-87 ms after the command;
-    R-7.2-03 a sequence given up had two retries, one more than 100 ms after its break;
-    R-7.2-04 (SHOULD) three sequences before giving up; R-7.2-05 every missing or invalid
-    reply triggered a retry; R-7.2-06 the retry waited for the invalid reply to end."""
+    """Section 7.2 over every command whose reply was missing or invalid: R-7.2-01 it was
+    retried (a PASS needs a retry inside the 87 ms window; a new break instead is a FAIL);
+    R-7.2-02 after no reply, a retry without a break 16.67-87 ms after the command; R-7.2-03
+    a sequence given up had two retries, one more than 100 ms after its break; R-7.2-04
+    (SHOULD) three sequences before giving up, judged only where a sequence held a retry;
+    R-7.2-05 every missing or invalid reply triggered a retry; R-7.2-06 the retry waited for
+    the invalid reply to end."""
     window: list[Finding] = []
     third: list[Finding] = []
     ends: list[Finding] = []
+    restarted: list[str] = []  # invalid replies followed by a new sequence, not a retry
     tally = Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05"))
-    retried_somewhere = False
     for group in retry_groups(line, uncertainty):
         if all(a.problem is None for a in group.attempts):
             continue
         where = escape(group.text)
         tally.observe(where, ids=["R-7.2-05"])
-        retried_somewhere = retried_somewhere or len(group.attempts) > 1
         # Given up, as opposed to accepted: silence cannot be mistaken for a valid reply, and
         # a command sent again shows the recorder found the reply invalid. A garbled reply
         # sent once may have been accepted: that is R-7.2-05's (and R-4.4.12-07's) finding.
         gave_up = group.attempts[-1].problem is NO_REPLY or len(group.attempts) > 1
-        if gave_up:
+        real = group.real_retries(uncertainty)
+        if real:
             tally.observe(where, ids=["R-7.2-01"])
-        if len(group.attempts) == 1 and gave_up:
-            tally.fail("R-7.2-01", where, f"not sent again after {group.attempts[0].problem}")
+        elif gave_up and not any(a.retry for a in group.attempts):
+            nxt = group.attempts[1] if len(group.attempts) > 1 else None
+            first = group.attempts[0]
+            tally.fail("R-7.2-01", where, f"{first.after()}: {first.instead(nxt)}")
+        elif gave_up:
+            tally.unobservable(
+                "R-7.2-01",
+                f"{where} was sent again without a break only later than "
+                f"{RETRY_MAX * 1e3:.0f} ms after the line went quiet (R-7.2-02 judges it); "
+                "no retry inside the window was seen",
+            )
         sequences = group.sequences()
         for n, seq in enumerate(sequences):
             later = sequences[n + 1][0] if n + 1 < len(sequences) else None
@@ -101,9 +163,13 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                 if a.problem is None:
                     continue
                 nxt = seq[k + 1] if k + 1 < len(seq) else None
-                follower = nxt or later
-                if follower is None and len(seq) < 3:
-                    tally.fail("R-7.2-05", where, f"{a.problem} at {a.sent.at()}, then no retry")
+                if nxt is None and len(seq) < 3:
+                    tally.fail(
+                        "R-7.2-05",
+                        where,
+                        f"{a.problem} at {a.sent.at()}, then "
+                        + ("a new sequence, not a retry" if later is not None else "no retry"),
+                    )
                 # "no reply" times a retry from a quiet line: sensor characters that met the
                 # command (the recorder talked over them) leave that window undecided
                 if a.problem is NO_REPLY and not a.sent.contention:
@@ -124,16 +190,19 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                             Finding(
                                 "R-7.2-02",
                                 Verdict.FAIL,
-                                f"no retry without a break after no reply to {a.sent.at()}",
+                                f"no retry without a break after no reply to {a.sent.at()}: "
+                                f"{a.instead(later)}",
                                 evidence=[a.sent.at()]
                                 + ([f"next: {later.sent.at()}"] if later is not None else []),
                                 observed=1,
                             )
                         )
-                elif follower is not None:
+                elif nxt is not None and nxt.in_window(uncertainty):
                     ends.append(
-                        _retry_after_reply(line, a.sent, follower.sent, a.problem, uncertainty)
+                        _retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty)
                     )
+                elif nxt is None and later is not None:
+                    restarted.append(f"{a.after()}: {a.instead(later)}")
             if any(a.problem is None for a in seq) or not gave_up:
                 continue
             label = f"{where} sequence {n + 1}"
@@ -161,25 +230,52 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                         evidence=[label],
                     )
                 )
-        if not group.succeeded and gave_up:
+        # R-7.2-04 is about repeating a whole break+command+retries sequence: repeats of a
+        # break and the command alone hold no retry and are no evidence for it either way
+        repeated = any(a in real for seq in sequences[:-1] for a in seq)
+        if not group.succeeded and gave_up and len(sequences) < 3:
+            tally.fail(
+                "R-7.2-04",
+                where,
+                f"gave up after {len(sequences)} break+command+retries sequence(s)",
+                warning=True,
+            )
+        elif len(sequences) > 1 and (repeated or (not group.succeeded and real)):
             tally.observe(where, ids=["R-7.2-04"])
-            if len(sequences) < 3:
-                tally.fail(
-                    "R-7.2-04",
-                    where,
-                    f"gave up after {len(sequences)} break+command+retries sequence(s)",
-                    warning=True,
-                )
         elif len(sequences) > 1:
-            tally.observe(where, ids=["R-7.2-04"])
-    if retried_somewhere:
-        tally.observe("the run", ids=["R-7.2-01"])
-    return [
-        *tally.findings("retried as due"),
+            tally.unobservable(
+                "R-7.2-04",
+                f"{where} was repeated {len(sequences)} times, each time a new sequence with "
+                "no retry in it: no break+command+retries sequence was seen to repeat",
+            )
+    for rid in tally.ids:
+        tally.decision(rid, RETRY_DECISION)
+    ok = {
+        "R-7.2-01": f"retried without a break within {RETRY_MAX * 1e3:.0f} ms of the line going "
+        f"quiet (decision {RETRY_DECISION})",
+        "R-7.2-04": "a break+command+retries sequence that drew no valid reply was repeated",
+        "R-7.2-05": "retried as due",
+    }
+    found = [
+        *tally.findings(ok),
         combine("R-7.2-02", window, "retry after no reply"),
         combine("R-7.2-03", third, "unanswered sequence"),
-        combine("R-7.2-06", ends, "retry after an invalid reply"),
+        _waited(ends, restarted),
     ]
+    for f in found[len(tally.ids) :]:
+        f.decision = RETRY_DECISION
+    return found
+
+
+def _waited(ends: list[Finding], restarted: list[str]) -> Finding:
+    """R-7.2-06 over the retries after an invalid reply; without one, say what came instead."""
+    if not ends and restarted:
+        return Finding(
+            "R-7.2-06",
+            Verdict.INCONCLUSIVE,
+            "no retry after an invalid reply was seen: " + "; ".join(restarted[:3]),
+        )
+    return combine("R-7.2-06", ends, "retry after an invalid reply")
 
 
 def _retry_after_reply(

@@ -9,7 +9,14 @@ from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ..tally import Tally
 from ..timing import judge_window
-from .common import CONCURRENT_KINDS, REACTION, SR_KINDS, combine
+from .common import (
+    CONCURRENT_KINDS,
+    REACTION,
+    REACTION_DECISION,
+    SR_KINDS,
+    beyond_reaction,
+    combine,
+)
 from .measurements import ObservedMeasurement
 
 
@@ -34,11 +41,13 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
         first = m.first_data
         if m.ttt == 0:
             tally.observe(where, ids=["R-4.4.5-05"])
-            if first is None or first.start - m.reply_end > REACTION:
+            if first is None:
+                tally.fail("R-4.4.5-05", where, "ttt = 000 but no aD0! followed", warning=True)
+            elif first.start - m.reply_end > REACTION:
                 tally.fail(
                     "R-4.4.5-05",
                     where,
-                    "ttt = 000 but aD0! did not follow at once",
+                    beyond_reaction(first.start - m.reply_end, "ttt = 000"),
                     warning=True,
                 )
             continue
@@ -84,14 +93,12 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
         delay = first.start - trigger
         if delay > REACTION:
             what = "the service request" if trigger == sr else "ttt"
-            tally.fail(
-                "R-4.4.5-05",
-                where,
-                f"aD0! came {delay:.3f} s after {what} (allowed {REACTION} s)",
-            )
+            tally.fail("R-4.4.5-05", where, beyond_reaction(delay, what), warning=True)
         if trigger != sr and first.break_event is None:
             tally.fail("R-4.4.5-05", where, "aD0! after ttt ran out, without a break first")
-    return [combine("R-4.4.5-04", early, "wait for data"), *tally.findings()]
+    tally.decision("R-4.4.5-05", REACTION_DECISION)
+    ok = {"R-4.4.5-05": f"aD0! within {REACTION} s of the service request or ttt (decision T1)"}
+    return [combine("R-4.4.5-04", early, "wait for data"), *tally.findings(ok)]
 
 
 def judge_concurrent_waits(
