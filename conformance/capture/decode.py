@@ -222,12 +222,8 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
                 origin = RECORDER_ORIGIN
                 matched += 1
                 j += 1
-        append(
-            Event(
-                ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty,
-                ev.duration_uncertainty,
-            )  # fmt: skip
-        )
+        du = ev.duration_uncertainty
+        append(Event(ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty, du))
     return out, n_tx - matched
 
 
