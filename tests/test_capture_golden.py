@@ -62,6 +62,31 @@ def digests_of_export(name: str, seed: int, rate: float, line: bool, tmp: Path) 
     }
 
 
+#: emulator faults whose exchanges are exported and decoded (none: a conforming sensor)
+SIM_FAULTS = ["none", "fast-baud", "parity-error", "inter-char-gap", "non-printable-char"]
+
+
+def digests_of_sim(fault: str, tmp: Path) -> dict:
+    """0I!, 0M!, 0D0! with the emulator (virtual time: the same events every run), exported
+    with the tool's TX channel and decoded with it."""
+    from conformance import emulator
+    from conformance.protocol import commands as cmds
+    from conformance.tool_recorder import Master
+    from conformance.transcript import EventKind
+
+    _, link, _ = emulator.sim_sensor(faults=[] if fault == "none" else [fault])
+    master = Master(link)
+    master.identify()
+    master.measure(cmds.measure("0"))
+    events = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]
+    path = tmp / f"sim-{fault}.sr"
+    export_events(events, path, "sr", tool_channel=True)
+    return {
+        "samples": samples_digest(path),
+        "decode-tx": decode_digest(decode_capture(path, tx_channel="TOOL_TX")),
+    }
+
+
 def digest_of_real(file: str, baud: int, framing: str) -> str:
     return decode_digest(decode_capture(SHARED / file, baud=baud, framing=framing))
 
@@ -69,6 +94,11 @@ def digest_of_real(file: str, baud: int, framing: str) -> str:
 @pytest.mark.parametrize("name,seed,rate,line", EXPORTS, ids=[e[0] for e in EXPORTS])
 def test_export_and_decode_unchanged(name, seed, rate, line, tmp_path):
     assert digests_of_export(name, seed, rate, line, tmp_path) == golden()[name]
+
+
+@pytest.mark.parametrize("fault", SIM_FAULTS)
+def test_sim_exchange_export_and_decode_unchanged(fault, tmp_path):
+    assert digests_of_sim(fault, tmp_path) == golden()[f"sim-{fault}"]
 
 
 @pytest.mark.parametrize("file,baud,framing", REAL, ids=[r[0] for r in REAL])
@@ -83,5 +113,6 @@ if __name__ == "__main__":
 
     with tempfile.TemporaryDirectory() as tmp:
         out: dict = {e[0]: digests_of_export(*e, Path(tmp)) for e in EXPORTS}
+        out |= {f"sim-{f}": digests_of_sim(f, Path(tmp)) for f in SIM_FAULTS}
     out |= {r[0]: digest_of_real(*r) for r in REAL}
     print(json.dumps(out, indent=1, sort_keys=True))
