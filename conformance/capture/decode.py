@@ -157,24 +157,28 @@ def _decode_channel(
         period_ticks=edges.period * edges.tick_rate,
         end_tick=edges.end,
     )
+    events, problems = out.events, out.problems
+    baud_error = out.baud_error_pct.append
+    nan = float("nan")
+    chars = framing_errors = parity_errors = glitches = breaks = pulses = 0
     for d in decoded:
         if d.event is not None:
-            out.events.append(d.event)
+            events.append(d.event)
         if d.kind == "char":
-            out.chars += 1
-            out.framing_errors += d.framing_error
-            out.parity_errors += d.parity_error
-            out.glitches += d.glitches
-            out.baud_error_pct.append(
-                float("nan") if d.baud_error_pct is None else d.baud_error_pct
-            )
+            chars += 1
+            framing_errors += d.framing_error
+            parity_errors += d.parity_error
+            glitches += d.glitches
+            baud_error(nan if d.baud_error_pct is None else d.baud_error_pct)
             if d.framing_error or d.parity_error or d.glitches:
-                out.problems.append(d)
+                problems.append(d)
             continue
-        out.problems.append(d)
-        out.breaks += d.kind == "break"
-        out.pulses += d.kind == "pulse"
-        out.glitches += d.kind == "glitch"
+        problems.append(d)
+        breaks += d.kind == "break"
+        pulses += d.kind == "pulse"
+        glitches += d.kind == "glitch"
+    out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
+    out.framing_errors, out.parity_errors = framing_errors, parity_errors
     bad = out.framing_errors + out.parity_errors + out.glitches
     est = _estimated_baud(prefix, edges.tick_rate)
     off = est is not None and not 0.8 < est / baud < 1.25
@@ -198,34 +202,29 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
     same character or break starting within ``tolerance`` seconds, else :data:`SENSOR_ORIGIN`; and
     how many TX events were not seen on the bus."""
     out: list[Event] = []
+    append = out.append
     j = 0
+    n_tx = len(tx)
     matched = 0
+    char = EventKind.CHAR
     for ev in bus:
-        while j < len(tx) and tx[j].start < ev.start - tolerance:
+        start = ev.start
+        while j < n_tx and tx[j].start < start - tolerance:
             j += 1
-        hit = (
-            j < len(tx)
-            and abs(tx[j].start - ev.start) <= tolerance
-            and tx[j].kind is ev.kind
-            and (ev.kind is not EventKind.CHAR or tx[j].wire == ev.wire)
-        )
-        if hit:
-            matched += 1
-            j += 1
-        origin = RECORDER_ORIGIN if hit else SENSOR_ORIGIN
-        out.append(
-            Event(
-                ev.kind,
-                origin,
-                ev.start,
-                ev.end,
-                wire=ev.wire,
-                text=ev.text,
-                uncertainty=ev.uncertainty,
-                duration_uncertainty=ev.duration_uncertainty,
-            )
-        )
-    return out, len(tx) - matched
+        origin = SENSOR_ORIGIN
+        if j < n_tx:
+            t = tx[j]
+            if (
+                abs(t.start - start) <= tolerance
+                and t.kind is ev.kind
+                and (ev.kind is not char or t.wire == ev.wire)
+            ):
+                origin = RECORDER_ORIGIN
+                matched += 1
+                j += 1
+        du = ev.duration_uncertainty
+        append(Event(ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty, du))
+    return out, n_tx - matched
 
 
 #: the last capture decoded, by file identity and settings: ``judge`` decodes a capture to

@@ -12,9 +12,11 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..transcript import TOOL, Event, EventKind
 from .comments import capture_comment
-from .levels import edges_of
+from .levels import edge_array
 from .writers import Channel, write_csv, write_sr, write_vcd
 
 DEFAULT_SAMPLE_RATE = 100_000.0
@@ -75,10 +77,10 @@ def export_events(
     end = max(e.end for e in wire) + TRAIL
     total = round((end - t0) * sample_rate)
     idle = 0 if line_polarity else 1
-    channels = [Channel(BUS_CHANNEL, idle, edges_of(wire, sample_rate, t0))]
+    channels = [Channel(BUS_CHANNEL, idle, _edges(wire, sample_rate, t0, fmt))]
     if tool_channel:
         tool = [e for e in wire if e.origin == TOOL]
-        channels.append(Channel(TOOL_CHANNEL, idle, edges_of(tool, sample_rate, t0)))
+        channels.append(Channel(TOOL_CHANNEL, idle, _edges(tool, sample_rate, t0, fmt)))
     # a CSV keeps the transcript's clock, so its notes keep their own times
     comment = capture_comment(
         notes, 0.0 if fmt == "csv" else t0, BUS_CHANNEL, TOOL_CHANNEL if tool_channel else None
@@ -94,3 +96,10 @@ def export_events(
     return ExportInfo(
         path, fmt, sample_rate, t0, total, tuple(c.name for c in channels), line_polarity
     )
+
+
+def _edges(events: list[Event], rate: float, t0: float, fmt: str) -> np.ndarray | list[int]:
+    """A channel's toggle ticks: the array itself for a .sr (written in bulk), Python ints
+    for the text formats (written an edge at a time)."""
+    ticks = edge_array(events, rate, t0)
+    return ticks if fmt == "sr" else ticks.tolist()

@@ -13,6 +13,7 @@ Levels are handled on the UART side (marking = 1). The SDI-12 line itself idles 
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
@@ -75,31 +76,119 @@ class Decoded:
     marking_before: float | None = None
 
 
-class _Cursor:
-    """Edges from chunks with look-ahead, without ever holding more than a chunk or two."""
+#: Frame shapes (a frame's edges relative to its start bit, and the bit time it is read with)
+#: whose reading is kept: a bus repeats the same few hundred shapes, and reading one again is
+#: most of a decode's time (an hour at 1 MHz: millions of frames). Kept per decode, dropped
+#: whole when full, so a noisy capture of endless distinct shapes stays bounded.
+FRAME_SHAPES = 1 << 14
 
-    __slots__ = ("buf", "i", "chunks")
+#: A shape read relative to its start gives the same bits at any start below this tick, as
+#: long as no edge lies within ``_MARGIN`` ticks of a bit centre: ``s + centre`` stays below
+#: 2**40 and is rounded by at most 2**-14 ticks, so no comparison of an edge with a centre
+#: can turn (the fit itself only sees edge differences, which are exact integers).
+_EXACT_BELOW = 2**39
+_MARGIN = 2.0**-12
 
-    def __init__(self, chunks: Iterable[list[int]]) -> None:
-        self.chunks = iter(chunks)
-        self.buf: list[int] = []
-        self.i = 0
 
-    def has(self, n: int) -> bool:
-        """At least ``n`` edges left from the cursor (reads chunks as needed)."""
-        while len(self.buf) - self.i < n:
-            nxt = next(self.chunks, None)
-            if nxt is None:
-                return False
-            self.buf = self.buf[self.i :] + list(nxt)
-            self.i = 0
-        return True
+@dataclass(frozen=True, slots=True)
+class _Reading:
+    """What one frame's edges say: its 8 wire bits, whether the stop bit was low, parity,
+    glitches, the measured bit-rate error and the bit time its bits were read with."""
 
-    def peek(self, k: int = 0) -> int | None:
-        j = self.i + k
-        if j < len(self.buf):  # the common case, without a call: the decoder peeks per edge
-            return self.buf[j]
-        return self.buf[self.i + k] if self.has(k + 1) else None
+    wire: int
+    framing_error: bool
+    parity_error: bool
+    glitches: int
+    err: float | None
+    used: float
+
+
+def _read_frame(
+    s: int,
+    inner: list[int] | tuple[int, ...],
+    used: float,
+    T: float,
+    nbits: int,
+    period_ticks: float,
+    framing: Framing,
+) -> _Reading:
+    """Read the frame whose start bit falls at ``s`` from the edges inside it, starting from
+    bit time ``used`` (the nominal one, or the sender's seen a character earlier)."""
+    half = T / 2
+    # the sender's bit time, fitted edge by edge (least squares through the start edge):
+    # early edges barely drift, so the fit follows a sender several % off the nominal
+    # rate and the bits are then read where that sender put them
+    # (a fit is trusted only where it differs from the nominal bit by more than the edges'
+    # own quantisation allows: at 8 samples a bit, one sample is 12 % of a bit)
+    bt = used
+    skk = sdk = 0.0
+    kmax = 0
+    bounds = [s, *inner]
+    for n, e in enumerate(inner, 1):
+        if e - bounds[n - 1] < half or (n < len(inner) and inner[n] - e < half):
+            continue  # an edge of a glitch: no bit boundary
+        d = e - s
+        kk = round(d / used)
+        if 1 <= kk < nbits and abs(d - kk * used) < used / 2:
+            skk += kk * kk
+            sdk += kk * d
+            kmax = max(kmax, kk)
+            bt = sdk / skk
+            used = bt if abs(bt - T) * kmax > 2 * period_ticks else T
+    bits = []
+    j = 0
+    lvl = 0
+    for b in range(nbits):
+        centre = s + (b + 0.5) * used
+        while j < len(inner) and inner[j] <= centre:
+            lvl ^= 1
+            j += 1
+        bits.append(lvl)
+    wire = 0
+    for b in range(8):
+        wire |= bits[1 + b] << b
+    # glitches: pulses inside the frame shorter than half a bit. A pulse also cuts the
+    # bit it lands in into short pieces, so a run of consecutive short runs is one glitch
+    glitches = 0
+    short_before = False
+    for a, b2 in zip(bounds, bounds[1:], strict=False):
+        short = b2 - a < half
+        if short and not short_before:
+            glitches += 1
+        short_before = short
+    err = (T / bt - 1) * 100 if skk else None
+    return _Reading(wire, bits[-1] == 0, not framing.parity_ok(wire), glitches, err, used)
+
+
+def _shape_reading(
+    shape: tuple[int, ...], used: float, T: float, nbits: int, period_ticks: float, framing: Framing
+) -> _Reading | None:
+    """:func:`_read_frame` of a frame starting at tick 0, or None when an edge lies so near
+    a bit centre that the same edges at another start might read differently."""
+    got = _read_frame(0, shape, used, T, nbits, period_ticks, framing)
+    if nbits * got.used >= _EXACT_BELOW / 2:
+        return None  # centres this far out could round differently past _EXACT_BELOW
+    for b in range(nbits):
+        centre = (b + 0.5) * got.used
+        for e in shape:
+            if abs(e - centre) <= _MARGIN:
+                return None
+    return got
+
+
+_UNREAD = object()  # a shape not read yet (None is a shape read as too near a centre)
+
+
+def _refill(src: Iterator[list[int]], buf: list[int], i: int, above: float) -> tuple[list, bool]:
+    """``buf[i:]`` with chunks appended until it holds two edges and its last is above
+    ``above``; and whether chunks may be left. Edges are non-decreasing (every reader's)."""
+    rest = buf[i:]
+    while len(rest) < 2 or rest[-1] <= above:
+        nxt = next(src, None)
+        if nxt is None:
+            return rest, False
+        rest.extend(nxt)
+    return rest, True
 
 
 def decode(
@@ -117,18 +206,26 @@ def decode(
     break_min: float = BREAK_MIN,
     pulse_min: float = BREAK_NEVER,
 ) -> Iterator[Decoded]:
-    """Frames, breaks, pulses and glitches in time order, from edge ticks.
+    """Frames, breaks, pulses and glitches in time order, from edge ticks (non-decreasing).
 
     ``period_ticks``: how many ticks one sample period spans (the edge position error), used
     to tell a measured bit rate from rounding. ``end_tick``: asked, once the edges are
     exhausted, where the capture ends, to measure a spacing still running there (a break the
-    capture cut); without it such a spacing is dropped."""
+    capture cut); without it such a spacing is dropped.
+
+    The edges are held a chunk or two at a time in one list scanned by index (``bisect`` for
+    the edges inside a frame), and each frame shape is read once (:data:`FRAME_SHAPES`)."""
     framing = framing or Framing.parse("7E1")
     nbits = framing.bits
     T = tick_rate / baud
     half = T / 2
     stop_centre = (nbits - 0.5) * T
-    cur = _Cursor(chunks)
+    frame_span = nbits * T * 1.1  # a slow sender's run a little past the nominal end
+    src = iter(chunks)
+    buf: list[int] = []
+    i = 0  # the next edge not consumed
+    more = True  # chunks may be left in src
+    shapes: dict[tuple, _Reading | None] = {}
     level = (initial_level & 1) ^ int(invert)
     last_end: float | None = None  # tick where the previous frame or break ended
     # the bit time the previous character was read with, when it read cleanly: the next one,
@@ -142,18 +239,22 @@ def decode(
         return t0 + tick / tick_rate
 
     if level == 0:  # the capture starts inside spacing: its start is unknown, skip it
-        first = cur.peek()
-        if first is None:
+        buf, more = _refill(src, buf, i, float("-inf"))
+        if not buf:
             return
-        cur.i += 1
+        i = 1
         level = 1
-        last_end = first
+        last_end = buf[0]
     while True:
-        s = cur.peek()
-        if s is None:
+        if more and len(buf) - i < 2:
+            buf, more = _refill(src, buf, i, float("-inf"))
+            i = 0
+        n_buf = len(buf)
+        if i >= n_buf:
             return
-        r = cur.peek(1)
-        cur.i += 1  # the falling edge is consumed; r (if any) is still ahead
+        s = buf[i]
+        r = buf[i + 1] if i + 1 < n_buf else None
+        i += 1  # the falling edge is consumed; r (if any) is still ahead
         if r is not None:
             r_end = r
         else:
@@ -163,7 +264,7 @@ def decode(
         if length < half:
             if r is None:
                 return  # the capture ends right after a falling edge: nothing to decode
-            cur.i += 1
+            i += 1
             yield Decoded("glitch", None, t(s), t(r))
             continue
         if length > stop_centre and length / tick_rate >= pulse_min:
@@ -181,82 +282,64 @@ def decode(
             prior_bt = None
             if r is None:
                 return
-            cur.i += 1
+            i += 1
             last_end = r
             continue
-        # a frame: the edges inside it (a slow sender's run a little past the nominal end)
-        frame_end = s + nbits * T * 1.1
-        inner: list[int] = []
-        k = 0
-        while (e := cur.peek(k)) is not None and e < frame_end:
-            inner.append(e)
-            k += 1
-        # the sender's bit time, fitted edge by edge (least squares through the start edge):
-        # early edges barely drift, so the fit follows a sender several % off the nominal
-        # rate and the bits are then read where that sender put them
-        # (a fit is trusted only where it differs from the nominal bit by more than the edges'
-        # own quantisation allows: at 8 samples a bit, one sample is 12 % of a bit)
+        # a frame: the edges inside it (bisect in a window first: a frame holds a few)
+        frame_end = s + frame_span
+        if more and buf[-1] <= frame_end:
+            buf, more = _refill(src, buf, i, frame_end)
+            i = 0
+        hi = i + 16
+        n_buf = len(buf)
+        j = bisect_left(buf, frame_end, i, hi if hi < n_buf else n_buf)
+        if j == hi:
+            j = bisect_left(buf, frame_end, hi)
         follows = prior_bt is not None and last_end is not None and s - last_end < nbits * T
-        bt = used = prior_bt if follows and prior_bt is not None else T
-        skk = sdk = 0.0
-        kmax = 0
-        bounds = [s, *inner]
-        for n, e in enumerate(inner, 1):
-            if e - bounds[n - 1] < half or (n < len(inner) and inner[n] - e < half):
-                continue  # an edge of a glitch: no bit boundary
-            d = e - s
-            kk = round(d / used)
-            if 1 <= kk < nbits and abs(d - kk * used) < used / 2:
-                skk += kk * kk
-                sdk += kk * d
-                kmax = max(kmax, kk)
-                bt = sdk / skk
-                used = bt if abs(bt - T) * kmax > 2 * period_ticks else T
-        bits = []
-        j = 0
-        lvl = 0
-        for b in range(nbits):
-            centre = s + (b + 0.5) * used
-            while j < len(inner) and inner[j] <= centre:
-                lvl ^= 1
-                j += 1
-            bits.append(lvl)
-        wire = 0
-        for b in range(8):
-            wire |= bits[1 + b] << b
-        framing_error = bits[-1] == 0
-        parity_error = not framing.parity_ok(wire)
-        # glitches: pulses inside the frame shorter than half a bit. A pulse also cuts the
-        # bit it lands in into short pieces, so a run of consecutive short runs is one glitch
-        glitches = 0
-        short_before = False
-        for a, b2 in zip(bounds, bounds[1:], strict=False):
-            short = b2 - a < half
-            if short and not short_before:
-                glitches += 1
-            short_before = short
-        err = (T / bt - 1) * 100 if skk else None
+        used = prior_bt if follows and prior_bt is not None else T
+        reading = None
+        if s < _EXACT_BELOW:
+            key = (used, *[e - s for e in buf[i:j]])
+            reading = shapes.get(key, _UNREAD)
+            if reading is _UNREAD:
+                if len(shapes) >= FRAME_SHAPES:
+                    shapes.clear()
+                reading = shapes[key] = _shape_reading(
+                    key[1:], used, T, nbits, period_ticks, framing
+                )
+        if reading is None:  # an edge on a bit centre, or a tick too far for the shapes
+            reading = _read_frame(s, buf[i:j], used, T, nbits, period_ticks, framing)
+        used = reading.used
+        framing_error = reading.framing_error
         end = s + nbits * used
         # consume the edges up to the stop bit's centre; a low stop bit runs on to its rise
-        while (e := cur.peek()) is not None and e <= s + (nbits - 0.5) * used:
-            cur.i += 1
-        if framing_error and (e := cur.peek()) is not None:
-            cur.i += 1
+        stop = s + (nbits - 0.5) * used
+        if stop < frame_end:  # every edge from j on is later
+            i = bisect_right(buf, stop, i, j)
+        else:
+            if more and buf[-1] <= stop:
+                buf, more = _refill(src, buf, i, stop)
+                i = 0
+            i = bisect_right(buf, stop, i)
+        e = buf[i] if i < len(buf) else None
+        if framing_error and e is not None:
+            i += 1
             end = max(end, e)
-        elif (e := cur.peek()) is not None and e < end:
+        elif e is not None and e < end:
             end = e  # the next start bit came first: this stop bit ended there (back to back)
-        ev = Event(EventKind.CHAR, BUS, t(s), t(end), wire=wire, uncertainty=uncertainty)
+        start = t0 + s / tick_rate
+        ev = Event(EventKind.CHAR, BUS, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
         prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity
         yield Decoded(
             "char",
             ev,
-            ev.start,
+            start,
             ev.end,
-            framing_error=framing_error,
-            parity_error=parity_error,
-            baud_error_pct=err,
-            glitches=glitches,
-            marking_before=marking,
+            framing_error,
+            reading.parity_error,
+            reading.err,
+            reading.glitches,
+            marking,
         )

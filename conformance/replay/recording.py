@@ -92,13 +92,37 @@ _READ: dict[tuple[str, int, int], tuple[Event, ...]] = {}
 
 def _read_events(file: Path) -> list[Event]:
     """The transcript's events (a fresh list each call; the events themselves are frozen)."""
-    st = file.stat()
-    key = (str(file.resolve()), st.st_mtime_ns, st.st_size)
+    key = _file_key(file)
     if key not in _READ:
-        if len(_READ) >= 2:
-            _READ.pop(next(iter(_READ)))
-        _READ[key] = tuple(read_transcript_jsonl(str(file)))
+        _keep(key, tuple(read_transcript_jsonl(str(file))))
     return list(_READ[key])
+
+
+def _file_key(file: Path) -> tuple[str, int, int]:
+    st = file.stat()
+    return (str(file.resolve()), st.st_mtime_ns, st.st_size)
+
+
+def _keep(key: tuple[str, int, int], events: tuple[Event, ...]) -> None:
+    if len(_READ) >= 2:
+        _READ.pop(next(iter(_READ)))
+    _READ[key] = events
+
+
+def _reads_back_as_itself(e: Event) -> bool:
+    """Whether ``e``'s JSON line reads back as an equal event with the same types (what
+    :func:`read_transcript_jsonl` gives): floats print as their shortest repr, which reads
+    back bit for bit, but an int time would come back a float."""
+    return (
+        type(e.kind) is EventKind
+        and type(e.origin) is str
+        and type(e.start) is float
+        and type(e.end) is float
+        and type(e.wire) is int
+        and type(e.text) is str
+        and type(e.uncertainty) is float
+        and (e.duration_uncertainty is None or type(e.duration_uncertainty) is float)
+    )
 
 
 def options_in(notes: list[Event]) -> dict[str, Any]:
@@ -114,8 +138,14 @@ def options_in(notes: list[Event]) -> dict[str, Any]:
 
 
 def write_recording(path: Path, events: list[Event]) -> None:
-    """A transcript file holding ``events`` (a decoded capture with its run's notes)."""
-    Transcript(list(events)).write_jsonl(str(path))
+    """A transcript file holding ``events`` (a run's, or a decoded capture with its run's
+    notes). What is written is also kept as its reading, when reading it back would give
+    the same events: a capture round trip reads both files it writes straight away, and a
+    run's 10^5 lines cost a second to parse."""
+    events = list(events)
+    Transcript(events).write_jsonl(str(path))
+    if all(map(_reads_back_as_itself, events)):
+        _keep(_file_key(Path(path)), tuple(events))
 
 
 def _options_from(file: Path, number: int, text: str) -> dict[str, Any]:

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..links.bus_time import bus_time
+from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL, ConformanceRun
 from .evidence import WireRef, wire_refs
@@ -128,7 +129,7 @@ def write(run: ConformanceRun, directory: Path) -> Path:
     run.document = build(run)  # what the command line prints and exits on: this run's own
     path.write_text(json.dumps(run.document, indent=2, ensure_ascii=False), encoding="utf-8")
     if run.link is not None:
-        run.link.transcript.write_jsonl(str(directory / "transcript.jsonl"))
+        write_recording(directory / "transcript.jsonl", run.link.transcript.events)
     else:
         (directory / "transcript.jsonl").write_text("", encoding="utf-8")
     return path
