@@ -17,13 +17,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
 from ..protocol.timing import NO_BREAK_WINDOW
 from ..transcript import Event, decode_8n1
-from .segments import IsRecorder, Transmission, read_view
+from .segments import IsRecorder, Transmission, _memo, read_view
 from .sides import ETX, LF, STX
+
+T = TypeVar("T")
 
 #: How a gap's stamps are worth where it lies: ``(start, end) -> uncertainty`` (s).
 GapUncertainty = Callable[[float, float], float]
@@ -100,9 +103,20 @@ def _place(seg: Segment, e: Event) -> None:
         seg.reply.append(e)  # a gap never ends a reply: R-7.0-12 judges it
 
 
-def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> list[Segment]:
+class Segments(list[Segment]):
+    """The segments of one recording (a list), holding what judges derive from them: a run's
+    whole-run cases read the same segments several times (a rule's judge and the probe that
+    asks what it wants confirmed), and derive the gaps and their observations once."""
+
+    def derived(self, name: str, key: object, build: Callable[[], T]) -> T:
+        """``build()``, kept under ``name`` while ``key`` (and the list's length) stays the
+        same."""
+        return _memo(self, name, (len(self), key), build)
+
+
+def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> Segments:
     """The recording's transmissions, regrouped for timing evidence."""
-    return [Segment.of(t) for t in read_view(events, is_recorder).transmissions]
+    return Segments(Segment.of(t) for t in read_view(events, is_recorder).transmissions)
 
 
 def runs(events: list[Event]) -> list[list[Event]]:
