@@ -149,5 +149,44 @@ class Transcript:
 
     def write_jsonl(self, path: str) -> None:
         with open(path, "w", encoding="utf-8") as fh:
-            for event in self.events:
-                fh.write(json.dumps(event.to_json()) + "\n")
+            line = _JsonLines().line
+            fh.writelines(line(event) for event in self.events)
+
+
+class _JsonLines:
+    """``json.dumps(event.to_json()) + "\\n"``, written without building the dict and
+    encoding it through the json module for each event (a run holds tens of thousands):
+    the same text, byte for byte; an event with anything but finite floats for its times
+    takes the json module's way."""
+
+    def __init__(self) -> None:
+        self._heads: dict[tuple[EventKind, str], str] = {}  # kinds and origins repeat
+        self._texts: dict[str, str] = {}  # and so do texts (nearly always "")
+
+    def line(self, e: Event) -> str:
+        start, end, u, du = e.start, e.end, e.uncertainty, e.duration_uncertainty
+        if not (
+            type(start) is float
+            and type(end) is float
+            and type(u) is float
+            and start - start == end - end == u - u == 0.0  # finite: json writes the repr
+            and (du is None or (type(du) is float and du - du == 0.0))
+            and type(e.wire) is int
+            and type(e.origin) is str
+            and type(e.text) is str
+            and isinstance(e.kind, EventKind)
+        ):
+            return json.dumps(e.to_json()) + "\n"
+        head = self._heads.get((e.kind, e.origin))
+        if head is None:
+            head = self._heads[(e.kind, e.origin)] = (
+                f'{{"kind": {json.dumps(str(e.kind))}, "origin": {json.dumps(e.origin)}, '
+            )
+        text = self._texts.get(e.text)
+        if text is None:
+            text = self._texts[e.text] = json.dumps(e.text)
+        tail = "}\n" if du is None else f', "duration_uncertainty": {du!r}}}\n'
+        return (
+            f'{head}"start": {start!r}, "end": {end!r}, "wire": {e.wire!r}, "text": {text}, '
+            f'"uncertainty": {u!r}{tail}'
+        )

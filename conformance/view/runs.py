@@ -79,8 +79,9 @@ class Segment:
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
         )
         clash = {id(e) for e in t.contention}
+        answerable = t.is_command  # asked once, not per character heard
         for e in t.heard:
-            if not t.is_command or id(e) in clash:
+            if not answerable or id(e) in clash:
                 seg.contention.append(e)  # not a reply: it met the command (or its tail did)
             else:
                 _place(seg, e)
