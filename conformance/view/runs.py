@@ -22,7 +22,7 @@ from typing import TypeVar
 from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
 from ..protocol.timing import NO_BREAK_WINDOW
-from ..transcript import Event, decode_8n1
+from ..transcript import Event, Transcript, decode_8n1
 from .segments import IsRecorder, Transmission, _memo, read_view
 from .sides import ETX, LF, STX
 
@@ -118,6 +118,13 @@ class Segments(list[Segment]):
 def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> Segments:
     """The recording's transmissions, regrouped for timing evidence."""
     return Segments(Segment.of(t) for t in read_view(events, is_recorder).transmissions)
+
+
+def transcript_segments(transcript: Transcript) -> Segments:
+    """:func:`segments` of a run's whole transcript, cut once per length (a transcript is
+    append-only): the whole-run cases and the report's timing diagrams read the same cut."""
+    events = transcript.events
+    return _memo(transcript, "_segments", len(events), lambda: segments(events))
 
 
 def runs(events: list[Event]) -> list[list[Event]]:
