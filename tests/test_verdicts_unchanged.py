@@ -28,6 +28,10 @@ RUNS = {
 }
 #: the runs the fast default selection keeps (the others are marked slow)
 FAST = {"clean", "inter-char-gap-tolerance"}
+#: cases whose findings' text depends on the process, not on the judges: the derandomised
+#: exploration draws its steps from the literals of the modules loaded (another order under
+#: xdist); their verdicts are compared, not their details
+PROCESS_DEPENDENT = {"testcases.sensor.test_8_exploration::test_random_command_sequences"}
 FINDING_KEYS = (
     "test", "verdict", "detail", "measured_ms", "limit_ms", "uncertainty_ms", "evidence",
     "decision", "observed", "consequence_of", "wire",
@@ -43,7 +47,12 @@ def digest(data: dict[str, Any]) -> dict[str, Any]:
             r["id"]: {
                 "verdict": r["verdict"],
                 "consequence_of": r["consequence_of"],
-                "findings": [{k: f[k] for k in FINDING_KEYS} for f in r["findings"]],
+                "findings": [
+                    {k: f[k] for k in FINDING_KEYS}
+                    if f["test"] not in PROCESS_DEPENDENT
+                    else {"test": f["test"], "verdict": f["verdict"]}
+                    for f in r["findings"]
+                ],
             }
             for r in data["requirements"]
         },
