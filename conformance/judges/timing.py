@@ -323,13 +323,6 @@ class Window:
             observed=1,  # one measured interval between two observed wire events
         )
 
-    def measure(
-        self, measured: float, uncertainty: float, evidence: list[str] | None = None
-    ) -> Measured:
-        """One interval judged for :func:`combine` / :func:`combine_local`, its finding built
-        only if they read its text (:class:`Measured`)."""
-        return Measured(self, measured, uncertainty, evidence)
-
 
 def _window_verdict(
     lo: float | None, hi: float | None, measured: float, uncertainty: float, should: bool
