@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from . import preconditions, report_folder, whole_run
+from . import gc_pace, preconditions, report_folder, whole_run
 from .case import Case
 from .interrupts import GUARD
 from .links.base import LinkError
@@ -35,6 +35,7 @@ from .verdicts import Finding, Verdict
 RUN = pytest.StashKey[ConformanceRun]()
 OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
 LOCKED = pytest.StashKey[Path]()  # the report folder this run holds (report_folder.acquire)
+PACE = pytest.StashKey[gc_pace.Pace]()  # the collector's pace before the run (gc_pace)
 EXIT_NO_DEVICE = 5
 
 
@@ -250,6 +251,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if not GUARD.installed:
         GUARD.install()  # `pytest --pyargs testcases` on its own: same Ctrl-C policy as the CLI
         config.stash[OWN_GUARD] = True
+    if PACE not in config.stash:
+        config.stash[PACE] = gc_pace.slow_down()  # the suite is loaded: the run starts
     for item in items:
         marker = item.get_closest_marker("requirements")
         if marker is None:
@@ -377,6 +380,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
+    pace = config.stash.get(PACE, None)
+    if pace is not None:
+        gc_pace.restore(pace)
     locked = config.stash.get(LOCKED, None)
     if locked is not None:
         report_folder.release(locked)

@@ -23,8 +23,9 @@ ROOT = Path(__file__).resolve().parent.parent / "conformance"
 #: name that contains a module places it, so a few modules of a package may sit higher than
 #: the package when they serve a higher layer.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    # protocol facts and the record of the wire (sans-I/O); process plumbing
-    ("wire", ("", "interrupts", "exits", "atomic", "suggest", "protocol", "transcript")),
+    # protocol facts and the record of the wire (sans-I/O); process plumbing (signals, exit
+    # codes, atomic writes, the garbage collector's pace)
+    ("wire", ("", "interrupts", "exits", "atomic", "suggest", "gc_pace", "protocol", "transcript")),
     # the requirements, what is declared about the DUT, and what was found
     (
         "requirements",

@@ -7,8 +7,9 @@ PASS only when the whole interval ``measured +/- uncertainty`` lies inside the a
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 from ..preconditions import awake
 from ..protocol.timing import STANDBY_MARKING, TOLERANCE
@@ -63,7 +64,8 @@ REPROBE_TIMES = 10
 #: and the position in that reply (a character index; 0 for the reply's start). None: no
 #: place known.
 Place = tuple[str, str, int]
-Observation = tuple[Finding, bool] | tuple[Finding, bool, Place | None]
+#: One judged observation: a :class:`Finding`, or a :class:`Measured` that builds it on demand.
+Observation = tuple["Finding | Measured", bool] | tuple["Finding | Measured", bool, Place | None]
 
 
 def sustained(deviating: int, total: int) -> bool:
@@ -91,7 +93,7 @@ class Pattern:
         return list(dict.fromkeys(p[0] for p in self.unconfirmed if p is not None))
 
 
-def deviation_pattern(observed: list[tuple[Finding, Place | None]]) -> Pattern:
+def deviation_pattern(observed: list[tuple[Finding | Measured, Place | None]]) -> Pattern:
     """:class:`Pattern` of the FAILing observations among ``observed``."""
     counts: dict[Place | None, list[int]] = {}
     for finding, place in observed:
@@ -113,7 +115,7 @@ def deviation_pattern(observed: list[tuple[Finding, Place | None]]) -> Pattern:
     return Pattern(recurring, stalls, unconfirmed)
 
 
-def _places(observed: list[Observation]) -> list[tuple[Finding, bool, Place | None]]:
+def _places(observed: list[Observation]) -> list[tuple[Finding | Measured, bool, Place | None]]:
     return [(o[0], o[1], o[2] if len(o) > 2 else None) for o in observed]  # type: ignore[misc]
 
 
@@ -164,10 +166,16 @@ def combine_local(
       :func:`to_confirm`, and the judge runs again over the repeats). Many deviations
       (:func:`sustained`) are a FAIL as they are. On a virtual clock every observation is
       exact and one is enough."""
-    placed = _places(observed)
-    kept_placed = [(f, p) for f, tainted, p in placed if not _aside(f, tainted)]
-    kept = [f for f, _ in kept_placed]
-    aside = [f for f, tainted, _ in placed if _aside(f, tainted)]
+    kept: list[Finding | Measured] = []
+    places: list[Place | None] = []  # of each kept one
+    aside: list[Finding | Measured] = []
+    for o in observed:  # one pass: a run's character gaps number tens of thousands
+        f = o[0]
+        if _aside(f, o[1]):
+            aside.append(f)
+        else:
+            kept.append(f)
+            places.append(o[2] if len(o) > 2 else None)  # type: ignore[misc]
     worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
     note = (
         f"{len(aside)} {plural(what) if len(aside) != 1 else what} set aside: the link's "
@@ -183,7 +191,7 @@ def combine_local(
         and not sustained(len(failing), len(kept))
     )
     if isolated:
-        found = _by_place(rid, kept_placed, what, smallest_is_worst)
+        found = _by_place(rid, list(zip(kept, places, strict=True)), what, smallest_is_worst)
     else:
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
@@ -193,7 +201,7 @@ def combine_local(
 
 def _by_place(
     rid: str,
-    kept: list[tuple[Finding, Place | None]],
+    kept: list[tuple[Finding | Measured, Place | None]],
     what: str,
     smallest_is_worst: bool,
 ) -> Finding:
@@ -264,38 +272,154 @@ def judge_window(
 
     ``should`` turns a definite violation into WARN (a SHOULD rule or a lenient decision).
     """
-    lo = None if low is None else low - tolerance - EPSILON
-    hi = None if high is None else high + tolerance + EPSILON
+    window = Window(requirement, what, low, high, tolerance, should, decision)
+    return window.judge(measured, uncertainty, evidence)
+
+
+@dataclass(frozen=True)
+class Window:
+    """The limits :func:`judge_window` applies, worked out once for the many intervals a
+    whole-run rule judges against them (tens of thousands of character gaps in a run)."""
+
+    requirement: str
+    what: str
+    low: float | None = None
+    high: float | None = None
+    tolerance: float = TOLERANCE
+    should: bool = False
+    decision: str | None = None
+
+    @cached_property
+    def lo(self) -> float | None:
+        return None if self.low is None else self.low - self.tolerance - EPSILON
+
+    @cached_property
+    def hi(self) -> float | None:
+        return None if self.high is None else self.high + self.tolerance + EPSILON
+
+    def judge(
+        self, measured: float, uncertainty: float, evidence: list[str] | None = None
+    ) -> Finding:
+        """The whole finding, detail text and all (:func:`judge_window`)."""
+        lo, hi = self.lo, self.hi
+        verdict, outside = _window_verdict(lo, hi, measured, uncertainty, self.should)
+        limit = _describe_limit(lo, hi)
+        detail = (
+            f"{self.what}: {measured * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} ms, allowed {limit}"
+        )
+        if verdict is Verdict.INCONCLUSIVE:
+            detail += " (the uncertainty straddles the limit)"
+        limit_ms = (hi if hi is not None else lo) or 0.0
+        return Finding(
+            self.requirement,
+            verdict,
+            detail,
+            measured_ms=round(measured * 1e3, 3),
+            limit_ms=round(limit_ms * 1e3, 3),
+            uncertainty_ms=round(uncertainty * 1e3, 3),
+            evidence=list(evidence or []),
+            decision=self.decision,
+            margin_ms=_margin_ms(lo, hi, measured, outside),
+            observed=1,  # one measured interval between two observed wire events
+        )
+
+
+def _window_verdict(
+    lo: float | None, hi: float | None, measured: float, uncertainty: float, should: bool
+) -> tuple[Verdict, bool]:
+    """The verdict of ``measured ± uncertainty`` against ``[lo, hi]``, and whether the whole
+    interval lies outside."""
     m_lo, m_hi = measured - uncertainty, measured + uncertainty
     inside = (lo is None or m_lo >= lo) and (hi is None or m_hi <= hi)
     outside = (lo is not None and m_hi < lo) or (hi is not None and m_lo > hi)
     if inside:
-        verdict = Verdict.PASS
-    elif outside:
-        verdict = Verdict.WARN if should else Verdict.FAIL
-    else:
-        verdict = Verdict.INCONCLUSIVE
-    limit = _describe_limit(lo, hi)
-    detail = f"{what}: {measured * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} ms, allowed {limit}"
-    if verdict is Verdict.INCONCLUSIVE:
-        detail += " (the uncertainty straddles the limit)"
-    limit_ms = (hi if hi is not None else lo) or 0.0
-    edges = [measured - lo if lo is not None else None, hi - measured if hi is not None else None]
-    distances = [abs(d) for d in edges if d is not None]
-    if outside:  # decided by the edge it is beyond
-        distances = [-d for d in edges if d is not None and d < 0]
-    return Finding(
-        requirement,
-        verdict,
-        detail,
-        measured_ms=round(measured * 1e3, 3),
-        limit_ms=round(limit_ms * 1e3, 3),
-        uncertainty_ms=round(uncertainty * 1e3, 3),
-        evidence=list(evidence or []),
-        decision=decision,
-        margin_ms=round(min(distances) * 1e3, 3) if distances else None,
-        observed=1,  # one measured interval between two observed wire events
-    )
+        return Verdict.PASS, outside
+    if outside:
+        return (Verdict.WARN if should else Verdict.FAIL), outside
+    return Verdict.INCONCLUSIVE, outside
+
+
+def _margin_ms(lo: float | None, hi: float | None, measured: float, outside: bool) -> float | None:
+    """How far (ms) ``measured`` sits from the edge that decided it: the nearer edge, or,
+    outside the window, the edge it is beyond."""
+    nearest = None
+    for edge in (None if lo is None else measured - lo, None if hi is None else hi - measured):
+        if edge is None or (outside and edge >= 0):
+            continue
+        distance = -edge if outside else abs(edge)
+        if nearest is None or distance < nearest:
+            nearest = distance
+    return None if nearest is None else round(nearest * 1e3, 3)
+
+
+class Measured:
+    """One interval judged against a :class:`Window`, standing in for its :class:`Finding`
+    among the observations :func:`combine` and :func:`combine_local` aggregate: they read
+    every observation's verdict and figures but the detail text and evidence of only the few
+    a verdict shows (the worst, a lone deviation), so only those are built; a run judges tens
+    of thousands of character gaps. A FAIL or WARN is built at once: the finding's own rules
+    (:class:`Finding`: evidence, the rule's level) may change its verdict."""
+
+    __slots__ = ("_finding", "_window", "margin_ms", "measured", "measured_ms", "uncertainty",
+                 "verdict", "evidence_lines")  # fmt: skip
+
+    observed = 1  # one measured interval between two observed wire events
+
+    def __init__(
+        self, window: Window, measured: float, uncertainty: float, evidence: list[str] | None
+    ) -> None:
+        lo, hi = window.lo, window.hi
+        self._window = window
+        self.measured = measured
+        self.uncertainty = uncertainty
+        self.evidence_lines = evidence
+        self._finding: Finding | None = None
+        self.measured_ms = round(measured * 1e3, 3)
+        if (lo is None or measured - uncertainty >= lo) and (
+            hi is None or measured + uncertainty <= hi
+        ):  # surely inside, as nearly every one is: _window_verdict's PASS, without the call
+            self.verdict = Verdict.PASS
+            self.margin_ms = _margin_ms(lo, hi, measured, False)
+            return
+        verdict, outside = _window_verdict(lo, hi, measured, uncertainty, window.should)
+        if verdict is Verdict.FAIL or verdict is Verdict.WARN:
+            self._finding = window.judge(measured, uncertainty, evidence)
+            verdict = self._finding.verdict
+        self.verdict = verdict
+        self.margin_ms = _margin_ms(lo, hi, measured, outside)
+
+    @property
+    def finding(self) -> Finding:
+        """The finding :func:`judge_window` gives for this interval."""
+        if self._finding is None:
+            self._finding = self._window.judge(self.measured, self.uncertainty, self.evidence_lines)
+        return self._finding
+
+    @property
+    def requirement(self) -> str:
+        return self._window.requirement
+
+    @property
+    def detail(self) -> str:
+        return self.finding.detail
+
+    @property
+    def evidence(self) -> list[str]:
+        # a copy: what combine() hands on may be extended by its reader, and the observations
+        # may be shared by several judges of one run
+        return list(self.finding.evidence)
+
+    @property
+    def limit_ms(self) -> float | None:
+        return self.finding.limit_ms
+
+    @property
+    def uncertainty_ms(self) -> float | None:
+        return round(self.uncertainty * 1e3, 3)
+
+    @property
+    def decision(self) -> str | None:
+        return self._window.decision
 
 
 def recheck(findings: list[Finding], uncertainty: float) -> int:
@@ -355,7 +479,7 @@ def plural(what: str) -> str:
 
 
 def combine(
-    rid: str, findings: list[Finding], what: str, *, smallest_is_worst: bool = False
+    rid: str, findings: Sequence[Finding | Measured], what: str, *, smallest_is_worst: bool = False
 ) -> Finding:
     """One finding per requirement out of many observations: the worst verdict (and, among
     equals, the largest measurement, or the smallest for minimum limits such as a break's
@@ -363,7 +487,11 @@ def combine(
     if not findings:
         return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
     sign = -1 if smallest_is_worst else 1
-    worst = max(findings, key=lambda f: (f.verdict.rank, sign * abs(f.measured_ms or 0)))
+    # the first with the worst verdict and, among those, the largest (smallest) measurement
+    top = max({f.verdict for f in findings}, key=lambda v: v.rank)
+    worst = max(
+        (f for f in findings if f.verdict is top), key=lambda f: sign * abs(f.measured_ms or 0)
+    )
     values = [f.measured_ms for f in findings if f.measured_ms is not None]
     count = f"{len(findings)} {plural(what) if len(findings) != 1 else what}"
     span = f"{count}, {min(values):.2f}..{max(values):.2f} ms" if values else ""

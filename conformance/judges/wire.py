@@ -9,6 +9,8 @@ chatter) (:class:`~conformance.view.runs.Segment`).
 
 from __future__ import annotations
 
+from math import copysign
+
 from ..protocol.responses import split_line
 from ..protocol.timing import (
     CHAR_TIME,
@@ -18,13 +20,15 @@ from ..protocol.timing import (
 )
 from ..transcript import Event, escape
 from ..verdicts import Finding, Verdict
-from ..view.runs import Segment, frames, runs, segments
+from ..view.runs import Segment, Segments, frames, runs, segments
 from ..view.sides import expected_reply_address
 from .tally import Tally
 from .timing import (
+    Measured,
     Observation,
     Place,
     StampUncertainty,
+    Window,
     combine_local,
     judge_window,
     stamp_uncertainty,
@@ -68,10 +72,20 @@ def starts_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty
     """The commands whose replies :func:`judge_response_start` wants observed again: rare
     deviations on a real-time link not yet placed (:func:`~.timing.to_confirm`)."""
     stamps = stamp_uncertainty(uncertainty)
+    if stamps.local is None:  # a virtual clock: nothing to confirm (to_confirm)
+        return []
     early, late = _start_observations(segs, stamps)
-    real = stamps.local is not None
-    both = to_confirm(early, real_time=real) + to_confirm(late, real_time=real)
+    both = to_confirm(early, real_time=True) + to_confirm(late, real_time=True)
     return list(dict.fromkeys(both))
+
+
+#: R-7.0-09 and R-7.0-10, against which every reply's start is judged
+EARLY_WINDOW = Window(
+    "R-7.0-09", "first response start bit after the command", low=CHAR_TIME, tolerance=TOLERANCE
+)
+LATE_WINDOW = Window(
+    "R-7.0-10", "first response start bit after the command", high=RESPONSE_START_MAX
+)
 
 
 def _start_observations(
@@ -87,35 +101,8 @@ def _start_observations(
         tainted = u > stamps.base
         where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
         place: Place = (seg.text, _text(seg), 0)
-        early.append(
-            (
-                judge_window(
-                    "R-7.0-09",
-                    "first response start bit after the command",
-                    delay,
-                    u,
-                    low=CHAR_TIME,
-                    tolerance=TOLERANCE,
-                    evidence=where,
-                ),
-                tainted,
-                place,
-            )
-        )
-        late.append(
-            (
-                judge_window(
-                    "R-7.0-10",
-                    "first response start bit after the command",
-                    delay,
-                    u,
-                    high=RESPONSE_START_MAX,
-                    evidence=where,
-                ),
-                tainted,
-                place,
-            )
-        )
+        early.append((Measured(EARLY_WINDOW, delay, u, where), tainted, place))
+        late.append((Measured(LATE_WINDOW, delay, u, where), tainted, place))
     return early, late
 
 
@@ -134,21 +121,38 @@ def reply_char_pairs(segs: list[Segment]) -> list[tuple[Event, Event]]:
     return [(a, b) for _gap, _where, a, b, _p in _gaps(segs)]
 
 
-def _gaps(segs: list[Segment]) -> list[tuple[float, str, Event, Event, Place]]:
+Gap = tuple[float, str, Event, Event, Place]
+
+
+def _gaps(segs: list[Segment]) -> list[Gap]:
+    """Each gap with its place (:func:`_cut_gaps`), cut once per :class:`Segments`."""
+    if isinstance(segs, Segments):
+        return segs.derived("_wire_gaps", None, lambda: _cut_gaps(segs))
+    return _cut_gaps(segs)
+
+
+def _cut_gaps(segs: list[Segment]) -> list[Gap]:
     """Each gap with its place: the command and the index of the character after the gap
     among everything the sensor sent after it (where a device's own gap recurs)."""
-    gaps = []
+    gaps: list[Gap] = []
+    add = gaps.append
     for seg in segs:
-        where = ""
+        if not seg.reply and not seg.later:
+            continue
         text = _text(seg)
+        where = f"in reply to {escape(seg.text)}"
+        multiline = seg.multiline
         first = 0  # index of the run's first character in all the sensor sent after it
         # the whole reply, however long a gap inside it: a gap is R-7.0-12's evidence
         for run in [seg.reply, *runs(seg.later)]:
-            for k, (a, b) in enumerate(zip(run, run[1:], strict=False), start=first + 1):
-                if seg.multiline and a.char7 == 0x0A:
-                    continue  # between lines of multi-line text: R-4.4.13.1-03's 150 ms
-                where = where or f"in reply to {escape(seg.text)}"
-                gaps.append((b.start - a.end, where, a, b, (seg.text, text, k)))
+            k = first
+            a = None
+            for b in run:
+                if a is not None and not (multiline and a.char7 == 0x0A):
+                    # (between lines of multi-line text: R-4.4.13.1-03's 150 ms)
+                    add((b.start - a.end, where, a, b, (seg.text, text, k)))
+                a = b
+                k += 1
             first += len(run)
     return gaps
 
@@ -172,23 +176,46 @@ def gaps_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty) 
     """The commands whose replies :func:`judge_gaps` wants observed again: rare deviating
     gaps on a real-time link not yet placed (:func:`~.timing.to_confirm`)."""
     stamps = stamp_uncertainty(uncertainty)
-    return to_confirm(_gap_observations(segs, stamps), real_time=stamps.local is not None)
+    if stamps.local is None:  # a virtual clock: nothing to confirm (to_confirm)
+        return []
+    return to_confirm(_gap_observations(segs, stamps), real_time=True)
+
+
+#: R-7.0-12's limit, against which every character gap of a run is judged
+GAP_WINDOW = Window(
+    "R-7.0-12", "marking between response characters", high=INTER_CHAR_GAP_MAX, tolerance=0.0
+)
 
 
 def _gap_observations(segs: list[Segment], stamps: StampUncertainty) -> list[Observation]:
+    """Every gap judged (:data:`GAP_WINDOW`), once per :class:`Segments` and stamps: the
+    rule's judge and its confirmation probe read the same observations."""
+    if isinstance(segs, Segments):
+        return segs.derived("_wire_gap_observations", stamps, lambda: _observe_gaps(segs, stamps))
+    return _observe_gaps(segs, stamps)
+
+
+def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observation]:
+    """Each gap judged against :data:`GAP_WINDOW`. A run's gaps take few distinct values in
+    the reply to one command (a simulated sensor's are exact; a real link's stamps are
+    quantised), and equal gaps judge alike: each distinct ``(gap, uncertainty, where)`` is
+    judged once and its :class:`~.timing.Measured` stands for every gap of that value."""
+    judged: dict[tuple[float, float, str], Measured] = {}
     observed: list[Observation] = []
+    add = observed.append
+    local = stamps.local is not None
+    base = stamps.base
     for gap, where, a, b, place in _gaps(segs):
-        u = stamps.between(a.start, b.end)
-        finding = judge_window(
-            "R-7.0-12",
-            "marking between response characters",
-            gap,
-            u,
-            high=INTER_CHAR_GAP_MAX,
-            tolerance=0.0,
-            evidence=[where],
-        )
-        observed.append((finding, u > stamps.base, place))
+        u = stamps.between(a.start, b.end) if local else base
+        # -0.0 == 0.0 as a key, but not in a detail text: a negative zero is judged apart
+        if (not gap and copysign(1.0, gap) < 0) or (not u and copysign(1.0, u) < 0):
+            measured = Measured(GAP_WINDOW, gap, u, [where])
+        else:
+            key = (gap, u, where)
+            measured = judged.get(key)
+            if measured is None:
+                measured = judged[key] = Measured(GAP_WINDOW, gap, u, [where])
+        add((measured, u > base, place))
     return observed
 
 

@@ -87,15 +87,18 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     waits = []
     command: list[Event] = []
     reply: list[Event] = []
+    # _ends_command(command) and _line_done(reply), kept as the two grow (asked per event)
+    commanded = replied = False
     for e in [*wire, None]:
         ends_exchange = e is None or e.kind is EventKind.BREAK
         if e is not None and e.origin == TOOL and e.kind is EventKind.CHAR:
-            ends_exchange = bool(reply) or _ends_command(command)
+            ends_exchange = bool(reply) or commanded
         if ends_exchange:
             wait = _announced_wait(command, reply)
             if wait is not None:
                 waits.append(wait)
             command, reply = [], []
+            commanded = replied = False
         if e is None:
             continue
         if e.kind is EventKind.BREAK:
@@ -104,8 +107,10 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
             continue
         if e.origin == TOOL:
             command.append(e)
-        elif _ends_command(command) and not _line_done(reply):
+            commanded = _ends_command(command)
+        elif commanded and not replied:
             reply.append(e)
+            replied = _line_done(reply)
     return waits
 
 

@@ -637,7 +637,7 @@ class HtmlReportPlugin:
         """For a timing case without evidence, the run's exchange behind its worst finding."""
         if record.evidence or not is_timing_case(record) or self.run.link is None:
             return None
-        return exchange_behind(record.findings, self.run.link.transcript.events)
+        return exchange_behind(record.findings, self.run.link.transcript)
 
     @pytest.hookimpl(wrapper=True)
     def pytest_runtest_makereport(self, item: Any, call: Any):

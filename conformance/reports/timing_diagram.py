@@ -29,9 +29,10 @@ from ..protocol.timing import (
     STANDBY_MARKING,
     TOLERANCE,
 )
-from ..transcript import TOOL, Event, EventKind
+from ..transcript import TOOL, Event, EventKind, Transcript
 from ..transcript import escape as escape_wire
 from ..verdicts import Finding
+from ..view.runs import transcript_segments
 
 PX_PER_MS = 5.0  # one 8.33 ms character is 42 px: room for "CR"/"LF" at reading size
 ELIDE_OVER = 0.14  # s: idle stretches longer than this are cut out of the axis
@@ -511,32 +512,23 @@ def _measures(seg: Segment) -> list[float]:
     return out
 
 
-_last_cut: tuple[Sequence[Event], int, list[Segment]] | None = None
-
-
-def _cut(events: Sequence[Event]) -> list[Segment]:
-    """:func:`segments` of the run's transcript, cut once for the several whole-run cases."""
-    global _last_cut
-    if _last_cut is None or _last_cut[0] is not events or _last_cut[1] != len(events):
-        _last_cut = (events, len(events), segments(events))
-    return _last_cut[2]
-
-
 def exchange_behind(
-    findings: Sequence[Finding], events: Sequence[Event]
+    findings: Sequence[Finding], events: Sequence[Event] | Transcript
 ) -> tuple[str, list[Event]] | None:
     """The exchange of the run behind a whole-run case's worst timing finding.
 
     Whole-run cases judge every reply of the transcript and attach no evidence; their finding
     keeps the worst measured value. The segment holding an interval equal to that value (the
-    first, if several do) is the one a reader needs to see drawn.
+    first, if several do) is the one a reader needs to see drawn. Given the run's
+    :class:`Transcript`, the cut the whole-run cases judged is reused.
     """
     timed = [f for f in findings if f.measured_ms is not None]
-    if not timed or not events:
+    if not timed or not len(events):
         return None
     target = max(timed, key=lambda f: f.verdict.rank)
+    cut = transcript_segments(events) if isinstance(events, Transcript) else segments(events)
     best, distance = None, float("inf")
-    for seg in _cut(events):
+    for seg in cut:
         for m in _measures(seg):
             if abs(m - target.measured_ms) < distance:
                 best, distance = seg, abs(m - target.measured_ms)

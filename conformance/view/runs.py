@@ -17,13 +17,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
 from ..protocol.timing import NO_BREAK_WINDOW
-from ..transcript import Event, decode_8n1
-from .segments import IsRecorder, Transmission, read_view
+from ..transcript import Event, Transcript, decode_8n1
+from .segments import IsRecorder, Transmission, _memo, read_view
 from .sides import ETX, LF, STX
+
+T = TypeVar("T")
 
 #: How a gap's stamps are worth where it lies: ``(start, end) -> uncertainty`` (s).
 GapUncertainty = Callable[[float, float], float]
@@ -76,8 +79,9 @@ class Segment:
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
         )
         clash = {id(e) for e in t.contention}
+        answerable = t.is_command  # asked once, not per character heard
         for e in t.heard:
-            if not t.is_command or id(e) in clash:
+            if not answerable or id(e) in clash:
                 seg.contention.append(e)  # not a reply: it met the command (or its tail did)
             else:
                 _place(seg, e)
@@ -100,9 +104,27 @@ def _place(seg: Segment, e: Event) -> None:
         seg.reply.append(e)  # a gap never ends a reply: R-7.0-12 judges it
 
 
-def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> list[Segment]:
+class Segments(list[Segment]):
+    """The segments of one recording (a list), holding what judges derive from them: a run's
+    whole-run cases read the same segments several times (a rule's judge and the probe that
+    asks what it wants confirmed), and derive the gaps and their observations once."""
+
+    def derived(self, name: str, key: object, build: Callable[[], T]) -> T:
+        """``build()``, kept under ``name`` while ``key`` (and the list's length) stays the
+        same."""
+        return _memo(self, name, (len(self), key), build)
+
+
+def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> Segments:
     """The recording's transmissions, regrouped for timing evidence."""
-    return [Segment.of(t) for t in read_view(events, is_recorder).transmissions]
+    return Segments(Segment.of(t) for t in read_view(events, is_recorder).transmissions)
+
+
+def transcript_segments(transcript: Transcript) -> Segments:
+    """:func:`segments` of a run's whole transcript, cut once per length (a transcript is
+    append-only): the whole-run cases and the report's timing diagrams read the same cut."""
+    events = transcript.events
+    return _memo(transcript, "_segments", len(events), lambda: segments(events))
 
 
 def runs(events: list[Event], gap: float = RUN_GAP) -> list[list[Event]]:

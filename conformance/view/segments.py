@@ -380,6 +380,7 @@ def read_view(
     unanswerable: list[Event] = []
     pending: Event | None = None
     current: Transmission | None = None
+    is_command = False  # current.is_command, kept as its characters come (asked per event)
     for e in ordered:
         if e.kind is EventKind.CHAR:
             chars.append(e)
@@ -387,12 +388,14 @@ def read_view(
             if e.kind is EventKind.BREAK:
                 breaks.append(e)
                 pending, current = e, None
-            elif current is None or (current.is_command and e.start - current.end >= NEW_COMMAND):
+            elif current is None or (is_command and e.start - current.end >= NEW_COMMAND):
                 current = Transmission(pending, [e], part=part)
                 transmissions.append(current)
                 pending = None
+                is_command = current.is_command
             else:
                 current.chars.append(e)
+                is_command = current.is_command
         elif e.kind is EventKind.CHAR:
             if current is not None:
                 current.heard.append(e)

@@ -14,6 +14,7 @@ import pytest
 from conformance.judges import wire
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
+from conformance.view.runs import transcript_segments
 
 requirements = pytest.mark.requirements
 pytestmark = pytest.mark.whole_run
@@ -22,8 +23,7 @@ pytestmark = pytest.mark.whole_run
 def _segments(sensor):
     """The run's transcript cut into segments, once the standard stimuli are on it."""
     sensor.standard_stimuli()
-    events = sensor.link.transcript.events
-    return sensor.once(("segments", len(events)), lambda: wire.segments(events))
+    return transcript_segments(sensor.link.transcript)  # cut once, shared with the report
 
 
 def _confirmed(sensor, case, wanted):

@@ -1,0 +1,63 @@
+"""CPU of one simulated run, side by side for two checkouts (issue 22).
+
+Run: ``python benchmarks/run_cpu.py [--runs N] [--port PORT ...] TREE [TREE ...]``, each
+TREE a folder holding a checkout (``git worktree`` or ``git archive`` of an older commit).
+Each run is one fresh process (bytecode caching on, as in CI) timing
+``conformance.matrix.run_once(PORT)`` with ``time.process_time``; the trees take turns, so a
+machine whose load drifts weighs on both alike. Prints every run, then per port the median
+CPU of each tree and its ratio to the first tree's. A benchmark, not a test: the figures
+depend on the machine, the ratios much less.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+ONE_RUN = (
+    "import json, sys, time\n"
+    "from conformance.matrix import run_once\n"
+    "started = time.process_time()\n"
+    "data = run_once(sys.argv[1])\n"
+    "print(json.dumps({'cpu': time.process_time() - started,"
+    " 'verdict': data['summary']['verdict']}))\n"
+)
+
+
+def one_run(tree: Path, port: str) -> dict:
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env["PYTHONPATH"] = str(tree)
+    done = subprocess.run(
+        [sys.executable, "-c", ONE_RUN, port],
+        cwd=tree, env=env, capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("trees", nargs="+", type=Path)
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--port", action="append", dest="ports")
+    args = parser.parse_args()
+    ports = args.ports or ["sim", "sim://?faults=wrong-crc"]
+    for port in ports:
+        cpu: dict[Path, list[float]] = {tree: [] for tree in args.trees}
+        for n in range(args.runs):
+            for tree in args.trees:
+                found = one_run(tree, port)
+                cpu[tree].append(found["cpu"])
+                print(f"{port} run {n + 1} {tree}: {found['cpu']:.2f} s CPU, {found['verdict']}")
+        first = statistics.median(cpu[args.trees[0]])
+        for tree in args.trees:
+            median = statistics.median(cpu[tree])
+            print(f"{port}: {tree} median {median:.2f} s CPU, {first / median:.2f}x the first")
+
+
+if __name__ == "__main__":
+    main()

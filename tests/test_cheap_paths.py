@@ -1,0 +1,203 @@
+"""The cheap ways a run is judged and written (issue 22) give what the plain ways gave:
+a :class:`~conformance.judges.timing.Measured` stands for its finding in every aggregate,
+the gap observations are shared, not recomputed, transcript.jsonl keeps its bytes, and the
+collector's pace is restored after a run."""
+
+from __future__ import annotations
+
+import gc
+import json
+import math
+import random
+from dataclasses import asdict
+
+import pytest
+
+from conformance import gc_pace
+from conformance.judges import wire
+from conformance.judges.timing import (
+    Measured,
+    StampUncertainty,
+    Window,
+    combine,
+    combine_local,
+    judge_window,
+    to_confirm,
+)
+from conformance.transcript import DUT, TOOL, Event, EventKind, Transcript, to_wire_7e1
+from conformance.view.runs import Segments
+
+WINDOWS = [
+    Window("R-7.0-12", "gap", high=1.66e-3, tolerance=0.0),
+    Window("R-7.0-09", "start", low=8.33e-3),
+    Window("R-7.0-10", "start", low=7.93e-3, high=15.0e-3, decision="A1"),
+    Window("R-4.4.5-09", "wait", high=1.0, should=True),  # a WARN, never a FAIL
+    Window("R-4.1-01", "spacing", low=8.1e-3, high=8.5e-3, tolerance=0.0),
+]
+
+
+def _interval(rng: random.Random, window: Window) -> tuple[float, float]:
+    edge = window.high if window.high is not None else window.low
+    measured = edge * rng.choice([0.0, 0.5, 0.99, 1.0, 1.001, 1.2, 3.0, -0.0])
+    uncertainty = rng.choice([0.0, 1e-5, 2e-4, edge * 0.05])
+    return measured, uncertainty
+
+
+def test_a_measured_interval_is_its_finding() -> None:
+    rng = random.Random(7)
+    for window in WINDOWS:
+        for _ in range(200):
+            measured, u = _interval(rng, window)
+            evidence = rng.choice([None, [], ["reply to 0M!"]])
+            m = Measured(window, measured, u, evidence)
+            f = judge_window(
+                window.requirement, window.what, measured, u, low=window.low,
+                high=window.high, tolerance=window.tolerance, should=window.should,
+                evidence=evidence, decision=window.decision,
+            )  # fmt: skip
+            assert asdict(m.finding) == asdict(f)
+            for key in ("verdict", "measured_ms", "margin_ms", "uncertainty_ms", "limit_ms",
+                        "detail", "evidence", "observed", "decision", "requirement"):  # fmt: skip
+                assert getattr(m, key) == getattr(f, key), key
+
+
+@pytest.mark.parametrize("real_time", [False, True])
+def test_aggregates_of_measured_intervals_equal_those_of_findings(real_time: bool) -> None:
+    """combine_local and to_confirm over Measured stand-ins give what they give over the
+    findings: on a virtual clock and on a real-time link (set-aside, rare and recurring
+    deviations, places)."""
+    rng = random.Random(3)
+    window = WINDOWS[0]
+    for trial in range(150):
+        observed_m, observed_f = [], []
+        for _ in range(rng.choice([1, 3, 12, 40])):
+            measured = rng.choice([0.0, 0.4e-3, 1.2e-3, 1.6e-3, 1.7e-3, 2.5e-3])
+            if rng.random() < 0.9:
+                measured = min(measured, 1.5e-3)  # mostly conforming: rare deviations
+            u = rng.choice([0.0, 0.0, 0.05e-3, 0.3e-3])
+            tainted = u > 0.1e-3
+            place = (f"0D{rng.randrange(2)}!", "0+1.0<CR><LF>", rng.randrange(3))
+            m = Measured(window, measured, u, ["in reply to 0D0!"])
+            observed_m.append((m, tainted, place))
+            observed_f.append((m.finding if trial % 2 else window.judge(measured, u, ["in reply to 0D0!"]), tainted, place))  # noqa: E501
+        for smallest in (False, True):
+            a = combine_local("R-7.0-12", observed_m, "character gap", smallest_is_worst=smallest,
+                              real_time=real_time)  # fmt: skip
+            b = combine_local("R-7.0-12", observed_f, "character gap", smallest_is_worst=smallest,
+                              real_time=real_time)  # fmt: skip
+            assert asdict(a) == asdict(b)
+        assert to_confirm(observed_m, real_time=real_time) == to_confirm(
+            observed_f, real_time=real_time
+        )
+        found = [o[0] for o in observed_m]
+        assert asdict(combine("R-7.0-12", found, "gap")) == asdict(
+            combine("R-7.0-12", [m.finding for m in found], "gap")
+        )
+
+
+def test_what_combine_hands_on_is_not_the_shared_observation() -> None:
+    """Observations are shared by a run's judges: extending a combined finding's evidence
+    leaves the next combination as it was."""
+    window = WINDOWS[0]
+    observed = [(Measured(window, 2e-3, 0.0, ["in reply to 0M!"]), False, None)]
+    first = combine_local("R-7.0-12", observed, "character gap", real_time=False)
+    first.evidence.append("more")
+    again = combine_local("R-7.0-12", observed, "character gap", real_time=False)
+    assert again.evidence == ["in reply to 0M!"]
+
+
+def _reply(t: float, text: str, gap: float) -> list[Event]:
+    out = []
+    for ch in text:
+        out.append(Event(EventKind.CHAR, DUT, t, t + 8.33e-3, wire=to_wire_7e1(ord(ch))))
+        t += 8.33e-3 + gap
+    return out
+
+
+def _command(t: float, text: str) -> list[Event]:
+    return [
+        Event(EventKind.CHAR, TOOL, t + i * 8.33e-3, t + (i + 1) * 8.33e-3,
+              wire=to_wire_7e1(ord(c)))
+        for i, c in enumerate(text)
+    ]  # fmt: skip
+
+
+def _run() -> list[Event]:
+    events = [Event(EventKind.BREAK, TOOL, 0.0, 0.013)]
+    events += _command(0.03, "0D0!")
+    events += _reply(0.03 + 4 * 8.33e-3 + 0.010, "0+1.5+22.25\r\n", 0.3e-3)
+    events += _command(0.4, "0D1!")
+    events += _reply(0.4 + 4 * 8.33e-3 + 0.010, "0+1.5+2.25\r\n", 1.9e-3)
+    return events
+
+
+def test_gap_judges_share_one_cut_and_judge_it_as_a_plain_list_would() -> None:
+    segs = wire.segments(_run())
+    assert isinstance(segs, Segments)
+    stamps = StampUncertainty(0.1e-3, lambda a, b: 0.4e-3 if a < 0.4 else 0.0)
+    cached = [asdict(f) for f in wire.judge_gaps(segs, stamps)]
+    assert cached == [asdict(f) for f in wire.judge_gaps(list(segs), stamps)]
+    assert wire._gaps(segs) is wire._gaps(segs)  # cut once per segments
+    observed = wire._gap_observations(segs, stamps)
+    assert wire._gap_observations(segs, stamps) is observed  # judged once per stamps
+    assert wire._gap_observations(segs, StampUncertainty(0.1e-3)) is not observed
+    assert wire.gaps_to_confirm(segs, stamps) == wire.gaps_to_confirm(list(segs), stamps)
+    verdicts = {f["requirement"]: f["verdict"] for f in cached}
+    assert verdicts["R-7.0-12"] == "FAIL"  # the 1.9 ms gaps of the second reply
+
+
+def test_equal_gaps_share_a_judgement_but_not_a_signed_zero() -> None:
+    segs = Segments(wire.segments(_run()))
+    observed = wire._observe_gaps(segs, StampUncertainty(0.0))
+    assert len({id(o[0]) for o in observed}) < len(observed)
+    window = wire.GAP_WINDOW
+    negative = Measured(window, -0.0, 0.0, ["x"])
+    assert negative.detail != Measured(window, 0.0, 0.0, ["x"]).detail  # why it is apart
+
+
+def test_transcript_lines_are_what_the_json_module_writes(tmp_path) -> None:
+    events = [
+        *_run(),
+        Event(EventKind.NOTE, TOOL, 0.0, 0.0, text='run-options {"port": "sim"} é\u2013\n'),
+        Event(EventKind.CHAR, "sensor-1", 1.25, 1.26, wire=0x8D, uncertainty=2.5e-4),
+        Event(EventKind.BREAK, TOOL, 3, 4),  # int stamps: the json module's way
+        Event(EventKind.CHAR, DUT, 5.0, math.inf, wire=1),
+        Event(EventKind.CHAR, DUT, 6.0, 6.1, wire=2, duration_uncertainty=1e-6),
+        Event(EventKind.CHAR, DUT, 7.0, 7.1, wire=True),  # a bool is not an int to json
+        Event(EventKind.CHAR, DUT, 1e-320, 123456789.123456789, text="\x00\t\\"),
+    ]
+    path = tmp_path / "t.jsonl"
+    Transcript(list(events)).write_jsonl(str(path))
+    expected = "".join(json.dumps(e.to_json()) + "\n" for e in events)
+    assert path.read_text(encoding="utf-8") == expected
+
+
+def test_the_collector_is_paced_for_a_run_and_restored_after() -> None:
+    before = gc.get_threshold()
+    pace = gc_pace.slow_down()
+    try:
+        assert gc.get_threshold() == gc_pace.RUN_THRESHOLDS
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc_pace.restore(pace)
+    assert gc.get_threshold() == before
+    assert gc.get_freeze_count() == 0
+
+
+def test_a_run_paces_the_collector_and_leaves_it_as_found(tmp_path) -> None:
+    from conformance.plugin import run_in_process
+    from conformance.suite import suite_args
+
+    seen = []
+
+    class Probe:
+        def pytest_runtest_call(self, item):
+            seen.append(gc.get_threshold())
+
+    before = gc.get_threshold()
+    args = suite_args("sensor", "sim", tmp_path, rootdir=tmp_path, html=False)
+    code, document = run_in_process([*args, "-k", "test_query_address"], plugins=[Probe()])
+    assert document is not None
+    assert seen and set(seen) == {gc_pace.RUN_THRESHOLDS}
+    assert gc.get_threshold() == before
+    assert gc.get_freeze_count() == 0
