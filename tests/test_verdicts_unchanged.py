@@ -71,8 +71,9 @@ def dump(digested: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-#: one run in a fresh process: what the exploration case sends (and so what every whole-run
-#: rule judges) depends on the modules the process loaded; a fresh process loads the same
+#: one run in a process of its own, as a user's run is (the exploration no longer depends on
+#: the modules a process loaded, tests/test_exploration_repro.py; the fresh process keeps
+#: every other state of a pytest worker out of the comparison too)
 RUN_SCRIPT = (
     "import json, sys\n"
     "from conformance.matrix import run_once\n"

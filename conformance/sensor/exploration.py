@@ -14,6 +14,8 @@ from __future__ import annotations
 import getpass
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 from hypothesis import HealthCheck, Phase, settings
@@ -235,26 +237,57 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
 
     keep_hypothesis_out_of_the_working_folder()
     try:
-        run_state_machine_as_test(
-            SensorMachine,
-            settings=settings(
-                max_examples=examples,
-                stateful_step_count=steps,
-                derandomize=True,
-                database=None,
-                deadline=None,
-                phases=[Phase.generate],
-                report_multiple_bugs=False,
-                suppress_health_check=list(HealthCheck),
-                print_blob=False,
-            ),
-        )
+        with no_local_constants():
+            _run(SensorMachine, examples, steps)
     except BaseException as exc:  # hypothesis may wrap the failure; find ours inside
         broken = record.broken or _first_broken(exc)
         if broken is None or isinstance(exc, KeyboardInterrupt):
             raise
         record.broken = broken
     return record
+
+
+def _run(machine: type[RuleBasedStateMachine], examples: int, steps: int) -> None:
+    run_state_machine_as_test(
+        machine,
+        settings=settings(
+            max_examples=examples,
+            stateful_step_count=steps,
+            derandomize=True,
+            database=None,
+            deadline=None,
+            phases=[Phase.generate],
+            report_multiple_bugs=False,
+            suppress_health_check=list(HealthCheck),
+            print_blob=False,
+        ),
+    )
+
+
+@contextmanager
+def no_local_constants() -> Iterator[None]:
+    """Hypothesis draws now and then from the constants of the non-library modules loaded
+    in the process (its "local constants"), so a derandomised exploration sent other
+    sequences in a pytest process that had loaded other test modules than the CLI does: the
+    same sensor got other stimuli, and other whole-run counts. A certificate's stimuli must
+    not depend on what else the process imported: the exploration sees none of them (an
+    internal of hypothesis; without it, the library's own behaviour stays)."""
+    try:
+        from hypothesis.internal.conjecture import providers
+
+        original = providers._get_local_constants
+        empty = providers.Constants()
+        cache = providers.CONSTANTS_CACHE.cache
+    except (ImportError, AttributeError):  # another hypothesis: nothing to hold still
+        yield
+        return
+    cache.clear()  # it holds the local constants allowed per kind of draw
+    providers._get_local_constants = lambda: empty
+    try:
+        yield
+    finally:
+        providers._get_local_constants = original
+        cache.clear()
 
 
 def moved_by_malformed(junk: str, reply: str, address: str) -> str | None:

@@ -1,0 +1,41 @@
+"""The exploration sends the same sequences whatever else the process has imported:
+hypothesis mixes the constants of loaded non-library modules into its draws, so a run in a
+pytest process with other test modules loaded explored differently from the CLI's run."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+
+from conformance.ports import open_sim, parse_sim
+from conformance.sensor import exploration
+from conformance.sensor.session import SensorSession
+
+
+def _explored() -> list[str]:
+    opened = open_sim(parse_sim("sim"))
+    session = SensorSession(opened.link, declaration=opened.declaration)
+    session.discover()
+    return exploration.explore(session).log  # the sequences a run sends
+
+
+def _load_module_full_of_constants(folder) -> None:
+    """A local module whose constants a draw could pick: strings of the junk alphabet, small
+    integers and floats."""
+    junk = [f'"{a}{b}{c}"' for a in "MDCR" for b in "0123" for c in "+-._"]
+    numbers = [str(n) for n in range(2, 400, 7)] + [f"{n / 8}" for n in range(1, 60)]
+    path = folder / "sdi12_local_constants.py"
+    path.write_text(f"JUNK = [{', '.join(junk)}]\nNUMBERS = [{', '.join(numbers)}]\n")
+    spec = importlib.util.spec_from_file_location("sdi12_local_constants", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["sdi12_local_constants"] = module
+    spec.loader.exec_module(module)
+
+
+def test_the_exploration_does_not_depend_on_the_modules_loaded(tmp_path):
+    before = _explored()
+    _load_module_full_of_constants(tmp_path)
+    try:
+        assert _explored() == before
+    finally:
+        sys.modules.pop("sdi12_local_constants", None)
