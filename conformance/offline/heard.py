@@ -22,7 +22,6 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..view.records import rebuild_records
 from ..view.runs import Segment
 from ..view.segments import TranscriptView, read_view
-from .judge import describe_decode
 from .recording_link import RecordingLink
 
 #: ambiguity reasons quoted in the notes (the count is always given)
@@ -39,6 +38,8 @@ def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     that the wire does not settle (direction, framing), with the first few reasons."""
     notes = list(link.notes)
     if link.decoded is not None:
+        from .judge import describe_decode  # the capture side, only for a capture
+
         notes += describe_decode(link.decoded)
     found = view.ambiguities()
     if found:

@@ -12,14 +12,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
-from ..capture import CaptureDecode, CaptureError, decode_capture
+from ..capture.errors import CaptureError
 from ..links.base import LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
 from ..replay.recording import RecordingError, read_recording
 from ..transcript import EventKind, Transcript
+
+if TYPE_CHECKING:
+    from ..capture import CaptureDecode
 
 SCHEME = "recording:"
 FORMATS = ("jsonl", "sr", "vcd", "csv")
@@ -133,6 +137,8 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
             bit_timing=_bit_timing(recording.options),
         )  # fmt: skip
         return RecordingLink(spec, info, Transcript(list(recording.events)), uncertainty, notes)
+    from ..capture import decode_capture  # the decoder (and numpy) only for a capture
+
     try:
         decoded = decode_capture(
             spec.path,
