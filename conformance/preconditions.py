@@ -59,6 +59,10 @@ CODES: Mapping[str, str] = MappingProxyType(
 )
 
 
+#: How a passive run says a rule's traffic is not in the recording (offline/heard.py).
+NOT_SEEN = "not seen in the recording"
+
+
 class PreconditionError(ValueError):
     """A declaration that names an unknown code or a requirement the case does not judge."""
 
@@ -141,6 +145,14 @@ def declared(item: Any, requirements: Sequence[str]) -> Declaration:
     if marker is None:
         return Declaration()
     return declaration(marker.args, marker.kwargs, requirements)
+
+
+def declared_on(fn: Any, requirements: Sequence[str]) -> Declaration:
+    """The declaration on a case function itself (a test that runs one case by hand)."""
+    marks = [m for m in getattr(fn, "pytestmark", []) if m.name == MARKER]
+    if not marks:
+        return Declaration()
+    return declaration(marks[0].args, marks[0].kwargs, requirements)
 
 
 # -- the checks, from the wire --------------------------------------------------------------
@@ -380,6 +392,4 @@ def overheard(items: Sequence[Any], what: str) -> Unmet | None:
     measurements of the rule's kind in the recording) is not empty; ``what`` names them."""
     if items:
         return None
-    from .offline.heard import NOT_SEEN
-
     return Unmet("heard", f"{NOT_SEEN}: {what}")
