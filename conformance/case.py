@@ -25,6 +25,9 @@ if TYPE_CHECKING:
 
 #: Verdicts about the device, which a precondition the wire did not show voids.
 JUDGED = (Verdict.PASS, Verdict.WARN, Verdict.FAIL)
+#: What a precondition met only in part voids (:attr:`Unmet.partial`): a FAIL on what did
+#: happen stands.
+WHOLE = (Verdict.PASS, Verdict.WARN)
 
 
 class Case:
@@ -50,13 +53,22 @@ class Case:
     def add(self, *findings: Finding) -> None:
         self.extend(findings)
 
-    def requires(self, code: str, unmet: Unmet | None) -> bool:
+    def requires(
+        self, code: str, unmet: Unmet | None, only: Iterable[str] | None = None
+    ) -> bool:
         """Apply the outcome of a declared precondition's check
         (:mod:`conformance.preconditions`): True when it held. When it did not, every
         requirement it guards is INCONCLUSIVE "precondition not met: <code>: ..." with the
         evidence, and a PASS, WARN or FAIL for it, found before or after, is dropped. A code
-        the case did not declare is a case bug (ERROR), so a declaration cannot lag its code."""
+        the case did not declare is a case bug (ERROR), so a declaration cannot lag its code.
+        ``only`` narrows the requirements voided to those of them (a rule whose FAIL is the
+        very absence the precondition notes keeps that FAIL)."""
         guarded = self.preconditions.guarded(code) if self.preconditions else ()
+        if only is not None and guarded:
+            guarded = tuple(r for r in guarded if r in set(only)) or ()
+            if not guarded:
+                self._note(code, unmet)
+                return unmet is None
         if not guarded:
             for rid in self.record.requirements:
                 self.record.findings.append(
@@ -68,20 +80,44 @@ class Case:
                     )
                 )
             return unmet is None
-        self.record.preconditions[code] = "met" if unmet is None else unmet.text
+        if unmet is not None and unmet.code != code:
+            raise ValueError(f"precondition {code!r} checked with a {unmet.code!r} outcome")
+        self._note(code, unmet)
         if unmet is None:
             return True
         for rid in guarded:
             if rid in self._blocked:
                 continue
             self._blocked[rid] = unmet
+            voided = _voided(unmet)
             self.record.findings = [
                 f
                 for f in self.record.findings
-                if not (f.requirement == rid and f.verdict in JUDGED)
+                if not (f.requirement == rid and f.verdict in voided)
             ]
-            self._append(unmet.finding(rid))
+            self._append(self._versioned(unmet.finding(rid)))
         return False
+
+    def _note(self, code: str, unmet: Unmet | None) -> None:
+        """Record the check for the report: the first reason it failed stands over a later
+        "met" (a code checked per requirement may hold for one and not another)."""
+        if unmet is not None:
+            self.record.preconditions.setdefault(code, unmet.text)
+            if self.record.preconditions[code] == "met":
+                self.record.preconditions[code] = unmet.text
+        else:
+            self.record.preconditions.setdefault(code, "met")
+
+    def _versioned(self, f: Finding) -> Finding:
+        """N/A for a rule the DUT's claimed version does not bind, whatever was found."""
+        version = self._version() if callable(self._version) else self._version
+        if version and not requirement(f.requirement).applies_to_version(version):
+            return not_applicable(
+                f.requirement,
+                f"rule binds SDI-12 v1.4 only; the DUT claims v{version[0]}.{version[1]}",
+                test=self.record.nodeid,
+            )
+        return f
 
     def extend(self, findings: Iterable[Finding]) -> None:
         version = self._version() if callable(self._version) else self._version
@@ -101,7 +137,9 @@ class Case:
                     f"rule binds SDI-12 v1.4 only; the DUT claims v{version[0]}.{version[1]}",
                     test=self.record.nodeid,
                 )
-            elif f.requirement in self._blocked and f.verdict in JUDGED:
+            elif f.requirement in self._blocked and f.verdict in _voided(
+                self._blocked[f.requirement]
+            ):
                 continue  # its precondition failed: the INCONCLUSIVE saying so stands
             self._append(f)
 
@@ -116,6 +154,10 @@ class Case:
     def evidence(self, label: str, record: Any) -> None:
         """Attach the wire events behind a record (Exchange, Measurement or events)."""
         self.record.evidence.append((label, events_of(record)))
+
+
+def _voided(unmet: Unmet) -> tuple[Verdict, ...]:
+    return WHOLE if unmet.partial else JUDGED
 
 
 def events_of(record: Any) -> list[Event]:

@@ -26,7 +26,7 @@ from .judges.support import serves_measurement
 from .protocol.timing import STANDBY_MARKING, TOLERANCE
 from .tool_recorder.records import Exchange, Measurement
 from .transcript import TOOL, Event, decode_7e1, escape
-from .verdicts import Finding, inconclusive
+from .verdicts import Finding, inconclusive, not_applicable
 
 MARKER = "preconditions"
 MARKER_HELP = (
@@ -59,6 +59,10 @@ CODES: Mapping[str, str] = MappingProxyType(
 )
 
 
+#: How a passive run says a rule's traffic is not in the recording (offline/heard.py).
+NOT_SEEN = "not seen in the recording"
+
+
 class PreconditionError(ValueError):
     """A declaration that names an unknown code or a requirement the case does not judge."""
 
@@ -72,6 +76,12 @@ class Unmet:
     evidence: tuple[str, ...] = ()
     #: the rule whose deviation probably removed the precondition (root_causes.py links it)
     consequence_of: str | None = None
+    #: the capability is absent (an optional feature not served, by declaration or on the
+    #: wire): its rules do not apply, N/A, rather than undecided
+    absent: bool = False
+    #: the stimulus happened in part (a scenario cut short): a FAIL on what the wire did show
+    #: stands beside the INCONCLUSIVE; a PASS or WARN, which would speak for the whole, does not
+    partial: bool = False
 
     def __post_init__(self) -> None:
         if self.code not in CODES:
@@ -82,6 +92,8 @@ class Unmet:
         return f"precondition not met: {self.code}: {self.detail}"
 
     def finding(self, rid: str) -> Finding:
+        if self.absent:
+            return not_applicable(rid, self.text)
         return inconclusive(
             rid, self.text, evidence=list(self.evidence), consequence_of=self.consequence_of
         )
@@ -121,7 +133,8 @@ def declaration(
     stray = sorted({r for rids in guards.values() for r in rids} - set(requirements))
     if stray:
         raise PreconditionError(f"preconditions guard {stray}, which the case does not judge")
-    if "none" in guards and len(guards) > 1:
+    if "none" in args and len(guards) > 1:
+        # 'none' for named requirements may stand beside codes guarding the others
         raise PreconditionError("'none' cannot stand beside other preconditions")
     return Declaration(MappingProxyType(guards))
 
@@ -132,6 +145,14 @@ def declared(item: Any, requirements: Sequence[str]) -> Declaration:
     if marker is None:
         return Declaration()
     return declaration(marker.args, marker.kwargs, requirements)
+
+
+def declared_on(fn: Any, requirements: Sequence[str]) -> Declaration:
+    """The declaration on a case function itself (a test that runs one case by hand)."""
+    marks = [m for m in getattr(fn, "pytestmark", []) if m.name == MARKER]
+    if not marks:
+        return Declaration()
+    return declaration(marks[0].args, marks[0].kwargs, requirements)
 
 
 # -- the checks, from the wire --------------------------------------------------------------
@@ -248,12 +269,23 @@ def aborted(undisturbed: Measurement, service_requests_after: list[list[Event]])
     return None
 
 
-def buffered(m: Measurement | None, what: str = "measurement") -> Unmet | None:
-    """The buffer holds values when a measurement delivered at least one."""
+def buffered(
+    m: Measurement | None, what: str = "measurement", detail: str | None = None
+) -> Unmet | None:
+    """The buffer holds values when a measurement delivered at least one (``detail``, if
+    given, says what the missing values leave unjudged)."""
     if m is not None and m.value_count:
         return None
     evidence = (cited(m.start),) if m is not None else ()
-    return Unmet("buffered", f"no {what} delivered values to compare", evidence)
+    return Unmet("buffered", detail or f"no {what} delivered values to compare", evidence)
+
+
+def buffered_any(
+    ms: Sequence[Measurement], what: str = "measurement", detail: str | None = None
+) -> Unmet | None:
+    """:func:`buffered` over several measurements: one that delivered values is enough."""
+    first = next((m for m in ms if m.value_count), ms[0] if ms else None)
+    return buffered(first, what, detail)
 
 
 def supported(m: Measurement, what: str | None = None) -> Unmet | None:
@@ -267,3 +299,97 @@ def supported(m: Measurement, what: str | None = None) -> Unmet | None:
         f"{name} was not shown served (no well-formed reply announcing values): {shown(m.start)}",
         (cited(m.start),),
     )
+
+
+def served(present: bool, detail: str, evidence: Iterable[str] = ()) -> Unmet | None:
+    """An optional capability is judged only where it was shown served (a well-formed answer
+    of its own kind, judges/support.py) or declared; ``detail`` says what was missing. Its
+    rules are N/A then, not undecided: the capability is absent, not unobserved."""
+    if present:
+        return None
+    return Unmet("supported", detail, tuple(evidence), absent=True)
+
+
+def shown_supported(
+    present: bool, detail: str, evidence: Iterable[str] = ()
+) -> Unmet | None:
+    """A capability the rule needs was not shown although the sensor must (or says it does)
+    have it: INCONCLUSIVE, since its absence is another rule's FAIL, not this one's N/A."""
+    if present:
+        return None
+    return Unmet("supported", detail, tuple(evidence))
+
+
+def answers_at(
+    control: Exchange | None, address: str, what: str, *, absent: bool = False
+) -> Unmet | None:
+    """The address judged against is the one the sensor has now: ``control``, a command at
+    ``address`` sent just before or after, was answered from it (``absent``: what the rule
+    is about did not happen at all, N/A rather than undecided)."""
+    if control is not None and control.answered:
+        return None  # what its reply starts with is the rule's to judge, not the precondition's
+    return Unmet(
+        "address",
+        f"the sensor was not shown at address '{address}' ({what})"
+        + (f": {shown(control)}" if control is not None else ""),
+        (cited(control),) if control is not None else (),
+        absent=absent,
+    )
+
+
+def silence_listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
+    """:func:`listening` where silence is judged: a probe that was answered is evidence
+    whatever its control did, so only all-silent probes need a listening sensor."""
+    if any(p.probe.answered for p in probes):
+        return None
+    return listening(probes)
+
+
+def answered_control(controls: Sequence[Exchange], what: str) -> Unmet | None:
+    """Silence is evidence only from a sensor shown listening: one of ``controls`` (its own
+    address, asked the same way) was answered."""
+    if any(ex.answered for ex in controls):
+        return None
+    return Unmet(
+        "listening",
+        "the sensor answered none of its own-address controls ("
+        + ", ".join(escape(ex.text) for ex in controls)
+        + f"), so its silence {what} shows nothing",
+        tuple(cited(ex) for ex in controls[:3]),
+    )
+
+
+def woke(wakes: Sequence[Exchange]) -> Unmet | None:
+    """The sensor was shown awake: it answered one of the wake-up ``a!`` (break, a!,
+    retries) sent before the probes whose silence or answer is judged."""
+    if any(ex.answered for ex in wakes):
+        return None
+    return Unmet(
+        "awake",
+        "the sensor did not answer the wake-up a!",
+        tuple(cited(ex) for ex in wakes[:2]),
+    )
+
+
+def silence_awake(answered: bool, marking: float, uncertainty: float) -> Unmet | None:
+    """:func:`awake` where it matters: a command that was answered judges no silence, so the
+    marking before it needs no bound."""
+    return None if answered else awake(marking, uncertainty)
+
+
+def acted(errors: Sequence[str]) -> Unmet | None:
+    """The recorder was made to act in the scenarios the rule is about: each ran to its end
+    (``errors``: why one did not). A driver that failed before the recorder said anything
+    stops the run (RecorderSession._check_setup), so what is left is a scenario cut short:
+    what the recorder did send is still judged (a FAIL stands), but no PASS speaks for it."""
+    if not errors:
+        return None
+    return Unmet("recorder", "; ".join(errors), partial=True)
+
+
+def overheard(items: Sequence[Any], what: str) -> Unmet | None:
+    """A passive run judges only traffic it overheard: ``items`` (the exchanges, commands or
+    measurements of the rule's kind in the recording) is not empty; ``what`` names them."""
+    if items:
+        return None
+    return Unmet("heard", f"{NOT_SEEN}: {what}")

@@ -23,6 +23,7 @@ from conformance.judges.timing import (
     judge_window,
 )
 from conformance.ports import open_sim, parse_sim
+from conformance.preconditions import declared_on
 from conformance.results import CaseRecord
 from conformance.sensor.session import PROBE_TRIES, SensorSession
 from conformance.sim.bus import SimLink
@@ -70,7 +71,9 @@ def _real_time_session(
 
 def _judged(case_fn, session: SensorSession, rid: str):
     record = CaseRecord(case_fn.__name__, case_fn.__name__, (rid, "R-7.0-01"))
-    case_fn(session, Case(record))
+    case_fn(
+        session, Case(record, preconditions=declared_on(case_fn, record.requirements))
+    )
     return {f.requirement: f for f in record.findings}, record
 
 
@@ -190,7 +193,9 @@ def _sim_session(faults: str = "") -> SensorSession:
 
 def _follow_up(session: SensorSession):
     record = CaseRecord(follow_up_case.__name__, follow_up_case.__name__, ("R-7.0-16",))
-    follow_up_case(session, Case(record))
+    follow_up_case(
+        session, Case(record, preconditions=declared_on(follow_up_case, record.requirements))
+    )
     (found,) = record.findings
     return found
 
@@ -242,7 +247,9 @@ def test_a_slow_waker_fails_r_7_0_07_though_the_first_probe_went_out_past_100ms(
     session = _sim_session("slow-wake")
     monkeypatch.setattr(SimLink, "write", write)
     record = CaseRecord(wake_case.__name__, wake_case.__name__, ("R-7.0-07",))
-    wake_case(session, Case(record))
+    wake_case(
+        session, Case(record, preconditions=declared_on(wake_case, record.requirements))
+    )
     (found,) = record.findings
     assert count["n"] == 1
     assert found.verdict is Verdict.FAIL, found.detail

@@ -14,6 +14,7 @@ import pytest
 from conformance.case import Case
 from conformance.judges.timing import not_listening
 from conformance.ports import open_sim, parse_sim
+from conformance.preconditions import declared_on
 from conformance.results import CaseRecord
 from conformance.sensor.session import PROBE_TRIES, SensorSession
 from conformance.sim.bus import SimLink
@@ -68,7 +69,9 @@ def test_a_probe_whose_echo_was_lost_is_sent_again_and_lands_where_it_aimed(monk
 
 def _judged(case_fn, session: SensorSession, rid: str):
     record = CaseRecord(case_fn.__name__, case_fn.__name__, (rid,))
-    case_fn(session, Case(record))
+    case_fn(
+        session, Case(record, preconditions=declared_on(case_fn, record.requirements))
+    )
     return record.findings
 
 

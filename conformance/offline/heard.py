@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from ..declaration import normalise_version
 from ..judges.exchanges import identification
 from ..judges.timing import StampUncertainty
+from ..preconditions import NOT_SEEN as _NOT_SEEN
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
 from ..protocol.responses import Identification
 from ..protocol.values import split_values
@@ -29,8 +30,9 @@ AMBIGUITIES_SHOWN = 3
 LAST_INDEX = 9  # aD9!: the last data command after aM!/aC!
 LAST_HV_INDEX = 999  # aD999!/aDB999!: the last after aHA!/aHB!
 EMPTY_PACKET = 6  # bytes of a binary packet holding no value (address, size, type, CRC)
-#: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS).
-NOT_SEEN = "not seen in the recording"
+#: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS): the
+#: wording of the ``heard`` precondition (conformance/preconditions.py), re-exported here.
+NOT_SEEN = _NOT_SEEN
 
 
 def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:

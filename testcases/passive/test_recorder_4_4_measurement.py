@@ -13,7 +13,7 @@ from conformance.judges.recorder.retries import judge_retries
 from conformance.judges.recorder.waits import judge_concurrent_waits, judge_measure_waits
 from conformance.verdicts import Verdict
 
-from ._helpers import not_seen, only, unseen
+from ._helpers import judged, judged_only, unseen_rule
 
 requirements = pytest.mark.requirements
 
@@ -29,7 +29,7 @@ def test_waiting_for_the_service_request(heard_recorder, case):
     then asks for aD0! at once, and talks to no other sensor until the data are in."""
     case.expect("aD0! not before the service request / ttt; within 0.5 s after it")
     u = heard_recorder.uncertainty
-    case.extend(unseen(judge_measure_waits(_taken(heard_recorder), u)))
+    judged(case, judge_measure_waits(_taken(heard_recorder), u))
 
 
 @requirements("R-4.4.7-06")
@@ -38,7 +38,7 @@ def test_concurrent_waits(heard_recorder, case):
     """After a concurrent reply, no data command to that sensor before ttt."""
     case.expect("first data command to each sensor at least ttt after its 'atttnn' reply")
     u = heard_recorder.uncertainty
-    case.extend(unseen(judge_concurrent_waits(_taken(heard_recorder), u)))
+    judged(case, judge_concurrent_waits(_taken(heard_recorder), u))
 
 
 @requirements("R-4.4.8-05")
@@ -47,7 +47,7 @@ def test_data_continuation(heard_recorder, case):
     """D0, D1, D2... until every announced value is in; the measurement again after an empty
     D reply."""
     case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
-    case.extend(unseen(judge_data_collection(_taken(heard_recorder))))
+    judged(case, judge_data_collection(_taken(heard_recorder)))
 
 
 @requirements("R-5.1-04", "R-5.2-08")
@@ -58,7 +58,7 @@ def test_high_volume(heard_recorder, case):
     question of what it can do, not of what one recording shows: not judged here.)"""
     case.expect("0D10!..0D14! (never 0D010!); DB0..DBn read, then stop")
     found = judge_high_volume(_taken(heard_recorder), heard_recorder.is_v14)
-    case.extend(only(found, *case.requirements))
+    judged_only(case, found, *case.requirements)
 
 
 @requirements("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-7.2-06")
@@ -66,7 +66,7 @@ def test_high_volume(heard_recorder, case):
 def test_retries(heard_recorder, case):
     """Recorded retries after no reply or an invalid one come inside the section 7.2 windows."""
     case.expect("retry 16.67-87 ms after an unanswered command; up to three sequences")
-    case.extend(unseen(judge_retries(heard_recorder.view, heard_recorder.uncertainty)))
+    judged(case, judge_retries(heard_recorder.view, heard_recorder.uncertainty))
 
 
 @requirements("R-4.3-03", "R-4.3-04")
@@ -77,7 +77,8 @@ def test_addresses(heard_recorder, case):
     case.expect("a valid exchange with each of the sensors at 0..9; only valid addresses")
     for f in judge_addresses(heard_recorder.view, heard_recorder.uncertainty):
         if f.requirement == "R-4.3-03" and f.verdict is not Verdict.PASS:
-            f = not_seen("R-4.3-03", f"polls that answered at {f.detail.split(': ', 1)[-1]}")
+            unseen_rule(case, "R-4.3-03", f"polls that answered at {f.detail.split(': ', 1)[-1]}")
         elif f.requirement == "R-4.3-04" and f.verdict is Verdict.NA:
-            f = not_seen("R-4.3-04", "no letter address used")
-        case.add(f)
+            unseen_rule(case, "R-4.3-04", "no letter address used")
+        else:
+            judged(case, [f])

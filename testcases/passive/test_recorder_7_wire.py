@@ -15,7 +15,7 @@ from conformance.judges.recorder.commands import (
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
 
-from ._helpers import only, unseen
+from ._helpers import judged, judged_only
 
 requirements = pytest.mark.requirements
 
@@ -25,7 +25,7 @@ requirements = pytest.mark.requirements
 def test_breaks(heard_recorder, case):
     """Every recorded break lasts at least 12 ms and is followed by 8.33 ms of marking."""
     case.expect("break >= 12 ms (-0.40); marking before the command >= 8.33 ms (-0.40)")
-    case.extend(unseen(judge_breaks(heard_recorder.view, heard_recorder.uncertainty)))
+    judged(case, judge_breaks(heard_recorder.view, heard_recorder.uncertainty))
 
 
 @requirements("R-7.0-17", "R-7.1-01")
@@ -35,7 +35,7 @@ def test_break_when_due(heard_recorder, case):
     before an aD0! that comes more than 87 ms after a service request."""
     case.expect("commands without a break only to the same sensor within 87 ms (+0.40)")
     found = judge_break_rules(heard_recorder.view, heard_recorder.uncertainty)
-    case.extend(only(found, *case.requirements))
+    judged_only(case, found, *case.requirements)
 
 
 @requirements("R-4.2-01", "R-4.4-04", "R-4.3-01")
@@ -43,7 +43,7 @@ def test_break_when_due(heard_recorder, case):
 def test_command_text(heard_recorder, case):
     """Recorded commands are printable, start with an address and end with their only '!'."""
     case.expect("printable ASCII; the address first; '!' last and nowhere else")
-    case.extend(unseen(judge_command_text(heard_recorder.view)))
+    judged(case, judge_command_text(heard_recorder.view))
 
 
 @requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")
@@ -52,8 +52,8 @@ def test_character_timing(heard_recorder, case):
     """At most 1.66 ms between command characters, at 1200 baud."""
     case.expect("every gap inside a command <= 1.66 ms; characters one 8.33 ms frame apart")
     view, u = heard_recorder.view, heard_recorder.uncertainty
-    case.extend(unseen(judge_character_gaps(view, u)))
+    judged(case, judge_character_gaps(view, u))
     if heard_recorder.link.info.bit_timing:
-        case.extend(unseen([judge_command_bit_rate(view, u)]))
+        judged(case, [judge_command_bit_rate(view, u)])
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))

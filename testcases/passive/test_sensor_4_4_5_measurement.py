@@ -8,7 +8,7 @@ import pytest
 from conformance.judges import measurements as judge
 from conformance.protocol.commands import Kind
 
-from ._helpers import unseen
+from ._helpers import judged
 
 requirements = pytest.mark.requirements
 
@@ -20,7 +20,7 @@ def test_measurement_reply(heard_sensors, case):
     case.expect("'atttn<CR><LF>' to each recorded aM!-type command")
     ms = heard_sensors.of_kind(Kind.MEASURE, Kind.VERIFY)
     case.evidence("recorded M-family replies", [m.start for m in ms])
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")
@@ -30,7 +30,7 @@ def test_service_request(heard_sensors, case):
     case.expect("exactly 'a<CR><LF>' within ttt of the reply; ttt not much longer than needed")
     ms = [m for m in heard_sensors.of_kind(Kind.MEASURE, Kind.VERIFY, whole=True) if m.ttt]
     case.evidence("recorded measurements with ttt > 0", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements("R-4.4.7-01", "R-4.4.7-02", "R-4.4.7-03")
@@ -40,4 +40,4 @@ def test_concurrent_reply(heard_sensors, case):
     case.expect("'atttnn<CR><LF>' to each recorded aC!-type command")
     ms = heard_sensors.of_kind(Kind.CONCURRENT)
     case.evidence("recorded C-family replies", [m.start for m in ms])
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))

@@ -8,7 +8,7 @@ import pytest
 from conformance.judges import measurements as judge
 from conformance.protocol.commands import Kind
 
-from ._helpers import unseen
+from ._helpers import judged
 
 requirements = pytest.mark.requirements
 ASCII = (Kind.MEASURE, Kind.VERIFY, Kind.CONCURRENT)
@@ -22,7 +22,7 @@ def test_data_replies(heard_sensors, case):
     case.expect("'a<values>[<CRC>]<CR><LF>'; sign + 1..7 digits + at most one '.'")
     ms = [m for m in heard_sensors.of_kind(*ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements("R-4.4.8-03", "R-4.4.8-04")
@@ -32,7 +32,7 @@ def test_announced_values_delivered(heard_sensors, case):
     case.expect("D0, D1, ... return exactly the announced number of values")
     ms = [m for m in heard_sensors.of_kind(*ASCII, Kind.HIGH_VOLUME_ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")
@@ -42,7 +42,7 @@ def test_value_grouping(heard_sensors, case):
     case.expect("every D reply starts with a sign; no empty Dk before a Dk+1 with values")
     ms = [m for m in heard_sensors.of_kind(*ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03", "R-4.4.12-05", "R-4.4.12-06")
@@ -53,7 +53,7 @@ def test_crc(heard_sensors, case):
     case.expect("3 CRC characters before CR LF exactly after aMC!/aCC!/aHA! and their match")
     ms = [m for m in heard_sensors.of_kind(*ASCII, Kind.HIGH_VOLUME_ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements("R-5.1-01", "R-5.1-02", "R-5.1-03")
@@ -63,7 +63,7 @@ def test_high_volume_ascii(heard_sensors, case):
     case.expect("'atttnnn<CR><LF>'; D replies of up to 75 characters with CRC")
     ms = heard_sensors.of_kind(Kind.HIGH_VOLUME_ASCII, whole=True)
     case.evidence("recorded aHA! measurements", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
 
 
 @requirements(
@@ -77,4 +77,4 @@ def test_high_volume_binary(heard_sensors, case):
     case.expect("packets: address, size, type, payload, CRC; the announced values in all")
     ms = heard_sensors.of_kind(Kind.HIGH_VOLUME_BINARY, whole=True)
     case.evidence("recorded aHB! measurements", ms)
-    case.extend(unseen(judge.judge(ms, case.requirements, heard_sensors.version)))
+    judged(case, judge.judge(ms, case.requirements, heard_sensors.version))

@@ -11,7 +11,7 @@ from conformance.judges import extended
 from conformance.judges.exchanges import reply_only_address
 from conformance.protocol.commands import Kind
 
-from ._helpers import not_seen, unseen
+from ._helpers import heard, judged
 
 requirements = pytest.mark.requirements
 
@@ -27,8 +27,7 @@ def test_acknowledge_active(heard_sensors, case):
     """Every recorded reply to a! is the address alone, then CR LF."""
     case.expect("'a<CR><LF>' to each answered a!")
     asked = [ex for ex in heard_sensors.exchanges_of(Kind.ACKNOWLEDGE) if ex.answered]
-    if not asked:
-        case.add(not_seen("R-4.4.1-01", "no answered a!"))
+    if not heard(case, asked, "no answered a!"):
         return
     case.evidence("recorded a! exchanges", asked)
     for ex in asked:
@@ -43,11 +42,10 @@ def test_extended_commands(heard_sensors, case):
     case.expect("'a...<CR><LF>' to each answered extended command")
     asked = heard_sensors.exchanges_of(Kind.EXTENDED)
     case.evidence("recorded extended commands", asked)
-    if not any(ex.answered for ex in asked):
-        case.add(*(not_seen(r, "no answered extended command") for r in case.requirements))
+    if not heard(case, [ex for ex in asked if ex.answered], "no answered extended command"):
         return
     for address, group in _by_address(asked):
-        case.extend(unseen(extended.extended_replies(list(group), address)))
+        judged(case, extended.extended_replies(list(group), address))
 
 
 @requirements("R-4.4.13.1-01", "R-4.4.13.1-02", "R-4.4.13.1-03")
@@ -57,9 +55,8 @@ def test_multiline_text(heard_sensors, case):
     75 characters a line, lines at most 150 ms apart."""
     case.expect("'a<STX>line<CR><LF>...<CR><LF><ETX>' framing and timing")
     multi = [ex for ex in heard_sensors.exchanges_of(Kind.EXTENDED) if extended.is_multiline(ex)]
-    if not multi:
-        case.add(*(not_seen(r, "no multi-line reply") for r in case.requirements))
+    if not heard(case, multi, "no multi-line reply"):
         return
     case.evidence("recorded multi-line replies", multi)
     for address, group in _by_address(multi):
-        case.extend(unseen(extended.multiline(list(group), address, heard_sensors.uncertainty)))
+        judged(case, extended.multiline(list(group), address, heard_sensors.uncertainty))

@@ -12,7 +12,7 @@ from conformance.links.base import NO_BIT_TIMING
 from conformance.protocol.commands import Kind
 from conformance.verdicts import inconclusive
 
-from ._helpers import not_seen, unseen
+from ._helpers import heard, judged
 
 requirements = pytest.mark.requirements
 
@@ -23,7 +23,7 @@ def test_response_start_window(heard_sensors, case):
     """Every recorded reply starts 7.93 to 15.40 ms after the command's last stop bit."""
     case.expect("8.33 ms (-0.40) <= delay <= 15.0 ms (+0.40), for every recorded reply")
     segs = heard_sensors.segments
-    case.extend(unseen(wire.judge_response_start(segs, heard_sensors.stamp_uncertainty)))
+    judged(case, wire.judge_response_start(segs, heard_sensors.stamp_uncertainty))
 
 
 @requirements("R-7.0-12", "R-7.0-01")
@@ -31,9 +31,7 @@ def test_response_start_window(heard_sensors, case):
 def test_character_gaps(heard_sensors, case):
     """No more than 1.66 ms of marking between the characters of a recorded reply."""
     case.expect("every inter-character gap of every recorded reply <= 1.66 ms")
-    case.extend(
-        unseen(wire.judge_gaps(heard_sensors.segments, heard_sensors.stamp_uncertainty))
-    )
+    judged(case, wire.judge_gaps(heard_sensors.segments, heard_sensors.stamp_uncertainty))
 
 
 @requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")
@@ -44,12 +42,10 @@ def test_reply_framing(heard_sensors, case):
     case.expect("even parity, printable characters, CR LF at the end, the address first")
     segs = heard_sensors.segments
     if heard_sensors.link.info.bit_timing:
-        case.extend(
-            unseen([wire.judge_reply_bit_rate(segs, heard_sensors.stamp_uncertainty)])
-        )
+        judged(case, [wire.judge_reply_bit_rate(segs, heard_sensors.stamp_uncertainty)])
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
-    case.extend(unseen(wire.judge_framing(segs, heard_sensors.stamp_uncertainty)))
+    judged(case, wire.judge_framing(segs, heard_sensors.stamp_uncertainty))
 
 
 @requirements("R-4.4.2-01", "R-4.4.2-02")
@@ -60,10 +56,9 @@ def test_identification(heard_sensors, case):
     asked = [
         ex for ex in heard_sensors.exchanges_of(Kind.IDENTIFY) if ex.answered
     ]
-    if not asked:
-        case.add(*(not_seen(r, "no answered aI!") for r in case.requirements))
+    if not heard(case, asked, "no answered aI!"):
         return
     case.evidence("recorded aI! exchanges", asked)
     for ex in asked:
         _, found = identification(ex, ex.command.address)
-        case.extend(unseen(found))
+        judged(case, found)

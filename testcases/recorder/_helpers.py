@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from conformance import preconditions as precondition
 from conformance.case import Case
 from conformance.recorder.scenarios import SCENARIOS
 from conformance.recorder.session import RecorderSession
@@ -16,15 +17,20 @@ def line_of(recorder: RecorderSession, case: Case, *names: str) -> TranscriptVie
     """
     chosen = [n for n in names if recorder.applies(n)]
     if not chosen:
-        case.not_applicable("these scenarios need a recorder claiming SDI-12 v1.4")
+        case.requires(
+            "recorder",
+            precondition.Unmet(
+                "recorder", "these scenarios need a recorder claiming SDI-12 v1.4", absent=True
+            ),
+        )
         return None
+    errors = []
     for name in chosen:
         run = recorder.run(name)
         case.evidence(f"scenario {name}: {SCENARIOS[name].describe()}", run.events)
         if run.error:
-            from conformance.verdicts import inconclusive
-
-            case.add(*(inconclusive(r, f"scenario {name}: {run.error}") for r in case.requirements))
+            errors.append(f"scenario {name}: {run.error}")
+    case.requires("recorder", precondition.acted(errors))
     return recorder.line(*chosen)
 
 

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
+from conformance.judges.support import serves_continuous
 from conformance.sensor.session import C_FAMILY, M_FAMILY
 from conformance.verdicts import Finding, passed, warned
 
@@ -30,6 +32,20 @@ def _with_continuous(sensor, ids) -> list[Finding]:
     return merged
 
 
+def _crc_served(sensor, case) -> None:
+    """A CRC is judged where one was asked for and served: a CRC-variant measurement that
+    announced values, or an aRCn! with values (CRC variants are mandatory from v1.3, so
+    their absence is R-4.4.12-01's FAIL and leaves these rules undecided, not N/A)."""
+    rc = [sensor.exchange(f"RC{i}") for i in range(10)]
+    case.requires(
+        "supported",
+        precondition.shown_supported(
+            bool(sensor.defined(CRC_CODES)) or any(serves_continuous(ex) for ex in rc),
+            "no CRC-variant measurement announced values and no aRCn! returned any",
+        ),
+    )
+
+
 @requirements("R-4.4.12-01")
 @pytest.mark.preconditions("none")
 def test_crc_commands_supported(sensor, case):
@@ -42,13 +58,14 @@ def test_crc_commands_supported(sensor, case):
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03")
-@pytest.mark.preconditions("supported")
+@pytest.mark.preconditions(supported=("R-4.4.12-02",), none=("R-4.4.12-03",))
 def test_crc_presence(sensor, case):
     """D replies after a CRC variant, and RC replies, end with 3 CRC characters; replies to
     the plain commands carry none."""
     case.expect("3 CRC characters before CR LF exactly where a CRC was asked for")
     case.evidence("D replies and R/RC replies", sensor.defined(M_FAMILY + C_FAMILY))
     case.extend(_with_continuous(sensor, case.requirements))
+    _crc_served(sensor, case)
 
 
 @requirements("R-4.4.12-03")
@@ -63,8 +80,12 @@ def test_crc_request_ends_with_its_command(sensor, case):
     meta = sensor.fresh_exchange("IMC_001")
     m = sensor.fresh_measurement("M")
     case.evidence("aIMC_001!, then aM! and its D replies", [meta, m])
-    if not meta.answered:
-        case.add(xjudge.inconclusive("R-4.4.12-03", "aIMC_001! got no reply to follow"))
+    if not case.requires(
+        "supported",
+        precondition.shown_supported(
+            meta.answered, "aIMC_001! got no reply to follow", [xjudge.cited(meta)]
+        ),
+    ):
         return
     case.extend(judge.judge([m], case.requirements, sensor.version))
 
@@ -77,6 +98,7 @@ def test_crc_value_and_encoding(sensor, case):
     case.expect("recomputed CRC equals the 3 characters sent")
     case.evidence("D replies and R/RC replies", sensor.defined(CRC_CODES))
     case.extend(_with_continuous(sensor, case.requirements))
+    _crc_served(sensor, case)
 
 
 @requirements("R-4.4.12-04")
@@ -92,6 +114,11 @@ def test_crc_variant_same_measurement(sensor, case):
         pairs.append((sensor.measurement(plain), sensor.measurement(twin)))
     case.evidence("plain and CRC measurement replies", [x.start for p in pairs for x in p])
     pairs = [(a, b) for a, b in pairs if a.count is not None and b.count is not None]
+    if not case.requires(
+        "supported",
+        precondition.shown_supported(bool(pairs), "no plain/CRC pair announced its counts"),
+    ):
+        return
     differ = [(a, b) for a, b in pairs if a.count != b.count]
     if differ:
         case.add(

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import extended as judge
 
 requirements = pytest.mark.requirements
@@ -21,11 +22,12 @@ def test_extended_commands(sensor, case):
     take the aX...! form (SHOULD)."""
     case.expect("'a...<CR><LF>' for each declared extended command; names start with X")
     names = declared(sensor)
-    if not names:
-        case.not_applicable(
-            "no extended command declared (extended commands are opt-in: list "
-            "them under [features] extended in the declaration)"
-        )
+    absent = precondition.served(
+        bool(names),
+        "no extended command declared (extended commands are opt-in: list "
+        "them under [features] extended in the declaration)",
+    )
+    if not case.requires("supported", absent):
         return
     exchanges = [sensor.exchange(name) for name in names]
     case.evidence("declared extended commands", exchanges)
@@ -42,13 +44,14 @@ def test_multiline_text(sensor, case):
     names = declared(sensor)
     exchanges = [sensor.exchange(name) for name in names]
     multi = [ex for ex in exchanges if judge.is_multiline(ex)]
-    if not multi:
-        case.not_applicable(
-            "no declared extended command answered with multi-line text "
-            "(multi-line text is optional)"
-            if names
-            else "no extended command declared (opt-in)"
-        )
+    absent = precondition.served(
+        bool(multi),
+        "no declared extended command answered with multi-line text "
+        "(multi-line text is optional)"
+        if names
+        else "no extended command declared (opt-in)",
+    )
+    if not case.requires("supported", absent):
         return
     case.evidence("multi-line replies", multi)
     case.extend(judge.multiline(multi, sensor.address, sensor.uncertainty))

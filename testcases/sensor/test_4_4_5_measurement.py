@@ -11,7 +11,7 @@ from conformance.judges.wire import runs
 from conformance.protocol.responses import is_service_request, split_line
 from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.transcript import decode_7e1, escape
-from conformance.verdicts import failed, inconclusive, passed, warned
+from conformance.verdicts import failed, passed, warned
 
 requirements = pytest.mark.requirements
 SR_FAMILY = M_FAMILY  # decision A5: the whole M family and V raise service requests
@@ -56,8 +56,9 @@ def test_service_request(sensor, case):
     )
     ms = [m for m in sensor.family(SR_FAMILY) if m.ttt]
     case.evidence("measurements with ttt > 0", ms)
-    if not ms:
-        case.not_applicable("no M-family measurement announced ttt > 0")
+    if not case.requires(
+        "supported", precondition.served(bool(ms), "no M-family measurement announced ttt > 0")
+    ):
         return
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
@@ -73,8 +74,10 @@ def test_ttt_zero(sensor, case):
         for code in SR_FAMILY
         if sensor.measurement(code).ttt == 0 and sensor.measurement(code).count
     ]
-    if not zero:
-        case.not_applicable("no measurement announced ttt = 000 with values")
+    if not case.requires(
+        "supported",
+        precondition.served(bool(zero), "no measurement announced ttt = 000 with values"),
+    ):
         return
     code = zero[0]
     start = sensor.fresh_exchange(code)
@@ -121,8 +124,9 @@ def test_no_service_request_after_concurrent(sensor, case):
     case.expect("no 'a<CR><LF>' between the atttnn/atttnnn reply and the D command")
     ms = [m for m in sensor.family(C_FAMILY + HV_FAMILY) if m.ttt]
     case.evidence("concurrent measurements", ms)
-    if not ms:
-        case.not_applicable("no concurrent measurement announced ttt > 0")
+    if not case.requires(
+        "supported", precondition.served(bool(ms), "no concurrent measurement announced ttt > 0")
+    ):
         return
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
@@ -134,8 +138,7 @@ def test_data_retained(sensor, case):
     """Data stay readable, unchanged, across a break, standby and non-measuring commands."""
     case.expect("the same D replies before and after: break, >100 ms idle, aI!, a!, break")
     m = next((m for m in sensor.family(("M", "MC", "V", *M_FAMILY)) if m.value_count), None)
-    if m is None:
-        case.add(inconclusive("R-4.4.5-10", "no M-type measurement delivered values to compare"))
+    if not case.requires("buffered", precondition.buffered(m, "M-type measurement")):
         return
     fresh = sensor.fresh_measurement(m.command.text()[1:-1])
     before = [ex.reply_text for ex in fresh.data]

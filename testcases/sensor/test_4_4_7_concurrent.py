@@ -34,8 +34,9 @@ def test_quiet_during_concurrent(sensor, case):
     case.expect("no character from the sensor while the concurrent measurement runs")
     ms = [m for m in sensor.family(C_FAMILY) if m.ttt]
     case.evidence("concurrent measurements with ttt > 0", ms)
-    if not ms:
-        case.not_applicable("no concurrent measurement announced ttt > 0")
+    if not case.requires(
+        "supported", precondition.served(bool(ms), "no concurrent measurement announced ttt > 0")
+    ):
         return
     case.extend(judge.judge(ms, case.requirements, sensor.version))
 
@@ -81,16 +82,20 @@ def test_concurrent_survives_break_and_other_traffic(sensor, case):
     measurement (decision A4)."""
     case.expect("all announced values delivered after a break and a foreign-address command")
     target = _running_concurrent(sensor)
-    if target is None:
-        case.not_applicable("no concurrent measurement with ttt > 0")
+    if not case.requires(
+        "supported",
+        precondition.served(target is not None, "no concurrent measurement with ttt > 0"),
+    ):
+        return
+    if not case.requires("buffered", precondition.buffered(target, "concurrent measurement")):
         return
     code = target.command.text()[1:-1]
     other = sensor.foreign_address()
     m, poke = sensor.disturbed_measurement(target.command, f"{other}I!")
     case.evidence(f"{code} with a break and {other}I! while it ran", [m, poke])
     unheard = precondition.heard_one_shot(sensor.hearing_marking(), f"{other}I!")
-    if m.value_count >= target.value_count and unheard is not None:
-        case.requires("listening", unheard)  # delivering all values shows nothing then
+    if m.value_count >= target.value_count and not case.requires("listening", unheard):
+        pass  # delivering all values shows nothing then
     elif m.value_count >= target.value_count:
         case.add(
             passed(
@@ -124,8 +129,12 @@ def test_own_command_aborts_concurrent(sensor, case):
     target = next(
         (m for m in sensor.family(("CC", "C", *C_FAMILY[2:])) if m.ttt and m.value_count), None
     )
-    if target is None:
-        case.not_applicable("no concurrent measurement with ttt > 0 and values")
+    if not case.requires(
+        "supported",
+        precondition.served(
+            target is not None, "no concurrent measurement with ttt > 0 and values"
+        ),
+    ):
         return
     code = target.command.text()[1:-1]
     sensor.fill_data_buffer(code)  # data kept from before the abort must show as values

@@ -23,6 +23,7 @@ def _unsupported(case, sensor, code):
     A sensor declared to support the command must not answer 'no values'."""
     m = sensor.measurement(code)
     if m.count or (m.start.answered and m.count is None):
+        case.requires("supported", None)
         return False
     if sensor.feature(FEATURE[code]) and FORMAT_RULE[code] in case.requirements:
         case.add(
@@ -33,11 +34,18 @@ def _unsupported(case, sensor, code):
                 observed=1,
             )
         )
-        case.not_applicable(
-            "no high-volume data to judge", [r for r in case.requirements if r != FORMAT_RULE[code]]
+        case.requires(
+            "supported",
+            precondition.served(False, "no high-volume data to judge", [xjudge.cited(m.start)]),
+            only=[r for r in case.requirements if r != FORMAT_RULE[code]],
         )
         return True
-    case.not_applicable(f"a{code}! announced no values: high-volume {code} not supported")
+    case.requires(
+        "supported",
+        precondition.served(
+            False, f"a{code}! announced no values: high-volume {code} not supported"
+        ),
+    )
     return True
 
 
@@ -145,8 +153,7 @@ def test_high_volume_is_concurrent(sensor, case):
     and other traffic, aborted by a valid command to the sensor itself."""
     case.expect("no SR; all values after a break + foreign command; none after an own aI!")
     codes = [c for c in ("HA", "HB") if sensor.supports(c)]
-    if not codes:
-        case.not_applicable("no high-volume support")
+    if not case.requires("supported", precondition.served(bool(codes), "no high-volume support")):
         return
     ms = [sensor.measurement(c) for c in codes]
     if any(m.ttt for m in ms):
@@ -172,9 +179,10 @@ def test_high_volume_is_concurrent(sensor, case):
                     observed=2,  # the undisturbed measurement and the disturbed one
                 )
             )
-        elif sensor.hearing_marking() is None:  # one code's FAIL above stands beside it
-            unheard = precondition.heard_one_shot(None, f"{other}I!")
-            case.add(unheard.finding("R-5.3-01"))
+        elif not case.requires(
+            "listening", precondition.heard_one_shot(sensor.hearing_marking(), f"{other}I!")
+        ):
+            pass  # its silence to the foreign command shows nothing: undecided
         elif not poke2.answered:
             case.add(
                 inconclusive(
@@ -200,17 +208,22 @@ def test_high_volume_is_concurrent(sensor, case):
                     observed=2,  # the kept and the stopped measurement
                 )
             )
-    disturbed = any(m.ttt and m.value_count for m in ms)
+    timed = [m for m in ms if m.ttt]
     if not case.record.findings:
-        case.not_applicable("no high-volume measurement with ttt > 0 and values to disturb")
-    elif not disturbed:
-        # the service-request half alone is not the rule: traffic and aborts went unjudged
-        case.add(
-            inconclusive(
-                "R-5.3-01",
-                "no HA/HB measurement with ttt > 0 delivered values, so whether a break, "
-                "other traffic or an own command disturbs one cannot be judged",
-                observed=len(ms),  # the measurements that delivered none: it outweighs the
-                evidence=[xjudge.shown(m.start) for m in ms],  # service-request half's PASS
-            )
+        case.requires(
+            "supported",
+            precondition.served(
+                False, "no high-volume measurement with ttt > 0 and values to disturb"
+            ),
         )
+        return
+    # the service-request half alone is not the rule: without values to disturb, traffic
+    # and aborts go unjudged, and the service-request half's PASS does not stand for it
+    case.requires(
+        "buffered",
+        precondition.buffered_any(
+            timed,
+            detail="no HA/HB measurement with ttt > 0 delivered values, so whether a break, "
+            "other traffic or an own command disturbs one cannot be judged",
+        ),
+    )

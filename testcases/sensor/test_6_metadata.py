@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata as judge
 from conformance.judges.support import serves_continuous
@@ -41,6 +42,11 @@ def test_identify_matches_measurement(sensor, case):
     case.expect("same atttn/atttnn/atttnnn shape and count; a ttt difference only warns")
     pairs = [(identify(sensor, code), sensor.measurement(code)) for code in DESCRIBED]
     case.evidence("identify replies", [p[0] for p in pairs])
+    both = any(i.answered and m.start.answered for i, m in pairs)
+    case.requires(
+        "supported",
+        precondition.shown_supported(both, "no identify command and its measurement both answered"),
+    )
     case.extend(judge.identify_matches(pairs))
 
 
@@ -51,8 +57,7 @@ def test_identify_starts_nothing(sensor, case):
     """An identify command starts no measurement: no service request, earlier data intact."""
     case.expect("no character after aIM!/aIC!/aIHA!; the D replies read before still come back")
     m = next((m for m in sensor.family(("M", "MC", "V", *M_FAMILY)) if m.value_count), None)
-    if m is None:
-        case.add(inconclusive("R-6.1-03", "no measurement delivered values to protect"))
+    if not case.requires("buffered", precondition.buffered(m, "measurement")):
         return
     fresh = sensor.fresh_measurement(m.command.text()[1:-1])
     wait = max((sensor.measurement(c).ttt or 0) for c in ("M", "V")) + 0.5
@@ -133,8 +138,9 @@ def test_parameter_metadata(sensor, case):
     case.expect("one well-formed record per value index 1..n of every measurement")
     plan = _metadata_plan(sensor)
     case.evidence("metadata commands", [p[0] for p in plan])
-    if not plan:
-        case.not_applicable("no measurement announces values")
+    if not case.requires(
+        "supported", precondition.served(bool(plan), "no measurement announces values")
+    ):
         return
     case.extend(judge.records(plan, case.requirements))
 
@@ -153,6 +159,10 @@ def test_metadata_invalid_index(sensor, case):
         plan.append((sensor.exchange(f"I{code}_000"), crc, False))
         plan.append((sensor.exchange(f"I{code}_{(m.count or 0) + 1:03d}"), crc, False))
     case.evidence("metadata with invalid indices", [p[0] for p in plan])
+    if not case.requires(
+        "supported", precondition.shown_supported(bool(plan), "no measurement gave a count")
+    ):
+        return
     case.extend(judge.records(plan, ("R-6.2-05",)))
 
 
@@ -203,8 +213,10 @@ def test_continuous_metadata(sensor, case):
                     f"{len(seq) - 1} record(s), but aR{i}! returns {values} value(s)",
                 )
     case.evidence("continuous metadata", evidence)
-    if not evidence:
-        case.not_applicable("the sensor serves no continuous measurement")
+    if not case.requires(
+        "supported",
+        precondition.served(bool(evidence), "the sensor serves no continuous measurement"),
+    ):
         return
     case.extend(tally.findings("records in turn, closed by the invalid-index reply"))
     _ = Kind

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance import preconditions as precondition
 from conformance.judges import wire
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
@@ -58,7 +59,9 @@ def test_character_gaps(sensor, case):
 
 
 @requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")
-@pytest.mark.preconditions("address")
+@pytest.mark.preconditions(
+    address=("R-4.3-01",), none=("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03")
+)
 def test_reply_framing(sensor, case):
     """Every reply is 1200 baud 7E1 (except aDBn! packets), printable, at least 3 characters
     ending in CR LF, and starts with the address of the sensor that answers."""
@@ -72,3 +75,8 @@ def test_reply_framing(sensor, case):
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
     case.extend(wire.judge_framing(segs, sensor.stamp_uncertainty))
+    # replies are judged against the address the sensor answered at (cached: no new traffic)
+    ack = sensor.exchange("")
+    case.requires(
+        "address", precondition.answers_at(ack, sensor.address, "a! at it got no reply")
+    )
