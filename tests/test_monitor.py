@@ -242,8 +242,16 @@ def test_bad_ports_and_options_exit_4_without_a_traceback(argv, capsys, tmp_path
 # -- real time: the monitor as a program beside an emulator and the golden recorder ------------
 def _start_emulator() -> tuple[subprocess.Popen, str, str]:
     proc = subprocess.Popen(
-        [sys.executable, "-m", "conformance.cli", "emulate", "--listen", "127.0.0.1:0",
-         "--tap", "socket://127.0.0.1:0"],
+        [
+            sys.executable,
+            "-m",
+            "conformance.cli",
+            "emulate",
+            "--listen",
+            "127.0.0.1:0",
+            "--tap",
+            "socket://127.0.0.1:0",
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -259,8 +267,17 @@ def _start_emulator() -> tuple[subprocess.Popen, str, str]:
 
 def _start_monitor(tap: str, report: Path, *extra: str) -> subprocess.Popen:
     proc = subprocess.Popen(
-        [sys.executable, "-m", "conformance.cli", "monitor", "--port", tap,
-         "--report-dir", str(report), *extra],
+        [
+            sys.executable,
+            "-m",
+            "conformance.cli",
+            "monitor",
+            "--port",
+            tap,
+            "--report-dir",
+            str(report),
+            *extra,
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -335,7 +352,9 @@ def test_monitor_shows_and_records_a_golden_recorder_talking_to_the_emulator(tmp
     assert written, out
     for path in written:
         rows = json.loads(path.read_text(encoding="utf-8"))["requirements"]
-        failed = [r["id"] for r in rows if r["verdict"] == "FAIL"]
+        failed = {
+            r["id"]: [f["detail"] for f in r["findings"]] for r in rows if r["verdict"] == "FAIL"
+        }
         assert not failed, (path, failed)  # the reference sensor and the golden recorder
     assert monitor.returncode in (0, 2), out
 
@@ -409,7 +428,11 @@ def test_a_break_read_as_a_nul_never_fails_the_break_length_rules():
     bus = Bus(uncertainty=0.1e-3)
     bus.events.append(
         Event(
-            EventKind.BREAK, BUS, 0.0, CHAR_TIME, uncertainty=0.1e-3,
+            EventKind.BREAK,
+            BUS,
+            0.0,
+            CHAR_TIME,
+            uncertainty=0.1e-3,
             duration_uncertainty=UNKNOWN_LENGTH,
         )
     )

@@ -73,7 +73,15 @@ class Heard:
 
     @property
     def stamp_uncertainty(self) -> StampUncertainty:
-        return StampUncertainty(self.link.uncertainty)
+        """The recording's uncertainty; for a host-stamped transcript also a (flat) local
+        figure, which makes the timing judges treat it as the real-time link it was: a rare
+        deviation among many conforming observations may be a stall of the recording host,
+        decided by where it falls, and INCONCLUSIVE when that cannot tell (a recording cannot
+        be probed again). A monitor's transcript FAILed R-7.0-12 on one stalled stamp."""
+        u = self.link.uncertainty
+        if self.link.host_stamped:
+            return StampUncertainty(u, local=lambda _start, _end: u)
+        return StampUncertainty(u)
 
     @property
     def version(self) -> str:

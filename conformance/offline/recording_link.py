@@ -109,6 +109,13 @@ class RecordingLink:
     notes: list[str] = field(default_factory=list)
     decoded: CaptureDecode | None = None  # a capture's decode figures (for the notes)
 
+    @property
+    def host_stamped(self) -> bool:
+        """A transcript of a real-time link (its stamps carry an uncertainty): a host that
+        stalled made some stamps late with no trace, as on a live link; a capture's stamps
+        are the analyser's samples, and a virtual-time run's are exact."""
+        return self.decoded is None and self.uncertainty > 0
+
     def now(self) -> float:
         events = self.transcript.events
         return max((e.end for e in events), default=0.0)
