@@ -40,6 +40,10 @@ def suite_args(
         "-p", "no:benchmark",  # pytest-benchmark, where installed, leaves .benchmarks/ behind
         "-p", "no:hypothesispytest",  # its import costs ~2 s a run; the cases use none of it
         "-p", "no:unraisableexception",  # its gc passes at the end cost ~0.3 s a run
+        # no output capture: the cases print nothing, and pytest's fd capture swallowed
+        # every repaint of the live progress bar once the first case started (it stood at
+        # "collecting the cases 0:00:00" for a whole run)
+        "--capture=no",
         "--pyargs", f"testcases.{role}",
         "--sdi12-port", port,
         "--sdi12-role", role,

@@ -111,3 +111,36 @@ def test_the_device_being_found_is_shown_while_it_takes(drawn):
 def test_the_bar_counts_cases_and_says_so(drawn):
     frames, _ = drawn
     assert any(re.search(r"\b1/2 cases\b", t) for _, t in frames.writes)
+
+
+def test_the_real_command_on_a_terminal_shows_cases_being_counted(tmp_path):
+    """The CLI itself in a pty: the bar moves past 'collecting the cases' while the cases run.
+    pytest's output capture used to swallow every repaint after the first case started, so a
+    whole run showed '0/? cases 0:00:00 collecting the cases' and then the summary."""
+    import os
+    import pty
+    import select
+    import sys
+
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: the command, its stdout a terminal
+        env = {k: v for k, v in os.environ.items() if not k.startswith("PYTEST")}
+        os.execve(sys.executable, [sys.executable, "-m", "conformance.cli", "--port", "sim",
+                                   "--report-dir", str(tmp_path / "r")], env)  # fmt: skip
+    out = b""
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([fd], [], [], 0.5)
+        if not ready:
+            continue
+        try:
+            chunk = os.read(fd, 65536)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        out += chunk
+    os.waitpid(pid, 0)
+    text = ANSI.sub("", out.decode("utf-8", "replace"))
+    counted = re.findall(r"(\d+)/(\d+) cases", text)
+    assert any(0 < int(done) < int(total) for done, total in counted), text[-2000:]
