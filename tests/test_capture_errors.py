@@ -100,6 +100,15 @@ def test_binary_garbage(tmp_path):
     fails(path, "binary data")
 
 
+@pytest.mark.parametrize("lead", [b"{", b" \t{", b"$date", b"time,"])
+def test_binary_garbage_that_starts_like_a_text_format(tmp_path, lead):
+    """Random bytes whose first characters spell a text format's start are binary data, not
+    a transcript, VCD or CSV (CI drew such a file once: 'a transcript, not a capture')."""
+    path = tmp_path / "garbage.sr"
+    path.write_bytes(lead + bytes(range(128, 256)) * 16)
+    fails(path, "binary data")
+
+
 def test_unknown_text_format(tmp_path):
     path = tmp_path / "notes.txt"
     path.write_text("just some text\nthat is no capture\n")
