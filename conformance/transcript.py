@@ -156,13 +156,12 @@ class Transcript:
 _quote = json.encoder.encode_basestring_ascii  # how json.dumps writes a str (ensure_ascii)
 
 
-def json_line(event: Event) -> str:
-    """``json.dumps(event.to_json())`` and a newline: a transcript's line. Written directly
-    when every field has the plain type whose JSON is its repr (json.dumps builds an encoder
-    per call, most of the cost of writing a run's 10^5 events), else by json.dumps."""
-    e = event
+def plain_fields(e: Event) -> bool:
+    """Whether every field of ``e`` has exactly the plain type a transcript line reads back
+    as (floats for the times, an int wire byte, str texts): what :func:`json_line` writes
+    directly, and what lets a transcript just written stand for its own reading."""
     du = e.duration_uncertainty
-    if not (
+    return (
         type(e.kind) is EventKind
         and type(e.origin) is str
         and type(e.text) is str
@@ -171,8 +170,16 @@ def json_line(event: Event) -> str:
         and type(e.end) is float
         and type(e.uncertainty) is float
         and (du is None or type(du) is float)
-        and math.isfinite(e.start + e.end + e.uncertainty + (du or 0.0))
-    ):
+    )
+
+
+def json_line(event: Event) -> str:
+    """``json.dumps(event.to_json())`` and a newline: a transcript's line. Written directly
+    when every field has the plain type whose JSON is its repr (json.dumps builds an encoder
+    per call, most of the cost of writing a run's 10^5 events), else by json.dumps."""
+    e = event
+    du = e.duration_uncertainty
+    if not (plain_fields(e) and math.isfinite(e.start + e.end + e.uncertainty + (du or 0.0))):
         return json.dumps(e.to_json()) + "\n"
     tail = "}\n" if du is None else f', "duration_uncertainty": {du!r}}}\n'
     return (

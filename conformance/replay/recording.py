@@ -17,7 +17,7 @@ from typing import Any
 
 from ..capture.errors import CaptureError
 from ..capture.transcript_io import read_transcript_jsonl
-from ..transcript import TOOL, Event, EventKind, Transcript
+from ..transcript import TOOL, Event, EventKind, Transcript, plain_fields
 
 #: Prefix of the NOTE that carries the run's options (first line of a transcript).
 OPTIONS_NOTE = "run-options "
@@ -109,22 +109,6 @@ def _keep(key: tuple[str, int, int], events: tuple[Event, ...]) -> None:
     _READ[key] = events
 
 
-def _reads_back_as_itself(e: Event) -> bool:
-    """Whether ``e``'s JSON line reads back as an equal event with the same types (what
-    :func:`read_transcript_jsonl` gives): floats print as their shortest repr, which reads
-    back bit for bit, but an int time would come back a float."""
-    return (
-        type(e.kind) is EventKind
-        and type(e.origin) is str
-        and type(e.start) is float
-        and type(e.end) is float
-        and type(e.wire) is int
-        and type(e.text) is str
-        and type(e.uncertainty) is float
-        and (e.duration_uncertainty is None or type(e.duration_uncertainty) is float)
-    )
-
-
 def options_in(notes: list[Event]) -> dict[str, Any]:
     """The run options in a run's notes ({} when there are none or they are not readable)."""
     for e in notes:
@@ -144,7 +128,9 @@ def write_recording(path: Path, events: list[Event]) -> None:
     run's 10^5 lines cost a second to parse."""
     events = list(events)
     Transcript(events).write_jsonl(str(path))
-    if all(map(_reads_back_as_itself, events)):
+    # floats print as their shortest repr, which reads back bit for bit; an int time would
+    # come back a float, so only events of exactly the plain types stand for their reading
+    if all(map(plain_fields, events)):
         _keep(_file_key(Path(path)), tuple(events))
 
 
