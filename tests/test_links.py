@@ -112,16 +112,19 @@ def test_loop_link_keeps_the_raw_bits_and_declares_no_break():
         link.close()
 
 
+@pytest.mark.realtime  # wall-clock bounds: in CI's niced session one took 156 ms for 109
 def test_receive_on_a_silent_line_is_bounded_by_its_deadline():
+    """The wait ends near its deadline, not at some read timeout of its own (0.5 s and up):
+    the bound leaves room for a busy host, never for a wait that ignores the deadline."""
     link = open_real_link("loop://")
     try:
         started = time.monotonic()
         assert link.receive(link.now() + 0.05) == []
         took = time.monotonic() - started
-        assert 0.05 <= took < 0.05 + CHAR_TIME + link.info.timing_uncertainty + 0.05
+        assert 0.05 <= took < 0.05 + CHAR_TIME + link.info.timing_uncertainty + 0.2
         started = time.monotonic()
         assert link.receive(link.now() - 1.0) == []  # a passed deadline: what is queued, now
-        assert time.monotonic() - started < 0.01
+        assert time.monotonic() - started < 0.1
     finally:
         link.close()
 

@@ -161,6 +161,37 @@ def test_listen_link_records_bus_events_and_a_nul_as_a_break_and_never_transmits
         link.close()
 
 
+def test_a_batch_the_host_stamped_back_to_back_neither_splits_a_command_nor_flags_a_reply():
+    """CI saw it on an idle machine: the tap delivered the '0' of '0R0!' alone, then 'R0!'
+    with the reply's first character in one batch. Stamped back to back, the batch showed
+    an 8.4 ms pause inside the command and a reply 0.2 ms after it: the monitor showed an
+    unknown '0', a command 'R0!', flagged R-7.0-09 and R-4.3-01 on the sensor, and the
+    judging that followed said NON-COMPLIANT."""
+    link = open_listen_link("loop://")
+    try:
+        wire = [to_wire_7e1(ord(c)) for c in "0R0!0+22.1+45.6\r\n"]
+        t = 1.0
+        zero_end = t + CHAR_TIME
+        link._arrived(bytes(wire[:1]), zero_end + 0.5e-3)  # '0' on time
+        reply_start = zero_end + 3 * CHAR_TIME + 8.5e-3  # the sensor's real turnaround
+        link._arrived(bytes(wire[1:5]), reply_start + CHAR_TIME + 0.5e-3)  # 'R0!' + '0', late
+        for k, byte in enumerate(wire[5:], start=2):
+            link._arrived(bytes([byte]), reply_start + k * CHAR_TIME + 0.5e-3)
+        events = link.heard_since(0)
+    finally:
+        link.close()
+    tracker = LineTracker()
+    tracker.add(events)
+    lines = tracker.poll(events[-1].end + 1.0, final=True)
+    assert [(line.who, line.text) for line in lines] == [
+        ("recorder", "0R0!"),
+        ("sensor", "0+22.1+45.6<CR><LF>"),
+    ], [line.plain() for line in lines]
+    assert [line.flags for line in lines] == [(), ()], [line.plain() for line in lines]
+    batched = [e for e in events if e.uncertainty > 20e-3]
+    assert len(batched) >= 4  # the batch carries what its stamps may be off by
+
+
 # -- the emulator's tap ------------------------------------------------------------------------
 @pytest.fixture
 def tapped():

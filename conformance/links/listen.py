@@ -59,8 +59,12 @@ class ListenLink(SerialLink):
         super().__init__(port, replace(info, can_break=False), None, name=name, echo=EchoMode.OFF)
 
     def _record(self, heard: Heard) -> None:
-        """One received byte as a BUS event (caller holds the lock)."""
-        u = self.meter.uncertainty()
+        """One received byte as a BUS event (caller holds the lock). Its uncertainty is the
+        local one: a byte that came in a batch was stamped back to back with the others, so
+        where it really ended is known only to the batch's room (the monitor read a gap of
+        its own making before such a batch as a change of talker, and a reply start inside
+        it as 0.2 ms, and flagged the sensor for both)."""
+        u = self.meter.latest_between(heard.end - CHAR_TIME, heard.end)
         if heard.byte == 0:
             event = Event(
                 EventKind.BREAK,

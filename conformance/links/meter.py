@@ -130,6 +130,18 @@ class TimingMeter:
                     u = max(u, v)
         return u
 
+    def latest_between(self, start: float, end: float, horizon: float = 1.0) -> float:
+        """:meth:`between` for a stamp just made, from the taints of the last ``horizon``
+        seconds only (they are kept in arrival order): a listener stamps every byte with its
+        local figure, and scanning a whole day's taints per byte would not keep up."""
+        u = self.uncertainty()
+        for t in reversed(self.taints):
+            if t.end < start - horizon:
+                break
+            if t.start <= end and start <= t.end:
+                u = max(u, t.error)
+        return u
+
     @property
     def reference(self) -> str:
         return "echo" if self.echo else "write"

@@ -51,6 +51,7 @@ class _State:
     after_break: bool = False
     last_side: str | None = None
     last_end: float = float("-inf")
+    last_uncertainty: float = 0.0  # of the stamp at last_end
     command: str = ""  # the recorder's current transmission so far
     command_end: float = float("-inf")
     awaiting_reply: bool = False  # a command ended in '!' and nothing answered yet
@@ -63,13 +64,18 @@ def _runs(chars: list[Event]) -> list[list[Event]]:
     """Bursts of one talker: a new run after a ``!`` or an LF (where the other side may take
     over), after a pause in which a turnaround is possible (7.93 ms), or where a character
     overlaps the one before (two talkers). Shorter pauses keep one talker's run whole, so a
-    gappy command or reply is still read as one."""
+    gappy command or reply is still read as one. A pause is "possible turnaround" only when
+    it surely is: where the stamps may be off (a host that got bytes in a batch and stamped
+    them back to back, so one stamp sits late and the gap before it looks long), a pause that
+    may have been shorter than 7.93 ms keeps the run whole; the monitor cut the recorder's
+    ``0R0!`` into an unknown ``0`` and a command ``R0!`` at such a gap of its own making."""
     out: list[list[Event]] = []
     for e in chars:
         if out:
             prev = out[-1][-1]
             gap = e.start - prev.end
-            if -_slack(prev, e) < gap < RESPONSE_START_MIN and prev.char7 not in (0x21, 0x0A):
+            slack = _slack(prev, e)
+            if -slack < gap < RESPONSE_START_MIN + slack and prev.char7 not in (0x21, 0x0A):
                 out[-1].append(e)
                 continue
         out.append([e])
@@ -106,6 +112,7 @@ def infer_directions(events: Iterable[Event]) -> list[tuple[Event, Direction]]:
             state.after_break, state.awaiting_reply = True, False
             state.command, state.reply = "", []
             state.last_side, state.last_end = RECORDER, e.end
+            state.last_uncertainty = e.uncertainty
         elif e.kind is EventKind.CHAR:
             if pending and e.start < pending[-1].end - _slack(pending[-1], e):
                 flush()  # an overlap: the runs on either side are read one by one
@@ -118,6 +125,7 @@ def _classify(run: list[Event], s: _State) -> Direction:
     text = decode_7e1(run)
     start = run[0].start
     gap = start - s.last_end
+    slack = run[0].uncertainty + s.last_uncertainty  # how far the stamps may misplace gap
     overlap = gap < -(2 * run[0].uncertainty + 1e-9)
     shown = escape(text[:12]) + ("..." if len(text) > 12 else "")
     if overlap:
@@ -136,12 +144,12 @@ def _classify(run: list[Event], s: _State) -> Direction:
             RECORDER, f"'{shown}' continues the recorder's '{escape(s.command)}' (no '!' yet)"
         )
     if s.last_side == SENSOR and s.reply and not _message_done(s):
-        if gap < RESPONSE_START_MIN:
+        if gap < RESPONSE_START_MIN + slack:
             return Direction(SENSOR, f"'{shown}' continues the sensor's line after {_ms(gap)}")
-        if _is_text(s.reply) and gap <= MULTILINE_GAP_MAX + TOLERANCE:
+        if _is_text(s.reply) and gap <= MULTILINE_GAP_MAX + TOLERANCE + slack:
             return Direction(SENSOR, f"'{shown}': the next line of multi-line text")
-    if s.awaiting_reply and gap <= NO_BREAK_WINDOW:
-        found = _as_reply(text, shown, gap, s)
+    if s.awaiting_reply and gap <= NO_BREAK_WINDOW + slack:
+        found = _as_reply(text, shown, gap, slack, s)
         if found is not None:
             return found
     if _looks_like_command(text):
@@ -163,9 +171,11 @@ def _classify(run: list[Event], s: _State) -> Direction:
     return Direction(None, f"'{shown}': no protocol cue (not after a break, no '!', no CR LF)")
 
 
-def _as_reply(text: str, shown: str, gap: float, s: _State) -> Direction | None:
-    """The first run after a command ending in '!' within 87 ms: the reply, or a retry."""
-    window = RESPONSE_START_MIN <= gap <= RESPONSE_START_MAX + TOLERANCE
+def _as_reply(text: str, shown: str, gap: float, slack: float, s: _State) -> Direction | None:
+    """The first run after a command ending in '!' within 87 ms: the reply, or a retry.
+    ``slack``: how far the stamps may misplace ``gap`` (a start they cannot place outside
+    the window is not a reason to doubt who sent it; the timing judges weigh it)."""
+    window = RESPONSE_START_MIN - slack <= gap <= RESPONSE_START_MAX + TOLERANCE + slack
     when = f"{_ms(gap)} after '{escape(s.command)}'" + (
         "" if window else " (outside 7.93-15.4 ms)"
     )
@@ -217,7 +227,8 @@ def _advance(s: _State, run: list[Event], d: Direction) -> None:
         s.awaiting_reply = False
         _note_announcement(s)
     s.last_side = d.side or s.last_side
-    s.last_end = max(s.last_end, run[-1].end)
+    if run[-1].end >= s.last_end:
+        s.last_end, s.last_uncertainty = run[-1].end, run[-1].uncertainty
 
 
 def _note_announcement(s: _State) -> None:
