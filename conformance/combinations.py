@@ -162,9 +162,30 @@ def combination_matrix(
 
 #: The CI selection: 27 pairs (seed 18) and 9 triples (seed 19), prefixes of the lists the
 #: measurement in notes/combos-result.md ran; 40 of them took 63 s CPU, so about 57 s.
+#: Combinations a longer measurement (200 pairs, 100 triples) found unexplained, each fixed
+#: in the tool or the emulator and kept in CI so the class stays fixed:
+REGRESSIONS: tuple[tuple[str, ...], ...] = (
+    # R-6.1-03 PASSed on identify commands the sensor never answered
+    ("identify-sends-service-request", "identify-unsupported"),
+    # a 0-value aM! with a ttt was taken for an undefined group: its D0 aborted the
+    # measurement, and the old data that came back FAILed R-4.4.8-03 instead of R-4.4.5.1-02
+    ("abort-keeps-old-data", "measure-count-zero"),
+    # R-7.0-15 probed only after a reply, where a sensor that sleeps early is silent anyway
+    ("extended-not-x", "standby-after-108ms", "standby-after-60ms"),
+    ("crc-wrong-encoding", "never-standby", "standby-after-40ms"),
+    # extended-not-x's renaming undid extended-no-crlf's rewrite (emulator composition)
+    ("break-aborts-concurrent", "extended-no-crlf", "extended-not-x"),
+    # an answered try followed by unheard retries without a break was judged as no reply
+    ("metadata-crc-sticks", "no-follow-up-without-break", "standby-after-108ms"),
+    ("high-volume-crc-missing", "high-volume-two-digit-count", "no-follow-up-without-break"),
+    # the reply to a command the sensor's service request cut was judged for its address
+    ("answers-old-address", "identify-sends-service-request", "value-missing-sign"),
+)
+
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
     *sample(27, 2, DEFAULT_SEED),
     *sample(9, 3, DEFAULT_SEED + 1),
+    *REGRESSIONS,
 )
 
 #: CI combinations the measurement found unexplained, each with its diagnosed class: the

@@ -239,7 +239,7 @@ def pending(
             f"'{escape(decode_7e1(sent))}' first), so nothing was left to abort",
             (cited(start), heard(sent, "then"), when),
         )
-    reply_end = start.attempts[-1].reply_events[-1].end if start.attempts[-1].reply_events else None
+    reply_end = start.reply_events[-1].end if start.reply_events else None
     if reply_end is not None and disturbance.start - reply_end >= ttt:
         return Unmet(
             "pending",

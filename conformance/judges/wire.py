@@ -393,7 +393,11 @@ def judge_framing(
             )
             body, framing = split_line(text, crc_positions=crc_positions)
             tally.observe(label, framing, ids=["R-4.2-02", "R-4.2-03"])
-            expected = expected_reply_address(seg.text) if is_reply else None
+            # a command the DUT talked over was heard in pieces, if at all: the reply answers
+            # what the sensor made of them (a sensor's service request cut 0IMC3! so that it
+            # answered '3!' at its old address), so its address is not this command's to judge
+            talked_over = bool(seg.contention)
+            expected = expected_reply_address(seg.text) if is_reply and not talked_over else None
             if not is_reply:  # unsolicited: a service request from the sensor
                 expected = chr(last_address) if last_address else None
             tally.observe(label, ids=["R-4.3-01"])

@@ -59,7 +59,7 @@ class AddressChanger:
             outcome.polls.append(poll)
             self.exchanges.append(poll)
             if poll.answered:
-                outcome.answered_after = poll.last.command_events[0].start - start  # answered try
+                outcome.answered_after = poll.judged.command_events[0].start - start  # answered try
                 return
             link.wait(POLL_INTERVAL)
 

@@ -67,15 +67,28 @@ class Exchange:
 
     @property
     def last(self) -> Attempt:
+        """The last attempt sent (retry timing and the line's state follow from it)."""
+        return self.attempts[-1]
+
+    @property
+    def judged(self) -> Attempt:
+        """The attempt the reply is judged from: the last one the DUT answered, else the
+        last one sent. A retry that went unheard after an answered try says nothing about
+        the reply: a sensor that needs a break before every command gave an invalid-looking
+        reply, ignored the two retries without a break, and its D0 was judged as never
+        answered (R-4.4-01 and four more FAILs that belong to no deviation of its)."""
+        for attempt in reversed(self.attempts):
+            if attempt.reply_events:
+                return attempt
         return self.attempts[-1]
 
     @property
     def reply_events(self) -> list[Event]:
-        return self.last.reply_events
+        return self.judged.reply_events
 
     @property
     def reply_text(self) -> str:
-        """The last attempt's reply as 7-bit text, CR LF included (parity stripped)."""
+        """The judged attempt's reply as 7-bit text, CR LF included (parity stripped)."""
         return decode_7e1(self.reply_events)
 
     @property
@@ -85,7 +98,7 @@ class Exchange:
 
     @property
     def answered(self) -> bool:
-        """The DUT sent something for the last attempt (valid or not)."""
+        """The DUT sent something for some attempt (valid or not)."""
         return bool(self.reply_events)
 
     @property

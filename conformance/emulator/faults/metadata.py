@@ -111,10 +111,11 @@ METADATA: tuple[Fault, ...] = (
     Fault(
         "identify-unsupported",
         "Identify-measurement commands (aIM!, aIC!, aIHA!...) get no answer."
-        " With no identify reply there is none to compare with the measurement's (R-6.1-02).",
+        " With no identify reply there is none to compare with the measurement's (R-6.1-02),"
+        " and nothing shows the sensor took one for an identify command (R-6.1-03).",
         ("R-6.1-01",),
         settings={"answer_identify_measurement": False},
-        inconclusive=("R-6.1-02",),
+        inconclusive=("R-6.1-02", "R-6.1-03"),
         needs=("v1.4",),
     ),
 )
