@@ -46,6 +46,12 @@ def no_crlf(tmp_path_factory):
     return faulty_run(tmp_path_factory, "missing-crlf")
 
 
+@pytest.fixture(scope="module")
+def bad_crc(tmp_path_factory):
+    """CRCs that do not match: R-4.4.12-05 FAILs naming a measurement and its D read."""
+    return faulty_run(tmp_path_factory, "wrong-crc")
+
+
 def noteworthy(data: dict) -> list[tuple[str, dict]]:
     return [
         (r["id"], f)
@@ -63,7 +69,7 @@ def wire_text(events: list[dict], origin: str | None = None) -> str:
     )
 
 
-@pytest.mark.parametrize("which", ["late", "no_crlf"])
+@pytest.mark.parametrize("which", ["late", "no_crlf", "bad_crc"])
 def test_every_noteworthy_finding_points_at_transcript_events(which, request):
     _, data, transcript = request.getfixturevalue(which)
     found = noteworthy(data)
@@ -79,7 +85,9 @@ def test_every_noteworthy_finding_points_at_transcript_events(which, request):
         assert wire["start_s"] == pytest.approx(min(e["start"] for e in span), abs=1e-6)
         assert wire["end_s"] == pytest.approx(max(e["end"] for e in span), abs=1e-6)
         if wire["exchange"] is not None:  # the exchange is the command the finding names
-            assert wire_text(span, "tool").startswith(wire["exchange"]), (rid, wire)
+            sent = wire_text(span, "tool")  # "0MC! 0D0!": those commands, in that order
+            assert sent.startswith(wire["exchange"].split()[0]), (rid, wire)
+            assert re.search(".*".join(map(re.escape, wire["exchange"].split())), sent)
             named = " ".join([*f["evidence"], f["detail"]])
             assert wire["located_by"] == "measured" or wire["exchange"] in named, (rid, wire)
 
@@ -110,6 +118,30 @@ def test_a_timing_fail_points_at_the_exchange_it_measured(late):
         reply = [e for e in span if e["kind"] == "char" and e["origin"] == "dut"]
         delay_ms = (reply[0]["start"] - command[-1]["end"]) * 1e3
         assert delay_ms == pytest.approx(f["measured_ms"], abs=0.05)
+
+
+def test_a_crc_fail_reaches_the_d_reply_that_carried_the_crc(bad_crc):
+    """The CRC FAIL names '0MC! 0D0!': its reference used to stop at 0MC!'s service request,
+    before the D reply whose CRC was wrong (the evidence was the unmarked line after it)."""
+    _, data, transcript = bad_crc
+    (fail,) = [
+        f for rid, f in noteworthy(data)
+        if rid == "R-4.4.12-05" and "test_crc_value_and_encoding" in f["test"]
+    ]  # fmt: skip
+    wire = fail["wire"]
+    assert wire["exchange"] == "0MC! 0D0!" and wire["located_by"] == "command"
+    first, last = wire["transcript_events"]
+    crc = re.search(r"CRC '(...)' does not match", fail["detail"]).group(1)
+    assert crc + "\r\n" in wire_text(transcript[first : last + 1], "dut"), wire
+
+
+def test_the_html_marks_the_d_reply_a_crc_fail_rests_on(bad_crc):
+    out, _, _ = bad_crc
+    shown = case_extras(out, "test_crc_value_and_encoding")
+    where = shown.split("Where: R-4.4.12-05 FAIL", 1)[1].split("<p><b>Wire:", 2)[1]
+    hits = [line for line in where.splitlines() if "▶ " in line]
+    assert any("→ sensor  0D0!" in h for h in hits), hits
+    assert any("← sensor  0+22.15+1013.2+45.7DOm" in h for h in hits), hits
 
 
 def case_extras(out: Path, name: str) -> str:
@@ -158,6 +190,22 @@ def test_a_finding_naming_a_command_gets_that_exchange_not_a_neighbour():
     ref = Locator(events).locate(finding, record)
     assert ref is not None and ref.exchange == "0D3!" and ref.how == "command"
     assert (ref.first, ref.last) == (9, 15)
+
+
+def test_a_line_naming_a_measurement_and_its_read_spans_both():
+    events = (
+        _chars("tool", "0M!", 0.0) + _chars("dut", "00011\r\n", 0.04)
+        + _chars("dut", "0\r\n", 1.1) + _chars("tool", "0D0!", 1.2)
+        + _chars("dut", "0+1\r\n", 1.245) + _chars("tool", "0D0!", 2.0)
+        + _chars("dut", "0+1\r\n", 2.045)
+    )  # fmt: skip
+    record = CaseRecord("t::c", "c", ("R-4.4.12-05",), window=(0, len(events)))
+    finding = Finding("R-4.4.12-05", Verdict.FAIL, "0M! 0D0!: bad", evidence=["0M! 0D0!"])
+    ref = Locator(events).locate(finding, record)
+    assert ref is not None and ref.exchange == "0M! 0D0!" and ref.how == "command"
+    assert (ref.first, ref.last) == (0, 21)  # through the first D reply's LF, not the second
+    alone = Finding("R-4.4.12-05", Verdict.FAIL, "bad", evidence=["0M! 0D9!"])  # not on the wire
+    assert Locator(events).locate(alone, record).exchange == "0M!"
 
 
 def test_a_finding_naming_nothing_rests_on_its_cases_traffic():

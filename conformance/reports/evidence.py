@@ -5,7 +5,10 @@ A report once showed, beside an R-4.2-03 FAIL on ``0D3!``, the ``?!`` exchange a
 the case had attached, and sent the reader to transcript.jsonl for the rest. So the exchange is
 looked up per finding, from what the finding itself says, in this order of trust:
 
-1. the commands its evidence lines (then its detail) name, e.g. ``reply to 0D3!``;
+1. the commands its evidence lines (then its detail) name, e.g. ``reply to 0D3!``; a line that
+   is a sequence of commands, ``0MC! 0D0!`` (a measurement and the data read that judged it),
+   names the exchanges from the first through the next of the last that follows it, so the
+   reply that carried the fault (the D reply's CRC) is inside the reference, not after it;
 2. among those (or, if it names none, among every exchange searched), the one holding an
    interval equal to the value a timing finding measured;
 3. otherwise the case's own traffic as a whole (an INCONCLUSIVE that no exchange exercised
@@ -36,6 +39,8 @@ MEASURE_MATCH_MS = 0.05  # a measured value matches an interval this close (roun
 LATER_SHOWN = 40  # characters after a reply kept in an exchange (what the line did next)
 STAMP = re.compile(r"\bt=(\d+(?:\.\d+)?) ?s\b")  # an evidence line's time on the link clock
 COMMAND = re.compile(r"[0-9A-Za-z?]\w*!")  # text naming a command, e.g. "reply to 0D3!"
+#: a line (or a detail's part before ':') that is a sequence of commands, "0MC! 0D0!"
+CHAIN = re.compile(r"^\s*((?:[0-9A-Za-z?]\w*!\s+)+[0-9A-Za-z?]\w*!)\s*(?::|$)")
 
 
 @dataclass(frozen=True)
@@ -67,6 +72,24 @@ def _named(command: str, text: str) -> bool:
             return True
         at = text.find(command, at + 1)
     return False
+
+
+def _chain(line: str, segs: list[Segment]) -> list[Segment] | None:
+    """The exchanges a line such as ``0MC! 0D0!`` names, in that order on the wire: the
+    first occurrence of the first command, then each next command after it (None: the
+    line is no such sequence, or the wire does not hold it)."""
+    match = CHAIN.match(line)
+    if not match:
+        return None
+    chain: list[Segment] = []
+    at = 0
+    for command in match.group(1).split():
+        found = next((i for i in range(at, len(segs)) if segs[i].text == command), None)
+        if found is None:
+            return None
+        chain.append(segs[found])
+        at = found + 1
+    return chain
 
 
 def _distance(seg: Segment, t: float) -> float:
@@ -122,8 +145,13 @@ class Locator:
             exchange, how,
         )  # fmt: skip
 
-    def _pick(self, finding: Finding, segs: list[Segment]) -> tuple[Segment, str] | None:
+    def _pick(self, finding: Finding, segs: list[Segment]) -> tuple[list[Segment], str] | None:
         lines = [*finding.evidence, finding.detail]
+        if finding.measured_ms is None:
+            for line in lines:
+                chained = _chain(line, segs)
+                if chained:
+                    return chained, "command"
         named: list[Segment] = []
         for line in lines:  # the evidence lines' commands first, in their order
             seen = {id(n) for n in named}
@@ -141,8 +169,8 @@ class Locator:
             if scored:
                 distance, best = min(scored, key=lambda p: p[0])
                 if distance <= MEASURE_MATCH_MS:
-                    return best, "command and measured" if named else "measured"
-        return (named[0], "command") if named else None
+                    return [best], "command and measured" if named else "measured"
+        return ([named[0]], "command") if named else None
 
     def locate(self, finding: Finding, record: CaseRecord) -> WireRef | None:
         """The exchange ``finding`` (of ``record``'s case) rests on, or None (no wire)."""
@@ -160,8 +188,9 @@ class Locator:
         for a, b in pools:
             found = self._pick(finding, self._segments(a, b))
             if found:
-                seg, how = found
-                return self._ref(_exchange_events(seg), seg.text, how)
+                chain, how = found
+                events = [e for seg in chain for e in _exchange_events(seg)]
+                return self._ref(events, " ".join(seg.text or "" for seg in chain), how)
         # no exchange named or measured: the case's own traffic (none known: no reference)
         own = self.events[lo:hi] if record.window else []
         return self._ref(own or [self.events[i] for i in attached], None, "case")
