@@ -19,7 +19,7 @@ from typing import TextIO
 from ..links.base import Link, LinkError, LinkInfo, StopCondition
 from ..recorder.request import RecorderOutput, Request, Task
 from ..transcript import DUT, TOOL, Event, EventKind, Transcript
-from .protocol import VERSION, seconds, us
+from .protocol import LOG, MAX_LINE, VERSION, seconds, us
 
 
 class ClientLink(Link):
@@ -96,6 +96,18 @@ class ClientLink(Link):
             self.reply(f"wait {us(limit)}")
 
 
+def log_lines(command: str, values: list[str]) -> list[str]:
+    """``log`` lines reporting ``values`` logged for ``command``, each within the protocol's
+    line length (a long measurement takes several lines; the tool appends them)."""
+    lines, line = [], f"{LOG} {command}"
+    for value in values:
+        if len(line) + 1 + len(value) > MAX_LINE and line != f"{LOG} {command}":
+            lines.append(line)
+            line = f"{LOG} {command}"
+        line += f" {value}"
+    return [*lines, line]
+
+
 def serve_recorder(
     program: Callable[[Request, Link], RecorderOutput],
     inp: TextIO = sys.stdin,
@@ -118,10 +130,13 @@ def serve_recorder(
     link = ClientLink(inp, out)
     link.clock = seconds(int(job[1]))
     try:
-        program(Request(Task(job[2]), tuple(job[3:])), link)
+        output = program(Request(Task(job[2]), tuple(job[3:])), link)
     except LinkError as exc:  # the tool ended the conversation (bye, or closed our input)
         print(f"job ended by the tool: {exc}", file=sys.stderr)
         return 0
+    for command, values in output.logged.items():
+        for line in log_lines(command, values):
+            out.write(line + "\n")
     out.write("done\n")
     out.flush()
     inp.readline()  # bye
