@@ -65,7 +65,6 @@ def test_the_golden_recorder_logs_what_the_sensors_sent(golden):
     by_id, _ = judged(golden, {n: golden.run(n).output.logged for n in names})
     assert by_id["R-4.4-02"].verdict is Verdict.PASS, by_id["R-4.4-02"].detail
     assert by_id["R-5.4-01"].verdict is Verdict.PASS
-    assert by_id["R-4.4-02"].decision == "T3"
     assert golden.run("d0-to-d2").output.logged == {"0M2!": M2}
 
 

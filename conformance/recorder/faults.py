@@ -337,7 +337,7 @@ FIELD_WIDTH = 7
 
 
 def _unsigned(command: Command, values: list[str]) -> list[str]:
-    return [v.lstrip("+-") for v in values]
+    return [v.lstrip("-") for v in values]
 
 
 def _cut(command: Command, values: list[str]) -> list[str]:

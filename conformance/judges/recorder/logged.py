@@ -3,9 +3,9 @@
 The wire shows which values the recorder collected; only the recorder's own report (the
 harness's ``log`` lines, the trigger's ``SDI12_LOG_FILE``, an in-process program's output)
 shows what it wrote down. Per measurement the two must agree in count, order, sign, digits
-and decimal point. Values are compared as numbers (catalog decision T3): a logger stores
-numbers, so ``+1.50`` logged as ``1.5`` is the same value, ``+1013.25`` logged as ``1013.2``
-or ``-3.75`` as ``3.75`` is not. HB values compare at the precision of their data type.
+and decimal point. Values are compared as numbers (the catalog's note on R-4.4-02): a logger
+stores numbers, so ``+1.50`` logged as ``1.5`` is the same value, ``+1013.25`` logged as
+``1013.2`` or ``-3.75`` as ``3.75`` is not. HB values compare at the precision of their type.
 
 The rule this rests on is R-4.4-02 ("can log data from" every measurement family) and, for
 aHA!/aHB!, R-5.4-01 ("including reading back their data"): the catalog's notes say why these
@@ -34,7 +34,6 @@ from .replies import crc_context, data_values, reply_problem
 LOGGED = "R-4.4-02"
 HIGH_VOLUME = "R-5.4-01"
 IDS = (LOGGED, HIGH_VOLUME)
-DECISION = "T3"
 NOTHING_REPORTED = "the recorder reported no logged values"
 #: Values quoted in one finding line (the recorder's words are untrusted and unbounded).
 SHOWN_VALUE = 24
@@ -131,6 +130,11 @@ def compare(sent: Sequence[Sent], logged: Sequence[str]) -> str | None:
     )
 
 
+def same_values(sent: Sequence[str], logged: Sequence[str]) -> bool:
+    """Whether ``logged`` records the ASCII values ``sent``, compared as numbers."""
+    return compare([Sent(v) for v in sent], logged) is None
+
+
 def _rid(command: str) -> str:
     try:
         kind = parse_command(command).kind
@@ -180,8 +184,6 @@ def judge_logged_values(
     if not any(r.logged is not None or r.problem for r in reports):
         return [not_applicable(rid, NOTHING_REPORTED) for rid in IDS]
     tally = Tally(IDS)
-    for rid in IDS:
-        tally.decision(rid, DECISION)
     if not high_volume:
         tally.not_applicable(HIGH_VOLUME, "the recorder does not claim v1.4")
     tally.unobservable(HIGH_VOLUME, "no aHA!/aHB! measurement with its values on the wire")
@@ -229,6 +231,5 @@ def _unreadable(rid: str, report: LogReport) -> Finding:
         f"scenario {report.scenario}: the recorder's report of what it logged could not be "
         f"read: {report.problem}",
         evidence=[f"scenario {report.scenario}"],
-        decision=DECISION,
         observed=1,
     )
