@@ -138,6 +138,17 @@ def test_a_measurement_left_out_of_the_log_fails(golden):
     assert "concurrent-two: 0C!: the sensor sent 5 value(s), none logged (no log report" in detail
 
 
+def test_a_scenario_cut_short_without_a_report_is_not_held_against_the_recorder(golden):
+    """A trigger that failed or timed out had no chance to write its log: no FAIL for it."""
+    for name in ("d0-to-d2", "two-sensors"):
+        golden.run(name)
+    reports = [LogReport("d0-to-d2", {"0M2!": M2}), LogReport("two-sensors", None, None, True)]
+    found = judge_logged_values(golden.line("d0-to-d2", "two-sensors"), reports, 0.0)
+    by_id = {f.requirement: f for f in found}
+    assert by_id["R-4.4-02"].verdict is Verdict.PASS, by_id["R-4.4-02"].detail
+    assert "two-sensors" not in by_id["R-4.4-02"].detail
+
+
 def test_values_logged_for_a_command_never_sent_fail(golden):
     by_id, _ = judged(golden, {"d0-to-d2": {"0M2!": M2, "0M7!": ["+1.0"]}})
     assert by_id["R-4.4-02"].verdict is Verdict.FAIL
@@ -308,3 +319,27 @@ def test_the_log_report_survives_a_replay():
     again = RecordedRecorder(events).act("service-request", REQUEST, SimLink(SimBus([])))
     assert again.log_source == out.log_source and again.log_problem == out.log_problem
     assert again.reported_logged() == {}
+
+
+def silent_logger():
+    """A recorder program (``sim://?recorder=``) that does the golden job but reports nothing
+    of what it logged, as a harness without ``log`` lines does."""
+    from conformance.recorder.golden import GoldenRecorder
+
+    def program(request: Request, link) -> RecorderOutput:  # noqa: ANN001 - a Link
+        out = GoldenRecorder()(request, link)
+        out.logged = {}
+        return out
+
+    return program
+
+
+def test_a_run_whose_recorder_reports_nothing_leaves_the_check_not_applicable():
+    from conformance.matrix import run_once
+
+    port = f"sim://?recorder={__name__}:silent_logger"
+    data = run_once(port, ("-k", "logged"), role="recorder")
+    found = {r["id"]: r for r in data["requirements"]}
+    for rid in ("R-4.4-02", "R-5.4-01"):
+        assert found[rid]["verdict"] == "N/A", found[rid]
+        assert found[rid]["findings"][0]["detail"] == NOTHING_REPORTED

@@ -51,6 +51,7 @@ def log_reports(recorder: RecorderSession, names: list[str]) -> list[LogReport]:
     :func:`line_of`'s view)."""
     reports = []
     for name in names:
-        out = recorder.run(name).output
-        reports.append(LogReport(name, out.reported_logged(), out.log_problem))
+        run = recorder.run(name)
+        out = run.output
+        reports.append(LogReport(name, out.reported_logged(), out.log_problem, bool(run.error)))
     return reports

@@ -55,6 +55,9 @@ class LogReport:
     scenario: str
     logged: dict[str, list[str]] | None
     problem: str | None = None
+    #: the scenario did not run to its end (the driver failed): without a report it had no
+    #: chance to make one, so its measurements are not held against it
+    cut_short: bool = False
 
 
 @dataclass(frozen=True)
@@ -195,6 +198,8 @@ def judge_logged_values(
         if report.problem is not None:
             rids = sorted({_rid(c) for c in sent} or {LOGGED})
             unreadable += [_unreadable(rid, report) for rid in rids]
+            continue
+        if report.logged is None and report.cut_short:
             continue
         logged = report.logged or {}
         for command, values in sent.items():
