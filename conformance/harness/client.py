@@ -5,8 +5,8 @@ other end of stdin/stdout: ``write`` answers ``tx`` and waits for ``sent``, ``se
 answers ``brk``, ``receive``/``wait_until`` answer ``wait`` and collect the characters heard
 meanwhile. Any recorder program written against a :class:`Link` (the golden recorder, or your
 own) thereby runs as a recorder harness: :func:`serve_recorder` does the job it is given and
-answers ``done``. The protocol itself is specified in ``docs/harness-protocol.md``; harnesses
-in other languages implement it directly.
+answers ``done`` after ``log`` lines of what it logged. The protocol itself is specified in
+``docs/harness-protocol.md``; harnesses in other languages implement it directly.
 """
 
 from __future__ import annotations
@@ -114,7 +114,8 @@ def serve_recorder(
     out: TextIO = sys.stdout,
     name: str = "python-recorder",
 ) -> int:
-    """Run one recorder job over stdin/stdout: hello, job, the program's work, done, bye."""
+    """Run one recorder job over stdin/stdout: hello, job, the program's work, ``log`` lines
+    of what it logged, done, bye."""
     hello = inp.readline().split()
     if hello[:2] != ["hello", str(VERSION)]:
         print(f"expected 'hello {VERSION} recorder', got {hello}", file=sys.stderr)
