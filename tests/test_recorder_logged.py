@@ -343,3 +343,9 @@ def test_a_run_whose_recorder_reports_nothing_leaves_the_check_not_applicable():
     for rid in ("R-4.4-02", "R-5.4-01"):
         assert found[rid]["verdict"] == "N/A", found[rid]
         assert found[rid]["findings"][0]["detail"] == NOTHING_REPORTED
+
+
+def test_a_harness_flooding_log_lines_is_stopped(tmp_path):
+    session = RecorderSession(_log_harness(tmp_path, ["log 0M! +1"] * (proto.MAX_LOG_LINES + 1)))
+    with pytest.raises(HarnessError, match="more than 1000 log lines in one job"):
+        session.run("service-request")
