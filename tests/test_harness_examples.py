@@ -121,7 +121,7 @@ def test_the_python_recorder_harness_is_compliant():
     assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
 
 
-@pytest.mark.parametrize("fault", ["no-retries", "short-break"])
+@pytest.mark.parametrize("fault", ["no-retries", "short-break", "truncates-values"])
 def test_a_faulty_recorder_harness_is_caught_by_exactly_its_requirements(fault):
     data = run_once(f"{RECORDER} {fault}", role="recorder")
     declared = RECORDER_FAULTS[fault]

@@ -235,6 +235,18 @@ def test_crc_mismatch_must_be_retried():
     assert found[0].verdict is Verdict.FAIL
 
 
+def test_true_values_logged_after_a_crc_retry_compare_as_numbers():
+    """'+1' logged as 1 is the value the sensor sent: no FAIL for a '+' left out (issue 20)."""
+    body = "0+1+2"
+    w = _measurement(Wire(), code="MC").sensor("0\r\n", delay_ms=200).idle(9).rec("0D0!")
+    w.sensor(body + ascii_crc("0+1+3") + "\r\n").idle(30).rec("0D0!")
+    line = w.sensor(body + ascii_crc(body) + "\r\n").line()
+    found = judge_crc_checked(line, 0.0, {"0MC!": ["1", "2.0"]}, ["+1", "+2"])
+    assert found[0].verdict is Verdict.PASS, found[0].detail
+    found = judge_crc_checked(line, 0.0, {"0MC!": ["1", "3"]}, ["+1", "+2"])
+    assert found[0].verdict is Verdict.FAIL
+
+
 def test_transparent_commands_pass_unchanged():
     w = Wire().brk().rec("0XSN!").sensor("0EMU\r\n")
     found = by_id(judge_transparent(w.line(), ["0XSN!"], 0.0, {"0XSN!": "0EMU\r\n"}))

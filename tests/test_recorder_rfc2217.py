@@ -129,6 +129,8 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
         session.close()
     assert record.error is None, record.error
     assert record.output.notes == ["logged 0M! +22.15 +1013.2 +45.7"]
+    assert record.output.logged == {"0M!": ["+22.15", "+1013.2", "+45.7"]}  # SDI12_LOG_FILE
+    assert record.output.log_source is not None
     sent = "".join(chr(e.char7) for e in record.events if e.kind == "char" and e.origin == "tool")
     assert sent.count("0M!") == 3, sent  # two unanswered tries, then the answered one
     verdicts = {f.requirement: str(f.verdict) for f in findings}

@@ -18,16 +18,21 @@ import subprocess
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 
 from ..links.base import LinkError
 from .protocol import (
     MAX_LINE,
+    MAX_LOG_LINES,
     HarnessProtocolError,
+    LogLine,
     Plan,
     Role,
     check_line,
     hello,
+    is_log,
     parse_hello,
+    parse_log,
     parse_plan,
     us,
 )
@@ -59,6 +64,7 @@ class Channel:
         self.closed = False
         self.last_sent = ""
         self.failure: str | None = None  # why the harness failed, once it has
+        self.logs: list[LogLine] = []  # a recorder harness's log lines, in order
 
     # subclass hooks
     def status(self) -> str:
@@ -122,10 +128,18 @@ class Channel:
         self.send(line)
         return self.answer(timeout)
 
-    def answer(self, timeout: float | None = None) -> str:
+    def answer(
+        self, timeout: float | None = None, aside: Callable[[str], bool] | None = None
+    ) -> str:
         """The one line answering the message sent last (:meth:`send` then :meth:`answer`
-        lets the caller work while the harness thinks)."""
+        lets the caller work while the harness thinks). Lines ``aside`` takes (returns True
+        for) come before that answer and are not it: a recorder harness's ``log`` lines."""
         reply = self.receive(timeout)
+        try:
+            while aside is not None and aside(reply):
+                reply = self.receive(timeout)
+        except HarnessProtocolError as exc:
+            raise self.protocol_error(exc) from exc
         if self._buffer:  # more than the one line that answers the message
             raise self.fail(
                 f"more than one reply to {self.last_sent!r}: also {self._buffer[:80]!r}"
@@ -146,12 +160,21 @@ class Channel:
         return self.read_plan(role, now)
 
     def read_plan(self, role: Role, now: float) -> Plan:
-        """The checked plan answering the line event sent last (at ``now`` s)."""
-        reply = self.answer()
+        """The checked plan answering the line event sent last (at ``now`` s); a recorder
+        harness's ``log`` lines before it go to :attr:`logs`."""
+        reply = self.answer(aside=self._take_log if role is Role.RECORDER else None)
         try:
             return parse_plan(reply, role, us(now))
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
+
+    def _take_log(self, text: str) -> bool:
+        if not is_log(text):
+            return False
+        if len(self.logs) >= MAX_LOG_LINES:
+            raise HarnessProtocolError(f"more than {MAX_LOG_LINES} log lines in one job", text)
+        self.logs.append(parse_log(text))
+        return True
 
     def protocol_error(self, exc: HarnessProtocolError) -> HarnessError:
         return self.fail(f"protocol error: {exc.reason}: {exc.line[:MAX_LINE]!r}")

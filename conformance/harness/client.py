@@ -5,8 +5,8 @@ other end of stdin/stdout: ``write`` answers ``tx`` and waits for ``sent``, ``se
 answers ``brk``, ``receive``/``wait_until`` answer ``wait`` and collect the characters heard
 meanwhile. Any recorder program written against a :class:`Link` (the golden recorder, or your
 own) thereby runs as a recorder harness: :func:`serve_recorder` does the job it is given and
-answers ``done``. The protocol itself is specified in ``docs/harness-protocol.md``; harnesses
-in other languages implement it directly.
+answers ``done`` after ``log`` lines of what it logged. The protocol itself is specified in
+``docs/harness-protocol.md``; harnesses in other languages implement it directly.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from typing import TextIO
 from ..links.base import Link, LinkError, LinkInfo, StopCondition
 from ..recorder.request import RecorderOutput, Request, Task
 from ..transcript import DUT, TOOL, Event, EventKind, Transcript
-from .protocol import VERSION, seconds, us
+from .protocol import LOG, MAX_LINE, VERSION, seconds, us
 
 
 class ClientLink(Link):
@@ -96,13 +96,26 @@ class ClientLink(Link):
             self.reply(f"wait {us(limit)}")
 
 
+def log_lines(command: str, values: list[str]) -> list[str]:
+    """``log`` lines reporting ``values`` logged for ``command``, each within the protocol's
+    line length (a long measurement takes several lines; the tool appends them)."""
+    lines, line = [], f"{LOG} {command}"
+    for value in values:
+        if len(line) + 1 + len(value) > MAX_LINE and line != f"{LOG} {command}":
+            lines.append(line)
+            line = f"{LOG} {command}"
+        line += f" {value}"
+    return [*lines, line]
+
+
 def serve_recorder(
     program: Callable[[Request, Link], RecorderOutput],
     inp: TextIO = sys.stdin,
     out: TextIO = sys.stdout,
     name: str = "python-recorder",
 ) -> int:
-    """Run one recorder job over stdin/stdout: hello, job, the program's work, done, bye."""
+    """Run one recorder job over stdin/stdout: hello, job, the program's work, ``log`` lines
+    of what it logged, done, bye."""
     hello = inp.readline().split()
     if hello[:2] != ["hello", str(VERSION)]:
         print(f"expected 'hello {VERSION} recorder', got {hello}", file=sys.stderr)
@@ -118,10 +131,13 @@ def serve_recorder(
     link = ClientLink(inp, out)
     link.clock = seconds(int(job[1]))
     try:
-        program(Request(Task(job[2]), tuple(job[3:])), link)
+        output = program(Request(Task(job[2]), tuple(job[3:])), link)
     except LinkError as exc:  # the tool ended the conversation (bye, or closed our input)
         print(f"job ended by the tool: {exc}", file=sys.stderr)
         return 0
+    for command, values in output.logged.items():
+        for line in log_lines(command, values):
+            out.write(line + "\n")
     out.write("done\n")
     out.flush()
     inp.readline()  # bye

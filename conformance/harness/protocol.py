@@ -124,6 +124,38 @@ def _byte(field: str, text: str) -> int:
 
 _FIELDS = {"tx": 3, "brk": 3, "wait": 2, "idle": 1, "done": 1}
 
+#: A recorder harness's report of values its logger logged: ``log CMD VALUE...`` lines,
+#: written before any plan (they answer nothing; several for one command append).
+LOG = "log"
+#: Most ``log`` lines one job may write (99 concurrent or 120 HA values take a few lines).
+MAX_LOG_LINES = 1000
+
+
+@dataclass(frozen=True, slots=True)
+class LogLine:
+    """Values the logger logged for the measurement ``command`` (wire text, ``0M!``)."""
+
+    command: str
+    values: tuple[str, ...]
+
+
+def is_log(text: str) -> bool:
+    return text.split(" ", 1)[0] == LOG
+
+
+def parse_log(text: str) -> LogLine:
+    """``log CMD VALUE...``: CMD is the measurement command as sent, with its address and
+    ``!`` (the values are the logger's own text, judged against the wire, not here)."""
+    parts = text.split(" ")
+    if len(parts) < 2 or not parts[1]:
+        raise HarnessProtocolError("'log' takes a command and the values logged for it", text)
+    command = parts[1]
+    if len(command) < 2 or not command.endswith("!") or "!" in command[:-1]:
+        raise HarnessProtocolError(f"log command {command!r} is not wire text like 0M!", text)
+    if "" in parts[2:]:
+        raise HarnessProtocolError("log values are separated by one space", text)
+    return LogLine(command, tuple(parts[2:]))
+
 
 def parse_plan(text: str, role: Role, now: int) -> Plan:
     """Check one plan reply against the role and the time ``now`` (us) of the message it

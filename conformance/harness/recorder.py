@@ -55,6 +55,10 @@ class HarnessRecorder:
             channel.close(proto.BYE)
         out = RecorderOutput()
         out.notes.append(f"harness {name or self.port}: {ended}")
+        for log in channel.logs:  # several lines for one command append, in order
+            out.logged.setdefault(log.command, []).extend(log.values)
+        if channel.logs:
+            out.log_source = f"{len(channel.logs)} log line(s) from the harness"
         return out
 
     def probe(self) -> None:

@@ -7,8 +7,8 @@ Three ways, one interface (``act(scenario, request, link) -> RecorderOutput``):
   judged on the virtual-time bus, where nothing outside the process can reach the line.
 - :class:`Trigger`: a shell command run once per scenario, with the request in environment
   variables (``SDI12_SCENARIO``, ``SDI12_TASK``, ``SDI12_COMMANDS``, ``SDI12_REQUEST``,
-  ``SDI12_TIMEOUT_S``), for a logger driven from CI. Its stdout is kept as the recorder's own
-  account of what it logged.
+  ``SDI12_TIMEOUT_S``), for a logger driven from CI. What the logger logged is read from
+  the file it writes at ``SDI12_LOG_FILE`` (:mod:`.logfile`); its stdout is kept as a note.
 - :class:`Interactive`: a prompt telling the operator what to make the logger do, answered by
   Enter (or an empty line) or left to time out.
 
@@ -22,11 +22,14 @@ import os
 import select
 import subprocess
 import sys
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Protocol, TextIO
 
 from ..links.base import Link
+from .logfile import LOG_FILE_VARIABLE, LogFileError, read_log_file
 from .request import RecorderOutput, Request
 
 #: Longest trigger output kept as evidence (the DUT's words are untrusted and unbounded).
@@ -75,7 +78,24 @@ class Trigger:
     environment: dict[str, str] = field(default_factory=dict)
 
     def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
-        env = {**os.environ, **self.environment, **request.environment(scenario, self.timeout)}
+        with tempfile.TemporaryDirectory(prefix="sdi12-log-") as folder:
+            log_file = Path(folder) / f"{scenario}.log"
+            out = self._run(scenario, request, log_file)
+            try:
+                out.logged = read_log_file(log_file) or {}
+                if log_file.exists():
+                    out.log_source = f"{LOG_FILE_VARIABLE} ({len(out.logged)} command(s))"
+            except LogFileError as exc:
+                out.log_problem = f"{LOG_FILE_VARIABLE} {exc}"
+        return out
+
+    def _run(self, scenario: str, request: Request, log_file: Path) -> RecorderOutput:
+        env = {
+            **os.environ,
+            **self.environment,
+            **request.environment(scenario, self.timeout),
+            LOG_FILE_VARIABLE: str(log_file),
+        }
         try:
             done = subprocess.run(
                 self.command,

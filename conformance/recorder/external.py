@@ -4,19 +4,22 @@
 conformance.recorder.external'`` runs one such process per scenario: it reads the request
 from the ``SDI12_*`` environment the trigger driver sets, connects to ``SDI12_PORT`` over
 RFC 2217 as any external logger would, does the job with the golden recorder (or the faulty
-twin named by ``SDI12_RECORDER_FAULT``), and prints what it logged. It proves the trigger
-path end to end with a recorder that lives outside the judging process (its own GIL and
-clock), as the golden recorder of issue 6 is meant to be run.
+twin named by ``SDI12_RECORDER_FAULT``), and writes what it logged to ``SDI12_LOG_FILE``
+(JSON lines) and stdout. It proves the trigger path end to end with a recorder that lives
+outside the judging process (its own GIL and clock), as the golden recorder of issue 6 is
+meant to be run.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 
 from ..links.echo import EchoMode
 from ..links.factory import open_real_link
 from .faults import faulty_recorder
+from .logfile import LOG_FILE_VARIABLE
 from .scenarios import SCENARIOS
 
 
@@ -33,6 +36,11 @@ def main(environ: dict[str, str] | None = None) -> int:
         output = program(SCENARIOS[scenario].request, link)
     finally:
         link.close()
+    log_file = env.get(LOG_FILE_VARIABLE)
+    if log_file:  # what it logged, as JSON lines (docs/harness-protocol.md)
+        with open(log_file, "w", encoding="utf-8") as f:
+            for command, values in output.logged.items():
+                f.write(json.dumps({"command": command, "values": values}) + "\n")
     for command, values in output.logged.items():
         print(f"logged {command} {' '.join(values)}")
     for command, reply in output.relayed.items():

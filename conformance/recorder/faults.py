@@ -319,6 +319,35 @@ class NoBreakTransparentRecorder(GoldenRecorder):
         return out
 
 
+@dataclass
+class MislogsRecorder(GoldenRecorder):
+    """Collects every value as the golden recorder does, then writes some down wrong:
+    ``spoil(command, values)`` is what it logs for each measurement command."""
+
+    spoil: Callable[[Command, list[str]], list[str]] = field(default=lambda c, v: v)
+
+    def __call__(self, request: Request, link: Link) -> RecorderOutput:
+        out = super().__call__(request, link)
+        out.logged = {t: self.spoil(parse_command(t), v) for t, v in out.logged.items()}
+        return out
+
+
+#: Characters a logger with a fixed field per value keeps (``+1013.25`` becomes ``+1013.2``).
+FIELD_WIDTH = 7
+
+
+def _unsigned(command: Command, values: list[str]) -> list[str]:
+    return [v.lstrip("-") for v in values]
+
+
+def _cut(command: Command, values: list[str]) -> list[str]:
+    return [v[:FIELD_WIDTH] for v in values]
+
+
+def _last_concurrent_lost(command: Command, values: list[str]) -> list[str]:
+    return values[:-1] if command.kind is Kind.CONCURRENT else values
+
+
 def _is_service_request(events: list, address: str) -> bool:
     return decode_7e1(events[-3:]) == f"{address}\r\n"
 
@@ -552,7 +581,33 @@ _FAULTS = (
     ),
 )
 
-RECORDER_FAULTS: dict[str, RecorderFault] = {f.name: f for f in _FAULTS}
+
+_LOGGING = (
+    RecorderFault(
+        "logs-without-sign",
+        "Collects every value, then logs it without its sign (-3.75 becomes 3.75): every "
+        "negative value logged from aM2!, aC! and the HB packets is wrong.",
+        ("R-4.4-02", "R-5.4-01"),
+        lambda: MislogsRecorder(spoil=_unsigned),
+    ),
+    RecorderFault(
+        "truncates-values",
+        f"Logs each value in a field of {FIELD_WIDTH} characters, so longer values lose digits "
+        "(+1013.25 becomes +1013.2, +1234.567 becomes +1234.5), in aM2!, aR1!, aHA! and aHB! "
+        "data.",
+        ("R-4.4-02", "R-5.4-01"),
+        lambda: MislogsRecorder(spoil=_cut),
+    ),
+    RecorderFault(
+        "loses-last-concurrent-value",
+        "Logs every concurrent measurement (aC!, aCn!, aCC!) without its last value: 98 of "
+        "aC9!'s 99 values, all of which it read from the sensor.",
+        ("R-4.4-02",),
+        lambda: MislogsRecorder(spoil=_last_concurrent_lost),
+    ),
+)
+
+RECORDER_FAULTS: dict[str, RecorderFault] = {f.name: f for f in (*_FAULTS, *_LOGGING)}
 
 
 def faulty_recorder(names: tuple[str, ...]) -> GoldenRecorder:

@@ -66,3 +66,13 @@ class RecorderOutput:
     logged: dict[str, list[str]] = field(default_factory=dict)
     relayed: dict[str, str] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    #: Where ``logged`` came from ("3 log lines from the harness", "SDI12_LOG_FILE, CSV"),
+    #: set when the recorder reported it even if it logged nothing; an in-process program's
+    #: non-empty ``logged`` counts as reported without it.
+    log_source: str | None = None
+    #: Why the recorder's report of what it logged could not be read (names the line).
+    log_problem: str | None = None
+
+    def reported_logged(self) -> dict[str, list[str]] | None:
+        """``logged`` if the recorder reported what it logged (even nothing), else None."""
+        return dict(self.logged) if self.logged or self.log_source is not None else None

@@ -36,6 +36,9 @@ def output_note(name: str, output: RecorderOutput, error: str | None) -> str:
         "notes": output.notes,
         "error": error,
     }
+    if output.log_source is not None or output.log_problem is not None:
+        found["log_source"] = output.log_source
+        found["log_problem"] = output.log_problem
     return OUTPUT_NOTE + json.dumps(found)
 
 
@@ -102,4 +105,6 @@ class RecordedRecorder:
             logged={k: list(v) for k, v in (account.get("logged") or {}).items()},
             relayed=dict(account.get("relayed") or {}),
             notes=list(account.get("notes") or []),
+            log_source=account.get("log_source"),
+            log_problem=account.get("log_problem"),
         )

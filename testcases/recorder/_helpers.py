@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from conformance import preconditions as precondition
 from conformance.case import Case
+from conformance.judges.recorder.logged import LogReport
 from conformance.recorder.scenarios import SCENARIOS
 from conformance.recorder.session import RecorderSession
 from conformance.view.segments import TranscriptView
@@ -43,3 +44,14 @@ def logged(recorder: RecorderSession, name: str) -> dict[str, list[str]] | None:
 def relayed(recorder: RecorderSession, name: str) -> dict[str, str] | None:
     out = recorder.run(name).output
     return out.relayed or None
+
+
+def log_reports(recorder: RecorderSession, names: list[str]) -> list[LogReport]:
+    """What the recorder says it logged in each scenario, in ``names`` order (the parts of
+    :func:`line_of`'s view)."""
+    reports = []
+    for name in names:
+        run = recorder.run(name)
+        out = run.output
+        reports.append(LogReport(name, out.reported_logged(), out.log_problem, bool(run.error)))
+    return reports

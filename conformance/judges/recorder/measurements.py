@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ...protocol.binary import parse_binary_packet
+from ...protocol.binary import DataType, parse_binary_packet
 from ...protocol.commands import Command, Kind
 from ...protocol.responses import parse_measurement_reply_for, split_line
 from ...transcript import Event, decode_7e1, decode_8n1, text_end
@@ -35,8 +35,13 @@ class ObservedMeasurement:
 
     def values(self) -> list[str]:
         """Values of the valid data replies, each index counted once."""
+        return [text for text, _ in self.sent_values()]
+
+    def sent_values(self) -> list[tuple[str, DataType | None]]:
+        """:meth:`values` with the binary data type of each (None: an ASCII value), so a
+        logged value can be compared with an HB value at the precision of its type."""
         seen: set[int] = set()
-        values: list[str] = []
+        values: list[tuple[str, DataType | None]] = []
         for sent, problem in self.data:
             d = sent.data_index
             if problem is not None or d is None or d[1] in seen:
@@ -44,10 +49,17 @@ class ObservedMeasurement:
             seen.add(d[1])
             if d[0]:
                 packet = parse_binary_packet(decode_8n1(sent.reply))
-                values += [repr(v) for v in packet.values]
+                values += [(repr(v), DataType(packet.dtype)) for v in packet.values]
             else:
-                values += data_values(sent, self.command)
+                values += [(v, None) for v in data_values(sent, self.command)]
         return values
+
+    def unread_indices(self) -> list[int]:
+        """Data indices whose every reply was invalid: values the recorder never validly
+        received (the retry rules judge those, R-7.2-05 and R-4.4.12-07)."""
+        valid = {d[1] for s, p in self.data if p is None and (d := s.data_index) is not None}
+        tried = {d[1] for s, _ in self.data if (d := s.data_index) is not None}
+        return sorted(tried - valid)
 
     @property
     def first_data(self) -> Transmission | None:

@@ -27,6 +27,7 @@ from ..reply_validity import NO_REPLY, Reason, ReplyProblem
 from ..tally import Tally
 from ..timing import judge_window
 from .common import combine
+from .logged import same_values
 from .replies import crc_context, reply_problem
 
 #: Marking after which a sensor is in standby (R-7.0-15, +0.40 ms): a command sent again
@@ -316,7 +317,7 @@ def judge_crc_checked(
                 tally.fail("R-4.4.12-07", where, f"accepted a reply whose {a.problem}")
     if logged is not None and truth:
         for command, values in logged.items():
-            if values and values != truth[: len(values)]:
+            if values and not same_values(truth[: len(values)], values):
                 tally.fail(
                     "R-4.4.12-07",
                     escape(command),
