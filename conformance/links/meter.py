@@ -31,7 +31,9 @@ regular figure is the worst echo spread once such outliers are set aside (they a
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from itertools import takewhile
 
 ECHO_FLOOR = 0.25e-3  # s: least uncertainty claimed on one receive path (UART sampling, clocks)
 OUTLIER_FACTOR = 2.0  # an echo spread beyond this many times the 90th percentile...
@@ -118,10 +120,7 @@ class TimingMeter:
     def between(self, start: float, end: float) -> float:
         """Uncertainty (s) of a measurement between two instants: the regular figure, or
         more where the run showed its stamps irregular near them."""
-        u = self.uncertainty()
-        for t in self.taints:
-            if t.start <= end and start <= t.end:
-                u = max(u, t.error)
+        u = _worst_taint(self.taints, start, end, self.uncertainty())
         values = sorted(v for _s, _e, v in self.spreads)
         if len(values) >= MIN_FOR_OUTLIERS:
             cut = self._outlier_cut(values)
@@ -134,13 +133,8 @@ class TimingMeter:
         """:meth:`between` for a stamp just made, from the taints of the last ``horizon``
         seconds only (they are kept in arrival order): a listener stamps every byte with its
         local figure, and scanning a whole day's taints per byte would not keep up."""
-        u = self.uncertainty()
-        for t in reversed(self.taints):
-            if t.end < start - horizon:
-                break
-            if t.start <= end and start <= t.end:
-                u = max(u, t.error)
-        return u
+        recent = takewhile(lambda t: t.end >= start - horizon, reversed(self.taints))
+        return _worst_taint(recent, start, end, self.uncertainty())
 
     @property
     def reference(self) -> str:
@@ -211,3 +205,11 @@ class TimingMeter:
             "local_irregularities": len(self.taints),
             "summary": self.summary(),
         }
+
+
+def _worst_taint(taints: Iterable[Taint], start: float, end: float, u: float) -> float:
+    """``u``, or the largest error of the taints that touch ``start..end``."""
+    for t in taints:
+        if t.start <= end and start <= t.end:
+            u = max(u, t.error)
+    return u

@@ -44,6 +44,12 @@ def _marking_before(ex, since: float) -> float:
     return ex.attempts[0].command_events[0].start - since
 
 
+def _marking_after_break(sensor, ex) -> float | None:
+    """The marking between the probe's break and its command (None: no break before it)."""
+    brk = _break_of(sensor, ex)
+    return None if brk is None else _marking_before(ex, brk.end)
+
+
 def _awake(sensor):
     """Wake the sensor the way a recorder does (break, a!, retries) and return that exchange:
     its last reply proves the sensor is awake, whatever it needed to wake up."""
@@ -214,11 +220,8 @@ def test_marking_after_break(sensor, case):
             f"{sensor.address}!", break_s=13e-3, marking_s=marking_s, idle_before=STANDBY
         )
 
-    def marking_of(ex):
-        return _marking_before(ex, _break_of(sensor, ex).end)
-
     def miss_ok(ex):
-        marking = marking_of(ex)
+        marking = _marking_after_break(sensor, ex)
         if marking - sensor.uncertainty < MARKING_AFTER_BREAK:
             return f"a! went out after {marking * 1e3:.2f} ms of marking, not surely 8.33 ms"
         heard = ex.attempts[0].reply_events
@@ -227,7 +230,7 @@ def test_marking_after_break(sensor, case):
         return None
 
     def miss_soon(ex):
-        quick = marking_of(ex)
+        quick = _marking_after_break(sensor, ex)
         if quick - sensor.uncertainty >= MARKING_AFTER_BREAK - TOLERANCE:
             return f"a! went out {quick * 1e3:.2f} ms after the break, not early"
         return None
@@ -447,12 +450,8 @@ def _standby_after_a_break(sensor, case, edge: float):
             f"{sensor.address}!", break_s=13e-3, marking_s=marking_s, idle_before=STANDBY
         )
 
-    def marking_of(ex):
-        brk = _break_of(sensor, ex)
-        return None if brk is None else _marking_before(ex, brk.end)
-
     def miss(ex):
-        idle = marking_of(ex)
+        idle = _marking_after_break(sensor, ex)
         if idle is None or idle - sensor.uncertainty <= STANDBY_MARKING + TOLERANCE:
             return "a! after a break did not go out surely past 100.4 ms of marking"
         return None
@@ -466,7 +465,7 @@ def _standby_after_a_break(sensor, case, edge: float):
     if aimed.landed is None:
         return None
     if ex.answered or control.answered:
-        return ex, marking_of(ex)
+        return ex, _marking_after_break(sensor, ex)
     return None
 
 
