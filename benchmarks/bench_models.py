@@ -8,10 +8,17 @@ verdict, FAIL/WARN counts, how many section 7 timing requirements got a definite
 
     python benchmarks/bench_models.py                # every model, 2 at a time (~20 min)
     python benchmarks/bench_models.py echo usb1-echo # some of them
+    python benchmarks/bench_models.py --runs 5 --burners 2   # the acceptance run (~95 min)
+
+``--runs N`` repeats every model N times and ``--burners K`` keeps K CPU burners busy beside the
+whole benchmark (on top of a model's own). With ``--runs`` above 1 it prints one row per model:
+how many of its runs were clean (no FAIL, no WARN), the verdicts seen, the rules that ever
+FAILed or WARNed and the spread of what the runs decided and measured.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import subprocess
 import sys
@@ -122,14 +129,65 @@ def row(r: dict) -> str:
     )
 
 
-def main(names: list[str]) -> int:
-    chosen = [m for m in MODELS if not names or m.name in names]
-    with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(2) as pool:
-        results = list(pool.map(lambda m: run(m, Path(tmp) / m.name), chosen))
-    print("| bench model | verdict | FAIL/WARN | section 7 timing decided | measured | wall |")
-    print("|---|---|---|---|---|---|")
-    for r in results:
-        print(row(r))
+def repeated_row(model: Model, results: list[dict]) -> str:
+    """One Markdown row summarising every run of ``model`` (the acceptance table)."""
+    clean = sum(1 for r in results if not r["fail"] and not r["warn"])
+    verdicts = ", ".join(sorted({r["verdict"] for r in results}))
+    flagged = sorted({x for r in results for x in r["fail"] + r["warn"]})
+    decided = [len(r["definite"]) for r in results]
+    unc = [r["uncertainty_ms"] for r in results]
+    walls = [r["wall_s"] for r in results]
+    return (
+        f"| {model.what} | {clean}/{len(results)} | {verdicts} | {' '.join(flagged) or 'none'} | "
+        f"{min(decided)}-{max(decided)}/{len(TIMING)} | "
+        f"±{min(unc):.2f}-{max(unc):.2f} ms | {min(walls):.0f}-{max(walls):.0f} s |"
+    )
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("models", nargs="*", help="model names (default: all)")
+    parser.add_argument("--runs", type=int, default=1, help="runs per model")
+    parser.add_argument("--burners", type=int, default=0, help="CPU burners beside everything")
+    parser.add_argument("--parallel", type=int, default=2, help="runs at a time")
+    parser.add_argument("--keep", type=Path, help="keep every run's report folder here")
+    args = parser.parse_args(argv)
+    chosen = [m for m in MODELS if not args.models or m.name in args.models]
+    if args.runs > 1 and not args.models:
+        # the burner model is the acceptance run's own condition when --burners is given
+        chosen = [m for m in chosen if not (args.burners and m.burners)]
+    jobs = [(m, i) for i in range(args.runs) for m in chosen]
+    burners = [burner() for _ in range(args.burners)]
+    try:
+        with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(args.parallel) as pool:
+            root = args.keep or Path(tmp)
+
+            def one(job: tuple[Model, int]) -> dict:
+                m, i = job
+                r = run(m, root / f"{m.name}-{i + 1}")
+                flagged = " ".join(r["fail"] + r["warn"]) or "clean"
+                line = f"{m.name} run {i + 1}: {r['verdict']} {flagged} {r['wall_s']:.0f} s"
+                print(line, file=sys.stderr, flush=True)
+                return r
+
+            results = list(pool.map(one, jobs))
+    finally:
+        for b in burners:
+            b.kill()
+            b.wait()
+    if args.runs > 1:
+        print(
+            "| bench model | clean runs | verdicts | ever FAIL/WARN | section 7 decided "
+            "| measured | wall |"
+        )
+        print("|---|---|---|---|---|---|---|")
+        for m in chosen:
+            print(repeated_row(m, [r for r in results if r["model"] is m]))
+    else:
+        print("| bench model | verdict | FAIL/WARN | section 7 timing decided | measured | wall |")
+        print("|---|---|---|---|---|---|")
+        for r in results:
+            print(row(r))
     for r in results:
         print(f"{r['model'].name}: emulator {r['emulator']}", file=sys.stderr)
     return 0 if all(not r["fail"] and not r["warn"] for r in results) else 1
