@@ -96,6 +96,12 @@ def build_parser() -> argparse.ArgumentParser:
         "what was selected; the rest is listed as not selected)",
     )
     add_cli_options(p, ("req",))
+    p.add_argument(
+        "--baseline",
+        metavar="DIR",
+        help="compare the run with an earlier one (its folder or verdicts.json) at its end; "
+        "the exit code is then 1 if anything got worse, 0 if not (sdi12-conform diff --help)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p
 
@@ -107,6 +113,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .ports import PortError, is_sim, parse_sim
     from .preflight import check_report_dir, check_role_options
     from .report_folder import new_report_dir
+    from .reports.diff import DiffError
     from .selection import SelectionError, resolve
 
     if args.port is None:
@@ -125,6 +132,11 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             normalise_version(args.sdi_version)
         if args.declaration:
             load_declaration(args.declaration)
+        baseline = None
+        if getattr(args, "baseline", None):
+            from .diff_command import check_baseline
+
+            baseline = check_baseline(args.baseline)
         if args.role == "recorder":
             from .recorder.session import check_port
 
@@ -142,19 +154,21 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         report_dir = Path(args.report_dir) if args.report_dir else new_report_dir(args.role)
         check_report_dir(report_dir)
         report_folder.acquire(report_dir)
-    except (DeclarationError, PortError, UsageError, SelectionError) as exc:
+    except (DeclarationError, PortError, UsageError, SelectionError, DiffError) as exc:
         from .links.errors import PortMissing
 
         also = f", or judge the built-in simulated {args.role} with --port sim"
         error(f"error: {exc}{also if isinstance(exc, PortMissing) else ''}")
         return EXIT_USAGE
     try:
-        return _run_pytest(args, report_dir, console)
+        return _run_pytest(args, report_dir, console, baseline)
     finally:
         report_folder.release(report_dir)
 
 
-def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) -> int:
+def _run_pytest(
+    args: argparse.Namespace, report_dir: Path, console: Console, baseline: dict | None = None
+) -> int:
     """The suite in this process; the summary and exit code from its own results."""
     from .options import pytest_args
     from .plugin import run_in_process
@@ -202,6 +216,12 @@ def _run_pytest(args: argparse.Namespace, report_dir: Path, console: Console) ->
             console.print(f"note: {note}", style="yellow", markup=False, highlight=False)
     if interrupted:
         return EXIT_INCOMPLETE
+    if baseline is not None:
+        from .diff_command import against_baseline
+
+        return against_baseline(
+            baseline, args.baseline, data, report_dir, exit_code(data, code), console
+        )
     return exit_code(data, code)
 
 
@@ -452,7 +472,7 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
 
 #: The subcommands that stop at once on Ctrl-C (KeyboardInterrupt: exit 2, outputs whole or
 #: absent); ``judge`` runs the suite, whose interrupts the guard turns into a partial report.
-SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor", "calibrate")
+SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor", "calibrate", "diff")
 #: what the main --help says of each subcommand (`sdi12-conform SUBCOMMAND --help`: the rest)
 SUBCOMMAND_HELP = {
     "judge": "judge a recording: a run's transcript.jsonl or folder, a .sr, .vcd or .csv",
@@ -463,6 +483,7 @@ SUBCOMMAND_HELP = {
     "emulate": "serve the simulated sensor in real time over RFC 2217, TCP or a serial port",
     "monitor": "listen to a live bus (never transmits) and judge what was heard",
     "calibrate": "measure a real bench's timing before a long run",
+    "diff": "what changed between two runs (exit 1 when anything got worse)",
 }
 
 
@@ -523,6 +544,10 @@ def _dispatch(argv: list[str]) -> int:
             from .monitor.command import monitor_main
 
             return monitor_main(argv[1:], console, cmd_judge)
+        if argv and argv[0] == "diff":
+            from .diff_command import diff_main
+
+            return diff_main(argv[1:], console)
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 
