@@ -471,7 +471,8 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
 
 
 #: The subcommands that stop at once on Ctrl-C (KeyboardInterrupt: exit 2, outputs whole or
-#: absent); ``judge`` runs the suite, whose interrupts the guard turns into a partial report.
+#: absent); ``judge`` and ``verify`` run the suite, whose interrupts the guard turns into a
+#: partial report.
 SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor", "calibrate", "diff")
 #: what the main --help says of each subcommand (`sdi12-conform SUBCOMMAND --help`: the rest)
 SUBCOMMAND_HELP = {
@@ -484,6 +485,7 @@ SUBCOMMAND_HELP = {
     "monitor": "listen to a live bus (never transmits) and judge what was heard",
     "calibrate": "measure a real bench's timing before a long run",
     "diff": "what changed between two runs (exit 1 when anything got worse)",
+    "verify": "check a run folder without the device: hashes, then the recording re-judged",
 }
 
 
@@ -548,6 +550,10 @@ def _dispatch(argv: list[str]) -> int:
             from .diff_command import diff_main
 
             return diff_main(argv[1:], console)
+        if argv and argv[0] == "verify":
+            from .verify_command import verify_main
+
+            return verify_main(argv[1:], console, cmd_judge)
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 

@@ -67,7 +67,10 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # pytest's side: options, fixtures, hooks that turn findings into outcomes and reports
     ("plugin", ("plugin",)),
     # the command line
-    ("cli", ("cli", "diff_command", "offline.passive", "roundtrip", "fault_tables")),
+    (
+        "cli",
+        ("cli", "diff_command", "verify_command", "offline.passive", "roundtrip", "fault_tables"),
+    ),
 )
 
 LAYER_OF = {name: rank for rank, (_, names) in enumerate(LAYERS) for name in names}

@@ -125,11 +125,17 @@ def _finding(f: Any, wire: WireRef | None = None) -> dict[str, Any]:
 
 
 def write(run: ConformanceRun, directory: Path) -> Path:
+    from .manifest import build_manifest
+
     path = directory / "verdicts.json"
     run.document = build(run)  # what the command line prints and exits on: this run's own
-    path.write_text(json.dumps(run.document, indent=2, ensure_ascii=False), encoding="utf-8")
     if run.link is not None:
         write_recording(directory / "transcript.jsonl", run.link.transcript.events)
     else:
         (directory / "transcript.jsonl").write_text("", encoding="utf-8")
+    # the recording first, so the manifest can pin it (sdi12-conform verify)
+    run.document["manifest"] = build_manifest(
+        directory, run.options.declaration, str(TOOL["version"])
+    )
+    path.write_text(json.dumps(run.document, indent=2, ensure_ascii=False), encoding="utf-8")
     return path
