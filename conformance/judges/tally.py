@@ -74,7 +74,10 @@ class Tally:
                         verdict,
                         detail,
                         decision=decision,
+                        # the detail quotes SHOWN; the rest is kept here, not dropped, so
+                        # the JSON and the report carry every offending observation
                         evidence=[*dict.fromkeys(w for w, _ in (hard or bad))][:SHOWN]
+                        + [f"also: {line}" for line in lines[SHOWN:]]
                         + [f"{len(seen)} observation(s)"],
                         observed=len(seen),
                     )
