@@ -218,6 +218,9 @@ class ConformanceRun:
         describe = getattr(self.link, "describe", None)
         if callable(describe):  # a real bench: echo, how breaks are made, measured timing
             found["bench"] = describe()
+        stderr = getattr(self.link, "harness_stderr", None)
+        if callable(stderr):  # exec: the harness's own log, its last STDERR_TAIL characters
+            found["harness_stderr"] = stderr()
         return found
 
     def close(self) -> None:

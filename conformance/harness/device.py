@@ -137,6 +137,13 @@ class HarnessLink(SimLink):
             if channel.failure is not None:
                 distrust_fails(cases, channel.failure)
 
+    def harness_stderr(self) -> str | None:
+        """The tail of what the harness wrote to stderr (None for a socket harness, which
+        has none): kept in every report, since a harness's own log explains a verdict as
+        often as it explains a failure."""
+        tail = getattr(self.device.channel, "stderr_tail", None)
+        return tail() if callable(tail) else None
+
     def close(self) -> None:
         self.device.channel.close(proto.BYE)
 

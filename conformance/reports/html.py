@@ -292,6 +292,11 @@ def header(run: ConformanceRun) -> str:
         ("Timing uncertainty", f"±{uncertainty} ms{exact}"),
         *bench_rows(link.get("bench")),
         *_talk_rows(link),
+        *(
+            [("Harness stderr (its last 2000 characters)", link["harness_stderr"] or "none")]
+            if "harness_stderr" in link
+            else []
+        ),
         ("Started", run.started),
         ("Finished", run.finished or "—"),
         ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),
