@@ -12,9 +12,9 @@ from conformance.harness.protocol import HarnessProtocolError, Plan, PlanKind, R
 @pytest.mark.parametrize(
     ("text", "role", "plan"),
     [
-        ("tx 1000 b1", Role.SENSOR, Plan(PlanKind.TX, start=1000, wire=0xB1)),
-        ("tx 10 8D", Role.SENSOR, Plan(PlanKind.TX, start=10, wire=0x8D)),
-        ("tx 0 30", Role.SENSOR, Plan(PlanKind.TX, start=0, wire=0x30)),  # before now: ASAP
+        ("tx 6000 b1", Role.SENSOR, Plan(PlanKind.TX, start=6000, wire=0xB1)),
+        ("tx 5010 8D", Role.SENSOR, Plan(PlanKind.TX, start=5010, wire=0x8D)),
+        ("tx 5000 30", Role.SENSOR, Plan(PlanKind.TX, start=5000, wire=0x30)),  # now: allowed
         ("wait 5001", Role.SENSOR, Plan(PlanKind.WAIT, start=5001)),
         ("idle", Role.SENSOR, Plan(PlanKind.IDLE)),
         ("brk 5000 17500", Role.RECORDER, Plan(PlanKind.BRK, start=5000, end=17500)),
@@ -40,15 +40,19 @@ def test_well_formed_plans(text, role, plan):
         ("tx -5 30", Role.SENSOR, "not a whole number of microseconds"),
         ("tx 0x10 30", Role.SENSOR, "not a whole number of microseconds"),
         ("tx 1000000000001 30", Role.SENSOR, "beyond 10^12"),
-        ("tx 100 3", Role.SENSOR, "not two hex digits"),
-        ("tx 100 130", Role.SENSOR, "not two hex digits"),
-        ("tx 100 zz", Role.SENSOR, "not two hex digits"),
+        ("tx 6000 3", Role.SENSOR, "not two hex digits"),
+        ("tx 6000 130", Role.SENSOR, "not two hex digits"),
+        ("tx 6000 zz", Role.SENSOR, "not two hex digits"),
+        # a start already past is the harness's mistake, never "now" behind its back
+        ("tx 0 30", Role.SENSOR, "5000 us before now (5000 us): the tool cannot send in the past"),
+        ("tx 4999 30", Role.SENSOR, "1 us before now (5000 us)"),
+        ("brk 4000 16500", Role.RECORDER, "1000 us before now"),
         ("wait 5000", Role.SENSOR, "not after now"),
         ("wait 10", Role.SENSOR, "not after now"),
         ("brk 6000 17500", Role.SENSOR, "recorder harnesses only"),
         ("done", Role.SENSOR, "recorder harnesses only"),
         ("brk 6000 6000", Role.RECORDER, "ends before it starts"),
-        ("brk 0 4000", Role.RECORDER, "ends before it starts"),
+        ("brk 0 4000", Role.RECORDER, "5000 us before now"),
         ("brk 6000", Role.RECORDER, "takes 2 field(s)"),
     ],
 )

@@ -157,11 +157,20 @@ def parse_log(text: str) -> LogLine:
     return LogLine(command, tuple(parts[2:]))
 
 
+def _past(word: str, start: int, now: int) -> str:
+    return (
+        f"'{word}' starts at {start} us, {now - start} us before now ({now} us): the tool "
+        "cannot send in the past (plan from the time of the message you answer)"
+    )
+
+
 def parse_plan(text: str, role: Role, now: int) -> Plan:
     """Check one plan reply against the role and the time ``now`` (us) of the message it
-    answers. A ``tx``/``brk`` start before ``now`` means "as soon as the line lets me" (the
-    bus starts it then); a ``wait`` must be later than ``now`` (else the harness would be woken
-    forever without time passing)."""
+    answers. A ``tx``/``brk`` must not start before ``now``: the tool cannot send in the
+    past, and starting it "now" instead would shorten a break or delay a character behind the
+    harness's back, so that the device is judged for the harness's mistake (a stale clock,
+    as a program let run ahead of the tool's time has). A ``wait`` must be later than ``now``
+    (else the harness would be woken forever without time passing)."""
     parts = text.split(" ")
     word = parts[0]
     if word not in _FIELDS:
@@ -172,11 +181,16 @@ def parse_plan(text: str, role: Role, now: int) -> Plan:
     if role is Role.SENSOR and kind in (PlanKind.BRK, PlanKind.DONE):
         raise HarnessProtocolError(f"'{word}' is for recorder harnesses only", text)
     if kind is PlanKind.TX:
-        return Plan(kind, start=_time(parts[1], text), wire=_byte(parts[2], text))
+        start = _time(parts[1], text)
+        if start < now:
+            raise HarnessProtocolError(_past(word, start, now), text)
+        return Plan(kind, start=start, wire=_byte(parts[2], text))
     if kind is PlanKind.BRK:
         start, end = _time(parts[1], text), _time(parts[2], text)
-        if end <= max(start, now):
-            raise HarnessProtocolError("break ends before it starts (or before now)", text)
+        if start < now:
+            raise HarnessProtocolError(_past(word, start, now), text)
+        if end <= start:
+            raise HarnessProtocolError("break ends before it starts", text)
         return Plan(kind, start=start, end=end)
     if kind is PlanKind.WAIT:
         start = _time(parts[1], text)
