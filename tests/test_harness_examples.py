@@ -128,3 +128,15 @@ def test_a_faulty_recorder_harness_is_caught_by_exactly_its_requirements(fault):
     row = row_from(fault, declared.violates, data, HARNESS + tuple(declared.inconclusive))
     assert row.exact, (row.missed, row.extra)
     assert data["summary"]["verdict"] == "NON-COMPLIANT"
+
+
+def test_the_python_sensor_with_its_extended_commands_has_no_harness_error(tmp_path):
+    """A harness adds frame lengths itself and lands a microsecond off the tool's rounded
+    figure; within the slack that is "now", not a start in the past (the extended commands'
+    long replies showed it: every run ERRORed when the check had no slack)."""
+    decl = tmp_path / "d.toml"
+    decl.write_text('[features]\nextended = ["XSN", "XHELP"]\n', encoding="utf-8")
+    port = f"exec:{sys.executable} {PY_DIR / 'sensor_harness.py'}"
+    data = run_once(port, ("--sdi12-declaration", str(decl), "-k", "extended"))
+    assert data["summary"]["counts"]["ERROR"] == 0, data["summary"]
+    assert {r["id"]: r["verdict"] for r in data["requirements"]}["R-4.4.13-01"] == "PASS"

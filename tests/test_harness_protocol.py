@@ -15,6 +15,8 @@ from conformance.harness.protocol import HarnessProtocolError, Plan, PlanKind, R
         ("tx 6000 b1", Role.SENSOR, Plan(PlanKind.TX, start=6000, wire=0xB1)),
         ("tx 5010 8D", Role.SENSOR, Plan(PlanKind.TX, start=5010, wire=0x8D)),
         ("tx 5000 30", Role.SENSOR, Plan(PlanKind.TX, start=5000, wire=0x30)),  # now: allowed
+        # within the rounding slack of whole-microsecond frame times: taken as now
+        ("tx 4998 30", Role.SENSOR, Plan(PlanKind.TX, start=4998, wire=0x30)),
         ("wait 5001", Role.SENSOR, Plan(PlanKind.WAIT, start=5001)),
         ("idle", Role.SENSOR, Plan(PlanKind.IDLE)),
         ("brk 5000 17500", Role.RECORDER, Plan(PlanKind.BRK, start=5000, end=17500)),
@@ -45,7 +47,7 @@ def test_well_formed_plans(text, role, plan):
         ("tx 6000 zz", Role.SENSOR, "not two hex digits"),
         # a start already past is the harness's mistake, never "now" behind its back
         ("tx 0 30", Role.SENSOR, "5000 us before now (5000 us): the tool cannot send in the past"),
-        ("tx 4999 30", Role.SENSOR, "1 us before now (5000 us)"),
+        ("tx 4997 30", Role.SENSOR, "3 us before now (5000 us)"),
         ("brk 4000 16500", Role.RECORDER, "1000 us before now"),
         ("wait 5000", Role.SENSOR, "not after now"),
         ("wait 10", Role.SENSOR, "not after now"),

@@ -157,6 +157,12 @@ def parse_log(text: str) -> LogLine:
     return LogLine(command, tuple(parts[2:]))
 
 
+#: How far before now a ``tx``/``brk`` may start and still be taken as starting now: frame
+#: times are whole microseconds rounded from 8333.33 us frames, so a harness that adds frame
+#: lengths itself lands up to a microsecond or two off the tool's rounded figure.
+PAST_SLACK_US = 2
+
+
 def _past(word: str, start: int, now: int) -> str:
     return (
         f"'{word}' starts at {start} us, {now - start} us before now ({now} us): the tool "
@@ -182,12 +188,12 @@ def parse_plan(text: str, role: Role, now: int) -> Plan:
         raise HarnessProtocolError(f"'{word}' is for recorder harnesses only", text)
     if kind is PlanKind.TX:
         start = _time(parts[1], text)
-        if start < now:
+        if start < now - PAST_SLACK_US:
             raise HarnessProtocolError(_past(word, start, now), text)
         return Plan(kind, start=start, wire=_byte(parts[2], text))
     if kind is PlanKind.BRK:
         start, end = _time(parts[1], text), _time(parts[2], text)
-        if start < now:
+        if start < now - PAST_SLACK_US:
             raise HarnessProtocolError(_past(word, start, now), text)
         if end <= start:
             raise HarnessProtocolError("break ends before it starts", text)
