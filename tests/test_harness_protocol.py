@@ -14,9 +14,10 @@ from conformance.harness.protocol import HarnessProtocolError, Plan, PlanKind, R
     [
         ("tx 6000 b1", Role.SENSOR, Plan(PlanKind.TX, start=6000, wire=0xB1)),
         ("tx 5010 8D", Role.SENSOR, Plan(PlanKind.TX, start=5010, wire=0x8D)),
-        ("tx 5000 30", Role.SENSOR, Plan(PlanKind.TX, start=5000, wire=0x30)),  # now: allowed
+        ("tx 5000 30", Role.SENSOR, Plan(PlanKind.TX, start=5000, wire=0x30)),
+        ("tx 0 30", Role.SENSOR, Plan(PlanKind.TX, start=0, wire=0x30)),  # before now: ASAP
         # within the rounding slack of whole-microsecond frame times: taken as now
-        ("tx 4998 30", Role.SENSOR, Plan(PlanKind.TX, start=4998, wire=0x30)),
+        ("brk 4998 17500", Role.RECORDER, Plan(PlanKind.BRK, start=4998, end=17500)),
         ("wait 5001", Role.SENSOR, Plan(PlanKind.WAIT, start=5001)),
         ("idle", Role.SENSOR, Plan(PlanKind.IDLE)),
         ("brk 5000 17500", Role.RECORDER, Plan(PlanKind.BRK, start=5000, end=17500)),
@@ -45,9 +46,9 @@ def test_well_formed_plans(text, role, plan):
         ("tx 6000 3", Role.SENSOR, "not two hex digits"),
         ("tx 6000 130", Role.SENSOR, "not two hex digits"),
         ("tx 6000 zz", Role.SENSOR, "not two hex digits"),
-        # a start already past is the harness's mistake, never "now" behind its back
-        ("tx 0 30", Role.SENSOR, "5000 us before now (5000 us): the tool cannot send in the past"),
-        ("tx 4997 30", Role.SENSOR, "3 us before now (5000 us)"),
+        # a break starting already past is the harness's mistake, never "now" behind its back
+        ("brk 0 16500", Role.RECORDER, "5000 us before now (5000 us): the tool cannot send in"),
+        ("brk 4997 16500", Role.RECORDER, "3 us before now (5000 us)"),
         ("brk 4000 16500", Role.RECORDER, "1000 us before now"),
         ("wait 5000", Role.SENSOR, "not after now"),
         ("wait 10", Role.SENSOR, "not after now"),
@@ -112,3 +113,14 @@ def test_the_tools_messages():
     assert proto.heard(0xB1, 0.020333333, 0.028666667) == "char 20333 28667 b1"
     assert proto.sent(0x0A, 1.0, 1.008333333) == "sent 1000000 1008333 0a"
     assert proto.time_is(2.25) == "time 2250000"
+
+
+def test_a_plan_held_back_by_the_frame_just_reported_may_repeat_its_start():
+    """A char is told after its stop bit: a recorder harness that planned brk 5200 before
+    hearing of a char sent 5000..13333 answers that char (now 13333) with the same plan."""
+    plan = proto.parse_plan("brk 5200 20000", Role.RECORDER, now=13333, since=5000)
+    assert plan == Plan(PlanKind.BRK, start=5200, end=20000)
+    with pytest.raises(HarnessProtocolError, match="before now"):
+        proto.parse_plan("brk 4000 20000", Role.RECORDER, now=13333, since=5000)
+    with pytest.raises(HarnessProtocolError, match="before now"):
+        proto.parse_plan("brk 5200 20000", Role.RECORDER, now=13333)  # after sent/time: no

@@ -154,17 +154,18 @@ class Channel:
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
 
-    def plan(self, message: str, role: Role, now: float) -> Plan:
-        """Send a line event (``now`` is its time in s) and return the checked plan."""
+    def plan(self, message: str, role: Role, now: float, since: float | None = None) -> Plan:
+        """Send a line event (``now`` is its time in s; ``since`` the START of the frame a
+        ``char``/``break`` reports) and return the checked plan."""
         self.send(message)
-        return self.read_plan(role, now)
+        return self.read_plan(role, now, since)
 
-    def read_plan(self, role: Role, now: float) -> Plan:
+    def read_plan(self, role: Role, now: float, since: float | None = None) -> Plan:
         """The checked plan answering the line event sent last (at ``now`` s); a recorder
         harness's ``log`` lines before it go to :attr:`logs`."""
         reply = self.answer(aside=self._take_log if role is Role.RECORDER else None)
         try:
-            return parse_plan(reply, role, us(now))
+            return parse_plan(reply, role, us(now), None if since is None else us(since))
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
 

@@ -31,19 +31,20 @@ class HarnessDevice:
         self._plan = Plan(PlanKind.IDLE)
         self._start = 0.0  # the plan's time in s
         self._pending: float | None = None  # time of a message whose answer is unread
+        self._since: float | None = None  # START of the frame that message reported
         self.harness_name = channel.greet(Role.SENSOR)
 
-    def _tell(self, message: str, now: float) -> None:
+    def _tell(self, message: str, now: float, since: float | None = None) -> None:
         """Send a line event; its answer is read when the plan is next needed, so the bus
         does its bookkeeping while the harness works (half the wall time on 2 cores)."""
         self._collect()
         self.channel.send(message)
-        self._pending = now
+        self._pending, self._since = now, since
 
     def _collect(self) -> None:
         if self._pending is not None:
             now, self._pending = self._pending, None
-            self._plan = plan = self.channel.read_plan(Role.SENSOR, now)
+            self._plan = plan = self.channel.read_plan(Role.SENSOR, now, self._since)
             # the harness saw ``now`` rounded to the microsecond; when it answers with that
             # very time it means this instant, not half a microsecond before or after it
             exact = plan.start == proto.us(now)
@@ -62,10 +63,10 @@ class HarnessDevice:
         self._tell(proto.time_is(now), now)
 
     def on_break(self, start: float, end: float) -> None:
-        self._tell(proto.line_break(start, end), end)
+        self._tell(proto.line_break(start, end), end, start)
 
     def on_char(self, wire: int, start: float, end: float) -> None:
-        self._tell(proto.heard(wire, start, end), end)
+        self._tell(proto.heard(wire, start, end), end, start)
 
     def next_frame(self) -> Frame | None:
         if self.plan.kind is not PlanKind.TX:
@@ -187,7 +188,6 @@ def open_sensor_harness(port: str, reply_timeout: float | None = None) -> Harnes
         raise
     bus.attach(device)
     return HarnessLink(bus, device, port.partition(":")[0])
-
 
 
 def _open_kind(port: str, options: PortOptions) -> OpenedPort:

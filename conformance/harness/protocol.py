@@ -170,13 +170,18 @@ def _past(word: str, start: int, now: int) -> str:
     )
 
 
-def parse_plan(text: str, role: Role, now: int) -> Plan:
+def parse_plan(text: str, role: Role, now: int, since: int | None = None) -> Plan:
     """Check one plan reply against the role and the time ``now`` (us) of the message it
-    answers. A ``tx``/``brk`` must not start before ``now``: the tool cannot send in the
-    past, and starting it "now" instead would shorten a break or delay a character behind the
-    harness's back, so that the device is judged for the harness's mistake (a stale clock,
-    as a program let run ahead of the tool's time has). A ``wait`` must be later than ``now``
-    (else the harness would be woken forever without time passing)."""
+    answers. A ``brk`` must not start before ``now``: the tool cannot send in the past, and
+    starting it "now" instead would shorten the break behind the harness's back, so that the
+    recorder is judged for the harness's mistake (a stale clock, as a program let run ahead
+    of the tool's time has). A ``tx`` start before ``now`` still means "as soon as the line
+    lets me". The one past break start that is no mistake: a ``char``/``break`` message is
+    told after the frame ends, so a plan made before it for a time inside that frame is held
+    back by it, and repeating it is right; ``since`` (the reported frame's START) is then
+    the earliest start accepted. A ``wait`` must be
+    later than ``now`` (else the harness would be woken forever without time passing)."""
+    floor = now if since is None else min(now, since)
     parts = text.split(" ")
     word = parts[0]
     if word not in _FIELDS:
@@ -187,16 +192,15 @@ def parse_plan(text: str, role: Role, now: int) -> Plan:
     if role is Role.SENSOR and kind in (PlanKind.BRK, PlanKind.DONE):
         raise HarnessProtocolError(f"'{word}' is for recorder harnesses only", text)
     if kind is PlanKind.TX:
-        start = _time(parts[1], text)
-        if start < now - PAST_SLACK_US:
-            raise HarnessProtocolError(_past(word, start, now), text)
-        return Plan(kind, start=start, wire=_byte(parts[2], text))
+        # a character planned in the past goes out as soon as the line lets it (harnesses
+        # that queue replies rely on it, e.g. a service request queued behind a reply)
+        return Plan(kind, start=_time(parts[1], text), wire=_byte(parts[2], text))
     if kind is PlanKind.BRK:
         start, end = _time(parts[1], text), _time(parts[2], text)
-        if start < now - PAST_SLACK_US:
+        if start < floor - PAST_SLACK_US:
             raise HarnessProtocolError(_past(word, start, now), text)
-        if end <= start:
-            raise HarnessProtocolError("break ends before it starts", text)
+        if end <= max(start, now):
+            raise HarnessProtocolError("break ends before it starts (or before now)", text)
         return Plan(kind, start=start, end=end)
     if kind is PlanKind.WAIT:
         start = _time(parts[1], text)

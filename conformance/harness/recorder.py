@@ -89,7 +89,7 @@ class HarnessRecorder:
             if heard:
                 got = heard[0]
                 message = proto.heard(got.wire, got.start, got.end)
-                plan = channel.plan(message, Role.RECORDER, got.end)
+                plan = channel.plan(message, Role.RECORDER, got.end, got.start)
                 continue
             if plan.kind is PlanKind.IDLE:
                 return f"idle with a quiet line for {IDLE_END:g} s of bus time"
