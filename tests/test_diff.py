@@ -90,9 +90,17 @@ def test_runs_of_different_roles_and_unreadable_files_are_refused(tmp_path: Path
 # -- live: the clean simulated sensor against faulty ones -----------------------------------
 
 
+class CleanRuns(dict):
+    """The clean sim's verdicts per version, each run once and only if a fault needs it."""
+
+    def __missing__(self, version: str) -> dict:
+        self[version] = run_once(f"sim://?version={version[0]}.{version[1]}")
+        return self[version]
+
+
 @pytest.fixture(scope="module")
-def clean() -> dict[str, dict]:
-    return {v: run_once(f"sim://?version={v[0]}.{v[1]}") for v in ("13", "14")}
+def clean() -> CleanRuns:
+    return CleanRuns()
 
 
 def worse_requirements(clean: dict, fault: str) -> set[str]:
@@ -101,13 +109,11 @@ def worse_requirements(clean: dict, fault: str) -> set[str]:
     return {c.requirement for c in diff_runs(clean[version], run_once(port)) if c.worse}
 
 
+#: one fault each of framing, addressing, measurement state and high volume (CI time is
+#: budgeted: the fault matrix itself proves every fault's requirements)
 SAMPLE = [
-    "wrong-crc",
     "missing-crlf",
     "answers-foreign-address",
-    "no-service-request",
-    "value-ten-chars",
-    "standby-after-60ms",
     "abort-keeps-old-data",
     "high-volume-two-digit-count",
 ]
