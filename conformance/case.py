@@ -53,9 +53,7 @@ class Case:
     def add(self, *findings: Finding) -> None:
         self.extend(findings)
 
-    def requires(
-        self, code: str, unmet: Unmet | None, only: Iterable[str] | None = None
-    ) -> bool:
+    def requires(self, code: str, unmet: Unmet | None, only: Iterable[str] | None = None) -> bool:
         """Apply the outcome of a declared precondition's check
         (:mod:`conformance.preconditions`): True when it held. When it did not, every
         requirement it guards is INCONCLUSIVE "precondition not met: <code>: ..." with the

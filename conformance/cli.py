@@ -113,7 +113,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     from .ports import PortError, is_sim, parse_sim
     from .preflight import check_report_dir, check_role_options
     from .report_folder import new_report_dir
-    from .reports.diff import DiffError
+    from .reports.diff import DiffError, load_run
     from .selection import SelectionError, resolve
 
     if args.port is None:
@@ -132,11 +132,8 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             normalise_version(args.sdi_version)
         if args.declaration:
             load_declaration(args.declaration)
-        baseline = None
-        if getattr(args, "baseline", None):
-            from .diff_command import check_baseline
-
-            baseline = check_baseline(args.baseline)
+        # the baseline is read before the run: a bad path is a usage error, not a late one
+        baseline = load_run(args.baseline) if getattr(args, "baseline", None) else None
         if args.role == "recorder":
             from .recorder.session import check_port
 

@@ -52,11 +52,6 @@ def diff_main(argv: list[str], console: Console) -> int:
     return EXIT_NON_COMPLIANT if worse(changes) else EXIT_OK
 
 
-def check_baseline(path: str) -> dict:
-    """The baseline run, read before the run starts (a bad path is a usage error then)."""
-    return load_run(path)
-
-
 def against_baseline(
     baseline: dict, name: str, data: dict, run_dir: Path, code: int, console: Console
 ) -> int:

@@ -310,9 +310,7 @@ def served(present: bool, detail: str, evidence: Iterable[str] = ()) -> Unmet | 
     return Unmet("supported", detail, tuple(evidence), absent=True)
 
 
-def shown_supported(
-    present: bool, detail: str, evidence: Iterable[str] = ()
-) -> Unmet | None:
+def shown_supported(present: bool, detail: str, evidence: Iterable[str] = ()) -> Unmet | None:
     """A capability the rule needs was not shown although the sensor must (or says it does)
     have it: INCONCLUSIVE, since its absence is another rule's FAIL, not this one's N/A."""
     if present:

@@ -1,4 +1,4 @@
-""""Did you mean": the nearest known names to a mistyped one, for every error that refuses
+""" "Did you mean": the nearest known names to a mistyped one, for every error that refuses
 a name (a subcommand, a fault, a profile). A user who typed ``no-service-requst`` should not
 have to read a table of 124 faults to find the one they meant."""
 

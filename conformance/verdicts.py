@@ -53,6 +53,7 @@ _RANK = {
     Verdict.ERROR: 5,
 }
 
+
 def worst(verdicts: Iterable[Verdict], default: Verdict = Verdict.NA) -> Verdict:
     result = None
     for v in verdicts:

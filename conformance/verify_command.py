@@ -98,25 +98,23 @@ def verify_main(argv: list[str], console: Console, judge: Judge) -> int:
 
 
 def _rejudge(folder: Path, console: Console, judge: Judge) -> dict | None:
-    """The folder judged again by replay into a scratch folder; None if it cannot be."""
-    from .offline.judge import JudgeError, plan
+    """The folder judged again by replay into a scratch folder; None if it cannot be (its
+    verdicts came out of passive judging, or none at all: ``judge``'s notes say why)."""
+    from io import StringIO
 
-    try:
-        found = plan([str(folder)])
-    except JudgeError as exc:
-        console.print(f"note: {exc}", markup=False, highlight=False)
-        return None
-    if found.replay_argv is None:
-        for note in found.notes:
-            console.print(f"note: {note}", markup=False, highlight=False)
-        return None
+    from rich.console import Console as RichConsole
+
+    from .replay.link import SCHEME
+
+    said = StringIO()
     with tempfile.TemporaryDirectory(prefix="sdi12-verify-") as tmp:
         out = Path(tmp) / "rejudged"
-        from io import StringIO
-
-        from rich.console import Console as RichConsole
-
-        quiet = RichConsole(file=StringIO())
-        judge([str(folder), "--report-dir", str(out)], quiet)
+        judge([str(folder), "--report-dir", str(out)], RichConsole(file=said, width=200))
         file = out / "verdicts.json"
-        return json.loads(file.read_text(encoding="utf-8")) if file.is_file() else None
+        data = json.loads(file.read_text(encoding="utf-8")) if file.is_file() else None
+    if data is not None and str(data["run"]["port"]).startswith(SCHEME):
+        return data
+    for line in said.getvalue().splitlines():
+        if line.startswith(("note:", "error:")):
+            console.print(line, markup=False, highlight=False)
+    return None

@@ -157,7 +157,7 @@ def parse_log(text: str) -> LogLine:
     return LogLine(command, tuple(parts[2:]))
 
 
-#: How far before now a ``tx``/``brk`` may start and still be taken as starting now: frame
+#: How far before now a ``brk`` may start and still be taken as starting now: frame
 #: times are whole microseconds rounded from 8333.33 us frames, so a harness that adds frame
 #: lengths itself lands up to a microsecond or two off the tool's rounded figure.
 PAST_SLACK_US = 2
@@ -179,8 +179,8 @@ def parse_plan(text: str, role: Role, now: int, since: int | None = None) -> Pla
     lets me". The one past break start that is no mistake: a ``char``/``break`` message is
     told after the frame ends, so a plan made before it for a time inside that frame is held
     back by it, and repeating it is right; ``since`` (the reported frame's START) is then
-    the earliest start accepted. A ``wait`` must be
-    later than ``now`` (else the harness would be woken forever without time passing)."""
+    the earliest start accepted. A ``wait`` must be later than ``now`` (else the harness
+    would be woken forever without time passing)."""
     floor = now if since is None else min(now, since)
     parts = text.split(" ")
     word = parts[0]

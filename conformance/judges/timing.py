@@ -227,8 +227,7 @@ def _by_place(
         found = combine(rid, rest, what, smallest_is_worst=smallest_is_worst)
         lone = failing[0]
         said = "; ".join(
-            f"{bad} of {total} at {_where(p)}"
-            for p, (bad, total) in pattern.not_reproduced.items()
+            f"{bad} of {total} at {_where(p)}" for p, (bad, total) in pattern.not_reproduced.items()
         )
         found.detail += (
             f"; {len(failing)} deviating {plural(what) if len(failing) != 1 else what} set "

@@ -198,8 +198,6 @@ def _low_latency(raw: serial.SerialBase) -> bool:
     return True
 
 
-
-
 def _kind(
     name: str, setup: LineSetup, info: LinkInfo, example: str, *, fallback: bool = False
 ) -> LinkKind:

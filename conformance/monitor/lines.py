@@ -123,7 +123,14 @@ class LineTracker:
         else:
             flags = []
         return BusLine(
-            "chars", run[0].start, run[-1].end, d.side, d.sure, d.how, escape(text), gap,
+            "chars",
+            run[0].start,
+            run[-1].end,
+            d.side,
+            d.sure,
+            d.how,
+            escape(text),
+            gap,
             tuple(flags),
         )
 

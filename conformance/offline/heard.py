@@ -196,8 +196,10 @@ def _collected(m: Measurement) -> bool:
     if m.binary:
         if m.binary_value_count >= m.count:
             return True
-        return len(last.reply_bytes) <= EMPTY_PACKET or last.command is None or (
-            last.command.index is not None and last.command.index >= LAST_HV_INDEX
+        return (
+            len(last.reply_bytes) <= EMPTY_PACKET
+            or last.command is None
+            or (last.command.index is not None and last.command.index >= LAST_HV_INDEX)
         )
     if m.value_count >= m.count:
         return True

@@ -485,9 +485,7 @@ _FAULTS = (
         "Transparent mode drops identify and metadata commands (aIM!, aIM_001!...) instead of "
         "passing them on.",
         ("R-6.3-01", "R-4.4.14-02"),
-        lambda: LacksCommandsRecorder(
-            lacks=frozenset({Kind.METADATA, Kind.IDENTIFY_MEASUREMENT})
-        ),
+        lambda: LacksCommandsRecorder(lacks=frozenset({Kind.METADATA, Kind.IDENTIFY_MEASUREMENT})),
     ),
     RecorderFault(
         "multiline-cut-short",
@@ -540,8 +538,7 @@ _FAULTS = (
     ),
     RecorderFault(
         "addresses-0-4-only",
-        "Can only use addresses 0-4: commands to sensors at 5-9, or moving one there, are "
-        "skipped.",
+        "Can only use addresses 0-4: commands to sensors at 5-9, or moving one there, are skipped.",
         ("R-4.3-03", "R-4.4-02"),
         lambda: LacksCommandsRecorder(unreachable="56789"),
     ),

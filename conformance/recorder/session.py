@@ -123,13 +123,7 @@ class RecorderSession:
                 "or --port rfc2217-serve://127.0.0.1:0 (served in real time, "
                 "the recorder connects over RFC 2217)"
             )
-        spec = (
-            parse_served(port)
-            if served
-            else SimSpec()
-            if harness or replay
-            else parse_sim(port)
-        )
+        spec = parse_served(port) if served else SimSpec() if harness or replay else parse_sim(port)
         faults = tuple(f for f in spec.extra.get("recorder-faults", "").split(",") if f)
         unknown = [f for f in faults if f not in RECORDER_FAULTS]
         if unknown or len(faults) > 1:

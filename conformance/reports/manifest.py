@@ -22,11 +22,8 @@ CATALOG = Path(__file__).resolve().parent.parent / "catalog.json"
 
 
 def digest(path: Path) -> str:
-    h = hashlib.sha256()
     with path.open("rb") as f:
-        for block in iter(lambda: f.read(1 << 16), b""):
-            h.update(block)
-    return h.hexdigest()
+        return hashlib.file_digest(f, ALGORITHM).hexdigest()
 
 
 def build_manifest(directory: Path, declaration: str | None, tool_version: str) -> dict[str, Any]:

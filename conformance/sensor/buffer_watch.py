@@ -38,7 +38,5 @@ class WatchedMaster(Master):
         command, reply = self.last_sent.get(address, (None, ""))
         body = reply.rstrip("\r\n")
         return (
-            command is not None
-            and command.kind is Kind.DATA
-            and any(c.isdigit() for c in body[1:])
+            command is not None and command.kind is Kind.DATA and any(c.isdigit() for c in body[1:])
         )

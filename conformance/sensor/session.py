@@ -347,9 +347,7 @@ class SensorSession:
         values, or ``code`` delivered none when it was cached (it would fill nothing). For
         cases that judge whether an abort emptied the buffer, which must not depend on what
         the case before them left in it."""
-        if self.measurement(code).value_count and not self.master.buffer_holds_values(
-            self.address
-        ):
+        if self.measurement(code).value_count and not self.master.buffer_holds_values(self.address):
             self.fresh_measurement(code)
 
     def feature(self, name: str) -> bool | None:

@@ -85,6 +85,4 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
 
 def collision_notes(events: Iterable[Event]) -> list[Event]:
     """The collision NOTEs of a transcript (old transcripts simply have none)."""
-    return [
-        e for e in events if e.kind is EventKind.NOTE and e.text.startswith(COLLISION_PREFIX)
-    ]
+    return [e for e in events if e.kind is EventKind.NOTE and e.text.startswith(COLLISION_PREFIX)]

@@ -176,9 +176,7 @@ def _as_reply(text: str, shown: str, gap: float, slack: float, s: _State) -> Dir
     ``slack``: how far the stamps may misplace ``gap`` (a start they cannot place outside
     the window is not a reason to doubt who sent it; the timing judges weigh it)."""
     window = RESPONSE_START_MIN - slack <= gap <= RESPONSE_START_MAX + TOLERANCE + slack
-    when = f"{_ms(gap)} after '{escape(s.command)}'" + (
-        "" if window else " (outside 7.93-15.4 ms)"
-    )
+    when = f"{_ms(gap)} after '{escape(s.command)}'" + ("" if window else " (outside 7.93-15.4 ms)")
     if _binary_command(s.command):
         return Direction(SENSOR, f"a packet answering '{escape(s.command)}', {when}", window)
     if _looks_like_command(text):

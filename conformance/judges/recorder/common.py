@@ -23,6 +23,8 @@ def beyond_reaction(delay: float, what: str) -> str:
         f"aD0! came {delay:.3f} s after {what}, later than the {REACTION} s the tool allows "
         f"(decision {REACTION_DECISION}: the standard gives no figure, so not a FAIL)"
     )
+
+
 #: Values a recorder must be able to store from one concurrent measurement (R-4.4.7-07, 2000).
 MIN_CONCURRENT_STORE = 20
 #: Measurements that end their wait with a service request (M family, V).
@@ -44,7 +46,8 @@ def record_of(transmissions: list[Transmission], texts: list[str] | None = None)
     sent = sorted({escape(t.text) for t in transmissions})
     return [
         f"{len(transmissions)} transmissions from t={first.first_char:.3f} s to "
-        f"t={last.first_char:.3f} s, of {len(sent)} kinds: " + " ".join(sent[:20])
+        f"t={last.first_char:.3f} s, of {len(sent)} kinds: "
+        + " ".join(sent[:20])
         + (" ..." if len(sent) > 20 else "")
     ]
 

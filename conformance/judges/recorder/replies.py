@@ -57,4 +57,3 @@ def first_answered(line: TranscriptView, uncertainty: float) -> dict[str, Transm
         if text not in found and reply_problem(s, crc[i], uncertainty) is None:
             found[text] = s
     return found
-

@@ -199,9 +199,7 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
                             )
                         )
                 elif nxt is not None and nxt.in_window(uncertainty):
-                    ends.append(
-                        _retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty)
-                    )
+                    ends.append(_retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty))
                 elif nxt is None and later is not None:
                     restarted.append(f"{a.after()}: {a.instead(later)}")
             if any(a.problem is None for a in seq) or not gave_up:
