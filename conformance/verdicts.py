@@ -63,6 +63,42 @@ def worst(verdicts: Iterable[Verdict], default: Verdict = Verdict.NA) -> Verdict
 
 
 @dataclass
+class Distribution:
+    """What a timed rule measured, all of it: a maker wants to know that the firmware passes
+    by 0.3 ms, not only that it passes (issue 24). Figures in ms.
+
+    ``low_ms``/``high_ms`` are the edges the verdict used (the standard's limit widened by its
+    tolerance), None where the rule has no such edge; ``mixed_limits`` says the observations
+    were judged against different edges (a wait that depends on each measurement's ttt), so
+    only the slack is comparable. ``slack_ms`` is each observation's distance to its nearer
+    edge, positive inside, sampled to at most :data:`MAX_TICKS` (min and max always kept);
+    ``values_ms`` the matching measurements.
+    """
+
+    count: int
+    min_ms: float
+    median_ms: float
+    max_ms: float
+    low_ms: float | None
+    high_ms: float | None
+    uncertainty_ms: float
+    margin_ms: float  # the smallest slack: negative when an observation is outside
+    mixed_limits: bool = False
+    values_ms: list[float] = field(default_factory=list)
+    slack_ms: list[float] = field(default_factory=list)
+
+    def margin_in_uncertainty(self, uncertainty_ms: float | None = None) -> float | None:
+        """The margin counted in uncertainties (None on an exact clock: any margin is
+        decided there)."""
+        u = max(self.uncertainty_ms, uncertainty_ms or 0.0)
+        return None if u <= 0 else round(self.margin_ms / u, 2)
+
+
+#: ticks a distribution keeps for the report's strip chart (a run judges ~16,000 gaps)
+MAX_TICKS = 240
+
+
+@dataclass
 class Finding:
     """One judged fact: a verdict on one requirement, with the evidence a reader needs.
 
@@ -87,6 +123,8 @@ class Finding:
     margin_ms: float | None = None
     observed: int = 0
     consequence_of: str | None = None  # the root finding's requirement (root_causes.py)
+    # timing findings: every measurement the verdict rests on (issue 24, margins)
+    distribution: Distribution | None = None
 
     def __post_init__(self) -> None:
         if self.verdict is Verdict.PASS and self.observed < 1:

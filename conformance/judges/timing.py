@@ -10,10 +10,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from statistics import median
 
 from ..preconditions import awake
 from ..protocol.timing import STANDBY_MARKING, TOLERANCE
-from ..verdicts import Finding, Verdict
+from ..verdicts import MAX_TICKS, Distribution, Finding, Verdict
 
 EPSILON = 1e-9  # s: a value exactly on a limit is inside it, whatever float rounding says
 
@@ -196,6 +197,8 @@ def combine_local(
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
         found.detail += f"; {note}"
+    # the chart shows every observation, also those a real-time link's stalls set aside
+    found.distribution = distribution([o[0] for o in observed])
     return found
 
 
@@ -320,7 +323,75 @@ class Window:
             decision=self.decision,
             margin_ms=_margin_ms(lo, hi, measured, outside),
             observed=1,  # one measured interval between two observed wire events
+            distribution=_single(measured, uncertainty, lo, hi),
         )
+
+
+def _slack(lo: float | None, hi: float | None, measured: float) -> float:
+    """Distance (s) from ``measured`` to its nearer edge, negative when outside."""
+    edges = [e for e in (None if lo is None else measured - lo,
+                         None if hi is None else hi - measured) if e is not None]  # fmt: skip
+    return min(edges) if edges else 0.0
+
+
+def _ms(seconds: float | None) -> float | None:
+    return None if seconds is None else round(seconds * 1e3, 3) + 0.0  # never -0.0
+
+
+def _single(
+    measured: float, uncertainty: float, lo: float | None, hi: float | None
+) -> Distribution:
+    value = round(measured * 1e3, 3)
+    slack = round(_slack(lo, hi, measured) * 1e3, 3)
+    return Distribution(1, value, value, value, _ms(lo), _ms(hi), round(uncertainty * 1e3, 3),
+                        slack, values_ms=[value], slack_ms=[slack])  # fmt: skip
+
+
+def distribution(observations: Sequence[Finding | Measured]) -> Distribution | None:
+    """Every measurement of ``observations`` as one :class:`Distribution` (None when none
+    was judged against a window): what the margins chart and ``verdicts.json`` show."""
+    values: list[float] = []
+    slacks: list[float] = []
+    edges: set[tuple[float | None, float | None]] = set()
+    uncertainty = 0.0
+    count = 0
+    for o in observations:
+        if isinstance(o, Measured):
+            lo, hi = o._window.lo, o._window.hi
+            values.append(o.measured_ms)
+            slacks.append(round(_slack(lo, hi, o.measured) * 1e3, 3))
+            edges.add((_ms(lo), _ms(hi)))
+            uncertainty = max(uncertainty, o.uncertainty * 1e3)
+            count += 1
+        elif o.distribution is not None:
+            d = o.distribution
+            values.extend(d.values_ms)
+            slacks.extend(d.slack_ms)
+            edges.add((d.low_ms, d.high_ms))
+            uncertainty = max(uncertainty, d.uncertainty_ms)
+            count += d.count
+    if not values:
+        return None
+    pairs = sorted(zip(values, slacks, strict=True))
+    if len(pairs) > MAX_TICKS:  # evenly through the sorted values: min and max kept
+        step = (len(pairs) - 1) / (MAX_TICKS - 1)
+        kept = [pairs[round(i * step)] for i in range(MAX_TICKS)]
+    else:
+        kept = pairs
+    low, high = next(iter(edges)) if len(edges) == 1 else (None, None)
+    return Distribution(
+        count,
+        pairs[0][0],
+        round(median(v for v, _ in pairs), 3),
+        pairs[-1][0],
+        low,
+        high,
+        round(uncertainty, 3),
+        min(s for _, s in pairs),
+        mixed_limits=len(edges) > 1,
+        values_ms=[v for v, _ in kept],
+        slack_ms=[s for _, s in kept],
+    )
 
 
 def _window_verdict(
@@ -521,4 +592,5 @@ def combine(
         evidence=worst.evidence,
         margin_ms=margin,
         observed=sum(f.observed for f in findings),
+        distribution=distribution(findings),
     )

@@ -14,6 +14,7 @@ from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL, ConformanceRun
 from .evidence import WireRef, wire_refs
+from .margins import distribution_json, margins_json
 
 SCHEMA = "sdi12-conform/verdicts/1"
 
@@ -78,6 +79,8 @@ def build(run: ConformanceRun) -> dict[str, Any]:
         },
         "dut": dut_block(run),
         "summary": {"verdict": run.verdict, "counts": counts(results)},
+        # every timed rule's smallest margin to its limit (finding "distribution": all of it)
+        "margins": margins_json(results),
         "requirements": [
             {
                 "id": r.requirement.id,
@@ -121,6 +124,8 @@ def _finding(f: Any, wire: WireRef | None = None) -> dict[str, Any]:
         "consequence_of": f.consequence_of,
         # FAIL/WARN/INCONCLUSIVE: the exchange it rests on, as transcript.jsonl positions
         "wire": wire.to_json() if wire is not None else None,
+        # timed rules: every measurement behind the verdict (margins, issue 24)
+        "distribution": distribution_json(f),
     }
 
 
