@@ -14,6 +14,9 @@ Without one the tool discovers what it can and says in the report what it assume
     [measurements]               # expected value counts per command code
     M = 3
     C = 20
+    [ttt]                        # announced seconds per command code (sdi12-conform plan)
+    M = 2
+    C = 3
 """
 
 from __future__ import annotations
@@ -50,6 +53,8 @@ class Declaration:
     features: dict[str, bool] = field(default_factory=dict)
     extended: tuple[str, ...] = ()
     measurements: dict[str, int] = field(default_factory=dict)
+    #: announced ttt (s) per measurement code: what ``sdi12-conform plan`` times the run by
+    ttt: dict[str, int] = field(default_factory=dict)
     factory_fresh: bool = False  # the unit has not been re-addressed since it left the factory
     source: str = ""
 
@@ -73,6 +78,7 @@ TOP_LEVEL: dict[str, type | tuple[type, ...]] = {
     "factory_fresh": bool,
     "features": dict,
     "measurements": dict,
+    "ttt": dict,
 }
 MEASUREMENT_CODE = re.compile(r"^(?:[MC]C?[1-9]?|H[AB]|V)$")
 
@@ -122,12 +128,19 @@ def load_declaration(path: str | Path) -> Declaration:
             raise refuse("measurements", key, "not a measurement command (M, M1..M9, C, MC1...)")
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 999:
             raise refuse("measurements", key, f"must be a value count 0..999, not {value!r}")
+    ttt = raw.get("ttt", {})
+    for key, value in ttt.items():
+        if not MEASUREMENT_CODE.match(key):
+            raise refuse("ttt", key, "not a measurement command (M, M1..M9, C, MC1...)")
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 999:
+            raise refuse("ttt", key, f"must be whole seconds 0..999, not {value!r}")
     return Declaration(
         address=address,
         sdi12_version=claimed,
         features={k: v for k, v in features.items() if k in FEATURES},
         extended=tuple(features.get("extended", [])),
         measurements=dict(measurements),
+        ttt=dict(ttt),
         factory_fresh=raw.get("factory_fresh", False),
         source=str(path),
     )

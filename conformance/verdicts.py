@@ -72,7 +72,8 @@ class Distribution:
     were judged against different edges (a wait that depends on each measurement's ttt), so
     only the slack is comparable. ``slack_ms`` is each observation's distance to its nearer
     edge, positive inside, sampled to at most :data:`MAX_TICKS` (min and max always kept);
-    ``values_ms`` the matching measurements.
+    ``values_ms`` the matching measurements. ``uncertainty_ms`` is the observations' median
+    uncertainty (on a real link a few stamps near a host stall are far wider than the rest).
     """
 
     count: int
@@ -84,13 +85,14 @@ class Distribution:
     uncertainty_ms: float
     margin_ms: float  # the smallest slack: negative when an observation is outside
     mixed_limits: bool = False
+    set_aside: int = 0  # observations a real-time link's irregular stamps left undecided
     values_ms: list[float] = field(default_factory=list)
     slack_ms: list[float] = field(default_factory=list)
 
     def margin_in_uncertainty(self, uncertainty_ms: float | None = None) -> float | None:
         """The margin counted in uncertainties (None on an exact clock: any margin is
         decided there)."""
-        u = max(self.uncertainty_ms, uncertainty_ms or 0.0)
+        u = self.uncertainty_ms if uncertainty_ms is None else uncertainty_ms
         return None if u <= 0 else round(self.margin_ms / u, 2)
 
 

@@ -197,8 +197,10 @@ def combine_local(
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
         found.detail += f"; {note}"
-    # the chart shows every observation, also those a real-time link's stalls set aside
-    found.distribution = distribution([o[0] for o in observed])
+    # the figures the verdict rests on; what the link's irregular stamps set aside is counted
+    found.distribution = distribution(kept)
+    if found.distribution is not None:
+        found.distribution.set_aside = len(aside)
     return found
 
 
@@ -353,7 +355,7 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
     values: list[float] = []
     slacks: list[float] = []
     edges: set[tuple[float | None, float | None]] = set()
-    uncertainty = 0.0
+    uncertainties: list[float] = []
     count = 0
     for o in observations:
         if isinstance(o, Measured):
@@ -361,14 +363,14 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
             values.append(o.measured_ms)
             slacks.append(round(_slack(lo, hi, o.measured) * 1e3, 3))
             edges.add((_ms(lo), _ms(hi)))
-            uncertainty = max(uncertainty, o.uncertainty * 1e3)
+            uncertainties.append(o.uncertainty * 1e3)
             count += 1
         elif o.distribution is not None:
             d = o.distribution
             values.extend(d.values_ms)
             slacks.extend(d.slack_ms)
             edges.add((d.low_ms, d.high_ms))
-            uncertainty = max(uncertainty, d.uncertainty_ms)
+            uncertainties.append(d.uncertainty_ms)
             count += d.count
     if not values:
         return None
@@ -386,7 +388,7 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
         pairs[-1][0],
         low,
         high,
-        round(uncertainty, 3),
+        round(median(uncertainties), 3),  # typical: a few stamps near a stall are far wider
         min(s for _, s in pairs),
         mixed_limits=len(edges) > 1,
         values_ms=[v for v, _ in kept],

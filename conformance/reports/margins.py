@@ -22,8 +22,8 @@ from ..results import RequirementResult
 from ..verdicts import Distribution, Finding
 
 WIDTH = 700  # px: the whole strip fits an A4 page printed at 100 %
-LABEL = 150  # px for the requirement on the left
-FIGURES = 170  # px for the figures on the right
+LABEL = 140  # px for the requirement on the left
+FIGURES = 190  # px for the figures on the right
 PLOT = WIDTH - LABEL - FIGURES
 ROW = 44
 
@@ -73,7 +73,9 @@ def margins_json(results: list[RequirementResult]) -> list[dict[str, Any]]:
 
 
 def _uncertainty(f: Finding, d: Distribution) -> float:
-    return max(d.uncertainty_ms, f.uncertainty_ms or 0.0)
+    """The band drawn: the finding's own uncertainty (its worst observation's, or the larger
+    one :func:`~conformance.judges.timing.recheck` re-judged it with), else the typical."""
+    return f.uncertainty_ms if f.uncertainty_ms is not None else d.uncertainty_ms
 
 
 def nice_ticks(lo: float, hi: float, most: int = 5) -> list[float]:
@@ -167,7 +169,8 @@ def strip(r: RequirementResult, f: Finding, count: int) -> str:
     in_u = d.margin_in_uncertainty(f.uncertainty_ms)
     margin = f"margin {_fmt(d.margin_ms)} ms" + (f" = {in_u:g} u" if in_u is not None else "")
     figures = (f"n={count} · {_fmt(d.min_ms)} / {_fmt(d.median_ms)} / {_fmt(d.max_ms)} ms",
-               f"{margin} · ±{u:.2f} ms")  # fmt: skip
+               f"{margin} · ±{u:.2f} ms"
+               + (f" · {d.set_aside} set aside" if d.set_aside else ""))  # fmt: skip
     return (
         f'<svg class="sdi12-strip" data-requirement="{rid}" width="{WIDTH}" height="{ROW}" '
         f'viewBox="0 0 {WIDTH} {ROW}" role="img" aria-label="{rid} {unit}">'
