@@ -102,6 +102,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="compare the run with an earlier one (its folder or verdicts.json) at its end; "
         "the exit code is then 1 if anything got worse, 0 if not (sdi12-conform diff --help)",
     )
+    p.add_argument(
+        "--plan",
+        choices=("auto", "always", "never"),
+        default="auto",
+        help="write the test plan (sdi12-conform plan) into the run folder first and show it "
+        "in the report beside what was judged; auto: on real-time links, where the run takes "
+        "minutes and the dry run a few seconds (default: auto)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p
 
@@ -137,16 +145,20 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         if args.role == "recorder":
             from .recorder.session import check_port
 
-            check_port(args.port, args.trigger)  # the port and recorder before pytest starts
+            # the port and recorder before pytest starts
+            real_time = check_port(args.port, args.trigger)
         elif is_sim(args.port):
             from .ports import open_sim
 
             open_sim(parse_sim(args.port))  # validate faults/parameters before pytest starts
+            real_time = False
         else:
             from .ports import open_port
 
             # a port that cannot be opened: a usage error
-            open_port(args.port, echo=args.echo, direction=args.direction).link.close()
+            link = open_port(args.port, echo=args.echo, direction=args.direction).link
+            real_time = not link.info.virtual_time
+            link.close()
         # a folder of this run's own: a new one, or the named one unless a live run holds it
         report_dir = Path(args.report_dir) if args.report_dir else new_report_dir(args.role)
         check_report_dir(report_dir)
@@ -158,9 +170,29 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
         error(f"error: {exc}{also if isinstance(exc, PortMissing) else ''}")
         return EXIT_USAGE
     try:
+        if args.plan == "always" or (args.plan == "auto" and real_time):
+            _plan_first(args, report_dir, console)
         return _run_pytest(args, report_dir, console, baseline)
     finally:
         report_folder.release(report_dir)
+
+
+def _plan_first(args: argparse.Namespace, report_dir: Path, console: Console) -> None:
+    """The test plan into the run folder before the run (issue 24): the report shows it next
+    to what was judged, and the user sees how long the run will take on the bus."""
+    from .plan_command import make_plan
+    from .reports.plan import write_plan
+
+    plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
+                     tuple(args.req))  # fmt: skip
+    write_plan(report_dir, plan)
+    minutes = (plan["expected_bus_s"] or 0.0) / 60
+    console.print(
+        f"plan: {len(plan['cases'])} cases, about {minutes:.1f} min on the bus "
+        f"(at least; {report_dir / 'plan.json'})",
+        markup=False,
+        highlight=False,
+    )
 
 
 def _run_pytest(
@@ -470,7 +502,9 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
 #: The subcommands that stop at once on Ctrl-C (KeyboardInterrupt: exit 2, outputs whole or
 #: absent); ``judge`` and ``verify`` run the suite, whose interrupts the guard turns into a
 #: partial report.
-SUBCOMMANDS = ("list", "faults", "matrix", "emulate", "export", "monitor", "calibrate", "diff")
+SUBCOMMANDS = (
+    "list", "faults", "matrix", "emulate", "export", "monitor", "calibrate", "diff", "plan"
+)  # fmt: skip
 #: what the main --help says of each subcommand (`sdi12-conform SUBCOMMAND --help`: the rest)
 SUBCOMMAND_HELP = {
     "judge": "judge a recording: a run's transcript.jsonl or folder, a .sr, .vcd or .csv",
@@ -483,6 +517,7 @@ SUBCOMMAND_HELP = {
     "calibrate": "measure a real bench's timing before a long run",
     "diff": "what changed between two runs (exit 1 when anything got worse)",
     "verify": "check a run folder without the device: hashes, then the recording re-judged",
+    "plan": "the test plan without touching the bus: cases, what they send, expected bus time",
 }
 
 
@@ -547,6 +582,10 @@ def _dispatch(argv: list[str]) -> int:
             from .diff_command import diff_main
 
             return diff_main(argv[1:], console)
+        if argv and argv[0] == "plan":
+            from .plan_command import plan_main
+
+            return plan_main(argv[1:])
         if argv and argv[0] == "verify":
             from .verify_command import verify_main
 

@@ -283,7 +283,9 @@ def pytest_runtest_call(item: pytest.Item):
     run = run_of(item.config)
     run.cases.append(record)
     started = time.perf_counter()
-    first_event = 0 if whole_run.is_whole_run(item) else _transcript_length(run)
+    before = _transcript_length(run)
+    first_event = 0 if whole_run.is_whole_run(item) else before
+    clock = run.link.now() if run.link is not None else None
     try:
         result = yield
     except (pytest.skip.Exception, pytest.fail.Exception, pytest.exit.Exception, KeyboardInterrupt):
@@ -312,6 +314,9 @@ def pytest_runtest_call(item: pytest.Item):
     finally:
         record.duration = time.perf_counter() - started
         record.window = (first_event, _transcript_length(run))
+        record.added = (before, record.window[1])
+        if clock is not None and run.link is not None:
+            record.bus_s = run.link.now() - clock
     verdict = record.summarise()
     if not record.findings:
         _error(record, "case produced no finding (a check that cannot fail is a defect)")

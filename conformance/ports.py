@@ -14,8 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from urllib.parse import parse_qs, urlsplit
 
-from .declaration import Declaration
+from .declaration import Declaration, DeclarationError, load_declaration
 from .emulator import FAULTS, CompositionError, Profile, compose, default_profile, sim_sensor
+from .emulator.declared import declared_profile
 from .emulator.profiles import PROFILES, profile_settings
 from .harness import device as harness_device
 from .links import adapter_link, factory
@@ -40,6 +41,8 @@ class SimSpec:
     version: str = "14"
     address: str = "0"
     extra: dict[str, str] = field(default_factory=dict)
+    #: a declaration file: the simulated sensor plays what it declares (sdi12-conform plan)
+    declaration: str = ""
 
 
 def is_sim(port: str) -> bool:
@@ -62,13 +65,20 @@ def parse_sim(port: str) -> SimSpec:
         spec.version = given.replace(".", "")
     if "address" in params:
         spec.address = params.pop("address")
+    if "declaration" in params:
+        spec.declaration = params.pop("declaration")
+        declared = _load(spec.declaration)
+        if "version" not in query and declared.sdi12_version:
+            spec.version = declared.sdi12_version
+        if "address" not in query and declared.address:
+            spec.address = declared.address
     for key in ("recorder-faults", "recorder"):  # recorder role: the recorder under test
         if key in params:
             spec.extra[key] = params.pop(key)
     if params:
         raise PortError(
             f"unknown sim parameters {sorted(params)} "
-            "(known: faults, profile, version, address, recorder-faults, recorder)"
+            "(known: faults, profile, version, address, declaration, recorder-faults, recorder)"
         )
     return spec
 
@@ -91,7 +101,11 @@ def sim_profile(spec: SimSpec) -> Profile:
         )
     if len(spec.address) != 1 or spec.address not in ADDRESS_CHARS:
         raise PortError(f"sim address must be one of 0-9, A-Z, a-z, not {spec.address!r}")
-    profile = replace(default_profile(spec.version), address=spec.address)
+    if spec.declaration:
+        profile = declared_profile(_load(spec.declaration), spec.version)
+        profile = replace(profile, address=spec.address)
+    else:
+        profile = replace(default_profile(spec.version), address=spec.address)
     try:
         misfits = compose(all_faults(spec)).misfits(profile)
     except CompositionError as exc:
@@ -111,8 +125,17 @@ def open_sim(spec: SimSpec) -> OpenedPort:
     profile = sim_profile(spec)
     quirks = profile_settings(spec.profiles)[1]
     _bus, link, emulator = sim_sensor(profile, faults=all_faults(spec), quirks=quirks)
+    if spec.declaration:  # it plays a maker's declaration: the run is judged by that one
+        return OpenedPort(link, [emulator], _load(spec.declaration))
     declared = emulator.faults.declared_profile(profile)  # the clean profile, not the faulted
     return OpenedPort(link, [emulator], sim_declaration(declared, spec))
+
+
+def _load(path: str) -> Declaration:
+    try:
+        return load_declaration(path)
+    except DeclarationError as exc:
+        raise PortError(f"sim declaration: {exc}") from None
 
 
 def sim_declaration(profile: Profile, spec: SimSpec) -> Declaration:

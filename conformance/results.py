@@ -36,6 +36,10 @@ class CaseRecord:
     #: declared precondition code -> "met" or the "precondition not met: ..." text, for each
     #: one the case checked (conformance/preconditions.py)
     preconditions: dict[str, str] = field(default_factory=dict)
+    #: the transcript events the case itself added (a whole-run case's too, unlike
+    #: ``window``) and the time it took on the link's clock: what a plan compares with
+    added: tuple[int, int] | None = None
+    bus_s: float | None = None
 
     def summarise(self) -> Verdict:
         self.verdict = worst((f.verdict for f in self.findings), default=Verdict.ERROR)

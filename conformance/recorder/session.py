@@ -300,7 +300,12 @@ def driver_for(trigger: str | None) -> Driver | None:
     return Trigger(trigger) if trigger else None
 
 
-def check_port(port: str, trigger: str | None = None) -> None:
+def check_port(port: str, trigger: str | None = None) -> bool:
     """Raise :class:`PortError` now, before a run starts, if the recorder role cannot use
-    ``port`` with ``trigger`` (unknown recorder fault, real port, external recorder on sim)."""
-    RecorderSession(port, driver=driver_for(trigger)).close()
+    ``port`` with ``trigger`` (unknown recorder fault, real port, external recorder on sim);
+    else say whether the line runs in real time (the run then takes minutes)."""
+    session = RecorderSession(port, driver=driver_for(trigger))
+    try:
+        return not session.link.info.virtual_time
+    finally:
+        session.close()

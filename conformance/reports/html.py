@@ -29,6 +29,7 @@ from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, Locator, WireRef
 from .margins import margins_html
+from .plan import plan_section, read_plan
 from .timing_diagram import exchange_behind, timing_svg, wire_title
 from .verdicts_json import dut_block
 
@@ -592,6 +593,8 @@ class HtmlReportPlugin:
             return
         top = banner(self.run) + header(self.run) + attention(self.run)
         top += margins_html(self.run.results)
+        judged = {c.nodeid: {"verdict": str(c.verdict), "bus_s": c.bus_s} for c in self.run.cases}
+        top += plan_section(read_plan(self.run.report_dir()), judged)
         made_by = escape(f"{TOOL['name']} {TOOL['version']}")
         prefix.extend(
             [

@@ -17,7 +17,7 @@ from typing import Any
 ALGORITHM = "sha256"
 #: files of the run folder the manifest pins (reports written after verdicts.json, such as
 #: report.html and junit.xml, are renderings of it and are checked through it)
-PINNED = ("transcript.jsonl",)
+PINNED = ("transcript.jsonl", "plan.json")  # plan.json: only where the run was planned
 CATALOG = Path(__file__).resolve().parent.parent / "catalog.json"
 
 

@@ -13,8 +13,11 @@ from ..links.bus_time import bus_time
 from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL, ConformanceRun
+from ..transcript import TOOL as TOOL_SIDE
+from ..transcript import Event, EventKind, escape
 from .evidence import WireRef, wire_refs
 from .margins import distribution_json, margins_json
+from .plan import PLAN_FILE, read_plan
 
 SCHEMA = "sdi12-conform/verdicts/1"
 
@@ -58,9 +61,21 @@ def bus_block(run: ConformanceRun) -> dict[str, Any]:
     return figures
 
 
+def plan_block(directory: Path) -> dict[str, Any] | None:
+    plan = read_plan(directory)
+    if plan is None:
+        return None
+    return {
+        "file": PLAN_FILE,
+        "expected_bus_s": plan.get("expected_bus_s"),
+        "cases": len(plan.get("cases", [])),
+    }
+
+
 def build(run: ConformanceRun) -> dict[str, Any]:
     results = run.results or []
-    refs = wire_refs(run.cases, run.link.transcript.events) if run.link is not None else {}
+    events = run.link.transcript.events if run.link is not None else None
+    refs = wire_refs(run.cases, events) if events is not None else {}
     return {
         "schema": SCHEMA,
         "tool": dict(TOOL),
@@ -78,6 +93,8 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             "bus": bus_block(run),
         },
         "dut": dut_block(run),
+        # the test plan the run was given (plan.json beside it), in short: planned vs judged
+        "plan": plan_block(run.report_dir()),
         "summary": {"verdict": run.verdict, "counts": counts(results)},
         # every timed rule's smallest margin to its limit (finding "distribution": all of it)
         "margins": margins_json(results),
@@ -104,10 +121,37 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "duration_s": round(c.duration, 4),
                 # each declared precondition the case checked: "met" or why not
                 "preconditions": dict(c.preconditions),
+                "description": c.description,
+                # what the case itself put on the bus: the run beside its plan (issue 24)
+                "bus_s": None if c.bus_s is None else round(c.bus_s, 3),
+                "sent": sent_by(events, c.added) if events is not None else [],
             }
             for c in run.cases
         ],
     }
+
+
+def sent_by(events: list[Event], added: tuple[int, int] | None) -> list[dict[str, Any]]:
+    """The commands the tool sent in ``events[added]``, in first-sent order, each with how
+    often; ``breaks`` counts the breaks in front of them."""
+    if added is None:
+        return []
+    counts: dict[str, dict[str, Any]] = {}
+    text, broke = "", False
+    for e in events[added[0] : added[1]]:
+        if e.origin != TOOL_SIDE:
+            continue
+        if e.kind is EventKind.BREAK:
+            broke = True
+        elif e.kind is EventKind.CHAR:
+            text += chr(e.char7)
+            if e.char7 == 0x21:  # '!' ends a command
+                row = counts.setdefault(escape(text), {"command": escape(text), "times": 0,
+                                                         "breaks": 0})  # fmt: skip
+                row["times"] += 1
+                row["breaks"] += broke
+                text, broke = "", False
+    return list(counts.values())
 
 
 def _finding(f: Any, wire: WireRef | None = None) -> dict[str, Any]:

@@ -1,0 +1,120 @@
+"""``sdi12-conform plan``: the test plan without touching the bus (issue 24).
+
+The suite runs once in virtual time against a simulated sensor playing the declaration (the
+golden recorder in the recorder role), and :mod:`conformance.reports.plan` turns that dry
+run into the plan. Exit 0 with the plan written; 4 for a usage error (an unreadable
+declaration, a selection that matches no case).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+from pathlib import Path
+from typing import Any
+from urllib.parse import quote
+
+from .declaration import DeclarationError, load_declaration, normalise_version
+from .emulator.declared import assumptions
+from .exits import EXIT_OK, EXIT_USAGE, say_error
+from .options import ROLES
+from .reports.plan import build_plan, plan_html, plan_markdown
+
+FORMATS = ("markdown", "html", "json")
+
+
+def plan_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sdi12-conform plan",
+        description="The test plan, without touching the bus: every case with its "
+        "requirement IDs, what it will send, the preconditions it checks, what makes it N/A "
+        "for the declaration, and the run's expected bus time (from a dry run in virtual "
+        "time against a simulated sensor playing the declaration).",
+    )
+    p.add_argument("--role", choices=ROLES, default="sensor", help="default: sensor")
+    p.add_argument("--declaration", help="the DUT's declaration (TOML; [ttt] times the plan)")
+    p.add_argument("--sdi-version", help="1.3 or 1.4 (default: the declaration's, else 1.4)")
+    p.add_argument("-k", dest="keyword", help="only cases matching this pytest -k expression")
+    p.add_argument("--req", action="append", default=[], metavar="ID_OR_CLAUSE",
+                   help="only cases judging this requirement or clause; repeatable")  # fmt: skip
+    p.add_argument("--format", choices=FORMATS, default="markdown", help="default: markdown")
+    p.add_argument("-o", "--output", help="write the plan here (default: standard output)")
+    return p
+
+
+def dry_port(role: str, declaration: str | None, version: str | None) -> str:
+    """The simulated device the dry run uses."""
+    if role == "recorder":
+        return "sim" if version is None else f"sim://?version={version[0]}.{version[1]}"
+    query = []
+    if declaration:
+        query.append(f"declaration={quote(str(Path(declaration).resolve()))}")
+    if version:
+        query.append(f"version={version[0]}.{version[1]}")
+    return "sim://?" + "&".join(query) if query else "sim"
+
+
+def make_plan(
+    role: str,
+    declaration: str | None = None,
+    version: str | None = None,
+    keyword: str | None = None,
+    reqs: tuple[str, ...] = (),
+) -> dict[str, Any]:
+    """Dry-run the suite and build its plan (:class:`DeclarationError` for a bad file)."""
+    from .matrix import run_into
+
+    declared = load_declaration(declaration) if declaration else None
+    digits = normalise_version(version) if version else None
+    port = dry_port(role, declaration, digits)
+    extra: list[str] = []
+    if declaration and role == "sensor":
+        extra += ["--sdi12-declaration", str(Path(declaration).resolve())]
+    if digits:
+        extra += ["--sdi12-version", f"{digits[0]}.{digits[1]}"]
+    if keyword:
+        extra += ["-k", keyword]
+    for r in reqs:
+        extra += ["--sdi12-req", r]
+    with tempfile.TemporaryDirectory(prefix="sdi12-plan-") as tmp:
+        dry = run_into(Path(tmp), port, tuple(extra), role)
+    said = assumptions(declared) if declared is not None and role == "sensor" else []
+    if role == "recorder":
+        said = ["timed on the golden recorder: a logger under test paces its own jobs"]
+        if declaration:
+            said.append("recorder declarations are not read yet: every job is planned")
+    elif declared is None:
+        said = ["no declaration: timed on the reference sensor's profile"]
+    selection = {"k": keyword, "req": list(reqs)} if keyword or reqs else None
+    return build_plan(
+        dry,
+        role=role,
+        dry_port=port,
+        declaration=str(declaration) if declaration else None,
+        assumptions=said,
+        selection=selection,
+    )
+
+
+def plan_main(argv: list[str]) -> int:
+    args = plan_parser().parse_args(argv)
+    try:
+        plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
+                         tuple(args.req))  # fmt: skip
+    except DeclarationError as exc:
+        say_error(f"error: {exc}")
+        return EXIT_USAGE
+    if not plan["cases"]:
+        say_error("error: the selection (-k/--req) matches no case: nothing to plan")
+        return EXIT_USAGE
+    text = {
+        "json": lambda: json.dumps(plan, indent=2, ensure_ascii=False) + "\n",
+        "markdown": lambda: plan_markdown(plan),
+        "html": lambda: plan_html(plan),
+    }[args.format]()
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+    else:
+        print(text, end="")
+    return EXIT_OK
