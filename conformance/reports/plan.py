@@ -23,6 +23,8 @@ from ..catalog import for_role
 from ..run import TOOL
 
 SCHEMA = "sdi12-conform/plan/1"
+#: what the commands a case puts on the bus are, by role
+SENDS = {"sensor": "the tool sends", "recorder": "the recorder is to send"}
 #: where a planned run keeps its plan, beside verdicts.json
 PLAN_FILE = "plan.json"
 DRY_RUN = {
@@ -139,7 +141,8 @@ def plan_markdown(plan: dict[str, Any]) -> str:
         lines.append(f"- Assumed: {a}")
     lines += [
         "",
-        "| case | requirements | preconditions | sends | bus time | N/A for this declaration |",
+        f"| case | requirements | preconditions | {SENDS[plan['role']]} | bus time "
+        "| N/A for this declaration |",
         "|---|---|---|---|---|---|",
     ]
     for c in plan["cases"]:
@@ -166,7 +169,8 @@ PLAN_STYLE = (
 def plan_table(plan: dict[str, Any], judged: dict[str, dict[str, Any]] | None = None) -> str:
     """The plan's cases as an HTML table; with ``judged`` (case id -> the run's tests entry)
     each row also shows what the run did: its verdict and its time on the bus."""
-    head = "<tr><th>case</th><th>requirements</th><th>preconditions</th><th>sends</th>"
+    head = "<tr><th>case</th><th>requirements</th><th>preconditions</th>"
+    head += f"<th>{SENDS[plan['role']]}</th>"
     head += "<th>planned bus time</th><th>N/A for this declaration</th>"
     head += "<th>judged</th><th>bus time</th></tr>" if judged is not None else "</tr>"
     rows = []
