@@ -295,18 +295,6 @@ class Sweep:
         failed = next((s for s in inside if not s.outcome.coped), None)
         return None if failed is None else self.kind.flag(failed.effective_ms)
 
-    def summary(self) -> str:
-        """One line for the console."""
-        k = self.kind
-        up = self.copes_up_to_ms
-        copes = "copes at no step" if up is None else f"copes up to {up:.2f} ms"
-        fail = self.first_failure_ms
-        stops = f", gives up at {fail:.2f} ms" if fail is not None else ", at every step"
-        limit = f" (the standard's limit: {k.limit_ms:.2f} ms)"
-        return f"{k.name} sweep: {copes}{stops}{limit}" + (
-            f"; FLAG: {self.flag}" if self.flag else ""
-        )
-
     def to_json(self) -> dict[str, Any]:
         k = self.kind
         return {

@@ -28,6 +28,7 @@ from ..transcript import Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, Locator, WireRef
+from .sweep_chart import section as sweep_section
 from .timing_diagram import exchange_behind, timing_svg, wire_title
 from .verdicts_json import dut_block
 
@@ -590,6 +591,7 @@ class HtmlReportPlugin:
         if self.run.results is None:
             return
         top = banner(self.run) + header(self.run) + attention(self.run)
+        top += sweep_section(self.run)  # --sweep only
         made_by = escape(f"{TOOL['name']} {TOOL['version']}")
         prefix.extend(
             [

@@ -14,6 +14,7 @@ from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL, ConformanceRun
 from .evidence import WireRef, wire_refs
+from .sweep_chart import sweeps_block
 
 SCHEMA = "sdi12-conform/verdicts/1"
 
@@ -104,6 +105,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             }
             for c in run.cases
         ],
+        **sweeps_block(run),  # --sweep only: the tolerance sweeps (informational)
     }
 
 
