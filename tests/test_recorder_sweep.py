@@ -231,3 +231,9 @@ def test_a_sweep_run_writes_valid_verdicts_and_changes_no_verdict(tmp_path: Path
     assert swept["summary"] == plain["summary"]
     bad = dict(swept, sweeps=[dict(swept["sweeps"][0], unit="s")])
     assert list(jsonschema.Draft202012Validator(SCHEMA).iter_errors(bad))
+    # a replay of the plain run has no sweep steps to play: the sweep stops, blaming nothing
+    replayed = run_sweeps(RecorderSession(f"replay:{tmp_path / 'plain'}"), ("reply",))[0]
+    assert replayed.steps == [] and "sweep-reply-0ms" in (replayed.stopped or "")
+    assert replayed.flag is None and replayed.copes_up_to_ms is None
+    html = render([replayed.to_json()])
+    assert "no step ran" in html and "Sweep stopped" in html

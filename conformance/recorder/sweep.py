@@ -48,6 +48,7 @@ from ..judges.recorder import read_line
 from ..judges.recorder.logged import same_values
 from ..judges.recorder.measurements import observed_measurements
 from ..judges.recorder.retries import STANDBY
+from ..links.base import LinkError
 from ..protocol.timing import RESPONSE_START_MAX, TOLERANCE, WAKE_LIMIT
 from ..transcript import Event, EventKind
 from ..view.segments import Transmission
@@ -324,8 +325,9 @@ def sweep_scenario(kind: SweepKind, extra_ms: float) -> Scenario:
 
 def run_sweeps(session: Any, kinds: Iterable[str]) -> list[Sweep]:
     """Run each named sweep on ``session`` (a :class:`~.session.RecorderSession`), step by
-    step, one job per step. A recorder that cannot be made to act stops that sweep (the
-    setup is broken, not the recorder: no step is held against it)."""
+    step, one job per step. A recorder that cannot be made to act, or a link that fails
+    (a ``replay:`` of a run that had no such step), stops that sweep with the reason in
+    ``stopped``: the setup is broken, not the recorder, so no step is held against it."""
     sweeps: list[Sweep] = []
     for name in kinds:
         kind = SWEEP_KINDS[name]
@@ -336,6 +338,9 @@ def run_sweeps(session: Any, kinds: Iterable[str]) -> list[Sweep]:
                 run = session.run_scenario(sweep_scenario(kind, extra))
             except RecorderSetupError as exc:
                 sweep.stopped = str(exc)
+                break
+            except LinkError as exc:  # a replayed run without this step, a link gone
+                sweep.stopped = f"{type(exc).__name__}: {exc}"
                 break
             outcome = judge_step(
                 run.events,

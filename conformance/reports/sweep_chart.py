@@ -37,6 +37,8 @@ def summary_lines(data: dict[str, Any]) -> list[str]:
         up, fail = sweep["copes_up_to_ms"], sweep.get("first_failure_ms")
         copes = "copes at no step" if up is None else f"copes up to {up:.2f} ms"
         stops = f", gives up at {fail:.2f} ms" if fail is not None else ", at every step"
+        if not sweep["steps"]:
+            copes, stops = "no step ran", ""
         line = f"{sweep['kind']} sweep: {copes}{stops} (limit {sweep['limit_ms']:.2f} ms)"
         if sweep["flag"]:
             line += f"; FLAG: {sweep['flag']}"
@@ -75,9 +77,11 @@ def _one(sweep: dict[str, Any]) -> str:
     limit = float(sweep["limit_ms"])
     rids = ", ".join(escape(r) for r in sweep["requirements"])
     up = sweep["copes_up_to_ms"]
-    copes = "at no step" if up is None else f"up to {up:.2f} ms"
+    copes = "copes at no step" if up is None else f"copes up to {up:.2f} ms"
+    if not sweep["steps"]:
+        copes = "no step ran"
     head = (
-        f'<h3 id="sdi12-sweep-{kind}">{kind} sweep: copes {copes} '
+        f'<h3 id="sdi12-sweep-{kind}">{kind} sweep: {copes} '
         f"(standard's limit {limit:.2f} ms, {rids})</h3>"
         f"<p>{escape(str(sweep.get('measures', '')))}.</p>"
     )
