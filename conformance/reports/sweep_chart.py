@@ -86,7 +86,11 @@ def _one(sweep: dict[str, Any]) -> str:
         f"<p>{escape(str(sweep.get('measures', '')))}.</p>"
     )
     flag = sweep["flag"]
-    flagged = f'<p class="sdi12-sweep-flag"><b>FLAG:</b> {escape(flag)}</p>' if flag else ""
+    flagged = (
+        f'<p class="sdi12-sweep-flag" style="color:{GAVE_UP}"><b>FLAG:</b> {escape(flag)}</p>'
+        if flag
+        else ""
+    )
     stopped = sweep.get("stopped")
     if stopped:
         flagged += f"<p><b>Sweep stopped:</b> {escape(stopped)}</p>"
