@@ -87,6 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
             "echo",
             "direction",
             "trigger",
+            "sweep",
         ),
     )
     p.add_argument(
@@ -133,7 +134,7 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             markup=False,
         )
     try:
-        check_role_options(args.role, args.port, args.trigger, args.address)
+        check_role_options(args.role, args.port, args.trigger, args.address, args.sweep)
         check_values(cli_values(args), plugin=False)
         resolve(args.role, args.req)  # --req names requirements the role can test
         if args.sdi_version:

@@ -37,6 +37,20 @@ def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") 
         raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
 
 
+def check_sweep(text: str | None, where: str = "--sweep") -> None:
+    """``--sweep`` names the sweeps (reply, wake); an unknown one would silently run none."""
+    names = [n.strip() for n in (text or "").split(",") if n.strip()]
+    unknown = [n for n in names if n not in SWEEPS]
+    if unknown or (text is not None and not names):
+        raise UsageError(
+            f"{where} takes {', '.join(SWEEPS)} or both comma-separated (got {text!r})"
+        )
+
+
+#: The recorder role's tolerance sweeps (conformance.recorder.sweep), named here so that
+#: ``--help`` stays light.
+SWEEPS = ("reply", "wake")
+
 _UNSET = object()
 
 
@@ -53,6 +67,8 @@ class Option:
     flag: bool = False  # store_true
     repeat: bool = False  # append: given once per value
     metavar: str | None = None
+    #: the value of an option given without one (``--sweep`` alone); None: a value is due
+    const: Any = None
     plugin_name: str | None = None  # pytest's name without "--sdi12-", if not ``name``
     plugin_help: str | None = None  # where pytest's wording must differ (its default)
     cli_default: Any = _UNSET  # the command line's default, if not ``default``
@@ -83,6 +99,8 @@ class Option:
         for key in ("choices", "type", "metavar"):
             if getattr(self, key) is not None:
                 kwargs[key] = getattr(self, key)
+        if self.const is not None:
+            kwargs["nargs"], kwargs["const"] = "?", self.const
         return kwargs
 
     def add_to_cli(self, parser: argparse.ArgumentParser) -> None:
@@ -163,6 +181,19 @@ OPTIONS: tuple[Option, ...] = (
         "trigger",
         "recorder role: shell command run per scenario with the request in SDI12_* "
         "environment variables, or 'interactive' to prompt an operator",
+    ),
+    Option(
+        "sweep",
+        "sweep",
+        "recorder role: after the suite, a tolerance sweep: one short job (aM!, aD0!) per "
+        "step on a sensor that starts its replies later and later (reply: 0-100 ms extra in "
+        "5 ms steps, and the 15.40 ms limit of R-7.0-10) or hears commands later and later "
+        "after a break (wake: 0-150 ms in 5 ms steps; R-7.0-07 allows 100 ms); shows where "
+        "the recorder stops coping and flags it inside the standard's limit, never changes a "
+        "verdict. Costs one job per step on a real logger. Given alone: both",
+        const="reply,wake",
+        metavar="reply,wake",
+        check=check_sweep,
     ),
     Option(
         "req",

@@ -70,7 +70,9 @@ def pytest_configure(config: pytest.Config) -> None:
     options = RunOptions.from_config(config)
     try:
         check_values(vars(options), plugin=True)
-        check_role_options(options.role, options.port, options.trigger, options.address)
+        check_role_options(
+            options.role, options.port, options.trigger, options.address, options.sweep
+        )
     except (UsageError, PortError) as exc:
         raise pytest.UsageError(str(exc)) from None
     config.stash[RUN] = ConformanceRun(options)

@@ -27,9 +27,14 @@ __all__ = [
 
 
 def check_role_options(
-    role: str, port: str, trigger: str | None, address: str | None = None
+    role: str, port: str, trigger: str | None, address: str | None = None, sweep: str | None = None
 ) -> None:
     """Settings that only mean something in the other role are mistakes, not no-ops."""
+    if role == "sensor" and sweep:
+        raise UsageError(
+            "--sweep plays ever slower sensors to a data recorder (--role recorder); "
+            "the sensor role has no tolerance sweep"
+        )
     if role == "recorder" and address:
         raise UsageError(
             "--address picks the sensor to judge (--role sensor); in the recorder role the "

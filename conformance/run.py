@@ -41,6 +41,7 @@ class RunOptions:
     direction: str = "none"  # real links: the modem line that enables the tool's driver
     requirements: tuple[str, ...] = ()  # --req: requirement IDs or clauses to judge
     keyword: str | None = None  # -k: the cases selected by name
+    sweep: str | None = None  # recorder role: tolerance sweeps to run ("reply,wake")
 
     @classmethod
     def from_config(cls, config: Any) -> RunOptions:
@@ -68,6 +69,9 @@ class ConformanceRun:
     verdict: str | None = None
     selection: Selection = field(default_factory=Selection)  # -k / --req: a partial run
     document: dict[str, Any] | None = None  # verdicts.json as written: the CLI reads this
+    #: recorder role, --sweep: the tolerance sweeps (conformance.recorder.sweep); informational,
+    #: never part of a verdict. None: not asked for (verdicts.json then has no "sweeps" key)
+    sweeps: list[Any] | None = None
 
     def __post_init__(self) -> None:
         if self.options.declaration:
@@ -137,6 +141,7 @@ class ConformanceRun:
         return self.session.version if self.session else None
 
     def finish(self, complete: bool) -> list[RequirementResult]:
+        self._run_sweeps(complete)
         self._check_link()
         self.complete = self.complete and complete
         self.finished = now_iso()
@@ -151,6 +156,18 @@ class ConformanceRun:
                 f"{unjudged} testable requirement(s) of the selected cases not judged"
             )
         return self.results
+
+    def _run_sweeps(self, complete: bool) -> None:
+        """``--sweep``: after every case judged, the tolerance sweeps on the same bus and
+        recorder. They come after the cases, so no case's transcript slice or verdict can
+        change; an interrupted run (or one whose recorder never got going) sweeps nothing."""
+        if not self.options.sweep or self.options.role != "recorder":
+            return
+        from .recorder.sweep import parse_kinds, run_sweeps
+
+        self.sweeps = []
+        if complete and self.complete and self.session is not None:
+            self.sweeps = run_sweeps(self.session, parse_kinds(self.options.sweep))
 
     def _check_link(self) -> None:
         """A link that can vouch for its records only at the end (a harness, whose answers

@@ -338,6 +338,7 @@ def replay_argv(recording: Recording, args: argparse.Namespace) -> list[str]:
         ("--declaration", "declaration"),
         ("--timing-uncertainty-ms", "timing_uncertainty_ms"),
         ("-k", "keyword"),
+        ("--sweep", "sweep"),  # a swept run's steps are in its recording: replayed too
     ):
         if saved.get(key) is not None:
             argv += [flag, str(saved[key])]

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from ..emulator import MeasurementSpec, Profile, SensorEmulator, default_profile
+from ..emulator.behaviour import REPLY_DELAY
 from ..protocol.commands import CommandError, parse_command
 from ..protocol.timing import PARTIAL_COMMAND_GAP, TOLERANCE
 from ..sim.bus import Frame
@@ -216,7 +217,10 @@ class SensorSpec:
 
     ``faults`` are emulator faults; ``unheard`` the number of commands it ignores first;
     ``spoil``/``spoil_command``/``spoil_times`` a reply it garbles; ``aborts_once`` loses the
-    first measurement.
+    first measurement. ``reply_extra`` (s) starts every reply that much later than the
+    reference's ~9 ms, ``wake_extra`` (s) is how long after a break's end the sensor needs
+    before it hears a start bit at all: the timing knobs of the recorder tolerance sweep
+    (:mod:`.sweep`), which go past what the standard allows on purpose.
     """
 
     address: str = "0"
@@ -227,6 +231,8 @@ class SensorSpec:
     spoil_times: int = 1
     aborts_once: bool = False
     version: str = "14"
+    reply_extra: float = 0.0
+    wake_extra: float = 0.0
 
     def describe(self) -> str:
         parts = [f"sensor at {self.address!r} (v{self.version[0]}.{self.version[1]})"]
@@ -238,11 +244,28 @@ class SensorSpec:
             parts.append(f"{self.spoil.kind} error in its reply to {self.spoil_command}")
         if self.aborts_once:
             parts.append("loses its first measurement")
+        if self.reply_extra:
+            start = (REPLY_DELAY + self.reply_extra) * 1e3
+            parts.append(f"starts each reply {start:.2f} ms after the command")
+        if self.wake_extra:
+            parts.append(f"hears nothing for {self.wake_extra * 1e3:.2f} ms after a break")
         return ", ".join(parts)
+
+    def quirks(self) -> dict[str, float]:
+        """The emulator's timing overrides for ``reply_extra``/``wake_extra`` (none: {})."""
+        out: dict[str, float] = {}
+        if self.reply_extra:
+            out["reply_delay"] = REPLY_DELAY + self.reply_extra
+        if self.wake_extra:
+            out["wake_delay"] = self.wake_extra
+        return out
 
     def build(self) -> SensorEmulator | SensorAdapter:
         emulator = SensorEmulator(
-            played_profile(self.address, self.version), self.faults, name=f"sensor{self.address}"
+            played_profile(self.address, self.version),
+            self.faults,
+            name=f"sensor{self.address}",
+            quirks=self.quirks() or None,
         )
         device: SensorEmulator | SensorAdapter = emulator
         if self.unheard:

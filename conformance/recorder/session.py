@@ -217,6 +217,11 @@ class RecorderSession:
             self.runs[name] = self._run(SCENARIOS[name])
         return self.runs[name]
 
+    def run_scenario(self, scenario: Scenario) -> ScenarioRun:
+        """Run a scenario that is not one of :data:`SCENARIOS` (a tolerance sweep's step),
+        every time it is asked for: nothing is kept, so no case judges it."""
+        return self._run(scenario)
+
     def _run(self, scenario: Scenario) -> ScenarioRun:
         if self.served is not None:
             return self._run_served(scenario, self.served)

@@ -20,6 +20,7 @@ from rich.table import Table
 from rich.text import Text
 
 from ..stash import CASE
+from .sweep_chart import summary_lines
 
 STYLE = {
     "PASS": "green",
@@ -309,6 +310,8 @@ def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> N
     say(_counts_line(data))
     for verdict, which, reason in noteworthy(data):
         say(f"{verdict:<12} {which}: {one_line(reason)}")
+    for line in summary_lines(data):  # --sweep: informational, no verdict
+        say(line)
     if data["run"].get("stop_reason"):
         say(f"{_stop_word(data)}: {data['run']['stop_reason']}")
     say(f"verdict: {verdict_words(data)}")
@@ -353,6 +356,8 @@ def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> No
         for level, which, reason in rows:
             lines.add_row(Text(level, style=STYLE[level]), which, Text(one_line(reason, room)))
         console.print(lines)
+    for line in summary_lines(data):  # --sweep: informational, no verdict
+        console.print(line, markup=False, highlight=False)
     if data["run"].get("stop_reason"):
         console.print(f"{_stop_word(data)}: {data['run']['stop_reason']}", markup=False)
     console.print(

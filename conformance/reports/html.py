@@ -30,6 +30,7 @@ from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, Locator, WireRef
 from .margins import margins_html
 from .plan import plan_section, read_plan
+from .sweep_chart import section as sweep_section
 from .timing_diagram import exchange_behind, timing_svg, wire_title
 from .verdicts_json import dut_block
 
@@ -595,6 +596,7 @@ class HtmlReportPlugin:
         top += margins_html(self.run.results)
         judged = {c.nodeid: {"verdict": str(c.verdict), "bus_s": c.bus_s} for c in self.run.cases}
         top += plan_section(read_plan(self.run.report_dir()), judged)
+        top += sweep_section(self.run)  # --sweep only
         made_by = escape(f"{TOOL['name']} {TOOL['version']}")
         prefix.extend(
             [

@@ -18,6 +18,7 @@ from ..transcript import Event, EventKind, escape
 from .evidence import WireRef, wire_refs
 from .margins import distribution_json, margins_json
 from .plan import PLAN_FILE, read_plan
+from .sweep_chart import sweeps_block
 
 SCHEMA = "sdi12-conform/verdicts/1"
 
@@ -128,6 +129,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             }
             for c in run.cases
         ],
+        **sweeps_block(run),  # --sweep only: the tolerance sweeps (informational)
     }
 
 
