@@ -24,6 +24,10 @@ from .reports.plan import build_plan, plan_html, plan_markdown
 FORMATS = ("markdown", "html", "json")
 
 
+class PlanError(ValueError):
+    """Nothing to plan (a usage error)."""
+
+
 def plan_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sdi12-conform plan",
@@ -78,7 +82,10 @@ def make_plan(
     for r in reqs:
         extra += ["--sdi12-req", r]
     with tempfile.TemporaryDirectory(prefix="sdi12-plan-") as tmp:
-        dry = run_into(Path(tmp), port, tuple(extra), role)
+        try:
+            dry = run_into(Path(tmp), port, tuple(extra), role)
+        except FileNotFoundError:  # pytest collected nothing: no verdicts.json
+            raise PlanError("the selection (-k/--req) matches no case: nothing to plan") from None
     said = assumptions(declared) if declared is not None and role == "sensor" else []
     if role == "recorder":
         said = ["timed on the golden recorder: a logger under test paces its own jobs"]
@@ -102,11 +109,8 @@ def plan_main(argv: list[str]) -> int:
     try:
         plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
                          tuple(args.req))  # fmt: skip
-    except DeclarationError as exc:
+    except (DeclarationError, PlanError) as exc:
         say_error(f"error: {exc}")
-        return EXIT_USAGE
-    if not plan["cases"]:
-        say_error("error: the selection (-k/--req) matches no case: nothing to plan")
         return EXIT_USAGE
     text = {
         "json": lambda: json.dumps(plan, indent=2, ensure_ascii=False) + "\n",
