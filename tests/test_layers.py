@@ -69,7 +69,15 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # the command line
     (
         "cli",
-        ("cli", "diff_command", "verify_command", "offline.passive", "roundtrip", "fault_tables"),
+        (
+            "cli",
+            "diff_command",
+            "verify_command",
+            "plan_command",
+            "offline.passive",
+            "roundtrip",
+            "fault_tables",
+        ),
     ),
 )
 
