@@ -197,8 +197,10 @@ def combine_local(
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
         found.detail += f"; {note}"
-    # the figures the verdict rests on; what the link's irregular stamps set aside is counted
-    found.distribution = distribution(kept)
+    # the figures the verdict rests on (combine() drew them already when it saw them all);
+    # what the link's irregular stamps set aside is counted
+    if isolated:
+        found.distribution = distribution(kept)
     if found.distribution is not None:
         found.distribution.set_aside = len(aside)
     return found
@@ -351,48 +353,62 @@ def _single(
 
 def distribution(observations: Sequence[Finding | Measured]) -> Distribution | None:
     """Every measurement of ``observations`` as one :class:`Distribution` (None when none
-    was judged against a window): what the margins chart and ``verdicts.json`` show."""
-    values: list[float] = []
-    slacks: list[float] = []
+    was judged against a window): what the margins chart and ``verdicts.json`` show.
+
+    One pass in seconds, rounded to ms only for what is kept: a run's character gaps number
+    tens of thousands, nearly all judged against one window."""
+    values: list[float] = []  # s
+    slacks: list[float] = []  # s
+    uncertainties: list[float] = []  # s
     edges: set[tuple[float | None, float | None]] = set()
-    uncertainties: list[float] = []
     count = 0
+    window = None
+    lo = hi = None
     for o in observations:
-        if isinstance(o, Measured):
-            lo, hi = o._window.lo, o._window.hi
-            values.append(o.measured_ms)
-            slacks.append(round(_slack(lo, hi, o.measured) * 1e3, 3))
-            edges.add((_ms(lo), _ms(hi)))
-            uncertainties.append(o.uncertainty * 1e3)
+        if type(o) is Measured:
+            if o._window is not window:
+                window = o._window
+                lo, hi = window.lo, window.hi
+                edges.add((_ms(lo), _ms(hi)))
+            m = o.measured
+            values.append(m)
+            slacks.append(_slack(lo, hi, m))
+            uncertainties.append(o.uncertainty)
             count += 1
         elif o.distribution is not None:
             d = o.distribution
-            values.extend(d.values_ms)
-            slacks.extend(d.slack_ms)
+            values.extend(v / 1e3 for v in d.values_ms)
+            slacks.extend(v / 1e3 for v in d.slack_ms)
             edges.add((d.low_ms, d.high_ms))
-            uncertainties.append(d.uncertainty_ms)
+            uncertainties.append(d.uncertainty_ms / 1e3)
             count += d.count
     if not values:
         return None
-    pairs = sorted(zip(values, slacks, strict=True))
-    if len(pairs) > MAX_TICKS:  # evenly through the sorted values: min and max kept
-        step = (len(pairs) - 1) / (MAX_TICKS - 1)
-        kept = [pairs[round(i * step)] for i in range(MAX_TICKS)]
+    order = sorted(range(len(values)), key=values.__getitem__)
+    if len(order) > MAX_TICKS:  # evenly through the sorted values: min and max kept
+        step = (len(order) - 1) / (MAX_TICKS - 1)
+        kept = [order[round(i * step)] for i in range(MAX_TICKS)]
     else:
-        kept = pairs
+        kept = order
     low, high = next(iter(edges)) if len(edges) == 1 else (None, None)
+    middle = len(order) // 2
+    mid = (
+        values[order[middle]]
+        if len(order) % 2
+        else (values[order[middle - 1]] + values[order[middle]]) / 2
+    )
     return Distribution(
         count,
-        pairs[0][0],
-        round(median(v for v, _ in pairs), 3),
-        pairs[-1][0],
+        _ms(values[order[0]]) or 0.0,
+        _ms(mid) or 0.0,
+        _ms(values[order[-1]]) or 0.0,
         low,
         high,
-        round(median(uncertainties), 3),  # typical: a few stamps near a stall are far wider
-        min(s for _, s in pairs),
+        _ms(median(uncertainties)) or 0.0,  # typical: a few stamps near a stall are far wider
+        _ms(min(slacks)) or 0.0,
         mixed_limits=len(edges) > 1,
-        values_ms=[v for v, _ in kept],
-        slack_ms=[s for _, s in kept],
+        values_ms=[_ms(values[i]) or 0.0 for i in kept],
+        slack_ms=[_ms(slacks[i]) or 0.0 for i in kept],
     )
 
 
