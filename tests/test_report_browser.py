@@ -20,7 +20,11 @@ from report_browser import SCREENSHOTS, Chromium, require_chromium
 # Drives headless Chromium.
 pytestmark = pytest.mark.browser
 
-RUNS = {"clean": ("sim", 0), "faulty": ("sim://?faults=no-service-request", 1)}
+RUNS = {
+    "clean": ("sim", 0),
+    "faulty": ("sim://?faults=no-service-request", 1),
+    "late": ("sim://?faults=response-too-late", 1),  # a timing fault: the margins chart
+}
 VIEWPORT = (1280, 720)
 
 STATE = """(function(){
@@ -234,4 +238,35 @@ def test_the_cases_table_speaks_verdicts_and_counts_cases(reports, browser):
     assert len(state["shown"]) == len(data["tests"])  # every case, skipped-by-pytest ones too
     assert state["credit"] and state["credit"][0].startswith("Report by sdi12-conform ")
     assert state["wrapped"] == []
+    assert browser.log.problems == []
+
+
+MARGINS = """(function(){
+  var strips=[...document.querySelectorAll('#sdi12-margins svg.sdi12-strip')];
+  return strips.map(function(s){ var r=s.getBoundingClientRect();
+    var limit=s.querySelector('.sdi12-limit'), ticks=s.querySelectorAll('.sdi12-tick');
+    var fonts=[...s.querySelectorAll('text')].map(t=>parseFloat(getComputedStyle(t).fontSize));
+    var tx=[...ticks].map(t=>t.getBoundingClientRect().x);
+    return {id: s.dataset.requirement, width: r.width, height: r.height,
+            limit: limit ? limit.getBoundingClientRect().x : null, ticks: tx,
+            smallest_font: Math.min.apply(null, fonts), text: s.textContent}; });
+})()"""
+
+
+def test_the_margins_chart_shows_a_timing_fault_beyond_its_limit(reports, browser):
+    """What a reader sees of a reply that starts late: R-7.0-10's ticks right of its limit
+    line, the figures beside it, every strip readable at A4 width (794 px at 96 dpi)."""
+    browser.open(reports["late"] / "report.html")
+    strips = {s["id"]: s for s in browser.evaluate(MARGINS)}
+    browser.screenshot(SCREENSHOTS / "report-margins-late.png",
+                       "document.getElementById('sdi12-margins')")  # fmt: skip
+    assert {"R-7.0-09", "R-7.0-10", "R-7.0-12"} <= set(strips)
+    late = strips["R-7.0-10"]
+    assert late["ticks"] and min(late["ticks"]) > late["limit"], late
+    assert "FAIL" in late["text"] and "margin -4.60 ms" in late["text"]
+    early = strips["R-7.0-09"]
+    assert max(early["ticks"]) > early["limit"]  # 20 ms is well after the 7.93 ms minimum
+    for s in strips.values():
+        assert s["width"] <= 794 and s["height"] > 30, s
+        assert s["smallest_font"] >= 9, s
     assert browser.log.problems == []
