@@ -173,6 +173,10 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
     try:
         if args.plan == "always" or (args.plan == "auto" and real_time):
             _plan_first(args, report_dir, console)
+            if GUARD.requested:  # Ctrl-C during the dry run: nothing has gone on the bus
+                error("interrupted while planning: nothing was sent to the device; no report")
+                return EXIT_INCOMPLETE
+            GUARD.reset()  # the dry run closed the guard: the run proper starts afresh
         return _run_pytest(args, report_dir, console, baseline)
     finally:
         report_folder.release(report_dir)
@@ -180,12 +184,15 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
 
 def _plan_first(args: argparse.Namespace, report_dir: Path, console: Console) -> None:
     """The test plan into the run folder before the run (issue 24): the report shows it next
-    to what was judged, and the user sees how long the run will take on the bus."""
+    to what was judged, and the user sees how long the run will take on the bus. A Ctrl-C
+    during the dry run stops it at its next case (the shared guard records it)."""
     from .plan_command import make_plan
     from .reports.plan import write_plan
 
     plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
                      tuple(args.req))  # fmt: skip
+    if GUARD.requested:
+        return  # a plan cut short by Ctrl-C is no plan
     write_plan(report_dir, plan)
     minutes = (plan["expected_bus_s"] or 0.0) / 60
     console.print(

@@ -15,6 +15,7 @@ from conformance.declaration import DeclarationError, load_declaration
 from conformance.emulator.declared import assumptions, declared_profile
 from conformance.plan_command import make_plan
 from conformance.ports import PortError, open_sim, parse_sim
+from conformance.report_folder import LOCK_NAME
 from conformance.reports.plan import plan_html, plan_markdown
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -162,3 +163,29 @@ def test_an_unplanned_sim_run_has_no_plan(tmp_path):
     assert main(["--port", "sim", "-k", "ttt_zero", "--report-dir", str(out)]) == 0
     data = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
     assert data["plan"] is None and not (out / "plan.json").exists()
+
+
+@pytest.mark.slow
+def test_ctrl_c_while_planning_stops_before_anything_goes_on_the_bus(tmp_path):
+    """The dry run takes seconds before a real run starts: an interrupt there is exit 2 at
+    once, with no plan and no report (nothing was sent to the device)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "run"
+    cli = subprocess.Popen(
+        [sys.executable, "-m", "conformance.cli", "--port", "sim", "--plan", "always",
+         "--report-dir", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )  # fmt: skip
+    deadline = time.monotonic() + 60
+    while not (out / LOCK_NAME).exists() and time.monotonic() < deadline:
+        time.sleep(0.05)  # the folder is taken just before the dry run starts
+    time.sleep(1.5)  # into the dry run (about 5 s)
+    cli.send_signal(signal.SIGINT)
+    text, _ = cli.communicate(timeout=60)
+    assert cli.returncode == 2, text
+    assert "interrupted while planning" in text and "plan:" not in text
+    assert not (out / "plan.json").exists() and not (out / "verdicts.json").exists()

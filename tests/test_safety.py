@@ -92,6 +92,8 @@ def test_ctrl_c_writes_the_partial_report_and_exits_2(tmp_path):
                 str(tmp_path),
                 "-k",
                 "test_address_range or test_parameter_metadata",
+                "--plan",  # the interrupt is for the run itself (planning: test_plan.py)
+                "never",
             ],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
