@@ -186,17 +186,16 @@ def _plan_first(args: argparse.Namespace, report_dir: Path, console: Console) ->
     """The test plan into the run folder before the run (issue 24): the report shows it next
     to what was judged, and the user sees how long the run will take on the bus. A Ctrl-C
     during the dry run stops it at its next case (the shared guard records it)."""
-    from .plan_command import make_plan
-    from .reports.plan import write_plan
+    from .plan_command import cached_plan
+    from .reports.plan import duration, write_plan
 
-    plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
+    plan = cached_plan(args.role, args.declaration, args.sdi_version, args.keyword,
                      tuple(args.req))  # fmt: skip
     if GUARD.requested:
         return  # a plan cut short by Ctrl-C is no plan
     write_plan(report_dir, plan)
-    minutes = (plan["expected_bus_s"] or 0.0) / 60
     console.print(
-        f"plan: {len(plan['cases'])} cases, about {minutes:.1f} min on the bus "
+        f"plan: {len(plan['cases'])} cases, about {duration(plan['expected_bus_s'])} on the bus "
         f"(at least; {report_dir / 'plan.json'})",
         markup=False,
         highlight=False,

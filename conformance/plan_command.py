@@ -9,7 +9,9 @@ declaration, a selection that matches no case).
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
+import os
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -57,6 +59,62 @@ def dry_port(role: str, declaration: str | None, version: str | None) -> str:
     if version:
         query.append(f"version={version[0]}.{version[1]}")
     return "sim://?" + "&".join(query) if query else "sim"
+
+
+def _cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(os.environ.get("SDI12_CACHE_DIR") or Path(base) / "sdi12-conform" / "plans")
+
+
+def _code_digest() -> str:
+    """The suite's own code (the package and its cases): a plan made by other code is not
+    this code's plan, whatever the version number says."""
+    h = hashlib.sha256()
+    root = Path(__file__).resolve().parent
+    for folder in (root, root.parent / "testcases"):
+        for path in sorted(folder.rglob("*")):
+            if path.suffix in (".py", ".json", ".ini") and "__pycache__" not in path.parts:
+                h.update(str(path.relative_to(folder)).encode())
+                h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def cached_plan(
+    role: str,
+    declaration: str | None = None,
+    version: str | None = None,
+    keyword: str | None = None,
+    reqs: tuple[str, ...] = (),
+) -> dict[str, Any]:
+    """:func:`make_plan`, kept on disk: the dry run is deterministic (virtual time), so the
+    same code, declaration and selection give the same plan, and a bench that runs the
+    same device again and again plans once (``SDI12_CACHE_DIR`` moves the cache)."""
+    if declaration:
+        load_declaration(declaration)  # a bad file is refused before the cache is read
+    key = hashlib.sha256(
+        json.dumps(
+            [role, version, keyword, list(reqs), declaration and str(Path(declaration).resolve()),
+             declaration and hashlib.sha256(Path(declaration).read_bytes()).hexdigest(),
+             _code_digest()]
+        ).encode()
+    ).hexdigest()  # fmt: skip
+    path = _cache_dir() / f"{key}.json"
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        pass
+    plan = make_plan(role, declaration, version, keyword, reqs)
+    from .interrupts import GUARD
+
+    if not GUARD.requested:  # a dry run cut short by Ctrl-C is kept nowhere
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_text(json.dumps(plan), encoding="utf-8")
+            tmp.replace(path)
+        except OSError:
+            pass  # no cache where none can be written
+    return plan
 
 
 def make_plan(

@@ -189,3 +189,18 @@ def test_ctrl_c_while_planning_stops_before_anything_goes_on_the_bus(tmp_path):
     assert cli.returncode == 2, text
     assert "interrupted while planning" in text and "plan:" not in text
     assert not (out / "plan.json").exists() and not (out / "verdicts.json").exists()
+
+
+def test_a_run_plans_once_for_the_same_code_and_declaration(tmp_path, monkeypatch):
+    import conformance.plan_command as plan_command
+
+    monkeypatch.setenv("SDI12_CACHE_DIR", str(tmp_path / "cache"))
+    first = plan_command.cached_plan("sensor", keyword="ttt_zero")
+
+    def no_dry_run(*args, **kw):
+        raise AssertionError("planned again")
+
+    monkeypatch.setattr(plan_command, "make_plan", no_dry_run)
+    assert plan_command.cached_plan("sensor", keyword="ttt_zero") == first
+    with pytest.raises(AssertionError, match="planned again"):  # another selection: new plan
+        plan_command.cached_plan("sensor", keyword="identification")

@@ -107,7 +107,7 @@ def build_plan(
     }
 
 
-def _duration(seconds: float | None) -> str:
+def duration(seconds: float | None) -> str:
     if seconds is None:
         return "—"
     if seconds >= 60:
@@ -130,7 +130,7 @@ def plan_markdown(plan: dict[str, Any]) -> str:
         f"- Tool: {plan['tool']['name']} {plan['tool']['version']}",
         f"- Declaration: {plan['declaration'] or 'none (the tool discovers what it can)'}",
         f"- SDI-12 version: {plan['sdi12_version'] or 'unknown'}",
-        f"- Expected bus time: {_duration(plan['expected_bus_s'])} "
+        f"- Expected bus time: {duration(plan['expected_bus_s'])} "
         "(a real link adds its host and turnaround delays)",
         f"- Cases: {len(plan['cases'])}; requirements judged {len(reqs['judged'])}, N/A for "
         f"this declaration {len(reqs['not_applicable'])}, untestable by this tool "
@@ -152,7 +152,7 @@ def plan_markdown(plan: dict[str, Any]) -> str:
             " ".join(c["requirements"]),
             ", ".join(c["preconditions"]) or "—",
             _sends(c["sends"]),
-            _duration(c["expected_bus_s"]),
+            duration(c["expected_bus_s"]),
             c["not_applicable"] or "",
         ]
         lines.append("| " + " | ".join(cell.replace("|", "\\|") for cell in cells) + " |")
@@ -180,13 +180,13 @@ def plan_table(plan: dict[str, Any], judged: dict[str, dict[str, Any]] | None = 
             f"<tr{cls}><td><code>{escape(c['id'].split('::')[-1])}</code><br>"
             f"{escape(c['title'])}</td><td>{escape(' '.join(c['requirements']))}</td>"
             f"<td>{escape(', '.join(c['preconditions']) or '—')}</td>"
-            f"<td>{escape(_sends(c['sends']))}</td><td>{_duration(c['expected_bus_s'])}</td>"
+            f"<td>{escape(_sends(c['sends']))}</td><td>{duration(c['expected_bus_s'])}</td>"
             f"<td>{escape(c['not_applicable'] or '')}</td>"
         )
         if judged is not None:
             done = judged.get(c["id"])
             row += (
-                f"<td>{escape(done['verdict'])}</td><td>{_duration(done.get('bus_s'))}</td>"
+                f"<td>{escape(done['verdict'])}</td><td>{duration(done.get('bus_s'))}</td>"
                 if done
                 else "<td>not run</td><td>—</td>"
             )
@@ -233,7 +233,7 @@ def plan_section(plan: dict[str, Any] | None, judged: dict[str, dict[str, Any]])
     return (
         '<details id="sdi12-plan"><summary><b>Test plan</b>: '
         f"{len(plan['cases'])} cases planned, expected bus time "
-        f"{_duration(plan.get('expected_bus_s'))}; this run: {len(judged)} cases, "
-        f"{_duration(took)} on the bus (plan.json beside this report)</summary>"
+        f"{duration(plan.get('expected_bus_s'))}; this run: {len(judged)} cases, "
+        f"{duration(took)} on the bus (plan.json beside this report)</summary>"
         f"{PLAN_STYLE}{plan_table(plan, judged)}</details>"
     )
