@@ -468,8 +468,11 @@ _FAULTS = (
     ),
     RecorderFault(
         "retry-too-early",
-        f"The first retry after no reply starts {EARLY_RETRY * 1e3:.0f} ms after the command.",
-        ("R-7.2-02",),
+        f"The first retry after no reply starts {EARLY_RETRY * 1e3:.0f} ms after the command. "
+        "Against the sensor that starts its replies 15.0 ms after the command (scenario "
+        "reply-at-window-edge) that retry runs into the reply, and on the line its characters "
+        "come apart (R-7.0-13): what R-7.2-02's 16.67 ms is there to prevent.",
+        ("R-7.2-02", "R-7.0-13"),
         lambda: GoldenRecorder(
             _GOLDEN.but(first_char_timeout=10e-3), _with_master(EarlyRetryMaster)
         ),
