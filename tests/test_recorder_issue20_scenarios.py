@@ -8,6 +8,7 @@ short-reply-timeout prove the whole suite catches exactly those)."""
 from __future__ import annotations
 
 import pytest
+from test_recorder_judges import Wire, by_id
 
 from conformance.judges.recorder import read_line
 from conformance.judges.recorder.collection import judge_data_collection
@@ -19,8 +20,6 @@ from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.recorder.scenarios import EDGE_REPLY, LONG_TTT, LONG_TTT_READY, SCENARIOS
 from conformance.recorder.session import RecorderSession
 from conformance.verdicts import Verdict
-
-from test_recorder_judges import Wire, by_id
 
 NEW = ("ttt-over-255", "concurrent-ttt-zero", "parity-mid-reply", "reply-at-window-edge")
 
