@@ -247,14 +247,32 @@ class SkipsTttZeroConcurrentRecorder(GoldenRecorder):
 
 class DropsAfterParityMaster(GoldenMaster):
     """Stops reading a reply at a character with a parity error and takes what came before
-    it as the whole reply: no retry, the values before the bad character kept."""
+    it as the whole reply, and the measurement as collected: no retry, and the values before
+    the bad character are what it logs (a logger library's read loop, issue 20)."""
+
+    _cut = False
 
     def _attempt(self, *args: object, **kw: object) -> Attempt:
         attempt = super()._attempt(*args, **kw)  # type: ignore[arg-type]
         bad = [i for i, e in enumerate(attempt.reply_events) if not e.parity_ok]
         if attempt.ok or not bad or "parity" not in attempt.reason:
             return attempt
+        self._cut = True
         return replace(attempt, reply_events=attempt.reply_events[: bad[0]], reason=OK)
+
+    def collect(
+        self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
+    ) -> Measurement:
+        """The golden collection one D command at a time, ending at a cut reply."""
+        self._cut = False
+        while m.count is not None and m.value_count < m.count:
+            n, have = len(m.data), m.value_count
+            limit = n if max_index is None else min(n, max_index)
+            super().collect(m, force_break=force_break, max_index=limit)
+            force_break = False
+            if self._cut or len(m.data) == n or not m.data[-1].ok or m.value_count == have:
+                break
+        return m
 
 
 class TalksOverMaster(Master):
@@ -668,8 +686,10 @@ _FAULTS = (
     RecorderFault(
         "drops-after-parity-error",
         "Stops reading a reply at a character with a parity error and takes what came before "
-        "it as the reply: no retry (R-7.2-05), the values before the bad character kept.",
-        ("R-7.2-05",),
+        "it as the reply and the measurement as collected: no retry (R-7.2-05), and it logs "
+        "the values before the bad character (+22.15 +10 for +22.15 +1013.2 +45.7), values "
+        "of a reply that was not valid (R-4.4-02).",
+        ("R-7.2-05", "R-4.4-02"),
         lambda: GoldenRecorder(_GOLDEN, _with_master(DropsAfterParityMaster)),
     ),
     RecorderFault(
