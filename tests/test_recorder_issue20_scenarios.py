@@ -12,6 +12,7 @@ from test_recorder_judges import Wire, by_id
 
 from conformance.judges.recorder import read_line
 from conformance.judges.recorder.collection import judge_data_collection
+from conformance.judges.recorder.logged import LogReport, judge_logged_values
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.replies import reply_problem
 from conformance.judges.recorder.retries import judge_retries
@@ -116,3 +117,16 @@ def test_short_reply_timeout_loses_the_window_edge_reply():
     collected = judge_data_collection(observed_measurements(line, 0.0))
     assert collected[0].verdict is Verdict.FAIL
     assert "R-4.4.8-05" in RECORDER_FAULTS["short-reply-timeout"].violates
+
+
+def test_values_logged_from_a_reply_with_a_parity_error_fail_r_4_4_02():
+    """A D0 reply with a parity error and no valid one after it: logging nothing from it is
+    fine, logging the values before the bad character is a FAIL."""
+    w = Wire().brk().rec("0M!").sensor("00003\r\n").idle(9).rec("0D0!")
+    w.sensor("0+22.15+10").chars("1", "sensor0", parity=False).chars("3.2+45.7\r\n", "sensor0")
+    line = w.line()
+    kept = judge_logged_values(line, [LogReport("p", {"0M!": ["+22.15", "+10"]})], 0.0)
+    found = by_id(kept)["R-4.4-02"]
+    assert found.verdict is Verdict.FAIL and "not valid" in found.detail
+    clean = judge_logged_values(line, [LogReport("p", {"0M!": []})], 0.0)
+    assert by_id(clean)["R-4.4-02"].verdict is not Verdict.FAIL
