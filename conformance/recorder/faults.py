@@ -16,10 +16,10 @@ from ..links.base import Link
 from ..protocol.commands import Command, Kind, parse_command
 from ..sim.bus import SimLink
 from ..tool_recorder import Master, Measurement, Policy
-from ..tool_recorder.records import Attempt, Exchange
+from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
-from .golden import GoldenMaster, GoldenRecorder
+from .golden import GoldenMaster, GoldenRecorder, logged_values
 from .request import RecorderOutput, Request, Task
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
@@ -194,6 +194,85 @@ class GappyCommandMaster(GoldenMaster):
         collide: bool,
     ) -> tuple[Event | None, list[Event], list[Event]]:
         return super()._transmit(wire, address, brk, max(gap, self.gap), marking, collide)
+
+
+#: What a logger that keeps ttt in an 8-bit variable can count to (issue 20).
+TTT_BITS = 8
+
+
+class EightBitTttMaster(GoldenMaster):
+    """Keeps the announced ttt in 8 bits: waits ``ttt % 256`` s (260 s becomes 4 s)."""
+
+    def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+        assert m.ttt is not None
+        announced, m.ttt = m.ttt, m.ttt % (1 << TTT_BITS)
+        try:
+            super()._wait_for_data(m, service_request=service_request)
+        finally:
+            m.ttt = announced
+
+
+@dataclass
+class EightBitTttRecorder(GoldenRecorder):
+    """The golden recorder with ttt kept in 8 bits, for aM!-type and concurrent waits."""
+
+    master_factory: Callable[[Link, Policy], Master] = field(
+        default=lambda link, policy: EightBitTttMaster(link, policy)
+    )
+
+    def _data_time(self, m: Measurement) -> float:
+        assert m.reply_end is not None and m.ttt is not None
+        margin = (self.policy or Policy.golden()).ttt_margin
+        return m.reply_end + m.ttt % (1 << TTT_BITS) * self.ttt_fraction + margin
+
+
+@dataclass
+class SkipsTttZeroConcurrentRecorder(GoldenRecorder):
+    """Starts concurrent measurements together but never collects one that announced
+    ttt = 000 (a logger library that waits for ttt to count down past zero, issue 20, stuck
+    there; here it gives up on that sensor rather than hang the run)."""
+
+    def _concurrent(self, master: Master, texts: tuple[str, ...], out: RecorderOutput) -> None:
+        started = [
+            master.measure(parse_command(text), collect=False, wait="none") for text in texts
+        ]
+        pending = [m for m in started if m.count is not None and m.ttt]
+        pending.sort(key=self._data_time)
+        for m in pending:
+            master.link.wait_until(self._data_time(m))
+            master.collect(m, force_break=True)
+        for text, m in zip(texts, started, strict=True):
+            out.logged[text] = logged_values(m)
+
+
+class DropsAfterParityMaster(GoldenMaster):
+    """Stops reading a reply at a character with a parity error and takes what came before
+    it as the whole reply, and the measurement as collected: no retry, and the values before
+    the bad character are what it logs (a logger library's read loop, issue 20)."""
+
+    _cut = False
+
+    def _attempt(self, *args: object, **kw: object) -> Attempt:
+        attempt = super()._attempt(*args, **kw)  # type: ignore[arg-type]
+        bad = [i for i, e in enumerate(attempt.reply_events) if not e.parity_ok]
+        if attempt.ok or not bad or "parity" not in attempt.reason:
+            return attempt
+        self._cut = True
+        return replace(attempt, reply_events=attempt.reply_events[: bad[0]], reason=OK)
+
+    def collect(
+        self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
+    ) -> Measurement:
+        """The golden collection one D command at a time, ending at a cut reply."""
+        self._cut = False
+        while m.count is not None and m.value_count < m.count:
+            n, have = len(m.data), m.value_count
+            limit = n if max_index is None else min(n, max_index)
+            super().collect(m, force_break=force_break, max_index=limit)
+            force_break = False
+            if self._cut or len(m.data) == n or not m.data[-1].ok or m.value_count == have:
+                break
+        return m
 
 
 class TalksOverMaster(Master):
@@ -407,8 +486,11 @@ _FAULTS = (
     ),
     RecorderFault(
         "retry-too-early",
-        f"The first retry after no reply starts {EARLY_RETRY * 1e3:.0f} ms after the command.",
-        ("R-7.2-02",),
+        f"The first retry after no reply starts {EARLY_RETRY * 1e3:.0f} ms after the command. "
+        "Against the sensor that starts its replies 15.0 ms after the command (scenario "
+        "reply-at-window-edge) that retry runs into the reply, and on the line its characters "
+        "come apart (R-7.0-13): what R-7.2-02's 16.67 ms is there to prevent.",
+        ("R-7.2-02", "R-7.0-13"),
         lambda: GoldenRecorder(
             _GOLDEN.but(first_char_timeout=10e-3), _with_master(EarlyRetryMaster)
         ),
@@ -576,12 +658,39 @@ _FAULTS = (
     RecorderFault(
         "short-reply-timeout",
         f"Takes a reply that has not started {SHORT_REPLY_TIMEOUT * 1e3:.0f} ms after the "
-        "command as silence and retries into it, though a sensor may start its reply up to "
-        "15.40 ms after the command (R-7.0-10). Every sensor the suite plays answers within "
-        "9 ms, so no requirement verdict sees it (the suite stays COMPLIANT); only the "
-        "tolerance sweep (--sweep reply) shows it giving up inside the standard's limit.",
-        (),
+        "command as silence, though a sensor may start its reply up to 15.40 ms after the "
+        "command (R-7.0-10). Against the sensor answering at 15.0 ms (scenario "
+        "reply-at-window-edge) it sends the command again after each whole reply, then, its "
+        "retries spent, a break 10 ms after the command that cuts the next reply off: no "
+        "retry without a break after that lost reply (R-7.2-01/-02/-05), no sequence with "
+        "two retries (R-7.2-03), and the measurement's data never collected (R-4.4.8-05). "
+        "The tolerance sweep (--sweep reply) shows where it gives up.",
+        ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05", "R-4.4.8-05"),
         lambda: GoldenRecorder(_GOLDEN.but(first_char_timeout=SHORT_REPLY_TIMEOUT)),
+    ),
+    RecorderFault(
+        "ttt-8-bit",
+        "Keeps the announced ttt in 8 bits (ttt % 256): told ttt = 260 s it waits 4 s, then "
+        "sends a break and aD0! before the service request (which comes after 5 s) and long "
+        "before ttt, taking the line while that request could still come.",
+        ("R-4.4.5-04", "R-4.4.5-07"),
+        lambda: EightBitTttRecorder(),
+    ),
+    RecorderFault(
+        "concurrent-ttt-zero-stalls",
+        "Never collects a concurrent measurement that announced ttt = 000: of two sensors "
+        "measured together it reads only the one with ttt > 0, none of the other's values.",
+        ("R-4.4.8-05", "R-4.4.7-08"),
+        lambda: SkipsTttZeroConcurrentRecorder(),
+    ),
+    RecorderFault(
+        "drops-after-parity-error",
+        "Stops reading a reply at a character with a parity error and takes what came before "
+        "it as the reply and the measurement as collected: no retry (R-7.2-05), and it logs "
+        "the values before the bad character (+22.15 +10 for +22.15 +1013.2 +45.7), values "
+        "of a reply that was not valid (R-4.4-02).",
+        ("R-7.2-05", "R-4.4-02"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(DropsAfterParityMaster)),
     ),
     RecorderFault(
         "short-marking",

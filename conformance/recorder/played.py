@@ -233,6 +233,9 @@ class SensorSpec:
     version: str = "14"
     reply_extra: float = 0.0
     wake_extra: float = 0.0
+    #: ``(measurement key, ttt, ready_after)`` overrides of :func:`played_profile`'s timing
+    #: (a ttt over 255 s, a concurrent ttt = 000...)
+    timing: tuple[tuple[str, int, float], ...] = ()
 
     def describe(self) -> str:
         parts = [f"sensor at {self.address!r} (v{self.version[0]}.{self.version[1]})"]
@@ -249,6 +252,8 @@ class SensorSpec:
             parts.append(f"starts each reply {start:.2f} ms after the command")
         if self.wake_extra:
             parts.append(f"hears nothing for {self.wake_extra * 1e3:.2f} ms after a break")
+        for key, ttt, ready in self.timing:
+            parts.append(f"a{key}! announces ttt = {ttt:03d}, data ready after {ready:g} s")
         return ", ".join(parts)
 
     def quirks(self) -> dict[str, float]:
@@ -261,8 +266,14 @@ class SensorSpec:
         return out
 
     def build(self) -> SensorEmulator | SensorAdapter:
+        profile = played_profile(self.address, self.version)
+        if self.timing:
+            m = dict(profile.measurements)
+            for key, ttt, ready in self.timing:
+                m[key] = _ready(m[key], ttt, ready)
+            profile = replace(profile, measurements=m)
         emulator = SensorEmulator(
-            played_profile(self.address, self.version),
+            profile,
             self.faults,
             name=f"sensor{self.address}",
             quirks=self.quirks() or None,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..emulator.behaviour import REPLY_DELAY
 from .played import SensorSpec, Spoil
 from .request import Request, Task
 
@@ -29,6 +30,15 @@ class Scenario:
 
 def _s(address: str = "0", **kw: object) -> SensorSpec:
     return SensorSpec(address, **kw)  # type: ignore[arg-type]
+
+
+#: ttt of ``ttt-over-255`` and when its service request comes: a recorder keeping ttt in
+#: 8 bits waits 260 % 256 = 4 s and asks for aD0! before the request (real time: 5 s, cheap)
+LONG_TTT = 260
+LONG_TTT_READY = 5.0
+#: When ``reply-at-window-edge``'s sensor starts each reply: 15.0 ms after the command's stop
+#: bit, inside the 15.40 ms a sensor may take (R-7.0-10)
+EDGE_REPLY = 15.0e-3
 
 
 def _measure(*commands: str) -> Request:
@@ -93,6 +103,26 @@ _SCENARIOS = (
         _measure("0M!"),
     ),
     Scenario(
+        "parity-mid-reply",
+        "a D0 reply with a parity error in a middle character (inside its second value), once",
+        (_s(spoil=Spoil("parity", at=10), spoil_command="0D0!"),),
+        _measure("0M!"),
+    ),
+    Scenario(
+        "ttt-over-255",
+        f"a measurement announcing ttt = {LONG_TTT} s, over what 8 bits hold, with its "
+        f"service request after {LONG_TTT_READY:g} s",
+        (_s(timing=(("M", LONG_TTT, LONG_TTT_READY),)),),
+        _measure("0M!"),
+    ),
+    Scenario(
+        "reply-at-window-edge",
+        f"a sensor that starts every reply {EDGE_REPLY * 1e3:.1f} ms after the command, at "
+        "the edge of the 15.40 ms it may take",
+        (_s(reply_extra=EDGE_REPLY - REPLY_DELAY),),
+        _measure("0M!"),
+    ),
+    Scenario(
         "two-sensors",
         "two sensors measured one after the other",
         (_s("0"), _s("1")),
@@ -102,6 +132,12 @@ _SCENARIOS = (
         "concurrent-two",
         "two sensors measuring concurrently",
         (_s("0"), _s("1")),
+        Request(Task.CONCURRENT, ("0C!", "1C!")),
+    ),
+    Scenario(
+        "concurrent-ttt-zero",
+        "two sensors measuring concurrently, one of them announcing ttt = 000 (data ready at once)",
+        (_s("0", timing=(("C", 0, 0.0),)), _s("1")),
         Request(Task.CONCURRENT, ("0C!", "1C!")),
     ),
     Scenario(

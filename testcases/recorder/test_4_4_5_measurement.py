@@ -11,7 +11,14 @@ from conformance.judges.recorder.waits import judge_measure_waits
 from ._helpers import line_of
 
 requirements = pytest.mark.requirements
-WAIT_SCENARIOS = ("service-request", "no-service-request", "ttt-zero", "two-sensors", "families")
+WAIT_SCENARIOS = (
+    "service-request",
+    "no-service-request",
+    "ttt-zero",
+    "ttt-over-255",
+    "two-sensors",
+    "families",
+)
 
 
 @requirements("R-4.4.5-04", "R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07")

@@ -20,7 +20,7 @@ def test_concurrent_measurements(recorder, case):
     """Two sensors measure at once: each one's data are asked for only after its ttt, and the
     recorder uses aC! and collects every value."""
     case.expect("first data command to each sensor at least ttt after its 'atttnn' reply")
-    names = ("concurrent-two", "concurrent-99", "families")
+    names = ("concurrent-two", "concurrent-ttt-zero", "concurrent-99", "families")
     line = line_of(recorder, case, *names)
     if line is None:
         return

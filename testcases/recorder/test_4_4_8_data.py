@@ -18,5 +18,13 @@ def test_data_continuation(recorder, case):
     """The recorder reads D0, D1, D2... until every announced value is in, and issues the
     measurement again when a D reply comes back valid but empty."""
     case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
-    line = line_of(recorder, case, "d0-to-d2", "empty-data", "concurrent-99", "families")
+    names = (
+        "d0-to-d2",
+        "empty-data",
+        "reply-at-window-edge",
+        "concurrent-ttt-zero",
+        "concurrent-99",
+        "families",
+    )
+    line = line_of(recorder, case, *names)
     case.extend(judge_data_collection(observed_measurements(line, recorder.uncertainty)))

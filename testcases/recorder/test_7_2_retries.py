@@ -14,8 +14,10 @@ RETRY_SCENARIOS = (
     "silent-six",
     "bad-crc-once",
     "parity-once",
+    "parity-mid-reply",
     "pause-once",
     "format-once",
+    "reply-at-window-edge",
 )
 
 

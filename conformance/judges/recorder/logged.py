@@ -27,6 +27,7 @@ from ...protocol.commands import CommandError, Kind, parse_command
 from ...transcript import escape
 from ...verdicts import Finding, Verdict, not_applicable
 from ...view.segments import TranscriptView
+from ..reply_validity import Reason
 from ..tally import Tally
 from .measurements import ObservedMeasurement, observed_measurements
 from .replies import crc_context, data_values, reply_problem
@@ -170,6 +171,25 @@ def _sent_per_command(
     return found
 
 
+def _invalid_only(taken: Sequence[ObservedMeasurement], part: int) -> dict[str, list[Sent]]:
+    """Per command text of scenario ``part`` whose last measurement has data indices that
+    never came in a valid reply (parity, framing, format, a pause...): the values its valid
+    replies did bring. A logger may log only those; values beyond them can only come from an
+    invalid reply. A CRC mismatch is left out: R-4.4.12-07 judges what is logged after one."""
+    found: dict[str, list[Sent]] = {}
+    for m in taken:
+        if m.start.part != part:
+            continue
+        found.pop(m.start.text, None)
+        unread = set(m.unread_indices())
+        problems = [
+            p for s, p in m.data if p is not None and (d := s.data_index) and d[1] in unread
+        ]
+        if unread and not any(p.reason is Reason.CRC_WRONG for p in problems):
+            found[m.start.text] = [Sent(t, d) for t, d in m.sent_values()]
+    return found
+
+
 def judge_logged_values(
     line: TranscriptView,
     reports: Sequence[LogReport],
@@ -202,8 +222,19 @@ def judge_logged_values(
         if report.logged is None and report.cut_short:
             continue
         logged = report.logged or {}
+        invalid = _invalid_only(taken, part)
         for command, values in sent.items():
             if values is None:
+                kept = invalid.get(command)
+                got = logged.get(command)
+                if kept is not None and got and len(got) > len(kept):
+                    tally.fail(
+                        _rid(command),
+                        f"{report.scenario}: {escape(command)}",
+                        f"logged {len(got)} value(s), only {len(kept)} came in valid replies: "
+                        f"from {_value(got[len(kept)])} on they are from a reply that was not "
+                        "valid",
+                    )
                 continue
             where = f"{report.scenario}: {escape(command)}"
             if command not in logged:
