@@ -228,6 +228,11 @@ class Capabilities:
             rule = mandatory_rule(token, self.v14)
             if rule is not None:
                 mandatory.setdefault(rule, []).append(f"{WHAT[token]} ({cited})")
+        rec = self.declared
+        if rec.addresses is not None and not set("0123456789") <= rec.addresses:
+            said = f'[recorder] addresses = "{rec.addresses_text}" ({rec.where["addresses"]})'
+            cited = f"addresses 0-9 ({said})"
+            mandatory.setdefault("R-4.3-03", []).append(cited)
         version = "v1.4" if self.v14 else "v1.3"
         for f in findings:
             if f.requirement in dependent:
