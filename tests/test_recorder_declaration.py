@@ -157,6 +157,9 @@ def test_an_optional_capability_declared_absent_is_not_asked_and_na(tmp_path):
     ]
     assert any(n.startswith("not asked: A! needs address A, declared absent") for n in notes)
     assert data["summary"]["verdict"] == "COMPLIANT"
+    # the golden recorder can address letters, and would (R-4.3-04 PASS) if it were asked
+    golden = run("sim", path)
+    assert verdicts(golden)["R-4.3-04"] == "N/A" and verdicts(run("sim"))["R-4.3-04"] == "PASS"
 
 
 def test_digits_declared_absent_are_asked_and_still_fail(tmp_path):
