@@ -31,6 +31,7 @@ from __future__ import annotations
 import contextlib
 from dataclasses import dataclass, replace
 
+from ..catalog import requirement
 from ..declaration import Declaration, RecorderDeclaration
 from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..transcript import Event, EventKind
@@ -261,6 +262,65 @@ class Capabilities:
                     f'says the recorder polls only "{self.declared.addresses_text}" '
                     f"({self.declared.where['addresses']}); none asked"
                 )
+
+
+def job_rules(commands: tuple[str, ...], v14: bool) -> tuple[dict[str, list[str]], set[str]]:
+    """The rules that require a recorder of this version to send ``commands`` (rule -> the
+    commands), and the optional rules that let it lack some of them (R-4.3-04 for letter
+    addresses). A command needing only an optional capability adds no mandatory rule."""
+    mandatory: dict[str, list[str]] = {}
+    optional: set[str] = set()
+    for text in commands:
+        try:
+            command = parse_command(text)
+        except CommandError:
+            continue
+        targets = [t for t in (command.address, command.new_address) if t and t != "?"]
+        if any(t.isalpha() for t in targets):
+            optional.add(LETTER_RULE)
+            continue
+        if targets:
+            mandatory.setdefault("R-4.3-03", []).append(text)
+        rule = mandatory_rule(token_of(command), v14)
+        if rule is None:
+            optional.add(DEPENDENT_RULES.get(token_of(command), ("",))[0])
+        else:
+            mandatory.setdefault(rule, []).append(text)
+    return mandatory, optional - {""}
+
+
+def cannot_finding(
+    rid: str, job: str, words: str, commands: tuple[str, ...], findings: list[Finding], version: str
+) -> Finding | None:
+    """The verdict on ``rid`` of a case judged on ``job``, which the recorder said it cannot
+    do. N/A when the job needs only what the standard lets a recorder lack, or ``rid`` is a
+    MAY (what only the missing job left undecided, or a MAY's FAIL, is dropped from
+    ``findings``). A FAIL, resting on the recorder's own words, when ``rid`` is a rule that
+    requires the job's commands of a recorder of this version (R-4.4-02 for aM!, R-4.3-03
+    for the addresses 0-9...). Any other rule: None, judged on what the case saw."""
+    v14 = version >= "14"
+    mandatory, optional_rules = job_rules(commands, v14)
+    level = requirement(rid).level
+    said = f"the recorder said it cannot do {job}" + (f" ({words})" if words else "")
+    if not mandatory or level == "MAY" or (rid in optional_rules and rid not in mandatory):
+        dropped = {Verdict.INCONCLUSIVE} | (
+            {Verdict.FAIL, Verdict.WARN} if level == "MAY" else set()
+        )
+        findings[:] = [f for f in findings if not (f.requirement == rid and f.verdict in dropped)]
+        why = f"{rid} is a MAY" if level == "MAY" else "the job needs only optional capabilities"
+        return Finding(rid, Verdict.NA, f"not applicable: {said}; {why}")
+    if rid not in mandatory:
+        return None
+    verdict = Verdict.WARN if level == "SHOULD" else Verdict.FAIL
+    needed = " ".join(mandatory[rid])
+    return Finding(
+        rid,
+        verdict,
+        f"{said}, but {rid} ({level}) requires a v{version[0]}.{version[1]} recorder to send "
+        f"{needed}",
+        evidence=[said],
+        observed=1,
+    )
 
 
 def sent_tokens(events: list[Event], is_recorder) -> set[str]:  # noqa: ANN001

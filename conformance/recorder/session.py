@@ -30,10 +30,11 @@ from ..ports import PortError, SimSpec, is_sim, parse_sim
 from ..replay.link import is_replay, open_recorder_replay, replayed_info
 from ..replay.recorder import RecordedRecorder, output_note
 from ..replay.recording import RecordingError
+from ..results import CaseRecord
 from ..sim.bus import Frame, SimBus, SimLink
 from ..suggest import did_you_mean
 from ..transcript import TOOL, Event, EventKind
-from .capability import Absence, Capabilities, sent_tokens
+from .capability import Absence, Capabilities, cannot_finding, sent_tokens
 from .drivers import (
     Driver,
     InProcess,
@@ -230,12 +231,27 @@ class RecorderSession:
             self.runs[name] = self._run(SCENARIOS[name])
         return self.runs[name]
 
-    def apply_declaration(self, findings: list) -> None:
-        """A case's findings read with the recorder declaration (recorder.capability)."""
+    def apply_declaration(self, record: CaseRecord) -> None:
+        """A case's findings read with what the recorder said it cannot do (a harness's
+        ``cannot``, a trigger's exit code 3) and with its declaration (recorder.capability)."""
+        used = [
+            title.removeprefix("scenario ").split(":", 1)[0]
+            for title, _ in record.evidence
+            if title.startswith("scenario ")
+        ]
+        for name in dict.fromkeys(used):
+            run = self.runs.get(name)
+            if run is None or run.output.cannot is None:
+                continue
+            for rid in record.requirements:
+                said = run.output.cannot
+                found = cannot_finding(rid, name, said, run.asked, record.findings, self.version)
+                if found is not None:
+                    record.findings.append(found)
         sent: set[str] = set()
         for run in self.runs.values():
             sent |= sent_tokens(run.events, self.is_recorder)
-        self.capabilities.apply(findings, sent)
+        self.capabilities.apply(record.findings, sent)
 
     def run_scenario(self, scenario: Scenario) -> ScenarioRun:
         """Run a scenario that is not one of :data:`SCENARIOS` (a tolerance sweep's step),
