@@ -7,14 +7,21 @@ when the recorder indeed never sent it."""
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import pytest
 
+from conformance.cli import main
 from conformance.declaration import DeclarationError, load_declaration
+from conformance.harness.protocol import HarnessProtocolError, PlanKind, Role, parse_plan
 from conformance.protocol.commands import Kind
+from conformance.recorder.capability import cannot_finding
+from conformance.recorder.drivers import CANNOT_EXIT, Trigger
 from conformance.recorder.faults import LacksCommandsRecorder
 from conformance.recorder.matrix import run_recorder_suite
+from conformance.recorder.request import Request, Task
+from conformance.verdicts import Finding, Verdict
 
 
 def write(tmp_path: Path, text: str, name: str = "recorder.toml") -> Path:
@@ -187,3 +194,92 @@ def test_without_a_declaration_the_assumptions_say_every_job_was_asked():
         a.startswith("no recorder declaration (none given): every job asked")
         for a in data["dut"]["assumptions"]
     )
+
+
+# -- "cannot JOB": a harness's answer, a trigger's exit code 3 ------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+HARNESS = f"exec:{sys.executable} {ROOT / 'examples/python/recorder_harness.py'}"
+NEAR = ("-k", "test_addresses or test_every_basic_command or test_logged_values")
+
+
+def test_a_harness_that_cannot_do_a_job(monkeypatch):
+    """``cannot`` for the addresses job: R-4.3-03 (MUST, addresses 0-9) FAILs on the
+    recorder's own words, R-4.3-04 (MAY, letters) is N/A citing them; ``cannot`` for the
+    basic aM! job FAILs R-4.4-02. The rules judged on other jobs keep their verdicts."""
+    # the harness process imports this tree's conformance, not another installed one
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    plain = run(HARNESS, None, *NEAR)
+    said = run(f"{HARNESS} --cannot addresses,service-request", None, *NEAR)
+    got, before = verdicts(said), verdicts(plain)
+    assert before["R-4.3-03"] == before["R-4.4-02"] == "PASS"
+    assert got["R-4.3-03"] == got["R-4.4-02"] == "FAIL"
+    assert any(
+        d.startswith("the recorder said it cannot do addresses (this logger cannot do addresses)")
+        and "R-4.3-03 (MUST)" in d
+        for d in details(said, "R-4.3-03")
+    )
+    assert any("cannot do service-request" in d for d in details(said, "R-4.4-02"))
+    assert got["R-4.3-04"] == "N/A"
+    assert any("cannot do addresses" in d and "MAY" in d for d in details(said, "R-4.3-04"))
+    rest = set(before) - {"R-4.3-03", "R-4.3-04", "R-4.4-02"}
+    assert {r: got[r] for r in rest} == {r: before[r] for r in rest}
+
+
+def test_cannot_is_a_recorder_plan_only():
+    plan = parse_plan("cannot no aC! here", Role.RECORDER, 0)
+    assert (plan.kind, plan.reason) == (PlanKind.CANNOT, "no aC! here")
+    assert parse_plan("cannot", Role.RECORDER, 0).reason == ""
+    with pytest.raises(HarnessProtocolError, match="recorder harnesses only"):
+        parse_plan("cannot", Role.SENSOR, 0)
+
+
+def test_a_job_of_optional_commands_only_is_na_when_the_recorder_cannot():
+    """A job that needs only what the standard lets a recorder lack (letter addresses): every
+    rule of it is N/A, and what only the missing job left undecided is dropped."""
+    undecided = Finding("R-4.3-01", Verdict.INCONCLUSIVE, "nothing observed")
+    kept = Finding("R-4.3-01", Verdict.FAIL, "seen on another job", evidence=["x"], observed=1)
+    findings = [undecided, kept]
+    got = cannot_finding("R-4.3-01", "letters", "", ("A!", "z!"), findings, "14")
+    assert got is not None and got.verdict is Verdict.NA
+    assert "the job needs only optional capabilities" in got.detail
+    assert findings == [kept]
+    mandatory = cannot_finding("R-4.3-03", "digits", "", ("0!", "A!"), [], "13")
+    assert mandatory is not None and mandatory.verdict is Verdict.FAIL
+    assert mandatory.evidence == ["the recorder said it cannot do digits"]
+    assert cannot_finding("R-7.0-02", "digits", "", ("0!",), [], "13") is None
+
+
+def test_a_trigger_exiting_with_3_says_it_cannot(tmp_path):
+    request = Request(Task.MEASURE, ("0C!",))
+    out = Trigger("echo 'no concurrent measurements' >&2; exit 3", timeout=10).act(
+        "concurrent-two",
+        request,
+        None,  # type: ignore[arg-type]
+    )
+    assert out.cannot == "no concurrent measurements"
+    assert CANNOT_EXIT == 3
+
+
+@pytest.mark.realtime
+def test_a_trigger_that_cannot_do_the_addresses_job(tmp_path):
+    out = tmp_path / "report"
+    code = main(
+        [
+            "--port",
+            "rfc2217-serve://127.0.0.1:0",
+            "--role",
+            "recorder",
+            "--trigger",
+            "echo 'letters only' >&2; exit 3",
+            "--report-dir",
+            str(out),
+            "-k",
+            "test_addresses",
+        ]
+    )
+    data = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
+    got = verdicts(data)
+    assert code == 1
+    assert got["R-4.3-03"] == "FAIL" and got["R-4.3-04"] == "N/A"
+    assert any("cannot do addresses (letters only)" in d for d in details(data, "R-4.3-03"))
