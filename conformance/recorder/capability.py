@@ -24,6 +24,12 @@ they are judged as usual.
 
 Without a declaration every job is asked and every capability assumed, as the report's
 assumptions say.
+
+The recorder may also say, job by job, that it cannot do one (a harness's ``cannot``, a
+trigger's exit code 3, an in-process program's ``RecorderOutput.cannot``): the same levels
+decide (:func:`cannot_finding`). N/A for a MAY rule or a job of optional commands only; a FAIL
+resting on the recorder's words for the rule that requires the job's commands; any other rule
+judged on what the wire shows.
 """
 
 from __future__ import annotations
