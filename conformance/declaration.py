@@ -17,6 +17,20 @@ Without one the tool discovers what it can and says in the report what it assume
     [ttt]                        # announced seconds per command code (sdi12-conform plan)
     M = 2
     C = 3
+
+The recorder role (``--role recorder``) reads the same file: ``sdi12_version`` is what the
+recorder claims, and a ``[recorder]`` table says what the logger can do (the sensor role
+ignores that table, and the recorder role the sensor's keys)::
+
+    sdi12_version = "1.3"
+    [recorder]
+    commands = ["?", "!", "I", "A", "M", "D", "MC", "V", "C", "CC", "R", "RC", "X", "IM"]
+    crc = true                   # false: no aMC!/aCC!/aRCn! (whatever ``commands`` says)
+    concurrent = true            # false: no aC!/aCn!/aCC!
+    high_volume = false          # false: no aHA!/aHB!/aDBn!
+    addresses = "0-9"            # the addresses it can poll: "0-9", "0-9,A-Z,a-z", "0-4"
+
+See :mod:`conformance.recorder.capability` for what an absent capability does to a run.
 """
 
 from __future__ import annotations
@@ -46,6 +60,74 @@ class DeclarationError(ValueError):
     """The declaration file is unreadable or says something impossible (a usage error)."""
 
 
+#: ``[recorder] commands`` tokens: the command kinds a logger can send (wire shape, no
+#: address): ``?`` ?!, ``!`` a!, ``I`` aI!, ``A`` aAb!, ``M`` aM!/aMn!, ``D`` aDn!, ``MC``
+#: aMC!/aMCn!, ``V`` aV!, ``C`` aC!/aCn!, ``CC`` aCC!/aCCn!, ``R`` aRn!, ``RC`` aRCn!, ``HA``
+#: aHA!, ``HB`` aHB!, ``DB`` aDBn!, ``X`` extended commands, ``IM`` identify-measurement
+#: and metadata commands (aIM!, aIM_001!...).
+RECORDER_COMMANDS = (
+    "?",
+    "!",
+    "I",
+    "A",
+    "M",
+    "D",
+    "MC",
+    "V",
+    "C",
+    "CC",
+    "R",
+    "RC",
+    "HA",
+    "HB",
+    "DB",
+    "X",
+    "IM",
+)
+RECORDER_KEYS: dict[str, type] = {
+    "commands": list,
+    "crc": bool,
+    "concurrent": bool,
+    "high_volume": bool,
+    "addresses": str,
+}
+
+
+@dataclass(frozen=True)
+class RecorderDeclaration:
+    """What a data recorder's maker says it can do; None: not declared (assumed present)."""
+
+    commands: frozenset[str] | None = None
+    crc: bool | None = None
+    concurrent: bool | None = None
+    high_volume: bool | None = None
+    addresses: frozenset[str] | None = None
+    addresses_text: str = ""
+    #: key -> "FILE:LINE", to cite the declaration in a finding
+    where: dict[str, str] = field(default_factory=dict)
+
+
+def parse_addresses(text: str) -> frozenset[str]:
+    """``"0-9,A-Z"`` -> the address characters; ValueError says what is wrong."""
+    chosen: set[str] = set()
+    for part in (p.strip() for p in text.split(",")):
+        if len(part) == 3 and part[1] == "-":
+            lo, hi = part[0], part[2]
+            if address_problem(lo) or address_problem(hi) or lo > hi:
+                raise ValueError(f"{part!r} is not a range of addresses like 0-9 or A-Z")
+            span = {c for c in ADDRESS_CHARS if lo <= c <= hi}
+            if not ({lo, hi} <= span) or (lo.isdigit() != hi.isdigit()):
+                raise ValueError(f"{part!r} mixes digits and letters: write 0-9,A-Z")
+            chosen |= span
+        elif address_problem(part) is None:
+            chosen.add(part)
+        else:
+            raise ValueError(
+                f'{part!r} is neither an address nor a range (e.g. "0-9", "0-9,A-Z,a-z")'
+            )
+    return frozenset(chosen)
+
+
 @dataclass(frozen=True)
 class Declaration:
     address: str | None = None
@@ -57,6 +139,8 @@ class Declaration:
     ttt: dict[str, int] = field(default_factory=dict)
     factory_fresh: bool = False  # the unit has not been re-addressed since it left the factory
     source: str = ""
+    #: the ``[recorder]`` table (recorder role), None when the file has none
+    recorder: RecorderDeclaration | None = None
 
     def feature(self, name: str) -> bool | None:
         """True/False when declared, None when the tool has to discover it."""
@@ -79,6 +163,7 @@ TOP_LEVEL: dict[str, type | tuple[type, ...]] = {
     "features": dict,
     "measurements": dict,
     "ttt": dict,
+    "recorder": dict,
 }
 MEASUREMENT_CODE = re.compile(r"^(?:[MC]C?[1-9]?|H[AB]|V)$")
 
@@ -134,6 +219,11 @@ def load_declaration(path: str | Path) -> Declaration:
             raise refuse("ttt", key, "not a measurement command (M, M1..M9, C, MC1...)")
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 999:
             raise refuse("ttt", key, f"must be whole seconds 0..999, not {value!r}")
+    recorder = None
+    if "recorder" in raw:
+        recorder = _recorder_table(
+            raw["recorder"], refuse, lambda key: _line_of(text, "recorder", key), path
+        )
     return Declaration(
         address=address,
         sdi12_version=claimed,
@@ -143,11 +233,60 @@ def load_declaration(path: str | Path) -> Declaration:
         ttt=dict(ttt),
         factory_fresh=raw.get("factory_fresh", False),
         source=str(path),
+        recorder=recorder,
+    )
+
+
+def _recorder_table(table: dict, refuse, line_of, path: str | Path) -> RecorderDeclaration:  # noqa: ANN001
+    """Check ``[recorder]`` as strictly as the rest: unknown key, wrong type, unknown token."""
+    for key, value in table.items():
+        if key not in RECORDER_KEYS:
+            raise refuse("recorder", key, f"unknown key (known: {', '.join(RECORDER_KEYS)})")
+        kind = RECORDER_KEYS[key]
+        if not isinstance(value, kind):
+            raise refuse("recorder", key, f"must be a {_type_name(kind)}, not {value!r}")
+    commands = table.get("commands")
+    if commands is not None:
+        unknown = [c for c in commands if c not in RECORDER_COMMANDS]
+        if unknown or not all(isinstance(c, str) for c in commands):
+            raise refuse(
+                "recorder",
+                "commands",
+                f"unknown command kind(s) {unknown!r} (known: {' '.join(RECORDER_COMMANDS)})",
+            )
+    families = {"crc": ("MC", "CC", "RC"), "concurrent": ("C", "CC"), "high_volume": ("HA", "HB")}
+    for key, tokens in families.items():
+        listed = [t for t in tokens if commands is not None and t in commands]
+        if table.get(key) is False and listed:
+            raise refuse(
+                "recorder", key, f"false, but [recorder] commands lists {' '.join(listed)}"
+            )
+    addresses = None
+    if "addresses" in table:
+        try:
+            addresses = parse_addresses(table["addresses"])
+        except ValueError as exc:
+            raise refuse("recorder", "addresses", str(exc)) from None
+    return RecorderDeclaration(
+        commands=frozenset(commands) if commands is not None else None,
+        crc=table.get("crc"),
+        concurrent=table.get("concurrent"),
+        high_volume=table.get("high_volume"),
+        addresses=addresses,
+        addresses_text=table.get("addresses", ""),
+        where={key: f"{path}:{line_of(key)}" for key in table},
     )
 
 
 def _type_name(kind: type | tuple[type, ...]) -> str:
-    names = {str: "string", float: "number", bool: "true/false", dict: "table", int: "integer"}
+    names = {
+        str: "string",
+        float: "number",
+        bool: "true/false",
+        dict: "table",
+        int: "integer",
+        list: "list",
+    }
     kinds = kind if isinstance(kind, tuple) else (kind,)
     return " or ".join(names.get(k, k.__name__) for k in kinds)
 

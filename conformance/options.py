@@ -144,7 +144,12 @@ OPTIONS: tuple[Option, ...] = (
         "force the rule set, 1.3 or 1.4 (default: from aI!)",
         plugin_name="version",
     ),
-    Option("declaration", "declaration", "TOML file declaring the DUT's address and features"),
+    Option(
+        "declaration",
+        "declaration",
+        "TOML file declaring the DUT's address and features (recorder role: its "
+        "[recorder] table of the command kinds, addresses and measurements it can do)",
+    ),
     Option(
         "report-dir",
         "report_dir",
@@ -180,7 +185,9 @@ OPTIONS: tuple[Option, ...] = (
         "trigger",
         "trigger",
         "recorder role: shell command run per scenario with the request in SDI12_* "
-        "environment variables, or 'interactive' to prompt an operator",
+        "environment variables (exit 0: done; exit 3: this logger cannot do this job, "
+        "N/A where only an optional rule asks for it, else a FAIL), or 'interactive' to "
+        "prompt an operator",
     ),
     Option(
         "sweep",

@@ -131,7 +131,7 @@ def make_plan(
     digits = normalise_version(version) if version else None
     port = dry_port(role, declaration, digits)
     extra: list[str] = []
-    if declaration and role == "sensor":
+    if declaration:  # the recorder role reads its sdi12_version and [recorder] table
         extra += ["--sdi12-declaration", str(Path(declaration).resolve())]
     if digits:
         extra += ["--sdi12-version", f"{digits[0]}.{digits[1]}"]
@@ -148,7 +148,10 @@ def make_plan(
     if role == "recorder":
         said = ["timed on the golden recorder: a logger under test paces its own jobs"]
         if declaration:
-            said.append("recorder declarations are not read yet: every job is planned")
+            said.append(
+                "recorder declaration read: commands it declares it cannot send, where the "
+                "standard lets it lack them, are not planned; every other job is"
+            )
     elif declared is None:
         said = ["no declaration: timed on the reference sensor's profile"]
     selection = {"k": keyword, "req": list(reqs)} if keyword or reqs else None

@@ -319,6 +319,9 @@ def pytest_runtest_call(item: pytest.Item):
         record.added = (before, record.window[1])
         if clock is not None and run.link is not None:
             record.bus_s = run.link.now() - clock
+    apply_declaration = getattr(run.session, "apply_declaration", None)
+    if apply_declaration is not None:  # recorder role: what its declaration excuses
+        apply_declaration(record)
     verdict = record.summarise()
     if not record.findings:
         _error(record, "case produced no finding (a check that cannot fail is a defect)")

@@ -131,6 +131,7 @@ class ConformanceRun:
                 version=version,
                 driver=driver,
                 timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
+                declaration=self.declaration,
             )
             self.link = self.session.link
             self.note_options()

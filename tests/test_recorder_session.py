@@ -77,8 +77,8 @@ def test_trigger_gets_the_request_and_keeps_its_output():
     trigger = Trigger('echo "$SDI12_SCENARIO $SDI12_TASK $SDI12_COMMANDS"', timeout=10)
     out = trigger.act("service-request", request, None)  # type: ignore[arg-type]
     assert out.notes == ["service-request measure 0M!"]
-    with pytest.raises(RecorderDriverError, match="exited with 3"):
-        Trigger("exit 3").act("x", request, None)  # type: ignore[arg-type]
+    with pytest.raises(RecorderDriverError, match="exited with 5"):
+        Trigger("exit 5").act("x", request, None)  # type: ignore[arg-type]
     with pytest.raises(RecorderDriverError, match="did not finish"):
         Trigger(f"{sys.executable} -c 'import time; time.sleep(5)'", timeout=0.2).act(
             "x",

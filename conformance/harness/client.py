@@ -138,7 +138,10 @@ def serve_recorder(
     for command, values in output.logged.items():
         for line in log_lines(command, values):
             out.write(line + "\n")
-    out.write("done\n")
+    if output.cannot is not None:  # the program says its logger cannot do this job
+        out.write(" ".join(("cannot", *output.cannot.split())) + "\n")
+    else:
+        out.write("done\n")
     out.flush()
     inp.readline()  # bye
     return 0

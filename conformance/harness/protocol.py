@@ -38,6 +38,8 @@ class PlanKind(StrEnum):
     WAIT = "wait"  # nothing before ``start``; tell me when it comes
     IDLE = "idle"  # nothing until something happens on the line
     DONE = "done"  # the job is finished (recorder harnesses only)
+    #: ``cannot [WORDS]``: this recorder cannot do the job (recorder harnesses only)
+    CANNOT = "cannot"
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,6 +50,7 @@ class Plan:
     start: int = 0  # us; TX/BRK: when it starts, WAIT: when to wake the harness
     end: int = 0  # us; BRK only
     wire: int = 0  # TX only: the 8 wire bits
+    reason: str = ""  # CANNOT only: the harness's own words, if any
 
 
 def us(seconds: float) -> int:
@@ -123,6 +126,8 @@ def _byte(field: str, text: str) -> int:
 
 
 _FIELDS = {"tx": 3, "brk": 3, "wait": 2, "idle": 1, "done": 1}
+#: Longest reason a ``cannot`` keeps (the harness's words are untrusted and unbounded).
+MAX_REASON = 200
 
 #: A recorder harness's report of values its logger logged: ``log CMD VALUE...`` lines,
 #: written before any plan (they answer nothing; several for one command append).
@@ -184,8 +189,12 @@ def parse_plan(text: str, role: Role, now: int, since: int | None = None) -> Pla
     floor = now if since is None else min(now, since)
     parts = text.split(" ")
     word = parts[0]
+    if word == PlanKind.CANNOT:
+        if role is Role.SENSOR:
+            raise HarnessProtocolError(f"'{word}' is for recorder harnesses only", text)
+        return Plan(PlanKind.CANNOT, reason=text[len(word) :].strip()[:MAX_REASON])
     if word not in _FIELDS:
-        raise HarnessProtocolError("unknown reply (want tx, wait, idle, brk or done)", text)
+        raise HarnessProtocolError("unknown reply (want tx, wait, idle, brk, done or cannot)", text)
     if len(parts) != _FIELDS[word]:
         raise HarnessProtocolError(f"'{word}' takes {_FIELDS[word] - 1} field(s)", text)
     kind = PlanKind(word)

@@ -49,11 +49,11 @@ class HarnessRecorder:
             name = channel.greet(Role.RECORDER)
             first = proto.job(link.now(), str(request.task), request.commands)
             plan = channel.plan(first, Role.RECORDER, link.now())
-            ended = self._drive(channel, plan, link)
+            ended, cannot = self._drive(channel, plan, link)
             channel.finish(proto.BYE)
         finally:
             channel.close(proto.BYE)
-        out = RecorderOutput()
+        out = RecorderOutput(cannot=cannot)
         out.notes.append(f"harness {name or self.port}: {ended}")
         for log in channel.logs:  # several lines for one command append, in order
             out.logged.setdefault(log.command, []).extend(log.values)
@@ -73,10 +73,11 @@ class HarnessRecorder:
         except HarnessError as exc:
             raise PortUnavailable(str(exc)) from exc
 
-    def _drive(self, channel: Channel, plan: Plan, link: Link) -> str:
-        """Carry out plans until ``done``; what ended the job, in words."""
+    def _drive(self, channel: Channel, plan: Plan, link: Link) -> tuple[str, str | None]:
+        """Carry out plans until ``done`` or ``cannot``; what ended the job, in words, and
+        the ``cannot`` reason (None: the harness did not say it cannot)."""
         limit = link.now() + JOB_LIMIT
-        while plan.kind is not PlanKind.DONE:
+        while plan.kind not in (PlanKind.DONE, PlanKind.CANNOT):
             if link.now() > limit:
                 raise RecorderDriverError(
                     f"recorder harness did not finish its job within {JOB_LIMIT:g} s of bus time"
@@ -92,7 +93,7 @@ class HarnessRecorder:
                 plan = channel.plan(message, Role.RECORDER, got.end, got.start)
                 continue
             if plan.kind is PlanKind.IDLE:
-                return f"idle with a quiet line for {IDLE_END:g} s of bus time"
+                return f"idle with a quiet line for {IDLE_END:g} s of bus time", None
             if plan.kind is PlanKind.WAIT:
                 message = proto.time_is(link.now())
             elif plan.kind is PlanKind.TX:
@@ -102,4 +103,6 @@ class HarnessRecorder:
                 made = link.send_break(proto.seconds(plan.end) - link.now())
                 message = proto.line_break(made.start, made.end)
             plan = channel.plan(message, Role.RECORDER, link.now())
-        return "done"
+        if plan.kind is PlanKind.CANNOT:
+            return "cannot" + (f" {plan.reason}" if plan.reason else ""), plan.reason
+        return "done", None

@@ -32,6 +32,8 @@ from ..links.base import Link
 from .logfile import LOG_FILE_VARIABLE, LogFileError, read_log_file
 from .request import RecorderOutput, Request
 
+#: The exit code by which a trigger says "this logger cannot do this job" (README).
+CANNOT_EXIT = 3
 #: Longest trigger output kept as evidence (the DUT's words are untrusted and unbounded).
 MAX_OUTPUT = 4000
 MAX_STDERR = 600  # a failing trigger's own words, shown to the user as they are
@@ -81,6 +83,8 @@ class Trigger:
         with tempfile.TemporaryDirectory(prefix="sdi12-log-") as folder:
             log_file = Path(folder) / f"{scenario}.log"
             out = self._run(scenario, request, log_file)
+            if out.cannot is not None:
+                return out
             try:
                 out.logged = read_log_file(log_file) or {}
                 if log_file.exists():
@@ -110,6 +114,9 @@ class Trigger:
             raise RecorderDriverError(
                 f"trigger did not finish within {self.timeout:g} s: {self.command}"
             ) from exc
+        if done.returncode == CANNOT_EXIT:  # the logger cannot do this job: its words
+            words = (done.stderr.strip() or done.stdout.strip())[:MAX_STDERR]
+            return RecorderOutput(cannot=words)
         if done.returncode != 0:
             said = done.stderr.strip()[:MAX_STDERR] or "(nothing on stderr)"
             raise RecorderDriverError(

@@ -72,6 +72,9 @@ class RecorderOutput:
     log_source: str | None = None
     #: Why the recorder's report of what it logged could not be read (names the line).
     log_problem: str | None = None
+    #: The recorder said it cannot do this job (a harness's ``cannot``, a trigger's exit
+    #: code 3): its own words ("" when it gave none); None when it said no such thing.
+    cannot: str | None = None
 
     def reported_logged(self) -> dict[str, list[str]] | None:
         """``logged`` if the recorder reported what it logged (even nothing), else None."""

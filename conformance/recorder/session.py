@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from ..declaration import Declaration
 from ..harness.device import is_harness_port
 from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
@@ -29,9 +30,11 @@ from ..ports import PortError, SimSpec, is_sim, parse_sim
 from ..replay.link import is_replay, open_recorder_replay, replayed_info
 from ..replay.recorder import RecordedRecorder, output_note
 from ..replay.recording import RecordingError
+from ..results import CaseRecord
 from ..sim.bus import Frame, SimBus, SimLink
 from ..suggest import did_you_mean
 from ..transcript import TOOL, Event, EventKind
+from .capability import Absence, Capabilities, cannot_finding, sent_tokens
 from .drivers import (
     Driver,
     InProcess,
@@ -43,7 +46,7 @@ from .drivers import (
 from .faults import RECORDER_FAULTS, faulty_recorder
 from .played import build_sensors
 from .realtime import ServedLine, is_served, parse_served
-from .request import RecorderOutput
+from .request import RecorderOutput, Request
 from .scenarios import SCENARIOS, Scenario
 
 #: Marking left after a recorder finished, so late sensor output is on record and the next
@@ -80,6 +83,14 @@ class ScenarioRun:
     output: RecorderOutput
     error: str | None = None
     played: tuple[object, ...] = ()
+    #: what the recorder was asked: the scenario's request less the commands its
+    #: declaration rules out where the standard lets it (recorder.capability)
+    request: Request | None = None
+    absences: tuple[Absence, ...] = ()
+
+    @property
+    def asked(self) -> tuple[str, ...]:
+        return (self.request or self.scenario.request).commands
 
     def expected_values(self, address: str, code: str) -> tuple[str, ...]:
         """The values the played sensor at ``address`` holds for measurement ``code``."""
@@ -112,6 +123,7 @@ class RecorderSession:
         version: str = "14",
         driver: Driver | None = None,
         timing_uncertainty: float | None = None,
+        declaration: Declaration | None = None,
     ) -> None:
         served = is_served(port)
         harness = is_harness_port(port)
@@ -170,6 +182,7 @@ class RecorderSession:
             if recording is not None:  # a replay: the recorded run's link, as it was
                 self.link.info = replayed_info(recording)
         self.version = version
+        self.capabilities = Capabilities(declaration, version)
         self.uncertainty = (
             self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
         )
@@ -190,6 +203,7 @@ class RecorderSession:
                 f"played sensors served in real time at {self.served.url}; stamps taken on the "
                 f"served line, \u00b1{self.uncertainty * 1e3:g} ms"
             )
+        self.assumptions += self.capabilities.assumptions()
 
     @property
     def is_v14(self) -> bool:
@@ -217,6 +231,28 @@ class RecorderSession:
             self.runs[name] = self._run(SCENARIOS[name])
         return self.runs[name]
 
+    def apply_declaration(self, record: CaseRecord) -> None:
+        """A case's findings read with what the recorder said it cannot do (a harness's
+        ``cannot``, a trigger's exit code 3) and with its declaration (recorder.capability)."""
+        used = [
+            title.removeprefix("scenario ").split(":", 1)[0]
+            for title, _ in record.evidence
+            if title.startswith("scenario ")
+        ]
+        for name in dict.fromkeys(used):
+            run = self.runs.get(name)
+            if run is None or run.output.cannot is None:
+                continue
+            for rid in record.requirements:
+                said = run.output.cannot
+                found = cannot_finding(rid, name, said, run.asked, record.findings, self.version)
+                if found is not None:
+                    record.findings.append(found)
+        sent: set[str] = set()
+        for run in self.runs.values():
+            sent |= sent_tokens(run.events, self.is_recorder)
+        self.capabilities.apply(record.findings, sent)
+
     def run_scenario(self, scenario: Scenario) -> ScenarioRun:
         """Run a scenario that is not one of :data:`SCENARIOS` (a tolerance sweep's step),
         every time it is asked for: nothing is kept, so no case judges it."""
@@ -231,9 +267,12 @@ class RecorderSession:
         transcript = self.link.transcript
         first = len(transcript)
         transcript.note(self.link.now(), f"scenario {scenario.name}: {scenario.describe()}")
+        request, absences = self.capabilities.trim(scenario.request)
+        for absence in absences:
+            transcript.note(self.link.now(), self._absence_note(absence))
         error = None
         try:
-            output = self.driver.act(scenario.name, scenario.request, self.link)
+            output = self.driver.act(scenario.name, request, self.link)
         except RecorderDriverError as exc:
             output, error = RecorderOutput(), str(exc)
         transcript.note(self.link.now(), output_note(scenario.name, output, error))
@@ -241,7 +280,13 @@ class RecorderSession:
         self.bus.rx.clear()
         events = transcript.since(first)
         self._check_setup(scenario, events, error)
-        return ScenarioRun(scenario, events, output, error, tuple(played))
+        return ScenarioRun(scenario, events, output, error, tuple(played), request, tuple(absences))
+
+    @staticmethod
+    def _absence_note(absence: Absence) -> str:
+        if absence.mandatory is None:
+            return f"not asked: {absence.text()} (optional)"
+        return f"asked all the same: {absence.text()} ({absence.mandatory} requires it)"
 
     def _check_setup(self, scenario: Scenario, events: list[Event], error: str | None) -> None:
         """A driver that failed while the recorder stayed silent is a setup error: stop."""
@@ -263,9 +308,12 @@ class RecorderSession:
         since = line.line.mark()
         begin = line.now()
         line.note(f"scenario {scenario.name}: {scenario.describe()}")
+        request, absences = self.capabilities.trim(scenario.request)
+        for absence in absences:
+            line.note(self._absence_note(absence))
         error = None
         try:
-            output = self._act_served(scenario, line)
+            output = self._act_served(scenario, request, line)
         except (RecorderDriverError, LinkError) as exc:
             output, error = RecorderOutput(), str(exc)
         line.note(output_note(scenario.name, output, error))
@@ -276,18 +324,18 @@ class RecorderSession:
         line.bus.set_devices([])
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
         self._check_setup(scenario, events, error)
-        return ScenarioRun(scenario, events, output, error, tuple(played))
+        return ScenarioRun(scenario, events, output, error, tuple(played), request, tuple(absences))
 
-    def _act_served(self, scenario: Scenario, line: ServedLine) -> RecorderOutput:
+    def _act_served(self, scenario: Scenario, request: Request, line: ServedLine) -> RecorderOutput:
         if self.driver.needs_real_time:  # an external recorder connects to line.url itself
-            return self.driver.act(scenario.name, scenario.request, line)  # type: ignore[arg-type]
+            return self.driver.act(scenario.name, request, line)  # type: ignore[arg-type]
         from ..links.echo import EchoMode
         from ..links.factory import open_real_link
 
         # the golden recorder on the served line: no interface in between, nothing echoes
         link = open_real_link(line.url, self.uncertainty, echo=EchoMode.OFF)
         try:
-            return self.driver.act(scenario.name, scenario.request, link)
+            return self.driver.act(scenario.name, request, link)
         finally:
             link.close()
             time.sleep(0.05)  # let the server see the disconnect before the next connection

@@ -36,6 +36,8 @@ def output_note(name: str, output: RecorderOutput, error: str | None) -> str:
         "notes": output.notes,
         "error": error,
     }
+    if output.cannot is not None:
+        found["cannot"] = output.cannot
     if output.log_source is not None or output.log_problem is not None:
         found["log_source"] = output.log_source
         found["log_problem"] = output.log_problem
@@ -106,5 +108,6 @@ class RecordedRecorder:
             relayed=dict(account.get("relayed") or {}),
             notes=list(account.get("notes") or []),
             log_source=account.get("log_source"),
+            cannot=account.get("cannot"),
             log_problem=account.get("log_problem"),
         )

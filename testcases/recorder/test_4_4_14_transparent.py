@@ -5,7 +5,6 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges.recorder.capabilities import judge_multiline_end, judge_transparent
-from conformance.recorder.scenarios import SCENARIOS
 
 from ._helpers import line_of, relayed
 
@@ -24,7 +23,7 @@ def test_transparent_mode(recorder, case):
     line = line_of(recorder, case, *names)
     if line is None:
         return
-    asked = [c for n in names for c in SCENARIOS[n].request.commands]
+    asked = [c for n in names for c in recorder.run(n).asked]
     reported = {}
     for n in names:
         reported.update(relayed(recorder, n) or {})

@@ -7,7 +7,6 @@ import pytest
 from conformance.judges.recorder.collection import judge_concurrent_storage
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.waits import judge_concurrent_waits
-from conformance.recorder.scenarios import SCENARIOS
 
 from ._helpers import line_of
 
@@ -24,7 +23,7 @@ def test_concurrent_measurements(recorder, case):
     line = line_of(recorder, case, *names)
     if line is None:
         return
-    asked = [c for n in names for c in SCENARIOS[n].request.commands]
+    asked = [c for n in names for c in recorder.run(n).asked]
     taken = observed_measurements(line, recorder.uncertainty)
     case.extend(judge_concurrent_waits(taken, recorder.uncertainty))
     case.extend(
