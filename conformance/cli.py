@@ -12,6 +12,7 @@ if __name__ == "__main__":  # `python -m conformance.cli`: Ctrl-C is ours before
     _EARLY_GUARD.install()
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -57,6 +58,16 @@ def subcommands_text() -> str:
     width = max(len(name) for name in SUBCOMMAND_HELP)
     rows = "".join(f"  {name:<{width}}  {what}\n" for name, what in SUBCOMMAND_HELP.items())
     return "subcommands (sdi12-conform SUBCOMMAND --help for each):\n" + rows
+
+
+PLAN_CHOICES = ("auto", "always", "never")
+
+
+def _plan_default() -> str:
+    """``--plan``'s default: auto, or ``SDI12_PLAN`` (the tool's own tests set never: their
+    real-time runs must not each pay, and load the machine with, a dry run)."""
+    chosen = os.environ.get("SDI12_PLAN", "auto")
+    return chosen if chosen in PLAN_CHOICES else "auto"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -105,11 +116,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--plan",
-        choices=("auto", "always", "never"),
-        default="auto",
+        choices=PLAN_CHOICES,
+        default=_plan_default(),
         help="write the test plan (sdi12-conform plan) into the run folder first and show it "
         "in the report beside what was judged; auto: on real-time links, where the run takes "
-        "minutes and the dry run a few seconds (default: auto)",
+        "minutes and the dry run a few seconds (default: auto, or $SDI12_PLAN)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
     return p

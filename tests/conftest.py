@@ -10,7 +10,14 @@ section of their own at the end of the run, even with ``-q`` and under pytest-xd
 
 from __future__ import annotations
 
+import os
+
 import pytest
+
+# Runs on real-time links plan first by default (a dry run of ~5 s of CPU); the tool's own
+# tests start dozens of those, side by side with real-time ones, so they run unplanned unless
+# a test asks (--plan always, tests/test_plan.py). Inherited by every CLI subprocess.
+os.environ.setdefault("SDI12_PLAN", "never")
 
 pytest_plugins = ["pytester"]  # tests/test_busy_summary.py runs tiny sessions
 

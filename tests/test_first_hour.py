@@ -212,10 +212,10 @@ def test_a_trigger_that_fails_before_the_recorder_spoke_shows_its_stderr(tmp_pat
     out = tmp_path / "r"
     proc = run(
         "--role", "recorder", "--port", "rfc2217-serve://127.0.0.1:0",
-        "--trigger", "echo logger offline >&2; exit 3", "--report-dir", str(out),
+        "--trigger", "echo logger offline >&2; exit 5", "--report-dir", str(out),
     )  # fmt: skip
     assert proc.returncode == EXIT_USAGE, proc.stdout + proc.stderr
-    assert "exited with 3: logger offline" in proc.stdout
+    assert "exited with 5: logger offline" in proc.stdout  # 3 means "cannot"
     data = json.loads((out / "verdicts.json").read_text())
     assert data["summary"]["counts"]["FAIL"] == 0 and data["run"]["complete"] is False
 

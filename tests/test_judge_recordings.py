@@ -56,7 +56,19 @@ def same_verdicts(first: Path, again: Path, *, uncertainty_may_differ: bool = Fa
         ("sim", "recorder"),
         pytest.param("sim", "sensor", marks=pytest.mark.slow),
         pytest.param("sim://?faults=no-service-request", "sensor", marks=pytest.mark.slow),
-        pytest.param("sim://?recorder-faults=retry-too-early", "recorder", marks=pytest.mark.slow),
+        pytest.param(
+            "sim://?recorder-faults=retry-too-early",
+            "recorder",
+            marks=[
+                pytest.mark.slow,
+                # its 12 ms retry runs into the 15 ms reply of scenario reply-at-window-edge;
+                # replayed, the played sensor starts that reply one character later than it
+                # did live (the replay does not yet reproduce a collision exactly), and
+                # R-7.0-13's worst gap differs (FAIL both times). Strict: the day the replay
+                # reproduces collisions this passes and the mark must go.
+                pytest.mark.xfail(reason="replay of a mid-command collision diverges", strict=True),
+            ],
+        ),
     ],
 )
 def test_replayed_transcript_gives_the_runs_verdicts(tmp_path, port, role):
