@@ -98,6 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
             "echo",
             "direction",
             "trigger",
+            "job-timeout",
             "sweep",
         ),
     )
@@ -145,7 +146,9 @@ def run_suite(args: argparse.Namespace, console: Console) -> int:
             markup=False,
         )
     try:
-        check_role_options(args.role, args.port, args.trigger, args.address, args.sweep)
+        check_role_options(
+            args.role, args.port, args.trigger, args.address, args.sweep, args.job_timeout
+        )
         check_values(cli_values(args), plugin=False)
         resolve(args.role, args.req)  # --req names requirements the role can test
         if args.sdi_version:

@@ -37,6 +37,12 @@ def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") 
         raise UsageError(f"{where} must be 0 or more milliseconds, not {ms:g}")
 
 
+def check_job_timeout(seconds: float | None, where: str = "--job-timeout") -> None:
+    """A job's budget is a positive time; 0 or less would cut every job before it began."""
+    if seconds is not None and not seconds > 0:  # `not >` also rejects NaN
+        raise UsageError(f"{where} must be more than 0 seconds, not {seconds:g}")
+
+
 def check_sweep(text: str | None, where: str = "--sweep") -> None:
     """``--sweep`` names the sweeps (reply, wake); an unknown one would silently run none."""
     names = [n.strip() for n in (text or "").split(",") if n.strip()]
@@ -188,6 +194,17 @@ OPTIONS: tuple[Option, ...] = (
         "environment variables (exit 0: done; exit 3: this logger cannot do this job, "
         "N/A where only an optional rule asks for it, else a FAIL), or 'interactive' to "
         "prompt an operator",
+    ),
+    Option(
+        "job-timeout",
+        "job_timeout",
+        "recorder role: bus seconds each scenario's job may take before it is cut and what "
+        "the recorder sent until then is judged (default per scenario: 30 s, plus 10 s and "
+        "the played sensor's longest ttt for each command asked; stated in the report and "
+        "in SDI12_TIMEOUT_S)",
+        type=float,
+        metavar="S",
+        check=check_job_timeout,
     ),
     Option(
         "sweep",

@@ -71,7 +71,12 @@ def pytest_configure(config: pytest.Config) -> None:
     try:
         check_values(vars(options), plugin=True)
         check_role_options(
-            options.role, options.port, options.trigger, options.address, options.sweep
+            options.role,
+            options.port,
+            options.trigger,
+            options.address,
+            options.sweep,
+            options.job_timeout,
         )
     except (UsageError, PortError) as exc:
         raise pytest.UsageError(str(exc)) from None

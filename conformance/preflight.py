@@ -27,9 +27,19 @@ __all__ = [
 
 
 def check_role_options(
-    role: str, port: str, trigger: str | None, address: str | None = None, sweep: str | None = None
+    role: str,
+    port: str,
+    trigger: str | None,
+    address: str | None = None,
+    sweep: str | None = None,
+    job_timeout: float | None = None,
 ) -> None:
     """Settings that only mean something in the other role are mistakes, not no-ops."""
+    if role == "sensor" and job_timeout is not None:
+        raise UsageError(
+            "--job-timeout bounds each job of a data recorder (--role recorder); the sensor "
+            "role times every reply by the standard's own limits"
+        )
     if role == "sensor" and sweep:
         raise UsageError(
             "--sweep plays ever slower sensors to a data recorder (--role recorder); "

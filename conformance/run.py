@@ -37,6 +37,7 @@ class RunOptions:
     strict: bool = False
     timing_uncertainty_ms: float | None = None
     trigger: str | None = None  # recorder role: shell command (or "interactive") per scenario
+    job_timeout: float | None = None  # recorder role: bus seconds per job (default per scenario)
     echo: str = "auto"  # real links: does the interface echo the tool's characters
     direction: str = "none"  # real links: the modem line that enables the tool's driver
     requirements: tuple[str, ...] = ()  # --req: requirement IDs or clauses to judge
@@ -132,6 +133,7 @@ class ConformanceRun:
                 driver=driver,
                 timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
                 declaration=self.declaration,
+                job_timeout=opts.job_timeout,
             )
             self.link = self.session.link
             self.note_options()
@@ -239,6 +241,10 @@ class ConformanceRun:
         stderr = getattr(self.link, "harness_stderr", None)
         if callable(stderr):  # exec: the harness's own log, its last STDERR_TAIL characters
             found["harness_stderr"] = stderr()
+        elif callable(kept := getattr(self.session, "harness_stderr", None)):
+            tail = kept()  # the recorder role: one harness per scenario, each tail named
+            if tail is not None:
+                found["harness_stderr"] = tail
         return found
 
     def close(self) -> None:

@@ -66,9 +66,7 @@ def verify_main(argv: list[str], console: Console, judge: Judge) -> int:
             say(ok, f"{name}: {why}")
             problems += not ok
     # a partial run (-k, --req) counts only what it selected (results.counts)
-    recount = Counter(
-        r["verdict"] for r in data.get("requirements", []) if r.get("selected", True)
-    )
+    recount = Counter(r["verdict"] for r in data.get("requirements", []) if r.get("selected", True))
     counts = (data.get("summary") or {}).get("counts") or {}
     if any(counts.get(v, 0) != recount.get(v, 0) for v in set(counts) | set(recount)):
         say(False, f"verdicts.json: summary counts {counts} do not match its requirements")

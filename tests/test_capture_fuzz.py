@@ -133,9 +133,7 @@ def test_many_damaged_captures(fmt, kind, seed, captures, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("member", ["metadata", "logic-1-1", "sdi12-conform-comment"])
-def test_a_session_member_with_an_unknown_compression_method(
-    member, captures, tmp_path, capsys
-):
+def test_a_session_member_with_an_unknown_compression_method(member, captures, tmp_path, capsys):
     """The damage seen to give exit 3: a member's compression method no zip reader knows
     (in the central directory, which is what Python's zipfile reads it from)."""
     data = bytearray(captures["sr"])

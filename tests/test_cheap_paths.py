@@ -79,7 +79,13 @@ def test_aggregates_of_measured_intervals_equal_those_of_findings(real_time: boo
             place = (f"0D{rng.randrange(2)}!", "0+1.0<CR><LF>", rng.randrange(3))
             m = Measured(window, measured, u, ["in reply to 0D0!"])
             observed_m.append((m, tainted, place))
-            observed_f.append((m.finding if trial % 2 else window.judge(measured, u, ["in reply to 0D0!"]), tainted, place))  # noqa: E501
+            observed_f.append(
+                (
+                    m.finding if trial % 2 else window.judge(measured, u, ["in reply to 0D0!"]),
+                    tainted,
+                    place,
+                )
+            )  # noqa: E501
         for smallest in (False, True):
             a = combine_local("R-7.0-12", observed_m, "character gap", smallest_is_worst=smallest,
                               real_time=real_time)  # fmt: skip

@@ -71,9 +71,7 @@ def _real_time_session(
 
 def _judged(case_fn, session: SensorSession, rid: str):
     record = CaseRecord(case_fn.__name__, case_fn.__name__, (rid, "R-7.0-01"))
-    case_fn(
-        session, Case(record, preconditions=declared_on(case_fn, record.requirements))
-    )
+    case_fn(session, Case(record, preconditions=declared_on(case_fn, record.requirements)))
     return {f.requirement: f for f in record.findings}, record
 
 
@@ -247,9 +245,7 @@ def test_a_slow_waker_fails_r_7_0_07_though_the_first_probe_went_out_past_100ms(
     session = _sim_session("slow-wake")
     monkeypatch.setattr(SimLink, "write", write)
     record = CaseRecord(wake_case.__name__, wake_case.__name__, ("R-7.0-07",))
-    wake_case(
-        session, Case(record, preconditions=declared_on(wake_case, record.requirements))
-    )
+    wake_case(session, Case(record, preconditions=declared_on(wake_case, record.requirements)))
     (found,) = record.findings
     assert count["n"] == 1
     assert found.verdict is Verdict.FAIL, found.detail

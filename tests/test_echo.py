@@ -195,9 +195,7 @@ def test_a_served_line_that_fell_behind_leaves_no_fail_standing():
     played sensors late, a FAIL may be the recorder's right reaction to a late sensor."""
     from conformance.verdicts import Finding
 
-    failed = Finding(
-        "R-4.4.8-05", Verdict.FAIL, "stopped reading", observed=1, evidence=["0D0!"]
-    )
+    failed = Finding("R-4.4.8-05", Verdict.FAIL, "stopped reading", observed=1, evidence=["0D0!"])
     warned = Finding("R-7.2-02", Verdict.WARN, "retried early", observed=1, evidence=["0M!"])
     passed = Finding("R-7.2-01", Verdict.PASS, "retried", observed=1)
     assert undecide_after_late_line([failed, warned, passed], 7.8e-3, 2e-3) == 2

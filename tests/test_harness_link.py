@@ -116,9 +116,7 @@ def test_the_python_example_sensor_is_compliant_with_exact_timing():
     unsure = {r["id"]: r for r in data["requirements"] if r["verdict"] == "INCONCLUSIVE"}
     assert list(unsure) == ["R-4.1-01"]
     assert "bit rate is not observed" in unsure["R-4.1-01"]["findings"][0]["detail"]
-    timed = [
-        f for r in data["requirements"] for f in r["findings"] if f["measured_ms"] is not None
-    ]
+    timed = [f for r in data["requirements"] for f in r["findings"] if f["measured_ms"] is not None]
     assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
 
 

@@ -45,9 +45,9 @@ def test_case_evidence_escapes_findings_and_wire_text():
     record = CaseRecord(
         "t::x", "x", ("R-4.4.2-01",), description=HOSTILE[0], expectation=HOSTILE[1]
     )
-    record.findings.append(Finding(
-            "R-4.4.2-01", Verdict.FAIL, HOSTILE[1], evidence=[HOSTILE[0]], observed=1
-        ))
+    record.findings.append(
+        Finding("R-4.4.2-01", Verdict.FAIL, HOSTILE[1], evidence=[HOSTILE[0]], observed=1)
+    )
     wire = [
         Event(EventKind.CHAR, DUT, i * 0.00833, (i + 1) * 0.00833, wire=to_wire_7e1(ord(c)))
         for i, c in enumerate(HOSTILE[1])

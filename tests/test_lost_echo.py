@@ -69,15 +69,11 @@ def test_a_probe_whose_echo_was_lost_is_sent_again_and_lands_where_it_aimed(monk
 
 def _judged(case_fn, session: SensorSession, rid: str):
     record = CaseRecord(case_fn.__name__, case_fn.__name__, (rid,))
-    case_fn(
-        session, Case(record, preconditions=declared_on(case_fn, record.requirements))
-    )
+    case_fn(session, Case(record, preconditions=declared_on(case_fn, record.requirements)))
     return record.findings
 
 
-@pytest.mark.parametrize(
-    ("case_fn", "rid"), [(wake_case, "R-7.0-04"), (marking_case, "R-7.0-05")]
-)
+@pytest.mark.parametrize(("case_fn", "rid"), [(wake_case, "R-7.0-04"), (marking_case, "R-7.0-05")])
 def test_silence_after_100ms_of_marking_is_no_fail(monkeypatch, case_fn, rid):
     """Every echo lost: the probe goes out late after PROBE_TRIES; the compliant sensor is
     asleep again by then, so its silence is INCONCLUSIVE "precondition not met", no FAIL."""

@@ -124,8 +124,10 @@ def test_more_recorder_faults_judged_passively(tmp_path, fault, capsys):
 
 # crc-missing, not wrong-crc: the same CRC replies to infer directions in, without the
 # 93,000 frames of retried reads that make wrong-crc's run the slowest to decode
-@pytest.mark.parametrize(("port", "role"), [("sim://?faults=crc-missing", "sensor"),
-                                            ("sim://?recorder-faults=short-break", "recorder")])
+@pytest.mark.parametrize(
+    ("port", "role"),
+    [("sim://?faults=crc-missing", "sensor"), ("sim://?recorder-faults=short-break", "recorder")],
+)
 @pytest.mark.slow
 def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, port, role):
     """Exported with no tool channel, every direction is inferred from the protocol."""

@@ -113,7 +113,8 @@ def test_inferred_direction_agrees_with_the_true_origins(name):
     assert len(inferred) == len(events)
     truth = [RECORDER if e.origin == TOOL else SENSOR for e in events]
     sure_wrong = [
-        (e.start, d.how) for (e, d), t in zip(inferred, truth, strict=True)
+        (e.start, d.how)
+        for (e, d), t in zip(inferred, truth, strict=True)
         if d.sure and d.side != t
     ]
     agree = sum(d.side == t for (_, d), t in zip(inferred, truth, strict=True))

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from ..links.base import Link
 from ..links.errors import PortUnavailable
-from ..recorder.drivers import RecorderDriverError
+from ..recorder.job_time import JobBudget, JobTimeout
 from ..recorder.request import RecorderOutput, Request
 from ..transcript import Event
 from . import protocol as proto
@@ -23,7 +23,7 @@ from .channel import Channel, HarnessError
 from .device import open_channel
 from .protocol import Plan, PlanKind, Role
 
-#: Bus time one job may take (the longest scenario needs a few seconds of it).
+#: Bus time one job may take when the session states no budget (:mod:`..recorder.job_time`).
 JOB_LIMIT = 600.0
 #: Bus time a harness may stay ``idle`` with nothing on the line before its job counts as over.
 IDLE_END = 10.0
@@ -31,6 +31,12 @@ IDLE_END = 10.0
 
 def _first(events: list[Event]) -> bool:
     return True
+
+
+def _stderr_of(channel: Channel) -> str | None:
+    """The tail of what the harness wrote to stderr (None for a socket harness)."""
+    tail = getattr(channel, "stderr_tail", None)
+    return tail() if callable(tail) else None
 
 
 @dataclass
@@ -42,18 +48,28 @@ class HarnessRecorder:
     kind: str = "harness"
     needs_real_time: bool = False
 
-    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
-        env = request.environment(scenario, JOB_LIMIT)
+    def act(
+        self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
+    ) -> RecorderOutput:
+        budget = budget or JobBudget(JOB_LIMIT, "the harness's default")
+        env = request.environment(scenario, budget.seconds)
         channel = open_channel(self.port, env, self.reply_timeout)
+        cut: JobTimeout | None = None
         try:
             name = channel.greet(Role.RECORDER)
             first = proto.job(link.now(), str(request.task), request.commands)
             plan = channel.plan(first, Role.RECORDER, link.now())
-            ended, cannot = self._drive(channel, plan, link)
+            ended, cannot = self._drive(channel, plan, link, budget)
             channel.finish(proto.BYE)
+        except JobTimeout as exc:
+            cut = exc
         finally:
             channel.close(proto.BYE)
-        out = RecorderOutput(cannot=cannot)
+        stderr = _stderr_of(channel)  # read once it has exited: nothing more can come
+        if cut is not None:  # judged on what it sent: its own log goes with it
+            cut.stderr = stderr
+            raise cut
+        out = RecorderOutput(cannot=cannot, stderr=stderr)
         out.notes.append(f"harness {name or self.port}: {ended}")
         for log in channel.logs:  # several lines for one command append, in order
             out.logged.setdefault(log.command, []).extend(log.values)
@@ -73,19 +89,27 @@ class HarnessRecorder:
         except HarnessError as exc:
             raise PortUnavailable(str(exc)) from exc
 
-    def _drive(self, channel: Channel, plan: Plan, link: Link) -> tuple[str, str | None]:
+    def _drive(
+        self, channel: Channel, plan: Plan, link: Link, budget: JobBudget
+    ) -> tuple[str, str | None]:
         """Carry out plans until ``done`` or ``cannot``; what ended the job, in words, and
-        the ``cannot`` reason (None: the harness did not say it cannot)."""
-        limit = link.now() + JOB_LIMIT
+        the ``cannot`` reason (None: the harness did not say it cannot). A harness still
+        busy when the budget runs out is cut there (:class:`JobTimeout`)."""
+        limit = link.now() + budget.seconds
         while plan.kind not in (PlanKind.DONE, PlanKind.CANNOT):
-            if link.now() > limit:
-                raise RecorderDriverError(
-                    f"recorder harness did not finish its job within {JOB_LIMIT:g} s of bus time"
-                )
             if plan.kind is PlanKind.IDLE:
                 deadline = link.now() + IDLE_END
             else:
                 deadline = proto.seconds(plan.start)
+            if deadline > limit and plan.kind is not PlanKind.IDLE:
+                # what it plans lies past the cut: listen until then
+                heard = link.receive(limit, until=_first)
+                if not heard:
+                    raise JobTimeout(budget.seconds, budget.reason)
+                got = heard[0]
+                message = proto.heard(got.wire, got.start, got.end)
+                plan = channel.plan(message, Role.RECORDER, got.end, got.start)
+                continue
             heard = link.receive(deadline, until=_first)
             if heard:
                 got = heard[0]

@@ -339,6 +339,7 @@ def replay_argv(recording: Recording, args: argparse.Namespace) -> list[str]:
         ("--timing-uncertainty-ms", "timing_uncertainty_ms"),
         ("-k", "keyword"),
         ("--sweep", "sweep"),  # a swept run's steps are in its recording: replayed too
+        ("--job-timeout", "job_timeout"),  # the budgets its scenario notes state
     ):
         if saved.get(key) is not None:
             argv += [flag, str(saved[key])]

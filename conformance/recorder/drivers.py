@@ -29,31 +29,34 @@ from pathlib import Path
 from typing import Protocol, TextIO
 
 from ..links.base import Link
+from .errors import RecorderDriverError, RecorderSetupError
+from .job_time import JobBudget, JobLink, JobTimeout
 from .logfile import LOG_FILE_VARIABLE, LogFileError, read_log_file
 from .request import RecorderOutput, Request
 
+__all__ = ["RecorderDriverError", "RecorderSetupError", "JobTimeout"]  # re-exported
+
 #: The exit code by which a trigger says "this logger cannot do this job" (README).
 CANNOT_EXIT = 3
+#: The word an operator types (then why) to say the same at the interactive prompt.
+CANNOT_WORD = "cannot"
 #: Longest trigger output kept as evidence (the DUT's words are untrusted and unbounded).
 MAX_OUTPUT = 4000
 MAX_STDERR = 600  # a failing trigger's own words, shown to the user as they are
-
-
-class RecorderDriverError(RuntimeError):
-    """The recorder could not be made to act (trigger failed, timed out, no operator)."""
-
-
-class RecorderSetupError(RecorderDriverError):
-    """The driver failed and the recorder never spoke: the test setup is broken (a trigger
-    that cannot start, or exits non-zero before making the recorder act), not the recorder.
-    Judging the silent line would blame the recorder for the tool's setup (false FAILs)."""
+#: Wall time a trigger gets beyond its job's budget to start the logger and reach the line.
+START = 30.0
 
 
 class Driver(Protocol):
     kind: str
     needs_real_time: bool
 
-    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput: ...
+    def act(
+        self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
+    ) -> RecorderOutput:
+        """Make the recorder do ``request`` on ``link``; ``budget``: the bus time the job may
+        take (:mod:`.job_time`), past which the driver raises :class:`JobTimeout`."""
+        ...
 
 
 @dataclass
@@ -64,8 +67,12 @@ class InProcess:
     kind: str = "in-process"
     needs_real_time: bool = False
 
-    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
-        return self.program(request, link)
+    def act(
+        self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
+    ) -> RecorderOutput:
+        if budget is None:
+            return self.program(request, link)
+        return self.program(request, JobLink(link, budget))  # type: ignore[arg-type]
 
 
 @dataclass
@@ -79,10 +86,12 @@ class Trigger:
     #: Set by the session: where the recorder connects (``SDI12_PORT``, an rfc2217:// URL).
     environment: dict[str, str] = field(default_factory=dict)
 
-    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+    def act(
+        self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
+    ) -> RecorderOutput:
         with tempfile.TemporaryDirectory(prefix="sdi12-log-") as folder:
             log_file = Path(folder) / f"{scenario}.log"
-            out = self._run(scenario, request, log_file)
+            out = self._run(scenario, request, log_file, budget)
             if out.cannot is not None:
                 return out
             try:
@@ -93,11 +102,16 @@ class Trigger:
                 out.log_problem = f"{LOG_FILE_VARIABLE} {exc}"
         return out
 
-    def _run(self, scenario: str, request: Request, log_file: Path) -> RecorderOutput:
+    def _run(
+        self, scenario: str, request: Request, log_file: Path, budget: JobBudget | None
+    ) -> RecorderOutput:
+        # the job's budget when it is longer than --trigger's own timeout, plus the time a
+        # trigger may need to start the logger and reach the line
+        timeout = self.timeout if budget is None else max(self.timeout, budget.seconds + START)
         env = {
             **os.environ,
             **self.environment,
-            **request.environment(scenario, self.timeout),
+            **request.environment(scenario, timeout if budget is None else budget.seconds),
             LOG_FILE_VARIABLE: str(log_file),
         }
         try:
@@ -107,10 +121,12 @@ class Trigger:
                 env=env,
                 capture_output=True,
                 text=True,
-                timeout=self.timeout,
+                timeout=timeout,
                 check=False,
             )
         except subprocess.TimeoutExpired as exc:
+            if budget is not None:
+                raise JobTimeout(timeout, f"{budget.reason}, and {START:g} s to start") from exc
             raise RecorderDriverError(
                 f"trigger did not finish within {self.timeout:g} s: {self.command}"
             ) from exc
@@ -147,18 +163,24 @@ class Interactive:
             f"\n[recorder scenario {scenario}] Make the data recorder {request.sentence()}"
             + (f" (sensors served at {where})" if where else "")
             + ".\n"
-            f"Press Enter when it has finished (you may type a note first); "
+            f"Press Enter when it has finished (you may type a note first), or type "
+            f"'{CANNOT_WORD} WHY' if this logger cannot do it; "
             f"{self.timeout:g} s until this scenario is abandoned: "
         )
 
-    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+    def act(
+        self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
+    ) -> RecorderOutput:
         self.prompt_out.write(self.prompt(scenario, request))
         self.prompt_out.flush()
         ready, _, _ = select.select([self.answer_in], [], [], self.timeout)
         if not ready:
             raise RecorderDriverError(f"no answer from the operator within {self.timeout:g} s")
-        note = self.answer_in.readline()
+        note = self.answer_in.readline().strip()
+        word, _, why = note.partition(" ")
+        if word.lower() == CANNOT_WORD:  # as a harness's `cannot` or a trigger's exit 3
+            return RecorderOutput(cannot=why.strip()[:MAX_STDERR])
         out = RecorderOutput()
-        if note.strip():
-            out.notes.append(note.strip()[:MAX_OUTPUT])
+        if note:
+            out.notes.append(note[:MAX_OUTPUT])
         return out

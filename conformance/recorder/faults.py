@@ -14,8 +14,9 @@ from dataclasses import dataclass, field, replace
 
 from ..links.base import Link
 from ..protocol.commands import Command, Kind, parse_command
-from ..sim.bus import SimLink
+from ..sim.bus import SimBus
 from ..tool_recorder import Master, Measurement, Policy
+from ..tool_recorder.engine import _service_request_end
 from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
@@ -98,6 +99,20 @@ class StopsAfterD0Master(GoldenMaster):
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
     ) -> Measurement:
         return super().collect(m, force_break=force_break, max_index=0)
+
+
+class WaitsForeverMaster(GoldenMaster):
+    """Waits for the service request of aM!/aV! with no end: ttt is never counted (a logger
+    loop written as "until the sensor calls"). A sensor that never sends one hangs it; the
+    job is cut at its budget (recorder.job_time) and judged on what it sent."""
+
+    def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+        if not service_request:
+            super()._wait_for_data(m, service_request=service_request)
+            return
+        while m.service_request_end is None:  # ends only through the job's cut
+            m.waited_events.extend(self.link.receive(self.link.now() + 1.0, until=ends_line))
+            m.service_request_end = _service_request_end(m.waited_events, m.command.address)
 
 
 class _ZeroPaddedData(Command):
@@ -299,7 +314,8 @@ class WrongBaudLink:
     of 8.33 ms (a recorder at the wrong bit rate); everything else is the link's own."""
 
     def __init__(self, link: Link, char_time: float) -> None:
-        if not isinstance(link, SimLink):
+        # the job's link (recorder.job_time) stands in front of the sim bus's own
+        if not isinstance(getattr(link, "bus", None), SimBus):
             raise TypeError("a wrong bit rate can only be played on the simulated bus")
         self._link = link
         self._char_time = char_time
@@ -521,6 +537,17 @@ _FAULTS = (
         "wait the whole ttt), so past the tool's 0.5 s this is a WARN (decision T1).",
         ("R-4.4.5-05",),
         lambda: GoldenRecorder(_GOLDEN, wait="ttt"),
+    ),
+    RecorderFault(
+        "waits-forever-for-service-request",
+        "Waits for the service request after aM!/aV! with no end, never counting ttt down: "
+        "a sensor that sends none hangs it until its job is cut at the stated budget. No aD0! "
+        "after ttt (R-4.4.5-05), no values collected (R-4.4.8-05); the rules over every "
+        "transmission still PASS on what it sent, while the rules about that job itself "
+        "cannot PASS on a job that never ended.",
+        ("R-4.4.5-05", "R-4.4.8-05"),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(WaitsForeverMaster)),
+        inconclusive=("R-4.4.5-04", "R-4.4.5-06", "R-4.4.5-07"),
     ),
     RecorderFault(
         "stops-after-d0",

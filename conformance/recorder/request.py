@@ -75,6 +75,8 @@ class RecorderOutput:
     #: The recorder said it cannot do this job (a harness's ``cannot``, a trigger's exit
     #: code 3): its own words ("" when it gave none); None when it said no such thing.
     cannot: str | None = None
+    #: An ``exec:`` harness's own log: the tail of what it wrote to stderr in this job.
+    stderr: str | None = None
 
     def reported_logged(self) -> dict[str, list[str]] | None:
         """``logged`` if the recorder reported what it logged (even nothing), else None."""

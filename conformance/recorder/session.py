@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..declaration import Declaration
+from ..harness.channel import STDERR_TAIL
 from ..harness.device import is_harness_port
 from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
@@ -44,6 +45,7 @@ from .drivers import (
     Trigger,
 )
 from .faults import RECORDER_FAULTS, faulty_recorder
+from .job_time import JobBudget, JobTimeout, job_budget
 from .played import build_sensors
 from .realtime import ServedLine, is_served, parse_served
 from .request import RecorderOutput, Request
@@ -87,6 +89,10 @@ class ScenarioRun:
     #: declaration rules out where the standard lets it (recorder.capability)
     request: Request | None = None
     absences: tuple[Absence, ...] = ()
+    #: the job ran out of its budget of bus time (``error`` says so too): what the recorder
+    #: sent until then is all it sent, so rules over every transmission judge it in full
+    timed_out: JobTimeout | None = None
+    budget: JobBudget | None = None
 
     @property
     def asked(self) -> tuple[str, ...]:
@@ -124,7 +130,9 @@ class RecorderSession:
         driver: Driver | None = None,
         timing_uncertainty: float | None = None,
         declaration: Declaration | None = None,
+        job_timeout: float | None = None,
     ) -> None:
+        self.job_timeout = job_timeout  # --job-timeout: one budget for every job
         served = is_served(port)
         harness = is_harness_port(port)
         replay = is_replay(port)
@@ -270,17 +278,21 @@ class RecorderSession:
         request, absences = self.capabilities.trim(scenario.request)
         for absence in absences:
             transcript.note(self.link.now(), self._absence_note(absence))
-        error = None
+        budget = job_budget(request, played, self.job_timeout)
+        transcript.note(self.link.now(), budget.note())
+        error, cut = None, None
         try:
-            output = self.driver.act(scenario.name, request, self.link)
+            output = self.driver.act(scenario.name, request, self.link, budget)
         except RecorderDriverError as exc:
-            output, error = RecorderOutput(), str(exc)
-        transcript.note(self.link.now(), output_note(scenario.name, output, error))
+            output, error, cut = _failed(exc)
+        transcript.note(self.link.now(), output_note(scenario.name, output, error, cut))
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
         events = transcript.since(first)
-        self._check_setup(scenario, events, error)
-        return ScenarioRun(scenario, events, output, error, tuple(played), request, tuple(absences))
+        self._check_setup(scenario, events, error, cut)
+        return ScenarioRun(
+            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
+        )
 
     @staticmethod
     def _absence_note(absence: Absence) -> str:
@@ -288,10 +300,18 @@ class RecorderSession:
             return f"not asked: {absence.text()} (optional)"
         return f"asked all the same: {absence.text()} ({absence.mandatory} requires it)"
 
-    def _check_setup(self, scenario: Scenario, events: list[Event], error: str | None) -> None:
-        """A driver that failed while the recorder stayed silent is a setup error: stop."""
+    def _check_setup(
+        self,
+        scenario: Scenario,
+        events: list[Event],
+        error: str | None,
+        cut: JobTimeout | None = None,
+    ) -> None:
+        """A driver that failed while the recorder stayed silent is a setup error: stop.
+        A job cut at its budget in virtual time is not: the recorder was reached (it runs on
+        the tool's own line) and its silence until the cut is what it did."""
         spoke = any(self.is_recorder(e) for e in events if e.kind is not EventKind.NOTE)
-        if error is None or spoke:
+        if error is None or spoke or (cut is not None and not self.driver.needs_real_time):
             return
         raise RecorderSetupError(
             f"the {self.driver.kind} could not make the recorder act (scenario "
@@ -311,39 +331,64 @@ class RecorderSession:
         request, absences = self.capabilities.trim(scenario.request)
         for absence in absences:
             line.note(self._absence_note(absence))
-        error = None
+        budget = job_budget(request, played, self.job_timeout)
+        line.note(budget.note())
+        error, cut = None, None
         try:
-            output = self._act_served(scenario, request, line)
-        except (RecorderDriverError, LinkError) as exc:
+            output = self._act_served(scenario, request, line, budget)
+        except LinkError as exc:
             output, error = RecorderOutput(), str(exc)
-        line.note(output_note(scenario.name, output, error))
+        except RecorderDriverError as exc:
+            output, error, cut = _failed(exc)
+        line.note(output_note(scenario.name, output, error, cut))
         line.settle(SETTLE)
         kept = line.line
         line.note(f"scenario {scenario.name} done; {kept.timekeeping(since, 'the scenario')}")
         end = line.now()
         line.bus.set_devices([])
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
-        self._check_setup(scenario, events, error)
-        return ScenarioRun(scenario, events, output, error, tuple(played), request, tuple(absences))
+        self._check_setup(scenario, events, error, cut)
+        return ScenarioRun(
+            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
+        )
 
-    def _act_served(self, scenario: Scenario, request: Request, line: ServedLine) -> RecorderOutput:
+    def _act_served(
+        self, scenario: Scenario, request: Request, line: ServedLine, budget: JobBudget
+    ) -> RecorderOutput:
         if self.driver.needs_real_time:  # an external recorder connects to line.url itself
-            return self.driver.act(scenario.name, request, line)  # type: ignore[arg-type]
+            return self.driver.act(scenario.name, request, line, budget)  # type: ignore[arg-type]
         from ..links.echo import EchoMode
         from ..links.factory import open_real_link
 
         # the golden recorder on the served line: no interface in between, nothing echoes
         link = open_real_link(line.url, self.uncertainty, echo=EchoMode.OFF)
         try:
-            return self.driver.act(scenario.name, request, link)
+            return self.driver.act(scenario.name, request, link, budget)
         finally:
             link.close()
             time.sleep(0.05)  # let the server see the disconnect before the next connection
+
+    def harness_stderr(self) -> str | None:
+        """What the recorder harness wrote to stderr, each scenario's tail under its name,
+        the last ``STDERR_TAIL`` characters of them all (None: no harness, nothing kept).
+        Kept in every report, as the sensor role keeps its harness's."""
+        parts = [f"[{n}]\n{r.output.stderr}" for n, r in self.runs.items() if r.output.stderr]
+        if not parts and not isinstance(self.driver, HarnessRecorder):
+            return None
+        return "\n".join(parts)[-STDERR_TAIL:]
 
     def close(self) -> None:
         """Stop serving (real-time ports); nothing to release on the simulated bus."""
         if self.served is not None:
             self.served.close()
+
+
+def _failed(exc: RecorderDriverError) -> tuple[RecorderOutput, str, JobTimeout | None]:
+    """What a driver's failure leaves: an empty account (a cut harness's stderr kept), the
+    error's words, and the cut when the job ran out of its budget."""
+    if isinstance(exc, JobTimeout):
+        return RecorderOutput(stderr=exc.stderr), str(exc), exc
+    return RecorderOutput(), str(exc), None
 
 
 def driver_for(trigger: str | None) -> Driver | None:

@@ -15,7 +15,8 @@ import json
 from typing import Any
 
 from ..links.base import Link
-from ..recorder.drivers import RecorderDriverError
+from ..recorder.errors import RecorderDriverError
+from ..recorder.job_time import JobBudget, JobTimeout
 from ..recorder.request import RecorderOutput, Request
 from ..sim.bus import SimLink
 from ..transcript import TOOL, Event, EventKind
@@ -27,8 +28,11 @@ SCENARIO_NOTE = "scenario "
 OUTPUT_NOTE = "recorder-output "
 
 
-def output_note(name: str, output: RecorderOutput, error: str | None) -> str:
-    """The note text a recorder session writes after scenario ``name``."""
+def output_note(
+    name: str, output: RecorderOutput, error: str | None, cut: JobTimeout | None = None
+) -> str:
+    """The note text a recorder session writes after scenario ``name`` (``cut``: the job
+    ran out of its budget, :mod:`conformance.recorder.job_time`)."""
     found: dict[str, Any] = {
         "scenario": name,
         "logged": output.logged,
@@ -36,6 +40,10 @@ def output_note(name: str, output: RecorderOutput, error: str | None) -> str:
         "notes": output.notes,
         "error": error,
     }
+    if cut is not None:
+        found["timed_out"] = {"seconds": cut.budget, "reason": cut.reason}
+    if output.stderr:
+        found["stderr"] = output.stderr
     if output.cannot is not None:
         found["cannot"] = output.cannot
     if output.log_source is not None or output.log_problem is not None:
@@ -81,7 +89,9 @@ class RecordedRecorder:
             if i >= 0:
                 self.slices[begins[i][1]][1].append(e)
 
-    def act(self, scenario: str, request: Request, link: Link) -> RecorderOutput:
+    def act(
+        self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
+    ) -> RecorderOutput:
         if scenario not in self.slices:
             raise ReplayDiverged(
                 f"the recording has no scenario {scenario!r} (it has: "
@@ -101,6 +111,9 @@ class RecordedRecorder:
             link.wait_until(self.done[scenario] + offset)
         if account is None:
             return RecorderOutput()
+        if account.get("timed_out"):
+            cut = account["timed_out"]
+            raise JobTimeout(float(cut["seconds"]), str(cut["reason"]))
         if account.get("error"):
             raise RecorderDriverError(str(account["error"]))
         return RecorderOutput(
@@ -110,4 +123,5 @@ class RecordedRecorder:
             log_source=account.get("log_source"),
             cannot=account.get("cannot"),
             log_problem=account.get("log_problem"),
+            stderr=account.get("stderr"),
         )

@@ -53,9 +53,7 @@ def test_reply_framing(heard_sensors, case):
 def test_identification(heard_sensors, case):
     """A recorded aI! reply has the identification fields and a valid version."""
     case.expect("'allccccccccmmmmmmvvvxxx...<CR><LF>' to each recorded aI!")
-    asked = [
-        ex for ex in heard_sensors.exchanges_of(Kind.IDENTIFY) if ex.answered
-    ]
+    asked = [ex for ex in heard_sensors.exchanges_of(Kind.IDENTIFY) if ex.answered]
     if not heard(case, asked, "no answered aI!"):
         return
     case.evidence("recorded aI! exchanges", asked)

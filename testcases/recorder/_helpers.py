@@ -10,11 +10,16 @@ from conformance.recorder.session import RecorderSession
 from conformance.view.segments import TranscriptView
 
 
-def line_of(recorder: RecorderSession, case: Case, *names: str) -> TranscriptView | None:
+def line_of(
+    recorder: RecorderSession, case: Case, *names: str, whole_run: bool = False
+) -> TranscriptView | None:
     """Run the scenarios (the applicable ones), attach their wire logs, and read them.
 
     None (with N/A findings) when none applies to the recorder's claimed version. A scenario
     the recorder could not be made to act on is a hole in the certificate: INCONCLUSIVE.
+    ``whole_run``: the rule is about every transmission the recorder made. A job cut at its
+    budget (recorder.job_time) holds all it sent, so such a rule judges it in full; a rule
+    about the job itself still cannot PASS on a job that never ended.
     """
     chosen = [n for n in names if recorder.applies(n)]
     if not chosen:
@@ -28,7 +33,12 @@ def line_of(recorder: RecorderSession, case: Case, *names: str) -> TranscriptVie
     errors = []
     for name in chosen:
         run = recorder.run(name)
-        case.evidence(f"scenario {name}: {SCENARIOS[name].describe()}", run.events)
+        label = f"scenario {name}: {SCENARIOS[name].describe()}"
+        if run.timed_out is not None:
+            label += f" [cut: {run.error}]"
+        case.evidence(label, run.events)
+        if run.timed_out is not None and whole_run:
+            continue  # every transmission it made is in the slice
         if run.error:
             errors.append(f"scenario {name}: {run.error}")
     case.requires("recorder", precondition.acted(errors))

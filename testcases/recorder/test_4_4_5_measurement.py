@@ -44,7 +44,5 @@ def test_d0_after_service_request(recorder, case):
     case.expect("aD0! within 87 ms (+0.40) of the service request, or a break first")
     line = line_of(recorder, case, "service-request", "two-sensors", "families")
     case.extend(
-        f
-        for f in judge_break_rules(line, recorder.uncertainty)
-        if f.requirement == "R-7.1-01"
+        f for f in judge_break_rules(line, recorder.uncertainty) if f.requirement == "R-7.1-01"
     )

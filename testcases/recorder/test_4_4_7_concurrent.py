@@ -26,9 +26,7 @@ def test_concurrent_measurements(recorder, case):
     asked = [c for n in names for c in recorder.run(n).asked]
     taken = observed_measurements(line, recorder.uncertainty)
     case.extend(judge_concurrent_waits(taken, recorder.uncertainty))
-    case.extend(
-        f for f in judge_concurrent_storage(taken, asked) if f.requirement == "R-4.4.7-08"
-    )
+    case.extend(f for f in judge_concurrent_storage(taken, asked) if f.requirement == "R-4.4.7-08")
 
 
 @requirements("R-4.4.7-07")

@@ -13,9 +13,7 @@ from ._helpers import line_of, log_reports
 requirements = pytest.mark.requirements
 #: Every scenario in which the recorder takes measurements and logs their values.
 LOG_SCENARIOS = tuple(
-    name
-    for name, s in SCENARIOS.items()
-    if s.request.task in (Task.MEASURE, Task.CONCURRENT)
+    name for name, s in SCENARIOS.items() if s.request.task in (Task.MEASURE, Task.CONCURRENT)
 )
 
 

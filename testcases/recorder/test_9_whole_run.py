@@ -23,7 +23,7 @@ requirements = pytest.mark.requirements
 
 
 def _everything(recorder, case):
-    return line_of(recorder, case, *recorder.applicable())
+    return line_of(recorder, case, *recorder.applicable(), whole_run=True)
 
 
 @requirements("R-7.0-02", "R-7.0-06")

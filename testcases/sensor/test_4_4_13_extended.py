@@ -34,7 +34,7 @@ def test_extended_commands(sensor, case):
     case.extend(judge.extended_replies(exchanges, sensor.address))
 
 
-@pytest.mark.needs('unsolicited')
+@pytest.mark.needs("unsolicited")
 @requirements("R-4.4.13.1-01", "R-4.4.13.1-02", "R-4.4.13.1-03")
 @pytest.mark.preconditions("supported")
 def test_multiline_text(sensor, case):
@@ -46,8 +46,7 @@ def test_multiline_text(sensor, case):
     multi = [ex for ex in exchanges if judge.is_multiline(ex)]
     absent = precondition.served(
         bool(multi),
-        "no declared extended command answered with multi-line text "
-        "(multi-line text is optional)"
+        "no declared extended command answered with multi-line text (multi-line text is optional)"
         if names
         else "no extended command declared (opt-in)",
     )

@@ -142,9 +142,7 @@ def test_own_command_aborts_concurrent(sensor, case):
     case.evidence(f"{code} interrupted by {sensor.address}I!", [m, poke])
     if poke.attempts and poke.attempts[0].command_events:  # an abort needs a running one
         first = poke.attempts[0].command_events[0]
-        case.requires(
-            "pending", precondition.pending(m.start, m.ttt or 0, [], first, poke.text)
-        )
+        case.requires("pending", precondition.pending(m.start, m.ttt or 0, [], first, poke.text))
     d0 = m.data[0] if m.data else None
     if not poke.answered:
         case.add(

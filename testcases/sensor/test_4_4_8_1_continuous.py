@@ -53,9 +53,7 @@ def test_continuous_independent(sensor, case):
     """Each Rn stands alone: asking for Rn first, straight after waking, still gives data."""
     case.expect("the same kind of reply to aRn! whether or not R0..R(n-1) came first")
     served = [
-        i
-        for i, (ex, _) in continuous_pairs(sensor).items()
-        if i > 0 and serves_continuous(ex)
+        i for i, (ex, _) in continuous_pairs(sensor).items() if i > 0 and serves_continuous(ex)
     ]
     if not case.requires(
         "supported",

@@ -98,8 +98,7 @@ def test_undefined_group_leaves_no_old_values(sensor, case):
         case.add(
             inconclusive(
                 "R-4.4.8-03",
-                f"needs values first, then 'a0000' and an answered D0: {shown(start)}; "
-                f"{shown(d0)}",
+                f"needs values first, then 'a0000' and an answered D0: {shown(start)}; {shown(d0)}",
             )
         )
     elif parse_data_reply_for(body, start.command, expected_address=sensor.address).values:

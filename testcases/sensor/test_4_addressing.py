@@ -159,8 +159,7 @@ def test_address_range(sensor, case):
     if not any(ex.answered for ex in sweep.exchanges):
         deaf = precondition.Unmet(
             "listening",
-            "it answered none of the address changes to 0-9 either, so refusing '$' "
-            "shows nothing",
+            "it answered none of the address changes to 0-9 either, so refusing '$' shows nothing",
         )
     elif not bad.accepted and not bad.listening:
         control = bad.exchanges[-1:] if len(bad.exchanges) > 1 else []

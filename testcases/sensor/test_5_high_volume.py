@@ -92,7 +92,7 @@ def test_high_volume_ascii(sensor, case):
     case.extend(judge.judge([m], case.requirements, sensor.version))
 
 
-@pytest.mark.needs('binary')
+@pytest.mark.needs("binary")
 @requirements(
     "R-5.2-01", "R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2-07", "R-5.2.1-01", "R-4.1-03"
 )
@@ -109,7 +109,7 @@ def test_high_volume_binary(sensor, case):
     case.extend(judge.judge([m], case.requirements, sensor.version))
 
 
-@pytest.mark.needs('binary')
+@pytest.mark.needs("binary")
 @requirements("R-5.2-06")
 @pytest.mark.preconditions("supported")
 def test_empty_packet_past_data(sensor, case):
@@ -155,7 +155,7 @@ def _in_part(marking: float | None, what: str) -> precondition.Unmet | None:
     return None if unmet is None else replace(unmet, partial=True)
 
 
-@pytest.mark.needs('break', 'unsolicited')
+@pytest.mark.needs("break", "unsolicited")
 @requirements("R-5.3-01")
 @pytest.mark.preconditions("supported", "buffered", "listening")
 def test_high_volume_is_concurrent(sensor, case):

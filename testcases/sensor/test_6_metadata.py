@@ -50,7 +50,7 @@ def test_identify_matches_measurement(sensor, case):
     case.extend(judge.identify_matches(pairs))
 
 
-@pytest.mark.needs('unsolicited')
+@pytest.mark.needs("unsolicited")
 @requirements("R-6.1-03")
 @pytest.mark.preconditions("buffered", "supported")
 def test_identify_starts_nothing(sensor, case):

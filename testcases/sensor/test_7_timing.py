@@ -180,8 +180,7 @@ def test_break_just_over_12ms_wakes(sensor, case):
             inconclusive(
                 "R-7.0-04",
                 f"achieved break {brk.duration * 1e3:.2f} ms ± "
-                f"{brk.length_uncertainty * 1e3:.2f} is not surely above 12.4 ms"
-                + aimed.missed,
+                f"{brk.length_uncertainty * 1e3:.2f} is not surely above 12.4 ms" + aimed.missed,
             )
         )
     elif not case.requires("awake", unheard):
@@ -459,9 +458,13 @@ def _standby_after_a_break(sensor, case, edge: float):
     control = after_break(77e-3)(0)
     aimed = sensor.aim(f"a! {edge * 1e3:.1f} ms after a break", after_break(edge), miss)
     ex = aimed.last
-    case.evidence("break, 77 ms marking, a! (control); break, marking past 100 ms, a!", [
-        control, ex,
-    ])
+    case.evidence(
+        "break, 77 ms marking, a! (control); break, marking past 100 ms, a!",
+        [
+            control,
+            ex,
+        ],
+    )
     if aimed.landed is None:
         return None
     if ex.answered or control.answered:
@@ -541,9 +544,7 @@ def test_data_after_service_request_without_break(sensor, case):
     )
     if not case.requires(
         "supported",
-        precondition.served(
-            m is not None, "no measurement produced a service request to follow"
-        ),
+        precondition.served(m is not None, "no measurement produced a service request to follow"),
     ):
         return
     d0 = m.data[0]
@@ -587,9 +588,7 @@ def test_partial_command_dropped(sensor, case):
     brk = _break_of(sensor, ex)
     if brk is not None and not case.requires(
         "awake",
-        precondition.silence_awake(
-            ex.answered, _marking_before(ex, brk.end), sensor.uncertainty
-        ),
+        precondition.silence_awake(ex.answered, _marking_before(ex, brk.end), sensor.uncertainty),
     ):
         return
     if not ex.answered:

@@ -11,7 +11,7 @@ from conformance.verdicts import failed, inconclusive, passed
 requirements = pytest.mark.requirements
 
 
-@pytest.mark.needs('break')
+@pytest.mark.needs("break")
 @requirements(*IDS)
 @pytest.mark.preconditions(
     listening=("R-4.0-01",),

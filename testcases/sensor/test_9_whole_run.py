@@ -77,6 +77,4 @@ def test_reply_framing(sensor, case):
     case.extend(wire.judge_framing(segs, sensor.stamp_uncertainty))
     # replies are judged against the address the sensor answered at (cached: no new traffic)
     ack = sensor.exchange("")
-    case.requires(
-        "address", precondition.answers_at(ack, sensor.address, "a! at it got no reply")
-    )
+    case.requires("address", precondition.answers_at(ack, sensor.address, "a! at it got no reply"))
