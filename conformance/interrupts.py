@@ -9,6 +9,11 @@ is first of all *recorded*, and raised only where pytest handles it (inside a ca
 call or teardown). A recorded interrupt is raised at the next case boundary if it was lost,
 and at session end it makes the run incomplete. Once the run is *closed* (the moment its
 completeness is decided) later interrupts change nothing.
+
+The interrupt raised inside a case can still land in a finalizer or a gc callback that runs
+in the middle of the case (hypothesis registers one); Python then prints it as "Exception
+ignored" and drops it. The guard's unraisable hook drops only that interrupt, silently: it is
+recorded, and the next case boundary or the session end acts on it.
 """
 
 from __future__ import annotations
@@ -31,18 +36,33 @@ class InterruptGuard:
         self.closed = False  # the run's completeness is decided: interrupts are too late
         self._armed = 0  # >0 inside a case: raise at once, pytest turns it into INTERRUPTED
         self._previous: Any = None
+        self._previous_unraisable: Any = None
 
     def install(self) -> None:
         """Take over SIGINT (main thread only; elsewhere Python cannot deliver signals)."""
         if self.installed or threading.current_thread() is not threading.main_thread():
             return
         self._previous = signal.signal(signal.SIGINT, self._on_sigint)
+        self._previous_unraisable = sys.unraisablehook
+        sys.unraisablehook = self._on_unraisable
         self.installed = True
 
     def uninstall(self) -> None:
         if self.installed:
             signal.signal(signal.SIGINT, self._previous or signal.default_int_handler)
+            self._restore_unraisable()
             self.installed = False
+
+    def _restore_unraisable(self) -> None:
+        if sys.unraisablehook == self._on_unraisable:
+            sys.unraisablehook = self._previous_unraisable or sys.__unraisablehook__
+
+    def _on_unraisable(self, unraisable: Any) -> None:
+        """Drop the interrupt this guard raised where Python could not deliver it (it is
+        recorded in ``requested``); hand everything else to the hook that was there."""
+        if self.requested and isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return
+        (self._previous_unraisable or sys.__unraisablehook__)(unraisable)
 
     def reset(self) -> None:
         """Forget an earlier run (a process that runs the suite twice, e.g. in tests)."""
@@ -80,6 +100,7 @@ class InterruptGuard:
         with SIGINT, exit 130, after a finished run; an ignored signal stays ignored.)"""
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, signal.SIG_IGN)
+        self._restore_unraisable()
         self.installed = False
 
     def close(self) -> bool:
