@@ -29,16 +29,13 @@ def guard(monkeypatch):
         g.uninstall()
 
 
-def test_interrupt_inside_a_finalizer_is_not_printed_and_stops_at_the_next_boundary(
-    guard, capsys
-):
+def test_interrupt_inside_a_finalizer_is_not_printed_and_stops_at_the_next_boundary(guard, capsys):
     with guard.armed():
         _SignalsInFinalizer()  # dropped at once: __del__ runs, the handler raises inside it
     assert guard.requested
     assert "Traceback" not in capsys.readouterr().err
-    with pytest.raises(KeyboardInterrupt):
-        with guard.armed():
-            pass
+    with pytest.raises(KeyboardInterrupt), guard.armed():
+        pass
     assert guard.close() is True
 
 
