@@ -140,3 +140,62 @@ def test_the_python_sensor_with_its_extended_commands_has_no_harness_error(tmp_p
     data = run_once(port, ("--sdi12-declaration", str(decl), "-k", "extended"))
     assert data["summary"]["counts"]["ERROR"] == 0, data["summary"]
     assert {r["id"]: r["verdict"] for r in data["requirements"]}["R-4.4.13-01"] == "PASS"
+
+
+# -- the C logger (examples/c/tiny_logger.c): the recorder role on firmware-style C ----------
+
+LOGGER_TWINS = ("retries-with-break", "ignores-bad-crc", "ttt-8-bit")
+LOGGER_DECLARATION = ("--sdi12-declaration", str(C_DIR / "tiny_logger.toml"))
+
+
+@pytest.fixture(scope="module")
+def c_logger(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Build the C logger harness and its faulty twins (-DFAULT_...), each named as the tool's
+    recorder fault whose rules it breaks."""
+    if COMPILER is None:
+        pytest.skip("no C compiler (cc/gcc) on PATH: the C example logger cannot be built")
+    out = tmp_path_factory.mktemp("c-logger")
+    sources = [str(C_DIR / "logger_harness.c"), str(C_DIR / "tiny_logger.c")]
+    built = {}
+    for name in ("clean", *LOGGER_TWINS):
+        flags = [] if name == "clean" else [f"-DFAULT_{name.upper().replace('-', '_')}"]
+        binary = out / f"logger-{name}"
+        subprocess.run(
+            [COMPILER, "-O2", "-Wall", "-Wextra", "-Werror", *flags, "-o", str(binary), *sources],
+            check=True,
+            capture_output=True,
+        )
+        built[name] = binary
+    return built
+
+
+def test_the_c_logger_is_compliant(c_logger):
+    data = run_once(f"exec:{c_logger['clean']}", LOGGER_DECLARATION, role="recorder")
+    assert clean(data), data["summary"]
+    verdicts = {r["id"]: r["verdict"] for r in data["requirements"] if r["testable"]}
+    passed = sorted(rid for rid, v in verdicts.items() if v == "PASS")
+    assert len(passed) >= 30, passed
+    # what the firmware did, not what it was spared: retries, CRC, values logged, concurrent
+    for rid in (
+        "R-7.2-01",
+        "R-7.2-02",
+        "R-7.2-03",
+        "R-7.2-06",
+        "R-4.4.12-07",
+        "R-4.4-02",
+        "R-4.4.7-08",
+        "R-4.4.8-05",
+        "R-4.4.5-04",
+    ):
+        assert verdicts[rid] == "PASS", rid
+    # a v1.3 logger without high-volume commands, as its declaration says
+    assert verdicts["R-5.4-01"] == verdicts["R-5.1-04"] == "N/A"
+
+
+@pytest.mark.parametrize("fault", LOGGER_TWINS)
+def test_a_faulty_c_logger_fails_exactly_its_requirements(c_logger, fault):
+    data = run_once(f"exec:{c_logger[fault]}", LOGGER_DECLARATION, role="recorder")
+    declared = RECORDER_FAULTS[fault]
+    row = row_from(fault, declared.violates, data, HARNESS + tuple(declared.inconclusive))
+    assert row.exact, (row.missed, row.extra)
+    assert data["summary"]["verdict"] == "NON-COMPLIANT"
