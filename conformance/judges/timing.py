@@ -562,8 +562,38 @@ def _describe_limit(lo: float | None, hi: float | None) -> str:
     return "any"
 
 
+#: Words that end the head noun of a phrase such as "retry after no reply".
+_PREPOSITIONS = frozenset(
+    [
+        "after",
+        "before",
+        "between",
+        "for",
+        "from",
+        "in",
+        "inside",
+        "of",
+        "on",
+        "to",
+        "with",
+        "without",
+    ]
+)
+
+
 def plural(what: str) -> str:
-    return what[:-1] + "ies" if what.endswith("y") and not what.endswith("ay") else what + "s"
+    """The plural of a counted phrase: its head noun, the word before the first preposition
+    ("retries after no reply", "commands without a break"); a command (``aD0!``) stays."""
+    words = what.split(" ")
+    head = next((i - 1 for i, w in enumerate(words) if i and w in _PREPOSITIONS), len(words) - 1)
+    noun = words[head]
+    if noun.endswith("!"):
+        return what
+    if noun.endswith("y") and not noun.endswith(("ay", "ey", "oy")):
+        words[head] = noun[:-1] + "ies"
+    else:
+        words[head] = noun + ("es" if noun.endswith(("s", "sh", "ch", "x")) else "s")
+    return " ".join(words)
 
 
 def combine(
