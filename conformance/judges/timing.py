@@ -179,7 +179,7 @@ def combine_local(
             places.append(o[2] if len(o) > 2 else None)  # type: ignore[misc]
     worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
     note = (
-        f"{len(aside)} {plural(what) if len(aside) != 1 else what} set aside: the link's "
+        f"{counted(len(aside), what)} set aside: the link's "
         f"stamps near them were irregular (±{worst_aside:.2f} ms there)"
     )
     if aside and not kept:
@@ -596,6 +596,11 @@ def plural(what: str) -> str:
     return " ".join(words)
 
 
+def counted(n: int, what: str) -> str:
+    """``1 retry after no reply``, ``6 retries after no reply``."""
+    return f"{n} {what if n == 1 else plural(what)}"
+
+
 def combine(
     rid: str, findings: Sequence[Finding | Measured], what: str, *, smallest_is_worst: bool = False
 ) -> Finding:
@@ -611,7 +616,7 @@ def combine(
         (f for f in findings if f.verdict is top), key=lambda f: sign * abs(f.measured_ms or 0)
     )
     values = [f.measured_ms for f in findings if f.measured_ms is not None]
-    count = f"{len(findings)} {plural(what) if len(findings) != 1 else what}"
+    count = counted(len(findings), what)
     span = f"{count}, {min(values):.2f}..{max(values):.2f} ms" if values else ""
     if worst.verdict is Verdict.PASS and ", allowed " in worst.detail:
         detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"

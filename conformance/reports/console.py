@@ -19,6 +19,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from rich.text import Text
 
+from ..judges.timing import counted
 from ..stash import CASE
 from .sweep_chart import summary_lines
 
@@ -104,7 +105,9 @@ class ProgressPlugin:
         if self.progress is not None:
             self.progress.update(self.task, total=self.total, description="")
         else:
-            self.console.print(f"running {plural(self.total, 'conformance case')}", highlight=False)
+            self.console.print(
+                f"running {counted(self.total, 'conformance case')}", highlight=False
+            )
 
     @pytest.hookimpl(wrapper=True)
     def pytest_fixture_setup(self, fixturedef: Any, request: Any) -> Any:
@@ -249,11 +252,6 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
         first,
         f"role {run['role']} · port {run['port']} · link {link['kind']}{u}",
     ]
-
-
-def plural(n: int, word: str) -> str:
-    """``1 conformance case``, ``2 conformance cases``."""
-    return f"{n} {word}{'' if n == 1 else 's'}"
 
 
 def _coverage(data: dict[str, Any]) -> str:

@@ -217,12 +217,10 @@ static int start(struct measurement *m, const char *cmd, int force_break) {
     snprintf(m->cmd, sizeof m->cmd, "%s", cmd);
     m->crc = wants_crc(cmd);
     if (!transact(cmd, force_break, 0, &r)) return 0;
+    m->ttt = strtol((char[]){r.text[1], r.text[2], r.text[3], 0}, 0, 10);
 #ifdef FAULT_TTT_8_BIT
-    unsigned char ttt = (unsigned char)strtol((char[]){r.text[1], r.text[2], r.text[3], 0}, 0, 10);
-#else
-    long ttt = strtol((char[]){r.text[1], r.text[2], r.text[3], 0}, 0, 10);
+    m->ttt = (unsigned char)m->ttt; /* stored in 8 bits: 260 s reads as 4 s */
 #endif
-    m->ttt = ttt;
     m->count = atoi(r.text + 4);
     m->ready = r.end + m->ttt * 1000000LL + TTT_MARGIN_US;
     return m->ok = 1;
