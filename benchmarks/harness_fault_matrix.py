@@ -48,8 +48,10 @@ def main(names: list[str]) -> int:
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as tmp:
         for name in faults:
-            extra = ("--sdi12-declaration", str(declaration(Path(tmp), name)))
-            data = run_once(f"exec:{sys.executable} {HARNESS} {name}", extra)
+            data = run_once(
+                f"exec:{sys.executable} {HARNESS} {name}",
+                declaration=str(declaration(Path(tmp), name)),
+            )
             # what the link cannot see may be INCONCLUSIVE beside the fault's own collateral
             allowed = (*sorted(UNOBSERVABLE), *FAULTS[name].inconclusive)
             row = row_from(name, FAULTS[name].violates, data, allowed)

@@ -8,24 +8,22 @@ figure depends on the machine (issue target: under 20 s on a 2-core machine).
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import tempfile
 import time
 from pathlib import Path
 
-import pytest
-
-from conformance.suite import suite_args
+from conformance.conduct import conduct
+from conformance.run import RunOptions
 
 
 def one_run() -> tuple[float, dict, int]:
     with tempfile.TemporaryDirectory(prefix="sdi12-bench-") as tmp:
-        args = suite_args("sensor", "sim", tmp, rootdir=tmp)
         started = time.perf_counter()
-        pytest.main(args)
+        result = conduct(RunOptions(report_dir=tmp), rootdir=tmp)
         elapsed = time.perf_counter() - started
-        data = json.loads((Path(tmp) / "verdicts.json").read_text(encoding="utf-8"))
+        data = result.document
+        assert data is not None
         events = sum(1 for _ in (Path(tmp) / "transcript.jsonl").open(encoding="utf-8"))
     return elapsed, data, events
 

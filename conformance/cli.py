@@ -22,13 +22,14 @@ from .interrupts import GUARD
 if TYPE_CHECKING:
     from rich.console import Console
 
-EXIT_COMPLIANT, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_USAGE, EXIT_NO_DEVICE = (
-    0,
-    1,
-    2,
-    3,
-    4,
-    5,
+    from .run import RunOptions
+
+from .exits import (
+    EXIT_COMPLIANT,
+    EXIT_INCOMPLETE,
+    EXIT_INTERNAL,
+    EXIT_NON_COMPLIANT,
+    EXIT_USAGE,
 )
 
 EXAMPLES = """\
@@ -127,84 +128,129 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def run_suite(args: argparse.Namespace, console: Console) -> int:
-    from . import report_folder
-    from .declaration import DeclarationError, load_declaration, normalise_version
-    from .options import UsageError, check_values, cli_values
-    from .ports import PortError, is_sim, parse_sim
-    from .preflight import check_report_dir, check_role_options
-    from .report_folder import new_report_dir
-    from .reports.diff import DiffError, load_run
-    from .selection import SelectionError, resolve
+def options_from_args(args: argparse.Namespace) -> RunOptions:
+    """The main command's parsed arguments as the run's options (every option spelled once,
+    in :mod:`conformance.options`)."""
+    from .options import cli_values
+    from .run import RunOptions
 
-    if args.port is None:
-        args.port = "sim"
+    return RunOptions.from_values(cli_values(args), args.keyword)
+
+
+def run_suite(
+    options: RunOptions,
+    console: Console,
+    *,
+    plan: str | None = None,
+    baseline: str | None = None,
+    verbose: bool = False,
+) -> int:
+    """The main command: check ``options``, run the suite, show the summary; the exit code.
+    ``plan``: write the test plan first (always/auto/never; default $SDI12_PLAN or auto);
+    ``baseline``: an earlier run to compare with at the end."""
+    return suite_outcome(options, console, plan=plan, baseline=baseline, verbose=verbose)[0]
+
+
+def suite_outcome(
+    options: RunOptions,
+    console: Console,
+    *,
+    plan: str | None = None,
+    baseline: str | None = None,
+    verbose: bool = False,
+) -> tuple[int, dict | None]:
+    """:func:`run_suite`'s exit code and the run's verdicts.json document (None: none)."""
+    from . import report_folder
+    from .declaration import DeclarationError
+    from .options import UsageError
+    from .ports import PortError
+    from .preflight import check_report_dir
+    from .report_folder import run_folder
+    from .reports.diff import DiffError, load_run
+    from .selection import SelectionError
+
+    if options.port is None:
+        options.port = "sim"
         console.print(
-            f"note: no --port given: judging the built-in SIMULATED {args.role}, not a real "
+            f"note: no --port given: judging the built-in SIMULATED {options.role}, not a real "
             "device (pass --port /dev/ttyUSB0, COM3 or rfc2217://HOST:PORT for one)",
             style="bold yellow",
             markup=False,
         )
     try:
-        check_role_options(
-            args.role, args.port, args.trigger, args.address, args.sweep, args.job_timeout
-        )
-        check_values(cli_values(args), plugin=False)
-        resolve(args.role, args.req)  # --req names requirements the role can test
-        if args.sdi_version:
-            normalise_version(args.sdi_version)
-        if args.declaration:
-            load_declaration(args.declaration)
+        real_time = check_run_options(options)
         # the baseline is read before the run: a bad path is a usage error, not a late one
-        baseline = load_run(args.baseline) if getattr(args, "baseline", None) else None
-        if args.role == "recorder":
-            from .recorder.session import check_port
-
-            # the port and recorder before pytest starts
-            real_time = check_port(args.port, args.trigger)
-        elif is_sim(args.port):
-            from .ports import open_sim
-
-            open_sim(parse_sim(args.port))  # validate faults/parameters before pytest starts
-            real_time = False
-        else:
-            from .ports import open_port
-
-            # a port that cannot be opened: a usage error
-            link = open_port(args.port, echo=args.echo, direction=args.direction).link
-            real_time = not link.info.virtual_time
-            link.close()
+        baseline_run = load_run(baseline) if baseline else None
         # a folder of this run's own: a new one, or the named one unless a live run holds it
-        report_dir = Path(args.report_dir) if args.report_dir else new_report_dir(args.role)
+        report_dir = run_folder(options.report_dir, options.role)
+        options.report_dir = str(report_dir)
         check_report_dir(report_dir)
         report_folder.acquire(report_dir)
     except (DeclarationError, PortError, UsageError, SelectionError, DiffError) as exc:
         from .links.errors import PortMissing
 
-        also = f", or judge the built-in simulated {args.role} with --port sim"
+        also = f", or judge the built-in simulated {options.role} with --port sim"
         error(f"error: {exc}{also if isinstance(exc, PortMissing) else ''}")
-        return EXIT_USAGE
+        return EXIT_USAGE, None
     try:
-        if args.plan == "always" or (args.plan == "auto" and real_time):
-            _plan_first(args, report_dir, console)
+        plan = plan or _plan_default()
+        if plan == "always" or (plan == "auto" and real_time):
+            _plan_first(options, report_dir, console)
             if GUARD.requested:  # Ctrl-C during the dry run: nothing has gone on the bus
                 error("interrupted while planning: nothing was sent to the device; no report")
-                return EXIT_INCOMPLETE
+                return EXIT_INCOMPLETE, None
             GUARD.reset()  # the dry run closed the guard: the run proper starts afresh
-        return _run_pytest(args, report_dir, console, baseline)
+        return _conducted(options, console, baseline, baseline_run, verbose)
     finally:
         report_folder.release(report_dir)
 
 
-def _plan_first(args: argparse.Namespace, report_dir: Path, console: Console) -> None:
+def check_run_options(options: RunOptions) -> bool:
+    """Refuse what the run cannot use before anything goes on the bus (a usage error, exit 4,
+    rather than a late one); whether the port runs in real time."""
+    from .declaration import load_declaration, normalise_version
+    from .options import check_values
+    from .ports import is_sim, parse_sim
+    from .preflight import check_role_options
+    from .selection import resolve
+
+    check_role_options(
+        options.role, options.port, options.trigger, options.address, options.sweep,
+        options.job_timeout,
+    )  # fmt: skip
+    check_values(vars(options), plugin=False)
+    resolve(options.role, list(options.requirements))  # --req names rules the role can test
+    if options.version:
+        normalise_version(options.version)
+    if options.declaration:
+        load_declaration(options.declaration)
+    if options.role == "recorder":
+        from .recorder.session import check_port
+
+        return check_port(options.port, options.trigger)  # the port and recorder first
+    if is_sim(options.port):
+        from .ports import open_sim
+
+        open_sim(parse_sim(options.port))  # validate faults/parameters before the run
+        return False
+    from .ports import open_port
+
+    # a port that cannot be opened: a usage error
+    link = open_port(options.port, echo=options.echo, direction=options.direction).link
+    real_time = not link.info.virtual_time
+    link.close()
+    return real_time
+
+
+def _plan_first(options: RunOptions, report_dir: Path, console: Console) -> None:
     """The test plan into the run folder before the run (issue 24): the report shows it next
     to what was judged, and the user sees how long the run will take on the bus. A Ctrl-C
     during the dry run stops it at its next case (the shared guard records it)."""
     from .plan_command import cached_plan
     from .reports.plan import duration, write_plan
 
-    plan = cached_plan(args.role, args.declaration, args.sdi_version, args.keyword,
-                     tuple(args.req))  # fmt: skip
+    plan = cached_plan(options.role, options.declaration, options.version, options.keyword,
+                     tuple(options.requirements))  # fmt: skip
     if GUARD.requested:
         return  # a plan cut short by Ctrl-C is no plan
     write_plan(report_dir, plan)
@@ -216,63 +262,62 @@ def _plan_first(args: argparse.Namespace, report_dir: Path, console: Console) ->
     )
 
 
-def _run_pytest(
-    args: argparse.Namespace, report_dir: Path, console: Console, baseline: dict | None = None
-) -> int:
+def _conducted(
+    options: RunOptions,
+    console: Console,
+    baseline: str | None,
+    baseline_run: dict | None,
+    verbose: bool,
+) -> tuple[int, dict | None]:
     """The suite in this process; the summary and exit code from its own results."""
-    from .options import pytest_args
-    from .plugin import run_in_process
+    from .conduct import conduct
     from .selection import resolve
-    from .suite import suite_args
 
-    argv = suite_args(args.role, args.port, report_dir, terminal=args.verbose)
-    argv += pytest_args(args)  # every run option, as the plugin spells it
-    if args.keyword:
-        argv += ["-k", args.keyword]
     plugins: list[object] = []
-    if args.verbose:
-        argv.append("-v")
-    else:
+    if not verbose:
         from .reports.console import ProgressPlugin
 
         plugins.append(ProgressPlugin(console))
-
-    code, data = run_in_process(argv, plugins)
+    result = conduct(options, verbose=verbose, plugins=plugins)
+    report_dir, code, data = result.report_dir, result.pytest_code, result.document
     interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
     if interrupted and data is None:
         error("interrupted before the run started; no report written")
-        return EXIT_INCOMPLETE
+        return EXIT_INCOMPLETE, None
     if code == 5 and data is None:  # pytest: no tests collected (e.g. -k matched none)
         for leftover in ("report.html", "junit.xml"):  # pytest-html's empty page misleads
             (report_dir / leftover).unlink(missing_ok=True)
         error(
-            f"error: no conformance case matched -k {args.keyword!r}; "
+            f"error: no conformance case matched -k {options.keyword!r}; "
             "`sdi12-conform list` shows the cases"
         )
-        return EXIT_USAGE
+        return EXIT_USAGE, None
     if data is None:
         error(f"error: the suite did not run (pytest exit {code}); rerun with -v")
-        return EXIT_INTERNAL if code == 3 else EXIT_USAGE
+        return (EXIT_INTERNAL if code == 3 else EXIT_USAGE), None
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))
     from .run_notes import req_pulled_in, version_mismatch
 
+    wanted = list(options.requirements)
     for note in (
-        req_pulled_in(data, resolve(args.role, args.req) if args.req else set(), args.req or []),
-        version_mismatch(data, args.sdi_version),
+        req_pulled_in(data, resolve(options.role, wanted) if wanted else set(), wanted),
+        version_mismatch(data, options.version),
     ):
         if note:
             console.print(f"note: {note}", style="yellow", markup=False, highlight=False)
+    exit_status = result.exit_code
+    assert exit_status is not None  # a document was written
     if interrupted:
-        return EXIT_INCOMPLETE
-    if baseline is not None:
+        return EXIT_INCOMPLETE, data
+    if baseline_run is not None:
         from .diff_command import against_baseline
 
         return against_baseline(
-            baseline, args.baseline, data, report_dir, exit_code(data, code), console
-        )
-    return exit_code(data, code)
+            baseline_run, baseline, data, report_dir, exit_status, console
+        ), data
+    return exit_status, data
 
 
 def cmd_judge(argv: list[str], console: Console) -> int:
@@ -289,36 +334,22 @@ def cmd_judge(argv: list[str], console: Console) -> int:
         return EXIT_INCOMPLETE
     for note in found.notes:
         console.print(f"note: {note}", markup=False, highlight=False)
-    if found.replay_argv is not None:
+    if found.replay is not None:
         console.print(
             f"judging {found.path} by replay: the run's cases ask again, the recording answers",
             markup=False,
             highlight=False,
         )
-        code = run_suite(build_parser().parse_args(found.replay_argv), console)
-        why = capture_replay_stopped(found, found.replay_argv) if code == EXIT_INTERNAL else None
+        code, document = suite_outcome(found.replay, console)
+        why = capture_replay_stopped(found, document) if code == EXIT_INTERNAL else None
         if why is not None:
             console.print(f"note: {why}", markup=False, highlight=False)
             return EXIT_INCOMPLETE
         return code
     from .offline.passive import judge_passively
 
-    return judge_passively(found.passive_argv or [], console)
-
-
-def exit_code(data: dict, pytest_code: int) -> int:
-    verdict = data["summary"]["verdict"]
-    if pytest_code in (EXIT_NO_DEVICE, EXIT_USAGE) and not data["run"]["complete"]:
-        return pytest_code  # nothing answered, or the setup (e.g. a --trigger) cannot work
-    if pytest_code in (EXIT_INCOMPLETE, EXIT_INTERNAL) and not data["run"]["complete"]:
-        return pytest_code  # Ctrl-C (pytest's 2) or the link failed mid-run (3)
-    if verdict == "NON-COMPLIANT":
-        return EXIT_NON_COMPLIANT
-    if verdict == "COMPLIANT":
-        return EXIT_COMPLIANT
-    if data["summary"]["counts"].get("ERROR"):
-        return EXIT_INTERNAL
-    return EXIT_INCOMPLETE
+    assert found.passive is not None  # plan() gives one or the other
+    return judge_passively(found.passive, console)
 
 
 def cmd_list(argv: list[str], console: Console) -> int:
@@ -628,7 +659,13 @@ def _dispatch(argv: list[str]) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:
             return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
-        return run_suite(args, console)
+        return run_suite(
+            options_from_args(args),
+            console,
+            plan=args.plan,
+            baseline=getattr(args, "baseline", None),
+            verbose=args.verbose,
+        )
     except SystemExit as exc:  # argparse of a subcommand: --help (0) or a usage error (2)
         return EXIT_COMPLIANT if exc.code in (0, None) else EXIT_USAGE
     except KeyboardInterrupt:

@@ -20,3 +20,22 @@ def say_error(text: str) -> None:
     Console(stderr=True, soft_wrap=not sys.stderr.isatty()).print(
         text, style="red", markup=False, highlight=False
     )
+
+
+def exit_code(document: dict, pytest_code: int) -> int:
+    """A run's exit status from its verdicts.json document and pytest's status: the one rule
+    every command that runs the suite (the main command, ``judge``, passive judging) gives.
+
+    A run cut short keeps the status that says why (nothing answered, a setup that cannot
+    work, Ctrl-C, the link failed); a finished run's status is its verdict's."""
+    stopped = (EXIT_NO_DEVICE, EXIT_USAGE, EXIT_INCOMPLETE, EXIT_INTERNAL)
+    if pytest_code in stopped and not document["run"]["complete"]:
+        return pytest_code
+    verdict = document["summary"]["verdict"]
+    if verdict == "NON-COMPLIANT":
+        return EXIT_NON_COMPLIANT
+    if verdict == "COMPLIANT":
+        return EXIT_COMPLIANT
+    if document["summary"]["counts"].get("ERROR"):
+        return EXIT_INTERNAL
+    return EXIT_INCOMPLETE

@@ -8,15 +8,15 @@ an untested rule.
 
 from __future__ import annotations
 
-import json
 import multiprocessing
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
-from .suite import suite_args
+from .conduct import conduct
+from .run import RunOptions
 
 ItemT = TypeVar("ItemT")
 RowT = TypeVar("RowT")
@@ -96,22 +96,29 @@ class MatrixRow:
         return f"{self.fault}: " + ("; ".join(parts) or "exact")
 
 
-def run_once(port: str, extra: tuple[str, ...] = (), role: str = "sensor") -> dict:
-    """Run the ``role`` suite in this process against ``port``; return verdicts.json."""
+class NoVerdicts(RuntimeError):
+    """The run wrote no verdicts (pytest stopped first: nothing collected, a usage error)."""
+
+
+def run_once(port: str, role: str = "sensor", **options: Any) -> dict:
+    """Run the ``role`` suite in this process against ``port``; return verdicts.json.
+    ``options``: more :class:`~conformance.run.RunOptions` fields (``version="1.3"``,
+    ``keyword="crc"``)."""
     with tempfile.TemporaryDirectory(prefix=f"sdi12-{role}-") as tmp:
-        return run_into(Path(tmp), port, extra, role)
+        return run_into(Path(tmp), port, role, **options)
 
 
-def run_into(
-    report_dir: Path, port: str, extra: tuple[str, ...] = (), role: str = "sensor"
-) -> dict:
+def run_into(report_dir: Path, port: str, role: str = "sensor", **options: Any) -> dict:
     """Run the ``role`` suite in this process against ``port`` with its reports (no HTML) in
-    ``report_dir``; return verdicts.json."""
-    import pytest
-
+    ``report_dir``; return verdicts.json (from memory: the run's own, never a file's)."""
     report_dir.mkdir(parents=True, exist_ok=True)
-    pytest.main([*suite_args(role, port, report_dir, rootdir=report_dir, html=False), *extra])
-    return json.loads((report_dir / "verdicts.json").read_text(encoding="utf-8"))
+    given = RunOptions(port=port, role=role, report_dir=str(report_dir), **options)
+    result = conduct(given, html=False, rootdir=report_dir)
+    if result.document is None:
+        raise NoVerdicts(
+            f"the {role} suite against {port} wrote no verdicts (pytest exit {result.pytest_code})"
+        )
+    return result.document
 
 
 def row_from(
@@ -133,8 +140,9 @@ def row_from(
     )
 
 
-#: one matrix item: fault, the requirements it declares, its version ("14"), extra arguments
-Item = tuple[str, tuple[str, ...], str, tuple[str, ...]]
+#: one matrix item: fault, the requirements it declares, its version ("14"), extra
+#: RunOptions fields as (name, value) pairs
+Item = tuple[str, tuple[str, ...], str, tuple[tuple[str, Any], ...]]
 
 
 def fault_port(item: Item) -> str:
@@ -150,7 +158,7 @@ def fault_row(item: Item, data: dict) -> MatrixRow:
 
 
 def _row(item: Item) -> MatrixRow:
-    return fault_row(item, run_once(fault_port(item), item[3]))
+    return fault_row(item, run_once(fault_port(item), **dict(item[3])))
 
 
 def fault_matrix(

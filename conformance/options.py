@@ -2,10 +2,11 @@
 
 Each :class:`Option` holds what both need: the name (``--echo`` on the command line,
 ``--sdi12-echo`` in pytest), type, default, choices, help and the check that refuses a value
-the tool cannot use. ``sdi12-conform`` hands its values on to pytest with :func:`pytest_args`,
-and the plugin reads them back into :class:`~conformance.run.RunOptions` with
-:func:`run_option_values`, so an option added to :data:`OPTIONS` reaches the run on both
-paths. Imported by ``sdi12-conform --help``: nothing heavy here.
+the tool cannot use. ``sdi12-conform`` turns its parsed values into a
+:class:`~conformance.run.RunOptions` with :func:`cli_values` and hands that object to
+:func:`conformance.conduct.conduct`; a plain ``pytest --sdi12-...`` run reads the plugin's
+flags with :func:`run_option_values`, so an option added to :data:`OPTIONS` reaches the run
+on both paths. Imported by ``sdi12-conform --help``: nothing heavy here.
 """
 
 from __future__ import annotations
@@ -229,9 +230,6 @@ OPTIONS: tuple[Option, ...] = (
     ),
 )
 
-#: What ``sdi12-conform`` passes to pytest through the suite's own arguments instead.
-PASSED_BY_SUITE = ("port", "role", "report-dir")
-
 
 def add_cli_options(parser: argparse.ArgumentParser, names: Iterable[str]) -> None:
     """Add the named options (in that order) to the command line's parser."""
@@ -251,23 +249,6 @@ def check_values(values: dict[str, Any], *, plugin: bool) -> None:
         if option.check is not None:
             where = option.plugin_flag if plugin else option.cli_flag
             option.check(values.get(option.field), where)
-
-
-def pytest_args(args: argparse.Namespace) -> list[str]:
-    """The command line's values as the plugin's options, for the pytest run it starts."""
-    out: list[str] = []
-    for option in OPTIONS:
-        if option.name in PASSED_BY_SUITE:
-            continue
-        value = getattr(args, option.cli_dest)
-        if option.flag:
-            out += [option.plugin_flag] if value else []
-        elif option.repeat:
-            for each in value:
-                out += [option.plugin_flag, str(each)]
-        elif value is not None and value != "":
-            out += [option.plugin_flag, str(value)]
-    return out
 
 
 def cli_values(args: argparse.Namespace) -> dict[str, Any]:

@@ -125,24 +125,22 @@ def make_plan(
     reqs: tuple[str, ...] = (),
 ) -> dict[str, Any]:
     """Dry-run the suite and build its plan (:class:`DeclarationError` for a bad file)."""
-    from .matrix import run_into
+    from .matrix import NoVerdicts, run_into
 
     declared = load_declaration(declaration) if declaration else None
     digits = normalise_version(version) if version else None
     port = dry_port(role, declaration, digits)
-    extra: list[str] = []
-    if declaration:  # the recorder role reads its sdi12_version and [recorder] table
-        extra += ["--sdi12-declaration", str(Path(declaration).resolve())]
-    if digits:
-        extra += ["--sdi12-version", f"{digits[0]}.{digits[1]}"]
-    if keyword:
-        extra += ["-k", keyword]
-    for r in reqs:
-        extra += ["--sdi12-req", r]
+    options = {
+        # the recorder role reads its sdi12_version and [recorder] table
+        "declaration": str(Path(declaration).resolve()) if declaration else None,
+        "version": f"{digits[0]}.{digits[1]}" if digits else None,
+        "keyword": keyword or None,
+        "requirements": tuple(reqs),
+    }
     with tempfile.TemporaryDirectory(prefix="sdi12-plan-") as tmp:
         try:
-            dry = run_into(Path(tmp), port, tuple(extra), role)
-        except FileNotFoundError:  # pytest collected nothing: no verdicts.json
+            dry = run_into(Path(tmp), port, role, **options)
+        except NoVerdicts:  # pytest collected nothing: no verdicts
             raise PlanError("the selection (-k/--req) matches no case: nothing to plan") from None
     said = assumptions(declared) if declared is not None and role == "sensor" else []
     if role == "recorder":

@@ -26,7 +26,7 @@ from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's sess
 from .replay.sensor import RecordingEnded
 from .reports import html, verdicts_json
 from .results import CaseRecord
-from .run import ConformanceRun, RunOptions
+from .run import ConformanceRun, RunOptions, given_options
 from .selection import SelectionError, resolve
 from .sensor.session import NoDeviceAnswered, SensorSession
 from .stash import CASE
@@ -81,6 +81,9 @@ def pytest_configure(config: pytest.Config) -> None:
     except (UsageError, PortError) as exc:
         raise pytest.UsageError(str(exc)) from None
     config.stash[RUN] = ConformanceRun(options)
+    given = given_options(config)
+    if given is not None:  # conformance.conduct: the caller reads the run from memory
+        given.run = config.stash[RUN]
     if config.pluginmanager.hasplugin("html"):
         config.pluginmanager.register(html.HtmlReportPlugin(config.stash[RUN]), "sdi12-html")
 
@@ -173,7 +176,7 @@ def case_role(item: pytest.Item) -> str | None:
 def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Deselect the other role's cases; none left for the chosen role is a usage error (a
     run of skips would end with exit 0 and nothing tested)."""
-    role = config.getoption("sdi12_role")
+    role = run_of(config).options.role
     cases = [i for i in items if i.get_closest_marker("requirements")]
     other = [i for i in cases if case_role(i) not in (None, role)]
     if not other:
@@ -404,22 +407,3 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     if config.stash.get(OWN_GUARD, False):
         GUARD.uninstall()
         GUARD.reset()
-
-
-class _RunOf:
-    """A pytest plugin that keeps hold of the run the conformance plugin made, so the caller
-    reads the verdicts from memory (a file on disk could be another run's)."""
-
-    def __init__(self) -> None:
-        self.run = None
-
-    def pytest_configure(self, config: pytest.Config) -> None:
-        self.run = config.stash.get(RUN, None)
-
-
-def run_in_process(argv: list[str], plugins: list[object] | None = None) -> tuple[int, dict | None]:
-    """``pytest.main(argv)`` in this process: its exit status and the run's verdicts.json
-    document as it was written (None: the run wrote none, e.g. a usage error)."""
-    held = _RunOf()
-    code = int(pytest.main(argv, plugins=[*(plugins or []), held]))
-    return code, getattr(held.run, "document", None)

@@ -122,3 +122,9 @@ def held(path: Path) -> Iterator[Path]:
         yield path
     finally:
         release(path)
+
+
+def run_folder(report_dir: str | Path | None, kind: str) -> Path:
+    """The folder a run writes into: the one named, or a new one of its own under the
+    default reports folder (``kind`` names it: the role, "passive", "monitor")."""
+    return Path(report_dir) if report_dir else new_report_dir(kind)

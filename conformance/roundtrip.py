@@ -12,15 +12,14 @@ budget: the round trip is a second suite run per fault.
 
 from __future__ import annotations
 
-import argparse
 import os
 import tempfile
 import zlib
 from dataclasses import replace
 from pathlib import Path
 
+from .conduct import conduct
 from .matrix import Item, MatrixRow, fault_port, fault_row, row_from, run_into
-from .options import OPTIONS, add_cli_options, pytest_args
 from .transcript import EventKind
 
 DECIDED = ("PASS", "FAIL", "WARN", "N/A")
@@ -52,19 +51,14 @@ def judged_through_capture(run_dir: Path, work: Path) -> dict:
         found = plan([str(capture), "--report-dir", str(again)])
     except (RecordingError, CaptureError, JudgeError, ValueError) as exc:
         raise RoundTripError(f"{run_dir}: {exc}") from None
-    if found.replay_argv is None:
+    if found.replay is None:
         raise RoundTripError(f"{run_dir}: its capture would be judged passively: {found.notes}")
-    args = _replay_parser().parse_args(found.replay_argv)
-    extra = pytest_args(args) + (["-k", args.keyword] if args.keyword else [])
-    return run_into(again, args.port, tuple(extra), args.role)
-
-
-def _replay_parser() -> argparse.ArgumentParser:
-    """The main command's run options (the replay's arguments are spelled as its own)."""
-    parser = argparse.ArgumentParser(add_help=False)
-    add_cli_options(parser, [o.name for o in OPTIONS])
-    parser.add_argument("-k", dest="keyword")
-    return parser
+    document = conduct(
+        replace(found.replay, report_dir=str(again)), html=False, rootdir=again
+    ).document
+    if document is None:
+        raise RoundTripError(f"{run_dir}: its capture's replay wrote no verdicts")
+    return document
 
 
 def verdict_changes(live: dict, again: dict) -> tuple[str, ...]:
@@ -117,7 +111,7 @@ def row_through_sampled_capture(item: Item) -> MatrixRow:
     if in_capture_sample(item[0]):
         return row_through_capture(item)
     with tempfile.TemporaryDirectory(prefix="sdi12-row-") as tmp:
-        return fault_row(item, run_into(Path(tmp) / "live", fault_port(item), item[3]))
+        return fault_row(item, run_into(Path(tmp) / "live", fault_port(item), **dict(item[3])))
 
 
 def row_through_capture(item: Item) -> MatrixRow:
@@ -125,7 +119,7 @@ def row_through_capture(item: Item) -> MatrixRow:
     its run also judged through a capture of itself."""
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
         live_dir = Path(tmp) / "live"
-        data = run_into(live_dir, fault_port(item), item[3])
+        data = run_into(live_dir, fault_port(item), **dict(item[3]))
         return replace(fault_row(item, data), capture=capture_changes(live_dir, data, Path(tmp)))
 
 

@@ -20,7 +20,7 @@ from .options import run_option_values
 from .ports import is_sim, open_port
 from .recorder.session import RecorderSession, driver_for
 from .replay.recording import options_note
-from .report_folder import new_report_dir
+from .report_folder import run_folder
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
 from .sensor.session import SensorSession
@@ -45,10 +45,38 @@ class RunOptions:
     sweep: str | None = None  # recorder role: tolerance sweeps to run ("reply,wake")
 
     @classmethod
+    def from_values(cls, values: dict[str, Any], keyword: str | None = None) -> RunOptions:
+        """From RunOptions field -> value (as :mod:`conformance.options` reads them)."""
+        values = dict(values)
+        values["requirements"] = tuple(values.get("requirements") or ())
+        return cls(**values, keyword=keyword or None)
+
+    @classmethod
     def from_config(cls, config: Any) -> RunOptions:
-        return cls(
-            **run_option_values(config.getoption), keyword=config.getoption("keyword") or None
-        )
+        """From pytest's own command line: ``pytest --pyargs testcases.sensor --sdi12-...``
+        (a run started by :func:`conformance.conduct.conduct` hands its options over whole)."""
+        given = given_options(config)
+        if given is not None:
+            return given.options
+        return cls.from_values(run_option_values(config.getoption), config.getoption("keyword"))
+
+
+class GivenOptions:
+    """A pytest plugin object that carries a run's options into the pytest session, so the
+    conformance plugin takes them as they are instead of parsing them back from flags; it
+    is also where the plugin leaves the :class:`ConformanceRun` it made, for the caller."""
+
+    def __init__(self, options: RunOptions) -> None:
+        self.options = options
+        self.run: ConformanceRun | None = None
+
+
+def given_options(config: Any) -> GivenOptions | None:
+    """The options handed to this pytest session, if a caller handed any."""
+    for plugin in config.pluginmanager.get_plugins():
+        if isinstance(plugin, GivenOptions):
+            return plugin
+    return None
 
 
 def now_iso() -> str:
@@ -208,12 +236,9 @@ class ConformanceRun:
 
     def report_dir(self) -> Path:
         """The run's folder: the one named, or a new one of its own (never another run's)."""
-        if self.options.report_dir:
-            path = Path(self.options.report_dir)
-            path.mkdir(parents=True, exist_ok=True)
-        else:
-            path = new_report_dir(self.options.role)
-            self.options.report_dir = str(path)
+        path = run_folder(self.options.report_dir, self.options.role)
+        path.mkdir(parents=True, exist_ok=True)
+        self.options.report_dir = str(path)
         return path
 
     def link_description(self) -> dict[str, Any]:

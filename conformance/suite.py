@@ -14,15 +14,16 @@ SUITE_ROOT = Path(str(resources.files("testcases"))).parent
 
 
 def suite_args(
-    role: str,
-    port: str,
+    cases: str,
     report_dir: Path | str,
     *,
     rootdir: Path | str | None = None,
     html: bool = True,
     terminal: bool = False,
 ) -> list[str]:
-    """pytest arguments for the ``role`` suite against ``port``, reports into ``report_dir``.
+    """pytest arguments for the conformance cases ``cases`` (``testcases.sensor``), their
+    HTML and JUnit reports into ``report_dir``. The run's own options are not among them:
+    :func:`conformance.conduct.conduct` hands them to the plugin whole.
 
     The bundled ``suite.ini`` keeps a project's own pytest settings out of the judged run.
     ``html`` adds report.html and junit.xml; ``terminal`` keeps pytest's own output.
@@ -44,10 +45,7 @@ def suite_args(
         # every repaint of the live progress bar once the first case started (it stood at
         # "collecting the cases 0:00:00" for a whole run)
         "--capture=no",
-        "--pyargs", f"testcases.{role}",
-        "--sdi12-port", port,
-        "--sdi12-role", role,
-        "--sdi12-report-dir", str(report_dir),
+        "--pyargs", cases,
     ]  # fmt: skip
     if html:
         args += [

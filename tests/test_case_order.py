@@ -10,14 +10,13 @@ cases it selected (a requirement it judges with fewer cases is a different quest
 
 from __future__ import annotations
 
-import json
 import random
 import tempfile
-from pathlib import Path
 
 import pytest
 
-from conformance.suite import suite_args
+from conformance.conduct import conduct
+from conformance.run import RunOptions
 
 
 class Reorder:
@@ -39,11 +38,10 @@ def run_suite(role: str, port: str, how: str = "default", seed: int = 0, k: str 
     """Run the ``role`` suite in this process in the given order; return verdicts.json
     with the order the cases ran in."""
     with tempfile.TemporaryDirectory(prefix="sdi12-order-") as tmp:
-        args = suite_args(role, port, tmp, rootdir=tmp, html=False)
-        if k:
-            args += ["-k", k]
-        pytest.main(args, plugins=[Reorder(how, seed)])
-        return json.loads((Path(tmp) / "verdicts.json").read_text(encoding="utf-8"))
+        options = RunOptions(port=port, role=role, report_dir=tmp, keyword=k or None)
+        result = conduct(options, html=False, rootdir=tmp, plugins=[Reorder(how, seed)])
+        assert result.document is not None
+        return result.document
 
 
 def case_verdicts(data: dict) -> dict[str, str]:

@@ -191,8 +191,8 @@ def test_the_collector_is_paced_for_a_run_and_restored_after() -> None:
 
 
 def test_a_run_paces_the_collector_and_leaves_it_as_found(tmp_path) -> None:
-    from conformance.plugin import run_in_process
-    from conformance.suite import suite_args
+    from conformance.conduct import conduct
+    from conformance.run import RunOptions
 
     seen = []
 
@@ -201,9 +201,9 @@ def test_a_run_paces_the_collector_and_leaves_it_as_found(tmp_path) -> None:
             seen.append(gc.get_threshold())
 
     before = gc.get_threshold()
-    args = suite_args("sensor", "sim", tmp_path, rootdir=tmp_path, html=False)
-    code, document = run_in_process([*args, "-k", "test_query_address"], plugins=[Probe()])
-    assert document is not None
+    options = RunOptions(report_dir=str(tmp_path), keyword="test_query_address")
+    result = conduct(options, html=False, rootdir=tmp_path, plugins=[Probe()])
+    assert result.document is not None
     assert seen and set(seen) == {gc_pace.RUN_THRESHOLDS}
     assert gc.get_threshold() == before
     assert gc.get_freeze_count() == 0

@@ -58,14 +58,14 @@ def c_harness(tmp_path_factory: pytest.TempPathFactory):
     return built
 
 
-DECLARATION = ("--sdi12-declaration", str(C_DIR / "tiny_sensor.toml"))
+DECLARATION = {"declaration": str(C_DIR / "tiny_sensor.toml")}
 
 
 @pytest.fixture(scope="module")
 def c_run(c_harness) -> tuple[dict, float]:
     """One run of the clean C harness and its wall time."""
     started = time.monotonic()
-    data = run_once(f"exec:{c_harness['clean']}", DECLARATION)
+    data = run_once(f"exec:{c_harness['clean']}", **DECLARATION)
     return data, time.monotonic() - started
 
 
@@ -88,12 +88,12 @@ def test_the_c_sensor_harness_is_compliant(c_run):
 
 def test_a_harness_run_is_deterministic(c_harness, c_run):
     """Virtual time: the same harness gives the same findings, to the microsecond."""
-    again = run_once(f"exec:{c_harness['clean']}", DECLARATION)
+    again = run_once(f"exec:{c_harness['clean']}", **DECLARATION)
     assert findings(again) == findings(c_run[0])
 
 
 def test_the_faulty_c_sensor_fails_exactly_its_requirement(c_harness):
-    data = run_once(f"exec:{c_harness['no-service-request']}", DECLARATION)
+    data = run_once(f"exec:{c_harness['no-service-request']}", **DECLARATION)
     fault = FAULTS["no-service-request"]
     row = row_from("no-service-request", fault.violates, data, HARNESS + fault.inconclusive)
     assert row.exact, (row.missed, row.extra)
@@ -137,7 +137,7 @@ def test_the_python_sensor_with_its_extended_commands_has_no_harness_error(tmp_p
     decl = tmp_path / "d.toml"
     decl.write_text('[features]\nextended = ["XSN", "XHELP"]\n', encoding="utf-8")
     port = f"exec:{sys.executable} {PY_DIR / 'sensor_harness.py'}"
-    data = run_once(port, ("--sdi12-declaration", str(decl), "-k", "extended"))
+    data = run_once(port, declaration=str(decl), keyword="extended")
     assert data["summary"]["counts"]["ERROR"] == 0, data["summary"]
     assert {r["id"]: r["verdict"] for r in data["requirements"]}["R-4.4.13-01"] == "PASS"
 
@@ -145,7 +145,7 @@ def test_the_python_sensor_with_its_extended_commands_has_no_harness_error(tmp_p
 # -- the C logger (examples/c/tiny_logger.c): the recorder role on firmware-style C ----------
 
 LOGGER_TWINS = ("retries-with-break", "ignores-bad-crc", "ttt-8-bit")
-LOGGER_DECLARATION = ("--sdi12-declaration", str(C_DIR / "tiny_logger.toml"))
+LOGGER_DECLARATION = {"declaration": str(C_DIR / "tiny_logger.toml")}
 
 
 @pytest.fixture(scope="module")
@@ -170,7 +170,7 @@ def c_logger(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 def test_the_c_logger_is_compliant(c_logger):
-    data = run_once(f"exec:{c_logger['clean']}", LOGGER_DECLARATION, role="recorder")
+    data = run_once(f"exec:{c_logger['clean']}", **LOGGER_DECLARATION, role="recorder")
     assert clean(data), data["summary"]
     verdicts = {r["id"]: r["verdict"] for r in data["requirements"] if r["testable"]}
     passed = sorted(rid for rid, v in verdicts.items() if v == "PASS")
@@ -194,7 +194,7 @@ def test_the_c_logger_is_compliant(c_logger):
 
 @pytest.mark.parametrize("fault", LOGGER_TWINS)
 def test_a_faulty_c_logger_fails_exactly_its_requirements(c_logger, fault):
-    data = run_once(f"exec:{c_logger[fault]}", LOGGER_DECLARATION, role="recorder")
+    data = run_once(f"exec:{c_logger[fault]}", **LOGGER_DECLARATION, role="recorder")
     declared = RECORDER_FAULTS[fault]
     row = row_from(fault, declared.violates, data, HARNESS + tuple(declared.inconclusive))
     assert row.exact, (row.missed, row.extra)

@@ -183,7 +183,7 @@ def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
 def test_a_run_whose_harness_fell_out_of_step_is_incomplete(misbehaving):
     """The same at run level: verdicts are not drawn from records read out of step."""
     port, pidfile = misbehaving("after-bye", 10**9)
-    data = run_once(port, ("-k", "acknowledge"))
+    data = run_once(port, keyword="acknowledge")
     assert data["summary"]["verdict"] == "INCOMPLETE"
     assert "out of step" in data["run"]["stop_reason"]
     assert reaped(pidfile)

@@ -15,11 +15,11 @@ HARNESS = Path(__file__).resolve().parent.parent / "examples" / "python" / "sens
 def test_a_harness_that_ran_well_has_its_stderr_in_the_report():
     inner = f"echo firmware log: booted >&2; exec {shlex.quote(sys.executable)} {HARNESS}"
     port = f"exec:sh -c {shlex.quote(inner)}"
-    data = run_once(port, ("-k", "test_acknowledge"))
+    data = run_once(port, keyword="test_acknowledge")
     assert data["run"]["complete"]
     assert "firmware log: booted" in data["run"]["link"]["harness_stderr"]
 
 
 def test_the_simulated_sensor_has_no_harness_stderr_key():
-    data = run_once("sim://", ("-k", "test_acknowledge"))
+    data = run_once("sim://", keyword="test_acknowledge")
     assert "harness_stderr" not in data["run"]["link"]

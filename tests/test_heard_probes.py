@@ -30,7 +30,7 @@ def test_a_slow_waking_sensor_that_takes_a_bad_address_is_caught():
     R-4.3-04 PASSed ("refused '$'") although the sensor takes '$' when it hears it."""
     data = run_once(
         "sim://?faults=late-address-after-break,accepts-invalid-address",
-        ("-k", "test_address_range"),
+        keyword="test_address_range",
     )
     assert verdict(data, "R-4.3-04") == "WARN"  # a MAY rule: broken, a WARN
 
@@ -40,7 +40,7 @@ def test_a_slow_waking_sensor_that_answers_foreign_addresses_is_caught():
     wake, and R-4.0-01 PASSed."""
     data = run_once(
         "sim://?faults=slow-wake,answers-foreign-address",
-        ("-k", "test_foreign_addresses_are_ignored"),
+        keyword="test_foreign_addresses_are_ignored",
     )
     assert verdict(data, "R-4.0-01") == "FAIL"
 

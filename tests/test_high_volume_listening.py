@@ -27,7 +27,7 @@ def test_an_unheard_probe_while_hb_ran_keeps_the_fail_ha_earned(monkeypatch):
 
     monkeypatch.setattr(SensorEmulator, "on_break", on_break)
     monkeypatch.setattr(SensorSession, "hearing_marking", lambda self: None)
-    data = run_once("sim://", ("-k", "test_high_volume_is_concurrent"))
+    data = run_once("sim://", keyword="test_high_volume_is_concurrent")
     row = next(r for r in data["requirements"] if r["id"] == "R-5.3-01")
     assert row["verdict"] == "FAIL", row
     details = [f["detail"] for f in row["findings"]]

@@ -48,6 +48,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
         "run",
         (
             "run",
+            "conduct",
             "offline",
             "options",
             "preflight",

@@ -63,7 +63,7 @@ def test_do_nothing_sensor_gets_no_pass(monkeypatch):
     skipped): whatever the cases send, nothing answers, and nothing may PASS."""
     monkeypatch.setattr(run_module, "open_port", _silent_bus)
     monkeypatch.setattr(SensorSession, "discover", lambda self: None)
-    data = run_once("sim", ("--sdi12-version", "1.4", "--sdi12-address", "0"))
+    data = run_once("sim", version="1.4", address="0")
     passes = [r["id"] for r in data["requirements"] if r["verdict"] == "PASS"]
     assert passes == []
     assert data["summary"]["counts"]["ERROR"] == 0

@@ -135,7 +135,7 @@ def test_pending_from_the_wire():
 
 
 def _abort(port: str) -> dict[str, dict]:
-    data = run_once(port, ("-k", "test_break_aborts_measurement"))
+    data = run_once(port, keyword="test_break_aborts_measurement")
     (test,) = data["tests"]
     checked = test["preconditions"]  # verdicts.json says which held and why one did not
     assert set(checked) <= {"pending", "aborted"} and "pending" in checked, checked
@@ -216,8 +216,8 @@ def test_every_declared_precondition_is_checked_when_the_sensor_suite_runs():
 def test_every_declared_precondition_is_checked_when_the_recorder_suite_runs():
     from conformance.recorder.matrix import run_recorder_suite
 
-    for extra in ((), ("--sdi12-version", "1.3")):
-        data = run_recorder_suite("sim", extra)
+    for extra in ({}, {"version": "1.3"}):
+        data = run_recorder_suite("sim", **extra)
         assert len(data["tests"]) > 12
         assert unchecked(data["tests"], _declared_codes()) == []
         assert all("recorder" in t["preconditions"] for t in data["tests"])

@@ -38,9 +38,10 @@ def details(data: dict, rid: str) -> list[str]:
     return [f["detail"] for r in data["requirements"] if r["id"] == rid for f in r["findings"]]
 
 
-def run(port: str, declaration: Path | None = None, *extra: str) -> dict:
-    args = ("--sdi12-declaration", str(declaration)) if declaration else ()
-    return run_recorder_suite(port, (*args, *extra))
+def run(port: str, declaration: Path | None = None, **options: object) -> dict:
+    if declaration:
+        options["declaration"] = str(declaration)
+    return run_recorder_suite(port, **options)
 
 
 # -- parsing ------------------------------------------------------------------------------
@@ -148,9 +149,7 @@ def test_an_optional_capability_declared_absent_is_not_asked_and_na(tmp_path):
     with_report = tmp_path / "run"
     from conformance.matrix import run_into
 
-    data = run_into(
-        with_report, PROGRAM + "letterless", ("--sdi12-declaration", str(path)), "recorder"
-    )
+    data = run_into(with_report, PROGRAM + "letterless", "recorder", declaration=str(path))
     got = verdicts(data)
     assert got["R-4.3-04"] == "N/A" and got["R-4.3-03"] == "PASS"
     assert details(data, "R-4.3-04") == [
@@ -200,7 +199,7 @@ def test_without_a_declaration_the_assumptions_say_every_job_was_asked():
 
 ROOT = Path(__file__).resolve().parents[1]
 HARNESS = f"exec:{sys.executable} {ROOT / 'examples/python/recorder_harness.py'}"
-NEAR = ("-k", "test_addresses or test_every_basic_command or test_logged_values")
+NEAR = {"keyword": "test_addresses or test_every_basic_command or test_logged_values"}
 
 
 def test_a_harness_that_cannot_do_a_job(monkeypatch):
@@ -209,8 +208,8 @@ def test_a_harness_that_cannot_do_a_job(monkeypatch):
     basic aM! job FAILs R-4.4-02. The rules judged on other jobs keep their verdicts."""
     # the harness process imports this tree's conformance, not another installed one
     monkeypatch.setenv("PYTHONPATH", str(ROOT))
-    plain = run(HARNESS, None, *NEAR)
-    said = run(f"{HARNESS} --cannot addresses,service-request", None, *NEAR)
+    plain = run(HARNESS, None, **NEAR)
+    said = run(f"{HARNESS} --cannot addresses,service-request", None, **NEAR)
     got, before = verdicts(said), verdicts(plain)
     assert before["R-4.3-03"] == before["R-4.4-02"] == "PASS"
     assert got["R-4.3-03"] == got["R-4.4-02"] == "FAIL"

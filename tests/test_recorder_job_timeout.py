@@ -71,7 +71,7 @@ def test_a_harness_that_loops_forever_is_cut_and_its_stderr_kept(tmp_path):
     """The same fault behind ``exec:``: the harness plans waits for ever, the tool cuts it at
     ``--job-timeout``, and what the harness logged about it is in the report."""
     port = f"exec:{shlex.quote(sys.executable)} {HARNESS} {FAULT}"
-    data = run_once(port, ("--sdi12-job-timeout", "20"), role="recorder")
+    data = run_once(port, job_timeout=20.0, role="recorder")
     verdicts = _verdicts(data)
     assert verdicts["R-4.4.5-05"] == "FAIL"
     for rid in WHOLE_RUN:
@@ -86,11 +86,11 @@ def test_a_harness_that_loops_forever_is_cut_and_its_stderr_kept(tmp_path):
 
 def test_the_golden_harness_has_an_empty_stderr_key():
     port = f"exec:{shlex.quote(sys.executable)} {HARNESS}"
-    data = run_once(port, ("-k", "test_every_basic_command_and_family"), role="recorder")
+    data = run_once(port, keyword="test_every_basic_command_and_family", role="recorder")
     assert data["run"]["link"]["harness_stderr"] == ""
     assert (
         "harness_stderr"
-        not in run_once("sim", ("-k", "test_every_basic_command_and_family"), role="recorder")[
+        not in run_once("sim", keyword="test_every_basic_command_and_family", role="recorder")[
             "run"
         ]["link"]
     )

@@ -338,7 +338,7 @@ def test_a_run_whose_recorder_reports_nothing_leaves_the_check_not_applicable():
     from conformance.matrix import run_once
 
     port = f"sim://?recorder={__name__}:silent_logger"
-    data = run_once(port, ("-k", "logged"), role="recorder")
+    data = run_once(port, keyword="logged", role="recorder")
     found = {r["id"]: r for r in data["requirements"]}
     for rid in ("R-4.4-02", "R-5.4-01"):
         assert found[rid]["verdict"] == "N/A", found[rid]

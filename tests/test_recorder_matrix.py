@@ -31,7 +31,7 @@ def test_golden_recorder_is_compliant_with_no_fail_warn_or_inconclusive():
 
 @pytest.mark.slow
 def test_v13_recorder_leaves_the_v14_rules_not_applicable():
-    data = run_recorder_suite("sim", ("--sdi12-version", "1.3"))
+    data = run_recorder_suite("sim", version="1.3")
     assert data["summary"]["verdict"] == "COMPLIANT"
     verdicts = {r["id"]: r["verdict"] for r in data["requirements"]}
     for rid in ("R-5.1-04", "R-5.2-08", "R-5.4-01", "R-6.3-01", "R-4.4.13.1-04"):

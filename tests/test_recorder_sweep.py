@@ -244,16 +244,16 @@ def test_a_sweep_run_writes_valid_verdicts_and_changes_no_verdict(tmp_path: Path
 def test_judging_a_swept_run_again_replays_its_sweeps(tmp_path: Path):
     """``sdi12-conform judge`` repeats the recorded options, --sweep included: the steps are
     in the recording, so the sweeps come out as the live run had them."""
-    from conformance.offline.judge import replay_argv
+    from conformance.offline.judge import replay_options
     from conformance.replay.recording import read_recording
 
-    live = run_into(tmp_path / "live", "sim", ("--sdi12-sweep", "wake"), role="recorder")
-    argv = replay_argv(read_recording(tmp_path / "live" / "transcript.jsonl"), _judge_args())
-    assert argv[argv.index("--sweep") + 1] == "wake"
+    live = run_into(tmp_path / "live", "sim", sweep="wake", role="recorder")
+    options = replay_options(read_recording(tmp_path / "live" / "transcript.jsonl"), _judge_args())
+    assert options.sweep == "wake"
     again = run_into(
         tmp_path / "again",
         f"replay:{tmp_path / 'live'}",
-        ("--sdi12-sweep", "wake"),
+        sweep="wake",
         role="recorder",
     )
     assert again["sweeps"] == live["sweeps"] and live["sweeps"][0]["copes_up_to_ms"] == 145.0

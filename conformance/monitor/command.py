@@ -31,7 +31,7 @@ from ..exits import say_error as error
 from ..interrupts import GUARD
 from ..links.errors import LinkError, PortError
 from ..options import UsageError
-from ..report_folder import new_report_dir
+from ..report_folder import run_folder
 from ..transcript import BUS, Event
 from .lines import BusLine, LineTracker
 
@@ -99,7 +99,7 @@ def monitor_main(argv: list[str], console: Console, judge: Judge) -> int:
         error(f"error: --duration must be more than 0 s, not {args.duration:g}")
         return EXIT_USAGE
     try:
-        report_dir = Path(args.report_dir) if args.report_dir else new_report_dir("monitor")
+        report_dir = run_folder(args.report_dir, "monitor")
         report_dir.mkdir(parents=True, exist_ok=True)
         report_folder.acquire(report_dir)  # no other run writes here while this one listens
     except (OSError, UsageError) as exc:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass, field, replace
+from dataclasses import fields as dataclass_fields
 from pathlib import Path
 
 from ..capture import (
@@ -39,10 +40,12 @@ from ..replay.recording import (
     transcript_path,
     write_recording,
 )
-from ..report_folder import held
+from ..report_folder import held, run_folder
+from ..run import RunOptions
 from ..transcript import BUS, DUT, TOOL, Event, EventKind
 from ..view.direction import infer_directions
 from ..view.sides import RECORDER, SENSOR
+from .job import PassiveJob
 
 ROLES = ("sensor", "recorder", "both")
 
@@ -70,13 +73,13 @@ class JudgeError(ValueError):
 
 @dataclass
 class JudgePlan:
-    """What ``judge`` will do: replay a run (``replay_argv`` for the main command) or judge
-    a recording passively (``passive_argv`` for the suite's passive cases)."""
+    """What ``judge`` will do: replay a run (``replay``: the main command's options for it)
+    or judge a recording passively (``passive``: the passive cases' job)."""
 
     path: Path
     kind: str  # "jsonl", "sr", "vcd", "csv"
-    replay_argv: list[str] | None = None
-    passive_argv: list[str] | None = None
+    replay: RunOptions | None = None
+    passive: PassiveJob | None = None
     notes: list[str] = field(default_factory=list)
     #: the role this tool's run judged, when the recording is of one: judged passively, only
     #: that role's rules by default (the other side is the tool's own, partly deliberately
@@ -158,14 +161,14 @@ def plan(argv: list[str]) -> JudgePlan:
             raise JudgeError(str(exc)) from None
         why_not = replay_refused(recording, args)
         if why_not is None:
-            found.replay_argv = replay_argv(recording, args)
+            found.replay = replay_options(recording, args)
             return found
         found.notes.append(f"judged passively: {why_not}")
         if recording.options:
             found.run_role = recording.role
     else:
         capture_replay(found, args)
-        if found.replay_argv is not None:
+        if found.replay is not None:
             return found
     if args.role is None and found.run_role is not None:
         other = "recorder" if found.run_role == "sensor" else "sensor"
@@ -173,12 +176,12 @@ def plan(argv: list[str]) -> JudgePlan:
             f"{found.run_role} rules only: the recording is of this tool's {found.run_role} "
             f"run, whose {other} side is the tool's own stimuli (--role both judges them too)"
         )
-    found.passive_argv = passive_argv(path, kind, args, found.run_role)
+    found.passive = passive_job(path, kind, args, found.run_role)
     return found
 
 
 def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
-    """Set ``found.replay_argv`` when the capture is of a run of this tool whose cases can be
+    """Set ``found.replay`` when the capture is of a run of this tool whose cases can be
     repeated against it: its options come from ``--run`` or from the notes an export kept in
     it, and every character's direction is known (else a note says why it is judged
     passively). The capture is decoded first in any case: a broken one is refused here."""
@@ -207,7 +210,7 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
             "capture's characters, and a replay needs every one (a --tx-channel settles it)"
         )
         return
-    report_dir = Path(args.report_dir or default_report_dir(str(options.get("role", "sensor"))))
+    report_dir = run_folder(args.report_dir, str(options.get("role", "sensor")))
     decoded_path = report_dir / "capture.jsonl"
     try:  # nothing is written into a folder another live run holds (issue 19)
         check_report_dir(report_dir)
@@ -221,7 +224,7 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
         found.notes.append(f"judged passively: {why_not}")
         return
     args.report_dir = str(report_dir)
-    found.replay_argv = replay_argv(recording, args)
+    found.replay = replay_options(recording, args)
     found.notes.append(f"decoded capture written to {decoded_path}")
 
 
@@ -301,13 +304,6 @@ def describe_decode(decoded: CaptureDecode) -> list[str]:
     return said
 
 
-def default_report_dir(role: str) -> Path:
-    """A new folder of this judging's own (see :func:`conformance.report_folder.new_report_dir`)."""
-    from ..report_folder import new_report_dir
-
-    return new_report_dir(role)
-
-
 def replay_refused(recording: Recording, args: argparse.Namespace) -> str | None:
     """Why this recording is not replayed (None: it is)."""
     if args.passive:
@@ -328,72 +324,60 @@ def replay_refused(recording: Recording, args: argparse.Namespace) -> str | None
     return None
 
 
-def replay_argv(recording: Recording, args: argparse.Namespace) -> list[str]:
-    """The main command's arguments that repeat the recorded run against its recording."""
+def replay_options(recording: Recording, args: argparse.Namespace) -> RunOptions:
+    """The main command's options that repeat the recorded run against its recording: the
+    options its run-options note saved, with what ``judge`` was told on top."""
     saved = recording.options
-    argv = ["--port", f"replay:{recording.path}", "--role", str(saved.get("role", "sensor"))]
-    for flag, key in (
-        ("--address", "address"),
-        ("--sdi-version", "version"),
-        ("--declaration", "declaration"),
-        ("--timing-uncertainty-ms", "timing_uncertainty_ms"),
-        ("-k", "keyword"),
-        ("--sweep", "sweep"),  # a swept run's steps are in its recording: replayed too
-        ("--job-timeout", "job_timeout"),  # the budgets its scenario notes state
-    ):
-        if saved.get(key) is not None:
-            argv += [flag, str(saved[key])]
-    for wanted in saved.get("requirements") or ():
-        argv += ["--req", str(wanted)]
-    if args.sdi_version:
-        argv += ["--sdi-version", args.sdi_version]
-    if saved.get("strict") or args.strict:
-        argv.append("--strict")
-    if args.report_dir:
-        argv += ["--report-dir", args.report_dir]
-    return argv
+    fields = {f.name for f in dataclass_fields(RunOptions)}
+    kept = {
+        key: saved[key]
+        for key in (
+            "address", "version", "declaration", "timing_uncertainty_ms", "keyword",
+            "sweep",  # a swept run's steps are in its recording: replayed too
+            "job_timeout",  # the budgets its scenario notes state
+        )
+        if key in fields and saved.get(key) is not None
+    }  # fmt: skip
+    return RunOptions(
+        port=f"replay:{recording.path}",
+        role=str(saved.get("role", "sensor")),
+        requirements=tuple(str(r) for r in saved.get("requirements") or ()),
+        strict=bool(saved.get("strict") or args.strict),
+        report_dir=args.report_dir,
+        **(kept | ({"version": args.sdi_version} if args.sdi_version else {})),
+    )
 
 
-def passive_argv(
+def passive_job(
     path: Path, kind: str, args: argparse.Namespace, run_role: str | None = None
-) -> list[str]:
-    """The passive judging's options (see :mod:`conformance.offline.passive`); ``run_role``:
-    the default role when the recording is of a run of this tool (else both)."""
-    argv = ["--recording", str(path), "--format", kind, "--role", args.role or run_role or "both"]
-    for flag, value in (
-        ("--address", args.address),
-        ("--channel", args.channel),
-        ("--tx-channel", args.tx_channel),
-        ("--sdi-version", args.sdi_version),
-        ("--report-dir", args.report_dir),
-    ):
-        if value is not None:
-            argv += [flag, value]
-    if args.invert is not None:
-        argv.append("--invert" if args.invert else "--no-invert")
-    if args.baud != 1200:
-        argv += ["--baud", str(args.baud)]
-    if args.strict:
-        argv.append("--strict")
-    return argv
+) -> PassiveJob:
+    """The passive judging's job (see :mod:`conformance.offline.passive`); ``run_role``: the
+    default role when the recording is of a run of this tool (else both)."""
+    return PassiveJob(
+        recording=str(path),
+        format=kind,
+        role=args.role or run_role or "both",
+        address=args.address,
+        channel=args.channel,
+        tx_channel=args.tx_channel,
+        sdi_version=args.sdi_version,
+        report_dir=args.report_dir,
+        invert=args.invert,
+        baud=args.baud,
+        strict=args.strict,
+    )
 
 
-def capture_replay_stopped(plan_: JudgePlan, argv: list[str]) -> str | None:
+def capture_replay_stopped(plan_: JudgePlan, document: dict | None) -> str | None:
     """Why a capture's replay stopped because the capture, not the tool, went astray (None:
     it did not). A capture comes from outside: damaged, cut, or decoded on a wrong channel or
     polarity, it stops following its run; that leaves the run incomplete (exit 2), where a
     run's own transcript.jsonl diverging is the tool's failure (exit 3)."""
-    import json
-
     from ..replay.sensor import DIVERGED
 
-    if plan_.kind == "jsonl" or "--report-dir" not in argv:
+    if plan_.kind == "jsonl" or document is None:
         return None
-    verdicts = Path(argv[argv.index("--report-dir") + 1]) / "verdicts.json"
-    try:
-        reason = json.loads(verdicts.read_text(encoding="utf-8"))["run"]["stop_reason"] or ""
-    except (OSError, ValueError, KeyError):
-        return None
+    reason = document["run"].get("stop_reason") or ""
     if DIVERGED not in reason:
         return None
     return (

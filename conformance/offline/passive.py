@@ -10,41 +10,24 @@ the worse of the two codes.
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..exits import EXIT_COMPLIANT, EXIT_USAGE
+from ..conduct import RunResult, conduct
+from ..exits import EXIT_COMPLIANT, EXIT_USAGE, exit_code
 from ..interrupts import GUARD
 from ..links.errors import PortError
 from ..protocol.commands import Kind
-from ..report_folder import new_report_dir
-from ..suite import suite_args
+from ..report_folder import run_folder
+from ..run import RunOptions
 from ..transcript import EventKind
-from .recording_link import FORMATS, recording_port
+from .job import PassiveJob
+from .recording_link import recording_port
 
 if TYPE_CHECKING:
     from rich.console import Console
 
 ROLES = ("sensor", "recorder")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """The options :func:`conformance.offline.judge.passive_argv` writes."""
-    p = argparse.ArgumentParser(prog="sdi12-conform judge (passive)")
-    p.add_argument("--recording", required=True)
-    p.add_argument("--format", choices=FORMATS, required=True)
-    p.add_argument("--role", choices=(*ROLES, "both"), default="both")
-    p.add_argument("--address")
-    p.add_argument("--channel")
-    p.add_argument("--tx-channel")
-    p.add_argument("--sdi-version")
-    p.add_argument("--report-dir")
-    p.add_argument("--invert", dest="invert", action="store_true", default=None)
-    p.add_argument("--no-invert", dest="invert", action="store_false")
-    p.add_argument("--baud", type=int, default=1200)
-    p.add_argument("--strict", action="store_true")
-    return p
 
 
 def no_traffic(port: str) -> str | None:
@@ -78,21 +61,6 @@ def error(text: str) -> None:
     Console(stderr=True, soft_wrap=True).print(text, style="red", markup=False, highlight=False)
 
 
-def exit_code(data: dict, pytest_code: int) -> int:
-    """One role's exit code from its verdicts.json, as the CLI gives a run's (``cli``
-    imports this module, so it cannot be imported from there)."""
-    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
-
-    if pytest_code in (EXIT_USAGE, EXIT_INTERNAL, EXIT_INCOMPLETE) and not data["run"]["complete"]:
-        return pytest_code  # the setup failed, the tool failed, or Ctrl-C (pytest's 2)
-    verdict = data["summary"]["verdict"]
-    if verdict == "NON-COMPLIANT":
-        return EXIT_NON_COMPLIANT
-    if verdict == "COMPLIANT":
-        return EXIT_COMPLIANT
-    return EXIT_INTERNAL if data["summary"]["counts"].get("ERROR") else EXIT_INCOMPLETE
-
-
 def forget(port: str) -> None:
     """Drop the loaded recording once judged (an in-process caller may judge many)."""
     from .fixtures import _LOADED
@@ -100,13 +68,12 @@ def forget(port: str) -> None:
     _LOADED.pop(port, None)
 
 
-def judge_passively(argv: list[str], console: Console) -> int:
-    """Judge the recording ``argv`` names; the exit code is the worse role's."""
+def judge_passively(args: PassiveJob, console: Console) -> int:
+    """Judge the recording ``args`` names; the exit code is the worse role's."""
     from ..declaration import DeclarationError, normalise_version
     from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
     from ..reports.console import print_summary
 
-    args = build_parser().parse_args(argv)
     port = recording_port(
         args.recording, args.format, channel=args.channel, tx_channel=args.tx_channel,
         invert=args.invert, baud=args.baud,
@@ -124,7 +91,7 @@ def judge_passively(argv: list[str], console: Console) -> int:
         error(f"error: {why}")
         return EXIT_USAGE
     roles = ROLES if args.role == "both" else (args.role,)
-    base = Path(args.report_dir) if args.report_dir else new_report_dir("passive")
+    base = run_folder(args.report_dir, "passive")
     console.print(
         f"judging {args.recording} passively: the rules its traffic can show "
         f"({' and '.join(roles)} rules)",
@@ -134,7 +101,8 @@ def judge_passively(argv: list[str], console: Console) -> int:
     codes = []
     for role in roles:
         report_dir = base / role if len(roles) > 1 else base
-        code, data = _run_role(role, port, report_dir, args, console)
+        result = _run_role(role, port, report_dir, args, console)
+        code, data = result.pytest_code, result.document
         codes.append(code)
         if GUARD.requested and data is None:  # Ctrl-C before this role wrote its verdicts
             forget(port)
@@ -157,20 +125,20 @@ def judge_passively(argv: list[str], console: Console) -> int:
 
 
 def _run_role(
-    role: str, port: str, report_dir: Path, args, console: Console
-) -> tuple[int, dict | None]:
-    from ..plugin import run_in_process
+    role: str, port: str, report_dir: Path, args: PassiveJob, console: Console
+) -> RunResult:
+    """One role's rules: the passive cases over the recording's port, aggregated as ``role``."""
     from ..reports.console import ProgressPlugin
 
-    argv = suite_args(role, port, report_dir)
-    argv[argv.index(f"testcases.{role}")] = "testcases.passive"
-    if args.address and role == "sensor":
-        argv += ["--sdi12-address", args.address]
-    if args.sdi_version:
-        argv += ["--sdi12-version", args.sdi_version]
-    if args.strict:
-        argv.append("--sdi12-strict")
-    return run_in_process(argv, [ProgressPlugin(console)])
+    options = RunOptions(
+        port=port,
+        role=role,
+        report_dir=str(report_dir),
+        address=args.address if role == "sensor" else None,
+        version=args.sdi_version,
+        strict=args.strict,
+    )
+    return conduct(options, cases="testcases.passive", plugins=[ProgressPlugin(console)])
 
 
 __all__ = ["EXIT_COMPLIANT", "judge_passively"]

@@ -3,9 +3,12 @@ recorder suite, compared with the requirements the fault declares (design.md 5).
 
 from __future__ import annotations
 
+from typing import Any
+
 from ..matrix import run_once
 
 
-def run_recorder_suite(port: str = "sim", extra: tuple[str, ...] = ()) -> dict:
-    """Run the recorder suite in this process against ``port``; return verdicts.json."""
-    return run_once(port, extra, role="recorder")
+def run_recorder_suite(port: str = "sim", **options: Any) -> dict:
+    """Run the recorder suite in this process against ``port``; return verdicts.json.
+    ``options``: more RunOptions fields (``version="1.3"``)."""
+    return run_once(port, role="recorder", **options)

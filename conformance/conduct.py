@@ -1,0 +1,77 @@
+"""One conformance run in this process: the entry point every caller shares.
+
+The main command, ``judge`` (replay and passive), the fault matrices and the capture round
+trip all build a :class:`~conformance.run.RunOptions` and call :func:`conduct`; the options
+reach the plugin as the object they are (no flags written out and parsed back), and the
+verdicts come back from memory (no verdicts.json read back, no subprocess).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from .exits import exit_code
+from .report_folder import run_folder
+from .run import ConformanceRun, GivenOptions, RunOptions
+from .suite import suite_args
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What one run gave: pytest's status, its folder, and the run the plugin made (None when
+    pytest stopped before the plugin could make one, e.g. a usage error)."""
+
+    pytest_code: int
+    report_dir: Path
+    run: ConformanceRun | None
+
+    @property
+    def document(self) -> dict[str, Any] | None:
+        """verdicts.json as it was written (None: the run wrote none)."""
+        return self.run.document if self.run is not None else None
+
+    @property
+    def exit_code(self) -> int | None:
+        """The run's exit status (None: no verdicts to give one from)."""
+        document = self.document
+        return None if document is None else exit_code(document, self.pytest_code)
+
+
+def conduct(
+    options: RunOptions,
+    *,
+    cases: str | None = None,
+    html: bool = True,
+    terminal: bool = False,
+    verbose: bool = False,
+    rootdir: Path | str | None = None,
+    plugins: Sequence[object] = (),
+) -> RunResult:
+    """Run the conformance cases ``cases`` (default: the role's, ``testcases.<role>``) with
+    ``options`` in this process.
+
+    ``html`` writes report.html and junit.xml beside verdicts.json; ``terminal`` keeps
+    pytest's own output (``verbose`` adds -v); ``plugins`` are more pytest plugins (the
+    console's live progress). The run's folder is made here when the options name none.
+    """
+    import pytest
+
+    report_dir = run_folder(options.report_dir, options.role)
+    options = replace(options, report_dir=str(report_dir))
+    argv = suite_args(
+        cases or f"testcases.{options.role}",
+        report_dir,
+        rootdir=rootdir,
+        html=html,
+        terminal=terminal or verbose,
+    )
+    if options.keyword:
+        argv += ["-k", options.keyword]
+    if verbose:
+        argv.append("-v")
+    given = GivenOptions(options)
+    code = int(pytest.main(argv, plugins=[*plugins, given]))
+    return RunResult(code, report_dir, given.run)
