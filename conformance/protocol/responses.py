@@ -535,6 +535,14 @@ def parse_metadata_reply(
             Violation("R-6.2-02", f"reply '{escape(body)}' carries a CRC nobody asked for")
         )
         text = text[:-ASCII_CRC_LEN]
+    fields = _metadata_fields(body, text, found)
+    return MetadataReply(address, fields, False, crc, crc_ok, found)
+
+
+def _metadata_fields(body: str, text: str, found: list[Violation]) -> list[str]:
+    """The fields of ``text`` (the reply through ';', CRC taken off), appending to ``found``
+    what is wrong with its frame and fields: kept apart from the CRC and invalid-index forms
+    :func:`parse_metadata_reply` settles first, since only a field reply gets this far."""
     content = text[1:]
     if not content.startswith(","):
         found.append(Violation("R-6.2-02", f"reply '{escape(body)}' has no ',' after the address"))
@@ -568,4 +576,4 @@ def parse_metadata_reply(
                 warning=True,
             )
         )
-    return MetadataReply(address, fields, False, crc, crc_ok, found)
+    return fields

@@ -11,7 +11,7 @@ after a long poll timeout, must not pass "implements retries")."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...protocol.timing import (
     RETRY_AFTER_BREAK,
@@ -129,124 +129,12 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
     (SHOULD) three sequences before giving up, judged only where a sequence held a retry;
     R-7.2-05 every missing or invalid reply triggered a retry; R-7.2-06 the retry waited for
     the invalid reply to end."""
-    window: list[Finding] = []
-    third: list[Finding] = []
-    ends: list[Finding] = []
-    restarted: list[str] = []  # invalid replies followed by a new sequence, not a retry
-    tally = Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05"))
+    acc = _RetryEvidence(Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05")))
     for group in retry_groups(line, uncertainty):
         if all(a.problem is None for a in group.attempts):
             continue
-        where = escape(group.text)
-        tally.observe(where, ids=["R-7.2-05"])
-        # Given up, as opposed to accepted: silence cannot be mistaken for a valid reply, and
-        # a command sent again shows the recorder found the reply invalid. A garbled reply
-        # sent once may have been accepted: that is R-7.2-05's (and R-4.4.12-07's) finding.
-        gave_up = group.attempts[-1].problem is NO_REPLY or len(group.attempts) > 1
-        real = group.real_retries(uncertainty)
-        if real:
-            tally.observe(where, ids=["R-7.2-01"])
-        elif gave_up and not any(a.retry for a in group.attempts):
-            nxt = group.attempts[1] if len(group.attempts) > 1 else None
-            first = group.attempts[0]
-            tally.fail("R-7.2-01", where, f"{first.after()}: {first.instead(nxt)}")
-        elif gave_up:
-            tally.unobservable(
-                "R-7.2-01",
-                f"{where} was sent again without a break only later than "
-                f"{RETRY_MAX * 1e3:.0f} ms after the line went quiet (R-7.2-02 judges it); "
-                "no retry inside the window was seen",
-            )
-        sequences = group.sequences()
-        for n, seq in enumerate(sequences):
-            later = sequences[n + 1][0] if n + 1 < len(sequences) else None
-            for k, a in enumerate(seq):
-                if a.problem is None:
-                    continue
-                nxt = seq[k + 1] if k + 1 < len(seq) else None
-                if nxt is None and len(seq) < 3:
-                    tally.fail(
-                        "R-7.2-05",
-                        where,
-                        f"{a.problem} at {a.sent.at()}, then "
-                        + ("a new sequence, not a retry" if later is not None else "no retry"),
-                    )
-                # "no reply" times a retry from a quiet line: sensor characters that met the
-                # command (the recorder talked over them) leave that window undecided
-                if a.problem is NO_REPLY and not a.sent.contention:
-                    if nxt is not None:
-                        window.append(
-                            judge_window(
-                                "R-7.2-02",
-                                "retry after no reply",
-                                nxt.sent.first_char - a.sent.end,
-                                uncertainty,
-                                low=RETRY_MIN,
-                                high=RETRY_MAX,
-                                evidence=[nxt.sent.at()],
-                            )
-                        )
-                    elif k == 0:
-                        window.append(
-                            Finding(
-                                "R-7.2-02",
-                                Verdict.FAIL,
-                                f"no retry without a break after no reply to {a.sent.at()}: "
-                                f"{a.instead(later)}",
-                                evidence=[a.sent.at()]
-                                + ([f"next: {later.sent.at()}"] if later is not None else []),
-                                observed=1,
-                            )
-                        )
-                elif nxt is not None and nxt.in_window(uncertainty):
-                    ends.append(_retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty))
-                elif nxt is None and later is not None:
-                    restarted.append(f"{a.after()}: {a.instead(later)}")
-            if any(a.problem is None for a in seq) or not gave_up:
-                continue
-            label = f"{where} sequence {n + 1}"
-            retries = seq[1:]
-            if len(retries) < 2:
-                third.append(
-                    Finding(
-                        "R-7.2-03",
-                        Verdict.FAIL,
-                        f"{label}: {len(retries)} retries, then no more",
-                        evidence=[a.sent.at() for a in seq],
-                        observed=len(seq),
-                    )
-                )
-                continue
-            brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
-            if brk is not None:
-                third.append(
-                    judge_window(
-                        "R-7.2-03",
-                        "latest retry after the end of the break",
-                        max(r.sent.first_char for r in retries) - brk.end,
-                        uncertainty,
-                        low=RETRY_AFTER_BREAK,
-                        evidence=[label],
-                    )
-                )
-        # R-7.2-04 is about repeating a whole break+command+retries sequence: repeats of a
-        # break and the command alone hold no retry and are no evidence for it either way
-        repeated = any(a in real for seq in sequences[:-1] for a in seq)
-        if not group.succeeded and gave_up and len(sequences) < 3:
-            tally.fail(
-                "R-7.2-04",
-                where,
-                f"gave up after {len(sequences)} break+command+retries sequence(s)",
-                warning=True,
-            )
-        elif len(sequences) > 1 and (repeated or (not group.succeeded and real)):
-            tally.observe(where, ids=["R-7.2-04"])
-        elif len(sequences) > 1:
-            tally.unobservable(
-                "R-7.2-04",
-                f"{where} was repeated {len(sequences)} times, each time a new sequence with "
-                "no retry in it: no break+command+retries sequence was seen to repeat",
-            )
+        _judge_group(line, group, uncertainty, acc)
+    tally = acc.tally
     for rid in tally.ids:
         tally.decision(rid, RETRY_DECISION)
     ok = {
@@ -257,13 +145,180 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
     }
     found = [
         *tally.findings(ok),
-        combine("R-7.2-02", window, "retry after no reply"),
-        combine("R-7.2-03", third, "unanswered sequence"),
-        _waited(ends, restarted),
+        combine("R-7.2-02", acc.window, "retry after no reply"),
+        combine("R-7.2-03", acc.third, "unanswered sequence"),
+        _waited(acc.ends, acc.restarted),
     ]
     for f in found[len(tally.ids) :]:
         f.decision = RETRY_DECISION
     return found
+
+
+@dataclass
+class _RetryEvidence:
+    """What :func:`judge_retries` gathers over all groups before combining: the tallied
+    requirements, and the findings of the ones combined from windows of their own."""
+
+    tally: Tally
+    window: list[Finding] = field(default_factory=list)  # R-7.2-02
+    third: list[Finding] = field(default_factory=list)  # R-7.2-03
+    ends: list[Finding] = field(default_factory=list)  # R-7.2-06
+    #: invalid replies followed by a new sequence, not a retry (R-7.2-06's INCONCLUSIVE)
+    restarted: list[str] = field(default_factory=list)
+
+
+def _judge_group(
+    line: TranscriptView, group: RetryGroup, uncertainty: float, acc: _RetryEvidence
+) -> None:
+    """One command's tries, at least one unanswered or invalid, into ``acc``."""
+    where = escape(group.text)
+    acc.tally.observe(where, ids=["R-7.2-05"])
+    # Given up, as opposed to accepted: silence cannot be mistaken for a valid reply, and
+    # a command sent again shows the recorder found the reply invalid. A garbled reply
+    # sent once may have been accepted: that is R-7.2-05's (and R-4.4.12-07's) finding.
+    gave_up = group.attempts[-1].problem is NO_REPLY or len(group.attempts) > 1
+    real = group.real_retries(uncertainty)
+    _judge_retried(acc.tally, group, where, real, gave_up)
+    sequences = group.sequences()
+    for n, seq in enumerate(sequences):
+        later = sequences[n + 1][0] if n + 1 < len(sequences) else None
+        _judge_tries(line, seq, later, where, uncertainty, acc)
+        if any(a.problem is None for a in seq) or not gave_up:
+            continue
+        _judge_given_up(line, seq, f"{where} sequence {n + 1}", uncertainty, acc.third)
+    _judge_repeated(acc.tally, group, where, sequences, real, gave_up)
+
+
+def _judge_retried(
+    tally: Tally, group: RetryGroup, where: str, real: list[Try], gave_up: bool
+) -> None:
+    """R-7.2-01: a PASS only from a retry inside the window, a FAIL where none was tried."""
+    if real:
+        tally.observe(where, ids=["R-7.2-01"])
+    elif gave_up and not any(a.retry for a in group.attempts):
+        nxt = group.attempts[1] if len(group.attempts) > 1 else None
+        first = group.attempts[0]
+        tally.fail("R-7.2-01", where, f"{first.after()}: {first.instead(nxt)}")
+    elif gave_up:
+        tally.unobservable(
+            "R-7.2-01",
+            f"{where} was sent again without a break only later than "
+            f"{RETRY_MAX * 1e3:.0f} ms after the line went quiet (R-7.2-02 judges it); "
+            "no retry inside the window was seen",
+        )
+
+
+def _judge_tries(
+    line: TranscriptView,
+    seq: list[Try],
+    later: Try | None,
+    where: str,
+    uncertainty: float,
+    acc: _RetryEvidence,
+) -> None:
+    """R-7.2-05, R-7.2-02 and R-7.2-06 over the failed tries of one sequence; ``later``:
+    the first try of the next sequence, if any."""
+    for k, a in enumerate(seq):
+        if a.problem is None:
+            continue
+        nxt = seq[k + 1] if k + 1 < len(seq) else None
+        if nxt is None and len(seq) < 3:
+            acc.tally.fail(
+                "R-7.2-05",
+                where,
+                f"{a.problem} at {a.sent.at()}, then "
+                + ("a new sequence, not a retry" if later is not None else "no retry"),
+            )
+        # "no reply" times a retry from a quiet line: sensor characters that met the
+        # command (the recorder talked over them) leave that window undecided
+        if a.problem is NO_REPLY and not a.sent.contention:
+            if nxt is not None:
+                acc.window.append(
+                    judge_window(
+                        "R-7.2-02",
+                        "retry after no reply",
+                        nxt.sent.first_char - a.sent.end,
+                        uncertainty,
+                        low=RETRY_MIN,
+                        high=RETRY_MAX,
+                        evidence=[nxt.sent.at()],
+                    )
+                )
+            elif k == 0:
+                acc.window.append(
+                    Finding(
+                        "R-7.2-02",
+                        Verdict.FAIL,
+                        f"no retry without a break after no reply to {a.sent.at()}: "
+                        f"{a.instead(later)}",
+                        evidence=[a.sent.at()]
+                        + ([f"next: {later.sent.at()}"] if later is not None else []),
+                        observed=1,
+                    )
+                )
+        elif nxt is not None and nxt.in_window(uncertainty):
+            acc.ends.append(_retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty))
+        elif nxt is None and later is not None:
+            acc.restarted.append(f"{a.after()}: {a.instead(later)}")
+
+
+def _judge_given_up(
+    line: TranscriptView, seq: list[Try], label: str, uncertainty: float, third: list[Finding]
+) -> None:
+    """R-7.2-03 over a sequence that never drew a valid reply: two retries, the latest more
+    than 100 ms after the break."""
+    retries = seq[1:]
+    if len(retries) < 2:
+        third.append(
+            Finding(
+                "R-7.2-03",
+                Verdict.FAIL,
+                f"{label}: {len(retries)} retries, then no more",
+                evidence=[a.sent.at() for a in seq],
+                observed=len(seq),
+            )
+        )
+        return
+    brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
+    if brk is not None:
+        third.append(
+            judge_window(
+                "R-7.2-03",
+                "latest retry after the end of the break",
+                max(r.sent.first_char for r in retries) - brk.end,
+                uncertainty,
+                low=RETRY_AFTER_BREAK,
+                evidence=[label],
+            )
+        )
+
+
+def _judge_repeated(
+    tally: Tally,
+    group: RetryGroup,
+    where: str,
+    sequences: list[list[Try]],
+    real: list[Try],
+    gave_up: bool,
+) -> None:
+    """R-7.2-04 is about repeating a whole break+command+retries sequence: repeats of a
+    break and the command alone hold no retry and are no evidence for it either way."""
+    repeated = any(a in real for seq in sequences[:-1] for a in seq)
+    if not group.succeeded and gave_up and len(sequences) < 3:
+        tally.fail(
+            "R-7.2-04",
+            where,
+            f"gave up after {len(sequences)} break+command+retries sequence(s)",
+            warning=True,
+        )
+    elif len(sequences) > 1 and (repeated or (not group.succeeded and real)):
+        tally.observe(where, ids=["R-7.2-04"])
+    elif len(sequences) > 1:
+        tally.unobservable(
+            "R-7.2-04",
+            f"{where} was repeated {len(sequences)} times, each time a new sequence with "
+            "no retry in it: no break+command+retries sequence was seen to repeat",
+        )
 
 
 def _waited(ends: list[Finding], restarted: list[str]) -> Finding:
