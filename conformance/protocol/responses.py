@@ -43,6 +43,7 @@ __all__ = [
     "check_address",
     "check_address_reply",
     "check_change_address_reply",
+    "service_request",
     "is_service_request",
     "Identification",
     "parse_ident",
@@ -146,6 +147,11 @@ def check_change_address_reply(body: str, old: str, new: str) -> list[Violation]
             )
         )
     return found
+
+
+def service_request(address: str) -> str:
+    """The service request sensor ``address`` sends, CR LF included (R-4.4.6-01)."""
+    return address + CRLF
 
 
 def is_service_request(body: str, address: str) -> bool:
