@@ -34,6 +34,7 @@ from conformance.protocol.values import (
     errors,
     split_values,
 )
+from conformance.protocol.version import V13
 from conformance.transcript import escape
 
 __all__ = [
@@ -286,7 +287,7 @@ def check_measurement_count(
             found.append(
                 Violation("R-4.4.7-02", f"{command} announced zero values instead of measuring")
             )
-    if target.kind is Kind.CONCURRENT and reply.count > 20 and version == "13":
+    if target.kind is Kind.CONCURRENT and reply.count > 20 and version == V13:
         found.append(
             Violation(
                 "R-4.4.7-03",
