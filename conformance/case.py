@@ -14,6 +14,7 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
 from .catalog import requirement
+from .protocol.version import format_version
 from .results import CaseRecord
 from .tool_recorder.records import Exchange, Measurement
 from .transcript import Event
@@ -112,7 +113,7 @@ class Case:
         if version and not requirement(f.requirement).applies_to_version(version):
             return not_applicable(
                 f.requirement,
-                f"rule binds SDI-12 v1.4 only; the DUT claims v{version[0]}.{version[1]}",
+                f"rule binds SDI-12 v1.4 only; the DUT claims v{format_version(version)}",
                 test=self.record.nodeid,
             )
         return f
@@ -132,7 +133,7 @@ class Case:
             elif version and not requirement(f.requirement).applies_to_version(version):
                 f = not_applicable(
                     f.requirement,
-                    f"rule binds SDI-12 v1.4 only; the DUT claims v{version[0]}.{version[1]}",
+                    f"rule binds SDI-12 v1.4 only; the DUT claims v{format_version(version)}",
                     test=self.record.nodeid,
                 )
             elif f.requirement in self._blocked and f.verdict in _voided(

@@ -19,6 +19,8 @@ from functools import cache
 from importlib.resources import files
 from typing import Any
 
+from .protocol.version import format_version
+
 __all__ = [
     "CHECK_KINDS",
     "LEVELS",
@@ -76,7 +78,7 @@ def _normalise_version(version: str) -> str:
     """
     text = version.strip()
     if len(text) == 2 and text.isdigit():
-        text = f"{text[0]}.{text[1]}"
+        text = format_version(text)
     if text not in VERSIONS:
         raise ValueError(
             f"SDI-12 version {version!r} is not covered by the catalog "

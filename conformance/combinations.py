@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 from .emulator.faults.interactions import INTERACTIONS, Interaction
 from .matrix import BAD, run_once, run_rows
+from .protocol.version import V14, format_version
 
 #: the seed CI and the CLI use unless told otherwise
 DEFAULT_SEED = 18
@@ -66,7 +67,7 @@ class ComboRow:
 def version_of(name: str) -> str:
     from .emulator import FAULTS
 
-    return getattr(FAULTS[name], "version", None) or "14"
+    return getattr(FAULTS[name], "version", None) or V14
 
 
 def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[str, ...]]:
@@ -131,7 +132,7 @@ def check(
 
 def combo_port(faults: tuple[str, ...]) -> str:
     version = version_of(faults[0])
-    return f"sim://?faults={','.join(faults)}&version={version[0]}.{version[1:]}"
+    return f"sim://?faults={','.join(faults)}&version={format_version(version)}"
 
 
 def declared_for(faults: Iterable[str]) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .protocol.commands import ADDRESS_CHARS
+from .protocol.version import parse_version
 
 ALLOWED_ADDRESSES = "0-9, A-Z, a-z"
 FEATURES = ("address_change", "continuous", "high_volume_ascii", "high_volume_binary")
@@ -149,8 +150,8 @@ class Declaration:
 
 def normalise_version(text: str) -> str:
     """``"1.4"``, ``"14"`` -> ``"14"``; raises DeclarationError for anything else."""
-    digits = text.replace(".", "").strip()
-    if digits not in ("13", "14"):
+    digits = parse_version(text)
+    if digits is None:
         raise DeclarationError(f"unsupported SDI-12 version {text!r} (use 1.3 or 1.4)")
     return digits
 

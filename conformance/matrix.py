@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from .conduct import conduct
+from .protocol.version import V14, format_version
 from .run import RunOptions
 
 ItemT = TypeVar("ItemT")
@@ -147,7 +148,7 @@ Item = tuple[str, tuple[str, ...], str, tuple[tuple[str, Any], ...]]
 
 def fault_port(item: Item) -> str:
     fault, _, version, _ = item
-    return f"sim://?faults={fault}&version={version[0]}.{version[1:]}"  # "13" is version=1.3
+    return f"sim://?faults={fault}&version={format_version(version)}"  # "13" is version=1.3
 
 
 def fault_row(item: Item, data: dict) -> MatrixRow:
@@ -175,7 +176,7 @@ def fault_matrix(
 
     names = faults or sorted(FAULTS)
     items = [
-        (n, tuple(FAULTS[n].violates), getattr(FAULTS[n], "version", None) or "14", ())
+        (n, tuple(FAULTS[n].violates), getattr(FAULTS[n], "version", None) or V14, ())
         for n in names
     ]
     return run_rows(items, row, processes, progress)

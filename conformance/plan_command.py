@@ -21,6 +21,7 @@ from .declaration import DeclarationError, load_declaration, normalise_version
 from .emulator.declared import assumptions
 from .exits import EXIT_OK, EXIT_USAGE, say_error
 from .options import ROLES
+from .protocol.version import format_version
 from .reports.plan import build_plan, plan_html, plan_markdown
 
 FORMATS = ("markdown", "html", "json")
@@ -52,12 +53,12 @@ def plan_parser() -> argparse.ArgumentParser:
 def dry_port(role: str, declaration: str | None, version: str | None) -> str:
     """The simulated device the dry run uses."""
     if role == "recorder":
-        return "sim" if version is None else f"sim://?version={version[0]}.{version[1]}"
+        return "sim" if version is None else f"sim://?version={format_version(version)}"
     query = []
     if declaration:
         query.append(f"declaration={quote(str(Path(declaration).resolve()))}")
     if version:
-        query.append(f"version={version[0]}.{version[1]}")
+        query.append(f"version={format_version(version)}")
     return "sim://?" + "&".join(query) if query else "sim"
 
 
@@ -133,7 +134,7 @@ def make_plan(
     options = {
         # the recorder role reads its sdi12_version and [recorder] table
         "declaration": str(Path(declaration).resolve()) if declaration else None,
-        "version": f"{digits[0]}.{digits[1]}" if digits else None,
+        "version": format_version(digits) if digits else None,
         "keyword": keyword or None,
         "requirements": tuple(reqs),
     }

@@ -25,6 +25,7 @@ from .links.errors import PortError
 from .links.registry import LinkKind, OpenedPort, PortOptions, find, register
 from .offline import recording_link
 from .protocol.commands import ADDRESS_CHARS
+from .protocol.version import V14, format_version, parse_version
 from .replay.link import is_replay
 from .suggest import did_you_mean
 
@@ -38,7 +39,7 @@ BUILTIN_KINDS = (factory, adapter_link, harness_device, recording_link)
 class SimSpec:
     faults: tuple[str, ...] = ()
     profiles: tuple[str, ...] = ()  # firmware profiles (conformance.emulator.profiles)
-    version: str = "14"
+    version: str = V14
     address: str = "0"
     extra: dict[str, str] = field(default_factory=dict)
     #: a declaration file: the simulated sensor plays what it declares (sdi12-conform plan)
@@ -60,9 +61,10 @@ def parse_sim(port: str) -> SimSpec:
         spec.profiles = tuple(p.strip() for p in params.pop("profile").split(",") if p.strip())
     if "version" in params:
         given = params.pop("version").strip()
-        if given not in ("1.3", "1.4"):
+        digits = parse_version(given)
+        if digits is None or given != format_version(digits):  # dotted only: 1.3 or 1.4
             raise PortError(f"sim version must be 1.3 or 1.4, not {given!r}")
-        spec.version = given.replace(".", "")
+        spec.version = digits
     if "address" in params:
         spec.address = params.pop("address")
     if "declaration" in params:

@@ -18,6 +18,7 @@ from .judges.timing import recheck, undecide_after_late_line
 from .links.base import Link, LinkError
 from .options import run_option_values
 from .ports import is_sim, open_port
+from .protocol.version import V14
 from .recorder.session import RecorderSession, driver_for
 from .replay.recording import options_note
 from .report_folder import run_folder
@@ -152,7 +153,7 @@ class ConformanceRun:
         if self.session is None:
             opts = self.options
             declared = self.declaration.sdi12_version if self.declaration else None
-            version = normalise_version(opts.version) if opts.version else declared or "14"
+            version = normalise_version(opts.version) if opts.version else declared or V14
             driver = driver_for(opts.trigger)
             uncertainty = opts.timing_uncertainty_ms
             self.session = RecorderSession(

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from .protocol.version import VERSIONS, format_version, parse_version
+
 SHOWN = 6  # requirement IDs named before "..."
 
 
@@ -41,13 +43,13 @@ def version_mismatch(data: dict[str, Any], forced: str | None) -> str | None:
         return None
     ident = (data["dut"].get("identification") or "").strip()
     reported = ident[1:3]
-    if len(ident) < 3 or reported not in ("13", "14"):
+    if len(ident) < 3 or reported not in VERSIONS:
         return None
-    wanted = forced.replace(".", "")
-    if wanted == reported:
+    wanted = parse_version(forced)
+    if wanted is None or wanted == reported:
         return None
     return (
-        f"--sdi-version {forced} judged the device by the v{wanted[0]}.{wanted[1]} rules, but "
-        f"its aI! reports v{reported[0]}.{reported[1]} ({ident!r}): a FAIL on a "
-        f"v{wanted[0]}.{wanted[1]}-only rule may be a rule the device never claimed"
+        f"--sdi-version {forced} judged the device by the v{format_version(wanted)} rules, but "
+        f"its aI! reports v{format_version(reported)} ({ident!r}): a FAIL on a "
+        f"v{format_version(wanted)}-only rule may be a rule the device never claimed"
     )

@@ -9,8 +9,7 @@ import time
 import pytest
 
 from conformance.emulator import default_profile, sim_sensor
-from conformance.protocol.commands import parse_command
-from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
+from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY, parse_command
 from conformance.tool_recorder import Master
 
 SINGLE = (

@@ -15,6 +15,7 @@ from dataclasses import replace
 
 from ..declaration import Declaration
 from ..protocol.values import format_value
+from ..protocol.version import V14
 from .profile import MeasurementSpec, Profile, default_profile
 
 #: families a declared feature removes when it is false
@@ -42,7 +43,7 @@ def _ready(ttt: int) -> float | None:
 
 def declared_profile(declaration: Declaration, version: str | None = None) -> Profile:
     """The reference profile as ``declaration`` describes it (``version`` overrides it)."""
-    chosen = version or declaration.sdi12_version or "14"
+    chosen = version or declaration.sdi12_version or V14
     base = default_profile(chosen)
     measurements = dict(base.measurements)
     for feature, codes in _FAMILIES.items():

@@ -19,6 +19,7 @@ from types import MappingProxyType
 from ..protocol.binary import DataType
 from ..protocol.commands import ADDRESS_CHARS, Command
 from ..protocol.values import format_value
+from ..protocol.version import V13, V14, VERSIONS
 
 Number = int | float
 
@@ -97,7 +98,7 @@ class Profile:
     """A sensor: identification fields (R-4.4.2-01 widths), measurements and options."""
 
     address: str = "0"
-    version: str = "14"
+    version: str = V14
     vendor: str = "CONFORM "
     model: str = "EMU001"
     sensor_version: str = "100"
@@ -110,7 +111,7 @@ class Profile:
     def __post_init__(self) -> None:
         if self.address not in ADDRESS_CHARS:
             raise ValueError(f"bad address {self.address!r}")
-        if self.version not in ("13", "14"):
+        if self.version not in VERSIONS:
             raise ValueError(f"version must be '13' or '14', not {self.version!r}")
         widths = (("vendor", 8), ("model", 6), ("sensor_version", 3))
         for name, width in widths:
@@ -123,7 +124,7 @@ class Profile:
 
     @property
     def v14(self) -> bool:
-        return self.version == "14"
+        return self.version == V14
 
     def spec_for(self, command: Command) -> MeasurementSpec | None:
         """The spec behind ``command`` (its CRC twin's if the CRC key is not defined)."""
@@ -247,7 +248,7 @@ EXTENDED = {
 }
 
 
-def default_profile(version: str = "14") -> Profile:
+def default_profile(version: str = V14) -> Profile:
     """The built-in sensor: every command family of ``version`` with realistic values.
 
     v1.4: M (3 values, SR after 1.5 s of ttt 2), M1 (ttt 0), M2 (D0..D2), V, C (20 values),
@@ -255,11 +256,11 @@ def default_profile(version: str = "14") -> Profile:
     every data type), metadata for every value and one extended command ``aXSN!``.
     v1.3: identification ``13``, no high-volume or metadata, concurrent counts of 20 and less.
     """
-    if version == "14":
+    if version == V14:
         measurements = _v14_measurements()
-    elif version == "13":
+    elif version == V13:
         measurements = _v13_measurements()
     else:
         raise ValueError(f"no default profile for version {version!r}")
-    extended = dict(EXTENDED) if version == "14" else {"XSN": EXTENDED["XSN"]}
+    extended = dict(EXTENDED) if version == V14 else {"XSN": EXTENDED["XSN"]}
     return Profile(version=version, measurements=measurements, extended=extended)

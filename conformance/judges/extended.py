@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..protocol.framing import ETX
+from ..protocol.framing import ETX, LF
 from ..protocol.timing import MULTILINE_GAP_MAX
 from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
@@ -11,7 +11,6 @@ from ..verdicts import Finding
 from .tally import Tally
 from .timing import judge_window
 
-LF = ord("\n")
 LINE_MAX = VALUES_MAX  # a multi-line text line is held to the longest reply's values part
 
 

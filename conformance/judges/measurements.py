@@ -16,6 +16,7 @@ from ..protocol.responses import (
     expected_value_limit,
     parse_data_reply_for,
     parse_measurement_reply_for,
+    service_request,
     split_line,
 )
 from ..protocol.timing import TOLERANCE
@@ -60,7 +61,7 @@ def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
     """Index of the service request: the first run that is exactly ``a<CR><LF>``, else the
     first run shaped like one (address ... CR LF), which R-4.4.6-01 then judges malformed."""
     texts = [decode_7e1(run) for run in runs_]
-    exact = next((i for i, t in enumerate(texts) if t == f"{address}\r\n"), None)
+    exact = next((i for i, t in enumerate(texts) if t == service_request(address)), None)
     if exact is not None:
         return exact
     return next(
@@ -102,7 +103,7 @@ def wait_violations(m: Measurement, tally: Tally) -> None:
         if sr is not None and m.reply_end is not None:
             text = decode_7e1(chunks[sr])
             tally.observe(label, ids=["R-4.4.6-01", "R-4.4.6-04", "R-4.4.5-09"])
-            if text != f"{address}\r\n":
+            if text != service_request(address):
                 tally.fail(
                     "R-4.4.6-01",
                     label,

@@ -22,6 +22,7 @@ from ..protocol.commands import (
     Kind,
     parse_command,
 )
+from ..protocol.framing import STX
 from ..protocol.responses import (
     check_address,
     is_service_request,
@@ -34,8 +35,6 @@ from ..protocol.timing import CHAR_TIME, RESPONSE_START_MAX, TOLERANCE
 from ..transcript import Event
 from ..verdicts import Verdict
 from ..view.sides import expected_reply_address
-
-STX = "\x02"
 
 
 @dataclass(frozen=True)
@@ -95,7 +94,7 @@ def reply_flags(text: str, ctx: Context, events: list[Event]) -> list[Flag]:
         flags += _timing_flags(ctx.command_last, events[0])
     first_line = not ctx.answered
     ctx.answered = True
-    if not first_line or not ctx.command_text or len(text) > 1 and text[1] == STX:
+    if not first_line or not ctx.command_text or len(text) > 1 and text[1] == chr(STX):
         return flags  # a later line (multi-line text, a service request): framing only
     command = _parse(ctx.command_text)
     if command is None:

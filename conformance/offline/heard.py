@@ -18,6 +18,7 @@ from ..preconditions import NOT_SEEN as _NOT_SEEN
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
 from ..protocol.responses import Identification
 from ..protocol.values import split_values
+from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
 from ..view.records import rebuild_records
@@ -88,13 +89,13 @@ class Heard:
         """The rule set: --sdi-version > the ``ll`` of an ``aI!`` reply seen > v1.4 (said)."""
         if self.forced_version:
             return self.forced_version
-        if self.identity is not None and self.identity.version in ("13", "14"):
+        if self.identity is not None and self.identity.version in VERSIONS:
             return self.identity.version
-        return "14"
+        return V14
 
     @property
     def is_v14(self) -> bool:
-        return self.version >= "14"
+        return is_v14(self.version)
 
 
 @dataclass
@@ -215,18 +216,18 @@ def _identify(heard: HeardSensors) -> None:
     for ex in heard.exchanges_of(Kind.IDENTIFY):
         if ex.answered and ex.command is not None:
             ident, _ = identification(ex, ex.command.address)
-            if ident is not None and ident.version in ("13", "14"):
+            if ident is not None and ident.version in VERSIONS:
                 heard.identity, heard.ident_exchange = ident, ex
                 heard.address = heard.address or ex.command.address
                 break
     if heard.forced_version:
-        heard.assumptions.append(f"rule set v{heard.version[0]}.{heard.version[1]} (--sdi-version)")
+        heard.assumptions.append(f"rule set v{format_version(heard.version)} (--sdi-version)")
     elif heard.identity is None:
         heard.assumptions.append("no aI! reply with a usable version seen; judging against v1.4")
     else:
         v = heard.identity.version
         heard.assumptions.append(
-            f"rule set v{v[0]}.{v[1]} from the aI! reply of sensor {heard.address!r}"
+            f"rule set v{format_version(v)} from the aI! reply of sensor {heard.address!r}"
         )
 
 

@@ -46,6 +46,12 @@ MEASUREMENT_KINDS = frozenset(
 SERVICE_REQUEST_KINDS = frozenset({Kind.MEASURE, Kind.VERIFY})
 #: Measurements that run concurrently: no service request, not aborted by a break (R-4.4.7-05).
 CONCURRENT_KINDS = frozenset({Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
+#: The command codes (after the address) of every measurement the suite asks of a sensor:
+#: the M family with V, the C family, high volume, and continuous measurements.
+M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in range(1, 10)), "V")
+C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
+HV_FAMILY = ("HA", "HB")
+CONTINUOUS = (*(f"RC{i}" for i in range(10)), *(f"R{i}" for i in range(10)))
 #: Kinds that an identify-measurement or metadata command may describe.
 DESCRIBABLE_KINDS = MEASUREMENT_KINDS | {Kind.CONTINUOUS}
 #: High-volume measurements (section 5): their replies always carry a CRC (R-5.1-03,

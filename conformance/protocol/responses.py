@@ -34,6 +34,7 @@ from conformance.protocol.values import (
     errors,
     split_values,
 )
+from conformance.protocol.version import V13
 from conformance.transcript import escape
 
 __all__ = [
@@ -43,6 +44,7 @@ __all__ = [
     "check_address",
     "check_address_reply",
     "check_change_address_reply",
+    "service_request",
     "is_service_request",
     "Identification",
     "parse_ident",
@@ -146,6 +148,11 @@ def check_change_address_reply(body: str, old: str, new: str) -> list[Violation]
             )
         )
     return found
+
+
+def service_request(address: str) -> str:
+    """The service request sensor ``address`` sends, CR LF included (R-4.4.6-01)."""
+    return address + CRLF
 
 
 def is_service_request(body: str, address: str) -> bool:
@@ -280,7 +287,7 @@ def check_measurement_count(
             found.append(
                 Violation("R-4.4.7-02", f"{command} announced zero values instead of measuring")
             )
-    if target.kind is Kind.CONCURRENT and reply.count > 20 and version == "13":
+    if target.kind is Kind.CONCURRENT and reply.count > 20 and version == V13:
         found.append(
             Violation(
                 "R-4.4.7-03",

@@ -40,6 +40,7 @@ from dataclasses import dataclass, replace
 from ..catalog import requirement
 from ..declaration import Declaration, RecorderDeclaration
 from ..protocol.commands import Command, CommandError, Kind, parse_command
+from ..protocol.version import format_version, is_v14
 from ..transcript import Event, EventKind
 from ..verdicts import Finding, Verdict
 from .request import Request
@@ -139,7 +140,7 @@ class Capabilities:
     def __init__(self, declaration: Declaration | None, version: str) -> None:
         self.source = declaration.source if declaration is not None else None
         self.declared: RecorderDeclaration | None = declaration.recorder if declaration else None
-        self.v14 = version >= "14"
+        self.v14 = is_v14(version)
         #: token -> where the declaration rules it out
         self.absent_tokens: dict[str, str] = {}
         rec = self.declared
@@ -304,7 +305,7 @@ def cannot_finding(
     ``findings``). A FAIL, resting on the recorder's own words, when ``rid`` is a rule that
     requires the job's commands of a recorder of this version (R-4.4-02 for aM!, R-4.3-03
     for the addresses 0-9...). Any other rule: None, judged on what the case saw."""
-    v14 = version >= "14"
+    v14 = is_v14(version)
     mandatory, optional_rules = job_rules(commands, v14)
     level = requirement(rid).level
     said = f"the recorder said it cannot do {job}" + (f" ({words})" if words else "")
@@ -322,7 +323,7 @@ def cannot_finding(
     return Finding(
         rid,
         verdict,
-        f"{said}, but {rid} ({level}) requires a v{version[0]}.{version[1]} recorder to send "
+        f"{said}, but {rid} ({level}) requires a v{format_version(version)} recorder to send "
         f"{needed}",
         evidence=[said],
         observed=1,

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 from ..links.base import Link
 from ..protocol.commands import Command, Kind, parse_command
+from ..protocol.responses import service_request
 from ..sim.bus import SimBus
 from ..tool_recorder import Master, Measurement, Policy
 from ..tool_recorder.engine import _service_request_end
@@ -447,7 +448,7 @@ def _last_concurrent_lost(command: Command, values: list[str]) -> list[str]:
 
 
 def _is_service_request(events: list, address: str) -> bool:
-    return decode_7e1(events[-3:]) == f"{address}\r\n"
+    return decode_7e1(events[-3:]) == service_request(address)
 
 
 def _with_master(cls: type[Master]) -> Callable[[Link, Policy], Master]:

@@ -18,6 +18,7 @@ from ..emulator import MeasurementSpec, Profile, SensorEmulator, default_profile
 from ..emulator.behaviour import REPLY_DELAY
 from ..protocol.commands import CommandError, parse_command
 from ..protocol.timing import PARTIAL_COMMAND_GAP, TOLERANCE
+from ..protocol.version import V14, format_version
 from ..sim.bus import Frame
 from ..transcript import to_wire_7e1
 
@@ -32,7 +33,7 @@ def _ready(spec: MeasurementSpec, ttt: int, ready_after: float) -> MeasurementSp
     return replace(spec, ttt=ttt, ready_after=ready_after)
 
 
-def played_profile(address: str = "0", version: str = "14") -> Profile:
+def played_profile(address: str = "0", version: str = V14) -> Profile:
     """The reference sensor, tuned for judging recorders.
 
     Data are ready (and the service request of M/V sent) well before half of ttt, so a
@@ -230,7 +231,7 @@ class SensorSpec:
     spoil_command: str = ""
     spoil_times: int = 1
     aborts_once: bool = False
-    version: str = "14"
+    version: str = V14
     reply_extra: float = 0.0
     wake_extra: float = 0.0
     #: ``(measurement key, ttt, ready_after)`` overrides of :func:`played_profile`'s timing
@@ -238,7 +239,7 @@ class SensorSpec:
     timing: tuple[tuple[str, int, float], ...] = ()
 
     def describe(self) -> str:
-        parts = [f"sensor at {self.address!r} (v{self.version[0]}.{self.version[1]})"]
+        parts = [f"sensor at {self.address!r} (v{format_version(self.version)})"]
         if self.faults:
             parts.append("faults " + ",".join(self.faults))
         if self.unheard:

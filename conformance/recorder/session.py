@@ -28,6 +28,7 @@ from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
 from ..links.base import Link, LinkError, LinkInfo
 from ..ports import PortError, SimSpec, is_sim, parse_sim
+from ..protocol.version import V14, format_version, is_v14
 from ..replay.link import is_replay, open_recorder_replay, replayed_info
 from ..replay.recorder import RecordedRecorder, output_note
 from ..replay.recording import RecordingError
@@ -126,7 +127,7 @@ class RecorderSession:
         self,
         port: str,
         *,
-        version: str = "14",
+        version: str = V14,
         driver: Driver | None = None,
         timing_uncertainty: float | None = None,
         declaration: Declaration | None = None,
@@ -202,7 +203,7 @@ class RecorderSession:
         self.ident_exchange = None
         self.address_notes: list[str] = []  # the recorder role changes no DUT address
         self.assumptions = [
-            f"recorder claims SDI-12 v{version[0]}.{version[1]}",
+            f"recorder claims SDI-12 v{format_version(version)}",
             f"recorder driven {driver.kind}"
             + (f" (golden recorder with fault {faults[0]})" if faults else ""),
         ]
@@ -215,7 +216,7 @@ class RecorderSession:
 
     @property
     def is_v14(self) -> bool:
-        return self.version >= "14"
+        return is_v14(self.version)
 
     def is_recorder(self, event: Event) -> bool:
         return event.origin in self.recorder_origins

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..links.bus_time import bus_time
+from ..protocol.version import format_version
 from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL, ConformanceRun
@@ -35,7 +36,7 @@ def dut_block(run: ConformanceRun) -> dict[str, Any]:
     return {
         "address": session.address if session else run.options.address,
         "identification": raw,
-        "sdi12_version": f"{version[0]}.{version[1]}" if version else None,
+        "sdi12_version": format_version(version) if version else None,
         "vendor": ident.vendor if ident else None,
         "model": ident.model if ident else None,
         "firmware": ident.sensor_version if ident else None,

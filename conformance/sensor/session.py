@@ -16,8 +16,17 @@ from ..declaration import Declaration
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
 from ..protocol import commands as cmd
-from ..protocol.commands import Command, CommandError, Kind, parse_command
+from ..protocol.commands import (
+    C_FAMILY,
+    CONTINUOUS,
+    M_FAMILY,
+    Command,
+    CommandError,
+    Kind,
+    parse_command,
+)
 from ..protocol.responses import Identification, parse_ident, split_line
+from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, escape
 from ..view.records import Rebuilt, rebuild_records
@@ -175,8 +184,7 @@ class SensorSession:
             self.probe_bench()
         if self.forced_version:
             self.assumptions.append(
-                f"rule set v{self.forced_version[0]}.{self.forced_version[1]} "
-                "forced by the user/declaration"
+                f"rule set v{format_version(self.forced_version)} forced by the user/declaration"
             )
 
     def _find_a_way_in(self) -> bool:
@@ -249,16 +257,16 @@ class SensorSession:
         """The rule set: forced > the ``ll`` of ``aI!`` > v1.4 (newest) as an assumption."""
         if self.forced_version:
             return self.forced_version
-        if self.identity and self.identity.version in ("13", "14"):
+        if self.identity and self.identity.version in VERSIONS:
             return self.identity.version
         if "version" not in self._cache:
             self._cache["version"] = True
             self.assumptions.append("aI! gave no usable version; judging against v1.4")
-        return "14"
+        return V14
 
     @property
     def is_v14(self) -> bool:
-        return self.version >= "14"
+        return is_v14(self.version)
 
     # -- cached stimuli ------------------------------------------------------------------------
     def once(self, key: Any, make: Callable[[], T]) -> T:
@@ -600,13 +608,6 @@ class SensorSession:
     def supports(self, code: str) -> bool:
         """Whether ``aHA!``/``aHB!`` (or a numbered group) announces values at all."""
         return bool(self.measurement(code).count)
-
-
-# -- what the suite asks of every sensor -------------------------------------------------------
-M_FAMILY = ("M", "MC", *(f"M{i}" for i in range(1, 10)), *(f"MC{i}" for i in range(1, 10)), "V")
-C_FAMILY = ("C", "CC", *(f"C{i}" for i in range(1, 10)), *(f"CC{i}" for i in range(1, 10)))
-HV_FAMILY = ("HA", "HB")
-CONTINUOUS = (*(f"RC{i}" for i in range(10)), *(f"R{i}" for i in range(10)))
 
 
 def _exchange_reading(ex: Exchange) -> tuple[Any, ...]:

@@ -25,6 +25,7 @@ from ..protocol.commands import (
     CommandError,
     Kind,
 )
+from ..protocol.responses import service_request
 from ..protocol.timing import (
     CHAR_TIME,
     NO_BREAK_WINDOW,
@@ -544,7 +545,7 @@ def _raises_sr(command: Command) -> bool:
 
 def _service_request_end(events: list[Event], address: str) -> float | None:
     """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
-    return text_end(events, f"{address}\r\n")
+    return text_end(events, service_request(address))
 
 
 #: Events before the last look that a collision scan takes again, so a transmission whose

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, Kind, parse_command
+from ..protocol.framing import STX
 from ..protocol.responses import parse_measurement_reply_for, split_line
 from ..protocol.timing import (
     MULTILINE_GAP_MAX,
@@ -28,7 +29,7 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..transcript import Event, EventKind, decode_7e1, decode_8n1, escape
-from .sides import RECORDER, SENSOR, STX, expected_reply_address
+from .sides import RECORDER, SENSOR, expected_reply_address
 
 #: How long past an announced ttt a service request is still read as one (a late one is a
 #: finding on the sensor, not a reason to doubt who sent it).

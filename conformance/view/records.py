@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from ..protocol.binary import packet_length
 from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, Kind
 from ..protocol.framing import ETX, STX
-from ..protocol.responses import parse_measurement_reply_for, split_line
+from ..protocol.responses import parse_measurement_reply_for, service_request, split_line
 from ..protocol.timing import CHAR_TIME, TOLERANCE
 from ..tool_recorder import validity
 from ..tool_recorder.engine import take_values
@@ -152,7 +152,7 @@ def _measurements(
         m.reply_end = ex.reply_events[-1].end
         if m.ttt > 0:
             m.waited_events = _waited(m, source[id(ex.last)], policy)
-            m.service_request_end = text_end(m.waited_events, f"{command.address}\r\n")
+            m.service_request_end = text_end(m.waited_events, service_request(command.address))
         probed_past_empty = False
         for later in exchanges[i + 1 :]:
             if not _collects(later, m) or m.value_count >= m.count:
@@ -182,7 +182,7 @@ def _waited(m: Measurement, t: Transmission, policy: Policy) -> list[Event]:
             if e.end > deadline:
                 break
             waited.append(e)
-            if text_end(waited, f"{m.command.address}\r\n") is not None:
+            if text_end(waited, service_request(m.command.address)) is not None:
                 break
         return waited
     deadline = m.reply_end + m.ttt + policy.ttt_margin

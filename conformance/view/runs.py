@@ -21,10 +21,10 @@ from typing import TypeVar
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
+from ..protocol.framing import ETX, LF, STX
 from ..protocol.timing import NO_BREAK_WINDOW
 from ..transcript import Event, Transcript, decode_8n1
 from .segments import IsRecorder, Transmission, _memo, read_view
-from .sides import ETX, LF, STX
 
 T = TypeVar("T")
 

@@ -26,6 +26,7 @@ from typing import TypeVar
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, parse_command
+from ..protocol.framing import ETX, LF, STX
 from ..protocol.timing import (
     INTER_CHAR_GAP_MAX,
     MARKING_AFTER_BREAK,
@@ -34,7 +35,7 @@ from ..protocol.timing import (
 )
 from ..transcript import COLLISION, TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
 from .direction import infer_directions
-from .sides import BUS, ETX, LF, RECORDER, STX, expected_reply_address
+from .sides import BUS, RECORDER, expected_reply_address
 
 IsRecorder = Callable[[Event], bool]
 

@@ -11,8 +11,6 @@ from ..transcript import BUS  # noqa: F401 - re-exported: the view names the sid
 #: tool plays: transcript origins ``tool``/``dut`` say who was on the tool's link, not that).
 RECORDER, SENSOR = "recorder", "sensor"
 
-STX, ETX, LF = 0x02, 0x03, 0x0A
-
 
 def expected_reply_address(text: str) -> str | None:
     """The address a reply to the command ``text`` must start with (None: any address: the

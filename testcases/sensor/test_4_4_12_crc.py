@@ -8,7 +8,7 @@ from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
 from conformance.judges.support import serves_continuous
-from conformance.sensor.session import C_FAMILY, M_FAMILY
+from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.verdicts import Finding, passed, warned
 
 requirements = pytest.mark.requirements

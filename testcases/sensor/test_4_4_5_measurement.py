@@ -8,8 +8,8 @@ from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
 from conformance.judges.exchanges import cite, cited, heard, shown
 from conformance.judges.wire import runs
+from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.protocol.responses import is_service_request, split_line
-from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, passed, warned
 

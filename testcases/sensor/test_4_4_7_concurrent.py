@@ -8,8 +8,8 @@ from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
 from conformance.judges.support import serves_measurement
+from conformance.protocol.commands import C_FAMILY
 from conformance.protocol.responses import split_line
-from conformance.sensor.session import C_FAMILY
 from conformance.verdicts import failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements

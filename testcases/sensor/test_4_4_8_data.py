@@ -7,12 +7,12 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
 from conformance.judges.exchanges import cite, shown
+from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import (
     parse_data_reply_for,
     parse_measurement_reply_for,
     split_line,
 )
-from conformance.sensor.session import C_FAMILY, M_FAMILY
 from conformance.verdicts import failed, inconclusive, passed
 
 requirements = pytest.mark.requirements

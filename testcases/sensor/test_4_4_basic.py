@@ -6,10 +6,10 @@ import pytest
 
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
+from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import check_change_address_reply, split_line
 from conformance.protocol.timing import ADDRESS_CHANGE_QUIET, TOLERANCE
 from conformance.sensor.address_change import AddressChanger
-from conformance.sensor.session import C_FAMILY, M_FAMILY
 from conformance.verdicts import failed, passed
 
 requirements = pytest.mark.requirements

@@ -9,10 +9,9 @@ from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata as judge
 from conformance.judges.support import serves_continuous
 from conformance.judges.tally import Tally
-from conformance.protocol.commands import Kind
+from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY, Kind
 from conformance.protocol.responses import split_line
 from conformance.protocol.values import split_values
-from conformance.sensor.session import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed
 

@@ -8,6 +8,7 @@ import re
 from dataclasses import replace
 
 from ...protocol.commands import Kind
+from ...protocol.version import V13
 from ..profile import MeasurementSpec
 from ..replies import Reply, ReplyKind
 from .edits import (
@@ -356,7 +357,7 @@ VERSION_13: tuple[Fault, ...] = (
         "v1.3 profile: aC! announces and delivers 25 values (the 2000 text allows 20).",
         ("R-4.4.7-03",),
         profile=with_spec("C", _v13_wide_concurrent),
-        version="13",
+        version=V13,
         replaces="the values of aC!",
     ),
 )

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
+from ...protocol.version import V14, format_version
 from ..behaviour import Behaviour
 from ..profile import Profile
 from ..replies import Reply
@@ -39,7 +40,7 @@ class Fault:
     settings: Mapping[str, Any] = field(default_factory=dict)
     rewrite: Rewrite | None = None
     profile: ProfileTransform | None = None
-    version: str = "14"
+    version: str = V14
     #: Requirements the fault honestly leaves undecided (the description says why); the
     #: matrix demands exactly these INCONCLUSIVE, so collateral is declared, never ignored.
     inconclusive: tuple[str, ...] = ()
@@ -158,7 +159,7 @@ class FaultSet:
             if missing:
                 reasons.append(
                     f"fault {fault.name} needs {', '.join(missing)}, which a "
-                    f"v{profile.version[0]}.{profile.version[1:]} sensor does not have"
+                    f"v{format_version(profile.version)} sensor does not have"
                 )
         return reasons
 

@@ -3,7 +3,7 @@ tool's decisions on how long a recorder may take."""
 
 from __future__ import annotations
 
-from ...protocol.commands import SERVICE_REQUEST_KINDS, Kind
+from ...protocol.commands import SERVICE_REQUEST_KINDS
 from ...transcript import escape
 from ...verdicts import Finding
 from ...view.segments import Transmission
@@ -29,7 +29,6 @@ def beyond_reaction(delay: float, what: str) -> str:
 MIN_CONCURRENT_STORE = 20
 #: Measurements that end their wait with a service request (M family, V).
 SR_KINDS = SERVICE_REQUEST_KINDS
-CONCURRENT_KINDS = (Kind.CONCURRENT, Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY)
 
 
 def record_of(transmissions: list[Transmission], texts: list[str] | None = None) -> list[str]:

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ...protocol.binary import DataType, parse_binary_packet
 from ...protocol.commands import Command, Kind
-from ...protocol.responses import parse_measurement_reply_for, split_line
+from ...protocol.responses import parse_measurement_reply_for, service_request, split_line
 from ...transcript import Event, decode_7e1, decode_8n1, text_end
 from ...view.segments import TranscriptView, Transmission
 from ..reply_validity import ReplyProblem
@@ -68,7 +68,7 @@ class ObservedMeasurement:
 
 def service_request_end(events: list[Event], address: str) -> float | None:
     """End of the first ``a<CR><LF>`` with good parity among ``events`` (R-4.4.6-01)."""
-    return text_end(events, f"{address}\r\n")
+    return text_end(events, service_request(address))
 
 
 def observed_measurements(line: TranscriptView, uncertainty: float) -> list[ObservedMeasurement]:

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ...protocol.commands import CONCURRENT_KINDS
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ..tally import Tally
 from ..timing import judge_window
 from .common import (
-    CONCURRENT_KINDS,
     REACTION,
     REACTION_DECISION,
     SR_KINDS,
