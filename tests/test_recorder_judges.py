@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
 from conformance.judges.recorder.capabilities import judge_addresses, judge_transparent
-from conformance.judges.recorder.collection import judge_data_collection
+from conformance.judges.recorder.collection import judge_concurrent_storage, judge_data_collection
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_crc_checked, judge_retries
@@ -268,3 +268,19 @@ def test_addresses():
     found = by_id(judge_addresses(w.line(), 0.0))
     assert found["R-4.3-03"].verdict is Verdict.FAIL and "9" in found["R-4.3-03"].detail
     assert found["R-4.3-04"].verdict is Verdict.NA
+
+
+def test_a_concurrent_measurement_repeated_before_its_data_owes_no_values():
+    """Seen over RFC 2217 on a busy host: the golden recorder heard 000205 late, sent 0C!
+    again (a retry), then read all five values of the second measurement. The first one
+    must not FAIL R-4.4.7-08 "read none of the 5 values"; a recorder that never reads the
+    data still does."""
+    values = "0-5.00-3.75-2.50-1.25+0.00\r\n"
+    retried = Wire().brk().rec("0C!").sensor("000205\r\n").idle(100).rec("0C!")
+    retried = retried.sensor("000205\r\n").idle(5200).brk().rec("0D0!").sensor(values)
+    found = judge_concurrent_storage(observed_measurements(retried.line(), 0.0), ("0C!",))
+    assert [f.verdict for f in found if f.requirement == "R-4.4.7-08"] == [Verdict.PASS]
+    never = Wire().brk().rec("0C!").sensor("000205\r\n").idle(100).rec("0C!")
+    never = never.sensor("000205\r\n").idle(5200).brk().rec("0I!")
+    found = judge_concurrent_storage(observed_measurements(never.line(), 0.0), ("0C!",))
+    assert Verdict.FAIL in [f.verdict for f in found if f.requirement == "R-4.4.7-08"]
