@@ -36,6 +36,37 @@ def _rows(path: str) -> Iterator[tuple[int, list[str]]]:
 
 def read_csv(path: str, channel: str | None = None) -> Edges:
     rows = _rows(path)
+    names, channel, notes = _header(path, rows, channel)
+    col = 1 + names.index(channel)
+    try:
+        number, fields = next(rows)
+    except StopIteration:
+        raise CaptureError(path, "no data rows: the export holds no samples") from None
+    t0_ns, first_level = _parse_row(path, col, number, fields)
+    end = [0]
+    # read ahead to estimate the sample period before handing out edges
+    stream = _edge_chunks(path, rows, col, t0_ns, first_level, end)
+    ahead = next(stream)
+    period = _period(ahead, notes)
+    return Edges(
+        path=path,
+        channel=channel,
+        channels=names,
+        tick_rate=NS,
+        period=period,
+        initial_level=first_level,
+        chunks=_handed_out(ahead, stream),
+        t0=t0_ns / NS,
+        end=lambda: end[0],
+        notes=notes,
+    )
+
+
+def _header(
+    path: str, rows: Iterator[tuple[int, list[str]]], channel: str | None
+) -> tuple[list[str], str, list[str]]:
+    """The channel names, the channel chosen (the first unless named) and the notes so far,
+    from the header row: an export that is not Saleae's is refused before any data is read."""
     try:
         _, header = next(rows)
     except StopIteration:
@@ -52,37 +83,64 @@ def read_csv(path: str, channel: str | None = None) -> Edges:
             notes.append(f"channel {channel!r} chosen: the first column (use a channel name)")
     if channel not in names:
         raise CaptureError(path, f"no channel {channel!r}; channels present: {', '.join(names)}")
-    col = 1 + names.index(channel)
+    return names, channel, notes
 
-    def parse(number: int, fields: list[str]) -> tuple[int, int]:
-        try:
-            ns = round(float(fields[0]) * NS)
-            level = int(fields[col])
-        except (ValueError, IndexError):
-            raise CaptureError(path, f"line {number}: not a time and a 0/1 level") from None
-        if level not in (0, 1):
-            raise CaptureError(path, f"line {number}: level {fields[col]!r} is not 0 or 1")
-        return ns, level
 
+def _parse_row(path: str, col: int, number: int, fields: list[str]) -> tuple[int, int]:
+    """(ns, level) of one data row: the first row and every later one are read alike."""
     try:
-        number, fields = next(rows)
-    except StopIteration:
-        raise CaptureError(path, "no data rows: the export holds no samples") from None
-    t0_ns, level = parse(number, fields)
-    first_level = level
-    # read ahead to estimate the sample period before handing out edges
-    ahead: list[int] = []
-    last = t0_ns
+        ns = round(float(fields[0]) * NS)
+        level = int(fields[col])
+    except (ValueError, IndexError):
+        raise CaptureError(path, f"line {number}: not a time and a 0/1 level") from None
+    if level not in (0, 1):
+        raise CaptureError(path, f"line {number}: level {fields[col]!r} is not 0 or 1")
+    return ns, level
+
+
+def _edge_chunks(
+    path: str,
+    rows: Iterator[tuple[int, list[str]]],
+    col: int,
+    t0_ns: int,
+    level: int,
+    end: list[int],
+) -> Iterator[list[int]]:
+    """The edges of column ``col`` (ns after ``t0_ns``, the first row's time, at ``level``)
+    in chunks: one loop over the rows both for the read-ahead and for the edges handed out
+    after it. The first chunk (up to :data:`PERIOD_SAMPLE_EDGES` edges, possibly empty) is
+    always yielded, with ``end[0]`` set to the last row read; then chunks of
+    :data:`CHUNK_ROWS`, and ``end[0]`` is the last row's time once the rows are exhausted."""
+    chunk: list[int] = []
+    size = PERIOD_SAMPLE_EDGES
+    ahead = True  # the first chunk (the read-ahead) is not yet out
+    prev = t0_ns
     for number, fields in rows:
-        ns, new = parse(number, fields)
-        if ns < last:
+        ns, new = _parse_row(path, col, number, fields)
+        if ns < prev:
             raise CaptureError(path, f"line {number}: time goes backwards")
-        last = ns
+        prev = ns
         if new != level:
-            ahead.append(ns - t0_ns)
+            chunk.append(ns - t0_ns)
             level = new
-            if len(ahead) >= PERIOD_SAMPLE_EDGES:
-                break
+            if len(chunk) >= size:
+                if ahead:
+                    end[0] = prev - t0_ns
+                    ahead = False
+                    size = CHUNK_ROWS
+                yield chunk
+                chunk = []
+    if ahead:
+        end[0] = prev - t0_ns
+        yield chunk
+    elif chunk:
+        yield chunk
+    end[0] = prev - t0_ns
+
+
+def _period(ahead: list[int], notes: list[str]) -> float:
+    """The sample period (s) as the gcd of the read-ahead edges' spacings (a CSV states no
+    rate), noting the estimate; one nanosecond when there are no edges to tell."""
     gcd = 0
     previous = 0
     for tick in ahead:
@@ -93,38 +151,11 @@ def read_csv(path: str, channel: str | None = None) -> Edges:
         notes.append(
             f"sample period {period * 1e9:g} ns estimated from the edges (CSV has no rate)"
         )
-    end = [last - t0_ns]
+    return period
 
-    def chunks() -> Iterator[list[int]]:
-        nonlocal level
-        if ahead:
-            yield ahead
-        chunk: list[int] = []
-        prev = last
-        for number, fields in rows:
-            ns, new = parse(number, fields)
-            if ns < prev:
-                raise CaptureError(path, f"line {number}: time goes backwards")
-            prev = ns
-            if new != level:
-                chunk.append(ns - t0_ns)
-                level = new
-                if len(chunk) >= CHUNK_ROWS:
-                    yield chunk
-                    chunk = []
-        if chunk:
-            yield chunk
-        end[0] = prev - t0_ns
 
-    return Edges(
-        path=path,
-        channel=channel,
-        channels=names,
-        tick_rate=NS,
-        period=period,
-        initial_level=first_level,
-        chunks=chunks(),
-        t0=t0_ns / NS,
-        end=lambda: end[0],
-        notes=notes,
-    )
+def _handed_out(ahead: list[int], rest: Iterator[list[int]]) -> Iterator[list[int]]:
+    """The read-ahead chunk (unless empty), then the rest: the edges a consumer is given."""
+    if ahead:
+        yield ahead
+    yield from rest

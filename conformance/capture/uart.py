@@ -176,7 +176,23 @@ def _shape_reading(
     return got
 
 
-_UNREAD = object()  # a shape not read yet (None is a shape read as too near a centre)
+class _Shapes(dict):
+    """Frame readings by shape, ``(bit time, *edges relative to the start bit)``: a miss
+    reads the shape (:func:`_shape_reading`, None when too near a bit centre) and keeps it,
+    after dropping them all once :data:`FRAME_SHAPES` are kept; a hit, the usual case, costs
+    the decoder's loop one dict lookup and no call."""
+
+    __slots__ = ("args",)
+
+    def __init__(self, T: float, nbits: int, period_ticks: float, framing: Framing) -> None:
+        super().__init__()
+        self.args = (T, nbits, period_ticks, framing)
+
+    def __missing__(self, key: tuple) -> _Reading | None:
+        if len(self) >= FRAME_SHAPES:
+            self.clear()
+        reading = self[key] = _shape_reading(key[1:], key[0], *self.args)
+        return reading
 
 
 def _refill(src: Iterator[list[int]], buf: list[int], i: int, above: float) -> tuple[list, bool]:
@@ -189,6 +205,23 @@ def _refill(src: Iterator[list[int]], buf: list[int], i: int, above: float) -> t
             return rest, False
         rest.extend(nxt)
     return rest, True
+
+
+@dataclass(frozen=True, slots=True)
+class _Line:
+    """What :func:`decode` is told about the line, fixed for a whole decode: handed to the
+    scanning loop as one value, which takes the few it uses per frame into locals."""
+
+    T: float  # ticks per bit
+    nbits: int
+    tick_rate: float
+    t0: float
+    uncertainty: float
+    period_ticks: float
+    framing: Framing
+    end_tick: Callable[[], int | None] | None
+    break_min: float
+    pulse_min: float
 
 
 def decode(
@@ -214,37 +247,95 @@ def decode(
     capture cut); without it such a spacing is dropped.
 
     The edges are held a chunk or two at a time in one list scanned by index (``bisect`` for
-    the edges inside a frame), and each frame shape is read once (:data:`FRAME_SHAPES`)."""
+    the edges inside a frame), and each frame shape is read once (:data:`FRAME_SHAPES`).
+
+    A character that follows the previous one within a frame's time is read from the bit
+    time that one was read with, when it read cleanly: it is the same sender's (a reply's
+    characters), and a frame whose only inner edge comes late (0xC0: seven spacing bits,
+    then marking) fits a fast and a slow sender equally well (6.46 bits at 1300 baud is 6
+    bits at 1114): the sender's rate seen a character earlier settles it."""
     framing = framing or Framing.parse("7E1")
-    nbits = framing.bits
-    T = tick_rate / baud
+    line = _Line(
+        tick_rate / baud,
+        framing.bits,
+        tick_rate,
+        t0,
+        uncertainty,
+        period_ticks,
+        framing,
+        end_tick,
+        break_min,
+        pulse_min,
+    )
+    yield from _scan(iter(chunks), (initial_level & 1) ^ int(invert), line)
+
+
+def _capture_end(s: int, end_tick: Callable[[], int | None] | None) -> int:
+    """Where a spacing from ``s`` still running when the edges run out ends: at the
+    capture's end when the reader can say, else at ``s`` (no length: it is dropped)."""
+    last = end_tick() if end_tick is not None else None
+    return s if last is None else max(s, last)
+
+
+def _spacing(s: int, r_end: int, last_end: float | None, line: _Line) -> Decoded:
+    """The break or spacing pulse from tick ``s`` to ``r_end`` (kept apart by length,
+    R-7.0-02..04); rare next to frames, so built outside the scanning loop."""
+    tick_rate, t0 = line.tick_rate, line.t0
+    kind = "break" if (r_end - s) / tick_rate >= line.break_min else "pulse"
+    ev = Event(
+        EventKind.BREAK,
+        BUS,
+        t0 + s / tick_rate,
+        t0 + r_end / tick_rate,
+        text="" if kind == "break" else SPACING_PULSE,
+        uncertainty=line.uncertainty,
+    )
+    marking = None if last_end is None else (s - last_end) / tick_rate
+    return Decoded(kind, ev, ev.start, ev.end, marking_before=marking)
+
+
+def _start(
+    src: Iterator[list[int]], level: int
+) -> tuple[list[int], int, bool, float | None] | None:
+    """The scan's starting state: the edges held, the next one not consumed, whether chunks
+    may be left in ``src``, and the tick where the previous frame or break ended. A capture
+    that starts inside spacing (``level`` 0) has that spacing's start unknown: it is
+    skipped, up to its first edge (None: there is none)."""
+    if level != 0:
+        return [], 0, True, None
+    buf, more = _refill(src, [], 0, float("-inf"))
+    if not buf:
+        return None
+    return buf, 1, more, buf[0]
+
+
+def _consume_to(
+    src: Iterator[list[int]], buf: list[int], i: int, more: bool, stop: float
+) -> tuple[list[int], bool, int]:
+    """``buf``, ``more`` and the first edge after ``stop`` (a bit centre past the frame's
+    window the scan holds edges for), chunks appended as needed: a rare case, off the
+    scan's own path."""
+    if more and buf[-1] <= stop:
+        buf, more = _refill(src, buf, i, stop)
+        i = 0
+    return buf, more, bisect_right(buf, stop, i)
+
+
+def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded]:
+    """:func:`decode`'s loop, one frame, break, pulse or glitch a turn from the falling edge
+    that starts it (``level``: the UART-side level the capture starts at). The hot path:
+    per frame it calls nothing it can do inline; the rare cases are built by helpers."""
+    T, nbits, tick_rate, t0 = line.T, line.nbits, line.tick_rate, line.t0
+    uncertainty = line.uncertainty
     half = T / 2
     stop_centre = (nbits - 0.5) * T
     frame_span = nbits * T * 1.1  # a slow sender's run a little past the nominal end
-    src = iter(chunks)
-    buf: list[int] = []
-    i = 0  # the next edge not consumed
-    more = True  # chunks may be left in src
-    shapes: dict[tuple, _Reading | None] = {}
-    level = (initial_level & 1) ^ int(invert)
-    last_end: float | None = None  # tick where the previous frame or break ended
-    # the bit time the previous character was read with, when it read cleanly: the next one,
-    # if it follows within a frame's time, is the same sender's (a reply's characters), and
-    # a frame whose only inner edge comes late (0xC0: seven spacing bits, then marking) fits
-    # a fast and a slow sender equally well (6.46 bits at 1300 baud is 6 bits at 1114): the
-    # sender's rate seen a character earlier settles it
-    prior_bt: float | None = None
-
-    def t(tick: float) -> float:
-        return t0 + tick / tick_rate
-
-    if level == 0:  # the capture starts inside spacing: its start is unknown, skip it
-        buf, more = _refill(src, buf, i, float("-inf"))
-        if not buf:
-            return
-        i = 1
-        level = 1
-        last_end = buf[0]
+    shapes = _Shapes(T, nbits, line.period_ticks, line.framing)
+    state = _start(src, level)
+    if state is None:
+        return
+    buf, i, more, last_end = state
+    prior_bt: float | None = None  # the previous clean character's bit time (see decode)
     while True:
         if more and len(buf) - i < 2:
             buf, more = _refill(src, buf, i, float("-inf"))
@@ -255,30 +346,16 @@ def decode(
         s = buf[i]
         r = buf[i + 1] if i + 1 < n_buf else None
         i += 1  # the falling edge is consumed; r (if any) is still ahead
-        if r is not None:
-            r_end = r
-        else:
-            last = end_tick() if end_tick is not None else None
-            r_end = s if last is None else max(s, last)
+        r_end = r if r is not None else _capture_end(s, line.end_tick)
         length = r_end - s
         if length < half:
             if r is None:
                 return  # the capture ends right after a falling edge: nothing to decode
             i += 1
-            yield Decoded("glitch", None, t(s), t(r))
+            yield Decoded("glitch", None, t0 + s / tick_rate, t0 + r / tick_rate)
             continue
-        if length > stop_centre and length / tick_rate >= pulse_min:
-            kind = "break" if length / tick_rate >= break_min else "pulse"
-            ev = Event(
-                EventKind.BREAK,
-                BUS,
-                t(s),
-                t(r_end),
-                text="" if kind == "break" else SPACING_PULSE,
-                uncertainty=uncertainty,
-            )
-            marking = None if last_end is None else (s - last_end) / tick_rate
-            yield Decoded(kind, ev, ev.start, ev.end, marking_before=marking)
+        if length > stop_centre and length / tick_rate >= line.pulse_min:
+            yield _spacing(s, r_end, last_end, line)
             prior_bt = None
             if r is None:
                 return
@@ -297,18 +374,9 @@ def decode(
             j = bisect_left(buf, frame_end, hi)
         follows = prior_bt is not None and last_end is not None and s - last_end < nbits * T
         used = prior_bt if follows and prior_bt is not None else T
-        reading = None
-        if s < _EXACT_BELOW:
-            key = (used, *[e - s for e in buf[i:j]])
-            reading = shapes.get(key, _UNREAD)
-            if reading is _UNREAD:
-                if len(shapes) >= FRAME_SHAPES:
-                    shapes.clear()
-                reading = shapes[key] = _shape_reading(
-                    key[1:], used, T, nbits, period_ticks, framing
-                )
+        reading = shapes[(used, *[e - s for e in buf[i:j]])] if s < _EXACT_BELOW else None
         if reading is None:  # an edge on a bit centre, or a tick too far for the shapes
-            reading = _read_frame(s, buf[i:j], used, T, nbits, period_ticks, framing)
+            reading = _read_frame(s, buf[i:j], used, T, nbits, line.period_ticks, line.framing)
         used = reading.used
         framing_error = reading.framing_error
         end = s + nbits * used
@@ -316,11 +384,8 @@ def decode(
         stop = s + (nbits - 0.5) * used
         if stop < frame_end:  # every edge from j on is later
             i = bisect_right(buf, stop, i, j)
-        else:
-            if more and buf[-1] <= stop:
-                buf, more = _refill(src, buf, i, stop)
-                i = 0
-            i = bisect_right(buf, stop, i)
+        else:  # a slow sender's stop bit, past the frame's window
+            buf, more, i = _consume_to(src, buf, i, more, stop)
         e = buf[i] if i < len(buf) else None
         if framing_error and e is not None:
             i += 1
@@ -332,14 +397,5 @@ def decode(
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
         prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity
-        yield Decoded(
-            "char",
-            ev,
-            start,
-            ev.end,
-            framing_error,
-            reading.parity_error,
-            reading.err,
-            reading.glitches,
-            marking,
-        )
+        pe, err, glitches = reading.parity_error, reading.err, reading.glitches
+        yield Decoded("char", ev, start, ev.end, framing_error, pe, err, glitches, marking)
