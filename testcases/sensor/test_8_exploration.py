@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from conformance import preconditions as precondition
-from conformance.sensor.exploration import IDS, explore
-from conformance.verdicts import failed, inconclusive, passed
+from conformance.judges.exploration import IDS, broken_finding, held_findings
+from conformance.sensor.exploration import explore
 
 requirements = pytest.mark.requirements
 
@@ -26,15 +26,7 @@ def test_random_command_sequences(sensor, case):
     run = explore(sensor)
     case.evidence(f"exploration: {run.steps} steps", run.exchanges)
     if run.broken is not None:
-        seq = " ; ".join(run.failing_sequence[-12:])
-        case.add(
-            failed(
-                run.broken.requirement,
-                run.broken.message,
-                evidence=[f"failing sequence (last steps): {seq}"],
-                observed=max(len(run.exchanges), 1),  # the step that broke it, at least
-            )
-        )
+        case.add(broken_finding(run.broken, run.failing_sequence, len(run.exchanges)))
     # silence to foreign addresses is evidence only from a sensor that answered its own; the
     # address replies are judged against is the one it answered at (moves were undone)
     own = [ex for ex in run.exchanges if ex.text.startswith(sensor.address)]
@@ -53,16 +45,4 @@ def test_random_command_sequences(sensor, case):
                 "no command of the exploration at its address was answered",
             ),
         )
-    for rid in IDS:
-        if run.broken is not None and rid == run.broken.requirement:
-            continue
-        if run.checked[rid]:
-            case.add(
-                passed(
-                    rid,
-                    f"held over {run.checked[rid]} checks in {run.steps} random steps",
-                    observed=run.checked[rid],
-                )
-            )
-        else:
-            case.add(inconclusive(rid, f"no step of the {run.steps} exercised it"))
+    case.add(*held_findings(run.observations, run.steps))

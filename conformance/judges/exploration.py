@@ -1,0 +1,177 @@
+"""Judges of the stateful exploration (``conformance.sensor.exploration``): every check it
+made of a reply, judged, and the run's breach and tally turned into Findings.
+
+The exploration only drives the sensor and records what each checked step showed as an
+:class:`Observation`. It still asks :func:`judge` after each one, because the first breach
+ends the exploration (the steps after it would start from whatever state the breach left,
+and a certificate must send the same stimuli every time); everything a verdict says, and
+why, is decided here, from the records alone, so a saved record can be judged again.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+from ..protocol.crc import is_crc_char
+from ..protocol.responses import parse_data_reply, split_line
+from ..transcript import escape
+from ..verdicts import Finding, failed, inconclusive, passed
+
+#: The requirements the exploration judges, in the order their findings are reported.
+IDS = ("R-4.0-01", "R-4.3-01", "R-4.2-03", "R-4.4.12-05", "R-4.4.12-06", "R-4.4.5-10")
+
+#: What an observation checks: silence to a foreign address, the framing and address of a
+#: reply, a claimed CRC, or a D0 repeated with no measurement between.
+Check = Literal["foreign", "framing", "crc", "repeat"]
+
+
+@dataclass(frozen=True)
+class Observation:
+    """One checked step of the exploration: the command sent, the reply heard, and the
+    context its check needs (kept with it, so the judgement needs no machine state)."""
+
+    check: Check
+    command: str  # the command as sent (Exchange.text)
+    reply: str  # the reply as heard (Exchange.reply_text); '' when silent
+    address: str = ""  # framing: the sensor's address; foreign: the address commanded
+    answered: bool = True  # foreign: whether anything answered
+    marked: bool = False  # foreign: sent with a marking the sensor was shown to hear
+    previous: str | None = None  # repeat: the D0 reply since the last measurement command
+
+
+@dataclass(frozen=True)
+class Breach:
+    """An invariant the sensor broke: the requirement and what was seen."""
+
+    requirement: str
+    message: str
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """What one observation counted as a check, and the breach it showed (if any)."""
+
+    checked: tuple[str, ...]
+    breach: Breach | None = None
+
+
+def _foreign(obs: Observation) -> Judgement:
+    """Silence to another address counts only when the command went out the way the sensor
+    was shown to hear one (else silence says nothing); an answer always counts, and breaks."""
+    checked = ("R-4.0-01",) if obs.marked or obs.answered else ()
+    if not obs.answered:
+        return Judgement(checked)
+    message = (
+        f"answered {escape(obs.command)}, a command for "
+        f"address '{obs.address}', with '{escape(obs.reply)}'"
+    )
+    return Judgement(checked, Breach("R-4.0-01", message))
+
+
+def _framing(obs: Observation) -> Judgement:
+    """Every reply ends in CR LF and starts with the sensor's address (CR LF first: a reply
+    cut short may also lack its address)."""
+    body, framing = split_line(obs.reply)
+    checked = ("R-4.2-03", "R-4.3-01")
+    label = escape(obs.command)
+    if [v for v in framing if v.requirement == "R-4.2-03"]:
+        message = f"reply to {label} '{escape(obs.reply)}' does not end in CR LF"
+        return Judgement(checked, Breach("R-4.2-03", message))
+    if body[:1] != obs.address:
+        message = f"reply to {label} starts with '{escape(body[:1])}', not '{obs.address}'"
+        return Judgement(checked, Breach("R-4.3-01", message))
+    return Judgement(checked)
+
+
+def _crc(obs: Observation) -> Judgement:
+    """A CRC the reply claims is right (05) and well encoded (06), in that order: a wrong
+    value ends the check before its encoding is counted. A reply that claims none is left to
+    the D-reply cases, which judge whether one was due."""
+    body, _ = split_line(obs.reply)
+    if len(body) < 4 or not all(is_crc_char(c) for c in body[-3:]):
+        return Judgement(())
+    reply = parse_data_reply(body, crc_expected=True, limit=75)
+    checked: tuple[str, ...] = ()
+    for rid in ("R-4.4.12-05", "R-4.4.12-06"):
+        checked += (rid,)
+        bad = [v for v in reply.violations if v.requirement == rid]
+        if bad:
+            message = f"reply to {escape(obs.command)}: {bad[0].message}"
+            return Judgement(checked, Breach(rid, message))
+    return Judgement(checked)
+
+
+def _repeat(obs: Observation) -> Judgement:
+    """D0 read again with no measurement between gives the same reply (the first D0 after
+    a measurement has nothing to compare with, but still counts as a check)."""
+    checked = ("R-4.4.5-10",)
+    if obs.previous is None or obs.reply == obs.previous:
+        return Judgement(checked)
+    message = (
+        f"D0 gave '{escape(obs.previous)}', then '{escape(obs.reply)}' with no measurement between"
+    )
+    return Judgement(checked, Breach("R-4.4.5-10", message))
+
+
+_JUDGES: dict[str, Callable[[Observation], Judgement]] = {
+    "foreign": _foreign,
+    "framing": _framing,
+    "crc": _crc,
+    "repeat": _repeat,
+}
+
+
+def judge(obs: Observation) -> Judgement:
+    """The judgement of one observation (pure: the same record always judges the same)."""
+    return _JUDGES[obs.check](obs)
+
+
+def first_breach(observations: Iterable[Observation]) -> Breach | None:
+    """The first breach among ``observations``: hypothesis replays a failing example to
+    confirm it, and a real device, whose state moved on, may then behave otherwise; the
+    first observation stands."""
+    for obs in observations:
+        breach = judge(obs).breach
+        if breach is not None:
+            return breach
+    return None
+
+
+def checks(observations: Iterable[Observation]) -> dict[str, int]:
+    """How many checks each requirement got, over every observation (replays included)."""
+    counted = {rid: 0 for rid in IDS}
+    for obs in observations:
+        for rid in judge(obs).checked:
+            counted[rid] += 1
+    return counted
+
+
+def broken_finding(breach: Breach, failing_sequence: Sequence[str], exchanges: int) -> Finding:
+    """The FAIL for the invariant that ended the exploration, with the last steps that led
+    to it as evidence (the whole sequence would drown the report)."""
+    seq = " ; ".join(failing_sequence[-12:])
+    return failed(
+        breach.requirement,
+        breach.message,
+        evidence=[f"failing sequence (last steps): {seq}"],
+        observed=max(exchanges, 1),  # the step that broke it, at least
+    )
+
+
+def held_findings(observations: Sequence[Observation], steps: int) -> list[Finding]:
+    """A PASS for every requirement checked and not broken, an INCONCLUSIVE for every one no
+    step exercised (the broken one has its FAIL from :func:`broken_finding`)."""
+    breach = first_breach(observations)
+    counted = checks(observations)
+    out: list[Finding] = []
+    for rid in IDS:
+        if breach is not None and rid == breach.requirement:
+            continue
+        if counted[rid]:
+            detail = f"held over {counted[rid]} checks in {steps} random steps"
+            out.append(passed(rid, detail, observed=counted[rid]))
+        else:
+            out.append(inconclusive(rid, f"no step of the {steps} exercised it"))
+    return out
