@@ -144,22 +144,11 @@ def run_suite(
     plan: str | None = None,
     baseline: str | None = None,
     verbose: bool = False,
-) -> int:
-    """The main command: check ``options``, run the suite, show the summary; the exit code.
-    ``plan``: write the test plan first (always/auto/never; default $SDI12_PLAN or auto);
-    ``baseline``: an earlier run to compare with at the end."""
-    return suite_outcome(options, console, plan=plan, baseline=baseline, verbose=verbose)[0]
-
-
-def suite_outcome(
-    options: RunOptions,
-    console: Console,
-    *,
-    plan: str | None = None,
-    baseline: str | None = None,
-    verbose: bool = False,
 ) -> tuple[int, dict | None]:
-    """:func:`run_suite`'s exit code and the run's verdicts.json document (None: none)."""
+    """The main command: check ``options``, run the suite, show the summary; the exit code
+    and the run's verdicts.json document (None: none). ``plan``: write the test plan first
+    (always/auto/never; default $SDI12_PLAN or auto); ``baseline``: an earlier run to compare
+    with at the end."""
     from . import report_folder
     from .declaration import DeclarationError
     from .options import UsageError
@@ -340,7 +329,7 @@ def cmd_judge(argv: list[str], console: Console) -> int:
             markup=False,
             highlight=False,
         )
-        code, document = suite_outcome(found.replay, console)
+        code, document = run_suite(found.replay, console)
         why = capture_replay_stopped(found, document) if code == EXIT_INTERNAL else None
         if why is not None:
             console.print(f"note: {why}", markup=False, highlight=False)
@@ -659,13 +648,14 @@ def _dispatch(argv: list[str]) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:
             return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
-        return run_suite(
+        code, _ = run_suite(
             options_from_args(args),
             console,
             plan=args.plan,
             baseline=getattr(args, "baseline", None),
             verbose=args.verbose,
         )
+        return code
     except SystemExit as exc:  # argparse of a subcommand: --help (0) or a usage error (2)
         return EXIT_COMPLIANT if exc.code in (0, None) else EXIT_USAGE
     except KeyboardInterrupt:

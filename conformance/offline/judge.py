@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass, field, replace
-from dataclasses import fields as dataclass_fields
 from pathlib import Path
 
 from ..capture import (
@@ -328,7 +327,6 @@ def replay_options(recording: Recording, args: argparse.Namespace) -> RunOptions
     """The main command's options that repeat the recorded run against its recording: the
     options its run-options note saved, with what ``judge`` was told on top."""
     saved = recording.options
-    fields = {f.name for f in dataclass_fields(RunOptions)}
     kept = {
         key: saved[key]
         for key in (
@@ -336,7 +334,7 @@ def replay_options(recording: Recording, args: argparse.Namespace) -> RunOptions
             "sweep",  # a swept run's steps are in its recording: replayed too
             "job_timeout",  # the budgets its scenario notes state
         )
-        if key in fields and saved.get(key) is not None
+        if saved.get(key) is not None
     }  # fmt: skip
     return RunOptions(
         port=f"replay:{recording.path}",

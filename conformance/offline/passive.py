@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..conduct import RunResult, conduct
-from ..exits import EXIT_COMPLIANT, EXIT_USAGE, exit_code
+from ..exits import EXIT_COMPLIANT, EXIT_USAGE
 from ..interrupts import GUARD
 from ..links.errors import PortError
 from ..protocol.commands import Kind
@@ -114,7 +114,7 @@ def judge_passively(args: PassiveJob, console: Console) -> int:
             return EXIT_INTERNAL
         console.print(f"{role} rules:", style="bold", markup=False, highlight=False)
         print_summary(console, data, str(report_dir))
-        codes[-1] = exit_code(data, code)
+        codes[-1] = result.exit_code
         if GUARD.requested:  # Ctrl-C: this role's report says so; the next one is not begun
             forget(port)
             GUARD.close()
