@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from .exits import EXIT_NO_DEVICE, EXIT_OK, EXIT_USAGE
 from .judges.wire import reply_char_pairs
 from .links.meter import TimingMeter
 from .protocol.timing import (
@@ -28,7 +29,6 @@ from .protocol.timing import (
 )
 from .view.runs import Segment, segments
 
-EXIT_OK, EXIT_USAGE, EXIT_NO_DEVICE = 0, 4, 5
 SYSFS_SERIAL = Path("/sys/bus/usb-serial/devices")
 
 

@@ -17,20 +17,20 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .interrupts import GUARD
-
-if TYPE_CHECKING:
-    from rich.console import Console
-
-    from .run import RunOptions
-
 from .exits import (
     EXIT_COMPLIANT,
     EXIT_INCOMPLETE,
     EXIT_INTERNAL,
     EXIT_NON_COMPLIANT,
     EXIT_USAGE,
+    PYTEST_NO_TESTS,
 )
+from .interrupts import GUARD
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from .run import RunOptions
 
 EXAMPLES = """\
 examples:
@@ -273,7 +273,7 @@ def _conducted(
     if interrupted and data is None:
         error("interrupted before the run started; no report written")
         return EXIT_INCOMPLETE, None
-    if code == 5 and data is None:  # pytest: no tests collected (e.g. -k matched none)
+    if code == PYTEST_NO_TESTS and data is None:  # e.g. -k matched none
         for leftover in ("report.html", "junit.xml"):  # pytest-html's empty page misleads
             (report_dir / leftover).unlink(missing_ok=True)
         error(
@@ -283,7 +283,7 @@ def _conducted(
         return EXIT_USAGE, None
     if data is None:
         error(f"error: the suite did not run (pytest exit {code}); rerun with -v")
-        return (EXIT_INTERNAL if code == 3 else EXIT_USAGE), None
+        return (EXIT_INTERNAL if code == EXIT_INTERNAL else EXIT_USAGE), None
     from .reports.console import print_summary
 
     print_summary(console, data, str(report_dir))

@@ -7,10 +7,11 @@ import sys
 
 EXIT_OK = EXIT_COMPLIANT = 0
 EXIT_NON_COMPLIANT = 1  # matrix: a fault not caught exactly
-EXIT_INCOMPLETE = 2  # interrupted, or verdicts left open
+EXIT_INCOMPLETE = EXIT_INTERRUPTED = 2  # interrupted, or verdicts left open
 EXIT_INTERNAL = 3  # a bug in the tool, or the link failed mid-run
 EXIT_USAGE = 4  # an ordinary mistake: bad option, file, port
 EXIT_NO_DEVICE = 5  # nothing answered
+PYTEST_NO_TESTS = 5  # pytest.ExitCode.NO_TESTS_COLLECTED (so the CLI need not import pytest)
 
 
 def say_error(text: str) -> None:

@@ -14,6 +14,7 @@ import pytest
 
 from . import gc_pace, preconditions, report_folder, whole_run
 from .case import Case
+from .exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NO_DEVICE, EXIT_USAGE
 from .interrupts import GUARD
 from .links.base import LinkError
 from .links.errors import BreakUnsupported
@@ -36,7 +37,6 @@ RUN = pytest.StashKey[ConformanceRun]()
 OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
 LOCKED = pytest.StashKey[Path]()  # the report folder this run holds (report_folder.acquire)
 PACE = pytest.StashKey[gc_pace.Pace]()  # the collector's pace before the run (gc_pace)
-EXIT_NO_DEVICE = 5
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -117,15 +117,15 @@ def sensor(sdi12_run: ConformanceRun) -> SensorSession:
     except PortError as exc:
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
-        pytest.exit(str(exc), returncode=4)
+        pytest.exit(str(exc), returncode=EXIT_USAGE)
     except RecordingEnded as exc:  # a replayed capture cut short before discovery ended
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
-        pytest.exit(str(exc), returncode=2)
+        pytest.exit(str(exc), returncode=EXIT_INCOMPLETE)
     except LinkError as exc:
         sdi12_run.complete = False
         sdi12_run.stop_reason = str(exc)
-        pytest.exit(f"link error: {exc}", returncode=3)
+        pytest.exit(f"link error: {exc}", returncode=EXIT_INTERNAL)
 
 
 @pytest.fixture
@@ -307,17 +307,17 @@ def pytest_runtest_call(item: pytest.Item):
         _error(record, f"test setup failed: {exc}")
         run.complete = False
         run.stop_reason = f"test setup failed: {exc}"
-        pytest.exit(run.stop_reason, returncode=4)
+        pytest.exit(run.stop_reason, returncode=EXIT_USAGE)
     except RecordingEnded as exc:  # a replayed capture cut short: the rest is left open
         _inconclusive(record, str(exc))
         run.complete = False
         run.stop_reason = str(exc)
-        pytest.exit(run.stop_reason, returncode=2)
+        pytest.exit(run.stop_reason, returncode=EXIT_INCOMPLETE)
     except LinkError as exc:  # the port failed: stop the run, keep the report (exit 3)
         _error(record, f"link failed: {exc}")
         run.complete = False
         run.stop_reason = f"link failed: {exc}"
-        pytest.exit(f"link failed: {exc}", returncode=3)
+        pytest.exit(f"link failed: {exc}", returncode=EXIT_INTERNAL)
     except Exception as exc:  # the tool failed: ERROR, never hidden as a FAIL or a PASS
         _error(record, f"tool error: {type(exc).__name__}: {exc}")
         raise
@@ -386,7 +386,7 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         run.stop_reason = "run interrupted (Ctrl-C)"
     if not run.active and run.session is None and not run.stop_reason:
         return  # no conformance case ran: an ordinary test session
-    stopped = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, 3, 4)
+    stopped = exitstatus in (pytest.ExitCode.INTERRUPTED, EXIT_NO_DEVICE, EXIT_INTERNAL, EXIT_USAGE)
     interrupted = late_interrupt or stopped
     if interrupted and not run.stop_reason:
         run.stop_reason = "run interrupted"

@@ -12,6 +12,7 @@ import argparse
 import signal
 import threading
 
+from ..exits import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
 from ..links.priority import EMULATED_LINE, quick_gil_handover, realtime_priority
 from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
@@ -19,7 +20,6 @@ from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
 from .tap import TapServer, parse_tap
 
-EXIT_OK, EXIT_INTERRUPTED, EXIT_USAGE = 0, 2, 4
 PORT_MAX = 65535
 
 

@@ -27,6 +27,7 @@ from typing import IO, TYPE_CHECKING
 
 from .. import report_folder
 from ..atomic import atomic_path
+from ..exits import EXIT_INCOMPLETE, EXIT_OK, EXIT_USAGE
 from ..exits import say_error as error
 from ..interrupts import GUARD
 from ..links.errors import LinkError, PortError
@@ -40,7 +41,6 @@ if TYPE_CHECKING:
 
     from ..links.listen import ListenLink
 
-EXIT_OK, EXIT_USAGE, EXIT_INCOMPLETE, EXIT_INTERNAL = 0, 4, 2, 3
 POLL = 0.05  # s: how often new bytes are taken from the reader and lines shown
 FLUSH_EVERY = 1.0  # s: the transcript on disk is at most this far behind the bus
 LIVE_ROWS = 40  # lines the live view keeps on screen

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import pytest
 
+from ..exits import EXIT_USAGE
 from ..links.errors import PortError
 from ..run import ConformanceRun
 from .heard import HeardRecorder, HeardSensors, hear_recorder, hear_sensors
@@ -37,7 +38,7 @@ def _heard(run: ConformanceRun, role: str):
         except PortError as exc:
             run.complete = False
             run.stop_reason = str(exc)
-            pytest.exit(str(exc), returncode=4)
+            pytest.exit(str(exc), returncode=EXIT_USAGE)
         run.link = link  # type: ignore[assignment]  # a recording stands where a link would
         if role == "sensor":
             run.session = hear_sensors(link, run.options.address, run.options.version)

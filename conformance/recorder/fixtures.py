@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from ..exits import EXIT_USAGE
 from ..ports import PortError
 from .session import RecorderSession
-
-EXIT_USAGE = 4
 
 
 @pytest.fixture(scope="session")
