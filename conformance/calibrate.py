@@ -219,7 +219,7 @@ def calibrate_main(argv: list[str], say: Callable[[str], None] = print) -> int:
             session.fresh_exchange("I")
         # a break as the timing cases make it (UART-timed where the link can), then a!
         session.probe(f"{session.address}!", break_s=13e-3, marking_s=9e-3, idle_before=0.15)
-        meter = getattr(link, "meter", None)
+        meter = link.meter
         if meter is None:
             say(f"port {args.port}: a {link.info.kind} link measures nothing of its own timing")
             return EXIT_OK

@@ -199,13 +199,11 @@ def check_run_options(options: RunOptions) -> bool:
     rather than a late one); whether the port runs in real time."""
     from .declaration import load_declaration, normalise_version
     from .options import check_values
-    from .ports import is_sim, parse_sim
     from .preflight import check_role_options
     from .selection import resolve
 
     check_role_options(
-        options.role, options.port, options.trigger, options.address, options.sweep,
-        options.job_timeout,
+        options.role, options.trigger, options.address, options.sweep, options.job_timeout,
     )  # fmt: skip
     check_values(vars(options), plugin=False)
     resolve(options.role, list(options.requirements))  # --req names rules the role can test
@@ -217,14 +215,9 @@ def check_run_options(options: RunOptions) -> bool:
         from .recorder.session import check_port
 
         return check_port(options.port, options.trigger)  # the port and recorder first
-    if is_sim(options.port):
-        from .ports import open_sim
-
-        open_sim(parse_sim(options.port))  # validate faults/parameters before the run
-        return False
     from .ports import open_port
 
-    # a port that cannot be opened: a usage error
+    # a port that cannot be opened (a sim URL's unknown fault too): a usage error
     link = open_port(options.port, echo=options.echo, direction=options.direction).link
     real_time = not link.info.virtual_time
     link.close()

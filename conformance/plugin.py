@@ -72,7 +72,6 @@ def pytest_configure(config: pytest.Config) -> None:
         check_values(vars(options), plugin=True)
         check_role_options(
             options.role,
-            options.port,
             options.trigger,
             options.address,
             options.sweep,
@@ -327,9 +326,8 @@ def pytest_runtest_call(item: pytest.Item):
         record.added = (before, record.window[1])
         if clock is not None and run.link is not None:
             record.bus_s = run.link.now() - clock
-    apply_declaration = getattr(run.session, "apply_declaration", None)
-    if apply_declaration is not None:  # recorder role: what its declaration excuses
-        apply_declaration(record)
+    if run.session is not None:  # recorder role: what its declaration excuses
+        run.session.apply_declaration(record)
     verdict = record.summarise()
     if not record.findings:
         _error(record, "case produced no finding (a check that cannot fail is a defect)")

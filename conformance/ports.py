@@ -4,9 +4,10 @@ Each kind registers itself with :mod:`~conformance.links.registry` when its modu
 imported; this module imports the built-in ones (:data:`BUILTIN_KINDS`) and registers the three
 it holds itself: ``sim`` / ``sim://?faults=a,b&version=1.3&address=0``, the built-in simulated
 bus with the reference sensor emulator on it (virtual time, exact stamps); ``replay:PATH``, a
-saved run's recorded sensor played back on that bus; and ``rfc2217-serve://``, which the
-sensor role refuses (it serves played sensors to a recorder under test). A new kind of link
-is a module that registers its :class:`LinkKind`, plus its line in :data:`BUILTIN_KINDS`.
+saved run's recorded sensor played back on that bus; and ``rfc2217-serve://``, which has no
+sensor-role opener (it serves played sensors to a recorder under test). A new kind of link
+is a module that registers its :class:`LinkKind`, plus its line in :data:`BUILTIN_KINDS`;
+its recorder-role opener, if it has one, goes in :mod:`conformance.recorder.openers`.
 """
 
 from __future__ import annotations
@@ -156,14 +157,33 @@ def sim_declaration(profile: Profile, spec: SimSpec) -> Declaration:
     )
 
 
-def open_port(port: str, *, echo: str = "auto", direction: str = "none") -> OpenedPort:
+def open_port(
+    port: str,
+    *,
+    echo: str = "auto",
+    direction: str = "none",
+    timing_uncertainty: float | None = None,
+) -> OpenedPort:
     """Open ``port`` for the sensor role; ``echo`` and ``direction`` describe a real bench
-    (kinds in virtual time ignore them)."""
-    return find(port).open(port, PortOptions(echo, direction))
+    (kinds in virtual time ignore them). ``timing_uncertainty`` (s, the user's) is applied
+    here, to whatever kind of link opened: it widens the link's own figure, never narrows."""
+    kind = find(port)
+    if kind.open_sensor_role is None:
+        raise PortError(f"port {port!r} cannot judge a sensor: {kind.wrong_role}")
+    opened = kind.open_sensor_role(port, PortOptions(echo, direction, timing_uncertainty))
+    opened.link.widen(timing_uncertainty)
+    return opened
 
 
 def _open_sim(port: str, options: PortOptions) -> OpenedPort:
-    return open_sim(parse_sim(port))
+    spec = parse_sim(port)
+    other = sorted(set(spec.extra) & {"recorder-faults", "recorder"})
+    if other:
+        raise PortError(
+            f"sim://?{other[0]}= belongs to the recorder role (--role recorder); "
+            "for a faulty simulated sensor use sim://?faults=NAME"
+        )
+    return open_sim(spec)
 
 
 def open_replay(port: str) -> OpenedPort:
@@ -193,18 +213,11 @@ def recorded_declaration(port: str | None) -> Declaration | None:
     return None
 
 
-def _refuse_served(port: str, options: PortOptions) -> OpenedPort:
-    raise PortError(
-        f"port {port!r} serves played sensors to a recorder under test (--role recorder); "
-        "to judge a sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
-    )
-
-
 SIM = register(
     LinkKind(
         "sim",
         matches=is_sim,
-        open=_open_sim,
+        open_sensor_role=_open_sim,
         info=LinkInfo(kind="sim", virtual_time=True),
         example="sim://?faults=no-service-request&version=1.3",
     )
@@ -213,7 +226,7 @@ REPLAY = register(
     LinkKind(
         "replay",
         matches=is_replay,
-        open=lambda port, options: open_replay(port),
+        open_sensor_role=lambda port, options: open_replay(port),
         info=LinkInfo(kind="replay", virtual_time=True),
         example="replay:reports/20250101-120000-sensor",
     )
@@ -222,8 +235,12 @@ SERVED = register(
     LinkKind(
         "rfc2217-serve",
         matches=lambda port: port.startswith("rfc2217-serve://"),
-        open=_refuse_served,
+        open_sensor_role=None,
         info=LinkInfo(kind="rfc2217-serve"),
         example="rfc2217-serve://127.0.0.1:0",
+        wrong_role=(
+            "it serves played sensors to a recorder under test (--role recorder); to judge a "
+            "sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
+        ),
     )
 )

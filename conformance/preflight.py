@@ -13,8 +13,6 @@ from pathlib import Path
 
 from .declaration import ALLOWED_ADDRESSES, address_problem
 from .options import UsageError, check_address, check_uncertainty
-from .ports import is_sim, parse_sim
-from .recorder.faults import RECORDER_FAULTS
 
 __all__ = [
     "ALLOWED_ADDRESSES",
@@ -28,7 +26,6 @@ __all__ = [
 
 def check_role_options(
     role: str,
-    port: str,
     trigger: str | None,
     address: str | None = None,
     sweep: str | None = None,
@@ -54,20 +51,6 @@ def check_role_options(
         raise UsageError(
             "--trigger makes a data recorder act (--role recorder); a sensor needs no trigger"
         )
-    if not is_sim(port):
-        return
-    spec = parse_sim(port)
-    if role == "recorder" and spec.faults:
-        raise UsageError(
-            "sim://?faults= breaks the simulated sensor judged in the sensor role; in the "
-            f"recorder role use sim://?recorder-faults=NAME ({_recorder_fault_names()})"
-        )
-    other = sorted(set(spec.extra) & {"recorder-faults", "recorder"})
-    if role == "sensor" and other:
-        raise UsageError(
-            f"sim://?{other[0]}= belongs to the recorder role (--role recorder); "
-            "for a faulty simulated sensor use sim://?faults=NAME"
-        )
 
 
 def check_report_dir(path: Path) -> Path:
@@ -89,7 +72,3 @@ def check_report_dir(path: Path) -> Path:
             "--report-dir DIR"
         ) from None
     return path
-
-
-def _recorder_fault_names() -> str:
-    return ", ".join(sorted(RECORDER_FAULTS))

@@ -13,9 +13,10 @@ from typing import Any
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
+from .dut import Session
 from .emulator_server.realtime import LATE_NOTICE
 from .judges.timing import recheck, undecide_after_late_line
-from .links.base import Link, LinkError
+from .links.base import BusEnd, Link, LinkError
 from .options import run_option_values
 from .ports import is_sim, open_port
 from .protocol.version import V14
@@ -90,8 +91,8 @@ class ConformanceRun:
     started: str = field(default_factory=now_iso)
     finished: str | None = None
     cases: list[CaseRecord] = field(default_factory=list)
-    link: Link | None = None
-    session: Any = None  # SensorSession, or RecorderSession in the recorder role
+    link: BusEnd | None = None  # a link; a served line or a recording (nothing transmits)
+    session: Session | None = None  # the sensor, recorder or passive session
     complete: bool = True
     stop_reason: str = ""
     declaration: Declaration | None = None
@@ -113,14 +114,20 @@ class ConformanceRun:
         return bool(self.cases)
 
     def open_link(self) -> Link:
+        """The sensor role's link, opened the first time it is asked for."""
         if self.link is None:
+            uncertainty = self.options.timing_uncertainty_ms
             opened = open_port(
-                self.options.port, echo=self.options.echo, direction=self.options.direction
+                self.options.port,
+                echo=self.options.echo,
+                direction=self.options.direction,
+                timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
             )
             self.link = opened.link
             if self.declaration is None:
                 self.declaration = opened.declaration
             self.note_options()
+        assert isinstance(self.link, Link), "the sensor role transmits on a link"
         return self.link
 
     def note_options(self) -> None:
@@ -133,7 +140,6 @@ class ConformanceRun:
 
     def sensor_session(self) -> SensorSession:
         if self.session is None:
-            uncertainty = self.options.timing_uncertainty_ms
             link = self.open_link()
             session = SensorSession(
                 link,
@@ -142,13 +148,13 @@ class ConformanceRun:
                 forced_version=normalise_version(self.options.version)
                 if self.options.version
                 else None,
-                timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
             )
             self.session = session
             session.discover()
+        assert isinstance(self.session, SensorSession)
         return self.session
 
-    def recorder_session(self) -> Any:
+    def recorder_session(self) -> RecorderSession:
         """The recorder role's scenario runner (conformance.recorder.session)."""
         if self.session is None:
             opts = self.options
@@ -156,7 +162,7 @@ class ConformanceRun:
             version = normalise_version(opts.version) if opts.version else declared or V14
             driver = driver_for(opts.trigger)
             uncertainty = opts.timing_uncertainty_ms
-            self.session = RecorderSession(
+            session = RecorderSession(
                 opts.port,
                 version=version,
                 driver=driver,
@@ -164,8 +170,9 @@ class ConformanceRun:
                 declaration=self.declaration,
                 job_timeout=opts.job_timeout,
             )
-            self.link = self.session.link
+            self.session, self.link = session, session.link
             self.note_options()
+        assert isinstance(self.session, RecorderSession)
         return self.session
 
     @property
@@ -204,11 +211,10 @@ class ConformanceRun:
     def _check_link(self) -> None:
         """A link that can vouch for its records only at the end (a harness, whose answers
         could have fallen out of step) is asked now, before the verdicts are drawn."""
-        check = getattr(self.link, "check_records", None)
-        if check is None:
+        if self.link is None:
             return
         try:
-            check(self.cases)
+            self.link.check_records(self.cases)
         except LinkError as exc:
             self.complete = False
             self.stop_reason = self.stop_reason or f"link failed: {exc}"
@@ -226,10 +232,7 @@ class ConformanceRun:
         """Recorder role on a served line (``rfc2217-serve://``): if the line this tool kept
         in real time fell behind its schedule, no FAIL or WARN of the run can be trusted to
         be the recorder's own (a false FAIL is what a busy host would otherwise give)."""
-        served = getattr(self.session, "served", None)
-        if served is None:
-            return
-        late = served.line.worst_lateness
+        late = self.session.worst_lateness() if self.session is not None else 0.0
         if late <= LATE_NOTICE:
             return
         for case in self.cases:
@@ -256,21 +259,13 @@ class ConformanceRun:
             "can_break": info.can_break,
             "timing_uncertainty_ms": round((uncertainty or 0.0) * 1000, 3),
         }
-        master = getattr(self.session, "master", None)
-        if master is not None:  # the sensor role: the tool's recorder drove the line
-            master.note_collisions()
-            found["collisions"] = master.collisions
-            found["talk_holds"] = master.holds
-        describe = getattr(self.link, "describe", None)
-        if callable(describe):  # a real bench: echo, how breaks are made, measured timing
-            found["bench"] = describe()
-        stderr = getattr(self.link, "harness_stderr", None)
-        if callable(stderr):  # exec: the harness's own log, its last STDERR_TAIL characters
-            found["harness_stderr"] = stderr()
-        elif callable(kept := getattr(self.session, "harness_stderr", None)):
-            tail = kept()  # the recorder role: one harness per scenario, each tail named
-            if tail is not None:
-                found["harness_stderr"] = tail
+        if self.session is not None:  # the tool recorder's collisions, a harness's stderr
+            found |= self.session.link_facts()
+        bench = self.link.describe()
+        if bench is not None:  # a real bench: echo, how breaks are made, measured timing
+            found["bench"] = bench
+        if self.link.runs_harness:  # exec:/unix: the harness's own log (null: a socket's)
+            found["harness_stderr"] = self.link.harness_stderr()
         return found
 
     def close(self) -> None:

@@ -42,7 +42,8 @@ def _real_time_session(
     faults: str = "", *, stalls: float = 0.0, seed: int = 7, stalled: frozenset[int] = frozenset()
 ) -> SensorSession:
     """A session on the simulated bus whose link looks like a real-time one: a measured
-    uncertainty of ``U``, a local-uncertainty hook (so the judges take it as real time), and
+    uncertainty of ``U``, a local-uncertainty figure and no virtual time (so the judges take
+    it as real time), and
     a share ``stalls`` of the sensor's characters (or those numbered in ``stalled``, counted
     from 0) stamped ``STALL`` late."""
     opened = open_sim(parse_sim(f"sim://?faults={faults}" if faults else "sim"))
@@ -66,6 +67,9 @@ def _real_time_session(
     link.transcript.add = stamped
     session = SensorSession(link, declaration=opened.declaration)
     session.discover()
+    # from here the judges take the link's stamps as a real-time link's (its local figure
+    # counts); discovery itself ran as on the sim bus (no bench probe)
+    link.info = replace(link.info, virtual_time=False)
     return session
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from types import SimpleNamespace
 
+from conformance.dut import DutClaim, Session
 from conformance.reports import html, timing_diagram
 from conformance.results import CaseRecord
 from conformance.run import ConformanceRun, RunOptions
@@ -14,21 +15,28 @@ from conformance.verdicts import Finding, Verdict
 HOSTILE = ["<script>alert(1)</script>", '"><img src=x onerror=alert(1)>']
 
 
+class HostileSession(Session):
+    """A session whose DUT says hostile things about itself."""
+
+    def __init__(self, said: DutClaim) -> None:
+        self.said = said
+        self.version = "14"
+        self.address = "0"
+        self.assumptions = [HOSTILE[1]]
+        self.address_notes = [HOSTILE[0]]
+        self.uncertainty = 0.0
+
+    def claim(self) -> DutClaim:
+        return self.said
+
+
 def hostile_run() -> ConformanceRun:
     run = ConformanceRun(RunOptions())
     ident = SimpleNamespace(
         vendor=HOSTILE[0], model=HOSTILE[1], sensor_version="<b>", optional="</table>", version="14"
     )
     exchange = SimpleNamespace(answered=True, reply_text="014" + HOSTILE[0] + HOSTILE[1] + "\r\n")
-    run.session = SimpleNamespace(
-        identity=ident,
-        ident_exchange=exchange,
-        version="14",
-        address="0",
-        assumptions=[HOSTILE[1]],
-        address_notes=[HOSTILE[0]],
-        uncertainty=0.0,
-    )
+    run.session = HostileSession(DutClaim(ident, exchange.reply_text, "14"))  # type: ignore[arg-type]
     run.finish(complete=True)
     return run
 

@@ -39,7 +39,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # a --port string opened as a link (every kind); the emulator served on a port
     ("ports", ("ports", "emulator_server")),
     # the tool's own data recorder and the judges of what it recorded
-    ("judging", ("tool_recorder", "case", "judges", "view", "preconditions")),
+    ("judging", ("tool_recorder", "case", "judges", "view", "preconditions", "dut")),
     # the two roles; the recorder harness drives a recorder under test
     ("roles", ("sensor", "recorder", "harness.recorder", "harness.client", "replay.recorder")),
     # one conformance run and what starts one: options, checks, the suite, matrices, calibration,

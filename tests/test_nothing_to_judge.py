@@ -17,10 +17,10 @@ from conformance.emulator import default_profile
 from conformance.matrix import run_once
 from conformance.ports import OpenedPort, SimSpec, sim_declaration
 from conformance.recorder.matrix import run_recorder_suite
-from conformance.recorder.session import LineMonitor
 from conformance.results import CaseRecord, aggregate
 from conformance.sensor.session import SensorSession
 from conformance.sim.bus import SimBus, SimLink
+from conformance.sim.line_monitor import LineMonitor
 from conformance.verdicts import NOTHING_TO_JUDGE, Finding, Verdict, passed
 
 

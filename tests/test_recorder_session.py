@@ -14,8 +14,9 @@ from conformance.protocol.commands import measure
 from conformance.recorder.drivers import Interactive, RecorderDriverError, Trigger
 from conformance.recorder.played import SensorSpec, Spoil
 from conformance.recorder.request import Request, Task
-from conformance.recorder.session import LineMonitor, RecorderSession, check_port
+from conformance.recorder.session import RecorderSession, check_port
 from conformance.sim.bus import SimBus, SimLink
+from conformance.sim.line_monitor import LineMonitor
 from conformance.tool_recorder import Master, Policy
 
 

@@ -11,8 +11,8 @@ from conformance import emulator
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import CHAR_TIME
 from conformance.recorder.played import SensorSpec, Spoil
-from conformance.recorder.session import LineMonitor
 from conformance.sim.bus import SimBus, SimLink
+from conformance.sim.line_monitor import LineMonitor
 from conformance.tool_recorder import Master, Policy
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.view.direction import infer_directions

@@ -118,6 +118,8 @@ class HarnessBus(SimBus):
 class HarnessLink(SimLink):
     """The tool's end of a :class:`HarnessBus`; closing it ends the harness."""
 
+    runs_harness = True
+
     def __init__(self, bus: HarnessBus, device: HarnessDevice, kind: str) -> None:
         super().__init__(bus)
         self.device = device
@@ -203,7 +205,7 @@ KINDS = tuple(
         LinkKind(
             name,
             matches=lambda port, name=name: port.startswith(f"{name}:"),
-            open=_open_kind,
+            open_sensor_role=_open_kind,
             info=LinkInfo(kind=name, virtual_time=True, bit_timing=False),
             example=example,
         )

@@ -254,7 +254,7 @@ KIND = register(
     LinkKind(
         "adapter",
         matches=is_adapter_port,
-        open=_open_kind,
+        open_sensor_role=_open_kind,
         info=INFO,
         example="adapter:///dev/ttyUSB0?baud=9600",
     )

@@ -10,9 +10,15 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..protocol.timing import CHAR_TIME
 from ..transcript import Event, EventKind, Transcript
+
+if TYPE_CHECKING:
+    from ..results import CaseRecord
+    from .echo import EchoTracker
+    from .meter import TimingMeter
 
 
 @dataclass(frozen=True)
@@ -44,18 +50,70 @@ class LinkError(RuntimeError):
 StopCondition = Callable[[list[Event]], bool]
 
 
-class Link(ABC):
-    """The tool's end of the bus.
+class BusEnd(ABC):
+    """What a run holds of the bus: its record, what it can do, its clock, and the optional
+    abilities a report asks every kind about (python-can's ``BusABC`` way: a default for each,
+    overridden by the kinds that have it, instead of probing with ``getattr``).
 
-    Times are seconds on the link's own clock (:meth:`now`). ``receive`` is always bounded by a
-    deadline, so a silent or babbling device can never hang the tool.
+    A :class:`Link` is a bus end the tool also transmits on; a line the tool serves to a
+    recorder under test and a recording judged after the fact are bus ends that are not.
     """
 
     info: LinkInfo
     transcript: Transcript
+    #: s: the user's --timing-uncertainty-ms, applied where the port is opened; it widens
+    #: what the link declares or measures and never narrows it
+    widened: float = 0.0
+    #: the stamp statistics of a real interface (:mod:`~conformance.links.meter`); None for
+    #: a bus end whose stamps are exact or fixed
+    meter: TimingMeter | None = None
+    #: what the interface echoes of the tool's own characters (:mod:`~conformance.links.echo`)
+    echo: EchoTracker | None = None
+    #: the DUT is a harness program the link runs (``exec:``/``unix:``): the reports keep
+    #: :meth:`harness_stderr`, even when the harness has none to give
+    runs_harness: bool = False
 
     @abstractmethod
     def now(self) -> float: ...
+
+    def close(self) -> None:  # noqa: B027 - optional for bus ends without resources
+        """Release the port."""
+
+    def widen(self, uncertainty: float | None) -> None:
+        """Take the user's timing uncertainty (s) as a floor under every stamp's."""
+        if uncertainty is not None:
+            self.widened = max(self.widened, uncertainty)
+
+    def timing_uncertainty(self) -> float:
+        """The uncertainty on every stamp now (s): the declared figure, or what a real link
+        has measured of its own stamps so far, widened by the user's."""
+        return max(self.info.timing_uncertainty, self.widened)
+
+    def uncertainty_between(self, start: float, end: float) -> float:
+        """The uncertainty of stamps between ``start`` and ``end``: more than
+        :meth:`timing_uncertainty` only where a real link saw its own stamps irregular."""
+        return self.timing_uncertainty()
+
+    def describe(self) -> dict[str, object] | None:
+        """The bench as measured (echo, how breaks are made, timing), for the reports; None
+        for a bus end with no bench to describe."""
+        return None
+
+    def harness_stderr(self) -> str | None:
+        """The tail of what a harness program wrote to stderr; None without a harness."""
+        return None
+
+    def check_records(self, cases: list[CaseRecord]) -> None:  # noqa: B027 - optional
+        """Vouch for the records before the verdicts are drawn (a harness, whose answers
+        could have fallen out of step, checks them at the end); raises LinkError if not."""
+
+
+class Link(BusEnd):
+    """The tool's end of the bus, where it transmits.
+
+    Times are seconds on the link's own clock (:meth:`now`). ``receive`` is always bounded by a
+    deadline, so a silent or babbling device can never hang the tool.
+    """
 
     @abstractmethod
     def send_break(self, duration: float, *, exact: bool = False) -> Event:
@@ -86,9 +144,6 @@ class Link(ABC):
 
     @abstractmethod
     def wait_until(self, time: float) -> None: ...
-
-    def close(self) -> None:  # noqa: B027 - optional for links without resources
-        """Release the port."""
 
     # helpers shared by all links
     def last_activity(self) -> float:

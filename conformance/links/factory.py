@@ -102,7 +102,8 @@ def open_real_link(
     if kind.info.virtual_time:
         kind = SERIAL
     options = PortOptions(echo.value, direction.value, timing_uncertainty)
-    return kind.open(port, options).link
+    assert kind.open_sensor_role is not None  # a real interface: the tool transmits on it
+    return kind.open_sensor_role(port, options).link
 
 
 def _pyserial_opener(info: LinkInfo, setup: LineSetup) -> Opener:
@@ -136,8 +137,7 @@ def _open_link(
         pulse=pulse,
         direction=None if direction is DirectionLine.NONE else Direction(raw, direction),
     )
-    if timing_uncertainty is not None:
-        link.meter.widen_to = timing_uncertainty
+    link.widen(timing_uncertainty)
     return link
 
 
@@ -204,7 +204,7 @@ def _kind(
     return LinkKind(
         name,
         matches=scheme_is(name),
-        open=_pyserial_opener(info, setup),
+        open_sensor_role=_pyserial_opener(info, setup),
         info=info,
         example=example,
         fallback=fallback,

@@ -2,8 +2,12 @@
 
 A kind of link is one module that calls :func:`register` when it is imported: a
 :class:`LinkKind` saying which port strings it takes, what its links can do at best
-(:class:`~conformance.links.base.LinkInfo`) and how to open one. :mod:`conformance.ports`
-imports every built-in kind module, so ``open_port`` sees them all; nothing else chooses
+(:class:`~conformance.links.base.LinkInfo`) and how to open one in each role: the sensor role
+(the tool is the recorder and transmits on the link) and the recorder role (the tool plays
+sensors to a recorder under test). The recorder-role openers build played sensors and
+recorder drivers, a layer above this one, so :mod:`conformance.recorder.openers` attaches them
+(:func:`attach_recorder_role`). :mod:`conformance.ports` imports every built-in kind module;
+``open_port`` and ``open_recorder_line`` look the port up here, and nothing else chooses
 between kinds. This is python-can's interface table (``can.interfaces.BACKENDS``: a name ->
 the module and class that open it) keyed by the port string instead of a name, because
 SDI-12 benches are named by device paths (``COM3``, ``/dev/ttyUSB0``) as often as by URLs.
@@ -17,7 +21,8 @@ kinds, found when the port is looked up.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 from ..declaration import Declaration
 from .base import Link, LinkInfo
@@ -59,17 +64,28 @@ class OpenedPort:
 #: :class:`~conformance.links.errors.PortError` for a string it cannot use.
 Opener = Callable[[str, PortOptions], OpenedPort]
 
+#: Opens ``port`` for the recorder role, given the recorder driver the user named
+#: (``--trigger``; None: the one the port implies): the line the played sensors go on and
+#: who the recorder under test is (a :class:`conformance.recorder.openers.RecorderLine`).
+RecorderOpener = Callable[[str, PortOptions, Any], Any]
+
 
 @dataclass(frozen=True)
 class LinkKind:
-    """One kind of link: which port strings name it, what it can do, how it opens."""
+    """One kind of link: which port strings name it, what it can do, how it opens in each
+    role (None: the kind serves the other role only; ``wrong_role`` says what to use)."""
 
     name: str  # the LinkInfo.kind of the links it opens
     matches: Callable[[str], bool]  # does this port string name a link of this kind
-    open: Opener
+    open_sensor_role: Opener | None
     info: LinkInfo  # what its links can do at best; an opener may only take away from it
     example: str  # a port string of this kind, for documentation and tests
     fallback: bool = False  # takes every port string no other kind claims
+    open_recorder_role: RecorderOpener | None = None
+    #: what the user should write instead, for a role this kind has no opener for
+    wrong_role: str = ""
+    #: how the kind is named to a user choosing a port for the recorder role
+    recorder_role_hint: str = ""
 
 
 _KINDS: dict[str, LinkKind] = {}
@@ -83,6 +99,14 @@ def register(kind: LinkKind) -> LinkKind:
     if kind.fallback and any(k.fallback and k.name != kind.name for k in _KINDS.values()):
         raise ValueError(f"link kind {kind.name!r}: there is a fallback kind already")
     _KINDS[kind.name] = kind
+    return kind
+
+
+def attach_recorder_role(name: str, opener: RecorderOpener, hint: str) -> LinkKind:
+    """Give the registered kind ``name`` its recorder-role opener (``hint``: how the kind
+    reads in the list of ports the recorder role takes)."""
+    kind = replace(_KINDS[name], open_recorder_role=opener, recorder_role_hint=hint)
+    _KINDS[name] = kind
     return kind
 
 

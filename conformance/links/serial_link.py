@@ -117,6 +117,12 @@ class SerialLink(Link):
         """What this link's stamps are worth so far (s): declared floor or measured."""
         return self.meter.uncertainty()
 
+    def widen(self, uncertainty: float | None) -> None:
+        """The user's figure goes to the meter, which reports it as the reason when it is
+        what decides a stamp's worth."""
+        super().widen(uncertainty)
+        self.meter.widen_to = self.widened
+
     def uncertainty_between(self, start: float, end: float) -> float:
         """What a measurement between two instants is worth (s): more than
         :meth:`timing_uncertainty` where the run saw its stamps irregular near them."""

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..declaration import normalise_version
+from ..dut import DutClaim, Session, sensor_claim
 from ..judges.exchanges import identification
 from ..judges.timing import StampUncertainty
 from ..preconditions import NOT_SEEN as _NOT_SEEN
@@ -56,7 +57,7 @@ def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
 
 
 @dataclass
-class Heard:
+class Heard(Session):
     """What both roles' passive cases share: the recording and its view."""
 
     link: RecordingLink
@@ -118,6 +119,9 @@ class HeardSensors(Heard):
 
     def exchanges_of(self, *kinds: Kind) -> list[Exchange]:
         return [x for x in self.exchanges if x.command is not None and x.command.kind in kinds]
+
+    def claim(self) -> DutClaim:
+        return sensor_claim(self.identity, self.ident_exchange, self.forced_version, self.version)
 
 
 @dataclass

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..capture.errors import CaptureError
-from ..links.base import LinkInfo
+from ..links.base import BusEnd, LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
 from ..replay.recording import RecordingError, read_recording
@@ -93,7 +93,7 @@ def parse_recording(port: str) -> RecordingSpec:
 
 
 @dataclass
-class RecordingLink:
+class RecordingLink(BusEnd):
     """A recording standing where a link would: its events, and what they are.
 
     ``uncertainty`` is the recording's own timing uncertainty (s): a capture's stamps, or the
@@ -119,6 +119,9 @@ class RecordingLink:
     def now(self) -> float:
         events = self.transcript.events
         return max((e.end for e in events), default=0.0)
+
+    def timing_uncertainty(self) -> float:
+        return max(self.uncertainty, self.widened)
 
     def close(self) -> None:
         """Nothing is open: the recording was read whole (a capture, streamed by its decoder)."""
@@ -179,7 +182,7 @@ RECORDING = register(
     LinkKind(
         "recording",
         matches=is_recording,
-        open=_open,
+        open_sensor_role=_open,
         info=LinkInfo(kind="recording", can_break=False),
         example="recording:capture.sr?format=sr&channel=D0",
     )

@@ -29,7 +29,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from ..emulator_server.realtime import RealTimeLine
 from ..emulator_server.servers import TcpEmulatorServer
-from ..links.base import LinkInfo
+from ..links.base import BusEnd, LinkInfo
 from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
 from ..links.priority import quick_gil_handover
 from ..ports import PortError
@@ -170,16 +170,18 @@ class PlayedBus:
             return Frame(start, frame.wire, frame.duration)
 
 
-class ServedLine:
+class ServedLine(BusEnd):
     """The tool's end of the served line: what the run's reports read as its link (kind,
     breaks, uncertainty, transcript, clock). The tool transmits nothing on it itself: the
     played sensors do, on the line's thread."""
 
-    def __init__(self, spec: ServeSpec, uncertainty: float | None = None) -> None:
+    def __init__(self, spec: ServeSpec, widen_to: float | None = None) -> None:
         host = spec.host
-        if uncertainty is None:
-            loopback = _is_loopback(f"x://{host}:0")
-            uncertainty = LOCAL_NET_UNCERTAINTY if loopback else REMOTE_NET_UNCERTAINTY
+        loopback = _is_loopback(f"x://{host}:0")
+        uncertainty = LOCAL_NET_UNCERTAINTY if loopback else REMOTE_NET_UNCERTAINTY
+        # the user's figure widens the network's, as on every link (never narrows it); the
+        # played sensors' stamps carry it, so a replay of the run reads the same figure
+        uncertainty = max(uncertainty, widen_to or 0.0)
         self.info = LinkInfo(kind=SCHEME, can_break=True, timing_uncertainty=uncertainty)
         self._t0 = time.perf_counter()
         self.bus = PlayedBus(uncertainty, self.now)

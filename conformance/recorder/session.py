@@ -16,65 +16,41 @@ the served line's, as the sensors hear it, in the same form.
 
 from __future__ import annotations
 
-import importlib
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from ..declaration import Declaration
+from ..dut import Session
 from ..harness.channel import STDERR_TAIL
-from ..harness.device import is_harness_port
 from ..harness.recorder import HarnessRecorder
 from ..judges.recorder import Line, merge_lines, read_line
-from ..links.base import Link, LinkError, LinkInfo
-from ..ports import PortError, SimSpec, is_sim, parse_sim
+from ..links.base import LinkError
+from ..links.registry import PortOptions
 from ..protocol.version import V14, format_version, is_v14
-from ..replay.link import is_replay, open_recorder_replay, replayed_info
-from ..replay.recorder import RecordedRecorder, output_note
-from ..replay.recording import RecordingError
+from ..replay.recorder import output_note
 from ..results import CaseRecord
-from ..sim.bus import Frame, SimBus, SimLink
-from ..suggest import did_you_mean
+from ..sim.bus import SimBus
+from ..sim.line_monitor import LineMonitor
 from ..transcript import TOOL, Event, EventKind
 from .capability import Absence, Capabilities, cannot_finding, sent_tokens
 from .drivers import (
     Driver,
-    InProcess,
     Interactive,
     RecorderDriverError,
     RecorderSetupError,
     Trigger,
 )
-from .faults import RECORDER_FAULTS, faulty_recorder
 from .job_time import JobBudget, JobTimeout, job_budget
+from .openers import open_recorder_line
 from .played import build_sensors
-from .realtime import ServedLine, is_served, parse_served
+from .realtime import ServedLine
 from .request import RecorderOutput, Request
 from .scenarios import SCENARIOS, Scenario
 
 #: Marking left after a recorder finished, so late sensor output is on record and the next
 #: scenario starts on a quiet line with every sensor in standby.
 SETTLE = 1.0
-
-
-class LineMonitor:
-    """A silent device on the sim bus. With it the bus names every sensor by its own name
-    (``sensor0``...) even when one sensor plays alone, instead of calling it the DUT: in the
-    recorder role the DUT is the recorder."""
-
-    name = "monitor"
-
-    def on_break(self, start: float, end: float) -> None:
-        """Hears breaks; keeps nothing (the transcript has them)."""
-
-    def on_char(self, wire: int, start: float, end: float) -> None:
-        """Hears characters; keeps nothing."""
-
-    def next_frame(self) -> Frame | None:
-        return None
-
-    def pop_frame(self) -> Frame:
-        raise RuntimeError("the line monitor never transmits")
 
 
 @dataclass
@@ -108,19 +84,7 @@ class ScenarioRun:
         return ()
 
 
-def load_program(path: str) -> Callable:
-    """``package.module:callable`` -> the callable (a recorder program or a factory)."""
-    module, _, name = path.partition(":")
-    if not module or not name:
-        raise PortError(f"recorder program {path!r} is not 'package.module:callable'")
-    try:
-        obj = getattr(importlib.import_module(module), name)
-    except (ImportError, AttributeError) as exc:
-        raise PortError(f"cannot load recorder program {path!r}: {exc}") from exc
-    return obj
-
-
-class RecorderSession:
+class RecorderSession(Session):
     """Runs scenarios against the recorder under test and keeps their records."""
 
     def __init__(
@@ -134,78 +98,23 @@ class RecorderSession:
         job_timeout: float | None = None,
     ) -> None:
         self.job_timeout = job_timeout  # --job-timeout: one budget for every job
-        served = is_served(port)
-        harness = is_harness_port(port)
-        replay = is_replay(port)
-        if not is_sim(port) and not served and not harness and not replay:
-            raise PortError(
-                f"port {port!r}: the recorder role plays the sensors itself: use --port sim "
-                "(virtual time), --port 'exec:PROGRAM ARGS' (a recorder harness, virtual time) "
-                "or --port rfc2217-serve://127.0.0.1:0 (served in real time, "
-                "the recorder connects over RFC 2217)"
-            )
-        spec = parse_served(port) if served else SimSpec() if harness or replay else parse_sim(port)
-        faults = tuple(f for f in spec.extra.get("recorder-faults", "").split(",") if f)
-        unknown = [f for f in faults if f not in RECORDER_FAULTS]
-        if unknown or len(faults) > 1:
-            known = ", ".join(sorted(RECORDER_FAULTS))
-            hint = did_you_mean(unknown, RECORDER_FAULTS)
-            raise PortError(
-                f"recorder-faults takes one of: {known} (got {','.join(faults)}){hint}; "
-                "`sdi12-conform faults --role recorder` describes them"
-            )
-        recording = None
-        if replay:
-            try:
-                recording = open_recorder_replay(port)
-            except RecordingError as exc:
-                raise PortError(str(exc)) from exc
-            driver = RecordedRecorder(recording.events)
-        elif driver is None and harness:
-            driver = HarnessRecorder(port)
-            driver.probe()
-        elif driver is None:
-            program = spec.extra.get("recorder")
-            driver = InProcess(load_program(program)() if program else faulty_recorder(faults))
-        elif driver.needs_real_time and not served:
-            raise PortError(
-                f"a {driver.kind} recorder acts outside this process and cannot reach the "
-                "simulated bus; serve the played sensors in real time with "
-                "--port rfc2217-serve://127.0.0.1:0 (the recorder connects to SDI12_PORT)"
-            )
-        self.driver = driver
-        self.faults = faults
-        self.served: ServedLine | None = None
-        if served:
-            self.served = ServedLine(spec, timing_uncertainty)  # type: ignore[arg-type]
-            self.link = self.served  # type: ignore[assignment] - what the reports read
-            environment = getattr(driver, "environment", None)
-            if environment is not None:  # an external recorder is told where to connect
-                environment["SDI12_PORT"] = self.served.url
-        else:
-            self.bus = SimBus([LineMonitor()])
-            self.link: Link = SimLink(self.bus)
-            if harness:  # the reports name the harness link, still virtual time
-                kind = port.partition(":")[0]
-                self.link.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
-            if recording is not None:  # a replay: the recorded run's link, as it was
-                self.link.info = replayed_info(recording)
+        options = PortOptions(timing_uncertainty=timing_uncertainty)
+        opened = open_recorder_line(port, options, driver)
+        self.driver = opened.driver
+        self.faults = opened.faults
+        self.served = opened.served
+        self.link = opened.link  # what the reports read: the sim bus's tool end, or the line
+        self._bus = opened.bus
         self.version = version
         self.capabilities = Capabilities(declaration, version)
-        self.uncertainty = (
-            self.link.info.timing_uncertainty if timing_uncertainty is None else timing_uncertainty
-        )
         self.recorder_origins = frozenset({TOOL})
         self.runs: dict[str, ScenarioRun] = {}
-        # what the reports' DUT block reads (shared with the sensor session's shape)
-        self.address = None
-        self.identity = None
-        self.ident_exchange = None
+        self.address = None  # a recorder has no address of its own
         self.address_notes: list[str] = []  # the recorder role changes no DUT address
         self.assumptions = [
             f"recorder claims SDI-12 v{format_version(version)}",
-            f"recorder driven {driver.kind}"
-            + (f" (golden recorder with fault {faults[0]})" if faults else ""),
+            f"recorder driven {self.driver.kind}"
+            + (f" (golden recorder with fault {self.faults[0]})" if self.faults else ""),
         ]
         if self.served is not None:
             self.assumptions.append(
@@ -217,6 +126,26 @@ class RecorderSession:
     @property
     def is_v14(self) -> bool:
         return is_v14(self.version)
+
+    @property
+    def uncertainty(self) -> float:
+        """The stamps' uncertainty (s): the line's figure, widened by the user's."""
+        return self.link.timing_uncertainty()
+
+    def link_facts(self) -> dict[str, Any]:
+        """A recorder harness's stderr, one tail per scenario (nothing without a harness)."""
+        tail = self.harness_stderr()
+        return {} if tail is None else {"harness_stderr": tail}
+
+    def worst_lateness(self) -> float:
+        """How far the served line fell behind its schedule (s; 0 on the sim bus)."""
+        return self.served.line.worst_lateness if self.served is not None else 0.0
+
+    @property
+    def bus(self) -> SimBus:
+        """The virtual-time bus the played sensors go on (not on a served line)."""
+        assert self._bus is not None, "played sensors are served in real time"
+        return self._bus
 
     def is_recorder(self, event: Event) -> bool:
         return event.origin in self.recorder_origins
@@ -380,8 +309,7 @@ class RecorderSession:
 
     def close(self) -> None:
         """Stop serving (real-time ports); nothing to release on the simulated bus."""
-        if self.served is not None:
-            self.served.close()
+        self.link.close()
 
 
 def _failed(exc: RecorderDriverError) -> tuple[RecorderOutput, str, JobTimeout | None]:

@@ -9,6 +9,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from ..dut import DutClaim
 from ..links.bus_time import bus_time
 from ..protocol.version import format_version
 from ..replay.recording import write_recording
@@ -26,16 +27,11 @@ SCHEMA = "sdi12-conform/verdicts/1"
 
 def dut_block(run: ConformanceRun) -> dict[str, Any]:
     session = run.session
-    ident = session.identity if session else None
-    raw = None
-    if session and session.ident_exchange is not None and session.ident_exchange.answered:
-        raw = session.ident_exchange.reply_text
-    version = session.version if session else None
-    if run.options.role == "sensor" and session and not (ident or session.forced_version):
-        version = None  # nothing answered aI! and nobody forced a rule set: no claim to show
+    claim = session.claim() if session else DutClaim()
+    ident, version = claim.identity, claim.version
     return {
         "address": session.address if session else run.options.address,
-        "identification": raw,
+        "identification": claim.reply,
         "sdi12_version": format_version(version) if version else None,
         "vendor": ident.vendor if ident else None,
         "model": ident.model if ident else None,

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 from ..declaration import Declaration
+from ..dut import DutClaim, Session, sensor_claim
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
 from ..protocol import commands as cmd
@@ -136,7 +137,7 @@ class NoDeviceAnswered(RuntimeError):
     """Nothing answered at the address: a wiring/power/address problem, not a verdict."""
 
 
-class SensorSession:
+class SensorSession(Session):
     def __init__(
         self,
         link: Link,
@@ -144,7 +145,6 @@ class SensorSession:
         address: str | None = None,
         declaration: Declaration | None = None,
         forced_version: str | None = None,
-        timing_uncertainty: float | None = None,
     ) -> None:
         self.link = link
         self.master = WatchedMaster(link)
@@ -152,7 +152,6 @@ class SensorSession:
         self.requested_address = address or self.declaration.address
         self.address = self.requested_address or "0"
         self.forced_version = forced_version or self.declaration.sdi12_version
-        self._widen = timing_uncertainty or 0.0  # the user may widen, never narrow
         self.identity: Identification | None = None
         self.ident_exchange: Exchange | None = None
         self.assumptions: list[str] = []
@@ -221,19 +220,28 @@ class SensorSession:
             "Check wiring and power, or try ?! with one sensor on the bus."
         )
 
+    def claim(self) -> DutClaim:
+        return sensor_claim(self.identity, self.ident_exchange, self.forced_version, self.version)
+
+    def link_facts(self) -> dict[str, Any]:
+        """The tool recorder drove the line: how often the DUT talked over it, and how often
+        it held a command back for a line still busy."""
+        self.master.note_collisions()
+        return {"collisions": self.master.collisions, "talk_holds": self.master.holds}
+
     @property
     def uncertainty(self) -> float:
         """The timing uncertainty findings use now (s): what the link has measured of its own
-        stamps so far (never less than its declared floor), widened by the user's figure."""
-        measured = getattr(self.link, "timing_uncertainty", None)
-        base = measured() if callable(measured) else self.link.info.timing_uncertainty
-        return max(base, self._widen)
+        stamps so far (never less than its declared floor), widened by the user's figure
+        (applied where the port was opened)."""
+        return self.link.timing_uncertainty()
 
     @property
     def stamp_uncertainty(self) -> StampUncertainty:
-        """:attr:`uncertainty`, plus where the link saw its own stamps irregular."""
-        local = getattr(self.link, "uncertainty_between", None)
-        return StampUncertainty(self.uncertainty, local if callable(local) else None)
+        """:attr:`uncertainty`, plus where a real link saw its own stamps irregular (a link in
+        virtual time has no such places)."""
+        local = None if self.link.info.virtual_time else self.link.uncertainty_between
+        return StampUncertainty(self.uncertainty, local)
 
     def probe_bench(self, rounds: int = PROBE_ROUNDS) -> None:
         """Measure the bench before judging anything (real links): a few wake-ups and
@@ -245,10 +253,9 @@ class SensorSession:
         self.assumptions.append(f"bench probed ({rounds} wake-ups): {self.bench_summary()}")
 
     def bench_summary(self) -> str:
-        meter = getattr(self.link, "meter", None)
+        meter, echo = self.link.meter, self.link.echo
         if meter is None:
             return f"declared ±{self.link.info.timing_uncertainty * 1e3:.2f} ms"
-        echo = getattr(self.link, "echo", None)
         said = "interface echoes" if echo is not None and echo.echoes else "no echo"
         return f"{said}; {meter.summary()}"
 
