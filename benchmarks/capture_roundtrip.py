@@ -3,8 +3,9 @@
 One simulated run (``--port``, default ``sim://?faults=wrong-crc``), then ``--repeat`` times,
 every cache cleared and the run's transcript written again as the run writes it: reading that
 transcript back, exporting it as .sr with the tool's TX channel, decoding the capture, the
-whole non-replay part of :func:`conformance.roundtrip.judged_through_capture` (the replay
-stubbed out) and :func:`conformance.roundtrip.capture_changes` itself. Medians of CPU seconds
+whole non-replay part of :func:`conformance.matrices.roundtrip.judged_through_capture`
+(the replay stubbed out) and :func:`conformance.matrices.roundtrip.capture_changes` itself.
+Medians of CPU seconds
 (``time.process_time``) as one JSON line, so two checkouts compare side by side::
 
     PYTHONPATH=OLD python benchmarks/capture_roundtrip.py --tag old
@@ -29,11 +30,11 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
 
     import conformance.capture.decode as decode_mod
+    import conformance.matrices.roundtrip as rt
     import conformance.replay.recording as rec
-    import conformance.roundtrip as rt
     from conformance.capture.decode import decode_capture
     from conformance.capture.export import export_events
-    from conformance.matrix import run_into
+    from conformance.conduct import run_into
     from conformance.transcript import EventKind
 
     base = Path(tempfile.mkdtemp(prefix="sdi12-bench-"))

@@ -17,8 +17,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from conformance.conduct import run_once
 from conformance.emulator import FAULTS, SensorEmulator, default_profile
-from conformance.matrix import row_from, run_once
+from conformance.matrices.sensor_matrix import row_from
 
 ROOT = Path(__file__).resolve().parents[1]
 HARNESS = ROOT / "examples" / "python" / "sensor_harness.py"

@@ -3,7 +3,7 @@
 Run: ``python benchmarks/run_cpu.py [--runs N] [--port PORT ...] TREE [TREE ...]``, each
 TREE a folder holding a checkout (``git worktree`` or ``git archive`` of an older commit).
 Each run is one fresh process (bytecode caching on, as in CI) timing
-``conformance.matrix.run_once(PORT)`` with ``time.process_time``; the trees take turns, so a
+``conformance.conduct.run_once(PORT)`` with ``time.process_time``; the trees take turns, so a
 machine whose load drifts weighs on both alike. Prints every run, then per port the median
 CPU of each tree and its ratio to the first tree's. A benchmark, not a test: the figures
 depend on the machine, the ratios much less.
@@ -21,7 +21,10 @@ from pathlib import Path
 
 ONE_RUN = (
     "import json, sys, time\n"
-    "from conformance.matrix import run_once\n"
+    "try:\n"
+    "    from conformance.conduct import run_once\n"
+    "except ImportError:  # a tree from before issue 21\n"
+    "    from conformance.matrix import run_once\n"
     "started = time.process_time()\n"
     "data = run_once(sys.argv[1])\n"
     "print(json.dumps({'cpu': time.process_time() - started,"

@@ -40,7 +40,7 @@ def normalise(data: object) -> object:
 def items() -> list[tuple[str, str, str]]:
     """(name, port, role) of every run: clean sims, then each sensor and recorder fault."""
     from conformance.emulator import FAULTS
-    from conformance.matrix import fault_port
+    from conformance.matrices.sensor_matrix import fault_port
     from conformance.recorder.faults import RECORDER_FAULTS
 
     runs = [("clean-sensor", "sim", "sensor"), ("clean-recorder", "sim", "recorder")]
@@ -55,7 +55,7 @@ def items() -> list[tuple[str, str, str]]:
 
 
 def snap(item: tuple[str, str, str], out: str) -> str:
-    from conformance.matrix import run_once
+    from conformance.conduct import run_once
 
     name, port, role = item
     data = normalise(run_once(port, role=role))
@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     runs = [i for i in items() if not args.only or i[0] in args.only]
     from functools import partial
 
-    from conformance.matrix import run_rows
+    from conformance.matrices.sensor_matrix import run_rows
 
     run_rows(
         runs,

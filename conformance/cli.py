@@ -212,7 +212,7 @@ def check_run_options(options: RunOptions) -> bool:
     if options.declaration:
         load_declaration(options.declaration)
     if options.role == "recorder":
-        from .recorder.session import check_port
+        from .recorder.scenario_runner import check_port
 
         return check_port(options.port, options.trigger)  # the port and recorder first
     from .ports import open_port
@@ -228,7 +228,7 @@ def _plan_first(options: RunOptions, report_dir: Path, console: Console) -> None
     """The test plan into the run folder before the run (issue 24): the report shows it next
     to what was judged, and the user sees how long the run will take on the bus. A Ctrl-C
     during the dry run stops it at its next case (the shared guard records it)."""
-    from .plan_command import cached_plan
+    from .commands.plan import cached_plan
     from .reports.plan import duration, write_plan
 
     plan = cached_plan(options.role, options.declaration, options.version, options.keyword,
@@ -294,7 +294,7 @@ def _conducted(
     if interrupted:
         return EXIT_INCOMPLETE, data
     if baseline_run is not None:
-        from .diff_command import against_baseline
+        from .commands.diff import against_baseline
 
         return against_baseline(
             baseline_run, baseline, data, report_dir, exit_status, console
@@ -328,7 +328,7 @@ def cmd_judge(argv: list[str], console: Console) -> int:
             console.print(f"note: {why}", markup=False, highlight=False)
             return EXIT_INCOMPLETE
         return code
-    from .offline.passive import judge_passively
+    from .commands.passive import judge_passively
 
     assert found.passive is not None  # plan() gives one or the other
     return judge_passively(found.passive, console)
@@ -388,7 +388,7 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     from rich.table import Table
 
     if args.role == "recorder":
-        from .fault_tables import recorder_faults_table
+        from .commands.fault_tables import recorder_faults_table
 
         console.print(recorder_faults_table())
         return EXIT_COMPLIANT
@@ -445,7 +445,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
         return _combination_matrix(args, console)
     from rich.table import Table
 
-    from .matrix import MatrixRow, fault_matrix
+    from .matrices.sensor_matrix import MatrixRow, fault_matrix
 
     names = [f for f in (args.faults or "").split(",") if f] or None
     from .emulator import FAULTS
@@ -470,7 +470,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
 
     status.print(f"running the sensor suite once per fault, {args.jobs} at a time...")
     if args.through_capture:
-        from .roundtrip import row_through_capture
+        from .matrices.roundtrip import row_through_capture
 
         rows = fault_matrix(names, args.jobs, progress, row=row_through_capture)
     else:
@@ -494,7 +494,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
 
 def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
     """``matrix --combinations N``: per combination its unexplained rows, then totals."""
-    from .combinations import DEFAULT_SEED, ComboRow, combination_matrix, sample
+    from .matrices.combinations import DEFAULT_SEED, ComboRow, combination_matrix, sample
 
     if args.combinations < 1 or args.jobs < 1:
         error("error: --combinations and --jobs must be 1 or more")
@@ -613,15 +613,15 @@ def _dispatch(argv: list[str]) -> int:
 
             return monitor_main(argv[1:], console, cmd_judge)
         if argv and argv[0] == "diff":
-            from .diff_command import diff_main
+            from .commands.diff import diff_main
 
             return diff_main(argv[1:], console)
         if argv and argv[0] == "plan":
-            from .plan_command import plan_main
+            from .commands.plan import plan_main
 
             return plan_main(argv[1:])
         if argv and argv[0] == "verify":
-            from .verify_command import verify_main
+            from .commands.verify import verify_main
 
             return verify_main(argv[1:], console, cmd_judge)
         if argv and argv[0] == "calibrate":

@@ -8,6 +8,7 @@ verdicts come back from memory (no verdicts.json read back, no subprocess).
 
 from __future__ import annotations
 
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -75,3 +76,28 @@ def conduct(
     given = GivenOptions(options)
     code = int(pytest.main(argv, plugins=[*plugins, given]))
     return RunResult(code, report_dir, given.run)
+
+
+class NoVerdicts(RuntimeError):
+    """The run wrote no verdicts (pytest stopped first: nothing collected, a usage error)."""
+
+
+def run_once(port: str, role: str = "sensor", **options: Any) -> dict:
+    """Run the ``role`` suite in this process against ``port``; return verdicts.json.
+    ``options``: more :class:`~conformance.run.RunOptions` fields (``version="1.3"``,
+    ``keyword="crc"``)."""
+    with tempfile.TemporaryDirectory(prefix=f"sdi12-{role}-") as tmp:
+        return run_into(Path(tmp), port, role, **options)
+
+
+def run_into(report_dir: Path, port: str, role: str = "sensor", **options: Any) -> dict:
+    """Run the ``role`` suite in this process against ``port`` with its reports (no HTML) in
+    ``report_dir``; return verdicts.json (from memory: the run's own, never a file's)."""
+    report_dir.mkdir(parents=True, exist_ok=True)
+    given = RunOptions(port=port, role=role, report_dir=str(report_dir), **options)
+    result = conduct(given, html=False, rootdir=report_dir)
+    if result.document is None:
+        raise NoVerdicts(
+            f"the {role} suite against {port} wrote no verdicts (pytest exit {result.pytest_code})"
+        )
+    return result.document

@@ -24,9 +24,9 @@ from .links import adapter_link, factory
 from .links.base import LinkInfo
 from .links.errors import PortError
 from .links.registry import LinkKind, OpenedPort, PortOptions, find, register
-from .offline import recording_link
 from .protocol.commands import ADDRESS_CHARS
 from .protocol.version import V14, format_version, parse_version
+from .replay import recording_link
 from .replay.link import is_replay
 from .suggest import did_you_mean
 

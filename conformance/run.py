@@ -20,7 +20,7 @@ from .links.base import BusEnd, Link, LinkError
 from .options import run_option_values
 from .ports import is_sim, open_port
 from .protocol.version import V14
-from .recorder.session import RecorderSession, driver_for
+from .recorder.scenario_runner import RecorderSession, driver_for
 from .replay.recording import options_note
 from .report_folder import run_folder
 from .results import CaseRecord, RequirementResult, aggregate, overall
@@ -155,7 +155,7 @@ class ConformanceRun:
         return self.session
 
     def recorder_session(self) -> RecorderSession:
-        """The recorder role's scenario runner (conformance.recorder.session)."""
+        """The recorder role's scenario runner (conformance.recorder.scenario_runner)."""
         if self.session is None:
             opts = self.options
             declared = self.declaration.sdi12_version if self.declaration else None
@@ -273,4 +273,4 @@ class ConformanceRun:
             self.link.close()
 
 
-TOOL = {"name": "sdi12-conform", "version": __version__}
+TOOL_IDENTITY = {"name": "sdi12-conform", "version": __version__}

@@ -6,7 +6,7 @@ Not test modules themselves: ``test_nothing_to_judge.py`` puts them on the line.
 from __future__ import annotations
 
 from conformance.links.base import Link
-from conformance.recorder.request import RecorderOutput, Request
+from conformance.recorder_jobs import RecorderOutput, Request
 
 
 def idle_recorder() -> object:

@@ -1,14 +1,15 @@
 """The combination fault matrix (issue 18, part 7): the checking logic on made-up verdicts
 (fast), and a CI-sized seeded selection of fault pairs run against the suite (marker
 ``matrix``). Combinations the measurement (notes/combos-result.md) found unexplained are
-listed in :data:`conformance.combinations.KNOWN_OPEN` and expected to fail strictly, so a fix
-flips them and the list must shrink."""
+listed in :data:`conformance.matrices.combinations.KNOWN_OPEN` and expected to fail strictly,
+so a fix flips them and the list must shrink."""
 
 from __future__ import annotations
 
 import pytest
 
-from conformance.combinations import (
+from conformance.emulator.faults.interactions import Interaction
+from conformance.matrices.combinations import (
     CI_COMBINATIONS,
     KNOWN_OPEN,
     check,
@@ -16,7 +17,6 @@ from conformance.combinations import (
     combo_row,
     sample,
 )
-from conformance.emulator.faults.interactions import Interaction
 
 DECLARED = {"a": (("R-1",), ("R-2",)), "b": (("R-3",), ())}
 
@@ -110,8 +110,9 @@ def test_combination_flags_only_its_members_requirements_and_misses_none(combo):
 
 def test_cli_prints_each_unexplained_row_and_totals_and_exits_1(monkeypatch, capsys):
     """``matrix --combinations``: the rows a (stubbed) run reports, totals, exit 1."""
-    from conformance import cli, combinations
-    from conformance.combinations import ComboRow, Finding
+    from conformance import cli
+    from conformance.matrices import combinations
+    from conformance.matrices.combinations import ComboRow, Finding
 
     def fake(combos, processes, progress):
         assert len(combos) == 2 and all(len(c) == 3 for c in combos)

@@ -81,7 +81,7 @@ def test_judge_replays_and_judges_passively_through_the_same_entry_point(
 
 
 def test_the_matrix_runs_through_it_too(handed):
-    from conformance.matrix import run_once
+    from conformance.conduct import run_once
 
     data = run_once("sim://?faults=crc-missing", keyword="crc")
     assert data["summary"]["verdict"] == "NON-COMPLIANT"

@@ -113,7 +113,7 @@ def test_one_line(text, width, expected):
 @pytest.mark.slow
 def test_judged_counts_verdicts_on_the_device_not_na():
     """Issue 10: a v1.3 run judged 77 rules; the 29 that bind v1.4 only are N/A, said apart."""
-    from conformance.matrix import run_once
+    from conformance.conduct import run_once
     from conformance.reports.console import _coverage
 
     line = _coverage(run_once("sim://?version=1.3"))

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from conformance.cli import main
-from conformance.combinations import combo_port
+from conformance.conduct import run_into, run_once
 from conformance.emulator import FAULTS
-from conformance.matrix import run_into, run_once
+from conformance.matrices.combinations import combo_port
 from conformance.reports.diff import DiffError, diff_runs, load_run, worse
 
 

@@ -17,9 +17,10 @@ from __future__ import annotations
 import pytest
 
 from conformance.catalog import for_role
+from conformance.conduct import run_once
 from conformance.emulator import FAULTS
-from conformance.matrix import MatrixRow, fault_matrix, run_once
-from conformance.roundtrip import in_capture_sample, row_through_sampled_capture
+from conformance.matrices.roundtrip import in_capture_sample, row_through_sampled_capture
+from conformance.matrices.sensor_matrix import MatrixRow, fault_matrix
 
 #: A handful of faults (protocol, CRC, timing) the default fast selection
 #: keeps; every other row carries the ``matrix`` marker and runs in the full run (.ci/run).

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
+from conformance.conduct import run_once
 from conformance.judges.support import serves_continuous, text_instead_of_values, values_of
-from conformance.matrix import run_once
 from tests.test_judges import exchange
 
 

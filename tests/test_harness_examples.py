@@ -12,8 +12,9 @@ from pathlib import Path
 
 import pytest
 
+from conformance.conduct import run_once
 from conformance.emulator import FAULTS
-from conformance.matrix import row_from, run_once
+from conformance.matrices.sensor_matrix import row_from
 from conformance.recorder.faults import RECORDER_FAULTS
 
 # Compiles the C harness and runs whole suites through harness processes.

@@ -15,11 +15,11 @@ from pathlib import Path
 
 import pytest
 
+from conformance.conduct import run_once
 from conformance.harness.channel import ChildChannel, HarnessError
 from conformance.harness.device import open_sensor_harness
 from conformance.harness.protocol import Role
 from conformance.links.errors import PortUnavailable
-from conformance.matrix import run_once
 from conformance.ports import open_port
 from conformance.results import CaseRecord
 from conformance.verdicts import Finding, Verdict

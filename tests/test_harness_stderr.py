@@ -7,7 +7,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from conformance.matrix import run_once
+from conformance.conduct import run_once
 
 HARNESS = Path(__file__).resolve().parent.parent / "examples" / "python" / "sensor_harness.py"
 

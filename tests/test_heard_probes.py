@@ -14,9 +14,9 @@ from dataclasses import replace
 
 import pytest
 
+from conformance.conduct import run_once
 from conformance.emulator import sim_sensor
 from conformance.judges.exchanges import silent_while_listening
-from conformance.matrix import run_once
 from conformance.sensor.session import HEARING_MARKINGS, HeardProbe, SensorSession
 from conformance.verdicts import Verdict
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from conformance.conduct import run_once
 from conformance.emulator.sensor import SensorEmulator
-from conformance.matrix import run_once
 from conformance.sensor.session import SensorSession
 
 

@@ -9,8 +9,8 @@ import re
 import pytest
 
 from conformance.catalog import requirement
+from conformance.conduct import run_once
 from conformance.judges.timing import Measured, Window, combine, distribution, judge_window
-from conformance.matrix import run_once
 from conformance.reports.margins import margins_html, margins_json, nice_ticks, strip
 from conformance.results import RequirementResult
 from conformance.verdicts import MAX_TICKS, Verdict

@@ -13,10 +13,10 @@ import pytest
 
 import conformance.run as run_module
 from conformance.catalog import catalog, strongest_verdict
+from conformance.conduct import run_once
 from conformance.emulator import default_profile
-from conformance.matrix import run_once
+from conformance.matrices.recorder_matrix import run_recorder_suite
 from conformance.ports import OpenedPort, SimSpec, sim_declaration
-from conformance.recorder.matrix import run_recorder_suite
 from conformance.results import CaseRecord, aggregate
 from conformance.sensor.session import SensorSession
 from conformance.sim.bus import SimBus, SimLink

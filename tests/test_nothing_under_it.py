@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import pytest
 
+from conformance.conduct import run_once
 from conformance.emulator import FAULTS
-from conformance.matrix import run_once
 from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.verdicts import NOTHING_UNDER_IT, Finding, Verdict, failed, warned
 

@@ -11,9 +11,9 @@ import jsonschema
 import pytest
 
 from conformance.cli import main
+from conformance.commands.plan import make_plan
 from conformance.declaration import DeclarationError, load_declaration
 from conformance.emulator.declared import assumptions, declared_profile
-from conformance.plan_command import make_plan
 from conformance.ports import PortError, open_sim, parse_sim
 from conformance.report_folder import LOCK_NAME
 from conformance.reports.plan import plan_html, plan_markdown
@@ -192,7 +192,7 @@ def test_ctrl_c_while_planning_stops_before_anything_goes_on_the_bus(tmp_path):
 
 
 def test_a_run_plans_once_for_the_same_code_and_declaration(tmp_path, monkeypatch):
-    import conformance.plan_command as plan_command
+    import conformance.commands.plan as plan_command
 
     monkeypatch.setenv("SDI12_CACHE_DIR", str(tmp_path / "cache"))
     first = plan_command.cached_plan("sensor", keyword="ttt_zero")

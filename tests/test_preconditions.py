@@ -15,7 +15,7 @@ import testcases
 from conformance import preconditions as pre
 from conformance.case import Case
 from conformance.catalog import for_role
-from conformance.matrix import run_once
+from conformance.conduct import run_once
 from conformance.results import CaseRecord
 from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Verdict, failed, passed
@@ -214,7 +214,7 @@ def test_every_declared_precondition_is_checked_when_the_sensor_suite_runs():
 
 
 def test_every_declared_precondition_is_checked_when_the_recorder_suite_runs():
-    from conformance.recorder.matrix import run_recorder_suite
+    from conformance.matrices.recorder_matrix import run_recorder_suite
 
     for extra in ({}, {"version": "1.3"}):
         data = run_recorder_suite("sim", **extra)

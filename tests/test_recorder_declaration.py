@@ -15,12 +15,12 @@ import pytest
 from conformance.cli import main
 from conformance.declaration import DeclarationError, load_declaration
 from conformance.harness.protocol import HarnessProtocolError, PlanKind, Role, parse_plan
+from conformance.matrices.recorder_matrix import run_recorder_suite
 from conformance.protocol.commands import Kind
 from conformance.recorder.capability import cannot_finding
 from conformance.recorder.drivers import CANNOT_EXIT, Trigger
 from conformance.recorder.faults import LacksCommandsRecorder
-from conformance.recorder.matrix import run_recorder_suite
-from conformance.recorder.request import Request, Task
+from conformance.recorder_jobs import Request, Task
 from conformance.verdicts import Finding, Verdict
 
 
@@ -147,7 +147,7 @@ def test_an_optional_capability_declared_absent_is_not_asked_and_na(tmp_path):
     is N/A citing the declaration, R-4.3-03 still judged on 0-9."""
     path = write(tmp_path, 'sdi12_version = "1.4"\n[recorder]\naddresses = "0-9"\n')
     with_report = tmp_path / "run"
-    from conformance.matrix import run_into
+    from conformance.conduct import run_into
 
     data = run_into(with_report, PROGRAM + "letterless", "recorder", declaration=str(path))
     got = verdicts(data)

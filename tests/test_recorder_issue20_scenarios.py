@@ -10,7 +10,6 @@ from __future__ import annotations
 import pytest
 from test_recorder_judges import Wire, by_id
 
-from conformance.judges.recorder import read_line
 from conformance.judges.recorder.collection import judge_data_collection
 from conformance.judges.recorder.logged import LogReport, judge_logged_values
 from conformance.judges.recorder.measurements import observed_measurements
@@ -18,9 +17,10 @@ from conformance.judges.recorder.replies import reply_problem
 from conformance.judges.recorder.retries import judge_retries
 from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.recorder.faults import RECORDER_FAULTS
+from conformance.recorder.scenario_runner import RecorderSession
 from conformance.recorder.scenarios import EDGE_REPLY, LONG_TTT, LONG_TTT_READY, SCENARIOS
-from conformance.recorder.session import RecorderSession
 from conformance.verdicts import Verdict
+from conformance.view.segments import read_view
 
 NEW = ("ttt-over-255", "concurrent-ttt-zero", "parity-mid-reply", "reply-at-window-edge")
 
@@ -28,7 +28,7 @@ NEW = ("ttt-over-255", "concurrent-ttt-zero", "parity-mid-reply", "reply-at-wind
 def _line(port: str, name: str):
     session = RecorderSession(port)
     run = session.run(name)
-    return read_line(run.events, session.is_recorder), run
+    return read_view(run.events, session.is_recorder), run
 
 
 @pytest.fixture(scope="module")
@@ -56,12 +56,12 @@ def test_eight_bit_ttt_is_judged_early():
     """aD0! 4 s after ttt = 260 (260 % 256), before the service request: R-4.4.5-04 fails."""
     w = Wire().brk().rec("0M!").sensor("02603\r\n").idle(4005).brk().rec("0D0!")
     w.sensor("0\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(w.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.FAIL
     assert found["R-4.4.5-07"].verdict is Verdict.FAIL
     w = Wire().brk().rec("0M!").sensor("02603\r\n").sensor("0\r\n", delay_ms=5000)
     w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(w.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.PASS
 
 
@@ -77,7 +77,7 @@ def test_a_concurrent_ttt_zero_never_collected_fails_the_collection_rule():
     w = Wire().brk().rec("0C!").sensor("000005\r\n").idle(20).brk().rec("1C!")
     w.sensor("100205\r\n", origin="sensor1").idle(2100).brk().rec("1D0!")
     w.sensor("1+1+2+3+4+5\r\n", origin="sensor1")
-    found = judge_data_collection(observed_measurements(w.line(), 0.0))
+    found = judge_data_collection(observed_measurements(w.view(), 0.0))
     assert found[0].verdict is Verdict.FAIL and "0C!" in found[0].detail
 
 
@@ -95,7 +95,7 @@ def test_a_parity_error_mid_reply_not_retried_fails_r_7_2_05():
     w = Wire().brk().rec("0D0!").sensor("0+22.15+10", delay_ms=9.0)
     w.chars("1", "sensor0", parity=False).chars("3.2+45.7\r\n", "sensor0")
     w.idle(10).rec("0D1!").sensor("0\r\n")
-    found = by_id(judge_retries(w.line(), 0.0))
+    found = by_id(judge_retries(w.view(), 0.0))
     assert found["R-7.2-05"].verdict is Verdict.FAIL and "parity" in found["R-7.2-05"].detail
 
 
@@ -124,7 +124,7 @@ def test_values_logged_from_a_reply_with_a_parity_error_fail_r_4_4_02():
     fine, logging the values before the bad character is a FAIL."""
     w = Wire().brk().rec("0M!").sensor("00003\r\n").idle(9).rec("0D0!")
     w.sensor("0+22.15+10").chars("1", "sensor0", parity=False).chars("3.2+45.7\r\n", "sensor0")
-    line = w.line()
+    line = w.view()
     kept = judge_logged_values(line, [LogReport("p", {"0M!": ["+22.15", "+10"]})], 0.0)
     found = by_id(kept)["R-4.4-02"]
     assert found.verdict is Verdict.FAIL and "not valid" in found.detail

@@ -13,12 +13,12 @@ from pathlib import Path
 
 import pytest
 
-from conformance.matrix import run_once
+from conformance.conduct import run_once
 from conformance.recorder.drivers import Interactive
 from conformance.recorder.job_time import JobBudget, JobLink, JobTimeout, job_budget
 from conformance.recorder.played import build_sensors
-from conformance.recorder.request import Request, Task
 from conformance.recorder.scenarios import LONG_TTT, SCENARIOS
+from conformance.recorder_jobs import Request, Task
 from conformance.sim.bus import SimBus, SimLink
 
 HARNESS = Path(__file__).resolve().parent.parent / "examples" / "python" / "recorder_harness.py"

@@ -48,7 +48,7 @@ class Wire:
         self.t += ms / 1e3
         return self
 
-    def line(self) -> TranscriptView:
+    def view(self) -> TranscriptView:
         return read_view(self.events)
 
 
@@ -57,46 +57,46 @@ def by_id(findings):
 
 
 def test_breaks_and_marking():
-    good = Wire().brk().rec("0!").sensor("0\r\n").line()
+    good = Wire().brk().rec("0!").sensor("0\r\n").view()
     assert {f.verdict for f in judge_breaks(good, 0.0)} == {Verdict.PASS}
-    short = by_id(judge_breaks(Wire().brk(10.0).rec("0!").line(), 0.0))
+    short = by_id(judge_breaks(Wire().brk(10.0).rec("0!").view(), 0.0))
     assert short["R-7.0-02"].verdict is Verdict.FAIL
     assert short["R-7.0-02"].measured_ms == 10.0
-    early = by_id(judge_breaks(Wire().brk(13.0, 5.0).rec("0!").line(), 0.0))
+    early = by_id(judge_breaks(Wire().brk(13.0, 5.0).rec("0!").view(), 0.0))
     assert early["R-7.0-06"].verdict is Verdict.FAIL
     # a 12 ms break stamped with ±1 ms cannot be told from an 11 ms one
-    unsure = by_id(judge_breaks(Wire().brk(12.0).rec("0!").line(), 1e-3))
+    unsure = by_id(judge_breaks(Wire().brk(12.0).rec("0!").view(), 1e-3))
     assert unsure["R-7.0-02"].verdict is Verdict.INCONCLUSIVE
 
 
 def test_command_text():
-    found = by_id(judge_command_text(Wire().brk().rec("0M!").line()))
+    found = by_id(judge_command_text(Wire().brk().rec("0M!").view()))
     assert {f.verdict for f in found.values()} == {Verdict.PASS}
     w = Wire().brk().rec("0M!!").idle(200).brk().rec("$M!").idle(200).brk().rec("0M")
-    bad = by_id(judge_command_text(w.line()))
+    bad = by_id(judge_command_text(w.view()))
     assert bad["R-4.4-04"].verdict is Verdict.FAIL
     assert "0M!!" in bad["R-4.4-04"].detail and "0M:" in bad["R-4.4-04"].detail
     assert bad["R-4.3-01"].verdict is Verdict.FAIL
-    ctrl = by_id(judge_command_text(Wire().brk().rec("0\x07!").line()))
+    ctrl = by_id(judge_command_text(Wire().brk().rec("0\x07!").view()))
     assert ctrl["R-4.2-01"].verdict is Verdict.FAIL
 
 
 def test_character_gaps_have_no_tolerance():
-    ok = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.5).line(), 0.0))
+    ok = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.5).view(), 0.0))
     assert ok["R-7.0-13"].verdict is ok["R-7.0-01"].verdict is Verdict.PASS
-    lean = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.9).line(), 0.0))
+    lean = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.9).view(), 0.0))
     assert lean["R-7.0-13"].verdict is lean["R-7.0-01"].verdict is Verdict.FAIL
-    wide = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=3.0).line(), 0.0))
+    wide = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=3.0).view(), 0.0))
     assert wide["R-7.0-13"].verdict is Verdict.FAIL
     assert wide["R-7.0-01"].verdict is Verdict.PASS
 
 
 def test_break_needed_for_a_new_address_and_after_87_ms():
-    ok = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("0I!").line()
+    ok = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("0I!").view()
     assert by_id(judge_break_rules(ok, 0.0))["R-7.0-17"].verdict is Verdict.PASS
-    new = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("1!").line()
+    new = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("1!").view()
     assert by_id(judge_break_rules(new, 0.0))["R-7.0-17"].verdict is Verdict.FAIL
-    late = Wire().brk().rec("0!").sensor("0\r\n").idle(95).rec("0I!").line()
+    late = Wire().brk().rec("0!").sensor("0\r\n").idle(95).rec("0I!").view()
     found = by_id(judge_break_rules(late, 0.0))["R-7.0-17"]
     assert found.verdict is Verdict.FAIL and found.measured_ms == 95.0
 
@@ -109,11 +109,11 @@ def _measurement(wire: Wire, address: str = "0", code: str = "M") -> Wire:
 def test_no_traffic_to_other_sensors_during_a_measurement():
     w = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(9).rec("0D0!")
     w.sensor("0+1+2+3\r\n")
-    taken = observed_measurements(w.line(), 0.0)
+    taken = observed_measurements(w.view(), 0.0)
     assert by_id(judge_measure_waits(taken, 0.0))["R-4.4.5-06"].verdict is Verdict.PASS
     w = _measurement(Wire()).idle(100).brk().rec("1!").sensor("1\r\n", origin="sensor1")
     w.idle(400).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(w.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
     assert found["R-4.4.5-06"].verdict is Verdict.FAIL
     # the recorder also took the line while the service request could still come
     assert found["R-4.4.5-07"].verdict is Verdict.FAIL
@@ -121,11 +121,11 @@ def test_no_traffic_to_other_sensors_during_a_measurement():
 
 def test_d0_before_ttt_and_late_reaction():
     early = _measurement(Wire()).idle(500).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(early.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(early.view(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.FAIL
     slow = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(900)
     slow.brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(slow.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(slow.view(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.PASS
     # 0.9 s after the service request: beyond the tool's 0.5 s, a figure the standard does
     # not give (decision T1), so a WARN that says so, not a FAIL
@@ -134,48 +134,48 @@ def test_d0_before_ttt_and_late_reaction():
     assert "0.5 s the tool allows" in late.detail and "decision T1" in late.detail
     # issue 20: aD0! 1.058 s after ttt (with its break) is a WARN too
     w = _measurement(Wire()).idle(1000 + 1058).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(w.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
     assert found["R-4.4.5-05"].verdict is Verdict.WARN and "1.058 s after ttt" in (
         found["R-4.4.5-05"].detail
     )
     # without a break after ttt the recorder demonstrably did otherwise: still a FAIL
     w = _measurement(Wire()).idle(1010).rec("0D0!").sensor("0+1+2+3\r\n")
-    found = by_id(judge_measure_waits(observed_measurements(w.line(), 0.0), 0.0))
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
     assert found["R-4.4.5-05"].verdict is Verdict.FAIL
 
 
 def test_empty_reply_must_lead_to_the_measurement_again():
     w = _measurement(Wire()).idle(1100).brk().rec("0D0!").sensor("0\r\n").idle(9).rec("0I!")
     w.sensor("014CONFORM EMU001100\r\n")
-    found = judge_data_collection(observed_measurements(w.line(), 0.0))
+    found = judge_data_collection(observed_measurements(w.view(), 0.0))
     assert found[0].verdict is Verdict.FAIL and "not issued again" in found[0].detail
     w = _measurement(Wire()).idle(1100).brk().rec("0D0!").sensor("0\r\n").idle(9).rec("0M!")
     w.sensor("00013\r\n").idle(1100).brk().rec("0D0!").sensor("0+1+2+3\r\n")
-    assert judge_data_collection(observed_measurements(w.line(), 0.0))[0].verdict is Verdict.PASS
+    assert judge_data_collection(observed_measurements(w.view(), 0.0))[0].verdict is Verdict.PASS
 
 
 def test_retry_windows_and_waiting_for_the_invalid_reply():
-    early = Wire().brk().rec("0!").idle(12).rec("0!").sensor("0\r\n").line()
+    early = Wire().brk().rec("0!").idle(12).rec("0!").sensor("0\r\n").view()
     assert by_id(judge_retries(early, 0.0))["R-7.2-02"].verdict is Verdict.FAIL
-    good = Wire().brk().rec("0!").idle(45).rec("0!").sensor("0\r\n").line()
+    good = Wire().brk().rec("0!").idle(45).rec("0!").sensor("0\r\n").view()
     found = by_id(judge_retries(good, 0.0))
     assert found["R-7.2-02"].verdict is found["R-7.2-01"].verdict is Verdict.PASS
     # a long reply with a parity error; the retry starts before that reply ended
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n", parity=False)
     w.t -= 30e-3  # the retry starts while the last characters are still coming
-    talked_over = w.rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").line()
+    talked_over = w.rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").view()
     assert by_id(judge_retries(talked_over, 0.0))["R-7.2-06"].verdict is Verdict.FAIL
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n", parity=False).idle(25)
-    waited = w.rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").line()
+    waited = w.rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").view()
     assert by_id(judge_retries(waited, 0.0))["R-7.2-06"].verdict is Verdict.PASS
 
 
 def test_gave_up_too_soon():
     w = Wire().brk().rec("0!").idle(45).rec("0!").idle(45).rec("0!").idle(300)
-    found = by_id(judge_retries(w.line(), 0.0))
+    found = by_id(judge_retries(w.view(), 0.0))
     assert found["R-7.2-04"].verdict is Verdict.WARN  # one sequence of three, not three
     assert found["R-7.2-03"].verdict is Verdict.PASS  # two retries, the last after 100 ms
-    once = by_id(judge_retries(Wire().brk().rec("0!").idle(300).line(), 0.0))
+    once = by_id(judge_retries(Wire().brk().rec("0!").idle(300).view(), 0.0))
     assert once["R-7.2-01"].verdict is once["R-7.2-03"].verdict is Verdict.FAIL
 
 
@@ -183,7 +183,7 @@ def test_repeats_with_a_new_break_are_no_retries():
     """Issue 20: a logger that only repeats break + command passed "implements retries" and
     "whole sequence repeated" on those repeats."""
     w = Wire().brk().rec("0!").idle(300).brk().rec("0!").idle(300).brk().rec("0!")
-    found = by_id(judge_retries(w.sensor("0\r\n").line(), 0.0))
+    found = by_id(judge_retries(w.sensor("0\r\n").view(), 0.0))
     assert found["R-7.2-01"].verdict is Verdict.FAIL
     assert "only after a new break" in found["R-7.2-01"].detail
     assert found["R-7.2-02"].verdict is found["R-7.2-05"].verdict is Verdict.FAIL
@@ -192,7 +192,7 @@ def test_repeats_with_a_new_break_are_no_retries():
     assert "no retry in it" in found["R-7.2-04"].detail
     # a parity error, then a break and the command again 1288 ms later: no retry to time
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5\r\n", parity=False).idle(1288)
-    found = by_id(judge_retries(w.brk().rec("0D0!").sensor("0+1.5+2.5\r\n").line(), 0.0))
+    found = by_id(judge_retries(w.brk().rec("0D0!").sensor("0+1.5+2.5\r\n").view(), 0.0))
     assert found["R-7.2-06"].verdict is Verdict.INCONCLUSIVE
     assert "new sequence" in found["R-7.2-06"].detail
     assert found["R-7.2-01"].verdict is found["R-7.2-05"].verdict is Verdict.FAIL
@@ -201,24 +201,24 @@ def test_repeats_with_a_new_break_are_no_retries():
 def test_a_resend_after_the_retry_window_is_no_retry():
     # aD0! again without a break after a 1.5 s poll timeout: the sensor is in standby
     w = Wire().brk().rec("0D0!").idle(1500).rec("0D0!").sensor("0+1+2\r\n")
-    found = by_id(judge_retries(w.line(), 0.0))
+    found = by_id(judge_retries(w.view(), 0.0))
     assert found["R-7.2-01"].verdict is Verdict.FAIL and "standby" in found["R-7.2-01"].detail
     assert found["R-7.2-02"].verdict is Verdict.FAIL
     # 95 ms: still heard as a retry, but late; a PASS of R-7.2-01 needs one inside 87 ms
     w = Wire().brk().rec("0!").idle(95).rec("0!").sensor("0\r\n")
-    found = by_id(judge_retries(w.line(), 0.0))
+    found = by_id(judge_retries(w.view(), 0.0))
     assert found["R-7.2-02"].verdict is Verdict.FAIL
     assert found["R-7.2-01"].verdict is Verdict.INCONCLUSIVE
     # 86.5 ms stamped ±1 ms may be past the window: no PASS on it either
     w = Wire().brk().rec("0!").idle(86.5).rec("0!").sensor("0\r\n")
-    assert by_id(judge_retries(w.line(), 1e-3))["R-7.2-01"].verdict is not Verdict.PASS
+    assert by_id(judge_retries(w.view(), 1e-3))["R-7.2-01"].verdict is not Verdict.PASS
 
 
 def test_a_repeated_sequence_with_retries_passes_the_should():
     w = Wire()
     for _ in range(2):
         w.brk().rec("0!").idle(45).rec("0!").idle(45).rec("0!").idle(300)
-    found = by_id(judge_retries(w.brk().rec("0!").sensor("0\r\n").line(), 0.0))
+    found = by_id(judge_retries(w.brk().rec("0!").sensor("0\r\n").view(), 0.0))
     assert found["R-7.2-04"].verdict is found["R-7.2-01"].verdict is Verdict.PASS
     assert found["R-7.2-03"].verdict is found["R-7.2-05"].verdict is Verdict.PASS
 
@@ -228,7 +228,7 @@ def test_crc_mismatch_must_be_retried():
     wrong = body + ascii_crc("0+1+3")
     w = _measurement(Wire(), code="MC").sensor("0\r\n", delay_ms=200).idle(9).rec("0D0!")
     w.sensor(wrong + "\r\n")
-    line = w.line()
+    line = w.view()
     found = judge_crc_checked(line, 0.0, None, [])
     assert found[0].verdict is Verdict.FAIL
     found = judge_crc_checked(line, 0.0, {"0MC!": ["+1", "+3"]}, ["+1", "+2"])
@@ -240,7 +240,7 @@ def test_true_values_logged_after_a_crc_retry_compare_as_numbers():
     body = "0+1+2"
     w = _measurement(Wire(), code="MC").sensor("0\r\n", delay_ms=200).idle(9).rec("0D0!")
     w.sensor(body + ascii_crc("0+1+3") + "\r\n").idle(30).rec("0D0!")
-    line = w.sensor(body + ascii_crc(body) + "\r\n").line()
+    line = w.sensor(body + ascii_crc(body) + "\r\n").view()
     found = judge_crc_checked(line, 0.0, {"0MC!": ["1", "2.0"]}, ["+1", "+2"])
     assert found[0].verdict is Verdict.PASS, found[0].detail
     found = judge_crc_checked(line, 0.0, {"0MC!": ["1", "3"]}, ["+1", "+2"])
@@ -249,14 +249,14 @@ def test_true_values_logged_after_a_crc_retry_compare_as_numbers():
 
 def test_transparent_commands_pass_unchanged():
     w = Wire().brk().rec("0XSN!").sensor("0EMU\r\n")
-    found = by_id(judge_transparent(w.line(), ["0XSN!"], 0.0, {"0XSN!": "0EMU\r\n"}))
+    found = by_id(judge_transparent(w.view(), ["0XSN!"], 0.0, {"0XSN!": "0EMU\r\n"}))
     assert found["R-4.4.14-01"].verdict is found["R-4.4.14-02"].verdict is Verdict.PASS
     assert found["R-4.4.13-03"].verdict is Verdict.PASS
     assert found["R-6.3-01"].verdict is Verdict.INCONCLUSIVE  # no metadata command was asked
-    changed = Wire().brk().rec("0XSN1!").sensor("0EMU\r\n").line()
+    changed = Wire().brk().rec("0XSN1!").sensor("0EMU\r\n").view()
     found = by_id(judge_transparent(changed, ["0XSN!"], 0.0, None))
     assert found["R-4.4.14-02"].verdict is found["R-4.4.13-03"].verdict is Verdict.FAIL
-    unbroken = Wire().rec("0XSN!").sensor("0EMU\r\n").line()
+    unbroken = Wire().rec("0XSN!").sensor("0EMU\r\n").view()
     found = by_id(judge_transparent(unbroken, ["0XSN!"], 0.0, {"0XSN!": "0EM\r\n"}))
     assert found["R-4.4.14-01"].verdict is Verdict.FAIL
 
@@ -265,7 +265,7 @@ def test_addresses():
     w = Wire()
     for a in "012345678":
         w.brk().rec(f"{a}!").sensor(f"{a}\r\n", origin=f"sensor{a}").idle(20)
-    found = by_id(judge_addresses(w.line(), 0.0))
+    found = by_id(judge_addresses(w.view(), 0.0))
     assert found["R-4.3-03"].verdict is Verdict.FAIL and "9" in found["R-4.3-03"].detail
     assert found["R-4.3-04"].verdict is Verdict.NA
 
@@ -278,9 +278,9 @@ def test_a_concurrent_measurement_repeated_before_its_data_owes_no_values():
     values = "0-5.00-3.75-2.50-1.25+0.00\r\n"
     retried = Wire().brk().rec("0C!").sensor("000205\r\n").idle(100).rec("0C!")
     retried = retried.sensor("000205\r\n").idle(5200).brk().rec("0D0!").sensor(values)
-    found = judge_concurrent_storage(observed_measurements(retried.line(), 0.0), ("0C!",))
+    found = judge_concurrent_storage(observed_measurements(retried.view(), 0.0), ("0C!",))
     assert [f.verdict for f in found if f.requirement == "R-4.4.7-08"] == [Verdict.PASS]
     never = Wire().brk().rec("0C!").sensor("000205\r\n").idle(100).rec("0C!")
     never = never.sensor("000205\r\n").idle(5200).brk().rec("0I!")
-    found = judge_concurrent_storage(observed_measurements(never.line(), 0.0), ("0C!",))
+    found = judge_concurrent_storage(observed_measurements(never.view(), 0.0), ("0C!",))
     assert Verdict.FAIL in [f.verdict for f in found if f.requirement == "R-4.4.7-08"]

@@ -24,9 +24,9 @@ from conformance.judges.recorder.logged import (
 from conformance.protocol.binary import DataType
 from conformance.recorder.drivers import Trigger
 from conformance.recorder.logfile import LogFileError, parse_log, read_log_file
-from conformance.recorder.request import RecorderOutput, Request, Task
-from conformance.recorder.session import RecorderSession
-from conformance.replay.recorder import OUTPUT_NOTE, RecordedRecorder, output_note
+from conformance.recorder.replay_driver import OUTPUT_NOTE, RecordedRecorder, output_note
+from conformance.recorder.scenario_runner import RecorderSession
+from conformance.recorder_jobs import RecorderOutput, Request, Task
 from conformance.sim.bus import SimBus, SimLink
 from conformance.transcript import Event, EventKind
 from conformance.verdicts import Verdict
@@ -56,7 +56,7 @@ def judged(session: RecorderSession, logs: dict[str, dict[str, list[str]] | None
     for name in names:
         session.run(name)
     reports = [LogReport(n, logs[n]) for n in names]
-    found = judge_logged_values(session.line(*names), reports, session.uncertainty, **kw)
+    found = judge_logged_values(session.view(*names), reports, session.uncertainty, **kw)
     return {f.requirement: f for f in found}, found
 
 
@@ -143,7 +143,7 @@ def test_a_scenario_cut_short_without_a_report_is_not_held_against_the_recorder(
     for name in ("d0-to-d2", "two-sensors"):
         golden.run(name)
     reports = [LogReport("d0-to-d2", {"0M2!": M2}), LogReport("two-sensors", None, None, True)]
-    found = judge_logged_values(golden.line("d0-to-d2", "two-sensors"), reports, 0.0)
+    found = judge_logged_values(golden.view("d0-to-d2", "two-sensors"), reports, 0.0)
     by_id = {f.requirement: f for f in found}
     assert by_id["R-4.4-02"].verdict is Verdict.PASS, by_id["R-4.4-02"].detail
     assert "two-sensors" not in by_id["R-4.4-02"].detail
@@ -158,7 +158,7 @@ def test_values_logged_for_a_command_never_sent_fail(golden):
 def test_an_unreadable_report_is_inconclusive_naming_why(golden):
     golden.run("d0-to-d2")
     reports = [LogReport("d0-to-d2", {}, "SDI12_LOG_FILE line 2: not JSON")]
-    found = judge_logged_values(golden.line("d0-to-d2"), reports, golden.uncertainty)
+    found = judge_logged_values(golden.view("d0-to-d2"), reports, golden.uncertainty)
     unreadable = [f for f in found if f.verdict is Verdict.INCONCLUSIVE and f.observed]
     assert [f.requirement for f in unreadable] == ["R-4.4-02"]
     assert "line 2: not JSON" in unreadable[0].detail
@@ -335,7 +335,7 @@ def silent_logger():
 
 
 def test_a_run_whose_recorder_reports_nothing_leaves_the_check_not_applicable():
-    from conformance.matrix import run_once
+    from conformance.conduct import run_once
 
     port = f"sim://?recorder={__name__}:silent_logger"
     data = run_once(port, keyword="logged", role="recorder")

@@ -7,9 +7,9 @@ from __future__ import annotations
 import pytest
 
 from conformance.catalog import for_role
+from conformance.matrices.recorder_matrix import run_recorder_suite
+from conformance.matrices.roundtrip import recorder_row_through_capture
 from conformance.recorder.faults import RECORDER_FAULTS
-from conformance.recorder.matrix import run_recorder_suite
-from conformance.roundtrip import recorder_row_through_capture
 
 #: A handful of recorder faults (retries, break, CRC, measurement timing) the default fast
 #: selection keeps; every other row carries the ``matrix`` marker and runs in the full run.

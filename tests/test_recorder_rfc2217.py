@@ -21,7 +21,7 @@ from conformance.emulator_server.realtime import LATE_NOTICE
 from conformance.judges.recorder.retries import judge_retries
 from conformance.recorder.drivers import Trigger
 from conformance.recorder.faults import RECORDER_FAULTS
-from conformance.recorder.session import RecorderSession
+from conformance.recorder.scenario_runner import RecorderSession
 
 SERVE = "rfc2217-serve://127.0.0.1:0"
 #: Requirements judged only on times measured on the line (PASS or INCONCLUSIVE when clean).
@@ -124,7 +124,7 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
     session = RecorderSession(SERVE, driver=trigger)
     try:
         record = session.run("silent-twice")
-        findings = judge_retries(session.line("silent-twice"), session.uncertainty)
+        findings = judge_retries(session.view("silent-twice"), session.uncertainty)
     finally:
         session.close()
     assert record.error is None, record.error

@@ -13,8 +13,8 @@ from conformance.ports import PortError
 from conformance.protocol.commands import measure
 from conformance.recorder.drivers import Interactive, RecorderDriverError, Trigger
 from conformance.recorder.played import SensorSpec, Spoil
-from conformance.recorder.request import Request, Task
-from conformance.recorder.session import RecorderSession, check_port
+from conformance.recorder.scenario_runner import RecorderSession, check_port
+from conformance.recorder_jobs import Request, Task
 from conformance.sim.bus import SimBus, SimLink
 from conformance.sim.line_monitor import LineMonitor
 from conformance.tool_recorder import Master, Policy

@@ -17,13 +17,12 @@ from typing import Any
 import jsonschema
 import pytest
 
-from conformance.matrix import run_into
+from conformance.conduct import run_into
 from conformance.options import UsageError, check_sweep
 from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.recorder.played import SensorSpec
-from conformance.recorder.request import Request, Task
+from conformance.recorder.scenario_runner import RecorderSession
 from conformance.recorder.scenarios import Scenario
-from conformance.recorder.session import RecorderSession
 from conformance.recorder.sweep import (
     AFTER_BREAK,
     AFTER_RETRY,
@@ -36,6 +35,7 @@ from conformance.recorder.sweep import (
     parse_kinds,
     run_sweeps,
 )
+from conformance.recorder_jobs import Request, Task
 from conformance.reports.sweep_chart import render, section, summary_lines
 
 SCHEMA = json.loads(

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from conformance.catalog import requirement
-from conformance.matrix import run_once
-from conformance.recorder.matrix import run_recorder_suite
+from conformance.conduct import run_once
+from conformance.matrices.recorder_matrix import run_recorder_suite
 from conformance.reports.console import noteworthy
 from conformance.results import RequirementResult
 from conformance.root_causes import DRAGS, link, reading_order

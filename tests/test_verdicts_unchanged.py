@@ -76,7 +76,7 @@ def dump(digested: dict[str, Any]) -> str:
 #: every other state of a pytest worker out of the comparison too)
 RUN_SCRIPT = (
     "import json, sys\n"
-    "from conformance.matrix import run_once\n"
+    "from conformance.conduct import run_once\n"
     "sys.stdout.write(json.dumps(run_once(sys.argv[1])))\n"
 )
 

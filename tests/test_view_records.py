@@ -9,7 +9,7 @@ from conformance import emulator
 from conformance.protocol import commands as cmds
 from conformance.tool_recorder import Master
 from conformance.tool_recorder.records import Attempt, Exchange, Measurement
-from conformance.view.records import rebuild_records
+from conformance.view.rebuilt_records import rebuild_records
 from conformance.view.segments import read_view
 
 FAULTS = [

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from typing import TextIO
 
 from ..links.base import Link, LinkError, LinkInfo, StopCondition
-from ..recorder.request import RecorderOutput, Request, Task
+from ..recorder_jobs import RecorderOutput, Request, Task
 from ..transcript import DUT, TOOL, Event, EventKind, Transcript
 from .protocol import LOG, MAX_LINE, VERSION, seconds, us
 

@@ -34,7 +34,7 @@ from ..protocol.timing import BAUD
 from . import adapter_link
 from .base import Link, LinkInfo
 from .breaks import BaudPulse, BreakMaker, Rfc2217Break, UartBreak
-from .direction import Direction, DirectionLine
+from .driver_enable import Direction, DirectionLine
 from .echo import EchoMode
 from .errors import PortError, unavailable
 from .kernel_stamps import stamped_port

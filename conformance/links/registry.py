@@ -26,7 +26,7 @@ from typing import Any
 
 from ..declaration import Declaration
 from .base import Link, LinkInfo
-from .direction import DirectionLine
+from .driver_enable import DirectionLine
 from .echo import EchoMode
 from .errors import PortError
 

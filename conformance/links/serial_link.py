@@ -14,7 +14,7 @@ events, stamped on the same receive path as the DUT's, so the path's latency can
 stamps are worth is measured as the run goes (:mod:`~conformance.links.meter`). Breaks and
 short spacing pulses are timed by the UART's bit clock where the port can change its bit rate
 (:mod:`~conformance.links.breaks`), and a transmit-enable line is raised for exactly the tool's
-transmissions (:mod:`~conformance.links.direction`). Every public call is bounded by its
+transmissions (:mod:`~conformance.links.driver_enable`). Every public call is bounded by its
 deadline; a port that fails while the run goes on raises
 :class:`~conformance.links.errors.PortVanished` from the next call.
 """
@@ -33,7 +33,7 @@ from ..protocol.timing import CHAR_TIME, RESPONSE_START_MAX, RESPONSE_START_MIN
 from ..transcript import COLLISION, DUT, TOOL, Event, EventKind, Transcript
 from .base import Link, LinkInfo, StopCondition
 from .breaks import BaudPulse, BreakMaker, PulseRefused
-from .direction import Direction, TimedRelease
+from .driver_enable import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
 from .meter import ECHO_FLOOR, TimingMeter

@@ -13,9 +13,9 @@ import pytest
 
 from ..exits import EXIT_USAGE
 from ..links.errors import PortError
+from ..replay.recording_link import RecordingLink, is_recording, load_recording, parse_recording
 from ..run import ConformanceRun
 from .heard import HeardRecorder, HeardSensors, hear_recorder, hear_sensors
-from .recording_link import RecordingLink, is_recording, load_recording, parse_recording
 
 _LOADED: dict[str, RecordingLink] = {}
 

@@ -20,12 +20,12 @@ from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
 from ..protocol.responses import Identification
 from ..protocol.values import split_values
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
+from ..replay.recording_link import RecordingLink
 from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
-from ..view.records import rebuild_records
+from ..view.rebuilt_records import rebuild_records
 from ..view.runs import Segment
 from ..view.segments import TranscriptView, read_view
-from .recording_link import RecordingLink
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3

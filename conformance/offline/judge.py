@@ -349,7 +349,7 @@ def replay_options(recording: Recording, args: argparse.Namespace) -> RunOptions
 def passive_job(
     path: Path, kind: str, args: argparse.Namespace, run_role: str | None = None
 ) -> PassiveJob:
-    """The passive judging's job (see :mod:`conformance.offline.passive`); ``run_role``: the
+    """The passive judging's job (see :mod:`conformance.commands.passive`); ``run_role``: the
     default role when the recording is of a run of this tool (else both)."""
     return PassiveJob(
         recording=str(path),

@@ -41,9 +41,9 @@ from ..catalog import requirement
 from ..declaration import Declaration, RecorderDeclaration
 from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..protocol.version import format_version, is_v14
+from ..recorder_jobs import Request
 from ..transcript import Event, EventKind
 from ..verdicts import Finding, Verdict
-from .request import Request
 
 _TOKENS = {
     Kind.QUERY_ADDRESS: "?",

@@ -29,10 +29,10 @@ from pathlib import Path
 from typing import Protocol, TextIO
 
 from ..links.base import Link
+from ..recorder_jobs import RecorderOutput, Request
 from .errors import RecorderDriverError, RecorderSetupError
 from .job_time import JobBudget, JobLink, JobTimeout
 from .logfile import LOG_FILE_VARIABLE, LogFileError, read_log_file
-from .request import RecorderOutput, Request
 
 __all__ = ["RecorderDriverError", "RecorderSetupError", "JobTimeout"]  # re-exported
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, replace
 from ..links.base import Link
 from ..protocol.commands import Command, Kind, parse_command
 from ..protocol.responses import service_request
+from ..recorder_jobs import RecorderOutput, Request, Task
 from ..sim.bus import SimBus
 from ..tool_recorder import Master, Measurement, Policy
 from ..tool_recorder.engine import _service_request_end
@@ -22,7 +23,6 @@ from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
 from .golden import GoldenMaster, GoldenRecorder, logged_values
-from .request import RecorderOutput, Request, Task
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02

@@ -6,7 +6,7 @@ import pytest
 
 from ..exits import EXIT_USAGE
 from ..ports import PortError
-from .session import RecorderSession
+from .scenario_runner import RecorderSession
 
 
 @pytest.fixture(scope="session")

@@ -1,7 +1,7 @@
 """The golden recorder: the master engine exposed as a recorder under test.
 
 A recorder program is any callable ``(request, link) -> RecorderOutput``: it receives what the
-scenario asks (:class:`~conformance.recorder.request.Request`) and the bus, does the job the
+scenario asks (:class:`~conformance.recorder_jobs.Request`) and the bus, does the job the
 way a data logger would, and says what it logged. :class:`GoldenRecorder` does it with the
 tool's own :class:`~conformance.tool_recorder.Master` under :meth:`Policy.golden`, so it is the
 reference every recorder judge must find COMPLIANT; its knobs (and the Master subclasses in
@@ -22,10 +22,10 @@ from ..links.base import Link
 from ..protocol.binary import parse_binary_packet
 from ..protocol.commands import Command, Kind, parse_command
 from ..protocol.values import split_values
+from ..recorder_jobs import RecorderOutput, Request, Task
 from ..tool_recorder import Master, Measurement, Policy, validity
 from ..tool_recorder.records import Exchange
 from ..transcript import TOOL, EventKind
-from .request import RecorderOutput, Request, Task
 
 RecorderProgram = Callable[[Request, Link], RecorderOutput]
 MasterFactory = Callable[[Link, Policy], Master]

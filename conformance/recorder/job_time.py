@@ -16,9 +16,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..links.base import Link, StopCondition
+from ..recorder_jobs import Request
 from ..transcript import Event
 from .errors import RecorderDriverError
-from .request import Request
 
 #: Bus time every job may take whatever it asks (waking sensors, the logger's own start-up).
 BASE_ALLOWANCE = 30.0

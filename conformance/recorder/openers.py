@@ -25,19 +25,19 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from .. import ports
-from ..harness.recorder import HarnessRecorder
 from ..links.base import BusEnd, LinkInfo
 from ..links.errors import PortError
 from ..links.registry import PortOptions, attach_recorder_role, find, kinds
 from ..replay.link import open_recorder_replay, replayed_info
-from ..replay.recorder import RecordedRecorder
 from ..replay.recording import RecordingError
 from ..sim.bus import SimBus, SimLink
 from ..sim.line_monitor import LineMonitor
 from ..suggest import did_you_mean
 from .drivers import Driver, InProcess
 from .faults import RECORDER_FAULTS, faulty_recorder
-from .realtime import ServedLine, parse_served
+from .harness_driver import HarnessRecorder
+from .replay_driver import RecordedRecorder
+from .served_line import ServedLine, parse_served
 
 
 @dataclass

@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..emulator.behaviour import REPLY_DELAY
+from ..recorder_jobs import Request, Task
 from .played import SensorSpec, Spoil
-from .request import Request, Task
 
 
 @dataclass(frozen=True)

@@ -44,17 +44,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..emulator.behaviour import REPLY_DELAY
-from ..judges.recorder import read_line
 from ..judges.recorder.logged import same_values
 from ..judges.recorder.measurements import observed_measurements
 from ..judges.recorder.retries import STANDBY
 from ..links.base import LinkError
 from ..protocol.timing import RESPONSE_START_MAX, TOLERANCE, WAKE_LIMIT
+from ..recorder_jobs import RecorderOutput, Request, Task
 from ..transcript import Event, EventKind
-from ..view.segments import Transmission
+from ..view.segments import Transmission, read_view
 from .drivers import RecorderSetupError
 from .played import SensorSpec
-from .request import RecorderOutput, Request, Task
 from .scenarios import Scenario
 
 REPLY = "reply"
@@ -213,7 +212,7 @@ def judge_step(
     commands: each sent once (first try), some sent again without a break within the sensor's
     wake time (after a retry), or some sent again after a break (after a new break).
     """
-    view = read_line(list(events), is_recorder)
+    view = read_view(list(events), is_recorder)
     sent = [t for t in view.transmissions if t.is_command]
     groups = _tries(sent, view)
     said = "; ".join(

@@ -21,10 +21,9 @@ import pytest
 from ..catalog import requirement
 from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..root_causes import reading_order
-from ..run import TOOL, ConformanceRun
+from ..run import TOOL_IDENTITY, ConformanceRun
 from ..stash import CASE
-from ..transcript import TOOL as TOOL_ORIGIN
-from ..transcript import Event, EventKind
+from ..transcript import TOOL, Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, Locator, WireRef
@@ -288,7 +287,7 @@ def header(run: ConformanceRun) -> str:
     if run.options.role == "sensor":  # the tool only changes a sensor's address
         device.append(("Address changes", _counted(dut.get("address_notes") or []) or "none made"))
     runrows = [
-        ("Tool", f"{TOOL['name']} {TOOL['version']}"),
+        ("Tool", f"{TOOL_IDENTITY['name']} {TOOL_IDENTITY['version']}"),
         ("Role judged", run.options.role),
         ("Port", run.options.port),
         ("Link", f"{link['kind']}, can send breaks: {breaks}"),
@@ -432,7 +431,7 @@ def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = 
         elif first.kind is EventKind.NOTE:
             lines.append(f"{prefix}note  {escape(first.text)}")
         else:
-            who = "tool" if first.origin == TOOL_ORIGIN else "dut"
+            who = "tool" if first.origin == TOOL else "dut"
             arrow = "→ sensor  " if who == "tool" else "← sensor  "
             text = wire_escape(bytes(e.char7 for e in group))
             bad = sum(1 for e in group if not e.parity_ok)
@@ -597,7 +596,7 @@ class HtmlReportPlugin:
         judged = {c.nodeid: {"verdict": str(c.verdict), "bus_s": c.bus_s} for c in self.run.cases}
         top += plan_section(read_plan(self.run.report_dir()), judged)
         top += sweep_section(self.run)  # --sweep only
-        made_by = escape(f"{TOOL['name']} {TOOL['version']}")
+        made_by = escape(f"{TOOL_IDENTITY['name']} {TOOL_IDENTITY['version']}")
         prefix.extend(
             [
                 STYLE,

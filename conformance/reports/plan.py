@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..catalog import for_role
-from ..run import TOOL
+from ..run import TOOL_IDENTITY
 
 SCHEMA = "sdi12-conform/plan/1"
 #: what the commands a case puts on the bus are, by role
@@ -85,7 +85,7 @@ def build_plan(
     bus = dry.get("run", {}).get("bus", {})
     return {
         "schema": SCHEMA,
-        "tool": dict(TOOL),
+        "tool": dict(TOOL_IDENTITY),
         "role": role,
         "sdi12_version": dry.get("dut", {}).get("sdi12_version"),
         "declaration": declaration,

@@ -14,9 +14,8 @@ from ..links.bus_time import bus_time
 from ..protocol.version import format_version
 from ..replay.recording import write_recording
 from ..results import counts
-from ..run import TOOL, ConformanceRun
-from ..transcript import TOOL as TOOL_SIDE
-from ..transcript import Event, EventKind, escape
+from ..run import TOOL_IDENTITY, ConformanceRun
+from ..transcript import TOOL, Event, EventKind, escape
 from .evidence import WireRef, wire_refs
 from .margins import distribution_json, margins_json
 from .plan import PLAN_FILE, read_plan
@@ -76,7 +75,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
     refs = wire_refs(run.cases, events) if events is not None else {}
     return {
         "schema": SCHEMA,
-        "tool": dict(TOOL),
+        "tool": dict(TOOL_IDENTITY),
         "run": {
             "started": run.started,
             "finished": run.finished,
@@ -138,7 +137,7 @@ def sent_by(events: list[Event], added: tuple[int, int] | None) -> list[dict[str
     counts: dict[str, dict[str, Any]] = {}
     text, broke = "", False
     for e in events[added[0] : added[1]]:
-        if e.origin != TOOL_SIDE:
+        if e.origin != TOOL:
             continue
         if e.kind is EventKind.BREAK:
             broke = True
@@ -183,7 +182,7 @@ def write(run: ConformanceRun, directory: Path) -> Path:
         (directory / "transcript.jsonl").write_text("", encoding="utf-8")
     # the recording first, so the manifest can pin it (sdi12-conform verify)
     run.document["manifest"] = build_manifest(
-        directory, run.options.declaration, str(TOOL["version"])
+        directory, run.options.declaration, str(TOOL_IDENTITY["version"])
     )
     path.write_text(json.dumps(run.document, indent=2, ensure_ascii=False), encoding="utf-8")
     return path

@@ -30,7 +30,7 @@ from ..protocol.responses import Identification, parse_ident, split_line
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, escape
-from ..view.records import Rebuilt, rebuild_records
+from ..view.rebuilt_records import Rebuilt, rebuild_records
 from ..view.segments import read_view
 from .address_change import AddressChanger
 from .buffer_watch import WatchedMaster

@@ -39,9 +39,9 @@ from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
 from ..view.segments import continues_frame
 from . import validity
 from .contention import HOLD_PREFIX, collisions
-from .framing import Framing
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
+from .reply_end import Framing
 
 #: After this many holds that reached ``max_hold`` (a DUT that never goes quiet), later holds
 #: are bounded by the turnaround: waiting a second before every command of the run would
@@ -570,7 +570,7 @@ def _last_dut_char_end(link: Link) -> float:
 
 def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:
     """Add an accepted D/DB reply's values to ``m``; False if it held none (stop). The view
-    rebuilds records with the same rule (:mod:`conformance.view.records`)."""
+    rebuilds records with the same rule (:mod:`conformance.view.rebuilt_records`)."""
     if m.binary:
         packet = exchange.reply_bytes
         m.packets.append(packet)

@@ -19,7 +19,7 @@ import sys
 
 from conformance.harness.client import serve_recorder
 from conformance.recorder.faults import faulty_recorder
-from conformance.recorder.request import RecorderOutput
+from conformance.recorder_jobs import RecorderOutput
 
 
 def main(args: list[str]) -> int:

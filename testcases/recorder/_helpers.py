@@ -5,8 +5,8 @@ from __future__ import annotations
 from conformance import preconditions as precondition
 from conformance.case import Case
 from conformance.judges.recorder.logged import LogReport
+from conformance.recorder.scenario_runner import RecorderSession
 from conformance.recorder.scenarios import SCENARIOS
-from conformance.recorder.session import RecorderSession
 from conformance.view.segments import TranscriptView
 
 
@@ -42,7 +42,7 @@ def line_of(
         if run.error:
             errors.append(f"scenario {name}: {run.error}")
     case.requires("recorder", precondition.acted(errors))
-    return recorder.line(*chosen)
+    return recorder.view(*chosen)
 
 
 def logged(recorder: RecorderSession, name: str) -> dict[str, list[str]] | None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges.recorder.logged import judge_logged_values
-from conformance.recorder.request import Task
 from conformance.recorder.scenarios import SCENARIOS
+from conformance.recorder_jobs import Task
 
 from ._helpers import line_of, log_reports
 

@@ -13,13 +13,3 @@ section 7.2 judges), ``measurements`` (measurement reconstruction), ``breaks``, 
 """
 
 from __future__ import annotations
-
-from ...view.segments import TranscriptView, merge_views, read_view
-
-# Re-exported under their old names for conformance/recorder/session.py (outside this
-# package's owner's remit): the scenario's wire is now the shared TranscriptView.
-Line = TranscriptView
-read_line = read_view
-merge_lines = merge_views
-
-__all__ = ["Line", "merge_lines", "read_line"]

@@ -1,7 +1,7 @@
 """The combination fault matrix (issue 18, part 7): pairs and triples of emulator faults.
 
-A single fault caught exactly (:mod:`conformance.matrix`) says little about firmware with
-several deviations at once. For each combination the suite runs once against
+A single fault caught exactly (:mod:`conformance.matrices.sensor_matrix`) says little about
+firmware with several deviations at once. For each combination the suite runs once against
 ``sim://?faults=A,B[,C]`` and two invariants are checked:
 
 - **false FAIL/WARN**: nothing FAILs or WARNs outside the union of the members' ``violates``
@@ -19,9 +19,10 @@ import random
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
-from .emulator.faults.interactions import INTERACTIONS, Interaction
-from .matrix import BAD, run_once, run_rows
-from .protocol.version import V14, format_version
+from ..conduct import run_once
+from ..emulator.faults.interactions import INTERACTIONS, Interaction
+from ..protocol.version import V14, format_version
+from .sensor_matrix import BAD, run_rows
 
 #: the seed CI and the CLI use unless told otherwise
 DEFAULT_SEED = 18
@@ -65,7 +66,7 @@ class ComboRow:
 
 
 def version_of(name: str) -> str:
-    from .emulator import FAULTS
+    from ..emulator import FAULTS
 
     return getattr(FAULTS[name], "version", None) or V14
 
@@ -76,7 +77,7 @@ def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[st
     Members share a profile version (a v1.3 fault and a v1.4-only one cannot be one sensor);
     names are sorted within a combination so the list is stable across registry order.
     """
-    from .emulator import FAULTS
+    from ..emulator import FAULTS
 
     if size < 2:
         raise ValueError(f"a combination has 2 or more faults, not {size}")
@@ -136,7 +137,7 @@ def combo_port(faults: tuple[str, ...]) -> str:
 
 
 def declared_for(faults: Iterable[str]) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
-    from .emulator import FAULTS
+    from ..emulator import FAULTS
 
     return {f: (tuple(FAULTS[f].violates), tuple(FAULTS[f].inconclusive)) for f in faults}
 
@@ -157,7 +158,7 @@ def combination_matrix(
     progress: Callable[[int, int, ComboRow], None] | None = None,
 ) -> list[ComboRow]:
     """One row per combination, ``processes`` at a time (spawned workers, like
-    :func:`conformance.matrix.fault_matrix`)."""
+    :func:`conformance.matrices.sensor_matrix.fault_matrix`)."""
     return run_rows(combinations, combo_row, processes, progress)
 
 

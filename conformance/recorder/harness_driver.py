@@ -13,15 +13,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..harness import protocol as proto
+from ..harness.channel import Channel, HarnessError
+from ..harness.device import open_channel
+from ..harness.protocol import Plan, PlanKind, Role
 from ..links.base import Link
 from ..links.errors import PortUnavailable
-from ..recorder.job_time import JobBudget, JobTimeout
-from ..recorder.request import RecorderOutput, Request
+from ..recorder_jobs import RecorderOutput, Request
 from ..transcript import Event
-from . import protocol as proto
-from .channel import Channel, HarnessError
-from .device import open_channel
-from .protocol import Plan, PlanKind, Role
+from .job_time import JobBudget, JobTimeout
 
 #: Bus time one job may take when the session states no budget (:mod:`..recorder.job_time`).
 JOB_LIMIT = 600.0

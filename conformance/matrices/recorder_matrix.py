@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..matrix import run_once
+from ..conduct import run_once
 
 
 def run_recorder_suite(port: str = "sim", **options: Any) -> dict:

@@ -17,12 +17,12 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
-from .declaration import DeclarationError, load_declaration, normalise_version
-from .emulator.declared import assumptions
-from .exits import EXIT_OK, EXIT_USAGE, say_error
-from .options import ROLES
-from .protocol.version import format_version
-from .reports.plan import build_plan, plan_html, plan_markdown
+from ..declaration import DeclarationError, load_declaration, normalise_version
+from ..emulator.declared import assumptions
+from ..exits import EXIT_OK, EXIT_USAGE, say_error
+from ..options import ROLES
+from ..protocol.version import format_version
+from ..reports.plan import build_plan, plan_html, plan_markdown
 
 FORMATS = ("markdown", "html", "json")
 
@@ -105,7 +105,7 @@ def cached_plan(
     except (OSError, ValueError):
         pass
     plan = make_plan(role, declaration, version, keyword, reqs)
-    from .interrupts import GUARD
+    from ..interrupts import GUARD
 
     if not GUARD.requested:  # a dry run cut short by Ctrl-C is kept nowhere
         try:
@@ -126,7 +126,7 @@ def make_plan(
     reqs: tuple[str, ...] = (),
 ) -> dict[str, Any]:
     """Dry-run the suite and build its plan (:class:`DeclarationError` for a bad file)."""
-    from .matrix import NoVerdicts, run_into
+    from ..conduct import NoVerdicts, run_into
 
     declared = load_declaration(declaration) if declaration else None
     digits = normalise_version(version) if version else None

@@ -8,7 +8,7 @@ that needs it judges the same slice.
 On ``--port sim`` the bus is the virtual-time :class:`SimBus`, the recorder runs in this
 process on the tool's :class:`SimLink` (the golden recorder unless ``recorder=`` names another
 callable), and its side of the wire has origin ``tool``. On ``--port rfc2217-serve://HOST:PORT``
-the tool serves the played sensors in real time (:mod:`conformance.recorder.realtime`) and the
+the tool serves the played sensors in real time (:mod:`conformance.recorder.served_line`) and the
 recorder connects to them over RFC 2217: the in-process one through a real link opened per
 scenario, an external one (``--trigger``) told where in ``SDI12_PORT``. The transcript is then
 the served line's, as the sensors hear it, in the same form.
@@ -23,16 +23,15 @@ from typing import Any
 from ..declaration import Declaration
 from ..dut import Session
 from ..harness.channel import STDERR_TAIL
-from ..harness.recorder import HarnessRecorder
-from ..judges.recorder import Line, merge_lines, read_line
 from ..links.base import LinkError
 from ..links.registry import PortOptions
 from ..protocol.version import V14, format_version, is_v14
-from ..replay.recorder import output_note
+from ..recorder_jobs import RecorderOutput, Request
 from ..results import CaseRecord
 from ..sim.bus import SimBus
 from ..sim.line_monitor import LineMonitor
 from ..transcript import TOOL, Event, EventKind
+from ..view.segments import TranscriptView, merge_views, read_view
 from .capability import Absence, Capabilities, cannot_finding, sent_tokens
 from .drivers import (
     Driver,
@@ -41,12 +40,13 @@ from .drivers import (
     RecorderSetupError,
     Trigger,
 )
+from .harness_driver import HarnessRecorder
 from .job_time import JobBudget, JobTimeout, job_budget
 from .openers import open_recorder_line
 from .played import build_sensors
-from .realtime import ServedLine
-from .request import RecorderOutput, Request
+from .replay_driver import output_note
 from .scenarios import SCENARIOS, Scenario
+from .served_line import ServedLine
 
 #: Marking left after a recorder finished, so late sensor output is on record and the next
 #: scenario starts on a quiet line with every sensor in standby.
@@ -157,10 +157,10 @@ class RecorderSession(Session):
     def applicable(self) -> list[str]:
         return [name for name in SCENARIOS if self.applies(name)]
 
-    def line(self, *names: str) -> Line:
+    def view(self, *names: str) -> TranscriptView:
         """The scenarios' transcripts read as the recorder's transmissions, one part each."""
-        return merge_lines(
-            [read_line(self.run(n).events, self.is_recorder, part=i) for i, n in enumerate(names)]
+        return merge_views(
+            [read_view(self.run(n).events, self.is_recorder, part=i) for i, n in enumerate(names)]
         )
 
     def run(self, name: str) -> ScenarioRun:

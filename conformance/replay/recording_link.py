@@ -19,8 +19,8 @@ from ..capture.errors import CaptureError
 from ..links.base import BusEnd, LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
-from ..replay.recording import RecordingError, read_recording
 from ..transcript import EventKind, Transcript
+from .recording import RecordingError, read_recording
 
 if TYPE_CHECKING:
     from ..capture import CaptureDecode

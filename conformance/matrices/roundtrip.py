@@ -18,9 +18,9 @@ import zlib
 from dataclasses import replace
 from pathlib import Path
 
-from .conduct import conduct
-from .matrix import Item, MatrixRow, fault_port, fault_row, row_from, run_into
-from .transcript import EventKind
+from ..conduct import conduct, run_into
+from ..transcript import EventKind
+from .sensor_matrix import Item, MatrixRow, fault_port, fault_row, row_from
 
 DECIDED = ("PASS", "FAIL", "WARN", "N/A")
 
@@ -35,10 +35,10 @@ def judged_through_capture(run_dir: Path, work: Path) -> dict:
     the TX channel the export named in it, the run's cases replayed against it; no HTML)
     into ``work/capture/`` and return its verdicts.json. A capture the judging would take
     passively raises, with the reason."""
-    from .capture.errors import CaptureError
-    from .capture.export import export_events
-    from .offline.judge import JudgeError, plan
-    from .replay.recording import RecordingError, read_recording
+    from ..capture.errors import CaptureError
+    from ..capture.export import export_events
+    from ..offline.judge import JudgeError, plan
+    from ..replay.recording import RecordingError, read_recording
 
     work.mkdir(parents=True, exist_ok=True)
     capture = work / "run.sr"
@@ -97,7 +97,7 @@ def in_capture_sample(fault: str) -> bool:
     every run; ``SDI12_MATRIX_CAPTURE=all`` takes every fault)."""
     if os.environ.get("SDI12_MATRIX_CAPTURE") == "all":
         return True
-    from .emulator import FAULTS
+    from ..emulator import FAULTS
 
     spec = FAULTS.get(fault)
     if spec is not None and MEASURED_TIMING.intersection(spec.violates):
@@ -115,8 +115,9 @@ def row_through_sampled_capture(item: Item) -> MatrixRow:
 
 
 def row_through_capture(item: Item) -> MatrixRow:
-    """A sensor fault's matrix row (:func:`conformance.matrix.fault_matrix`'s ``row``) with
-    its run also judged through a capture of itself."""
+    """A sensor fault's matrix row (the ``row`` of
+    :func:`conformance.matrices.sensor_matrix.fault_matrix`) with its run also judged through a
+    capture of itself."""
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
         live_dir = Path(tmp) / "live"
         data = run_into(live_dir, fault_port(item), **dict(item[3]))
@@ -125,7 +126,7 @@ def row_through_capture(item: Item) -> MatrixRow:
 
 def recorder_row_through_capture(fault: str) -> MatrixRow:
     """A recorder fault's matrix row with its run also judged through a capture of itself."""
-    from .recorder.faults import RECORDER_FAULTS
+    from ..recorder.faults import RECORDER_FAULTS
 
     spec = RECORDER_FAULTS[fault]
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:

@@ -9,15 +9,12 @@ an untested rule.
 from __future__ import annotations
 
 import multiprocessing
-import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, TypeVar
 
-from .conduct import conduct
-from .protocol.version import V14, format_version
-from .run import RunOptions
+from ..conduct import run_once
+from ..protocol.version import V14, format_version
 
 ItemT = TypeVar("ItemT")
 RowT = TypeVar("RowT")
@@ -97,31 +94,6 @@ class MatrixRow:
         return f"{self.fault}: " + ("; ".join(parts) or "exact")
 
 
-class NoVerdicts(RuntimeError):
-    """The run wrote no verdicts (pytest stopped first: nothing collected, a usage error)."""
-
-
-def run_once(port: str, role: str = "sensor", **options: Any) -> dict:
-    """Run the ``role`` suite in this process against ``port``; return verdicts.json.
-    ``options``: more :class:`~conformance.run.RunOptions` fields (``version="1.3"``,
-    ``keyword="crc"``)."""
-    with tempfile.TemporaryDirectory(prefix=f"sdi12-{role}-") as tmp:
-        return run_into(Path(tmp), port, role, **options)
-
-
-def run_into(report_dir: Path, port: str, role: str = "sensor", **options: Any) -> dict:
-    """Run the ``role`` suite in this process against ``port`` with its reports (no HTML) in
-    ``report_dir``; return verdicts.json (from memory: the run's own, never a file's)."""
-    report_dir.mkdir(parents=True, exist_ok=True)
-    given = RunOptions(port=port, role=role, report_dir=str(report_dir), **options)
-    result = conduct(given, html=False, rootdir=report_dir)
-    if result.document is None:
-        raise NoVerdicts(
-            f"the {role} suite against {port} wrote no verdicts (pytest exit {result.pytest_code})"
-        )
-    return result.document
-
-
 def row_from(
     fault: str, declared: tuple[str, ...], data: dict, inconclusive: tuple[str, ...] = ()
 ) -> MatrixRow:
@@ -152,7 +124,7 @@ def fault_port(item: Item) -> str:
 
 
 def fault_row(item: Item, data: dict) -> MatrixRow:
-    from .emulator import FAULTS
+    from ..emulator import FAULTS
 
     fault, declared, _, _ = item
     return row_from(fault, declared, data, tuple(FAULTS[fault].inconclusive))
@@ -171,8 +143,8 @@ def fault_matrix(
     """One row per fault (all of them by default), run ``processes`` at a time;
     ``progress(done, total, row)`` hears of each row as it arrives (the whole matrix takes
     minutes). ``row`` makes one row from an item in a worker process (a module-level
-    function: :func:`conformance.roundtrip.row_through_capture` adds the capture check)."""
-    from .emulator import FAULTS
+    function: :func:`conformance.matrices.roundtrip.row_through_capture` adds the capture check)."""
+    from ..emulator import FAULTS
 
     names = faults or sorted(FAULTS)
     items = [

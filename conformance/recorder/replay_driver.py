@@ -15,12 +15,12 @@ import json
 from typing import Any
 
 from ..links.base import Link
-from ..recorder.errors import RecorderDriverError
-from ..recorder.job_time import JobBudget, JobTimeout
-from ..recorder.request import RecorderOutput, Request
+from ..recorder_jobs import RecorderOutput, Request
+from ..replay.sensor import ReplayDiverged
 from ..sim.bus import SimLink
 from ..transcript import TOOL, Event, EventKind
-from .sensor import ReplayDiverged
+from .errors import RecorderDriverError
+from .job_time import JobBudget, JobTimeout
 
 #: Prefix of the scenario-start note (written by the recorder session).
 SCENARIO_NOTE = "scenario "

@@ -17,8 +17,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .exits import EXIT_NON_COMPLIANT, EXIT_OK, EXIT_USAGE, say_error
-from .reports.diff import DiffError, diff_json, diff_runs, diff_text, load_run, worse
+from ..exits import EXIT_NON_COMPLIANT, EXIT_OK, EXIT_USAGE, say_error
+from ..reports.diff import DiffError, diff_json, diff_runs, diff_text, load_run, worse
 
 if TYPE_CHECKING:
     from rich.console import Console

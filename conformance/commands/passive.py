@@ -17,12 +17,12 @@ from ..conduct import RunResult, conduct
 from ..exits import EXIT_COMPLIANT, EXIT_USAGE
 from ..interrupts import GUARD
 from ..links.errors import PortError
+from ..offline.job import PassiveJob
 from ..protocol.commands import Kind
+from ..replay.recording_link import recording_port
 from ..report_folder import run_folder
 from ..run import RunOptions
 from ..transcript import EventKind
-from .job import PassiveJob
-from .recording_link import recording_port
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -32,8 +32,8 @@ ROLES = ("sensor", "recorder")
 
 def no_traffic(port: str) -> str | None:
     """Why the recording holds nothing to judge (None: it holds SDI-12 traffic)."""
+    from ..offline.fixtures import recording_of
     from ..view.segments import read_view
-    from .fixtures import recording_of
 
     link = recording_of(port)
     events = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]
@@ -63,7 +63,7 @@ def error(text: str) -> None:
 
 def forget(port: str) -> None:
     """Drop the loaded recording once judged (an in-process caller may judge many)."""
-    from .fixtures import _LOADED
+    from ..offline.fixtures import _LOADED
 
     _LOADED.pop(port, None)
 

@@ -23,9 +23,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .exits import EXIT_INCOMPLETE, EXIT_NON_COMPLIANT, EXIT_OK, EXIT_USAGE, say_error
-from .reports.diff import DiffError, load_run
-from .reports.manifest import check_files
+from ..exits import EXIT_INCOMPLETE, EXIT_NON_COMPLIANT, EXIT_OK, EXIT_USAGE, say_error
+from ..reports.diff import DiffError, load_run
+from ..reports.manifest import check_files
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -105,7 +105,7 @@ def _rejudge(folder: Path, console: Console, judge: Judge) -> dict | None:
 
     from rich.console import Console as RichConsole
 
-    from .replay.link import SCHEME
+    from ..replay.link import SCHEME
 
     said = StringIO()
     with tempfile.TemporaryDirectory(prefix="sdi12-verify-") as tmp:

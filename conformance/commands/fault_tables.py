@@ -7,7 +7,7 @@ from rich.table import Table
 
 
 def recorder_faults_table() -> Table:
-    from .recorder.faults import RECORDER_FAULTS
+    from ..recorder.faults import RECORDER_FAULTS
 
     table = Table(
         title=f"{len(RECORDER_FAULTS)} recorder faults (use --role recorder with "
