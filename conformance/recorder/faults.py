@@ -1,7 +1,8 @@
 """Faulty golden recorders: the recorder role's fault-detection matrix (design.md 5).
 
-Each fault is the golden recorder with one deviation (a policy value, a small Master
-subclass, or a recorder knob) and the requirements it breaks. The matrix test runs the whole
+Each fault is the golden recorder with one deviation (a policy value, engine hooks
+(:class:`~conformance.tool_recorder.hooks.Hooks`), a small Master subclass overriding a
+public method, or a recorder knob) and the requirements it breaks. The matrix test runs the whole
 recorder suite against each and demands that exactly those requirements come out FAIL/WARN.
 Where one deviation honestly breaks several rules (a recorder that never retries also never
 retries on a bad CRC), all of them are declared, with the reason in the description.
@@ -19,10 +20,11 @@ from ..recorder_jobs import RecorderOutput, Request, Task
 from ..sim.bus import SimBus
 from ..tool_recorder import Master, Measurement, Policy
 from ..tool_recorder.engine import _service_request_end
+from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
-from .golden import GoldenMaster, GoldenRecorder, logged_values
+from .golden import GoldenHooks, GoldenMaster, GoldenRecorder, logged_values
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
@@ -34,42 +36,77 @@ POLL_TIMEOUT = 1.5  # s a logger library waited for a reply before it tried agai
 SHORT_REPLY_TIMEOUT = 10e-3
 
 
-class EarlyRetryMaster(GoldenMaster):
+class EarlyRetryHooks(GoldenHooks):
     """Retries a silent sensor 12 ms after the command (the first retry of each sequence)."""
 
-    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+    def retry_time(
+        self,
+        master: Engine,
+        exchange: Exchange,
+        sequence: int,
+        per_sequence: int,
+        usual: Callable[[], float],
+    ) -> float:
+        """12 ms after the command for the first retry after silence; else the golden time."""
         prev = exchange.last
         first_retry = not any(a.sequence == sequence and a.retry for a in exchange.attempts)
         if first_retry and not prev.reply_events and prev.command_end is not None:
-            return max(prev.command_end + EARLY_RETRY, self.link.now())
-        return super()._retry_time(exchange, sequence, per_sequence)
+            return max(prev.command_end + EARLY_RETRY, master.link.now())
+        return super().retry_time(master, exchange, sequence, per_sequence, usual)
 
 
-class LateRetryMaster(GoldenMaster):
+class SkipsNextBreakHooks(GoldenHooks):
+    """The golden hooks, able to leave out the break the break rules put in front of the next
+    command: a deviation decided before the command it applies to goes out."""
+
+    skip_break = False
+
+    def needs_break(
+        self, master: Engine, address: str, at: float, usual: Callable[[], bool]
+    ) -> bool:
+        """No break once after ``skip_break`` was set; the engine's rules otherwise."""
+        if self.skip_break:
+            self.skip_break = False
+            return False
+        return usual()
+
+
+class LateRetryHooks(SkipsNextBreakHooks):
     """Retries a silent sensor 95 ms after the command, still without a break."""
 
-    _skip_break = False
-
-    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+    def retry_time(
+        self,
+        master: Engine,
+        exchange: Exchange,
+        sequence: int,
+        per_sequence: int,
+        usual: Callable[[], float],
+    ) -> float:
+        """95 ms after the command, unbroken, for the first retry after silence."""
         prev = exchange.last
         first_retry = not any(a.sequence == sequence and a.retry for a in exchange.attempts)
         if first_retry and not prev.reply_events and prev.command_end is not None:
-            self._skip_break = True
-            return max(prev.command_end + LATE_RETRY, self.link.now())
-        return super()._retry_time(exchange, sequence, per_sequence)
+            self.skip_break = True
+            return max(prev.command_end + LATE_RETRY, master.link.now())
+        return super().retry_time(master, exchange, sequence, per_sequence, usual)
 
-    def _needs_break(self, address: str, at: float) -> bool:
-        if self._skip_break:
-            self._skip_break = False
-            return False
-        return super()._needs_break(address, at)
+
+class NoBreakAfterMarkingHooks(GoldenHooks):
+    """Sends a break only when the address changes, never for 87 ms of marking."""
+
+    def needs_break(
+        self, master: Engine, address: str, at: float, usual: Callable[[], bool]
+    ) -> bool:
+        """A break for a new address only."""
+        return master.last_address is None or address != master.last_address
 
 
 class NoBreakAfterMarkingMaster(GoldenMaster):
-    """Sends a break only when the address changes, never for 87 ms of marking."""
+    """The golden engine with :class:`NoBreakAfterMarkingHooks`, and no forced break in front
+    of D0 after ttt either."""
 
-    def _needs_break(self, address: str, at: float) -> bool:
-        return self.last_address is None or address != self.last_address
+    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
+        super().__init__(link, policy, address=address, hooks=NoBreakAfterMarkingHooks())
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
@@ -77,14 +114,21 @@ class NoBreakAfterMarkingMaster(GoldenMaster):
         return super().collect(m, force_break=False, max_index=max_index)
 
 
-class EarlyDataMaster(GoldenMaster):
+class EarlyDataHooks(GoldenHooks):
     """Without a service request, reads data after half of ttt instead of the whole."""
 
-    def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+    def wait_for_data(
+        self,
+        master: Engine,
+        m: Measurement,
+        service_request: bool,
+        usual: Callable[[], None],
+    ) -> None:
+        """Listen for half of ttt, stopping at a service request when one is awaited."""
         assert m.reply_end is not None and m.ttt is not None
         deadline = m.reply_end + m.ttt / 2
-        while self.link.now() < deadline:
-            got = self.link.receive(deadline, until=ends_line)
+        while master.link.now() < deadline:
+            got = master.link.receive(deadline, until=ends_line)
             m.waited_events.extend(got)
             if service_request and _is_service_request(m.waited_events, m.command.address):
                 m.service_request_end = m.waited_events[-1].end
@@ -102,17 +146,24 @@ class StopsAfterD0Master(GoldenMaster):
         return super().collect(m, force_break=force_break, max_index=0)
 
 
-class WaitsForeverMaster(GoldenMaster):
+class WaitsForeverHooks(GoldenHooks):
     """Waits for the service request of aM!/aV! with no end: ttt is never counted (a logger
     loop written as "until the sensor calls"). A sensor that never sends one hangs it; the
     job is cut at its budget (recorder.job_time) and judged on what it sent."""
 
-    def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+    def wait_for_data(
+        self,
+        master: Engine,
+        m: Measurement,
+        service_request: bool,
+        usual: Callable[[], None],
+    ) -> None:
+        """The engine's wait for ttt; for a service request, a wait with no deadline."""
         if not service_request:
-            super()._wait_for_data(m, service_request=service_request)
+            usual()
             return
         while m.service_request_end is None:  # ends only through the job's cut
-            m.waited_events.extend(self.link.receive(self.link.now() + 1.0, until=ends_line))
+            m.waited_events.extend(master.link.receive(master.link.now() + 1.0, until=ends_line))
             m.service_request_end = _service_request_end(m.waited_events, m.command.address)
 
 
@@ -132,98 +183,110 @@ class LeadingZerosMaster(GoldenMaster):
         return super().transact(command, **kw)  # type: ignore[arg-type]
 
 
-class IgnoresCrcMaster(GoldenMaster):
+class IgnoresCrcHooks(GoldenHooks):
     """Accepts a reply whose CRC does not match its text."""
 
-    def _attempt(self, *args: object, **kw: object) -> Attempt:
-        attempt = super()._attempt(*args, **kw)  # type: ignore[arg-type]
+    def attempt(
+        self,
+        master: Engine,
+        wire: bytes,
+        address: str,
+        command: Command | None,
+        proceed: Callable[[], Attempt],
+    ) -> Attempt:
+        """The engine's attempt, taken as valid when only its CRC was wrong."""
+        attempt = proceed()
         if "should be" in attempt.reason:  # the engine's words for a CRC mismatch
             attempt = replace(attempt, reason="ok")
         return attempt
 
 
-class BreakEveryTryMaster(GoldenMaster):
+class BreakEveryTryHooks(GoldenHooks):
     """Never retries: after an unanswered or invalid reply it waits out a poll timeout, then
     sends a break and the command again (what a widely used logger library was seen to do,
     issue 20). With ``retries_per_sequence=0`` every repeat is such a new sequence."""
 
     _failed: tuple[bytes, float] | None = None  # the wire text that failed, and when
 
-    def _attempt(self, wire: bytes, *args: object, **kw: object) -> Attempt:
+    def attempt(
+        self,
+        master: Engine,
+        wire: bytes,
+        address: str,
+        command: Command | None,
+        proceed: Callable[[], Attempt],
+    ) -> Attempt:
+        """The engine's attempt, sent again only a poll timeout after it failed."""
         if self._failed is not None and self._failed[0] == wire:
-            self.link.wait_until(self._failed[1] + POLL_TIMEOUT)
-        attempt = super()._attempt(wire, *args, **kw)  # type: ignore[arg-type]
-        self._failed = None if attempt.ok else (wire, self.link.now())
+            master.link.wait_until(self._failed[1] + POLL_TIMEOUT)
+        attempt = proceed()
+        self._failed = None if attempt.ok else (wire, master.link.now())
         return attempt
 
 
-class ResendAfterTimeoutMaster(GoldenMaster):
+class ResendAfterTimeoutHooks(SkipsNextBreakHooks):
     """Retries without a break, but only after a poll timeout: by then the sensor has been in
     standby for over a second and takes the command as no retry (issue 20's "D0 sent again
     after a 1.5 s poll timeout")."""
 
-    _late = False
-
-    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
-        self._late = True
-        return max(exchange.last.end + POLL_TIMEOUT, self.link.now())
-
-    def _needs_break(self, address: str, at: float) -> bool:
-        if self._late:
-            self._late = False
-            return False
-        return super()._needs_break(address, at)
+    def retry_time(
+        self,
+        master: Engine,
+        exchange: Exchange,
+        sequence: int,
+        per_sequence: int,
+        usual: Callable[[], float],
+    ) -> float:
+        """A poll timeout after the last attempt ended, and no break before the retry."""
+        self.skip_break = True
+        return max(exchange.last.end + POLL_TIMEOUT, master.link.now())
 
 
 class LateD0AfterServiceRequestMaster(GoldenMaster):
     """After a service request waits 95 ms, then sends aD0! without a break."""
 
-    _no_break_once = False
+    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
+        self.skips = SkipsNextBreakHooks()
+        super().__init__(link, policy, address=address, hooks=self.skips)
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
     ) -> Measurement:
         if m.service_request_end is not None and not m.data:
             self.link.wait_until(m.service_request_end + LATE_D0)
-            self._no_break_once = True
+            self.skips.skip_break = True
         return super().collect(m, force_break=force_break, max_index=max_index)
 
-    def _needs_break(self, address: str, at: float) -> bool:
-        if self._no_break_once:
-            self._no_break_once = False
-            return False
-        return super()._needs_break(address, at)
 
-
-class GappyCommandMaster(GoldenMaster):
+class GappyCommandHooks(GoldenHooks):
     """Leaves ``gap`` of marking between the characters of every command."""
 
     gap = 3e-3
 
-    def _transmit(
-        self,
-        wire: bytes,
-        address: str,
-        brk: bool | None,
-        gap: float,
-        marking: float | None,
-        collide: bool,
-    ) -> tuple[Event | None, list[Event], list[Event]]:
-        return super()._transmit(wire, address, brk, max(gap, self.gap), marking, collide)
+    def command_gap(self, master: Engine, gap: float) -> float:
+        """At least ``self.gap`` between characters."""
+        return max(gap, self.gap)
 
 
 #: What a logger that keeps ttt in an 8-bit variable can count to (issue 20).
 TTT_BITS = 8
 
 
-class EightBitTttMaster(GoldenMaster):
+class EightBitTttHooks(GoldenHooks):
     """Keeps the announced ttt in 8 bits: waits ``ttt % 256`` s (260 s becomes 4 s)."""
 
-    def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+    def wait_for_data(
+        self,
+        master: Engine,
+        m: Measurement,
+        service_request: bool,
+        usual: Callable[[], None],
+    ) -> None:
+        """The engine's wait, for the announced ttt cut to 8 bits."""
         assert m.ttt is not None
         announced, m.ttt = m.ttt, m.ttt % (1 << TTT_BITS)
         try:
-            super()._wait_for_data(m, service_request=service_request)
+            usual()
         finally:
             m.ttt = announced
 
@@ -233,7 +296,7 @@ class EightBitTttRecorder(GoldenRecorder):
     """The golden recorder with ttt kept in 8 bits, for aM!-type and concurrent waits."""
 
     master_factory: Callable[[Link, Policy], Master] = field(
-        default=lambda link, policy: EightBitTttMaster(link, policy)
+        default=lambda link, policy: GoldenMaster(link, policy, hooks=EightBitTttHooks())
     )
 
     def _data_time(self, m: Measurement) -> float:
@@ -261,32 +324,49 @@ class SkipsTttZeroConcurrentRecorder(GoldenRecorder):
             out.logged[text] = logged_values(m)
 
 
+class DropsAfterParityHooks(GoldenHooks):
+    """Takes a reply cut at its first parity error as valid, noting that it did (``cut``)."""
+
+    cut = False
+
+    def attempt(
+        self,
+        master: Engine,
+        wire: bytes,
+        address: str,
+        command: Command | None,
+        proceed: Callable[[], Attempt],
+    ) -> Attempt:
+        """The engine's attempt; one invalid for parity becomes its characters before the bad
+        one, valid."""
+        attempt = proceed()
+        bad = [i for i, e in enumerate(attempt.reply_events) if not e.parity_ok]
+        if attempt.ok or not bad or "parity" not in attempt.reason:
+            return attempt
+        self.cut = True
+        return replace(attempt, reply_events=attempt.reply_events[: bad[0]], reason=OK)
+
+
 class DropsAfterParityMaster(GoldenMaster):
     """Stops reading a reply at a character with a parity error and takes what came before
     it as the whole reply, and the measurement as collected: no retry, and the values before
     the bad character are what it logs (a logger library's read loop, issue 20)."""
 
-    _cut = False
-
-    def _attempt(self, *args: object, **kw: object) -> Attempt:
-        attempt = super()._attempt(*args, **kw)  # type: ignore[arg-type]
-        bad = [i for i, e in enumerate(attempt.reply_events) if not e.parity_ok]
-        if attempt.ok or not bad or "parity" not in attempt.reason:
-            return attempt
-        self._cut = True
-        return replace(attempt, reply_events=attempt.reply_events[: bad[0]], reason=OK)
+    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
+        self.parity = DropsAfterParityHooks()
+        super().__init__(link, policy, address=address, hooks=self.parity)
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
     ) -> Measurement:
         """The golden collection one D command at a time, ending at a cut reply."""
-        self._cut = False
+        self.parity.cut = False
         while m.count is not None and m.value_count < m.count:
             n, have = len(m.data), m.value_count
             limit = n if max_index is None else min(n, max_index)
             super().collect(m, force_break=force_break, max_index=limit)
             force_break = False
-            if self._cut or len(m.data) == n or not m.data[-1].ok or m.value_count == have:
+            if self.parity.cut or len(m.data) == n or not m.data[-1].ok or m.value_count == have:
                 break
         return m
 
@@ -303,7 +383,7 @@ class TalksOverMaster(Master):
         return self.link.now()
 
 
-class BandGapCommandMaster(GappyCommandMaster):
+class BandGapCommandHooks(GappyCommandHooks):
     """1.9 ms between command characters: only the ±0.40 ms tolerance the 1.66 ms limit does
     not have would make it pass."""
 
@@ -455,6 +535,12 @@ def _with_master(cls: type[Master]) -> Callable[[Link, Policy], Master]:
     return lambda link, policy: cls(link, policy)
 
 
+def _with_hooks(cls: type[Hooks]) -> Callable[[Link, Policy], Master]:
+    """The golden engine with a fault's hooks: a fresh ``cls`` per engine, since what a
+    stateful fault remembers belongs to one engine (a recorder may build several)."""
+    return lambda link, policy: GoldenMaster(link, policy, hooks=cls())
+
+
 @dataclass(frozen=True)
 class RecorderFault:
     name: str
@@ -487,7 +573,7 @@ _FAULTS = (
         "reply to end before a retry (R-7.2-06) cannot be seen.",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05"),
         lambda: GoldenRecorder(
-            _GOLDEN.but(retries_per_sequence=0, sequences=3), _with_master(BreakEveryTryMaster)
+            _GOLDEN.but(retries_per_sequence=0, sequences=3), _with_hooks(BreakEveryTryHooks)
         ),
         inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
@@ -498,7 +584,7 @@ _FAULTS = (
         "-05), no sequence with two retries (R-7.2-03), and a command after 87 ms of marking "
         "without a break (R-7.0-17).",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05", "R-7.0-17"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(ResendAfterTimeoutMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(ResendAfterTimeoutHooks)),
         inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
     RecorderFault(
@@ -508,16 +594,14 @@ _FAULTS = (
         "reply-at-window-edge) that retry runs into the reply, and on the line its characters "
         "come apart (R-7.0-13): what R-7.2-02's 16.67 ms is there to prevent.",
         ("R-7.2-02", "R-7.0-13"),
-        lambda: GoldenRecorder(
-            _GOLDEN.but(first_char_timeout=10e-3), _with_master(EarlyRetryMaster)
-        ),
+        lambda: GoldenRecorder(_GOLDEN.but(first_char_timeout=10e-3), _with_hooks(EarlyRetryHooks)),
     ),
     RecorderFault(
         "retry-too-late",
         f"The first retry after no reply starts {LATE_RETRY * 1e3:.0f} ms after the command, "
         "without a break.",
         ("R-7.2-02", "R-7.0-17"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(LateRetryMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(LateRetryHooks)),
     ),
     RecorderFault(
         "no-break-after-87ms",
@@ -529,7 +613,7 @@ _FAULTS = (
         "d0-before-ttt",
         "Without a service request, asks for data after half of ttt.",
         ("R-4.4.5-04", "R-4.4.5-07", "R-4.4.7-06"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(EarlyDataMaster), ttt_fraction=0.5),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(EarlyDataHooks), ttt_fraction=0.5),
     ),
     RecorderFault(
         "ignores-service-request",
@@ -547,7 +631,7 @@ _FAULTS = (
         "transmission still PASS on what it sent, while the rules about that job itself "
         "cannot PASS on a job that never ended.",
         ("R-4.4.5-05", "R-4.4.8-05"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(WaitsForeverMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(WaitsForeverHooks)),
         inconclusive=("R-4.4.5-04", "R-4.4.5-06", "R-4.4.5-07"),
     ),
     RecorderFault(
@@ -566,7 +650,7 @@ _FAULTS = (
         "ignores-bad-crc",
         "Accepts a reply whose CRC does not match (no retry, wrong value logged).",
         ("R-4.4.12-07", "R-7.2-05"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(IgnoresCrcMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(IgnoresCrcHooks)),
     ),
     RecorderFault(
         "short-break",
@@ -624,7 +708,7 @@ _FAULTS = (
         "gappy-commands",
         "Leaves 3 ms of marking between the characters of every command (1.66 ms at most).",
         ("R-7.0-13",),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(GappyCommandMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(GappyCommandHooks)),
         inconclusive=("R-4.1-01",),  # no back-to-back characters: rate and gaps inseparable
     ),
     RecorderFault(
@@ -632,7 +716,7 @@ _FAULTS = (
         "Leaves 1.9 ms between command characters: over 1.66 ms, inside the ±0.40 ms that "
         "this limit does not grant.",
         ("R-7.0-13", "R-7.0-01"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(BandGapCommandMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_hooks(BandGapCommandHooks)),
         inconclusive=("R-4.1-01",),
     ),
     RecorderFault(

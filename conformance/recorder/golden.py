@@ -4,7 +4,7 @@ A recorder program is any callable ``(request, link) -> RecorderOutput``: it rec
 scenario asks (:class:`~conformance.recorder_jobs.Request`) and the bus, does the job the
 way a data logger would, and says what it logged. :class:`GoldenRecorder` does it with the
 tool's own :class:`~conformance.tool_recorder.Master` under :meth:`Policy.golden`, so it is the
-reference every recorder judge must find COMPLIANT; its knobs (and the Master subclasses in
+reference every recorder judge must find COMPLIANT; its knobs (and the engine hooks in
 :mod:`conformance.recorder.faults`) make the faulty recorders of the fault-detection matrix.
 
 Beyond what the engine does per command, a logger has duties across commands, kept here:
@@ -24,6 +24,7 @@ from ..protocol.commands import Command, Kind, parse_command
 from ..protocol.values import split_values
 from ..recorder_jobs import RecorderOutput, Request, Task
 from ..tool_recorder import Master, Measurement, Policy, validity
+from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.records import Exchange
 from ..transcript import TOOL, EventKind
 
@@ -34,29 +35,58 @@ MasterFactory = Callable[[Link, Policy], Master]
 MAX_DRAIN = 1.0
 
 
-class GoldenMaster(Master):
+class GoldenHooks(Hooks):
     """The engine as a recorder under test: before a retry it lets an invalid reply finish.
 
     The engine stops reading a reply after 8.33 ms of marking (a retry trigger, R-7.2-05), but
     a sensor may resume after such a pause; a recorder must not talk over it (R-7.2-06). So
     the retry waits until the line has been quiet for ``retry_gap`` after the sensor's last
-    character, keeping the late characters with the attempt they belong to.
+    character, keeping the late characters with the attempt they belong to. The faulty
+    recorders' hooks (:mod:`conformance.recorder.faults`) build on these.
     """
 
-    def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+    def retry_time(
+        self,
+        master: Engine,
+        exchange: Exchange,
+        sequence: int,
+        per_sequence: int,
+        usual: Callable[[], float],
+    ) -> float:
+        """The engine's retry time, once the line has been quiet for ``retry_gap``."""
         prev = exchange.last
+        link = master.link
         if prev.reply_events:
-            quiet = self.policy.retry_gap
-            limit = self.link.now() + MAX_DRAIN
-            while (last := self._last_sensor_char()) + quiet > self.link.now() < limit:
-                prev.reply_events += self.link.receive(min(last + quiet, limit))
-        return max(super()._retry_time(exchange, sequence, per_sequence), self.link.now())
+            quiet = master.policy.retry_gap
+            limit = link.now() + MAX_DRAIN
+            while (last := _last_sensor_char(link)) + quiet > link.now() < limit:
+                prev.reply_events += link.receive(min(last + quiet, limit))
+        return max(usual(), link.now())
 
-    def _last_sensor_char(self) -> float:
-        for event in reversed(self.link.transcript.events):
-            if event.kind is EventKind.CHAR and event.origin != TOOL:
-                return event.end
-        return float("-inf")
+
+class GoldenMaster(Master):
+    """The engine with :class:`GoldenHooks` (or ``hooks`` built on them): the golden recorder's
+    engine, and the faulty recorders' unless they pass hooks of their own."""
+
+    def __init__(
+        self,
+        link: Link,
+        policy: Policy | None = None,
+        *,
+        address: str = "0",
+        hooks: Hooks | None = None,
+    ) -> None:
+        super().__init__(
+            link, policy, address=address, hooks=hooks if hooks is not None else GoldenHooks()
+        )
+
+
+def _last_sensor_char(link: Link) -> float:
+    """End of the last character the sensor sent, or -inf."""
+    for event in reversed(link.transcript.events):
+        if event.kind is EventKind.CHAR and event.origin != TOOL:
+            return event.end
+    return float("-inf")
 
 
 @dataclass

@@ -9,26 +9,46 @@ explicitly; this watch lets the session say "already filled" without sending any
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
 
+from ..links.base import Link
 from ..protocol.commands import Command, Kind
 from ..tool_recorder.engine import Master
+from ..tool_recorder.hooks import Engine, Hooks
+from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
 from ..transcript import EventKind
+
+
+class BufferWatchHooks(Hooks):
+    """Engine hooks that change nothing and note, per address, the last command sent and the
+    characters of its reply (``last_sent``)."""
+
+    def __init__(self) -> None:
+        self.last_sent: dict[str, tuple[Command | None, str]] = {}
+
+    def attempt(
+        self,
+        master: Engine,
+        wire: bytes,
+        address: str,
+        command: Command | None,
+        proceed: Callable[[], Attempt],
+    ) -> Attempt:
+        """The engine's attempt, noted."""
+        attempt = proceed()
+        reply = "".join(chr(e.char7) for e in attempt.reply_events if e.kind is EventKind.CHAR)
+        self.last_sent[address] = (command, reply)
+        return attempt
 
 
 class WatchedMaster(Master):
     """The master engine, noting per address the last command sent and its reply."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.last_sent: dict[str, tuple[Command | None, str]] = {}
-
-    def _attempt(self, wire: bytes, address: str, command: Command | None, **kw: Any) -> Attempt:
-        attempt = super()._attempt(wire, address, command, **kw)
-        reply = "".join(chr(e.char7) for e in attempt.reply_events if e.kind is EventKind.CHAR)
-        self.last_sent[address] = (command, reply)
-        return attempt
+    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
+        self.watch = BufferWatchHooks()
+        super().__init__(link, policy, address=address, hooks=self.watch)
+        self.last_sent = self.watch.last_sent
 
     def buffer_holds_values(self, address: str) -> bool:
         """The last command sent to ``address`` was an ASCII D read answered with values:

@@ -39,6 +39,7 @@ from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
 from ..view.segments import continues_frame
 from . import validity
 from .contention import HOLD_PREFIX, collisions
+from .hooks import Hooks
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
 from .reply_end import Framing
@@ -53,11 +54,21 @@ class Master:
     """Drives a :class:`Link` as an SDI-12 data recorder and returns records.
 
     ``address`` is the default sensor address for the conveniences (:meth:`identify`...).
+    ``hooks`` takes the decisions a deviating recorder makes differently (:mod:`.hooks`);
+    the default ones take the engine's own.
     """
 
-    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
+    def __init__(
+        self,
+        link: Link,
+        policy: Policy | None = None,
+        *,
+        address: str = "0",
+        hooks: Hooks | None = None,
+    ) -> None:
         self.link = link
         self.policy = policy or Policy()
+        self.hooks = hooks if hooks is not None else Hooks()
         self.address = address
         self.last_address: str | None = None  # address of the last command sent
         self.last_break_end = float("-inf")
@@ -358,6 +369,12 @@ class Master:
             self._crc_pending[command.address] = command.returns_crc
 
     def _wait_for_data(self, m: Measurement, *, service_request: bool) -> None:
+        """Wait for ``m``'s data as the hooks say (:meth:`Hooks.wait_for_data`)."""
+        self.hooks.wait_for_data(
+            self, m, service_request, lambda: self._usual_wait_for_data(m, service_request)
+        )
+
+    def _usual_wait_for_data(self, m: Measurement, service_request: bool) -> None:
         """Wait out ttt, recording every DUT character; with ``service_request`` stop at the
         first ``a<CR><LF>`` (R-4.4.5-04, R-4.4.6). Keeps listening ``late_sr_grace`` past ttt
         so a late service request is evidence, not a miss."""
@@ -384,6 +401,12 @@ class Master:
         return max(self.link.now(), last_dut + self.policy.turnaround)
 
     def _needs_break(self, address: str, at: float) -> bool:
+        """Whether the break rules put a break in front, as the hooks say."""
+        return self.hooks.needs_break(
+            self, address, at, lambda: self._usual_needs_break(address, at)
+        )
+
+    def _usual_needs_break(self, address: str, at: float) -> bool:
         """R-7.0-17 / R-7.1-01: break for a new address or after > 87 ms of marking."""
         if self.last_address is None or address != self.last_address:
             return True
@@ -409,7 +432,8 @@ class Master:
             # socket://: the link noted it; the command goes alone
             with contextlib.suppress(BreakUnsupported):
                 break_event = self._break(marking)
-        events = self.link.write(wire, gap)  # gap 0: back to back, R-7.0-13
+        # gap 0: back to back, R-7.0-13
+        events = self.link.write(wire, self.hooks.command_gap(self, gap))
         self.last_address = address
         return break_event, events, stray
 
@@ -426,6 +450,28 @@ class Master:
         marking: float | None = None,
         collide: bool = False,
     ) -> Attempt:
+        """One transmission and its reply, as the hooks let it go (:meth:`Hooks.attempt`)."""
+
+        def proceed() -> Attempt:
+            return self._usual_attempt(
+                wire, address, command, brk, binary, crc, gap, marking, collide
+            )
+
+        return self.hooks.attempt(self, wire, address, command, proceed)
+
+    def _usual_attempt(
+        self,
+        wire: bytes,
+        address: str,
+        command: Command | None,
+        brk: bool | None,
+        binary: bool,
+        crc: bool | None,
+        gap: float,
+        marking: float | None,
+        collide: bool,
+    ) -> Attempt:
+        """Listen before talk, send, then read and judge the reply."""
         break_event, sent, stray = self._transmit(wire, address, brk, gap, marking, collide)
         command_end = sent[-1].end if sent else self.link.now()
         p = self.policy
@@ -514,6 +560,16 @@ class Master:
         return OK if why is None else f"invalid: {why}"
 
     def _retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
+        """When the next retry starts, as the hooks say (:meth:`Hooks.retry_time`)."""
+        return self.hooks.retry_time(
+            self,
+            exchange,
+            sequence,
+            per_sequence,
+            lambda: self._usual_retry_time(exchange, sequence, per_sequence),
+        )
+
+    def _usual_retry_time(self, exchange: Exchange, sequence: int, per_sequence: int) -> float:
         """When the next retry (no break) starts, per R-7.2-02/03/06.
 
         ``retry_gap`` after the end of the invalid reply (it must have finished) or of the
