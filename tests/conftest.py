@@ -16,10 +16,10 @@ import pytest
 
 # Runs on real-time links plan first by default (a dry run of ~5 s of CPU); the tool's own
 # tests start dozens of those, side by side with real-time ones, so they run unplanned unless
-# a test asks (--plan always, tests/test_plan.py). Inherited by every CLI subprocess.
+# a test asks (--plan always, tests/commands/test_plan.py). Inherited by every CLI subprocess.
 os.environ.setdefault("SDI12_PLAN", "never")
 
-pytest_plugins = ["pytester"]  # tests/test_busy_summary.py runs tiny sessions
+pytest_plugins = ["pytester"]  # tests/test_conftest.py runs tiny sessions
 
 #: The phrase every busy-machine skip reason carries (with its measured figure after it).
 BUSY = "the machine was too busy"

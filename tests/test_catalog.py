@@ -13,14 +13,14 @@ import difflib
 import json
 import re
 from importlib.resources import files
-from pathlib import Path
 from typing import Any
 
 import pytest
 
 from conformance import catalog as cat
+from tests.support.paths import SHARED
 
-SPEC = Path(__file__).resolve().parents[2] / "shared" / "spec" / "requirements.md"
+SPEC = SHARED / "spec" / "requirements.md"
 
 # Above this similarity (difflib ratio of normalised text) a "paraphrase" is a near-copy.
 MAX_SIMILARITY = 0.80

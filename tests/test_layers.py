@@ -16,7 +16,9 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent / "conformance"
+from tests.support.paths import ROOT
+
+ROOT = ROOT / "conformance"
 
 #: The layers, lowest first. A module may import its own layer and the ones before it. Names
 #: are top-level packages or modules under ``conformance`` (``""`` is the package itself): a

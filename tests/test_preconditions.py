@@ -19,7 +19,7 @@ from conformance.conduct import run_once
 from conformance.results import CaseRecord
 from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Verdict, failed, passed
-from tests.test_judges import exchange
+from tests.judges.test_judges import exchange
 
 ABORT = ("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03")
 
@@ -226,7 +226,7 @@ def test_every_declared_precondition_is_checked_when_the_recorder_suite_runs():
 def test_the_passive_suite_checks_heard(tmp_path):
     """Each passive case routes its judges' findings through ``heard``: a rule the recording
     does not hold is "precondition not met: heard: not seen in the recording", never PASS."""
-    from tests.test_passive import live, passive
+    from tests.commands.test_passive import live, passive
 
     first = live(tmp_path, "sim", "sensor")
     lines = (first / "transcript.jsonl").read_text(encoding="utf-8").splitlines()

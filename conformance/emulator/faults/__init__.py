@@ -27,7 +27,7 @@ Faults compose: :func:`compose` merges their settings, chains their rewrites and
 their profile transforms. A set is refused (:class:`CompositionError`) where two faults set
 one knob to different values or one declares that it ``masks`` the other; otherwise the
 result does not depend on the order and each member's deviation still shows on the wire
-(tests/test_fault_composition.py checks every pair whose hooks touch the same thing).
+(tests/emulator/test_fault_composition.py checks every pair whose hooks touch the same thing).
 """
 
 from __future__ import annotations

@@ -1,0 +1,246 @@
+"""Issue 22's fast paths against the straightforward readings they replace: the bulk export
+edges against :func:`edges_of`, the bulk sample blocks against filling a block edge by edge,
+the decoder's kept frame shapes against reading every frame at its own ticks, a transcript
+line against ``json.dumps``, and a written transcript kept as its reading against parsing it.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from conformance.capture import levels, uart, writers
+from conformance.capture.levels import edge_array, edges_of
+from conformance.capture.writers import Channel
+from conformance.replay import recording
+from conformance.replay.recording import read_recording, write_recording
+from conformance.transcript import DUT, TOOL, Event, EventKind, json_line, to_wire_7e1
+from tests.support.capture_digest import traffic  # noqa: E402
+
+RATES = st.sampled_from([1_000.0, 48_000.0, 100_000.0, 625_000.0, 1_000_000.0, 500.0])
+
+
+@st.composite
+def wire_events(draw) -> list[Event]:
+    """Characters (some long, some of no or negative length) and breaks that overlap."""
+    out = []
+    t = draw(st.floats(0.0, 2.0))
+    for _ in range(draw(st.integers(0, 40))):
+        t += draw(st.floats(-0.02, 0.03))
+        if draw(st.booleans()):
+            dur = draw(st.sampled_from([10 / 1200, 10 / 1150, 10 / 300, 0.0, 0.06, 0.2, -0.001]))
+            wire = draw(st.integers(-3, 300))
+            out.append(Event(EventKind.CHAR, draw(st.sampled_from([TOOL, DUT])), t, t + dur, wire))
+        else:
+            out.append(Event(EventKind.BREAK, TOOL, t, t + draw(st.floats(-0.001, 0.02))))
+    if draw(st.booleans()):
+        out.sort(key=lambda e: e.start)  # what export gives (unsorted: the slow path)
+    return out
+
+
+@settings(max_examples=150, deadline=None)
+@given(wire_events(), RATES, st.floats(0.0, 1.0))
+def test_edge_array_is_edges_of(events, rate, t0):
+    assert edge_array(events, rate, t0).tolist() == list(edges_of(events, rate, t0))
+
+
+def test_edge_array_of_a_busy_bus_is_edges_of():
+    events = traffic(7, seconds=30.0)
+    for rate in (100_000.0, 1_000_000.0):
+        assert edge_array(events, rate, 0.03).tolist() == list(edges_of(events, rate, 0.03))
+
+
+def edge_by_edge(channels: list[tuple[int, list[int]]], total: int, block: int) -> list[bytes]:
+    """Sample words as the writer filled them before: a block at a time, edge by edge."""
+    blocks = []
+    streams = []
+    for idle, edges in channels:
+        it = iter(edges)
+        level, nxt, out = idle, next(it, None), []
+        for base in range(0, total, block):
+            n = min(block, total - base)
+            buf = np.zeros(n, dtype=np.uint8)
+            p = base
+            while nxt is not None and nxt < base + n:
+                if nxt > p:
+                    buf[p - base : nxt - base] = level
+                    p = nxt
+                level ^= 1
+                nxt = next(it, None)
+            buf[p - base : n] = level
+            out.append(buf)
+        streams.append(out)
+    for parts in zip(*streams, strict=True):
+        word = parts[0].copy()
+        for bit, b in enumerate(parts[1:], 1):
+            word |= b << bit
+        blocks.append(word.tobytes())
+    return blocks
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 1), st.lists(st.integers(-5, 400), max_size=30)),
+        min_size=1,
+        max_size=3,
+    ),
+    st.integers(0, 350),
+)
+def test_sample_words_are_the_edge_by_edge_fill(monkeypatch, channels, total):
+    """Any edge list, even one going back or past the end, fills the same samples."""
+    monkeypatch.setattr(writers, "BLOCK_SAMPLES", 64)
+    got = [
+        w.tobytes()
+        for w in writers._words(
+            [Channel(f"c{i}", idle, e) for i, (idle, e) in enumerate(channels)], total
+        )
+    ]
+    assert got == edge_by_edge(channels, total, 64)
+
+
+def decoded(edges: list[int], rate: float, **kw) -> list:
+    chunks = [edges[i : i + 37] for i in range(0, len(edges), 37)]
+    return list(uart.decode(chunks, initial_level=1, tick_rate=rate, end_tick=lambda: None, **kw))
+
+
+@st.composite
+def jittered_frames(draw) -> tuple[list[int], float]:
+    """Edges of 7E1 frames at a drawn bit rate, jittered and sometimes glitched."""
+    rate = draw(st.sampled_from([9_600.0, 48_000.0, 100_000.0, 1_000_000.0]))
+    start = draw(st.sampled_from([0, 10**6, 2**39 - 10**5, 2**41]))  # shapes off past 2**39
+    bit = rate / 1200 * draw(st.sampled_from([1.0, 0.96, 1.04, 1.1]))
+    edges: list[int] = []
+    t = start + draw(st.integers(1, 50))
+    for c in draw(st.text("0123456789+-.!aDM\r\n", min_size=1, max_size=25)):
+        wire = to_wire_7e1(ord(c)) if draw(st.integers(0, 9)) else draw(st.integers(0, 255))
+        levels_ = [0] + [(wire >> i) & 1 for i in range(8)] + [1]
+        prev = 1
+        for k, lvl in enumerate(levels_):
+            if lvl != prev:
+                edges.append(int(t + k * bit) + draw(st.integers(-1, 1)))
+                prev = lvl
+        if draw(st.integers(0, 12)) == 0:
+            g = int(t + draw(st.floats(0.3, 9.0)) * bit)
+            edges += [g, g + 1]
+        t += 10 * bit + draw(st.sampled_from([0, 0, 3, int(bit), int(20 * bit)]))
+    edges = sorted(set(edges))
+    return edges, rate
+
+
+@settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(jittered_frames())
+def test_kept_frame_shapes_read_as_every_frame_read_alone(monkeypatch, frames):
+    edges, rate = frames
+    kept = decoded(edges, rate)
+    monkeypatch.setattr(uart, "_EXACT_BELOW", 0)  # no shape kept: every frame at its ticks
+    assert kept == decoded(edges, rate)
+
+
+def test_an_edge_on_a_bit_centre_is_read_at_its_own_ticks(monkeypatch):
+    """Bit centres of 1200 baud at 2.4 kHz fall on whole ticks: such a shape is never kept
+    (a start far out could round its centre to either side), and reads as read alone."""
+    calls = []
+    real = uart._read_frame
+    monkeypatch.setattr(uart, "_read_frame", lambda *a: calls.append(a[0]) or real(*a))
+    edges = []
+    for n in range(4):
+        s = 2**38 + n * 30
+        edges += [s, s + 1, s + 3, s + 4]  # 0x55-like: edges half a bit off the centres
+    got = decoded(edges, 2400.0)
+    assert [d.kind for d in got] == ["char"] * 4
+    assert 2**38 in calls  # read at its own ticks, not as a kept shape
+    monkeypatch.setattr(uart, "_EXACT_BELOW", 0)
+    assert got == decoded(edges, 2400.0)
+
+
+def test_frame_shapes_stay_bounded(monkeypatch):
+    monkeypatch.setattr(uart, "FRAME_SHAPES", 3)
+    sizes = []
+    real = uart._shape_reading
+    monkeypatch.setattr(uart, "_shape_reading", lambda *a: sizes.append(1) or real(*a))
+    edges, rate = [], 100_000.0
+    t = 100
+    for k in range(40):  # a sender drifting: a new shape nearly every frame
+        bit = 83.3 + k * 0.05
+        edges += [t, int(t + bit), int(t + 2 * bit), int(t + 9 * bit)]
+        t += int(12 * bit)
+    kept = decoded(edges, rate)
+    monkeypatch.setattr(uart, "_EXACT_BELOW", 0)
+    assert kept == decoded(edges, rate)
+    assert len(sizes) > 3
+
+
+TEXTS = st.text(st.characters(), max_size=12)
+FLOATS = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True), st.integers(-5, 5), st.just(-0.0)
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(
+    st.sampled_from(list(EventKind)),
+    st.sampled_from([TOOL, DUT, "bus", 'é\n"x']),
+    FLOATS,
+    FLOATS,
+    st.one_of(st.integers(-3, 1 << 70), st.booleans()),
+    TEXTS,
+    FLOATS,
+    st.one_of(st.none(), FLOATS),
+)
+def test_json_line_is_json_dumps(kind, origin, start, end, wire, text, unc, du):
+    e = Event(kind, origin, start, end, wire, text, unc, du)
+    assert json_line(e) == json.dumps(e.to_json()) + "\n"
+
+
+def test_a_written_transcript_is_its_own_reading(tmp_path, monkeypatch):
+    events = [
+        Event(EventKind.NOTE, TOOL, 0.0, 0.0, text='run-options {"role": "sensor"}'),
+        *traffic(3, seconds=2.0),
+        Event(EventKind.CHAR, DUT, 3.0, 3.1, 65, "", 1e-5, 2e-6),
+    ]
+    path = tmp_path / "transcript.jsonl"
+    write_recording(path, events)
+    parsed = []
+    real = recording.read_transcript_jsonl
+    monkeypatch.setattr(recording, "read_transcript_jsonl", lambda p: parsed.append(p) or real(p))
+    kept = read_recording(path).events
+    assert parsed == []  # nothing parsed: what was written is the reading
+    recording._READ.clear()
+    fresh = read_recording(path).events
+    assert parsed == [str(path)]
+    assert kept == fresh
+    assert [tuple(map(type, (e.start, e.end, e.wire, e.uncertainty))) for e in kept] == [
+        tuple(map(type, (e.start, e.end, e.wire, e.uncertainty))) for e in fresh
+    ]
+
+
+def test_a_transcript_that_reads_back_otherwise_is_parsed(tmp_path):
+    """An int time is written as an int and read back as a float: never kept as written."""
+    path = tmp_path / "transcript.jsonl"
+    write_recording(path, [Event(EventKind.CHAR, DUT, 1, 2, 65)])
+    (got,) = read_recording(path).events
+    assert type(got.start) is float and got.start == 1.0
+
+
+def test_a_rewritten_transcript_is_read_again(tmp_path):
+    path = tmp_path / "transcript.jsonl"
+    write_recording(path, [Event(EventKind.CHAR, DUT, 1.0, 2.0, 65)])
+    assert read_recording(path).events[0].wire == 65
+    path.write_text(json.dumps(Event(EventKind.CHAR, DUT, 1.0, 2.0, 66, "x").to_json()) + "\n")
+    assert read_recording(path).events[0].wire == 66
+
+
+@pytest.mark.parametrize("rate", [100_000.0, 1_000_000.0])
+def test_the_bulk_export_is_taken_for_a_busy_bus(monkeypatch, rate):
+    """The slow path is for what the bulk union could order differently, not for traffic."""
+    monkeypatch.setattr(levels, "edges_of", None)
+    assert edge_array(traffic(9, seconds=5.0), rate, 0.0).size > 1000

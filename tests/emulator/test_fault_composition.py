@@ -1,0 +1,201 @@
+"""Faults compose faithfully: for every pair whose hooks touch the same thing, the composed
+emulator is the same in either order and still shows each member's deviation on the wire,
+or the pair is refused with the reason declared as data (a settings clash or ``masks``).
+
+The "wire" of a fault is three maps: its profile (every field of every measurement spec and
+of the sensor, the announced count included), the wire frames of each reply of a session of
+the clean sensor after its rewrites (None for silence), and its behaviour settings. A member
+survives when an aspect only it touches reads as it does alone, or when an aspect both touch
+reads unlike the clean sensor and unlike the other member alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields, replace
+from itertools import combinations
+from typing import Any
+
+import pytest
+
+from conformance.emulator import FAULTS, CompositionError, FaultSet, compose, default_profile
+from conformance.emulator.faults import clash, conflicts
+from conformance.emulator.profile import MeasurementSpec, Profile
+from conformance.emulator.replies import Reply
+from tests.emulator.test_sensor import Rig
+
+_MEASUREMENTS = ("M", "MC", "M1", "MC1", "M2", "V", "C", "CC", "C9", "HA", "HB",
+                 "IM", "IMC", "IC", "IHA")  # fmt: skip
+_OTHERS = ("0!", "?!", "0I!", "0R0!", "0RC0!", "0R1!", "0R9!", "0RC9!", "0XSN!", "0XHELP!",
+           "0IM_001!", "0IMC_001!", "0IM_000!", "0IR0_001!", "0IHA_001!", "0IHAC_002!")  # fmt: skip
+
+
+class _Recorder(FaultSet):
+    """A clean fault set that keeps every reply the sensor describes."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        object.__setattr__(self, "seen", [])
+
+    def rewrite(self, reply: Reply) -> Reply | None:
+        self.seen.append(replace(reply))
+        return reply
+
+
+def _corpus() -> list[Reply]:
+    rig = Rig()
+    recorder = _Recorder()
+    rig.emulator.faults = recorder
+    for code in _MEASUREMENTS:
+        rig.measure(f"0{code}!")
+        for index in range(3):
+            rig.ask(f"0D{index}!")
+            rig.ask(f"0D{index}!")  # a repeat: faults may make repeats differ
+        if code == "HB":
+            for index in range(3):
+                rig.ask(f"0DB{index}!")
+    for text in _OTHERS:
+        rig.ask(text)
+    return recorder.seen
+
+
+CORPUS = _corpus()
+CLEAN = default_profile()
+
+
+def _profile_aspects(profile: Profile) -> dict[tuple[str, ...], Any]:
+    aspects: dict[tuple[str, ...], Any] = {}
+    for f in fields(Profile):
+        if f.name != "measurements":
+            aspects[("profile", f.name)] = getattr(profile, f.name)
+    for key in set(profile.measurements) | set(CLEAN.measurements):
+        spec = profile.measurements.get(key)
+        for f in fields(MeasurementSpec):
+            aspects[("spec", key, f.name)] = getattr(spec, f.name, None)
+        aspects[("spec", key, "count")] = spec.count if spec is not None else None
+    return aspects
+
+
+def _wire(fault_set: FaultSet) -> dict[tuple[Any, ...], Any]:
+    """Every aspect of the sensor ``fault_set`` makes (see the module docstring)."""
+    state = {key: value for key, value in _profile_aspects(fault_set.apply_profile(CLEAN)).items()}
+    for n, reply in enumerate(CORPUS):
+        out = fault_set.rewrite(replace(reply))
+        state[("reply", n)] = None if out is None else tuple(out.wires())
+    for f in fields(fault_set.behaviour):
+        state[("setting", f.name)] = getattr(fault_set.behaviour, f.name)
+    return state
+
+
+BASE = _wire(FaultSet())
+ALONE = {name: _wire(compose([name])) for name in FAULTS}
+TOUCHED = {name: {k for k, v in ALONE[name].items() if BASE.get(k) != v} for name in FAULTS}
+
+
+def _touching_pairs() -> list[tuple[str, str]]:
+    names = sorted(FAULTS)
+    return [(a, b) for a, b in combinations(names, 2) if TOUCHED[a] & TOUCHED[b]]
+
+
+PAIRS = _touching_pairs()
+
+
+def _lost(member: str, other: str, composed: dict) -> str | None:
+    """Why ``member``'s deviation does not show in ``composed`` beside ``other`` (None if
+    it does)."""
+    mine, theirs = TOUCHED[member], TOUCHED[other]
+    owned = mine - theirs
+    undone = [k for k in owned if composed.get(k) != ALONE[member].get(k)]
+    if undone:
+        return f"{other} changes what only {member} touches: {sorted(map(str, undone))[:3]}"
+    if owned:
+        return None
+    for k in mine & theirs:
+        if composed.get(k) != ALONE[other].get(k) and composed.get(k) != BASE.get(k):
+            return None
+    return f"{member} shows nowhere beside {other}"
+
+
+def test_the_pairs_cover_every_kind_of_hook():
+    """The pairs checked include profile edits, CRC rewrites and settings that clash."""
+    kinds = {next(iter(TOUCHED[a] & TOUCHED[b]))[0] for a, b in PAIRS}
+    assert {"spec", "reply", "setting"} <= kinds
+    assert ("measure-count-zero", "value-ten-chars") in PAIRS
+    assert ("crc-missing", "wrong-crc") in PAIRS
+    assert ("response-too-early", "response-too-late") in PAIRS
+
+
+def test_every_touching_pair_composes_faithfully_or_is_refused():
+    problems = []
+    for a, b in PAIRS:
+        reason = clash(FAULTS[a], FAULTS[b])
+        if reason is not None:
+            with pytest.raises(CompositionError, match="masks|both set|both replace"):
+                compose([a, b])
+            continue
+        try:
+            ab, ba = _wire(compose([a, b])), _wire(compose([b, a]))
+        except (KeyError, IndexError) as exc:
+            problems.append(f"{a} + {b}: one removes what the other edits ({exc})")
+            continue
+        if ab != ba:
+            differ = sorted(str(k) for k in ab if ab[k] != ba.get(k))[:3]
+            problems.append(f"{a} + {b}: the order matters ({differ})")
+            continue
+        for member, other in ((a, b), (b, a)):
+            lost = _lost(member, other, ab)
+            if lost:
+                problems.append(f"{a} + {b}: {lost}")
+    assert problems == []
+
+
+def test_declared_masks_are_real():
+    """A ``masks`` declaration is not a way to silence the test above: composed by hand,
+    the masked fault really shows nowhere."""
+    declared = [(f.name, other) for f in FAULTS.values() for other in f.masks]
+    assert declared
+    for name, other in declared:
+        assert other in FAULTS, (name, other)
+        assert FAULTS[name].masks[other].strip(), (name, other)
+        forced = FaultSet((FAULTS[name], FAULTS[other]))
+        try:
+            state = _wire(forced)
+        except KeyError:
+            continue  # the masking fault removed what the other edits: nothing to show
+        assert _lost(other, name, state) is not None, (name, other)
+
+
+def test_the_two_seen_bugs_are_gone():
+    """Issue 18: a value edit brought back the values measure-count-zero removed, and a CRC
+    forged by wrong-crc outlived crc-missing."""
+    with pytest.raises(CompositionError, match="measure-count-zero masks value-ten-chars"):
+        compose(["value-ten-chars", "measure-count-zero"])
+    rig = Rig(faults=("wrong-crc", "crc-missing"))
+    rig.measure("0MC1!")
+    assert rig.ask("0D0!").body == "0+12.61+3.3"
+
+
+def test_settings_that_clash_are_refused_with_both_values():
+    with pytest.raises(CompositionError, match=r"both set reply_delay \(0.005 and 0.02\)"):
+        compose(["response-too-early", "response-too-late"])
+    assert conflicts(["wrong-crc", "crc-missing"]) == []
+
+
+# -- a fault that does not fit the claimed version --------------------------------------------
+@pytest.mark.parametrize("name", sorted(FAULTS))
+def test_every_fault_on_a_v13_sensor_is_accepted_or_a_usage_error(name):
+    """Issue 18: ``sim://?faults=binary-payload-over-1000&version=1.3`` ended in a KeyError
+    (exit 3). Every fault with version=1.3 either builds a sensor that answers, or is refused
+    where the sim port is parsed, with a PortError (exit 4) that names what is missing."""
+    from conformance.ports import PortError, open_sim, parse_sim
+
+    try:
+        opened = open_sim(parse_sim(f"sim://?faults={name}&version=1.3"))
+    except PortError as exc:
+        assert "\n" not in str(exc) and name in str(exc) and "v1.3 sensor" in str(exc)
+        assert FAULTS[name].version == "14"
+        return
+    rig = Rig.__new__(Rig)  # the sensor the sim port built, on its own link
+    rig.link, rig.emulator = opened.link, opened.devices[0]
+    for text in ("0!", "0I!", "0M!", "0D0!", "0C!", "0D0!", "0R0!", "0XSN!", "0M1!", "0D0!"):
+        rig.ask(text)  # the v1.3 sensor serves the fault without an internal error
+    assert rig.emulator.profile.version == "13"

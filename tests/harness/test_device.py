@@ -1,0 +1,375 @@
+"""The harness link (``--port exec:`` / ``unix:``): exact verdicts through another process, and
+every way a harness can fail (crash, hang, flood, garbage, early exit) ends as a bounded ERROR
+with the harness's stderr tail, never a traceback, a hang, a verdict about the DUT, or a zombie.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from conformance.conduct import run_once
+from conformance.harness.channel import ChildChannel, HarnessError
+from conformance.harness.device import open_sensor_harness
+from conformance.harness.protocol import Role
+from conformance.links.errors import PortUnavailable
+from conformance.ports import open_port
+from conformance.results import CaseRecord
+from conformance.verdicts import Finding, Verdict
+from tests.support.paths import ROOT
+
+#: A sensor harness (the reference sensor) that misbehaves at message number ``AT``.
+MISBEHAVING = textwrap.dedent(
+    """
+    import os, sys, time
+    from pathlib import Path
+    from conformance.emulator import SensorEmulator, default_profile
+
+    MODE, AT = sys.argv[1], int(sys.argv[2])
+    if len(sys.argv) > 3:
+        Path(sys.argv[3]).write_text(str(os.getpid()))
+    sensor = SensorEmulator(default_profile())
+
+    def plan(now):
+        f = sensor.next_frame()
+        return "idle" if f is None else f"tx {max(round(f.start * 1e6), now)} {f.wire:02x}"
+
+    for n, line in enumerate(sys.stdin):
+        word, *fields = line.split()
+        if n == AT:
+            print(f"harness goes {MODE} at message {n}: {line.strip()}", file=sys.stderr)
+            sys.stderr.flush()
+            if MODE == "crash":
+                os.abort()
+            if MODE == "exit":
+                sys.exit(0)
+            if MODE == "hang":
+                time.sleep(3600)
+            if MODE == "flood":
+                while True:
+                    print("idle", flush=True)
+            if MODE == "garbage":
+                print("\\x00\\x7f\\x1b[31mGARBAGE", flush=True)
+            if MODE == "twice":
+                print("idle\\nidle", flush=True)
+            if MODE == "late-extra":
+                print("idle", flush=True)
+                time.sleep(0.2)
+                print("idle", flush=True)
+            if MODE == "badbyte":
+                print("tx 99999999 1b4", flush=True)
+            continue
+        if word == "hello":
+            print("hello 1 misbehaving", flush=True)
+            continue
+        if word == "bye":
+            if MODE == "after-bye":  # one answer too many: the stream was out of step
+                time.sleep(0.2)
+                print("idle", flush=True)
+            break
+        t = [int(x) for x in fields[:2]]
+        if word == "break":
+            sensor.on_break(t[0] / 1e6, t[1] / 1e6)
+        elif word == "char":
+            sensor.on_char(int(fields[2], 16), t[0] / 1e6, t[1] / 1e6)
+        elif word == "sent":
+            sensor.pop_frame()
+        print(plan(t[-1]), flush=True)
+    """
+)
+
+
+@pytest.fixture
+def misbehaving(tmp_path: Path):
+    script = tmp_path / "misbehaving.py"
+    script.write_text(MISBEHAVING)
+
+    def port(mode: str, at: int) -> tuple[str, Path]:
+        pidfile = tmp_path / f"{mode}.pid"
+        return f"exec:{sys.executable} {script} {mode} {at} {pidfile}", pidfile
+
+    return port
+
+
+def reaped(pidfile: Path) -> bool:
+    """The harness process is gone: not running and not a zombie waiting to be collected."""
+    pid = int(pidfile.read_text())
+    return not Path(f"/proc/{pid}").exists()
+
+
+@pytest.mark.slow
+def test_the_python_example_sensor_is_compliant_with_exact_timing():
+    data = run_once(f"exec:{sys.executable} {ROOT / 'examples/python/sensor_harness.py'}")
+    assert data["summary"]["verdict"] == "COMPLIANT"
+    counts = data["summary"]["counts"]
+    assert counts["FAIL"] == counts["ERROR"] == counts["WARN"] == 0
+    assert data["run"]["link"]["kind"] == "exec"
+    # the one thing a harness link cannot see: the bit rate (the tool makes the frames)
+    unsure = {r["id"]: r for r in data["requirements"] if r["verdict"] == "INCONCLUSIVE"}
+    assert list(unsure) == ["R-4.1-01"]
+    assert "bit rate is not observed" in unsure["R-4.1-01"]["findings"][0]["detail"]
+    timed = [f for r in data["requirements"] for f in r["findings"] if f["measured_ms"] is not None]
+    assert timed and all(f["uncertainty_ms"] == 0.0 for f in timed)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("mode", "at", "words"),
+    [
+        ("crash", 300, ["killed by signal SIGABRT", "harness goes crash at message 300"]),
+        ("exit", 300, ["closed its output", "exit status 0", "harness goes exit"]),
+        ("garbage", 300, ["not printable ASCII", "GARBAGE"]),
+        ("twice", 300, ["more than one reply"]),
+        ("flood", 300, ["more than one reply"]),
+        ("badbyte", 300, ["not two hex digits", "tx 99999999 1b4"]),
+        # one answer late: caught by the next check, or the harness chokes on what follows
+        ("late-extra", 300, ["unsolicited output|more than one reply|out of step|closed its"]),
+    ],
+)
+def test_a_failing_harness_ends_the_run_with_an_error_not_a_verdict(misbehaving, mode, at, words):
+    port, pidfile = misbehaving(mode, at)
+    started = time.monotonic()
+    data = run_once(port)
+    assert time.monotonic() - started < 30
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    assert data["run"]["complete"] is False
+    reason = data["run"]["stop_reason"]
+    assert reason.startswith("link failed: harness")
+    for word in words:
+        assert any(w in reason for w in word.split("|")), reason
+    counts = data["summary"]["counts"]
+    assert counts["FAIL"] == 0  # never a verdict about the DUT
+    assert reaped(pidfile)
+
+
+def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
+    """A line written unasked while the tool already waits for the next answer is taken as
+    that answer, and the stream is one line late from then on; no single line shows it. The
+    end does: an answer arrives after ``bye``, and the records are not trusted."""
+    script = tmp_path / "late.py"
+    script.write_text(
+        textwrap.dedent(
+            """
+            import sys, time
+            print("hello 1 late", flush=True) if sys.stdin.readline() else None
+            sys.stdin.readline()
+            print("idle", flush=True)
+            time.sleep(0.3)
+            print("idle", flush=True)  # unasked: the tool has sent its next message by now
+            sys.stdin.readline()
+            time.sleep(0.3)
+            print("tx 99 30", flush=True)  # the real answer, one line late
+            sys.stdin.readline()
+            """
+        )
+    )
+    channel = ChildChannel(f"{sys.executable} {script}")
+    channel.greet(Role.SENSOR)
+    assert channel.ask("time 1") == "idle"
+    assert channel.ask("time 2") == "idle"  # the unasked line, read as the answer
+    with pytest.raises(HarnessError, match="out of step"):
+        channel.finish("bye")
+    assert channel.proc.returncode is not None
+
+
+def test_a_run_whose_harness_fell_out_of_step_is_incomplete(misbehaving):
+    """The same at run level: verdicts are not drawn from records read out of step."""
+    port, pidfile = misbehaving("after-bye", 10**9)
+    data = run_once(port, keyword="acknowledge")
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    assert "out of step" in data["run"]["stop_reason"]
+    assert reaped(pidfile)
+
+
+@pytest.mark.slow
+def test_a_hung_harness_is_stopped_after_the_reply_timeout(misbehaving):
+    port, pidfile = misbehaving("hang", 40)
+    link = open_sensor_harness(port, reply_timeout=0.5)
+    started = time.monotonic()
+    with pytest.raises(HarnessError) as caught:
+        for _ in range(20):
+            link.send_break(0.0125)
+            link.write(b"0!")
+            link.receive(link.now() + 0.1)
+    assert time.monotonic() - started < 5
+    message = str(caught.value)
+    assert "no reply within 0.5 s" in message and "harness goes hang" in message
+    assert "killed by signal SIGTERM" in message
+    link.close()
+    assert reaped(pidfile)
+
+
+def test_a_harness_that_never_answers_hello_is_a_usage_error(tmp_path: Path):
+    script = tmp_path / "silent.py"
+    script.write_text("import sys\nprint('starting up', file=sys.stderr)\nsys.exit(2)\n")
+    with pytest.raises(PortUnavailable) as caught:
+        open_port(f"exec:{sys.executable} {script}")
+    assert "exit status 2" in str(caught.value) and "starting up" in str(caught.value)
+
+
+def test_a_missing_program_is_a_usage_error(tmp_path: Path):
+    with pytest.raises(PortUnavailable, match="cannot start harness"):
+        open_port(f"exec:{tmp_path / 'no-such-harness'}")
+    with pytest.raises(PortUnavailable, match="needs a program"):
+        open_port("exec:")
+
+
+def test_the_harness_is_reaped_after_a_clean_run(misbehaving):
+    port, pidfile = misbehaving("never", 10**9)
+    link = open_sensor_harness(port)
+    link.send_break(0.0125)
+    link.wait(0.009)
+    link.write(b"0!")  # "0!"
+    reply = link.receive(link.now() + 0.1, idle=0.02)
+    assert bytes(e.wire & 0x7F for e in reply) == b"0\r\n"
+    link.close()
+    assert link.device.channel.proc.returncode == 0
+    assert reaped(pidfile)
+
+
+def test_a_unix_socket_harness(tmp_path: Path):
+    """``unix:PATH``: the same protocol from a program that listens on a socket."""
+    path = str(tmp_path / "h.sock")
+    server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    server.bind(path)
+    server.listen(1)
+    seen: list[str] = []
+
+    def serve() -> None:
+        conn, _ = server.accept()
+        with conn, conn.makefile("rw") as stream:
+            for line in stream:
+                seen.append(line.strip())
+                if line.startswith("bye"):
+                    return
+                answer = "hello 1 socket" if line.startswith("hello") else "idle"
+                if line.startswith("char") and line.split()[3] == "21":  # '!': answer '0'
+                    end = int(line.split()[2])
+                    answer = f"tx {end + 9000} 30"
+                stream.write(answer + "\n")
+                stream.flush()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    link = open_port(f"unix:{path}").link
+    link.send_break(0.0125)
+    link.wait(0.009)
+    events = link.write(b"0!")
+    got = link.receive(link.now() + 0.1, idle=0.02)
+    link.close()
+    thread.join(timeout=5)
+    server.close()
+    assert [chr(e.wire & 0x7F) for e in got] == ["0"]
+    assert got[0].start == pytest.approx(events[-1].end + 9e-3, abs=1e-6)
+    assert seen[0] == "hello 1 sensor" and seen[1] == "break 0 12500" and seen[-1] == "bye"
+    assert link.info.kind == "unix" and link.info.timing_uncertainty == 0.0
+
+
+def test_no_harness_process_outlives_the_tests():
+    """No zombie children of this process (a zombie is a child never waited for)."""
+    mine = str(os.getpid())
+    zombies = []
+    for status in Path("/proc").glob("[0-9]*/status"):
+        try:
+            fields = dict(
+                line.split(":\t", 1) for line in status.read_text().splitlines() if ":\t" in line
+            )
+        except OSError:
+            continue
+        if fields.get("PPid", "").strip() == mine and fields.get("State", "").startswith("Z"):
+            zombies.append(status.parent.name)
+    assert not zombies
+
+
+def test_a_crashing_recorder_harness_ends_the_run_with_an_error(tmp_path: Path):
+    """Recorder role: the harness breaks the line, then crashes; the run stops with an ERROR
+    naming the crash and the stderr tail, and the process is reaped."""
+    script = tmp_path / "crashing-recorder.py"
+    pidfile = tmp_path / "recorder.pid"
+    script.write_text(
+        textwrap.dedent(
+            f"""
+            import os, sys
+            from pathlib import Path
+            Path({str(pidfile)!r}).write_text(str(os.getpid()))
+            for line in sys.stdin:
+                word, *fields = line.split()
+                if word == "hello":
+                    print("hello 1 crashing-recorder", flush=True)
+                elif word == "job":
+                    now = int(fields[0])
+                    print(f"brk {{now}} {{now + 12500}}", flush=True)
+                else:
+                    print("recorder firmware assertion failed", file=sys.stderr, flush=True)
+                    os.abort()
+            """
+        )
+    )
+    data = run_once(f"exec:{sys.executable} {script}", role="recorder")
+    assert data["summary"]["verdict"] == "INCOMPLETE"
+    reason = data["run"]["stop_reason"]
+    assert "SIGABRT" in reason and "recorder firmware assertion failed" in reason
+    assert data["summary"]["counts"]["FAIL"] == 0
+    assert reaped(pidfile)
+
+
+@pytest.mark.slow
+def test_a_unix_socket_recorder_harness_is_judged_per_scenario(tmp_path: Path):
+    """``--role recorder --port unix:PATH``: the tool connects afresh for each scenario; here
+    the golden recorder serves each connection through the Python client."""
+    from conformance.harness.client import serve_recorder
+    from conformance.recorder.faults import faulty_recorder
+
+    path = str(tmp_path / "recorder.sock")
+    server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    server.bind(path)
+    server.listen(4)
+    served: list[int] = []
+
+    def serve() -> None:
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return  # closed: the run is over
+            with conn, conn.makefile("r") as inp, conn.makefile("w") as out:
+                served.append(serve_recorder(faulty_recorder(()), inp, out))
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        data = run_once(f"unix:{path}", role="recorder")
+    finally:
+        server.close()
+    assert data["summary"]["verdict"] == "COMPLIANT", data["summary"]
+    assert data["run"]["link"]["kind"] == "unix"
+    assert len(served) >= 10 and set(served) == {0}  # the probe, then one per scenario
+
+
+def test_fails_recorded_through_a_harness_that_failed_are_not_trusted(misbehaving):
+    """A harness that fails may have been out of step before it showed, so a FAIL recorded
+    through it becomes INCONCLUSIVE (saying why) and the run is INCOMPLETE, never
+    NON-COMPLIANT because of the harness; PASS and N/A stay (no overall verdict rests on
+    them: the run is incomplete)."""
+    port, pidfile = misbehaving("after-bye", 10**9)
+    link = open_sensor_harness(port)
+    record = CaseRecord("t::x", "x", ("R-4.4.6-02", "R-4.4.1-01"))
+    record.findings = [
+        Finding("R-4.4.6-02", Verdict.FAIL, "no service request", observed=1, evidence=["0M!"]),
+        Finding("R-4.4.1-01", Verdict.PASS, "a! answered", observed=1),
+    ]
+    record.summarise()
+    link.send_break(0.0125)
+    with pytest.raises(HarnessError, match="out of step"):
+        link.check_records([record])
+    assert [f.verdict for f in record.findings] == [Verdict.INCONCLUSIVE, Verdict.PASS]
+    assert record.findings[0].detail.startswith("not trusted, the harness failed")
+    assert record.verdict is Verdict.INCONCLUSIVE
+    assert reaped(pidfile)

@@ -1,0 +1,60 @@
+"""The end-of-run section that lists real-time tests skipped because the machine was busy
+(``tests/conftest.py``): each with its figure, even with ``-q`` and under pytest-xdist, and
+nothing when no test skipped for that reason."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.support.paths import TESTS
+
+CONFTEST = TESTS / "conftest.py"
+
+TINY = """
+import pytest
+
+def test_line_fell_behind():
+    pytest.skip("the machine was too busy to keep real time: the served line fell "
+                "12.5 ms behind its schedule")
+
+def test_without_compiler():
+    pytest.skip("no C compiler on PATH")
+
+def test_passes():
+    pass
+"""
+
+
+@pytest.fixture
+def tiny(pytester: pytest.Pytester) -> pytest.Pytester:
+    pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
+    pytester.makepyfile(test_tiny=TINY)
+    return pytester
+
+
+def test_busy_skip_is_listed_with_its_figure_even_with_q(tiny):
+    result = tiny.runpytest("-q", "-p", "no:xdist")
+    result.assert_outcomes(passed=1, skipped=2)
+    result.stdout.fnmatch_lines(
+        [
+            "*= skipped because the machine was busy: 1 =*",
+            "test_tiny.py::test_line_fell_behind: the machine was too busy * 12.5 ms behind*",
+        ]
+    )
+    assert "no C compiler" not in result.stdout.str()  # an ordinary skip is not listed
+
+
+@pytest.mark.slow  # starts a worker process
+def test_busy_skip_is_listed_from_an_xdist_worker(tiny):
+    pytest.importorskip("xdist")
+    result = tiny.runpytest_subprocess("-q", "-n", "1")
+    result.assert_outcomes(passed=1, skipped=2)
+    result.stdout.fnmatch_lines(["*test_line_fell_behind: the machine was too busy * 12.5 ms*"])
+
+
+def test_no_section_when_nothing_skipped_for_a_busy_machine(pytester):
+    pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
+    pytester.makepyfile(test_fine="def test_ok():\n    pass\n")
+    result = pytester.runpytest("-q", "-p", "no:xdist")
+    result.assert_outcomes(passed=1)
+    assert "machine was busy" not in result.stdout.str()

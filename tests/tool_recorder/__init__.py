@@ -1,0 +1,1 @@
+"""Tests of conformance/tool_recorder/."""
