@@ -1,7 +1,7 @@
 """What a link is: moves breaks and characters, stamps them, and declares what it can do.
 
 Every link records into one :class:`~conformance.transcript.Transcript`. The tool side
-(master engine in the sensor role, played sensors in the recorder role) only ever talks to a
+(the tool recorder in the sensor role, played sensors in the recorder role) only ever talks to a
 :class:`Link`; nothing above this layer knows whether the bus is simulated or real.
 """
 

@@ -3,7 +3,7 @@
 ``PortError`` is a port string the tool cannot use; the CLI turns it into a usage error (exit
 4). ``PortUnavailable`` is both a ``PortError`` (the user named a port that cannot be opened)
 and a :class:`~conformance.links.base.LinkError` (code that only knows links still catches
-it). ``BreakUnsupported`` lets the master engine send a command without its wake-up break on
+it). ``BreakUnsupported`` lets the tool recorder send a command without its wake-up break on
 a link that has none, while a case that presents a break of its own becomes INCONCLUSIVE.
 :func:`explain_open_failure` is the one place that turns pyserial's complaint into advice.
 """

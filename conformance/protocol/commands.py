@@ -2,7 +2,7 @@
 
 A :class:`Command` is a value; :func:`parse_command` turns wire text into one or raises
 :class:`CommandError` with a reason, and :meth:`Command.text` gives the canonical wire text.
-The same grammar serves the master engine (what to send), the emulator (what it heard) and the
+The same grammar serves the tool recorder (what to send), the emulator (what it heard) and the
 recorder-role judges (was the recorder's command well formed).
 """
 

@@ -2,7 +2,7 @@
 
 Each parser takes a reply *body* (the text after :func:`split_line` removed CR LF), never
 raises on malformed input, and returns a frozen record with the fields it could recover plus
-a list of :class:`Violation`. A judge turns violations into findings; the master engine uses
+a list of :class:`Violation`. A judge turns violations into findings; the tool recorder uses
 ``ok`` to decide whether a reply is valid enough to stop retrying (R-7.2-05).
 
 Every violation names the most specific requirement of requirements.md. Rules that depend on

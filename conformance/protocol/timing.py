@@ -1,6 +1,6 @@
 """Timing constants of SDI-12 section 7 (v1.3 section 5), in seconds.
 
-Kept in one place so that the emulator, the master engine and the judges can never disagree
+Kept in one place so that the emulator, the tool recorder and the judges can never disagree
 about a limit. Every value carries the spec's +/-0.40 ms tolerance (R-7.0-01) unless noted;
 the tolerance is applied by the judges, never folded into the constants.
 """

@@ -1,7 +1,7 @@
 """Faulty golden recorders: the recorder role's fault-detection matrix (design.md 5).
 
 Each fault is the golden recorder with one deviation (a policy value, engine hooks
-(:class:`~conformance.tool_recorder.hooks.Hooks`), a small Master subclass overriding a
+(:class:`~conformance.tool_recorder.hooks.Hooks`), a small ToolRecorder subclass overriding a
 public method, or a recorder knob) and the requirements it breaks. The matrix test runs the whole
 recorder suite against each and demands that exactly those requirements come out FAIL/WARN.
 Where one deviation honestly breaks several rules (a recorder that never retries also never
@@ -18,13 +18,13 @@ from ..protocol.commands import Command, Kind, parse_command
 from ..protocol.responses import service_request
 from ..recorder_jobs import RecorderOutput, Request, Task
 from ..sim.bus import SimBus
-from ..tool_recorder import Master, Measurement, Policy
+from ..tool_recorder import Measurement, Policy, ToolRecorder
 from ..tool_recorder.engine import _service_request_end
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
-from .golden import GoldenHooks, GoldenMaster, GoldenRecorder, logged_values
+from .golden import GoldenHooks, GoldenRecorder, GoldenToolRecorder, logged_values
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
 LATE_RETRY = 95e-3  # s after the command: past the 87 ms of R-7.2-02
@@ -101,7 +101,7 @@ class NoBreakAfterMarkingHooks(GoldenHooks):
         return master.last_address is None or address != master.last_address
 
 
-class NoBreakAfterMarkingMaster(GoldenMaster):
+class NoBreakAfterMarkingToolRecorder(GoldenToolRecorder):
     """The golden engine with :class:`NoBreakAfterMarkingHooks`, and no forced break in front
     of D0 after ttt either."""
 
@@ -137,7 +137,7 @@ class EarlyDataHooks(GoldenHooks):
                 return
 
 
-class StopsAfterD0Master(GoldenMaster):
+class StopsAfterD0ToolRecorder(GoldenToolRecorder):
     """Reads D0 (or DB0) only, whatever the announced count."""
 
     def collect(
@@ -174,7 +174,7 @@ class _ZeroPaddedData(Command):
         return f"{self.address}D{self.index:03d}!"
 
 
-class LeadingZerosMaster(GoldenMaster):
+class LeadingZerosToolRecorder(GoldenToolRecorder):
     """Writes D10 and above with three digits (``0D010!``)."""
 
     def transact(self, command: Command | str, **kw: object) -> Exchange:
@@ -242,7 +242,7 @@ class ResendAfterTimeoutHooks(SkipsNextBreakHooks):
         return max(exchange.last.end + POLL_TIMEOUT, master.link.now())
 
 
-class LateD0AfterServiceRequestMaster(GoldenMaster):
+class LateD0AfterServiceRequestToolRecorder(GoldenToolRecorder):
     """After a service request waits 95 ms, then sends aD0! without a break."""
 
     def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
@@ -295,8 +295,8 @@ class EightBitTttHooks(GoldenHooks):
 class EightBitTttRecorder(GoldenRecorder):
     """The golden recorder with ttt kept in 8 bits, for aM!-type and concurrent waits."""
 
-    master_factory: Callable[[Link, Policy], Master] = field(
-        default=lambda link, policy: GoldenMaster(link, policy, hooks=EightBitTttHooks())
+    master_factory: Callable[[Link, Policy], ToolRecorder] = field(
+        default=lambda link, policy: GoldenToolRecorder(link, policy, hooks=EightBitTttHooks())
     )
 
     def _data_time(self, m: Measurement) -> float:
@@ -311,7 +311,9 @@ class SkipsTttZeroConcurrentRecorder(GoldenRecorder):
     ttt = 000 (a logger library that waits for ttt to count down past zero, issue 20, stuck
     there; here it gives up on that sensor rather than hang the run)."""
 
-    def _concurrent(self, master: Master, texts: tuple[str, ...], out: RecorderOutput) -> None:
+    def _concurrent(
+        self, master: ToolRecorder, texts: tuple[str, ...], out: RecorderOutput
+    ) -> None:
         started = [
             master.measure(parse_command(text), collect=False, wait="none") for text in texts
         ]
@@ -347,7 +349,7 @@ class DropsAfterParityHooks(GoldenHooks):
         return replace(attempt, reply_events=attempt.reply_events[: bad[0]], reason=OK)
 
 
-class DropsAfterParityMaster(GoldenMaster):
+class DropsAfterParityToolRecorder(GoldenToolRecorder):
     """Stops reading a reply at a character with a parity error and takes what came before
     it as the whole reply, and the measurement as collected: no retry, and the values before
     the bad character are what it logs (a logger library's read loop, issue 20)."""
@@ -371,7 +373,7 @@ class DropsAfterParityMaster(GoldenMaster):
         return m
 
 
-class TalksOverMaster(Master):
+class TalksOverToolRecorder(ToolRecorder):
     """The engine without any wait for a quiet line: neither the golden recorder's drain
     before a retry nor the engine's own listen before talk. It keeps only the turnaround
     after the last sensor character it has already seen, as the engine did before it
@@ -531,14 +533,14 @@ def _is_service_request(events: list, address: str) -> bool:
     return decode_7e1(events[-3:]) == service_request(address)
 
 
-def _with_master(cls: type[Master]) -> Callable[[Link, Policy], Master]:
+def _with_master(cls: type[ToolRecorder]) -> Callable[[Link, Policy], ToolRecorder]:
     return lambda link, policy: cls(link, policy)
 
 
-def _with_hooks(cls: type[Hooks]) -> Callable[[Link, Policy], Master]:
+def _with_hooks(cls: type[Hooks]) -> Callable[[Link, Policy], ToolRecorder]:
     """The golden engine with a fault's hooks: a fresh ``cls`` per engine, since what a
     stateful fault remembers belongs to one engine (a recorder may build several)."""
-    return lambda link, policy: GoldenMaster(link, policy, hooks=cls())
+    return lambda link, policy: GoldenToolRecorder(link, policy, hooks=cls())
 
 
 @dataclass(frozen=True)
@@ -607,7 +609,7 @@ _FAULTS = (
         "no-break-after-87ms",
         "Breaks only for a new address: aD0! after ttt goes out without a break.",
         ("R-7.0-17", "R-4.4.5-05"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(NoBreakAfterMarkingMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(NoBreakAfterMarkingToolRecorder)),
     ),
     RecorderFault(
         "d0-before-ttt",
@@ -638,13 +640,13 @@ _FAULTS = (
         "stops-after-d0",
         "Reads D0 (DB0) only, so values in D1 and later are never collected.",
         ("R-4.4.8-05", "R-4.4.7-07", "R-5.1-04", "R-5.2-08"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(StopsAfterD0Master)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(StopsAfterD0ToolRecorder)),
     ),
     RecorderFault(
         "leading-zeros-after-d9",
         "After aHA! writes D10 and later as aD010!.",
         ("R-5.1-04",),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(LeadingZerosMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(LeadingZerosToolRecorder)),
     ),
     RecorderFault(
         "ignores-bad-crc",
@@ -695,7 +697,7 @@ _FAULTS = (
         f"Sends aD0! {LATE_D0 * 1e3:.0f} ms after the service request without a break (87 ms "
         "is the limit; after it a break is due, which R-7.0-17 also demands).",
         ("R-7.1-01", "R-7.0-17"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(LateD0AfterServiceRequestMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(LateD0AfterServiceRequestToolRecorder)),
     ),
     RecorderFault(
         "fast-baud",
@@ -751,7 +753,7 @@ _FAULTS = (
         "without the golden recorder's wait for a quiet line). Its retry collides with the "
         "rest of the reply, and on the line its characters come apart (R-7.0-13).",
         ("R-7.2-06", "R-7.0-13"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(TalksOverMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(TalksOverToolRecorder)),
     ),
     RecorderFault(
         "interleaves-measurements",
@@ -802,7 +804,7 @@ _FAULTS = (
         "the values before the bad character (+22.15 +10 for +22.15 +1013.2 +45.7), values "
         "of a reply that was not valid (R-4.4-02).",
         ("R-7.2-05", "R-4.4-02"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(DropsAfterParityMaster)),
+        lambda: GoldenRecorder(_GOLDEN, _with_master(DropsAfterParityToolRecorder)),
     ),
     RecorderFault(
         "short-marking",

@@ -1,10 +1,10 @@
-"""The golden recorder: the master engine exposed as a recorder under test.
+"""The golden recorder: the tool recorder exposed as a recorder under test.
 
 A recorder program is any callable ``(request, link) -> RecorderOutput``: it receives what the
 scenario asks (:class:`~conformance.recorder_jobs.Request`) and the bus, does the job the
 way a data logger would, and says what it logged. :class:`GoldenRecorder` does it with the
-tool's own :class:`~conformance.tool_recorder.Master` under :meth:`Policy.golden`, so it is the
-reference every recorder judge must find COMPLIANT; its knobs (and the engine hooks in
+tool's own :class:`~conformance.tool_recorder.ToolRecorder` under :meth:`Policy.golden`, so it
+is the reference every recorder judge must find COMPLIANT; its knobs (and the engine hooks in
 :mod:`conformance.recorder.faults`) make the faulty recorders of the fault-detection matrix.
 
 Beyond what the engine does per command, a logger has duties across commands, kept here:
@@ -23,13 +23,13 @@ from ..protocol.binary import parse_binary_packet
 from ..protocol.commands import Command, Kind, parse_command
 from ..protocol.values import split_values
 from ..recorder_jobs import RecorderOutput, Request, Task
-from ..tool_recorder import Master, Measurement, Policy, validity
+from ..tool_recorder import Measurement, Policy, ToolRecorder, validity
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.records import Exchange
 from ..transcript import TOOL, EventKind
 
 RecorderProgram = Callable[[Request, Link], RecorderOutput]
-MasterFactory = Callable[[Link, Policy], Master]
+MasterFactory = Callable[[Link, Policy], ToolRecorder]
 
 #: Longest the golden recorder waits for a babbling sensor to fall quiet before a retry.
 MAX_DRAIN = 1.0
@@ -64,7 +64,7 @@ class GoldenHooks(Hooks):
         return max(usual(), link.now())
 
 
-class GoldenMaster(Master):
+class GoldenToolRecorder(ToolRecorder):
     """The engine with :class:`GoldenHooks` (or ``hooks`` built on them): the golden recorder's
     engine, and the faulty recorders' unless they pass hooks of their own."""
 
@@ -100,7 +100,7 @@ class GoldenRecorder:
     """
 
     policy: Policy | None = None
-    master_factory: MasterFactory = GoldenMaster
+    master_factory: MasterFactory = GoldenToolRecorder
     wait: str = "auto"
     ttt_fraction: float = 1.0
     reissues: int = 2
@@ -126,7 +126,7 @@ class GoldenRecorder:
         return out
 
     # -- measurements ----------------------------------------------------------------------
-    def _measure(self, master: Master, command: Command) -> list[str]:
+    def _measure(self, master: ToolRecorder, command: Command) -> list[str]:
         if command.kind is Kind.CONTINUOUS:  # aRn!: the values come in the reply itself
             ex = master.transact(command)
             text = validity.data_values_text(ex.reply_text, command.crc) if ex.ok else ""
@@ -138,7 +138,9 @@ class GoldenRecorder:
             m = master.measure(command, wait=self.wait)  # R-4.4.8-05
         return logged_values(m)
 
-    def _concurrent(self, master: Master, texts: tuple[str, ...], out: RecorderOutput) -> None:
+    def _concurrent(
+        self, master: ToolRecorder, texts: tuple[str, ...], out: RecorderOutput
+    ) -> None:
         started = [
             master.measure(parse_command(text), collect=False, wait="none") for text in texts
         ]

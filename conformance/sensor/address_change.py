@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from ..protocol.responses import split_line
 from ..protocol.timing import ADDRESS_CHANGE_QUIET
-from ..tool_recorder.engine import Master
+from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.records import Exchange
 
 POLL_INTERVAL = 0.2  # s between "are you there at the new address?" polls
@@ -28,7 +28,7 @@ class ChangeOutcome:
 
 
 class AddressChanger:
-    def __init__(self, master: Master, original: str) -> None:
+    def __init__(self, master: ToolRecorder, original: str) -> None:
         self.master = master
         self.original = original
         self.current = original

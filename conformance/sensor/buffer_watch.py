@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 from ..links.base import Link
 from ..protocol.commands import Command, Kind
-from ..tool_recorder.engine import Master
+from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
@@ -42,8 +42,8 @@ class BufferWatchHooks(Hooks):
         return attempt
 
 
-class WatchedMaster(Master):
-    """The master engine, noting per address the last command sent and its reply."""
+class WatchedToolRecorder(ToolRecorder):
+    """The tool recorder, noting per address the last command sent and its reply."""
 
     def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
         self.watch = BufferWatchHooks()

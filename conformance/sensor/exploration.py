@@ -1,7 +1,7 @@
 """Property-based exploration of a sensor: random sequences of valid commands, foreign
 addresses, malformed commands, breaks and pauses, with invariants checked after every step.
 
-A hypothesis state machine drives the master engine. It is derandomised, so every run sends
+A hypothesis state machine drives the tool recorder. It is derandomised, so every run sends
 the same sequences (a certificate must be reproducible), and it never shrinks: a sensor keeps
 state between examples (its data buffer, its address), so replaying a shorter sequence is not
 the same experiment, and on real hardware a shrinking storm costs minutes of bus time. Each

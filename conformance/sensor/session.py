@@ -1,6 +1,6 @@
 """The sensor under test as the sensor-role cases see it.
 
-One master engine on one link, the identity read from ``aI!``, the declaration, and a cache of
+One tool recorder on one link, the identity read from ``aI!``, the declaration, and a cache of
 stimuli: each exchange (say one ``aMC!`` with its service request and D replies) runs once and
 is judged by every case that bears on it ("one stimulus, many judges"). Cases that need a
 fresh state (aborts, address change) ask for a ``fresh`` stimulus explicitly.
@@ -33,7 +33,7 @@ from ..transcript import Event, escape
 from ..view.rebuilt_records import Rebuilt, rebuild_records
 from ..view.segments import read_view
 from .address_change import AddressChanger
-from .buffer_watch import WatchedMaster
+from .buffer_watch import WatchedToolRecorder
 
 R = TypeVar("R", Exchange, Measurement)
 T = TypeVar("T")
@@ -147,7 +147,7 @@ class SensorSession(Session):
         forced_version: str | None = None,
     ) -> None:
         self.link = link
-        self.master = WatchedMaster(link)
+        self.master = WatchedToolRecorder(link)
         self.declaration = declaration or Declaration()
         self.requested_address = address or self.declaration.address
         self.address = self.requested_address or "0"
@@ -415,7 +415,7 @@ class SensorSession(Session):
         echo that never came back) is sent again (:meth:`aim`): the probe lands where it
         aimed or, after ``PROBE_TRIES``, goes out late and its case judges the marking it got.
         The break waits for a quiet line like every transmission of the tool
-        (:meth:`Master.clear_to_send`); ``collide`` sends it into a talking DUT on purpose."""
+        (:meth:`ToolRecorder.clear_to_send`); ``collide`` sends it into a talking DUT on purpose."""
         if idle_before:
             self.listen(idle_before)
         if break_s is not None:

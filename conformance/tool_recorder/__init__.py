@@ -1,7 +1,7 @@
-"""The master engine: the tool's own correct SDI-12 data recorder (see ``engine.py``)."""
+"""The tool recorder: the tool's own correct SDI-12 data recorder (see ``engine.py``)."""
 
-from .engine import Master
+from .engine import ToolRecorder
 from .policy import Policy
 from .records import Attempt, Exchange, Measurement
 
-__all__ = ["Attempt", "Exchange", "Master", "Measurement", "Policy"]
+__all__ = ["Attempt", "Exchange", "Measurement", "Policy", "ToolRecorder"]

@@ -1,8 +1,9 @@
 """Where the tool's own transmissions met the DUT's on the wire: collisions, found from stamps.
 
-The tool listens before it talks (:meth:`~conformance.tool_recorder.engine.Master.clear_to_send`),
-but a DUT may start a character the tool could not yet see (a real link delivers it up to its
-timing uncertainty late), or a case may collide on purpose. Such a collision is never evidence
+The tool listens before it talks
+(:meth:`~conformance.tool_recorder.engine.ToolRecorder.clear_to_send`), but a DUT may start a
+character the tool could not yet see (a real link delivers it up to its timing uncertainty
+late), or a case may collide on purpose. Such a collision is never evidence
 against the DUT: what it overlapped may be garbled by the tool's own spacing or characters.
 
 A collision is recorded as a NOTE whose text starts with :data:`COLLISION_PREFIX`, not as a new

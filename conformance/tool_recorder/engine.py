@@ -1,4 +1,4 @@
-"""The master engine: the tool's own data recorder, correct per section 7, that only records.
+"""The tool recorder: the tool's own data recorder, correct per section 7, that only records.
 
 In the sensor role it is the stimulus that drives the device under test; in the recorder role
 it is the "golden recorder" that other recorders are compared with. Either way it sends what a
@@ -50,7 +50,7 @@ from .reply_end import Framing
 OVERRUNS_BEFORE_SHORT = 3
 
 
-class Master:
+class ToolRecorder:
     """Drives a :class:`Link` as an SDI-12 data recorder and returns records.
 
     ``address`` is the default sensor address for the conveniences (:meth:`identify`...).

@@ -1,14 +1,14 @@
-"""The declared points where a recorder built on the master engine may deviate from it.
+"""The declared points where a recorder built on the tool recorder may deviate from it.
 
 The recorder role's fault-detection matrix needs faulty recorders (one that retries too
 early, one that never breaks after 87 ms of marking, one that accepts a bad CRC...), and the
 sensor session needs to watch what each attempt got back. Both used to subclass
-:class:`~conformance.tool_recorder.engine.Master` and override its private methods, so any
+:class:`~conformance.tool_recorder.engine.ToolRecorder` and override its private methods, so any
 change inside the engine could silently change what a fault does. :class:`Hooks` names the
 few decisions the engine lets others take instead: the engine calls a hook at each of those
 points, hands it the engine's own behaviour (``usual`` or ``proceed``, a callable that does
 what the engine would do), and uses what the hook returns. The defaults return exactly that,
-so ``Master(link)`` behaves as it always did. A stateful deviation keeps its state on its
+so ``ToolRecorder(link)`` behaves as it always did. A stateful deviation keeps its state on its
 own hooks object, one per engine.
 """
 
@@ -26,7 +26,7 @@ if TYPE_CHECKING:
 
 class Engine(Protocol):
     """What a hook may use of the engine that calls it: its link, its policy and the address
-    it last sent to. The engine is :class:`~conformance.tool_recorder.engine.Master`; naming
+    it last sent to. The engine is :class:`~conformance.tool_recorder.engine.ToolRecorder`; naming
     it here would make the two modules import each other."""
 
     link: Link

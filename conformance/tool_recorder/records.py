@@ -1,4 +1,4 @@
-"""What the master engine hands back: plain records of what it sent and what came back.
+"""What the tool recorder hands back: plain records of what it sent and what came back.
 
 The engine never judges. It keeps every attempt (break, command characters, reply characters,
 and why the attempt ended) so that judges can decide timing, format and retry questions from

@@ -20,7 +20,7 @@ from conformance.capture import (
 )
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import BIT_TIME, CHAR_TIME
-from conformance.tool_recorder import Master
+from conformance.tool_recorder import ToolRecorder
 from conformance.transcript import DUT, TOOL, Event, EventKind, Transcript, to_wire_7e1
 
 FORMATS = ["sr", "vcd", "csv"]
@@ -28,9 +28,9 @@ FORMATS = ["sr", "vcd", "csv"]
 
 @pytest.fixture(scope="module")
 def sim_events() -> list[Event]:
-    """A real simulated exchange: 0I!, 0M!, 0D0! between the master engine and the emulator."""
+    """A real simulated exchange: 0I!, 0M!, 0D0! between the tool recorder and the emulator."""
     _, link, _ = emulator.sim_sensor()
-    master = Master(link)
+    master = ToolRecorder(link)
     assert master.identify().ok
     measurement = master.measure(cmds.measure("0"))
     assert measurement.data and measurement.values
@@ -210,7 +210,7 @@ def test_every_emulator_fault_round_trips(tmp_path):
     differ = []
     for name in faults.FAULTS:
         _, link, _ = emulator.sim_sensor(faults=[name])
-        master = Master(link)
+        master = ToolRecorder(link)
         master.identify()
         master.measure(cmds.measure("0"))
         sent = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]

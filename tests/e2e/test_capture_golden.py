@@ -69,11 +69,11 @@ def digests_of_sim(fault: str, tmp: Path) -> dict:
     with the tool's TX channel and decoded with it."""
     from conformance import emulator
     from conformance.protocol import commands as cmds
-    from conformance.tool_recorder import Master
+    from conformance.tool_recorder import ToolRecorder
     from conformance.transcript import EventKind
 
     _, link, _ = emulator.sim_sensor(faults=[] if fault == "none" else [fault])
-    master = Master(link)
+    master = ToolRecorder(link)
     master.identify()
     master.measure(cmds.measure("0"))
     events = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]

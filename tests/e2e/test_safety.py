@@ -20,7 +20,7 @@ from conformance.ports import open_sim, parse_sim
 from conformance.results import CaseRecord
 from conformance.sensor.address_change import AddressChanger
 from conformance.sensor.session import SensorSession
-from conformance.tool_recorder.engine import Master
+from conformance.tool_recorder.engine import ToolRecorder
 from testcases.sensor.test_4_4_basic import test_change_address as change_address_case
 
 
@@ -112,7 +112,7 @@ def test_ctrl_c_writes_the_partial_report_and_exits_2(tmp_path):
         # the sensor is where it was found: it answers at address 0
         link = open_real_link(emulator.url)
         try:
-            assert Master(link).acknowledge("0").answered
+            assert ToolRecorder(link).acknowledge("0").answered
         finally:
             link.close()
     finally:

@@ -29,7 +29,7 @@ from conformance.links.factory import open_real_link
 from conformance.ports import PortError
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import INTER_CHAR_GAP_MAX, RESPONSE_START_MAX, RESPONSE_START_MIN
-from conformance.tool_recorder.engine import Master
+from conformance.tool_recorder.engine import ToolRecorder
 from conformance.transcript import to_wire_7e1
 
 #: Cases that together touch wake-up, identification, a measurement with its service request,
@@ -60,7 +60,7 @@ def served():
 
 @pytest.mark.realtime
 def test_served_sensor_answers_in_the_section_7_window(served):
-    exchange = Master(served).identify("0")
+    exchange = ToolRecorder(served).identify("0")
     assert exchange.ok, exchange.reply_text
     attempt = exchange.attempts[0]
     start = attempt.reply_events[0].start - attempt.command_events[-1].end
@@ -78,7 +78,7 @@ def test_served_sensor_answers_in_the_section_7_window(served):
 @pytest.mark.realtime
 def test_served_sensor_measures_with_a_service_request(served):
     started = time.monotonic()
-    m = Master(served).measure(cmds.parse_command("0M!"))
+    m = ToolRecorder(served).measure(cmds.parse_command("0M!"))
     assert m.values and m.count == len(m.values)
     assert m.service_request_end is not None
     assert m.ttt is not None and time.monotonic() - started < m.ttt + 1.5

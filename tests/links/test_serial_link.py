@@ -26,7 +26,7 @@ from conformance.links.factory import open_real_link, port_kind
 from conformance.links.stamps import MAX_LEAD, chunk_frames
 from conformance.ports import PortError, open_port
 from conformance.protocol.timing import CHAR_TIME
-from conformance.tool_recorder.engine import Master
+from conformance.tool_recorder.engine import ToolRecorder
 from conformance.transcript import EventKind, to_wire_7e1
 
 pty_only = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal")
@@ -206,7 +206,7 @@ def test_socket_link_cannot_break_and_the_engine_sends_anyway():
         assert link.info.kind == "socket" and not link.info.can_break
         with pytest.raises(BreakUnsupported):
             link.send_break(13e-3)
-        exchange = Master(link).transact("0!", retries=False)
+        exchange = ToolRecorder(link).transact("0!", retries=False)
         assert exchange.attempts[0].break_event is None
         assert not exchange.answered
         notes = [e.text for e in link.transcript if e.kind is EventKind.NOTE]

@@ -31,7 +31,7 @@ from conformance.monitor.lines import LineTracker
 from conformance.protocol.commands import parse_command
 from conformance.protocol.crc import ascii_crc
 from conformance.protocol.timing import CHAR_TIME
-from conformance.tool_recorder.engine import Master
+from conformance.tool_recorder.engine import ToolRecorder
 from conformance.tool_recorder.policy import Policy
 from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Verdict
@@ -231,7 +231,7 @@ def test_the_tap_hears_both_sides_and_ignores_what_listeners_send(tapped):
     with socket.create_connection((host, port)) as listener:
         time.sleep(0.2)  # accepted
         listener.sendall(b"\x000X!junk")  # a listener trying to talk: dropped
-        exchange = Master(link, Policy.golden()).identify("0")
+        exchange = ToolRecorder(link, Policy.golden()).identify("0")
         heard = _read_for(listener, 0.5)
     assert exchange.ok, exchange.reply_text
     text = bytes(b & 0x7F for b in heard)
@@ -338,7 +338,7 @@ def test_monitor_shows_and_records_a_golden_recorder_talking_to_the_emulator(tmp
         monitor = _start_monitor(tap, report, "--duration", "6")
         link = open_real_link(url)
         try:
-            master = Master(link, Policy.golden())
+            master = ToolRecorder(link, Policy.golden())
             assert master.acknowledge("0").ok
             assert master.identify("0").ok
             measured = master.measure(parse_command("0M!"))
@@ -399,7 +399,7 @@ def test_ctrl_c_stops_the_monitor_writes_the_transcript_and_exits_cleanly(tmp_pa
         monitor = _start_monitor(tap, report)
         link = open_real_link(url)
         try:
-            assert Master(link, Policy.golden()).acknowledge("0").ok
+            assert ToolRecorder(link, Policy.golden()).acknowledge("0").ok
         finally:
             link.close()
         time.sleep(0.5)  # shown (the line settles), then Ctrl-C

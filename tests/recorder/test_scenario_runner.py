@@ -17,12 +17,12 @@ from conformance.recorder.scenario_runner import RecorderSession, check_port
 from conformance.recorder_jobs import Request, Task
 from conformance.sim.bus import SimBus, SimLink
 from conformance.sim.line_monitor import LineMonitor
-from conformance.tool_recorder import Master, Policy
+from conformance.tool_recorder import Policy, ToolRecorder
 
 
-def _bus(spec: SensorSpec) -> Master:
+def _bus(spec: SensorSpec) -> ToolRecorder:
     bus = SimBus([LineMonitor(), spec.build()])
-    return Master(SimLink(bus), Policy.golden())
+    return ToolRecorder(SimLink(bus), Policy.golden())
 
 
 def test_unheard_sensor_answers_the_third_transmission():

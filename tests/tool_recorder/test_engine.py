@@ -1,4 +1,4 @@
-"""Master engine: break rules, wire timing, retries and bounded reads (section 7)."""
+"""The tool recorder's engine: break rules, wire timing, retries and bounded reads (section 7)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Master engine measurements: service request / ttt waits and D0..Dn / DB0.. collection."""
+"""The tool recorder's measurements: service request / ttt waits and D0..Dn / DB0.. collection."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The master engine against the reference emulator: a conforming sensor needs no retries,
+"""The tool recorder against the reference emulator: a conforming sensor needs no retries,
 and every announced value comes back. Skipped until ``conformance.emulator.sim_sensor`` exists."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.protocol import commands as cmds
-from conformance.tool_recorder import Master
+from conformance.tool_recorder import ToolRecorder
 
 emulator = pytest.importorskip("conformance.emulator")
 if not hasattr(emulator, "sim_sensor"):
@@ -14,14 +14,14 @@ if not hasattr(emulator, "sim_sensor"):
 
 
 @pytest.fixture
-def master() -> Master:
+def master() -> ToolRecorder:
     _, link, _ = emulator.sim_sensor()
-    return Master(link)
+    return ToolRecorder(link)
 
 
-def master_with(*faults: str) -> Master:
+def master_with(*faults: str) -> ToolRecorder:
     _, link, _ = emulator.sim_sensor(faults=faults)
-    return Master(link)
+    return ToolRecorder(link)
 
 
 def single_attempts(*exchanges) -> bool:

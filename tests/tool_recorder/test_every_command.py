@@ -1,4 +1,4 @@
-"""Acceptance of the foundation: the master engine completes every command of Table 5 and of
+"""Acceptance of the foundation: the tool recorder completes every command of Table 5 and of
 v1.4 against the reference emulator in virtual time (CRC variants and the 99-value concurrent
 measurement included), each on its first transmission."""
 
@@ -10,7 +10,7 @@ import pytest
 
 from conformance.emulator import default_profile, sim_sensor
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY, parse_command
-from conformance.tool_recorder import Master
+from conformance.tool_recorder import ToolRecorder
 
 SINGLE = (
     ["0!", "?!", "0I!"]
@@ -23,9 +23,9 @@ SINGLE = (
 
 
 @pytest.fixture()
-def master() -> Master:
+def master() -> ToolRecorder:
     _bus, link, _emulator = sim_sensor(default_profile("14"))
-    return Master(link)
+    return ToolRecorder(link)
 
 
 @pytest.mark.parametrize("text", SINGLE)
@@ -65,6 +65,6 @@ def test_ttt_999_takes_virtual_time_only():
     slow["M"] = MeasurementSpec(("+1",), ttt=999, ready_after=998.0)
     _bus, link, _ = sim_sensor(replace(profile, measurements=slow))
     started = time.perf_counter()
-    m = Master(link).measure(parse_command("0M!"))
+    m = ToolRecorder(link).measure(parse_command("0M!"))
     assert time.perf_counter() - started < 1.0
     assert m.values == ["+1"] and m.service_request_end - m.reply_end == pytest.approx(998.0, 0.01)

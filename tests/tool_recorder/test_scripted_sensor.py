@@ -16,7 +16,7 @@ import pytest
 from conformance.protocol.crc import ascii_crc
 from conformance.protocol.timing import CHAR_TIME
 from conformance.sim.bus import Frame, SimBus, SimLink
-from conformance.tool_recorder.engine import Master
+from conformance.tool_recorder.engine import ToolRecorder
 from conformance.tool_recorder.policy import Policy
 from conformance.transcript import TOOL, EventKind, to_wire_7e1
 
@@ -157,9 +157,9 @@ class Babbler:
         return frame
 
 
-def rig(*devices: object, policy: Policy | None = None) -> tuple[Master, SimBus]:
+def rig(*devices: object, policy: Policy | None = None) -> tuple[ToolRecorder, SimBus]:
     bus = SimBus(list(devices))  # type: ignore[arg-type]
-    return Master(SimLink(bus), policy), bus
+    return ToolRecorder(SimLink(bus), policy), bus
 
 
 def tool_breaks(bus: SimBus):

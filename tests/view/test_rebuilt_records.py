@@ -7,7 +7,7 @@ import pytest
 
 from conformance import emulator
 from conformance.protocol import commands as cmds
-from conformance.tool_recorder import Master
+from conformance.tool_recorder import ToolRecorder
 from conformance.tool_recorder.records import Attempt, Exchange, Measurement
 from conformance.view.rebuilt_records import rebuild_records
 from conformance.view.segments import read_view
@@ -28,7 +28,7 @@ FAULTS = [
 ]
 
 
-def _drive(master: Master) -> list[Exchange | Measurement]:
+def _drive(master: ToolRecorder) -> list[Exchange | Measurement]:
     out: list[Exchange | Measurement] = [master.acknowledge(), master.identify()]
     for text in ("0M!", "0MC!", "0C!", "0V!", "0HA!", "0HB!"):
         out.append(master.measure(cmds.parse_command(text)))
@@ -66,7 +66,7 @@ def _measurement(m: Measurement) -> tuple:
 @pytest.mark.parametrize("faults", FAULTS, ids=lambda f: ",".join(f) or "clean")
 def test_records_rebuilt_from_the_view_equal_the_masters(faults):
     _, link, _ = emulator.sim_sensor(faults=faults)
-    written = _drive(Master(link))
+    written = _drive(ToolRecorder(link))
     rebuilt = rebuild_records(read_view(link.transcript.events))
     live = _exchanges(written)
     assert [(e.text, e.command, e.reply_text) for e in rebuilt.exchanges] == [
@@ -80,7 +80,7 @@ def test_records_rebuilt_from_the_view_equal_the_masters(faults):
 
 def test_a_fault_that_forces_retries_is_rebuilt_with_its_sequences():
     _, link, _ = emulator.sim_sensor(faults=("missing-crlf",))
-    written = _exchanges(_drive(Master(link)))
+    written = _exchanges(_drive(ToolRecorder(link)))
     assert any(len(e.attempts) > 3 for e in written)  # retries and repeated sequences
     rebuilt = rebuild_records(read_view(link.transcript.events)).exchanges
     assert [[(a.sequence, a.retry) for a in e.attempts] for e in rebuilt] == [

@@ -13,7 +13,7 @@ from conformance.protocol.timing import CHAR_TIME
 from conformance.recorder.played import SensorSpec, Spoil
 from conformance.sim.bus import SimBus, SimLink
 from conformance.sim.line_monitor import LineMonitor
-from conformance.tool_recorder import Master, Policy
+from conformance.tool_recorder import Policy, ToolRecorder
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.view.direction import infer_directions
 from conformance.view.segments import read_view
@@ -75,7 +75,7 @@ def test_two_talkers_are_flagged():
 
 def _sensor_role(faults: tuple[str, ...]) -> list[Event]:
     _, link, _ = emulator.sim_sensor(faults=faults)
-    master = Master(link)
+    master = ToolRecorder(link)
     master.acknowledge(), master.identify()
     for text in ("0M!", "0MC!", "0C!", "0V!", "0HB!"):
         master.measure(cmds.parse_command(text))
@@ -85,7 +85,7 @@ def _sensor_role(faults: tuple[str, ...]) -> list[Event]:
 
 def _recorder_role(spec: SensorSpec) -> list[Event]:
     link = SimLink(SimBus([LineMonitor(), spec.build()]))
-    master = Master(link, Policy.golden())
+    master = ToolRecorder(link, Policy.golden())
     master.transact("0!"), master.measure(cmds.measure("0", crc=True))
     master.measure(cmds.concurrent("0"))
     return link.transcript.events
