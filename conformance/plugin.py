@@ -25,7 +25,7 @@ from .preflight import check_report_dir, check_role_options
 from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .replay.sensor import RecordingEnded
-from .reports import html, verdicts_json
+from .reports import html, writers
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions, given_options
 from .selection import SelectionError, resolve
@@ -391,7 +391,7 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if session.shouldstop or session.shouldfail:
         run.complete = False
     run.finish(complete=not interrupted)
-    verdicts_json.write(run, run.report_dir())
+    writers.write_reports(run, run.report_dir())
     run.close()
 
 

@@ -253,3 +253,18 @@ def test_every_module_imports_on_its_own():
         timeout=120,
     )
     assert done.returncode == 0, done.stdout + done.stderr
+
+
+#: The longest a function of ``conformance/`` may be (issue 21): past it, split it.
+MAX_FUNCTION_LINES = 80
+
+
+def test_no_function_is_over_80_lines():
+    long = []
+    for module, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_FUNCTION_LINES:
+                    long.append(f"{module}.{node.name}: {lines} lines")
+    assert not long, "\n".join(long)

@@ -150,21 +150,21 @@ def test_a_stale_lock_of_a_dead_process_is_taken_over(tmp_path, capsys):
 def test_the_summary_is_the_runs_own_not_the_file_on_disk(tmp_path, capsys, monkeypatch):
     """A verdicts.json another process rewrote after this run wrote it changes nothing the
     command prints or exits on."""
-    from conformance.reports import verdicts_json
+    from conformance.reports import writers
 
-    real_write = verdicts_json.write
-
-    def then_overwritten(run, directory):
-        path = real_write(run, directory)
+    def overwrite(run, directory):
+        path = directory / "verdicts.json"
         forged = json.loads(path.read_text(encoding="utf-8"))
         forged["summary"]["verdict"] = "COMPLIANT"
         forged["run"]["port"] = "someone else's"
         path.write_text(json.dumps(forged), encoding="utf-8")
         return path
 
-    monkeypatch.setattr(verdicts_json, "write", then_overwritten)
+    forger = writers.ReportWriter("verdicts.json", "a forgery after the real one", overwrite)
+    monkeypatch.setattr(writers, "REPORT_WRITERS", (*writers.REPORT_WRITERS, forger))
     code = main(["--port", FAULTY, *QUICK, "--report-dir", str(tmp_path)])
     out = capsys.readouterr().out
+    assert json.loads((tmp_path / "verdicts.json").read_text())["summary"]["verdict"] == "COMPLIANT"
     assert code == 1
     assert "verdict: NON-COMPLIANT" in out and "someone else's" not in out
 

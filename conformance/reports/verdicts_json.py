@@ -171,16 +171,24 @@ def _finding(f: Any, wire: WireRef | None = None) -> dict[str, Any]:
     }
 
 
+def write_transcript(run: ConformanceRun, directory: Path) -> Path:
+    """``transcript.jsonl``: every event of the run's link (empty when no link opened). It is
+    the evidence, written before verdicts.json so the manifest can pin it."""
+    path = directory / "transcript.jsonl"
+    if run.link is not None:
+        write_recording(path, run.link.transcript.events)
+    else:
+        path.write_text("", encoding="utf-8")
+    return path
+
+
 def write(run: ConformanceRun, directory: Path) -> Path:
+    """``verdicts.json``, with the manifest of the files written before it
+    (``sdi12-conform verify``); the document stays on the run for the caller."""
     from .manifest import build_manifest
 
     path = directory / "verdicts.json"
     run.document = build(run)  # what the command line prints and exits on: this run's own
-    if run.link is not None:
-        write_recording(directory / "transcript.jsonl", run.link.transcript.events)
-    else:
-        (directory / "transcript.jsonl").write_text("", encoding="utf-8")
-    # the recording first, so the manifest can pin it (sdi12-conform verify)
     run.document["manifest"] = build_manifest(
         directory, run.options.declaration, str(TOOL_IDENTITY["version"])
     )
