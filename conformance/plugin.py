@@ -104,27 +104,20 @@ def sensor(sdi12_run: ConformanceRun) -> SensorSession:
     try:
         return sdi12_run.sensor_session()
     except NoDeviceAnswered as exc:
-        sdi12_run.complete = False
-        sdi12_run.stop_reason = str(exc)
+        reason = str(exc)
         link = sdi12_run.link
         if link is not None and not link.info.can_break:
-            sdi12_run.stop_reason += (
+            reason += (
                 f" This {link.info.kind} link cannot send breaks, so a sensor in standby "
                 "cannot be woken through it; use a serial port or rfc2217://."
             )
-        pytest.exit(sdi12_run.stop_reason, returncode=EXIT_NO_DEVICE)
+        sdi12_run.cut_short(reason, EXIT_NO_DEVICE)
     except PortError as exc:
-        sdi12_run.complete = False
-        sdi12_run.stop_reason = str(exc)
-        pytest.exit(str(exc), returncode=EXIT_USAGE)
+        sdi12_run.cut_short(str(exc), EXIT_USAGE)
     except RecordingEnded as exc:  # a replayed capture cut short before discovery ended
-        sdi12_run.complete = False
-        sdi12_run.stop_reason = str(exc)
-        pytest.exit(str(exc), returncode=EXIT_INCOMPLETE)
+        sdi12_run.cut_short(str(exc), EXIT_INCOMPLETE)
     except LinkError as exc:
-        sdi12_run.complete = False
-        sdi12_run.stop_reason = str(exc)
-        pytest.exit(f"link error: {exc}", returncode=EXIT_INTERNAL)
+        sdi12_run.cut_short(str(exc), EXIT_INTERNAL, shown=f"link error: {exc}")
 
 
 @pytest.fixture
@@ -304,19 +297,13 @@ def pytest_runtest_call(item: pytest.Item):
         pytest.skip(f"INCONCLUSIVE: the link cannot send breaks ({exc})")
     except RecorderSetupError as exc:  # a trigger that cannot work: stop, blame the setup
         _error(record, f"test setup failed: {exc}")
-        run.complete = False
-        run.stop_reason = f"test setup failed: {exc}"
-        pytest.exit(run.stop_reason, returncode=EXIT_USAGE)
+        run.cut_short(f"test setup failed: {exc}", EXIT_USAGE)
     except RecordingEnded as exc:  # a replayed capture cut short: the rest is left open
         _inconclusive(record, str(exc))
-        run.complete = False
-        run.stop_reason = str(exc)
-        pytest.exit(run.stop_reason, returncode=EXIT_INCOMPLETE)
+        run.cut_short(str(exc), EXIT_INCOMPLETE)
     except LinkError as exc:  # the port failed: stop the run, keep the report (exit 3)
         _error(record, f"link failed: {exc}")
-        run.complete = False
-        run.stop_reason = f"link failed: {exc}"
-        pytest.exit(f"link failed: {exc}", returncode=EXIT_INTERNAL)
+        run.cut_short(f"link failed: {exc}", EXIT_INTERNAL)
     except Exception as exc:  # the tool failed: ERROR, never hidden as a FAIL or a PASS
         _error(record, f"tool error: {type(exc).__name__}: {exc}")
         raise

@@ -9,7 +9,7 @@ from __future__ import annotations
 import datetime as dt
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
@@ -174,6 +174,15 @@ class ConformanceRun:
             self.note_options()
         assert isinstance(self.session, RecorderSession)
         return self.session
+
+    def cut_short(self, reason: str, code: int, *, shown: str | None = None) -> NoReturn:
+        """Stop the whole pytest session now with exit status ``code`` (exits.py), the run
+        left incomplete for ``reason``: the reports are still written, and say why."""
+        import pytest
+
+        self.complete = False
+        self.stop_reason = reason
+        pytest.exit(shown or reason, returncode=code)
 
     @property
     def dut_version(self) -> str | None:

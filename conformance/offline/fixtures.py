@@ -36,9 +36,7 @@ def _heard(run: ConformanceRun, role: str):
         try:
             link = recording_of(run.options.port)
         except PortError as exc:
-            run.complete = False
-            run.stop_reason = str(exc)
-            pytest.exit(str(exc), returncode=EXIT_USAGE)
+            run.cut_short(str(exc), EXIT_USAGE)
         run.link = link  # a recording: a bus end the tool does not transmit on
         if role == "sensor":
             run.session = hear_sensors(link, run.options.address, run.options.version)

@@ -17,6 +17,4 @@ def recorder(sdi12_run) -> RecorderSession:  # noqa: ANN001 - the plugin's Confo
     try:
         return sdi12_run.recorder_session()
     except PortError as exc:
-        sdi12_run.complete = False
-        sdi12_run.stop_reason = str(exc)
-        pytest.exit(str(exc), returncode=EXIT_USAGE)
+        sdi12_run.cut_short(str(exc), EXIT_USAGE)
