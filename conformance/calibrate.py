@@ -17,6 +17,7 @@ from pathlib import Path
 
 from .exits import EXIT_NO_DEVICE, EXIT_OK, EXIT_USAGE
 from .judges.wire import reply_char_pairs
+from .links.base import BusEnd
 from .links.meter import TimingMeter
 from .protocol.timing import (
     BREAK_ALWAYS,
@@ -95,11 +96,11 @@ def latency_timer(port: str) -> int | None:
 
 
 def report(
-    link: object, meter: TimingMeter, port: str, uart_timed: bool, length_error: float
+    link: BusEnd, meter: TimingMeter, port: str, uart_timed: bool, length_error: float
 ) -> list[str]:
     """The lines ``calibrate`` prints (pure: reads what the probe left in the link)."""
-    describe: Callable[[], dict] = link.describe  # type: ignore[attr-defined]
-    bench = describe()
+    bench = link.describe()
+    assert bench is not None, "a link that meters its stamps describes its bench"
     t = bench["timing"]
     lines = [
         f"port {port}: {'the interface echoes the tool' if bench['echo'] else 'no echo'} "
@@ -131,7 +132,7 @@ def report(
                 f"{timer} ms)"
             )
     lines.append(f"a run here would use: {meter.summary()}")
-    segs = segments(link.transcript.events)  # type: ignore[attr-defined]
+    segs = segments(link.transcript.events)
     for rule in RULES:
         lines.append(_prediction(rule, meter, segs, uart_timed, length_error))
     return lines

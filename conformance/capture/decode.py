@@ -53,6 +53,9 @@ class CaptureDecode:
     glitches: int = 0
     breaks: int = 0
     pulses: int = 0
+    #: frames the capture cut (begun before it could tell a start bit, or still running
+    #: at its end): dropped, never judged
+    partial_frames: int = 0
     baud_error_pct: array = field(default_factory=lambda: array("f"))
     problems: list[Decoded] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -170,7 +173,7 @@ def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
     events, problems = out.events, out.problems
     baud_error = out.baud_error_pct.append
     nan = float("nan")
-    chars = framing_errors = parity_errors = glitches = breaks = pulses = 0
+    chars = framing_errors = parity_errors = glitches = breaks = pulses = partial = 0
     for d in decoded:
         if d.event is not None:
             events.append(d.event)
@@ -187,7 +190,9 @@ def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
         breaks += d.kind == "break"
         pulses += d.kind == "pulse"
         glitches += d.kind == "glitch"
+        partial += d.kind == "partial"
     out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
+    out.partial_frames = partial
     out.framing_errors, out.parity_errors = framing_errors, parity_errors
 
 

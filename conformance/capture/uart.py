@@ -59,7 +59,9 @@ class Framing:
 @dataclass(slots=True)
 class Decoded:
     """One thing the decoder found. ``kind``: ``char``, ``break``, ``pulse`` (spacing 6.5-12
-    ms), or ``glitch`` (a pulse shorter than half a bit outside any frame; ``event`` None).
+    ms), ``glitch`` (a pulse shorter than half a bit outside any frame; ``event`` None), or
+    ``partial`` (a frame the capture cut: begun before the decoder could tell a start bit from
+    a data bit, or still running when the capture ended; ``event`` None, never judged).
 
     ``marking_before``: marking (s) since the previous frame's stop bit or break ended (None
     for the first); ``baud_error_pct``: the frame's own bit rate against the nominal one, from
@@ -267,7 +269,8 @@ def decode(
         break_min,
         pulse_min,
     )
-    yield from _scan(iter(chunks), (initial_level & 1) ^ int(invert), line)
+    level = (initial_level & 1) ^ int(invert)
+    yield from _synchronised(_scan(iter(chunks), level, line), SYNC_BITS * line.T / tick_rate, t0)
 
 
 def _capture_end(s: int, end_tick: Callable[[], int | None] | None) -> int:
@@ -321,15 +324,66 @@ def _consume_to(
     return buf, more, bisect_right(buf, stop, i)
 
 
+#: Marking (in bits) before a falling edge that makes it a start bit for certain: inside a
+#: 7E1 or 8N1 frame the line marks at most 9 bits in a row (bit 1 to the stop bit), so after
+#: a longer run the next fall starts a frame. A capture that begins on a busy line is read
+#: from the first such run (or the first spacing too long for a frame) on.
+SYNC_BITS = 9.5
+
+
+#: Frames the decoder holds while the capture has not yet proven where start bits are. A
+#: stream that never pauses long enough (a UART test pattern) is read as a plain UART reads
+#: it, from the first falling edge, once this many frames came without a proof.
+HOLD_FRAMES = 64
+
+
+def _synchronised(items: Iterator[Decoded], sync_s: float, t0: float) -> Iterator[Decoded]:
+    """``items`` from the first start bit the capture proves on: a frame after at least
+    :data:`SYNC_BITS` of marking, or a spacing too long for a frame (a break). The frames
+    before the proof are marked ``partial``: a capture begun inside traffic reads them from
+    a data bit. Without a proof within :data:`HOLD_FRAMES` frames, or in the whole capture,
+    the frames are taken as they read."""
+    held: list[Decoded] = []
+    for d in items:
+        if d.kind in ("break", "pulse") or (d.kind == "char" and _proves(d, sync_s, t0)):
+            yield from _cut(held)
+            held = []
+            yield d
+            break
+        held.append(d)
+        if len(held) >= HOLD_FRAMES:
+            break
+    yield from held  # no proof (within HOLD_FRAMES frames, or at all): as they read
+    yield from items
+
+
+def _proves(d: Decoded, sync_s: float, t0: float) -> bool:
+    """Whether the marking before frame ``d`` proves its start bit (before the first frame
+    of a capture that begins marking: since the capture began)."""
+    marking = d.start - t0 if d.marking_before is None else d.marking_before
+    return marking >= sync_s - 1e-9
+
+
+def _cut(held: list[Decoded]) -> Iterator[Decoded]:
+    """``held`` with every frame marked ``partial`` (glitches stay what they were)."""
+    for d in held:
+        yield Decoded("partial", None, d.start, d.end) if d.kind == "char" else d
+
+
+def _spans(T: float, nbits: int) -> tuple[float, float, float]:
+    """The scan's lengths in ticks: half a bit (shorter is a glitch), the stop bit's centre
+    (a longer spacing is no frame) and a frame's window (a slow sender's run a little past
+    the nominal end)."""
+    return T / 2, (nbits - 0.5) * T, nbits * T * 1.1
+
+
 def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded]:
     """:func:`decode`'s loop, one frame, break, pulse or glitch a turn from the falling edge
     that starts it (``level``: the UART-side level the capture starts at). The hot path:
     per frame it calls nothing it can do inline; the rare cases are built by helpers."""
     T, nbits, tick_rate, t0 = line.T, line.nbits, line.tick_rate, line.t0
     uncertainty = line.uncertainty
-    half = T / 2
-    stop_centre = (nbits - 0.5) * T
-    frame_span = nbits * T * 1.1  # a slow sender's run a little past the nominal end
+    half, stop_centre, frame_span = _spans(T, nbits)
     shapes = _Shapes(T, nbits, line.period_ticks, line.framing)
     state = _start(src, level)
     if state is None:
@@ -367,8 +421,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         if more and buf[-1] <= frame_end:
             buf, more = _refill(src, buf, i, frame_end)
             i = 0
-        hi = i + 16
-        n_buf = len(buf)
+        hi, n_buf = i + 16, len(buf)
         j = bisect_left(buf, frame_end, i, hi if hi < n_buf else n_buf)
         if j == hi:
             j = bisect_left(buf, frame_end, hi)
@@ -377,8 +430,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         reading = shapes[(used, *[e - s for e in buf[i:j]])] if s < _EXACT_BELOW else None
         if reading is None:  # an edge on a bit centre, or a tick too far for the shapes
             reading = _read_frame(s, buf[i:j], used, T, nbits, line.period_ticks, line.framing)
-        used = reading.used
-        framing_error = reading.framing_error
+        used, framing_error = reading.used, reading.framing_error
         end = s + nbits * used
         # consume the edges up to the stop bit's centre; a low stop bit runs on to its rise
         stop = s + (nbits - 0.5) * used
@@ -393,6 +445,9 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         elif e is not None and e < end:
             end = e  # the next start bit came first: this stop bit ended there (back to back)
         start = t0 + s / tick_rate
+        if framing_error and e is None and not more:  # the capture ended in its low stop bit
+            yield Decoded("partial", None, start, t0 + end / tick_rate)
+            return
         ev = Event(EventKind.CHAR, BUS, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end

@@ -299,6 +299,12 @@ def describe_decode(decoded: CaptureDecode) -> list[str]:
             f"{decoded.framing_errors} framing error(s), {decoded.parity_errors} parity "
             f"error(s), {decoded.glitches} glitch(es) in the capture"
         )
+    if decoded.partial_frames:
+        said.append(
+            f"{decoded.partial_frames} frame(s) the capture cut dropped, not judged (it began "
+            "inside traffic, before a start bit could be told from a data bit, or ended inside "
+            "a character)"
+        )
     said.extend(decoded.notes)
     return said
 
