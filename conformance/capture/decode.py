@@ -24,6 +24,9 @@ from .uart import Decoded, Framing, decode
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong bit rate
+#: Glitches per decoded frame above which a capture is mostly pulses too short for a bit:
+#: with the shortest pulses off the bit rate, a wrong bit rate rather than a noisy line
+GLITCHES_PER_FRAME = 4
 RECORDER_ORIGIN = TOOL  # origin of what the recorder's TX channel shows
 SENSOR_ORIGIN = DUT  # origin of the rest of the bus
 
@@ -201,8 +204,13 @@ def _check_plausible(out: CaptureDecode, est: float | None, framing: Framing) ->
     than a noisy line: ``est`` is the bit rate the shortest pulses suggest) or holds no
     event at all, since judging it would only report the user's mistake as the device's."""
     path, baud = out.path, out.baud
-    bad = out.framing_errors + out.parity_errors + out.glitches
+    # spikes on an idle field cable are noise, not a sign of a wrong bit rate: what tells is
+    # frames that do not read, or a capture that is mostly pulses too short for a bit
+    bad = out.framing_errors + out.parity_errors
+    spiky = out.glitches > GLITCHES_PER_FRAME * max(out.chars, 1)
     off = est is not None and not 0.8 < est / baud < 1.25
+    if spiky and off and out.glitches >= MIN_BAD:
+        bad += out.glitches
     if out.chars and bad >= MIN_BAD and bad * 5 >= out.chars and (off or 2 * bad > out.chars):
         hint = f"; the shortest pulses suggest about {est:.0f} baud" if est else ""
         raise CaptureError(
