@@ -46,6 +46,12 @@ class RunOptions:
     keyword: str | None = None  # -k: the cases selected by name
     sweep: str | None = None  # recorder role: tolerance sweeps to run ("reply,wake")
 
+    @property
+    def timing_uncertainty(self) -> float | None:
+        """``--timing-uncertainty-ms`` in seconds, as the port openers take it."""
+        ms = self.timing_uncertainty_ms
+        return None if ms is None else ms / 1000
+
     @classmethod
     def from_values(cls, values: dict[str, Any], keyword: str | None = None) -> RunOptions:
         """From RunOptions field -> value (as :mod:`conformance.options` reads them)."""
@@ -116,12 +122,11 @@ class ConformanceRun:
     def open_link(self) -> Link:
         """The sensor role's link, opened the first time it is asked for."""
         if self.link is None:
-            uncertainty = self.options.timing_uncertainty_ms
             opened = open_port(
                 self.options.port,
                 echo=self.options.echo,
                 direction=self.options.direction,
-                timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
+                timing_uncertainty=self.options.timing_uncertainty,
             )
             self.link = opened.link
             if self.declaration is None:
@@ -161,12 +166,11 @@ class ConformanceRun:
             declared = self.declaration.sdi12_version if self.declaration else None
             version = normalise_version(opts.version) if opts.version else declared or V14
             driver = driver_for(opts.trigger)
-            uncertainty = opts.timing_uncertainty_ms
             session = RecorderSession(
                 opts.port,
                 version=version,
                 driver=driver,
-                timing_uncertainty=None if uncertainty is None else uncertainty / 1000,
+                timing_uncertainty=opts.timing_uncertainty,
                 declaration=self.declaration,
                 job_timeout=opts.job_timeout,
             )

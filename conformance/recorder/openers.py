@@ -85,13 +85,16 @@ def recorder_faults(extra: dict[str, str]) -> tuple[str, ...]:
     faults = tuple(f for f in extra.get("recorder-faults", "").split(",") if f)
     unknown = [f for f in faults if f not in RECORDER_FAULTS]
     if unknown or len(faults) > 1:
-        known = ", ".join(sorted(RECORDER_FAULTS))
         hint = did_you_mean(unknown, RECORDER_FAULTS)
         raise PortError(
-            f"recorder-faults takes one of: {known} (got {','.join(faults)}){hint}; "
+            f"recorder-faults takes one of: {_known_faults()} (got {','.join(faults)}){hint}; "
             "`sdi12-conform faults --role recorder` describes them"
         )
     return faults
+
+
+def _known_faults() -> str:
+    return ", ".join(sorted(RECORDER_FAULTS))
 
 
 def _in_process(extra: dict[str, str], faults: tuple[str, ...]) -> Driver:
@@ -120,7 +123,7 @@ def _open_sim(port: str, options: PortOptions, driver: Driver | None) -> Recorde
     if spec.faults:
         raise PortError(
             "sim://?faults= breaks the simulated sensor judged in the sensor role; in the "
-            f"recorder role use sim://?recorder-faults=NAME ({', '.join(sorted(RECORDER_FAULTS))})"
+            f"recorder role use sim://?recorder-faults=NAME ({_known_faults()})"
         )
     extra = spec.extra
     faults = recorder_faults(extra)

@@ -331,8 +331,8 @@ def check_port(port: str, trigger: str | None = None) -> bool:
     """Raise :class:`PortError` now, before a run starts, if the recorder role cannot use
     ``port`` with ``trigger`` (unknown recorder fault, real port, external recorder on sim);
     else say whether the line runs in real time (the run then takes minutes)."""
-    session = RecorderSession(port, driver=driver_for(trigger))
+    line = open_recorder_line(port, PortOptions(), driver_for(trigger))
     try:
-        return not session.link.info.virtual_time
+        return not line.link.info.virtual_time
     finally:
-        session.close()
+        line.link.close()
