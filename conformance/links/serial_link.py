@@ -92,6 +92,7 @@ class SerialLink(Link):
         self._rx_floor = 0.0  # end of the last received frame: the next cannot start before
         # (floor before it, marking its stamps showed before it, arrival) of the last chunk
         self._previous_chunk = (0.0, 0.0, float("-inf"))
+        self._last_origin = ""  # who sent the last frame recorded ("tool": its echo)
         self._tx_free = 0.0  # end of the tool's last frame on the wire
         self._failure: BaseException | None = None
         self._closing = threading.Event()
@@ -204,7 +205,20 @@ class SerialLink(Link):
         pushed = overlap(count, arrival, floor)
         if pushed > 0:
             self.meter.artefacts.add(pushed, f"frames overlapping by {pushed * 1e3:.2f} ms")
-        if pushed > jitter:
+        if pushed > 0 and self._last_origin == "tool" and not self.echo.pending:
+            # after the tool's whole echo any overlap is proof, not jitter: a reply cannot
+            # start before a command that came back intact ended, so one of the two stamps
+            # is wrong by more than the overlap, by how much more nothing here shows. The
+            # placement at the echo's end is the clamp's, not a measurement: the gap between
+            # command and reply is unknown by a whole character beside the path's range (a
+            # reply start measured as 0 ms would otherwise FAIL R-7.0-09).
+            self.meter.taint(
+                floor - 2 * CHAR_TIME,
+                arrival,
+                pushed + CHAR_TIME + 2 * jitter,
+                "a reply overlapped the echo of the command",
+            )
+        elif pushed > jitter:
             # the frame is placed after the previous one; where it really was, the path's
             # latency range further hides: its stamps may be off by both
             self.meter.taint(floor - 2 * CHAR_TIME, arrival, pushed + jitter, "frames overlapped")
@@ -215,6 +229,7 @@ class SerialLink(Link):
 
     def _record(self, heard: Heard) -> None:
         """Put one sorted byte in the transcript (caller holds the lock)."""
+        self._last_origin = heard.origin
         expected = heard.expected
         if heard.origin == "tool" and expected is not None and not _is_char(expected):
             # a break or a UART-timed pulse read back: a line state, not a character

@@ -56,6 +56,42 @@ def test_a_flood_overlaps_rather_than_running_into_the_future():
     assert frames[0][0] < 0.99  # more bytes than 1200 baud could carry: visibly overlapping
 
 
+def _echo_then_reply(gap_after_echo: float):
+    """A link that heard the echo of ``0D1!`` a character at a time, then the reply's first
+    character alone, stamped ``gap_after_echo`` s after the echo's end (negative: before it
+    could have started): the meter's figure for the command-to-reply gap."""
+    from conformance.links.echo import Expected
+
+    link = open_real_link("loop://", echo=EchoMode.ON)  # nothing is written: the line is idle
+    try:
+        link.echo.expect([Expected(to_wire_7e1(ord(c)), CHAR_TIME) for c in "0D1!"])
+        wire = [to_wire_7e1(ord(c)) for c in "0D1!"]
+        for k, byte in enumerate(wire):
+            link._arrived(bytes([byte]), 1.0 + k * CHAR_TIME)
+        echo_end = 1.0 + 3 * CHAR_TIME
+        link._arrived(bytes([to_wire_7e1(ord("0"))]), echo_end + gap_after_echo + CHAR_TIME)
+        reply = [e for e in link.transcript.events if e.kind is EventKind.CHAR][-1]
+        assert reply.start >= echo_end - 1e-9  # placed after the echo, never into it
+        return link.meter.between(echo_end, reply.start), link.meter.uncertainty()
+    finally:
+        link.close()
+
+
+def test_a_reply_stamped_before_the_echo_ended_taints_the_gap_by_a_character():
+    """The usb16-echo false FAIL: a reply start stamped 0.4 ms before the command's echo
+    ended was placed at its end and measured as a 0.00 ms gap at the regular figure, a FAIL
+    of R-7.0-09 for a sensor that waited 9.4 ms. An intact echo proves the command ended
+    before the reply began, so the overlap shows the stamps wrong by more than it: the gap
+    is worth no more than a whole character there."""
+    between, regular = _echo_then_reply(-0.4e-3)
+    assert between >= CHAR_TIME > regular
+
+
+def test_a_reply_stamped_after_the_echo_keeps_the_regular_figure():
+    between, regular = _echo_then_reply(9.4e-3)
+    assert between == regular
+
+
 # -- port kinds and open errors ---------------------------------------------------------------
 @pytest.mark.parametrize(
     ("port", "kind"),
