@@ -34,9 +34,13 @@ BUS = "bus"
 COLLISION = "collision"
 
 
+#: even parity of every 7-bit character (a table: every received character is checked)
+_PARITY = tuple(bin(c).count("1") & 1 for c in range(0x80))
+
+
 def parity_bit(char7: int) -> int:
     """Even parity bit for a 7-bit character."""
-    return bin(char7 & 0x7F).count("1") & 1
+    return _PARITY[char7 & 0x7F]
 
 
 def to_wire_7e1(char7: int) -> int:
@@ -69,7 +73,7 @@ class Event:
 
     @property
     def parity_ok(self) -> bool:
-        return (self.wire >> 7) == parity_bit(self.wire)
+        return (self.wire >> 7) == _PARITY[self.wire & 0x7F]
 
     @property
     def duration(self) -> float:
@@ -100,7 +104,8 @@ class Event:
 
 def decode_7e1(events: Iterable[Event]) -> str:
     """Text of 7E1 characters (parity stripped: a frame's parity is ``Event.parity_ok``)."""
-    return "".join(chr(e.char7) for e in events if e.kind is EventKind.CHAR)
+    char = EventKind.CHAR
+    return "".join([_CHR7[e.wire & 0x7F] for e in events if e.kind is char])
 
 
 def decode_8n1(events: Iterable[Event]) -> bytes:
@@ -118,12 +123,24 @@ def text_end(events: list[Event], text: str) -> float | None:
     return None
 
 
+_CHR7 = tuple(chr(c) for c in range(0x80))
+_NAMES = {"\r": "<CR>", "\n": "<LF>", "\x02": "<STX>", "\x03": "<ETX>"}
+#: how :func:`escape` shows every character it can meet (str.translate: one pass in C)
+_ESCAPES = {
+    c: _NAMES.get(chr(c), chr(c) if 0x20 <= c <= 0x7E else f"<0x{c:02X}>") for c in range(0x100)
+}
+
+
 def escape(data: str | bytes) -> str:
     """Printable rendering of wire text: ``<CR><LF>``, ``<0x02>``... for evidence lines."""
     if isinstance(data, bytes):
         data = data.decode("latin-1")
-    names = {"\r": "<CR>", "\n": "<LF>", "\x02": "<STX>", "\x03": "<ETX>"}
-    return "".join(names.get(c, c if 0x20 <= ord(c) <= 0x7E else f"<0x{ord(c):02X}>") for c in data)
+    if data.isascii() and data.isprintable():
+        return data
+    out = data.translate(_ESCAPES)
+    if out.isascii():
+        return out
+    return "".join(_ESCAPES.get(ord(c)) or f"<0x{ord(c):02X}>" for c in out)
 
 
 @dataclass

@@ -56,6 +56,8 @@ def unprintable(body: str, crc_positions: int = 0) -> list[str]:
     ``crc_positions`` (3 where a CRC ends the body) exempts 0x7F in that many final
     characters: CRC characters 2 and 3 may legally be 0x7F.
     """
+    if body.isascii() and body.isprintable():
+        return []  # the usual body: nothing to list
     exempt_from = len(body) - crc_positions
     return [
         c

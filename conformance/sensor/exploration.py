@@ -89,6 +89,9 @@ class Exploration:
     exchanges: list[Exchange] = field(default_factory=list)
     observations: list[Observation] = field(default_factory=list)
     failing_sequence: list[str] = field(default_factory=list)
+    #: whether an observation so far broke an invariant (``broken`` judges them all again;
+    #: asked at every step, that was quadratic in the exploration's length)
+    breached: bool = False
 
     @property
     def broken(self) -> Breach | None:
@@ -140,12 +143,12 @@ class _Explorer(RuleBasedStateMachine):
         invariant. The failing sequence is kept at the first breach: hypothesis replays a
         failing example to confirm it, and a real device, whose state moved on, may then
         behave otherwise (hypothesis calls that flaky); the first observation stands."""
-        first = self.record.broken is None
         self.record.observations.append(observation)
         breach = judge(observation).breach
         if breach is None:
             return
-        if first:
+        if not self.record.breached:
+            self.record.breached = True
             self.record.failing_sequence = list(self.trail)
         raise InvariantBroken(breach.requirement, breach.message)
 
@@ -231,7 +234,7 @@ class _Explorer(RuleBasedStateMachine):
 
     def teardown(self) -> None:
         self.record.log.append(" ; ".join(self.trail))
-        if self.record.broken is None:  # after a break, the sequence that broke it stays
+        if not self.record.breached:  # after a break, the sequence that broke it stays
             self.record.failing_sequence = list(self.trail)
 
 

@@ -5,6 +5,7 @@ and report, beside what was judged."""
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import jsonschema
@@ -15,7 +16,6 @@ from conformance.commands.plan import make_plan
 from conformance.declaration import DeclarationError, load_declaration
 from conformance.emulator.declared import assumptions, declared_profile
 from conformance.ports import PortError, open_sim, parse_sim
-from conformance.report_folder import LOCK_NAME
 from conformance.reports.plan import plan_html, plan_markdown
 from tests.support.paths import ROOT
 
@@ -175,15 +175,20 @@ def test_ctrl_c_while_planning_stops_before_anything_goes_on_the_bus(tmp_path):
     import time
 
     out = tmp_path / "run"
+    scratch = tmp_path / "tmp"  # where the dry run makes its folder: seen, it is under way
+    scratch.mkdir()
+    env = os.environ | {"TMPDIR": str(scratch), "SDI12_CACHE_DIR": str(tmp_path / "cache")}
     cli = subprocess.Popen(
         [sys.executable, "-m", "conformance.cli", "--port", "sim", "--plan", "always",
          "--report-dir", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
     )  # fmt: skip
     deadline = time.monotonic() + 60
-    while not (out / LOCK_NAME).exists() and time.monotonic() < deadline:
-        time.sleep(0.05)  # the folder is taken just before the dry run starts
-    time.sleep(1.5)  # into the dry run (about 5 s)
+    # no cached plan (a fresh cache folder), so a dry run must run; it takes about a second
+    # on the virtual clock, and the interrupt goes in as soon as its folder exists (a fixed
+    # sleep missed it once the suite got faster: the whole run was over)
+    while not list(scratch.glob("sdi12-plan-*")) and time.monotonic() < deadline:
+        time.sleep(0.01)
     cli.send_signal(signal.SIGINT)
     text, _ = cli.communicate(timeout=60)
     assert cli.returncode == 2, text
