@@ -563,12 +563,38 @@ def main(argv: list[str] | None = None) -> int:
     GUARD.install()  # first of all: Ctrl-C from here on is recorded, never a traceback
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        return _dispatch(argv)
+        code = _dispatch(argv)
     finally:
         if whole_process:
             GUARD.ignore_from_now()  # a Ctrl-C while Python shuts down must not exit 130
         else:
             GUARD.uninstall()
+    if whole_process and not (argv and argv[0] in SUBCOMMANDS):
+        _exit_at_once(code)
+    return code
+
+
+def _exit_at_once(code: int) -> None:
+    """End a finished run's process without the interpreter's teardown: freeing a run's
+    10^5 events, findings and modules one by one took about 0.15 s of a 1.4 s process, for
+    nothing. Every report is written and closed by now; what Python would still do that
+    matters is done here (the streams flushed, atexit handlers and finalizers run). Only
+    with no other thread left that Python's exit would wait for; else the usual exit."""
+    import atexit
+    import contextlib
+    import threading
+
+    if any(
+        t.is_alive() and not t.daemon
+        for t in threading.enumerate()
+        if t is not threading.current_thread()
+    ):
+        return
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):  # a closed pipe: nothing more to say
+            stream.flush()
+    os._exit(code)
 
 
 def make_console(*, stderr: bool = False) -> Console:
@@ -576,8 +602,18 @@ def make_console(*, stderr: bool = False) -> Console:
     a log or a pipe gets whole lines (rich would hard-wrap them at 80 columns)."""
     from rich.console import Console
 
+    class RunConsole(Console):
+        def on_broken_pipe(self) -> None:
+            """The reader went away (``| head``): say nothing more there, but let the run
+            finish and write its reports. rich's default ends the process with exit 1 from
+            inside a pytest hook (an INTERNALERROR traceback and exit 3, the run cut off)."""
+            self.quiet = True
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, stream.fileno())
+            os.close(devnull)
+
     stream = sys.stderr if stderr else sys.stdout
-    return Console(stderr=stderr, soft_wrap=not stream.isatty())
+    return RunConsole(stderr=stderr, soft_wrap=not stream.isatty())
 
 
 def error(text: str) -> None:

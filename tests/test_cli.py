@@ -97,3 +97,39 @@ def test_version_1_3_sensor_is_compliant(tmp_path):
     assert proc.returncode == 0, proc.stdout
     data = json.loads((tmp_path / "verdicts.json").read_text())
     assert data["dut"]["sdi12_version"] == "1.3" and data["dut"]["address"] == "5"
+
+
+def test_a_reader_that_goes_away_leaves_the_run_to_finish(tmp_path):
+    """``sdi12-conform ... | head -2``: the pipe closes after two lines. The run goes on to
+    its end and its reports, with the verdict's exit code; before, rich ended the process
+    from inside a pytest hook (INTERNALERROR tracebacks, exit 3, no report)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "conformance.cli", "--port", "sim://?faults=wrong-crc",
+         "--report-dir", str(tmp_path)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.readline()
+    proc.stdout.close()  # the reader is gone: every later write meets a broken pipe
+    stderr = proc.stderr.read()
+    assert proc.wait(timeout=120) == 1, stderr  # NON-COMPLIANT, as the run found
+    assert "INTERNALERROR" not in stderr and "Traceback" not in stderr, stderr
+    data = json.loads((tmp_path / "verdicts.json").read_text())
+    assert data["summary"]["verdict"] == "NON-COMPLIANT" and data["run"]["complete"]
+
+
+def test_the_process_ends_at_once_only_when_no_thread_would_be_waited_for():
+    """A finished run's process skips the interpreter's teardown (about 0.15 s), but never
+    while a non-daemon thread is alive: Python's exit would have waited for it."""
+    import threading
+
+    from conformance.cli import _exit_at_once
+
+    release = threading.Event()
+    worker = threading.Thread(target=release.wait)
+    worker.start()
+    try:
+        assert _exit_at_once(0) is None  # returned: the usual exit will join the thread
+    finally:
+        release.set()
+        worker.join()
