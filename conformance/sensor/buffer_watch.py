@@ -17,7 +17,7 @@ from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
-from ..transcript import EventKind
+from ..transcript import decode_7e1
 
 
 class BufferWatchHooks(Hooks):
@@ -37,7 +37,7 @@ class BufferWatchHooks(Hooks):
     ) -> Attempt:
         """The engine's attempt, noted."""
         attempt = proceed()
-        reply = "".join(chr(e.char7) for e in attempt.reply_events if e.kind is EventKind.CHAR)
+        reply = decode_7e1(attempt.reply_events)
         self.last_sent[address] = (command, reply)
         return attempt
 

@@ -33,7 +33,7 @@ SELECTION = (
     "or test_short_spacing_is_not_a_break or test_break_just_over_12ms_wakes"
 )
 
-PARALLEL = 3  # runs side by side: a busy machine, yet every emulator can keep its line
+PARALLEL = 5  # runs side by side: a busy machine, yet every emulator can keep its line
 
 #: (id, emulate options, tool options, CPU burners)
 CLEAN = [
