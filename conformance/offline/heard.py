@@ -16,7 +16,7 @@ from ..dut import DutClaim, Session, sensor_claim
 from ..judges.exchanges import identification
 from ..judges.timing import StampUncertainty
 from ..preconditions import NOT_SEEN as _NOT_SEEN
-from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
+from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
 from ..protocol.responses import Identification
 from ..protocol.values import split_values
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
@@ -152,8 +152,8 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     if cut:
         heard.assumptions.append(
             f"{cut} recorded measurement(s) interrupted by the recorder (a command before the "
-            "service request or ttt, or no aD0! next): their replies are judged, not their "
-            "waits or data"
+            "service request or ttt, or no aD0! next; for a concurrent one, a command to the "
+            "same sensor before its aD0!): their replies are judged, not their waits or data"
         )
     if address is not None:
         heard.assumptions.append(f"sensor rules judged on sensor {address!r} only (--address)")
@@ -164,10 +164,12 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
 def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     """What the recorder did that keeps ``m``'s wait and data from being the sensor's own
     doing: a transmission or a break before the service request (or ttt) of an aM!-type
-    measurement, or anything but its aD0!/aDB0! as the next transmission (the rebuilt
-    records follow a measurement's data only while nothing else comes between; a concurrent
-    measurement interleaved with another sensor's is left to its reply rules, a conservative
-    choice). None: undisturbed."""
+    measurement, or anything but its aD0!/aDB0! as the next transmission (after an aM!-type
+    measurement the recorder talks to no one else, R-4.4.5-06). A concurrent measurement
+    (C/CC/Cn/CCn/HA/HB) is disturbed only by a command to its own sensor before its aD0!
+    (it aborts it, R-4.4.7.1-01, R-5.3-01): traffic to other sensors is what it is for, and
+    a break does not abort it either (R-4.4.7-05, decision A4), so neither sets it aside.
+    The rebuilt records follow its data the same way. None: undisturbed."""
     if m.reply_end is None or m.ttt is None:
         return "no usable reply"
     later = [t for t in view.transmissions if t.start >= m.reply_end]
@@ -178,6 +180,8 @@ def disturbance(m: Measurement, view: TranscriptView) -> str | None:
             return early.text
         if any(m.reply_end <= b.start < due for b in view.breaks):
             return "break"  # a break aborts an aM!-type measurement (R-4.4.5-10)
+    if m.command.kind in CONCURRENT_KINDS:
+        later = [t for t in later if t.address == m.command.address]
     if not later:
         return "nothing more sent"
     index = later[0].data_index
