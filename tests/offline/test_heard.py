@@ -80,15 +80,28 @@ def _heard_bus(tmp_path: Path, address: str | None = None, **kwargs):
     return hear_sensors(link, address, None)
 
 
-def test_concurrent_measurements_on_a_bus_are_not_disturbed_by_the_other_sensors(tmp_path):
-    """aC! to 0, 1 and 3, then the D0s of each: the traffic to the others between a
-    sensor's aC! and its aD0! is what concurrent measurement is for (R-4.4.7-05), and the
-    breaks in front of each aD0! do not abort it either (decision A4)."""
-    heard = _heard_bus(tmp_path)
-    concurrent = heard.of_kind(Kind.CONCURRENT)
+@pytest.mark.parametrize(
+    ("code", "kind"),
+    [
+        ("C", Kind.CONCURRENT),
+        ("CC", Kind.CONCURRENT),
+        ("HA", Kind.HIGH_VOLUME_ASCII),
+        ("HB", Kind.HIGH_VOLUME_BINARY),
+    ],
+)
+def test_concurrent_measurements_on_a_bus_are_not_disturbed_by_the_other_sensors(
+    tmp_path, code, kind
+):
+    """a<code>! to 0, 1 and 3, then the data of each: the traffic to the others between a
+    sensor's start and its aD0!/aDB0! is what concurrent measurement is for (R-4.4.7-05,
+    R-5.3-01), and the breaks in front of each do not abort it either (decision A4)."""
+    heard = _heard_bus(tmp_path, code=code)
+    concurrent = heard.of_kind(kind)
     assert [m.command.address for m in concurrent] == ["0", "1", "3"]
     assert [m.aborted_by for m in concurrent] == [None, None, None]
-    assert [m.value_count for m in heard.of_kind(Kind.CONCURRENT, whole=True)] == [20] * 3
+    whole = heard.of_kind(kind, whole=True)
+    assert len(whole) == 3 and all(m.count for m in whole)
+    assert all((m.binary_value_count if m.binary else m.value_count) == m.count for m in whole)
     assert not any("interrupted" in note for note in heard.assumptions), heard.assumptions
 
 
@@ -118,3 +131,24 @@ def test_an_m_measurement_is_still_disturbed_by_a_command_to_another_sensor():
     view = read_view(as_heard(bus))
     (rebuilt,) = rebuild_records(view).measurements
     assert disturbance(rebuilt, view) == "1I!"
+
+
+def test_the_sensors_on_the_bus_are_known_by_their_first_address():
+    """sensors_on: each answering address once, in address order, identified where an aI!
+    reply was heard; a sensor moved by aAb! (and back) stays one sensor, not two."""
+    from conformance.offline.heard import sensors_on
+    from conformance.view.rebuilt_records import rebuild_records
+    from conformance.view.segments import read_view
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, serial
+
+    bus, recorder = bus_of_sensors("30")
+    recorder.acknowledge("3")
+    recorder.identify("0")
+    assert recorder.change_address("5", "0").ok and recorder.identify("5").ok
+    assert recorder.change_address("0", "5").ok
+    found = sensors_on(rebuild_records(read_view(as_heard(bus))).exchanges)
+    assert [s.address for s in found] == ["0", "3"]
+    zero, three = found
+    assert zero.identity is not None and zero.identity.optional == serial("0")
+    assert zero.claim().version == "14" and zero.reply.startswith("014")
+    assert three.identity is None and three.claim().reply is None  # no aI! heard: nulls
