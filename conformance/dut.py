@@ -53,6 +53,12 @@ class Session(Protocol):
         a harness's stderr); empty by default."""
         return {}
 
+    def bus_sensors(self) -> list[tuple[str, DutClaim]] | None:
+        """Every sensor the run saw on the bus, in address order, with what each said about
+        itself (``verdicts.json``'s ``duts``). A passive run lists the sensors its recording
+        shows; a live run drives one DUT and gives None (the key is then left out)."""
+        return None
+
     def worst_lateness(self) -> float:
         """How far a line the tool kept in real time fell behind its schedule (s); 0 when
         the tool keeps no such line."""

@@ -6,12 +6,18 @@ once per role over the port ``recording:PATH?...``: the sensor rules aggregate a
 ``sensor``, the recorder rules as role ``recorder``. ``--role both`` writes two report sets,
 ``<report-dir>/sensor/`` and ``<report-dir>/recorder/``, prints both verdicts and exits with
 the worse of the two codes.
+
+Every sensor on the bus is a DUT (issue 23): when the recording shows replies from several
+sensor addresses and no ``--address`` narrows it, the sensor rules run once per address into
+``<report-dir>/sensor-<a>/`` (the recorder rules into ``<report-dir>/recorder/``), the console
+ends with one line per sensor, and the exit code is the worst of them all.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..conduct import RunResult, conduct
 from ..exits import EXIT_COMPLIANT, EXIT_USAGE
@@ -68,11 +74,52 @@ def forget(port: str) -> None:
     _LOADED.pop(port, None)
 
 
+@dataclass(frozen=True)
+class RoleJob:
+    """One run of the passive cases: whose rules (``role``), narrowed to which sensor
+    (``address``; None: all), into which folder, and the label the console gives it."""
+
+    label: str
+    role: str
+    address: str | None
+    report_dir: Path
+    of_bus: bool = False  # one of several sensors on the bus, each judged as a DUT
+
+
+def sensors_heard(port: str) -> list[str]:
+    """The addresses of the sensors the recording shows replies from, in address order
+    (a sensor moved by ``aAb!`` counted once, at its first address)."""
+    from ..offline.fixtures import recording_of
+    from ..offline.heard import sensors_on
+    from ..view.rebuilt_records import rebuild_records
+    from ..view.segments import read_view
+
+    link = recording_of(port)
+    view = read_view(link.transcript.events)
+    rebuilt = rebuild_records(view, uncertainty=link.uncertainty)
+    return [s.address for s in sensors_on(rebuilt.exchanges)]
+
+
+def role_jobs(roles: tuple[str, ...], base: Path, args: PassiveJob, port: str) -> list[RoleJob]:
+    """The runs to make. Every sensor on the bus is a DUT: with replies from more than one
+    address and no ``--address``, the sensor rules run once per address, each narrowed as
+    ``--address`` narrows them, into ``<base>/sensor-<a>/`` (the recorder rules, if asked
+    for, into ``<base>/recorder/``). One sensor keeps one folder per role, as before."""
+    addresses = sensors_heard(port) if "sensor" in roles and args.address is None else []
+    several = len(addresses) > 1
+    jobs: list[RoleJob] = []
+    for role in roles:
+        if role == "sensor" and several:
+            jobs += [RoleJob(f"sensor {a}", role, a, base / f"sensor-{a}", True) for a in addresses]
+            continue
+        folder = base / role if len(roles) > 1 or several else base
+        jobs.append(RoleJob(role, role, args.address if role == "sensor" else None, folder))
+    return jobs
+
+
 def judge_passively(args: PassiveJob, console: Console) -> int:
-    """Judge the recording ``args`` names; the exit code is the worse role's."""
+    """Judge the recording ``args`` names; the exit code is the worst run's."""
     from ..declaration import DeclarationError, normalise_version
-    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
-    from ..reports.console import print_summary
 
     port = recording_port(
         args.recording, args.format, channel=args.channel, tx_channel=args.tx_channel,
@@ -91,50 +138,74 @@ def judge_passively(args: PassiveJob, console: Console) -> int:
         error(f"error: {why}")
         return EXIT_USAGE
     roles = ROLES if args.role == "both" else (args.role,)
-    base = run_folder(args.report_dir, "passive")
+    jobs = role_jobs(roles, run_folder(args.report_dir, "passive"), args, port)
+    sensors = [j.address for j in jobs if j.of_bus]
     console.print(
         f"judging {args.recording} passively: the rules its traffic can show "
-        f"({' and '.join(roles)} rules)",
+        f"({' and '.join(roles)} rules)"
+        + (f"; {len(sensors)} sensors on the bus ({', '.join(map(str, sensors))}), each a DUT"
+           if sensors else ""),
         markup=False,
         highlight=False,
-    )
-    codes = []
-    for role in roles:
-        report_dir = base / role if len(roles) > 1 else base
-        result = _run_role(role, port, report_dir, args, console)
+    )  # fmt: skip
+    code = _run_jobs(jobs, port, args, console)
+    forget(port)
+    return code
+
+
+def _run_jobs(jobs: list[RoleJob], port: str, args: PassiveJob, console: Console) -> int:
+    """Each job in turn, its summary printed; then one line per sensor when there were
+    several. The exit code is the worst of all (an internal error first)."""
+    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
+    from ..reports.console import print_summary
+
+    codes: list[int] = []
+    done: list[tuple[RoleJob, dict[str, Any]]] = []
+    for job in jobs:
+        result = _run_role(job, port, args, console)
         code, data = result.pytest_code, result.document
-        codes.append(code)
-        if GUARD.requested and data is None:  # Ctrl-C before this role wrote its verdicts
-            forget(port)
+        if GUARD.requested and data is None:  # Ctrl-C before this run wrote its verdicts
             return EXIT_INCOMPLETE
-        if data is None:  # the role's run wrote no verdicts (its own, never a file's)
+        if data is None:  # the run wrote no verdicts (its own, never a file's)
             if code in (EXIT_USAGE, EXIT_INTERNAL):
                 return code
-            error(f"error: the {role} rules were not judged (pytest exit {code})")
+            error(f"error: the {job.label} rules were not judged (pytest exit {code})")
             return EXIT_INTERNAL
-        console.print(f"{role} rules:", style="bold", markup=False, highlight=False)
-        print_summary(console, data, str(report_dir))
-        codes[-1] = result.exit_code
-        if GUARD.requested:  # Ctrl-C: this role's report says so; the next one is not begun
-            forget(port)
+        console.print(f"{job.label} rules:", style="bold", markup=False, highlight=False)
+        print_summary(console, data, str(job.report_dir))
+        codes.append(result.exit_code if result.exit_code is not None else code)
+        done.append((job, data))
+        if GUARD.requested:  # Ctrl-C: this run's report says so; the next one is not begun
             GUARD.close()
             return EXIT_INCOMPLETE
-    forget(port)
+    _print_sensors(console, [(j, d) for j, d in done if j.of_bus])
     order = (EXIT_INTERNAL, EXIT_USAGE, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_COMPLIANT)
     return min(codes, key=lambda c: order.index(c) if c in order else -1)
 
 
-def _run_role(
-    role: str, port: str, report_dir: Path, args: PassiveJob, console: Console
-) -> RunResult:
-    """One role's rules: the passive cases over the recording's port, aggregated as ``role``."""
+def _print_sensors(console: Console, done: list[tuple[RoleJob, dict[str, Any]]]) -> None:
+    """One line per sensor of a bus: address, identification, verdict, report folder."""
+    if not done:
+        return
+    console.print("sensors on the bus:", style="bold", markup=False, highlight=False)
+    for job, data in done:
+        ident = (data["dut"].get("identification") or "(no aI! reply seen)").strip()
+        console.print(
+            f"  sensor {job.address} · {ident!r} · {data['summary']['verdict']} · {job.report_dir}",
+            markup=False,
+            highlight=False,
+        )
+
+
+def _run_role(job: RoleJob, port: str, args: PassiveJob, console: Console) -> RunResult:
+    """One job's rules: the passive cases over the recording's port, aggregated as its role."""
     from ..reports.console import ProgressPlugin
 
     options = RunOptions(
         port=port,
-        role=role,
-        report_dir=str(report_dir),
-        address=args.address if role == "sensor" else None,
+        role=job.role,
+        report_dir=str(job.report_dir),
+        address=job.address,
         version=args.sdi_version,
         strict=args.strict,
     )

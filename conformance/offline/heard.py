@@ -16,7 +16,7 @@ from ..dut import DutClaim, Session, sensor_claim
 from ..judges.exchanges import identification
 from ..judges.timing import StampUncertainty
 from ..preconditions import NOT_SEEN as _NOT_SEEN
-from ..protocol.commands import SERVICE_REQUEST_KINDS, Kind
+from ..protocol.commands import ADDRESS_CHARS, CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
 from ..protocol.responses import Identification
 from ..protocol.values import split_values
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
@@ -99,6 +99,43 @@ class Heard(Session):
         return is_v14(self.version)
 
 
+@dataclass(frozen=True)
+class BusSensor:
+    """A sensor the recording shows answering: its address and its ``aI!`` reply, if one
+    was heard (``identity``: parsed; ``reply``: as heard)."""
+
+    address: str
+    identity: Identification | None = None
+    reply: str | None = None
+
+    def claim(self) -> DutClaim:
+        version = self.identity.version if self.identity is not None else None
+        return DutClaim(self.identity, self.reply, version if version in VERSIONS else None)
+
+
+def sensors_on(exchanges: list[Exchange]) -> list[BusSensor]:
+    """The sensors whose replies the recording holds, in address order. A sensor is known by
+    the address it first answered at: an accepted ``aAb!`` moves it, not a new sensor (a
+    sensor run moves its DUT and back), so its later replies at ``b`` are its own."""
+    moved: dict[str, str] = {}  # address now -> the address the sensor was first heard at
+    seen: dict[str, BusSensor] = {}
+    for ex in exchanges:
+        said = ex.reply_text[:1] if ex.answered else ""
+        if not said or said not in ADDRESS_CHARS or ex.command is None:
+            continue
+        if ex.command.kind is Kind.CHANGE_ADDRESS and said == ex.command.new_address:
+            moved[said] = moved.get(ex.command.address, ex.command.address)
+            continue
+        home = moved.get(said, said)
+        if home not in seen:
+            seen[home] = BusSensor(home)
+        if ex.command.kind is Kind.IDENTIFY and seen[home].identity is None:
+            ident, _ = identification(ex, said)
+            if ident is not None and ident.version in VERSIONS:
+                seen[home] = BusSensor(home, ident, ex.reply_text)
+    return [seen[a] for a in sorted(seen, key=ADDRESS_CHARS.index)]
+
+
 @dataclass
 class HeardSensors(Heard):
     """The sensor rules' records: every exchange and measurement the recording shows (of
@@ -107,6 +144,11 @@ class HeardSensors(Heard):
     exchanges: list[Exchange] = field(default_factory=list)
     measurements: list[Measurement] = field(default_factory=list)
     segments: list[Segment] = field(default_factory=list)
+    #: every sensor on the bus (``--address`` or not), for ``verdicts.json``'s ``duts``
+    on_bus: list[BusSensor] = field(default_factory=list)
+
+    def bus_sensors(self) -> list[tuple[str, DutClaim]]:
+        return [(s.address, s.claim()) for s in self.on_bus]
 
     def of_kind(self, *kinds: Kind, whole: bool = False) -> list[Measurement]:
         """The recorded measurements of ``kinds``; ``whole``: only those the recorder let
@@ -128,6 +170,11 @@ class HeardSensors(Heard):
 class HeardRecorder(Heard):
     """The recorder rules read the whole bus (``--address`` does not narrow them)."""
 
+    on_bus: list[BusSensor] = field(default_factory=list)
+
+    def bus_sensors(self) -> list[tuple[str, DutClaim]]:
+        return [(s.address, s.claim()) for s in self.on_bus]
+
 
 def _mine(address: str | None, text: str) -> bool:
     return address is None or text[:1] == address
@@ -144,6 +191,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         exchanges=[x for x in rebuilt.exchanges if _mine(address, x.text)],
         measurements=[m for m in rebuilt.measurements if _mine(address, m.command.address)],
         segments=[Segment.of(t) for t in view.transmissions if _mine(address, t.text)],
+        on_bus=sensors_on(rebuilt.exchanges),
     )
     for m in heard.measurements:
         m.aborted_by = disturbance(m, view)
@@ -152,11 +200,14 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     if cut:
         heard.assumptions.append(
             f"{cut} recorded measurement(s) interrupted by the recorder (a command before the "
-            "service request or ttt, or no aD0! next): their replies are judged, not their "
-            "waits or data"
+            "service request or ttt, or no aD0! next; for a concurrent one, a command to the "
+            "same sensor before its aD0!): their replies are judged, not their waits or data"
         )
     if address is not None:
-        heard.assumptions.append(f"sensor rules judged on sensor {address!r} only (--address)")
+        bus = ", ".join(s.address for s in heard.on_bus)
+        several = len(heard.on_bus) > 1
+        why = f"of the {len(heard.on_bus)} sensors on the bus: {bus}" if several else "--address"
+        heard.assumptions.append(f"sensor rules judged on sensor {address!r} only ({why})")
     _identify(heard)
     return heard
 
@@ -164,10 +215,12 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
 def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     """What the recorder did that keeps ``m``'s wait and data from being the sensor's own
     doing: a transmission or a break before the service request (or ttt) of an aM!-type
-    measurement, or anything but its aD0!/aDB0! as the next transmission (the rebuilt
-    records follow a measurement's data only while nothing else comes between; a concurrent
-    measurement interleaved with another sensor's is left to its reply rules, a conservative
-    choice). None: undisturbed."""
+    measurement, or anything but its aD0!/aDB0! as the next transmission (after an aM!-type
+    measurement the recorder talks to no one else, R-4.4.5-06). A concurrent measurement
+    (C/CC/Cn/CCn/HA/HB) is disturbed only by a command to its own sensor before its aD0!
+    (it aborts it, R-4.4.7.1-01, R-5.3-01): traffic to other sensors is what it is for, and
+    a break does not abort it either (R-4.4.7-05, decision A4), so neither sets it aside.
+    The rebuilt records follow its data the same way. None: undisturbed."""
     if m.reply_end is None or m.ttt is None:
         return "no usable reply"
     later = [t for t in view.transmissions if t.start >= m.reply_end]
@@ -178,6 +231,8 @@ def disturbance(m: Measurement, view: TranscriptView) -> str | None:
             return early.text
         if any(m.reply_end <= b.start < due for b in view.breaks):
             return "break"  # a break aborts an aM!-type measurement (R-4.4.5-10)
+    if m.command.kind in CONCURRENT_KINDS:
+        later = [t for t in later if t.address == m.command.address]
     if not later:
         return "nothing more sent"
     index = later[0].data_index
@@ -238,7 +293,10 @@ def _identify(heard: HeardSensors) -> None:
 def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
     view = read_view(link.transcript.events)
     heard = HeardRecorder(
-        link, view, forced_version=normalise_version(version) if version else None
+        link,
+        view,
+        forced_version=normalise_version(version) if version else None,
+        on_bus=sensors_on(rebuild_records(view, uncertainty=link.uncertainty).exchanges),
     )
     heard.assumptions = recording_notes(link, view)
     if heard.forced_version is None:

@@ -31,7 +31,7 @@ from .margins import margins_html
 from .plan import plan_section, read_plan
 from .sweep_chart import section as sweep_section
 from .timing_diagram import exchange_behind, timing_svg, wire_title
-from .verdicts_json import dut_block
+from .verdicts_json import dut_block, duts_block
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
@@ -259,6 +259,15 @@ def _talk_rows(link: dict[str, Any]) -> list[tuple[str, str]]:
     ]
 
 
+def _other_sensors(duts: list[dict[str, Any]]) -> str:
+    """The other sensors a recording shows, one phrase each: address and identification
+    (escaped by the table that shows it, as every DUT field)."""
+    ident = {d["address"]: d["identification"] for d in duts}
+    return "; ".join(
+        f"{a}: {wire_escape(i.strip()) if i else '(no aI! reply seen)'}" for a, i in ident.items()
+    )
+
+
 def header(run: ConformanceRun) -> str:
     """The DUT identity and the run's identity, side by side."""
     dut = dut_block(run)
@@ -286,6 +295,9 @@ def header(run: ConformanceRun) -> str:
     ]
     if run.options.role == "sensor":  # the tool only changes a sensor's address
         device.append(("Address changes", _counted(dut.get("address_notes") or []) or "none made"))
+    others = [d for d in duts_block(run) or [] if d["address"] != dut["address"]]
+    if others:  # a bus of sensors judged passively: each has its own report
+        device.append(("Other sensors on the bus", _other_sensors(others)))
     runrows = [
         ("Tool", f"{TOOL_IDENTITY['name']} {TOOL_IDENTITY['version']}"),
         ("Role judged", run.options.role),

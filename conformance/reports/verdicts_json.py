@@ -24,18 +24,34 @@ from .sweep_chart import sweeps_block
 SCHEMA = "sdi12-conform/verdicts/1"
 
 
-def dut_block(run: ConformanceRun) -> dict[str, Any]:
-    session = run.session
-    claim = session.claim() if session else DutClaim()
+def identity_fields(address: str | None, claim: DutClaim) -> dict[str, Any]:
+    """What a DUT said about itself, as ``dut`` and each entry of ``duts`` give it."""
     ident, version = claim.identity, claim.version
     return {
-        "address": session.address if session else run.options.address,
+        "address": address,
         "identification": claim.reply,
         "sdi12_version": format_version(version) if version else None,
         "vendor": ident.vendor if ident else None,
         "model": ident.model if ident else None,
         "firmware": ident.sensor_version if ident else None,
         "serial": ident.optional if ident else None,
+    }
+
+
+def duts_block(run: ConformanceRun) -> list[dict[str, Any]] | None:
+    """Every sensor the run saw on the bus (``duts``), in address order; None (the key left
+    out) for a live run, which drives one DUT, the ``dut`` block's (Session.bus_sensors)."""
+    found = run.session.bus_sensors() if run.session else None
+    if found is None:
+        return None
+    return [identity_fields(address, claim) for address, claim in found]
+
+
+def dut_block(run: ConformanceRun) -> dict[str, Any]:
+    session = run.session
+    claim = session.claim() if session else DutClaim()
+    return {
+        **identity_fields(session.address if session else run.options.address, claim),
         "assumptions": list(session.assumptions) if session else [],
         "declaration": run.declaration.source if run.declaration else None,
         # whether every address change was undone (design.md 7: leave the DUT as found)
@@ -90,6 +106,8 @@ def build(run: ConformanceRun) -> dict[str, Any]:
             "bus": bus_block(run),
         },
         "dut": dut_block(run),
+        # a passive run: every sensor on the bus (issue 23), ``dut`` being this run's own
+        **({"duts": duts} if (duts := duts_block(run)) is not None else {}),
         # the test plan the run was given (plan.json beside it), in short: planned vs judged
         "plan": plan_block(run.report_dir()),
         "summary": {"verdict": run.verdict, "counts": counts(results)},

@@ -7,7 +7,8 @@ capture, a saved transcript), the same records are rebuilt here from the wire al
 transmission becomes an attempt; consecutive transmissions of one command whose reply was
 not accepted are its retries (a break starts a new sequence); a measurement command with an
 ``atttn`` reply, the sensor's characters while it waited (service request) and the
-``aD0!``.. ``aDn!`` that followed become a measurement.
+``aD0!``.. ``aDn!`` that followed become a measurement (for a concurrent measurement, the
+``aD0!``.. of its address that followed, whatever was said to other sensors between).
 
 Whether an attempt's reply was accepted is the tool recorder's own decision
 (:mod:`conformance.tool_recorder.validity`), as in the records it writes live: these are its
@@ -18,10 +19,11 @@ the first-character timeout.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from ..protocol.binary import packet_length
-from ..protocol.commands import SERVICE_REQUEST_KINDS, Command, Kind
+from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
 from ..protocol.framing import ETX, STX
 from ..protocol.responses import parse_measurement_reply_for, service_request, split_line
 from ..protocol.timing import CHAR_TIME, TOLERANCE
@@ -154,7 +156,7 @@ def _measurements(
             m.waited_events = _waited(m, source[id(ex.last)], policy)
             m.service_request_end = text_end(m.waited_events, service_request(command.address))
         probed_past_empty = False
-        for later in exchanges[i + 1 :]:
+        for later in _following(exchanges[i + 1 :], m):
             if not _collects(later, m) or m.value_count >= m.count:
                 break
             m.data.append(later)
@@ -187,6 +189,18 @@ def _waited(m: Measurement, t: Transmission, policy: Policy) -> list[Event]:
         return waited
     deadline = m.reply_end + m.ttt + policy.ttt_margin
     return [e for e in after if e.end <= deadline]
+
+
+def _following(later: list[Exchange], m: Measurement) -> Iterator[Exchange]:
+    """The exchanges that may carry ``m``'s data, in wire order. A concurrent measurement
+    (C/CC/Cn/CCn/HA/HB) runs while the recorder talks to other sensors (R-4.4.7-05, R-5.3-01):
+    that is what it is for, so only the exchanges to its own address follow it (the first
+    that is not its next data command ends it, as a command to it aborts it, R-4.4.7.1-01).
+    After an aM!-type measurement the recorder talks to no one else (R-4.4.5-06): the very
+    next exchange is its data or the end of it."""
+    concurrent = m.command.kind in CONCURRENT_KINDS
+    # lazily: the caller stops at the first exchange that is not the next data command
+    return (x for x in later if not concurrent or x.text[:1] == m.command.address)
 
 
 def _collects(ex: Exchange, m: Measurement) -> bool:

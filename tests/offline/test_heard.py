@@ -1,7 +1,10 @@
 """A transcript of a real-time link judged passively is host-stamped: one stalled stamp is
 no evidence against the sensor (it may be the recording host's), while a deviation that
 recurs at the same point of the same reply is the device's. A monitor's transcript of the
-reference sensor FAILed R-7.0-12 on one stalled stamp (CI, issue 18)."""
+reference sensor FAILed R-7.0-12 on one stalled stamp (CI, issue 18).
+
+On a bus of several sensors, a concurrent measurement is followed through its own data
+commands, whatever the recorder said to the other sensors between (issue 23)."""
 
 from __future__ import annotations
 
@@ -12,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from conformance.cli import main
+from conformance.protocol.commands import Kind
 from conformance.replay.recording import read_recording, write_recording
 from conformance.transcript import DUT, EventKind
 
@@ -63,3 +67,88 @@ def test_a_gap_that_recurs_in_every_reply_fails(a_run, tmp_path):
     path = _host_stamped(a_run, tmp_path, stalled_replies=99)
     r = _verdict(path, tmp_path / "judged", "R-7.0-12")
     assert r["verdict"] == "FAIL", r
+
+
+def _heard_bus(tmp_path: Path, address: str | None = None, **kwargs):
+    """The sensor rules' reading of a three-sensor bus recording (tests/support)."""
+    from conformance.offline.heard import hear_sensors
+    from conformance.replay.recording_link import load_recording, parse_recording, recording_port
+    from tests.support.bus_of_sensors import record
+
+    path = record(tmp_path / "bus", **kwargs)
+    link = load_recording(parse_recording(recording_port(path, "jsonl")))
+    return hear_sensors(link, address, None)
+
+
+@pytest.mark.parametrize(
+    ("code", "kind"),
+    [
+        ("C", Kind.CONCURRENT),
+        ("CC", Kind.CONCURRENT),
+        ("HA", Kind.HIGH_VOLUME_ASCII),
+        ("HB", Kind.HIGH_VOLUME_BINARY),
+    ],
+)
+def test_concurrent_measurements_on_a_bus_are_not_disturbed_by_the_other_sensors(
+    tmp_path, code, kind
+):
+    """a<code>! to 0, 1 and 3, then the data of each: the traffic to the others between a
+    sensor's start and its aD0!/aDB0! is what concurrent measurement is for (R-4.4.7-05,
+    R-5.3-01), and the breaks in front of each do not abort it either (decision A4)."""
+    heard = _heard_bus(tmp_path, code=code)
+    concurrent = heard.of_kind(kind)
+    assert [m.command.address for m in concurrent] == ["0", "1", "3"]
+    assert [m.aborted_by for m in concurrent] == [None, None, None]
+    whole = heard.of_kind(kind, whole=True)
+    assert len(whole) == 3 and all(m.count for m in whole)
+    assert all((m.binary_value_count if m.binary else m.value_count) == m.count for m in whole)
+    assert not any("interrupted" in note for note in heard.assumptions), heard.assumptions
+
+
+def test_a_command_to_the_same_sensor_still_sets_its_concurrent_measurement_aside(tmp_path):
+    """0I! after 0C! and before 0D0! aborts sensor 0's measurement (R-4.4.7.1-01): its data
+    rules are not judged on it, the others' are, and the note counts that one."""
+    heard = _heard_bus(tmp_path, meddle={"0": "0I!"})
+    assert [m.aborted_by for m in heard.of_kind(Kind.CONCURRENT)] == ["0I!", None, None]
+    assert [m.command.address for m in heard.of_kind(Kind.CONCURRENT, whole=True)] == ["1", "3"]
+    notes = [n for n in heard.assumptions if "interrupted" in n]
+    assert len(notes) == 1 and notes[0].startswith("1 recorded measurement(s)"), notes
+
+
+def test_an_m_measurement_is_still_disturbed_by_a_command_to_another_sensor():
+    """After aM! and before its service request the recorder talks to no one else
+    (R-4.4.5-06): 1I! there sets 0M!'s wait and data aside, as before."""
+    from conformance.offline.heard import disturbance
+    from conformance.view.rebuilt_records import rebuild_records
+    from conformance.view.segments import read_view
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+
+    bus, recorder = bus_of_sensors("01")
+    m = start(recorder, "0M!")
+    recorder.transact("1I!")
+    recorder.link.wait_until(recorder.link.now() + m.ttt + 0.1)
+    recorder.collect(m, force_break=True)
+    view = read_view(as_heard(bus))
+    (rebuilt,) = rebuild_records(view).measurements
+    assert disturbance(rebuilt, view) == "1I!"
+
+
+def test_the_sensors_on_the_bus_are_known_by_their_first_address():
+    """sensors_on: each answering address once, in address order, identified where an aI!
+    reply was heard; a sensor moved by aAb! (and back) stays one sensor, not two."""
+    from conformance.offline.heard import sensors_on
+    from conformance.view.rebuilt_records import rebuild_records
+    from conformance.view.segments import read_view
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, serial
+
+    bus, recorder = bus_of_sensors("30")
+    recorder.acknowledge("3")
+    recorder.identify("0")
+    assert recorder.change_address("5", "0").ok and recorder.identify("5").ok
+    assert recorder.change_address("0", "5").ok
+    found = sensors_on(rebuild_records(read_view(as_heard(bus))).exchanges)
+    assert [s.address for s in found] == ["0", "3"]
+    zero, three = found
+    assert zero.identity is not None and zero.identity.optional == serial("0")
+    assert zero.claim().version == "14" and zero.reply.startswith("014")
+    assert three.identity is None and three.claim().reply is None  # no aI! heard: nulls

@@ -149,6 +149,8 @@ def test_faulty_run_fails_what_the_fault_breaks(run):
         (lambda d: d["run"]["link"].__setitem__("can_break", "yes"), "a boolean as text"),
         (lambda d: d["dut"].__setitem__("sdi12_version", "14"), "version not dotted"),
         (lambda d: d["tests"][0].__setitem__("duration_s", -1), "negative duration"),
+        (lambda d: d.__setitem__("duts", [{"address": "0"}]), "a bus sensor without its fields"),
+        (lambda d: d.__setitem__("duts", {"0": None}), "the bus sensors not a list"),
     ],
 )
 def test_schema_rejects_a_broken_document(run, break_it, why):
@@ -156,3 +158,10 @@ def test_schema_rejects_a_broken_document(run, break_it, why):
     broken = copy.deepcopy(data)
     break_it(broken)
     assert errors(broken), f"the schema accepted a document where {why}"
+
+
+def test_a_live_run_leaves_the_bus_sensors_out(run):
+    """``duts`` (every sensor on the bus) is a passive run's: a live run drives one DUT, the
+    ``dut`` block's, and its document stays valid without it (Session.bus_sensors)."""
+    _, _, data = run
+    assert "duts" not in data and errors(data) == []

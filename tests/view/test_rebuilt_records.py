@@ -122,3 +122,48 @@ def test_a_record_the_view_reads_otherwise_is_said_not_hidden():
     assert session._as_seen(made, None) is made
     assert session.view_disagreements == 1
     assert any("the view read otherwise" in a for a in session.assumptions)
+
+
+def test_a_concurrent_measurement_keeps_its_data_across_other_sensors_traffic():
+    """Three sensors measure concurrently, interleaved (aC! to each, then the D commands of
+    each): every measurement gets its own address's aD0!/aD1! and all its values, as the
+    engine collected them, although other sensors were addressed between."""
+    from tests.support.bus_of_sensors import ADDRESSES, as_heard, bus_of_sensors, concurrent_round
+
+    bus, recorder = bus_of_sensors()
+    for a in ADDRESSES:
+        recorder.identify(a)
+    written = concurrent_round(recorder)
+    rebuilt = rebuild_records(read_view(as_heard(bus))).measurements
+    assert [m.command.text() for m in rebuilt] == ["0C!", "1C!", "3C!"]
+    for live, found in zip(written, rebuilt, strict=True):
+        assert found.count == live.count == 20 and found.value_count == 20
+        assert [d.text for d in found.data] == [d.text for d in live.data]
+        assert all(d.text[0] == found.command.address for d in found.data)
+        assert found.values == live.values
+
+
+def test_a_command_to_the_same_sensor_ends_a_concurrent_measurements_data():
+    """0I! between 0C! and 0D0! aborts sensor 0's measurement (R-4.4.7.1-01): its records
+    take no data after it, while sensors 1 and 3 keep theirs."""
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, concurrent_round
+
+    bus, recorder = bus_of_sensors()
+    concurrent_round(recorder, meddle={"0": "0I!"})
+    rebuilt = rebuild_records(read_view(as_heard(bus))).measurements
+    assert [len(m.data) for m in rebuilt] == [0, 2, 2]
+
+
+def test_an_m_measurement_still_takes_only_the_very_next_exchange_as_its_data():
+    """After aM! the recorder talks to no one else (R-4.4.5-06): a command to another
+    sensor before 0D0! ends 0M!'s data in the records, as before."""
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+
+    bus, recorder = bus_of_sensors("01")
+    m = start(recorder, "0M!")
+    recorder.transact("1I!")
+    recorder.link.wait_until(recorder.link.now() + m.ttt + 0.1)
+    recorder.collect(m, force_break=True)
+    assert m.data and m.data[0].text == "0D0!"  # on the wire, for a rebuild to take wrongly
+    rebuilt = rebuild_records(read_view(as_heard(bus))).measurements
+    assert [(x.command.text(), len(x.data)) for x in rebuilt] == [("0M!", 0)]

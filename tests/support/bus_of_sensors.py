@@ -1,0 +1,100 @@
+"""A recording of a bus of several sensors, as a monitor or a capture of it would give it.
+
+Clean (or faulty) emulators sit on one :class:`~conformance.sim.bus.SimBus`; the tool
+recorder engine identifies each, starts a concurrent measurement on every one in turn
+(interleaved, as concurrent measurement is meant to be used), waits the longest ttt out and
+then reads each sensor's data with a break in front. The transcript is written with origin
+``bus`` on every event (what a one-wire capture or a listen-only monitor holds), so the
+view infers every direction itself and ``judge`` judges it passively.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+from conformance.emulator.profile import default_profile
+from conformance.emulator.sensor import SensorEmulator
+from conformance.protocol import commands as cmds
+from conformance.replay.recording import write_recording
+from conformance.sim.bus import SimBus, SimLink
+from conformance.tool_recorder import ToolRecorder, validity
+from conformance.tool_recorder.records import Measurement
+from conformance.transcript import BUS, Event, EventKind
+
+ADDRESSES = "013"
+
+
+def serial(address: str) -> str:
+    """The serial number (optional identification field) the sensor at ``address`` gives."""
+    return f"SN000{address}"
+
+
+def bus_of_sensors(
+    addresses: str = ADDRESSES, faults: Mapping[str, Sequence[str]] | None = None
+) -> tuple[SimBus, ToolRecorder]:
+    """A bus with one default-profile emulator per address (``faults``: per address), each
+    with its own serial number so that the identifications differ."""
+    bus = SimBus()
+    for a in addresses:
+        profile = replace(default_profile(), address=a, optional=serial(a))
+        bus.attach(SensorEmulator(profile, (faults or {}).get(a, ()), name=f"sensor-{a}"))
+    return bus, ToolRecorder(SimLink(bus))
+
+
+def start(recorder: ToolRecorder, text: str) -> Measurement:
+    """A measurement started (its reply recorded), its data not yet asked for."""
+    command = cmds.parse_command(text)
+    m = Measurement(command, recorder.transact(command))
+    parsed = validity.parse_start_reply(m.start.reply_text, validity.count_digits(command))
+    assert parsed is not None, m.start.reply_text
+    m.ttt, m.count = parsed
+    m.reply_end = m.start.reply_events[-1].end
+    return m
+
+
+def concurrent_round(
+    recorder: ToolRecorder,
+    addresses: str = ADDRESSES,
+    *,
+    code: str = "C",
+    meddle: Mapping[str, str] | None = None,
+) -> list[Measurement]:
+    """``a<code>!`` to each sensor in turn, then (ttt out) the D commands of each, a break
+    before each sensor's first. ``meddle``: address -> a command sent to that sensor after
+    every measurement was started and before its data (a concurrent abort, R-4.4.7.1-01)."""
+    started = [start(recorder, f"{a}{code}!") for a in addresses]
+    for text in (meddle or {}).values():
+        recorder.transact(text)
+    link = recorder.link
+    ends = [m.reply_end + m.ttt for m in started if m.reply_end is not None and m.ttt]
+    link.wait_until(max([link.now(), *ends]) + 0.1)
+    for m in started:
+        recorder.collect(m, force_break=True)
+    return started
+
+
+def as_heard(bus: SimBus) -> list[Event]:
+    """The bus's events as a capture holds them: origin ``bus``, no notes."""
+    return [replace(e, origin=BUS) for e in bus.transcript.events if e.kind is not EventKind.NOTE]
+
+
+def record(
+    path: Path,
+    addresses: str = ADDRESSES,
+    *,
+    faults: Mapping[str, Sequence[str]] | None = None,
+    code: str = "C",
+    meddle: Mapping[str, str] | None = None,
+) -> Path:
+    """The whole exchange (``aI!`` each, a concurrent round) as ``path``/transcript.jsonl,
+    every event of origin ``bus``; returns the file."""
+    bus, recorder = bus_of_sensors(addresses, faults)
+    for a in addresses:
+        recorder.identify(a)
+    concurrent_round(recorder, addresses, code=code, meddle=meddle)
+    path.mkdir(parents=True, exist_ok=True)
+    out = path / "transcript.jsonl"
+    write_recording(out, as_heard(bus))
+    return out
