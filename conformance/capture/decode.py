@@ -20,6 +20,7 @@ from ..transcript import DUT, TOOL, Event, EventKind
 from .edges import Edges
 from .errors import CaptureError
 from .formats import read_edges, sniff
+from .glitch_filter import DEFAULT_BITS, GlitchFilter
 from .uart import Decoded, Framing, decode
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
@@ -59,6 +60,13 @@ class CaptureDecode:
     #: frames the capture cut (begun before it could tell a start bit, or still running
     #: at its end): dropped, never judged
     partial_frames: int = 0
+    #: the glitch filter's width (s; 0: off), the pulses it removed, and how many of them
+    #: sat beside an edge that stayed (whose stamp is then widened by the width)
+    glitch_filter_s: float = 0.0
+    filtered: int = 0
+    filtered_beside_edges: int = 0
+    #: the plausibility check's refusal, overridden by ``force`` (None: not refused)
+    forced_past: str | None = None
     baud_error_pct: array = field(default_factory=lambda: array("f"))
     problems: list[Decoded] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -110,17 +118,26 @@ def _estimated_baud(prefix: list[int], tick_rate: float) -> float | None:
     return tick_rate / runs[len(runs) // 20]  # a low percentile: one bit, not a glitch
 
 
+@dataclass(frozen=True)
+class DecodeSettings:
+    """How a channel is decoded beyond its format: the line's bit rate and framing, an extra
+    edge error of the analyzer's input (s), the glitch filter's width (s; 0: off) and
+    whether a decode the plausibility check refuses is judged anyway (``force``)."""
+
+    baud: float
+    framing: Framing
+    edge_error: float = 0.0
+    glitch_filter: float = 0.0
+    force: bool = False
+
+
 def _decode_channel(
-    path: str,
-    fmt: str,
-    channel: str | None,
-    invert: bool | None,
-    baud: float,
-    framing: Framing,
-    edge_error: float,
+    path: str, fmt: str, channel: str | None, invert: bool | None, how: DecodeSettings
 ) -> CaptureDecode:
+    baud, framing, edge_error = how.baud, how.framing, how.edge_error
     edges = read_edges(path, channel, fmt)
-    chunks = iter(edges.chunks)
+    glitch = GlitchFilter(how.glitch_filter * edges.tick_rate)
+    chunks = iter(glitch(edges.chunks))
     prefix: list[int] = []
     taken: list[list[int]] = []
     while len(prefix) < PROBE_EDGES and (chunk := next(chunks, None)) is not None:
@@ -165,8 +182,20 @@ def _decode_channel(
         end_tick=edges.end,
     )
     _collect(decoded, out)
-    _check_plausible(out, _estimated_baud(prefix, edges.tick_rate), framing)
+    _filtered(out, glitch, how.glitch_filter)
+    _check_plausible(out, _estimated_baud(prefix, edges.tick_rate), framing, force=how.force)
     return out
+
+
+def _filtered(out: CaptureDecode, glitch: GlitchFilter, width: float) -> None:
+    """What the glitch filter took out, in ``out``; where a removed pulse sat beside an edge
+    that stayed (a chattering transition), that edge is known only to the filter's width,
+    so every stamp is widened by it (a rare case: a clean capture's stamps stay as sampled)."""
+    out.glitch_filter_s, out.filtered = width, glitch.removed
+    out.filtered_beside_edges = glitch.beside_edges
+    if glitch.beside_edges:
+        out.uncertainty_s += width
+        out.events = [replace(e, uncertainty=e.uncertainty + width) for e in out.events]
 
 
 def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
@@ -199,10 +228,14 @@ def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
     out.framing_errors, out.parity_errors = framing_errors, parity_errors
 
 
-def _check_plausible(out: CaptureDecode, est: float | None, framing: Framing) -> None:
+def _check_plausible(
+    out: CaptureDecode, est: float | None, framing: Framing, *, force: bool = False
+) -> None:
     """Refuse a decode that is mostly errors (a wrong bit rate, framing or channel, rather
     than a noisy line: ``est`` is the bit rate the shortest pulses suggest) or holds no
-    event at all, since judging it would only report the user's mistake as the device's."""
+    event at all, since judging it would only report the user's mistake as the device's.
+    ``force``: a decode that is mostly errors is judged anyway, the refusal kept in
+    ``out.forced_past`` for the notes (one with no event at all still cannot be)."""
     path, baud = out.path, out.baud
     # spikes on an idle field cable are noise, not a sign of a wrong bit rate: what tells is
     # frames that do not read, or a capture that is mostly pulses too short for a bit
@@ -213,12 +246,14 @@ def _check_plausible(out: CaptureDecode, est: float | None, framing: Framing) ->
         bad += out.glitches
     if out.chars and bad >= MIN_BAD and bad * 5 >= out.chars and (off or 2 * bad > out.chars):
         hint = f"; the shortest pulses suggest about {est:.0f} baud" if est else ""
-        raise CaptureError(
-            path,
+        why = (
             f"{bad} framing/parity errors and glitches in {out.chars} frames on "
             f"{out.channel!r} at {baud:g} baud {framing}: wrong bit rate, framing or "
-            f"channel?{hint}",
+            f"channel?{hint}"
         )
+        if not force:
+            raise CaptureError(path, why + " (--force judges it anyway)")
+        out.forced_past = why
     if not out.events:
         raise CaptureError(
             path, f"channel {out.channel!r} holds only glitches: no frame or break to decode"
@@ -270,6 +305,8 @@ def decode_capture(
     baud: float = 1200,
     framing: str = "7E1",
     edge_error: float = 0.0,
+    glitch_filter: float | None = None,
+    force: bool = False,
 ) -> CaptureDecode:
     """Decode ``channel`` of the capture at ``path`` (format detected by content).
 
@@ -277,21 +314,30 @@ def decode_capture(
     the recorder's TX on a second channel; its characters on the bus become origin
     :data:`RECORDER_ORIGIN`, all others :data:`SENSOR_ORIGIN` (without it every event is origin
     :data:`BUS`). ``edge_error``: any extra edge position error (s) of the analyzer's input
-    stage, added to the one-sample-period uncertainty."""
+    stage, added to the one-sample-period uncertainty. ``glitch_filter``: pulses shorter than
+    this (s) are removed before decoding (None: 1/16 of a bit, :data:`DEFAULT_BITS`; 0: off).
+    ``force``: judge a decode the plausibility check would refuse (the refusal is kept)."""
     global _LAST
     path = str(path)
+    if glitch_filter is None:
+        glitch_filter = DEFAULT_BITS / baud if baud > 0 else 0.0
     try:
         st = os.stat(path)
         key: tuple | None = (
             os.path.realpath(path), st.st_mtime_ns, st.st_size,
-            channel, tx_channel, invert, baud, framing, edge_error,
+            channel, tx_channel, invert, baud, framing, edge_error, glitch_filter, force,
         )  # fmt: skip
     except OSError:
         key = None  # the decoding below says what is wrong with the file
     if key is not None and _LAST is not None and _LAST[0] == key:
         kept = _LAST[1]
         return replace(kept, events=list(kept.events), notes=list(kept.notes))
-    out = _decode_capture(path, channel, tx_channel, invert, baud, framing, edge_error)
+    try:
+        frame_format = Framing.parse(framing)
+    except ValueError as exc:
+        raise CaptureError(path, str(exc)) from None
+    how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force)
+    out = _decode_capture(path, channel, tx_channel, invert, how)
     if key is not None:
         _LAST = (key, replace(out, events=list(out.events), notes=list(out.notes)))
     return out
@@ -302,25 +348,20 @@ def _decode_capture(
     channel: str | None,
     tx_channel: str | None,
     invert: bool | None,
-    baud: float,
-    framing: str,
-    edge_error: float,
+    how: DecodeSettings,
 ) -> CaptureDecode:
-    try:
-        frame_format = Framing.parse(framing)
-    except ValueError as exc:
-        raise CaptureError(path, str(exc)) from None
+    baud = how.baud
     if baud <= 0:
         raise CaptureError(path, f"baud {baud} is not a bit rate")
     fmt = sniff(path)
     if fmt == "jsonl":
         raise CaptureError(path, "a transcript, not a capture: read it with read_transcript_jsonl")
-    out = _decode_channel(path, fmt, channel, invert, baud, frame_format, edge_error)
+    out = _decode_channel(path, fmt, channel, invert, how)
     if tx_channel is None:
         return out
     if tx_channel == out.channel:
         raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
-    tx = _decode_channel(path, fmt, tx_channel, None, baud, frame_format, edge_error)
+    tx = _decode_channel(path, fmt, tx_channel, None, how)
     out.events, unseen = merge_tx(out.events, tx.events, 0.5 / baud + 2 * out.uncertainty_s)
     out.tx_channel = tx.channel
     out.notes.append(f"TX channel {tx.channel!r}: {tx.polarity} polarity")

@@ -123,7 +123,8 @@ def judge_passively(args: PassiveJob, console: Console) -> int:
 
     port = recording_port(
         args.recording, args.format, channel=args.channel, tx_channel=args.tx_channel,
-        invert=args.invert, baud=args.baud,
+        invert=args.invert, baud=args.baud, glitch_filter_us=args.glitch_filter_us,
+        force=args.force,
     )  # fmt: skip
     try:
         if args.sdi_version:

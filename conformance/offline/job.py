@@ -22,3 +22,5 @@ class PassiveJob:
     invert: bool | None = None  # None: detected
     baud: int = 1200
     strict: bool = False
+    glitch_filter_us: float | None = None  # None: the decoder's default (1/16 bit)
+    force: bool = False  # judge a capture whose decode looks wrong

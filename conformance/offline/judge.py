@@ -124,6 +124,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="the capture has UART levels (marking high); default: detected",
     )
     parser.add_argument("--baud", type=int, default=1200, help="bit rate (default 1200)")
+    parser.add_argument(
+        "--glitch-filter-us",
+        type=float,
+        default=None,
+        metavar="US",
+        help="a capture's pulses shorter than this are removed before decoding, counted in "
+        "the notes (default: 1/16 of a bit, 52 us at 1200 baud; 0: off)",
+    )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="judge a capture whose decode is mostly errors (a wrong bit rate, framing or "
+        "channel, it seems) instead of refusing it; the notes keep why it was refused",
+    )
     parser.add_argument("--report-dir", help="output folder (default: reports/<date>-judge)")
     parser.add_argument("--strict", action="store_true", help="WARN (SHOULD violations) fails")
     parser.add_argument(
@@ -279,9 +293,18 @@ def decode(path: Path, args: argparse.Namespace, tx_channel: str | None = None) 
             tx_channel=tx_channel or args.tx_channel,
             invert=args.invert,
             baud=args.baud,
+            glitch_filter=glitch_filter(args.glitch_filter_us),
+            force=args.force,
         )
     except CaptureError as exc:
         raise JudgeError(str(exc)) from None
+
+
+def glitch_filter(us: float | None) -> float | None:
+    """``--glitch-filter-us`` in seconds (None: the decoder's default)."""
+    if us is not None and us < 0:
+        raise JudgeError(f"--glitch-filter-us {us:g}: a width, 0 or more")
+    return None if us is None else us * 1e-6
 
 
 def describe_decode(decoded: CaptureDecode) -> list[str]:
@@ -299,6 +322,19 @@ def describe_decode(decoded: CaptureDecode) -> list[str]:
             f"{decoded.framing_errors} framing error(s), {decoded.parity_errors} parity "
             f"error(s), {decoded.glitches} glitch(es) in the capture"
         )
+    if decoded.filtered:
+        said.append(
+            f"glitch filter {decoded.glitch_filter_s * 1e6:.0f} us: {decoded.filtered} "
+            "pulse(s) shorter than that removed before decoding (spikes, chattering edges)"
+            + (
+                f"; {decoded.filtered_beside_edges} beside an edge that stayed, whose "
+                f"position is known to the filter's width: stamps widened by it"
+                if decoded.filtered_beside_edges
+                else ""
+            )
+        )
+    if decoded.forced_past:
+        said.append(f"judged although the decode looks wrong (--force): {decoded.forced_past}")
     if decoded.partial_frames:
         said.append(
             f"{decoded.partial_frames} frame(s) the capture cut dropped, not judged (it began "
@@ -369,6 +405,8 @@ def passive_job(
         invert=args.invert,
         baud=args.baud,
         strict=args.strict,
+        glitch_filter_us=args.glitch_filter_us,
+        force=args.force,
     )
 
 

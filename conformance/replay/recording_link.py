@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
 SCHEME = "recording:"
 FORMATS = ("jsonl", "sr", "vcd", "csv")
-_PARAMS = ("format", "channel", "tx-channel", "invert", "baud")
+_PARAMS = ("format", "channel", "tx-channel", "invert", "baud", "glitch-us", "force")
 
 
 def is_recording(port: str) -> bool:
@@ -42,6 +42,8 @@ def recording_port(
     tx_channel: str | None = None,
     invert: bool | None = None,
     baud: int = 1200,
+    glitch_filter_us: float | None = None,
+    force: bool = False,
 ) -> str:
     """The port string naming ``path`` read as ``fmt`` with these decoding options."""
     query = [f"format={fmt}"]
@@ -53,6 +55,10 @@ def recording_port(
         query.append(f"invert={int(invert)}")
     if baud != 1200:
         query.append(f"baud={baud}")
+    if glitch_filter_us is not None:
+        query.append(f"glitch-us={glitch_filter_us:g}")
+    if force:
+        query.append("force=1")
     return f"{SCHEME}{path}?{'&'.join(query)}"
 
 
@@ -64,6 +70,8 @@ class RecordingSpec:
     tx_channel: str | None = None
     invert: bool | None = None
     baud: int = 1200
+    glitch_filter_us: float | None = None  # None: the decoder's default
+    force: bool = False
 
 
 def parse_recording(port: str) -> RecordingSpec:
@@ -89,6 +97,14 @@ def parse_recording(port: str) -> RecordingSpec:
         spec.baud = int(params.get("baud", "1200"))
     except ValueError:
         raise PortError(f"recording baud must be a whole number, not {params['baud']!r}") from None
+    if "glitch-us" in params:
+        try:
+            spec.glitch_filter_us = float(params["glitch-us"])
+        except ValueError:
+            raise PortError(
+                f"recording glitch-us must be a number, not {params['glitch-us']!r}"
+            ) from None
+    spec.force = params.get("force", "0") not in ("0", "false", "no")
     return spec
 
 
@@ -156,6 +172,8 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
             tx_channel=spec.tx_channel,
             invert=spec.invert,
             baud=spec.baud,
+            glitch_filter=None if spec.glitch_filter_us is None else spec.glitch_filter_us * 1e-6,
+            force=spec.force,
         )
     except CaptureError as exc:
         raise PortError(str(exc)) from None

@@ -164,3 +164,13 @@ def test_export_rejects_what_it_cannot_write(tmp_path):
         export_events([], tmp_path / "x.sr")
     with pytest.raises(ValueError, match="1, 10 or 100 units"):
         export_events(some_events(), tmp_path / "x.vcd", sample_rate=3e5)
+
+
+def test_force_judges_a_decode_the_check_would_refuse_and_keeps_why():
+    """``judge --force``: a capture that looks like the wrong bit rate is decoded anyway (a
+    user who knows the bus better than the check), the refusal kept for the notes."""
+    fails(hello(1200), r"--force judges it anyway", baud=9600, framing="8N1")
+    forced = decode_capture(hello(1200), baud=9600, framing="8N1", force=True)
+    assert forced.forced_past is not None and "wrong bit rate" in forced.forced_past
+    assert forced.events  # what decoded is there to judge
+    assert decode_capture(hello(1200), framing="8N1").forced_past is None

@@ -117,8 +117,9 @@ def test_spacing_pulse_is_not_a_break(tmp_path, fmt):
 
 
 def test_glitches_are_reported(tmp_path):
-    # one glitch on idle line, one inside the stop bit... of '0' (its data bits 4, 5 mark)
-    events = [*chars("0", 0.03), brk(0.05, 50e-6), *chars("0", 0.06), *chars("1", 0.08)]
+    # one glitch on idle line, one inside the stop bit... of '0' (its data bits 4, 5 mark);
+    # both longer than the glitch filter's 52 us, so the decoder itself sees them
+    events = [*chars("0", 0.03), brk(0.05, 60e-6), *chars("0", 0.06), *chars("1", 0.08)]
     inside = brk(0.06 + 5.2 * BIT_TIME, 80e-6)  # in frame bit 5, away from its centre
     path = tmp_path / "glitch.sr"
     export_events([*events, inside], path, sample_rate=1e6)
@@ -127,6 +128,13 @@ def test_glitches_are_reported(tmp_path):
     kinds = [(p.kind, p.glitches) for p in d.problems]
     assert kinds == [("glitch", 0), ("char", 1)]
     assert d.glitches == 2 and d.framing_errors == d.parity_errors == 0
+    assert d.filtered == 0
+    # a spike shorter than the filter never reaches the decoder: counted as filtered
+    short = tmp_path / "spike.sr"
+    export_events([*events[:1], brk(0.05, 30e-6), *events[2:]], short, sample_rate=1e6)
+    d = decode_capture(short)
+    assert (d.glitches, d.filtered, d.filtered_beside_edges) == (0, 1, 0)
+    assert [chr(e.wire & 0x7F) for e in d.events] == ["0", "0", "1"]
 
 
 @pytest.mark.parametrize("error", [2.0, -2.0])
