@@ -26,6 +26,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..view.rebuilt_records import rebuild_records
 from ..view.runs import Segment
 from ..view.segments import TranscriptView, read_view
+from .decode_quality import decode_quality, sensor_characters
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3
@@ -197,6 +198,12 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         m.aborted_by = disturbance(m, view)
     cut = sum(1 for m in heard.measurements if m.aborted_by is not None)
     heard.assumptions = recording_notes(link, view)
+    if link.decoded is not None:  # a capture: how well this sensor's own characters read
+        who = f"sensor {address!r}" if address is not None else "the sensor(s)"
+        chars = sensor_characters(heard.exchanges)
+        quality = decode_quality(link.decoded, link.transcript.events, chars, who)
+        if quality is not None:
+            heard.assumptions.append(quality)
     if cut:
         heard.assumptions.append(
             f"{cut} recorded measurement(s) interrupted by the recorder (a command before the "

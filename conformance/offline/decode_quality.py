@@ -1,0 +1,48 @@
+"""How well one sensor's characters decoded from a capture: the figures a reader weighs the
+sensor's verdicts by (issue 23, item 3).
+
+A capture of a field bus holds several sensors, each with its own oscillator and cable: one
+may run 3 % fast while the others are exact, or be the one whose frames break. The decode's
+figures for the whole capture hide that, so each sensor's report gives its own: how many of
+its characters decoded, their bit-rate error (min, median, max), and how many had a parity or
+framing error or a glitch inside. Pure: it reads the decode and the sensor's exchanges.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Iterable
+from typing import Any
+
+from ..tool_recorder.records import Exchange
+from ..transcript import Event, EventKind
+
+
+def sensor_characters(exchanges: Iterable[Exchange]) -> list[Event]:
+    """Every character the sensor sent in ``exchanges``' replies, every attempt's."""
+    return [e for ex in exchanges for a in ex.attempts for e in a.reply_events]
+
+
+def decode_quality(decoded: Any, events: list[Event], chars: list[Event], who: str) -> str | None:
+    """One note on ``chars`` (the sensor's characters among ``events``, the capture's decoded
+    events in order) as ``decoded`` (a :class:`~conformance.capture.decode.CaptureDecode`)
+    read them; None when the sensor sent none."""
+    if not chars:
+        return None
+    rates = decoded.baud_error_pct  # one per character, in the order of the events
+    in_order = [e for e in events if e.kind is EventKind.CHAR]
+    # (a list that does not match the characters one for one tells no character's rate)
+    error = dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
+    broken = {id(p.event): p for p in decoded.problems if p.kind == "char" and p.event is not None}
+    measured = [v for v in (error.get(id(c)) for c in chars) if v is not None and v == v]
+    parity = sum(1 for c in chars if not c.parity_ok)
+    framing = sum(1 for c in chars if id(c) in broken and broken[id(c)].framing_error)
+    glitched = sum(1 for c in chars if id(c) in broken and broken[id(c)].glitches)
+    rate = "bit rate not measurable"
+    if measured:
+        low, mid, high = min(measured), statistics.median(measured), max(measured)
+        rate = f"bit rate {low:+.2f}..{high:+.2f} % off 1200 baud (median {mid:+.2f} %)"
+    return (
+        f"decode quality of {who}: {len(chars)} character(s), {rate}; {parity} with a parity "
+        f"error, {framing} with a framing error, {glitched} with a glitch inside"
+    )

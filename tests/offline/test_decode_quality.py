@@ -1,0 +1,56 @@
+"""Decode quality per sensor (issue 23, item 3): on a capture of two sensors, one of them
+3 % fast, each sensor's report gives its own characters' bit-rate error and errors, so the
+fast one is seen as such beside an exact one."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from conformance.capture import export_events
+from conformance.cli import main
+from conformance.protocol.timing import BIT_TIME
+from conformance.transcript import DUT
+from tests.capture.test_export import brk, chars
+
+
+def _exchange(address: str, start: float, fast_pct: float = 0.0) -> tuple[list, float]:
+    """A break, ``aI!`` and the sensor's reply 9.5 ms after it, the reply at a bit rate
+    ``fast_pct`` % above 1200 baud; the events and where they end."""
+    command = chars(f"{address}I!", start + 0.02)
+    bit = BIT_TIME / (1 + fast_pct / 100)
+    reply = chars(
+        f"{address}14CONFORM EMU001100SN000{address}\r\n", command[-1].end + 9.5e-3, DUT, bit
+    )
+    return [brk(start, 0.013), *command, *reply], reply[-1].end
+
+
+def test_each_sensor_of_a_capture_gets_its_own_decode_figures(tmp_path):
+    first, end = _exchange("0", 0.05)
+    second, _ = _exchange("1", end + 0.1, fast_pct=3.0)
+    capture = tmp_path / "two.sr"
+    export_events([*first, *second], capture, sample_rate=1e6)
+    out = tmp_path / "judged"
+    assert main(["judge", str(capture), "--role", "sensor", "--report-dir", str(out)]) == 1
+    notes = {
+        a: " ".join(
+            json.loads((out / f"sensor-{a}" / "verdicts.json").read_text())["dut"]["assumptions"]
+        )
+        for a in "01"
+    }
+    for a in "01":
+        assert f"decode quality of sensor '{a}'" in notes[a], notes[a]
+    failed = {
+        a: {
+            r["id"]
+            for r in json.loads((out / f"sensor-{a}" / "verdicts.json").read_text())["requirements"]
+            if r["verdict"] == "FAIL"
+        }
+        for a in "01"
+    }
+    assert failed == {"0": set(), "1": {"R-4.1-01"}}  # 3 % fast is outside the bit rate's tolerance
+    median = {a: float(notes[a].split("(median ")[1].split(" %")[0]) for a in "01"}
+    assert median["0"] == pytest.approx(0.0, abs=0.3)
+    assert median["1"] == pytest.approx(3.0, abs=0.3)
+    assert "28 character(s)" in notes["1"] and "0 with a parity error" in notes["1"]
