@@ -370,6 +370,20 @@ def _cut(held: list[Decoded]) -> Iterator[Decoded]:
         yield Decoded("partial", None, d.start, d.end) if d.kind == "char" else d
 
 
+def _cut_by_end(
+    framing_error: bool, stop: float, buf: list[int], end_tick: Callable[[], int | None] | None
+) -> bool:
+    """Whether the last frame of a capture is one the capture cut: its stop bit still low
+    when the edges ran out, or the capture's end before the stop bit's centre, so that bits
+    read as marking were never sampled. Only a reader that knows where the capture ended
+    (a sigrok session's sample count, a VCD's last timestamp) can show the second; one whose
+    end is its last edge (a CSV of transitions) cannot, and its last frame is read."""
+    if framing_error:
+        return True
+    last = end_tick() if end_tick is not None else None
+    return last is not None and bool(buf) and last > buf[-1] and last < stop
+
+
 def _spans(T: float, nbits: int) -> tuple[float, float, float]:
     """The scan's lengths in ticks: half a bit (shorter is a glitch), the stop bit's centre
     (a longer spacing is no frame) and a frame's window (a slow sender's run a little past
@@ -445,7 +459,9 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         elif e is not None and e < end:
             end = e  # the next start bit came first: this stop bit ended there (back to back)
         start = t0 + s / tick_rate
-        if framing_error and e is None and not more:  # the capture ended in its low stop bit
+        if e is None and not more and _cut_by_end(framing_error, stop, buf, line.end_tick):
+            # the capture ended in its low stop bit, or before the stop bit's centre while
+            # the line marked: the bits after the end are unknown, not marking
             yield Decoded("partial", None, start, t0 + end / tick_rate)
             return
         ev = Event(EventKind.CHAR, BUS, start, t0 + end / tick_rate, reading.wire, "", uncertainty)

@@ -110,3 +110,18 @@ def test_a_capture_that_starts_on_an_idle_line_loses_nothing():
     edges = frame_edges(10 * BIT, to_wire_7e1(ord("0")))  # exactly the proving run before it
     (found,) = chars(decode(edges, round(40 * BIT)))
     assert found.event.wire == to_wire_7e1(ord("0"))
+
+
+def test_a_capture_ended_while_a_character_marked_drops_it_too():
+    """The capture stops in a marking data bit of the last frame: with no edge after it the
+    rest would read as marking and make up a character ('0' = 0x30 seen as 0x70, 'p');
+    the reader knows where the capture ends, so the frame is dropped as cut."""
+    edges = frame_edges(START, to_wire_7e1(ord("0")))
+    last = frame_edges(START + 10 * BIT, to_wire_7e1(ord("0")))  # bits 4 and 5 mark
+    end = round(START + 15.5 * BIT)  # inside bit 5, marking, before the stop bit's centre
+    edges += [e for e in last if e < end]
+    found = decode(edges, end)
+    assert [chr(d.event.wire & 0x7F) for d in chars(found)] == ["0"]
+    assert [d.kind for d in found][-1] == "partial"
+    whole = decode(edges + [e for e in last if e >= end], round(START + 40 * BIT))
+    assert [chr(d.event.wire & 0x7F) for d in chars(whole)] == ["0", "0"]  # not cut: read
