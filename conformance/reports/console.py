@@ -298,6 +298,21 @@ def _counts_line(data: dict[str, Any]) -> str:
     return f"{tally}; {_coverage(data)}"
 
 
+def bus_line(data: dict[str, Any]) -> str | None:
+    """On a real link, what the run cost against what it had to cost: the bus-time lower
+    bound (its exchanges at 1200 baud and the waits the device announced), the wall time,
+    and their ratio (issue 22: a bench sees at once whether the tool or the device is slow).
+    None on a virtual clock or a recording, whose time is no one's wall time."""
+    bus = data["run"].get("bus") or {}
+    lower, wall, ratio = bus.get("bus_lower_bound_s"), bus.get("wall_s"), bus.get("efficiency")
+    if not data["run"]["link"].get("bench") or lower is None or not wall:
+        return None
+    return (
+        f"bus time: at least {lower:.1f} s on the wire, {wall:.1f} s wall "
+        f"(efficiency {ratio:.2f})"
+    )
+
+
 def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
     def say(text: str) -> None:
         console.print(text, markup=False, highlight=False, soft_wrap=True)
@@ -312,6 +327,8 @@ def _plain_summary(console: Console, data: dict[str, Any], report_dir: str) -> N
         say(line)
     if data["run"].get("stop_reason"):
         say(f"{_stop_word(data)}: {data['run']['stop_reason']}")
+    if (cost := bus_line(data)) is not None:
+        say(cost)
     say(f"verdict: {verdict_words(data)}")
     _paths(say, report_dir)
 
@@ -358,6 +375,8 @@ def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> No
         console.print(line, markup=False, highlight=False)
     if data["run"].get("stop_reason"):
         console.print(f"{_stop_word(data)}: {data['run']['stop_reason']}", markup=False)
+    if (cost := bus_line(data)) is not None:
+        console.print(cost, markup=False, highlight=False)
     console.print(
         Text.assemble(
             (f" {verdict} ", STYLE.get(verdict, "")),

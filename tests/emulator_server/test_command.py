@@ -249,6 +249,8 @@ def test_clean_emulator_over_rfc2217_has_no_failure(e2e):
     assert link["kind"] == "rfc2217" and link["can_break"] is True
     bus = data["run"]["bus"]
     assert 0 < bus["bus_lower_bound_s"] <= bus["wall_s"]
+    # the run's own cost, printed at its end on every real link (issue 22)
+    assert f"bus time: at least {bus['bus_lower_bound_s']:.1f} s on the wire" in text, text
     # protocol verdicts are definite; timing ones are PASS or honestly INCONCLUSIVE
     assert verdicts["R-4.4.1-01"] == verdicts["R-4.4.6-02"] == "PASS", text
     assert verdicts["R-7.0-10"] in ("PASS", "INCONCLUSIVE"), text

@@ -118,3 +118,17 @@ def test_judged_counts_verdicts_on_the_device_not_na():
 
     line = _coverage(run_once("sim://?version=1.3"))
     assert line.startswith("77 of 106 testable requirements judged, 29 N/A")
+
+
+def test_a_real_link_run_ends_with_its_bus_time_and_efficiency():
+    from conformance.reports.console import bus_line
+
+    bus = {"bus_lower_bound_s": 290.04, "wall_s": 331.2, "efficiency": 0.876}
+    real = {"run": {"bus": bus, "link": {"kind": "rfc2217", "bench": {"echo": False}}}}
+    assert (
+        bus_line(real) == "bus time: at least 290.0 s on the wire, 331.2 s wall (efficiency 0.88)"
+    )
+    sim = {"run": {"bus": {**bus, "wall_s": None}, "link": {"kind": "sim"}}}
+    assert bus_line(sim) is None  # a virtual clock's time is no one's wall time
+    recording = {"run": {"bus": bus, "link": {"kind": "capture sr"}}}
+    assert bus_line(recording) is None
