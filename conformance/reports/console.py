@@ -308,8 +308,7 @@ def bus_line(data: dict[str, Any]) -> str | None:
     if not data["run"]["link"].get("bench") or lower is None or not wall:
         return None
     return (
-        f"bus time: at least {lower:.1f} s on the wire, {wall:.1f} s wall "
-        f"(efficiency {ratio:.2f})"
+        f"bus time: at least {lower:.1f} s on the wire, {wall:.1f} s wall (efficiency {ratio:.2f})"
     )
 
 

@@ -309,3 +309,26 @@ def test_db_command_on_its_own_is_read_as_a_binary_packet():
     master, _ = rig(ScriptedSensor({"0DB0!": [packet]}))
     ex = master.transact("0DB0!")
     assert ex.binary and ex.ok and ex.reply_bytes == packet
+
+
+def test_the_last_dut_character_is_read_on_and_again_after_an_insertion():
+    """The engine asks before every transmission where the DUT's last character ended; it
+    reads the transcript on from where it stopped, and all again when an event went in
+    before that (a served line keeps its transcript in start order)."""
+    from conformance.tool_recorder.engine import _LastDutChar
+    from conformance.transcript import DUT, TOOL, Event, EventKind
+
+    def char(origin: str, start: float) -> Event:
+        return Event(EventKind.CHAR, origin, start, start + 0.008, wire=0x30)
+
+    events = [char(TOOL, 0.0), char(DUT, 0.02)]
+    last = _LastDutChar()
+    assert last.after(events) == pytest.approx(0.028)
+    events += [char(TOOL, 0.05), Event(EventKind.NOTE, TOOL, 0.06, 0.06, text="note")]
+    assert last.after(events) == pytest.approx(0.028)  # nothing of the DUT's since
+    events.append(char(DUT, 0.1))
+    assert last.after(events) == pytest.approx(0.108)
+    events.insert(1, char(DUT, 0.01))  # earlier in the list: the last by position stands
+    events.append(char(TOOL, 0.2))
+    assert last.after(events) == pytest.approx(0.108)
+    assert _LastDutChar().after([char(TOOL, 0.0)]) == float("-inf")
