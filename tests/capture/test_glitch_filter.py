@@ -42,3 +42,46 @@ def test_clean_edges_pass_untouched_and_a_zero_width_is_off():
     edges = [0, 100, 200, 300, 1000]
     assert filtered(edges)[0] == edges and filtered(edges)[1].removed == 0
     assert filtered([0, 1, 2, 3], width=0)[0] == [0, 1, 2, 3]
+
+
+def reference(edges: list[int], width: float) -> tuple[list[int], int, int]:
+    """The filter's rule edge by edge on the whole list at once: what any chunking of the
+    same edges must give."""
+    kept: list[int] = []
+    removed = beside = 0
+    last_removed = float("-inf")
+    for e in edges:
+        if kept and e - kept[-1] < width:
+            kept.pop()
+            removed += 1
+            last_removed = e
+            continue
+        beside += e - last_removed < width
+        last_removed = float("-inf")
+        kept.append(e)
+    return kept, removed, beside
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_any_chunking_gives_the_rule_applied_edge_by_edge(seed):
+    """Random edges (mostly bit-long runs, some spikes and bounces) cut into random chunks:
+    the fast path for chunks without a short pulse and the edge-by-edge path agree with the
+    rule applied to the whole list."""
+    import random
+
+    rng = random.Random(seed)
+    edges, t = [], 0
+    # even seeds: a noisy line (4 edges in 10 a spike or a bounce); odd ones: a clean line
+    # with a rare spike, so that most chunks take the fast path
+    noisy = [1, 2, 5, 9, 833, 833, 1666, 4000, 9, 833]
+    clean = [833] * 30 + [1666] * 10 + [4000] * 5 + [3]
+    for _ in range(rng.randrange(1, 300)):
+        t += rng.choice(clean if seed % 2 else noisy)
+        edges.append(t)
+    cuts = sorted(
+        {*rng.sample(range(1, len(edges) + 1), k=min(len(edges), rng.randrange(1, 20))), len(edges)}
+    )
+    chunks = [edges[a:b] for a, b in zip([0, *cuts], cuts, strict=False)]
+    f = GlitchFilter(10)
+    got = [e for c in f(chunks) for e in c]
+    assert (got, f.removed, f.beside_edges) == reference(edges, 10)
