@@ -109,7 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="a partial run: only cases matching this pytest -k expression (exit 0/1 on "
         "what was selected; the rest is listed as not selected)",
     )
-    add_cli_options(p, ("req",))
+    add_cli_options(p, ("req", "profile"))
     p.add_argument(
         "--baseline",
         metavar="DIR",
@@ -171,6 +171,7 @@ def run_suite(
         # the baseline is read before the run: a bad path is a usage error, not a late one
         baseline_run = load_run(baseline) if baseline else None
         # a folder of this run's own: a new one, or the named one unless a live run holds it
+        own_folder = not options.report_dir
         report_dir = run_folder(options.report_dir, options.role)
         options.report_dir = str(report_dir)
         check_report_dir(report_dir)
@@ -189,7 +190,7 @@ def run_suite(
                 error("interrupted while planning: nothing was sent to the device; no report")
                 return EXIT_INCOMPLETE, None
             GUARD.reset()  # the dry run closed the guard: the run proper starts afresh
-        return _conducted(options, console, baseline, baseline_run, verbose)
+        return _conducted(options, console, baseline, baseline_run, verbose, own_folder)
     finally:
         report_folder.release(report_dir)
 
@@ -232,7 +233,7 @@ def _plan_first(options: RunOptions, report_dir: Path, console: Console) -> None
     from .reports.plan import duration, write_plan
 
     plan = cached_plan(options.role, options.declaration, options.version, options.keyword,
-                     tuple(options.requirements))  # fmt: skip
+                     tuple(options.requirements), options.profile)  # fmt: skip
     if GUARD.requested:
         return  # a plan cut short by Ctrl-C is no plan
     write_plan(report_dir, plan)
@@ -250,8 +251,11 @@ def _conducted(
     baseline: str | None,
     baseline_run: dict | None,
     verbose: bool,
+    own_folder: bool = False,
 ) -> tuple[int, dict | None]:
-    """The suite in this process; the summary and exit code from its own results."""
+    """The suite in this process; the summary and exit code from its own results.
+    ``own_folder``: the run made its folder (no --report-dir), which a production run then
+    names by the sensor's serial number."""
     from .conduct import conduct
     from .selection import resolve
 
@@ -262,6 +266,10 @@ def _conducted(
         plugins.append(ProgressPlugin(console))
     result = conduct(options, verbose=verbose, plugins=plugins)
     report_dir, code, data = result.report_dir, result.pytest_code, result.document
+    if data is not None and options.profile == "production" and own_folder:
+        from .report_folder import named_by_serial
+
+        report_dir = named_by_serial(report_dir, data["dut"].get("serial"), options.role)
     interrupted = GUARD.close()  # the run is over: a later Ctrl-C leaves its report alone
     if interrupted and data is None:
         error("interrupted before the run started; no report written")

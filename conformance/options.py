@@ -221,6 +221,14 @@ OPTIONS: tuple[Option, ...] = (
         check=check_sweep,
     ),
     Option(
+        "profile",
+        "profile",
+        "sensor role: a named short selection instead of the whole suite; production: an "
+        "end-of-line test (identification, address, one measurement of each kind with its "
+        "CRC, the timing windows), its report folder named by the sensor's serial number",
+        choices=("production",),
+    ),
+    Option(
         "req",
         "requirements",
         "a partial run: only cases judging this requirement ID (R-4.4.6-02) or clause "

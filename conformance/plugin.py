@@ -22,6 +22,7 @@ from .offline.fixtures import heard_recorder, heard_sensors  # noqa: F401 - pass
 from .options import UsageError, add_pytest_options, check_values
 from .ports import PortError
 from .preflight import check_report_dir, check_role_options
+from .profiles import PROFILES
 from .recorder.drivers import RecorderSetupError
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .replay.sensor import RecordingEnded
@@ -185,6 +186,21 @@ def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
     config.hook.pytest_deselected(items=other)
 
 
+def keep_profile_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """``--sdi12-profile``: keep the profile's cases (a partial run, said as such)."""
+    run = run_of(config)
+    if run.options.profile is None:
+        return
+    if run.options.role != "sensor":
+        raise pytest.UsageError(f"--profile {run.options.profile} selects sensor cases")
+    profile = PROFILES[run.options.profile]
+    dropped = [i for i in items if _requirements_of(i) and i.name not in profile.cases]
+    items[:] = [i for i in items if i not in dropped]
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+    run.selection.how.append(f"--profile {profile.name}")
+
+
 def keep_selected_requirements(config: pytest.Config, items: list[pytest.Item]) -> None:
     """``--sdi12-req``: keep the cases that judge one of the named requirements."""
     run = run_of(config)
@@ -250,6 +266,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if not any(item.get_closest_marker("requirements") for item in items):
         return  # an ordinary test session
     keep_role_cases(config, items)
+    keep_profile_cases(config, items)
     keep_selected_requirements(config, items)
     check_reports_writable(config)
     if not GUARD.installed:

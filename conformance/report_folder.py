@@ -124,6 +124,23 @@ def held(path: Path) -> Iterator[Path]:
         release(path)
 
 
+def named_by_serial(folder: Path, serial: str | None, kind: str) -> Path:
+    """A finished run's own new folder ``STAMP-kind`` renamed ``STAMP-SERIAL`` (the sensor's
+    serial number from its ``aI!`` reply: a production line's reports found by unit), and
+    its new path; ``folder`` itself when there is no usable serial or the name is taken.
+    The run's lock is let go first: the run is over, and the lock would move with it."""
+    safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in (serial or "").strip())
+    if not safe.strip("._-") or not folder.name.endswith(f"-{kind}"):
+        return folder
+    target = folder.with_name(folder.name[: -len(kind)] + safe)
+    release(folder)
+    try:
+        folder.rename(target)  # refuses an existing non-empty folder: the old name stays
+    except OSError:
+        return folder
+    return target
+
+
 def run_folder(report_dir: str | Path | None, kind: str) -> Path:
     """The folder a run writes into: the one named, or a new one of its own under the
     default reports folder (``kind`` names it: the role, "passive", "monitor")."""

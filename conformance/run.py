@@ -19,6 +19,7 @@ from .judges.timing import recheck, undecide_after_late_line
 from .links.base import BusEnd, Link, LinkError
 from .options import run_option_values
 from .ports import is_sim, open_port
+from .profiles import PROFILES
 from .protocol.version import V14
 from .recorder.scenario_runner import RecorderSession, driver_for
 from .replay.recording import options_note
@@ -45,6 +46,7 @@ class RunOptions:
     requirements: tuple[str, ...] = ()  # --req: requirement IDs or clauses to judge
     keyword: str | None = None  # -k: the cases selected by name
     sweep: str | None = None  # recorder role: tolerance sweeps to run ("reply,wake")
+    profile: str | None = None  # a named selection of the sensor suite (conformance.profiles)
 
     @property
     def timing_uncertainty(self) -> float | None:
@@ -155,6 +157,10 @@ class ConformanceRun:
                 else None,
             )
             self.session = session
+            if self.options.profile is not None:
+                profile = PROFILES[self.options.profile]
+                session.groups = profile.groups
+                session.assumptions.append(profile.note())
             session.discover()
         assert isinstance(self.session, SensorSession)
         return self.session

@@ -36,6 +36,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "catalog",
             "verdicts",
             "selection",
+            "profiles",
             "results",
             "root_causes",
             "coverage",

@@ -21,6 +21,7 @@ from ..declaration import DeclarationError, load_declaration, normalise_version
 from ..emulator.declared import assumptions
 from ..exits import EXIT_OK, EXIT_USAGE, say_error
 from ..options import ROLES
+from ..profiles import PROFILES
 from ..protocol.version import format_version
 from ..reports.plan import build_plan, plan_html, plan_markdown
 
@@ -45,6 +46,7 @@ def plan_parser() -> argparse.ArgumentParser:
     p.add_argument("-k", dest="keyword", help="only cases matching this pytest -k expression")
     p.add_argument("--req", action="append", default=[], metavar="ID_OR_CLAUSE",
                    help="only cases judging this requirement or clause; repeatable")  # fmt: skip
+    p.add_argument("--profile", choices=tuple(PROFILES), help="a named selection (production)")
     p.add_argument("--format", choices=FORMATS, default="markdown", help="default: markdown")
     p.add_argument("-o", "--output", help="write the plan here (default: standard output)")
     return p
@@ -86,6 +88,7 @@ def cached_plan(
     version: str | None = None,
     keyword: str | None = None,
     reqs: tuple[str, ...] = (),
+    profile: str | None = None,
 ) -> dict[str, Any]:
     """:func:`make_plan`, kept on disk: the dry run is deterministic (virtual time), so the
     same code, declaration and selection give the same plan, and a bench that runs the
@@ -94,7 +97,8 @@ def cached_plan(
         load_declaration(declaration)  # a bad file is refused before the cache is read
     key = hashlib.sha256(
         json.dumps(
-            [role, version, keyword, list(reqs), declaration and str(Path(declaration).resolve()),
+            [role, version, keyword, list(reqs), profile,
+             declaration and str(Path(declaration).resolve()),
              declaration and hashlib.sha256(Path(declaration).read_bytes()).hexdigest(),
              _code_digest()]
         ).encode()
@@ -104,7 +108,7 @@ def cached_plan(
         return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         pass
-    plan = make_plan(role, declaration, version, keyword, reqs)
+    plan = make_plan(role, declaration, version, keyword, reqs, profile)
     from ..interrupts import GUARD
 
     if not GUARD.requested:  # a dry run cut short by Ctrl-C is kept nowhere
@@ -124,6 +128,7 @@ def make_plan(
     version: str | None = None,
     keyword: str | None = None,
     reqs: tuple[str, ...] = (),
+    profile: str | None = None,
 ) -> dict[str, Any]:
     """Dry-run the suite and build its plan (:class:`DeclarationError` for a bad file)."""
     from ..conduct import NoVerdicts, run_into
@@ -137,6 +142,7 @@ def make_plan(
         "version": format_version(digits) if digits else None,
         "keyword": keyword or None,
         "requirements": tuple(reqs),
+        "profile": profile,
     }
     with tempfile.TemporaryDirectory(prefix="sdi12-plan-") as tmp:
         try:
@@ -154,6 +160,8 @@ def make_plan(
     elif declared is None:
         said = ["no declaration: timed on the reference sensor's profile"]
     selection = {"k": keyword, "req": list(reqs)} if keyword or reqs else None
+    if profile:
+        selection = (selection or {"k": None, "req": []}) | {"profile": profile}
     return build_plan(
         dry,
         role=role,
@@ -168,7 +176,7 @@ def plan_main(argv: list[str]) -> int:
     args = plan_parser().parse_args(argv)
     try:
         plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
-                         tuple(args.req))  # fmt: skip
+                         tuple(args.req), args.profile)  # fmt: skip
     except (DeclarationError, PlanError) as exc:
         say_error(f"error: {exc}")
         return EXIT_USAGE

@@ -374,6 +374,7 @@ def replay_options(recording: Recording, args: argparse.Namespace) -> RunOptions
         for key in (
             "address", "version", "declaration", "timing_uncertainty_ms", "keyword",
             "sweep",  # a swept run's steps are in its recording: replayed too
+            "profile",  # a production run's selection and the groups it tried
             "job_timeout",  # the budgets its scenario notes state
         )
         if saved.get(key) is not None

@@ -158,6 +158,8 @@ class SensorSession(Session):
         self.address_notes: list[str] = []  # what every address change left behind
         self._cache: dict[Any, Any] = {}
         self.view_disagreements = 0  # stimuli whose view record differed (see _as_seen)
+        #: the measurement codes a family may be tried with (None: all; a profile's groups)
+        self.groups: frozenset[str] | None = None
 
     # -- discovery ----------------------------------------------------------------------------
     def discover(self) -> None:
@@ -584,8 +586,15 @@ class SensorSession(Session):
         return m, poke
 
     def family(self, codes: tuple[str, ...]) -> list[Measurement]:
-        """Cached measurements for every command code of a family (``M_FAMILY``...)."""
-        return [self.measurement(code) for code in codes]
+        """Cached measurements for every command code of a family (``M_FAMILY``...); under a
+        profile that limits the groups tried (``groups``), for those codes only."""
+        return [self.measurement(code) for code in self.tried(codes)]
+
+    def tried(self, codes: tuple[str, ...]) -> tuple[str, ...]:
+        """``codes``, or those of them a profile lets the run try (``groups``)."""
+        if self.groups is None:
+            return codes
+        return tuple(c for c in codes if c in self.groups)
 
     def defined(self, codes: tuple[str, ...]) -> list[Measurement]:
         """The measurements of ``codes`` that announced at least one value."""
@@ -602,7 +611,7 @@ class SensorSession(Session):
     def check_declared_counts(self, codes: tuple[str, ...]) -> list[str]:
         """Where the sensor announces another count than declared: noted for the report."""
         notes = []
-        for code in codes:
+        for code in self.tried(codes):
             want = self.declared_count(code)
             got = self.measurement(code).count
             if want is not None and got != want:
