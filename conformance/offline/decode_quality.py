@@ -33,15 +33,22 @@ def decode_quality(decoded: Any, events: list[Event], chars: list[Event], who: s
     in_order = [e for e in events if e.kind is EventKind.CHAR]
     # (a list that does not match the characters one for one tells no character's rate)
     error = dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
-    broken = {id(p.event): p for p in decoded.problems if p.kind == "char" and p.event is not None}
+    # by start and byte, not identity: a decode that widened its stamps (the glitch filter
+    # beside an edge) holds new events, its problems the ones it first read
+    broken = {
+        (p.event.start, p.event.wire): p
+        for p in decoded.problems
+        if p.kind == "char" and p.event is not None
+    }
     measured = [v for v in (error.get(id(c)) for c in chars) if v is not None and v == v]
     parity = sum(1 for c in chars if not c.parity_ok)
-    framing = sum(1 for c in chars if id(c) in broken and broken[id(c)].framing_error)
-    glitched = sum(1 for c in chars if id(c) in broken and broken[id(c)].glitches)
+    flagged = [broken[(c.start, c.wire)] for c in chars if (c.start, c.wire) in broken]
+    framing = sum(1 for d in flagged if d.framing_error)
+    glitched = sum(1 for d in flagged if d.glitches)
     rate = "bit rate not measurable"
     if measured:
         low, mid, high = min(measured), statistics.median(measured), max(measured)
-        rate = f"bit rate {low:+.2f}..{high:+.2f} % off 1200 baud (median {mid:+.2f} %)"
+        rate = f"bit rate {low:+.2f}..{high:+.2f} % off {decoded.baud:g} baud (median {mid:+.2f} %)"
     return (
         f"decode quality of {who}: {len(chars)} character(s), {rate}; {parity} with a parity "
         f"error, {framing} with a framing error, {glitched} with a glitch inside"

@@ -54,3 +54,22 @@ def test_each_sensor_of_a_capture_gets_its_own_decode_figures(tmp_path):
     assert median["0"] == pytest.approx(0.0, abs=0.3)
     assert median["1"] == pytest.approx(3.0, abs=0.3)
     assert "28 character(s)" in notes["1"] and "0 with a parity error" in notes["1"]
+
+
+def test_a_sensor_s_framing_errors_are_counted_on_widened_or_merged_events():
+    """A decode that widened its stamps (the glitch filter beside an edge) or merged a TX
+    channel holds new event objects; its problems still name the characters they are of."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from conformance.capture.uart import Decoded
+    from conformance.offline.decode_quality import decode_quality
+    from conformance.transcript import BUS, Event, EventKind
+
+    first = [Event(EventKind.CHAR, BUS, t, t + 0.00833, wire=0x30) for t in (1.0, 1.01, 1.02)]
+    problems = [Decoded("char", first[1], first[1].start, first[1].end, True)]  # framing error
+    events = [replace(e, uncertainty=5.2e-5) for e in first]  # widened: other objects
+    decoded = SimpleNamespace(baud_error_pct=[0.0, 0.5, -0.5], problems=problems, baud=1200)
+    said = decode_quality(decoded, events, events[1:], "sensor '0'")
+    assert said is not None and "2 character(s)" in said and "1 with a framing error" in said
+    assert "bit rate -0.50..+0.50 % off 1200 baud (median +0.00 %)" in said, said
