@@ -200,8 +200,12 @@ def test_uart_break_records_the_duration_it_held():
     try:
         event = link.send_break(13e-3)
         assert event.kind is EventKind.BREAK
-        assert 13e-3 <= event.duration < 16e-3
-        assert "break_condition" in event.text and "held" in event.text
+        # what was held, not what was asked: at least 13 ms, and an overshoot of the host's
+        # timer (3.4 ms once on a loaded CI machine, beyond the old fixed 16 ms bound) within
+        # the uncertainty the link states for a host-timed break
+        assert 13e-3 <= event.duration <= 13e-3 + event.uncertainty, event
+        assert f"held {event.duration * 1e3:.2f} ms" in event.text, event.text
+        assert "break_condition" in event.text
     finally:
         link.close()
         os.close(controller)
