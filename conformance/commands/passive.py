@@ -39,13 +39,13 @@ ROLES = ("sensor", "recorder")
 def no_traffic(port: str) -> str | None:
     """Why the recording holds nothing to judge (None: it holds SDI-12 traffic)."""
     from ..offline.fixtures import recording_of
-    from ..view.segments import read_view
+    from ..offline.heard import heard_records
 
     link = recording_of(port)
     events = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]
     chars = [e for e in events if e.kind is EventKind.CHAR]
     breaks = [e for e in events if e.kind is EventKind.BREAK]
-    view = read_view(events)
+    view, _rebuilt = heard_records(link)  # the cut every later step reads (notes left out)
     commands = [t.command for t in view.transmissions if t.command is not None]
     # any text ending in '!' parses as an extended command: alone it is no sign of SDI-12
     if any(c.kind is not Kind.EXTENDED for c in commands) or (commands and breaks):
@@ -90,13 +90,9 @@ def sensors_heard(port: str) -> list[str]:
     """The addresses of the sensors the recording shows replies from, in address order
     (a sensor moved by ``aAb!`` counted once, at its first address)."""
     from ..offline.fixtures import recording_of
-    from ..offline.heard import sensors_on
-    from ..view.rebuilt_records import rebuild_records
-    from ..view.segments import read_view
+    from ..offline.heard import heard_records, sensors_on
 
-    link = recording_of(port)
-    view = read_view(link.transcript.events)
-    rebuilt = rebuild_records(view, uncertainty=link.uncertainty)
+    _view, rebuilt = heard_records(recording_of(port))
     return [s.address for s in sensors_on(rebuilt.exchanges)]
 
 

@@ -23,9 +23,9 @@ from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..replay.recording_link import RecordingLink
 from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
-from ..view.rebuilt_records import rebuild_records
+from ..view.rebuilt_records import Rebuilt, rebuild_records
 from ..view.runs import Segment
-from ..view.segments import TranscriptView, read_view
+from ..view.segments import TranscriptView, memo, read_view
 from .decode_quality import decode_quality, sensor_characters
 
 #: ambiguity reasons quoted in the notes (the count is always given)
@@ -69,6 +69,11 @@ class Heard(Session):
     identity: Identification | None = None
     ident_exchange: Exchange | None = None
     address_notes: list[str] = field(default_factory=list)
+    #: every sensor on the bus (``--address`` or not), for ``verdicts.json``'s ``duts``
+    on_bus: list[BusSensor] = field(default_factory=list)
+
+    def bus_sensors(self) -> list[tuple[str, DutClaim]]:
+        return [(s.address, s.claim()) for s in self.on_bus]
 
     @property
     def uncertainty(self) -> float:
@@ -145,11 +150,6 @@ class HeardSensors(Heard):
     exchanges: list[Exchange] = field(default_factory=list)
     measurements: list[Measurement] = field(default_factory=list)
     segments: list[Segment] = field(default_factory=list)
-    #: every sensor on the bus (``--address`` or not), for ``verdicts.json``'s ``duts``
-    on_bus: list[BusSensor] = field(default_factory=list)
-
-    def bus_sensors(self) -> list[tuple[str, DutClaim]]:
-        return [(s.address, s.claim()) for s in self.on_bus]
 
     def of_kind(self, *kinds: Kind, whole: bool = False) -> list[Measurement]:
         """The recorded measurements of ``kinds``; ``whole``: only those the recorder let
@@ -171,10 +171,18 @@ class HeardSensors(Heard):
 class HeardRecorder(Heard):
     """The recorder rules read the whole bus (``--address`` does not narrow them)."""
 
-    on_bus: list[BusSensor] = field(default_factory=list)
 
-    def bus_sensors(self) -> list[tuple[str, DutClaim]]:
-        return [(s.address, s.claim()) for s in self.on_bus]
+def heard_records(link: RecordingLink) -> tuple[TranscriptView, Rebuilt]:
+    """The recording's view and the records rebuilt from it, cut once per loaded recording:
+    the count of sensors on it, each sensor's run and the recorder's read the same (cut
+    again for each, an hour's capture cost seconds a run, N + 2 times for N sensors). Kept
+    while the transcript keeps its length (a recording only grows while it is read)."""
+
+    def cut() -> tuple[TranscriptView, Rebuilt]:
+        view = read_view(link.transcript.events)
+        return view, rebuild_records(view, uncertainty=link.uncertainty)
+
+    return memo(link, "_heard_records", len(link.transcript.events), cut)
 
 
 def _mine(address: str | None, text: str) -> bool:
@@ -182,8 +190,7 @@ def _mine(address: str | None, text: str) -> bool:
 
 
 def hear_sensors(link: RecordingLink, address: str | None, version: str | None) -> HeardSensors:
-    view = read_view(link.transcript.events)
-    rebuilt = rebuild_records(view, uncertainty=link.uncertainty)
+    view, rebuilt = heard_records(link)
     heard = HeardSensors(
         link,
         view,
@@ -298,12 +305,12 @@ def _identify(heard: HeardSensors) -> None:
 
 
 def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
-    view = read_view(link.transcript.events)
+    view, rebuilt = heard_records(link)
     heard = HeardRecorder(
         link,
         view,
         forced_version=normalise_version(version) if version else None,
-        on_bus=sensors_on(rebuild_records(view, uncertainty=link.uncertainty).exchanges),
+        on_bus=sensors_on(rebuilt.exchanges),
     )
     heard.assumptions = recording_notes(link, view)
     if heard.forced_version is None:

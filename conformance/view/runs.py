@@ -24,7 +24,7 @@ from ..protocol.commands import Kind
 from ..protocol.framing import ETX, LF, STX
 from ..protocol.timing import NO_BREAK_WINDOW
 from ..transcript import Event, Transcript, decode_8n1
-from .segments import IsRecorder, Transmission, _memo, read_view
+from .segments import IsRecorder, Transmission, memo, read_view
 
 T = TypeVar("T")
 
@@ -112,7 +112,7 @@ class Segments(list[Segment]):
     def derived(self, name: str, key: object, build: Callable[[], T]) -> T:
         """``build()``, kept under ``name`` while ``key`` (and the list's length) stays the
         same."""
-        return _memo(self, name, (len(self), key), build)
+        return memo(self, name, (len(self), key), build)
 
 
 def segments(events: Iterable[Event], is_recorder: IsRecorder | None = None) -> Segments:
@@ -124,7 +124,7 @@ def transcript_segments(transcript: Transcript) -> Segments:
     """:func:`segments` of a run's whole transcript, cut once per length (a transcript is
     append-only): the whole-run cases and the report's timing diagrams read the same cut."""
     events = transcript.events
-    return _memo(transcript, "_segments", len(events), lambda: segments(events))
+    return memo(transcript, "_segments", len(events), lambda: segments(events))
 
 
 def runs(events: list[Event], gap: float = RUN_GAP) -> list[list[Event]]:

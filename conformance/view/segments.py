@@ -71,7 +71,7 @@ class Transmission:
     def text(self) -> str:
         # asked for tens of times per transmission by the judges: decoded once per length
         # (characters are only ever appended while the view is cut)
-        return _memo(self, "_text", len(self.chars), lambda: decode_7e1(self.chars))
+        return memo(self, "_text", len(self.chars), lambda: decode_7e1(self.chars))
 
     @property
     def address(self) -> str:
@@ -248,9 +248,7 @@ class TranscriptView:
         """A derived index, built once per view (a field recording holds tens of thousands of
         transmissions; scanning the line per question made judging quadratic). Rebuilt if the
         view gained events since."""
-        return _memo(
-            self, name, (len(self.chars), len(self.breaks), len(self.transmissions)), build
-        )
+        return memo(self, name, (len(self.chars), len(self.breaks), len(self.transmissions)), build)
 
     def last_break_before(self, t: Transmission) -> Event | None:
         before = [b for b in self.breaks if b.end <= t.start]
@@ -417,7 +415,7 @@ def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:
     )
 
 
-def _memo(owner: object, name: str, key: object, build: Callable[[], T]) -> T:
+def memo(owner: object, name: str, key: object, build: Callable[[], T]) -> T:
     """``build()``, kept in ``owner`` under ``name`` while ``key`` (the sizes it was built
     from: the view only ever grows while it is cut) stays the same."""
     cached = owner.__dict__.get(name)
