@@ -245,6 +245,13 @@ def _plan_first(options: RunOptions, report_dir: Path, console: Console) -> None
     )
 
 
+def _folder_by_serial(profile: str | None) -> bool:
+    """Whether the run's profile names its own folder by the sensor's serial number."""
+    from .profiles import PROFILES
+
+    return profile is not None and PROFILES[profile].folder_by_serial
+
+
 def _conducted(
     options: RunOptions,
     console: Console,
@@ -254,8 +261,8 @@ def _conducted(
     own_folder: bool = False,
 ) -> tuple[int, dict | None]:
     """The suite in this process; the summary and exit code from its own results.
-    ``own_folder``: the run made its folder (no --report-dir), which a production run then
-    names by the sensor's serial number."""
+    ``own_folder``: the run made its folder (no --report-dir), which a profile such as
+    production then names by the sensor's serial number."""
     from .conduct import conduct
     from .selection import resolve
 
@@ -266,7 +273,7 @@ def _conducted(
         plugins.append(ProgressPlugin(console))
     result = conduct(options, verbose=verbose, plugins=plugins)
     report_dir, code, data = result.report_dir, result.pytest_code, result.document
-    if data is not None and options.profile == "production" and own_folder:
+    if data is not None and own_folder and _folder_by_serial(options.profile):
         from .report_folder import named_by_serial
 
         report_dir = named_by_serial(report_dir, data["dut"].get("serial"), options.role)

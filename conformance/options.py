@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .declaration import address_problem
+from .profiles import PROFILES
 
 ROLES = ("sensor", "recorder")
 
@@ -226,7 +227,7 @@ OPTIONS: tuple[Option, ...] = (
         "sensor role: a named short selection instead of the whole suite; production: an "
         "end-of-line test (identification, address, one measurement of each kind with its "
         "CRC, the timing windows), its report folder named by the sensor's serial number",
-        choices=("production",),
+        choices=tuple(PROFILES),
     ),
     Option(
         "req",

@@ -25,6 +25,8 @@ class Profile:
     about: str
     cases: tuple[str, ...]
     groups: frozenset[str]
+    #: a run's own folder is named by the sensor's serial number (a unit's report found)
+    folder_by_serial: bool = False
 
     def note(self) -> str:
         """What the report says about the profile's stimuli."""
@@ -55,6 +57,7 @@ PRODUCTION = Profile(
         "test_reply_framing",
     ),
     groups=frozenset(("M", "MC", "C", "CC")),
+    folder_by_serial=True,
 )
 
 PROFILES: dict[str, Profile] = {p.name: p for p in (PRODUCTION,)}

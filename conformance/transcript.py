@@ -36,6 +36,7 @@ COLLISION = "collision"
 
 #: even parity of every 7-bit character (a table: every received character is checked)
 _PARITY = tuple(bin(c).count("1") & 1 for c in range(0x80))
+_CHR7 = tuple(chr(c) for c in range(0x80))  # a 7-bit character's text, looked up
 
 
 def parity_bit(char7: int) -> int:
@@ -123,12 +124,18 @@ def text_end(events: list[Event], text: str) -> float | None:
     return None
 
 
-_CHR7 = tuple(chr(c) for c in range(0x80))
+class _Escapes(dict):
+    """How :func:`escape` shows each character (str.translate: one pass in C), down to the
+    ones past Latin-1 it makes up as asked."""
+
+    def __missing__(self, code: int) -> str:
+        return f"<0x{code:02X}>"
+
+
 _NAMES = {"\r": "<CR>", "\n": "<LF>", "\x02": "<STX>", "\x03": "<ETX>"}
-#: how :func:`escape` shows every character it can meet (str.translate: one pass in C)
-_ESCAPES = {
-    c: _NAMES.get(chr(c), chr(c) if 0x20 <= c <= 0x7E else f"<0x{c:02X}>") for c in range(0x100)
-}
+_ESCAPES = _Escapes(
+    {c: _NAMES.get(chr(c), chr(c) if 0x20 <= c <= 0x7E else f"<0x{c:02X}>") for c in range(0x100)}
+)
 
 
 def escape(data: str | bytes) -> str:
@@ -137,10 +144,7 @@ def escape(data: str | bytes) -> str:
         data = data.decode("latin-1")
     if data.isascii() and data.isprintable():
         return data
-    out = data.translate(_ESCAPES)
-    if out.isascii():
-        return out
-    return "".join(_ESCAPES.get(ord(c)) or f"<0x{ord(c):02X}>" for c in out)
+    return data.translate(_ESCAPES)
 
 
 @dataclass
