@@ -133,8 +133,14 @@ class RecordingLink(BusEnd):
         return self.decoded is None and self.uncertainty > 0
 
     def now(self) -> float:
+        """The recording's last moment: asked once per case and per report, and an hour's
+        capture holds 10^6 events, so it is kept while the transcript keeps its length."""
         events = self.transcript.events
-        return max((e.end for e in events), default=0.0)
+        kept = self.__dict__.get("_latest_end")
+        if kept is None or kept[0] != len(events):
+            kept = (len(events), max((e.end for e in events), default=0.0))
+            self.__dict__["_latest_end"] = kept
+        return kept[1]
 
     def timing_uncertainty(self) -> float:
         return max(self.uncertainty, self.widened)

@@ -29,9 +29,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..results import CaseRecord
-from ..transcript import Event, EventKind
+from ..transcript import Event, EventKind, Transcript
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, segments
+from ..view.segments import memo
 
 #: the verdicts a reader must be able to check against the wire
 NEEDS_EVIDENCE = (Verdict.FAIL, Verdict.WARN, Verdict.INCONCLUSIVE)
@@ -196,9 +197,18 @@ class Locator:
         return self._ref(own or [self.events[i] for i in attached], None, "case")
 
 
-def wire_refs(cases: Sequence[CaseRecord], events: Sequence[Event]) -> dict[int, WireRef]:
+def locator_of(transcript: Transcript) -> Locator:
+    """The one locator of a transcript, shared by every report that places findings on it
+    (verdicts.json and report.html, and each run of a passive judgement, which all read the
+    one loaded recording): a cut of an hour's capture takes seconds, and each report made
+    its own, 2 per run and 11 runs for a bus of ten sensors. Its cuts stay true as the
+    transcript grows, since a transcript is append-only."""
+    return memo(transcript, "_locator", None, lambda: Locator(transcript.events))
+
+
+def wire_refs(cases: Sequence[CaseRecord], transcript: Transcript) -> dict[int, WireRef]:
     """``id(finding)`` -> its reference, for every finding that needs evidence."""
-    locator = Locator(events)
+    locator = locator_of(transcript)
     found: dict[int, WireRef] = {}
     for record in cases:
         for f in record.findings:

@@ -26,7 +26,7 @@ from ..stash import CASE
 from ..transcript import TOOL, Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
-from .evidence import NEEDS_EVIDENCE, Locator, WireRef
+from .evidence import NEEDS_EVIDENCE, WireRef, locator_of
 from .margins import margins_html
 from .plan import plan_section, read_plan
 from .sweep_chart import section as sweep_section
@@ -593,7 +593,6 @@ class HtmlReportPlugin:
 
     def __init__(self, run: ConformanceRun) -> None:
         self.run = run
-        self._locator: Locator | None = None
 
     def pytest_html_report_title(self, report: Any) -> None:
         report.title = f"SDI-12 conformance report ({self.run.options.role})"
@@ -645,12 +644,11 @@ class HtmlReportPlugin:
         if self.run.link is None:
             return ""
         events = self.run.link.transcript.events
-        if self._locator is None or self._locator.events is not events:
-            self._locator = Locator(events)
+        locator = locator_of(self.run.link.transcript)
         grouped: dict[WireRef, list[Finding]] = {}
         for f in record.findings:
             if f.verdict in NEEDS_EVIDENCE:
-                ref = self._locator.locate(f, record)
+                ref = locator.locate(f, record)
                 if ref is not None:
                     grouped.setdefault(ref, []).append(f)
         timing = is_timing_case(record)

@@ -13,6 +13,7 @@ DUT goes through :func:`html.escape`: the device is untrusted (design.md 7).
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from html import escape
@@ -512,6 +513,38 @@ def _measures(seg: Segment) -> list[float]:
     return out
 
 
+class MeasureIndex:
+    """Every interval of a cut's segments (:func:`_measures`), sorted, with the segment it
+    was measured in: a whole-run case asks for the segment nearest its worst value, and an
+    hour's recording holds 10^5 segments, scanned whole for each timing case before."""
+
+    def __init__(self, cut: Sequence[Segment] = (), *, measures: Iterable[list[float]] = ()):
+        """``measures``: each segment's intervals, given instead of ``cut`` (for tests)."""
+        per_segment = [_measures(seg) for seg in cut] if cut else list(measures)
+        pairs = sorted((m, i) for i, ms in enumerate(per_segment) for m in ms)
+        self.values = [m for m, _ in pairs]
+        self.owners = [i for _, i in pairs]
+
+    def nearest(self, target: float) -> int | None:
+        """The first segment (in recording order) holding an interval nearest ``target``:
+        the one a scan of every segment's intervals in order would pick."""
+        values = self.values
+        if not values:
+            return None
+        at = bisect_left(values, target)
+        distance = min(abs(values[i] - target) for i in (at - 1, at) if 0 <= i < len(values))
+        near: list[int] = []
+        i = at - 1  # equally near, below: values equal to one another sort by segment
+        while i >= 0 and abs(values[i] - target) == distance:
+            near.append(self.owners[i])
+            i -= 1
+        i = at
+        while i < len(values) and abs(values[i] - target) == distance:
+            near.append(self.owners[i])
+            i += 1
+        return min(near)
+
+
 def exchange_behind(
     findings: Sequence[Finding], events: Sequence[Event] | Transcript
 ) -> tuple[str, list[Event]] | None:
@@ -526,14 +559,16 @@ def exchange_behind(
     if not timed or not len(events):
         return None
     target = max(timed, key=lambda f: f.verdict.rank)
-    cut = transcript_segments(events) if isinstance(events, Transcript) else segments(events)
-    best, distance = None, float("inf")
-    for seg in cut:
-        for m in _measures(seg):
-            if abs(m - target.measured_ms) < distance:
-                best, distance = seg, abs(m - target.measured_ms)
-    if best is None:
+    if isinstance(events, Transcript):
+        cut = transcript_segments(events)
+        index = cut.derived("measure_index", None, lambda: MeasureIndex(cut))
+    else:
+        cut = segments(events)
+        index = MeasureIndex(cut)
+    found = index.nearest(target.measured_ms)
+    if found is None:
         return None
+    best = cut[found]
     drawn = [best.break_event] if best.break_event else []
     drawn += best.command + best.reply + best.later[:80]
     label = (

@@ -255,7 +255,11 @@ class TranscriptView:
         return before[-1] if before else None
 
     def service_requests(self) -> list[ServiceRequest]:
-        """Every ``a<CR><LF>`` the sensors sent after a reply, in order."""
+        """Every ``a<CR><LF>`` the sensors sent after a reply, in order (found once per view:
+        each run of a passive judgement asks it of the one recording's view)."""
+        return list(self._sorted("_service_requests", self._find_service_requests))
+
+    def _find_service_requests(self) -> list[ServiceRequest]:
         found = []
         for t in self.transmissions:
             after = t.after
@@ -271,7 +275,11 @@ class TranscriptView:
         return found
 
     def ambiguities(self) -> list[Ambiguity]:
-        """Every split the view had to make that the wire alone does not settle."""
+        """Every split the view had to make that the wire alone does not settle (found once
+        per view, as :meth:`service_requests`)."""
+        return list(self._sorted("_ambiguities", self._find_ambiguities))
+
+    def _find_ambiguities(self) -> list[Ambiguity]:
         found: list[Ambiguity] = []
         for e in self.undirected:
             found.append(Ambiguity("direction unknown: no protocol cue", e.start, (e,)))

@@ -1,0 +1,32 @@
+"""The index that finds the exchange behind a whole-run timing finding picks what a scan of
+every segment's intervals, in recording order, would pick (the first segment nearest)."""
+
+from __future__ import annotations
+
+from hypothesis import given
+from hypothesis import strategies as st
+
+from conformance.reports.timing_diagram import MeasureIndex
+
+# few distinct values, so that ties (equal values, equal distances either side) are common
+value = st.sampled_from([-2.5, 0.0, 1.0, 7.5, 8.33, 9.0, 10.5, 15.4, 16.0])
+
+
+def scan(per_segment: list[list[float]], target: float) -> int | None:
+    """The scan the index replaces: the first segment whose interval is nearest."""
+    best, distance = None, float("inf")
+    for i, measures in enumerate(per_segment):
+        for m in measures:
+            if abs(m - target) < distance:
+                best, distance = i, abs(m - target)
+    return best
+
+
+@given(st.lists(st.lists(value, max_size=4), max_size=12), st.floats(-5, 20) | value)
+def test_the_index_picks_what_a_scan_picks(per_segment: list[list[float]], target: float):
+    assert MeasureIndex(measures=per_segment).nearest(target) == scan(per_segment, target)
+
+
+def test_no_interval_no_segment():
+    assert MeasureIndex(measures=[[], []]).nearest(8.0) is None
+    assert MeasureIndex(measures=[[], [9.0]]).nearest(8.0) == 1
