@@ -692,6 +692,12 @@ def _dispatch(argv: list[str]) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:
             return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
+        from .options import is_bus
+
+        if is_bus(args.address):  # several sensors on the line: conformance.commands.bus
+            from .commands.bus import run_bus
+
+            return run_bus(options_from_args(args), console, verbose=args.verbose)
         code, _ = run_suite(
             options_from_args(args),
             console,

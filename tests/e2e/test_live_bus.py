@@ -1,0 +1,142 @@
+"""Several DUTs on one port, live (issue 23, item 2): ``--address 0,1,3`` / ``--address all``
+on ``sim://?sensors=...``, each sensor judged in its own folder, then the bus cases.
+
+(i) A clean three-sensor bus: every sensor COMPLIANT with both bus cases PASSing, ``duts``
+naming all three, ``?!`` never sent. (ii) The bus fault matrix: each bus fault on sensor 1 FAILs
+exactly its requirements in sensor 1's folder, the bus case FAILing among them, and the clean
+neighbours FAIL nothing. (iii) A duplicate address stops the run before anything is judged
+(exit 4, only bus.json); a named address nothing answers at stops it with exit 5.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import pytest
+from rich.console import Console
+
+from conformance.commands.bus import BUS_FILE, run_bus
+from conformance.emulator import FAULTS
+from conformance.run import RunOptions
+from tests.support.paths import ROOT
+
+SCHEMA = json.loads((ROOT / "conformance" / "schemas" / "verdicts-1.json").read_text("utf-8"))
+BUS_CASES = (
+    "testcases.sensor.test_bus::test_concurrent_kept_while_others_answer",
+    "testcases.sensor.test_bus::test_silent_while_others_are_addressed",
+)
+
+
+def run(port: str, address: str, folder: Path) -> tuple[int, str]:
+    """The main command's bus path in this process: its exit code and console text."""
+    out = io.StringIO()
+    options = RunOptions(port=port, address=address, report_dir=str(folder))
+    return run_bus(options, Console(file=out, width=200)), out.getvalue()
+
+
+def verdicts(folder: Path) -> dict[str, Any]:
+    data = json.loads((folder / "verdicts.json").read_text(encoding="utf-8"))
+    jsonschema.validate(data, SCHEMA)
+    return data
+
+
+def by_verdict(data: dict[str, Any], verdict: str) -> set[str]:
+    return {r["id"] for r in data["requirements"] if r["verdict"] == verdict}
+
+
+def bus_findings(data: dict[str, Any]) -> dict[tuple[str, str], str]:
+    """(case, requirement) -> verdict of each bus case's finding."""
+    return {
+        (f["test"], r["id"]): f["verdict"]
+        for r in data["requirements"]
+        for f in r["findings"]
+        if f["test"] in BUS_CASES
+    }
+
+
+@pytest.fixture(scope="module")
+def clean_bus(tmp_path_factory) -> tuple[Path, int, str]:
+    folder = tmp_path_factory.mktemp("bus") / "run"
+    code, said = run("sim://?sensors=0,1,3", "all", folder)
+    return folder, code, said
+
+
+def test_a_clean_bus_of_three_is_compliant_with_every_bus_case_judged(clean_bus):
+    folder, code, said = clean_bus
+    assert code == 0, said
+    assert sorted(p.name for p in folder.iterdir()) == [
+        BUS_FILE, "sensor-0", "sensor-1", "sensor-3"
+    ]  # fmt: skip
+    found = json.loads((folder / BUS_FILE).read_text(encoding="utf-8"))
+    assert [s["address"] for s in found["sensors"]] == ["0", "1", "3"]
+    assert found["duplicates"] == [] and found["probes"] >= 62  # a! at every address
+    for a in "013":
+        data = verdicts(folder / f"sensor-{a}")
+        assert data["dut"]["address"] == a and f"SN000{'013'.index(a) + 1}" in data["dut"]["serial"]
+        assert data["summary"]["verdict"] == "COMPLIANT" and not by_verdict(data, "FAIL")
+        assert [d["address"] for d in data["duts"]] == ["0", "1", "3"]
+        assert set(bus_findings(data).values()) == {"PASS"}, bus_findings(data)
+        assert len(bus_findings(data)) == 2
+        # what a shared line cannot show alone is said, not guessed
+        assert {"R-4.4.3-01", "R-4.4.3-02", "R-4.3-03"} <= by_verdict(data, "INCONCLUSIVE")
+        checked = {c for t in data["tests"] for c in t["preconditions"]}
+        assert {"alone", "others"} <= checked  # the bus-only codes (test_preconditions.py)
+    assert "sensors on the bus:" in said and said.count("· COMPLIANT ·") == 3
+
+
+def test_no_query_goes_onto_a_shared_bus(clean_bus):
+    folder, _code, _said = clean_bus
+    for a in "013":
+        text = (folder / f"sensor-{a}" / "transcript.jsonl").read_text(encoding="utf-8")
+        tool = [json.loads(line) for line in text.splitlines() if '"tool"' in line]
+        sent = "".join(chr(e["wire"] & 0x7F) for e in tool if e.get("kind") == "char")
+        assert "?" not in sent
+
+
+#: Each bus fault (and the single-sensor fault the bus case catches as well), on sensor 1 of
+#: a bus of two: its requirements, exactly.
+BUS_MATRIX = (
+    "aborts-on-foreign-reply",
+    "answers-foreign-reply",
+    "foreign-command-aborts-concurrent",
+)
+FAST = {"answers-foreign-reply"}  # the rest run with the other matrix rows (.ci/run)
+
+
+@pytest.mark.parametrize(
+    "fault", [pytest.param(f, marks=() if f in FAST else pytest.mark.matrix) for f in BUS_MATRIX]
+)
+def test_a_bus_fault_fails_exactly_its_requirements(fault, tmp_path):
+    code, said = run(f"sim://?sensors=0,1:{fault}", "0,1", tmp_path)
+    assert code == 1, said
+    faulty, clean = verdicts(tmp_path / "sensor-1"), verdicts(tmp_path / "sensor-0")
+    assert by_verdict(faulty, "FAIL") == set(FAULTS[fault].violates)
+    assert "FAIL" in bus_findings(faulty).values()  # a bus case caught it
+    assert not by_verdict(clean, "FAIL"), by_verdict(clean, "FAIL")
+    assert set(bus_findings(clean).values()) == {"PASS"}
+
+
+def test_every_bus_fault_is_in_the_bus_matrix():
+    assert {n for n, f in FAULTS.items() if f.bus} <= set(BUS_MATRIX)
+
+
+def test_a_duplicate_address_is_a_bus_fault_found_before_anything_is_judged(tmp_path, capsys):
+    code, _said = run("sim://?sensors=0,0,3", "all", tmp_path / "all")
+    assert code == 4
+    assert sorted(p.name for p in (tmp_path / "all").iterdir()) == [BUS_FILE]
+    found = json.loads((tmp_path / "all" / BUS_FILE).read_text(encoding="utf-8"))
+    assert [d["address"] for d in found["duplicates"]] == ["0"]
+    assert "two sensors answer at address '0'" in capsys.readouterr().err
+    named, _ = run("sim://?sensors=3,0,0", "0,3", tmp_path / "named")
+    assert named == 4 and not (tmp_path / "named" / "sensor-3").exists()
+
+
+def test_a_named_sensor_that_does_not_answer_stops_the_run(tmp_path, capsys):
+    code, _said = run("sim://?sensors=0,1", "0,1,5", tmp_path)
+    assert code == 5
+    assert "nothing answered a! at 5" in capsys.readouterr().err
+    assert not (tmp_path / "sensor-0").exists()
