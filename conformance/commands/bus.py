@@ -104,8 +104,14 @@ def _refusal(found: BusDiscovery, named: tuple[str, ...] | None, folder: Path) -
 
 def run_bus(options: RunOptions, console: Console, *, verbose: bool = False) -> int:
     """The whole bus: discovery, then the suite once per sensor (see the module's text)."""
+    from ..options import UsageError, check_values
     from ..report_folder import run_folder
 
+    try:
+        check_values(vars(options), plugin=False)  # refused before anything goes on the bus
+    except UsageError as exc:
+        say_error(f"error: {exc}")
+        return EXIT_USAGE
     if options.role != "sensor":
         say_error("error: --address 0,1,3 / all judges the sensors of a bus (--role sensor)")
         return EXIT_USAGE

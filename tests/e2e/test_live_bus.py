@@ -140,3 +140,20 @@ def test_a_named_sensor_that_does_not_answer_stops_the_run(tmp_path, capsys):
     assert code == 5
     assert "nothing answered a! at 5" in capsys.readouterr().err
     assert not (tmp_path / "sensor-0").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--address", "0,0"],  # an address named twice
+        ["--address", "0,1", "--port", "sim://?sensors=0,1", "--role", "recorder"],
+        ["--address", "0,1", "--port", "sim://?sensors=0,1", "--baseline", "x"],
+        ["--address", "0,1", "--port", "sim://?sensors=0,1:no-such-fault"],
+    ],
+)
+def test_a_bus_run_that_cannot_work_is_a_usage_error(argv, tmp_path, capsys):
+    from conformance.cli import main
+
+    assert main([*argv, "--report-dir", str(tmp_path / "run")]) == 4
+    assert capsys.readouterr().err.startswith("error: ")
+    assert not (tmp_path / "run" / "sensor-0").exists()
