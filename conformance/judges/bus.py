@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import TOOL, Event, EventKind, escape
-from ..verdicts import Finding, failed, passed
+from ..verdicts import Finding, failed, inconclusive, passed
 from .cite import cite, heard
 
 
@@ -35,6 +35,19 @@ def sensor_lines(events: Sequence[Event]) -> list[list[Event]]:
     if current:
         lines.append(current)
     return lines
+
+
+def _lines_by_start(events: Sequence[Event]) -> tuple[list[list[Event]], list[list[Event]]]:
+    """The sensor lines that surely start a transmission (the first, or one after a line
+    that reached its LF), and the rest: the remainder of a line the tool's own
+    transmission cut, whose first character may be the middle of another sensor's reply."""
+    whole: list[list[Event]] = []
+    cut: list[list[Event]] = []
+    ended = True
+    for line in sensor_lines(events):
+        (whole if ended else cut).append(line)
+        ended = line[-1].char7 == 0x0A
+    return whole, cut
 
 
 def kept_through_bus(
@@ -66,7 +79,18 @@ def silent_among_others(
     """R-4.0-01: while its concurrent measurement waited, the DUT said nothing: no line of
     the ``window`` (from its ``atttnn`` to its ``aD0!``) starts with its address, though the
     other sensors were addressed and answered (``others_heard``) and their data were read."""
-    own = [line for line in sensor_lines(window) if line and chr(line[0].char7) == address]
+    whole, cut = _lines_by_start(window)
+    own = [line for line in whole if chr(line[0].char7) == address]
+    unsure = [line for line in cut if chr(line[0].char7) == address]
+    if not own and unsure:
+        shown = "; ".join(heard(line, "cut line") for line in unsure[:3])
+        return [
+            inconclusive(
+                "R-4.0-01",
+                f"{len(unsure)} line(s) starting with its address '{escape(address)}' were cut "
+                f"by the tool's own transmissions ({shown}): whose they were cannot be told",
+            )
+        ]
     if not own:
         return [
             passed(

@@ -33,14 +33,19 @@ class BusRound:
     control: Exchange
     window: list[Event]
 
-    def other_replies(self) -> list[Exchange]:
-        """The others' answered exchanges (starts and data) inside the DUT's wait."""
+    def other_replies(self, *, running: bool = False) -> list[Exchange]:
+        """The others' answered exchanges (starts and data) inside the DUT's wait;
+        ``running``: only those over before its ttt ran out, while its measurement could
+        still be running (one that ended early cannot be told from the wire)."""
         start = self.dut.reply_end
+        if start is None:
+            return []
+        until = start + self.dut.ttt if running and self.dut.ttt is not None else float("inf")
         out = []
         for m in self.others.values():
             for ex in (m.start, *m.data):
                 ends = [e.end for e in ex.reply_events]
-                if ex.answered and start is not None and ends and ends[-1] > start:
+                if ex.answered and ends and start < ends[-1] < until:
                     out.append(ex)
         return out
 

@@ -28,18 +28,19 @@ def bus_round(sensor) -> BusRound:
     )
 
 
-def _others(sensor, case, made: BusRound) -> bool:
+def _others(sensor, case, made: BusRound, *, running: bool = False) -> bool:
     """The DUT answered a! just before, and at least one other sensor answered while the
-    DUT's measurement waited: else there was nothing on the bus to judge it by."""
+    DUT's measurement waited (``running``: before its ttt ran out): else there was nothing
+    on the bus to judge it by."""
     if not made.control.answered:
         unmet = precondition.Unmet(
             "others", f"the DUT did not answer {shown(made.control)} before the round"
         )
-    elif not made.other_replies():
+    elif not made.other_replies(running=running):
         unmet = precondition.Unmet(
             "others",
             f"none of the sensors at {', '.join(sorted(sensor.others))} answered while the "
-            "DUT's measurement waited",
+            "DUT's measurement " + ("could still run (before its ttt)" if running else "waited"),
         )
     else:
         unmet = None
@@ -55,16 +56,17 @@ def test_concurrent_kept_while_others_answer(sensor, case):
     undisturbed = sensor.measurement("C")
     made = bus_round(sensor)
     case.evidence("the round: aC! to every sensor, then their data", [made.control, made.dut])
-    case.evidence("the others' replies while it waited", made.other_replies())
+    case.evidence("the others' replies while it ran", made.other_replies(running=True))
     served = bool(made.dut.ttt) and bool(made.dut.count) and undisturbed.value_count > 0
     if not case.requires(
         "supported",
         precondition.served(served, "the DUT's aC! announced no values or ttt 000"),
     ):
         return
-    if not _others(sensor, case, made):
+    if not _others(sensor, case, made, running=True):
         return
-    case.extend(judge.kept_through_bus(made.dut, undisturbed.value_count, made.other_replies()))
+    during = made.other_replies(running=True)
+    case.extend(judge.kept_through_bus(made.dut, undisturbed.value_count, during))
 
 
 @requirements("R-4.0-01")

@@ -65,3 +65,11 @@ def test_a_measurement_kept_through_the_bus_passes_and_a_lost_one_fails():
     m.values = []
     lost = kept_through_bus(m, 20, others)[0]
     assert lost.verdict is Verdict.FAIL and "aborted it" in lost.detail
+
+
+def test_a_cut_line_with_the_dut_address_is_undecided_not_a_fail():
+    """The tool's break cut another sensor's reply: its remainder may start with any digit."""
+    brk = Event(EventKind.BREAK, TOOL, 1.3, 1.313)
+    events, others = window_with(chars("1+", DUT, 1.25), [brk], chars("0.5\r\n", DUT, 1.4))
+    (finding,) = silent_among_others("0", events, others)
+    assert finding.verdict is Verdict.INCONCLUSIVE and "cut" in finding.detail
