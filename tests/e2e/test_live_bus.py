@@ -157,3 +157,22 @@ def test_a_bus_run_that_cannot_work_is_a_usage_error(argv, tmp_path, capsys):
     assert main([*argv, "--report-dir", str(tmp_path / "run")]) == 4
     assert capsys.readouterr().err.startswith("error: ")
     assert not (tmp_path / "run" / "sensor-0").exists()
+
+
+def test_judge_replays_one_sensor_of_the_bus_to_the_same_verdicts(clean_bus, tmp_path):
+    """``judge sensor-1/`` repeats that sensor's run against its recording: the bus (from the
+    run-options note) again, so no ?! and the same bus cases, to the same verdicts."""
+    from conformance.cli import cmd_judge
+
+    folder, _code, _said = clean_bus
+    out = io.StringIO()
+    code = cmd_judge(
+        [str(folder / "sensor-1"), "--report-dir", str(tmp_path / "judged")],
+        Console(file=out, width=200),
+    )
+    assert code == 0, out.getvalue()
+    ran, judged = verdicts(folder / "sensor-1"), verdicts(tmp_path / "judged")
+    assert {r["id"]: r["verdict"] for r in ran["requirements"]} == {
+        r["id"]: r["verdict"] for r in judged["requirements"]
+    }
+    assert len(bus_findings(judged)) == 2
