@@ -176,3 +176,17 @@ def test_judge_replays_one_sensor_of_the_bus_to_the_same_verdicts(clean_bus, tmp
         r["id"]: r["verdict"] for r in judged["requirements"]
     }
     assert len(bus_findings(judged)) == 2
+
+
+@pytest.mark.slow
+def test_sensors_at_the_spare_and_foreign_addresses_are_left_alone(tmp_path):
+    """The suite's own spare (9) and foreign (z) addresses taken by sensors of the bus: no
+    probe meant for nobody reaches them, so every sensor stays COMPLIANT; the sweep through
+    0-9 is left out where a sensor holds one of them, made where none does."""
+    code, said = run("sim://?sensors=0,9,z", "all", tmp_path / "a")
+    assert code == 0, said
+    for a in "09z":
+        assert verdicts(tmp_path / "a" / f"sensor-{a}")["summary"]["verdict"] == "COMPLIANT"
+    code, said = run("sim://?sensors=y,z", "y,z", tmp_path / "b")
+    assert code == 0, said
+    assert "R-4.3-03" not in by_verdict(verdicts(tmp_path / "b" / "sensor-y"), "INCONCLUSIVE")
