@@ -92,11 +92,15 @@ def silent_among_others(
             )
         ]
     if not own:
+        shaped = sum(
+            1 for ex in others_heard if ex.command and ex.reply_text == f"{ex.command.address}\r\n"
+        )
         return [
             passed(
                 "R-4.0-01",
                 f"silent through {len(others_heard)} commands to other sensors and their "
-                f"replies, while its own concurrent measurement waited",
+                f"replies ({shaped} of them 'b<CR><LF>', a service request's shape), while "
+                "its own concurrent measurement waited",
                 observed=len(others_heard),
             )
         ]

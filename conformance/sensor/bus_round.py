@@ -2,7 +2,8 @@
 of a shared line at once, and their data collected in turn.
 
 The sensor judged (the DUT) is asked ``a!`` first (shown listening), then ``aC!``; then every
-other sensor its ``aC!``, each answering while the DUT's measurement runs; once the longest ttt
+other sensor its ``aC!`` and ``a!`` (whose ``b<CR><LF>`` is a service request's very shape),
+each answering while the DUT's measurement runs; once the longest ttt
 is out (all finished together, or near it) the others' data are collected first, a break
 before each sensor's first ``aD0!``, and the DUT's last. So the DUT held its measurement
 through commands to the others, their replies and their data, and everything it said in that
@@ -12,7 +13,7 @@ time is on the wire. Acts only: the judging is in ``testcases/sensor/test_bus.py
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..protocol.commands import parse_command
 from ..tool_recorder import ToolRecorder, validity
@@ -32,6 +33,10 @@ class BusRound:
     others: dict[str, Measurement]
     control: Exchange
     window: list[Event]
+    #: ``b!`` to each other sensor while all measurements run: each answers ``b<CR><LF>``,
+    #: the very shape of a service request (there is no other way to make one meet a
+    #: concurrent measurement: only M-type measurements raise them)
+    acks: dict[str, Exchange] = field(default_factory=dict)
 
     def other_replies(self, *, running: bool = False) -> list[Exchange]:
         """The others' answered exchanges (starts and data) inside the DUT's wait;
@@ -43,7 +48,9 @@ class BusRound:
         until = start + self.dut.ttt if running and self.dut.ttt is not None else float("inf")
         out = []
         for m in self.others.values():
-            for ex in (m.start, *m.data):
+            for ex in (m.start, self.acks.get(m.command.address), *m.data):
+                if ex is None:
+                    continue
                 ends = [e.end for e in ex.reply_events]
                 if ex.answered and ends and start < ends[-1] < until:
                     out.append(ex)
@@ -74,6 +81,7 @@ def concurrent_round(
     control = master.acknowledge(address)
     dut = start_measurement(master, f"{address}{code}!")
     started = {a: start_measurement(master, f"{a}{code}!") for a in sorted(others)}
+    acks = {a: master.acknowledge(a) for a in started}
     link = master.link
     ends = [
         m.reply_end + m.ttt for m in (dut, *started.values()) if m.reply_end is not None and m.ttt
@@ -88,7 +96,7 @@ def concurrent_round(
     begin = dut.reply_end if dut.reply_end is not None else dut.start.attempts[-1].end
     until = asked.start if asked is not None else link.now()
     window = [e for e in link.transcript.events if begin <= e.start < until]
-    return BusRound(dut, started, control, window)
+    return BusRound(dut, started, control, window, acks)
 
 
 __all__ = ["BusRound", "concurrent_round", "start_measurement"]
