@@ -33,7 +33,7 @@ class BusRound:
     others: dict[str, Measurement]
     control: Exchange
     window: list[Event]
-    #: ``b!`` to each other sensor while all measurements run: each answers ``b<CR><LF>``,
+    #: ``b!`` to each other sensor, before its ``bC!``: each answers ``b<CR><LF>``,
     #: the very shape of a service request (there is no other way to make one meet a
     #: concurrent measurement: only M-type measurements raise them)
     acks: dict[str, Exchange] = field(default_factory=dict)
@@ -80,8 +80,11 @@ def concurrent_round(
     """The round described above, on ``master``'s link."""
     control = master.acknowledge(address)
     dut = start_measurement(master, f"{address}{code}!")
-    started = {a: start_measurement(master, f"{a}{code}!") for a in sorted(others)}
-    acks = {a: master.acknowledge(a) for a in started}
+    acks: dict[str, Exchange] = {}
+    started: dict[str, Measurement] = {}
+    for other in sorted(others):  # its a! first: a command to itself would abort its own C
+        acks[other] = master.acknowledge(other)
+        started[other] = start_measurement(master, f"{other}{code}!")
     link = master.link
     ends = [
         m.reply_end + m.ttt for m in (dut, *started.values()) if m.reply_end is not None and m.ttt
