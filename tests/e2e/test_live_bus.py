@@ -190,3 +190,12 @@ def test_sensors_at_the_spare_and_foreign_addresses_are_left_alone(tmp_path):
     code, said = run("sim://?sensors=y,z", "y,z", tmp_path / "b")
     assert code == 0, said
     assert "R-4.3-03" not in by_verdict(verdicts(tmp_path / "b" / "sensor-y"), "INCONCLUSIVE")
+
+
+def test_all_finding_one_sensor_judges_it_alone(tmp_path):
+    """One sensor found: its own folder, the whole suite with ?! (it is alone), no bus case."""
+    code, said = run("sim://?address=5", "all", tmp_path)
+    assert code == 0, said
+    data = verdicts(tmp_path / "sensor-5")
+    assert not bus_findings(data) and "duts" not in data
+    assert by_verdict(data, "PASS") >= {"R-4.4.3-01", "R-4.3-03"}
