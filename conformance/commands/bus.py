@@ -127,6 +127,10 @@ def run_bus(options: RunOptions, console: Console, *, verbose: bool = False) -> 
     found = look_at_the_bus(options, base, console)
     if isinstance(found, int):
         return found
+    if GUARD.requested:  # Ctrl-C while the bus was looked at: nothing judged yet
+        GUARD.close()
+        say_error(f"interrupted while looking at the bus: nothing judged ({base / BUS_FILE})")
+        return EXIT_INCOMPLETE
     bus = tuple((s.address, s.identification) for s in found.found)
     alone = len(bus) == 1
     console.print(
@@ -152,7 +156,9 @@ def _run_sensors(
 
     codes: list[int] = []
     done: list[tuple[str | None, dict[str, Any], Path]] = []
-    for address, _ident in bus:
+    for n, (address, _ident) in enumerate(bus):
+        if n:
+            GUARD.reset()  # the last sensor's run closed the guard: this one starts afresh
         folder = base / f"sensor-{address}"
         one = replace(options, address=address, report_dir=str(folder), bus=() if alone else bus)
         plugins: list[object] = [] if verbose else [ProgressPlugin(console)]
@@ -171,6 +177,7 @@ def _run_sensors(
         if GUARD.requested:  # Ctrl-C: this sensor's report says so; the next is not begun
             GUARD.close()
             return EXIT_INCOMPLETE
+    GUARD.close()  # every sensor judged: a later Ctrl-C leaves the reports alone
     print_sensors(console, done)
     return worst_exit(codes)
 

@@ -199,3 +199,54 @@ def test_all_finding_one_sensor_judges_it_alone(tmp_path):
     data = verdicts(tmp_path / "sensor-5")
     assert not bus_findings(data) and "duts" not in data
     assert by_verdict(data, "PASS") >= {"R-4.4.3-01", "R-4.3-03"}
+
+
+def test_ctrl_c_after_one_sensor_leaves_the_rest_unbegun(tmp_path, monkeypatch):
+    """A Ctrl-C recorded during sensor 1's run: its report stands, sensor 3's run is not
+    begun, exit 2; and sensor 1's run began with the guard open again (the end of sensor 0's
+    closed it). (The signal's own delivery is tests/e2e/test_interrupts.py's.)"""
+    import conformance.conduct as conduct_module
+    from conformance.interrupts import GUARD
+
+    real = conduct_module.conduct
+    closed_at_start: list[bool] = []
+
+    def interrupted_after(options, **kw):
+        closed_at_start.append(GUARD.closed)
+        result = real(options, **kw)
+        GUARD.requested = options.address == "1"  # as the SIGINT handler records it
+        return result
+
+    monkeypatch.setattr(conduct_module, "conduct", interrupted_after)
+    GUARD.reset()
+    GUARD.install()  # as the command line has it: a run's end closes it
+    try:
+        code, _said = run("sim://?sensors=0,1,3", "0,1,3", tmp_path)
+    finally:
+        GUARD.uninstall()
+        GUARD.reset()
+    assert code == 2
+    assert closed_at_start == [False, False]  # sensor 1's run could still be interrupted
+    assert (tmp_path / "sensor-1" / "verdicts.json").exists()
+    assert not (tmp_path / "sensor-3").exists()
+
+
+def test_ctrl_c_while_the_bus_is_looked_at_judges_nothing(tmp_path, monkeypatch, capsys):
+    import conformance.sensor.bus_discovery as discovery
+    from conformance.interrupts import GUARD
+
+    real = discovery.discover_bus
+
+    def interrupted(*args, **kw):
+        found = real(*args, **kw)
+        GUARD.requested = True
+        return found
+
+    monkeypatch.setattr(discovery, "discover_bus", interrupted)
+    GUARD.reset()
+    try:
+        code, _said = run("sim://?sensors=0,1", "0,1", tmp_path)
+    finally:
+        GUARD.reset()
+    assert code == 2 and sorted(p.name for p in tmp_path.iterdir()) == [BUS_FILE]
+    assert "nothing judged" in capsys.readouterr().err
