@@ -535,7 +535,7 @@ class SensorSession(Session):
         the DUT, so even a sensor that keeps answering its old addresses is not addressed
         (and on a shared bus one no other sensor has: its silence is the point)."""
         taken = {self.address, *self.others}
-        return next(a for a in "zyxwvu" if a not in taken)
+        return next(a for a in "zyxwvu" + cmd.ADDRESS_CHARS[::-1] if a not in taken)
 
     @property
     def shared(self) -> bool:
