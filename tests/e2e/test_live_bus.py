@@ -250,3 +250,16 @@ def test_ctrl_c_while_the_bus_is_looked_at_judges_nothing(tmp_path, monkeypatch,
         GUARD.reset()
     assert code == 2 and sorted(p.name for p in tmp_path.iterdir()) == [BUS_FILE]
     assert "nothing judged" in capsys.readouterr().err
+
+
+@pytest.mark.matrix
+def test_three_faulty_sensors_each_fail_their_own_requirements_only(tmp_path):
+    """Both bus faults and a single-sensor one, one per sensor of a bus of three: each
+    sensor's folder FAILs exactly its own fault's requirements."""
+    faults = {"0": "aborts-on-foreign-reply", "1": "answers-foreign-reply", "3": "wrong-crc"}
+    port = "sim://?sensors=" + ",".join(f"{a}:{f}" for a, f in faults.items())
+    code, said = run(port, "all", tmp_path)
+    assert code == 1, said
+    for a, fault in faults.items():
+        failed = by_verdict(verdicts(tmp_path / f"sensor-{a}"), "FAIL")
+        assert failed == set(FAULTS[fault].violates), (a, failed)
