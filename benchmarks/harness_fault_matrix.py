@@ -43,7 +43,11 @@ def declaration(folder: Path, fault: str) -> Path:
 
 
 def main(names: list[str]) -> int:
-    v14 = [n for n in FAULTS if (getattr(FAULTS[n], "version", None) or "14") == "14"]
+    v14 = [
+        n
+        for n, f in FAULTS.items()
+        if (getattr(f, "version", None) or "14") == "14" and not f.bus  # a bus fault needs a bus
+    ]
     faults = names or sorted(v14)
     wrong = unseen_rows = 0
     started = time.monotonic()

@@ -636,6 +636,25 @@ def error(text: str) -> None:
     make_console(stderr=True).print(text, style="red", markup=False, highlight=False)
 
 
+def _main_command(args: argparse.Namespace, console: Console) -> int:
+    """The main command: one DUT (:func:`run_suite`), or several sensors on one line
+    (``--address 0,1,3`` / ``all``: :mod:`conformance.commands.bus`)."""
+    from .options import is_bus
+
+    baseline = getattr(args, "baseline", None)
+    if is_bus(args.address):
+        from .commands.bus import run_bus
+
+        if baseline:
+            error("error: --baseline compares the run of one sensor: give one --address")
+            return EXIT_USAGE
+        return run_bus(options_from_args(args), console, verbose=args.verbose)
+    code, _ = run_suite(
+        options_from_args(args), console, plan=args.plan, baseline=baseline, verbose=args.verbose
+    )
+    return code
+
+
 def _dispatch(argv: list[str]) -> int:
     console = make_console()
     try:
@@ -692,14 +711,7 @@ def _dispatch(argv: list[str]) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:
             return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
-        code, _ = run_suite(
-            options_from_args(args),
-            console,
-            plan=args.plan,
-            baseline=getattr(args, "baseline", None),
-            verbose=args.verbose,
-        )
-        return code
+        return _main_command(args, console)
     except SystemExit as exc:  # argparse of a subcommand: --help (0) or a usage error (2)
         return EXIT_COMPLIANT if exc.code in (0, None) else EXIT_USAGE
     except KeyboardInterrupt:

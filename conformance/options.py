@@ -27,10 +27,40 @@ class UsageError(ValueError):
 
 
 def check_address(text: str | None, where: str = "--address") -> None:
-    """An invalid address would go onto the bus (``00I!``) and look like a silent device."""
+    """An invalid address would go onto the bus (``00I!``) and look like a silent device.
+    The command line also takes several (``0,1,3``) or ``all``: a bus of sensors, each judged
+    in turn (:func:`bus_addresses`); one pytest run judges one DUT."""
+    if text is not None and where == "--address" and is_bus(text):
+        bus_addresses(text, where)
+        return
     problem = None if text is None else address_problem(text)
     if problem:
         raise UsageError(f"{where}: {problem}")
+
+
+#: ``--address all``: every sensor on the line, found by trying each address.
+ALL = "all"
+
+
+def is_bus(text: str | None) -> bool:
+    """Whether ``--address`` names a bus of sensors (``0,1,3`` or ``all``), not one."""
+    return text is not None and (text.strip() == ALL or "," in text)
+
+
+def bus_addresses(text: str, where: str = "--address") -> tuple[str, ...] | None:
+    """``0,1,3`` -> ('0', '1', '3'), each checked, none twice; ``all`` -> None (found by
+    trying each address)."""
+    if text.strip() == ALL:
+        return None
+    addresses = tuple(a.strip() for a in text.split(","))
+    for address in addresses:
+        problem = address_problem(address)
+        if problem:
+            raise UsageError(f"{where}: {problem} (in {text!r})")
+    twice = sorted({a for a in addresses if addresses.count(a) > 1})
+    if twice:
+        raise UsageError(f"{where}: address {', '.join(twice)} named twice in {text!r}")
+    return addresses
 
 
 def check_uncertainty(ms: float | None, where: str = "--timing-uncertainty-ms") -> None:
@@ -143,7 +173,9 @@ OPTIONS: tuple[Option, ...] = (
     Option(
         "address",
         "address",
-        "DUT address (default: the declaration, else ask with ?!)",
+        "DUT address (default: the declaration, else ask with ?!); several sensors on one "
+        "line: 0,1,3 or all (each judged in turn into sensor-<a>/, then the bus cases; all "
+        "tries a! at each of the 62 addresses, never ?!)",
         check=check_address,
     ),
     Option(

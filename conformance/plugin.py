@@ -66,6 +66,9 @@ def pytest_configure(config: pytest.Config) -> None:
     )
     config.addinivalue_line("markers", whole_run.MARKER_HELP)
     config.addinivalue_line("markers", preconditions.MARKER_HELP)
+    config.addinivalue_line(
+        "markers", "bus: a bus case, run only when the DUT shares its line with other sensors"
+    )
     if not config.pluginmanager.has_plugin("sdi12-whole-run-last"):
         config.pluginmanager.register(whole_run.WholeRunLast(), "sdi12-whole-run-last")
     options = RunOptions.from_config(config)
@@ -186,6 +189,19 @@ def keep_role_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
     config.hook.pytest_deselected(items=other)
 
 
+#: The marker of the cases only a bus of several sensors can make (testcases/sensor/test_bus.py).
+BUS_MARKER = "bus"
+
+
+def keep_bus_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The bus cases run only when the DUT shares its line with other sensors
+    (``RunOptions.bus``). Alone, they are not part of the suite at all, not left out of it:
+    a single-sensor run is the same run it always was, not a partial one."""
+    if run_of(config).options.bus:
+        return
+    items[:] = [i for i in items if i.get_closest_marker(BUS_MARKER) is None]
+
+
 def keep_profile_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
     """``--sdi12-profile``: keep the profile's cases (a partial run, said as such)."""
     run = run_of(config)
@@ -266,6 +282,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if not any(item.get_closest_marker("requirements") for item in items):
         return  # an ordinary test session
     keep_role_cases(config, items)
+    keep_bus_cases(config, items)
     keep_profile_cases(config, items)
     keep_selected_requirements(config, items)
     check_reports_writable(config)

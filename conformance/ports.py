@@ -19,6 +19,7 @@ from .declaration import Declaration, DeclarationError, load_declaration
 from .emulator import FAULTS, CompositionError, Profile, compose, default_profile, sim_sensor
 from .emulator.declared import declared_profile
 from .emulator.profiles import PROFILES, profile_settings
+from .emulator.sensor import SensorEmulator
 from .harness import device as harness_device
 from .links import adapter_link, factory
 from .links.base import LinkInfo
@@ -45,6 +46,25 @@ class SimSpec:
     extra: dict[str, str] = field(default_factory=dict)
     #: a declaration file: the simulated sensor plays what it declares (sdi12-conform plan)
     declaration: str = ""
+    #: a bus of several emulators (``sensors=0,1:wrong-crc+no-crc,3``): each one's address and
+    #: own faults (``faults=`` applies to all of them); empty: the one sensor at ``address``
+    sensors: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+
+def parse_sensors(text: str) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """``0,1:wrong-crc+no-crc,3`` -> (('0', ()), ('1', ('wrong-crc', 'no-crc')), ('3', ())).
+    An address may appear twice (a duplicate address is a bus fault the run must find);
+    each address and fault is checked where the profile is made (:func:`sim_profile`)."""
+    sensors = []
+    for item in (part.strip() for part in text.split(",")):
+        address, _, faults = item.partition(":")
+        if not address:
+            raise PortError(f"sim sensors: an empty entry in {text!r} (use sensors=0,1:FAULT,3)")
+        # a query string reads '+' as a space: either separates one sensor's faults
+        sensors.append((address, tuple(faults.replace("+", " ").split())))
+    if len(sensors) < 2:
+        raise PortError(f"sim sensors= puts several sensors on the bus, not {len(sensors)}")
+    return tuple(sensors)
 
 
 def is_sim(port: str) -> bool:
@@ -68,6 +88,12 @@ def parse_sim(port: str) -> SimSpec:
         spec.version = digits
     if "address" in params:
         spec.address = params.pop("address")
+    if "sensors" in params:
+        if "address" in query or "declaration" in params:
+            raise PortError(
+                "sim sensors= gives every sensor its address: no address= or declaration="
+            )
+        spec.sensors = parse_sensors(params.pop("sensors"))
     if "declaration" in params:
         spec.declaration = params.pop("declaration")
         declared = _load(spec.declaration)
@@ -81,7 +107,8 @@ def parse_sim(port: str) -> SimSpec:
     if params:
         raise PortError(
             f"unknown sim parameters {sorted(params)} "
-            "(known: faults, profile, version, address, declaration, recorder-faults, recorder)"
+            "(known: faults, profile, version, address, sensors, declaration, recorder-faults, "
+            "recorder)"
         )
     return spec
 
@@ -124,7 +151,9 @@ def all_faults(spec: SimSpec) -> tuple[str, ...]:
 
 
 def open_sim(spec: SimSpec) -> OpenedPort:
-    """Build the simulated bus with one reference emulator on it."""
+    """Build the simulated bus with one reference emulator on it (several: ``sensors=``)."""
+    if spec.sensors:
+        return open_sim_bus(spec)
     profile = sim_profile(spec)
     quirks = profile_settings(spec.profiles)[1]
     _bus, link, emulator = sim_sensor(profile, faults=all_faults(spec), quirks=quirks)
@@ -132,6 +161,27 @@ def open_sim(spec: SimSpec) -> OpenedPort:
         return OpenedPort(link, [emulator], _load(spec.declaration))
     declared = emulator.faults.declared_profile(profile)  # the clean profile, not the faulted
     return OpenedPort(link, [emulator], sim_declaration(declared, spec))
+
+
+def open_sim_bus(spec: SimSpec) -> OpenedPort:
+    """Several reference emulators on one simulated bus, each with its address, its serial
+    number (``SN0001``, ``SN0002``... in the order given, so that two sensors at one address
+    give different ``aI!`` replies and collide, as two real ones would) and its faults.
+    Every character they send is stamped ``dut``, as a real bus shows it: which sensor spoke
+    is for the run to tell from the address, not for the simulation to give away."""
+    from .sim.bus import SimBus, SimLink
+    from .transcript import DUT
+
+    emulators = []
+    for n, (address, own) in enumerate(spec.sensors, start=1):
+        one = replace(spec, address=address, faults=(*spec.faults, *own), sensors=())
+        profile = replace(sim_profile(one), optional=f"SN{n:04d}")
+        quirks = profile_settings(spec.profiles)[1]
+        emulators.append(SensorEmulator(profile, all_faults(one), name=DUT, quirks=quirks))
+    link = SimLink(SimBus(list(emulators)))
+    declared = emulators[0].faults.declared_profile(default_profile(spec.version))
+    bus_spec = replace(spec, address="")  # no sensor of a bus is called fresh from the factory
+    return OpenedPort(link, list(emulators), sim_declaration(declared, bus_spec))
 
 
 def _load(path: str) -> Declaration:

@@ -55,6 +55,10 @@ CODES: Mapping[str, str] = MappingProxyType(
         "recorder": "the recorder was made to act in the scenario the rule is about",
         "heard": "the traffic the rule is about was heard on the line (a passive run judges"
         " only what it overheard; none heard is INCONCLUSIVE, never a PASS)",
+        "alone": "the sensor was alone on the line: on a bus shared with other sensors ?! (and"
+        " addresses they hold) would draw their answers too, so such probes are not sent",
+        "others": "other sensors on the line answered the traffic a bus case is about, and the"
+        " sensor judged was shown listening just before (a bus of one shows nothing)",
     }
 )
 
@@ -166,6 +170,18 @@ class ControlledProbe(Protocol):
 
     @property
     def listening(self) -> bool: ...
+
+
+def alone(others: Iterable[str], what: str) -> Unmet | None:
+    """``what`` (``?!``, an address sweep) goes out only to a sensor alone on the line."""
+    shared = sorted(others)
+    if not shared:
+        return None
+    return Unmet(
+        "alone",
+        f"{what} not sent: the sensor shares the line with the sensor(s) at "
+        f"{', '.join(shared)}, who would answer too",
+    )
 
 
 def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:

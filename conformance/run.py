@@ -47,6 +47,9 @@ class RunOptions:
     keyword: str | None = None  # -k: the cases selected by name
     sweep: str | None = None  # recorder role: tolerance sweeps to run ("reply,wake")
     profile: str | None = None  # a named selection of the sensor suite (conformance.profiles)
+    #: every sensor on the line as (address, its aI! reply or None), when the DUT shares it
+    #: with others (``--address 0,1,3`` / ``all``: conformance.commands.bus); empty: alone
+    bus: tuple[tuple[str, str | None], ...] = ()
 
     @property
     def timing_uncertainty(self) -> float | None:
@@ -143,6 +146,8 @@ class ConformanceRun:
         if self.link is None:
             return
         options = asdict(self.options) | {"link": asdict(self.link.info)}
+        if not self.options.bus:
+            del options["bus"]  # a DUT alone on its line: the note as it always was
         self.link.transcript.add(options_note(options, self.link.now()))
 
     def sensor_session(self) -> SensorSession:
@@ -155,6 +160,7 @@ class ConformanceRun:
                 forced_version=normalise_version(self.options.version)
                 if self.options.version
                 else None,
+                bus=self.options.bus,
             )
             self.session = session
             if self.options.profile is not None:

@@ -153,7 +153,7 @@ def judge_passively(args: PassiveJob, console: Console) -> int:
 def _run_jobs(jobs: list[RoleJob], port: str, args: PassiveJob, console: Console) -> int:
     """Each job in turn, its summary printed; then one line per sensor when there were
     several. The exit code is the worst of all (an internal error first)."""
-    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
+    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL
     from ..reports.console import print_summary
 
     codes: list[int] = []
@@ -175,20 +175,29 @@ def _run_jobs(jobs: list[RoleJob], port: str, args: PassiveJob, console: Console
         if GUARD.requested:  # Ctrl-C: this run's report says so; the next one is not begun
             GUARD.close()
             return EXIT_INCOMPLETE
-    _print_sensors(console, [(j, d) for j, d in done if j.of_bus])
+    print_sensors(console, [(j.address, d, j.report_dir) for j, d in done if j.of_bus])
+    return worst_exit(codes)
+
+
+def worst_exit(codes: list[int]) -> int:
+    """The exit code of several runs: an internal error first, then a usage error, a FAIL,
+    an incomplete run, and compliant only if every run was."""
+    from ..exits import EXIT_INCOMPLETE, EXIT_INTERNAL, EXIT_NON_COMPLIANT
+
     order = (EXIT_INTERNAL, EXIT_USAGE, EXIT_NON_COMPLIANT, EXIT_INCOMPLETE, EXIT_COMPLIANT)
     return min(codes, key=lambda c: order.index(c) if c in order else -1)
 
 
-def _print_sensors(console: Console, done: list[tuple[RoleJob, dict[str, Any]]]) -> None:
-    """One line per sensor of a bus: address, identification, verdict, report folder."""
+def print_sensors(console: Console, done: list[tuple[str | None, dict[str, Any], Path]]) -> None:
+    """One line per sensor of a bus: address, identification, verdict, report folder (the
+    passive judging of a recording and a live bus run alike)."""
     if not done:
         return
     console.print("sensors on the bus:", style="bold", markup=False, highlight=False)
-    for job, data in done:
+    for address, data, folder in done:
         ident = (data["dut"].get("identification") or "(no aI! reply seen)").strip()
         console.print(
-            f"  sensor {job.address} · {ident!r} · {data['summary']['verdict']} · {job.report_dir}",
+            f"  sensor {address} · {ident!r} · {data['summary']['verdict']} · {folder}",
             markup=False,
             highlight=False,
         )

@@ -88,6 +88,11 @@ class Behaviour:
     abort_reply: str = ""
     break_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
     foreign_aborts_concurrent: bool = False  # True breaks R-4.4.7-05
+    #: A bus of several sensors only: another sensor's reply (a line ending CR LF, which no
+    #: command ends with) heard while a concurrent measurement runs drops it (R-4.4.7-05) or
+    #: is answered with this sensor's address as if it were a command to it (R-4.0-01).
+    foreign_reply_aborts_concurrent: bool = False
+    answer_foreign_reply: bool = False
     command_aborts_concurrent: bool = True  # R-4.4.7.1-01
     # -- data buffer -------------------------------------------------------------------------
     clear_on_break_after_read: bool = False

@@ -102,6 +102,7 @@ class SensorEmulator:
         self._crc_stuck = False  # only a faulty sensor sets it (metadata_crc_sticks)
         self._replied_last = False  # the last thing on the line was this sensor's own
         self._report: Transmission | None = None  # only a faulty sensor sets it (abort_reply)
+        self._overheard = ""  # the last two characters heard (a bus fault's CR LF)
 
     # -- introspection (tests, CLI) ----------------------------------------------------------
     @property
@@ -167,6 +168,7 @@ class SensorEmulator:
         self._last_activity = end
         self._replied_last = False
         self._buf = []
+        self._overheard = ""
 
     def on_char(self, wire: int, start: float, end: float) -> None:
         b = self.behaviour
@@ -176,6 +178,8 @@ class SensorEmulator:
             self._tx.cancel(lambda t: t is not report)
             self._report = None
         self._settle(start)
+        if b.foreign_reply_aborts_concurrent or b.answer_foreign_reply:
+            self._overhear(chr(wire & 0x7F), end)
         previous = self._last_activity
         heard = self._hear(start)
         self._last_activity = max(self._last_activity, end)
@@ -207,6 +211,20 @@ class SensorEmulator:
                 self._command(text, begun, end, foreign)
         elif len(self._buf) > _MAX_COMMAND:
             self._buf = []
+
+    def _overhear(self, char: str, end: float) -> None:
+        """What only a faulty sensor on a bus of several does with another sensor's reply (its
+        CR LF: the tool's commands end in '!') heard while its own concurrent measurement runs:
+        drop the measurement, or answer the reply with its address as if it were a command."""
+        self._overheard = (self._overheard + char)[-2:]
+        run = self._run
+        if self._overheard != "\r\n" or run is None or not run.concurrent:
+            return
+        if self.behaviour.foreign_reply_aborts_concurrent:
+            self._abort()
+        if self.behaviour.answer_foreign_reply:
+            reply = Reply(ReplyKind.CHATTER, self.address, source=run.command)
+            self._send(reply, end + self.behaviour.reply_delay)
 
     def _hear(self, start: float) -> bool:
         """Apply the idle rules at a start bit; False if the sensor cannot hear it."""

@@ -83,6 +83,8 @@ def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[st
         raise ValueError(f"a combination has 2 or more faults, not {size}")
     by_version: dict[str, list[str]] = {}
     for name in sorted(FAULTS):
+        if FAULTS[name].bus:  # shows only beside other sensors: not on the one sensor here
+            continue
         by_version.setdefault(version_of(name), []).append(name)
     pools = [names for _, names in sorted(by_version.items()) if len(names) >= size]
     weights = [len(p) for p in pools]

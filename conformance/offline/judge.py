@@ -379,6 +379,8 @@ def replay_options(recording: Recording, args: argparse.Namespace) -> RunOptions
         )
         if saved.get(key) is not None
     }  # fmt: skip
+    if saved.get("bus"):  # one sensor of a shared line (commands/bus.py): its bus, again
+        kept["bus"] = tuple((str(a), None if i is None else str(i)) for a, i in saved["bus"])
     return RunOptions(
         port=f"replay:{recording.path}",
         role=str(saved.get("role", "sensor")),

@@ -125,6 +125,11 @@ def _open_sim(port: str, options: PortOptions, driver: Driver | None) -> Recorde
             "sim://?faults= breaks the simulated sensor judged in the sensor role; in the "
             f"recorder role use sim://?recorder-faults=NAME ({_known_faults()})"
         )
+    if spec.sensors:
+        raise PortError(
+            "sim://?sensors= puts several simulated sensors on the line to judge them (the "
+            "sensor role, --address 0,1,3); the recorder role plays its own sensors"
+        )
     extra = spec.extra
     faults = recorder_faults(extra)
     if driver is None:

@@ -244,6 +244,12 @@ def _machine(
     """The state machine class for one run. Hypothesis orders rules by name and draws by
     strategy, so the names and strategies here are the exploration's stimuli: keep them."""
     foreign = [a for a in "9zy" if a != sensor.address]
+    if sensor.shared:  # never an address another sensor of the line answers at
+        spare = "9zyxwv" + ADDRESS_CHARS[::-1]
+        foreign = [
+            a for a in dict.fromkeys(spare) if a != sensor.address and a not in sensor.others
+        ]
+        foreign = foreign[:3]
 
     class SensorMachine(_Explorer):
         @rule(code=st.sampled_from(OWN))

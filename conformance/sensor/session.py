@@ -145,6 +145,7 @@ class SensorSession(Session):
         address: str | None = None,
         declaration: Declaration | None = None,
         forced_version: str | None = None,
+        bus: tuple[tuple[str, str | None], ...] = (),
     ) -> None:
         self.link = link
         self.master = WatchedToolRecorder(link)
@@ -160,11 +161,15 @@ class SensorSession(Session):
         self.view_disagreements = 0  # stimuli whose view record differed (see _as_seen)
         #: the measurement codes a family may be tried with (None: all; a profile's groups)
         self.groups: frozenset[str] | None = None
+        #: every sensor on the line with its aI! reply, when the DUT is not alone on it
+        self.bus = bus
+        #: the other sensors' addresses: never a spare or foreign address, never ``?!``
+        self.others = frozenset(a for a, _ in bus if a != self.address)
 
     # -- discovery ----------------------------------------------------------------------------
     def discover(self) -> None:
         """Find the address (``?!`` if none was given) and read ``aI!`` to pick the rule set."""
-        if self.requested_address is None:
+        if self.requested_address is None and not self.shared:
             ex = self.master.query_address()
             body, _ = split_line(ex.reply_text)
             if ex.answered and len(body) == 1 and body in cmd.ADDRESS_CHARS:
@@ -207,6 +212,12 @@ class SensorSession(Session):
                 )
                 return True
         self.master.policy = usual
+        if self.shared:  # every sensor on the line would answer ?!
+            raise NoDeviceAnswered(
+                f"no device answered at address {self.address!r} (a! and aI! got no reply "
+                f"after retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms); "
+                "?! is not sent on a bus shared with other sensors"
+            )
         query = self.master.query_address()
         body, _ = split_line(query.reply_text)
         if query.answered and body == self.address:
@@ -514,13 +525,36 @@ class SensorSession(Session):
         return self.once("address-change", self._discover_address_change)
 
     def spare_address(self) -> str:
-        """The address the address-change cases move the sensor to (and back from)."""
-        return next(a for a in "9876543210" if a != self.address)
+        """The address the address-change cases move the sensor to (and back from): on a
+        shared bus never another sensor's."""
+        taken = {self.address, *self.others}
+        return next(a for a in "9876543210" + cmd.ADDRESS_CHARS[10:] if a not in taken)
 
     def foreign_address(self) -> str:
         """An address for "traffic to another sensor": one no address-change case ever gives
-        the DUT, so even a sensor that keeps answering its old addresses is not addressed."""
-        return next(a for a in "zyx" if a != self.address)
+        the DUT, so even a sensor that keeps answering its old addresses is not addressed
+        (and on a shared bus one no other sensor has: its silence is the point)."""
+        taken = {self.address, *self.others}
+        return next(a for a in "zyxwvu" + cmd.ADDRESS_CHARS[::-1] if a not in taken)
+
+    @property
+    def shared(self) -> bool:
+        """Whether other sensors share the line: ``?!`` would draw every one's answer."""
+        return bool(self.others)
+
+    def bus_sensors(self) -> list[tuple[str, DutClaim]] | None:
+        """Every sensor on the shared line with what its ``aI!`` said (``duts``); None alone."""
+        if not self.bus:
+            return None
+        claims = []
+        for address, reply in sorted(self.bus):
+            if address == self.address:
+                claims.append((address, self.claim()))
+                continue
+            body = split_line(reply)[0] if reply else ""
+            ident = parse_ident(body, expected_address=address) if reply else None
+            claims.append((address, DutClaim(ident, reply, ident.version if ident else None)))
+        return claims
 
     def _discover_address_change(self) -> bool:
         changer = AddressChanger(self.master, self.address)

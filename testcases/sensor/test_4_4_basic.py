@@ -58,7 +58,8 @@ def test_every_basic_command_is_answered(sensor, case):
             exchanges.append(sensor.measurement(code).start)
         else:
             exchanges.append(sensor.exchange(code))
-    exchanges.append(sensor.once("query", sensor.master.query_address))
+    if not sensor.shared:  # ?! on a shared bus draws every sensor's answer: not sent
+        exchanges.append(sensor.once("query", sensor.master.query_address))
     case.evidence("Table 5 commands", exchanges)
     case.add(judge.answered("R-4.4-01", exchanges, "it is a basic command"))
 

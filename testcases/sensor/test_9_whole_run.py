@@ -15,16 +15,21 @@ from conformance import preconditions as precondition
 from conformance.judges import wire
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
-from conformance.view.runs import transcript_segments
+from conformance.view.runs import Segments, transcript_segments
 
 requirements = pytest.mark.requirements
 pytestmark = pytest.mark.whole_run
 
 
 def _segments(sensor):
-    """The run's transcript cut into segments, once the standard stimuli are on it."""
+    """The run's transcript cut into segments, once the standard stimuli are on it. On a
+    bus shared with other sensors only the commands to the DUT and what followed them: the
+    others' replies (the bus cases') are theirs, not evidence about this sensor."""
     sensor.standard_stimuli()
-    return transcript_segments(sensor.link.transcript)  # cut once, shared with the report
+    segs = transcript_segments(sensor.link.transcript)  # cut once, shared with the report
+    if not sensor.shared:
+        return segs
+    return Segments(s for s in segs if s.text[:1] == sensor.address)
 
 
 def _confirmed(sensor, case, wanted):

@@ -8,11 +8,13 @@ they deviate from is asserted in test_emulator.py.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import pytest
 
 from conformance.catalog import catalog
 from conformance.emulator import FAULTS, compose, default_profile
+from conformance.emulator.sensor import SensorEmulator
 from conformance.protocol.binary import parse_binary_packet
 from conformance.protocol.commands import parse_command
 from conformance.protocol.crc import ascii_crc, binary_crc
@@ -922,6 +924,32 @@ CHECKS.update(
         "unknown-command-text": check_unknown_command_text,
         "abort-sends-zero-reply": check_abort_sends_zero_reply,
         "ident-pause": check_ident_pause,
+    }
+)
+
+
+def _beside_sensor_1(rig: Rig) -> Answer:
+    """A clean sensor at address 1 joins the rig's bus; the rig's sensor (0) starts a
+    concurrent measurement and sensor 1 is asked a! while it runs: its reply is heard."""
+    rig.bus.attach(SensorEmulator(replace(default_profile(), address="1"), name="sensor-1"))
+    assert rig.ask("0C!").body[:4] == "0003"  # ttt 3 s: still running below
+    return rig.ask("1!")
+
+
+def check_aborts_on_foreign_reply(rig: Rig) -> None:
+    _beside_sensor_1(rig)
+    rig.wait(3.5)
+    assert rig.ask("0D0!").text == "0\r\n"  # the measurement was dropped: no values
+
+
+def check_answers_foreign_reply(rig: Rig) -> None:
+    assert _beside_sensor_1(rig).text == "1\r\n0\r\n"  # sensor 0 answered sensor 1's reply
+
+
+CHECKS.update(
+    {
+        "aborts-on-foreign-reply": check_aborts_on_foreign_reply,
+        "answers-foreign-reply": check_answers_foreign_reply,
     }
 )
 

@@ -16,10 +16,10 @@ from pathlib import Path
 
 from conformance.emulator.profile import default_profile
 from conformance.emulator.sensor import SensorEmulator
-from conformance.protocol import commands as cmds
 from conformance.replay.recording import write_recording
+from conformance.sensor.bus_round import start_measurement
 from conformance.sim.bus import SimBus, SimLink
-from conformance.tool_recorder import ToolRecorder, validity
+from conformance.tool_recorder import ToolRecorder
 from conformance.tool_recorder.records import Measurement
 from conformance.transcript import BUS, Event, EventKind
 
@@ -45,12 +45,8 @@ def bus_of_sensors(
 
 def start(recorder: ToolRecorder, text: str) -> Measurement:
     """A measurement started (its reply recorded), its data not yet asked for."""
-    command = cmds.parse_command(text)
-    m = Measurement(command, recorder.transact(command))
-    parsed = validity.parse_start_reply(m.start.reply_text, validity.count_digits(command))
-    assert parsed is not None, m.start.reply_text
-    m.ttt, m.count = parsed
-    m.reply_end = m.start.reply_events[-1].end
+    m = start_measurement(recorder, text)
+    assert m.count is not None, m.start.reply_text
     return m
 
 

@@ -38,7 +38,16 @@ from types import MappingProxyType
 from typing import Any
 
 from ..behaviour import Behaviour
-from . import addressing, firmware_replies, high_volume, measurements, metadata, replies, timing
+from . import (
+    addressing,
+    bus,
+    firmware_replies,
+    high_volume,
+    measurements,
+    metadata,
+    replies,
+    timing,
+)
 from .model import CompositionError, Fault, FaultSet, ProfileTransform, Rewrite, clash
 
 __all__ = [
@@ -98,6 +107,8 @@ _RUNS: tuple[tuple[Fault, ...], ...] = (
     measurements.VERSION_13,
     # what real firmware answers where the reference is silent (issue 18)
     firmware_replies.FIRMWARE_REPLIES,
+    # what only a bus of several sensors shows (issue 23, item 2)
+    bus.BUS,
 )
 
 

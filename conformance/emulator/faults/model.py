@@ -59,6 +59,9 @@ class Fault:
     #: The one thing the fault replaces, when another fault may replace it too (say, "the
     #: first value of aM!"): two faults replacing the same thing cannot both show.
     replaces: str | None = None
+    #: The fault shows only beside other sensors on one bus (``sim://?sensors=``): the
+    #: single-sensor matrix leaves it to the bus cases' own matrix.
+    bus: bool = False
 
     def __post_init__(self) -> None:
         if not self.violates:
