@@ -25,6 +25,11 @@ def _counts(counts: dict[str, int] | None) -> str:
     return ", ".join(f"{counts[k]} {k}" for k in _COUNT_KEYS if counts.get(k))
 
 
+def _verdict(row: dict[str, Any]) -> str:
+    verdict = row["verdict"] or "(none)"
+    return verdict if row["complete"] or verdict == "INCOMPLETE" else f"{verdict} (incomplete)"
+
+
 def _report_link(row: dict[str, Any], rack_dir: Path) -> str:
     folder = row["folder"]
     if folder and (rack_dir / folder / "report.html").is_file():
@@ -40,7 +45,7 @@ def _row(row: dict[str, Any], rack_dir: Path) -> str:
         f"<code>{escape(row['port'])}</code>",
         escape(ident),
         escape(row["serial"] or ""),
-        escape(row["verdict"] or "(none)") + ("" if row["complete"] else " (incomplete)"),
+        escape(_verdict(row)),
         escape(_counts(row["counts"])),
         f"{row['exit_code']} ({escape(row['meaning'])})",
         _report_link(row, rack_dir),

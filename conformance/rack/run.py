@@ -82,7 +82,7 @@ def _line(prefix: str, row: dict[str, Any]) -> str:
     """One DUT's line: its verdict, exit status, time and folder, and why, where it has no
     verdict of its own."""
     verdict = row["verdict"] or "no verdict"
-    if row["verdict"] and not row["complete"]:
+    if row["verdict"] not in (None, "INCOMPLETE") and not row["complete"]:
         verdict += " (incomplete)"
     text = (f"{prefix}{row['name']} ({row['port']}): {verdict}, exit "
             f"{row['exit_code']} ({row['meaning']})")  # fmt: skip
@@ -106,7 +106,8 @@ def _table(console: Console, document: dict[str, Any], rack_dir: Path) -> None:
         for column in ("DUT", "port", "serial", "verdict", "exit", "folder"):
             table.add_column(column, overflow="fold")
         for row in rows:
-            verdict = (row["verdict"] or "-") + ("" if row["complete"] else " (incomplete)")
+            verdict = row["verdict"] or "-"
+            verdict += "" if row["complete"] or verdict == "INCOMPLETE" else " (incomplete)"
             table.add_row(row["name"], row["port"], row["serial"] or "-", verdict,
                           f"{row['exit_code']} {row['meaning']}", row["folder"] or "-")  # fmt: skip
         console.print(table)

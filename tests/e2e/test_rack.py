@@ -1,0 +1,126 @@
+"""A rack of simulated DUTs (issue 23, item 4), as a user runs it: each DUT's run in a
+worker process of its own, its four reports in its own folder, the rack's summary, the worst
+exit status; every way of naming a rack wrongly is one line and exit 4.
+
+The rack of RFC 2217 emulators and its Ctrl-C are in test_rack_realtime.py."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from conformance.cli import main
+from conformance.interrupts import GUARD
+from conformance.rack.worker import run_dut
+from conformance.run import RunOptions
+
+REPORTS = {"verdicts.json", "report.html", "junit.xml", "transcript.jsonl"}
+
+
+def _rack_json(folder: Path) -> dict:
+    return json.loads((folder / "rack.json").read_text(encoding="utf-8"))
+
+
+def test_a_sim_rack_with_a_faulty_dut_exits_1_with_a_folder_per_dut_named_by_serial(tmp_path):
+    rack = tmp_path / "rack"
+    code = main(["--port", "sim", "--port", "sim://?faults=wrong-crc",
+                 "--profile", "production", "--report-dir", str(rack)])  # fmt: skip
+    assert code == 1
+    data = _rack_json(rack)
+    assert data["rack"]["exit_code"] == 1 and data["rack"]["complete"]
+    good, bad = data["duts"]
+    assert (good["name"], good["exit_code"], good["verdict"]) == ("1-sim", 0, "COMPLIANT")
+    assert (bad["name"], bad["exit_code"], bad["verdict"]) == ("2-sim", 1, "NON-COMPLIANT")
+    # --profile production names each folder by the serial; the second unit of that serial
+    # (every emulator says SN0001) by its serial and its name
+    assert (good["folder"], bad["folder"]) == ("SN0001", "SN0001-2-sim")
+    assert good["serial"] == bad["serial"] == "SN0001" and good["complete"] and bad["complete"]
+    for row in (good, bad):
+        assert {p.name for p in (rack / row["folder"]).iterdir()} >= REPORTS
+        assert not (rack / row["folder"] / ".sdi12-conform.lock").exists()
+    verdicts = json.loads((rack / "SN0001-2-sim" / "verdicts.json").read_text(encoding="utf-8"))
+    failed = {r["id"] for r in verdicts["requirements"] if r["verdict"] == "FAIL"}
+    assert failed == {"R-4.4.12-05"}  # the fault's own rule, as a single run finds it
+    suites = ET.parse(rack / "junit.xml").getroot().findall("testsuite")
+    assert [s.get("name") for s in suites] == ["1-sim", "2-sim"]
+    assert [s.get("failures") for s in suites] == ["0", "2"]
+    page = (rack / "index.html").read_text(encoding="utf-8")
+    assert 'href="SN0001/report.html"' in page and 'href="SN0001-2-sim/report.html"' in page
+    assert not (rack / ".sdi12-conform.lock").exists()
+
+
+@pytest.mark.slow  # 10 s: the recorder role's cases
+def test_a_rack_file_gives_names_roles_and_a_port_that_cannot_open_its_own_exit(
+    tmp_path, capsys
+):
+    (tmp_path / "bench.toml").write_text(
+        '[[dut]]\nname = "bay1"\nport = "sim"\n'
+        '[[dut]]\nname = "bay2"\nport = "/dev/ttyNOSUCH"\n'
+        '[[dut]]\nname = "logger"\nport = "sim"\nrole = "recorder"\n',
+        encoding="utf-8",
+    )
+    rack = tmp_path / "out"
+    code = main(["rack", str(tmp_path / "bench.toml"), "-k", "identification or test_4_4_1",
+                 "--report-dir", str(rack)])  # fmt: skip
+    assert code == 4  # usage error beats compliant: bay2's port does not exist
+    rows = {r["name"]: r for r in _rack_json(rack)["duts"]}
+    assert rows["bay1"]["exit_code"] == 0 and rows["bay1"]["folder"] == "bay1"
+    assert rows["logger"]["role"] == "recorder" and rows["logger"]["folder"] == "logger"
+    assert rows["bay2"]["exit_code"] == 4 and rows["bay2"]["folder"] is None
+    assert "does not exist" in rows["bay2"]["errors"][-1]
+    out = capsys.readouterr().out
+    assert "bay2 (/dev/ttyNOSUCH): no verdict, exit 4 (usage error)" in out
+    assert "rack: exit 4 (usage error, the worst DUT's)" in out
+
+
+def test_a_worker_that_cannot_start_is_an_internal_error_row(tmp_path):
+    rack = tmp_path / "rack"
+    code = main(["--port", "sim", "--port", "sim", "-k", "test_identification",
+                 "--tx", "popen", "--tx", "popen//python=/nonexistent/python",
+                 "--report-dir", str(rack)])  # fmt: skip
+    assert code == 3
+    first, second = _rack_json(rack)["duts"]
+    assert first["exit_code"] == 0 and first["worker"] == "popen"
+    assert second["exit_code"] == 3 and not second["complete"] and second["folder"] is None
+    assert "did not start" in second["errors"][0]
+
+
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        (["rack"], "name the rack file first"),
+        (["rack", "{tmp}/none.toml"], "none.toml: No such file"),
+        (["--rack", "{tmp}/bad.toml"], "unknown key(s) speed"),
+        (["--rack", "{tmp}/bad.toml", "--port", "sim"], "give no --port"),
+        (["--port", "sim", "--port", "sim", "--baseline", "{tmp}"], "--baseline compares one"),
+        (["--port", "sim", "--port", "sim", "--tx", "nothing"], "names no worker"),
+        (["--port", "sim", "--port", "sim", "--req", "R-9.9-99"], "R-9.9-99"),
+        (["--port", "sim", "--port", "sim", "--declaration", "{tmp}/x.toml"], "DUT 1-sim:"),
+    ],
+)
+def test_a_rack_named_wrongly_is_one_line_and_exit_4(tmp_path, capsys, argv, says):
+    (tmp_path / "bad.toml").write_text("[[dut]]\nport = 'sim'\nspeed = 9600\n", encoding="utf-8")
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main([*argv, "--report-dir", str(tmp_path / "rack")]) == 4
+    err = capsys.readouterr().err.strip()
+    assert says in err and len(err.splitlines()) == 1, err
+    assert not (tmp_path / "rack" / "rack.json").exists()
+
+
+def test_a_worker_on_another_host_sends_its_folder_back(tmp_path):
+    """The worker's side of a rack on another host (``report_dir`` None): its run goes into
+    a folder of its own and the files come back in the result (here in this process)."""
+    options = RunOptions(port="sim://?faults=wrong-crc", keyword="test_crc_value_and_encoding")
+    job = {"options": vars(options), "plan": "never", "report_dir": None,
+           "declaration_text": None, "name": "far"}  # fmt: skip
+    try:
+        result = run_dut(job)
+    finally:
+        GUARD.reset()
+    assert result["exit_code"] == 1 and result["folder"] is None
+    assert REPORTS - {"report.html", "junit.xml"} <= set(result["files"])
+    assert result["document"]["summary"]["verdict"] == "NON-COMPLIANT"
+    assert result["document"]["run"]["complete"] is True
