@@ -116,10 +116,27 @@ def _check_names(duts: list[Dut], where: str) -> list[Dut]:
     return duts
 
 
+def _check_ports(duts: list[Dut], where: str) -> list[Dut]:
+    """One worker per port: two DUTs on one port of one host would fight over it (a sim
+    port is a new simulated device each time; a port on two hosts is two ports)."""
+    from ..ports import is_sim
+
+    owner: dict[tuple[str, str], str] = {}
+    for dut in duts:
+        key = (dut.port, dut.tx)
+        if key in owner and not is_sim(dut.port):
+            raise RackError(
+                f"{where}: DUTs {owner[key]!r} and {dut.name!r} both name port {dut.port!r} "
+                "on one worker host; one DUT per port"
+            )
+        owner.setdefault(key, dut.name)
+    return duts
+
+
 def duts_from_ports(ports: Sequence[str], tx: Sequence[str] = ()) -> list[Dut]:
     """The rack ``--port A --port B`` makes: every DUT with the command line's options."""
     duts = [Dut(default_name(i, port), port) for i, port in enumerate(ports, 1)]
-    return _assign_tx(_check_names(duts, "--port"), tx)
+    return _check_ports(_assign_tx(_check_names(duts, "--port"), tx), "--port")
 
 
 def _text(table: dict[str, Any], key: str, where: str) -> str | None:
@@ -181,4 +198,4 @@ def load_rack_file(path: str | Path, tx: Sequence[str] = ()) -> list[Dut]:
         raise RackError(f"{where}: tx must be a string or a list of strings")
     folder = Path(path).resolve().parent
     duts = [_dut_from_table(t, i, folder, where) for i, t in enumerate(tables, 1)]
-    return _assign_tx(_check_names(duts, where), list(tx) or file_tx)
+    return _check_ports(_assign_tx(_check_names(duts, where), list(tx) or file_tx), where)

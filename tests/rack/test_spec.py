@@ -103,3 +103,11 @@ def test_a_missing_rack_file_is_a_usage_error(tmp_path):
 def test_a_default_name_is_a_folder_name():
     assert default_name(7, "exec:./dev --fast") == "7-exec-.-dev-fast"
     assert default_name(1, "???") == "1-port"
+
+
+def test_one_port_is_one_dut_on_a_host_but_sim_ports_and_other_hosts_repeat():
+    assert len(duts_from_ports(["sim", "sim", "sim"])) == 3  # three simulated sensors
+    with pytest.raises(RackError, match="both name port '/dev/ttyUSB0'"):
+        duts_from_ports(["/dev/ttyUSB0", "/dev/ttyUSB0"])
+    on_two_hosts = duts_from_ports(["/dev/ttyUSB0"] * 2, ["ssh=bench1", "ssh=bench2"])
+    assert [d.tx for d in on_two_hosts] == ["ssh=bench1", "ssh=bench2"]

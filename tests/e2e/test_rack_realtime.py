@@ -1,0 +1,86 @@
+"""A rack of three RFC 2217 emulators, one faulty (issue 23, item 4's acceptance), run as a
+user runs it (a subprocess): the DUTs in parallel, a correct summary, exit 1; and Ctrl-C
+stopping every worker with every DUT's report saying ``complete: false``, exit 2."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from conformance.emulator_server.process import EmulatorProcess
+
+pytestmark = [pytest.mark.realtime, pytest.mark.slow]
+
+
+@pytest.fixture(scope="module")
+def three_emulators() -> Iterator[list[str]]:
+    """Two clean emulators and one whose CRCs are wrong, each on its own RFC 2217 port."""
+    emulators = [EmulatorProcess(), EmulatorProcess(), EmulatorProcess("--faults", "wrong-crc")]
+    try:
+        yield [e.url for e in emulators]
+    finally:
+        for emulator in emulators:
+            emulator.stop()
+
+
+def _rack_argv(urls: list[str], folder: Path) -> list[str]:
+    ports = [arg for url in urls for arg in ("--port", url)]
+    return [sys.executable, "-m", "conformance.cli", *ports, "--profile", "production",
+            "--plan", "never", "--report-dir", str(folder)]  # fmt: skip
+
+
+def test_three_emulators_one_faulty_run_in_parallel_and_exit_1(three_emulators, tmp_path):
+    rack = tmp_path / "rack"
+    proc = subprocess.run(_rack_argv(three_emulators, rack), capture_output=True, text=True,
+                          timeout=600)  # fmt: skip
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    data = json.loads((rack / "rack.json").read_text(encoding="utf-8"))
+    rows = data["duts"]
+    assert [r["exit_code"] for r in rows] == [0, 0, 1]
+    assert [r["verdict"] for r in rows] == ["COMPLIANT", "COMPLIANT", "NON-COMPLIANT"]
+    assert all(r["complete"] and r["serial"] == "SN0001" for r in rows)
+    assert data["rack"]["complete"] and data["rack"]["exit_code"] == 1
+    faulty = json.loads((rack / rows[2]["folder"] / "verdicts.json").read_text(encoding="utf-8"))
+    assert {r["id"] for r in faulty["requirements"] if r["verdict"] == "FAIL"} == {"R-4.4.12-05"}
+    assert faulty["run"]["link"]["kind"] != "sim"  # judged over the real-time link
+    # in parallel: the rack took about its slowest DUT, well under the DUTs one after another
+    walls = [r["wall_s"] for r in rows]
+    assert data["rack"]["wall_s"] < 0.8 * sum(walls), (data["rack"]["wall_s"], walls)
+    for name in ("index.html", "junit.xml"):
+        assert (rack / name).is_file()
+    assert proc.stdout.count("-> SN0001") == 6  # a line as each finished, a line each at the end
+
+
+@pytest.mark.quiet
+def test_ctrl_c_stops_every_worker_and_every_report_says_incomplete(three_emulators, tmp_path):
+    rack = tmp_path / "rack"
+    proc = subprocess.Popen(_rack_argv(three_emulators, rack), stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)  # fmt: skip
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:  # every DUT's run has its folder: the runs are on
+        if len([p for p in rack.glob("*") if p.is_dir()]) == 3:
+            break
+        time.sleep(0.1)
+    time.sleep(3.0)  # well inside the runs (each is 20 s or more on the bus)
+    began = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=120)
+    took = time.monotonic() - began
+    assert proc.returncode == 2, out
+    assert "Traceback" not in out and "KeyboardInterrupt" not in out, out
+    assert took < 20, f"{took:.1f} s to stop\n{out}"
+    data = json.loads((rack / "rack.json").read_text(encoding="utf-8"))
+    assert data["rack"]["interrupted"] and not data["rack"]["complete"]
+    assert data["rack"]["exit_code"] == 2
+    for row in data["duts"]:
+        assert row["exit_code"] == 2 and row["complete"] is False, row
+        verdicts = json.loads((rack / row["folder"] / "verdicts.json").read_text(encoding="utf-8"))
+        assert verdicts["run"]["complete"] is False
+        assert verdicts["run"]["stop_reason"] == "run interrupted (Ctrl-C)"
