@@ -114,6 +114,8 @@ class Pool:
                 EXIT_INTERNAL,
             )  # fmt: skip
         self.results[i] = item
+        with contextlib.suppress(Exception):  # its work is done: let its process go now
+            self._channels[i].gateway.exit()
         on_result(i, item)
 
     def wait(
