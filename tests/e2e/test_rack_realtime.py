@@ -5,6 +5,7 @@ stopping every worker with every DUT's report saying ``complete: false``, exit 2
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -84,3 +85,30 @@ def test_ctrl_c_stops_every_worker_and_every_report_says_incomplete(three_emulat
         verdicts = json.loads((rack / row["folder"] / "verdicts.json").read_text(encoding="utf-8"))
         assert verdicts["run"]["complete"] is False
         assert verdicts["run"]["stop_reason"] == "run interrupted (Ctrl-C)"
+
+
+def _children(pid: int) -> list[int]:
+    """The processes ``pid`` started (Linux's /proc), by pid."""
+    found: list[int] = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        text = (task / "children").read_text(encoding="ascii")
+        found.extend(int(p) for p in text.split())
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="finds the worker in /proc")
+def test_a_worker_killed_mid_run_is_an_internal_error_row_not_complete(three_emulators, tmp_path):
+    rack = tmp_path / "rack"
+    argv = [*_rack_argv(three_emulators[:1], rack), "--tx", "popen"]  # a rack of one
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not [p for p in rack.glob("*") if p.is_dir()]:
+        time.sleep(0.1)  # the DUT's run has made its folder
+    time.sleep(3.0)  # inside the run
+    (worker,) = _children(proc.pid)
+    os.kill(worker, signal.SIGKILL)
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == 3, out
+    (row,) = json.loads((rack / "rack.json").read_text(encoding="utf-8"))["duts"]
+    assert row["exit_code"] == 3 and row["complete"] is False
+    assert "ended without a result" in row["errors"][0]
