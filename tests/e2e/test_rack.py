@@ -124,3 +124,12 @@ def test_a_worker_on_another_host_sends_its_folder_back(tmp_path):
     assert REPORTS - {"report.html", "junit.xml"} <= set(result["files"])
     assert result["document"]["summary"]["verdict"] == "NON-COMPLIANT"
     assert result["document"]["run"]["complete"] is True
+
+
+def test_rack_help_shows_the_rack_file_and_main_help_the_rack_options(capsys):
+    assert main(["rack", "--help"]) == 0
+    out = capsys.readouterr().out
+    assert "[[dut]]" in out and "sdi12-conform --rack FILE" in out
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    assert "--rack FILE" in out and "--tx SPEC" in out and "rack" in out
