@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from conformance.emulator_server.process import EmulatorProcess
+from tests.conftest import BUSY
 
 pytestmark = [pytest.mark.realtime, pytest.mark.slow]
 
@@ -37,13 +38,32 @@ def _rack_argv(urls: list[str], folder: Path) -> list[str]:
             "--plan", "never", "--report-dir", str(folder)]  # fmt: skip
 
 
+def _no_false_fail_else_busy(rack: Path, rows: list[dict], out: str) -> None:
+    """Never a FAIL but the faulty DUT's own rule; a DUT that a loaded machine left
+    incomplete (a rule INCONCLUSIVE at the uncertainty it measured, exit 2) skips the test
+    and says so."""
+    busy = []
+    for i, row in enumerate(rows):
+        verdicts = json.loads((rack / row["folder"] / "verdicts.json").read_text("utf-8"))
+        by_id = {r["id"]: r["verdict"] for r in verdicts["requirements"]}
+        failed = {rid for rid, v in by_id.items() if v in ("FAIL", "ERROR")}
+        allowed = {"R-4.4.12-05"} if i == 2 else set()
+        assert failed <= allowed, f"{row['name']}: false FAIL {failed - allowed}\n{out}"
+        if row["exit_code"] == 2 and verdicts["run"]["complete"]:
+            u = verdicts["run"]["link"]["timing_uncertainty_ms"]
+            busy.append(f"{row['name']} INCOMPLETE at a measured ±{u} ms")
+    if busy:
+        pytest.skip(f"{BUSY} for every rule of the rack to be decided: {', '.join(busy)}")
+
+
 def test_three_emulators_one_faulty_run_in_parallel_and_exit_1(three_emulators, tmp_path):
     rack = tmp_path / "rack"
     proc = subprocess.run(_rack_argv(three_emulators, rack), capture_output=True, text=True,
                           timeout=600)  # fmt: skip
-    assert proc.returncode == 1, proc.stdout + proc.stderr
     data = json.loads((rack / "rack.json").read_text(encoding="utf-8"))
     rows = data["duts"]
+    _no_false_fail_else_busy(rack, rows, proc.stdout)
+    assert proc.returncode == 1, proc.stdout + proc.stderr
     assert [r["exit_code"] for r in rows] == [0, 0, 1]
     assert [r["verdict"] for r in rows] == ["COMPLIANT", "COMPLIANT", "NON-COMPLIANT"]
     assert all(r["complete"] and r["serial"] == "SN0001" for r in rows)
