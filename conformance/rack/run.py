@@ -23,23 +23,10 @@ if TYPE_CHECKING:
     from .spec import Dut
 
 
-def _target(rack_dir: Path, dut: Dut, result: dict[str, Any], by_serial: bool) -> Path:
-    """Where a DUT's reports go: its name, or with a production profile its serial number
-    (``SERIAL-NAME`` when another DUT's folder has the serial's name already)."""
-    own = rack_dir / dut.name
-    document = result.get("document") or {}
-    serial = serial_folder_name((document.get("dut") or {}).get("serial")) if by_serial else None
-    if serial is None:
-        return own
-    for name in (serial, f"{serial}-{dut.name}"):
-        if name not in RESERVED and not (rack_dir / name).exists():
-            return rack_dir / name
-    return own
-
-
-def place_folder(rack_dir: Path, dut: Dut, result: dict[str, Any], by_serial: bool) -> Path | None:
-    """Put a DUT's reports where they belong; their folder (None: the run wrote none)."""
-    target = _target(rack_dir, dut, result, by_serial)
+def place_folder(rack_dir: Path, dut: Dut, result: dict[str, Any]) -> Path | None:
+    """Put a DUT's reports in its folder of the rack (a worker elsewhere sent their files);
+    the folder (None: the run wrote none)."""
+    target = rack_dir / dut.name
     files = result.get("files")
     if files is not None:  # a worker on another host: its folder's files came back
         for name, data in files.items():
@@ -48,14 +35,29 @@ def place_folder(rack_dir: Path, dut: Dut, result: dict[str, Any], by_serial: bo
             path.write_bytes(data)
         return target
     folder = Path(result["folder"]) if result.get("folder") else None
-    if folder is None or not folder.is_dir():
-        return None
-    if folder != target:
-        try:
-            folder.rename(target)
-        except OSError:
-            return folder
-    return target
+    return folder if folder is not None and folder.is_dir() else None
+
+
+def name_by_serial(rack_dir: Path, rows: list[dict[str, Any]]) -> None:
+    """Rename each DUT's folder after its sensor's serial number (from ``aI!``), once every
+    DUT has finished and in rack order, so the same rack names the same folders however
+    its workers raced: ``SERIAL``, or ``SERIAL-NAME`` for a later unit of a serial already
+    taken (a factory's duplicate serial, shown rather than hidden). ``rows`` (rack.json's)
+    get their new folders; a folder that cannot be renamed keeps its name."""
+    for row in rows:
+        serial = serial_folder_name(row["serial"])
+        if serial is None or row["folder"] is None:
+            continue
+        for name in (serial, f"{serial}-{row['name']}"):
+            target = rack_dir / name
+            if name in RESERVED or target.exists():
+                continue
+            try:
+                (rack_dir / row["folder"]).rename(target)
+            except OSError:
+                break
+            row["folder"] = name
+            break
 
 
 def job_for(options: RunOptions, dut: Dut, rack_dir: Path, plan: str) -> dict[str, Any]:
@@ -124,6 +126,11 @@ def _table(console: Console, document: dict[str, Any], rack_dir: Path) -> None:
     )
 
 
+def _by_serial(options: RunOptions) -> bool:
+    """Whether the DUT's profile names its folder by the sensor's serial (production)."""
+    return options.profile is not None and PROFILES[options.profile].folder_by_serial
+
+
 def run_rack(duts: list[Dut], per_dut: list[RunOptions], rack_dir: Path, plan: str,
              console: Console) -> int:  # fmt: skip
     """Run every DUT at once, one worker each; write the summary; the rack's exit status."""
@@ -139,10 +146,8 @@ def run_rack(duts: list[Dut], per_dut: list[RunOptions], rack_dir: Path, plan: s
     rows: dict[int, dict[str, Any]] = {}
 
     def on_result(i: int, result: dict[str, Any]) -> None:
-        options = per_dut[i]
-        by_serial = options.profile is not None and PROFILES[options.profile].folder_by_serial
-        folder = place_folder(rack_dir, duts[i], result, by_serial)
-        rows[i] = dut_row(duts[i], options.role, result, folder, rack_dir)
+        folder = place_folder(rack_dir, duts[i], result)
+        rows[i] = dut_row(duts[i], per_dut[i].role, result, folder, rack_dir)
         console.print(_line(f"[{len(rows)}/{len(duts)}] ", rows[i]), markup=False,
                       highlight=False)  # fmt: skip
 
@@ -152,6 +157,8 @@ def run_rack(duts: list[Dut], per_dut: list[RunOptions], rack_dir: Path, plan: s
     finally:
         pool.close()
     interrupted = GUARD.close()
+    ordered = [rows[i] for i in range(len(duts))]
+    name_by_serial(rack_dir, [r for r, o in zip(ordered, per_dut, strict=True) if _by_serial(o)])
     facts = {
         "folder": str(rack_dir),
         "started": started,
@@ -160,7 +167,7 @@ def run_rack(duts: list[Dut], per_dut: list[RunOptions], rack_dir: Path, plan: s
         "workers": [d.tx for d in duts],
         "interrupted": interrupted,
     }
-    document = rack_document([rows[i] for i in range(len(duts))], facts)
+    document = rack_document(ordered, facts)
     write_json(document, rack_dir / "rack.json")
     write_junit(document["duts"], rack_dir)
     write_index(document, rack_dir)

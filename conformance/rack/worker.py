@@ -101,7 +101,8 @@ def run_dut(job: dict[str, Any]) -> dict[str, Any]:
         folder = Path(job["report_dir"]) if not ship else Path(tmp) / "run"
         options.report_dir = str(folder)
         if job.get("declaration_text") is not None:
-            options.declaration = str(Path(tmp) / "declaration.toml")
+            name = Path(options.declaration or "declaration.toml").name  # the rack's name
+            options.declaration = str(Path(tmp) / name)
             Path(options.declaration).write_text(job["declaration_text"], encoding="utf-8")
         errors = io.StringIO()
         code, document = _run(options, job.get("plan") or "auto", errors)

@@ -16,6 +16,7 @@ from conformance.cli import main
 from conformance.interrupts import GUARD
 from conformance.rack.worker import run_dut
 from conformance.run import RunOptions
+from tests.support.socket_worker import socket_worker_host
 
 REPORTS = {"verdicts.json", "report.html", "junit.xml", "transcript.jsonl"}
 
@@ -133,3 +134,27 @@ def test_rack_help_shows_the_rack_file_and_main_help_the_rack_options(capsys):
     assert main(["--help"]) == 0
     out = capsys.readouterr().out
     assert "--rack FILE" in out and "--tx SPEC" in out and "rack" in out
+
+
+def test_a_worker_elsewhere_gets_its_declaration_and_sends_its_reports_back(tmp_path):
+    """A worker that is not a local process (execnet's socket server on loopback stands for
+    another host): its declaration goes over as text, its folder's files come back."""
+    (tmp_path / "decl.toml").write_text('address = "0"\n', encoding="utf-8")
+    rack = tmp_path / "rack"
+    with socket_worker_host() as spec:
+        (tmp_path / "bench.toml").write_text(
+            '[[dut]]\nname = "near"\nport = "sim"\n'
+            '[[dut]]\nname = "far"\nport = "sim://?faults=wrong-crc"\n'
+            f'declaration = "decl.toml"\ntx = "{spec}"\n',
+            encoding="utf-8",
+        )
+        code = main(["rack", str(tmp_path / "bench.toml"), "--profile", "production",
+                     "--report-dir", str(rack)])  # fmt: skip
+    assert code == 1
+    near, far = _rack_json(rack)["duts"]
+    assert far["worker"] == spec and far["exit_code"] == 1 and far["folder"] == "SN0001-far"
+    assert {p.name for p in (rack / far["folder"]).iterdir()} >= REPORTS
+    verdicts = json.loads((rack / far["folder"] / "verdicts.json").read_text(encoding="utf-8"))
+    copy = Path(verdicts["dut"]["declaration"])  # the worker's own copy, by the file's name
+    assert copy.name == "decl.toml" and copy.parent != tmp_path
+    assert verdicts["run"]["complete"] and near["exit_code"] == 0

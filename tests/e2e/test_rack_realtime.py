@@ -17,6 +17,7 @@ import pytest
 
 from conformance.emulator_server.process import EmulatorProcess
 from tests.conftest import BUSY
+from tests.support.socket_worker import socket_worker_host
 
 pytestmark = [pytest.mark.realtime, pytest.mark.slow]
 
@@ -76,20 +77,32 @@ def test_three_emulators_one_faulty_run_in_parallel_and_exit_1(three_emulators, 
     assert data["rack"]["wall_s"] < 0.8 * sum(walls), (data["rack"]["wall_s"], walls)
     for name in ("index.html", "junit.xml"):
         assert (rack / name).is_file()
-    assert proc.stdout.count("-> SN0001") == 6  # a line as each finished, a line each at the end
+    # a line as each finished (its own name), then the rack in order (by serial, named once
+    # every DUT had finished, in rack order: the same folders however the workers raced)
+    assert [r["folder"] for r in rows] == ["SN0001", f"SN0001-{rows[1]['name']}",
+                                           f"SN0001-{rows[2]['name']}"]  # fmt: skip
+    assert proc.stdout.count("-> SN0001") == 3 and proc.stdout.count("-> 1-rfc2217") == 1
 
 
 @pytest.mark.quiet
 def test_ctrl_c_stops_every_worker_and_every_report_says_incomplete(three_emulators, tmp_path):
+    """Two local workers and one elsewhere (execnet's socket server stands for another
+    host: its stop goes over the channel, its partial report comes back)."""
     rack = tmp_path / "rack"
-    proc = subprocess.Popen(_rack_argv(three_emulators, rack), stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True)  # fmt: skip
+    with socket_worker_host() as elsewhere:
+        argv = [*_rack_argv(three_emulators, rack), "--tx", "popen", "--tx", "popen",
+                "--tx", elsewhere]  # fmt: skip
+        _interrupted(argv, rack)
+
+
+def _interrupted(argv: list[str], rack: Path) -> None:
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:  # every DUT's run has its folder: the runs are on
-        if len([p for p in rack.glob("*") if p.is_dir()]) == 3:
+    while time.monotonic() < deadline:  # the local DUTs' runs have their folders
+        if len([p for p in rack.glob("*") if p.is_dir()]) == 2:
             break
         time.sleep(0.1)
-    time.sleep(3.0)  # well inside the runs (each is 20 s or more on the bus)
+    time.sleep(4.0)  # well inside the runs (each is 20 s or more on the bus)
     began = time.monotonic()
     proc.send_signal(signal.SIGINT)
     out, _ = proc.communicate(timeout=120)
@@ -100,6 +113,7 @@ def test_ctrl_c_stops_every_worker_and_every_report_says_incomplete(three_emulat
     data = json.loads((rack / "rack.json").read_text(encoding="utf-8"))
     assert data["rack"]["interrupted"] and not data["rack"]["complete"]
     assert data["rack"]["exit_code"] == 2
+    assert data["duts"][2]["worker"].startswith("socket=")
     for row in data["duts"]:
         assert row["exit_code"] == 2 and row["complete"] is False, row
         verdicts = json.loads((rack / row["folder"] / "verdicts.json").read_text(encoding="utf-8"))

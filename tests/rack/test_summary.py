@@ -20,7 +20,7 @@ from conformance.exits import (
 )
 from conformance.rack.index_html import write_index
 from conformance.rack.junit import write_junit
-from conformance.rack.run import place_folder
+from conformance.rack.run import name_by_serial, place_folder
 from conformance.rack.spec import Dut
 from conformance.rack.summary import WORST_FIRST, dut_row, rack_document, worst
 
@@ -136,21 +136,22 @@ def test_index_html_has_a_row_per_dut_linking_its_report_and_escapes_what_device
     assert "exit 4 (usage error)" in page
 
 
-def test_a_production_folder_is_named_by_serial_and_a_second_unit_of_that_serial_by_both(tmp_path):
-    result = _result(0, _document("COMPLIANT", True, serial="SN 42/7"))
-    for name in ("a", "b"):
+def test_production_folders_are_named_by_serial_in_rack_order_a_repeated_serial_by_both(
+    tmp_path,
+):
+    rows = []
+    for name, serial in (("a", "SN 42/7"), ("b", "SN 42/7"), ("c", None), ("d", "SN9")):
         (tmp_path / name).mkdir()
-        result["folder"] = str(tmp_path / name)
-        place_folder(tmp_path, Dut(name, "sim"), result, by_serial=True)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["SN_42_7", "SN_42_7-b"]
-    (tmp_path / "c").mkdir()
-    result["folder"] = str(tmp_path / "c")
-    assert place_folder(tmp_path, Dut("c", "sim"), result, by_serial=False) == tmp_path / "c"
+        rows.append({"name": name, "serial": serial, "folder": name})
+    rows.append({"name": "e", "serial": "SN9", "folder": None})  # wrote nothing
+    name_by_serial(tmp_path, rows)
+    assert [r["folder"] for r in rows] == ["SN_42_7", "SN_42_7-b", "c", "SN9", None]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["SN9", "SN_42_7", "SN_42_7-b", "c"]
 
 
 def test_files_sent_back_by_a_worker_elsewhere_land_in_the_dut_folder(tmp_path):
     files = {"verdicts.json": b"{}", "sub/plan.json": b"[]"}
     folder = place_folder(tmp_path, Dut("far", "/dev/ttyUSB0", tx="ssh=h"),
-                          _result(0, None, files=files), by_serial=True)  # fmt: skip
+                          _result(0, None, files=files))  # fmt: skip
     assert folder == tmp_path / "far"
     assert (folder / "sub" / "plan.json").read_bytes() == b"[]"
