@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..atomic import atomic_path
+from .summary import verdict_text
 
 _STYLE = """
 body{font-family:system-ui,sans-serif;margin:1.5em;color:#222}
@@ -23,11 +24,6 @@ def _counts(counts: dict[str, int] | None) -> str:
     if not counts:
         return ""
     return ", ".join(f"{counts[k]} {k}" for k in _COUNT_KEYS if counts.get(k))
-
-
-def _verdict(row: dict[str, Any]) -> str:
-    verdict = row["verdict"] or "(none)"
-    return verdict if row["complete"] or verdict == "INCOMPLETE" else f"{verdict} (incomplete)"
 
 
 def _report_link(row: dict[str, Any], rack_dir: Path) -> str:
@@ -45,7 +41,7 @@ def _row(row: dict[str, Any], rack_dir: Path) -> str:
         f"<code>{escape(row['port'])}</code>",
         escape(ident),
         escape(row["serial"] or ""),
-        escape(_verdict(row)),
+        escape(verdict_text(row)),
         escape(_counts(row["counts"])),
         f"{row['exit_code']} ({escape(row['meaning'])})",
         _report_link(row, rack_dir),

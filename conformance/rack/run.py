@@ -9,12 +9,12 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..exits import EXIT_COMPLIANT, EXIT_NON_COMPLIANT
+from ..exits import EXIT_COMPLIANT, EXIT_INCOMPLETE, EXIT_NON_COMPLIANT, say_error
 from ..interrupts import GUARD
 from ..profiles import PROFILES
 from ..report_folder import serial_folder_name
 from .spec import RESERVED
-from .summary import dut_row, rack_document, write_json
+from .summary import dut_row, rack_document, verdict_text, write_json
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -83,10 +83,7 @@ def job_for(options: RunOptions, dut: Dut, rack_dir: Path, plan: str) -> dict[st
 def _line(prefix: str, row: dict[str, Any]) -> str:
     """One DUT's line: its verdict, exit status, time and folder, and why, where it has no
     verdict of its own."""
-    verdict = row["verdict"] or "no verdict"
-    if row["verdict"] not in (None, "INCOMPLETE") and not row["complete"]:
-        verdict += " (incomplete)"
-    text = (f"{prefix}{row['name']} ({row['port']}): {verdict}, exit "
+    text = (f"{prefix}{row['name']} ({row['port']}): {verdict_text(row)}, exit "
             f"{row['exit_code']} ({row['meaning']})")  # fmt: skip
     if row["wall_s"] is not None:
         text += f" in {row['wall_s']:.1f} s"
@@ -108,9 +105,7 @@ def _table(console: Console, document: dict[str, Any], rack_dir: Path) -> None:
         for column in ("DUT", "port", "serial", "verdict", "exit", "folder"):
             table.add_column(column, overflow="fold")
         for row in rows:
-            verdict = row["verdict"] or "-"
-            verdict += "" if row["complete"] or verdict == "INCOMPLETE" else " (incomplete)"
-            table.add_row(row["name"], row["port"], row["serial"] or "-", verdict,
+            table.add_row(row["name"], row["port"], row["serial"] or "-", verdict_text(row),
                           f"{row['exit_code']} {row['meaning']}", row["folder"] or "-")  # fmt: skip
         console.print(table)
     else:
@@ -143,6 +138,9 @@ def run_rack(duts: list[Dut], per_dut: list[RunOptions], rack_dir: Path, plan: s
     console.print(f"rack: {len(duts)} DUTs, one worker each ({workers}) -> {rack_dir}",
                   markup=False, highlight=False)  # fmt: skip
     jobs = [job_for(o, d, rack_dir, plan) for o, d in zip(per_dut, duts, strict=True)]
+    if GUARD.requested:  # Ctrl-C while the rack was being checked: no DUT was touched
+        say_error("interrupted before the rack started: nothing was sent to any DUT; no report")
+        return EXIT_INCOMPLETE
     rows: dict[int, dict[str, Any]] = {}
 
     def on_result(i: int, result: dict[str, Any]) -> None:

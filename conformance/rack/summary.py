@@ -52,6 +52,15 @@ def meaning(code: int) -> str:
     return _MEANING.get(code, f"exit {code}")
 
 
+def verdict_text(row: dict[str, Any]) -> str:
+    """A DUT's verdict as the console and index.html show it: an incomplete run's verdict
+    says so (an INCOMPLETE one already does)."""
+    verdict = row["verdict"]
+    if verdict is None:
+        return "no verdict"
+    return verdict if row["complete"] or verdict == "INCOMPLETE" else f"{verdict} (incomplete)"
+
+
 def dut_row(dut: Any, role: str, result: dict[str, Any], folder: Path | None,
             rack_dir: Path) -> dict[str, Any]:  # fmt: skip
     """One DUT's row of rack.json from its worker's result; ``folder``: where its reports

@@ -6,6 +6,7 @@ The rack of RFC 2217 emulators and its Ctrl-C are in test_rack_realtime.py."""
 
 from __future__ import annotations
 
+import io
 import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -158,3 +159,21 @@ def test_a_worker_elsewhere_gets_its_declaration_and_sends_its_reports_back(tmp_
     copy = Path(verdicts["dut"]["declaration"])  # the worker's own copy, by the file's name
     assert copy.name == "decl.toml" and copy.parent != tmp_path
     assert verdicts["run"]["complete"] and near["exit_code"] == 0
+
+
+def test_ctrl_c_before_the_rack_starts_touches_no_dut(tmp_path, capsys):
+    from rich.console import Console
+
+    from conformance.rack.run import run_rack
+    from conformance.rack.spec import duts_from_ports
+
+    duts = duts_from_ports(["sim", "sim"])
+    GUARD.requested = True  # as the guard records a Ctrl-C while the rack is checked
+    try:
+        code = run_rack(duts, [RunOptions(port=d.port) for d in duts], tmp_path, "never",
+                        Console(file=io.StringIO()))  # fmt: skip
+    finally:
+        GUARD.reset()
+    assert code == 2
+    assert "nothing was sent to any DUT" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

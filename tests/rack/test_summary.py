@@ -155,3 +155,14 @@ def test_files_sent_back_by_a_worker_elsewhere_land_in_the_dut_folder(tmp_path):
                           _result(0, None, files=files))  # fmt: skip
     assert folder == tmp_path / "far"
     assert (folder / "sub" / "plan.json").read_bytes() == b"[]"
+
+
+def test_a_verdict_says_when_its_run_was_not_complete():
+    from conformance.rack.summary import verdict_text
+
+    assert verdict_text({"verdict": "COMPLIANT", "complete": True}) == "COMPLIANT"
+    assert verdict_text({"verdict": "NON-COMPLIANT", "complete": False}) == (
+        "NON-COMPLIANT (incomplete)"
+    )
+    assert verdict_text({"verdict": "INCOMPLETE", "complete": False}) == "INCOMPLETE"
+    assert verdict_text({"verdict": None, "complete": False}) == "no verdict"
