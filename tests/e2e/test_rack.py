@@ -11,8 +11,10 @@ import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import jsonschema
 import pytest
 
+import conformance
 from conformance.cli import main
 from conformance.interrupts import GUARD
 from conformance.rack.worker import run_dut
@@ -22,8 +24,16 @@ from tests.support.socket_worker import socket_worker_host
 REPORTS = {"verdicts.json", "report.html", "junit.xml", "transcript.jsonl"}
 
 
+SCHEMA = json.loads(
+    (Path(conformance.__file__).parent / "schemas" / "rack-1.json").read_text(encoding="utf-8")
+)
+
+
 def _rack_json(folder: Path) -> dict:
-    return json.loads((folder / "rack.json").read_text(encoding="utf-8"))
+    """rack.json, checked against its contract (schemas/rack-1.json)."""
+    data = json.loads((folder / "rack.json").read_text(encoding="utf-8"))
+    jsonschema.Draft202012Validator(SCHEMA).validate(data)
+    return data
 
 
 def test_a_sim_rack_with_a_faulty_dut_exits_1_with_a_folder_per_dut_named_by_serial(tmp_path):

@@ -166,3 +166,23 @@ def test_a_verdict_says_when_its_run_was_not_complete():
     )
     assert verdict_text({"verdict": "INCOMPLETE", "complete": False}) == "INCOMPLETE"
     assert verdict_text({"verdict": None, "complete": False}) == "no verdict"
+
+
+def test_rack_json_holds_its_contract_and_the_contract_can_refuse(tmp_path):
+    import json
+
+    import jsonschema
+
+    import conformance
+
+    schema = json.loads((Path(conformance.__file__).parent / "schemas" / "rack-1.json")
+                        .read_text(encoding="utf-8"))  # fmt: skip
+    validator = jsonschema.Draft202012Validator(schema)
+    facts = {"folder": str(tmp_path), "started": "2026-12-04T18:00:00+00:00",
+             "finished": "2026-12-04T18:00:30+00:00", "wall_s": 30.0,
+             "workers": ["popen"] * 3, "interrupted": False}  # fmt: skip
+    document = rack_document(_rows(tmp_path), facts)
+    validator.validate(document)
+    renamed = json.loads(json.dumps(document))
+    renamed["duts"][0]["exit"] = renamed["duts"][0].pop("exit_code")
+    assert not validator.is_valid(renamed)
