@@ -27,6 +27,7 @@ import io
 import os
 import platform
 import signal
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -120,10 +121,33 @@ def run_dut(job: dict[str, Any]) -> dict[str, Any]:
         }
 
 
+def cannot_run(why: str) -> dict[str, Any]:
+    """The result of a worker whose Python cannot run the tool (not installed there)."""
+    return {
+        "exit_code": 3,  # exits.EXIT_INTERNAL: the rack's tool could not run on that host
+        "folder": None,
+        "document": None,
+        "errors": [why],
+        "files": None,
+        "wall_s": None,
+        "host": platform.node(),
+        "pid": os.getpid(),
+    }
+
+
 def serve(channel: Any) -> None:
     """The worker's life: one job in, one result out, a stop heard in between."""
     _own_process_group()
-    from conformance.interrupts import GUARD
+    try:
+        from conformance.interrupts import GUARD
+    except ImportError as exc:  # a host whose Python has no sdi12-conform
+        channel.receive()
+        channel.send(cannot_run(
+            f"the worker's Python ({sys.executable}) cannot run sdi12-conform: "
+            f"{type(exc).__name__}: {exc}; install sdi12-conform there, or name another "
+            "python in its spec (//python=PATH)"
+        ))  # fmt: skip
+        return
 
     GUARD.reset()
     GUARD.install()  # the main thread (execmodel main_thread_only): Ctrl-C is the run's

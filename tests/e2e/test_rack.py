@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 import json
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -187,3 +188,21 @@ def test_ctrl_c_before_the_rack_starts_touches_no_dut(tmp_path, capsys):
     assert code == 2
     assert "nothing was sent to any DUT" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_worker_whose_python_lacks_the_tool_says_so(tmp_path):
+    """A host whose Python has no sdi12-conform (here: the same Python without its site
+    packages, in a folder without the source) is a row that says what to install where."""
+    python = tmp_path / "python"
+    python.write_text(f'#!/bin/sh\nexec {sys.executable} -S -E "$@"\n', encoding="utf-8")
+    python.chmod(0o755)
+    rack = tmp_path / "rack"
+    code = main(["--port", "sim", "--port", "sim", "-k", "test_identification",
+                 "--tx", "popen", "--tx", f"popen//python={python}//chdir={tmp_path}",
+                 "--report-dir", str(rack)])  # fmt: skip
+    assert code == 3
+    first, second = _rack_json(rack)["duts"]
+    assert first["exit_code"] == 0
+    assert second["exit_code"] == 3 and second["folder"] is None
+    assert "cannot run sdi12-conform" in second["errors"][0]
+    assert "No module named 'conformance'" in second["errors"][0]
