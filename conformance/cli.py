@@ -47,6 +47,8 @@ examples:
   sdi12-conform emulate --listen 127.0.0.1:4001            serve the emulator over RFC 2217
   sdi12-conform calibrate --port /dev/ttyUSB0              measure the bench's timing first
   sdi12-conform monitor --port /dev/ttyUSB0                listen to a live bus (never transmits)
+  sdi12-conform --port sim --port 'sim://?faults=wrong-crc' a rack: one worker per port
+  sdi12-conform rack bench.toml --profile production       a rack file's DUTs, in parallel
 
 exit codes (every subcommand): 0 compliant/success, 1 non-compliant (matrix: a fault not
   caught exactly), 2 interrupted/incomplete, 3 internal error, 4 usage error, 5 no device
@@ -125,6 +127,24 @@ def build_parser() -> argparse.ArgumentParser:
         "minutes and the dry run a few seconds (default: auto, or $SDI12_PLAN)",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output")
+    rack = p.add_argument_group(
+        "a rack (many DUTs in one run, each in a worker process of its own: --port given "
+        "more than once, or --rack FILE; README 'A rack')"
+    )
+    rack.add_argument(
+        "--rack",
+        metavar="FILE",
+        help="a TOML rack file naming each DUT's port, and where they differ, its role, "
+        "address, declaration, folder name and worker (sdi12-conform rack --help)",
+    )
+    rack.add_argument(
+        "--tx",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="where the workers run, as pytest-xdist's --tx: popen (default), "
+        "ssh=HOST//python=PATH, N*SPEC; repeatable, given to the DUTs in turn",
+    )
     return p
 
 
@@ -198,20 +218,9 @@ def run_suite(
 def check_run_options(options: RunOptions) -> bool:
     """Refuse what the run cannot use before anything goes on the bus (a usage error, exit 4,
     rather than a late one); whether the port runs in real time."""
-    from .declaration import load_declaration, normalise_version
-    from .options import check_values
-    from .preflight import check_role_options
-    from .selection import resolve
+    from .preflight import check_options_offline
 
-    check_role_options(
-        options.role, options.trigger, options.address, options.sweep, options.job_timeout,
-    )  # fmt: skip
-    check_values(vars(options), plugin=False)
-    resolve(options.role, list(options.requirements))  # --req names rules the role can test
-    if options.version:
-        normalise_version(options.version)
-    if options.declaration:
-        load_declaration(options.declaration)
+    check_options_offline(options)
     if options.role == "recorder":
         from .recorder.scenario_runner import check_port
 
@@ -567,6 +576,7 @@ SUBCOMMAND_HELP = {
     "diff": "what changed between two runs (exit 1 when anything got worse)",
     "verify": "check a run folder without the device: hashes, then the recording re-judged",
     "plan": "the test plan without touching the bus: cases, what they send, expected bus time",
+    "rack": "many DUTs in one run from a rack file (rack FILE [options]; --port twice: the same)",
 }
 
 
@@ -636,13 +646,28 @@ def error(text: str) -> None:
     make_console(stderr=True).print(text, style="red", markup=False, highlight=False)
 
 
-def _main_command(args: argparse.Namespace, console: Console) -> int:
-    """The main command: one DUT (:func:`run_suite`), or several sensors on one line
-    (``--address 0,1,3`` / ``all``: :mod:`conformance.commands.bus`)."""
+def _main_command(argv: list[str], console: Console) -> int:
+    """The main command: one DUT (:func:`run_suite`), a rack when it names several DUTs
+    (:mod:`conformance.rack`), or several sensors on one line (``--address 0,1,3`` / ``all``:
+    :mod:`conformance.commands.bus`)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:
+        return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
     from .options import is_bus
+    from .rack.command import is_rack, rack_main
 
     baseline = getattr(args, "baseline", None)
-    if is_bus(args.address):
+    bus = is_bus(args.address)
+    if is_rack(argv, args):  # --port twice or more, --rack, --tx: a rack
+        if bus:
+            error(
+                "error: a rack runs one DUT per port: --address 0,1,3 / all (several sensors "
+                "on one line) is for a run of one port"
+            )
+            return EXIT_USAGE
+        return rack_main(argv, args, options_from_args(args), console)
+    if bus:
         from .commands.bus import run_bus
 
         if baseline:
@@ -694,6 +719,11 @@ def _dispatch(argv: list[str]) -> int:
             from .commands.verify import verify_main
 
             return verify_main(argv[1:], console, cmd_judge)
+        if argv and argv[0] == "rack":  # rack FILE ...: the main command's --rack FILE ...
+            from .rack.command import rack_argv
+
+            given = rack_argv(argv[1:], console)
+            return given if isinstance(given, int) else _main_command(given, console)
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 
@@ -707,11 +737,7 @@ def _dispatch(argv: list[str]) -> int:
             )
             error(subcommands_text().rstrip())
             return EXIT_USAGE
-        try:
-            args = build_parser().parse_args(argv)
-        except SystemExit as exc:
-            return EXIT_COMPLIANT if exc.code == 0 else EXIT_USAGE
-        return _main_command(args, console)
+        return _main_command(argv, console)
     except SystemExit as exc:  # argparse of a subcommand: --help (0) or a usage error (2)
         return EXIT_COMPLIANT if exc.code in (0, None) else EXIT_USAGE
     except KeyboardInterrupt:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
+from typing import Any
 
 from .declaration import ALLOWED_ADDRESSES, address_problem
 from .options import UsageError, check_address, check_uncertainty
@@ -22,6 +23,25 @@ __all__ = [
     "check_role_options",
     "check_uncertainty",
 ]
+
+
+def check_options_offline(options: Any) -> None:
+    """Every check of a run's options that needs no port (``sdi12-conform`` makes them
+    before it opens one; a rack makes them for each DUT before any worker starts).
+    ``options``: a :class:`~conformance.run.RunOptions`."""
+    from .declaration import load_declaration, normalise_version
+    from .options import check_values
+    from .selection import resolve
+
+    check_role_options(
+        options.role, options.trigger, options.address, options.sweep, options.job_timeout,
+    )  # fmt: skip
+    check_values(vars(options), plugin=False)
+    resolve(options.role, list(options.requirements))  # --req names rules the role can test
+    if options.version:
+        normalise_version(options.version)
+    if options.declaration:
+        load_declaration(options.declaration)
 
 
 def check_role_options(

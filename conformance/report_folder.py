@@ -124,13 +124,20 @@ def held(path: Path) -> Iterator[Path]:
         release(path)
 
 
+def serial_folder_name(serial: str | None) -> str | None:
+    """A serial number as a folder name (a character a path cannot hold becomes ``_``);
+    None when nothing usable is left (no serial, or only dots and dashes)."""
+    safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in (serial or "").strip())
+    return safe if safe.strip("._-") else None
+
+
 def named_by_serial(folder: Path, serial: str | None, kind: str) -> Path:
     """A finished run's own new folder ``STAMP-kind`` renamed ``STAMP-SERIAL`` (the sensor's
     serial number from its ``aI!`` reply: a production line's reports found by unit), and
     its new path; ``folder`` itself when there is no usable serial or the name is taken.
     The run's lock is let go first: the run is over, and the lock would move with it."""
-    safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in (serial or "").strip())
-    if not safe.strip("._-") or not folder.name.endswith(f"-{kind}"):
+    safe = serial_folder_name(serial)
+    if safe is None or not folder.name.endswith(f"-{kind}"):
         return folder
     target = folder.with_name(folder.name[: -len(kind)] + safe)
     release(folder)

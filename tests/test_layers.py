@@ -80,7 +80,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # pytest's side: options, fixtures, hooks that turn findings into outcomes and reports
     ("plugin", ("plugin",)),
     # the command line: the main command and the subcommands that render as they go
-    ("cli", ("cli", "commands")),
+    ("cli", ("cli", "commands", "rack")),
 )
 
 LAYER_OF = {name: rank for rank, (_, names) in enumerate(LAYERS) for name in names}
