@@ -16,6 +16,7 @@ body{font-family:system-ui,sans-serif;margin:1.5em;color:#222}
 table{border-collapse:collapse}th,td{border:1px solid #ccc;padding:.3em .6em;text-align:left}
 th{background:#f3f3f3}.code-0{background:#e6f4e6}.code-1{background:#fde2e2}
 .code-2,.code-3,.code-4,.code-5{background:#fff3cd}code{font-size:90%}
+.rid{font-family:monospace;font-size:90%}
 """
 _COUNT_KEYS = ("PASS", "FAIL", "WARN", "INCONCLUSIVE", "N/A", "ERROR")
 
@@ -41,7 +42,8 @@ def _row(row: dict[str, Any], rack_dir: Path) -> str:
         f"<code>{escape(row['port'])}</code>",
         escape(ident),
         escape(row["serial"] or ""),
-        escape(verdict_text(row)),
+        escape(verdict_text(row))
+        + "".join(f'<br><span class="rid">{escape(r)}</span>' for r in row.get("failed", [])),
         escape(_counts(row["counts"])),
         f"{row['exit_code']} ({escape(row['meaning'])})",
         _report_link(row, rack_dir),

@@ -13,7 +13,8 @@ STOP = "stop"
 
 def slim_document(document: dict[str, Any] | None) -> dict[str, Any] | None:
     """What the rack's summary reads of a DUT's verdicts.json (its full file stays in its
-    folder): the summary, the run's completeness and the DUT's identity."""
+    folder): the summary, the run's completeness, the DUT's identity and the requirements it
+    FAILed (what a production line's operator needs to see in the rack's row)."""
     if document is None:
         return None
     run = document["run"]
@@ -22,4 +23,9 @@ def slim_document(document: dict[str, Any] | None) -> dict[str, Any] | None:
         "summary": document["summary"],
         "run": {key: run.get(key) for key in keep},
         "dut": document["dut"],
+        "failed": [
+            r["id"]
+            for r in document.get("requirements", [])
+            if r.get("verdict") == "FAIL" and r.get("selected", True)
+        ],
     }

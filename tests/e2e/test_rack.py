@@ -57,11 +57,13 @@ def test_a_sim_rack_with_a_faulty_dut_exits_1_with_a_folder_per_dut_named_by_ser
     verdicts = json.loads((rack / "SN0001-2-sim" / "verdicts.json").read_text(encoding="utf-8"))
     failed = {r["id"] for r in verdicts["requirements"] if r["verdict"] == "FAIL"}
     assert failed == {"R-4.4.12-05"}  # the fault's own rule, as a single run finds it
+    assert (good["failed"], bad["failed"]) == ([], ["R-4.4.12-05"])  # the row says which
     suites = ET.parse(rack / "junit.xml").getroot().findall("testsuite")
     assert [s.get("name") for s in suites] == ["1-sim", "2-sim"]
     assert [s.get("failures") for s in suites] == ["0", "2"]
     page = (rack / "index.html").read_text(encoding="utf-8")
     assert 'href="SN0001/report.html"' in page and 'href="SN0001-2-sim/report.html"' in page
+    assert '<span class="rid">R-4.4.12-05</span>' in page
     assert not (rack / ".sdi12-conform.lock").exists()
 
 
