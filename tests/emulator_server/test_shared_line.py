@@ -116,3 +116,38 @@ def test_make_bus_refuses_what_sim_refuses():
         make_bus("1.4", "0,1:no-such-fault", "")
     with pytest.raises(PortError, match="several sensors"):
         make_bus("1.4", "0", "")
+
+
+def test_the_real_time_line_serves_each_sensor_of_the_bus():
+    """The served line itself (its thread, the wall clock) with a bus on it: each sensor
+    answers its own aI!, whole, and no other sensor speaks (timing is the realtime tests')."""
+    import threading
+    import time
+
+    from conformance.emulator_server.realtime import RealTimeLine
+
+    heard: list[tuple[float, int]] = []
+    lock = threading.Lock()
+
+    def send(data: bytes) -> None:
+        with lock:
+            heard.extend((time.perf_counter(), b) for b in data)
+
+    line = RealTimeLine(make_bus("1.4", "0,1,3", ""), send).start()
+    try:
+        for address, serial in (("3", "SN0003"), ("1", "SN0002")):
+            heard.clear()
+            line.break_on()
+            time.sleep(0.013)
+            line.break_off()
+            time.sleep(0.010)
+            line.tool_bytes(bytes(to_wire_7e1(ord(c)) for c in f"{address}I!"))
+            deadline = time.monotonic() + 3.0
+            while not (heard and heard[-1][1] & 0x7F == 0x0A) and time.monotonic() < deadline:
+                time.sleep(0.005)
+            with lock:
+                text = "".join(chr(b & 0x7F) for _t, b in heard)
+            assert text.startswith(f"{address}14") and serial in text and text.endswith("\r\n")
+            assert text.count("\n") == 1, text
+    finally:
+        line.stop()
