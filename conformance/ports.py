@@ -170,6 +170,19 @@ def open_sim_bus(spec: SimSpec) -> OpenedPort:
     Every character they send is stamped ``dut``, as a real bus shows it: which sensor spoke
     is for the run to tell from the address, not for the simulation to give away."""
     from .sim.bus import SimBus, SimLink
+
+    emulators = bus_emulators(spec)
+    link = SimLink(SimBus(list(emulators)))
+    declared = emulators[0].faults.declared_profile(default_profile(spec.version))
+    bus_spec = replace(spec, address="")  # no sensor of a bus is called fresh from the factory
+    return OpenedPort(link, list(emulators), sim_declaration(declared, bus_spec))
+
+
+def bus_emulators(spec: SimSpec) -> list[SensorEmulator]:
+    """The emulators of ``sensors=`` (see :func:`open_sim_bus`), each checked as one sim URL
+    would be (:class:`PortError` with the reason): the one place the simulated bus and
+    ``emulate --sensors`` (a bus served in real time) make them, so both carry the same serial
+    numbers and faults."""
     from .transcript import DUT
 
     emulators = []
@@ -178,10 +191,7 @@ def open_sim_bus(spec: SimSpec) -> OpenedPort:
         profile = replace(sim_profile(one), optional=f"SN{n:04d}")
         quirks = profile_settings(spec.profiles)[1]
         emulators.append(SensorEmulator(profile, all_faults(one), name=DUT, quirks=quirks))
-    link = SimLink(SimBus(list(emulators)))
-    declared = emulators[0].faults.declared_profile(default_profile(spec.version))
-    bus_spec = replace(spec, address="")  # no sensor of a bus is called fresh from the factory
-    return OpenedPort(link, list(emulators), sim_declaration(declared, bus_spec))
+    return emulators
 
 
 def _load(path: str) -> Declaration:

@@ -3,7 +3,9 @@
 Serves the same emulator as ``--port sim`` (profile version, address, faults: the parameters
 of a ``sim://`` URL) either as an RFC 2217 server on a TCP port, as raw bytes on a TCP port
 (what ``socket://`` speaks; no breaks), or on a serial port. A recorder, or this tool with
-``--port rfc2217://HOST:PORT``, then talks to it as to a sensor on a bus.
+``--port rfc2217://HOST:PORT``, then talks to it as to a sensor on a bus. With ``--sensors
+0,1:FAULT,3`` (the ``sensors=`` of a ``sim://`` URL) several emulators share the one served line
+(:mod:`.shared_line`), for ``--address all`` runs over a real-time link.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
 from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
+from .shared_line import SharedLine
 from .tap import TapServer, parse_tap
 
 PORT_MAX = 65535
@@ -32,7 +35,9 @@ def build_parser() -> argparse.ArgumentParser:
         "  sdi12-conform emulate --listen 127.0.0.1:4001\n"
         "  sdi12-conform --port rfc2217://127.0.0.1:4001     (in another shell)\n"
         "  sdi12-conform emulate --listen 127.0.0.1:4001 --faults no-service-request\n"
-        "  sdi12-conform emulate --serial /dev/ttyUSB1 --version 1.3 --address 5",
+        "  sdi12-conform emulate --serial /dev/ttyUSB1 --version 1.3 --address 5\n"
+        "  sdi12-conform emulate --listen 127.0.0.1:4001 --sensors 0,1:answers-foreign-reply,3\n"
+        "  sdi12-conform --port rfc2217://127.0.0.1:4001 --address all  (a bus of three)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     where = p.add_mutually_exclusive_group(required=True)
@@ -51,7 +56,15 @@ def build_parser() -> argparse.ArgumentParser:
         "send is dropped (for `sdi12-conform monitor`)",
     )
     p.add_argument("--version", dest="sdi_version", default="1.4", help="1.3 or 1.4 (default)")
-    p.add_argument("--address", default="0", help="the sensor's address (default 0)")
+    p.add_argument("--address", default=None, help="the sensor's address (default 0)")
+    p.add_argument(
+        "--sensors",
+        metavar="A[:FAULT+FAULT],...",
+        default=None,
+        help="several sensors on the one line, as sim://?sensors= (e.g. 0,1:wrong-crc,3): "
+        "each its address, serial number SN0001.. in order, and own faults; --faults and "
+        "--version apply to every one (not with --address)",
+    )
     p.add_argument("--faults", default="", help="comma-separated fault names (see `faults`)")
     bench = p.add_argument_group(
         "bench models (what a real interface between recorder and line does; default: none)"
@@ -113,6 +126,37 @@ def make_device(version: str, address: str, faults: str) -> object:
     return SensorEmulator(sim_profile(spec), spec.faults)
 
 
+def make_bus(version: str, sensors: str, faults: str) -> SharedLine:
+    """The emulators a ``sim://?sensors=..`` URL would put on the simulated bus, as one device
+    of the served line (raises :class:`PortError` with the reason)."""
+    from urllib.parse import urlencode
+
+    from ..ports import bus_emulators
+
+    query = {"version": version, "sensors": sensors, "faults": faults}
+    return SharedLine(bus_emulators(parse_sim("sim://?" + urlencode(query))))
+
+
+def serving_what(args: argparse.Namespace, bench: BenchModel) -> tuple[object, str]:
+    """The device the options ask for (one sensor, or a :class:`SharedLine` of several) and
+    the words the server's first line says it with (raises :class:`PortError`)."""
+    faults = args.faults or "none"
+    if args.sensors is not None:
+        if args.address is not None:
+            raise PortError("--sensors gives every sensor its address: no --address with it")
+        bus = make_bus(args.sdi_version, args.sensors, args.faults)
+        return bus, (
+            f"bus of {len(bus.devices)} reference sensors v{args.sdi_version} "
+            f"({args.sensors}), faults on every one: {faults}, bench: {bench.describe()}"
+        )
+    address = args.address or "0"
+    device = make_device(args.sdi_version, address, args.faults)
+    return device, (
+        f"reference sensor v{args.sdi_version}, address {address}, faults: {faults}, "
+        f"bench: {bench.describe()}"
+    )
+
+
 def _host_port(text: str) -> tuple[str, int]:
     host, sep, port = text.rpartition(":")
     if not sep or not port.isdigit():
@@ -133,8 +177,8 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
     except SystemExit as exc:
         return EXIT_OK if exc.code == 0 else EXIT_USAGE
     try:
-        device = make_device(args.sdi_version, args.address, args.faults)
         bench = bench_model(args)
+        device, what = serving_what(args, bench)
         if args.raw and not args.listen:
             raise PortError("--raw applies to --listen only")
         tap_at = parse_tap(args.tap) if args.tap else None
@@ -143,11 +187,6 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
     except PortError as exc:
         print_line(f"error: {exc}")
         return EXIT_USAGE
-    faults = args.faults or "none"
-    what = (
-        f"reference sensor v{args.sdi_version}, address {args.address}, faults: {faults}, "
-        f"bench: {bench.describe()}"
-    )
     # the line's thread must get the interpreter back at once when a frame is due, and no
     # thread of the server may be preempted while it holds the lock the line needs
     quick_gil_handover()  # for the life of the process

@@ -37,11 +37,15 @@ class EmulatorProcess:
         for line in self.proc.stdout or ():
             self.log.append(line.strip())
 
-    def worst_lateness(self, connections: int = 2, wait: float = 3.0) -> float | None:
+    def worst_lateness(self, connections: int | None = 2, wait: float = 3.0) -> float | None:
         """How far (s) the served line fell behind its schedule, the worst over the log lines
         the server writes when a recorder disconnects, once ``connections`` of them are in
-        (the CLI connects twice: a port check, then the run). None if they did not come."""
+        (the CLI connects twice: a port check, then the run; None: as many as have connected
+        so far, for a run whose count varies, such as a bus run's one per sensor). None if
+        they did not come."""
         deadline = time.monotonic() + wait
+        if connections is None:
+            connections = sum(line.startswith("recorder connected") for line in list(self.log))
         while True:
             found = [re.search(r"within ([0-9.]+) ms", line) for line in list(self.log)]
             values = [float(m[1]) / 1e3 for m in found if m]

@@ -94,6 +94,10 @@ def test_served_sensor_measures_with_a_service_request(served):
         (["--listen", "nowhere"], "HOST:PORT"),
         (["--serial", "/dev/ttyUSB-sdi12-missing"], "cannot open"),
         (["--serial", "loop://", "--raw"], "--listen only"),
+        (["--listen", "127.0.0.1:0", "--sensors", "0"], "several sensors"),
+        (["--listen", "127.0.0.1:0", "--sensors", "0,1", "--address", "3"], "no --address"),
+        (["--listen", "127.0.0.1:0", "--sensors", "0,1:no-such-fault"], "unknown fault"),
+        (["--listen", "127.0.0.1:0", "--sensors", "0,$"], "address must be"),
     ],
 )
 def test_emulate_usage_errors_exit_4(argv, message):
