@@ -91,7 +91,7 @@ def test_a_carriage_return_before_the_newline_is_accepted():
     [
         ("hi 1", "expected 'hello 1"),
         ("hello", "another protocol version"),
-        ("hello 2 future", "another protocol version"),
+        ("hello 3 future", "another protocol version"),
         ("idle", "expected 'hello 1"),
     ],
 )
