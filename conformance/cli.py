@@ -567,6 +567,7 @@ SUBCOMMAND_HELP = {
     "diff": "what changed between two runs (exit 1 when anything got worse)",
     "verify": "check a run folder without the device: hashes, then the recording re-judged",
     "plan": "the test plan without touching the bus: cases, what they send, expected bus time",
+    "kit": "compile an Arduino sketch with the kit's core for the host and run the suite on it",
 }
 
 
@@ -675,6 +676,10 @@ def _dispatch(argv: list[str]) -> int:
             from .commands.verify import verify_main
 
             return verify_main(argv[1:], console, cmd_judge)
+        if argv and argv[0] == "kit":
+            from .commands.kit import kit_main
+
+            return kit_main(argv[1:], main)  # the run itself, with its own Ctrl-C guard
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 

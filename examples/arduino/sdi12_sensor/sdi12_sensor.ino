@@ -9,7 +9,7 @@
  *   -DFAULT_BAUD       bit time 800 us, 4 % short (about 1250 baud)     R-4.1-01
  *   -DFAULT_CRC        the CRC of aMC!/aCC! data is wrong               R-4.4.12-05
  *   -DFAULT_NO_SR      no service request after aM!                     R-4.4.6-02
- *   -DFAULT_SLOW_REPLY first start bit 16 ms after the command          R-7.0-09 */
+ *   -DFAULT_SLOW_REPLY first start bit 16 ms after the command          R-7.0-10 */
 #include <TinySDI12.h>
 
 #define DATA_PIN 7
