@@ -108,11 +108,19 @@ def compile_command(build: ArduinoBuild, compiler: str, main_cpp: Path, out: Pat
         *(f"-I{path}" for path in includes),
         *flags,
         *build.extra_flags,
-        *(str(s) for s in sources),
-        str(ARDUINO_DIR / "kit_core.cpp"),
+        *_by_language([*sources, ARDUINO_DIR / "kit_core.cpp"]),
         "-o",
         str(out),
     ]
+
+
+def _by_language(sources: list[Path]) -> list[str]:
+    """Each source with its language: a ``.c`` file is C (a C library in a sketch, included
+    in ``extern "C"`` as on a board), everything else C++."""
+    out: list[str] = []
+    for source in sources:
+        out += ["-x", "c" if source.suffix == ".c" else "c++", str(source)]
+    return out
 
 
 def build_arduino(build: ArduinoBuild, compiler: str | None = None) -> Path:

@@ -15,6 +15,8 @@ ARDUINO = ROOT / "examples" / "arduino"
 SENSOR = ARDUINO / "sdi12_sensor"
 TINY_SDI12 = ARDUINO / "libraries" / "TinySDI12"
 SKETCHES = Path(__file__).parent / "sketches"
+LOGGER = ARDUINO / "sdi12_logger"
+LOGGER_DECLARATION = str(ROOT / "examples" / "c" / "tiny_logger.toml")
 
 Build = Callable[..., Path]
 

@@ -49,7 +49,8 @@ const double NOMINAL_BIT = 1e6 / 1200.0; /* us */
 const us_t NEVER = (us_t)1 << 60;
 const int PINS = 256;
 
-us_t vt = 0;           /* the sketch's clock */
+us_t vt = 0;           /* the sketch's clock, on the tool's time line */
+us_t boot = 0;         /* when the board came up: micros() counts from here (a recorder's job) */
 us_t horizon = 0;      /* the tool's now: the line is known up to here */
 bool recorder = false; /* the role the tool asked for */
 
@@ -301,8 +302,29 @@ void add_tool_frame(us_t start, us_t end, int wire) {
     }
 }
 
+/* a `log CMD VALUE...` line as the protocol takes it: split where it would pass 200
+ * characters (several lines for one command append, in order) */
+void print_log(const std::string &line) {
+    size_t at = line.find(' ', 4);
+    std::string head = line.substr(0, at), values = at == std::string::npos ? "" : line.substr(at + 1);
+    std::string out = head;
+    size_t pos = 0;
+    while (pos < values.size()) {
+        size_t next = values.find(' ', pos);
+        std::string value = values.substr(pos, next == std::string::npos ? std::string::npos : next - pos);
+        pos = next == std::string::npos ? values.size() : next + 1;
+        if (value.empty()) continue;
+        if (out.size() + 1 + value.size() > 190 && out != head) {
+            printf("%s\n", out.c_str());
+            out = head;
+        }
+        out += " " + value;
+    }
+    printf("%s\n", out.c_str());
+}
+
 void answer() {
-    for (auto &line : logs) printf("%s\n", line.c_str());
+    for (auto &line : logs) print_log(line);
     logs.clear();
     if (!out.empty()) {
         Out &o = out.front();
@@ -324,12 +346,12 @@ void answer() {
 unsigned long micros(void) {
     read_clock = true;
     advance_to(vt + KIT_CALL_COST_US, false);
-    return (unsigned long)vt;
+    return (unsigned long)(vt - boot);
 }
 unsigned long millis(void) {
     read_clock = true;
     advance_to(vt + KIT_CALL_COST_US, false);
-    return (unsigned long)(vt / 1000);
+    return (unsigned long)((vt - boot) / 1000);
 }
 void delay(unsigned long ms) {
     read_clock = true;
@@ -449,7 +471,10 @@ int main(void) {
         }
         us_t now;
         if (strcmp(word, "break") == 0 && sscanf(line, "%*s %lld %lld", &a, &b) == 2) {
-            if (!out.empty() && out.front().kind == 'b' && out.front().start == a) {
+            if (!out.empty() && out.front().kind == 'b' && out.front().end == b) {
+                if (out.front().start != a) /* planned inside a frame the tool then reported */
+                    fprintf(stderr, "sdi12-kit: the break planned from %lld us was held from "
+                            "%lld us (the line was busy)\n", out.front().start, a);
                 out.pop_front(); /* our own break, told back */
             } else {
                 edges.push_back({a, 1});
@@ -473,6 +498,7 @@ int main(void) {
             const char *rest = strchr(line + 4, ' ');
             serial_in += rest ? rest + 1 : "\n";
             now = a;
+            if (!started) vt = boot = a; /* the board starts with its job */
         } else {
             fail("unexpected message: %s", line);
             return 3;

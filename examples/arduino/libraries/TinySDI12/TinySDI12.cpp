@@ -5,7 +5,7 @@ static TinySDI12 *active = nullptr;
 
 TinySDI12::TinySDI12(uint8_t pin)
     : pin_(pin), bit_us_(TINY_SDI12_BIT_US), in_frame_(false), frame_start_(0),
-      spacing_since_(0), bits_done_(0), value_(0), stop_ok_(true), break_seen_(false),
+      spacing_since_(0), line_spacing_(false), bits_done_(0), value_(0), stop_ok_(true), break_seen_(false),
       break_start_(0), break_end_(0), head_(0), tail_(0) {}
 
 void TinySDI12::begin() {
@@ -46,6 +46,7 @@ void TinySDI12::finish() {
 }
 
 void TinySDI12::edge(unsigned long t, int spacing) {
+    line_spacing_ = spacing;
     if (in_frame_) {
         int k = (int)((t - frame_start_ + bit_us_ / 2) / bit_us_);
         fill(k, spacing ? 1 : 0); /* the bits before this edge had the other level */
@@ -72,8 +73,10 @@ int TinySDI12::available() {
     if (in_frame_) { /* the stop bit has no edge: finish the frame once it has passed */
         noInterrupts();
         unsigned long now = micros();
-        if (in_frame_ && now - frame_start_ >= 19 * bit_us_ / 2) {
-            fill(10, digitalRead(pin_) == HIGH ? 0 : 1);
+        if (in_frame_ && now - frame_start_ >= 10 * bit_us_) { /* its stop bit has ended */
+            /* the level its last edge left, not the pin's now: the next start bit may
+             * have begun, its interrupt held back by noInterrupts() */
+            fill(10, line_spacing_ ? 0 : 1);
             finish();
         }
         interrupts();
@@ -118,4 +121,20 @@ void TinySDI12::send(const char *text) {
     }
     pinMode(pin_, INPUT);
     interrupts();
+}
+
+void TinySDI12::sendBreak(unsigned long us) {
+    noInterrupts();
+    digitalWrite(pin_, LOW);
+    pinMode(pin_, OUTPUT);
+    digitalWrite(pin_, HIGH);
+    delayMicroseconds(us);
+    digitalWrite(pin_, LOW);
+    pinMode(pin_, INPUT);
+    interrupts();
+}
+
+bool TinySDI12::receiving(unsigned long *start) const {
+    *start = frame_start_;
+    return in_frame_;
 }

@@ -35,6 +35,10 @@ class TinySDI12 {
     bool takeBreak(unsigned long *start, unsigned long *end);
     /* send text now, back to back, bit by bit (blocks for its whole length) */
     void send(const char *text);
+    /* hold the line spacing for `us` microseconds (a data recorder's break) */
+    void sendBreak(unsigned long us);
+    /* a character is being received: true, with its start bit's stamp */
+    bool receiving(unsigned long *start) const;
     unsigned long bitTime() const { return bit_us_; }
     void setBitTime(unsigned long us) { bit_us_ = us; }
 
@@ -48,6 +52,7 @@ class TinySDI12 {
     /* receiver state (written by the interrupt) */
     volatile bool in_frame_;
     volatile unsigned long frame_start_, spacing_since_;
+    volatile bool line_spacing_; /* the level the last edge left */
     volatile int bits_done_, value_;
     volatile bool stop_ok_;
     volatile bool break_seen_;
