@@ -147,7 +147,7 @@ class HarnessLink(SimLink):
         self.device = device
         # a version-2 harness gives each frame's own duration: the bit rate is observed
         timed = device.channel.version >= 2
-        self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=timed)
+        self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=timed, frame_lengths=timed)
 
     def check_records(self, cases: list[CaseRecord]) -> None:
         """Before the verdicts: end the harness and make sure its answers were in step

@@ -149,15 +149,17 @@ void onBreak(unsigned long start, unsigned long end) {
 }
 
 void onChar(const TinySDI12Char &ch) {
-    if (awake && ch.start - last_activity >= STANDBY_US) awake = false;
+    /* signed: a character heard at a slower bit time than its sender's ends after the next
+     * one starts */
+    if (awake && (long)(ch.start - last_activity) >= (long)STANDBY_US) awake = false;
     last_activity = ch.end;
     if (!awake) {
         cmd_len = 0;
         return;
     }
-    if (cmd_len && ch.start - cmd_end >= PARTIAL_GAP_US) cmd_len = 0;
+    if (cmd_len && (long)(ch.start - cmd_end) >= (long)PARTIAL_GAP_US) cmd_len = 0;
     if (cmd_len == 0) {
-        cmd_bad = after_break && ch.start - break_end < ADDRESS_MARK_US;
+        cmd_bad = after_break && (long)(ch.start - break_end) < (long)ADDRESS_MARK_US;
         after_break = false;
         if (!cmd_bad && ch.c != address && ch.c != '?') {
             awake = false; /* a command for another sensor: standby until the next break */
