@@ -66,6 +66,7 @@ class Channel:
         self.failure: str | None = None  # why the harness failed, once it has
         self.logs: list[LogLine] = []  # a recorder harness's log lines, in order
         self.version = 1  # the protocol version the harness answered hello with
+        self.last_plan: Plan | None = None  # the plan it answered last (a repeat is told apart)
 
     # subclass hooks
     def status(self) -> str:
@@ -167,9 +168,16 @@ class Channel:
         harness's ``log`` lines before it go to :attr:`logs`."""
         reply = self.answer(aside=self._take_log if role is Role.RECORDER else None)
         try:
-            return parse_plan(
-                reply, role, us(now), None if since is None else us(since), self.version
+            plan = parse_plan(
+                reply,
+                role,
+                us(now),
+                None if since is None else us(since),
+                self.version,
+                self.last_plan,
             )
+            self.last_plan = plan
+            return plan
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
 

@@ -191,7 +191,12 @@ def _past(word: str, start: int, now: int) -> str:
 
 
 def parse_plan(
-    text: str, role: Role, now: int, since: int | None = None, version: int = VERSION
+    text: str,
+    role: Role,
+    now: int,
+    since: int | None = None,
+    version: int = VERSION,
+    previous: Plan | None = None,
 ) -> Plan:
     """Check one plan reply against the role and the time ``now`` (us) of the message it
     answers. A ``brk`` must not start before ``now``: the tool cannot send in the past, and
@@ -207,7 +212,7 @@ def parse_plan(
     floor = now if since is None else min(now, since)
     parts = text.split(" ")
     if parts[0] == PlanKind.TX and version >= 2:
-        return _parse_tx(parts, text, now, floor)
+        return _parse_tx(parts, text, now, since, previous)
     word = parts[0]
     if word == PlanKind.CANNOT:
         if role is Role.SENSOR:
@@ -239,16 +244,29 @@ def parse_plan(
     return Plan(kind)
 
 
-def _parse_tx(parts: list[str], text: str, now: int, floor: int) -> Plan:
+def _parse_tx(
+    parts: list[str], text: str, now: int, since: int | None, previous: Plan | None
+) -> Plan:
     """A version-2 ``tx START XX [DURATION]``. Its START must not be before now (within the
-    rounding slack, or the START of the frame the message reported, as for ``brk``): a
-    harness that plans a character in the past has let its device run ahead of the tool's
-    clock or answered a stale message, and the tool starting it "now" instead would move the
-    device's timing behind its back. DURATION, when given, is the frame's own length."""
+    rounding slack): a harness that plans a character in the past has let its device run
+    ahead of the tool's clock or answered a stale message, and the tool starting it "now"
+    instead would move the device's timing behind its back. The one exception is the plan
+    it had, repeated unchanged after a ``char``/``break`` reported a frame that began before
+    it (START at or after that frame's START): it goes out once the line is free. A *new*
+    plan inside the frame just reported transmits before the line is idle: an error too.
+    DURATION, when given, is the frame's own length."""
     if len(parts) not in (3, 4):
         raise HarnessProtocolError("'tx' takes 2 or 3 field(s) (version 2)", text)
     start, wire = _time(parts[1], text), _byte(parts[2], text)
-    if start < floor - PAST_SLACK_US:
+    repeated = previous is not None and previous.kind is PlanKind.TX
+    repeated = repeated and (previous.start, previous.wire) == (start, wire)  # type: ignore[union-attr]
+    if start < now - PAST_SLACK_US and not (repeated and since is not None and start >= since):
+        if since is not None and start >= since - PAST_SLACK_US:
+            raise HarnessProtocolError(
+                f"'tx' starts at {start} us, inside the character or break just reported "
+                f"({since}..{now} us): a new plan must wait for the line to be idle",
+                text,
+            )
         raise HarnessProtocolError(_past("tx", start, now), text)
     duration = _time(parts[3], text) if len(parts) == 4 else 0
     if len(parts) == 4 and not FRAME_US_MIN <= duration <= FRAME_US_MAX:

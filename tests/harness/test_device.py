@@ -410,3 +410,34 @@ def test_a_harness_is_not_woken_inside_the_tools_break(tmp_path):
     told = [line.split()[0] for line in log.read_text().splitlines()]
     assert told[:3] == ["hello", "char", "break"], told
     assert "time" not in told, told
+
+
+PAST_TX = textwrap.dedent(
+    """
+    import sys
+    for line in sys.stdin:
+        word, *fields = line.split()
+        if word == "hello":
+            print("hello 2 runs-ahead", flush=True)  # version 2: held to the clock
+        elif word == "char":
+            print(f"tx {int(fields[1]) - 1000} 30 8330", flush=True)  # a reply in the past
+        elif word != "bye":
+            print("idle", flush=True)
+    """
+)
+
+
+def test_a_version_2_harness_answering_in_the_past_is_an_error_naming_the_line(tmp_path):
+    """A harness whose device ran ahead of the tool's clock plans its reply 1 ms before the
+    message it answers: an ERROR quoting that line, never a reply moved to "now" and judged."""
+    script = tmp_path / "past.py"
+    script.write_text(PAST_TX)
+    link = open_sensor_harness(f"exec:{sys.executable} {script}")
+    try:
+        assert link.info.bit_timing and link.info.frame_lengths
+        link.write(bytes([0x30]))
+        with pytest.raises(HarnessError, match="wait for the line to be idle") as err:
+            link.receive(link.now() + 0.05)
+        assert "'tx 7333 30 8330'" in str(err.value)
+    finally:
+        link.close()

@@ -154,8 +154,14 @@ def test_a_version_2_tx_in_the_past_is_a_harness_error():
     assert proto.parse_plan("tx 4000 30", Role.SENSOR, now=5000).start == 4000  # v1: ASAP
     with pytest.raises(HarnessProtocolError, match="1000 us before now"):
         proto.parse_plan("tx 4000 30 8330", Role.SENSOR, now=5000, version=2)
-    # within the rounding slack it is now; a plan repeated after a reported frame that
-    # began before it is taken (it goes out when the line is free)
+    # within the rounding slack it is now; the plan it had, repeated unchanged after a
+    # reported frame that began before it, is taken (it goes out when the line is free)
     assert proto.parse_plan("tx 4999 30", Role.SENSOR, now=5000, version=2).start == 5000
-    late = proto.parse_plan("tx 4200 30 8330", Role.SENSOR, now=13333, since=4000, version=2)
+    had = Plan(PlanKind.TX, start=4200, wire=0x30)
+    late = proto.parse_plan(
+        "tx 4200 30 8330", Role.SENSOR, now=13333, since=4000, version=2, previous=had
+    )
     assert late.start == 13333
+    # a new plan inside the frame just reported transmits before the line is idle
+    with pytest.raises(HarnessProtocolError, match="wait for the line to be idle"):
+        proto.parse_plan("tx 4200 30 8330", Role.SENSOR, now=13333, since=4000, version=2)

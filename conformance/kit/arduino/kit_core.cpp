@@ -328,6 +328,14 @@ void answer() {
     logs.clear();
     if (!out.empty()) {
         Out &o = out.front();
+        if (o.start < horizon) { /* begun while the tool's own frame was on the line */
+            fprintf(stderr, "sdi12-kit: the sketch began a %s at %lld us, inside the line's "
+                    "last character or break (until %lld us): both cannot be on the line, "
+                    "it goes out from %lld us\n", o.kind == 'b' ? "break" : "frame", o.start,
+                    horizon, horizon);
+            if (o.kind == 't') o.end += horizon - o.start;
+            o.start = horizon;
+        }
         if (o.kind == 'b') printf("brk %lld %lld\n", o.start, o.end);
         else printf("tx %lld %02x %lld\n", o.start, o.wire, o.end - o.start);
     } else if (!finish.empty()) {
