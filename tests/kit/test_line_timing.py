@@ -93,3 +93,36 @@ def test_a_sensor_holding_the_line_spacing_is_a_harness_error(kit_build):
         assert "a sensor cannot send a break" in channel.stderr_tail()
     finally:
         channel.close()
+
+
+def test_a_stuck_transmitter_stops_the_kit_with_a_message(kit_build):
+    """Spacing held for 10 s of virtual time is a stuck line, not a break to wait out: the
+    kit exits naming it (the tool's harness ERROR) instead of spinning until the reply
+    timeout."""
+    binary = kit_build(SKETCHES / "stuck_line")
+    channel = ChildChannel(str(binary))
+    try:
+        channel.greet(Role.RECORDER)
+        with pytest.raises(HarnessError, match="closed its output"):
+            channel.ask("job 0 measure 0M!")
+        assert "exit status 3" in channel.status()
+        assert "held the line spacing since 0 us, 10 s" in channel.stderr_tail()
+    finally:
+        channel.close()
+
+
+def test_a_break_timed_by_polling_micros_is_rebuilt(kit_build):
+    """A sketch that ends its break when micros() says so, from loop(): held 12.5 ms (plus
+    the loop's own microseconds), told as one brk, then done."""
+    channel = ChildChannel(str(kit_build(SKETCHES / "polled_break")))
+    try:
+        channel.greet(Role.RECORDER)
+        plan = parse_plan(channel.ask("job 0 measure 0M!"), Role.RECORDER, 0, version=2)
+        if plan.kind == "wait":  # its first micros() call: 1 us past the job's time
+            plan = parse_plan(channel.ask(f"time {plan.start}"), Role.RECORDER, plan.start)
+        assert plan.kind == "brk" and plan.start <= 2
+        assert 12500 <= plan.end - plan.start <= 12500 + TOLERANCE_US
+        end = parse_plan(channel.ask(f"break {plan.start} {plan.end}"), Role.RECORDER, plan.end)
+        assert end.kind == "done"
+    finally:
+        channel.close()

@@ -37,6 +37,9 @@
 #ifndef KIT_IDLE_POLL_US
 #define KIT_IDLE_POLL_US 500 /* a loop() that only read the clock runs again this much later */
 #endif
+#ifndef KIT_MAX_BREAK_US
+#define KIT_MAX_BREAK_US 10000000 /* spacing held longer than this is a stuck line: the kit stops */
+#endif
 #ifndef KIT_STACK
 #define KIT_STACK (256 * 1024)
 #endif
@@ -217,13 +220,17 @@ void line_write(int before, int level) {
 
 us_t limit() {
     if (!composing) return horizon;
-    if (holding_break) return NEVER;
+    if (holding_break) return frame_start + KIT_MAX_BREAK_US;
     if (close_at != NEVER) return close_at;
     return frame_start + (us_t)llround(10.5 * NOMINAL_BIT);
 }
 
 /* the end of a frame's time: rebuild it (or, with the line still spacing, a break begins) */
 void reach_limit() {
+    if (holding_break)
+        fail("the sketch has held the line spacing since %lld us, %d s: a stuck transmitter "
+             "(nothing more can be heard or said on the line)", frame_start,
+             KIT_MAX_BREAK_US / 1000000);
     if (close_at == NEVER && sketch_drive()) {
         holding_break = true;
         return;
@@ -256,8 +263,12 @@ void advance_to(us_t target, bool stop_on_edge) {
 }
 
 void idle_pass() {
-    if (composing) {
-        advance_to(limit() == NEVER ? vt + 1000 : limit(), false);
+    if (composing && read_clock) {
+        /* sending, timed by polling the clock in loop(): the line is the sketch's own, so
+         * its passes cost no message; each takes the loop's own microsecond */
+        advance_to(vt + KIT_LOOP_COST_US, false);
+    } else if (composing) {
+        advance_to(limit(), false); /* nothing it does can end the frame: close it */
     } else if (read_clock) {
         advance_to(vt + KIT_IDLE_POLL_US, true);
     } else {
