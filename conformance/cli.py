@@ -577,6 +577,7 @@ SUBCOMMAND_HELP = {
     "verify": "check a run folder without the device: hashes, then the recording re-judged",
     "plan": "the test plan without touching the bus: cases, what they send, expected bus time",
     "rack": "many DUTs in one run from a rack file (rack FILE [options]; --port twice: the same)",
+    "kit": "compile an Arduino sketch with the kit's core for the host and run the suite on it",
 }
 
 
@@ -724,6 +725,10 @@ def _dispatch(argv: list[str]) -> int:
 
             given = rack_argv(argv[1:], console)
             return given if isinstance(given, int) else _main_command(given, console)
+        if argv and argv[0] == "kit":
+            from .commands.kit import kit_main
+
+            return kit_main(argv[1:], main)  # the run itself, with its own Ctrl-C guard
         if argv and argv[0] == "calibrate":
             from .calibrate import calibrate_main
 

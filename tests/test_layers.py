@@ -73,6 +73,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "monitor",
             "whole_run",
             "report_folder",
+            "kit",
         ),
     ),
     # what a run is rendered as: console, HTML, verdicts.json

@@ -31,7 +31,7 @@ from .protocol import (
     check_line,
     hello,
     is_log,
-    parse_hello,
+    parse_hello_version,
     parse_log,
     parse_plan,
     us,
@@ -65,6 +65,8 @@ class Channel:
         self.last_sent = ""
         self.failure: str | None = None  # why the harness failed, once it has
         self.logs: list[LogLine] = []  # a recorder harness's log lines, in order
+        self.version = 1  # the protocol version the harness answered hello with
+        self.last_plan: Plan | None = None  # the plan it answered last (a repeat is told apart)
 
     # subclass hooks
     def status(self) -> str:
@@ -150,7 +152,8 @@ class Channel:
         """Exchange hellos (with the longer start-up allowance); the harness's name."""
         reply = self.ask(hello(role), max(HELLO_TIMEOUT, self.reply_timeout))
         try:
-            return parse_hello(reply)
+            name, self.version = parse_hello_version(reply)
+            return name
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
 
@@ -165,7 +168,16 @@ class Channel:
         harness's ``log`` lines before it go to :attr:`logs`."""
         reply = self.answer(aside=self._take_log if role is Role.RECORDER else None)
         try:
-            return parse_plan(reply, role, us(now), None if since is None else us(since))
+            plan = parse_plan(
+                reply,
+                role,
+                us(now),
+                None if since is None else us(since),
+                self.version,
+                self.last_plan,
+            )
+            self.last_plan = plan
+            return plan
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
 

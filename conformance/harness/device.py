@@ -15,6 +15,7 @@ from ..links.registry import LinkKind, OpenedPort, PortOptions, register
 from ..protocol.timing import CHAR_TIME
 from ..results import CaseRecord
 from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
+from ..transcript import Event
 from ..verdicts import Verdict
 from . import protocol as proto
 from .channel import Channel, ChildChannel, HarnessError, SocketChannel
@@ -69,22 +70,41 @@ class HarnessDevice:
         self._tell(proto.heard(wire, start, end), end, start)
 
     def next_frame(self) -> Frame | None:
-        if self.plan.kind is not PlanKind.TX:
+        plan = self.plan
+        if plan.kind is not PlanKind.TX:
             return None
-        return Frame(self._start, self.plan.wire)
+        # a version-2 harness (a firmware kit) names the frame's own length: its bit time
+        duration = proto.seconds(plan.duration) if plan.duration else CHAR_TIME
+        return Frame(self._start, plan.wire, duration)
 
     def pop_frame(self) -> Frame:
         frame = self.next_frame()
         if frame is None:
             raise HarnessError("the bus committed a character the harness did not plan")
         start = max(frame.start, self.clock.now)  # as SimBus._commit places it
-        self._tell(proto.sent(frame.wire, start, start + CHAR_TIME), start + CHAR_TIME)
+        end = start + frame.duration
+        self._tell(proto.sent(frame.wire, start, end), end)
         return frame
 
 
 class HarnessBus(SimBus):
     """The sim bus, plus wake-ups: a harness that answered ``wait T`` is told ``time T`` when
-    the clock gets there with nothing else on the line first."""
+    the clock gets there with nothing else on the line first.
+
+    Never inside the tool's own break: a break is told when it ends, and a ``time T`` for a
+    T after its start would tell the harness that nothing happened until T (a sensor's
+    service request due then went out over the break; a kit's sketch ran on past its start
+    and heard it late)."""
+
+    _held_from: float | None = None  # the start of the tool's break being held
+
+    def tool_break(self, duration: float) -> Event:
+        self.advance(self.clock.now)
+        self._held_from = self.clock.now
+        try:
+            return super().tool_break(duration)
+        finally:
+            self._held_from = None
 
     def _wake_before(self, limit: float) -> bool:
         """Wake the earliest harness due before ``limit`` (and before the next character)."""
@@ -92,6 +112,8 @@ class HarnessBus(SimBus):
         if not due:
             return False
         when, device = min(due, key=lambda pair: pair[0])
+        if self._held_from is not None and when > self._held_from:
+            return False  # the break message answers it
         nxt = self._next()
         if when >= limit or (nxt is not None and nxt[1].start < when):
             return False
@@ -123,7 +145,9 @@ class HarnessLink(SimLink):
     def __init__(self, bus: HarnessBus, device: HarnessDevice, kind: str) -> None:
         super().__init__(bus)
         self.device = device
-        self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=False)
+        # a version-2 harness gives each frame's own duration: the bit rate is observed
+        timed = device.channel.version >= 2
+        self.info = LinkInfo(kind=kind, virtual_time=True, bit_timing=timed, frame_lengths=timed)
 
     def check_records(self, cases: list[CaseRecord]) -> None:
         """Before the verdicts: end the harness and make sure its answers were in step

@@ -12,6 +12,15 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 VERSION = 1
+#: The versions a harness may answer ``hello`` with. Version 2 (the firmware kits, docs/kit.md)
+#: adds the frame's measured duration to ``tx`` (``tx START XX DURATION``), so the tool
+#: places a frame of the device's own bit time on the line and R-4.1-01 is observed; and it
+#: holds the harness to the clock: a ``tx`` planned before now is an ERROR, not "as soon as
+#: possible". The tool still greets with ``hello 1``: a version-1 harness sees no change.
+VERSIONS = (1, 2)
+#: The frame durations a version-2 ``tx`` may name (us): 10 bits at 800 to 1800 baud, far
+#: outside any rate a receiver would frame, so a wrong unit is caught, a wrong rate judged.
+FRAME_US_MIN, FRAME_US_MAX = 5556, 12500
 #: Longest reply line accepted (a harness that writes more is flooding or writing garbage).
 MAX_LINE = 200
 #: Largest time accepted (about 11.6 days of bus time): beyond it a harness is counting wrong.
@@ -50,6 +59,7 @@ class Plan:
     start: int = 0  # us; TX/BRK: when it starts, WAIT: when to wake the harness
     end: int = 0  # us; BRK only
     wire: int = 0  # TX only: the 8 wire bits
+    duration: int = 0  # TX only, version 2: the frame's own length in us (0: one 1200-baud frame)
     reason: str = ""  # CANNOT only: the harness's own words, if any
 
 
@@ -101,13 +111,18 @@ def check_line(raw: bytes) -> str:
 
 
 def parse_hello(text: str) -> str:
-    """The harness's name from its ``hello 1 [name]`` answer."""
+    """The harness's name from its ``hello 1 [name]`` (or ``hello 2 [name]``) answer."""
+    return parse_hello_version(text)[0]
+
+
+def parse_hello_version(text: str) -> tuple[str, int]:
+    """The harness's name and the protocol version it answered with (one of ``VERSIONS``)."""
     parts = text.split(maxsplit=2)
     if not parts or parts[0] != "hello":
         raise HarnessProtocolError("expected 'hello 1 [name]' as the first reply", text)
-    if len(parts) < 2 or parts[1] != str(VERSION):
+    if len(parts) < 2 or parts[1] not in {str(v) for v in VERSIONS}:
         raise HarnessProtocolError(f"harness speaks another protocol version, not {VERSION}", text)
-    return parts[2] if len(parts) > 2 else ""
+    return (parts[2] if len(parts) > 2 else ""), int(parts[1])
 
 
 def _time(field: str, text: str) -> int:
@@ -175,7 +190,14 @@ def _past(word: str, start: int, now: int) -> str:
     )
 
 
-def parse_plan(text: str, role: Role, now: int, since: int | None = None) -> Plan:
+def parse_plan(
+    text: str,
+    role: Role,
+    now: int,
+    since: int | None = None,
+    version: int = VERSION,
+    previous: Plan | None = None,
+) -> Plan:
     """Check one plan reply against the role and the time ``now`` (us) of the message it
     answers. A ``brk`` must not start before ``now``: the tool cannot send in the past, and
     starting it "now" instead would shorten the break behind the harness's back, so that the
@@ -185,9 +207,12 @@ def parse_plan(text: str, role: Role, now: int, since: int | None = None) -> Pla
     told after the frame ends, so a plan made before it for a time inside that frame is held
     back by it, and repeating it is right; ``since`` (the reported frame's START) is then
     the earliest start accepted. A ``wait`` must be later than ``now`` (else the harness
-    would be woken forever without time passing)."""
+    would be woken forever without time passing). A version-2 harness may add a ``tx``'s
+    duration and is held to the clock for ``tx`` as for ``brk`` (:func:`_parse_tx`)."""
     floor = now if since is None else min(now, since)
     parts = text.split(" ")
+    if parts[0] == PlanKind.TX and version >= 2:
+        return _parse_tx(parts, text, now, since, previous)
     word = parts[0]
     if word == PlanKind.CANNOT:
         if role is Role.SENSOR:
@@ -217,3 +242,37 @@ def parse_plan(text: str, role: Role, now: int, since: int | None = None) -> Pla
             raise HarnessProtocolError(f"wait time is not after now ({now} us)", text)
         return Plan(kind, start=start)
     return Plan(kind)
+
+
+def _parse_tx(
+    parts: list[str], text: str, now: int, since: int | None, previous: Plan | None
+) -> Plan:
+    """A version-2 ``tx START XX [DURATION]``. Its START must not be before now (within the
+    rounding slack): a harness that plans a character in the past has let its device run
+    ahead of the tool's clock or answered a stale message, and the tool starting it "now"
+    instead would move the device's timing behind its back. The one exception is the plan
+    it had, repeated unchanged after a ``char``/``break`` reported a frame that began before
+    it (START at or after that frame's START): it goes out once the line is free. A *new*
+    plan inside the frame just reported transmits before the line is idle: an error too.
+    DURATION, when given, is the frame's own length."""
+    if len(parts) not in (3, 4):
+        raise HarnessProtocolError("'tx' takes 2 or 3 field(s) (version 2)", text)
+    start, wire = _time(parts[1], text), _byte(parts[2], text)
+    repeated = previous is not None and previous.kind is PlanKind.TX
+    repeated = repeated and (previous.start, previous.wire) == (start, wire)  # type: ignore[union-attr]
+    if start < now - PAST_SLACK_US and not (repeated and since is not None and start >= since):
+        if since is not None and start >= since - PAST_SLACK_US:
+            raise HarnessProtocolError(
+                f"'tx' starts at {start} us, inside the character or break just reported "
+                f"({since}..{now} us): a new plan must wait for the line to be idle",
+                text,
+            )
+        raise HarnessProtocolError(_past("tx", start, now), text)
+    duration = _time(parts[3], text) if len(parts) == 4 else 0
+    if len(parts) == 4 and not FRAME_US_MIN <= duration <= FRAME_US_MAX:
+        raise HarnessProtocolError(
+            f"frame duration {duration} us is outside {FRAME_US_MIN}..{FRAME_US_MAX} us "
+            "(10 bits at 800 to 1800 baud)",
+            text,
+        )
+    return Plan(PlanKind.TX, start=max(start, now), wire=wire, duration=duration)

@@ -287,7 +287,7 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
     if not spacings:
         return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character reply observed")
     shortest, text = min(spacings)
-    low, high = CHAR_TIME * 0.98, CHAR_TIME * 1.02
+    low = CHAR_TIME * 0.98
     where = [f"in reply to {escape(text)}"]
     if stamps.local is not None and shortest + 2 * uncertainty < low:
         if not sustained(len(fast), len(spacings)):  # a few bursts of a stalling host
@@ -323,16 +323,8 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
             evidence=where,
             decision="A14",
         )
-    finding = judge_window(
-        "R-4.1-01",
-        "shortest character start-to-start spacing",
-        shortest,
-        2 * uncertainty,
-        low=low,
-        high=high,
-        tolerance=0.0,
-        evidence=where,
-        decision="A14",
+    finding = judge_rate(
+        "shortest character start-to-start spacing", shortest, 2 * uncertainty, where
     )
     if finding.verdict is Verdict.FAIL:  # too slow or gapped: not decidable, see docstring
         finding.verdict = Verdict.INCONCLUSIVE
@@ -340,6 +332,56 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
     baud = 10 / shortest if shortest > 0 else float("inf")
     finding.detail += f"; about {baud:.0f} baud from {len(spacings)} spacings"
     return finding
+
+
+def judge_rate(what: str, measured: float, uncertainty: float, evidence: list[str]) -> Finding:
+    """R-4.1-01 on one measured frame time (a frame's length, or the spacing of two frames
+    back to back): decision A14, 1200 baud ±2 %, no further tolerance."""
+    return judge_window(
+        "R-4.1-01",
+        what,
+        measured,
+        uncertainty,
+        low=CHAR_TIME * 0.98,
+        high=CHAR_TIME * 1.02,
+        tolerance=0.0,
+        evidence=evidence,
+        decision="A14",
+    )
+
+
+def judge_frame_lengths(
+    frames_at: list[tuple[Event, str]], uncertainty: float | StampUncertainty
+) -> Finding:
+    """R-4.1-01 (decision A14: 1200 baud ±2%) where each character event lasts its own
+    measured frame (a version-2 harness: a firmware kit rebuilds frames from pin writes):
+    ten bits of the sender's, so a frame's length is its bit rate, too slow as well as too
+    fast, with no back-to-back pair needed. ``frames_at``: each frame and where it was."""
+    if not frames_at:
+        return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no character observed")
+    base = stamp_uncertainty(uncertainty).base
+    lengths = [(e.end - e.start, where) for e, where in frames_at]
+    worst, where = max(lengths, key=lambda pair: abs(pair[0] - CHAR_TIME))
+    finding = judge_rate("frame length (ten bits)", worst, 2 * base, [where])
+    low, high = min(n for n, _ in lengths), max(n for n, _ in lengths)
+    finding.detail += (
+        f"; {len(lengths)} frames {low * 1e3:.3f}..{high * 1e3:.3f} ms, "
+        f"about {10 / worst:.0f} baud at the farthest"
+    )
+    return finding
+
+
+def judge_reply_frame_lengths(
+    segs: list[Segment], uncertainty: float | StampUncertainty
+) -> Finding:
+    """R-4.1-01 from the length of every reply frame (:func:`judge_frame_lengths`)."""
+    frames_at = [
+        (e, f"in reply to {escape(seg.text)}")
+        for seg in segs
+        for run in [seg.reply, *runs(seg.later)]
+        for e in run
+    ]
+    return judge_frame_lengths(frames_at, uncertainty)
 
 
 # -- framing of every reply -------------------------------------------------------------------

@@ -34,6 +34,9 @@ class LinkInfo:
     #: The DUT's characters come with its own bit timing (baud rate). False on a harness link
     #: (``exec:``/``unix:``), where the DUT names bytes and the tool makes the frames.
     bit_timing: bool = True
+    #: Each character event lasts its own measured frame (ten of its sender's bits), so a
+    #: frame's length is its bit rate: a version-2 harness (a firmware kit) says so.
+    frame_lengths: bool = False
 
 
 #: Why R-4.1-01 (the bit rate) stays INCONCLUSIVE on a link without ``bit_timing``.

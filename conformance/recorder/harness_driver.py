@@ -47,6 +47,7 @@ class HarnessRecorder:
     reply_timeout: float | None = None
     kind: str = "harness"
     needs_real_time: bool = False
+    version: int = 1  # the protocol version the harness answered hello with (probe)
 
     def act(
         self, scenario: str, request: Request, link: Link, budget: JobBudget | None = None
@@ -84,6 +85,7 @@ class HarnessRecorder:
             channel = open_channel(self.port, None, self.reply_timeout)
             try:
                 channel.greet(Role.RECORDER)
+                self.version = channel.version
             finally:
                 channel.close(proto.BYE)
         except HarnessError as exc:
@@ -121,7 +123,7 @@ class HarnessRecorder:
             if plan.kind is PlanKind.WAIT:
                 message = proto.time_is(link.now())
             elif plan.kind is PlanKind.TX:
-                done = link.write(bytes([plan.wire]))[0]
+                done = _transmit(link, plan)
                 message = proto.sent(done.wire, done.start, done.end)
             else:  # BRK
                 made = link.send_break(proto.seconds(plan.end) - link.now())
@@ -130,3 +132,12 @@ class HarnessRecorder:
         if plan.kind is PlanKind.CANNOT:
             return "cannot" + (f" {plan.reason}" if plan.reason else ""), plan.reason
         return "done", None
+
+
+def _transmit(link: Link, plan: Plan) -> Event:
+    """The planned character on the line: a version-2 harness's frame lasts what it says
+    (its firmware's own bit time, so the recorder's bit rate is judged), else one frame."""
+    bus = getattr(link, "bus", None)  # the job's link stands in front of the sim bus's
+    if plan.duration and bus is not None:
+        return bus.tool_char(plan.wire, link.now(), proto.seconds(plan.duration))
+    return link.write(bytes([plan.wire]))[0]

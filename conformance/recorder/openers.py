@@ -145,8 +145,12 @@ def _open_harness(port: str, options: PortOptions, driver: Driver | None) -> Rec
         driver = harness
     _refuse_outside(driver)
     line = _sim_line(driver)
-    # the reports name the harness link, still virtual time
-    line.link.info = LinkInfo(kind=port.partition(":")[0], virtual_time=True, bit_timing=False)
+    # the reports name the harness link, still virtual time; a version-2 harness (a kit)
+    # gives each frame's own length, so the recorder's bit rate is observed
+    timed = getattr(driver, "version", 1) >= 2
+    line.link.info = LinkInfo(
+        kind=port.partition(":")[0], virtual_time=True, bit_timing=timed, frame_lengths=timed
+    )
     return line
 
 

@@ -61,6 +61,7 @@ def replayed_info(recording: Recording) -> LinkInfo:
         timing_uncertainty=max(base.timing_uncertainty, stamped),
         virtual_time=True,
         bit_timing=base.bit_timing,
+        frame_lengths=base.frame_lengths,  # the replay plays each frame at its own length
     )
 
 

@@ -167,6 +167,7 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
         info = LinkInfo(
             kind="transcript", can_break=False, timing_uncertainty=uncertainty,
             bit_timing=_bit_timing(recording.options),
+            frame_lengths=bool((recording.options.get("link") or {}).get("frame_lengths")),
         )  # fmt: skip
         return RecordingLink(spec, info, Transcript(list(recording.events)), uncertainty, notes)
     from ..capture import decode_capture  # the decoder (and numpy) only for a capture

@@ -12,6 +12,7 @@ from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
 from conformance.judges.recorder.commands import (
     judge_character_gaps,
     judge_command_bit_rate,
+    judge_command_frame_lengths,
     judge_command_text,
 )
 from conformance.links.base import NO_BIT_TIMING
@@ -68,5 +69,7 @@ def test_character_timing(recorder, case):
         )
     elif not recorder.link.info.bit_timing:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
+    elif recorder.link.info.frame_lengths:  # a firmware kit: each frame its own ten bits
+        case.add(judge_command_frame_lengths(line, recorder.uncertainty))
     else:
         case.add(judge_command_bit_rate(line, recorder.uncertainty))

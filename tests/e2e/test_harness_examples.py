@@ -14,6 +14,7 @@ import pytest
 
 from conformance.conduct import run_once
 from conformance.emulator import FAULTS
+from conformance.kit import C_DIR as C_KIT_DIR
 from conformance.matrices.sensor_matrix import row_from
 from conformance.recorder.faults import RECORDER_FAULTS
 from tests.support.paths import ROOT
@@ -26,6 +27,8 @@ HARNESS = ("R-4.1-01",)
 C_DIR = ROOT / "examples" / "c"
 PY_DIR = ROOT / "examples" / "python"
 COMPILER = shutil.which("cc") or shutil.which("gcc")
+#: the C kit's header (the harness loop both C harnesses are built on)
+KIT_C = f"-I{C_KIT_DIR}"
 
 
 def clean(data: dict) -> bool:
@@ -51,7 +54,7 @@ def c_harness(tmp_path_factory: pytest.TempPathFactory):
     for name, flags in (("clean", []), ("no-service-request", ["-DFAULT_NO_SERVICE_REQUEST"])):
         binary = out / f"sensor-{name}"
         subprocess.run(
-            [COMPILER, "-O2", "-Wall", "-Werror", *flags, "-o", str(binary), *sources],
+            [COMPILER, "-O2", "-Wall", "-Werror", KIT_C, *flags, "-o", str(binary), *sources],
             check=True,
             capture_output=True,
         )
@@ -162,7 +165,8 @@ def c_logger(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         flags = [] if name == "clean" else [f"-DFAULT_{name.upper().replace('-', '_')}"]
         binary = out / f"logger-{name}"
         subprocess.run(
-            [COMPILER, "-O2", "-Wall", "-Wextra", "-Werror", *flags, "-o", str(binary), *sources],
+            [COMPILER, "-O2", "-Wall", "-Wextra", "-Werror", KIT_C, *flags, "-o", str(binary)]
+            + sources,
             check=True,
             capture_output=True,
         )

@@ -373,3 +373,71 @@ def test_fails_recorded_through_a_harness_that_failed_are_not_trusted(misbehavin
     assert record.findings[0].detail.startswith("not trusted, the harness failed")
     assert record.verdict is Verdict.INCONCLUSIVE
     assert reaped(pidfile)
+
+
+WAITS = textwrap.dedent(
+    """
+    import sys
+    log = open(sys.argv[1], "w")
+    for line in sys.stdin:
+        log.write(line)
+        log.flush()
+        word = line.split()[0]
+        if word == "hello":
+            print("hello 1 waiter", flush=True)
+        elif word == "char":
+            print("wait 20000", flush=True)  # nothing to send before 20 ms: wake me then
+        elif word != "bye":
+            print("idle", flush=True)
+    """
+)
+
+
+def test_a_harness_is_not_woken_inside_the_tools_break(tmp_path):
+    """A ``wait`` due inside the tool's break is answered by the break's message (told when
+    it ends), never by a ``time`` that says nothing happened until then: that let a service
+    request due at that time go out over the break, and a kit's sketch run past its start."""
+    script, log = tmp_path / "waits.py", tmp_path / "messages.txt"
+    script.write_text(WAITS)
+    link = open_sensor_harness(f"exec:{sys.executable} {script} {log}")
+    try:
+        link.write(bytes([0x30]))  # 0 .. 8333 us: answered "wait 20000"
+        link.wait_until(0.015)
+        link.send_break(0.013)  # 15 ms .. 28 ms: the wake-up at 20 ms falls inside it
+        link.receive(link.now() + 0.005)
+    finally:
+        link.close()
+    told = [line.split()[0] for line in log.read_text().splitlines()]
+    assert told[:3] == ["hello", "char", "break"], told
+    assert "time" not in told, told
+
+
+PAST_TX = textwrap.dedent(
+    """
+    import sys
+    for line in sys.stdin:
+        word, *fields = line.split()
+        if word == "hello":
+            print("hello 2 runs-ahead", flush=True)  # version 2: held to the clock
+        elif word == "char":
+            print(f"tx {int(fields[1]) - 1000} 30 8330", flush=True)  # a reply in the past
+        elif word != "bye":
+            print("idle", flush=True)
+    """
+)
+
+
+def test_a_version_2_harness_answering_in_the_past_is_an_error_naming_the_line(tmp_path):
+    """A harness whose device ran ahead of the tool's clock plans its reply 1 ms before the
+    message it answers: an ERROR quoting that line, never a reply moved to "now" and judged."""
+    script = tmp_path / "past.py"
+    script.write_text(PAST_TX)
+    link = open_sensor_harness(f"exec:{sys.executable} {script}")
+    try:
+        assert link.info.bit_timing and link.info.frame_lengths
+        link.write(bytes([0x30]))
+        with pytest.raises(HarnessError, match="wait for the line to be idle") as err:
+            link.receive(link.now() + 0.05)
+        assert "'tx 7333 30 8330'" in str(err.value)
+    finally:
+        link.close()

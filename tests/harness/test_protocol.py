@@ -91,7 +91,7 @@ def test_a_carriage_return_before_the_newline_is_accepted():
     [
         ("hi 1", "expected 'hello 1"),
         ("hello", "another protocol version"),
-        ("hello 2 future", "another protocol version"),
+        ("hello 3 future", "another protocol version"),
         ("idle", "expected 'hello 1"),
     ],
 )
@@ -124,3 +124,44 @@ def test_a_plan_held_back_by_the_frame_just_reported_may_repeat_its_start():
         proto.parse_plan("brk 4000 20000", Role.RECORDER, now=13333, since=5000)
     with pytest.raises(HarnessProtocolError, match="before now"):
         proto.parse_plan("brk 5200 20000", Role.RECORDER, now=13333)  # after sent/time: no
+
+
+# -- version 2 (the firmware kits): frame lengths, and no tx in the past ---------------------
+
+
+def test_a_harness_may_answer_version_2():
+    assert proto.parse_hello_version("hello 2 my-sketch") == ("my-sketch", 2)
+    assert proto.parse_hello_version("hello 1") == ("", 1)
+
+
+def test_a_version_2_tx_carries_its_frame_length():
+    plan = proto.parse_plan("tx 6000 30 8000", Role.SENSOR, now=5000, version=2)
+    assert (plan.kind, plan.start, plan.wire, plan.duration) == (PlanKind.TX, 6000, 0x30, 8000)
+    assert proto.parse_plan("tx 6000 30", Role.SENSOR, now=5000, version=2).duration == 0
+    with pytest.raises(HarnessProtocolError, match="takes 2 field"):
+        proto.parse_plan("tx 6000 30 8000", Role.SENSOR, now=5000)  # version 1: three fields
+
+
+@pytest.mark.parametrize("duration", ["5555", "12501", "8.3", "833"])
+def test_a_frame_length_outside_800_to_1800_baud_is_refused(duration):
+    with pytest.raises(HarnessProtocolError):
+        proto.parse_plan(f"tx 6000 30 {duration}", Role.SENSOR, now=5000, version=2)
+
+
+def test_a_version_2_tx_in_the_past_is_a_harness_error():
+    """Version 1 starts it now ("as soon as possible"); version 2 holds the harness to the
+    clock, as brk is: the line is named, the device is never judged for it."""
+    assert proto.parse_plan("tx 4000 30", Role.SENSOR, now=5000).start == 4000  # v1: ASAP
+    with pytest.raises(HarnessProtocolError, match="1000 us before now"):
+        proto.parse_plan("tx 4000 30 8330", Role.SENSOR, now=5000, version=2)
+    # within the rounding slack it is now; the plan it had, repeated unchanged after a
+    # reported frame that began before it, is taken (it goes out when the line is free)
+    assert proto.parse_plan("tx 4999 30", Role.SENSOR, now=5000, version=2).start == 5000
+    had = Plan(PlanKind.TX, start=4200, wire=0x30)
+    late = proto.parse_plan(
+        "tx 4200 30 8330", Role.SENSOR, now=13333, since=4000, version=2, previous=had
+    )
+    assert late.start == 13333
+    # a new plan inside the frame just reported transmits before the line is idle
+    with pytest.raises(HarnessProtocolError, match="wait for the line to be idle"):
+        proto.parse_plan("tx 4200 30 8330", Role.SENSOR, now=13333, since=4000, version=2)

@@ -237,3 +237,26 @@ def test_tolerance_misuse_needs_the_gap_surely_in_the_band():
     segs = wire.segments(transcript_of(gapped))
     assert verdicts(wire.judge_gaps(segs, 0.1e-3))["R-7.0-01"] is Verdict.FAIL
     assert verdicts(wire.judge_gaps(segs, 0.5e-3))["R-7.0-01"] is Verdict.INCONCLUSIVE
+
+
+@pytest.mark.parametrize(
+    ("frame", "verdict"),
+    [(8.330e-3, Verdict.PASS), (8.000e-3, Verdict.FAIL), (8.670e-3, Verdict.FAIL)],
+)
+def test_bit_rate_from_frame_lengths_sees_slow_as_well_as_fast(frame, verdict):
+    """Where each event lasts its own measured frame (a firmware kit), its length is its
+    rate: a sender 4 % slow, with gaps between its characters, FAILs too (the spacing judge
+    cannot tell that from a gap), and one exact frame among slow ones does not hide them."""
+    ex = exchange("0!", "", 0.0)
+    t0 = ex.last.command_end + 9e-3
+    ex.attempts[0].reply_events = [
+        Event(EventKind.CHAR, DUT, t0, t0 + 8.33e-3, wire=0x30),
+        *(
+            Event(EventKind.CHAR, DUT, t0 + i * 9e-3, t0 + i * 9e-3 + frame, wire=0x30)
+            for i in range(1, 4)
+        ),
+    ]
+    found = wire.judge_reply_frame_lengths(wire.segments(transcript_of(ex)), 0.0)
+    assert found.verdict is verdict, found
+    assert found.observed == 1 and "4 frames" in found.detail
+    assert wire.judge_reply_frame_lengths([], 0.0).verdict is Verdict.INCONCLUSIVE

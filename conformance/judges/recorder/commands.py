@@ -10,6 +10,7 @@ from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView
 from ..tally import Tally
 from ..timing import judge_window
+from ..wire import judge_frame_lengths, judge_rate
 from .common import combine
 
 
@@ -89,16 +90,11 @@ def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:
     if not spacings:
         return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
     shortest, s = min(spacings, key=lambda x: x[0])
-    finding = judge_window(
-        "R-4.1-01",
+    finding = judge_rate(
         "shortest start-to-start spacing of command characters",
         shortest,
         2 * uncertainty,
-        low=CHAR_TIME * 0.98,
-        high=CHAR_TIME * 1.02,
-        tolerance=0.0,
-        evidence=[f"in {s.at()}"],
-        decision="A14",
+        [f"in {s.at()}"],
     )
     too_slow = shortest - 2 * uncertainty > CHAR_TIME * 1.02
     if (
@@ -108,3 +104,10 @@ def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:
         finding.detail += " (no back-to-back characters: rate and gaps cannot be separated)"
     finding.detail += f"; about {10 / shortest:.0f} baud over {len(spacings)} spacings"
     return finding
+
+
+def judge_command_frame_lengths(line: TranscriptView, uncertainty: float) -> Finding:
+    """R-4.1-01 from the length of every command frame, where each character event lasts its
+    own measured frame (a firmware kit): slow as well as fast rates are seen."""
+    frames_at = [(e, f"in {s.at()}") for s in line.transmissions for e in s.chars]
+    return judge_frame_lengths(frames_at, uncertainty)

@@ -1,0 +1,100 @@
+/* sdi12-conform kit: Arduino's String, on the host (kept small: what SDI-12 sketches use). */
+#ifndef SDI12_KIT_WSTRING_H
+#define SDI12_KIT_WSTRING_H
+
+#include <stdlib.h>
+#include <string.h>
+
+#include <string>
+
+class String {
+  public:
+    String(const char *text = "") : s_(text ? text : "") {}
+    String(const std::string &text) : s_(text) {}
+    explicit String(char c) : s_(1, c) {}
+    String(int value, unsigned char base = 10) : s_(format_long(value, base)) {}
+    String(unsigned int value, unsigned char base = 10) : s_(format_ulong(value, base)) {}
+    String(long value, unsigned char base = 10) : s_(format_long(value, base)) {}
+    String(unsigned long value, unsigned char base = 10) : s_(format_ulong(value, base)) {}
+    String(float value, unsigned char decimals = 2) : s_(format_double(value, decimals)) {}
+    String(double value, unsigned char decimals = 2) : s_(format_double(value, decimals)) {}
+
+    unsigned int length() const { return (unsigned int)s_.size(); }
+    const char *c_str() const { return s_.c_str(); }
+    bool reserve(unsigned int size) { s_.reserve(size); return true; }
+    char charAt(unsigned int i) const { return i < s_.size() ? s_[i] : 0; }
+    void setCharAt(unsigned int i, char c) { if (i < s_.size()) s_[i] = c; }
+    char operator[](unsigned int i) const { return charAt(i); }
+    char &operator[](unsigned int i) { return s_[i]; }
+
+    String &operator+=(const String &other) { s_ += other.s_; return *this; }
+    String &operator+=(const char *text) { s_ += text; return *this; }
+    String &operator+=(char c) { s_ += c; return *this; }
+    String &operator+=(int v) { s_ += format_long(v, 10); return *this; }
+    String &operator+=(long v) { s_ += format_long(v, 10); return *this; }
+    String &operator+=(unsigned long v) { s_ += format_ulong(v, 10); return *this; }
+    bool concat(const String &other) { s_ += other.s_; return true; }
+    bool concat(char c) { s_ += c; return true; }
+    friend String operator+(const String &a, const String &b) { return String(a.s_ + b.s_); }
+    friend String operator+(const String &a, const char *b) { return String(a.s_ + b); }
+    friend String operator+(const char *a, const String &b) { return String(a + b.s_); }
+    friend String operator+(const String &a, char b) { return String(a.s_ + b); }
+
+    bool equals(const String &other) const { return s_ == other.s_; }
+    bool operator==(const String &other) const { return s_ == other.s_; }
+    bool operator==(const char *text) const { return s_ == text; }
+    bool operator!=(const String &other) const { return s_ != other.s_; }
+    bool operator!=(const char *text) const { return s_ != text; }
+    bool startsWith(const String &prefix) const { return s_.compare(0, prefix.s_.size(), prefix.s_) == 0; }
+    bool endsWith(const String &suffix) const {
+        return s_.size() >= suffix.s_.size() &&
+               s_.compare(s_.size() - suffix.s_.size(), suffix.s_.size(), suffix.s_) == 0;
+    }
+    int indexOf(char c, unsigned int from = 0) const {
+        size_t at = s_.find(c, from);
+        return at == std::string::npos ? -1 : (int)at;
+    }
+    int indexOf(const String &text, unsigned int from = 0) const {
+        size_t at = s_.find(text.s_, from);
+        return at == std::string::npos ? -1 : (int)at;
+    }
+    String substring(unsigned int from) const { return from < s_.size() ? String(s_.substr(from)) : String(); }
+    String substring(unsigned int from, unsigned int to) const {
+        if (from > to) { unsigned int t = from; from = to; to = t; }
+        if (from >= s_.size()) return String();
+        return String(s_.substr(from, to - from));
+    }
+    void remove(unsigned int index) { if (index < s_.size()) s_.erase(index); }
+    void remove(unsigned int index, unsigned int count) { if (index < s_.size()) s_.erase(index, count); }
+    void trim() {
+        size_t a = s_.find_first_not_of(" \t\r\n"), b = s_.find_last_not_of(" \t\r\n");
+        s_ = a == std::string::npos ? std::string() : s_.substr(a, b - a + 1);
+    }
+    void toUpperCase() { for (auto &c : s_) if (c >= 'a' && c <= 'z') c = (char)(c - 32); }
+    void toLowerCase() { for (auto &c : s_) if (c >= 'A' && c <= 'Z') c = (char)(c + 32); }
+    long toInt() const { return strtol(s_.c_str(), nullptr, 10); }
+    float toFloat() const { return strtof(s_.c_str(), nullptr); }
+    double toDouble() const { return strtod(s_.c_str(), nullptr); }
+
+  private:
+    std::string s_;
+    static std::string format_ulong(unsigned long v, unsigned char base) {
+        char buf[72];
+        int i = 70;
+        buf[71] = 0;
+        if (base < 2 || base > 36) base = 10;
+        do { buf[i--] = "0123456789abcdefghijklmnopqrstuvwxyz"[v % base]; v /= base; } while (v && i >= 0);
+        return std::string(buf + i + 1);
+    }
+    static std::string format_long(long v, unsigned char base) {
+        if (v < 0 && base == 10) return "-" + format_ulong((unsigned long)(-(v + 1)) + 1, base);
+        return format_ulong((unsigned long)v, base);
+    }
+    static std::string format_double(double v, unsigned char decimals) {
+        char buf[64];
+        snprintf(buf, sizeof buf, "%.*f", (int)decimals, v);
+        return std::string(buf);
+    }
+};
+
+#endif

@@ -1,0 +1,224 @@
+/* sdi12_kit.h: the harness loop for SDI-12 firmware written in C (docs/kit.md, "The C kit").
+ *
+ * A C sensor or logger library is put on sdi12-conform's virtual-time line (`--port exec:`,
+ * docs/harness-protocol.md) with a few lines: the kit reads the tool's messages, keeps the
+ * clock, and answers with the library's plan. Two adapters:
+ *
+ *   - a sensor written as event handlers (a break, a character heard, a character sent, and
+ *     "what do you send next"): fill a struct sdi12_sensor and call sdi12_kit_sensor();
+ *   - a recorder written in blocking bus calls (hold a break, write a character at a time,
+ *     read one with a deadline, log values): call sdi12_kit_break/_write/_read/_log from the
+ *     library's bus layer and hand its job function to sdi12_kit_recorder().
+ *
+ * Header-only: in exactly one .c file, #define SDI12_KIT_IMPLEMENTATION before including it.
+ * Times are microseconds on the tool's clock; a character is 7 bits, the kit adds and checks
+ * even parity. The tool makes 1200-baud frames of the bytes named (version 1 of the protocol:
+ * the bit rate is not observed; a bit-banging library goes through the Arduino kit instead).
+ *
+ * Build: cc -I$(python -c 'import conformance.kit as k; print(k.C_DIR)') ... */
+#ifndef SDI12_KIT_H
+#define SDI12_KIT_H
+
+typedef long long sdi12_us;
+
+/* -- a sensor as event handlers -------------------------------------------------------- */
+enum sdi12_plan_kind { SDI12_IDLE, SDI12_TX, SDI12_WAIT };
+
+struct sdi12_plan {
+    enum sdi12_plan_kind kind;
+    sdi12_us at;        /* SDI12_TX: the character's start; SDI12_WAIT: when to look again */
+    unsigned char wire; /* SDI12_TX: 7 data bits, even parity in bit 7 (sdi12_kit_wire) */
+};
+
+struct sdi12_sensor {
+    const char *name;                                                  /* shown in the report */
+    void (*on_break)(sdi12_us start, sdi12_us end);                    /* spacing, any length */
+    void (*on_char)(unsigned char wire, sdi12_us start, sdi12_us end); /* another's character */
+    void (*on_sent)(sdi12_us start, sdi12_us end);                     /* the planned one went */
+    struct sdi12_plan (*plan)(sdi12_us now);                           /* what comes next */
+};
+
+/* The loop, until the tool says bye: the program's exit status. */
+int sdi12_kit_sensor(const struct sdi12_sensor *sensor);
+
+/* -- a recorder in blocking bus calls --------------------------------------------------- */
+#define SDI12_KIT_TIMEOUT (-2) /* sdi12_kit_read: no start bit before the deadline */
+#define SDI12_KIT_PARITY (-1)  /* sdi12_kit_read: a character with a parity error */
+
+sdi12_us sdi12_kit_now(void);
+/* Hold the line spacing for `duration` from now; returns at the break's end. */
+void sdi12_kit_break(sdi12_us duration);
+/* Send `c` starting at `at` (now, if that is earlier); returns at its stop bit. */
+void sdi12_kit_write(char c, sdi12_us at);
+/* The next character whose start bit comes before `deadline`: its 7-bit value or
+ * SDI12_KIT_PARITY, *end its stop bit; SDI12_KIT_TIMEOUT (now = deadline) if none came. */
+int sdi12_kit_read(sdi12_us deadline, sdi12_us *end);
+/* What the logger stored for a measurement command: space-separated values ("": none). */
+void sdi12_kit_log(const char *command, const char *values);
+
+/* A recorder's job: TASK and the commands (wire text); NULL when done, else why it cannot. */
+typedef const char *(*sdi12_job)(const char *task, char *const commands[], int n);
+/* Greet, read the job, run it, report: the program's exit status. */
+int sdi12_kit_recorder(const char *name, sdi12_job job);
+
+/* 7-bit character -> 8 wire bits (even parity in bit 7); 1 if a wire byte's parity is even */
+unsigned char sdi12_kit_wire(char c);
+int sdi12_kit_parity_ok(unsigned wire);
+
+#ifdef SDI12_KIT_IMPLEMENTATION
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static sdi12_us sdi12_kit_clock;
+static char sdi12_kit_message[256]; /* the tool's last message: every answer is to it */
+
+unsigned char sdi12_kit_wire(char c) {
+    unsigned wire = (unsigned char)c & 0x7f;
+    return (unsigned char)(sdi12_kit_parity_ok(wire) ? wire : wire | 0x80);
+}
+
+int sdi12_kit_parity_ok(unsigned wire) {
+    int ones = 0;
+    for (int i = 0; i < 8; i++) ones += (wire >> i) & 1;
+    return ones % 2 == 0;
+}
+
+/* the next message (exit at bye or end of input); its first word */
+static const char *sdi12_kit_next(void) {
+    static char word[16];
+    if (!fgets(sdi12_kit_message, sizeof sdi12_kit_message, stdin)) exit(0);
+    if (sscanf(sdi12_kit_message, "%15s", word) != 1) {
+        fprintf(stderr, "sdi12-kit: empty message\n");
+        exit(2);
+    }
+    if (strcmp(word, "bye") == 0) exit(0);
+    return word;
+}
+
+static void sdi12_kit_say(const char *line) {
+    printf("%s\n", line);
+    fflush(stdout);
+}
+
+/* the fields of a line event; now moves to its end (or to T of `time T`) */
+static int sdi12_kit_fields(const char *word, sdi12_us *a, sdi12_us *b, unsigned *byte) {
+    long long x = 0, y = 0;
+    *byte = 0;
+    int got = sscanf(sdi12_kit_message, "%*s %lld %lld %x", &x, &y, byte);
+    *a = x;
+    *b = y;
+    if (strcmp(word, "time") == 0 && got >= 1) return (void)(sdi12_kit_clock = x), 1;
+    if (got < 2) {
+        fprintf(stderr, "sdi12-kit: unexpected message: %s", sdi12_kit_message);
+        exit(2);
+    }
+    sdi12_kit_clock = y;
+    return 1;
+}
+
+int sdi12_kit_sensor(const struct sdi12_sensor *sensor) {
+    char line[64];
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    for (;;) {
+        const char *word = sdi12_kit_next();
+        sdi12_us a, b;
+        unsigned byte;
+        if (strcmp(word, "hello") == 0) {
+            snprintf(line, sizeof line, "hello 1 %s", sensor->name);
+            sdi12_kit_say(line);
+            continue;
+        }
+        sdi12_kit_fields(word, &a, &b, &byte);
+        if (strcmp(word, "break") == 0) sensor->on_break(a, b);
+        else if (strcmp(word, "char") == 0) sensor->on_char((unsigned char)byte, a, b);
+        else if (strcmp(word, "sent") == 0) sensor->on_sent(a, b);
+        struct sdi12_plan p = sensor->plan(sdi12_kit_clock);
+        if (p.kind == SDI12_TX)
+            snprintf(line, sizeof line, "tx %lld %02x", p.at > sdi12_kit_clock ? p.at : sdi12_kit_clock, p.wire);
+        else if (p.kind == SDI12_WAIT && p.at > sdi12_kit_clock) snprintf(line, sizeof line, "wait %lld", p.at);
+        else snprintf(line, sizeof line, "idle");
+        sdi12_kit_say(line);
+    }
+}
+
+/* -- the recorder: every bus call answers the last message with a plan, reads the next ---- */
+static char sdi12_kit_logs[64][210];
+static int sdi12_kit_nlogs;
+
+static const char *sdi12_kit_answer(const char *plan, sdi12_us *start, sdi12_us *end,
+                                    unsigned *byte) {
+    sdi12_kit_say(plan);
+    const char *word = sdi12_kit_next();
+    sdi12_kit_fields(word, start, end, byte);
+    return word;
+}
+
+sdi12_us sdi12_kit_now(void) { return sdi12_kit_clock; }
+
+void sdi12_kit_break(sdi12_us duration) {
+    char plan[64];
+    sdi12_us s, e;
+    unsigned byte;
+    do snprintf(plan, sizeof plan, "brk %lld %lld", sdi12_kit_clock, sdi12_kit_clock + duration);
+    while (strcmp(sdi12_kit_answer(plan, &s, &e, &byte), "break") != 0); /* heard someone */
+}
+
+void sdi12_kit_write(char c, sdi12_us at) {
+    char plan[64];
+    sdi12_us s, e;
+    unsigned byte;
+    do snprintf(plan, sizeof plan, "tx %lld %02x", at > sdi12_kit_clock ? at : sdi12_kit_clock,
+                sdi12_kit_wire(c));
+    while (strcmp(sdi12_kit_answer(plan, &s, &e, &byte), "sent") != 0);
+}
+
+int sdi12_kit_read(sdi12_us deadline, sdi12_us *end) {
+    char plan[64];
+    sdi12_us s;
+    unsigned byte;
+    if (deadline <= sdi12_kit_clock) return SDI12_KIT_TIMEOUT;
+    snprintf(plan, sizeof plan, "wait %lld", deadline);
+    if (strcmp(sdi12_kit_answer(plan, &s, end, &byte), "char") != 0) return SDI12_KIT_TIMEOUT;
+    return sdi12_kit_parity_ok(byte) ? (int)(byte & 0x7f) : SDI12_KIT_PARITY;
+}
+
+void sdi12_kit_log(const char *command, const char *values) {
+    const char *p = values;
+    do { /* lines of at most 200 characters, each value whole */
+        char *out = sdi12_kit_logs[sdi12_kit_nlogs];
+        int n = snprintf(out, sizeof sdi12_kit_logs[0], "log %s", command);
+        while (*p == ' ') p++;
+        while (*p) {
+            int len = (int)strcspn(p, " ");
+            if (n + 1 + len > 200) break;
+            n += snprintf(out + n, sizeof sdi12_kit_logs[0] - (size_t)n, " %.*s", len, p);
+            p += len;
+            while (*p == ' ') p++;
+        }
+    } while (++sdi12_kit_nlogs < 64 && *p);
+}
+
+int sdi12_kit_recorder(const char *name, sdi12_job job) {
+    char task[16], *commands[32], *tok, line[64];
+    int n = 0;
+    long long at;
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    if (strcmp(sdi12_kit_next(), "hello") != 0 || !strstr(sdi12_kit_message, "recorder")) return 2;
+    snprintf(line, sizeof line, "hello 1 %s", name);
+    sdi12_kit_say(line);
+    sdi12_kit_next();
+    if (sscanf(sdi12_kit_message, "job %lld %15s", &at, task) != 2) return 2;
+    sdi12_kit_clock = at;
+    strtok(sdi12_kit_message, " \r\n"), strtok(NULL, " \r\n"), strtok(NULL, " \r\n");
+    while (n < 32 && (tok = strtok(NULL, " \r\n"))) commands[n++] = strdup(tok);
+    const char *cannot = job(task, commands, n);
+    for (int i = 0; i < sdi12_kit_nlogs; i++) printf("%s\n", sdi12_kit_logs[i]);
+    if (cannot) printf("cannot %s\n", cannot);
+    else printf("done\n");
+    fflush(stdout);
+    sdi12_kit_next(); /* bye */
+    return 0;
+}
+#endif /* SDI12_KIT_IMPLEMENTATION */
+#endif /* SDI12_KIT_H */

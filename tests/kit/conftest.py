@@ -1,0 +1,43 @@
+"""Building sketches with the kit once per session (skipped, saying why, without a C++
+compiler): ``kit_build(sketch, libs, defines)`` returns the binary, cached by its flags."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from conformance.kit.build import ArduinoBuild, build_arduino, find_compiler
+from tests.support.paths import ROOT
+
+ARDUINO = ROOT / "examples" / "arduino"
+SENSOR = ARDUINO / "sdi12_sensor"
+TINY_SDI12 = ARDUINO / "libraries" / "TinySDI12"
+SKETCHES = Path(__file__).parent / "sketches"
+LOGGER = ARDUINO / "sdi12_logger"
+LOGGER_DECLARATION = str(ROOT / "examples" / "c" / "tiny_logger.toml")
+
+Build = Callable[..., Path]
+
+
+@pytest.fixture(scope="session")
+def kit_builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The session's build folder (skipped without a compiler): a sketch built once with
+    the same flags, by a fixture or by the kit subcommand given ``--build-dir``, is reused."""
+    if find_compiler() is None:
+        pytest.skip("no C++ compiler (c++, g++ or clang++): the kit cannot build a sketch")
+    return tmp_path_factory.mktemp("kit-builds")
+
+
+def build_dir(folder: Path, sketch: Path, defines: tuple[str, ...] = ()) -> Path:
+    return folder / "-".join((sketch.name, *defines))
+
+
+@pytest.fixture(scope="session")
+def kit_build(kit_builds: Path) -> Build:
+    def build(sketch: Path, libs: tuple[Path, ...] = (), defines: tuple[str, ...] = ()) -> Path:
+        where = build_dir(kit_builds, sketch, defines)
+        return build_arduino(ArduinoBuild(sketch, libs, defines, build_dir=where))
+
+    return build
