@@ -81,6 +81,7 @@ class Pool:
         self.group = execnet.Group(execmodel="main_thread_only")
         self._inbox: queue.Queue[tuple[int, Any]] = queue.Queue()
         self._channels: dict[int, Any] = {}
+        self._let_go: list[Any] = []  # gateways exited as their result came: reaped at close
         source = worker_source()
         for i, (spec, job) in enumerate(zip(specs, jobs, strict=True)):
             try:
@@ -113,7 +114,9 @@ class Pool:
             )  # fmt: skip
         self.results[i] = item
         with contextlib.suppress(Exception):  # its work is done: let its process go now
-            self._channels[i].gateway.exit()
+            gateway = self._channels[i].gateway
+            gateway.exit()
+            self._let_go.append(gateway)
         on_result(i, item)
 
     def wait(
@@ -145,5 +148,27 @@ class Pool:
         return [self.results[i] for i in range(len(self.jobs))]
 
     def close(self) -> None:
-        """End every worker process (each has sent its result, or is given up on)."""
+        """End every worker process (each has sent its result, or is given up on), and wait
+        for the local ones let go early: an exited gateway leaves its group, so terminate()
+        no longer waits for its process, which stayed a zombie of the rack's process (found
+        by tests/harness/test_device.py after the rack tests, in one process)."""
         self.group.terminate(timeout=5.0)
+        for gateway in self._let_go:
+            _reap(gateway)
+
+
+def _reap(gateway: Any, timeout: float = 5.0) -> None:
+    """Wait for a ``popen`` worker's process (killed if it will not end); other kinds of
+    gateway have no local process."""
+    import subprocess
+
+    popen = getattr(getattr(gateway, "_io", None), "popen", None)
+    if popen is None:
+        return
+    try:
+        popen.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        with contextlib.suppress(OSError):
+            popen.kill()
+        with contextlib.suppress(OSError, subprocess.TimeoutExpired):
+            popen.wait(timeout=timeout)
