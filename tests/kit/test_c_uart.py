@@ -21,6 +21,8 @@ from conformance.matrices.sensor_matrix import row_from
 from tests.kit.conftest import C_EXAMPLES, c_compiler
 
 DECLARATION = str(C_EXAMPLES / "tiny_sensor.toml")
+#: test firmware: uart_order.c logs the adapter's callbacks in the order it makes them
+FIRMWARE = Path(__file__).parent / "firmware"
 #: what a byte-level (version 1) harness never shows: the bit rate
 BYTE_LEVEL = ("R-4.1-01",)
 
@@ -32,24 +34,58 @@ def uart_sensor(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     out = tmp_path_factory.mktemp("c-uart")
     sources = [str(C_EXAMPLES / "uart_sensor.c"), str(C_EXAMPLES / "tiny_sensor.c")]
     built = {}
-    for name, flags in (("clean", []), ("tx-gap", ["-DFAULT_TX_GAP"])):
-        binary = out / f"uart-sensor-{name}"
-        command = [compiler, "-O2", "-Wall", "-Wextra", "-Werror", f"-I{C_DIR}", *flags]
-        subprocess.run([*command, "-o", str(binary), *sources], check=True, capture_output=True)
+    probe = [str(FIRMWARE / "uart_order.c")]
+    for name, flags, files in (
+        ("clean", [], sources),
+        ("tx-gap", ["-DFAULT_TX_GAP"], sources),
+        ("order", [], probe),
+    ):
+        binary = out / f"uart-{name}"
+        command = [compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{C_DIR}", *flags]
+        subprocess.run([*command, "-o", str(binary), *files], check=True, capture_output=True)
         built[name] = binary
     return built
 
 
 def session(binary: Path, messages: list[str]) -> list[str]:
     """The firmware's answers to the tool's messages, in order (the greeting first)."""
+    return converse(binary, messages)[0]
+
+
+def converse(binary: Path, messages: list[str]) -> tuple[list[str], str]:
+    """The firmware's answers (the greeting first) and its stderr."""
     channel = ChildChannel(str(binary))
     try:
         answers = [channel.greet(Role.SENSOR)]
         answers += [channel.ask(message) for message in messages]
         channel.finish("bye")
-        return answers
+        return answers, channel.stderr_tail()
     finally:
         channel.close()
+
+
+def test_callbacks_come_in_line_order(uart_sensor):
+    """A timer falling inside a character heard fires at its own time, before that
+    character's rx interrupt; the bytes it writes go out from the line's now, back to back;
+    tx-done comes once the buffer is empty; a parity error is a status bit."""
+    answers, log = converse(
+        uart_sensor["order"],
+        [
+            "break 0 12000",  # arms the timer for 25000
+            "char 20333 28667 b1",  # '1' spans 25000
+            "sent 28667 37000 41",
+            "sent 37000 45333 42",
+            "char 50000 58333 31",  # '1' with odd parity
+        ],
+    )
+    assert answers == ["uart-order", "wait 25000", "tx 28667 41", "tx 37000 42", "idle", "idle"]
+    assert log.split("\n")[:5] == [
+        "break 0 12000",
+        "timer 25000 now 25000",
+        "rx 31 28667",
+        "tx-done 45333",
+        "rx 31 parity 58333",
+    ]
 
 
 #: "0!" heard, then its reply told as sent (docs/harness-protocol.md's sensor session)

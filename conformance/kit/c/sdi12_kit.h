@@ -233,6 +233,7 @@ void sdi12_kit_log(const char *command, const char *values) {
 }
 
 int sdi12_kit_recorder(const char *name, sdi12_job job) {
+    static char job_line[sizeof sdi12_kit_message]; /* the commands point into it (C99: no strdup) */
     char task[16], *commands[32], *tok, line[64];
     int n = 0;
     long long at;
@@ -243,8 +244,9 @@ int sdi12_kit_recorder(const char *name, sdi12_job job) {
     sdi12_kit_next();
     if (sscanf(sdi12_kit_message, "job %lld %15s", &at, task) != 2) return 2;
     sdi12_kit_clock = at;
-    strtok(sdi12_kit_message, " \r\n"), strtok(NULL, " \r\n"), strtok(NULL, " \r\n");
-    while (n < 32 && (tok = strtok(NULL, " \r\n"))) commands[n++] = strdup(tok);
+    memcpy(job_line, sdi12_kit_message, sizeof job_line);
+    strtok(job_line, " \r\n"), strtok(NULL, " \r\n"), strtok(NULL, " \r\n");
+    while (n < 32 && (tok = strtok(NULL, " \r\n"))) commands[n++] = tok;
     const char *cannot = job(task, commands, n);
     for (int i = 0; i < sdi12_kit_nlogs; i++) printf("%s\n", sdi12_kit_logs[i]);
     if (cannot) printf("cannot %s\n", cannot);
