@@ -163,7 +163,7 @@ def _digest(command: list[str]) -> str:
 
 
 def c_pin_commands(
-    sources: list[Path], out: Path, defines: tuple[str, ...] = (), data_pin: int = 2
+    sources: list[Path], out: Path, defines: tuple[str, ...] = ()
 ) -> list[list[str]]:
     """The calls that build C firmware on the pin adapter (``c/sdi12_kit_pin.h``): each C
     file with the C compiler into ``out``'s folder, then one C++ link with the adapter and
@@ -177,9 +177,8 @@ def c_pin_commands(
     ]
     cxx = find_compiler() or "c++"
     name = f'-DKIT_NAME="{out.name}"'
-    pins = f"-DKIT_DATA_PIN={data_pin}"
     core = [str(C_DIR / "kit_pin.cpp"), str(ARDUINO_DIR / "kit_core.cpp")]
-    link = [cxx, "-std=gnu++17", OPT, "-w", f"-I{ARDUINO_DIR}", f"-I{C_DIR}", name, pins]
+    link = [cxx, "-std=gnu++17", OPT, "-w", f"-I{ARDUINO_DIR}", f"-I{C_DIR}", name]
     calls.append([*link, *map(str, objects), *core, "-o", str(out)])
     return calls
 

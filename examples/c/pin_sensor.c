@@ -4,8 +4,8 @@
  * adapter (conformance/kit/c/sdi12_kit_pin.h: the Arduino kit's core seen from C):
  *
  *   cc -c -I conformance/kit/c examples/c/pin_sensor.c examples/c/tiny_sensor.c
- *   c++ -std=gnu++17 -I conformance/kit/arduino -I conformance/kit/c -DKIT_DATA_PIN=2 \
- *       pin_sensor.o tiny_sensor.o conformance/kit/c/kit_pin.cpp \
+ *   c++ -std=gnu++17 -I conformance/kit/arduino -I conformance/kit/c pin_sensor.o \
+ *       tiny_sensor.o conformance/kit/c/kit_pin.cpp \
  *       conformance/kit/arduino/kit_core.cpp -o pin_sensor
  *   sdi12-conform --port exec:./pin_sensor --declaration examples/c/tiny_sensor.toml
  *

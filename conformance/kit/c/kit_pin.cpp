@@ -1,7 +1,7 @@
 /* kit_pin.cpp: sdi12_kit_pin.h on the Arduino kit's core (kit_core.cpp), so that C firmware
  * that bit-bangs is run by the same machinery as a sketch, not a second one. The data pin is
- * KIT_DATA_PIN (give it to kit_core.cpp as well: the firmware may write before it asks for
- * edges). */
+ * KIT_DATA_PIN (2), named to the core before kit_setup() runs: the firmware may write the
+ * line before it asks for edges. */
 #include <Arduino.h>
 
 #include "sdi12_kit_pin.h"
@@ -41,8 +41,12 @@ void kit_log(const char *text) { Serial.println(text); }
 
 }  // extern "C"
 
+static void no_handler(void) {}
+
 void setup() {
     Serial.begin(115200);
+    attachInterrupt(PIN, no_handler, CHANGE); /* the core's data pin is its first interrupt's */
+    detachInterrupt(PIN);
     kit_setup();
 }
 

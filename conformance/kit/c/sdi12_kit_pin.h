@@ -11,8 +11,7 @@
  * Build: the firmware's C files with cc, linked with c++ against the core:
  *   K=$(python -c 'import conformance.kit as k; print(k.ARDUINO_DIR)')
  *   C=$(python -c 'import conformance.kit as k; print(k.C_DIR)')
- *   cc -c -I$C my_fw.c && c++ -std=gnu++17 -I$K -I$C -DKIT_DATA_PIN=2 \
- *       my_fw.o $C/kit_pin.cpp $K/kit_core.cpp -o fw
+ *   cc -c -I$C my_fw.c && c++ -std=gnu++17 -I$K -I$C my_fw.o $C/kit_pin.cpp $K/kit_core.cpp -o fw
  * (-DKIT_NAME='"my-fw"' names it in the report.) */
 #ifndef SDI12_KIT_PIN_H
 #define SDI12_KIT_PIN_H
