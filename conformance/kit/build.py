@@ -20,7 +20,7 @@ import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import ARDUINO_DIR
+from . import ARDUINO_DIR, C_DIR
 
 #: Optimisation: the run is about the sketch's decisions on a virtual clock, not its speed.
 OPT = "-O1"
@@ -160,3 +160,34 @@ def _digest(command: list[str]) -> str:
         if path.is_file():
             h.update(path.read_bytes())
     return h.hexdigest()
+
+
+def c_pin_commands(
+    sources: list[Path], out: Path, defines: tuple[str, ...] = ()
+) -> list[list[str]]:
+    """The calls that build C firmware on the pin adapter (``c/sdi12_kit_pin.h``): each C
+    file with the C compiler into ``out``'s folder, then one C++ link with the adapter and
+    the Arduino core (docs/kit.md, "The C kit"). ``$CC``, else ``cc``; ``$CXX``, else c++."""
+    cc = os.environ.get("CC") or "cc"
+    flags = [f"-D{d}" for d in defines]
+    objects = [out.parent / f"{out.name}-{source.stem}.o" for source in sources]
+    calls = [
+        [cc, OPT, f"-I{C_DIR}", *flags, "-c", str(source), "-o", str(obj)]
+        for source, obj in zip(sources, objects, strict=True)
+    ]
+    cxx = find_compiler() or "c++"
+    name = f'-DKIT_NAME="{out.name}"'
+    core = [str(C_DIR / "kit_pin.cpp"), str(ARDUINO_DIR / "kit_core.cpp")]
+    link = [cxx, "-std=gnu++17", OPT, "-w", f"-I{ARDUINO_DIR}", f"-I{C_DIR}", name]
+    calls.append([*link, *map(str, objects), *core, "-o", str(out)])
+    return calls
+
+
+def build_c_pin(sources: list[Path], out: Path, defines: tuple[str, ...] = ()) -> Path:
+    """Build C firmware that bit-bangs (``c_pin_commands``) as ``out``; KitBuildError with
+    the compiler's messages when it does not compile."""
+    for command in c_pin_commands(sources, out, defines):
+        done = subprocess.run(command, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            raise KitBuildError(f"did not compile ({shlex.join(command)}):\n{done.stderr.strip()}")
+    return out

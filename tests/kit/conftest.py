@@ -3,6 +3,8 @@ compiler): ``kit_build(sketch, libs, defines)`` returns the binary, cached by it
 
 from __future__ import annotations
 
+import os
+import shutil
 from collections.abc import Callable
 from pathlib import Path
 
@@ -41,3 +43,15 @@ def kit_build(kit_builds: Path) -> Build:
         return build_arduino(ArduinoBuild(sketch, libs, defines, build_dir=where))
 
     return build
+
+
+C_EXAMPLES = ROOT / "examples" / "c"
+
+
+def c_compiler() -> str:
+    """The host C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``); skips, saying why,
+    without one."""
+    for candidate in [os.environ.get("CC") or "cc", "gcc", "clang"]:
+        if shutil.which(candidate):
+            return candidate
+    pytest.skip("no C compiler (cc, gcc or clang): the C kit's examples cannot be built")

@@ -2,13 +2,16 @@
  *
  * A C sensor or logger library is put on sdi12-conform's virtual-time line (`--port exec:`,
  * docs/harness-protocol.md) with a few lines: the kit reads the tool's messages, keeps the
- * clock, and answers with the library's plan. Two adapters:
+ * clock, and answers with the library's plan. Three adapters:
  *
  *   - a sensor written as event handlers (a break, a character heard, a character sent, and
  *     "what do you send next"): fill a struct sdi12_sensor and call sdi12_kit_sensor();
  *   - a recorder written in blocking bus calls (hold a break, write a character at a time,
  *     read one with a deadline, log values): call sdi12_kit_break/_write/_read/_log from the
- *     library's bus layer and hand its job function to sdi12_kit_recorder().
+ *     library's bus layer and hand its job function to sdi12_kit_recorder();
+ *   - a sensor firmware written against a hardware UART (an rx interrupt, a tx buffer it
+ *     writes bytes into, a tx-complete interrupt, a one-shot timer): fill a struct sdi12_uart
+ *     and call sdi12_kit_uart(); its handlers call sdi12_uart_write() and sdi12_uart_timer().
  *
  * Header-only: in exactly one .c file, #define SDI12_KIT_IMPLEMENTATION before including it.
  * Times are microseconds on the tool's clock; a character is 7 bits, the kit adds and checks
@@ -60,6 +63,30 @@ void sdi12_kit_log(const char *command, const char *values);
 typedef const char *(*sdi12_job)(const char *task, char *const commands[], int n);
 /* Greet, read the job, run it, report: the program's exit status. */
 int sdi12_kit_recorder(const char *name, sdi12_job job);
+
+/* -- a sensor firmware on a UART (7E1, 1200 baud, a direction pin the kit need not see) ---- */
+#define SDI12_UART_PARITY_ERROR 0x100 /* on_rx: or-ed into the character, as UART status bits */
+#define SDI12_UART_FRAME_US 8333      /* one character on the line (the tool's: 8333.33 us) */
+
+struct sdi12_uart {
+    const char *name;                               /* shown in the report */
+    void (*on_rx)(int c, sdi12_us stamp);           /* a character received: its 7 bits (or-ed
+                                                       with SDI12_UART_PARITY_ERROR), stamped at
+                                                       its stop bit's end (the rx interrupt) */
+    void (*on_break)(sdi12_us start, sdi12_us end); /* the line held spacing, any length */
+    void (*on_tx_done)(sdi12_us stamp);             /* the tx buffer ran empty: the last stop
+                                                       bit went (turn the direction pin round) */
+    void (*on_timer)(sdi12_us now);                 /* the timer armed by sdi12_uart_timer */
+};
+
+/* From a handler: put `c` in the tx buffer (the UART adds even parity). A byte written while
+ * one is going out follows it back to back; into an empty buffer it starts now. 0: full. */
+int sdi12_uart_write(char c);
+/* From a handler: the one-shot timer fires at `at` (on_timer); a later call re-arms it,
+ * at < 0 stops it. Virtual time waits for it: a firmware delay is a timer. */
+void sdi12_uart_timer(sdi12_us at);
+/* The loop, until the tool says bye (sdi12_kit_now() is the clock in every handler). */
+int sdi12_kit_uart(const struct sdi12_uart *uart);
 
 /* 7-bit character -> 8 wire bits (even parity in bit 7); 1 if a wire byte's parity is even */
 unsigned char sdi12_kit_wire(char c);
@@ -117,19 +144,25 @@ static int sdi12_kit_fields(const char *word, sdi12_us *a, sdi12_us *b, unsigned
     return 1;
 }
 
+/* a sensor's next line event (a `hello` answered on the way, as version 1): its word */
+static const char *sdi12_kit_event(const char *name, sdi12_us *a, sdi12_us *b, unsigned *byte) {
+    char line[64];
+    const char *word;
+    while (strcmp(word = sdi12_kit_next(), "hello") == 0) {
+        snprintf(line, sizeof line, "hello 1 %s", name);
+        sdi12_kit_say(line);
+    }
+    sdi12_kit_fields(word, a, b, byte);
+    return word;
+}
+
 int sdi12_kit_sensor(const struct sdi12_sensor *sensor) {
     char line[64];
     setvbuf(stdout, NULL, _IOLBF, 0);
     for (;;) {
-        const char *word = sdi12_kit_next();
         sdi12_us a, b;
         unsigned byte;
-        if (strcmp(word, "hello") == 0) {
-            snprintf(line, sizeof line, "hello 1 %s", sensor->name);
-            sdi12_kit_say(line);
-            continue;
-        }
-        sdi12_kit_fields(word, &a, &b, &byte);
+        const char *word = sdi12_kit_event(sensor->name, &a, &b, &byte);
         if (strcmp(word, "break") == 0) sensor->on_break(a, b);
         else if (strcmp(word, "char") == 0) sensor->on_char((unsigned char)byte, a, b);
         else if (strcmp(word, "sent") == 0) sensor->on_sent(a, b);
@@ -200,6 +233,7 @@ void sdi12_kit_log(const char *command, const char *values) {
 }
 
 int sdi12_kit_recorder(const char *name, sdi12_job job) {
+    static char job_line[sizeof sdi12_kit_message]; /* the commands point into it (C99: no strdup) */
     char task[16], *commands[32], *tok, line[64];
     int n = 0;
     long long at;
@@ -210,8 +244,9 @@ int sdi12_kit_recorder(const char *name, sdi12_job job) {
     sdi12_kit_next();
     if (sscanf(sdi12_kit_message, "job %lld %15s", &at, task) != 2) return 2;
     sdi12_kit_clock = at;
-    strtok(sdi12_kit_message, " \r\n"), strtok(NULL, " \r\n"), strtok(NULL, " \r\n");
-    while (n < 32 && (tok = strtok(NULL, " \r\n"))) commands[n++] = strdup(tok);
+    memcpy(job_line, sdi12_kit_message, sizeof job_line);
+    strtok(job_line, " \r\n"), strtok(NULL, " \r\n"), strtok(NULL, " \r\n");
+    while (n < 32 && (tok = strtok(NULL, " \r\n"))) commands[n++] = tok;
     const char *cannot = job(task, commands, n);
     for (int i = 0; i < sdi12_kit_nlogs; i++) printf("%s\n", sdi12_kit_logs[i]);
     if (cannot) printf("cannot %s\n", cannot);
@@ -219,6 +254,61 @@ int sdi12_kit_recorder(const char *name, sdi12_job job) {
     fflush(stdout);
     sdi12_kit_next(); /* bye */
     return 0;
+}
+
+/* -- the UART: a tx buffer drained one planned character at a time, timers as `wait` ---- */
+static unsigned char sdi12_uart_tx[256]; /* wire bytes; indices wrap at 256 */
+static unsigned char sdi12_uart_head, sdi12_uart_count;
+static sdi12_us sdi12_uart_alarm = -1;
+
+int sdi12_uart_write(char c) {
+    if (sdi12_uart_count == 255) return 0;
+    sdi12_uart_tx[(unsigned char)(sdi12_uart_head + sdi12_uart_count++)] = sdi12_kit_wire(c);
+    return 1;
+}
+
+void sdi12_uart_timer(sdi12_us at) { sdi12_uart_alarm = at < 0 ? -1 : at; }
+
+/* Fire the timer while it falls at or before `until`, each at its own time (never before
+ * `from`, the line's last known time): a timer inside a character heard fires before the
+ * character's rx interrupt, as on a board. A timer re-armed in the past fires at once. */
+static void sdi12_uart_fire(const struct sdi12_uart *uart, sdi12_us from, sdi12_us until) {
+    for (int n = 0; sdi12_uart_alarm >= 0 && sdi12_uart_alarm <= until; n++) {
+        if (n == 10000) {
+            fprintf(stderr, "sdi12-kit: the UART timer re-armed 10000 times at %lld us\n", until);
+            exit(3);
+        }
+        sdi12_kit_clock = sdi12_uart_alarm > from ? sdi12_uart_alarm : from;
+        sdi12_uart_alarm = -1;
+        uart->on_timer(sdi12_kit_clock);
+    }
+    sdi12_kit_clock = until;
+}
+
+int sdi12_kit_uart(const struct sdi12_uart *uart) {
+    char line[64];
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    for (;;) {
+        sdi12_us from = sdi12_kit_clock, a, b; /* the line's time before this message */
+        unsigned byte;
+        const char *word = sdi12_kit_event(uart->name, &a, &b, &byte);
+        sdi12_uart_fire(uart, from, sdi12_kit_clock);
+        if (strcmp(word, "break") == 0) {
+            uart->on_break(a, b);
+        } else if (strcmp(word, "char") == 0) {
+            int c = (int)(byte & 0x7f);
+            uart->on_rx(sdi12_kit_parity_ok(byte) ? c : c | SDI12_UART_PARITY_ERROR, b);
+        } else if (strcmp(word, "sent") == 0 && sdi12_uart_count) {
+            sdi12_uart_head++, sdi12_uart_count--;
+            if (!sdi12_uart_count && uart->on_tx_done) uart->on_tx_done(b);
+        }
+        sdi12_uart_fire(uart, sdi12_kit_clock, sdi12_kit_clock);
+        if (sdi12_uart_count) /* the UART sends what it holds, from now */
+            snprintf(line, sizeof line, "tx %lld %02x", sdi12_kit_clock, sdi12_uart_tx[sdi12_uart_head]);
+        else if (sdi12_uart_alarm >= 0) snprintf(line, sizeof line, "wait %lld", sdi12_uart_alarm);
+        else snprintf(line, sizeof line, "idle");
+        sdi12_kit_say(line);
+    }
 }
 #endif /* SDI12_KIT_IMPLEMENTATION */
 #endif /* SDI12_KIT_H */
