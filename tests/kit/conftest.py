@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from conformance.harness.channel import ChildChannel
+from conformance.harness.protocol import Role, parse_plan
 from conformance.kit.build import ArduinoBuild, build_arduino, find_compiler
 from tests.support.paths import ROOT
 
@@ -55,3 +57,36 @@ def c_compiler() -> str:
         if shutil.which(candidate):
             return candidate
     pytest.skip("no C compiler (cc, gcc or clang): the C kit's examples cannot be built")
+
+
+def play_sensor(
+    binary: Path, name: str, events: list[str], until: int | None = None, steps: int = 200
+) -> tuple[list[tuple[int, int, int]], str]:
+    """Play the tool's side for a bit-level sensor (version 2): tell `events` in order (each
+    when the firmware's wait reaches its start), `time T` for every other wait (up to `until`
+    us, or `steps` messages), `sent` for every tx; the frames it sent and its stderr."""
+    channel = ChildChannel(str(binary))
+    try:
+        assert channel.greet(Role.SENSOR) == name and channel.version == 2
+        events = list(events)
+        message = events.pop(0)
+        now, sent = int(message.split()[2]), []  # the first event's end
+        for _ in range(steps):
+            if until is not None and now >= until:
+                break
+            plan = parse_plan(channel.ask(message), Role.SENSOR, now, version=2)
+            if plan.kind == "tx":
+                end = plan.start + plan.duration
+                sent.append((plan.start, end, plan.wire))
+                message, now = f"sent {plan.start} {end} {plan.wire:02x}", end
+            elif events and (plan.kind == "idle" or int(events[0].split()[1]) < plan.start):
+                message = events.pop(0)
+                now = int(message.split()[2])
+            elif plan.kind == "wait":
+                message, now = f"time {plan.start}", plan.start
+            else:
+                break
+        channel.finish("bye")
+        return sent, channel.stderr_tail()
+    finally:
+        channel.close()

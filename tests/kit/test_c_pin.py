@@ -12,11 +12,9 @@ import pytest
 
 from conformance.conduct import run_once
 from conformance.emulator import FAULTS
-from conformance.harness.channel import ChildChannel
-from conformance.harness.protocol import Role, parse_plan
 from conformance.kit.build import build_c_pin
 from conformance.matrices.sensor_matrix import row_from
-from tests.kit.conftest import C_EXAMPLES, c_compiler
+from tests.kit.conftest import C_EXAMPLES, c_compiler, play_sensor
 
 DECLARATION = str(C_EXAMPLES / "tiny_sensor.toml")
 SOURCES = [C_EXAMPLES / "pin_sensor.c", C_EXAMPLES / "tiny_sensor.c"]
@@ -39,30 +37,8 @@ ACKNOWLEDGE = ["break 0 12000", "char 20333 28667 30", "char 28667 37000 21"]
 
 
 def frames_sent(binary: Path, events: list[str]) -> list[tuple[int, int, int]]:
-    """Play the tool's side: tell `events` in order (each when the firmware's wait reaches
-    its start), `time T` for every other wait, `sent` for every tx; the frames it sent."""
-    channel = ChildChannel(str(binary))
-    try:
-        assert channel.greet(Role.SENSOR) == binary.name and channel.version == 2
-        events = list(events)
-        message, now, sent = events.pop(0), 12000, []
-        for _ in range(200):
-            plan = parse_plan(channel.ask(message), Role.SENSOR, now, version=2)
-            if plan.kind == "tx":
-                end = plan.start + plan.duration
-                sent.append((plan.start, end, plan.wire))
-                message, now = f"sent {plan.start} {end} {plan.wire:02x}", end
-            elif events and (plan.kind == "idle" or int(events[0].split()[1]) < plan.start):
-                message = events.pop(0)
-                now = int(message.split()[2])
-            elif plan.kind == "wait":
-                message, now = f"time {plan.start}", plan.start
-            else:
-                break
-        channel.finish("bye")
-        return sent
-    finally:
-        channel.close()
+    """The frames the firmware sent while the tool told it `events` (conftest.play_sensor)."""
+    return play_sensor(binary, binary.name, events)[0]
 
 
 @pytest.mark.parametrize("bit", sorted(BITS))

@@ -35,6 +35,26 @@ typedef uint16_t word;
 #define MSBFIRST 1
 #define NOT_AN_INTERRUPT -1
 #define PROGMEM
+/* Flash strings: the host has one address space, so a "flash" string is an ordinary one and
+ * reading it byte by byte is a plain load (what pgm_read_byte does on a board). */
+class __FlashStringHelper;
+#define PGM_P const char *
+#define PSTR(text) (text)
+#define pgm_read_byte(address) (*(const uint8_t *)(address))
+#define strlen_P(text) strlen(text)
+#define strcpy_P(to, from) strcpy((to), (from))
+#define memcpy_P(to, from, n) memcpy((to), (from), (n))
+/* Code placement on an ESP (an ISR kept in instruction RAM): no behaviour to model on the
+ * host, the function runs the same. Defined for every build so a library's ESP path compiles. */
+#define IRAM_ATTR
+#define ICACHE_RAM_ATTR
+/* The ESP flavour (-D ESP32 or -D ESP8266, docs/kit.md): the CPU clock those cores define,
+ * which libraries test to decide whether micros() is fast enough to time bits with. */
+#if !defined(F_CPU) && defined(ESP32)
+#define F_CPU 240000000L
+#elif !defined(F_CPU) && defined(ESP8266)
+#define F_CPU 80000000L
+#endif
 #define F(text) (text)
 #define PI 3.1415926535897932384626433832795
 #define bitRead(value, bit) (((value) >> (bit)) & 0x01)
@@ -93,6 +113,7 @@ inline bool isSpace(int c) { return c == ' ' || (c >= 9 && c <= 13); }
 
 #include "WString.h"
 #include "HardwareSerial.h"
+#include "Stream.h" /* as a board core's Arduino.h brings it: Print, Stream */
 
 /* The sketch's own two functions. */
 void setup(void);

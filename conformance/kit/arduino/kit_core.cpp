@@ -450,11 +450,6 @@ size_t HardwareSerial::write(uint8_t c) {
     }
     return 1;
 }
-size_t HardwareSerial::write(const char *text) {
-    size_t n = 0;
-    for (; text[n]; n++) write((uint8_t)text[n]);
-    return n;
-}
 int HardwareSerial::available() { return (int)serial_in.size(); }
 int HardwareSerial::peek() { return serial_in.empty() ? -1 : (unsigned char)serial_in[0]; }
 int HardwareSerial::read() {
