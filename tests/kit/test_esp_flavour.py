@@ -1,11 +1,11 @@
-"""The kit's ESP flavour (``-D ESP32``) and its Print/Stream classes, as the widely used
-EnviroDIY SDI-12 library's ESP path uses them (docs/kit.md): sketches/esp_stream (our own
-code) derives a line class from Stream, sends with print()/println() through write(uint8_t)
-timed by a 64-us tick (micros() >> 6, 13 ticks a bit, 8-bit wrap-around), hears the tool's
-characters from an IRAM_ATTR CHANGE handler, and reads the command with Stream's
-readStringUntil on millis(). The tests play the tool's side of the harness protocol, so what
-is checked is the kit: the frames come out at the tick-timed bit, the reply where the sketch
-put it, and a timed read waits its timeout on the virtual clock."""
+"""The kit's ESP flavours (``-D ESP32``, ``-D ESP8266``) and its Print/Stream classes, as the
+widely used EnviroDIY SDI-12 library's ESP path uses them (docs/kit.md): sketches/esp_stream
+(our own code) derives a line class from Stream, sends with print()/println() through
+write(uint8_t) timed by a 64-us tick (micros() >> 6, 13 ticks a bit, 8-bit wrap-around),
+hears the tool's characters from an IRAM_ATTR CHANGE handler, and reads the command with
+Stream's readStringUntil on millis(). The tests play the tool's side of the harness
+protocol, so what is checked is the kit: the frames come out at the tick-timed bit, the reply
+where the sketch put it, and a timed read waits its timeout on the virtual clock."""
 
 from __future__ import annotations
 
@@ -23,9 +23,10 @@ COMMAND_END = 37000
 TICK_US = 64
 
 
-@pytest.fixture(scope="module")
-def esp_stream(kit_build) -> Path:
-    return kit_build(SKETCH, defines=("ESP32",))
+@pytest.fixture(scope="module", params=["ESP32", "ESP8266"])
+def esp_stream(kit_build, request) -> Path:
+    """The sketch built as each ESP board (it asserts the flavour's F_CPU as it compiles)."""
+    return kit_build(SKETCH, defines=(request.param,))
 
 
 def test_the_stream_reply_goes_out_at_the_tick_timed_bit(esp_stream):

@@ -1,17 +1,20 @@
-/* The kit's ESP flavour (-D ESP32) and its Print/Stream classes, used the way the widely used
- * EnviroDIY SDI-12 library's ESP path uses them (our own code, not theirs):
+/* The kit's ESP flavours (-D ESP32, -D ESP8266) and its Print/Stream classes, used the way
+ * the widely used EnviroDIY SDI-12 library's ESP path uses them (our own code, not theirs):
  * - a line class derived from Stream: print()/println() funnel into write(uint8_t), which
  *   bit-bangs 7E1 timed by a 64-us tick read from micros() >> 6, waiting 13 ticks a bit
  *   with 8-bit wrap-around arithmetic, interrupts held off for the character;
  * - receive from an IRAM_ATTR CHANGE handler on digitalPinToInterrupt(pin), stamping edges;
  * - readStringUntil('!') (Stream's timed read on millis(), the virtual clock);
- * - F()/PSTR strings read with strlen_P/pgm_read_byte; F_CPU as the ESP32 core sets it.
+ * - F()/PROGMEM strings read with strlen_P/pgm_read_byte; F_CPU as the ESP cores set it.
  * It answers "0!" with "0<CR><LF>" 9 ms after the '!' is decoded, logging each frame it
  * sends ("F start_us wire") and each timed read that timed out ("T from_ms to_ms"). */
-#ifndef ESP32
-#error "build with -D ESP32 (the kit's ESP flavour)"
-#endif
+#if defined(ESP32)
 static_assert(F_CPU == 240000000L, "the ESP32 flavour's CPU clock");
+#elif defined(ESP8266)
+static_assert(F_CPU == 80000000L, "the ESP8266 flavour's CPU clock");
+#else
+#error "build with -D ESP32 or -D ESP8266 (the kit's ESP flavours)"
+#endif
 
 #define PIN 4
 #define BIT_US 833
