@@ -159,6 +159,7 @@ def test_a_bus_run_that_cannot_work_is_a_usage_error(argv, tmp_path, capsys):
     assert not (tmp_path / "run" / "sensor-0").exists()
 
 
+@pytest.mark.slow  # a second whole run of one sensor
 def test_judge_replays_one_sensor_of_the_bus_to_the_same_verdicts(clean_bus, tmp_path):
     """``judge sensor-1/`` repeats that sensor's run against its recording: the bus (from the
     run-options note) again, so no ?! and the same bus cases, to the same verdicts."""

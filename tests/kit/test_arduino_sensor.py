@@ -57,6 +57,7 @@ def test_a_faulty_twin_fails_exactly_its_requirements(kit_build, define):
     assert data["summary"]["verdict"] == "NON-COMPLIANT"
 
 
+@pytest.mark.slow  # a whole run and its verify; the 4 % slow twin keeps the rule in the inner loop
 def test_a_sketch_4_percent_fast_fails_the_bit_rate(kit_builds, tmp_path):
     """Through the kit subcommand, as a user runs it: 800 us bits are 8.00 ms frames."""
     build, run = str(build_dir(kit_builds, SENSOR, ("FAULT_BAUD",))), str(tmp_path / "run")
