@@ -28,8 +28,8 @@ import pytest
 from conformance.commands.bus import BUS_FILE
 from conformance.emulator import FAULTS
 from conformance.emulator_server.process import EmulatorProcess
-from conformance.emulator_server.realtime import LATE_NOTICE
 from tests.e2e.test_live_bus import BUS_CASES, bus_findings, by_verdict, verdicts
+from tests.support.served_timing import fail_unless_too_busy
 
 pytestmark = [pytest.mark.realtime, pytest.mark.slow]
 
@@ -80,16 +80,8 @@ def served(tmp_path_factory) -> dict[str, Served]:
 
 
 def _unless_too_busy(run: Served, wrong: list[str]) -> None:
-    """Fail on what the run got wrong, unless the served line could not keep real time: then
-    its timing is no evidence either way (skipped, with the figure)."""
-    if not wrong:
-        return
-    if run.late is not None and run.late > LATE_NOTICE:
-        pytest.skip(
-            f"the machine was too busy to keep real time: the served line fell "
-            f"{run.late * 1e3:.1f} ms behind its schedule; {wrong}"
-        )
-    pytest.fail(f"{wrong} (line late by {run.late} s):\n{run.text}")
+    """Fail on what the run got wrong, unless the served line could not keep real time."""
+    fail_unless_too_busy(run.late, "; ".join(map(str, wrong)) if wrong else "", run.text)
 
 
 def test_discovery_over_rfc2217_finds_every_served_sensor(served):

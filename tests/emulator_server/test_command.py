@@ -23,7 +23,7 @@ import serial
 
 from conformance.emulator_server.command import emulate_main, make_device
 from conformance.emulator_server.process import EmulatorProcess
-from conformance.emulator_server.realtime import LATE_NOTICE, RealTimeLine
+from conformance.emulator_server.realtime import RealTimeLine
 from conformance.emulator_server.servers import TcpEmulatorServer, serve_serial
 from conformance.links.factory import open_real_link
 from conformance.ports import PortError
@@ -31,6 +31,7 @@ from conformance.protocol import commands as cmds
 from conformance.protocol.timing import INTER_CHAR_GAP_MAX, RESPONSE_START_MAX, RESPONSE_START_MIN
 from conformance.tool_recorder.engine import ToolRecorder
 from conformance.transcript import to_wire_7e1
+from tests.support.served_timing import fail_unless_too_busy
 
 #: Cases that together touch wake-up, identification, a measurement with its service request,
 #: data, and the whole-transcript framing and timing judges.
@@ -225,16 +226,9 @@ def e2e(tmp_path_factory) -> dict[str, Served]:
 
 def unexpected_failures(run: Served, unexpected: set[str]) -> None:
     """Fail on FAILs nobody expected, unless the served line itself could not keep real
-    time: on a machine that busy a late frame is the host's doing, not the sensor's, and the
-    run's timing is no evidence either way (skipped, with the figures)."""
-    if not unexpected:
-        return
-    if run.late is not None and run.late > LATE_NOTICE:
-        pytest.skip(
-            f"the machine was too busy to keep real time: the served line fell "
-            f"{run.late * 1e3:.1f} ms behind its schedule; unexpected {sorted(unexpected)}"
-        )
-    pytest.fail(f"unexpected FAILs {sorted(unexpected)} (line late by {run.late}):\n{run.text}")
+    time (then skipped, with the figures)."""
+    wrong = f"unexpected FAILs {sorted(unexpected)}" if unexpected else ""
+    fail_unless_too_busy(run.late, wrong, run.text)
 
 
 @pytest.mark.realtime
