@@ -22,6 +22,8 @@ from conformance.judges.recorder.retries import judge_retries
 from conformance.recorder.drivers import Trigger
 from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.recorder.scenario_runner import RecorderSession
+from tests.support.host_lag import HostLag
+from tests.support.served_timing import fail_unless_too_busy
 
 SERVE = "rfc2217-serve://127.0.0.1:0"
 #: Requirements judged only on times measured on the line (PASS or INCONCLUSIVE when clean).
@@ -119,12 +121,16 @@ def test_unusable_serve_ports_are_usage_errors(port):
 def test_golden_recorder_as_a_separate_process_through_the_trigger():
     """The golden recorder outside the judging process (``--trigger`` runs
     ``python -m conformance.recorder.external`` per scenario): its retries of a silent sensor
-    are judged from the served line without a FAIL, and it says what it logged."""
+    are judged from the served line without a FAIL, and it says what it logged. The recorder
+    process is timed by the host: when its retry misses the window while the host woke
+    threads late (or the served line fell behind), the machine was too busy for evidence."""
     trigger = Trigger(f"{sys.executable} -m conformance.recorder.external", 30)
     session = RecorderSession(SERVE, driver=trigger)
     try:
-        record = session.run("silent-twice")
+        with HostLag() as lag:
+            record = session.run("silent-twice")
         findings = judge_retries(session.view("silent-twice"), session.uncertainty)
+        late = max(session.worst_lateness(), lag.worst)
     finally:
         session.close()
     assert record.error is None, record.error
@@ -134,8 +140,14 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
     sent = "".join(chr(e.char7) for e in record.events if e.kind == "char" and e.origin == "tool")
     assert sent.count("0M!") == 3, sent  # two unanswered tries, then the answered one
     verdicts = {f.requirement: str(f.verdict) for f in findings}
-    assert verdicts.get("R-7.2-01") == "PASS", verdicts
-    assert "FAIL" not in verdicts.values(), verdicts
+    wrong = (
+        ""
+        if verdicts.get("R-7.2-01") == "PASS" and "FAIL" not in verdicts.values()
+        else f"retries judged {verdicts}"
+    )
+    fail_unless_too_busy(
+        late, wrong, "\n".join(f"{f.requirement} {f.verdict}: {f.detail}" for f in findings)
+    )
 
 
 def test_serving_sensors_is_refused_in_the_sensor_role(capsys):
