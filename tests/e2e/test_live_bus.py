@@ -65,6 +65,7 @@ def clean_bus(tmp_path_factory) -> tuple[Path, int, str]:
     return folder, code, said
 
 
+@pytest.mark.slow  # three whole runs; the default selection keeps the two-sensor fault run
 def test_a_clean_bus_of_three_is_compliant_with_every_bus_case_judged(clean_bus):
     folder, code, said = clean_bus
     assert code == 0, said
@@ -88,6 +89,7 @@ def test_a_clean_bus_of_three_is_compliant_with_every_bus_case_judged(clean_bus)
     assert "sensors on the bus:" in said and said.count("· COMPLIANT ·") == 3
 
 
+@pytest.mark.slow  # the three-sensor bus run above
 def test_no_query_goes_onto_a_shared_bus(clean_bus):
     folder, _code, _said = clean_bus
     for a in "013":

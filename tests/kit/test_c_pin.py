@@ -52,6 +52,7 @@ def test_the_frames_rebuilt_are_at_the_firmwares_bit_time(pin_sensor, bit):
     assert abs(sent[0][0] - (heard_end + 10000)) <= TOLERANCE_US
 
 
+@pytest.mark.slow  # a whole run; the default keeps the Arduino sketch's 4 %-slow twin
 def test_the_fast_twin_fails_the_bit_rate(pin_sensor):
     data = run_once(
         f"exec:{pin_sensor[800]}", declaration=DECLARATION, keyword="test_reply_framing"
