@@ -63,6 +63,7 @@ us_t vt = 0;           /* the sketch's clock, on the tool's time line */
 us_t boot = 0;         /* when the board came up: micros() counts from here (a recorder's job) */
 us_t horizon = 0;      /* the tool's now: the line is known up to here */
 us_t quiet = 0;        /* nothing from the tool starts before this (0: not told) */
+us_t woke_to = 0;      /* the latest time the sketch woke itself to since the last message */
 bool recorder = false; /* the role the tool asked for */
 
 /* the coroutine */
@@ -228,7 +229,8 @@ void line_write(int before, int level) {
 }
 
 us_t limit() {
-    if (!composing) return quiet - 1 > horizon ? quiet - 1 : horizon;
+    /* a recorder whose job is over waits where it said so (its `done` is told then) */
+    if (!composing) return finish.empty() && quiet - 1 > horizon ? quiet - 1 : horizon;
     if (holding_break) return frame_start + KIT_MAX_BREAK_US;
     if (close_at != NEVER) return close_at;
     return frame_start + (us_t)llround(10.5 * NOMINAL_BIT);
@@ -263,6 +265,7 @@ void advance_to(us_t target, bool stop_on_edge) {
             continue;
         }
         if (target <= lim) {
+            if (!composing && target > horizon && target > woke_to) woke_to = target;
             if (target > vt) vt = target;
             return;
         }
@@ -371,7 +374,16 @@ std::string plan_line() {
 void answer(const std::string &prefix = "") {
     for (auto &line : logs) print_log(line);
     logs.clear();
-    printf("%s%s\n", prefix.c_str(), plan_line().c_str());
+    /* A recorder's `done`, `cannot` and `idle` take their time from the message they
+     * answer (the job's end; the idle line's start). Reached after waking itself, the sketch
+     * asks for the time it woke to (`wait T`), as it would have without QUIET, and says it
+     * in the answer to `time T`: the tool's clock is where it was before. */
+    bool timeless = out.empty() && (!finish.empty() || waiting != WANT);
+    if (recorder && timeless && woke_to > horizon) {
+        printf("%swait %lld\n", prefix.c_str(), woke_to);
+    } else {
+        printf("%s%s\n", prefix.c_str(), plan_line().c_str());
+    }
     fflush(stdout);
 }
 
@@ -487,8 +499,10 @@ size_t HardwareSerial::write(uint8_t c) {
     if (c == '\n') {
         fprintf(stderr, "[%lld.%06lld s] %s\n", vt / 1000000, vt % 1000000, serial_line.c_str());
         if (recorder && serial_line.rfind("log ", 0) == 0) logs.push_back(serial_line);
-        if (recorder && (serial_line == "done" || serial_line.rfind("cannot", 0) == 0))
+        if (recorder && (serial_line == "done" || serial_line.rfind("cannot", 0) == 0)) {
             finish = serial_line;
+            quiet = 0; /* the job's end is told at the time it came: the sketch waits there */
+        }
         serial_line.clear();
     } else if (c != '\r') {
         serial_line += (char)c;
@@ -529,7 +543,7 @@ int main(void) {
             continue;
         }
         us_t now;
-        quiet = 0; /* each message says its own */
+        quiet = woke_to = 0; /* each message says its own */
         if (strcmp(word, "chars") == 0) {
             hear_chars(line + strlen("chars"));
             continue;
