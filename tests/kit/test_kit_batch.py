@@ -13,7 +13,7 @@ import pytest
 
 from conformance.conduct import run_into
 from conformance.harness import protocol as proto
-from tests.kit.conftest import SENSOR, TINY_SDI12
+from tests.kit.conftest import LOGGER, LOGGER_DECLARATION, SENSOR, TINY_SDI12
 
 DECLARATION = str(SENSOR / "sdi12_sensor.toml")
 #: cases with waits of ttt seconds the sketch polls through, service requests, a measurement
@@ -22,9 +22,10 @@ KEYWORD = "service_request or break_aborts_measurement or concurrent_survives"
 
 
 def line_events(folder: Path) -> list[dict]:
-    """The transcript's line events (notes name the run's folder, which differs)."""
+    """The transcript: line events and notes (a job's end among them), but the run's options,
+    which name the run's folder."""
     rows = (json.loads(line) for line in (folder / "transcript.jsonl").read_text().splitlines())
-    return [row for row in rows if row["kind"] != "note"]
+    return [row for row in rows if not row["text"].startswith("run-options")]
 
 
 @pytest.mark.slow  # two runs; CI runs it, the inner loop keeps test_batch.py's scripted device
@@ -41,3 +42,21 @@ def test_the_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_path, monk
     assert batched["summary"]["counts"]["PASS"] >= 3
     verdicts = {r["id"]: r["verdict"] for r in batched["requirements"]}
     assert verdicts == {r["id"]: r["verdict"] for r in plain["requirements"]}
+
+
+@pytest.mark.slow  # two recorder runs
+def test_the_logger_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_path, monkeypatch):
+    """The recorder role: told QUIET (the played sensors' next character), the logger sketch
+    wakes itself while it waits for a reply or a service request; a job's end is told at
+    the time it came, so the next job starts where it did before."""
+    port = f"exec:{kit_build(LOGGER, (TINY_SDI12,))}"
+    options = {"declaration": LOGGER_DECLARATION, "role": "recorder"}
+    options["keyword"] = "service_request or crc_mismatch or transparent"
+    batched = run_into(tmp_path / "batched", port, **options)
+    monkeypatch.setattr(proto, "BATCH", "not-offered")
+    plain = run_into(tmp_path / "plain", port, **options)
+    events = line_events(tmp_path / "batched")
+    assert len(events) > 100
+    assert events == line_events(tmp_path / "plain")
+    assert batched["summary"] == plain["summary"]
+    assert batched["summary"]["counts"]["PASS"] >= 3
