@@ -8,7 +8,9 @@ then times, the trees taking turns so that a machine whose load drifts weighs on
 
 - ``c``: ``sdi12-conform --port exec:sensor_harness --declaration tiny_sensor.toml``;
 - ``kit``: ``sdi12-conform kit arduino examples/arduino/sdi12_sensor --lib ... --declaration
-  sdi12_sensor.toml`` (the build cached, as CI's second run of a sketch finds it).
+  sdi12_sensor.toml`` (the build cached, as CI's second run of a sketch finds it);
+- ``logger``: the same for ``examples/arduino/sdi12_logger`` in the recorder role (24 jobs,
+  a harness process each).
 
 Each run is one fresh process (bytecode caching on, as in CI); CPU is the process and the
 harness it starts (``RUSAGE_CHILDREN``). Prints every run, then per case the median wall and
@@ -28,7 +30,9 @@ import tempfile
 import time
 from pathlib import Path
 
-SKETCH = ("examples/arduino/sdi12_sensor", "--lib", "examples/arduino/libraries/TinySDI12")
+LIB = ("--lib", "examples/arduino/libraries/TinySDI12")
+SKETCH = ("examples/arduino/sdi12_sensor", *LIB)
+LOGGER = ("examples/arduino/sdi12_logger", *LIB)
 
 
 def environment(tree: Path) -> dict[str, str]:
@@ -44,14 +48,16 @@ def build(tree: Path, folder: Path) -> dict[str, list[str]]:
     c_dir = tree / "conformance" / "kit" / "c"
     sources = [str(tree / "examples" / "c" / n) for n in ("sensor_harness.c", "tiny_sensor.c")]
     subprocess.run(["cc", "-O2", f"-I{c_dir}", "-o", str(binary), *sources], check=True)
-    kit = [sys.executable, "-m", "conformance.cli", "kit", "arduino", *SKETCH]
-    kit += ["--build-dir", str(folder / "kit")]
-    subprocess.run([*kit, "--build-only"], cwd=tree, env=environment(tree), check=True,
-                   capture_output=True)  # fmt: skip
     cli = [sys.executable, "-m", "conformance.cli"]
+    kit = [*cli, "kit", "arduino", *SKETCH, "--build-dir", str(folder / "kit")]
+    logger = [*cli, "kit", "arduino", *LOGGER, "--build-dir", str(folder / "logger")]
+    for command in (kit, logger):
+        subprocess.run([*command, "--build-only"], cwd=tree, env=environment(tree), check=True,
+                       capture_output=True)  # fmt: skip
     return {
         "c": [*cli, "--port", f"exec:{binary}", "--declaration", "examples/c/tiny_sensor.toml"],
         "kit": [*kit, "--declaration", "examples/arduino/sdi12_sensor/sdi12_sensor.toml"],
+        "logger": [*logger, "--role", "recorder", "--declaration", "examples/c/tiny_logger.toml"],
     }
 
 
@@ -74,12 +80,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("trees", nargs="+", type=Path)
     parser.add_argument("--runs", type=int, default=3)
-    parser.add_argument("--case", action="append", choices=("c", "kit"), dest="cases")
+    parser.add_argument("--case", action="append", choices=("c", "kit", "logger"), dest="cases")
     args = parser.parse_args()
     trees = [tree.resolve() for tree in args.trees]
     with tempfile.TemporaryDirectory(prefix="sdi12-harness-bench-") as tmp:
         commands = {tree: build(tree, Path(tmp) / str(i)) for i, tree in enumerate(trees)}
-        for case in args.cases or ["c", "kit"]:
+        for case in args.cases or ["c", "kit", "logger"]:
             found: dict[Path, list[dict]] = {tree: [] for tree in trees}
             for n in range(args.runs):
                 for tree in trees:
