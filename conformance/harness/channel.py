@@ -31,7 +31,8 @@ from .protocol import (
     check_line,
     hello,
     is_log,
-    parse_hello_version,
+    parse_heard,
+    parse_hello_features,
     parse_log,
     parse_plan,
     us,
@@ -66,6 +67,7 @@ class Channel:
         self.failure: str | None = None  # why the harness failed, once it has
         self.logs: list[LogLine] = []  # a recorder harness's log lines, in order
         self.version = 1  # the protocol version the harness answered hello with
+        self.features: frozenset[str] = frozenset()  # what it added to it (``2+batch``)
         self.last_plan: Plan | None = None  # the plan it answered last (a repeat is told apart)
 
     # subclass hooks
@@ -152,7 +154,7 @@ class Channel:
         """Exchange hellos (with the longer start-up allowance); the harness's name."""
         reply = self.ask(hello(role), max(HELLO_TIMEOUT, self.reply_timeout))
         try:
-            name, self.version = parse_hello_version(reply)
+            name, self.version, self.features = parse_hello_features(reply)
             return name
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
@@ -180,6 +182,22 @@ class Channel:
             return plan
         except HarnessProtocolError as exc:
             raise self.protocol_error(exc) from exc
+
+    def read_heard(self, role: Role, frames: list[tuple[int, int, int]]) -> tuple[int, Plan]:
+        """The answer to a ``chars`` message of ``frames`` ``(wire, start us, end us)``: how
+        many the harness heard and its checked plan after the last of them (the plan it had
+        before them counts as the previous one only if it heard one: in between it planned
+        nothing it had to tell)."""
+        reply = self.answer()
+        try:
+            taken, text = parse_heard(reply, len(frames))
+            _, start, end = frames[taken - 1]
+            previous = self.last_plan if taken == 1 else None
+            plan = parse_plan(text, role, end, start, self.version, previous)
+        except HarnessProtocolError as exc:
+            raise self.protocol_error(exc) from exc
+        self.last_plan = plan
+        return taken, plan
 
     def _take_log(self, text: str) -> bool:
         if not is_log(text):

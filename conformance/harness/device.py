@@ -15,7 +15,7 @@ from ..links.registry import LinkKind, OpenedPort, PortOptions, register
 from ..protocol.timing import CHAR_TIME
 from ..results import CaseRecord
 from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
-from ..transcript import Event
+from ..transcript import TOOL, Event, EventKind
 from ..verdicts import Verdict
 from . import protocol as proto
 from .channel import Channel, ChildChannel, HarnessError, SocketChannel
@@ -34,17 +34,36 @@ class HarnessDevice:
         self._pending: float | None = None  # time of a message whose answer is unread
         self._since: float | None = None  # START of the frame that message reported
         self.harness_name = channel.greet(Role.SENSOR)
+        #: the harness takes ``chars`` batches and a QUIET field (``hello V+batch``)
+        self.batches = proto.BATCH in channel.features
+        self._unsent: str | None = None  # a batch harness's message, told when needed
+        #: bus time (s) before which the tool starts nothing but what this device's own
+        #: characters lead to: set by :class:`HarnessBus` before it asks for a plan, void
+        #: once anything happens on the line (:meth:`_tell`)
+        self.quiet: float | None = None
 
     def _tell(self, message: str, now: float, since: float | None = None) -> None:
-        """Send a line event; its answer is read when the plan is next needed, so the bus
-        does its bookkeeping while the harness works (half the wall time on 2 cores)."""
+        """Tell a line event; its answer is read when the plan is next needed, so the bus
+        does its bookkeeping while the harness works (half the wall time on 2 cores). A
+        batch harness is told then too, with the QUIET field known at that moment (how long
+        the line stays the device's: it wakes itself for its waits until then)."""
         self._collect()
-        self.channel.send(message)
+        self.quiet = None
+        if self.batches:
+            self._unsent = message
+        else:
+            self.channel.send(message)
         self._pending, self._since = now, since
 
     def _collect(self) -> None:
         if self._pending is not None:
             now, self._pending = self._pending, None
+            if self._unsent is not None:
+                message, self._unsent = self._unsent, None
+                quiet = None if self.quiet is None else proto.quiet_until(self.quiet)
+                if quiet is not None and quiet > proto.us(now):
+                    message = f"{message} {quiet}"
+                self.channel.send(message)
             self._plan = plan = self.channel.read_plan(Role.SENSOR, now, self._since)
             # the harness saw ``now`` rounded to the microsecond; when it answers with that
             # very time it means this instant, not half a microsecond before or after it
@@ -62,6 +81,19 @@ class HarnessDevice:
 
     def wake(self, now: float) -> None:
         self._tell(proto.time_is(now), now)
+
+    def hear_chars(self, frames: list[tuple[int, float, float]]) -> int:
+        """Tell a batch harness the tool's characters ``(wire, start, end)`` of one write
+        in one ``chars`` message; how many it heard (it stops where its plan would act
+        before the next character starts: the rest is then the bus's to send as usual)."""
+        self._collect()
+        self.channel.send(proto.heard_chars(frames))
+        in_us = [(wire, proto.us(start), proto.us(end)) for wire, start, end in frames]
+        taken, plan = self.channel.read_heard(Role.SENSOR, in_us)
+        now = frames[taken - 1][2]
+        self._plan = plan
+        self._start = now if plan.start == proto.us(now) else proto.seconds(plan.start)
+        return taken
 
     def on_break(self, start: float, end: float) -> None:
         self._tell(proto.line_break(start, end), end, start)
@@ -106,8 +138,17 @@ class HarnessBus(SimBus):
         finally:
             self._held_from = None
 
+    def _promise(self, limit: float) -> None:
+        """Before a plan is asked for: the tool starts nothing before ``limit`` (inside its
+        own break, nothing after the break's start), which a batch harness alone on the bus
+        is told with its next message (its QUIET field). Alone: another device's characters
+        would be line events it has not been told of."""
+        if len(self.devices) == 1 and isinstance(device := self.devices[0], HarnessDevice):
+            device.quiet = self._held_from if self._held_from is not None else limit
+
     def _wake_before(self, limit: float) -> bool:
         """Wake the earliest harness due before ``limit`` (and before the next character)."""
+        self._promise(limit)
         due = [(d.wake_at, d) for d in self.devices if getattr(d, "wake_at", None) is not None]
         if not due:
             return False
@@ -125,6 +166,7 @@ class HarnessBus(SimBus):
         while True:
             if self._wake_before(time):
                 continue
+            self._promise(time)  # still so after a character of the device's own
             nxt = self._next()
             if nxt is None or nxt[1].start >= time:
                 break
@@ -134,7 +176,25 @@ class HarnessBus(SimBus):
     def step(self, limit: float):  # noqa: ANN201 - as SimBus.step
         while self._wake_before(limit):
             pass
+        self._promise(limit)  # until its next character: the tool may answer that
         return super().step(limit)
+
+    def tool_chars(self, wire: bytes, start: float, gap: float) -> list[Event]:
+        """The tool's characters from ``start``, ``gap`` apart, told to the one batch
+        harness in one message: the events of those it heard, placed exactly as
+        :meth:`~conformance.sim.bus.SimBus.tool_char` places them one by one (nothing of the
+        device's comes between: it would have stopped the batch). At least one."""
+        self.advance(start)
+        time, frames = self.clock.now, []
+        for byte in wire:
+            frames.append((byte, time, time + CHAR_TIME))
+            time = time + CHAR_TIME + gap
+        taken = self.devices[0].hear_chars(frames)  # type: ignore[attr-defined]
+        events = []
+        for byte, first, end in frames[:taken]:
+            events.append(self.transcript.add(Event(EventKind.CHAR, TOOL, first, end, wire=byte)))
+            self.clock.advance_to(end)
+        return events
 
 
 class HarnessLink(SimLink):
@@ -170,6 +230,24 @@ class HarnessLink(SimLink):
         often as it explains a failure."""
         tail = getattr(self.device.channel, "stderr_tail", None)
         return tail() if callable(tail) else None
+
+    def write(self, wire: bytes, gap: float = 0.0) -> list[Event]:
+        """As :meth:`SimLink.write`; to a batch harness alone on the bus, up to
+        ``BATCH_MAX`` characters a message (one round trip for a command, not one a
+        character), the same events at the same times."""
+        bus = self.bus
+        if not (self.device.batches and isinstance(bus, HarnessBus) and len(bus.devices) == 1):
+            return super().write(wire, gap)
+        events: list[Event] = []
+        time = self.now()
+        while len(events) < len(wire):
+            rest = wire[len(events) : len(events) + proto.BATCH_MAX]
+            if len(rest) == 1:
+                events.append(bus.tool_char(rest[0], time))
+            else:
+                events.extend(bus.tool_chars(rest, time, gap))
+            time = events[-1].end + gap
+        return events
 
     def close(self) -> None:
         self.device.channel.close(proto.BYE)

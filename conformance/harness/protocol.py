@@ -18,6 +18,16 @@ VERSION = 1
 #: holds the harness to the clock: a ``tx`` planned before now is an ERROR, not "as soon as
 #: possible". The tool still greets with ``hello 1``: a version-1 harness sees no change.
 VERSIONS = (1, 2)
+#: What a harness may add to its version in the ``hello`` answer (``hello 2+batch NAME``):
+#: ``batch`` lets the tool send a write's characters in one ``chars`` message (answered
+#: ``heard K PLAN``: the harness heard the first K and stopped where its plan would act before
+#: the next) and add to ``time T`` when nothing from the tool can start (``time T QUIET``), so
+#: the harness wakes itself for any ``wait`` before QUIET. The same device behaviour in fewer
+#: round trips (docs/harness-protocol.md, "Batches").
+FEATURES = ("batch",)
+BATCH = "batch"
+#: Most characters one ``chars`` message carries (its line stays under 256 characters).
+BATCH_MAX = 8
 #: The frame durations a version-2 ``tx`` may name (us): 10 bits at 800 to 1800 baud, far
 #: outside any rate a receiver would frame, so a wrong unit is caught, a wrong rate judged.
 FRAME_US_MIN, FRAME_US_MAX = 5556, 12500
@@ -93,8 +103,25 @@ def sent(wire: int, start: float, end: float) -> str:
     return f"sent {us(start)} {us(end)} {wire:02x}"
 
 
-def time_is(now: float) -> str:
-    return f"time {us(now)}"
+def time_is(now: float, quiet: int | None = None) -> str:
+    """``time NOW``, or ``time NOW QUIET`` (batch harnesses: nothing from the tool starts
+    before QUIET us, so the harness may wake itself for any ``wait`` before it)."""
+    return f"time {us(now)}" if quiet is None else f"time {us(now)} {quiet}"
+
+
+def quiet_until(limit: float) -> int | None:
+    """The QUIET field for a bus time ``limit`` (s) before which the tool starts nothing: the
+    whole microseconds Q such that every ``wait T`` with T < Q is before ``limit`` (floor,
+    so a harness never wakes itself where the tool would not have); None when unbounded."""
+    if not limit < MAX_TIME_US / 1e6:
+        return None
+    return int(limit * 1e6)
+
+
+def heard_chars(frames: list[tuple[int, float, float]]) -> str:
+    """``chars S1 E1 XX1 S2 E2 XX2 ...``: the tool's characters ``(wire, start, end)`` of one
+    write, back to back, each sent only if the harness has not transmitted before its START."""
+    return "chars " + " ".join(f"{us(s)} {us(e)} {w:02x}" for w, s, e in frames)
 
 
 BYE = "bye"
@@ -117,12 +144,42 @@ def parse_hello(text: str) -> str:
 
 def parse_hello_version(text: str) -> tuple[str, int]:
     """The harness's name and the protocol version it answered with (one of ``VERSIONS``)."""
+    name, version, _ = parse_hello_features(text)
+    return name, version
+
+
+def parse_hello_features(text: str) -> tuple[str, int, frozenset[str]]:
+    """The harness's name, version and the features it added (``hello 2+batch NAME``: each
+    one of ``FEATURES``, at most once)."""
     parts = text.split(maxsplit=2)
     if not parts or parts[0] != "hello":
         raise HarnessProtocolError("expected 'hello 1 [name]' as the first reply", text)
-    if len(parts) < 2 or parts[1] not in {str(v) for v in VERSIONS}:
+    version, *features = parts[1].split("+") if len(parts) > 1 else ("",)
+    if version not in {str(v) for v in VERSIONS}:
         raise HarnessProtocolError(f"harness speaks another protocol version, not {VERSION}", text)
-    return (parts[2] if len(parts) > 2 else ""), int(parts[1])
+    unknown = [f for f in features if f not in FEATURES]
+    if unknown or len(set(features)) != len(features):
+        raise HarnessProtocolError(
+            f"unknown or repeated feature {'+'.join(unknown or features)!r} "
+            f"(known: {', '.join(FEATURES)})",
+            text,
+        )
+    return (parts[2] if len(parts) > 2 else ""), int(version), frozenset(features)
+
+
+#: The answer to ``chars``: ``heard K PLAN`` (K the characters heard, PLAN the plan after them).
+HEARD = "heard"
+
+
+def parse_heard(text: str, count: int) -> tuple[int, str]:
+    """How many of a ``chars`` message's ``count`` characters the harness heard (1..count),
+    and the text of its plan after them (checked by :func:`parse_plan`)."""
+    parts = text.split(" ", 2)
+    if len(parts) < 3 or parts[0] != HEARD:
+        raise HarnessProtocolError("a 'chars' message is answered 'heard K PLAN'", text)
+    if not parts[1].isdigit() or not 1 <= int(parts[1]) <= count:
+        raise HarnessProtocolError(f"'heard' takes a count from 1 to {count}", text)
+    return int(parts[1]), parts[2]
 
 
 def _time(field: str, text: str) -> int:

@@ -20,6 +20,7 @@ from ..harness.protocol import Plan, PlanKind, Role
 from ..links.base import Link
 from ..links.errors import PortUnavailable
 from ..recorder_jobs import RecorderOutput, Request
+from ..sim.bus import SimBus, earliest_frame
 from ..transcript import Event
 from .job_time import JobBudget, JobTimeout
 
@@ -109,13 +110,13 @@ class HarnessRecorder:
                 if not heard:
                     raise JobTimeout(budget.seconds, budget.reason)
                 got = heard[0]
-                message = proto.heard(got.wire, got.start, got.end)
+                message = _quiet(channel, link, limit, proto.heard(got.wire, got.start, got.end))
                 plan = channel.plan(message, Role.RECORDER, got.end, got.start)
                 continue
             heard = link.receive(deadline, until=_first)
             if heard:
                 got = heard[0]
-                message = proto.heard(got.wire, got.start, got.end)
+                message = _quiet(channel, link, limit, proto.heard(got.wire, got.start, got.end))
                 plan = channel.plan(message, Role.RECORDER, got.end, got.start)
                 continue
             if plan.kind is PlanKind.IDLE:
@@ -128,10 +129,24 @@ class HarnessRecorder:
             else:  # BRK
                 made = link.send_break(proto.seconds(plan.end) - link.now())
                 message = proto.line_break(made.start, made.end)
+            message = _quiet(channel, link, limit, message)
             plan = channel.plan(message, Role.RECORDER, link.now())
         if plan.kind is PlanKind.CANNOT:
             return "cannot" + (f" {plan.reason}" if plan.reason else ""), plan.reason
         return "done", None
+
+
+def _quiet(channel: Channel, link: Link, limit: float, message: str) -> str:
+    """``message`` with its QUIET field for a ``batch`` harness on the sim bus: nothing
+    starts on the line before the played sensors' next character (each knows it: they are
+    sans-I/O) or the job's cut at ``limit``, unless the harness transmits first; so it wakes
+    itself for its waits until then (a logger sketch polling for a service request)."""
+    bus = getattr(link, "bus", None)
+    if proto.BATCH not in channel.features or not isinstance(bus, SimBus):
+        return message
+    nxt = earliest_frame(bus.devices)
+    quiet = proto.quiet_until(limit if nxt is None else min(limit, nxt[1].start))
+    return message if quiet is None or quiet <= proto.us(link.now()) else f"{message} {quiet}"
 
 
 def _transmit(link: Link, plan: Plan) -> Event:

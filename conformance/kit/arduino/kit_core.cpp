@@ -11,7 +11,14 @@
  * line is the sketch's own, and nothing the tool could say changes what it writes. Any other
  * time the sketch asks for (a delay, a micros() call) is answered `wait T` to the tool, which
  * tells either `time T` or what happened on the line first; the sketch then runs on from
- * there with the tool's edges fed to its pin, so it never acts on a line it has not seen. */
+ * there with the tool's edges fed to its pin, so it never acts on a line it has not seen.
+ *
+ * With the `batch` feature (`hello 2+batch`) the tool says how far the line is known to stay
+ * quiet (`time T QUIET`, and each character of a `chars` message until the next one's start):
+ * nothing from the tool starts before QUIET, so a time the sketch asks for before it is known
+ * already and the sketch runs on to it without a message (an idle loop() polling millis()
+ * for a measurement's end costs no round trip a poll). The same instants, the same edges:
+ * only the `wait`/`time` pairs the tool would have answered are left out. */
 #include <signal.h>
 #include <stdarg.h>
 #include <ucontext.h>
@@ -55,6 +62,8 @@ const int PINS = 256;
 us_t vt = 0;           /* the sketch's clock, on the tool's time line */
 us_t boot = 0;         /* when the board came up: micros() counts from here (a recorder's job) */
 us_t horizon = 0;      /* the tool's now: the line is known up to here */
+us_t quiet = 0;        /* nothing from the tool starts before this (0: not told) */
+us_t woke_to = 0;      /* the latest time the sketch woke itself to since the last message */
 bool recorder = false; /* the role the tool asked for */
 
 /* the coroutine */
@@ -179,6 +188,7 @@ void close_frame(us_t next_start) {
 }
 
 void begin_frame(us_t t) {
+    quiet = 0; /* the tool's promise held until the sketch's own frame: it may answer it */
     composing = true;
     holding_break = false;
     frame_start = t;
@@ -219,7 +229,8 @@ void line_write(int before, int level) {
 }
 
 us_t limit() {
-    if (!composing) return horizon;
+    /* a recorder whose job is over waits where it said so (its `done` is told then) */
+    if (!composing) return finish.empty() && quiet - 1 > horizon ? quiet - 1 : horizon;
     if (holding_break) return frame_start + KIT_MAX_BREAK_US;
     if (close_at != NEVER) return close_at;
     return frame_start + (us_t)llround(10.5 * NOMINAL_BIT);
@@ -254,10 +265,11 @@ void advance_to(us_t target, bool stop_on_edge) {
             continue;
         }
         if (target <= lim) {
+            if (!composing && target > horizon && target > woke_to) woke_to = target;
             if (target > vt) vt = target;
             return;
         }
-        if (lim > vt) vt = lim;
+        if (horizon > vt) vt = horizon; /* the line is known up to the tool's now */
         suspend(WANT, target);
     }
 }
@@ -334,9 +346,9 @@ void print_log(const std::string &line) {
     printf("%s\n", out.c_str());
 }
 
-void answer() {
-    for (auto &line : logs) print_log(line);
-    logs.clear();
+/* the plan after the last message, as its answer line (without the newline) */
+std::string plan_line() {
+    char line[96];
     if (!out.empty()) {
         Out &o = out.front();
         if (o.start < horizon) { /* begun while the tool's own frame was on the line */
@@ -347,16 +359,61 @@ void answer() {
             if (o.kind == 't') o.end += horizon - o.start;
             o.start = horizon;
         }
-        if (o.kind == 'b') printf("brk %lld %lld\n", o.start, o.end);
-        else printf("tx %lld %02x %lld\n", o.start, o.wire, o.end - o.start);
-    } else if (!finish.empty()) {
-        printf("%s\n", finish.c_str());
-    } else if (waiting == WANT) {
-        printf("wait %lld\n", want_at);
+        if (o.kind == 'b') snprintf(line, sizeof line, "brk %lld %lld", o.start, o.end);
+        else snprintf(line, sizeof line, "tx %lld %02x %lld", o.start, o.wire, o.end - o.start);
+        return line;
+    }
+    if (!finish.empty()) return finish;
+    if (waiting == WANT) {
+        snprintf(line, sizeof line, "wait %lld", want_at);
+        return line;
+    }
+    return "idle";
+}
+
+void answer(const std::string &prefix = "") {
+    for (auto &line : logs) print_log(line);
+    logs.clear();
+    /* A recorder's `done`, `cannot` and `idle` take their time from the message they
+     * answer (the job's end; the idle line's start). Reached after waking itself, the sketch
+     * asks for the time it woke to (`wait T`), as it would have without QUIET, and says it
+     * in the answer to `time T`: the tool's clock is where it was before. */
+    bool timeless = out.empty() && (!finish.empty() || waiting != WANT);
+    if (recorder && timeless && woke_to > horizon) {
+        printf("%swait %lld\n", prefix.c_str(), woke_to);
     } else {
-        printf("idle\n");
+        printf("%s%s\n", prefix.c_str(), plan_line().c_str());
     }
     fflush(stdout);
+}
+
+/* after a character of a `chars` message: may the sketch hear the next one, starting at
+ * `next`? Only if it would have answered `idle` or a `wait` after `next` (a wait at the
+ * rounded start may be before it on the tool's clock), with nothing to say meanwhile. */
+bool hears_next(us_t next) {
+    if (!out.empty() || !finish.empty() || !logs.empty()) return false;
+    return waiting == IDLE || (waiting == WANT && want_at > next);
+}
+
+/* `chars S E XX S E XX ...` (the `batch` feature): the tool's characters of one write, each
+ * heard as a `char`, the line quiet until the next one's start; answered `heard K PLAN`
+ * after the K-th, where the sketch's plan might act before the next one */
+void hear_chars(const char *fields) {
+    long long start, end, next;
+    unsigned wire;
+    int used, heard = 0;
+    while (sscanf(fields, "%lld %lld %x%n", &start, &end, &wire, &used) == 3) {
+        fields += used;
+        heard++;
+        add_tool_frame(start, end, (int)wire);
+        if (end > horizon) horizon = end;
+        bool last = sscanf(fields, "%lld", &next) != 1;
+        quiet = last ? 0 : next;
+        resume();
+        if (last || !hears_next(next)) break;
+    }
+    if (heard == 0) fail("unexpected message: chars%s", fields);
+    answer("heard " + std::to_string(heard) + " ");
 }
 
 }  // namespace
@@ -442,8 +499,10 @@ size_t HardwareSerial::write(uint8_t c) {
     if (c == '\n') {
         fprintf(stderr, "[%lld.%06lld s] %s\n", vt / 1000000, vt % 1000000, serial_line.c_str());
         if (recorder && serial_line.rfind("log ", 0) == 0) logs.push_back(serial_line);
-        if (recorder && (serial_line == "done" || serial_line.rfind("cannot", 0) == 0))
+        if (recorder && (serial_line == "done" || serial_line.rfind("cannot", 0) == 0)) {
             finish = serial_line;
+            quiet = 0; /* the job's end is told at the time it came: the sketch waits there */
+        }
         serial_line.clear();
     } else if (c != '\r') {
         serial_line += (char)c;
@@ -479,11 +538,16 @@ int main(void) {
         if (strcmp(word, "hello") == 0) {
             if (sscanf(line, "%*s %*d %15s", role) != 1) fail("bad hello: %s", line);
             recorder = strcmp(role, "recorder") == 0;
-            printf("hello 2 %s\n", KIT_NAME);
+            printf("hello 2+batch %s\n", KIT_NAME);
             fflush(stdout);
             continue;
         }
         us_t now;
+        quiet = woke_to = 0; /* each message says its own */
+        if (strcmp(word, "chars") == 0) {
+            hear_chars(line + strlen("chars"));
+            continue;
+        }
         if (strcmp(word, "break") == 0 && sscanf(line, "%*s %lld %lld", &a, &b) == 2) {
             if (!out.empty() && out.front().kind == 'b' && out.front().end == b) {
                 if (out.front().start != a) /* planned inside a frame the tool then reported */
@@ -494,10 +558,12 @@ int main(void) {
                 edges.push_back({a, 1});
                 edges.push_back({b, 0});
             }
+            if (sscanf(line, "%*s %*lld %*lld %lld", &c) == 1) quiet = c; /* break S E QUIET */
             now = b;
         } else if (strcmp(word, "char") == 0 &&
                    sscanf(line, "%*s %lld %lld %x", &a, &b, &byte_value) == 3) {
             add_tool_frame(a, b, (int)byte_value);
+            if (sscanf(line, "%*s %*lld %*lld %*x %lld", &c) == 1) quiet = c; /* char S E XX QUIET */
             now = b;
         } else if (strcmp(word, "sent") == 0 && sscanf(line, "%*s %lld %lld %x", &a, &b, &byte_value) == 3) {
             if (out.empty() || out.front().kind != 't') fail("'sent' for a frame not planned: %s", line);
@@ -505,9 +571,11 @@ int main(void) {
                 fprintf(stderr, "sdi12-kit: the frame planned at %lld us went out at %lld us "
                         "(the line was busy)\n", out.front().start, a);
             out.pop_front();
+            if (sscanf(line, "%*s %*lld %*lld %*x %lld", &c) == 1) quiet = c; /* sent S E XX QUIET */
             now = b;
         } else if (strcmp(word, "time") == 0 && sscanf(line, "%*s %lld", &a) == 1) {
             now = a;
+            if (sscanf(line, "%*s %*lld %lld", &b) == 1) quiet = b; /* time T QUIET */
         } else if (strcmp(word, "job") == 0 && sscanf(line, "%*s %lld", &a) == 1) {
             const char *rest = strchr(line + 4, ' ');
             serial_in += rest ? rest + 1 : "\n";
@@ -517,7 +585,6 @@ int main(void) {
             fail("unexpected message: %s", line);
             return 3;
         }
-        (void)c;
         if (now > horizon) horizon = now;
         resume();
         answer();

@@ -98,7 +98,7 @@ int sdi12_kit_parity_ok(unsigned wire);
 #include <string.h>
 
 static sdi12_us sdi12_kit_clock;
-static char sdi12_kit_message[256]; /* the tool's last message: every answer is to it */
+static char sdi12_kit_message[512]; /* the tool's last message: every answer is to it */
 
 unsigned char sdi12_kit_wire(char c) {
     unsigned wire = (unsigned char)c & 0x7f;
@@ -144,33 +144,73 @@ static int sdi12_kit_fields(const char *word, sdi12_us *a, sdi12_us *b, unsigned
     return 1;
 }
 
-/* a sensor's next line event (a `hello` answered on the way, as version 1): its word */
-static const char *sdi12_kit_event(const char *name, sdi12_us *a, sdi12_us *b, unsigned *byte) {
-    char line[64];
+/* a sensor's next line event (a `hello` answered on the way with `version`): its word */
+static const char *sdi12_kit_event(const char *name, const char *version, sdi12_us *a,
+                                   sdi12_us *b, unsigned *byte) {
+    char line[96];
     const char *word;
     while (strcmp(word = sdi12_kit_next(), "hello") == 0) {
-        snprintf(line, sizeof line, "hello 1 %s", name);
+        snprintf(line, sizeof line, "hello %s %s", version, name);
         sdi12_kit_say(line);
     }
     sdi12_kit_fields(word, a, b, byte);
     return word;
 }
 
+/* the sensor's plan at the kit's clock, as its answer line */
+static void sdi12_kit_plan_line(const struct sdi12_sensor *sensor, char *line, size_t size) {
+    struct sdi12_plan p = sensor->plan(sdi12_kit_clock);
+    if (p.kind == SDI12_TX)
+        snprintf(line, size, "tx %lld %02x", p.at > sdi12_kit_clock ? p.at : sdi12_kit_clock, p.wire);
+    else if (p.kind == SDI12_WAIT && p.at > sdi12_kit_clock) snprintf(line, size, "wait %lld", p.at);
+    else snprintf(line, size, "idle");
+}
+
+/* `chars S E XX S E XX ...` (the `batch` feature): the tool's characters of one write, each
+ * told in turn as a `char`; after one whose plan might act before the next starts (anything
+ * but `idle` or a `wait` after that start: the start is rounded, so a wait at it may be
+ * before it on the tool's clock) the rest are not heard: the answer `heard K
+ * PLAN` says how many were, and the tool sends the rest after whatever the plan does. */
+static void sdi12_kit_chars(const struct sdi12_sensor *sensor, char *line, size_t size) {
+    const char *at = sdi12_kit_message + strlen("chars");
+    long long start, end, next, until;
+    unsigned wire;
+    int used, heard = 0;
+    char plan[64] = "idle";
+    while (sscanf(at, "%lld %lld %x%n", &start, &end, &wire, &used) == 3) {
+        at += used;
+        heard++;
+        sdi12_kit_clock = end;
+        sensor->on_char((unsigned char)wire, start, end);
+        sdi12_kit_plan_line(sensor, plan, sizeof plan);
+        if (sscanf(at, "%lld", &next) != 1) break; /* the last one */
+        if (strcmp(plan, "idle") == 0) continue;
+        if (sscanf(plan, "wait %lld", &until) == 1 && until > next) continue;
+        break; /* it acts before the next one starts */
+    }
+    if (heard == 0) {
+        fprintf(stderr, "sdi12-kit: unexpected message: %s", sdi12_kit_message);
+        exit(2);
+    }
+    snprintf(line, size, "heard %d %s", heard, plan);
+}
+
 int sdi12_kit_sensor(const struct sdi12_sensor *sensor) {
-    char line[64];
+    char line[96];
     setvbuf(stdout, NULL, _IOLBF, 0);
     for (;;) {
         sdi12_us a, b;
         unsigned byte;
-        const char *word = sdi12_kit_event(sensor->name, &a, &b, &byte);
+        const char *word = sdi12_kit_event(sensor->name, "1+batch", &a, &b, &byte);
+        if (strcmp(word, "chars") == 0) {
+            sdi12_kit_chars(sensor, line, sizeof line);
+            sdi12_kit_say(line);
+            continue;
+        }
         if (strcmp(word, "break") == 0) sensor->on_break(a, b);
         else if (strcmp(word, "char") == 0) sensor->on_char((unsigned char)byte, a, b);
         else if (strcmp(word, "sent") == 0) sensor->on_sent(a, b);
-        struct sdi12_plan p = sensor->plan(sdi12_kit_clock);
-        if (p.kind == SDI12_TX)
-            snprintf(line, sizeof line, "tx %lld %02x", p.at > sdi12_kit_clock ? p.at : sdi12_kit_clock, p.wire);
-        else if (p.kind == SDI12_WAIT && p.at > sdi12_kit_clock) snprintf(line, sizeof line, "wait %lld", p.at);
-        else snprintf(line, sizeof line, "idle");
+        sdi12_kit_plan_line(sensor, line, sizeof line);
         sdi12_kit_say(line);
     }
 }
@@ -291,7 +331,7 @@ int sdi12_kit_uart(const struct sdi12_uart *uart) {
     for (;;) {
         sdi12_us from = sdi12_kit_clock, a, b; /* the line's time before this message */
         unsigned byte;
-        const char *word = sdi12_kit_event(uart->name, &a, &b, &byte);
+        const char *word = sdi12_kit_event(uart->name, "1", &a, &b, &byte);
         sdi12_uart_fire(uart, from, sdi12_kit_clock);
         if (strcmp(word, "break") == 0) {
             uart->on_break(a, b);

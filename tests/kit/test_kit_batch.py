@@ -1,0 +1,62 @@
+"""The sensor sketch on the harness protocol's ``batch`` feature (the kit answers
+``hello 2+batch``): told with ``chars`` messages and QUIET fields it wakes itself for its idle
+polls instead of asking. Run again with the tool offering no feature (plain version-2
+messages, a ``time`` for every poll), it must put down the same line, instant for instant,
+and get the same verdicts: the sketch observes the same times either way."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from conformance.conduct import run_into
+from conformance.harness import protocol as proto
+from tests.kit.conftest import LOGGER, LOGGER_DECLARATION, SENSOR, TINY_SDI12
+
+DECLARATION = str(SENSOR / "sdi12_sensor.toml")
+#: cases with waits of ttt seconds the sketch polls through, service requests, a measurement
+#: aborted by a break, concurrent measurements among other sensors' traffic
+KEYWORD = "service_request or break_aborts_measurement or concurrent_survives"
+
+
+def line_events(folder: Path) -> list[dict]:
+    """The transcript: line events and notes (a job's end among them), but the run's options,
+    which name the run's folder."""
+    rows = (json.loads(line) for line in (folder / "transcript.jsonl").read_text().splitlines())
+    return [row for row in rows if not row["text"].startswith("run-options")]
+
+
+@pytest.mark.slow  # two runs; CI runs it, the inner loop keeps test_batch.py's scripted device
+def test_the_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_path, monkeypatch):
+    port = f"exec:{kit_build(SENSOR, (TINY_SDI12,))}"
+    options = {"declaration": DECLARATION, "keyword": KEYWORD}
+    batched = run_into(tmp_path / "batched", port, **options)
+    monkeypatch.setattr(proto, "BATCH", "not-offered")  # the tool takes the feature as unknown
+    plain = run_into(tmp_path / "plain", port, **options)
+    events = line_events(tmp_path / "batched")
+    assert len(events) > 300
+    assert events == line_events(tmp_path / "plain")
+    assert batched["summary"] == plain["summary"]
+    assert batched["summary"]["counts"]["PASS"] >= 3
+    verdicts = {r["id"]: r["verdict"] for r in batched["requirements"]}
+    assert verdicts == {r["id"]: r["verdict"] for r in plain["requirements"]}
+
+
+@pytest.mark.slow  # two recorder runs
+def test_the_logger_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_path, monkeypatch):
+    """The recorder role: told QUIET (the played sensors' next character), the logger sketch
+    wakes itself while it waits for a reply or a service request; a job's end is told at
+    the time it came, so the next job starts where it did before."""
+    port = f"exec:{kit_build(LOGGER, (TINY_SDI12,))}"
+    options = {"declaration": LOGGER_DECLARATION, "role": "recorder"}
+    options["keyword"] = "service_request or crc_mismatch or transparent"
+    batched = run_into(tmp_path / "batched", port, **options)
+    monkeypatch.setattr(proto, "BATCH", "not-offered")
+    plain = run_into(tmp_path / "plain", port, **options)
+    events = line_events(tmp_path / "batched")
+    assert len(events) > 100
+    assert events == line_events(tmp_path / "plain")
+    assert batched["summary"] == plain["summary"]
+    assert batched["summary"]["counts"]["PASS"] >= 3
