@@ -95,7 +95,7 @@ def figures(tree: Path, work: Path, minutes: float) -> dict[str, Callable[[], li
     def kit() -> list[str]:
         sketch = tree / "examples" / "arduino"
         return cli("kit", "arduino", str(sketch / "sdi12_sensor"),
-                   "--lib", str(sketch / "libraries"), "--report-dir", reports)  # fmt: skip
+                   "--lib", str(sketch / "libraries" / "TinySDI12"), "--report-dir", reports)  # fmt: skip
 
     def capture() -> list[str]:
         return cli("judge", str(capture_file(work.parent, minutes)), "--report-dir", reports)
