@@ -94,8 +94,9 @@ def figures(tree: Path, work: Path, minutes: float) -> dict[str, Callable[[], li
 
     def kit() -> list[str]:
         sketch = tree / "examples" / "arduino"
+        library = sketch / "libraries" / "TinySDI12"
         return cli("kit", "arduino", str(sketch / "sdi12_sensor"),
-                   "--lib", str(sketch / "libraries" / "TinySDI12"), "--report-dir", reports)  # fmt: skip
+                   "--lib", str(library), "--report-dir", reports)  # fmt: skip
 
     def capture() -> list[str]:
         return cli("judge", str(capture_file(work.parent, minutes)), "--report-dir", reports)
