@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from operator import attrgetter
 
 from ..protocol.commands import CommandError, parse_command
 from ..protocol.responses import measurement_digits, parse_measurement_reply
@@ -48,7 +49,7 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     wire = [e for e in events if e.kind is not EventKind.NOTE]
     if not wire:
         return BusTime(0.0, 0.0, 0, 0)
-    wire.sort(key=lambda e: e.start)
+    wire.sort(key=attrgetter("start"))
     spans: list[tuple[float, float]] = []
     frames = breaks = 0
     for e in wire:
@@ -82,12 +83,17 @@ def _forced_gap(before: Event, after: Event, gap: float) -> float:
     return 0.0
 
 
+_BANG, _CR, _LF = ord("!"), ord("\r"), ord("\n")
+
+
 def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     """[end of ``atttn``, end + ttt] for each measurement the DUT started."""
     waits = []
+    open_from = 0  # waits[open_from:] came after the last break: only those can be cut
     command: list[Event] = []
     reply: list[Event] = []
-    # _ends_command(command) and _line_done(reply), kept as the two grow (asked per event)
+    # whether the command ends in '!' and the reply in CR LF, kept as the two grow (asked
+    # per event: from the last characters, never decoding the whole command or reply)
     commanded = replied = False
     for e in [*wire, None]:
         ends_exchange = e is None or e.kind is EventKind.BREAK
@@ -102,15 +108,21 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
         if e is None:
             continue
         if e.kind is EventKind.BREAK:
-            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that
-            waits = [(start, min(end, max(start, e.start))) for start, end in waits]
+            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that.
+            # Only the waits since the last break: one already cut ends by that break's start,
+            # which no later break (in start order) precedes, so cutting it again changes
+            # nothing, and cutting them all at every break made this quadratic.
+            waits[open_from:] = [
+                (start, min(end, max(start, e.start))) for start, end in waits[open_from:]
+            ]
+            open_from = len(waits)
             continue
         if e.origin == TOOL:
             command.append(e)
-            commanded = _ends_command(command)
+            commanded = e.wire & 0x7F == _BANG
         elif commanded and not replied:
             reply.append(e)
-            replied = _line_done(reply)
+            replied = e.wire & 0x7F == _LF and len(reply) >= 2 and reply[-2].wire & 0x7F == _CR
     return waits
 
 
@@ -136,16 +148,6 @@ def announced_time(text: str, digits: int) -> int | None:
         return None
     shape = parse_measurement_reply(body, digits)
     return shape.ttt if shape.count is not None else None
-
-
-def _ends_command(command: list[Event]) -> bool:
-    """The tool's characters so far end in ``!`` (only characters are ever collected: the
-    last one decides, without decoding the whole command for every event)."""
-    return bool(command) and command[-1].char7 == ord("!")
-
-
-def _line_done(reply: list[Event]) -> bool:
-    return len(reply) >= 2 and reply[-2].char7 == ord("\r") and reply[-1].char7 == ord("\n")
 
 
 def _union(spans: list[tuple[float, float]]) -> float:

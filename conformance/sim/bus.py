@@ -49,6 +49,9 @@ class BusDevice(Protocol):
 
 def earliest_frame(devices: list[BusDevice]) -> tuple[BusDevice, Frame] | None:
     """The device whose next character starts first, and that character (None if silent)."""
+    if len(devices) == 1:  # one sensor: the usual bus, asked once or twice per character
+        frame = devices[0].next_frame()
+        return None if frame is None else (devices[0], frame)
     best: tuple[BusDevice, Frame] | None = None
     for device in devices:
         frame = device.next_frame()
