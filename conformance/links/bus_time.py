@@ -50,26 +50,35 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     if not wire:
         return BusTime(0.0, 0.0, 0, 0)
     wire.sort(key=attrgetter("start"))
+    # one pass: each event's own span and the marking before it (as much as was forced)
     spans: list[tuple[float, float]] = []
-    frames = breaks = 0
-    for e in wire:
-        if e.kind is EventKind.BREAK:
-            breaks += 1
-            spans.append((e.start, e.end + MARKING_AFTER_BREAK))
-        else:
-            frames += 1
-            spans.append((e.start, e.start + CHAR_TIME))
+    add = spans.append
+    brk = EventKind.BREAK
     previous = wire[0]
     previous_end = previous.end
+    breaks = int(previous.kind is brk)
+    add(_own_span(previous))
     for e in wire[1:]:
-        if e.start > previous_end:
-            spans.append(
-                (previous_end, previous_end + _forced_gap(previous, e, e.start - previous_end))
-            )
+        start = e.start
+        if e.kind is brk:
+            breaks += 1
+            add((start, e.end + MARKING_AFTER_BREAK))
+        else:
+            add((start, start + CHAR_TIME))
+        if start > previous_end:
+            add((previous_end, previous_end + _forced_gap(previous, e, start - previous_end)))
         if e.end >= previous_end:
             previous, previous_end = e, e.end
+    frames = len(wire) - breaks
     spans += _announced_waits(wire)
     return BusTime(_union(spans), wire[-1].end - wire[0].start, frames, breaks)
+
+
+def _own_span(e: Event) -> tuple[float, float]:
+    """A frame, or a break and the marking that must follow it (R-7.0-06)."""
+    if e.kind is EventKind.BREAK:
+        return e.start, e.end + MARKING_AFTER_BREAK
+    return e.start, e.start + CHAR_TIME
 
 
 def _forced_gap(before: Event, after: Event, gap: float) -> float:
@@ -95,19 +104,15 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     # whether the command ends in '!' and the reply in CR LF, kept as the two grow (asked
     # per event: from the last characters, never decoding the whole command or reply)
     commanded = replied = False
-    for e in [*wire, None]:
-        ends_exchange = e is None or e.kind is EventKind.BREAK
-        if e is not None and e.origin == TOOL and e.kind is EventKind.CHAR:
-            ends_exchange = bool(reply) or commanded
-        if ends_exchange:
-            wait = _announced_wait(command, reply)
+    brk = EventKind.BREAK
+    for e in wire:  # breaks and characters only
+        if e.kind is brk or (e.origin == TOOL and (reply or commanded)):
+            wait = _announced_wait(command, reply)  # the exchange ends here
             if wait is not None:
                 waits.append(wait)
             command, reply = [], []
             commanded = replied = False
-        if e is None:
-            continue
-        if e.kind is EventKind.BREAK:
+        if e.kind is brk:
             # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that.
             # Only the waits since the last break: one already cut ends by that break's start,
             # which no later break (in start order) precedes, so cutting it again changes
@@ -116,13 +121,15 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
                 (start, min(end, max(start, e.start))) for start, end in waits[open_from:]
             ]
             open_from = len(waits)
-            continue
-        if e.origin == TOOL:
+        elif e.origin == TOOL:
             command.append(e)
             commanded = e.wire & 0x7F == _BANG
         elif commanded and not replied:
             reply.append(e)
             replied = e.wire & 0x7F == _LF and len(reply) >= 2 and reply[-2].wire & 0x7F == _CR
+    wait = _announced_wait(command, reply)  # the last exchange
+    if wait is not None:
+        waits.append(wait)
     return waits
 
 
