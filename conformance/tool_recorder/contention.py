@@ -66,17 +66,28 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
 
     A tool character read back as an echo is the tool's; characters of any other origin
     (``dut``, a named sim device, ``bus``) count as the DUT's. The engine asks this before
-    every transmission (about a thousand times a run), so it sorts and splits the window in
-    one pass each and stops at once when either side is missing."""
+    every transmission (about a thousand times a run), nearly always to find none: the pass
+    that splits the window also looks for any tool event and DUT character whose spans meet
+    at all (with no slack: every overlap counted below is one of those), and without one
+    there is nothing to group."""
     wire = sorted([e for e in events if e.kind is not EventKind.NOTE], key=_START)
     tool: list[Event] = []
     dut: list[Event] = []
+    tool_end = dut_end = float("-inf")  # the latest end of each side so far (by start)
+    touching = False  # an event starts before the other side's latest end so far
+    char = EventKind.CHAR
     for e in wire:
         if e.origin == TOOL:
             tool.append(e)
-        elif e.kind is EventKind.CHAR:
+            touching = touching or e.start < dut_end
+            if e.end > tool_end:
+                tool_end = e.end
+        elif e.kind is char:
             dut.append(e)
-    if not tool or not dut:
+            touching = touching or e.start < tool_end
+            if e.end > dut_end:
+                dut_end = e.end
+    if not touching:  # _overlap needs d.start < t.end and t.start < d.end (slack >= 0)
         return []
     found: list[Collision] = []
     k = 0
