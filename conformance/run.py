@@ -9,24 +9,25 @@ from __future__ import annotations
 import datetime as dt
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from . import __version__, root_causes
 from .declaration import Declaration, load_declaration, normalise_version
 from .dut import Session
-from .emulator_server.realtime import LATE_NOTICE
 from .judges.timing import recheck, undecide_after_late_line
 from .links.base import BusEnd, Link, LinkError
 from .options import run_option_values
 from .ports import is_sim, open_port
 from .profiles import PROFILES
 from .protocol.version import V14
-from .recorder.scenario_runner import RecorderSession, driver_for
 from .replay.recording import options_note
 from .report_folder import run_folder
 from .results import CaseRecord, RequirementResult, aggregate, overall
 from .selection import Selection
 from .sensor.session import SensorSession
+
+if TYPE_CHECKING:  # the recorder role's runner: imported by the run that plays it
+    from .recorder.scenario_runner import RecorderSession
 
 
 @dataclass
@@ -172,7 +173,10 @@ class ConformanceRun:
         return self.session
 
     def recorder_session(self) -> RecorderSession:
-        """The recorder role's scenario runner (conformance.recorder.scenario_runner)."""
+        """The recorder role's scenario runner (conformance.recorder.scenario_runner, imported
+        here: a sensor-role process never loads the recorder role, about 45 ms of its start)."""
+        from .recorder.scenario_runner import RecorderSession, driver_for
+
         if self.session is None:
             opts = self.options
             declared = self.declaration.sdi12_version if self.declaration else None
@@ -258,6 +262,11 @@ class ConformanceRun:
         in real time fell behind its schedule, no FAIL or WARN of the run can be trusted to
         be the recorder's own (a false FAIL is what a busy host would otherwise give)."""
         late = self.session.worst_lateness() if self.session is not None else 0.0
+        if late <= 0.0:
+            return  # nothing fell behind: every line but a served one (and its package's
+            # servers stay unloaded, as the rest of a run needs none of them)
+        from .emulator_server.realtime import LATE_NOTICE
+
         if late <= LATE_NOTICE:
             return
         for case in self.cases:

@@ -169,9 +169,22 @@ class Transcript:
     def since(self, index: int) -> list[Event]:
         return self.events[index:]
 
-    def write_jsonl(self, path: str) -> None:
+    def write_jsonl(self, path: str) -> bool:
+        """One :func:`json_line` per event. Returns whether every event had
+        :func:`plain_fields`, which each line asks anyway (a caller keeping what it wrote as
+        its own reading needs to know, and asking again cost a second pass over 10^5)."""
+        plain = True
+        lines: list[str] = []
+        add = lines.append
+        for e in self.events:
+            if plain_fields(e):
+                add(_plain_line(e))
+            else:
+                plain = False
+                add(json.dumps(e.to_json()) + "\n")
         with open(path, "w", encoding="utf-8") as fh:
-            fh.writelines(map(json_line, self.events))
+            fh.writelines(lines)
+        return plain
 
 
 _quote = json.encoder.encode_basestring_ascii  # how json.dumps writes a str (ensure_ascii)
@@ -195,16 +208,24 @@ def plain_fields(e: Event) -> bool:
 
 
 def json_line(event: Event) -> str:
-    """``json.dumps(event.to_json())`` and a newline: a transcript's line. Written directly
-    when every field has the plain type whose JSON is its repr (json.dumps builds an encoder
-    per call, most of the cost of writing a run's 10^5 events), else by json.dumps."""
-    e = event
+    """``json.dumps(event.to_json()) + "\n"``: a transcript's line. Written directly when
+    every field has the plain type whose JSON is its repr (json.dumps builds an encoder per
+    call, most of the cost of writing a run's 10^5 events), else by json.dumps."""
+    if plain_fields(event):
+        return _plain_line(event)
+    return json.dumps(event.to_json()) + "\n"
+
+
+def _plain_line(e: Event) -> str:
+    """:func:`json_line` of an event with :func:`plain_fields` (a non-finite time still goes
+    through json.dumps, which spells it its own way). ``{e.kind}`` is ``str(e.kind)``, the
+    value: a StrEnum formats as its str."""
     du = e.duration_uncertainty
-    if not (plain_fields(e) and math.isfinite(e.start + e.end + e.uncertainty + (du or 0.0))):
+    if not math.isfinite(e.start + e.end + e.uncertainty + (du or 0.0)):
         return json.dumps(e.to_json()) + "\n"
     tail = "}\n" if du is None else f', "duration_uncertainty": {du!r}}}\n'
     return (
-        f'{{"kind": "{e.kind.value}", "origin": {_quote(e.origin)}, "start": {e.start!r}, '
+        f'{{"kind": "{e.kind}", "origin": {_quote(e.origin)}, "start": {e.start!r}, '
         f'"end": {e.end!r}, "wire": {e.wire!r}, "text": {_quote(e.text)}, '
         f'"uncertainty": {e.uncertainty!r}{tail}'
     )

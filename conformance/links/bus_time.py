@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from operator import attrgetter
 
 from ..protocol.commands import CommandError, parse_command
 from ..protocol.responses import measurement_digits, parse_measurement_reply
@@ -48,27 +49,36 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     wire = [e for e in events if e.kind is not EventKind.NOTE]
     if not wire:
         return BusTime(0.0, 0.0, 0, 0)
-    wire.sort(key=lambda e: e.start)
+    wire.sort(key=attrgetter("start"))
+    # one pass: each event's own span and the marking before it (as much as was forced)
     spans: list[tuple[float, float]] = []
-    frames = breaks = 0
-    for e in wire:
-        if e.kind is EventKind.BREAK:
-            breaks += 1
-            spans.append((e.start, e.end + MARKING_AFTER_BREAK))
-        else:
-            frames += 1
-            spans.append((e.start, e.start + CHAR_TIME))
+    add = spans.append
+    brk = EventKind.BREAK
     previous = wire[0]
     previous_end = previous.end
+    breaks = int(previous.kind is brk)
+    add(_own_span(previous))
     for e in wire[1:]:
-        if e.start > previous_end:
-            spans.append(
-                (previous_end, previous_end + _forced_gap(previous, e, e.start - previous_end))
-            )
+        start = e.start
+        if e.kind is brk:
+            breaks += 1
+            add((start, e.end + MARKING_AFTER_BREAK))
+        else:
+            add((start, start + CHAR_TIME))
+        if start > previous_end:
+            add((previous_end, previous_end + _forced_gap(previous, e, start - previous_end)))
         if e.end >= previous_end:
             previous, previous_end = e, e.end
+    frames = len(wire) - breaks
     spans += _announced_waits(wire)
     return BusTime(_union(spans), wire[-1].end - wire[0].start, frames, breaks)
+
+
+def _own_span(e: Event) -> tuple[float, float]:
+    """A frame, or a break and the marking that must follow it (R-7.0-06)."""
+    if e.kind is EventKind.BREAK:
+        return e.start, e.end + MARKING_AFTER_BREAK
+    return e.start, e.start + CHAR_TIME
 
 
 def _forced_gap(before: Event, after: Event, gap: float) -> float:
@@ -82,35 +92,44 @@ def _forced_gap(before: Event, after: Event, gap: float) -> float:
     return 0.0
 
 
+_BANG, _CR, _LF = ord("!"), ord("\r"), ord("\n")
+
+
 def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     """[end of ``atttn``, end + ttt] for each measurement the DUT started."""
     waits = []
+    open_from = 0  # waits[open_from:] came after the last break: only those can be cut
     command: list[Event] = []
     reply: list[Event] = []
-    # _ends_command(command) and _line_done(reply), kept as the two grow (asked per event)
+    # whether the command ends in '!' and the reply in CR LF, kept as the two grow (asked
+    # per event: from the last characters, never decoding the whole command or reply)
     commanded = replied = False
-    for e in [*wire, None]:
-        ends_exchange = e is None or e.kind is EventKind.BREAK
-        if e is not None and e.origin == TOOL and e.kind is EventKind.CHAR:
-            ends_exchange = bool(reply) or commanded
-        if ends_exchange:
-            wait = _announced_wait(command, reply)
+    brk = EventKind.BREAK
+    for e in wire:  # breaks and characters only
+        if e.kind is brk or (e.origin == TOOL and (reply or commanded)):
+            wait = _announced_wait(command, reply)  # the exchange ends here
             if wait is not None:
                 waits.append(wait)
             command, reply = [], []
             commanded = replied = False
-        if e is None:
-            continue
-        if e.kind is EventKind.BREAK:
-            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that
-            waits = [(start, min(end, max(start, e.start))) for start, end in waits]
-            continue
-        if e.origin == TOOL:
+        if e.kind is brk:
+            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that.
+            # Only the waits since the last break: one already cut ends by that break's start,
+            # which no later break (in start order) precedes, so cutting it again changes
+            # nothing, and cutting them all at every break made this quadratic.
+            waits[open_from:] = [
+                (start, min(end, max(start, e.start))) for start, end in waits[open_from:]
+            ]
+            open_from = len(waits)
+        elif e.origin == TOOL:
             command.append(e)
-            commanded = _ends_command(command)
+            commanded = e.wire & 0x7F == _BANG
         elif commanded and not replied:
             reply.append(e)
-            replied = _line_done(reply)
+            replied = e.wire & 0x7F == _LF and len(reply) >= 2 and reply[-2].wire & 0x7F == _CR
+    wait = _announced_wait(command, reply)  # the last exchange
+    if wait is not None:
+        waits.append(wait)
     return waits
 
 
@@ -136,16 +155,6 @@ def announced_time(text: str, digits: int) -> int | None:
         return None
     shape = parse_measurement_reply(body, digits)
     return shape.ttt if shape.count is not None else None
-
-
-def _ends_command(command: list[Event]) -> bool:
-    """The tool's characters so far end in ``!`` (only characters are ever collected: the
-    last one decides, without decoding the whole command for every event)."""
-    return bool(command) and command[-1].char7 == ord("!")
-
-
-def _line_done(reply: list[Event]) -> bool:
-    return len(reply) >= 2 and reply[-2].char7 == ord("\r") and reply[-1].char7 == ord("\n")
 
 
 def _union(spans: list[tuple[float, float]]) -> float:

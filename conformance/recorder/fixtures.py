@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import pytest
 
 from ..exits import EXIT_USAGE
 from ..ports import PortError
-from .scenario_runner import RecorderSession
+
+if TYPE_CHECKING:  # the run makes the session (ConformanceRun.recorder_session), importing
+    # the runner then: a sensor-role run never loads the recorder role's modules
+    from .scenario_runner import RecorderSession
 
 
 @pytest.fixture(scope="session")

@@ -17,7 +17,7 @@ from typing import Any
 
 from ..capture.errors import CaptureError
 from ..capture.transcript_io import read_transcript_jsonl
-from ..transcript import TOOL, Event, EventKind, Transcript, plain_fields
+from ..transcript import TOOL, Event, EventKind, Transcript
 
 #: Prefix of the NOTE that carries the run's options (first line of a transcript).
 OPTIONS_NOTE = "run-options "
@@ -127,10 +127,10 @@ def write_recording(path: Path, events: list[Event]) -> None:
     the same events: a capture round trip reads both files it writes straight away, and a
     run's 10^5 lines cost a second to parse."""
     events = list(events)
-    Transcript(events).write_jsonl(str(path))
     # floats print as their shortest repr, which reads back bit for bit; an int time would
-    # come back a float, so only events of exactly the plain types stand for their reading
-    if all(map(plain_fields, events)):
+    # come back a float, so only events of exactly the plain types (the writer says whether
+    # all were) stand for their reading
+    if Transcript(events).write_jsonl(str(path)):
         _keep(_file_key(Path(path)), tuple(events))
 
 

@@ -23,7 +23,7 @@ from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..root_causes import reading_order
 from ..run import TOOL_IDENTITY, ConformanceRun
 from ..stash import CASE
-from ..transcript import TOOL, Event, EventKind
+from ..transcript import TOOL, Event, EventKind, to_wire_7e1
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, WireRef, locator_of
@@ -417,6 +417,11 @@ def requirements_table(run: ConformanceRun) -> str:
     )
 
 
+#: the wire bits of every 7E1 character with good parity: ``Event.parity_ok`` as a lookup, for
+#: the tens of thousands of characters a report's wire logs show
+_GOOD_PARITY = frozenset(to_wire_7e1(c) for c in range(0x80))
+
+
 def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = frozenset()) -> str:
     """The wire log: one line per break, note or run of characters from one side; lines
     holding a ``marked`` event (the exchange a finding rests on) are highlighted with ▶."""
@@ -445,8 +450,9 @@ def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = 
         else:
             who = "tool" if first.origin == TOOL else "dut"
             arrow = "→ sensor  " if who == "tool" else "← sensor  "
-            text = wire_escape(bytes(e.char7 for e in group))
-            bad = sum(1 for e in group if not e.parity_ok)
+            wires = [e.wire for e in group]
+            text = wire_escape(bytes([w & 0x7F for w in wires]))
+            bad = sum(1 for w in wires if w not in _GOOD_PARITY)  # not Event.parity_ok
             parity = f'  <span class="bad">[{bad} parity error(s)]</span>' if bad else ""
             lines.append(
                 f'<span class="{who}">{prefix}{arrow}{escape(text)}'
@@ -511,17 +517,20 @@ def where_html(findings: list[Finding], ref: WireRef, events: list[Event], timin
 def _group(events: list[Event]) -> list[list[Event]]:
     """Runs of characters from one side with gaps under two frame times form one line."""
     groups: list[list[Event]] = []
+    last: Event | None = None  # groups[-1][-1]
+    char = EventKind.CHAR
     for e in events:
         if (
-            groups
-            and e.kind is EventKind.CHAR
-            and groups[-1][-1].kind is EventKind.CHAR
-            and groups[-1][-1].origin == e.origin
-            and e.start - groups[-1][-1].end < 0.0167
+            last is not None
+            and e.kind is char
+            and last.kind is char
+            and last.origin == e.origin
+            and e.start - last.end < 0.0167
         ):
             groups[-1].append(e)
         else:
             groups.append([e])
+        last = e
     return groups
 
 

@@ -49,6 +49,9 @@ class BusDevice(Protocol):
 
 def earliest_frame(devices: list[BusDevice]) -> tuple[BusDevice, Frame] | None:
     """The device whose next character starts first, and that character (None if silent)."""
+    if len(devices) == 1:  # one sensor: the usual bus, asked once or twice per character
+        frame = devices[0].next_frame()
+        return None if frame is None else (devices[0], frame)
     best: tuple[BusDevice, Frame] | None = None
     for device in devices:
         frame = device.next_frame()
@@ -160,15 +163,17 @@ class SimLink(Link):
         self, deadline: float, until: StopCondition | None = None, idle: float | None = None
     ) -> list[Event]:
         got: list[Event] = []
+        bus = self.bus
+        rx = bus.rx  # the bus's one queue (cleared in place, never replaced): per character
         while True:
-            if self.bus.rx:
-                got.append(self.bus.rx.popleft())
+            if rx:
+                got.append(rx.popleft())
                 if until is not None and until(got):
                     return got
                 continue
             limit = deadline
             if idle is not None and got:
                 limit = min(limit, got[-1].end + idle)
-            if self.bus.step(limit) is None:
-                self.bus.clock.advance_to(max(limit, self.now()))
+            if bus.step(limit) is None:
+                bus.clock.advance_to(max(limit, bus.clock.now))
                 return got

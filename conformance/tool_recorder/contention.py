@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from operator import attrgetter
 
 from ..protocol.timing import CHAR_TIME
 from ..transcript import TOOL, Event, EventKind
@@ -30,6 +31,7 @@ HOLD_PREFIX = "listen before talk: "
 #: Tool events closer than this belong to one transmission (a break, its marking, the
 #: command's back-to-back characters), so one collision is counted once, not per character.
 _SAME_TRANSMISSION = 10e-3
+_START = attrgetter("start")  # the sort key of events by time
 
 
 @dataclass(frozen=True)
@@ -63,10 +65,30 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
     """Every tool transmission that overlaps DUT characters, oldest first (pure: stamps only).
 
     A tool character read back as an echo is the tool's; characters of any other origin
-    (``dut``, a named sim device, ``bus``) count as the DUT's."""
-    wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=lambda e: e.start)
-    tool = [e for e in wire if e.origin == TOOL]
-    dut = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
+    (``dut``, a named sim device, ``bus``) count as the DUT's. The engine asks this before
+    every transmission (about a thousand times a run), nearly always to find none: the pass
+    that splits the window also looks for any tool event and DUT character whose spans meet
+    at all (with no slack: every overlap counted below is one of those), and without one
+    there is nothing to group."""
+    wire = sorted([e for e in events if e.kind is not EventKind.NOTE], key=_START)
+    tool: list[Event] = []
+    dut: list[Event] = []
+    tool_end = dut_end = float("-inf")  # the latest end of each side so far (by start)
+    touching = False  # an event starts before the other side's latest end so far
+    char = EventKind.CHAR
+    for e in wire:
+        if e.origin == TOOL:
+            tool.append(e)
+            touching = touching or e.start < dut_end
+            if e.end > tool_end:
+                tool_end = e.end
+        elif e.kind is char:
+            dut.append(e)
+            touching = touching or e.start < tool_end
+            if e.end > dut_end:
+                dut_end = e.end
+    if not touching:  # _overlap needs d.start < t.end and t.start < d.end (slack >= 0)
+        return []
     found: list[Collision] = []
     k = 0
     for group in runs(tool, _SAME_TRANSMISSION):
@@ -74,7 +96,8 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
         while k < len(dut) and dut[k].end <= begin - CHAR_TIME:
             k += 1
         met = []
-        for d in dut[k:]:
+        for i in range(k, len(dut)):
+            d = dut[i]
             if d.start >= end:
                 break
             if any(_overlap(d, t) for t in group):

@@ -15,8 +15,7 @@ import re
 from ..protocol.binary import EMPTY_LEN, DataType, packet_length, type_size
 from ..protocol.commands import ADDRESS_CHARS, Command, Kind, count_digits
 from ..protocol.crc import ASCII_CRC_LEN, ascii_crc, binary_crc, is_crc_char
-from ..protocol.framing import CRLF, LF, TEXT_END, crc_tail, strip_crlf, unprintable
-from ..protocol.framing import ends_line as _ends_line
+from ..protocol.framing import CR, CRLF, LF, TEXT_END, crc_tail, strip_crlf, unprintable
 from ..transcript import Event, decode_7e1, decode_8n1, escape
 
 _TYPE_CODES = frozenset(int(t) for t in DataType)  # R-5.2.1-01: codes above 10 are invalid
@@ -41,8 +40,9 @@ def parse_start_reply(text: str, digits: int) -> tuple[int, int] | None:
 
 
 def ends_line(events: list[Event]) -> bool:
-    """The characters so far end in CR LF (7-bit, parity ignored)."""
-    return _ends_line([e.char7 for e in events[-2:]])
+    """The characters so far end in CR LF (7-bit, parity ignored): ``framing.ends_line`` of
+    their codes, read off the last two events (asked after every character a reply brings)."""
+    return len(events) >= 2 and events[-2].wire & 0x7F == CR and events[-1].wire & 0x7F == LF
 
 
 def packet_value_count(data: bytes) -> int:

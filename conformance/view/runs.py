@@ -64,7 +64,9 @@ class Segment:
         if not self.reply:
             return False
         if self.binary_reply:
-            length = packet_length(decode_8n1(self.reply))
+            # the size field is in the first three bytes: decoding the whole packet for each
+            # byte placed made a long packet quadratic
+            length = packet_length(decode_8n1(self.reply[:3]))
             return length is not None and len(self.reply) >= length
         last = self.reply[-1].char7
         return last == ETX if self.multiline else last == LF
@@ -89,19 +91,26 @@ class Segment:
 
 
 def _place(seg: Segment, e: Event) -> None:
+    """``e`` into the reply or ``later``. Asked for every character a run's sensor sent
+    (once more per whole-run cut), so :attr:`Segment.multiline` and
+    :attr:`Segment.reply_ended` are spelled out here for a 7E1 reply."""
     if seg.later:
         seg.later.append(e)
         return
-    if not seg.reply:
-        (seg.reply if e.start - seg.command_end <= REPLY_SEARCH else seg.later).append(e)
+    reply = seg.reply
+    if not reply:
+        (reply if e.start - seg.command_end <= REPLY_SEARCH else seg.later).append(e)
         return
-    last = seg.reply[-1]
+    last = reply[-1]
+    last7 = last.wire & 0x7F
+    multiline = len(reply) > 1 and reply[1].wire & 0x7F == STX
     # the next line of multi-line text may come late (R-4.4.13.1-03 judges how late)
-    late_line = seg.multiline and last.char7 == LF and e.start - last.end > LINE_RUN_GAP
-    if seg.reply_ended or late_line:
+    late_line = multiline and last7 == LF and e.start - last.end > LINE_RUN_GAP
+    ended = seg.reply_ended if seg.binary_reply else last7 == (ETX if multiline else LF)
+    if ended or late_line:
         seg.later.append(e)
     else:
-        seg.reply.append(e)  # a gap never ends a reply: R-7.0-12 judges it
+        reply.append(e)  # a gap never ends a reply: R-7.0-12 judges it
 
 
 class Segments(list[Segment]):

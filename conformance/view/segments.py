@@ -22,6 +22,7 @@ import re
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import TypeVar
 
 from ..protocol.binary import packet_length
@@ -46,6 +47,10 @@ NEW_COMMAND = MARKING_AFTER_BREAK - TOLERANCE
 REPLY_PAUSE = INTER_CHAR_GAP_MAX + TOLERANCE
 
 _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
+#: ``current.is_command`` as :func:`read_view` keeps it per character: a recorder's
+#: transmission holds characters only, so its text ends in ``!`` when its last one is ``!``
+_BANG = ord("!")
+_START = attrgetter("start")  # events in time order
 
 
 def on_tool_link(event: Event) -> bool:
@@ -367,7 +372,7 @@ def read_view(
     inferred from the protocol (:func:`~conformance.view.direction.infer_directions`);
     characters it cannot place are kept apart in ``undirected``.
     """
-    ordered = sorted((e for e in events if e.kind is not EventKind.NOTE), key=lambda e: e.start)
+    ordered = sorted([e for e in events if e.kind is not EventKind.NOTE], key=_START)
     undirected: list[Event] = []
     if is_recorder is None:
         is_recorder = on_tool_link
@@ -399,10 +404,10 @@ def read_view(
                 current = Transmission(pending, [e], part=part)
                 transmissions.append(current)
                 pending = None
-                is_command = current.is_command
+                is_command = e.wire & 0x7F == _BANG
             else:
                 current.chars.append(e)
-                is_command = current.is_command
+                is_command = e.wire & 0x7F == _BANG
         elif e.kind is EventKind.CHAR:
             if current is not None:
                 current.heard.append(e)

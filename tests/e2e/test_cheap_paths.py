@@ -178,6 +178,68 @@ def test_transcript_lines_are_what_the_json_module_writes(tmp_path) -> None:
     assert path.read_text(encoding="utf-8") == expected
 
 
+def test_the_writer_says_whether_every_event_was_plain(tmp_path) -> None:
+    """What write_recording keeps as a transcript's own reading rests on this answer."""
+    plain = [Event(EventKind.CHAR, DUT, 1.0, 2.0, wire=65)]
+    assert Transcript(plain).write_jsonl(str(tmp_path / "a.jsonl")) is True
+    int_times = [*plain, Event(EventKind.BREAK, TOOL, 3, 4)]
+    assert Transcript(int_times).write_jsonl(str(tmp_path / "b.jsonl")) is False
+
+
+def _random_window(rng: random.Random) -> list[Event]:
+    """Tool and DUT events of every kind, close together, some overlapping, some stamps
+    uncertain: what a collision scan is asked about."""
+    events, t = [], 0.0
+    for _ in range(rng.randrange(30)):
+        t += rng.choice([0.0, 0.001, 0.004, 8.33e-3, 0.02, 0.1, -0.005])
+        events.append(
+            Event(
+                rng.choice([EventKind.CHAR] * 5 + [EventKind.BREAK, EventKind.NOTE]),
+                rng.choice([TOOL, DUT, "bus", "sensor-1"]),
+                t,
+                t + rng.choice([0.0, 1e-4, 8.33e-3, 0.012]),
+                wire=65,
+                uncertainty=rng.choice([0.0, 0.0, 0.002, 0.006]),
+            )
+        )
+    return events
+
+
+def test_collisions_are_found_exactly_where_a_tool_event_and_a_dut_character_overlap() -> None:
+    """The scan returns early when nothing meets: it may never skip a real overlap."""
+    from conformance.tool_recorder.contention import _overlap, collisions
+
+    rng = random.Random(22)
+    for _ in range(3000):
+        window = _random_window(rng)
+        tool = [e for e in window if e.kind is not EventKind.NOTE and e.origin == TOOL]
+        dut = [e for e in window if e.kind is EventKind.CHAR and e.origin != TOOL]
+        found = collisions(window)
+        assert bool(found) == any(_overlap(d, t) for d in dut for t in tool)
+        for c in found:
+            assert all(any(_overlap(d, t) for t in c.tool) for d in c.dut)
+
+
+def test_a_one_line_replys_stop_rule_is_the_general_one() -> None:
+    """Framing.stop's shortcut for a one-line 7E1 reply, and a packet's size read from its
+    first bytes, against the rules they stand for."""
+    from conformance.tool_recorder.reply_end import Framing, _head
+    from conformance.transcript import decode_8n1
+
+    rng = random.Random(12)
+    framings = [Framing(idle=0.01, max_chars=n) for n in (1, 3, 80)]
+    for _ in range(2000):
+        chars = [
+            Event(rng.choice([EventKind.CHAR] * 6 + [EventKind.BREAK]), DUT, 0.0, 1.0,
+                  wire=rng.choice([0x0D, 0x8D, 0x0A, 0x8A, 0x02, 0x03, 0x31, 0xB1]))
+            for _ in range(rng.randrange(6))
+        ]  # fmt: skip
+        assert _head(chars) == decode_8n1(chars)[:3]
+        for f in framings:
+            general = len(chars) >= f.limit(chars) or f.finished(chars) or f.at_line_end(chars)
+            assert f.stop(chars) == general
+
+
 def test_the_collector_is_paced_for_a_run_and_restored_after() -> None:
     before = gc.get_threshold()
     pace = gc_pace.slow_down()
