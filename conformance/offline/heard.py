@@ -24,8 +24,8 @@ from ..replay.recording_link import RecordingLink
 from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
 from ..view.rebuilt_records import Rebuilt, rebuild_records
-from ..view.runs import Segment
-from ..view.segments import TranscriptView, memo, read_view
+from ..view.runs import Segment, transcript_segments, transcript_view
+from ..view.segments import TranscriptView, memo
 from .decode_quality import decode_quality, sensor_characters
 
 #: ambiguity reasons quoted in the notes (the count is always given)
@@ -179,7 +179,7 @@ def heard_records(link: RecordingLink) -> tuple[TranscriptView, Rebuilt]:
     while the transcript keeps its length (a recording only grows while it is read)."""
 
     def cut() -> tuple[TranscriptView, Rebuilt]:
-        view = read_view(link.transcript.events)
+        view = transcript_view(link.transcript)  # the reports' evidence reads it too
         return view, rebuild_records(view, uncertainty=link.uncertainty)
 
     return memo(link, "_heard_records", len(link.transcript.events), cut)
@@ -198,7 +198,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         address=address,
         exchanges=[x for x in rebuilt.exchanges if _mine(address, x.text)],
         measurements=[m for m in rebuilt.measurements if _mine(address, m.command.address)],
-        segments=[Segment.of(t) for t in view.transmissions if _mine(address, t.text)],
+        segments=[s for s in transcript_segments(link.transcript) if _mine(address, s.text)],
         on_bus=sensors_on(rebuilt.exchanges),
     )
     for m in heard.measurements:
