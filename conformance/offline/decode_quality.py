@@ -16,11 +16,21 @@ from typing import Any
 
 from ..tool_recorder.records import Exchange
 from ..transcript import Event, EventKind
+from ..view.segments import memo
 
 
 def sensor_characters(exchanges: Iterable[Exchange]) -> list[Event]:
     """Every character the sensor sent in ``exchanges``' replies, every attempt's."""
     return [e for ex in exchanges for a in ex.attempts for e in a.reply_events]
+
+
+def _rate_of(decoded: Any, events: list[Event]) -> dict[int, float]:
+    """``id(character)`` -> its bit-rate error, for every character of ``events`` (made once
+    per decode: each sensor of a bus asks, and each pass read the whole capture)."""
+    rates = decoded.baud_error_pct  # one per character, in the order of the events
+    in_order = [e for e in events if e.kind is EventKind.CHAR]
+    # (a list that does not match the characters one for one tells no character's rate)
+    return dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
 
 
 def decode_quality(decoded: Any, events: list[Event], chars: list[Event], who: str) -> str | None:
@@ -29,10 +39,7 @@ def decode_quality(decoded: Any, events: list[Event], chars: list[Event], who: s
     read them; None when the sensor sent none."""
     if not chars:
         return None
-    rates = decoded.baud_error_pct  # one per character, in the order of the events
-    in_order = [e for e in events if e.kind is EventKind.CHAR]
-    # (a list that does not match the characters one for one tells no character's rate)
-    error = dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
+    error = memo(decoded, "_rate_of", len(events), lambda: _rate_of(decoded, events))
     # by start and byte, not identity: a decode that widened its stamps (the glitch filter
     # beside an edge) holds new events, its problems the ones it first read
     broken = {

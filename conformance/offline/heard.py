@@ -9,7 +9,9 @@ version, assumptions), so the passive run's reports have the live run's shape.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from ..declaration import normalise_version
 from ..dut import DutClaim, Session, sensor_claim
@@ -36,6 +38,7 @@ EMPTY_PACKET = 6  # bytes of a binary packet holding no value (address, size, ty
 #: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS): the
 #: wording of the ``heard`` precondition (conformance/preconditions.py), re-exported here.
 NOT_SEEN = _NOT_SEEN
+T = TypeVar("T")
 
 
 def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
@@ -185,26 +188,75 @@ def heard_records(link: RecordingLink) -> tuple[TranscriptView, Rebuilt]:
     return memo(link, "_heard_records", len(link.transcript.events), cut)
 
 
-def _mine(address: str | None, text: str) -> bool:
-    return address is None or text[:1] == address
+def _by_address(items: Iterable[T], address_of: Callable[[T], str]) -> dict[str, list[T]]:
+    """``items`` by the address each names (the first character of its text), in order."""
+    grouped: dict[str, list[T]] = {}
+    for item in items:
+        grouped.setdefault(address_of(item)[:1], []).append(item)
+    return grouped
+
+
+@dataclass(frozen=True)
+class _PerSensor:
+    """The recording's records and segments, each list split by sensor address once."""
+
+    exchanges: dict[str, list[Exchange]]
+    measurements: dict[str, list[Measurement]]
+    segments: dict[str, list[Segment]]
+
+
+def _per_sensor(link: RecordingLink) -> _PerSensor:
+    """Every sensor's share of the recording, split in one pass per list: a bus of ten
+    sensors is judged in ten runs, and each filtering the whole recording again cost an
+    hour's capture seconds."""
+
+    def split() -> _PerSensor:
+        _view, rebuilt = heard_records(link)
+        return _PerSensor(
+            _by_address(rebuilt.exchanges, lambda x: x.text),
+            _by_address(rebuilt.measurements, lambda m: m.command.address),
+            _by_address(transcript_segments(link.transcript), lambda s: s.text),
+        )
+
+    return memo(link, "_per_sensor", len(link.transcript.events), split)
+
+
+def _shared_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
+    """:func:`recording_notes`, made once per loaded recording (each run gets its own list)."""
+    return list(
+        memo(link, "_notes", len(link.transcript.events), lambda: recording_notes(link, view))
+    )
+
+
+def _bus_sensors(link: RecordingLink, exchanges: list[Exchange]) -> list[BusSensor]:
+    """:func:`sensors_on` the recording's exchanges, found once per loaded recording."""
+    return list(memo(link, "_on_bus", len(link.transcript.events), lambda: sensors_on(exchanges)))
 
 
 def hear_sensors(link: RecordingLink, address: str | None, version: str | None) -> HeardSensors:
     view, rebuilt = heard_records(link)
+    if address is None:
+        segments = list(transcript_segments(link.transcript))
+        exchanges, measurements = list(rebuilt.exchanges), list(rebuilt.measurements)
+    else:
+        mine = _per_sensor(link)
+        exchanges = list(mine.exchanges.get(address, ()))
+        measurements = list(mine.measurements.get(address, ()))
+        segments = list(mine.segments.get(address, ()))
     heard = HeardSensors(
         link,
         view,
         forced_version=normalise_version(version) if version else None,
         address=address,
-        exchanges=[x for x in rebuilt.exchanges if _mine(address, x.text)],
-        measurements=[m for m in rebuilt.measurements if _mine(address, m.command.address)],
-        segments=[s for s in transcript_segments(link.transcript) if _mine(address, s.text)],
-        on_bus=sensors_on(rebuilt.exchanges),
+        exchanges=exchanges,
+        measurements=measurements,
+        segments=segments,
+        on_bus=_bus_sensors(link, rebuilt.exchanges),
     )
     for m in heard.measurements:
         m.aborted_by = disturbance(m, view)
     cut = sum(1 for m in heard.measurements if m.aborted_by is not None)
-    heard.assumptions = recording_notes(link, view)
+    heard.assumptions = _shared_notes(link, view)
     if link.decoded is not None:  # a capture: how well this sensor's own characters read
         who = f"sensor {address!r}" if address is not None else "the sensor(s)"
         chars = sensor_characters(heard.exchanges)
@@ -310,9 +362,9 @@ def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
         link,
         view,
         forced_version=normalise_version(version) if version else None,
-        on_bus=sensors_on(rebuilt.exchanges),
+        on_bus=_bus_sensors(link, rebuilt.exchanges),
     )
-    heard.assumptions = recording_notes(link, view)
+    heard.assumptions = _shared_notes(link, view)
     if heard.forced_version is None:
         heard.assumptions.append("the recorder's SDI-12 version is not on the wire; judging v1.4")
     return heard
