@@ -9,9 +9,13 @@ version, assumptions), so the passive run's reports have the live run's shape.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+import math
+from bisect import bisect_left
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import TypeVar
+from itertools import islice, takewhile
+from operator import le
+from typing import Protocol, TypeVar
 
 from ..declaration import normalise_version
 from ..dut import DutClaim, Session, sensor_claim
@@ -278,6 +282,35 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     return heard
 
 
+class _Timed(Protocol):
+    @property
+    def start(self) -> float: ...
+
+
+_Item = TypeVar("_Item", bound=_Timed)
+
+
+def _from(
+    view: TranscriptView, items: list[_Item], at: float, before: float = math.inf
+) -> Iterator[_Item]:
+    """``items`` (a view's transmissions or breaks) starting at or after ``at``, in order;
+    given ``before``, the caller wants only those starting before it and may get no more.
+    One recording's items are in time order, so this is a bisection and a few items, not a
+    scan of the whole recording for each measurement (quadratic over an hour of aM! polls);
+    items out of order (never seen) are all scanned, as before."""
+    key = "_transmission_starts" if items is view.transmissions else "_break_starts"
+    starts = memo(view, key, len(items), lambda: _starts_if_ordered(items))
+    if starts is None:
+        return (t for t in items if t.start >= at)
+    found = islice(items, bisect_left(starts, at), None)
+    return takewhile(lambda t: t.start < before, found) if before < math.inf else found
+
+
+def _starts_if_ordered(items: list[_Item]) -> list[float] | None:
+    starts = [t.start for t in items]
+    return starts if all(map(le, starts, starts[1:])) else None
+
+
 def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     """What the recorder did that keeps ``m``'s wait and data from being the sensor's own
     doing: a transmission or a break before the service request (or ttt) of an aM!-type
@@ -289,22 +322,26 @@ def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     The rebuilt records follow its data the same way. None: undisturbed."""
     if m.reply_end is None or m.ttt is None:
         return "no usable reply"
-    later = [t for t in view.transmissions if t.start >= m.reply_end]
+    reply_end = m.reply_end
     if m.command.kind in SERVICE_REQUEST_KINDS and m.ttt:
-        due = m.service_request_end or m.reply_end + m.ttt
-        early = next((t for t in later if t.start < due), None)
+        due = m.service_request_end or reply_end + m.ttt
+        early = next(
+            (t for t in _from(view, view.transmissions, reply_end, due) if t.start < due), None
+        )
         if early is not None:
             return early.text
-        if any(m.reply_end <= b.start < due for b in view.breaks):
+        if any(reply_end <= b.start < due for b in _from(view, view.breaks, reply_end, due)):
             return "break"  # a break aborts an aM!-type measurement (R-4.4.5-10)
+    later = _from(view, view.transmissions, reply_end)
     if m.command.kind in CONCURRENT_KINDS:
-        later = [t for t in later if t.address == m.command.address]
-    if not later:
+        later = (t for t in later if t.address == m.command.address)
+    first = next(later, None)
+    if first is None:
         return "nothing more sent"
-    index = later[0].data_index
-    if later[0].address != m.command.address or index is None or index[1] != 0:
+    index = first.data_index
+    if first.address != m.command.address or index is None or index[1] != 0:
         # the records follow a measurement's data only while nothing else comes between
-        return later[0].text
+        return first.text
     if not _collected(m):
         return "the recorder stopped asking for data while values were due"
     return None
