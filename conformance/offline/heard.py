@@ -32,7 +32,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..view.rebuilt_records import Rebuilt, rebuild_records
 from ..view.runs import Segment, transcript_segments, transcript_view
 from ..view.segments import TranscriptView, memo
-from .decode_quality import decode_quality, sensor_characters
+from .decode_quality import decode_quality, rate_of, sensor_characters
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3
@@ -225,6 +225,23 @@ def _per_sensor(link: RecordingLink) -> _PerSensor:
     return memo(link, "_per_sensor", len(link.transcript.events), split)
 
 
+def _qualities(link: RecordingLink) -> dict[str, str | None]:
+    """Each sensor's decode-quality note, by address, all made in one pass: the map of every
+    character's bit-rate error is built once and not kept (an hour's is tens of MB)."""
+
+    def build() -> dict[str, str | None]:
+        events = link.transcript.events
+        rates = rate_of(link.decoded, events)
+        return {
+            a: decode_quality(
+                link.decoded, events, sensor_characters(xs), f"sensor {a!r}", rates=rates
+            )
+            for a, xs in _per_sensor(link).exchanges.items()
+        }
+
+    return memo(link, "_qualities", len(link.transcript.events), build)
+
+
 def _shared_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     """:func:`recording_notes`, made once per loaded recording (each run gets its own list)."""
     return list(
@@ -263,8 +280,11 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     heard.assumptions = _shared_notes(link, view)
     if link.decoded is not None:  # a capture: how well this sensor's own characters read
         who = f"sensor {address!r}" if address is not None else "the sensor(s)"
-        chars = sensor_characters(heard.exchanges)
-        quality = decode_quality(link.decoded, link.transcript.events, chars, who)
+        if address is None:
+            chars = sensor_characters(heard.exchanges)
+            quality = decode_quality(link.decoded, link.transcript.events, chars, who)
+        else:
+            quality = _qualities(link).get(address)
         if quality is not None:
             heard.assumptions.append(quality)
     if cut:
