@@ -20,6 +20,7 @@ import numpy as np
 
 from .edges import Edges, transitions
 from .errors import CaptureError
+from .read_ahead import read_ahead
 
 #: What Python's zipfile raises for a damaged archive or member: besides the obvious, an
 #: unknown compression method (NotImplementedError), an "encrypted" flag (RuntimeError), a
@@ -172,7 +173,7 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
         tick_rate=session.samplerate,
         period=1.0 / session.samplerate,
         initial_level=first_level[0],
-        chunks=all_chunks(),
+        chunks=read_ahead(all_chunks()),  # inflated and scanned beside the decoder
         end=lambda: total[0] or None,
         notes=notes,
     )

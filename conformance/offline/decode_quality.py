@@ -23,16 +23,30 @@ def sensor_characters(exchanges: Iterable[Exchange]) -> list[Event]:
     return [e for ex in exchanges for a in ex.attempts for e in a.reply_events]
 
 
-def decode_quality(decoded: Any, events: list[Event], chars: list[Event], who: str) -> str | None:
-    """One note on ``chars`` (the sensor's characters among ``events``, the capture's decoded
-    events in order) as ``decoded`` (a :class:`~conformance.capture.decode.CaptureDecode`)
-    read them; None when the sensor sent none."""
-    if not chars:
-        return None
+def rate_of(decoded: Any, events: list[Event]) -> dict[int, float]:
+    """``id(character)`` -> its bit-rate error, for every character of ``events``: made once
+    for all the sensors of a bus (:func:`decode_quality`'s ``rates``) rather than once each,
+    each pass over the whole capture."""
     rates = decoded.baud_error_pct  # one per character, in the order of the events
     in_order = [e for e in events if e.kind is EventKind.CHAR]
     # (a list that does not match the characters one for one tells no character's rate)
-    error = dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
+    return dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
+
+
+def decode_quality(
+    decoded: Any,
+    events: list[Event],
+    chars: list[Event],
+    who: str,
+    rates: dict[int, float] | None = None,
+) -> str | None:
+    """One note on ``chars`` (the sensor's characters among ``events``, the capture's decoded
+    events in order) as ``decoded`` (a :class:`~conformance.capture.decode.CaptureDecode`)
+    read them; None when the sensor sent none. ``rates``: :func:`rate_of` ``events``, when
+    the caller made it already."""
+    if not chars:
+        return None
+    error = rate_of(decoded, events) if rates is None else rates
     # by start and byte, not identity: a decode that widened its stamps (the glitch filter
     # beside an edge) holds new events, its problems the ones it first read
     broken = {

@@ -9,7 +9,13 @@ version, assumptions), so the passive run's reports have the live run's shape.
 
 from __future__ import annotations
 
+import math
+from bisect import bisect_left
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
+from itertools import islice, takewhile
+from operator import le
+from typing import Protocol, TypeVar
 
 from ..declaration import normalise_version
 from ..dut import DutClaim, Session, sensor_claim
@@ -24,9 +30,9 @@ from ..replay.recording_link import RecordingLink
 from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
 from ..view.rebuilt_records import Rebuilt, rebuild_records
-from ..view.runs import Segment
-from ..view.segments import TranscriptView, memo, read_view
-from .decode_quality import decode_quality, sensor_characters
+from ..view.runs import Segment, transcript_segments, transcript_view
+from ..view.segments import TranscriptView, memo
+from .decode_quality import decode_quality, rate_of, sensor_characters
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3
@@ -36,6 +42,7 @@ EMPTY_PACKET = 6  # bytes of a binary packet holding no value (address, size, ty
 #: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS): the
 #: wording of the ``heard`` precondition (conformance/preconditions.py), re-exported here.
 NOT_SEEN = _NOT_SEEN
+T = TypeVar("T")
 
 
 def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
@@ -179,36 +186,105 @@ def heard_records(link: RecordingLink) -> tuple[TranscriptView, Rebuilt]:
     while the transcript keeps its length (a recording only grows while it is read)."""
 
     def cut() -> tuple[TranscriptView, Rebuilt]:
-        view = read_view(link.transcript.events)
+        view = transcript_view(link.transcript)  # the reports' evidence reads it too
         return view, rebuild_records(view, uncertainty=link.uncertainty)
 
     return memo(link, "_heard_records", len(link.transcript.events), cut)
 
 
-def _mine(address: str | None, text: str) -> bool:
-    return address is None or text[:1] == address
+def _by_address(items: Iterable[T], address_of: Callable[[T], str]) -> dict[str, list[T]]:
+    """``items`` by the address each names (the first character of its text), in order."""
+    grouped: dict[str, list[T]] = {}
+    for item in items:
+        grouped.setdefault(address_of(item)[:1], []).append(item)
+    return grouped
+
+
+@dataclass(frozen=True)
+class _PerSensor:
+    """The recording's records and segments, each list split by sensor address once."""
+
+    exchanges: dict[str, list[Exchange]]
+    measurements: dict[str, list[Measurement]]
+    segments: dict[str, list[Segment]]
+
+
+def _per_sensor(link: RecordingLink) -> _PerSensor:
+    """Every sensor's share of the recording, split in one pass per list: a bus of ten
+    sensors is judged in ten runs, and each filtering the whole recording again cost an
+    hour's capture seconds."""
+
+    def split() -> _PerSensor:
+        _view, rebuilt = heard_records(link)
+        return _PerSensor(
+            _by_address(rebuilt.exchanges, lambda x: x.text),
+            _by_address(rebuilt.measurements, lambda m: m.command.address),
+            _by_address(transcript_segments(link.transcript), lambda s: s.text),
+        )
+
+    return memo(link, "_per_sensor", len(link.transcript.events), split)
+
+
+def _qualities(link: RecordingLink) -> dict[str, str | None]:
+    """Each sensor's decode-quality note, by address, all made in one pass: the map of every
+    character's bit-rate error is built once and not kept (an hour's is tens of MB)."""
+
+    def build() -> dict[str, str | None]:
+        events = link.transcript.events
+        rates = rate_of(link.decoded, events)
+        return {
+            a: decode_quality(
+                link.decoded, events, sensor_characters(xs), f"sensor {a!r}", rates=rates
+            )
+            for a, xs in _per_sensor(link).exchanges.items()
+        }
+
+    return memo(link, "_qualities", len(link.transcript.events), build)
+
+
+def _shared_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
+    """:func:`recording_notes`, made once per loaded recording (each run gets its own list)."""
+    return list(
+        memo(link, "_notes", len(link.transcript.events), lambda: recording_notes(link, view))
+    )
+
+
+def _bus_sensors(link: RecordingLink, exchanges: list[Exchange]) -> list[BusSensor]:
+    """:func:`sensors_on` the recording's exchanges, found once per loaded recording."""
+    return list(memo(link, "_on_bus", len(link.transcript.events), lambda: sensors_on(exchanges)))
 
 
 def hear_sensors(link: RecordingLink, address: str | None, version: str | None) -> HeardSensors:
     view, rebuilt = heard_records(link)
+    if address is None:
+        segments = list(transcript_segments(link.transcript))
+        exchanges, measurements = list(rebuilt.exchanges), list(rebuilt.measurements)
+    else:
+        mine = _per_sensor(link)
+        exchanges = list(mine.exchanges.get(address, ()))
+        measurements = list(mine.measurements.get(address, ()))
+        segments = list(mine.segments.get(address, ()))
     heard = HeardSensors(
         link,
         view,
         forced_version=normalise_version(version) if version else None,
         address=address,
-        exchanges=[x for x in rebuilt.exchanges if _mine(address, x.text)],
-        measurements=[m for m in rebuilt.measurements if _mine(address, m.command.address)],
-        segments=[Segment.of(t) for t in view.transmissions if _mine(address, t.text)],
-        on_bus=sensors_on(rebuilt.exchanges),
+        exchanges=exchanges,
+        measurements=measurements,
+        segments=segments,
+        on_bus=_bus_sensors(link, rebuilt.exchanges),
     )
     for m in heard.measurements:
         m.aborted_by = disturbance(m, view)
     cut = sum(1 for m in heard.measurements if m.aborted_by is not None)
-    heard.assumptions = recording_notes(link, view)
+    heard.assumptions = _shared_notes(link, view)
     if link.decoded is not None:  # a capture: how well this sensor's own characters read
         who = f"sensor {address!r}" if address is not None else "the sensor(s)"
-        chars = sensor_characters(heard.exchanges)
-        quality = decode_quality(link.decoded, link.transcript.events, chars, who)
+        if address is None:
+            chars = sensor_characters(heard.exchanges)
+            quality = decode_quality(link.decoded, link.transcript.events, chars, who)
+        else:
+            quality = _qualities(link).get(address)
         if quality is not None:
             heard.assumptions.append(quality)
     if cut:
@@ -226,6 +302,35 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     return heard
 
 
+class _Timed(Protocol):
+    @property
+    def start(self) -> float: ...
+
+
+_Item = TypeVar("_Item", bound=_Timed)
+
+
+def _from(
+    view: TranscriptView, items: list[_Item], at: float, before: float = math.inf
+) -> Iterator[_Item]:
+    """``items`` (a view's transmissions or breaks) starting at or after ``at``, in order;
+    given ``before``, the caller wants only those starting before it and may get no more.
+    One recording's items are in time order, so this is a bisection and a few items, not a
+    scan of the whole recording for each measurement (quadratic over an hour of aM! polls);
+    items out of order (never seen) are all scanned, as before."""
+    key = "_transmission_starts" if items is view.transmissions else "_break_starts"
+    starts = memo(view, key, len(items), lambda: _starts_if_ordered(items))
+    if starts is None:
+        return (t for t in items if t.start >= at)
+    found = islice(items, bisect_left(starts, at), None)
+    return takewhile(lambda t: t.start < before, found) if before < math.inf else found
+
+
+def _starts_if_ordered(items: list[_Item]) -> list[float] | None:
+    starts = [t.start for t in items]
+    return starts if all(map(le, starts, starts[1:])) else None
+
+
 def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     """What the recorder did that keeps ``m``'s wait and data from being the sensor's own
     doing: a transmission or a break before the service request (or ttt) of an aM!-type
@@ -237,22 +342,26 @@ def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     The rebuilt records follow its data the same way. None: undisturbed."""
     if m.reply_end is None or m.ttt is None:
         return "no usable reply"
-    later = [t for t in view.transmissions if t.start >= m.reply_end]
+    reply_end = m.reply_end
     if m.command.kind in SERVICE_REQUEST_KINDS and m.ttt:
-        due = m.service_request_end or m.reply_end + m.ttt
-        early = next((t for t in later if t.start < due), None)
+        due = m.service_request_end or reply_end + m.ttt
+        early = next(
+            (t for t in _from(view, view.transmissions, reply_end, due) if t.start < due), None
+        )
         if early is not None:
             return early.text
-        if any(m.reply_end <= b.start < due for b in view.breaks):
+        if any(reply_end <= b.start < due for b in _from(view, view.breaks, reply_end, due)):
             return "break"  # a break aborts an aM!-type measurement (R-4.4.5-10)
+    later = _from(view, view.transmissions, reply_end)
     if m.command.kind in CONCURRENT_KINDS:
-        later = [t for t in later if t.address == m.command.address]
-    if not later:
+        later = (t for t in later if t.address == m.command.address)
+    first = next(later, None)
+    if first is None:
         return "nothing more sent"
-    index = later[0].data_index
-    if later[0].address != m.command.address or index is None or index[1] != 0:
+    index = first.data_index
+    if first.address != m.command.address or index is None or index[1] != 0:
         # the records follow a measurement's data only while nothing else comes between
-        return later[0].text
+        return first.text
     if not _collected(m):
         return "the recorder stopped asking for data while values were due"
     return None
@@ -310,9 +419,9 @@ def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
         link,
         view,
         forced_version=normalise_version(version) if version else None,
-        on_bus=sensors_on(rebuilt.exchanges),
+        on_bus=_bus_sensors(link, rebuilt.exchanges),
     )
-    heard.assumptions = recording_notes(link, view)
+    heard.assumptions = _shared_notes(link, view)
     if heard.forced_version is None:
         heard.assumptions.append("the recorder's SDI-12 version is not on the wire; judging v1.4")
     return heard

@@ -31,7 +31,7 @@ from typing import Any
 from ..results import CaseRecord
 from ..transcript import Event, EventKind, Transcript
 from ..verdicts import Finding, Verdict
-from ..view.runs import Segment, segments
+from ..view.runs import Segment, segments, transcript_segments
 from ..view.segments import memo
 
 #: the verdicts a reader must be able to check against the wire
@@ -115,8 +115,11 @@ class Locator:
     """Finds the exchange behind each finding in one run's transcript ``events`` (a list the
     link may still be appending to: positions are indexed as it grows)."""
 
-    def __init__(self, events: Sequence[Event]) -> None:
+    def __init__(self, events: Sequence[Event], transcript: Transcript | None = None) -> None:
+        """``transcript``: the one ``events`` belongs to, whose whole cut
+        (:func:`~..view.runs.transcript_segments`) stands for a search of all its events."""
         self.events = events
+        self.transcript = transcript
         self.position: dict[Event, int] = {}
         self._indexed = 0
         self._cuts: dict[tuple[int, int], list[Segment]] = {}
@@ -133,7 +136,9 @@ class Locator:
         if key not in self._cuts:
             if len(self._cuts) > 64:
                 self._cuts.clear()
-            self._cuts[key] = [s for s in segments(self.events[lo:hi]) if s.command]
+            whole = self.transcript is not None and lo == 0 and hi == len(self.events)
+            cut = transcript_segments(self.transcript) if whole else segments(self.events[lo:hi])
+            self._cuts[key] = [s for s in cut if s.command]
         return self._cuts[key]
 
     def _ref(self, events: Sequence[Event], exchange: str | None, how: str) -> WireRef | None:
@@ -203,7 +208,7 @@ def locator_of(transcript: Transcript) -> Locator:
     one loaded recording): a cut of an hour's capture takes seconds, and each report made
     its own, 2 per run and 11 runs for a bus of ten sensors. Its cuts stay true as the
     transcript grows, since a transcript is append-only."""
-    return memo(transcript, "_locator", None, lambda: Locator(transcript.events))
+    return memo(transcript, "_locator", None, lambda: Locator(transcript.events, transcript))
 
 
 def wire_refs(cases: Sequence[CaseRecord], transcript: Transcript) -> dict[int, WireRef]:

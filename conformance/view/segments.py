@@ -103,6 +103,11 @@ class Transmission:
 
     @property
     def command(self) -> Command | None:
+        # parsed once per length, as ``text`` is decoded: the judges ask each transmission
+        # several times (30,000 parses of the same few texts per 10 minutes of a busy bus)
+        return memo(self, "_command", len(self.chars), self._parsed)
+
+    def _parsed(self) -> Command | None:
         try:
             return parse_command(self.text)
         except CommandError:
@@ -124,13 +129,23 @@ class Transmission:
     def contention(self) -> list[Event]:
         """Sensor characters that started before the command ended, or came back between the
         echoes of its characters (two talkers): never part of a reply."""
-        return collided(self.heard, self.end)
+        return list(memo(self, "_contention", self._grown, lambda: collided(self.heard, self.end)))
+
+    @property
+    def _grown(self) -> tuple[int, int]:
+        """How far the transmission has grown (its lists are only appended to while the view
+        is cut): what its derived lists are kept under. The judges ask for a transmission's
+        reply many times; each caller gets its own copy of the list."""
+        return len(self.chars), len(self.heard)
 
     @property
     def reply(self) -> list[Event]:
         """The reply proper, framed as the protocol frames it: up to the first LF (7E1), the
         packet's length (``aDBn!``), or ETX / 150 ms of marking after a line (multi-line
         text). How long it took to start is the timing rules' question, not the framing's."""
+        return list(memo(self, "_reply", self._grown, self._framed_reply))
+
+    def _framed_reply(self) -> list[Event]:
         clash = {id(e) for e in self.contention}
         heard = [e for e in self.heard if id(e) not in clash]
         if self.binary:
@@ -151,6 +166,9 @@ class Transmission:
     @property
     def after(self) -> list[Event]:
         """What the sensors sent after the reply (service requests, chatter)."""
+        return list(memo(self, "_after", self._grown, self._after))
+
+    def _after(self) -> list[Event]:
         taken = {id(e) for e in self.reply} | {id(e) for e in self.contention}
         return [e for e in self.heard if id(e) not in taken]
 
