@@ -11,7 +11,10 @@ exchanges next to the wall time it took. The lower bound is the union of:
 - after the DUT's last character, the 7.5 ms it may still hold the line (R-7.0-11); after a
   command that got no reply, the 16.67 ms before a retry may start (R-7.2-02);
 - the ttt a measurement announced, counted from the end of its ``atttn`` reply up to ttt
-  or the next break (a break before ttt is the tool's choice: an abort, or giving up).
+  or the tool's choice to end it sooner: for an M-type or V measurement the next break (an
+  abort, or giving up), for a concurrent one (C, CC, Cn, CCn, HA, HB) the next command to the
+  same sensor. A break does not end a concurrent measurement (R-4.4.7-05): a recorder that
+  breaks to talk to other sensors meanwhile still waits for ttt before it reads the data.
 
 Anything beyond that (retry spacing, listening windows for silence, patience past limits,
 scheduling latency) is the tool's overhead.
@@ -82,9 +85,24 @@ def _forced_gap(before: Event, after: Event, gap: float) -> float:
     return 0.0
 
 
+@dataclass
+class _Wait:
+    """The ttt a measurement announced: from ``start`` (the end of ``atttn``) to ``end``."""
+
+    start: float
+    end: float
+    address: str
+    concurrent: bool
+
+    def cut(self, at: float) -> None:
+        """The tool ended the wait at ``at`` (never before it began)."""
+        self.end = min(self.end, max(self.start, at))
+
+
 def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
-    """[end of ``atttn``, end + ttt] for each measurement the DUT started."""
-    waits = []
+    """[end of ``atttn``, end + ttt] for each measurement the DUT started, cut where the tool
+    chose to end it sooner (see the module docstring)."""
+    waits: list[_Wait] = []
     command: list[Event] = []
     reply: list[Event] = []
     # _ends_command(command) and _line_done(reply), kept as the two grow (asked per event)
@@ -102,19 +120,32 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
         if e is None:
             continue
         if e.kind is EventKind.BREAK:
-            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that
-            waits = [(start, min(end, max(start, e.start))) for start, end in waits]
+            # a break before ttt ran out aborts (or gives up on) an M-type wait: the tool
+            # chose that; a concurrent measurement runs on through it (R-4.4.7-05)
+            for wait in waits:
+                if not wait.concurrent:
+                    wait.cut(e.start)
             continue
         if e.origin == TOOL:
+            if not command:  # the first character of a command: its address
+                _cut_concurrent(waits, chr(e.char7), e.start)
             command.append(e)
             commanded = _ends_command(command)
         elif commanded and not replied:
             reply.append(e)
             replied = _line_done(reply)
-    return waits
+    return [(w.start, w.end) for w in waits]
 
 
-def _announced_wait(command: list[Event], reply: list[Event]) -> tuple[float, float] | None:
+def _cut_concurrent(waits: list[_Wait], address: str, at: float) -> None:
+    """A command to a sensor ends its concurrent measurement's wait there: read early,
+    or aborted (R-4.4.7.1-01), it is the tool's choice."""
+    for wait in waits:
+        if wait.concurrent and wait.address == address:
+            wait.cut(at)
+
+
+def _announced_wait(command: list[Event], reply: list[Event]) -> _Wait | None:
     if not reply:
         return None
     try:
@@ -126,7 +157,8 @@ def _announced_wait(command: list[Event], reply: list[Event]) -> tuple[float, fl
     ttt = announced_time(decode_7e1(reply), measurement_digits(cmd))
     if not ttt:
         return None
-    return reply[-1].end, reply[-1].end + ttt
+    end = reply[-1].end
+    return _Wait(end, end + ttt, cmd.address, cmd.is_concurrent)
 
 
 def announced_time(text: str, digits: int) -> int | None:
