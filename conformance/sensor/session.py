@@ -129,6 +129,9 @@ REPROBE_KINDS = frozenset(
     }
 )
 
+#: The high-volume data index read past any measurement's data (R-5.2-06).
+PAST_DATA_INDEX = 999
+
 #: Breaks (s) tried before a device that ignored the usual 13 ms break is called absent.
 LONGER_BREAKS = (30e-3, 60e-3, 100e-3)
 
@@ -314,7 +317,30 @@ class SensorSession(Session):
 
     def measurement(self, code: str) -> Measurement:
         """The cached full measurement for ``"M"``, ``"MC"``, ``"C9"``, ``"HA"``, ``"HB"``..."""
-        return self.once(("m", code), lambda: self.fresh_measurement(code))
+        return self.once(("m", code), lambda: self._shared_measurement(code))
+
+    def _shared_measurement(self, code: str) -> Measurement:
+        """A cached measurement as it is made, with what must follow it at once: after
+        ``aHB!`` the reads past its packets (:meth:`packets_past_data`)."""
+        m = self.fresh_measurement(code)
+        if code == "HB" and self.link.info.binary and _shows_support(m):
+            self._cache[("past-data", code)] = self._read_past_data(m)
+        return m
+
+    def packets_past_data(self) -> list[Exchange]:
+        """``aDBn!`` past the data of the cached ``aHB!`` measurement: the index after its last
+        packet (when it was complete) and ``aDB999!``, read right after its collection. The DB
+        indices refer to the latest measurement, so they ride on the one every case shares
+        rather than on a measurement of their own (issue 22: one ``aHB!`` less, 4.4 s of bus
+        time). Empty where HB announced no values or the link carries no binary packets."""
+        self.measurement("HB")
+        return self._cache.get(("past-data", "HB"), [])
+
+    def _read_past_data(self, m: Measurement) -> list[Exchange]:
+        probes = [PAST_DATA_INDEX]  # no measurement of at most 999 values fills 1000 packets
+        if m.complete:
+            probes.insert(0, len(m.data))
+        return [self.fresh_exchange(f"DB{i}") for i in probes]
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
         first = len(self.link.transcript)
@@ -671,6 +697,12 @@ class SensorSession(Session):
     def supports(self, code: str) -> bool:
         """Whether ``aHA!``/``aHB!`` (or a numbered group) announces values at all."""
         return bool(self.measurement(code).count)
+
+
+def _shows_support(m: Measurement) -> bool:
+    """Whether a high-volume measurement counts as supported: values announced, or a reply
+    too malformed to read a count from (judged as support); a well-formed "no values" is not."""
+    return bool(m.count) or (m.start.answered and m.count is None)
 
 
 def _exchange_reading(ex: Exchange) -> tuple[Any, ...]:
