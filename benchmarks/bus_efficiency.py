@@ -15,9 +15,10 @@ take seconds of CPU; both are printed, with the load average before and after, s
 figure moves with the machine's load. Compare two trees one after the other on the same
 machine (``PYTHONPATH=OLD python OLD/benchmarks/bus_efficiency.py``, then the new one).
 
-Measured (issue 22, the 2-core machine with four other sessions on it, load 9.6-14.7): the
-tree before (a515f24) 268.3 s lower bound, 302.8 s span, 309.1 s wall (0.87); with the
-shared stimuli and the corrected bound see README's "Measured".
+Measured (issue 22, the 2-core machine with four other sessions on it, each tree one after
+the other): a515f24 268.3 and 268.0 s lower bound, 302.8 and 310.6 s span, 309.1 and 317.6 s
+wall (0.87 at load 9.8, 0.84 at load 16); with the shared ``aHB!`` 262.7 s lower bound,
+295.1 s span, 302.0 s wall (0.87 at load 16). README's "Measured" says where the rest goes.
 """
 
 from __future__ import annotations
