@@ -16,9 +16,10 @@ figure moves with the machine's load. Compare two trees one after the other on t
 machine (``PYTHONPATH=OLD python OLD/benchmarks/bus_efficiency.py``, then the new one).
 
 Measured (issue 22, the 2-core machine with four other sessions on it, each tree one after
-the other): a515f24 268.3 and 268.0 s lower bound, 302.8 and 310.6 s span, 309.1 and 317.6 s
-wall (0.87 at load 9.8, 0.84 at load 16); with the shared ``aHB!`` 262.7 s lower bound,
-295.1 s span, 302.0 s wall (0.87 at load 16). README's "Measured" says where the rest goes.
+the other): a515f24 268.3, 268.0 and 265.2 s lower bound (as it counted), 302.8, 310.6 and
+297.2 s span, 309.1, 317.6 and 302.5 s wall (0.87, 0.84, 0.88 at load 10, 16, 11); with
+the shared ``aHB!`` 262.7 and 263.7 s lower bound, 295.1 and 295.0 s span, 302.0 and 300.5 s
+wall (0.87, 0.88 at load 16, 10). README's "Measured" says where the rest goes.
 """
 
 from __future__ import annotations
