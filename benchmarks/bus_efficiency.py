@@ -15,11 +15,12 @@ take seconds of CPU; both are printed, with the load average before and after, s
 figure moves with the machine's load. Compare two trees one after the other on the same
 machine (``PYTHONPATH=OLD python OLD/benchmarks/bus_efficiency.py``, then the new one).
 
-Measured (issue 22, the 2-core machine with four other sessions on it, each tree one after
-the other): a515f24 268.3, 268.0 and 265.2 s lower bound (as it counted), 302.8, 310.6 and
-297.2 s span, 309.1, 317.6 and 302.5 s wall (0.87, 0.84, 0.88 at load 10, 16, 11); with
-the shared ``aHB!`` 262.7 and 263.7 s lower bound, 295.1 and 295.0 s span, 302.0 and 300.5 s
-wall (0.87, 0.88 at load 16, 10). README's "Measured" says where the rest goes.
+Measured (issue 22, the 2-core machine with four other sessions on it, one run after the
+other; run a tree from outside it, ``cd /tmp``, or ``-m conformance.cli`` imports the tree
+in the working directory): a515f24 268.3 and 267.6 s lower bound (as it counted), 302.8 and
+301.0 s span, 309.1 and 304.3 s wall (0.87, 0.88); this tree 262.7, 263.7, 265.2 and 268.0 s,
+295.1, 295.0, 297.2 and 310.6 s, 302.0, 300.5, 302.5 and 317.6 s (0.87, 0.88, 0.88, 0.84) at
+load average 4-17. README's "Measured" says where the rest goes.
 """
 
 from __future__ import annotations
