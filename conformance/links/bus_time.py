@@ -11,7 +11,10 @@ exchanges next to the wall time it took. The lower bound is the union of:
 - after the DUT's last character, the 7.5 ms it may still hold the line (R-7.0-11); after a
   command that got no reply, the 16.67 ms before a retry may start (R-7.2-02);
 - the ttt a measurement announced, counted from the end of its ``atttn`` reply up to ttt
-  or the next break (a break before ttt is the tool's choice: an abort, or giving up).
+  or the tool's choice to end it sooner: for an M-type or V measurement the next break (an
+  abort, or giving up), for a concurrent one (C, CC, Cn, CCn, HA, HB) the next command to the
+  same sensor. A break does not end a concurrent measurement (R-4.4.7-05): a recorder that
+  breaks to talk to other sensors meanwhile still waits for ttt before it reads the data.
 
 Anything beyond that (retry spacing, listening windows for silence, patience past limits,
 scheduling latency) is the tool's overhead.
@@ -95,10 +98,57 @@ def _forced_gap(before: Event, after: Event, gap: float) -> float:
 _BANG, _CR, _LF = ord("!"), ord("\r"), ord("\n")
 
 
+@dataclass
+class _Wait:
+    """The ttt a measurement announced: from ``start`` (the end of ``atttn``) to ``end``."""
+
+    start: float
+    end: float
+    address: str
+    concurrent: bool
+
+    def cut(self, at: float) -> None:
+        """The tool ended the wait at ``at`` (never before it began)."""
+        self.end = min(self.end, max(self.start, at))
+
+
+@dataclass
+class _OpenWaits:
+    """The waits a later event may still cut. A wait cut at ``t`` ends by ``t``, and events
+    come in start order, so cutting it again later changes nothing: each wait is cut at most
+    once by its kind of event (cutting every wait at every break made this quadratic)."""
+
+    every: list[_Wait]
+    by_break: list[_Wait]  # M-type and V waits since the last break
+    by_command: dict[str, list[_Wait]]  # concurrent waits, by address, until a command to it
+
+    def keep(self, wait: _Wait | None) -> None:
+        if wait is None:
+            return
+        self.every.append(wait)
+        if wait.concurrent:
+            self.by_command.setdefault(wait.address, []).append(wait)
+        else:
+            self.by_break.append(wait)
+
+    def break_at(self, at: float) -> None:
+        """A break before ttt ran out aborts (or gives up on) an M-type wait: the tool chose
+        that; a concurrent measurement runs on through it (R-4.4.7-05)."""
+        for wait in self.by_break:
+            wait.cut(at)
+        self.by_break = []
+
+    def command_at(self, address: str, at: float) -> None:
+        """A command to a sensor ends its concurrent measurement's wait there: read early,
+        or aborted (R-4.4.7.1-01), it is the tool's choice."""
+        for wait in self.by_command.pop(address, ()):
+            wait.cut(at)
+
+
 def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
-    """[end of ``atttn``, end + ttt] for each measurement the DUT started."""
-    waits = []
-    open_from = 0  # waits[open_from:] came after the last break: only those can be cut
+    """[end of ``atttn``, end + ttt] for each measurement the DUT started, cut where the tool
+    chose to end it sooner (see the module docstring)."""
+    waits = _OpenWaits([], [], {})
     command: list[Event] = []
     reply: list[Event] = []
     # whether the command ends in '!' and the reply in CR LF, kept as the two grow (asked
@@ -107,33 +157,24 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     brk = EventKind.BREAK
     for e in wire:  # breaks and characters only
         if e.kind is brk or (e.origin == TOOL and (reply or commanded)):
-            wait = _announced_wait(command, reply)  # the exchange ends here
-            if wait is not None:
-                waits.append(wait)
+            waits.keep(_announced_wait(command, reply))  # the exchange ends here
             command, reply = [], []
             commanded = replied = False
         if e.kind is brk:
-            # a break before ttt ran out aborts (or gives up on) the wait: the tool chose that.
-            # Only the waits since the last break: one already cut ends by that break's start,
-            # which no later break (in start order) precedes, so cutting it again changes
-            # nothing, and cutting them all at every break made this quadratic.
-            waits[open_from:] = [
-                (start, min(end, max(start, e.start))) for start, end in waits[open_from:]
-            ]
-            open_from = len(waits)
+            waits.break_at(e.start)
         elif e.origin == TOOL:
+            if not command:  # the first character of a command: its address
+                waits.command_at(chr(e.char7), e.start)
             command.append(e)
             commanded = e.wire & 0x7F == _BANG
         elif commanded and not replied:
             reply.append(e)
             replied = e.wire & 0x7F == _LF and len(reply) >= 2 and reply[-2].wire & 0x7F == _CR
-    wait = _announced_wait(command, reply)  # the last exchange
-    if wait is not None:
-        waits.append(wait)
-    return waits
+    waits.keep(_announced_wait(command, reply))  # the last exchange
+    return [(w.start, w.end) for w in waits.every]
 
 
-def _announced_wait(command: list[Event], reply: list[Event]) -> tuple[float, float] | None:
+def _announced_wait(command: list[Event], reply: list[Event]) -> _Wait | None:
     if not reply:
         return None
     try:
@@ -145,7 +186,8 @@ def _announced_wait(command: list[Event], reply: list[Event]) -> tuple[float, fl
     ttt = announced_time(decode_7e1(reply), measurement_digits(cmd))
     if not ttt:
         return None
-    return reply[-1].end, reply[-1].end + ttt
+    end = reply[-1].end
+    return _Wait(end, end + ttt, cmd.address, cmd.is_concurrent)
 
 
 def announced_time(text: str, digits: int) -> int | None:

@@ -129,6 +129,9 @@ REPROBE_KINDS = frozenset(
     }
 )
 
+#: The high-volume data index read past any measurement's data (R-5.2-06).
+PAST_DATA_INDEX = 999
+
 #: Breaks (s) tried before a device that ignored the usual 13 ms break is called absent.
 LONGER_BREAKS = (30e-3, 60e-3, 100e-3)
 
@@ -314,7 +317,30 @@ class SensorSession(Session):
 
     def measurement(self, code: str) -> Measurement:
         """The cached full measurement for ``"M"``, ``"MC"``, ``"C9"``, ``"HA"``, ``"HB"``..."""
-        return self.once(("m", code), lambda: self.fresh_measurement(code))
+        return self.once(("m", code), lambda: self._shared_measurement(code))
+
+    def _shared_measurement(self, code: str) -> Measurement:
+        """A cached measurement as it is made, with what must follow it at once: after
+        ``aHB!`` the reads past its packets (:meth:`packets_past_data`)."""
+        m = self.fresh_measurement(code)
+        if code == "HB" and self.link.info.binary and _shows_support(m):
+            self._cache[("past-data", code)] = self._read_past_data(m)
+        return m
+
+    def packets_past_data(self) -> list[Exchange]:
+        """``aDBn!`` past the data of the cached ``aHB!`` measurement: the index after its last
+        packet (when it was complete) and ``aDB999!``, read right after its collection. The DB
+        indices refer to the latest measurement, so they ride on the one every case shares
+        rather than on a measurement of their own (issue 22: one ``aHB!`` less, 4.4 s of bus
+        time). Empty where HB announced no values or the link carries no binary packets."""
+        self.measurement("HB")
+        return self._cache.get(("past-data", "HB"), [])
+
+    def _read_past_data(self, m: Measurement) -> list[Exchange]:
+        probes = [PAST_DATA_INDEX]  # no measurement of at most 999 values fills 1000 packets
+        if m.complete:
+            probes.insert(0, len(m.data))
+        return [self.fresh_exchange(f"DB{i}") for i in probes]
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
         first = len(self.link.transcript)
@@ -410,6 +436,19 @@ class SensorSession(Session):
     def listen(self, duration: float) -> list[Event]:
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""
         return self.link.receive(self.link.now() + duration)
+
+    def mark_until(self, at: float) -> list[Event]:
+        """Keep the line marking so that the tool's next command can go out at ``at`` (a timed
+        probe's marking), and return what the DUT sent meanwhile. :meth:`listen` up to ``at``
+        would overshoot on a real link: a read whose limit lies ahead waits a frame and the
+        link's latency past it for characters that started in time, and the tool then listens
+        its own look before transmitting (:meth:`ToolRecorder.look_before_transmit`), about
+        18 ms in all behind an RFC 2217 port, which pushed a follow-up aimed 12 ms inside the
+        87 ms window out of it. The wait ends that look early instead and takes in what has
+        arrived; a DUT that talked meanwhile still holds the command back
+        (:meth:`ToolRecorder.clear_to_send`)."""
+        self.link.wait_until(at - self.master.look_before_transmit())
+        return self.link.receive(self.link.now())
 
     def probe(
         self,
@@ -658,6 +697,12 @@ class SensorSession(Session):
     def supports(self, code: str) -> bool:
         """Whether ``aHA!``/``aHB!`` (or a numbered group) announces values at all."""
         return bool(self.measurement(code).count)
+
+
+def _shows_support(m: Measurement) -> bool:
+    """Whether a high-volume measurement counts as supported: values announced, or a reply
+    too malformed to read a count from (judged as support); a well-formed "no values" is not."""
+    return bool(m.count) or (m.start.answered and m.count is None)
 
 
 def _exchange_reading(ex: Exchange) -> tuple[Any, ...]:

@@ -203,7 +203,7 @@ class ToolRecorder:
         self.link.wait_until(self._earliest_transmit())
         began = self.link.now()
         uncertainty = self.link.info.timing_uncertainty
-        look = 0.0 if _own_break_last(self.link) else uncertainty
+        look = self.look_before_transmit()
         held = False
         while True:
             if look:
@@ -231,6 +231,14 @@ class ToolRecorder:
             look = uncertainty
         self.holds += held
         return self.link.now()
+
+    def look_before_transmit(self) -> float:
+        """How long :meth:`clear_to_send` listens, once the line is clear, before it transmits
+        (s): the link's timing uncertainty, or nothing right after the tool's own break. A
+        case that aims a transmission at a moment starts its wait this much earlier."""
+        if _own_break_last(self.link):
+            return 0.0
+        return self.link.info.timing_uncertainty
 
     def note_collisions(self) -> int:
         """Add a collision NOTE for each tool transmission that overlapped DUT characters

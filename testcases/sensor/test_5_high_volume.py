@@ -117,11 +117,8 @@ def test_empty_packet_past_data(sensor, case):
     case.expect("address, 00 00, 00, CRC: 6 bytes, for the first index past the data and DB999")
     if _unsupported(case, sensor, "HB"):
         return
-    m = sensor.fresh_measurement("HB")  # the DB indices refer to the latest measurement
-    probes = [999]  # no measurement of at most 999 values fills 1000 packets
-    if m.complete:
-        probes.insert(0, len(m.data))
-    exchanges = [sensor.fresh_exchange(f"DB{i}") for i in probes]
+    # read right after the shared aHB! measurement: the DB indices refer to the latest one
+    exchanges = sensor.packets_past_data()
     case.evidence("aDBn! past the data", exchanges)
     bad = []
     for ex in exchanges:

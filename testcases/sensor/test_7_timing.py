@@ -367,7 +367,7 @@ EDGE_MARGIN = 1.5e-3
 def _after_marking(sensor, last_end: float, marking: float, text: str):
     """Send ``text`` without a break once the line has marked ``marking`` s since
     ``last_end``; return the exchange and the marking actually left before it."""
-    sensor.listen(max(0.0, last_end + marking - sensor.link.now()))
+    sensor.mark_until(last_end + marking)
     ex = sensor.master.raw(text, break_first=False)
     return ex, _marking_before(ex, last_end)
 

@@ -71,3 +71,44 @@ def test_a_service_request_wait_is_the_sensors_time():
     lower = bus_time(w.events).lower_bound
     # the 1.5 s until the service request and ttt overlap: counted once, not twice
     assert 1.5 < lower < 5.0 + 0.2
+
+
+def test_a_break_does_not_end_a_concurrent_measurements_wait():
+    """R-4.4.7-05: a recorder that breaks to talk to another sensor during ``aC!`` still waits
+    for ttt before it reads the data, so the whole ttt is forced."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    reply_end = w.t
+    w.pause(0.05).brk().pause(9e-3).send(TOOL, "zI!")  # another sensor's command, no reply
+    w.pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    assert lower >= reply_end + 5.0 - 1e-9  # the start, then the whole 5 s ttt
+
+
+def test_a_break_still_ends_an_m_measurements_wait():
+    """A break aborts ``aM!`` (R-4.4.5.1-01): what the tool waits after it is its own choice."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0M!").pause(9e-3).send(DUT, "00053\r\n")
+    reply_end = w.t
+    w.pause(0.05).brk().pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    assert lower < reply_end + 0.05 + 2 * (13e-3 + MARKING_AFTER_BREAK) + 9e-3 + 4 * CHAR_TIME
+    assert lower > reply_end  # the 50 ms up to the abort were the sensor's
+
+
+def test_an_own_command_ends_a_concurrent_measurements_wait():
+    """A command to the sensor itself aborts its concurrent measurement (R-4.4.7.1-01): the
+    tool chose to end the wait there, and waiting out ttt afterwards is its own patience."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    w.pause(0.05).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    assert lower < 1.0  # frames, delays and the 50 ms of ttt before 0I!, not the 5.2 s
+    assert lower > 0.05
+
+
+def test_a_concurrent_wait_at_another_address_is_not_ended_by_the_duts_commands():
+    """On a shared line, ``1C!`` keeps running while the tool talks to sensor 0."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "1C!").pause(9e-3).send(DUT, "100320\r\n")
+    reply_end = w.t
+    w.pause(0.05).brk().pause(9e-3).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(3.2).brk().pause(9e-3).send(TOOL, "1D0!")
+    assert bus_time(w.events).lower_bound >= reply_end + 3.0 - 1e-9
