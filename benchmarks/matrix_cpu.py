@@ -1,6 +1,6 @@
 """CPU of the fault matrices, side by side for two or more checkouts (issue 22).
 
-Run: ``python benchmarks/matrix_cpu.py [--what sensor|combinations] [--faults N] TREE [TREE ...]``,
+Run: ``python benchmarks/matrix_cpu.py [--what sensor|combinations] [--every K] TREE [TREE ...]``,
 each TREE a folder holding a checkout (``git worktree``, or a read-only unpacked tree: its
 bytecode then goes to a cache folder of its own). Each tree gets one fresh process (bytecode
 caching on, as in CI), and the trees' processes run at the same time, so a machine whose load
@@ -9,7 +9,7 @@ drifts weighs on all alike. Each process makes the rows one after the other in i
 it) and prints one JSON line: rows, how many came out exact (clean), total CPU, and each
 row's CPU.
 
-- ``--what sensor``: every single-sensor fault (or the first ``--faults N``), live and each
+- ``--what sensor``: every single-sensor fault (or every K-th of the sorted list), live and each
   judged through its capture (``roundtrip.row_through_capture``, as
   ``SDI12_MATRIX_CAPTURE=all`` and ``sdi12-conform matrix --through-capture`` do);
 - ``--what combinations``: CI's combinations (``combinations.CI_COMBINATIONS``: 27 pairs,
@@ -31,19 +31,19 @@ from pathlib import Path
 
 ONE_TREE = r"""
 import json, sys, time
-what, limit = sys.argv[1], int(sys.argv[2])
+what, every = sys.argv[1], int(sys.argv[2])
 cpu = []
 if what == "sensor":
     from conformance.emulator import FAULTS
     from conformance.matrices.roundtrip import row_through_capture
     from conformance.matrices.sensor_matrix import fault_matrix
-    names = sorted(n for n, f in FAULTS.items() if not f.bus)[: limit or None]
+    names = sorted(n for n, f in FAULTS.items() if not f.bus)[::every]
     make, good = row_through_capture, (lambda row: row.exact)
     def run(progress):
         return fault_matrix(names, processes=1, progress=progress, row=make)
 else:
     from conformance.matrices.combinations import CI_COMBINATIONS, combination_matrix
-    combos = list(CI_COMBINATIONS)[: limit or None]
+    combos = list(CI_COMBINATIONS)[::every]
     good = lambda row: row.clean
     def run(progress):
         return combination_matrix(combos, processes=1, progress=progress)
@@ -62,14 +62,14 @@ print(json.dumps({
 """
 
 
-def start(tree: Path, what: str, limit: int, cache: Path) -> subprocess.Popen:
+def start(tree: Path, what: str, every: int, cache: Path) -> subprocess.Popen:
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     env.pop("SDI12_MATRIX_CAPTURE", None)
     env["PYTHONPATH"] = str(tree)
     if not os.access(tree, os.W_OK):  # a read-only tree: its bytecode cached elsewhere
         env["PYTHONPYCACHEPREFIX"] = str(cache / tree.name)
     return subprocess.Popen(
-        [sys.executable, "-c", ONE_TREE, what, str(limit)],
+        [sys.executable, "-c", ONE_TREE, what, str(every)],
         cwd=tree, env=env, stdout=subprocess.PIPE, text=True,
     )  # fmt: skip
 
@@ -78,10 +78,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("trees", nargs="+", type=Path)
     parser.add_argument("--what", choices=("sensor", "combinations"), default="sensor")
-    parser.add_argument("--faults", type=int, default=0, help="only the first N rows")
+    parser.add_argument(
+        "--every", type=int, default=1, help="every K-th row only (a fixed subset: 1 in K)"
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="sdi12-pyc-") as cache:
-        procs = [start(t.resolve(), args.what, args.faults, Path(cache)) for t in args.trees]
+        procs = [start(t.resolve(), args.what, args.every, Path(cache)) for t in args.trees]
         results = [json.loads(p.communicate()[0].strip().splitlines()[-1]) for p in procs]
     for tree, found in zip(args.trees, results, strict=True):
         print(json.dumps({"tree": str(tree), "what": args.what} | found))
