@@ -95,8 +95,12 @@ def in_capture_sample(fault: str) -> bool:
     """Whether the test suite's matrix judges ``fault`` through its capture too: a fixed
     third of the faults, chosen by a hash of the name (the same in every worker process and
     every run; ``SDI12_MATRIX_CAPTURE=all`` takes every fault)."""
-    if os.environ.get("SDI12_MATRIX_CAPTURE") == "all":
-        return True
+    return os.environ.get("SDI12_MATRIX_CAPTURE") == "all" or in_default_sample(fault)
+
+
+def in_default_sample(fault: str) -> bool:
+    """Whether ``fault`` is in the fixed sample :func:`in_capture_sample` takes when not told
+    to take every fault (the test suite spreads the sampled rows over its modules by it)."""
     from ..emulator import FAULTS
 
     spec = FAULTS.get(fault)

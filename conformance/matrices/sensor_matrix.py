@@ -171,6 +171,7 @@ def run_rows(
         if progress is not None:
             progress(len(rows), len(items), made)
 
+    processes = min(processes, len(items))  # a worker for no row costs a whole start-up
     if processes <= 1:
         for item in items:
             keep(make(item))

@@ -8,69 +8,39 @@ the capture): the same verdicts, or a capture deciding what the live run left IN
 (``SDI12_MATRIX_CAPTURE=all`` takes every fault, as ``sdi12-conform matrix`` does; a second
 suite run per fault is what CI's budget cannot hold for all 125).
 
-One test per fault, so a failure names its fault. The runs themselves are made once per
-module, two at a time, for the faults the session selected (``-k some-fault`` runs one).
+One test per fault, so a failure names its fault; the rows are held by
+``test_sensor_matrix_rows_<n>.py`` (:mod:`tests.matrices.sensor_rows`: split so several
+pytest-xdist workers share them), each module making the rows of its selected faults once
+(``-k some-fault`` runs one). This module holds the matrix's other tests.
 """
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import pytest
 
 from conformance.catalog import for_role
 from conformance.conduct import run_once
 from conformance.emulator import FAULTS
-from conformance.matrices.roundtrip import in_capture_sample, row_through_sampled_capture
-from conformance.matrices.sensor_matrix import MatrixRow, fault_matrix
-
-#: A handful of faults (protocol, CRC, timing) the default fast selection
-#: keeps; every other row carries the ``matrix`` marker and runs in the full run (.ci/run).
-FAST_FAULTS = {"response-too-late"}
+from conformance.matrices.roundtrip import in_capture_sample, in_default_sample
+from tests.matrices.sensor_rows import SHARDS, SINGLE, shard_faults
 
 
-def selected_params(request: pytest.FixtureRequest, name: str) -> list[str]:
-    """The values of parameter ``name`` among this module's selected tests."""
-    return sorted(
-        {
-            item.callspec.params[name]
-            for item in request.session.items
-            if item.module is request.module
-            and name in getattr(getattr(item, "callspec", None), "params", {})
-        }
-    )
-
-
-@pytest.fixture(scope="module")
-def rows(request: pytest.FixtureRequest) -> dict[str, MatrixRow]:
-    wanted = selected_params(request, "fault")
-    made = fault_matrix(wanted, processes=2, row=row_through_sampled_capture)
-    return {r.fault: r for r in made}
-
-
-#: Faults whose row the judges do not yet get exact, with what goes wrong: strict, so the row
-#: must be taken out of here the moment the judges are fixed (issue 18, part 5).
-AWAITING_JUDGES: dict[str, str] = {}
-
-
-def _marks(fault: str) -> list[pytest.MarkDecorator]:
-    marks = [] if fault in FAST_FAULTS else [pytest.mark.matrix]
-    if fault in AWAITING_JUDGES:
-        marks.append(pytest.mark.xfail(reason=AWAITING_JUDGES[fault], strict=True))
-    return marks
-
-
-#: a bus fault shows only beside other sensors (tests/e2e/test_live_bus.py proves those)
-SINGLE = sorted(name for name, fault in FAULTS.items() if not fault.bus)
-
-
-@pytest.mark.parametrize("fault", [pytest.param(f, marks=_marks(f)) for f in SINGLE])
-def test_fault_is_caught_by_exactly_its_requirements(fault, rows):
-    row = rows[fault]
-    assert (row.capture is not None) == in_capture_sample(fault)  # judged through its capture
-    assert row.exact, row.explain()
-    # a FAIL makes the run NON-COMPLIANT; a fault of a SHOULD rule only warns
-    assert (row.verdict == "NON-COMPLIANT") == bool(row.failed)
+def test_the_rows_modules_hold_every_fault_once():
+    """Each single-sensor fault has its row in exactly one rows module, one test each."""
+    held = [f for shard in range(1, SHARDS + 1) for f in shard_faults(shard)]
+    assert sorted(held) == SINGLE and len(held) == len(set(held))
+    for weigh in (lambda f: True, in_default_sample):  # all rows, the captured ones
+        sizes = [sum(map(weigh, shard_faults(shard))) for shard in range(1, SHARDS + 1)]
+        assert max(sizes) - min(sizes) <= 1
+    rows_modules = sorted(Path(__file__).parent.glob("test_sensor_matrix_rows_*.py"))
+    assert [m.stem.rsplit("_", 1)[1] for m in rows_modules] == [
+        str(n) for n in range(1, SHARDS + 1)
+    ]
+    for n, module in enumerate(rows_modules, 1):
+        assert f"shard_params({n})" in module.read_text()
 
 
 def test_the_matrix_is_large():
