@@ -28,18 +28,26 @@ def line_events(folder: Path) -> list[dict]:
     return [row for row in rows if not row["text"].startswith("run-options")]
 
 
+def both_ways(port: str, options: dict, tmp_path: Path, monkeypatch) -> tuple[dict, dict]:
+    """The run with the batch feature, then with the tool offering none (it takes the
+    feature as unknown); asserts both put down the same line and the same summary."""
+    batched = run_into(tmp_path / "batched", port, **options)
+    monkeypatch.setattr(proto, "BATCH", "not-offered")
+    plain = run_into(tmp_path / "plain", port, **options)
+    events = line_events(tmp_path / "batched")
+    assert len(events) > 100
+    assert events == line_events(tmp_path / "plain")
+    assert batched["summary"] == plain["summary"]
+    assert batched["summary"]["counts"]["PASS"] >= 3
+    return batched, plain
+
+
 @pytest.mark.slow  # two runs; CI runs it, the inner loop keeps test_batch.py's scripted device
 def test_the_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_path, monkeypatch):
     port = f"exec:{kit_build(SENSOR, (TINY_SDI12,))}"
     options = {"declaration": DECLARATION, "keyword": KEYWORD}
-    batched = run_into(tmp_path / "batched", port, **options)
-    monkeypatch.setattr(proto, "BATCH", "not-offered")  # the tool takes the feature as unknown
-    plain = run_into(tmp_path / "plain", port, **options)
-    events = line_events(tmp_path / "batched")
-    assert len(events) > 300
-    assert events == line_events(tmp_path / "plain")
-    assert batched["summary"] == plain["summary"]
-    assert batched["summary"]["counts"]["PASS"] >= 3
+    batched, plain = both_ways(port, options, tmp_path, monkeypatch)
+    assert len(line_events(tmp_path / "batched")) > 300
     verdicts = {r["id"]: r["verdict"] for r in batched["requirements"]}
     assert verdicts == {r["id"]: r["verdict"] for r in plain["requirements"]}
 
@@ -52,11 +60,4 @@ def test_the_logger_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_pat
     port = f"exec:{kit_build(LOGGER, (TINY_SDI12,))}"
     options = {"declaration": LOGGER_DECLARATION, "role": "recorder"}
     options["keyword"] = "service_request or crc_mismatch or transparent"
-    batched = run_into(tmp_path / "batched", port, **options)
-    monkeypatch.setattr(proto, "BATCH", "not-offered")
-    plain = run_into(tmp_path / "plain", port, **options)
-    events = line_events(tmp_path / "batched")
-    assert len(events) > 100
-    assert events == line_events(tmp_path / "plain")
-    assert batched["summary"] == plain["summary"]
-    assert batched["summary"]["counts"]["PASS"] >= 3
+    both_ways(port, options, tmp_path, monkeypatch)
