@@ -60,10 +60,7 @@ class HarnessDevice:
             now, self._pending = self._pending, None
             if self._unsent is not None:
                 message, self._unsent = self._unsent, None
-                quiet = None if self.quiet is None else proto.quiet_until(self.quiet)
-                if quiet is not None and quiet > proto.us(now):
-                    message = f"{message} {quiet}"
-                self.channel.send(message)
+                self.channel.send(proto.with_quiet(message, self.quiet, now))
             self._plan = plan = self.channel.read_plan(Role.SENSOR, now, self._since)
             # the harness saw ``now`` rounded to the microsecond; when it answers with that
             # very time it means this instant, not half a microsecond before or after it

@@ -103,10 +103,8 @@ def sent(wire: int, start: float, end: float) -> str:
     return f"sent {us(start)} {us(end)} {wire:02x}"
 
 
-def time_is(now: float, quiet: int | None = None) -> str:
-    """``time NOW``, or ``time NOW QUIET`` (batch harnesses: nothing from the tool starts
-    before QUIET us, so the harness may wake itself for any ``wait`` before it)."""
-    return f"time {us(now)}" if quiet is None else f"time {us(now)} {quiet}"
+def time_is(now: float) -> str:
+    return f"time {us(now)}"
 
 
 def quiet_until(limit: float) -> int | None:
@@ -116,6 +114,14 @@ def quiet_until(limit: float) -> int | None:
     if not limit < MAX_TIME_US / 1e6:
         return None
     return int(limit * 1e6)
+
+
+def with_quiet(message: str, limit: float | None, now: float) -> str:
+    """A line event's ``message`` for a batch harness: with its QUIET field when the tool
+    starts nothing before ``limit`` (s) and that is after ``now`` (the harness may wake
+    itself for any ``wait`` before it); unchanged when nothing is promised."""
+    quiet = None if limit is None else quiet_until(limit)
+    return message if quiet is None or quiet <= us(now) else f"{message} {quiet}"
 
 
 def heard_chars(frames: list[tuple[int, float, float]]) -> str:

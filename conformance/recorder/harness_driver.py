@@ -145,8 +145,7 @@ def _quiet(channel: Channel, link: Link, limit: float, message: str) -> str:
     if proto.BATCH not in channel.features or not isinstance(bus, SimBus):
         return message
     nxt = earliest_frame(bus.devices)
-    quiet = proto.quiet_until(limit if nxt is None else min(limit, nxt[1].start))
-    return message if quiet is None or quiet <= proto.us(link.now()) else f"{message} {quiet}"
+    return proto.with_quiet(message, limit if nxt is None else min(limit, nxt[1].start), link.now())
 
 
 def _transmit(link: Link, plan: Plan) -> Event:
