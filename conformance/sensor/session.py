@@ -323,7 +323,7 @@ class SensorSession(Session):
         """A cached measurement as it is made, with what must follow it at once: after
         ``aHB!`` the reads past its packets (:meth:`packets_past_data`)."""
         m = self.fresh_measurement(code)
-        if code == "HB" and self.link.info.binary and _shows_support(m):
+        if code == "HB" and self.link.info.binary and shows_support(m):
             self._cache[("past-data", code)] = self._read_past_data(m)
         return m
 
@@ -699,7 +699,7 @@ class SensorSession(Session):
         return bool(self.measurement(code).count)
 
 
-def _shows_support(m: Measurement) -> bool:
+def shows_support(m: Measurement) -> bool:
     """Whether a high-volume measurement counts as supported: values announced, or a reply
     too malformed to read a count from (judged as support); a well-formed "no values" is not."""
     return bool(m.count) or (m.start.answered and m.count is None)

@@ -11,6 +11,7 @@ from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
 from conformance.protocol.binary import parse_binary_packet
 from conformance.protocol.responses import split_line
+from conformance.sensor.session import shows_support
 from conformance.verdicts import failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
@@ -24,7 +25,7 @@ def _unsupported(case, sensor, code):
     """N/A only for a well-formed 'no values' reply; a malformed reply is judged as support.
     A sensor declared to support the command must not answer 'no values'."""
     m = sensor.measurement(code)
-    if m.count or (m.start.answered and m.count is None):
+    if shows_support(m):
         case.requires("supported", None)
         return False
     if sensor.feature(FEATURE[code]) and FORMAT_RULE[code] in case.requirements:
