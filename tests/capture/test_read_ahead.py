@@ -74,4 +74,5 @@ def test_thread_ends_when_the_caller_stops() -> None:
     ahead.close()
     never_read = read_ahead(endless())
     del never_read  # dropped before its first chunk
-    assert _settle(before) == before
+    # at most as many as before: a thread an earlier test in this worker left may end meanwhile
+    assert _settle(before) <= before
