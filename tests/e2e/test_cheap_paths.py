@@ -338,3 +338,25 @@ def test_a_sensor_run_on_the_simulated_bus_loads_only_what_it_needs(tmp_path) ->
         if m == unwanted or m.startswith(unwanted + ".")
     )  # fmt: skip
     assert not found, f"a sensor run on the sim bus imported {found}"
+
+
+def test_the_run_needs_no_assertion_rewriting() -> None:
+    """The judged run turns pytest's assertion rewriting off (``--assert=plain``, a run
+    that cannot cache it spent ~0.1 s rewriting): right only while no conformance case and
+    not the plugin uses a bare ``assert``, whose failure message rewriting would have
+    explained (a case records findings through ``case``)."""
+    import ast
+    from pathlib import Path
+
+    from conformance import plugin
+    from conformance.suite import SUITE_ROOT, suite_args
+
+    assert "--assert=plain" in suite_args("testcases.sensor", "out")
+    sources = [*sorted((SUITE_ROOT / "testcases").rglob("*.py")), Path(plugin.__file__)]
+    asserting = [
+        f"{path}:{node.lineno}"
+        for path in sources
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Assert)
+    ]
+    assert len(sources) > 10 and not asserting, asserting
