@@ -23,7 +23,7 @@ from .options import UsageError, add_pytest_options, check_values
 from .ports import PortError
 from .preflight import check_report_dir, check_role_options
 from .profiles import PROFILES
-from .recorder.drivers import RecorderSetupError
+from .recorder.errors import RecorderSetupError  # not .drivers: a sensor run loads no driver
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .replay.sensor import RecordingEnded
 from .reports import html, writers

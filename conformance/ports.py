@@ -29,7 +29,6 @@ from .protocol.commands import ADDRESS_CHARS
 from .protocol.version import V14, format_version, parse_version
 from .replay import recording_link
 from .replay.link import is_replay
-from .suggest import did_you_mean
 
 __all__ = ["OpenedPort", "PortError", "SimSpec", "is_sim", "open_port", "open_sim", "parse_sim"]
 
@@ -118,6 +117,8 @@ def sim_profile(spec: SimSpec) -> Profile:
     (:class:`PortError` with the reason): the one check ``sim`` and ``emulate`` share."""
     unknown_profiles = [p for p in spec.profiles if p not in PROFILES]
     if unknown_profiles:
+        from .suggest import did_you_mean  # difflib: only for a mistyped name
+
         raise PortError(
             f"unknown profile(s) {', '.join(unknown_profiles)}"
             f"{did_you_mean(unknown_profiles, PROFILES)}; "
@@ -125,6 +126,8 @@ def sim_profile(spec: SimSpec) -> Profile:
         )
     unknown = [f for f in spec.faults if f not in FAULTS]
     if unknown:
+        from .suggest import did_you_mean
+
         raise PortError(
             f"unknown fault(s) {', '.join(unknown)}{did_you_mean(unknown, FAULTS)}; "
             "`sdi12-conform faults` lists the known ones"

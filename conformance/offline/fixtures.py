@@ -9,13 +9,17 @@ role ``sensor``, and likewise for the recorder. The recording is loaded once per
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import pytest
 
 from ..exits import EXIT_USAGE
 from ..links.errors import PortError
 from ..replay.recording_link import RecordingLink, is_recording, load_recording, parse_recording
 from ..run import ConformanceRun
-from .heard import HeardRecorder, HeardSensors, hear_recorder, hear_sensors
+
+if TYPE_CHECKING:  # imported by a passive run only: the plugin loads this module for every run
+    from .heard import HeardRecorder, HeardSensors
 
 _LOADED: dict[str, RecordingLink] = {}
 
@@ -33,6 +37,8 @@ def _heard(run: ConformanceRun, role: str):
     if not is_recording(run.options.port):
         pytest.skip("a passive case judges a recording: --sdi12-port recording:PATH")
     if run.session is None:
+        from .heard import hear_recorder, hear_sensors
+
         try:
             link = recording_of(run.options.port)
         except PortError as exc:

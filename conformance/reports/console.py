@@ -11,13 +11,14 @@ a one-line reason, and where the report is.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.table import Table
 from rich.text import Text
+
+if TYPE_CHECKING:  # the bar and the tables are a terminal's: a log or a pipe loads neither
+    from rich.progress import Progress
 
 from ..judges.timing import counted
 from ..stash import CASE
@@ -84,6 +85,14 @@ class ProgressPlugin:
     def pytest_configure(self, config: pytest.Config) -> None:
         if not self.console.is_terminal or self.progress is not None:
             return
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+        )
+
         self.progress = Progress(
             TextColumn("[bold]judging"),
             BarColumn(),
@@ -344,6 +353,8 @@ def _paths(say: Any, report_dir: str) -> None:
 
 
 def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
+    from rich.table import Table
+
     summary = data["summary"]
     verdict = summary["verdict"]
     console.print()

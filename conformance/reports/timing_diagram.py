@@ -521,9 +521,17 @@ class MeasureIndex:
     def __init__(self, cut: Sequence[Segment] = (), *, measures: Iterable[list[float]] = ()):
         """``measures``: each segment's intervals, given instead of ``cut`` (for tests)."""
         per_segment = [_measures(seg) for seg in cut] if cut else list(measures)
-        pairs = sorted((m, i) for i, ms in enumerate(per_segment) for m in ms)
-        self.values = [m for m, _ in pairs]
-        self.owners = [i for _, i in pairs]
+        values = [m for ms in per_segment for m in ms]
+        owners = [i for i, ms in enumerate(per_segment) for _ in ms]
+        if any(m != m for m in values):  # a NaN: ordered as the (value, segment) pairs were
+            pairs = sorted(zip(values, owners, strict=True))
+            self.values, self.owners = [m for m, _ in pairs], [i for _, i in pairs]
+            return
+        # a stable sort by value keeps equal values in segment order, as sorting (value,
+        # segment) pairs did, without a tuple per interval (10^4 of them in a simulated run)
+        order = sorted(range(len(values)), key=values.__getitem__)
+        self.values = [values[k] for k in order]
+        self.owners = [owners[k] for k in order]
 
     def nearest(self, target: float) -> int | None:
         """The first segment (in recording order) holding an interval nearest ``target``:

@@ -269,3 +269,94 @@ def test_a_run_paces_the_collector_and_leaves_it_as_found(tmp_path) -> None:
     assert seen and set(seen) == {gc_pace.RUN_THRESHOLDS}
     assert gc.get_threshold() == before
     assert gc.get_freeze_count() == 0
+
+
+#: What a sensor run on the simulated bus needs none of (issue 22: the start-up cost of a
+#: run): the recorder role, the emulator servers, the passive and capture code, the rack and
+#: the subcommands, pyserial's siblings that only real benches use, and off a terminal the
+#: live bar and the summary's tables; and hypothesis, which only the exploration case loads
+#: (the ``-k`` run below selects another). Each entry is a package or a module.
+NOT_ON_A_SENSOR_RUN = (
+    "hypothesis",
+    "conformance.sensor.exploration_machine",
+    "conformance.recorder.scenario_runner",
+    "conformance.recorder.openers",
+    "conformance.recorder.drivers",
+    "conformance.recorder.job_time",
+    "conformance.emulator_server",
+    "conformance.offline.heard",
+    "conformance.offline.judge",
+    "conformance.capture.sigrok",
+    "conformance.capture.decode",
+    "conformance.rack.pool",
+    "conformance.monitor",
+    "conformance.matrices",
+    "conformance.commands",
+    "conformance.kit",
+    "conformance.calibrate",
+    "conformance.suggest",
+    "execnet",
+    "numpy",
+    "asyncio",
+    "unittest.mock",
+    "rich.progress",
+    "rich.table",
+    "rich.live",
+)
+
+#: the CLI as ``sdi12-conform`` runs it (the whole process: ``main()`` with no argv), with
+#: the module table written out when the process ends (its exit runs the atexit handlers)
+MODULES_AT_EXIT = """
+import atexit, json, sys
+out = sys.argv.pop(1)
+atexit.register(lambda: open(out, "w").write(json.dumps(sorted(sys.modules))))
+from conformance.cli import main
+main()
+"""
+
+
+def test_a_sensor_run_on_the_simulated_bus_loads_only_what_it_needs(tmp_path) -> None:
+    """The whole ``sdi12-conform --port sim`` process, off a terminal, imports none of
+    :data:`NOT_ON_A_SENSOR_RUN`: a module-level import that pulls one back in (and its
+    start-up cost into every run, every matrix row and every CI job) fails here. It runs in
+    a folder of its own, as a user's does: in a checkout, pytest would also load the tool's
+    own ``tests/conftest.py`` (pytest reads ``test*/conftest.py`` under where it starts)."""
+    import subprocess
+    import sys
+
+    listed = tmp_path / "modules.json"
+    done = subprocess.run(
+        [sys.executable, "-c", MODULES_AT_EXIT, str(listed), "--port", "sim",
+         "-k", "test_query_address", "--report-dir", str(tmp_path / "run"), "--plan", "never"],
+        capture_output=True, text=True, timeout=120, cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr
+    loaded = set(json.loads(listed.read_text()))
+    assert "conformance.sensor.session" in loaded  # the run did run
+    found = sorted(
+        m for m in loaded for unwanted in NOT_ON_A_SENSOR_RUN
+        if m == unwanted or m.startswith(unwanted + ".")
+    )  # fmt: skip
+    assert not found, f"a sensor run on the sim bus imported {found}"
+
+
+def test_the_run_needs_no_assertion_rewriting() -> None:
+    """The judged run turns pytest's assertion rewriting off (``--assert=plain``, a run
+    that cannot cache it spent ~0.1 s rewriting): right only while no conformance case and
+    not the plugin uses a bare ``assert``, whose failure message rewriting would have
+    explained (a case records findings through ``case``)."""
+    import ast
+    from pathlib import Path
+
+    from conformance import plugin
+    from conformance.suite import SUITE_ROOT, suite_args
+
+    assert "--assert=plain" in suite_args("testcases.sensor", "out")
+    sources = [*sorted((SUITE_ROOT / "testcases").rglob("*.py")), Path(plugin.__file__)]
+    asserting = [
+        f"{path}:{node.lineno}"
+        for path in sources
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Assert)
+    ]
+    assert len(sources) > 10 and not asserting, asserting

@@ -1,0 +1,219 @@
+"""The exploration's hypothesis state machine: the rules that draw the stimuli and the steps
+that send them and check the invariants (:mod:`.exploration` holds what a run keeps, and
+:func:`~.exploration.explore` loads this module, hypothesis with it, only when it runs)."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from hypothesis import HealthCheck, Phase, seed, settings
+from hypothesis import strategies as st
+from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
+
+from ..judges.exploration import Observation, judge
+from ..protocol.commands import ADDRESS_CHARS
+from ..protocol.responses import split_line
+from ..tool_recorder.records import Exchange
+from ..transcript import escape
+from .address_change import AddressChanger
+from .exploration_record import (
+    FOREIGN_FORMS,
+    MAX_WAIT_OUT,
+    OWN,
+    SEED,
+    Exploration,
+    InvariantBroken,
+    harmless,
+    moved_by_malformed,
+)
+from .session import SensorSession
+
+
+def junk_strategy() -> st.SearchStrategy[str]:
+    """The malformed commands' strategy (:data:`.exploration.JUNK`)."""
+    return st.text(
+        alphabet=st.sampled_from("MDCRIVXAB0123456789+-._#"), min_size=1, max_size=6
+    ).filter(harmless)
+
+
+class _Explorer(RuleBasedStateMachine):
+    """The stimuli and records behind the rules of :func:`machine_class`'s class (the rules
+    themselves are made per run: their strategies depend on the sensor's address and on the
+    module's JUNK at the time of the run, handed in as ``junk``)."""
+
+    sensor: ClassVar[SensorSession]
+    record: ClassVar[Exploration]
+    marking: ClassVar[float | None]  # the marking foreign commands go out with
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.address = self.sensor.address
+        self.trail: list[str] = []
+        self.last_d0: str | None = None  # D0 reply since the last measurement command
+        self.sensor.master.send_break()
+
+    def _observe(self, observation: Observation) -> None:
+        """Record one checked step and end the example if the judges find it broke an
+        invariant. The failing sequence is kept at the first breach: hypothesis replays a
+        failing example to confirm it, and a real device, whose state moved on, may then
+        behave otherwise (hypothesis calls that flaky); the first observation stands."""
+        self.record.observations.append(observation)
+        breach = judge(observation).breach
+        if breach is None:
+            return
+        if not self.record.breached:
+            self.record.breached = True
+            self.record.failing_sequence = list(self.trail)
+        raise InvariantBroken(breach.requirement, breach.message)
+
+    def _wait_out(self, ex: Exchange) -> None:
+        """A concurrent measurement runs on after its reply: wait its announced time, so
+        anything it sends then (a faulty service request) lands in a pause of its own and
+        is judged by the concurrent cases, not taken for the reply to the next step."""
+        body, _ = split_line(ex.reply_text)
+        ttt = body[1:4]
+        if ttt.isdigit() and int(ttt) > 0:
+            heard = self.sensor.listen(min(int(ttt), MAX_WAIT_OUT) + 0.05)
+            self._note(f"wait {ttt} s" + (" (heard something)" if heard else ""))
+
+    def _note(self, text: str) -> None:
+        self.trail.append(text)
+        self.record.steps += 1
+
+    def _send(self, code: str) -> Exchange:
+        ex = self.sensor.master.transact(f"{self.address}{code}!")
+        self.record.exchanges.append(ex)
+        self._note(f"{escape(ex.text)} -> '{escape(ex.reply_text)}'")
+        return ex
+
+    def _own(self, code: str) -> None:
+        """A command to the sensor's own address; its reply's framing, CRC and D0 repeat
+        are observed (only an answered one: silence is judged by the other cases)."""
+        ex = self._send(code)
+        if code[:1] in ("M", "C", "V", "H"):
+            self.last_d0 = None  # a new measurement may change the data
+        if not ex.answered:
+            return
+        if code in ("C", "CC"):
+            self._wait_out(ex)
+        self._observe_framing(ex)
+        if code.startswith("D"):
+            self._observe(Observation("crc", ex.text, ex.reply_text))
+        if code == "D0":
+            previous = self.last_d0
+            self._observe(Observation("repeat", ex.text, ex.reply_text, previous=previous))
+            self.last_d0 = ex.reply_text
+
+    def _foreign(self, other: str, code: str) -> None:
+        """A command to another address, sent the way the sensor was shown to hear."""
+        ex = self.sensor.master.raw(f"{other}{code}!", break_first=True, marking=self.marking)
+        self.record.exchanges.append(ex)
+        self._note(f"{escape(ex.text)} (foreign) -> '{escape(ex.reply_text)}'")
+        marked = self.marking is not None
+        self._observe(
+            Observation(
+                "foreign", ex.text, ex.reply_text, other, answered=ex.answered, marked=marked
+            )
+        )
+
+    def _malformed(self, junk: str) -> None:
+        """A malformed command: silence or any well-framed reply is fine (decision A12)."""
+        ex = self.sensor.master.raw(f"{self.address}{junk}!", break_first=None)
+        self.record.exchanges.append(ex)
+        self._note(f"{escape(ex.text)} (malformed?) -> '{escape(ex.reply_text)}'")
+        if ex.answered:
+            moved = moved_by_malformed(junk, ex.reply_text, self.address)
+            if moved is not None:
+                self._follow_address_change(moved)
+                return
+            self._observe_framing(ex)
+            # junk can spell a real command ("M", or "-7!0MC" ending in one): whatever
+            # the sensor accepted may have started a measurement
+            self.last_d0 = None
+
+    def _follow_address_change(self, moved: str) -> None:
+        """The sensor read the malformed command as ``aAb!`` and now answers at
+        ``moved``: informative under decision A12, not a reply from the wrong address;
+        put it back, so every later step talks to the address it has."""
+        changer = AddressChanger(self.sensor.master, self.address)
+        changer.current = moved
+        changer.tried.append(moved)
+        note = changer.restore()
+        self.record.exchanges += changer.exchanges
+        self.sensor.address_notes.append(note)
+        self._note(f"taken as a change to address '{moved}' (decision A12); {note}")
+
+    def _observe_framing(self, ex: Exchange) -> None:
+        self._observe(Observation("framing", ex.text, ex.reply_text, self.address))
+
+    def teardown(self) -> None:
+        self.record.log.append(" ; ".join(self.trail))
+        if not self.record.breached:  # after a break, the sequence that broke it stays
+            self.record.failing_sequence = list(self.trail)
+
+
+def machine_class(
+    sensor: SensorSession,
+    record: Exploration,
+    marking: float | None,
+    junk: st.SearchStrategy[str],
+) -> type[RuleBasedStateMachine]:
+    """The state machine class for one run. Hypothesis orders rules by name and draws by
+    strategy, so the names and strategies here are the exploration's stimuli: keep them."""
+    foreign = [a for a in "9zy" if a != sensor.address]
+    if sensor.shared:  # never an address another sensor of the line answers at
+        spare = "9zyxwv" + ADDRESS_CHARS[::-1]
+        foreign = [
+            a for a in dict.fromkeys(spare) if a != sensor.address and a not in sensor.others
+        ]
+        foreign = foreign[:3]
+
+    class SensorMachine(_Explorer):
+        @rule(code=st.sampled_from(OWN))
+        def own_command(self, code: str) -> None:
+            self._own(code)
+
+        @rule(index=st.sampled_from(("0", "0", "1")))
+        def read_data(self, index: str) -> None:
+            """D replies, the place where the CRC and buffer invariants bite."""
+            self._own(f"D{index}")
+
+        @rule(other=st.sampled_from(foreign), code=st.sampled_from(FOREIGN_FORMS))
+        def foreign_command(self, other: str, code: str) -> None:
+            self._foreign(other, code)
+
+        @rule(junk=junk)
+        def malformed_command(self, junk: str) -> None:
+            self._malformed(junk)
+
+        @rule()
+        def brk(self) -> None:
+            self.sensor.master.send_break()
+            self._note("break")
+
+        @rule(seconds=st.sampled_from((0.01, 0.05, 0.12, 0.25)))
+        def pause(self, seconds: float) -> None:
+            self.sensor.listen(seconds)
+            self._note(f"pause {seconds * 1e3:.0f} ms")
+
+    SensorMachine.sensor = sensor
+    SensorMachine.record = record
+    SensorMachine.marking = marking
+    return seed(SEED)(SensorMachine)
+
+
+def run_machine(machine: type[RuleBasedStateMachine], examples: int, steps: int) -> None:
+    run_state_machine_as_test(
+        machine,
+        settings=settings(
+            max_examples=examples,
+            stateful_step_count=steps,
+            derandomize=True,
+            database=None,
+            deadline=None,
+            phases=[Phase.generate],
+            report_multiple_bugs=False,
+            suppress_health_check=list(HealthCheck),
+            print_blob=False,
+        ),
+    )
