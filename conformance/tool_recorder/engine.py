@@ -532,7 +532,7 @@ class ToolRecorder:
             # rule only starts once that read has received something.
             more = self.link.receive(
                 min(deadline, chars[-1].end + framing.window(chars)),
-                until=lambda m, have=chars: framing.stop(have + m),
+                until=lambda m, have=chars: framing.stop_after(have, m),
                 idle=framing.idle,
             )
             if not more:

@@ -269,3 +269,68 @@ def test_a_run_paces_the_collector_and_leaves_it_as_found(tmp_path) -> None:
     assert seen and set(seen) == {gc_pace.RUN_THRESHOLDS}
     assert gc.get_threshold() == before
     assert gc.get_freeze_count() == 0
+
+
+def test_stop_after_a_read_is_stop_of_the_reply_so_far() -> None:
+    """Framing.stop_after(have, more), asked after every character without making
+    ``have + more``, against Framing.stop of that list, for every kind of framing."""
+    from conformance.tool_recorder.reply_end import Framing
+
+    rng = random.Random(21)
+    framings = [Framing(idle=0.01, max_chars=n) for n in (1, 3, 80)] + [
+        Framing(idle=0.01, max_chars=80, binary=True),
+        Framing(idle=0.01, max_chars=80, multiline=True, max_text_chars=200),
+    ]
+    codes = [0x0D, 0x8D, 0x0A, 0x8A, 0x02, 0x03, 0x31, 0xB1]
+    for _ in range(2000):
+        chars = [
+            Event(rng.choice([EventKind.CHAR] * 6 + [EventKind.BREAK]), DUT, 0.0, 1.0,
+                  wire=rng.choice(codes))
+            for _ in range(rng.randrange(1, 8))
+        ]  # fmt: skip
+        cut = rng.randrange(len(chars))  # ``more`` holds at least one character
+        for f in framings:
+            assert f.stop_after(chars[:cut], chars[cut:]) == f.stop(chars)
+
+
+def test_a_command_parsed_again_is_what_a_first_parse_gives() -> None:
+    """parse_command's memo: every text, valid or not, wildcard or not, str or bytes, gives
+    what the grammar gives it (the same command, or an error with the same reason), the first
+    time and every time after, also once the memo was cleared for growing."""
+    from conformance.protocol import commands
+    from conformance.protocol.commands import CommandError, _parse_text, parse_command
+
+    rng = random.Random(5)
+    texts = ["0!", "?!", "0I!", "0M!", "0MC3!", "0D0!", "0DB12!", "0D01!", "0IM1_002!", "0XYZ!",
+             "0A1!", "0AA1!", "0", "", "0\x01!", "0!!", "?M!", "!", "0R9!", "0RC3!", "0IR0!",
+             "0HB!", "0I_001!", "0IM_01!", "0XWT!", "$M!"]  # fmt: skip
+    texts += ["".join(rng.choice("0?!MDCIRVHAB_1239x") for _ in range(rng.randrange(7)))
+              for _ in range(400)]  # fmt: skip
+
+    def fresh(text: str, wildcard: bool) -> tuple[str, object]:
+        try:
+            return "ok", _parse_text(text, wildcard)
+        except CommandError as exc:
+            return "error", (exc.text, exc.reason, str(exc))
+
+    def memo(text: str | bytes, wildcard: bool) -> tuple[str, object]:
+        try:
+            return "ok", parse_command(text, allow_wildcard=wildcard)
+        except CommandError as exc:
+            return "error", (exc.text, exc.reason, str(exc))
+
+    commands._PARSED.clear()
+    for _round in range(3):
+        for text in texts:
+            for wildcard in (False, True):
+                expected = fresh(text, wildcard)
+                assert memo(text, wildcard) == expected
+                assert memo(text.encode("ascii"), wildcard) == expected
+        commands._PARSED_MAX, saved = 7, commands._PARSED_MAX
+        commands._PARSED.clear()
+        try:
+            for text in texts:
+                assert memo(text, False) == fresh(text, False)
+                assert len(commands._PARSED) <= 7
+        finally:
+            commands._PARSED_MAX = saved
