@@ -70,6 +70,9 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
     that splits the window also looks for any tool event and DUT character whose spans meet
     at all (with no slack: every overlap counted below is one of those), and without one
     there is nothing to group."""
+    events = events if isinstance(events, list) else list(events)
+    if _apart_in_order(events):
+        return []
     wire = sorted([e for e in events if e.kind is not EventKind.NOTE], key=_START)
     tool: list[Event] = []
     dut: list[Event] = []
@@ -105,6 +108,34 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
         if met:
             found.append(Collision(tuple(group), tuple(met)))
     return found
+
+
+def _apart_in_order(events: list[Event]) -> bool:
+    """True when the wire events are already in start order (as a sim bus or a link's
+    reader appends them) and no tool event meets a DUT character: the pass of
+    :func:`collisions` before its grouping, without the copy and sort it needs for events
+    out of order. False: not known (the full pass decides)."""
+    tool_end = dut_end = last = float("-inf")
+    note, char = EventKind.NOTE, EventKind.CHAR
+    for e in events:
+        kind = e.kind
+        if kind is note:
+            continue
+        start = e.start
+        if start < last:
+            return False
+        last = start
+        if e.origin == TOOL:
+            if start < dut_end:
+                return False
+            if e.end > tool_end:
+                tool_end = e.end
+        elif kind is char:
+            if start < tool_end:
+                return False
+            if e.end > dut_end:
+                dut_end = e.end
+    return True
 
 
 def collision_notes(events: Iterable[Event]) -> list[Event]:
