@@ -20,7 +20,7 @@ from typing import Protocol, runtime_checkable
 
 from ..links.base import Link, LinkInfo, StopCondition
 from ..protocol.timing import CHAR_TIME
-from ..transcript import DUT, TOOL, Event, EventKind, Transcript
+from ..transcript import DUT, TOOL, Event, EventKind, Transcript, wire_event
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,7 +140,7 @@ class SimBus:
         start = max(frame.start, self.clock.now)
         end = start + frame.duration
         origin = DUT if len(self.devices) == 1 else device.name
-        event = self.transcript.add(Event(EventKind.CHAR, origin, start, end, wire=frame.wire))
+        event = self.transcript.add(wire_event(EventKind.CHAR, origin, start, end, frame.wire))
         for other in self.devices:
             if other is not device:
                 other.on_char(frame.wire, start, end)
@@ -164,7 +164,7 @@ class SimBus:
         self.advance(start)
         start = self.clock.now
         end = start + duration
-        event = self.transcript.add(Event(EventKind.CHAR, TOOL, start, end, wire=wire))
+        event = self.transcript.add(wire_event(EventKind.CHAR, TOOL, start, end, wire))
         for device in self.devices:
             device.on_char(wire, start, end)
         self.clock.advance_to(end)
@@ -250,7 +250,7 @@ class SimLink(Link):
                 now = clock.now
                 start = max(start, now)
                 end = start + duration
-                event = Event(char, DUT, start, end, wire=wire)
+                event = wire_event(char, DUT, start, end, wire)
                 add(event)
                 taken += 1
                 if end > now:

@@ -163,3 +163,26 @@ def test_reads_with_idle_windows_and_stops_end_where_they_ended(monkeypatch) -> 
     deadlines inside a reply: each read returns the same characters and leaves the clock
     where frame by frame left it."""
     assert _reads(True, monkeypatch) == _reads(False, monkeypatch)
+
+
+def test_a_wire_event_is_the_event_its_constructor_makes() -> None:
+    """transcript.wire_event, the sim bus's fast way to make a character, sets every field
+    as ``Event(kind, origin, start, end, wire=wire)`` does, defaults included: a field added
+    to Event without it here fails this test."""
+    import dataclasses
+    import random
+
+    from conformance.transcript import TOOL, Event, EventKind, wire_event
+
+    fields = dataclasses.fields(Event)
+    assert [f.name for f in fields] == list(Event.__slots__)
+    rng = random.Random(4)
+    for _ in range(500):
+        args = (rng.choice(list(EventKind)), rng.choice([TOOL, "dut", "sensor-1"]),
+                rng.random(), rng.random() + 1.0, rng.randrange(256))  # fmt: skip
+        fast, made = wire_event(*args), Event(*args[:4], wire=args[4])
+        assert fast == made and hash(fast) == hash(made) and repr(fast) == repr(made)
+        for f in fields:
+            assert type(getattr(fast, f.name)) is type(getattr(made, f.name))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.start = 0.0  # type: ignore[misc]
