@@ -138,6 +138,67 @@ def _apart_in_order(events: list[Event]) -> bool:
     return True
 
 
+class ApartSoFar:
+    """:func:`_apart_in_order` kept up as a transcript grows, read on from where the last look
+    stopped: the engine asks before every transmission about the last 64 events and what
+    came since, nearly always to find them apart. What it has read covers a window from
+    ``base`` on; a window that starts there or later is a suffix of it, and a suffix of
+    events in order, apart, is in order and apart (each side's latest end before an event
+    can only be smaller in it). Where it cannot tell (a meeting read, a transcript not only
+    appended to) it starts again at the window asked about."""
+
+    def __init__(self) -> None:
+        self._restart(0)
+        self._last: Event | None = None  # the event at ``seen - 1`` when last looked
+
+    def _restart(self, base: int) -> None:
+        self.ok = True
+        self.base = self.seen = base
+        self.tool_end = self.dut_end = self.last = float("-inf")
+
+    def holds(self, events: list[Event], first: int) -> bool:
+        """True when ``events[first:]`` are surely what :func:`_apart_in_order` says apart
+        (so :func:`collisions` finds nothing in them); False: not known."""
+        n = len(events)
+        seen = self.seen
+        if (
+            not self.ok
+            or first < self.base
+            or n < seen
+            or (seen > self.base and events[seen - 1] is not self._last)
+        ):
+            self._restart(first)
+            seen = first
+        tool_end, dut_end, last = self.tool_end, self.dut_end, self.last
+        note, char = EventKind.NOTE, EventKind.CHAR
+        for k in range(seen, n):
+            e = events[k]
+            kind = e.kind
+            if kind is note:
+                continue
+            start = e.start
+            if start < last:
+                self.ok = False
+                return False
+            last = start
+            if e.origin == TOOL:
+                if start < dut_end:
+                    self.ok = False
+                    return False
+                if e.end > tool_end:
+                    tool_end = e.end
+            elif kind is char:
+                if start < tool_end:
+                    self.ok = False
+                    return False
+                if e.end > dut_end:
+                    dut_end = e.end
+        self.tool_end, self.dut_end, self.last = tool_end, dut_end, last
+        self.seen = n
+        self._last = events[n - 1] if n else None
+        return True
+
+
 def collision_notes(events: Iterable[Event]) -> list[Event]:
     """The collision NOTEs of a transcript (old transcripts simply have none)."""
     return [e for e in events if e.kind is EventKind.NOTE and e.text.startswith(COLLISION_PREFIX)]

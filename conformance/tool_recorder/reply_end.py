@@ -72,12 +72,16 @@ class Framing:
         if len(have) + len(more) >= self.max_chars:
             return True
         before = more[-2] if len(more) > 1 else have[-1] if have else None
-        return before is not None and ends_line([before, more[-1]])
+        # ends_line of the two, spelt out: asked per character
+        return before is not None and before.wire & 0x7F == _CR and more[-1].wire & 0x7F == _LF
 
     def deadline(self, first: Event) -> float:
         """Hard bound for a DUT that trickles characters just inside each window."""
         per_char = first.duration + max(self.idle, self.line_wait if self.multiline else 0.0)
         return first.start + max(self.max_chars, self.max_text_chars) * per_char
+
+
+_CR, _LF = ord("\r"), ord("\n")
 
 
 def _head(chars: list[Event]) -> bytes:

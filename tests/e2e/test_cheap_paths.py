@@ -357,3 +357,31 @@ def test_events_in_order_and_apart_are_what_the_sorted_pass_finds_apart() -> Non
             assert collisions(list(reversed(window))) == []  # the full pass agrees
         assert (collisions(window) == []) >= apart
     assert shortcut > 300  # the shortcut was taken, so the comparison compared something
+
+
+def test_apart_so_far_says_apart_only_where_the_window_is_apart() -> None:
+    """contention.ApartSoFar, read on as a transcript grows (events appended in bursts, in
+    order or not, the window's start moving on, the list replaced now and then), says
+    'apart' only where _apart_in_order of the window asked about does; and it says so
+    often for a transcript that is in order."""
+    from conformance.tool_recorder.contention import ApartSoFar, _apart_in_order
+
+    rng = random.Random(31)
+    held = 0
+    for trial in range(300):
+        apart, events, t, scanned = ApartSoFar(), [], 0.0, 0
+        ordered = trial % 3 != 0
+        for _step in range(40):
+            for _ in range(rng.randrange(6)):
+                t += rng.choice([0.009, 0.02, 0.1, 0.0] + ([] if ordered else [-0.005]))
+                kind = rng.choice([EventKind.CHAR] * 5 + [EventKind.NOTE])
+                origin = TOOL if rng.random() < 0.5 else DUT
+                events.append(Event(kind, origin, t, t + 8.33e-3 * rng.random()))
+            if rng.random() < 0.03:
+                events = list(events)  # a new list: its identity says nothing
+            first = max(0, scanned - rng.choice([0, 3, 64]))
+            if apart.holds(events, first):
+                held += 1
+                assert _apart_in_order(events[first:])
+            scanned = len(events)
+    assert held > 3000
