@@ -240,7 +240,7 @@ class SimLink(Link):
         all sent; and the limit of the read as the last character left it."""
         device, frames = run
         clock = self.bus.clock
-        add = self.bus.transcript.events.append
+        add = self.bus.transcript.add  # (what it returns is the event: a test may restamp it)
         char = EventKind.CHAR
         taken = 0
         try:
@@ -250,8 +250,7 @@ class SimLink(Link):
                 now = clock.now
                 start = max(start, now)
                 end = start + duration
-                event = wire_event(char, DUT, start, end, wire)
-                add(event)
+                event = add(wire_event(char, DUT, start, end, wire))
                 taken += 1
                 if end > now:
                     clock.now = end
@@ -259,7 +258,7 @@ class SimLink(Link):
                 if until is not None and until(got):
                     return True, limit
                 if idle is not None:
-                    limit = min(deadline, end + idle)
+                    limit = min(deadline, event.end + idle)
             return None, limit
         finally:
             if taken:

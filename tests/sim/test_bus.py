@@ -5,6 +5,8 @@ check runs both ways and the transcripts are compared."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from conformance.emulator import FAULTS, default_profile
@@ -145,10 +147,21 @@ READS = [  # (how far the deadline lies, stop after how many characters, idle)
 ]  # fmt: skip
 
 
-def _reads(planned: bool, monkeypatch: pytest.MonkeyPatch) -> list:
+def _reads(planned: bool, monkeypatch: pytest.MonkeyPatch, restamp: bool = False) -> list:
     if not planned:
         _frame_by_frame(monkeypatch)
     link = SimLink(SimBus([_Talker()]))
+    if restamp:  # as tests/judges/test_confirmation.py models a stalling host: some late
+        add, heard = link.transcript.add, [0]
+
+        def stamped(event):  # noqa: ANN001, ANN202 - as Transcript.add
+            if event.origin == "dut":
+                heard[0] += 1
+                if heard[0] % 3 == 0:
+                    event = replace(event, start=event.start + 0.03, end=event.end + 0.03)
+            return add(event)
+
+        link.transcript.add = stamped  # type: ignore[method-assign]
     found = []
     for ahead, count, idle in READS:
         until = None if count is None else (lambda got, n=count: len(got) >= n)
@@ -163,6 +176,16 @@ def test_reads_with_idle_windows_and_stops_end_where_they_ended(monkeypatch) -> 
     deadlines inside a reply: each read returns the same characters and leaves the clock
     where frame by frame left it."""
     assert _reads(True, monkeypatch) == _reads(False, monkeypatch)
+
+
+def test_a_transcript_that_restamps_what_it_is_given_is_read_as_it_restamped(
+    monkeypatch,
+) -> None:
+    """A read returns (and times its idle window from) the event the transcript's ``add``
+    returned, in a run as frame by frame: a test models a stalling host that way."""
+    restamped = _reads(True, monkeypatch, restamp=True)
+    assert restamped == _reads(False, monkeypatch, restamp=True)
+    assert restamped != _reads(True, monkeypatch)  # the restamping changed the reads
 
 
 def test_a_wire_event_is_the_event_its_constructor_makes() -> None:
