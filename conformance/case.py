@@ -11,6 +11,7 @@ the case goes on to find about it.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 from .catalog import requirement
@@ -159,6 +160,9 @@ def _voided(unmet: Unmet) -> tuple[Verdict, ...]:
     return WHOLE if unmet.partial else JUDGED
 
 
+_START = attrgetter("start")  # an event's start (a C getter: events are sorted by it often)
+
+
 def events_of(record: Any) -> list[Event]:
     """Every bus event behind an Exchange, a Measurement, or a list of them, in time order."""
     if record is None:
@@ -172,14 +176,14 @@ def events_of(record: Any) -> list[Event]:
             if a.break_event is not None:
                 found.append(a.break_event)
             found += a.command_events + a.reply_events
-        return sorted(found, key=lambda e: e.start)
+        return sorted(found, key=_START)
     if isinstance(record, Measurement):
         found = events_of(record.start) + list(record.waited_events)
         for ex in record.data:
             found += events_of(ex)
-        return sorted(found, key=lambda e: e.start)
+        return sorted(found, key=_START)
     if isinstance(record, (list, tuple)):
         if all(isinstance(e, Event) for e in record):
             return list(record)
-        return sorted((e for r in record for e in events_of(r)), key=lambda e: e.start)
+        return sorted((e for r in record for e in events_of(r)), key=_START)
     raise TypeError(f"no events in {type(record).__name__}")

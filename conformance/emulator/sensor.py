@@ -29,7 +29,7 @@ reply, never partial data (decision A3).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import replace
 from math import inf
 from typing import Any
@@ -266,7 +266,19 @@ class SensorEmulator:
 
     def pop_frame(self) -> Frame:
         frame, item = self._tx.pop_frame()
-        self._last_activity = max(self._last_activity, frame.start + frame.duration)
+        self._sent(frame.start + frame.duration, item)
+        return frame
+
+    # -- sim.bus.PlansFrames: a reply committed in one run ----------------------------------
+    def frames_ahead(self) -> Iterator[tuple[float, int, float]] | None:
+        return self._tx.ahead()
+
+    def pop_frames(self, count: int) -> None:
+        self._sent(*self._tx.pop_frames(count))
+
+    def _sent(self, end: float, item: Transmission) -> None:
+        """After a frame of ``item`` ending at ``end`` went out (the latest of several)."""
+        self._last_activity = max(self._last_activity, end)
         self._replied_last = True
         if item.done:
             kind = item.reply.kind
@@ -274,7 +286,6 @@ class SensorEmulator:
                 self._awake = not self.behaviour.standby_after_service_request
             elif kind is not ReplyKind.CHATTER and self.behaviour.standby_after_reply:
                 self._awake = False
-        return frame
 
     # -- measurement bookkeeping -------------------------------------------------------------
     def _settle(self, now: float) -> None:

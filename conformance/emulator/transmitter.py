@@ -7,7 +7,7 @@ scheduled transmissions rather than something pushed onto the wire.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from ..protocol.timing import CHAR_TIME
@@ -44,6 +44,16 @@ class Transmission:
     @property
     def done(self) -> bool:
         return self.sent >= len(self.wires)
+
+    def rest(self) -> Iterator[tuple[float, int, float]]:
+        """``(start, wire, duration)`` of the frames not sent yet, in order: :meth:`frame`
+        of each index from :attr:`sent` on (the same arithmetic, so the same floats)."""
+        at, extra = self.pause
+        step = self.char_time + self.gap
+        start, wires, char_time = self.start, self.wires, self.char_time
+        for index in range(self.sent, len(wires)):
+            held = extra if 0 < at <= index else 0.0
+            yield start + index * step + held, wires[index], char_time
 
 
 class Transmitter:
@@ -90,6 +100,29 @@ class Transmitter:
         frame = item.frame(item.sent)
         self._offered = (item, item.sent, frame)
         return frame
+
+    def ahead(self) -> Iterator[tuple[float, int, float]] | None:
+        """The frames :meth:`next_frame` would offer one after the other while nothing
+        changes the queue: the rest of its first transmission (``sim.bus.PlansFrames``).
+        None when there is none, or when its frames' ends might not rise (a gap or pause
+        shorter than nothing), which :meth:`pop_frames` relies on."""
+        if not self.queue:
+            return None
+        item = self.queue[0]
+        if item.char_time + item.gap <= 0 or item.pause[1] < 0:
+            return None
+        return item.rest()
+
+    def pop_frames(self, count: int) -> tuple[float, Transmission]:
+        """Commit the first ``count`` (at least one) frames :meth:`ahead` offered, as
+        ``count`` calls of :meth:`pop_frame`; returns the last one's end (the latest: ends
+        rise within a transmission) and the transmission they are of."""
+        item = self.queue[0]
+        item.sent += count
+        last = item.frame_start(item.sent - 1) + item.char_time
+        if item.done:
+            self.queue.pop(0)
+        return last, item
 
     def pop_frame(self) -> tuple[Frame, Transmission]:
         item = self.queue[0]

@@ -313,17 +313,43 @@ def _leading_zero_reason(code: str) -> str | None:
     return None
 
 
+#: what :func:`parse_command` made of each text it was given: the (frozen) command, or the
+#: reason it is none. A run parses the same few dozen texts thousands of times (the emulator
+#: as it hears them, the view per segment, the bus time per wait); cleared when it grows.
+_PARSED: dict[tuple[str, bool], Command | str] = {}
+_PARSED_MAX = 4096
+
+
 def parse_command(text: str | bytes, *, allow_wildcard: bool = False) -> Command:
     """Parse one command (``!`` included). Raises :class:`CommandError` with the reason.
 
     ``allow_wildcard`` admits ``?`` as the address of commands other than ``?!``
-    (R-4.4.3-02: a sensor may accept it); by default only ``?!`` may use it.
+    (R-4.4.3-02: a sensor may accept it); by default only ``?!`` may use it. A text parsed
+    before gives the same command object again (commands are frozen), or a new
+    :class:`CommandError` with the same reason.
     """
     if isinstance(text, bytes):
         try:
             text = text.decode("ascii")
         except UnicodeDecodeError:
             raise CommandError(repr(text), "contains a non-ASCII byte") from None
+    key = (text, allow_wildcard)
+    found = _PARSED.get(key)
+    if found is None:
+        try:
+            found = _parse_text(text, allow_wildcard)
+        except CommandError as exc:
+            found = exc.reason
+        if len(_PARSED) >= _PARSED_MAX:
+            _PARSED.clear()
+        _PARSED[key] = found
+    if type(found) is str:
+        raise CommandError(text, found)
+    return found  # type: ignore[return-value]
+
+
+def _parse_text(text: str, allow_wildcard: bool) -> Command:
+    """:func:`parse_command` of a text it has not seen (the grammar itself)."""
     if not text:
         raise CommandError(text, "empty")
     bad = next((c for c in text if not 0x20 <= ord(c) <= 0x7E), None)

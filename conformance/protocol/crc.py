@@ -37,9 +37,22 @@ def encode_ascii(crc: int) -> str:
     return "".join(chr(0x40 | ((crc >> shift) & 0x3F)) for shift in (12, 6, 0))
 
 
+#: ascii_crc of each text asked: the emulator's replies, the recorder's checks and the view
+#: ask it of the same few hundred texts thousands of times a run (a faulty one more often:
+#: every retry); cleared when it grows
+_ASCII_CRCS: dict[str, str] = {}
+_ASCII_CRCS_MAX = 4096
+
+
 def ascii_crc(text: str) -> str:
     """The three CRC characters for ``text`` (address through the last value, no CR LF)."""
-    return encode_ascii(crc16(text))
+    found = _ASCII_CRCS.get(text)
+    if found is None:
+        found = encode_ascii(crc16(text))
+        if len(_ASCII_CRCS) >= _ASCII_CRCS_MAX:
+            _ASCII_CRCS.clear()
+        _ASCII_CRCS[text] = found
+    return found
 
 
 def encode_binary(crc: int) -> bytes:

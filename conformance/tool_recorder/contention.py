@@ -70,6 +70,9 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
     that splits the window also looks for any tool event and DUT character whose spans meet
     at all (with no slack: every overlap counted below is one of those), and without one
     there is nothing to group."""
+    events = events if isinstance(events, list) else list(events)
+    if _apart_in_order(events):
+        return []
     wire = sorted([e for e in events if e.kind is not EventKind.NOTE], key=_START)
     tool: list[Event] = []
     dut: list[Event] = []
@@ -105,6 +108,95 @@ def collisions(events: Iterable[Event]) -> list[Collision]:
         if met:
             found.append(Collision(tuple(group), tuple(met)))
     return found
+
+
+def _apart_in_order(events: list[Event]) -> bool:
+    """True when the wire events are already in start order (as a sim bus or a link's
+    reader appends them) and no tool event meets a DUT character: the pass of
+    :func:`collisions` before its grouping, without the copy and sort it needs for events
+    out of order. False: not known (the full pass decides)."""
+    tool_end = dut_end = last = float("-inf")
+    note, char = EventKind.NOTE, EventKind.CHAR
+    for e in events:
+        kind = e.kind
+        if kind is note:
+            continue
+        start = e.start
+        if start < last:
+            return False
+        last = start
+        if e.origin == TOOL:
+            if start < dut_end:
+                return False
+            if e.end > tool_end:
+                tool_end = e.end
+        elif kind is char:
+            if start < tool_end:
+                return False
+            if e.end > dut_end:
+                dut_end = e.end
+    return True
+
+
+class ApartSoFar:
+    """:func:`_apart_in_order` kept up as a transcript grows, read on from where the last look
+    stopped: the engine asks before every transmission about the last 64 events and what
+    came since, nearly always to find them apart. What it has read covers a window from
+    ``base`` on; a window that starts there or later is a suffix of it, and a suffix of
+    events in order, apart, is in order and apart (each side's latest end before an event
+    can only be smaller in it). Where it cannot tell (a meeting read, a transcript not only
+    appended to) it starts again at the window asked about."""
+
+    def __init__(self) -> None:
+        self._restart(0)
+        self._last: Event | None = None  # the event at ``seen - 1`` when last looked
+
+    def _restart(self, base: int) -> None:
+        self.ok = True
+        self.base = self.seen = base
+        self.tool_end = self.dut_end = self.last = float("-inf")
+
+    def holds(self, events: list[Event], first: int) -> bool:
+        """True when ``events[first:]`` are surely what :func:`_apart_in_order` says apart
+        (so :func:`collisions` finds nothing in them); False: not known."""
+        n = len(events)
+        seen = self.seen
+        if (
+            not self.ok
+            or first < self.base
+            or n < seen
+            or (seen > self.base and events[seen - 1] is not self._last)
+        ):
+            self._restart(first)
+            seen = first
+        tool_end, dut_end, last = self.tool_end, self.dut_end, self.last
+        note, char = EventKind.NOTE, EventKind.CHAR
+        for k in range(seen, n):
+            e = events[k]
+            kind = e.kind
+            if kind is note:
+                continue
+            start = e.start
+            if start < last:
+                self.ok = False
+                return False
+            last = start
+            if e.origin == TOOL:
+                if start < dut_end:
+                    self.ok = False
+                    return False
+                if e.end > tool_end:
+                    tool_end = e.end
+            elif kind is char:
+                if start < tool_end:
+                    self.ok = False
+                    return False
+                if e.end > dut_end:
+                    dut_end = e.end
+        self.tool_end, self.dut_end, self.last = tool_end, dut_end, last
+        self.seen = n
+        self._last = events[n - 1] if n else None
+        return True
 
 
 def collision_notes(events: Iterable[Event]) -> list[Event]:

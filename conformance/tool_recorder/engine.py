@@ -12,6 +12,7 @@ deadline so a silent or babbling device can never hang it.
 from __future__ import annotations
 
 import contextlib
+from functools import partial
 
 from ..links.base import Link
 from ..links.errors import BreakUnsupported
@@ -38,7 +39,7 @@ from ..protocol.values import split_values
 from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
 from ..view.segments import continues_frame
 from . import validity
-from .contention import HOLD_PREFIX, collisions
+from .contention import HOLD_PREFIX, ApartSoFar, collisions
 from .hooks import Hooks
 from .policy import Policy
 from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
@@ -80,6 +81,7 @@ class ToolRecorder:
         self.collisions = 0  # tool transmissions that overlapped DUT characters (noted)
         self._scanned = 0  # transcript events already looked at for collisions
         self._collided: set[tuple[float, float]] = set()  # tool events already noted
+        self._apart = ApartSoFar()  # the collision scan's shortcut, read on as events come
         self._dut_end = _LastDutChar()  # the end of the DUT's last character, kept up to date
 
     # -- single commands -------------------------------------------------------------------
@@ -245,7 +247,11 @@ class ToolRecorder:
         since the last look (:mod:`~conformance.tool_recorder.contention`); returns how many
         transmissions collided so far."""
         events = self.link.transcript.events
-        window = events[max(0, self._scanned - _COLLISION_LOOKBACK) :]
+        first = max(0, self._scanned - _COLLISION_LOOKBACK)
+        if self._apart.holds(events, first):  # nothing met: no collision to note
+            self._scanned = len(events)
+            return self.collisions
+        window = events[first:]
         self._scanned = len(events)
         for collision in collisions(window):
             spans = {(e.start, e.end) for e in collision.tool}
@@ -532,7 +538,7 @@ class ToolRecorder:
             # rule only starts once that read has received something.
             more = self.link.receive(
                 min(deadline, chars[-1].end + framing.window(chars)),
-                until=lambda m, have=chars: framing.stop(have + m),
+                until=partial(framing.stop_after, chars),
                 idle=framing.idle,
             )
             if not more:

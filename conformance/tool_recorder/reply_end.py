@@ -63,10 +63,25 @@ class Framing:
             return len(chars) >= self.max_chars or ends_line(chars)
         return len(chars) >= self.limit(chars) or self.finished(chars) or self.at_line_end(chars)
 
+    def stop_after(self, have: list[Event], more: list[Event]) -> bool:
+        """:meth:`stop` of ``have + more`` (``more`` not empty), without making that list for
+        a one-line 7E1 reply: asked after every character, the copy made reading a reply
+        quadratic in its length."""
+        if self.binary or self.multiline:
+            return self.stop(have + more)
+        if len(have) + len(more) >= self.max_chars:
+            return True
+        before = more[-2] if len(more) > 1 else have[-1] if have else None
+        # ends_line of the two, spelt out: asked per character
+        return before is not None and before.wire & 0x7F == _CR and more[-1].wire & 0x7F == _LF
+
     def deadline(self, first: Event) -> float:
         """Hard bound for a DUT that trickles characters just inside each window."""
         per_char = first.duration + max(self.idle, self.line_wait if self.multiline else 0.0)
         return first.start + max(self.max_chars, self.max_text_chars) * per_char
+
+
+_CR, _LF = ord("\r"), ord("\n")
 
 
 def _head(chars: list[Event]) -> bytes:

@@ -360,3 +360,118 @@ def test_the_run_needs_no_assertion_rewriting() -> None:
         if isinstance(node, ast.Assert)
     ]
     assert len(sources) > 10 and not asserting, asserting
+
+def test_stop_after_a_read_is_stop_of_the_reply_so_far() -> None:
+    """Framing.stop_after(have, more), asked after every character without making
+    ``have + more``, against Framing.stop of that list, for every kind of framing."""
+    from conformance.tool_recorder.reply_end import Framing
+
+    rng = random.Random(21)
+    framings = [Framing(idle=0.01, max_chars=n) for n in (1, 3, 80)] + [
+        Framing(idle=0.01, max_chars=80, binary=True),
+        Framing(idle=0.01, max_chars=80, multiline=True, max_text_chars=200),
+    ]
+    codes = [0x0D, 0x8D, 0x0A, 0x8A, 0x02, 0x03, 0x31, 0xB1]
+    for _ in range(2000):
+        chars = [
+            Event(rng.choice([EventKind.CHAR] * 6 + [EventKind.BREAK]), DUT, 0.0, 1.0,
+                  wire=rng.choice(codes))
+            for _ in range(rng.randrange(1, 8))
+        ]  # fmt: skip
+        cut = rng.randrange(len(chars))  # ``more`` holds at least one character
+        for f in framings:
+            assert f.stop_after(chars[:cut], chars[cut:]) == f.stop(chars)
+
+
+def test_a_command_parsed_again_is_what_a_first_parse_gives() -> None:
+    """parse_command's memo: every text, valid or not, wildcard or not, str or bytes, gives
+    what the grammar gives it (the same command, or an error with the same reason), the first
+    time and every time after, also once the memo was cleared for growing."""
+    from conformance.protocol import commands
+    from conformance.protocol.commands import CommandError, _parse_text, parse_command
+
+    rng = random.Random(5)
+    texts = ["0!", "?!", "0I!", "0M!", "0MC3!", "0D0!", "0DB12!", "0D01!", "0IM1_002!", "0XYZ!",
+             "0A1!", "0AA1!", "0", "", "0\x01!", "0!!", "?M!", "!", "0R9!", "0RC3!", "0IR0!",
+             "0HB!", "0I_001!", "0IM_01!", "0XWT!", "$M!"]  # fmt: skip
+    texts += ["".join(rng.choice("0?!MDCIRVHAB_1239x") for _ in range(rng.randrange(7)))
+              for _ in range(400)]  # fmt: skip
+
+    def fresh(text: str, wildcard: bool) -> tuple[str, object]:
+        try:
+            return "ok", _parse_text(text, wildcard)
+        except CommandError as exc:
+            return "error", (exc.text, exc.reason, str(exc))
+
+    def memo(text: str | bytes, wildcard: bool) -> tuple[str, object]:
+        try:
+            return "ok", parse_command(text, allow_wildcard=wildcard)
+        except CommandError as exc:
+            return "error", (exc.text, exc.reason, str(exc))
+
+    commands._PARSED.clear()
+    for _round in range(3):
+        for text in texts:
+            for wildcard in (False, True):
+                expected = fresh(text, wildcard)
+                assert memo(text, wildcard) == expected
+                assert memo(text.encode("ascii"), wildcard) == expected
+        commands._PARSED_MAX, saved = 7, commands._PARSED_MAX
+        commands._PARSED.clear()
+        try:
+            for text in texts:
+                assert memo(text, False) == fresh(text, False)
+                assert len(commands._PARSED) <= 7
+        finally:
+            commands._PARSED_MAX = saved
+
+
+def test_events_in_order_and_apart_are_what_the_sorted_pass_finds_apart() -> None:
+    """contention's in-order shortcut says 'apart' only where the sorted pass finds no
+    tool event meeting a DUT character; windows in start order (as a sim bus appends them),
+    shuffled, and with equal starts."""
+    from conformance.tool_recorder.contention import _apart_in_order, collisions
+
+    rng = random.Random(23)
+    shortcut = 0
+    for n in range(3000):
+        window = _random_window(rng)
+        if n % 3:
+            window.sort(key=lambda e: e.start)  # stable: notes and ties keep their order
+        sorted_wire = sorted((e for e in window if e.kind is not EventKind.NOTE),
+                             key=lambda e: e.start)  # fmt: skip
+        apart = _apart_in_order(window)
+        if apart:
+            shortcut += 1
+            assert [e for e in window if e.kind is not EventKind.NOTE] == sorted_wire
+            assert collisions(list(reversed(window))) == []  # the full pass agrees
+        assert (collisions(window) == []) >= apart
+    assert shortcut > 300  # the shortcut was taken, so the comparison compared something
+
+
+def test_apart_so_far_says_apart_only_where_the_window_is_apart() -> None:
+    """contention.ApartSoFar, read on as a transcript grows (events appended in bursts, in
+    order or not, the window's start moving on, the list replaced now and then), says
+    'apart' only where _apart_in_order of the window asked about does; and it says so
+    often for a transcript that is in order."""
+    from conformance.tool_recorder.contention import ApartSoFar, _apart_in_order
+
+    rng = random.Random(31)
+    held = 0
+    for trial in range(300):
+        apart, events, t, scanned = ApartSoFar(), [], 0.0, 0
+        ordered = trial % 3 != 0
+        for _step in range(40):
+            for _ in range(rng.randrange(6)):
+                t += rng.choice([0.009, 0.02, 0.1, 0.0] + ([] if ordered else [-0.005]))
+                kind = rng.choice([EventKind.CHAR] * 5 + [EventKind.NOTE])
+                origin = TOOL if rng.random() < 0.5 else DUT
+                events.append(Event(kind, origin, t, t + 8.33e-3 * rng.random()))
+            if rng.random() < 0.03:
+                events = list(events)  # a new list: its identity says nothing
+            first = max(0, scanned - rng.choice([0, 3, 64]))
+            if apart.holds(events, first):
+                held += 1
+                assert _apart_in_order(events[first:])
+            scanned = len(events)
+    assert held > 3000

@@ -104,3 +104,23 @@ def test_is_crc_char() -> None:
     for c in "+-.0123456789?\x80":
         assert not is_crc_char(c)
     assert not is_crc_char("") and not is_crc_char("AB")
+
+
+def test_a_crc_asked_again_is_the_one_computed() -> None:
+    """ascii_crc's memo gives what the CRC gives, the first time and after, across clears."""
+    import random
+
+    from conformance.protocol import crc
+
+    rng = random.Random(9)
+    texts = ["".join(rng.choice("0123456789+-.abcXYZ") for _ in range(rng.randrange(40)))
+             for _ in range(300)]  # fmt: skip
+    crc._ASCII_CRCS.clear()
+    saved, crc._ASCII_CRCS_MAX = crc._ASCII_CRCS_MAX, 50
+    try:
+        for _round in range(3):
+            for text in texts:
+                assert crc.ascii_crc(text) == crc.encode_ascii(crc.crc16(text))
+                assert len(crc._ASCII_CRCS) <= 50
+    finally:
+        crc._ASCII_CRCS_MAX = saved

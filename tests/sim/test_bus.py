@@ -1,0 +1,211 @@
+"""The sim bus's run of planned frames (``SimBus.planned_run``, ``SimLink._take_run``) puts
+on the wire exactly what asking the device frame by frame puts there: the same events, the
+same stamps, the same clock, the same device state after. Every emulator fault's own wire
+check runs both ways and the transcripts are compared."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from conformance.emulator import FAULTS, default_profile
+from conformance.emulator.replies import Reply, ReplyKind
+from conformance.emulator.transmitter import Transmission, Transmitter
+from conformance.sim.bus import SimBus, SimLink
+from tests.emulator.test_faults import CHECKS
+from tests.emulator.test_sensor import Rig
+
+
+def _frame_by_frame(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(SimBus, "planned_run", lambda self: None)
+
+
+def _checked(name: str | None) -> tuple[list, str, int]:
+    """The transcript of a fault's wire check (or of the clean emulator failing it), the
+    check's outcome and how many characters went through a planned run."""
+    version = FAULTS[name].version if name else FAULTS[sorted(FAULTS)[0]].version
+    rig = Rig(default_profile(version), (name,) if name else ())
+    runs = []
+    take = SimLink._take_run
+
+    def counted(self, run, got, *args):  # noqa: ANN001, ANN202 - as SimLink._take_run
+        before = len(got)
+        try:
+            return take(self, run, got, *args)
+        finally:
+            runs.append(len(got) - before)
+
+    SimLink._take_run = counted  # type: ignore[method-assign]
+    try:
+        CHECKS[name or sorted(FAULTS)[0]](rig)
+        outcome = "passed"
+    except AssertionError as exc:
+        outcome = f"failed: {exc}"
+    finally:
+        SimLink._take_run = take  # type: ignore[method-assign]
+    return list(rig.bus.transcript.events), outcome, sum(runs)
+
+
+@pytest.mark.parametrize("name", sorted(FAULTS))
+def test_a_planned_run_is_what_frame_by_frame_gives(name: str, monkeypatch) -> None:
+    fast, fast_outcome, in_runs = _checked(name)
+    _frame_by_frame(monkeypatch)
+    slow, slow_outcome, none = _checked(name)
+    assert none == 0
+    assert fast == slow
+    assert fast_outcome == slow_outcome
+    if any(e.origin == "dut" for e in fast):
+        assert in_runs > 0  # the run was taken, so the comparison compared something
+
+
+def test_the_clean_emulator_is_the_same_both_ways(monkeypatch) -> None:
+    fast, _, in_runs = _checked(None)
+    _frame_by_frame(monkeypatch)
+    assert _checked(None)[0] == fast
+    assert in_runs > 0
+
+
+def test_the_rest_of_a_transmission_is_each_frame_in_turn() -> None:
+    reply = Reply(ReplyKind.DATA, "0+1.25+3.5")
+    for gap, pause, char_time in [(0.0, (0, 0.0), 8.33e-3), (1.7e-3, (4, 0.3), 8.33e-3),
+                                  (0.4e-3, (1, 0.011), 9.1e-3)]:  # fmt: skip
+        item = Transmission(reply, 1.234567, reply.wires(), gap, char_time=char_time, pause=pause)
+        for sent in range(len(item.wires)):
+            item.sent = sent
+            expected = [item.frame(i) for i in range(sent, len(item.wires))]
+            got = list(item.rest())
+            assert got == [(f.start, f.wire, f.duration) for f in expected]
+
+
+def test_frames_whose_ends_might_fall_are_asked_one_by_one() -> None:
+    reply = Reply(ReplyKind.DATA, "0+1")
+    tx = Transmitter()
+    tx.schedule(reply, 1.0, gap=-0.009)
+    assert tx.ahead() is None
+    tx = Transmitter()
+    tx.schedule(reply, 1.0, gap=0.0, pause=(2, -0.001))
+    assert tx.ahead() is None
+    tx = Transmitter()
+    assert tx.ahead() is None
+    tx.schedule(reply, 1.0, gap=0.0)
+    assert tx.ahead() is not None
+
+
+def test_popping_a_run_is_popping_each_frame() -> None:
+    reply = Reply(ReplyKind.DATA, "0+1.5")
+    one, many = Transmitter(), Transmitter()
+    for tx in (one, many):
+        tx.schedule(reply, 0.5, gap=0.001, pause=(3, 0.02))
+        tx.schedule(reply, 2.0, gap=0.0)
+    for _ in range(4):
+        frame, _item = one.pop_frame()
+    end, item = many.pop_frames(4)
+    assert end == frame.start + frame.duration
+    assert item.sent == 4 and one.next_frame() == many.next_frame()
+    rest = len(item.wires) - 4
+    for _ in range(rest):
+        one.pop_frame()
+    end, item = many.pop_frames(rest)
+    assert item.done and len(many.queue) == 1 and one.next_frame() == many.next_frame()
+
+
+class _Talker:
+    """A device that only talks: its planned replies, offered either way."""
+
+    name = "dut"
+
+    def __init__(self) -> None:
+        self.tx = Transmitter()
+        self.tx.schedule(Reply(ReplyKind.DATA, "0+1.5+2.25"), 0.010, gap=0.0004)
+        self.tx.schedule(Reply(ReplyKind.DATA, "0+3"), 0.050, gap=0.0, pause=(3, 0.045))
+        self.tx.schedule(Reply(ReplyKind.DATA, "0+77.125"), 0.500, gap=0.021)
+        self.tx.schedule(Reply(ReplyKind.SERVICE_REQUEST, "0"), 0.900, gap=0.0)
+
+    def on_break(self, start: float, end: float) -> None:
+        pass
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        pass
+
+    def next_frame(self):  # noqa: ANN201 - as BusDevice
+        return self.tx.next_frame()
+
+    def pop_frame(self):  # noqa: ANN201 - as BusDevice
+        return self.tx.pop_frame()[0]
+
+    def frames_ahead(self):  # noqa: ANN201 - as PlansFrames
+        return self.tx.ahead()
+
+    def pop_frames(self, count: int) -> None:
+        self.tx.pop_frames(count)
+
+
+READS = [  # (how far the deadline lies, stop after how many characters, idle)
+    (0.005, None, None), (0.02, 1, None), (1.0, 3, 0.02), (1.0, None, 0.02), (0.3, None, 0.05),
+    (1.0, 2, 0.0), (1.0, None, 0.03), (0.01, None, None), (2.0, None, None),
+]  # fmt: skip
+
+
+def _reads(planned: bool, monkeypatch: pytest.MonkeyPatch, restamp: bool = False) -> list:
+    if not planned:
+        _frame_by_frame(monkeypatch)
+    link = SimLink(SimBus([_Talker()]))
+    if restamp:  # as tests/judges/test_confirmation.py models a stalling host: some late
+        add, heard = link.transcript.add, [0]
+
+        def stamped(event):  # noqa: ANN001, ANN202 - as Transcript.add
+            if event.origin == "dut":
+                heard[0] += 1
+                if heard[0] % 3 == 0:
+                    event = replace(event, start=event.start + 0.03, end=event.end + 0.03)
+            return add(event)
+
+        link.transcript.add = stamped  # type: ignore[method-assign]
+    found = []
+    for ahead, count, idle in READS:
+        until = None if count is None else (lambda got, n=count: len(got) >= n)
+        got = link.receive(link.now() + ahead, until=until, idle=idle)
+        found.append(([(e.start, e.end, e.wire) for e in got], link.now()))
+    monkeypatch.undo()
+    return [found, list(link.transcript.events)]
+
+
+def test_reads_with_idle_windows_and_stops_end_where_they_ended(monkeypatch) -> None:
+    """Idle windows that close inside a reply's pause, stops after some characters,
+    deadlines inside a reply: each read returns the same characters and leaves the clock
+    where frame by frame left it."""
+    assert _reads(True, monkeypatch) == _reads(False, monkeypatch)
+
+
+def test_a_transcript_that_restamps_what_it_is_given_is_read_as_it_restamped(
+    monkeypatch,
+) -> None:
+    """A read returns (and times its idle window from) the event the transcript's ``add``
+    returned, in a run as frame by frame: a test models a stalling host that way."""
+    restamped = _reads(True, monkeypatch, restamp=True)
+    assert restamped == _reads(False, monkeypatch, restamp=True)
+    assert restamped != _reads(True, monkeypatch)  # the restamping changed the reads
+
+
+def test_a_wire_event_is_the_event_its_constructor_makes() -> None:
+    """transcript.wire_event, the sim bus's fast way to make a character, sets every field
+    as ``Event(kind, origin, start, end, wire=wire)`` does, defaults included: a field added
+    to Event without it here fails this test."""
+    import dataclasses
+    import random
+
+    from conformance.transcript import TOOL, Event, EventKind, wire_event
+
+    fields = dataclasses.fields(Event)
+    assert [f.name for f in fields] == list(Event.__slots__)
+    rng = random.Random(4)
+    for _ in range(500):
+        args = (rng.choice(list(EventKind)), rng.choice([TOOL, "dut", "sensor-1"]),
+                rng.random(), rng.random() + 1.0, rng.randrange(256))  # fmt: skip
+        fast, made = wire_event(*args), Event(*args[:4], wire=args[4])
+        assert fast == made and hash(fast) == hash(made) and repr(fast) == repr(made)
+        for f in fields:
+            assert type(getattr(fast, f.name)) is type(getattr(made, f.name))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.start = 0.0  # type: ignore[misc]
