@@ -361,6 +361,7 @@ def test_the_run_needs_no_assertion_rewriting() -> None:
     ]
     assert len(sources) > 10 and not asserting, asserting
 
+
 def test_stop_after_a_read_is_stop_of_the_reply_so_far() -> None:
     """Framing.stop_after(have, more), asked after every character without making
     ``have + more``, against Framing.stop of that list, for every kind of framing."""
