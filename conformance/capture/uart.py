@@ -80,8 +80,9 @@ class Decoded:
 
 #: Frame shapes (a frame's edges relative to its start bit, and the bit time it is read with)
 #: whose reading is kept: a bus repeats the same few hundred shapes, and reading one again is
-#: most of a decode's time (an hour at 1 MHz: millions of frames). Kept per decode, dropped
-#: whole when full, so a noisy capture of endless distinct shapes stays bounded.
+#: most of a decode's time (an hour at 1 MHz: millions of frames). Kept per line and process
+#: (:func:`_shapes_for`), dropped whole when full, so a noisy capture of endless distinct
+#: shapes stays bounded.
 FRAME_SHAPES = 1 << 14
 
 #: A shape read relative to its start gives the same bits at any start below this tick, as
@@ -197,6 +198,27 @@ class _Shapes(dict):
         return reading
 
 
+#: How many lines' kept shapes a process holds (a line: bit time, bits, sample period and
+#: framing, which a shape's reading depends on besides its edges).
+KEPT_LINES = 8
+_KEPT: dict[tuple[float, int, float, Framing], _Shapes] = {}
+
+
+def _shapes_for(T: float, nbits: int, period_ticks: float, framing: Framing) -> _Shapes:
+    """The kept shapes of this line, shared by every decode of it in this process: a reading
+    is a pure function of the shape and the line, and a matrix worker decodes the same line
+    hundreds of times (each channel of each row twice for its polarity, then whole), so each
+    shape is read once per process instead of once per decode. Bounded as :class:`_Shapes`
+    is, and to :data:`KEPT_LINES` lines (the oldest dropped)."""
+    key = (T, nbits, period_ticks, framing)
+    shapes = _KEPT.get(key)
+    if shapes is None:
+        if len(_KEPT) >= KEPT_LINES:
+            _KEPT.pop(next(iter(_KEPT)))
+        shapes = _KEPT[key] = _Shapes(T, nbits, period_ticks, framing)
+    return shapes
+
+
 def _refill(src: Iterator[list[int]], buf: list[int], i: int, above: float) -> tuple[list, bool]:
     """``buf[i:]`` with chunks appended until it holds two edges and its last is above
     ``above``; and whether chunks may be left. Edges are non-decreasing (every reader's)."""
@@ -249,7 +271,7 @@ def decode(
     capture cut); without it such a spacing is dropped.
 
     The edges are held a chunk or two at a time in one list scanned by index (``bisect`` for
-    the edges inside a frame), and each frame shape is read once (:data:`FRAME_SHAPES`).
+    the edges inside a frame), and each frame shape is read once a process (:func:`_shapes_for`).
 
     A character that follows the previous one within a frame's time is read from the bit
     time that one was read with, when it read cleanly: it is the same sender's (a reply's
@@ -398,7 +420,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
     T, nbits, tick_rate, t0 = line.T, line.nbits, line.tick_rate, line.t0
     uncertainty = line.uncertainty
     half, stop_centre, frame_span = _spans(T, nbits)
-    shapes = _Shapes(T, nbits, line.period_ticks, line.framing)
+    shapes = _shapes_for(T, nbits, line.period_ticks, line.framing)
     state = _start(src, level)
     if state is None:
         return

@@ -59,6 +59,9 @@ class RecordedSensor:
         self.heard = 0  # tool events matched so far
         self.next_reply = 0
         self.offset = 0.0  # now minus recorded time, at the last matched tool event
+        # the frame next_frame offered, by (next_reply, heard): what it depends on moves only
+        # with those two (offset with heard), and the bus asks again at every step between
+        self._offered: tuple[int, int, Frame | None] = (-1, -1, None)
 
     # -- what the tool does -------------------------------------------------------------------
     def on_break(self, start: float, end: float) -> None:
@@ -85,6 +88,14 @@ class RecordedSensor:
 
     # -- what the recording says the sensor did -------------------------------------------------
     def next_frame(self) -> Frame | None:
+        at, heard, frame = self._offered
+        if at == self.next_reply and heard == self.heard:
+            return frame
+        frame = self._next_frame()
+        self._offered = (self.next_reply, self.heard, frame)
+        return frame
+
+    def _next_frame(self) -> Frame | None:
         if self.next_reply >= len(self.replies):
             return None
         if self._needs[self.next_reply] > self.heard:

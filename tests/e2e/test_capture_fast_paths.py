@@ -18,6 +18,7 @@ from conformance.capture.levels import edge_array, edges_of
 from conformance.capture.writers import Channel
 from conformance.replay import recording
 from conformance.replay.recording import read_recording, write_recording
+from conformance.replay.sensor import RecordedSensor
 from conformance.transcript import DUT, TOOL, Event, EventKind, json_line, to_wire_7e1
 from tests.support.capture_digest import traffic  # noqa: E402
 
@@ -164,6 +165,7 @@ def test_an_edge_on_a_bit_centre_is_read_at_its_own_ticks(monkeypatch):
 
 def test_frame_shapes_stay_bounded(monkeypatch):
     monkeypatch.setattr(uart, "FRAME_SHAPES", 3)
+    monkeypatch.setattr(uart, "_KEPT", {})  # none kept by an earlier decode in this process
     sizes = []
     real = uart._shape_reading
     monkeypatch.setattr(uart, "_shape_reading", lambda *a: sizes.append(1) or real(*a))
@@ -177,6 +179,31 @@ def test_frame_shapes_stay_bounded(monkeypatch):
     monkeypatch.setattr(uart, "_EXACT_BELOW", 0)
     assert kept == decoded(edges, rate)
     assert len(sizes) > 3
+
+
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(jittered_frames(), jittered_frames())
+def test_shapes_kept_by_earlier_decodes_read_as_every_frame_read_alone(monkeypatch, one, two):
+    """The process keeps each line's shapes across decodes (a matrix worker decodes the same
+    line hundreds of times): a decode that finds another's shapes, of its own line or of
+    another line, reads as it would alone."""
+    monkeypatch.setattr(uart, "_KEPT", {})
+    got = [decoded(edges, rate) for edges, rate in (one, two, one, two)]
+    assert got[2] == got[0] and got[3] == got[1]
+    assert len(uart._KEPT) == len({one[1], two[1]})  # one line per tick rate, kept
+    monkeypatch.setattr(uart, "_EXACT_BELOW", 0)  # no shape kept: every frame at its ticks
+    assert got[:2] == [decoded(edges, rate) for edges, rate in (one, two)]
+
+
+def test_kept_lines_stay_bounded(monkeypatch):
+    monkeypatch.setattr(uart, "_KEPT", {})
+    monkeypatch.setattr(uart, "KEPT_LINES", 2)
+    edges = [100, 183, 266, 933]
+    for rate in (100_000.0, 48_000.0, 9_600.0, 100_000.0):
+        decoded(edges, rate)
+    assert [key[0] for key in uart._KEPT] == [9_600.0 / 1200, 100_000.0 / 1200]
 
 
 TEXTS = st.text(st.characters(), max_size=12)
@@ -244,3 +271,28 @@ def test_the_bulk_export_is_taken_for_a_busy_bus(monkeypatch, rate):
     """The slow path is for what the bulk union could order differently, not for traffic."""
     monkeypatch.setattr(levels, "edges_of", None)
     assert edge_array(traffic(9, seconds=5.0), rate, 0.0).size > 1000
+
+
+@pytest.mark.parametrize("seed", [3, 7])
+def test_the_replayed_sensor_offers_what_it_would_work_out_again(seed):
+    """:class:`RecordedSensor` keeps the frame it offered until a tool event is matched or a
+    reply popped (the bus asks at every step between): at every point of a replay, with the
+    tool late or early against the recording, the kept offer is the one worked out anew."""
+    events = traffic(seed, seconds=3.0)
+    sensor = RecordedSensor(events)
+    shift, offers, popped = 0.0, 0, 0
+    for n, e in enumerate(sorted(events, key=lambda e: (e.start, e.end))):
+        for _ in range(2):
+            assert sensor.next_frame() == sensor._next_frame()
+        shift = (n % 7 - 3) * 1e-4  # the tool now late, now early
+        if e.origin == TOOL:
+            if e.kind is EventKind.BREAK:
+                sensor.on_break(e.start + shift, e.end + shift)
+            else:
+                sensor.on_char(e.wire, e.start + shift, e.end + shift)
+        elif sensor.next_frame() is not None:
+            offers += 1
+            assert sensor.pop_frame() is not None
+            popped += 1
+    assert sensor.next_frame() == sensor._next_frame()
+    assert popped == offers > 20
