@@ -5,19 +5,16 @@ INI file: ``samplerate``, ``total probes``, ``probeN`` names, ``unitsize`` bytes
 ``capturefile`` prefix) and the raw samples split into members ``logic-1-1``, ``logic-1-2``, ...
 (probe N is bit N-1 of each little-endian ``unitsize``-byte word). Version 1 sessions kept the
 samples in one member named after ``capturefile``; both are read. Members are decompressed block
-by block, so memory stays a few megabytes whatever the capture's length (plus, from a whole
-read, the other probes' edges up to :data:`KEPT_EDGES`: the next read of one takes them).
+by block, so memory stays a few megabytes whatever the capture's length.
 """
 
 from __future__ import annotations
 
 import configparser
-import os
 import re
 import zipfile
 import zlib
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -128,89 +125,9 @@ class SrSession:
         return max(counts, key=lambda n: counts[n])
 
 
-#: Edges of a session's other probes kept from one whole read, for at most this many edges in
-#: all (8 bytes each): judging a capture of a run decodes the bus, then the tool's TX channel,
-#: and inflating the samples is about half of reading a channel
-KEPT_EDGES = 1 << 21
-
-
-@dataclass
-class _Kept:
-    """The other probes' edges a whole read of one session found, by probe name: the level of
-    the first sample, the edge ticks and the session's sample count."""
-
-    file: tuple[str, int, int]
-    first: dict[str, int]
-    ticks: dict[str, list[np.ndarray]]
-    total: int = 0
-    held: int = 0
-    complete: bool = False
-
-
-#: the session whose other probes were kept (one session, the last read whole)
-_KEPT: _Kept | None = None
-
-
-def _file_key(path: str) -> tuple[str, int, int] | None:
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    return (os.path.realpath(path), st.st_mtime_ns, st.st_size)
-
-
-def _keep_others(
-    kept: _Kept, block: np.ndarray, offset: int, previous: dict[str, tuple[int, int | None]]
-) -> None:
-    """The other probes' transitions in ``block`` (at sample ``offset``) into ``kept``;
-    given up past :data:`KEPT_EDGES` (an hour of a busy line reads its channels again)."""
-    if not block.size:
-        return
-    for name in kept.ticks:
-        bit, last = previous[name]
-        levels = (block >> bit) & 1 if bit else block & 1
-        kept.first.setdefault(name, int(levels[0]))
-        found = np.flatnonzero(levels[1:] != levels[:-1]) + 1
-        if last is not None and int(levels[0]) != last:
-            found = np.concatenate((np.zeros(1, dtype=found.dtype), found))
-        previous[name] = (bit, int(levels[-1]))
-        kept.ticks[name].append(found + offset)
-        kept.held += found.size
-    if kept.held > KEPT_EDGES:
-        kept.ticks.clear()
-
-
-def _kept_edges(path: str, channel: str, session: SrSession) -> Edges | None:
-    """``channel``'s edges from the last whole read of this very file (unchanged since), as
-    reading it again gives them (taken once: a third read reads the samples)."""
-    kept, key = _KEPT, _file_key(path)
-    if kept is None or not kept.complete or key != kept.file or channel not in kept.ticks:
-        return None
-    ticks = np.concatenate(kept.ticks.pop(channel)).tolist() if kept.total else []
-    session.zip.close()
-    total = kept.total
-    return Edges(
-        path=path,
-        channel=channel,
-        channels=list(session.probes),
-        tick_rate=session.samplerate,
-        period=1.0 / session.samplerate,
-        initial_level=kept.first[channel],
-        chunks=[ticks[i : i + BLOCK_SAMPLES] for i in range(0, len(ticks), BLOCK_SAMPLES)],
-        end=lambda: total or None,
-        notes=[],
-    )
-
-
 def read_sr(path: str, channel: str | None = None) -> Edges:
-    """Edges of one probe of a session (``channel`` by name; default the busiest one). A
-    whole read also keeps the other probes' edges (:data:`KEPT_EDGES`), which a read of one
-    of them by name takes instead of inflating the samples again."""
+    """Edges of one probe of a session (``channel`` by name; default the busiest one)."""
     session = SrSession(path)
-    if channel is not None and channel in session.probes:
-        again = _kept_edges(path, channel, session)
-        if again is not None:
-            return again
     notes: list[str] = []
     if channel is None:
         channel = session.busiest_probe() if len(session.probes) > 1 else next(iter(session.probes))
@@ -223,14 +140,8 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
     bit = session.probes[channel]
     total = [0]
     first_level: list[int] = []
-    key = _file_key(path)
-    others: dict[str, tuple[int, int | None]] = {
-        name: (b, None) for name, b in session.probes.items() if name != channel
-    }
-    kept = _Kept(key, {}, {name: [] for name in others}) if key and others else None
 
     def chunks() -> Iterator[list[int]]:
-        global _KEPT
         previous: int | None = None
         offset = 0
         for block in session.blocks():
@@ -238,16 +149,11 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
             if previous is None and levels.size:
                 first_level.append(int(levels[0]))
             idx, previous = transitions(levels, previous)
-            if kept is not None and kept.ticks:
-                _keep_others(kept, block, offset, others)
             if idx:
                 yield [offset + i for i in idx] if offset else idx
             offset += levels.size
         total[0] = offset
         session.zip.close()
-        if kept is not None and kept.ticks:
-            kept.total, kept.complete = offset, True
-            _KEPT = kept
 
     gen = chunks()
     # the starting level is needed before any edge: read the first block now
