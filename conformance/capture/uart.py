@@ -426,6 +426,9 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         return
     buf, i, more, last_end = state
     prior_bt: float | None = None  # the previous clean character's bit time (see decode)
+    # what every frame uses, in locals (a global or attribute lookup per frame adds up over
+    # an hour's millions of frames)
+    exact_below, char, bus, event, decoded = _EXACT_BELOW, EventKind.CHAR, BUS, Event, Decoded
     while True:
         if more and len(buf) - i < 2:
             buf, more = _refill(src, buf, i, float("-inf"))
@@ -463,7 +466,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
             j = bisect_left(buf, frame_end, hi)
         follows = prior_bt is not None and last_end is not None and s - last_end < nbits * T
         used = prior_bt if follows and prior_bt is not None else T
-        reading = shapes[(used, *[e - s for e in buf[i:j]])] if s < _EXACT_BELOW else None
+        reading = shapes[(used, *map(s.__rsub__, buf[i:j]))] if s < exact_below else None
         if reading is None:  # an edge on a bit centre, or a tick too far for the shapes
             reading = _read_frame(s, buf[i:j], used, T, nbits, line.period_ticks, line.framing)
         used, framing_error = reading.used, reading.framing_error
@@ -486,9 +489,10 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
             # the line marked: the bits after the end are unknown, not marking
             yield Decoded("partial", None, start, t0 + end / tick_rate)
             return
-        ev = Event(EventKind.CHAR, BUS, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
+        stop_s = t0 + end / tick_rate
+        ev = event(char, bus, start, stop_s, reading.wire, "", uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
         prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity
         pe, err, glitches = reading.parity_error, reading.err, reading.glitches
-        yield Decoded("char", ev, start, ev.end, framing_error, pe, err, glitches, marking)
+        yield decoded("char", ev, start, stop_s, framing_error, pe, err, glitches, marking)
