@@ -416,7 +416,7 @@ def _spans(T: float, nbits: int) -> tuple[float, float, float]:
 def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded]:
     """:func:`decode`'s loop, one frame, break, pulse or glitch a turn from the falling edge
     that starts it (``level``: the UART-side level the capture starts at). The hot path:
-    per frame it calls nothing it can do inline; the rare cases are built by helpers."""
+    per frame it calls nothing it can do inline, nor looks a global up; helpers do the rest."""
     T, nbits, tick_rate, t0 = line.T, line.nbits, line.tick_rate, line.t0
     uncertainty = line.uncertainty
     half, stop_centre, frame_span = _spans(T, nbits)
@@ -426,8 +426,6 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         return
     buf, i, more, last_end = state
     prior_bt: float | None = None  # the previous clean character's bit time (see decode)
-    # what every frame uses, in locals (a global or attribute lookup per frame adds up over
-    # an hour's millions of frames)
     exact_below, char, bus, event, decoded = _EXACT_BELOW, EventKind.CHAR, BUS, Event, Decoded
     while True:
         if more and len(buf) - i < 2:
@@ -489,10 +487,9 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
             # the line marked: the bits after the end are unknown, not marking
             yield Decoded("partial", None, start, t0 + end / tick_rate)
             return
-        stop_s = t0 + end / tick_rate
-        ev = event(char, bus, start, stop_s, reading.wire, "", uncertainty)
+        ev = event(char, bus, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
         prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity
         pe, err, glitches = reading.parity_error, reading.err, reading.glitches
-        yield decoded("char", ev, start, stop_s, framing_error, pe, err, glitches, marking)
+        yield decoded("char", ev, start, ev.end, framing_error, pe, err, glitches, marking)
