@@ -125,6 +125,22 @@ class SrSession:
         return max(counts, key=lambda n: counts[n])
 
 
+def _transitions(
+    block: np.ndarray, bit: int, previous: int | None, offset: int
+) -> tuple[list[int], int]:
+    """:func:`~.edges.transitions` of probe ``bit`` in a block of sample words, as ticks
+    (``offset``: the block's first sample), and the probe's last level. The words that
+    differ from the one before are found first, across all probes in one pass, and only
+    those few are looked at for the probe's bit: a block is millions of samples, a line
+    changes level a few thousand times."""
+    changed = np.flatnonzero(block[1:] != block[:-1])
+    changed = changed[((block[changed] ^ block[changed + 1]) >> bit) & 1 != 0]
+    idx = (changed + (offset + 1)).tolist()
+    if previous is not None and int(block[0]) >> bit & 1 != previous:
+        idx.insert(0, offset)
+    return idx, int(block[-1]) >> bit & 1
+
+
 def read_sr(path: str, channel: str | None = None) -> Edges:
     """Edges of one probe of a session (``channel`` by name; default the busiest one)."""
     session = SrSession(path)
@@ -145,13 +161,15 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
         previous: int | None = None
         offset = 0
         for block in session.blocks():
-            levels = block & 1 if bit == 0 else (block >> bit) & 1
-            if previous is None and levels.size:
-                first_level.append(int(levels[0]))
-            idx, previous = transitions(levels, previous)
+            if not block.size:  # as the general reader takes it (-1 if first)
+                previous = transitions(block, previous)[1]
+                continue
+            if previous is None:
+                first_level.append(int(block[0]) >> bit & 1)
+            idx, previous = _transitions(block, bit, previous, offset)
             if idx:
-                yield [offset + i for i in idx] if offset else idx
-            offset += levels.size
+                yield idx
+            offset += block.size
         total[0] = offset
         session.zip.close()
 

@@ -80,8 +80,9 @@ class Decoded:
 
 #: Frame shapes (a frame's edges relative to its start bit, and the bit time it is read with)
 #: whose reading is kept: a bus repeats the same few hundred shapes, and reading one again is
-#: most of a decode's time (an hour at 1 MHz: millions of frames). Kept per decode, dropped
-#: whole when full, so a noisy capture of endless distinct shapes stays bounded.
+#: most of a decode's time (an hour at 1 MHz: millions of frames). Kept per line and process
+#: (:func:`_shapes_for`), dropped whole when full, so a noisy capture of endless distinct
+#: shapes stays bounded.
 FRAME_SHAPES = 1 << 14
 
 #: A shape read relative to its start gives the same bits at any start below this tick, as
@@ -197,6 +198,27 @@ class _Shapes(dict):
         return reading
 
 
+#: How many lines' kept shapes a process holds (a line: bit time, bits, sample period and
+#: framing, which a shape's reading depends on besides its edges).
+KEPT_LINES = 8
+_KEPT: dict[tuple[float, int, float, Framing], _Shapes] = {}
+
+
+def _shapes_for(T: float, nbits: int, period_ticks: float, framing: Framing) -> _Shapes:
+    """The kept shapes of this line, shared by every decode of it in this process: a reading
+    is a pure function of the shape and the line, and a matrix worker decodes the same line
+    hundreds of times (each channel of each row twice for its polarity, then whole), so each
+    shape is read once per process instead of once per decode. Bounded as :class:`_Shapes`
+    is, and to :data:`KEPT_LINES` lines (the oldest dropped)."""
+    key = (T, nbits, period_ticks, framing)
+    shapes = _KEPT.get(key)
+    if shapes is None:
+        if len(_KEPT) >= KEPT_LINES:
+            _KEPT.pop(next(iter(_KEPT)))
+        shapes = _KEPT[key] = _Shapes(T, nbits, period_ticks, framing)
+    return shapes
+
+
 def _refill(src: Iterator[list[int]], buf: list[int], i: int, above: float) -> tuple[list, bool]:
     """``buf[i:]`` with chunks appended until it holds two edges and its last is above
     ``above``; and whether chunks may be left. Edges are non-decreasing (every reader's)."""
@@ -249,7 +271,7 @@ def decode(
     capture cut); without it such a spacing is dropped.
 
     The edges are held a chunk or two at a time in one list scanned by index (``bisect`` for
-    the edges inside a frame), and each frame shape is read once (:data:`FRAME_SHAPES`).
+    the edges inside a frame), and each frame shape is read once a process (:func:`_shapes_for`).
 
     A character that follows the previous one within a frame's time is read from the bit
     time that one was read with, when it read cleanly: it is the same sender's (a reply's
@@ -394,16 +416,17 @@ def _spans(T: float, nbits: int) -> tuple[float, float, float]:
 def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded]:
     """:func:`decode`'s loop, one frame, break, pulse or glitch a turn from the falling edge
     that starts it (``level``: the UART-side level the capture starts at). The hot path:
-    per frame it calls nothing it can do inline; the rare cases are built by helpers."""
+    per frame it calls nothing it can do inline, nor looks a global up; helpers do the rest."""
     T, nbits, tick_rate, t0 = line.T, line.nbits, line.tick_rate, line.t0
     uncertainty = line.uncertainty
     half, stop_centre, frame_span = _spans(T, nbits)
-    shapes = _Shapes(T, nbits, line.period_ticks, line.framing)
+    shapes = _shapes_for(T, nbits, line.period_ticks, line.framing)
     state = _start(src, level)
     if state is None:
         return
     buf, i, more, last_end = state
     prior_bt: float | None = None  # the previous clean character's bit time (see decode)
+    exact_below, char, bus, event, decoded = _EXACT_BELOW, EventKind.CHAR, BUS, Event, Decoded
     while True:
         if more and len(buf) - i < 2:
             buf, more = _refill(src, buf, i, float("-inf"))
@@ -441,7 +464,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
             j = bisect_left(buf, frame_end, hi)
         follows = prior_bt is not None and last_end is not None and s - last_end < nbits * T
         used = prior_bt if follows and prior_bt is not None else T
-        reading = shapes[(used, *[e - s for e in buf[i:j]])] if s < _EXACT_BELOW else None
+        reading = shapes[(used, *map(s.__rsub__, buf[i:j]))] if s < exact_below else None
         if reading is None:  # an edge on a bit centre, or a tick too far for the shapes
             reading = _read_frame(s, buf[i:j], used, T, nbits, line.period_ticks, line.framing)
         used, framing_error = reading.used, reading.framing_error
@@ -464,9 +487,9 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
             # the line marked: the bits after the end are unknown, not marking
             yield Decoded("partial", None, start, t0 + end / tick_rate)
             return
-        ev = Event(EventKind.CHAR, BUS, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
+        ev = event(char, bus, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
         prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity
         pe, err, glitches = reading.parity_error, reading.err, reading.glitches
-        yield Decoded("char", ev, start, ev.end, framing_error, pe, err, glitches, marking)
+        yield decoded("char", ev, start, ev.end, framing_error, pe, err, glitches, marking)

@@ -56,9 +56,13 @@ class RecordedSensor:
             while i < len(self.tool) and self.tool[i].start < reply.start:
                 i += 1
             self._needs.append(i)
+        self._touching = [self._touches(k) for k in range(len(self.replies))]
         self.heard = 0  # tool events matched so far
         self.next_reply = 0
         self.offset = 0.0  # now minus recorded time, at the last matched tool event
+        # the frame next_frame offered, by (next_reply, heard): what it depends on moves only
+        # with those two (offset with heard), and the bus asks again at every step between
+        self._offered: tuple[int, int, Frame | None] = (-1, -1, None)
 
     # -- what the tool does -------------------------------------------------------------------
     def on_break(self, start: float, end: float) -> None:
@@ -85,37 +89,57 @@ class RecordedSensor:
 
     # -- what the recording says the sensor did -------------------------------------------------
     def next_frame(self) -> Frame | None:
-        if self.next_reply >= len(self.replies):
+        at, heard, frame = self._offered
+        if at == self.next_reply and heard == self.heard:
+            return frame
+        frame = self._next_frame()
+        self._offered = (self.next_reply, self.heard, frame)
+        return frame
+
+    def _next_frame(self) -> Frame | None:
+        k = self.next_reply
+        if k >= len(self.replies):
             return None
-        if self._needs[self.next_reply] > self.heard:
+        need = self._needs[k]
+        if need > self.heard:
             return None  # its question has not been asked yet
-        reply = self.replies[self.next_reply]
-        start = reply.start + self.offset
-        before = self._just_before(reply)
-        if before is not None and abs(reply.start - before.end) <= (
-            reply.uncertainty + before.uncertainty
-        ):
+        reply = self.replies[k]
+        if self._touching[k][self.heard > need]:
             # back to back with what was on the line before it, within what the recording can
             # tell (a capture's edges sit on its sample grid): it goes the moment the line is
             # free, so it wins the line against the tool's next frame, as recorded (else the
             # order of frames that touch could turn on a few microseconds of quantization)
-            start = LINE_FREE
-        return Frame(start, reply.wire, reply.end - reply.start)
+            return Frame(LINE_FREE, reply.wire, reply.end - reply.start)
+        return Frame(reply.start + self.offset, reply.wire, reply.end - reply.start)
 
-    def _just_before(self, reply: Event) -> Event | None:
-        """The recorded event that ended last before ``reply``: the tool's last matched one
-        or the previous reply character."""
-        found = [self.tool[self.heard - 1]] if self.heard else []
-        if self.next_reply:
-            found.append(self.replies[self.next_reply - 1])
-        found = [e for e in found if e.start < reply.start]
-        return max(found, key=lambda e: e.end, default=None)
+    def _touches(self, k: int) -> tuple[bool, bool]:
+        """Whether reply ``k`` starts where the recorded event that ended last before it
+        ended (within both stamps' uncertainty), when it is offered with the tool's matched
+        events exactly those before it, and with the tool gone on past its start. That event
+        is the tool's last matched one or the previous reply character, whichever ends later
+        (the tool's on a tie); the tool's counts only if it started before the reply, which
+        the first case's does and the second's does not: so the two cases are all there is,
+        worked out once instead of at every step of the bus."""
+        reply, need = self.replies[k], self._needs[k]
+        previous = self.replies[k - 1] if k else None
+        if previous is not None and not previous.start < reply.start:
+            previous = None
+        tool = self.tool[need - 1] if need else None
+        if tool is not None and previous is not None and previous.end > tool.end:
+            tool = previous
+        return _touching(reply, tool or previous), _touching(reply, previous)
 
     def pop_frame(self) -> Frame:
         frame = self.next_frame()
         assert frame is not None, "the bus pops only a frame that was offered"
         self.next_reply += 1
         return frame
+
+
+def _touching(reply: Event, before: Event | None) -> bool:
+    return before is not None and abs(reply.start - before.end) <= (
+        reply.uncertainty + before.uncertainty
+    )
 
 
 def same_action(recorded: Event, kind: EventKind, wire: int, length: float) -> bool:

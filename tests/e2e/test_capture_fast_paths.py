@@ -7,6 +7,7 @@ line against ``json.dumps``, and a written transcript kept as its reading agains
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -18,6 +19,8 @@ from conformance.capture.levels import edge_array, edges_of
 from conformance.capture.writers import Channel
 from conformance.replay import recording
 from conformance.replay.recording import read_recording, write_recording
+from conformance.replay.sensor import LINE_FREE, RecordedSensor
+from conformance.sim.bus import Frame
 from conformance.transcript import DUT, TOOL, Event, EventKind, json_line, to_wire_7e1
 from tests.support.capture_digest import traffic  # noqa: E402
 
@@ -164,6 +167,7 @@ def test_an_edge_on_a_bit_centre_is_read_at_its_own_ticks(monkeypatch):
 
 def test_frame_shapes_stay_bounded(monkeypatch):
     monkeypatch.setattr(uart, "FRAME_SHAPES", 3)
+    monkeypatch.setattr(uart, "_KEPT", {})  # none kept by an earlier decode in this process
     sizes = []
     real = uart._shape_reading
     monkeypatch.setattr(uart, "_shape_reading", lambda *a: sizes.append(1) or real(*a))
@@ -177,6 +181,31 @@ def test_frame_shapes_stay_bounded(monkeypatch):
     monkeypatch.setattr(uart, "_EXACT_BELOW", 0)
     assert kept == decoded(edges, rate)
     assert len(sizes) > 3
+
+
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(jittered_frames(), jittered_frames())
+def test_shapes_kept_by_earlier_decodes_read_as_every_frame_read_alone(monkeypatch, one, two):
+    """The process keeps each line's shapes across decodes (a matrix worker decodes the same
+    line hundreds of times): a decode that finds another's shapes, of its own line or of
+    another line, reads as it would alone."""
+    monkeypatch.setattr(uart, "_KEPT", {})
+    got = [decoded(edges, rate) for edges, rate in (one, two, one, two)]
+    assert got[2] == got[0] and got[3] == got[1]
+    assert len(uart._KEPT) == len({one[1], two[1]})  # one line per tick rate, kept
+    monkeypatch.setattr(uart, "_EXACT_BELOW", 0)  # no shape kept: every frame at its ticks
+    assert got[:2] == [decoded(edges, rate) for edges, rate in (one, two)]
+
+
+def test_kept_lines_stay_bounded(monkeypatch):
+    monkeypatch.setattr(uart, "_KEPT", {})
+    monkeypatch.setattr(uart, "KEPT_LINES", 2)
+    edges = [100, 183, 266, 933]
+    for rate in (100_000.0, 48_000.0, 9_600.0, 100_000.0):
+        decoded(edges, rate)
+    assert [key[0] for key in uart._KEPT] == [9_600.0 / 1200, 100_000.0 / 1200]
 
 
 TEXTS = st.text(st.characters(), max_size=12)
@@ -244,3 +273,71 @@ def test_the_bulk_export_is_taken_for_a_busy_bus(monkeypatch, rate):
     """The slow path is for what the bulk union could order differently, not for traffic."""
     monkeypatch.setattr(levels, "edges_of", None)
     assert edge_array(traffic(9, seconds=5.0), rate, 0.0).size > 1000
+
+
+def offer_worked_out(sensor: RecordedSensor) -> Frame | None:
+    """The frame a :class:`RecordedSensor` offers, worked out from its state as the replay
+    first did at every step: the reply's question heard, then whether it touches the
+    recorded event that ended last before it (the tool's last matched one or the previous
+    reply, the later-ending; the tool's on a tie)."""
+    k = sensor.next_reply
+    if k >= len(sensor.replies) or sensor._needs[k] > sensor.heard:
+        return None
+    reply = sensor.replies[k]
+    found = [sensor.tool[sensor.heard - 1]] if sensor.heard else []
+    if k:
+        found.append(sensor.replies[k - 1])
+    found = [e for e in found if e.start < reply.start]
+    before = max(found, key=lambda e: e.end, default=None)
+    start = reply.start + sensor.offset
+    if before is not None and abs(reply.start - before.end) <= (
+        reply.uncertainty + before.uncertainty
+    ):
+        start = LINE_FREE
+    return Frame(start, reply.wire, reply.end - reply.start)
+
+
+@pytest.mark.parametrize(("seed", "uncertainty"), [(3, 0.0), (7, 0.0), (7, 1e-5), (8, 2e-3)])
+def test_the_replayed_sensor_offers_what_it_would_work_out_anew(seed, uncertainty):
+    """:class:`RecordedSensor` works out once per reply whether it goes back to back, and
+    keeps the frame it offered until a tool event is matched or a reply popped (the bus asks
+    at every step between): at every point of a replay, with the tool late or early against
+    the recording, its offer is the one worked out anew from its state."""
+    events = [replace(e, uncertainty=uncertainty) for e in traffic(seed, seconds=3.0)]
+    sensor = RecordedSensor(events)
+    tool = sorted((e for e in events if e.origin == TOOL), key=lambda e: (e.start, e.end))
+    popped, free, past = 0, 0, 0
+    for n, e in enumerate([*tool, None]):
+        # the replies due, popped now or (every third turn) left until the tool went on
+        while (n % 3 or e is None) and (offer := sensor.next_frame()) is not None:
+            assert offer == offer_worked_out(sensor)
+            free += offer.start == LINE_FREE
+            past += sensor.heard > sensor._needs[sensor.next_reply]
+            assert sensor.pop_frame() == offer
+            assert sensor.next_frame() == offer_worked_out(sensor)
+            popped += 1
+        if e is None:
+            break
+        assert sensor.next_frame() == offer_worked_out(sensor)
+        shift = (n % 7 - 3) * 1e-4  # the tool now late, now early
+        if e.kind is EventKind.BREAK:
+            sensor.on_break(e.start + shift, e.end + shift)
+        else:
+            sensor.on_char(e.wire, e.start + shift, e.end + shift)
+    assert popped == len(sensor.replies)
+    assert popped > 20 and 0 < free < popped and past > 0  # both cases, both ways
+
+
+def test_on_a_tie_the_tools_event_is_the_one_before_a_reply():
+    """The tool's last event and the previous reply end together: the tool's (here the one
+    with no uncertainty) decides whether the next reply touches it."""
+    sensor = RecordedSensor(
+        [
+            Event(EventKind.CHAR, TOOL, 0.0, 1.0, 0x30),
+            Event(EventKind.CHAR, DUT, 0.5, 1.0, 0x31, "", 0.3),
+            Event(EventKind.CHAR, DUT, 1.2, 2.0, 0x32),
+        ]
+    )
+    sensor.on_char(0x30, 0.0, 1.0)
+    sensor.pop_frame()
+    assert sensor.next_frame() == offer_worked_out(sensor) == Frame(1.2, 0x32, 0.8)
