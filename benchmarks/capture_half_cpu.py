@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
+
+from tree_process import start_in_tree
 
 ONE_TREE = r"""
 import json, sys, tempfile, time
@@ -73,14 +73,7 @@ PHASES = ("export", "plan", "replay")
 
 
 def start(tree: Path, every: int, rounds: int, cache: Path) -> subprocess.Popen:
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    env["PYTHONPATH"] = str(tree)
-    if not os.access(tree, os.W_OK):  # a read-only tree: its bytecode cached elsewhere
-        env["PYTHONPYCACHEPREFIX"] = str(cache / tree.name)
-    return subprocess.Popen(
-        [sys.executable, "-c", ONE_TREE, str(every), str(rounds)],
-        cwd=tempfile.gettempdir(), env=env, stdout=subprocess.PIPE, text=True,
-    )  # fmt: skip
+    return start_in_tree(tree, ONE_TREE, [str(every), str(rounds)], cache, tempfile.gettempdir())
 
 
 def main() -> None:

@@ -23,11 +23,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
+
+from tree_process import start_in_tree
 
 ONE_TREE = r"""
 import json, sys, time
@@ -63,15 +63,9 @@ print(json.dumps({
 
 
 def start(tree: Path, what: str, every: int, cache: Path) -> subprocess.Popen:
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    env.pop("SDI12_MATRIX_CAPTURE", None)
-    env["PYTHONPATH"] = str(tree)
-    if not os.access(tree, os.W_OK):  # a read-only tree: its bytecode cached elsewhere
-        env["PYTHONPYCACHEPREFIX"] = str(cache / tree.name)
-    return subprocess.Popen(
-        [sys.executable, "-c", ONE_TREE, what, str(every)],
-        cwd=tree, env=env, stdout=subprocess.PIPE, text=True,
-    )  # fmt: skip
+    return start_in_tree(
+        tree, ONE_TREE, [what, str(every)], cache, cwd=tree, drop_env=["SDI12_MATRIX_CAPTURE"]
+    )
 
 
 def main() -> None:

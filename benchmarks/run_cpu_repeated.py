@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
+
+from tree_process import start_in_tree
 
 REPEATED = r"""
 import json, sys, tempfile, time
@@ -40,14 +40,7 @@ print(json.dumps({"cpu": cpu, "verdict": document["summary"]["verdict"]}))
 
 
 def start(tree: Path, port: str, runs: int, cache: Path) -> subprocess.Popen:
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    env["PYTHONPATH"] = str(tree)
-    if not os.access(tree, os.W_OK):  # a read-only tree: its bytecode cached elsewhere
-        env["PYTHONPYCACHEPREFIX"] = str(cache / tree.name)
-    return subprocess.Popen(
-        [sys.executable, "-c", REPEATED, port, str(runs)],
-        cwd=tempfile.gettempdir(), env=env, stdout=subprocess.PIPE, text=True,
-    )  # fmt: skip
+    return start_in_tree(tree, REPEATED, [port, str(runs)], cache, tempfile.gettempdir())
 
 
 def main() -> None:
