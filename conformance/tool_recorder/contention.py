@@ -115,27 +115,43 @@ def _apart_in_order(events: list[Event]) -> bool:
     reader appends them) and no tool event meets a DUT character: the pass of
     :func:`collisions` before its grouping, without the copy and sort it needs for events
     out of order. False: not known (the full pass decides)."""
-    tool_end = dut_end = last = float("-inf")
+    return _read_apart(events, 0, _NOTHING) is not None
+
+
+#: what :func:`_read_apart` has seen before its first event: the tool's latest end, the
+#: DUT's latest character end, the latest start
+_NOTHING = (float("-inf"), float("-inf"), float("-inf"))
+
+
+def _read_apart(
+    events: list[Event], first: int, seen: tuple[float, float, float]
+) -> tuple[float, float, float] | None:
+    """:func:`_apart_in_order`'s pass over ``events[first:]`` after events that left ``seen``
+    (tool end, DUT end, last start): what it leaves, or None at the first event out of order
+    or where a tool event and a DUT character meet. Each side's latest end before an event
+    can only grow as more is read, so a pass may stop and go on later from what it left."""
+    tool_end, dut_end, last = seen
     note, char = EventKind.NOTE, EventKind.CHAR
-    for e in events:
+    for k in range(first, len(events)):
+        e = events[k]
         kind = e.kind
         if kind is note:
             continue
         start = e.start
         if start < last:
-            return False
+            return None
         last = start
         if e.origin == TOOL:
             if start < dut_end:
-                return False
+                return None
             if e.end > tool_end:
                 tool_end = e.end
         elif kind is char:
             if start < tool_end:
-                return False
+                return None
             if e.end > dut_end:
                 dut_end = e.end
-    return True
+    return tool_end, dut_end, last
 
 
 class ApartSoFar:
@@ -154,7 +170,7 @@ class ApartSoFar:
     def _restart(self, base: int) -> None:
         self.ok = True
         self.base = self.seen = base
-        self.tool_end = self.dut_end = self.last = float("-inf")
+        self.state = _NOTHING  # what _read_apart left at ``seen``
 
     def holds(self, events: list[Event], first: int) -> bool:
         """True when ``events[first:]`` are surely what :func:`_apart_in_order` says apart
@@ -169,31 +185,11 @@ class ApartSoFar:
         ):
             self._restart(first)
             seen = first
-        tool_end, dut_end, last = self.tool_end, self.dut_end, self.last
-        note, char = EventKind.NOTE, EventKind.CHAR
-        for k in range(seen, n):
-            e = events[k]
-            kind = e.kind
-            if kind is note:
-                continue
-            start = e.start
-            if start < last:
-                self.ok = False
-                return False
-            last = start
-            if e.origin == TOOL:
-                if start < dut_end:
-                    self.ok = False
-                    return False
-                if e.end > tool_end:
-                    tool_end = e.end
-            elif kind is char:
-                if start < tool_end:
-                    self.ok = False
-                    return False
-                if e.end > dut_end:
-                    dut_end = e.end
-        self.tool_end, self.dut_end, self.last = tool_end, dut_end, last
+        state = _read_apart(events, seen, self.state)
+        if state is None:
+            self.ok = False
+            return False
+        self.state = state
         self.seen = n
         self._last = events[n - 1] if n else None
         return True

@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..protocol.binary import packet_length
-from ..protocol.framing import ETX, is_text
+from ..protocol.framing import CR, ETX, LF, is_text
 from ..protocol.timing import MULTILINE_GAP_MAX, TOLERANCE
 from ..transcript import Event, EventKind
 from .validity import ends_line
@@ -73,15 +73,12 @@ class Framing:
             return True
         before = more[-2] if len(more) > 1 else have[-1] if have else None
         # ends_line of the two, spelt out: asked per character
-        return before is not None and before.wire & 0x7F == _CR and more[-1].wire & 0x7F == _LF
+        return before is not None and before.wire & 0x7F == CR and more[-1].wire & 0x7F == LF
 
     def deadline(self, first: Event) -> float:
         """Hard bound for a DUT that trickles characters just inside each window."""
         per_char = first.duration + max(self.idle, self.line_wait if self.multiline else 0.0)
         return first.start + max(self.max_chars, self.max_text_chars) * per_char
-
-
-_CR, _LF = ord("\r"), ord("\n")
 
 
 def _head(chars: list[Event]) -> bytes:
