@@ -12,6 +12,7 @@ if __name__ == "__main__":  # `python -m conformance.cli`: Ctrl-C is ours before
     _EARLY_GUARD.install()
 
 import argparse
+import gc
 import os
 import sys
 from pathlib import Path
@@ -588,6 +589,11 @@ def main(argv: list[str] | None = None) -> int:
         GUARD.reset()  # an earlier in-process run's interrupt is not this one's
     GUARD.install()  # first of all: Ctrl-C from here on is recorded, never a traceback
     argv = list(sys.argv[1:] if argv is None else argv)
+    if whole_process and not (argv and not argv[0].startswith("-")):
+        # the main command's process: no collections outside its runs (conformance.gc_pace
+        # turns the collector on for each run); a subcommand keeps it (emulate, monitor and
+        # calibrate run for as long as the user wants)
+        gc.disable()
     try:
         code = _dispatch(argv)
     finally:

@@ -8,6 +8,12 @@ So, for the run, what was loaded before it (pytest, the suite, the libraries) is
 the collector's sight (:func:`gc.freeze`) and collections come every 20,000 net allocations
 instead of every 700; both are undone when the run ends. Cyclic garbage is still collected,
 only later.
+
+A whole ``sdi12-conform`` process turns the collector off before its imports (the modules,
+classes and functions it loads are never garbage, yet the collector walked them some dozens of
+times before the first case) and after its run (the reports are written, the process ends
+without freeing anything): :func:`slow_down` turns it on for the run whatever the caller did,
+and :func:`restore` leaves it as it was found.
 """
 
 from __future__ import annotations
@@ -25,15 +31,19 @@ class Pace:
 
     thresholds: tuple[int, int, int]
     froze: bool
+    #: whether the collector was on (a whole process turns it off outside its run)
+    enabled: bool = True
 
 
 def slow_down() -> Pace:
-    """Collect less often until :func:`restore`; freeze what exists unless something else
-    froze objects already (unfreezing would then thaw its objects too)."""
-    pace = Pace(gc.get_threshold(), gc.get_freeze_count() == 0)
+    """Collect less often until :func:`restore`, and collect at all (a run's cyclic garbage
+    is collected whatever its caller did outside it); freeze what exists unless something
+    else froze objects already (unfreezing would then thaw its objects too)."""
+    pace = Pace(gc.get_threshold(), gc.get_freeze_count() == 0, gc.isenabled())
     if pace.froze:
         gc.freeze()
     gc.set_threshold(*RUN_THRESHOLDS)
+    gc.enable()
     return pace
 
 
@@ -41,3 +51,5 @@ def restore(pace: Pace) -> None:
     gc.set_threshold(*pace.thresholds)
     if pace.froze:
         gc.unfreeze()
+    if not pace.enabled:
+        gc.disable()

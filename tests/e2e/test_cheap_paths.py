@@ -178,6 +178,32 @@ def test_transcript_lines_are_what_the_json_module_writes(tmp_path) -> None:
     assert path.read_text(encoding="utf-8") == expected
 
 
+def test_a_start_written_as_the_end_before_it_is_what_the_json_module_writes(tmp_path) -> None:
+    """The writer reuses the text of the line before's end for a start equal to it: back to
+    back characters, equal times after a signed zero, a non-plain line between, and random
+    times, some equal to the end before, are written as json.dumps writes each alone."""
+    rng = random.Random(11)
+    events = [
+        Event(EventKind.CHAR, DUT, 0.0, -0.0, wire=65),
+        Event(EventKind.CHAR, DUT, 0.0, 0.1 + 0.2, wire=66),  # -0.0 before: 0.0 apart
+        Event(EventKind.CHAR, DUT, -0.0, 0.3, wire=67),
+        Event(EventKind.CHAR, DUT, 0.30000000000000004, 0.4, wire=68),  # == 0.1 + 0.2
+        Event(EventKind.BREAK, TOOL, 3, 4),  # not plain: json.dumps
+        Event(EventKind.CHAR, DUT, 4.0, 5.0, wire=69),  # equal to the int 4 before
+        Event(EventKind.CHAR, DUT, 5.0, math.inf, wire=70),  # not finite: json.dumps
+        Event(EventKind.CHAR, DUT, 5.0, 6.0, wire=71),
+    ]
+    t = 0.0
+    for _ in range(3000):
+        start = t if rng.random() < 0.6 else t + rng.choice([1e-9, -1e-3, 0.0117, 1 / 3])
+        t = start + rng.choice([8.33e-3, 1 / 120, 0.0, 1e-17, 7.123456789e-3])
+        events.append(Event(EventKind.CHAR, DUT, start, t, wire=rng.randrange(256)))
+    path = tmp_path / "t.jsonl"
+    Transcript(list(events)).write_jsonl(str(path))
+    expected = "".join(json.dumps(e.to_json()) + "\n" for e in events)
+    assert path.read_text(encoding="utf-8") == expected
+
+
 def test_the_writer_says_whether_every_event_was_plain(tmp_path) -> None:
     """What write_recording keeps as a transcript's own reading rests on this answer."""
     plain = [Event(EventKind.CHAR, DUT, 1.0, 2.0, wire=65)]
@@ -269,6 +295,73 @@ def test_a_run_paces_the_collector_and_leaves_it_as_found(tmp_path) -> None:
     assert seen and set(seen) == {gc_pace.RUN_THRESHOLDS}
     assert gc.get_threshold() == before
     assert gc.get_freeze_count() == 0
+
+
+def test_a_run_collects_even_when_its_caller_turned_the_collector_off(tmp_path) -> None:
+    """A whole ``sdi12-conform`` process turns the collector off outside its run: the run
+    itself still collects, at its pace, and the collector is off again after it."""
+    from conformance.conduct import conduct
+    from conformance.run import RunOptions
+
+    seen = []
+
+    class Probe:
+        def pytest_runtest_call(self, item):
+            seen.append((gc.isenabled(), gc.get_threshold()))
+
+    options = RunOptions(report_dir=str(tmp_path), keyword="test_query_address")
+    gc.disable()
+    try:
+        result = conduct(options, html=False, rootdir=tmp_path, plugins=[Probe()])
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+    assert result.document is not None
+    assert seen and set(seen) == {(True, gc_pace.RUN_THRESHOLDS)}
+
+
+def test_the_main_commands_process_collects_only_during_its_run(tmp_path) -> None:
+    """``sdi12-conform --port sim`` as a process: the collector is off before and after
+    the run and on, at the run's pace, during it (a subcommand's process keeps it on)."""
+    probe = tmp_path / "probe.py"
+    probe.write_text(
+        "import gc, json, sys\n"
+        "from conformance import cli, conduct\n"
+        "seen = {}\n"
+        "real = conduct.conduct\n"
+        "class Probe:\n"
+        "    def pytest_runtest_call(self, item):\n"
+        "        seen['run'] = [gc.isenabled(), list(gc.get_threshold())]\n"
+        "def probed(options, **kw):\n"
+        "    seen['before'] = gc.isenabled()\n"
+        "    kw['plugins'] = [*kw.get('plugins', ()), Probe()]\n"
+        "    result = real(options, **kw)\n"
+        "    seen['after'] = gc.isenabled()\n"
+        "    return result\n"
+        "conduct.conduct = probed\n"
+        "cli.atexit_probe = seen\n"
+        "import atexit\n"
+        "atexit.register(lambda: print('SEEN ' + json.dumps(seen)))\n"
+        "sys.argv = ['sdi12-conform', *sys.argv[1:]]\n"
+        "cli.main()\n",
+        encoding="utf-8",
+    )
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, str(probe), "--port", "sim", "-k", "test_query_address",
+         "--report-dir", str(tmp_path / "r")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    line = next(x for x in done.stdout.splitlines() if x.startswith("SEEN "))
+    seen = json.loads(line[5:])
+    assert seen == {
+        "before": False,
+        "run": [True, list(gc_pace.RUN_THRESHOLDS)],
+        "after": False,
+    }
 
 
 #: What a sensor run on the simulated bus needs none of (issue 22: the start-up cost of a
