@@ -131,6 +131,9 @@ def parse_addresses(text: str) -> frozenset[str]:
 
 @dataclass(frozen=True)
 class Declaration:
+    """What a maker declares about a sensor (address, version, features, extended commands,
+    announced ttt): the run judges the device against this, and the plan times the run by it."""
+
     address: str | None = None
     sdi12_version: str | None = None  # "13" / "14"
     features: dict[str, bool] = field(default_factory=dict)

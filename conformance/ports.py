@@ -38,6 +38,9 @@ BUILTIN_KINDS = (factory, adapter_link, harness_device, recording_link)
 
 @dataclass
 class SimSpec:
+    """A ``sim://`` port string read apart: the simulated sensor's faults, profiles, version,
+    address, declaration, or the sensors of a simulated bus."""
+
     faults: tuple[str, ...] = ()
     profiles: tuple[str, ...] = ()  # firmware profiles (conformance.emulator.profiles)
     version: str = V14

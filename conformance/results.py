@@ -48,6 +48,9 @@ class CaseRecord:
 
 @dataclass
 class RequirementResult:
+    """One requirement's verdict for a run, with the findings and the cases behind it (what
+    verdicts.json, the HTML table and the console summary show per requirement)."""
+
     requirement: Requirement
     verdict: Verdict
     findings: list[Finding]

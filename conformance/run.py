@@ -32,6 +32,9 @@ if TYPE_CHECKING:  # the recorder role's runner: imported by the run that plays 
 
 @dataclass
 class RunOptions:
+    """Every option of one run (the CLI's, the plugin's and the callers' of
+    :func:`conformance.conduct.conduct`), once, as the run reads them."""
+
     port: str = "sim"
     role: str = "sensor"
     address: str | None = None
@@ -99,6 +102,9 @@ def now_iso() -> str:
 
 @dataclass
 class ConformanceRun:
+    """One run as it happens and after: its options, link, session and case records; the
+    reports are written from it, and its verdicts document stays on it for the caller."""
+
     options: RunOptions
     started: str = field(default_factory=now_iso)
     finished: str | None = None

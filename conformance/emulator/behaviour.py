@@ -29,6 +29,9 @@ REPLY_DELAY = 9.0e-3
 
 @dataclass(frozen=True)
 class Behaviour:
+    """Every knob of the reference sensor's behaviour (timing, replies, measurements), at a
+    conforming value by default; a fault is a change of one or more of them."""
+
     # -- receiving (section 7) ---------------------------------------------------------------
     break_threshold: float = BREAK_THRESHOLD
     # Marking needed after a break before a start bit counts as an address (R-7.0-05). The

@@ -34,6 +34,9 @@ from ..transcript import TOOL, Event, EventKind, decode_7e1
 
 @dataclass(frozen=True)
 class BusTime:
+    """The run's bus time (``run.bus`` in verdicts.json): the least time its exchanges needed
+    on the wire, the span from first to last event, and how many frames and breaks."""
+
     lower_bound: float  # s the exchanges needed at the very least
     span: float  # s from the first to the last event on the wire
     frames: int

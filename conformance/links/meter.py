@@ -72,6 +72,9 @@ class Worst:
 
 @dataclass
 class TimingMeter:
+    """What a run's stamps are worth, measured as it goes: the declared floor, and the worst
+    echo spread, batching, artefacts and reader lag seen (the run's timing uncertainty)."""
+
     declared: float  # s: the link's declared floor without echo (latency it cannot see)
     kernel_stamps: bool = False
     echo_spread: Worst = field(default_factory=Worst)

@@ -64,6 +64,9 @@ def recording_port(
 
 @dataclass
 class RecordingSpec:
+    """A ``recording:`` port string read apart: the file, its format, and for a capture the
+    channels, polarity and bit rate to decode it with."""
+
     path: str
     format: str = "jsonl"
     channel: str | None = None

@@ -41,6 +41,9 @@ T = TypeVar("T")
 
 @dataclass
 class Sweep:
+    """An address sweep's exchanges, the addresses the sensor refused, and how its own
+    address was put back."""
+
     exchanges: list[Exchange]
     refused: list[str]
     restore_note: str
@@ -48,6 +51,9 @@ class Sweep:
 
 @dataclass
 class InvalidAddressAttempt:
+    """An attempt to move the sensor to an invalid address: the exchanges, and whether the
+    sensor took the address."""
+
     exchanges: list[Exchange]
     accepted: bool
     #: an ``a!`` at the old address sent the same way right after it was answered: the

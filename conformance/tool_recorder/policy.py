@@ -15,6 +15,9 @@ from ..protocol.timing import CHAR_TIME, MULTILINE_GAP_MAX, RETRY_MAX, TOLERANCE
 
 @dataclass(frozen=True)
 class Policy:
+    """How the tool's recorder times its stimuli: each figure sits inside its section 7 limit
+    with a margin, so a link's own latency cannot push the tool out of spec."""
+
     # R-7.0-02: >= 12 ms of spacing; 12 + 0.4 tolerance + margin.
     break_duration: float = 13e-3
     # R-7.0-06: >= 8.33 ms of marking after the break before the first start bit.
