@@ -176,8 +176,15 @@ def run_suite(
     from .ports import PortError
     from .preflight import check_report_dir
     from .report_folder import run_folder
-    from .reports.diff import DiffError, load_run
     from .selection import SelectionError
+
+    refused: tuple[type[Exception], ...] = (
+        DeclarationError, PortError, UsageError, SelectionError
+    )  # fmt: skip
+    if baseline:  # the comparison's module only for a run that compares
+        from .reports.diff import DiffError, load_run
+
+        refused += (DiffError,)
 
     if options.port is None:
         options.port = "sim"
@@ -197,7 +204,7 @@ def run_suite(
         options.report_dir = str(report_dir)
         check_report_dir(report_dir)
         report_folder.acquire(report_dir)
-    except (DeclarationError, PortError, UsageError, SelectionError, DiffError) as exc:
+    except refused as exc:
         from .links.errors import PortMissing
 
         also = f", or judge the built-in simulated {options.role} with --port sim"

@@ -388,6 +388,7 @@ NOT_ON_A_SENSOR_RUN = (
     "conformance.kit",
     "conformance.calibrate",
     "conformance.suggest",
+    "conformance.reports.diff",  # --baseline only
     "execnet",
     "numpy",
     "asyncio",
