@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from . import gc_pace
 from .exits import (
     EXIT_COMPLIANT,
     EXIT_INCOMPLETE,
@@ -196,6 +197,8 @@ def run_suite(
         )
     try:
         real_time = check_run_options(options)
+        if _OWN_PROCESS and not real_time:  # a bounded run: no collections (gc_pace)
+            gc_pace.never_in_this_process()
         # the baseline is read before the run: a bad path is a usage error, not a late one
         baseline_run = load_run(baseline) if baseline else None
         # a folder of this run's own: a new one, or the named one unless a live run holds it
@@ -589,6 +592,10 @@ SUBCOMMAND_HELP = {
 }
 
 
+#: main() runs the main command in a process of its own (conformance.gc_pace)
+_OWN_PROCESS = False
+
+
 def main(argv: list[str] | None = None) -> int:
     """The program (``argv`` None: the process is ours to the end) or an in-process call."""
     whole_process = argv is None
@@ -598,8 +605,11 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if whole_process and not (argv and not argv[0].startswith("-")):
         # the main command's process: no collections outside its runs (conformance.gc_pace
-        # turns the collector on for each run); a subcommand keeps it (emulate, monitor and
-        # calibrate run for as long as the user wants)
+        # turns the collector on for each run), none at all for a run in virtual time
+        # (run_suite); a subcommand keeps it (emulate, monitor and calibrate run for as long
+        # as the user wants)
+        global _OWN_PROCESS
+        _OWN_PROCESS = True
         gc.disable()
     try:
         code = _dispatch(argv)

@@ -13,7 +13,8 @@ A whole ``sdi12-conform`` process turns the collector off before its imports (th
 classes and functions it loads are never garbage, yet the collector walked them some dozens of
 times before the first case) and after its run (the reports are written, the process ends
 without freeing anything): :func:`slow_down` turns it on for the run whatever the caller did,
-and :func:`restore` leaves it as it was found.
+and :func:`restore` leaves it as it was found. A whole process whose run is in virtual time
+(``--port sim``, an ``exec:`` harness) does not collect at all (:func:`never_in_this_process`).
 """
 
 from __future__ import annotations
@@ -23,6 +24,21 @@ from dataclasses import dataclass
 
 #: generation thresholds during a run (CPython's default: 700, 10, 10)
 RUN_THRESHOLDS = (20_000, 20, 20)
+
+
+#: set by :func:`never_in_this_process`
+_NEVER = False
+
+
+def never_in_this_process() -> None:
+    """No collections from here to the end of the process: for a process whose one job is a
+    bounded run in virtual time. Such a run leaves next to no cyclic garbage (the peak memory
+    of a whole ``--port sim`` process is the same with and without collections: 72 MB, 134 MB
+    against wrong-crc), yet its collections walked its 10^5 events: 1.5% of the process's
+    instructions. A real-time run, which lasts as long as the bus makes it, keeps collecting."""
+    global _NEVER
+    _NEVER = True
+    gc.disable()
 
 
 @dataclass(frozen=True)
@@ -39,6 +55,8 @@ def slow_down() -> Pace:
     """Collect less often until :func:`restore`, and collect at all (a run's cyclic garbage
     is collected whatever its caller did outside it); freeze what exists unless something
     else froze objects already (unfreezing would then thaw its objects too)."""
+    if _NEVER:  # the process collects nothing (never_in_this_process): nothing to pace
+        return Pace(gc.get_threshold(), froze=False, enabled=False)
     pace = Pace(gc.get_threshold(), gc.get_freeze_count() == 0, gc.isenabled())
     if pace.froze:
         gc.freeze()

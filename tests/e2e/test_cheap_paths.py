@@ -320,35 +320,36 @@ def test_a_run_collects_even_when_its_caller_turned_the_collector_off(tmp_path) 
     assert seen and set(seen) == {(True, gc_pace.RUN_THRESHOLDS)}
 
 
-def test_the_main_commands_process_collects_only_during_its_run(tmp_path) -> None:
-    """``sdi12-conform --port sim`` as a process: the collector is off before and after
-    the run and on, at the run's pace, during it (a subcommand's process keeps it on)."""
-    probe = tmp_path / "probe.py"
-    probe.write_text(
-        "import gc, json, sys\n"
-        "from conformance import cli, conduct\n"
-        "seen = {}\n"
-        "real = conduct.conduct\n"
-        "class Probe:\n"
-        "    def pytest_runtest_call(self, item):\n"
-        "        seen['run'] = [gc.isenabled(), list(gc.get_threshold())]\n"
-        "def probed(options, **kw):\n"
-        "    seen['before'] = gc.isenabled()\n"
-        "    kw['plugins'] = [*kw.get('plugins', ()), Probe()]\n"
-        "    result = real(options, **kw)\n"
-        "    seen['after'] = gc.isenabled()\n"
-        "    return result\n"
-        "conduct.conduct = probed\n"
-        "cli.atexit_probe = seen\n"
-        "import atexit\n"
-        "atexit.register(lambda: print('SEEN ' + json.dumps(seen)))\n"
-        "sys.argv = ['sdi12-conform', *sys.argv[1:]]\n"
-        "cli.main()\n",
-        encoding="utf-8",
-    )
+_PROBE = (
+    "import gc, json, sys\n"
+    "from conformance import cli, conduct\n"
+    "seen = {}\n"
+    "real = conduct.conduct\n"
+    "class Probe:\n"
+    "    def pytest_runtest_call(self, item):\n"
+    "        seen['run'] = gc.isenabled()\n"
+    "def probed(options, **kw):\n"
+    "    seen['before'] = gc.isenabled()\n"
+    "    kw['plugins'] = [*kw.get('plugins', ()), Probe()]\n"
+    "    result = real(options, **kw)\n"
+    "    seen['after'] = gc.isenabled()\n"
+    "    return result\n"
+    "conduct.conduct = probed\n"
+    "import atexit\n"
+    "atexit.register(lambda: print('SEEN ' + json.dumps(seen)))\n"
+    "sys.argv = ['sdi12-conform', *sys.argv[1:]]\n"
+    "cli.main()\n"
+)
+
+
+def test_the_main_commands_sim_process_never_collects(tmp_path) -> None:
+    """``sdi12-conform --port sim`` as a process: a bounded run in virtual time, so the
+    collector is off before, during and after the run (gc_pace.never_in_this_process)."""
     import subprocess
     import sys
 
+    probe = tmp_path / "probe.py"
+    probe.write_text(_PROBE, encoding="utf-8")
     done = subprocess.run(
         [sys.executable, str(probe), "--port", "sim", "-k", "test_query_address",
          "--report-dir", str(tmp_path / "r")],
@@ -356,12 +357,33 @@ def test_the_main_commands_process_collects_only_during_its_run(tmp_path) -> Non
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     line = next(x for x in done.stdout.splitlines() if x.startswith("SEEN "))
-    seen = json.loads(line[5:])
-    assert seen == {
-        "before": False,
-        "run": [True, list(gc_pace.RUN_THRESHOLDS)],
-        "after": False,
-    }
+    assert json.loads(line[5:]) == {"before": False, "run": False, "after": False}
+
+
+def test_a_process_that_never_collects_is_not_paced(monkeypatch) -> None:
+    monkeypatch.setattr(gc_pace, "_NEVER", True)
+    before = gc.get_threshold()
+    gc.disable()
+    try:
+        pace = gc_pace.slow_down()
+        assert not gc.isenabled() and gc.get_threshold() == before
+        assert gc.get_freeze_count() == 0
+        gc_pace.restore(pace)
+        assert not gc.isenabled() and gc.get_threshold() == before
+    finally:
+        gc.enable()
+
+
+def test_the_main_command_called_in_a_process_keeps_collecting(tmp_path) -> None:
+    """main(argv) in someone else's process (a test, a rack worker's caller) leaves the
+    collector to that process: on after the run, and runs after it still paced."""
+    from conformance import cli
+
+    assert gc.isenabled()
+    code = cli.main(["--port", "sim", "-k", "test_query_address",
+                     "--report-dir", str(tmp_path / "r"), "--plan", "never"])  # fmt: skip
+    assert code == 0
+    assert gc.isenabled() and not gc_pace._NEVER
 
 
 #: What a sensor run on the simulated bus needs none of (issue 22: the start-up cost of a
