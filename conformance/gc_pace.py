@@ -55,11 +55,14 @@ def slow_down() -> Pace:
     """Collect less often until :func:`restore`, and collect at all (a run's cyclic garbage
     is collected whatever its caller did outside it); freeze what exists unless something
     else froze objects already (unfreezing would then thaw its objects too)."""
-    if _NEVER:  # the process collects nothing (never_in_this_process): nothing to pace
-        return Pace(gc.get_threshold(), froze=False, enabled=False)
     pace = Pace(gc.get_threshold(), gc.get_freeze_count() == 0, gc.isenabled())
     if pace.froze:
         gc.freeze()
+    if _NEVER:
+        # nothing to pace (never_in_this_process), but what exists stays frozen: a library's
+        # own gc.collect() (hypothesis's register_random makes one a process) then walks
+        # only what the run made, not every module and object loaded before it
+        return pace
     gc.set_threshold(*RUN_THRESHOLDS)
     gc.enable()
     return pace
