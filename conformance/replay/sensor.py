@@ -15,6 +15,8 @@ run with that said, instead of inventing answers.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 from ..links.base import LinkError
 from ..protocol.timing import BIT_TIME, CHAR_TIME
 from ..sim.bus import Frame
@@ -134,6 +136,31 @@ class RecordedSensor:
         assert frame is not None, "the bus pops only a frame that was offered"
         self.next_reply += 1
         return frame
+
+    # -- sim.bus.PlansFrames: the replies due committed in one run ----------------------------
+    def frames_ahead(self) -> Iterator[tuple[float, int, float]] | None:
+        """``(start, wire, duration)`` of the replies :meth:`next_frame` would offer one
+        after the other while the tool sends nothing: every reply whose question has been
+        heard, in order (what one offers depends only on ``heard``, which only the tool's
+        events move, and on its own index). None when none is due, as ``next_frame`` says."""
+        k = self.next_reply
+        if k >= len(self.replies) or self._needs[k] > self.heard:
+            return None
+        return self._due(k, self.heard, self.offset)
+
+    def _due(self, k: int, heard: int, offset: float) -> Iterator[tuple[float, int, float]]:
+        replies, needs, touching = self.replies, self._needs, self._touching
+        count = len(replies)
+        while k < count and needs[k] <= heard:
+            reply = replies[k]
+            start = LINE_FREE if touching[k][heard > needs[k]] else reply.start + offset
+            yield start, reply.wire, reply.end - reply.start
+            k += 1
+
+    def pop_frames(self, count: int) -> None:
+        """Commit the first ``count`` of :meth:`frames_ahead`, as ``count`` :meth:`pop_frame`
+        calls would (the offer kept for the bus is keyed by the reply index: it moves on)."""
+        self.next_reply += count
 
 
 def _touching(reply: Event, before: Event | None) -> bool:
