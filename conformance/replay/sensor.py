@@ -15,6 +15,7 @@ run with that said, instead of inventing answers.
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Iterator
 from operator import attrgetter
 
@@ -53,13 +54,10 @@ class RecordedSensor:
         wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=_START_END)
         self.tool = [e for e in wire if e.origin == TOOL]
         self.replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
-        # how many tool events the recording has before each reply character starts
-        self._needs: list[int] = []
-        i = 0
-        for reply in self.replies:
-            while i < len(self.tool) and self.tool[i].start < reply.start:
-                i += 1
-            self._needs.append(i)
+        # how many tool events the recording has before each reply character starts (the
+        # tool's starts never decrease: they are sorted with the rest)
+        starts = [e.start for e in self.tool]
+        self._needs: list[int] = [bisect_left(starts, reply.start) for reply in self.replies]
         self._touching = _touching_each(self.tool, self.replies, self._needs)
         self.heard = 0  # tool events matched so far
         self.next_reply = 0

@@ -388,6 +388,8 @@ def test_the_replayed_sensors_planned_replies_are_its_offers_in_turn(seed, uncer
     events = [replace(e, uncertainty=uncertainty) for e in traffic(seed, seconds=3.0)]
     sensor = RecordedSensor(events)
     tool = sorted((e for e in events if e.origin == TOOL), key=lambda e: (e.start, e.end))
+    # each reply's question: the tool's events that start before it, counted one by one
+    assert sensor._needs == [sum(t.start < r.start for t in tool) for r in sensor.replies]
     planned = popped = 0
     for n, e in enumerate([*tool, None]):
         expected = offered_one_by_one(sensor)
