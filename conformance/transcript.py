@@ -109,9 +109,26 @@ _SET = tuple(Event.__dict__[name].__set__ for name in Event.__slots__)  # each f
 
 def wire_event(kind: EventKind, origin: str, start: float, end: float, wire: int = 0) -> Event:
     """``Event(kind, origin, start, end, wire=wire)``, every other field at its default, made
-    without the frozen dataclass's ``__init__`` (a ``setattr`` by name per field, two thirds
-    of the cost): the sim bus makes one per character, 10^4 to 10^5 a run. Sets every slot
-    (``tests/sim/test_bus.py`` holds it to the constructor field by field)."""
+    by :func:`full_event` (no frozen ``__init__``): the sim bus makes one per character, 10^4
+    to 10^5 a run (``tests/sim/test_bus.py`` holds it to the constructor field by field)."""
+    return full_event(kind, origin, start, end, wire, "", 0.0, None)
+
+
+def full_event(
+    kind: EventKind,
+    origin: str,
+    start: float,
+    end: float,
+    wire: int,
+    text: str,
+    uncertainty: float,
+    duration_uncertainty: float | None,
+) -> Event:
+    """``Event(kind, origin, start, end, wire, text, uncertainty, duration_uncertainty)``
+    made without the frozen dataclass's ``__init__`` (a ``setattr`` by name per field, two
+    thirds of the cost), every slot set: the sim bus (:func:`wire_event`), a capture's
+    decoder and its TX merge make one per character, 10^4 to 10^5 a run, 10^6 an hour's
+    capture."""
     event = _new(Event)
     set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = _SET
     set_kind(event, kind)
@@ -119,9 +136,9 @@ def wire_event(kind: EventKind, origin: str, start: float, end: float, wire: int
     set_start(event, start)
     set_end(event, end)
     set_wire(event, wire)
-    set_text(event, "")
-    set_u(event, 0.0)
-    set_du(event, None)
+    set_text(event, text)
+    set_u(event, uncertainty)
+    set_du(event, duration_uncertainty)
     return event
 
 

@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from itertools import chain
 
-from ..transcript import DUT, TOOL, Event, EventKind
+from ..transcript import DUT, TOOL, Event, EventKind, full_event
 from .edges import Edges
 from .errors import CaptureError
 from .formats import read_edges, sniff
@@ -269,7 +269,7 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
     j = 0
     n_tx = len(tx)
     matched = 0
-    char = EventKind.CHAR
+    char, event = EventKind.CHAR, full_event
     for ev in bus:
         start = ev.start
         while j < n_tx and tx[j].start < start - tolerance:
@@ -286,7 +286,7 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
                 matched += 1
                 j += 1
         du = ev.duration_uncertainty
-        append(Event(ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty, du))
+        append(event(ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty, du))
     return out, n_tx - matched
 
 

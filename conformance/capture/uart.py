@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 from ..protocol.timing import BREAK_MIN, BREAK_NEVER
-from ..transcript import BUS, Event, EventKind
+from ..transcript import BUS, Event, EventKind, full_event
 
 SPACING_PULSE = "spacing pulse"  # text of a BREAK event 6.5-12 ms long (R-7.0-03/04)
 
@@ -426,7 +426,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
         return
     buf, i, more, last_end = state
     prior_bt: float | None = None  # the previous clean character's bit time (see decode)
-    exact_below, char, bus, event, decoded = _EXACT_BELOW, EventKind.CHAR, BUS, Event, Decoded
+    exact_below, char, bus, event, decoded = _EXACT_BELOW, EventKind.CHAR, BUS, full_event, Decoded
     while True:
         if more and len(buf) - i < 2:
             buf, more = _refill(src, buf, i, float("-inf"))
@@ -487,7 +487,7 @@ def _scan(src: Iterator[list[int]], level: int, line: _Line) -> Iterator[Decoded
             # the line marked: the bits after the end are unknown, not marking
             yield Decoded("partial", None, start, t0 + end / tick_rate)
             return
-        ev = event(char, bus, start, t0 + end / tick_rate, reading.wire, "", uncertainty)
+        ev = event(char, bus, start, t0 + end / tick_rate, reading.wire, "", uncertainty, None)
         marking = None if last_end is None else max(0.0, (s - last_end) / tick_rate)
         last_end = end
         prior_bt = None if framing_error else used  # 8N1 binary bytes fail 7E1 parity

@@ -32,6 +32,22 @@ def test_a_probes_transitions_are_its_levels_transitions(dtype, words, bit, prev
     )
 
 
+@settings(max_examples=200, deadline=None)
+@given(
+    st.sampled_from([np.uint8, np.dtype("<u2"), np.dtype("<u4"), np.dtype("<u8")]),
+    st.lists(st.integers(0, 2**64 - 1), min_size=1, max_size=60),
+    st.lists(st.integers(0, 63), min_size=1, max_size=8, unique=True),
+)
+def test_each_probes_changes_are_counted_as_its_levels_change(dtype, words, bits):
+    """``probe_changes`` (which picks the busiest probe of a session) counts what a pass over
+    each probe's own levels counts."""
+    block = np.array(words, dtype=np.uint64).astype(dtype)
+    probes = {f"D{b}": b % (8 * block.itemsize) for b in bits}
+    assert sigrok.probe_changes(block, probes) == {
+        name: int(np.count_nonzero(np.diff((block >> bit) & 1))) for name, bit in probes.items()
+    }
+
+
 @pytest.mark.parametrize("block", [997, 1 << 22])
 def test_a_session_reads_as_its_levels_say(tmp_path, monkeypatch, block):
     """Three probes over many blocks (edges on the blocks' bounds too), one idle low."""

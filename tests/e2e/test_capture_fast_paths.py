@@ -6,7 +6,9 @@ line against ``json.dumps``, and a written transcript kept as its reading agains
 
 from __future__ import annotations
 
+import copy
 import json
+import shutil
 from dataclasses import replace
 
 import numpy as np
@@ -21,7 +23,15 @@ from conformance.replay import recording
 from conformance.replay.recording import read_recording, write_recording
 from conformance.replay.sensor import LINE_FREE, RecordedSensor
 from conformance.sim.bus import Frame
-from conformance.transcript import DUT, TOOL, Event, EventKind, json_line, to_wire_7e1
+from conformance.transcript import (
+    DUT,
+    TOOL,
+    Event,
+    EventKind,
+    full_event,
+    json_line,
+    to_wire_7e1,
+)
 from tests.support.capture_digest import traffic  # noqa: E402
 
 RATES = st.sampled_from([1_000.0, 48_000.0, 100_000.0, 625_000.0, 1_000_000.0, 500.0])
@@ -212,10 +222,8 @@ TEXTS = st.text(st.characters(), max_size=12)
 FLOATS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True), st.integers(-5, 5), st.just(-0.0)
 )
-
-
-@settings(max_examples=400, deadline=None)
-@given(
+#: every field of an Event, in order, with the awkward values a line or a copy must keep
+EVENT_FIELDS = (
     st.sampled_from(list(EventKind)),
     st.sampled_from([TOOL, DUT, "bus", 'é\n"x']),
     FLOATS,
@@ -225,9 +233,25 @@ FLOATS = st.one_of(
     FLOATS,
     st.one_of(st.none(), FLOATS),
 )
+
+
+@settings(max_examples=400, deadline=None)
+@given(*EVENT_FIELDS)
 def test_json_line_is_json_dumps(kind, origin, start, end, wire, text, unc, du):
     e = Event(kind, origin, start, end, wire, text, unc, du)
     assert json_line(e) == json.dumps(e.to_json()) + "\n"
+
+
+@settings(max_examples=200, deadline=None)
+@given(*EVENT_FIELDS)
+def test_full_event_is_the_event_its_constructor_makes(kind, origin, start, end, wire, text, u, du):
+    """transcript.full_event (the capture decoder's and TX merge's fast way to make an
+    event) sets every field as the frozen constructor does: equal, same hash, same types."""
+    fields = (kind, origin, start, end, wire, text, u, du)
+    fast, made = full_event(*fields), Event(*fields)
+    assert fast == made and hash(fast) == hash(made)
+    for name in Event.__slots__:
+        assert getattr(fast, name) is getattr(made, name)
 
 
 def test_a_written_transcript_is_its_own_reading(tmp_path, monkeypatch):
@@ -341,3 +365,99 @@ def test_on_a_tie_the_tools_event_is_the_one_before_a_reply():
     sensor.on_char(0x30, 0.0, 1.0)
     sensor.pop_frame()
     assert sensor.next_frame() == offer_worked_out(sensor) == Frame(1.2, 0x32, 0.8)
+
+
+def offered_one_by_one(sensor: RecordedSensor) -> list[tuple[float, int, float]]:
+    """What :meth:`RecordedSensor.next_frame` offers frame after frame, each popped, while
+    the tool sends nothing: the straightforward reading of ``frames_ahead``. Works on a copy
+    (the sensor itself is left as it was)."""
+    twin = copy.copy(sensor)
+    offered = []
+    while (frame := twin.next_frame()) is not None:
+        offered.append((frame.start, frame.wire, frame.duration))
+        twin.pop_frame()
+    return offered
+
+
+@pytest.mark.parametrize(("seed", "uncertainty"), [(3, 0.0), (7, 1e-5), (8, 2e-3)])
+def test_the_replayed_sensors_planned_replies_are_its_offers_in_turn(seed, uncertainty):
+    """:meth:`RecordedSensor.frames_ahead` (the sim bus commits them in one run) at every
+    point of a replay, with the tool late or early against the recording and some replies
+    left pending, is what ``next_frame``/``pop_frame`` would offer one by one; and
+    ``pop_frames(n)`` leaves the sensor where n ``pop_frame`` calls would."""
+    events = [replace(e, uncertainty=uncertainty) for e in traffic(seed, seconds=3.0)]
+    sensor = RecordedSensor(events)
+    tool = sorted((e for e in events if e.origin == TOOL), key=lambda e: (e.start, e.end))
+    # each reply's question: the tool's events that start before it, counted one by one
+    assert sensor._needs == [sum(t.start < r.start for t in tool) for r in sensor.replies]
+    planned = popped = 0
+    for n, e in enumerate([*tool, None]):
+        expected = offered_one_by_one(sensor)
+        ahead = sensor.frames_ahead()
+        assert (ahead is None) == (not expected)
+        if ahead is not None and (n % 3 or e is None):
+            got = list(ahead)
+            assert got == expected
+            take = len(got) if n % 2 or e is None else (len(got) + 1) // 2
+            twin = copy.copy(sensor)
+            for _ in range(take):
+                twin.pop_frame()
+            sensor.pop_frames(take)
+            assert (sensor.next_reply, sensor.next_frame()) == (twin.next_reply, twin.next_frame())
+            planned += take
+            popped += take
+        if e is None:
+            break
+        shift = (n % 7 - 3) * 1e-4  # the tool now late, now early
+        if e.kind is EventKind.BREAK:
+            sensor.on_break(e.start + shift, e.end + shift)
+        else:
+            sensor.on_char(e.wire, e.start + shift, e.end + shift)
+    assert popped == len(sensor.replies) and planned > 20
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fault", ["response-too-early", "wrong-crc", "late-service-request"])
+def test_a_capture_replayed_in_planned_runs_is_the_replay_frame_by_frame(
+    tmp_path, monkeypatch, fault
+):
+    """A fault run's capture (exported with the tool's TX, decoded as ``judge`` does) replayed
+    with the recorded sensor's replies committed in runs gives the transcript and the
+    verdicts of the replay frame by frame: event for event, finding for finding."""
+    from conformance.capture.export import export_events
+    from conformance.conduct import conduct, run_into
+    from conformance.offline.judge import plan
+    from conformance.sim.bus import SimBus
+
+    run_into(tmp_path / "live", f"sim://?faults={fault}")
+    events = read_recording(tmp_path / "live").events
+    notes = [e for e in events if e.kind is EventKind.NOTE]
+    export_events(events, str(tmp_path / "run.sr"), "sr", tool_channel=True, notes=notes)
+    replays, in_runs = [], []
+    pop_frames = RecordedSensor.pop_frames
+    monkeypatch.setattr(
+        RecordedSensor, "pop_frames", lambda self, n: in_runs.append(n) or pop_frames(self, n)
+    )
+    for planned in (True, False):
+        if not planned:
+            assert sum(in_runs) > 100  # the runs were taken: the comparison compares something
+            monkeypatch.setattr(SimBus, "planned_run", lambda self: None)
+        again = tmp_path / "capture"  # the same folder, named in the run's notes
+        shutil.rmtree(again, ignore_errors=True)
+        found = plan([str(tmp_path / "run.sr"), "--report-dir", str(again)])
+        result = conduct(replace(found.replay, report_dir=str(again)), html=False, rootdir=again)
+        replays.append((list(result.run.link.transcript.events), steady(result.document)))
+    assert replays[0][0] and replays[0] == replays[1]
+
+
+#: what differs between two runs of the same thing: wall-clock stamps and the manifest's hashes
+VOLATILE = frozenset(("started", "finished", "duration_s", "wall_s", "cpu_s", "manifest"))
+
+
+def steady(data: object) -> object:
+    """``data`` (a verdicts.json document) without its :data:`VOLATILE` keys."""
+    if isinstance(data, dict):
+        return {k: steady(v) for k, v in data.items() if k not in VOLATILE}
+    if isinstance(data, list):
+        return [steady(v) for v in data]
+    return data
