@@ -39,46 +39,47 @@ pytest_plugins = ["pytester"]  # tests/test_conftest.py runs tiny sessions
 # CI's not-real-time session (.ci/test) runs under pytest-xdist with --dist loadfile, which
 # gives each worker a whole module at a time, in the order of its work queue. By default
 # xdist 3.8 orders that queue by the number of tests a module holds, so the sensor matrix's
-# rows modules (31 tests, 60-75 s of CPU each) started about half-way through, and the
+# rows modules (31 tests, 53-67 s of CPU each) started about half-way through, and the
 # modules that mostly wait on a line paced in real time (hostile devices on socket://) last:
 # a tail with a core idle. .ci/test passes --no-loadscope-reorder, so the queue follows the
 # collection order, and the hook below puts the modules of FIRST first, in that order; every
 # other module keeps its place after them. Only the order changes: every test still runs, in
 # the same module, with the same fixtures.
 #
-# Measured (stop 37, shared 2-core machine): the not-real-time session's sum of test
-# durations per module (--durations=0, 4 workers, the real-time session beside it); each
-# module's share of the 4,599 s in parentheses.
+# Measured (stop 37, shared 2-core machine, benchmarks/ci_schedule.py's plugin): each module's
+# CPU in the not-real-time session, its own and its subprocesses', with its share of the
+# session's 788 s; the waiting modules with the wall time they took alone.
 
 #: Modules that mostly wait (a CLI subprocess judging a device paced at 1200 baud on
 #: ``socket://``): first, so their waits overlap the others' CPU instead of ending the session.
 WAITING = (
-    "tests/e2e/test_hostile_devices.py",  # 157 s (3.4%)
-    "tests/e2e/test_hostile_replies.py",  # 94 s (2.0%)
+    "tests/e2e/test_hostile_devices.py",  # 13 s of CPU, 167 s of wall alone
+    "tests/e2e/test_hostile_replies.py",  # 4 s of CPU, 94 s of wall alone
 )
 
-#: Then the modules that take longest, longest first (they are CPU-bound).
+#: Then the modules that take most CPU, most first.
 LONGEST = (
-    "tests/matrices/test_sensor_matrix_rows_4.py",  # 407 s (8.9%)
-    "tests/matrices/test_sensor_matrix_rows_1.py",  # 368 s (8.0%)
-    "tests/e2e/test_live_bus.py",  # 372 s (8.1%)
-    "tests/commands/test_passive.py",  # 343 s (7.5%)
-    "tests/matrices/test_sensor_matrix_rows_3.py",  # 332 s (7.2%)
-    "tests/matrices/test_sensor_matrix_rows_2.py",  # 328 s (7.1%)
-    "tests/matrices/test_combinations.py",  # 291 s (6.3%)
-    "tests/matrices/test_recorder_matrix.py",  # 272 s (5.9%)
-    "tests/e2e/test_first_hour.py",  # 190 s (4.1%)
-    "tests/offline/test_judge.py",  # 157 s (3.4%)
-    "tests/reports/test_diff.py",  # 130 s (2.8%)
-    "tests/kit/test_arduino_sensor.py",  # 118 s (2.6%)
-    "tests/e2e/test_case_order.py",  # 92 s (2.0%)
-    "tests/test_cli.py",  # 68 s (1.5%)
-    "tests/recorder/test_capability.py",  # 65 s (1.4%)
-    "tests/recorder/test_scenario_runner.py",  # 47 s (1.0%)
-    "tests/e2e/test_nothing_under_it.py",  # 46 s (1.0%)
-    "tests/protocol/test_binary.py",  # 43 s (0.9%)
-    "tests/e2e/test_rack.py",  # 42 s (0.9%)
-    "tests/e2e/test_capture_fast_paths.py",  # 41 s (0.9%)
+    "tests/matrices/test_sensor_matrix_rows_4.py",  # 67 s (8.6%)
+    "tests/matrices/test_sensor_matrix_rows_1.py",  # 61 s (7.7%)
+    "tests/matrices/test_sensor_matrix_rows_3.py",  # 56 s (7.1%)
+    "tests/matrices/test_sensor_matrix_rows_2.py",  # 53 s (6.7%)
+    "tests/commands/test_passive.py",  # 49 s (6.2%)
+    "tests/matrices/test_combinations.py",  # 43 s (5.5%)
+    "tests/e2e/test_live_bus.py",  # 39 s (4.9%)
+    "tests/matrices/test_recorder_matrix.py",  # 36 s (4.6%)
+    "tests/e2e/test_first_hour.py",  # 26 s (3.3%)
+    "tests/e2e/test_roundtrip_commands.py",  # 24 s (3.0%)
+    "tests/e2e/test_harness_examples.py",  # 23 s (3.0%)
+    "tests/offline/test_judge.py",  # 21 s (2.6%)
+    "tests/kit/test_arduino_sensor.py",  # 20 s (2.6%)
+    "tests/e2e/test_case_order.py",  # 19 s (2.4%)
+    "tests/recorder/test_capability.py",  # 11 s (1.4%)
+    "tests/test_cli.py",  # 9 s (1.2%)
+    "tests/reports/test_diff.py",  # 9 s (1.2%)
+    "tests/kit/test_kit_batch.py",  # 9 s (1.2%)
+    "tests/e2e/test_capture_fuzz.py",  # 9 s (1.1%)
+    "tests/kit/test_arduino_logger.py",  # 9 s (1.1%)
+    "tests/e2e/test_verdicts_unchanged.py",  # 8 s (1.1%)
 )
 
 #: The modules that go first, in order.
