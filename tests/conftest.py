@@ -6,11 +6,15 @@ false verdict. A skip like that must not vanish among ordinary skips, so every s
 ``the machine was too busy`` and the figure it measured (how late the served line fell, or the
 timing uncertainty that left a verdict INCONCLUSIVE), and the hook below lists them in a
 section of their own at the end of the run, even with ``-q`` and under pytest-xdist.
+
+The modules are handed out longest first (:data:`FIRST`), so that CI's workers do not end the
+session on a long module started last.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 
 import pytest
 from hypothesis import HealthCheck, settings
@@ -28,6 +32,78 @@ settings.load_profile("project")
 os.environ.setdefault("SDI12_PLAN", "never")
 
 pytest_plugins = ["pytester"]  # tests/test_conftest.py runs tiny sessions
+
+
+# The order the test modules are handed out in: the long ones first.
+#
+# CI's not-real-time session (.ci/test) runs under pytest-xdist with --dist loadfile, which
+# gives each worker a whole module at a time, in the order of its work queue. By default
+# xdist 3.8 orders that queue by the number of tests a module holds, so the sensor matrix's
+# rows modules (31 tests, 53-67 s of CPU each) started about half-way through, and the
+# modules that mostly wait on a line paced in real time (hostile devices on socket://) last:
+# a tail with a core idle. .ci/test passes --no-loadscope-reorder, so the queue follows the
+# collection order, and the hook below puts the modules of FIRST first, in that order; every
+# other module keeps its place after them. Only the order changes: every test still runs, in
+# the same module, with the same fixtures.
+#
+# Measured (stop 37, shared 2-core machine, benchmarks/ci_schedule.py's plugin): each module's
+# CPU in the not-real-time session, its own and its subprocesses', with its share of the
+# session's 788 s; the waiting modules with the wall time they took alone.
+
+#: Modules that mostly wait (a CLI subprocess judging a device paced at 1200 baud on
+#: ``socket://``): first, so their waits overlap the others' CPU instead of ending the session.
+WAITING = (
+    "tests/e2e/test_hostile_devices.py",  # 13 s of CPU, 167 s of wall alone
+    "tests/e2e/test_hostile_replies.py",  # 4 s of CPU, 94 s of wall alone
+)
+
+#: Then the modules that take most CPU, most first.
+LONGEST = (
+    "tests/matrices/test_sensor_matrix_rows_4.py",  # 67 s (8.6%)
+    "tests/matrices/test_sensor_matrix_rows_1.py",  # 61 s (7.7%)
+    "tests/matrices/test_sensor_matrix_rows_3.py",  # 56 s (7.1%)
+    "tests/matrices/test_sensor_matrix_rows_2.py",  # 53 s (6.7%)
+    "tests/commands/test_passive.py",  # 49 s (6.2%)
+    "tests/matrices/test_combinations.py",  # 43 s (5.5%)
+    "tests/e2e/test_live_bus.py",  # 39 s (4.9%)
+    "tests/matrices/test_recorder_matrix.py",  # 36 s (4.6%)
+    "tests/e2e/test_first_hour.py",  # 26 s (3.3%)
+    "tests/e2e/test_roundtrip_commands.py",  # 24 s (3.0%)
+    "tests/e2e/test_harness_examples.py",  # 23 s (3.0%)
+    "tests/offline/test_judge.py",  # 21 s (2.6%)
+    "tests/kit/test_arduino_sensor.py",  # 20 s (2.6%)
+    "tests/e2e/test_case_order.py",  # 19 s (2.4%)
+    "tests/recorder/test_capability.py",  # 11 s (1.4%)
+    "tests/test_cli.py",  # 9 s (1.2%)
+    "tests/reports/test_diff.py",  # 9 s (1.2%)
+    "tests/kit/test_kit_batch.py",  # 9 s (1.2%)
+    "tests/e2e/test_capture_fuzz.py",  # 9 s (1.1%)
+    "tests/kit/test_arduino_logger.py",  # 9 s (1.1%)
+    "tests/e2e/test_verdicts_unchanged.py",  # 8 s (1.1%)
+)
+
+#: The modules that go first, in order.
+FIRST: tuple[str, ...] = WAITING + LONGEST
+
+
+def module_of(item: pytest.Item) -> str:
+    """The module part of a test's node id (``tests/e2e/test_rack.py``)."""
+    return item.nodeid.split("::", 1)[0]
+
+
+def longest_first(items: Sequence[pytest.Item]) -> list[pytest.Item]:
+    """``items`` with the modules of :data:`FIRST` first, in its order; within a module and
+    among the other modules, the order is kept (a stable sort by rank)."""
+    rank = {module: place for place, module in enumerate(FIRST)}
+    return sorted(items, key=lambda item: rank.get(module_of(item), len(FIRST)))
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest groups the items by their fixtures' scopes
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The longest modules first (the comment above :data:`WAITING` says why): CI's xdist
+    workers take whole modules in collection order (``.ci/test``, ``--no-loadscope-reorder``)."""
+    items[:] = longest_first(items)
+
 
 #: The phrase every busy-machine skip reason carries (with its measured figure after it).
 BUSY = "the machine was too busy"

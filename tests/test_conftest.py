@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.support.paths import TESTS
+from tests.support.paths import ROOT, TESTS
 
 CONFTEST = TESTS / "conftest.py"
 
@@ -58,3 +58,29 @@ def test_no_section_when_nothing_skipped_for_a_busy_machine(pytester):
     result = pytester.runpytest("-q", "-p", "no:xdist")
     result.assert_outcomes(passed=1)
     assert "machine was busy" not in result.stdout.str()
+
+
+def test_every_module_named_first_exists():
+    """A module renamed or removed would silently lose its place at the front."""
+    from tests.conftest import FIRST
+
+    assert len(set(FIRST)) == len(FIRST)
+    missing = [name for name in FIRST if not (ROOT / name).is_file()]
+    assert not missing, missing
+
+
+def test_the_longest_modules_are_collected_first_and_nothing_else_moves(pytester):
+    """Collection order is the order CI's xdist workers take the modules in (.ci/test)."""
+    from tests.conftest import FIRST
+
+    pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
+    two = "def test_one():\n    pass\n\ndef test_two():\n    pass\n"
+    by_name = ["tests/aaa/test_early_by_name.py", "tests/zzz/test_late_by_name.py"]
+    for name in [*by_name, FIRST[2], FIRST[0]]:
+        path = pytester.path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(two, encoding="utf-8")
+    result = pytester.runpytest("--collect-only", "-q", "-p", "no:xdist")
+    ids = [line for line in result.stdout.lines if "::test_" in line]
+    expected = [FIRST[0], FIRST[2], *by_name]
+    assert ids == [f"{m}::{t}" for m in expected for t in ("test_one", "test_two")], ids

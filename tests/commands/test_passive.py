@@ -12,6 +12,7 @@ The default selection keeps a few faults per role; ``matrix`` adds more (minutes
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import jsonschema
@@ -64,6 +65,24 @@ def live(tmp: Path, port: str, role: str) -> Path:
     return out
 
 
+LiveRuns = Callable[[str, str], Path]
+
+
+@pytest.fixture(scope="module")
+def live_runs(tmp_path_factory: pytest.TempPathFactory) -> LiveRuns:
+    """``live(port, role)``'s folder, made once in this module: several tests judge the same
+    run (the clean sensor, ``crc-missing``, the recorder's ``short-break``: eight runs were
+    three). The tests read the folder and write their judgements elsewhere."""
+    made: dict[tuple[str, str], Path] = {}
+
+    def run(port: str, role: str) -> Path:
+        if (port, role) not in made:
+            made[port, role] = live(tmp_path_factory.mktemp("live"), port, role)
+        return made[port, role]
+
+    return run
+
+
 def passive(recording: Path, role: str, out: Path, *extra: str) -> dict[str, str]:
     code = main(["judge", str(recording), "--passive", "--role", role, "--report-dir", str(out),
                  *extra])  # fmt: skip
@@ -78,8 +97,10 @@ def agreement(live_run: dict[str, str], judged: dict[str, str]) -> tuple[int, di
     return len(decided), differ
 
 
-def _check(tmp_path: Path, port: str, role: str, fault: str | None, capsys) -> None:
-    first = live(tmp_path, port, role)
+def _check(
+    tmp_path: Path, live_runs: LiveRuns, port: str, role: str, fault: str | None, capsys
+) -> None:
+    first = live_runs(port, role)
     judged = passive(first, role, tmp_path / "passive")
     before = verdicts(first)
     decided, contradictions = agreement(before, judged)
@@ -99,28 +120,28 @@ def _check(tmp_path: Path, port: str, role: str, fault: str | None, capsys) -> N
 
 @pytest.mark.slow
 @pytest.mark.parametrize("fault", [None, *SENSOR_SHOWN])
-def test_sensor_run_judged_passively_agrees(tmp_path, fault, capsys):
+def test_sensor_run_judged_passively_agrees(tmp_path, live_runs, fault, capsys):
     port = "sim" if fault is None else f"sim://?faults={fault}"
-    _check(tmp_path, port, "sensor", fault, capsys)
+    _check(tmp_path, live_runs, port, "sensor", fault, capsys)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("fault", [None, *RECORDER_SHOWN])
-def test_recorder_run_judged_passively_agrees(tmp_path, fault, capsys):
+def test_recorder_run_judged_passively_agrees(tmp_path, live_runs, fault, capsys):
     port = "sim" if fault is None else f"sim://?recorder-faults={fault}"
-    _check(tmp_path, port, "recorder", fault, capsys)
+    _check(tmp_path, live_runs, port, "recorder", fault, capsys)
 
 
 @pytest.mark.matrix
 @pytest.mark.parametrize("fault", SENSOR_MORE)
-def test_more_sensor_faults_judged_passively(tmp_path, fault, capsys):
-    _check(tmp_path, f"sim://?faults={fault}", "sensor", fault, capsys)
+def test_more_sensor_faults_judged_passively(tmp_path, live_runs, fault, capsys):
+    _check(tmp_path, live_runs, f"sim://?faults={fault}", "sensor", fault, capsys)
 
 
 @pytest.mark.matrix
 @pytest.mark.parametrize("fault", RECORDER_MORE)
-def test_more_recorder_faults_judged_passively(tmp_path, fault, capsys):
-    _check(tmp_path, f"sim://?recorder-faults={fault}", "recorder", fault, capsys)
+def test_more_recorder_faults_judged_passively(tmp_path, live_runs, fault, capsys):
+    _check(tmp_path, live_runs, f"sim://?recorder-faults={fault}", "recorder", fault, capsys)
 
 
 # crc-missing, not wrong-crc: the same CRC replies to infer directions in, without the
@@ -130,9 +151,11 @@ def test_more_recorder_faults_judged_passively(tmp_path, fault, capsys):
     [("sim://?faults=crc-missing", "sensor"), ("sim://?recorder-faults=short-break", "recorder")],
 )
 @pytest.mark.slow
-def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, port, role):
+def test_single_wire_capture_gives_the_transcripts_passive_verdicts(
+    tmp_path, live_runs, port, role
+):
     """Exported with no tool channel, every direction is inferred from the protocol."""
-    first = live(tmp_path, port, role)
+    first = live_runs(port, role)
     from_transcript = passive(first, role, tmp_path / "transcript")
     capture = tmp_path / "run.sr"
     export = ["export", str(first), "--to", "sr", "-o", str(capture), "--no-tool-channel"]
@@ -150,8 +173,8 @@ def test_single_wire_capture_gives_the_transcripts_passive_verdicts(tmp_path, po
 
 
 @pytest.mark.slow
-def test_both_roles_write_two_report_sets(tmp_path, capsys):
-    first = live(tmp_path, "sim://?faults=crc-missing", "sensor")
+def test_both_roles_write_two_report_sets(tmp_path, live_runs, capsys):
+    first = live_runs("sim://?faults=crc-missing", "sensor")
     capsys.readouterr()  # the live run's own summary
     out = tmp_path / "both"
     code = main(["judge", str(first), "--passive", "--role", "both", "--report-dir", str(out)])
@@ -165,10 +188,12 @@ def test_both_roles_write_two_report_sets(tmp_path, capsys):
     assert code == 1  # the worse of the two: the sensor's missing CRC
 
 
-def test_a_run_of_this_tool_is_judged_for_its_device_under_test_by_default(tmp_path, capsys):
+def test_a_run_of_this_tool_is_judged_for_its_device_under_test_by_default(
+    tmp_path, live_runs, capsys
+):
     """A run's recording holds the tool's own stimuli on the other side (short breaks, slow
     characters, invalid addresses on purpose): by default only the judged role's rules, said."""
-    first = live(tmp_path, "sim://?recorder-faults=short-break", "recorder")
+    first = live_runs("sim://?recorder-faults=short-break", "recorder")
     capsys.readouterr()
     out = tmp_path / "default"
     assert main(["judge", str(first), "--passive", "--report-dir", str(out)]) == 1
@@ -199,9 +224,9 @@ def test_address_limits_the_sensor_rules(tmp_path):
                 assert all(label.removeprefix("reply to ")[:1] == "7" for label in labels), f
 
 
-def test_unseen_rules_are_inconclusive_not_passed(tmp_path):
+def test_unseen_rules_are_inconclusive_not_passed(tmp_path, live_runs):
     """A recording with no aHB!: the binary rules are 'not seen in the recording'."""
-    first = live(tmp_path, "sim", "sensor")
+    first = live_runs("sim", "sensor")
     lines = (first / "transcript.jsonl").read_text(encoding="utf-8").splitlines()
     cut = tmp_path / "short.jsonl"
     cut.write_text("\n".join(lines[:400]) + "\n", encoding="utf-8")

@@ -58,7 +58,7 @@ def clean_bus(tmp_path_factory) -> tuple[Path, int, str]:
     out = io.StringIO()
     code = cmd_judge(
         [str(path), "--role", "both", "--report-dir", str(tmp / "judged")],
-        Console(file=out, width=200),
+        Console(file=out, width=1000),  # lines hold tmp paths: no wrap however long they are
     )
     return tmp / "judged", code, out.getvalue()
 
