@@ -6,12 +6,12 @@ busy bus (ten sensors polled back to back, ``benchmarks/capture_decode.busy_bus`
 by at most :data:`MB_PER_MINUTE` per minute of capture.
 
 Measured on the project's 2-core machine (peak RSS of the child, glibc's malloc arenas
-capped at one): 2 minutes 74-77 MB, 14 minutes 108 MB, so 2.6-2.8 MB a minute (the hour,
-uncapped: 250 MB); the tree before (57aa7db) 76 and 122 MB, 3.8 MB a minute (the hour: 312
+capped at one): 2 minutes 73-74 MB, 14 minutes 105 MB, so 2.6 MB a minute (the hour,
+uncapped: 238 MB); the tree before (57aa7db) 76 and 122 MB, 3.8 MB a minute (the hour: 318
 MB), which this test fails. The cap makes the figure repeatable: without it the decode's
 read-ahead thread gets an arena of its own, and the short run's peak was 75 or 81 MB from
 one run to the next; with it, runs of one length differ by 3 MB at most, against the 6 MB
-either tree stands off the limit over the 12 minutes between the two lengths. The short one
+or more either tree stands off the limit over the 12 minutes between the two lengths. The short one
 is judged twice and its lower peak taken (the steeper slope).
 """
 
