@@ -213,20 +213,25 @@ class Transcript:
         :func:`plain_fields`, which each line asks anyway (a caller keeping what it wrote as
         its own reading needs to know, and asking again cost a second pass over 10^5)."""
         plain = True
-        lines: list[str] = []
-        add = lines.append
         shown = _LastEnd()
-        for e in self.events:
-            if plain_fields(e):
-                add(_plain_line(e, shown))
-            else:
-                plain = False
-                add(json.dumps(e.to_json()) + "\n")
         with open(path, "w", encoding="utf-8") as fh:
-            fh.writelines(lines)
+            # written a block of lines at a time: an hour's capture is 43 MB of lines, which
+            # formatted whole before writing were the peak of a passive judgement's memory
+            for at in range(0, len(self.events), WRITE_BLOCK):
+                lines: list[str] = []
+                add = lines.append
+                for e in self.events[at : at + WRITE_BLOCK]:
+                    if plain_fields(e):
+                        add(_plain_line(e, shown))
+                    else:
+                        plain = False
+                        add(json.dumps(e.to_json()) + "\n")
+                fh.writelines(lines)
         return plain
 
 
+#: lines of a transcript formatted before they are written (bounded memory, few writes)
+WRITE_BLOCK = 4096
 _quote = json.encoder.encode_basestring_ascii  # how json.dumps writes a str (ensure_ascii)
 
 

@@ -22,9 +22,12 @@ scheduling latency) is the tool's overhead.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from operator import attrgetter
+from heapq import merge
+from itertools import islice
+from math import isfinite
+from operator import attrgetter, itemgetter
 
 from ..protocol.commands import CommandError, parse_command
 from ..protocol.responses import measurement_digits, parse_measurement_reply
@@ -56,35 +59,52 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     if not wire:
         return BusTime(0.0, 0.0, 0, 0)
     wire.sort(key=attrgetter("start"))
-    # one pass: each event's own span and the marking before it (as much as was forced)
-    spans: list[tuple[float, float]] = []
-    add = spans.append
     brk = EventKind.BREAK
+    breaks = sum(1 for e in wire if e.kind is brk)
+    frames = len(wire) - breaks
+    waits = _announced_waits(wire)
+    if _well_formed(wire):
+        # each event's own span and the marking before it come in start order: merged as
+        # they are made, never held (an hour's capture: 700,000 spans, 40 MB as a list)
+        spans = merge(_own_spans(wire), _gaps(wire), sorted(waits), key=itemgetter(0))
+        lower = _sweep(spans)
+    else:  # a time that is no number, or a break ending before it began: as it always was
+        lower = _sweep(sorted([*_own_spans(wire), *_gaps(wire), *waits]))
+    return BusTime(lower, wire[-1].end - wire[0].start, frames, breaks)
+
+
+def _own_spans(wire: list[Event]) -> Iterator[tuple[float, float]]:
+    """Each event's own span, in the events' (start) order."""
+    brk = EventKind.BREAK
+    for e in wire:
+        start = e.start
+        yield (start, e.end + MARKING_AFTER_BREAK) if e.kind is brk else (start, start + CHAR_TIME)
+
+
+def _gaps(wire: list[Event]) -> Iterator[tuple[float, float]]:
+    """The marking before each event, as much of it as was forced: in start order, since
+    each starts where the latest end so far lies."""
     previous = wire[0]
     previous_end = previous.end
-    breaks = int(previous.kind is brk)
-    add(_own_span(previous))
-    for e in wire[1:]:
+    for e in islice(wire, 1, None):
         start = e.start
-        if e.kind is brk:
-            breaks += 1
-            add((start, e.end + MARKING_AFTER_BREAK))
-        else:
-            add((start, start + CHAR_TIME))
         if start > previous_end:
-            add((previous_end, previous_end + _forced_gap(previous, e, start - previous_end)))
+            yield previous_end, previous_end + _forced_gap(previous, e, start - previous_end)
         if e.end >= previous_end:
             previous, previous_end = e, e.end
-    frames = len(wire) - breaks
-    spans += _announced_waits(wire)
-    return BusTime(_union(spans), wire[-1].end - wire[0].start, frames, breaks)
 
 
-def _own_span(e: Event) -> tuple[float, float]:
-    """A frame, or a break and the marking that must follow it (R-7.0-06)."""
-    if e.kind is EventKind.BREAK:
-        return e.start, e.end + MARKING_AFTER_BREAK
-    return e.start, e.start + CHAR_TIME
+def _well_formed(wire: list[Event]) -> bool:
+    """Whether every span starts where it may be merged in start order: finite times, and
+    no break ending (with its marking) before it began. Then the union of the spans does
+    not depend on how equal starts are ordered, and merging the sorted streams gives the
+    sum sorting them all gave, to the bit (``tests/links/test_bus_time.py``)."""
+    brk = EventKind.BREAK
+    return all(
+        isfinite(e.start) and isfinite(e.end)
+        and (e.kind is not brk or e.end + MARKING_AFTER_BREAK >= e.start)
+        for e in wire
+    )  # fmt: skip
 
 
 def _forced_gap(before: Event, after: Event, gap: float) -> float:
@@ -202,10 +222,11 @@ def announced_time(text: str, digits: int) -> int | None:
     return shape.ttt if shape.count is not None else None
 
 
-def _union(spans: list[tuple[float, float]]) -> float:
+def _sweep(spans: Iterable[tuple[float, float]]) -> float:
+    """The length of the union of ``spans``, given in start order."""
     total = 0.0
     current_start = current_end = None
-    for start, end in sorted(spans):
+    for start, end in spans:
         if current_end is None or start > current_end:
             if current_end is not None:
                 total += current_end - current_start

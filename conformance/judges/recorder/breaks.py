@@ -6,9 +6,13 @@ from __future__ import annotations
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..timing import judge_window
+from ..timing import MeasuredAsJudged, Window, judge_window
 from .common import SR_KINDS, combine
 from .measurements import service_request_end
+
+#: R-7.0-02's and R-7.0-06's windows, worked out once for the many breaks of a recording
+BREAK_LENGTH = Window("R-7.0-02", "break length", low=BREAK_MIN)
+MARKING = Window("R-7.0-06", "marking after the break", low=MARKING_AFTER_BREAK)
 
 
 def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
@@ -16,25 +20,23 @@ def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
     at least 8.33 ms before the first start bit of its command (both ±0.40 ms)."""
     # a break read by a UART as a NUL (a listen-only monitor) is known to have lasted only
     # at least a frame: its length, and so where it ended, carries that event's own doubt
+    # one judged interval each, its finding made only where the verdict shows it (an hour
+    # of a busy bus holds 15,000 breaks)
     lengths = [
-        judge_window(
-            "R-7.0-02",
-            "break length",
+        MeasuredAsJudged(
+            BREAK_LENGTH,
             b.duration,
             max(uncertainty, b.duration_uncertainty or 0.0),
-            low=BREAK_MIN,
-            evidence=[f"break at t={b.start:.3f} s"],
+            [f"break at t={b.start:.3f} s"],
         )
         for b in line.breaks
     ]
     markings = [
-        judge_window(
-            "R-7.0-06",
-            "marking after the break",
+        MeasuredAsJudged(
+            MARKING,
             s.first_char - s.break_event.end,
             max(uncertainty, s.break_event.duration_uncertainty or 0.0),
-            low=MARKING_AFTER_BREAK,
-            evidence=[f"before {s.at()}"],
+            [f"before {s.at()}"],
         )
         for s in line.transmissions
         if s.break_event is not None

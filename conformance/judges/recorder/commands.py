@@ -9,9 +9,14 @@ from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView
 from ..tally import Tally
-from ..timing import judge_window
+from ..timing import MeasuredAsJudged, Window
 from ..wire import judge_frame_lengths, judge_rate
 from .common import combine
+
+#: R-7.0-13's window, worked out once for the many gaps of a recording
+COMMAND_GAP = Window(
+    "R-7.0-13", "marking between command characters", high=INTER_CHAR_GAP_MAX, tolerance=0.0
+)
 
 
 def judge_command_text(line: TranscriptView) -> list[Finding]:
@@ -40,18 +45,8 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
         for s in line.transmissions
         for a, b in zip(s.chars, s.chars[1:], strict=False)
     ]
-    found = [
-        judge_window(
-            "R-7.0-13",
-            "marking between command characters",
-            gap,
-            uncertainty,
-            high=INTER_CHAR_GAP_MAX,
-            tolerance=0.0,
-            evidence=[f"in {s.at()}"],
-        )
-        for gap, s in gaps
-    ]
+    # one judged interval each, its finding made only where the verdict shows it
+    found = [MeasuredAsJudged(COMMAND_GAP, gap, uncertainty, [f"in {s.at()}"]) for gap, s in gaps]
     leaning = [
         (gap, s) for gap, s in gaps if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE
     ]

@@ -3,10 +3,13 @@ tool's decisions on how long a recorder may take."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from ...protocol.commands import SERVICE_REQUEST_KINDS
 from ...transcript import escape
 from ...verdicts import Finding
 from ...view.segments import Transmission
+from ..timing import Measured
 from ..timing import combine as combine_timing
 
 #: A recorder reacts to a service request (or to ttt running out) with aD0! within this long.
@@ -51,7 +54,7 @@ def record_of(transmissions: list[Transmission], texts: list[str] | None = None)
     ]
 
 
-def combine(rid: str, findings: list[Finding], what: str) -> Finding:
+def combine(rid: str, findings: Sequence[Finding | Measured], what: str) -> Finding:
     """Recorder limits are mostly minimums (break length, marking, waits): the smallest
     measurement is the one to show."""
     return combine_timing(rid, findings, what, smallest_is_worst=True)

@@ -1,0 +1,83 @@
+"""How a passive judgement's memory grows with the recording (issue 22: one hour of a busy
+1 MHz capture judged in bounded memory). It is NOT bounded yet: the events, their view and
+the records rebuilt from them are held whole while the report sets are made. What is held
+to a figure here is the growth: the peak resident memory of ``sdi12-conform judge`` over a
+busy bus (ten sensors polled back to back, ``benchmarks/capture_decode.busy_bus``) may grow
+by at most :data:`MB_PER_MINUTE` per minute of capture.
+
+Measured on the project's 2-core machine (peak RSS of the child, glibc's malloc arenas
+capped at one): 2 minutes 73-74 MB, 14 minutes 105 MB, so 2.6 MB a minute (the hour,
+uncapped: 238 MB); the tree before (57aa7db) 76 and 122 MB, 3.8 MB a minute (the hour: 318
+MB), which this test fails. The cap makes the figure repeatable: without it the decode's
+read-ahead thread gets an arena of its own, and the short run's peak was 75 or 81 MB from
+one run to the next; with it, runs of one length differ by 3 MB at most, against the 6 MB
+or more either tree stands off the limit over the 12 minutes between the two lengths. The short one
+is judged twice and its lower peak taken (the steeper slope).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+MB_PER_MINUTE = 3.3
+SHORT, LONG = 2.0, 14.0  # minutes
+
+#: judges the capture in this child process, then prints its own peak resident memory (MB)
+CHILD = (
+    "import json, resource, sys\n"
+    "from conformance.cli import main\n"
+    "try:\n"
+    "    code = main(['judge', sys.argv[1], '--report-dir', sys.argv[2]])\n"
+    "except SystemExit as exc:\n"
+    "    code = exc.code\n"
+    "peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024\n"
+    "print(json.dumps({'code': code, 'peak_mb': peak}))\n"
+)
+
+
+def busy_capture(path: Path, minutes: float) -> None:
+    """The benchmark's busy bus (break, ``aD0!``, an 18-character reply, addresses 0-9),
+    written as a 1 MHz sigrok session."""
+    bench = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
+    spec = importlib.util.spec_from_file_location("capture_decode_bench", bench)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    from conformance.capture import export_events
+
+    export_events(module.busy_bus(minutes * 60), str(path), sample_rate=1e6)
+
+
+def judged_peak(capture: Path, reports: Path) -> float:
+    env = {**os.environ, "MALLOC_ARENA_MAX": "1"}  # a repeatable peak (see above)
+    done = subprocess.run(
+        [sys.executable, "-c", CHILD, str(capture), str(reports)],
+        capture_output=True, text=True, check=True, env=env,
+    )  # fmt: skip
+    found = json.loads(done.stdout.strip().splitlines()[-1])
+    assert found["code"] == 2, done.stdout[-2000:]  # incomplete: no aI!, no measurement seen
+    assert len([p for p in reports.iterdir() if p.is_dir()]) == 11  # ten sensors, the recorder
+    return float(found["peak_mb"])
+
+
+@pytest.mark.slow
+def test_peak_memory_grows_at_most_its_figure_with_the_capture(tmp_path: Path):
+    peaks = {}
+    for minutes, times in ((SHORT, 2), (LONG, 1)):
+        capture = tmp_path / f"busy{minutes:g}.sr"
+        busy_capture(capture, minutes)
+        peaks[minutes] = min(
+            judged_peak(capture, tmp_path / f"reports{minutes:g}-{i}") for i in range(times)
+        )
+    growth = (peaks[LONG] - peaks[SHORT]) / (LONG - SHORT)
+    assert growth <= MB_PER_MINUTE, (
+        f"peak RSS {peaks[SHORT]:.0f} MB at {SHORT:g} min, {peaks[LONG]:.0f} MB at {LONG:g} "
+        f"min: {growth:.2f} MB a minute of capture, more than {MB_PER_MINUTE}"
+    )
