@@ -98,7 +98,7 @@ def _well_formed(wire: list[Event]) -> bool:
     """Whether every span starts where it may be merged in start order: finite times, and
     no break ending (with its marking) before it began. Then the union of the spans does
     not depend on how equal starts are ordered, and merging the sorted streams gives the
-    sum sorting them all gave, to the bit (``tests/links/test_bus_time.py``)."""
+    sum sorting them all gave, to the bit (``tests/links/test_bus_time_merged.py``)."""
     brk = EventKind.BREAK
     return all(
         isfinite(e.start) and isfinite(e.end)

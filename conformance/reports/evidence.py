@@ -122,7 +122,7 @@ class Positions:
     is searched by bisection over its start times, 8 bytes an event in an array, where the
     dict took some 90 (an hour's capture: 357,000 events, 32 MB held by every report of a
     passive judgement); one out of order, or with a start that is not a finite number, is
-    indexed by the dict as before. ``tests/reports/test_evidence.py`` holds the two to
+    indexed by the dict as before. ``tests/reports/test_evidence_positions.py`` holds the two to
     the same answers."""
 
     def __init__(self, events: Sequence[Event]) -> None:
