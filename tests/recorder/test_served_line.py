@@ -55,7 +55,8 @@ def skip_if_line_was_late(events: list[dict], what: object) -> None:
 
 @pytest.mark.realtime
 def test_golden_recorder_over_rfc2217_is_compliant(tmp_path):
-    code, data, events = run(tmp_path, SERVE)
+    with HostLag() as lag:
+        code, data, events = run(tmp_path, SERVE)
     verdicts = {r["id"]: r["verdict"] for r in data["requirements"]}
     bad = {rid: v for rid, v in verdicts.items() if v in ("FAIL", "WARN", "ERROR")}
     # never a FAIL, even when the host was too busy: a late served line makes them INCONCLUSIVE
@@ -83,7 +84,12 @@ def test_golden_recorder_over_rfc2217_is_compliant(tmp_path):
     assert {("break", "tool"), ("char", "tool"), ("char", "sensor0"), ("char", "sensor1")} <= kinds
     assert {e["uncertainty"] for e in events if e["kind"] != "note"} == {5e-3}
     breaks = [e["end"] - e["start"] for e in events if e["kind"] == "break"]
-    assert breaks and all(0.008 < b < 0.030 for b in breaks), breaks  # golden: 13 ms asked
+    assert breaks and all(b > 0.008 for b in breaks), breaks  # golden: 13 ms asked
+    # The in-process recorder ends its break after a host-timed sleep: a long break is wrong
+    # only when the host woke threads on time meanwhile (CI once measured 35 ms under load).
+    too_long = [round(b * 1e3, 2) for b in breaks if b >= 0.030]
+    wrong = f"breaks of {too_long} ms where 13 ms were asked" if too_long else ""
+    fail_unless_too_busy(max(worst_lateness(events), lag.worst), wrong, repr(breaks))
 
 
 @pytest.mark.realtime
