@@ -15,6 +15,13 @@ exchanges next to the wall time it took. The lower bound is the union of:
   abort, or giving up), for a concurrent one (C, CC, Cn, CCn, HA, HB) the next command to the
   same sensor. A break does not end a concurrent measurement (R-4.4.7-05): a recorder that
   breaks to talk to other sensors meanwhile still waits for ttt before it reads the data.
+- the rest of that ttt after the tool ended it sooner, when the tool's next command to the
+  sensor is a data command (``aD0!``, ``aDB0!``...) sent once ttt has run out. That command
+  asks whether the measurement the tool aborted (a break, R-4.4.5.1-01/02; a command to the
+  sensor, R-4.4.7.1-01) left data: a sensor that had not aborted has them only when ttt has
+  passed, and before it a sensor that did abort answers the same, so no recorder can show
+  the abort sooner and the wait is the verdict's, not the tool's patience. The grace the
+  tool listens past ttt for a late service request is still its own.
 
 Anything beyond that (retry spacing, listening windows for silence, patience past limits,
 scheduling latency) is the tool's overhead.
@@ -23,13 +30,13 @@ scheduling latency) is the tool's overhead.
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from heapq import merge
 from itertools import islice
 from math import isfinite
 from operator import attrgetter, itemgetter
 
-from ..protocol.commands import CommandError, parse_command
+from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..protocol.responses import measurement_digits, parse_measurement_reply
 from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
 from ..transcript import TOOL, Event, EventKind, decode_7e1
@@ -123,16 +130,23 @@ _BANG, _CR, _LF = ord("!"), ord("\r"), ord("\n")
 
 @dataclass
 class _Wait:
-    """The ttt a measurement announced: from ``start`` (the end of ``atttn``) to ``end``."""
+    """The ttt a measurement announced: from ``start`` (the end of ``atttn``) to ``end``;
+    ``ready`` is where ttt runs out, whatever cut the wait."""
 
     start: float
     end: float
     address: str
     concurrent: bool
+    ready: float = 0.0
 
-    def cut(self, at: float) -> None:
-        """The tool ended the wait at ``at`` (never before it began)."""
+    def __post_init__(self) -> None:
+        self.ready = self.end
+
+    def cut(self, at: float) -> bool:
+        """The tool ended the wait at ``at`` (never before it began); True if that was
+        before ttt ran out (an abort, or reading early)."""
         self.end = min(self.end, max(self.start, at))
+        return self.end < self.ready
 
 
 @dataclass
@@ -144,6 +158,10 @@ class _OpenWaits:
     every: list[_Wait]
     by_break: list[_Wait]  # M-type and V waits since the last break
     by_command: dict[str, list[_Wait]]  # concurrent waits, by address, until a command to it
+    # waits cut before ttt ran out, by address, that the next command to the sensor may show
+    # to have been the verdict's (a data command once ttt is over: see the module docstring)
+    aborted: dict[str, list[_Wait]] = field(default_factory=dict)
+    cut_by_command: dict[str, list[_Wait]] = field(default_factory=dict)  # by the one in hand
 
     def keep(self, wait: _Wait | None) -> None:
         if wait is None:
@@ -158,14 +176,28 @@ class _OpenWaits:
         """A break before ttt ran out aborts (or gives up on) an M-type wait: the tool chose
         that; a concurrent measurement runs on through it (R-4.4.7-05)."""
         for wait in self.by_break:
-            wait.cut(at)
+            if wait.cut(at):
+                self.aborted.setdefault(wait.address, []).append(wait)
         self.by_break = []
 
     def command_at(self, address: str, at: float) -> None:
         """A command to a sensor ends its concurrent measurement's wait there: read early,
         or aborted (R-4.4.7.1-01), it is the tool's choice."""
-        for wait in self.by_command.pop(address, ()):
-            wait.cut(at)
+        cut = [wait for wait in self.by_command.pop(address, ()) if wait.cut(at)]
+        if cut:
+            self.cut_by_command[address] = cut
+
+    def asked(self, address: str, data: bool, at: float) -> None:
+        """The tool's command to ``address`` that started at ``at`` is complete (``data``: a
+        D or DB command). It is the next command after the aborts before it: a data command
+        once ttt ran out counts each aborted wait in full. Waits this command cut wait for
+        the next one."""
+        for wait in self.aborted.pop(address, ()):
+            if data and at >= wait.ready:
+                wait.end = wait.ready
+        cut = self.cut_by_command.pop(address, None)
+        if cut:
+            self.aborted.setdefault(address, []).extend(cut)
 
 
 def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
@@ -180,7 +212,7 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
     brk = EventKind.BREAK
     for e in wire:  # breaks and characters only
         if e.kind is brk or (e.origin == TOOL and (reply or commanded)):
-            waits.keep(_announced_wait(command, reply))  # the exchange ends here
+            _exchange_ended(waits, command, reply)
             command, reply = [], []
             commanded = replied = False
         if e.kind is brk:
@@ -193,17 +225,31 @@ def _announced_waits(wire: list[Event]) -> list[tuple[float, float]]:
         elif commanded and not replied:
             reply.append(e)
             replied = e.wire & 0x7F == _LF and len(reply) >= 2 and reply[-2].wire & 0x7F == _CR
-    waits.keep(_announced_wait(command, reply))  # the last exchange
+    _exchange_ended(waits, command, reply)  # the last exchange
     return [(w.start, w.end) for w in waits.every]
 
 
-def _announced_wait(command: list[Event], reply: list[Event]) -> _Wait | None:
-    if not reply:
-        return None
+def _exchange_ended(waits: _OpenWaits, command: list[Event], reply: list[Event]) -> None:
+    """One exchange is over: the wait its reply announced, and what its command shows of the
+    aborted waits before it (:meth:`_OpenWaits.asked`)."""
+    if not command:
+        return
     try:
-        cmd = parse_command(decode_7e1(command))
-    except CommandError:
-        return None
+        cmd: Command | None = parse_command(decode_7e1(command))
+    except CommandError:  # no data command, yet the next one to its address all the same
+        cmd = None
+    if cmd is None:
+        waits.asked(chr(command[0].char7), False, command[0].start)
+        return
+    waits.asked(cmd.address, cmd.kind in _DATA_KINDS, command[0].start)
+    if reply:
+        waits.keep(_announced_wait(cmd, reply))
+
+
+_DATA_KINDS = frozenset({Kind.DATA, Kind.BINARY_DATA})
+
+
+def _announced_wait(cmd: Command, reply: list[Event]) -> _Wait | None:
     if not cmd.starts_measurement:
         return None
     ttt = announced_time(decode_7e1(reply), measurement_digits(cmd))

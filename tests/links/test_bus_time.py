@@ -85,10 +85,11 @@ def test_a_break_does_not_end_a_concurrent_measurements_wait():
 
 
 def test_a_break_still_ends_an_m_measurements_wait():
-    """A break aborts ``aM!`` (R-4.4.5.1-01): what the tool waits after it is its own choice."""
+    """A break aborts ``aM!`` (R-4.4.5.1-01): what the tool waits after it is its own choice
+    when nothing it sends next needs ttt to be over (here another measurement)."""
     w = Wire().brk().pause(9e-3).send(TOOL, "0M!").pause(9e-3).send(DUT, "00053\r\n")
     reply_end = w.t
-    w.pause(0.05).brk().pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    w.pause(0.05).brk().pause(5.2).brk().pause(9e-3).send(TOOL, "0M!")
     lower = bus_time(w.events).lower_bound
     assert lower < reply_end + 0.05 + 2 * (13e-3 + MARKING_AFTER_BREAK) + 9e-3 + 4 * CHAR_TIME
     assert lower > reply_end  # the 50 ms up to the abort were the sensor's
@@ -96,13 +97,63 @@ def test_a_break_still_ends_an_m_measurements_wait():
 
 def test_an_own_command_ends_a_concurrent_measurements_wait():
     """A command to the sensor itself aborts its concurrent measurement (R-4.4.7.1-01): the
-    tool chose to end the wait there, and waiting out ttt afterwards is its own patience."""
+    tool chose to end the wait there, and waiting out ttt afterwards is its own patience
+    when its next command to the sensor needs no ttt (here ``aI!`` again)."""
     w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
     w.pause(0.05).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
-    w.pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    w.pause(5.2).brk().pause(9e-3).send(TOOL, "0I!")
     lower = bus_time(w.events).lower_bound
     assert lower < 1.0  # frames, delays and the 50 ms of ttt before 0I!, not the 5.2 s
     assert lower > 0.05
+
+
+def test_data_asked_after_an_own_command_abort_counts_the_whole_ttt():
+    """``aD0!`` sent once ttt ran out after ``aI!`` aborted ``aC!`` asks whether the data
+    are gone (R-4.4.7.1-01): before ttt a sensor that ignored the abort answers as one that
+    obeyed, so no recorder shows the abort sooner and the whole ttt is the verdict's."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    reply_end = w.t
+    w.pause(0.05).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    assert lower >= reply_end + 5.0 - 1e-9  # the start, then the whole 5 s ttt
+    assert lower < w.t - 0.1  # the 5 ms and more past ttt stay the tool's own
+
+
+def test_data_asked_after_a_break_abort_counts_the_whole_ttt():
+    """The same for ``aM!`` aborted by a break (R-4.4.5.1-01/02): silence, then ``aD0!``
+    once ttt ran out."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0M!").pause(9e-3).send(DUT, "00053\r\n")
+    reply_end = w.t
+    w.pause(0.05).brk().pause(5.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    lower = bus_time(w.events).lower_bound
+    assert lower >= reply_end + 5.0 - 1e-9
+    assert lower < w.t - 0.1
+
+
+def test_data_asked_before_ttt_ran_out_leaves_an_abort_the_tools_choice():
+    """``aD0!`` right after the abort could show nothing ttt would: the wait stays cut."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    w.pause(0.05).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(1.0).brk().pause(9e-3).send(TOOL, "0D0!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(4.2).brk().pause(9e-3).send(TOOL, "0D0!")  # not the next command after the abort
+    assert bus_time(w.events).lower_bound < 1.0
+
+
+def test_only_the_next_command_to_the_sensor_shows_an_abort_was_needed():
+    """Another command to the sensor between the abort and ``aD0!`` (which a sensor might
+    take as the abort) leaves the wait cut; a command to another address does not."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    w.pause(0.05).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(1.0).brk().pause(9e-3).send(TOOL, "0!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(4.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    assert bus_time(w.events).lower_bound < 1.0
+    w = Wire().brk().pause(9e-3).send(TOOL, "0C!").pause(9e-3).send(DUT, "000520\r\n")
+    reply_end = w.t
+    w.pause(0.05).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
+    w.pause(1.0).brk().pause(9e-3).send(TOOL, "1!")  # another sensor: no answer
+    w.pause(4.2).brk().pause(9e-3).send(TOOL, "0D0!")
+    assert bus_time(w.events).lower_bound >= reply_end + 5.0 - 1e-9
 
 
 def test_a_concurrent_wait_at_another_address_is_not_ended_by_the_duts_commands():
