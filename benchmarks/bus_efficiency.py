@@ -7,6 +7,7 @@ would need for the same exchanges: frames, breaks, the marking after them, the s
 delays and announced measurement times) next to the wall time the run took, and their ratio.
 
     python benchmarks/bus_efficiency.py [-k EXPR] [--faults NAME,...] [--keep DIR]
+    python benchmarks/bus_efficiency.py --attribute DIR   (a kept run: where the rest went)
 
 Takes about as long as the suite's bus time (roughly five minutes for every case). The wall
 time counts everything the run did on the link's clock: the bus span (first to last event on
@@ -27,16 +28,25 @@ working directory first.
 from __future__ import annotations
 
 import argparse
+import bisect
 import json
 import os
 import subprocess
 import sys
 import tempfile
 import time
+from collections import defaultdict
 from pathlib import Path
 
 import conformance
+from conformance.capture.transcript_io import read_transcript_jsonl
 from conformance.emulator_server.process import EmulatorProcess
+from conformance.links.bus_time import bus_time, uncounted
+from conformance.transcript import TOOL, Event, EventKind, decode_7e1
+
+#: an uncounted stretch this long is listening on purpose (a wait, a probe's idle marking),
+#: not the turnaround, look and read grace around one exchange
+LONG = 0.05
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,7 +54,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("-k", dest="keyword", help="only cases matching this expression")
     p.add_argument("--faults", default="", help="emulator faults (default: clean)")
     p.add_argument("--keep", help="write the reports here instead of a temporary folder")
+    p.add_argument(
+        "--attribute",
+        metavar="DIR",
+        help="no run: sort the wall beyond the lower bound of a kept run by its causes",
+    )
     args = p.parse_args(argv)
+    if args.attribute:
+        events = read_transcript_jsonl(str(Path(args.attribute) / "transcript.jsonl"))
+        print(attribution(events))
+        return 0
     out = Path(args.keep or tempfile.mkdtemp(prefix="sdi12-bus-")).resolve()
     # the children start with ``-m conformance.cli``, which imports the package of the working
     # directory first: run them in the tree this script imported, so PYTHONPATH=OLD runs OLD
@@ -82,6 +101,66 @@ def main(argv: list[str] | None = None) -> int:
     print(f"load average         {_load(load_before)} before, {_load(os.getloadavg())} after")
     print(f"reports              {out}")
     return 0
+
+
+def attribution(events: list[Event]) -> str:
+    """A table of the span's uncounted stretches (:func:`bus_time.uncounted`) by what was
+    on the wire either side of them, with the commands before the longest ones: which wait
+    of which case the wall beyond the bound went to."""
+    wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=lambda e: e.start)
+    starts = [e.start for e in wire]
+    commands = _commands(wire)
+    command_starts = [start for start, _ in commands]
+    rows: dict[str, list] = defaultdict(lambda: [0, 0.0, []])
+    for start, end in uncounted(wire):
+        before = wire[max(0, bisect.bisect_right(starts, start) - 1)]
+        k = bisect.bisect_right(command_starts, start) - 1
+        command = commands[k][1] if k >= 0 else "?"
+        row = rows[_cause(before, end - start)]
+        row[0] += 1
+        row[1] += end - start
+        row[2].append((end - start, command))
+    figures = bus_time(wire)
+    lines = [
+        f"lower bound {figures.lower_bound:.1f} s, span {figures.span:.1f} s: "
+        f"{figures.span - figures.lower_bound:.1f} s uncounted",
+        "   seconds  count  cause (commands before the longest)",
+    ]
+    for cause, (count, seconds, longest) in sorted(rows.items(), key=lambda r: -r[1][1]):
+        top = ", ".join(f"{c} {d * 1e3:.0f} ms" for d, c in sorted(longest, reverse=True)[:3])
+        lines.append(f"{seconds:10.2f} {count:6d}  {cause} ({top})")
+    return "\n".join(lines)
+
+
+def _cause(before: Event, length: float) -> str:
+    """What the engine was doing in an uncounted stretch, from the event before it."""
+    long = length >= LONG
+    if before.kind is EventKind.BREAK:
+        return "listening after the tool's break" if long else "marking after a break"
+    if before.origin != TOOL:
+        if long:
+            return "listening after the DUT's last character (waits, idle marking)"
+        return "turnaround and look before transmitting after the DUT"
+    if before.wire & 0x7F == ord("!"):
+        if long:
+            return "listening after an unanswered command (probes for silence)"
+        return "waiting for a reply that did not come (first-character timeout, read grace)"
+    return "marking inside a command (partial-command probes)"
+
+
+def _commands(wire: list[Event]) -> list[tuple[float, str]]:
+    """(start, text) of each tool command ending in '!', in order."""
+    found: list[tuple[float, str]] = []
+    current: list[Event] = []
+    for e in wire:
+        if e.kind is EventKind.BREAK:
+            current = []
+        elif e.origin == TOOL:
+            current.append(e)
+            if e.wire & 0x7F == ord("!"):
+                found.append((current[0].start, decode_7e1(current)))
+                current = []
+    return found
 
 
 def _load(averages: tuple[float, float, float]) -> str:

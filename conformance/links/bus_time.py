@@ -80,6 +80,27 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     return BusTime(lower, wire[-1].end - wire[0].start, frames, breaks)
 
 
+def uncounted(events: Iterable[Event]) -> list[tuple[float, float]]:
+    """The stretches between the first and the last event on the wire that the lower bound
+    does not count: the tool's overhead, where a run's wall time beyond its bound goes
+    (``benchmarks/bus_efficiency.py --attribute`` sorts them by what the tool did there).
+    Their lengths sum to the span less the part of the bound inside it."""
+    wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=attrgetter("start"))
+    if not wire:
+        return []
+    spans = sorted([*_own_spans(wire), *_gaps(wire), *_announced_waits(wire)])
+    first, last = wire[0].start, max(e.end for e in wire)
+    holes: list[tuple[float, float]] = []
+    covered = first
+    for start, end in spans:
+        if start > covered:
+            holes.append((covered, min(start, last)))
+        covered = max(covered, end)
+        if covered >= last:
+            break
+    return [(a, b) for a, b in holes if b > a]
+
+
 def _own_spans(wire: list[Event]) -> Iterator[tuple[float, float]]:
     """Each event's own span, in the events' (start) order."""
     brk = EventKind.BREAK

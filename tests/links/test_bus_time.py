@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.links.bus_time import bus_time
+from conformance.links.bus_time import bus_time, uncounted
 from conformance.protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 
@@ -163,3 +163,22 @@ def test_a_concurrent_wait_at_another_address_is_not_ended_by_the_duts_commands(
     w.pause(0.05).brk().pause(9e-3).send(TOOL, "0I!").pause(9e-3).send(DUT, "0\r\n")
     w.pause(3.2).brk().pause(9e-3).send(TOOL, "1D0!")
     assert bus_time(w.events).lower_bound >= reply_end + 3.0 - 1e-9
+
+
+def test_the_uncounted_stretches_are_the_span_less_the_bound():
+    """``uncounted`` gives where the wall beyond the bound went: here the 9 ms of marking
+    after the break less the 8.33 ms it needs, the tool's 200 ms of patience after an
+    unanswered command less the 16.67 ms a retry must wait, and the 300 ms it marked after
+    a reply less the 7.5 ms the sensor may hold the line."""
+    w = Wire().brk().pause(9e-3).send(TOOL, "0!").pause(0.2)
+    w.send(TOOL, "0!").pause(9e-3).send(DUT, "0\r\n").pause(0.3)
+    w.send(TOOL, "0!")
+    figures = bus_time(w.events)
+    holes = uncounted(w.events)
+    assert [round(b - a, 6) for a, b in holes] == [
+        round(9e-3 - MARKING_AFTER_BREAK, 6),
+        round(0.2 - RETRY_MIN, 6),
+        round(0.3 - RELEASE_LINE, 6),
+    ]
+    assert sum(b - a for a, b in holes) == pytest.approx(figures.span - figures.lower_bound)
+    assert uncounted([]) == []

@@ -1,0 +1,48 @@
+"""``benchmarks/bus_efficiency.py --attribute``: where a kept run's wall beyond its bus-time
+lower bound went, by cause, from its transcript alone."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+from conformance.links.bus_time import bus_time, uncounted
+from conformance.protocol.timing import RELEASE_LINE, RETRY_MIN
+from conformance.transcript import DUT, TOOL
+from tests.links.test_bus_time import Wire
+
+
+def bench_module():
+    path = Path(__file__).parents[2] / "benchmarks" / "bus_efficiency.py"
+    spec = importlib.util.spec_from_file_location("bus_efficiency_bench", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_each_uncounted_stretch_goes_to_the_cause_the_wire_shows():
+    w = Wire().brk().pause(9e-3).send(TOOL, "9I!").pause(0.2)  # silence probe: no answer
+    w.brk().pause(9e-3).send(TOOL, "0!").pause(9e-3).send(DUT, "0\r\n").pause(14e-3)
+    w.send(TOOL, "0I!").pause(9e-3).send(DUT, "013X\r\n").pause(0.3)  # idle marking
+    w.brk().pause(9e-3).send(TOOL, "0!")
+    table = bench_module().attribution(w.events)
+    lines = table.splitlines()
+    figures = bus_time(w.events)
+    assert lines[0].startswith(f"lower bound {figures.lower_bound:.1f} s")
+    rows = {m[3]: (float(m[1]), int(m[2]), m[4]) for m in map(ROW.match, lines[2:]) if m}
+    assert len(rows) == len(lines) - 2
+    seconds, count, longest = rows["listening after an unanswered command (probes for silence)"]
+    assert (round(seconds, 2), count) == (round(0.2 - RETRY_MIN, 2), 1)
+    assert longest == "9I! 183 ms"
+    seconds, count, longest = rows["listening after the DUT's last character (waits, idle marking)"]
+    assert (round(seconds, 2), count) == (round(0.3 - RELEASE_LINE, 2), 1)
+    assert longest.startswith("0I! 29")
+    seconds, count, longest = rows["turnaround and look before transmitting after the DUT"]
+    assert count == 1 and seconds == round(14e-3 - RELEASE_LINE, 2)
+    # every uncounted stretch is in exactly one row
+    assert sum(count for _, count, _ in rows.values()) == len(uncounted(w.events))
+
+
+ROW = re.compile(r"^\s*([\d.]+)\s+(\d+)  (.*) \((.*)\)$")
