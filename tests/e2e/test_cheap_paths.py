@@ -415,7 +415,8 @@ NOT_ON_A_SENSOR_RUN = (
     "execnet",
     "numpy",
     "asyncio",
-    "unittest.mock",
+    "unittest",  # pytest's unittest plugin is blocked (conformance.suite.UNUSED_PYTEST_PLUGINS)
+    "pdb",  # so is its debugging plugin, which imported pdb (and readline, cmd, code) to wrap it
     "rich.progress",
     "rich.table",
     "rich.live",
