@@ -1,13 +1,15 @@
 """Turn a ``--port`` string into a link: every kind of link, looked up in one registry.
 
 Each kind registers itself with :mod:`~conformance.links.registry` when its module is
-imported; this module imports the built-in ones (:data:`BUILTIN_KINDS`) and registers the three
-it holds itself: ``sim`` / ``sim://?faults=a,b&version=1.3&address=0``, the built-in simulated
-bus with the reference sensor emulator on it (virtual time, exact stamps); ``replay:PATH``, a
-saved run's recorded sensor played back on that bus; and ``rfc2217-serve://``, which has no
-sensor-role opener (it serves played sensors to a recorder under test). A new kind of link
-is a module that registers its :class:`LinkKind`, plus its line in :data:`BUILTIN_KINDS`;
-its recorder-role opener, if it has one, goes in :mod:`conformance.recorder.openers`.
+imported; this module has the built-in ones imported when a port first needs them
+(:func:`builtin_kinds`, deferred: a ``--port sim`` run loads none of them) and registers
+the three it holds itself, sole kinds whose port strings no other kind claims: ``sim`` /
+``sim://?faults=a,b&version=1.3&address=0``, the built-in simulated bus with the reference
+sensor emulator on it (virtual time, exact stamps); ``replay:PATH``, a saved run's recorded
+sensor played back on that bus; and ``rfc2217-serve://``, which has no sensor-role opener
+(it serves played sensors to a recorder under test). A new kind of link is a module that
+registers its :class:`LinkKind`, plus its import in :func:`builtin_kinds`; its recorder-role
+opener, if it has one, goes in :mod:`conformance.recorder.openers`.
 """
 
 from __future__ import annotations
@@ -20,20 +22,28 @@ from .emulator import FAULTS, CompositionError, Profile, compose, default_profil
 from .emulator.declared import declared_profile
 from .emulator.profiles import PROFILES, profile_settings
 from .emulator.sensor import SensorEmulator
-from .harness import device as harness_device
-from .links import adapter_link, factory
 from .links.base import LinkInfo
 from .links.errors import PortError
-from .links.registry import LinkKind, OpenedPort, PortOptions, find, register
+from .links.registry import LinkKind, OpenedPort, PortOptions, defer, find, register
 from .protocol.commands import ADDRESS_CHARS
 from .protocol.version import V14, format_version, parse_version
-from .replay import recording_link
 from .replay.link import is_replay
 
 __all__ = ["OpenedPort", "PortError", "SimSpec", "is_sim", "open_port", "open_sim", "parse_sim"]
 
-#: The modules whose kinds of link register themselves on import (besides the three below).
-BUILTIN_KINDS = (factory, adapter_link, harness_device, recording_link)
+
+def builtin_kinds() -> tuple[object, ...]:
+    """The modules whose kinds of link register themselves on import (besides the three
+    below), imported when a port string is looked up that no sole kind claims, or when the
+    table of kinds is read (:func:`conformance.links.registry.defer`)."""
+    from .harness import device as harness_device
+    from .links import adapter_link, factory
+    from .replay import recording_link
+
+    return (factory, adapter_link, harness_device, recording_link)
+
+
+defer(builtin_kinds)
 
 
 @dataclass
@@ -286,6 +296,7 @@ SIM = register(
         open_sensor_role=_open_sim,
         info=LinkInfo(kind="sim", virtual_time=True),
         example="sim://?faults=no-service-request&version=1.3",
+        sole=True,
     )
 )
 REPLAY = register(
@@ -295,6 +306,7 @@ REPLAY = register(
         open_sensor_role=lambda port, options: open_replay(port),
         info=LinkInfo(kind="replay", virtual_time=True),
         example="replay:reports/20250101-120000-sensor",
+        sole=True,
     )
 )
 SERVED = register(
@@ -308,5 +320,6 @@ SERVED = register(
             "it serves played sensors to a recorder under test (--role recorder); to judge a "
             "sensor served over RFC 2217, connect to it with rfc2217://HOST:PORT"
         ),
+        sole=True,
     )
 )

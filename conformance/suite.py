@@ -12,6 +12,19 @@ from pathlib import Path
 #: the folder that holds the ``testcases`` package (a checkout or site-packages)
 SUITE_ROOT = Path(str(resources.files("testcases"))).parent
 
+#: pytest's default plugins that nothing of a judged run uses, blocked: no case takes their
+#: fixtures (tmp_path, monkeypatch, recwarn, caplog, subtests), nothing logs, no run is
+#: debugged, stepped, paste-binned, set up only or made of doctests or unittest classes, and
+#: no plugin of the run reads a legacy ``py.path``. Each still registered options and
+#: fixtures, imported its modules (pdb and readline for ``debugging``, unittest) and, for
+#: ``logging``, wrapped every phase of every case in log capturing: 0.9% of a sim process's
+#: instructions together. ``warnings``, ``threadexception`` and ``faulthandler`` stay: they
+#: decide what becomes of a warning, a thread's exception or a crash.
+UNUSED_PYTEST_PLUGINS = (
+    "debugging", "doctest", "legacypath", "tmpdir", "monkeypatch", "recwarn", "pastebin",
+    "stepwise", "setuponly", "setupplan", "subtests", "logging", "unittest",
+)  # fmt: skip
+
 
 def suite_args(
     cases: str,
@@ -44,6 +57,8 @@ def suite_args(
         "-p", "conformance.plugin",
         "-p", "no:cacheprovider",
         "-p", "no:unraisableexception",  # its gc passes at the end cost ~0.3 s a run
+        # pytest's own plugins a judged run never uses (:data:`UNUSED_PYTEST_PLUGINS`)
+        *[arg for name in UNUSED_PYTEST_PLUGINS for arg in ("-p", f"no:{name}")],
         # no assertion rewriting: no case and no plugin of the run uses a bare assert (a
         # case records findings), yet rewriting the 15 case modules and the plugins cost
         # ~0.1 s of CPU in every run that could not cache it (PYTHONDONTWRITEBYTECODE, an

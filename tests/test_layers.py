@@ -26,8 +26,21 @@ ROOT = ROOT / "conformance"
 #: layer instead of being excepted here.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # protocol facts and the record of the wire (sans-I/O); process plumbing (signals, exit
-    # codes, atomic writes, the garbage collector's pace)
-    ("wire", ("", "interrupts", "exits", "atomic", "suggest", "gc_pace", "protocol", "transcript")),
+    # codes, atomic writes, the garbage collector's pace, dataclass code compiled once)
+    (
+        "wire",
+        (
+            "",
+            "interrupts",
+            "exits",
+            "atomic",
+            "suggest",
+            "gc_pace",
+            "dataclass_code",
+            "protocol",
+            "transcript",
+        ),
+    ),
     # the requirements, what is declared about the DUT, what a recorder under test is asked
     # to do, and what was found
     (

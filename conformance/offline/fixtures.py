@@ -15,10 +15,10 @@ import pytest
 
 from ..exits import EXIT_USAGE
 from ..links.errors import PortError
-from ..replay.recording_link import RecordingLink, is_recording, load_recording, parse_recording
 from ..run import ConformanceRun
 
 if TYPE_CHECKING:  # imported by a passive run only: the plugin loads this module for every run
+    from ..replay.recording_link import RecordingLink
     from .heard import HeardRecorder, HeardSensors
 
 _LOADED: dict[str, RecordingLink] = {}
@@ -26,12 +26,16 @@ _LOADED: dict[str, RecordingLink] = {}
 
 def recording_of(port: str) -> RecordingLink:
     """The recording a ``recording:`` port names, loaded once (PortError if it cannot be)."""
+    from ..replay.recording_link import load_recording, parse_recording
+
     if port not in _LOADED:
         _LOADED[port] = load_recording(parse_recording(port))
     return _LOADED[port]
 
 
 def _heard(run: ConformanceRun, role: str):
+    from ..replay.recording_link import is_recording
+
     if run.options.role != role:
         pytest.skip(f"{role}-rule case; this run judges the {run.options.role} rules")
     if not is_recording(run.options.port):

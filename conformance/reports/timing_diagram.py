@@ -14,7 +14,7 @@ DUT goes through :func:`html.escape`: the device is untrusted (design.md 7).
 from __future__ import annotations
 
 from array import array
-from bisect import bisect_left
+from bisect import bisect_left, bisect_right
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from html import escape
@@ -548,15 +548,22 @@ class MeasureIndex:
             return None
         at = bisect_left(values, target)
         distance = min(abs(values[i] - target) for i in (at - 1, at) if 0 <= i < len(values))
+        # values equal to one another sort by segment, so a run of equal values offers its
+        # first owner only: one step per distinct value that is equally near, not one per
+        # interval (a simulated run's 10^4 character gaps are a few values: each timing
+        # case's look-up walked thousands of equal ones). Distinct values may be equally
+        # near (a difference rounds), so the walk goes on while the distance holds.
+        owners = self.owners
         near: list[int] = []
-        i = at - 1  # equally near, below: values equal to one another sort by segment
+        i = at - 1  # equally near, below
         while i >= 0 and abs(values[i] - target) == distance:
-            near.append(self.owners[i])
+            i = bisect_left(values, values[i], 0, i)  # the first of its equal run
+            near.append(owners[i])
             i -= 1
-        i = at
+        i = at  # equally near, above: the first of each equal run
         while i < len(values) and abs(values[i] - target) == distance:
-            near.append(self.owners[i])
-            i += 1
+            near.append(owners[i])
+            i = bisect_right(values, values[i], i)
         return min(near)
 
 

@@ -415,7 +415,14 @@ NOT_ON_A_SENSOR_RUN = (
     "execnet",
     "numpy",
     "asyncio",
-    "unittest.mock",
+    "unittest",  # pytest's unittest plugin is blocked (conformance.suite.UNUSED_PYTEST_PLUGINS)
+    "serial",  # pyserial, the serial, RFC 2217, adapter and harness links and the capture
+    "conformance.links.factory",  # link: kinds a sim port never looks up (links.registry.defer)
+    "conformance.links.serial_link",
+    "conformance.links.adapter_link",
+    "conformance.harness.device",
+    "conformance.replay.recording_link",
+    "pdb",  # so is its debugging plugin, which imported pdb (and readline, cmd, code) to wrap it
     "rich.progress",
     "rich.table",
     "rich.live",

@@ -22,6 +22,49 @@ def test_every_link_kind_claims_its_example_and_the_rest_are_serial_devices():
         assert find(device).name == "serial"
 
 
+def test_a_sole_kinds_port_strings_are_claimed_by_no_other_kind():
+    """A sole kind is looked up without loading the deferred kinds (a ``--port sim`` run
+    imports no serial, harness or capture module): right only while no other kind claims a
+    string it claims, which the full look-up would refuse as a double claim."""
+    from conformance.links.registry import find, kinds
+
+    sole = [k for k in kinds() if k.sole]
+    assert {k.name for k in sole} == {"sim", "replay", "rfc2217-serve"}
+    ports = {
+        "sim": ["sim", "sim:", "sim://?faults=wrong-crc", "sim://?sensors=0,1:no-crc"],
+        "replay": ["replay:run", "replay:/tmp/x y", "replay:"],
+        "rfc2217-serve": ["rfc2217-serve://127.0.0.1:0", "rfc2217-serve://h:4001?x=1"],
+    }
+    for kind in sole:
+        for port in [kind.example, *ports[kind.name]]:
+            assert kind.matches(port)
+            others = [
+                k.name for k in kinds() if k is not kind and not k.fallback and k.matches(port)
+            ]
+            assert not others, f"{port!r} is claimed by {kind.name} and {others}"
+            assert find(port) is kind
+
+
+def test_a_sim_port_is_found_without_the_deferred_kinds():
+    """In a fresh process ``open_port('sim')`` leaves the deferred kinds unloaded; the table
+    read whole (``kinds()``) loads them, and a port no sole kind claims does too."""
+    import subprocess
+    import sys
+
+    script = (
+        "import sys\n"
+        "from conformance.ports import open_port\n"
+        "from conformance.links import registry\n"
+        "open_port('sim').link.close()\n"
+        "print('conformance.links.factory' in sys.modules, 'serial' in sys.modules)\n"
+        "print(registry.find('loop://').name, 'conformance.links.factory' in sys.modules)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert done.stdout.split() == ["False", "False", "loop", "True"], done.stdout + done.stderr
+
+
 def test_each_kind_opens_in_the_roles_it_serves_and_names_the_others():
     """One dispatcher: the registry says which kinds open in which role; a port of the wrong
     role is refused with what to write instead, before anything goes on a bus."""

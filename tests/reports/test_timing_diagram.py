@@ -27,6 +27,20 @@ def test_the_index_picks_what_a_scan_picks(per_segment: list[list[float]], targe
     assert MeasureIndex(measures=per_segment).nearest(target) == scan(per_segment, target)
 
 
+def test_equal_values_and_equally_near_distinct_values_give_the_first_segment():
+    """Runs of equal values (a simulated run's gaps) answer with their first segment, and
+    distinct values whose distances to the target round equal are all weighed."""
+    gaps = [[8.333] * 3, [16.666, 8.333], [8.333], [16.666]]
+    for target in (8.0, 8.333, 12.4995, 16.666, 20.0, 0.0):
+        assert MeasureIndex(measures=gaps).nearest(target) == scan(gaps, target)
+    a, b = 1.0, 1.0 + 2**-52  # distinct, yet 1e17 - a == 1e17 - b
+    far = 1e17
+    assert a != b and far - a == far - b
+    for per_segment in ([[b], [a]], [[a], [b]], [[b, a], [a]], [[a], [a], [b]]):
+        assert MeasureIndex(measures=per_segment).nearest(far) == scan(per_segment, far)
+        assert MeasureIndex(measures=per_segment).nearest(-far) == scan(per_segment, -far)
+
+
 def test_no_interval_no_segment():
     assert MeasureIndex(measures=[[], []]).nearest(8.0) is None
     assert MeasureIndex(measures=[[], [9.0]]).nearest(8.0) == 1
