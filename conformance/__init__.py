@@ -2,12 +2,6 @@
 
 from __future__ import annotations
 
-from . import dataclass_code
-
-# before any dataclass of the tool (or of pytest and hypothesis, loaded after it) is defined:
-# their generated methods' code is read from the installation's cache, not compiled again
-dataclass_code.install()
-
 
 def __getattr__(name: str) -> str:
     """``__version__`` on first use: importlib.metadata costs ~50 ms at start-up, and the

@@ -11,6 +11,14 @@ if __name__ == "__main__":  # `python -m conformance.cli`: Ctrl-C is ours before
 
     _EARLY_GUARD.install()
 
+# In the tool's own process only (not wherever pytest loads the plugin), before the tool's,
+# pytest's and hypothesis's dataclasses are defined: their generated methods' code is read
+# from the installation's cache instead of being compiled again (conformance.dataclass_code)
+from . import dataclass_code
+
+if dataclass_code.CACHE is None:
+    dataclass_code.install()
+
 import argparse
 import gc
 import os

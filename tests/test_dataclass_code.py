@@ -138,17 +138,28 @@ def test_a_file_that_is_not_this_interpreters_table_is_an_empty_one(tmp_path, co
     assert read_table(tmp_path / "missing") == {}
 
 
-def test_the_package_installs_it_for_dataclasses():
-    """Importing ``conformance`` stands the cache in for ``exec`` in dataclasses (before any
-    of its classes is made: ``conformance/__init__.py``)."""
-    assert dataclass_code.CACHE is not None
-    assert dataclasses.exec == dataclass_code.CACHE.exec  # type: ignore[attr-defined]
+def test_the_command_line_installs_it_and_the_plugin_alone_does_not():
+    """``conformance.cli`` stands the cache in for ``exec`` in dataclasses before it imports
+    the rest of the tool; a pytest session elsewhere that only loads the plugin (it is an
+    installed entry point) keeps the builtin and writes nothing into the package."""
+    probe = "import dataclasses, {}; print('exec' in vars(dataclasses))"
+    seen = {
+        module: subprocess.run(
+            [sys.executable, "-c", probe.format(module)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=True,
+        ).stdout.strip()  # fmt: skip
+        for module in ("conformance.plugin", "conformance.cli")
+    }
+    assert seen == {"conformance.plugin": "False", "conformance.cli": "True"}, seen
 
 
 def test_a_whole_sim_process_reads_every_method_from_the_table(tmp_path):
     """The second of two ``--port sim`` processes compiles no dataclass method: every one
     it defines was written to the table by the first (bytecode writing on, as in CI; a table
-    of the test's own, swapped in before the package makes its first dataclass)."""
+    of the test's own, swapped in before the command line makes its first dataclass)."""
     import os
 
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
@@ -156,6 +167,7 @@ def test_a_whole_sim_process_reads_every_method_from_the_table(tmp_path):
         "import atexit, sys\n"
         "from pathlib import Path\n"
         "from conformance import dataclass_code as d\n"
+        "d.install()\n"
         "out = sys.argv.pop(1)\n"
         "d.CACHE.path = Path(sys.argv.pop(1))\n"
         "d.CACHE.code = d.read_table(d.CACHE.path)\n"
