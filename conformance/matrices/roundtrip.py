@@ -17,8 +17,10 @@ import tempfile
 import zlib
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
-from ..conduct import conduct, run_into
+from ..conduct import NoVerdicts, conduct, run_into
+from ..run import RunOptions
 from ..transcript import EventKind
 from .sensor_matrix import Item, MatrixRow, fault_port, fault_row, row_from
 
@@ -53,12 +55,34 @@ def judged_through_capture(run_dir: Path, work: Path) -> dict:
         raise RoundTripError(f"{run_dir}: {exc}") from None
     if found.replay is None:
         raise RoundTripError(f"{run_dir}: its capture would be judged passively: {found.notes}")
-    document = conduct(
-        replace(found.replay, report_dir=str(again)), html=False, rootdir=again
-    ).document
+    result = conduct(
+        replace(found.replay, report_dir=str(again)), html=False, rootdir=again, files=()
+    )
+    document = result.run.verdict_lines() if result.run is not None else None
     if document is None:
-        raise RoundTripError(f"{run_dir}: its capture's replay wrote no verdicts")
+        raise RoundTripError(f"{run_dir}: its capture's replay gave no verdicts")
     return document
+
+
+#: the one report file a matrix row's live run writes: the evidence its capture is exported
+#: from, read back as ``sdi12-conform export`` reads it (its verdicts come from memory)
+LIVE_FILES = ("transcript.jsonl",)
+
+
+def live_run(report_dir: Path, port: str, role: str = "sensor", **options: Any) -> dict:
+    """:func:`conformance.conduct.run_into` for a matrix row: the same run, which writes only
+    its ``transcript.jsonl`` and gives its verdicts from memory
+    (:meth:`~conformance.run.ConformanceRun.verdict_lines`: what a row reads of verdicts.json;
+    the report files cost a sixth of a row, and no row reads them)."""
+    report_dir.mkdir(parents=True, exist_ok=True)
+    given = RunOptions(port=port, role=role, report_dir=str(report_dir), **options)
+    result = conduct(given, html=False, rootdir=report_dir, files=LIVE_FILES)
+    lines = result.run.verdict_lines() if result.run is not None else None
+    if lines is None:
+        raise NoVerdicts(
+            f"the {role} suite against {port} gave no verdicts (pytest exit {result.pytest_code})"
+        )
+    return lines
 
 
 def verdict_changes(live: dict, again: dict) -> tuple[str, ...]:
@@ -124,7 +148,7 @@ def row_through_capture(item: Item) -> MatrixRow:
     capture of itself."""
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
         live_dir = Path(tmp) / "live"
-        data = run_into(live_dir, fault_port(item), **dict(item[3]))
+        data = live_run(live_dir, fault_port(item), **dict(item[3]))
         return replace(fault_row(item, data), capture=capture_changes(live_dir, data, Path(tmp)))
 
 
@@ -135,6 +159,6 @@ def recorder_row_through_capture(fault: str) -> MatrixRow:
     spec = RECORDER_FAULTS[fault]
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
         live_dir = Path(tmp) / "live"
-        data = run_into(live_dir, f"sim://?recorder-faults={fault}", role="recorder")
+        data = live_run(live_dir, f"sim://?recorder-faults={fault}", role="recorder")
         row = row_from(fault, spec.violates, data, spec.inconclusive)
         return replace(row, capture=capture_changes(live_dir, data, Path(tmp)))
