@@ -84,9 +84,9 @@ class GivenOptions:
     is also where the plugin leaves the :class:`ConformanceRun` it made, for the caller.
 
     ``files``: which of the run's report files (``reports.writers.REPORT_WRITERS`` by name) it
-    writes; None: all of them. A fault matrix reads its rows' verdicts from memory
-    (:meth:`ConformanceRun.verdict_lines`) and writes only the transcript a capture is
-    exported from: a run's verdicts do not depend on which files it writes."""
+    writes; None: all of them. A fault matrix's runs write none: a row reads its verdicts
+    (:meth:`ConformanceRun.verdict_lines`) and its events from memory, and a run's verdicts
+    do not depend on which files it writes."""
 
     def __init__(self, options: RunOptions) -> None:
         self.options = options

@@ -1,8 +1,9 @@
-"""A matrix row's runs write no verdicts.json (``roundtrip.live_run``, the capture's replay
+"""A matrix row's runs write no report file (``roundtrip.live_run``, the capture's replay
 run): the row reads its verdicts from memory (``ConformanceRun.verdict_lines``). Here the
 fast path against the slow one: the lines are exactly what verdicts.json holds of the same
-run, a run told to write only its transcript writes that file byte for byte as a whole run
-does, and a row through its capture comes out the same either way, sensor and recorder."""
+run, the events a row's run gives are what a whole run's transcript.jsonl reads back as (and
+a transcript a line would not read back exactly is written and read), and a row through its
+capture comes out the same either way, sensor and recorder."""
 
 from __future__ import annotations
 
@@ -10,10 +11,12 @@ import shutil
 import tempfile
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
 from conformance.capture.export import export_events
+from conformance.capture.transcript_io import read_transcript_jsonl
 from conformance.conduct import conduct, run_into
 from conformance.emulator import FAULTS
 from conformance.matrices import roundtrip
@@ -23,7 +26,7 @@ from conformance.protocol.version import V14
 from conformance.recorder.faults import RECORDER_FAULTS
 from conformance.replay.recording import read_recording
 from conformance.run import RunOptions
-from conformance.transcript import EventKind
+from conformance.transcript import TOOL, Event, EventKind
 
 
 def projection(document: dict) -> dict:
@@ -57,15 +60,25 @@ def test_verdict_lines_are_what_verdicts_json_holds_of_the_same_run(tmp_path, po
     assert any(r["verdict"] in ("FAIL", "WARN") for r in lines["requirements"]) is (port != "sim")
 
 
-def test_a_run_told_to_write_its_transcript_writes_only_that_and_the_same_bytes(tmp_path):
+def test_a_row_run_writes_no_file_and_gives_the_events_its_transcript_reads_back(tmp_path):
     folder = tmp_path / "live"  # the same folder both times: the options note names it
     data = run_into(folder, "sim://?faults=wrong-crc")
-    whole = (folder / "transcript.jsonl").read_bytes()
+    written = read_transcript_jsonl(str(folder / "transcript.jsonl"))  # parsed, not kept
     shutil.rmtree(folder)
-    lines = roundtrip.live_run(folder, "sim://?faults=wrong-crc")
-    assert sorted(p.name for p in folder.iterdir()) == ["transcript.jsonl"]
-    assert (folder / "transcript.jsonl").read_bytes() == whole
+    lines, events = roundtrip.live_run(folder, "sim://?faults=wrong-crc")
+    assert list(folder.iterdir()) == []
+    assert events == written
+    assert [type(e.start) for e in events] == [type(e.start) for e in written]
     assert lines == projection(data)
+
+
+def test_events_a_line_would_not_read_back_exactly_are_written_and_read(tmp_path):
+    odd = Event(EventKind.CHAR, TOOL, 1, 1.0083, wire=0x30)  # an int time reads back a float
+    run = SimpleNamespace(link=SimpleNamespace(transcript=SimpleNamespace(events=[odd])))
+    events = roundtrip.recorded_events(run, tmp_path)
+    assert (tmp_path / "transcript.jsonl").is_file()
+    assert events == read_transcript_jsonl(str(tmp_path / "transcript.jsonl"))
+    assert type(events[0].start) is float
 
 
 def whole_row(fault: str) -> roundtrip.MatrixRow:
