@@ -134,7 +134,8 @@ class ConformanceRun:
         """What a fault matrix reads of verdicts.json, taken from the run itself, with the
         very expressions ``reports.verdicts_json.build`` writes them with (None before the
         run finished): ``summary.verdict``, ``run.link``, ``run.stop_reason`` and each
-        requirement's ``id`` and ``verdict``. A matrix's runs write no verdicts.json
+        requirement's ``id``, ``verdict`` and its findings' ``verdict`` and ``detail`` (a
+        combination's reader's why). A matrix's runs write no verdicts.json
         (``tests/matrices/test_verdict_lines.py`` compares the two)."""
         if self.results is None:
             return None
@@ -142,7 +143,14 @@ class ConformanceRun:
             "run": {"link": self.link_description(), "stop_reason": self.stop_reason or None},
             "summary": {"verdict": self.verdict},
             "requirements": [
-                {"id": r.requirement.id, "verdict": str(r.verdict)} for r in self.results
+                {
+                    "id": r.requirement.id,
+                    "verdict": str(r.verdict),
+                    "findings": [
+                        {"verdict": str(f.verdict), "detail": f.detail} for f in r.findings
+                    ],
+                }
+                for r in self.results
             ],
         }
 

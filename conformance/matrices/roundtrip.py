@@ -19,10 +19,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ..conduct import NoVerdicts, conduct, run_into
-from ..run import ConformanceRun, RunOptions
+from ..conduct import conduct, run_into
+from ..run import ConformanceRun
 from ..transcript import Event, EventKind, plain_fields
-from .sensor_matrix import Item, MatrixRow, fault_port, fault_row, row_from
+from .sensor_matrix import Item, MatrixRow, fault_port, fault_row, matrix_run, row_from
 
 DECIDED = ("PASS", "FAIL", "WARN", "N/A")
 
@@ -77,21 +77,11 @@ def judged_events(events: list[Event], name: str, work: Path) -> dict:
 def live_run(
     report_dir: Path, port: str, role: str = "sensor", **options: Any
 ) -> tuple[dict, list[Event]]:
-    """:func:`conformance.conduct.run_into` for a matrix row: the same run, which writes no
-    report file, and gives its verdicts from memory
-    (:meth:`~conformance.run.ConformanceRun.verdict_lines`: what a row reads of
-    verdicts.json) with its events as its transcript.jsonl would read back
-    (:func:`recorded_events`): the report files cost about a seventh of a row, and no row
-    reads them."""
-    report_dir.mkdir(parents=True, exist_ok=True)
-    given = RunOptions(port=port, role=role, report_dir=str(report_dir), **options)
-    result = conduct(given, html=False, rootdir=report_dir, files=())
-    lines = result.run.verdict_lines() if result.run is not None else None
-    if result.run is None or lines is None:
-        raise NoVerdicts(
-            f"the {role} suite against {port} gave no verdicts (pytest exit {result.pytest_code})"
-        )
-    return lines, recorded_events(result.run, report_dir)
+    """A matrix row's live run (:func:`~.sensor_matrix.matrix_run`: no report file): its
+    verdict lines and its events as its transcript.jsonl would read back
+    (:func:`recorded_events`)."""
+    run, lines = matrix_run(report_dir, port, role, **options)
+    return lines, recorded_events(run, report_dir)
 
 
 def recorded_events(run: ConformanceRun, folder: Path) -> list[Event]:

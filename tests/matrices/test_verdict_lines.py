@@ -17,9 +17,9 @@ import pytest
 
 from conformance.capture.export import export_events
 from conformance.capture.transcript_io import read_transcript_jsonl
-from conformance.conduct import conduct, run_into
+from conformance.conduct import conduct, run_into, run_once
 from conformance.emulator import FAULTS
-from conformance.matrices import roundtrip
+from conformance.matrices import combinations, roundtrip, sensor_matrix
 from conformance.matrices.sensor_matrix import fault_row
 from conformance.offline.judge import plan
 from conformance.protocol.version import V14
@@ -38,7 +38,14 @@ def projection(document: dict) -> dict:
         },
         "summary": {"verdict": document["summary"]["verdict"]},
         "requirements": [
-            {"id": r["id"], "verdict": r["verdict"]} for r in document["requirements"]
+            {
+                "id": r["id"],
+                "verdict": r["verdict"],
+                "findings": [
+                    {"verdict": f["verdict"], "detail": f["detail"]} for f in r["findings"]
+                ],
+            }
+            for r in document["requirements"]
         ],
     }
 
@@ -125,3 +132,16 @@ def test_a_recorder_row_through_its_capture_gives_its_verdicts_from_memory():
     row = roundtrip.recorder_row_through_capture("short-break")
     assert row.capture == ()
     assert set(RECORDER_FAULTS["short-break"].violates) <= set(row.flagged)
+
+
+@pytest.mark.slow
+def test_a_plain_row_and_a_combination_are_the_same_from_verdicts_json():
+    fault = "wrong-crc"
+    item = (fault, tuple(FAULTS[fault].violates), V14, ())
+    assert sensor_matrix._row(item) == fault_row(item, run_once(sensor_matrix.fault_port(item)))
+    faults = combinations.CI_COMBINATIONS[0]
+    made = combinations.combo_row(faults)
+    whole = combinations.check(
+        faults, combinations.declared_for(faults), run_once(combinations.combo_port(faults))
+    )
+    assert replace(made, cpu_s=0.0) == whole
