@@ -19,10 +19,18 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ..conduct import conduct, run_into
+from ..conduct import conduct
 from ..run import ConformanceRun
 from ..transcript import Event, EventKind, plain_fields
-from .sensor_matrix import Item, MatrixRow, fault_port, fault_row, matrix_run, row_from
+from .sensor_matrix import (
+    Item,
+    MatrixRow,
+    fault_port,
+    fault_row,
+    matrix_run,
+    matrix_verdicts,
+    row_from,
+)
 
 DECIDED = ("PASS", "FAIL", "WARN", "N/A")
 
@@ -159,8 +167,7 @@ def row_through_sampled_capture(item: Item) -> MatrixRow:
     live row alone for the others."""
     if in_capture_sample(item[0]):
         return row_through_capture(item)
-    with tempfile.TemporaryDirectory(prefix="sdi12-row-") as tmp:
-        return fault_row(item, run_into(Path(tmp) / "live", fault_port(item), **dict(item[3])))
+    return fault_row(item, matrix_verdicts(fault_port(item), **dict(item[3])))
 
 
 def row_through_capture(item: Item) -> MatrixRow:
