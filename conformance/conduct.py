@@ -50,6 +50,7 @@ def conduct(
     verbose: bool = False,
     rootdir: Path | str | None = None,
     plugins: Sequence[object] = (),
+    files: tuple[str, ...] | None = None,
 ) -> RunResult:
     """Run the conformance cases ``cases`` (default: the role's, ``testcases.<role>``) with
     ``options`` in this process.
@@ -57,6 +58,9 @@ def conduct(
     ``html`` writes report.html and junit.xml beside verdicts.json; ``terminal`` keeps
     pytest's own output (``verbose`` adds -v); ``plugins`` are more pytest plugins (the
     console's live progress). The run's folder is made here when the options name none.
+    ``files``: only these of the run's report files (``reports.writers.REPORT_WRITERS``
+    names; None: all); without verdicts.json the document is None and the verdicts are read
+    from ``RunResult.run`` (:meth:`~conformance.run.ConformanceRun.verdict_lines`).
     """
     import pytest
 
@@ -74,6 +78,7 @@ def conduct(
     if verbose:
         argv.append("-v")
     given = GivenOptions(options)
+    given.files = files
     code = int(pytest.main(argv, plugins=[*plugins, given]))
     return RunResult(code, report_dir, given.run)
 

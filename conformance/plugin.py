@@ -87,6 +87,7 @@ def pytest_configure(config: pytest.Config) -> None:
     given = given_options(config)
     if given is not None:  # conformance.conduct: the caller reads the run from memory
         given.run = config.stash[RUN]
+        given.run.report_files = given.files
     # pytest-html as an entry point ("html": a project's own pytest run) or named with -p
     # (the judged run: conformance.suite loads no plugin it does not name)
     if any(config.pluginmanager.hasplugin(n) for n in ("html", "pytest_html.plugin")):

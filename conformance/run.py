@@ -81,10 +81,16 @@ class RunOptions:
 class GivenOptions:
     """A pytest plugin object that carries a run's options into the pytest session, so the
     conformance plugin takes them as they are instead of parsing them back from flags; it
-    is also where the plugin leaves the :class:`ConformanceRun` it made, for the caller."""
+    is also where the plugin leaves the :class:`ConformanceRun` it made, for the caller.
+
+    ``files``: which of the run's report files (``reports.writers.REPORT_WRITERS`` by name) it
+    writes; None: all of them. A fault matrix's runs write none: a row reads its verdicts
+    (:meth:`ConformanceRun.verdict_lines`) and its events from memory, and a run's verdicts
+    do not depend on which files it writes."""
 
     def __init__(self, options: RunOptions) -> None:
         self.options = options
+        self.files: tuple[str, ...] | None = None
         self.run: ConformanceRun | None = None
 
 
@@ -121,6 +127,32 @@ class ConformanceRun:
     #: recorder role, --sweep: the tolerance sweeps (conformance.recorder.sweep); informational,
     #: never part of a verdict. None: not asked for (verdicts.json then has no "sweeps" key)
     sweeps: list[Any] | None = None
+    #: the report files the run writes when it ends (None: every one; see GivenOptions)
+    report_files: tuple[str, ...] | None = None
+
+    def verdict_lines(self) -> dict[str, Any] | None:
+        """What a fault matrix reads of verdicts.json, taken from the run itself, with the
+        very expressions ``reports.verdicts_json.build`` writes them with (None before the
+        run finished): ``summary.verdict``, ``run.link``, ``run.stop_reason`` and each
+        requirement's ``id``, ``verdict`` and its findings' ``verdict`` and ``detail`` (a
+        combination's reader's why). A matrix's runs write no verdicts.json
+        (``tests/matrices/test_verdict_lines.py`` compares the two)."""
+        if self.results is None:
+            return None
+        return {
+            "run": {"link": self.link_description(), "stop_reason": self.stop_reason or None},
+            "summary": {"verdict": self.verdict},
+            "requirements": [
+                {
+                    "id": r.requirement.id,
+                    "verdict": str(r.verdict),
+                    "findings": [
+                        {"verdict": str(f.verdict), "detail": f.detail} for f in r.findings
+                    ],
+                }
+                for r in self.results
+            ],
+        }
 
     def __post_init__(self) -> None:
         if self.options.declaration:

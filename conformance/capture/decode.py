@@ -24,6 +24,10 @@ from .glitch_filter import DEFAULT_BITS, GlitchFilter
 from .uart import Decoded, Framing, decode
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
+#: Clean characters the short polarity probe (the first :data:`PROBE_EDGES` edges) must read
+#: in one polarity, with not one bad frame or glitch, while the other polarity reads worse,
+#: before its choice is taken without decoding the rest of the first block both ways
+SHORT_PROBE_CLEAN = 64
 MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong bit rate
 #: Glitches per decoded frame above which a capture is mostly pulses too short for a bit:
 #: with the shortest pulses off the bit rate, a wrong bit rate rather than a noisy line
@@ -94,12 +98,46 @@ def _score(decoded: list[Decoded]) -> int:
     return good - bad
 
 
+def _clean_winner(decoded: dict[bool, list[Decoded]]) -> bool | None:
+    """The polarity whose decode of the short probe is beyond doubt: at least
+    :data:`SHORT_PROBE_CLEAN` clean characters and no bad frame or glitch (the last item
+    aside: the probe's cut may fall inside a frame), while the other scores lower. None:
+    not decisive, the whole first block decides."""
+    for inv, items in decoded.items():
+        body = items[:-1]
+        clean = sum(d.kind == "char" for d in body)
+        bad = any(
+            d.kind == "glitch" or (d.kind == "char" and (d.framing_error or d.parity_error))
+            for d in body
+        )
+        if clean >= SHORT_PROBE_CLEAN and not bad and _score(body) > _score(decoded[not inv][:-1]):
+            return inv
+    return None
+
+
 def _choose_polarity(
     edges: Edges, prefix: list[int], baud: float, framing: Framing
 ) -> tuple[bool, str]:
     """Decode the first edges both ways; the polarity that gives clean frames wins, the
-    starting level (idle) decides a tie."""
+    starting level (idle) decides a tie.
+
+    The first :data:`PROBE_EDGES` edges are tried first (a sigrok block holds tens of
+    thousands: decoding all of them twice was most of a short capture's probe); only when
+    they read cleanly one way (:func:`_clean_winner`) is that taken, anything less clear is
+    decided on the whole ``prefix`` as before (``tests/capture/test_polarity_probe.py``
+    holds a capture whose first edges alone would pick the wrong polarity)."""
     kw = dict(initial_level=edges.initial_level, tick_rate=edges.tick_rate, baud=baud)
+    if len(prefix) > PROBE_EDGES:
+        short = prefix[:PROBE_EDGES]
+        tried = {
+            inv: list(decode([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
+        }
+        inv = _clean_winner(tried)
+        if inv is not None:
+            return (
+                inv,
+                f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames",
+            )
     scores = {
         inv: _score(list(decode([prefix], invert=inv, framing=framing, **kw)))
         for inv in (False, True)

@@ -19,10 +19,9 @@ import random
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
-from ..conduct import run_once
 from ..emulator.faults.interactions import INTERACTIONS, Interaction
 from ..protocol.version import V14, format_version
-from .sensor_matrix import BAD, run_rows
+from .sensor_matrix import BAD, matrix_verdicts, run_rows
 
 #: the seed CI and the CLI use unless told otherwise
 DEFAULT_SEED = 18
@@ -149,7 +148,7 @@ def combo_row(faults: tuple[str, ...]) -> ComboRow:
     import time
 
     start = time.process_time()
-    data = run_once(combo_port(faults))
+    data = matrix_verdicts(combo_port(faults))
     cpu = time.process_time() - start
     return check(faults, declared_for(faults), data, cpu_s=cpu)
 

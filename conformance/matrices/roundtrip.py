@@ -17,10 +17,20 @@ import tempfile
 import zlib
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
-from ..conduct import conduct, run_into
-from ..transcript import EventKind
-from .sensor_matrix import Item, MatrixRow, fault_port, fault_row, row_from
+from ..conduct import conduct
+from ..run import ConformanceRun
+from ..transcript import Event, EventKind, plain_fields
+from .sensor_matrix import (
+    Item,
+    MatrixRow,
+    fault_port,
+    fault_row,
+    matrix_run,
+    matrix_verdicts,
+    row_from,
+)
 
 DECIDED = ("PASS", "FAIL", "WARN", "N/A")
 
@@ -33,32 +43,67 @@ def judged_through_capture(run_dir: Path, work: Path) -> dict:
     """Export the run in ``run_dir`` to ``work/run.sr`` (the tool's TX on a second channel),
     judge that capture as ``sdi12-conform judge capture.sr`` does (decoded, directions from
     the TX channel the export named in it, the run's cases replayed against it; no HTML)
-    into ``work/capture/`` and return its verdicts.json. A capture the judging would take
-    passively raises, with the reason."""
+    into ``work/capture/`` and return its verdicts (:meth:`ConformanceRun.verdict_lines`). A
+    capture the judging would take passively raises, with the reason."""
+    from ..replay.recording import RecordingError, read_recording
+
+    try:
+        events = read_recording(run_dir).events
+    except RecordingError as exc:
+        raise RoundTripError(f"{run_dir}: {exc}") from None
+    return judged_events(events, str(run_dir), work)
+
+
+def judged_events(events: list[Event], name: str, work: Path) -> dict:
+    """:func:`judged_through_capture` of a run's events as its transcript.jsonl reads back
+    (``name`` says which run in an error)."""
     from ..capture.errors import CaptureError
     from ..capture.export import export_events
     from ..offline.judge import JudgeError, plan
-    from ..replay.recording import RecordingError, read_recording
 
     work.mkdir(parents=True, exist_ok=True)
     capture = work / "run.sr"
     again = work / "capture"
     try:
-        recording = read_recording(run_dir)
-        notes = [e for e in recording.events if e.kind is EventKind.NOTE]
-        export_events(recording.events, str(capture), "sr", tool_channel=True, notes=notes)
+        notes = [e for e in events if e.kind is EventKind.NOTE]
+        export_events(events, str(capture), "sr", tool_channel=True, notes=notes)
         # no --tx-channel: judge reads which channel is the tool's from the capture itself
         found = plan([str(capture), "--report-dir", str(again)])
-    except (RecordingError, CaptureError, JudgeError, ValueError) as exc:
-        raise RoundTripError(f"{run_dir}: {exc}") from None
+    except (CaptureError, JudgeError, ValueError) as exc:
+        raise RoundTripError(f"{name}: {exc}") from None
     if found.replay is None:
-        raise RoundTripError(f"{run_dir}: its capture would be judged passively: {found.notes}")
-    document = conduct(
-        replace(found.replay, report_dir=str(again)), html=False, rootdir=again
-    ).document
+        raise RoundTripError(f"{name}: its capture would be judged passively: {found.notes}")
+    result = conduct(
+        replace(found.replay, report_dir=str(again)), html=False, rootdir=again, files=()
+    )
+    document = result.run.verdict_lines() if result.run is not None else None
     if document is None:
-        raise RoundTripError(f"{run_dir}: its capture's replay wrote no verdicts")
+        raise RoundTripError(f"{name}: its capture's replay gave no verdicts")
     return document
+
+
+def live_run(
+    report_dir: Path, port: str, role: str = "sensor", **options: Any
+) -> tuple[dict, list[Event]]:
+    """A matrix row's live run (:func:`~.sensor_matrix.matrix_run`: no report file): its
+    verdict lines and its events as its transcript.jsonl would read back
+    (:func:`recorded_events`)."""
+    run, lines = matrix_run(report_dir, port, role, **options)
+    return lines, recorded_events(run, report_dir)
+
+
+def recorded_events(run: ConformanceRun, folder: Path) -> list[Event]:
+    """The run's events as ``sdi12-conform export`` reads them from its transcript.jsonl: the
+    transcript's own when every event has the plain fields a line reads back as exactly
+    (what ``replay.recording.write_recording`` keeps as the file's reading), else written
+    to ``folder/transcript.jsonl`` and read back."""
+    from ..replay.recording import read_recording, write_recording
+
+    events = run.link.transcript.events if run.link is not None else []
+    if all(map(plain_fields, events)):
+        return list(events)
+    write_recording(folder / "transcript.jsonl", events)
+    return read_recording(folder).events
 
 
 def verdict_changes(live: dict, again: dict) -> tuple[str, ...]:
@@ -81,6 +126,14 @@ def capture_changes(run_dir: Path, live: dict, work: Path) -> tuple[str, ...]:
     export or judging that fails is itself a change (never an exception in a matrix)."""
     try:
         return verdict_changes(live, judged_through_capture(run_dir, work))
+    except RoundTripError as exc:
+        return (str(exc),)
+
+
+def event_changes(events: list[Event], name: str, live: dict, work: Path) -> tuple[str, ...]:
+    """:func:`capture_changes` of a run's events (:func:`live_run`)."""
+    try:
+        return verdict_changes(live, judged_events(events, name, work))
     except RoundTripError as exc:
         return (str(exc),)
 
@@ -114,8 +167,7 @@ def row_through_sampled_capture(item: Item) -> MatrixRow:
     live row alone for the others."""
     if in_capture_sample(item[0]):
         return row_through_capture(item)
-    with tempfile.TemporaryDirectory(prefix="sdi12-row-") as tmp:
-        return fault_row(item, run_into(Path(tmp) / "live", fault_port(item), **dict(item[3])))
+    return fault_row(item, matrix_verdicts(fault_port(item), **dict(item[3])))
 
 
 def row_through_capture(item: Item) -> MatrixRow:
@@ -124,8 +176,9 @@ def row_through_capture(item: Item) -> MatrixRow:
     capture of itself."""
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
         live_dir = Path(tmp) / "live"
-        data = run_into(live_dir, fault_port(item), **dict(item[3]))
-        return replace(fault_row(item, data), capture=capture_changes(live_dir, data, Path(tmp)))
+        data, events = live_run(live_dir, fault_port(item), **dict(item[3]))
+        changes = event_changes(events, str(live_dir), data, Path(tmp))
+        return replace(fault_row(item, data), capture=changes)
 
 
 def recorder_row_through_capture(fault: str) -> MatrixRow:
@@ -135,6 +188,6 @@ def recorder_row_through_capture(fault: str) -> MatrixRow:
     spec = RECORDER_FAULTS[fault]
     with tempfile.TemporaryDirectory(prefix="sdi12-capture-") as tmp:
         live_dir = Path(tmp) / "live"
-        data = run_into(live_dir, f"sim://?recorder-faults={fault}", role="recorder")
+        data, events = live_run(live_dir, f"sim://?recorder-faults={fault}", role="recorder")
         row = row_from(fault, spec.violates, data, spec.inconclusive)
-        return replace(row, capture=capture_changes(live_dir, data, Path(tmp)))
+        return replace(row, capture=event_changes(events, str(live_dir), data, Path(tmp)))

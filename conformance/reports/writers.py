@@ -53,5 +53,7 @@ PYTEST_RENDERINGS: dict[str, str] = {
 
 
 def write_reports(run: ConformanceRun, directory: Path) -> list[Path]:
-    """Write every file of :data:`REPORT_WRITERS` into ``directory``, in order."""
-    return [writer.write(run, directory) for writer in REPORT_WRITERS]
+    """Write every file of :data:`REPORT_WRITERS` into ``directory``, in order (only those
+    ``run.report_files`` names, when the caller of the run named some)."""
+    only = run.report_files
+    return [w.write(run, directory) for w in REPORT_WRITERS if only is None or w.file in only]
