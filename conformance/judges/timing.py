@@ -7,7 +7,6 @@ PASS only when the whole interval ``measured +/- uncertainty`` lies inside the a
 
 from __future__ import annotations
 
-from array import array
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -353,40 +352,15 @@ def _single(
                         slack, values_ms=[value], slack_ms=[slack])  # fmt: skip
 
 
-#: from this many values :func:`stable_order` asks numpy (a stable argsort of the array as
-#: it is: 8 bytes a value where ``sorted(range(n))`` made an int object, a key and a list
-#: slot a value, 70 bytes); below it, as in every simulated run, numpy is not imported
-NUMPY_FROM = 50_000
-
-
-def stable_order(values: array[float], numpy_from: int | None = None) -> Sequence[int]:
-    """The indices of ``values`` in ascending order of value, equal values in index order
-    (``sorted(range(n), key=values.__getitem__)``). From ``numpy_from`` values (default
-    :data:`NUMPY_FROM`) and without a NaN (whose place numpy and Python's sort set apart),
-    numpy's stable argsort makes it, as an ``array("q")``: the same order, in a tenth of
-    the memory (``tests/judges/test_stable_order.py``)."""
-    if len(values) < (NUMPY_FROM if numpy_from is None else numpy_from) or any(
-        v != v for v in values
-    ):
-        return sorted(range(len(values)), key=values.__getitem__)
-    import numpy as np
-
-    order = array("q")
-    order.frombytes(np.argsort(np.frombuffer(values, dtype=np.float64), kind="stable").tobytes())
-    return order
-
-
 def distribution(observations: Sequence[Finding | Measured]) -> Distribution | None:
     """Every measurement of ``observations`` as one :class:`Distribution` (None when none
     was judged against a window): what the margins chart and ``verdicts.json`` show.
 
     One pass in seconds, rounded to ms only for what is kept: a run's character gaps number
     tens of thousands, nearly all judged against one window."""
-    # arrays, 8 bytes a value where a list held a float object of 32 (an hour's recorder
-    # character gaps: 45,000 observations, at the peak of its judging)
-    values = array("d")  # s
-    slacks = array("d")  # s
-    uncertainties = array("d")  # s
+    values: list[float] = []  # s
+    slacks: list[float] = []  # s
+    uncertainties: list[float] = []  # s
     edges: set[tuple[float | None, float | None]] = set()
     count = 0
     window = None
@@ -411,7 +385,7 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
             count += d.count
     if not values:
         return None
-    order = stable_order(values)
+    order = sorted(range(len(values)), key=values.__getitem__)
     if len(order) > MAX_TICKS:  # evenly through the sorted values: min and max kept
         step = (len(order) - 1) / (MAX_TICKS - 1)
         kept = [order[round(i * step)] for i in range(MAX_TICKS)]
