@@ -11,7 +11,11 @@ framing error or a glitch inside. Pure: it reads the decode and the sensor's exc
 from __future__ import annotations
 
 import statistics
+from array import array
+from bisect import bisect_left
 from collections.abc import Iterable
+from itertools import islice
+from operator import le
 from typing import Any
 
 from ..tool_recorder.records import Exchange
@@ -23,14 +27,47 @@ def sensor_characters(exchanges: Iterable[Exchange]) -> list[Event]:
     return [e for ex in exchanges for a in ex.attempts for e in a.reply_events]
 
 
-def rate_of(decoded: Any, events: list[Event]) -> dict[int, float]:
-    """``id(character)`` -> its bit-rate error, for every character of ``events``: made once
-    for all the sensors of a bus (:func:`decode_quality`'s ``rates``) rather than once each,
-    each pass over the whole capture."""
-    rates = decoded.baud_error_pct  # one per character, in the order of the events
-    in_order = [e for e in events if e.kind is EventKind.CHAR]
-    # (a list that does not match the characters one for one tells no character's rate)
-    return dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
+class CharRates:
+    """Each character's bit-rate error, looked up by the character: made once for all the
+    sensors of a bus (:func:`decode_quality`'s ``rates``) rather than once each, each pass
+    over the whole capture. The decode gives the errors in the order of its characters; a
+    character is found among them by its start (a bisection of their starts, kept as an
+    array, then its identity among the characters with that start), where a map from every
+    character to its error was a transient of 90 bytes a character (an hour's capture: 30 MB
+    at the peak of its judging). Characters out of time order (never seen from a decode)
+    are mapped by identity, as they all were."""
+
+    def __init__(self, decoded: Any, events: list[Event]) -> None:
+        rates = decoded.baud_error_pct  # one per character, in the order of the events
+        chars = [e for e in events if e.kind is EventKind.CHAR]
+        # (a list that does not match the characters one for one tells no character's rate)
+        self._rates = rates if len(rates) == len(chars) else None
+        self._chars = chars
+        starts = array("d", [e.start for e in chars])
+        ordered = all(map(le, starts, islice(starts, 1, None)))
+        self._starts = starts if ordered else None
+        self._by_id: dict[int, float] = {}
+        if self._rates is not None and not ordered:
+            self._by_id = dict(zip(map(id, chars), self._rates, strict=True))
+
+    def get(self, c: Event) -> float | None:
+        """``c``'s bit-rate error in %, None if it is not one of the decode's characters."""
+        if self._rates is None:
+            return None
+        if self._starts is None:
+            return self._by_id.get(id(c))
+        starts, at = self._starts, c.start
+        i = bisect_left(starts, at)
+        while i < len(starts) and starts[i] == at:
+            if self._chars[i] is c:
+                return self._rates[i]
+            i += 1
+        return None
+
+
+def rate_of(decoded: Any, events: list[Event]) -> CharRates:
+    """The bit-rate error of every character of ``events`` (:class:`CharRates`)."""
+    return CharRates(decoded, events)
 
 
 def decode_quality(
@@ -38,7 +75,7 @@ def decode_quality(
     events: list[Event],
     chars: list[Event],
     who: str,
-    rates: dict[int, float] | None = None,
+    rates: CharRates | None = None,
 ) -> str | None:
     """One note on ``chars`` (the sensor's characters among ``events``, the capture's decoded
     events in order) as ``decoded`` (a :class:`~conformance.capture.decode.CaptureDecode`)
@@ -54,7 +91,7 @@ def decode_quality(
         for p in decoded.problems
         if p.kind == "char" and p.event is not None
     }
-    measured = [v for v in (error.get(id(c)) for c in chars) if v is not None and v == v]
+    measured = [v for v in map(error.get, chars) if v is not None and v == v]
     parity = sum(1 for c in chars if not c.parity_ok)
     flagged = [broken[(c.start, c.wire)] for c in chars if (c.start, c.wire) in broken]
     framing = sum(1 for d in flagged if d.framing_error)

@@ -226,8 +226,9 @@ def _per_sensor(link: RecordingLink) -> _PerSensor:
 
 
 def _qualities(link: RecordingLink) -> dict[str, str | None]:
-    """Each sensor's decode-quality note, by address, all made in one pass: the map of every
-    character's bit-rate error is built once and not kept (an hour's is tens of MB)."""
+    """Each sensor's decode-quality note, by address, all made in one pass: the lookup of
+    every character's bit-rate error (:class:`~.decode_quality.CharRates`, 16 bytes a
+    character) is built once and not kept."""
 
     def build() -> dict[str, str | None]:
         events = link.transcript.events

@@ -112,8 +112,33 @@ def test_the_judge_gives_what_a_finding_per_gap_gave(gaps_ms: list[float]):
         )  # fmt: skip
         for g, s in measured
     ]
-    found = commands.judge_character_gaps(view, 1e-6)[0]
+    found, tolerance = commands.judge_character_gaps(view, 1e-6)
     assert found.to_json() == combine("R-7.0-13", before, "character gap").to_json()
+    assert tolerance.to_json() == tolerance_as_judged(measured).to_json()
+
+
+def tolerance_as_judged(measured: list) -> Finding:
+    """R-7.0-01 as judge_character_gaps made it from its list of every (gap, command)."""
+    leaning = [(g, s) for g, s in measured if LIMIT < g <= LIMIT + TOLERANCE]
+    if leaning:
+        gap, s = leaning[0]
+        return Finding(
+            "R-7.0-01",
+            Verdict.FAIL,
+            f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which the "
+            f"1.66 ms character gap does not have ({len(leaning)} such gap(s))",
+            measured_ms=round(gap * 1e3, 3),
+            limit_ms=LIMIT * 1e3,
+            evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in leaning[:5]],
+            observed=len(measured),
+        )
+    return Finding(
+        "R-7.0-01",
+        Verdict.PASS,
+        f"{len(measured)} command character gaps, none inside the tolerance band the 1.66 ms "
+        "limit does not have; ±0.40 ms applied to every other recorder limit",
+        observed=len(measured),
+    )
 
 
 @given(

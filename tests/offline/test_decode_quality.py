@@ -73,3 +73,45 @@ def test_a_sensor_s_framing_errors_are_counted_on_widened_or_merged_events():
     said = decode_quality(decoded, events, events[1:], "sensor '0'")
     assert said is not None and "2 character(s)" in said and "1 with a framing error" in said
     assert "bit rate -0.50..+0.50 % off 1200 baud (median +0.00 %)" in said, said
+
+
+def _by_identity(decoded, events):
+    """The lookup CharRates replaces: a map from every character to its error."""
+    from conformance.transcript import EventKind
+
+    in_order = [e for e in events if e.kind is EventKind.CHAR]
+    rates = decoded.baud_error_pct
+    return dict(zip(map(id, in_order), rates, strict=True)) if len(rates) == len(in_order) else {}
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_rate_of_a_character_is_the_one_a_map_by_identity_gives(seed):
+    """Characters with tied starts, breaks among them, characters out of time order,
+    characters not of the decode, an error list of another length: each character's
+    error is what a map from every character to its error gave."""
+    import random
+    from array import array
+    from types import SimpleNamespace
+
+    from conformance.offline.decode_quality import CharRates
+    from conformance.transcript import BUS, Event, EventKind
+
+    rnd = random.Random(seed)
+    events = []
+    t = 0.0
+    for _ in range(rnd.randint(0, 30)):
+        t += rnd.choice([0.0, 0.0, 0.001, 0.00833])  # ties of start are common
+        kind = EventKind.BREAK if rnd.random() < 0.15 else EventKind.CHAR
+        events.append(Event(kind, BUS, t, t + 0.00833, wire=rnd.randint(0, 127)))
+    if events and rnd.random() < 0.3:  # out of time order
+        i = rnd.randrange(len(events))
+        events.append(events.pop(i))
+    n = sum(e.kind is EventKind.CHAR for e in events) + (rnd.random() < 0.15)
+    errors = array("f", [rnd.choice([0.5, -1.25, float("nan"), 3.0]) for _ in range(n)])
+    decoded = SimpleNamespace(baud_error_pct=errors)
+    strangers = [Event(EventKind.CHAR, BUS, e.start, e.end, wire=e.wire) for e in events[:3]]
+    looked_up = CharRates(decoded, events)
+    mapped = _by_identity(decoded, events)
+    for c in [*events, *strangers]:
+        got, want = looked_up.get(c), mapped.get(id(c))
+        assert (got is None and want is None) or got == want or (got != got and want != want)

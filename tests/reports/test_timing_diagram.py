@@ -44,3 +44,14 @@ def test_equal_values_and_equally_near_distinct_values_give_the_first_segment():
 def test_no_interval_no_segment():
     assert MeasureIndex(measures=[[], []]).nearest(8.0) is None
     assert MeasureIndex(measures=[[], [9.0]]).nearest(8.0) == 1
+
+
+@given(st.lists(st.lists(value, max_size=4), max_size=80))  # past numpy's insertion sort
+def test_numpy_orders_the_index_as_the_sort_does(per_segment: list[list[float]]):
+    """A long recording's index is ordered by numpy's stable argsort (NUMPY_FROM): the same
+    arrays, to the sign of a zero, as Python's stable sort of a short one."""
+    plain = MeasureIndex(measures=per_segment, numpy_from=10**9)
+    fast = MeasureIndex(measures=per_segment, numpy_from=0)
+    assert fast.values.tobytes() == plain.values.tobytes()
+    assert list(fast.owners) == list(plain.owners)
+    assert len(plain.values) == sum(map(len, per_segment))

@@ -7,9 +7,9 @@ from ...protocol.commands import ADDRESS_CHARS
 from ...protocol.timing import CHAR_TIME, INTER_CHAR_GAP_MAX, TOLERANCE
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
-from ...view.segments import TranscriptView
+from ...view.segments import TranscriptView, Transmission
 from ..tally import Tally
-from ..timing import MeasuredAsJudged, Window
+from ..timing import MeasuredIn, Window
 from ..wire import judge_frame_lengths, judge_rate
 from .common import combine
 
@@ -40,16 +40,17 @@ def judge_command_text(line: TranscriptView) -> list[Finding]:
 def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-13: at most 1.66 ms of marking between the characters of a command (no
     tolerance); R-7.0-01: no gap leans on the ±0.40 ms that this limit does not have."""
-    gaps = [
-        (b.start - a.end, s)
-        for s in line.transmissions
-        for a, b in zip(s.chars, s.chars[1:], strict=False)
-    ]
-    # one judged interval each, its finding made only where the verdict shows it
-    found = [MeasuredAsJudged(COMMAND_GAP, gap, uncertainty, [f"in {s.at()}"]) for gap, s in gaps]
-    leaning = [
-        (gap, s) for gap, s in gaps if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE
-    ]
+    # one judged interval each, its finding (and evidence line) made only where the verdict
+    # shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
+    found: list[MeasuredIn] = []
+    leaning: list[tuple[float, Transmission]] = []
+    for s in line.transmissions:
+        chars = s.chars
+        for a, b in zip(chars, chars[1:], strict=False):
+            gap = b.start - a.end
+            found.append(MeasuredIn(COMMAND_GAP, gap, uncertainty, s))
+            if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
+                leaning.append((gap, s))
     if leaning:
         gap, s = leaning[0]
         tol = Finding(
@@ -60,15 +61,15 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
             measured_ms=round(gap * 1e3, 3),
             limit_ms=INTER_CHAR_GAP_MAX * 1e3,
             evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in leaning[:5]],
-            observed=len(gaps),
+            observed=len(found),
         )
-    elif gaps:
+    elif found:
         tol = Finding(
             "R-7.0-01",
             Verdict.PASS,
-            f"{len(gaps)} command character gaps, none inside the tolerance band the 1.66 ms "
+            f"{len(found)} command character gaps, none inside the tolerance band the 1.66 ms "
             "limit does not have; ±0.40 ms applied to every other recorder limit",
-            observed=len(gaps),
+            observed=len(found),
         )
     else:
         tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
