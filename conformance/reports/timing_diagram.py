@@ -13,6 +13,7 @@ DUT goes through :func:`html.escape`: the device is untrusted (design.md 7).
 
 from __future__ import annotations
 
+import sys
 from array import array
 from bisect import bisect_left, bisect_right
 from collections.abc import Iterable, Sequence
@@ -517,7 +518,9 @@ def _measures(seg: Segment) -> list[float]:
 #: from this many intervals a :class:`MeasureIndex` is ordered by numpy (a stable argsort of
 #: the arrays as they are: 8 bytes an interval where ``sorted(range(n))`` made an int object
 #: and a list slot per interval, 36 bytes; an hour's capture: 535,000 intervals, the peak of
-#: its passive judgement). Below it, as in every simulated run, numpy is not imported.
+#: its passive judgement). Only when numpy is loaded already (a capture's decoding loads it):
+#: importing it for the order alone cost a simulated run more than it saved (a wrong-crc run's
+#: 145,000 intervals: 0.07 s of import and 12 MB), so a simulated run never imports it here.
 NUMPY_FROM = 50_000
 
 
@@ -564,7 +567,9 @@ class MeasureIndex:
             self.values.extend(m for m, _ in pairs)
             self.owners.extend(i for _, i in pairs)
             return
-        if len(values) >= (NUMPY_FROM if numpy_from is None else numpy_from):
+        if len(values) >= (NUMPY_FROM if numpy_from is None else numpy_from) and (
+            numpy_from is not None or "numpy" in sys.modules
+        ):
             self.values, self.owners = _numpy_order(values, owners)
             return
         # a stable sort by value keeps equal values in segment order, as sorting (value,

@@ -55,3 +55,23 @@ def test_numpy_orders_the_index_as_the_sort_does(per_segment: list[list[float]])
     assert fast.values.tobytes() == plain.values.tobytes()
     assert list(fast.owners) == list(plain.owners)
     assert len(plain.values) == sum(map(len, per_segment))
+
+
+def test_a_long_index_imports_no_numpy_for_its_order():
+    """Past NUMPY_FROM the index is ordered by numpy only where numpy is loaded already (a
+    capture's decoding): a simulated run of 145,000 intervals (sim://?faults=wrong-crc) paid
+    more for the import than the order saved. Both orders are the same (the test above)."""
+    import subprocess
+    import sys
+
+    script = (
+        "import sys\n"
+        "from conformance.reports.timing_diagram import NUMPY_FROM, MeasureIndex\n"
+        "segments = [[float(i % 97), float(i % 13)] for i in range(NUMPY_FROM)]\n"
+        "MeasureIndex(measures=segments)\n"
+        "print('numpy' in sys.modules)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=60, check=True
+    )
+    assert done.stdout.strip() == "False", done.stdout + done.stderr
