@@ -299,7 +299,8 @@ def _conducted(
         from .reports.console import ProgressPlugin
 
         plugins.append(ProgressPlugin(console))
-    result = conduct(options, verbose=verbose, plugins=plugins)
+    # the main command's own process: report.html may be rendered beside the rest
+    result = conduct(options, verbose=verbose, plugins=plugins, html_aside=_OWN_PROCESS)
     report_dir, code, data = result.report_dir, result.pytest_code, result.document
     if data is not None and own_folder and _folder_by_serial(options.profile):
         from .report_folder import named_by_serial

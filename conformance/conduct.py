@@ -51,6 +51,7 @@ def conduct(
     rootdir: Path | str | None = None,
     plugins: Sequence[object] = (),
     files: tuple[str, ...] | None = None,
+    html_aside: bool = False,
 ) -> RunResult:
     """Run the conformance cases ``cases`` (default: the role's, ``testcases.<role>``) with
     ``options`` in this process.
@@ -61,6 +62,8 @@ def conduct(
     ``files``: only these of the run's report files (``reports.writers.REPORT_WRITERS``
     names; None: all); without verdicts.json the document is None and the verdicts are read
     from ``RunResult.run`` (:meth:`~conformance.run.ConformanceRun.verdict_lines`).
+    ``html_aside``: the caller owns this process to its end (the main command), so report.html
+    may be rendered by a forked process beside the rest (:mod:`conformance.reports.html_aside`).
     """
     import pytest
 
@@ -79,6 +82,7 @@ def conduct(
         argv.append("-v")
     given = GivenOptions(options)
     given.files = files
+    given.html_aside = html_aside
     code = int(pytest.main(argv, plugins=[*plugins, given]))
     return RunResult(code, report_dir, given.run)
 

@@ -27,6 +27,7 @@ from .recorder.errors import RecorderSetupError  # not .drivers: a sensor run lo
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .replay.sensor import RecordingEnded
 from .reports import html, writers
+from .reports.html_aside import Aside, render_aside
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions, given_options
 from .selection import SelectionError, resolve
@@ -38,6 +39,7 @@ RUN = pytest.StashKey[ConformanceRun]()
 OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT for this run
 LOCKED = pytest.StashKey[Path]()  # the report folder this run holds (report_folder.acquire)
 PACE = pytest.StashKey[gc_pace.Pace]()  # the collector's pace before the run (gc_pace)
+ASIDE = pytest.StashKey[Aside]()  # the process rendering report.html (reports.html_aside)
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -91,7 +93,10 @@ def pytest_configure(config: pytest.Config) -> None:
     # pytest-html as an entry point ("html": a project's own pytest run) or named with -p
     # (the judged run: conformance.suite loads no plugin it does not name)
     if any(config.pluginmanager.hasplugin(n) for n in ("html", "pytest_html.plugin")):
-        config.pluginmanager.register(html.HtmlReportPlugin(config.stash[RUN]), "sdi12-html")
+        aside = given is not None and given.html_aside
+        config.pluginmanager.register(
+            html.HtmlReportPlugin(config.stash[RUN], defer_cases=aside), "sdi12-html"
+        )
 
 
 def run_of(config: pytest.Config) -> ConformanceRun:
@@ -415,11 +420,19 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if session.shouldstop or session.shouldfail:
         run.complete = False
     run.finish(complete=not interrupted)
+    ours = session.config.pluginmanager.get_plugin("sdi12-html")
+    if ours is not None and ours.defer_cases:  # report.html by another process, at once
+        aside = render_aside(session, ours)
+        if aside is not None:
+            session.config.stash[ASIDE] = aside
     writers.write_reports(run, run.report_dir())
     run.close()
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
+    aside = config.stash.get(ASIDE, None)
+    if aside is not None:  # pytest-html waits for it; here too if its session end did not run
+        aside.wait()
     pace = config.stash.get(PACE, None)
     if pace is not None:
         gc_pace.restore(pace)

@@ -86,12 +86,16 @@ class GivenOptions:
     ``files``: which of the run's report files (``reports.writers.REPORT_WRITERS`` by name) it
     writes; None: all of them. A fault matrix's runs write none: a row reads its verdicts
     (:meth:`ConformanceRun.verdict_lines`) and its events from memory, and a run's verdicts
-    do not depend on which files it writes."""
+    do not depend on which files it writes. ``html_aside``: report.html may be rendered by a
+    forked process while this one writes the rest (:mod:`conformance.reports.html_aside`)."""
 
     def __init__(self, options: RunOptions) -> None:
         self.options = options
         self.files: tuple[str, ...] | None = None
         self.run: ConformanceRun | None = None
+        #: report.html may be rendered by a forked process (reports.html_aside): a caller
+        #: that owns its process to the end says so
+        self.html_aside = False
 
 
 def given_options(config: Any) -> GivenOptions | None:

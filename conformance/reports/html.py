@@ -14,7 +14,7 @@ the DUT goes through :func:`html.escape` (design.md 7: the device is untrusted).
 from __future__ import annotations
 
 from html import escape
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
@@ -32,6 +32,9 @@ from .plan import plan_section, read_plan
 from .sweep_chart import section as sweep_section
 from .timing_diagram import exchange_behind, timing_svg, wire_title
 from .verdicts_json import dut_block, duts_block
+
+if TYPE_CHECKING:
+    from .html_aside import Aside
 
 # Severity order for the banner, the "read first" list and sorting the verdict column.
 SEVERITY = ("ERROR", "FAIL", "INCONCLUSIVE", "WARN", "PASS", "N/A")
@@ -598,10 +601,25 @@ def case_html(
 
 
 class HtmlReportPlugin:
-    """pytest-html hooks, bound to the run whose verdicts they show."""
+    """pytest-html hooks, bound to the run whose verdicts they show.
 
-    def __init__(self, run: ConformanceRun) -> None:
+    ``defer_cases``: each case's HTML piece is made when the page is rendered rather than
+    as the case ends (the same text: it reads the case's record and the events up to its
+    end), so a page rendered by another process (:mod:`.html_aside`) takes that work off
+    the run; the pieces wait in pytest-html's extras, which it keeps by reference."""
+
+    def __init__(self, run: ConformanceRun, *, defer_cases: bool = False) -> None:
         self.run = run
+        self.defer_cases = defer_cases
+        self._pending: list[tuple[CaseRecord, dict[str, Any]]] = []
+        #: set in the parent while another process renders the page (html_aside)
+        self.aside: Aside | None = None
+
+    def fill_cases(self) -> None:
+        """The deferred cases' HTML pieces, into the extras pytest-html holds."""
+        for record, extra in self._pending:
+            extra["content"] = case_html(record, self._derived(record), self._where(record))
+        self._pending.clear()
 
     def pytest_html_report_title(self, report: Any) -> None:
         report.title = f"SDI-12 conformance report ({self.run.options.role})"
@@ -609,6 +627,10 @@ class HtmlReportPlugin:
     def pytest_html_results_summary(
         self, prefix: list[str], summary: list[str], postfix: list[str], session: Any
     ) -> None:
+        if self.aside is not None:  # another process renders the page (html_aside)
+            self.aside.summary_lists = (prefix, summary, postfix)
+            return
+        self.fill_cases()
         if self.run.results is None:
             return
         top = banner(self.run) + header(self.run) + attention(self.run)
@@ -676,6 +698,10 @@ class HtmlReportPlugin:
         if record is not None and report.when == "call":
             from pytest_html import extras
 
-            html = case_html(record, self._derived(record), self._where(record))
-            report.extras = [*getattr(report, "extras", []), extras.html(html)]
+            if self.defer_cases:  # made with the page (fill_cases)
+                extra = extras.html("")
+                self._pending.append((record, extra))
+            else:
+                extra = extras.html(case_html(record, self._derived(record), self._where(record)))
+            report.extras = [*getattr(report, "extras", []), extra]
         return report
