@@ -24,7 +24,7 @@ import gc
 import os
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TextIO, cast
 
 from . import gc_pace
 from .exits import (
@@ -655,23 +655,38 @@ def _exit_at_once(code: int) -> None:
     os._exit(code)
 
 
-def make_console(*, stderr: bool = False) -> Console:
+def make_console(*, stderr: bool = False, plain: bool = False) -> Console:
     """A console for results (stdout) or errors (stderr). Off a terminal nothing is wrapped:
-    a log or a pipe gets whole lines (rich would hard-wrap them at 80 columns)."""
+    a log or a pipe gets whole lines (rich would hard-wrap them at 80 columns). ``plain``:
+    off a terminal, lines written as rich writes them there without importing rich
+    (:mod:`conformance.reports.plain_console`; rich for anything more, on first need)."""
+    stream = sys.stderr if stderr else sys.stdout
+    if plain:
+        from .reports.plain_console import PlainConsole, plain_output
+
+        if plain_output(stream):
+            plain_console = PlainConsole(
+                lambda: make_console(stderr=stderr), lambda: _silence(plain_console, stream),
+                stderr=stderr,
+            )  # fmt: skip
+            return cast("Console", plain_console)
     from rich.console import Console
 
     class RunConsole(Console):
         def on_broken_pipe(self) -> None:
-            """The reader went away (``| head``): say nothing more there, but let the run
-            finish and write its reports. rich's default ends the process with exit 1 from
-            inside a pytest hook (an INTERNALERROR traceback and exit 3, the run cut off)."""
-            self.quiet = True
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, stream.fileno())
-            os.close(devnull)
+            _silence(self, stream)
 
-    stream = sys.stderr if stderr else sys.stdout
     return RunConsole(stderr=stderr, soft_wrap=not stream.isatty())
+
+
+def _silence(console: Any, stream: TextIO) -> None:
+    """The reader went away (``| head``): say nothing more there, but let the run finish and
+    write its reports. rich's default ends the process with exit 1 from inside a pytest hook
+    (an INTERNALERROR traceback and exit 3, the run cut off)."""
+    console.quiet = True
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, stream.fileno())
+    os.close(devnull)
 
 
 def error(text: str) -> None:
@@ -692,6 +707,8 @@ def _main_command(argv: list[str], console: Console) -> int:
 
     baseline = getattr(args, "baseline", None)
     bus = is_bus(args.address)
+    if bus or is_rack(argv, args):  # their tables and lines are rich's
+        console = make_console()
     if is_rack(argv, args):  # --port twice or more, --rack, --tx: a rack
         if bus:
             error(
@@ -714,7 +731,9 @@ def _main_command(argv: list[str], console: Console) -> int:
 
 
 def _dispatch(argv: list[str]) -> int:
-    console = make_console()
+    # the main command off a terminal writes plain lines without rich (a subcommand's
+    # tables are rich's)
+    console = make_console(plain=not (argv and argv[0] in SUBCOMMANDS))
     try:
         if argv and argv[0] in SUBCOMMANDS:
             if GUARD.requested:  # Ctrl-C while the program was starting

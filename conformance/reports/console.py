@@ -14,10 +14,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import pytest
-from rich.console import Console
-from rich.text import Text
 
-if TYPE_CHECKING:  # the bar and the tables are a terminal's: a log or a pipe loads neither
+if TYPE_CHECKING:  # rich is a terminal's: a log or a pipe loads none of it (plain_console)
+    from rich.console import Console
     from rich.progress import Progress
 
 from ..judges.timing import counted
@@ -154,6 +153,8 @@ class ProgressPlugin:
         name = nodeid.split("::")[-1]
         if self.progress is not None:
             if verdict in NOTEWORTHY:
+                from rich.text import Text
+
                 line = Text.assemble(
                     (f"{verdict:<12}", STYLE[verdict]), f" {name}  ", (one_line(reason, 200), "")
                 )
@@ -354,6 +355,7 @@ def _paths(say: Any, report_dir: str) -> None:
 
 def _rich_summary(console: Console, data: dict[str, Any], report_dir: str) -> None:
     from rich.table import Table
+    from rich.text import Text
 
     summary = data["summary"]
     verdict = summary["verdict"]
