@@ -375,6 +375,35 @@ def test_a_process_that_never_collects_is_not_paced(monkeypatch) -> None:
         gc.enable()
 
 
+def test_before_a_library_collects_what_exists_is_frozen_only_where_nothing_collects(
+    monkeypatch,
+) -> None:
+    """gc_pace.freeze_for_libraries (before hypothesis, whose register_random collects once a
+    process): in a process that never collects, what the run made so far is frozen with what
+    was loaded; anywhere else (a paced run, a caller's process) nothing changes."""
+    pace = gc_pace.slow_down()  # a paced run: collecting, so nothing more is frozen
+    try:
+        frozen = gc.get_freeze_count()
+        made_paced = [[n] for n in range(1000)]  # objects the run made
+        gc_pace.freeze_for_libraries()
+        assert gc.get_freeze_count() == frozen
+    finally:
+        gc_pace.restore(pace)
+    monkeypatch.setattr(gc_pace, "_NEVER", True)
+    gc.disable()
+    try:
+        pace = gc_pace.slow_down()
+        frozen = gc.get_freeze_count()
+        made_never = [[n] for n in range(1000)]
+        gc_pace.freeze_for_libraries()
+        assert gc.get_freeze_count() >= frozen + 1000
+        gc_pace.restore(pace)
+        assert gc.get_freeze_count() == 0
+    finally:
+        gc.enable()
+    assert len(made_paced) == len(made_never)  # both kept alive to the end
+
+
 def test_the_main_command_called_in_a_process_keeps_collecting(tmp_path) -> None:
     """main(argv) in someone else's process (a test, a rack worker's caller) leaves the
     collector to that process: on after the run, and runs after it still paced."""

@@ -4,6 +4,7 @@ pytest process with other test modules loaded explored differently from the CLI'
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import sys
 
@@ -39,3 +40,20 @@ def test_the_exploration_does_not_depend_on_the_modules_loaded(tmp_path):
         assert _explored() == before
     finally:
         sys.modules.pop("sdi12_local_constants", None)
+
+
+def test_the_database_key_changes_nothing_drawn(monkeypatch):
+    """With a fixed example-database key (there is no database) the exploration sends what it
+    sent with hypothesis's digest of the sources, and digests no source."""
+    from hypothesis import core, stateful
+    from hypothesis.internal import reflection
+
+    digested: list[str] = []
+    clean = reflection._clean_source  # what function_digest alone calls, per source it reads
+    monkeypatch.setattr(reflection, "_clean_source", lambda src: digested.append(src) or clean(src))
+    with_key = _explored()
+    assert digested == []
+    monkeypatch.setattr(exploration, "no_database_key", contextlib.nullcontext)
+    assert _explored() == with_key
+    assert len(digested) == 2  # the plain way digests the machine and its runner
+    assert core.function_digest is stateful.function_digest is reflection.function_digest
