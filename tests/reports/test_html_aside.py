@@ -47,9 +47,13 @@ def normalised(page: str) -> str:
     return re.sub(r"/(aside|plain)\b", "/FOLDER", page)
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(
-    "port", ["sim", "sim://?faults=wrong-crc", "sim://?faults=response-too-late"]
+    "port",
+    [
+        "sim",  # the default selection keeps one (two runs in a subprocess: a few seconds)
+        pytest.param("sim://?faults=wrong-crc", marks=pytest.mark.slow),
+        pytest.param("sim://?faults=response-too-late", marks=pytest.mark.slow),
+    ],
 )
 def test_the_forked_page_is_the_page(port: str, tmp_path: Path) -> None:
     """The cases' HTML pieces made when the page is rendered, in a child process, give the
