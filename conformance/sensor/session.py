@@ -447,13 +447,13 @@ class SensorSession(Session):
         """Keep the line marking so that the tool's next command can go out at ``at`` (a timed
         probe's marking), and return what the DUT sent meanwhile. :meth:`listen` up to ``at``
         would overshoot on a real link: a read whose limit lies ahead waits a frame and the
-        link's latency past it for characters that started in time, and the tool then listens
-        its own look before transmitting (:meth:`ToolRecorder.look_before_transmit`), about
-        18 ms in all behind an RFC 2217 port, which pushed a follow-up aimed 12 ms inside the
-        87 ms window out of it. The wait ends that look early instead and takes in what has
-        arrived; a DUT that talked meanwhile still holds the command back
-        (:meth:`ToolRecorder.clear_to_send`)."""
-        self.link.wait_until(at - self.master.look_before_transmit())
+        link's latency past it for characters that started in time, which pushed a follow-up
+        aimed 12 ms inside the 87 ms window out of it behind an RFC 2217 port. The wait ends
+        at ``at`` instead and takes in what has arrived; the tool's look before transmitting
+        (:meth:`ToolRecorder.look_before_transmit`) is over by then unless ``at`` lies within
+        the turnaround and the look after the DUT's last character, and a DUT that talked
+        meanwhile still holds the command back (:meth:`ToolRecorder.clear_to_send`)."""
+        self.link.wait_until(at)
         return self.link.receive(self.link.now())
 
     def probe(

@@ -189,28 +189,34 @@ class ToolRecorder:
         """Listen before talk: wait until the tool may drive the line, and return when.
 
         A real recorder's UART sees the DUT's start bits; this one sees the DUT's characters
-        as the link delivers them, up to ``timing_uncertainty`` late, so before it transmits
-        it takes in what arrives until then (not after the tool's own break: the line has been
-        the tool's since, and a timed probe's marking must not grow). While the DUT's last
-        character ended less than ``policy.turnaround`` ago (R-7.0-11; longer than any gap
-        inside a reply) the transmission is held. A DUT that keeps talking is waited out for
-        at most ``policy.max_hold``; then the tool transmits anyway, with a NOTE. Nothing is
-        read off the link here: what the DUT sent stays queued for whoever reads next (the
-        attempt's stray characters, or a case waiting for a service request). ``collide``:
-        transmit now, without listening or the turnaround (a probe that means to talk into
-        the DUT). Collisions that happened anyway are noted (:meth:`note_collisions`)."""
+        as the link delivers them, up to ``timing_uncertainty`` late, so the line must have
+        been quiet for the turnaround and then that look more (:meth:`look_before_transmit`)
+        before it transmits: what arrives by then is taken in (not after the tool's own
+        break: the line has been the tool's since, and a timed probe's marking must not grow).
+        While the DUT's last character ended less than ``policy.turnaround`` (R-7.0-11;
+        longer than any gap inside a reply) and the look ago, the transmission is held. The
+        look is counted from the end of the turnaround, not from whenever the engine came to
+        ask: after a wait that already listened to a quiet line for that long (a read to its
+        deadline, a case's listening, a retry's spacing) it is done, and adding it again only
+        made every such transmission ``timing_uncertainty`` later (issue 22). At the moment
+        of transmitting the tool knows exactly what it knew before, what arrived by then,
+        and holds on more of it: a character seen less than turnaround and look ago.
+        A DUT that keeps talking is waited out for at most ``policy.max_hold``; then the tool
+        transmits anyway, with a NOTE. Nothing is read off the link here: what the DUT sent
+        stays queued for whoever reads next (the attempt's stray characters, or a case
+        waiting for a service request). ``collide``: transmit now, without listening or the
+        turnaround (a probe that means to talk into the DUT). Collisions that happened anyway
+        are noted (:meth:`note_collisions`)."""
         self.note_collisions()
         if collide:
             return self.link.now()
-        self.link.wait_until(self._earliest_transmit())
+        look = self.look_before_transmit()
+        self.link.wait_until(self._earliest_transmit(look))
         began = self.link.now()
         uncertainty = self.link.info.timing_uncertainty
-        look = self.look_before_transmit()
         held = False
         while True:
-            if look:
-                self.link.wait_until(self.link.now() + look)
-            clear = self._earliest_transmit()
+            clear = self._earliest_transmit(look)
             now = self.link.now()
             if clear <= now:
                 break
@@ -235,9 +241,11 @@ class ToolRecorder:
         return self.link.now()
 
     def look_before_transmit(self) -> float:
-        """How long :meth:`clear_to_send` listens, once the line is clear, before it transmits
-        (s): the link's timing uncertainty, or nothing right after the tool's own break. A
-        case that aims a transmission at a moment starts its wait this much earlier."""
+        """How long past the turnaround after the DUT's last character :meth:`clear_to_send`
+        listens before it transmits (s): the link's timing uncertainty, or nothing right after
+        the tool's own break. It ends that long after the turnaround, so a case that aims a
+        transmission at a moment later than that need not start its wait any earlier
+        (:meth:`SensorSession.mark_until`)."""
         if _own_break_last(self.link):
             return 0.0
         return self.link.info.timing_uncertainty
@@ -410,10 +418,11 @@ class ToolRecorder:
             if not got:
                 return
 
-    def _earliest_transmit(self) -> float:
-        """Now, or later if the DUT may still hold the line after its last character."""
+    def _earliest_transmit(self, look: float = 0.0) -> float:
+        """Now, or later if the DUT may still hold the line after its last character (and
+        ``look`` past that, for characters the link delivers late)."""
         last_dut = self._dut_end.after(self.link.transcript.events)
-        return max(self.link.now(), last_dut + self.policy.turnaround)
+        return max(self.link.now(), last_dut + self.policy.turnaround + look)
 
     def _needs_break(self, address: str, at: float) -> bool:
         """Whether the break rules put a break in front, as the hooks say."""

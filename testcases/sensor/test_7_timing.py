@@ -23,12 +23,15 @@ from conformance.protocol.timing import (
     TOLERANCE,
     WAKE_LIMIT,
 )
+from conformance.sensor.session import PROBE_TRIES
 from conformance.transcript import EventKind
 from conformance.verdicts import failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
 pytestmark = pytest.mark.needs("break")
 STANDBY = 0.15  # s of marking that puts any sensor in standby before a probe
+OK_MARKING = 9e-3  # s: the marking after a break R-7.0-05's answered probe aims at
+UNREACHABLE = " (a link stamped to ±{u:.2f} ms cannot show 8.33 ms of marking from 9: one try)"
 
 
 def _break_of(sensor, ex):
@@ -234,7 +237,16 @@ def test_marking_after_break(sensor, case):
             return f"a! went out {quick * 1e3:.2f} ms after the break, not early"
         return None
 
-    aimed = sensor.aim("a! after 9 ms of marking", after(9e-3), miss_ok)
+    # Stamped more loosely than 9 - 8.33 ms, the link can never show the 9 ms probe's marking
+    # to be 8.33 ms or more (the floor of its uncertainty only grows): a second try could land
+    # only by a host stall pushing it later, so one goes out (four more cost a real run 1 s)
+    hopeless = OK_MARKING - sensor.uncertainty < MARKING_AFTER_BREAK
+    aimed = sensor.aim(
+        "a! after 9 ms of marking",
+        after(OK_MARKING),
+        miss_ok,
+        tries=1 if hopeless else PROBE_TRIES,
+    )
     ok = aimed.last
     soon = sensor.aim("a! after 2 ms of marking", after(2e-3), miss_soon).last
     case.evidence("break + 9 ms marking + a!, then break + 2 ms marking + a!", [ok, soon])
@@ -244,7 +256,8 @@ def test_marking_after_break(sensor, case):
         case.add(
             inconclusive(
                 "R-7.0-05",
-                f"marking {marking * 1e3:.2f} ms is not surely 8.33 ms or more{aimed.missed}",
+                f"marking {marking * 1e3:.2f} ms is not surely 8.33 ms or more{aimed.missed}"
+                + (UNREACHABLE.format(u=sensor.uncertainty * 1e3) if hopeless else ""),
             )
         )
         return
