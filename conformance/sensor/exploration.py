@@ -52,7 +52,7 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
     machine = machine_class(sensor, record, sensor.hearing_marking(), junk)
     keep_hypothesis_out_of_the_working_folder()
     try:
-        with no_local_constants():
+        with no_local_constants(), digests_kept():
             run_machine(machine, examples, steps)
     except BaseException as exc:  # hypothesis may wrap the failure; a breach recorded stands
         if record.broken is None or isinstance(exc, KeyboardInterrupt):
@@ -84,6 +84,84 @@ def no_local_constants() -> Iterator[None]:
     finally:
         providers._get_local_constants = original
         cache.clear()
+
+
+#: hypothesis's own digest of each object the exploration's runs have had digested
+_DIGESTS: dict[tuple[object, ...], bytes] = {}
+
+
+@contextmanager
+def digests_kept() -> Iterator[None]:
+    """Hypothesis digests the state machine class and its test function on every run (from
+    their source text: ``inspect.getsource``, a parse of the module for a class, a tokenize
+    of the function), about 11 ms of CPU a run, for its example database only. An
+    exploration runs without one (``database=None``) and draws from :data:`SEED`, so nothing
+    it sends depends on the digests, but the machine class is made anew per run: the
+    digests are kept here per process by what they are a digest of (the class's module,
+    name and ``__init__``; the function's code and defaults), each computed once by
+    hypothesis itself (``tests/sensor/test_exploration.py`` compares them with its own)."""
+    try:
+        from hypothesis import core, stateful
+
+        original = stateful.function_digest
+    except (ImportError, AttributeError):  # another hypothesis: its own digests, as they are
+        yield
+        return
+    if core.function_digest is not original:  # someone else's stands in: leave it be
+        yield
+        return
+
+    def kept(function: object) -> bytes:
+        key = digest_key(function)
+        if key is None:
+            return original(function)
+        digest = _DIGESTS.get(key)
+        if digest is None:
+            digest = _DIGESTS[key] = original(function)
+        return digest
+
+    stateful.function_digest = core.function_digest = kept
+    try:
+        yield
+    finally:
+        stateful.function_digest = core.function_digest = original
+
+
+def digest_key(function: object) -> tuple[object, ...] | None:
+    """What hypothesis's ``function_digest`` of ``function`` rests on: its source (a class's
+    found by module and qualified name, a function's by its code), its signature (a class's
+    from ``__init__``; a function's from its code, defaults and any ``__signature__`` or
+    ``__wrapped__``, annotations) and the ``_hypothesis_internal_add_digest`` it carries. None: an
+    object of another kind, or a key that cannot be hashed (digested each time)."""
+    add = getattr(function, "_hypothesis_internal_add_digest", None)
+    if isinstance(function, type):
+        key: tuple[object, ...] = (
+            "class",
+            function.__module__,
+            function.__qualname__,
+            function.__init__,
+            function.__dict__.get("__signature__"),
+            add,
+        )
+    else:
+        code = getattr(function, "__code__", None)
+        if code is None:
+            return None
+        key = (
+            "function",
+            code,
+            getattr(function, "__defaults__", None),
+            getattr(function, "__kwdefaults__", None),
+            getattr(function, "__signature__", None),
+            getattr(function, "__wrapped__", None),
+            tuple(getattr(function, "__annotations__", {}).items()),
+            add,
+        )
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
 
 
 def keep_hypothesis_out_of_the_working_folder() -> None:

@@ -39,3 +39,71 @@ def test_the_exploration_does_not_depend_on_the_modules_loaded(tmp_path):
         assert _explored() == before
     finally:
         sys.modules.pop("sdi12_local_constants", None)
+
+
+def _machine_and_test():
+    """A fresh exploration machine class and the test function hypothesis makes of it, as a
+    run makes them (a new class per run)."""
+    from hypothesis.stateful import get_state_machine_test
+
+    from conformance.sensor.exploration_machine import junk_strategy, machine_class
+    from conformance.sensor.exploration_record import Exploration
+
+    opened = open_sim(parse_sim("sim"))
+    session = SensorSession(opened.link, declaration=opened.declaration)
+    machine = machine_class(session, Exploration(), None, junk_strategy())
+    test = get_state_machine_test(machine).hypothesis.inner_test
+    return machine, test
+
+
+def test_kept_digests_are_hypothesis_own():
+    """The digests kept per process (``digests_kept``) are the ones hypothesis computes for
+    each run's new machine class and test function, and the same object kind of a changed
+    signature gets its own."""
+    from hypothesis import core, stateful
+    from hypothesis.internal.reflection import function_digest
+
+    first, second = _machine_and_test(), _machine_and_test()
+    assert first[0] is not second[0]
+    with exploration.digests_kept():
+        assert stateful.function_digest is core.function_digest is not function_digest
+        kept = [stateful.function_digest(obj) for pair in (first, second) for obj in pair]
+        assert len(exploration._DIGESTS) >= 2
+    assert stateful.function_digest is core.function_digest is function_digest
+    own = [function_digest(obj) for pair in (first, second) for obj in pair]
+    assert kept == own
+    assert kept[0] != kept[1]  # the class and the test function: two digests
+
+    def plain(a: int) -> None: ...
+
+    def other(a: int, b: int = 2) -> None: ...
+
+    with exploration.digests_kept():
+        assert stateful.function_digest(plain) == function_digest(plain)
+        assert stateful.function_digest(other) == function_digest(other)
+    assert exploration.digest_key(plain) != exploration.digest_key(other)
+    assert exploration.digest_key(object()) is None
+
+
+def test_an_exploration_digests_its_machine_once_a_process(monkeypatch):
+    """A second exploration in the process asks hypothesis for no digest: the source of
+    the machine and of its test is read once."""
+    from hypothesis.internal import reflection
+
+    asked = []
+    original = reflection.function_digest
+
+    def counted(function):
+        asked.append(function)
+        return original(function)
+
+    first = _explored()
+    exploration._DIGESTS.clear()
+    from hypothesis import core, stateful
+
+    monkeypatch.setattr(stateful, "function_digest", counted)
+    monkeypatch.setattr(core, "function_digest", counted)
+    assert _explored() == first
+    assert len(asked) == 2  # the class and its test, once
+    assert _explored() == first
+    assert len(asked) == 2
