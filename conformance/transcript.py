@@ -14,6 +14,7 @@ import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
+from math import copysign, isfinite
 from typing import Any
 
 
@@ -47,6 +48,19 @@ def parity_bit(char7: int) -> int:
 def to_wire_7e1(char7: int) -> int:
     """The 8 bits a 7E1 frame carries between start and stop bit."""
     return (char7 & 0x7F) | (parity_bit(char7) << 7)
+
+
+#: each byte's 7E1 frame bits (:func:`to_wire_7e1` of its low 7 bits), for bytes.translate
+_WIRE_7E1 = bytes(to_wire_7e1(c) for c in range(0x100))
+
+
+def encode_7e1(text: str) -> bytes:
+    """``bytes(to_wire_7e1(ord(c)) for c in text)``: a reply's or a command's frames in one
+    ``bytes.translate`` (C), not a call per character (every frame of a sim run is made so)."""
+    try:
+        return text.encode("latin-1").translate(_WIRE_7E1)
+    except UnicodeEncodeError:  # past Latin-1: its low 7 bits, as to_wire_7e1 takes them
+        return bytes(_WIRE_7E1[ord(c) & 0x7F] for c in text)
 
 
 @dataclass(frozen=True, slots=True)
@@ -214,6 +228,7 @@ class Transcript:
         its own reading needs to know, and asking again cost a second pass over 10^5)."""
         plain = True
         shown = _LastEnd()
+        parts: dict[tuple[object, ...], tuple[str, str]] = {}  # _line_parts by the fields
         with open(path, "w", encoding="utf-8") as fh:
             # written a block of lines at a time: an hour's capture is 43 MB of lines, which
             # formatted whole before writing were the peak of a passive judgement's memory
@@ -221,11 +236,28 @@ class Transcript:
                 lines: list[str] = []
                 add = lines.append
                 for e in self.events[at : at + WRITE_BLOCK]:
-                    if plain_fields(e):
-                        add(_plain_line(e, shown))
-                    else:
+                    if not plain_fields(e):
                         plain = False
                         add(json.dumps(e.to_json()) + "\n")
+                        continue
+                    u, du = e.uncertainty, e.duration_uncertainty
+                    key = (e.kind, e.origin, e.wire, e.text, u, du)
+                    found = parts.get(key)
+                    # a negative zero is equal to 0.0 as a key, but written apart
+                    signed = (not u and copysign(1.0, u) < 0) or (
+                        du is not None and not du and copysign(1.0, du) < 0
+                    )
+                    if found is None or signed or not isfinite(e.start + e.end):
+                        add(_plain_line(e, shown))
+                        if found is None and not signed and isfinite(u + (du or 0.0)):
+                            parts[key] = _line_parts(e)
+                        continue
+                    start = e.start
+                    end = repr(e.end)
+                    shown_start = shown.text if start == shown.end and start != 0.0 else repr(start)
+                    shown.end, shown.text = e.end, end
+                    head, tail = found
+                    add(f'{head}{shown_start}, "end": {end}{tail}')
                 fh.writelines(lines)
         return plain
 
@@ -259,6 +291,20 @@ def json_line(event: Event) -> str:
     if plain_fields(event):
         return _plain_line(event)
     return json.dumps(event.to_json()) + "\n"
+
+
+def _line_parts(e: Event) -> tuple[str, str]:
+    """What :func:`_plain_line` writes of ``e`` before its start and after its end: the
+    same for every event with its kind, origin, wire byte, text and uncertainties (a run's
+    characters share a few hundred such), so :meth:`Transcript.write_jsonl` formats them
+    once per run rather than per line (``e``: plain fields, finite uncertainties, neither a
+    negative zero)."""
+    du = e.duration_uncertainty
+    tail = "}\n" if du is None else f', "duration_uncertainty": {du!r}}}\n'
+    return (
+        f'{{"kind": "{e.kind}", "origin": {_quote(e.origin)}, "start": ',
+        f', "wire": {e.wire!r}, "text": {_quote(e.text)}, "uncertainty": {e.uncertainty!r}{tail}',
+    )
 
 
 class _LastEnd:

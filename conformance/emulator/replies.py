@@ -14,7 +14,7 @@ from enum import StrEnum
 from ..protocol.commands import Command
 from ..protocol.crc import ascii_crc, binary_crc
 from ..protocol.framing import CRLF
-from ..transcript import to_wire_7e1
+from ..transcript import encode_7e1
 
 
 class ReplyKind(StrEnum):
@@ -106,7 +106,7 @@ class Reply:
         """The 8 wire bits of each frame: 7E1 for ASCII (R-4.1-02), raw 8N1 bytes for HB."""
         if self.binary is not None:
             return list(self.binary.encode())
-        frames = [to_wire_7e1(ord(c)) for c in self.text()]
+        frames = list(encode_7e1(self.text()))
         for index in self.flip_parity:
             if -len(frames) <= index < len(frames):
                 frames[index] ^= 0x80

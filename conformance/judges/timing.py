@@ -7,9 +7,11 @@ PASS only when the whole interval ``measured +/- uncertainty`` lies inside the a
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from bisect import bisect_right
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from itertools import accumulate
 from statistics import median
 from typing import Protocol
 
@@ -357,7 +359,12 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
     was judged against a window): what the margins chart and ``verdicts.json`` show.
 
     One pass in seconds, rounded to ms only for what is kept: a run's character gaps number
-    tens of thousands, nearly all judged against one window."""
+    tens of thousands, nearly all judged against one window, and most of them are the same
+    few hundred :class:`Measured` (equal gaps of one reply judged once: ``judges/wire``), so
+    those are figured once each (:func:`_distribution_of_one_window`)."""
+    grouped = _grouped(observations)
+    if grouped is not None:
+        return _distribution_of_one_window(*grouped, len(observations))
     values: list[float] = []  # s
     slacks: list[float] = []  # s
     uncertainties: list[float] = []  # s
@@ -410,6 +417,83 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
         mixed_limits=len(edges) > 1,
         values_ms=[_ms(values[i]) or 0.0 for i in kept],
         slack_ms=[_ms(slacks[i]) or 0.0 for i in kept],
+    )
+
+
+def _grouped(
+    observations: Sequence[Finding | Measured],
+) -> tuple[Window, list[Measured], list[int]] | None:
+    """``observations`` as each distinct object and how often it comes, in the order each
+    first comes, where every one is a plain :class:`Measured` against the one window (the
+    same object); None otherwise (or none at all): :func:`distribution` then goes one by
+    one. An object says the same each time it comes, so its figures stand for every time."""
+    first = observations[0] if observations else None
+    if type(first) is not Measured:
+        return None
+    window = first._window
+    at: dict[int, int] = {}  # id -> index in distinct
+    distinct: list[Measured] = []
+    counts: list[int] = []
+    for o in observations:
+        i = at.get(id(o))
+        if i is not None:
+            counts[i] += 1
+            continue
+        if type(o) is not Measured or o._window is not window:
+            return None
+        if o.measured != o.measured or o.uncertainty != o.uncertainty:
+            return None  # a NaN sorts by where it stands: one by one
+        at[id(o)] = len(distinct)
+        distinct.append(o)  # type: ignore[arg-type]
+        counts.append(1)
+    return window, distinct, counts
+
+
+def _distribution_of_one_window(
+    window: Window, distinct: list[Measured], counts: list[int], count: int
+) -> Distribution:
+    """:func:`distribution` of ``count`` observations, ``distinct`` each ``counts`` times,
+    judged against ``window``: the same figures as one by one. Equal values have equal
+    slacks against one window, so which of them a sorted position picks does not matter;
+    the position ``p`` of the values sorted is found among the distinct ones by the running
+    counts (``_at``)."""
+    lo, hi = window.lo, window.hi
+    by_value = sorted(range(len(distinct)), key=lambda i: distinct[i].measured)
+    values = [distinct[i].measured for i in by_value]
+    ends = list(accumulate(counts[i] for i in by_value))  # sorted position after each value
+
+    def at(p: int) -> float:
+        return values[bisect_right(ends, p)]
+
+    positions: Iterable[int]
+    if count > MAX_TICKS:  # evenly through the sorted values: min and max kept
+        step = (count - 1) / (MAX_TICKS - 1)
+        positions = [round(i * step) for i in range(MAX_TICKS)]
+    else:
+        positions = range(count)
+    ticks = [at(p) for p in positions]
+    middle = count // 2
+    mid = at(middle) if count % 2 else (at(middle - 1) + at(middle)) / 2
+    by_u = sorted(range(len(distinct)), key=lambda i: distinct[i].uncertainty)
+    us = [distinct[i].uncertainty for i in by_u]
+    u_ends = list(accumulate(counts[i] for i in by_u))
+
+    def u_at(p: int) -> float:
+        return us[bisect_right(u_ends, p)]
+
+    u_mid = u_at(middle) if count % 2 else (u_at(middle - 1) + u_at(middle)) / 2
+    return Distribution(
+        count,
+        _ms(values[0]) or 0.0,
+        _ms(mid) or 0.0,
+        _ms(values[-1]) or 0.0,
+        _ms(lo),
+        _ms(hi),
+        _ms(u_mid) or 0.0,  # the median of the uncertainties, as statistics.median gives it
+        _ms(min(_slack(lo, hi, m) for m in values)) or 0.0,
+        mixed_limits=False,
+        values_ms=[_ms(v) or 0.0 for v in ticks],
+        slack_ms=[_ms(_slack(lo, hi, v)) or 0.0 for v in ticks],
     )
 
 
@@ -651,12 +735,15 @@ def combine(
     if not findings:
         return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
     sign = -1 if smallest_is_worst else 1
+    # each object once, in the order it first comes (a run's character gaps: tens of
+    # thousands, a few hundred distinct): the first of the largest is the same either way
+    distinct = list({id(f): f for f in findings}.values())
     # the first with the worst verdict and, among those, the largest (smallest) measurement
-    top = max({f.verdict for f in findings}, key=lambda v: v.rank)
+    top = max({f.verdict for f in distinct}, key=lambda v: v.rank)
     worst = max(
-        (f for f in findings if f.verdict is top), key=lambda f: sign * abs(f.measured_ms or 0)
+        (f for f in distinct if f.verdict is top), key=lambda f: sign * abs(f.measured_ms or 0)
     )
-    values = [f.measured_ms for f in findings if f.measured_ms is not None]
+    values = [f.measured_ms for f in distinct if f.measured_ms is not None]
     count = counted(len(findings), what)
     span = f"{count}, {min(values):.2f}..{max(values):.2f} ms" if values else ""
     if worst.verdict is Verdict.PASS and ", allowed " in worst.detail:
@@ -670,7 +757,7 @@ def combine(
         if span:
             parts.append(span)
         detail = "; ".join(parts)
-    same = [f.margin_ms for f in findings if f.verdict is worst.verdict]
+    same = [f.margin_ms for f in distinct if f.verdict is worst.verdict]
     margins = [m for m in same if m is not None]
     margin = None
     if margins and len(margins) == len(same):

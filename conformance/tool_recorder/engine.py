@@ -36,7 +36,7 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..protocol.values import split_values
-from ..transcript import TOOL, Event, EventKind, text_end, to_wire_7e1
+from ..transcript import TOOL, Event, EventKind, encode_7e1, text_end, to_wire_7e1
 from ..view.segments import continues_frame
 from . import validity
 from .contention import HOLD_PREFIX, ApartSoFar, collisions
@@ -110,7 +110,7 @@ class ToolRecorder:
             binary = command.kind is Kind.BINARY_DATA
         if crc is None and command.kind in (Kind.DATA, Kind.BINARY_DATA):
             crc = self._crc_pending.get(command.address)
-        wire = bytes(to_wire_7e1(ord(c)) for c in text)
+        wire = encode_7e1(text)
         exchange = Exchange(command, text, [], binary=binary, expect_reply=expect_reply)
         repeat = retries and expect_reply
         sequences = self.policy.sequences if repeat else 1

@@ -127,6 +127,11 @@ def _shape_problem(command: Command, body: str, crc_expected: bool | None) -> st
     return None  # extended commands: address and CR LF are all the standard fixes
 
 
+#: the replies :func:`check_ascii` judged last, by what it was asked: (the events, why)
+_JUDGED: dict[tuple[object, ...], tuple[list[Event], str | None]] = {}
+_JUDGED_MAX = 64  # cleared when full: the tool recorder's attempts of a stimulus or two
+
+
 def check_ascii(
     command: Command | None,
     events: list[Event],
@@ -141,7 +146,33 @@ def check_ascii(
 
     ``address`` is used when the command could not be parsed (raw probes). ``multiline``:
     an ``a<STX>...<CR><LF><ETX>`` text, where the pauses between lines are allowed.
+
+    A pure function of its arguments, asked twice about nearly every reply of a sensor run:
+    by the tool recorder as it reads the reply, then by the view's records of the stimulus
+    (``view.rebuilt_records``), the same characters with the same command, so the answers
+    to the last few questions are kept (the events compared, not only their number).
     """
+    key = (command, address, command_end, gap_limit, crc_expected, multiline, len(events))
+    kept = _JUDGED.get(key)
+    if kept is not None and kept[0] == events:
+        return kept[1]
+    why = _ascii_problem(command, events, address, command_end, gap_limit, crc_expected, multiline)
+    if len(_JUDGED) >= _JUDGED_MAX:
+        _JUDGED.clear()
+    _JUDGED[key] = (list(events), why)
+    return why
+
+
+def _ascii_problem(
+    command: Command | None,
+    events: list[Event],
+    address: str,
+    command_end: float,
+    gap_limit: float,
+    crc_expected: bool | None,
+    multiline: bool,
+) -> str | None:
+    """:func:`check_ascii`, worked out."""
     if events and events[0].start < command_end:
         return "bus contention (reply started during the command)"
     bad = next((i for i, e in enumerate(events) if not e.parity_ok), None)

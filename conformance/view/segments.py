@@ -51,6 +51,7 @@ _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
 #: transmission holds characters only, so its text ends in ``!`` when its last one is ``!``
 _BANG = ord("!")
 _START = attrgetter("start")  # events in time order
+_TEXT = attrgetter("text")
 
 
 def on_tool_link(event: Event) -> bool:
@@ -182,7 +183,19 @@ def collided(heard: list[Event], end: float) -> list[Event]:
     started before it ended or came back between its echoes (two talkers), and the rest of a
     frame that began that way: characters that follow the last collided one within a
     character gap (widened by both stamps' uncertainty) until its LF. A service request that
-    started during the tool's command ends after it; that tail is no reply (issue 18)."""
+    started during the tool's command ends after it; that tail is no reply (issue 18).
+
+    Where no character met it (nearly every transmission: all started after it ended, none
+    a collision) there is no tail either: found by two passes in C, not the loop per
+    character (asked of every transmission, by each stimulus's records and the whole run's
+    segments)."""
+    if not heard or (min(map(_START, heard)) >= end and COLLISION not in map(_TEXT, heard)):
+        return []
+    return _collided_each(heard, end)
+
+
+def _collided_each(heard: list[Event], end: float) -> list[Event]:
+    """:func:`collided`, character by character."""
     out: list[Event] = []
     prev: Event | None = None  # the character before ``e``, when it collided
     for e in heard:
