@@ -16,12 +16,14 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from itertools import chain
 
-from ..transcript import DUT, TOOL, Event, EventKind, full_event
+from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .edges import Edges
 from .errors import CaptureError
 from .formats import read_edges, sniff
 from .glitch_filter import DEFAULT_BITS, GlitchFilter
-from .uart import Decoded, Framing, decode
+from .uart import HOLD_FRAMES, SYNC_BITS, Decoded, Framing, _synchronised, decode
+from .uart_bulk import Batch, decode_batches
+from .uart_bulk import decode as decode_bulk
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 #: Clean characters the short polarity probe (the first :data:`PROBE_EDGES` edges) must read
@@ -32,6 +34,10 @@ MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong 
 #: Glitches per decoded frame above which a capture is mostly pulses too short for a bit:
 #: with the shortest pulses off the bit rate, a wrong bit rate rather than a noisy line
 GLITCHES_PER_FRAME = 4
+#: Whether captures are decoded in bulk (:mod:`.uart_bulk`); False: by the reference decoder,
+#: a Python step a frame (:func:`.uart.decode`), which gives the same result item for item
+#: (``tests/capture/test_uart_bulk.py`` decodes both ways)
+BULK = True
 RECORDER_ORIGIN = TOOL  # origin of what the recorder's TX channel shows
 SENSOR_ORIGIN = DUT  # origin of the rest of the bus
 
@@ -127,10 +133,11 @@ def _choose_polarity(
     decided on the whole ``prefix`` as before (``tests/capture/test_polarity_probe.py``
     holds a capture whose first edges alone would pick the wrong polarity)."""
     kw = dict(initial_level=edges.initial_level, tick_rate=edges.tick_rate, baud=baud)
+    items = decode_bulk if BULK else decode
     if len(prefix) > PROBE_EDGES:
         short = prefix[:PROBE_EDGES]
         tried = {
-            inv: list(decode([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
+            inv: list(items([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
         }
         inv = _clean_winner(tried)
         if inv is not None:
@@ -139,7 +146,7 @@ def _choose_polarity(
                 f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames",
             )
     scores = {
-        inv: _score(list(decode([prefix], invert=inv, framing=framing, **kw)))
+        inv: _score(list(items([prefix], invert=inv, framing=framing, **kw)))
         for inv in (False, True)
     }
     if scores[False] != scores[True]:
@@ -207,8 +214,7 @@ def _decode_channel(
         framing=str(framing),
         notes=notes,
     )
-    decoded = decode(
-        chain(taken, chunks),
+    line = dict(
         initial_level=edges.initial_level,
         tick_rate=edges.tick_rate,
         invert=inverted,
@@ -219,7 +225,11 @@ def _decode_channel(
         period_ticks=edges.period * edges.tick_rate,
         end_tick=edges.end,
     )
-    _collect(decoded, out)
+    if BULK:
+        sync_s = SYNC_BITS * (edges.tick_rate / baud) / edges.tick_rate  # as uart.decode has it
+        _collect_batches(decode_batches(chain(taken, chunks), **line), out, sync_s, edges.t0)
+    else:
+        _collect(decode(chain(taken, chunks), **line), out)
     _filtered(out, glitch, how.glitch_filter)
     _check_plausible(out, _estimated_baud(prefix, edges.tick_rate), framing, force=how.force)
     return out
@@ -264,6 +274,80 @@ def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
     out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
     out.partial_frames = partial
     out.framing_errors, out.parity_errors = framing_errors, parity_errors
+
+
+def _collect_batches(
+    batches: Iterator[Batch], out: CaptureDecode, sync_s: float, t0: float
+) -> None:
+    """:func:`_collect` of :func:`~.uart.decode`'s items as :func:`~.uart_bulk.decode_batches`
+    gives them: a certified frame's event is made from the batch's lists, without a
+    :class:`~.uart.Decoded` (made only for a problem); the first :data:`~.uart.HOLD_FRAMES`
+    items, all that :func:`~.uart._synchronised` looks at, go through it as items."""
+    unc = out.uncertainty_s
+    head: list[Batch] = []  # the batches holding the first HOLD_FRAMES items
+    while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
+        head.append(b)
+    _synchronise_head(head, unc, sync_s, t0)
+    events, problems = out.events, out.problems
+    add, baud_error = events.append, out.baud_error_pct.append
+    nan = float("nan")
+    chars = framing_errors = parity_errors = glitches = breaks = pulses = partial = 0
+    char, bus, event = EventKind.CHAR, BUS, full_event
+    for b in chain(head, batches):
+        st, en, wi, fe, pe, err, gl = (
+            b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
+        )  # fmt: skip
+        for x in b.order:
+            if x.__class__ is int:
+                add(event(char, bus, st[x], en[x], wi[x], "", unc, None))  # type: ignore[index]
+                chars += 1
+                e = err[x]  # type: ignore[index]
+                baud_error(nan if e is None else e)
+                if fe[x] or pe[x] or gl[x]:  # type: ignore[index]
+                    framing_errors += fe[x]  # type: ignore[index]
+                    parity_errors += pe[x]  # type: ignore[index]
+                    glitches += gl[x]  # type: ignore[index]
+                    problems.append(b.item(x, unc))  # type: ignore[arg-type]
+                continue
+            d: Decoded = x  # type: ignore[assignment]
+            if d.event is not None:
+                add(d.event)
+            if d.kind == "char":
+                chars += 1
+                framing_errors += d.framing_error
+                parity_errors += d.parity_error
+                glitches += d.glitches
+                baud_error(nan if d.baud_error_pct is None else d.baud_error_pct)
+                if d.framing_error or d.parity_error or d.glitches:
+                    problems.append(d)
+                continue
+            problems.append(d)
+            breaks += d.kind == "break"
+            pulses += d.kind == "pulse"
+            glitches += d.kind == "glitch"
+            partial += d.kind == "partial"
+    out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
+    out.partial_frames = partial
+    out.framing_errors, out.parity_errors = framing_errors, parity_errors
+
+
+def _synchronise_head(batches: list[Batch], unc: float, sync_s: float, t0: float) -> None:
+    """The first :data:`~.uart.HOLD_FRAMES` items of ``batches`` made items and passed
+    through :func:`~.uart._synchronised` in place: it decides on those alone (a frame that
+    proves a start bit among them, or none), and gives back as many as it takes."""
+    head: list[tuple[Batch, int]] = []
+    for b in batches:
+        for k in range(min(len(b.order), HOLD_FRAMES - len(head))):
+            head.append((b, k))
+        if len(head) >= HOLD_FRAMES:
+            break
+    items = [b.order[k] for b, k in head]
+    made = [
+        x if x.__class__ is not int else b.item(x, unc)  # type: ignore[arg-type]
+        for x, (b, _) in zip(items, head, strict=True)
+    ]
+    for (b, k), d in zip(head, _synchronised(iter(made), sync_s, t0), strict=True):
+        b.order[k] = d
 
 
 def _check_plausible(
