@@ -385,7 +385,7 @@ class _Certified:
         after: np.ndarray,
         n: int,
     ) -> None:
-        T, nbits, period = line.T, line.nbits, line.period_ticks
+        T, nbits = line.T, line.nbits
         half, _, frame_span = _spans(T, nbits)
         m_frames = starts.size
         s = W[starts]
@@ -400,32 +400,8 @@ class _Certified:
         inner_next = (at - starts[owner]) < m[owner]  # an inner edge follows this one
         gap_next = np.where(inner_next, W[np.minimum(at + 1, W.size - 1)] - e, 0)
         glitch_edge = (gap < half) | (inner_next & (gap_next < half))
-        d = e - s[owner]
-        kk = np.rint(d / T)
-        valid = ~glitch_edge & (kk >= 1) & (kk < nbits) & (np.abs(d - kk * T) < T / 2)
-        kkv = np.where(valid, kk, 0.0).astype(np.int64)
-        kk2 = np.cumsum(kkv * kkv)
-        kd = np.cumsum(kkv * d)
-        base = first - 1
-        kk2_before = np.where(base >= 0, kk2[np.maximum(base, 0)], 0) if owner.size else kk2[:0]
-        kd_before = np.where(base >= 0, kd[np.maximum(base, 0)], 0) if owner.size else kd[:0]
-        skk = kk2 - kk2_before[owner]
-        sdk = kd - kd_before[owner]
-        kmax = np.maximum.accumulate(kkv + owner * 16) - owner * 16
-        with np.errstate(divide="ignore", invalid="ignore"):
-            bt = sdk.astype(np.float64) / skk.astype(np.float64)
-            moved = valid & (np.abs(bt - T) * kmax.astype(np.float64) > 2 * period)
-        ok = np.ones(m_frames, dtype=bool)
-        ok[owner[moved]] = False
-        ok &= after < n  # an edge after the stop bit: not the capture's last frame
-        # the fit's final bit time per frame: its last valid edge's
-        last_valid = np.full(m_frames, -1, dtype=np.int64)
-        vidx = np.flatnonzero(valid)
-        last_valid[owner[vidx]] = vidx  # later indices overwrite earlier ones
-        has_fit = last_valid >= 0
-        err = np.full(m_frames, np.nan)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            err[has_fit] = (T / bt[last_valid[has_fit]] - 1) * 100
+        moved, err = _fitted(e - s[owner], ~glitch_edge, owner, first, m_frames, line)
+        ok = ~moved & (after < n)  # an edge after the stop bit: not the capture's last frame
         # bits at their centres
         centres = sf[:, None] + (np.arange(nbits) + 0.5) * T
         count = np.searchsorted(Wf, centres, "right") - (starts + 1)[:, None]
@@ -465,3 +441,44 @@ class _Certified:
             glitches.tolist(),
             [None] * m_frames,
         )
+
+
+def _fitted(
+    d: np.ndarray,
+    usable: np.ndarray,
+    owner: np.ndarray,
+    first: np.ndarray,
+    m_frames: int,
+    line: _Line,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`.uart._read_frame`'s fit of the sender's bit time at the nominal one, for the
+    inner edges of many frames at once (``d``: each edge's distance from its frame's start
+    bit, ``usable``: not a glitch's edge, ``owner``: its frame, ``first``: each frame's first
+    edge): per frame, whether the fit would have moved the bit time off the nominal one at
+    any edge, and the measured error in % (NaN: no edge fitted). The sums are integers,
+    summed exactly as the reference's floats are."""
+    T, nbits, period = line.T, line.nbits, line.period_ticks
+    kk = np.rint(d / T)
+    valid = usable & (kk >= 1) & (kk < nbits) & (np.abs(d - kk * T) < T / 2)
+    kkv = np.where(valid, kk, 0.0).astype(np.int64)
+    kk2 = np.cumsum(kkv * kkv)
+    kd = np.cumsum(kkv * d)
+    base = np.maximum(first - 1, 0)
+    before = first >= 1
+    skk = kk2 - np.where(before, kk2[base] if kk2.size else 0, 0)[owner]
+    sdk = kd - np.where(before, kd[base] if kd.size else 0, 0)[owner]
+    kmax = np.maximum.accumulate(kkv + owner * 16) - owner * 16  # per frame (kk < 16)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bt = sdk.astype(np.float64) / skk.astype(np.float64)
+        off = valid & (np.abs(bt - T) * kmax.astype(np.float64) > 2 * period)
+    moved = np.zeros(m_frames, dtype=bool)
+    moved[owner[off]] = True
+    vidx = np.flatnonzero(valid)  # the fit's final bit time: its frame's last valid edge's
+    of = owner[vidx]  # non-decreasing
+    last = np.searchsorted(of, np.arange(m_frames), "right") - 1
+    has_fit = last >= 0
+    has_fit[has_fit] = of[last[has_fit]] == np.flatnonzero(has_fit)
+    err = np.full(m_frames, np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        err[has_fit] = (T / bt[vidx[last[has_fit]]] - 1) * 100
+    return moved, err
