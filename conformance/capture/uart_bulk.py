@@ -33,7 +33,7 @@ from __future__ import annotations
 
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -67,7 +67,7 @@ class Batch:
     """One window's items in time order: ``order`` holds, per item, either an index into
     the window's certified frames (an ``int``: their fields in the lists below) or the
     :class:`.uart.Decoded` the scan's own code made (glitches, spacings, frames read one at
-    a time). ``marking``: each certified frame's marking before it (None for the first)."""
+    a time). Each certified frame's marking before it is worked out when it is made an item."""
 
     order: list[int | Decoded]
     start: list[float]
@@ -77,7 +77,17 @@ class Batch:
     parity_error: list[bool]
     err: list[float | None]
     glitches: list[int]
-    marking: list[float | None]
+    #: each certified frame's start tick and the end (tick) of the frame or spacing before
+    #: it (None: none), its marking worked out only for a frame made an item (a problem,
+    #: or one of the first few, which the synchronisation looks at)
+    start_ticks: list[int] = field(default_factory=list)
+    before: list[float | None] = field(default_factory=list)
+    tick_rate: float = 1.0
+
+    def marking(self, p: int) -> float | None:
+        """The marking before certified frame ``p``, as the scan works it out (s)."""
+        b = self.before[p]
+        return None if b is None else max(0.0, (self.start_ticks[p] - b) / self.tick_rate)
 
     def item(self, p: int, uncertainty: float) -> Decoded:
         """Certified frame ``p`` as the :class:`.uart.Decoded` the reference makes."""
@@ -93,7 +103,7 @@ class Batch:
             self.parity_error[p],
             self.err[p],
             self.glitches[p],
-            self.marking[p],
+            self.marking(p),
         )
 
     def items(self, uncertainty: float) -> Iterator[Decoded]:
@@ -232,7 +242,7 @@ class _Window:
         ok, nxt, end, fe = cert.ok, cert.next, cert.end_ticks, cert.framing_error
         order: list = []
         add = order.append
-        before = cert.before  # each certified frame's last_end, its marking made below
+        before = cert.before  # each certified frame's last_end (Batch.marking)
         span = nbits * T
         k = 0
         while k < n:
@@ -280,10 +290,7 @@ class _Window:
                 add(d)
         batch = cert.batch
         batch.order = order
-        batch.marking = [
-            None if b is None else max(0.0, (x - b) / tick_rate)
-            for x, b in zip(cert.start_ticks, before, strict=True)
-        ]
+        batch.before, batch.start_ticks, batch.tick_rate = before, cert.start_ticks, tick_rate
         return batch, k, last_end, prior_bt
 
     def _step(self, k: int, last_end, prior_bt) -> tuple | None:
@@ -439,7 +446,6 @@ class _Certified:
             parity_error.tolist(),
             [None if v != v else v for v in err.tolist()],
             glitches.tolist(),
-            [None] * m_frames,
         )
 
 
