@@ -177,7 +177,12 @@ class DecodeSettings:
 
 
 def _decode_channel(
-    path: str, fmt: str, channel: str | None, invert: bool | None, how: DecodeSettings
+    path: str,
+    fmt: str,
+    channel: str | None,
+    invert: bool | None,
+    how: DecodeSettings,
+    origin: str = BUS,
 ) -> CaptureDecode:
     baud, framing, edge_error = how.baud, how.framing, how.edge_error
     edges = read_edges(path, channel, fmt)
@@ -227,7 +232,8 @@ def _decode_channel(
     )
     if BULK:
         sync_s = SYNC_BITS * (edges.tick_rate / baud) / edges.tick_rate  # as uart.decode has it
-        _collect_batches(decode_batches(chain(taken, chunks), **line), out, sync_s, edges.t0)
+        batches = decode_batches(chain(taken, chunks), **line)
+        _collect_batches(batches, out, sync_s, edges.t0, origin)
     else:
         _collect(decode(chain(taken, chunks), **line), out)
     _filtered(out, glitch, how.glitch_filter)
@@ -277,12 +283,13 @@ def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
 
 
 def _collect_batches(
-    batches: Iterator[Batch], out: CaptureDecode, sync_s: float, t0: float
+    batches: Iterator[Batch], out: CaptureDecode, sync_s: float, t0: float, origin: str = BUS
 ) -> None:
     """:func:`_collect` of :func:`~.uart.decode`'s items as :func:`~.uart_bulk.decode_batches`
     gives them: a certified frame's event is made from the batch's lists, without a
     :class:`~.uart.Decoded` (made only for a problem); the first :data:`~.uart.HOLD_FRAMES`
-    items, all that :func:`~.uart._synchronised` looks at, go through it as items."""
+    items, all that :func:`~.uart._synchronised` looks at, go through it as items. The
+    events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's)."""
     unc = out.uncertainty_s
     head: list[Batch] = []  # the batches holding the first HOLD_FRAMES items
     while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
@@ -292,7 +299,7 @@ def _collect_batches(
     add, baud_error = events.append, out.baud_error_pct.append
     nan = float("nan")
     chars = framing_errors = parity_errors = glitches = breaks = pulses = partial = 0
-    char, bus, event = EventKind.CHAR, BUS, full_event
+    char, bus, event = EventKind.CHAR, origin, full_event
     for b in chain(head, batches):
         st, en, wi, fe, pe, err, gl = (
             b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
@@ -310,8 +317,11 @@ def _collect_batches(
                     problems.append(b.item(x, unc))  # type: ignore[arg-type]
                 continue
             d: Decoded = x  # type: ignore[assignment]
-            if d.event is not None:
-                add(d.event)
+            if (ev := d.event) is not None:
+                if origin != BUS:
+                    u, du = ev.uncertainty, ev.duration_uncertainty
+                    ev = event(ev.kind, bus, ev.start, ev.end, ev.wire, ev.text, u, du)
+                add(ev)
             if d.kind == "char":
                 chars += 1
                 framing_errors += d.framing_error
@@ -412,6 +422,34 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
     return out, n_tx - matched
 
 
+def _mark_recorder(bus: list[Event], tx: list[Event], tolerance: float) -> int:
+    """:func:`merge_tx` of bus events decoded with origin :data:`SENSOR_ORIGIN` already, in
+    place: only the events it gives :data:`RECORDER_ORIGIN` are made again (the others are
+    already what it makes); how many TX events were not seen on the bus."""
+    j = 0
+    n_tx = len(tx)
+    matched = 0
+    char, event = EventKind.CHAR, full_event
+    for i, ev in enumerate(bus):
+        start = ev.start
+        while j < n_tx and tx[j].start < start - tolerance:
+            j += 1
+        if j < n_tx:
+            t = tx[j]
+            if (
+                abs(t.start - start) <= tolerance
+                and t.kind is ev.kind
+                and (ev.kind is not char or t.wire == ev.wire)
+            ):
+                du = ev.duration_uncertainty
+                bus[i] = event(
+                    ev.kind, RECORDER_ORIGIN, start, ev.end, ev.wire, ev.text, ev.uncertainty, du
+                )
+                matched += 1
+                j += 1
+    return n_tx - matched
+
+
 #: the last capture decoded, by file identity and settings: ``judge`` decodes a capture to
 #: decide whether it can be replayed, and passive judging reads the same decode again (an
 #: hour of 1 MHz samples is tens of seconds to decode; one decode is kept, not a history)
@@ -478,13 +516,20 @@ def _decode_capture(
     fmt = sniff(path)
     if fmt == "jsonl":
         raise CaptureError(path, "a transcript, not a capture: read it with read_transcript_jsonl")
-    out = _decode_channel(path, fmt, channel, invert, how)
+    # in bulk, a bus merged with a TX channel is decoded as the sensors' (SENSOR_ORIGIN) and
+    # only the recorder's events are made again (_mark_recorder), not every one
+    merged = tx_channel is not None and BULK
+    out = _decode_channel(path, fmt, channel, invert, how, SENSOR_ORIGIN if merged else BUS)
     if tx_channel is None:
         return out
     if tx_channel == out.channel:
         raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
     tx = _decode_channel(path, fmt, tx_channel, None, how)
-    out.events, unseen = merge_tx(out.events, tx.events, 0.5 / baud + 2 * out.uncertainty_s)
+    tolerance = 0.5 / baud + 2 * out.uncertainty_s
+    if merged:
+        unseen = _mark_recorder(out.events, tx.events, tolerance)
+    else:
+        out.events, unseen = merge_tx(out.events, tx.events, tolerance)
     out.tx_channel = tx.channel
     out.notes.append(f"TX channel {tx.channel!r}: {tx.polarity} polarity")
     if unseen:
