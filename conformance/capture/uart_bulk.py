@@ -55,9 +55,11 @@ from .uart import (
     _synchronised,
 )
 
-#: Edges held in one window (a matrix row's capture is one or two windows; an hour's
-#: capture is read a window at a time, so its edges are never one array)
-WINDOW = 1 << 17
+#: Edges held in one window: a capture is read a window at a time, so its edges are never
+#: one array. Its arrays and lists are a few MB at this size; a 5-minute 1 MHz capture's
+#: decode peaked at 54 / 63 / 83 MB RSS with 2^12 / 2^15 / 2^17 edges (the reference
+#: decoder: 53), for the same CPU (a matrix row's capture: 184-194 ms each way)
+WINDOW = 1 << 12
 
 _GLITCH, _SPACING, _FRAME, _TAIL = 0, 1, 2, 3
 
