@@ -175,3 +175,21 @@ def test_shared_captures_decode_the_same_both_ways(monkeypatch, name, baud, fram
     for invert in (None, True):
         kw = dict(baud=baud, framing=framing, invert=invert, force=True)
         same_decode(*both_ways(monkeypatch, path, **kw))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fault", ["fast-baud", "inter-char-gap", "binary-invalid-type"])
+def test_a_fault_runs_capture_decodes_the_same_both_ways(tmp_path, monkeypatch, fault):
+    """A fault run's capture as ``judge`` decodes it (the tool's TX on a second channel):
+    a sender at 1300 baud (every reply character read by the scan's own code), gaps
+    between characters, 8N1 binary bytes among 7E1 frames."""
+    from conformance.conduct import run_into
+    from conformance.replay.recording import read_recording
+
+    run_into(tmp_path / "live", f"sim://?faults={fault}")
+    events = read_recording(tmp_path / "live").events
+    path = tmp_path / "run.sr"
+    export_events(events, str(path), "sr", tool_channel=True)
+    a, b = both_ways(monkeypatch, path, tx_channel="TOOL_TX")
+    same_decode(a, b)
+    assert a.chars > 10_000
