@@ -16,12 +16,14 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from itertools import chain
 
-from ..transcript import DUT, TOOL, Event, EventKind, full_event
+from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .edges import Edges
 from .errors import CaptureError
 from .formats import read_edges, sniff
 from .glitch_filter import DEFAULT_BITS, GlitchFilter
-from .uart import Decoded, Framing, decode
+from .uart import HOLD_FRAMES, SYNC_BITS, Decoded, Framing, _synchronised, decode
+from .uart_bulk import Batch, decode_batches
+from .uart_bulk import decode as decode_bulk
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 #: Clean characters the short polarity probe (the first :data:`PROBE_EDGES` edges) must read
@@ -32,6 +34,10 @@ MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong 
 #: Glitches per decoded frame above which a capture is mostly pulses too short for a bit:
 #: with the shortest pulses off the bit rate, a wrong bit rate rather than a noisy line
 GLITCHES_PER_FRAME = 4
+#: Whether captures are decoded in bulk (:mod:`.uart_bulk`); False: by the reference decoder,
+#: a Python step a frame (:func:`.uart.decode`), which gives the same result item for item
+#: (``tests/capture/test_uart_bulk.py`` decodes both ways)
+BULK = True
 RECORDER_ORIGIN = TOOL  # origin of what the recorder's TX channel shows
 SENSOR_ORIGIN = DUT  # origin of the rest of the bus
 
@@ -127,10 +133,11 @@ def _choose_polarity(
     decided on the whole ``prefix`` as before (``tests/capture/test_polarity_probe.py``
     holds a capture whose first edges alone would pick the wrong polarity)."""
     kw = dict(initial_level=edges.initial_level, tick_rate=edges.tick_rate, baud=baud)
+    items = decode_bulk if BULK else decode
     if len(prefix) > PROBE_EDGES:
         short = prefix[:PROBE_EDGES]
         tried = {
-            inv: list(decode([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
+            inv: list(items([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
         }
         inv = _clean_winner(tried)
         if inv is not None:
@@ -139,7 +146,7 @@ def _choose_polarity(
                 f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames",
             )
     scores = {
-        inv: _score(list(decode([prefix], invert=inv, framing=framing, **kw)))
+        inv: _score(list(items([prefix], invert=inv, framing=framing, **kw)))
         for inv in (False, True)
     }
     if scores[False] != scores[True]:
@@ -170,7 +177,12 @@ class DecodeSettings:
 
 
 def _decode_channel(
-    path: str, fmt: str, channel: str | None, invert: bool | None, how: DecodeSettings
+    path: str,
+    fmt: str,
+    channel: str | None,
+    invert: bool | None,
+    how: DecodeSettings,
+    origin: str = BUS,
 ) -> CaptureDecode:
     baud, framing, edge_error = how.baud, how.framing, how.edge_error
     edges = read_edges(path, channel, fmt)
@@ -207,8 +219,7 @@ def _decode_channel(
         framing=str(framing),
         notes=notes,
     )
-    decoded = decode(
-        chain(taken, chunks),
+    line = dict(
         initial_level=edges.initial_level,
         tick_rate=edges.tick_rate,
         invert=inverted,
@@ -219,7 +230,12 @@ def _decode_channel(
         period_ticks=edges.period * edges.tick_rate,
         end_tick=edges.end,
     )
-    _collect(decoded, out)
+    if BULK:
+        sync_s = SYNC_BITS * (edges.tick_rate / baud) / edges.tick_rate  # as uart.decode has it
+        batches = decode_batches(chain(taken, chunks), **line)
+        _collect_batches(batches, out, sync_s, edges.t0, origin)
+    else:
+        _collect(decode(chain(taken, chunks), **line), out)
     _filtered(out, glitch, how.glitch_filter)
     _check_plausible(out, _estimated_baud(prefix, edges.tick_rate), framing, force=how.force)
     return out
@@ -264,6 +280,84 @@ def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
     out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
     out.partial_frames = partial
     out.framing_errors, out.parity_errors = framing_errors, parity_errors
+
+
+def _collect_batches(
+    batches: Iterator[Batch], out: CaptureDecode, sync_s: float, t0: float, origin: str = BUS
+) -> None:
+    """:func:`_collect` of :func:`~.uart.decode`'s items as :func:`~.uart_bulk.decode_batches`
+    gives them: a certified frame's event is made from the batch's lists, without a
+    :class:`~.uart.Decoded` (made only for a problem); the first :data:`~.uart.HOLD_FRAMES`
+    items, all that :func:`~.uart._synchronised` looks at, go through it as items. The
+    events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's)."""
+    unc = out.uncertainty_s
+    head: list[Batch] = []  # the batches holding the first HOLD_FRAMES items
+    while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
+        head.append(b)
+    _synchronise_head(head, unc, sync_s, t0)
+    events, problems = out.events, out.problems
+    add, baud_error = events.append, out.baud_error_pct.append
+    nan = float("nan")
+    chars = framing_errors = parity_errors = glitches = breaks = pulses = partial = 0
+    char, bus, event = EventKind.CHAR, origin, full_event
+    for b in chain(head, batches):
+        st, en, wi, fe, pe, err, gl = (
+            b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
+        )  # fmt: skip
+        for x in b.order:
+            if x.__class__ is int:
+                add(event(char, bus, st[x], en[x], wi[x], "", unc, None))  # type: ignore[index]
+                chars += 1
+                e = err[x]  # type: ignore[index]
+                baud_error(nan if e is None else e)
+                if fe[x] or pe[x] or gl[x]:  # type: ignore[index]
+                    framing_errors += fe[x]  # type: ignore[index]
+                    parity_errors += pe[x]  # type: ignore[index]
+                    glitches += gl[x]  # type: ignore[index]
+                    problems.append(b.item(x, unc))  # type: ignore[arg-type]
+                continue
+            d: Decoded = x  # type: ignore[assignment]
+            if (ev := d.event) is not None:
+                if origin != BUS:
+                    u, du = ev.uncertainty, ev.duration_uncertainty
+                    ev = event(ev.kind, bus, ev.start, ev.end, ev.wire, ev.text, u, du)
+                add(ev)
+            if d.kind == "char":
+                chars += 1
+                framing_errors += d.framing_error
+                parity_errors += d.parity_error
+                glitches += d.glitches
+                baud_error(nan if d.baud_error_pct is None else d.baud_error_pct)
+                if d.framing_error or d.parity_error or d.glitches:
+                    problems.append(d)
+                continue
+            problems.append(d)
+            breaks += d.kind == "break"
+            pulses += d.kind == "pulse"
+            glitches += d.kind == "glitch"
+            partial += d.kind == "partial"
+    out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
+    out.partial_frames = partial
+    out.framing_errors, out.parity_errors = framing_errors, parity_errors
+
+
+def _synchronise_head(batches: list[Batch], unc: float, sync_s: float, t0: float) -> None:
+    """The first :data:`~.uart.HOLD_FRAMES` items of ``batches`` made items and passed
+    through :func:`~.uart._synchronised` in place: it decides on those alone (a frame that
+    proves a start bit among them, or none), and gives back as many as it takes."""
+    head: list[tuple[Batch, int]] = []
+    for b in batches:
+        for k in range(min(len(b.order), HOLD_FRAMES - len(head))):
+            head.append((b, k))
+        if len(head) >= HOLD_FRAMES:
+            break
+    items = [b.order[k] for b, k in head]
+    made = [
+        x if x.__class__ is not int else b.item(x, unc)  # type: ignore[arg-type]
+        for x, (b, _) in zip(items, head, strict=True)
+    ]
+    for (b, k), d in zip(head, _synchronised(iter(made), sync_s, t0), strict=True):
+        b.order[k] = d
 
 
 def _check_plausible(
@@ -326,6 +420,34 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
         du = ev.duration_uncertainty
         append(event(ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty, du))
     return out, n_tx - matched
+
+
+def _mark_recorder(bus: list[Event], tx: list[Event], tolerance: float) -> int:
+    """:func:`merge_tx` of bus events decoded with origin :data:`SENSOR_ORIGIN` already, in
+    place: only the events it gives :data:`RECORDER_ORIGIN` are made again (the others are
+    already what it makes); how many TX events were not seen on the bus."""
+    j = 0
+    n_tx = len(tx)
+    matched = 0
+    char, event = EventKind.CHAR, full_event
+    for i, ev in enumerate(bus):
+        start = ev.start
+        while j < n_tx and tx[j].start < start - tolerance:
+            j += 1
+        if j < n_tx:
+            t = tx[j]
+            if (
+                abs(t.start - start) <= tolerance
+                and t.kind is ev.kind
+                and (ev.kind is not char or t.wire == ev.wire)
+            ):
+                du = ev.duration_uncertainty
+                bus[i] = event(
+                    ev.kind, RECORDER_ORIGIN, start, ev.end, ev.wire, ev.text, ev.uncertainty, du
+                )
+                matched += 1
+                j += 1
+    return n_tx - matched
 
 
 #: the last capture decoded, by file identity and settings: ``judge`` decodes a capture to
@@ -394,13 +516,20 @@ def _decode_capture(
     fmt = sniff(path)
     if fmt == "jsonl":
         raise CaptureError(path, "a transcript, not a capture: read it with read_transcript_jsonl")
-    out = _decode_channel(path, fmt, channel, invert, how)
+    # in bulk, a bus merged with a TX channel is decoded as the sensors' (SENSOR_ORIGIN) and
+    # only the recorder's events are made again (_mark_recorder), not every one
+    merged = tx_channel is not None and BULK
+    out = _decode_channel(path, fmt, channel, invert, how, SENSOR_ORIGIN if merged else BUS)
     if tx_channel is None:
         return out
     if tx_channel == out.channel:
         raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
     tx = _decode_channel(path, fmt, tx_channel, None, how)
-    out.events, unseen = merge_tx(out.events, tx.events, 0.5 / baud + 2 * out.uncertainty_s)
+    tolerance = 0.5 / baud + 2 * out.uncertainty_s
+    if merged:
+        unseen = _mark_recorder(out.events, tx.events, tolerance)
+    else:
+        out.events, unseen = merge_tx(out.events, tx.events, tolerance)
     out.tx_channel = tx.channel
     out.notes.append(f"TX channel {tx.channel!r}: {tx.polarity} polarity")
     if unseen:

@@ -11,6 +11,7 @@ by block, so memory stays a few megabytes whatever the capture's length.
 from __future__ import annotations
 
 import configparser
+import os
 import re
 import zipfile
 import zlib
@@ -133,14 +134,19 @@ def probe_changes(block: np.ndarray, probes: dict[str, int]) -> dict[str, int]:
 
 
 def _transitions(
-    block: np.ndarray, bit: int, previous: int | None, offset: int
+    block: np.ndarray,
+    bit: int,
+    previous: int | None,
+    offset: int,
+    changed: np.ndarray | None = None,
 ) -> tuple[list[int], int]:
     """:func:`~.edges.transitions` of probe ``bit`` in a block of sample words, as ticks
     (``offset``: the block's first sample), and the probe's last level. The words that
-    differ from the one before are found first, across all probes in one pass, and only
-    those few are looked at for the probe's bit: a block is millions of samples, a line
-    changes level a few thousand times."""
-    changed = np.flatnonzero(block[1:] != block[:-1])
+    differ from the one before are found first, across all probes in one pass (``changed``,
+    when already found for another probe), and only those few are looked at for the probe's
+    bit: a block is millions of samples, a line changes level a few thousand times."""
+    if changed is None:
+        changed = np.flatnonzero(block[1:] != block[:-1])
     changed = changed[((block[changed] ^ block[changed + 1]) >> bit) & 1 != 0]
     idx = (changed + (offset + 1)).tolist()
     if previous is not None and int(block[0]) >> bit & 1 != previous:
@@ -148,8 +154,34 @@ def _transitions(
     return idx, int(block[-1]) >> bit & 1
 
 
+#: The other probes' edges found in the last whole pass over a session, by the file's
+#: identity: ``judge`` decodes a capture's bus channel and then the tool's TX channel, and
+#: the second pass inflated and scanned every sample again for the one bit it had skipped
+#: (a matrix row's capture: 31 M samples, two fifths of the TX channel's decode). Kept only
+#: while their edges stay under :data:`OTHERS_MAX_EDGES` (a long busy capture's are read
+#: again), one session at a time.
+OTHERS_MAX_EDGES = 1 << 20
+_OTHERS: dict[tuple, dict[str, tuple[int, list[list[int]], int]]] = {}
+
+
+def _identity(path: str) -> tuple | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (os.path.realpath(path), st.st_mtime_ns, st.st_size)
+
+
 def read_sr(path: str, channel: str | None = None) -> Edges:
-    """Edges of one probe of a session (``channel`` by name; default the busiest one)."""
+    """Edges of one probe of a session (``channel`` by name; default the busiest one). The
+    pass over the samples keeps the other probes' edges too (:data:`_OTHERS`), which a
+    later read of one of them takes instead of a pass of its own."""
+    key = _identity(path)
+    kept = _OTHERS.get(key, {}).get(channel or "") if key is not None else None
+    if kept is not None:
+        session = SrSession(path)  # its metadata checked as a pass would check it
+        session.zip.close()
+        return _kept_edges(path, channel or "", session, kept)
     session = SrSession(path)
     notes: list[str] = []
     if channel is None:
@@ -163,6 +195,7 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
     bit = session.probes[channel]
     total = [0]
     first_level: list[int] = []
+    others = _Others(key, session, channel)
 
     def chunks() -> Iterator[list[int]]:
         previous: int | None = None
@@ -170,14 +203,18 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
         for block in session.blocks():
             if not block.size:  # as the general reader takes it (-1 if first)
                 previous = transitions(block, previous)[1]
+                others.empty(block)
                 continue
             if previous is None:
                 first_level.append(int(block[0]) >> bit & 1)
-            idx, previous = _transitions(block, bit, previous, offset)
+            changed = np.flatnonzero(block[1:] != block[:-1])
+            idx, previous = _transitions(block, bit, previous, offset, changed)
+            others.add(block, offset, changed)
             if idx:
                 yield idx
             offset += block.size
         total[0] = offset
+        others.keep(offset)
         session.zip.close()
 
     gen = chunks()
@@ -201,4 +238,61 @@ def read_sr(path: str, channel: str | None = None) -> Edges:
         chunks=read_ahead(all_chunks()),  # inflated and scanned beside the decoder
         end=lambda: total[0] or None,
         notes=notes,
+    )
+
+
+class _Others:
+    """The other probes' edges gathered during one pass (see :data:`_OTHERS`): each probe's
+    first level, chunks and last level, as a pass of its own would find them."""
+
+    def __init__(self, key: tuple | None, session: SrSession, channel: str) -> None:
+        self.key = key
+        self.bits = {n: b for n, b in session.probes.items() if n != channel}
+        self.state: dict[str, list] = {n: [None, [], None] for n in self.bits}
+        self.edges = 0
+        self.live = key is not None and bool(self.bits)
+
+    def empty(self, block: np.ndarray) -> None:
+        for st in self.state.values():
+            st[2] = transitions(block, st[2])[1]
+
+    def add(self, block: np.ndarray, offset: int, changed: np.ndarray) -> None:
+        if not self.live:
+            return
+        for name, bit in self.bits.items():
+            st = self.state[name]
+            if st[2] is None:
+                st[0] = int(block[0]) >> bit & 1
+            idx, st[2] = _transitions(block, bit, st[2], offset, changed)
+            if idx:
+                st[1].append(idx)
+                self.edges += len(idx)
+        if self.edges > OTHERS_MAX_EDGES:
+            self.live = False
+            self.state.clear()
+
+    def keep(self, total: int) -> None:
+        if not self.live or self.key is None:
+            return
+        _OTHERS.clear()
+        _OTHERS[self.key] = {
+            n: (st[0], st[1], total) for n, st in self.state.items() if st[0] is not None
+        }
+
+
+def _kept_edges(
+    path: str, channel: str, session: SrSession, kept: tuple[int, list[list[int]], int]
+) -> Edges:
+    """The edges of ``channel`` a pass over another probe kept (:class:`_Others`)."""
+    first_level, chunks, total = kept
+    return Edges(
+        path=path,
+        channel=channel,
+        channels=list(session.probes),
+        tick_rate=session.samplerate,
+        period=1.0 / session.samplerate,
+        initial_level=first_level,
+        chunks=iter([list(c) for c in chunks]),
+        end=lambda: total or None,
+        notes=[],
     )

@@ -109,7 +109,9 @@ def write_sr(
         if comment:
             zf.writestr(SR_COMMENT_MEMBER, comment)
         for n, word in enumerate(_words(channels, total), 1):
-            zf.writestr(f"logic-1-{n}", word.tobytes())
+            # the array's own buffer (zipfile takes any buffer: its CRC and deflate read
+            # it in place), not a copy of 4 MiB a block
+            zf.writestr(f"logic-1-{n}", memoryview(word))
 
 
 def _merged(channels: list[Channel]) -> Iterator[tuple[int, int]]:
