@@ -75,7 +75,9 @@ LONGEST = (
     "tests/kit/test_arduino_sensor.py",  # 20 s (2.6%)
     "tests/e2e/test_case_order.py",  # 19 s (2.4%)
     "tests/offline/test_judge_memory.py",  # 15 s alone (stop 38), 64 s of wall in CI
+    "tests/reports/test_html_aside.py",  # 11 s alone (stop 39: three forked pages)
     "tests/recorder/test_capability.py",  # 11 s (1.4%)
+    "tests/capture/test_uart_bulk.py",  # 9 s alone (stop 39: hypothesis + fault captures)
     "tests/test_cli.py",  # 9 s (1.2%)
     "tests/reports/test_diff.py",  # 9 s (1.2%)
     "tests/kit/test_kit_batch.py",  # 9 s (1.2%)
