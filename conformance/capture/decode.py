@@ -254,32 +254,48 @@ def _filtered(out: CaptureDecode, glitch: GlitchFilter, width: float) -> None:
 
 def _collect(decoded: Iterator[Decoded], out: CaptureDecode) -> None:
     """Every decoded item into ``out``: its events, problems, per-character bit-rate errors
-    and counts. One loop over the whole capture (millions of items an hour), with the
-    counters kept in locals and stored once at the end."""
-    events, problems = out.events, out.problems
-    baud_error = out.baud_error_pct.append
-    nan = float("nan")
-    chars = framing_errors = parity_errors = glitches = breaks = pulses = partial = 0
+    and counts (the reference path, ``BULK`` off: :func:`_collect_batches` is the fast one)."""
+    tally = _Tally(out)
     for d in decoded:
         if d.event is not None:
-            events.append(d.event)
+            out.events.append(d.event)
+        tally.item(d)
+    tally.store(out)
+
+
+class _Tally:
+    """The counts of a capture's decoded items, and its problems and bit-rate errors, as
+    :func:`_collect` and the rare items of :func:`_collect_batches` (problems, the first
+    frames) add them; the bulk loop adds its certified frames to the counters directly."""
+
+    def __init__(self, out: CaptureDecode) -> None:
+        self.problems, self.baud_error = out.problems, out.baud_error_pct.append
+        self.chars = self.framing_errors = self.parity_errors = self.glitches = 0
+        self.breaks = self.pulses = self.partial = 0
+
+    def item(self, d: Decoded) -> None:
+        """Count one item (its event is the caller's: origins differ)."""
         if d.kind == "char":
-            chars += 1
-            framing_errors += d.framing_error
-            parity_errors += d.parity_error
-            glitches += d.glitches
-            baud_error(nan if d.baud_error_pct is None else d.baud_error_pct)
+            self.chars += 1
+            self.framing_errors += d.framing_error
+            self.parity_errors += d.parity_error
+            self.glitches += d.glitches
+            self.baud_error(float("nan") if d.baud_error_pct is None else d.baud_error_pct)
             if d.framing_error or d.parity_error or d.glitches:
-                problems.append(d)
-            continue
-        problems.append(d)
-        breaks += d.kind == "break"
-        pulses += d.kind == "pulse"
-        glitches += d.kind == "glitch"
-        partial += d.kind == "partial"
-    out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
-    out.partial_frames = partial
-    out.framing_errors, out.parity_errors = framing_errors, parity_errors
+                self.problems.append(d)
+            return
+        self.problems.append(d)
+        self.breaks += d.kind == "break"
+        self.pulses += d.kind == "pulse"
+        self.glitches += d.kind == "glitch"
+        self.partial += d.kind == "partial"
+
+    def store(self, out: CaptureDecode) -> None:
+        out.chars, out.breaks, out.pulses, out.glitches = (
+            self.chars, self.breaks, self.pulses, self.glitches,
+        )  # fmt: skip
+        out.partial_frames = self.partial
+        out.framing_errors, out.parity_errors = self.framing_errors, self.parity_errors
 
 
 def _collect_batches(
@@ -295,10 +311,10 @@ def _collect_batches(
     while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
         head.append(b)
     _synchronise_head(head, unc, sync_s, t0)
-    events, problems = out.events, out.problems
-    add, baud_error = events.append, out.baud_error_pct.append
+    problems, tally = out.problems, _Tally(out)
+    add, baud_error = out.events.append, out.baud_error_pct.append
     nan = float("nan")
-    chars = framing_errors = parity_errors = glitches = breaks = pulses = partial = 0
+    chars = framing_errors = parity_errors = glitches = 0  # the certified frames'
     char, bus, event = EventKind.CHAR, origin, full_event
     for b in chain(head, batches):
         st, en, wi, fe, pe, err, gl = (
@@ -322,23 +338,12 @@ def _collect_batches(
                     u, du = ev.uncertainty, ev.duration_uncertainty
                     ev = event(ev.kind, bus, ev.start, ev.end, ev.wire, ev.text, u, du)
                 add(ev)
-            if d.kind == "char":
-                chars += 1
-                framing_errors += d.framing_error
-                parity_errors += d.parity_error
-                glitches += d.glitches
-                baud_error(nan if d.baud_error_pct is None else d.baud_error_pct)
-                if d.framing_error or d.parity_error or d.glitches:
-                    problems.append(d)
-                continue
-            problems.append(d)
-            breaks += d.kind == "break"
-            pulses += d.kind == "pulse"
-            glitches += d.kind == "glitch"
-            partial += d.kind == "partial"
-    out.chars, out.breaks, out.pulses, out.glitches = chars, breaks, pulses, glitches
-    out.partial_frames = partial
-    out.framing_errors, out.parity_errors = framing_errors, parity_errors
+            tally.item(d)
+    tally.chars += chars
+    tally.framing_errors += framing_errors
+    tally.parity_errors += parity_errors
+    tally.glitches += glitches
+    tally.store(out)
 
 
 def _synchronise_head(batches: list[Batch], unc: float, sync_s: float, t0: float) -> None:
