@@ -401,36 +401,19 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
     """The bus events with origin :data:`RECORDER_ORIGIN` where the recorder's TX channel shows the
     same character or break starting within ``tolerance`` seconds, else :data:`SENSOR_ORIGIN`; and
     how many TX events were not seen on the bus."""
-    out: list[Event] = []
-    append = out.append
-    j = 0
-    n_tx = len(tx)
-    matched = 0
-    char, event = EventKind.CHAR, full_event
-    for ev in bus:
-        start = ev.start
-        while j < n_tx and tx[j].start < start - tolerance:
-            j += 1
-        origin = SENSOR_ORIGIN
-        if j < n_tx:
-            t = tx[j]
-            if (
-                abs(t.start - start) <= tolerance
-                and t.kind is ev.kind
-                and (ev.kind is not char or t.wire == ev.wire)
-            ):
-                origin = RECORDER_ORIGIN
-                matched += 1
-                j += 1
-        du = ev.duration_uncertainty
-        append(event(ev.kind, origin, start, ev.end, ev.wire, ev.text, ev.uncertainty, du))
-    return out, n_tx - matched
+    event = full_event
+    out = [
+        event(e.kind, SENSOR_ORIGIN, e.start, e.end, e.wire, e.text, e.uncertainty,
+              e.duration_uncertainty)
+        for e in bus
+    ]  # fmt: skip
+    return out, _mark_recorder(out, tx, tolerance)
 
 
 def _mark_recorder(bus: list[Event], tx: list[Event], tolerance: float) -> int:
-    """:func:`merge_tx` of bus events decoded with origin :data:`SENSOR_ORIGIN` already, in
-    place: only the events it gives :data:`RECORDER_ORIGIN` are made again (the others are
-    already what it makes); how many TX events were not seen on the bus."""
+    """:func:`merge_tx` of bus events with origin :data:`SENSOR_ORIGIN` already, in place (the
+    one matching rule of both): only the events it gives :data:`RECORDER_ORIGIN` are made
+    again (the others are already what it makes); how many TX events were not seen on the bus."""
     j = 0
     n_tx = len(tx)
     matched = 0
