@@ -252,12 +252,9 @@ class Transcript:
                         if found is None and not signed and isfinite(u + (du or 0.0)):
                             parts[key] = _line_parts(e)
                         continue
-                    start = e.start
-                    end = repr(e.end)
-                    shown_start = shown.text if start == shown.end and start != 0.0 else repr(start)
-                    shown.end, shown.text = e.end, end
+                    start, end = shown.times(e.start, e.end)
                     head, tail = found
-                    add(f'{head}{shown_start}, "end": {end}{tail}')
+                    add(f'{head}{start}, "end": {end}{tail}')
                 fh.writelines(lines)
         return plain
 
@@ -296,9 +293,9 @@ def json_line(event: Event) -> str:
 def _line_parts(e: Event) -> tuple[str, str]:
     """What :func:`_plain_line` writes of ``e`` before its start and after its end: the
     same for every event with its kind, origin, wire byte, text and uncertainties (a run's
-    characters share a few hundred such), so :meth:`Transcript.write_jsonl` formats them
-    once per run rather than per line (``e``: plain fields, finite uncertainties, neither a
-    negative zero)."""
+    characters share a few hundred such), so :meth:`Transcript.write_jsonl` keeps them and
+    formats them once per run rather than per line (kept only where no uncertainty is a
+    negative zero, which is equal to 0.0 as a key but written apart)."""
     du = e.duration_uncertainty
     tail = "}\n" if du is None else f', "duration_uncertainty": {du!r}}}\n'
     return (
@@ -318,24 +315,21 @@ class _LastEnd:
         self.end: float | None = None
         self.text = ""
 
+    def times(self, start: float, end: float) -> tuple[str, str]:
+        """A line's start and end as written: the start as the line before's end text when
+        equal (never a zero: 0.0 and -0.0 are equal but written apart); this end kept."""
+        shown = self.text if start == self.end and start != 0.0 else repr(start)
+        self.end, self.text = end, repr(end)
+        return shown, self.text
+
 
 def _plain_line(e: Event, shown: _LastEnd | None = None) -> str:
     """:func:`json_line` of an event with :func:`plain_fields` (a non-finite time still goes
     through json.dumps, which spells it its own way). ``{e.kind}`` is ``str(e.kind)``, the
     value: a StrEnum formats as its str. ``shown``: the line before's end, whose text stands
     for a start equal to it (never a zero: 0.0 and -0.0 are equal but written apart)."""
-    du = e.duration_uncertainty
-    if not math.isfinite(e.start + e.end + e.uncertainty + (du or 0.0)):
+    if not math.isfinite(e.start + e.end + e.uncertainty + (e.duration_uncertainty or 0.0)):
         return json.dumps(e.to_json()) + "\n"
-    tail = "}\n" if du is None else f', "duration_uncertainty": {du!r}}}\n'
-    if shown is None:
-        start, end = repr(e.start), repr(e.end)
-    else:
-        start = shown.text if e.start == shown.end and e.start != 0.0 else repr(e.start)
-        end = repr(e.end)
-        shown.end, shown.text = e.end, end
-    return (
-        f'{{"kind": "{e.kind}", "origin": {_quote(e.origin)}, "start": {start}, '
-        f'"end": {end}, "wire": {e.wire!r}, "text": {_quote(e.text)}, '
-        f'"uncertainty": {e.uncertainty!r}{tail}'
-    )
+    head, tail = _line_parts(e)
+    start, end = (repr(e.start), repr(e.end)) if shown is None else shown.times(e.start, e.end)
+    return f'{head}{start}, "end": {end}{tail}'
