@@ -456,15 +456,9 @@ def _distribution_of_one_window(
     judged against ``window``: the same figures as one by one. Equal values have equal
     slacks against one window, so which of them a sorted position picks does not matter;
     the position ``p`` of the values sorted is found among the distinct ones by the running
-    counts (``_at``)."""
+    counts (:func:`_sorted_positions`)."""
     lo, hi = window.lo, window.hi
-    by_value = sorted(range(len(distinct)), key=lambda i: distinct[i].measured)
-    values = [distinct[i].measured for i in by_value]
-    ends = list(accumulate(counts[i] for i in by_value))  # sorted position after each value
-
-    def at(p: int) -> float:
-        return values[bisect_right(ends, p)]
-
+    values, at = _sorted_positions([m.measured for m in distinct], counts)
     positions: Iterable[int]
     if count > MAX_TICKS:  # evenly through the sorted values: min and max kept
         step = (count - 1) / (MAX_TICKS - 1)
@@ -472,16 +466,10 @@ def _distribution_of_one_window(
     else:
         positions = range(count)
     ticks = [at(p) for p in positions]
-    middle = count // 2
-    mid = at(middle) if count % 2 else (at(middle - 1) + at(middle)) / 2
-    by_u = sorted(range(len(distinct)), key=lambda i: distinct[i].uncertainty)
-    us = [distinct[i].uncertainty for i in by_u]
-    u_ends = list(accumulate(counts[i] for i in by_u))
-
-    def u_at(p: int) -> float:
-        return us[bisect_right(u_ends, p)]
-
-    u_mid = u_at(middle) if count % 2 else (u_at(middle - 1) + u_at(middle)) / 2
+    mid = _median_of_positions(at, count)
+    u_mid = _median_of_positions(
+        _sorted_positions([m.uncertainty for m in distinct], counts)[1], count
+    )
     return Distribution(
         count,
         _ms(values[0]) or 0.0,
@@ -495,6 +483,23 @@ def _distribution_of_one_window(
         values_ms=[_ms(v) or 0.0 for v in ticks],
         slack_ms=[_ms(_slack(lo, hi, v)) or 0.0 for v in ticks],
     )
+
+
+def _sorted_positions(
+    distinct: list[float], counts: list[int]
+) -> tuple[list[float], Callable[[int], float]]:
+    """``distinct`` sorted, and the value at a position of the list where each comes
+    ``counts`` times (found by the running counts, not by making that list)."""
+    order = sorted(range(len(distinct)), key=distinct.__getitem__)
+    values = [distinct[i] for i in order]
+    ends = list(accumulate(counts[i] for i in order))  # sorted position after each value
+    return values, lambda p: values[bisect_right(ends, p)]
+
+
+def _median_of_positions(at: Callable[[int], float], count: int) -> float:
+    """``statistics.median`` of ``count`` sorted values, each at ``at(position)``."""
+    middle = count // 2
+    return at(middle) if count % 2 else (at(middle - 1) + at(middle)) / 2
 
 
 def _window_verdict(
