@@ -22,7 +22,8 @@ SUITE_ROOT = Path(str(resources.files("testcases"))).parent
 #: decide what becomes of a warning, a thread's exception or a crash.
 UNUSED_PYTEST_PLUGINS = (
     "debugging", "doctest", "legacypath", "tmpdir", "monkeypatch", "recwarn", "pastebin",
-    "stepwise", "setuponly", "setupplan", "subtests", "logging", "unittest",
+    "stepwise", "setuponly", "setupplan", "subtests", "logging", "unittest", "assertion",
+    "capture",
 )  # fmt: skip
 
 
@@ -59,15 +60,6 @@ def suite_args(
         "-p", "no:unraisableexception",  # its gc passes at the end cost ~0.3 s a run
         # pytest's own plugins a judged run never uses (:data:`UNUSED_PYTEST_PLUGINS`)
         *[arg for name in UNUSED_PYTEST_PLUGINS for arg in ("-p", f"no:{name}")],
-        # no assertion rewriting: no case and no plugin of the run uses a bare assert (a
-        # case records findings), yet rewriting the 15 case modules and the plugins cost
-        # ~0.1 s of CPU in every run that could not cache it (PYTHONDONTWRITEBYTECODE, an
-        # install the user cannot write to), and its import hook ~10 ms in every other
-        "--assert=plain",
-        # no output capture: the cases print nothing, and pytest's fd capture swallowed
-        # every repaint of the live progress bar once the first case started (it stood at
-        # "collecting the cases 0:00:00" for a whole run)
-        "--capture=no",
         "--pyargs", cases,
     ]  # fmt: skip
     if html:

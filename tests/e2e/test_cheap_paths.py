@@ -454,6 +454,8 @@ NOT_ON_A_SENSOR_RUN = (
     "conformance.replay.recording_link",
     "pdb",  # so is its debugging plugin, which imported pdb (and readline, cmd, code) to wrap it
     "rich",  # off a terminal the main command's lines are plain (reports.plain_console)
+    "readline",  # pytest's capture plugin imported it early; the judged run blocks it
+    "tomllib",  # a declaration file's reader: a run given none parses no TOML
 )
 
 #: the CLI as ``sdi12-conform`` runs it (the whole process: ``main()`` with no argv), with
@@ -509,17 +511,19 @@ def test_a_sensor_run_on_the_simulated_bus_loads_only_what_it_needs(tmp_path) ->
 
 
 def test_the_run_needs_no_assertion_rewriting() -> None:
-    """The judged run turns pytest's assertion rewriting off (``--assert=plain``, a run
-    that cannot cache it spent ~0.1 s rewriting): right only while no conformance case and
-    not the plugin uses a bare ``assert``, whose failure message rewriting would have
-    explained (a case records findings through ``case``)."""
+    """The judged run has no assertion rewriting (pytest's ``assertion`` plugin blocked,
+    which also leaves ``--assert`` at plain; a run that cannot cache it spent ~0.1 s
+    rewriting): right only while no conformance case and not the plugin uses a bare
+    ``assert``, whose failure message rewriting would have explained (a case records
+    findings through ``case``)."""
     import ast
     from pathlib import Path
 
     from conformance import plugin
     from conformance.suite import SUITE_ROOT, suite_args
 
-    assert "--assert=plain" in suite_args("testcases.sensor", "out")
+    args = suite_args("testcases.sensor", "out")
+    assert "no:assertion" in args and not any(a.startswith("--assert") for a in args)
     sources = [*sorted((SUITE_ROOT / "testcases").rglob("*.py")), Path(plugin.__file__)]
     asserting = [
         f"{path}:{node.lineno}"
