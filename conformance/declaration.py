@@ -36,7 +36,6 @@ See :mod:`conformance.recorder.capability` for what an absent capability does to
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -175,6 +174,8 @@ MEASUREMENT_CODE = re.compile(r"^(?:[MC]C?[1-9]?|H[AB]|V)$")
 def load_declaration(path: str | Path) -> Declaration:
     """Read and check a declaration: an unknown key or a wrong type is refused with the
     file, the key and its line (a typo silently ignored would change what is judged)."""
+    import tomllib  # here: a run without a declaration (every sim run) never parses TOML
+
     try:
         text = Path(path).read_text(encoding="utf-8")
         raw = tomllib.loads(text)
