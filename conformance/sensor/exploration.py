@@ -14,9 +14,11 @@ from __future__ import annotations
 
 import getpass
 import os
+import sys
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
+from types import ModuleType
 
 from .. import gc_pace
 from ..judges.exploration import IDS as IDS  # the cases import it from here
@@ -34,17 +36,41 @@ def __getattr__(name: str) -> object:
     from here when the run starts."""
     if name != "JUNK":
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from .exploration_machine import junk_strategy
-
+    junk_strategy = _machine_module().junk_strategy
     globals()["JUNK"] = junk = junk_strategy()
     return junk
+
+
+#: hypothesis's switch for its entry-point plugins (``hypothesis.entry_points.run``)
+NO_PLUGINS = "HYPOTHESIS_NO_PLUGINS"
+
+
+def _machine_module() -> ModuleType:
+    """:mod:`.exploration_machine`, and hypothesis with it, loaded without the environment's
+    hypothesis plugins: as the judged pytest session loads none of the environment's pytest
+    plugins (``suite.suite_args``), a package registering a hypothesis entry point (a
+    settings profile, another backend) must not change the exploration's stimuli; finding
+    none also read every installed distribution's entry points (4 ms with 28 of them).
+    Where hypothesis is already loaded (a pytest session with its plugin), nothing changes;
+    the variable is the user's again once the import is done."""
+    if "hypothesis" in sys.modules or NO_PLUGINS in os.environ:
+        from . import exploration_machine
+
+        return exploration_machine
+    os.environ[NO_PLUGINS] = "1"
+    try:
+        from . import exploration_machine
+    finally:
+        os.environ.pop(NO_PLUGINS, None)
+    return exploration_machine
 
 
 def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Exploration:
     """Explore ``sensor`` with derandomised random sequences and record what happened; the
     first broken invariant ends the exploration (the sensor is left as the breach left it)."""
     gc_pace.freeze_for_libraries()  # hypothesis's one gc.collect() walks only what it made
-    from .exploration_machine import machine_class, run_machine  # hypothesis: loaded here
+    machine_module = _machine_module()  # hypothesis: loaded here
+    machine_class, run_machine = machine_module.machine_class, machine_module.run_machine
 
     record = Exploration()
     junk = globals()["JUNK"] if "JUNK" in globals() else __getattr__("JUNK")  # or a caller's

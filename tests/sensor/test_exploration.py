@@ -57,3 +57,37 @@ def test_the_database_key_changes_nothing_drawn(monkeypatch):
     assert _explored() == with_key
     assert len(digested) == 2  # the plain way digests the machine and its runner
     assert core.function_digest is stateful.function_digest is reflection.function_digest
+
+
+#: a fresh interpreter (hypothesis not loaded yet): the groups of entry points read while the
+#: exploration's machine loads, and the plugin switch as the user had it afterwards
+LOADS_MACHINE = """
+import importlib.metadata as metadata, json, os
+asked = []
+real = metadata.entry_points
+def entry_points(**selection):
+    asked.append(selection.get("group"))
+    return real(**selection)
+metadata.entry_points = entry_points
+from conformance.sensor import exploration
+exploration._machine_module()
+import hypothesis
+print(json.dumps([asked, os.environ.get("HYPOTHESIS_NO_PLUGINS")]))
+"""
+
+
+def test_the_machine_loads_hypothesis_without_the_environments_plugins() -> None:
+    """The exploration's hypothesis reads no entry-point plugin of the environment (as the
+    judged session loads no pytest plugin it does not name), and the switch that says so is
+    gone again once hypothesis is loaded."""
+    import json
+    import os
+    import subprocess
+
+    env = {k: v for k, v in os.environ.items() if k != "HYPOTHESIS_NO_PLUGINS"}
+    done = subprocess.run(
+        [sys.executable, "-c", LOADS_MACHINE], capture_output=True, text=True, env=env,
+        check=True, timeout=120,
+    )  # fmt: skip
+    asked, switch = json.loads(done.stdout.strip().splitlines()[-1])
+    assert "hypothesis" not in asked and switch is None, done.stdout
