@@ -8,6 +8,7 @@ own; it stays inert in test runs that contain no conformance case.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -27,7 +28,7 @@ from .recorder.errors import RecorderSetupError  # not .drivers: a sensor run lo
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .replay.sensor import RecordingEnded
 from .reports import html, writers
-from .reports.html_aside import Aside, render_aside
+from .reports.html_aside import Aside, render_aside, template_when_rendered
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions, given_options
 from .selection import SelectionError, resolve
@@ -40,6 +41,7 @@ OWN_GUARD = pytest.StashKey[bool]()  # the plugin (not the CLI) took over SIGINT
 LOCKED = pytest.StashKey[Path]()  # the report folder this run holds (report_folder.acquire)
 PACE = pytest.StashKey[gc_pace.Pace]()  # the collector's pace before the run (gc_pace)
 ASIDE = pytest.StashKey[Aside]()  # the process rendering report.html (reports.html_aside)
+UNDEFER = pytest.StashKey[Callable[[], None]]()  # pytest-html's template reader put back
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -59,6 +61,9 @@ def is_conformance_session(config: pytest.Config) -> bool:
 def pytest_configure(config: pytest.Config) -> None:
     if is_conformance_session(config) and hasattr(config.option, "self_contained_html"):
         config.option.self_contained_html = True  # a certificate is one file, no assets/
+        undo = template_when_rendered()  # compiled where the page is made (html_aside)
+        if undo is not None:
+            config.stash[UNDEFER] = undo
     config.addinivalue_line(
         "markers", "requirements(*ids): the requirement IDs a conformance case judges"
     )
@@ -433,6 +438,9 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     aside = config.stash.get(ASIDE, None)
     if aside is not None:  # pytest-html waits for it; here too if its session end did not run
         aside.wait()
+    undo = config.stash.get(UNDEFER, None)
+    if undo is not None:
+        undo()
     pace = config.stash.get(PACE, None)
     if pace is not None:
         gc_pace.restore(pace)
