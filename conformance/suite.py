@@ -18,8 +18,15 @@ SUITE_ROOT = Path(str(resources.files("testcases"))).parent
 #: no plugin of the run reads a legacy ``py.path``. Each still registered options and
 #: fixtures, imported its modules (pdb and readline for ``debugging``, unittest) and, for
 #: ``logging``, wrapped every phase of every case in log capturing: 0.9% of a sim process's
-#: instructions together. ``warnings``, ``threadexception`` and ``faulthandler`` stay: they
-#: decide what becomes of a warning, a thread's exception or a crash.
+#: instructions together. ``assertion``: no case and no plugin of the run uses a bare assert
+#: (a case records findings), yet rewriting the case modules cost ~0.1 s of CPU in every run
+#: that could not cache it; blocked, nothing installs the rewriting hook (``--assert`` stays
+#: plain) and nothing wraps each case. ``capture``: the cases print nothing, and fd capture
+#: swallowed every repaint of the live progress bar (it stood at "collecting the cases" for a
+#: whole run); blocked, nothing is captured, as ``--capture=no`` did, and its early readline
+#: import and per-phase hooks are gone. ``warnings``, ``threadexception`` and
+#: ``faulthandler`` stay: they decide what becomes of a warning, a thread's exception or a
+#: crash.
 UNUSED_PYTEST_PLUGINS = (
     "debugging", "doctest", "legacypath", "tmpdir", "monkeypatch", "recwarn", "pastebin",
     "stepwise", "setuponly", "setupplan", "subtests", "logging", "unittest", "assertion",
