@@ -28,7 +28,8 @@ from .recorder.errors import RecorderSetupError  # not .drivers: a sensor run lo
 from .recorder.fixtures import recorder  # noqa: F401 - the recorder role's session fixture
 from .replay.sensor import RecordingEnded
 from .reports import html, writers
-from .reports.html_aside import Aside, render_aside, template_when_rendered
+from .reports.html_aside import Aside, render_aside
+from .reports.page_template import template_when_rendered
 from .results import CaseRecord
 from .run import ConformanceRun, RunOptions, given_options
 from .selection import SelectionError, resolve

@@ -85,46 +85,6 @@ class Aside:
         self._render(*args, **kwargs)
 
 
-class TemplateWhenRendered:
-    """pytest-html's page template, read and compiled by jinja2 when the page is rendered
-    rather than when the session is configured: in the main command's process the page is
-    rendered by the forked child (:func:`render_aside`), so the parent, whose run is the
-    process's critical path, never compiles it (about 10 ms). The same template from the
-    same call, only later; in a process that renders its own page nothing changes but when.
-    """
-
-    def __init__(self, read: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any]):
-        self._read = read
-        self._args = args
-        self._kwargs = kwargs
-        self._template: Any = None
-
-    def render(self, *args: Any, **kwargs: Any) -> str:
-        if self._template is None:
-            self._template = self._read(*self._args, **self._kwargs)
-        return self._template.render(*args, **kwargs)
-
-
-def template_when_rendered() -> Callable[[], None] | None:
-    """Make pytest-html's configure hand its report a :class:`TemplateWhenRendered` (call it
-    before that hook runs); the function that undoes it (at the session's end), or None
-    where pytest-html is not loaded or its template reader is not the one this knows."""
-    page_plugin = sys.modules.get("pytest_html.plugin")
-    read = getattr(page_plugin, "_read_template", None)
-    if read is None or getattr(read, "__module__", None) != "pytest_html.util":
-        return None  # another pytest-html, or already deferred: leave it
-
-    def deferred(*args: Any, **kwargs: Any) -> TemplateWhenRendered:
-        return TemplateWhenRendered(read, args, kwargs)
-
-    page_plugin._read_template = deferred  # type: ignore[union-attr]
-
-    def undo() -> None:
-        page_plugin._read_template = read  # type: ignore[union-attr]
-
-    return undo
-
-
 def render_aside(session: Any, ours: SummaryHook) -> Aside | None:
     """Fork a child that writes report.html through pytest-html's own session end and exits;
     in the parent, pytest-html's rendering then waits for it (:meth:`Aside.generate`). None:

@@ -144,48 +144,6 @@ def test_no_page_no_fork() -> None:
     assert html_aside.pytest_html_page([object(), _Page()]) is None
 
 
-def test_the_template_read_when_rendered_renders_what_pytest_html_reads() -> None:
-    """pytest-html's own template, read at once and read on first render, gives the same
-    page text for the same values (twice: the second render reuses the first read)."""
-    from pytest_html import util
-
-    search = [Path(util.__file__).parent / "resources"]
-    values = {
-        "title": "t", "date": "01-Jan-2026", "time": "00:00:00", "version": "4",
-        "styles": "b{}", "run_count": "1 test took 1 ms.", "running_state": "finished",
-        "self_contained": True, "outcomes": {}, "test_data": "{}", "table_head": [],
-        "additional_summary": {"prefix": [], "summary": [], "postfix": []},
-    }  # fmt: skip
-    reads: list[object] = []
-
-    def read(*args: object, **kwargs: object):
-        reads.append(args)
-        return util._read_template(*args, **kwargs)
-
-    later = html_aside.TemplateWhenRendered(read, (search,), {})
-    assert reads == []  # nothing read until a page is made
-    page = util._read_template(search).render(**values)
-    assert later.render(**values) == page and later.render(**values) == page
-    assert len(reads) == 1
-
-
-def test_the_template_reader_is_put_back() -> None:
-    """Deferring replaces pytest-html's reader for the session only; a reader that is not
-    pytest-html's own (deferred already, or another version's) is left alone."""
-    from pytest_html import plugin as page_plugin
-
-    own = page_plugin._read_template
-    undo = html_aside.template_when_rendered()
-    assert undo is not None
-    try:
-        assert page_plugin._read_template is not own
-        assert isinstance(page_plugin._read_template([]), html_aside.TemplateWhenRendered)
-        assert html_aside.template_when_rendered() is None  # not deferred twice
-    finally:
-        undo()
-    assert page_plugin._read_template is own
-
-
 #: the main command's way (forked page) in a fresh interpreter: prints whether the parent
 #: compiled pytest-html's template (it should not: the child renders the page)
 PARENT_COMPILES = """
