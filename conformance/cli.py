@@ -300,6 +300,10 @@ def _conducted(
 
         plugins.append(ProgressPlugin(console))
     # the main command's own process: report.html may be rendered beside the rest
+    if _OWN_PROCESS:  # and jinja2 loaded only where it is (reports.page_template)
+        from .reports.page_template import page_plugin_without_jinja2
+
+        page_plugin_without_jinja2()
     result = conduct(options, verbose=verbose, plugins=plugins, html_aside=_OWN_PROCESS)
     report_dir, code, data = result.report_dir, result.pytest_code, result.document
     if data is not None and own_folder and _folder_by_serial(options.profile):

@@ -15,6 +15,11 @@ lexer, parser and code generator. Two things change here, neither what the page 
   ``Environment.compile`` makes, unmarshalled (under 1 ms) instead of compiled; written only
   where bytecode may be written, never a failure when it cannot be.
 
+- :func:`page_plugin_without_jinja2`: in the main command's process pytest-html's helper
+  module is loaded with stand-ins for the three jinja2 names it binds, each loading jinja2
+  on its first use: only the process that reads the template (the forked child) loads
+  jinja2 and markupsafe (about 20 ms), the parent never does.
+
 pytest-html's own reader still builds the environment with its own options
 (:func:`template_when_rendered` only lends it the cache), so a page is what pytest-html makes.
 ``tests/reports/test_page_template.py`` compares the pages.
@@ -23,8 +28,10 @@ pytest-html's own reader still builds the environment with its own options
 from __future__ import annotations
 
 import contextlib
+import importlib
 import os
 import sys
+import types
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -101,8 +108,9 @@ def with_installed_cache(
 
     def cached_read(*args: Any, **kwargs: Any) -> Any:
         environment = util.Environment
+        real = environment.real() if isinstance(environment, JinjaName) else environment
 
-        class CachedEnvironment(environment):  # type: ignore[misc, valid-type]
+        class CachedEnvironment(real):  # type: ignore[misc, valid-type]
             def __init__(self, *a: Any, **k: Any) -> None:
                 if k.get("bytecode_cache") is None:
                     k["bytecode_cache"] = installed_cache(folder)
@@ -127,7 +135,7 @@ def template_when_rendered() -> Callable[[], None] | None:
     read = getattr(page_plugin, "_read_template", None)
     if read is None or util is None or read is not getattr(util, "_read_template", None):
         return None  # another pytest-html, or already deferred: leave it
-    if not isinstance(getattr(util, "Environment", None), type):
+    if not isinstance(getattr(util, "Environment", None), (type, JinjaName)):
         return None
     cached_read = with_installed_cache(read, util)
 
@@ -140,3 +148,52 @@ def template_when_rendered() -> Callable[[], None] | None:
         page_plugin._read_template = read  # type: ignore[union-attr]
 
     return undo
+
+
+class JinjaName:
+    """Stands for one name of jinja2 bound by pytest-html's helper module
+    (:func:`page_plugin_without_jinja2`): jinja2 is imported when the name is first called
+    or looked into, and the call is jinja2's own."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def real(self) -> Any:
+        return getattr(importlib.import_module("jinja2"), self.name)
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return self.real()(*args, **kwargs)
+
+    def __getattr__(self, attribute: str) -> Any:
+        if attribute.startswith("__"):  # a probe (copy, inspect) does not load jinja2
+            raise AttributeError(attribute)
+        return getattr(self.real(), attribute)
+
+
+def _jinja_name(name: str) -> JinjaName:
+    """The stand-in module's ``__getattr__``: a :class:`JinjaName` for a name it binds, no
+    answer for the import system's probes (``__path__``, ``__spec__``...)."""
+    if name.startswith("__"):
+        raise AttributeError(name)
+    return JinjaName(name)
+
+
+def page_plugin_without_jinja2() -> bool:
+    """Load pytest-html's helper module (``pytest_html.util``, which the plugin imports)
+    with :class:`JinjaName` stand-ins for what it takes from jinja2, so loading pytest-html
+    does not load jinja2; whether it did (not where pytest-html or jinja2 is loaded
+    already, or pytest-html is missing). A helper module that binds more of jinja2 gets a
+    stand-in for each; jinja2 itself stays out of ``sys.modules`` until one is used."""
+    if "pytest_html.util" in sys.modules or "jinja2" in sys.modules:
+        return False
+    stand_in = types.ModuleType("jinja2")
+    stand_in.__getattr__ = _jinja_name  # type: ignore[method-assign]  # any name it binds
+    sys.modules["jinja2"] = stand_in
+    try:
+        importlib.import_module("pytest_html.util")
+    except ImportError:
+        return False
+    finally:
+        if sys.modules.get("jinja2") is stand_in:
+            del sys.modules["jinja2"]
+    return True

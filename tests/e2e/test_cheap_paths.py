@@ -456,6 +456,8 @@ NOT_ON_A_SENSOR_RUN = (
     "rich",  # off a terminal the main command's lines are plain (reports.plain_console)
     "readline",  # pytest's capture plugin imported it early; the judged run blocks it
     "tomllib",  # a declaration file's reader: a run given none parses no TOML
+    "jinja2",  # report.html's template: read by the forked child that renders the page
+    "markupsafe",  # (reports.page_template), which is not this process
 )
 
 #: the CLI as ``sdi12-conform`` runs it (the whole process: ``main()`` with no argv), with

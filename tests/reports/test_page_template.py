@@ -114,3 +114,53 @@ def test_a_cache_file_is_named_by_versions_and_template(tmp_path: Path, writing)
     assert len(names) == 2
     tag = f"{sys.implementation.cache_tag}.jinja2-{jinja2.__version__}.html-{__version__}"
     assert all(n.startswith(f"page_template.{tag}.") for n in names), names
+
+
+#: a fresh interpreter: pytest-html's helper loaded without jinja2, then its page rendered
+#: (pytest-html's own reader, and the cached one); prints whether jinja2 was loaded before
+#: the first render, then the two pages
+WITHOUT_JINJA2 = """
+import json, sys
+from pathlib import Path
+from conformance.reports import page_template
+loaded = page_template.page_plugin_without_jinja2()
+from pytest_html import plugin, util
+before = "jinja2" in sys.modules or "markupsafe" in sys.modules
+search, values, folder = json.loads(sys.argv[1])
+own = util._read_template(search).render(**values)
+read = page_template.with_installed_cache(util._read_template, util, Path(folder))
+cached = page_template.TemplateWhenRendered(read, (search,), {}).render(**values)
+print(json.dumps([loaded, before, own, cached]))
+"""
+
+
+def test_pytest_html_loads_without_jinja2_and_renders_the_same_page(tmp_path: Path) -> None:
+    import json
+    import os
+    import subprocess
+
+    page = util._read_template(SEARCH).render(**VALUES)
+    given = json.dumps([[str(p) for p in SEARCH], VALUES, str(tmp_path)])
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    done = subprocess.run(
+        [sys.executable, "-c", WITHOUT_JINJA2, given], capture_output=True, text=True,
+        env=env, check=True, timeout=120,
+    )  # fmt: skip
+    loaded, before, own, cached = json.loads(done.stdout.strip().splitlines()[-1])
+    assert loaded is True and before is False
+    assert own == page and cached == page
+
+
+def test_the_stand_in_answers_no_probe() -> None:
+    """The import system's and introspection's probes (``__path__``, ``__wrapped__``) get
+    no answer from a stand-in, so nothing but a real use loads jinja2."""
+    assert not hasattr(page_template.JinjaName("Environment"), "__wrapped__")
+    with pytest.raises(AttributeError):
+        page_template._jinja_name("__path__")
+    assert page_template._jinja_name("Environment").name == "Environment"
+
+
+def test_nothing_is_stood_in_where_pytest_html_is_loaded_already() -> None:
+    assert "pytest_html.util" in sys.modules  # this module imported it
+    assert page_template.page_plugin_without_jinja2() is False
+    assert util.Environment.__module__.startswith("jinja2")
