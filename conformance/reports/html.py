@@ -420,9 +420,12 @@ def requirements_table(run: ConformanceRun) -> str:
     )
 
 
-#: the wire bits of every 7E1 character with good parity: ``Event.parity_ok`` as a lookup, for
-#: the tens of thousands of characters a report's wire logs show
-_GOOD_PARITY = frozenset(to_wire_7e1(c) for c in range(0x80))
+#: the wire bits of every 7E1 character with good parity, as the bytes a line's characters
+#: lose to ``bytes.translate`` (what is left: the parity errors; ``Event.parity_ok``, for the
+#: tens of thousands of characters a report's wire logs show, in one C call a line)
+_GOOD_PARITY = bytes(sorted(to_wire_7e1(c) for c in range(0x80)))
+#: a wire byte's seven character bits, as a ``bytes.translate`` table
+_SEVEN_BITS = bytes(w & 0x7F for w in range(0x100))
 
 
 def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = frozenset()) -> str:
@@ -453,9 +456,7 @@ def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = 
         else:
             who = "tool" if first.origin == TOOL else "dut"
             arrow = "→ sensor  " if who == "tool" else "← sensor  "
-            wires = [e.wire for e in group]
-            text = wire_escape(bytes([w & 0x7F for w in wires]))
-            bad = sum(1 for w in wires if w not in _GOOD_PARITY)  # not Event.parity_ok
+            text, bad = _line_chars(group)
             parity = f'  <span class="bad">[{bad} parity error(s)]</span>' if bad else ""
             lines.append(
                 f'<span class="{who}">{prefix}{arrow}{escape(text)}'
@@ -465,6 +466,13 @@ def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = 
             previous_end = group[-1].end
     wire = "\n".join(_highlighted(lines))
     return f'<p><b>Wire: {escape(label)}</b></p><div class="sdi12-wire">{wire}</div>'
+
+
+def _line_chars(group: list[Event]) -> tuple[str, int]:
+    """A line's characters (escaped, parity bit dropped) and how many of them fail
+    ``Event.parity_ok``."""
+    wires = bytes([e.wire for e in group])
+    return wire_escape(wires.translate(_SEVEN_BITS)), len(wires.translate(None, _GOOD_PARITY))
 
 
 def _highlighted(lines: list[str | None]) -> list[str]:
@@ -520,20 +528,25 @@ def where_html(findings: list[Finding], ref: WireRef, events: list[Event], timin
 def _group(events: list[Event]) -> list[list[Event]]:
     """Runs of characters from one side with gaps under two frame times form one line."""
     groups: list[list[Event]] = []
-    last: Event | None = None  # groups[-1][-1]
     char = EventKind.CHAR
+    # the previous event's fields (groups[-1][-1]'s), read once per event
+    group: list[Event] = []
+    last_kind: EventKind | None = None
+    last_origin = ""
+    last_end = 0.0
     for e in events:
+        kind, origin = e.kind, e.origin
         if (
-            last is not None
-            and e.kind is char
-            and last.kind is char
-            and last.origin == e.origin
-            and e.start - last.end < 0.0167
+            kind is char
+            and last_kind is char
+            and origin == last_origin
+            and (e.start - last_end < 0.0167)
         ):
-            groups[-1].append(e)
+            group.append(e)
         else:
-            groups.append([e])
-        last = e
+            group = [e]
+            groups.append(group)
+        last_kind, last_origin, last_end = kind, origin, e.end
     return groups
 
 

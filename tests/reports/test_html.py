@@ -10,6 +10,7 @@ from conformance.reports import html, timing_diagram
 from conformance.results import CaseRecord
 from conformance.run import ConformanceRun, RunOptions
 from conformance.transcript import DUT, TOOL, Event, EventKind, decode_7e1, to_wire_7e1
+from conformance.transcript import escape as wire_escape
 from conformance.verdicts import Finding, Verdict
 
 HOSTILE = ["<script>alert(1)</script>", '"><img src=x onerror=alert(1)>']
@@ -231,3 +232,50 @@ def test_the_result_cell_carries_the_verdict_and_ids_do_not_wrap():
     assert cells[0] == ('<td class="col-result sdi12-verdict v-NA" data-verdict="N/A">Skipped</td>')
     assert cells[1].count('<span class="sdi12-rid">') == 2
     assert "td.col-result.sdi12-verdict::before{content:attr(data-verdict)" in html.STYLE
+
+
+def _reference_group(events: list[Event]) -> list[list[Event]]:
+    """The wire log's grouping as it was written first: a run of characters from one side
+    with gaps under two frame times is one line."""
+    groups: list[list[Event]] = []
+    last: Event | None = None
+    for e in events:
+        if (
+            last is not None
+            and e.kind is EventKind.CHAR
+            and last.kind is EventKind.CHAR
+            and last.origin == e.origin
+            and e.start - last.end < 0.0167
+        ):
+            groups[-1].append(e)
+        else:
+            groups.append([e])
+        last = e
+    return groups
+
+
+def test_the_wire_log_groups_and_counts_parity_as_event_by_event() -> None:
+    """The wire log's lines (grouping with the previous event's fields read once, a line's
+    characters and parity errors by ``bytes.translate``) are the lines made event by event:
+    the same groups, the text with the parity bit dropped, ``Event.parity_ok``'s count of
+    errors, over random traffic of both sides with breaks, notes and any 8-bit byte."""
+    import random
+
+    rng = random.Random(7)
+    for _ in range(200):
+        t, events = 0.0, []
+        for _ in range(rng.randrange(0, 60)):
+            kind = rng.choice([EventKind.CHAR] * 8 + [EventKind.BREAK, EventKind.NOTE])
+            t += rng.choice([0.0, 0.001, 0.0166, 0.0167, 0.02, 0.2])
+            end = t + (0.0083 if kind is EventKind.CHAR else 0.013)
+            wire = rng.randrange(256) if kind is EventKind.CHAR else 0
+            text = "a note" if kind is EventKind.NOTE else ""
+            events.append(Event(kind, rng.choice([TOOL, DUT]), t, end, wire=wire, text=text))
+            t = end
+        groups = html._group(events)
+        assert groups == _reference_group(events)
+        for group in groups:
+            if group[0].kind is EventKind.CHAR:
+                text = wire_escape(bytes([e.wire & 0x7F for e in group]))
+                bad = sum(1 for e in group if not e.parity_ok)
+                assert html._line_chars(group) == (text, bad)
