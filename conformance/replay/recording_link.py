@@ -196,9 +196,7 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
         kind=f"capture {decoded.format}", can_break=False,
         timing_uncertainty=decoded.uncertainty_s,
     )  # fmt: skip
-    return RecordingLink(
-        spec, info, Transcript(events), decoded.uncertainty_s, decoded=decoded
-    )
+    return RecordingLink(spec, info, Transcript(events), decoded.uncertainty_s, decoded=decoded)
 
 
 def _bit_timing(options: dict) -> bool:
