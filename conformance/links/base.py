@@ -75,6 +75,11 @@ class BusEnd(ABC):
     #: the DUT is a harness program the link runs (``exec:``/``unix:``): the reports keep
     #: :meth:`harness_stderr`, even when the harness has none to give
     runs_harness: bool = False
+    #: a ``transcript.jsonl`` written of this bus end's events is kept as its reading (a run
+    #: judged again at once, by replay or through its capture, reads it back); a loaded
+    #: recording's is not (nothing reads a passive judgement's copy back, and an hour's
+    #: capture kept it as a tuple of its 357,000 events through every later report set)
+    keeps_written_reading: bool = True
 
     @abstractmethod
     def now(self) -> float: ...

@@ -121,11 +121,15 @@ def options_in(notes: list[Event]) -> dict[str, Any]:
     return {}
 
 
-def write_recording(path: Path, events: list[Event]) -> None:
+def write_recording(path: Path, events: list[Event], *, keep: bool = True) -> None:
     """A transcript file holding ``events`` (a run's, or a decoded capture with its run's
     notes). What is written is also kept as its reading, when reading it back would give
     the same events: a capture round trip reads both files it writes straight away, and a
-    run's 10^5 lines cost a second to parse."""
+    run's 10^5 lines cost a second to parse. ``keep`` False: written only (no copy of the
+    events made or kept), for a file nothing in this process reads back."""
+    if not keep:
+        Transcript(events).write_jsonl(str(path))
+        return
     events = list(events)
     # floats print as their shortest repr, which reads back bit for bit; an int time would
     # come back a float, so only events of exactly the plain types (the writer says whether

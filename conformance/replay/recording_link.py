@@ -127,6 +127,7 @@ class RecordingLink(BusEnd):
     uncertainty: float
     notes: list[str] = field(default_factory=list)
     decoded: CaptureDecode | None = None  # a capture's decode figures (for the notes)
+    keeps_written_reading = False  # its report transcripts are not read back (BusEnd)
 
     @property
     def host_stamped(self) -> bool:
@@ -184,16 +185,18 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
             baud=spec.baud,
             glitch_filter=None if spec.glitch_filter_us is None else spec.glitch_filter_us * 1e-6,
             force=spec.force,
+            keep=False,  # this link holds it while it is judged
         )
     except CaptureError as exc:
         raise PortError(str(exc)) from None
+    # the decode's own list becomes the transcript's (nothing reads a loaded capture's
+    # ``decoded.events`` again): an hour's capture held one list of its events, not two
+    events, decoded.events = decoded.events, []
     info = LinkInfo(
         kind=f"capture {decoded.format}", can_break=False,
         timing_uncertainty=decoded.uncertainty_s,
     )  # fmt: skip
-    return RecordingLink(
-        spec, info, Transcript(list(decoded.events)), decoded.uncertainty_s, decoded=decoded
-    )
+    return RecordingLink(spec, info, Transcript(events), decoded.uncertainty_s, decoded=decoded)
 
 
 def _bit_timing(options: dict) -> bool:

@@ -207,7 +207,7 @@ def write_transcript(run: ConformanceRun, directory: Path) -> Path:
             # judgement writes the one recording: 43 MB an hour of a busy bus, 3 s to format)
             shutil.copyfile(written[1], path)
         else:
-            write_recording(path, transcript.events)
+            write_recording(path, transcript.events, keep=run.link.keeps_written_reading)
             transcript.__dict__["_written_to"] = (len(transcript), path)
     else:
         path.write_text("", encoding="utf-8")

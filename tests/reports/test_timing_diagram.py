@@ -3,6 +3,8 @@ every segment's intervals, in recording order, would pick (the first segment nea
 
 from __future__ import annotations
 
+from array import array
+
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -46,15 +48,35 @@ def test_no_interval_no_segment():
     assert MeasureIndex(measures=[[], [9.0]]).nearest(8.0) == 1
 
 
-@given(st.lists(st.lists(value, max_size=4), max_size=80))  # past numpy's insertion sort
-def test_numpy_orders_the_index_as_the_sort_does(per_segment: list[list[float]]):
-    """A long recording's index is ordered by numpy's stable argsort (NUMPY_FROM): the same
-    arrays, to the sign of a zero, as Python's stable sort of a short one."""
+def first_of_runs(index: MeasureIndex) -> tuple[list[float], list[int]]:
+    """The index's values and owners with each run of equal values kept as its first."""
+    values: list[float] = []
+    owners: list[int] = []
+    for v, o in zip(index.values, index.owners, strict=True):
+        if not values or v != values[-1]:
+            values.append(v)
+            owners.append(o)
+    return values, owners
+
+
+@given(
+    st.lists(st.lists(value, max_size=4), max_size=80),  # past numpy's insertion sort
+    st.lists(st.floats(-5, 20) | value, max_size=6),
+)
+def test_numpy_orders_the_index_as_the_sort_does(
+    per_segment: list[list[float]], targets: list[float]
+):
+    """A long recording's index is ordered by numpy's stable argsort (NUMPY_FROM): the
+    arrays of Python's stable sort of a short one, to the sign of a zero, with each run of
+    equal values kept as its first only; both answer every target as the scan does."""
     plain = MeasureIndex(measures=per_segment, numpy_from=10**9)
     fast = MeasureIndex(measures=per_segment, numpy_from=0)
-    assert fast.values.tobytes() == plain.values.tobytes()
-    assert list(fast.owners) == list(plain.owners)
+    values, owners = first_of_runs(plain)
+    assert fast.values.tobytes() == array("d", values).tobytes()
+    assert list(fast.owners) == owners
     assert len(plain.values) == sum(map(len, per_segment))
+    for target in targets:
+        assert fast.nearest(target) == plain.nearest(target) == scan(per_segment, target)
 
 
 def test_a_long_index_imports_no_numpy_for_its_order():
