@@ -19,8 +19,9 @@ from conformance.protocol.commands import (
 )
 from conformance.protocol.responses import parse_measurement_reply_for, split_line
 from conformance.protocol.values import split_values
-from conformance.transcript import decode_7e1, escape
+from conformance.transcript import TOOL, EventKind, decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed
+from conformance.view.runs import runs
 
 requirements = pytest.mark.requirements
 DESCRIBED = M_FAMILY + C_FAMILY + HV_FAMILY
@@ -78,8 +79,12 @@ def test_identify_starts_nothing(sensor, case):
         return [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
 
     control = reread()
+    first = len(sensor.link.transcript)
     pokes = [sensor.fresh_exchange(f"I{code}") for code in ("M", "C", "HA", "V")]
     heard = sensor.listen(max(0.0, _service_request_deadline(sensor, pokes) - sensor.link.now()))
+    # a service request that came while the tool was still sending the identify commands
+    # (one soon after aIM!) was taken in as a later command's stray characters, not heard
+    heard = _requests_between(sensor, first, pokes, heard) + heard
     again = reread()
     case.evidence(
         "measurement, D again (control), identify commands, listening, D again",
@@ -157,6 +162,22 @@ def _service_request_deadline(sensor, pokes) -> float:
             ttt = max(ttt, announced.ttt or 0)
         latest = max(latest, ex.end + ttt + grace)
     return latest
+
+
+def _requests_between(sensor, first: int, pokes, heard) -> list:
+    """The complete service requests (``a<CR><LF>``, R-4.4.6-01) of the sensor's address on
+    the wire since transcript index ``first`` that are neither a reply to one of ``pokes``
+    nor among ``heard``: what the sensor sent unasked while the tool was still sending the
+    identify commands. Only service requests: other characters after a reply are that
+    reply's own framing fault, judged by its rules."""
+    own = {id(e) for ex in pokes for a in ex.attempts for e in a.reply_events}
+    own |= {id(e) for e in heard}
+    dut = [
+        e
+        for e in sensor.link.transcript.since(first)
+        if e.kind is EventKind.CHAR and e.origin != TOOL and id(e) not in own
+    ]
+    return [e for run in runs(dut) if decode_7e1(run) == f"{sensor.address}\r\n" for e in run]
 
 
 def _metadata_plan(sensor):
