@@ -70,6 +70,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.attribute:
         events = read_transcript_jsonl(str(Path(args.attribute) / "transcript.jsonl"))
         print(attribution(events))
+        verdicts = Path(args.attribute) / "verdicts.json"
+        if verdicts.exists():
+            print(look_figures(json.loads(verdicts.read_text())["run"]["link"]))
         return 0
     out = Path(args.keep or tempfile.mkdtemp(prefix="sdi12-bus-")).resolve()
     # the children start with ``-m conformance.cli``, which imports the package of the working
@@ -137,6 +140,31 @@ def attribution(events: list[Event]) -> str:
         top = ", ".join(f"{c} {d * 1e3:.0f} ms" for d, c in sorted(longest, reverse=True)[:3])
         lines.append(f"{seconds:10.2f} {count:6d}  {cause} ({top})")
     return "\n".join(lines)
+
+
+def look_figures(link: dict) -> str:
+    """What the look before transmitting (``ToolRecorder.look_before_transmit``: the link's
+    declared timing uncertainty, after each turnaround that follows the DUT) rests on, beside
+    what the run measured of its characters' lateness (``run.link`` of verdicts.json). The
+    look could only be the measured figure where the link measures one; without an echo it
+    sees only lower bounds: a batch of bytes, or a character stamped less than a frame after
+    the one before, shows that one of them came that much late."""
+    timing = (link.get("bench") or {}).get("timing") or {}
+    declared = link.get("timing_uncertainty_ms")
+    if not timing:
+        return f"look before transmitting: {declared} ms declared (no bench figures)"
+    reference = timing.get("reference")
+    text = (
+        f"look before transmitting: {declared} ms declared; the run timed against the "
+        f"{'echo of its commands' if reference == 'echo' else 'write time (no echo)'}, "
+        f"regular figure {timing['regular_ms']} ms"
+    )
+    batches, artefacts = timing["batches"], timing["artefacts"]
+    return (
+        f"{text}; late characters seen: batches worst {batches['worst_ms']} ms "
+        f"({batches['samples']}), overlapping frames worst {artefacts['worst_ms']} ms, "
+        f"{timing['local_irregularities']} local irregularities"
+    )
 
 
 def _cause(before: Event, length: float) -> str:
