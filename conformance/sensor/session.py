@@ -474,8 +474,8 @@ class SensorSession(Session):
         aimed or, after ``PROBE_TRIES``, goes out late and its case judges the marking it got.
         The break waits for a quiet line like every transmission of the tool
         (:meth:`ToolRecorder.clear_to_send`); ``collide`` sends it into a talking DUT on purpose."""
-        if idle_before:
-            self.listen(idle_before)
+        if idle_before:  # that much marking since the line's last activity, as the rules count
+            self.mark_until(self.link.last_activity() + idle_before)
         if break_s is not None:
 
             def send(tries: int) -> Event:
