@@ -75,7 +75,7 @@ def test_identify_starts_nothing(sensor, case):
         # the same idle (the line marking REREAD_IDLE s, so standby) and break before each
         # read: only the pokes differ. Counted from the line's last activity, so the long
         # listening after the pokes already is the second read's idle (issue 22)
-        sensor.mark_until(sensor.link.last_activity() + REREAD_IDLE)
+        sensor.idle(REREAD_IDLE)
         return [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
 
     control = reread()

@@ -56,23 +56,15 @@ def _marking_after_break(sensor, ex) -> float | None:
 def _awake(sensor):
     """Wake the sensor the way a recorder does (break, a!, retries) and return that exchange:
     its last reply proves the sensor is awake, whatever it needed to wake up."""
-    _idle(sensor)
+    sensor.idle(STANDBY)
     return sensor.master.transact(f"{sensor.address}!", force_break=True)
-
-
-def _idle(sensor):
-    """STANDBY s of marking since the line's last activity: what the standby rule counts
-    (R-7.0-15). A wait begun after a read that ran to its deadline (a probe nobody answered:
-    the first-character wait and the read's grace, some 43 ms behind RFC 2217) and then the
-    read's own grace past it made each one up to 56 ms longer on a real link (issue 22)."""
-    sensor.mark_until(sensor.link.last_activity() + STANDBY)
 
 
 def _asleep(sensor):
     """Put the sensor in standby by both routes (a command for another address, then more
     than 100 ms of marking), so a sensor that ignores one of them still sleeps."""
     sensor.probe(f"{sensor.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
-    _idle(sensor)
+    sensor.idle(STANDBY)
 
 
 def _shown_asleep(sensor, case):
