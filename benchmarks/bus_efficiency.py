@@ -26,8 +26,12 @@ against 274.0 s lower bound, 294.7 against 294.9 s wall (0.89, 0.93). Its fifth 
 look before transmitting counted from the turnaround's end, a hopeless timed probe sent once),
 1297dda and this tree side by side at load 3-7: 274.0 against 273.7 s lower bound, 292.3
 against 290.3 s span, 295.9 against 294.4 s wall (0.926, 0.930); at load 5-7 275.1 against
-274.5, 293.8 against 291.7, 296.0 against 294.0 s (0.929, 0.934). README's "Measured" and
-``--attribute`` say where the rest goes. The children
+274.5, 293.8 against 291.7, 296.0 against 294.0 s (0.929, 0.934). Its sixth round (R-6.1-03's
+listening ends with its rule's window; idles counted as marking from the line's last
+activity), b999a88 and this tree side by side at load 5-10: 0.907 against 0.915, 0.906
+against 0.912, 0.922 against 0.929 (span beyond the bound 20.5/18.9, 26.2/23.6, 19.3/17.7 s).
+README's "Measured" and ``--attribute`` say where the rest goes; ``--attribute`` also prints
+the look before transmitting beside the late characters the run's meter saw. The children
 run in the tree this script imported: ``-m conformance.cli`` imports the package of the
 working directory first.
 """
