@@ -26,8 +26,12 @@ against 274.0 s lower bound, 294.7 against 294.9 s wall (0.89, 0.93). Its fifth 
 look before transmitting counted from the turnaround's end, a hopeless timed probe sent once),
 1297dda and this tree side by side at load 3-7: 274.0 against 273.7 s lower bound, 292.3
 against 290.3 s span, 295.9 against 294.4 s wall (0.926, 0.930); at load 5-7 275.1 against
-274.5, 293.8 against 291.7, 296.0 against 294.0 s (0.929, 0.934). README's "Measured" and
-``--attribute`` say where the rest goes. The children
+274.5, 293.8 against 291.7, 296.0 against 294.0 s (0.929, 0.934). Its sixth round (R-6.1-03's
+listening ends with its rule's window; idles counted as marking from the line's last
+activity), b999a88 and this tree side by side at load 5-10: 0.907 against 0.915, 0.906
+against 0.912, 0.922 against 0.929 (span beyond the bound 20.5/18.9, 26.2/23.6, 19.3/17.7 s).
+README's "Measured" and ``--attribute`` say where the rest goes; ``--attribute`` also prints
+the look before transmitting beside the late characters the run's meter saw. The children
 run in the tree this script imported: ``-m conformance.cli`` imports the package of the
 working directory first.
 """
@@ -70,6 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.attribute:
         events = read_transcript_jsonl(str(Path(args.attribute) / "transcript.jsonl"))
         print(attribution(events))
+        verdicts = Path(args.attribute) / "verdicts.json"
+        if verdicts.exists():
+            print(look_figures(json.loads(verdicts.read_text())["run"]["link"]))
         return 0
     out = Path(args.keep or tempfile.mkdtemp(prefix="sdi12-bus-")).resolve()
     # the children start with ``-m conformance.cli``, which imports the package of the working
@@ -137,6 +144,31 @@ def attribution(events: list[Event]) -> str:
         top = ", ".join(f"{c} {d * 1e3:.0f} ms" for d, c in sorted(longest, reverse=True)[:3])
         lines.append(f"{seconds:10.2f} {count:6d}  {cause} ({top})")
     return "\n".join(lines)
+
+
+def look_figures(link: dict) -> str:
+    """What the look before transmitting (``ToolRecorder.look_before_transmit``: the link's
+    declared timing uncertainty, after each turnaround that follows the DUT) rests on, beside
+    what the run measured of its characters' lateness (``run.link`` of verdicts.json). The
+    look could only be the measured figure where the link measures one; without an echo it
+    sees only lower bounds: a batch of bytes, or a character stamped less than a frame after
+    the one before, shows that one of them came that much late."""
+    timing = (link.get("bench") or {}).get("timing") or {}
+    declared = link.get("timing_uncertainty_ms")
+    if not timing:
+        return f"look before transmitting: {declared} ms declared (no bench figures)"
+    reference = timing.get("reference")
+    text = (
+        f"look before transmitting: {declared} ms declared; the run timed against the "
+        f"{'echo of its commands' if reference == 'echo' else 'write time (no echo)'}, "
+        f"regular figure {timing['regular_ms']} ms"
+    )
+    batches, artefacts = timing["batches"], timing["artefacts"]
+    return (
+        f"{text}; late characters seen: batches worst {batches['worst_ms']} ms "
+        f"({batches['samples']}), overlapping frames worst {artefacts['worst_ms']} ms, "
+        f"{timing['local_irregularities']} local irregularities"
+    )
 
 
 def _cause(before: Event, length: float) -> str:

@@ -270,7 +270,7 @@ class SensorSession(Session):
         acknowledgements put echo, latency and jitter figures in the link's meter, so the
         first timing finding already rests on a measured uncertainty."""
         for _ in range(rounds):
-            self.listen(PROBE_IDLE)
+            self.idle(PROBE_IDLE)
             self.master.transact(f"{self.address}!", force_break=True)
         self.assumptions.append(f"bench probed ({rounds} wake-ups): {self.bench_summary()}")
 
@@ -443,6 +443,15 @@ class SensorSession(Session):
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""
         return self.link.receive(self.link.now() + duration)
 
+    def idle(self, marking: float) -> list[Event]:
+        """Keep the line marking until it has marked ``marking`` s since its last activity,
+        and return what the DUT sent meanwhile: an idle that a rule counts as marking (a
+        sensor in standby after 100 ms of it, R-7.0-15; a wake-up from standby). Counted from
+        the wire, not from when the case got there: after a read that ran to its deadline
+        the line has marked that long already, and :meth:`listen` would also wait a frame
+        and the link's latency past the end (issue 22, sixth round)."""
+        return self.mark_until(self.link.last_activity() + marking)
+
     def mark_until(self, at: float) -> list[Event]:
         """Keep the line marking so that the tool's next command can go out at ``at`` (a timed
         probe's marking), and return what the DUT sent meanwhile. :meth:`listen` up to ``at``
@@ -475,12 +484,12 @@ class SensorSession(Session):
         The break waits for a quiet line like every transmission of the tool
         (:meth:`ToolRecorder.clear_to_send`); ``collide`` sends it into a talking DUT on purpose."""
         if idle_before:
-            self.listen(idle_before)
+            self.idle(idle_before)
         if break_s is not None:
 
             def send(tries: int) -> Event:
                 if tries:
-                    self.listen(max(idle_before, PROBE_IDLE))  # from standby, as the first was
+                    self.idle(max(idle_before, PROBE_IDLE))  # from standby, as the first was
                 self.master.clear_to_send(collide=collide)
                 return self.link.send_break(break_s, exact=True)
 
@@ -535,7 +544,7 @@ class SensorSession(Session):
 
     def _find_hearing_marking(self) -> float | None:
         for marking in HEARING_MARKINGS:
-            self.listen(PROBE_IDLE)
+            self.idle(PROBE_IDLE)
             ex = self.master.raw(f"{self.address}!", break_first=True, marking=marking)
             if ex.answered:
                 if marking != HEARING_MARKINGS[0]:

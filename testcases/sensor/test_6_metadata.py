@@ -9,14 +9,25 @@ from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata as judge
 from conformance.judges.support import serves_continuous
 from conformance.judges.tally import Tally
-from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY, Kind
-from conformance.protocol.responses import split_line
+from conformance.protocol.commands import (
+    C_FAMILY,
+    HV_FAMILY,
+    M_FAMILY,
+    SERVICE_REQUEST_KINDS,
+    Kind,
+    described,
+)
+from conformance.protocol.responses import parse_measurement_reply_for, split_line
 from conformance.protocol.values import split_values
-from conformance.transcript import decode_7e1, escape
+from conformance.transcript import TOOL, EventKind, decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed
+from conformance.view.runs import runs
 
 requirements = pytest.mark.requirements
 DESCRIBED = M_FAMILY + C_FAMILY + HV_FAMILY
+#: s of marking before each re-read of the data: past the 100 ms after which any sensor is in
+#: standby (R-7.0-15), so each read starts from standby with a break
+REREAD_IDLE = 0.2
 META_IDS = ("R-6.2-01", "R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2-07", "R-6.2.1-01", "R-6.2.2-01")
 
 
@@ -59,15 +70,21 @@ def test_identify_starts_nothing(sensor, case):
     if not case.requires("buffered", precondition.buffered(m, "measurement")):
         return
     fresh = sensor.fresh_measurement(m.command.text()[1:-1])
-    wait = max((sensor.measurement(c).ttt or 0) for c in ("M", "V")) + 0.5
 
     def reread():
-        sensor.listen(0.2)  # the same idle and break before each read: only the pokes differ
+        # the same idle (the line marking REREAD_IDLE s, so standby) and break before each
+        # read: only the pokes differ. Counted from the line's last activity, so the long
+        # listening after the pokes already is the second read's idle (issue 22)
+        sensor.idle(REREAD_IDLE)
         return [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
 
     control = reread()
+    first = len(sensor.link.transcript)
     pokes = [sensor.fresh_exchange(f"I{code}") for code in ("M", "C", "HA", "V")]
-    heard = sensor.listen(wait)
+    heard = sensor.listen(max(0.0, _service_request_deadline(sensor, pokes) - sensor.link.now()))
+    # a service request that came while the tool was still sending the identify commands
+    # (one soon after aIM!) was taken in as a later command's stray characters, not heard
+    heard = _requests_between(sensor, first, pokes, heard) + heard
     again = reread()
     case.evidence(
         "measurement, D again (control), identify commands, listening, D again",
@@ -121,6 +138,46 @@ def test_identify_starts_nothing(sensor, case):
                 observed=sum(ex.answered for ex in pokes) + len(again),
             )
         )
+
+
+def _service_request_deadline(sensor, pokes) -> float:
+    """Until when a service request could still follow the identify commands: a sensor that
+    took ``aIM!`` for ``aM!`` (``aIV!`` for ``aV!``) owes its service request before the ttt
+    of that measurement has passed since its reply (R-4.4.6-04), and the engine's own
+    patience for a late one (``late_sr_grace``) is added, as after any M or V. The ttt is
+    the larger of the measurement's own and the one the identify reply announced. ``aIC!``
+    and ``aIHA!`` name measurements that send no service request (R-4.4.6-05). Each window
+    runs from the end of its own identify command's exchange, not from the last one's: the
+    listening ends when the latest of them has (issue 22: it began after ``aIV!`` and took
+    the ttt of ``aM!`` from there)."""
+    grace = sensor.master.policy.late_sr_grace
+    latest = sensor.link.now()
+    for ex in pokes:
+        target = described(ex.command)
+        if target.kind not in SERVICE_REQUEST_KINDS:
+            continue
+        ttt = sensor.measurement(target.text()[1:-1]).ttt or 0
+        if ex.answered:
+            announced = parse_measurement_reply_for(split_line(ex.reply_text)[0], ex.command)
+            ttt = max(ttt, announced.ttt or 0)
+        latest = max(latest, ex.end + ttt + grace)
+    return latest
+
+
+def _requests_between(sensor, first: int, pokes, heard) -> list:
+    """The complete service requests (``a<CR><LF>``, R-4.4.6-01) of the sensor's address on
+    the wire since transcript index ``first`` that are neither a reply to one of ``pokes``
+    nor among ``heard``: what the sensor sent unasked while the tool was still sending the
+    identify commands. Only service requests: other characters after a reply are that
+    reply's own framing fault, judged by its rules."""
+    own = {id(e) for ex in pokes for a in ex.attempts for e in a.reply_events}
+    own |= {id(e) for e in heard}
+    dut = [
+        e
+        for e in sensor.link.transcript.since(first)
+        if e.kind is EventKind.CHAR and e.origin != TOOL and id(e) not in own
+    ]
+    return [e for run in runs(dut) if decode_7e1(run) == f"{sensor.address}\r\n" for e in run]
 
 
 def _metadata_plan(sensor):

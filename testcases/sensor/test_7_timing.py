@@ -56,7 +56,7 @@ def _marking_after_break(sensor, ex) -> float | None:
 def _awake(sensor):
     """Wake the sensor the way a recorder does (break, a!, retries) and return that exchange:
     its last reply proves the sensor is awake, whatever it needed to wake up."""
-    sensor.listen(STANDBY)
+    sensor.idle(STANDBY)
     return sensor.master.transact(f"{sensor.address}!", force_break=True)
 
 
@@ -64,7 +64,7 @@ def _asleep(sensor):
     """Put the sensor in standby by both routes (a command for another address, then more
     than 100 ms of marking), so a sensor that ignores one of them still sleeps."""
     sensor.probe(f"{sensor.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
-    sensor.listen(STANDBY)
+    sensor.idle(STANDBY)
 
 
 def _shown_asleep(sensor, case):

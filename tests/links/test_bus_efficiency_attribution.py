@@ -46,3 +46,36 @@ def test_each_uncounted_stretch_goes_to_the_cause_the_wire_shows():
 
 
 ROW = re.compile(r"^\s*([\d.]+)\s+(\d+)  (.*) \((.*)\)$")
+
+
+def _link(reference: str) -> dict:
+    part = {"worst_ms": 0.0, "samples": 0, "where": ""}
+    return {
+        "timing_uncertainty_ms": 5.0,
+        "bench": {
+            "timing": {
+                "reference": reference,
+                "regular_ms": 0.25 if reference == "echo" else 0.0,
+                "batches": {**part, "worst_ms": 8.22, "samples": 8},
+                "artefacts": {**part, "worst_ms": 10.481, "samples": 14301},
+                "local_irregularities": 717,
+            }
+        },
+    }
+
+
+def test_the_look_is_shown_beside_the_lateness_the_run_saw():
+    """The look before transmitting is the declared figure; the run's own lower bounds of
+    its characters' lateness stand beside it (issue 22, sixth round: a local RFC 2217
+    emulator on a loaded machine showed an 8.2 ms batch and 10.5 ms of overlap)."""
+    text = bench_module().look_figures(_link("write"))
+    assert text.startswith("look before transmitting: 5.0 ms declared")
+    assert "write time (no echo)" in text
+    assert "batches worst 8.22 ms (8), overlapping frames worst 10.481 ms" in text
+    assert text.endswith("717 local irregularities")
+    assert "echo of its commands, regular figure 0.25 ms" in bench_module().look_figures(
+        _link("echo")
+    )
+    assert bench_module().look_figures({"timing_uncertainty_ms": 1.0}) == (
+        "look before transmitting: 1.0 ms declared (no bench figures)"
+    )
