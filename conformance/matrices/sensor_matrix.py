@@ -12,11 +12,9 @@ import multiprocessing
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import partial
 from pathlib import Path
 from typing import Any, TypeVar
 
-from .. import gc_pace
 from ..conduct import NoVerdicts, conduct
 from ..protocol.version import V14, format_version
 from ..run import ConformanceRun, RunOptions
@@ -184,21 +182,6 @@ def fault_matrix(
     return run_rows(items, row, processes, progress)
 
 
-def paced_row(make: Callable[[ItemT], RowT], item: ItemT) -> RowT:
-    """``make(item)`` with the garbage collector at a run's pace (:func:`gc_pace.slow_down`)
-    for the whole row, not only inside its runs: between a row's live run and the replay of
-    its capture, the export and the decode make ~10^5 objects of their own while the live
-    run's ~10^5 events are still alive, and at CPython's default pace (a young collection
-    every 700 allocations, a full one whenever the heap grew by a quarter) the collector
-    walked them over and over: a full collection in the decode took 0.30 s, and a row's
-    collections took half as much CPU paced for the whole row (6 rows: 1.25 s -> 0.66 s)."""
-    pace = gc_pace.slow_down()
-    try:
-        return make(item)
-    finally:
-        gc_pace.restore(pace)
-
-
 def run_rows(
     items: Sequence[ItemT],
     make: Callable[[ItemT], RowT],
@@ -207,10 +190,8 @@ def run_rows(
 ) -> list[RowT]:
     """``make(item)`` for each item, ``processes`` at a time in spawned workers (each run is
     a whole pytest session: a fresh process keeps runs apart), in the items' order;
-    ``progress(done, total, row)`` hears of each row as it arrives. Each row is made at the
-    collector's run pace (:func:`paced_row`)."""
+    ``progress(done, total, row)`` hears of each row as it arrives."""
     rows: list[RowT] = []
-    make = partial(paced_row, make)  # module-level parts: a spawned worker unpickles it
 
     def keep(made: RowT) -> None:
         rows.append(made)

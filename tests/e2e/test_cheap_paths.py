@@ -383,26 +383,6 @@ def test_a_run_collects_even_when_its_caller_turned_the_collector_off(tmp_path) 
     assert seen and set(seen) == {(True, gc_pace.RUN_THRESHOLDS)}
 
 
-def test_a_matrix_row_is_made_at_the_run_pace_and_the_collector_left_as_found() -> None:
-    """The export and decode between a row's two runs are paced too (run_rows makes every
-    row through paced_row), and what the caller had is back after each row."""
-    from conformance.matrices.sensor_matrix import run_rows
-
-    def make(item: int) -> tuple[int, bool, tuple[int, int, int], bool]:
-        return item, gc.isenabled(), gc.get_threshold(), gc.get_freeze_count() > 0
-
-    before = gc.get_threshold()
-    gc.disable()
-    try:
-        rows = run_rows([1, 2], make, processes=1)
-        assert not gc.isenabled()
-    finally:
-        gc.enable()
-    assert rows == [(i, True, gc_pace.RUN_THRESHOLDS, True) for i in (1, 2)]
-    assert gc.get_threshold() == before
-    assert gc.get_freeze_count() == 0
-
-
 _PROBE = (
     "import gc, json, sys\n"
     "from conformance import cli, conduct\n"
