@@ -170,16 +170,14 @@ def combine_local(
       :func:`to_confirm`, and the judge runs again over the repeats). Many deviations
       (:func:`sustained`) are a FAIL as they are. On a virtual clock every observation is
       exact and one is enough."""
-    kept: list[Finding | Measured] = []
-    places: list[Place | None] = []  # of each kept one
-    aside: list[Finding | Measured] = []
-    for o in observed:  # one pass: a run's character gaps number tens of thousands
-        f = o[0]
-        if _aside(f, o[1]):
-            aside.append(f)
-        else:
-            kept.append(f)
-            places.append(o[2] if len(o) > 2 else None)  # type: ignore[misc]
+    # a run's character gaps number tens of thousands, nearly always none tainted (never on
+    # a virtual clock): then every one is kept, as one slice; the places are wanted only by
+    # the few deviations of a real-time link (_by_place), and gathered only then
+    if any(o[1] for o in observed):
+        kept = [o[0] for o in observed if not _aside(o[0], o[1])]
+        aside = [o[0] for o in observed if _aside(o[0], o[1])]
+    else:
+        kept, aside = [o[0] for o in observed], []
     worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
     note = (
         f"{counted(len(aside), what)} set aside: the link's "
@@ -195,6 +193,7 @@ def combine_local(
         and not sustained(len(failing), len(kept))
     )
     if isolated:
+        places = [o[2] if len(o) > 2 else None for o in observed if not _aside(o[0], o[1])]  # type: ignore[misc]
         found = _by_place(rid, list(zip(kept, places, strict=True)), what, smallest_is_worst)
     else:
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)

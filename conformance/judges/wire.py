@@ -200,11 +200,13 @@ def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observa
     the reply to one command (a simulated sensor's are exact; a real link's stamps are
     quantised), and equal gaps judge alike: each distinct ``(gap, uncertainty, where)`` is
     judged once and its :class:`~.timing.Measured` stands for every gap of that value."""
+    base = stamps.base
+    if stamps.local is None and not (not base and copysign(1.0, base) < 0):
+        return _observe_gaps_alike(_gaps(segs), base)
     judged: dict[tuple[float, float, str], Measured] = {}
     observed: list[Observation] = []
     add = observed.append
     local = stamps.local is not None
-    base = stamps.base
     for gap, where, a, b, place in _gaps(segs):
         u = stamps.between(a.start, b.end) if local else base
         # -0.0 == 0.0 as a key, but not in a detail text: a negative zero is judged apart
@@ -216,6 +218,24 @@ def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observa
             if measured is None:
                 measured = judged[key] = Measured(GAP_WINDOW, gap, u, [where])
         add((measured, u > base, place))
+    return observed
+
+
+def _observe_gaps_alike(gaps: list[Gap], base: float) -> list[Observation]:
+    """:func:`_observe_gaps` where every gap has the stamps' one uncertainty ``base`` (no
+    local irregularity: a virtual clock, a capture's sample grid), which is then no part of
+    the key and taints none: the same observations, with less asked per gap."""
+    judged: dict[tuple[float, str], Measured] = {}
+    observed: list[Observation] = []
+    add = observed.append
+    for gap, where, _a, _b, place in gaps:
+        if not gap and copysign(1.0, gap) < 0:  # judged apart, as _observe_gaps does
+            add((Measured(GAP_WINDOW, gap, base, [where]), False, place))
+            continue
+        measured = judged.get((gap, where))
+        if measured is None:
+            measured = judged[(gap, where)] = Measured(GAP_WINDOW, gap, base, [where])
+        add((measured, False, place))
     return observed
 
 
@@ -285,29 +305,22 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
     the ±2% band), so without such a pair the verdict is INCONCLUSIVE, never a guess."""
     stamps = stamp_uncertainty(uncertainty)
     uncertainty = stamps.base
-    spacings = []
-    fast = []  # spacings surely too short even with the stamps' local uncertainty
-    for seg in segs:
-        for run in [seg.reply, *runs(seg.later)]:
-            for a, b in zip(run, run[1:], strict=False):
-                spacings.append((b.start - a.start, seg.text))
-                if b.start - a.start + 2 * stamps.between(a.start, b.end) < CHAR_TIME * 0.98:
-                    fast.append((b.start - a.start, seg.text))
-    if not spacings:
+    count, least, fast = _spacings(segs, stamps)
+    if least is None:
         return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character reply observed")
-    shortest, text = min(spacings)
+    shortest, text = least
     low = CHAR_TIME * 0.98
     where = [f"in reply to {escape(text)}"]
     if stamps.local is not None and shortest + 2 * uncertainty < low:
-        if not sustained(len(fast), len(spacings)):  # a few bursts of a stalling host
+        if not sustained(len(fast), count):  # a few bursts of a stalling host
             return Finding(
                 "R-4.1-01",
                 Verdict.INCONCLUSIVE,
-                f"{len(fast)} of {len(spacings)} character spacings are shorter than a frame "
+                f"{len(fast)} of {count} character spacings are shorter than a frame "
                 f"(shortest {shortest * 1e3:.2f} ms); too few, or too near irregular stamps, "
                 "to tell a fast bit rate from bursts of the link",
                 evidence=where,
-                observed=len(spacings),
+                observed=count,
             )
         shortest, text = min(fast)
         where = [f"in reply to {escape(text)}"]
@@ -319,7 +332,7 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
             "shorter than any character a 1200-baud receiver can frame: the stamps (a burst "
             "of one read), not the sensor, made that spacing, and it is no bit rate; undecided",
             evidence=where,
-            observed=len(spacings),
+            observed=count,
         )
     if shortest + 2 * uncertainty < low:
         return judge_window(
@@ -339,8 +352,38 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
         finding.verdict = Verdict.INCONCLUSIVE
         finding.detail += " (no back-to-back characters: rate and gaps cannot be separated)"
     baud = 10 / shortest if shortest > 0 else float("inf")
-    finding.detail += f"; about {baud:.0f} baud from {len(spacings)} spacings"
+    finding.detail += f"; about {baud:.0f} baud from {count} spacings"
     return finding
+
+
+Spacing = tuple[float, str]  # a start-to-start spacing (s) and the command it answered
+
+
+def _spacings(
+    segs: list[Segment], stamps: StampUncertainty
+) -> tuple[int, Spacing | None, list[Spacing]]:
+    """:func:`judge_reply_bit_rate`'s pass over every pair of consecutive reply characters:
+    how many, the least ``(spacing, command)`` as ``min`` of them all gives it (the first
+    least spacing, ties by the command's text), and those surely too short even with the
+    stamps' local uncertainty. Kept as it goes, not as a list of every pair (tens of
+    thousands a run, once each) and a ``min`` over it."""
+    count = 0
+    least: Spacing | None = None
+    fast: list[Spacing] = []
+    between = stamps.between
+    low = CHAR_TIME * 0.98
+    for seg in segs:
+        text = seg.text
+        for run in [seg.reply, *runs(seg.later)]:
+            count += max(len(run) - 1, 0)
+            for a, b in zip(run, run[1:], strict=False):
+                spacing = b.start - a.start
+                # (spacing, text) < least, as min() compares: the float first, then the text
+                if least is None or (spacing <= least[0] and (spacing, text) < least):
+                    least = (spacing, text)
+                if spacing + 2 * between(a.start, b.end) < low:
+                    fast.append((spacing, text))
+    return count, least, fast
 
 
 def judge_rate(what: str, measured: float, uncertainty: float, evidence: list[str]) -> Finding:

@@ -10,6 +10,7 @@ import json
 import math
 import random
 from dataclasses import asdict
+from math import copysign
 
 import pytest
 
@@ -25,7 +26,7 @@ from conformance.judges.timing import (
     to_confirm,
 )
 from conformance.transcript import DUT, TOOL, Event, EventKind, Transcript, to_wire_7e1
-from conformance.view.runs import Segments
+from conformance.view.runs import Segment, Segments
 
 WINDOWS = [
     Window("R-7.0-12", "gap", high=1.66e-3, tolerance=0.0),
@@ -159,6 +160,68 @@ def test_equal_gaps_share_a_judgement_but_not_a_signed_zero() -> None:
     window = wire.GAP_WINDOW
     negative = Measured(window, -0.0, 0.0, ["x"])
     assert negative.detail != Measured(window, 0.0, 0.0, ["x"]).detail  # why it is apart
+
+
+def _observation_figures(observed) -> list[tuple]:
+    """Each observation's figures and which earlier one shares its Measured (by position)."""
+    first: dict[int, int] = {}
+    return [
+        (
+            m.measured, copysign(1.0, m.measured), m.uncertainty, m.verdict, m.margin_ms,
+            m.evidence_lines, tainted, place, first.setdefault(id(m), i),
+        )
+        for i, (m, tainted, place) in enumerate(observed)
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("base", [0.0, 1e-5, 0.4e-3])
+def test_gaps_of_one_uncertainty_are_observed_as_the_general_path_does(base) -> None:
+    """Without local irregularity (a virtual clock, a capture's grid) the gaps are observed
+    by the short loop (_observe_gaps_alike): the same observations, shared alike, as the
+    general loop gives when a local uncertainty that is never above the base is asked."""
+    rng = random.Random(5)
+    events = _run()
+    t = 1.0
+    for _ in range(40):  # replies with equal, signed-zero, overlapping and random gaps
+        events += _command(t, "0D0!")
+        t += 4 * 8.33e-3 + 0.010
+        for c in "0+1.5+2\r\n":
+            gap = rng.choice([0.0, -0.0, 0.3e-3, 1.9e-3, -1e-3, rng.random() * 2e-3])
+            events.append(Event(EventKind.CHAR, DUT, t, t + 8.33e-3, wire=to_wire_7e1(ord(c))))
+            t += 8.33e-3 + gap
+        t += 0.2
+    segs = wire.segments(events)
+    alike = wire._observe_gaps(segs, StampUncertainty(base))
+    general = wire._observe_gaps(segs, StampUncertainty(base, lambda a, b: base / 2))
+    assert len(alike) > 300
+    assert _observation_figures(alike) == _observation_figures(general)
+
+
+def test_the_least_spacing_is_the_one_min_gives() -> None:
+    """judge_reply_bit_rate keeps the least (spacing, command) as it goes: the pair ``min``
+    over a list of them all gives, ties between commands broken by the text, a negative zero
+    kept where it came first."""
+    rng = random.Random(3)
+    for _ in range(200):
+        segs = []
+        for _ in range(rng.randrange(1, 6)):
+            t = rng.random()
+            reply = []
+            for _ in range(rng.randrange(0, 5)):
+                reply.append(Event(EventKind.CHAR, DUT, t, t + 8.33e-3, wire=0x30))
+                t += rng.choice([8.33e-3, 8.33e-3, 0.0, -0.0, 4e-3, 9e-3])
+            segs.append(Segment(None, [], reply, text=rng.choice(["0D0!", "0D1!", "1D0!"])))
+        pairs = [
+            (b.start - a.start, seg.text)
+            for seg in segs
+            for a, b in zip(seg.reply, seg.reply[1:], strict=False)
+        ]
+        count, least, _fast = wire._spacings(segs, StampUncertainty(0.0))
+        assert count == len(pairs)
+        if pairs:
+            assert least == min(pairs) and copysign(1.0, least[0]) == copysign(1.0, min(pairs)[0])
+        else:
+            assert least is None
 
 
 def test_transcript_lines_are_what_the_json_module_writes(tmp_path) -> None:
