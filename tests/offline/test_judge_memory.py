@@ -8,14 +8,13 @@ by at most :data:`MB_PER_MINUTE` per minute of capture.
 Measured on the project's 2-core machine (peak RSS of the child, glibc's malloc arenas
 capped at one, the lower of two runs): 2 minutes 70 MB, 14 minutes 96 MB, so 2.17 MB a
 minute (10 to 60 minutes: 2.18, the hour 196 MB); b999a88 71 and 101 MB, 2.5 MB a minute
-(10 to 60: 2.42, the hour 212 MB), which sits on this limit. Before that: 73.6 and 103.5
-MB, 2.5 MB a minute (the hour 213 MB); 807fdce 73.8 and 105.5 MB, 2.6 MB a minute (10
-to 60 minutes 2.8, the hour 236 MB) and 57aa7db 76 and 122 MB, 3.8 MB a minute (the
-hour: 318 MB), which this test fails. The cap
-makes the figure repeatable: without it the decode's read-ahead thread gets an arena of its
-own, and the short run's peak was 75 or 81 MB from one run to the next; with it, runs of
-one length differ by 3 MB at most (0.25 MB a minute over the 12 minutes between the two
-lengths), against the 4 MB or more this tree stands off the limit. The short one is judged
+(10 to 60: 2.42, the hour 212 MB) and 807fdce 2.6 (the hour 236 MB), which this limit
+does not tell apart; 57aa7db 76 and 122 MB, 3.8 MB a minute (the hour: 318 MB), which this
+test fails. The cap makes the figure repeatable: without it the decode's read-ahead thread
+gets an arena of its own, and the short run's peak was 75 or 81 MB from one run to the
+next; with it, runs of one length differ by 3 MB at most (0.25 MB a minute over the 12
+minutes between the two lengths), and the limit stands 0.43 MB a minute (5 MB) above this
+tree's figure, so that noise cannot fail CI. The short one is judged
 twice and its lower peak taken (the steeper slope).
 """
 
@@ -30,7 +29,8 @@ from pathlib import Path
 
 import pytest
 
-MB_PER_MINUTE = 2.5  # 2.17 measured, runs of one length differ by 3 MB: 0.25 a minute
+MB_PER_MINUTE = 2.6  # 2.17 measured (lower of two), runs of one length differ by 3 MB: 0.25 a
+# minute each, so up to 0.5 between two runs; CI must not fail on the noise
 SHORT, LONG = 2.0, 14.0  # minutes
 
 #: judges the capture in this child process, then prints its own peak resident memory (MB)
