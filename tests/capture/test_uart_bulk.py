@@ -20,6 +20,7 @@ from conformance.capture.levels import _RUNS
 from conformance.protocol.timing import CHAR_TIME
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from tests.support.paths import SHARED
+from tests.support.shared_runs import copied_run
 
 FRAME = st.tuples(
     st.just("frame"),
@@ -179,14 +180,17 @@ def test_shared_captures_decode_the_same_both_ways(monkeypatch, name, baud, fram
 
 @pytest.mark.slow
 @pytest.mark.parametrize("fault", ["fast-baud", "inter-char-gap", "binary-invalid-type"])
-def test_a_fault_runs_capture_decodes_the_same_both_ways(tmp_path, monkeypatch, fault):
+def test_a_fault_runs_capture_decodes_the_same_both_ways(
+    tmp_path, tmp_path_factory, monkeypatch, fault
+):
     """A fault run's capture as ``judge`` decodes it (the tool's TX on a second channel):
     a sender at 1300 baud (every reply character read by the scan's own code), gaps
     between characters, 8N1 binary bytes among 7E1 frames."""
-    from conformance.conduct import run_into
     from conformance.replay.recording import read_recording
 
-    run_into(tmp_path / "live", f"sim://?faults={fault}")
+    # the main command's run of the fault, made once a session (inter-char-gap and fast-baud
+    # are judged passively in tests/commands/test_passive.py too: tests/support/shared_runs.py)
+    copied_run(tmp_path_factory, tmp_path / "live", f"sim://?faults={fault}")
     events = read_recording(tmp_path / "live").events
     path = tmp_path / "run.sr"
     export_events(events, str(path), "sr", tool_channel=True)

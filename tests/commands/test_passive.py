@@ -22,6 +22,7 @@ from conformance.cli import main
 from conformance.emulator import FAULTS
 from conformance.recorder.faults import RECORDER_FAULTS
 from tests.support.paths import ROOT, SHARED
+from tests.support.shared_runs import copied_run
 
 EXIT_USAGE = 4
 DECIDED = ("PASS", "FAIL", "WARN")
@@ -70,14 +71,17 @@ LiveRuns = Callable[[str, str], Path]
 
 @pytest.fixture(scope="module")
 def live_runs(tmp_path_factory: pytest.TempPathFactory) -> LiveRuns:
-    """``live(port, role)``'s folder, made once in this module: several tests judge the same
-    run (the clean sensor, ``crc-missing``, the recorder's ``short-break``: eight runs were
-    three). The tests read the folder and write their judgements elsewhere."""
+    """The folder of the live run of ``role`` against ``port``, copied once into this module:
+    several tests judge the same run (the clean sensor, ``crc-missing``, the recorder's
+    ``short-break``: eight runs were three), and other modules judge the clean runs too
+    (tests/support/shared_runs.py makes each once a session). The tests read the folder and
+    write their judgements elsewhere."""
     made: dict[tuple[str, str], Path] = {}
 
     def run(port: str, role: str) -> Path:
         if (port, role) not in made:
-            made[port, role] = live(tmp_path_factory.mktemp("live"), port, role)
+            into = tmp_path_factory.mktemp("live") / "live"
+            made[port, role], _code = copied_run(tmp_path_factory, into, port, role)
         return made[port, role]
 
     return run

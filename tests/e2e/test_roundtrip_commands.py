@@ -22,6 +22,7 @@ import pytest
 from conformance.capture import embedded_meta
 from conformance.cli import main
 from conformance.replay.recording import OPTIONS_NOTE
+from tests.support.shared_runs import copied_run
 
 #: requirements whose verdict a capture may change, with why (none in these runs)
 CANNOT_CARRY: dict[str, str] = {}
@@ -43,12 +44,12 @@ def changed(live: dict[str, str], again: dict[str, str]) -> dict[str, tuple[str,
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> dict[str, Path]:
-    """One live run per port (made once: the formats share it)."""
+    """One live run per port, copied once into this module (the formats share it; the runs
+    themselves are made once a session: tests/support/shared_runs.py)."""
     made = {}
     for port, role in (("sim", "sensor"), ("sim://?faults=no-service-request", "sensor")):
         out = tmp_path_factory.mktemp("live") / "run"
-        main(["--port", port, "--role", role, "--report-dir", str(out)])
-        made[port] = out
+        made[port], _code = copied_run(tmp_path_factory, out, port, role)
     return made
 
 

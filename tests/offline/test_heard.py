@@ -18,6 +18,7 @@ from conformance.cli import main
 from conformance.protocol.commands import Kind
 from conformance.replay.recording import read_recording, write_recording
 from conformance.transcript import DUT, EventKind
+from tests.support.shared_runs import copied_run
 
 STALL = 7.5e-3  # s: beyond 1.66 ms + the ±5 ms the stamps declare
 
@@ -30,8 +31,9 @@ def _verdict(path: Path, out: Path, rid: str) -> dict:
 
 @pytest.fixture(scope="module")
 def a_run(tmp_path_factory) -> Path:
-    run = tmp_path_factory.mktemp("run")
-    assert main(["--port", "sim", "--report-dir", str(run)]) == 0  # the whole run: many aI!
+    into = tmp_path_factory.mktemp("run") / "run"  # the session's clean run (shared_runs.py)
+    run, code = copied_run(tmp_path_factory, into, "sim")
+    assert code == 0  # the whole run: many aI!
     return run
 
 

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import json
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 from conformance.cli import main
 from conformance.replay.recording import OPTIONS_NOTE, read_recording
+from tests.support.shared_runs import copied_run
 
 EXIT_USAGE = 4
 
@@ -26,11 +28,21 @@ def requirements(run: Path) -> dict[str, dict]:
     return {r["id"]: r for r in data["requirements"]}
 
 
-def live(tmp: Path, port: str, role: str = "sensor") -> Path:
-    out = tmp / "live"
-    code = main(["--port", port, "--role", role, "--report-dir", str(out)])
-    assert (out / "verdicts.json").exists(), code
-    return out
+Live = Callable[..., Path]
+
+
+@pytest.fixture
+def live(tmp_path_factory: pytest.TempPathFactory, tmp_path: Path) -> Live:
+    """``live(port, role="sensor")``: this test's copy (``tmp_path/live``) of the session's
+    live run of ``role`` against ``port`` (tests/support/shared_runs.py: the clean sensor's
+    run was made four times in this module and again in others)."""
+
+    def run(port: str, role: str = "sensor") -> Path:
+        out, _code = copied_run(tmp_path_factory, tmp_path / "live", port, role)
+        assert (out / "verdicts.json").exists()
+        return out
+
+    return run
 
 
 def wire_lines(run: Path) -> list[str]:
@@ -71,8 +83,8 @@ def same_verdicts(first: Path, again: Path, *, uncertainty_may_differ: bool = Fa
         ),
     ],
 )
-def test_replayed_transcript_gives_the_runs_verdicts(tmp_path, port, role):
-    first = live(tmp_path, port, role)
+def test_replayed_transcript_gives_the_runs_verdicts(tmp_path, live, port, role):
+    first = live(port, role)
     again = tmp_path / "again"
     code = main(["judge", str(first / "transcript.jsonl"), "--report-dir", str(again)])
     assert code in (0, 1)
@@ -83,8 +95,8 @@ def test_replayed_transcript_gives_the_runs_verdicts(tmp_path, port, role):
 
 
 @pytest.mark.slow
-def test_a_run_records_how_it_was_made(tmp_path):
-    first = live(tmp_path, "sim://?version=1.3")
+def test_a_run_records_how_it_was_made(live):
+    first = live("sim://?version=1.3")
     recording = read_recording(first)
     assert recording.options["port"] == "sim://?version=1.3"
     assert recording.options["link"]["virtual_time"] is True
@@ -92,10 +104,10 @@ def test_a_run_records_how_it_was_made(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_replay_that_no_longer_matches_stops_and_says_where(tmp_path):
+def test_a_replay_that_no_longer_matches_stops_and_says_where(tmp_path, live):
     """A recorder-role recording cannot answer the sensor cases: the run stops (INCOMPLETE,
     exit 3) naming what the tool sent and what the recording has, never invented answers."""
-    first = live(tmp_path, "sim", "recorder")
+    first = live("sim", "recorder")
     out = tmp_path / "wrong"
     code = main(["--port", f"replay:{first}", "--report-dir", str(out)])
     assert code == 3
@@ -105,10 +117,10 @@ def test_a_replay_that_no_longer_matches_stops_and_says_where(tmp_path):
 
 
 @pytest.mark.slow
-def test_capture_of_a_run_gives_its_verdicts(tmp_path):
+def test_capture_of_a_run_gives_its_verdicts(tmp_path, live):
     """Export to .sr with the tool's TX channel, judge the capture: the run's verdicts, with
     the capture's own uncertainty (one sample period) in the timing figures."""
-    first = live(tmp_path, "sim://?faults=response-too-early")
+    first = live("sim://?faults=response-too-early")
     capture = tmp_path / "run.sr"
     assert main(["export", str(first), "--to", "sr", "--tool-channel", "-o", str(capture)]) == 0
     with zipfile.ZipFile(capture) as zf:
@@ -124,8 +136,8 @@ def test_capture_of_a_run_gives_its_verdicts(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["vcd", "csv"])
-def test_export_formats_open_again(tmp_path, fmt):
-    first = live(tmp_path, "sim")
+def test_export_formats_open_again(tmp_path, live, fmt):
+    first = live("sim")
     out = tmp_path / f"run.{fmt}"
     assert main(["export", str(first), "--to", fmt, "-o", str(out)]) == 0
     text = out.read_text(encoding="ascii")
@@ -160,10 +172,10 @@ def test_bad_recordings_are_refused_plainly(tmp_path, capsys, name, content, wor
 
 
 @pytest.mark.slow
-def test_missing_recording_and_wrong_channel(tmp_path, capsys):
+def test_missing_recording_and_wrong_channel(tmp_path, live, capsys):
     assert main(["judge", str(tmp_path / "nothing.sr")]) == EXIT_USAGE
     assert "nothing.sr" in capsys.readouterr().err
-    first = live(tmp_path, "sim")
+    first = live("sim")
     capture = tmp_path / "run.sr"
     assert main(["export", str(first), "--to", "sr", "-o", str(capture)]) == 0
     code = main(["judge", str(capture), "--channel", "D7", "--run", str(first)])

@@ -18,6 +18,7 @@ from conformance.recorder_jobs import Request, Task
 from conformance.sim.bus import SimBus, SimLink
 from conformance.sim.line_monitor import LineMonitor
 from conformance.tool_recorder import Policy, ToolRecorder
+from tests.support.shared_runs import copied_run
 
 
 def _bus(spec: SensorSpec) -> ToolRecorder:
@@ -103,10 +104,15 @@ def test_interactive_prompts_and_times_out():
 
 
 @pytest.mark.slow
-def test_cli_recorder_role(tmp_path):
-    assert main(["--port", "sim", "--role", "recorder", "--report-dir", str(tmp_path / "a")]) == 0
-    assert (tmp_path / "a" / "report.html").exists()
-    faulty = ["--port", "sim://?recorder-faults=short-break", "--role", "recorder"]
-    assert main([*faulty, "--report-dir", str(tmp_path / "b")]) == 1
+def test_cli_recorder_role(tmp_path, tmp_path_factory):
+    # the main command's runs, made once a session (tests/support/shared_runs.py): the clean
+    # and short-break recorder runs are judged again in tests/commands/test_passive.py
+    clean, code = copied_run(tmp_path_factory, tmp_path / "a", "sim", "recorder")
+    assert code == 0
+    assert (clean / "report.html").exists()
+    _faulty, code = copied_run(
+        tmp_path_factory, tmp_path / "b", "sim://?recorder-faults=short-break", "recorder"
+    )
+    assert code == 1
     assert main(["--port", "sim://?recorder-faults=bogus", "--role", "recorder"]) == 4
     assert main(["--port", "sim", "--role", "recorder", "--trigger", "true"]) == 4

@@ -18,6 +18,7 @@ from conformance.reports.evidence import Locator, _named
 from conformance.results import CaseRecord
 from conformance.transcript import Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
+from tests.support.shared_runs import copied_run
 
 NOTEWORTHY = ("FAIL", "WARN", "INCONCLUSIVE")
 SCHEMA = json.loads(
@@ -26,8 +27,10 @@ SCHEMA = json.loads(
 
 
 def faulty_run(tmp_path_factory, fault: str) -> tuple[Path, dict, list[dict]]:
-    out = tmp_path_factory.mktemp(fault)
-    code = cli.main(["--port", f"sim://?faults={fault}", "--report-dir", str(out)])
+    """The main command's run of ``fault``, made once a session (``wrong-crc`` is judged in
+    tests/commands/test_passive.py too: tests/support/shared_runs.py), in a copy of its own."""
+    into = tmp_path_factory.mktemp(fault) / "run"
+    out, code = copied_run(tmp_path_factory, into, f"sim://?faults={fault}")
     assert code == cli.EXIT_NON_COMPLIANT
     data = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
     lines = (out / "transcript.jsonl").read_text(encoding="utf-8").splitlines()
