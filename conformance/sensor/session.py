@@ -443,6 +443,14 @@ class SensorSession(Session):
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""
         return self.link.receive(self.link.now() + duration)
 
+    def listen_until(self, at: float) -> list[Event]:
+        """:meth:`listen` up to ``at`` (at once if it has passed): a window for silence counted
+        from the event its rule counts from (a reply's end, ttt and the engine's late-service-
+        request grace after it), not from when the case got there, which lay a break, a
+        turnaround and a read's end later (issue 22). Characters that started by ``at`` and
+        arrive later are waited for, as :meth:`listen` does: they are evidence."""
+        return self.link.receive(max(at, self.link.now()))
+
     def idle(self, marking: float) -> list[Event]:
         """Keep the line marking until it has marked ``marking`` s since its last activity,
         and return what the DUT sent meanwhile: an idle that a rule counts as marking (a

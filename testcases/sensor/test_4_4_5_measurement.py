@@ -81,9 +81,10 @@ def test_ttt_zero(sensor, case):
         return
     code = zero[0]
     start = sensor.fresh_exchange(code)
-    quiet = sensor.listen(0.5)
+    grace = sensor.master.policy.late_sr_grace
+    quiet = sensor.listen_until(_reply_end(start) + grace)  # ttt = 0: the grace alone
     d0 = sensor.fresh_exchange("D0")
-    case.evidence(f"{code} with ttt 000, 0.5 s of listening, D0", [start, quiet, d0])
+    case.evidence(f"{code} with ttt 000, {grace:.1f} s of listening, D0", [start, quiet, d0])
     if quiet:
         case.add(
             failed(
@@ -98,7 +99,7 @@ def test_ttt_zero(sensor, case):
         case.add(
             passed(
                 "R-4.4.6-03",
-                f"no service request in 0.5 s after {shown(start)}",
+                f"no service request in {grace:.1f} s after {shown(start)}",
                 observed=int(start.answered),  # silence after no reply says nothing
             )
         )
@@ -194,7 +195,11 @@ def test_break_aborts_measurement(sensor, case):
     start = sensor.fresh_exchange(code)
     before = sensor.listen(min(0.05, target.ttt / 10))
     brk = sensor.master.send_break()
-    waited = sensor.listen(target.ttt + 0.5)
+    # as long as an undisturbed measurement's service request could come late (R-4.4.6-04:
+    # within ttt of its reply, and the engine's grace past that): from that reply, not from
+    # the break a break, a read's end and a turnaround later (issue 22)
+    grace = sensor.master.policy.late_sr_grace
+    waited = sensor.listen_until(_reply_end(start) + target.ttt + grace)
     d0 = sensor.fresh_exchange("D0", crc=target.command.crc)
     start2 = sensor.fresh_exchange(code)  # abort again, and this time start anew after it
     before2 = sensor.listen(min(0.05, target.ttt / 10))
@@ -250,8 +255,8 @@ def test_break_aborts_measurement(sensor, case):
         case.add(
             passed(
                 "R-4.4.5.1-01",
-                f"no service request in the {target.ttt + 0.5:.1f} s after the break "
-                f"(undisturbed, {code} raised one)",
+                f"no service request after the break, up to {target.ttt + grace:.1f} s after "
+                f"{code}'s reply (undisturbed, {code} raised one)",
                 observed=2,  # the undisturbed service request and the silence after the break
             )
         )
@@ -320,3 +325,9 @@ def test_break_aborts_measurement(sensor, case):
                 observed=1 + len(again.data),
             )
         )
+
+
+def _reply_end(ex) -> float:
+    """Where a measurement's ttt counts from (R-4.4.5-04): its reply's last stop bit, or
+    where the engine stopped listening when nothing came."""
+    return ex.reply_events[-1].end if ex.answered else ex.end

@@ -81,7 +81,7 @@ def test_identify_starts_nothing(sensor, case):
     control = reread()
     first = len(sensor.link.transcript)
     pokes = [sensor.fresh_exchange(f"I{code}") for code in ("M", "C", "HA", "V")]
-    heard = sensor.listen(max(0.0, _service_request_deadline(sensor, pokes) - sensor.link.now()))
+    heard = sensor.listen_until(_service_request_deadline(sensor, pokes))
     # a service request that came while the tool was still sending the identify commands
     # (one soon after aIM!) was taken in as a later command's stray characters, not heard
     heard = _requests_between(sensor, first, pokes, heard) + heard
