@@ -255,6 +255,14 @@ def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
             sure.append((g, w))
         if g + uncertainty > band_lo and g - uncertainty <= band_hi:
             maybe.append((g, w))
+    return _tolerance_finding(sure, maybe, len(gaps), uncertainty)
+
+
+def _tolerance_finding(
+    sure: list[tuple[float, str]], maybe: list[tuple[float, str]], count: int, uncertainty: float
+) -> Finding:
+    """R-7.0-01's finding from the ``(gap, where)`` surely and possibly inside the band, out
+    of ``count`` gaps judged (:func:`_judge_tolerance_use`)."""
     if sure:
         gap, where = sure[0]
         return Finding(
@@ -264,7 +272,7 @@ def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
             f"tolerance, which the 1.66 ms character gap does not have ({len(sure)} such "
             "gap(s))",
             evidence=[where for _, where in sure[:5]],
-            observed=len(gaps),
+            observed=count,
             measured_ms=round(gap * 1e3, 3),
             limit_ms=INTER_CHAR_GAP_MAX * 1e3,
             uncertainty_ms=round(uncertainty * 1e3, 3),
@@ -281,14 +289,14 @@ def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
             limit_ms=INTER_CHAR_GAP_MAX * 1e3,
             uncertainty_ms=round(uncertainty * 1e3, 3),
         )
-    if not gaps:
+    if not count:
         return Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no character gap observed")
     return Finding(
         "R-7.0-01",
         Verdict.PASS,
-        f"{len(gaps)} character gaps: none leans on a tolerance the rule does not grant; "
+        f"{count} character gaps: none leans on a tolerance the rule does not grant; "
         "±0.40 ms applied to every other limit",
-        observed=len(gaps),
+        observed=count,
     )
 
 

@@ -9,49 +9,16 @@ from hypothesis import strategies as st
 
 from conformance.judges import wire
 from conformance.protocol.timing import INTER_CHAR_GAP_MAX, TOLERANCE
-from conformance.verdicts import Finding, Verdict
+from conformance.verdicts import Finding
 
 
 def _two_passes(gaps: list[tuple[float, str]], uncertainty: float) -> Finding:
-    """The judge as it was: a list of every (gap, where), filtered twice."""
+    """The judge as it was: a list of every (gap, where), filtered twice, the finding made
+    from the two lists as the judge makes it."""
     band_lo, band_hi = INTER_CHAR_GAP_MAX, INTER_CHAR_GAP_MAX + TOLERANCE
     sure = [(g, w) for g, w in gaps if g - uncertainty > band_lo and g + uncertainty <= band_hi]
     maybe = [(g, w) for g, w in gaps if g + uncertainty > band_lo and g - uncertainty <= band_hi]
-    if sure:
-        gap, where = sure[0]
-        return Finding(
-            "R-7.0-01",
-            Verdict.FAIL,
-            f"gap of {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} relies on the ±0.40 ms "
-            f"tolerance, which the 1.66 ms character gap does not have ({len(sure)} such "
-            "gap(s))",
-            evidence=[where for _, where in sure[:5]],
-            observed=len(gaps),
-            measured_ms=round(gap * 1e3, 3),
-            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
-            uncertainty_ms=round(uncertainty * 1e3, 3),
-        )
-    if maybe:
-        gap, where = maybe[0]
-        return Finding(
-            "R-7.0-01",
-            Verdict.INCONCLUSIVE,
-            f"{len(maybe)} gap(s) such as {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} may lie "
-            "in the 1.66..2.06 ms band, where no tolerance applies",
-            evidence=[where],
-            measured_ms=round(gap * 1e3, 3),
-            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
-            uncertainty_ms=round(uncertainty * 1e3, 3),
-        )
-    if not gaps:
-        return Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no character gap observed")
-    return Finding(
-        "R-7.0-01",
-        Verdict.PASS,
-        f"{len(gaps)} character gaps: none leans on a tolerance the rule does not grant; "
-        "±0.40 ms applied to every other limit",
-        observed=len(gaps),
-    )
+    return wire._tolerance_finding(sure, maybe, len(gaps), uncertainty)
 
 
 gap_values = st.floats(-1e-3, 3e-3, allow_nan=False) | st.sampled_from(
