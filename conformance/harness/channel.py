@@ -96,11 +96,37 @@ class Channel:
             self._buffer += chunk
         if self._buffer:
             raise self.fail(f"unsolicited output {self._buffer[:80]!r}")
-        self.last_sent = line
-        try:
-            os.write(self._write_fd, (line + "\n").encode("ascii"))
-        except OSError as exc:
-            raise self.fail(f"cannot write to the harness ({exc.strerror or exc})") from exc
+        last, self.last_sent = self.last_sent, line
+        self._write((line + "\n").encode("ascii"), last)
+
+    def _write(self, data: bytes, last: str) -> None:
+        """Write ``data`` only while the harness reads its input, ``select.PIPE_BUF`` bytes
+        at a time (never more than the pipe has room for, so no write blocks): a harness
+        that stopped reading (it floods, or hangs) while its output fills its own pipe
+        would otherwise hold the tool in ``os.write`` and the harness in its write for
+        ever, the one hang the channel's bounds did not cover. What the harness writes
+        meanwhile answers no message but ``last``, already answered: a reply too many. No
+        room within ``reply_timeout`` s: hung."""
+        view = memoryview(data)
+        deadline = time.monotonic() + self.reply_timeout
+        while view:
+            left = deadline - time.monotonic()
+            readable, writable, _ = select.select(
+                [self._read_fd], [self._write_fd], [], max(left, 0)
+            )
+            if readable:
+                chunk = self._read_chunk()
+                if not chunk:
+                    raise self.fail("the harness closed its output (exited?)")
+                raise self.fail(f"more than one reply to {last!r}: also {chunk[:80]!r}")
+            if not writable:
+                raise self.fail(
+                    f"the harness has not read its input for {self.reply_timeout:g} s (hung?)"
+                )
+            try:
+                view = view[os.write(self._write_fd, view[: select.PIPE_BUF]) :]
+            except OSError as exc:
+                raise self.fail(f"cannot write to the harness ({exc.strerror or exc})") from exc
 
     def _read_chunk(self) -> bytes:
         try:
@@ -239,8 +265,8 @@ class Channel:
         """Say ``farewell`` if still possible, then release the harness (idempotent)."""
         if self.closed:
             return
-        if farewell is not None:
-            with contextlib.suppress(OSError):
+        if farewell is not None and select.select([], [self._write_fd], [], 0)[1]:
+            with contextlib.suppress(OSError):  # room for it now, or none: never a wait
                 os.write(self._write_fd, (farewell + "\n").encode("ascii"))
         self.closed = True
         self._release()

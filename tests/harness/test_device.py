@@ -179,6 +179,51 @@ def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
     assert channel.proc.returncode is not None
 
 
+@pytest.mark.parametrize("then", ["sleep", "flood"])
+def test_a_harness_that_stops_reading_never_holds_the_tool_in_a_write(tmp_path: Path, then):
+    """A harness that answers hello, then reads no more (asleep, or flooding its output,
+    which fills its own pipe): the tool's messages fill the harness's input, and a plain
+    write would wait for ever (a CI run hung on a flood harness in lockstep). Every write
+    waits at most the reply timeout, and output written meanwhile is a reply too many."""
+    script = tmp_path / "deaf.py"
+    script.write_text(
+        textwrap.dedent(
+            f"""
+            import sys, time
+            sys.stdin.readline()
+            print("hello 1 deaf", flush=True)
+            time.sleep(60 if {then!r} == "sleep" else 0.3)  # the tool fills the input meanwhile
+            while True:
+                sys.stdout.write("idle\\n" * 2000)
+                sys.stdout.flush()
+            """
+        )
+    )
+    channel = ChildChannel(f"{sys.executable} {script}", reply_timeout=0.5)
+    channel.greet(Role.SENSOR)
+    outcome: list[BaseException] = []
+
+    def fill() -> None:
+        try:
+            for n in range(100_000):  # ~3 MB: far beyond any pipe's buffer
+                channel.send(f"time {n:020d}")  # never answered: the harness is not reading
+        except BaseException as exc:  # noqa: BLE001 - handed to the test's thread
+            outcome.append(exc)
+
+    worker = threading.Thread(target=fill, daemon=True)
+    started = time.monotonic()
+    worker.start()
+    worker.join(10)
+    try:
+        assert not worker.is_alive(), "the tool is stuck writing to a harness that stopped reading"
+        assert time.monotonic() - started < 5
+        assert outcome and isinstance(outcome[0], HarnessError), outcome
+        expected = "has not read its input" if then == "sleep" else "more than one reply"
+        assert expected in str(outcome[0]), outcome[0]
+    finally:
+        channel.close()
+
+
 def test_a_run_whose_harness_fell_out_of_step_is_incomplete(misbehaving):
     """The same at run level: verdicts are not drawn from records read out of step."""
     port, pidfile = misbehaving("after-bye", 10**9)
