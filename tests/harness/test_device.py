@@ -153,20 +153,28 @@ def test_a_failing_harness_ends_the_run_with_an_error_not_a_verdict(misbehaving,
 def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
     """A line written unasked while the tool already waits for the next answer is taken as
     that answer, and the stream is one line late from then on; no single line shows it. The
-    end does: an answer arrives after ``bye``, and the records are not trusted."""
+    end does: an answer arrives after ``bye``, and the records are not trusted.
+
+    The harness writes each late line once the tool's next message is in its input (select),
+    not after a sleep: a tool held longer than the sleep (a busy machine) found the line
+    before sending, an "unsolicited output", a right answer to another interleaving."""
     script = tmp_path / "late.py"
     script.write_text(
         textwrap.dedent(
             """
-            import sys, time
+            import select, sys
+
+            def sent_next():  # the tool's next message has arrived (not read yet)
+                select.select([sys.stdin], [], [])
+
             print("hello 1 late", flush=True) if sys.stdin.readline() else None
             sys.stdin.readline()
             print("idle", flush=True)
-            time.sleep(0.3)
-            print("idle", flush=True)  # unasked: the tool has sent its next message by now
+            sent_next()
+            print("idle", flush=True)  # unasked: written before the message it answers is read
             sys.stdin.readline()
-            time.sleep(0.3)
-            print("tx 99 30", flush=True)  # the real answer, one line late
+            sent_next()
+            print("tx 99 30", flush=True)  # the real answer, one line late: after bye
             sys.stdin.readline()
             """
         )
