@@ -150,19 +150,23 @@ def test_a_failing_harness_ends_the_run_with_an_error_not_a_verdict(misbehaving,
     assert reaped(pidfile)
 
 
-def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
+@pytest.mark.parametrize("held", [0.0, 1.5])
+def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path, held: float):
     """A line written unasked while the tool already waits for the next answer is taken as
     that answer, and the stream is one line late from then on; no single line shows it. The
     end does: an answer arrives after ``bye``, and the records are not trusted.
 
     The harness writes each late line once the tool's next message is in its input (select),
     not after a sleep: a tool held longer than the sleep (a busy machine) found the line
-    before sending, an "unsolicited output", a right answer to another interleaving."""
+    before sending, an "unsolicited output", a right answer to another interleaving. The
+    last one comes ``held`` s after ``bye`` (a harness a busy machine held): the tool waits
+    for it as for any answer, up to the reply timeout (30 s here, so that no load decides);
+    it used to stop after 1 s and trusted the records."""
     script = tmp_path / "late.py"
     script.write_text(
         textwrap.dedent(
             """
-            import select, sys
+            import select, sys, time
 
             def sent_next():  # the tool's next message has arrived (not read yet)
                 select.select([sys.stdin], [], [])
@@ -174,12 +178,13 @@ def test_answers_out_of_step_are_caught_when_the_harness_ends(tmp_path: Path):
             print("idle", flush=True)  # unasked: written before the message it answers is read
             sys.stdin.readline()
             sent_next()
+            time.sleep(float(sys.argv[1]))
             print("tx 99 30", flush=True)  # the real answer, one line late: after bye
             sys.stdin.readline()
             """
         )
     )
-    channel = ChildChannel(f"{sys.executable} {script}")
+    channel = ChildChannel(f"{sys.executable} {script} {held}", reply_timeout=30.0)
     channel.greet(Role.SENSOR)
     assert channel.ask("time 1") == "idle"
     assert channel.ask("time 2") == "idle"  # the unasked line, read as the answer
