@@ -198,7 +198,12 @@ def test_a_harness_that_stops_reading_never_holds_the_tool_in_a_write(tmp_path: 
     """A harness that answers hello, then reads no more (asleep, or flooding its output,
     which fills its own pipe): the tool's messages fill the harness's input, and a plain
     write would wait for ever (a CI run hung on a flood harness in lockstep). Every write
-    waits at most the reply timeout, and output written meanwhile is a reply too many."""
+    waits at most the reply timeout, and output written meanwhile is a reply too many.
+    The flooding harness gets a long reply timeout (30 s): with 0.5 s, a harness a busy
+    machine held past it before its flood began was rightly called not reading ("has not
+    read its input"), and which reason came depended on the load (CI-like stress: nice 19
+    beside two CPU burners, 1 of 1 round); now the flood always comes first, and the
+    write still ends at once when it does (the bound below)."""
     script = tmp_path / "deaf.py"
     script.write_text(
         textwrap.dedent(
@@ -213,7 +218,8 @@ def test_a_harness_that_stops_reading_never_holds_the_tool_in_a_write(tmp_path: 
             """
         )
     )
-    channel = ChildChannel(f"{sys.executable} {script}", reply_timeout=0.5)
+    timeout = 0.5 if then == "sleep" else 30.0
+    channel = ChildChannel(f"{sys.executable} {script}", reply_timeout=timeout)
     channel.greet(Role.SENSOR)
     outcome: list[BaseException] = []
 
