@@ -200,10 +200,10 @@ def test_a_harness_that_stops_reading_never_holds_the_tool_in_a_write(tmp_path: 
     write would wait for ever (a CI run hung on a flood harness in lockstep). Every write
     waits at most the reply timeout, and output written meanwhile is a reply too many.
     The flooding harness gets a long reply timeout (30 s): with 0.5 s, a harness a busy
-    machine held past it before its flood began was rightly called not reading ("has not
-    read its input"), and which reason came depended on the load (CI-like stress: nice 19
-    beside two CPU burners, 1 of 1 round); now the flood always comes first, and the
-    write still ends at once when it does (the bound below)."""
+    machine held past it before its flood began was called not reading ("has not read its
+    input": right, but not the flood), and which reason came depended on the load (CI-like
+    stress: nice 19 beside two CPU burners, 1 of 1 round); now the flood is always what is
+    named, and the write still ends at once when it comes (the bound below)."""
     script = tmp_path / "deaf.py"
     script.write_text(
         textwrap.dedent(
@@ -238,8 +238,12 @@ def test_a_harness_that_stops_reading_never_holds_the_tool_in_a_write(tmp_path: 
         assert not worker.is_alive(), "the tool is stuck writing to a harness that stopped reading"
         assert time.monotonic() - started < 5
         assert outcome and isinstance(outcome[0], HarnessError), outcome
-        expected = "has not read its input" if then == "sleep" else "more than one reply"
-        assert expected in str(outcome[0]), outcome[0]
+        # the flood is read while the tool waits to write (a reply too many), or, when the
+        # tool's writer had not filled the pipe yet, before its next message (unsolicited)
+        expected = ["has not read its input"] if then == "sleep" else [
+            "more than one reply", "unsolicited output"
+        ]  # fmt: skip
+        assert any(e in str(outcome[0]) for e in expected), outcome[0]
     finally:
         channel.close()
 
