@@ -20,6 +20,7 @@ import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..atomic import atomic_path
 from . import ARDUINO_DIR, C_DIR
 
 #: Optimisation: the run is about the sketch's decisions on a virtual clock, not its speed.
@@ -134,18 +135,26 @@ def build_arduino(build: ArduinoBuild, compiler: str | None = None) -> Path:
     main_cpp = folder / f"{build.name}.ino.cpp"
     text = joined_sketch(inos)
     if not main_cpp.exists() or main_cpp.read_text() != text:
-        main_cpp.write_text(text)
+        with atomic_path(main_cpp) as joined:  # a compiler reading it meanwhile sees it whole
+            joined.write_text(text)
     probe = compile_command(build, compiler, main_cpp, folder / "sketch")
     digest = _digest(probe)
     out = folder / f"sketch-{digest[:12]}"
     if out.exists():
         return out
-    command = compile_command(build, compiler, main_cpp, out)
-    done = subprocess.run(command, capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        raise KitBuildError(
-            f"the sketch did not compile ({shlex.join(command)}):\n{done.stderr.strip()}"
+    # Built under a temporary name, renamed onto ``out`` once whole: ``out`` existing means
+    # built. Two builds of one sketch at once (two ``kit`` commands, test workers) each
+    # compile; written in place, the second found the first's ``out`` half linked and ran it.
+    with atomic_path(out) as partial:
+        done = subprocess.run(
+            compile_command(build, compiler, main_cpp, partial),
+            capture_output=True,
+            text=True,
+            check=False,
         )
+        if done.returncode != 0:
+            command = shlex.join(compile_command(build, compiler, main_cpp, out))
+            raise KitBuildError(f"the sketch did not compile ({command}):\n{done.stderr.strip()}")
     return out
 
 

@@ -120,7 +120,10 @@ def test_make_bus_refuses_what_sim_refuses():
 
 def test_the_real_time_line_serves_each_sensor_of_the_bus():
     """The served line itself (its thread, the wall clock) with a bus on it: each sensor
-    answers its own aI!, whole, and no other sensor speaks (timing is the realtime tests')."""
+    answers its own aI!, whole, and no other sensor speaks (timing is the realtime tests').
+    The break and the command are put on the line at stated times, not after sleeps: a test
+    thread that a busy machine held for 100 ms between the break and the command left the
+    sensors in standby (R-7.0-15: 100 ms of marking), and the test failed on no fault."""
     import threading
     import time
 
@@ -137,11 +140,10 @@ def test_the_real_time_line_serves_each_sensor_of_the_bus():
     try:
         for address, serial in (("3", "SN0003"), ("1", "SN0002")):
             heard.clear()
-            line.break_on()
-            time.sleep(0.013)
-            line.break_off()
-            time.sleep(0.010)
-            line.tool_bytes(bytes(to_wire_7e1(ord(c)) for c in f"{address}I!"))
+            at = line.now()
+            line.break_on(at)
+            line.break_off(at + 0.013)
+            line.tool_bytes(bytes(to_wire_7e1(ord(c)) for c in f"{address}I!"), at + 0.023)
             deadline = time.monotonic() + 3.0
             while not (heard and heard[-1][1] & 0x7F == 0x0A) and time.monotonic() < deadline:
                 time.sleep(0.005)
