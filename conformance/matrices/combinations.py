@@ -183,6 +183,8 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("high-volume-crc-missing", "high-volume-two-digit-count", "no-follow-up-without-break"),
     # the reply to a command the sensor's service request cut was judged for its address
     ("answers-old-address", "identify-sends-service-request", "value-missing-sign"),
+    # found by the after-landing check of 2026-12-05 (seed 2026 triples), still open:
+    ("measure-ttt-two-digits", "metadata-missing-record", "metadata-r-count-short"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
@@ -193,4 +195,10 @@ CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 
 #: CI combinations the measurement found unexplained, each with its diagnosed class: the
 #: tests expect them to fail (strictly), so a fix of the class shows and shrinks this list.
-KNOWN_OPEN: dict[tuple[str, ...], str] = {}
+KNOWN_OPEN: dict[tuple[str, ...], str] = {
+    ("measure-ttt-two-digits", "metadata-missing-record", "metadata-r-count-short"): (
+        "R-6.2-07 PASSes on the other groups' 276 records while aIM_002! is missing: aM! and "
+        "aIM! both answer 'attn', so group M has no count and its indices are never asked; "
+        "a group without a count needs the records probed until the invalid-index reply"
+    ),
+}
