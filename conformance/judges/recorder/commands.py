@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ...protocol.commands import ADDRESS_CHARS
 from ...protocol.timing import CHAR_TIME, INTER_CHAR_GAP_MAX, TOLERANCE
-from ...transcript import Event, escape
+from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
 from ..tally import Tally
@@ -44,13 +44,9 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
     # shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
     found: list[MeasuredIn] = []
     leaning: list[tuple[float, Transmission]] = []
-    held = 0  # gaps another device's characters filled: the line was not marking
     for s in line.transmissions:
         chars = s.chars
         for a, b in zip(chars, chars[1:], strict=False):
-            if s.contention and _filled(s.contention, a.end, b.start):
-                held += 1
-                continue
             gap = b.start - a.end
             found.append(MeasuredIn(COMMAND_GAP, gap, uncertainty, s))
             if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
@@ -77,19 +73,7 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
         )
     else:
         tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
-    gaps = combine("R-7.0-13", found, "character gap")
-    if held:
-        gaps.detail += (
-            f"; {held} gap(s) between command characters held another device's characters "
-            "(contention, not marking: set aside)"
-        )
-    return [gaps, tol]
-
-
-def _filled(others: list[Event], start: float, end: float) -> bool:
-    """Whether another device's character lies between two command characters (a line
-    that carried it was not marking: the recorder's next character was held behind it)."""
-    return any(e.start >= start and e.end <= end for e in others)
+    return [combine("R-7.0-13", found, "character gap"), tol]
 
 
 def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:
