@@ -373,6 +373,21 @@ def answered_control(controls: Sequence[Exchange], what: str) -> Unmet | None:
     )
 
 
+def acknowledges(probes: Sequence[Exchange], acknowledged: bool, address: str) -> Unmet | None:
+    """Silence to an ``a!`` probe shows something only from a sensor that answers ``a!``:
+    ``acknowledged``, one of its ``a!`` at ``address`` drew a valid reply somewhere in the
+    run. A sensor that answers its other commands but never ``a!`` (R-4.4.1-01 FAILs that)
+    says nothing about waking or about an address by not answering one."""
+    if acknowledged or any(ex.answered for ex in probes):
+        return None
+    return Unmet(
+        "listening",
+        f"the sensor answered no {address}! anywhere in the run (R-4.4.1-01), so its silence "
+        "to the a! probe shows nothing",
+        tuple(cited(ex) for ex in probes[:2]),
+    )
+
+
 def woke(wakes: Sequence[Exchange]) -> Unmet | None:
     """The sensor was shown awake: it answered one of the wake-up ``a!`` (break, a!,
     retries) sent before the probes whose silence or answer is judged."""

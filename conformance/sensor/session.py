@@ -9,7 +9,7 @@ fresh state (aborts, address change) ask for a ``fresh`` stimulus explicitly.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Generic, TypeVar
 
 from ..declaration import Declaration
@@ -47,6 +47,9 @@ class Sweep:
     exchanges: list[Exchange]
     refused: list[str]
     restore_note: str
+    #: Of ``refused``: the addresses the sensor took (its reply named them) and then answered
+    #: no ``b!`` poll at: lost, or a sensor that answers no ``a!`` anywhere.
+    unanswered: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -634,7 +637,7 @@ class SensorSession(Session):
     def address_sweep(self, targets: str) -> Sweep:
         """Change to each address in ``targets`` and back; restore whatever happens."""
         changer = AddressChanger(self.master, self.address)
-        refused = []
+        refused, unanswered = [], []
         try:
             for target in targets:
                 if target == self.address:
@@ -642,13 +645,15 @@ class SensorSession(Session):
                 outcome = changer.change(target)
                 if not outcome.took or outcome.answered_after is None:
                     refused.append(target)
+                if outcome.took and outcome.answered_after is None:
+                    unanswered.append(target)
                 note = changer.restore()
                 if not changer.restored:
                     break
         finally:
             note = changer.restore()
             self.address_notes.append(note)
-        return Sweep(changer.exchanges, refused, note)
+        return Sweep(changer.exchanges, refused, note, unanswered)
 
     def try_invalid_address(self, bad: str) -> InvalidAddressAttempt:
         """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it."""

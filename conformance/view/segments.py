@@ -72,6 +72,12 @@ class Transmission:
     chars: list[Event]
     heard: list[Event] = field(default_factory=list)
     part: int = 0  # which recording of a merged view it belongs to
+    #: The last character of a sensor frame that was still going (no LF, its next character
+    #: due) when this transmission's first character began: the recorder cut into it, so
+    #: what follows the transmission within a character gap is that frame's tail
+    #: (:func:`collided`), never a reply. A line that queues frames (the sim bus, a kit)
+    #: puts the tail right after the command, 0 ms later, where it read as a reply before.
+    cut: Event | None = None
 
     @property
     def text(self) -> str:
@@ -130,7 +136,9 @@ class Transmission:
     def contention(self) -> list[Event]:
         """Sensor characters that started before the command ended, or came back between the
         echoes of its characters (two talkers): never part of a reply."""
-        return list(memo(self, "_contention", self._grown, lambda: collided(self.heard, self.end)))
+        return list(
+            memo(self, "_contention", self._grown, lambda: collided(self.heard, self.end, self.cut))
+        )
 
     @property
     def _grown(self) -> tuple[int, int]:
@@ -178,26 +186,30 @@ class Transmission:
         return f"{escape(self.text)} at t={self.first_char:.3f} s"
 
 
-def collided(heard: list[Event], end: float) -> list[Event]:
+def collided(heard: list[Event], end: float, cut: Event | None = None) -> list[Event]:
     """The sensor characters that met a tool transmission ending at ``end``: those that
     started before it ended or came back between its echoes (two talkers), and the rest of a
     frame that began that way: characters that follow the last collided one within a
     character gap (widened by both stamps' uncertainty) until its LF. A service request that
-    started during the tool's command ends after it; that tail is no reply (issue 18).
+    started during the tool's command ends after it; that tail is no reply (issue 18). So is
+    the tail of a frame the transmission cut into (``cut``, its last character before it:
+    :attr:`Transmission.cut`), as the tool's recorder reads it live.
 
     Where no character met it (nearly every transmission: all started after it ended, none
     a collision) there is no tail either: found by two passes in C, not the loop per
     character (asked of every transmission, by each stimulus's records and the whole run's
     segments)."""
-    if not heard or (min(map(_START, heard)) >= end and COLLISION not in map(_TEXT, heard)):
+    if not heard or (
+        cut is None and min(map(_START, heard)) >= end and COLLISION not in map(_TEXT, heard)
+    ):
         return []
-    return _collided_each(heard, end)
+    return _collided_each(heard, end, cut)
 
 
-def _collided_each(heard: list[Event], end: float) -> list[Event]:
+def _collided_each(heard: list[Event], end: float, cut: Event | None = None) -> list[Event]:
     """:func:`collided`, character by character."""
     out: list[Event] = []
-    prev: Event | None = None  # the character before ``e``, when it collided
+    prev: Event | None = cut  # the character before ``e``, when it collided (or was cut)
     for e in heard:
         met = e.start < end or e.text == COLLISION
         tail = prev is not None and continues_frame(
@@ -475,6 +487,7 @@ def _cut(
     pending: Event | None = None
     current: Transmission | None = None
     is_command = False  # current.is_command, kept as its characters come (asked per event)
+    last_heard: Event | None = None  # the sensors' last character so far
     for e, own in zip(ordered, mine, strict=True):
         if e.kind is EventKind.CHAR:
             chars.append(e)
@@ -483,7 +496,7 @@ def _cut(
                 breaks.append(e)
                 pending, current = e, None
             elif current is None or (is_command and e.start - current.end >= NEW_COMMAND):
-                current = Transmission(pending, [e], part=part)
+                current = Transmission(pending, [e], part=part, cut=_cut_into(last_heard, e))
                 transmissions.append(current)
                 pending = None
                 is_command = e.wire & 0x7F == _BANG
@@ -491,11 +504,21 @@ def _cut(
                 current.chars.append(e)
                 is_command = e.wire & 0x7F == _BANG
         elif e.kind is EventKind.CHAR:
+            last_heard = e
             if current is not None:
                 current.heard.append(e)
             else:
                 unanswerable.append(e)
     return TranscriptView(transmissions, breaks, chars, unanswerable, undirected)
+
+
+def _cut_into(last: Event | None, first: Event) -> Event | None:
+    """``last``, the sensors' last character before a transmission whose first character is
+    ``first``, if its frame was still going then (:attr:`Transmission.cut`)."""
+    if last is None:
+        return None
+    slack = max(last.uncertainty, first.uncertainty)
+    return last if continues_frame(last, first, last.end, slack) else None
 
 
 def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:

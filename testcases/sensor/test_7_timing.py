@@ -81,6 +81,14 @@ def _shown_asleep(sensor, case):
     return None
 
 
+def _acknowledges(sensor, probes):
+    """The "listening" outcome for silence to ``a!`` probes: it shows something only from a
+    sensor that answered an ``a!`` somewhere in the run (not one that answers its other
+    commands only)."""
+    acked = sensor.address in sensor.master.acknowledged
+    return precondition.acknowledges(probes, acked, sensor.address)
+
+
 def _hears_after_a_break(sensor, case, what: str) -> bool:
     """Silence to a probe sent after a hand-made pulse counts only if the sensor, put to
     sleep the same way, answers an a! sent after a real break with the same marking: one
@@ -139,7 +147,7 @@ def test_short_spacing_is_not_a_break(sensor, case):
 
 
 @requirements("R-7.0-04")
-@pytest.mark.preconditions("standby", "awake")
+@pytest.mark.preconditions("standby", "awake", "listening")
 def test_break_just_over_12ms_wakes(sensor, case):
     """Spacing longer than 12 ms is always a break: after a 12.6 ms break the sensor answers
     (the command is repeated without a break as a recorder's retries would be, so a sensor
@@ -188,6 +196,8 @@ def test_break_just_over_12ms_wakes(sensor, case):
         )
     elif not case.requires("awake", unheard):
         pass  # silence from a sensor that may lawfully be asleep again
+    elif not case.requires("listening", _acknowledges(sensor, tries)):
+        pass  # silence to a! from a sensor that answers no a!
     elif any(t.answered for t in tries):
         case.add(
             passed(
@@ -211,7 +221,7 @@ def test_break_just_over_12ms_wakes(sensor, case):
 
 
 @requirements("R-7.0-05")
-@pytest.mark.preconditions("awake")
+@pytest.mark.preconditions("awake", "listening")
 def test_marking_after_break(sensor, case):
     """After a break the sensor looks for its address once 8.33 ms of marking have passed:
     it answers a command sent then, and (decision A18) ignores one sent sooner."""
@@ -268,6 +278,8 @@ def test_marking_after_break(sensor, case):
         unheard = replace(unheard, detail=unheard.detail + aimed.missed)
     if not case.requires("awake", unheard):
         return  # an unanswered command the sensor need no longer have heard
+    if not case.requires("listening", _acknowledges(sensor, [ok])):
+        return  # silence to a! from a sensor that answers no a!
     found = judge.answered(
         "R-7.0-05",
         [ok],
@@ -311,7 +323,7 @@ def test_marking_after_break(sensor, case):
 
 
 @requirements("R-7.0-07")
-@pytest.mark.preconditions("awake")
+@pytest.mark.preconditions("awake", "listening")
 def test_ready_within_100ms_of_break(sensor, case):
     """Within 100 ms of a break the sensor can take a command: one sent 90 ms after it."""
     case.expect("a reply to a! whose start bit comes 90 ms after the break")
@@ -342,7 +354,9 @@ def test_ready_within_100ms_of_break(sensor, case):
         + aimed.missed,
         (f"t={brk.start:.4f} s: break", judge.cited(ex)),
     )
-    if case.requires("awake", late if aimed.landed is None else None):
+    if case.requires("awake", late if aimed.landed is None else None) and case.requires(
+        "listening", _acknowledges(sensor, [ex])
+    ):
         case.add(
             judge.answered(
                 "R-7.0-07",

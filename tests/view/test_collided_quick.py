@@ -36,6 +36,14 @@ def test_quick_answer_is_the_loops(events):
     assert collided(events, END) == _collided_each(events, END)
 
 
+@given(heard(), st.sampled_from(["0", "\n"]), st.sampled_from([0.08, END - 8.33e-3, END]))
+def test_quick_answer_is_the_loops_after_a_cut_frame(events, char, at):
+    """With a frame the transmission cut into (its last character before it), the loop runs
+    whatever the characters' times: a tail right after the transmission is that frame's."""
+    cut = Event(EventKind.CHAR, DUT, at - 8.33e-3, at, to_wire_7e1(ord(char)))
+    assert collided(events, END, cut) == _collided_each(events, END, cut)
+
+
 def test_nothing_met():
     late = [
         Event(EventKind.CHAR, DUT, END + 0.01 * i, END + 0.01 * i + 8.3e-3, 0x30) for i in range(3)

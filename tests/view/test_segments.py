@@ -201,6 +201,31 @@ def test_the_tail_of_a_frame_that_met_the_command_is_no_reply():
     assert len(seg.contention) == 3 and seg.reply[0] is reply[0]
 
 
+def test_the_tail_of_a_frame_the_command_cut_into_is_no_reply():
+    """A late reply that began at the end of the tool's retry break, its characters back to
+    back, cut by the retried command after the break's marking (the line queues the rest behind
+    the command, as the Arduino kit and the simulated bus do): the rest is that reply's tail,
+    not a reply begun 0 ms after the command (before: a 0.00 ms R-7.0-09 FAIL on the outside
+    Due sensor of tests/e2e/test_outside_sensors.py). The tool's recorder reads it so live."""
+    first = _chars(TOOL, "0D0!", 0.0)
+    brk = Event(EventKind.BREAK, TOOL, first[-1].end + 30e-3, first[-1].end + 43e-3)
+    head = _chars(DUT, "0+", brk.end)  # the late reply to the first 0D0!
+    retry = _chars(TOOL, "0D0!", head[-1].end)  # back to back with it: it was still going
+    tail = _chars(DUT, "1.5\r\n", retry[-1].end)
+    events = [*first, brk, *head, *retry, *tail]
+    _, t = read_view(events).transmissions
+    assert t.cut is head[-1]
+    assert t.reply == [] and [e.char7 for e in t.contention] == [e.char7 for e in tail]
+    seg = wire.segments(events)[1]
+    assert seg.reply == [] and len(seg.contention) == len(tail)
+    # a reply after a frame that had ended (its LF came) is the command's, as before
+    done = _chars(DUT, "0+2\r\n", brk.end)
+    again = _chars(TOOL, "0D0!", done[-1].end)
+    reply = _chars(DUT, "0+1.5\r\n", again[-1].end + 9e-3)
+    _, t = read_view([*first, brk, *done, *again, *reply]).transmissions
+    assert t.cut is None and t.reply == reply
+
+
 @pytest.mark.parametrize("profile", ["quick-ready", "prompt-sr"])
 def test_a_sensor_whose_service_request_comes_early_draws_no_fail(profile, tmp_path):
     """Both legal profiles send their service request long before ttt; whatever the tool's

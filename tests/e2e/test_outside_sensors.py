@@ -1,0 +1,68 @@
+"""False FAILs the after-landing check of 2026-12-05 (ninth round) found on an outside sensor.
+
+An Arduino Due student sensor (TonyN678/Sdi12-Sensor, docs/kit.md) answers ``?!``, ``aAb!``,
+``aM!``, ``aD0!`` and ``aR0!`` but never ``a!``; it replies 15 ms after a command and, for
+50 ms after each reply, leaves new commands unread (they are answered late, from its buffer).
+Two things the tool said about it were false:
+
+- every rule probed with ``a!`` (R-7.0-04, -05, -07 on waking; R-4.3-03 and R-4.4.4-03 on
+  answering at a new address) FAILed on the silence of a sensor that answers no ``a!`` at all:
+  that silence is R-4.4.1-01's FAIL, and says nothing about waking or addresses. Now they are
+  INCONCLUSIVE "precondition not met: listening" unless the sensor answered an ``a!`` somewhere
+  in the run (``ToolRecorder.acknowledged``, ``preconditions.acknowledges``);
+- a late reply that began during the tool's retry break went out at the break's end, and the
+  tool's command after the break's marking cut it in two (the line queued the rest behind the
+  command): the rest read as a reply begun 0 ms after the command, a R-7.0-09 FAIL. The tool's
+  recorder already took that tail for contention live; now the view does too
+  (``Transmission.cut``, tests/view/test_segments.py).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.conduct import run_once
+from conformance.emulator.faults import FaultSet
+from conformance.emulator.replies import ReplyKind
+
+#: The cases that probe with a! (and R-4.4.1-01's own).
+A_PROBES = (
+    "test_acknowledge_active or test_address_range or test_change_address or "
+    "test_ready_within_100ms_of_break or test_break_just_over_12ms_wakes or "
+    "test_marking_after_break"
+)
+#: The rules those cases judged on the silence of a sensor that answers no a!.
+ON_A_SILENCE = ("R-4.3-03", "R-4.4.4-03", "R-7.0-04", "R-7.0-05", "R-7.0-07")
+
+
+def _verdicts(data: dict) -> dict[str, dict]:
+    return {r["id"]: r for r in data["requirements"]}
+
+
+@pytest.fixture
+def a_never_answered(monkeypatch):
+    """The simulated sensor, every reply as usual but ``a!``'s (the Due sensor's way)."""
+    usual = FaultSet.rewrite
+
+    def rewrite(self, reply):
+        return None if reply.kind is ReplyKind.ACKNOWLEDGE else usual(self, reply)
+
+    monkeypatch.setattr(FaultSet, "rewrite", rewrite)
+
+
+def test_a_sensor_that_never_answers_a_is_judged_on_a_only_by_r_4_4_1_01(a_never_answered):
+    found = _verdicts(run_once("sim://", keyword=A_PROBES))
+    assert found["R-4.4.1-01"]["verdict"] == "FAIL"
+    for rid in ON_A_SILENCE:
+        assert found[rid]["verdict"] == "INCONCLUSIVE", (rid, found[rid]["findings"])
+        details = " ".join(f["detail"] for f in found[rid]["findings"])
+        assert "answered no 0!" in details, (rid, details)
+    assert found["R-4.4.4-01"]["verdict"] == "PASS"  # it took the new address: its reply says so
+
+
+def test_the_same_cases_still_fail_a_sensor_that_answers_a_but_wakes_too_slowly():
+    """The precondition holds wherever an a! was answered: slow-wake (110 ms after a break,
+    its retries answered) still FAILs R-7.0-07 on the silence of its first try."""
+    found = _verdicts(run_once("sim://?faults=slow-wake", keyword=A_PROBES))
+    assert found["R-7.0-07"]["verdict"] == "FAIL"
+    assert found["R-4.4.1-01"]["verdict"] == "PASS"
