@@ -375,8 +375,8 @@ def answered_control(controls: Sequence[Exchange], what: str) -> Unmet | None:
 
 def acknowledges(probes: Sequence[Exchange], acknowledged: bool, address: str) -> Unmet | None:
     """Silence to an ``a!`` probe shows something only from a sensor that answers ``a!``:
-    ``acknowledged``, one of its ``a!`` at ``address`` drew a valid reply somewhere in the
-    run. A sensor that answers its other commands but never ``a!`` (R-4.4.1-01 FAILs that)
+    ``acknowledged``, one of its ``a!`` at ``address`` drew a reply (valid or not) somewhere
+    in the run. A sensor that answers its other commands but never ``a!`` (R-4.4.1-01 FAILs that)
     says nothing about waking or about an address by not answering one."""
     if acknowledged or any(ex.answered for ex in probes):
         return None

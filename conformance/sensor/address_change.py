@@ -67,11 +67,20 @@ class AddressChanger:
         """Put the sensor back at its original address and check that it answers there;
         returns a note for the report. A change whose reply was unclear may still have
         happened, so every address tried is asked to move back until the original answers."""
+        back = None
         if self.current != self.original:
-            self.change(self.original, wait_for_answer=False)
+            back = self.change(self.original, wait_for_answer=False)
         if self._answers(self.original):
             self.current, self.restored = self.original, True
             return f"address restored to '{self.original}' (it answers there)"
+        if back is not None and back.took and not self.master.acknowledged:
+            # a sensor that answers no a! anywhere cannot be checked that way: its reply is
+            # all there is (restored stays None: unchecked, so an address sweep stops)
+            self.current, self.restored = self.original, None
+            return (
+                f"address moved back to '{self.original}' by its reply to "
+                f"{back.request.text} (not checked: the sensor answers no a! anywhere)"
+            )
         for tried in dict.fromkeys(self.tried):
             if tried == self.original:
                 continue

@@ -83,9 +83,9 @@ class ToolRecorder:
         self._collided: set[tuple[float, float]] = set()  # tool events already noted
         self._apart = ApartSoFar()  # the collision scan's shortcut, read on as events come
         self._dut_end = _LastDutChar()  # the end of the DUT's last character, kept up to date
-        #: Addresses whose ``a!`` drew a valid reply so far: silence to an ``a!`` probe
-        #: (a wake-up, a poll at a new address) is evidence only from a sensor shown to
-        #: answer ``a!`` at all (:func:`~conformance.preconditions.acknowledges`).
+        #: Addresses whose ``a!`` drew a reply so far (valid or not, not contention): silence
+        #: to an ``a!`` probe (a wake-up, a poll at a new address) is evidence only from a
+        #: sensor shown to answer ``a!`` at all (:func:`~conformance.preconditions.acknowledges`).
         self.acknowledged: set[str] = set()
 
     # -- single commands -------------------------------------------------------------------
@@ -518,7 +518,7 @@ class ToolRecorder:
             state = f"invalid: bus contention ({len(collided)} characters during the command)"
         elif state is None:
             state = self._judge_reply(reply, command, address, command_end, framing, crc)
-        if state == OK and command is not None and command.kind is Kind.ACKNOWLEDGE:
+        if reply and not collided and command is not None and command.kind is Kind.ACKNOWLEDGE:
             self.acknowledged.add(address)
         return Attempt(
             break_event, sent, reply, state, self.link.now(), stray_events=stray + collided

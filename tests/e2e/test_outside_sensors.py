@@ -9,7 +9,9 @@ Two things the tool said about it were false:
   answering at a new address) FAILed on the silence of a sensor that answers no ``a!`` at all:
   that silence is R-4.4.1-01's FAIL, and says nothing about waking or addresses. Now they are
   INCONCLUSIVE "precondition not met: listening" unless the sensor answered an ``a!`` somewhere
-  in the run (``ToolRecorder.acknowledged``, ``preconditions.acknowledges``);
+  in the run (``ToolRecorder.acknowledged``, ``preconditions.acknowledges``); its address,
+  moved back after a change, was reported "COULD NOT restore" (checked with ``a!``): now
+  "moved back ... by its reply ... (not checked)";
 - a late reply that began during the tool's retry break went out at the break's end, and the
   tool's command after the break's marking cut it in two (the line queued the rest behind the
   command): the rest read as a reply begun 0 ms after the command, a R-7.0-09 FAIL. The tool's
@@ -58,6 +60,9 @@ def test_a_sensor_that_never_answers_a_is_judged_on_a_only_by_r_4_4_1_01(a_never
         details = " ".join(f["detail"] for f in found[rid]["findings"])
         assert "answered no 0!" in details, (rid, details)
     assert found["R-4.4.4-01"]["verdict"] == "PASS"  # it took the new address: its reply says so
+    # and went back by its reply: never "COULD NOT restore" (its a! being the only check)
+    note = found["R-4.4.4-01"]["findings"][0]["detail"]
+    assert "moved back to '0' by its reply" in note and "COULD NOT" not in note, note
 
 
 def test_the_same_cases_still_fail_a_sensor_that_answers_a_but_wakes_too_slowly():
