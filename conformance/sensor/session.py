@@ -570,6 +570,15 @@ class SensorSession(Session):
         )
         return None
 
+    def acknowledgement(self, probes: list[Exchange]) -> list[Exchange]:
+        """The controls for silence to ``a!`` ``probes``: whether the sensor answers ``a!`` at
+        all (:func:`~conformance.preconditions.acknowledges`). None are needed when a probe
+        was answered or an ``a!`` at its address drew a reply earlier in the run; else one
+        ``a!`` now, after a break and with retries, as a recorder wakes a sensor."""
+        if any(ex.answered for ex in probes) or self.address in self.master.acknowledged:
+            return []
+        return [self.master.transact(f"{self.address}!", force_break=True)]
+
     def heard_probe(self, text: str, *, control_address: str | None = None) -> HeardProbe:
         """Send ``text`` once after a break with :meth:`hearing_marking`, then the control:
         ``a!`` (at ``control_address``, default the sensor's) sent the same way."""

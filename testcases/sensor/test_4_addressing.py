@@ -150,6 +150,7 @@ def test_address_range(sensor, case):
     polls = [ex for ex in sweep.exchanges if ex.command and ex.command.kind is Kind.ACKNOWLEDGE]
     unheard = None
     if refused and set(refused) <= set(sweep.unanswered):
+        polls += sensor.acknowledgement(polls)
         acked = sensor.address in sensor.master.acknowledged
         unheard = precondition.acknowledges(polls, acked, sensor.address)
     if not alone:

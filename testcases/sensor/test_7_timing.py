@@ -83,8 +83,9 @@ def _shown_asleep(sensor, case):
 
 def _acknowledges(sensor, probes):
     """The "listening" outcome for silence to ``a!`` probes: it shows something only from a
-    sensor that answered an ``a!`` somewhere in the run (not one that answers its other
-    commands only)."""
+    sensor that answers an ``a!`` (in the run so far, or to a control sent now), not one
+    that answers its other commands only."""
+    probes = [*probes, *sensor.acknowledgement(probes)]
     acked = sensor.address in sensor.master.acknowledged
     return precondition.acknowledges(probes, acked, sensor.address)
 

@@ -8,8 +8,9 @@ Two things the tool said about it were false:
 - every rule probed with ``a!`` (R-7.0-04, -05, -07 on waking; R-4.3-03 and R-4.4.4-03 on
   answering at a new address) FAILed on the silence of a sensor that answers no ``a!`` at all:
   that silence is R-4.4.1-01's FAIL, and says nothing about waking or addresses. Now they are
-  INCONCLUSIVE "precondition not met: listening" unless the sensor answered an ``a!`` somewhere
-  in the run (``ToolRecorder.acknowledged``, ``preconditions.acknowledges``); its address,
+  INCONCLUSIVE "precondition not met: listening" unless the sensor answered an ``a!`` earlier in
+  the run or a control ``a!`` sent after the silent probe (``ToolRecorder.acknowledged``,
+  ``SensorSession.acknowledgement``, ``preconditions.acknowledges``); its address,
   moved back after a change, was reported "COULD NOT restore" (checked with ``a!``): now
   "moved back ... by its reply ... (not checked)";
 - a late reply that began during the tool's retry break went out at the break's end, and the
