@@ -441,14 +441,24 @@ class _Certified:
         tick_rate, t0 = line.tick_rate, line.t0
         self.batch = Batch(
             [],
-            (t0 + s / tick_rate).tolist(),
-            (t0 + end / tick_rate).tolist(),
+            *_stamps(t0 + s / tick_rate, t0 + end / tick_rate),
             wire.tolist(),
             self.framing_error,
             parity_error.tolist(),
             [None if v != v else v for v in err.tolist()],
             glitches.tolist(),
         )
+
+
+def _stamps(starts: np.ndarray, ends: np.ndarray) -> tuple[list[float], list[float]]:
+    """The frames' start and end stamps as lists of floats, a start equal to the end before
+    it (back-to-back characters: most of a reply's) the same float object as that end, not
+    a second one: an event holds 24 bytes less, the same values (an hour of a busy bus:
+    about 200,000 of its 357,000 events)."""
+    first, last = starts.tolist(), ends.tolist()
+    for i in np.flatnonzero((starts[1:] == ends[:-1]) & (starts[1:] != 0.0)).tolist():
+        first[i + 1] = last[i]
+    return first, last
 
 
 def _fitted(

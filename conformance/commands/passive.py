@@ -158,9 +158,14 @@ def _run_jobs(jobs: list[RoleJob], port: str, args: PassiveJob, console: Console
 
     codes: list[int] = []
     done: list[tuple[RoleJob, dict[str, Any]]] = []
-    for job in jobs:
+    for i, job in enumerate(jobs):
         result = _run_role(job, port, args, console)
         code, data = result.pytest_code, result.document
+        if result.run is not None:
+            # its session (its share of the records) is held by the run's pytest objects,
+            # cyclic garbage that lives until the next full collection: let it go now
+            result.run.session = None
+        release(port, jobs[i + 1 :])
         if GUARD.requested and data is None:  # Ctrl-C before this run wrote its verdicts
             return EXIT_INCOMPLETE
         if data is None:  # the run wrote no verdicts (its own, never a file's)
@@ -177,6 +182,21 @@ def _run_jobs(jobs: list[RoleJob], port: str, args: PassiveJob, console: Console
             return EXIT_INCOMPLETE
     print_sensors(console, [(j.address, d, j.report_dir) for j, d in done if j.of_bus])
     return worst_exit(codes)
+
+
+def release(port: str, later: list[RoleJob]) -> None:
+    """Drop the loaded recording's rebuilt records that none of the ``later`` runs reads
+    (:func:`~conformance.offline.heard.release_records`): each sensor's once it is judged,
+    all of them before the recorder's run, so that run's peak does not hold them. Nothing
+    when a later run judges every sensor together (no ``--address``, one sensor)."""
+    from ..offline.fixtures import _LOADED
+    from ..offline.heard import release_records
+
+    link = _LOADED.get(port)
+    sensors = [j.address for j in later if j.role == "sensor"]
+    if link is None or None in sensors:
+        return
+    release_records(link, {a for a in sensors if a is not None})
 
 
 def worst_exit(codes: list[int]) -> int:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_left
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Collection, Iterable, Iterator
 from dataclasses import dataclass, field
 from itertools import islice, takewhile
 from operator import le
@@ -202,17 +202,20 @@ def _by_address(items: Iterable[T], address_of: Callable[[T], str]) -> dict[str,
 
 @dataclass(frozen=True)
 class _PerSensor:
-    """The recording's records and segments, each list split by sensor address once."""
+    """The recording's records and segments, each list split by sensor address once;
+    ``released``: the addresses whose share :func:`release_records` dropped."""
 
     exchanges: dict[str, list[Exchange]]
     measurements: dict[str, list[Measurement]]
     segments: dict[str, list[Segment]]
+    released: set[str] = field(default_factory=set)
 
 
-def _per_sensor(link: RecordingLink) -> _PerSensor:
+def _per_sensor(link: RecordingLink, address: str | None = None) -> _PerSensor:
     """Every sensor's share of the recording, split in one pass per list: a bus of ten
     sensors is judged in ten runs, and each filtering the whole recording again cost an
-    hour's capture seconds."""
+    hour's capture seconds. Split again (from records rebuilt again) if ``address``'s share
+    was released: the same records, since they are a pure function of the recording."""
 
     def split() -> _PerSensor:
         _view, rebuilt = heard_records(link)
@@ -222,7 +225,31 @@ def _per_sensor(link: RecordingLink) -> _PerSensor:
             _by_address(transcript_segments(link.transcript), lambda s: s.text),
         )
 
-    return memo(link, "_per_sensor", len(link.transcript.events), split)
+    n = len(link.transcript.events)
+    mine = memo(link, "_per_sensor", n, split)
+    if address is not None and address in mine.released:
+        link.__dict__.pop("_per_sensor")
+        mine = memo(link, "_per_sensor", n, split)
+    return mine
+
+
+def release_records(link: RecordingLink, keep: Collection[str]) -> None:
+    """Drop the records rebuilt from ``link`` that no later run reads: the whole lists, and
+    every sensor's share but those of the addresses in ``keep`` (the sensors still to be
+    judged). A passive judgement of a bus judges its sensors one after the other and the
+    recorder last, which reads the view and the segments only; keeping every sensor's
+    records to the end held them all at the recorder run's peak (about 0.4 MB a minute of
+    a busy capture). A run that asks again gets them rebuilt, the same (:func:`_per_sensor`,
+    :func:`heard_records`), so what is judged never depends on what was released."""
+    link.__dict__.pop("_heard_records", None)
+    held = link.__dict__.get("_per_sensor")
+    if held is None:
+        return
+    mine: _PerSensor = held[1]
+    for address in [a for a in mine.exchanges if a not in keep]:
+        mine.exchanges.pop(address, None)
+        mine.measurements.pop(address, None)
+        mine.released.add(address)
 
 
 def _qualities(link: RecordingLink) -> dict[str, str | None]:
@@ -250,18 +277,23 @@ def _shared_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     )
 
 
-def _bus_sensors(link: RecordingLink, exchanges: list[Exchange]) -> list[BusSensor]:
+def _bus_sensors(link: RecordingLink) -> list[BusSensor]:
     """:func:`sensors_on` the recording's exchanges, found once per loaded recording."""
-    return list(memo(link, "_on_bus", len(link.transcript.events), lambda: sensors_on(exchanges)))
+
+    def find() -> list[BusSensor]:
+        return sensors_on(heard_records(link)[1].exchanges)
+
+    return list(memo(link, "_on_bus", len(link.transcript.events), find))
 
 
 def hear_sensors(link: RecordingLink, address: str | None, version: str | None) -> HeardSensors:
-    view, rebuilt = heard_records(link)
+    view = transcript_view(link.transcript)  # the one heard_records rebuilt records from
     if address is None:
+        _view, rebuilt = heard_records(link)
         segments = list(transcript_segments(link.transcript))
         exchanges, measurements = list(rebuilt.exchanges), list(rebuilt.measurements)
     else:
-        mine = _per_sensor(link)
+        mine = _per_sensor(link, address)
         exchanges = list(mine.exchanges.get(address, ()))
         measurements = list(mine.measurements.get(address, ()))
         segments = list(mine.segments.get(address, ()))
@@ -273,7 +305,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         exchanges=exchanges,
         measurements=measurements,
         segments=segments,
-        on_bus=_bus_sensors(link, rebuilt.exchanges),
+        on_bus=_bus_sensors(link),
     )
     for m in heard.measurements:
         m.aborted_by = disturbance(m, view)
@@ -281,11 +313,12 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     heard.assumptions = _shared_notes(link, view)
     if link.decoded is not None:  # a capture: how well this sensor's own characters read
         who = f"sensor {address!r}" if address is not None else "the sensor(s)"
-        if address is None:
+        found = _qualities(link) if address is not None else {}
+        if address in found:
+            quality = found[address]
+        else:  # all the sensors, or one whose share was released before the notes were made
             chars = sensor_characters(heard.exchanges)
             quality = decode_quality(link.decoded, link.transcript.events, chars, who)
-        else:
-            quality = _qualities(link).get(address)
         if quality is not None:
             heard.assumptions.append(quality)
     if cut:
@@ -415,12 +448,12 @@ def _identify(heard: HeardSensors) -> None:
 
 
 def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
-    view, rebuilt = heard_records(link)
+    view = transcript_view(link.transcript)  # the recorder rules read no rebuilt record
     heard = HeardRecorder(
         link,
         view,
         forced_version=normalise_version(version) if version else None,
-        on_bus=_bus_sensors(link, rebuilt.exchanges),
+        on_bus=_bus_sensors(link),
     )
     heard.assumptions = _shared_notes(link, view)
     if heard.forced_version is None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..timing import MeasuredAsJudged, Window, judge_window
+from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
 from .common import SR_KINDS, combine
 from .measurements import service_request_end
 
@@ -22,25 +22,27 @@ def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
     # at least a frame: its length, and so where it ended, carries that event's own doubt
     # one judged interval each, its finding made only where the verdict shows it (an hour
     # of a busy bus holds 15,000 breaks)
-    lengths = [
-        MeasuredAsJudged(
-            BREAK_LENGTH,
-            b.duration,
-            max(uncertainty, b.duration_uncertainty or 0.0),
-            [f"break at t={b.start:.3f} s"],
+    # an interval equal to one judged before is that one again (Repeats), so the breaks
+    # hold one object per distinct length and marking
+    lengths: list[MeasuredAsJudged] = []
+    seen: Repeats[MeasuredAsJudged] = Repeats()
+    for b in line.breaks:
+        length, u = b.duration, max(uncertainty, b.duration_uncertainty or 0.0)
+        lengths.append(
+            seen.first(length, u)
+            or seen.keep(MeasuredAsJudged(BREAK_LENGTH, length, u, [f"break at t={b.start:.3f} s"]))
         )
-        for b in line.breaks
-    ]
-    markings = [
-        MeasuredAsJudged(
-            MARKING,
-            s.first_char - s.break_event.end,
-            max(uncertainty, s.break_event.duration_uncertainty or 0.0),
-            [f"before {s.at()}"],
+    markings: list[MeasuredAsJudged] = []
+    seen = Repeats()
+    for s in line.transmissions:
+        if s.break_event is None:
+            continue
+        marking = s.first_char - s.break_event.end
+        u = max(uncertainty, s.break_event.duration_uncertainty or 0.0)
+        markings.append(
+            seen.first(marking, u)
+            or seen.keep(MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"]))
         )
-        for s in line.transmissions
-        if s.break_event is not None
-    ]
     return [combine("R-7.0-02", lengths, "break"), combine("R-7.0-06", markings, "marking")]
 
 

@@ -9,7 +9,7 @@ from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
 from ..tally import Tally
-from ..timing import MeasuredIn, Window
+from ..timing import MeasuredIn, Repeats, Window
 from ..wire import judge_frame_lengths, judge_rate
 from .common import combine
 
@@ -44,11 +44,16 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
     # shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
     found: list[MeasuredIn] = []
     leaning: list[tuple[float, Transmission]] = []
+    # a gap equal to one judged before is that interval again (its first one: Repeats)
+    judged: Repeats[MeasuredIn] = Repeats()
     for s in line.transmissions:
         chars = s.chars
         for a, b in zip(chars, chars[1:], strict=False):
             gap = b.start - a.end
-            found.append(MeasuredIn(COMMAND_GAP, gap, uncertainty, s))
+            found.append(
+                judged.first(gap, uncertainty)
+                or judged.keep(MeasuredIn(COMMAND_GAP, gap, uncertainty, s))
+            )
             if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
                 leaning.append((gap, s))
     if leaning:
