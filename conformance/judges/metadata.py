@@ -7,7 +7,8 @@ import re
 from ..protocol.responses import parse_measurement_reply_for, parse_metadata_reply, split_line
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import escape
-from ..verdicts import Finding
+from ..verdicts import Finding, inconclusive
+from .cite import cite, shown
 from .tally import Tally
 
 SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
@@ -40,6 +41,34 @@ def identify_matches(pairs: list[tuple[Exchange, Measurement]]) -> list[Finding]
                 "R-6.1-02", label, f"ttt {pa.ttt} differs from {m.command}'s {pb.ttt}", warning=True
             )
     return tally.findings("same reply as the measurement command")
+
+
+def announced_count(ident: Exchange) -> int | None:
+    """The value count an identify-measurement reply announces (None: no reply, or none
+    readable in it)."""
+    if not ident.answered or ident.command is None:
+        return None
+    body, _ = split_line(ident.reply_text)
+    return parse_measurement_reply_for(body, ident.command).count
+
+
+def uncounted_groups(groups: list[tuple[Exchange, Exchange]]) -> list[Finding]:
+    """R-6.2-07 for the measurements (start exchange, identify exchange) of which neither
+    reply gave a value count although one of them answered: their records cannot be
+    checked against a count, so the rule is INCONCLUSIVE for them, whatever the other
+    groups' records showed (a FAIL found there still stands). Observed: those replies."""
+    if not groups:
+        return []
+    listed = "; ".join(f"{shown(start)}, {shown(ident)}" for start, ident in groups[:3])
+    more = f" (+{len(groups) - 3} more)" if len(groups) > 3 else ""
+    return [
+        inconclusive(
+            "R-6.2-07",
+            f"no value count to check the records against: {listed}{more}",
+            evidence=cite(ex for pair in groups for ex in pair),
+            observed=len(groups),
+        )
+    ]
 
 
 def records(exchanges: list[tuple[Exchange, bool, bool]], ids: tuple[str, ...]) -> list[Finding]:
