@@ -73,7 +73,7 @@ def test_crc_presence(sensor, case):
 def test_crc_request_ends_with_its_command(sensor, case):
     """A CRC asked for on a metadata command (aIMC_001!) is for that reply only: the D
     replies of a plain aM! after it carry no CRC."""
-    # aM! stands for the first plain measurement that delivered values, and aIMC_001! for
+    # aM! stands for the first plain measurement that announced values, and aIMC_001! for
     # its CRC twin's metadata command (aMC!'s for aV!): see _plain_with_values
     case.expect("aIMC_001!, then aM! and its D replies without a CRC")
     if not sensor.is_v14:
@@ -84,7 +84,7 @@ def test_crc_request_ends_with_its_command(sensor, case):
         "supported",
         precondition.shown_supported(
             plain is not None,
-            "no plain measurement (aM!, aMn!, aV!, aC!, aCn!) delivered values, so no D "
+            "no plain measurement (aM!, aMn!, aV!, aC!, aCn!) announced values, so no D "
             "reply could show a CRC that outlived its command",
         ),
     ):
@@ -106,11 +106,12 @@ def test_crc_request_ends_with_its_command(sensor, case):
 
 
 def _plain_with_values(sensor):
-    """The first plain measurement (aM! first) that delivered values: a fixed aM! left
-    this case nothing to judge when aM! announced none, and the PASS of the D replies read
-    before any CRC metadata command then stood alone (issue 22, after-landing check:
+    """The first plain measurement (aM! first) that announced values, so D replies follow
+    it (empty ones too show a CRC that outlived its command): a fixed aM! left this case
+    nothing to judge when aM! announced none, and the PASS of the D replies read before any
+    CRC metadata command then stood alone (issue 22, after-landing check:
     measure-count-zero + metadata-crc-sticks)."""
-    return next((m for m in sensor.family(PLAIN_CODES) if m.value_count), None)
+    return next((m for m in sensor.family(PLAIN_CODES) if m.count), None)
 
 
 def _bare(text: str) -> str:

@@ -7,7 +7,7 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
   gives now makes the rule INCONCLUSIVE.
 - R-4.4.12-03's case after a CRC metadata command read the D replies of aM!, which
   measure-count-zero empties: it found nothing and the PASS of the replies read before
-  any CRC metadata command stood; it now takes the first plain measurement with values.
+  any CRC metadata command stood; it now takes the first plain measurement that announced values.
 - R-4.4.11-01 PASSed "aV! breaks nothing aM! keeps" when aV!'s reply gave no ttt, so the
   service-request rules were judged on neither (measure-ttt-two-digits +
   verify-no-service-request): INCONCLUSIVE now.
