@@ -71,20 +71,30 @@ def uncounted_groups(groups: list[tuple[Exchange, Exchange]]) -> list[Finding]:
     ]
 
 
-def records(exchanges: list[tuple[Exchange, bool, bool]], ids: tuple[str, ...]) -> list[Finding]:
-    """Metadata replies: each item is (exchange, crc expected, index expected valid)."""
+def records(
+    exchanges: list[tuple[Exchange, bool, bool | None]], ids: tuple[str, ...]
+) -> list[Finding]:
+    """Metadata replies: each item is (exchange, crc expected, index expected valid); valid
+    None: inside a count only the identify reply announced (its measurement gave none), where
+    a missing record may as well be that count's fault (R-6.1-02, which has no measurement
+    reply to compare it with): R-6.2-07 is INCONCLUSIVE there, never FAIL."""
     tally = Tally(ids)
+    unconfirmed: list[Exchange] = []
     for ex, crc, valid in exchanges:
         label = escape(ex.text)
         if not ex.answered:
-            rid = "R-6.2-07" if valid else "R-6.2-05"
-            tally.fail(rid, label, f"{label} got no reply")
+            if valid is None:
+                unconfirmed.append(ex)
+            else:
+                tally.fail("R-6.2-07" if valid else "R-6.2-05", label, f"{label} got no reply")
             tally.fail("R-6.2-01", label, f"{label} got no reply")
             continue
         body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
         reply = parse_metadata_reply(body, crc_expected=crc, expected_address=ex.text[0])
         tally.observe(label, framing, ids=["R-6.2-01"])
-        if valid:
+        if valid is None and reply.invalid_index:
+            unconfirmed.append(ex)
+        elif valid is not False:
             tally.observe(
                 label,
                 reply.violations,
@@ -118,4 +128,21 @@ def records(exchanges: list[tuple[Exchange, bool, bool]], ids: tuple[str, ...]) 
                     f"invalid index answered '{escape(body)}' instead "
                     f"of 'a{'<CRC>' if crc else ''}<CR><LF>'",
                 )
-    return tally.findings()
+    return tally.findings() + _unconfirmed(unconfirmed, ids)
+
+
+def _unconfirmed(missing: list[Exchange], ids: tuple[str, ...]) -> list[Finding]:
+    """R-6.2-07 INCONCLUSIVE for records missing inside a count only an identify reply gave."""
+    if not missing or "R-6.2-07" not in ids:
+        return []
+    listed = "; ".join(shown(ex) for ex in missing[:3])
+    more = f" (+{len(missing) - 3} more)" if len(missing) > 3 else ""
+    return [
+        inconclusive(
+            "R-6.2-07",
+            "no record inside a count only the identify reply announced (its measurement "
+            f"gave none to confirm it): {listed}{more}",
+            evidence=cite(missing),
+            observed=len(missing),
+        )
+    ]

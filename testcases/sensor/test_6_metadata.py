@@ -192,8 +192,9 @@ def _requests_between(sensor, first: int, pokes, heard) -> list:
 
 
 def _metadata_plan(sensor):
-    """(exchange, crc expected, index valid) for every index of every described command,
-    and the described commands whose count is unknown (:func:`_announced`)."""
+    """(exchange, crc expected, index valid) for every index of every described command
+    (valid None where only the identify reply gave the count, :func:`judge.records`), and
+    the described commands whose count is unknown (:func:`_announced`)."""
     plan, unread = [], []
     for code in DESCRIBED:
         m = sensor.measurement(code)
@@ -203,11 +204,12 @@ def _metadata_plan(sensor):
                 unread.append((m.start, ident))
             continue
         crc = m.command.returns_crc
+        valid = True if ident is None else None  # None: a count only aIX! gave
         indices = range(1, count + 1)
         if code[:2] in ("MC", "CC"):  # the CRC twin describes the same values: ends suffice
             indices = sorted({1, count}) if count else ()
         for i in indices:
-            plan.append((sensor.exchange(f"I{code}_{i:03d}"), crc, True))
+            plan.append((sensor.exchange(f"I{code}_{i:03d}"), crc, valid))
     return plan, unread
 
 

@@ -4,7 +4,8 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
 
 - R-6.2-07 PASSed on the other groups' records while aM!/aIM! gave no readable count
   (measure-ttt-two-digits + metadata-missing-record): a group whose count neither reply
-  gives now makes the rule INCONCLUSIVE.
+  gives now makes the rule INCONCLUSIVE; one whose count only the identify reply gives is
+  asked by it, a record missing there INCONCLUSIVE too (the count may be what is wrong).
 - R-4.4.12-03's case after a CRC metadata command read the D replies of aM!, which
   measure-count-zero empties: it found nothing and the PASS of the replies read before
   any CRC metadata command stood; it now takes the first plain measurement that announced values.
@@ -13,6 +14,9 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
   verify-no-service-request): INCONCLUSIVE now.
 - R-6.1-03 PASSed "data unchanged" on a fresh measurement that delivered no values
   (buffer-cleared-by-break + crc-missing + metadata-crc-sticks): INCONCLUSIVE now.
+- R-5.2-04 PASSed on aDB0! alone: an unreadable packet (binary-size-big-endian) ended the
+  aHB! collection, so the 1002-byte DB10 (binary-payload-over-1000) was never asked; the
+  observer now reads on past an unreadable packet to the empty one.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from testcases.sensor.test_4_4_9_additional import test_verification as verifica
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
+from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
 
@@ -62,6 +67,11 @@ def _rules(case_fn) -> tuple[str, ...]:
         ("measure-ttt-two-digits,metadata-missing-record", Verdict.INCONCLUSIVE),
         ("measure-ttt-two-digits", Verdict.INCONCLUSIVE),
         ("metadata-missing-record", Verdict.FAIL),
+        # aC! silent: its records are asked by aIC!'s count, which identify-reply-differs
+        # makes one too many: the missing 21st record is no FAIL (seed 4056)
+        ("concurrent-unsupported,identify-reply-differs", Verdict.INCONCLUSIVE),
+        ("concurrent-unsupported", Verdict.PASS),
+        ("identify-reply-differs", Verdict.PASS),
         ("", Verdict.PASS),
     ],
 )
@@ -109,3 +119,20 @@ def test_identify_starts_nothing_needs_data_to_disturb(faults, expected):
     session.family(("M", "MC", "V", *M_FAMILY))
     session.fresh_exchange("IMC_001")
     assert _verdict(session, identify_case, "R-6.1-03") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("binary-payload-over-1000,binary-size-big-endian", Verdict.FAIL),
+        ("binary-payload-over-1000", Verdict.FAIL),
+        ("binary-size-big-endian", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_binary_packets_past_an_unreadable_one(faults, expected):
+    session = _session(faults)
+    assert _verdict(session, binary_case, "R-5.2-04") is expected
+    packets = session.measurement("HB").packets
+    # the eleventh, 1002-byte packet was asked for, whatever the packets before it looked like
+    assert any(len(p) > 1000 for p in packets) is ("payload-over-1000" in faults)
