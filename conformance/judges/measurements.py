@@ -64,9 +64,12 @@ def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
     exact = next((i for i, t in enumerate(texts) if t == service_request(address)), None)
     if exact is not None:
         return exact
-    return next(
-        (i for i, t in enumerate(texts) if t.startswith(address) and t.endswith("\r\n")), None
-    )
+    return next((i for i, t in enumerate(texts) if _sr_shaped(t, address)), None)
+
+
+def _sr_shaped(text: str, address: str) -> bool:
+    """A line shaped like a service request: the address ... CR LF."""
+    return text.startswith(address) and text.endswith("\r\n")
 
 
 def wait_violations(m: Measurement, tally: Tally) -> None:
@@ -93,41 +96,7 @@ def wait_violations(m: Measurement, tally: Tally) -> None:
                 f"no service request within ttt={m.ttt} s (the recorder had to wait it "
                 "out and break)",
             )
-        before = chunks if sr is None else chunks[:sr]
-        if before:
-            tally.fail(
-                "R-4.4.5-08",
-                label,
-                f"sent '{escape(decode_7e1(before[0]))}' between its reply and the service request",
-            )
-        if sr is not None and m.reply_end is not None:
-            text = decode_7e1(chunks[sr])
-            tally.observe(label, ids=["R-4.4.6-01", "R-4.4.6-04", "R-4.4.5-09"])
-            if text != service_request(address):
-                tally.fail(
-                    "R-4.4.6-01",
-                    label,
-                    f"service request '{escape(text)}' is not '{address}<CR><LF>'",
-                )
-            elapsed = chunks[sr][-1].end - m.reply_end
-            if elapsed > m.ttt + TOLERANCE:
-                tally.fail(
-                    "R-4.4.6-04",
-                    label,
-                    f"service request completed {elapsed:.3f} s after the reply, "
-                    f"past ttt={m.ttt} s",
-                )
-            slack = m.ttt - elapsed
-            allowed = max(SR_MARGIN_MIN, SR_MARGIN_FRACTION * m.ttt)
-            if slack > allowed:
-                tally.fail(
-                    "R-4.4.5-09",
-                    label,
-                    f"service request came {elapsed:.2f} s after the reply, {slack:.2f} s "
-                    f"before ttt={m.ttt} s (more than the {allowed:.2f} s margin this "
-                    "tool tolerates)",
-                    warning=True,
-                )
+        _service_request(m, chunks, sr, tally)
     if is_concurrent(m):
         tally.observe(
             label,
@@ -146,6 +115,64 @@ def wait_violations(m: Measurement, tally: Tally) -> None:
                 label,
                 f"sent '{escape(decode_7e1(chunks[0]))}' before it was asked for data",
             )
+
+
+def _service_request(
+    m: Measurement, chunks: list[list[Event]], sr: int | None, tally: Tally
+) -> None:
+    """R-4.4.5-08/-09, R-4.4.6-01/-04 on the run ``sr`` taken for ``m``'s service request.
+    With no exact ``a<CR><LF>`` and two or more lines shaped like one (``a...<CR><LF>``),
+    which one is the request cannot be told: the first, as before, for its form (every
+    candidate is malformed), but what came between reply and request, and when the request
+    came, are undecided (chatter-before-service-request beside service-request-extra-chars
+    took the 'aBUSY' chatter for the request: an early-request WARN and an R-4.4.5-08 PASS)."""
+    label = where(m)
+    address = m.command.address
+    before = chunks if sr is None else chunks[:sr]
+    if before:
+        tally.fail(
+            "R-4.4.5-08",
+            label,
+            f"sent '{escape(decode_7e1(before[0]))}' between its reply and the service request",
+        )
+    if sr is None or m.reply_end is None:
+        return
+    text = decode_7e1(chunks[sr])
+    tally.observe(label, ids=["R-4.4.6-01"])
+    if text != service_request(address):
+        tally.fail(
+            "R-4.4.6-01",
+            label,
+            f"service request '{escape(text)}' is not '{address}<CR><LF>'",
+        )
+    shaped = [c for c in chunks[sr + 1 :] if _sr_shaped(decode_7e1(c), address)]
+    if text != service_request(address) and shaped:
+        why = (
+            f"'{escape(text)}' and '{escape(decode_7e1(shaped[0]))}' both could be the "
+            "service request"
+        )
+        for rid in ("R-4.4.5-08", "R-4.4.6-04", "R-4.4.5-09"):
+            tally.undecide(rid, label, why)
+        return
+    tally.observe(label, ids=["R-4.4.6-04", "R-4.4.5-09"])
+    elapsed = chunks[sr][-1].end - m.reply_end
+    if elapsed > m.ttt + TOLERANCE:
+        tally.fail(
+            "R-4.4.6-04",
+            label,
+            f"service request completed {elapsed:.3f} s after the reply, past ttt={m.ttt} s",
+        )
+    slack = m.ttt - elapsed
+    allowed = max(SR_MARGIN_MIN, SR_MARGIN_FRACTION * m.ttt)
+    if slack > allowed:
+        tally.fail(
+            "R-4.4.5-09",
+            label,
+            f"service request came {elapsed:.2f} s after the reply, {slack:.2f} s "
+            f"before ttt={m.ttt} s (more than the {allowed:.2f} s margin this "
+            "tool tolerates)",
+            warning=True,
+        )
 
 
 # -- the data -------------------------------------------------------------------------------

@@ -7,7 +7,8 @@ import re
 from ..protocol.responses import parse_measurement_reply_for, parse_metadata_reply, split_line
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import escape
-from ..verdicts import Finding
+from ..verdicts import Finding, inconclusive
+from .cite import cite, shown
 from .tally import Tally
 
 SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
@@ -42,20 +43,58 @@ def identify_matches(pairs: list[tuple[Exchange, Measurement]]) -> list[Finding]
     return tally.findings("same reply as the measurement command")
 
 
-def records(exchanges: list[tuple[Exchange, bool, bool]], ids: tuple[str, ...]) -> list[Finding]:
-    """Metadata replies: each item is (exchange, crc expected, index expected valid)."""
+def announced_count(ident: Exchange) -> int | None:
+    """The value count an identify-measurement reply announces (None: no reply, or none
+    readable in it)."""
+    if not ident.answered or ident.command is None:
+        return None
+    body, _ = split_line(ident.reply_text)
+    return parse_measurement_reply_for(body, ident.command).count
+
+
+def uncounted_groups(groups: list[tuple[Exchange, Exchange]]) -> list[Finding]:
+    """R-6.2-07 for the measurements (start exchange, identify exchange) of which neither
+    reply gave a value count although one of them answered: their records cannot be
+    checked against a count, so the rule is INCONCLUSIVE for them, whatever the other
+    groups' records showed (a FAIL found there still stands). Observed: those replies."""
+    if not groups:
+        return []
+    listed = "; ".join(f"{shown(start)}, {shown(ident)}" for start, ident in groups[:3])
+    more = f" (+{len(groups) - 3} more)" if len(groups) > 3 else ""
+    return [
+        inconclusive(
+            "R-6.2-07",
+            f"no value count to check the records against: {listed}{more}",
+            evidence=cite(ex for pair in groups for ex in pair),
+            observed=len(groups),
+        )
+    ]
+
+
+def records(
+    exchanges: list[tuple[Exchange, bool, bool | None]], ids: tuple[str, ...]
+) -> list[Finding]:
+    """Metadata replies: each item is (exchange, crc expected, index expected valid); valid
+    None: inside a count only the identify reply announced (its measurement gave none), where
+    a missing record may as well be that count's fault (R-6.1-02, which has no measurement
+    reply to compare it with): R-6.2-07 is INCONCLUSIVE there, never FAIL."""
     tally = Tally(ids)
+    unconfirmed: list[Exchange] = []
     for ex, crc, valid in exchanges:
         label = escape(ex.text)
         if not ex.answered:
-            rid = "R-6.2-07" if valid else "R-6.2-05"
-            tally.fail(rid, label, f"{label} got no reply")
+            if valid is None:
+                unconfirmed.append(ex)
+            else:
+                tally.fail("R-6.2-07" if valid else "R-6.2-05", label, f"{label} got no reply")
             tally.fail("R-6.2-01", label, f"{label} got no reply")
             continue
         body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
         reply = parse_metadata_reply(body, crc_expected=crc, expected_address=ex.text[0])
         tally.observe(label, framing, ids=["R-6.2-01"])
-        if valid:
+        if valid is None and reply.invalid_index:
+            unconfirmed.append(ex)
+        elif valid is not False:
             tally.observe(
                 label,
                 reply.violations,
@@ -89,4 +128,21 @@ def records(exchanges: list[tuple[Exchange, bool, bool]], ids: tuple[str, ...]) 
                     f"invalid index answered '{escape(body)}' instead "
                     f"of 'a{'<CRC>' if crc else ''}<CR><LF>'",
                 )
-    return tally.findings()
+    return tally.findings() + _unconfirmed(unconfirmed, ids)
+
+
+def _unconfirmed(missing: list[Exchange], ids: tuple[str, ...]) -> list[Finding]:
+    """R-6.2-07 INCONCLUSIVE for records missing inside a count only an identify reply gave."""
+    if not missing or "R-6.2-07" not in ids:
+        return []
+    listed = "; ".join(shown(ex) for ex in missing[:3])
+    more = f" (+{len(missing) - 3} more)" if len(missing) > 3 else ""
+    return [
+        inconclusive(
+            "R-6.2-07",
+            "no record inside a count only the identify reply announced (its measurement "
+            f"gave none to confirm it): {listed}{more}",
+            evidence=cite(missing),
+            observed=len(missing),
+        )
+    ]

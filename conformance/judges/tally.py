@@ -27,6 +27,7 @@ class Tally:
         self.violations: dict[str, list[tuple[str, Violation]]] = {rid: [] for rid in self.ids}
         self.na: dict[str, str] = {}
         self.why_not: dict[str, str] = {}  # why a rule may end up with nothing to judge
+        self.undecided: dict[str, list[str]] = {rid: [] for rid in self.ids}
         self.decisions: dict[str, str] = {}
 
     def observe(
@@ -49,6 +50,13 @@ class Tally:
     def unobservable(self, rid: str, reason: str) -> None:
         """Say why ``rid`` could not be observed here (its INCONCLUSIVE reason if nothing is)."""
         self.why_not.setdefault(rid, reason)
+
+    def undecide(self, rid: str, where: str, reason: str) -> None:
+        """An observation at ``where`` that could not decide ``rid``: unless a violation FAILs
+        or WARNs it, the rule is INCONCLUSIVE (counted, so another observation's PASS does
+        not stand for this one)."""
+        if rid in self.undecided:
+            self.undecided[rid].append(f"{where}: {reason}")
 
     def decision(self, rid: str, label: str) -> None:
         self.decisions[rid] = label
@@ -80,6 +88,18 @@ class Tally:
                         + [f"also: {line}" for line in lines[SHOWN:]]
                         + [f"{len(seen)} observation(s)"],
                         observed=len(seen),
+                    )
+                )
+            elif self.undecided[rid]:
+                lines = _counted(self.undecided[rid])
+                more = f" (+{len(lines) - SHOWN} more)" if len(lines) > SHOWN else ""
+                result.append(
+                    Finding(
+                        rid,
+                        Verdict.INCONCLUSIVE,
+                        "; ".join(lines[:SHOWN]) + more,
+                        decision=decision,
+                        observed=len(seen) + len(self.undecided[rid]),
                     )
                 )
             elif rid in self.na and not seen:

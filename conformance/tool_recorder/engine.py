@@ -366,7 +366,7 @@ class ToolRecorder:
             usable = exchange.ok or (self.policy.salvage and exchange.answered)
             if not usable:
                 break
-            if not take_values(m, exchange, crc):
+            if not take_values(m, exchange, crc) and not reads_on(m, self.policy):
                 # An empty reply ends collection (R-4.4.8-05). An observer looks one index
                 # further, once, so a sensor whose groups start late leaves evidence.
                 if (
@@ -670,6 +670,18 @@ class _LastDutChar:
         self.seen = len(events)
         self._last = events[-1] if events else None
         return self.end
+
+
+def reads_on(m: Measurement, policy: Policy) -> bool:
+    """After a DB packet without values: an observer reads on past an unreadable one as it
+    does past an invalid ASCII D reply (:func:`validity.reads_past_packet`). The view
+    rebuilds records with the same rule."""
+    return (
+        m.binary
+        and policy.salvage
+        and m.aborted_by is None
+        and validity.reads_past_packet(m.packets, m.count or 0)
+    )
 
 
 def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:

@@ -29,6 +29,7 @@ __all__ = [
     "ends_line",
     "packet_value_count",
     "parse_start_reply",
+    "reads_past_packet",
     "split_crc",
 ]
 
@@ -52,6 +53,22 @@ def packet_value_count(data: bytes) -> int:
         return 0
     size = type_size(data[3])
     return (length - EMPTY_LEN) // size if size else 0
+
+
+def reads_past_packet(packets: list[bytes], count: int) -> bool:
+    """Whether an observer (a salvaging recorder) reads on past the last of ``packets``, a DB
+    packet that held no values: unless it is the empty packet (a size field of 0, either
+    byte order), the same packet as the one before (the sensor is not advancing), or as
+    many packets are in as the measurement announced values (each holds one at least).
+    An unreadable packet (a size field that does not fit, an unknown type) ended the
+    collection, so the packets after it were never asked: R-5.2-04 PASSed on aDB0! alone
+    beside a 1002-byte DB10 (binary-size-big-endian + binary-payload-over-1000)."""
+    last = packets[-1]
+    if len(last) < EMPTY_LEN or last[1:3] == b"\x00\x00":
+        return False
+    if len(packets) >= 2 and packets[-2] == last:
+        return False
+    return len(packets) < count
 
 
 def split_crc(body: str, crc_expected: bool | None) -> tuple[str, str | None]:

@@ -28,7 +28,7 @@ from ..protocol.framing import ETX, STX
 from ..protocol.responses import parse_measurement_reply_for, service_request, split_line
 from ..protocol.timing import CHAR_TIME, TOLERANCE
 from ..tool_recorder import validity
-from ..tool_recorder.engine import take_values
+from ..tool_recorder.engine import reads_on, take_values
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
 from ..transcript import Event, decode_8n1, text_end
@@ -162,7 +162,7 @@ def _measurements(
             m.data.append(later)
             if not (later.ok or (policy.salvage and later.answered)):
                 break
-            if not take_values(m, later, m.command.returns_crc):
+            if not take_values(m, later, m.command.returns_crc) and not reads_on(m, policy):
                 # an observer looks one index past an empty reply, once (as the engine does)
                 if not policy.salvage or probed_past_empty or m.binary:
                     break

@@ -73,21 +73,55 @@ def test_crc_presence(sensor, case):
 def test_crc_request_ends_with_its_command(sensor, case):
     """A CRC asked for on a metadata command (aIMC_001!) is for that reply only: the D
     replies of a plain aM! after it carry no CRC."""
+    # aM! stands for the first plain measurement that announced values, and aIMC_001! for
+    # its CRC twin's metadata command (aMC!'s for aV!): see _plain_with_values
     case.expect("aIMC_001!, then aM! and its D replies without a CRC")
     if not sensor.is_v14:
         case.not_applicable("metadata commands exist from SDI-12 v1.4 on")
         return
-    meta = sensor.fresh_exchange("IMC_001")
-    m = sensor.fresh_measurement("M")
-    case.evidence("aIMC_001!, then aM! and its D replies", [meta, m])
+    plain = _plain_with_values(sensor)
     if not case.requires(
         "supported",
         precondition.shown_supported(
-            meta.answered, "aIMC_001! got no reply to follow", [xjudge.cited(meta)]
+            plain is not None,
+            "no plain measurement (aM!, aMn!, aV!, aC!, aCn!) announced values, so no D "
+            "reply could show a CRC that outlived its command",
+        ),
+    ):
+        return
+    code = plain.command.text()[1:-1]
+    meta = sensor.fresh_exchange(f"I{_crc_twin(code)}_001")
+    m = sensor.fresh_measurement(code)
+    case.evidence(
+        f"{_bare(meta.text)}, then {_bare(m.command.text())} and its D replies", [meta, m]
+    )
+    if not case.requires(
+        "supported",
+        precondition.shown_supported(
+            meta.answered, f"{_bare(meta.text)} got no reply to follow", [xjudge.cited(meta)]
         ),
     ):
         return
     case.extend(judge.judge([m], case.requirements, sensor.version))
+
+
+def _plain_with_values(sensor):
+    """The first plain measurement (aM! first) that announced values, so D replies follow
+    it (empty ones too show a CRC that outlived its command): a fixed aM! left this case
+    nothing to judge when aM! announced none, and the PASS of the D replies read before any
+    CRC metadata command then stood alone (issue 22, after-landing check:
+    measure-count-zero + metadata-crc-sticks)."""
+    return next((m for m in sensor.family(PLAIN_CODES) if m.count), None)
+
+
+def _bare(text: str) -> str:
+    """``0IMC_001!`` as ``aIMC_001!``: the evidence label names the command, not the address."""
+    return "a" + text[1:]
+
+
+def _crc_twin(code: str) -> str:
+    """The CRC variant of a plain measurement code (aV! has none: aMC!'s stands in)."""
+    return "MC" if code == "V" else code[0] + "C" + code[1:]
 
 
 @requirements("R-4.4.12-05", "R-4.4.12-06")

@@ -8,7 +8,7 @@ from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
 from conformance.protocol.responses import split_line
-from conformance.verdicts import passed, warned
+from conformance.verdicts import inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
 MN = tuple(f"M{i}" for i in range(1, 10)) + tuple(f"MC{i}" for i in range(1, 10))
@@ -131,6 +131,20 @@ def test_verification(sensor, case):
                 evidence=[xjudge.cited(m.start), xjudge.cited(reference.start)]
                 + [line for rid in differ for line in as_v[rid].evidence],
                 observed=2,  # aV! and the aM! it is compared with
+            )
+        )
+    elif m.ttt is None:
+        # no ttt to wait out: the service-request rules were judged on neither reply, so
+        # "breaks nothing aM! keeps" would rest on no observation of them (a missed
+        # verify-no-service-request beside measure-ttt-two-digits, seed 4051)
+        case.add(
+            inconclusive(
+                "R-4.4.11-01",
+                f"aV! answered '{xjudge.escape(m.start.reply_text)}', which gives no ttt: "
+                "whether it owes a service request (R-4.4.6-02) cannot be judged, so it "
+                "cannot be shown to behave like aM!",
+                evidence=[xjudge.cited(m.start)],
+                observed=1,
             )
         )
     else:

@@ -127,6 +127,15 @@ def test_size_field_disagrees_with_length() -> None:
     assert packet.values == [] and packet.payload == b"\xff\xff\x01\x00\x00"
 
 
+def test_an_unframed_packet_s_size_field_is_no_evidence_of_its_values() -> None:
+    """A size field sent high byte first (1002 read as 59907, odd) says nothing of whether
+    the payload holds whole UINT16 values: R-5.2-02 only (R-5.2-04 still sees the 1002
+    bytes that came)."""
+    payload = struct.pack("<501H", *range(501))
+    packet = with_crc(b"1" + (1002).to_bytes(2, "big") + bytes([DataType.UINT16]) + payload)
+    assert ids(parse_binary_packet(packet).violations) == ["R-5.2-02", "R-5.2-04"]
+
+
 def test_bad_crc() -> None:
     data = bytearray(build_packet("1", DataType.UINT8, [1, 2, 3]))
     data[-1] ^= 0xFF

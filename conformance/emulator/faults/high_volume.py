@@ -135,7 +135,8 @@ COVERAGE: tuple[Fault, ...] = (
         "high-volume-binary-two-digit-count",
         "aHB! replies give a 2-digit count (atttnn instead of atttnnn)."
         " With the count unreadable no packet is asked for, so the packet rules have nothing"
-        " to judge.",
+        " to judge, nor has the count aHB!'s metadata records are checked against"
+        " (aIHB! answers alike, R-6.2-07).",
         ("R-5.2-01",),
         rewrite=when(_hb_start, lambda r: replace(r, body=r.body[:4] + r.body[5:])),
         inconclusive=(
@@ -146,6 +147,7 @@ COVERAGE: tuple[Fault, ...] = (
             "R-5.2-05",
             "R-5.2-07",
             "R-5.2.1-01",
+            "R-6.2-07",
         ),
         needs=("HB",),
     ),

@@ -146,10 +146,12 @@ FORMAT: tuple[Fault, ...] = (
         "measure-ttt-two-digits",
         "M/MC/Mn/V replies give ttt with two digits (atttn becomes attn)."
         " No measurement reply parses, so no data are there for the identify commands to"
-        " disturb (R-6.1-03).",
+        " disturb (R-6.1-03), no ttt tells whether aV! owes a service request as aM! does"
+        " (R-4.4.11-01), and no count (aIM! answers alike) says which metadata records"
+        " the M-type groups owe (R-6.2-07).",
         ("R-4.4.5-01",),
         rewrite=_start_with(1, lambda body: body[0] + body[2:]),
-        inconclusive=("R-6.1-03",),
+        inconclusive=("R-6.1-03", "R-4.4.11-01", "R-6.2-07"),
     ),
     Fault(
         "measure-count-zero",
@@ -187,13 +189,14 @@ FORMAT: tuple[Fault, ...] = (
         "high-volume-two-digit-count",
         "HA replies give a 2-digit count (atttnn instead of atttnnn)."
         " With the count unreadable no D data are asked for, so the aHA! data rules have"
-        " nothing to judge.",
+        " nothing to judge, nor has the count aHA!'s metadata records are checked against"
+        " (aIHA! answers alike, R-6.2-07).",
         ("R-5.1-01",),
         rewrite=when(
             lambda r: measure_family(r, 3) and source_kind(r) is Kind.HIGH_VOLUME_ASCII,
             lambda r: replace(r, body=r.body[:4] + r.body[5:]),
         ),
-        inconclusive=("R-5.1-02", "R-5.1-03"),
+        inconclusive=("R-5.1-02", "R-5.1-03", "R-6.2-07"),
         needs=("HA",),
     ),
     Fault(
