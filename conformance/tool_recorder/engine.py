@@ -695,7 +695,7 @@ def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:
         return count > 0
     text = validity.data_values_text(exchange.reply_text, crc)
     if not exchange.ok:  # salvaged: keep only what reads as values (no stray CRC, spaces)
-        text = text.rstrip("".join(map(chr, range(0x40, 0x80)))).strip()
+        text = validity.salvaged_values_text(text)
     values = split_values(text)
     m.values.extend(values)
     return bool(values)

@@ -10,7 +10,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..protocol.commands import Command, Kind
+from ..protocol.values import split_values
 from ..transcript import Event, decode_7e1, decode_8n1
+from .validity import data_values_text, salvaged_values_text
 
 # Reasons an attempt ended. "invalid: <why>" carries the engine's own (loose) reason.
 OK = "ok"
@@ -76,11 +78,23 @@ class Exchange:
         last one sent. A retry that went unheard after an answered try says nothing about
         the reply: a sensor that needs a break before every command gave an invalid-looking
         reply, ignored the two retries without a break, and its D0 was judged as never
-        answered (R-4.4-01 and four more FAILs that belong to no deviation of its)."""
+        answered (R-4.4-01 and four more FAILs that belong to no deviation of its).
+
+        A D command none of whose replies was accepted is judged from the reply before a
+        break that held more values than the last answered one after it
+        (:func:`delivered`): a new sequence of retries starts with a break (R-7.2-04), and a
+        sensor whose buffer the break emptied answered it with no values although an earlier
+        try delivered them; the values rules read that empty reply as five deviations of a
+        sensor whose one deviation (data lost at a break, R-4.4.5-10) is its own rule's
+        business, which reads the D commands again (fault combinations of 2026-12-05)."""
         for attempt in reversed(self.attempts):
             if attempt.reply_events:
-                return attempt
-        return self.attempts[-1]
+                break
+        else:
+            return self.attempts[-1]
+        if attempt.ok or attempt is self.attempts[0] or not _is_data(self.command):
+            return attempt
+        return delivered(self.attempts, attempt)
 
     @property
     def reply_events(self) -> list[Event]:
@@ -113,6 +127,35 @@ class Exchange:
     @property
     def end(self) -> float:
         return self.last.end
+
+
+def _is_data(command: Command | None) -> bool:
+    return command is not None and command.kind is Kind.DATA
+
+
+def delivered(attempts: list[Attempt], last: Attempt) -> Attempt:
+    """Among ``attempts`` of one ASCII D command, none accepted, with ``last`` the last one
+    answered: the attempt whose reply the values are read from. That is ``last`` unless an
+    attempt answered before a break that came before ``last`` held more values (salvaged:
+    a stray or missing CRC cut off); of those holding the most, the later. Retries without
+    a break between never replace ``last``: only a break can empty a buffer that the
+    standard says keeps its data (R-4.4.5-10), and a sensor that gives fewer values to a
+    plain retry shows what it holds."""
+    end = next(i for i, a in enumerate(attempts) if a is last)
+    broken = max((i for i in range(1, end + 1) if attempts[i].break_event), default=0)
+    best, most = last, _values_held(last)
+    for attempt in attempts[:broken]:
+        held = _values_held(attempt) if attempt.reply_events else 0
+        if held > most or (held == most and best is not last):
+            best, most = attempt, held
+    return best
+
+
+def _values_held(attempt: Attempt) -> int:
+    """How many values an attempt's reply reads as (as salvaged: address, CR LF, any CRC's
+    characters cut off)."""
+    text = data_values_text(decode_7e1(attempt.reply_events), False)
+    return len(split_values(salvaged_values_text(text)))
 
 
 @dataclass

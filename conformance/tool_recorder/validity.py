@@ -88,6 +88,16 @@ def data_values_text(reply: str, crc_expected: bool | None) -> str:
     return split_crc(strip_crlf(reply), crc_expected)[0][1:]
 
 
+#: Every character an ASCII CRC is made of (0x40..0x7F); no value character is one.
+CRC_CHARS = "".join(map(chr, range(0x40, 0x80)))
+
+
+def salvaged_values_text(values: str) -> str:
+    """What the ``<values>`` part of a D reply that was not accepted still reads as values
+    (an observer's salvage): a stray or unexpected CRC's characters and spaces cut off."""
+    return values.rstrip(CRC_CHARS).strip()
+
+
 def _reply_address(command: Command) -> str | None:
     """The address the reply must start with; None means any address character."""
     if command.kind is Kind.QUERY_ADDRESS:
