@@ -205,6 +205,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # and R-4.4.8-04 FAILed for data R-4.4.5-10 alone had lost (crc-on-plain the same, seed
     # 4056); fixed by Exchange.judged reading the reply before the break (records.delivered)
     ("buffer-cleared-by-break", "crc-missing", "metadata-crc-sticks"),
+    # the same class where the plain retries already found the buffer empty (R-4.4.5-03,
+    # R-4.4.8-03 and R-4.4.8-04 FAILed; found while fixing the row above)
+    ("buffer-cleared-after-read", "crc-on-plain"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

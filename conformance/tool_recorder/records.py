@@ -136,11 +136,14 @@ def _is_data(command: Command | None) -> bool:
 def delivered(attempts: list[Attempt], last: Attempt) -> Attempt:
     """Among ``attempts`` of one ASCII D command, none accepted, with ``last`` the last one
     answered: the attempt whose reply the values are read from. That is ``last`` unless an
-    attempt answered before a break that came before ``last`` held more values (salvaged:
-    a stray or missing CRC cut off); of those holding the most, the later. Retries without
-    a break between never replace ``last``: only a break can empty a buffer that the
-    standard says keeps its data (R-4.4.5-10), and a sensor that gives fewer values to a
-    plain retry shows what it holds."""
+    attempt answered before a break that came before ``last`` (an earlier sequence of
+    retries, R-7.2-04) held more values (salvaged: a stray or missing CRC cut off); of those
+    holding the most, the later. The data a sensor delivered stay its data until the next
+    measurement, across breaks and repeated ``aDn!`` (R-4.4.5-10): fewer values to the
+    retries after a break are that rule's deviation (buffer-cleared-by-break, and
+    buffer-cleared-after-read, whose plain retries already found the buffer empty), which
+    its own cases judge by reading the D commands again. Only retries with no break between
+    them are read as they came (the last answered), as before."""
     end = next(i for i, a in enumerate(attempts) if a is last)
     broken = max((i for i in range(1, end + 1) if attempts[i].break_event), default=0)
     best, most = last, _values_held(last)

@@ -71,3 +71,17 @@ def test_the_emulated_combination_delivers_its_values_on_the_sim_bus():
     d0 = m.data[0]
     assert m.count == 3 and len(m.values) == 3 and d0.reply_text.startswith("0+22.15")
     assert {decode_7e1(a.reply_events) for a in d0.attempts[3:]} == {"0\r\n"}  # emptied
+
+
+def test_values_lost_to_plain_retries_before_the_break_are_read_from_the_first_try():
+    """buffer-cleared-after-read: the plain retries already found the buffer empty; the
+    break that starts the next sequence came after the try that delivered the values."""
+    m, rebuilt = _measured({"0D0!": [STRAY_CRC, EMPTIED]})
+    assert m.values == ["+1", "+2", "+3"] == rebuilt.values
+    assert m.data[0].judged is m.data[0].attempts[0]
+
+
+def test_only_d_commands_are_read_from_before_a_break():
+    master, _ = rig(ScriptedSensor({"0R0!": [STRAY_CRC] * 3 + [EMPTIED]}))
+    ex = master.transact("0R0!")
+    assert not ex.ok and ex.reply_text == EMPTIED  # the last answered, as before
