@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from ..protocol.commands import Command, Kind
 from ..protocol.values import split_values
 from ..transcript import Event, decode_7e1, decode_8n1
-from .validity import data_values_text, salvaged_values_text
+from .validity import data_values_text, packet_value_count, salvaged_values_text
 
 # Reasons an attempt ended. "invalid: <why>" carries the engine's own (loose) reason.
 OK = "ok"
@@ -80,7 +80,7 @@ class Exchange:
         reply, ignored the two retries without a break, and its D0 was judged as never
         answered (R-4.4-01 and four more FAILs that belong to no deviation of its).
 
-        A D command none of whose replies was accepted is judged from the reply before a
+        A D or DB command none of whose replies was accepted is judged from the reply before a
         break that held more values than the last answered one after it
         (:func:`delivered`): a new sequence of retries starts with a break (R-7.2-04), and a
         sensor whose buffer the break emptied answered it with no values although an earlier
@@ -94,7 +94,7 @@ class Exchange:
             return self.attempts[-1]
         if attempt.ok or attempt is self.attempts[0] or not _is_data(self.command):
             return attempt
-        return delivered(self.attempts, attempt)
+        return delivered(self.attempts, attempt, binary=self.binary)
 
     @property
     def reply_events(self) -> list[Event]:
@@ -130,15 +130,16 @@ class Exchange:
 
 
 def _is_data(command: Command | None) -> bool:
-    return command is not None and command.kind is Kind.DATA
+    return command is not None and command.kind in (Kind.DATA, Kind.BINARY_DATA)
 
 
-def delivered(attempts: list[Attempt], last: Attempt) -> Attempt:
-    """Among ``attempts`` of one ASCII D command, none accepted, with ``last`` the last one
-    answered: the attempt whose reply the values are read from. That is ``last`` unless an
-    attempt answered before a break that came before ``last`` (an earlier sequence of
-    retries, R-7.2-04) held more values (salvaged: a stray or missing CRC cut off); of those
-    holding the most, the later. The data a sensor delivered stay its data until the next
+def delivered(attempts: list[Attempt], last: Attempt, *, binary: bool = False) -> Attempt:
+    """Among ``attempts`` of one D or DB (``binary``) command, none accepted, with ``last``
+    the last one answered: the attempt whose reply the values are read from. That is
+    ``last`` unless an attempt answered before a break that came before ``last`` (an earlier
+    sequence of retries, R-7.2-04) held more values (salvaged: a stray or missing CRC cut
+    off; a DB packet's: those its size and type make, as the collection counts them); of
+    those holding the most, the later. The data a sensor delivered stay its data until the next
     measurement, across breaks and repeated ``aDn!`` (R-4.4.5-10): fewer values to the
     retries after a break are that rule's deviation (buffer-cleared-by-break, and
     buffer-cleared-after-read, whose plain retries already found the buffer empty), which
@@ -146,17 +147,19 @@ def delivered(attempts: list[Attempt], last: Attempt) -> Attempt:
     them are read as they came (the last answered), as before."""
     end = next(i for i, a in enumerate(attempts) if a is last)
     broken = max((i for i in range(1, end + 1) if attempts[i].break_event), default=0)
-    best, most = last, _values_held(last)
+    best, most = last, _values_held(last, binary)
     for attempt in attempts[:broken]:
-        held = _values_held(attempt) if attempt.reply_events else 0
+        held = _values_held(attempt, binary) if attempt.reply_events else 0
         if held > most or (held == most and best is not last):
             best, most = attempt, held
     return best
 
 
-def _values_held(attempt: Attempt) -> int:
+def _values_held(attempt: Attempt, binary: bool) -> int:
     """How many values an attempt's reply reads as (as salvaged: address, CR LF, any CRC's
-    characters cut off)."""
+    characters cut off; a packet's as its size and type give them)."""
+    if binary:
+        return packet_value_count(decode_8n1(attempt.reply_events))
     text = data_values_text(decode_7e1(attempt.reply_events), False)
     return len(split_values(salvaged_values_text(text)))
 

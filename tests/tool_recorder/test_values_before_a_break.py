@@ -14,7 +14,7 @@ from conformance.protocol import commands as cmds
 from conformance.protocol.crc import ascii_crc
 from conformance.tool_recorder import ToolRecorder
 from conformance.tool_recorder.policy import Policy
-from conformance.transcript import decode_7e1
+from conformance.transcript import decode_7e1, decode_8n1
 from conformance.view.rebuilt_records import rebuild_records
 from conformance.view.segments import read_view
 from tests.tool_recorder.test_scripted_sensor import ScriptedSensor, rig, with_crc
@@ -85,3 +85,16 @@ def test_only_d_commands_are_read_from_before_a_break():
     master, _ = rig(ScriptedSensor({"0R0!": [STRAY_CRC] * 3 + [EMPTIED]}))
     ex = master.transact("0R0!")
     assert not ex.ok and ex.reply_text == EMPTIED  # the last answered, as before
+
+
+def test_a_db_packet_delivered_before_the_break_is_read_not_the_emptied_retry():
+    """binary-crc-wrong + buffer-cleared-by-break: every packet's CRC is wrong, so each DBn
+    is retried after breaks; the break after the last page emptied the buffer, and the
+    empty packets to its retries had cost the last page's values (R-5.2-07 FAILed)."""
+    _, link, _ = emulator.sim_sensor(faults=("binary-crc-wrong", "buffer-cleared-by-break"))
+    m = ToolRecorder(link).measure(cmds.parse_command("0HB!"))
+    rebuilt = rebuild_records(read_view(link.transcript.events)).measurements[0]
+    assert m.binary_value_count == m.count == rebuilt.binary_value_count
+    last = m.data[-1]
+    assert not last.ok and last.judged is not last.attempts[-1]
+    assert len(decode_8n1(last.attempts[-1].reply_events)) < len(last.reply_bytes)  # emptied
