@@ -107,7 +107,7 @@ class Exchange:
 
     @property
     def reply_bytes(self) -> bytes:
-        """The last attempt's reply as raw 8N1 bytes (HB packets)."""
+        """The judged attempt's reply as raw 8N1 bytes (HB packets)."""
         return decode_8n1(self.reply_events)
 
     @property
