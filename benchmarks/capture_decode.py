@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -51,13 +50,35 @@ def busy_bus(seconds: float) -> list[Event]:
     return events
 
 
+def own_peak_mb() -> float:
+    """This process's own peak resident memory (MB): the high-water mark of its address space
+    (``VmHWM``). Not ``ru_maxrss``: Linux carries that over an exec from the address space
+    before it, and subprocess starts a child by vfork, so a child reported its parent's peak
+    (the busy bus just generated) whenever that was the larger."""
+    with open("/proc/self/status") as status:
+        return next(int(line.split()[1]) for line in status if line.startswith("VmHWM:")) / 1024
+
+
+def judge_child(path: str, reports: str) -> None:
+    """``sdi12-conform judge`` of ``path`` into ``reports`` in this (child) process; prints its
+    exit status and this process's own peak as JSON (``tests/offline/test_judge_memory.py``
+    runs it too)."""
+    from conformance.cli import main
+
+    try:
+        code = main(["judge", path, "--report-dir", reports])
+    except SystemExit as exc:
+        code = exc.code
+    print(json.dumps({"code": code, "peak_mb": own_peak_mb()}))
+
+
 def decode_child(path: str) -> None:
     from conformance.capture import decode_capture
 
     start = time.perf_counter()
     d = decode_capture(path)
     wall = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    peak = own_peak_mb()
     print(
         json.dumps(
             {
@@ -79,7 +100,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--keep", help="write the capture here and keep it")
     p.add_argument("--judge", action="store_true", help="also judge it (sdi12-conform judge)")
     p.add_argument("--decode-only", help=argparse.SUPPRESS)
+    p.add_argument("--judge-only", nargs=2, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
+    if args.judge_only:
+        judge_child(*args.judge_only)
+        return 0
     if args.decode_only:
         decode_child(args.decode_only)
         return 0
@@ -130,18 +155,20 @@ def judge(path: str) -> bool:
     with tempfile.TemporaryDirectory() as reports:
         start = time.perf_counter()
         done = subprocess.run(
-            [sys.executable, "-m", "conformance.cli", "judge", path, "--report-dir", reports],
+            [sys.executable, __file__, "--judge-only", path, reports],
             capture_output=True,
             text=True,
         )
         wall = time.perf_counter() - start
-        peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+        lines = done.stdout.strip().splitlines()
+        found = json.loads(lines[-1]) if done.returncode == 0 and lines else {}
         folders = sorted(p.name for p in os.scandir(reports) if p.is_dir())
+    code, peak = found.get("code"), found.get("peak_mb", float("nan"))
     print(
-        f"judged in {wall:.1f} s wall, peak RSS {peak:.0f} MB (largest child), exit "
-        f"{done.returncode}, report sets: {', '.join(folders)}"
+        f"judged in {wall:.1f} s wall, peak RSS {peak:.0f} MB (the judging child's own), exit "
+        f"{code}, report sets: {', '.join(folders)}"
     )
-    return done.returncode in (0, 1, 2) and len(folders) == 11
+    return code in (0, 1, 2) and len(folders) == 11
 
 
 if __name__ == "__main__":

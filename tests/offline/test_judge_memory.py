@@ -34,29 +34,18 @@ MB_PER_MINUTE = 2.15  # 1.73-1.76 measured, fef5b8a 2.19-2.32; runs of one lengt
 # MB: 0.25 a minute each, so up to 0.5 between two runs; CI must not fail on the noise
 SHORT, LONG = 2.0, 14.0  # minutes
 
-#: judges the capture in this child process, then prints its own peak resident memory (MB):
-#: the high-water mark of its own address space (``VmHWM``), not ``ru_maxrss``, which Linux
-#: carries over an exec from the address space before it: a child started by vfork (as
-#: subprocess does) reported this test's own peak (the busy bus it had just generated: 104
-#: MB at 14 minutes whatever the judgement took, and 75 at 2)
-CHILD = (
-    "import json, sys\n"
-    "from conformance.cli import main\n"
-    "try:\n"
-    "    code = main(['judge', sys.argv[1], '--report-dir', sys.argv[2]])\n"
-    "except SystemExit as exc:\n"
-    "    code = exc.code\n"
-    "with open('/proc/self/status') as status:\n"
-    "    peak = next(int(l.split()[1]) for l in status if l.startswith('VmHWM:')) / 1024\n"
-    "print(json.dumps({'code': code, 'peak_mb': peak}))\n"
-)
+#: the benchmark that makes the busy bus and judges a capture in a child process, which prints
+#: its own peak resident memory: the high-water mark of its own address space (``VmHWM``),
+#: not ``ru_maxrss``, which Linux carries over an exec from the address space before it: a
+#: child started by vfork (as subprocess does) reported this test's own peak (the busy bus it
+#: had just generated: 104 MB at 14 minutes whatever the judgement took, and 75 at 2)
+BENCH = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
 
 
 def busy_capture(path: Path, minutes: float) -> None:
     """The benchmark's busy bus (break, ``aD0!``, an 18-character reply, addresses 0-9),
     written as a 1 MHz sigrok session."""
-    bench = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
-    spec = importlib.util.spec_from_file_location("capture_decode_bench", bench)
+    spec = importlib.util.spec_from_file_location("capture_decode_bench", BENCH)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -68,7 +57,7 @@ def busy_capture(path: Path, minutes: float) -> None:
 def judged_peak(capture: Path, reports: Path) -> float:
     env = {**os.environ, "MALLOC_ARENA_MAX": "1"}  # a repeatable peak (see above)
     done = subprocess.run(
-        [sys.executable, "-c", CHILD, str(capture), str(reports)],
+        [sys.executable, str(BENCH), "--judge-only", str(capture), str(reports)],
         capture_output=True, text=True, check=True, env=env,
     )  # fmt: skip
     found = json.loads(done.stdout.strip().splitlines()[-1])
