@@ -211,6 +211,13 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # the same class for DB packets: a wrong packet CRC retried after the break that emptied
     # the buffer lost the last page's values (R-5.2-07 FAILed; found on the way too)
     ("binary-crc-wrong", "buffer-cleared-by-break"),
+    # (seed 4062, after the merge) aC! answered '0000000', a zero count in three digits:
+    # R-4.4.7-08 PASSed it as a malformed reply that still answers aC!; a reply whose every
+    # reading is zero values starts no measurement, as a00000 does not
+    ("concurrent-three-digit-count", "concurrent-zero"),
+    # (seeds 4061 and 4062, still open: see KNOWN_OPEN)
+    ("buffer-cleared-after-read", "value-missing-sign"),
+    ("measure-ttt-two-digits", "value-ten-chars"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
@@ -221,4 +228,18 @@ CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 
 #: CI combinations the measurement found unexplained, each with its diagnosed class: the
 #: tests expect them to fail (strictly), so a fix of the class shows and shrinks this list.
-KNOWN_OPEN: dict[tuple[str, ...], str] = {}
+KNOWN_OPEN: dict[tuple[str, ...], str] = {
+    ("buffer-cleared-after-read", "value-missing-sign"): (
+        "aD0! answers values without a sign (invalid), the retry with no break between finds "
+        "the buffer emptied by the read and its '0<CR><LF>' is accepted: the value rules read "
+        "that accepted empty retry, so R-4.4.8-03/-04 FAIL (a consequence of R-4.4.5-10) and "
+        "R-4.4.8-02 PASSes though the first reply broke it; records.delivered reads an earlier "
+        "try only when no retry was accepted and a break came between"
+    ),
+    ("measure-ttt-two-digits", "value-ten-chars"): (
+        "R-4.4.8-02 PASSes on 24 aC!-family D replies while no aM!-family group could be read "
+        "(every start reply gives no count, so no aD0! follows it) and value-ten-chars spoils "
+        "aM!'s values only: a value rule that could not reach the primary measurement's data "
+        "should be INCONCLUSIVE, as R-6.2-07 now is for a group without a count"
+    ),
+}

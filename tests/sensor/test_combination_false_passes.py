@@ -17,6 +17,9 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
 - R-5.2-04 PASSed on aDB0! alone: an unreadable packet (binary-size-big-endian) ended the
   aHB! collection, so the 1002-byte DB10 (binary-payload-over-1000) was never asked; the
   observer now reads on past an unreadable packet to the empty one.
+- R-4.4.7-08 PASSed "aC! answered '0000000'" (concurrent-three-digit-count +
+  concurrent-zero, seed 4062): a malformed reply still answers aC!, but one that reads as
+  zero values whatever its count's width is no measurement started: FAIL, as a00000 is.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from conformance.protocol.commands import M_FAMILY
 from conformance.results import CaseRecord, counted
 from conformance.sensor.session import SensorSession
 from conformance.verdicts import Verdict, worst
+from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
 from testcases.sensor.test_4_4_9_additional import test_verification as verification_case
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
@@ -136,3 +140,16 @@ def test_binary_packets_past_an_unreadable_one(faults, expected):
     packets = session.measurement("HB").packets
     # the eleventh, 1002-byte packet was asked for, whatever the packets before it looked like
     assert any(len(p) > 1000 for p in packets) is ("payload-over-1000" in faults)
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("concurrent-three-digit-count,concurrent-zero", Verdict.FAIL),
+        ("concurrent-zero", Verdict.FAIL),
+        ("concurrent-three-digit-count", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_concurrent_reply_of_zero_values_in_any_reading(faults, expected):
+    assert _verdict(_session(faults), concurrent_case, "R-4.4.7-08") is expected
