@@ -215,8 +215,12 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # R-4.4.7-08 PASSed it as a malformed reply that still answers aC!; a reply whose every
     # reading is zero values starts no measurement, as a00000 does not
     ("concurrent-three-digit-count", "concurrent-zero"),
-    # (seeds 4061 and 4062, still open: see KNOWN_OPEN)
+    # (seeds 4061 and 4062) an invalid D reply (a value without its sign) drew a retry with
+    # no break between, which the read had emptied; its '0<CR><LF>' was accepted and read:
+    # R-4.4.8-03/-04 FAILed for R-4.4.5-10's deviation and R-4.4.8-02 PASSed on the empty
+    # reply; fixed by Exchange.judged reading the try that held values (records.emptied)
     ("buffer-cleared-after-read", "value-missing-sign"),
+    # (seed 4061, still open: see KNOWN_OPEN)
     ("measure-ttt-two-digits", "value-ten-chars"),
 )
 
@@ -229,13 +233,6 @@ CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 #: CI combinations the measurement found unexplained, each with its diagnosed class: the
 #: tests expect them to fail (strictly), so a fix of the class shows and shrinks this list.
 KNOWN_OPEN: dict[tuple[str, ...], str] = {
-    ("buffer-cleared-after-read", "value-missing-sign"): (
-        "aD0! answers values without a sign (invalid), the retry with no break between finds "
-        "the buffer emptied by the read and its '0<CR><LF>' is accepted: the value rules read "
-        "that accepted empty retry, so R-4.4.8-03/-04 FAIL (a consequence of R-4.4.5-10) and "
-        "R-4.4.8-02 PASSes though the first reply broke it; records.delivered reads an earlier "
-        "try only when no retry was accepted and a break came between"
-    ),
     ("measure-ttt-two-digits", "value-ten-chars"): (
         "R-4.4.8-02 PASSes on 24 aC!-family D replies while no aM!-family group could be read "
         "(every start reply gives no count, so no aD0! follows it) and value-ten-chars spoils "

@@ -694,7 +694,7 @@ def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:
         m.binary_value_count += count
         return count > 0
     text = validity.data_values_text(exchange.reply_text, crc)
-    if not exchange.ok:  # salvaged: keep only what reads as values (no stray CRC, spaces)
+    if not exchange.judged.ok:  # salvaged: only what reads as values (no stray CRC, spaces)
         text = validity.salvaged_values_text(text)
     values = split_values(text)
     m.values.extend(values)

@@ -86,14 +86,17 @@ class Exchange:
         sensor whose buffer the break emptied answered it with no values although an earlier
         try delivered them; the values rules read that empty reply as five deviations of a
         sensor whose one deviation (data lost at a break, R-4.4.5-10) is its own rule's
-        business, which reads the D commands again (fault combinations of 2026-12-05)."""
+        business, which reads the D commands again (fault combinations of 2026-12-05). So is
+        one whose accepted retry holds no values after a try that held some (:func:`emptied`)."""
         for attempt in reversed(self.attempts):
             if attempt.reply_events:
                 break
         else:
             return self.attempts[-1]
-        if attempt.ok or attempt is self.attempts[0] or not _is_data(self.command):
+        if attempt is self.attempts[0] or not _is_data(self.command):
             return attempt
+        if attempt.ok:
+            return emptied(self.attempts, attempt, binary=self.binary)
         return delivered(self.attempts, attempt, binary=self.binary)
 
     @property
@@ -151,6 +154,28 @@ def delivered(attempts: list[Attempt], last: Attempt, *, binary: bool = False) -
     for attempt in attempts[:broken]:
         held = _values_held(attempt, binary) if attempt.reply_events else 0
         if held > most or (held == most and best is not last):
+            best, most = attempt, held
+    return best
+
+
+def emptied(attempts: list[Attempt], accepted: Attempt, *, binary: bool = False) -> Attempt:
+    """Among ``attempts`` of one D or DB command, ``accepted`` the valid reply that ended
+    them: the attempt whose reply the values are read from. That is ``accepted`` unless it
+    holds no values and an earlier try held some (of those holding the most, the later): a
+    sensor whose buffer the read emptied (buffer-cleared-after-read) answered a retry, that
+    an invalid first reply (a value without its sign) drew, with no values; reading that
+    empty reply FAILed R-4.4.8-03/-04 for R-4.4.5-10's deviation and left the first reply's
+    values unjudged (R-4.4.8-02 PASSed). Only an empty accepted reply is set aside: noise
+    cannot empty a reply, but it can make a garbled one look like more values than a valid
+    retry holds, which is then read as before."""
+    if _values_held(accepted, binary):
+        return accepted
+    best, most = accepted, 0
+    for attempt in attempts:
+        if attempt is accepted:
+            break
+        held = _values_held(attempt, binary) if attempt.reply_events else 0
+        if held and held >= most:
             best, most = attempt, held
     return best
 

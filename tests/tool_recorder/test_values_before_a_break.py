@@ -4,7 +4,9 @@ empties its buffer at a break (buffer-cleared-by-break) and puts a CRC where non
 none where one does, delivered the values to the first try, but the tool read the empty
 reply to the retry after the break, so R-4.4.5-03, R-4.4.5.1-03, R-4.4.7-05, R-4.4.8-03 and
 R-4.4.8-04 FAILed for data R-4.4.5-10 alone had lost. The empty replies stay in the
-attempts; a reply that was accepted, and retries with no break between, are read as before.
+attempts; a reply that was accepted, and retries with no break between, are read as before,
+unless the accepted reply is empty after a try that held values (buffer-cleared-after-read
++ value-missing-sign, seed 4061: :func:`~conformance.tool_recorder.records.emptied`).
 The view's rebuilt records read the same (:mod:`conformance.view.rebuilt_records`)."""
 
 from __future__ import annotations
@@ -43,10 +45,27 @@ def test_values_delivered_before_the_break_are_read_not_the_emptied_retry():
     assert (rebuilt.values, rebuilt.data[0].reply_text) == (m.values, d0.reply_text)
 
 
-def test_an_accepted_empty_retry_after_the_break_is_read_as_before():
+def test_an_accepted_empty_retry_after_a_try_that_held_values_is_not_the_one_read():
+    """buffer-cleared-after-read + value-missing-sign (seed 4061): the retry an invalid
+    reply drew found the buffer emptied and its empty reply was accepted; the values are
+    the first try's (R-4.4.8-02 judges them), the empty reply stays in the attempts."""
     m, rebuilt = _measured({"0D0!": [STRAY_CRC] * 3 + ["0\r\n"]})
-    assert m.data[0].ok and m.data[0].reply_text == "0\r\n"
-    assert m.values == [] == rebuilt.values
+    d0 = m.data[0]
+    assert d0.ok and d0.last.reply_events and decode_7e1(d0.last.reply_events) == "0\r\n"
+    assert d0.reply_text == STRAY_CRC and m.values == ["+1", "+2", "+3"] == rebuilt.values
+
+
+def test_an_accepted_retry_with_fewer_values_is_read_as_before():
+    """Noise can make a garbled reply look like more values than the valid retry holds: an
+    accepted retry that holds values is the one read."""
+    m, rebuilt = _measured({"0D0!": ["0+1+2+3+4\r\n".replace("3+4", "3+4x"), "0+1+2+3\r\n"]})
+    assert m.data[0].ok and m.data[0].reply_text == "0+1+2+3\r\n"
+    assert m.values == ["+1", "+2", "+3"] == rebuilt.values
+
+
+def test_an_accepted_empty_first_reply_is_read_as_it_came():
+    m, rebuilt = _measured({"0D0!": ["0\r\n"]})
+    assert m.data[0].ok and m.data[0].reply_text == "0\r\n" and m.values == [] == rebuilt.values
 
 
 def test_fewer_values_to_retries_without_a_break_between_are_read_as_before():
