@@ -150,12 +150,8 @@ def delivered(attempts: list[Attempt], last: Attempt, *, binary: bool = False) -
     them are read as they came (the last answered), as before."""
     end = next(i for i, a in enumerate(attempts) if a is last)
     broken = max((i for i in range(1, end + 1) if attempts[i].break_event), default=0)
-    best, most = last, _values_held(last, binary)
-    for attempt in attempts[:broken]:
-        held = _values_held(attempt, binary) if attempt.reply_events else 0
-        if held > most or (held == most and best is not last):
-            best, most = attempt, held
-    return best
+    best, most = _fullest(attempts[:broken], binary)
+    return best if best is not None and most > _values_held(last, binary) else last
 
 
 def emptied(attempts: list[Attempt], accepted: Attempt, *, binary: bool = False) -> Attempt:
@@ -170,14 +166,21 @@ def emptied(attempts: list[Attempt], accepted: Attempt, *, binary: bool = False)
     retry holds, which is then read as before."""
     if _values_held(accepted, binary):
         return accepted
-    best, most = accepted, 0
+    end = next(i for i, a in enumerate(attempts) if a is accepted)
+    best, _ = _fullest(attempts[:end], binary)
+    return best if best is not None else accepted
+
+
+def _fullest(attempts: list[Attempt], binary: bool) -> tuple[Attempt | None, int]:
+    """Of ``attempts``, the later of those whose replies hold the most values, and how many
+    (None, 0: none holds any): where :func:`delivered` and :func:`emptied` read values from
+    an earlier try."""
+    best, most = None, 0
     for attempt in attempts:
-        if attempt is accepted:
-            break
         held = _values_held(attempt, binary) if attempt.reply_events else 0
         if held and held >= most:
             best, most = attempt, held
-    return best
+    return best, most
 
 
 def _values_held(attempt: Attempt, binary: bool) -> int:
