@@ -4,7 +4,7 @@ judges and the case object use, cite the wire the same way without importing eit
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 from ..tool_recorder.records import Exchange
 from ..transcript import Event, decode_7e1, escape
@@ -32,3 +32,10 @@ def heard(events: list[Event], what: str) -> str:
     outside any exchange (a service request, stray bytes), with when they began."""
     start = f"t={events[0].start:.4f} s: " if events else ""
     return f"{start}{what} '{escape(decode_7e1(events))}'"
+
+
+def listed(lines: Sequence[str], limit: int = 3) -> str:
+    """``a; b; c (+2 more)``: the first ``limit`` lines of a finding's detail, and how many
+    it leaves out (the evidence keeps them all)."""
+    more = len(lines) - limit
+    return "; ".join(lines[:limit]) + (f" (+{more} more)" if more > 0 else "")

@@ -8,7 +8,7 @@ from ..protocol.responses import parse_measurement_reply_for, parse_metadata_rep
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import escape
 from ..verdicts import Finding, inconclusive
-from .cite import cite, shown
+from .cite import cite, listed, shown
 from .tally import Tally
 
 SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
@@ -59,12 +59,11 @@ def uncounted_groups(groups: list[tuple[Exchange, Exchange]]) -> list[Finding]:
     groups' records showed (a FAIL found there still stands). Observed: those replies."""
     if not groups:
         return []
-    listed = "; ".join(f"{shown(start)}, {shown(ident)}" for start, ident in groups[:3])
-    more = f" (+{len(groups) - 3} more)" if len(groups) > 3 else ""
+    pairs = listed([f"{shown(start)}, {shown(ident)}" for start, ident in groups])
     return [
         inconclusive(
             "R-6.2-07",
-            f"no value count to check the records against: {listed}{more}",
+            f"no value count to check the records against: {pairs}",
             evidence=cite(ex for pair in groups for ex in pair),
             observed=len(groups),
         )
@@ -135,13 +134,11 @@ def _unconfirmed(missing: list[Exchange], ids: tuple[str, ...]) -> list[Finding]
     """R-6.2-07 INCONCLUSIVE for records missing inside a count only an identify reply gave."""
     if not missing or "R-6.2-07" not in ids:
         return []
-    listed = "; ".join(shown(ex) for ex in missing[:3])
-    more = f" (+{len(missing) - 3} more)" if len(missing) > 3 else ""
     return [
         inconclusive(
             "R-6.2-07",
             "no record inside a count only the identify reply announced (its measurement "
-            f"gave none to confirm it): {listed}{more}",
+            f"gave none to confirm it): {listed([shown(ex) for ex in missing])}",
             evidence=cite(missing),
             observed=len(missing),
         )

@@ -11,6 +11,7 @@ from collections.abc import Iterable
 
 from ..protocol.values import Violation
 from ..verdicts import Finding, Verdict
+from .cite import listed
 
 SHOWN = 3  # offending observations quoted per finding
 
@@ -71,16 +72,11 @@ class Tally:
                 hard = [b for b in bad if not b[1].warning]
                 verdict = Verdict.FAIL if hard else Verdict.WARN
                 lines = _counted(f"{w}: {v.message}" for w, v in (hard or bad))
-                shown = lines[:SHOWN]
-                more = len(lines) - len(shown)
-                detail = "; ".join(shown)
-                if more:
-                    detail += f" (+{more} more)"
                 result.append(
                     Finding(
                         rid,
                         verdict,
-                        detail,
+                        listed(lines, SHOWN),
                         decision=decision,
                         # the detail quotes SHOWN; the rest is kept here, not dropped, so
                         # the JSON and the report carry every offending observation
@@ -92,12 +88,11 @@ class Tally:
                 )
             elif self.undecided[rid]:
                 lines = _counted(self.undecided[rid])
-                more = f" (+{len(lines) - SHOWN} more)" if len(lines) > SHOWN else ""
                 result.append(
                     Finding(
                         rid,
                         Verdict.INCONCLUSIVE,
-                        "; ".join(lines[:SHOWN]) + more,
+                        listed(lines, SHOWN),
                         decision=decision,
                         observed=len(seen) + len(self.undecided[rid]),
                     )
@@ -111,14 +106,14 @@ class Tally:
                 result.append(Finding(rid, Verdict.INCONCLUSIVE, reason, decision=decision))
             else:
                 text = ok if isinstance(ok, str) else ok.get(rid, "conforms")
-                listed = ", ".join(dict.fromkeys(seen))
-                if len(listed) > 160:
-                    listed = listed[:157] + "..."
+                checked = ", ".join(dict.fromkeys(seen))
+                if len(checked) > 160:
+                    checked = checked[:157] + "..."
                 result.append(
                     Finding(
                         rid,
                         Verdict.PASS,
-                        f"{text} ({len(seen)} checked: {listed})",
+                        f"{text} ({len(seen)} checked: {checked})",
                         decision=decision,
                         observed=len(seen),
                     )
