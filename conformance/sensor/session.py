@@ -16,6 +16,7 @@ from ..declaration import Declaration
 from ..dut import DutClaim, Session, sensor_claim
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
+from ..preconditions import Unmet, acknowledges
 from ..protocol import commands as cmd
 from ..protocol.commands import (
     C_FAMILY,
@@ -578,6 +579,13 @@ class SensorSession(Session):
         if any(ex.answered for ex in probes) or self.address in self.master.acknowledged:
             return []
         return [self.master.transact(f"{self.address}!", force_break=True)]
+
+    def acknowledges(self, probes: list[Exchange]) -> Unmet | None:
+        """The "listening" outcome for silence to ``a!`` ``probes``: met if the sensor answers
+        an ``a!`` (one of them, one earlier in the run, or the control :meth:`acknowledgement`
+        sends now), unmet for a sensor that answers its other commands only."""
+        probes = [*probes, *self.acknowledgement(probes)]
+        return acknowledges(probes, self.address in self.master.acknowledged, self.address)
 
     def heard_probe(self, text: str, *, control_address: str | None = None) -> HeardProbe:
         """Send ``text`` once after a break with :meth:`hearing_marking`, then the control:

@@ -81,15 +81,6 @@ def _shown_asleep(sensor, case):
     return None
 
 
-def _acknowledges(sensor, probes):
-    """The "listening" outcome for silence to ``a!`` probes: it shows something only from a
-    sensor that answers an ``a!`` (in the run so far, or to a control sent now), not one
-    that answers its other commands only."""
-    probes = [*probes, *sensor.acknowledgement(probes)]
-    acked = sensor.address in sensor.master.acknowledged
-    return precondition.acknowledges(probes, acked, sensor.address)
-
-
 def _hears_after_a_break(sensor, case, what: str) -> bool:
     """Silence to a probe sent after a hand-made pulse counts only if the sensor, put to
     sleep the same way, answers an a! sent after a real break with the same marking: one
@@ -197,7 +188,7 @@ def test_break_just_over_12ms_wakes(sensor, case):
         )
     elif not case.requires("awake", unheard):
         pass  # silence from a sensor that may lawfully be asleep again
-    elif not case.requires("listening", _acknowledges(sensor, tries)):
+    elif not case.requires("listening", sensor.acknowledges(tries)):
         pass  # silence to a! from a sensor that answers no a!
     elif any(t.answered for t in tries):
         case.add(
@@ -279,7 +270,7 @@ def test_marking_after_break(sensor, case):
         unheard = replace(unheard, detail=unheard.detail + aimed.missed)
     if not case.requires("awake", unheard):
         return  # an unanswered command the sensor need no longer have heard
-    if not case.requires("listening", _acknowledges(sensor, [ok])):
+    if not case.requires("listening", sensor.acknowledges([ok])):
         return  # silence to a! from a sensor that answers no a!
     found = judge.answered(
         "R-7.0-05",
@@ -356,7 +347,7 @@ def test_ready_within_100ms_of_break(sensor, case):
         (f"t={brk.start:.4f} s: break", judge.cited(ex)),
     )
     if case.requires("awake", late if aimed.landed is None else None) and case.requires(
-        "listening", _acknowledges(sensor, [ex])
+        "listening", sensor.acknowledges([ex])
     ):
         case.add(
             judge.answered(
