@@ -95,9 +95,14 @@ class Exchange:
             return self.attempts[-1]
         if attempt is self.attempts[0] or not _is_data(self.command):
             return attempt
-        if attempt.ok:
-            return emptied(self.attempts, attempt, binary=self.binary)
-        return delivered(self.attempts, attempt, binary=self.binary)
+        # asked by every judge of the exchange, and each choice decodes every try: made once
+        # per attempts list and length (attempts are only ever added, each whole)
+        attempts, made = self.attempts, self.__dict__.get("_judged")
+        if made is None or made[0] is not attempts or made[1] != len(attempts):
+            pick = emptied if attempt.ok else delivered
+            made = (attempts, len(attempts), pick(attempts, attempt, binary=self.binary))
+            self.__dict__["_judged"] = made
+        return made[2]
 
     @property
     def reply_events(self) -> list[Event]:
