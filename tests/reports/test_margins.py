@@ -86,6 +86,21 @@ def test_the_strip_draws_the_limit_the_band_and_a_tick_per_measurement():
     assert max(xs) < limit
 
 
+def test_the_figures_fit_their_column_on_a_bench_links_uncertainty():
+    """A late reply judged with a bench link's ±15.34 ms: the right-hand figures, drawn in
+    10 px type, must fit the FIGURES column (about 5.6 px a character), not run off the strip
+    ("margin -4.60 ms = -0.30 u · ±15.34 ms" did)."""
+    from conformance.reports.margins import FIGURES
+
+    seen = [Measured(LATE, ms / 1e3, 0.01534, None) for ms in (9.0, 20.0, 123.4)]
+    found = combine("R-7.0-10", seen, "reply")
+    svg = strip(_result(found), found, 1234)
+    right = re.findall(r'<text x="(\d+)" y="\d+" font-size="10">([^<]*)</text>', svg)
+    lines = [text for x, text in right if int(x) > 400]
+    assert any("u" in t and "margin" in t for t in lines) and any("±15.34 ms" in t for t in lines)
+    assert max(len(t) for t in lines) * 5.6 <= FIGURES - 8, lines
+
+
 def test_no_band_on_an_exact_clock_and_no_section_without_timed_rules():
     found = combine("R-7.0-10", [Measured(LATE, 0.009, 0.0, None)], "reply")
     assert 'class="sdi12-band"' not in strip(_result(found), found, 1)
