@@ -72,3 +72,45 @@ def test_the_same_cases_still_fail_a_sensor_that_answers_a_but_wakes_too_slowly(
     found = _verdicts(run_once("sim://?faults=slow-wake", keyword=A_PROBES))
     assert found["R-7.0-07"]["verdict"] == "FAIL"
     assert found["R-4.4.1-01"]["verdict"] == "PASS"
+
+
+def test_a_sensor_that_talked_is_not_sent_to_the_wiring():
+    """An outside sensor firmware (RTGS-Lab Firmware_-_Aleppo, docs/kit.md) has no a! reply,
+    prints its replies without CR LF and answers whatever stale command its UART buffer
+    holds: it answered the first ?! with '0', then nothing the tool took for a reply to a!,
+    aI! or the last ?!. The tool stopped with "no device answered ... Check wiring and
+    power". The stop (exit 5, still no verdict) now says the device talked, what it sent
+    first, and to check its reply format. Here: a sensor that answers ?! once, then only
+    silence."""
+    from conformance.emulator import sim_sensor
+    from conformance.sensor.session import NoDeviceAnswered, SensorSession
+
+    class OnceOnQuery(FaultSet):
+        queries = 0
+
+        def rewrite(self, reply):
+            if reply.kind is ReplyKind.ADDRESS:
+                OnceOnQuery.queries += 1
+                return super().rewrite(reply) if OnceOnQuery.queries == 1 else None
+            return None
+
+    _, link, emulator = sim_sensor()
+    emulator.faults = OnceOnQuery(emulator.faults.faults, emulator.behaviour)
+    with pytest.raises(NoDeviceAnswered) as stop:
+        SensorSession(link).discover()
+    said = str(stop.value)
+    assert "The device did talk" in said and "'0<CR><LF>'" in said, said
+    assert "Check wiring" not in said, said
+
+
+def test_total_silence_still_sends_the_user_to_the_wiring():
+    from dataclasses import replace
+
+    from conformance.emulator import sim_sensor
+    from conformance.sensor.session import NoDeviceAnswered, SensorSession
+
+    _, link, emulator = sim_sensor()
+    emulator.behaviour = replace(emulator.behaviour, break_threshold=1.0)
+    with pytest.raises(NoDeviceAnswered, match="Check wiring") as stop:
+        SensorSession(link, address="0").discover()
+    assert "did talk" not in str(stop.value)
