@@ -35,6 +35,7 @@ judged on what the wire shows.
 from __future__ import annotations
 
 import contextlib
+import re
 from dataclasses import dataclass, replace
 
 from ..catalog import requirement
@@ -252,7 +253,11 @@ class Capabilities:
                     f"(otherwise: {was})"
                 )
                 f.consequence_of = None
-            elif f.requirement in mandatory and f.verdict is Verdict.FAIL:
+            elif (
+                f.requirement in mandatory
+                and f.verdict is Verdict.FAIL
+                and self._may_name_absent(f, mandatory[f.requirement])
+            ):
                 f.detail += (
                     f" — declared absent ({'; '.join(mandatory[f.requirement])}), but "
                     f"{f.requirement} requires it of a recorder claiming {version}: the "
@@ -269,6 +274,32 @@ class Capabilities:
                     f'says the recorder polls only "{self.declared.addresses_text}" '
                     f"({self.declared.where['addresses']}); none asked"
                 )
+
+    def _may_name_absent(self, finding: Finding, cited: list[str]) -> bool:
+        """Whether a FAIL of a rule that asks for a declared-absent capability may be about
+        that absence, so that the "declared absent ... does not excuse it" note belongs on
+        it. A FAIL naming only commands the declaration allows (values logged wrong from
+        ``0M2!``) is about something else: the note would blame the absence for it. A finding
+        that names no command, or cuts its list short, keeps the note."""
+        text = " ".join([finding.detail, *finding.evidence])
+        named = _COMMAND_TEXT.findall(text)
+        if not named or "more)" in text or any(c.startswith("addresses") for c in cited):
+            return True
+        for word in named:
+            try:
+                command = parse_command(word)
+            except CommandError:
+                return True  # not a command after all: keep the note, as before
+            token = token_of(command)
+            if token in self.absent_tokens and mandatory_rule(token, self.v14) == (
+                finding.requirement
+            ):
+                return True
+        return False
+
+
+#: command text as findings quote it (``0M2!``, ``0XHELP!``, ``aHA!``)
+_COMMAND_TEXT = re.compile(r"(?<![\w!])[0-9A-Za-z?][0-9A-Za-z_?]*!")
 
 
 def job_rules(commands: tuple[str, ...], v14: bool) -> tuple[dict[str, list[str]], set[str]]:

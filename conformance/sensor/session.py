@@ -30,7 +30,7 @@ from ..protocol.commands import (
 from ..protocol.responses import Identification, parse_ident, split_line
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..tool_recorder.records import Exchange, Measurement
-from ..transcript import Event, escape
+from ..transcript import TOOL, Event, EventKind, decode_7e1, escape
 from ..view.rebuilt_records import Rebuilt, rebuild_records
 from ..view.segments import read_view
 from .address_change import AddressChanger
@@ -240,10 +240,28 @@ class SensorSession(Session):
             )
             return False
         other = f"; ?! was answered '{escape(query.reply_text)}'" if query.answered else ""
+        talked = self._talked()
         raise NoDeviceAnswered(
             f"no device answered at address {self.address!r} (a! and aI! got no reply after "
-            f"retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms{other}). "
-            "Check wiring and power, or try ?! with one sensor on the bus."
+            f"retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms{other})"
+            + (talked or ". Check wiring and power, or try ?! with one sensor on the bus.")
+        )
+
+    def _talked(self) -> str:
+        """What the device sent although nothing it sent was a reply: a sensor whose replies
+        lack CR LF, or that answers the wrong command, is talking, so the stop must not send
+        its user to the wiring (seen on an outside sensor firmware, docs/kit.md). Only for a
+        device alone on the line: on a shared bus the other sensors' characters are heard."""
+        heard = [
+            e for e in self.link.transcript.events if e.kind is EventKind.CHAR and e.origin != TOOL
+        ]
+        if not heard:
+            return ""
+        return (
+            f". The device did talk: {len(heard)} character(s), first "
+            f"'{escape(decode_7e1(heard[:12]))}' at t={heard[0].start:.3f} s, none of it "
+            "taken as a reply to a! or aI!: check its reply format (CR LF) and address, not "
+            "the wiring"
         )
 
     def claim(self) -> DutClaim:

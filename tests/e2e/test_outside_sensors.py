@@ -18,6 +18,11 @@ Two things the tool said about it were false:
   command): the rest read as a reply begun 0 ms after the command, a R-7.0-09 FAIL. The tool's
   recorder already took that tail for contention live; now the view does too
   (``Transmission.cut``, tests/view/test_segments.py).
+
+The tenth round (docs/kit.md) added two: a sensor firmware that talked but never validly
+(RTGS-Lab Firmware_-_Aleppo) was sent to its wiring by the "no device answered" stop, and
+R-4.4.14-01's PASS for a logger that reports no relayed replies (USDI12 on the C kit) did not
+say the relay went unjudged.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ import pytest
 from conformance.conduct import run_once
 from conformance.emulator.faults import FaultSet
 from conformance.emulator.replies import ReplyKind
+from conformance.recorder.golden import GoldenRecorder
 
 #: The cases that probe with a! (and R-4.4.1-01's own).
 A_PROBES = (
@@ -72,3 +78,74 @@ def test_the_same_cases_still_fail_a_sensor_that_answers_a_but_wakes_too_slowly(
     found = _verdicts(run_once("sim://?faults=slow-wake", keyword=A_PROBES))
     assert found["R-7.0-07"]["verdict"] == "FAIL"
     assert found["R-4.4.1-01"]["verdict"] == "PASS"
+
+
+def test_a_sensor_that_talked_is_not_sent_to_the_wiring():
+    """An outside sensor firmware (RTGS-Lab Firmware_-_Aleppo, docs/kit.md) has no a! reply,
+    prints its replies without CR LF and answers whatever stale command its UART buffer
+    holds: it answered the first ?! with '0', then nothing the tool took for a reply to a!,
+    aI! or the last ?!. The tool stopped with "no device answered ... Check wiring and
+    power". The stop (exit 5, still no verdict) now says the device talked, what it sent
+    first, and to check its reply format. Here: a sensor that answers ?! once, then only
+    silence."""
+    from conformance.emulator import sim_sensor
+    from conformance.sensor.session import NoDeviceAnswered, SensorSession
+
+    class OnceOnQuery(FaultSet):
+        queries = 0
+
+        def rewrite(self, reply):
+            if reply.kind is ReplyKind.ADDRESS:
+                OnceOnQuery.queries += 1
+                return super().rewrite(reply) if OnceOnQuery.queries == 1 else None
+            return None
+
+    _, link, emulator = sim_sensor()
+    emulator.faults = OnceOnQuery(emulator.faults.faults, emulator.behaviour)
+    with pytest.raises(NoDeviceAnswered) as stop:
+        SensorSession(link).discover()
+    said = str(stop.value)
+    assert "The device did talk" in said and "'0<CR><LF>'" in said, said
+    assert "Check wiring" not in said, said
+
+
+def test_total_silence_still_sends_the_user_to_the_wiring():
+    from dataclasses import replace
+
+    from conformance.emulator import sim_sensor
+    from conformance.sensor.session import NoDeviceAnswered, SensorSession
+
+    _, link, emulator = sim_sensor()
+    emulator.behaviour = replace(emulator.behaviour, break_threshold=1.0)
+    with pytest.raises(NoDeviceAnswered, match="Check wiring") as stop:
+        SensorSession(link, address="0").discover()
+    assert "did talk" not in str(stop.value)
+
+
+class _RelaysUnreported(GoldenRecorder):
+    """The golden recorder, its transparent-mode replies not reported (as an outside logger
+    on the C kit's recorder adapter, which has no call for them)."""
+
+    def __call__(self, request, link):
+        out = super().__call__(request, link)
+        out.relayed.clear()
+        return out
+
+
+def relays_unreported() -> GoldenRecorder:
+    return _RelaysUnreported()
+
+
+def test_a_transparent_pass_says_when_the_relay_was_not_judged():
+    """USDI12 (jwidess/uart-sdi12, docs/kit.md) in transparent mode: R-4.4.14-01 PASSed
+    "passed through" on the break and the command seen on the wire, though the relay of the
+    reply to the host, which the rule also asks, was never reported. The PASS stands (what
+    the wire shows conforms) and now says the relay was not judged; with relays reported
+    (the golden recorder) it reads as before."""
+    keyword = "test_transparent_mode"
+    port = "sim:?recorder=tests.e2e.test_outside_sensors:relays_unreported"
+    unreported = _verdicts(run_once(port, role="recorder", keyword=keyword))["R-4.4.14-01"]
+    reported = _verdicts(run_once("sim", role="recorder", keyword=keyword))["R-4.4.14-01"]
+    assert unreported["verdict"] == reported["verdict"] == "PASS"
+    assert "were not reported: not judged" in unreported["findings"][0]["detail"]
+    assert "not judged" not in reported["findings"][0]["detail"]

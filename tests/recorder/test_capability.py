@@ -282,3 +282,41 @@ def test_a_trigger_that_cannot_do_the_addresses_job(tmp_path):
     assert code == 1
     assert got["R-4.3-03"] == "FAIL" and got["R-4.3-04"] == "N/A"
     assert any("cannot do addresses (letters only)" in d for d in details(data, "R-4.3-03"))
+
+
+# -- the "declared absent" note only where the absence is what failed (outside check, 2026-12-05)
+
+
+def test_a_fail_about_allowed_commands_is_not_blamed_on_a_declared_absence(tmp_path):
+    """R-4.4-02 asks both for the command families (aMC!, declared absent here) and for the
+    logged values to be the ones sent. A logger that cuts digits off 0M2!'s values FAILs the
+    latter; that FAIL said "declared absent (aMC! ...), but R-4.4-02 requires it ... does not
+    excuse it", blaming the absence for a fault in 0M2!'s logging (seen on USDI12, a logger
+    that logged a paused D0 reply, run with crc = false declared: docs/kit.md)."""
+    path = write(tmp_path, 'sdi12_version = "1.3"\n[recorder]\ncrc = false\n')
+    found = details(run("sim:?recorder-faults=truncates-values", path), "R-4.4-02")
+    cut = [d for d in found if "digits cut off" in d]
+    assert cut, found
+    assert not any("declared absent" in d for d in cut), cut
+
+
+def test_the_note_stays_where_a_finding_names_a_declared_absent_command(tmp_path):
+    """Unit level: a FAIL naming aMC! (or naming no command at all, or a list cut short)
+    keeps the note; one naming only 0M2! does not."""
+    from conformance.recorder.capability import Capabilities
+
+    path = write(tmp_path, 'sdi12_version = "1.3"\n[recorder]\ncrc = false\n')
+    caps = Capabilities(load_declaration(path), "13")
+
+    def fail(detail: str, *evidence: str) -> Finding:
+        seen = list(evidence) or ["the run"]  # a FAIL needs an evidence line
+        return Finding("R-4.4-02", Verdict.FAIL, detail, evidence=seen, observed=1)
+
+    findings = [
+        fail("never answered validly: 0MC!, 0V!"),
+        fail("pause-once: 0M2!: logged 9 value(s), 6 in valid replies", "pause-once: 0M2!"),
+        fail("the logger logged nothing"),
+        fail("never answered validly: 0M!, 0M1! (+2 more)"),
+    ]
+    caps.apply(findings, sent=set())
+    assert ["declared absent" in f.detail for f in findings] == [True, False, True, True]

@@ -106,10 +106,11 @@ def judge_transparent(
     relayed: dict[str, str] | None,
 ) -> list[Finding]:
     """R-4.4.14-01: each host command goes out whole, after a break, and (when the recorder
-    reports it) the sensor's reply is relayed unchanged. R-4.4.14-02: basic, extended and
-    metadata commands pass unchanged. R-4.4.13-03: extended commands start with the address
-    and end with ``!``. R-6.3-01: metadata commands pass through (what a recorder that does
-    not understand metadata must at least do)."""
+    reports it) the sensor's reply is relayed unchanged; a PASS without that report says the
+    relay was not judged (an outside logger on the C kit, which has no call to report it).
+    R-4.4.14-02: basic, extended and metadata commands pass unchanged. R-4.4.13-03: extended
+    commands start with the address and end with ``!``. R-6.3-01: metadata commands pass
+    through (what a recorder that does not understand metadata must at least do)."""
     mechanism = Tally(("R-4.4.14-01",))
     unchanged = Tally(("R-4.4.14-02", "R-4.4.13-03", "R-6.3-01"))
     sent_texts = [s.text for s in line.transmissions]
@@ -146,7 +147,10 @@ def judge_transparent(
                     where,
                     f"relayed '{escape(got[:40])}', the sensor sent '{escape(want[:40])}'",
                 )
-    return [*mechanism.findings("passed through"), *unchanged.findings("passed unchanged")]
+    through = "passed through"
+    if relayed is None:  # the wire shows the break and the command, not what the host got
+        through += " (the replies relayed to the host were not reported: not judged)"
+    return [*mechanism.findings(through), *unchanged.findings("passed unchanged")]
 
 
 def judge_multiline_end(
