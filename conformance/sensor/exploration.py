@@ -71,6 +71,7 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
     gc_pace.freeze_for_libraries()  # hypothesis's one gc.collect() walks only what it made
     machine_module = _machine_module()  # hypothesis: loaded here
     machine_class, run_machine = machine_module.machine_class, machine_module.run_machine
+    release = machine_module.release
 
     record = Exploration()
     junk = globals()["JUNK"] if "JUNK" in globals() else __getattr__("JUNK")  # or a caller's
@@ -85,6 +86,8 @@ def explore(sensor: SensorSession, *, examples: int = 10, steps: int = 25) -> Ex
     except BaseException as exc:  # hypothesis may wrap the failure; a breach recorded stands
         if record.broken is None or isinstance(exc, KeyboardInterrupt):
             raise
+    finally:
+        release(machine)  # hypothesis keeps the class for the process: not the run with it
     return record
 
 

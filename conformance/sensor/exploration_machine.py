@@ -202,6 +202,23 @@ def machine_class(
     return seed(SEED)(SensorMachine)
 
 
+def release(machine: type[RuleBasedStateMachine]) -> None:
+    """Let go of the run a machine class of :func:`machine_class` was made for, once it has
+    run. Hypothesis keeps every state machine class it ran for the rest of the process
+    (``RuleBasedStateMachine._setup_state_per_class``, a plain dict), and the class held its
+    run's sensor session, hence the run's link, transcript and views: a process making run
+    after run (a fault matrix's worker, a test session) kept every one of them, about 650,000
+    objects (some 100 MB against wrong-crc) a run, which its collections then walked again
+    and again. The class's own attributes are dropped (nothing reads them after the run) and
+    hypothesis's entry for it, where this hypothesis keeps one."""
+    for name in ("sensor", "record", "marking"):
+        if name in vars(machine):
+            delattr(machine, name)
+    kept = getattr(RuleBasedStateMachine, "_setup_state_per_class", None)
+    if isinstance(kept, dict):
+        kept.pop(machine, None)
+
+
 def run_machine(machine: type[RuleBasedStateMachine], examples: int, steps: int) -> None:
     run_state_machine_as_test(
         machine,
