@@ -515,36 +515,34 @@ def _measures(seg: Segment) -> list[float]:
     return out
 
 
-#: from this many intervals a :class:`MeasureIndex` is ordered by numpy (a stable argsort of
-#: the arrays as they are: 8 bytes an interval where ``sorted(range(n))`` made an int object
-#: and a list slot per interval, 36 bytes; an hour's capture: 535,000 intervals, the peak of
-#: its passive judgement). Only when numpy is loaded already (a capture's decoding loads it):
-#: importing it for the order alone cost a simulated run more than it saved (a wrong-crc run's
-#: 145,000 intervals: 0.07 s of import and 12 MB), so a simulated run never imports it here.
+#: from this many intervals a :class:`MeasureIndex` keeps each distinct value once, with the
+#: first segment that holds it (:func:`_first_owners`), where a shorter one keeps every
+#: interval sorted; only where numpy is loaded already, which is to say where a capture was
+#: decoded (an hour's capture: 535,000 intervals of a few thousand distinct values). A
+#: simulated run keeps its arrays as before (a wrong-crc run's 145,000 intervals), read in
+#: one pass.
 NUMPY_FROM = 50_000
 
 
-def _numpy_order(values: array[float], owners: array[int]) -> tuple[array[float], array[int]]:
-    """``values`` sorted, stably (equal values keep their order, so their segments stay in
-    recording order), and ``owners`` in the same order, each run of equal values kept as its
-    first only (its first owner: the one :meth:`MeasureIndex.nearest` answers with, which
-    looks at nothing else of a run). No NaN among ``values``. An hour's capture holds
-    535,000 intervals of a few thousand distinct values: the index it keeps through every
-    later report set is those, not 8.6 MB of arrays."""
-    import numpy as np
-
-    v = np.frombuffer(values, dtype=np.float64)
-    order = np.argsort(v, kind="stable")
-    ordered = v[order]
-    del v  # the buffer export of ``values`` ends here
-    first = np.ones(len(ordered), dtype=bool)
-    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])  # -0.0 == 0.0, as bisect has it
-    sorted_values, sorted_owners = array("d"), array("q")
-    sorted_values.frombytes(ordered[first].tobytes())
-    del ordered
-    kept = np.frombuffer(owners, dtype=np.int64)[order[first]]
-    sorted_owners.frombytes(kept.tobytes())
-    return sorted_values, sorted_owners
+def _first_owners(each: Iterable[list[float]]) -> tuple[dict[float, int] | None, int]:
+    """Each distinct value of ``each`` segment's intervals with the first segment holding
+    it, and how many intervals there were; None for the values if one is a NaN. Read as
+    the segments come, so nothing is kept per interval: the arrays of every interval and
+    numpy's stable argsort of them, which this replaces, were the peak of an hour's passive
+    judgement (16 bytes an interval kept and some 25 more while sorting: 9.3 MB above what
+    was held at 30 minutes of a busy capture). A dict keeps a key's first spelling, so of
+    the equal -0.0 and 0.0 the one met first stays, with its segment, as the stable sort
+    kept the first of each run of equal values."""
+    first: dict[float, int] = {}
+    add = first.setdefault
+    count = 0
+    for i, ms in enumerate(each):
+        count += len(ms)
+        for m in ms:
+            add(m, i)
+    if any(m != m for m in first):
+        return None, count
+    return first, count
 
 
 class MeasureIndex:
@@ -560,14 +558,23 @@ class MeasureIndex:
         numpy_from: int | None = None,
     ):
         """``measures``: each segment's intervals, given instead of ``cut`` (for tests);
-        ``numpy_from``: from how many intervals the order is found by numpy (default
-        :data:`NUMPY_FROM`; tests set it to compare both ways)."""
+        ``numpy_from``: from how many intervals each distinct value is kept once (default
+        :data:`NUMPY_FROM`, where numpy is loaded; tests set it to compare both ways)."""
         #: kept as arrays, 16 bytes an interval where lists of floats and ints took 40 and
         #: more: the index outlives the report that built it (an hour's capture: 535,000
-        #: intervals, held through every later run of a passive judgement); ordered by
-        #: numpy, a run of equal values is kept as its first only (:func:`_numpy_order`)
+        #: intervals, held through every later run of a passive judgement); a long one
+        #: keeps each distinct value once, with its first segment (:func:`_first_owners`)
         self.values: array[float] = array("d")
         self.owners: array[int] = array("q")
+        if not cut:
+            measures = list(measures)  # read twice below, perhaps
+        if numpy_from is not None or "numpy" in sys.modules:
+            first, count = _first_owners(map(_measures, cut) if cut else measures)
+            if first is not None and count >= (NUMPY_FROM if numpy_from is None else numpy_from):
+                ordered = sorted(first)  # distinct: no two equal, so no order among equals
+                self.values.extend(ordered)
+                self.owners.extend(map(first.__getitem__, ordered))
+                return
         values, owners = array("d"), array("q")
         for i, ms in enumerate(map(_measures, cut) if cut else measures):
             values.extend(ms)
@@ -576,11 +583,6 @@ class MeasureIndex:
             pairs = sorted(zip(values, owners, strict=True))
             self.values.extend(m for m, _ in pairs)
             self.owners.extend(i for _, i in pairs)
-            return
-        if len(values) >= (NUMPY_FROM if numpy_from is None else numpy_from) and (
-            numpy_from is not None or "numpy" in sys.modules
-        ):
-            self.values, self.owners = _numpy_order(values, owners)
             return
         # a stable sort by value keeps equal values in segment order, as sorting (value,
         # segment) pairs did, without a tuple per interval (10^4 of them in a simulated run)

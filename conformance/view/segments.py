@@ -63,6 +63,9 @@ def on_tool_link(event: Event) -> bool:
 
 T = TypeVar("T")
 
+#: the names :class:`Transmission` keeps its derived values under (:func:`memo`)
+_MEMOS = ("_text", "_command", "_contention", "_reply", "_after")
+
 
 @dataclass
 class Transmission:
@@ -78,6 +81,14 @@ class Transmission:
     #: (:func:`collided`), never a reply. A line that queues frames (the sim bus, a kit)
     #: puts the tail right after the command, 0 ms later, where it read as a reply before.
     cut: Event | None = None
+
+    def __post_init__(self) -> None:
+        # every derived value :func:`memo` keeps here, named up front in one order: the
+        # instances' attribute dicts then share their keys (CPython's split tables, 8 bytes
+        # a value) instead of each growing a table of its own as the judges happen to ask
+        # (464 bytes a transmission; an hour's busy capture has some 15,000)
+        for name in _MEMOS:
+            self.__dict__[name] = None
 
     @property
     def text(self) -> str:
@@ -136,16 +147,21 @@ class Transmission:
     def contention(self) -> list[Event]:
         """Sensor characters that started before the command ended, or came back between the
         echoes of its characters (two talkers): never part of a reply."""
-        return list(
-            memo(self, "_contention", self._grown, lambda: collided(self.heard, self.end, self.cut))
-        )
+        return list(memo(self, "_contention", self._grown, self._collided))
+
+    def _collided(self) -> Sequence[Event]:
+        # none, nearly always: kept as the one empty tuple, not an empty list each
+        return collided(self.heard, self.end, self.cut) or ()
 
     @property
-    def _grown(self) -> tuple[int, int]:
-        """How far the transmission has grown (its lists are only appended to while the view
-        is cut): what its derived lists are kept under. The judges ask for a transmission's
-        reply many times; each caller gets its own copy of the list."""
-        return len(self.chars), len(self.heard)
+    def _grown(self) -> int:
+        """How far the transmission has grown: what its derived lists are kept under. Its
+        lists are only appended to while the view is cut, so their total length changes
+        whenever either does; a sum (a small int, nearly always one CPython keeps) where a
+        tuple of both lengths was one more object for each of three lists a transmission.
+        The judges ask for a transmission's reply many times; each caller gets its own copy
+        of the list."""
+        return len(self.chars) + len(self.heard)
 
     @property
     def reply(self) -> list[Event]:
@@ -156,34 +172,43 @@ class Transmission:
 
     def _framed_reply(self) -> list[Event]:
         clash = {id(e) for e in self.contention}
-        heard = [e for e in self.heard if id(e) not in clash]
+        # every character heard, nearly always (no contention, nothing after the reply's
+        # end): kept as the transmission's own list, not a copy (``reply`` hands out copies,
+        # and the key it is kept under changes if the list grows)
+        heard = [e for e in self.heard if id(e) not in clash] if clash else self.heard
         if self.binary:
             length = packet_length(decode_8n1(heard))
-            return heard[:length] if length is not None else heard
+            return _first(heard, length) if length is not None else heard
         text = len(heard) > 1 and heard[1].char7 == STX
         for i, e in enumerate(heard):
             if text and e.char7 == ETX:
-                return heard[: i + 1]
+                return _first(heard, i + 1)
             if not text and e.char7 == LF:
-                return heard[: i + 1]
+                return _first(heard, i + 1)
             if text and e.char7 == LF:
                 nxt = heard[i + 1] if i + 1 < len(heard) else None
                 if nxt is None or nxt.start - e.end > MULTILINE_GAP_MAX + TOLERANCE:
-                    return heard[: i + 1]
+                    return _first(heard, i + 1)
         return heard
 
     @property
     def after(self) -> list[Event]:
         """What the sensors sent after the reply (service requests, chatter)."""
-        return list(memo(self, "_after", self._grown, self._after))
+        return list(memo(self, "_after", self._grown, self._heard_after))
 
-    def _after(self) -> list[Event]:
+    def _heard_after(self) -> Sequence[Event]:
         taken = {id(e) for e in self.reply} | {id(e) for e in self.contention}
-        return [e for e in self.heard if id(e) not in taken]
+        return [e for e in self.heard if id(e) not in taken] or ()
 
     def at(self) -> str:
         """Where it is, for evidence lines."""
         return f"{escape(self.text)} at t={self.first_char:.3f} s"
+
+
+def _first(items: list[T], n: int) -> list[T]:
+    """``items[:n]``, or ``items`` itself when that is all of it (a kept value handed out
+    only as copies need not be a copy of its own)."""
+    return items if n >= len(items) else items[:n]
 
 
 def collided(heard: list[Event], end: float, cut: Event | None = None) -> list[Event]:

@@ -1,0 +1,64 @@
+"""What the role-neutral view holds per transmission once the judges have asked it everything
+(issue 22: a passive judgement holds the view of the whole recording while its report sets
+are made, so its size a transmission is part of the peak's growth a minute of capture).
+
+Measured on the benchmark's busy bus (break, ``aD0!``, a 19-character reply; 2 minutes, 495
+transmissions, directions inferred): the view with every transmission's text, command,
+contention, reply and what came after asked, 1,924 bytes a transmission on the tree before
+(689a849: each transmission's attribute dict grown key by key to 464 bytes, a tuple
+of both list lengths kept per derived list, a copy of the heard list as its reply, an empty
+list each for the contention and what came after), 1,100 now. The events are made before
+and not counted.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import tracemalloc
+from dataclasses import replace
+from pathlib import Path
+
+from conformance.transcript import BUS
+from conformance.view.segments import read_view
+
+BENCH = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
+BYTES_PER_TRANSMISSION = 1_300  # 1,100 measured; the tree before 1,924
+
+
+def busy_events(seconds: float):
+    """The capture benchmark's busy bus, every event undirected as a capture's are."""
+    spec = importlib.util.spec_from_file_location("capture_decode_bench", BENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return [replace(e, origin=BUS) for e in module.busy_bus(seconds)]
+
+
+def test_a_judged_views_size_per_transmission_stays_under_its_figure():
+    events = busy_events(120)
+    read_view(events[:50])  # imports and first-use caches outside the measurement
+    tracemalloc.start()
+    try:
+        view = read_view(events)
+        for t in view.transmissions:
+            t.text, t.command, t.contention, t.reply, t.after  # noqa: B018 (what judges ask)
+        size, _peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    n = len(view.transmissions)
+    assert n == 495
+    assert size / n <= BYTES_PER_TRANSMISSION, f"{size / n:.0f} bytes a transmission"
+
+
+def test_derived_lists_stay_the_same_when_handed_out():
+    """Each caller still gets its own list: changing one changes neither the transmission
+    nor what the next caller gets (the reply is now kept as the heard list itself)."""
+    view = read_view(busy_events(2))
+    t = view.transmissions[0]
+    reply = t.reply
+    assert reply == t.heard and reply is not t.heard
+    reply.clear()
+    t.contention.append(t.heard[0])
+    t.after.append(t.heard[0])
+    assert t.reply == t.heard and len(t.heard) == 19
+    assert t.contention == [] and t.after == []
