@@ -23,7 +23,8 @@ built without an array of every interval): 2 minutes 69.2-69.5 MB, 14 minutes 87
 single runs, so 1.54-1.89 MB a minute; 689a849, the tree before, 69.3-70.0 and 91.3-94.6,
 1.81-2.10. So the long capture is judged twice too now, and the lower of each pair taken:
 1.56, 1.58 and 1.61 MB a minute in three runs of this test, 689a849 1.77, 1.77 and 2.10,
-which this limit fails (by a thin margin: 0.02 MB a minute in its best runs).
+which a limit of 1.75 would fail by a thin
+margin (0.02 MB a minute in its best runs): the limit is set above CI's noise instead.
 """
 
 from __future__ import annotations
@@ -37,8 +38,11 @@ from pathlib import Path
 
 import pytest
 
-MB_PER_MINUTE = 1.75  # 1.56-1.61 measured (issue 22's tenth round), 689a849 1.77-2.10; the
-# lower of two runs of each length (one long run alone varied by 4.4 MB, 0.37 a minute)
+MB_PER_MINUTE = 1.90  # 1.56-1.61 measured (issue 22's tenth round), 689a849 1.77-2.10; the
+# lower of two runs of each length (one long run alone varied by 4.4 MB, 0.37 a minute). Not
+# 1.75, which fails 689a849's best runs by 0.02 only: too thin for a CI under load. The tenth
+# round's cuts have their own tests that fail on 689a849 (tests/view/test_view_memory.py,
+# test_timing_diagram's long index); this one guards the slope against regressions.
 SHORT, LONG = 2.0, 14.0  # minutes
 
 #: the benchmark that makes the busy bus and judges a capture in a child process, which prints
