@@ -23,7 +23,9 @@ from ..protocol.timing import TOLERANCE
 from ..protocol.values import Violation, check_value
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
-from ..verdicts import Finding
+from ..verdicts import Finding, inconclusive
+from .cite import cite, listed, shown
+from .support import unreadable_count
 from .tally import Tally
 from .wire import runs
 
@@ -307,6 +309,25 @@ def judge(
         wait_violations(m, tally)
         data_violations(m, tally)
     return tally.findings(ok)
+
+
+def unread_data(measurements: Iterable[Measurement], ids: Iterable[str]) -> list[Finding]:
+    """``ids`` INCONCLUSIVE where a measurement's start reply gave no readable count
+    (:func:`~conformance.judges.support.unreadable_count`): its D replies were never asked
+    for, so a PASS over the other measurements' replies would speak for values nobody read
+    (measure-ttt-two-digits beside value-ten-chars PASSed R-4.4.8-02 on aC!'s replies while
+    aM!'s ten-character value stayed in the sensor). A violation found elsewhere still
+    FAILs: the run's verdict is the worst of its findings. Observed: those start replies."""
+    unread = [m for m in measurements if unreadable_count(m)]
+    if not unread:
+        return []
+    starts = [m.start for m in unread]
+    detail = (
+        "no value count in "
+        + listed([shown(ex) for ex in starts])
+        + ": no D command followed, so the values held there are unjudged"
+    )
+    return [inconclusive(rid, detail, evidence=cite(starts), observed=len(starts)) for rid in ids]
 
 
 def _reply_ids(m: Measurement) -> list[str]:

@@ -32,6 +32,7 @@ def test_data_replies(sensor, case):
     case.evidence("every defined measurement's D replies", ms)
     case.requires("buffered", precondition.buffered_any(ms))
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES), case.requirements))
 
 
 @requirements("R-4.4.8-03", "R-4.4.8-04")
@@ -45,6 +46,7 @@ def test_announced_values_delivered(sensor, case):
         "supported", precondition.shown_supported(bool(ms), "no measurement announced values")
     )
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES + ("HA",)), case.requirements))
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")
@@ -59,6 +61,7 @@ def test_value_grouping(sensor, case):
     case.evidence("every defined measurement", ms)
     case.requires("buffered", precondition.buffered_any(ms))
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES), case.requirements))
 
 
 @requirements("R-4.4.8-03")

@@ -20,6 +20,11 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
 - R-4.4.7-08 PASSed "aC! answered '0000000'" (concurrent-three-digit-count +
   concurrent-zero, seed 4062): a malformed reply still answers aC!, but one that reads as
   zero values whatever its count's width is no measurement started: FAIL, as a00000 is.
+- R-4.4.8-02 PASSed on aC!'s D replies while aM!'s reply gave no readable count, so its
+  ten-character value was never asked for (measure-ttt-two-digits + value-ten-chars, seed
+  4061); R-4.4-05 the same over aM2!'s 40 characters (+ values-over-35) and aC!'s 80
+  (concurrent-three-digit-count + values-over-75): the D-reply and value rules are
+  INCONCLUSIVE where a start reply in digits gives no count (a reply of zeros announces none).
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ from conformance.results import CaseRecord, counted
 from conformance.sensor.session import SensorSession
 from conformance.verdicts import Verdict, worst
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
+from testcases.sensor.test_4_4_8_data import test_data_replies as data_case
 from testcases.sensor.test_4_4_9_additional import test_verification as verification_case
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
@@ -153,3 +159,24 @@ def test_binary_packets_past_an_unreadable_one(faults, expected):
 )
 def test_a_concurrent_reply_of_zero_values_in_any_reading(faults, expected):
     assert _verdict(_session(faults), concurrent_case, "R-4.4.7-08") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "rule", "expected"),
+    [
+        ("measure-ttt-two-digits,value-ten-chars", "R-4.4.8-02", Verdict.INCONCLUSIVE),
+        ("measure-ttt-two-digits", "R-4.4.8-02", Verdict.INCONCLUSIVE),
+        ("value-ten-chars", "R-4.4.8-02", Verdict.FAIL),
+        ("", "R-4.4.8-02", Verdict.PASS),
+        ("measure-ttt-two-digits,values-over-35", "R-4.4-05", Verdict.INCONCLUSIVE),
+        ("values-over-35", "R-4.4-05", Verdict.FAIL),
+        ("concurrent-three-digit-count,values-over-75", "R-4.4-05", Verdict.INCONCLUSIVE),
+        ("concurrent-three-digit-count", "R-4.4.8-02", Verdict.INCONCLUSIVE),
+        ("values-over-75", "R-4.4-05", Verdict.FAIL),
+        ("", "R-4.4-05", Verdict.PASS),
+        # a value rule that does FAIL on what was read still FAILs
+        ("concurrent-three-digit-count,value-ten-chars", "R-4.4.8-02", Verdict.FAIL),
+    ],
+)
+def test_value_rules_with_a_measurement_whose_count_is_unreadable(faults, rule, expected):
+    assert _verdict(_session(faults), data_case, rule) is expected
