@@ -227,6 +227,16 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # aC!'s three-digit count hid its 80 value characters (R-4.4-05 PASSed on aM!'s)
     ("measure-ttt-two-digits", "value-ten-chars"),
     ("concurrent-three-digit-count", "values-over-75"),
+    # (seed 4064) a0000 then an empty D0 PASSed R-4.4.8-03 on a sensor whose groups start
+    # at D1, where it kept the old values; the case now reads up to the D command that gave
+    # the measurement before it its first values
+    ("groups-start-at-d1", "undefined-group-keeps-data"),
+    # (seed 4064) R-7.0-14 PASSed on silence to a! after b! from a sensor that needs a break
+    # after every reply; the silence counts only where a! sent as late without b! is answered
+    ("never-standby", "no-follow-up-without-break"),
+    # (seed 4065) a value cut across D0 and D1 was counted as two: R-4.4.8-03 FAILed
+    # "10 values for 9" for R-4.4.8.3-01's deviation
+    ("split-value", "values-over-35"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -25,6 +25,17 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
   4061); R-4.4-05 the same over aM2!'s 40 characters (+ values-over-35) and aC!'s 80
   (concurrent-three-digit-count + values-over-75): the D-reply and value rules are
   INCONCLUSIVE where a start reply in digits gives no count (a reply of zeros announces none).
+- R-4.4.8-03 PASSed "a0000 then an empty D0" on a sensor whose groups start at D1, so its
+  D0 is empty whatever it keeps (groups-start-at-d1 + undefined-group-keeps-data, seed
+  4064): the D commands are read up to the one that gave the measurement before its values.
+- R-7.0-14 PASSed "silent to a! after b!" on a sensor that needs a break after every reply
+  (never-standby + no-follow-up-without-break, seed 4064): the silence counts only where a!
+  sent as late after a reply, with no b! before it, was answered.
+
+And a false FAIL: R-4.4.8-03 FAILed "10 values for 9" where a value cut in two across D0
+and D1 was counted twice (split-value + values-over-35, seed 4065; split-value alone only
+came out right because collection stopped a reply early, having counted the tail as a
+value): the halves are one value, for the count rule and for collection alike.
 """
 
 from __future__ import annotations
@@ -39,7 +50,11 @@ from conformance.results import CaseRecord, counted
 from conformance.sensor.session import SensorSession
 from conformance.verdicts import Verdict, worst
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
+from testcases.sensor.test_4_4_8_data import test_announced_values_delivered as count_case
 from testcases.sensor.test_4_4_8_data import test_data_replies as data_case
+from testcases.sensor.test_4_4_8_data import (
+    test_undefined_group_leaves_no_old_values as undefined_group_case,
+)
 from testcases.sensor.test_4_4_9_additional import test_verification as verification_case
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
@@ -47,6 +62,7 @@ from testcases.sensor.test_4_4_12_crc import (
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
+from testcases.sensor.test_7_timing import test_standby_after_foreign_command as foreign_case
 
 
 def _session(faults: str) -> SensorSession:
@@ -180,3 +196,47 @@ def test_a_concurrent_reply_of_zero_values_in_any_reading(faults, expected):
 )
 def test_value_rules_with_a_measurement_whose_count_is_unreadable(faults, rule, expected):
     assert _verdict(_session(faults), data_case, rule) is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("groups-start-at-d1,undefined-group-keeps-data", Verdict.FAIL),
+        ("undefined-group-keeps-data", Verdict.FAIL),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_old_values_kept_behind_an_empty_d0(faults, expected):
+    assert _verdict(_session(faults), undefined_group_case, "R-4.4.8-03") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("split-value,values-over-35", Verdict.PASS),
+        ("split-value", Verdict.PASS),
+        ("fewer-values-than-announced", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_value_split_over_two_replies_counts_once(faults, expected):
+    session = _session(faults)
+    assert _verdict(session, count_case, "R-4.4.8-03") is expected
+    if "split-value" in faults:  # collected in full: every value, each whole, read
+        m2 = session.measurement("M2")
+        assert len(m2.values) == m2.count == 9
+        assert "+5555.555" in m2.values and all(v[0] in "+-" for v in m2.values)
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("never-standby,no-follow-up-without-break", Verdict.INCONCLUSIVE),
+        ("no-follow-up-without-break", Verdict.INCONCLUSIVE),
+        ("never-standby", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_standby_after_a_foreign_command_needs_a_follow_up_answered(faults, expected):
+    assert _verdict(_session(faults), foreign_case, "R-7.0-14") is expected
