@@ -59,14 +59,38 @@ def reply_violations(m: Measurement, version: str) -> list[Violation]:
 
 
 # -- the wait -------------------------------------------------------------------------------
-def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
+def _sr_run(
+    runs_: list[list[Event]], address: str, chatter: frozenset[str] = frozenset()
+) -> int | None:
     """Index of the service request: the first run that is exactly ``a<CR><LF>``, else the
-    first run shaped like one (address ... CR LF), which R-4.4.6-01 then judges malformed."""
+    first run shaped like one (address ... CR LF), which R-4.4.6-01 then judges malformed,
+    unless it is ``chatter``: a line this sensor sent before its exact service request after
+    another command (:func:`known_chatter`)."""
     texts = [decode_7e1(run) for run in runs_]
     exact = next((i for i, t in enumerate(texts) if t == service_request(address)), None)
     if exact is not None:
         return exact
-    return next((i for i, t in enumerate(texts) if _sr_shaped(t, address)), None)
+    return next(
+        (i for i, t in enumerate(texts) if _sr_shaped(t, address) and t not in chatter), None
+    )
+
+
+def known_chatter(measurements: Iterable[Measurement]) -> frozenset[str]:
+    """Lines shaped like a service request that a measurement's wait held before its exact
+    ``a<CR><LF>``: this sensor's chatter, not its request. Where another command's wait
+    holds such a line and no request, that wait had none (R-4.4.6-02), not a malformed one
+    (R-4.4.6-01): chatter-before-service-request beside verify-no-service-request FAILed
+    R-4.4.6-01 on aV!'s 'aBUSY' and PASSed R-4.4.6-02 (seed 4064)."""
+    found: set[str] = set()
+    for m in measurements:
+        if not (raises_sr(m) and m.ttt and m.start.answered):
+            continue
+        texts = [decode_7e1(run) for run in runs(list(m.waited_events))]
+        request = service_request(m.command.address)
+        if request in texts:
+            before = texts[: texts.index(request)]
+            found.update(t for t in before if _sr_shaped(t, m.command.address))
+    return frozenset(found)
 
 
 def _sr_shaped(text: str, address: str) -> bool:
@@ -74,16 +98,16 @@ def _sr_shaped(text: str, address: str) -> bool:
     return text.startswith(address) and text.endswith("\r\n")
 
 
-def wait_violations(m: Measurement, tally: Tally) -> None:
+def wait_violations(m: Measurement, tally: Tally, chatter: frozenset[str] = frozenset()) -> None:
     """Service-request rules (R-4.4.6-*, R-4.4.5-08/09) and the quiet rules of concurrent
-    measurements (R-4.4.6-05, R-4.4.7-04, R-5.3-01)."""
+    measurements (R-4.4.6-05, R-4.4.7-04, R-5.3-01); ``chatter``: :func:`known_chatter`."""
     label = where(m)
     if m.ttt is None or not m.start.answered:
         return
     chunks = runs(list(m.waited_events))
     address = m.command.address
     if raises_sr(m) and m.ttt > 0:
-        sr = _sr_run(chunks, address)
+        sr = _sr_run(chunks, address, chatter)
         tally.observe(label, ids=["R-4.4.6-02", "R-4.4.5-08"])
         if sr is None:
             for rid in ("R-4.4.6-01", "R-4.4.6-04", "R-4.4.5-09"):
@@ -300,13 +324,15 @@ def judge(
 ) -> list[Finding]:
     """Findings for ``ids`` over ``measurements``: reply, wait and data rules together."""
     tally = Tally(ids)
+    measurements = list(measurements)
+    chatter = known_chatter(measurements)
     for m in measurements:
         tally.observe(
             where(m),
             reply_violations(m, version),
             ids=[i for i in _reply_ids(m) if m.start.answered],
         )
-        wait_violations(m, tally)
+        wait_violations(m, tally, chatter)
         data_violations(m, tally)
     return tally.findings(ok)
 
