@@ -66,3 +66,15 @@ def unreadable_count(m: Measurement) -> bool:
         return False
     rest = split_line(m.start.reply_text)[0][1:]
     return rest.isdigit() and set(rest) != {"0"}
+
+
+def first_filled(m: Measurement) -> int:
+    """The index of the first of ``m``'s D replies that held values (a sign past its
+    address), 0 if none did. A sensor whose groups start later answers the D commands
+    before it with no values whatever its buffer holds, so a probe for values left in the
+    buffer reads up to this one (groups-start-at-d1 hid the old data an undefined aMn!
+    and an abort left behind: seeds 4064, 4066)."""
+    for i, ex in enumerate(m.data):
+        if ex.answered and any(c in SIGNS for c in split_line(ex.reply_text)[0][1:]):
+            return i
+    return 0

@@ -7,6 +7,7 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
 from conformance.judges.exchanges import cite, shown
+from conformance.judges.support import first_filled
 from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import (
     parse_data_reply_for,
@@ -91,7 +92,7 @@ def test_undefined_group_leaves_no_old_values(sensor, case):
     # groups start at D1 answers D0 empty whatever it keeps, so an empty D0 alone showed
     # nothing (groups-start-at-d1 + undefined-group-keeps-data PASSed, seed 4064)
     ds: list = []
-    for i in range(_first_filled(before) + 1):
+    for i in range(first_filled(before) + 1):
         ds.append(sensor.fresh_exchange(f"D{i}"))
         if not ds[-1].answered or _values(ds[-1], start.command, sensor.address):
             break
@@ -137,8 +138,3 @@ def _values(ex, command, address: str) -> list[str]:
     """The values of a D reply to a measurement started by ``command``."""
     body, _ = split_line(ex.reply_text)
     return parse_data_reply_for(body, command, expected_address=address).values
-
-
-def _first_filled(m) -> int:
-    """The index of the first of ``m``'s D replies that held values (0 if none did)."""
-    return next((i for i, ex in enumerate(m.data) if _values(ex, m.command, m.command.address)), 0)

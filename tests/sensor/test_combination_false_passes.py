@@ -25,9 +25,12 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
   4061); R-4.4-05 the same over aM2!'s 40 characters (+ values-over-35) and aC!'s 80
   (concurrent-three-digit-count + values-over-75): the D-reply and value rules are
   INCONCLUSIVE where a start reply in digits gives no count (a reply of zeros announces none).
+  So is R-4.4.5-02 (n of 1..9), which PASSed on 21 such replies beside measure-count-zero
+  (seed 4066).
 - R-4.4.8-03 PASSed "a0000 then an empty D0" on a sensor whose groups start at D1, so its
   D0 is empty whatever it keeps (groups-start-at-d1 + undefined-group-keeps-data, seed
   4064): the D commands are read up to the one that gave the measurement before its values.
+  R-4.4.5.1-02 the same after an abort (abort-keeps-old-data + groups-start-at-d1, seed 4066).
 - R-7.0-14 PASSed "silent to a! after b!" on a sensor that needs a break after every reply
   (never-standby + no-follow-up-without-break, seed 4064): the silence counts only where a!
   sent as late after a reply, with no b! before it, was answered.
@@ -49,6 +52,8 @@ from conformance.protocol.commands import M_FAMILY
 from conformance.results import CaseRecord, counted
 from conformance.sensor.session import SensorSession
 from conformance.verdicts import Verdict, worst
+from testcases.sensor.test_4_4_5_measurement import test_break_aborts_measurement as abort_case
+from testcases.sensor.test_4_4_5_measurement import test_measurement_reply as reply_case
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
 from testcases.sensor.test_4_4_8_data import test_announced_values_delivered as count_case
 from testcases.sensor.test_4_4_8_data import test_data_replies as data_case
@@ -240,3 +245,29 @@ def test_a_value_split_over_two_replies_counts_once(faults, expected):
 )
 def test_standby_after_a_foreign_command_needs_a_follow_up_answered(faults, expected):
     assert _verdict(_session(faults), foreign_case, "R-7.0-14") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,groups-start-at-d1", Verdict.WARN),
+        ("abort-keeps-old-data", Verdict.WARN),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_data_kept_after_an_abort_behind_an_empty_d0(faults, expected):
+    assert _verdict(_session(faults), abort_case, "R-4.4.5.1-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("measure-count-zero,measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("measure-count-zero", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_count_rule_on_replies_that_give_no_count(faults, expected):
+    assert _verdict(_session(faults), reply_case, "R-4.4.5-02") is expected

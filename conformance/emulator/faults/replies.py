@@ -165,13 +165,15 @@ FORMAT: tuple[Fault, ...] = (
         " (R-4.4.11-01), and no count (aIM! answers alike) says which metadata records"
         " the M-type groups owe (R-6.2-07). With no count no D command follows aM!, aV!"
         " or any aMn!: the D-reply and value rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read"
-        " only aC!'s data and are left open for the values aM! holds.",
+        " only aC!'s data and are left open for the values aM! holds, as is the count's"
+        " 1..9 rule (R-4.4.5-02).",
         ("R-4.4.5-01",),
         rewrite=_start_with(1, lambda body: body[0] + body[2:]),
         inconclusive=(
             "R-6.1-03",
             "R-4.4.11-01",
             "R-6.2-07",
+            "R-4.4.5-02",
             *UNREAD_DATA,
         ),
     ),
