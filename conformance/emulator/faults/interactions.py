@@ -65,4 +65,24 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " on text (seed 4066).",
         removes=("R-4.4.12-02",),
     ),
+    Interaction(
+        frozenset({"split-value", "values-not-packed"}),
+        "split-value fills every D reply after M/V to exactly 35 characters, so no reply is"
+        " left one value short: the replies are full on the wire and R-4.4.8.3-03 holds"
+        " (the cut is R-4.4.8.3-01's; seed 4068).",
+        removes=("R-4.4.8.3-03",),
+    ),
+    Interaction(
+        frozenset({"address-change-not-applied", "answers-old-address"}),
+        "the address change never takes effect, so the address the sensor keeps answering is"
+        " its own, not an old one beside the new: nothing answers a foreign address and"
+        " R-4.0-01 holds (seed 4068).",
+        removes=("R-4.0-01",),
+    ),
+    Interaction(
+        frozenset({"undefined-concurrent-silent", "unknown-command-text"}),
+        "an undefined aCn! gets no answer at all, so no 'aUNKN' is ever sent to one, and the"
+        " defined concurrent replies rightly hold R-4.4.7-01 (seed 4069).",
+        removes=("R-4.4.7-01",),
+    ),
 )
