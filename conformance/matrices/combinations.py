@@ -246,6 +246,11 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("measure-count-zero", "measure-ttt-two-digits"),
     # (seed 4066) the exploration PASSed R-4.4.5-10 on empty D0s read twice
     ("continuous-overwrites-data", "d0-empty"),
+    # (seed 4072) R-4.4.11-01 FAILed for R-4.4.8-04, which aM! (count 0) had no D0 to show kept
+    ("groups-start-at-d1", "measure-count-zero"),
+    # (seed 4071) the change reply named the old address and a! is answered anywhere: the
+    # sensor was left at '1' while every later case spoke to '0' (seven false FAILs)
+    ("address-change-wrong-reply", "answers-foreign-address"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -38,7 +38,13 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
 And a false FAIL: R-4.4.8-03 FAILed "10 values for 9" where a value cut in two across D0
 and D1 was counted twice (split-value + values-over-35, seed 4065; split-value alone only
 came out right because collection stopped a reply early, having counted the tail as a
-value): the halves are one value, for the count rule and for collection alike.
+value): the halves are one value, for the count rule and for collection alike. And
+R-4.4.11-01 FAILed "aV! breaks rules aM! keeps" for R-4.4.8-04, which aM! (count 0 under
+measure-count-zero) had no D0 to show kept (+ groups-start-at-d1, seed 4072): INCONCLUSIVE.
+A sensor that answers a! at any address, and whose change reply names its old address, was
+left at '1' after the change-address case ("restored: it answers there" on '0!'), so every
+later case spoke to an empty address (seven false FAILs, seed 4071): after a move away whose
+reply was unclear, every address tried is asked to move back.
 """
 
 from __future__ import annotations
@@ -64,6 +70,7 @@ from testcases.sensor.test_4_4_9_additional import test_verification as verifica
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
+from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
@@ -271,3 +278,26 @@ def test_data_kept_after_an_abort_behind_an_empty_d0(faults, expected):
 )
 def test_a_count_rule_on_replies_that_give_no_count(faults, expected):
     assert _verdict(_session(faults), reply_case, "R-4.4.5-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("groups-start-at-d1,measure-count-zero", Verdict.INCONCLUSIVE),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("verify-no-service-request", Verdict.FAIL),
+    ],
+)
+def test_verification_against_rules_m_was_not_shown_to_keep(faults, expected):
+    assert _verdict(_session(faults), verification_case, "R-4.4.11-01") is expected
+
+
+@pytest.mark.parametrize(
+    "faults",
+    ["address-change-wrong-reply,answers-foreign-address", "address-change-wrong-reply", ""],
+)
+def test_the_sensor_is_back_at_its_address_after_the_change_case(faults):
+    session = _session(faults)
+    _verdict(session, change_case, "R-4.4.4-01")
+    # aM! is answered at its own address only (answers-foreign-address answers a!, aI!)
+    assert session.fresh_exchange("M").answered
