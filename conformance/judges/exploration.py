@@ -104,10 +104,15 @@ def _crc(obs: Observation) -> Judgement:
 
 
 def _repeat(obs: Observation) -> Judgement:
-    """D0 read again with no measurement between gives the same reply (the first D0 after
-    a measurement has nothing to compare with, but still counts as a check)."""
+    """D0 read again with no measurement between gives the same reply. It counts as a check
+    only where the earlier D0 held values (a digit past the address; CRC characters never
+    are digits): the first D0 after a measurement, or a buffer that was empty, has nothing
+    a lost buffer would change, and a sensor that never delivered a value PASSed "held over
+    48 checks" (continuous-overwrites-data beside d0-empty, seed 4066)."""
+    if obs.previous is None or not any(c.isdigit() for c in obs.previous.rstrip("\r\n")[1:]):
+        return Judgement(())
     checked = ("R-4.4.5-10",)
-    if obs.previous is None or obs.reply == obs.previous:
+    if obs.reply == obs.previous:
         return Judgement(checked)
     message = (
         f"D0 gave '{escape(obs.previous)}', then '{escape(obs.reply)}' with no measurement between"

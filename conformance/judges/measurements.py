@@ -23,7 +23,9 @@ from ..protocol.timing import TOLERANCE
 from ..protocol.values import Violation, check_value
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
-from ..verdicts import Finding
+from ..verdicts import Finding, inconclusive
+from .cite import cite, listed, shown
+from .support import unreadable_count
 from .tally import Tally
 from .wire import runs
 
@@ -57,14 +59,38 @@ def reply_violations(m: Measurement, version: str) -> list[Violation]:
 
 
 # -- the wait -------------------------------------------------------------------------------
-def _sr_run(runs_: list[list[Event]], address: str) -> int | None:
+def _sr_run(
+    runs_: list[list[Event]], address: str, chatter: frozenset[str] = frozenset()
+) -> int | None:
     """Index of the service request: the first run that is exactly ``a<CR><LF>``, else the
-    first run shaped like one (address ... CR LF), which R-4.4.6-01 then judges malformed."""
+    first run shaped like one (address ... CR LF), which R-4.4.6-01 then judges malformed,
+    unless it is ``chatter``: a line this sensor sent before its exact service request after
+    another command (:func:`known_chatter`)."""
     texts = [decode_7e1(run) for run in runs_]
     exact = next((i for i, t in enumerate(texts) if t == service_request(address)), None)
     if exact is not None:
         return exact
-    return next((i for i, t in enumerate(texts) if _sr_shaped(t, address)), None)
+    return next(
+        (i for i, t in enumerate(texts) if _sr_shaped(t, address) and t not in chatter), None
+    )
+
+
+def known_chatter(measurements: Iterable[Measurement]) -> frozenset[str]:
+    """Lines shaped like a service request that a measurement's wait held before its exact
+    ``a<CR><LF>``: this sensor's chatter, not its request. Where another command's wait
+    holds such a line and no request, that wait had none (R-4.4.6-02), not a malformed one
+    (R-4.4.6-01): chatter-before-service-request beside verify-no-service-request FAILed
+    R-4.4.6-01 on aV!'s 'aBUSY' and PASSed R-4.4.6-02 (seed 4064)."""
+    found: set[str] = set()
+    for m in measurements:
+        if not (raises_sr(m) and m.ttt and m.start.answered):
+            continue
+        texts = [decode_7e1(run) for run in runs(list(m.waited_events))]
+        request = service_request(m.command.address)
+        if request in texts:
+            before = texts[: texts.index(request)]
+            found.update(t for t in before if _sr_shaped(t, m.command.address))
+    return frozenset(found)
 
 
 def _sr_shaped(text: str, address: str) -> bool:
@@ -72,16 +98,16 @@ def _sr_shaped(text: str, address: str) -> bool:
     return text.startswith(address) and text.endswith("\r\n")
 
 
-def wait_violations(m: Measurement, tally: Tally) -> None:
+def wait_violations(m: Measurement, tally: Tally, chatter: frozenset[str] = frozenset()) -> None:
     """Service-request rules (R-4.4.6-*, R-4.4.5-08/09) and the quiet rules of concurrent
-    measurements (R-4.4.6-05, R-4.4.7-04, R-5.3-01)."""
+    measurements (R-4.4.6-05, R-4.4.7-04, R-5.3-01); ``chatter``: :func:`known_chatter`."""
     label = where(m)
     if m.ttt is None or not m.start.answered:
         return
     chunks = runs(list(m.waited_events))
     address = m.command.address
     if raises_sr(m) and m.ttt > 0:
-        sr = _sr_run(chunks, address)
+        sr = _sr_run(chunks, address, chatter)
         tally.observe(label, ids=["R-4.4.6-02", "R-4.4.5-08"])
         if sr is None:
             for rid in ("R-4.4.6-01", "R-4.4.6-04", "R-4.4.5-09"):
@@ -298,21 +324,47 @@ def judge(
 ) -> list[Finding]:
     """Findings for ``ids`` over ``measurements``: reply, wait and data rules together."""
     tally = Tally(ids)
+    measurements = list(measurements)
+    chatter = known_chatter(measurements)
     for m in measurements:
         tally.observe(
             where(m),
             reply_violations(m, version),
             ids=[i for i in _reply_ids(m) if m.start.answered],
         )
-        wait_violations(m, tally)
+        if unreadable_count(m):
+            # no count to hold to 1..9 (measure-ttt-two-digits beside measure-count-zero
+            # PASSed R-4.4.5-02 on 21 replies none of which gave a count, seed 4066)
+            tally.undecide("R-4.4.5-02", where(m), "its reply gives no readable count")
+        wait_violations(m, tally, chatter)
         data_violations(m, tally)
     return tally.findings(ok)
+
+
+def unread_data(measurements: Iterable[Measurement], ids: Iterable[str]) -> list[Finding]:
+    """``ids`` INCONCLUSIVE where a measurement's start reply gave no readable count
+    (:func:`~conformance.judges.support.unreadable_count`): its D replies were never asked
+    for, so a PASS over the other measurements' replies would speak for values nobody read
+    (measure-ttt-two-digits beside value-ten-chars PASSed R-4.4.8-02 on aC!'s replies while
+    aM!'s ten-character value stayed in the sensor). A violation found elsewhere still
+    FAILs: the run's verdict is the worst of its findings. Observed: those start replies."""
+    unread = [m for m in measurements if unreadable_count(m)]
+    if not unread:
+        return []
+    starts = [m.start for m in unread]
+    detail = (
+        "no value count in "
+        + listed([shown(ex) for ex in starts])
+        + ": no D command followed, so the values held there are unjudged"
+    )
+    return [inconclusive(rid, detail, evidence=cite(starts), observed=len(starts)) for rid in ids]
 
 
 def _reply_ids(m: Measurement) -> list[str]:
     kind = m.command.kind
     if kind in (Kind.MEASURE, Kind.VERIFY):
-        return ["R-4.4.5-01", "R-4.4.5-02", "R-4.2-02", "R-4.2-03"]
+        counted = ["R-4.4.5-02"] if m.count is not None else []
+        return ["R-4.4.5-01", *counted, "R-4.2-02", "R-4.2-03"]
     if kind is Kind.CONCURRENT:
         if not m.count:
             # no count to bound (R-4.4.7-03); a00000 to plain aC!/aCC! is no answer of the

@@ -55,3 +55,26 @@ def serves_measurement(m: Measurement) -> bool:
     """A measurement command is served when its start reply is well formed and announces
     at least one value (``a00000`` to ``aC!`` starts no measurement, R-4.4.7-02)."""
     return m.start.answered and m.count is not None and m.count > 0 and m.ttt is not None
+
+
+def unreadable_count(m: Measurement) -> bool:
+    """The start reply answered in digits that give no count (``0023`` to ``aM!``: a ttt of
+    two digits), so no D command followed it: values the sensor may hold there were never
+    read. A reply of zeros only announces no values however it is read (``a000`` to an
+    undefined ``aMn!``), and text (``aUNKN``) is no measurement reply: neither hides values."""
+    if not m.start.answered or m.count is not None:
+        return False
+    rest = split_line(m.start.reply_text)[0][1:]
+    return rest.isdigit() and set(rest) != {"0"}
+
+
+def first_filled(m: Measurement) -> int:
+    """The index of the first of ``m``'s D replies that held values (a sign past its
+    address), 0 if none did. A sensor whose groups start later answers the D commands
+    before it with no values whatever its buffer holds, so a probe for values left in the
+    buffer reads up to this one (groups-start-at-d1 hid the old data an undefined aMn!
+    and an abort left behind: seeds 4064, 4066)."""
+    for i, ex in enumerate(m.data):
+        if ex.answered and any(c in SIGNS for c in split_line(ex.reply_text)[0][1:]):
+            return i
+    return 0

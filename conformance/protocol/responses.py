@@ -449,12 +449,20 @@ def parse_data_reply_for(
 def check_data_sequence(replies: list[DataReply], announced: int, limit: int) -> list[Violation]:
     """Rules that span the D0, D1, ... replies of one measurement.
 
-    R-4.4.8-03: the values add up to the announced count. R-4.4.8.3-01: a later reply whose
+    R-4.4.8-03: the values add up to the announced count (a value split over two replies
+    counted once). R-4.4.8.3-01: a later reply whose
     text starts without a sign continues a value cut off in the reply before. R-4.4.8.3-03
     (a warning): a reply left room for the next reply's first value.
     """
     found = []
-    total = sum(len(r.values) for r in replies)
+    # a reply starting without a sign continues the value the reply before cut off: the
+    # halves are one value (R-4.4.8.3-01 judges the cut), not one too many for the count
+    joined = sum(
+        1
+        for before, after in zip(replies, replies[1:], strict=False)
+        if before.values and after.values and after.values[0][0] not in "+-"
+    )
+    total = sum(len(r.values) for r in replies) - joined
     if total != announced:
         found.append(
             Violation("R-4.4.8-03", f"{total} values were returned for {announced} announced")

@@ -35,6 +35,7 @@ class AddressChanger:
         self.exchanges: list[Exchange] = []
         self.restored: bool | None = None
         self.tried: list[str] = []  # addresses the sensor may have been moved to
+        self.unclear = False  # a move away drew no reply, or one naming another address
 
     def change(self, new: str, *, wait_for_answer: bool = True) -> ChangeOutcome:
         if new != self.original:
@@ -43,6 +44,8 @@ class AddressChanger:
         self.exchanges.append(ex)
         body, _ = split_line(ex.reply_text)
         took = ex.answered and body == new
+        if new != self.original and not took:
+            self.unclear = True
         outcome = ChangeOutcome(ex, took)
         if took:
             self.current = new
@@ -71,6 +74,8 @@ class AddressChanger:
         if self.current != self.original:
             back = self.change(self.original, wait_for_answer=False)
         if self._answers(self.original):
+            if self.unclear:
+                self._move_back_from_tried()
             self.current, self.restored = self.original, True
             return f"address restored to '{self.original}' (it answers there)"
         if back is not None and back.took and not self.master.acknowledged:
@@ -94,6 +99,21 @@ class AddressChanger:
             f"COULD NOT restore the address: the sensor does not answer at "
             f"'{self.original}' (tried moving it back from {', '.join(self.tried)})"
         )
+
+    def _move_back_from_tried(self) -> None:
+        """After a move whose reply was unclear, ask every address tried to move back, though
+        the original answers a!: a sensor that answers a! at any address (answers-foreign-
+        address) answers there from wherever it went, and one whose change reply names its
+        old address (address-change-wrong-reply) did move: the two together left it at '1'
+        while every later case spoke to '0' (seven false FAILs, seed 4071). A sensor at the
+        original ignores a command for another address."""
+        for tried in dict.fromkeys(self.tried):
+            if tried == self.original:
+                continue
+            self.current = tried
+            self.change(self.original, wait_for_answer=False)
+        self.current = self.original
+        self._answers(self.original)
 
     def _answers(self, address: str) -> bool:
         """Whether the sensor answers at ``address``, allowing it the 1 s of deafness that

@@ -697,5 +697,11 @@ def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:
     if not exchange.judged.ok:  # salvaged: only what reads as values (no stray CRC, spaces)
         text = validity.salvaged_values_text(text)
     values = split_values(text)
+    held = bool(values)
+    if values and m.values and values[0][0] not in "+-":
+        # the rest of a value the reply before cut in two (R-4.4.8.3-01's deviation): one
+        # value, not two, or collection stops a value early and the count rule reads the
+        # fragments as one value too many (split-value + values-over-35, seed 4065)
+        m.values[-1] += values.pop(0)
     m.values.extend(values)
-    return bool(values)
+    return held

@@ -23,6 +23,7 @@ def test_data_replies(heard_sensors, case):
     ms = [m for m in heard_sensors.of_kind(*ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
     judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
+    _unread(heard_sensors, case)
 
 
 @requirements("R-4.4.8-03", "R-4.4.8-04")
@@ -33,6 +34,7 @@ def test_announced_values_delivered(heard_sensors, case):
     ms = [m for m in heard_sensors.of_kind(*ASCII, Kind.HIGH_VOLUME_ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
     judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
+    _unread(heard_sensors, case, Kind.HIGH_VOLUME_ASCII)
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")
@@ -43,6 +45,16 @@ def test_value_grouping(heard_sensors, case):
     ms = [m for m in heard_sensors.of_kind(*ASCII, whole=True) if m.count]
     case.evidence("recorded measurements with data", ms)
     judged(case, judge.judge(ms, case.requirements, heard_sensors.version))
+    _unread(heard_sensors, case)
+
+
+def _unread(heard_sensors, case, *kinds: Kind) -> None:
+    """The rules left open by a recorded start reply with no readable count
+    (:func:`conformance.judges.measurements.unread_data`): no D command read its values.
+    Every recorded one, not only the ``whole`` ones: with no aD0! after it, the
+    recording counts it as interrupted by the recorder."""
+    heard = heard_sensors.of_kind(*ASCII, *kinds)
+    judged(case, judge.unread_data(heard, case.requirements))
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03", "R-4.4.12-05", "R-4.4.12-06")

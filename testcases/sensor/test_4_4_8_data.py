@@ -7,6 +7,7 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
 from conformance.judges.exchanges import cite, shown
+from conformance.judges.support import first_filled
 from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import (
     parse_data_reply_for,
@@ -32,6 +33,7 @@ def test_data_replies(sensor, case):
     case.evidence("every defined measurement's D replies", ms)
     case.requires("buffered", precondition.buffered_any(ms))
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES), case.requirements))
 
 
 @requirements("R-4.4.8-03", "R-4.4.8-04")
@@ -45,6 +47,7 @@ def test_announced_values_delivered(sensor, case):
         "supported", precondition.shown_supported(bool(ms), "no measurement announced values")
     )
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES + ("HA",)), case.requirements))
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")
@@ -59,6 +62,7 @@ def test_value_grouping(sensor, case):
     case.evidence("every defined measurement", ms)
     case.requires("buffered", precondition.buffered_any(ms))
     case.extend(judge.judge(ms, case.requirements, sensor.version))
+    case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES), case.requirements))
 
 
 @requirements("R-4.4.8-03")
@@ -84,30 +88,39 @@ def test_undefined_group_leaves_no_old_values(sensor, case):
     code = undefined.command.text()[1:-1]
     before = sensor.fresh_measurement(filled.command.text()[1:-1])
     start = sensor.fresh_exchange(code)
-    d0 = sensor.fresh_exchange("D0")
-    case.evidence(f"{filled.command}, then {code} and D0", [before, start, d0])
-    body, _ = split_line(d0.reply_text)
+    # the D commands up to the one that gave `before` its first values: a sensor whose
+    # groups start at D1 answers D0 empty whatever it keeps, so an empty D0 alone showed
+    # nothing (groups-start-at-d1 + undefined-group-keeps-data PASSed, seed 4064)
+    ds: list = []
+    for i in range(first_filled(before) + 1):
+        ds.append(sensor.fresh_exchange(f"D{i}"))
+        if not ds[-1].answered or _values(ds[-1], start.command, sensor.address):
+            break
+    case.evidence(f"{filled.command}, then {code} and D0..", [before, start, *ds])
     announced = parse_measurement_reply_for(split_line(start.reply_text)[0], start.command)
+    asked = "; ".join(shown(d) for d in ds)
+    returned = next((d for d in ds if _values(d, start.command, sensor.address)), None)
     if not (
         before.value_count
         and start.answered
         and announced.count == 0
         and not announced.ttt
-        and d0.answered
+        and all(d.answered for d in ds)
     ):
         case.add(
             inconclusive(
                 "R-4.4.8-03",
-                f"needs values first, then 'a0000' and an answered D0: {shown(start)}; {shown(d0)}",
+                f"needs values first, then 'a0000' and answered D replies: {shown(start)}; "
+                + asked,
             )
         )
-    elif parse_data_reply_for(body, start.command, expected_address=sensor.address).values:
+    elif returned is not None:
         case.add(
             failed(
                 "R-4.4.8-03",
-                f"{shown(start)} announced no values, yet {shown(d0)} returned some "
+                f"{shown(start)} announced no values, yet {shown(returned)} returned some "
                 f"(the previous {filled.command}'s?)",
-                evidence=cite([start, d0]),
+                evidence=cite([start, returned]),
                 observed=1,
             )
         )
@@ -115,7 +128,13 @@ def test_undefined_group_leaves_no_old_values(sensor, case):
         case.add(
             passed(
                 "R-4.4.8-03",
-                f"{shown(start)} then {shown(d0)}: no values",
-                observed=3,  # the measurement with values, the empty announcement, D0
+                f"{shown(start)} then {asked}: no values",
+                observed=3,  # the measurement with values, the empty announcement, its D's
             )
         )
+
+
+def _values(ex, command, address: str) -> list[str]:
+    """The values of a D reply to a measurement started by ``command``."""
+    body, _ = split_line(ex.reply_text)
+    return parse_data_reply_for(body, command, expected_address=address).values

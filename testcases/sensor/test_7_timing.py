@@ -364,7 +364,10 @@ def test_ready_within_100ms_of_break(sensor, case):
 def test_standby_after_foreign_command(sensor, case):
     """After a command for another address the sensor ignores its own address without a
     new break."""
-    case.expect("a! answered; then, with no break, b! (another sensor) and a!: silence")
+    case.expect(
+        "a! answered; then, with no break, b! (another sensor) and a!: silence; and a! "
+        "answered when sent as late after a reply, with no b! between (the control)"
+    )
     awake = _awake(sensor)
     if not case.requires("awake", precondition.woke([awake])):
         return
@@ -372,8 +375,22 @@ def test_standby_after_foreign_command(sensor, case):
     sensor.listen(0.02)
     foreign = sensor.master.raw(f"{other}!", break_first=False)
     ex = sensor.master.raw(f"{sensor.address}!", break_first=False)
-    case.evidence(f"a!, then {other}! and a! with no break", [awake, foreign, ex])
-    case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby", baseline=awake))
+    # the control: a! as long after a reply, with no b! before it. A sensor silent to it
+    # is silent to an unbroken follow-up anyway (it needs a break after every reply, or
+    # sleeps early), so its silence after b! shows no standby (never-standby PASSed beside
+    # no-follow-up-without-break, seed 4064)
+    gap = _marking_before(ex, awake.judged.reply_events[-1].end) if awake.answered else 0.0
+    again = _awake(sensor)
+    control = (
+        _after_marking(sensor, again.judged.reply_events[-1].end, gap, f"{sensor.address}!")[0]
+        if again.answered
+        else again
+    )
+    case.evidence(
+        f"a!, then {other}! and a! with no break; a!, then a! as late with no break",
+        [awake, foreign, ex, again, control],
+    )
+    case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby", baseline=control))
 
 
 #: How far inside a limit a boundary probe aims, beyond the tolerance and twice the link's

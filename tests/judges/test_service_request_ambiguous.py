@@ -41,3 +41,25 @@ def test_chatter_before_an_exact_request_fails_r_4_4_5_08():
     got = _verdicts(("0BUSY\r\n", 0.8), ("0\r\n", 1.95))
     assert got["R-4.4.5-08"] is Verdict.FAIL
     assert got["R-4.4.6-01"] is got["R-4.4.6-04"] is Verdict.PASS
+
+
+def _measured(*lines: tuple[str, float]):
+    m = measurement("00023\r\n", None, [("0D0!", "0+1+2+3\r\n")])
+    for text, after in lines:
+        m.waited_events += chars(text, m.reply_end + after, "dut")
+    return m
+
+
+def test_a_line_the_sensor_sent_before_its_exact_request_is_chatter_elsewhere_too():
+    """aM!'s wait shows 'aBUSY' before an exact request; a second wait holding only 'aBUSY'
+    had no request (R-4.4.6-02), not a malformed one (R-4.4.6-01): chatter-before-service-
+    request beside verify-no-service-request, seed 4064."""
+    exact = _measured(("0BUSY\r\n", 0.8), ("0\r\n", 1.95))
+    none = _measured(("0BUSY\r\n", 0.8))
+    got = {f.requirement: f.verdict for f in measurements.judge([exact, none], IDS, "14")}
+    assert got["R-4.4.6-02"] is Verdict.FAIL
+    assert got["R-4.4.6-01"] is Verdict.PASS
+    assert got["R-4.4.5-08"] is Verdict.FAIL
+    # judged alone, the lone line is still the only candidate for a malformed request
+    alone = {f.requirement: f.verdict for f in measurements.judge([none], IDS, "14")}
+    assert alone["R-4.4.6-01"] is Verdict.FAIL

@@ -20,6 +20,31 @@ breaks the rule alone (the case must still FAIL it) and the clean sensor (it mus
 - R-4.4.7-08 PASSed "aC! answered '0000000'" (concurrent-three-digit-count +
   concurrent-zero, seed 4062): a malformed reply still answers aC!, but one that reads as
   zero values whatever its count's width is no measurement started: FAIL, as a00000 is.
+- R-4.4.8-02 PASSed on aC!'s D replies while aM!'s reply gave no readable count, so its
+  ten-character value was never asked for (measure-ttt-two-digits + value-ten-chars, seed
+  4061); R-4.4-05 the same over aM2!'s 40 characters (+ values-over-35) and aC!'s 80
+  (concurrent-three-digit-count + values-over-75): the D-reply and value rules are
+  INCONCLUSIVE where a start reply in digits gives no count (a reply of zeros announces none).
+  So is R-4.4.5-02 (n of 1..9), which PASSed on 21 such replies beside measure-count-zero
+  (seed 4066).
+- R-4.4.8-03 PASSed "a0000 then an empty D0" on a sensor whose groups start at D1, so its
+  D0 is empty whatever it keeps (groups-start-at-d1 + undefined-group-keeps-data, seed
+  4064): the D commands are read up to the one that gave the measurement before its values.
+  R-4.4.5.1-02 the same after an abort (abort-keeps-old-data + groups-start-at-d1, seed 4066).
+- R-7.0-14 PASSed "silent to a! after b!" on a sensor that needs a break after every reply
+  (never-standby + no-follow-up-without-break, seed 4064): the silence counts only where a!
+  sent as late after a reply, with no b! before it, was answered.
+
+And a false FAIL: R-4.4.8-03 FAILed "10 values for 9" where a value cut in two across D0
+and D1 was counted twice (split-value + values-over-35, seed 4065; split-value alone only
+came out right because collection stopped a reply early, having counted the tail as a
+value): the halves are one value, for the count rule and for collection alike. And
+R-4.4.11-01 FAILed "aV! breaks rules aM! keeps" for R-4.4.8-04, which aM! (count 0 under
+measure-count-zero) had no D0 to show kept (+ groups-start-at-d1, seed 4072): INCONCLUSIVE.
+A sensor that answers a! at any address, and whose change reply names its old address, was
+left at '1' after the change-address case ("restored: it answers there" on '0!'), so every
+later case spoke to an empty address (seven false FAILs, seed 4071): after a move away whose
+reply was unclear, every address tried is asked to move back.
 """
 
 from __future__ import annotations
@@ -33,14 +58,23 @@ from conformance.protocol.commands import M_FAMILY
 from conformance.results import CaseRecord, counted
 from conformance.sensor.session import SensorSession
 from conformance.verdicts import Verdict, worst
+from testcases.sensor.test_4_4_5_measurement import test_break_aborts_measurement as abort_case
+from testcases.sensor.test_4_4_5_measurement import test_measurement_reply as reply_case
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
+from testcases.sensor.test_4_4_8_data import test_announced_values_delivered as count_case
+from testcases.sensor.test_4_4_8_data import test_data_replies as data_case
+from testcases.sensor.test_4_4_8_data import (
+    test_undefined_group_leaves_no_old_values as undefined_group_case,
+)
 from testcases.sensor.test_4_4_9_additional import test_verification as verification_case
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
+from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
+from testcases.sensor.test_7_timing import test_standby_after_foreign_command as foreign_case
 
 
 def _session(faults: str) -> SensorSession:
@@ -153,3 +187,117 @@ def test_binary_packets_past_an_unreadable_one(faults, expected):
 )
 def test_a_concurrent_reply_of_zero_values_in_any_reading(faults, expected):
     assert _verdict(_session(faults), concurrent_case, "R-4.4.7-08") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "rule", "expected"),
+    [
+        ("measure-ttt-two-digits,value-ten-chars", "R-4.4.8-02", Verdict.INCONCLUSIVE),
+        ("measure-ttt-two-digits", "R-4.4.8-02", Verdict.INCONCLUSIVE),
+        ("value-ten-chars", "R-4.4.8-02", Verdict.FAIL),
+        ("", "R-4.4.8-02", Verdict.PASS),
+        ("measure-ttt-two-digits,values-over-35", "R-4.4-05", Verdict.INCONCLUSIVE),
+        ("values-over-35", "R-4.4-05", Verdict.FAIL),
+        ("concurrent-three-digit-count,values-over-75", "R-4.4-05", Verdict.INCONCLUSIVE),
+        ("concurrent-three-digit-count", "R-4.4.8-02", Verdict.INCONCLUSIVE),
+        ("values-over-75", "R-4.4-05", Verdict.FAIL),
+        ("", "R-4.4-05", Verdict.PASS),
+        # a value rule that does FAIL on what was read still FAILs
+        ("concurrent-three-digit-count,value-ten-chars", "R-4.4.8-02", Verdict.FAIL),
+    ],
+)
+def test_value_rules_with_a_measurement_whose_count_is_unreadable(faults, rule, expected):
+    assert _verdict(_session(faults), data_case, rule) is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("groups-start-at-d1,undefined-group-keeps-data", Verdict.FAIL),
+        ("undefined-group-keeps-data", Verdict.FAIL),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_old_values_kept_behind_an_empty_d0(faults, expected):
+    assert _verdict(_session(faults), undefined_group_case, "R-4.4.8-03") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("split-value,values-over-35", Verdict.PASS),
+        ("split-value", Verdict.PASS),
+        ("fewer-values-than-announced", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_value_split_over_two_replies_counts_once(faults, expected):
+    session = _session(faults)
+    assert _verdict(session, count_case, "R-4.4.8-03") is expected
+    if "split-value" in faults:  # collected in full: every value, each whole, read
+        m2 = session.measurement("M2")
+        assert len(m2.values) == m2.count == 9
+        assert "+5555.555" in m2.values and all(v[0] in "+-" for v in m2.values)
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("never-standby,no-follow-up-without-break", Verdict.INCONCLUSIVE),
+        ("no-follow-up-without-break", Verdict.INCONCLUSIVE),
+        ("never-standby", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_standby_after_a_foreign_command_needs_a_follow_up_answered(faults, expected):
+    assert _verdict(_session(faults), foreign_case, "R-7.0-14") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,groups-start-at-d1", Verdict.WARN),
+        ("abort-keeps-old-data", Verdict.WARN),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_data_kept_after_an_abort_behind_an_empty_d0(faults, expected):
+    assert _verdict(_session(faults), abort_case, "R-4.4.5.1-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("measure-count-zero,measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("measure-count-zero", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_count_rule_on_replies_that_give_no_count(faults, expected):
+    assert _verdict(_session(faults), reply_case, "R-4.4.5-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("groups-start-at-d1,measure-count-zero", Verdict.INCONCLUSIVE),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("verify-no-service-request", Verdict.FAIL),
+    ],
+)
+def test_verification_against_rules_m_was_not_shown_to_keep(faults, expected):
+    assert _verdict(_session(faults), verification_case, "R-4.4.11-01") is expected
+
+
+@pytest.mark.parametrize(
+    "faults",
+    ["address-change-wrong-reply,answers-foreign-address", "address-change-wrong-reply", ""],
+)
+def test_the_sensor_is_back_at_its_address_after_the_change_case(faults):
+    session = _session(faults)
+    _verdict(session, change_case, "R-4.4.4-01")
+    # aM! is answered at its own address only (answers-foreign-address answers a!, aI!)
+    assert session.fresh_exchange("M").answered

@@ -51,4 +51,38 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " values, and the defined groups' counts rightly hold R-4.4.8-03.",
         removes=("R-4.4.8-03",),
     ),
+    Interaction(
+        frozenset({"abort-sends-zero-reply", "break-does-not-abort-measure"}),
+        "a break never aborts the measurement, so no abort is ever followed by the unasked"
+        " a0000: the service request and data come as usual and R-4.4.5-08 holds on the wire"
+        " (seed 4064: 'nothing arrived unasked after the break').",
+        removes=("R-4.4.5-08",),
+    ),
+    Interaction(
+        frozenset({"unknown-command-text", "unsupported-rc-without-crc"}),
+        "every unsupported aRCn! is answered 'aUNKN', so the CRC-less empty reply never"
+        " reaches the wire; the text is R-4.4.8.1-03's deviation, and no CRC format is judged"
+        " on text (seed 4066).",
+        removes=("R-4.4.12-02",),
+    ),
+    Interaction(
+        frozenset({"split-value", "values-not-packed"}),
+        "split-value fills every D reply after M/V to exactly 35 characters, so no reply is"
+        " left one value short: the replies are full on the wire and R-4.4.8.3-03 holds"
+        " (the cut is R-4.4.8.3-01's; seed 4068).",
+        removes=("R-4.4.8.3-03",),
+    ),
+    Interaction(
+        frozenset({"address-change-not-applied", "answers-old-address"}),
+        "the address change never takes effect, so the address the sensor keeps answering is"
+        " its own, not an old one beside the new: nothing answers a foreign address and"
+        " R-4.0-01 holds (seed 4068).",
+        removes=("R-4.0-01",),
+    ),
+    Interaction(
+        frozenset({"undefined-concurrent-silent", "unknown-command-text"}),
+        "an undefined aCn! gets no answer at all, so no 'aUNKN' is ever sent to one, and the"
+        " defined concurrent replies rightly hold R-4.4.7-01 (seed 4069).",
+        removes=("R-4.4.7-01",),
+    ),
 )

@@ -245,10 +245,12 @@ COUNTS: tuple[Fault, ...] = (
         " (R-4.4.7-05, R-5.3-01)"
         " nor data the identify commands could disturb (R-6.1-03) can be compared; nor is there"
         " a value whose format, length or grouping could be judged (R-4.4.8-02, R-4.4-05,"
-        " R-4.4.8.3-01..03: precondition buffered not met, where an empty D reply once PASSed).",
+        " R-4.4.8.3-01..03: precondition buffered not met, where an empty D reply once PASSed),"
+        " nor a buffer whose values a repeated D0 could show kept or lost (R-4.4.5-10).",
         ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
         settings={"drop_all_values": True},
         inconclusive=(
+            "R-4.4.5-10",
             "R-4.4.7-05",
             "R-6.1-03",
             "R-5.3-01",

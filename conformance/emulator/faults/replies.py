@@ -112,6 +112,21 @@ def _crc_twin(profile: Profile) -> Profile:
     return replace(profile, measurements={**profile.measurements, "MC": twin})
 
 
+#: The D-reply and value rules (testcases/sensor/test_4_4_8_data.py's first three cases):
+#: INCONCLUSIVE where a start reply gives no readable count, since no D command follows it
+#: and the values it holds are never read (judges.measurements.unread_data).
+UNREAD_DATA = (
+    "R-4.4.8-01",
+    "R-4.4.8-02",
+    "R-4.4-05",
+    "R-4.4.8-03",
+    "R-4.4.8-04",
+    "R-4.4.8.3-01",
+    "R-4.4.8.3-02",
+    "R-4.4.8.3-03",
+)
+
+
 #: Identification and reply format.
 FORMAT: tuple[Fault, ...] = (
     Fault(
@@ -148,10 +163,19 @@ FORMAT: tuple[Fault, ...] = (
         " No measurement reply parses, so no data are there for the identify commands to"
         " disturb (R-6.1-03), no ttt tells whether aV! owes a service request as aM! does"
         " (R-4.4.11-01), and no count (aIM! answers alike) says which metadata records"
-        " the M-type groups owe (R-6.2-07).",
+        " the M-type groups owe (R-6.2-07). With no count no D command follows aM!, aV!"
+        " or any aMn!: the D-reply and value rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read"
+        " only aC!'s data and are left open for the values aM! holds, as is the count's"
+        " 1..9 rule (R-4.4.5-02).",
         ("R-4.4.5-01",),
         rewrite=_start_with(1, lambda body: body[0] + body[2:]),
-        inconclusive=("R-6.1-03", "R-4.4.11-01", "R-6.2-07"),
+        inconclusive=(
+            "R-6.1-03",
+            "R-4.4.11-01",
+            "R-6.2-07",
+            "R-4.4.5-02",
+            *UNREAD_DATA,
+        ),
     ),
     Fault(
         "measure-count-zero",
@@ -172,9 +196,14 @@ FORMAT: tuple[Fault, ...] = (
         "concurrent-three-digit-count",
         "C/CC/Cn replies give a 3-digit count (atttnnn instead of atttnn)."
         " No concurrent reply has a readable count, so its bound (R-4.4.7-03) has nothing"
-        " to judge.",
+        " to judge, and no D command follows aC!, aCC!, aC9!, aCC9!: the D-reply and value"
+        " rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read only the M family's data and are"
+        " left open for the values those hold.",
         ("R-4.4.7-01",),
-        inconclusive=("R-4.4.7-03",),
+        inconclusive=(
+            "R-4.4.7-03",
+            *UNREAD_DATA,
+        ),
         rewrite=_start_with(2, lambda body: body[:4] + "0" + body[4:]),
     ),
     Fault(
@@ -190,13 +219,14 @@ FORMAT: tuple[Fault, ...] = (
         "HA replies give a 2-digit count (atttnn instead of atttnnn)."
         " With the count unreadable no D data are asked for, so the aHA! data rules have"
         " nothing to judge, nor has the count aHA!'s metadata records are checked against"
-        " (aIHA! answers alike, R-6.2-07).",
+        " (aIHA! answers alike, R-6.2-07); the announced-count rules of the D data"
+        " (R-4.4.8-03/-04) are left open for aHA!'s.",
         ("R-5.1-01",),
         rewrite=when(
             lambda r: measure_family(r, 3) and source_kind(r) is Kind.HIGH_VOLUME_ASCII,
             lambda r: replace(r, body=r.body[:4] + r.body[5:]),
         ),
-        inconclusive=("R-5.1-02", "R-5.1-03", "R-6.2-07"),
+        inconclusive=("R-5.1-02", "R-5.1-03", "R-6.2-07", "R-4.4.8-03", "R-4.4.8-04"),
         needs=("HA",),
     ),
     Fault(

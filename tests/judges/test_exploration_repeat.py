@@ -1,0 +1,32 @@
+"""The exploration's D0-repeat check (R-4.4.5-10) counts only where the earlier D0 held
+values: an empty buffer read twice cannot show data lost (continuous-overwrites-data beside
+d0-empty PASSed "held over 48 checks" from a sensor that never delivered a value, seed 4066)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.judges.exploration import Observation, judge
+
+
+def repeat(previous: str | None, reply: str) -> Observation:
+    return Observation("repeat", "0D0!", reply, previous=previous)
+
+
+@pytest.mark.parametrize(
+    ("previous", "reply"),
+    [
+        (None, "0+1.5\r\n"),  # the first D0 after a measurement: nothing to compare with
+        ("0\r\n", "0\r\n"),  # an empty buffer read twice
+        ("0Ba]\r\n", "0Ba]\r\n"),  # an empty CRC reply: CRC characters are never digits
+    ],
+)
+def test_a_repeat_of_nothing_is_no_check(previous, reply):
+    assert judge(repeat(previous, reply)).checked == ()
+
+
+def test_values_read_again_are_a_check_and_lost_values_breach_it():
+    kept = judge(repeat("0+1.5-2\r\n", "0+1.5-2\r\n"))
+    assert kept.checked == ("R-4.4.5-10",) and kept.breach is None
+    lost = judge(repeat("0+1.5-2\r\n", "0\r\n"))
+    assert lost.breach is not None and lost.breach.requirement == "R-4.4.5-10"
