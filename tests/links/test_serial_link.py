@@ -323,6 +323,22 @@ def _served_break(duration: float, exact: bool = False) -> tuple[object, tuple[f
         line.stop()
 
 
+def _served_break_heard(
+    duration: float, exact: bool = False, tries: int = 3
+) -> tuple[object, tuple[float, float]]:
+    """:func:`_served_break`, tried again (up to ``tries`` in all) while the line did not hear
+    the break as long as the link stamped it. The emulated line stamps a break's edges when
+    its thread handles the two SET_CONTROL messages; a thread starved for longer than the
+    break handles both at once and hears 0 ms (CI beside two other sessions: a 5.05 ms
+    break heard as 0.0 ms). That is the test machine, not the link; a link that does not
+    hold breaks as it stamps them fails every try, and the last is what the test judges."""
+    for _ in range(tries):
+        event, heard = _served_break(duration, exact)
+        if abs(heard[1] - heard[0] - event.duration) <= event.uncertainty:
+            break
+    return event, heard
+
+
 def _held_within_its_uncertainty(event, asked: float) -> None:
     """A host-timed hold may overrun by the link's declared uncertainty; more than that is
     the shared machine failing to wake the sleeping thread in time (the event still says
@@ -357,7 +373,7 @@ def test_rfc2217_short_break_is_a_nul_timed_by_the_uart():
 @pytest.mark.realtime  # breaks timed by the host: run serially
 def test_rfc2217_wake_up_break_is_held_by_set_control():
     """An ordinary wake-up break (not near a threshold) is held with raw SET_CONTROL."""
-    event, (start, end) = _served_break(13e-3)
+    event, (start, end) = _served_break_heard(13e-3)
     assert event.duration >= 13e-3, event
     _held_within_its_uncertainty(event, 13e-3)
     assert "SET_CONTROL" in event.text
@@ -380,7 +396,7 @@ def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
             pass
 
     monkeypatch.setattr(servers, "VirtualPort", Stubborn)
-    event, (start, end) = _served_break(5e-3, exact=True)
+    event, (start, end) = _served_break_heard(5e-3, exact=True)
     assert "SET_CONTROL" in event.text and "baud" not in event.text
     _heard_as_stamped(event, end - start)
 
@@ -388,7 +404,7 @@ def test_server_that_keeps_its_bit_rate_gets_host_timed_breaks(monkeypatch):
 @pytest.mark.realtime  # breaks timed by the host: run serially
 def test_rfc2217_long_break_is_held_by_set_control():
     """Longer than a NUL at the lowest rate can make: held with raw SET_CONTROL messages."""
-    event, (start, end) = _served_break(100e-3, exact=True)
+    event, (start, end) = _served_break_heard(100e-3, exact=True)
     assert event.duration >= 100e-3, event
     _held_within_its_uncertainty(event, 100e-3)
     assert "SET_CONTROL" in event.text
