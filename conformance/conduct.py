@@ -84,7 +84,10 @@ def conduct(
     given.files = files
     given.html_aside = html_aside
     code = int(pytest.main(argv, plugins=[*plugins, given]))
-    return RunResult(code, report_dir, given.run)
+    # pytest's objects hold ``given`` in reference cycles: the run is the caller's alone from
+    # here, freed when the caller lets it go (plugin.detach_run)
+    run, given.run = given.run, None
+    return RunResult(code, report_dir, run)
 
 
 class NoVerdicts(RuntimeError):

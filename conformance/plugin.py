@@ -43,6 +43,7 @@ LOCKED = pytest.StashKey[Path]()  # the report folder this run holds (report_fol
 PACE = pytest.StashKey[gc_pace.Pace]()  # the collector's pace before the run (gc_pace)
 ASIDE = pytest.StashKey[Aside]()  # the process rendering report.html (reports.html_aside)
 UNDEFER = pytest.StashKey[Callable[[], None]]()  # pytest-html's template reader put back
+CASED = pytest.StashKey[list[pytest.Item]]()  # the items given a CASE record (detach_run)
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -314,6 +315,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             requirements=tuple(marker.args),
             description=" ".join(doc.split()),
         )
+        config.stash.setdefault(CASED, []).append(item)
 
 
 @pytest.hookimpl(wrapper=True)
@@ -451,3 +453,20 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     if config.stash.get(OWN_GUARD, False):
         GUARD.uninstall()
         GUARD.reset()
+    detach_run(config)
+
+
+def detach_run(config: pytest.Config) -> None:
+    """Let go of the run at the session's very end. pytest's config, session and items hold
+    each other in reference cycles, so whatever they reference lives until the cyclic
+    collector walks it: the whole run (its transcript's 10^4..10^5 events, the case records
+    and their findings), a fault-matrix process's dozens of runs piling up for full
+    collections over all of them. Dropped here (with ``GivenOptions.run`` in
+    :func:`conformance.conduct.conduct`), the run is freed by reference counting as soon as
+    its caller lets it go; the run itself holds no cycle back to pytest."""
+    for item in config.stash.get(CASED, ()):
+        if CASE in item.stash:
+            del item.stash[CASE]
+    for key in (CASED, RUN):
+        if key in config.stash:
+            del config.stash[key]

@@ -93,3 +93,30 @@ def test_a_run_without_a_folder_gets_one_of_its_own(monkeypatch, tmp_path):
     result = conduct(RunOptions(keyword="test_query_address"), html=False)
     assert result.report_dir.parent == Path("reports") and result.exit_code == EXIT_COMPLIANT
     assert (tmp_path / result.report_dir / "verdicts.json").exists()
+
+
+def test_a_finished_run_is_freed_by_reference_counting(tmp_path):
+    """Issue 22 (fault-matrix CPU): pytest's config, session and items hold each other in
+    reference cycles; a run they still reference after pytest.main returns lives until a
+    full collection walks it (10^5 events for a CRC fault). With the collector off, the run
+    must die the moment its caller drops it, its transcript's events with it."""
+    import gc
+    import weakref
+
+    options = RunOptions(port="sim", report_dir=str(tmp_path), keyword="test_query_address or crc")
+    was_on = gc.isenabled()
+    gc.collect()
+    gc.disable()
+    try:
+        result = conduct(options, html=False, rootdir=tmp_path, files=())
+        run = result.run
+        assert run is not None and run.verdict_lines() is not None
+        assert run.link is not None and run.link.transcript.events
+        run_ref = weakref.ref(run)
+        record_ref = weakref.ref(run.cases[0])
+        del run, result
+        assert run_ref() is None, "the run outlived its caller (held by pytest's cycles)"
+        assert record_ref() is None, "a case record outlived the run (held by its item)"
+    finally:
+        if was_on:
+            gc.enable()
