@@ -251,6 +251,11 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (seed 4071) the change reply named the old address and a! is answered anywhere: the
     # sensor was left at '1' while every later case spoke to '0' (seven false FAILs)
     ("address-change-wrong-reply", "answers-foreign-address"),
+    # (seeds 4063-4072, with metadata-missing-units) aIM!'s service request fell due while
+    # the sensor answered a later command: the bus sent its overdue frames back to back
+    # (gaps 0 and 1.667 ms from a 3 ms sensor): R-7.0-01 FAILed, R-4.1-01 PASSed; the
+    # transmitter now moves a transmission due during an earlier-starting one after it, whole
+    ("identify-sends-service-request", "inter-char-gap"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
