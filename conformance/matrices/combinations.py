@@ -73,10 +73,14 @@ def version_of(name: str) -> str:
 def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[str, ...]]:
     """``count`` distinct combinations of ``size`` faults, the same list for the same seed.
 
-    Members share a profile version (a v1.3 fault and a v1.4-only one cannot be one sensor);
-    names are sorted within a combination so the list is stable across registry order.
+    Members share a profile version (a v1.3 fault and a v1.4-only one cannot be one sensor)
+    and compose (:func:`~conformance.emulator.faults.conflicts`: two faults that set one knob
+    apart, or one that masks the other, cannot be one sensor either; the sim port refuses
+    them and the run judges nothing); names are sorted within a combination so the list is
+    stable across registry order.
     """
     from ..emulator import FAULTS
+    from ..emulator.faults import conflicts
 
     if size < 2:
         raise ValueError(f"a combination has 2 or more faults, not {size}")
@@ -93,7 +97,9 @@ def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[st
         if len(chosen) >= count:
             break
         pool = rng.choices(pools, weights)[0]
-        chosen.setdefault(tuple(sorted(rng.sample(pool, size))), None)
+        combo = tuple(sorted(rng.sample(pool, size)))
+        if not conflicts(combo):
+            chosen.setdefault(combo, None)
     return list(chosen)
 
 
@@ -113,6 +119,10 @@ def check(
 ) -> ComboRow:
     """Judge one combination's verdicts.json (``data``) against ``declared``: per member
     fault, its ``(violates, inconclusive)``. Pure: the fast tests hand it made-up verdicts."""
+    if data["summary"]["verdict"] == "INCOMPLETE":
+        # a refused composition or a run cut short judged little or nothing: never clean
+        reason = str((data.get("run") or {}).get("stop_reason") or "the run stopped early")
+        return ComboRow(faults, "INCOMPLETE", (), (), (Finding("run", "INCOMPLETE", reason),))
     live = [i for i in interactions if i.applies(faults)]
     allowed = {r for f in faults for r in declared[f][0]} | {r for i in live for r in i.adds}
     removed = {r for f in faults for part in declared[f] for r in part}
