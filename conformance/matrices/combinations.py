@@ -266,6 +266,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (gaps 0 and 1.667 ms from a 3 ms sensor): R-7.0-01 FAILed, R-4.1-01 PASSed; the
     # transmitter now moves a transmission due during an earlier-starting one after it, whole
     ("identify-sends-service-request", "inter-char-gap"),
+    # (seed 4077) aA$! was taken and a! is answered anywhere: restore found '0' answering
+    # and left the sensor at '$' (seven false FAILs, as seed 4071's row above)
+    ("accepts-invalid-address", "answers-foreign-address"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

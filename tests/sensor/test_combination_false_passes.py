@@ -44,7 +44,8 @@ measure-count-zero) had no D0 to show kept (+ groups-start-at-d1, seed 4072): IN
 A sensor that answers a! at any address, and whose change reply names its old address, was
 left at '1' after the change-address case ("restored: it answers there" on '0!'), so every
 later case spoke to an empty address (seven false FAILs, seed 4071): after a move away whose
-reply was unclear, every address tried is asked to move back.
+reply was unclear, every address tried is asked to move back. The same after aA$! taken
+(accepts-invalid-address + answers-foreign-address, seed 4077: the sensor left at '$').
 """
 
 from __future__ import annotations
@@ -71,6 +72,7 @@ from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
 from testcases.sensor.test_4_4_basic import test_change_address as change_case
+from testcases.sensor.test_4_addressing import test_address_range as range_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
@@ -300,4 +302,14 @@ def test_the_sensor_is_back_at_its_address_after_the_change_case(faults):
     session = _session(faults)
     _verdict(session, change_case, "R-4.4.4-01")
     # aM! is answered at its own address only (answers-foreign-address answers a!, aI!)
+    assert session.fresh_exchange("M").answered
+
+
+@pytest.mark.parametrize(
+    "faults", ["accepts-invalid-address,answers-foreign-address", "accepts-invalid-address", ""]
+)
+def test_the_sensor_is_back_at_its_address_after_the_invalid_address(faults):
+    session = _session(faults)
+    expected = Verdict.WARN if faults else Verdict.PASS  # decision A17: lenient
+    assert _verdict(session, range_case, "R-4.3-04") is expected
     assert session.fresh_exchange("M").answered
