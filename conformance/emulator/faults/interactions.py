@@ -100,4 +100,21 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " request, R-4.4.6-01's, not as chatter before a request that never comes).",
         removes=("R-4.4.5-08",),
     ),
+    Interaction(
+        frozenset({"early-address", "slow-wake"}),
+        "a sensor that wakes 110 ms after the break while a retry is on the line needs marking"
+        " before it takes an address, and early-address removes that marking: it takes the"
+        " tail of a command for one ('0!' inside '0D0!') and answers it, so the wire holds"
+        " empty D replies and unanswered changes that the rules on them rightly FAIL (seed"
+        " 4082: 0D0! -> '0<CR><LF>' 9 ms after the retry that it woke inside).",
+        adds=(
+            "R-4.4.4-01",
+            "R-4.4.5-03",
+            "R-4.4.5-10",
+            "R-4.4.8-03",
+            "R-4.4.8-04",
+            "R-4.4.8.3-02",
+            "R-5.2-02",
+        ),
+    ),
 )
