@@ -269,6 +269,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (seed 4077) aA$! was taken and a! is answered anywhere: restore found '0' answering
     # and left the sensor at '$' (seven false FAILs, as seed 4071's row above)
     ("accepts-invalid-address", "answers-foreign-address"),
+    # (seed 4088) R-4.4.12-04 PASSed "the pairs announce the same counts" over the pairs
+    # that gave one, while aM!/aMC!, the pair that differs, gave none readable
+    ("crc-variant-different-count", "measure-ttt-two-digits"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -46,6 +46,9 @@ left at '1' after the change-address case ("restored: it answers there" on '0!')
 later case spoke to an empty address (seven false FAILs, seed 4071): after a move away whose
 reply was unclear, every address tried is asked to move back. The same after aA$! taken
 (accepts-invalid-address + answers-foreign-address, seed 4077: the sensor left at '$').
+R-4.4.12-04 PASSed "10 plain/CRC pairs announce the same counts" while aM!/aMC! gave no
+readable count, the one pair crc-variant-different-count changes (+ measure-ttt-two-digits,
+seed 4088): INCONCLUSIVE where a pair was not compared.
 """
 
 from __future__ import annotations
@@ -71,6 +74,7 @@ from testcases.sensor.test_4_4_9_additional import test_verification as verifica
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
+from testcases.sensor.test_4_4_12_crc import test_crc_variant_same_measurement as twin_case
 from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_4_addressing import test_address_range as range_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
@@ -313,3 +317,16 @@ def test_the_sensor_is_back_at_its_address_after_the_invalid_address(faults):
     expected = Verdict.WARN if faults else Verdict.PASS  # decision A17: lenient
     assert _verdict(session, range_case, "R-4.3-04") is expected
     assert session.fresh_exchange("M").answered
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("crc-variant-different-count,measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("crc-variant-different-count", Verdict.WARN),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_crc_twin_whose_count_went_unread(faults, expected):
+    assert _verdict(_session(faults), twin_case, "R-4.4.12-04") is expected
