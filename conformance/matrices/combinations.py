@@ -272,6 +272,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (seed 4088) R-4.4.12-04 PASSed "the pairs announce the same counts" over the pairs
     # that gave one, while aM!/aMC!, the pair that differs, gave none readable
     ("crc-variant-different-count", "measure-ttt-two-digits"),
+    # (seed 4088) R-5.2-02 FAILed on silence to DB10, read past an uncountable packet, where
+    # binary-no-empty-packet owes no packet but R-5.2-06's empty one
+    ("binary-invalid-type", "binary-no-empty-packet"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -49,6 +49,9 @@ reply was unclear, every address tried is asked to move back. The same after aA$
 R-4.4.12-04 PASSed "10 plain/CRC pairs announce the same counts" while aM!/aMC! gave no
 readable count, the one pair crc-variant-different-count changes (+ measure-ttt-two-digits,
 seed 4088): INCONCLUSIVE where a pair was not compared.
+And a false FAIL: R-5.2-02 FAILed "no packet returned for 0DB10!" where the collection read
+on past an uncountable packet (binary-invalid-type) to an index past the data, which
+binary-no-empty-packet leaves silent (R-5.2-06's deviation, seed 4088): INCONCLUSIVE there.
 """
 
 from __future__ import annotations
@@ -330,3 +333,16 @@ def test_the_sensor_is_back_at_its_address_after_the_invalid_address(faults):
 )
 def test_a_crc_twin_whose_count_went_unread(faults, expected):
     assert _verdict(_session(faults), twin_case, "R-4.4.12-04") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("binary-invalid-type,binary-no-empty-packet", Verdict.INCONCLUSIVE),
+        ("binary-no-empty-packet", Verdict.PASS),
+        ("binary-size-big-endian", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_silence_past_uncountable_packets(faults, expected):
+    assert _verdict(_session(faults), binary_case, "R-5.2-02") is expected
