@@ -226,6 +226,10 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
         tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
         replies.append(reply)
+        if _refuses_high_index(m, ex, body):
+            # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
+            # as silence there is (high-volume-stops-at-d9 + unknown-command-text PASSed)
+            tally.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
     seq = check_data_sequence(replies, m.count, limit)
     _drop_split_fragments(replies, seq, tally, label)
     tally.observe(
@@ -272,6 +276,16 @@ def data_reply_ids(command: Command) -> list[str]:
     if command.returns_crc:
         return ids + ["R-4.4.12-02", "R-4.4.12-05", "R-4.4.12-06"]
     return ids + ["R-4.4.12-03"]
+
+
+def _refuses_high_index(m: Measurement, ex: Exchange, body: str) -> bool:
+    """A reply of text, neither values nor empty, to an ``aDn!`` of two or more digits
+    after ``aHA!``: the D commands past D9 exist only for high-volume data (R-5.1-02)."""
+    command = ex.command
+    if m.command.kind is not Kind.HIGH_VOLUME_ASCII or command is None:
+        return False
+    rest = body[1:]
+    return command.kind is Kind.DATA and command.index >= 10 and rest[:1] not in ("", "+", "-")
 
 
 def _drop_split_fragments(

@@ -52,6 +52,8 @@ seed 4088): INCONCLUSIVE where a pair was not compared.
 And a false FAIL: R-5.2-02 FAILed "no packet returned for 0DB10!" where the collection read
 on past an uncountable packet (binary-invalid-type) to an index past the data, which
 binary-no-empty-packet leaves silent (R-5.2-06's deviation, seed 4088): INCONCLUSIVE there.
+R-5.1-02 PASSed where aD10! after aHA! was answered 'aUNKN' rather than left silent
+(high-volume-stops-at-d9 + unknown-command-text, seed 4090): text there FAILs as silence does.
 """
 
 from __future__ import annotations
@@ -80,6 +82,7 @@ from testcases.sensor.test_4_4_12_crc import (
 from testcases.sensor.test_4_4_12_crc import test_crc_variant_same_measurement as twin_case
 from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_4_addressing import test_address_range as range_case
+from testcases.sensor.test_5_high_volume import test_high_volume_ascii as ascii_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
@@ -346,3 +349,16 @@ def test_a_crc_twin_whose_count_went_unread(faults, expected):
 )
 def test_silence_past_uncountable_packets(faults, expected):
     assert _verdict(_session(faults), binary_case, "R-5.2-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("high-volume-stops-at-d9,unknown-command-text", Verdict.FAIL),
+        ("high-volume-stops-at-d9", Verdict.FAIL),
+        ("unknown-command-text", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_text_to_a_high_index_after_ha(faults, expected):
+    assert _verdict(_session(faults), ascii_case, "R-5.1-02") is expected
