@@ -277,6 +277,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("binary-invalid-type", "binary-no-empty-packet"),
     # (seed 4090) R-5.1-02 PASSed on 'aUNKN' to aD10! after aHA!, where silence FAILs it
     ("high-volume-stops-at-d9", "unknown-command-text"),
+    # (seed 4091) aIMC_001! unanswered: the case stopped, though the plain D replies after
+    # it carried a CRC, and R-4.4.12-03 PASSed on the replies read before it
+    ("metadata-crc-sticks", "metadata-silent"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

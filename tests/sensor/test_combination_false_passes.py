@@ -54,6 +54,9 @@ on past an uncountable packet (binary-invalid-type) to an index past the data, w
 binary-no-empty-packet leaves silent (R-5.2-06's deviation, seed 4088): INCONCLUSIVE there.
 R-5.1-02 PASSed where aD10! after aHA! was answered 'aUNKN' rather than left silent
 (high-volume-stops-at-d9 + unknown-command-text, seed 4090): text there FAILs as silence does.
+R-4.4.12-03 PASSed on the D replies read before any CRC metadata command where aIMC_001!
+went unanswered, though aM!'s D replies after it carried the CRC it had asked for
+(metadata-crc-sticks + metadata-silent, seed 4091): that CRC FAILs the rule either way.
 """
 
 from __future__ import annotations
@@ -362,3 +365,16 @@ def test_silence_past_uncountable_packets(faults, expected):
 )
 def test_text_to_a_high_index_after_ha(faults, expected):
     assert _verdict(_session(faults), ascii_case, "R-5.1-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("metadata-crc-sticks,metadata-silent", Verdict.FAIL),
+        ("metadata-silent", Verdict.INCONCLUSIVE),
+        ("metadata-crc-sticks", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_crc_that_outlived_an_unanswered_metadata_command(faults, expected):
+    assert _verdict(_session(faults), crc_request_case, "R-4.4.12-03") is expected
