@@ -117,4 +117,18 @@ INTERACTIONS: tuple[Interaction, ...] = (
             "R-5.2-02",
         ),
     ),
+    Interaction(
+        frozenset({"abort-keeps-old-data", "buffer-cleared-after-read"}),
+        "the measurement before the aborted one was read to its end, which emptied the buffer,"
+        " so the old data the abort brings back are none: D0 after the abort is empty on the"
+        " wire and the abort rules hold there (seed 4094).",
+        removes=("R-4.4.5.1-02", "R-4.4.7.1-01", "R-4.4.7.1-02"),
+    ),
+    Interaction(
+        frozenset({"buffer-cleared-after-read", "undefined-group-keeps-data"}),
+        "the data an undefined aMn! leaves readable were read to their end before it, which"
+        " emptied them, so its a0000 is followed by an empty D0 and R-4.4.8-03 holds on the"
+        " wire (seed 4094).",
+        removes=("R-4.4.8-03",),
+    ),
 )
