@@ -57,6 +57,9 @@ R-5.1-02 PASSed where aD10! after aHA! was answered 'aUNKN' rather than left sil
 R-4.4.12-03 PASSed on the D replies read before any CRC metadata command where aIMC_001!
 went unanswered, though aM!'s D replies after it carried the CRC it had asked for
 (metadata-crc-sticks + metadata-silent, seed 4091): that CRC FAILs the rule either way.
+R-4.4.5-08 FAILed "the sensor sent '0SR<CR><LF>' unasked" after a break that did not abort
+aM!: the line was aM!'s own malformed request, sent in the undisturbed wait too
+(break-does-not-abort-measure + service-request-extra-chars, seed 4093).
 """
 
 from __future__ import annotations
@@ -378,3 +381,15 @@ def test_text_to_a_high_index_after_ha(faults, expected):
 )
 def test_a_crc_that_outlived_an_unanswered_metadata_command(faults, expected):
     assert _verdict(_session(faults), crc_request_case, "R-4.4.12-03") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("break-does-not-abort-measure,service-request-extra-chars", Verdict.NA),
+        ("abort-sends-zero-reply", Verdict.FAIL),
+        ("", Verdict.NA),
+    ],
+)
+def test_the_measurements_own_line_after_a_break_is_not_unasked(faults, expected):
+    assert _verdict(_session(faults), abort_case, "R-4.4.5-08") is expected
