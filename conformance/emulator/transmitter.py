@@ -79,9 +79,23 @@ class Transmitter:
             if other.start <= start < other.end + CHAR_TIME:
                 start = other.end + CHAR_TIME
         item = Transmission(reply, start, wires, gap, char_time=char_time, pause=pause)
+        self._make_way(item)
         self.queue.append(item)
         self.queue.sort(key=lambda t: t.start)
         return item
+
+    def _make_way(self, item: Transmission) -> None:
+        """Move transmissions planned to start while ``item`` is on the wire (a service
+        request due in the middle of a reply scheduled after it) to after it, whole, as a
+        later one waits for an earlier: the bus would otherwise send their frames that fell
+        due meanwhile back to back (at the wire's ``max(start, now)``), dropping the
+        marking the sensor puts between its characters (an ``inter-char-gap`` sensor's 3 ms)."""
+        end = item.end
+        for other in sorted(self.queue, key=lambda t: t.start):
+            if other.sent == 0 and item.start <= other.start < end + CHAR_TIME:
+                other.start = end + CHAR_TIME
+                end = other.end
+                self._offered = None  # its frames are not where they were offered
 
     def cancel(self, keep: Callable[[Transmission], bool] | None = None) -> None:
         """Drop pending output (all of it, or what ``keep`` rejects)."""

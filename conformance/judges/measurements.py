@@ -226,6 +226,10 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
         tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
         replies.append(reply)
+        if _refuses_high_index(m, ex, body):
+            # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
+            # as silence there is (high-volume-stops-at-d9 + unknown-command-text PASSed)
+            tally.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
     seq = check_data_sequence(replies, m.count, limit)
     _drop_split_fragments(replies, seq, tally, label)
     tally.observe(
@@ -274,6 +278,16 @@ def data_reply_ids(command: Command) -> list[str]:
     return ids + ["R-4.4.12-03"]
 
 
+def _refuses_high_index(m: Measurement, ex: Exchange, body: str) -> bool:
+    """A reply of text, neither values nor empty, to an ``aDn!`` of two or more digits
+    after ``aHA!``: the D commands past D9 exist only for high-volume data (R-5.1-02)."""
+    command = ex.command
+    if m.command.kind is not Kind.HIGH_VOLUME_ASCII or command is None:
+        return False
+    rest = body[1:]
+    return command.kind is Kind.DATA and command.index >= 10 and rest[:1] not in ("", "+", "-")
+
+
 def _drop_split_fragments(
     replies: list[DataReply], seq: list[Violation], tally: Tally, label: str
 ) -> None:
@@ -301,7 +315,18 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
         if not ex.answered:
-            tally.fail("R-5.2-02", dlabel, f"no packet returned for {where(ex)}")
+            if not countable:
+                # (seed 4088) read on past a packet whose values could not be counted, so
+                # this index may be past the data, where the empty packet is R-5.2-06's
+                # (binary-invalid-type + binary-no-empty-packet FAILed R-5.2-02 on DB10)
+                tally.undecide(
+                    "R-5.2-02",
+                    dlabel,
+                    f"no packet for {where(ex)}, which may lie past the data: the packets"
+                    " before it could not be counted",
+                )
+            elif total < m.count:
+                tally.fail("R-5.2-02", dlabel, f"no packet returned for {where(ex)}")
             return
         packet = parse_binary_packet(ex.reply_bytes, expected_address=m.command.address)
         tally.observe(dlabel, packet.violations, ids=ids)

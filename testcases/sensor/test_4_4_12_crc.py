@@ -7,9 +7,9 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
-from conformance.judges.support import serves_continuous
+from conformance.judges.support import serves_continuous, unreadable_count
 from conformance.protocol.commands import C_FAMILY, M_FAMILY
-from conformance.verdicts import Finding, passed, warned
+from conformance.verdicts import Finding, Verdict, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
 CRC_CODES = tuple(c for c in M_FAMILY + C_FAMILY if c[:2] in ("MC", "CC"))
@@ -95,6 +95,12 @@ def test_crc_request_ends_with_its_command(sensor, case):
     case.evidence(
         f"{_bare(meta.text)}, then {_bare(m.command.text())} and its D replies", [meta, m]
     )
+    findings = judge.judge([m], case.requirements, sensor.version)
+    if not meta.answered and any(f.verdict is Verdict.FAIL for f in findings):
+        # a CRC on a plain D reply breaks the rule whether or not the metadata command that
+        # asked for it was answered (metadata-crc-sticks + metadata-silent, seed 4091)
+        case.extend(findings)
+        return
     if not case.requires(
         "supported",
         precondition.shown_supported(
@@ -102,7 +108,7 @@ def test_crc_request_ends_with_its_command(sensor, case):
         ),
     ):
         return
-    case.extend(judge.judge([m], case.requirements, sensor.version))
+    case.extend(findings)
 
 
 def _plain_with_values(sensor):
@@ -147,6 +153,8 @@ def test_crc_variant_same_measurement(sensor, case):
         twin = plain[0] + "C" + plain[1:]
         pairs.append((sensor.measurement(plain), sensor.measurement(twin)))
     case.evidence("plain and CRC measurement replies", [x.start for p in pairs for x in p])
+    # a reply in digits that gives no count (a two-digit ttt) hides the n it was to compare
+    unread = [(a, b) for a, b in pairs if unreadable_count(a) or unreadable_count(b)]
     pairs = [(a, b) for a, b in pairs if a.count is not None and b.count is not None]
     if not case.requires(
         "supported",
@@ -163,6 +171,20 @@ def test_crc_variant_same_measurement(sensor, case):
                     for a, b in differ[:3]
                 ),
                 evidence=xjudge.cite(x.start for pair in differ for x in pair),
+                observed=len(pairs),
+            )
+        )
+    elif unread:
+        # (seed 4088) crc-variant-different-count's aMC! went unread beside aM!'s: 'the
+        # same counts' over the other pairs would PASS the one pair that differs
+        case.add(
+            inconclusive(
+                "R-4.4.12-04",
+                f"{len(pairs)} plain/CRC pairs announce the same counts, but no count could be"
+                " read in "
+                + ", ".join(f"{a.command}/{b.command}" for a, b in unread)
+                + ": not compared",
+                evidence=xjudge.cite(x.start for pair in unread for x in pair),
                 observed=len(pairs),
             )
         )

@@ -199,3 +199,18 @@ def test_every_fault_on_a_v13_sensor_is_accepted_or_a_usage_error(name):
     for text in ("0!", "0I!", "0M!", "0D0!", "0C!", "0D0!", "0R0!", "0XSN!", "0M1!", "0D0!"):
         rig.ask(text)  # the v1.3 sensor serves the fault without an internal error
     assert rig.emulator.profile.version == "13"
+
+
+def test_a_service_request_due_during_a_reply_keeps_the_sensors_character_gap():
+    """R-7.0-12, R-4.1-01 (combination seen in round 1, seeds 4063-4072): aIM!'s service
+    request fell due while the sensor was answering the next command; the bus sent its
+    frames that were already due back to back after the reply, so an ``inter-char-gap``
+    sensor showed 0 and 1.667 ms gaps it never makes (a false R-7.0-01 FAIL and a PASS of
+    R-4.1-01 that ``inter-char-gap`` leaves undecided). The request waits, whole."""
+    rig = Rig(faults=("identify-sends-service-request", "inter-char-gap"))
+    due = rig.ask("0IM!").events[-1].end + 1.5  # 0 002 3: ready_after 1.5 s
+    while rig.now < due - 0.2:
+        rig.ask("0!", brk=False)  # keeps the sensor awake without a break
+    answer = rig.ask("0I!", brk=False)  # its 317 ms reply covers the moment
+    assert answer.text == "014CONFORM EMU001100SN0001\r\n0\r\n"
+    assert min(answer.gaps) == pytest.approx(3e-3)

@@ -44,7 +44,22 @@ measure-count-zero) had no D0 to show kept (+ groups-start-at-d1, seed 4072): IN
 A sensor that answers a! at any address, and whose change reply names its old address, was
 left at '1' after the change-address case ("restored: it answers there" on '0!'), so every
 later case spoke to an empty address (seven false FAILs, seed 4071): after a move away whose
-reply was unclear, every address tried is asked to move back.
+reply was unclear, every address tried is asked to move back. The same after aA$! taken
+(accepts-invalid-address + answers-foreign-address, seed 4077: the sensor left at '$').
+R-4.4.12-04 PASSed "10 plain/CRC pairs announce the same counts" while aM!/aMC! gave no
+readable count, the one pair crc-variant-different-count changes (+ measure-ttt-two-digits,
+seed 4088): INCONCLUSIVE where a pair was not compared.
+And a false FAIL: R-5.2-02 FAILed "no packet returned for 0DB10!" where the collection read
+on past an uncountable packet (binary-invalid-type) to an index past the data, which
+binary-no-empty-packet leaves silent (R-5.2-06's deviation, seed 4088): INCONCLUSIVE there.
+R-5.1-02 PASSed where aD10! after aHA! was answered 'aUNKN' rather than left silent
+(high-volume-stops-at-d9 + unknown-command-text, seed 4090): text there FAILs as silence does.
+R-4.4.12-03 PASSed on the D replies read before any CRC metadata command where aIMC_001!
+went unanswered, though aM!'s D replies after it carried the CRC it had asked for
+(metadata-crc-sticks + metadata-silent, seed 4091): that CRC FAILs the rule either way.
+R-4.4.5-08 FAILed "the sensor sent '0SR<CR><LF>' unasked" after a break that did not abort
+aM!: the line was aM!'s own malformed request, sent in the undisturbed wait too
+(break-does-not-abort-measure + service-request-extra-chars, seed 4093).
 """
 
 from __future__ import annotations
@@ -70,7 +85,10 @@ from testcases.sensor.test_4_4_9_additional import test_verification as verifica
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
+from testcases.sensor.test_4_4_12_crc import test_crc_variant_same_measurement as twin_case
 from testcases.sensor.test_4_4_basic import test_change_address as change_case
+from testcases.sensor.test_4_addressing import test_address_range as range_case
+from testcases.sensor.test_5_high_volume import test_high_volume_ascii as ascii_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
@@ -301,3 +319,77 @@ def test_the_sensor_is_back_at_its_address_after_the_change_case(faults):
     _verdict(session, change_case, "R-4.4.4-01")
     # aM! is answered at its own address only (answers-foreign-address answers a!, aI!)
     assert session.fresh_exchange("M").answered
+
+
+@pytest.mark.parametrize(
+    "faults", ["accepts-invalid-address,answers-foreign-address", "accepts-invalid-address", ""]
+)
+def test_the_sensor_is_back_at_its_address_after_the_invalid_address(faults):
+    session = _session(faults)
+    expected = Verdict.WARN if faults else Verdict.PASS  # decision A17: lenient
+    assert _verdict(session, range_case, "R-4.3-04") is expected
+    assert session.fresh_exchange("M").answered
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("crc-variant-different-count,measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+        ("crc-variant-different-count", Verdict.WARN),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_crc_twin_whose_count_went_unread(faults, expected):
+    assert _verdict(_session(faults), twin_case, "R-4.4.12-04") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("binary-invalid-type,binary-no-empty-packet", Verdict.INCONCLUSIVE),
+        ("binary-no-empty-packet", Verdict.PASS),
+        ("binary-size-big-endian", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_silence_past_uncountable_packets(faults, expected):
+    assert _verdict(_session(faults), binary_case, "R-5.2-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("high-volume-stops-at-d9,unknown-command-text", Verdict.FAIL),
+        ("high-volume-stops-at-d9", Verdict.FAIL),
+        ("unknown-command-text", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_text_to_a_high_index_after_ha(faults, expected):
+    assert _verdict(_session(faults), ascii_case, "R-5.1-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("metadata-crc-sticks,metadata-silent", Verdict.FAIL),
+        ("metadata-silent", Verdict.INCONCLUSIVE),
+        ("metadata-crc-sticks", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_crc_that_outlived_an_unanswered_metadata_command(faults, expected):
+    assert _verdict(_session(faults), crc_request_case, "R-4.4.12-03") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("break-does-not-abort-measure,service-request-extra-chars", Verdict.NA),
+        ("abort-sends-zero-reply", Verdict.FAIL),
+        ("", Verdict.NA),
+    ],
+)
+def test_the_measurements_own_line_after_a_break_is_not_unasked(faults, expected):
+    assert _verdict(_session(faults), abort_case, "R-4.4.5-08") is expected

@@ -85,4 +85,50 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " defined concurrent replies rightly hold R-4.4.7-01 (seed 4069).",
         removes=("R-4.4.7-01",),
     ),
+    Interaction(
+        frozenset({"measure-count-zero", "metadata-missing-record"}),
+        "aM! and aMC! announce no values, so their aIM_002!/aIMC_002! name an index past the"
+        " count and the bare 'a<CR><LF>' is the right answer: the record metadata-missing-"
+        "record drops is never owed, and R-6.2-07 holds on the wire (seed 4075).",
+        removes=("R-6.2-07",),
+    ),
+    Interaction(
+        frozenset({"chatter-before-service-request", "no-service-request"}),
+        "the chatter is timed halfway to the service request, and with none sent the sensor"
+        " sends nothing between atttn and the data: R-4.4.5-08 holds on the wire (seed 4081;"
+        " sending the chatter anyway leaves one 'aBUSY' line that reads as a malformed"
+        " request, R-4.4.6-01's, not as chatter before a request that never comes).",
+        removes=("R-4.4.5-08",),
+    ),
+    Interaction(
+        frozenset({"early-address", "slow-wake"}),
+        "a sensor that wakes 110 ms after the break while a retry is on the line needs marking"
+        " before it takes an address, and early-address removes that marking: it takes the"
+        " tail of a command for one ('0!' inside '0D0!') and answers it, so the wire holds"
+        " empty D replies and unanswered changes that the rules on them rightly FAIL (seed"
+        " 4082: 0D0! -> '0<CR><LF>' 9 ms after the retry that it woke inside).",
+        adds=(
+            "R-4.4.4-01",
+            "R-4.4.5-03",
+            "R-4.4.5-10",
+            "R-4.4.8-03",
+            "R-4.4.8-04",
+            "R-4.4.8.3-02",
+            "R-5.2-02",
+        ),
+    ),
+    Interaction(
+        frozenset({"abort-keeps-old-data", "buffer-cleared-after-read"}),
+        "the measurement before the aborted one was read to its end, which emptied the buffer,"
+        " so the old data the abort brings back are none: D0 after the abort is empty on the"
+        " wire and the abort rules hold there (seed 4094).",
+        removes=("R-4.4.5.1-02", "R-4.4.7.1-01", "R-4.4.7.1-02"),
+    ),
+    Interaction(
+        frozenset({"buffer-cleared-after-read", "undefined-group-keeps-data"}),
+        "the data an undefined aMn! leaves readable were read to their end before it, which"
+        " emptied them, so its a0000 is followed by an empty D0 and R-4.4.8-03 holds on the"
+        " wire (seed 4094).",
+        removes=("R-4.4.8-03",),
+    ),
 )

@@ -166,7 +166,8 @@ FORMAT: tuple[Fault, ...] = (
         " the M-type groups owe (R-6.2-07). With no count no D command follows aM!, aV!"
         " or any aMn!: the D-reply and value rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read"
         " only aC!'s data and are left open for the values aM! holds, as is the count's"
-        " 1..9 rule (R-4.4.5-02).",
+        " 1..9 rule (R-4.4.5-02). Nor can aM!'s count be set beside aMC!'s"
+        " (R-4.4.12-04).",
         ("R-4.4.5-01",),
         rewrite=_start_with(1, lambda body: body[0] + body[2:]),
         inconclusive=(
@@ -174,6 +175,7 @@ FORMAT: tuple[Fault, ...] = (
             "R-4.4.11-01",
             "R-6.2-07",
             "R-4.4.5-02",
+            "R-4.4.12-04",
             *UNREAD_DATA,
         ),
     ),
@@ -198,10 +200,12 @@ FORMAT: tuple[Fault, ...] = (
         " No concurrent reply has a readable count, so its bound (R-4.4.7-03) has nothing"
         " to judge, and no D command follows aC!, aCC!, aC9!, aCC9!: the D-reply and value"
         " rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read only the M family's data and are"
-        " left open for the values those hold.",
+        " left open for the values those hold. Nor can aC!'s count be set beside aCC!'s"
+        " (R-4.4.12-04).",
         ("R-4.4.7-01",),
         inconclusive=(
             "R-4.4.7-03",
+            "R-4.4.12-04",
             *UNREAD_DATA,
         ),
         rewrite=_start_with(2, lambda body: body[:4] + "0" + body[4:]),
