@@ -58,7 +58,12 @@ def interrupt(proc: subprocess.Popen[str]) -> tuple[int, str, float]:
     """SIGINT now; the exit code, the rest of the output and the seconds it took to exit."""
     began = time.monotonic()
     proc.send_signal(signal.SIGINT)
-    out, _ = proc.communicate(timeout=120)
+    try:
+        out, _ = proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        proc.kill()  # never leave it behind: a loaded CI left an emulator serving after it
+        proc.communicate()
+        raise
     return proc.returncode, out, time.monotonic() - began
 
 
