@@ -110,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"bus-time lower bound {bus['bus_lower_bound_s']:.1f} s")
     print(f"bus span             {bus['bus_span_s']:.1f} s (first to last event on the wire)")
     print(f"wall time (link)     {bus['wall_s']:.1f} s")
-    print(f"efficiency           {bus['efficiency']:.2f} (lower bound / wall time)")
+    print(f"efficiency           {bus['efficiency']:.3f} (lower bound / wall time)")
     print(f"whole process        {process_s:.1f} s (pytest start-up and reports included)")
     print(f"load average         {_load(load_before)} before, {_load(os.getloadavg())} after")
     print(f"reports              {out}")
