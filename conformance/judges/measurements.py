@@ -25,7 +25,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
-from .support import unreadable_count
+from .support import text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wire import runs
 
@@ -226,7 +226,7 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
         tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
         replies.append(reply)
-        if _refuses_high_index(m, ex, body):
+        if _refuses_high_index(m, ex):
             # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
             # as silence there is (high-volume-stops-at-d9 + unknown-command-text PASSed)
             tally.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
@@ -278,14 +278,19 @@ def data_reply_ids(command: Command) -> list[str]:
     return ids + ["R-4.4.12-03"]
 
 
-def _refuses_high_index(m: Measurement, ex: Exchange, body: str) -> bool:
-    """A reply of text, neither values nor empty, to an ``aDn!`` of two or more digits
-    after ``aHA!``: the D commands past D9 exist only for high-volume data (R-5.1-02)."""
+def _refuses_high_index(m: Measurement, ex: Exchange) -> bool:
+    """A reply of text, neither values nor empty (:func:`text_instead_of_values`, which
+    knows the empty form with its CRC, ``a<CRC>``: aHA!'s replies always carry one), to an
+    ``aDn!`` of two or more digits after ``aHA!``: the D commands past D9 exist only for
+    high-volume data (R-5.1-02)."""
     command = ex.command
     if m.command.kind is not Kind.HIGH_VOLUME_ASCII or command is None:
         return False
-    rest = body[1:]
-    return command.kind is Kind.DATA and command.index >= 10 and rest[:1] not in ("", "+", "-")
+    return (
+        command.kind is Kind.DATA
+        and command.index >= 10
+        and text_instead_of_values(ex, m.command.returns_crc)
+    )
 
 
 def _drop_split_fragments(

@@ -47,3 +47,25 @@ def test_the_rules_asked_are_inconclusive_citing_every_unread_start():
 
 def test_nothing_when_every_start_reply_was_read():
     assert unread_data([started("0M!", "00013\r\n", 3)], ("R-4.4.8-02",)) == []
+
+
+def test_an_empty_reply_with_its_crc_past_d9_is_no_refusal_of_the_index():
+    """R-5.1-02 FAILs text ('0UNKN') to aD10! after aHA!, as it does silence (seed 4090);
+    the empty form with aHA!'s CRC ('0' + CRC) is no such text. The first version took any
+    character after the address but a sign for text, so '0' + CRC FAILed."""
+    from conformance.judges.measurements import data_violations
+    from conformance.judges.tally import Tally
+    from conformance.protocol.crc import ascii_crc
+
+    def verdict(d10: str) -> Verdict:
+        m = started("0HA!", "0000011\r\n", 11)
+        replies = [f"0+{i}{ascii_crc(f'0+{i}')}\r\n" for i in range(10)]
+        m.data = [exchange(f"0D{i}!", reply, 1.0 + i) for i, reply in enumerate(replies)]
+        m.data.append(exchange("0D10!", d10, 11.0))
+        tally = Tally(("R-5.1-02",))
+        data_violations(m, tally)
+        (finding,) = tally.findings("conforms")
+        return finding.verdict
+
+    assert verdict("0UNKN\r\n") is Verdict.FAIL
+    assert verdict(f"0{ascii_crc('0')}\r\n") is not Verdict.FAIL
