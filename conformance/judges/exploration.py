@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from ..protocol.crc import is_crc_char
-from ..protocol.responses import parse_data_reply, split_line
+from ..protocol.responses import holds_values, parse_data_reply, split_line
 from ..transcript import escape
 from ..verdicts import Finding, failed, inconclusive, passed
 
@@ -109,7 +109,7 @@ def _repeat(obs: Observation) -> Judgement:
     are digits): the first D0 after a measurement, or a buffer that was empty, has nothing
     a lost buffer would change, and a sensor that never delivered a value PASSed "held over
     48 checks" (continuous-overwrites-data beside d0-empty, seed 4066)."""
-    if obs.previous is None or not any(c.isdigit() for c in obs.previous.rstrip("\r\n")[1:]):
+    if obs.previous is None or not holds_values(obs.previous):
         return Judgement(())
     checked = ("R-4.4.5-10",)
     if obs.reply == obs.previous:

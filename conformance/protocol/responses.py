@@ -150,6 +150,14 @@ def check_change_address_reply(body: str, old: str, new: str) -> list[Violation]
     return found
 
 
+def holds_values(reply: str) -> bool:
+    """A D reply that holds values: a digit after the address. A value has digits and CRC
+    characters never do, so this holds even for a value the sensor wrote badly (without its
+    sign, say); the empty reply, with or without its CRC, holds none. Whether a sensor's
+    buffer still has data (R-4.4.5-10) is asked of the last reply read from it."""
+    return any(c.isdigit() for c in reply.rstrip("\r\n")[1:])
+
+
 def service_request(address: str) -> str:
     """The service request sensor ``address`` sends, CR LF included (R-4.4.6-01)."""
     return address + CRLF

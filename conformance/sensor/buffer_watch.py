@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 from ..links.base import Link
 from ..protocol.commands import Command, Kind
+from ..protocol.responses import holds_values
 from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
@@ -53,10 +54,7 @@ class WatchedToolRecorder(ToolRecorder):
     def buffer_holds_values(self, address: str) -> bool:
         """The last command sent to ``address`` was an ASCII D read answered with values:
         its buffer holds values now (a break or standby since keeps them, R-4.4.5-10).
-        A value has digits and CRC characters never do, so a digit after the address is a
-        value, even one the sensor wrote badly (without its sign, say) or behind a wrong address."""
+        A digit after the address is a value (:func:`holds_values`), even behind a wrong
+        address."""
         command, reply = self.last_sent.get(address, (None, ""))
-        body = reply.rstrip("\r\n")
-        return (
-            command is not None and command.kind is Kind.DATA and any(c.isdigit() for c in body[1:])
-        )
+        return command is not None and command.kind is Kind.DATA and holds_values(reply)

@@ -561,3 +561,13 @@ def test_an_unasked_metadata_crc_is_one_violation_not_two():
     reply = parse_metadata_reply(body + ascii_crc(body), crc_expected=False)
     assert [v.requirement for v in reply.violations] == ["R-6.2-02"]
     assert reply.fields == ["TA", "degC"]
+
+
+def test_holds_values_is_a_digit_after_the_address():
+    from conformance.protocol.crc import ascii_crc
+    from conformance.protocol.responses import holds_values
+
+    assert holds_values("0+1.5-2\r\n") and holds_values("01.5\r\n")  # a value without its sign
+    assert holds_values(f"0+3{ascii_crc('0+3')}\r\n")
+    assert not holds_values("0\r\n") and not holds_values(f"0{ascii_crc('0')}\r\n")
+    assert not holds_values("0UNKN\r\n") and not holds_values("")
