@@ -20,7 +20,7 @@ from ..protocol.responses import (
     split_line,
 )
 from ..protocol.timing import TOLERANCE
-from ..protocol.values import Violation, check_value
+from ..protocol.values import Violation, check_value, continues_split_value
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
@@ -302,7 +302,7 @@ def _drop_split_fragments(
         if v.requirement != "R-4.4.8.3-01":
             continue
         for before, after in zip(replies, replies[1:], strict=False):
-            if after.values and after.values[0][0] not in "+-" and before.values:
+            if continues_split_value(after.values) and before.values:
                 joined = before.values[-1] + after.values[0]
                 if not [x for x in check_value(joined) if not x.warning]:
                     fragment = f"'{escape(after.values[0])}'"

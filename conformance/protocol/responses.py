@@ -31,6 +31,7 @@ from conformance.protocol.values import (
     Checked,
     Violation,
     check_value,
+    continues_split_value,
     errors,
     split_values,
 )
@@ -468,7 +469,7 @@ def check_data_sequence(replies: list[DataReply], announced: int, limit: int) ->
     joined = sum(
         1
         for before, after in zip(replies, replies[1:], strict=False)
-        if before.values and after.values and after.values[0][0] not in "+-"
+        if before.values and continues_split_value(after.values)
     )
     total = sum(len(r.values) for r in replies) - joined
     if total != announced:
@@ -479,7 +480,7 @@ def check_data_sequence(replies: list[DataReply], announced: int, limit: int) ->
         if not after.values:
             continue
         first = after.values[0]
-        if first[0] not in "+-":
+        if continues_split_value(after.values):
             found.append(
                 Violation(
                     "R-4.4.8.3-01",

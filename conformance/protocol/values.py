@@ -70,6 +70,13 @@ def split_values(text: str) -> list[str]:
     return _SIGN_SPLIT.findall(text)
 
 
+def continues_split_value(values: list[str]) -> bool:
+    """A reply's :func:`split_values` begin with the rest of a value the reply before cut in
+    two: its first token has no sign (R-4.4.8.3-01's deviation; counted once with its first
+    half, R-4.4.8-03)."""
+    return bool(values) and values[0][0] not in "+-"
+
+
 def check_value(value: str) -> list[Violation]:
     """Violations of the value grammar for one token of :func:`split_values`.
 

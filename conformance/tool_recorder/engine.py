@@ -35,7 +35,7 @@ from ..protocol.timing import (
     RETRY_MIN,
     TOLERANCE,
 )
-from ..protocol.values import split_values
+from ..protocol.values import continues_split_value, split_values
 from ..transcript import TOOL, Event, EventKind, encode_7e1, text_end, to_wire_7e1
 from ..view.segments import continues_frame
 from . import validity
@@ -698,7 +698,7 @@ def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:
         text = validity.salvaged_values_text(text)
     values = split_values(text)
     held = bool(values)
-    if values and m.values and values[0][0] not in "+-":
+    if m.values and continues_split_value(values):
         # the rest of a value the reply before cut in two (R-4.4.8.3-01's deviation): one
         # value, not two, or collection stops a value early and the count rule reads the
         # fragments as one value too many (split-value + values-over-35, seed 4065)
