@@ -10,6 +10,7 @@ case while another calls it unsupported.
 
 from __future__ import annotations
 
+from ..protocol.crc import is_crc_char
 from ..protocol.responses import split_line
 from ..protocol.values import check_value, split_values
 from ..tool_recorder.records import Exchange, Measurement
@@ -78,3 +79,11 @@ def first_filled(m: Measurement) -> int:
         if ex.answered and any(c in SIGNS for c in split_line(ex.reply_text)[0][1:]):
             return i
     return 0
+
+
+def empty_data_reply(ex: Exchange) -> bool:
+    """A D reply with no values: ``a`` or ``a<CRC>`` before the CR LF (its address and CRC
+    are judged by their own rules): what a sensor must give after an abort (R-4.4.5.1-02,
+    R-4.4.7.1-02)."""
+    rest = split_line(ex.reply_text)[0][1:]
+    return rest == "" or (len(rest) == 3 and all(map(is_crc_char, rest)))

@@ -7,7 +7,7 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
 from conformance.judges.exchanges import cite, cited, heard, shown
-from conformance.judges.support import first_filled
+from conformance.judges.support import empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.protocol.responses import is_service_request, split_line
@@ -206,7 +206,7 @@ def test_break_aborts_measurement(sensor, case):
     # start at D1, D0 is empty whatever the abort left (abort-keeps-old-data beside
     # groups-start-at-d1 PASSed on D0 alone, seed 4066)
     ds = [d0]
-    while len(ds) <= first_filled(target) and ds[-1].answered and _empty(ds[-1]):
+    while len(ds) <= first_filled(target) and ds[-1].answered and empty_data_reply(ds[-1]):
         ds.append(sensor.fresh_exchange(f"D{len(ds)}", crc=target.command.crc))
     start2 = sensor.fresh_exchange(code)  # abort again, and this time start anew after it
     before2 = sensor.listen(min(0.05, target.ttt / 10))
@@ -273,7 +273,7 @@ def test_break_aborts_measurement(sensor, case):
         )
     if not case.requires("aborted", abort):
         return
-    full = next((d for d in ds if not (d.answered and _empty(d))), None)
+    full = next((d for d in ds if not (d.answered and empty_data_reply(d))), None)
     if full is None:  # its address and CRC are judged by their own rules
         case.add(
             passed(
@@ -340,9 +340,3 @@ def _reply_end(ex) -> float:
     """Where a measurement's ttt counts from (R-4.4.5-04): its reply's last stop bit, or
     where the engine stopped listening when nothing came."""
     return ex.reply_events[-1].end if ex.answered else ex.end
-
-
-def _empty(ex) -> bool:
-    """A D reply with no values: ``a`` or ``a<CRC>`` before the CR LF."""
-    rest = split_line(ex.reply_text)[0][1:]
-    return rest == "" or (len(rest) == 3 and all(0x40 <= ord(c) <= 0x7F for c in rest))
