@@ -127,13 +127,31 @@ class HarnessBus(SimBus):
 
     _held_from: float | None = None  # the start of the tool's break being held
 
+    def _watch_clash(self, at: float, end: float) -> None:
+        """The tool takes the line from ``at`` to ``end``: if the harness wants it then too
+        (a character planned for ``at`` or before, which the tool's own goes ahead of), both
+        would talk at once on a wire. A kit's sketch that began a frame inside the tool's
+        character is planned so, once per character, until the line is free (the kit says
+        so on stderr): it then reads as a reply begun 0 ms after the command, cut short where
+        the firmware heard the clash (Open-SDI12-Blue's "a0000" after an abort break,
+        docs/kit.md). :attr:`SimBus.clashed` marks it; the view takes it for contention."""
+        nxt = self._next()
+        if nxt is not None and nxt[1].start <= at:
+            self.clashed = end
+
     def tool_break(self, duration: float) -> Event:
         self.advance(self.clock.now)
+        self._watch_clash(self.clock.now, self.clock.now + duration)
         self._held_from = self.clock.now
         try:
             return super().tool_break(duration)
         finally:
             self._held_from = None
+
+    def tool_char(self, wire: int, start: float, duration: float = CHAR_TIME) -> Event:
+        self.advance(start)
+        self._watch_clash(self.clock.now, self.clock.now + duration)
+        return super().tool_char(wire, start, duration)
 
     def _promise(self, limit: float) -> None:
         """Before a plan is asked for: the tool starts nothing before ``limit`` (inside its
@@ -186,6 +204,7 @@ class HarnessBus(SimBus):
         for byte in wire:
             frames.append((byte, time, time + CHAR_TIME))
             time = time + CHAR_TIME + gap
+        self._watch_clash(frames[0][1], frames[0][2])
         taken = self.devices[0].hear_chars(frames)  # type: ignore[attr-defined]
         events = []
         for byte, first, end in frames[:taken]:

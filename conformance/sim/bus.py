@@ -20,7 +20,7 @@ from typing import Protocol, runtime_checkable
 
 from ..links.base import Link, LinkInfo, StopCondition
 from ..protocol.timing import CHAR_TIME
-from ..transcript import DUT, TOOL, Event, EventKind, Transcript, wire_event
+from ..transcript import COLLISION, DUT, TOOL, Event, EventKind, Transcript, full_event, wire_event
 
 
 @dataclass(frozen=True, slots=True)
@@ -99,6 +99,12 @@ class SimBus:
         # asks frame by frame: only this class's own step is what planned_run repeats
         self._runs = type(self).step is SimBus.step and type(self).advance is SimBus.advance
         self._checked: tuple[BusDevice | None, bool] = (None, False)
+        #: set by a bus that watches for it (:class:`~conformance.harness.device.HarnessBus`):
+        #: the end of the tool's transmission that went first over a device frame planned
+        #: for the same instant or earlier; the device's next character planned by then is
+        #: marked :data:`~conformance.transcript.COLLISION`. The in-process emulators' bus
+        #: leaves it None: their timing faults are judged as they always were.
+        self.clashed: float | None = None
 
     def planned_run(self) -> tuple[PlansFrames, Iterator[tuple[float, int, float]]] | None:
         """The one device on the bus and its :meth:`PlansFrames.frames_ahead`, where the bus
@@ -140,7 +146,13 @@ class SimBus:
         start = max(frame.start, self.clock.now)
         end = start + frame.duration
         origin = DUT if len(self.devices) == 1 else device.name
-        event = self.transcript.add(wire_event(EventKind.CHAR, origin, start, end, frame.wire))
+        if self.clashed is not None and frame.start <= self.clashed:
+            # it wanted the line while the tool's own transmission took it: two talkers
+            self.clashed = None
+            event = full_event(EventKind.CHAR, origin, start, end, frame.wire, COLLISION, 0.0, None)
+            event = self.transcript.add(event)
+        else:
+            event = self.transcript.add(wire_event(EventKind.CHAR, origin, start, end, frame.wire))
         for other in self.devices:
             if other is not device:
                 other.on_char(frame.wire, start, end)

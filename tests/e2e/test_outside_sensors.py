@@ -23,6 +23,12 @@ The tenth round (docs/kit.md) added two: a sensor firmware that talked but never
 (RTGS-Lab Firmware_-_Aleppo) was sent to its wiring by the "no device answered" stop, and
 R-4.4.14-01's PASS for a logger that reports no relayed replies (USDI12 on the C kit) did not
 say the relay went unjudged.
+
+The eleventh: a firmware (joembedded/Open-SDI12-Blue) that began a character while the
+tool's own command was on the line (its "a0000" after an abort break) was judged on it as a
+reply begun 0 ms after the command, cut to '0' by the firmware's own echo check: R-4.2-03
+FAILed "reply '0' does not end with CR LF". The harness bus now marks such a character
+COLLISION (two talkers), which the view takes for contention.
 """
 
 from __future__ import annotations
@@ -32,7 +38,12 @@ import pytest
 from conformance.conduct import run_once
 from conformance.emulator.faults import FaultSet
 from conformance.emulator.replies import ReplyKind
+from conformance.harness.device import HarnessBus
+from conformance.protocol.timing import CHAR_TIME
 from conformance.recorder.golden import GoldenRecorder
+from conformance.sim.bus import Frame
+from conformance.transcript import COLLISION, DUT
+from conformance.view.runs import segments
 
 #: The cases that probe with a! (and R-4.4.1-01's own).
 A_PROBES = (
@@ -149,3 +160,63 @@ def test_a_transparent_pass_says_when_the_relay_was_not_judged():
     assert unreported["verdict"] == reported["verdict"] == "PASS"
     assert "were not reported: not judged" in unreported["findings"][0]["detail"]
     assert "not judged" not in reported["findings"][0]["detail"]
+
+
+class _KitLikeTalker:
+    """A harness device that wants to send ``wire`` from ``at`` on and, told of a character
+    of the tool's that its frame would overlap, plans it again where that character ends, as
+    the firmware kit does for a sketch that began a frame inside the line's last character
+    ("it goes out from ..." on stderr): the plan then meets the tool's next character of a
+    command at the instant it starts, and the tool's goes first."""
+
+    name = "kit-like"
+
+    def __init__(self, wire: int, at: float) -> None:
+        self.frames = [Frame(at, wire)]
+
+    def on_break(self, start: float, end: float) -> None:
+        self.on_char(0, start, end)
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        if self.frames and self.frames[0].start < end:
+            self.frames[0] = Frame(end, self.frames[0].wire)
+
+    def next_frame(self) -> Frame | None:
+        return self.frames[0] if self.frames else None
+
+    def pop_frame(self) -> Frame:
+        return self.frames.pop(0)
+
+
+def _sent(bus: HarnessBus, text: str, start: float) -> None:
+    for k, c in enumerate(text.encode()):
+        bus.tool_char(c, start + k * CHAR_TIME)
+    bus.advance(start + len(text) * CHAR_TIME + 0.1)
+
+
+@pytest.mark.parametrize("begun", [0.004, 0.012])  # inside the command's '0', inside its 'M'
+def test_a_character_begun_over_the_tools_command_is_contention_not_a_reply_r_4_2_03(begun):
+    bus = HarnessBus()
+    bus.attach(_KitLikeTalker(ord("0"), begun))
+    _sent(bus, "0M!", 0.0)
+    dut = [e for e in bus.transcript.events if e.origin == DUT]
+    assert len(dut) == 1 and dut[0].start == pytest.approx(3 * CHAR_TIME)  # after the command
+    assert dut[0].text == COLLISION  # it wanted the line while the tool had it
+    (seg,) = segments(bus.transcript.events)
+    assert seg.reply == [] and seg.contention == dut  # no reply '0' without CR LF
+
+
+def test_a_reply_planned_at_the_commands_end_is_still_the_reply():
+    """A sensor that answers 0 ms after the command (libsdi12's example, docs/kit.md) planned
+    it when it heard the '!': no character of the tool's went ahead of it."""
+    bus = HarnessBus()
+    talker = _KitLikeTalker(ord("0"), 99.0)
+    bus.attach(talker)
+    bus.tool_char(ord("0"), 0.0)
+    bus.tool_char(ord("M"), CHAR_TIME)
+    bus.tool_char(ord("!"), 2 * CHAR_TIME)
+    talker.frames = [Frame(3 * CHAR_TIME, ord("0"))]  # planned on hearing the '!'
+    bus.advance(1.0)
+    dut = [e for e in bus.transcript.events if e.origin == DUT]
+    assert [e.text for e in dut] == [""]
+    assert [s.reply for s in segments(bus.transcript.events)][-1] == dut
