@@ -13,13 +13,14 @@ from ...verdicts import Finding
 from ...view.segments import Transmission
 from ..tally import Tally
 from .common import MIN_CONCURRENT_STORE
-from .measurements import ObservedMeasurement, collection_end
+from .measurements import ObservedMeasurement, collection_end, read_past_empty
 
 
 def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]:
     """R-4.4.8-05: aD0!, aD1!, ... in order until every announced value is in; after a valid
     empty reply the measurement is issued again. A collection that ended on a reply the
-    recorder found invalid is left to the retry rules (section 7.2)."""
+    recorder found invalid is left to the retry rules (section 7.2), unless a valid empty
+    reply before it was read past without the measurement issued again."""
     tally = Tally(("R-4.4.8-05",))
     for m in taken:
         if m.kind is Kind.HIGH_VOLUME_BINARY or not m.count:
@@ -35,6 +36,15 @@ def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]
         if have >= m.count:
             continue
         last, problem, empty = collection_end(m)
+        past = read_past_empty(m) if problem is not None else None
+        if past is not None and (m.next_start is None or m.next_start.text != m.start.text):
+            tally.fail(
+                "R-4.4.8-05",
+                where,
+                f"{escape(past.text)} came back empty and the measurement was not issued "
+                f"again (the recorder read on, to {escape(last.text) if last else '?'})",
+            )
+            continue
         if problem is not None:
             continue
         if empty:

@@ -119,7 +119,20 @@ def collection_end(m: ObservedMeasurement) -> tuple[Transmission | None, ReplyPr
     sent, problem = m.data[-1]
     if problem is not None:
         return sent, problem, False
+    return sent, None, _empty(m, sent)
+
+
+def read_past_empty(m: ObservedMeasurement) -> Transmission | None:
+    """The first data transmission whose valid reply was empty and after which the recorder
+    asked for more data (D1 after an empty D0): the collection's end says nothing of it when
+    a later one failed (ESP32-SDI12 went on to aD10!, unanswered, docs/kit.md)."""
+    for sent, problem in m.data[:-1]:
+        if problem is None and _empty(m, sent):
+            return sent
+    return None
+
+
+def _empty(m: ObservedMeasurement, sent: Transmission) -> bool:
     if sent.binary:
-        packet = parse_binary_packet(decode_8n1(sent.reply))
-        return sent, None, not packet.values
-    return sent, None, not data_values(sent, m.command)
+        return not parse_binary_packet(decode_8n1(sent.reply)).values
+    return not data_values(sent, m.command)

@@ -154,6 +154,22 @@ def test_empty_reply_must_lead_to_the_measurement_again():
     assert judge_data_collection(observed_measurements(w.view(), 0.0))[0].verdict is Verdict.PASS
 
 
+def test_an_empty_reply_read_past_fails_r_4_4_8_05_however_the_collection_ends():
+    """HarveyBates/ESP32-SDI12 (docs/kit.md): after an empty D0 it asks D1, D2, ... up to D10,
+    which gets no reply, and gives up: R-4.4.8-05 PASSed, the collection having ended on a
+    problem (left to the retry rules) and the empty D0 before it not looked at."""
+    w = _measurement(Wire()).idle(1100).brk().rec("0D0!").sensor("0\r\n").idle(9).brk()
+    w.rec("0D1!").sensor("0\r\n").idle(9).brk().rec("0D2!").idle(1000)
+    (found,) = judge_data_collection(observed_measurements(w.view(), 0.0))
+    assert found.verdict is Verdict.FAIL, found.detail
+    assert "0D0! came back empty" in found.detail and "read on, to 0D2!" in found.detail
+    # ended on an unanswered D1 with no empty reply before it: still the retry rules'
+    w = _measurement(Wire()).idle(1100).brk().rec("0D0!").sensor("0+1\r\n").idle(9).brk()
+    w.rec("0D1!").idle(1000)
+    (found,) = judge_data_collection(observed_measurements(w.view(), 0.0))
+    assert found.verdict is not Verdict.FAIL, found.detail
+
+
 def test_retry_windows_and_waiting_for_the_invalid_reply():
     early = Wire().brk().rec("0!").idle(12).rec("0!").sensor("0\r\n").view()
     assert by_id(judge_retries(early, 0.0))["R-7.2-02"].verdict is Verdict.FAIL
