@@ -34,6 +34,7 @@ from ..replay.link import VIRTUAL_KINDS
 from ..replay.recording import (
     Recording,
     RecordingError,
+    hold_recording,
     options_in,
     read_recording,
     transcript_path,
@@ -41,7 +42,7 @@ from ..replay.recording import (
 )
 from ..report_folder import held, run_folder
 from ..run import RunOptions
-from ..transcript import BUS, DUT, TOOL, Event, EventKind
+from ..transcript import BUS, DUT, TOOL, Event, EventKind, plain_fields
 from ..view.direction import infer_directions
 from ..view.sides import RECORDER, SENSOR
 from .job import PassiveJob
@@ -156,8 +157,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def plan(argv: list[str]) -> JudgePlan:
-    """Parse ``judge``'s arguments and decide how to judge the file (JudgeError if not)."""
+def plan(argv: list[str], *, in_memory: bool = False) -> JudgePlan:
+    """Parse ``judge``'s arguments and decide how to judge the file (JudgeError if not).
+    ``in_memory``: a capture's decoding is not written to capture.jsonl but held for its
+    replay (:func:`~conformance.replay.recording.hold_recording`; the caller lets it go with
+    :func:`~conformance.replay.recording.held_recordings`): the fault matrix's round trip."""
     args = build_parser().parse_args(argv)
     path = Path(args.file)
     if path.is_dir():
@@ -180,7 +184,7 @@ def plan(argv: list[str]) -> JudgePlan:
         if recording.options:
             found.run_role = recording.role
     else:
-        capture_replay(found, args)
+        capture_replay(found, args, in_memory)
         if found.replay is not None:
             return found
     if args.role is None and found.run_role is not None:
@@ -193,7 +197,7 @@ def plan(argv: list[str]) -> JudgePlan:
     return found
 
 
-def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
+def capture_replay(found: JudgePlan, args: argparse.Namespace, in_memory: bool = False) -> None:
     """Set ``found.replay`` when the capture is of a run of this tool whose cases can be
     repeated against it: its options come from ``--run`` or from the notes an export kept in
     it, and every character's direction is known (else a note says why it is judged
@@ -225,10 +229,16 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
         return
     report_dir = run_folder(args.report_dir, str(options.get("role", "sensor")))
     decoded_path = report_dir / "capture.jsonl"
+    decoded_events = sorted([*notes, *events], key=lambda e: e.start)
+    # held only where the events are what the file would read back as (write_recording's rule)
+    kept = in_memory and all(map(plain_fields, decoded_events))
     try:  # nothing is written into a folder another live run holds (issue 19)
         check_report_dir(report_dir)
-        with held(report_dir):
-            write_recording(decoded_path, sorted([*notes, *events], key=lambda e: e.start))
+        if kept:
+            hold_recording(decoded_path, decoded_events)
+        else:
+            with held(report_dir):
+                write_recording(decoded_path, decoded_events)
     except UsageError as exc:
         raise JudgeError(str(exc)) from None
     recording = read_recording(decoded_path)
@@ -238,7 +248,9 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace) -> None:
         return
     args.report_dir = str(report_dir)
     found.replay = replay_options(recording, args)
-    found.notes.append(f"decoded capture written to {decoded_path}")
+    found.notes.append(
+        f"decoded capture {'held in memory as' if kept else 'written to'} {decoded_path}"
+    )
 
 
 def directed(events: list[Event]) -> tuple[list[Event], int]:

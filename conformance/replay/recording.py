@@ -11,6 +11,8 @@ transcript and the command line fill in what they can.
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -69,12 +71,16 @@ def transcript_path(path: Path) -> Path:
 def read_recording(path: str | Path) -> Recording:
     """Read a run's transcript (a ``transcript.jsonl`` or the run folder holding it)."""
     file = transcript_path(Path(path))
-    if not file.exists():
+    held = _HELD.get(str(file.resolve())) if _HELD else None
+    if held is not None:
+        events = list(held)
+    elif not file.exists():
         raise RecordingError(f"{file}: no such file")
-    try:
-        events = _read_events(file)
-    except CaptureError as exc:
-        raise RecordingError(str(exc)) from None
+    else:
+        try:
+            events = _read_events(file)
+        except CaptureError as exc:
+            raise RecordingError(str(exc)) from None
     options: dict[str, Any] = {}
     for number, event in enumerate(events, 1):
         if event.kind is EventKind.NOTE and event.text.startswith(OPTIONS_NOTE):
@@ -107,6 +113,27 @@ def _keep(key: tuple[str, int, int], events: tuple[Event, ...]) -> None:
     if len(_READ) >= 2:
         _READ.pop(next(iter(_READ)))
     _READ[key] = events
+
+
+#: recordings handed over in memory (:func:`hold_recording`), by the file they stand for
+_HELD: dict[str, tuple[Event, ...]] = {}
+
+
+def hold_recording(path: Path, events: list[Event]) -> None:
+    """Let :func:`read_recording` of ``path`` give ``events`` with no file written, until
+    :func:`held_recordings` ends: for a decoded capture that is judged straight away and
+    deleted (a fault-matrix row's round trip, issue 22: writing its 10^4..10^5 lines was 3%
+    of the row's CPU). A user's ``judge`` writes its capture.jsonl, as before."""
+    _HELD[str(transcript_path(Path(path)).resolve())] = tuple(events)
+
+
+@contextmanager
+def held_recordings() -> Iterator[None]:
+    """What :func:`hold_recording` holds while this lasts is let go at its end."""
+    try:
+        yield
+    finally:
+        _HELD.clear()
 
 
 def options_in(notes: list[Event]) -> dict[str, Any]:
