@@ -13,25 +13,13 @@ from __future__ import annotations
 import gc
 from pathlib import Path
 
-import pytest
-
-import conformance.capture.decode as capture_decode
 from conformance import gc_pace
 from conformance.cli import main
-from tests.offline.test_judge_memory import busy_capture
 
 #: cyclic garbage a judgement may leave: the ten sensors' and the recorder's runs left 57,800
 #: objects together before (some 5,000 a run); what is left after the last collection (the
 #: recording let go, the console's lines about the sensors) is some 600
 LEFT_AT_MOST = 3000
-
-
-@pytest.fixture
-def capture(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    monkeypatch.setattr(capture_decode, "_LAST", None)
-    path = tmp_path / "busy.sr"
-    busy_capture(path, 0.05)  # three seconds of a busy bus, ten sensors
-    return path
 
 
 def test_R_issue22_no_run_garbage_left_after_a_bus_is_judged(capture: Path, tmp_path: Path):
