@@ -21,6 +21,7 @@ from .edges import Edges
 from .errors import CaptureError
 from .formats import read_edges, sniff
 from .glitch_filter import DEFAULT_BITS, GlitchFilter
+from .heap import give_back_freed_heap
 from .uart import HOLD_FRAMES, SYNC_BITS, Decoded, Framing, _synchronised, decode
 from .uart_bulk import Batch, decode_batches
 from .uart_bulk import decode as decode_bulk
@@ -493,6 +494,7 @@ def decode_capture(
         raise CaptureError(path, str(exc)) from None
     how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force)
     out = _decode_capture(path, channel, tx_channel, invert, how)
+    give_back_freed_heap()  # the decoder's transients, whatever pages they were left on
     if key is not None and keep:
         _LAST = (key, replace(out, events=list(out.events), notes=list(out.notes)))
     return out

@@ -15,10 +15,12 @@ ends with one line per sensor, and the exit code is the worst of them all.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .. import gc_pace
 from ..conduct import RunResult, conduct
 from ..exits import EXIT_COMPLIANT, EXIT_USAGE
 from ..interrupts import GUARD
@@ -158,30 +160,46 @@ def _run_jobs(jobs: list[RoleJob], port: str, args: PassiveJob, console: Console
 
     codes: list[int] = []
     done: list[tuple[RoleJob, dict[str, Any]]] = []
-    for i, job in enumerate(jobs):
-        result = _run_role(job, port, args, console)
-        code, data = result.pytest_code, result.document
-        if result.run is not None:
-            # its session (its share of the records) is held by the run's pytest objects,
-            # cyclic garbage that lives until the next full collection: let it go now
-            result.run.session = None
-        release(port, jobs[i + 1 :])
-        if GUARD.requested and data is None:  # Ctrl-C before this run wrote its verdicts
-            return EXIT_INCOMPLETE
-        if data is None:  # the run wrote no verdicts (its own, never a file's)
-            if code in (EXIT_USAGE, EXIT_INTERNAL):
-                return code
-            error(f"error: the {job.label} rules were not judged (pytest exit {code})")
-            return EXIT_INTERNAL
-        console.print(f"{job.label} rules:", style="bold", markup=False, highlight=False)
-        print_summary(console, data, str(job.report_dir))
-        codes.append(result.exit_code if result.exit_code is not None else code)
-        done.append((job, data))
-        if GUARD.requested:  # Ctrl-C: this run's report says so; the next one is not begun
-            GUARD.close()
-            return EXIT_INCOMPLETE
+    with gc_pace.runs_over_held_data() as collect:  # each run's garbage freed before the next
+        for i, job in enumerate(jobs):
+            code, data = _run_one(i, jobs, port, args, console, collect)
+            if GUARD.requested and data is None:  # Ctrl-C before this run wrote its verdicts
+                return EXIT_INCOMPLETE
+            if data is None:  # the run wrote no verdicts (its own, never a file's)
+                if code in (EXIT_USAGE, EXIT_INTERNAL):
+                    return code
+                error(f"error: the {job.label} rules were not judged (pytest exit {code})")
+                return EXIT_INTERNAL
+            console.print(f"{job.label} rules:", style="bold", markup=False, highlight=False)
+            print_summary(console, data, str(job.report_dir))
+            codes.append(code)
+            done.append((job, data))
+            if GUARD.requested:  # Ctrl-C: this run's report says so; the next one is not begun
+                GUARD.close()
+                return EXIT_INCOMPLETE
     print_sensors(console, [(j.address, d, j.report_dir) for j, d in done if j.of_bus])
     return worst_exit(codes)
+
+
+def _run_one(
+    i: int, jobs: list[RoleJob], port: str, args: PassiveJob, console: Console,
+    collect: Callable[[], None],
+) -> tuple[int, dict[str, Any] | None]:  # fmt: skip
+    """Job ``i``'s run; then what no later job reads is let go: its session, the records
+    only it read (:func:`release`) and its run's cyclic garbage (``collect``). Gives the
+    run's exit code (its own if it made one, pytest's otherwise) and its verdicts (None: it
+    wrote none)."""
+    result = _run_role(jobs[i], port, args, console)
+    code, data = result.pytest_code, result.document
+    if result.run is not None:
+        # its session (its share of the records) is held by the run's pytest objects,
+        # cyclic garbage (freed by collect() below, or by the next full collection)
+        result.run.session = None
+    release(port, jobs[i + 1 :])
+    collect()
+    if data is not None and result.exit_code is not None:
+        code = result.exit_code
+    return code, data
 
 
 def release(port: str, later: list[RoleJob]) -> None:

@@ -11,19 +11,9 @@ from pathlib import Path
 
 import pytest
 
-import conformance.capture.decode as capture_decode
 from conformance.cli import main
 from conformance.offline import heard
 from conformance.replay.recording_link import load_recording, parse_recording, recording_port
-from tests.offline.test_judge_memory import busy_capture
-
-
-@pytest.fixture
-def capture(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    monkeypatch.setattr(capture_decode, "_LAST", None)
-    path = tmp_path / "busy.sr"
-    busy_capture(path, 0.05)  # three seconds of a busy bus, ten sensors
-    return path
 
 
 def _load(capture: Path):
