@@ -60,6 +60,11 @@ went unanswered, though aM!'s D replies after it carried the CRC it had asked fo
 R-4.4.5-08 FAILed "the sensor sent '0SR<CR><LF>' unasked" after a break that did not abort
 aM!: the line was aM!'s own malformed request, sent in the undisturbed wait too
 (break-does-not-abort-measure + service-request-extra-chars, seed 4093).
+R-4.4.8.3-01 PASSed on aM2!'s D0, cut at 35 characters, whose D1 went unanswered
+(m2-later-data-silent + split-value, seed 4099): undecided where values were still owed.
+R-5.1-02 and R-5.1-03 PASSed on aHA!'s empty D0 and D1 of 120 announced values, R-5.2-04
+and R-5.2-05 on aHB!'s empty packet (d0-empty beside high-volume-stops-at-d9,
+high-volume-values-over-75 and binary-payload-not-multiple, seeds 4100 and 4104).
 """
 
 from __future__ import annotations
@@ -81,6 +86,7 @@ from testcases.sensor.test_4_4_8_data import test_data_replies as data_case
 from testcases.sensor.test_4_4_8_data import (
     test_undefined_group_leaves_no_old_values as undefined_group_case,
 )
+from testcases.sensor.test_4_4_8_data import test_value_grouping as grouping_case
 from testcases.sensor.test_4_4_9_additional import test_verification as verification_case
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
@@ -393,3 +399,48 @@ def test_a_crc_that_outlived_an_unanswered_metadata_command(faults, expected):
 )
 def test_the_measurements_own_line_after_a_break_is_not_unasked(faults, expected):
     assert _verdict(_session(faults), abort_case, "R-4.4.5-08") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        # aM2!'s D0 cut a value at 35 characters and its D1 went unanswered (seed 4099)
+        ("m2-later-data-silent,split-value", Verdict.INCONCLUSIVE),
+        ("split-value", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_cut_value_whose_tail_was_never_answered(faults, expected):
+    assert _verdict(_session(faults), grouping_case, "R-4.4.8.3-01") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "rule", "expected"),
+    [
+        # aHA!'s 120 values announced, D0 and D1 empty (seed 4100)
+        ("d0-empty,high-volume-stops-at-d9", "R-5.1-02", Verdict.INCONCLUSIVE),
+        ("d0-empty,high-volume-values-over-75", "R-5.1-03", Verdict.INCONCLUSIVE),
+        ("high-volume-stops-at-d9", "R-5.1-02", Verdict.FAIL),
+        ("high-volume-values-over-75", "R-5.1-03", Verdict.FAIL),
+        ("", "R-5.1-02", Verdict.PASS),
+        ("", "R-5.1-03", Verdict.PASS),
+    ],
+)
+def test_high_volume_ascii_rules_over_empty_replies(faults, rule, expected):
+    assert _verdict(_session(faults), ascii_case, rule) is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "rule", "expected"),
+    [
+        # aHB!'s 33 values announced, DB0 the empty packet (seed 4104)
+        ("binary-payload-not-multiple,d0-empty", "R-5.2-05", Verdict.INCONCLUSIVE),
+        ("d0-empty", "R-5.2-04", Verdict.INCONCLUSIVE),
+        ("binary-payload-not-multiple", "R-5.2-05", Verdict.FAIL),
+        ("binary-payload-over-1000", "R-5.2-04", Verdict.FAIL),
+        ("", "R-5.2-05", Verdict.PASS),
+        ("", "R-5.2-04", Verdict.PASS),
+    ],
+)
+def test_binary_payload_rules_over_an_empty_packet(faults, rule, expected):
+    assert _verdict(_session(faults), binary_case, rule) is expected
