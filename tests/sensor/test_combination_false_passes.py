@@ -65,6 +65,9 @@ R-4.4.8.3-01 PASSed on aM2!'s D0, cut at 35 characters, whose D1 went unanswered
 R-5.1-02 and R-5.1-03 PASSed on aHA!'s empty D0 and D1 of 120 announced values, R-5.2-04
 and R-5.2-05 on aHB!'s empty packet (d0-empty beside high-volume-stops-at-d9,
 high-volume-values-over-75 and binary-payload-not-multiple, seeds 4100 and 4104).
+R-4.4.4-01 and R-4.3-03 PASSed on a! answered at each new address by a sensor that never
+moved but answers a! at any address (address-change-not-applied + answers-foreign-address,
+seed 4104): INCONCLUSIVE where a! at an address it never had is answered too.
 """
 
 from __future__ import annotations
@@ -444,3 +447,35 @@ def test_high_volume_ascii_rules_over_empty_replies(faults, rule, expected):
 )
 def test_binary_payload_rules_over_an_empty_packet(faults, rule, expected):
     assert _verdict(_session(faults), binary_case, rule) is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "rule", "expected"),
+    [
+        # the change not applied, and a! answered at any address (seed 4104)
+        ("address-change-not-applied,answers-foreign-address", "R-4.4.4-01", Verdict.INCONCLUSIVE),
+        ("address-change-not-applied,answers-foreign-address", "R-4.4.4-02", Verdict.INCONCLUSIVE),
+        ("answers-foreign-address", "R-4.4.4-01", Verdict.INCONCLUSIVE),
+        # answers the old address beside the new one, not any: the move shows
+        ("answers-old-address", "R-4.4.4-01", Verdict.PASS),
+        ("address-change-not-applied", "R-4.4.4-01", Verdict.FAIL),
+        ("", "R-4.4.4-01", Verdict.PASS),
+        ("", "R-4.4.4-02", Verdict.PASS),
+    ],
+)
+def test_an_answer_at_the_new_address_from_a_sensor_that_answers_anywhere(faults, rule, expected):
+    assert _verdict(_session(faults), change_case, rule) is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        # every move refused in silence but answered, and a! answered anywhere (seed 4104)
+        ("address-change-not-applied,answers-foreign-address", Verdict.INCONCLUSIVE),
+        ("address-change-not-applied", Verdict.FAIL),
+        ("answers-foreign-address", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_an_address_sweep_answered_by_a_sensor_that_answers_anywhere(faults, expected):
+    assert _verdict(_session(faults), range_case, "R-4.3-03") is expected
