@@ -86,6 +86,13 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.7-01",),
     ),
     Interaction(
+        frozenset({"undefined-measure-silent", "unknown-command-text"}),
+        "an undefined aMn!/aMCn! gets no answer at all, so no 'aUNKN' is ever sent to one, and"
+        " the defined groups' replies rightly hold R-4.4.5-01 (seed 4105: aM3!..aM9! and"
+        " aMC3!..aMC9! unanswered through nine tries each, no 'aUNKN' to any M command).",
+        removes=("R-4.4.5-01",),
+    ),
+    Interaction(
         frozenset({"measure-count-zero", "metadata-missing-record"}),
         "aM! and aMC! announce no values, so their aIM_002!/aIMC_002! name an index past the"
         " count and the bare 'a<CR><LF>' is the right answer: the record metadata-missing-"
