@@ -68,6 +68,10 @@ high-volume-values-over-75 and binary-payload-not-multiple, seeds 4100 and 4104)
 R-4.4.4-01 and R-4.3-03 PASSed on a! answered at each new address by a sensor that never
 moved but answers a! at any address (address-change-not-applied + answers-foreign-address,
 seed 4104): INCONCLUSIVE where a! at an address it never had is answered too.
+R-7.0-15 PASSed behind --echo --usb-latency 16 beside two CPU burners on a sensor awake for
+108 ms (+ deaf-after-service-request): with ±15 ms its probes went out 119-137 ms into the
+marking, where the sensor sleeps too; the sim, probing at 101.9 ms, FAILs it. A silence
+PASSes only where the probe surely landed within 3 ms past the 100.4 ms limit.
 """
 
 from __future__ import annotations
@@ -101,6 +105,7 @@ from testcases.sensor.test_5_high_volume import test_high_volume_ascii as ascii_
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
+from testcases.sensor.test_7_timing import test_standby_after_100ms as standby_case
 from testcases.sensor.test_7_timing import test_standby_after_foreign_command as foreign_case
 
 
@@ -479,3 +484,22 @@ def test_an_answer_at_the_new_address_from_a_sensor_that_answers_anywhere(faults
 )
 def test_an_address_sweep_answered_by_a_sensor_that_answers_anywhere(faults, expected):
     assert _verdict(_session(faults), range_case, "R-4.3-03") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "widened_ms", "expected"),
+    [
+        # behind a bench model whose link measured ±10 ms (the run above: ±15 ms, where
+        # the 115 ms probe is not surely past 100.4 ms either)
+        ("standby-after-108ms", 10.0, Verdict.INCONCLUSIVE),
+        ("", 10.0, Verdict.INCONCLUSIVE),
+        ("never-standby", 5.0, Verdict.FAIL),
+        ("standby-after-108ms", 0.0, Verdict.FAIL),
+        ("", 0.0, Verdict.PASS),
+        ("", 0.5, Verdict.PASS),
+    ],
+)
+def test_standby_silence_probed_later_than_the_link_resolves(faults, widened_ms, expected):
+    session = _session(faults)
+    session.link.widen(widened_ms / 1e3)
+    assert _verdict(session, standby_case, "R-7.0-15") is expected
