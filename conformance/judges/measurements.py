@@ -301,10 +301,11 @@ def _undecide_cut_at_silence(
 ) -> None:
     """R-4.4.8.3-01 and -03 judge a reply by the next one's first value (its unsigned tail,
     or a value that would have fitted): where the next D went unanswered with values still
-    owed, the last reply read may have cut one, and the rules are undecided there
+    owed, the replies read and unread may have cut one, and the rules are undecided there
     (m2-later-data-silent + split-value, seed 4099: R-4.4.8.3-01 PASSed although aM2!'s
-    D0, cut at 35 characters, was followed by a D1 nobody heard)."""
-    if silent is None or m.complete or not replies or not replies[-1].values:
+    D0, cut at 35 characters, was followed by a D1 nobody heard; + groups-start-at-d1,
+    seed 4098: D0 empty, D1 silent, none of aM2!'s values read)."""
+    if silent is None or m.complete:
         return
     for rid in ("R-4.4.8.3-01", "R-4.4.8.3-03"):
         tally.undecide(

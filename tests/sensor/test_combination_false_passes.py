@@ -414,6 +414,8 @@ def test_the_measurements_own_line_after_a_break_is_not_unasked(faults, expected
     [
         # aM2!'s D0 cut a value at 35 characters and its D1 went unanswered (seed 4099)
         ("m2-later-data-silent,split-value", Verdict.INCONCLUSIVE),
+        # D0 empty, D1 silent: none of aM2!'s nine values read (seed 4098)
+        ("groups-start-at-d1,m2-later-data-silent", Verdict.INCONCLUSIVE),
         ("split-value", Verdict.FAIL),
         ("", Verdict.PASS),
     ],
