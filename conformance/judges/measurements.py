@@ -227,6 +227,8 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         body, framing = split_line(ex.reply_text, crc_positions=3 if m.command.returns_crc else 0)
         reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
         tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
+        if reply.crc and not reply.crc_ok:
+            _undecide_uncompared_crc(reply, tally, dlabel)
         replies.append(reply)
         if _refuses_high_index(m, ex):
             # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
@@ -293,6 +295,19 @@ def _undecide_unread_high_volume(
             label,
             f"values still owed of the {m.count} announced, and no D command past D9 was"
             " answered: the reading stopped before it",
+        )
+
+
+def _undecide_uncompared_crc(reply: DataReply, tally: Tally, where_: str) -> None:
+    """A CRC whose encoding is no CRC-16's (R-4.4.12-06) is not compared with the text
+    (protocol.responses._check_crc), so it shows nothing of R-4.4.12-05 either way
+    (crc-wrong-encoding + wrong-crc + value-two-points, seed 4118: R-4.4.12-05 PASSed
+    "17 checked" where every CRC was off by one and none compared)."""
+    if not any(v.requirement == "R-4.4.12-05" for v in reply.violations):
+        tally.undecide(
+            "R-4.4.12-05",
+            where_,
+            f"CRC '{escape(reply.crc or '')}' is encoded as no CRC-16: its value not compared",
         )
 
 

@@ -72,6 +72,8 @@ R-7.0-15 PASSed behind --echo --usb-latency 16 beside two CPU burners on a senso
 108 ms (+ deaf-after-service-request): with ±15 ms its probes went out 119-137 ms into the
 marking, where the sensor sleeps too; the sim, probing at 101.9 ms, FAILs it. A silence
 PASSes only where the probe surely landed within 3 ms past the 100.4 ms limit.
+R-4.4.12-05 PASSed "17 checked" where every CRC was encoded as no CRC-16 (0x60) and off by
+one (crc-wrong-encoding + wrong-crc + value-two-points, seed 4118): none was compared.
 """
 
 from __future__ import annotations
@@ -98,6 +100,7 @@ from testcases.sensor.test_4_4_9_additional import test_verification as verifica
 from testcases.sensor.test_4_4_12_crc import (
     test_crc_request_ends_with_its_command as crc_request_case,
 )
+from testcases.sensor.test_4_4_12_crc import test_crc_value_and_encoding as crc_value_case
 from testcases.sensor.test_4_4_12_crc import test_crc_variant_same_measurement as twin_case
 from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_4_addressing import test_address_range as range_case
@@ -505,3 +508,16 @@ def test_standby_silence_probed_later_than_the_link_resolves(faults, widened_ms,
     session = _session(faults)
     session.link.widen(widened_ms / 1e3)
     assert _verdict(session, standby_case, "R-7.0-15") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("crc-wrong-encoding,wrong-crc", Verdict.INCONCLUSIVE),
+        ("crc-wrong-encoding", Verdict.INCONCLUSIVE),
+        ("wrong-crc", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_crc_value_never_compared(faults, expected):
+    assert _verdict(_session(faults), crc_value_case, "R-4.4.12-05") is expected
