@@ -215,16 +215,20 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         return
     replies: list[DataReply] = []
     limit = expected_value_limit(m.command)
+    silent = None
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
         if not ex.answered:
             tally.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
             if m.command.kind is Kind.HIGH_VOLUME_ASCII:
                 tally.fail("R-5.1-02", dlabel, f"no reply to {where(ex)} after aHA!")
+            silent = ex
             break
         body, framing = split_line(ex.reply_text, crc_positions=3 if m.command.returns_crc else 0)
         reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
         tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
+        if reply.crc and not reply.crc_ok:
+            _undecide_uncompared_crc(reply, tally, dlabel)
         replies.append(reply)
         if _refuses_high_index(m, ex):
             # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
@@ -232,6 +236,7 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
             tally.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
     seq = check_data_sequence(replies, m.count, limit)
     _drop_split_fragments(replies, seq, tally, label)
+    _undecide_cut_at_silence(m, replies, silent, tally, label)
     tally.observe(
         label,
         seq,
@@ -262,6 +267,68 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
                 break
     if m.command.kind is Kind.HIGH_VOLUME_ASCII:
         tally.observe(label, ids=["R-5.1-02"])
+        _undecide_unread_high_volume(m, replies, tally, label)
+
+
+def _undecide_unread_high_volume(
+    m: Measurement, replies: list[DataReply], tally: Tally, label: str
+) -> None:
+    """aHA!'s rules on what its D replies hold, undecided where they held none of the values
+    owed: R-5.1-03's 75 characters and uncut values where no reply held a value, R-5.1-02's
+    D10..D999 where values were still owed and no index past D9 was read (d0-empty beside
+    high-volume-stops-at-d9, seed 4100, and beside high-volume-values-over-75, seed 4100:
+    both PASSed on the empty D0 and D1 of 120 announced values). A FAIL found stands."""
+    if not m.count or m.complete:
+        return
+    if not any(r.values for r in replies):
+        tally.undecide(
+            "R-5.1-03",
+            label,
+            f"no D reply held a value of the {m.count} announced: their length and cut unseen",
+        )
+    past_d9 = [
+        ex for ex in m.data if ex.answered and ex.command is not None and ex.command.index >= 10
+    ]
+    if not past_d9:
+        tally.undecide(
+            "R-5.1-02",
+            label,
+            f"values still owed of the {m.count} announced, and no D command past D9 was"
+            " answered: the reading stopped before it",
+        )
+
+
+def _undecide_uncompared_crc(reply: DataReply, tally: Tally, where_: str) -> None:
+    """A CRC whose encoding is no CRC-16's (R-4.4.12-06) is not compared with the text
+    (protocol.responses._check_crc), so it shows nothing of R-4.4.12-05 either way
+    (crc-wrong-encoding + wrong-crc + value-two-points, seed 4118: R-4.4.12-05 PASSed
+    "17 checked" where every CRC was off by one and none compared)."""
+    if not any(v.requirement == "R-4.4.12-05" for v in reply.violations):
+        tally.undecide(
+            "R-4.4.12-05",
+            where_,
+            f"CRC '{escape(reply.crc or '')}' is encoded as no CRC-16: its value not compared",
+        )
+
+
+def _undecide_cut_at_silence(
+    m: Measurement, replies: list[DataReply], silent: Exchange | None, tally: Tally, label: str
+) -> None:
+    """R-4.4.8.3-01 and -03 judge a reply by the next one's first value (its unsigned tail,
+    or a value that would have fitted): where the next D went unanswered with values still
+    owed, the replies read and unread may have cut one, and the rules are undecided there
+    (m2-later-data-silent + split-value, seed 4099: R-4.4.8.3-01 PASSed although aM2!'s
+    D0, cut at 35 characters, was followed by a D1 nobody heard; + groups-start-at-d1,
+    seed 4098: D0 empty, D1 silent, none of aM2!'s values read)."""
+    if silent is None or m.complete:
+        return
+    for rid in ("R-4.4.8.3-01", "R-4.4.8.3-03"):
+        tally.undecide(
+            rid,
+            f"{label} {where(silent)}",
+            f"no reply to {where(silent)} with values still owed: whether the reply before"
+            " cut one, or left room for one, is unread",
+        )
 
 
 def data_reply_ids(command: Command) -> list[str]:
@@ -340,6 +407,13 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
         if any(v.requirement in ("R-5.2.1-01", "R-5.2-05", "R-5.2-02") for v in packet.violations):
             countable = False  # unknown type, ragged payload or broken framing: uncountable
         total += len(packet.values)
+    if countable and m.count and total == 0:
+        # (seed 4104, d0-empty + binary-payload-not-multiple) the empty packet alone has
+        # no payload whose length or size could be judged: R-5.2-04/-05 PASSed on it
+        for rid in ("R-5.2-04", "R-5.2-05"):
+            tally.undecide(
+                rid, label, f"no packet held a payload of the {m.count} values announced"
+            )
     if countable:
         tally.observe(label, ids=["R-5.2-07"])
         if total != m.count:

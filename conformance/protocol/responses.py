@@ -480,7 +480,10 @@ def check_data_sequence(replies: list[DataReply], announced: int, limit: int) ->
         if not after.values:
             continue
         first = after.values[0]
-        if continues_split_value(after.values):
+        # only a reply that held values can have cut one: after an empty D0 (a sensor whose
+        # groups start at D1) an unsigned first value is R-4.4.8-02's missing sign, not the
+        # rest of a split (groups-start-at-d1 + value-missing-sign, seed 4096)
+        if before.values and continues_split_value(after.values):
             found.append(
                 Violation(
                     "R-4.4.8.3-01",

@@ -10,7 +10,7 @@ from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import check_change_address_reply, split_line
 from conformance.protocol.timing import ADDRESS_CHANGE_QUIET, TOLERANCE
 from conformance.sensor.address_change import AddressChanger
-from conformance.verdicts import failed, passed
+from conformance.verdicts import failed, inconclusive, passed
 
 requirements = pytest.mark.requirements
 
@@ -82,6 +82,7 @@ def test_change_address(sensor, case):
     changer = AddressChanger(sensor.master, original)
     old = None
     heard = None
+    elsewhere = None
     sensor.hearing_marking()  # found at the original address, before the change
     try:
         outcome = changer.change(target)
@@ -91,6 +92,15 @@ def test_change_address(sensor, case):
             heard = sensor.heard_probe(f"{original}!", control_address=target)
             old = heard.probe
             changer.exchanges.extend(heard.exchanges)
+            if old.answered:
+                # answered at the old address too: one that answers a! at any address shows
+                # nothing by its answer at the new one (address-change-not-applied beside
+                # answers-foreign-address, seed 4104: '9!' answered by a sensor left at '0'
+                # PASSed R-4.4.4-01); an address no case gives it tells the two apart
+                elsewhere = sensor.heard_probe(
+                    f"{sensor.foreign_address()}!", control_address=target
+                )
+                changer.exchanges.extend(elsewhere.exchanges)
     finally:
         note = changer.restore()
         sensor.address_notes.append(note)
@@ -99,6 +109,16 @@ def test_change_address(sensor, case):
     problems = check_change_address_reply(body, original, target)
     after = outcome.answered_after
     stayed = old is not None and old.answered
+    anywhere = elsewhere is not None and (elsewhere.probe.answered or not elsewhere.listening)
+    unshown = (
+        f"'{target}!' was answered, but so was a! at the old address and "
+        + (
+            f"at '{elsewhere.probe.text[:-1]}', an address it never had"
+            if elsewhere is not None and elsewhere.probe.answered
+            else "no control was heard after a probe of an address it never had"
+        )
+        + ": the answer at the new address does not show the move"
+    )
     request = [judge.cited(outcome.request)]
     if not outcome.request.answered:
         case.add(
@@ -119,6 +139,15 @@ def test_change_address(sensor, case):
                 f"replied '{target}' but stayed at '{original}' ({note})",
                 evidence=request + judge.cite([*outcome.polls[-1:], old]),
                 observed=2,  # the change and the answer at the old address
+            )
+        )
+    elif anywhere:
+        case.add(
+            inconclusive(
+                "R-4.4.4-01",
+                f"{unshown} ({note})",
+                evidence=request + judge.cite(elsewhere.exchanges),
+                observed=1 + len(elsewhere.exchanges),
             )
         )
     else:
@@ -153,7 +182,16 @@ def test_change_address(sensor, case):
         case.requires("address", shown_at)
         return
     case.requires("address", shown_at)
-    if after > ADDRESS_CHANGE_QUIET + TOLERANCE + 0.25:  # one poll interval of slack
+    if anywhere:
+        case.add(
+            inconclusive(
+                "R-4.4.4-02",
+                unshown,
+                evidence=request + judge.cite(elsewhere.exchanges),
+                observed=1 + len(elsewhere.exchanges),
+            )
+        )
+    elif after > ADDRESS_CHANGE_QUIET + TOLERANCE + 0.25:  # one poll interval of slack
         case.add(
             failed(
                 "R-4.4.4-02",

@@ -7,6 +7,7 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.protocol.commands import ADDRESS_CHARS, Kind
+from conformance.sensor.session import HeardProbe
 from conformance.verdicts import failed, inconclusive, passed
 
 requirements = pytest.mark.requirements
@@ -19,6 +20,26 @@ def spare_addresses(sensor, count: int = 3) -> list[str]:
     spare = sensor.spare_address()
     taken = {sensor.address, spare, *sensor.others}
     return [spare] + [a for a in "0123456789" if a not in taken][: count - 1]
+
+
+def _answers_anywhere(sensor, sweep) -> HeardProbe | None:
+    """Where a change back in the sweep went unanswered (the sensor may never have left its
+    address), a! at an address no case gives it, with its control: returned when it was
+    answered or not heard, so the answers at each new address show no move (address-change-
+    not-applied beside answers-foreign-address, seed 4104: R-4.3-03 PASSed on a! answered
+    at 1..9 by a sensor left at '0'). None: no such doubt, or the probe was silent."""
+    back = [
+        ex
+        for ex in sweep.exchanges
+        if ex.command is not None
+        and ex.command.kind is Kind.CHANGE_ADDRESS
+        and ex.command.address != sensor.address
+        and not ex.answered
+    ]
+    if not back:
+        return None
+    heard = sensor.heard_probe(f"{sensor.foreign_address()}!")
+    return heard if heard.probe.answered or not heard.listening else None
 
 
 @requirements("R-4.0-01")
@@ -163,6 +184,22 @@ def test_address_range(sensor, case):
                 "refused or lost address(es) " + ", ".join(refused),
                 evidence=judge.cite(asked or sweep.exchanges),
                 observed=len(sweep.exchanges),
+            )
+        )
+    elif (anywhere := _answers_anywhere(sensor, sweep)) is not None:
+        case.evidence("a! at an address it never had", anywhere.exchanges)
+        case.add(
+            inconclusive(
+                "R-4.3-03",
+                "answered at every address 0-9, but a change back went unanswered and "
+                + (
+                    f"'{anywhere.probe.text}' was answered too, at an address it never had"
+                    if anywhere.probe.answered
+                    else "no control was heard after a! at an address it never had"
+                )
+                + f": its answers do not show it moved; {sweep.restore_note}",
+                evidence=judge.cite(anywhere.exchanges),
+                observed=len(sweep.exchanges) + len(anywhere.exchanges),
             )
         )
     else:

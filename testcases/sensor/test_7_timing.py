@@ -25,7 +25,7 @@ from conformance.protocol.timing import (
 )
 from conformance.sensor.session import PROBE_TRIES
 from conformance.transcript import EventKind
-from conformance.verdicts import failed, inconclusive, passed, warned
+from conformance.verdicts import Verdict, failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
 pytestmark = pytest.mark.needs("break")
@@ -398,6 +398,10 @@ def test_standby_after_foreign_command(sensor, case):
 #: tell a limit from a sensor's shortcut (a standby after 40 ms instead of 100 ms), far enough
 #: that the probe stays surely inside the limit.
 EDGE_MARGIN = 1.5e-3
+#: how far past the 100.4 ms limit R-7.0-15's first probe may surely land for its silence to
+#: PASS the rule: the sim's probe lands EDGE_MARGIN past it; one that can land later leaves
+#: a sensor awake that much too long unseen
+STANDBY_RESOLUTION = 2 * EDGE_MARGIN
 
 
 def _after_marking(sensor, last_end: float, marking: float, text: str):
@@ -461,14 +465,28 @@ def test_standby_after_100ms(sensor, case):
     if heard_break is not None:
         probes.append(heard_break)
         shown += f", {heard_break[1] * 1e3:.2f} ms after a break,"
-    case.add(
-        judge.silent(
-            "R-7.0-15",
-            [ex for ex, _ in probes],
-            f"{shown} of marking put it in standby",
-            baseline=wakes,
-        )
+    found = judge.silent(
+        "R-7.0-15",
+        [ex for ex, _ in probes],
+        f"{shown} of marking put it in standby",
+        baseline=wakes,
     )
+    # silence shows standby only by the time the probe went out: probed as late as the
+    # link's uncertainty forces (2u past the limit), a sensor awake a few ms too long is
+    # asleep by then too (standby-after-108ms + deaf-after-service-request behind
+    # --echo --usb-latency 16 beside two CPU burners: silent at 119-137 ms ±15 ms, PASSed,
+    # where the sim, probing at 101.9 ms, FAILs it)
+    latest = probes[0][1] + u
+    if found.verdict is Verdict.PASS and latest > STANDBY_MARKING + TOLERANCE + STANDBY_RESOLUTION:
+        found = inconclusive(
+            "R-7.0-15",
+            f"silent, but {shown} of marking (±{u * 1e3:.2f} ms): standby by"
+            f" {(STANDBY_MARKING + TOLERANCE) * 1e3:.1f} ms is not resolved, only by"
+            f" {latest * 1e3:.1f} ms (the tool vouches for"
+            f" {STANDBY_RESOLUTION * 1e3:.1f} ms past the limit)",
+            observed=found.observed,
+        )
+    case.add(found)
 
 
 def _standby_after_a_break(sensor, case, edge: float):

@@ -445,6 +445,15 @@ def test_data_sequence_split_value() -> None:
     ]
 
 
+def test_data_sequence_unsigned_first_value_after_an_empty_reply_is_no_split() -> None:
+    """R-4.4.8.3-01: an empty D0 cut no value, so D1's unsigned first value is R-4.4.8-02's
+    missing sign alone (groups-start-at-d1 + value-missing-sign + values-over-75, seed 4096:
+    'D1 starts with '22.15', the rest of a split value' FAILed)."""
+    assert check_data_sequence(_replies("0", "022.15+1013.2+45.7"), 3, limit=35) == []
+    # a value cut behind a reply that held values is still the cut
+    assert ids(check_data_sequence(_replies("0", "0+1.2", "034"), 1, limit=35)) == ["R-4.4.8.3-01"]
+
+
 def test_data_sequence_room_left_is_a_warning() -> None:
     found = check_data_sequence(_replies("0+3.14", "0+2.718", "0+1.414"), 3, limit=35)
     assert ids(found) == ["R-4.4.8.3-03", "R-4.4.8.3-03"]

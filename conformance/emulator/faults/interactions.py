@@ -86,6 +86,20 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.7-01",),
     ),
     Interaction(
+        frozenset({"undefined-measure-silent", "unknown-command-text"}),
+        "an undefined aMn!/aMCn! gets no answer at all, so no 'aUNKN' is ever sent to one, and"
+        " the defined groups' replies rightly hold R-4.4.5-01 (seed 4105: aM3!..aM9! and"
+        " aMC3!..aMC9! unanswered through nine tries each, no 'aUNKN' to any M command).",
+        removes=("R-4.4.5-01",),
+    ),
+    Interaction(
+        frozenset({"undefined-group-keeps-data", "unknown-command-text"}),
+        "an undefined aMn! is answered 'aUNKN', not a0000, so no a0000 is ever followed by the"
+        " stale D0 values, and the defined groups' counts rightly hold R-4.4.8-03 (seed 4115:"
+        " 0M3! -> '0UNKN' nine times; the stale-data case found no a0000 group: N/A).",
+        removes=("R-4.4.8-03",),
+    ),
+    Interaction(
         frozenset({"measure-count-zero", "metadata-missing-record"}),
         "aM! and aMC! announce no values, so their aIM_002!/aIMC_002! name an index past the"
         " count and the bare 'a<CR><LF>' is the right answer: the record metadata-missing-"
@@ -123,6 +137,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " so the old data the abort brings back are none: D0 after the abort is empty on the"
         " wire and the abort rules hold there (seed 4094).",
         removes=("R-4.4.5.1-02", "R-4.4.7.1-01", "R-4.4.7.1-02"),
+    ),
+    Interaction(
+        frozenset({"abort-keeps-old-data", "buffer-cleared-by-break"}),
+        "the measurement before the aborted one was read to its end, and the break before the"
+        " D0 that follows the abort empties such a buffer, so the old data the abort brings"
+        " back are none: D0 after each abort is empty on the wire ('0', '0AP@') and the abort"
+        " rules hold there (seed 4118 with missing-crlf).",
+        removes=("R-4.4.5.1-02", "R-4.4.7.1-01", "R-4.4.7.1-02", "R-5.3-01"),
     ),
     Interaction(
         frozenset({"buffer-cleared-after-read", "undefined-group-keeps-data"}),

@@ -246,7 +246,10 @@ COUNTS: tuple[Fault, ...] = (
         " nor data the identify commands could disturb (R-6.1-03) can be compared; nor is there"
         " a value whose format, length or grouping could be judged (R-4.4.8-02, R-4.4-05,"
         " R-4.4.8.3-01..03: precondition buffered not met, where an empty D reply once PASSed),"
-        " nor a buffer whose values a repeated D0 could show kept or lost (R-4.4.5-10).",
+        " nor a buffer whose values a repeated D0 could show kept or lost (R-4.4.5-10);"
+        " nor, after aHA!, a reply's length or a D past D9 (R-5.1-02, R-5.1-03), nor, after"
+        " aHB!, a payload (R-5.2-04, R-5.2-05: all PASSed on the empty replies, seeds"
+        " 4100, 4104).",
         ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
         settings={"drop_all_values": True},
         inconclusive=(
@@ -259,6 +262,10 @@ COUNTS: tuple[Fault, ...] = (
             "R-4.4.8.3-01",
             "R-4.4.8.3-02",
             "R-4.4.8.3-03",
+            "R-5.1-02",
+            "R-5.1-03",
+            "R-5.2-04",
+            "R-5.2-05",
         ),
     ),
     Fault(
@@ -293,9 +300,11 @@ COUNTS: tuple[Fault, ...] = (
 COVERAGE_DATA: tuple[Fault, ...] = (
     Fault(
         "m2-later-data-silent",
-        "After aM2!/aMC2! the sensor answers aD0! but not aD1! and later.",
+        "After aM2!/aMC2! the sensor answers aD0! but not aD1! and later; whether D0 cut a"
+        " value, or left room for D1's first, is then unread (R-4.4.8.3-01, -03; seed 4099).",
         ("R-4.4.8-01", "R-4.4.8-03"),
         rewrite=when(_later_m2_data, silence),
+        inconclusive=("R-4.4.8.3-01", "R-4.4.8.3-03"),
     ),
 )
 
