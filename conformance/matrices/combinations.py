@@ -295,6 +295,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("address-change-not-applied", "answers-foreign-address"),
     # (seed 4118) R-4.4.12-05 PASSed where every CRC was encoded as no CRC-16 and off by one
     ("crc-wrong-encoding", "wrong-crc"),
+    # (seed 4118) R-6.2-04 PASSed on the other groups' records while aM!'s count was
+    # unreadable and its too-long record never asked for
+    ("measure-ttt-two-digits", "metadata-too-long"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -239,7 +239,7 @@ def test_parameter_metadata(sensor, case):
     ):
         return
     case.extend(judge.records(plan, case.requirements))
-    case.extend(judge.uncounted_groups(unread))
+    case.extend(judge.uncounted_groups(unread, case.requirements))
 
 
 @requirements("R-6.2-05")

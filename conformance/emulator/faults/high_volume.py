@@ -18,6 +18,7 @@ from .edits import (
     with_spec,
 )
 from .model import Fault
+from .replies import UNREAD_RECORDS
 
 
 def _binary_first_packet(change: Callable[[Reply], None]) -> Callable[[Reply], None]:
@@ -136,7 +137,7 @@ COVERAGE: tuple[Fault, ...] = (
         "aHB! replies give a 2-digit count (atttnn instead of atttnnn)."
         " With the count unreadable no packet is asked for, so the packet rules have nothing"
         " to judge, nor has the count aHB!'s metadata records are checked against"
-        " (aIHB! answers alike, R-6.2-07).",
+        " (aIHB! answers alike, R-6.2-07), nor are those records read.",
         ("R-5.2-01",),
         rewrite=when(_hb_start, lambda r: replace(r, body=r.body[:4] + r.body[5:])),
         inconclusive=(
@@ -147,7 +148,7 @@ COVERAGE: tuple[Fault, ...] = (
             "R-5.2-05",
             "R-5.2-07",
             "R-5.2.1-01",
-            "R-6.2-07",
+            *UNREAD_RECORDS,
         ),
         needs=("HB",),
     ),

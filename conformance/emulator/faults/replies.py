@@ -126,6 +126,11 @@ UNREAD_DATA = (
     "R-4.4.8.3-03",
 )
 
+#: The metadata record rules (testcases/sensor/test_6_metadata.py's records): INCONCLUSIVE
+#: where neither a measurement's start reply nor its identify reply gives a readable count,
+#: since none of that group's records is asked for (judges.metadata.uncounted_groups).
+UNREAD_RECORDS = ("R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2-07", "R-6.2.1-01", "R-6.2.2-01")
+
 
 #: Identification and reply format.
 FORMAT: tuple[Fault, ...] = (
@@ -163,7 +168,8 @@ FORMAT: tuple[Fault, ...] = (
         " No measurement reply parses, so no data are there for the identify commands to"
         " disturb (R-6.1-03), no ttt tells whether aV! owes a service request as aM! does"
         " (R-4.4.11-01), and no count (aIM! answers alike) says which metadata records"
-        " the M-type groups owe (R-6.2-07). With no count no D command follows aM!, aV!"
+        " the M-type groups owe (R-6.2-07), so none of theirs is read (the record rules)."
+        " With no count no D command follows aM!, aV!"
         " or any aMn!: the D-reply and value rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read"
         " only aC!'s data and are left open for the values aM! holds, as is the count's"
         " 1..9 rule (R-4.4.5-02). Nor can aM!'s count be set beside aMC!'s"
@@ -173,7 +179,7 @@ FORMAT: tuple[Fault, ...] = (
         inconclusive=(
             "R-6.1-03",
             "R-4.4.11-01",
-            "R-6.2-07",
+            *UNREAD_RECORDS,
             "R-4.4.5-02",
             "R-4.4.12-04",
             *UNREAD_DATA,
@@ -223,14 +229,14 @@ FORMAT: tuple[Fault, ...] = (
         "HA replies give a 2-digit count (atttnn instead of atttnnn)."
         " With the count unreadable no D data are asked for, so the aHA! data rules have"
         " nothing to judge, nor has the count aHA!'s metadata records are checked against"
-        " (aIHA! answers alike, R-6.2-07); the announced-count rules of the D data"
-        " (R-4.4.8-03/-04) are left open for aHA!'s.",
+        " (aIHA! answers alike, R-6.2-07) nor its records read; the announced-count rules"
+        " of the D data (R-4.4.8-03/-04) are left open for aHA!'s.",
         ("R-5.1-01",),
         rewrite=when(
             lambda r: measure_family(r, 3) and source_kind(r) is Kind.HIGH_VOLUME_ASCII,
             lambda r: replace(r, body=r.body[:4] + r.body[5:]),
         ),
-        inconclusive=("R-5.1-02", "R-5.1-03", "R-6.2-07", "R-4.4.8-03", "R-4.4.8-04"),
+        inconclusive=("R-5.1-02", "R-5.1-03", *UNREAD_RECORDS, "R-4.4.8-03", "R-4.4.8-04"),
         needs=("HA",),
     ),
     Fault(
