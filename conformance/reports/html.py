@@ -61,7 +61,7 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
 #sdi12-requirements thead th.desc::after{content:" ▼";color:#333}
 #sdi12-requirements th{white-space:nowrap}
 #sdi12-requirements td:nth-child(5){min-width:260px;max-width:420px}
-#sdi12-requirements td:nth-child(6){min-width:260px}
+#sdi12-requirements td:nth-child(6){min-width:260px;overflow-wrap:anywhere}
 #sdi12-requirements td:nth-child(7){max-width:260px;font-size:12px}
 .sdi12-legend{font:12px sans-serif;color:#555;margin:2px 0 6px}
 .sdi12-attention .tests{color:#555;font-size:12px}
