@@ -317,7 +317,7 @@ def header(run: ConformanceRun) -> str:
         ("Started", run.started),
         ("Finished", run.finished or "—"),
         ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),
-        ("Ran to the end", "yes" if run.complete else "no (interrupted or the link failed)"),
+        ("Ran to the end", _ran_to_the_end(run)),
     ]
     if run.stop_reason:
         runrows.append(("Note" if run.complete else "Stopped because", run.stop_reason))
@@ -327,6 +327,16 @@ def header(run: ConformanceRun) -> str:
         + _kv_table("Run", runrows, "sdi12-run")
         + "</div>"
     )
+
+
+def _ran_to_the_end(run: ConformanceRun) -> str:
+    """A run stopped for a stated reason (no device answered) was neither interrupted nor
+    failed by its link: the row points at the reason rather than guess one."""
+    if run.complete:
+        return "yes"
+    if run.stop_reason:
+        return "no (see Stopped because)"
+    return "no (interrupted or the link failed)"
 
 
 def attention(run: ConformanceRun) -> str:
