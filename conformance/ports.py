@@ -14,6 +14,7 @@ opener, if it has one, goes in :mod:`conformance.recorder.openers`.
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass, field, replace
 from urllib.parse import parse_qs, urlsplit
 
@@ -117,10 +118,13 @@ def parse_sim(port: str) -> SimSpec:
         if key in params:
             spec.extra[key] = params.pop(key)
     if params:
+        known = ("faults", "profile", "version", "address", "sensors", "declaration")
+        known += ("recorder-faults", "recorder")
+        near = [m for p in sorted(params) for m in difflib.get_close_matches(p, known, 1)]
         raise PortError(
-            f"unknown sim parameters {sorted(params)} "
-            "(known: faults, profile, version, address, sensors, declaration, recorder-faults, "
-            "recorder)"
+            f"unknown sim parameter(s) {', '.join(sorted(params))}"
+            + (f" (did you mean {', '.join(near)}?)" if near else "")
+            + f"; known: {', '.join(known)}"
         )
     return spec
 

@@ -71,6 +71,8 @@ def test_a_fault_makes_the_run_non_compliant(tmp_path):
         (("--role", "recorder", "--port", "sim://?recorder-faults=x"), "recorder-faults takes"),
         (("--port", "/dev/ttyUSB9"), "serial port /dev/ttyUSB9 does not exist"),
         (("--bogus",), "unrecognized arguments"),
+        # first-hour look (2026-12-05): "unknown sim parameters ['fault']", a Python list
+        (("--port", "sim://?fault=wrong-crc"), "sim parameter(s) fault (did you mean faults?)"),
     ],
 )
 def test_usage_errors_exit_4_with_a_reason(tmp_path, args, message):

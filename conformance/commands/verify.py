@@ -45,6 +45,8 @@ def verify_main(argv: list[str], console: Console, judge: Judge) -> int:
     args = p.parse_args(argv)
     folder = Path(args.folder)
     try:
+        if not folder.exists():  # a mistyped path: "not a run folder" read as a bad folder
+            raise DiffError(f"{folder}: no such folder")
         if not folder.is_dir():
             raise DiffError(f"{folder}: not a run folder")
         data = load_run(folder)

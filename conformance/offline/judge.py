@@ -157,6 +157,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: the files a run folder holds beside its recording, which ``judge`` is sometimes given
+RUN_REPORTS = frozenset({"verdicts.json", "junit.xml", "report.html"})
+
+
 def plan(argv: list[str], *, in_memory: bool = False) -> JudgePlan:
     """Parse ``judge``'s arguments and decide how to judge the file (JudgeError if not).
     ``in_memory``: a capture's decoding is not written to capture.jsonl but held for its
@@ -166,6 +170,13 @@ def plan(argv: list[str], *, in_memory: bool = False) -> JudgePlan:
     path = Path(args.file)
     if path.is_dir():
         path = transcript_path(path)
+    elif path.name in RUN_REPORTS and (path.parent / "transcript.jsonl").is_file():
+        # A run's report beside its recording: the parse error it drew ("line 1: not a
+        # transcript event (Expecting property name ...)") did not say what to pass instead.
+        raise JudgeError(
+            f"{path}: a report of a run, not a recording; judge the run's folder "
+            f"({path.parent}) or its transcript ({path.parent / 'transcript.jsonl'})"
+        )
     try:
         kind = sniff(str(path))
     except CaptureError as exc:

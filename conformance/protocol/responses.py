@@ -282,6 +282,7 @@ def check_measurement_count(
     A zero count is legitimate only for an undefined numbered group or for HA/HB; plain
     M/MC/V must announce 1-9 (R-4.4.5-02) and plain C/CC must not answer ``a00000``
     (R-4.4.7-02). Under ``ll`` = 13 a concurrent count above 20 is a warning (R-4.4.7-03).
+    The texts leave the command out: the judge leads each with it ("0C!: announced 25 values ...")
     """
     if reply.count is None:
         return []
@@ -289,18 +290,14 @@ def check_measurement_count(
     found = []
     if reply.count == 0 and target.group == 0:
         if target.kind in (Kind.MEASURE, Kind.VERIFY):
-            found.append(
-                Violation("R-4.4.5-02", f"{command} announced zero values; n must be 1 to 9")
-            )
+            found.append(Violation("R-4.4.5-02", "announced zero values; n must be 1 to 9"))
         elif target.kind is Kind.CONCURRENT:
-            found.append(
-                Violation("R-4.4.7-02", f"{command} announced zero values instead of measuring")
-            )
+            found.append(Violation("R-4.4.7-02", "announced zero values instead of measuring"))
     if target.kind is Kind.CONCURRENT and reply.count > 20 and version == V13:
         found.append(
             Violation(
                 "R-4.4.7-03",
-                f"{command} announced {reply.count} values; the 2000 v1.3 text allows 20",
+                f"announced {reply.count} values; the 2000 v1.3 text allows 20",
                 warning=True,
             )
         )

@@ -200,7 +200,8 @@ def _reason(requirement: dict[str, Any]) -> str:
     same = [f for f in requirement["findings"] if f["verdict"] == requirement["verdict"]]
     if not same:
         return ""
-    more = f" (+{len(same) - 1} more findings)" if len(same) > 1 else ""
+    extra = len(same) - 1
+    more = f" (+{extra} more finding{'s' if extra > 1 else ''})" if extra else ""
     return same[0]["detail"] + more
 
 

@@ -126,8 +126,14 @@ def _verdicts(a: dict, b: dict) -> list[Change]:
 def _first_detail(req: dict, verdict: str) -> str:
     for f in req.get("findings", []):
         if f.get("verdict") == verdict:
-            return str(f.get("detail", ""))[:160]
+            return _cut(str(f.get("detail", "")), 160)
     return ""
+
+
+def _cut(text: str, width: int) -> str:
+    """``text`` cut to ``width`` with an ellipsis: a detail cut bare ("... wait it out and)")
+    reads as the whole finding."""
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def _key(rid: str, f: dict) -> tuple[str, str, str, str]:
@@ -157,7 +163,7 @@ def _findings(a: dict, b: dict) -> list[Change]:
 
 def _details(data: dict) -> dict[tuple[str, str, str, str], str]:
     return {
-        _key(r["id"], f): str(f["detail"])[:200]
+        _key(r["id"], f): _cut(str(f["detail"]), 200)
         for r in data.get("requirements", [])
         for f in r.get("findings", [])
     }

@@ -61,7 +61,7 @@ table.sdi12.kv th{font-weight:normal;color:#555;white-space:nowrap}
 #sdi12-requirements thead th.desc::after{content:" ▼";color:#333}
 #sdi12-requirements th{white-space:nowrap}
 #sdi12-requirements td:nth-child(5){min-width:260px;max-width:420px}
-#sdi12-requirements td:nth-child(6){min-width:260px}
+#sdi12-requirements td:nth-child(6){min-width:260px;overflow-wrap:anywhere}
 #sdi12-requirements td:nth-child(7){max-width:260px;font-size:12px}
 .sdi12-legend{font:12px sans-serif;color:#555;margin:2px 0 6px}
 .sdi12-attention .tests{color:#555;font-size:12px}
@@ -317,7 +317,7 @@ def header(run: ConformanceRun) -> str:
         ("Started", run.started),
         ("Finished", run.finished or "—"),
         ("Strict (SHOULD as MUST)", "yes" if run.options.strict else "no"),
-        ("Ran to the end", "yes" if run.complete else "no (interrupted or the link failed)"),
+        ("Ran to the end", _ran_to_the_end(run)),
     ]
     if run.stop_reason:
         runrows.append(("Note" if run.complete else "Stopped because", run.stop_reason))
@@ -327,6 +327,16 @@ def header(run: ConformanceRun) -> str:
         + _kv_table("Run", runrows, "sdi12-run")
         + "</div>"
     )
+
+
+def _ran_to_the_end(run: ConformanceRun) -> str:
+    """A run stopped for a stated reason (no device answered) was neither interrupted nor
+    failed by its link: the row points at the reason rather than guess one."""
+    if run.complete:
+        return "yes"
+    if run.stop_reason:
+        return "no (see Stopped because)"
+    return "no (interrupted or the link failed)"
 
 
 def attention(run: ConformanceRun) -> str:

@@ -19,6 +19,7 @@ from ..links.base import Link
 from ..preconditions import Unmet, acknowledges
 from ..protocol import commands as cmd
 from ..protocol.commands import (
+    ADDRESS_CHARS,
     C_FAMILY,
     CONTINUOUS,
     M_FAMILY,
@@ -240,6 +241,16 @@ class SensorSession(Session):
             )
             return False
         other = f"; ?! was answered '{escape(query.reply_text)}'" if query.answered else ""
+        if query.answered and len(body) == 1 and body in ADDRESS_CHARS:
+            # The device is there, at another address: "check its reply format" (what it
+            # said was a well-formed ?! reply) or the wiring would send the user astray.
+            raise NoDeviceAnswered(
+                f"no device answered at address {self.address!r} (a! and aI! got no reply "
+                f"after retries, nor a! after breaks of up to "
+                f"{LONGER_BREAKS[-1] * 1e3:.0f} ms{other}): the device is at address "
+                f"{body!r}; judge it there with --address {body} (or the declaration's "
+                "address), or give no address and the tool asks with ?!"
+            )
         talked = self._talked()
         raise NoDeviceAnswered(
             f"no device answered at address {self.address!r} (a! and aI! got no reply after "

@@ -64,3 +64,13 @@ def test_an_edited_transcript_line_fails_naming_the_file(folder: Path, tmp_path:
 def test_a_folder_without_verdicts_is_a_usage_error(tmp_path: Path):
     assert main(["verify", str(tmp_path)]) == 4
     assert main(["verify", str(tmp_path / "none")]) == 4
+
+
+def test_a_mistyped_folder_is_said_to_be_missing(tmp_path: Path, capsys):
+    """First-hour look (2026-12-05): ``verify nonexist`` said "nonexist: not a run folder",
+    as if the folder were there but wrong."""
+    assert main(["verify", str(tmp_path / "none")]) == 4
+    assert f"{tmp_path / 'none'}: no such folder" in capsys.readouterr().err
+    (tmp_path / "file").write_text("", encoding="utf-8")
+    assert main(["verify", str(tmp_path / "file")]) == 4
+    assert "not a run folder" in capsys.readouterr().err

@@ -364,3 +364,14 @@ def test_readme_points_at_what_the_package_ships():
     from importlib import resources
 
     assert resources.files("conformance").joinpath("catalog.json").is_file()
+
+
+def test_readme_judge_section_explains_judging_not_benchmarks():
+    """First-hour look (2026-12-05): "## Judge a recording" opened its list with a bullet of
+    CI and wall-time figures of issue 22's ninth round (a "Measured" entry that had slipped
+    below the heading), before the Replay and Passive bullets a reader came for."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("\n## Judge a recording\n", 1)[1].split("\n## ", 1)[0]
+    bullets = [line for line in section.splitlines() if line.startswith("- ")]
+    assert bullets[0].startswith("- **Replay**"), bullets[0]
+    assert "CI on a clean clone" not in section

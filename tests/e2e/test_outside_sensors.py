@@ -220,3 +220,19 @@ def test_a_reply_planned_at_the_commands_end_is_still_the_reply():
     dut = [e for e in bus.transcript.events if e.origin == DUT]
     assert [e.text for e in dut] == [""]
     assert [s.reply for s in segments(bus.transcript.events)][-1] == dut
+
+
+def test_a_sensor_at_another_address_is_named_not_sent_to_its_reply_format():
+    """First-hour look (2026-12-05): ``--port sim --address 7`` (the sim is at 0) stopped
+    with "?! was answered '0<CR><LF>'. The device did talk ... check its reply format (CR LF)
+    and address, not the wiring": the reply was well-formed, the address was the only fault.
+    The stop now names the address the device answered at and how to judge it there."""
+    from conformance.emulator import sim_sensor
+    from conformance.sensor.session import NoDeviceAnswered, SensorSession
+
+    _, link, _ = sim_sensor()
+    with pytest.raises(NoDeviceAnswered) as stop:
+        SensorSession(link, address="7").discover()
+    said = str(stop.value)
+    assert "the device is at address '0'" in said and "--address 0" in said, said
+    assert "reply format" not in said and "Check wiring" not in said, said

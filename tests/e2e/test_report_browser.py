@@ -25,6 +25,7 @@ RUNS = {
     "clean": ("sim", 0),
     "faulty": ("sim://?faults=no-service-request", 1),
     "late": ("sim://?faults=response-too-late", 1),  # a timing fault: the margins chart
+    "long": ("sim://?faults=abort-keeps-old-data", 1),  # 60-character replies as evidence
 }
 VIEWPORT = (1280, 720)
 
@@ -271,3 +272,18 @@ def test_the_margins_chart_shows_a_timing_fault_beyond_its_limit(reports, browse
         assert s["width"] <= 794 and s["height"] > 30, s
         assert s["smallest_font"] >= 9, s
     assert browser.log.problems == []
+
+
+def test_a_long_reply_in_the_evidence_wraps_inside_the_page(reports, browser):
+    """First-hour look (2026-12-05): abort-keeps-old-data quotes D0's reply
+    '0-5.00-3.75-2.50-...' (80 characters without a space) as evidence; the Evidence column
+    could not wrap it, the requirements table's narrowest width grew from 1129 to 1271
+    pixels and a 1280-pixel window with its scrollbar scrolled sideways, the Tests column
+    cut off. Squeezed, the column now keeps to its own width as in the clean run's report."""
+    browser.open(reports["long"] / "report.html")
+    widths = browser.evaluate(
+        "(function(){ document.body.style.width = '600px';"
+        " return [...document.querySelectorAll('#sdi12-requirements td:nth-child(6)')]"
+        ".map(c => c.getBoundingClientRect().width); })()"
+    )
+    assert widths and max(widths) < 300, max(widths)  # 273 (260 + padding); 416 before

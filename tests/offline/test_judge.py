@@ -171,6 +171,18 @@ def test_bad_recordings_are_refused_plainly(tmp_path, capsys, name, content, wor
     assert "Traceback" not in err
 
 
+@pytest.mark.parametrize("name", ["verdicts.json", "junit.xml", "report.html"])
+def test_a_run_s_report_given_as_the_recording_names_what_to_pass(tmp_path, capsys, name):
+    """First-hour look (2026-12-05): ``judge RUN/verdicts.json`` said "line 1: not a
+    transcript event (Expecting property name enclosed in double quotes ...)"."""
+    (tmp_path / "transcript.jsonl").write_text("", encoding="utf-8")
+    report = _bad(tmp_path, name, b'{\n "schema": "sdi12-conform/verdicts/1"\n}\n')
+    assert main(["judge", str(report), "--report-dir", str(tmp_path / "out")]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "a report of a run, not a recording" in err, err
+    assert str(tmp_path / "transcript.jsonl") in err, err
+
+
 @pytest.mark.slow
 def test_missing_recording_and_wrong_channel(tmp_path, live, capsys):
     assert main(["judge", str(tmp_path / "nothing.sr")]) == EXIT_USAGE

@@ -15,7 +15,7 @@ import pytest
 from rich.console import Console
 
 from conformance import cli
-from conformance.reports.console import REASON_WIDTH, one_line
+from conformance.reports.console import REASON_WIDTH, _reason, one_line
 
 FAULTY = "sim://?faults=no-service-request"
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
@@ -133,3 +133,16 @@ def test_a_real_link_run_ends_with_its_bus_time_and_efficiency():
     assert bus_line(sim) is None  # a virtual clock's time is no one's wall time
     recording = {"run": {"bus": bus, "link": {"kind": "capture sr"}}}
     assert bus_line(recording) is None
+
+
+def test_the_count_of_further_findings_agrees_in_number():
+    """First-hour look (2026-12-05): abort-keeps-old-data's R-5.3-01 line ended "(+1 more
+    findings)"."""
+
+    def requirement(n: int) -> dict:
+        found = [{"verdict": "FAIL", "detail": f"d{i}"} for i in range(n)]
+        return {"verdict": "FAIL", "findings": [*found, {"verdict": "PASS", "detail": "ok"}]}
+
+    assert _reason(requirement(1)) == "d0"
+    assert _reason(requirement(2)) == "d0 (+1 more finding)"
+    assert _reason(requirement(3)) == "d0 (+2 more findings)"

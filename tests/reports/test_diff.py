@@ -55,6 +55,21 @@ def test_a_new_deviation_under_a_rule_already_failing_is_worse():
     assert added.worse and "two values" in added.text
 
 
+def test_a_long_detail_is_cut_with_an_ellipsis_not_bare():
+    """First-hour look (2026-12-05): diffing the clean sim against no-service-request listed
+    "R-4.4.6-02: PASS -> FAIL (... (the recorder had to wait it out and)": the detail cut at
+    160 characters with nothing to say so, the verdict line and the finding line alike."""
+    long = "0M!: no service request within ttt=2 s (the recorder had to wait it out). " * 5
+    changes = diff_runs(
+        run(("R-4.4.6-02", "PASS", [])), run(("R-4.4.6-02", "FAIL", [finding("FAIL", long)]))
+    )
+    texts = {c.kind: c.text for c in changes}
+    assert texts["verdict"].endswith("...)") and len(texts["verdict"]) < len(long)
+    assert texts["finding-added"].endswith("...")
+    short = run(("R-4.4.6-02", "FAIL", [finding("FAIL", "late")]))
+    assert [c.text for c in diff_runs(run(("R-4.4.6-02", "PASS", [])), short)][0].endswith("(late)")
+
+
 def test_the_same_deviation_with_other_numbers_is_not_new():
     a = run(("R-4.4.8-03", "FAIL", [finding("FAIL", "4 values were returned for 9 announced")]))
     b = run(("R-4.4.8-03", "FAIL", [finding("FAIL", "3 values were returned for 9 announced")]))

@@ -202,6 +202,19 @@ def test_read_first_groups_requirements_with_one_reason_and_header_says_why_inco
     assert f"note: {run.stop_reason}" in html.banner(run)
 
 
+def test_a_run_stopped_for_a_reason_does_not_say_it_was_interrupted():
+    """First-hour look (2026-12-05): ``--port sim --address 7`` stopped because no device
+    answered at 7, and the header's "Ran to the end" read "no (interrupted or the link
+    failed)", neither of which happened."""
+    run = ConformanceRun(RunOptions())
+    run.stop_reason = "no device answered at address 7"
+    run.finish(complete=False)
+    head = html.header(run)
+    assert "<th>Ran to the end</th><td>no (see Stopped because)</td>" in head, head
+    assert f"<th>Stopped because</th><td>{run.stop_reason}</td>" in head
+    assert "interrupted or the link failed" not in head
+
+
 def test_a_diagram_title_states_the_marking_it_draws():
     """Issue 19: a diagram titled "break, 77 ms marking, a!" drew 89.05 ms of marking (the
     link's latency). The title keeps the case's words and says what is drawn."""

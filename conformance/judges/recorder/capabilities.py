@@ -26,6 +26,7 @@ def judge_commands_issued(
     drew a valid reply; for measurements, every announced value was read."""
     first = first_answered(line, uncertainty)
     missing = [text for text in asked if text not in first]
+    sent = {s.text for s in line.transmissions}
     taken = {m.start.text: m for m in observed_measurements(line, uncertainty)}
     short = [
         f"{escape(t)} ({len(m.values())} of {m.count} values)"
@@ -34,8 +35,16 @@ def judge_commands_issued(
     ]
     if missing or short:
         parts = []
-        if missing:
-            parts.append("never answered validly: " + ", ".join(escape(t) for t in missing))
+        # A command the recorder never sent is its own fault, not a missing reply: the
+        # sensor side is the tool's, so "never answered" alone read as the tool's failure.
+        unsent = [t for t in missing if t not in sent]
+        unanswered = [t for t in missing if t in sent]
+        if unsent:
+            parts.append("never sent: " + ", ".join(escape(t) for t in unsent))
+        if unanswered:
+            parts.append(
+                "sent but never answered validly: " + ", ".join(escape(t) for t in unanswered)
+            )
         if short:
             parts.append("data not read: " + ", ".join(short))
         return Finding(
@@ -62,7 +71,7 @@ def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
         Finding(
             "R-4.3-03",
             Verdict.FAIL,
-            f"addresses never polled successfully: {digits}",
+            "addresses never polled successfully: " + ", ".join(digits),
             evidence=record_of(line.transmissions, [f"{a}!" for a in digits]),
             observed=len(line.transmissions),
         )

@@ -4,7 +4,11 @@ the deviation it exists for (a judge that cannot fail is a defect)."""
 from __future__ import annotations
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
-from conformance.judges.recorder.capabilities import judge_addresses, judge_transparent
+from conformance.judges.recorder.capabilities import (
+    judge_addresses,
+    judge_commands_issued,
+    judge_transparent,
+)
 from conformance.judges.recorder.collection import judge_concurrent_storage, judge_data_collection
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
 from conformance.judges.recorder.measurements import observed_measurements
@@ -284,6 +288,28 @@ def test_addresses():
     found = by_id(judge_addresses(w.view(), 0.0))
     assert found["R-4.3-03"].verdict is Verdict.FAIL and "9" in found["R-4.3-03"].detail
     assert found["R-4.3-04"].verdict is Verdict.NA
+
+
+def test_r_4_3_03_lists_the_unpolled_addresses_as_text():
+    """First-hour look (2026-12-05): the FAIL read "addresses never polled successfully:
+    ['5', '6', '7', '8', '9']", a Python list in a report meant for a firmware engineer."""
+    w = Wire()
+    for a in "01234":
+        w.brk().rec(f"{a}!").sensor(f"{a}\r\n", origin=f"sensor{a}").idle(20)
+    detail = by_id(judge_addresses(w.view(), 0.0))["R-4.3-03"].detail
+    assert detail == "addresses never polled successfully: 5, 6, 7, 8, 9"
+
+
+def test_r_4_4_02_tells_a_command_never_sent_from_one_never_answered():
+    """First-hour look (2026-12-05): a recorder that cannot address 5 never sends 0A5!, and
+    R-4.4-02 said "never answered validly: 0A5!", which reads as the tool's simulated sensor
+    failing to answer. A command not on the wire is "never sent"; one sent whose replies
+    were all invalid is still "sent but never answered validly"."""
+    w = Wire().brk().rec("0!").sensor("0\r\n").idle(20)
+    w = w.brk().rec("0I!").sensor("0I\r\n").idle(20)  # not a valid aI! reply
+    found = judge_commands_issued(w.view(), ["0!", "0I!", "0A5!"], 0.0)
+    assert found.verdict is Verdict.FAIL
+    assert found.detail == "never sent: 0A5!; sent but never answered validly: 0I!"
 
 
 def test_a_concurrent_measurement_repeated_before_its_data_owes_no_values():
