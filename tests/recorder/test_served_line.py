@@ -144,13 +144,16 @@ def test_golden_recorder_as_a_separate_process_through_the_trigger():
     assert record.output.logged == {"0M!": ["+22.15", "+1013.2", "+45.7"]}  # SDI12_LOG_FILE
     assert record.output.log_source is not None
     sent = "".join(chr(e.char7) for e in record.events if e.kind == "char" and e.origin == "tool")
-    assert sent.count("0M!") == 3, sent  # two unanswered tries, then the answered one
     verdicts = {f.requirement: str(f.verdict) for f in findings}
     wrong = (
         ""
         if verdicts.get("R-7.2-01") == "PASS" and "FAIL" not in verdicts.values()
         else f"retries judged {verdicts}"
     )
+    # two unanswered tries, then the answered one; a retry the host sent late finds the
+    # sensor in standby, unanswered (CI beside the other suites, stop 44: '0M!' x5 then D0)
+    if sent.count("0M!") != 3:
+        wrong = f"{wrong}; tries sent {sent!r}, not two silent 0M! and the answered one"
     fail_unless_too_busy(
         late, wrong, "\n".join(f"{f.requirement} {f.verdict}: {f.detail}" for f in findings)
     )
