@@ -153,4 +153,13 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " wire (seed 4094).",
         removes=("R-4.4.8-03",),
     ),
+    Interaction(
+        frozenset({"identify-sends-service-request", "partial-command-accepted"}),
+        "the partial commands shift the schedule so that the service request an identify"
+        " command wrongly owes falls due while the tool sends 0ICC1!: the sensor sends it the"
+        " moment the command ends and its reply straight after, so the wire holds a"
+        " reply-shaped '0<CR><LF>' 0 ms after the command (R-7.0-09; taken for the service"
+        " request, the reply proper starts 25 ms after, R-7.0-10 instead), seed 4120.",
+        adds=("R-7.0-09",),
+    ),
 )
