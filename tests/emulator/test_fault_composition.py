@@ -214,3 +214,13 @@ def test_a_service_request_due_during_a_reply_keeps_the_sensors_character_gap():
     answer = rig.ask("0I!", brk=False)  # its 317 ms reply covers the moment
     assert answer.text == "014CONFORM EMU001100SN0001\r\n0\r\n"
     assert min(answer.gaps) == pytest.approx(3e-3)
+
+
+def test_a_semicolon_in_units_spares_records_another_fault_left_without_units():
+    """metadata-missing-units beside metadata-semicolon-in-field (seed 4138, with
+    ignores-query): aM!'s records have no units field to put the ';' in, and the rewrite
+    raised IndexError inside the sensor, 8 requirements ERROR. Those records keep their one
+    field; aM1!'s, which still have units, carry the ';'."""
+    rig = Rig(faults=("metadata-missing-units", "metadata-semicolon-in-field"))
+    assert rig.ask("0IM_001!").body == "0,TA;"
+    assert rig.ask("0IM1_001!").body == "0,VB,V;x,supply;"

@@ -39,7 +39,8 @@ def _metadata_field(change: Callable[[list[str]], None]) -> Rewrite:
 
 
 def _semicolon_in_units(fields: list[str]) -> None:
-    fields[1] = fields[1] + ";x"
+    if len(fields) > 1:  # a record another fault left without units (metadata-missing-units)
+        fields[1] = fields[1] + ";x"  # keeps its one field: the other groups' show the ';'
 
 
 def _long_identifier(fields: list[str]) -> None:
