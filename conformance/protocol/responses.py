@@ -461,26 +461,25 @@ def check_data_sequence(replies: list[DataReply], announced: int, limit: int) ->
     (a warning): a reply left room for the next reply's first value.
     """
     found = []
+    pairs = list(enumerate(zip(replies, replies[1:], strict=False), start=1))
     # a reply starting without a sign continues the value the reply before cut off: the
-    # halves are one value (R-4.4.8.3-01 judges the cut), not one too many for the count
-    joined = sum(
-        1
-        for before, after in zip(replies, replies[1:], strict=False)
-        if before.values and continues_split_value(after.values)
-    )
-    total = sum(len(r.values) for r in replies) - joined
+    # halves are one value (R-4.4.8.3-01 judges the cut), not one too many for the count.
+    # Only a reply that held values can have cut one: after an empty D0 (a sensor whose
+    # groups start at D1) an unsigned first value is R-4.4.8-02's missing sign, not the
+    # rest of a split (groups-start-at-d1 + value-missing-sign, seed 4096)
+    cut = {
+        i for i, (before, after) in pairs if before.values and continues_split_value(after.values)
+    }
+    total = sum(len(r.values) for r in replies) - len(cut)
     if total != announced:
         found.append(
             Violation("R-4.4.8-03", f"{total} values were returned for {announced} announced")
         )
-    for index, (before, after) in enumerate(zip(replies, replies[1:], strict=False), start=1):
+    for index, (before, after) in pairs:
         if not after.values:
             continue
         first = after.values[0]
-        # only a reply that held values can have cut one: after an empty D0 (a sensor whose
-        # groups start at D1) an unsigned first value is R-4.4.8-02's missing sign, not the
-        # rest of a split (groups-start-at-d1 + value-missing-sign, seed 4096)
-        if before.values and continues_split_value(after.values):
+        if index in cut:
             found.append(
                 Violation(
                     "R-4.4.8.3-01",

@@ -226,11 +226,13 @@ class SensorSession(Session):
                 )
                 return True
         self.master.policy = usual
+        unanswered = (
+            f"no device answered at address {self.address!r} (a! and aI! got no reply after "
+            f"retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms"
+        )
         if self.shared:  # every sensor on the line would answer ?!
             raise NoDeviceAnswered(
-                f"no device answered at address {self.address!r} (a! and aI! got no reply "
-                f"after retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms); "
-                "?! is not sent on a bus shared with other sensors"
+                f"{unanswered}); ?! is not sent on a bus shared with other sensors"
             )
         query = self.master.query_address()
         body, _ = split_line(query.reply_text)
@@ -245,16 +247,13 @@ class SensorSession(Session):
             # The device is there, at another address: "check its reply format" (what it
             # said was a well-formed ?! reply) or the wiring would send the user astray.
             raise NoDeviceAnswered(
-                f"no device answered at address {self.address!r} (a! and aI! got no reply "
-                f"after retries, nor a! after breaks of up to "
-                f"{LONGER_BREAKS[-1] * 1e3:.0f} ms{other}): the device is at address "
-                f"{body!r}; judge it there with --address {body} (or the declaration's "
-                "address), or give no address and the tool asks with ?!"
+                f"{unanswered}{other}): the device is at address {body!r}; judge it there "
+                f"with --address {body} (or the declaration's address), or give no address "
+                "and the tool asks with ?!"
             )
         talked = self._talked()
         raise NoDeviceAnswered(
-            f"no device answered at address {self.address!r} (a! and aI! got no reply after "
-            f"retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms{other})"
+            f"{unanswered}{other})"
             + (talked or ". Check wiring and power, or try ?! with one sensor on the bus.")
         )
 
