@@ -49,6 +49,9 @@ def plan_parser() -> argparse.ArgumentParser:
     p.add_argument("--profile", choices=tuple(PROFILES), help="a named selection (production)")
     p.add_argument("--format", choices=FORMATS, default="markdown", help="default: markdown")
     p.add_argument("-o", "--output", help="write the plan here (default: standard output)")
+    # not an option of the plan: taken only to say so, since the main command's --port is
+    # the first thing a user types (argparse's "unrecognized arguments" says nothing more)
+    p.add_argument("--port", help=argparse.SUPPRESS)
     return p
 
 
@@ -174,6 +177,13 @@ def make_plan(
 
 def plan_main(argv: list[str]) -> int:
     args = plan_parser().parse_args(argv)
+    if args.port is not None:
+        say_error(
+            "error: plan does not touch the bus, so it takes no --port: its bus time comes "
+            "from a dry run against a simulated sensor. Leave --port out; to run the suite "
+            f"on {args.port}: sdi12-conform --port {args.port}"
+        )
+        return EXIT_USAGE
     try:
         plan = make_plan(args.role, args.declaration, args.sdi_version, args.keyword,
                          tuple(args.req), args.profile)  # fmt: skip

@@ -142,6 +142,12 @@ def test_the_command_line(tmp_path, capsys):
     assert main(["plan", "-k", "no_such_case_anywhere"]) == 4
 
 
+def test_a_port_given_to_plan_is_refused_with_the_command_that_runs_it(capsys):
+    assert main(["plan", "--port", "sim"]) == 4
+    err = capsys.readouterr().err
+    assert "plan does not touch the bus" in err and "sdi12-conform --port sim" in err
+
+
 def test_a_planned_run_keeps_its_plan_beside_what_was_judged(tmp_path):
     out = tmp_path / "run"
     assert main(["--port", "sim", "--plan", "always", "-k", "ttt_zero or identification",
