@@ -41,13 +41,13 @@ ROLES = ("sensor", "recorder")
 def no_traffic(port: str) -> str | None:
     """Why the recording holds nothing to judge (None: it holds SDI-12 traffic)."""
     from ..offline.fixtures import recording_of
-    from ..offline.heard import heard_records
+    from ..view.runs import transcript_view
 
     link = recording_of(port)
     events = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]
     chars = [e for e in events if e.kind is EventKind.CHAR]
     breaks = [e for e in events if e.kind is EventKind.BREAK]
-    view, _rebuilt = heard_records(link)  # the cut every later step reads (notes left out)
+    view = transcript_view(link.transcript)  # the cut every later step reads (notes left out)
     commands = [t.command for t in view.transmissions if t.command is not None]
     # any text ending in '!' parses as an extended command: alone it is no sign of SDI-12
     if any(c.kind is not Kind.EXTENDED for c in commands) or (commands and breaks):
@@ -92,10 +92,9 @@ def sensors_heard(port: str) -> list[str]:
     """The addresses of the sensors the recording shows replies from, in address order
     (a sensor moved by ``aAb!`` counted once, at its first address)."""
     from ..offline.fixtures import recording_of
-    from ..offline.heard import heard_records, sensors_on
+    from ..offline.heard import bus_sensors
 
-    _view, rebuilt = heard_records(recording_of(port))
-    return [s.address for s in sensors_on(rebuilt.exchanges)]
+    return [s.address for s in bus_sensors(recording_of(port))]
 
 
 def role_jobs(roles: tuple[str, ...], base: Path, args: PassiveJob, port: str) -> list[RoleJob]:
@@ -139,6 +138,11 @@ def judge_passively(args: PassiveJob, console: Console) -> int:
     roles = ROLES if args.role == "both" else (args.role,)
     jobs = role_jobs(roles, run_folder(args.report_dir, "passive"), args, port)
     sensors = [j.address for j in jobs if j.of_bus]
+    if sensors:  # judged one by one: no run holds every sensor's records (issue 22)
+        from ..offline.fixtures import recording_of
+        from ..offline.heard import settle_bus
+
+        settle_bus(recording_of(port))
     console.print(
         f"judging {args.recording} passively: the rules its traffic can show "
         f"({' and '.join(roles)} rules)"

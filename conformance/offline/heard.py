@@ -29,7 +29,8 @@ from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..replay.recording_link import RecordingLink
 from ..tool_recorder import validity
 from ..tool_recorder.records import Exchange, Measurement
-from ..view.rebuilt_records import Rebuilt, rebuild_records
+from ..transcript import Event
+from ..view.rebuilt_records import Rebuilt, rebuild_records, rebuilt_exchanges
 from ..view.runs import Segment, transcript_segments, transcript_view
 from ..view.segments import TranscriptView, memo
 from .decode_quality import decode_quality, rate_of, sensor_characters
@@ -126,7 +127,7 @@ class BusSensor:
         return DutClaim(self.identity, self.reply, version if version in VERSIONS else None)
 
 
-def sensors_on(exchanges: list[Exchange]) -> list[BusSensor]:
+def sensors_on(exchanges: Iterable[Exchange]) -> list[BusSensor]:
     """The sensors whose replies the recording holds, in address order. A sensor is known by
     the address it first answered at: an accepted ``aAb!`` moves it, not a new sensor (a
     sensor run moves its DUT and back), so its later replies at ``b`` are its own."""
@@ -202,34 +203,34 @@ def _by_address(items: Iterable[T], address_of: Callable[[T], str]) -> dict[str,
 
 @dataclass(frozen=True)
 class _PerSensor:
-    """The recording's records and segments, each list split by sensor address once;
-    ``released``: the addresses whose share :func:`release_records` dropped."""
+    """The recording's segments, split by sensor address once, and the records of the
+    sensors asked for so far (each rebuilt alone, :func:`_per_sensor`)."""
 
     exchanges: dict[str, list[Exchange]]
     measurements: dict[str, list[Measurement]]
     segments: dict[str, list[Segment]]
-    released: set[str] = field(default_factory=set)
 
 
 def _per_sensor(link: RecordingLink, address: str | None = None) -> _PerSensor:
-    """Every sensor's share of the recording, split in one pass per list: a bus of ten
-    sensors is judged in ten runs, and each filtering the whole recording again cost an
-    hour's capture seconds. Split again (from records rebuilt again) if ``address``'s share
-    was released: the same records, since they are a pure function of the recording."""
+    """Every sensor's segments, split in one pass (a bus of ten sensors is judged in ten
+    runs, and each filtering the whole recording again cost an hour's capture seconds), and
+    ``address``'s records: rebuilt for that sensor alone
+    (:func:`~conformance.view.rebuilt_records.rebuild_records` ``only``), the same records
+    the whole run's rebuild gives it, so that a bus's first sensor run does not hold every
+    sensor's (15 MB at an hour of a busy capture). Rebuilt again if :func:`release_records`
+    let them go: they are a pure function of the recording."""
 
     def split() -> _PerSensor:
-        _view, rebuilt = heard_records(link)
         return _PerSensor(
-            _by_address(rebuilt.exchanges, lambda x: x.text),
-            _by_address(rebuilt.measurements, lambda m: m.command.address),
-            _by_address(transcript_segments(link.transcript), lambda s: s.text),
+            {}, {}, _by_address(transcript_segments(link.transcript), lambda s: s.text)
         )
 
-    n = len(link.transcript.events)
-    mine = memo(link, "_per_sensor", n, split)
-    if address is not None and address in mine.released:
-        link.__dict__.pop("_per_sensor")
-        mine = memo(link, "_per_sensor", n, split)
+    mine = memo(link, "_per_sensor", len(link.transcript.events), split)
+    if address is not None and address not in mine.exchanges:
+        view = transcript_view(link.transcript)
+        rebuilt = rebuild_records(view, uncertainty=link.uncertainty, only=address)
+        mine.exchanges[address] = rebuilt.exchanges
+        mine.measurements[address] = rebuilt.measurements
     return mine
 
 
@@ -249,7 +250,22 @@ def release_records(link: RecordingLink, keep: Collection[str]) -> None:
     for address in [a for a in mine.exchanges if a not in keep]:
         mine.exchanges.pop(address, None)
         mine.measurements.pop(address, None)
-        mine.released.add(address)
+
+
+def bus_sensors(link: RecordingLink) -> list[BusSensor]:
+    """:func:`sensors_on` the recording (found once per loaded recording)."""
+    return _bus_sensors(link)
+
+
+def settle_bus(link: RecordingLink) -> None:
+    """Make what the runs of a bus's sensors read of every sensor's records (the sensors on
+    the bus, each one's decode-quality note) before the first run, from the exchanges made
+    one at a time, and let go of any whole-run records: each sensor's run then rebuilds its
+    own alone (:func:`_per_sensor`), and no run holds every sensor's at once."""
+    _bus_sensors(link)
+    if link.decoded is not None:
+        _qualities(link)
+    link.__dict__.pop("_heard_records", None)
 
 
 def _qualities(link: RecordingLink) -> dict[str, str | None]:
@@ -261,13 +277,28 @@ def _qualities(link: RecordingLink) -> dict[str, str | None]:
         events = link.transcript.events
         rates = rate_of(link.decoded, events)
         return {
-            a: decode_quality(
-                link.decoded, events, sensor_characters(xs), f"sensor {a!r}", rates=rates
-            )
-            for a, xs in _per_sensor(link).exchanges.items()
+            a: decode_quality(link.decoded, events, chars, f"sensor {a!r}", rates=rates)
+            for a, chars in _characters_by_sensor(link).items()
         }
 
     return memo(link, "_qualities", len(link.transcript.events), build)
+
+
+def _exchanges(link: RecordingLink) -> Iterator[Exchange]:
+    """Every exchange of the recording in wire order, made one at a time
+    (:func:`~conformance.view.rebuilt_records.rebuilt_exchanges`): the same exchanges
+    :func:`heard_records` holds, for what reads each once."""
+    return rebuilt_exchanges(transcript_view(link.transcript), uncertainty=link.uncertainty)
+
+
+def _characters_by_sensor(link: RecordingLink) -> dict[str, list[Event]]:
+    """:func:`~.decode_quality.sensor_characters` of each sensor's exchanges (by the first
+    character of their text, in order of first appearance), read from the exchanges one at
+    a time."""
+    found: dict[str, list[Event]] = {}
+    for x in _exchanges(link):
+        found.setdefault(x.text[:1], []).extend(sensor_characters([x]))
+    return found
 
 
 def _shared_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
@@ -281,7 +312,7 @@ def _bus_sensors(link: RecordingLink) -> list[BusSensor]:
     """:func:`sensors_on` the recording's exchanges, found once per loaded recording."""
 
     def find() -> list[BusSensor]:
-        return sensors_on(heard_records(link)[1].exchanges)
+        return sensors_on(_exchanges(link))
 
     return list(memo(link, "_on_bus", len(link.transcript.events), find))
 
@@ -316,7 +347,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         found = _qualities(link) if address is not None else {}
         if address in found:
             quality = found[address]
-        else:  # all the sensors, or one whose share was released before the notes were made
+        else:  # all the sensors, or an address that never answered
             chars = sensor_characters(heard.exchanges)
             quality = decode_quality(link.decoded, link.transcript.events, chars, who)
         if quality is not None:

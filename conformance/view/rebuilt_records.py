@@ -45,21 +45,67 @@ class Rebuilt:
 
 
 def rebuild_records(
-    view: TranscriptView, policy: Policy | None = None, *, uncertainty: float = 0.0
+    view: TranscriptView,
+    policy: Policy | None = None,
+    *,
+    uncertainty: float = 0.0,
+    only: str | None = None,
 ) -> Rebuilt:
     """Exchanges and measurements from ``view``, as the tool recorder would have recorded
-    them with ``policy`` (its reply window and idle rule decide where a reply ends)."""
+    them with ``policy`` (its reply window and idle rule decide where a reply ends).
+
+    ``only``: the records of the sensor at that address alone, equal to the whole run's
+    records of that address (exchanges by their text's first character, measurements by
+    their command's address), without the other sensors' ever being made: a passive
+    judgement of a bus judges one sensor at a time, and holding every sensor's records at
+    the first one's run held an hour's capture's 15 MB at its peak. What another sensor's
+    transmission changes for this one's is only that it came between (it ends an aM!-type
+    measurement's data, :func:`_measurements`) and that it is no retry of this one's last
+    exchange; the CRC expected of a data reply is its own address's."""
     policy = policy or Policy()
-    exchanges: list[Exchange] = []
     source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
+    exchanges = list(_exchanges(view, policy, uncertainty, only, source))
+    measurements = _measurements(exchanges, source, policy)
+    return Rebuilt([x for x in exchanges if x is not None], measurements)
+
+
+def rebuilt_exchanges(
+    view: TranscriptView, policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Iterator[Exchange]:
+    """:func:`rebuild_records`'s exchanges, each given once complete (its retries in) and
+    held by nobody else: what reads every sensor's exchanges once (the sensors on a bus,
+    their characters' decode quality) then holds one exchange at a time, not an hour's
+    capture's 15 MB of them."""
+    found = _exchanges(view, policy or Policy(), uncertainty, None, {})
+    return (x for x in found if x is not None)
+
+
+def _exchanges(
+    view: TranscriptView,
+    policy: Policy,
+    uncertainty: float,
+    only: str | None,
+    source: dict[int, Transmission],
+) -> Iterator[Exchange | None]:
+    """The exchanges of ``view`` in wire order, each once its last attempt is in (of the
+    sensor at ``only``, with a None where other sensors' exchanges came between); fills
+    ``source`` (id of each attempt -> its transmission)."""
     crc_pending: dict[str, bool] = {}
+    last: Exchange | None = None  # the last exchange, None when it is another sensor's
+    begun = False
     for t in view.transmissions:
+        if only is not None and t.text[:1] != only:
+            if last is not None or not begun:
+                if last is not None:
+                    yield last
+                yield None
+            last, begun = None, True
+            continue
         command = t.command
         binary = command is not None and command.kind is Kind.BINARY_DATA
         crc = crc_pending.get(t.address) if binary or _is_data(command) else None
         attempt = _attempt(t, command, binary, crc, policy, uncertainty)
         source[id(attempt)] = t
-        last = exchanges[-1] if exchanges else None
         if last is not None and last.text == t.text and not last.ok and command is not None:
             retries = [a for a in last.attempts if a.sequence == last.last.sequence]
             if t.break_event is None:
@@ -68,11 +114,13 @@ def rebuild_records(
                 attempt.sequence = last.last.sequence + 1
             last.attempts.append(attempt)
         else:
-            last = Exchange(command, t.text, [attempt], binary=binary)
-            exchanges.append(last)
+            if last is not None:
+                yield last
+            last, begun = Exchange(command, t.text, [attempt], binary=binary), True
         if command is not None and command.starts_measurement and (attempt.ok or policy.salvage):
             crc_pending[command.address] = command.returns_crc
-    return Rebuilt(exchanges, _measurements(exchanges, source, policy))
+    if last is not None:
+        yield last
 
 
 def _is_data(command: Command | None) -> bool:
@@ -135,12 +183,14 @@ def _complete(t: Transmission, reply: list[Event]) -> bool:
 
 
 def _measurements(
-    exchanges: list[Exchange], source: dict[int, Transmission], policy: Policy
+    exchanges: list[Exchange | None], source: dict[int, Transmission], policy: Policy
 ) -> list[Measurement]:
+    """The measurements the exchanges start, each with its data; a None among ``exchanges``
+    stands for other sensors' exchanges (:func:`rebuild_records`'s ``only``)."""
     found: list[Measurement] = []
     for i, ex in enumerate(exchanges):
-        command = ex.command
-        if command is None or not command.starts_measurement:
+        command = ex.command if ex is not None else None
+        if ex is None or command is None or not command.starts_measurement:
             continue
         m = Measurement(command, ex)
         found.append(m)
@@ -157,7 +207,7 @@ def _measurements(
             m.service_request_end = text_end(m.waited_events, service_request(command.address))
         probed_past_empty = False
         for later in _following(exchanges[i + 1 :], m):
-            if not _collects(later, m) or m.value_count >= m.count:
+            if later is None or not _collects(later, m) or m.value_count >= m.count:
                 break
             m.data.append(later)
             if not (later.ok or (policy.salvage and later.answered)):
@@ -191,21 +241,25 @@ def _waited(m: Measurement, t: Transmission, policy: Policy) -> list[Event]:
     return [e for e in after if e.end <= deadline]
 
 
-def _following(later: list[Exchange], m: Measurement) -> Iterator[Exchange]:
+def _following(later: list[Exchange | None], m: Measurement) -> Iterator[Exchange | None]:
     """The exchanges that may carry ``m``'s data, in wire order. A concurrent measurement
     (C/CC/Cn/CCn/HA/HB) runs while the recorder talks to other sensors (R-4.4.7-05, R-5.3-01):
     that is what it is for, so only the exchanges to its own address follow it (the first
     that is not its next data command ends it, as a command to it aborts it, R-4.4.7.1-01).
     After an aM!-type measurement the recorder talks to no one else (R-4.4.5-06): the very
-    next exchange is its data or the end of it."""
+    next exchange is its data or the end of it (a None, other sensors' exchanges, ends it;
+    a concurrent one passes over it)."""
     concurrent = m.command.kind in CONCURRENT_KINDS
     # lazily: the caller stops at the first exchange that is not the next data command
-    return (x for x in later if not concurrent or x.text[:1] == m.command.address)
+    if not concurrent:
+        return iter(later)
+    return (x for x in later if x is not None and x.text[:1] == m.command.address)
 
 
-def _collects(ex: Exchange, m: Measurement) -> bool:
-    """``ex`` is the next data command of ``m``: same address, the next index."""
-    cmd = ex.command
+def _collects(ex: Exchange | None, m: Measurement) -> bool:
+    """``ex`` is the next data command of ``m``: same address, the next index (None, other
+    sensors' exchanges, never is)."""
+    cmd = ex.command if ex is not None else None
     want = Kind.BINARY_DATA if m.binary else Kind.DATA
     return (
         cmd is not None
@@ -215,4 +269,4 @@ def _collects(ex: Exchange, m: Measurement) -> bool:
     )
 
 
-__all__ = ["Rebuilt", "rebuild_records"]
+__all__ = ["Rebuilt", "rebuild_records", "rebuilt_exchanges"]
