@@ -33,6 +33,8 @@ COLLISION (two talkers), which the view takes for contention.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from conformance.conduct import run_once
@@ -236,3 +238,59 @@ def test_a_sensor_at_another_address_is_named_not_sent_to_its_reply_format():
     said = str(stop.value)
     assert "the device is at address '0'" in said and "--address 0" in said, said
     assert "reply format" not in said and "Check wiring" not in said, said
+
+
+@pytest.fixture
+def lost_after_address_change(monkeypatch):
+    """The simulated sensor as the twelfth round's PIC firmware (RxTx1200/SDI-12_slave,
+    docs/kit.md) behaves: ``aAb!`` moves it, its reply names a third address (the firmware
+    answers with the EEPROM's first slot, '0' to 'jA9!'), and from then on it answers nothing
+    anywhere (it takes only lowercase letters as addresses, so at '9' it is deaf). Its address
+    change is not declared (an exec: firmware with no declaration), so the tool tries it."""
+    from conformance.sensor.session import SensorSession
+
+    declared = SensorSession.feature
+    monkeypatch.setattr(
+        SensorSession,
+        "feature",
+        lambda self, name: None if name == "address_change" else declared(self, name),
+    )
+    usual = FaultSet.rewrite
+    moved = []
+
+    def rewrite(self, reply):
+        if moved:
+            return None
+        if reply.kind is ReplyKind.CHANGE_ADDRESS:
+            moved.append(reply.body)
+            return replace(reply, body="5")
+        return usual(self, reply)
+
+    monkeypatch.setattr(FaultSet, "rewrite", rewrite)
+
+
+#: a! answered, the address-change case, then a case that judges waking on a! silence.
+LOST_CASES = "test_acknowledge_active or test_change_address or test_ready_within_100ms_of_break"
+
+
+def test_r_4_4_4_01_fails_a_change_answered_with_a_third_address(lost_after_address_change):
+    """'0A9!' answered '5': neither the new address nor the unchanged old one (R-4.4.4-01
+    allows those two only). The tool took the reply for "not software-settable" and said N/A."""
+    found = _verdicts(run_once("sim://", keyword=LOST_CASES))
+    rule = found["R-4.4.4-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    detail = " ".join(f["detail"] for f in rule["findings"])
+    assert "'5'" in detail and "neither" in detail, detail
+
+
+def test_a_sensor_lost_after_an_address_change_stops_the_run(lost_after_address_change):
+    """A sensor that answered a! before the change, and at no address tried after it, is
+    lost: every later case would judge its silence (R-7.0-07 FAILed "no reply ... 90 ms after
+    the break" on the PIC firmware, which wakes in 8 ms). The run stops there, INCOMPLETE."""
+    data = run_once("sim://", keyword=LOST_CASES)
+    found = _verdicts(data)
+    assert found["R-7.0-07"]["verdict"] != "FAIL", found["R-7.0-07"]["findings"]
+    assert not data["run"]["complete"]
+    assert "lost" in data["run"]["stop_reason"] and "'0'" in data["run"]["stop_reason"], data[
+        "run"
+    ]["stop_reason"]
