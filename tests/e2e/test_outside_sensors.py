@@ -294,3 +294,33 @@ def test_a_sensor_lost_after_an_address_change_stops_the_run(lost_after_address_
     assert "lost" in data["run"]["stop_reason"] and "'0'" in data["run"]["stop_reason"], data[
         "run"
     ]["stop_reason"]
+
+
+@pytest.fixture
+def commands_end_in_cr_lf(monkeypatch):
+    """The golden recorder, every command written with CR LF after its '!' (a PC logger's
+    way: lories' Sdi12Connector writes f"{address}M!\\r\\n" through pyserial, twelfth round)."""
+    from conformance.tool_recorder import engine
+
+    encode = engine.encode_7e1
+    monkeypatch.setattr(
+        engine, "encode_7e1", lambda text: encode(text + "\r\n" if text.endswith("!") else text)
+    )
+
+
+#: the measurement flow's cases (its wait for data, what it logged)
+FLOW_CASES = "test_waiting_for_the_service_request or test_logged_values_are_the_values_sent"
+
+
+def test_a_command_with_cr_lf_after_its_bang_is_still_that_command(commands_end_in_cr_lf):
+    """A sensor answers at the '!', so '0M!<CR><LF>' started a measurement: the values logged
+    for it were "logged, the command never sent" (R-4.4-02) and its wait for data went
+    unjudged ("no wait for data was observed"). The CR LF itself stays R-4.4-04's FAIL."""
+    found = _verdicts(
+        run_once("sim", role="recorder", keyword=FLOW_CASES + " or test_command_text")
+    )
+    assert found["R-4.4-04"]["verdict"] == "FAIL"
+    assert found["R-4.4.5-04"]["verdict"] == "PASS", found["R-4.4.5-04"]["findings"]
+    logged = " ".join(f["detail"] for f in found["R-4.4-02"]["findings"])
+    assert "never sent" not in logged, logged
+    assert found["R-4.4-02"]["verdict"] == "PASS", found["R-4.4-02"]["findings"]
