@@ -324,3 +324,11 @@ def test_a_command_with_cr_lf_after_its_bang_is_still_that_command(commands_end_
     logged = " ".join(f["detail"] for f in found["R-4.4-02"]["findings"])
     assert "never sent" not in logged, logged
     assert found["R-4.4-02"]["verdict"] == "PASS", found["R-4.4-02"]["findings"]
+
+
+def test_retries_of_a_command_with_cr_lf_after_its_bang_are_judged(commands_end_in_cr_lf):
+    """The retry rules looked only at transmissions ending in '!': every retry of
+    '0M!<CR><LF>' went unseen, R-7.2-01 "nothing was observed" (lories' connector, which
+    never retries, was not FAILed for it)."""
+    found = _verdicts(run_once("sim", role="recorder", keyword="test_retries"))
+    assert found["R-7.2-01"]["verdict"] == "PASS", found["R-7.2-01"]["findings"]
