@@ -29,6 +29,14 @@ tool's own command was on the line (its "a0000" after an abort break) was judged
 reply begun 0 ms after the command, cut to '0' by the firmware's own echo check: R-4.2-03
 FAILed "reply '0' does not end with CR LF". The harness bus now marks such a character
 COLLISION (two talkers), which the view takes for contention.
+
+The twelfth: a PIC18 firmware (RxTx1200/SDI-12_slave) answered '0' to 'jA9!' and went deaf at
+'9' (it takes only lowercase letters as addresses): R-4.4.4-01 was N/A "not software-settable"
+and every later case judged the silence of a lost sensor; now the trial's third address FAILs
+R-4.4.4-01 and a sensor lost by an address change stops the run. A Python logger (lories'
+Sdi12Connector) ends each command with CR LF: the recorder view took '0M!<CR><LF>' for no
+command, its values as "logged, the command never sent" and its measurement flow and retries as
+unobserved; now the command is read up to its '!' (``Transmission.stem``).
 """
 
 from __future__ import annotations
