@@ -369,6 +369,8 @@ def pytest_runtest_call(item: pytest.Item):
     if not record.findings:
         _error(record, "case produced no finding (a check that cannot fail is a defect)")
         pytest.fail("no finding recorded", pytrace=False)
+    if isinstance(run.session, SensorSession) and run.session.lost:
+        run.cut_short(_lost(record, run.session.lost), EXIT_NO_DEVICE)
     if verdict in (Verdict.FAIL, Verdict.ERROR):
         lines = [
             f"{f.verdict} {f.requirement}: {f.detail}"
@@ -380,6 +382,17 @@ def pytest_runtest_call(item: pytest.Item):
         reasons = sorted({f.detail for f in record.findings if f.verdict is verdict})
         pytest.skip(f"{verdict}: {'; '.join(reasons)}")
     return result
+
+
+def _lost(record: CaseRecord, note: str) -> str:
+    """Why the run stops after a case that lost the sensor (:attr:`SensorSession.lost`):
+    this case's verdicts and the ones before it stand, no later case runs."""
+    case = record.nodeid.rsplit("::", 1)[-1]
+    return (
+        f"the sensor was lost in {case}: {note}; every later case would judge the silence "
+        "of an address it no longer answers, so the run stops here (the verdicts so far "
+        "stand; a declaration with address_change = false judges the rest without moving it)"
+    )
 
 
 def _transcript_length(run: ConformanceRun) -> int:

@@ -27,6 +27,17 @@ class ChangeOutcome:
     polls: list[Exchange] = field(default_factory=list)
 
 
+@dataclass
+class Trial:
+    """The one ``aAb!`` that found out whether an undeclared address is software-settable:
+    the exchange, the two addresses and what the restore after it said."""
+
+    request: Exchange
+    original: str
+    target: str
+    note: str
+
+
 class AddressChanger:
     def __init__(self, master: ToolRecorder, original: str) -> None:
         self.master = master

@@ -138,9 +138,8 @@ class _Explorer(RuleBasedStateMachine):
         changer = AddressChanger(self.sensor.master, self.address)
         changer.current = moved
         changer.tried.append(moved)
-        note = changer.restore()
+        note = self.sensor.restore(changer)
         self.record.exchanges += changer.exchanges
-        self.sensor.address_notes.append(note)
         self._note(f"taken as a change to address '{moved}' (decision A12); {note}")
 
     def _observe_framing(self, ex: Exchange) -> None:

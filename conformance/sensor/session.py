@@ -34,7 +34,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import TOOL, Event, EventKind, decode_7e1, escape
 from ..view.rebuilt_records import Rebuilt, rebuild_records
 from ..view.segments import read_view
-from .address_change import AddressChanger
+from .address_change import AddressChanger, Trial
 from .buffer_watch import WatchedToolRecorder
 
 R = TypeVar("R", Exchange, Measurement)
@@ -171,6 +171,10 @@ class SensorSession(Session):
         self.ident_exchange: Exchange | None = None
         self.assumptions: list[str] = []
         self.address_notes: list[str] = []  # what every address change left behind
+        #: why the sensor can no longer be reached (a restore that found it nowhere), or None
+        self.lost: str | None = None
+        #: the aAb! that found out whether an undeclared address is settable (None: not tried)
+        self.address_trial: Trial | None = None
         self._cache: dict[Any, Any] = {}
         self.view_disagreements = 0  # stimuli whose view record differed (see _as_seen)
         #: the measurement codes a family may be tried with (None: all; a profile's groups)
@@ -666,12 +670,27 @@ class SensorSession(Session):
             claims.append((address, DutClaim(ident, reply, ident.version if ident else None)))
         return claims
 
+    def restore(self, changer: AddressChanger) -> str:
+        """Put the sensor back (:meth:`AddressChanger.restore`) and note it. A sensor that
+        answered ``a!`` earlier in the run and now at none of the addresses tried is lost:
+        every later case would judge the silence of an address it no longer has (a PIC
+        firmware that took '9' answers only lowercase letters; R-7.0-07 FAILed "no reply 90
+        ms after the break" on it), so :attr:`lost` says why and the run stops."""
+        note = changer.restore()
+        self.address_notes.append(note)
+        if changer.restored is False and self.master.acknowledged and self.lost is None:
+            self.lost = note
+        return note
+
     def _discover_address_change(self) -> bool:
         changer = AddressChanger(self.master, self.address)
+        target = self.spare_address()
         try:
-            took = changer.change(self.spare_address()).took
+            outcome = changer.change(target)
         finally:
-            self.address_notes.append(changer.restore())
+            note = self.restore(changer)
+        took = outcome.took
+        self.address_trial = Trial(outcome.request, self.address, target, note)
         self.assumptions.append(
             "address change (aAb!) "
             + ("supported" if took else "not supported")
@@ -696,8 +715,7 @@ class SensorSession(Session):
                 if not changer.restored:
                     break
         finally:
-            note = changer.restore()
-            self.address_notes.append(note)
+            note = self.restore(changer)
         return Sweep(changer.exchanges, refused, note, unanswered)
 
     def try_invalid_address(self, bad: str) -> InvalidAddressAttempt:
@@ -714,7 +732,7 @@ class SensorSession(Session):
             # + answers-foreign-address, seed 4077, was left at '$': seven false FAILs)
             changer.unclear = changer.unclear or accepted
         finally:
-            self.address_notes.append(changer.restore())
+            self.restore(changer)
         return InvalidAddressAttempt(changer.exchanges, accepted, heard.listening)
 
     def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:

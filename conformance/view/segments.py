@@ -50,6 +50,7 @@ _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
 #: ``current.is_command`` as :func:`read_view` keeps it per character: a recorder's
 #: transmission holds characters only, so its text ends in ``!`` when its last one is ``!``
 _BANG = ord("!")
+_LINE_ENDS = (0x0D, 0x0A)  # CR, LF
 _START = attrgetter("start")  # events in time order
 _TEXT = attrgetter("text")
 
@@ -115,9 +116,22 @@ class Transmission:
         return self.chars[-1].end
 
     @property
+    def stem(self) -> str:
+        """The command as a sensor takes it: the text up to its ``!`` where only line ends
+        (CR, LF) follow (a PC logger that ends each command with CR LF, lories'
+        Sdi12Connector: a sensor answers at the ``!``, and its values were "logged, the
+        command never sent"), else the whole text. R-4.2-01 and R-4.4-04 judge ``text``."""
+        text = self.text
+        bang = text.find("!")
+        if 0 <= bang < len(text) - 1 and not text[bang + 1 :].strip("\r\n"):
+            return text[: bang + 1]
+        return text
+
+    @property
     def is_command(self) -> bool:
-        """Ends in ``!``: something a sensor may answer (anything else draws no reply)."""
-        return self.text.endswith("!")
+        """Ends in ``!`` (line ends after it aside): something a sensor may answer (anything
+        else draws no reply)."""
+        return self.stem.endswith("!")
 
     @property
     def command(self) -> Command | None:
@@ -127,14 +141,14 @@ class Transmission:
 
     def _parsed(self) -> Command | None:
         try:
-            return parse_command(self.text)
+            return parse_command(self.stem)
         except CommandError:
             return None
 
     @property
     def data_index(self) -> tuple[bool, int, str] | None:
         """``(binary, index, digits)`` of an ``aDn!``/``aDBn!``, leading zeros included."""
-        m = _DATA.match(self.text)
+        m = _DATA.match(self.stem)
         return (m[2] == "B", int(m[3]), m[3]) if m else None
 
     @property
@@ -527,7 +541,9 @@ def _cut(
                 is_command = e.wire & 0x7F == _BANG
             else:
                 current.chars.append(e)
-                is_command = e.wire & 0x7F == _BANG
+                # CR LF after the '!' keep it a command (Transmission.stem)
+                bits = e.wire & 0x7F
+                is_command = bits == _BANG or (is_command and bits in _LINE_ENDS)
         elif e.kind is EventKind.CHAR:
             last_heard = e
             if current is not None:

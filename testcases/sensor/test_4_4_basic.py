@@ -73,9 +73,11 @@ def test_change_address(sensor, case):
         "the original address is restored afterwards"
     )
     settable = sensor.address_change_supported()
+    wrong = not settable and _answered_a_third_address(sensor, case)
     if not case.requires(
         "supported",
         precondition.served(settable, "the sensor's address is not software-settable"),
+        only=("R-4.4.4-02", "R-4.4.4-03") if wrong else None,
     ):
         return
     original, target = sensor.address, sensor.spare_address()
@@ -102,8 +104,7 @@ def test_change_address(sensor, case):
                 )
                 changer.exchanges.extend(elsewhere.exchanges)
     finally:
-        note = changer.restore()
-        sensor.address_notes.append(note)
+        note = sensor.restore(changer)
     case.evidence("address change and restore", changer.exchanges)
     body, _ = split_line(outcome.request.reply_text)
     problems = check_change_address_reply(body, original, target)
@@ -241,3 +242,22 @@ def test_change_address(sensor, case):
                 observed=2,  # the silent old address and the answered new one
             )
         )
+
+
+def _answered_a_third_address(sensor, case) -> bool:
+    """Whether the aAb! that found the address not settable drew a reply naming neither b nor
+    the unchanged address: R-4.4.4-01 allows only those two, so that reply FAILs it whatever
+    the sensor can do (a PIC firmware answered '0' to 'jA9!' from the wrong EEPROM slot, and
+    moved to '9': the tool said N/A "not software-settable")."""
+    trial = sensor.address_trial
+    if trial is None or not trial.request.answered:
+        return False
+    body, _ = split_line(trial.request.reply_text)
+    problems = check_change_address_reply(body, trial.original, trial.target)
+    if not problems or body == trial.original:
+        return False
+    case.evidence("the address-change trial", [trial.request])
+    reasons = "; ".join(v.message for v in problems)
+    detail = f"{reasons} (found trying whether it is settable; {trial.note})"
+    case.add(failed("R-4.4.4-01", detail, evidence=[judge.cited(trial.request)], observed=1))
+    return True

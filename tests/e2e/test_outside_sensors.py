@@ -29,9 +29,19 @@ tool's own command was on the line (its "a0000" after an abort break) was judged
 reply begun 0 ms after the command, cut to '0' by the firmware's own echo check: R-4.2-03
 FAILed "reply '0' does not end with CR LF". The harness bus now marks such a character
 COLLISION (two talkers), which the view takes for contention.
+
+The twelfth: a PIC18 firmware (RxTx1200/SDI-12_slave) answered '0' to 'jA9!' and went deaf at
+'9' (it takes only lowercase letters as addresses): R-4.4.4-01 was N/A "not software-settable"
+and every later case judged the silence of a lost sensor; now the trial's third address FAILs
+R-4.4.4-01 and a sensor lost by an address change stops the run. A Python logger (lories'
+Sdi12Connector) ends each command with CR LF: the recorder view took '0M!<CR><LF>' for no
+command, its values as "logged, the command never sent" and its measurement flow and retries as
+unobserved; now the command is read up to its '!' (``Transmission.stem``).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import pytest
 
@@ -236,3 +246,97 @@ def test_a_sensor_at_another_address_is_named_not_sent_to_its_reply_format():
     said = str(stop.value)
     assert "the device is at address '0'" in said and "--address 0" in said, said
     assert "reply format" not in said and "Check wiring" not in said, said
+
+
+@pytest.fixture
+def lost_after_address_change(monkeypatch):
+    """The simulated sensor as the twelfth round's PIC firmware (RxTx1200/SDI-12_slave,
+    docs/kit.md) behaves: ``aAb!`` moves it, its reply names a third address (the firmware
+    answers with the EEPROM's first slot, '0' to 'jA9!'), and from then on it answers nothing
+    anywhere (it takes only lowercase letters as addresses, so at '9' it is deaf). Its address
+    change is not declared (an exec: firmware with no declaration), so the tool tries it."""
+    from conformance.sensor.session import SensorSession
+
+    declared = SensorSession.feature
+    monkeypatch.setattr(
+        SensorSession,
+        "feature",
+        lambda self, name: None if name == "address_change" else declared(self, name),
+    )
+    usual = FaultSet.rewrite
+    moved = []
+
+    def rewrite(self, reply):
+        if moved:
+            return None
+        if reply.kind is ReplyKind.CHANGE_ADDRESS:
+            moved.append(reply.body)
+            return replace(reply, body="5")
+        return usual(self, reply)
+
+    monkeypatch.setattr(FaultSet, "rewrite", rewrite)
+
+
+#: a! answered, the address-change case, then a case that judges waking on a! silence.
+LOST_CASES = "test_acknowledge_active or test_change_address or test_ready_within_100ms_of_break"
+
+
+def test_r_4_4_4_01_fails_a_change_answered_with_a_third_address(lost_after_address_change):
+    """'0A9!' answered '5': neither the new address nor the unchanged old one (R-4.4.4-01
+    allows those two only). The tool took the reply for "not software-settable" and said N/A."""
+    found = _verdicts(run_once("sim://", keyword=LOST_CASES))
+    rule = found["R-4.4.4-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    detail = " ".join(f["detail"] for f in rule["findings"])
+    assert "'5'" in detail and "neither" in detail, detail
+
+
+def test_a_sensor_lost_after_an_address_change_stops_the_run(lost_after_address_change):
+    """A sensor that answered a! before the change, and at no address tried after it, is
+    lost: every later case would judge its silence (R-7.0-07 FAILed "no reply ... 90 ms after
+    the break" on the PIC firmware, which wakes in 8 ms). The run stops there, INCOMPLETE."""
+    data = run_once("sim://", keyword=LOST_CASES)
+    found = _verdicts(data)
+    assert found["R-7.0-07"]["verdict"] != "FAIL", found["R-7.0-07"]["findings"]
+    assert not data["run"]["complete"]
+    assert "lost" in data["run"]["stop_reason"] and "'0'" in data["run"]["stop_reason"], data[
+        "run"
+    ]["stop_reason"]
+
+
+@pytest.fixture
+def commands_end_in_cr_lf(monkeypatch):
+    """The golden recorder, every command written with CR LF after its '!' (a PC logger's
+    way: lories' Sdi12Connector writes f"{address}M!\\r\\n" through pyserial, twelfth round)."""
+    from conformance.tool_recorder import engine
+
+    encode = engine.encode_7e1
+    monkeypatch.setattr(
+        engine, "encode_7e1", lambda text: encode(text + "\r\n" if text.endswith("!") else text)
+    )
+
+
+#: the measurement flow's cases (its wait for data, what it logged)
+FLOW_CASES = "test_waiting_for_the_service_request or test_logged_values_are_the_values_sent"
+
+
+def test_a_command_with_cr_lf_after_its_bang_is_still_that_command(commands_end_in_cr_lf):
+    """A sensor answers at the '!', so '0M!<CR><LF>' started a measurement: the values logged
+    for it were "logged, the command never sent" (R-4.4-02) and its wait for data went
+    unjudged ("no wait for data was observed"). The CR LF itself stays R-4.4-04's FAIL."""
+    found = _verdicts(
+        run_once("sim", role="recorder", keyword=FLOW_CASES + " or test_command_text")
+    )
+    assert found["R-4.4-04"]["verdict"] == "FAIL"
+    assert found["R-4.4.5-04"]["verdict"] == "PASS", found["R-4.4.5-04"]["findings"]
+    logged = " ".join(f["detail"] for f in found["R-4.4-02"]["findings"])
+    assert "never sent" not in logged, logged
+    assert found["R-4.4-02"]["verdict"] == "PASS", found["R-4.4-02"]["findings"]
+
+
+def test_retries_of_a_command_with_cr_lf_after_its_bang_are_judged(commands_end_in_cr_lf):
+    """The retry rules looked only at transmissions ending in '!': every retry of
+    '0M!<CR><LF>' went unseen, R-7.2-01 "nothing was observed" (lories' connector, which
+    never retries, was not FAILed for it)."""
+    found = _verdicts(run_once("sim", role="recorder", keyword="test_retries"))
+    assert found["R-7.2-01"]["verdict"] == "PASS", found["R-7.2-01"]["findings"]

@@ -84,7 +84,7 @@ def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
         )
     )
     letters = sorted(a for a in polled if a.isalpha())
-    commands = [s for s in line.transmissions if s.text.endswith("!")]  # R-4.4-04 judges the rest
+    commands = [s for s in line.transmissions if s.is_command]  # R-4.4-04 judges the rest
     foreign = sorted({s.address for s in commands if s.address not in ADDRESS_CHARS} - {"?"})
     if foreign:  # a MAY rule: the Finding caps this at WARN
         shown = ", ".join(f"'{escape(a)}'" for a in foreign)

@@ -158,16 +158,16 @@ def _sent_per_command(
         if m.start.part != part:
             continue
         unread = m.unread_indices()
-        found[m.start.text] = None if unread else [Sent(t, d) for t, d in m.sent_values()]
+        found[m.start.stem] = None if unread else [Sent(t, d) for t, d in m.sent_values()]
     crc = crc_context(line)
     for i, s in enumerate(line.transmissions):
         cmd = s.command
         if s.part != part or cmd is None or cmd.kind is not Kind.CONTINUOUS:
             continue
         if reply_problem(s, crc[i], uncertainty) is None:
-            found[s.text] = [Sent(v) for v in data_values(s, cmd)]
+            found[s.stem] = [Sent(v) for v in data_values(s, cmd)]
         else:
-            found.setdefault(s.text, None)
+            found.setdefault(s.stem, None)
     return found
 
 
@@ -180,13 +180,13 @@ def _invalid_only(taken: Sequence[ObservedMeasurement], part: int) -> dict[str, 
     for m in taken:
         if m.start.part != part:
             continue
-        found.pop(m.start.text, None)
+        found.pop(m.start.stem, None)
         unread = set(m.unread_indices())
         problems = [
             p for s, p in m.data if p is not None and (d := s.data_index) and d[1] in unread
         ]
         if unread and not any(p.reason is Reason.CRC_WRONG for p in problems):
-            found[m.start.text] = [Sent(t, d) for t, d in m.sent_values()]
+            found[m.start.stem] = [Sent(t, d) for t, d in m.sent_values()]
     return found
 
 
@@ -212,7 +212,7 @@ def judge_logged_values(
     tally.unobservable(HIGH_VOLUME, "no aHA!/aHB! measurement with its values on the wire")
     unreadable: list[Finding] = []
     taken = observed_measurements(line, uncertainty)
-    sent_texts = {(s.part, s.text) for s in line.transmissions}
+    sent_texts = {(s.part, s.stem) for s in line.transmissions}
     for part, report in enumerate(reports):
         sent = _sent_per_command(line, taken, part, uncertainty)
         if report.problem is not None:

@@ -103,21 +103,21 @@ def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
     crc = crc_context(line)
     out: list[RetryGroup] = []
     for i, s in enumerate(line.transmissions):
-        if not s.text.endswith("!"):
+        if not s.is_command:  # CR LF after the '!' aside (Transmission.stem)
             continue  # no command, so no reply to retry for; R-4.4-04 judges its text
         attempt = Try(s, reply_problem(s, crc[i], uncertainty))
         last = out[-1].attempts[-1] if out else None
         if (
             last is not None
             and last.sent.part == s.part
-            and last.sent.text == s.text
+            and last.sent.stem == s.stem
             and (last.problem is not None)
         ):
             before = line.previous_activity(s)
             attempt.quiet = s.first_char - (last.sent.end if before is None else before)
             out[-1].attempts.append(attempt)
         else:
-            out.append(RetryGroup(s.text, [attempt]))
+            out.append(RetryGroup(s.stem, [attempt]))
     return out
 
 
