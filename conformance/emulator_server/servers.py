@@ -11,7 +11,6 @@ break that ended when it was read.
 
 from __future__ import annotations
 
-import contextlib
 import fcntl
 import itertools
 import socket
@@ -115,9 +114,15 @@ class TcpEmulatorServer:
         self.log = log
         self.listener = socket.create_server((host, port))
         self.listener.settimeout(RECV_POLL)
+        # from now on: the kernel stamps a packet as it is received, and only if asked by
+        # then (a connection's first bytes may come before its reader starts)
+        ArrivalReader.ask_for_stamps(self.listener)
         self.address = self.listener.getsockname()[:2]
         self.stopped = threading.Event()
         self.connections = 0
+        # nothing a recorder sends can have arrived before the server listened: the floor of
+        # a connection's first arrival (:class:`ArrivalReader`), however late it was accepted
+        self.opened = line.now()
 
     @property
     def url(self) -> str:
@@ -159,7 +164,7 @@ class TcpEmulatorServer:
             self.line.set_sender(lambda data: conn.write(b"".join(manager.escape(data))))
         else:
             self.line.set_sender(conn.write)
-        reader = ArrivalReader(sock, self.line.now)
+        reader = ArrivalReader(sock, self.line.now, self.opened)
         try:
             while not self.stopped.is_set():
                 try:
@@ -246,18 +251,27 @@ class ArrivalReader:
     45: a late read made a 13 ms break look 6 ms long, and the tap heard '@'); bytes of one
     stamp (one packet, or packets the kernel merged while nobody read) are one group. Without
     stamps a group is one ``recv`` stamped as it returned. Either way a group came after the
-    one before it: ``since`` is that group's ``at`` (the first: when the connection opened).
+    one before it: ``since`` is that group's ``at`` (the first: ``opened``, when the server
+    began to listen; not when this reader started, which may be late too).
     """
 
-    def __init__(self, sock: socket.socket, clock: Callable[[], float]) -> None:
+    def __init__(self, sock: socket.socket, clock: Callable[[], float], opened: float) -> None:
         self.sock = sock
         self.clock = clock
-        self.since = clock()
-        self.stamped = False
-        if sys.platform.startswith("linux") and STAMP_SPACE:
-            with contextlib.suppress(OSError):
-                sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
-                self.stamped = True
+        self.since = opened
+        self.stamped = self.ask_for_stamps(sock)
+
+    @staticmethod
+    def ask_for_stamps(sock: socket.socket) -> bool:
+        """Have the kernel stamp what ``sock`` (or, a listener, what its connections)
+        receive; whether it will."""
+        if not (sys.platform.startswith("linux") and STAMP_SPACE):
+            return False
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+        except OSError:
+            return False
+        return True
 
     def read(self) -> list[tuple[bytes, float, float]] | None:
         """The next groups (blocks up to the socket's timeout: TimeoutError); None: closed."""

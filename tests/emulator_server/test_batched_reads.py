@@ -11,12 +11,16 @@ any machine, loaded or not): the marking is unknowable, and the verdict must say
 from __future__ import annotations
 
 import socket
+import threading
 import time
 
+import pytest
 from serial import rfc2217
 
+from conformance.emulator_server.servers import TcpEmulatorServer
 from conformance.judges.recorder.breaks import judge_breaks
 from conformance.protocol.timing import CHAR_TIME
+from conformance.recorder import served_line
 from conformance.recorder.served_line import ServedLine, ServeSpec
 from conformance.transcript import EventKind, to_wire_7e1
 from conformance.verdicts import Verdict
@@ -98,3 +102,45 @@ def test_r_7_0_02_break_on_and_off_in_one_send_is_not_a_0_ms_break():
     assert brk.duration > CHAR_TIME, brk  # not a 0 ms break for the played sensors
     found = verdicts(events)
     assert found["R-7.0-02"].verdict is Verdict.INCONCLUSIVE, found["R-7.0-02"]
+
+
+class _LateReader(TcpEmulatorServer):
+    """A server whose reader thread first gets the CPU ``LATE`` s after the recorder's first
+    send, as a loaded host's may: what it reads then arrived long before."""
+
+    sent = threading.Event()
+
+    def _serve_connection(self, sock: socket.socket) -> None:
+        self.sent.wait(1.0)
+        time.sleep(LATE)
+        super()._serve_connection(sock)
+
+
+LATE = 0.025
+
+
+@pytest.mark.realtime  # real sends and sleeps 25-30 ms apart
+def test_r_7_0_02_a_break_on_read_late_keeps_its_arrival_time(monkeypatch):
+    """CI (stop 45, under load): the tap heard a 13 ms break as '@' (6 ms of spacing): the
+    line stamped the break-on when its late reader got to it, the break-off on time. The
+    kernel stamped the packet when it came; with that stamp the break is as long as sent."""
+    monkeypatch.setattr(served_line, "TcpEmulatorServer", _LateReader)
+    _LateReader.sent = threading.Event()
+    line = ServedLine(ServeSpec("127.0.0.1", 0))
+    try:
+        with socket.create_connection(line.server.address) as client:
+            client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            client.sendall(BREAK_ON)
+            _LateReader.sent.set()
+            time.sleep(0.030)  # the reader wakes 25 ms into the break
+            client.sendall(BREAK_OFF)
+            time.sleep(0.030)
+            client.sendall(command("0I!"))
+            time.sleep(0.1)
+        events = list(line.transcript.events)
+    finally:
+        line.close()
+    (brk,) = [e for e in events if e.kind is EventKind.BREAK]
+    assert brk.duration > 0.030 - U, brk  # not 0.030 - LATE
+    assert brk.duration_uncertainty is None, brk  # each read held one packet
+    assert verdicts(events)["R-7.0-02"].verdict is Verdict.PASS
