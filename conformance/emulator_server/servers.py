@@ -11,12 +11,10 @@ break that ended when it was read.
 
 from __future__ import annotations
 
-import fcntl
 import itertools
 import socket
 import struct
 import sys
-import termios
 import threading
 import time
 from collections.abc import Callable
@@ -283,9 +281,7 @@ class ArrivalReader:
         got = [self._stamped_byte()]
         if not got[0][0]:
             return None
-        waiting = bytearray(4)
-        fcntl.ioctl(self.sock.fileno(), termios.FIONREAD, waiting)
-        got += [self._stamped_byte() for _ in range(int.from_bytes(waiting, sys.byteorder))]
+        got += [self._stamped_byte() for _ in range(self._waiting())]
         now, now_ns = self.clock(), time.time_ns()
         groups: list[tuple[bytes, float, float]] = []
         for stamp, run in itertools.groupby(got, key=lambda b: b[1]):
@@ -298,6 +294,16 @@ class ArrivalReader:
         at = max(at, self.since)  # a clock step back must not reorder the recorder's events
         since, self.since = self.since, at
         return data, since, at
+
+    def _waiting(self) -> int:
+        """How many received bytes the socket holds (Linux, where stamps are asked for: a
+        read of one more would wait for it)."""
+        import fcntl  # POSIX only: the module must import where there are no stamps
+        import termios
+
+        waiting = bytearray(4)
+        fcntl.ioctl(self.sock.fileno(), termios.FIONREAD, waiting)
+        return int.from_bytes(waiting, sys.byteorder)
 
     def _stamped_byte(self) -> tuple[bytes, int | None]:
         """One byte and its packet's kernel stamp (wall-clock ns; None if none came)."""

@@ -1,7 +1,11 @@
-"""Where the served line lays events that reached it together (sans-I/O: no socket, no
-thread): :mod:`conformance.emulator_server.arrivals` and the UART chunks of serve_serial."""
+"""Where the served line lays events that reached it together (sans-I/O:
+:mod:`conformance.emulator_server.arrivals`, the UART chunks of serve_serial), and how its
+socket reads group them (:class:`~conformance.emulator_server.servers.ArrivalReader`)."""
 
 from __future__ import annotations
+
+import socket
+import time
 
 import pytest
 
@@ -13,7 +17,7 @@ from conformance.emulator_server.arrivals import (
     merged,
     placed,
 )
-from conformance.emulator_server.servers import serial_arrivals
+from conformance.emulator_server.servers import ArrivalReader, serial_arrivals
 from conformance.links.stamps import chunk_frames
 from conformance.protocol.timing import CHAR_TIME
 
@@ -100,3 +104,49 @@ def test_r_7_0_05_a_nul_read_with_the_command_leaves_the_sensor_marking_to_hear(
     free = at - 3 * CHAR_TIME - floor
     assert first - nul_end == pytest.approx(free / 2)
     assert doubt == pytest.approx(free)
+
+
+def _pair() -> tuple[socket.socket, socket.socket]:
+    listener = socket.create_server(("127.0.0.1", 0))
+    with listener:
+        client = socket.create_connection(listener.getsockname()[:2])
+        server, _ = listener.accept()
+    server.settimeout(0.5)
+    return client, server
+
+
+@pytest.mark.parametrize("stamped", [True, False])
+def test_each_read_group_comes_after_the_one_before(stamped):
+    """With kernel stamps (Linux) or without (a group per recv, stamped as it returned):
+    a group's room starts where the previous group's arrival was."""
+    client, server = _pair()
+    try:
+        reader = ArrivalReader(server, time.perf_counter, opened=time.perf_counter())
+        reader.stamped = reader.stamped and stamped
+        start = reader.since
+        client.sendall(b"ab")
+        ((data, since, at),) = reader.read()
+        assert (data, since) == (b"ab", start) and at >= since
+        client.sendall(b"cd")
+        ((data2, since2, at2),) = reader.read()
+        assert (data2, since2) == (b"cd", at) and at2 >= at
+        client.close()
+        assert reader.read() is None
+    finally:
+        server.close()
+
+
+def test_a_late_read_keeps_the_kernels_arrival_stamp():
+    client, server = _pair()
+    try:
+        reader = ArrivalReader(server, time.perf_counter, opened=time.perf_counter())
+        if not reader.stamped:
+            pytest.skip("no kernel receive stamps on this platform")
+        client.sendall(b"a")
+        sent = time.perf_counter()
+        time.sleep(0.030)  # the reader runs late
+        ((_data, _since, at),) = reader.read()
+        assert abs(at - sent) < 0.010, (at - sent) * 1e3
+    finally:
+        client.close()
+        server.close()
