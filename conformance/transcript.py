@@ -78,8 +78,10 @@ class Event:
     wire: int = 0
     text: str = ""
     uncertainty: float = 0.0
-    # of the length of a line state the UART timed (a NUL at another bit rate), when that is
-    # far better known than its position; None: the length is as uncertain as the stamps
+    # of the length of a line state, where it is known apart from the stamps: better (a NUL
+    # at another bit rate, timed by the UART) or worse (a NUL a monitor read: at least a
+    # frame; a served line's break whose end came in one read with other events, which may
+    # have ended anywhere in the room since the read before); None: as uncertain as the stamps
     duration_uncertainty: float | None = None
 
     @property

@@ -23,6 +23,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from math import inf
+from typing import Protocol, runtime_checkable
 
 from ..links.priority import EMULATED_LINE, realtime_priority
 from ..protocol.timing import CHAR_TIME
@@ -40,6 +41,16 @@ SPIN = 0.0008  # s: poll the last stretch before a due time instead of oversleep
 RT_SPIN = 0.0001  # s: the same with a real-time class, whose sleeps end within microseconds
 LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counted as late
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
+
+
+@runtime_checkable
+class WeighsBreaks(Protocol):
+    """A device that keeps what the line knows of a break's place (the played bus, whose
+    transcript the judges read): the line hands it breaks whose ends it could only place
+    within a room (events read together, :mod:`.arrivals`) through this, not ``on_break``."""
+
+    def on_break_within(self, start: float, end: float, room: float) -> None:
+        """``on_break(start, end)`` for a break whose ends may lie ``room`` s from there."""
 
 
 @dataclass(frozen=True)
@@ -87,6 +98,7 @@ class RealTimeLine:
         self._seq = itertools.count()
         self._tool_free = -inf  # end of the recorder's last frame on the emulated wire
         self._break_start: float | None = None
+        self._break_doubt = 0.0  # how far (s) the held break's start may be off (a batch)
         self._last_spacing = (inf, inf)  # (start, end) of the recorder's last break
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="sdi12-emulated-line", daemon=True)
@@ -150,18 +162,24 @@ class RealTimeLine:
                     self._push(self._delivery.time(end), lambda w=wire: self._emit(w, echo=True))
             self._cond.notify()
 
-    def break_on(self, at: float | None = None) -> None:
+    def break_on(self, at: float | None = None, doubt: float = 0.0) -> None:
+        """The recorder starts spacing at ``at``, which may be ``doubt`` s off (it arrived
+        together with other events: :mod:`.arrivals`)."""
         at = self.now() if at is None else at
         with self._cond:
             if self._break_start is None and self._rts:
                 self._break_start = start = max(at, self._tool_free)
+                self._break_doubt = doubt
                 if self.bench.echo:  # a receiver reads spacing at its stop-bit sample
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._echo_spacing(s))
                 if self._taps:
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._tap_held(s))
                     self._cond.notify()  # due before the break ends: wake the line for it
 
-    def break_off(self, at: float | None = None) -> None:
+    def break_off(self, at: float | None = None, doubt: float = 0.0) -> None:
+        """The recorder stops spacing at ``at`` (``doubt``: as :meth:`break_on`). A break with
+        an end in doubt goes to a device that weighs it (:class:`WeighsBreaks`) with that
+        room, so its length and the marking after it are judged with it."""
         at = self.now() if at is None else at
         with self._cond:
             start, self._break_start = self._break_start, None
@@ -170,7 +188,12 @@ class RealTimeLine:
             end = max(at, start)
             self._tool_free = end
             self._last_spacing = (start, end)
-            self._push(end, lambda s=start, e=end: self.device.on_break(s, e))
+            room = max(doubt, self._break_doubt)
+            device = self.device
+            if room > 0 and isinstance(device, WeighsBreaks):
+                self._push(end, lambda s=start, e=end: device.on_break_within(s, e, room))
+            else:
+                self._push(end, lambda s=start, e=end: device.on_break(s, e))
             self._cond.notify()
 
     def _echo_spacing(self, start: float) -> None:

@@ -11,15 +11,21 @@ break that ended when it was read.
 
 from __future__ import annotations
 
+import itertools
 import socket
+import struct
+import sys
 import threading
+import time
 from collections.abc import Callable
 
 import serial
 from serial import rfc2217
 
+from ..links.kernel_stamps import SO_TIMESTAMPNS, STAMP_SPACE
 from ..links.stamps import chunk_frames
 from ..protocol.timing import BREAK_MIN, CHAR_TIME
+from .arrivals import Arrival, ToolEvent, lay, step
 from .realtime import RealTimeLine
 
 RECV_POLL = 0.1  # s: socket and port reads time out this often so a stop is noticed
@@ -31,7 +37,9 @@ class VirtualPort:
 
     def __init__(self, line: RealTimeLine) -> None:
         self.line = line
-        self.arrival: float | None = None  # when the bytes being filtered reached the server
+        # what the recorder did, in order, while the PortManager filters one arrival: the
+        # server lays it on the line once the arrival's events are all known (arrivals.lay)
+        self.events: list[ToolEvent] = []
         self.baudrate = 1200
         self.bytesize = serial.EIGHTBITS
         self.parity = serial.PARITY_NONE
@@ -51,7 +59,7 @@ class VirtualPort:
     def rts(self, value: bool) -> None:
         """The recorder's transmit enable (an RS-485-style driver on an RTS line)."""
         self._rts = bool(value)
-        self.line.set_rts(self._rts)
+        self.events.append(ToolEvent("rts", on=self._rts))
 
     @property
     def break_condition(self) -> bool:
@@ -59,11 +67,9 @@ class VirtualPort:
 
     @break_condition.setter
     def break_condition(self, value: bool) -> None:
+        if bool(value) != self._break:
+            self.events.append(ToolEvent("break", on=bool(value)))
         self._break = bool(value)
-        if value:
-            self.line.break_on(self.arrival)
-        else:
-            self.line.break_off(self.arrival)
 
     def reset_input_buffer(self) -> None:
         """Nothing is buffered: bytes go on the emulated wire as they arrive."""
@@ -106,9 +112,15 @@ class TcpEmulatorServer:
         self.log = log
         self.listener = socket.create_server((host, port))
         self.listener.settimeout(RECV_POLL)
+        # from now on: the kernel stamps a packet as it is received, and only if asked by
+        # then (a connection's first bytes may come before its reader starts)
+        ArrivalReader.ask_for_stamps(self.listener)
         self.address = self.listener.getsockname()[:2]
         self.stopped = threading.Event()
         self.connections = 0
+        # nothing a recorder sends can have arrived before the server listened: the floor of
+        # a connection's first arrival (:class:`ArrivalReader`), however late it was accepted
+        self.opened = line.now()
 
     @property
     def url(self) -> str:
@@ -150,28 +162,31 @@ class TcpEmulatorServer:
             self.line.set_sender(lambda data: conn.write(b"".join(manager.escape(data))))
         else:
             self.line.set_sender(conn.write)
+        reader = ArrivalReader(sock, self.line.now, self.opened)
         try:
             while not self.stopped.is_set():
                 try:
-                    data = sock.recv(4096)
+                    groups = reader.read()
                 except TimeoutError:
                     continue
                 except OSError:
                     return
-                if not data:
+                if groups is None:
                     return
-                at = self.line.now()
-                if not self.rfc2217:
-                    self.line.tool_bytes(data, at)
-                    continue
-                port.arrival = at
-                # byte by byte: a SET_CONTROL inside the chunk toggles the break in between
-                for byte in manager.filter(data):
-                    self.line.tool_bytes(byte, at, port.baudrate)
+                for data, since, at in groups:
+                    if self.rfc2217:
+                        # byte by byte: a SET_CONTROL inside the data switches in between
+                        for byte in manager.filter(data):
+                            port.events.append(ToolEvent("bytes", byte, port.baudrate))
+                        events, port.events = tuple(port.events), []
+                    else:
+                        events = (ToolEvent("bytes", data),)
+                    lay(self.line, Arrival(events, since, at))
         finally:
             self.line.set_sender(_discard)
             if port.break_condition:
                 port.break_condition = False
+                self.line.break_off()
 
 
 def serve_serial(line: RealTimeLine, port: serial.SerialBase, stopped: threading.Event) -> None:
@@ -179,18 +194,122 @@ def serve_serial(line: RealTimeLine, port: serial.SerialBase, stopped: threading
 
     Bytes are stamped on arrival and laid back to back ending then (chunks read at once
     cannot show their gaps); a NUL is a break of at least 12 ms that ended as it was read.
+    A NUL read together with characters cannot show the marking between them either: the
+    chunk's events share the marking its frames leave free since the previous chunk
+    (:func:`serial_arrivals`), and the break carries that room as its doubt.
     """
-    floor = 0.0
+    floor = line.now()
     while not stopped.is_set():
         data = port.read(max(1, port.in_waiting))
         if not data:
             continue
         at = line.now()
         frames = chunk_frames(len(data), at, floor)
-        floor = frames[-1][1]
-        for byte, (start, end) in zip(data, frames, strict=True):
-            if byte == 0:
-                line.break_on(end - max(BREAK_MIN, CHAR_TIME))
-                line.break_off(end)
+        for run, (first, end), doubt in serial_arrivals(data, frames, floor):
+            if run == b"\x00":
+                line.break_on(end - max(BREAK_MIN, CHAR_TIME), doubt)
+                line.break_off(end, doubt)
             else:
-                line.tool_bytes(bytes([byte]), start)
+                line.tool_bytes(run, first)
+        floor = frames[-1][1]
+
+
+def serial_arrivals(
+    data: bytes, frames: list[tuple[float, float]], floor: float
+) -> list[tuple[bytes, tuple[float, float], float]]:
+    """A UART chunk as runs (a NUL alone, characters back to back), each with the (start,
+    end) of its frames and its doubt (s). Alone, a run keeps the frames
+    :func:`~conformance.links.stamps.chunk_frames` gave it; several share out the marking
+    the chunk's frames leave free after ``floor`` (the previous frame's end), evenly and in
+    order, the last still ending at the chunk's arrival (:func:`~.arrivals.step` apart), and
+    each may be off by all of it."""
+    runs: list[bytes] = []
+    for byte in data:
+        if runs and byte != 0 and runs[-1][:1] not in (b"", b"\x00"):
+            runs[-1] += bytes([byte])
+        else:
+            runs.append(bytes([byte]))
+    free = max(0.0, frames[0][0] - floor) if len(runs) > 1 else 0.0
+    gap = step(free, len(runs))
+    out = []
+    k = 0
+    for index, run in enumerate(runs):
+        shift = (len(runs) - 1 - index) * gap
+        out.append((run, (frames[k][0] - shift, frames[k + len(run) - 1][1] - shift), free))
+        k += len(run)
+    return out
+
+
+class ArrivalReader:
+    """Reads a recorder's socket as groups of bytes that arrived together: ``(data, since,
+    at)``, ``at`` the latest the bytes can have arrived, ``since`` the earliest.
+
+    On Linux every byte comes with the kernel's receive stamp of its packet
+    (``SO_TIMESTAMPNS``), taken as it arrived, however late this thread then ran (CI, stop
+    45: a late read made a 13 ms break look 6 ms long, and the tap heard '@'); bytes of one
+    stamp (one packet, or packets the kernel merged while nobody read) are one group. Without
+    stamps a group is one ``recv`` stamped as it returned. Either way a group came after the
+    one before it: ``since`` is that group's ``at`` (the first: ``opened``, when the server
+    began to listen; not when this reader started, which may be late too).
+    """
+
+    def __init__(self, sock: socket.socket, clock: Callable[[], float], opened: float) -> None:
+        self.sock = sock
+        self.clock = clock
+        self.since = opened
+        self.stamped = self.ask_for_stamps(sock)
+
+    @staticmethod
+    def ask_for_stamps(sock: socket.socket) -> bool:
+        """Have the kernel stamp what ``sock`` (or, a listener, what its connections)
+        receive; whether it will."""
+        if not (sys.platform.startswith("linux") and STAMP_SPACE):
+            return False
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+        except OSError:
+            return False
+        return True
+
+    def read(self) -> list[tuple[bytes, float, float]] | None:
+        """The next groups (blocks up to the socket's timeout: TimeoutError); None: closed."""
+        if not self.stamped:
+            data = self.sock.recv(4096)
+            if not data:
+                return None
+            return [self._group(data, self.clock())]
+        got = [self._stamped_byte()]
+        if not got[0][0]:
+            return None
+        got += [self._stamped_byte() for _ in range(self._waiting())]
+        now, now_ns = self.clock(), time.time_ns()
+        groups: list[tuple[bytes, float, float]] = []
+        for stamp, run in itertools.groupby(got, key=lambda b: b[1]):
+            data = b"".join(b for b, _ in run)
+            age = max(0.0, (now_ns - stamp) / 1e9) if stamp is not None else 0.0
+            groups.append(self._group(data, now - age))
+        return groups
+
+    def _group(self, data: bytes, at: float) -> tuple[bytes, float, float]:
+        at = max(at, self.since)  # a clock step back must not reorder the recorder's events
+        since, self.since = self.since, at
+        return data, since, at
+
+    def _waiting(self) -> int:
+        """How many received bytes the socket holds (Linux, where stamps are asked for: a
+        read of one more would wait for it)."""
+        import fcntl  # POSIX only: the module must import where there are no stamps
+        import termios
+
+        waiting = bytearray(4)
+        fcntl.ioctl(self.sock.fileno(), termios.FIONREAD, waiting)
+        return int.from_bytes(waiting, sys.byteorder)
+
+    def _stamped_byte(self) -> tuple[bytes, int | None]:
+        """One byte and its packet's kernel stamp (wall-clock ns; None if none came)."""
+        data, ancdata, _flags, _addr = self.sock.recvmsg(1, STAMP_SPACE)
+        for level, kind, payload in ancdata:
+            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
+                sec, nsec = struct.unpack("qq", payload[:16])
+                return data, sec * 1_000_000_000 + nsec
+        return data, None

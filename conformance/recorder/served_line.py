@@ -118,8 +118,24 @@ class PlayedBus:
 
     # -- BusDevice (the line's thread) --------------------------------------------------------
     def on_break(self, start: float, end: float) -> None:
+        self.on_break_within(start, end, 0.0)
+
+    def on_break_within(self, start: float, end: float, room: float) -> None:
+        """A recorder break; ``room`` > 0: the served line could place its ends only within
+        that many s (events read together), so where it ended, and so its length and the
+        marking after it, are known only to the stamps' uncertainty plus the room
+        (``duration_uncertainty``, which the break judges weigh)."""
+        doubt = self.uncertainty + room if room > 0 else None
+        event = Event(
+            EventKind.BREAK,
+            TOOL,
+            start,
+            end,
+            uncertainty=self.uncertainty,
+            duration_uncertainty=doubt,
+        )
         with self._lock:
-            self.add(Event(EventKind.BREAK, TOOL, start, end, uncertainty=self.uncertainty))
+            self.add(event)
             for device in self.devices:
                 device.on_break(start, end)
 

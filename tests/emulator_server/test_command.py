@@ -118,6 +118,47 @@ def test_make_device_takes_the_sim_url_parameters():
         make_device("1.4", "0", "no-such-fault")
 
 
+class _BatchingUart:
+    """A serial port as serve_serial reads it, whose driver hands over ``chunk`` in one read
+    ``after`` s (a USB UART's latency timer), and collects what the line writes."""
+
+    def __init__(self, chunk: bytes, after: float) -> None:
+        self.chunk, self.due = chunk, time.monotonic() + after
+        self.written = b""
+        self.in_waiting = 0
+
+    def read(self, _size: int) -> bytes:
+        time.sleep(0.005)
+        if self.chunk and time.monotonic() >= self.due:
+            chunk, self.chunk = self.chunk, b""
+            return chunk
+        return b""
+
+    def write(self, data: bytes) -> None:
+        self.written += data
+
+
+@pytest.mark.realtime  # a real-time line: a starved one answers late
+def test_r_7_0_05_serial_mode_a_nul_read_with_the_command_still_wakes_the_sensor():
+    """A USB UART's latency timer hands over the break's NUL and the command in one read:
+    laid back to back, the sensor heard 0 ms of marking after the break and refused the
+    command (R-7.0-05); that marking is unknown, so it gets a share of the chunk's room."""
+    port = _BatchingUart(b"\x00" + bytes(to_wire_7e1(ord(c)) for c in "0!"), after=0.080)
+    line = RealTimeLine(make_device("1.4", "0", ""), port.write, deliver_at_end=False).start()
+    stopped = threading.Event()
+    thread = threading.Thread(target=serve_serial, args=(line, port, stopped), daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + 1.0
+        while not port.written.endswith(b"\n") and time.monotonic() < deadline:
+            time.sleep(0.005)
+    finally:
+        stopped.set()
+        thread.join(timeout=1)
+        line.stop()
+    assert bytes(b & 0x7F for b in port.written) == b"0\r\n"
+
+
 @pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal")
 def test_serial_mode_takes_a_nul_as_the_break():
     """On a UART a break reads as NUL: the served sensor wakes on it and answers a!."""
