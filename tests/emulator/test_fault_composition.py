@@ -224,3 +224,16 @@ def test_a_semicolon_in_units_spares_records_another_fault_left_without_units():
     rig = Rig(faults=("metadata-missing-units", "metadata-semicolon-in-field"))
     assert rig.ask("0IM_001!").body == "0,TA;"
     assert rig.ask("0IM1_001!").body == "0,VB,V;x,supply;"
+
+
+def test_a_sensor_deaf_after_a_change_answers_no_address_while_deaf():
+    """R-4.4.4-02, R-4.4.4-03 (seed 4148: address-change-deaf-2s + address-change-not-
+    applied + answers-foreign-address): the sensor that ignores every command for 2 s after
+    aAb! still answered '9!' through the any-address path 0.08 s after '0A9!', while '0!', its
+    own address, went unheard: the tool took the answer at '9' for a listening sensor and
+    its silence at '0' for the move (R-4.4.4-01/-02/-03 PASS). Deaf is deaf at every address."""
+    rig = Rig(faults=("address-change-deaf-2s", "answers-foreign-address"))
+    assert rig.ask("0A9!").body == "9"
+    assert rig.ask("5!").text == ""  # inside the 2 s: nothing answered anywhere
+    rig.wait(2.0)
+    assert rig.ask("5!").body == "5"  # after them the any-address answer is back
