@@ -171,6 +171,15 @@ INTERACTIONS: tuple[Interaction, ...] = (
         adds=("R-7.0-09",),
     ),
     Interaction(
+        frozenset({"fast-baud", "identify-sends-service-request"}),
+        "the 7.69 ms replies shift the schedule so that the service request an identify"
+        " command wrongly owes falls due while the tool sends 0IC2!: the sensor sends it the"
+        " moment the command ends and the reply 25 ms after, so the wire holds '0<CR><LF>'"
+        " 0 ms after the command (R-7.0-09), the mechanism of partial-command-accepted's"
+        " (seed 4142 with crc-wrong-encoding: 0IC2! ends at 381.983 s, '0' starts then).",
+        adds=("R-7.0-09",),
+    ),
+    Interaction(
         frozenset({"late-service-request", "ttt-overstated"}),
         "every service request is held until 0.25 s past the announced ttt, so the 1.5 s"
         " readiness ttt-overstated gives is never on the wire: aM!'s request comes after its"
