@@ -237,3 +237,25 @@ def test_a_sensor_deaf_after_a_change_answers_no_address_while_deaf():
     assert rig.ask("5!").text == ""  # inside the 2 s: nothing answered anywhere
     rig.wait(2.0)
     assert rig.ask("5!").body == "5"  # after them the any-address answer is back
+
+
+@pytest.mark.parametrize(
+    "faults",
+    [
+        ("continuous-crc-missing", "crc-on-continuous"),
+        ("crc-on-continuous", "continuous-crc-missing"),
+        ("metadata-crc-missing", "metadata-crc-unasked"),
+        ("metadata-crc-unasked", "metadata-crc-missing"),
+    ],
+)
+def test_two_crc_toggles_each_edit_the_replies_their_command_asked_for(faults):
+    """R-4.4.12-02, R-4.4.12-03, R-6.2-02 (seed 4143: continuous-crc-missing + crc-on-
+    continuous): each toggle matched the reply as the other had left it, so aRC0!'s CRC was
+    dropped by one and put back by the other, and R-4.4.12-02 PASSed on 17 replies that all
+    carried one. Each fault edits the replies of the commands it is about: aRn!/aIM_001!
+    get a CRC nobody asked for, aRCn!/aIMC_001! lose theirs, in either order."""
+    rig = Rig(faults=faults)
+    plain, crc = ("0R0!", "0RC0!") if "crc-on-continuous" in faults else ("0IM_001!", "0IMC_001!")
+    bare = Rig()
+    assert rig.ask(plain).body == bare.ask(crc).body  # the CRC nobody asked for
+    assert rig.ask(crc).body == bare.ask(plain).body  # the asked CRC gone
