@@ -73,6 +73,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.8.3-03",),
     ),
     Interaction(
+        frozenset({"values-not-packed", "values-over-35"}),
+        "each D reply after M/V holds one value fewer than its 40-character limit would take;"
+        " with the reference sensor's 9- and 10-character values the one left out is the one"
+        " that crossed 35: aM2!'s replies carry 27, 27, 18 and 9 value characters, none over"
+        " 35, so R-4.4-05 holds on the wire (seed 4149).",
+        removes=("R-4.4-05",),
+    ),
+    Interaction(
         frozenset({"address-change-not-applied", "answers-old-address"}),
         "the address change never takes effect, so the address the sensor keeps answering is"
         " its own, not an old one beside the new: nothing answers a foreign address and"
