@@ -188,6 +188,15 @@ INTERACTIONS: tuple[Interaction, ...] = (
         adds=("R-7.0-09",),
     ),
     Interaction(
+        frozenset({"identify-sends-service-request", "measure-ttt-two-digits"}),
+        "the two-digit ttt replies shift the schedule so that the service request an identify"
+        " command wrongly owes falls due while the tool sends 0ICC!: the sensor sends '0' the"
+        " moment the command ends (153.150 s) and the reply 30 ms after, R-7.0-09 broken on"
+        " the wire as with fast-baud and partial-command-accepted (seed 4156 with"
+        " late-address-after-break).",
+        adds=("R-7.0-09",),
+    ),
+    Interaction(
         frozenset({"late-service-request", "ttt-overstated"}),
         "every service request is held until 0.25 s past the announced ttt, so the 1.5 s"
         " readiness ttt-overstated gives is never on the wire: aM!'s request comes after its"
@@ -208,6 +217,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " 0x0000 reads the same in either byte order: every packet on the wire is"
         " '0<00 00><00><0F 00>', well formed, and R-5.2-02 holds there (seed 4143).",
         removes=("R-5.2-02",),
+    ),
+    Interaction(
+        frozenset({"binary-no-empty-packet", "d0-empty"}),
+        "aHB! announces 33 values but the measurement holds none, so aDB0! is already past"
+        " the data, and binary-no-empty-packet answers that with nothing: an aDBn! inside the"
+        " announced count returns no packet at all, R-5.2-02 broken on the wire as with"
+        " binary-fewer-values (seed 4155 with metadata-missing-units).",
+        adds=("R-5.2-02",),
     ),
     Interaction(
         frozenset({"concurrent-service-request", "no-service-request"}),
