@@ -140,6 +140,15 @@ INTERACTIONS: tuple[Interaction, ...] = (
         ),
     ),
     Interaction(
+        frozenset({"crc-on-continuous", "early-address", "slow-wake"}),
+        "aR1!'s reply carries a CRC nobody asked for, so the tool retries it after a break;"
+        " the sensor wakes 110 ms after each break inside the next try and early-address"
+        " lets it take that try's tail ('1!') for a command to another sensor, after which it"
+        " sleeps: 0R2!..0R6! go unanswered through nine tries each (28.44-30.97 s), so the"
+        " rules that they be answered rightly FAIL (seed 4152).",
+        adds=("R-4.4-01", "R-4.4.8.1-01"),
+    ),
+    Interaction(
         frozenset({"abort-keeps-old-data", "buffer-cleared-after-read"}),
         "the measurement before the aborted one was read to its end, which emptied the buffer,"
         " so the old data the abort brings back are none: D0 after the abort is empty on the"
