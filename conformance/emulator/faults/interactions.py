@@ -236,6 +236,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         adds=("R-5.2-02",),
     ),
     Interaction(
+        frozenset({"high-volume-stops-at-d9", "high-volume-unsupported-silent"}),
+        "the sensor has no aHA! (silent to it), so no D10 after one is ever owed: the values"
+        " high-volume-stops-at-d9 withholds do not exist, and every measurement that did"
+        " start delivered its count, R-4.4.8-03 holding on the wire over 11 of them (seed"
+        " 4156 with extended-no-crlf).",
+        removes=("R-4.4.8-03", "R-5.1-02"),
+    ),
+    Interaction(
         frozenset({"concurrent-service-request", "no-service-request"}),
         "the sensor sends no service request at all (the emulator's switch silences the"
         " concurrent ones too), so none follows aC!, aCC!, aHA! or aHB! and the rules that"
