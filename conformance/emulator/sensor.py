@@ -328,6 +328,8 @@ class SensorEmulator:
             self._non_command(text, end, foreign)
             return  # decision A12: silence to what is not a command
         at = end + b.reply_delay
+        if start < self._quiet_until or self._deaf:
+            return  # deaf at every address: the any-address answer too (seed 4148)
         if foreign:
             if b.answer_foreign and cmd.kind in (Kind.ACKNOWLEDGE, Kind.IDENTIFY):
                 self._dispatch(cmd, at)
@@ -336,8 +338,6 @@ class SensorEmulator:
             return
         if cmd.address == "?" and cmd.kind is not Kind.QUERY_ADDRESS:
             return  # R-4.4.3-02: the wildcard is accepted only in ?!
-        if start < self._quiet_until or self._deaf:
-            return
         if cmd.kind is Kind.QUERY_ADDRESS and not b.answer_query:
             return
         if not self.profile.v14 and cmd.kind in V14_ONLY_KINDS:

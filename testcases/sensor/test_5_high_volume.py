@@ -21,10 +21,29 @@ FEATURE = {"HA": "high_volume_ascii", "HB": "high_volume_binary"}
 FORMAT_RULE = {"HA": "R-5.1-01", "HB": "R-5.2-01"}
 
 
+def _text_reply(ex) -> bool:
+    """Whether ``ex`` was answered with text that has no digit after the address ('aUNKN'):
+    neither the a000000 of a sensor without high volume nor a start reply, malformed or not."""
+    body, _ = split_line(ex.reply_text)
+    return ex.answered and bool(body[1:]) and not any(c.isdigit() for c in body[1:])
+
+
 def _unsupported(case, sensor, code):
-    """N/A only for a well-formed 'no values' reply; a malformed reply is judged as support.
-    A sensor declared to support the command must not answer 'no values'."""
+    """N/A only for a well-formed 'no values' reply; a malformed reply is judged as support,
+    but text with no digit ('aUNKN', seed 4167) leaves support undecided. A sensor declared
+    to support the command must not answer 'no values'."""
     m = sensor.measurement(code)
+    if _text_reply(m.start) and not sensor.feature(FEATURE[code]):
+        case.requires(
+            "supported",
+            precondition.shown_supported(
+                False,
+                f"a{code}! answered {xjudge.shown(m.start)}: text, no start reply, so"
+                " whether the sensor has high volume is undecided",
+                [xjudge.cited(m.start)],
+            ),
+        )
+        return True
     if shows_support(m):
         case.requires("supported", None)
         return False
@@ -62,7 +81,7 @@ def test_high_volume_optional(sensor, case):
     odd = []
     for ex in starts:
         body, _ = split_line(ex.reply_text)
-        if not ex.answered or (body[4:7] == "000" and body[1:] != "000000"):
+        if not ex.answered or (body[4:7] == "000" and body[1:] != "000000") or _text_reply(ex):
             odd.append(ex)
     if odd:
         case.add(

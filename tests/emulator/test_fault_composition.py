@@ -224,3 +224,38 @@ def test_a_semicolon_in_units_spares_records_another_fault_left_without_units():
     rig = Rig(faults=("metadata-missing-units", "metadata-semicolon-in-field"))
     assert rig.ask("0IM_001!").body == "0,TA;"
     assert rig.ask("0IM1_001!").body == "0,VB,V;x,supply;"
+
+
+def test_a_sensor_deaf_after_a_change_answers_no_address_while_deaf():
+    """R-4.4.4-02, R-4.4.4-03 (seed 4148: address-change-deaf-2s + address-change-not-
+    applied + answers-foreign-address): the sensor that ignores every command for 2 s after
+    aAb! still answered '9!' through the any-address path 0.08 s after '0A9!', while '0!', its
+    own address, went unheard: the tool took the answer at '9' for a listening sensor and
+    its silence at '0' for the move (R-4.4.4-01/-02/-03 PASS). Deaf is deaf at every address."""
+    rig = Rig(faults=("address-change-deaf-2s", "answers-foreign-address"))
+    assert rig.ask("0A9!").body == "9"
+    assert rig.ask("5!").text == ""  # inside the 2 s: nothing answered anywhere
+    rig.wait(2.0)
+    assert rig.ask("5!").body == "5"  # after them the any-address answer is back
+
+
+@pytest.mark.parametrize(
+    "faults",
+    [
+        ("continuous-crc-missing", "crc-on-continuous"),
+        ("crc-on-continuous", "continuous-crc-missing"),
+        ("metadata-crc-missing", "metadata-crc-unasked"),
+        ("metadata-crc-unasked", "metadata-crc-missing"),
+    ],
+)
+def test_two_crc_toggles_each_edit_the_replies_their_command_asked_for(faults):
+    """R-4.4.12-02, R-4.4.12-03, R-6.2-02 (seed 4143: continuous-crc-missing + crc-on-
+    continuous): each toggle matched the reply as the other had left it, so aRC0!'s CRC was
+    dropped by one and put back by the other, and R-4.4.12-02 PASSed on 17 replies that all
+    carried one. Each fault edits the replies of the commands it is about: aRn!/aIM_001!
+    get a CRC nobody asked for, aRCn!/aIMC_001! lose theirs, in either order."""
+    rig = Rig(faults=faults)
+    plain, crc = ("0R0!", "0RC0!") if "crc-on-continuous" in faults else ("0IM_001!", "0IMC_001!")
+    bare = Rig()
+    assert rig.ask(plain).body == bare.ask(crc).body  # the CRC nobody asked for
+    assert rig.ask(crc).body == bare.ask(plain).body  # the asked CRC gone

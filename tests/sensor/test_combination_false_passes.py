@@ -106,6 +106,7 @@ from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_4_addressing import test_address_range as range_case
 from testcases.sensor.test_5_high_volume import test_high_volume_ascii as ascii_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
+from testcases.sensor.test_5_high_volume import test_high_volume_optional as optional_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
 from testcases.sensor.test_7_timing import test_standby_after_100ms as standby_case
@@ -521,3 +522,27 @@ def test_standby_silence_probed_later_than_the_link_resolves(faults, widened_ms,
 )
 def test_a_crc_value_never_compared(faults, expected):
     assert _verdict(_session(faults), crc_value_case, "R-4.4.12-05") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "case_fn", "rule", "expected"),
+    [
+        ("high-volume-unsupported-silent,unknown-command-text", optional_case, "R-5.4-02",
+         Verdict.WARN),
+        ("high-volume-unsupported-silent,unknown-command-text", ascii_case, "R-5.1-01",
+         Verdict.INCONCLUSIVE),
+        ("high-volume-unsupported-silent,unknown-command-text", binary_case, "R-5.2-01",
+         Verdict.INCONCLUSIVE),
+        ("high-volume-unsupported-silent", optional_case, "R-5.4-02", Verdict.WARN),
+        ("high-volume-two-digit-count", ascii_case, "R-5.1-01", Verdict.FAIL),
+        ("unknown-command-text", optional_case, "R-5.4-02", Verdict.PASS),
+        ("unknown-command-text", ascii_case, "R-5.1-01", Verdict.PASS),
+        ("", optional_case, "R-5.4-02", Verdict.PASS),
+    ],
+)  # fmt: skip
+def test_text_to_a_high_volume_command(faults, case_fn, rule, expected):
+    """R-5.4-02 PASSed on 'aUNKN' to aHA!/aHB! from a sensor without high volume, while
+    R-5.1-01/R-5.2-01 FAILed the same text as a malformed start reply (seed 4167,
+    high-volume-unsupported-silent + unknown-command-text): text with no digit is neither
+    the a000000 the rule asks for nor a start reply, so support is undecided there."""
+    assert _verdict(_session(faults), case_fn, rule) is expected

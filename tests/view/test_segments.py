@@ -262,3 +262,26 @@ def test_a_reply_after_a_cut_collided_frame_is_kept_on_an_uncertain_link():
     (t,) = read_view(cmd + sr + bang + reply).transmissions
     assert "".join(chr(e.char7) for e in t.reply) == "0+1\r\n"
     assert [chr(e.char7) for e in t.contention] == ["0", "\r"]
+
+
+def _framing_after_foreign_identify(request: str) -> Verdict:
+    """R-4.3-01 over 0C!, then zI! answered for 'z', then the unsolicited ``request``."""
+    start = _chars(TOOL, "0C!", 0.0)
+    ack = _chars(DUT, "000320\r\n", start[-1].end + 10e-3)
+    ident = _chars(TOOL, "zI!", ack[-1].end + 0.2)
+    reply = _chars(DUT, "z14CONFORM EMU001100SN0001\r\n", ident[-1].end + 10e-3)
+    sr = _chars(DUT, request, reply[-1].end + 1.9)
+    segs = wire.segments(start + ack + ident + reply + sr)
+    return _verdicts(wire.judge_framing(segs, 0.0))["R-4.3-01"].verdict
+
+
+@pytest.mark.parametrize(
+    ("line", "expected"),
+    [("0\r\n", Verdict.PASS), ("z\r\n", Verdict.PASS), ("1\r\n", Verdict.FAIL)],
+)
+def test_a_service_request_after_a_reply_for_another_address(line, expected):
+    """R-4.3-01 (seed 4141, answers-foreign-address + concurrent-service-request): aC!'s
+    service request '0' came 1.9 s after the sensor answered zI! for 'z', and was judged
+    against 'z', the last reply's address: FAIL x3. A line sent unasked may carry the address
+    of the measurement it belongs to, the last one started; any other address still FAILs."""
+    assert _framing_after_foreign_identify(line) is expected

@@ -78,9 +78,21 @@ def with_spec(key: str, change: Callable[[MeasurementSpec], MeasurementSpec]) ->
 
 
 def toggle_crc(kind: ReplyKind, *, crc: bool, values: bool = True) -> Rewrite:
-    """Replies of ``kind`` that carry a CRC (``crc``) or not, with values or without (the
-    bare ``a[<CRC>]`` form), get the opposite: a CRC missing or one nobody asked for."""
+    """Replies of ``kind`` to commands that ask for a CRC (``crc``) or not, with values or
+    without (the bare ``a[<CRC>]`` form), get the opposite: a CRC missing or one nobody
+    asked for. Matched on the command, not on the reply's ``crc``: two toggles matched on
+    what the other left undid each other (continuous-crc-missing + crc-on-continuous put
+    aRC0!'s CRC back, seed 4143)."""
     return when(
-        lambda r: r.kind is kind and bool(r.crc) == crc and has_values(r) == values,
+        lambda r: r.kind is kind and _asked_crc(r) == crc and has_values(r) == values,
         set_to(crc=not crc),
     )
+
+
+def _asked_crc(reply: Reply) -> bool:
+    """Whether the command ``reply`` answers asked for a CRC: a metadata command by the
+    measurement it describes (aIMC_001!, aIHA_001!), others by their own C (its own ``crc``
+    where the reply answers no command)."""
+    if reply.kind is ReplyKind.METADATA and reply.source is not None:
+        return reply.source.returns_crc
+    return reply.command.crc if reply.command is not None else bool(reply.crc)

@@ -73,6 +73,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.8.3-03",),
     ),
     Interaction(
+        frozenset({"values-not-packed", "values-over-35"}),
+        "each D reply after M/V holds one value fewer than its 40-character limit would take;"
+        " with the reference sensor's 9- and 10-character values the one left out is the one"
+        " that crossed 35: aM2!'s replies carry 27, 27, 18 and 9 value characters, none over"
+        " 35, so R-4.4-05 holds on the wire (seed 4149).",
+        removes=("R-4.4-05",),
+    ),
+    Interaction(
         frozenset({"address-change-not-applied", "answers-old-address"}),
         "the address change never takes effect, so the address the sensor keeps answering is"
         " its own, not an old one beside the new: nothing answers a foreign address and"
@@ -132,6 +140,15 @@ INTERACTIONS: tuple[Interaction, ...] = (
         ),
     ),
     Interaction(
+        frozenset({"crc-on-continuous", "early-address", "slow-wake"}),
+        "aR1!'s reply carries a CRC nobody asked for, so the tool retries it after a break;"
+        " the sensor wakes 110 ms after each break inside the next try and early-address"
+        " lets it take that try's tail ('1!') for a command to another sensor, after which it"
+        " sleeps: 0R2!..0R6! go unanswered through nine tries each (28.44-30.97 s), so the"
+        " rules that they be answered rightly FAIL (seed 4152).",
+        adds=("R-4.4-01", "R-4.4.8.1-01"),
+    ),
+    Interaction(
         frozenset({"abort-keeps-old-data", "buffer-cleared-after-read"}),
         "the measurement before the aborted one was read to its end, which emptied the buffer,"
         " so the old data the abort brings back are none: D0 after the abort is empty on the"
@@ -144,6 +161,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " D0 that follows the abort empties such a buffer, so the old data the abort brings"
         " back are none: D0 after each abort is empty on the wire ('0', '0AP@') and the abort"
         " rules hold there (seed 4118 with missing-crlf).",
+        removes=("R-4.4.5.1-02", "R-4.4.7.1-01", "R-4.4.7.1-02", "R-5.3-01"),
+    ),
+    Interaction(
+        frozenset({"abort-keeps-old-data", "data-lost-after-standby"}),
+        "the measurement before the aborted one was read to its end and the sensor then went"
+        " to standby, which emptied the buffer, so the old data the abort brings back are"
+        " none: D0 after each abort is empty on the wire (seed 4148 with abort-sends-zero-"
+        "reply: 0D0! at 81.55 s read all 3 values, the abort's 0D0! -> '0<CR><LF>').",
         removes=("R-4.4.5.1-02", "R-4.4.7.1-01", "R-4.4.7.1-02", "R-5.3-01"),
     ),
     Interaction(
@@ -163,6 +188,24 @@ INTERACTIONS: tuple[Interaction, ...] = (
         adds=("R-7.0-09",),
     ),
     Interaction(
+        frozenset({"fast-baud", "identify-sends-service-request"}),
+        "the 7.69 ms replies shift the schedule so that the service request an identify"
+        " command wrongly owes falls due while the tool sends 0IC2!: the sensor sends it the"
+        " moment the command ends and the reply 25 ms after, so the wire holds '0<CR><LF>'"
+        " 0 ms after the command (R-7.0-09), the mechanism of partial-command-accepted's"
+        " (seed 4142 with crc-wrong-encoding: 0IC2! ends at 381.983 s, '0' starts then).",
+        adds=("R-7.0-09",),
+    ),
+    Interaction(
+        frozenset({"identify-sends-service-request", "measure-ttt-two-digits"}),
+        "the two-digit ttt replies shift the schedule so that the service request an identify"
+        " command wrongly owes falls due while the tool sends 0ICC!: the sensor sends '0' the"
+        " moment the command ends (153.150 s) and the reply 30 ms after, R-7.0-09 broken on"
+        " the wire as with fast-baud and partial-command-accepted (seed 4156 with"
+        " late-address-after-break).",
+        adds=("R-7.0-09",),
+    ),
+    Interaction(
         frozenset({"late-service-request", "ttt-overstated"}),
         "every service request is held until 0.25 s past the announced ttt, so the 1.5 s"
         " readiness ttt-overstated gives is never on the wire: aM!'s request comes after its"
@@ -176,6 +219,29 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " R-5.2-02 (every aDBn! returns a packet) is broken on the wire, and R-5.2-07 is left"
         " undecided, since a withheld packet and data that end early look alike (seed 4129).",
         adds=("R-5.2-02",),
+    ),
+    Interaction(
+        frozenset({"binary-size-big-endian", "d0-empty"}),
+        "the measurement holds no values, so aDB0! returns the empty packet, whose size"
+        " 0x0000 reads the same in either byte order: every packet on the wire is"
+        " '0<00 00><00><0F 00>', well formed, and R-5.2-02 holds there (seed 4143).",
+        removes=("R-5.2-02",),
+    ),
+    Interaction(
+        frozenset({"binary-no-empty-packet", "d0-empty"}),
+        "aHB! announces 33 values but the measurement holds none, so aDB0! is already past"
+        " the data, and binary-no-empty-packet answers that with nothing: an aDBn! inside the"
+        " announced count returns no packet at all, R-5.2-02 broken on the wire as with"
+        " binary-fewer-values (seed 4155 with metadata-missing-units).",
+        adds=("R-5.2-02",),
+    ),
+    Interaction(
+        frozenset({"high-volume-stops-at-d9", "high-volume-unsupported-silent"}),
+        "the sensor has no aHA! (silent to it), so no D10 after one is ever owed: the values"
+        " high-volume-stops-at-d9 withholds do not exist, and every measurement that did"
+        " start delivered its count, R-4.4.8-03 holding on the wire over 11 of them (seed"
+        " 4156 with extended-no-crlf).",
+        removes=("R-4.4.8-03", "R-5.1-02"),
     ),
     Interaction(
         frozenset({"concurrent-service-request", "no-service-request"}),
