@@ -304,6 +304,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (seed 4141) aC!'s service request '0', sent after the sensor answered zI! for 'z', was
     # judged against 'z' (R-4.3-01 FAIL x3)
     ("answers-foreign-address", "concurrent-service-request"),
+    # a sensor that ignores ?! at an address other than '0' was called absent (INCOMPLETE,
+    # seed 4158); discovery now asks each address with a! before it stops
+    ("factory-address-not-zero", "ignores-query"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

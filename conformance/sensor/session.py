@@ -247,6 +247,25 @@ class SensorSession(Session):
             )
             return False
         other = f"; ?! was answered '{escape(query.reply_text)}'" if query.answered else ""
+        if not query.answered:
+            found = self._answering_addresses()
+            if len(found) == 1 and self.requested_address is None:
+                self.address = found[0]
+                self.assumptions.append(
+                    f"no answer to ?! nor at '0'; of the {len(ADDRESS_CHARS)} addresses asked "
+                    f"with a!, only {found[0]!r} answered: the device is judged there"
+                )
+                return True
+            if found:
+                where = ", ".join(repr(a) for a in found)
+                pick = (
+                    f"judge the device there with --address {found[0]}"
+                    if len(found) == 1
+                    else "more than one device answers: pick one with --address"
+                )
+                raise NoDeviceAnswered(
+                    f"{unanswered}; ?! went unanswered, a! was answered at {where}): {pick}"
+                )
         if query.answered and len(body) == 1 and body in ADDRESS_CHARS:
             # The device is there, at another address: "check its reply format" (what it
             # said was a well-formed ?! reply) or the wiring would send the user astray.
@@ -260,6 +279,21 @@ class SensorSession(Session):
             f"{unanswered}{other})"
             + (talked or ". Check wiring and power, or try ?! with one sensor on the bus.")
         )
+
+    def _answering_addresses(self) -> list[str]:
+        """Every other address that answers ``a!`` once (no retries: about 80 ms an address on
+        a real bus, 5 s for all 61): a sensor that ignores ``?!`` at an address that is not
+        '0' is found instead of called absent (seed 4158, ignores-query with
+        factory-address-not-zero). Only for a device alone on the line (not ``shared``)."""
+        usual = self.master.policy
+        self.master.policy = usual.but(retries_per_sequence=0, sequences=1)
+        try:
+            return [
+                a for a in ADDRESS_CHARS
+                if a != self.address and self.master.acknowledge(a).answered
+            ]  # fmt: skip
+        finally:
+            self.master.policy = usual
 
     def _talked(self) -> str:
         """What the device sent although nothing it sent was a reply: a sensor whose replies

@@ -131,6 +131,28 @@ def test_a_sensor_that_answers_only_the_query_is_judged_on_what_it_does():
     assert any("?! was answered" in a for a in sensor.assumptions)
 
 
+def test_a_sensor_that_ignores_the_query_is_found_by_asking_each_address():
+    """Seed 4158: a sensor at '1' that ignores ?! was called absent ("no device answered at
+    address '0'"), the run INCOMPLETE with every rule undecided. Discovery now asks each
+    address with a! once; the one that answers is judged, and ?!'s silence FAILs its rule."""
+    data = run_once("sim://?faults=factory-address-not-zero,ignores-query")
+    assert data["run"]["complete"], data["run"].get("stop_reason")
+    assert verdict(data, "R-4.4.3-01") == "FAIL"
+    assert verdict(data, "R-4.3-02") == "FAIL"
+    assert data["dut"]["address"] == "1"
+    assert any("only '1' answered" in a for a in data["dut"]["assumptions"]), data["dut"]
+
+
+def test_an_address_asked_for_is_not_swapped_for_the_one_that_answers():
+    """With --address given, the tool does not judge another device: it stops and names
+    the address that answered a!."""
+    from conformance.sensor.session import NoDeviceAnswered
+
+    _, link, _ = sim_sensor(faults=("factory-address-not-zero", "ignores-query"))
+    with pytest.raises(NoDeviceAnswered, match="answered at '1'.*--address 1"):
+        SensorSession(link, address="7").discover()
+
+
 def test_total_silence_is_still_no_device():
     from conformance.sensor.session import NoDeviceAnswered
 
