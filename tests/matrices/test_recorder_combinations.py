@@ -1,0 +1,39 @@
+"""The recorder role's combination matrix: golden-recorder faults two and three at a time,
+each row checked against what its members declare alone and the declared interactions."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.matrices.recorder_combinations import CI_COMBINATIONS, combo_row, sample
+from conformance.recorder.faults import RECORDER_FAULTS, composition_conflict
+from conformance.recorder.interactions import RECORDER_INTERACTIONS
+
+
+@pytest.mark.parametrize("faults", CI_COMBINATIONS, ids=",".join)
+def test_recorder_combination_is_explained_by_its_members(faults):
+    row = combo_row(faults)
+    assert row.clean, row.explain()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "faults", [tuple(sorted(i.members)) for i in RECORDER_INTERACTIONS], ids=",".join
+)
+def test_each_declared_interaction_row_is_clean(faults):
+    """Every interaction's own row, as found (seeds 1, 20, 21)."""
+    row = combo_row(faults)
+    assert row.clean, row.explain()
+
+
+def test_interactions_name_faults_that_compose():
+    for i in RECORDER_INTERACTIONS:
+        assert i.members <= set(RECORDER_FAULTS), i.members
+        assert composition_conflict(tuple(sorted(i.members))) is None, i.members
+        declared = {r for f in i.members for r in RECORDER_FAULTS[f].violates}
+        assert set(i.removes) <= declared, i.members  # only a member's FAIL can be masked
+        assert not set(i.adds) & declared, i.members
+
+
+def test_the_recorder_sampler_is_seeded():
+    assert sample(5, 2, 3) == sample(5, 2, 3) != sample(5, 2, 4)
