@@ -5,7 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.matrices.recorder_combinations import CI_COMBINATIONS, combo_row, sample
+from conformance.matrices.recorder_combinations import (
+    CI_COMBINATIONS,
+    KNOWN_OPEN,
+    combo_row,
+    sample,
+)
 from conformance.recorder.faults import RECORDER_FAULTS, composition_conflict
 from conformance.recorder.interactions import RECORDER_INTERACTIONS
 
@@ -24,6 +29,14 @@ def test_each_declared_interaction_row_is_clean(faults):
     """Every interaction's own row, as found (seeds 1, 20, 21)."""
     row = combo_row(faults)
     assert row.clean, row.explain()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("faults", list(KNOWN_OPEN), ids=",".join)
+def test_known_open_rows_are_still_open(faults):
+    """Strict: a row that turns clean must leave KNOWN_OPEN (its class was fixed)."""
+    row = combo_row(faults)
+    assert not row.clean, f"{row.explain()}: fixed? remove it from KNOWN_OPEN"
 
 
 def test_interactions_name_faults_that_compose():
