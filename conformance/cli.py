@@ -465,8 +465,8 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT
 
 
-def cmd_matrix(argv: list[str], console: Console) -> int:
-    """Run the fault-detection matrix and print it: every emulator fault against the suite."""
+def _matrix_parser() -> argparse.ArgumentParser:
+    """``sdi12-conform matrix``'s options: single faults, or combinations of either role's."""
     p = argparse.ArgumentParser(
         prog="sdi12-conform matrix",
         description="run the sensor suite against every emulator fault and show which "
@@ -496,6 +496,12 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
         help="with --combinations: combine the emulator's faults (sensor, default) or the "
         "golden recorder's (recorder: sim://?recorder-faults=A,B against the recorder suite)",
     )
+    return p
+
+
+def cmd_matrix(argv: list[str], console: Console) -> int:
+    """Run the fault-detection matrix and print it: every emulator fault against the suite."""
+    p = _matrix_parser()
     args = p.parse_args(argv)
     if args.combinations is not None:
         return _combination_matrix(args, console)

@@ -50,3 +50,15 @@ def test_interactions_name_faults_that_compose():
 
 def test_the_recorder_sampler_is_seeded():
     assert sample(5, 2, 3) == sample(5, 2, 3) != sample(5, 2, 4)
+
+
+def test_the_cli_runs_recorder_combinations(capsys):
+    """``matrix --role recorder --combinations N``: the rows, then the totals (exit 0 clean)."""
+    from conformance.cli import main
+
+    combo = sample(1, 2, 5)[0]
+    assert main(["matrix", "--role", "recorder", "--combinations", "1", "--seed", "5"]) == 0
+    out = capsys.readouterr()
+    assert ",".join(combo) in out.err
+    assert "1/1 combinations clean" in out.out
+    assert main(["matrix", "--role", "recorder"]) == 4  # single recorder faults: pytest
