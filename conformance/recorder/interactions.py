@@ -103,6 +103,22 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
         " the wire (seed 22: 'a break before 0D0! after the service request').",
         removes=("R-7.1-01",),
     ),
+    Interaction(
+        frozenset({"ignores-service-request", "waits-forever-for-service-request"}),
+        "ignores-service-request never waits for a service request (aD0! after the whole"
+        " ttt), so waits-forever-for-service-request's endless wait for one never starts:"
+        " every job ends and its values are collected (seed 23).",
+        removes=("R-4.4.5-04", "R-4.4.5-06", "R-4.4.5-07", "R-4.4.8-05"),
+    ),
+    Interaction(
+        frozenset({"ignores-bad-crc", "ignores-service-request", "no-break-after-87ms"}),
+        "aD0! after the whole ttt without a break finds the sensor asleep, it and its"
+        " unbroken retries unheard; the break+aD0! that follows draws bad-crc-once's bad CRC,"
+        " which ignores-bad-crc takes as valid: the job ends after two sequences, the second"
+        " without a retry after an invalid reply (R-7.2-03, R-7.2-04: true on the wire,"
+        " seed 23).",
+        adds=("R-7.2-03", "R-7.2-04"),
+    ),
     # masked: with every try after a break unheard, no aM! starts on two sensors at once
     *(
         Interaction(
@@ -111,6 +127,16 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
             " two-sensors is ever answered: no measurement runs to be interleaved, and the"
             " service-request rules PASS on the other scenarios' measurements.",
             removes=("R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07"),
+        )
+        for never in ("no-retries", "retries-with-break")
+    ),
+    *(
+        Interaction(
+            frozenset({"ttt-8-bit", never, "short-marking"}),
+            f"{_UNHEARD} and {never} never retries without a break, so ttt-over-255's aM! is"
+            " never answered: no ttt of 260 s reaches the recorder to be cut to 8 bits"
+            " (seed 23).",
+            removes=("R-4.4.5-04", "R-4.4.5-07"),
         )
         for never in ("no-retries", "retries-with-break")
     ),
