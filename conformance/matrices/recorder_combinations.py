@@ -82,13 +82,4 @@ CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 
 #: Rows a measurement found unexplained and not yet fixed, each with its diagnosis: the test
 #: expects them to fail (strictly), so a fix of the class shows and shrinks this list.
-KNOWN_OPEN: dict[tuple[str, ...], str] = {
-    # (seed 22) reply-at-window-edge: each break+command drew a valid 15.0 ms reply that the
-    # 10 ms timeout ignored, and each ignored reply was followed by two unbroken resends
-    # 1.5 s later, unheard; three break+command sequences went out, yet R-7.2-04 WARNs
-    # "gave up after 2 break+command+retries sequence(s)": the retry grouping counts the
-    # sequences from the first unanswered resend, not the breaks the recorder sent. Probably
-    # a false WARN (every sequence drew a valid reply, so R-7.2-04's "still no valid reply"
-    # never held); not fixed in this round.
-    ("resends-after-timeout", "short-reply-timeout"): "R-7.2-04 WARN, retry grouping",
-}
+KNOWN_OPEN: dict[tuple[str, ...], str] = {}

@@ -119,6 +119,16 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
         " seed 23).",
         adds=("R-7.2-03", "R-7.2-04"),
     ),
+    Interaction(
+        frozenset({"resends-after-timeout", "short-reply-timeout"}),
+        "reply-at-window-edge: each break+aM! draws a valid 15.0 ms reply that the 10 ms"
+        " timeout ignores, and each is followed by two unbroken resends 1.5 s later, unheard"
+        " by the sleeping sensor; after the third break+aM! the last two resends go"
+        " unanswered and the recorder stops, its last command with no valid reply and no"
+        " break+command sequence after it (R-7.2-04, SHOULD: true on the wire, seeds 22-24;"
+        " alone, resends-after-timeout's last sequence draws a reply it takes).",
+        adds=("R-7.2-04",),
+    ),
     # masked: with every try after a break unheard, no aM! starts on two sensors at once
     *(
         Interaction(
