@@ -90,6 +90,11 @@ def judge_concurrent_storage(
             tally.fail("R-4.4.7-08", where, f"read none of the {m.count} values")
         if m.count <= MIN_CONCURRENT_STORE:
             continue
+        if have < m.count and _ended_on_problem(m):
+            # the last D command drew no valid reply: how many values the recorder would
+            # store is unseen (why it went unheard is another rule's, e.g. R-7.0-17)
+            tally.undecide("R-4.4.7-07", where, "collection ended on a D command unanswered")
+            continue
         tally.observe(where, ids=["R-4.4.7-07"])
         if have < MIN_CONCURRENT_STORE:
             tally.fail(
@@ -126,12 +131,15 @@ def judge_high_volume(
     answered leaves the reading back unseen (undecided, not a FAIL)."""
     tally = Tally(("R-5.1-04", "R-5.2-08", "R-5.4-01"))
     used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
+    unheard: set[Kind] = set()  # started, its collection ended on a D command unanswered
     for m in taken:
         if m.kind not in used:
             continue
         where = escape(m.start.text)
         have = len(m.values())
         used[m.kind] = used[m.kind] or have > 0
+        if not have and _ended_on_problem(m):
+            unheard.add(m.kind)
         rid = "R-5.1-04" if m.kind is Kind.HIGH_VOLUME_ASCII else "R-5.2-08"
         tally.observe(where, ids=[rid])
         zeros = [s for s, _ in m.data if (d := s.data_index) and d[2] != str(d[1])]
@@ -161,10 +169,13 @@ def judge_high_volume(
             tally.observe(kind.value.replace("a", "", 1), ids=["R-5.4-01"])
             if ok:
                 continue
-            if any(_kind_of(text) is kind for text in sent) and not any(
-                m.kind is kind for m in taken
+            if kind in unheard or (
+                any(_kind_of(text) is kind for text in sent)
+                and not any(m.kind is kind for m in taken)
             ):
-                tally.undecide("R-5.4-01", str(kind), f"{kind} sent, never validly answered")
+                tally.undecide(
+                    "R-5.4-01", str(kind), f"{kind} sent, its data never validly answered"
+                )
             else:
                 tally.fail("R-5.4-01", str(kind), f"{kind} was not issued or its data not read")
     else:

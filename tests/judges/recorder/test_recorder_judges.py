@@ -365,3 +365,24 @@ def test_commands_sent_but_never_answered_leave_the_capability_rules_undecided()
     none_sent = {s.text for s in nothing.transmissions}
     found = by_id(judge_high_volume(observed_measurements(nothing, 0.0), True, none_sent))
     assert found["R-5.4-01"].verdict is Verdict.FAIL
+
+
+def test_data_commands_never_answered_leave_storage_and_high_volume_undecided():
+    """Recorder combination matrix (no-break-after-87ms + no-retries, seed 26): aD0! and
+    aDB0! went out after ttt without a break, unheard by the sleeping sensor, and no retry
+    followed: R-4.4.7-07 WARNed "read 0 of 99 values" and R-5.4-01 FAILed "not issued or its
+    data not read" for R-7.0-17's deviation. A collection that ended on an unanswered data
+    command is undecided; one the recorder stopped itself still FAILs."""
+    unheard = Wire().brk().rec("0C9!").sensor("000299\r\n").idle(2100).rec("0D0!").idle(200)
+    unheard = unheard.brk().rec("0HB!").sensor("0002033\r\n").idle(2100).rec("0DB0!").idle(200)
+    unheard = unheard.brk().rec("0HA!").sensor("0002033\r\n").idle(2100).rec("0D0!").idle(200)
+    taken = observed_measurements(unheard.view(), 0.0)
+    r707 = by_id(judge_concurrent_storage(taken))["R-4.4.7-07"]
+    assert r707.verdict is Verdict.INCONCLUSIVE
+    assert by_id(judge_high_volume(taken, True))["R-5.4-01"].verdict is Verdict.INCONCLUSIVE
+    stopped = Wire().brk().rec("0C9!").sensor("000299\r\n").idle(2100)
+    stopped = stopped.brk().rec("0HB!").sensor("0002033\r\n").idle(2100)
+    stopped = stopped.brk().rec("0HA!").sensor("0002033\r\n").idle(2100)
+    taken = observed_measurements(stopped.view(), 0.0)
+    assert by_id(judge_concurrent_storage(taken))["R-4.4.7-07"].verdict is Verdict.WARN
+    assert by_id(judge_high_volume(taken, True))["R-5.4-01"].verdict is Verdict.FAIL
