@@ -500,9 +500,10 @@ class RewritingRecorder(GoldenRecorder):
 @dataclass
 class InterleavingRecorder(GoldenRecorder):
     """Asked to measure several sensors with aM!, starts them all before collecting any, as
-    if they were concurrent measurements."""
-
-    CHAINS = frozenset({"__call__"})
+    if they were concurrent measurements. Its ``__call__`` needs the whole job in one call, so
+    it does not pass on through a recorder that splits the job per command
+    (:class:`RewritingRecorder`): seed 27 drew crlf-wake-up + interleaves-measurements, and
+    the split lost the interleaving. No ``CHAINS``: such pairs are refused."""
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
         if request.task is Task.MEASURE and len({t[:1] for t in request.commands}) > 1:
