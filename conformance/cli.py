@@ -430,7 +430,8 @@ def cmd_faults(argv: list[str], console: Console) -> int:
         default="sensor",
         choices=("sensor", "recorder"),
         help="the simulated sensor's faults and firmware profiles (default), or the golden "
-        "recorder's faults (sim://?recorder-faults=NAME with --role recorder)",
+        "recorder's faults (sim://?recorder-faults=NAME[,NAME] with --role recorder; faults "
+        "that change one thing apart are refused)",
     )
     args = p.parse_args(argv)
     from rich.table import Table
@@ -464,8 +465,8 @@ def cmd_faults(argv: list[str], console: Console) -> int:
     return EXIT_COMPLIANT
 
 
-def cmd_matrix(argv: list[str], console: Console) -> int:
-    """Run the fault-detection matrix and print it: every emulator fault against the suite."""
+def _matrix_parser() -> argparse.ArgumentParser:
+    """``sdi12-conform matrix``'s options: single faults, or combinations of either role's."""
     p = argparse.ArgumentParser(
         prog="sdi12-conform matrix",
         description="run the sensor suite against every emulator fault and show which "
@@ -488,9 +489,28 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     )
     p.add_argument("--size", type=int, choices=(2, 3), default=2, help="faults per combination")
     p.add_argument("--seed", type=int, help="the sampler's seed (the same list for the same seed)")
+    p.add_argument(
+        "--role",
+        choices=("sensor", "recorder"),
+        default="sensor",
+        help="with --combinations: combine the emulator's faults (sensor, default) or the "
+        "golden recorder's (recorder: sim://?recorder-faults=A,B against the recorder suite)",
+    )
+    return p
+
+
+def cmd_matrix(argv: list[str], console: Console) -> int:
+    """Run the fault-detection matrix and print it: every emulator fault against the suite."""
+    p = _matrix_parser()
     args = p.parse_args(argv)
     if args.combinations is not None:
         return _combination_matrix(args, console)
+    if args.role == "recorder":
+        error(
+            "error: matrix --role recorder runs combinations (--combinations N); the single "
+            "recorder faults' matrix is tests/matrices/test_recorder_matrix.py (pytest -m matrix)"
+        )
+        return EXIT_USAGE
     from rich.table import Table
 
     from .matrices.sensor_matrix import MatrixRow, fault_matrix
@@ -542,19 +562,27 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
 
 def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
     """``matrix --combinations N``: per combination its unexplained rows, then totals."""
-    from .matrices.combinations import DEFAULT_SEED, ComboRow, combination_matrix, sample
+    from .matrices.combinations import ComboRow
 
+    if args.role == "recorder":
+        from .matrices import recorder_combinations as combinations
+    else:
+        from .matrices import combinations  # type: ignore[no-redef]
     if args.combinations < 1 or args.jobs < 1:
         error("error: --combinations and --jobs must be 1 or more")
         return EXIT_USAGE
-    combos = sample(args.combinations, args.size, DEFAULT_SEED if args.seed is None else args.seed)
+    seed = combinations.DEFAULT_SEED if args.seed is None else args.seed
+    combos = combinations.sample(args.combinations, args.size, seed)
     status = make_console(stderr=True)
 
     def progress(done: int, total: int, row: ComboRow) -> None:
         status.print(f"[{done}/{total}] {row.explain()}", markup=False, highlight=False)
 
-    status.print(f"running the sensor suite once per combination, {args.jobs} at a time...")
-    rows = combination_matrix(combos, args.jobs, progress)
+    status.print(
+        f"running the {args.role} suite once per combination (seed {seed}), "
+        f"{args.jobs} at a time..."
+    )
+    rows = combinations.combination_matrix(combos, args.jobs, progress)
     for r in rows:
         if r.clean:
             continue

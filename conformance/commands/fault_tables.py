@@ -11,7 +11,7 @@ def recorder_faults_table() -> Table:
 
     table = Table(
         title=f"{len(RECORDER_FAULTS)} recorder faults (use --role recorder with "
-        "sim://?recorder-faults=NAME; one at a time)"
+        "sim://?recorder-faults=NAME[,NAME]; they compose where independent)"
     )
     table.add_column("fault", no_wrap=True, min_width=max(len(n) for n in RECORDER_FAULTS))
     table.add_column("violates", overflow="fold")

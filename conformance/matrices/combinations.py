@@ -90,6 +90,19 @@ def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[st
             continue
         by_version.setdefault(version_of(name), []).append(name)
     pools = [names for _, names in sorted(by_version.items()) if len(names) >= size]
+    return draw(pools, count, size, seed, conflicts)
+
+
+def draw(
+    pools: list[list[str]],
+    count: int,
+    size: int,
+    seed: int,
+    refused: Callable[[tuple[str, ...]], object],
+) -> list[tuple[str, ...]]:
+    """``count`` distinct sorted combinations of ``size`` names from one pool each (a pool
+    drawn in proportion to its size), none that ``refused`` holds true; the same list for the
+    same seed. Shared by the sensor and the recorder role's samplers."""
     weights = [len(p) for p in pools]
     rng = random.Random(seed)
     chosen: dict[tuple[str, ...], None] = {}
@@ -98,7 +111,7 @@ def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[st
             break
         pool = rng.choices(pools, weights)[0]
         combo = tuple(sorted(rng.sample(pool, size)))
-        if not conflicts(combo):
+        if not refused(combo):
             chosen.setdefault(combo, None)
     return list(chosen)
 

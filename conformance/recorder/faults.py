@@ -20,10 +20,11 @@ from ..recorder_jobs import RecorderOutput, Request, Task
 from ..sim.bus import SimBus
 from ..tool_recorder import Measurement, Policy, ToolRecorder
 from ..tool_recorder.engine import _service_request_end
-from ..tool_recorder.hooks import Engine, Hooks
+from ..tool_recorder.hooks import Engine
 from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
+from .compose import Parts, compose, conflict
 from .golden import GoldenHooks, GoldenRecorder, GoldenToolRecorder, logged_values
 
 EARLY_RETRY = 12e-3  # s after the command: inside the 16.67 ms that R-7.2-02 forbids
@@ -102,11 +103,10 @@ class NoBreakAfterMarkingHooks(GoldenHooks):
 
 
 class NoBreakAfterMarkingToolRecorder(GoldenToolRecorder):
-    """The golden engine with :class:`NoBreakAfterMarkingHooks`, and no forced break in front
-    of D0 after ttt either."""
+    """The golden engine (with :class:`NoBreakAfterMarkingHooks`) with no forced break in
+    front of D0 after ttt either."""
 
-    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
-        super().__init__(link, policy, address=address, hooks=NoBreakAfterMarkingHooks())
+    CHAINS = frozenset({"collect"})
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
@@ -139,6 +139,8 @@ class EarlyDataHooks(GoldenHooks):
 
 class StopsAfterD0ToolRecorder(GoldenToolRecorder):
     """Reads D0 (or DB0) only, whatever the announced count."""
+
+    CHAINS = frozenset({"collect"})
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
@@ -186,6 +188,8 @@ class LeadingZerosToolRecorder(GoldenToolRecorder):
 class IgnoresCrcHooks(GoldenHooks):
     """Accepts a reply whose CRC does not match its text."""
 
+    CHAINS = frozenset({"attempt"})
+
     def attempt(
         self,
         master: Engine,
@@ -195,7 +199,7 @@ class IgnoresCrcHooks(GoldenHooks):
         proceed: Callable[[], Attempt],
     ) -> Attempt:
         """The engine's attempt, taken as valid when only its CRC was wrong."""
-        attempt = proceed()
+        attempt = super().attempt(master, wire, address, command, proceed)
         if "should be" in attempt.reason:  # the engine's words for a CRC mismatch
             attempt = replace(attempt, reason="ok")
         return attempt
@@ -205,6 +209,8 @@ class BreakEveryTryHooks(GoldenHooks):
     """Never retries: after an unanswered or invalid reply it waits out a poll timeout, then
     sends a break and the command again (what a widely used logger library was seen to do,
     issue 20). With ``retries_per_sequence=0`` every repeat is such a new sequence."""
+
+    CHAINS = frozenset({"attempt"})
 
     _failed: tuple[bytes, float] | None = None  # the wire text that failed, and when
 
@@ -219,7 +225,7 @@ class BreakEveryTryHooks(GoldenHooks):
         """The engine's attempt, sent again only a poll timeout after it failed."""
         if self._failed is not None and self._failed[0] == wire:
             master.link.wait_until(self._failed[1] + POLL_TIMEOUT)
-        attempt = proceed()
+        attempt = super().attempt(master, wire, address, command, proceed)
         self._failed = None if attempt.ok else (wire, master.link.now())
         return attempt
 
@@ -243,18 +249,18 @@ class ResendAfterTimeoutHooks(SkipsNextBreakHooks):
 
 
 class LateD0AfterServiceRequestToolRecorder(GoldenToolRecorder):
-    """After a service request waits 95 ms, then sends aD0! without a break."""
+    """After a service request waits 95 ms, then sends aD0! without a break (its hooks are
+    :class:`SkipsNextBreakHooks`, or built on them)."""
 
-    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
-        self.skips = SkipsNextBreakHooks()
-        super().__init__(link, policy, address=address, hooks=self.skips)
+    CHAINS = frozenset({"collect"})
+    hooks: SkipsNextBreakHooks
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
     ) -> Measurement:
         if m.service_request_end is not None and not m.data:
             self.link.wait_until(m.service_request_end + LATE_D0)
-            self.skips.skip_break = True
+            self.hooks.skip_break = True
         return super().collect(m, force_break=force_break, max_index=max_index)
 
 
@@ -293,11 +299,8 @@ class EightBitTttHooks(GoldenHooks):
 
 @dataclass
 class EightBitTttRecorder(GoldenRecorder):
-    """The golden recorder with ttt kept in 8 bits, for aM!-type and concurrent waits."""
-
-    master_factory: Callable[[Link, Policy], ToolRecorder] = field(
-        default=lambda link, policy: GoldenToolRecorder(link, policy, hooks=EightBitTttHooks())
-    )
+    """The golden recorder with ttt kept in 8 bits for concurrent waits (and, with
+    :class:`EightBitTttHooks`, for aM!-type ones)."""
 
     def _data_time(self, m: Measurement) -> float:
         assert m.reply_end is not None and m.ttt is not None
@@ -329,6 +332,8 @@ class SkipsTttZeroConcurrentRecorder(GoldenRecorder):
 class DropsAfterParityHooks(GoldenHooks):
     """Takes a reply cut at its first parity error as valid, noting that it did (``cut``)."""
 
+    CHAINS = frozenset({"attempt"})
+
     cut = False
 
     def attempt(
@@ -341,7 +346,7 @@ class DropsAfterParityHooks(GoldenHooks):
     ) -> Attempt:
         """The engine's attempt; one invalid for parity becomes its characters before the bad
         one, valid."""
-        attempt = proceed()
+        attempt = super().attempt(master, wire, address, command, proceed)
         bad = [i for i, e in enumerate(attempt.reply_events) if not e.parity_ok]
         if attempt.ok or not bad or "parity" not in attempt.reason:
             return attempt
@@ -352,32 +357,47 @@ class DropsAfterParityHooks(GoldenHooks):
 class DropsAfterParityToolRecorder(GoldenToolRecorder):
     """Stops reading a reply at a character with a parity error and takes what came before
     it as the whole reply, and the measurement as collected: no retry, and the values before
-    the bad character are what it logs (a logger library's read loop, issue 20)."""
+    the bad character are what it logs (a logger library's read loop, issue 20). Its hooks
+    are :class:`DropsAfterParityHooks`, or built on them."""
 
-    def __init__(self, link: Link, policy: Policy | None = None, *, address: str = "0") -> None:
-        self.parity = DropsAfterParityHooks()
-        super().__init__(link, policy, address=address, hooks=self.parity)
+    hooks: DropsAfterParityHooks
 
     def collect(
         self, m: Measurement, *, force_break: bool | None = None, max_index: int | None = None
     ) -> Measurement:
         """The golden collection one D command at a time, ending at a cut reply."""
-        self.parity.cut = False
+        self.hooks.cut = False
         while m.count is not None and m.value_count < m.count:
             n, have = len(m.data), m.value_count
             limit = n if max_index is None else min(n, max_index)
             super().collect(m, force_break=force_break, max_index=limit)
             force_break = False
-            if self.parity.cut or len(m.data) == n or not m.data[-1].ok or m.value_count == have:
+            if self.hooks.cut or len(m.data) == n or not m.data[-1].ok or m.value_count == have:
                 break
         return m
 
 
-class TalksOverToolRecorder(ToolRecorder):
+class EngineRetryHooks(GoldenHooks):
+    """The engine's own retry time, without the golden recorder's wait for a quiet line."""
+
+    def retry_time(
+        self,
+        master: Engine,
+        exchange: Exchange,
+        sequence: int,
+        per_sequence: int,
+        usual: Callable[[], float],
+    ) -> float:
+        """``usual()``: no drain of a reply that may still be coming."""
+        return usual()
+
+
+class TalksOverToolRecorder(GoldenToolRecorder):
     """The engine without any wait for a quiet line: neither the golden recorder's drain
     before a retry nor the engine's own listen before talk. It keeps only the turnaround
     after the last sensor character it has already seen, as the engine did before it
-    listened (a retry goes out while the rest of a paused reply is still arriving)."""
+    listened (a retry goes out while the rest of a paused reply is still arriving). Its
+    hooks are :class:`EngineRetryHooks`."""
 
     def clear_to_send(self, *, collide: bool = False) -> float:
         self.note_collisions()
@@ -419,6 +439,8 @@ class WrongBaudLink:
 class WrongBaudRecorder(GoldenRecorder):
     """The golden recorder sending at a bit rate 4% too high (frames of 8.0 ms)."""
 
+    CHAINS = frozenset({"__call__"})
+
     char_time: float = FAST_CHAR_TIME
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
@@ -429,6 +451,8 @@ class WrongBaudRecorder(GoldenRecorder):
 class LacksCommandsRecorder(GoldenRecorder):
     """A logger that does not implement some command kinds, or cannot reach some addresses:
     asked for such commands, it skips them."""
+
+    CHAINS = frozenset({"__call__"})
 
     lacks: frozenset[Kind] = frozenset()
     unreachable: str = ""  # addresses it cannot use (as the addressee or a new address)
@@ -476,7 +500,10 @@ class RewritingRecorder(GoldenRecorder):
 @dataclass
 class InterleavingRecorder(GoldenRecorder):
     """Asked to measure several sensors with aM!, starts them all before collecting any, as
-    if they were concurrent measurements."""
+    if they were concurrent measurements. Its ``__call__`` needs the whole job in one call, so
+    it does not pass on through a recorder that splits the job per command
+    (:class:`RewritingRecorder`): seed 27 drew crlf-wake-up + interleaves-measurements, and
+    the split lost the interleaving. No ``CHAINS``: such pairs are refused."""
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
         if request.task is Task.MEASURE and len({t[:1] for t in request.commands}) > 1:
@@ -504,6 +531,8 @@ class NoBreakTransparentRecorder(GoldenRecorder):
 class MislogsRecorder(GoldenRecorder):
     """Collects every value as the golden recorder does, then writes some down wrong:
     ``spoil(command, values)`` is what it logs for each measurement command."""
+
+    CHAINS = frozenset({"__call__"})
 
     spoil: Callable[[Command, list[str]], list[str]] = field(default=lambda c, v: v)
 
@@ -533,14 +562,21 @@ def _is_service_request(events: list, address: str) -> bool:
     return decode_7e1(events[-3:]) == service_request(address)
 
 
-def _with_master(cls: type[ToolRecorder]) -> Callable[[Link, Policy], ToolRecorder]:
-    return lambda link, policy: cls(link, policy)
+def _lacks(**knobs: object) -> Parts:
+    return Parts(recorder=LacksCommandsRecorder, knobs=knobs)
 
 
-def _with_hooks(cls: type[Hooks]) -> Callable[[Link, Policy], ToolRecorder]:
-    """The golden engine with a fault's hooks: a fresh ``cls`` per engine, since what a
-    stateful fault remembers belongs to one engine (a recorder may build several)."""
-    return lambda link, policy: GoldenToolRecorder(link, policy, hooks=cls())
+def _rewriting(**knobs: object) -> Parts:
+    return Parts(recorder=RewritingRecorder, knobs=knobs)
+
+
+def _mislogs(**knobs: object) -> Parts:
+    return Parts(recorder=MislogsRecorder, knobs=knobs)
+
+
+def _without_extended_address(text: str) -> str:
+    """``XSN!`` for ``0XSN!``: an extended command sent without its address."""
+    return text[1:] if text[1:2] == "X" else text
 
 
 @dataclass(frozen=True)
@@ -548,12 +584,15 @@ class RecorderFault:
     name: str
     description: str
     violates: tuple[str, ...]
-    make: Callable[[], GoldenRecorder] = field(compare=False)
+    #: where it departs from the golden recorder (:mod:`conformance.recorder.compose`)
+    parts: Parts = field(compare=False)
     #: collateral INCONCLUSIVEs the fault declares (see the sensor faults' field)
     inconclusive: tuple[str, ...] = ()
 
+    def make(self) -> GoldenRecorder:
+        """The golden recorder with this fault alone."""
+        return compose(((self.name, self.parts),))
 
-_GOLDEN = Policy.golden()
 
 _FAULTS = (
     RecorderFault(
@@ -562,7 +601,7 @@ _FAULTS = (
         "CRC or a garbled reply ends the job. With no retry at all, whether a retry waits for "
         "an invalid reply to end (R-7.2-06) cannot be seen.",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-04", "R-7.2-05", "R-4.4.12-07"),
-        lambda: GoldenRecorder(_GOLDEN.but(retries_per_sequence=0, sequences=1)),
+        Parts(policy={"retries_per_sequence": 0, "sequences": 1}),
         inconclusive=("R-7.2-06",),
     ),
     RecorderFault(
@@ -574,9 +613,7 @@ _FAULTS = (
         "on the wire whether it would repeat one (R-7.2-04, SHOULD) or wait for an invalid "
         "reply to end before a retry (R-7.2-06) cannot be seen.",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05"),
-        lambda: GoldenRecorder(
-            _GOLDEN.but(retries_per_sequence=0, sequences=3), _with_hooks(BreakEveryTryHooks)
-        ),
+        Parts(policy={"retries_per_sequence": 0, "sequences": 3}, hooks=BreakEveryTryHooks),
         inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
     RecorderFault(
@@ -586,7 +623,7 @@ _FAULTS = (
         "-05), no sequence with two retries (R-7.2-03), and a command after 87 ms of marking "
         "without a break (R-7.0-17).",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05", "R-7.0-17"),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(ResendAfterTimeoutHooks)),
+        Parts(hooks=ResendAfterTimeoutHooks),
         inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
     RecorderFault(
@@ -596,26 +633,26 @@ _FAULTS = (
         "reply-at-window-edge) that retry runs into the reply, and on the line its characters "
         "come apart (R-7.0-13): what R-7.2-02's 16.67 ms is there to prevent.",
         ("R-7.2-02", "R-7.0-13"),
-        lambda: GoldenRecorder(_GOLDEN.but(first_char_timeout=10e-3), _with_hooks(EarlyRetryHooks)),
+        Parts(policy={"first_char_timeout": 10e-3}, hooks=EarlyRetryHooks),
     ),
     RecorderFault(
         "retry-too-late",
         f"The first retry after no reply starts {LATE_RETRY * 1e3:.0f} ms after the command, "
         "without a break.",
         ("R-7.2-02", "R-7.0-17"),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(LateRetryHooks)),
+        Parts(hooks=LateRetryHooks),
     ),
     RecorderFault(
         "no-break-after-87ms",
         "Breaks only for a new address: aD0! after ttt goes out without a break.",
         ("R-7.0-17", "R-4.4.5-05"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(NoBreakAfterMarkingToolRecorder)),
+        Parts(hooks=NoBreakAfterMarkingHooks, master=NoBreakAfterMarkingToolRecorder),
     ),
     RecorderFault(
         "d0-before-ttt",
         "Without a service request, asks for data after half of ttt.",
         ("R-4.4.5-04", "R-4.4.5-07", "R-4.4.7-06"),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(EarlyDataHooks), ttt_fraction=0.5),
+        Parts(hooks=EarlyDataHooks, knobs={"ttt_fraction": 0.5}),
     ),
     RecorderFault(
         "ignores-service-request",
@@ -623,7 +660,7 @@ _FAULTS = (
         "standard gives no figure for how soon aD0! follows the request (and lets a recorder "
         "wait the whole ttt), so past the tool's 0.5 s this is a WARN (decision T1).",
         ("R-4.4.5-05",),
-        lambda: GoldenRecorder(_GOLDEN, wait="ttt"),
+        Parts(knobs={"wait": "ttt"}),
     ),
     RecorderFault(
         "waits-forever-for-service-request",
@@ -633,32 +670,32 @@ _FAULTS = (
         "transmission still PASS on what it sent, while the rules about that job itself "
         "cannot PASS on a job that never ended.",
         ("R-4.4.5-05", "R-4.4.8-05"),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(WaitsForeverHooks)),
+        Parts(hooks=WaitsForeverHooks),
         inconclusive=("R-4.4.5-04", "R-4.4.5-06", "R-4.4.5-07"),
     ),
     RecorderFault(
         "stops-after-d0",
         "Reads D0 (DB0) only, so values in D1 and later are never collected.",
         ("R-4.4.8-05", "R-4.4.7-07", "R-5.1-04", "R-5.2-08"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(StopsAfterD0ToolRecorder)),
+        Parts(master=StopsAfterD0ToolRecorder),
     ),
     RecorderFault(
         "leading-zeros-after-d9",
         "After aHA! writes D10 and later as aD010!.",
         ("R-5.1-04",),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(LeadingZerosToolRecorder)),
+        Parts(master=LeadingZerosToolRecorder),
     ),
     RecorderFault(
         "ignores-bad-crc",
         "Accepts a reply whose CRC does not match (no retry, wrong value logged).",
         ("R-4.4.12-07", "R-7.2-05"),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(IgnoresCrcHooks)),
+        Parts(hooks=IgnoresCrcHooks),
     ),
     RecorderFault(
         "short-break",
         "Breaks last 10 ms (at least 12 ms are due).",
         ("R-7.0-02",),
-        lambda: GoldenRecorder(_GOLDEN.but(break_duration=10e-3)),
+        Parts(policy={"break_duration": 10e-3}),
     ),
     RecorderFault(
         "no-concurrent",
@@ -666,7 +703,7 @@ _FAULTS = (
         "concurrent measurement on the wire, its waits (R-4.4.7-06) and how many of its values "
         "are stored (R-4.4.7-07) cannot be seen.",
         ("R-4.4.7-08", "R-4.4-02"),
-        lambda: LacksCommandsRecorder(lacks=frozenset({Kind.CONCURRENT})),
+        _lacks(lacks=frozenset({Kind.CONCURRENT})),
         inconclusive=("R-4.4.7-06", "R-4.4.7-07"),
     ),
     RecorderFault(
@@ -674,9 +711,7 @@ _FAULTS = (
         "A v1.4 recorder without aHA!/aHB!: asked for them, it sends nothing. How it would read "
         "past D9 (R-5.1-04) or binary packets (R-5.2-08) then cannot be seen.",
         ("R-5.4-01",),
-        lambda: LacksCommandsRecorder(
-            lacks=frozenset({Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})
-        ),
+        _lacks(lacks=frozenset({Kind.HIGH_VOLUME_ASCII, Kind.HIGH_VOLUME_BINARY})),
         inconclusive=("R-5.1-04", "R-5.2-08"),
     ),
     RecorderFault(
@@ -684,33 +719,33 @@ _FAULTS = (
         "Transparent mode drops identify and metadata commands (aIM!, aIM_001!...) instead of "
         "passing them on.",
         ("R-6.3-01", "R-4.4.14-02"),
-        lambda: LacksCommandsRecorder(lacks=frozenset({Kind.METADATA, Kind.IDENTIFY_MEASUREMENT})),
+        _lacks(lacks=frozenset({Kind.METADATA, Kind.IDENTIFY_MEASUREMENT})),
     ),
     RecorderFault(
         "multiline-cut-short",
         "Takes multi-line text without ETX as finished 50 ms after a line, not 150 ms.",
         ("R-4.4.13.1-04",),
-        lambda: GoldenRecorder(_GOLDEN.but(line_wait=50e-3)),
+        Parts(policy={"line_wait": 50e-3}),
     ),
     RecorderFault(
         "late-d0-without-break",
         f"Sends aD0! {LATE_D0 * 1e3:.0f} ms after the service request without a break (87 ms "
         "is the limit; after it a break is due, which R-7.0-17 also demands).",
         ("R-7.1-01", "R-7.0-17"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(LateD0AfterServiceRequestToolRecorder)),
+        Parts(hooks=SkipsNextBreakHooks, master=LateD0AfterServiceRequestToolRecorder),
     ),
     RecorderFault(
         "fast-baud",
         f"Sends at {10 / FAST_CHAR_TIME:.0f} baud: every command character lasts "
         f"{FAST_CHAR_TIME * 1e3:.2f} ms, not 8.33 ms (decision A14 allows 2%).",
         ("R-4.1-01",),
-        lambda: WrongBaudRecorder(),
+        Parts(recorder=WrongBaudRecorder),
     ),
     RecorderFault(
         "gappy-commands",
         "Leaves 3 ms of marking between the characters of every command (1.66 ms at most).",
         ("R-7.0-13",),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(GappyCommandHooks)),
+        Parts(hooks=GappyCommandHooks),
         inconclusive=("R-4.1-01",),  # no back-to-back characters: rate and gaps inseparable
     ),
     RecorderFault(
@@ -718,34 +753,34 @@ _FAULTS = (
         "Leaves 1.9 ms between command characters: over 1.66 ms, inside the ±0.40 ms that "
         "this limit does not grant.",
         ("R-7.0-13", "R-7.0-01"),
-        lambda: GoldenRecorder(_GOLDEN, _with_hooks(BandGapCommandHooks)),
+        Parts(hooks=BandGapCommandHooks),
         inconclusive=("R-4.1-01",),
     ),
     RecorderFault(
         "transparent-no-break",
         "Transparent mode sends host commands without a break of its own.",
         ("R-4.4.14-01",),
-        lambda: NoBreakTransparentRecorder(),
+        Parts(recorder=NoBreakTransparentRecorder),
     ),
     RecorderFault(
         "transparent-drops-address",
         "Transparent mode sends extended commands without their address (XSN! for 0XSN!). "
         "No sensor answers those, so no multi-line text comes whose end R-4.4.13.1-04 judges.",
         ("R-4.4.13-03", "R-4.4.14-02"),
-        lambda: RewritingRecorder(rewrite=lambda t: t[1:] if t[1:2] == "X" else t),
+        _rewriting(rewrite=_without_extended_address),
         inconclusive=("R-4.4.13.1-04",),
     ),
     RecorderFault(
         "addresses-0-4-only",
         "Can only use addresses 0-4: commands to sensors at 5-9, or moving one there, are skipped.",
         ("R-4.3-03", "R-4.4-02"),
-        lambda: LacksCommandsRecorder(unreachable="56789"),
+        _lacks(unreachable="56789"),
     ),
     RecorderFault(
         "polls-dollar",
         "Before each job it polls '$!', as if '$' were a sensor address.",
         ("R-4.3-01", "R-4.3-04"),
-        lambda: RewritingRecorder(extra="$"),
+        _rewriting(extra="$"),
     ),
     RecorderFault(
         "talks-over-reply",
@@ -753,7 +788,7 @@ _FAULTS = (
         "without the golden recorder's wait for a quiet line). Its retry collides with the "
         "rest of the reply, and on the line its characters come apart (R-7.0-13).",
         ("R-7.2-06", "R-7.0-13"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(TalksOverToolRecorder)),
+        Parts(hooks=EngineRetryHooks, master=TalksOverToolRecorder),
     ),
     RecorderFault(
         "interleaves-measurements",
@@ -761,13 +796,13 @@ _FAULTS = (
         "it takes the line while the first one's service request may come (R-4.4.5-07) and "
         "reads its data only after ttt, not on that request (R-4.4.5-05).",
         ("R-4.4.5-06", "R-4.4.5-07", "R-4.4.5-05"),
-        lambda: InterleavingRecorder(),
+        Parts(recorder=InterleavingRecorder),
     ),
     RecorderFault(
         "crlf-wake-up",
         "Before each job it sends a break and CR LF, a modem-style wake-up that is no command.",
         ("R-4.2-01", "R-4.4-04", "R-4.3-01"),
-        lambda: RewritingRecorder(preamble="\r\n"),
+        _rewriting(preamble="\r\n"),
     ),
     RecorderFault(
         "short-reply-timeout",
@@ -780,7 +815,7 @@ _FAULTS = (
         "two retries (R-7.2-03), and the measurement's data never collected (R-4.4.8-05). "
         "The tolerance sweep (--sweep reply) shows where it gives up.",
         ("R-7.2-01", "R-7.2-02", "R-7.2-03", "R-7.2-05", "R-4.4.8-05"),
-        lambda: GoldenRecorder(_GOLDEN.but(first_char_timeout=SHORT_REPLY_TIMEOUT)),
+        Parts(policy={"first_char_timeout": SHORT_REPLY_TIMEOUT}),
     ),
     RecorderFault(
         "ttt-8-bit",
@@ -788,14 +823,14 @@ _FAULTS = (
         "sends a break and aD0! before the service request (which comes after 5 s) and long "
         "before ttt, taking the line while that request could still come.",
         ("R-4.4.5-04", "R-4.4.5-07"),
-        lambda: EightBitTttRecorder(),
+        Parts(hooks=EightBitTttHooks, recorder=EightBitTttRecorder),
     ),
     RecorderFault(
         "concurrent-ttt-zero-stalls",
         "Never collects a concurrent measurement that announced ttt = 000: of two sensors "
         "measured together it reads only the one with ttt > 0, none of the other's values.",
         ("R-4.4.8-05", "R-4.4.7-08"),
-        lambda: SkipsTttZeroConcurrentRecorder(),
+        Parts(recorder=SkipsTttZeroConcurrentRecorder),
     ),
     RecorderFault(
         "drops-after-parity-error",
@@ -804,13 +839,13 @@ _FAULTS = (
         "the values before the bad character (+22.15 +10 for +22.15 +1013.2 +45.7), values "
         "of a reply that was not valid (R-4.4-02).",
         ("R-7.2-05", "R-4.4-02"),
-        lambda: GoldenRecorder(_GOLDEN, _with_master(DropsAfterParityToolRecorder)),
+        Parts(hooks=DropsAfterParityHooks, master=DropsAfterParityToolRecorder),
     ),
     RecorderFault(
         "short-marking",
         "Leaves 5 ms of marking after the break before the command (8.33 ms are due).",
         ("R-7.0-06",),
-        lambda: GoldenRecorder(_GOLDEN.but(post_break_marking=5e-3)),
+        Parts(policy={"post_break_marking": 5e-3}),
     ),
 )
 
@@ -821,7 +856,7 @@ _LOGGING = (
         "Collects every value, then logs it without its sign (-3.75 becomes 3.75): every "
         "negative value logged from aM2!, aC! and the HB packets is wrong.",
         ("R-4.4-02", "R-5.4-01"),
-        lambda: MislogsRecorder(spoil=_unsigned),
+        _mislogs(spoil=_unsigned),
     ),
     RecorderFault(
         "truncates-values",
@@ -829,14 +864,14 @@ _LOGGING = (
         "(+1013.25 becomes +1013.2, +1234.567 becomes +1234.5), in aM2!, aR1!, aHA! and aHB! "
         "data.",
         ("R-4.4-02", "R-5.4-01"),
-        lambda: MislogsRecorder(spoil=_cut),
+        _mislogs(spoil=_cut),
     ),
     RecorderFault(
         "loses-last-concurrent-value",
         "Logs every concurrent measurement (aC!, aCn!, aCC!) without its last value: 98 of "
         "aC9!'s 99 values, all of which it read from the sensor.",
         ("R-4.4-02",),
-        lambda: MislogsRecorder(spoil=_last_concurrent_lost),
+        _mislogs(spoil=_last_concurrent_lost),
     ),
 )
 
@@ -844,12 +879,14 @@ RECORDER_FAULTS: dict[str, RecorderFault] = {f.name: f for f in (*_FAULTS, *_LOG
 
 
 def faulty_recorder(names: tuple[str, ...]) -> GoldenRecorder:
-    """The golden recorder with one fault (several are not composable: each replaces it)."""
-    if not names:
-        return GoldenRecorder()
-    if len(names) > 1:
-        raise ValueError("recorder faults do not compose; choose one")
+    """The golden recorder with the named faults' deviations at once (KeyError for an unknown
+    name; :class:`~conformance.recorder.compose.Refused` for faults that cannot compose)."""
     unknown = [n for n in names if n not in RECORDER_FAULTS]
     if unknown:
         raise KeyError(", ".join(unknown))
-    return RECORDER_FAULTS[names[0]].make()
+    return compose([(n, RECORDER_FAULTS[n].parts) for n in dict.fromkeys(names)])
+
+
+def composition_conflict(names: tuple[str, ...]) -> str | None:
+    """Why the named faults cannot be one recorder, or None when they compose."""
+    return conflict([(n, RECORDER_FAULTS[n].parts) for n in dict.fromkeys(names)])

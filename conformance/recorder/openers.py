@@ -7,7 +7,7 @@ so they are attached here (:func:`~conformance.links.registry.attach_recorder_ro
 registry stays the one place that chooses between kinds:
 
 - ``sim`` / ``sim://?recorder-faults=NAME&recorder=module:callable``: the virtual-time sim
-  bus, the golden recorder (with one fault) or a named program in this process;
+  bus, the golden recorder (with one or more faults) or a named program in this process;
 - ``exec:PROGRAM`` / ``unix:PATH``: a recorder harness, on the same virtual-time bus;
 - ``replay:FOLDER``: a saved recorder-role run, its recorder played back from the recording;
 - ``rfc2217-serve://HOST:PORT``: the played sensors served in real time; the recorder
@@ -34,7 +34,7 @@ from ..sim.bus import SimBus, SimLink
 from ..sim.line_monitor import LineMonitor
 from ..suggest import did_you_mean
 from .drivers import Driver, InProcess
-from .faults import RECORDER_FAULTS, faulty_recorder
+from .faults import RECORDER_FAULTS, composition_conflict, faulty_recorder
 from .harness_driver import HarnessRecorder
 from .replay_driver import RecordedRecorder
 from .served_line import ServedLine, parse_served
@@ -48,7 +48,7 @@ class RecorderLine:
 
     link: BusEnd
     driver: Driver
-    faults: tuple[str, ...] = ()  # the golden recorder's fault (?recorder-faults=)
+    faults: tuple[str, ...] = ()  # the golden recorder's faults (?recorder-faults=)
     bus: SimBus | None = None
     served: ServedLine | None = None
 
@@ -80,16 +80,19 @@ def load_program(path: str) -> Callable:
 
 
 def recorder_faults(extra: dict[str, str]) -> tuple[str, ...]:
-    """The one golden-recorder fault a port's ``recorder-faults=`` names (PortError if it is
-    unknown, or more than one)."""
+    """The golden-recorder faults a port's ``recorder-faults=`` names (PortError if one is
+    unknown, or if they cannot be one recorder: two that change one thing apart)."""
     faults = tuple(f for f in extra.get("recorder-faults", "").split(",") if f)
     unknown = [f for f in faults if f not in RECORDER_FAULTS]
-    if unknown or len(faults) > 1:
+    if unknown:
         hint = did_you_mean(unknown, RECORDER_FAULTS)
         raise PortError(
-            f"recorder-faults takes one of: {_known_faults()} (got {','.join(faults)}){hint}; "
-            "`sdi12-conform faults --role recorder` describes them"
+            f"recorder-faults takes one or more of: {_known_faults()} (got "
+            f"{','.join(faults)}){hint}; `sdi12-conform faults --role recorder` describes them"
         )
+    clash = composition_conflict(faults)
+    if clash:
+        raise PortError(f"recorder-faults={','.join(faults)} do not compose: {clash}")
     return faults
 
 

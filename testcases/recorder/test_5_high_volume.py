@@ -22,4 +22,5 @@ def test_high_volume(recorder, case):
     if line is None:
         return
     taken = observed_measurements(line, recorder.uncertainty)
-    case.extend(judge_high_volume(taken, recorder.is_v14))
+    sent = {s.text for s in line.transmissions}
+    case.extend(judge_high_volume(taken, recorder.is_v14, sent))

@@ -60,7 +60,11 @@ def test_session_runs_each_scenario_once_and_names_the_sensors():
 
 @pytest.mark.parametrize(
     "port",
-    ["sim://?recorder-faults=nonsense", "sim://?recorder-faults=no-retries,short-break", "COM9"],
+    [
+        "sim://?recorder-faults=nonsense",
+        "sim://?recorder-faults=retry-too-early,retry-too-late",
+        "COM9",
+    ],
 )
 def test_unusable_recorder_ports_are_refused(port):
     with pytest.raises(PortError):

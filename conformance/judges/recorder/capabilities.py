@@ -15,7 +15,7 @@ from ..reply_validity import STX
 from ..tally import Tally
 from ..timing import judge_window
 from .common import combine, record_of
-from .measurements import observed_measurements
+from .measurements import collection_end, observed_measurements
 from .replies import first_answered
 
 
@@ -23,7 +23,10 @@ def judge_commands_issued(
     line: TranscriptView, asked: Sequence[str], uncertainty: float, rid: str = "R-4.4-02"
 ) -> Finding:
     """``rid`` (R-4.4-02 by default): every command the recorder was asked to use went out and
-    drew a valid reply; for measurements, every announced value was read."""
+    drew a valid reply; for measurements, every announced value was read. Commands that went
+    out and drew no valid reply from the tool's own played sensors, with nothing else amiss,
+    leave it undecided: the wire shows the recorder issuing them, and why they went unheard
+    is another rule's (a wake-up too short, R-7.0-06), not a command the recorder lacks."""
     first = first_answered(line, uncertainty)
     missing = [text for text in asked if text not in first]
     sent = {s.text for s in line.transmissions}
@@ -32,6 +35,12 @@ def judge_commands_issued(
         f"{escape(t)} ({len(m.values())} of {m.count} values)"
         for t, m in taken.items()
         if t in asked and len(m.values()) < m.count
+    ]
+    # a collection that ended on a data command no valid reply answered: sent, unheard
+    stopped = [
+        t
+        for t, m in taken.items()
+        if t in asked and len(m.values()) < m.count and collection_end(m)[1] is None
     ]
     if missing or short:
         parts = []
@@ -49,7 +58,7 @@ def judge_commands_issued(
             parts.append("data not read: " + ", ".join(short))
         return Finding(
             rid,
-            Verdict.FAIL,
+            Verdict.FAIL if unsent or stopped else Verdict.INCONCLUSIVE,
             "; ".join(parts),
             evidence=record_of(line.transmissions, missing)
             + [m.start.at() for t, m in taken.items() if t in asked and len(m.values()) < m.count],
@@ -64,14 +73,20 @@ def judge_commands_issued(
 
 
 def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
-    """R-4.3-03: the recorder polls every address 0-9. R-4.3-04 (MAY): letters as addresses."""
+    """R-4.3-03: the recorder polls every address 0-9 (an address it polled that never drew a
+    valid reply from the played sensors is undecided, as in :func:`judge_commands_issued`).
+    R-4.3-04 (MAY): letters as addresses."""
     polled = {s.address for s in first_answered(line, uncertainty).values()}
     digits = [a for a in "0123456789" if a not in polled]
+    tried = {s.address for s in line.transmissions}
+    unsent = [a for a in digits if a not in tried]
     r3 = (
         Finding(
             "R-4.3-03",
-            Verdict.FAIL,
-            "addresses never polled successfully: " + ", ".join(digits),
+            Verdict.FAIL if unsent else Verdict.INCONCLUSIVE,
+            "addresses never polled successfully: "
+            + ", ".join(digits)
+            + ("" if unsent else " (each was polled, never validly answered)"),
             evidence=record_of(line.transmissions, [f"{a}!" for a in digits]),
             observed=len(line.transmissions),
         )

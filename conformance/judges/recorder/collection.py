@@ -4,10 +4,10 @@ R-5.4-01)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 from ...protocol.binary import parse_binary_packet
-from ...protocol.commands import Kind, parse_command
+from ...protocol.commands import CommandError, Kind, parse_command
 from ...transcript import decode_8n1, escape
 from ...verdicts import Finding
 from ...view.segments import Transmission
@@ -62,16 +62,23 @@ def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]
 
 
 def judge_concurrent_storage(
-    taken: Sequence[ObservedMeasurement], asked: Sequence[str] = ()
+    taken: Sequence[ObservedMeasurement], asked: Sequence[str] = (), sent: Collection[str] = ()
 ) -> list[Finding]:
     """R-4.4.7-07: a concurrent measurement of more than 20 values: at least 20 read and stored
     (the 2000 text's MUST); fewer than announced is a WARN (the capacity should be documented,
     which the tool cannot see). R-4.4.7-08: the recorder uses aC!-type commands: each one in
-    ``asked`` (what the scenarios told it to send) must be on the wire."""
+    ``asked`` (what the scenarios told it to send) must be on the wire. One in ``sent`` (the
+    texts the recorder transmitted) that no valid reply answered shows the command, not what
+    the recorder does with a measurement: undecided (the reason is another rule's, such as a
+    wake-up the played sensor could not hear, R-7.0-06)."""
     tally = Tally(("R-4.4.7-07", "R-4.4.7-08"))
     started = {m.start.text for m in taken}
     for text in asked:
-        if parse_command(text).kind is Kind.CONCURRENT and text not in started:
+        if parse_command(text).kind is not Kind.CONCURRENT or text in started:
+            continue
+        if text in sent:
+            tally.undecide("R-4.4.7-08", escape(text), "sent, never validly answered")
+        else:
             tally.fail("R-4.4.7-08", escape(text), f"asked for {escape(text)}, never sent it")
     for m in taken:
         if m.kind is not Kind.CONCURRENT:
@@ -82,6 +89,11 @@ def judge_concurrent_storage(
         if not have and m.count and not _ended_on_problem(m) and not _issued_again(m):
             tally.fail("R-4.4.7-08", where, f"read none of the {m.count} values")
         if m.count <= MIN_CONCURRENT_STORE:
+            continue
+        if have < m.count and _ended_on_problem(m):
+            # the last D command drew no valid reply: how many values the recorder would
+            # store is unseen (why it went unheard is another rule's, e.g. R-7.0-17)
+            tally.undecide("R-4.4.7-07", where, "collection ended on a D command unanswered")
             continue
         tally.observe(where, ids=["R-4.4.7-07"])
         if have < MIN_CONCURRENT_STORE:
@@ -109,19 +121,25 @@ def _ended_on_problem(m: ObservedMeasurement) -> bool:
     return collection_end(m)[1] is not None
 
 
-def judge_high_volume(taken: Sequence[ObservedMeasurement], is_v14: bool) -> list[Finding]:
+def judge_high_volume(
+    taken: Sequence[ObservedMeasurement], is_v14: bool, sent: Collection[str] = ()
+) -> list[Finding]:
     """R-5.1-04: after aHA! data commands go past aD9! as needed, without leading zeros.
     R-5.2-08: after aHB! aDBn! commands in 7E1, packets checked, collection stops at the empty
     packet or once every value is in. R-5.4-01: a v1.4 recorder issues aHA! and aHB! and reads
-    their data back."""
+    their data back; one it sent (``sent``: the texts it transmitted) that no valid reply
+    answered leaves the reading back unseen (undecided, not a FAIL)."""
     tally = Tally(("R-5.1-04", "R-5.2-08", "R-5.4-01"))
     used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
+    unheard: set[Kind] = set()  # started, its collection ended on a D command unanswered
     for m in taken:
         if m.kind not in used:
             continue
         where = escape(m.start.text)
         have = len(m.values())
         used[m.kind] = used[m.kind] or have > 0
+        if not have and _ended_on_problem(m):
+            unheard.add(m.kind)
         rid = "R-5.1-04" if m.kind is Kind.HIGH_VOLUME_ASCII else "R-5.2-08"
         tally.observe(where, ids=[rid])
         zeros = [s for s, _ in m.data if (d := s.data_index) and d[2] != str(d[1])]
@@ -149,11 +167,27 @@ def judge_high_volume(taken: Sequence[ObservedMeasurement], is_v14: bool) -> lis
     if is_v14:
         for kind, ok in used.items():
             tally.observe(kind.value.replace("a", "", 1), ids=["R-5.4-01"])
-            if not ok:
+            if ok:
+                continue
+            if kind in unheard or (
+                any(_kind_of(text) is kind for text in sent)
+                and not any(m.kind is kind for m in taken)
+            ):
+                tally.undecide(
+                    "R-5.4-01", str(kind), f"{kind} sent, its data never validly answered"
+                )
+            else:
                 tally.fail("R-5.4-01", str(kind), f"{kind} was not issued or its data not read")
     else:
         tally.not_applicable("R-5.4-01", "the recorder does not claim v1.4")
     return tally.findings("conforms")
+
+
+def _kind_of(text: str) -> Kind | None:
+    try:
+        return parse_command(text).kind
+    except CommandError:
+        return None
 
 
 def _after_done(m: ObservedMeasurement) -> Transmission | None:

@@ -9,7 +9,11 @@ from conformance.judges.recorder.capabilities import (
     judge_commands_issued,
     judge_transparent,
 )
-from conformance.judges.recorder.collection import judge_concurrent_storage, judge_data_collection
+from conformance.judges.recorder.collection import (
+    judge_concurrent_storage,
+    judge_data_collection,
+    judge_high_volume,
+)
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_crc_checked, judge_retries
@@ -326,3 +330,59 @@ def test_a_concurrent_measurement_repeated_before_its_data_owes_no_values():
     never = never.sensor("000205\r\n").idle(5200).brk().rec("0I!")
     found = judge_concurrent_storage(observed_measurements(never.view(), 0.0), ("0C!",))
     assert Verdict.FAIL in [f.verdict for f in found if f.requirement == "R-4.4.7-08"]
+
+
+def _unheard(*texts: str) -> Wire:
+    """Each command sent three times after a break, never answered (what the played sensors
+    do to a wake-up with 5 ms of marking: short-marking, with no retry soon after)."""
+    w = Wire()
+    for text in texts:
+        for _ in range(3):
+            w.brk(marking_ms=5.0).rec(text).idle(1500)
+    return w
+
+
+def test_commands_sent_but_never_answered_leave_the_capability_rules_undecided():
+    """Recorder combination matrix (short-marking + resends-after-timeout, seed 20): every
+    command went out, none was heard, and R-4.4-02, R-4.3-03, R-4.4.7-08 and R-5.4-01 FAILed
+    "never sent it" / "not issued" for what R-7.0-06 alone had lost. Sent but unanswered is
+    undecided; never sent still FAILs."""
+    view = _unheard("0M!", "0C!", "0HA!", "0HB!", *(f"{a}!" for a in "0123456789")).view()
+    assert judge_commands_issued(view, ["0M!", "0C!"], 0.0).verdict is Verdict.INCONCLUSIVE
+    assert by_id(judge_addresses(view, 0.0))["R-4.3-03"].verdict is Verdict.INCONCLUSIVE
+    taken = observed_measurements(view, 0.0)
+    sent = {s.text for s in view.transmissions}
+    r708 = by_id(judge_concurrent_storage(taken, ("0C!",), sent))["R-4.4.7-08"]
+    assert r708.verdict is Verdict.INCONCLUSIVE
+    assert by_id(judge_high_volume(taken, True, sent))["R-5.4-01"].verdict is Verdict.INCONCLUSIVE
+    # the same rules still FAIL a command, address or kind the recorder never sent
+    assert judge_commands_issued(view, ["0M!", "0V!"], 0.0).verdict is Verdict.FAIL
+    few = _unheard("0!", "1!").view()
+    assert by_id(judge_addresses(few, 0.0))["R-4.3-03"].verdict is Verdict.FAIL
+    r708 = by_id(judge_concurrent_storage(taken, ("0C1!",), sent))["R-4.4.7-08"]
+    assert r708.verdict is Verdict.FAIL
+    nothing = _unheard("0M!").view()
+    none_sent = {s.text for s in nothing.transmissions}
+    found = by_id(judge_high_volume(observed_measurements(nothing, 0.0), True, none_sent))
+    assert found["R-5.4-01"].verdict is Verdict.FAIL
+
+
+def test_data_commands_never_answered_leave_storage_and_high_volume_undecided():
+    """Recorder combination matrix (no-break-after-87ms + no-retries, seed 26): aD0! and
+    aDB0! went out after ttt without a break, unheard by the sleeping sensor, and no retry
+    followed: R-4.4.7-07 WARNed "read 0 of 99 values" and R-5.4-01 FAILed "not issued or its
+    data not read" for R-7.0-17's deviation. A collection that ended on an unanswered data
+    command is undecided; one the recorder stopped itself still FAILs."""
+    unheard = Wire().brk().rec("0C9!").sensor("000299\r\n").idle(2100).rec("0D0!").idle(200)
+    unheard = unheard.brk().rec("0HB!").sensor("0002033\r\n").idle(2100).rec("0DB0!").idle(200)
+    unheard = unheard.brk().rec("0HA!").sensor("0002033\r\n").idle(2100).rec("0D0!").idle(200)
+    taken = observed_measurements(unheard.view(), 0.0)
+    r707 = by_id(judge_concurrent_storage(taken))["R-4.4.7-07"]
+    assert r707.verdict is Verdict.INCONCLUSIVE
+    assert by_id(judge_high_volume(taken, True))["R-5.4-01"].verdict is Verdict.INCONCLUSIVE
+    stopped = Wire().brk().rec("0C9!").sensor("000299\r\n").idle(2100)
+    stopped = stopped.brk().rec("0HB!").sensor("0002033\r\n").idle(2100)
+    stopped = stopped.brk().rec("0HA!").sensor("0002033\r\n").idle(2100)
+    taken = observed_measurements(stopped.view(), 0.0)
+    assert by_id(judge_concurrent_storage(taken))["R-4.4.7-07"].verdict is Verdict.WARN
+    assert by_id(judge_high_volume(taken, True))["R-5.4-01"].verdict is Verdict.FAIL
