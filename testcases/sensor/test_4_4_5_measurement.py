@@ -144,10 +144,10 @@ def test_data_retained(sensor, case):
         return
     fresh = sensor.fresh_measurement(m.command.text()[1:-1])
     before = [ex.reply_text for ex in fresh.data]
-    sensor.idle(0.2)  # standby
+    sensor.to_standby()  # standby
     sensor.master.send_break()
     pokes = [sensor.fresh_exchange(code) for code in ("I", "", "R0", "RC0")]
-    sensor.idle(0.2)
+    sensor.to_standby()
     again = [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
     case.evidence(
         "measurement, then break/standby/aI!/a!/aR0!/aRC0!, then the D commands again",

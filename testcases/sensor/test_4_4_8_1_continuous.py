@@ -61,7 +61,7 @@ def test_continuous_independent(sensor, case):
     ):
         return
     index = served[-1]
-    sensor.idle(0.2)  # standby, so the next command starts a fresh conversation
+    sensor.to_standby()  # standby, so the next command starts a fresh conversation
     sensor.master.send_break()
     sensor.fresh_exchange("I")
     ex = sensor.fresh_exchange(f"R{index}")

@@ -25,9 +25,6 @@ from conformance.view.runs import runs
 
 requirements = pytest.mark.requirements
 DESCRIBED = M_FAMILY + C_FAMILY + HV_FAMILY
-#: s of marking before each re-read of the data: past the 100 ms after which any sensor is in
-#: standby (R-7.0-15), so each read starts from standby with a break
-REREAD_IDLE = 0.2
 META_IDS = ("R-6.2-01", "R-6.2-02", "R-6.2-03", "R-6.2-04", "R-6.2-07", "R-6.2.1-01", "R-6.2.2-01")
 
 
@@ -72,10 +69,11 @@ def test_identify_starts_nothing(sensor, case):
     fresh = sensor.fresh_measurement(m.command.text()[1:-1])
 
     def reread():
-        # the same idle (the line marking REREAD_IDLE s, so standby) and break before each
-        # read: only the pokes differ. Counted from the line's last activity, so the long
-        # listening after the pokes already is the second read's idle (issue 22)
-        sensor.idle(REREAD_IDLE)
+        # the same idle (the line marking past the 100 ms after which any sensor is in
+        # standby, R-7.0-15: SensorSession.to_standby) and break before each read: only
+        # the pokes differ. Counted from the line's last activity, so the long listening
+        # after the pokes already is the second read's idle (issue 22)
+        sensor.to_standby()
         return [sensor.fresh_exchange(ex.text[1:-1]) for ex in fresh.data]
 
     control = reread()

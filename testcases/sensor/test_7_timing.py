@@ -29,7 +29,6 @@ from conformance.verdicts import Verdict, failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
 pytestmark = pytest.mark.needs("break")
-STANDBY = 0.15  # s of marking that puts any sensor in standby before a probe
 OK_MARKING = 9e-3  # s: the marking after a break R-7.0-05's answered probe aims at
 UNREACHABLE = " (a link stamped to ±{u:.2f} ms cannot show 8.33 ms of marking from 9: one try)"
 
@@ -55,16 +54,23 @@ def _marking_after_break(sensor, ex) -> float | None:
 
 def _awake(sensor):
     """Wake the sensor the way a recorder does (break, a!, retries) and return that exchange:
-    its last reply proves the sensor is awake, whatever it needed to wake up."""
-    sensor.idle(STANDBY)
+    its last reply proves the sensor is awake, whatever it needed to wake up. No standby idle
+    before it: the rules that wake it this way (R-7.0-14, -15, -16) time their probes from
+    that reply, and a break wakes an awake sensor as it wakes a sleeping one (R-7.0-04/05
+    judge the wake-up from standby with idles of their own); the 150 ms idle that preceded
+    each of the five wake-ups was 134-143 ms of a real run's bus time apiece (issue 22)."""
     return sensor.master.transact(f"{sensor.address}!", force_break=True)
 
 
-def _asleep(sensor):
+def _asleep(sensor) -> float:
     """Put the sensor in standby by both routes (a command for another address, then more
-    than 100 ms of marking), so a sensor that ignores one of them still sleeps."""
-    sensor.probe(f"{sensor.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
-    sensor.idle(STANDBY)
+    than 100 ms of marking: :meth:`SensorSession.to_standby`), so a sensor that ignores one
+    of them still sleeps; returns that idle (s). The foreign command goes out without a
+    break: a sensor awake hears it (R-7.0-14 sends it to standby), one asleep already need
+    not; a break before it (with 50 ms of marking) cost a real run 13 + 50 ms and, nothing
+    answering it, moved the idle after it to 100 ms past the break (issue 22)."""
+    sensor.master.raw(f"{sensor.foreign_address()}!", break_first=False)
+    return sensor.to_standby()
 
 
 def _shown_asleep(sensor, case):
@@ -72,9 +78,9 @@ def _shown_asleep(sensor, case):
     standby, one that ignores a command without a break after more than 100 ms of marking.
     Returns that ignored ``a!``, or None with the case's "standby" precondition not met
     (linked to R-7.0-15, the rule a sensor that never sleeps breaks)."""
-    _asleep(sensor)
+    idle = _asleep(sensor)
     check = sensor.master.raw(f"{sensor.address}!", break_first=False)
-    unmet = precondition.standby(check, STANDBY)
+    unmet = precondition.standby(check, idle)
     if case.requires("standby", unmet):
         return check
     case.evidence("sensor put to sleep, then a! with no break", [check])
@@ -221,7 +227,10 @@ def test_marking_after_break(sensor, case):
 
     def after(marking_s):
         return lambda _n: sensor.probe(
-            f"{sensor.address}!", break_s=13e-3, marking_s=marking_s, idle_before=STANDBY
+            f"{sensor.address}!",
+            break_s=13e-3,
+            marking_s=marking_s,
+            standby=True,
         )
 
     def miss_ok(ex):
@@ -331,9 +340,7 @@ def test_ready_within_100ms_of_break(sensor, case):
 
     aimed = sensor.aim(
         "a! 90 ms after a break",
-        lambda _n: sensor.probe(
-            f"{sensor.address}!", break_s=13e-3, marking_s=77e-3, idle_before=STANDBY
-        ),
+        lambda _n: sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=77e-3, standby=True),
         miss,
     )
     ex = aimed.last
@@ -500,7 +507,10 @@ def _standby_after_a_break(sensor, case, edge: float):
 
     def after_break(marking_s):
         return lambda _n: sensor.probe(
-            f"{sensor.address}!", break_s=13e-3, marking_s=marking_s, idle_before=STANDBY
+            f"{sensor.address}!",
+            break_s=13e-3,
+            marking_s=marking_s,
+            standby=True,
         )
 
     def miss(ex):
@@ -637,7 +647,7 @@ def test_partial_command_dropped(sensor, case):
     """A command interrupted by 8.33 ms or more of marking is dropped (decision A18: a reply
     is only a warning)."""
     case.expect("silence to 'aI!' sent with 10 ms of marking between its characters")
-    ex = sensor.probe(f"{sensor.address}I!", break_s=13e-3, gap=10e-3, idle_before=STANDBY)
+    ex = sensor.probe(f"{sensor.address}I!", break_s=13e-3, gap=10e-3, standby=True)
     case.evidence("aI! with 10 ms gaps", [ex])
     brk = _break_of(sensor, ex)
     if brk is not None and not case.requires(
@@ -648,7 +658,7 @@ def test_partial_command_dropped(sensor, case):
     if not ex.answered:
         # its silence counts only if it hears an aI! sent the same way (the same break and
         # marking) in one piece: a sensor slow to wake hears neither (issue 18)
-        control = sensor.probe(f"{sensor.address}I!", break_s=13e-3, idle_before=STANDBY)
+        control = sensor.probe(f"{sensor.address}I!", break_s=13e-3, standby=True)
         case.evidence("aI! sent the same way in one piece (the control)", [control])
         if not case.requires(
             "listening", precondition.answered_control([control], "to the cut aI!")
