@@ -65,11 +65,8 @@ def _awake(sensor):
 def _asleep(sensor) -> float:
     """Put the sensor in standby by both routes (a command for another address, then more
     than 100 ms of marking: :meth:`SensorSession.to_standby`), so a sensor that ignores one
-    of them still sleeps; returns that idle (s). The foreign command goes out without a
-    break: a sensor awake hears it (R-7.0-14 sends it to standby), one asleep already need
-    not; a break before it (with 50 ms of marking) cost a real run 13 + 50 ms and, nothing
-    answering it, moved the idle after it to 100 ms past the break (issue 22)."""
-    sensor.master.raw(f"{sensor.foreign_address()}!", break_first=False)
+    of them still sleeps; returns that idle (s)."""
+    sensor.probe(f"{sensor.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
     return sensor.to_standby()
 
 
