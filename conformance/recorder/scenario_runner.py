@@ -113,8 +113,7 @@ class RecorderSession(Session):
         self.address_notes: list[str] = []  # the recorder role changes no DUT address
         self.assumptions = [
             f"recorder claims SDI-12 v{format_version(version)}",
-            f"recorder driven {self.driver.kind}"
-            + (f" (golden recorder with fault {self.faults[0]})" if self.faults else ""),
+            f"recorder driven {self.driver.kind}" + _with_faults(self.faults),
         ]
         if self.served is not None:
             self.assumptions.append(
@@ -336,3 +335,13 @@ def check_port(port: str, trigger: str | None = None) -> bool:
         return not line.link.info.virtual_time
     finally:
         line.link.close()
+
+
+def _with_faults(faults: tuple[str, ...] | list[str]) -> str:
+    """What the assumptions say of the golden recorder's faults: every one of a composed set
+    (the report named only the first of ``short-break,no-retries``)."""
+    if not faults:
+        return ""
+    if len(faults) == 1:
+        return f" (golden recorder with fault {faults[0]})"
+    return f" (golden recorder with faults {', '.join(faults)})"

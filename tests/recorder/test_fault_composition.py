@@ -49,6 +49,13 @@ def test_a_pair_puts_both_deviations_on_the_wire(pair):
         assert set(RECORDER_FAULTS[fault].violates) <= flagged, (fault, flagged)
 
 
+def test_the_report_names_every_fault_of_a_pair():
+    """The assumptions named only the first fault of ``short-break,no-retries``."""
+    data = run_recorder_suite("sim://?recorder-faults=short-break,no-retries", keyword="breaks")
+    said = " ".join(data["dut"]["assumptions"])
+    assert "golden recorder with faults short-break, no-retries" in said, said
+
+
 def test_two_attempt_hooks_chain():
     """retries-with-break waits a poll timeout before each repeat and ignores-bad-crc takes a
     bad CRC as valid: both hooks' ``attempt`` run, one through the other's super()."""
