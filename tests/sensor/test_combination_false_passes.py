@@ -80,13 +80,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.case import Case
-from conformance.ports import open_sim, parse_sim
-from conformance.preconditions import declared_on
 from conformance.protocol.commands import M_FAMILY
-from conformance.results import CaseRecord, counted
-from conformance.sensor.session import SensorSession
-from conformance.verdicts import Verdict, worst
+from conformance.verdicts import Verdict
 from testcases.sensor.test_4_4_5_measurement import test_break_aborts_measurement as abort_case
 from testcases.sensor.test_4_4_5_measurement import test_measurement_reply as reply_case
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
@@ -111,28 +106,7 @@ from testcases.sensor.test_6_metadata import test_identify_starts_nothing as ide
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
 from testcases.sensor.test_7_timing import test_standby_after_100ms as standby_case
 from testcases.sensor.test_7_timing import test_standby_after_foreign_command as foreign_case
-
-
-def _session(faults: str) -> SensorSession:
-    """The reference sensor with ``faults`` (comma-separated; "" for none)."""
-    opened = open_sim(parse_sim(f"sim://?faults={faults}" if faults else "sim"))
-    session = SensorSession(opened.link, declaration=opened.declaration)
-    session.discover()
-    return session
-
-
-def _verdict(session: SensorSession, case_fn, rule: str) -> Verdict:
-    """``rule``'s verdict from ``case_fn`` alone, its findings combined as the run does."""
-    rules = _rules(case_fn)
-    record = CaseRecord(case_fn.__name__, case_fn.__name__, rules)
-    case_fn(session, Case(record, preconditions=declared_on(case_fn, rules)))
-    findings = [f for f in record.findings if f.requirement == rule]
-    return worst(f.verdict for f in counted(findings))
-
-
-def _rules(case_fn) -> tuple[str, ...]:
-    marks = [m for m in case_fn.pytestmark if m.name == "requirements"]
-    return tuple(marks[0].args)
+from tests.support.case_verdicts import case_verdict, sim_session
 
 
 @pytest.mark.parametrize(
@@ -150,7 +124,7 @@ def _rules(case_fn) -> tuple[str, ...]:
     ],
 )
 def test_metadata_records_of_a_group_without_a_count(faults, expected):
-    assert _verdict(_session(faults), metadata_case, "R-6.2-07") is expected
+    assert case_verdict(sim_session(faults), metadata_case, "R-6.2-07") is expected
 
 
 @pytest.mark.parametrize(
@@ -163,7 +137,7 @@ def test_metadata_records_of_a_group_without_a_count(faults, expected):
     ],
 )
 def test_crc_request_followed_by_a_plain_measurement_with_values(faults, expected):
-    assert _verdict(_session(faults), crc_request_case, "R-4.4.12-03") is expected
+    assert case_verdict(sim_session(faults), crc_request_case, "R-4.4.12-03") is expected
 
 
 @pytest.mark.parametrize(
@@ -175,7 +149,7 @@ def test_crc_request_followed_by_a_plain_measurement_with_values(faults, expecte
     ],
 )
 def test_verification_without_a_ttt(faults, expected):
-    assert _verdict(_session(faults), verification_case, "R-4.4.11-01") is expected
+    assert case_verdict(sim_session(faults), verification_case, "R-4.4.11-01") is expected
 
 
 @pytest.mark.parametrize(
@@ -186,13 +160,13 @@ def test_verification_without_a_ttt(faults, expected):
     ],
 )
 def test_identify_starts_nothing_needs_data_to_disturb(faults, expected):
-    session = _session(faults)
+    session = sim_session(faults)
     # as in a whole run: the measurements cached first, then a CRC metadata command, after
     # which metadata-crc-sticks gives plain D replies a CRC: the fresh aM!'s replies are
     # retried with a break, which buffer-cleared-by-break answers with an empty buffer
     session.family(("M", "MC", "V", *M_FAMILY))
     session.fresh_exchange("IMC_001")
-    assert _verdict(session, identify_case, "R-6.1-03") is expected
+    assert case_verdict(session, identify_case, "R-6.1-03") is expected
 
 
 @pytest.mark.parametrize(
@@ -205,8 +179,8 @@ def test_identify_starts_nothing_needs_data_to_disturb(faults, expected):
     ],
 )
 def test_binary_packets_past_an_unreadable_one(faults, expected):
-    session = _session(faults)
-    assert _verdict(session, binary_case, "R-5.2-04") is expected
+    session = sim_session(faults)
+    assert case_verdict(session, binary_case, "R-5.2-04") is expected
     packets = session.measurement("HB").packets
     # the eleventh, 1002-byte packet was asked for, whatever the packets before it looked like
     assert any(len(p) > 1000 for p in packets) is ("payload-over-1000" in faults)
@@ -222,7 +196,7 @@ def test_binary_packets_past_an_unreadable_one(faults, expected):
     ],
 )
 def test_a_concurrent_reply_of_zero_values_in_any_reading(faults, expected):
-    assert _verdict(_session(faults), concurrent_case, "R-4.4.7-08") is expected
+    assert case_verdict(sim_session(faults), concurrent_case, "R-4.4.7-08") is expected
 
 
 @pytest.mark.parametrize(
@@ -243,7 +217,7 @@ def test_a_concurrent_reply_of_zero_values_in_any_reading(faults, expected):
     ],
 )
 def test_value_rules_with_a_measurement_whose_count_is_unreadable(faults, rule, expected):
-    assert _verdict(_session(faults), data_case, rule) is expected
+    assert case_verdict(sim_session(faults), data_case, rule) is expected
 
 
 @pytest.mark.parametrize(
@@ -256,7 +230,7 @@ def test_value_rules_with_a_measurement_whose_count_is_unreadable(faults, rule, 
     ],
 )
 def test_old_values_kept_behind_an_empty_d0(faults, expected):
-    assert _verdict(_session(faults), undefined_group_case, "R-4.4.8-03") is expected
+    assert case_verdict(sim_session(faults), undefined_group_case, "R-4.4.8-03") is expected
 
 
 @pytest.mark.parametrize(
@@ -269,8 +243,8 @@ def test_old_values_kept_behind_an_empty_d0(faults, expected):
     ],
 )
 def test_a_value_split_over_two_replies_counts_once(faults, expected):
-    session = _session(faults)
-    assert _verdict(session, count_case, "R-4.4.8-03") is expected
+    session = sim_session(faults)
+    assert case_verdict(session, count_case, "R-4.4.8-03") is expected
     if "split-value" in faults:  # collected in full: every value, each whole, read
         m2 = session.measurement("M2")
         assert len(m2.values) == m2.count == 9
@@ -287,7 +261,7 @@ def test_a_value_split_over_two_replies_counts_once(faults, expected):
     ],
 )
 def test_standby_after_a_foreign_command_needs_a_follow_up_answered(faults, expected):
-    assert _verdict(_session(faults), foreign_case, "R-7.0-14") is expected
+    assert case_verdict(sim_session(faults), foreign_case, "R-7.0-14") is expected
 
 
 @pytest.mark.parametrize(
@@ -300,7 +274,7 @@ def test_standby_after_a_foreign_command_needs_a_follow_up_answered(faults, expe
     ],
 )
 def test_data_kept_after_an_abort_behind_an_empty_d0(faults, expected):
-    assert _verdict(_session(faults), abort_case, "R-4.4.5.1-02") is expected
+    assert case_verdict(sim_session(faults), abort_case, "R-4.4.5.1-02") is expected
 
 
 @pytest.mark.parametrize(
@@ -313,7 +287,7 @@ def test_data_kept_after_an_abort_behind_an_empty_d0(faults, expected):
     ],
 )
 def test_a_count_rule_on_replies_that_give_no_count(faults, expected):
-    assert _verdict(_session(faults), reply_case, "R-4.4.5-02") is expected
+    assert case_verdict(sim_session(faults), reply_case, "R-4.4.5-02") is expected
 
 
 @pytest.mark.parametrize(
@@ -325,7 +299,7 @@ def test_a_count_rule_on_replies_that_give_no_count(faults, expected):
     ],
 )
 def test_verification_against_rules_m_was_not_shown_to_keep(faults, expected):
-    assert _verdict(_session(faults), verification_case, "R-4.4.11-01") is expected
+    assert case_verdict(sim_session(faults), verification_case, "R-4.4.11-01") is expected
 
 
 @pytest.mark.parametrize(
@@ -333,8 +307,8 @@ def test_verification_against_rules_m_was_not_shown_to_keep(faults, expected):
     ["address-change-wrong-reply,answers-foreign-address", "address-change-wrong-reply", ""],
 )
 def test_the_sensor_is_back_at_its_address_after_the_change_case(faults):
-    session = _session(faults)
-    _verdict(session, change_case, "R-4.4.4-01")
+    session = sim_session(faults)
+    case_verdict(session, change_case, "R-4.4.4-01")
     # aM! is answered at its own address only (answers-foreign-address answers a!, aI!)
     assert session.fresh_exchange("M").answered
 
@@ -343,9 +317,9 @@ def test_the_sensor_is_back_at_its_address_after_the_change_case(faults):
     "faults", ["accepts-invalid-address,answers-foreign-address", "accepts-invalid-address", ""]
 )
 def test_the_sensor_is_back_at_its_address_after_the_invalid_address(faults):
-    session = _session(faults)
+    session = sim_session(faults)
     expected = Verdict.WARN if faults else Verdict.PASS  # decision A17: lenient
-    assert _verdict(session, range_case, "R-4.3-04") is expected
+    assert case_verdict(session, range_case, "R-4.3-04") is expected
     assert session.fresh_exchange("M").answered
 
 
@@ -359,7 +333,7 @@ def test_the_sensor_is_back_at_its_address_after_the_invalid_address(faults):
     ],
 )
 def test_a_crc_twin_whose_count_went_unread(faults, expected):
-    assert _verdict(_session(faults), twin_case, "R-4.4.12-04") is expected
+    assert case_verdict(sim_session(faults), twin_case, "R-4.4.12-04") is expected
 
 
 @pytest.mark.parametrize(
@@ -372,7 +346,7 @@ def test_a_crc_twin_whose_count_went_unread(faults, expected):
     ],
 )
 def test_silence_past_uncountable_packets(faults, expected):
-    assert _verdict(_session(faults), binary_case, "R-5.2-02") is expected
+    assert case_verdict(sim_session(faults), binary_case, "R-5.2-02") is expected
 
 
 @pytest.mark.parametrize(
@@ -385,7 +359,7 @@ def test_silence_past_uncountable_packets(faults, expected):
     ],
 )
 def test_text_to_a_high_index_after_ha(faults, expected):
-    assert _verdict(_session(faults), ascii_case, "R-5.1-02") is expected
+    assert case_verdict(sim_session(faults), ascii_case, "R-5.1-02") is expected
 
 
 @pytest.mark.parametrize(
@@ -398,7 +372,7 @@ def test_text_to_a_high_index_after_ha(faults, expected):
     ],
 )
 def test_a_crc_that_outlived_an_unanswered_metadata_command(faults, expected):
-    assert _verdict(_session(faults), crc_request_case, "R-4.4.12-03") is expected
+    assert case_verdict(sim_session(faults), crc_request_case, "R-4.4.12-03") is expected
 
 
 @pytest.mark.parametrize(
@@ -410,7 +384,7 @@ def test_a_crc_that_outlived_an_unanswered_metadata_command(faults, expected):
     ],
 )
 def test_the_measurements_own_line_after_a_break_is_not_unasked(faults, expected):
-    assert _verdict(_session(faults), abort_case, "R-4.4.5-08") is expected
+    assert case_verdict(sim_session(faults), abort_case, "R-4.4.5-08") is expected
 
 
 @pytest.mark.parametrize(
@@ -425,7 +399,7 @@ def test_the_measurements_own_line_after_a_break_is_not_unasked(faults, expected
     ],
 )
 def test_a_cut_value_whose_tail_was_never_answered(faults, expected):
-    assert _verdict(_session(faults), grouping_case, "R-4.4.8.3-01") is expected
+    assert case_verdict(sim_session(faults), grouping_case, "R-4.4.8.3-01") is expected
 
 
 @pytest.mark.parametrize(
@@ -441,7 +415,7 @@ def test_a_cut_value_whose_tail_was_never_answered(faults, expected):
     ],
 )
 def test_high_volume_ascii_rules_over_empty_replies(faults, rule, expected):
-    assert _verdict(_session(faults), ascii_case, rule) is expected
+    assert case_verdict(sim_session(faults), ascii_case, rule) is expected
 
 
 @pytest.mark.parametrize(
@@ -457,7 +431,7 @@ def test_high_volume_ascii_rules_over_empty_replies(faults, rule, expected):
     ],
 )
 def test_binary_payload_rules_over_an_empty_packet(faults, rule, expected):
-    assert _verdict(_session(faults), binary_case, rule) is expected
+    assert case_verdict(sim_session(faults), binary_case, rule) is expected
 
 
 @pytest.mark.parametrize(
@@ -475,7 +449,7 @@ def test_binary_payload_rules_over_an_empty_packet(faults, rule, expected):
     ],
 )
 def test_an_answer_at_the_new_address_from_a_sensor_that_answers_anywhere(faults, rule, expected):
-    assert _verdict(_session(faults), change_case, rule) is expected
+    assert case_verdict(sim_session(faults), change_case, rule) is expected
 
 
 @pytest.mark.parametrize(
@@ -489,7 +463,7 @@ def test_an_answer_at_the_new_address_from_a_sensor_that_answers_anywhere(faults
     ],
 )
 def test_an_address_sweep_answered_by_a_sensor_that_answers_anywhere(faults, expected):
-    assert _verdict(_session(faults), range_case, "R-4.3-03") is expected
+    assert case_verdict(sim_session(faults), range_case, "R-4.3-03") is expected
 
 
 @pytest.mark.parametrize(
@@ -506,9 +480,9 @@ def test_an_address_sweep_answered_by_a_sensor_that_answers_anywhere(faults, exp
     ],
 )
 def test_standby_silence_probed_later_than_the_link_resolves(faults, widened_ms, expected):
-    session = _session(faults)
+    session = sim_session(faults)
     session.link.widen(widened_ms / 1e3)
-    assert _verdict(session, standby_case, "R-7.0-15") is expected
+    assert case_verdict(session, standby_case, "R-7.0-15") is expected
 
 
 @pytest.mark.parametrize(
@@ -521,7 +495,7 @@ def test_standby_silence_probed_later_than_the_link_resolves(faults, widened_ms,
     ],
 )
 def test_a_crc_value_never_compared(faults, expected):
-    assert _verdict(_session(faults), crc_value_case, "R-4.4.12-05") is expected
+    assert case_verdict(sim_session(faults), crc_value_case, "R-4.4.12-05") is expected
 
 
 @pytest.mark.parametrize(
@@ -545,4 +519,4 @@ def test_text_to_a_high_volume_command(faults, case_fn, rule, expected):
     R-5.1-01/R-5.2-01 FAILed the same text as a malformed start reply (seed 4167,
     high-volume-unsupported-silent + unknown-command-text): text with no digit is neither
     the a000000 the rule asks for nor a start reply, so support is undecided there."""
-    assert _verdict(_session(faults), case_fn, rule) is expected
+    assert case_verdict(sim_session(faults), case_fn, rule) is expected

@@ -16,39 +16,17 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.case import Case
-from conformance.ports import open_sim, parse_sim
-from conformance.preconditions import declared_on
 from conformance.protocol.timing import STANDBY_MARKING, TOLERANCE
-from conformance.results import CaseRecord, counted
 from conformance.sensor.session import PROBE_IDLE, SensorSession
 from conformance.transcript import EventKind
-from conformance.verdicts import Verdict, worst
+from conformance.verdicts import Verdict
 from testcases.sensor.test_7_timing import test_break_just_over_12ms_wakes as wake_case
 from testcases.sensor.test_7_timing import test_follow_up_without_break as follow_up_case
 from testcases.sensor.test_7_timing import test_marking_after_break as marking_case
 from testcases.sensor.test_7_timing import test_short_spacing_is_not_a_break as spacing_case
 from testcases.sensor.test_7_timing import test_standby_after_100ms as standby_case
 from testcases.sensor.test_7_timing import test_standby_after_foreign_command as foreign_case
-
-
-def _session(faults: str = "") -> SensorSession:
-    opened = open_sim(parse_sim(f"sim://?faults={faults}" if faults else "sim"))
-    session = SensorSession(opened.link, declaration=opened.declaration)
-    session.discover()
-    return session
-
-
-def _rules(case_fn) -> tuple[str, ...]:
-    return tuple(next(m for m in case_fn.pytestmark if m.name == "requirements").args)
-
-
-def _verdict(session: SensorSession, case_fn, rule: str) -> Verdict:
-    rules = _rules(case_fn)
-    record = CaseRecord(case_fn.__name__, case_fn.__name__, rules)
-    case_fn(session, Case(record, preconditions=declared_on(case_fn, rules)))
-    findings = [f for f in record.findings if f.requirement == rule]
-    return worst(f.verdict for f in counted(findings))
+from tests.support.case_verdicts import case_verdict, sim_session
 
 
 def _markings_before_breaks(session: SensorSession, first: int) -> list[float]:
@@ -68,14 +46,14 @@ def _markings_before_breaks(session: SensorSession, first: int) -> list[float]:
 
 def test_r_7_0_16_wake_up_needs_no_standby_idle_first():
     """R-7.0-16's wake-up break follows the line's last activity without a 150 ms idle."""
-    session = _session()
+    session = sim_session()
     first = len(session.link.transcript.events)
-    assert _verdict(session, follow_up_case, "R-7.0-16") is Verdict.PASS
+    assert case_verdict(session, follow_up_case, "R-7.0-16") is Verdict.PASS
     assert _markings_before_breaks(session, first)[0] < 0.05
 
 
 def test_standby_idle_is_probe_idle_on_a_tight_link_and_grows_with_the_uncertainty(monkeypatch):
-    session = _session()
+    session = sim_session()
     assert session.standby_idle() == PROBE_IDLE == 0.12
     monkeypatch.setattr(session.link, "timing_uncertainty", lambda: 0.015)
     assert session.standby_idle() == pytest.approx(STANDBY_MARKING + TOLERANCE + 0.030)
@@ -84,9 +62,9 @@ def test_standby_idle_is_probe_idle_on_a_tight_link_and_grows_with_the_uncertain
 def test_r_7_0_05_wake_ups_come_after_the_standby_idle():
     """Each of R-7.0-05's two wake-ups (9 ms and 2 ms of marking) is from 120 ms of marking
     on the sim, past the 100.4 ms limit, no longer 150 ms."""
-    session = _session()
+    session = sim_session()
     first = len(session.link.transcript.events)
-    assert _verdict(session, marking_case, "R-7.0-05") is Verdict.PASS
+    assert case_verdict(session, marking_case, "R-7.0-05") is Verdict.PASS
     idles = [m for m in _markings_before_breaks(session, first) if m > 0.1]
     assert idles == [pytest.approx(0.12, abs=1e-6)] * 2
 
@@ -120,13 +98,13 @@ def test_r_7_0_05_wake_ups_come_after_the_standby_idle():
     ],
 )
 def test_the_idles_serve_the_same_verdicts(faults, case_fn, rule, expected):
-    assert _verdict(_session(faults), case_fn, rule) is expected
+    assert case_verdict(sim_session(faults), case_fn, rule) is expected
 
 
 def test_to_standby_after_an_unanswered_break_counts_from_the_latest_wake_up():
     """After a break nothing answered, the idle runs to 100 ms (R-7.0-07) plus the standby
     idle past the break's end; after a reply, the standby idle past the reply."""
-    session = _session()
+    session = sim_session()
     session.probe(f"{session.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
     brk = next(e for e in reversed(session.link.transcript.events) if e.kind is EventKind.BREAK)
     marked = session.to_standby()
