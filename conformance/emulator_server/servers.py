@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import itertools
 import socket
-import struct
 import sys
 import threading
 import time
@@ -22,7 +21,7 @@ from collections.abc import Callable
 import serial
 from serial import rfc2217
 
-from ..links.kernel_stamps import SO_TIMESTAMPNS, STAMP_SPACE
+from ..links.kernel_stamps import SO_TIMESTAMPNS, STAMP_SPACE, recv_stamped_byte
 from ..links.stamps import chunk_frames
 from ..protocol.timing import BREAK_MIN, CHAR_TIME
 from .arrivals import Arrival, ToolEvent, lay, step
@@ -307,9 +306,4 @@ class ArrivalReader:
 
     def _stamped_byte(self) -> tuple[bytes, int | None]:
         """One byte and its packet's kernel stamp (wall-clock ns; None if none came)."""
-        data, ancdata, _flags, _addr = self.sock.recvmsg(1, STAMP_SPACE)
-        for level, kind, payload in ancdata:
-            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
-                sec, nsec = struct.unpack("qq", payload[:16])
-                return data, sec * 1_000_000_000 + nsec
-        return data, None
+        return recv_stamped_byte(self.sock)

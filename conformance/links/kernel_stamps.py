@@ -39,6 +39,18 @@ def _clock_offset_ns() -> int:
     return time.time_ns() - time.perf_counter_ns()
 
 
+def recv_stamped_byte(sock: socket.socket, *flags: int) -> tuple[bytes, int | None]:
+    """One byte from ``sock`` and the kernel's receive stamp of its packet (wall-clock ns,
+    as the kernel gives it; None if none came): the tool's link and the emulator server's
+    reader (``emulator_server.servers.ArrivalReader``) both read this way."""
+    data, ancdata, _flags, _addr = sock.recvmsg(1, STAMP_SPACE, *flags)
+    for level, kind, payload in ancdata:
+        if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
+            sec, nsec = struct.unpack("qq", payload[:16])
+            return data, sec * 1_000_000_000 + nsec
+    return data, None
+
+
 class StampTape:
     """Kernel stamps (perf_counter ns) of received data bytes, oldest first."""
 
@@ -72,12 +84,8 @@ class StampingSocket:
         self.on_stamp: Any = None  # called with (stamp_ns, nbytes) for each recv
 
     def recv(self, _size: int, *flags: int) -> bytes:
-        data, ancdata, _flags, _addr = self._sock.recvmsg(1, STAMP_SPACE, *flags)
-        stamp = None
-        for level, kind, payload in ancdata:
-            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
-                sec, nsec = struct.unpack("qq", payload[:16])
-                stamp = sec * 1_000_000_000 + nsec - _clock_offset_ns()
+        data, wall_ns = recv_stamped_byte(self._sock, *flags)
+        stamp = None if wall_ns is None else wall_ns - _clock_offset_ns()
         self.current_ns = stamp
         if self.on_stamp is not None and data:
             self.on_stamp(stamp, len(data))
