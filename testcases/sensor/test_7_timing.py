@@ -87,10 +87,18 @@ def _shown_asleep(sensor, case):
 def _hears_after_a_break(sensor, case, what: str) -> bool:
     """Silence to a probe sent after a hand-made pulse counts only if the sensor, put to
     sleep the same way, answers an a! sent after a real break with the same marking: one
-    slow to wake (a fault of R-7.0-05) would have missed the probe whatever the pulse was."""
+    slow to wake (a fault of R-7.0-05) would have missed the probe whatever the pulse was.
+    The control repeats the probe's whole prelude, the a! without a break that showed it
+    asleep included: a firmware that takes that a!'s leading spacing for a break and then
+    only waits for a '!' (uRADMonitor's, docs/kit.md thirteenth round) is blind to the
+    next break, and would have missed the pulse however it treats one."""
     _asleep(sensor)
+    check = sensor.master.raw(f"{sensor.address}!", break_first=False)
     control = sensor.probe(f"{sensor.address}!", break_s=13e-3)
-    case.evidence("put to sleep again, then a 13 ms break and a! (the control)", [control])
+    case.evidence(
+        "put to sleep again, a! with no break, then a 13 ms break and a! (the control)",
+        [check, control],
+    )
     return case.requires("listening", precondition.answered_control([control], what))
 
 

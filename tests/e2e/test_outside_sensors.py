@@ -37,6 +37,12 @@ R-4.4.4-01 and a sensor lost by an address change stops the run. A Python logger
 Sdi12Connector) ends each command with CR LF: the recorder view took '0M!<CR><LF>' for no
 command, its values as "logged, the command never sent" and its measurement flow and retries as
 unobserved; now the command is read up to its '!' (``Transmission.stem``).
+
+The thirteenth: an AVR firmware (uRADMonitor, radhoo/sdi12) takes the leading spacing of the
+unbroken a! that shows it asleep for a break and waits 100 ms for a '!', blind to breaks: its
+silence after R-7.0-03's 5 ms pulse PASSed, though it wakes on 2 ms of spacing, because the
+control (a real break and a!) was sent without that a! before it. The control now repeats the
+probe's whole prelude.
 """
 
 from __future__ import annotations
@@ -340,3 +346,74 @@ def test_retries_of_a_command_with_cr_lf_after_its_bang_are_judged(commands_end_
     never retries, was not FAILed for it)."""
     found = _verdicts(run_once("sim", role="recorder", keyword="test_retries"))
     assert found["R-7.2-01"]["verdict"] == "PASS", found["R-7.2-01"]["findings"]
+
+
+#: A firmware's 100 ms wait for a '!' after what it took for a break (s): uRADMonitor's.
+WAIT_FOR_BANG = 0.1
+
+
+@pytest.fixture
+def blind_after_an_unbroken_command(monkeypatch):
+    """The simulated sensor, as uRADMonitor's SDI-12 firmware (radhoo/sdi12) behaves: a
+    command heard in standby, without a break, leaves it blind to breaks for the next 100 ms
+    (the firmware polls for a break by counting, takes the command's leading spacing for one,
+    then only waits up to 100 ms for a '!', not looking for breaks); a break in that time
+    goes unseen, so the command after it is not answered either."""
+    from conformance.emulator.sensor import SensorEmulator
+
+    on_char, on_break = SensorEmulator.on_char, SensorEmulator.on_break
+
+    def hear(self, wire, start, end):
+        if not self.awake(start):
+            self._blind_until = end + WAIT_FOR_BANG
+        on_char(self, wire, start, end)
+
+    def brk(self, start, end):
+        if start < getattr(self, "_blind_until", float("-inf")):
+            return  # the firmware was waiting for a '!', not polling for a break
+        on_break(self, start, end)
+
+    monkeypatch.setattr(SensorEmulator, "on_char", hear)
+    monkeypatch.setattr(SensorEmulator, "on_break", brk)
+
+
+def test_silence_after_a_short_pulse_counts_only_if_the_same_prelude_lets_a_break_through_r_7_0_03(
+    blind_after_an_unbroken_command,
+):
+    """uRADMonitor's firmware takes 2 ms of spacing for a break (its 5000-count poll is 2 ms
+    of a 14.7456 MHz AVR, not the 12 ms its comment says), so a 5 ms pulse wakes it: a
+    R-7.0-03 fault. The tool PASSed R-7.0-03 "stayed silent (a 5.00 ms spacing is not a
+    break)": the a! without a break that showed it asleep had left it blind (its leading
+    spacing taken for a break, then 100 ms of waiting for a '!'), and the control, a 13 ms
+    break and a!, was sent without that a! before it, so it was answered. Here: the simulated
+    sensor waking on 4 ms of spacing (wakes-on-short-spacing) and blind as the firmware is.
+    The control now follows the probe's own prelude: it goes unanswered, so R-7.0-03 is not
+    decided on that silence."""
+    found = _verdicts(
+        run_once("sim://?faults=wakes-on-short-spacing", keyword="test_short_spacing")
+    )
+    rule = found["R-7.0-03"]
+    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+    assert "listening" in " ".join(f["detail"] for f in rule["findings"])
+
+
+def test_a_sensor_woken_by_a_short_pulse_still_fails_r_7_0_03():
+    """Without the blindness the same fault FAILs R-7.0-03, as before: the control's own a!
+    without a break does not stop a sensor that hears breaks from being judged."""
+    found = _verdicts(
+        run_once("sim://?faults=wakes-on-short-spacing", keyword="test_short_spacing")
+    )
+    assert found["R-7.0-03"]["verdict"] == "FAIL", found["R-7.0-03"]["findings"]
+
+
+def test_a_blind_sensor_that_ignores_short_pulses_is_not_failed_for_them(
+    blind_after_an_unbroken_command,
+):
+    """The blindness alone (breaks of 9 ms or more, as the simulated sensor takes them):
+    R-7.0-03 is not FAILed on it, and R-7.0-04 FAILs, the 12.6 ms break after the unbroken
+    a! going unseen (true of such a firmware: it misses a break it should take; its a!
+    answered after a break in test_acknowledge_active shows its silence is not R-4.4.1-01's)."""
+    keyword = "test_acknowledge_active or test_short_spacing or test_break_just_over_12ms_wakes"
+    found = _verdicts(run_once("sim://", keyword=keyword))
+    assert found["R-7.0-03"]["verdict"] != "FAIL", found["R-7.0-03"]["findings"]
+    assert found["R-7.0-04"]["verdict"] == "FAIL", found["R-7.0-04"]["findings"]
