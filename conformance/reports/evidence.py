@@ -35,7 +35,7 @@ from typing import Any
 from ..results import CaseRecord
 from ..transcript import Event, EventKind, Transcript
 from ..verdicts import Finding, Verdict
-from ..view.runs import Segment, segments, transcript_segments
+from ..view.runs import LazyCut, Segment, segments, whole_cut
 from ..view.segments import memo
 
 #: the verdicts a reader must be able to check against the wire
@@ -79,7 +79,7 @@ def _named(command: str, text: str) -> bool:
     return False
 
 
-def _chain(line: str, segs: list[Segment]) -> list[Segment] | None:
+def _chain(line: str, segs: Sequence[Segment]) -> list[Segment] | None:
     """The exchanges a line such as ``0MC! 0D0!`` names, in that order on the wire: the
     first occurrence of the first command, then each next command after it (None: the
     line is no such sequence, or the wire does not hold it)."""
@@ -88,13 +88,57 @@ def _chain(line: str, segs: list[Segment]) -> list[Segment] | None:
         return None
     chain: list[Segment] = []
     at = 0
+    texts = _texts(segs)
     for command in match.group(1).split():
-        found = next((i for i in range(at, len(segs)) if segs[i].text == command), None)
+        found = next((i for i in range(at, len(segs)) if texts[i] == command), None)
         if found is None:
             return None
         chain.append(segs[found])
         at = found + 1
     return chain
+
+
+def _texts(segs: Sequence[Segment]) -> list[str]:
+    """The segments' texts, read without making the segments of a :class:`LazyCut`."""
+    return segs.texts() if isinstance(segs, LazyCut) else [s.text for s in segs]
+
+
+def _named_in(segs: Sequence[Segment], lines: list[str]) -> list[Segment]:
+    """The segments whose command one of ``lines`` names, each once: those the first line
+    names in wire order, then the next line's not yet taken, and so on."""
+    texts = _texts(segs)
+    taken: list[int] = []
+    for line in lines:
+        seen = set(taken)
+        taken += [i for i, x in enumerate(texts) if x and _named(x, line) and i not in seen]
+    return [segs[i] for i in taken]
+
+
+def _nearest_measured(segs: Sequence[Segment], target: float) -> tuple[float, Segment] | None:
+    """The first segment (wire order) holding an interval nearest ``target`` ms, with how
+    near: what scoring every segment by its nearest interval and taking the first of the
+    least finds. A :class:`LazyCut` (a whole recording's) answers from an index of its
+    intervals made once (:class:`~.timing_diagram.MeasureIndex`), not by making each of its
+    segments for each finding; one with a NaN interval, whose order the index does not
+    keep as the scan does, is scanned."""
+    if isinstance(segs, LazyCut):
+        index, has_nan = memo(segs, "_measure_index", len(segs), lambda: _index(segs))
+        if not has_nan and target == target:  # a NaN target: scanned, as before
+            found = index.nearest(target)
+            if found is None:
+                return None
+            best = segs[found]
+            return min(abs(m - target) for m in _measures(best)), best
+    scored = [(min(abs(m - target) for m in _measures(s)), s) for s in segs if _measures(s)]
+    return min(scored, key=lambda p: p[0]) if scored else None
+
+
+def _index(segs: LazyCut) -> tuple[Any, bool]:
+    """:class:`~.timing_diagram.MeasureIndex` of ``segs`` and whether an interval is NaN."""
+    from .timing_diagram import MeasureIndex
+
+    index = MeasureIndex(segs)
+    return index, any(v != v for v in index.values)
 
 
 def _distance(seg: Segment, t: float) -> float:
@@ -177,12 +221,12 @@ class Locator:
         self.events = events
         self.transcript = transcript
         self.position = Positions(events)
-        self._cuts: dict[tuple[int, int], list[Segment]] = {}
+        self._cuts: dict[tuple[int, int], Sequence[Segment]] = {}
 
     def _index(self) -> None:
         self.position.index()
 
-    def _segments(self, lo: int, hi: int) -> list[Segment]:
+    def _segments(self, lo: int, hi: int) -> Sequence[Segment]:
         """The exchanges among events ``lo..hi-1`` (cut once per range: a whole run's cut
         takes a fifth of a second)."""
         key = (lo, hi)
@@ -190,8 +234,11 @@ class Locator:
             if len(self._cuts) > 64:
                 self._cuts.clear()
             whole = self.transcript is not None and lo == 0 and hi == len(self.events)
-            cut = transcript_segments(self.transcript) if whole else segments(self.events[lo:hi])
-            self._cuts[key] = [s for s in cut if s.command]
+            cut = whole_cut(self.transcript) if whole else segments(self.events[lo:hi])
+            if isinstance(cut, LazyCut):  # a command's segment: a transmission with characters
+                self._cuts[key] = LazyCut([t for t in cut.transmissions if t.chars])
+            else:
+                self._cuts[key] = [s for s in cut if s.command]
         return self._cuts[key]
 
     def _ref(self, events: Sequence[Event], exchange: str | None, how: str) -> WireRef | None:
@@ -204,29 +251,21 @@ class Locator:
             exchange, how,
         )  # fmt: skip
 
-    def _pick(self, finding: Finding, segs: list[Segment]) -> tuple[list[Segment], str] | None:
+    def _pick(self, finding: Finding, segs: Sequence[Segment]) -> tuple[list[Segment], str] | None:
         lines = [*finding.evidence, finding.detail]
         if finding.measured_ms is None:
             for line in lines:
                 chained = _chain(line, segs)
                 if chained:
                     return chained, "command"
-        named: list[Segment] = []
-        for line in lines:  # the evidence lines' commands first, in their order
-            seen = {id(n) for n in named}
-            named += [s for s in segs if s.text and _named(s.text, line) and id(s) not in seen]
+        named = _named_in(segs, lines)  # the evidence lines' commands first, in their order
         stamps = [float(t) for line in lines for t in STAMP.findall(line)]
         if stamps and named:  # "reply to ?! at t=0.0387 s": the one nearest that time first
             named.sort(key=lambda s: min(_distance(s, t) for t in stamps))
         if finding.measured_ms is not None:
-            pool = named or segs
-            scored = [
-                (min(abs(m - finding.measured_ms) for m in _measures(s)), s)
-                for s in pool
-                if _measures(s)
-            ]
-            if scored:
-                distance, best = min(scored, key=lambda p: p[0])
+            nearest = _nearest_measured(named or segs, finding.measured_ms)
+            if nearest is not None:
+                distance, best = nearest
                 if distance <= MEASURE_MATCH_MS:
                     return [best], "command and measured" if named else "measured"
         return ([named[0]], "command") if named else None

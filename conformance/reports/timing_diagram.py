@@ -35,7 +35,8 @@ from ..protocol.timing import (
 from ..transcript import TOOL, Event, EventKind, Transcript
 from ..transcript import escape as escape_wire
 from ..verdicts import Finding
-from ..view.runs import transcript_segments
+from ..view.runs import LazyCut, whole_cut
+from ..view.segments import memo
 
 PX_PER_MS = 5.0  # one 8.33 ms character is 42 px: room for "CR"/"LF" at reading size
 ELIDE_OVER = 0.14  # s: idle stretches longer than this are cut out of the axis
@@ -632,8 +633,13 @@ def exchange_behind(
         return None
     target = max(timed, key=lambda f: f.verdict.rank)
     if isinstance(events, Transcript):
-        cut = transcript_segments(events)
-        index = cut.derived("measure_index", None, lambda: MeasureIndex(cut))
+        cut = whole_cut(events)
+        if isinstance(cut, LazyCut):  # a passive judgement's: the index kept, no segment
+            index = memo(
+                events, "_whole_measure_index", len(events.events), lambda: MeasureIndex(cut)
+            )
+        else:
+            index = cut.derived("measure_index", None, lambda: MeasureIndex(cut))
     else:
         cut = segments(events)
         index = MeasureIndex(cut)

@@ -15,9 +15,9 @@ is ``contention``: never the DUT's reply text. Both cuts come from the one segme
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import TypeVar, overload
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
@@ -180,6 +180,53 @@ def transcript_segments(transcript: Transcript) -> Segments:
         len(transcript.events),
         lambda: Segments(Segment.of(t) for t in transcript_view(transcript).transmissions),
     )
+
+
+class LazyCut(Sequence[Segment]):
+    """A whole transcript's segments (:func:`transcript_segments`' list, item for item) made
+    from its view's transmissions as they are read, none held: each read of an item makes it
+    again (:meth:`Segment.of` of one transmission, which depends on that transmission alone).
+    A passive judgement's reports search the whole run's exchanges for a finding's evidence
+    (:mod:`~conformance.reports.evidence`) and a whole-run case's worst value
+    (:func:`~conformance.reports.timing_diagram.exchange_behind`); holding the whole list
+    for them kept 11.5 MB at an hour of a busy bus (770 bytes a segment) through every run
+    (issue 22). :meth:`texts` gives the segments' texts without making them."""
+
+    def __init__(self, transmissions: Sequence[Transmission]) -> None:
+        self.transmissions = transmissions
+
+    def __len__(self) -> int:
+        return len(self.transmissions)
+
+    @overload
+    def __getitem__(self, i: int) -> Segment: ...
+    @overload
+    def __getitem__(self, i: slice) -> list[Segment]: ...
+    def __getitem__(self, i: int | slice) -> Segment | list[Segment]:
+        if isinstance(i, slice):
+            return [Segment.of(t) for t in self.transmissions[i]]
+        return Segment.of(self.transmissions[i])
+
+    def __iter__(self) -> Iterator[Segment]:
+        return map(Segment.of, self.transmissions)
+
+    def texts(self) -> list[str]:
+        """Every segment's text, in order (kept: one reference a segment, the strings are
+        the transmissions' own)."""
+        return memo(
+            self, "_texts", len(self.transmissions), lambda: [t.text for t in self.transmissions]
+        )
+
+
+def whole_cut(transcript: Transcript) -> Segments | LazyCut:
+    """The whole transcript's segments for a report's search: the held list where a whole-run
+    case of this run cut it already (:func:`transcript_segments`), else a :class:`LazyCut`
+    of the same segments that holds none (a passive judgement's sensor runs each cut their
+    own sensor's only)."""
+    held = transcript.__dict__.get("_segments")
+    if held is not None and held[0] == len(transcript.events):
+        return held[1]
+    return LazyCut(transcript_view(transcript).transmissions)
 
 
 def runs(events: list[Event], gap: float = RUN_GAP) -> list[list[Event]]:
