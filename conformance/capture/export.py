@@ -16,6 +16,7 @@ import numpy as np
 
 from ..transcript import TOOL, Event, EventKind
 from .comments import capture_comment
+from .held_sr import hold_sr
 from .levels import edge_array
 from .writers import Channel, write_csv, write_sr, write_vcd
 
@@ -51,6 +52,7 @@ def export_events(
     line_polarity: bool = False,
     tool_channel: bool = False,
     notes: Sequence[Event] = (),
+    hold: bool = False,
 ) -> ExportInfo:
     """Write ``events`` as a capture at ``path``.
 
@@ -60,7 +62,9 @@ def export_events(
     transmissions (origin ``tool``), like a capture of the recorder's TX beside the bus.
     ``notes``: NOTE events kept in the file (a .sr member, a VCD ``$comment``, a CSV comment
     line), in capture time, with which channel is the bus and which the tool's; read back
-    with :func:`~conformance.capture.comments.embedded_meta`."""
+    with :func:`~conformance.capture.comments.embedded_meta`. ``hold`` (a .sr only): the
+    samples are not written but held as the edges they read back as, for a capture judged
+    at once and deleted (:mod:`.held_sr`; inside :func:`~.held_sr.held_sr_captures`)."""
     path = str(path)
     fmt = (fmt or os.path.splitext(path)[1].lstrip(".")).lower()
     if fmt not in EXPORT_FORMATS:
@@ -85,8 +89,12 @@ def export_events(
     comment = capture_comment(
         notes, 0.0 if fmt == "csv" else t0, BUS_CHANNEL, TOOL_CHANNEL if tool_channel else None
     )
+    if hold and fmt != "sr":
+        raise ValueError(f"only a .sr export is held without its samples, not a {fmt}")
     if fmt == "sr":
-        write_sr(path, channels, sample_rate, total, comment=comment)
+        write_sr(path, channels, sample_rate, total, comment=comment, samples=not hold)
+        if hold:
+            hold_sr(path, channels, sample_rate, total)
     else:
         with open(path, "w", encoding="ascii", newline="\n") as fh:
             if fmt == "vcd":

@@ -21,6 +21,7 @@ import numpy as np
 
 from .edges import Edges, transitions
 from .errors import CaptureError
+from .held_sr import held_edges
 from .read_ahead import read_ahead
 
 #: What Python's zipfile raises for a damaged archive or member: besides the obvious, an
@@ -175,7 +176,11 @@ def _identity(path: str) -> tuple | None:
 def read_sr(path: str, channel: str | None = None) -> Edges:
     """Edges of one probe of a session (``channel`` by name; default the busiest one). The
     pass over the samples keeps the other probes' edges too (:data:`_OTHERS`), which a
-    later read of one of them takes instead of a pass of its own."""
+    later read of one of them takes instead of a pass of its own. A session held without its
+    samples (:mod:`.held_sr`: a matrix row's export) gives the edges they read back as."""
+    held = held_edges(path, channel, BLOCK_SAMPLES)
+    if held is not None:
+        return held
     key = _identity(path)
     kept = _OTHERS.get(key, {}).get(channel or "") if key is not None else None
     if kept is not None:

@@ -92,11 +92,13 @@ def write_sr(
     total: int,
     level: int = 1,
     comment: str | None = None,
+    samples: bool = True,
 ) -> None:
     """A sigrok session, version 2 (libsigrok >= 0.4): ``version``, ``metadata`` and the
     samples in ``logic-1-1``, ``logic-1-2``... one byte per sample, channel N on bit N-1.
     ``level``: deflate level (1 is several times faster than the default and the samples are
-    runs, which compress well at any level)."""
+    runs, which compress well at any level). ``samples`` False: no sample member is written,
+    the caller holds them (:func:`~.held_sr.hold_sr`)."""
     probes = "".join(f"probe{i + 1}={c.name}\n" for i, c in enumerate(channels))
     metadata = (
         "[global]\nsigrok version=0.5.2\n\n[device 1]\ncapturefile=logic-1\n"
@@ -108,7 +110,7 @@ def write_sr(
         zf.writestr("metadata", metadata)
         if comment:
             zf.writestr(SR_COMMENT_MEMBER, comment)
-        for n, word in enumerate(_words(channels, total), 1):
+        for n, word in enumerate(_words(channels, total) if samples else (), 1):
             # the array's own buffer (zipfile takes any buffer: its CRC and deflate read
             # it in place), not a copy of 4 MiB a block
             zf.writestr(f"logic-1-{n}", memoryview(word))

@@ -6,6 +6,7 @@ events a file would not read back as exactly are written in the matrix too."""
 
 from __future__ import annotations
 
+import zipfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -13,6 +14,7 @@ import pytest
 
 import conformance.offline.judge as judge
 import conformance.replay.recording as recording
+from conformance.capture import held_sr
 from conformance.capture.export import export_events
 from conformance.conduct import conduct
 from conformance.matrices import roundtrip
@@ -46,6 +48,19 @@ def test_the_round_trip_writes_no_decoded_capture(live, tmp_path: Path):
     assert roundtrip.verdict_changes(data, again) == ()
     assert any(r["verdict"] == "FAIL" for r in again["requirements"])
     assert recording._HELD == {}  # let go with the row
+
+
+def test_the_round_trip_holds_its_captures_samples(live, tmp_path: Path):
+    """The row's .sr holds its metadata and comment, not its 3*10^7 samples: they are held
+    as the edges they read back as (capture/held_sr.py) while the row is judged, then let
+    go; the verdicts are the live run's (and a user's judge of the written file's, below)."""
+    data, events = live
+    again = roundtrip.judged_events(events, "live", tmp_path)
+    with zipfile.ZipFile(tmp_path / "run.sr") as zf:
+        names = zf.namelist()
+    assert "metadata" in names and not [n for n in names if n.startswith("logic-1")]
+    assert held_sr._HELD == {}
+    assert roundtrip.verdict_changes(data, again) == ()
 
 
 def test_a_users_judge_writes_it_and_judges_alike(live, tmp_path: Path):
