@@ -218,6 +218,14 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-5.2-02",),
     ),
     Interaction(
+        frozenset({"binary-invalid-type", "d0-empty"}),
+        "the measurement holds no values, so aDB0! returns the empty packet, and the type"
+        " code 11 binary-invalid-type puts on DB0's values has no values to go on: the one"
+        " packet on the wire is '0<00 00><00><0F 00>', type 0, a valid code, and R-5.2.1-01"
+        " holds there (seed 4186 with extended-not-x: 0DB0! and 0DB999! alike).",
+        removes=("R-5.2.1-01",),
+    ),
+    Interaction(
         frozenset({"binary-no-empty-packet", "d0-empty"}),
         "aHB! announces 33 values but the measurement holds none, so aDB0! is already past"
         " the data, and binary-no-empty-packet answers that with nothing: an aDBn! inside the"
