@@ -79,6 +79,15 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.8.3-03",),
     ),
     Interaction(
+        frozenset({"more-values-than-announced", "values-not-packed"}),
+        "aM!'s D0 holds one value fewer than would fit, so it returns the 3 announced"
+        " ('0+22.15+1013.2+45.7') and the fourth, the one too many, is left for aD1!, which"
+        " a recorder (and this tool, decision A12) never sends once the count is read: no"
+        " reply on the wire holds more values than announced, and R-4.4.8-03 holds there"
+        " (seed 4187 with verify-no-service-request: aM! read 9 times, never a D1 after it).",
+        removes=("R-4.4.8-03",),
+    ),
+    Interaction(
         frozenset({"values-not-packed", "values-over-35"}),
         "each D reply after M/V holds one value fewer than its 40-character limit would take;"
         " with the reference sensor's 9- and 10-character values the one left out is the one"
