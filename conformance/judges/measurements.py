@@ -311,12 +311,18 @@ def shown_reply_ids(command: Command, reply: DataReply) -> list[str]:
     return ids
 
 
-def undecide_uncompared_crc(reply: DataReply, tally: Tally, where_: str) -> None:
+def uncompared_crc(reply: DataReply) -> bool:
     """A CRC whose encoding is no CRC-16's (R-4.4.12-06) is not compared with the text
-    (protocol.responses._check_crc), so it shows nothing of R-4.4.12-05 either way
-    (crc-wrong-encoding + wrong-crc + value-two-points, seed 4118: R-4.4.12-05 PASSed
-    "17 checked" where every CRC was off by one and none compared)."""
-    if not any(v.requirement == "R-4.4.12-05" for v in reply.violations):
+    (protocol.responses._check_crc), so it shows nothing of R-4.4.12-05 either way."""
+    wrong = any(v.requirement == "R-4.4.12-05" for v in reply.violations)
+    return bool(reply.crc) and not reply.crc_ok and not wrong
+
+
+def undecide_uncompared_crc(reply: DataReply, tally: Tally, where_: str) -> None:
+    """R-4.4.12-05 undecided on an :func:`uncompared_crc` (crc-wrong-encoding + wrong-crc
+    + value-two-points, seed 4118: R-4.4.12-05 PASSed "17 checked" where every CRC was off
+    by one and none compared)."""
+    if uncompared_crc(reply):
         tally.undecide(
             "R-4.4.12-05",
             where_,

@@ -30,8 +30,18 @@ def _with_continuous(sensor, ids) -> list[Finding]:
     for f in found:
         other = more.get(f.requirement)
         both = counted([f] if other is None else [f, other])
-        merged.append(max(both, key=lambda x: x.verdict.rank))
+        # of two undecided, the one over observations (an aRCn! CRC not compared) says more
+        # than the one that saw nothing (seed 4198, + measure-ttt-two-digits: the unreached
+        # one was kept, and the exploration's PASS outvoted it)
+        merged.append(max(both, key=_weight))
     return merged
+
+
+def _weight(finding: Finding) -> tuple[int, int]:
+    """Worse first; between two INCONCLUSIVEs, the one over more observations (ties keep
+    the D replies' finding, as before)."""
+    undecided = finding.verdict is Verdict.INCONCLUSIVE
+    return finding.verdict.rank, (finding.observed or 0) if undecided else 0
 
 
 def _crc_served(sensor, case) -> None:

@@ -543,3 +543,20 @@ def test_text_to_a_high_volume_command(faults, case_fn, rule, expected):
     high-volume-unsupported-silent + unknown-command-text): text with no digit is neither
     the a000000 the rule asks for nor a start reply, so support is undecided there."""
     assert case_verdict(sim_session(faults), case_fn, rule) is expected
+
+
+def test_an_uncompared_crc_is_an_observation_the_run_counts():
+    """(seed 4198, crc-missing + crc-wrong-encoding + measure-ttt-two-digits) the CRC case
+    kept the D replies' "nothing observed" over the aRCn! replies' "not compared", two
+    INCONCLUSIVEs of one rank, and the run let the exploration's PASS outvote the one that
+    saw nothing: the one over observations is kept."""
+    from conformance.case import Case
+    from conformance.preconditions import declared_on
+    from conformance.results import CaseRecord
+
+    session = sim_session("crc-missing,crc-wrong-encoding,measure-ttt-two-digits")
+    rules = ("R-4.4.12-05", "R-4.4.12-06")
+    record = CaseRecord("crc", "crc", rules)
+    crc_value_case(session, Case(record, preconditions=declared_on(crc_value_case, rules)))
+    [finding] = [f for f in record.findings if f.requirement == "R-4.4.12-05"]
+    assert finding.verdict is Verdict.INCONCLUSIVE and finding.observed >= 1
