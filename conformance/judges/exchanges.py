@@ -34,7 +34,7 @@ __all__ = [
 from ..preconditions import ControlledProbe, listening
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .cite import cite, cited, heard, shown
-from .measurements import data_reply_ids
+from .measurements import shown_reply_ids, undecide_uncompared_crc
 from .support import text_instead_of_values
 from .tally import Tally
 
@@ -211,12 +211,14 @@ def continuous(
                 continue
             body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
             reply = parse_data_reply_for(body, ex.command, expected_address=ex.command.address)
-            ids_here = [i for i in data_reply_ids(ex.command) if i != "R-4.4.8-01"]
+            ids_here = [i for i in shown_reply_ids(ex.command, reply) if i != "R-4.4.8-01"]
             tally.observe(
                 label,
                 framing + [v for v in reply.violations if v.requirement != "R-4.4.8-01"],
                 ids=ids_here + ["R-4.4.8.1-01"],
             )
+            if reply.crc and not reply.crc_ok:
+                undecide_uncompared_crc(reply, tally, label)
             if not reply.values:
                 unsupported += 1
                 tally.observe(label, ids=["R-4.4.8.1-03"])

@@ -226,9 +226,9 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
             break
         body, framing = split_line(ex.reply_text, crc_positions=3 if m.command.returns_crc else 0)
         reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
-        tally.observe(dlabel, framing + reply.violations, ids=data_reply_ids(m.command))
+        tally.observe(dlabel, framing + reply.violations, ids=shown_reply_ids(m.command, reply))
         if reply.crc and not reply.crc_ok:
-            _undecide_uncompared_crc(reply, tally, dlabel)
+            undecide_uncompared_crc(reply, tally, dlabel)
         replies.append(reply)
         if _refuses_high_index(m, ex):
             # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
@@ -298,12 +298,31 @@ def _undecide_unread_high_volume(
         )
 
 
-def _undecide_uncompared_crc(reply: DataReply, tally: Tally, where_: str) -> None:
+def shown_reply_ids(command: Command, reply: DataReply) -> list[str]:
+    """The rules one D (or R) reply is an observation of: a reply that should carry a CRC and
+    carries none (R-4.4.12-02's deviation) shows nothing of the CRC's value or encoding
+    (crc-missing + crc-wrong-encoding + extended-not-x, seed 4179: R-4.4.12-05 PASSed
+    "17 checked" on aMC!/aCC!'s CRC-less replies while every CRC on the wire was encoded
+    as no CRC-16 and none was compared; the aRCn! replies, encoded so too, PASSed it as well
+    once those were left out)."""
+    ids = data_reply_ids(command)
+    if command.returns_crc and reply.crc is None:
+        return [i for i in ids if i not in ("R-4.4.12-05", "R-4.4.12-06")]
+    return ids
+
+
+def uncompared_crc(reply: DataReply) -> bool:
     """A CRC whose encoding is no CRC-16's (R-4.4.12-06) is not compared with the text
-    (protocol.responses._check_crc), so it shows nothing of R-4.4.12-05 either way
-    (crc-wrong-encoding + wrong-crc + value-two-points, seed 4118: R-4.4.12-05 PASSed
-    "17 checked" where every CRC was off by one and none compared)."""
-    if not any(v.requirement == "R-4.4.12-05" for v in reply.violations):
+    (protocol.responses._check_crc), so it shows nothing of R-4.4.12-05 either way."""
+    wrong = any(v.requirement == "R-4.4.12-05" for v in reply.violations)
+    return bool(reply.crc) and not reply.crc_ok and not wrong
+
+
+def undecide_uncompared_crc(reply: DataReply, tally: Tally, where_: str) -> None:
+    """R-4.4.12-05 undecided on an :func:`uncompared_crc` (crc-wrong-encoding + wrong-crc
+    + value-two-points, seed 4118: R-4.4.12-05 PASSed "17 checked" where every CRC was off
+    by one and none compared)."""
+    if uncompared_crc(reply):
         tally.undecide(
             "R-4.4.12-05",
             where_,

@@ -259,3 +259,26 @@ def test_two_crc_toggles_each_edit_the_replies_their_command_asked_for(faults):
     bare = Rig()
     assert rig.ask(plain).body == bare.ask(crc).body  # the CRC nobody asked for
     assert rig.ask(crc).body == bare.ask(plain).body  # the asked CRC gone
+
+
+def test_no_reply_edit_raises_on_what_another_left():
+    """R-5.2.1-01, R-5.2-05 (seed 4183: binary-invalid-type + binary-payload-not-multiple):
+    the pad read DB0's type after the other fault had set it to 11, and type_size(11) raised
+    inside the sensor (21 requirements ERROR). The pair touches different replies of the
+    corpus (DB0 int8, DB2 int16), so the faithfulness test above never composed it: here
+    every two faults that edit replies rewrite each reply either touches, in both orders."""
+    editing = sorted(n for n in FAULTS if any(key[0] == "reply" for key in TOUCHED[n]))
+    problems = []
+    for a, b in combinations(editing, 2):
+        replies = sorted({key[1] for key in TOUCHED[a] | TOUCHED[b] if key[0] == "reply"})
+        for order in ((a, b), (b, a)):
+            try:
+                fault_set = compose(list(order))
+            except CompositionError:
+                break
+            for n in replies:
+                try:
+                    fault_set.rewrite(replace(CORPUS[n]))
+                except Exception as exc:  # noqa: BLE001 - any raise is the finding
+                    problems.append(f"{' + '.join(order)} on {CORPUS[n].kind}: {exc!r}")
+    assert problems == []

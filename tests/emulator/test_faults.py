@@ -272,6 +272,27 @@ def check_identify_sends_service_request(rig: Rig) -> None:
     assert decode_7e1(rig.line(2.0)) == "0\r\n"
 
 
+def test_an_identify_service_request_due_during_a_command_follows_it_at_once():
+    """R-7.0-09, which interactions.py lets identify-sends-service-request break beside any
+    partner: with this fault alone, a command whose last character is on the line when the
+    wrongly owed request falls due is followed by that request 0 ms after its end, then by
+    its own reply (seeds 4120, 4142, 4156 saw it where partners moved the schedule)."""
+
+    def after_identify() -> Rig:
+        rig = Rig(faults=("identify-sends-service-request",))
+        rig.ask("0IM!")
+        return rig
+
+    due = after_identify().line(3.0)[0].start
+    rig = after_identify()
+    while rig.now < due - 0.1:
+        rig.ask("0!", brk=False)  # awake, as in a run's run of identify commands
+    rig.link.wait_until(due - 0.020)  # 0I!'s third character spans the moment
+    answer = rig.ask("0I!", brk=False)
+    assert answer.text == "0\r\n014CONFORM EMU001100SN0001\r\n"
+    assert answer.delay < RESPONSE_START_MIN  # 7.93 ms
+
+
 # -- aborts -----------------------------------------------------------------------------------
 def check_break_does_not_abort_measure(rig: Rig) -> None:
     rig.ask("0M!")

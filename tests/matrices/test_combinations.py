@@ -78,7 +78,31 @@ def test_an_interaction_without_reason_or_effect_is_refused():
     with pytest.raises(ValueError):
         Interaction(frozenset({"a", "b"}), "why")
     with pytest.raises(ValueError):
-        Interaction(frozenset({"a"}), "why", adds=("R-9",))
+        Interaction(frozenset(), "why", adds=("R-9",))
+
+
+def test_one_fault_alone_adds_beside_any_partner_and_never_removes():
+    """identify-sends-service-request's R-7.0-09 (a request that falls due while a command
+    is on the line follows it at once) was declared three times, pair by pair (seeds 4120,
+    4142, 4156), though any partner that moves the schedule can land it: declared once now.
+    A mask is a partner's doing, so a fault alone may not remove: that would excuse every
+    missed FAIL of its requirement in every combination."""
+    timing = Interaction(frozenset({"a"}), "a's stray line lands where the schedule puts it",
+                         adds=("R-9",))  # fmt: skip
+    data = verdicts(R_1="FAIL", R_3="FAIL", R_9="FAIL")
+    assert check(("a", "b"), DECLARED, data, [timing]).clean
+    assert check(("a", "c"), {**DECLARED, "c": (("R-3",), ())}, data, [timing]).clean
+    row = check(("b", "c"), {**DECLARED, "c": (("R-1",), ())}, data, [timing])  # no a
+    assert [f.requirement for f in row.unexpected] == ["R-9"]
+    with pytest.raises(ValueError, match="alone only adds"):
+        Interaction(frozenset({"a"}), "why", removes=("R-1",))
+
+
+def test_identify_service_request_timing_is_declared_once():
+    from conformance.emulator.faults.interactions import INTERACTIONS
+
+    holding = [i for i in INTERACTIONS if "R-7.0-09" in i.adds]
+    assert [sorted(i.members) for i in holding] == [["identify-sends-service-request"]]
 
 
 def test_the_sampler_is_deterministic_distinct_and_version_consistent():

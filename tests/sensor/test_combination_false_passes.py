@@ -74,6 +74,10 @@ marking, where the sensor sleeps too; the sim, probing at 101.9 ms, FAILs it. A 
 PASSes only where the probe surely landed within 3 ms past the 100.4 ms limit.
 R-4.4.12-05 PASSed "17 checked" where every CRC was encoded as no CRC-16 (0x60) and off by
 one (crc-wrong-encoding + wrong-crc + value-two-points, seed 4118): none was compared.
+R-4.4.12-05 PASSed "17 checked" on the D replies after aMC!/aCC!, which carried no CRC at
+all, while the aRCn! replies' CRCs were encoded as no CRC-16 (crc-missing + crc-wrong-
+encoding + extended-not-x, seed 4179): a reply without its CRC shows nothing of the CRC's
+value or encoding, and an uncompared aRCn! CRC leaves the value undecided as a D reply's does.
 """
 
 from __future__ import annotations
@@ -490,12 +494,31 @@ def test_standby_silence_probed_later_than_the_link_resolves(faults, widened_ms,
     [
         ("crc-wrong-encoding,wrong-crc", Verdict.INCONCLUSIVE),
         ("crc-wrong-encoding", Verdict.INCONCLUSIVE),
+        # (seed 4179) the CRC-less D replies after aMC!/aCC! were "checked", and the aRCn!
+        # replies, encoded as no CRC-16, too: none was compared
+        ("crc-missing,crc-wrong-encoding", Verdict.INCONCLUSIVE),
+        # the aRCn! replies' CRCs are compared and right: the D replies without one do not
+        # outvote them
+        ("crc-missing", Verdict.PASS),
+        ("crc-missing,wrong-crc", Verdict.FAIL),
         ("wrong-crc", Verdict.FAIL),
         ("", Verdict.PASS),
     ],
 )
 def test_a_crc_value_never_compared(faults, expected):
     assert case_verdict(sim_session(faults), crc_value_case, "R-4.4.12-05") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("crc-missing", Verdict.PASS),  # the aRCn! replies' CRCs are well encoded
+        ("crc-missing,crc-wrong-encoding", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_a_missing_crc_shows_no_encoding(faults, expected):
+    assert case_verdict(sim_session(faults), crc_value_case, "R-4.4.12-06") is expected
 
 
 @pytest.mark.parametrize(
@@ -520,3 +543,20 @@ def test_text_to_a_high_volume_command(faults, case_fn, rule, expected):
     high-volume-unsupported-silent + unknown-command-text): text with no digit is neither
     the a000000 the rule asks for nor a start reply, so support is undecided there."""
     assert case_verdict(sim_session(faults), case_fn, rule) is expected
+
+
+def test_an_uncompared_crc_is_an_observation_the_run_counts():
+    """(seed 4198, crc-missing + crc-wrong-encoding + measure-ttt-two-digits) the CRC case
+    kept the D replies' "nothing observed" over the aRCn! replies' "not compared", two
+    INCONCLUSIVEs of one rank, and the run let the exploration's PASS outvote the one that
+    saw nothing: the one over observations is kept."""
+    from conformance.case import Case
+    from conformance.preconditions import declared_on
+    from conformance.results import CaseRecord
+
+    session = sim_session("crc-missing,crc-wrong-encoding,measure-ttt-two-digits")
+    rules = ("R-4.4.12-05", "R-4.4.12-06")
+    record = CaseRecord("crc", "crc", rules)
+    crc_value_case(session, Case(record, preconditions=declared_on(crc_value_case, rules)))
+    [finding] = [f for f in record.findings if f.requirement == "R-4.4.12-05"]
+    assert finding.verdict is Verdict.INCONCLUSIVE and finding.observed >= 1
