@@ -240,19 +240,20 @@ class ToolRecorder:
                 break
             held = True
             self.link.wait_until(min(clear, began + bound))
-            look = uncertainty
+            look = look_past_turnaround(uncertainty, self.policy.turnaround)
         self.holds += held
         return self.link.now()
 
     def look_before_transmit(self) -> float:
         """How long past the turnaround after the DUT's last character :meth:`clear_to_send`
-        listens before it transmits (s): the link's timing uncertainty, or nothing right after
-        the tool's own break. It ends that long after the turnaround, so a case that aims a
-        transmission at a moment later than that need not start its wait any earlier
-        (:meth:`SensorSession.mark_until`)."""
+        listens before it transmits (s): what the turnaround leaves of a back-to-back
+        character's frame and the link's timing uncertainty (:func:`look_past_turnaround`),
+        or nothing right after the tool's own break. It ends that long after the turnaround,
+        so a case that aims a transmission at a moment later than that need not start its
+        wait any earlier (:meth:`SensorSession.mark_until`)."""
         if _own_break_last(self.link):
             return 0.0
-        return self.link.info.timing_uncertainty
+        return look_past_turnaround(self.link.info.timing_uncertainty, self.policy.turnaround)
 
     def note_collisions(self) -> int:
         """Add a collision NOTE for each tool transmission that overlapped DUT characters
@@ -637,6 +638,19 @@ def _service_request_end(events: list[Event], address: str) -> float | None:
 #: Events before the last look that a collision scan takes again, so a transmission whose
 #: DUT characters arrived after the look is still seen whole.
 _COLLISION_LOOKBACK = 64
+
+
+def look_past_turnaround(uncertainty: float, turnaround: float) -> float:
+    """The look after the turnaround (s): a DUT that goes on talking back to back after its
+    last character (its CR LF) starts the next one as that one ends, so the link has shown
+    it ``CHAR_TIME`` (its frame) plus at most ``uncertainty`` (the link's lateness) after the
+    last one's stamp. The turnaround already listened that long but for the rest, so the look
+    is the rest, not the whole uncertainty again: 4.33 ms behind RFC 2217 (5 ms), where the
+    look used to run 5 ms past the turnaround and so waited for a character that started up
+    to 0.67 ms after the CR LF as well (issue 22, eff10: 0.67 ms of each of about 680
+    turnarounds a real run). On the sim (no uncertainty) the turnaround covers the frame and
+    nothing is added, as before."""
+    return max(0.0, CHAR_TIME + uncertainty - turnaround)
 
 
 def _own_break_last(link: Link) -> bool:

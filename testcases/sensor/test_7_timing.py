@@ -24,7 +24,7 @@ from conformance.protocol.timing import (
     WAKE_LIMIT,
 )
 from conformance.sensor.session import PROBE_TRIES
-from conformance.transcript import EventKind
+from conformance.transcript import TOOL, EventKind, decode_7e1
 from conformance.verdicts import Verdict, failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
@@ -65,9 +65,67 @@ def _awake(sensor):
 def _asleep(sensor) -> float:
     """Put the sensor in standby by both routes (a command for another address, then more
     than 100 ms of marking: :meth:`SensorSession.to_standby`), so a sensor that ignores one
-    of them still sleeps; returns that idle (s)."""
-    sensor.probe(f"{sensor.foreign_address()}!", break_s=13e-3, marking_s=50e-3)
+    of them still sleeps; returns that idle (s). The foreign command goes out without a
+    break where the run has shown, on the wire, that the sensor answers its ``a!`` sent
+    without a break while awake (:func:`_answers_unbroken_while_awake`): awake, it hears
+    the command (R-7.0-14 sends it to standby); asleep, it need not. Elsewhere a 13 ms break
+    and 50 ms of marking go first, as before: a sensor deaf to every command without a
+    break (no-follow-up-without-break) would not hear the foreign command, nor then the
+    ``a!`` check of :func:`_shown_asleep`, and that silence is no sign of standby (the
+    false PASS of a11164e beside never-standby). The break cost a real run 63 ms and moved
+    the idle after it to 100 ms past the break, three times (issue 22, eff10)."""
+    foreign = f"{sensor.foreign_address()}!"
+    if _answers_unbroken_while_awake(sensor):
+        sensor.master.raw(foreign, break_first=False)
+    else:
+        sensor.probe(foreign, break_s=13e-3, marking_s=50e-3)
     return sensor.to_standby()
+
+
+def _answers_unbroken_while_awake(sensor) -> bool:
+    """Whether the run's wire shows the sensor answering its ``a!`` sent without a break
+    while awake: the tool's ``a!`` following the sensor's own last character by at most the
+    87 ms of R-7.0-16, nothing between, and ``a<CR><LF>`` starting within the engine's
+    first-character wait of its end. Looked for once in the transcript so far, then only in
+    what was added since (the answer, once shown, stays)."""
+    state = sensor.once(("control", "unbroken a! answered"), lambda: {"from": 0, "shown": False})
+    if not state["shown"]:
+        events = sensor.link.transcript.events
+        start = max(0, state["from"] - 8)  # an exchange cut by the last look is seen whole
+        state["from"] = len(events)
+        state["shown"] = unbroken_acknowledge_answered(
+            events[start:], sensor.address, sensor.master.policy.first_char_timeout
+        )
+    return state["shown"]
+
+
+def unbroken_acknowledge_answered(events, address: str, first_char: float) -> bool:
+    """Whether ``events`` hold the DUT's character, then (no break, at most 87 ms later) the
+    tool's ``a!`` for ``address``, then the DUT's ``a<CR><LF>`` with good parity starting
+    within ``first_char`` s of the command's end (a pure function over a transcript)."""
+    wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=lambda e: e.start)
+    want = f"{address}\r\n"
+    for i in range(1, len(wire) - 4):
+        a, bang, before = wire[i], wire[i + 1], wire[i - 1]
+        if not (
+            a.origin == TOOL
+            and bang.origin == TOOL
+            and a.kind is EventKind.CHAR
+            and bang.kind is EventKind.CHAR
+            and decode_7e1((a, bang)) == f"{address}!"
+            and before.kind is EventKind.CHAR
+            and before.origin != TOOL
+            and a.start - before.end <= NO_BREAK_WINDOW
+        ):
+            continue
+        reply = wire[i + 2 : i + 5]
+        if (
+            all(e.kind is EventKind.CHAR and e.origin != TOOL and e.parity_ok for e in reply)
+            and decode_7e1(reply) == want
+            and reply[0].start - bang.end <= first_char
+        ):
+            return True
+    return False
 
 
 def _shown_asleep(sensor, case):

@@ -14,6 +14,7 @@ from dataclasses import replace
 import pytest
 
 from conformance.ports import open_sim, parse_sim
+from conformance.protocol.timing import CHAR_TIME
 from conformance.sensor.session import SensorSession
 
 UNCERTAINTY = 5e-3
@@ -71,7 +72,8 @@ def test_a_moment_inside_the_turnaround_and_the_look_is_not_kept():
     session = _session()
     policy = session.master.policy
     marking = _follow_up_at(session, 10e-3)
-    assert marking == pytest.approx(policy.turnaround + UNCERTAINTY, abs=1e-9)
+    assert marking == pytest.approx(policy.turnaround + session.master.look_before_transmit())
+    assert marking == pytest.approx(CHAR_TIME + UNCERTAINTY, abs=1e-9)  # a back-to-back frame
 
 
 def test_right_after_the_tools_own_break_nothing_is_taken_off():

@@ -5,6 +5,11 @@ the turnaround: a wait that already listened to a quiet line that long (a case's
 read to its deadline, a retry's spacing) has done it, and adding it again made each such
 transmission 5 ms later behind an RFC 2217 port (about 110 of them in a full run).
 
+The look after the turnaround is what the turnaround leaves of a back-to-back character's frame
+and the link's lateness (eff10): a DUT going on right after its CR LF has shown its next
+character by CHAR_TIME + uncertainty after the last one's stamp, 13.33 ms behind RFC 2217,
+where the tool waited 9 + 5 ms.
+
 The sim link stands in for a real one with a 5 ms timing uncertainty, as in
 ``tests/sensor/test_mark_until.py``."""
 
@@ -15,13 +20,15 @@ from dataclasses import replace
 import pytest
 
 from conformance.protocol.timing import CHAR_TIME
-from conformance.tool_recorder.engine import ToolRecorder
+from conformance.tool_recorder.engine import ToolRecorder, look_past_turnaround
 from conformance.tool_recorder.policy import Policy
 from conformance.transcript import TOOL, EventKind
 from tests.tool_recorder.test_scripted_sensor import ScriptedSensor, rig, then_sr
 
 UNCERTAINTY = 5e-3
 TURNAROUND = Policy().turnaround
+#: the look after the turnaround behind a link stamped to 5 ms: 8.33 + 5 - 9 ms
+LOOK = CHAR_TIME + UNCERTAINTY - TURNAROUND
 
 
 def _real_like(*devices: object) -> ToolRecorder:
@@ -44,7 +51,20 @@ def test_after_a_reply_the_turnaround_and_the_look_are_both_kept():
     last = _reply_end(master)
     ex = master.transact("0I!")
     start = ex.attempts[0].command_events[0].start
-    assert start == pytest.approx(last + TURNAROUND + UNCERTAINTY, abs=1e-12)
+    assert start == pytest.approx(last + TURNAROUND + LOOK, abs=1e-12)
+    assert start - last == pytest.approx(CHAR_TIME + UNCERTAINTY, abs=1e-12)  # 13.33 ms
+
+
+def test_the_look_covers_a_back_to_back_character_and_no_more():
+    """A character that starts as the DUT's last one ends has arrived, at the latest, when
+    the tool transmits; on the sim (no uncertainty) nothing is added to the turnaround, and
+    a link looser than the turnaround's spare (0.67 ms) gets the rest of its uncertainty."""
+    for u in (0.0, 0.5e-3, 2e-3, UNCERTAINTY, 15.409e-3):
+        look = look_past_turnaround(u, TURNAROUND)
+        assert look >= 0.0
+        assert TURNAROUND + look >= CHAR_TIME + u - 1e-12
+        assert TURNAROUND + look == pytest.approx(max(TURNAROUND, CHAR_TIME + u), abs=1e-12)
+    assert look_past_turnaround(0.0, TURNAROUND) == 0.0
 
 
 def test_after_listening_past_the_look_the_tool_transmits_at_once():
@@ -64,7 +84,7 @@ def test_after_a_wait_shorter_than_the_look_only_the_rest_of_it_is_listened():
     master.link.wait_until(last + TURNAROUND + 2e-3)
     ex = master.transact("0I!")
     start = ex.attempts[0].command_events[0].start
-    assert start == pytest.approx(last + TURNAROUND + UNCERTAINTY, abs=1e-12)
+    assert start == pytest.approx(last + TURNAROUND + LOOK, abs=1e-12)
 
 
 def test_a_retry_goes_out_at_its_retry_time():
@@ -88,9 +108,9 @@ def test_a_character_that_came_during_the_wait_still_holds_the_transmission():
     master.link.wait_until(reply_end + 0.5 + 3 * CHAR_TIME + 2e-3)
     sr_end = _reply_end(master)
     assert sr_end > reply_end + 0.5
-    assert master.link.now() < sr_end + TURNAROUND + UNCERTAINTY
+    assert master.link.now() < sr_end + TURNAROUND + LOOK
     brk = master.send_break()
-    assert brk.start == pytest.approx(sr_end + TURNAROUND + UNCERTAINTY, abs=1e-12)
+    assert brk.start == pytest.approx(sr_end + TURNAROUND + LOOK, abs=1e-12)
 
 
 def test_right_after_the_tools_own_break_there_is_no_look():
