@@ -19,7 +19,7 @@ from ..protocol.timing import (
     RESPONSE_START_MAX,
     TOLERANCE,
 )
-from ..transcript import Event, escape
+from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_bytes
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, Segments, frames, runs, segments
 from ..view.sides import expected_reply_address
@@ -108,8 +108,9 @@ def _start_observations(
 
 
 def _text(seg: Segment) -> str:
-    """All the sensor sent after the command, as text: part of an observation's place."""
-    return "".join(chr(e.char7) for e in seg.reply + seg.later)
+    """All the sensor sent after the command, as text: part of an observation's place (one
+    C pass over the characters, :func:`~conformance.transcript.text7`)."""
+    return text7(seg.reply + seg.later)
 
 
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
@@ -485,7 +486,7 @@ def judge_framing(
         for n, chunk in enumerate(chunks):
             is_reply = n == 0 and bool(reply)
             label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
-            bad = [e for e in chunk if not e.parity_ok]
+            bad, text = _parity_errors_and_text(chunk)
             tally.observe(label, ids=["R-4.1-02"])
             if bad:
                 tally.fail(
@@ -493,7 +494,6 @@ def judge_framing(
                     label,
                     f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
                 )
-            text = "".join(chr(e.char7) for e in chunk)
             if seg.multiline and is_reply:  # decision A10: each line is framed on its own
                 lines = text.replace("\x02", "", 1).rstrip("\x03").split("\r\n")
                 for line in lines[:-1]:
@@ -528,3 +528,15 @@ def judge_framing(
                     f"'{escape(body[:1])}', not the address '{expected}'",
                 )
     return tally.findings()
+
+
+def _parity_errors_and_text(chunk: list[Event]) -> tuple[list[Event], str]:
+    """The characters of ``chunk`` failing ``Event.parity_ok``, and its text (parity
+    stripped): :func:`judge_framing` asks both of every reply and service request, a run's
+    tens of thousands of characters, which the wire bytes answer in two C passes (the list
+    of errors made only where there are some)."""
+    wires = wire_bytes(chunk)
+    if wires is None:
+        return [e for e in chunk if not e.parity_ok], "".join(chr(e.char7) for e in chunk)
+    bad = [e for e in chunk if not e.parity_ok] if wires.translate(None, GOOD_PARITY) else []
+    return bad, wires.translate(SEVEN_BITS).decode("ascii")
