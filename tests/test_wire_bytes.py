@@ -10,6 +10,7 @@ import random
 import pytest
 
 from conformance.judges import wire as wire_judges
+from conformance.judges.timing import StampUncertainty
 from conformance.judges.wire import _parity_errors_and_text, judge_framing
 from conformance.transcript import (
     DUT,
@@ -21,7 +22,7 @@ from conformance.transcript import (
     wire_bytes,
 )
 from conformance.verdicts import Verdict
-from conformance.view.runs import segments
+from conformance.view.runs import Segment, segments
 from conformance.view.segments import on_tool_link, read_view
 from conformance.view.sides import BUS
 
@@ -99,3 +100,37 @@ def test_the_view_takes_the_tool_links_events_as_the_recorders() -> None:
     assert view.transmissions[0].heard == events[3:]
     bus = [Event(e.kind, BUS, e.start, e.end, wire=e.wire) for e in events]
     assert [t.text for t in read_view(bus).transmissions] == ["0I!"]
+
+
+def _segment(text: str, starts: list[float], later: list[float]) -> Segment:
+    command = _chars(list(encode_7e1(text)), TOOL)
+    step = 1 / 120
+
+    def chars(at: list[float]) -> list[Event]:
+        return [Event(EventKind.CHAR, DUT, t, t + step, wire=0x30) for t in at]
+
+    return Segment(None, command, reply=chars(starts), later=chars(later), text=text)
+
+
+def test_spacings_on_one_uncertainty_are_the_pair_by_pair_ones() -> None:
+    """R-4.1-01's spacings where every pair has one uncertainty (a virtual clock) are read
+    per run in C (``wire._spacings_alike``): the count, the least ``(spacing, command)`` and
+    the too-short ones are those of the pair-by-pair pass (a local uncertainty equal to the
+    base everywhere takes that pass), with ties, negative zeros and NaN stamps."""
+    rng = random.Random(41)
+    odd = [0.0, -0.0, float("nan"), 1 / 120, 0.004, float("inf")]
+    for _ in range(300):
+        segs = []
+        for k in range(rng.randrange(1, 5)):
+            t, starts, later = 1.0 + k, [], []
+            for _ in range(rng.randrange(0, 6)):
+                starts.append(float("nan") if rng.random() < 0.05 else t)  # one odd stamp
+                t += rng.choice(odd) if rng.random() < 0.2 else rng.choice([1 / 120, 0.0085])
+            for _ in range(rng.randrange(0, 3)):
+                t += 0.2
+                later.append(t)
+            segs.append(_segment(rng.choice(["0M!", "0D0!", "1I!"]), starts, later))
+        base = rng.choice([0.0, 0.0005])
+        alike = wire_judges._spacings(segs, StampUncertainty(base))
+        paired = wire_judges._spacings(segs, StampUncertainty(base, lambda a, b, u=base: u))
+        assert repr(alike) == repr(paired)

@@ -9,7 +9,8 @@ chatter) (:class:`~conformance.view.runs.Segment`).
 
 from __future__ import annotations
 
-from math import copysign
+from math import copysign, isnan
+from operator import sub
 
 from ..protocol.commands import MEASUREMENT_KINDS, CommandError, parse_command
 from ..protocol.responses import split_line
@@ -377,6 +378,8 @@ def _spacings(
     least spacing, ties by the command's text), and those surely too short even with the
     stamps' local uncertainty. Kept as it goes, not as a list of every pair (tens of
     thousands a run, once each) and a ``min`` over it."""
+    if stamps.local is None:
+        return _spacings_alike(segs, stamps.base)
     count = 0
     least: Spacing | None = None
     fast: list[Spacing] = []
@@ -393,6 +396,38 @@ def _spacings(
                     least = (spacing, text)
                 if spacing + 2 * between(a.start, b.end) < low:
                     fast.append((spacing, text))
+    return count, least, fast
+
+
+def _spacings_alike(segs: list[Segment], base: float) -> tuple[int, Spacing | None, list[Spacing]]:
+    """:func:`_spacings` where every pair has the stamps' one uncertainty ``base`` (a virtual
+    clock, a capture's sample grid): a run's spacings subtracted in C, its least by ``min``
+    (the least ``(spacing, command)`` of a run is its least spacing's, and ``min`` keeps the
+    first of equal ones, as the pair-by-pair rule does), the too-short ones in one pass. A
+    run with a NaN spacing (stamps no clock gives) goes pair by pair, where the order of
+    comparisons with NaN decides."""
+    count = 0
+    least: Spacing | None = None
+    fast: list[Spacing] = []
+    low = CHAR_TIME * 0.98
+    twice = 2 * base  # 2 * between(...) of every pair
+    for seg in segs:
+        text = seg.text
+        for run in [seg.reply, *runs(seg.later)]:
+            if len(run) < 2:
+                continue
+            starts = [e.start for e in run]
+            spacings = list(map(sub, starts[1:], starts))
+            count += len(spacings)
+            if any(map(isnan, spacings)):
+                for spacing in spacings:
+                    if least is None or (spacing <= least[0] and (spacing, text) < least):
+                        least = (spacing, text)
+            else:
+                spacing = min(spacings)
+                if least is None or (spacing <= least[0] and (spacing, text) < least):
+                    least = (spacing, text)
+            fast += [(spacing, text) for spacing in spacings if spacing + twice < low]
     return count, least, fast
 
 
