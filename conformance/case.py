@@ -11,6 +11,7 @@ the case goes on to find about it.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from itertools import repeat
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
@@ -183,7 +184,8 @@ def events_of(record: Any) -> list[Event]:
             found += events_of(ex)
         return sorted(found, key=_START)
     if isinstance(record, (list, tuple)):
-        if all(isinstance(e, Event) for e in record):
+        # (asked of a whole run's events, too: in C, not a generator step per event)
+        if all(map(isinstance, record, repeat(Event))):
             return list(record)
         return sorted((e for r in record for e in events_of(r)), key=_START)
     raise TypeError(f"no events in {type(record).__name__}")

@@ -9,7 +9,8 @@ chatter) (:class:`~conformance.view.runs.Segment`).
 
 from __future__ import annotations
 
-from math import copysign
+from math import copysign, isnan
+from operator import sub
 
 from ..protocol.commands import MEASUREMENT_KINDS, CommandError, parse_command
 from ..protocol.responses import split_line
@@ -19,7 +20,7 @@ from ..protocol.timing import (
     RESPONSE_START_MAX,
     TOLERANCE,
 )
-from ..transcript import Event, escape
+from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_bytes
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, Segments, frames, runs, segments
 from ..view.sides import expected_reply_address
@@ -108,8 +109,9 @@ def _start_observations(
 
 
 def _text(seg: Segment) -> str:
-    """All the sensor sent after the command, as text: part of an observation's place."""
-    return "".join(chr(e.char7) for e in seg.reply + seg.later)
+    """All the sensor sent after the command, as text: part of an observation's place (one
+    C pass over the characters, :func:`~conformance.transcript.text7`)."""
+    return text7(seg.reply + seg.later)
 
 
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
@@ -376,6 +378,8 @@ def _spacings(
     least spacing, ties by the command's text), and those surely too short even with the
     stamps' local uncertainty. Kept as it goes, not as a list of every pair (tens of
     thousands a run, once each) and a ``min`` over it."""
+    if stamps.local is None:
+        return _spacings_alike(segs, stamps.base)
     count = 0
     least: Spacing | None = None
     fast: list[Spacing] = []
@@ -392,6 +396,38 @@ def _spacings(
                     least = (spacing, text)
                 if spacing + 2 * between(a.start, b.end) < low:
                     fast.append((spacing, text))
+    return count, least, fast
+
+
+def _spacings_alike(segs: list[Segment], base: float) -> tuple[int, Spacing | None, list[Spacing]]:
+    """:func:`_spacings` where every pair has the stamps' one uncertainty ``base`` (a virtual
+    clock, a capture's sample grid): a run's spacings subtracted in C, its least by ``min``
+    (the least ``(spacing, command)`` of a run is its least spacing's, and ``min`` keeps the
+    first of equal ones, as the pair-by-pair rule does), the too-short ones in one pass. A
+    run with a NaN spacing (stamps no clock gives) goes pair by pair, where the order of
+    comparisons with NaN decides."""
+    count = 0
+    least: Spacing | None = None
+    fast: list[Spacing] = []
+    low = CHAR_TIME * 0.98
+    twice = 2 * base  # 2 * between(...) of every pair
+    for seg in segs:
+        text = seg.text
+        for run in [seg.reply, *runs(seg.later)]:
+            if len(run) < 2:
+                continue
+            starts = [e.start for e in run]
+            spacings = list(map(sub, starts[1:], starts))
+            count += len(spacings)
+            if any(map(isnan, spacings)):
+                for spacing in spacings:
+                    if least is None or (spacing <= least[0] and (spacing, text) < least):
+                        least = (spacing, text)
+            else:
+                spacing = min(spacings)
+                if least is None or (spacing <= least[0] and (spacing, text) < least):
+                    least = (spacing, text)
+            fast += [(spacing, text) for spacing in spacings if spacing + twice < low]
     return count, least, fast
 
 
@@ -485,7 +521,7 @@ def judge_framing(
         for n, chunk in enumerate(chunks):
             is_reply = n == 0 and bool(reply)
             label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
-            bad = [e for e in chunk if not e.parity_ok]
+            bad, text = _parity_errors_and_text(chunk)
             tally.observe(label, ids=["R-4.1-02"])
             if bad:
                 tally.fail(
@@ -493,7 +529,6 @@ def judge_framing(
                     label,
                     f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
                 )
-            text = "".join(chr(e.char7) for e in chunk)
             if seg.multiline and is_reply:  # decision A10: each line is framed on its own
                 lines = text.replace("\x02", "", 1).rstrip("\x03").split("\r\n")
                 for line in lines[:-1]:
@@ -528,3 +563,15 @@ def judge_framing(
                     f"'{escape(body[:1])}', not the address '{expected}'",
                 )
     return tally.findings()
+
+
+def _parity_errors_and_text(chunk: list[Event]) -> tuple[list[Event], str]:
+    """The characters of ``chunk`` failing ``Event.parity_ok``, and its text (parity
+    stripped): :func:`judge_framing` asks both of every reply and service request, a run's
+    tens of thousands of characters, which the wire bytes answer in two C passes (the list
+    of errors made only where there are some)."""
+    wires = wire_bytes(chunk)
+    if wires is None:
+        return [e for e in chunk if not e.parity_ok], "".join(chr(e.char7) for e in chunk)
+    bad = [e for e in chunk if not e.parity_ok] if wires.translate(None, GOOD_PARITY) else []
+    return bad, wires.translate(SEVEN_BITS).decode("ascii")

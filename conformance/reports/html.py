@@ -23,7 +23,7 @@ from ..results import COMPLIANT, NON_COMPLIANT, CaseRecord, RequirementResult
 from ..root_causes import reading_order
 from ..run import TOOL_IDENTITY, ConformanceRun
 from ..stash import CASE
-from ..transcript import TOOL, Event, EventKind, to_wire_7e1
+from ..transcript import GOOD_PARITY, SEVEN_BITS, TOOL, Event, EventKind
 from ..transcript import escape as wire_escape
 from ..verdicts import Finding, Verdict
 from .evidence import NEEDS_EVIDENCE, WireRef, locator_of
@@ -430,14 +430,6 @@ def requirements_table(run: ConformanceRun) -> str:
     )
 
 
-#: the wire bits of every 7E1 character with good parity, as the bytes a line's characters
-#: lose to ``bytes.translate`` (what is left: the parity errors; ``Event.parity_ok``, for the
-#: tens of thousands of characters a report's wire logs show, in one C call a line)
-_GOOD_PARITY = bytes(sorted(to_wire_7e1(c) for c in range(0x80)))
-#: a wire byte's seven character bits, as a ``bytes.translate`` table
-_SEVEN_BITS = bytes(w & 0x7F for w in range(0x100))
-
-
 def transcript_html(label: str, events: list[Event], marked: frozenset[Event] = frozenset()) -> str:
     """The wire log: one line per break, note or run of characters from one side; lines
     holding a ``marked`` event (the exchange a finding rests on) are highlighted with ▶."""
@@ -482,7 +474,7 @@ def _line_chars(group: list[Event]) -> tuple[str, int]:
     """A line's characters (escaped, parity bit dropped) and how many of them fail
     ``Event.parity_ok``."""
     wires = bytes([e.wire for e in group])
-    return wire_escape(wires.translate(_SEVEN_BITS)), len(wires.translate(None, _GOOD_PARITY))
+    return wire_escape(wires.translate(SEVEN_BITS)), len(wires.translate(None, GOOD_PARITY))
 
 
 def _highlighted(lines: list[str | None]) -> list[str]:
