@@ -487,6 +487,12 @@ def _matrix_parser() -> argparse.ArgumentParser:
         help="instead of single faults, run N combinations of faults drawn by a seeded sampler "
         "(exit 1 if any has a FAIL/WARN outside its members' requirements or a missed FAIL)",
     )
+    p.add_argument(
+        "--all-pairs",
+        action="store_true",
+        help="with --role recorder: every pair of recorder faults that composes, in name order, "
+        "instead of --combinations N drawn ones",
+    )
     p.add_argument("--size", type=int, choices=(2, 3), default=2, help="faults per combination")
     p.add_argument("--seed", type=int, help="the sampler's seed (the same list for the same seed)")
     p.add_argument(
@@ -503,7 +509,7 @@ def cmd_matrix(argv: list[str], console: Console) -> int:
     """Run the fault-detection matrix and print it: every emulator fault against the suite."""
     p = _matrix_parser()
     args = p.parse_args(argv)
-    if args.combinations is not None:
+    if args.combinations is not None or args.all_pairs:
         return _combination_matrix(args, console)
     if args.role == "recorder":
         error(
@@ -568,18 +574,25 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
         from .matrices import recorder_combinations as combinations
     else:
         from .matrices import combinations  # type: ignore[no-redef]
-    if args.combinations < 1 or args.jobs < 1:
+    if args.all_pairs and (args.role != "recorder" or args.combinations is not None):
+        error("error: --all-pairs runs every recorder pair: --role recorder, no --combinations")
+        return EXIT_USAGE
+    if (args.combinations is not None and args.combinations < 1) or args.jobs < 1:
         error("error: --combinations and --jobs must be 1 or more")
         return EXIT_USAGE
     seed = combinations.DEFAULT_SEED if args.seed is None else args.seed
-    combos = combinations.sample(args.combinations, args.size, seed)
+    if args.all_pairs:
+        combos = combinations.all_pairs()  # type: ignore[attr-defined]
+    else:
+        combos = combinations.sample(args.combinations, args.size, seed)
     status = make_console(stderr=True)
 
     def progress(done: int, total: int, row: ComboRow) -> None:
         status.print(f"[{done}/{total}] {row.explain()}", markup=False, highlight=False)
 
+    drawn = "every composing pair" if args.all_pairs else f"seed {seed}"
     status.print(
-        f"running the {args.role} suite once per combination (seed {seed}), "
+        f"running the {args.role} suite once per combination ({drawn}, {len(combos)}), "
         f"{args.jobs} at a time..."
     )
     rows = combinations.combination_matrix(combos, args.jobs, progress)

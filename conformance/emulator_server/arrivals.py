@@ -40,17 +40,29 @@ class ToolEvent:
 class Arrival:
     """Events that reached the line together: no earlier than ``since`` (the line's previous
     arrival, which they came after), no later than ``at`` (their packet's kernel stamp, or
-    the moment the read returned)."""
+    the moment the read returned). ``earliest``: where the reader also saw the socket empty
+    after ``since`` (:class:`~.servers.ArrivalReader`), the latest such moment, which they
+    came after too; None: ``since``."""
 
     events: tuple[ToolEvent, ...]
     since: float
     at: float
+    earliest: float | None = None
+
+    @property
+    def unseen(self) -> float:
+        """How long (s) before ``at`` the first of the events may have arrived: the span in
+        which what came together may have been sent apart."""
+        floor = self.since if self.earliest is None else max(self.since, self.earliest)
+        return max(0.0, self.at - floor)
 
 
 class ToolSide(Protocol):
     """What :func:`lay` drives: the recorder's side of a real-time line."""
 
-    def tool_bytes(self, data: bytes, at: float | None = None, baud: int = BAUD) -> None: ...
+    def tool_bytes(
+        self, data: bytes, at: float | None = None, baud: int = BAUD, doubt: float = 0.0
+    ) -> None: ...
 
     def break_on(self, at: float | None = None, doubt: float = 0.0) -> None: ...
 
@@ -100,9 +112,21 @@ def placed(since: float, at: float, count: int) -> tuple[list[float], float]:
     return [at - (count - 1 - k) * gap for k in range(count)], room
 
 
+def char_doubt(arrival: Arrival, timed: int, length: int) -> float:
+    """How far (s) the characters of a bytes event of ``length`` bytes, one of ``timed``
+    timed events of ``arrival``, may be from where they are laid: 0 for a byte alone in its
+    arrival (its packet's own stamp), else :attr:`Arrival.unseen`. Bytes that came together
+    are laid back to back from the arrival, but the kernel merges packets nobody read yet
+    into one stamp (the later one): a recorder that sent '0', paused 20 ms, then 'M!' is
+    read as '0M!' stamped at the 'M!', its first character 20 ms later and its gap 0 ms, as
+    far as the stamps go. Each character may have been sent anywhere in that span."""
+    return arrival.unseen if timed > 1 or length > 1 else 0.0
+
+
 def lay(line: ToolSide, arrival: Arrival) -> None:
     """Put one arrival's events on ``line`` in order, each where :func:`placed` puts it; RTS
-    switches take no time of their own (they only decide whether later bytes reach the bus)."""
+    switches take no time of their own (they only decide whether later bytes reach the bus).
+    Bytes go with the doubt :func:`char_doubt` gives them."""
     events = merged(arrival.events)
     timed = [e for e in events if e.kind != "rts"]
     times, doubt = placed(arrival.since, arrival.at, len(timed))
@@ -111,7 +135,8 @@ def lay(line: ToolSide, arrival: Arrival) -> None:
         if event.kind == "rts":
             line.set_rts(event.on)
         elif event.kind == "bytes":
-            line.tool_bytes(event.data, next(slot), event.baud)
+            chars = char_doubt(arrival, len(timed), len(event.data))
+            line.tool_bytes(event.data, next(slot), event.baud, chars)
         elif event.on:
             line.break_on(next(slot), doubt)
         else:

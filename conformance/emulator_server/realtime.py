@@ -53,6 +53,16 @@ class WeighsBreaks(Protocol):
         """``on_break(start, end)`` for a break whose ends may lie ``room`` s from there."""
 
 
+@runtime_checkable
+class WeighsChars(Protocol):
+    """A device that keeps what the line knows of a recorder character's place (the played
+    bus): characters that came in one read with others, which may have been sent anywhere
+    in the span before it (:func:`.arrivals.char_doubt`), come through this."""
+
+    def on_char_within(self, wire: int, start: float, end: float, doubt: float) -> None:
+        """``on_char(wire, start, end)`` for a character that may lie ``doubt`` s from there."""
+
+
 @dataclass(frozen=True)
 class LineTally:
     """The line's counts at one moment (:meth:`RealTimeLine.mark`), so a log can report a
@@ -134,12 +144,17 @@ class RealTimeLine:
         with self._cond:
             self._rts = bool(raised)
 
-    def tool_bytes(self, data: bytes, at: float | None = None, baud: int = BAUD) -> None:
+    def tool_bytes(
+        self, data: bytes, at: float | None = None, baud: int = BAUD, doubt: float = 0.0
+    ) -> None:
         """Recorder bytes that reached the line at ``at``: each takes one frame, back to
         back behind the previous one; bytes sent while the recorder holds a break, or (with
         an RTS-switched driver) without RTS raised, are lost. A byte sent at another bit rate
         is what it is on the wire: its runs of spacing, each heard by the device as a pulse
-        (a NUL at 4800 baud is 1.875 ms of spacing; at 720 baud a 12.5 ms break)."""
+        (a NUL at 4800 baud is 1.875 ms of spacing; at 720 baud a 12.5 ms break). ``doubt``
+        > 0: how far (s) the characters may be from where they are laid (they came in one
+        read with others: :func:`.arrivals.char_doubt`), for a device that weighs it
+        (:class:`WeighsChars`)."""
         at = self.now() if at is None else at
         with self._cond:
             if self._break_start is not None or not self._rts:
@@ -150,7 +165,7 @@ class RealTimeLine:
                 end = start + frame
                 self._tool_free = end
                 if abs(baud - BAUD) <= BAUD * 0.02:
-                    self._push(end, lambda w=wire, s=start, e=end: self.device.on_char(w, s, e))
+                    self._push(end, self._char(wire, start, end, doubt))
                     if self._taps:
                         self._push(end, lambda w=wire: self._tap(w))
                 else:
@@ -161,6 +176,13 @@ class RealTimeLine:
                 if self.bench.echo:  # the recorder's receiver, at its own rate, reads it back
                     self._push(self._delivery.time(end), lambda w=wire: self._emit(w, echo=True))
             self._cond.notify()
+
+    def _char(self, wire: int, start: float, end: float, doubt: float) -> Callable[[], None]:
+        """The device hearing one recorder character, with its doubt where it weighs one."""
+        device = self.device
+        if doubt > 0 and isinstance(device, WeighsChars):
+            return lambda: device.on_char_within(wire, start, end, doubt)
+        return lambda: device.on_char(wire, start, end)
 
     def break_on(self, at: float | None = None, doubt: float = 0.0) -> None:
         """The recorder starts spacing at ``at``, which may be ``doubt`` s off (it arrived

@@ -32,6 +32,18 @@ def sample(count: int, size: int = 2, seed: int = DEFAULT_SEED) -> list[tuple[st
     return draw([sorted(RECORDER_FAULTS)], count, size, seed, composition_conflict)
 
 
+def all_pairs() -> list[tuple[str, ...]]:
+    """Every pair of recorder faults that composes (none that
+    :func:`~conformance.recorder.faults.composition_conflict` refuses), in name order: the
+    whole pair matrix, where :func:`sample` draws some of it."""
+    from itertools import combinations
+
+    from ..recorder.faults import RECORDER_FAULTS, composition_conflict
+
+    pairs = combinations(sorted(RECORDER_FAULTS), 2)
+    return [pair for pair in pairs if not composition_conflict(pair)]
+
+
 def combo_port(faults: tuple[str, ...]) -> str:
     return f"sim://?recorder-faults={','.join(faults)}"
 

@@ -58,18 +58,22 @@ class EarlyRetryHooks(GoldenHooks):
 
 class SkipsNextBreakHooks(GoldenHooks):
     """The golden hooks, able to leave out the break the break rules put in front of the next
-    command: a deviation decided before the command it applies to goes out."""
+    command: a deviation decided before the command it applies to goes out. Otherwise it
+    passes the decision on (``CHAINS``): with no-break-after-87ms, whose rules break only for
+    a new address, a skipped break is skipped and the rest follow those rules."""
+
+    CHAINS = frozenset({"needs_break"})
 
     skip_break = False
 
     def needs_break(
         self, master: Engine, address: str, at: float, usual: Callable[[], bool]
     ) -> bool:
-        """No break once after ``skip_break`` was set; the engine's rules otherwise."""
+        """No break once after ``skip_break`` was set; the next hooks' rules otherwise."""
         if self.skip_break:
             self.skip_break = False
             return False
-        return usual()
+        return super().needs_break(master, address, at, usual)
 
 
 class LateRetryHooks(SkipsNextBreakHooks):
@@ -279,7 +283,12 @@ TTT_BITS = 8
 
 
 class EightBitTttHooks(GoldenHooks):
-    """Keeps the announced ttt in 8 bits: waits ``ttt % 256`` s (260 s becomes 4 s)."""
+    """Keeps the announced ttt in 8 bits: waits ``ttt % 256`` s (260 s becomes 4 s). It
+    changes the figure only and passes the wait on (``CHAINS``): with d0-before-ttt the
+    logger reads data after half of the cut ttt, with waits-forever-for-service-request it
+    waits the cut ttt where no service request is due."""
+
+    CHAINS = frozenset({"wait_for_data"})
 
     def wait_for_data(
         self,
@@ -292,7 +301,7 @@ class EightBitTttHooks(GoldenHooks):
         assert m.ttt is not None
         announced, m.ttt = m.ttt, m.ttt % (1 << TTT_BITS)
         try:
-            usual()
+            super().wait_for_data(master, m, service_request, usual)
         finally:
             m.ttt = announced
 
@@ -529,16 +538,23 @@ class NoBreakTransparentRecorder(GoldenRecorder):
 
 @dataclass
 class MislogsRecorder(GoldenRecorder):
-    """Collects every value as the golden recorder does, then writes some down wrong:
-    ``spoil(command, values)`` is what it logs for each measurement command."""
+    """Collects every value as the golden recorder does, then writes some down wrong: each
+    of ``spoils`` (``spoil(command, values)``) in :data:`SPOIL_ORDER` turns what it logs for
+    each measurement command. A set, so the mislogging faults compose (a logger that drops
+    the sign may cut the field too): the knobs unite (compose._merge_values)."""
 
     CHAINS = frozenset({"__call__"})
 
-    spoil: Callable[[Command, list[str]], list[str]] = field(default=lambda c, v: v)
+    spoils: frozenset[Callable[[Command, list[str]], list[str]]] = frozenset()
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
         out = super().__call__(request, link)
-        out.logged = {t: self.spoil(parse_command(t), v) for t, v in out.logged.items()}
+        spoils = [s for s in SPOIL_ORDER if s in self.spoils]
+        for text, values in out.logged.items():
+            command = parse_command(text)
+            for spoil in spoils:
+                values = spoil(command, values)
+            out.logged[text] = values
         return out
 
 
@@ -556,6 +572,11 @@ def _cut(command: Command, values: list[str]) -> list[str]:
 
 def _last_concurrent_lost(command: Command, values: list[str]) -> list[str]:
     return values[:-1] if command.kind is Kind.CONCURRENT else values
+
+
+#: The order a logger's spoils act in: the value dropped from the record, then each value
+#: formatted without its sign, then written into its fixed field.
+SPOIL_ORDER = (_last_concurrent_lost, _unsigned, _cut)
 
 
 def _is_service_request(events: list, address: str) -> bool:
@@ -856,7 +877,7 @@ _LOGGING = (
         "Collects every value, then logs it without its sign (-3.75 becomes 3.75): every "
         "negative value logged from aM2!, aC! and the HB packets is wrong.",
         ("R-4.4-02", "R-5.4-01"),
-        _mislogs(spoil=_unsigned),
+        _mislogs(spoils=frozenset({_unsigned})),
     ),
     RecorderFault(
         "truncates-values",
@@ -864,14 +885,14 @@ _LOGGING = (
         "(+1013.25 becomes +1013.2, +1234.567 becomes +1234.5), in aM2!, aR1!, aHA! and aHB! "
         "data.",
         ("R-4.4-02", "R-5.4-01"),
-        _mislogs(spoil=_cut),
+        _mislogs(spoils=frozenset({_cut})),
     ),
     RecorderFault(
         "loses-last-concurrent-value",
         "Logs every concurrent measurement (aC!, aCn!, aCC!) without its last value: 98 of "
         "aC9!'s 99 values, all of which it read from the sensor.",
         ("R-4.4-02",),
-        _mislogs(spoil=_last_concurrent_lost),
+        _mislogs(spoils=frozenset({_last_concurrent_lost})),
     ),
 )
 

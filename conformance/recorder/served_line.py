@@ -140,8 +140,16 @@ class PlayedBus:
                 device.on_break(start, end)
 
     def on_char(self, wire: int, start: float, end: float) -> None:
+        self.on_char_within(wire, start, end, 0.0)
+
+    def on_char_within(self, wire: int, start: float, end: float, doubt: float) -> None:
+        """A recorder character; ``doubt`` > 0: the served line read it together with others
+        and may have laid it that many s from where it was sent (the kernel merges packets
+        nobody read yet), so its stamp carries the stamps' uncertainty plus that doubt, and
+        the judges that time it (R-7.0-06/-13/-17, R-7.1-01, R-7.2-02) weigh it."""
+        u = self.uncertainty + doubt if doubt > 0 else self.uncertainty
         with self._lock:
-            event = Event(EventKind.CHAR, TOOL, start, end, wire=wire, uncertainty=self.uncertainty)
+            event = Event(EventKind.CHAR, TOOL, start, end, wire=wire, uncertainty=u)
             self.add(event)
             for device in self.devices:
                 device.on_char(wire, start, end)

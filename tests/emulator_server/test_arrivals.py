@@ -28,8 +28,10 @@ class _Line:
     def __init__(self) -> None:
         self.calls: list[tuple] = []
 
-    def tool_bytes(self, data: bytes, at: float | None = None, baud: int = 1200) -> None:
-        self.calls.append(("bytes", data, at, baud))
+    def tool_bytes(
+        self, data: bytes, at: float | None = None, baud: int = 1200, doubt: float = 0.0
+    ) -> None:
+        self.calls.append(("bytes", data, at, baud) + ((doubt,) if doubt else ()))
 
     def break_on(self, at: float | None = None, doubt: float = 0.0) -> None:
         self.calls.append(("on", at, doubt))
@@ -78,7 +80,7 @@ def test_r_7_0_06_a_break_off_and_command_read_together_are_laid_apart_with_the_
     lay(line, Arrival(events, since=2.0, at=2.03))
     assert line.calls == [
         ("off", pytest.approx(2.015), pytest.approx(0.03)),
-        ("bytes", b"0!", 2.03, 1200),
+        ("bytes", b"0!", 2.03, 1200, pytest.approx(0.03)),
     ]
 
 
@@ -147,6 +149,47 @@ def test_a_late_read_keeps_the_kernels_arrival_stamp():
         time.sleep(0.030)  # the reader runs late
         ((_data, _since, at),) = reader.read()
         assert abs(at - sent) < 0.010, (at - sent) * 1e3
+    finally:
+        client.close()
+        server.close()
+
+
+def test_r_7_0_13_characters_read_together_carry_the_span_they_may_have_been_sent_in():
+    """The kernel merges packets nobody read yet under the later one's stamp: '0', 20 ms,
+    'M!' read late is '0M!' stamped at the 'M!'. Laid back to back, its gap looks 0 ms and
+    its start 20 ms late; each character may have been anywhere since the socket was last
+    seen empty, and says so."""
+    line = _Line()
+    lay(line, Arrival((ToolEvent("bytes", b"0M!"),), since=2.0, at=2.03, earliest=2.01))
+    assert line.calls == [("bytes", b"0M!", 2.03, 1200, pytest.approx(0.02))]
+
+
+def test_a_byte_alone_in_its_read_is_its_packet_and_has_no_doubt():
+    line = _Line()
+    lay(line, Arrival((ToolEvent("bytes", b"0"),), since=2.0, at=2.03))
+    assert line.calls == [("bytes", b"0", 2.03, 1200)]
+
+
+def test_an_arrival_seen_empty_after_since_counts_its_span_from_then():
+    assert Arrival((), since=1.0, at=1.05).unseen == pytest.approx(0.05)
+    assert Arrival((), since=1.0, at=1.05, earliest=1.049).unseen == pytest.approx(0.001)
+    assert Arrival((), since=1.0, at=1.05, earliest=0.5).unseen == pytest.approx(0.05)
+
+
+def test_the_reader_notes_when_it_saw_the_socket_empty():
+    """What a read returns came after the reader last saw nothing to read: a reader that
+    looked just before bounds the merged span to that look."""
+    client, server = _pair()
+    try:
+        opened = time.perf_counter()
+        reader = ArrivalReader(server, time.perf_counter, opened=opened)
+        with pytest.raises(TimeoutError):
+            reader.read()  # nothing sent yet: it looked, and saw the socket empty
+        looked = reader.empty_at
+        assert opened < looked <= time.perf_counter()
+        client.sendall(b"0M!")
+        ((data, _since, at),) = reader.read()
+        assert data == b"0M!" and reader.empty_at == looked <= at + 1e-3
     finally:
         client.close()
         server.close()

@@ -63,3 +63,27 @@ def test_the_cli_runs_recorder_combinations(capsys):
     assert ",".join(combo) in out.err
     assert "1/1 combinations clean" in out.out
     assert main(["matrix", "--role", "recorder"]) == 4  # single recorder faults: pytest
+
+
+def test_the_cli_runs_every_composing_pair_with_all_pairs(capsys, monkeypatch):
+    """``matrix --role recorder --all-pairs``: every pair that composes, not a drawn few (the
+    rows themselves stubbed to the first two pairs' here: the whole matrix is 614 runs)."""
+    from conformance.cli import main
+    from conformance.matrices import recorder_combinations
+
+    ran: list[tuple[str, ...]] = []
+    every = recorder_combinations.all_pairs()
+    monkeypatch.setattr(recorder_combinations, "all_pairs", lambda: every[:2])
+    real = recorder_combinations.combination_matrix
+
+    def spy(combos, processes=1, progress=None):
+        ran.extend(combos)
+        return real(combos, 1, progress)
+
+    monkeypatch.setattr(recorder_combinations, "combination_matrix", spy)
+    assert main(["matrix", "--role", "recorder", "--all-pairs", "--jobs", "1"]) == 0
+    assert ran == every[:2]
+    out = capsys.readouterr()
+    assert "every composing pair, 2" in out.err and "2/2 combinations clean" in out.out
+    assert main(["matrix", "--all-pairs"]) == 4  # the sensor role has no such list
+    assert main(["matrix", "--role", "recorder", "--all-pairs", "--combinations", "3"]) == 4

@@ -41,6 +41,13 @@ def test_one_fault_builds_the_recorder_it_always_was():
         ("no-break-after-87ms", "stops-after-d0"),
         # engine hooks and a recorder subclass with its knob
         ("ignores-bad-crc", "no-concurrent"),
+        # refused before (rt2): a logger may drop the sign and cut the field; keep ttt in 8
+        # bits and read data after half of it; skip the break of a late retry and never
+        # break after 87 ms of marking
+        ("logs-without-sign", "truncates-values"),
+        ("d0-before-ttt", "ttt-8-bit"),
+        ("no-break-after-87ms", "retry-too-late"),
+        ("late-d0-without-break", "no-break-after-87ms"),
     ],
 )
 def test_a_pair_puts_both_deviations_on_the_wire(pair):
@@ -73,7 +80,7 @@ def test_two_attempt_hooks_chain():
         (("retry-too-early", "retry-too-late"), "retry_time"),
         (("no-retries", "retries-with-break"), "sequences (1 and 3)"),
         (("command-gap-in-tolerance", "gappy-commands"), "gap"),
-        (("logs-without-sign", "truncates-values"), "spoil (_unsigned and _cut)"),
+        (("d0-before-ttt", "waits-forever-for-service-request"), "wait_for_data"),
         (("polls-dollar", "transparent-no-break"), "__call__"),
         # the rewriting recorder splits the job per command: the interleaving would be lost
         (("crlf-wake-up", "interleaves-measurements"), "__call__"),
@@ -103,3 +110,54 @@ def test_the_sampler_never_draws_a_refused_combination(size):
     assert len(drawn) == 60 and len(set(drawn)) == 60
     assert all(composition_conflict(c) is None for c in drawn)
     assert drawn == recorder_combinations.sample(60, size, seed=7)
+
+
+def test_mislogging_faults_compose_in_one_order():
+    """logs-without-sign + truncates-values (refused before: both set the knob ``spoil``):
+    the spoils unite and act as a logger writes, the sign dropped, then the field cut."""
+    from conformance.protocol.commands import Command, Kind
+
+    recorder = faulty_recorder(("truncates-values", "logs-without-sign"))
+    assert len(recorder.spoils) == 2  # type: ignore[attr-defined]
+    from conformance.recorder.faults import SPOIL_ORDER
+
+    values = ["-1013.256", "+2.5"]
+    for spoil in SPOIL_ORDER:
+        if spoil in recorder.spoils:  # type: ignore[attr-defined]
+            values = spoil(Command("0", Kind.MEASURE), values)
+    assert values == ["1013.25", "+2.5"]
+
+
+def test_a_skipped_break_passes_the_rest_on_to_the_other_break_rules():
+    """retry-too-late + no-break-after-87ms (refused before: both change needs_break): the
+    late retry's skipped break is skipped, and otherwise a break goes out only for a new
+    address, never for 87 ms of marking."""
+    recorder = faulty_recorder(("no-break-after-87ms", "retry-too-late"))
+    master = recorder.master_factory(None, recorder.policy)
+    hooks = master.hooks
+
+    class _Master:
+        last_address = "0"
+
+    def usual() -> bool:
+        return True  # the engine's rules: a break (87 ms of marking)
+
+    assert hooks.needs_break(_Master(), "0", 1.0, usual) is False  # no break for marking
+    assert hooks.needs_break(_Master(), "1", 1.0, usual) is True  # a new address: a break
+    hooks.skip_break = True
+    assert hooks.needs_break(_Master(), "1", 1.0, usual) is False  # the skipped one
+    assert hooks.needs_break(_Master(), "1", 1.0, usual) is True
+
+
+def test_all_pairs_are_every_composing_pair():
+    pairs = recorder_combinations.all_pairs()
+    names = sorted(RECORDER_FAULTS)
+    assert len(pairs) == len(set(pairs)) == 614
+    assert all(composition_conflict(p) is None and list(p) == sorted(p) for p in pairs)
+    refused = [
+        (a, b)
+        for i, a in enumerate(names)
+        for b in names[i + 1 :]
+        if composition_conflict((a, b)) is not None
+    ]
+    assert len(pairs) + len(refused) == len(names) * (len(names) - 1) // 2 == 630

@@ -7,7 +7,7 @@ from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
 from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
-from .common import SR_KINDS, combine
+from .common import SR_KINDS, combine, own_uncertainty
 from .measurements import service_request_end
 
 #: R-7.0-02's and R-7.0-06's windows, worked out once for the many breaks of a recording
@@ -38,7 +38,7 @@ def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
         if s.break_event is None:
             continue
         marking = s.first_char - s.break_event.end
-        u = max(uncertainty, s.break_event.duration_uncertainty or 0.0)
+        u = max(own_uncertainty(uncertainty, s.chars[0]), s.break_event.duration_uncertainty or 0.0)
         markings.append(
             seen.first(marking, u)
             or seen.keep(MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"]))
@@ -76,7 +76,7 @@ def judge_break_rules(line: TranscriptView, uncertainty: float) -> list[Finding]
                         "R-7.0-17",
                         "marking before a command sent without a break",
                         quiet,
-                        uncertainty,
+                        own_uncertainty(uncertainty, s.chars[0], previous.chars[-1]),
                         high=NO_BREAK_WINDOW,
                         evidence=where,
                     )
@@ -89,7 +89,7 @@ def judge_break_rules(line: TranscriptView, uncertainty: float) -> list[Finding]
                         "R-7.1-01",
                         "aD0! without a break after the service request",
                         s.first_char - sr_end,
-                        uncertainty,
+                        own_uncertainty(uncertainty, s.chars[0]),
                         high=NO_BREAK_WINDOW,
                         evidence=where,
                     )

@@ -11,7 +11,7 @@ from ...view.segments import TranscriptView, Transmission
 from ..tally import Tally
 from ..timing import MeasuredIn, Repeats, Window
 from ..wire import judge_frame_lengths, judge_rate
-from .common import combine
+from .common import combine, own_uncertainty
 
 #: R-7.0-13's window, worked out once for the many gaps of a recording
 COMMAND_GAP = Window(
@@ -50,10 +50,8 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
         chars = s.chars
         for a, b in zip(chars, chars[1:], strict=False):
             gap = b.start - a.end
-            found.append(
-                judged.first(gap, uncertainty)
-                or judged.keep(MeasuredIn(COMMAND_GAP, gap, uncertainty, s))
-            )
+            u = own_uncertainty(uncertainty, a, b)
+            found.append(judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s)))
             if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
                 leaning.append((gap, s))
     if leaning:
@@ -84,13 +82,13 @@ def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Findi
 def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:
     """R-4.1-01 (decision A14, ±2%): back-to-back command characters start one frame apart."""
     spacings = [
-        (b.start - a.start, s)
+        (b.start - a.start, s, own_uncertainty(uncertainty, a, b))
         for s in line.transmissions
         for a, b in zip(s.chars, s.chars[1:], strict=False)
     ]
     if not spacings:
         return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
-    shortest, s = min(spacings, key=lambda x: x[0])
+    shortest, s, uncertainty = min(spacings, key=lambda x: x[0])
     finding = judge_rate(
         "shortest start-to-start spacing of command characters",
         shortest,

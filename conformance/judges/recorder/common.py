@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ...protocol.commands import SERVICE_REQUEST_KINDS
-from ...transcript import escape
+from ...transcript import Event, escape
 from ...verdicts import Finding
 from ...view.segments import Transmission
 from ..timing import Measured
@@ -52,6 +52,18 @@ def record_of(transmissions: list[Transmission], texts: list[str] | None = None)
         + " ".join(sent[:20])
         + (" ..." if len(sent) > 20 else "")
     ]
+
+
+def own_uncertainty(uncertainty: float, *events: Event) -> float:
+    """The uncertainty (s) of an interval between ``events``: the run's figure, or wider
+    where an event's own stamp is (a served line's characters read together with others may
+    have been sent anywhere in the span before that read: their gaps and places are not
+    known to the run's figure, and a verdict must not rest on them)."""
+    u = uncertainty
+    for e in events:
+        if e.uncertainty > u:
+            u = e.uncertainty
+    return u
 
 
 def combine(rid: str, findings: Sequence[Finding | Measured], what: str) -> Finding:

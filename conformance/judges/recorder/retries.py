@@ -26,7 +26,7 @@ from ...view.segments import TranscriptView, Transmission
 from ..reply_validity import NO_REPLY, Reason, ReplyProblem
 from ..tally import Tally
 from ..timing import judge_window
-from .common import combine
+from .common import combine, own_uncertainty
 from .logged import same_values
 from .replies import crc_context, reply_problem
 
@@ -238,7 +238,7 @@ def _judge_tries(
                         "R-7.2-02",
                         "retry after no reply",
                         nxt.sent.first_char - a.sent.end,
-                        uncertainty,
+                        own_uncertainty(uncertainty, a.sent.chars[-1], nxt.sent.chars[0]),
                         low=RETRY_MIN,
                         high=RETRY_MAX,
                         evidence=[nxt.sent.at()],
