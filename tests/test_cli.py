@@ -68,7 +68,7 @@ def test_a_fault_makes_the_run_non_compliant(tmp_path):
         (("--port", "sim://?version=2.0"), "1.3 or 1.4"),
         (("--sdi-version", "1.7"), "unsupported SDI-12 version"),
         (("--declaration", "/nonexistent.toml"), "does not exist"),
-        (("--role", "recorder", "--port", "sim://?recorder-faults=x"), "recorder-faults takes"),
+        (("--role", "recorder", "--port", "sim://?recorder-faults=x"), "is not a recorder fault"),
         (("--port", "/dev/ttyUSB9"), "serial port /dev/ttyUSB9 does not exist"),
         (("--bogus",), "unrecognized arguments"),
         # first-hour look (2026-12-05): "unknown sim parameters ['fault']", a Python list

@@ -86,9 +86,11 @@ def recorder_faults(extra: dict[str, str]) -> tuple[str, ...]:
     unknown = [f for f in faults if f not in RECORDER_FAULTS]
     if unknown:
         hint = did_you_mean(unknown, RECORDER_FAULTS)
+        named = ", ".join(repr(f) for f in unknown)
         raise PortError(
-            f"recorder-faults takes one or more of: {_known_faults()} (got "
-            f"{','.join(faults)}){hint}; `sdi12-conform faults --role recorder` describes them"
+            f"recorder-faults: {named} {'is' if len(unknown) == 1 else 'are'} not a recorder "
+            f"fault{hint}; it takes one or more of: {_known_faults()} (got "
+            f"{','.join(faults)}); `sdi12-conform faults --role recorder` describes them"
         )
     clash = composition_conflict(faults)
     if clash:

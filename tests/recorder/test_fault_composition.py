@@ -161,3 +161,13 @@ def test_all_pairs_are_every_composing_pair():
         if composition_conflict((a, b)) is not None
     ]
     assert len(pairs) + len(refused) == len(names) * (len(names) - 1) // 2 == 630
+
+
+def test_an_unknown_fault_is_named_apart_from_the_known_ones():
+    """'mislog-drops-sign,ttt-8-bit': the error says which of the two is not a fault, with a
+    near name where one exists, before the list of every fault."""
+    with pytest.raises(PortError) as err:
+        recorder_faults({"recorder-faults": "mislog-drops-sign,ttt-8-bit"})
+    assert str(err.value).startswith("recorder-faults: 'mislog-drops-sign' is not a recorder fault")
+    with pytest.raises(PortError, match=r"'retry-to-early' is not .*did you mean retry-too-early"):
+        recorder_faults({"recorder-faults": "retry-to-early"})
