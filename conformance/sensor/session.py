@@ -8,7 +8,8 @@ fresh state (aborts, address change) ask for a ``fresh`` stimulus explicitly.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Generic, TypeVar
 
@@ -221,8 +222,10 @@ class SensorSession(Session):
         silence raises :class:`NoDeviceAnswered` (exit 5)."""
         usual = self.master.policy
         for duration in LONGER_BREAKS:
-            self.master.policy = usual.but(break_duration=duration)
-            if self.master.acknowledge(self.address).answered:
+            with self._policy_for_now(break_duration=duration):
+                answered = self.master.acknowledge(self.address).answered
+            if answered:
+                self.master.policy = usual.but(break_duration=duration)  # kept from here
                 self.assumptions.append(
                     f"a! and aI! went unanswered after {usual.break_duration * 1e3:.0f} ms "
                     f"breaks, a! answered after a {duration * 1e3:.0f} ms one: the tool "
@@ -230,7 +233,6 @@ class SensorSession(Session):
                     "the short ones)"
                 )
                 return True
-        self.master.policy = usual
         unanswered = (
             f"no device answered at address {self.address!r} (a! and aI! got no reply after "
             f"retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms"
@@ -286,13 +288,21 @@ class SensorSession(Session):
         a real bus, 5 s for all 61): a sensor that ignores ``?!`` at an address that is not
         '0' is found instead of called absent (seed 4158, ignores-query with
         factory-address-not-zero). Only for a device alone on the line (not ``shared``)."""
-        usual = self.master.policy
-        self.master.policy = usual.but(retries_per_sequence=0, sequences=1)
-        try:
+        with self._policy_for_now(retries_per_sequence=0, sequences=1):
             return [
                 a for a in ADDRESS_CHARS
                 if a != self.address and self.master.acknowledge(a).answered
             ]  # fmt: skip
+
+    @contextmanager
+    def _policy_for_now(self, **changes: Any) -> Iterator[None]:
+        """The tool recorder's policy with ``changes`` for what runs inside, the usual one
+        back after it even when the link fails there: discovery tries longer breaks and
+        single asks without leaving them in force for the suite."""
+        usual = self.master.policy
+        self.master.policy = usual.but(**changes)
+        try:
+            yield
         finally:
             self.master.policy = usual
 
