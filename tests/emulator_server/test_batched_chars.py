@@ -13,7 +13,6 @@ and the judges say INCONCLUSIVE.
 
 from __future__ import annotations
 
-import socket
 import time
 
 import pytest
@@ -26,7 +25,7 @@ from conformance.transcript import EventKind
 from conformance.verdicts import Verdict
 from conformance.view.segments import read_view
 
-from .test_batched_reads import BREAK_OFF, BREAK_ON, U, command
+from .test_batched_reads import BREAK_OFF, BREAK_ON, U, command, playing
 
 
 class _StallingReader(servers.ArrivalReader):
@@ -54,13 +53,7 @@ def served(monkeypatch, after: bytes, stall: float, *steps: bytes | float) -> li
     monkeypatch.setattr(servers, "ArrivalReader", _StallingReader)
     line = ServedLine(ServeSpec("127.0.0.1", 0))
     try:
-        with socket.create_connection(line.server.address) as client:
-            client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            for step in steps:
-                if isinstance(step, float):
-                    time.sleep(step)
-                else:
-                    client.sendall(step)
+        with playing(line.server.address, steps):
             time.sleep(stall + 0.1)
         return list(line.transcript.events)
     finally:

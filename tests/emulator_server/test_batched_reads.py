@@ -13,6 +13,8 @@ from __future__ import annotations
 import socket
 import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import pytest
 from serial import rfc2217
@@ -36,18 +38,26 @@ def command(text: str) -> bytes:
     return bytes(to_wire_7e1(ord(c)) for c in text)
 
 
+@contextmanager
+def playing(address: tuple[str, int], steps: tuple[bytes | float, ...]) -> Iterator[None]:
+    """A client connected to ``address`` that has sent ``steps`` (bytes: one ``sendall``;
+    float: a pause in s), still connected inside the block."""
+    with socket.create_connection(address) as client:
+        client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        for step in steps:
+            if isinstance(step, float):
+                time.sleep(step)
+            else:
+                client.sendall(step)
+        yield
+
+
 def served_exchange(*steps: bytes | float) -> list:
     """Send ``steps`` (bytes: one ``sendall``; float: a pause in s) to a served line of no
     sensors and return its transcript once it has laid everything."""
     line = ServedLine(ServeSpec("127.0.0.1", 0))
     try:
-        with socket.create_connection(line.server.address) as client:
-            client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            for step in steps:
-                if isinstance(step, float):
-                    time.sleep(step)
-                else:
-                    client.sendall(step)
+        with playing(line.server.address, steps):
             deadline = time.monotonic() + 2.0
             sent = b"".join(s for s in steps if isinstance(s, bytes))
             wanted = len(sent.replace(BREAK_ON, b"").replace(BREAK_OFF, b""))
