@@ -26,9 +26,7 @@ def gap_sequences(draw):
     """Gaps as ``_cut_gaps`` gives them, drawn from few values so that many tie."""
     pool = draw(st.lists(st.tuples(gap_values, wheres), min_size=1, max_size=8))
     picks = draw(st.lists(st.integers(0, len(pool) - 1), min_size=0, max_size=300))
-    return [
-        (pool[i][0], pool[i][1], None, None, ("0D0!", "0+1", k)) for k, i in enumerate(picks)
-    ]
+    return [(pool[i][0], pool[i][1], None, None, ("0D0!", "0+1", k)) for k, i in enumerate(picks)]
 
 
 def _seen(found) -> str:
