@@ -8,7 +8,7 @@ PASS only when the whole interval ``measured +/- uncertainty`` lies inside the a
 from __future__ import annotations
 
 from bisect import bisect_right
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from itertools import accumulate
@@ -174,7 +174,10 @@ def combine_local(
     # a run's character gaps number tens of thousands, nearly always none tainted (never on
     # a virtual clock): then every one is kept, as one slice; the places are wanted only by
     # the few deviations of a real-time link (_by_place), and gathered only then
-    if any(o[1] for o in observed):
+    kept: Sequence[Finding | Measured]
+    if type(observed) is Observed:  # none tainted, grouped as they were made
+        kept, aside = Alike(observed), []
+    elif any(o[1] for o in observed):
         kept = [o[0] for o in observed if not _aside(o[0], o[1])]
         aside = [o[0] for o in observed if _aside(o[0], o[1])]
     else:
@@ -186,13 +189,11 @@ def combine_local(
     )
     if aside and not kept:
         return Finding(rid, Verdict.INCONCLUSIVE, f"every {what} undecided; {note}")
-    failing = [f for f in kept if f.verdict is Verdict.FAIL]
-    isolated = (
-        real_time
-        and failing
-        and len(failing) < len(kept)
-        and not sustained(len(failing), len(kept))
-    )
+    if type(kept) is Alike:
+        failing = kept.failing()
+    else:
+        failing = sum(f.verdict is Verdict.FAIL for f in kept)
+    isolated = real_time and failing and failing < len(kept) and not sustained(failing, len(kept))
     if isolated:
         places = [o[2] if len(o) > 2 else None for o in observed if not _aside(o[0], o[1])]  # type: ignore[misc]
         found = _by_place(rid, list(zip(kept, places, strict=True)), what, smallest_is_worst)
@@ -450,6 +451,8 @@ def _grouped(
     first comes, where every one is a plain :class:`Measured` against the one window (the
     same object); None otherwise (or none at all): :func:`distribution` then goes one by
     one. An object says the same each time it comes, so its figures stand for every time."""
+    if type(observations) is Alike:
+        return observations.grouped()
     first = observations[0] if observations else None
     if type(first) is not Measured:
         return None
@@ -470,6 +473,63 @@ def _grouped(
         distinct.append(o)  # type: ignore[arg-type]
         counts.append(1)
     return window, distinct, counts
+
+
+class Alike(Sequence["Measured"]):
+    """The findings of untainted observations (:class:`Observed`), each distinct object with
+    how often it comes, in the order each first comes: what :func:`combine` and
+    :func:`distribution` would otherwise work out again from the tens of thousands of a
+    run's character gaps (``{id(f): f}``, :func:`_grouped`). Reads as the sequence of the
+    observations' findings, one by one, where something needs them so."""
+
+    __slots__ = ("_observed", "counts", "distinct")
+
+    def __init__(self, observed: Observed) -> None:
+        self._observed = observed
+        self.distinct = observed.distinct
+        self.counts = observed.counts
+
+    def __len__(self) -> int:
+        return len(self._observed)
+
+    def __getitem__(self, i):  # type: ignore[no-untyped-def,override]
+        if isinstance(i, slice):
+            return [o[0] for o in self._observed[i]]
+        return self._observed[i][0]
+
+    def __iter__(self) -> Iterator[Measured]:
+        return (o[0] for o in self._observed)
+
+    def failing(self) -> int:
+        """How many of them FAIL."""
+        return sum(c for m, c in zip(self.distinct, self.counts, strict=True)
+                   if m.verdict is Verdict.FAIL)  # fmt: skip
+
+    def grouped(self) -> tuple[Window, list[Measured], list[int]] | None:
+        """:func:`_grouped` of the findings, from the groups: the same answer."""
+        if not self.distinct:
+            return None
+        window = self.distinct[0]._window
+        for m in self.distinct:
+            if type(m) is not Measured or m._window is not window:
+                return None
+            if m.measured != m.measured or m.uncertainty != m.uncertainty:
+                return None  # a NaN sorts by where it stands: one by one
+        return window, self.distinct, self.counts
+
+
+class Observed(list):  # type: ignore[type-arg]
+    """Observations ``(measured, False, place)``, none tainted, made in one pass with their
+    :class:`Measured` objects grouped (``distinct``, each first where it first comes, and
+    ``counts``: ``judges/wire``'s equal gaps judged once). :func:`combine_local` then reads
+    the groups instead of passing over every observation again."""
+
+    __slots__ = ("counts", "distinct")
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.distinct: list[Measured] = []
+        self.counts: list[int] = []
 
 
 def _distribution_of_one_window(
@@ -795,7 +855,12 @@ def combine(
     sign = -1 if smallest_is_worst else 1
     # each object once, in the order it first comes (a run's character gaps: tens of
     # thousands, a few hundred distinct): the first of the largest is the same either way
-    distinct = list({id(f): f for f in findings}.values())
+    if type(findings) is Alike:
+        distinct: list[Finding | Measured] = list(findings.distinct)
+        observed = sum(f.observed * c for f, c in zip(distinct, findings.counts, strict=True))
+    else:
+        distinct = list({id(f): f for f in findings}.values())
+        observed = sum(f.observed for f in findings)
     # the first with the worst verdict and, among those, the largest (smallest) measurement
     top = max({f.verdict for f in distinct}, key=lambda v: v.rank)
     worst = max(
@@ -830,6 +895,6 @@ def combine(
         uncertainty_ms=worst.uncertainty_ms,
         evidence=worst.evidence,
         margin_ms=margin,
-        observed=sum(f.observed for f in findings),
+        observed=observed,
         distribution=distribution(findings),
     )

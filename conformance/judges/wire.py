@@ -28,6 +28,7 @@ from .tally import Tally
 from .timing import (
     Measured,
     Observation,
+    Observed,
     Place,
     StampUncertainty,
     Window,
@@ -224,20 +225,32 @@ def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observa
     return observed
 
 
-def _observe_gaps_alike(gaps: list[Gap], base: float) -> list[Observation]:
+def _observe_gaps_alike(gaps: list[Gap], base: float) -> Observed:
     """:func:`_observe_gaps` where every gap has the stamps' one uncertainty ``base`` (no
     local irregularity: a virtual clock, a capture's sample grid), which is then no part of
-    the key and taints none: the same observations, with less asked per gap."""
-    judged: dict[tuple[float, str], Measured] = {}
-    observed: list[Observation] = []
-    add = observed.append
+    the key and taints none: the same observations, with less asked per gap, grouped as they
+    are made (:class:`~.timing.Observed`: what combine_local reads instead of passing over
+    some 20,000 gaps a run five more times)."""
+    judged: dict[tuple[float, str], int] = {}  # -> its index in distinct
+    observed = Observed()
+    distinct, counts = observed.distinct, observed.counts
+    add, new, once = observed.append, distinct.append, counts.append
     for gap, where, _a, _b, place in gaps:
         if not gap and copysign(1.0, gap) < 0:  # judged apart, as _observe_gaps does
-            add((Measured(GAP_WINDOW, gap, base, [where]), False, place))
+            measured = Measured(GAP_WINDOW, gap, base, [where])
+            new(measured)
+            once(1)
+            add((measured, False, place))
             continue
-        measured = judged.get((gap, where))
-        if measured is None:
-            measured = judged[(gap, where)] = Measured(GAP_WINDOW, gap, base, [where])
+        i = judged.get((gap, where))
+        if i is None:
+            measured = Measured(GAP_WINDOW, gap, base, [where])
+            judged[(gap, where)] = len(distinct)
+            new(measured)
+            once(1)
+        else:
+            measured = distinct[i]
+            counts[i] += 1
         add((measured, False, place))
     return observed
 
