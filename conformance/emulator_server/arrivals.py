@@ -42,12 +42,15 @@ class Arrival:
     arrival, which they came after), no later than ``at`` (their packet's kernel stamp, or
     the moment the read returned). ``earliest``: where the reader also saw the socket empty
     after ``since`` (:class:`~.servers.ArrivalReader`), the latest such moment, which they
-    came after too; None: ``since``."""
+    came after too; None: ``since``. ``stamped``: ``at`` is the kernel's receive stamp of
+    their packet; else it is when the read returned, and even one event alone may have
+    arrived anywhere in :attr:`unseen` (a late read of a packet the kernel did not stamp)."""
 
     events: tuple[ToolEvent, ...]
     since: float
     at: float
     earliest: float | None = None
+    stamped: bool = True
 
     @property
     def unseen(self) -> float:
@@ -115,12 +118,12 @@ def placed(since: float, at: float, count: int) -> tuple[list[float], float]:
 def char_doubt(arrival: Arrival, timed: int, length: int) -> float:
     """How far (s) the characters of a bytes event of ``length`` bytes, one of ``timed``
     timed events of ``arrival``, may be from where they are laid: 0 for a byte alone in its
-    arrival (its packet's own stamp), else :attr:`Arrival.unseen`. Bytes that came together
+    arrival with its packet's own stamp, else :attr:`Arrival.unseen`. Bytes that came together
     are laid back to back from the arrival, but the kernel merges packets nobody read yet
     into one stamp (the later one): a recorder that sent '0', paused 20 ms, then 'M!' is
     read as '0M!' stamped at the 'M!', its first character 20 ms later and its gap 0 ms, as
     far as the stamps go. Each character may have been sent anywhere in that span."""
-    return arrival.unseen if timed > 1 or length > 1 else 0.0
+    return arrival.unseen if timed > 1 or length > 1 or not arrival.stamped else 0.0
 
 
 def lay(line: ToolSide, arrival: Arrival) -> None:
@@ -130,6 +133,8 @@ def lay(line: ToolSide, arrival: Arrival) -> None:
     events = merged(arrival.events)
     timed = [e for e in events if e.kind != "rts"]
     times, doubt = placed(arrival.since, arrival.at, len(timed))
+    if not arrival.stamped:  # one event alone, stamped as the read returned: maybe late
+        doubt = max(doubt, arrival.unseen)
     slot = iter(times)
     for event in events:
         if event.kind == "rts":
