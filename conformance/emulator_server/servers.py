@@ -16,13 +16,18 @@ import select
 import socket
 import sys
 import threading
-import time
 from collections.abc import Callable
 
 import serial
 from serial import rfc2217
 
-from ..links.kernel_stamps import SO_TIMESTAMPNS, STAMP_SPACE, recv_stamped_byte
+from ..links.kernel_stamps import (
+    SO_TIMESTAMPNS,
+    STAMP_SPACE,
+    TIGHT_BRACKET_NS,
+    bracketed_wall,
+    recv_stamped_byte,
+)
 from ..links.stamps import chunk_frames
 from ..protocol.timing import BREAK_MIN, CHAR_TIME
 from .arrivals import Arrival, ToolEvent, lay, step
@@ -304,7 +309,7 @@ class ArrivalReader:
         if not got[0][0]:
             return None
         got += [self._stamped_byte() for _ in range(self._waiting())]
-        now, now_ns = self.clock(), time.time_ns()
+        now, now_ns = bracketed_wall(self.clock, TIGHT_BRACKET_NS / 1e9)
         groups: list[tuple[bytes, float, float, bool]] = []
         for stamp, run in itertools.groupby(got, key=lambda b: b[1]):
             data = b"".join(b for b, _ in run)

@@ -22,6 +22,7 @@ import sys
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from typing import Any
 
 import serial
@@ -38,21 +39,27 @@ STAMP_SPACE = socket.CMSG_SPACE(16) if hasattr(socket, "CMSG_SPACE") else 0
 TIGHT_BRACKET_NS = 50_000
 
 
-def _clock_offset_ns(tries: int = 4) -> int:
-    """CLOCK_REALTIME minus perf_counter (kernel stamps are wall time): the wall clock read
-    between two perf_counter reads, taken from the tightest of a few brackets. Read once
-    back to back, a thread descheduled between the two reads (a loaded host) put every
-    stamp of that byte late by the whole stall."""
-    best_width, best = -1, 0
+def bracketed_wall(clock: Callable[[], float], tight: float, tries: int = 4) -> tuple[float, int]:
+    """``clock`` and the wall clock (ns) read at one moment: the wall read between two
+    ``clock`` reads, from the tightest of up to ``tries`` brackets (one within ``tight``, in
+    the clock's units, is taken at once). Read once back to back, a thread descheduled
+    between the two reads (a loaded host) pairs readings a whole stall apart."""
+    best_width, best = -1.0, (0.0, 0)
     for _ in range(tries):
-        before = time.perf_counter_ns()
+        before = clock()
         wall = time.time_ns()
-        after = time.perf_counter_ns()
+        after = clock()
         if best_width < 0 or after - before < best_width:
-            best_width, best = after - before, wall - (before + after) // 2
-        if best_width <= TIGHT_BRACKET_NS:
+            best_width, best = after - before, ((before + after) / 2, wall)
+        if best_width <= tight:
             break
     return best
+
+
+def _clock_offset_ns() -> int:
+    """CLOCK_REALTIME minus perf_counter (kernel stamps are wall time)."""
+    mid, wall = bracketed_wall(time.perf_counter_ns, TIGHT_BRACKET_NS)
+    return wall - round(mid)
 
 
 def recv_stamped_byte(sock: socket.socket, *flags: int) -> tuple[bytes, int | None]:

@@ -34,3 +34,12 @@ def test_a_tight_first_bracket_is_taken_at_once(monkeypatch):
 def test_on_this_machine_the_offset_is_stable_to_well_under_a_millisecond():
     offsets = [kernel_stamps._clock_offset_ns() for _ in range(200)]
     assert max(offsets) - min(offsets) < 1_000_000
+
+
+def test_a_served_lines_clock_pairs_with_the_wall_clock_across_a_stall(monkeypatch):
+    """The emulator server's reader pairs its line clock (s) with the wall clock the same
+    way: a 40 ms stall between the first two reads does not shift the pair."""
+    line = iter([10.0, 10.040, 11.0, 11.00001])
+    monkeypatch.setattr(time, "time_ns", iter([5_000_000_000, 6_000_005_000]).__next__)
+    now, wall = kernel_stamps.bracketed_wall(line.__next__, 50e-6)
+    assert abs((wall / 1e9 - now) - (5.0 - 10.0)) < 1e-5
