@@ -20,7 +20,7 @@ from ..recorder_jobs import RecorderOutput, Request, Task
 from ..sim.bus import SimBus
 from ..tool_recorder import Measurement, Policy, ToolRecorder
 from ..tool_recorder.engine import _service_request_end
-from ..tool_recorder.hooks import Engine
+from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.records import OK, Attempt, Exchange
 from ..tool_recorder.validity import ends_line
 from ..transcript import Event, decode_7e1
@@ -387,18 +387,10 @@ class DropsAfterParityToolRecorder(GoldenToolRecorder):
 
 
 class EngineRetryHooks(GoldenHooks):
-    """The engine's own retry time, without the golden recorder's wait for a quiet line."""
+    """The engine's own retry time, without the golden recorder's wait for a quiet line (no
+    drain of a reply that may still be coming)."""
 
-    def retry_time(
-        self,
-        master: Engine,
-        exchange: Exchange,
-        sequence: int,
-        per_sequence: int,
-        usual: Callable[[], float],
-    ) -> float:
-        """``usual()``: no drain of a reply that may still be coming."""
-        return usual()
+    retry_time = Hooks.retry_time
 
 
 class TalksOverToolRecorder(GoldenToolRecorder):
