@@ -123,13 +123,10 @@ def test_an_m_measurement_is_still_disturbed_by_a_command_to_another_sensor():
     from conformance.offline.heard import disturbance
     from conformance.view.rebuilt_records import rebuild_records
     from conformance.view.segments import read_view
-    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, measured_past_another
 
     bus, recorder = bus_of_sensors("01")
-    m = start(recorder, "0M!")
-    recorder.transact("1I!")
-    recorder.link.wait_until(recorder.link.now() + m.ttt + 0.1)
-    recorder.collect(m, force_break=True)
+    measured_past_another(recorder)
     view = read_view(as_heard(bus))
     (rebuilt,) = rebuild_records(view).measurements
     assert disturbance(rebuilt, view) == "1I!"

@@ -50,6 +50,19 @@ def start(recorder: ToolRecorder, text: str) -> Measurement:
     return m
 
 
+def measured_past_another(
+    recorder: ToolRecorder, text: str = "0M!", other: str = "1I!"
+) -> Measurement:
+    """``text`` started, ``other`` (a command to another sensor) sent before its service
+    request, then its data asked for after the ttt with a break (R-4.4.5-06's disturbance:
+    on the wire the D command follows, for a rebuild to take wrongly)."""
+    m = start(recorder, text)
+    recorder.transact(other)
+    recorder.link.wait_until(recorder.link.now() + m.ttt + 0.1)
+    recorder.collect(m, force_break=True)
+    return m
+
+
 def concurrent_round(
     recorder: ToolRecorder,
     addresses: str = ADDRESSES,

@@ -22,7 +22,7 @@ from tests.support.bus_of_sensors import (
     as_heard,
     bus_of_sensors,
     concurrent_round,
-    start,
+    measured_past_another,
 )
 
 
@@ -78,10 +78,7 @@ def test_an_m_measurements_data_ended_by_another_sensor_stays_ended_alone():
     0M! no data (the very next exchange was another sensor's); sensor 0's alone must not
     take the 0D0! that follows once 1I! is left out."""
     bus, recorder = bus_of_sensors("01")
-    m = start(recorder, "0M!")
-    recorder.transact("1I!")
-    recorder.link.wait_until(recorder.link.now() + m.ttt + 0.1)
-    recorder.collect(m, force_break=True)
+    measured_past_another(recorder)
     view = read_view(as_heard(bus))
     whole = _each_sensor_alike(view)
     assert [(x.command.text(), len(x.data)) for x in whole.measurements] == [("0M!", 0)]

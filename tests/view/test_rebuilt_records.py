@@ -157,13 +157,10 @@ def test_a_command_to_the_same_sensor_ends_a_concurrent_measurements_data():
 def test_an_m_measurement_still_takes_only_the_very_next_exchange_as_its_data():
     """After aM! the recorder talks to no one else (R-4.4.5-06): a command to another
     sensor before 0D0! ends 0M!'s data in the records, as before."""
-    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+    from tests.support.bus_of_sensors import as_heard, bus_of_sensors, measured_past_another
 
     bus, recorder = bus_of_sensors("01")
-    m = start(recorder, "0M!")
-    recorder.transact("1I!")
-    recorder.link.wait_until(recorder.link.now() + m.ttt + 0.1)
-    recorder.collect(m, force_break=True)
+    m = measured_past_another(recorder)
     assert m.data and m.data[0].text == "0D0!"  # on the wire, for a rebuild to take wrongly
     rebuilt = rebuild_records(read_view(as_heard(bus))).measurements
     assert [(x.command.text(), len(x.data)) for x in rebuilt] == [("0M!", 0)]
