@@ -59,6 +59,8 @@ class Reason(StrEnum):
     CRC_WRONG = "crc-wrong"
     CRC_UNASKED = "crc-unasked"
     PACKET = "packet"
+    #: not the sensor's: the recorder's own break cut into the reply while it was coming
+    CUT = "cut-by-recorder"
 
 
 @dataclass(frozen=True)

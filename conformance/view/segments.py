@@ -84,6 +84,12 @@ class Transmission:
     #: (:func:`collided`), never a reply. A line that queues frames (the sim bus, a kit)
     #: puts the tail right after the command, 0 ms later, where it read as a reply before.
     cut: Event | None = None
+    #: The recorder's own break that began while this transmission's reply was still
+    #: coming (its last character heard had no LF and the break started within a character
+    #: gap of it): the recorder took the line over the reply, so what was heard of it is no
+    #: invalid reply of the sensor's (a logger whose poll timeout is shorter than a long
+    #: reply, the fourteenth round's MicroPython driver).
+    cut_by: Event | None = None
 
     def __post_init__(self) -> None:
         # every derived value :func:`memo` keeps here, named up front in one order: the
@@ -538,6 +544,8 @@ def _cut(
         if own:
             if kind is brk:
                 breaks.append(e)
+                if current is not None and current.heard and current.heard[-1] is last_heard:
+                    current.cut_by = e if _cut_into(last_heard, e) is not None else None
                 pending, current = e, None
             elif current is None or (is_command and e.start - current.end >= NEW_COMMAND):
                 current = Transmission(pending, [e], part=part, cut=_cut_into(last_heard, e))

@@ -5,18 +5,24 @@ held. Retry and measurement reconstruction both start from these decisions."""
 from __future__ import annotations
 
 from ...protocol.commands import Command
+from ...protocol.framing import ETX, LF
 from ...protocol.responses import parse_data_reply, split_line
 from ...protocol.timing import CHAR_TIME, TOLERANCE
-from ...transcript import decode_7e1
+from ...transcript import decode_7e1, escape
 from ...view.segments import TranscriptView, Transmission
-from ..reply_validity import NO_LIMIT, ReplyProblem, check_packet, check_reply
+from ..reply_validity import NO_LIMIT, Reason, ReplyProblem, check_packet, check_reply
 
 
 def reply_problem(
     sent: Transmission, crc_expected: bool | None, uncertainty: float
 ) -> ReplyProblem | None:
     """Why the sensor's reply to ``sent`` was not a valid reply (:data:`NO_REPLY` if none
-    came), by the judges' own rules (:mod:`.reply_validity`), not the golden recorder's."""
+    came), by the judges' own rules (:mod:`.reply_validity`), not the golden recorder's. A
+    reply the recorder's own break cut into (:attr:`Transmission.cut_by`) is
+    :data:`Reason.CUT`: what was heard of it is no invalid reply of the sensor's."""
+    cut = cut_off(sent)
+    if cut is not None:
+        return cut
     if sent.binary:
         return check_packet(sent.reply, address=sent.address, command_end=sent.end)
     return check_reply(
@@ -26,6 +32,22 @@ def reply_problem(
         command_end=sent.end,
         gap_limit=CHAR_TIME + TOLERANCE + uncertainty,
         crc_expected=crc_expected,
+    )
+
+
+def cut_off(sent: Transmission) -> ReplyProblem | None:
+    """:data:`Reason.CUT` where the recorder's own break began while the reply to ``sent``
+    was still coming (its framed reply ends with the last character heard, no LF or ETX)."""
+    brk = sent.cut_by
+    if brk is None or sent.binary:
+        return None
+    reply = sent.reply
+    if not reply or reply[-1] is not sent.heard[-1] or reply[-1].char7 in (LF, ETX):
+        return None
+    return ReplyProblem(
+        Reason.CUT,
+        f"the recorder's break at t={brk.start:.3f} s cut into the reply "
+        f"'{escape(decode_7e1(reply))}' while the sensor was still sending it",
     )
 
 

@@ -28,7 +28,7 @@ from ..tally import Tally
 from ..timing import judge_window
 from .common import combine, own_uncertainty
 from .logged import same_values
-from .replies import crc_context, reply_problem
+from .replies import crc_context, cut_off, reply_problem
 
 #: Marking after which a sensor is in standby (R-7.0-15, +0.40 ms): a command sent again
 #: without a break after longer than this is not a retry but a new try without its break.
@@ -105,7 +105,10 @@ def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
     for i, s in enumerate(line.transmissions):
         if not s.is_command:  # CR LF after the '!' aside (Transmission.stem)
             continue  # no command, so no reply to retry for; R-4.4-04 judges its text
-        attempt = Try(s, reply_problem(s, crc[i], uncertainty))
+        problem = reply_problem(s, crc[i], uncertainty)
+        if problem is not None and problem.reason is Reason.CUT:
+            problem = None  # the recorder's own break cut it: no reply of the sensor's to retry
+        attempt = Try(s, problem)
         last = out[-1].attempts[-1] if out else None
         if (
             last is not None
@@ -134,6 +137,7 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
         if all(a.problem is None for a in group.attempts):
             continue
         _judge_group(line, group, uncertainty, acc)
+    acc.restarted.extend(_cut_replies(line))
     tally = acc.tally
     for rid in tally.ids:
         tally.decision(rid, RETRY_DECISION)
@@ -319,6 +323,18 @@ def _judge_repeated(
             f"{where} was repeated {len(sequences)} times, each time a new sequence with "
             "no retry in it: no break+command+retries sequence was seen to repeat",
         )
+
+
+def _cut_replies(line: TranscriptView) -> list[str]:
+    """Replies the recorder's own break cut into (:func:`.replies.cut_off`): no invalid
+    reply of the sensor's, so no retry was due (R-7.2-01, -03, -05 leave them out); the
+    break and what follows it are a new sequence, not a retry (decision T2), so R-7.2-06
+    names them and stays INCONCLUSIVE on them."""
+    return [
+        f"{cut} (after {s.at()}): a new sequence, not a retry"
+        for s in line.transmissions
+        if (cut := cut_off(s)) is not None
+    ]
 
 
 def _waited(ends: list[Finding], restarted: list[str]) -> Finding:

@@ -222,6 +222,34 @@ def test_repeats_with_a_new_break_are_no_retries():
     assert found["R-7.2-01"].verdict is found["R-7.2-05"].verdict is Verdict.FAIL
 
 
+def test_a_reply_the_recorders_own_break_cut_into_is_not_the_sensors_invalid_reply():
+    """Fourteenth round (docs/kit.md): a MicroPython logger polls a reply for 500 ms, then
+    breaks and sends the command again, over a long reply still coming. R-7.2-01, -03 and -05
+    FAILed "reply '0+1.5+2.' does not end with CR LF ..., then a new sequence": the sensor's
+    reply was valid, the recorder cut it. No invalid reply is seen there now, and R-7.2-06
+    names the cut (a new break is no retry: decision T2, INCONCLUSIVE)."""
+    w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n")
+    w.t -= 60e-3  # the break starts while the reply's last characters are still coming
+    line = w.brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").view()
+    found = by_id(judge_retries(line, 0.0))
+    for rid in ("R-7.2-01", "R-7.2-03", "R-7.2-05"):
+        assert found[rid].verdict is Verdict.INCONCLUSIVE, found[rid].detail
+    assert line.transmissions[0].cut_by is line.breaks[1]
+    assert found["R-7.2-06"].verdict is Verdict.INCONCLUSIVE
+    assert "break at t=0.129 s cut into the reply '0+1.5+2.'" in found["R-7.2-06"].detail
+    # a reply the sensor itself left unfinished (no LF, then 300 ms of marking before the
+    # break) is still its invalid reply, and a new break instead of a retry still FAILs
+    w = Wire().brk().rec("0D0!").sensor("0+1.5+2.").idle(300)
+    line = w.brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").view()
+    assert line.transmissions[0].cut_by is None
+    found = by_id(judge_retries(line, 0.0))
+    assert found["R-7.2-05"].verdict is found["R-7.2-01"].verdict is Verdict.FAIL
+    assert "does not end with CR LF" in found["R-7.2-05"].detail
+    # a complete reply, then the break 1 ms after its LF: nothing was cut
+    w = Wire().brk().rec("0D0!").sensor("0+1.5\r\n").idle(1)
+    assert w.brk().rec("0D1!").view().transmissions[0].cut_by is None
+
+
 def test_a_resend_after_the_retry_window_is_no_retry():
     # aD0! again without a break after a 1.5 s poll timeout: the sensor is in standby
     w = Wire().brk().rec("0D0!").idle(1500).rec("0D0!").sensor("0+1+2\r\n")
