@@ -283,6 +283,11 @@ def test_crc_mismatch_must_be_retried():
     line = w.view()
     found = judge_crc_checked(line, 0.0, None, [])
     assert found[0].verdict is Verdict.FAIL
+    # the fourteenth round's logger raised on that reply and logged nothing for it: the
+    # finding said "accepted a reply whose CRC ..."; what the wire shows is no retry
+    found = judge_crc_checked(line, 0.0, {"0MC!": []}, ["+1", "+2"])
+    assert found[0].verdict is Verdict.FAIL
+    assert found[0].detail.startswith("0D0!: not retried after a reply whose CRC"), found[0].detail
     found = judge_crc_checked(line, 0.0, {"0MC!": ["+1", "+3"]}, ["+1", "+2"])
     assert found[0].verdict is Verdict.FAIL
 
