@@ -16,7 +16,7 @@ from ..tally import Tally
 from ..timing import judge_window
 from .common import combine, record_of
 from .measurements import collection_end, observed_measurements
-from .replies import first_answered
+from .replies import cut_off, first_answered
 
 
 def judge_commands_issued(
@@ -186,7 +186,21 @@ def judge_multiline_end(
     found: list[Finding] = []
     for i, s in enumerate(line.transmissions):
         answer = s.reply
-        if len(answer) < 2 or answer[1].char7 != STX or answer[-1].char7 != 0x0A:
+        if len(answer) < 2 or answer[1].char7 != STX:
+            continue
+        cut = cut_off(s)
+        if cut is not None:  # the recorder broke into a line: it waited for no end at all
+            found.append(
+                Finding(
+                    "R-4.4.13.1-04",
+                    Verdict.WARN,
+                    f"{cut}: it did not wait for the text to end",
+                    evidence=[f"text in reply to {s.at()}"],
+                    observed=1,
+                )
+            )
+            continue
+        if answer[-1].char7 != 0x0A:
             continue
         nxt = line.transmissions[i + 1] if i + 1 < len(line.transmissions) else None
         where = [f"text in reply to {s.at()}"]

@@ -7,6 +7,7 @@ from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
 from conformance.judges.recorder.capabilities import (
     judge_addresses,
     judge_commands_issued,
+    judge_multiline_end,
     judge_transparent,
 )
 from conformance.judges.recorder.collection import (
@@ -248,6 +249,22 @@ def test_a_reply_the_recorders_own_break_cut_into_is_not_the_sensors_invalid_rep
     # a complete reply, then the break 1 ms after its LF: nothing was cut
     w = Wire().brk().rec("0D0!").sensor("0+1.5\r\n").idle(1)
     assert w.brk().rec("0D1!").view().transmissions[0].cut_by is None
+
+
+def test_multi_line_text_the_recorder_broke_into_is_not_waited_for_r_4_4_13_1_04():
+    """Fourteenth round: the MicroPython logger's 500 ms poll ended inside the second line of
+    0XHELP!'s text and it broke over it: "no multi-line text without ETX was observed". A
+    line the recorder's own break cut into is a WARN (the SHOULD: wait 150 ms after the last
+    line); one it let end and then waited 150 ms for still PASSes."""
+    text = "0\x02first line\r\nsecond line\r\n"
+    w = Wire().brk().rec("0XHELP!").sensor(text)
+    w.t -= 50e-3  # the break starts inside the second line
+    (found,) = judge_multiline_end(w.brk().rec("0I!").view(), None, 0.0)
+    assert found.verdict is Verdict.WARN, found.detail
+    assert "did not wait for the text to end" in found.detail
+    w = Wire().brk().rec("0XHELP!").sensor(text).idle(160)
+    (found,) = judge_multiline_end(w.brk().rec("0I!").view(), None, 0.0)
+    assert found.verdict is Verdict.PASS, found.detail
 
 
 def test_a_resend_after_the_retry_window_is_no_retry():
