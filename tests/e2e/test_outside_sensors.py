@@ -43,6 +43,12 @@ unbroken a! that shows it asleep for a break and waits 100 ms for a '!', blind t
 silence after R-7.0-03's 5 ms pulse PASSed, though it wakes on 2 ms of spacing, because the
 control (a real break and a!) was sent without that a! before it. The control now repeats the
 probe's whole prelude.
+
+The fourteenth (two loggers): a MicroPython ESP32 driver polls a reply for 500 ms, then breaks
+and sends the command again over a reply still coming; the part before its break read as the
+sensor's invalid reply (R-7.2-01/-03/-05 FAILed "does not end with CR LF"), and a multi-line
+text it broke into as "no multi-line text without ETX was observed". Their tests are the
+recorder judges' (tests/judges/recorder/test_recorder_judges.py, ``Transmission.cut_by``).
 """
 
 from __future__ import annotations
