@@ -48,11 +48,20 @@ def judge_commands_issued(
         # sensor side is the tool's, so "never answered" alone read as the tool's failure.
         unsent = [t for t in missing if t not in sent]
         unanswered = [t for t in missing if t in sent]
+        # a reply the recorder's own break cut into was never heard whole, by its doing
+        cut = {s.text for s in line.transmissions if cut_off(s) is not None}
+        cut_short = [t for t in unanswered if t in cut]
+        unanswered = [t for t in unanswered if t not in cut]
         if unsent:
             parts.append("never sent: " + ", ".join(escape(t) for t in unsent))
         if unanswered:
             parts.append(
                 "sent but never answered validly: " + ", ".join(escape(t) for t in unanswered)
+            )
+        if cut_short:
+            parts.append(
+                "sent, its reply cut by the recorder's own break: "
+                + ", ".join(escape(t) for t in cut_short)
             )
         if short:
             parts.append("data not read: " + ", ".join(short))

@@ -364,6 +364,13 @@ def test_r_4_4_02_tells_a_command_never_sent_from_one_never_answered():
     found = judge_commands_issued(w.view(), ["0!", "0I!", "0A5!"], 0.0)
     assert found.verdict is Verdict.FAIL
     assert found.detail == "never sent: 0A5!; sent but never answered validly: 0I!"
+    # fourteenth round: the MicroPython logger broke over 0I!'s reply 50 ms into it; the
+    # sensor answered, the recorder cut it ("sent but never answered validly" blamed the reply)
+    w = Wire().brk().rec("0!").sensor("0\r\n").idle(20).brk().rec("0I!")
+    w.sensor("013CONFORM EMU001100SN0001\r\n").t -= 180e-3
+    found = judge_commands_issued(w.brk().rec("0!").view(), ["0!", "0I!", "0A5!"], 0.0)
+    assert found.verdict is Verdict.FAIL
+    assert found.detail == "never sent: 0A5!; sent, its reply cut by the recorder's own break: 0I!"
 
 
 def test_a_concurrent_measurement_repeated_before_its_data_owes_no_values():
