@@ -679,12 +679,13 @@ _FAULTS = (
         "waits-forever-for-service-request",
         "Waits for the service request after aM!/aV! with no end, never counting ttt down: "
         "a sensor that sends none hangs it until its job is cut at the stated budget. No aD0! "
-        "after ttt (R-4.4.5-05), no values collected (R-4.4.8-05); the rules over every "
-        "transmission still PASS on what it sent, while the rules about that job itself "
-        "cannot PASS on a job that never ended.",
-        ("R-4.4.5-05", "R-4.4.8-05"),
+        "in the seconds from ttt to the cut (R-4.4.5-05); whether it would then have collected "
+        "the values (R-4.4.8-05) the cut leaves unobserved. The rules over every transmission "
+        "still PASS on what it sent, while the rules about that job itself cannot PASS on a "
+        "job that never ended.",
+        ("R-4.4.5-05",),
         Parts(hooks=WaitsForeverHooks),
-        inconclusive=("R-4.4.5-04", "R-4.4.5-06", "R-4.4.5-07"),
+        inconclusive=("R-4.4.5-04", "R-4.4.5-06", "R-4.4.5-07", "R-4.4.8-05"),
     ),
     RecorderFault(
         "stops-after-d0",

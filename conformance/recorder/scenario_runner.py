@@ -70,6 +70,8 @@ class ScenarioRun:
     #: sent until then is all it sent, so rules over every transmission judge it in full
     timed_out: JobTimeout | None = None
     budget: JobBudget | None = None
+    #: line time at which the tool cut the job (``timed_out``): the recorder was still in it
+    cut_at: float | None = None
 
     @property
     def asked(self) -> tuple[str, ...]:
@@ -158,9 +160,13 @@ class RecorderSession(Session):
 
     def view(self, *names: str) -> TranscriptView:
         """The scenarios' transcripts read as the recorder's transmissions, one part each."""
-        return merge_views(
+        view = merge_views(
             [read_view(self.run(n).events, self.is_recorder, part=i) for i, n in enumerate(names)]
         )
+        view.cut_parts = {
+            i: cut for i, n in enumerate(names) if (cut := self.run(n).cut_at) is not None
+        }
+        return view
 
     def run(self, name: str) -> ScenarioRun:
         """The scenario's record, running it the first time it is asked for."""
@@ -214,13 +220,23 @@ class RecorderSession(Session):
             output = self.driver.act(scenario.name, request, self.link, budget)
         except RecorderDriverError as exc:
             output, error, cut = _failed(exc)
+        cut_at = self.link.now() if cut is not None else None
         transcript.note(self.link.now(), output_note(scenario.name, output, error, cut))
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
         events = transcript.since(first)
         self._check_setup(scenario, events, error, cut)
         return ScenarioRun(
-            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
+            scenario,
+            events,
+            output,
+            error,
+            tuple(played),
+            request,
+            tuple(absences),
+            cut,
+            budget,
+            cut_at,
         )
 
     @staticmethod
@@ -269,6 +285,7 @@ class RecorderSession(Session):
             output, error = RecorderOutput(), str(exc)
         except RecorderDriverError as exc:
             output, error, cut = _failed(exc)
+        cut_at = line.now() if cut is not None else None
         line.note(output_note(scenario.name, output, error, cut))
         line.settle(SETTLE)
         kept = line.line
@@ -278,7 +295,16 @@ class RecorderSession(Session):
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
         self._check_setup(scenario, events, error, cut)
         return ScenarioRun(
-            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
+            scenario,
+            events,
+            output,
+            error,
+            tuple(played),
+            request,
+            tuple(absences),
+            cut,
+            budget,
+            cut_at,
         )
 
     def _act_served(

@@ -314,6 +314,9 @@ class TranscriptView:
     chars: list[Event]  # every character, both sides, in time order
     unanswerable: list[Event] = field(default_factory=list)  # sensor chars with no command
     undirected: list[Event] = field(default_factory=list)  # direction left unknown
+    #: parts whose job the tool cut at its budget while the recorder was still in it, with the
+    #: line time of the cut: what the recorder had not sent by then it may still have sent
+    cut_parts: dict[int, float] = field(default_factory=dict)
 
     @property
     def commands(self) -> list[Transmission]:

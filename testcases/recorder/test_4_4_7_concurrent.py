@@ -27,7 +27,7 @@ def test_concurrent_measurements(recorder, case):
     taken = observed_measurements(line, recorder.uncertainty)
     case.extend(judge_concurrent_waits(taken, recorder.uncertainty))
     sent = {s.text for s in line.transmissions}
-    found = judge_concurrent_storage(taken, asked, sent)
+    found = judge_concurrent_storage(taken, asked, sent, cut=bool(line.cut_parts))
     case.extend(f for f in found if f.requirement == "R-4.4.7-08")
 
 

@@ -67,6 +67,34 @@ def test_a_recorder_that_waits_forever_is_cut_and_judged_on_what_it_sent():
     assert "within its 42 s of bus time" in " ".join(f["detail"] for f in found["findings"])
 
 
+def _details(data: dict, rid: str) -> str:
+    return " ".join(
+        f["detail"] for r in data["requirements"] if r["id"] == rid for f in r["findings"]
+    )
+
+
+def test_the_waits_forever_fail_gives_the_wait_and_leaves_the_collection_undecided():
+    """The FAIL says how long past ttt no aD0! came; whether the values would then have been
+    collected (R-4.4.8-05) the cut leaves unobserved: it FAILed 'stopped after the reply'."""
+    data = run_once(f"sim://?recorder-faults={FAULT}", role="recorder")
+    assert "s from when ttt ran out to the tool cutting the job" in _details(data, "R-4.4.5-05")
+    assert _verdicts(data)["R-4.4.8-05"] == "INCONCLUSIVE"
+    assert "the recorder still in this measurement" in _details(data, "R-4.4.8-05")
+
+
+def test_a_clean_recorder_cut_by_a_short_budget_fails_nothing():
+    """--job-timeout shorter than the jobs: every scenario is cut while the golden recorder is
+    still in it, so what it had not sent by then proves nothing. Before, six rules FAILed on
+    those absences ('never sent', 'stopped at D0', 'not on the wire as typed')."""
+    data = run_once("sim", role="recorder", job_timeout=1.5)
+    verdicts = _verdicts(data)
+    assert [r for r, v in verdicts.items() if v == "FAIL"] == []
+    assert verdicts["R-4.4-02"] == "INCONCLUSIVE"
+    assert "not sent before the tool cut a job at its budget" in _details(data, "R-4.4-02")
+    for rid in ("R-4.4.7-08", "R-5.1-04", "R-5.2-08", "R-5.4-01", "R-4.4.14-02"):
+        assert verdicts[rid] == "INCONCLUSIVE", rid
+
+
 def test_a_harness_that_loops_forever_is_cut_and_its_stderr_kept(tmp_path):
     """The same fault behind ``exec:``: the harness plans waits for ever, the tool cuts it at
     ``--job-timeout``, and what the harness logged about it is in the report."""

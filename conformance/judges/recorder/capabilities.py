@@ -14,7 +14,7 @@ from ...view.segments import TranscriptView
 from ..reply_validity import STX
 from ..tally import Tally
 from ..timing import judge_window
-from .common import combine, record_of
+from .common import CUT_SHORT, combine, record_of
 from .measurements import collection_end, observed_measurements
 from .replies import cut_off, first_answered
 
@@ -40,8 +40,12 @@ def judge_commands_issued(
     stopped = [
         t
         for t, m in taken.items()
-        if t in asked and len(m.values()) < m.count and collection_end(m)[1] is None
+        if t in asked
+        and len(m.values()) < m.count
+        and collection_end(m)[1] is None
+        and m.cut_at is None
     ]
+    cut_job = bool(line.cut_parts)  # an unsent command may have been owed by the cut job
     if missing or short:
         parts = []
         # A command the recorder never sent is its own fault, not a missing reply: the
@@ -53,7 +57,8 @@ def judge_commands_issued(
         cut_short = [t for t in unanswered if t in cut]
         unanswered = [t for t in unanswered if t not in cut]
         if unsent:
-            parts.append("never sent: " + ", ".join(escape(t) for t in unsent))
+            said = CUT_SHORT if cut_job else "never sent"
+            parts.append(f"{said}: " + ", ".join(escape(t) for t in unsent))
         if unanswered:
             parts.append(
                 "sent but never answered validly: " + ", ".join(escape(t) for t in unanswered)
@@ -67,7 +72,7 @@ def judge_commands_issued(
             parts.append("data not read: " + ", ".join(short))
         return Finding(
             rid,
-            Verdict.FAIL if unsent or stopped else Verdict.INCONCLUSIVE,
+            Verdict.FAIL if (unsent and not cut_job) or stopped else Verdict.INCONCLUSIVE,
             "; ".join(parts),
             evidence=record_of(line.transmissions, missing)
             + [m.start.at() for t, m in taken.items() if t in asked and len(m.values()) < m.count],
@@ -89,13 +94,15 @@ def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
     digits = [a for a in "0123456789" if a not in polled]
     tried = {s.address for s in line.transmissions}
     unsent = [a for a in digits if a not in tried]
+    cut_job = bool(line.cut_parts)
     r3 = (
         Finding(
             "R-4.3-03",
-            Verdict.FAIL if unsent else Verdict.INCONCLUSIVE,
+            Verdict.FAIL if unsent and not cut_job else Verdict.INCONCLUSIVE,
             "addresses never polled successfully: "
             + ", ".join(digits)
-            + ("" if unsent else " (each was polled, never validly answered)"),
+            + ("" if unsent else " (each was polled, never validly answered)")
+            + (f" ({CUT_SHORT})" if unsent and cut_job else ""),
             evidence=record_of(line.transmissions, [f"{a}!" for a in digits]),
             observed=len(line.transmissions),
         )
@@ -165,7 +172,10 @@ def judge_transparent(
                 else f"nothing starting with {escape(text[:1])!r} was sent"
             )
             for rid in ids:
-                unchanged.fail(rid, where, f"not on the wire as typed ({instead})")
+                if line.cut_parts:
+                    unchanged.undecide(rid, where, f"{CUT_SHORT} ({instead})")
+                else:
+                    unchanged.fail(rid, where, f"not on the wire as typed ({instead})")
             continue
         mechanism.observe(where)  # only a command that went out shows how it went out
         first = matching[0]

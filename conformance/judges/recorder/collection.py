@@ -12,7 +12,7 @@ from ...transcript import decode_8n1, escape
 from ...verdicts import Finding
 from ...view.segments import Transmission
 from ..tally import Tally
-from .common import MIN_CONCURRENT_STORE
+from .common import CUT_SHORT, MIN_CONCURRENT_STORE
 from .measurements import ObservedMeasurement, collection_end, read_past_empty
 
 
@@ -47,6 +47,9 @@ def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]
             continue
         if problem is not None:
             continue
+        if m.cut_at is not None:
+            tally.undecide("R-4.4.8-05", where, _cut_with(have, m))
+            continue
         if empty:
             if m.next_start is None or m.next_start.text != m.start.text:
                 tally.fail(
@@ -62,7 +65,10 @@ def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]
 
 
 def judge_concurrent_storage(
-    taken: Sequence[ObservedMeasurement], asked: Sequence[str] = (), sent: Collection[str] = ()
+    taken: Sequence[ObservedMeasurement],
+    asked: Sequence[str] = (),
+    sent: Collection[str] = (),
+    cut: bool = False,
 ) -> list[Finding]:
     """R-4.4.7-07: a concurrent measurement of more than 20 values: at least 20 read and stored
     (the 2000 text's MUST); fewer than announced is a WARN (the capacity should be documented,
@@ -70,7 +76,8 @@ def judge_concurrent_storage(
     ``asked`` (what the scenarios told it to send) must be on the wire. One in ``sent`` (the
     texts the recorder transmitted) that no valid reply answered shows the command, not what
     the recorder does with a measurement: undecided (the reason is another rule's, such as a
-    wake-up the played sensor could not hear, R-7.0-06)."""
+    wake-up the played sensor could not hear, R-7.0-06). ``cut``: a job of the view was cut at
+    its budget, so a command asked and not sent may still have been owed (undecided)."""
     tally = Tally(("R-4.4.7-07", "R-4.4.7-08"))
     started = {m.start.text for m in taken}
     for text in asked:
@@ -78,6 +85,8 @@ def judge_concurrent_storage(
             continue
         if text in sent:
             tally.undecide("R-4.4.7-08", escape(text), "sent, never validly answered")
+        elif cut:
+            tally.undecide("R-4.4.7-08", escape(text), CUT_SHORT)
         else:
             tally.fail("R-4.4.7-08", escape(text), f"asked for {escape(text)}, never sent it")
     for m in taken:
@@ -87,13 +96,19 @@ def judge_concurrent_storage(
         have = len(m.values())
         tally.observe(where, ids=["R-4.4.7-08"])
         if not have and m.count and not _ended_on_problem(m) and not _issued_again(m):
-            tally.fail("R-4.4.7-08", where, f"read none of the {m.count} values")
+            if m.cut_at is not None:
+                tally.undecide("R-4.4.7-08", where, _cut_with(have, m))
+            else:
+                tally.fail("R-4.4.7-08", where, f"read none of the {m.count} values")
         if m.count <= MIN_CONCURRENT_STORE:
             continue
         if have < m.count and _ended_on_problem(m):
             # the last D command drew no valid reply: how many values the recorder would
             # store is unseen (why it went unheard is another rule's, e.g. R-7.0-17)
             tally.undecide("R-4.4.7-07", where, "collection ended on a D command unanswered")
+            continue
+        if have < m.count and m.cut_at is not None:
+            tally.undecide("R-4.4.7-07", where, _cut_with(have, m))
             continue
         tally.observe(where, ids=["R-4.4.7-07"])
         if have < MIN_CONCURRENT_STORE:
@@ -110,6 +125,14 @@ def judge_concurrent_storage(
     return tally.findings("values read")
 
 
+def _cut_with(have: int, m: ObservedMeasurement) -> str:
+    """Why a collection the tool's budget cut short decides nothing of what came next."""
+    return (
+        f"{have} of {m.count} values in when the tool cut the job at its budget "
+        f"(t={m.cut_at:.3f} s), the recorder still in this measurement"
+    )
+
+
 def _issued_again(m: ObservedMeasurement) -> bool:
     """The same command sent again before any data was asked for (a retry: a recorder on a
     busy host that heard the reply late repeats the command, section 7.2): the values are
@@ -122,13 +145,17 @@ def _ended_on_problem(m: ObservedMeasurement) -> bool:
 
 
 def judge_high_volume(
-    taken: Sequence[ObservedMeasurement], is_v14: bool, sent: Collection[str] = ()
+    taken: Sequence[ObservedMeasurement],
+    is_v14: bool,
+    sent: Collection[str] = (),
+    cut: bool = False,
 ) -> list[Finding]:
     """R-5.1-04: after aHA! data commands go past aD9! as needed, without leading zeros.
     R-5.2-08: after aHB! aDBn! commands in 7E1, packets checked, collection stops at the empty
     packet or once every value is in. R-5.4-01: a v1.4 recorder issues aHA! and aHB! and reads
     their data back; one it sent (``sent``: the texts it transmitted) that no valid reply
-    answered leaves the reading back unseen (undecided, not a FAIL)."""
+    answered leaves the reading back unseen (undecided, not a FAIL); so does one not sent in a
+    view with a job cut at its budget (``cut``), and a collection that cut left unfinished."""
     tally = Tally(("R-5.1-04", "R-5.2-08", "R-5.4-01"))
     used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
     unheard: set[Kind] = set()  # started, its collection ended on a D command unanswered
@@ -142,6 +169,8 @@ def judge_high_volume(
             unheard.add(m.kind)
         rid = "R-5.1-04" if m.kind is Kind.HIGH_VOLUME_ASCII else "R-5.2-08"
         tally.observe(where, ids=[rid])
+        if m.cut_at is not None and have < m.count:
+            tally.undecide(rid, where, _cut_with(have, m))
         zeros = [s for s, _ in m.data if (d := s.data_index) and d[2] != str(d[1])]
         if zeros:
             tally.fail(rid, where, f"{escape(zeros[0].text)} has leading zeros")
@@ -150,14 +179,14 @@ def judge_high_volume(
             if parity:
                 tally.fail(rid, where, "a DB command was not sent in 7E1 (parity)")
             last, problem, empty = collection_end(m)
-            if problem is None and have < m.count and not empty:
+            if problem is None and have < m.count and not empty and m.cut_at is None:
                 tally.fail(rid, where, f"stopped with {have} of {m.count} values, no empty packet")
             extra = _after_done(m)
             if extra:
                 tally.fail(rid, where, f"{escape(extra.text)} sent after every value was in")
         else:
             last, problem, _ = collection_end(m)
-            if problem is None and have < m.count:
+            if problem is None and have < m.count and m.cut_at is None:
                 tally.fail(
                     rid,
                     where,
@@ -176,6 +205,8 @@ def judge_high_volume(
                 tally.undecide(
                     "R-5.4-01", str(kind), f"{kind} sent, its data never validly answered"
                 )
+            elif cut:
+                tally.undecide("R-5.4-01", str(kind), f"{kind}: {CUT_SHORT}, or its data not read")
             else:
                 tally.fail("R-5.4-01", str(kind), f"{kind} was not issued or its data not read")
     else:

@@ -28,6 +28,11 @@ def beyond_reaction(delay: float, what: str) -> str:
     )
 
 
+#: Why an absence proves nothing in a view with a job the tool cut at its budget
+#: (``TranscriptView.cut_parts``): the recorder was still in that job, and what it had not
+#: sent by then it may still have sent. Such an absence is undecided, never a FAIL.
+CUT_SHORT = "not sent before the tool cut a job at its budget"
+
 #: Values a recorder must be able to store from one concurrent measurement (R-4.4.7-07, 2000).
 MIN_CONCURRENT_STORE = 20
 #: Measurements that end their wait with a service request (M family, V).

@@ -28,6 +28,10 @@ class ObservedMeasurement:
     data: list[tuple[Transmission, ReplyProblem | None]]  # data transmissions, with their problems
     next_start: Transmission | None  # the next measurement command to the same sensor, if any
     others: list[Transmission]  # transmissions to other sensors before the data were all in
+    #: the line time at which the tool cut the job at its budget while the recorder was still
+    #: in this measurement (nothing it sent after the measurement ended it): what it had not
+    #: done by then is unobserved, not refused (None: the recorder itself moved on or ended)
+    cut_at: float | None = None
 
     @property
     def kind(self) -> Kind:
@@ -89,6 +93,7 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
         data: list[tuple[Transmission, ReplyProblem | None]] = []
         others: list[Transmission] = []
         nxt: Transmission | None = None
+        left = False  # the recorder turned to something else at this address
         for j in range(i + 1, len(line.transmissions)):
             t = line.transmissions[j]
             if t.part != s.part:
@@ -102,12 +107,25 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
                 continue
             if tc is not None and tc.starts_measurement:
                 nxt = t
+            left = True
             break
         if data:
             last = data[-1][0]
             others = [o for o in others if o.start < last.end]
         taken.append(
-            ObservedMeasurement(i, s, cmd, ttt, count, s.reply[-1].end, sr, data, nxt, others)
+            ObservedMeasurement(
+                i,
+                s,
+                cmd,
+                ttt,
+                count,
+                s.reply[-1].end,
+                sr,
+                data,
+                nxt,
+                others,
+                None if left else line.cut_parts.get(s.part),
+            )
         )
     return taken
 
