@@ -50,6 +50,7 @@ def rebuild_records(
     *,
     uncertainty: float = 0.0,
     only: str | None = None,
+    carried: dict[str, bool] | None = None,
 ) -> Rebuilt:
     """Exchanges and measurements from ``view``, as the tool recorder would have recorded
     them with ``policy`` (its reply window and idle rule decide where a reply ends).
@@ -61,10 +62,14 @@ def rebuild_records(
     the first one's run held an hour's capture's 15 MB at its peak. What another sensor's
     transmission changes for this one's is only that it came between (it ends an aM!-type
     measurement's data, :func:`_measurements`) and that it is no retry of this one's last
-    exchange; the CRC expected of a data reply is its own address's."""
+    exchange; the CRC expected of a data reply is its own address's.
+
+    ``carried``: whether each address's last measurement asked for a CRC, from before
+    ``view`` (a window of a longer recording, :mod:`.windows`): a data reply read long after
+    its measurement is judged by it. Updated in place with ``view``'s, for the next window."""
     policy = policy or Policy()
     source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
-    exchanges = list(_exchanges(view, policy, uncertainty, only, source))
+    exchanges = list(_exchanges(view, policy, uncertainty, only, source, carried))
     measurements = _measurements(exchanges, source, policy)
     return Rebuilt([x for x in exchanges if x is not None], measurements)
 
@@ -86,11 +91,14 @@ def _exchanges(
     uncertainty: float,
     only: str | None,
     source: dict[int, Transmission],
+    crc_pending: dict[str, bool] | None = None,
 ) -> Iterator[Exchange | None]:
     """The exchanges of ``view`` in wire order, each once its last attempt is in (of the
     sensor at ``only``, with a None where other sensors' exchanges came between); fills
-    ``source`` (id of each attempt -> its transmission)."""
-    crc_pending: dict[str, bool] = {}
+    ``source`` (id of each attempt -> its transmission) and ``crc_pending`` (address ->
+    whether its last measurement asked for a CRC; what came before ``view`` if given)."""
+    if crc_pending is None:
+        crc_pending = {}
     last: Exchange | None = None  # the last exchange, None when it is another sensor's
     begun = False
     for t in view.transmissions:
