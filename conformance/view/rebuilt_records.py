@@ -20,7 +20,7 @@ the first-character timeout.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
@@ -38,10 +38,12 @@ from .segments import TranscriptView, Transmission
 @dataclass
 class Rebuilt:
     """The exchanges in wire order (measurement starts and data included) and the
-    measurements they form."""
+    measurements they form; ``open``: those of them whose data the exchanges ran out on
+    (the next exchange could still be their data: a window of a recording ended there)."""
 
     exchanges: list[Exchange]
     measurements: list[Measurement]
+    open: list[Measurement] = field(default_factory=list)
 
 
 def rebuild_records(
@@ -70,8 +72,9 @@ def rebuild_records(
     policy = policy or Policy()
     source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
     exchanges = list(_exchanges(view, policy, uncertainty, only, source, carried))
-    measurements = _measurements(exchanges, source, policy)
-    return Rebuilt([x for x in exchanges if x is not None], measurements)
+    open_: list[Measurement] = []
+    measurements = _measurements(exchanges, source, policy, open_)
+    return Rebuilt([x for x in exchanges if x is not None], measurements, open_)
 
 
 def rebuilt_exchanges(
@@ -191,10 +194,14 @@ def _complete(t: Transmission, reply: list[Event]) -> bool:
 
 
 def _measurements(
-    exchanges: list[Exchange | None], source: dict[int, Transmission], policy: Policy
+    exchanges: list[Exchange | None],
+    source: dict[int, Transmission],
+    policy: Policy,
+    open_: list[Measurement] | None = None,
 ) -> list[Measurement]:
     """The measurements the exchanges start, each with its data; a None among ``exchanges``
-    stands for other sensors' exchanges (:func:`rebuild_records`'s ``only``)."""
+    stands for other sensors' exchanges (:func:`rebuild_records`'s ``only``). ``open_``:
+    given the measurements whose data nothing ended but the end of ``exchanges``."""
     found: list[Measurement] = []
     for i, ex in enumerate(exchanges):
         command = ex.command if ex is not None else None
@@ -225,6 +232,9 @@ def _measurements(
                 if not policy.salvage or probed_past_empty or m.binary:
                     break
                 probed_past_empty = True
+        else:  # the exchanges ran out first: a later exchange could still be its data
+            if open_ is not None and m.value_count < m.count:
+                open_.append(m)
     return found
 
 

@@ -28,7 +28,7 @@ direction is, never which side it gives).
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from operator import attrgetter
 
 from ..tool_recorder.policy import Policy
@@ -95,6 +95,68 @@ def window_events(
         yield window
 
 
+def stream_windows(
+    events: Iterable[Event], policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Iterator[list[Event]]:
+    """The windows :func:`window_starts` finds in the whole recording, cut from ``events``
+    as they come (by start, as a capture's decoder gives them), holding only the events not
+    yet given out: what comes after a window's last transmission stays held until a break
+    shows where the next may begin, and a measurement whose data may still come (its
+    concurrent measurement's next data command, minutes later) holds everything from its
+    command on until something ends it. Each break asks the held events' view and records
+    again: a long open stretch costs a rebuild a break, the price of a bounded hold. The CRC
+    expectations the windows before leave (:func:`rebuild_windowed`) move no cut: they judge
+    only data replies of measurements begun before the held events, none of the held ones'
+    data, and two transmissions of one text in a row are never cut apart anyway."""
+    held: list[Event] = []
+    for e in events:
+        if e.kind is EventKind.NOTE:
+            continue
+        if held and e.start < held[-1].start:
+            raise ValueError(f"events out of order at {e.start!r}: windows need them by start")
+        if e.kind is EventKind.BREAK and held:  # the transmission before it is complete
+            yield from _settled(held, policy, uncertainty, final=False)
+        held.append(e)
+    if held:
+        yield from _settled(held, policy, uncertainty, final=True)
+
+
+def _settled(
+    held: list[Event],
+    policy: Policy | None,
+    uncertainty: float,
+    *,
+    final: bool,
+) -> Iterator[list[Event]]:
+    """The windows of ``held`` that nothing to come can change, taken out of it (all of
+    them when ``final``)."""
+    view = read_view(held)
+    if final and not view.transmissions:  # nothing the recorder sent: one window
+        yield held[:]
+        held.clear()
+        return
+    records = rebuild_records(view, policy, uncertainty=uncertainty)
+    starts = window_starts(view, records)
+    if not final and records.open:  # no window begins after an open measurement's command
+        index = {id(t.chars[0]): i for i, t in enumerate(view.transmissions)}
+        first = min(index[id(m.start.attempts[0].command_events[0])] for m in records.open)
+        starts = [i for i in starts if i <= first]
+    if final:
+        starts.append(len(view.transmissions))  # the rest is the last window
+    taken = 0
+    for i in starts[1:]:
+        end = len(held) if i == len(view.transmissions) else _position(held, view, i)
+        yield held[taken:end]
+        taken = end
+    del held[:taken]
+
+
+def _position(held: list[Event], view: TranscriptView, i: int) -> int:
+    """Where in ``held`` transmission ``i``'s break is."""
+    brk = view.transmissions[i].break_event
+    return next(j for j, e in enumerate(held) if e is brk)
+
+
 def rebuild_windowed(
     events: Sequence[Event],
     view: TranscriptView,
@@ -114,4 +176,4 @@ def rebuild_windowed(
         yield rebuild_records(part, policy, uncertainty=uncertainty, only=only, carried=carried)
 
 
-__all__ = ["rebuild_windowed", "window_events", "window_starts"]
+__all__ = ["rebuild_windowed", "stream_windows", "window_events", "window_starts"]

@@ -11,11 +11,19 @@ after its aMC! (R-4.4.12-01's CRC: the expectation is carried across the cut), r
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
+from conformance.transcript import EventKind
 from conformance.view.rebuilt_records import Rebuilt, rebuild_records
 from conformance.view.segments import TranscriptView, read_view
-from conformance.view.windows import rebuild_windowed, window_events, window_starts
+from conformance.view.windows import (
+    rebuild_windowed,
+    stream_windows,
+    window_events,
+    window_starts,
+)
 from tests.support.bus_of_sensors import (
     ADDRESSES,
     as_heard,
@@ -57,6 +65,8 @@ def _check(events: list, *, min_windows: int = 2) -> list[int]:
     windows = list(window_events(events, whole, starts))
     assert len(windows) == len(starts)
     assert [e for w in windows for e in w] == sorted(events, key=lambda e: e.start)
+    streamed = list(stream_windows(iter(sorted(events, key=lambda e: e.start))))
+    assert [list(map(id, w)) for w in streamed] == [list(map(id, w)) for w in windows]
     _same_view(whole, [read_view(w) for w in windows])
     for only in (None, *ADDRESSES):
         expected = rebuild_records(whole, only=only)
@@ -181,3 +191,44 @@ def test_rounds_of_every_measurement_kind_rebuild_alike(code):
                 recorder.collect(m, force_break=True)
         _idle(recorder, 1.0)
     _check(as_heard(bus))
+
+
+def test_streamed_windows_hold_an_open_measurement_until_it_ends():
+    """Cut as the events come: while 0C!'s data may still come (sensor 1 identified in
+    between, 30 s of idle), no window is given out past 0C!; the windows given out before
+    the last event never change afterwards, and notes are left out."""
+    bus, recorder = bus_of_sensors()
+    recorder.identify("3")
+    m = start(recorder, "0C!")
+    _idle(recorder)
+    recorder.identify("1")
+    _idle(recorder, m.ttt)
+    recorder.collect(m, force_break=True)
+    recorder.identify("3")
+    events = sorted(as_heard(bus), key=lambda e: e.start)
+    given: list[tuple[int, list]] = []  # how many events had come when each window went
+    fed = 0
+
+    def feed():
+        nonlocal fed
+        for e in events:
+            fed += 1
+            yield e
+
+    for w in stream_windows(feed()):
+        given.append((fed, w))
+    texts = [read_view(w).transmissions[0].text for _, w in given]
+    assert texts == ["3I!", "0C!", "3I!"]  # 0C! .. its data one window, 1I! inside it
+    d0 = next(t for t in read_view(events).transmissions if t.text == "0D0!")
+    data = next(i for i, e in enumerate(events) if e is d0.break_event)
+    assert given[1][0] > data  # 0C!'s window went only after its data had come
+    notes = [replace(events[0], kind=EventKind.NOTE, text="n")]
+    assert list(stream_windows(notes + events[:1])) == [events[:1]]
+
+
+def test_streamed_events_out_of_order_are_refused():
+    bus, recorder = bus_of_sensors("0")
+    recorder.identify("0")
+    events = sorted(as_heard(bus), key=lambda e: e.start)
+    with pytest.raises(ValueError, match="out of order"):
+        list(stream_windows([events[1], events[0]]))
