@@ -145,16 +145,16 @@ def _settled(
         starts.append(len(view.transmissions))  # the rest is the last window
     taken = 0
     for i in starts[1:]:
-        end = len(held) if i == len(view.transmissions) else _position(held, view, i)
+        end = len(held) if i == len(view.transmissions) else _position(held, view, i, taken)
         yield held[taken:end]
         taken = end
     del held[:taken]
 
 
-def _position(held: list[Event], view: TranscriptView, i: int) -> int:
-    """Where in ``held`` transmission ``i``'s break is."""
+def _position(held: list[Event], view: TranscriptView, i: int, after: int) -> int:
+    """Where in ``held`` transmission ``i``'s break is (past index ``after``)."""
     brk = view.transmissions[i].break_event
-    return next(j for j, e in enumerate(held) if e is brk)
+    return next(j for j in range(after, len(held)) if held[j] is brk)
 
 
 def rebuild_windowed(
