@@ -20,7 +20,7 @@ the first-character timeout.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
@@ -38,10 +38,12 @@ from .segments import TranscriptView, Transmission
 @dataclass
 class Rebuilt:
     """The exchanges in wire order (measurement starts and data included) and the
-    measurements they form."""
+    measurements they form; ``open``: those of them whose data the exchanges ran out on
+    (the next exchange could still be their data: a window of a recording ended there)."""
 
     exchanges: list[Exchange]
     measurements: list[Measurement]
+    open: list[Measurement] = field(default_factory=list)
 
 
 def rebuild_records(
@@ -50,6 +52,7 @@ def rebuild_records(
     *,
     uncertainty: float = 0.0,
     only: str | None = None,
+    carried: dict[str, bool] | None = None,
 ) -> Rebuilt:
     """Exchanges and measurements from ``view``, as the tool recorder would have recorded
     them with ``policy`` (its reply window and idle rule decide where a reply ends).
@@ -61,12 +64,17 @@ def rebuild_records(
     the first one's run held an hour's capture's 15 MB at its peak. What another sensor's
     transmission changes for this one's is only that it came between (it ends an aM!-type
     measurement's data, :func:`_measurements`) and that it is no retry of this one's last
-    exchange; the CRC expected of a data reply is its own address's."""
+    exchange; the CRC expected of a data reply is its own address's.
+
+    ``carried``: whether each address's last measurement asked for a CRC, from before
+    ``view`` (a window of a longer recording, :mod:`.windows`): a data reply read long after
+    its measurement is judged by it. Updated in place with ``view``'s, for the next window."""
     policy = policy or Policy()
     source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
-    exchanges = list(_exchanges(view, policy, uncertainty, only, source))
-    measurements = _measurements(exchanges, source, policy)
-    return Rebuilt([x for x in exchanges if x is not None], measurements)
+    exchanges = list(_exchanges(view, policy, uncertainty, only, source, carried))
+    open_: list[Measurement] = []
+    measurements = _measurements(exchanges, source, policy, open_)
+    return Rebuilt([x for x in exchanges if x is not None], measurements, open_)
 
 
 def rebuilt_exchanges(
@@ -86,11 +94,14 @@ def _exchanges(
     uncertainty: float,
     only: str | None,
     source: dict[int, Transmission],
+    crc_pending: dict[str, bool] | None = None,
 ) -> Iterator[Exchange | None]:
     """The exchanges of ``view`` in wire order, each once its last attempt is in (of the
     sensor at ``only``, with a None where other sensors' exchanges came between); fills
-    ``source`` (id of each attempt -> its transmission)."""
-    crc_pending: dict[str, bool] = {}
+    ``source`` (id of each attempt -> its transmission) and ``crc_pending`` (address ->
+    whether its last measurement asked for a CRC; what came before ``view`` if given)."""
+    if crc_pending is None:
+        crc_pending = {}
     last: Exchange | None = None  # the last exchange, None when it is another sensor's
     begun = False
     for t in view.transmissions:
@@ -183,10 +194,14 @@ def _complete(t: Transmission, reply: list[Event]) -> bool:
 
 
 def _measurements(
-    exchanges: list[Exchange | None], source: dict[int, Transmission], policy: Policy
+    exchanges: list[Exchange | None],
+    source: dict[int, Transmission],
+    policy: Policy,
+    open_: list[Measurement] | None = None,
 ) -> list[Measurement]:
     """The measurements the exchanges start, each with its data; a None among ``exchanges``
-    stands for other sensors' exchanges (:func:`rebuild_records`'s ``only``)."""
+    stands for other sensors' exchanges (:func:`rebuild_records`'s ``only``). ``open_``:
+    given the measurements whose data nothing ended but the end of ``exchanges``."""
     found: list[Measurement] = []
     for i, ex in enumerate(exchanges):
         command = ex.command if ex is not None else None
@@ -217,6 +232,9 @@ def _measurements(
                 if not policy.salvage or probed_past_empty or m.binary:
                     break
                 probed_past_empty = True
+        else:  # the exchanges ran out first: a later exchange could still be its data
+            if open_ is not None and m.value_count < m.count:
+                open_.append(m)
     return found
 
 

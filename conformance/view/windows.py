@@ -1,0 +1,179 @@
+"""Where a long recording may be cut into windows read one after the other (issue 22).
+
+A windowed judge reads an hour's capture a window at a time and lets each window's events and
+view go once it is read. A cut is only safe where the bus is idle in the sense the records
+need: the window's first transmission begins with a break (a new sequence: the recorder woke
+the line), no sensor frame was still going when it began, it is no retry of the transmission
+before it (same text: :func:`~.rebuilt_records.rebuild_records` makes both one exchange), and
+it falls inside no exchange (its retries) and no measurement, from the measurement command to
+its last data command. A measurement's records depend on nothing after its last data
+exchange: the one after it either ended it (no data command of it) or is left out of it
+either way, so a window that ends there rebuilds it the same. A gap longer than the standby
+time alone is no such place: a concurrent measurement's data may come minutes later, after
+other sensors' exchanges (R-4.4.7-05).
+
+What a window still needs from before is carried explicitly, not re-read: whether each
+address's last measurement asked for a CRC (a data reply read again long after its
+measurement is judged by it), :func:`rebuild_windowed` passes it from window to window. The
+records need nothing else; the timing judges will (the line's last activity before a window's
+first break, the marking a break follows: :meth:`~.segments.TranscriptView.previous_activity`),
+and the rules that count over the whole run their compact observations: not done here yet.
+
+The cut is a pure function of the view (:func:`window_starts`); a window's view is
+:func:`~.segments.read_view` of that window's events alone (:func:`window_events`), equal to
+the whole view's transmissions of the window: the direction inference starts over at every
+break (only a service request's announced ttt outlives one, and it changes how sure a
+direction is, never which side it gives).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Sequence
+from operator import attrgetter
+
+from ..tool_recorder.policy import Policy
+from ..tool_recorder.records import Attempt
+from ..transcript import Event, EventKind
+from .rebuilt_records import Rebuilt, rebuild_records
+from .segments import TranscriptView, Transmission, read_view
+
+_START = attrgetter("start")  # the view's order (read_view sorts by start, stably)
+
+
+def window_starts(view: TranscriptView, records: Rebuilt | None = None) -> list[int]:
+    """The indices of ``view``'s transmissions where a window may begin (the first, 0,
+    always when there is one): see the module's docstring for what makes a place safe.
+    ``records``: ``view``'s (:func:`~.rebuilt_records.rebuild_records`; made if not given),
+    which say where each exchange and measurement begins and ends."""
+    if not view.transmissions:
+        return []
+    records = records if records is not None else rebuild_records(view)
+    index = {id(t.chars[0]): i for i, t in enumerate(view.transmissions)}
+    spans = [_span(x.attempts, x.attempts, index) for x in records.exchanges]
+    spans += [_span(m.start.attempts, (m.data or [m.start])[-1].attempts, index)
+              for m in records.measurements]  # fmt: skip
+    inside = bytearray(len(view.transmissions) + 1)  # 1: no window begins at that index
+    for first, last in spans:
+        inside[first + 1 : last + 1] = b"\1" * max(0, last - first)
+    before = view.transmissions[0]
+    starts = [0]
+    for i, t in enumerate(view.transmissions[1:], 1):
+        if not inside[i] and _opens(before, t):
+            starts.append(i)
+        before = t
+    return starts
+
+
+def _span(
+    first: Sequence[Attempt], last: Sequence[Attempt], index: dict[int, int]
+) -> tuple[int, int]:
+    """The transmissions from ``first``'s first attempt to ``last``'s last one."""
+    return index[id(first[0].command_events[0])], index[id(last[-1].command_events[0])]
+
+
+def _opens(before: Transmission, t: Transmission) -> bool:
+    """``t`` begins a new sequence that nothing of ``before`` runs into."""
+    return t.break_event is not None and t.cut is None and t.text != before.text
+
+
+def window_events(
+    events: Sequence[Event], view: TranscriptView, starts: Sequence[int]
+) -> Iterator[list[Event]]:
+    """``events`` (one recording; notes are left out) in the order the view reads them (by
+    start), cut before the break of each window's first transmission: each window's events.
+    What comes before the first transmission stays in the first window."""
+    breaks = iter([view.transmissions[i].break_event for i in starts[1:]] + [None])
+    cut = next(breaks)
+    window: list[Event] = []
+    for e in sorted([e for e in events if e.kind is not EventKind.NOTE], key=_START):
+        if e is cut:
+            yield window
+            window = []
+            cut = next(breaks)
+        window.append(e)
+    if window or not starts:
+        yield window
+
+
+def stream_windows(
+    events: Iterable[Event], policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Iterator[list[Event]]:
+    """The windows :func:`window_starts` finds in the whole recording, cut from ``events``
+    as they come (by start, as a capture's decoder gives them), holding only the events not
+    yet given out: what comes after a window's last transmission stays held until a break
+    shows where the next may begin, and a measurement whose data may still come (its
+    concurrent measurement's next data command, minutes later) holds everything from its
+    command on until something ends it. Each break asks the held events' view and records
+    again: a long open stretch costs a rebuild a break, the price of a bounded hold. The CRC
+    expectations the windows before leave (:func:`rebuild_windowed`) move no cut: they judge
+    only data replies of measurements begun before the held events, none of the held ones'
+    data, and two transmissions of one text in a row are never cut apart anyway."""
+    held: list[Event] = []
+    for e in events:
+        if e.kind is EventKind.NOTE:
+            continue
+        if held and e.start < held[-1].start:
+            raise ValueError(f"events out of order at {e.start!r}: windows need them by start")
+        if e.kind is EventKind.BREAK and held:  # the transmission before it is complete
+            yield from _settled(held, policy, uncertainty, final=False)
+        held.append(e)
+    if held:
+        yield from _settled(held, policy, uncertainty, final=True)
+
+
+def _settled(
+    held: list[Event],
+    policy: Policy | None,
+    uncertainty: float,
+    *,
+    final: bool,
+) -> Iterator[list[Event]]:
+    """The windows of ``held`` that nothing to come can change, taken out of it (all of
+    them when ``final``)."""
+    view = read_view(held)
+    if final and not view.transmissions:  # nothing the recorder sent: one window
+        yield held[:]
+        held.clear()
+        return
+    records = rebuild_records(view, policy, uncertainty=uncertainty)
+    starts = window_starts(view, records)
+    if not final and records.open:  # no window begins after an open measurement's command
+        index = {id(t.chars[0]): i for i, t in enumerate(view.transmissions)}
+        first = min(index[id(m.start.attempts[0].command_events[0])] for m in records.open)
+        starts = [i for i in starts if i <= first]
+    if final:
+        starts.append(len(view.transmissions))  # the rest is the last window
+    taken = 0
+    for i in starts[1:]:
+        end = len(held) if i == len(view.transmissions) else _position(held, view, i, taken)
+        yield held[taken:end]
+        taken = end
+    del held[:taken]
+
+
+def _position(held: list[Event], view: TranscriptView, i: int, after: int) -> int:
+    """Where in ``held`` transmission ``i``'s break is (past index ``after``)."""
+    brk = view.transmissions[i].break_event
+    return next(j for j in range(after, len(held)) if held[j] is brk)
+
+
+def rebuild_windowed(
+    events: Sequence[Event],
+    view: TranscriptView,
+    policy: Policy | None = None,
+    *,
+    uncertainty: float = 0.0,
+    only: str | None = None,
+) -> Iterator[Rebuilt]:
+    """Each window's records, read from its own events alone (a view of its own), with what
+    the windows before it left carried in: together the records
+    :func:`~.rebuilt_records.rebuild_records` gives the whole ``view``, in order. ``view``
+    and its records only say where the windows are (:func:`window_starts`)."""
+    whole = rebuild_records(view, policy, uncertainty=uncertainty)
+    carried: dict[str, bool] = {}
+    for window in window_events(events, view, window_starts(view, whole)):
+        part = read_view(window)
+        yield rebuild_records(part, policy, uncertainty=uncertainty, only=only, carried=carried)
+
+
+__all__ = ["rebuild_windowed", "stream_windows", "window_events", "window_starts"]

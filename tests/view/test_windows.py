@@ -1,0 +1,234 @@
+"""A recording cut into windows (issue 22's windowed judge, ``conformance.view.windows``):
+each window's view, read from its own events alone, is the whole view's transmissions of
+that window, and the records rebuilt window by window (what the windows before carried in)
+are the whole run's, exchange for exchange and measurement for measurement.
+
+The cases a wrong cut or merge gets wrong: a concurrent measurement pending across a long
+idle gap and another sensor's exchange (R-4.4.7-05: a cut at the gap loses its data), an
+aM! whose data another sensor's exchange ends (R-4.4.5-06), a data reply read again long
+after its aMC! (R-4.4.12-01's CRC: the expectation is carried across the cut), retries
+(R-7.2-01: a retry is no window's start), and a whole bus's identify and concurrent round."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from conformance.transcript import EventKind
+from conformance.view.rebuilt_records import Rebuilt, rebuild_records
+from conformance.view.segments import TranscriptView, read_view
+from conformance.view.windows import (
+    rebuild_windowed,
+    stream_windows,
+    window_events,
+    window_starts,
+)
+from tests.support.bus_of_sensors import (
+    ADDRESSES,
+    as_heard,
+    bus_of_sensors,
+    concurrent_round,
+    measured_past_another,
+    start,
+)
+from tests.view.test_rebuilt_for_one_sensor import _exchange, _measurement
+
+IDLE = 30.0  # s of silence: far past the standby time (100 ms), as a field logger idles
+
+
+def _transmission(t) -> tuple:
+    return (t.break_event, t.chars, t.heard, t.cut, t.text)
+
+
+def _same_view(whole: TranscriptView, parts: list[TranscriptView]) -> None:
+    assert [_transmission(t) for p in parts for t in p.transmissions] == [
+        _transmission(t) for t in whole.transmissions
+    ]
+    for name in ("breaks", "chars", "unanswerable", "undirected"):
+        assert [e for p in parts for e in getattr(p, name)] == getattr(whole, name), name
+
+
+def _records(rebuilt: list[Rebuilt]) -> tuple[list, list]:
+    return (
+        [_exchange(x) for r in rebuilt for x in r.exchanges],
+        [_measurement(m) for r in rebuilt for m in r.measurements],
+    )
+
+
+def _check(events: list, *, min_windows: int = 2) -> list[int]:
+    """The windows of ``events`` read alone equal the whole: view and records (the whole
+    bus's and each sensor's alone); gives the window starts."""
+    whole = read_view(events)
+    starts = window_starts(whole)
+    assert len(starts) >= min_windows
+    windows = list(window_events(events, whole, starts))
+    assert len(windows) == len(starts)
+    assert [e for w in windows for e in w] == sorted(events, key=lambda e: e.start)
+    streamed = list(stream_windows(iter(sorted(events, key=lambda e: e.start))))
+    assert [list(map(id, w)) for w in streamed] == [list(map(id, w)) for w in windows]
+    _same_view(whole, [read_view(w) for w in windows])
+    for only in (None, *ADDRESSES):
+        expected = rebuild_records(whole, only=only)
+        got = _records(list(rebuild_windowed(events, whole, only=only)))
+        assert got == _records([expected]), only
+    return starts
+
+
+def _idle(recorder, seconds: float = IDLE) -> None:
+    recorder.link.wait_until(recorder.link.now() + seconds)
+
+
+def test_a_bus_round_is_cut_between_its_sequences_and_rebuilds_alike():
+    bus, recorder = bus_of_sensors()
+    for a in ADDRESSES:
+        recorder.identify(a)
+    concurrent_round(recorder)
+    _idle(recorder)
+    for a in ADDRESSES:
+        recorder.identify(a)
+    starts = _check(as_heard(bus))
+    view = read_view(as_heard(bus))
+    texts = [view.transmissions[i].text for i in starts]
+    # each identify opens a window; the concurrent round is one, up to the next identify
+    assert texts[: len(ADDRESSES)] == [f"{a}I!" for a in ADDRESSES]
+    assert f"{ADDRESSES[0]}C!" in texts
+    assert all(not t.endswith("D0!") for t in texts)
+
+
+def test_a_concurrent_measurement_pending_across_an_idle_gap_is_never_cut():
+    """0C! started, the bus idle 30 s, sensor 1 identified, then 0's data: no window may
+    begin between 0C! and 0D0! (R-4.4.7-05), however long the gap; a cut at the gap (the
+    standby rule alone) would rebuild 0C! without its data."""
+    bus, recorder = bus_of_sensors()
+    m = start(recorder, "0C!")
+    _idle(recorder)
+    recorder.identify("1")
+    _idle(recorder, m.ttt)
+    recorder.collect(m, force_break=True)
+    _idle(recorder)
+    recorder.identify("3")
+    events = as_heard(bus)
+    starts = _check(events)
+    view = read_view(events)
+    texts = [t.text for t in view.transmissions]
+    assert texts.index("1I!") not in starts and texts.index("0D0!") not in starts
+    assert texts.index("3I!") in starts
+    # the wrong cut (at the idle gap before 1I!) fails the merge: 0C! loses its data
+    wrong = [0, texts.index("1I!")]
+    windows = list(window_events(events, view, wrong))
+    parts = [rebuild_records(read_view(w)) for w in windows]
+    whole = rebuild_records(view)
+    assert [m.value_count for m in whole.measurements] == [whole.measurements[0].count]
+    assert [m.data for p in parts for m in p.measurements] == [[]]
+    assert _records(parts) != _records([whole])
+
+
+def test_an_m_measurement_ended_by_another_sensor_is_cut_there():
+    """aM!, then 1I! before its service request, then its D0 after a break (R-4.4.5-06):
+    1I! ends the measurement, so a window may begin at 1I! and the D0 reads as no data of
+    it, as the whole run reads it."""
+    bus, recorder = bus_of_sensors()
+    recorder.identify("0")
+    measured_past_another(recorder)
+    _idle(recorder)
+    recorder.identify("0")
+    _check(as_heard(bus))
+
+
+def test_a_crc_expectation_is_carried_across_the_cut():
+    """aMC! to a sensor that leaves the CRC off, its data read, the bus idle, another
+    command to it, and aD0! again: the re-read's CRC is still expected (the whole run's
+    rebuild finds it missing). Rebuilt without the carried expectation, the window would
+    take the reply as a plain one: a different record, which the merge check catches."""
+    bus, recorder = bus_of_sensors(faults={"0": ["crc-missing"]})
+    m = start(recorder, "0MC!")
+    _idle(recorder, m.ttt + 0.1)
+    recorder.collect(m, force_break=True)
+    _idle(recorder)
+    recorder.identify("0")
+    _idle(recorder)
+    recorder.transact("0D0!", force_break=True)
+    events = as_heard(bus)
+    starts = _check(events, min_windows=3)
+    view = read_view(events)
+    texts = [t.text for t in view.transmissions]
+    again = texts.index("0I!") + 1  # the re-read, then its retries (its CRC missing)
+    assert texts[again] == "0D0!" and again in starts
+    whole = rebuild_records(view)
+    assert not whole.exchanges[-1].ok  # the CRC asked for by 0MC! is missing
+    uncarried = [rebuild_records(read_view(w)) for w in window_events(events, view, starts)]
+    assert uncarried[-1].exchanges[-1].ok  # no expectation: taken as a plain reply
+    assert _records(uncarried) != _records([whole])
+
+
+def test_a_retry_never_starts_a_window():
+    """A sensor slow to wake (it misses a command after the break): the recorder's retries
+    (R-7.2-01), each of the same text, stay with the first attempt in one exchange and one
+    window."""
+    bus, recorder = bus_of_sensors("0", faults={"0": ["slow-wake"]})
+    recorder.identify("0")
+    _idle(recorder)
+    recorder.identify("0")
+    events = as_heard(bus)
+    view = read_view(events)
+    starts = window_starts(view)
+    for i in starts[1:]:
+        assert view.transmissions[i].text != view.transmissions[i - 1].text
+    _check(events, min_windows=1)
+
+
+@pytest.mark.parametrize("code", ["C", "CC", "M", "MC"])
+def test_rounds_of_every_measurement_kind_rebuild_alike(code):
+    bus, recorder = bus_of_sensors()
+    for _ in range(2):
+        if code.startswith("C"):
+            concurrent_round(recorder, code=code)
+        else:
+            for a in ADDRESSES:
+                m = start(recorder, f"{a}{code}!")
+                _idle(recorder, m.ttt + 0.1)
+                recorder.collect(m, force_break=True)
+        _idle(recorder, 1.0)
+    _check(as_heard(bus))
+
+
+def test_streamed_windows_hold_an_open_measurement_until_it_ends():
+    """Cut as the events come: while 0C!'s data may still come (sensor 1 identified in
+    between, 30 s of idle), no window is given out past 0C!; the windows given out before
+    the last event never change afterwards, and notes are left out."""
+    bus, recorder = bus_of_sensors()
+    recorder.identify("3")
+    m = start(recorder, "0C!")
+    _idle(recorder)
+    recorder.identify("1")
+    _idle(recorder, m.ttt)
+    recorder.collect(m, force_break=True)
+    recorder.identify("3")
+    events = sorted(as_heard(bus), key=lambda e: e.start)
+    given: list[tuple[int, list]] = []  # how many events had come when each window went
+    fed = 0
+
+    def feed():
+        nonlocal fed
+        for e in events:
+            fed += 1
+            yield e
+
+    for w in stream_windows(feed()):
+        given.append((fed, w))
+    texts = [read_view(w).transmissions[0].text for _, w in given]
+    assert texts == ["3I!", "0C!", "3I!"]  # 0C! .. its data one window, 1I! inside it
+    d0 = next(t for t in read_view(events).transmissions if t.text == "0D0!")
+    data = next(i for i, e in enumerate(events) if e is d0.break_event)
+    assert given[1][0] > data  # 0C!'s window went only after its data had come
+    notes = [replace(events[0], kind=EventKind.NOTE, text="n")]
+    assert list(stream_windows(notes + events[:1])) == [events[:1]]
+
+
+def test_streamed_events_out_of_order_are_refused():
+    bus, recorder = bus_of_sensors("0")
+    recorder.identify("0")
+    events = sorted(as_heard(bus), key=lambda e: e.start)
+    with pytest.raises(ValueError, match="out of order"):
+        list(stream_windows([events[1], events[0]]))
