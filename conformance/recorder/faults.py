@@ -491,7 +491,13 @@ class LacksCommandsRecorder(GoldenRecorder):
 @dataclass
 class RewritingRecorder(GoldenRecorder):
     """A logger that changes what it is asked to send (``rewrite`` maps the wire text; an
-    empty result is skipped) or adds commands of its own (``extra``, before the job)."""
+    empty result is skipped) or adds commands of its own (``extra``, before the job).
+
+    Outside transparent mode the job goes on whole to the golden recorder (concurrent
+    measurements started together, a recorder before it in the order that changes the task
+    seen): it used to go one command at a time, which measured two sensors' aC! one after
+    the other (R-4.4.7-06's concurrent waits 2005..2005 ms instead of the golden 2005..2180)
+    and lost interleaves-measurements' interleaving."""
 
     rewrite: Callable[[str], str] = field(default=lambda text: text)
     extra: str = ""  # addresses it polls with a! before the job
@@ -503,30 +509,28 @@ class RewritingRecorder(GoldenRecorder):
             master.transact(Command(address, Kind.ACKNOWLEDGE), force_break=True)
         if self.preamble:
             master.raw(self.preamble, break_first=True)
-        out = super().__call__(replace(request, commands=()), link)
+        if request.task is not Task.TRANSPARENT:
+            kept = tuple(t for t in request.commands if self.rewrite(t))
+            return super().__call__(replace(request, commands=kept), link)
+        out = RecorderOutput()
         for text in request.commands:
             wire = self.rewrite(text)
-            if not wire:
-                continue
-            if request.task is Task.TRANSPARENT:
+            if wire:
                 # a break of its own, or the engine's break rules (True or None)
                 ex = master.raw(wire, break_first=self.transparent_break or None)
                 out.relayed[text] = ex.reply_text if ex.answered else ""
-            else:
-                sub = replace(request, commands=(text,))
-                got = super().__call__(sub, link)
-                out.logged.update(got.logged)
-                out.relayed.update(got.relayed)
         return out
 
 
 @dataclass
 class InterleavingRecorder(GoldenRecorder):
     """Asked to measure several sensors with aM!, starts them all before collecting any, as
-    if they were concurrent measurements. Its ``__call__`` needs the whole job in one call, so
-    it does not pass on through a recorder that splits the job per command
-    (:class:`RewritingRecorder`): seed 27 drew crlf-wake-up + interleaves-measurements, and
-    the split lost the interleaving. No ``CHAINS``: such pairs are refused."""
+    if they were concurrent measurements. It changes the task and passes the whole job on
+    (``CHAINS``): the recorders it passes it to keep a job whole (the rewriting one used to
+    split it per command, and seed 27 drew crlf-wake-up + interleaves-measurements with the
+    interleaving lost)."""
+
+    CHAINS = frozenset({"__call__"})
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
         if request.task is Task.MEASURE and len({t[:1] for t in request.commands}) > 1:
