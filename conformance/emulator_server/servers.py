@@ -26,6 +26,7 @@ from ..links.kernel_stamps import (
     STAMP_SPACE,
     TIGHT_BRACKET_NS,
     bracketed_wall,
+    data_segments_in,
     recv_stamped_byte,
 )
 from ..links.stamps import chunk_frames
@@ -39,6 +40,11 @@ RECV_POLL = 0.1  # s: socket and port reads time out this often so a stop is not
 #: together may have lain merged in the kernel (arrivals.char_doubt). One look costs some
 #: 10 us of CPU: 1 ms keeps the doubt of a prompt read near 1 ms for about 1 % of a core.
 EMPTY_POLL = 1e-3
+#: How long (s) after the recorder's last arrival the reader keeps looking every
+#: :data:`EMPTY_POLL` where it can count segments (ArrivalReader): inside an exchange a look
+#: is what bounds a merged packet's span; on a line idle longer it blocks up to
+#: :data:`RECV_POLL` instead (3 % of a core per idle line for looks that bound nothing).
+ACTIVE_WINDOW = 1.0
 
 
 class VirtualPort:
@@ -272,6 +278,16 @@ class ArrivalReader:
     A stamp cannot show packets the kernel merged while nobody read (the merged ones take
     the later stamp), but they can only have come since the socket was last seen empty:
     a prompt reader bounds that span to about a poll, a late one shows it long.
+
+    The kernel can say more where it counts the segments it received (TCP_INFO,
+    :func:`~conformance.links.kernel_stamps.data_segments_in`): counted as the reader saw
+    the socket empty, and again after a read, a read of as many stamp groups as segments
+    came since merged none of them into a wholly unread one, so its first group's stamp is
+    when the first of them arrived, and the socket was empty until then (``empty_at``
+    that stamp, however late the reader woke). Then a line idle for :data:`ACTIVE_WINDOW`
+    blocks in ``select`` up to :data:`RECV_POLL` instead of looking every
+    :data:`EMPTY_POLL`; inside the window it still looks, so a read that merged segments
+    keeps the look's bound.
     """
 
     def __init__(self, sock: socket.socket, clock: Callable[[], float], opened: float) -> None:
@@ -280,6 +296,10 @@ class ArrivalReader:
         self.since = opened
         self.empty_at = opened
         self.stamped = self.ask_for_stamps(sock)
+        #: segments counted when the socket was last seen empty (None: not since the last
+        #: read, or the kernel does not count them)
+        self.counted: int | None = None
+        self.counts = self.stamped and data_segments_in(sock) is not None
 
     @staticmethod
     def ask_for_stamps(sock: socket.socket) -> bool:
@@ -294,11 +314,13 @@ class ArrivalReader:
         return True
 
     def read(self) -> list[tuple[bytes, float, float, bool]] | None:
-        """The next groups (waits up to :data:`EMPTY_POLL`, else TimeoutError); None: closed."""
+        """The next groups (waits up to :meth:`wait`, else TimeoutError); None: closed."""
+        counted = data_segments_in(self.sock) if self.counts else None
         looked = self.clock()  # before the look: whatever it finds came after this
         if not self._readable(0.0):
             self.empty_at = max(self.empty_at, looked)
-            if not self._readable(EMPTY_POLL):
+            self.counted = counted  # every segment counted was queued, and is read
+            if not self._readable(self.wait(looked)):
                 raise TimeoutError
         if not self.stamped:
             data = self.sock.recv(4096)
@@ -315,7 +337,28 @@ class ArrivalReader:
             data = b"".join(b for b, _ in run)
             age = max(0.0, (now_ns - stamp) / 1e9) if stamp is not None else 0.0
             groups.append(self._group(data, now - age, stamp is not None))
+        self._empty_until_first(groups)
         return groups
+
+    def wait(self, looked: float) -> float:
+        """How long a read waits on an empty socket seen at ``looked``: :data:`EMPTY_POLL`,
+        or :data:`RECV_POLL` where segments are counted and the line has been idle for
+        :data:`ACTIVE_WINDOW`."""
+        idle = self.counts and looked - self.since >= ACTIVE_WINDOW
+        return RECV_POLL if idle else EMPTY_POLL
+
+    def _empty_until_first(self, groups: list[tuple[bytes, float, float, bool]]) -> None:
+        """``empty_at`` at the first group's stamp when the kernel counted as many segments
+        since the socket was seen empty as there are groups: each group then began with a
+        segment of its own (a segment merged into a wholly unread one leaves fewer groups;
+        one merged into a partly read one splits it, and the later group's span starts at
+        the earlier's stamp, its ``since``), and the first came to an empty socket."""
+        counted, self.counted = self.counted, None
+        if counted is None or not groups or not groups[0][3]:
+            return
+        now_counted = data_segments_in(self.sock)
+        if now_counted is not None and now_counted - counted == len(groups):
+            self.empty_at = max(self.empty_at, groups[0][2])
 
     def _readable(self, wait: float) -> bool:
         """Whether the socket has bytes (or its end) to read within ``wait`` s."""

@@ -74,6 +74,24 @@ def recv_stamped_byte(sock: socket.socket, *flags: int) -> tuple[bytes, int | No
     return data, None
 
 
+#: Where struct tcp_info (linux/tcp.h) keeps tcpi_data_segs_in, the count of segments with
+#: data the connection received (Linux 4.6 and later; a shorter struct has none).
+_DATA_SEGS_IN = 152
+
+
+def data_segments_in(sock: socket.socket) -> int | None:
+    """How many segments with data ``sock`` (TCP, Linux) has received so far; None where the
+    kernel does not say. The kernel counts a segment and queues it under one socket lock, so
+    every segment this counts is in the receive queue (or read) when it returns."""
+    try:
+        info = sock.getsockopt(socket.IPPROTO_TCP, getattr(socket, "TCP_INFO", -1), 256)
+    except OSError:
+        return None
+    if len(info) < _DATA_SEGS_IN + 4:
+        return None
+    return int(struct.unpack_from("I", info, _DATA_SEGS_IN)[0])
+
+
 class StampTape:
     """Kernel stamps (perf_counter ns) of received data bytes, oldest first."""
 

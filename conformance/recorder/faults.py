@@ -37,8 +37,14 @@ POLL_TIMEOUT = 1.5  # s a logger library waited for a reply before it tried agai
 SHORT_REPLY_TIMEOUT = 10e-3
 
 
-class EarlyRetryHooks(GoldenHooks):
-    """Retries a silent sensor 12 ms after the command (the first retry of each sequence)."""
+class SilentRetryHooks(GoldenHooks):
+    """The golden hooks with the first retry after silence in each sequence timed by
+    :meth:`silent_retry_time`, every other retry passed on (``CHAINS``). A fault that times
+    only that retry (too early, too late) overrides :meth:`silent_retry_time` alone, so it
+    composes with one that times the retries after a reply (talks-over-reply's engine time),
+    and two that time that retry apart are refused: both override :meth:`silent_retry_time`."""
+
+    CHAINS = frozenset({"retry_time"})
 
     def retry_time(
         self,
@@ -48,12 +54,26 @@ class EarlyRetryHooks(GoldenHooks):
         per_sequence: int,
         usual: Callable[[], float],
     ) -> float:
-        """12 ms after the command for the first retry after silence; else the golden time."""
+        """:meth:`silent_retry_time` for the sequence's first retry after no reply; the next
+        hooks' time otherwise."""
         prev = exchange.last
         first_retry = not any(a.sequence == sequence and a.retry for a in exchange.attempts)
         if first_retry and not prev.reply_events and prev.command_end is not None:
-            return max(prev.command_end + EARLY_RETRY, master.link.now())
+            return max(self.silent_retry_time(master, prev), master.link.now())
         return super().retry_time(master, exchange, sequence, per_sequence, usual)
+
+    def silent_retry_time(self, master: Engine, prev: Attempt) -> float:
+        """When the retry after ``prev`` (an attempt that drew no reply) starts."""
+        raise NotImplementedError(f"{type(self).__name__} times no retry after silence")
+
+
+class EarlyRetryHooks(SilentRetryHooks):
+    """Retries a silent sensor 12 ms after the command (the first retry of each sequence)."""
+
+    def silent_retry_time(self, master: Engine, prev: Attempt) -> float:
+        """12 ms after the command."""
+        assert prev.command_end is not None
+        return prev.command_end + EARLY_RETRY
 
 
 class SkipsNextBreakHooks(GoldenHooks):
@@ -76,24 +96,16 @@ class SkipsNextBreakHooks(GoldenHooks):
         return super().needs_break(master, address, at, usual)
 
 
-class LateRetryHooks(SkipsNextBreakHooks):
+class LateRetryHooks(SilentRetryHooks, SkipsNextBreakHooks):
     """Retries a silent sensor 95 ms after the command, still without a break."""
 
-    def retry_time(
-        self,
-        master: Engine,
-        exchange: Exchange,
-        sequence: int,
-        per_sequence: int,
-        usual: Callable[[], float],
-    ) -> float:
-        """95 ms after the command, unbroken, for the first retry after silence."""
-        prev = exchange.last
-        first_retry = not any(a.sequence == sequence and a.retry for a in exchange.attempts)
-        if first_retry and not prev.reply_events and prev.command_end is not None:
-            self.skip_break = True
-            return max(prev.command_end + LATE_RETRY, master.link.now())
-        return super().retry_time(master, exchange, sequence, per_sequence, usual)
+    CHAINS = frozenset({"retry_time", "needs_break"})
+
+    def silent_retry_time(self, master: Engine, prev: Attempt) -> float:
+        """95 ms after the command, unbroken."""
+        assert prev.command_end is not None
+        self.skip_break = True
+        return prev.command_end + LATE_RETRY
 
 
 class NoBreakAfterMarkingHooks(GoldenHooks):
@@ -234,10 +246,15 @@ class BreakEveryTryHooks(GoldenHooks):
         return attempt
 
 
-class ResendAfterTimeoutHooks(SkipsNextBreakHooks):
+class ResendAfterTimeoutHooks(SilentRetryHooks, SkipsNextBreakHooks):
     """Retries without a break, but only after a poll timeout: by then the sensor has been in
     standby for over a second and takes the command as no retry (issue 20's "D0 sent again
-    after a 1.5 s poll timeout")."""
+    after a 1.5 s poll timeout"). Every retry is timed so, after silence or a reply: its
+    ``retry_time`` passes nothing on (no ``CHAINS`` for it), and its
+    :meth:`silent_retry_time` refuses it beside a fault that times the retry after silence
+    its own way (retry-too-early, retry-too-late)."""
+
+    CHAINS = frozenset({"needs_break"})
 
     def retry_time(
         self,
@@ -248,8 +265,12 @@ class ResendAfterTimeoutHooks(SkipsNextBreakHooks):
         usual: Callable[[], float],
     ) -> float:
         """A poll timeout after the last attempt ended, and no break before the retry."""
+        return max(self.silent_retry_time(master, exchange.last), master.link.now())
+
+    def silent_retry_time(self, master: Engine, prev: Attempt) -> float:
+        """A poll timeout after ``prev`` ended, unbroken."""
         self.skip_break = True
-        return max(exchange.last.end + POLL_TIMEOUT, master.link.now())
+        return prev.end + POLL_TIMEOUT
 
 
 class LateD0AfterServiceRequestToolRecorder(GoldenToolRecorder):
@@ -470,7 +491,13 @@ class LacksCommandsRecorder(GoldenRecorder):
 @dataclass
 class RewritingRecorder(GoldenRecorder):
     """A logger that changes what it is asked to send (``rewrite`` maps the wire text; an
-    empty result is skipped) or adds commands of its own (``extra``, before the job)."""
+    empty result is skipped) or adds commands of its own (``extra``, before the job).
+
+    Outside transparent mode the job goes on whole to the golden recorder (concurrent
+    measurements started together, a recorder before it in the order that changes the task
+    seen): it used to go one command at a time, which measured two sensors' aC! one after
+    the other (R-4.4.7-06's concurrent waits 2005..2005 ms instead of the golden 2005..2180)
+    and lost interleaves-measurements' interleaving."""
 
     rewrite: Callable[[str], str] = field(default=lambda text: text)
     extra: str = ""  # addresses it polls with a! before the job
@@ -482,50 +509,33 @@ class RewritingRecorder(GoldenRecorder):
             master.transact(Command(address, Kind.ACKNOWLEDGE), force_break=True)
         if self.preamble:
             master.raw(self.preamble, break_first=True)
-        out = super().__call__(replace(request, commands=()), link)
+        if request.task is not Task.TRANSPARENT:
+            kept = tuple(t for t in request.commands if self.rewrite(t))
+            return super().__call__(replace(request, commands=kept), link)
+        out = RecorderOutput()
         for text in request.commands:
             wire = self.rewrite(text)
-            if not wire:
-                continue
-            if request.task is Task.TRANSPARENT:
-                ex = master.raw(wire, break_first=True)
+            if wire:
+                # a break of its own, or the engine's break rules (True or None)
+                ex = master.raw(wire, break_first=self.transparent_break or None)
                 out.relayed[text] = ex.reply_text if ex.answered else ""
-            else:
-                sub = replace(request, commands=(text,))
-                got = super().__call__(sub, link)
-                out.logged.update(got.logged)
-                out.relayed.update(got.relayed)
         return out
 
 
 @dataclass
 class InterleavingRecorder(GoldenRecorder):
     """Asked to measure several sensors with aM!, starts them all before collecting any, as
-    if they were concurrent measurements. Its ``__call__`` needs the whole job in one call, so
-    it does not pass on through a recorder that splits the job per command
-    (:class:`RewritingRecorder`): seed 27 drew crlf-wake-up + interleaves-measurements, and
-    the split lost the interleaving. No ``CHAINS``: such pairs are refused."""
+    if they were concurrent measurements. It changes the task and passes the whole job on
+    (``CHAINS``): the recorders it passes it to keep a job whole (the rewriting one used to
+    split it per command, and seed 27 drew crlf-wake-up + interleaves-measurements with the
+    interleaving lost)."""
+
+    CHAINS = frozenset({"__call__"})
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
         if request.task is Task.MEASURE and len({t[:1] for t in request.commands}) > 1:
             request = replace(request, task=Task.CONCURRENT)
         return super().__call__(request, link)
-
-
-@dataclass
-class NoBreakTransparentRecorder(GoldenRecorder):
-    """Transparent mode sends each host command as soon as it comes, with no break of its
-    own (the engine still breaks for a new address or after 87 ms of marking)."""
-
-    def __call__(self, request: Request, link: Link) -> RecorderOutput:
-        if request.task is not Task.TRANSPARENT:
-            return super().__call__(request, link)
-        master = self.master_factory(link, self.policy or Policy.golden())
-        out = RecorderOutput()
-        for text in request.commands:
-            ex = master.transact(parse_command(text))
-            out.relayed[text] = ex.reply_text if ex.answered else ""
-        return out
 
 
 @dataclass
@@ -774,7 +784,7 @@ _FAULTS = (
         "transparent-no-break",
         "Transparent mode sends host commands without a break of its own.",
         ("R-4.4.14-01",),
-        Parts(recorder=NoBreakTransparentRecorder),
+        Parts(knobs={"transparent_break": False}),
     ),
     RecorderFault(
         "transparent-drops-address",

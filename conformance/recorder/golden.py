@@ -96,7 +96,11 @@ class GoldenRecorder:
     ``wait``: how ``aM!``-type measurements wait for data ("auto": the service request or
     ttt, whichever first; "ttt": always the full ttt). ``ttt_fraction`` scales the wait before
     collecting concurrent data (1 = the full ttt). ``reissues``: how often a measurement is
-    issued again after a valid empty D reply.
+    issued again after a valid empty D reply. ``transparent_break``: whether a host command
+    relayed in transparent mode gets a break of its own (R-4.4.14-01); False leaves it to the
+    engine's break rules (a new address, 87 ms of marking). A knob rather than a ``__call__``
+    of its own, so the loggers that rewrite what they send (faults.RewritingRecorder) relay
+    without a break too when a fault says so.
     """
 
     policy: Policy | None = None
@@ -104,6 +108,7 @@ class GoldenRecorder:
     wait: str = "auto"
     ttt_fraction: float = 1.0
     reissues: int = 2
+    transparent_break: bool = True
 
     def __call__(self, request: Request, link: Link) -> RecorderOutput:
         master = self.master_factory(link, self.policy or Policy.golden())
@@ -121,7 +126,8 @@ class GoldenRecorder:
             case Task.TRANSPARENT:
                 for text in request.commands:
                     # the host's command goes out as typed, woken by a break (R-4.4.14-01)
-                    ex = master.transact(parse_command(text), force_break=True)
+                    brk = self.transparent_break
+                    ex = master.transact(parse_command(text), force_break=brk)
                     out.relayed[text] = ex.reply_text if ex.answered else ""
         return out
 

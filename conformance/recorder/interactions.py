@@ -150,4 +150,27 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
         )
         for never in ("no-retries", "retries-with-break")
     ),
+    # masked: with every try after a break unheard, no aC! announces ttt = 000
+    *(
+        Interaction(
+            frozenset({"concurrent-ttt-zero-stalls", never, "short-marking"}),
+            f"{_UNHEARD} and {never} never retries without a break, so neither sensor of"
+            " concurrent-ttt-zero ever answers its aC! (seed 43: six break+aC! tries, no"
+            " reply, logged {'0C!': [], '1C!': []}): no concurrent measurement announcing"
+            " ttt = 000 starts for concurrent-ttt-zero-stalls to leave uncollected, and"
+            " R-4.4.8-05 holds on the six measurements that ran (R-4.4.7-08 still FAILs).",
+            removes=("R-4.4.8-05",),
+        )
+        for never in ("no-retries", "retries-with-break")
+    ),
+    Interaction(
+        frozenset({"ignores-service-request", "late-d0-without-break", "short-marking"}),
+        "ignores-service-request waits the whole ttt and sends aD0! after a break, so"
+        " late-d0-without-break's skipped break is left over; beside it alone the next"
+        " command takes it (1M! to a new sensor with no break: R-7.0-17). Here"
+        f" {_UNHEARD}, and the retry without a break that follows it (which needs none)"
+        " takes the skip: 1M! goes out after a break, every unbroken command comes 9-45 ms"
+        " after the line's last activity and R-7.0-17 holds on the wire (seed 50).",
+        removes=("R-7.0-17",),
+    ),
 )

@@ -4,6 +4,8 @@ apart are refused with the reason, never drawn by the combination sampler."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import pytest
 
 from conformance.links.errors import PortError
@@ -48,6 +50,22 @@ def test_one_fault_builds_the_recorder_it_always_was():
         ("d0-before-ttt", "ttt-8-bit"),
         ("no-break-after-87ms", "retry-too-late"),
         ("late-d0-without-break", "no-break-after-87ms"),
+        # refused before (rt3): the first retry after silence timed early or late, the retry
+        # after a paused reply without the drain (R-7.2-02 at 12.00 / 95.00 ms and R-7.2-06
+        # at -100.00 ms in one transcript); transparent mode without a break of its own
+        # beside a logger that rewrites or adds commands ('0I!: sent without a break' beside
+        # '$!', the CR LF preamble, XSN!) or interleaves aM!
+        ("retry-too-early", "talks-over-reply"),
+        ("retry-too-late", "talks-over-reply"),
+        ("crlf-wake-up", "transparent-no-break"),
+        ("polls-dollar", "transparent-no-break"),
+        ("transparent-drops-address", "transparent-no-break"),
+        ("interleaves-measurements", "transparent-no-break"),
+        # refused before (rt3): the rewriting recorder split the job per command and lost
+        # the interleaving (seed 27); it now passes the job on whole
+        ("crlf-wake-up", "interleaves-measurements"),
+        ("interleaves-measurements", "polls-dollar"),
+        ("interleaves-measurements", "transparent-drops-address"),
     ],
 )
 def test_a_pair_puts_both_deviations_on_the_wire(pair):
@@ -74,24 +92,70 @@ def test_two_attempt_hooks_chain():
     assert names.index("IgnoresCrcHooks") < names.index("GoldenHooks")
 
 
-@pytest.mark.parametrize(
-    ("pair", "reason"),
-    [
-        (("retry-too-early", "retry-too-late"), "retry_time"),
-        (("no-retries", "retries-with-break"), "sequences (1 and 3)"),
-        (("command-gap-in-tolerance", "gappy-commands"), "gap"),
-        (("d0-before-ttt", "waits-forever-for-service-request"), "wait_for_data"),
-        (("polls-dollar", "transparent-no-break"), "__call__"),
-        # the rewriting recorder splits the job per command: the interleaving would be lost
-        (("crlf-wake-up", "interleaves-measurements"), "__call__"),
-    ],
-)
+#: Every pair that does not compose, with the part the composer names and why no logger can
+#: have both deviations the way each fault states it (test_the_refusals_are_exactly_these).
+REFUSED = [
+    # one number each: how many sequences (1 and 3), the gap between command characters
+    # (3 ms and 1.9 ms)
+    (("no-retries", "retries-with-break"), "sequences (1 and 3)"),
+    (("command-gap-in-tolerance", "gappy-commands"), "gap"),
+    # the first retry after silence at 12 ms, 95 ms or after the 1.5 s poll timeout: one
+    # retry, three times
+    (("retry-too-early", "retry-too-late"), "silent_retry_time"),
+    (("resends-after-timeout", "retry-too-early"), "silent_retry_time"),
+    (("resends-after-timeout", "retry-too-late"), "silent_retry_time"),
+    # every retry 1.5 s after the last attempt vs the retry into a paused reply: the
+    # talking over would never reach the wire
+    (("resends-after-timeout", "talks-over-reply"), "retry_time"),
+    # aD0! after half of ttt vs a wait with no end for the service request, both for aM!
+    (("d0-before-ttt", "waits-forever-for-service-request"), "wait_for_data"),
+]
+
+
+@pytest.mark.parametrize(("pair", "reason"), REFUSED)
 def test_faults_that_change_one_thing_apart_are_refused_with_the_reason(pair, reason):
     assert reason in (composition_conflict(pair) or "")
     with pytest.raises(Refused, match="their own way|both set"):
         faulty_recorder(pair)
     with pytest.raises(PortError, match="do not compose"):
         recorder_faults({"recorder-faults": ",".join(pair)})
+
+
+def test_the_refusals_are_exactly_these():
+    """No pair is refused without its reason in :data:`REFUSED` (a new clash is looked at)."""
+    names = sorted(RECORDER_FAULTS)
+    refused = {
+        (a, b)
+        for i, a in enumerate(names)
+        for b in names[i + 1 :]
+        if composition_conflict((a, b)) is not None
+    }
+    assert refused == {tuple(sorted(pair)) for pair, _ in REFUSED}
+
+
+def test_a_retry_after_silence_and_one_after_a_reply_are_timed_by_their_own_faults():
+    """retry-too-early + talks-over-reply: the first retry after no reply 12 ms after the
+    command (silent_retry_time), one after a paused reply at the engine's own time with no
+    wait for a quiet line (EngineRetryHooks: usual() at once)."""
+    from conformance.recorder.faults import EARLY_RETRY
+    from conformance.tool_recorder.records import Attempt, Exchange
+
+    recorder = faulty_recorder(("retry-too-early", "talks-over-reply"))
+    hooks = recorder.master_factory(None, recorder.policy).hooks
+
+    class _Link:
+        def now(self) -> float:
+            return 1.0
+
+    class _Master:
+        link = _Link()
+
+    sent = [SimpleNamespace(end=1.0)]  # the command's last character ended at 1.0 s
+    silent = Attempt(None, sent, [], "no reply", end=1.02)
+    replied = Attempt(None, sent, [SimpleNamespace(end=1.01)], "no CR LF", end=1.02)
+    for attempt, expected in ((silent, 1.0 + EARLY_RETRY), (replied, 7.0)):
+        exchange = Exchange(None, "0M!", [attempt])
+        assert hooks.retry_time(_Master(), exchange, 0, 2, lambda: 7.0) == expected
 
 
 def test_same_kind_knobs_unite():
@@ -152,7 +216,7 @@ def test_a_skipped_break_passes_the_rest_on_to_the_other_break_rules():
 def test_all_pairs_are_every_composing_pair():
     pairs = recorder_combinations.all_pairs()
     names = sorted(RECORDER_FAULTS)
-    assert len(pairs) == len(set(pairs)) == 614
+    assert len(pairs) == len(set(pairs)) == 623
     assert all(composition_conflict(p) is None and list(p) == sorted(p) for p in pairs)
     refused = [
         (a, b)
@@ -171,3 +235,20 @@ def test_an_unknown_fault_is_named_apart_from_the_known_ones():
     assert str(err.value).startswith("recorder-faults: 'mislog-drops-sign' is not a recorder fault")
     with pytest.raises(PortError, match=r"'retry-to-early' is not .*did you mean retry-too-early"):
         recorder_faults({"recorder-faults": "retry-to-early"})
+
+
+def _concurrent_waits(port: str) -> list[str]:
+    data = run_recorder_suite(port, keyword="concurrent")
+    (req,) = (r for r in data["requirements"] if r["id"] == "R-4.4.7-06")
+    return [f["detail"] for f in req["findings"]]
+
+
+@pytest.mark.parametrize("fault", ["crlf-wake-up", "polls-dollar", "transparent-drops-address"])
+def test_a_rewriting_logger_measures_concurrent_sensors_together(fault):
+    """R-4.4.7-06: the rewriting recorder passes a concurrent job on whole, so its two
+    sensors' aC! are started together and the second waits its own ttt as the golden one's
+    does (2005..2180 ms); split per command, each was started and collected alone
+    (2005..2005 ms), a deviation no fault declares."""
+    golden = _concurrent_waits("sim")
+    assert any("2005.00..2180.00 ms" in d for d in golden), golden
+    assert _concurrent_waits(f"sim://?recorder-faults={fault}") == golden
