@@ -320,6 +320,10 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # a sensor that ignores ?! at an address other than '0' was called absent (INCOMPLETE,
     # seed 4158); discovery now asks each address with a! before it stops
     ("factory-address-not-zero", "ignores-query"),
+    # (seed 4197) R-4.4.5-10 PASSed on the exploration's one repeated D0, which checks
+    # repeated reads only, while the retention case (no M-type values to read) could not
+    # send the aRn! that continuous-overwrites-data empties the buffer at
+    ("continuous-overwrites-data", "measure-ttt-two-digits", "value-two-points"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
