@@ -78,6 +78,10 @@ R-4.4.12-05 PASSed "17 checked" on the D replies after aMC!/aCC!, which carried 
 all, while the aRCn! replies' CRCs were encoded as no CRC-16 (crc-missing + crc-wrong-
 encoding + extended-not-x, seed 4179): a reply without its CRC shows nothing of the CRC's
 value or encoding, and an uncompared aRCn! CRC leaves the value undecided as a D reply's does.
+R-4.4.5-10 PASSed on the exploration's one repeated D0 (continuous-overwrites-data +
+measure-ttt-two-digits + value-two-points, seed 4197) while the retention case, finding no
+M-type measurement with values, never sent the aR0! that empties the buffer: that PASS is
+partial now (results.counted), and the case reads a concurrent measurement's values there.
 """
 
 from __future__ import annotations
@@ -87,6 +91,7 @@ import pytest
 from conformance.protocol.commands import M_FAMILY
 from conformance.verdicts import Verdict
 from testcases.sensor.test_4_4_5_measurement import test_break_aborts_measurement as abort_case
+from testcases.sensor.test_4_4_5_measurement import test_data_retained as retained_case
 from testcases.sensor.test_4_4_5_measurement import test_measurement_reply as reply_case
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
 from testcases.sensor.test_4_4_8_data import test_announced_values_delivered as count_case
@@ -560,3 +565,18 @@ def test_an_uncompared_crc_is_an_observation_the_run_counts():
     crc_value_case(session, Case(record, preconditions=declared_on(crc_value_case, rules)))
     [finding] = [f for f in record.findings if f.requirement == "R-4.4.12-05"]
     assert finding.verdict is Verdict.INCONCLUSIVE and finding.observed >= 1
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("continuous-overwrites-data,measure-ttt-two-digits", Verdict.FAIL),
+        ("measure-ttt-two-digits", Verdict.PASS),
+        ("continuous-overwrites-data", Verdict.FAIL),
+        ("", Verdict.PASS),
+        ("d0-empty,measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+    ],
+)
+def test_retention_read_on_concurrent_values_where_m_gave_none(faults, expected):
+    """aM! gave no count, so the retention case reads aC!'s values again after its pokes."""
+    assert case_verdict(sim_session(faults), retained_case, "R-4.4.5-10") is expected

@@ -173,14 +173,11 @@ FORMAT: tuple[Fault, ...] = (
         " or any aMn!: the D-reply and value rules (R-4.4.8-*, R-4.4-05, R-4.4.8.3-*) read"
         " only aC!'s data and are left open for the values aM! holds, as is the count's"
         " 1..9 rule (R-4.4.5-02). Nor can aM!'s count be set beside aMC!'s"
-        " (R-4.4.12-04). Nor has the retention case an M-type measurement's values to read"
-        " again after a break, standby and aI!/a!/aR0!/aRC0!; the exploration's repeated"
-        " D0 over aC!'s data checks repeated reads only (R-4.4.5-10, seed 4197).",
+        " (R-4.4.12-04).",
         ("R-4.4.5-01",),
         rewrite=_start_with(1, lambda body: body[0] + body[2:]),
         inconclusive=(
             "R-6.1-03",
-            "R-4.4.5-10",
             "R-4.4.11-01",
             *UNREAD_RECORDS,
             "R-4.4.5-02",
