@@ -324,6 +324,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # repeated reads only, while the retention case (no M-type values to read) could not
     # send the aRn! that continuous-overwrites-data empties the buffer at
     ("continuous-overwrites-data", "measure-ttt-two-digits", "value-two-points"),
+    # (seed 4216, with continuous-over-75) R-5.2-05 PASSed on a big-endian size field read as
+    # a multiple of 256, while the CRC checked over 9 bytes of INT16 between header and CRC
+    ("binary-payload-not-multiple", "binary-size-big-endian"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

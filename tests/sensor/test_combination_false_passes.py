@@ -82,6 +82,10 @@ R-4.4.5-10 PASSed on the exploration's one repeated D0 (continuous-overwrites-da
 measure-ttt-two-digits + value-two-points, seed 4197) while the retention case, finding no
 M-type measurement with values, never sent the aR0! that empties the buffer: that PASS is
 partial now (results.counted), and the case reads a concurrent measurement's values there.
+R-5.2-05 PASSed on aHB!'s packets whose size field was sent high byte first (+ binary-payload-
+not-multiple, seed 4216): read as a multiple of 256 it is a multiple of every type's size,
+while the CRC checked over 9 bytes of INT16 between header and CRC; those bytes are judged now,
+and a packet neither its size nor its CRC bounds leaves the rule undecided.
 """
 
 from __future__ import annotations
@@ -580,3 +584,17 @@ def test_an_uncompared_crc_is_an_observation_the_run_counts():
 def test_retention_read_on_concurrent_values_where_m_gave_none(faults, expected):
     """aM! gave no count, so the retention case reads aC!'s values again after its pokes."""
     assert case_verdict(sim_session(faults), retained_case, "R-4.4.5-10") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("binary-payload-not-multiple,binary-size-big-endian", Verdict.FAIL),
+        ("binary-size-big-endian", Verdict.PASS),
+        ("binary-payload-not-multiple", Verdict.FAIL),
+        ("binary-crc-wrong,binary-size-big-endian", Verdict.INCONCLUSIVE),
+        ("", Verdict.PASS),
+    ],
+)
+def test_payload_length_where_the_size_field_is_unreadable(faults, expected):
+    assert case_verdict(sim_session(faults), binary_case, "R-5.2-05") is expected
