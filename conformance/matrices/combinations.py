@@ -327,6 +327,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (seed 4216, with continuous-over-75) R-5.2-05 PASSed on a big-endian size field read as
     # a multiple of 256, while the CRC checked over 9 bytes of INT16 between header and CRC
     ("binary-payload-not-multiple", "binary-size-big-endian"),
+    # (seed 4227, with crc-missing) R-4.4.5.1-02 PASSed on an empty D0 after the abort where
+    # the measurement before it had delivered no values either: old data kept look the same
+    ("abort-keeps-old-data", "d0-empty"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

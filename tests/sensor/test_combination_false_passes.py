@@ -86,6 +86,8 @@ R-5.2-05 PASSed on aHB!'s packets whose size field was sent high byte first (+ b
 not-multiple, seed 4216): read as a multiple of 256 it is a multiple of every type's size,
 while the CRC checked over 9 bytes of INT16 between header and CRC; those bytes are judged now,
 and a packet neither its size nor its CRC bounds leaves the rule undecided.
+R-4.4.5.1-02 PASSed on an empty D0 after the abort where the buffer held no values before it
+(abort-keeps-old-data + d0-empty, seed 4227 with crc-missing): INCONCLUSIVE there.
 """
 
 from __future__ import annotations
@@ -598,3 +600,16 @@ def test_retention_read_on_concurrent_values_where_m_gave_none(faults, expected)
 )
 def test_payload_length_where_the_size_field_is_unreadable(faults, expected):
     assert case_verdict(sim_session(faults), binary_case, "R-5.2-05") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,d0-empty", Verdict.INCONCLUSIVE),
+        ("d0-empty", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data", Verdict.WARN),
+        ("", Verdict.PASS),
+    ],
+)
+def test_an_empty_d0_after_an_abort_needs_values_before_it(faults, expected):
+    assert case_verdict(sim_session(faults), abort_case, "R-4.4.5.1-02") is expected
