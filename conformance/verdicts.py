@@ -108,7 +108,11 @@ class Finding:
     holds escaped wire text or other short observations; ``decision`` cites a
     requirements.md section 5 decision (``"A13"``) that shaped the verdict. ``observed`` is the
     number of exchanges, events or measurements the verdict rests on: a PASS needs at least one,
-    and a FAIL or WARN needs at least one and an evidence line.
+    and a FAIL or WARN needs at least one and an evidence line. ``partial`` marks a PASS that
+    checked one clause of its rule only (the exploration's repeated D0 judges repeated reads,
+    not retention across the breaks, standby and commands the rule names): it stands beside
+    the case built for the whole rule, never for it (:func:`conformance.results.counted`).
+    It is the judges' knowledge, not the report's: verdicts.json leaves it out.
     """
 
     requirement: str
@@ -127,6 +131,7 @@ class Finding:
     consequence_of: str | None = None  # the root finding's requirement (root_causes.py)
     # timing findings: every measurement the verdict rests on (issue 24, margins)
     distribution: Distribution | None = None
+    partial: bool = False
 
     def __post_init__(self) -> None:
         if self.verdict is Verdict.PASS and self.observed < 1:
@@ -153,6 +158,7 @@ class Finding:
 
     def to_json(self) -> dict[str, Any]:
         d = asdict(self)
+        del d["partial"]  # how the run weighs it, not a field of the report (contract)
         d["verdict"] = str(self.verdict)
         return d
 

@@ -320,6 +320,16 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # a sensor that ignores ?! at an address other than '0' was called absent (INCOMPLETE,
     # seed 4158); discovery now asks each address with a! before it stops
     ("factory-address-not-zero", "ignores-query"),
+    # (seed 4197) R-4.4.5-10 PASSed on the exploration's one repeated D0, which checks
+    # repeated reads only, while the retention case (no M-type values to read) could not
+    # send the aRn! that continuous-overwrites-data empties the buffer at
+    ("continuous-overwrites-data", "measure-ttt-two-digits", "value-two-points"),
+    # (seed 4216, with continuous-over-75) R-5.2-05 PASSed on a big-endian size field read as
+    # a multiple of 256, while the CRC checked over 9 bytes of INT16 between header and CRC
+    ("binary-payload-not-multiple", "binary-size-big-endian"),
+    # (seed 4227, with crc-missing) R-4.4.5.1-02 PASSed on an empty D0 after the abort where
+    # the measurement before it had delivered no values either: old data kept look the same
+    ("abort-keeps-old-data", "d0-empty"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -125,6 +125,13 @@ class BinaryPacket(Checked):
     violations: list[Violation] = field(default_factory=list)
 
     @property
+    def payload_known(self) -> bool:
+        """The payload's length is on the wire: the size field agrees with the packet's
+        length, or the CRC checks over the packet as read (so it ended where it was read to
+        end, whatever its size field says). Else neither tells how long the payload was."""
+        return len(self.payload) == self.size or self.crc_ok
+
+    @property
     def is_empty(self) -> bool:
         """The R-5.2-06 empty packet: no payload and type 0."""
         return self.size == 0 and self.dtype == DataType.INVALID
@@ -194,6 +201,17 @@ def parse_binary_packet(data: bytes, expected_address: str | None = None) -> Bin
             Violation(
                 "R-5.2-05",
                 f"payload of {size} bytes is not a whole number of {dtype.name} values",
+            )
+        )
+    elif not framed and crc_ok and len(payload) % type_size(dtype):
+        # (seed 4216) a size field that disagrees with a packet whose CRC checks is no
+        # evidence of its payload, but the bytes between header and CRC are: 9 bytes of
+        # INT16 behind a big-endian size field (read as 2304, even) PASSed R-5.2-05
+        found.append(
+            Violation(
+                "R-5.2-05",
+                f"payload of {len(payload)} bytes between header and CRC (the CRC checks; the"
+                f" size field says {size}) is not a whole number of {dtype.name} values",
             )
         )
     elif framed:

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges.exploration import Observation, judge
+from conformance.judges.exploration import Observation, held_findings, judge
+from conformance.verdicts import Verdict
 
 
 def repeat(previous: str | None, reply: str) -> Observation:
@@ -30,3 +31,14 @@ def test_values_read_again_are_a_check_and_lost_values_breach_it():
     assert kept.checked == ("R-4.4.5-10",) and kept.breach is None
     lost = judge(repeat("0+1.5-2\r\n", "0\r\n"))
     assert lost.breach is not None and lost.breach.requirement == "R-4.4.5-10"
+
+
+def test_a_held_repeat_is_a_partial_pass_the_other_rules_whole_ones():
+    """R-4.4.5-10's PASS from repeated D0s checks repeated reads only: no pair need span the
+    aRn! continuous-overwrites-data empties the buffer at (seed 4197), so it is partial and
+    cannot stand for the retention case; a framing check is a PASS of its rule as usual."""
+    kept = repeat("0+1.5-2\r\n", "0+1.5-2\r\n")
+    framed = Observation("framing", "0D0!", "0+1.5-2\r\n", "0")
+    found = {f.requirement: f for f in held_findings([kept, framed], 10)}
+    assert found["R-4.4.5-10"].verdict is Verdict.PASS and found["R-4.4.5-10"].partial
+    assert found["R-4.3-01"].verdict is Verdict.PASS and not found["R-4.3-01"].partial

@@ -197,6 +197,49 @@ def test_aggregation_worst_finding_untestable_and_unjudged():
     assert worst([Verdict.PASS, Verdict.FAIL, Verdict.WARN]) is Verdict.FAIL
 
 
+@pytest.mark.parametrize(
+    ("exploration", "case", "expected"),
+    [
+        # seed 4197: the one repeated D0 beside the retention case that met no precondition
+        (Verdict.PASS, "unreached", Verdict.INCONCLUSIVE),
+        (Verdict.PASS, Verdict.PASS, Verdict.PASS),  # beside the whole rule's PASS it stands
+        (Verdict.FAIL, "unreached", Verdict.FAIL),  # a clause broken breaks the rule
+    ],
+)
+def test_a_partial_pass_does_not_outvote_the_case_built_for_the_whole_rule(
+    exploration, case, expected
+):
+    rid = "R-4.4.5-10"
+    evidence = {"evidence": ["0D0! -> '0+1'"]} if exploration is Verdict.FAIL else {}
+    partial = Finding(rid, exploration, "held", observed=1, partial=True, **evidence)
+    if case == "unreached":
+        whole = Finding(rid, Verdict.INCONCLUSIVE, "precondition not met: buffered")
+    else:
+        whole = Finding(rid, case, "4 D replies identical", observed=4)
+    records = [CaseRecord("t::e", "e", (rid,), findings=[partial])]
+    records.append(CaseRecord("t::r", "r", (rid,), findings=[whole]))
+    results = {r.requirement.id: r for r in aggregate("sensor", records)}
+    assert results[rid].verdict is expected
+
+
+def test_a_whole_rules_pass_still_outvotes_an_unreached_case():
+    rid = "R-4.4.5-10"
+    findings = [
+        Finding(rid, Verdict.PASS, "held", observed=1),
+        Finding(rid, Verdict.INCONCLUSIVE, "the exploration stopped early"),
+    ]
+    results = {
+        r.requirement.id: r
+        for r in aggregate("sensor", [CaseRecord("t", "t", (rid,), findings=findings)])
+    }
+    assert results[rid].verdict is Verdict.PASS
+
+
+def test_partial_is_the_runs_weighing_not_a_field_of_verdicts_json():
+    finding = Finding("R-4.4.5-10", Verdict.PASS, "held", observed=1, partial=True)
+    assert "partial" not in finding.to_json()
+
+
 def test_overall_verdict():
     case = CaseRecord(
         "t::a",

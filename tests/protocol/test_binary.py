@@ -119,11 +119,12 @@ def test_size_field_disagrees_with_length() -> None:
     full = build_packet("1", DataType.INT16, [-1, 1])
     short = with_crc(full[:-3])  # one payload byte missing, CRC recomputed
     packet = parse_binary_packet(short)
-    assert ids(packet.violations) == ["R-5.2-02"]
+    # the CRC checks over the packet as read: its 3 payload bytes are no whole INT16 values
+    assert ids(packet.violations) == ["R-5.2-02", "R-5.2-05"]
     assert packet.values == [] and packet.payload == b"\xff\xff\x01"
     long = with_crc(full[:-2] + b"\x00")  # a trailing extra byte
     packet = parse_binary_packet(long)
-    assert ids(packet.violations) == ["R-5.2-02"]
+    assert ids(packet.violations) == ["R-5.2-02", "R-5.2-05"]
     assert packet.values == [] and packet.payload == b"\xff\xff\x01\x00\x00"
 
 
@@ -257,3 +258,27 @@ def test_parser_never_raises(data: bytes) -> None:
     packet = parse_binary_packet(data)
     if packet.ok:
         assert len(data) == packet_length(data)
+
+
+def _big_endian_sized(payload: bytes, code: int = 3) -> bytes:
+    """An INT16 packet whose size field is sent high byte first (binary-size-big-endian)."""
+    return with_crc(b"0" + len(payload).to_bytes(2, "big") + bytes([code]) + payload)
+
+
+def test_a_ragged_payload_behind_an_unreadable_size_field_is_judged_by_its_crc() -> None:
+    """(seed 4216, binary-payload-not-multiple + binary-size-big-endian) 9 bytes of INT16
+    behind a size field read as 2304 (even) PASSed R-5.2-05: the CRC checks over the packet
+    as read, so the 9 bytes between header and CRC are its payload."""
+    packet = parse_binary_packet(_big_endian_sized(bytes(9)), expected_address="0")
+    assert packet.payload_known
+    assert ids(packet.violations) == ["R-5.2-02", "R-5.2-05"]
+    whole = parse_binary_packet(_big_endian_sized(bytes(8)), expected_address="0")
+    assert ids(whole.violations) == ["R-5.2-02"]  # 8 bytes: whole INT16 values
+
+
+def test_a_payload_neither_its_size_nor_its_crc_bounds_is_unknown() -> None:
+    data = bytearray(_big_endian_sized(bytes(9)))
+    data[-1] ^= 0x01  # the CRC no longer checks
+    packet = parse_binary_packet(bytes(data), expected_address="0")
+    assert not packet.payload_known
+    assert "R-5.2-05" not in ids(packet.violations)

@@ -78,6 +78,16 @@ R-4.4.12-05 PASSed "17 checked" on the D replies after aMC!/aCC!, which carried 
 all, while the aRCn! replies' CRCs were encoded as no CRC-16 (crc-missing + crc-wrong-
 encoding + extended-not-x, seed 4179): a reply without its CRC shows nothing of the CRC's
 value or encoding, and an uncompared aRCn! CRC leaves the value undecided as a D reply's does.
+R-4.4.5-10 PASSed on the exploration's one repeated D0 (continuous-overwrites-data +
+measure-ttt-two-digits + value-two-points, seed 4197) while the retention case, finding no
+M-type measurement with values, never sent the aR0! that empties the buffer: that PASS is
+partial now (results.counted), and the case reads a concurrent measurement's values there.
+R-5.2-05 PASSed on aHB!'s packets whose size field was sent high byte first (+ binary-payload-
+not-multiple, seed 4216): read as a multiple of 256 it is a multiple of every type's size,
+while the CRC checked over 9 bytes of INT16 between header and CRC; those bytes are judged now,
+and a packet neither its size nor its CRC bounds leaves the rule undecided.
+R-4.4.5.1-02 PASSed on an empty D0 after the abort where the buffer held no values before it
+(abort-keeps-old-data + d0-empty, seed 4227 with crc-missing): INCONCLUSIVE there.
 """
 
 from __future__ import annotations
@@ -87,6 +97,7 @@ import pytest
 from conformance.protocol.commands import M_FAMILY
 from conformance.verdicts import Verdict
 from testcases.sensor.test_4_4_5_measurement import test_break_aborts_measurement as abort_case
+from testcases.sensor.test_4_4_5_measurement import test_data_retained as retained_case
 from testcases.sensor.test_4_4_5_measurement import test_measurement_reply as reply_case
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
 from testcases.sensor.test_4_4_8_data import test_announced_values_delivered as count_case
@@ -560,3 +571,45 @@ def test_an_uncompared_crc_is_an_observation_the_run_counts():
     crc_value_case(session, Case(record, preconditions=declared_on(crc_value_case, rules)))
     [finding] = [f for f in record.findings if f.requirement == "R-4.4.12-05"]
     assert finding.verdict is Verdict.INCONCLUSIVE and finding.observed >= 1
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("continuous-overwrites-data,measure-ttt-two-digits", Verdict.FAIL),
+        ("measure-ttt-two-digits", Verdict.PASS),
+        ("continuous-overwrites-data", Verdict.FAIL),
+        ("", Verdict.PASS),
+        ("d0-empty,measure-ttt-two-digits", Verdict.INCONCLUSIVE),
+    ],
+)
+def test_retention_read_on_concurrent_values_where_m_gave_none(faults, expected):
+    """aM! gave no count, so the retention case reads aC!'s values again after its pokes."""
+    assert case_verdict(sim_session(faults), retained_case, "R-4.4.5-10") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("binary-payload-not-multiple,binary-size-big-endian", Verdict.FAIL),
+        ("binary-size-big-endian", Verdict.PASS),
+        ("binary-payload-not-multiple", Verdict.FAIL),
+        ("binary-crc-wrong,binary-size-big-endian", Verdict.INCONCLUSIVE),
+        ("", Verdict.PASS),
+    ],
+)
+def test_payload_length_where_the_size_field_is_unreadable(faults, expected):
+    assert case_verdict(sim_session(faults), binary_case, "R-5.2-05") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,d0-empty", Verdict.INCONCLUSIVE),
+        ("d0-empty", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data", Verdict.WARN),
+        ("", Verdict.PASS),
+    ],
+)
+def test_an_empty_d0_after_an_abort_needs_values_before_it(faults, expected):
+    assert case_verdict(sim_session(faults), abort_case, "R-4.4.5.1-02") is expected

@@ -249,7 +249,8 @@ COUNTS: tuple[Fault, ...] = (
         " nor a buffer whose values a repeated D0 could show kept or lost (R-4.4.5-10);"
         " nor, after aHA!, a reply's length or a D past D9 (R-5.1-02, R-5.1-03), nor, after"
         " aHB!, a payload (R-5.2-04, R-5.2-05: all PASSed on the empty replies, seeds"
-        " 4100, 4104).",
+        " 4100, 4104). Nor has a break's abort data to keep: D0 after it is empty whatever the"
+        " sensor does with its buffer (R-4.4.5.1-02, seed 4227).",
         ("R-4.4.8-04", "R-4.4.8-03", "R-4.4.5-03", "R-5.2-07"),
         settings={"drop_all_values": True},
         inconclusive=(
@@ -266,6 +267,7 @@ COUNTS: tuple[Fault, ...] = (
             "R-5.1-03",
             "R-5.2-04",
             "R-5.2-05",
+            "R-4.4.5.1-02",
         ),
     ),
     Fault(
