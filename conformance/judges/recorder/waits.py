@@ -66,10 +66,7 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
                 f"reply, while a service request could still come",
             )
         if first is None:
-            if m.cut_at is None:
-                tally.fail("R-4.4.5-05", where, "no aD0! after the measurement")
-            else:
-                _cut_while_waiting(tally, m, where, ready, uncertainty)
+            _no_data_command(tally, m, where, ready, uncertainty)
             continue
         if sr is None or sr > first.start:
             early.append(
@@ -126,17 +123,20 @@ def judge_concurrent_waits(
     return [combine("R-4.4.7-06", found, "concurrent wait")]
 
 
-def _cut_while_waiting(
+def _no_data_command(
     tally: Tally, m: ObservedMeasurement, where: str, ready: float, uncertainty: float
 ) -> None:
-    """R-4.4.5-05 for a measurement the recorder was still in when the tool cut its job at the
-    budget, with no aD0! yet. A FAIL when the cut came past the allowance after the service
-    request or ttt (no aD0! at all where one was due: not a late one, which decision T1 makes a
-    WARN); undecided when the cut came before an aD0! was due, which says nothing."""
+    """R-4.4.5-05 for a measurement after which no aD0! came: a FAIL when the recorder moved on
+    or ended its job. When the tool cut the job at its budget with the recorder still in this
+    measurement: a FAIL when the cut came past the allowance after the service request or ttt
+    (no aD0! at all where one was due: not a late one, which decision T1 makes a WARN);
+    undecided when it came before an aD0! was due, which says nothing."""
+    if m.cut_at is None:
+        tally.fail("R-4.4.5-05", where, "no aD0! after the measurement")
+        return
     sr = m.service_request_end
     trigger = sr if sr is not None and sr <= ready else ready
     what = "the service request" if trigger == sr else "ttt ran out"
-    assert m.cut_at is not None
     waited = m.cut_at - trigger
     if waited - uncertainty > REACTION:
         tally.fail(
