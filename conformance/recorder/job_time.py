@@ -42,6 +42,8 @@ class JobTimeout(RecorderDriverError):
         )
         self.budget = budget
         self.reason = reason
+        #: the line time of the cut, set by whoever holds the line's clock (the scenario runner)
+        self.at: float | None = None
 
 
 @dataclass(frozen=True)

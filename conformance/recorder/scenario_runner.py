@@ -70,8 +70,12 @@ class ScenarioRun:
     #: sent until then is all it sent, so rules over every transmission judge it in full
     timed_out: JobTimeout | None = None
     budget: JobBudget | None = None
-    #: line time at which the tool cut the job (``timed_out``): the recorder was still in it
-    cut_at: float | None = None
+
+    @property
+    def cut_at(self) -> float | None:
+        """Line time at which the tool cut the job (``timed_out``): the recorder was still
+        in it, so what it had not sent by then it may yet have sent."""
+        return self.timed_out.at if self.timed_out is not None else None
 
     @property
     def asked(self) -> tuple[str, ...]:
@@ -220,23 +224,15 @@ class RecorderSession(Session):
             output = self.driver.act(scenario.name, request, self.link, budget)
         except RecorderDriverError as exc:
             output, error, cut = _failed(exc)
-        cut_at = self.link.now() if cut is not None else None
+        if cut is not None:
+            cut.at = self.link.now()
         transcript.note(self.link.now(), output_note(scenario.name, output, error, cut))
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
         events = transcript.since(first)
         self._check_setup(scenario, events, error, cut)
         return ScenarioRun(
-            scenario,
-            events,
-            output,
-            error,
-            tuple(played),
-            request,
-            tuple(absences),
-            cut,
-            budget,
-            cut_at,
+            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
         )
 
     @staticmethod
@@ -285,7 +281,8 @@ class RecorderSession(Session):
             output, error = RecorderOutput(), str(exc)
         except RecorderDriverError as exc:
             output, error, cut = _failed(exc)
-        cut_at = line.now() if cut is not None else None
+        if cut is not None:
+            cut.at = line.now()
         line.note(output_note(scenario.name, output, error, cut))
         line.settle(SETTLE)
         kept = line.line
@@ -295,16 +292,7 @@ class RecorderSession(Session):
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
         self._check_setup(scenario, events, error, cut)
         return ScenarioRun(
-            scenario,
-            events,
-            output,
-            error,
-            tuple(played),
-            request,
-            tuple(absences),
-            cut,
-            budget,
-            cut_at,
+            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
         )
 
     def _act_served(
