@@ -18,7 +18,7 @@ from ..protocol.responses import (
 )
 from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
-from ..transcript import escape
+from ..transcript import DUT, decode_7e1, escape
 
 __all__ = [
     "ascii_crc",
@@ -158,16 +158,49 @@ def silent_while_listening(
     )
 
 
+def late_reply(ex: Exchange) -> str:
+    """What the DUT sent after the tool had stopped listening for a try of ``ex`` and before
+    its next try ('' if nothing): a late reply, R-7.0-10's deviation, not silence. A Pico
+    firmware reads its RTD for 30 ms before it answers ``aM1!``; its '00001' came 32 ms after
+    each try, and "no reply although silence does not comply" was false (docs/kit.md,
+    fifteenth round)."""
+    return decode_7e1([e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT])
+
+
+def late_shown(ex: Exchange) -> str:
+    """``0M1! -> late '00001<CR><LF>'``: the command and the first line of its late reply."""
+    text = late_reply(ex)
+    return f"{escape(ex.text)} -> late '{escape(text[: text.find(chr(10)) + 1] or text)}'"
+
+
 def answered(
-    rid: str, exchanges: Iterable[Exchange], why: str, *, first_attempt: bool = False
+    rid: str,
+    exchanges: Iterable[Exchange],
+    why: str,
+    *,
+    first_attempt: bool = False,
+    late_is_reply: bool = False,
 ) -> Finding:
-    """Each exchange must have drawn a reply (on its first transmission, if asked)."""
+    """Each exchange must have drawn a reply (on its first transmission, if asked). With
+    ``late_is_reply`` (a rule that asks for a reply, not for its timing) an exchange answered
+    only after the reply window is no silence: INCONCLUSIVE where no other is silent."""
     exchanges = list(exchanges)
     missing = [
         ex
         for ex in exchanges
         if not (ex.attempts[0].reply_events if first_attempt else ex.answered)
     ]
+    late = [ex for ex in missing if late_is_reply and late_reply(ex)]
+    missing = [ex for ex in missing if ex not in late]
+    if late and not missing:
+        return inconclusive(
+            rid,
+            f"answered only after the reply window ({why}): "
+            + "; ".join(late_shown(e) for e in late[:5])
+            + " (R-7.0-10 judges its timing; a reply this rule could take was not heard)",
+            evidence=cite(late),
+            observed=len(late),
+        )
     if missing:
         how = "on the first transmission " if first_attempt else ""
         return failed(

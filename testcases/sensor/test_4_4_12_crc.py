@@ -66,7 +66,11 @@ def test_crc_commands_supported(sensor, case):
     exchanges = [sensor.measurement(c).start for c in CRC_CODES]
     exchanges += [sensor.exchange(f"RC{i}") for i in range(10)]
     case.evidence("CRC-variant commands", exchanges)
-    case.add(xjudge.answered("R-4.4.12-01", exchanges, "CRC variants are mandatory from v1.3"))
+    case.add(
+        xjudge.answered(
+            "R-4.4.12-01", exchanges, "CRC variants are mandatory from v1.3", late_is_reply=True
+        )
+    )
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03")

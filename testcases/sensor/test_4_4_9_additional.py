@@ -22,7 +22,7 @@ def test_additional_m_answered(sensor, case):
     case.expect("a reply to each of the 18 commands")
     starts = [m.start for m in sensor.family(MN)]
     case.evidence("aM1..9!, aMC1..9!", starts)
-    case.add(xjudge.answered("R-4.4.9-01", starts, "silence does not comply"))
+    case.add(xjudge.answered("R-4.4.9-01", starts, "silence does not comply", late_is_reply=True))
 
 
 @requirements("R-4.4.10-01")
@@ -32,7 +32,7 @@ def test_additional_c_answered(sensor, case):
     case.expect("a reply to each of the 18 commands")
     starts = [m.start for m in sensor.family(CN)]
     case.evidence("aC1..9!, aCC1..9!", starts)
-    case.add(xjudge.answered("R-4.4.10-01", starts, "silence does not comply"))
+    case.add(xjudge.answered("R-4.4.10-01", starts, "silence does not comply", late_is_reply=True))
 
 
 def _undefined(sensor, codes, rid, expected_tail):
@@ -40,8 +40,21 @@ def _undefined(sensor, codes, rid, expected_tail):
     'a0...0'. Silence is judged here as a SHOULD (and as a MUST by R-4.4.9-01/R-4.4.10-01)."""
     ms = sensor.family(codes)
     zero = [m for m in ms if m.start.answered and m.count == 0]
-    silent = [m for m in ms if not m.start.answered]
+    unheard = [m for m in ms if not m.start.answered]
+    late = [m for m in unheard if xjudge.late_reply(m.start)]  # late, not silent: R-7.0-10's
+    silent = [m for m in unheard if m not in late]
     if not zero and not silent:
+        if late:
+            shown = ", ".join(xjudge.late_shown(m.start) for m in late[:3])
+            return [
+                inconclusive(
+                    rid,
+                    f"answered only after the reply window: {shown}; whether a group is "
+                    "undefined is not told by a reply the tool could not take",
+                    evidence=xjudge.cite(m.start for m in late),
+                    observed=len(late),
+                )
+            ]
         return [xjudge.na(rid, "every numbered group is defined")]
     odd = [m for m in zero if split_line(m.start.reply_text)[0][1:] != expected_tail] + silent
     if odd:

@@ -39,7 +39,9 @@ def test_identify_measurement_answered(sensor, case):
     case.expect("a reply to each of the 43 identify forms")
     exchanges = [identify(sensor, code) for code in DESCRIBED]
     case.evidence("identify-measurement commands", exchanges)
-    case.add(xjudge.answered("R-6.1-01", exchanges, "v1.4 makes them mandatory"))
+    case.add(
+        xjudge.answered("R-6.1-01", exchanges, "v1.4 makes them mandatory", late_is_reply=True)
+    )
 
 
 @requirements("R-6.1-02")

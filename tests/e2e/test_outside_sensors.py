@@ -49,6 +49,13 @@ and sends the command again over a reply still coming; the part before its break
 sensor's invalid reply (R-7.2-01/-03/-05 FAILed "does not end with CR LF"), and a multi-line
 text it broke into as "no multi-line text without ETX was observed". Their tests are the
 recorder judges' (tests/judges/recorder/test_recorder_judges.py, ``Transmission.cut_by``).
+
+The fifteenth: a Raspberry Pi Pico PT100 sensor (PIO UART, on the C kit's UART adapter) reads
+its RTD for 30 ms before it answers ``aM1!``..``aM7!``: its '00001' came 32 ms after each try,
+between the tool's retries. R-4.4.9-01 and R-4.4.12-01 FAILed "no reply although silence does
+not comply" and R-4.4.9-02 WARNed "undefined group answered 0M1! -> '(silence)'": a sensor that
+answered, late (R-7.0-10's FAIL). A reply heard after a try's window and before the next try
+(``exchanges.late_reply``) is no silence for the rules that ask only for a reply.
 """
 
 from __future__ import annotations
@@ -423,3 +430,36 @@ def test_a_blind_sensor_that_ignores_short_pulses_is_not_failed_for_them(
     found = _verdicts(run_once("sim://", keyword=keyword))
     assert found["R-7.0-03"]["verdict"] != "FAIL", found["R-7.0-03"]["findings"]
     assert found["R-7.0-04"]["verdict"] == "FAIL", found["R-7.0-04"]["findings"]
+
+
+@pytest.fixture
+def numbered_groups_answer_late(monkeypatch):
+    """The simulated sensor, every aMn!/aMCn! (n >= 1) start reply 24 ms later than usual,
+    about 33 ms after the command (the Pico firmware's RTD read before its reply)."""
+    from conformance.emulator.sensor import SensorEmulator
+    from conformance.protocol.commands import Kind
+
+    usual = SensorEmulator._send
+
+    def _send(self, reply, at):
+        cmd = reply.command
+        numbered = cmd is not None and cmd.kind is Kind.MEASURE and cmd.group > 0
+        late = reply.kind is ReplyKind.START and numbered
+        return usual(self, reply, at + (24e-3 if late else 0.0))
+
+    monkeypatch.setattr(SensorEmulator, "_send", _send)
+
+
+def test_a_late_reply_to_a_numbered_group_is_not_silence_r_4_4_9_01(numbered_groups_answer_late):
+    found = _verdicts(run_once("sim://"))
+    assert found["R-7.0-10"]["verdict"] == "FAIL"  # the deviation: the reply comes too late
+    for rid in ("R-4.4.9-01", "R-4.4.9-02", "R-4.4.12-01"):
+        assert found[rid]["verdict"] == "INCONCLUSIVE", (rid, found[rid]["findings"])
+        details = " ".join(f["detail"] for f in found[rid]["findings"])
+        assert "answered only after the reply window" in details and "late '0" in details
+
+
+def test_a_numbered_group_never_answered_still_fails_r_4_4_9_01():
+    found = _verdicts(run_once("sim://?faults=undefined-measure-silent"))
+    assert found["R-4.4.9-01"]["verdict"] == "FAIL"
+    assert found["R-4.4.9-02"]["verdict"] == "WARN"
