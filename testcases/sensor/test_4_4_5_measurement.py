@@ -11,6 +11,7 @@ from conformance.judges.support import empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.protocol.responses import is_service_request, split_line
+from conformance.protocol.timing import STANDBY_MARKING
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed, warned
 
@@ -183,6 +184,20 @@ def test_data_retained(sensor, case):
         )
 
 
+def _read_to_values(sensor, target, d0=None) -> list:
+    """``aD0!`` (or the ``d0`` already read; else after standby and a break, as before an
+    abort) and on to the D command that gave ``target`` its first values, while each reads
+    empty: where its groups start at D1, D0 is empty whatever the buffer holds
+    (abort-keeps-old-data beside groups-start-at-d1, seed 4066)."""
+    if d0 is None:
+        sensor.listen(2 * STANDBY_MARKING)  # in standby, as the sensor may be before an abort
+        d0 = sensor.fresh_exchange("D0", crc=target.command.crc, force_break=True)
+    ds = [d0]
+    while len(ds) <= first_filled(target) and ds[-1].answered and empty_data_reply(ds[-1]):
+        ds.append(sensor.fresh_exchange(f"D{len(ds)}", crc=target.command.crc))
+    return ds
+
+
 @pytest.mark.needs("break", "unsolicited")
 @requirements("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03", "R-4.4.5-08")
 @pytest.mark.preconditions("pending", aborted=("R-4.4.5.1-02", "R-4.4.5.1-03"))
@@ -214,16 +229,21 @@ def test_break_aborts_measurement(sensor, case):
     # and on to the D command that gave the measurement its first values: where its groups
     # start at D1, D0 is empty whatever the abort left (abort-keeps-old-data beside
     # groups-start-at-d1 PASSed on D0 alone, seed 4066)
-    ds = [d0]
-    while len(ds) <= first_filled(target) and ds[-1].answered and empty_data_reply(ds[-1]):
-        ds.append(sensor.fresh_exchange(f"D{len(ds)}", crc=target.command.crc))
+    ds = _read_to_values(sensor, target, d0)
     start2 = sensor.fresh_exchange(code)  # abort again, and this time start anew after it
     before2 = sensor.listen(min(0.05, target.ttt / 10))
     brk2 = sensor.master.send_break()
     again = sensor.master.measure(target.command)  # within 87 ms: no second break
+    full = next((d for d in ds if not (d.answered and empty_data_reply(d))), None)
+    # an empty D0 shows the abort emptied the buffer only where the buffer held values up
+    # to it: a sensor that empties it once its pages were read, at the break after that or
+    # in standby gives the same empty D0 whatever the abort does (abort-keeps-old-data
+    # beside buffer-cleared-after-read, -by-break, data-lost-after-standby). So the same
+    # steps without an abort: read to the end, a break, D0 again
+    kept = _read_to_values(sensor, target) if full is None and filled else []
     case.evidence(
         f"{code}, break, wait past ttt, D0; then {code}, break and {code} at once",
-        [start, before, [brk], waited, *ds, start2, before2, [brk2], again],
+        [start, before, [brk], waited, *ds, start2, before2, [brk2], again, *kept],
     )
     # nothing can be aborted that had already finished (issue 18)
     case.requires(
@@ -282,7 +302,6 @@ def test_break_aborts_measurement(sensor, case):
         )
     if not case.requires("aborted", abort):
         return
-    full = next((d for d in ds if not (d.answered and empty_data_reply(d))), None)
     if full is None and not filled:
         case.add(
             inconclusive(
@@ -292,6 +311,18 @@ def test_break_aborts_measurement(sensor, case):
                 + "; ".join(shown(d) for d in ds),
                 decision="A3",
                 observed=len(ds),
+            )
+        )
+    elif full is None and not any(d.answered and not empty_data_reply(d) for d in kept):
+        case.add(
+            inconclusive(
+                "R-4.4.5.1-02",
+                "D0 after the abort holds no values, but the buffer was not shown to hold"
+                f" values up to the abort: after {code}'s values were read to the end, a"
+                " break and D0 gave none either, with no abort: "
+                + "; ".join(shown(d) for d in (*ds, *kept)),
+                decision="A3",
+                observed=len(ds) + len(kept),
             )
         )
     elif full is None:  # its address and CRC are judged by their own rules
