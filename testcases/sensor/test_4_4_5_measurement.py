@@ -11,7 +11,6 @@ from conformance.judges.support import empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.protocol.responses import is_service_request, split_line
-from conformance.protocol.timing import STANDBY_MARKING
 from conformance.transcript import decode_7e1, escape
 from conformance.verdicts import failed, inconclusive, passed, warned
 
@@ -184,20 +183,6 @@ def test_data_retained(sensor, case):
         )
 
 
-def _read_to_values(sensor, target, d0=None) -> list:
-    """``aD0!`` (or the ``d0`` already read; else after standby and a break, as before an
-    abort) and on to the D command that gave ``target`` its first values, while each reads
-    empty: where its groups start at D1, D0 is empty whatever the buffer holds
-    (abort-keeps-old-data beside groups-start-at-d1, seed 4066)."""
-    if d0 is None:
-        sensor.listen(2 * STANDBY_MARKING)  # in standby, as the sensor may be before an abort
-        d0 = sensor.fresh_exchange("D0", crc=target.command.crc, force_break=True)
-    ds = [d0]
-    while len(ds) <= first_filled(target) and ds[-1].answered and empty_data_reply(ds[-1]):
-        ds.append(sensor.fresh_exchange(f"D{len(ds)}", crc=target.command.crc))
-    return ds
-
-
 @pytest.mark.needs("break", "unsolicited")
 @requirements("R-4.4.5.1-01", "R-4.4.5.1-02", "R-4.4.5.1-03", "R-4.4.5-08")
 @pytest.mark.preconditions("pending", aborted=("R-4.4.5.1-02", "R-4.4.5.1-03"))
@@ -229,7 +214,9 @@ def test_break_aborts_measurement(sensor, case):
     # and on to the D command that gave the measurement its first values: where its groups
     # start at D1, D0 is empty whatever the abort left (abort-keeps-old-data beside
     # groups-start-at-d1 PASSed on D0 alone, seed 4066)
-    ds = _read_to_values(sensor, target, d0)
+    ds = [d0]
+    while len(ds) <= first_filled(target) and ds[-1].answered and empty_data_reply(ds[-1]):
+        ds.append(sensor.fresh_exchange(f"D{len(ds)}", crc=target.command.crc))
     start2 = sensor.fresh_exchange(code)  # abort again, and this time start anew after it
     before2 = sensor.listen(min(0.05, target.ttt / 10))
     brk2 = sensor.master.send_break()
@@ -239,8 +226,8 @@ def test_break_aborts_measurement(sensor, case):
     # to it: a sensor that empties it once its pages were read, at the break after that or
     # in standby gives the same empty D0 whatever the abort does (abort-keeps-old-data
     # beside buffer-cleared-after-read, -by-break, data-lost-after-standby). So the same
-    # steps without an abort: read to the end, a break, D0 again
-    kept = _read_to_values(sensor, target) if full is None and filled else []
+    # steps without an abort: read to the end, standby, a break, D0 again
+    kept = sensor.values_after_standby(target) if full is None and filled else []
     case.evidence(
         f"{code}, break, wait past ttt, D0; then {code}, break and {code} at once",
         [start, before, [brk], waited, *ds, start2, before2, [brk2], again, *kept],
@@ -318,8 +305,8 @@ def test_break_aborts_measurement(sensor, case):
             inconclusive(
                 "R-4.4.5.1-02",
                 "D0 after the abort holds no values, but the buffer was not shown to hold"
-                f" values up to the abort: after {code}'s values were read to the end, a"
-                " break and D0 gave none either, with no abort: "
+                f" values up to the abort: after {code}'s values were read to the end,"
+                " standby, a break and D0 gave none either, with no abort: "
                 + "; ".join(shown(d) for d in (*ds, *kept)),
                 decision="A3",
                 observed=len(ds) + len(kept),
