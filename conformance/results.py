@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from .catalog import Requirement, for_role
 from .selection import NOT_SELECTED
 from .transcript import Event
-from .verdicts import Finding, Verdict, worst
+from .verdicts import Finding, Verdict, inconclusive, worst
 
 COMPLIANT = "COMPLIANT"
 NON_COMPLIANT = "NON-COMPLIANT"
@@ -95,6 +95,9 @@ def aggregate(
             findings = [Finding(req.id, Verdict.NA, NOT_SELECTED)]
         elif not findings:
             findings = [Finding(req.id, Verdict.INCONCLUSIVE, "no case judged this requirement")]
+        short = partial_only(req.id, counted(findings))
+        if short is not None:
+            findings = [short, *findings]
         verdict = worst(f.verdict for f in counted(findings))
         judged = not (req.testable(role) and req.id not in by_id)
         selected = judged or req.id not in not_selected
@@ -127,6 +130,26 @@ def counted(findings: list[Finding]) -> list[Finding]:
     does, and the rule stays INCONCLUSIVE."""
     decided = any(decides(f) for f in findings)
     return [f for f in findings if not (decided and unreached(f))]
+
+
+def partial_only(rid: str, findings: list[Finding]) -> Finding | None:
+    """An INCONCLUSIVE for ``rid`` where what its counted ``findings`` PASS is partial PASSes
+    only (one clause of the rule checked, no case judged the whole of it): a PASS there
+    would report the rule held where only a clause was seen to (a ``-k`` run of the
+    exploration alone PASSed R-4.4.5-10 on repeated D0 reads, retention across breaks,
+    standby and commands never tried). None where another finding decides or is worse."""
+    if worst((f.verdict for f in findings), default=Verdict.NA) is not Verdict.PASS:
+        return None
+    if any(decides(f) for f in findings):
+        return None
+    parts = [f for f in findings if f.partial]
+    return inconclusive(
+        rid,
+        "only one clause of the rule was checked ("
+        + "; ".join(f"{f.test or 'a case'}: {f.detail}" for f in parts)
+        + "): no case judged the rest of it",
+        observed=sum(f.observed for f in parts),
+    )
 
 
 def overall(results: list[RequirementResult], *, strict: bool, complete: bool) -> str:

@@ -26,8 +26,13 @@ IDS = ("R-4.0-01", "R-4.3-01", "R-4.2-03", "R-4.4.12-05", "R-4.4.12-06", "R-4.4.
 #: The requirements whose checks here judge one clause of the rule only: a repeated D0
 #: shows repeated reads identical across whatever random steps fell between, not retention
 #: across the breaks, standby and aI!/a!/aRn! the rule names (the retention case sends
-#: those). Their PASS stands beside that case's, never for it (results.counted).
-PARTIAL = frozenset({"R-4.4.5-10"})
+#: those); the framing check reads replies only, never the service requests R-4.2-03 names
+#: ("service requests included"; the whole-run framing judge reads those). Their PASS
+#: stands beside that case's, never for it (results.counted), nor alone
+#: (results.partial_only). R-4.3-01 (a reply's first character is the address) and
+#: R-4.0-01, R-4.4.12-05/-06 (each foreign command, each claimed CRC) are checked whole on
+#: every reply or command they count.
+PARTIAL = frozenset({"R-4.4.5-10", "R-4.2-03"})
 
 #: What an observation checks: silence to a foreign address, the framing and address of a
 #: reply, a claimed CRC, or a D0 repeated with no measurement between.

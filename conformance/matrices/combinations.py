@@ -330,6 +330,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # (seed 4227, with crc-missing) R-4.4.5.1-02 PASSed on an empty D0 after the abort where
     # the measurement before it had delivered no values either: old data kept look the same
     ("abort-keeps-old-data", "d0-empty"),
+    # R-4.4.5.1-02 PASSed on an empty D0 after the abort where the break after the last full
+    # read had emptied the buffer (declared masked): the same steps without an abort are read
+    ("abort-keeps-old-data", "buffer-cleared-by-break"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -15,6 +15,7 @@ from typing import Any, Generic, TypeVar
 
 from ..declaration import Declaration
 from ..dut import DutClaim, Session, sensor_claim
+from ..judges.support import empty_data_reply, first_filled
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
 from ..preconditions import Unmet, acknowledges
@@ -490,6 +491,22 @@ class SensorSession(Session):
         the case before them left in it."""
         if self.measurement(code).value_count and not self.master.buffer_holds_values(self.address):
             self.fresh_measurement(code)
+
+    def values_after_standby(self, m: Measurement) -> list[Exchange]:
+        """With ``m``'s values read to their end: standby, a break, then ``aD0!`` and on to
+        the D command that gave ``m`` its first values (:func:`first_filled`) while each
+        reads empty. The steps that come before an abort without the abort: an empty D0 after
+        an abort shows the abort emptied the buffer only where these leave values in it (a
+        sensor that empties it once read, at the next break or in standby gives the same
+        empty D0 whatever the abort does: abort-keeps-old-data beside buffer-cleared-after-
+        read, -by-break, data-lost-after-standby PASSed R-4.4.5.1-02)."""
+        self.to_standby()
+        # the D replies of whatever measurement the buffer holds: with or without a CRC as
+        # the engine's last measurement at this address had it, not as ``m`` has it
+        ds = [self.fresh_exchange("D0", force_break=True)]
+        while len(ds) <= first_filled(m) and ds[-1].answered and empty_data_reply(ds[-1]):
+            ds.append(self.fresh_exchange(f"D{len(ds)}"))
+        return ds
 
     def feature(self, name: str) -> bool | None:
         return self.declaration.feature(name)

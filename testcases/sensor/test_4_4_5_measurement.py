@@ -221,9 +221,16 @@ def test_break_aborts_measurement(sensor, case):
     before2 = sensor.listen(min(0.05, target.ttt / 10))
     brk2 = sensor.master.send_break()
     again = sensor.master.measure(target.command)  # within 87 ms: no second break
+    full = next((d for d in ds if not (d.answered and empty_data_reply(d))), None)
+    # an empty D0 shows the abort emptied the buffer only where the buffer held values up
+    # to it: a sensor that empties it once its pages were read, at the break after that or
+    # in standby gives the same empty D0 whatever the abort does (abort-keeps-old-data
+    # beside buffer-cleared-after-read, -by-break, data-lost-after-standby). So the same
+    # steps without an abort: read to the end, standby, a break, D0 again
+    kept = sensor.values_after_standby(target) if full is None and filled else []
     case.evidence(
         f"{code}, break, wait past ttt, D0; then {code}, break and {code} at once",
-        [start, before, [brk], waited, *ds, start2, before2, [brk2], again],
+        [start, before, [brk], waited, *ds, start2, before2, [brk2], again, *kept],
     )
     # nothing can be aborted that had already finished (issue 18)
     case.requires(
@@ -282,7 +289,6 @@ def test_break_aborts_measurement(sensor, case):
         )
     if not case.requires("aborted", abort):
         return
-    full = next((d for d in ds if not (d.answered and empty_data_reply(d))), None)
     if full is None and not filled:
         case.add(
             inconclusive(
@@ -292,6 +298,18 @@ def test_break_aborts_measurement(sensor, case):
                 + "; ".join(shown(d) for d in ds),
                 decision="A3",
                 observed=len(ds),
+            )
+        )
+    elif full is None and not any(d.answered and not empty_data_reply(d) for d in kept):
+        case.add(
+            inconclusive(
+                "R-4.4.5.1-02",
+                "D0 after the abort holds no values, but the buffer was not shown to hold"
+                f" values up to the abort: after {code}'s values were read to the end,"
+                " standby, a break and D0 gave none either, with no abort: "
+                + "; ".join(shown(d) for d in (*ds, *kept)),
+                decision="A3",
+                observed=len(ds) + len(kept),
             )
         )
     elif full is None:  # its address and CRC are judged by their own rules

@@ -42,3 +42,12 @@ def test_a_held_repeat_is_a_partial_pass_the_other_rules_whole_ones():
     found = {f.requirement: f for f in held_findings([kept, framed], 10)}
     assert found["R-4.4.5-10"].verdict is Verdict.PASS and found["R-4.4.5-10"].partial
     assert found["R-4.3-01"].verdict is Verdict.PASS and not found["R-4.3-01"].partial
+
+
+def test_r_4_2_03_framing_of_replies_is_a_partial_pass():
+    """The exploration reads replies only; R-4.2-03 names service requests too, so its
+    framing PASS is partial (a -k run of it alone: INCONCLUSIVE), R-4.3-01's whole."""
+    framed = Observation("framing", "0I!", "013TEST\r\n", "0")
+    found = {f.requirement: f for f in held_findings([framed], 10)}
+    assert found["R-4.2-03"].verdict is Verdict.PASS and found["R-4.2-03"].partial
+    assert not found["R-4.3-01"].partial

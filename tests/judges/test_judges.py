@@ -222,6 +222,21 @@ def test_a_partial_pass_does_not_outvote_the_case_built_for_the_whole_rule(
     assert results[rid].verdict is expected
 
 
+@pytest.mark.parametrize("beside", [None, Verdict.NA])
+def test_r_4_4_5_10_a_partial_pass_alone_does_not_pass_the_rule(beside):
+    """A run of the exploration alone (-k, --req) checks one clause of R-4.4.5-10:
+    INCONCLUSIVE, naming the clause it checked, never a PASS of the rule."""
+    rid = "R-4.4.5-10"
+    findings = [Finding(rid, Verdict.PASS, "held over 3 checks", observed=3, partial=True)]
+    if beside is not None:
+        findings.append(Finding(rid, beside, "not supported"))
+    records = [CaseRecord("t::e", "e", (rid,), findings=findings)]
+    results = {r.requirement.id: r for r in aggregate("sensor", records)}
+    assert results[rid].verdict is Verdict.INCONCLUSIVE
+    assert "held over 3 checks" in results[rid].one_line
+    assert "no case judged the rest" in results[rid].one_line
+
+
 def test_a_whole_rules_pass_still_outvotes_an_unreached_case():
     rid = "R-4.4.5-10"
     findings = [

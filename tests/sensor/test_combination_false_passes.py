@@ -87,7 +87,11 @@ not-multiple, seed 4216): read as a multiple of 256 it is a multiple of every ty
 while the CRC checked over 9 bytes of INT16 between header and CRC; those bytes are judged now,
 and a packet neither its size nor its CRC bounds leaves the rule undecided.
 R-4.4.5.1-02 PASSed on an empty D0 after the abort where the buffer held no values before it
-(abort-keeps-old-data + d0-empty, seed 4227 with crc-missing): INCONCLUSIVE there.
+(abort-keeps-old-data + d0-empty, seed 4227 with crc-missing): INCONCLUSIVE there. And where
+the buffer was emptied before the abort by a read to its end, the break after it or standby
+(abort-keeps-old-data + buffer-cleared-after-read, -by-break, data-lost-after-standby, declared
+masked until now): the case reads D0 again after the same steps without an abort, and an empty
+D0 there leaves the rule INCONCLUSIVE. R-4.4.7.1-02 the same after aI! aborted aC!.
 """
 
 from __future__ import annotations
@@ -100,6 +104,9 @@ from testcases.sensor.test_4_4_5_measurement import test_break_aborts_measuremen
 from testcases.sensor.test_4_4_5_measurement import test_data_retained as retained_case
 from testcases.sensor.test_4_4_5_measurement import test_measurement_reply as reply_case
 from testcases.sensor.test_4_4_7_concurrent import test_concurrent_supported as concurrent_case
+from testcases.sensor.test_4_4_7_concurrent import (
+    test_own_command_aborts_concurrent as concurrent_abort_case,
+)
 from testcases.sensor.test_4_4_8_data import test_announced_values_delivered as count_case
 from testcases.sensor.test_4_4_8_data import test_data_replies as data_case
 from testcases.sensor.test_4_4_8_data import (
@@ -613,3 +620,45 @@ def test_payload_length_where_the_size_field_is_unreadable(faults, expected):
 )
 def test_an_empty_d0_after_an_abort_needs_values_before_it(faults, expected):
     assert case_verdict(sim_session(faults), abort_case, "R-4.4.5.1-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,buffer-cleared-after-read", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data,buffer-cleared-by-break", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data,data-lost-after-standby", Verdict.INCONCLUSIVE),
+        ("buffer-cleared-after-read", Verdict.INCONCLUSIVE),
+        ("buffer-cleared-by-break", Verdict.INCONCLUSIVE),
+        ("data-lost-after-standby", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data", Verdict.WARN),
+        ("abort-keeps-old-data,groups-start-at-d1", Verdict.WARN),
+        ("groups-start-at-d1", Verdict.PASS),
+        ("", Verdict.PASS),
+    ],
+)
+def test_r_4_4_5_1_02_an_empty_d0_after_an_abort_needs_a_buffer_that_kept_values(faults, expected):
+    """The same steps without an abort (values read to the end, standby, a break, D0) must
+    leave values in D0 before an empty D0 after the abort shows the abort emptied it."""
+    assert case_verdict(sim_session(faults), abort_case, "R-4.4.5.1-02") is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,buffer-cleared-after-read", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data,buffer-cleared-by-break", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data,data-lost-after-standby", Verdict.INCONCLUSIVE),
+        ("buffer-cleared-after-read", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data", Verdict.WARN),
+        ("concurrent-not-aborted", Verdict.WARN),
+        ("", Verdict.PASS),
+    ],
+)
+def test_r_4_4_7_1_02_an_empty_d0_after_a_concurrent_abort_needs_a_buffer_that_kept_values(
+    faults, expected
+):
+    """As R-4.4.5.1-02: aC! undisturbed, read to the end, standby, a break and D0 must show
+    values before an empty D0 after aI! aborted aC! shows the abort emptied the buffer."""
+    verdict = case_verdict(sim_session(faults), concurrent_abort_case, "R-4.4.7.1-02")
+    assert verdict is expected

@@ -180,19 +180,21 @@ DATA_BUFFER: tuple[Fault, ...] = (
         "buffer-cleared-by-break",
         "Once all D pages were read, the next break empties the data buffer."
         " Data that do not survive a plain re-read leave nothing for the identify commands"
-        " to disturb (R-6.1-03).",
+        " to disturb (R-6.1-03), nor an empty D0 after an abort to show the abort emptied"
+        " them (R-4.4.5.1-02, R-4.4.7.1-02).",
         ("R-4.4.5-10",),
         settings={"clear_on_break_after_read": True},
-        inconclusive=("R-6.1-03",),
+        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02"),
     ),
     Fault(
         "buffer-cleared-after-read",
         "Once all D pages were read, the buffer is empty (repeated D returns nothing)."
         " Data that do not survive a plain re-read leave nothing for the identify commands"
-        " to disturb (R-6.1-03).",
+        " to disturb (R-6.1-03), nor an empty D0 after an abort to show the abort emptied"
+        " them (R-4.4.5.1-02, R-4.4.7.1-02).",
         ("R-4.4.5-10",),
         settings={"clear_after_read": True},
-        inconclusive=("R-6.1-03",),
+        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02"),
     ),
     Fault(
         "data-changes-on-repeat",
@@ -207,10 +209,11 @@ DATA_BUFFER: tuple[Fault, ...] = (
         "data-lost-after-standby",
         "Once all D pages were read, entering standby empties the data buffer."
         " Data that do not survive a plain re-read leave nothing for the identify commands"
-        " to disturb (R-6.1-03).",
+        " to disturb (R-6.1-03), nor an empty D0 after an abort to show the abort emptied"
+        " them (R-4.4.5.1-02, R-4.4.7.1-02).",
         ("R-4.4.5-10",),
         settings={"clear_on_standby_after_read": True},
-        inconclusive=("R-6.1-03",),
+        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02"),
     ),
     Fault(
         "identify-clears-buffer",
