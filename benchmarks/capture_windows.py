@@ -11,7 +11,8 @@ bus's and each sensor's alone: every exchange's attempts and every measurement's
 be the whole run's), and the windows cut as the events come (``stream_windows``: the same
 events in the same windows). Prints the windows, the largest, and the CPU of the whole cut
 and of the streamed one; exits 1 on any difference. The same checks as
-``tests/view/test_windows.py``, on a recording too long for a test.
+``tests/view/test_windows.py`` (the fields compared are ``tests/support/records_alike.py``'s),
+on a recording too long for a test.
 """
 
 from __future__ import annotations
@@ -19,12 +20,11 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from typing import Any
+from pathlib import Path
 
 from conformance.capture import decode_capture
-from conformance.tool_recorder.records import Exchange, Measurement
-from conformance.view.rebuilt_records import Rebuilt, rebuild_records
-from conformance.view.segments import TranscriptView, read_view
+from conformance.view.rebuilt_records import rebuild_records
+from conformance.view.segments import read_view
 from conformance.view.windows import (
     rebuild_windowed,
     stream_windows,
@@ -32,48 +32,8 @@ from conformance.view.windows import (
     window_starts,
 )
 
-
-def _exchange(x: Exchange) -> tuple[Any, ...]:
-    return (
-        x.text,
-        x.command,
-        x.binary,
-        [
-            (a.break_event, a.command_events, a.reply_events, a.reason, a.end, a.sequence)
-            + (a.retry, a.stray_events)
-            for a in x.attempts
-        ],
-    )
-
-
-def _measurement(m: Measurement) -> tuple[Any, ...]:
-    return (
-        _exchange(m.start), m.ttt, m.count, m.reply_end, m.service_request_end,
-        m.waited_events, [_exchange(d) for d in m.data], m.values, m.packets,
-    )  # fmt: skip
-
-
-def records(rebuilt: list[Rebuilt]) -> tuple[list[Any], list[Any]]:
-    """Every exchange and measurement of ``rebuilt``, field by field, in order."""
-    return (
-        [_exchange(x) for r in rebuilt for x in r.exchanges],
-        [_measurement(m) for r in rebuilt for m in r.measurements],
-    )
-
-
-def same_view(whole: TranscriptView, parts: list[TranscriptView]) -> list[str]:
-    """What of ``parts`` (read alone, in order) is not ``whole`` (empty: nothing)."""
-
-    def shape(t: Any) -> tuple[Any, ...]:
-        return (t.break_event, t.chars, t.heard, t.cut, t.text)
-
-    wrong = []
-    if [shape(t) for p in parts for t in p.transmissions] != list(map(shape, whole.transmissions)):
-        wrong.append("transmissions")
-    for name in ("breaks", "chars", "unanswerable", "undirected"):
-        if [e for p in parts for e in getattr(p, name)] != getattr(whole, name):
-            wrong.append(name)
-    return wrong
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the tree's tests.support
+from tests.support.records_alike import records_fields, view_differences  # noqa: E402
 
 
 def check(path: str) -> bool:
@@ -84,10 +44,13 @@ def check(path: str) -> bool:
     starts = window_starts(whole, rebuild_records(whole, uncertainty=u))
     windows = list(window_events(events, whole, starts))
     whole_cpu = time.process_time() - cpu
-    wrong = same_view(whole, [read_view(w) for w in windows])
+    wrong = view_differences(whole, [read_view(w) for w in windows])
     for only in (None, *sorted({t.text[:1] for t in whole.transmissions})):
-        expected = records([rebuild_records(whole, uncertainty=u, only=only)])
-        if records(list(rebuild_windowed(events, whole, uncertainty=u, only=only))) != expected:
+        expected = records_fields([rebuild_records(whole, uncertainty=u, only=only)])
+        if (
+            records_fields(list(rebuild_windowed(events, whole, uncertainty=u, only=only)))
+            != expected
+        ):
             wrong.append(f"records of {only or 'the bus'}")
     cpu = time.process_time()
     streamed = list(stream_windows(iter(events), uncertainty=u))

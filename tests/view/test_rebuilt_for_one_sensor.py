@@ -13,7 +13,6 @@ from conformance import emulator
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import CHAR_TIME
 from conformance.tool_recorder import ToolRecorder
-from conformance.tool_recorder.records import Exchange, Measurement
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.view.rebuilt_records import Rebuilt, rebuild_records, rebuilt_exchanges
 from conformance.view.segments import TranscriptView, read_view
@@ -24,46 +23,21 @@ from tests.support.bus_of_sensors import (
     concurrent_round,
     measured_past_another,
 )
-
-
-def _exchange(x: Exchange) -> tuple:
-    return (
-        x.text,
-        x.command,
-        x.binary,
-        [
-            (a.break_event, a.command_events, a.reply_events, a.reason, a.end, a.sequence)
-            + (a.retry, a.stray_events)
-            for a in x.attempts
-        ],
-    )
-
-
-def _measurement(m: Measurement) -> tuple:
-    return (
-        _exchange(m.start),
-        m.ttt,
-        m.count,
-        m.reply_end,
-        m.service_request_end,
-        m.waited_events,
-        [_exchange(d) for d in m.data],
-        m.values,
-        m.packets,
-        m.binary_value_count,
-    )
+from tests.support.records_alike import exchange_fields, measurement_fields
 
 
 def _share(whole: Rebuilt, address: str) -> tuple[list, list]:
     return (
-        [_exchange(x) for x in whole.exchanges if x.text[:1] == address],
-        [_measurement(m) for m in whole.measurements if m.command.address == address],
+        [exchange_fields(x) for x in whole.exchanges if x.text[:1] == address],
+        [measurement_fields(m) for m in whole.measurements if m.command.address == address],
     )
 
 
 def _alone(view: TranscriptView, address: str) -> tuple[list, list]:
     mine = rebuild_records(view, only=address)
-    return [_exchange(x) for x in mine.exchanges], [_measurement(m) for m in mine.measurements]
+    return [exchange_fields(x) for x in mine.exchanges], [
+        measurement_fields(m) for m in mine.measurements
+    ]
 
 
 def _each_sensor_alike(view: TranscriptView) -> Rebuilt:
@@ -125,7 +99,7 @@ def _wire(exchanges: list[tuple[str, str]]) -> list[Event]:
     return events
 
 
-def test_a_sensors_unanswered_command_again_after_anothers_is_a_new_exchange():
+def test_a_sensors_unanswered_command_again_after_anothers_is_a_newexchange_fields():
     """1I! unanswered, 0I! answered, 1I! again: the whole run's records make the second 1I!
     an exchange of its own (the one before it was sensor 0's), not a retry of the first;
     sensor 1's records alone must not join them because 0I! is left out."""
@@ -145,7 +119,9 @@ def test_the_exchanges_one_at_a_time_are_the_whole_runs():
     wire = _wire([("1I!", ""), ("1I!", ""), ("0I!", "014TESTCO  SENSOR001\r\n"), ("1I!", "")])
     for view in (read_view(wire), _concurrent_bus_view()):
         whole = rebuild_records(view).exchanges
-        assert [_exchange(x) for x in rebuilt_exchanges(view)] == [_exchange(x) for x in whole]
+        assert [exchange_fields(x) for x in rebuilt_exchanges(view)] == [
+            exchange_fields(x) for x in whole
+        ]
     seen = [len(x.attempts) for x in rebuilt_exchanges(read_view(wire))]
     assert seen == [2, 1, 1]
 

@@ -16,8 +16,8 @@ from dataclasses import replace
 import pytest
 
 from conformance.transcript import EventKind
-from conformance.view.rebuilt_records import Rebuilt, rebuild_records
-from conformance.view.segments import TranscriptView, read_view
+from conformance.view.rebuilt_records import rebuild_records
+from conformance.view.segments import read_view
 from conformance.view.windows import (
     rebuild_windowed,
     stream_windows,
@@ -32,28 +32,9 @@ from tests.support.bus_of_sensors import (
     measured_past_another,
     start,
 )
-from tests.view.test_rebuilt_for_one_sensor import _exchange, _measurement
+from tests.support.records_alike import records_fields, view_differences
 
 IDLE = 30.0  # s of silence: far past the standby time (100 ms), as a field logger idles
-
-
-def _transmission(t) -> tuple:
-    return (t.break_event, t.chars, t.heard, t.cut, t.text)
-
-
-def _same_view(whole: TranscriptView, parts: list[TranscriptView]) -> None:
-    assert [_transmission(t) for p in parts for t in p.transmissions] == [
-        _transmission(t) for t in whole.transmissions
-    ]
-    for name in ("breaks", "chars", "unanswerable", "undirected"):
-        assert [e for p in parts for e in getattr(p, name)] == getattr(whole, name), name
-
-
-def _records(rebuilt: list[Rebuilt]) -> tuple[list, list]:
-    return (
-        [_exchange(x) for r in rebuilt for x in r.exchanges],
-        [_measurement(m) for r in rebuilt for m in r.measurements],
-    )
 
 
 def _check(events: list, *, min_windows: int = 2) -> list[int]:
@@ -67,11 +48,11 @@ def _check(events: list, *, min_windows: int = 2) -> list[int]:
     assert [e for w in windows for e in w] == sorted(events, key=lambda e: e.start)
     streamed = list(stream_windows(iter(sorted(events, key=lambda e: e.start))))
     assert [list(map(id, w)) for w in streamed] == [list(map(id, w)) for w in windows]
-    _same_view(whole, [read_view(w) for w in windows])
+    assert view_differences(whole, [read_view(w) for w in windows]) == []
     for only in (None, *ADDRESSES):
         expected = rebuild_records(whole, only=only)
-        got = _records(list(rebuild_windowed(events, whole, only=only)))
-        assert got == _records([expected]), only
+        got = records_fields(list(rebuild_windowed(events, whole, only=only)))
+        assert got == records_fields([expected]), only
     return starts
 
 
@@ -121,7 +102,7 @@ def test_a_concurrent_measurement_pending_across_an_idle_gap_is_never_cut():
     whole = rebuild_records(view)
     assert [m.value_count for m in whole.measurements] == [whole.measurements[0].count]
     assert [m.data for p in parts for m in p.measurements] == [[]]
-    assert _records(parts) != _records([whole])
+    assert records_fields(parts) != records_fields([whole])
 
 
 def test_an_m_measurement_ended_by_another_sensor_is_cut_there():
@@ -159,7 +140,7 @@ def test_a_crc_expectation_is_carried_across_the_cut():
     assert not whole.exchanges[-1].ok  # the CRC asked for by 0MC! is missing
     uncarried = [rebuild_records(read_view(w)) for w in window_events(events, view, starts)]
     assert uncarried[-1].exchanges[-1].ok  # no expectation: taken as a plain reply
-    assert _records(uncarried) != _records([whole])
+    assert records_fields(uncarried) != records_fields([whole])
 
 
 def test_a_retry_never_starts_a_window():
