@@ -13,7 +13,7 @@ import pytest
 
 from conformance.conduct import run_into
 from conformance.harness import protocol as proto
-from tests.kit.conftest import LOGGER, LOGGER_DECLARATION, SENSOR, TINY_SDI12
+from tests.kit.conftest import LOGGER, LOGGER_DECLARATION, SENSOR, SKETCHES, TINY_SDI12
 
 DECLARATION = str(SENSOR / "sdi12_sensor.toml")
 #: cases with waits of ttt seconds the sketch polls through, service requests, a measurement
@@ -61,3 +61,26 @@ def test_the_logger_sketch_makes_the_same_line_batched_or_not(kit_build, tmp_pat
     options = {"declaration": LOGGER_DECLARATION, "role": "recorder"}
     options["keyword"] = "service_request or crc_mismatch or transparent"
     both_ways(port, options, tmp_path, monkeypatch)
+
+
+def test_a_sketch_spinning_after_its_reply_hears_the_follow_up_batched_or_not(
+    kit_build, tmp_path, monkeypatch
+):
+    """Sixteenth round (docs/kit.md): a sensor that spins on its receive queue after a reply
+    of back-to-back frames ran on to the QUIET the tool told for the reply's first frame,
+    which the tool shortened once it heard the LF; the follow-up it then sent 20 ms after the
+    reply (R-7.0-16), and the break and command after it, came in the sketch's past and went
+    unheard: R-7.0-16 FAILed and, on the lagopus sketch, R-4.3-04 PASSed "refused '$'" on a
+    command never heard. A ``sent`` QUIET is now dropped when the sketch has begun another
+    frame since, so the line is the same batched or not."""
+    port = f"exec:{kit_build(SKETCHES / 'spin_sensor', (TINY_SDI12,))}"
+    options = {"address": "0", "keyword": "test_follow_up_without_break"}
+    batched = run_into(tmp_path / "batched", port, **options)
+    monkeypatch.setattr(proto, "BATCH", "not-offered")
+    plain = run_into(tmp_path / "plain", port, **options)
+    events = line_events(tmp_path / "batched")
+    assert len(events) > 20
+    assert batched["summary"] == plain["summary"]
+    assert events == line_events(tmp_path / "plain")
+    verdicts = {r["id"]: r["verdict"] for r in batched["requirements"]}
+    assert verdicts["R-7.0-16"] == "PASS", verdicts

@@ -571,7 +571,14 @@ int main(void) {
                 fprintf(stderr, "sdi12-kit: the frame planned at %lld us went out at %lld us "
                         "(the line was busy)\n", out.front().start, a);
             out.pop_front();
-            if (sscanf(line, "%*s %*lld %*lld %*x %lld", &c) == 1) quiet = c; /* sent S E XX QUIET */
+            /* sent S E XX QUIET: the tool's promise knows the line up to this frame. A frame
+             * the sketch began since (back to back: it was composed before this answer came)
+             * voids it, as the sketch's own transmission does (begin_frame): the tool may
+             * answer that frame sooner, and a sketch run on to the old QUIET would hear the
+             * tool's break and command in its past (an EnviroDIY-based sensor spinning on
+             * read() after its reply missed the tool's 20 ms follow-up, sixteenth round) */
+            if (sscanf(line, "%*s %*lld %*lld %*x %lld", &c) == 1 && out.empty() && !composing)
+                quiet = c;
             now = b;
         } else if (strcmp(word, "time") == 0 && sscanf(line, "%*s %lld", &a) == 1) {
             now = a;
