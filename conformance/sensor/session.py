@@ -200,9 +200,9 @@ class SensorSession(Session):
                 self.assumptions.append("no answer to ?!; assuming address '0'")
         ex = self.master.identify(self.address)
         self.ident_exchange = ex
-        if not ex.answered:
+        if not self._answered_here(ex):
             ack = self.master.acknowledge(self.address)
-            if not ack.answered and self._find_a_way_in():
+            if not self._answered_here(ack) and self._find_a_way_in():
                 ex = self.master.identify(self.address)  # the break that woke it, again
                 self.ident_exchange = ex
         body, _ = split_line(ex.reply_text)
@@ -224,7 +224,7 @@ class SensorSession(Session):
         usual = self.master.policy
         for duration in LONGER_BREAKS:
             with self._policy_for_now(break_duration=duration):
-                answered = self.master.acknowledge(self.address).answered
+                answered = self._answered_here(self.master.acknowledge(self.address))
             if answered:
                 self.master.policy = usual.but(break_duration=duration)  # kept from here
                 self.assumptions.append(
@@ -270,6 +270,18 @@ class SensorSession(Session):
                 raise NoDeviceAnswered(
                     f"{unanswered}; ?! went unanswered, a! was answered at {where}): {pick}"
                 )
+        if (
+            query.answered
+            and len(body) == 1
+            and body in ADDRESS_CHARS
+            and not self.requested_address
+        ):
+            self.assumptions.append(
+                f"no answer at the assumed address {self.address!r} (the first ?! went "
+                f"unanswered); ?! asked again was answered '{body}': the device is judged there"
+            )
+            self.address = body
+            return True
         if query.answered and len(body) == 1 and body in ADDRESS_CHARS:
             # The device is there, at another address: "check its reply format" (what it
             # said was a well-formed ?! reply) or the wiring would send the user astray.
@@ -283,6 +295,17 @@ class SensorSession(Session):
             f"{unanswered}{other})"
             + (talked or ". Check wiring and power, or try ?! with one sensor on the bus.")
         )
+
+    def _answered_here(self, ex: Exchange) -> bool:
+        """Whether ``a!`` or ``aI!`` at the address in use was answered by a device there: any
+        reply counts (a malformed one is that device's to be judged on) but a bare other
+        address. '5<CR><LF>' to '0!' is no sensor at '0': a sensor at '5', deaf to the first
+        ``?!`` while it booted, answered it late from its buffer (the sixteenth round's
+        lagopus sketch), and a run judged at '0' FAILed a!, aI! and every command on the
+        silence of a sensor that is not there; ``_find_a_way_in`` asks ``?!`` again."""
+        body, _ = split_line(ex.reply_text)
+        named = len(body) == 1 and body in ADDRESS_CHARS and body != self.address
+        return ex.answered and not named
 
     def _answering_addresses(self) -> list[str]:
         """Every other address that answers ``a!`` once (no retries: about 80 ms an address on

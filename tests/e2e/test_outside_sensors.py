@@ -56,6 +56,15 @@ between the tool's retries. R-4.4.9-01 and R-4.4.12-01 FAILed "no reply although
 not comply" and R-4.4.9-02 WARNed "undefined group answered 0M1! -> '(silence)'": a sensor that
 answered, late (R-7.0-10's FAIL). A reply heard after a try's window and before the next try
 (``exchanges.late_reply``) is no silence for the rules that ask only for a reply.
+
+The sixteenth: a sensor sketch on EnviroDIY's library (spectraphilic/wsn_arduino's lagopus, at
+address '5') listens from 0.5 s after power-up but reads its buffer only from 1.5 s, after
+its sensors' set-up: the tool's ?!s went unanswered, it assumed '0', and the sketch's late
+answers to the buffered ?!s, '5<CR><LF>' twice, came 1.5 ms after the tool's '0!'. The tool
+took that for a! answered at '0' and judged the sensor there: a!, aI! and every command
+FAILed on the silence of a sensor at '5'. A reply to a! that is a bare other address is no
+device at the assumed address now; ?! is asked again and its answer taken
+(``SensorSession._acknowledged``).
 """
 
 from __future__ import annotations
@@ -463,3 +472,59 @@ def test_a_numbered_group_never_answered_still_fails_r_4_4_9_01():
     found = _verdicts(run_once("sim://?faults=undefined-measure-silent"))
     assert found["R-4.4.9-01"]["verdict"] == "FAIL"
     assert found["R-4.4.9-02"]["verdict"] == "WARN"
+
+
+#: The sixteenth round's sketch hears the line from 0.5 s after power-up (setup()'s
+#: delay(500), then forceListen()) and reads what it kept from 1.5 s (a 1 s heater pulse).
+LISTENS = 0.5
+
+
+def boots_late(monkeypatch, reads_from: float) -> None:
+    """The simulated sensor (at '1': factory-address-not-zero) deaf until ``reads_from``,
+    keeping what it heard from LISTENS on; the first command it hears after that is
+    followed, 1.5 ms after its '!', by its answers to the ?!s it kept (the lagopus sketch's
+    '5<CR><LF>' twice after the tool's 0!)."""
+    from conformance.emulator.replies import Reply
+    from conformance.emulator.sensor import SensorEmulator
+
+    on_char = SensorEmulator.on_char
+
+    def hear(self, wire, start, end):
+        kept = getattr(self, "_kept_at_boot", None)
+        if kept is None:
+            kept = self._kept_at_boot = []
+        if start < reads_from:
+            if start >= LISTENS:
+                kept.append(chr(wire & 0x7F))
+            return
+        on_char(self, wire, start, end)
+        queries = "".join(kept).count("?!")
+        if queries and chr(wire & 0x7F) == "!":
+            kept.clear()
+            for n in range(queries):
+                self._send(Reply(ReplyKind.ADDRESS, self.address), end + 1.5e-3 + n * 33e-3)
+
+    monkeypatch.setattr(SensorEmulator, "on_char", hear)
+
+
+@pytest.mark.parametrize(
+    "reads_from",
+    [1.45, 1.2],
+    ids=[
+        "answers-after-a",
+        "answers-after-aI",
+    ],  # the tool's probes then: 0! at 1.49 s, 0I! at 1.21 s
+)
+def test_a_late_answer_naming_another_address_is_no_sensor_at_the_assumed_one(
+    monkeypatch, reads_from
+):
+    boots_late(monkeypatch, reads_from)
+    data = run_once(
+        "sim://?faults=factory-address-not-zero",
+        keyword="test_acknowledge_active or test_identification",
+    )
+    found = _verdicts(data)
+    for rid in ("R-4.4.1-01", "R-4.4.2-01"):
+        assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])
+    said = " ".join(data["dut"]["assumptions"])
+    assert "?! asked again was answered '1': the device is judged there" in said, said
