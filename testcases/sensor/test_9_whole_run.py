@@ -81,7 +81,7 @@ def test_reply_framing(sensor, case):
         case.add(wire.judge_reply_bit_rate(segs, sensor.stamp_uncertainty))
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
-    case.extend(wire.judge_framing(segs, sensor.stamp_uncertainty))
+    case.extend(wire.judge_framing(segs, sensor.stamp_uncertainty, own=sensor.address))
     # replies are judged against the address the sensor answered at (cached: no new traffic)
     ack = sensor.exchange("")
     case.requires("address", precondition.answers_at(ack, sensor.address, "a! at it got no reply"))

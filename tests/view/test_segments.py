@@ -285,3 +285,31 @@ def test_a_service_request_after_a_reply_for_another_address(line, expected):
     against 'z', the last reply's address: FAIL x3. A line sent unasked may carry the address
     of the measurement it belongs to, the last one started; any other address still FAILs."""
     assert _framing_after_foreign_identify(line) is expected
+
+
+def _framing_of(exchanges: list[tuple[str, str]], own: str | None) -> Verdict:
+    """R-4.3-01 over commands and their replies, 100 ms apart, judged with ``own``."""
+    events, at = [], 0.0
+    for command, reply in exchanges:
+        sent = _chars(TOOL, command, at)
+        heard = _chars(DUT, reply, sent[-1].end + 1.5e-3)
+        events += sent + heard
+        at = heard[-1].end + 0.1
+    return _verdicts(wire.judge_framing(wire.segments(events), 0.0, own=own))["R-4.3-01"].verdict
+
+
+def test_a_reply_with_the_sensors_own_address_after_another_address_is_its_address_first():
+    """Sixteenth round: the lagopus sketch at '5' answered, 1.5 ms after the tool's '0!'
+    (sent while the tool still assumed '0'), the ?!s it had kept while booting: '5<CR><LF>'
+    has the responding sensor's address first. Judged without the sensor's address the
+    reply is read against the command's, as before."""
+    late = [("0!", "5\r\n"), ("5I!", "514UOSLOGEOLAGOPU000\r\n")]
+    assert _framing_of(late, own="5") is Verdict.PASS
+    assert _framing_of(late, own=None) is Verdict.FAIL
+
+
+def test_a_sensor_shown_at_an_address_is_judged_there_not_at_its_own():
+    """Once a reply began with its command's address ('9!' answered '9'), that address is the
+    sensor's: '9!' answered with its first address '0' still FAILs R-4.3-01."""
+    moved = [("9!", "9\r\n"), ("9!", "0\r\n")]
+    assert _framing_of(moved, own="0") is Verdict.FAIL
