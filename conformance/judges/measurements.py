@@ -498,12 +498,16 @@ def _reply_ids(m: Measurement) -> list[str]:
         counted = ["R-4.4.5-02"] if m.count is not None else []
         return ["R-4.4.5-01", *counted, "R-4.2-02", "R-4.2-03"]
     if kind is Kind.CONCURRENT:
+        # R-4.4.7-02 (aC! measures for real) is about plain aC!/aCC! only: an aCn! reply
+        # cannot break it, so it is no check of it (the lagopus sketch, silent to aC! and
+        # aCC!, PASSed it "conforms (2 checked: 5C5!, 5CC5!)" on its a! answer to each)
+        plain = ["R-4.4.7-02"] if m.command.group == 0 else []
         if not m.count:
             # no count to bound (R-4.4.7-03); a00000 to plain aC!/aCC! is no answer of the
             # kind (R-4.4.7-02 judges it), so its format stands for nothing either
             plain_zero = m.count == 0 and m.command.group == 0
-            return [*([] if plain_zero else ["R-4.4.7-01"]), "R-4.4.7-02", "R-4.2-02", "R-4.2-03"]
-        return ["R-4.4.7-01", "R-4.4.7-02", "R-4.4.7-03", "R-4.2-02", "R-4.2-03"]
+            return [*([] if plain_zero else ["R-4.4.7-01"]), *plain, "R-4.2-02", "R-4.2-03"]
+        return ["R-4.4.7-01", *plain, "R-4.4.7-03", "R-4.2-02", "R-4.2-03"]
     if kind is Kind.HIGH_VOLUME_ASCII:
         return ["R-5.1-01", "R-4.2-02", "R-4.2-03"]
     return ["R-5.2-01", "R-4.2-02", "R-4.2-03"]

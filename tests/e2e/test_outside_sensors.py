@@ -528,3 +528,33 @@ def test_a_late_answer_naming_another_address_is_no_sensor_at_the_assumed_one(
         assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])
     said = " ".join(data["dut"]["assumptions"])
     assert "?! asked again was answered '1': the device is judged there" in said, said
+
+
+@pytest.fixture
+def plain_concurrent_silent(monkeypatch):
+    """The simulated sensor silent to plain aC! and aCC! (the lagopus sketch's parser knows
+    no C; what it answered to aCn! was its a! answer, which reaches the same rule)."""
+    from conformance.protocol.commands import Kind
+
+    usual = FaultSet.rewrite
+
+    def rewrite(self, reply):
+        cmd = reply.command
+        plain = cmd is not None and cmd.kind is Kind.CONCURRENT and cmd.group == 0
+        return None if plain and reply.kind is ReplyKind.START else usual(self, reply)
+
+    monkeypatch.setattr(FaultSet, "rewrite", rewrite)
+
+
+def test_r_4_4_7_02_is_not_judged_on_numbered_concurrent_groups(plain_concurrent_silent):
+    """R-4.4.7-02 (aC! starts a real measurement: 'a00000' does not conform) PASSed
+    "conforms (18 checked: 0C1!, ...)" on a sensor that answered no plain aC!/aCC! at all:
+    an aCn! reply cannot break the rule. It is not decided now; R-4.4.7-08 FAILs the
+    silence, as before."""
+    found = _verdicts(
+        run_once("sim://", keyword="test_concurrent_reply or test_concurrent_supported")
+    )
+    rule = found["R-4.4.7-02"]
+    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+    assert found["R-4.4.7-08"]["verdict"] == "FAIL"
+    assert found["R-4.4.7-01"]["verdict"] == "PASS"  # the numbered groups' form is still judged
