@@ -510,14 +510,7 @@ def judge_framing(
     """R-4.1-02 (7E1 parity), R-4.2-02 (printable), R-4.2-03 (>= 3 chars, CR LF), R-4.3-01
     (the responding sensor's address first) over every ASCII reply and service request.
 
-    ``own`` is the address the sensor was judged at. Until a reply shows where it is (one
-    that starts with its command's address), a reply that starts with ``own`` after a command
-    for another address has the responding sensor's address first: R-4.3-01 holds, and that
-    it answered there at all is another rule's. (The sixteenth round's lagopus sketch at '5'
-    answered the ?!s it had kept while booting 1.5 ms after the tool's '0!', and R-4.3-01
-    FAILed "reply '5<CR><LF>' starts with '5', not the address '0'".) Once a reply has shown
-    the sensor's address, that address is its own: a sensor moved to '9' that answers '9!'
-    with '0' is still FAILed.
+    ``own``: the sensor's address, see :func:`_expected_addresses`.
 
     A reply is framed by its protocol end, never by a gap (:class:`Segment`); unsolicited
     characters after it are framed at each LF, and at a gap only where it is surely there
@@ -571,16 +564,13 @@ def judge_framing(
             # answered '3!' at its old address), so its address is not this command's to judge
             talked_over = bool(seg.contention)
             expected = expected_reply_address(seg.text) if is_reply and not talked_over else None
-            # unsolicited: a service request from the sensor, which may also name the
-            # measurement it belongs to: a sensor that answered zI! for 'z' (answers-foreign-
-            # address) sends aC!'s request as '0' (seed 4141: FAILed against 'z')
             if not is_reply:
                 expected = chr(last_address) if last_address else None
             tally.observe(label, ids=["R-4.3-01"])
             if is_reply and expected and body[:1] == expected:
                 shown = expected
-            unsolicited = started if not is_reply else None
-            if expected and body[:1] not in (expected, unsolicited, shown or own):
+            allowed = _expected_addresses(expected, started if not is_reply else None, shown, own)
+            if expected and body[:1] not in allowed:
                 tally.fail(
                     "R-4.3-01",
                     label,
@@ -588,6 +578,24 @@ def judge_framing(
                     f"'{escape(body[:1])}', not the address '{expected}'",
                 )
     return tally.findings()
+
+
+def _expected_addresses(
+    expected: str | None, unsolicited: str | None, shown: str | None, own: str | None
+) -> tuple[str | None, ...]:
+    """The first characters R-4.3-01 takes in a reply whose command named ``expected`` (the
+    last reply's address for characters sent unasked).
+
+    ``unsolicited``: a service request may name the measurement it belongs to, the last one
+    started (a sensor that answered zI! for 'z', answers-foreign-address, sends aC!'s request
+    as '0': seed 4141 FAILed it against 'z'). ``own``, the address the sensor was judged at,
+    until a reply has ``shown`` it elsewhere (one that began with its command's address): a
+    reply that starts with it after a command for another address has the responding
+    sensor's address first, and that it answered there at all is another rule's (the
+    sixteenth round's lagopus sketch at '5' answered the ?!s it had kept while booting 1.5 ms
+    after the tool's '0!': R-4.3-01 FAILed "reply '5<CR><LF>' starts with '5', not the address
+    '0'"). A sensor moved to '9' that answers '9!' with '0' is still FAILed."""
+    return (expected, unsolicited, shown or own)
 
 
 def _parity_errors_and_text(chunk: list[Event]) -> tuple[list[Event], str]:

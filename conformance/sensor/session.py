@@ -221,19 +221,8 @@ class SensorSession(Session):
         on the rest with breaks it hears; True), then ``?!`` (a sensor that answers it at the
         address is there and is judged on what it does: False, the suite goes on). Only total
         silence raises :class:`NoDeviceAnswered` (exit 5)."""
-        usual = self.master.policy
-        for duration in LONGER_BREAKS:
-            with self._policy_for_now(break_duration=duration):
-                answered = self._answered_here(self.master.acknowledge(self.address))
-            if answered:
-                self.master.policy = usual.but(break_duration=duration)  # kept from here
-                self.assumptions.append(
-                    f"a! and aI! went unanswered after {usual.break_duration * 1e3:.0f} ms "
-                    f"breaks, a! answered after a {duration * 1e3:.0f} ms one: the tool "
-                    f"recorder's breaks are {duration * 1e3:.0f} ms from here (R-7.0-04 judges "
-                    "the short ones)"
-                )
-                return True
+        if self._wakes_on_longer_breaks():
+            return True
         unanswered = (
             f"no device answered at address {self.address!r} (a! and aI! got no reply after "
             f"retries, nor a! after breaks of up to {LONGER_BREAKS[-1] * 1e3:.0f} ms"
@@ -270,19 +259,15 @@ class SensorSession(Session):
                 raise NoDeviceAnswered(
                     f"{unanswered}; ?! went unanswered, a! was answered at {where}): {pick}"
                 )
-        if (
-            query.answered
-            and len(body) == 1
-            and body in ADDRESS_CHARS
-            and not self.requested_address
-        ):
+        named = query.answered and len(body) == 1 and body in ADDRESS_CHARS
+        if named and not self.requested_address:  # the address was only assumed
             self.assumptions.append(
                 f"no answer at the assumed address {self.address!r} (the first ?! went "
                 f"unanswered); ?! asked again was answered '{body}': the device is judged there"
             )
             self.address = body
             return True
-        if query.answered and len(body) == 1 and body in ADDRESS_CHARS:
+        if named:
             # The device is there, at another address: "check its reply format" (what it
             # said was a well-formed ?! reply) or the wiring would send the user astray.
             raise NoDeviceAnswered(
@@ -295,6 +280,24 @@ class SensorSession(Session):
             f"{unanswered}{other})"
             + (talked or ". Check wiring and power, or try ?! with one sensor on the bus.")
         )
+
+    def _wakes_on_longer_breaks(self) -> bool:
+        """``a!`` after 30, 60 and 100 ms breaks: True, the breaks kept from here, if one is
+        answered by a device at the address (:meth:`_find_a_way_in`)."""
+        usual = self.master.policy
+        for duration in LONGER_BREAKS:
+            with self._policy_for_now(break_duration=duration):
+                answered = self._answered_here(self.master.acknowledge(self.address))
+            if answered:
+                self.master.policy = usual.but(break_duration=duration)  # kept from here
+                self.assumptions.append(
+                    f"a! and aI! went unanswered after {usual.break_duration * 1e3:.0f} ms "
+                    f"breaks, a! answered after a {duration * 1e3:.0f} ms one: the tool "
+                    f"recorder's breaks are {duration * 1e3:.0f} ms from here (R-7.0-04 judges "
+                    "the short ones)"
+                )
+                return True
+        return False
 
     def _answered_here(self, ex: Exchange) -> bool:
         """Whether ``a!`` or ``aI!`` at the address in use was answered by a device there: any

@@ -64,7 +64,9 @@ answers to the buffered ?!s, '5<CR><LF>' twice, came 1.5 ms after the tool's '0!
 took that for a! answered at '0' and judged the sensor there: a!, aI! and every command
 FAILed on the silence of a sensor at '5'. A reply to a! that is a bare other address is no
 device at the assumed address now; ?! is asked again and its answer taken
-(``SensorSession._acknowledged``).
+(``SensorSession._answered_here``). Its parser answers aCn! with its a! reply, and R-4.4.7-02
+(aC! measures for real) PASSed on those while aC! and aCC! were silent: it is judged on plain
+aC!/aCC! only.
 """
 
 from __future__ import annotations
