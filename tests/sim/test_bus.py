@@ -209,3 +209,81 @@ def test_a_wire_event_is_the_event_its_constructor_makes() -> None:
             assert type(getattr(fast, f.name)) is type(getattr(made, f.name))
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.start = 0.0  # type: ignore[misc]
+
+
+def _one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The tool's characters placed as ``SimLink.write`` placed them before ``tool_run``:
+    each by :meth:`SimBus.tool_char`, the next ``gap`` after the end of the kept event."""
+
+    def each(self, wires, start, gap):  # noqa: ANN001, ANN202 - as SimBus.tool_run
+        events, time = [], start
+        for wire in wires:
+            event = self.tool_char(wire, time)
+            events.append(event)
+            time = event.end + gap
+        return events
+
+    monkeypatch.setattr(SimBus, "tool_run", each)
+
+
+def _written(name: str | None) -> tuple[list, str, int]:
+    """:func:`_checked`, with the count of the tool's characters ``tool_run`` placed."""
+    placed = []
+    run = SimBus.tool_run
+
+    def counted(self, wires, start, gap):  # noqa: ANN001, ANN202 - as SimBus.tool_run
+        events = run(self, wires, start, gap)
+        placed.append(len(events))
+        return events
+
+    SimBus.tool_run = counted  # type: ignore[method-assign]
+    try:
+        events, outcome, _ = _checked(name)
+    finally:
+        SimBus.tool_run = run  # type: ignore[method-assign]
+    return events, outcome, sum(placed)
+
+
+@pytest.mark.parametrize("name", [None, *sorted(FAULTS)])
+def test_a_command_written_in_one_run_is_what_char_by_char_gives(name, monkeypatch) -> None:
+    """R-7.0-13 and every rule a command's timing feeds rest on the tool's characters'
+    stamps: ``SimBus.tool_run`` (a command's characters in one loop) puts on the wire exactly
+    what ``tool_char`` one by one put there, with every emulator fault's wire check (the
+    sensors' own hearing included: a fault that answers early or mid-command)."""
+    fast, fast_outcome, placed = _written(name)
+    _one_by_one(monkeypatch)
+    slow, slow_outcome, _ = _written(name)
+    assert fast == slow
+    assert fast_outcome == slow_outcome
+    assert placed == sum(e.origin == "tool" and e.kind.name == "CHAR" for e in fast) > 0
+
+
+def test_a_command_with_gaps_and_a_restamping_transcript_is_written_as_before(
+    monkeypatch,
+) -> None:
+    """Gaps between the command's characters, a device talking across the command, and a
+    transcript whose ``add`` restamps what it is given (a stalling host): each next
+    character starts ``gap`` after the end of the event the transcript kept, as before."""
+
+    def written(one_by_one: bool) -> list:
+        if one_by_one:
+            _one_by_one(monkeypatch)
+        link = SimLink(SimBus([_Talker()]))
+        add, count = link.transcript.add, [0]
+
+        def stamped(event):  # noqa: ANN001, ANN202 - as Transcript.add
+            count[0] += 1
+            if event.origin == "tool" and count[0] % 4 == 0:
+                event = replace(event, start=event.start + 0.002, end=event.end + 0.002)
+            return add(event)
+
+        link.transcript.add = stamped  # type: ignore[method-assign]
+        found = []
+        for wires, gap in ((b"0M!", 0.0), (b"0D0!", 0.003), (b"0R0!", 0.0015)):
+            link.wait_until(link.now() + 0.004)
+            sent = link.write(wires, gap)
+            found.append([(e.start, e.end, e.wire) for e in sent])
+        monkeypatch.undo()
+        return [found, link.now(), list(link.transcript.events)]
+
+    assert written(False) == written(True)
