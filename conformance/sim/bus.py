@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
-from ..links.base import Link, LinkInfo, StopCondition
+from ..links.base import LineEnd, Link, LinkInfo, StopCondition
 from ..protocol.timing import CHAR_TIME
 from ..transcript import (
     COLLISION,
@@ -301,18 +301,34 @@ class SimLink(Link):
         all sent; and the limit of the read as the last character left it."""
         device, frames = run
         clock = self.bus.clock
-        add = self.bus.transcript.add  # (what it returns is the event: a test may restamp it)
+        transcript = self.bus.transcript
+        add = transcript.add  # (what it returns is the event: a test may restamp it)
+        # the transcript's own add keeps the event as it is: appended here, not called
+        keep = (
+            transcript.events.append
+            if type(transcript).add is Transcript.add and "add" not in vars(transcript)
+            else None
+        )
         char = EventKind.CHAR
         # wire_event spelt out (its slots set in place): a run's 10^4..10^5 characters each
         # went through two calls more
         set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
+        # a one-line reply's stop (LineEnd) checked here, not called after each character:
+        # the characters before this read's and the 7 bits of the last one so far
+        line = until if type(until) is LineEnd else None
+        if line is not None:
+            until = None
+            held = len(line.before)
+            last = got[-1] if got else line.before[-1] if line.before else None
+            last7 = -1 if last is None else last.wire & 0x7F
         taken = 0
         try:
             for start, wire, duration in frames:
                 if start >= limit:
                     return False, limit
                 now = clock.now
-                start = max(start, now)
+                if start < now:  # max(start, now), spelt out
+                    start = now
                 end = start + duration
                 made = new_event(Event)
                 set_kind(made, char)
@@ -323,15 +339,25 @@ class SimLink(Link):
                 set_text(made, "")
                 set_u(made, 0.0)
                 set_du(made, None)
-                event = add(made)
+                if keep is not None:
+                    keep(made)
+                    event = made
+                else:
+                    event = add(made)
                 taken += 1
                 if end > now:
                     clock.now = end
                 got.append(event)
-                if until is not None and until(got):
+                if line is not None:
+                    wire7 = event.wire & 0x7F
+                    if held + len(got) >= line.most or (last7 == 0x0D and wire7 == 0x0A):
+                        return True, limit
+                    last7 = wire7
+                elif until is not None and until(got):
                     return True, limit
                 if idle is not None:
-                    limit = min(deadline, event.end + idle)
+                    later = event.end + idle
+                    limit = later if later < deadline else deadline  # min(deadline, later)
             return None, limit
         finally:
             if taken:

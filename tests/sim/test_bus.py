@@ -287,3 +287,80 @@ def test_a_command_with_gaps_and_a_restamping_transcript_is_written_as_before(
         return [found, link.now(), list(link.transcript.events)]
 
     assert written(False) == written(True)
+
+
+def _line_reads(inline: bool, restamp: bool = False) -> list:
+    """Reads of ``_Talker``'s replies each stopped by a ``LineEnd`` (as the tool recorder
+    reads a one-line reply), checked inline by the sim link's run (``inline``) or called
+    after each character as any other stop condition is (a plain function around it)."""
+    from conformance.links.base import LineEnd
+
+    link = SimLink(SimBus([_Talker()]))
+    if restamp:
+        add, heard = link.transcript.add, [0]
+
+        def stamped(event):  # noqa: ANN001, ANN202 - as Transcript.add
+            heard[0] += 1
+            if heard[0] % 3 == 0:
+                event = replace(event, start=event.start + 0.03, end=event.end + 0.03)
+            return add(event)
+
+        link.transcript.add = stamped  # type: ignore[method-assign]
+    found, before = [], []
+    for ahead, most, idle, fresh in [
+        (0.02, 99, None, True), (1.0, 5, 0.02, False), (1.0, 99, 0.05, False),
+        (1.0, 3, None, True), (1.0, 99, 0.03, False), (2.0, 99, None, False),
+    ]:  # fmt: skip
+        if fresh:
+            before = []
+        stop = LineEnd(list(before), most)
+        until = stop if inline else (lambda got, stop=stop: stop(got))
+        got = link.receive(link.now() + ahead, until=until, idle=idle)
+        before += got
+        found.append(([(e.start, e.end, e.wire) for e in got], link.now()))
+    return [found, list(link.transcript.events)]
+
+
+def test_a_line_end_checked_inline_stops_where_its_call_stops(monkeypatch) -> None:
+    """The tool recorder's one-line reply read (``LineEnd``: R-4.2-02's CR LF, or the most
+    characters it takes) stops at the same character, leaves the same clock and the same
+    transcript whether the sim link's run checks it inline or calls it per character, with
+    the transcript's own ``add`` and with one that restamps (which the run then calls)."""
+    from conformance.links.base import LineEnd
+
+    for restamp in (False, True):
+        assert _line_reads(True, restamp) == _line_reads(False, restamp)
+    assert _line_reads(True) != _line_reads(True, restamp=True)  # the restamping counted
+    calls, call = [], LineEnd.__call__
+
+    def counted(self, got):  # noqa: ANN001, ANN202 - as LineEnd.__call__
+        calls.append(len(got))
+        return call(self, got)
+
+    monkeypatch.setattr(LineEnd, "__call__", counted)
+    _line_reads(True)
+    assert calls == []  # inline: never called
+    _line_reads(False)
+    assert calls  # called: the comparison above compared two ways
+
+
+def test_a_line_end_is_the_framing_s_stop_after() -> None:
+    """``Framing.stop_for`` of a one-line 7E1 reply is a ``LineEnd`` that answers as
+    ``Framing.stop_after`` does, character by character, at every split of a reply (CR LF
+    at the end, a CR alone, a reply cut at the most characters)."""
+    from conformance.links.base import LineEnd
+    from conformance.tool_recorder.reply_end import Framing
+    from conformance.transcript import Event, EventKind
+
+    framing = Framing(idle=0.0083, max_chars=9)
+    for text in ("0+1.5\r\n", "0\r\r\n", "0+1\r+2\n\r\n", "0123456789012\r\n", "\n\r\n"):
+        chars = [Event(EventKind.CHAR, "dut", i, i + 1, wire=ord(c)) for i, c in enumerate(text)]
+        for cut in range(len(chars)):
+            have = chars[:cut]
+            stop = framing.stop_for(have)
+            assert isinstance(stop, LineEnd)
+            for more in range(cut + 1, len(chars) + 1):
+                got = chars[cut:more]
+                assert stop(got) == framing.stop_after(have, got), (text, cut, more)
+    assert not isinstance(Framing(idle=0.01, max_chars=9, binary=True).stop_for([]), LineEnd)
+    assert not isinstance(Framing(idle=0.01, max_chars=9, multiline=True).stop_for([]), LineEnd)
