@@ -53,6 +53,27 @@ class LinkError(RuntimeError):
 StopCondition = Callable[[list[Event]], bool]
 
 
+class LineEnd:
+    """A :data:`StopCondition`: stop once ``before`` and the characters received so far hold
+    ``most`` characters or more, or end in CR LF (7-bit, parity ignored). The tool
+    recorder's read of a one-line 7E1 reply on from ``before`` (``Framing.stop_after``).
+    Kept as data as well as a call, so a link that makes the characters itself (the sim
+    bus's run of a reply) checks it inline instead of calling it after every character."""
+
+    __slots__ = ("before", "most")
+
+    def __init__(self, before: list[Event], most: int) -> None:
+        self.before = before
+        self.most = most
+
+    def __call__(self, got: list[Event]) -> bool:
+        before = self.before
+        if len(before) + len(got) >= self.most:
+            return True
+        last = got[-2] if len(got) > 1 else before[-1] if before else None
+        return last is not None and last.wire & 0x7F == 0x0D and got[-1].wire & 0x7F == 0x0A
+
+
 class BusEnd(ABC):
     """What a run holds of the bus: its record, what it can do, its clock, and the optional
     abilities a report asks every kind about (python-can's ``BusABC`` way: a default for each,

@@ -12,7 +12,6 @@ deadline so a silent or babbling device can never hang it.
 from __future__ import annotations
 
 import contextlib
-from functools import partial
 
 from ..links.base import Link
 from ..links.errors import BreakUnsupported
@@ -554,7 +553,7 @@ class ToolRecorder:
             # rule only starts once that read has received something.
             more = self.link.receive(
                 min(deadline, chars[-1].end + framing.window(chars)),
-                until=partial(framing.stop_after, chars),
+                until=framing.stop_for(chars),
                 idle=framing.idle,
             )
             if not more:

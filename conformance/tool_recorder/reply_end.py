@@ -8,7 +8,9 @@ the engine's read loop stays one loop for all three kinds.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
+from ..links.base import LineEnd, StopCondition
 from ..protocol.binary import packet_length
 from ..protocol.framing import CR, ETX, LF, is_text
 from ..protocol.timing import MULTILINE_GAP_MAX, TOLERANCE
@@ -74,6 +76,14 @@ class Framing:
         before = more[-2] if len(more) > 1 else have[-1] if have else None
         # ends_line of the two, spelt out: asked per character
         return before is not None and before.wire & 0x7F == CR and more[-1].wire & 0x7F == LF
+
+    def stop_for(self, have: list[Event]) -> StopCondition:
+        """:meth:`stop_after` of ``have`` as a read's stop condition: a one-line 7E1 reply's
+        as a :class:`~conformance.links.base.LineEnd` (the same rule, which a sim link checks
+        inline), any other's as the call."""
+        if self.binary or self.multiline:
+            return partial(self.stop_after, have)
+        return LineEnd(have, self.max_chars)
 
     def deadline(self, first: Event) -> float:
         """Hard bound for a DUT that trickles characters just inside each window."""

@@ -209,3 +209,158 @@ def test_a_wire_event_is_the_event_its_constructor_makes() -> None:
             assert type(getattr(fast, f.name)) is type(getattr(made, f.name))
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.start = 0.0  # type: ignore[misc]
+
+
+def _one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The tool's characters placed as ``SimLink.write`` placed them before ``tool_run``:
+    each by :meth:`SimBus.tool_char`, the next ``gap`` after the end of the kept event."""
+
+    def each(self, wires, start, gap):  # noqa: ANN001, ANN202 - as SimBus.tool_run
+        events, time = [], start
+        for wire in wires:
+            event = self.tool_char(wire, time)
+            events.append(event)
+            time = event.end + gap
+        return events
+
+    monkeypatch.setattr(SimBus, "tool_run", each)
+
+
+def _written(name: str | None) -> tuple[list, str, int]:
+    """:func:`_checked`, with the count of the tool's characters ``tool_run`` placed."""
+    placed = []
+    run = SimBus.tool_run
+
+    def counted(self, wires, start, gap):  # noqa: ANN001, ANN202 - as SimBus.tool_run
+        events = run(self, wires, start, gap)
+        placed.append(len(events))
+        return events
+
+    SimBus.tool_run = counted  # type: ignore[method-assign]
+    try:
+        events, outcome, _ = _checked(name)
+    finally:
+        SimBus.tool_run = run  # type: ignore[method-assign]
+    return events, outcome, sum(placed)
+
+
+@pytest.mark.parametrize("name", [None, *sorted(FAULTS)])
+def test_a_command_written_in_one_run_is_what_char_by_char_gives(name, monkeypatch) -> None:
+    """R-7.0-13 and every rule a command's timing feeds rest on the tool's characters'
+    stamps: ``SimBus.tool_run`` (a command's characters in one loop) puts on the wire exactly
+    what ``tool_char`` one by one put there, with every emulator fault's wire check (the
+    sensors' own hearing included: a fault that answers early or mid-command)."""
+    fast, fast_outcome, placed = _written(name)
+    _one_by_one(monkeypatch)
+    slow, slow_outcome, _ = _written(name)
+    assert fast == slow
+    assert fast_outcome == slow_outcome
+    assert placed == sum(e.origin == "tool" and e.kind.name == "CHAR" for e in fast) > 0
+
+
+def test_a_command_with_gaps_and_a_restamping_transcript_is_written_as_before(
+    monkeypatch,
+) -> None:
+    """Gaps between the command's characters, a device talking across the command, and a
+    transcript whose ``add`` restamps what it is given (a stalling host): each next
+    character starts ``gap`` after the end of the event the transcript kept, as before."""
+
+    def written(one_by_one: bool) -> list:
+        if one_by_one:
+            _one_by_one(monkeypatch)
+        link = SimLink(SimBus([_Talker()]))
+        add, count = link.transcript.add, [0]
+
+        def stamped(event):  # noqa: ANN001, ANN202 - as Transcript.add
+            count[0] += 1
+            if event.origin == "tool" and count[0] % 4 == 0:
+                event = replace(event, start=event.start + 0.002, end=event.end + 0.002)
+            return add(event)
+
+        link.transcript.add = stamped  # type: ignore[method-assign]
+        found = []
+        for wires, gap in ((b"0M!", 0.0), (b"0D0!", 0.003), (b"0R0!", 0.0015)):
+            link.wait_until(link.now() + 0.004)
+            sent = link.write(wires, gap)
+            found.append([(e.start, e.end, e.wire) for e in sent])
+        monkeypatch.undo()
+        return [found, link.now(), list(link.transcript.events)]
+
+    assert written(False) == written(True)
+
+
+def _line_reads(inline: bool, restamp: bool = False) -> list:
+    """Reads of ``_Talker``'s replies each stopped by a ``LineEnd`` (as the tool recorder
+    reads a one-line reply), checked inline by the sim link's run (``inline``) or called
+    after each character as any other stop condition is (a plain function around it)."""
+    from conformance.links.base import LineEnd
+
+    link = SimLink(SimBus([_Talker()]))
+    if restamp:
+        add, heard = link.transcript.add, [0]
+
+        def stamped(event):  # noqa: ANN001, ANN202 - as Transcript.add
+            heard[0] += 1
+            if heard[0] % 3 == 0:
+                event = replace(event, start=event.start + 0.03, end=event.end + 0.03)
+            return add(event)
+
+        link.transcript.add = stamped  # type: ignore[method-assign]
+    found, before = [], []
+    for ahead, most, idle, fresh in [
+        (0.02, 99, None, True), (1.0, 5, 0.02, False), (1.0, 99, 0.05, False),
+        (1.0, 3, None, True), (1.0, 99, 0.03, False), (2.0, 99, None, False),
+    ]:  # fmt: skip
+        if fresh:
+            before = []
+        stop = LineEnd(list(before), most)
+        until = stop if inline else (lambda got, stop=stop: stop(got))
+        got = link.receive(link.now() + ahead, until=until, idle=idle)
+        before += got
+        found.append(([(e.start, e.end, e.wire) for e in got], link.now()))
+    return [found, list(link.transcript.events)]
+
+
+def test_a_line_end_checked_inline_stops_where_its_call_stops(monkeypatch) -> None:
+    """The tool recorder's one-line reply read (``LineEnd``: R-4.2-02's CR LF, or the most
+    characters it takes) stops at the same character, leaves the same clock and the same
+    transcript whether the sim link's run checks it inline or calls it per character, with
+    the transcript's own ``add`` and with one that restamps (which the run then calls)."""
+    from conformance.links.base import LineEnd
+
+    for restamp in (False, True):
+        assert _line_reads(True, restamp) == _line_reads(False, restamp)
+    assert _line_reads(True) != _line_reads(True, restamp=True)  # the restamping counted
+    calls, call = [], LineEnd.__call__
+
+    def counted(self, got):  # noqa: ANN001, ANN202 - as LineEnd.__call__
+        calls.append(len(got))
+        return call(self, got)
+
+    monkeypatch.setattr(LineEnd, "__call__", counted)
+    _line_reads(True)
+    assert calls == []  # inline: never called
+    _line_reads(False)
+    assert calls  # called: the comparison above compared two ways
+
+
+def test_a_line_end_is_the_framing_s_stop_after() -> None:
+    """``Framing.stop_for`` of a one-line 7E1 reply is a ``LineEnd`` that answers as
+    ``Framing.stop_after`` does, character by character, at every split of a reply (CR LF
+    at the end, a CR alone, a reply cut at the most characters)."""
+    from conformance.links.base import LineEnd
+    from conformance.tool_recorder.reply_end import Framing
+    from conformance.transcript import Event, EventKind
+
+    framing = Framing(idle=0.0083, max_chars=9)
+    for text in ("0+1.5\r\n", "0\r\r\n", "0+1\r+2\n\r\n", "0123456789012\r\n", "\n\r\n"):
+        chars = [Event(EventKind.CHAR, "dut", i, i + 1, wire=ord(c)) for i, c in enumerate(text)]
+        for cut in range(len(chars)):
+            have = chars[:cut]
+            stop = framing.stop_for(have)
+            assert isinstance(stop, LineEnd)
+            for more in range(cut + 1, len(chars) + 1):
+                got = chars[cut:more]
+                assert stop(got) == framing.stop_after(have, got), (text, cut, more)
+    assert not isinstance(Framing(idle=0.01, max_chars=9, binary=True).stop_for([]), LineEnd)
+    assert not isinstance(Framing(idle=0.01, max_chars=9, multiline=True).stop_for([]), LineEnd)
