@@ -14,54 +14,23 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from conformance.judges.recorder.breaks import (
-    BreakRules,
-    Breaks,
-    judge_break_rules,
-    judge_breaks,
-)
-from conformance.judges.recorder.commands import (
-    CharacterGaps,
-    CommandBitRate,
-    CommandText,
-    judge_character_gaps,
-    judge_command_bit_rate,
-    judge_command_text,
-)
 from conformance.protocol.commands import parse_command
 from conformance.transcript import Event, EventKind
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import TranscriptView, read_view
 from conformance.view.windows import stream_windows, window_events, window_starts
 from tests.support.bus_of_sensors import ADDRESSES, as_heard, bus_of_sensors, concurrent_round
+from tests.support.windowed_judges import recorder_wire, recorder_wire_windowed
 
 U = 1e-6  # a 1 MHz capture's stamps
 
 
 def _whole(view: TranscriptView) -> list[Finding]:
-    return [
-        *judge_breaks(view, U),
-        *judge_break_rules(view, U),
-        *judge_command_text(view),
-        *judge_character_gaps(view, U),
-        judge_command_bit_rate(view, U),
-    ]
+    return recorder_wire(view, U)
 
 
 def _windowed(windows: list[list[Event]]) -> list[Finding]:
-    judges = Breaks(U), BreakRules(U), CommandText(), CharacterGaps(U), CommandBitRate(U)
-    for window in windows:
-        view = read_view(window)
-        for judge in judges:
-            judge.add(view)
-    breaks, rules, text, gaps, rate = judges
-    return [
-        *breaks.findings(),
-        *rules.findings(),
-        *text.findings(),
-        *gaps.findings(),
-        rate.finding(),
-    ]
+    return recorder_wire_windowed(windows, U)
 
 
 def _at_every_break(events: list[Event]) -> list[list[Event]]:
