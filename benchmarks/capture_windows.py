@@ -10,12 +10,15 @@ objects), the records rebuilt window by window with the CRC expectation carried 
 bus's and each sensor's alone: every exchange's attempts and every measurement's data must
 be the whole run's), and the windows cut as the events come (``stream_windows``: the same
 events in the same windows), the sensors on the bus found window by window (``SensorsOn``:
-the same addresses and identifications), and the recorder's wire rules judged over the
-streamed windows, each window's view read and let go (``tests/support/windowed_judges.py``:
-every finding, detail and evidence must be the whole view's). Prints the windows, the
+the same addresses and identifications), each sensor's decode-quality note gathered window
+by window (``Quality``: the same counts, min, median and max), and the recorder's wire
+rules judged over the streamed windows, each window's view read and let go
+(``tests/support/windowed_judges.py``: every finding, detail and evidence must be the whole
+view's). Prints the windows, the
 largest, and the CPU of the whole cut, of the streamed one and of the two judgements; exits
 1 on any difference. The same checks as ``tests/view/test_windows.py``,
-``tests/offline/test_sensors_on_windowed.py`` and
+``tests/offline/test_sensors_on_windowed.py``,
+``tests/offline/test_decode_quality_windowed.py`` and
 ``tests/judges/recorder/test_windowed_wire.py`` (the fields compared are
 ``tests/support/records_alike.py``'s), on a recording too long for a test.
 """
@@ -41,7 +44,12 @@ from conformance.view.windows import (
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the tree's tests.support
 from tests.support.records_alike import records_fields, view_differences  # noqa: E402
-from tests.support.windowed_judges import recorder_wire, recorder_wire_windowed  # noqa: E402
+from tests.support.windowed_judges import (  # noqa: E402
+    qualities,
+    qualities_windowed,
+    recorder_wire,
+    recorder_wire_windowed,
+)
 
 
 def check(path: str) -> bool:
@@ -75,6 +83,9 @@ def check(path: str) -> bool:
         wrong.append("recorder wire findings")
     if sensors_streamed(events, u) != sensors_on(rebuild_records(whole, uncertainty=u).exchanges):
         wrong.append("sensors on the bus")
+    streamed_notes = qualities_windowed(decoded, stream_windows(iter(events), uncertainty=u), u)
+    if streamed_notes != qualities(decoded, events, u):
+        wrong.append("decode-quality notes")
     print(
         f"{path}: {len(events)} events, {len(whole.transmissions)} transmissions, "
         f"{len(windows)} windows (largest {max(map(len, windows), default=0)} events); "
@@ -83,7 +94,8 @@ def check(path: str) -> bool:
         + (
             "differs: " + ", ".join(wrong)
             if wrong
-            else "views, records, streamed windows, sensors and recorder wire findings equal"
+            else "views, records, streamed windows, sensors, decode-quality notes and recorder "
+            "wire findings equal"
         )
     )
     return not wrong
