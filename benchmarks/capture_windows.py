@@ -9,16 +9,17 @@ characters, unanswerable and undirected characters must be the whole view's, the
 objects), the records rebuilt window by window with the CRC expectation carried (the whole
 bus's and each sensor's alone: every exchange's attempts and every measurement's data must
 be the whole run's), and the windows cut as the events come (``stream_windows``: the same
-events in the same windows), the sensors on the bus found window by window (``SensorsOn``:
-the same addresses and identifications), each sensor's decode-quality note gathered window
-by window (``Quality``: the same counts, min, median and max), and the recorder's wire
-rules judged over the streamed windows, each window's view read and let go
-(``tests/support/windowed_judges.py``: every finding, detail and evidence must be the whole
-view's). Prints the windows, the
-largest, and the CPU of the whole cut, of the streamed one and of the two judgements; exits
-1 on any difference. The same checks as ``tests/view/test_windows.py``,
-``tests/offline/test_sensors_on_windowed.py``,
-``tests/offline/test_decode_quality_windowed.py`` and
+events in the same windows). Then, over the streamed windows, each window's view read and
+let go (``tests/support/windowed_judges.py``): the sensors on the bus (``SensorsOn``: the
+same addresses and identifications), each sensor's decode-quality note (``Quality``: the
+same counts, min, median and max), each sensor's reply timing (``ResponseStarts``,
+``ReplyGaps``) and the recorder's wire rules (``Breaks``, ``BreakRules``, ``CommandText``,
+``CharacterGaps``, ``CommandBitRate``): every finding, detail and evidence must be the whole
+view's. Prints the windows, the largest, and the CPU of the whole cut, of the streamed one
+and of the recorder's wire rules judged both ways; exits 1 on any difference. The same
+checks as ``tests/view/test_windows.py``, ``tests/offline/test_sensors_on_windowed.py``,
+``tests/offline/test_decode_quality_windowed.py``,
+``tests/judges/test_windowed_sensor_timing.py`` and
 ``tests/judges/recorder/test_windowed_wire.py`` (the fields compared are
 ``tests/support/records_alike.py``'s), on a recording too long for a test.
 """
@@ -49,6 +50,8 @@ from tests.support.windowed_judges import (  # noqa: E402
     qualities_windowed,
     recorder_wire,
     recorder_wire_windowed,
+    sensor_timing,
+    sensor_timing_windowed,
 )
 
 
@@ -83,6 +86,10 @@ def check(path: str) -> bool:
         wrong.append("recorder wire findings")
     if sensors_streamed(events, u) != sensors_on(rebuild_records(whole, uncertainty=u).exchanges):
         wrong.append("sensors on the bus")
+    if sensor_timing_windowed(stream_windows(iter(events), uncertainty=u), u) != sensor_timing(
+        whole, u
+    ):
+        wrong.append("sensors' reply timing findings")
     streamed_notes = qualities_windowed(decoded, stream_windows(iter(events), uncertainty=u), u)
     if streamed_notes != qualities(decoded, events, u):
         wrong.append("decode-quality notes")
@@ -94,8 +101,8 @@ def check(path: str) -> bool:
         + (
             "differs: " + ", ".join(wrong)
             if wrong
-            else "views, records, streamed windows, sensors, decode-quality notes and recorder "
-            "wire findings equal"
+            else "views, records, streamed windows, sensors, decode-quality notes, sensors' "
+            "reply timing and recorder wire findings equal"
         )
     )
     return not wrong

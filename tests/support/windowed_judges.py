@@ -1,4 +1,5 @@
-"""The recorder's wire rules (``testcases/passive/test_recorder_7_wire.py``'s judges) and
+"""The recorder's wire rules (``testcases/passive/test_recorder_7_wire.py``'s judges), each
+sensor's reply timing (``test_sensor_7_wire.py``'s response start and character gaps) and
 each sensor's decode-quality note over a whole recording and over its windows, each window's
 view read from its own events alone: ``tests/judges/recorder/test_windowed_wire.py``,
 ``tests/offline/test_decode_quality_windowed.py`` and ``benchmarks/capture_windows.py``
@@ -23,6 +24,7 @@ from conformance.judges.recorder.commands import (
     judge_command_bit_rate,
     judge_command_text,
 )
+from conformance.judges.wire import ReplyGaps, ResponseStarts, judge_gaps, judge_response_start
 from conformance.offline.decode_quality import (
     CharRates,
     Quality,
@@ -34,6 +36,7 @@ from conformance.offline.decode_quality import (
 from conformance.transcript import Event, EventKind
 from conformance.verdicts import Finding
 from conformance.view.rebuilt_records import rebuild_records, rebuilt_exchanges
+from conformance.view.runs import Segment
 from conformance.view.segments import TranscriptView, read_view
 
 
@@ -97,3 +100,36 @@ def qualities_windowed(
         for x in rebuild_records(view, uncertainty=uncertainty, carried=carried).exchanges:
             found.setdefault(x.text[:1], Quality()).add(sensor_characters([x]), rates, broken)
     return {a: q.note(decoded.baud, f"sensor {a!r}") for a, q in found.items()}
+
+
+def _sensor_segments(view: TranscriptView) -> dict[str, list[Segment]]:
+    """The view's segments by the sensor each transmission is to (its first character)."""
+    found: dict[str, list[Segment]] = {}
+    for t in view.transmissions:
+        found.setdefault(t.text[:1], []).append(Segment.of(t))
+    return found
+
+
+def sensor_timing(view: TranscriptView, uncertainty: float) -> dict[str, list[Finding]]:
+    """Each sensor's reply timing findings (R-7.0-09/-10, R-7.0-12, R-7.0-01) from the
+    whole view, as its passive run judges its own segments."""
+    return {
+        a: [*judge_response_start(segs, uncertainty), *judge_gaps(segs, uncertainty)]
+        for a, segs in _sensor_segments(view).items()
+    }
+
+
+def sensor_timing_windowed(
+    windows: Iterable[list[Event]], uncertainty: float
+) -> dict[str, list[Finding]]:
+    """The same findings from ``windows`` (in order), each window's view read alone and
+    let go: each sensor's segments of the window added to its own judges."""
+    judges: dict[str, tuple[ResponseStarts, ReplyGaps]] = {}
+    for window in windows:
+        for a, segs in _sensor_segments(read_view(window)).items():
+            starts, gaps = judges.setdefault(
+                a, (ResponseStarts(uncertainty), ReplyGaps(uncertainty))
+            )
+            starts.add(segs)
+            gaps.add(segs)
+    return {a: [*s.findings(), *g.findings()] for a, (s, g) in judges.items()}
