@@ -3,8 +3,6 @@ and when a break is due (R-7.0-17, R-7.1-01)."""
 
 from __future__ import annotations
 
-from bisect import bisect_right
-
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
@@ -90,9 +88,9 @@ class BreakRules:
     """:func:`judge_break_rules` over a recording read a window at a time (issue 22): each
     window's view :meth:`add`-ed in order, the findings those of the whole recording's view.
     Carried from window to window: the transmission before (R-7.0-17 asks whether the next
-    command is to the same sensor, R-7.1-01 whether it follows a service request), the end
-    of the line's activity before a window (a command sent without a break first in its
-    window is timed from it) and the count of commands (R-7.0-17's PASS says how many)."""
+    command is to the same sensor, R-7.1-01 whether it follows a service request), the
+    window before (a command sent without a break first in its window is timed from the
+    line's last activity there) and the count of commands (R-7.0-17's PASS says how many)."""
 
     def __init__(self, uncertainty: float) -> None:
         self.uncertainty = uncertainty
@@ -100,17 +98,16 @@ class BreakRules:
         self.rule71: list[Finding] = []
         self.previous: Transmission | None = None
         self.commands = 0
-        #: the ends of the line's activity in the window before (sorted), for a command sent
-        #: without a break first in its window: where its marking began
-        self._ends_before: list[float] = []
+        #: the window before, for a command sent without a break first in its window: where
+        #: its marking began (asked of that view only then: one window's events held)
+        self._before: TranscriptView | None = None
 
     def _previous_activity(self, line: TranscriptView, s: Transmission) -> float | None:
         """:meth:`~.segments.TranscriptView.previous_activity` of ``s`` in the whole
         recording: in its window, or else where the window before ended."""
         found = line.previous_activity(s)
-        if found is None and self._ends_before:
-            i = bisect_right(self._ends_before, s.start)
-            found = self._ends_before[i - 1] if i else None
+        if found is None and self._before is not None:
+            found = self._before.previous_activity(s)
         return found
 
     def add(self, line: TranscriptView) -> None:
@@ -170,7 +167,7 @@ class BreakRules:
             previous = s
         self.previous = previous
         self.commands += len(line.transmissions)
-        self._ends_before = sorted([e.end for e in line.chars + line.breaks])
+        self._before = line
 
     def findings(self) -> list[Finding]:
         """R-7.0-17 and R-7.1-01 over everything added."""
