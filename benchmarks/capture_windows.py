@@ -9,10 +9,19 @@ characters, unanswerable and undirected characters must be the whole view's, the
 objects), the records rebuilt window by window with the CRC expectation carried (the whole
 bus's and each sensor's alone: every exchange's attempts and every measurement's data must
 be the whole run's), and the windows cut as the events come (``stream_windows``: the same
-events in the same windows). Prints the windows, the largest, and the CPU of the whole cut
-and of the streamed one; exits 1 on any difference. The same checks as
-``tests/view/test_windows.py`` (the fields compared are ``tests/support/records_alike.py``'s),
-on a recording too long for a test.
+events in the same windows). Then, over the streamed windows, each window's view read and
+let go (``tests/support/windowed_judges.py``): the sensors on the bus (``SensorsOn``: the
+same addresses and identifications), each sensor's decode-quality note (``Quality``: the
+same counts, min, median and max), each sensor's reply timing (``ResponseStarts``,
+``ReplyGaps``) and the recorder's wire rules (``Breaks``, ``BreakRules``, ``CommandText``,
+``CharacterGaps``, ``CommandBitRate``): every finding, detail and evidence must be the whole
+view's. Prints the windows, the largest, and the CPU of the whole cut, of the streamed one
+and of the recorder's wire rules judged both ways; exits 1 on any difference. The same
+checks as ``tests/view/test_windows.py``, ``tests/offline/test_sensors_on_windowed.py``,
+``tests/offline/test_decode_quality_windowed.py``,
+``tests/judges/test_windowed_sensor_timing.py`` and
+``tests/judges/recorder/test_windowed_wire.py`` (the fields compared are
+``tests/support/records_alike.py``'s), on a recording too long for a test.
 """
 
 from __future__ import annotations
@@ -23,6 +32,8 @@ import time
 from pathlib import Path
 
 from conformance.capture import decode_capture
+from conformance.offline.heard import BusSensor, SensorsOn, sensors_on
+from conformance.transcript import Event
 from conformance.view.rebuilt_records import rebuild_records
 from conformance.view.segments import read_view
 from conformance.view.windows import (
@@ -34,6 +45,14 @@ from conformance.view.windows import (
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the tree's tests.support
 from tests.support.records_alike import records_fields, view_differences  # noqa: E402
+from tests.support.windowed_judges import (  # noqa: E402
+    qualities,
+    qualities_windowed,
+    recorder_wire,
+    recorder_wire_windowed,
+    sensor_timing,
+    sensor_timing_windowed,
+)
 
 
 def check(path: str) -> bool:
@@ -57,13 +76,45 @@ def check(path: str) -> bool:
     stream_cpu = time.process_time() - cpu
     if [list(map(id, w)) for w in streamed] != [list(map(id, w)) for w in windows]:
         wrong.append("streamed windows")
+    cpu = time.process_time()
+    expected = recorder_wire(whole, u)
+    judge_cpu = time.process_time() - cpu
+    cpu = time.process_time()
+    found = recorder_wire_windowed(stream_windows(iter(events), uncertainty=u), u)
+    windowed_cpu = time.process_time() - cpu
+    if found != expected:
+        wrong.append("recorder wire findings")
+    if sensors_streamed(events, u) != sensors_on(rebuild_records(whole, uncertainty=u).exchanges):
+        wrong.append("sensors on the bus")
+    if sensor_timing_windowed(stream_windows(iter(events), uncertainty=u), u) != sensor_timing(
+        whole, u
+    ):
+        wrong.append("sensors' reply timing findings")
+    streamed_notes = qualities_windowed(decoded, stream_windows(iter(events), uncertainty=u), u)
+    if streamed_notes != qualities(decoded, events, u):
+        wrong.append("decode-quality notes")
     print(
         f"{path}: {len(events)} events, {len(whole.transmissions)} transmissions, "
         f"{len(windows)} windows (largest {max(map(len, windows), default=0)} events); "
-        f"whole cut {whole_cpu:.2f} s CPU, streamed {stream_cpu:.2f} s; "
-        + ("differs: " + ", ".join(wrong) if wrong else "views, records and streamed windows equal")
+        f"whole cut {whole_cpu:.2f} s CPU, streamed {stream_cpu:.2f} s; recorder wire rules "
+        f"judged whole {judge_cpu:.2f} s, streamed and windowed {windowed_cpu:.2f} s; "
+        + (
+            "differs: " + ", ".join(wrong)
+            if wrong
+            else "views, records, streamed windows, sensors, decode-quality notes, sensors' "
+            "reply timing and recorder wire findings equal"
+        )
     )
     return not wrong
+
+
+def sensors_streamed(events: list[Event], u: float) -> list[BusSensor]:
+    """The sensors on the bus found window by window as the windows are cut (each window's
+    records rebuilt alone, the CRC expectations carried), each window let go."""
+    found, carried = SensorsOn(), {}
+    for window in stream_windows(iter(events), uncertainty=u):
+        found.add(rebuild_records(read_view(window), uncertainty=u, carried=carried).exchanges)
+    return found.sensors()
 
 
 def main(argv: list[str] | None = None) -> int:

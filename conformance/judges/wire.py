@@ -42,6 +42,8 @@ from .timing import (
 # The cut these judges read lives in the shared view; re-exported for the timing diagram
 # (reports/) and the sensor measurement judges, which import it from here.
 __all__ = [
+    "ReplyGaps",
+    "ResponseStarts",
     "Segment",
     "gaps_to_confirm",
     "judge_framing",
@@ -207,11 +209,19 @@ def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observa
     base = stamps.base
     if stamps.local is None and not (not base and copysign(1.0, base) < 0):
         return _observe_gaps_alike(_gaps(segs), base)
-    judged: dict[tuple[float, float, str], Measured] = {}
+    return _observe_each(_gaps(segs), stamps, {})
+
+
+def _observe_each(
+    gaps: list[Gap], stamps: StampUncertainty, judged: dict[tuple[float, float, str], Measured]
+) -> list[Observation]:
+    """:func:`_observe_gaps`' observations one by one (stamps with a local irregularity),
+    ``judged``: the distinct gaps judged so far (:class:`ReplyGaps` carries it)."""
+    base = stamps.base
     observed: list[Observation] = []
     add = observed.append
     local = stamps.local is not None
-    for gap, where, a, b, place in _gaps(segs):
+    for gap, where, a, b, place in gaps:
         u = stamps.between(a.start, b.end) if local else base
         # -0.0 == 0.0 as a key, but not in a detail text: a negative zero is judged apart
         if (not gap and copysign(1.0, gap) < 0) or (not u and copysign(1.0, u) < 0):
@@ -231,28 +241,41 @@ def _observe_gaps_alike(gaps: list[Gap], base: float) -> Observed:
     the key and taints none: the same observations, with less asked per gap, grouped as they
     are made (:class:`~.timing.Observed`: what combine_local reads instead of passing over
     some 20,000 gaps a run five more times)."""
-    judged: dict[tuple[float, str], int] = {}  # -> its index in distinct
-    observed = Observed()
-    distinct, counts = observed.distinct, observed.counts
-    add, new, once = observed.append, distinct.append, counts.append
-    for gap, where, _a, _b, place in gaps:
-        if not gap and copysign(1.0, gap) < 0:  # judged apart, as _observe_gaps does
-            measured = Measured(GAP_WINDOW, gap, base, [where])
-            new(measured)
-            once(1)
+    alike = _GapsAlike(base)
+    alike.add(gaps)
+    return alike.observed
+
+
+class _GapsAlike:
+    """:func:`_observe_gaps_alike` of gaps given a part at a time (:class:`ReplyGaps`, a
+    window at a time): the distinct gaps judged so far carried from part to part."""
+
+    def __init__(self, base: float) -> None:
+        self.base = base
+        self.judged: dict[tuple[float, str], int] = {}  # -> its index in distinct
+        self.observed = Observed()
+
+    def add(self, gaps: list[Gap]) -> None:
+        base, judged, observed = self.base, self.judged, self.observed
+        distinct, counts = observed.distinct, observed.counts
+        add, new, once = observed.append, distinct.append, counts.append
+        for gap, where, _a, _b, place in gaps:
+            if not gap and copysign(1.0, gap) < 0:  # judged apart, as _observe_gaps does
+                measured = Measured(GAP_WINDOW, gap, base, [where])
+                new(measured)
+                once(1)
+                add((measured, False, place))
+                continue
+            i = judged.get((gap, where))
+            if i is None:
+                measured = Measured(GAP_WINDOW, gap, base, [where])
+                judged[(gap, where)] = len(distinct)
+                new(measured)
+                once(1)
+            else:
+                measured = distinct[i]
+                counts[i] += 1
             add((measured, False, place))
-            continue
-        i = judged.get((gap, where))
-        if i is None:
-            measured = Measured(GAP_WINDOW, gap, base, [where])
-            judged[(gap, where)] = len(distinct)
-            new(measured)
-            once(1)
-        else:
-            measured = distinct[i]
-            counts[i] += 1
-        add((measured, False, place))
-    return observed
 
 
 def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
@@ -261,17 +284,99 @@ def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
     link's uncertainty, is INCONCLUSIVE; a gap surely beyond 2.06 ms is R-7.0-12's alone.
     One pass over the gaps (:func:`_gaps`: tens of thousands a run), nearly all below the
     band, where neither test can hold."""
-    band_lo, band_hi = INTER_CHAR_GAP_MAX, INTER_CHAR_GAP_MAX + TOLERANCE
-    sure: list[tuple[float, str]] = []
-    maybe: list[tuple[float, str]] = []
-    for g, w, _a, _b, _p in gaps:
-        if g + uncertainty <= band_lo and g - uncertainty <= band_lo:
-            continue  # below the band either way (nearly every gap)
-        if g - uncertainty > band_lo and g + uncertainty <= band_hi:
-            sure.append((g, w))
-        if g + uncertainty > band_lo and g - uncertainty <= band_hi:
-            maybe.append((g, w))
-    return _tolerance_finding(sure, maybe, len(gaps), uncertainty)
+    use = _ToleranceUse(uncertainty)
+    use.add(gaps)
+    return use.finding()
+
+
+class _ToleranceUse:
+    """:func:`_judge_tolerance_use` of gaps given a part at a time (:class:`ReplyGaps`):
+    the gaps in or maybe in the band, and how many gaps, carried from part to part."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self.sure: list[tuple[float, str]] = []
+        self.maybe: list[tuple[float, str]] = []
+        self.count = 0
+
+    def add(self, gaps: list[Gap]) -> None:
+        uncertainty, sure, maybe = self.uncertainty, self.sure, self.maybe
+        band_lo, band_hi = INTER_CHAR_GAP_MAX, INTER_CHAR_GAP_MAX + TOLERANCE
+        for g, w, _a, _b, _p in gaps:
+            if g + uncertainty <= band_lo and g - uncertainty <= band_lo:
+                continue  # below the band either way (nearly every gap)
+            if g - uncertainty > band_lo and g + uncertainty <= band_hi:
+                sure.append((g, w))
+            if g + uncertainty > band_lo and g - uncertainty <= band_hi:
+                maybe.append((g, w))
+        self.count += len(gaps)
+
+    def finding(self) -> Finding:
+        return _tolerance_finding(self.sure, self.maybe, self.count, self.uncertainty)
+
+
+class ResponseStarts:
+    """:func:`judge_response_start` over a recording read a window at a time (issue 22's
+    windowed judge): each window's segments :meth:`add`-ed in order, the findings those of
+    the whole recording's segments (each reply's delay is its own segment's: the windows'
+    observations in order are the whole run's)."""
+
+    def __init__(self, uncertainty: float | StampUncertainty) -> None:
+        self.stamps = stamp_uncertainty(uncertainty)
+        self.early: list[Observation] = []
+        self.late: list[Observation] = []
+
+    def add(self, segs: list[Segment]) -> None:
+        """The replies of ``segs`` (the next window's segments)."""
+        early, late = _start_observations(segs, self.stamps)
+        self.early += early
+        self.late += late
+
+    def findings(self) -> list[Finding]:
+        """R-7.0-09 and R-7.0-10 over everything added."""
+        real = self.stamps.local is not None
+        return [
+            combine_local("R-7.0-09", self.early, "reply", real_time=real),
+            combine_local("R-7.0-10", self.late, "reply", real_time=real),
+        ]
+
+
+class ReplyGaps:
+    """:func:`judge_gaps` over a recording read a window at a time (issue 22's windowed
+    judge): each window's segments :meth:`add`-ed in order, the findings those of the whole
+    recording's segments. A gap lies inside one segment (one transmission's reply and what
+    followed it), so the windows' gaps in order are the whole run's; carried across windows:
+    the distinct gaps judged so far (each judged once, counted) and R-7.0-01's gaps in or
+    maybe in the tolerance band with the count of all."""
+
+    def __init__(self, uncertainty: float | StampUncertainty) -> None:
+        self.stamps = stamps = stamp_uncertainty(uncertainty)
+        base = stamps.base
+        self._alike = (
+            _GapsAlike(base)
+            if stamps.local is None and not (not base and copysign(1.0, base) < 0)
+            else None
+        )
+        self._each: list[Observation] = []
+        self._judged: dict[tuple[float, float, str], Measured] = {}
+        self._tolerance = _ToleranceUse(base)
+
+    def add(self, segs: list[Segment]) -> None:
+        """The reply character gaps of ``segs`` (the next window's segments)."""
+        gaps = _cut_gaps(segs)
+        if self._alike is not None:
+            self._alike.add(gaps)
+        else:
+            self._each += _observe_each(gaps, self.stamps, self._judged)
+        self._tolerance.add(gaps)
+
+    def findings(self) -> list[Finding]:
+        """R-7.0-12 and R-7.0-01 over everything added."""
+        observed = self._alike.observed if self._alike is not None else self._each
+        gap_finding = combine_local(
+            "R-7.0-12", observed, "character gap", real_time=self.stamps.local is not None
+        )
+        return [gap_finding, self._tolerance.finding()]
 
 
 def _tolerance_finding(

@@ -13,7 +13,7 @@ from __future__ import annotations
 import statistics
 from array import array
 from bisect import bisect_left
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from itertools import islice
 from operator import le
 from typing import Any
@@ -38,7 +38,17 @@ class CharRates:
     are mapped by identity, as they all were."""
 
     def __init__(self, decoded: Any, events: list[Event]) -> None:
-        rates = decoded.baud_error_pct  # one per character, in the order of the events
+        self._read(decoded.baud_error_pct, events)  # one per character, in events' order
+
+    @classmethod
+    def of_rates(cls, rates: Sequence[float], events: list[Event]) -> CharRates:
+        """The errors ``rates`` of ``events``' characters, one for one in their order: a
+        window's share of the decode's (issue 22's windowed judge reads a window at a time)."""
+        found = cls.__new__(cls)
+        found._read(rates, events)
+        return found
+
+    def _read(self, rates: Sequence[float], events: list[Event]) -> None:
         chars = [e for e in events if e.kind is EventKind.CHAR]
         # (a list that does not match the characters one for one tells no character's rate)
         self._rates = rates if len(rates) == len(chars) else None
@@ -70,6 +80,55 @@ def rate_of(decoded: Any, events: list[Event]) -> CharRates:
     return CharRates(decoded, events)
 
 
+def problems_by_character(decoded: Any) -> dict[tuple[float, int], Any]:
+    """The decode's problem items of characters (framing or parity error, a glitch), by the
+    start and byte of their character, not its identity: a decode that widened its stamps
+    (the glitch filter beside an edge) holds new events, its problems the ones it first
+    read."""
+    return {
+        (p.event.start, p.event.wire): p
+        for p in decoded.problems
+        if p.kind == "char" and p.event is not None
+    }
+
+
+class Quality:
+    """One sensor's decode figures gathered a part of the recording at a time (issue 22's
+    windowed judge: each window's characters of the sensor :meth:`add`-ed as they come), the
+    note :func:`decode_quality` gives all of them at once. It keeps counts and the measured
+    bit-rate errors (8 bytes a character, for the median), never the characters."""
+
+    def __init__(self) -> None:
+        self.chars = self.parity = self.framing = self.glitched = 0
+        self.measured = array("d")
+
+    def add(
+        self, chars: list[Event], error: CharRates, broken: dict[tuple[float, int], Any]
+    ) -> None:
+        """``chars`` (the sensor's, in order), their bit-rate errors looked up in ``error``
+        and their problems in ``broken`` (:func:`problems_by_character`)."""
+        self.chars += len(chars)
+        self.measured.extend([v for v in map(error.get, chars) if v is not None and v == v])
+        self.parity += sum(1 for c in chars if not c.parity_ok)
+        flagged = [broken[(c.start, c.wire)] for c in chars if (c.start, c.wire) in broken]
+        self.framing += sum(1 for d in flagged if d.framing_error)
+        self.glitched += sum(1 for d in flagged if d.glitches)
+
+    def note(self, baud: float, who: str) -> str | None:
+        """The note on everything added (None: no character)."""
+        if not self.chars:
+            return None
+        rate, measured = "bit rate not measurable", self.measured
+        if measured:
+            low, mid, high = min(measured), statistics.median(measured), max(measured)
+            rate = f"bit rate {low:+.2f}..{high:+.2f} % off {baud:g} baud (median {mid:+.2f} %)"
+        return (
+            f"decode quality of {who}: {self.chars} character(s), {rate}; {self.parity} with a "
+            f"parity error, {self.framing} with a framing error, {self.glitched} with a "
+            "glitch inside"
+        )
+
+
 def decode_quality(
     decoded: Any,
     events: list[Event],
@@ -83,24 +142,7 @@ def decode_quality(
     the caller made it already."""
     if not chars:
         return None
+    quality = Quality()
     error = rate_of(decoded, events) if rates is None else rates
-    # by start and byte, not identity: a decode that widened its stamps (the glitch filter
-    # beside an edge) holds new events, its problems the ones it first read
-    broken = {
-        (p.event.start, p.event.wire): p
-        for p in decoded.problems
-        if p.kind == "char" and p.event is not None
-    }
-    measured = [v for v in map(error.get, chars) if v is not None and v == v]
-    parity = sum(1 for c in chars if not c.parity_ok)
-    flagged = [broken[(c.start, c.wire)] for c in chars if (c.start, c.wire) in broken]
-    framing = sum(1 for d in flagged if d.framing_error)
-    glitched = sum(1 for d in flagged if d.glitches)
-    rate = "bit rate not measurable"
-    if measured:
-        low, mid, high = min(measured), statistics.median(measured), max(measured)
-        rate = f"bit rate {low:+.2f}..{high:+.2f} % off {decoded.baud:g} baud (median {mid:+.2f} %)"
-    return (
-        f"decode quality of {who}: {len(chars)} character(s), {rate}; {parity} with a parity "
-        f"error, {framing} with a framing error, {glitched} with a glitch inside"
-    )
+    quality.add(chars, error, problems_by_character(decoded))
+    return quality.note(decoded.baud, who)

@@ -132,23 +132,42 @@ def sensors_on(exchanges: Iterable[Exchange]) -> list[BusSensor]:
     """The sensors whose replies the recording holds, in address order. A sensor is known by
     the address it first answered at: an accepted ``aAb!`` moves it, not a new sensor (a
     sensor run moves its DUT and back), so its later replies at ``b`` are its own."""
-    moved: dict[str, str] = {}  # address now -> the address the sensor was first heard at
-    seen: dict[str, BusSensor] = {}
-    for ex in exchanges:
-        said = ex.reply_text[:1] if ex.answered else ""
-        if not said or said not in ADDRESS_CHARS or ex.command is None:
-            continue
-        if ex.command.kind is Kind.CHANGE_ADDRESS and said == ex.command.new_address:
-            moved[said] = moved.get(ex.command.address, ex.command.address)
-            continue
-        home = moved.get(said, said)
-        if home not in seen:
-            seen[home] = BusSensor(home)
-        if ex.command.kind is Kind.IDENTIFY and seen[home].identity is None:
-            ident, _ = identification(ex, said)
-            if ident is not None and ident.version in VERSIONS:
-                seen[home] = BusSensor(home, ident, ex.reply_text)
-    return [seen[a] for a in sorted(seen, key=ADDRESS_CHARS.index)]
+    found = SensorsOn()
+    found.add(exchanges)
+    return found.sensors()
+
+
+class SensorsOn:
+    """:func:`sensors_on` of a recording read a window at a time (issue 22's windowed
+    judge): each window's exchanges :meth:`add`-ed in order, the sensors those of the whole
+    recording's exchanges. Carried across windows: where each moved sensor answers now, and
+    each sensor heard (with its first valid ``aI!`` reply), nothing of a window's events."""
+
+    def __init__(self) -> None:
+        self.moved: dict[str, str] = {}  # address now -> the address it was first heard at
+        self.seen: dict[str, BusSensor] = {}
+
+    def add(self, exchanges: Iterable[Exchange]) -> None:
+        """The exchanges of the next window of the recording, in order."""
+        moved, seen = self.moved, self.seen
+        for ex in exchanges:
+            said = ex.reply_text[:1] if ex.answered else ""
+            if not said or said not in ADDRESS_CHARS or ex.command is None:
+                continue
+            if ex.command.kind is Kind.CHANGE_ADDRESS and said == ex.command.new_address:
+                moved[said] = moved.get(ex.command.address, ex.command.address)
+                continue
+            home = moved.get(said, said)
+            if home not in seen:
+                seen[home] = BusSensor(home)
+            if ex.command.kind is Kind.IDENTIFY and seen[home].identity is None:
+                ident, _ = identification(ex, said)
+                if ident is not None and ident.version in VERSIONS:
+                    seen[home] = BusSensor(home, ident, ex.reply_text)
+
+    def sensors(self) -> list[BusSensor]:
+        """The sensors heard so far, in address order."""
+        return [self.seen[a] for a in sorted(self.seen, key=ADDRESS_CHARS.index)]
 
 
 @dataclass

@@ -18,102 +18,171 @@ MARKING = Window("R-7.0-06", "marking after the break", low=MARKING_AFTER_BREAK)
 def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-02: every break lasts at least 12 ms. R-7.0-06: after a break the recorder marks
     at least 8.33 ms before the first start bit of its command (both ±0.40 ms)."""
-    # a break read by a UART as a NUL (a listen-only monitor) is known to have lasted only
-    # at least a frame: its length, and so where it ended, carries that event's own doubt
-    # one judged interval each, its finding made only where the verdict shows it (an hour
-    # of a busy bus holds 15,000 breaks)
-    # an interval equal to one judged before is that one again (Repeats), so the breaks
-    # hold one object per distinct length and marking
-    lengths: list[MeasuredAsJudged] = []
-    seen: Repeats[MeasuredAsJudged] = Repeats()
-    for b in line.breaks:
-        length, u = b.duration, max(uncertainty, b.duration_uncertainty or 0.0)
-        lengths.append(
-            seen.first(length, u)
-            or seen.keep(MeasuredAsJudged(BREAK_LENGTH, length, u, [f"break at t={b.start:.3f} s"]))
-        )
-    markings: list[MeasuredAsJudged] = []
-    seen = Repeats()
-    for s in line.transmissions:
-        if s.break_event is None:
-            continue
-        marking = s.first_char - s.break_event.end
-        u = max(own_uncertainty(uncertainty, s.chars[0]), s.break_event.duration_uncertainty or 0.0)
-        markings.append(
-            seen.first(marking, u)
-            or seen.keep(MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"]))
-        )
-    return [combine("R-7.0-02", lengths, "break"), combine("R-7.0-06", markings, "marking")]
+    judge = Breaks(uncertainty)
+    judge.add(line)
+    return judge.findings()
+
+
+class Breaks:
+    """:func:`judge_breaks` over a recording read a window at a time (issue 22): each
+    window's view :meth:`add`-ed in order, the findings those of the whole recording's view.
+    What it keeps across windows is one observation per distinct length and marking
+    (:class:`~..timing.Repeats`), never a window's events."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self.lengths: list[MeasuredAsJudged] = []
+        self.markings: list[MeasuredAsJudged] = []
+        self._lengths_seen: Repeats[MeasuredAsJudged] = Repeats()
+        self._markings_seen: Repeats[MeasuredAsJudged] = Repeats()
+
+    def add(self, line: TranscriptView) -> None:
+        """The breaks and markings of ``line`` (the next window of the recording)."""
+        # a break read by a UART as a NUL (a listen-only monitor) is known to have lasted only
+        # at least a frame: its length, and so where it ended, carries that event's own doubt
+        # one judged interval each, its finding made only where the verdict shows it (an hour
+        # of a busy bus holds 15,000 breaks)
+        # an interval equal to one judged before is that one again (Repeats), so the breaks
+        # hold one object per distinct length and marking
+        uncertainty = self.uncertainty
+        seen = self._lengths_seen
+        for b in line.breaks:
+            length, u = b.duration, max(uncertainty, b.duration_uncertainty or 0.0)
+            self.lengths.append(
+                seen.first(length, u)
+                or seen.keep(
+                    MeasuredAsJudged(BREAK_LENGTH, length, u, [f"break at t={b.start:.3f} s"])
+                )
+            )
+        seen = self._markings_seen
+        for s in line.transmissions:
+            if s.break_event is None:
+                continue
+            marking = s.first_char - s.break_event.end
+            u = max(
+                own_uncertainty(uncertainty, s.chars[0]), s.break_event.duration_uncertainty or 0.0
+            )
+            self.markings.append(
+                seen.first(marking, u)
+                or seen.keep(MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"]))
+            )
+
+    def findings(self) -> list[Finding]:
+        """R-7.0-02 and R-7.0-06 over everything added."""
+        return [
+            combine("R-7.0-02", self.lengths, "break"),
+            combine("R-7.0-06", self.markings, "marking"),
+        ]
 
 
 def judge_break_rules(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-17: a break before every command to a different sensor than the last one, or after
     more than 87 ms of marking. R-7.1-01: ``aD0!`` without a break only within 87 ms of the
     service request."""
-    rule17: list[Finding] = []
-    rule71: list[Finding] = []
-    previous: Transmission | None = None
-    for s in line.transmissions:
-        if previous is not None and previous.part != s.part:
-            previous = None  # a new scenario: the line was idle and the sensors are new
-        if s.break_event is None:
-            where = [f"before {s.at()}"]
-            if previous is None or previous.address != s.address:
-                who = "no earlier command" if previous is None else f"last was {previous.text}"
-                rule17.append(
+    judge = BreakRules(uncertainty)
+    judge.add(line)
+    return judge.findings()
+
+
+class BreakRules:
+    """:func:`judge_break_rules` over a recording read a window at a time (issue 22): each
+    window's view :meth:`add`-ed in order, the findings those of the whole recording's view.
+    Carried from window to window: the transmission before (R-7.0-17 asks whether the next
+    command is to the same sensor, R-7.1-01 whether it follows a service request), the
+    window before (a command sent without a break first in its window is timed from the
+    line's last activity there) and the count of commands (R-7.0-17's PASS says how many)."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self.rule17: list[Finding] = []
+        self.rule71: list[Finding] = []
+        self.previous: Transmission | None = None
+        self.commands = 0
+        #: the window before, for a command sent without a break first in its window: where
+        #: its marking began (asked of that view only then: one window's events held)
+        self._before: TranscriptView | None = None
+
+    def _previous_activity(self, line: TranscriptView, s: Transmission) -> float | None:
+        """:meth:`~.segments.TranscriptView.previous_activity` of ``s`` in the whole
+        recording: in its window, or else where the window before ended."""
+        found = line.previous_activity(s)
+        if found is None and self._before is not None:
+            found = self._before.previous_activity(s)
+        return found
+
+    def add(self, line: TranscriptView) -> None:
+        """The commands of ``line`` (the next window of the recording)."""
+        uncertainty, rule17, rule71 = self.uncertainty, self.rule17, self.rule71
+        previous = self.previous
+        for s in line.transmissions:
+            if previous is not None and previous.part != s.part:
+                previous = None  # a new scenario: the line was idle and the sensors are new
+            if s.break_event is None:
+                where = [f"before {s.at()}"]
+                if previous is None or previous.address != s.address:
+                    who = "no earlier command" if previous is None else f"last was {previous.text}"
+                    rule17.append(
+                        Finding(
+                            "R-7.0-17",
+                            Verdict.FAIL,
+                            f"no break before {s.at()}, a new sensor ({who})",
+                            evidence=where,
+                            observed=1,
+                        )
+                    )
+                else:
+                    quiet = s.first_char - (self._previous_activity(line, s) or float("-inf"))
+                    rule17.append(
+                        judge_window(
+                            "R-7.0-17",
+                            "marking before a command sent without a break",
+                            quiet,
+                            own_uncertainty(uncertainty, s.chars[0], previous.chars[-1]),
+                            high=NO_BREAK_WINDOW,
+                            evidence=where,
+                        )
+                    )
+                if previous is not None and _follows_service_request(previous, s):
+                    sr_end = service_request_end(previous.after, s.address)
+                    assert sr_end is not None
+                    rule71.append(
+                        judge_window(
+                            "R-7.1-01",
+                            "aD0! without a break after the service request",
+                            s.first_char - sr_end,
+                            own_uncertainty(uncertainty, s.chars[0]),
+                            high=NO_BREAK_WINDOW,
+                            evidence=where,
+                        )
+                    )
+            elif previous is not None and _follows_service_request(previous, s):
+                rule71.append(
                     Finding(
-                        "R-7.0-17",
-                        Verdict.FAIL,
-                        f"no break before {s.at()}, a new sensor ({who})",
-                        evidence=where,
+                        "R-7.1-01",
+                        Verdict.PASS,
+                        f"a break before {s.at()} after the service request",
                         observed=1,
                     )
                 )
-            else:
-                quiet = s.first_char - (line.previous_activity(s) or float("-inf"))
-                rule17.append(
-                    judge_window(
-                        "R-7.0-17",
-                        "marking before a command sent without a break",
-                        quiet,
-                        own_uncertainty(uncertainty, s.chars[0], previous.chars[-1]),
-                        high=NO_BREAK_WINDOW,
-                        evidence=where,
-                    )
-                )
-            if previous is not None and _follows_service_request(previous, s):
-                sr_end = service_request_end(previous.after, s.address)
-                assert sr_end is not None
-                rule71.append(
-                    judge_window(
-                        "R-7.1-01",
-                        "aD0! without a break after the service request",
-                        s.first_char - sr_end,
-                        own_uncertainty(uncertainty, s.chars[0]),
-                        high=NO_BREAK_WINDOW,
-                        evidence=where,
-                    )
-                )
-        elif previous is not None and _follows_service_request(previous, s):
-            rule71.append(
-                Finding(
-                    "R-7.1-01",
-                    Verdict.PASS,
-                    f"a break before {s.at()} after the service request",
-                    observed=1,
-                )
-            )
-        previous = s
-    return [
-        combine("R-7.0-17", rule17, "command without a break")
-        if rule17
-        else Finding("R-7.0-17", Verdict.PASS, _all_broke(line), observed=len(line.transmissions)),
-        combine("R-7.1-01", rule71, "aD0! after a service request"),
-    ]
+            previous = s
+        self.previous = previous
+        self.commands += len(line.transmissions)
+        self._before = line
+
+    def findings(self) -> list[Finding]:
+        """R-7.0-17 and R-7.1-01 over everything added."""
+        return [
+            combine("R-7.0-17", self.rule17, "command without a break")
+            if self.rule17
+            else Finding(
+                "R-7.0-17", Verdict.PASS, _all_broke(self.commands), observed=self.commands
+            ),
+            combine("R-7.1-01", self.rule71, "aD0! after a service request"),
+        ]
 
 
-def _all_broke(line: TranscriptView) -> str:
-    return f"all {len(line.transmissions)} commands were sent after a break"
+def _all_broke(commands: int) -> str:
+    return f"all {commands} commands were sent after a break"
 
 
 def _follows_service_request(previous: Transmission, s: Transmission) -> bool:

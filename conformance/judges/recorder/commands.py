@@ -22,87 +22,162 @@ COMMAND_GAP = Window(
 def judge_command_text(line: TranscriptView) -> list[Finding]:
     """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else; R-4.3-01
     the first character is the address (``?`` only in ``?!``)."""
-    tally = Tally(("R-4.2-01", "R-4.4-04", "R-4.3-01"))
-    for s in line.transmissions:
-        text, where = s.text, escape(s.text)
-        bad = [c for c in text if not 0x20 <= ord(c) <= 0x7E]
-        tally.observe(where, ids=["R-4.2-01", "R-4.4-04", "R-4.3-01"])
-        if bad:
-            tally.fail("R-4.2-01", where, f"non-printable {escape(''.join(bad))} in the command")
-        if not text.endswith("!") or "!" in text[:-1]:
-            tally.fail("R-4.4-04", where, "'!' is not exactly the last character")
-        first = text[:1]
-        if not (first in ADDRESS_CHARS or text == "?!"):
-            tally.fail("R-4.3-01", where, f"starts with {escape(first)}, not an address")
-    return tally.findings("well formed")
+    judge = CommandText()
+    judge.add(line)
+    return judge.findings()
+
+
+class CommandText:
+    """:func:`judge_command_text` over a recording read a window at a time (issue 22): each
+    window's view :meth:`add`-ed in order, the findings those of the whole view. It keeps
+    the tally's labels (one short string a command), none of a window's events."""
+
+    def __init__(self) -> None:
+        self.tally = Tally(("R-4.2-01", "R-4.4-04", "R-4.3-01"))
+
+    def add(self, line: TranscriptView) -> None:
+        """The commands of ``line`` (the next window of the recording)."""
+        tally = self.tally
+        for s in line.transmissions:
+            text, where = s.text, escape(s.text)
+            bad = [c for c in text if not 0x20 <= ord(c) <= 0x7E]
+            tally.observe(where, ids=["R-4.2-01", "R-4.4-04", "R-4.3-01"])
+            if bad:
+                tally.fail(
+                    "R-4.2-01", where, f"non-printable {escape(''.join(bad))} in the command"
+                )
+            if not text.endswith("!") or "!" in text[:-1]:
+                tally.fail("R-4.4-04", where, "'!' is not exactly the last character")
+            first = text[:1]
+            if not (first in ADDRESS_CHARS or text == "?!"):
+                tally.fail("R-4.3-01", where, f"starts with {escape(first)}, not an address")
+
+    def findings(self) -> list[Finding]:
+        """R-4.2-01, R-4.4-04 and R-4.3-01 over everything added."""
+        return self.tally.findings("well formed")
 
 
 def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-13: at most 1.66 ms of marking between the characters of a command (no
     tolerance); R-7.0-01: no gap leans on the ±0.40 ms that this limit does not have."""
-    # one judged interval each, its finding (and evidence line) made only where the verdict
-    # shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
-    found: list[MeasuredIn] = []
-    leaning: list[tuple[float, Transmission]] = []
-    # a gap equal to one judged before is that interval again (its first one: Repeats)
-    judged: Repeats[MeasuredIn] = Repeats()
-    for s in line.transmissions:
-        chars = s.chars
-        for a, b in zip(chars, chars[1:], strict=False):
-            gap = b.start - a.end
-            u = own_uncertainty(uncertainty, a, b)
-            found.append(judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s)))
-            if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
-                leaning.append((gap, s))
-    if leaning:
-        gap, s = leaning[0]
-        tol = Finding(
-            "R-7.0-01",
-            Verdict.FAIL,
-            f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which the "
-            f"1.66 ms character gap does not have ({len(leaning)} such gap(s))",
-            measured_ms=round(gap * 1e3, 3),
-            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
-            evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in leaning[:5]],
-            observed=len(found),
-        )
-    elif found:
-        tol = Finding(
-            "R-7.0-01",
-            Verdict.PASS,
-            f"{len(found)} command character gaps, none inside the tolerance band the 1.66 ms "
-            "limit does not have; ±0.40 ms applied to every other recorder limit",
-            observed=len(found),
-        )
-    else:
-        tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
-    return [combine("R-7.0-13", found, "character gap"), tol]
+    judge = CharacterGaps(uncertainty)
+    judge.add(line)
+    return judge.findings()
+
+
+#: R-7.0-01's evidence: the first gaps inside the tolerance band, quoted
+LEANING_SHOWN = 5
+
+
+class CharacterGaps:
+    """:func:`judge_character_gaps` over a recording read a window at a time (issue 22):
+    each window's view :meth:`add`-ed in order, the findings those of the whole view. Kept
+    across windows: one judged interval per distinct gap (:class:`~..timing.Repeats`, each
+    holding the one transmission its evidence names) and, of the gaps inside the tolerance
+    band, the first few R-7.0-01 quotes and how many there were."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        # one judged interval each, its finding (and evidence line) made only where the
+        # verdict shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
+        self.found: list[MeasuredIn] = []
+        self.leaning: list[tuple[float, Transmission]] = []  # the first LEANING_SHOWN
+        self.leaning_count = 0
+        # a gap equal to one judged before is that interval again (its first one: Repeats)
+        self._judged: Repeats[MeasuredIn] = Repeats()
+
+    def add(self, line: TranscriptView) -> None:
+        """The command character gaps of ``line`` (the next window of the recording)."""
+        uncertainty, found, judged = self.uncertainty, self.found, self._judged
+        for s in line.transmissions:
+            chars = s.chars
+            for a, b in zip(chars, chars[1:], strict=False):
+                gap = b.start - a.end
+                u = own_uncertainty(uncertainty, a, b)
+                found.append(
+                    judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s))
+                )
+                if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
+                    self.leaning_count += 1
+                    if len(self.leaning) < LEANING_SHOWN:
+                        self.leaning.append((gap, s))
+
+    def findings(self) -> list[Finding]:
+        """R-7.0-13 and R-7.0-01 over everything added."""
+        found, leaning = self.found, self.leaning
+        if leaning:
+            gap, s = leaning[0]
+            tol = Finding(
+                "R-7.0-01",
+                Verdict.FAIL,
+                f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which "
+                f"the 1.66 ms character gap does not have ({self.leaning_count} such gap(s))",
+                measured_ms=round(gap * 1e3, 3),
+                limit_ms=INTER_CHAR_GAP_MAX * 1e3,
+                evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in leaning],
+                observed=len(found),
+            )
+        elif found:
+            tol = Finding(
+                "R-7.0-01",
+                Verdict.PASS,
+                f"{len(found)} command character gaps, none inside the tolerance band the "
+                "1.66 ms limit does not have; ±0.40 ms applied to every other recorder limit",
+                observed=len(found),
+            )
+        else:
+            tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
+        return [combine("R-7.0-13", found, "character gap"), tol]
 
 
 def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:
     """R-4.1-01 (decision A14, ±2%): back-to-back command characters start one frame apart."""
-    spacings = [
-        (b.start - a.start, s, own_uncertainty(uncertainty, a, b))
-        for s in line.transmissions
-        for a, b in zip(s.chars, s.chars[1:], strict=False)
-    ]
-    if not spacings:
-        return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
-    shortest, s, uncertainty = min(spacings, key=lambda x: x[0])
-    finding = judge_rate(
-        "shortest start-to-start spacing of command characters",
-        shortest,
-        2 * uncertainty,
-        [f"in {s.at()}"],
-    )
-    too_slow = shortest - 2 * uncertainty > CHAR_TIME * 1.02
-    if (
-        finding.verdict is Verdict.FAIL and too_slow
-    ):  # a gap, not a rate: see wire.judge_reply_bit_rate
-        finding.verdict = Verdict.INCONCLUSIVE
-        finding.detail += " (no back-to-back characters: rate and gaps cannot be separated)"
-    finding.detail += f"; about {10 / shortest:.0f} baud over {len(spacings)} spacings"
-    return finding
+    judge = CommandBitRate(uncertainty)
+    judge.add(line)
+    return judge.finding()
+
+
+class CommandBitRate:
+    """:func:`judge_command_bit_rate` over a recording read a window at a time (issue 22):
+    each window's view :meth:`add`-ed in order, the finding that of the whole view. Kept
+    across windows: the shortest spacing so far (the first of the shortest, as ``min``
+    takes it), its transmission and uncertainty, and how many spacings there were."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self.shortest: tuple[float, Transmission, float] | None = None
+        self.spacings = 0
+
+    def add(self, line: TranscriptView) -> None:
+        """The command character spacings of ``line`` (the next window of the recording)."""
+        uncertainty, shortest = self.uncertainty, self.shortest
+        for s in line.transmissions:
+            for a, b in zip(s.chars, s.chars[1:], strict=False):
+                self.spacings += 1
+                spacing = b.start - a.start
+                if shortest is None or spacing < shortest[0]:
+                    shortest = (spacing, s, own_uncertainty(uncertainty, a, b))
+        self.shortest = shortest
+
+    def finding(self) -> Finding:
+        """R-4.1-01 over everything added."""
+        if self.shortest is None:
+            return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
+        shortest, s, uncertainty = self.shortest
+        finding = judge_rate(
+            "shortest start-to-start spacing of command characters",
+            shortest,
+            2 * uncertainty,
+            [f"in {s.at()}"],
+        )
+        too_slow = shortest - 2 * uncertainty > CHAR_TIME * 1.02
+        if (
+            finding.verdict is Verdict.FAIL and too_slow
+        ):  # a gap, not a rate: see wire.judge_reply_bit_rate
+            finding.verdict = Verdict.INCONCLUSIVE
+            finding.detail += " (no back-to-back characters: rate and gaps cannot be separated)"
+        finding.detail += f"; about {10 / shortest:.0f} baud over {self.spacings} spacings"
+        return finding
 
 
 def judge_command_frame_lengths(line: TranscriptView, uncertainty: float) -> Finding:
