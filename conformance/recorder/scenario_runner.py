@@ -70,6 +70,9 @@ class ScenarioRun:
     #: sent until then is all it sent, so rules over every transmission judge it in full
     timed_out: JobTimeout | None = None
     budget: JobBudget | None = None
+    #: line time at which the recorder's job ended (its done, cannot or failure; a cut job's
+    #: cut): what a sensor began to send after it, the recorder did not hear in the job
+    ended_at: float | None = None
 
     @property
     def cut_at(self) -> float | None:
@@ -170,6 +173,11 @@ class RecorderSession(Session):
         view.cut_parts = {
             i: cut for i, n in enumerate(names) if (cut := self.run(n).cut_at) is not None
         }
+        view.ended_parts = {
+            i: end
+            for i, n in enumerate(names)
+            if (end := self.run(n).ended_at) is not None and i not in view.cut_parts
+        }
         return view
 
     def run(self, name: str) -> ScenarioRun:
@@ -224,15 +232,25 @@ class RecorderSession(Session):
             output = self.driver.act(scenario.name, request, self.link, budget)
         except RecorderDriverError as exc:
             output, error, cut = _failed(exc)
+        ended = self.link.now()
         if cut is not None:
-            cut.at = self.link.now()
-        transcript.note(self.link.now(), output_note(scenario.name, output, error, cut))
+            cut.at = ended
+        transcript.note(ended, output_note(scenario.name, output, error, cut))
         self.bus.advance(self.link.now() + SETTLE)
         self.bus.rx.clear()
         events = transcript.since(first)
         self._check_setup(scenario, events, error, cut)
         return ScenarioRun(
-            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
+            scenario,
+            events,
+            output,
+            error,
+            tuple(played),
+            request,
+            tuple(absences),
+            cut,
+            budget,
+            ended,
         )
 
     @staticmethod
@@ -281,8 +299,9 @@ class RecorderSession(Session):
             output, error = RecorderOutput(), str(exc)
         except RecorderDriverError as exc:
             output, error, cut = _failed(exc)
+        ended = line.now()
         if cut is not None:
-            cut.at = line.now()
+            cut.at = ended
         line.note(output_note(scenario.name, output, error, cut))
         line.settle(SETTLE)
         kept = line.line
@@ -292,7 +311,16 @@ class RecorderSession(Session):
         events = [e for e in list(line.transcript.events) if begin <= e.start <= end]
         self._check_setup(scenario, events, error, cut)
         return ScenarioRun(
-            scenario, events, output, error, tuple(played), request, tuple(absences), cut, budget
+            scenario,
+            events,
+            output,
+            error,
+            tuple(played),
+            request,
+            tuple(absences),
+            cut,
+            budget,
+            ended,
         )
 
     def _act_served(

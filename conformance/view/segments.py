@@ -317,6 +317,9 @@ class TranscriptView:
     #: parts whose job the tool cut at its budget while the recorder was still in it, with the
     #: line time of the cut: what the recorder had not sent by then it may still have sent
     cut_parts: dict[int, float] = field(default_factory=dict)
+    #: parts whose job the recorder ended itself (done or cannot), with the line time it did:
+    #: a reply that began after it was never heard by the recorder in that job
+    ended_parts: dict[int, float] = field(default_factory=dict)
 
     @property
     def commands(self) -> list[Transmission]:

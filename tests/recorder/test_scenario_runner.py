@@ -9,15 +9,19 @@ import sys
 import pytest
 
 from conformance.cli import main
+from conformance.judges.recorder.collection import judge_data_collection
+from conformance.judges.recorder.measurements import observed_measurements
 from conformance.ports import PortError
 from conformance.protocol.commands import measure
 from conformance.recorder.drivers import Interactive, RecorderDriverError, Trigger
 from conformance.recorder.played import SensorSpec, Spoil
 from conformance.recorder.scenario_runner import RecorderSession, check_port
-from conformance.recorder_jobs import Request, Task
+from conformance.recorder_jobs import RecorderOutput, Request, Task
 from conformance.sim.bus import SimBus, SimLink
 from conformance.sim.line_monitor import LineMonitor
 from conformance.tool_recorder import Policy, ToolRecorder
+from conformance.transcript import to_wire_7e1
+from conformance.verdicts import Verdict
 from tests.support.shared_runs import copied_run
 
 
@@ -120,3 +124,35 @@ def test_cli_recorder_role(tmp_path, tmp_path_factory):
     assert code == 1
     assert main(["--port", "sim://?recorder-faults=bogus", "--role", "recorder"]) == 4
     assert main(["--port", "sim", "--role", "recorder", "--trigger", "true"]) == 4
+
+
+class _GivesUpAtTheStopBit:
+    """A recorder that sends a break and its first command, then ends its job at the stop
+    bit, as HydroSense/SDI12's ``refresh()`` (a 15 ms timeout counted from queueing the
+    command) made the seventeenth round's logger do (docs/kit.md)."""
+
+    kind = "gives-up"
+    needs_real_time = False
+
+    def act(self, scenario, request, link, budget=None):
+        link.bus.tool_break(0.0125)
+        link.wait_until(link.now() + 0.009)
+        for c in request.commands[0]:
+            link.bus.tool_char(to_wire_7e1(ord(c)), link.now())
+        return RecorderOutput()
+
+
+def test_a_job_ended_before_the_reply_keeps_its_end_and_owes_no_values():
+    """The session keeps when each job ended (``ScenarioRun.ended_at``, the view's
+    ``ended_parts``): the played sensor's 000299 to 0C9!, begun after the recorder was done,
+    starts no measurement it should have collected (R-4.4.8-05 FAILed it before)."""
+    session = RecorderSession("sim", driver=_GivesUpAtTheStopBit())
+    run = session.run("concurrent-99")
+    sent = [e for e in run.events if e.kind == "char" and e.origin == "tool"]
+    assert run.ended_at == pytest.approx(sent[-1].end)
+    view = session.view("concurrent-99")
+    assert view.ended_parts == {0: run.ended_at}
+    assert any(e.origin == "sensor0" and e.start > run.ended_at for e in run.events)
+    taken = observed_measurements(view, 0.0)
+    assert taken == []
+    assert judge_data_collection(taken)[0].verdict is not Verdict.FAIL

@@ -84,6 +84,8 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
         cmd = s.command
         if cmd is None or not cmd.starts_measurement or problems[i] is not None:
             continue
+        if _after_the_job(line, s):
+            continue  # the recorder had ended its job: it never heard this reply
         body, _ = split_line(decode_7e1(s.reply))
         parsed = parse_measurement_reply_for(body, cmd)
         if parsed.ttt is None or parsed.count is None:
@@ -128,6 +130,14 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
             )
         )
     return taken
+
+
+def _after_the_job(line: TranscriptView, s: Transmission) -> bool:
+    """Whether ``s``'s reply began after the recorder ended its job (``ended_parts``): a
+    measurement it never heard announced, so it owed none of its values (the retry rules
+    judge a command given up on; R-4.4.8-05 would blame a collection never begun)."""
+    end = line.ended_parts.get(s.part)
+    return end is not None and bool(s.reply) and s.reply[0].start >= end
 
 
 def collection_end(m: ObservedMeasurement) -> tuple[Transmission | None, ReplyProblem | None, bool]:

@@ -443,3 +443,28 @@ def test_data_commands_never_answered_leave_storage_and_high_volume_undecided():
     taken = observed_measurements(stopped.view(), 0.0)
     assert by_id(judge_concurrent_storage(taken))["R-4.4.7-07"].verdict is Verdict.WARN
     assert by_id(judge_high_volume(taken, True))["R-5.4-01"].verdict is Verdict.FAIL
+
+
+def test_a_reply_after_the_recorder_ended_its_job_owes_no_values_r_4_4_8_05():
+    """Seventeenth round, HydroSense/SDI12 (docs/kit.md): ``refresh()`` gives up 15 ms after
+    queueing ``0C1!`` (before its ``!`` was out) and the logger said done at the stop bit; the
+    played sensor's ``000204`` came 9 ms later, and R-4.4.8-05 FAILed "0C1!: stopped after the
+    reply with 0 of 4 values" (R-4.4.7-08 "read none"), a reply the recorder never heard. A
+    reply begun after the job's end (``ended_parts``) starts no measurement; one begun before
+    it, the recorder ending all the same, still FAILs."""
+    w = Wire().brk().rec("0C1!")
+    end = w.t
+    w.sensor("000204\r\n")
+    view = w.view()
+    sent = {s.text for s in view.transmissions}
+    assert judge_data_collection(observed_measurements(view, 0.0))[0].verdict is Verdict.FAIL
+    view.ended_parts = {0: end}
+    taken = observed_measurements(view, 0.0)
+    assert taken == []
+    assert judge_data_collection(taken)[0].verdict is Verdict.INCONCLUSIVE
+    r708 = by_id(judge_concurrent_storage(taken, ("0C1!",), sent))["R-4.4.7-08"]
+    assert r708.verdict is Verdict.INCONCLUSIVE and "never validly answered" in r708.detail
+    # the job ended after the reply began: heard, and no D0 followed
+    view.ended_parts = {0: end + 0.010}
+    found = judge_data_collection(observed_measurements(view, 0.0))
+    assert found[0].verdict is Verdict.FAIL and "0 of 4 values" in found[0].detail
