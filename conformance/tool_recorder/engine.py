@@ -82,6 +82,9 @@ class ToolRecorder:
         self._collided: set[tuple[float, float]] = set()  # tool events already noted
         self._apart = ApartSoFar()  # the collision scan's shortcut, read on as events come
         self._dut_end = _LastDutChar()  # the end of the DUT's last character, kept up to date
+        #: the end of the last reply read whole to its CR LF after which no rule reads on
+        #: (:func:`closes_exchange`): no look past the turnaround after it (issue 22, eff11)
+        self._closed_reply_end: float | None = None
         #: Addresses whose ``a!`` drew a reply so far (valid or not, not contention): silence
         #: to an ``a!`` probe (a wake-up, a poll at a new address) is evidence only from a
         #: sensor shown to answer ``a!`` at all (:func:`~conformance.preconditions.acknowledges`).
@@ -247,10 +250,15 @@ class ToolRecorder:
         """How long past the turnaround after the DUT's last character :meth:`clear_to_send`
         listens before it transmits (s): what the turnaround leaves of a back-to-back
         character's frame and the link's timing uncertainty (:func:`look_past_turnaround`),
-        or nothing right after the tool's own break. It ends that long after the turnaround,
+        or nothing right after the tool's own break or after a reply that closed its exchange
+        at its CR LF, where no rule reads what follows (:func:`closes_exchange`; a character
+        the DUT sent since brings the look back). It ends that long after the turnaround,
         so a case that aims a transmission at a moment later than that need not start its
         wait any earlier (:meth:`SensorSession.mark_until`)."""
         if _own_break_last(self.link):
+            return 0.0
+        closed = self._closed_reply_end
+        if closed is not None and self._dut_end.after(self.link.transcript.events) == closed:
             return 0.0
         return look_past_turnaround(self.link.info.timing_uncertainty, self.policy.turnaround)
 
@@ -480,12 +488,19 @@ class ToolRecorder:
     ) -> Attempt:
         """One transmission and its reply, as the hooks let it go (:meth:`Hooks.attempt`)."""
 
+        proceeded = False
+
         def proceed() -> Attempt:
+            nonlocal proceeded
+            proceeded = True
             return self._usual_attempt(
                 wire, address, command, brk, binary, crc, gap, marking, collide
             )
 
-        return self.hooks.attempt(self, wire, address, command, proceed)
+        attempt = self.hooks.attempt(self, wire, address, command, proceed)
+        if not proceeded:  # a hook's own attempt: no reply known to have closed it
+            self._closed_reply_end = None
+        return attempt
 
     def _usual_attempt(
         self,
@@ -501,6 +516,7 @@ class ToolRecorder:
     ) -> Attempt:
         """Listen before talk, send, then read and judge the reply."""
         break_event, sent, stray = self._transmit(wire, address, brk, gap, marking, collide)
+        self._closed_reply_end = None
         command_end = sent[-1].end if sent else self.link.now()
         p = self.policy
         framing = Framing(
@@ -520,6 +536,8 @@ class ToolRecorder:
             state = self._judge_reply(reply, command, address, command_end, framing, crc)
         if reply and not collided and command is not None and command.kind is Kind.ACKNOWLEDGE:
             self.acknowledged.add(address)
+        if not collided and not framing.is_text(reply) and closes_exchange(command, reply):
+            self._closed_reply_end = reply[-1].end
         return Attempt(
             break_event, sent, reply, state, self.link.now(), stray_events=stray + collided
         )
@@ -650,6 +668,41 @@ def look_past_turnaround(uncertainty: float, turnaround: float) -> float:
     turnarounds a real run). On the sim (no uncertainty) the turnaround covers the frame and
     nothing is added, as before."""
     return max(0.0, CHAR_TIME + uncertainty - turnaround)
+
+
+#: Commands whose one-line reply ends the exchange at its CR LF: nothing the standard lets
+#: the sensor send may follow it at once. Left out: measurements and aIM!-style commands
+#: (their ``atttn`` may be followed by a service request, at once where ttt is 000: R-4.4.6-03,
+#: R-6.1-03), extended and unparsed commands (a reply may run over several lines), binary.
+CLOSED_BY_LINE_END = frozenset(
+    {
+        Kind.ACKNOWLEDGE,
+        Kind.QUERY_ADDRESS,
+        Kind.IDENTIFY,
+        Kind.CHANGE_ADDRESS,
+        Kind.DATA,
+        Kind.CONTINUOUS,
+        Kind.METADATA,
+    }
+)
+
+
+def closes_exchange(command: Command | None, reply: list[Event]) -> bool:
+    """Whether ``reply``, read to its CR LF, leaves nothing a rule reads on the line after it,
+    so the tool may transmit once the turnaround is over without the look for a character
+    sent back to back after the LF (:meth:`ToolRecorder.look_before_transmit`). A compliant
+    sensor has released the line 7.5 ms after its LF (R-7.0-11) and the turnaround is 9 ms
+    after the LF's stamp, which is never earlier than its end on the wire: the tool
+    transmits inside the standard, and what a faulty sensor still sends is recorded all
+    the same (a collision is noted). Where a rule does read what follows at once (a
+    service request after ``atttn``) the look stays. Issue 22, eff11: about 600 of a real
+    run's 680 turnarounds behind RFC 2217, 4.33 ms each."""
+    return (
+        command is not None
+        and command.kind in CLOSED_BY_LINE_END
+        and validity.ends_line(reply)
+        and all(e.kind is EventKind.CHAR for e in reply)
+    )
 
 
 def _own_break_last(link: Link) -> bool:

@@ -66,14 +66,28 @@ def test_listening_up_to_the_moment_adds_no_look_once_it_is_over():
     assert marking == pytest.approx(75e-3, abs=1e-9)
 
 
-def test_a_moment_inside_the_turnaround_and_the_look_is_not_kept():
-    """Aimed closer to the reply than the turnaround and the look, the command waits for
-    both, as it did: the collision guard is not cut short by aiming."""
+def test_a_moment_inside_the_turnaround_is_not_kept():
+    """Aimed closer to the reply than the turnaround, the command waits for it, as it did:
+    the collision guard is not cut short by aiming. After ``a!``'s reply, which closed its
+    exchange at its CR LF, there is no look past the turnaround (issue 22, eff11:
+    ``tests/tool_recorder/test_look_after_line_end.py``); it was 13.33 ms."""
     session = _session()
     policy = session.master.policy
-    marking = _follow_up_at(session, 10e-3)
-    assert marking == pytest.approx(policy.turnaround + session.master.look_before_transmit())
-    assert marking == pytest.approx(CHAR_TIME + UNCERTAINTY, abs=1e-9)  # a back-to-back frame
+    marking = _follow_up_at(session, 5e-3)
+    assert marking == pytest.approx(policy.turnaround, abs=1e-9)
+
+
+def test_a_moment_inside_the_turnaround_and_the_look_after_a_start_reply_is_not_kept():
+    """After ``atttn`` (a service request may follow at once) the look stays: the command
+    waits for the turnaround and the look, a back-to-back frame behind the link's lateness."""
+    session = _session()
+    session.listen(0.15)
+    first = session.master.transact("0M!", force_break=True)
+    last_end = first.attempts[-1].reply_events[-1].end
+    session.mark_until(last_end + 10e-3)
+    ex = session.master.raw("0I!", break_first=False)
+    marking = ex.attempts[0].command_events[0].start - last_end
+    assert marking == pytest.approx(CHAR_TIME + UNCERTAINTY, abs=1e-9)
 
 
 def test_right_after_the_tools_own_break_nothing_is_taken_off():

@@ -45,11 +45,13 @@ def _reply_end(master: ToolRecorder) -> float:
     )
 
 
-def test_after_a_reply_the_turnaround_and_the_look_are_both_kept():
-    master = _real_like(ScriptedSensor({"0!": ["0\r\n"], "0I!": ["0ident\r\n"]}))
-    master.transact("0!")
+def test_after_a_start_reply_the_turnaround_and_the_look_are_both_kept():
+    """``atttn`` may be followed at once by a service request (ttt = 000, R-4.4.6-03): the
+    tool looks for a character sent back to back after its LF before it transmits."""
+    master = _real_like(ScriptedSensor({"0M!": ["00001\r\n"], "0D0!": ["0+1\r\n"]}))
+    master.transact("0M!")
     last = _reply_end(master)
-    ex = master.transact("0I!")
+    ex = master.transact("0D0!")
     start = ex.attempts[0].command_events[0].start
     assert start == pytest.approx(last + TURNAROUND + LOOK, abs=1e-12)
     assert start - last == pytest.approx(CHAR_TIME + UNCERTAINTY, abs=1e-12)  # 13.33 ms
@@ -69,8 +71,8 @@ def test_the_look_covers_a_back_to_back_character_and_no_more():
 
 def test_after_listening_past_the_look_the_tool_transmits_at_once():
     """The look is over: the command goes out when the wait ends, not 5 ms later (it did)."""
-    master = _real_like(ScriptedSensor({"0!": ["0\r\n"], "0I!": ["0ident\r\n"]}))
-    master.transact("0!")
+    master = _real_like(ScriptedSensor({"0M!": ["00001\r\n"], "0I!": ["0ident\r\n"]}))
+    master.transact("0M!")
     master.link.receive(master.link.now() + 0.2)  # a case's listening
     listened = master.link.now()
     ex = master.transact("0I!")  # past 87 ms of marking: a break first
@@ -78,8 +80,8 @@ def test_after_listening_past_the_look_the_tool_transmits_at_once():
 
 
 def test_after_a_wait_shorter_than_the_look_only_the_rest_of_it_is_listened():
-    master = _real_like(ScriptedSensor({"0!": ["0\r\n"], "0I!": ["0ident\r\n"]}))
-    master.transact("0!")
+    master = _real_like(ScriptedSensor({"0M!": ["00001\r\n"], "0I!": ["0ident\r\n"]}))
+    master.transact("0M!")
     last = _reply_end(master)
     master.link.wait_until(last + TURNAROUND + 2e-3)
     ex = master.transact("0I!")
