@@ -176,20 +176,21 @@ INTERACTIONS: tuple[Interaction, ...] = (
         frozenset({"abort-keeps-old-data", "buffer-cleared-by-break"}),
         "the measurement before the aborted one was read to its end, and the break before the"
         " D0 that follows the abort empties such a buffer, so the old data the abort brings"
-        " back are none: D0 after each abort is empty on the wire ('0', '0AP@') and the abort"
-        " rules hold there (seed 4118 with missing-crlf). R-4.4.5.1-02 and R-4.4.7.1-02"
-        " are INCONCLUSIVE: the same steps without an abort leave D0 empty too.",
-        removes=("R-4.4.7.1-01", "R-5.3-01"),
+        " back are none: D0 after each abort is empty on the wire ('0', '0AP@'), and aI! was"
+        " shown to abort aC! (R-4.4.7.1-01; seed 4118 with missing-crlf). R-4.4.5.1-02,"
+        " R-4.4.7.1-02 and R-5.3-01 are INCONCLUSIVE: the same steps without an abort leave"
+        " D0 (DB0 after aHB!) empty too.",
+        removes=("R-4.4.7.1-01",),
     ),
     Interaction(
         frozenset({"abort-keeps-old-data", "data-lost-after-standby"}),
         "the measurement before the aborted one was read to its end and the sensor then went"
         " to standby, which emptied the buffer, so the old data the abort brings back are"
         " none: D0 after each abort is empty on the wire (seed 4148 with abort-sends-zero-"
-        "reply: 0D0! at 81.55 s read all 3 values, the abort's 0D0! -> '0<CR><LF>')."
-        " R-4.4.5.1-02 and R-4.4.7.1-02 are INCONCLUSIVE: the same steps without an abort"
-        " leave D0 empty too.",
-        removes=("R-4.4.7.1-01", "R-5.3-01"),
+        "reply: 0D0! at 81.55 s read all 3 values, the abort's 0D0! -> '0<CR><LF>'), and aI!"
+        " was shown to abort aC! (R-4.4.7.1-01). R-4.4.5.1-02, R-4.4.7.1-02 and R-5.3-01 are"
+        " INCONCLUSIVE: the same steps without an abort leave D0 (DB0 after aHB!) empty too.",
+        removes=("R-4.4.7.1-01",),
     ),
     Interaction(
         frozenset({"buffer-cleared-after-read", "undefined-group-keeps-data"}),
