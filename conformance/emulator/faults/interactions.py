@@ -257,6 +257,32 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.8-03", "R-5.1-02"),
     ),
     Interaction(
+        frozenset({"buffer-cleared-after-read", "high-volume-two-digit-count"}),
+        "aHA!'s count is unreadable, so its data are never read and R-5.3-01 is judged on"
+        " aHB! alone, whose packets read up to the count (never past it to the empty one) are"
+        " not 'all read': the control DB0 after standby and a break still holds values, so the"
+        " empty DB0 after aI! shows the abort emptied the buffer, and R-5.3-01 holds on the"
+        " wire (seed 4248 with value-eight-digits: 'aHB! ... 0I! aborted it').",
+        removes=("R-5.3-01",),
+    ),
+    Interaction(
+        frozenset({"data-lost-after-standby", "standby-ignored"}),
+        "the sensor never drops to standby by itself, so the standby that would empty its"
+        " buffer never comes: the control reads after standby and a break hold values, and the"
+        " empty D0 after each abort, and the data unchanged by identify commands, are shown on"
+        " the wire (seed 4248 with partial-command-accepted).",
+        removes=("R-4.4.5.1-02", "R-4.4.7.1-02", "R-5.3-01", "R-6.1-03"),
+    ),
+    Interaction(
+        frozenset({"answers-foreign-address", "never-standby", "standby-after-60ms"}),
+        "answers-foreign-address's standby after it answers another address and standby-after-"
+        "60ms's 60 ms after a reply together leave the sensor shown in standby, where never-"
+        "standby beside either alone is not ('the sensor was not shown in standby'): the"
+        " spacing probes find it asleep, silent after a 5.00 ms spacing and woken by a 12.60 ms"
+        " break, so R-7.0-03 and R-7.0-04 hold on the wire (seed 4251).",
+        removes=("R-7.0-03", "R-7.0-04"),
+    ),
+    Interaction(
         frozenset({"concurrent-service-request", "no-service-request"}),
         "the sensor sends no service request at all (the emulator's switch silences the"
         " concurrent ones too), so none follows aC!, aCC!, aHA! or aHB! and the rules that"
