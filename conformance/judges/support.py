@@ -10,6 +10,7 @@ case while another calls it unsupported.
 
 from __future__ import annotations
 
+from ..protocol.binary import parse_binary_packet
 from ..protocol.crc import is_crc_char
 from ..protocol.responses import split_line
 from ..protocol.values import check_value, split_values
@@ -87,3 +88,14 @@ def empty_data_reply(ex: Exchange) -> bool:
     R-4.4.7.1-02)."""
     rest = split_line(ex.reply_text)[0][1:]
     return rest == "" or (len(rest) == 3 and all(map(is_crc_char, rest)))
+
+
+def holds_values(ex: Exchange, binary: bool = False) -> bool:
+    """An answered D reply with more than its address and CRC, or with ``binary`` a DB packet
+    with a payload: what a buffer that kept values gives (the control read before an abort,
+    :meth:`SensorSession.values_after_standby`)."""
+    if not ex.answered:
+        return False
+    if binary:
+        return parse_binary_packet(ex.reply_bytes).size > 0
+    return not empty_data_reply(ex)

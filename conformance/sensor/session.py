@@ -521,12 +521,15 @@ class SensorSession(Session):
     def values_after_standby(self, m: Measurement) -> list[Exchange]:
         """With ``m``'s values read to their end: standby, a break, then ``aD0!`` and on to
         the D command that gave ``m`` its first values (:func:`first_filled`) while each
-        reads empty. The steps that come before an abort without the abort: an empty D0 after
-        an abort shows the abort emptied the buffer only where these leave values in it (a
-        sensor that empties it once read, at the next break or in standby gives the same
-        empty D0 whatever the abort does: abort-keeps-old-data beside buffer-cleared-after-
-        read, -by-break, data-lost-after-standby PASSed R-4.4.5.1-02)."""
+        reads empty (after ``aHB!``: ``aDB0!``). The steps that come before an abort without
+        the abort: an empty D0 after an abort shows the abort emptied the buffer only where
+        these leave values in it (a sensor that empties it once read, at the next break or in
+        standby gives the same empty D0 whatever the abort does: abort-keeps-old-data beside
+        buffer-cleared-after-read, -by-break, data-lost-after-standby PASSed R-4.4.5.1-02,
+        R-4.4.7.1-02 and R-5.3-01)."""
         self.to_standby()
+        if m.binary:  # aHB!'s values are read as packets; its groups never start late
+            return [self.fresh_exchange("DB0", binary=True, force_break=True)]
         # the D replies of whatever measurement the buffer holds: with or without a CRC as
         # the engine's last measurement at this address had it, not as ``m`` has it
         ds = [self.fresh_exchange("D0", force_break=True)]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges.recorder.retries import judge_retries
+from conformance.judges.recorder.retries import judge_breaks_over_replies, judge_retries
 
 from ._helpers import line_of
 
@@ -33,3 +33,11 @@ def test_retries(recorder, case):
     )
     line = line_of(recorder, case, *RETRY_SCENARIOS)
     case.extend(judge_retries(line, recorder.uncertainty))
+    # a break over a reply still coming and the command again is no retry that waited for
+    # the response to complete, in any scenario: the long replies are in the others (a 40-
+    # character buffer broke into aHA!'s and aC9!'s 75-character D replies unjudged)
+    others = [n for n in recorder.applicable() if n not in RETRY_SCENARIOS]
+    if line is not None and others:
+        rest = line_of(recorder, case, *others, whole_run=True)
+        if rest is not None:
+            case.extend(judge_breaks_over_replies(rest, recorder.uncertainty))

@@ -9,6 +9,7 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
+from conformance.judges.support import holds_values
 from conformance.protocol.binary import parse_binary_packet
 from conformance.protocol.responses import split_line
 from conformance.sensor.session import shows_support
@@ -191,10 +192,16 @@ def test_high_volume_is_concurrent(sensor, case):
         if not baseline.ttt or not baseline.value_count:
             continue
         kept, poke1 = sensor.disturbed_measurement(baseline.command, f"{other}I!")
+        # an empty D0 after the own aI! shows the abort emptied the buffer only where the
+        # buffer keeps values through what comes before it without an abort (read to the
+        # end, standby, a break: abort-keeps-old-data beside buffer-cleared-by-break or
+        # data-lost-after-standby PASSed 'aI! aborted it', as R-4.4.7.1-02 did)
+        control = sensor.values_after_standby(kept)
         stopped, poke2 = sensor.disturbed_measurement(baseline.command, f"{sensor.address}I!")
         case.evidence(
-            f"{code}: break + {other}I!, then {sensor.address}I!, while running",
-            [kept, poke1, stopped, poke2],
+            f"{code}: break + {other}I!, standby, break and D0, then {sensor.address}I!,"
+            " while running",
+            [kept, poke1, *control, stopped, poke2],
         )
         if kept.value_count < baseline.value_count:
             case.add(
@@ -223,6 +230,18 @@ def test_high_volume_is_concurrent(sensor, case):
                     f"({stopped.value_count} values still delivered)",
                     evidence=xjudge.cite([stopped.start, poke2, *stopped.data]),
                     observed=1,
+                )
+            )
+        elif not any(holds_values(d, kept.binary) for d in control):
+            case.add(
+                inconclusive(
+                    "R-5.3-01",
+                    f"a{code}! survived a break and {other}I!, and no values came after"
+                    f" {sensor.address}I!, but the buffer was not shown to hold values up to"
+                    " the abort (old data kept look the same): read to its end, standby, a"
+                    " break and a D read gave none either: "
+                    + "; ".join(xjudge.shown(d) for d in control),
+                    observed=2 + len(control),
                 )
             )
         else:

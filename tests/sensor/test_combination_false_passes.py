@@ -92,6 +92,10 @@ the buffer was emptied before the abort by a read to its end, the break after it
 (abort-keeps-old-data + buffer-cleared-after-read, -by-break, data-lost-after-standby, declared
 masked until now): the case reads D0 again after the same steps without an abort, and an empty
 D0 there leaves the rule INCONCLUSIVE. R-4.4.7.1-02 the same after aI! aborted aC!.
+R-5.3-01 the same after aI! aborted aHA!/aHB! (abort-keeps-old-data + buffer-cleared-by-break,
+data-lost-after-standby, declared masked until round 8): 'aI! aborted it' PASSed on an empty
+D0 the break before it or standby had emptied; the undisturbed measurement is read again after
+standby and a break first, and an empty read there leaves the rule INCONCLUSIVE.
 """
 
 from __future__ import annotations
@@ -123,6 +127,9 @@ from testcases.sensor.test_4_4_basic import test_change_address as change_case
 from testcases.sensor.test_4_addressing import test_address_range as range_case
 from testcases.sensor.test_5_high_volume import test_high_volume_ascii as ascii_case
 from testcases.sensor.test_5_high_volume import test_high_volume_binary as binary_case
+from testcases.sensor.test_5_high_volume import (
+    test_high_volume_is_concurrent as high_volume_abort_case,
+)
 from testcases.sensor.test_5_high_volume import test_high_volume_optional as optional_case
 from testcases.sensor.test_6_metadata import test_identify_starts_nothing as identify_case
 from testcases.sensor.test_6_metadata import test_parameter_metadata as metadata_case
@@ -661,4 +668,27 @@ def test_r_4_4_7_1_02_an_empty_d0_after_a_concurrent_abort_needs_a_buffer_that_k
     """As R-4.4.5.1-02: aC! undisturbed, read to the end, standby, a break and D0 must show
     values before an empty D0 after aI! aborted aC! shows the abort emptied the buffer."""
     verdict = case_verdict(sim_session(faults), concurrent_abort_case, "R-4.4.7.1-02")
+    assert verdict is expected
+
+
+@pytest.mark.parametrize(
+    ("faults", "expected"),
+    [
+        ("abort-keeps-old-data,buffer-cleared-by-break", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data,data-lost-after-standby", Verdict.INCONCLUSIVE),
+        ("buffer-cleared-by-break", Verdict.INCONCLUSIVE),
+        ("data-lost-after-standby", Verdict.INCONCLUSIVE),
+        ("abort-keeps-old-data,buffer-cleared-after-read", Verdict.FAIL),
+        ("abort-keeps-old-data", Verdict.FAIL),
+        ("concurrent-not-aborted", Verdict.FAIL),
+        ("", Verdict.PASS),
+    ],
+)
+def test_r_5_3_01_an_empty_d0_after_an_own_command_abort_needs_a_buffer_that_kept_values(
+    faults, expected
+):
+    """As R-4.4.7.1-02 for aHA!/aHB!: the measurement read to its end, standby, a break and
+    D0 (DB0) must show values before an empty D0 after aI! aborted it shows the abort
+    emptied the buffer rather than kept old data a break or standby had emptied already."""
+    verdict = case_verdict(sim_session(faults), high_volume_abort_case, "R-5.3-01")
     assert verdict is expected

@@ -176,20 +176,21 @@ INTERACTIONS: tuple[Interaction, ...] = (
         frozenset({"abort-keeps-old-data", "buffer-cleared-by-break"}),
         "the measurement before the aborted one was read to its end, and the break before the"
         " D0 that follows the abort empties such a buffer, so the old data the abort brings"
-        " back are none: D0 after each abort is empty on the wire ('0', '0AP@') and the abort"
-        " rules hold there (seed 4118 with missing-crlf). R-4.4.5.1-02 and R-4.4.7.1-02"
-        " are INCONCLUSIVE: the same steps without an abort leave D0 empty too.",
-        removes=("R-4.4.7.1-01", "R-5.3-01"),
+        " back are none: D0 after each abort is empty on the wire ('0', '0AP@'), and aI! was"
+        " shown to abort aC! (R-4.4.7.1-01; seed 4118 with missing-crlf). R-4.4.5.1-02,"
+        " R-4.4.7.1-02 and R-5.3-01 are INCONCLUSIVE: the same steps without an abort leave"
+        " D0 (DB0 after aHB!) empty too.",
+        removes=("R-4.4.7.1-01",),
     ),
     Interaction(
         frozenset({"abort-keeps-old-data", "data-lost-after-standby"}),
         "the measurement before the aborted one was read to its end and the sensor then went"
         " to standby, which emptied the buffer, so the old data the abort brings back are"
         " none: D0 after each abort is empty on the wire (seed 4148 with abort-sends-zero-"
-        "reply: 0D0! at 81.55 s read all 3 values, the abort's 0D0! -> '0<CR><LF>')."
-        " R-4.4.5.1-02 and R-4.4.7.1-02 are INCONCLUSIVE: the same steps without an abort"
-        " leave D0 empty too.",
-        removes=("R-4.4.7.1-01", "R-5.3-01"),
+        "reply: 0D0! at 81.55 s read all 3 values, the abort's 0D0! -> '0<CR><LF>'), and aI!"
+        " was shown to abort aC! (R-4.4.7.1-01). R-4.4.5.1-02, R-4.4.7.1-02 and R-5.3-01 are"
+        " INCONCLUSIVE: the same steps without an abort leave D0 (DB0 after aHB!) empty too.",
+        removes=("R-4.4.7.1-01",),
     ),
     Interaction(
         frozenset({"buffer-cleared-after-read", "undefined-group-keeps-data"}),
@@ -254,6 +255,32 @@ INTERACTIONS: tuple[Interaction, ...] = (
         " start delivered its count, R-4.4.8-03 holding on the wire over 11 of them (seed"
         " 4156 with extended-no-crlf).",
         removes=("R-4.4.8-03", "R-5.1-02"),
+    ),
+    Interaction(
+        frozenset({"buffer-cleared-after-read", "high-volume-two-digit-count"}),
+        "aHA!'s count is unreadable, so its data are never read and R-5.3-01 is judged on"
+        " aHB! alone, whose packets read up to the count (never past it to the empty one) are"
+        " not 'all read': the control DB0 after standby and a break still holds values, so the"
+        " empty DB0 after aI! shows the abort emptied the buffer, and R-5.3-01 holds on the"
+        " wire (seed 4248 with value-eight-digits: 'aHB! ... 0I! aborted it').",
+        removes=("R-5.3-01",),
+    ),
+    Interaction(
+        frozenset({"data-lost-after-standby", "standby-ignored"}),
+        "the sensor never drops to standby by itself, so the standby that would empty its"
+        " buffer never comes: the control reads after standby and a break hold values, and the"
+        " empty D0 after each abort, and the data unchanged by identify commands, are shown on"
+        " the wire (seed 4248 with partial-command-accepted).",
+        removes=("R-4.4.5.1-02", "R-4.4.7.1-02", "R-5.3-01", "R-6.1-03"),
+    ),
+    Interaction(
+        frozenset({"answers-foreign-address", "never-standby", "standby-after-60ms"}),
+        "answers-foreign-address's standby after it answers another address and standby-after-"
+        "60ms's 60 ms after a reply together leave the sensor shown in standby, where never-"
+        "standby beside either alone is not ('the sensor was not shown in standby'): the"
+        " spacing probes find it asleep, silent after a 5.00 ms spacing and woken by a 12.60 ms"
+        " break, so R-7.0-03 and R-7.0-04 hold on the wire (seed 4251).",
+        removes=("R-7.0-03", "R-7.0-04"),
     ),
     Interaction(
         frozenset({"concurrent-service-request", "no-service-request"}),

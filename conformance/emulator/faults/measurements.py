@@ -181,20 +181,20 @@ DATA_BUFFER: tuple[Fault, ...] = (
         "Once all D pages were read, the next break empties the data buffer."
         " Data that do not survive a plain re-read leave nothing for the identify commands"
         " to disturb (R-6.1-03), nor an empty D0 after an abort to show the abort emptied"
-        " them (R-4.4.5.1-02, R-4.4.7.1-02).",
+        " them (R-4.4.5.1-02, R-4.4.7.1-02, R-5.3-01).",
         ("R-4.4.5-10",),
         settings={"clear_on_break_after_read": True},
-        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02"),
+        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02", "R-5.3-01"),
     ),
     Fault(
         "buffer-cleared-after-read",
         "Once all D pages were read, the buffer is empty (repeated D returns nothing)."
         " Data that do not survive a plain re-read leave nothing for the identify commands"
         " to disturb (R-6.1-03), nor an empty D0 after an abort to show the abort emptied"
-        " them (R-4.4.5.1-02, R-4.4.7.1-02).",
+        " them (R-4.4.5.1-02, R-4.4.7.1-02, R-5.3-01).",
         ("R-4.4.5-10",),
         settings={"clear_after_read": True},
-        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02"),
+        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02", "R-5.3-01"),
     ),
     Fault(
         "data-changes-on-repeat",
@@ -210,10 +210,10 @@ DATA_BUFFER: tuple[Fault, ...] = (
         "Once all D pages were read, entering standby empties the data buffer."
         " Data that do not survive a plain re-read leave nothing for the identify commands"
         " to disturb (R-6.1-03), nor an empty D0 after an abort to show the abort emptied"
-        " them (R-4.4.5.1-02, R-4.4.7.1-02).",
+        " them (R-4.4.5.1-02, R-4.4.7.1-02, R-5.3-01).",
         ("R-4.4.5-10",),
         settings={"clear_on_standby_after_read": True},
-        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02"),
+        inconclusive=("R-6.1-03", "R-4.4.5.1-02", "R-4.4.7.1-02", "R-5.3-01"),
     ),
     Fault(
         "identify-clears-buffer",

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ...protocol.timing import (
+    CHAR_TIME,
     RETRY_AFTER_BREAK,
     RETRY_MAX,
     RETRY_MIN,
@@ -23,7 +24,7 @@ from ...protocol.timing import (
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..reply_validity import NO_REPLY, Reason, ReplyProblem
+from ..reply_validity import NO_REPLY, STX, Reason, ReplyProblem
 from ..tally import Tally
 from ..timing import judge_window
 from .common import combine, own_uncertainty
@@ -37,6 +38,11 @@ STANDBY = STANDBY_MARKING + TOLERANCE
 WINDOW = RETRY_MAX + TOLERANCE
 #: The catalog decision that says what counts as a retry (and cites these two figures).
 RETRY_DECISION = "T2"
+#: The longest single-line reply a sensor may give (address, 75 value characters after aHA!,
+#: aCn!, aRn!, a CRC, CR LF): a break over a reply heard shorter than this, whose last
+#: character had not yet been followed by 8.33 ms of marking, cut a response that may
+#: still have been on its way to completing (section 7.2).
+LONGEST_LINE = 1 + 75 + 3 + 2
 
 
 @dataclass
@@ -137,7 +143,9 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
         if all(a.problem is None for a in group.attempts):
             continue
         _judge_group(line, group, uncertainty, acc)
-    acc.restarted.extend(_cut_replies(line))
+    resent, restarted = cut_replies(line, uncertainty)
+    acc.ends.extend(resent)
+    acc.restarted.extend(restarted)
     tally = acc.tally
     for rid in tally.ids:
         tally.decision(rid, RETRY_DECISION)
@@ -325,16 +333,57 @@ def _judge_repeated(
         )
 
 
-def _cut_replies(line: TranscriptView) -> list[str]:
+def cut_replies(line: TranscriptView, uncertainty: float) -> tuple[list[Finding], list[str]]:
     """Replies the recorder's own break cut into (:func:`.replies.cut_off`): no invalid
-    reply of the sensor's, so no retry was due (R-7.2-01, -03, -05 leave them out); the
-    break and what follows it are a new sequence, not a retry (decision T2), so R-7.2-06
-    names them and stays INCONCLUSIVE on them."""
-    return [
-        f"{cut} (after {s.at()}): a new sequence, not a retry"
-        for s in line.transmissions
-        if (cut := cut_off(s)) is not None
-    ]
+    reply of the sensor's, so no retry was due (R-7.2-01, -03, -05 leave them out). Where
+    the same command followed that break (the command sent again) over a single-line reply
+    heard shorter than any reply may be (:data:`LONGEST_LINE`), less than 8.33 ms after its
+    last character even at the stamps' uncertainty, the recorder did not "wait for the
+    response to complete before sending a retry" (section 7.2): R-7.2-06 FAILs (a 500 ms
+    poll over a 75-value reply, the fourteenth round's MicroPython logger; a break and the
+    command again is the sequence repeated, part of the retry logic, even where decision T2
+    counts no retry in it). Else R-7.2-06 names the cut and stays INCONCLUSIVE (a break to
+    abort, a reply longer than any valid one, multi-line text: R-4.4.13.1-04's)."""
+    failed: list[Finding] = []
+    named: list[str] = []
+    transmissions = line.transmissions
+    for i, s in enumerate(transmissions):
+        cut = cut_off(s)
+        if cut is None:
+            continue
+        nxt = transmissions[i + 1] if i + 1 < len(transmissions) else None
+        last, brk = s.reply[-1], s.cut_by
+        assert brk is not None  # cut_off found it
+        early = brk.start - last.end + own_uncertainty(uncertainty, last, brk) < CHAR_TIME
+        if (
+            nxt is not None
+            and nxt.break_event is brk
+            and nxt.stem == s.stem
+            and len(s.reply) < LONGEST_LINE
+            and not (len(s.reply) > 1 and s.reply[1].char7 == STX)
+            and early
+        ):
+            failed.append(
+                Finding(
+                    "R-7.2-06",
+                    Verdict.FAIL,
+                    f"{cut}, and sent {escape(nxt.text)} again after it: it did not wait for"
+                    " the response to complete",
+                    evidence=[s.at(), nxt.at()],
+                    observed=1,
+                )
+            )
+        else:
+            named.append(f"{cut} (after {s.at()}): a new sequence, not a retry")
+    return failed, named
+
+
+def judge_breaks_over_replies(line: TranscriptView, uncertainty: float) -> list[Finding]:
+    """R-7.2-06's FAILs of :func:`cut_replies` alone (none where nothing was cut): for
+    the scenarios :func:`judge_retries` does not read, whose long replies a recorder with a
+    short receive buffer or poll breaks into (breaks-over-long-reply: aHA!'s and aC9!'s
+    75-character D replies)."""
+    return cut_replies(line, uncertainty)[0]
 
 
 def _waited(ends: list[Finding], restarted: list[str]) -> Finding:

@@ -228,7 +228,9 @@ def test_a_reply_the_recorders_own_break_cut_into_is_not_the_sensors_invalid_rep
     breaks and sends the command again, over a long reply still coming. R-7.2-01, -03 and -05
     FAILed "reply '0+1.5+2.' does not end with CR LF ..., then a new sequence": the sensor's
     reply was valid, the recorder cut it. No invalid reply is seen there now, and R-7.2-06
-    names the cut (a new break is no retry: decision T2, INCONCLUSIVE)."""
+    names the cut. Eighth truth round: the same command sent again after that break is the
+    sequence repeated before the response completed (section 7.2: "The data recorder must
+    wait for the response to complete before sending a retry"): R-7.2-06 FAILs there."""
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n")
     w.t -= 60e-3  # the break starts while the reply's last characters are still coming
     line = w.brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n").view()
@@ -236,8 +238,9 @@ def test_a_reply_the_recorders_own_break_cut_into_is_not_the_sensors_invalid_rep
     for rid in ("R-7.2-01", "R-7.2-03", "R-7.2-05"):
         assert found[rid].verdict is Verdict.INCONCLUSIVE, found[rid].detail
     assert line.transmissions[0].cut_by is line.breaks[1]
-    assert found["R-7.2-06"].verdict is Verdict.INCONCLUSIVE
+    assert found["R-7.2-06"].verdict is Verdict.FAIL
     assert "break at t=0.129 s cut into the reply '0+1.5+2.'" in found["R-7.2-06"].detail
+    assert "sent 0D0! again after it" in found["R-7.2-06"].detail
     # a reply the sensor itself left unfinished (no LF, then 300 ms of marking before the
     # break) is still its invalid reply, and a new break instead of a retry still FAILs
     w = Wire().brk().rec("0D0!").sensor("0+1.5+2.").idle(300)
@@ -249,6 +252,22 @@ def test_a_reply_the_recorders_own_break_cut_into_is_not_the_sensors_invalid_rep
     # a complete reply, then the break 1 ms after its LF: nothing was cut
     w = Wire().brk().rec("0D0!").sensor("0+1.5\r\n").idle(1)
     assert w.brk().rec("0D1!").view().transmissions[0].cut_by is None
+
+
+def test_a_break_over_a_reply_then_another_command_is_named_not_failed_r_7_2_06():
+    """A break over a reply that the recorder follows with another command is no re-send
+    (a recorder may abort): R-7.2-06 names the cut and stays INCONCLUSIVE. So does one over
+    a reply already longer than any single line may be (a babbling sensor)."""
+    w = Wire().brk().rec("0D0!").sensor("0+1.5+2.5+3.5\r\n")
+    w.t -= 60e-3
+    found = by_id(judge_retries(w.brk().rec("1M!").sensor("10011\r\n").view(), 0.0))
+    assert found["R-7.2-06"].verdict is Verdict.INCONCLUSIVE, found["R-7.2-06"].detail
+    assert "cut into the reply" in found["R-7.2-06"].detail
+    babble = "0" + "+1.5" * 30 + "\r\n"  # 123 characters: no reply is this long
+    w = Wire().brk().rec("0D0!").sensor(babble)
+    w.t -= 60e-3
+    found = by_id(judge_retries(w.brk().rec("0D0!").sensor("0+1.5\r\n").view(), 0.0))
+    assert found["R-7.2-06"].verdict is Verdict.INCONCLUSIVE, found["R-7.2-06"].detail
 
 
 def test_multi_line_text_the_recorder_broke_into_is_not_waited_for_r_4_4_13_1_04():
