@@ -139,12 +139,13 @@ class HarnessBus(SimBus):
         if nxt is not None and nxt[1].start <= at:
             self.clashed = end
 
-    def tool_break(self, duration: float) -> Event:
-        self.advance(self.clock.now)
-        self._watch_clash(self.clock.now, self.clock.now + duration)
-        self._held_from = self.clock.now
+    def tool_break(self, duration: float, at: float | None = None) -> Event:
+        self.advance(self.clock.now if at is None else at)
+        start = self.clock.now if at is None else at
+        self._watch_clash(start, start + duration)
+        self._held_from = start
         try:
-            return super().tool_break(duration)
+            return super().tool_break(duration, at)
         finally:
             self._held_from = None
 

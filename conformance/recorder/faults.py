@@ -640,6 +640,37 @@ _FAULTS = (
         inconclusive=("R-7.2-04", "R-7.2-06"),
     ),
     RecorderFault(
+        "breaks-over-long-reply",
+        "Reads at most 40 characters of a reply (a fixed receive buffer) and never retries "
+        "without a break: past the 40th it gives the reply up and at once sends a break and the "
+        "command again over the rest, so it never waits for a long reply to complete "
+        "(R-7.2-06: aC9!'s and aHA!'s 75-character D0 replies). Those replies and pause-once's "
+        "aM2! data are never read whole: values lost (R-4.4-02, R-5.4-01), aC9! and aHA! given "
+        "up at D0 (R-4.4.8-05, R-4.4.7-07, R-5.1-04); and no retry is seen (R-7.2-01/-02/-03/"
+        "-05), nor a break+command+retries sequence repeated (R-7.2-04).",
+        (
+            "R-7.2-06",
+            "R-4.4-02",
+            "R-5.4-01",
+            "R-4.4.8-05",
+            "R-4.4.7-07",
+            "R-5.1-04",
+            "R-7.2-01",
+            "R-7.2-02",
+            "R-7.2-03",
+            "R-7.2-05",
+        ),
+        Parts(
+            policy={
+                "max_reply_chars": 40,
+                "retries_per_sequence": 0,
+                "max_hold": 0.0,
+                "post_break_marking": 20e-3,
+            }
+        ),
+        inconclusive=("R-7.2-04",),
+    ),
+    RecorderFault(
         "resends-after-timeout",
         f"Sends a command again without a break only {POLL_TIMEOUT} s after no reply or an "
         "invalid one, long after the sensor's 100 ms to standby: not a retry (R-7.2-01/-02/"

@@ -104,7 +104,8 @@ class RecordedRecorder:
         for e in sent:
             link.wait_until(e.start + offset)
             if e.kind is EventKind.BREAK:
-                link.bus.tool_break(e.end - e.start)
+                # where it was sent, even over a sensor's character still coming
+                link.bus.tool_break(e.end - e.start, e.start + offset)
             else:
                 link.bus.tool_char(e.wire, e.start + offset, e.end - e.start)
         if scenario in self.done:  # the recorder was busy (listening) until then

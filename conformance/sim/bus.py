@@ -178,9 +178,15 @@ class SimBus:
         return event
 
     # tool-side actions
-    def tool_break(self, duration: float) -> Event:
-        self.advance(self.clock.now)
-        start, end = self.clock.now, self.clock.now + duration
+    def tool_break(self, duration: float, at: float | None = None) -> Event:
+        """The tool's break of ``duration`` from now, or from ``at`` (a recorded break played
+        again where it was sent): a device's character begun before ``at`` is committed whole
+        and moves the clock past ``at``, but the break still began at ``at``, over it, as a
+        recorder's break over a reply still coming does (R-7.0-06's marking is counted from
+        its end)."""
+        self.advance(self.clock.now if at is None else at)
+        start = self.clock.now if at is None else at
+        end = start + duration
         event = self.transcript.add(Event(EventKind.BREAK, TOOL, start, end))
         self.advance(end)  # devices that were talking keep talking (contention is theirs)
         for device in self.devices:

@@ -4,42 +4,26 @@ complete before sending a retry", and the break and the command again are the se
 repeated. No rule judged it: R-7.2-06's retry case read the retry scenarios only, whose
 replies are short, and named a cut there INCONCLUSIVE (decision T2: no retry in it).
 
-The logger here reads at most 40 characters of a reply (a fixed receive buffer), never
-retries without a break, and takes the line at once: aHA!'s and aC9!'s 75-character D
-replies are broken into every time. It is not in the fault registry: judged through a
-capture of itself, the sensor's characters that go on under and past its break spoil the
-marking after that break (R-7.0-06 'marking after the break: 6.99 ms' where the recorder
-held 20 ms), a capture judging open beside this (the report's "left")."""
+The logger here (the registry's breaks-over-long-reply) reads at most 40 characters of a
+reply (a fixed receive buffer), never retries without a break, and takes the line at once:
+aHA!'s and aC9!'s 75-character D replies are broken into every time. Judged through a capture
+of itself it once FAILed R-7.0-06 ('marking after the break: 6.99 ms' where it held 20 ms):
+the capture's replay played its break only after the sensor's characters still coming under
+it had ended (the simulated bus committed each whole), so the break ended 16.7 ms late and the
+marking before the command, played where it was sent, read short."""
 
 from __future__ import annotations
 
 import pytest
 
 from conformance.matrices.recorder_matrix import run_recorder_suite
-from conformance.recorder import faults
-from conformance.recorder.compose import Parts
-
-#: the fault, as the registry would hold it
-BREAKS_OVER_LONG_REPLY = faults.RecorderFault(
-    "breaks-over-long-reply",
-    "Reads at most 40 characters of a reply and never retries without a break: past the 40th"
-    " it gives the reply up and at once sends a break and the command again over the rest.",
-    ("R-7.2-06",),
-    Parts(
-        policy={
-            "max_reply_chars": 40,
-            "retries_per_sequence": 0,
-            "max_hold": 0.0,
-            "post_break_marking": 20e-3,
-        }
-    ),
-)
+from conformance.matrices.roundtrip import recorder_row_through_capture
+from conformance.recorder.faults import RECORDER_FAULTS
 
 
 @pytest.fixture
-def breaks_over_long_reply(monkeypatch):
-    monkeypatch.setitem(faults.RECORDER_FAULTS, BREAKS_OVER_LONG_REPLY.name, BREAKS_OVER_LONG_REPLY)
-    return f"sim://?recorder-faults={BREAKS_OVER_LONG_REPLY.name}"
+def breaks_over_long_reply():
+    return "sim://?recorder-faults=breaks-over-long-reply"
 
 
 def _r_7_2_06(data: dict) -> dict:
@@ -65,3 +49,16 @@ def test_retries_with_break_is_still_undecided_on_r_7_2_06():
         run_recorder_suite("sim://?recorder-faults=retries-with-break", keyword="test_retries")
     )
     assert row["verdict"] == "INCONCLUSIVE", row["findings"]
+
+
+def test_the_fault_is_registered_with_r_7_2_06_declared():
+    assert "R-7.2-06" in RECORDER_FAULTS["breaks-over-long-reply"].violates
+
+
+def test_r_7_0_06_through_the_capture_is_the_live_runs_pass():
+    """R-7.0-06 (the recorder's marking after its break, >= 8.33 ms): the live run PASSes it
+    (20.00..26.33 ms); through its capture it FAILed on 6.99 ms before the replay played the
+    break where it was sent."""
+    row = recorder_row_through_capture("breaks-over-long-reply")
+    assert row.capture == (), row.capture
+    assert row.exact, row.explain()
