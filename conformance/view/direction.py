@@ -22,6 +22,7 @@ from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, Kind, pars
 from ..protocol.framing import STX
 from ..protocol.responses import parse_measurement_reply_for, split_line
 from ..protocol.timing import (
+    MARKING_AFTER_BREAK,
     MULTILINE_GAP_MAX,
     NO_BREAK_WINDOW,
     RESPONSE_START_MAX,
@@ -50,6 +51,9 @@ class _State:
     """What the reading so far implies about the next run."""
 
     after_break: bool = False
+    #: the break just sent came while the sensor's line was still coming (its last
+    #: character ended less than a character before the break began, the line unfinished)
+    broke_into_line: bool = False
     last_side: str | None = None
     last_end: float = float("-inf")
     last_uncertainty: float = 0.0  # of the stamp at last_end
@@ -116,6 +120,7 @@ def iter_directions(events: Iterable[Event]) -> Iterator[tuple[Event, Direction]
         if e.kind is EventKind.BREAK:
             yield from flush()
             yield e, Direction(RECORDER, "a break: only the recorder sends one")
+            state.broke_into_line = _line_coming(state, e)
             state.after_break, state.awaiting_reply = True, False
             state.command, state.reply = "", []
             state.last_side, state.last_end = RECORDER, e.end
@@ -142,6 +147,16 @@ def _classify(run: list[Event], s: _State) -> Direction:
             sure=False,
         )
     if s.after_break:
+        if s.broke_into_line and "!" not in text and gap < MARKING_AFTER_BREAK - TOLERANCE:
+            # the sensor cannot hear a break while it sends: the rest of its character
+            # under the break ends after it, and a UART reads that tail as a character
+            # (breaks-over-long-reply: '~' 1.1 ms after the break, then '0D0!' 23 ms after)
+            return Direction(
+                SENSOR,
+                f"'{shown}' {_ms(gap)} after a break over the sensor's line still coming: "
+                "that line's rest, or the recorder's command too soon after the break",
+                sure=False,
+            )
         if text.endswith("!") or "!" not in text:
             return Direction(RECORDER, f"'{shown}' right after a break: the recorder's")
         return Direction(RECORDER, f"'{shown}' right after a break", sure=False)
@@ -175,6 +190,23 @@ def _classify(run: list[Event], s: _State) -> Direction:
             SENSOR, f"'{shown}' ends like a sensor's line but answers no command", sure=False
         )
     return Direction(None, f"'{shown}': no protocol cue (not after a break, no '!', no CR LF)")
+
+
+def _line_coming(s: _State, brk: Event) -> bool:
+    """Whether the sensor's line was still coming when ``brk`` began: its message so far
+    unfinished, its last character read ending less than two character times before the
+    break (the character the break began over reads as part of the break where its spacing
+    bits run into it: 9.0 ms between the last one read and the break in aHA!'s D0); or,
+    a command awaiting its reply, the reply may have begun under the break (a sensor cannot
+    hear a break while it sends: pause-once's aD0! answered 9 ms into the break)."""
+    if s.awaiting_reply:
+        return brk.end - s.command_end > RESPONSE_START_MIN
+    return (
+        s.last_side == SENSOR
+        and bool(s.reply)
+        and not _message_done(s)
+        and brk.start - s.last_end < 2 * MARKING_AFTER_BREAK
+    )
 
 
 def _as_reply(text: str, shown: str, gap: float, slack: float, s: _State) -> Direction | None:
