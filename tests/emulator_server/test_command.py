@@ -169,18 +169,24 @@ def test_serial_mode_takes_a_nul_as_the_break():
     stopped = threading.Event()
     thread = threading.Thread(target=serve_serial, args=(line, port, stopped), daemon=True)
     thread.start()
+    os.set_blocking(controller, False)
     try:
-        os.write(controller, b"\x00")  # read ~8 ms into a 13 ms break; 9 ms marking follow
-        time.sleep(0.030)
-        os.write(controller, bytes(to_wire_7e1(ord(c)) for c in "0!"))
-        reply = b""
-        deadline = time.monotonic() + 1.0
-        while not reply.endswith(b"\n") and time.monotonic() < deadline:
-            os.set_blocking(controller, False)
-            try:
-                reply += os.read(controller, 16)
-            except BlockingIOError:
-                time.sleep(0.005)
+        # a starved reader can take the NUL and the command in one late read, and the sensor
+        # then refuses a command after too little marking (R-7.0-05, as it should): like a
+        # recorder, try the wake-up again (CI's real-time group, stop 48: once, under load)
+        for _attempt in range(3):
+            os.write(controller, b"\x00")  # read ~8 ms into a 13 ms break; 9 ms marking follow
+            time.sleep(0.030)
+            os.write(controller, bytes(to_wire_7e1(ord(c)) for c in "0!"))
+            reply = b""
+            deadline = time.monotonic() + 0.5
+            while not reply.endswith(b"\n") and time.monotonic() < deadline:
+                try:
+                    reply += os.read(controller, 16)
+                except BlockingIOError:
+                    time.sleep(0.005)
+            if reply:
+                break
         assert bytes(b & 0x7F for b in reply) == b"0\r\n"
     finally:
         stopped.set()
