@@ -53,6 +53,12 @@ class Behaviour:
     #: pauses at the same point of the same reply, as it fetches the next field, say.
     ident_pause: float = 0.0
     ident_pause_at: int = 6  # the index of the character the pause comes before
+    #: A stray character sent this long (s) after the LF of every aD<n>! and aI! reply
+    #: (None: nothing), as a firmware that flushes one more byte from its UART after a line
+    #: makes: the reply then does not end with CR LF (R-4.2-03), and a recorder that
+    #: transmits at the turnaround after the LF talks over it (issue 22's risk, eff12).
+    stray_after_line_end: float | None = None
+    stray_char: str = "#"
     char_time: float = CHAR_TIME  # one 10-bit frame: 1200 baud (R-4.1-01)
     line_gap: float = 20e-3  # marking between the lines of multi-line text (R-4.4.13.1-03)
     line_limit: int | None = None  # cut multi-line text lines to this (None: as written)

@@ -55,6 +55,9 @@ from .profile import MeasurementSpec, Profile
 from .replies import BinaryParts, Reply, ReplyKind
 from .transmitter import Transmission, Transmitter
 
+#: The replies :attr:`Behaviour.stray_after_line_end` follows: two that close their exchange
+#: at their CR LF (``engine.closes_exchange``), a data page and the identification.
+_STRAY_AFTER = frozenset({ReplyKind.DATA, ReplyKind.IDENTIFICATION})
 _MAX_COMMAND = 64  # a command longer than this is noise; drop it rather than grow forever
 
 
@@ -434,10 +437,18 @@ class SensorEmulator:
         if rewritten is None:
             return None
         b = self.behaviour
-        pause = b.ident_pause if rewritten.kind is ReplyKind.IDENTIFICATION else 0.0
-        return self._tx.schedule(
-            rewritten, at, b.char_gap, b.char_time, pause=(b.ident_pause_at, pause)
+        pause = (
+            (b.ident_pause_at, b.ident_pause)
+            if rewritten.kind is ReplyKind.IDENTIFICATION
+            else (0, 0.0)
         )
+        stray = b.stray_after_line_end
+        if stray is not None and rewritten.kind in _STRAY_AFTER and rewritten.end == CRLF:
+            # the stray character goes out in the same transmission, ``stray`` of marking
+            # after the LF (a pause before its frame), so nothing can be scheduled between
+            pause = (len(rewritten.text()), stray)
+            rewritten = replace(rewritten, end=CRLF + b.stray_char)
+        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pause=pause)
 
     def _change_address(self, cmd: Command, at: float) -> None:
         old, new = self.address, cmd.new_address

@@ -99,7 +99,7 @@ def _start_observations(
     early: list[Observation] = []
     late: list[Observation] = []
     for seg in segs:
-        if not seg.reply:
+        if not seg.reply or _reply_set_aside(seg):
             continue
         delay = seg.reply[0].start - seg.command_end
         u = stamps.between(seg.command[-1].start, seg.reply[0].end)
@@ -109,6 +109,17 @@ def _start_observations(
         early.append((Measured(EARLY_WINDOW, delay, u, where), tainted, place))
         late.append((Measured(LATE_WINDOW, delay, u, where), tainted, place))
     return early, late
+
+
+def _reply_set_aside(seg: Segment) -> bool:
+    """Whether characters stamped after the command ended were set aside as contention
+    (two talkers between its echoes): they may be the reply's own start, so what is left is
+    not surely its first. eff12, on a link that echoes and batches (``--echo --usb-latency
+    16``): a reply '0<CR><LF>' set aside left the stray '#' a sensor sent after its LF timed
+    as the reply, 39.83 ms, a false R-7.0-10 FAIL. A character that started before the
+    command ended (a service request that met it) is no reply: the one after it is timed."""
+    end = seg.command_end
+    return any(e.start >= end for e in seg.contention)
 
 
 def _text(seg: Segment) -> str:

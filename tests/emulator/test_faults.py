@@ -967,6 +967,23 @@ def check_answers_foreign_reply(rig: Rig) -> None:
     assert _beside_sensor_1(rig).text == "1\r\n0\r\n"  # sensor 0 answered sensor 1's reply
 
 
+def check_stray_after_line_end(rig: Rig) -> None:
+    """R-4.2-03, R-4.3-01: a '#' 2 ms after the LF of aI! and aD0! replies (the empty page
+    here: no measurement ran), which close their exchange at the CR LF (the recorder may
+    transmit 9 ms after the LF, eff11), the reply back to back before it; a! and the atttn
+    reply end at their CR LF."""
+    for command in ("0I!", "0D0!"):
+        answer = rig.ask(command)
+        assert answer.text.endswith("\r\n#")
+        assert answer.gaps[-1] == pytest.approx(2e-3)
+        assert all(g == pytest.approx(0.0) for g in answer.gaps[:-1])
+    assert rig.ask("0!").text == "0\r\n"
+    assert rig.ask("0M!").text.endswith("\r\n")
+
+
+CHECKS["stray-after-line-end"] = check_stray_after_line_end
+
+
 CHECKS.update(
     {
         "aborts-on-foreign-reply": check_aborts_on_foreign_reply,

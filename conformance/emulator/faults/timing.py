@@ -38,6 +38,16 @@ TIMING: tuple[Fault, ...] = (
         settings={"ident_pause": 4e-3, "ident_pause_at": 6},
     ),
     Fault(
+        "stray-after-line-end",
+        "A stray '#' 2 ms after the LF of every aD<n>! and aI! reply, as a firmware that"
+        " flushes one more byte after a line sends: the reply does not end with CR LF"
+        " (R-4.2-03) and the '#' it sent on its own does not start with its address"
+        " (R-4.3-01); a recorder that transmits at the turnaround after the LF (9 ms after"
+        " its stamp, issue 22) would talk over it.",
+        ("R-4.2-03", "R-4.3-01"),
+        settings={"stray_after_line_end": 2e-3},
+    ),
+    Fault(
         "ignores-short-breaks",
         "Spacing under 12.9 ms is not taken as a break (a 12.5 ms break goes unseen).",
         ("R-7.0-04",),
