@@ -173,4 +173,44 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
         " after the line's last activity and R-7.0-17 holds on the wire (seed 50).",
         removes=("R-7.0-17",),
     ),
+    # masked: breaks-over-long-reply never retries without a break (all pairs, stop 48)
+    *(
+        Interaction(
+            frozenset({"breaks-over-long-reply", other}),
+            "breaks-over-long-reply never retries without a break (it breaks and sends the"
+            f" command again instead), so {other}'s unbroken retry after 87 ms of marking"
+            " never goes out: R-7.0-17 holds on the wire ('42 commands without a break,"
+            " 9.00..9.00 ms').",
+            removes=("R-7.0-17",),
+        )
+        for other in ("retry-too-late", "resends-after-timeout")
+    ),
+    *(
+        Interaction(
+            frozenset({"breaks-over-long-reply", other}),
+            "breaks-over-long-reply never retries without a break, so"
+            f" {other}'s retry into reply-at-window-edge's 15.0 ms reply never goes out:"
+            " every command goes out whole and R-7.0-13 holds on the wire (325 gaps,"
+            " 0.00 ms).",
+            removes=("R-7.0-13",),
+        )
+        for other in ("talks-over-reply", "retry-too-early")
+    ),
+    Interaction(
+        frozenset({"breaks-over-long-reply", "no-concurrent"}),
+        "no-concurrent sends no aC!, so aC9!'s 75-character D0 reply, the one measurement"
+        " whose data breaks-over-long-reply gives up at D0, is never asked for: R-4.4.8-05"
+        " holds on the measurements that ran (R-7.2-06 and R-5.4-01 still FAIL on aHA!'s"
+        " long reply).",
+        removes=("R-4.4.8-05",),
+    ),
+    Interaction(
+        frozenset({"no-retries", "short-reply-timeout"}),
+        "no-retries gives a try up when no reply has started 10 ms after the command"
+        " (short-reply-timeout's timeout) and sends nothing more, so reply-at-window-edge's"
+        " 15.0 ms reply starts after the job ended: no measurement was announced to the"
+        " recorder and R-4.4.8-05 is owed nothing (a reply after the job's end, seventeenth"
+        " outside round); short-reply-timeout's other rules FAIL for no-retries as well.",
+        removes=("R-4.4.8-05",),
+    ),
 )
