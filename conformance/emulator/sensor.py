@@ -443,9 +443,16 @@ class SensorEmulator:
             else (0, 0.0)
         )
         stray = b.stray_after_line_end
-        if stray is not None and rewritten.kind in _STRAY_AFTER and rewritten.end == CRLF:
+        if (
+            stray is not None
+            and not pause[1]
+            and rewritten.kind in _STRAY_AFTER
+            and rewritten.end == CRLF
+        ):
             # the stray character goes out in the same transmission, ``stray`` of marking
-            # after the LF (a pause before its frame), so nothing can be scheduled between
+            # after the LF (a pause before its frame), so nothing can be scheduled between;
+            # a transmission takes one pause, and another fault's (ident-pause's) comes
+            # first: that reply goes without its stray, the aD<n>! replies still carry it
             pause = (len(rewritten.text()), stray)
             rewritten = replace(rewritten, end=CRLF + b.stray_char)
         return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pause=pause)
