@@ -12,14 +12,15 @@ be the whole run's), and the windows cut as the events come (``stream_windows``:
 events in the same windows). Then, over the streamed windows, each window's view read and
 let go (``tests/support/windowed_judges.py``): the sensors on the bus (``SensorsOn``: the
 same addresses and identifications), each sensor's decode-quality note (``Quality``: the
-same counts, min, median and max), each sensor's reply timing (``ResponseStarts``,
-``ReplyGaps``) and the recorder's wire rules (``Breaks``, ``BreakRules``, ``CommandText``,
-``CharacterGaps``, ``CommandBitRate``): every finding, detail and evidence must be the whole
+same counts, min, median and max), each sensor's reply timing and framing
+(``ResponseStarts``, ``ReplyGaps``, ``ReplyBitRate``, ``Framing``) and the recorder's wire
+rules (``Breaks``, ``BreakRules``, ``CommandText``, ``CharacterGaps``, ``CommandBitRate``):
+every finding, detail and evidence must be the whole
 view's. Prints the windows, the largest, and the CPU of the whole cut, of the streamed one
 and of the recorder's wire rules judged both ways; exits 1 on any difference. The same
 checks as ``tests/view/test_windows.py``, ``tests/offline/test_sensors_on_windowed.py``,
 ``tests/offline/test_decode_quality_windowed.py``,
-``tests/judges/test_windowed_sensor_timing.py`` and
+``tests/judges/test_windowed_sensor_timing.py``, ``tests/judges/test_windowed_framing.py`` and
 ``tests/judges/recorder/test_windowed_wire.py`` (the fields compared are
 ``tests/support/records_alike.py``'s), on a recording too long for a test.
 """
@@ -89,7 +90,7 @@ def check(path: str) -> bool:
     if sensor_timing_windowed(stream_windows(iter(events), uncertainty=u), u) != sensor_timing(
         whole, u
     ):
-        wrong.append("sensors' reply timing findings")
+        wrong.append("sensors' reply timing and framing findings")
     streamed_notes = qualities_windowed(decoded, stream_windows(iter(events), uncertainty=u), u)
     if streamed_notes != qualities(decoded, events, u):
         wrong.append("decode-quality notes")
@@ -102,7 +103,7 @@ def check(path: str) -> bool:
             "differs: " + ", ".join(wrong)
             if wrong
             else "views, records, streamed windows, sensors, decode-quality notes, sensors' "
-            "reply timing and recorder wire findings equal"
+            "reply timing and framing and recorder wire findings equal"
         )
     )
     return not wrong

@@ -14,6 +14,35 @@ from ..verdicts import Finding, Verdict
 from .cite import listed
 
 SHOWN = 3  # offending observations quoted per finding
+CHECKED_SHOWN = 160  # characters of a PASS finding's list of what was checked
+
+
+class Seen:
+    """The observations of one rule as a finding reads them: how many, and the distinct
+    labels in first-seen order only as far as a PASS detail quotes them (their list cut at
+    :data:`CHECKED_SHOWN` characters). Not every label: a windowed judge (issue 22) keeps a
+    tally over an hour's replies, one f-string each, and the finding needs their count."""
+
+    __slots__ = ("count", "labels", "_width")
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.labels: dict[str, None] = {}
+        self._width = -2  # len(", ".join(labels))
+
+    def append(self, where: str) -> None:
+        self.count += 1
+        if self._width <= CHECKED_SHOWN and where not in self.labels:
+            self.labels[where] = None
+            self._width += len(where) + 2
+
+    def __len__(self) -> int:
+        return self.count
+
+    def checked(self) -> str:
+        """``", ".join`` of every distinct label, cut as a PASS detail cuts it."""
+        checked = ", ".join(self.labels)
+        return checked[:157] + "..." if len(checked) > CHECKED_SHOWN else checked
 
 
 class Tally:
@@ -24,7 +53,7 @@ class Tally:
 
     def __init__(self, ids: Iterable[str]) -> None:
         self.ids = tuple(ids)
-        self.observed: dict[str, list[str]] = {rid: [] for rid in self.ids}
+        self.observed: dict[str, Seen] = {rid: Seen() for rid in self.ids}
         self.violations: dict[str, list[tuple[str, Violation]]] = {rid: [] for rid in self.ids}
         self.na: dict[str, str] = {}
         self.why_not: dict[str, str] = {}  # why a rule may end up with nothing to judge
@@ -106,9 +135,7 @@ class Tally:
                 result.append(Finding(rid, Verdict.INCONCLUSIVE, reason, decision=decision))
             else:
                 text = ok if isinstance(ok, str) else ok.get(rid, "conforms")
-                checked = ", ".join(dict.fromkeys(seen))
-                if len(checked) > 160:
-                    checked = checked[:157] + "..."
+                checked = seen.checked()
                 result.append(
                     Finding(
                         rid,

@@ -442,27 +442,67 @@ def judge_reply_bit_rate(segs: list[Segment], uncertainty: float | StampUncertai
     so the shortest start-to-start spacing inside a reply is at least one frame (8.17 ms at
     +2%). A shorter spacing proves the rate too high. A rate too low cannot be told apart from
     an allowed inter-character gap unless some characters come back to back (spacing within
-    the ±2% band), so without such a pair the verdict is INCONCLUSIVE, never a guess."""
-    stamps = stamp_uncertainty(uncertainty)
+    the ±2% band), so without such a pair the verdict is INCONCLUSIVE, never a guess.
+    One :meth:`ReplyBitRate.add` of every segment (the windowed judge's code path)."""
+    rate = ReplyBitRate(uncertainty)
+    rate.add(segs)
+    return rate.finding()
+
+
+class ReplyBitRate:
+    """:func:`judge_reply_bit_rate` over a recording read a window at a time (issue 22's
+    windowed judge): each window's segments :meth:`add`-ed in order, the finding that of the
+    whole recording's segments. A spacing lies inside one reply (one segment), so the
+    windows' spacings in order are the whole run's; carried across windows: how many, the
+    least ``(spacing, command)`` so far (each window's pairs compared against it, in order,
+    as one pass over the whole run compares them) and of the spacings surely too short
+    their count and least, never the list."""
+
+    def __init__(self, uncertainty: float | StampUncertainty) -> None:
+        self.stamps = stamp_uncertainty(uncertainty)
+        self.count = 0
+        self.least: Spacing | None = None
+        self.fast = 0
+        self.fastest: Spacing | None = None
+
+    def add(self, segs: list[Segment]) -> None:
+        """The reply character spacings of ``segs`` (the next window's segments)."""
+        count, self.least, fast = _spacings(segs, self.stamps, self.least)
+        self.count += count
+        self.fast += len(fast)
+        if fast:
+            least = min(fast)
+            self.fastest = least if self.fastest is None else min(self.fastest, least)
+
+    def finding(self) -> Finding:
+        """R-4.1-01 over everything added."""
+        return _bit_rate_finding(self.stamps, self.count, self.least, self.fast, self.fastest)
+
+
+def _bit_rate_finding(
+    stamps: StampUncertainty, count: int, least: Spacing | None, fast: int,
+    fastest: Spacing | None,
+) -> Finding:  # fmt: skip
+    """R-4.1-01 from :class:`ReplyBitRate`'s figures: ``count`` spacings, the ``least``, and
+    ``fast`` of them surely too short, the least of those ``fastest``."""
     uncertainty = stamps.base
-    count, least, fast = _spacings(segs, stamps)
     if least is None:
         return Finding("R-4.1-01", Verdict.INCONCLUSIVE, "no multi-character reply observed")
     shortest, text = least
     low = CHAR_TIME * 0.98
     where = [f"in reply to {escape(text)}"]
     if stamps.local is not None and shortest + 2 * uncertainty < low:
-        if not sustained(len(fast), count):  # a few bursts of a stalling host
+        if not sustained(fast, count):  # a few bursts of a stalling host
             return Finding(
                 "R-4.1-01",
                 Verdict.INCONCLUSIVE,
-                f"{len(fast)} of {count} character spacings are shorter than a frame "
+                f"{fast} of {count} character spacings are shorter than a frame "
                 f"(shortest {shortest * 1e3:.2f} ms); too few, or too near irregular stamps, "
                 "to tell a fast bit rate from bursts of the link",
                 evidence=where,
                 observed=count,
             )
-        shortest, text = min(fast)
+        shortest, text = fastest or least  # fast > 0 here: sustained() is False for none
         where = [f"in reply to {escape(text)}"]
     if shortest < IMPOSSIBLE_SPACING and (uncertainty > 0 or stamps.local is not None):
         return Finding(
@@ -500,17 +540,17 @@ Spacing = tuple[float, str]  # a start-to-start spacing (s) and the command it a
 
 
 def _spacings(
-    segs: list[Segment], stamps: StampUncertainty
+    segs: list[Segment], stamps: StampUncertainty, least: Spacing | None = None
 ) -> tuple[int, Spacing | None, list[Spacing]]:
     """:func:`judge_reply_bit_rate`'s pass over every pair of consecutive reply characters:
     how many, the least ``(spacing, command)`` as ``min`` of them all gives it (the first
     least spacing, ties by the command's text), and those surely too short even with the
     stamps' local uncertainty. Kept as it goes, not as a list of every pair (tens of
-    thousands a run, once each) and a ``min`` over it."""
+    thousands a run, once each) and a ``min`` over it. ``least``: the least of the pairs
+    before ``segs`` (a window's: :class:`ReplyBitRate`), which each pair is compared with."""
     if stamps.local is None:
-        return _spacings_alike(segs, stamps.base)
+        return _spacings_alike(segs, stamps.base, least)
     count = 0
-    least: Spacing | None = None
     fast: list[Spacing] = []
     between = stamps.between
     low = CHAR_TIME * 0.98
@@ -528,7 +568,9 @@ def _spacings(
     return count, least, fast
 
 
-def _spacings_alike(segs: list[Segment], base: float) -> tuple[int, Spacing | None, list[Spacing]]:
+def _spacings_alike(
+    segs: list[Segment], base: float, least: Spacing | None = None
+) -> tuple[int, Spacing | None, list[Spacing]]:
     """:func:`_spacings` where every pair has the stamps' one uncertainty ``base`` (a virtual
     clock, a capture's sample grid): a run's spacings subtracted in C, its least by ``min``
     (the least ``(spacing, command)`` of a run is its least spacing's, and ``min`` keeps the
@@ -536,7 +578,6 @@ def _spacings_alike(segs: list[Segment], base: float) -> tuple[int, Spacing | No
     run with a NaN spacing (stamps no clock gives) goes pair by pair, where the order of
     comparisons with NaN decides."""
     count = 0
-    least: Spacing | None = None
     fast: list[Spacing] = []
     low = CHAR_TIME * 0.98
     twice = 2 * base  # 2 * between(...) of every pair
@@ -632,21 +673,55 @@ def judge_framing(
     characters after it are framed at each LF, and at a gap only where it is surely there
     given the stamps' ``uncertainty``. What the tool's next transmission talked over (the
     DUT's characters meeting it: ``contention``) is no DUT's text, and the part before it
-    was cut by the tool, not by the DUT: neither is judged here."""
-    stamps = stamp_uncertainty(uncertainty)
-    tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
-    last_address = None
-    started = None  # the address of the last reply that started a measurement
-    shown = None  # the address the last reply that began with its command's address showed
-    for i, seg in enumerate(segs):
+    was cut by the tool, not by the DUT: neither is judged here. One :meth:`Framing.add`
+    of every segment (the windowed judge's code path)."""
+    framing = Framing(uncertainty, own)
+    framing.add(segs)
+    return framing.findings()
+
+
+class Framing:
+    """:func:`judge_framing` over a recording read a window at a time (issue 22's windowed
+    judge): each window's segments :meth:`add`-ed in order, the findings those of the whole
+    recording's segments. Carried across windows: the tally (counts, the first labels and
+    every violation), the last reply's address, the address of the last reply that started
+    a measurement and the one the last reply showed; and a window's last segment, judged
+    only once the next segment is known (whether that one's contention cut it: the next
+    window's first), or at :meth:`findings`."""
+
+    def __init__(self, uncertainty: float | StampUncertainty = 0.0, own: str | None = None):
+        self.stamps = stamp_uncertainty(uncertainty)
+        self.own = own
+        self.tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
+        self.last_address: int | None = None
+        self.started: str | None = None  # the address of the last reply starting a measurement
+        self.shown: str | None = None  # the address the last reply beginning with its own showed
+        self._pending: Segment | None = None  # the last segment added, not judged yet
+
+    def add(self, segs: list[Segment]) -> None:
+        """The replies and later lines of ``segs`` (the next window's segments)."""
+        for seg in segs:
+            if self._pending is not None:
+                self._judge(self._pending, cut=bool(seg.contention))
+            self._pending = seg
+
+    def findings(self) -> list[Finding]:
+        """R-4.1-02, R-4.2-02, R-4.2-03 and R-4.3-01 over everything added."""
+        if self._pending is not None:
+            self._judge(self._pending, cut=False)
+            self._pending = None
+        return self.tally.findings()
+
+    def _judge(self, seg: Segment, *, cut: bool) -> None:
+        """One segment; ``cut``: the next transmission's contention met what followed it."""
+        tally = self.tally
         if seg.reply:
-            last_address = seg.reply[0].char7
+            self.last_address = last_address = seg.reply[0].char7
             if _starts_measurement(seg.text):
-                started = chr(last_address)
+                self.started = chr(last_address)
         # characters cut off by the next transmission collided with it: what is left of
         # them says nothing about framing (the collision is judged by the rule it breaks)
-        cut = i + 1 < len(segs) and bool(segs[i + 1].contention)
-        later = [] if cut else frames(seg.later, stamps.between)
+        later = [] if cut else frames(seg.later, self.stamps.between)
         tool_cut = cut and not seg.reply_ended and not seg.later  # the tool spoke over it
         reply = [seg.reply] if seg.reply and not seg.binary_reply and not tool_cut else []
         chunks = reply + later
@@ -681,11 +756,13 @@ def judge_framing(
             talked_over = bool(seg.contention)
             expected = expected_reply_address(seg.text) if is_reply and not talked_over else None
             if not is_reply:
-                expected = chr(last_address) if last_address else None
+                expected = chr(self.last_address) if self.last_address else None
             tally.observe(label, ids=["R-4.3-01"])
             if is_reply and expected and body[:1] == expected:
-                shown = expected
-            allowed = _expected_addresses(expected, started if not is_reply else None, shown, own)
+                self.shown = expected
+            allowed = _expected_addresses(
+                expected, self.started if not is_reply else None, self.shown, self.own
+            )
             if expected and body[:1] not in allowed:
                 tally.fail(
                     "R-4.3-01",
@@ -693,7 +770,6 @@ def judge_framing(
                     f"reply '{escape(text)}' starts with "
                     f"'{escape(body[:1])}', not the address '{expected}'",
                 )
-    return tally.findings()
 
 
 def _expected_addresses(

@@ -1,5 +1,6 @@
 """The recorder's wire rules (``testcases/passive/test_recorder_7_wire.py``'s judges), each
-sensor's reply timing (``test_sensor_7_wire.py``'s response start and character gaps) and
+sensor's reply timing and framing (``test_sensor_7_wire.py``'s response start, character
+gaps, bit rate and framing) and
 each sensor's decode-quality note over a whole recording and over its windows, each window's
 view read from its own events alone: ``tests/judges/recorder/test_windowed_wire.py``,
 ``tests/offline/test_decode_quality_windowed.py`` and ``benchmarks/capture_windows.py``
@@ -24,7 +25,16 @@ from conformance.judges.recorder.commands import (
     judge_command_bit_rate,
     judge_command_text,
 )
-from conformance.judges.wire import ReplyGaps, ResponseStarts, judge_gaps, judge_response_start
+from conformance.judges.wire import (
+    Framing,
+    ReplyBitRate,
+    ReplyGaps,
+    ResponseStarts,
+    judge_framing,
+    judge_gaps,
+    judge_reply_bit_rate,
+    judge_response_start,
+)
 from conformance.offline.decode_quality import (
     CharRates,
     Quality,
@@ -111,10 +121,16 @@ def _sensor_segments(view: TranscriptView) -> dict[str, list[Segment]]:
 
 
 def sensor_timing(view: TranscriptView, uncertainty: float) -> dict[str, list[Finding]]:
-    """Each sensor's reply timing findings (R-7.0-09/-10, R-7.0-12, R-7.0-01) from the
-    whole view, as its passive run judges its own segments."""
+    """Each sensor's reply timing and framing findings (R-7.0-09/-10, R-7.0-12, R-7.0-01,
+    R-4.1-01, R-4.1-02, R-4.2-02/-03, R-4.3-01) from the whole view, as its passive run
+    judges its own segments."""
     return {
-        a: [*judge_response_start(segs, uncertainty), *judge_gaps(segs, uncertainty)]
+        a: [
+            *judge_response_start(segs, uncertainty),
+            *judge_gaps(segs, uncertainty),
+            judge_reply_bit_rate(segs, uncertainty),
+            *judge_framing(segs, uncertainty),
+        ]
         for a, segs in _sensor_segments(view).items()
     }
 
@@ -124,12 +140,21 @@ def sensor_timing_windowed(
 ) -> dict[str, list[Finding]]:
     """The same findings from ``windows`` (in order), each window's view read alone and
     let go: each sensor's segments of the window added to its own judges."""
-    judges: dict[str, tuple[ResponseStarts, ReplyGaps]] = {}
+    judges: dict[str, tuple[ResponseStarts, ReplyGaps, ReplyBitRate, Framing]] = {}
     for window in windows:
         for a, segs in _sensor_segments(read_view(window)).items():
-            starts, gaps = judges.setdefault(
-                a, (ResponseStarts(uncertainty), ReplyGaps(uncertainty))
+            folds = judges.setdefault(
+                a,
+                (
+                    ResponseStarts(uncertainty),
+                    ReplyGaps(uncertainty),
+                    ReplyBitRate(uncertainty),
+                    Framing(uncertainty),
+                ),
             )
-            starts.add(segs)
-            gaps.add(segs)
-    return {a: [*s.findings(), *g.findings()] for a, (s, g) in judges.items()}
+            for fold in folds:
+                fold.add(segs)
+    return {
+        a: [*s.findings(), *g.findings(), r.finding(), *f.findings()]
+        for a, (s, g, r, f) in judges.items()
+    }
