@@ -454,14 +454,57 @@ def judge(
     version: str,
     ok: dict[str, str] | str = "conforms",
 ) -> list[Finding]:
-    """Findings for ``ids`` over ``measurements``: reply, wait and data rules together."""
-    tally = Tally(ids)
-    measurements = list(measurements)
-    chatter = known_chatter(measurements)
-    for m in measurements:
+    """Findings for ``ids`` over ``measurements``: reply, wait and data rules together.
+    One :meth:`Measurements.add` of them all (the windowed judge's code path)."""
+    fold = Measurements(ids, version)
+    fold.add(measurements)
+    return fold.findings(ok)
+
+
+class Measurements:
+    """:func:`judge` over a recording's measurements given a window at a time (issue 22's
+    windowed judge): each window's measurements :meth:`add`-ed in order, the findings those
+    of the whole recording's. A measurement's records end in its window, but one rule reads
+    the whole run: the lines :func:`known_chatter` finds before any sensor's exact service
+    request decide which line of another measurement's wait is its request. So a
+    measurement whose request that could change (:func:`_waits_on_chatter`) is held, with
+    every one after it (the tally keeps the whole run's order), until the chatter it needs
+    is known or :meth:`findings`; the rest are judged as they come and let go. Carried: the
+    tally, the chatter found so far and the measurements held."""
+
+    def __init__(self, ids: Iterable[str], version: str) -> None:
+        self.tally = Tally(ids)
+        self.version = version
+        self.chatter: set[str] = set()
+        self.held: list[Measurement] = []
+
+    def add(self, measurements: Iterable[Measurement]) -> None:
+        """The next window's measurements."""
+        for m in measurements:
+            self.chatter.update(known_chatter([m]))
+            self.held.append(m)
+        chatter = frozenset(self.chatter)
+        settled = 0
+        for m in self.held:
+            if _waits_on_chatter(m, chatter):
+                break
+            self._judge(m, chatter)
+            settled += 1
+        del self.held[:settled]
+
+    def findings(self, ok: dict[str, str] | str = "conforms") -> list[Finding]:
+        """The findings over everything added (the measurements held judged now)."""
+        chatter = frozenset(self.chatter)
+        for m in self.held:
+            self._judge(m, chatter)
+        self.held.clear()
+        return self.tally.findings(ok)
+
+    def _judge(self, m: Measurement, chatter: frozenset[str]) -> None:
+        tally = self.tally
         tally.observe(
             where(m),
-            reply_violations(m, version),
+            reply_violations(m, self.version),
             ids=[i for i in _reply_ids(m) if m.start.answered],
         )
         if unreadable_count(m):
@@ -470,7 +513,20 @@ def judge(
             tally.undecide("R-4.4.5-02", where(m), "its reply gives no readable count")
         wait_violations(m, tally, chatter)
         data_violations(m, tally)
-    return tally.findings(ok)
+
+
+def _waits_on_chatter(m: Measurement, chatter: frozenset[str]) -> bool:
+    """Whether chatter found later may still change which line of ``m``'s wait
+    :func:`wait_violations` takes for its service request: it asks :func:`_sr_run` with the
+    chatter, there is no exact ``a<CR><LF>``, and a line shaped like one is not known as
+    chatter yet (chatter only grows: once all are, the choice is final)."""
+    if m.ttt is None or not m.start.answered or not (raises_sr(m) and m.ttt > 0):
+        return False
+    address = m.command.address
+    texts = [decode_7e1(run) for run in runs(list(m.waited_events))]
+    if service_request(address) in texts:
+        return False
+    return any(_sr_shaped(t, address) and t not in chatter for t in texts)
 
 
 def unread_data(measurements: Iterable[Measurement], ids: Iterable[str]) -> list[Finding]:
