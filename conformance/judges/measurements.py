@@ -535,17 +535,38 @@ def unread_data(measurements: Iterable[Measurement], ids: Iterable[str]) -> list
     for, so a PASS over the other measurements' replies would speak for values nobody read
     (measure-ttt-two-digits beside value-ten-chars PASSed R-4.4.8-02 on aC!'s replies while
     aM!'s ten-character value stayed in the sensor). A violation found elsewhere still
-    FAILs: the run's verdict is the worst of its findings. Observed: those start replies."""
-    unread = [m for m in measurements if unreadable_count(m)]
-    if not unread:
-        return []
-    starts = [m.start for m in unread]
-    detail = (
-        "no value count in "
-        + listed([shown(ex) for ex in starts])
-        + ": no D command followed, so the values held there are unjudged"
-    )
-    return [inconclusive(rid, detail, evidence=cite(starts), observed=len(starts)) for rid in ids]
+    FAILs: the run's verdict is the worst of its findings. Observed: those start replies.
+    One :meth:`UnreadData.add` of them all (the windowed judge's code path)."""
+    fold = UnreadData()
+    fold.add(measurements)
+    return fold.findings(ids)
+
+
+class UnreadData:
+    """:func:`unread_data` over a recording's measurements given a window at a time (issue
+    22's windowed judge): carried, the start exchanges of those whose reply gave no readable
+    count (each is quoted), not the measurements."""
+
+    def __init__(self) -> None:
+        self.starts: list[Exchange] = []
+
+    def add(self, measurements: Iterable[Measurement]) -> None:
+        """The next window's measurements."""
+        self.starts += [m.start for m in measurements if unreadable_count(m)]
+
+    def findings(self, ids: Iterable[str]) -> list[Finding]:
+        """``ids`` INCONCLUSIVE over every unread start reply added (none: no finding)."""
+        starts = self.starts
+        if not starts:
+            return []
+        detail = (
+            "no value count in "
+            + listed([shown(ex) for ex in starts])
+            + ": no D command followed, so the values held there are unjudged"
+        )
+        return [
+            inconclusive(rid, detail, evidence=cite(starts), observed=len(starts)) for rid in ids
+        ]
 
 
 def _reply_ids(m: Measurement) -> list[str]:

@@ -14,7 +14,7 @@ known, it does not, and the measurements after it keep the whole run's order."""
 from __future__ import annotations
 
 from conformance.judges import measurements
-from conformance.judges.measurements import Measurements
+from conformance.judges.measurements import Measurements, UnreadData
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
 from conformance.tool_recorder.records import Attempt, Exchange, Measurement
@@ -120,3 +120,21 @@ def test_over_the_windows_of_a_bus_the_findings_are_the_whole_recording_s():
     assert _by_rule(expected)["R-4.4.6-02"].verdict is Verdict.PASS
     assert _by_rule(expected)["R-4.4.8-03"].observed == 2 * 2 * len(ADDRESSES)
     assert fold.findings() == expected
+
+
+def _unread(command: str, t: float) -> Measurement:
+    """``command`` answered '0023' (a two-digit ttt: no count to read), no D command."""
+    start = _exchange(command, "0023\r\n", t)
+    return Measurement(start.command, start, ttt=None, count=None)
+
+
+def test_unread_start_replies_of_every_part_are_quoted_together():
+    ms = [_unread("0M!", 0.0), *_run()[:2], _unread("0M5!", 200.0)]
+    whole = measurements.unread_data(ms, ("R-4.4.8-02",))
+    assert whole[0].observed == 2 and "0M5!" in whole[0].detail, whole
+    for k in range(len(ms) + 1):
+        fold = UnreadData()
+        fold.add(ms[:k])
+        fold.add(ms[k:])
+        assert fold.findings(("R-4.4.8-02",)) == whole
+    assert UnreadData().findings(("R-4.4.8-02",)) == measurements.unread_data([], ["R-4.4.8-02"])
