@@ -307,6 +307,10 @@ class Window:
     def hi(self) -> float | None:
         return None if self.high is None else self.high + self.tolerance + EPSILON
 
+    def inside(self, measured: float) -> bool:
+        """Whether ``measured`` is within the limits, taken as exact."""
+        return _slack(self.lo, self.hi, measured) >= 0
+
     def judge(
         self, measured: float, uncertainty: float, evidence: list[str] | None = None
     ) -> Finding:

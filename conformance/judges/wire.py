@@ -98,7 +98,9 @@ def _start_observations(
 ) -> tuple[list[Observation], list[Observation]]:
     early: list[Observation] = []
     late: list[Observation] = []
+    before: Segment | None = None
     for seg in segs:
+        earlier, before = _unanswered_before(before, seg), seg
         if not seg.reply or _reply_set_aside(seg):
             continue
         delay = seg.reply[0].start - seg.command_end
@@ -106,9 +108,38 @@ def _start_observations(
         tainted = u > stamps.base
         where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
         place: Place = (seg.text, _text(seg), 0)
-        early.append((Measured(EARLY_WINDOW, delay, u, where), tainted, place))
-        late.append((Measured(LATE_WINDOW, delay, u, where), tainted, place))
+        if earlier is not None:
+            # the reply may answer the unanswered command before this one, late: it counts
+            # only where both readings give the same answer
+            lagged = seg.reply[0].start - earlier.command_end
+            where = [
+                f"{where[0]} (or to {escape(earlier.text)} before it, "
+                f"{lagged * 1e3:.2f} ms after that one)"
+            ]
+        for window, out in ((EARLY_WINDOW, early), (LATE_WINDOW, late)):
+            if earlier is not None and window.inside(delay) != window.inside(lagged):
+                continue
+            out.append((Measured(window, delay, u, where), tainted, place))
     return early, late
+
+
+def _unanswered_before(before: Segment | None, seg: Segment) -> Segment | None:
+    """The command before ``seg`` if ``seg``'s reply may be that command's late reply: it got
+    no reply and nothing after it, and the reply starts with the address its reply would
+    (any for ``?!`` and ``aAb!``). Found on an Arduino Due sensor (eighteenth round, docs/
+    kit.md) whose every reply starts 100 ms after its command: the tool's retry 55 ms after
+    the first try had ended before the reply began, and the reply was timed from the retry,
+    11.35 ms, an in-time reply (R-7.0-10 PASS evidence), 16 such; '$<CR><LF>' answering
+    ``0A$!`` was timed as a reply to the ``0!`` sent after it (53.01 ms). The wire cannot
+    tell which command a reply that began after both answers."""
+    if before is None or before.reply or before.later or before.contention:
+        return None
+    if not before.text or not seg.reply:
+        return None
+    address = expected_reply_address(before.text)
+    if address is not None and seg.reply[0].char7 != ord(address[0]):
+        return None
+    return before
 
 
 def _reply_set_aside(seg: Segment) -> bool:

@@ -252,7 +252,7 @@ def _identity_lines(data: dict[str, Any]) -> list[str]:
         ref = bench["timing"]["reference"]
         u += f" (measured, against the {'echo' if ref == 'echo' else 'write time'})"
         u += ", interface echoes" if bench["echo"] else ""
-    version = dut.get("sdi12_version") or "not known (the run stopped before aI!)"
+    version = dut.get("sdi12_version") or "not known (no version from aI!)"
     if run["role"] == "recorder":
         first = f"DUT data recorder · SDI-12 {version}"
     elif dut.get("address") is None:  # stopped before the sensor was found

@@ -176,6 +176,8 @@ class SensorSession(Session):
         self.address_notes: list[str] = []  # what every address change left behind
         #: why the sensor can no longer be reached (a restore that found it nowhere), or None
         self.lost: str | None = None
+        #: what ``?!`` was answered while finding the address (None: not asked, or silence)
+        self.queried: str | None = None
         #: the aAb! that found out whether an undeclared address is settable (None: not tried)
         self.address_trial: Trial | None = None
         self._cache: dict[Any, Any] = {}
@@ -193,6 +195,7 @@ class SensorSession(Session):
         if self.requested_address is None and not self.shared:
             ex = self.master.query_address()
             body, _ = split_line(ex.reply_text)
+            self.queried = body if ex.answered else None
             if ex.answered and len(body) == 1 and body in cmd.ADDRESS_CHARS:
                 self.address = body
                 self.assumptions.append(f"address {body!r} found with ?! (one sensor on the bus)")
@@ -233,6 +236,7 @@ class SensorSession(Session):
             )
         query = self.master.query_address()
         body, _ = split_line(query.reply_text)
+        self.queried = body if query.answered else None
         if query.answered and body == self.address:
             self.assumptions.append(
                 f"a! and aI! went unanswered, ?! was answered '{body}': judged on what the "
@@ -804,9 +808,28 @@ class SensorSession(Session):
         ms after the break" on it), so :attr:`lost` says why and the run stops."""
         note = changer.restore()
         self.address_notes.append(note)
-        if changer.restored is False and self.master.acknowledged and self.lost is None:
-            self.lost = note
+        if changer.restored is False and self.lost is None:
+            if self.master.acknowledged:
+                self.lost = note
+            elif (elsewhere := self._queried_elsewhere()) is not None:
+                self.lost = f"{note}; ?! is answered {elsewhere} now"
         return note
+
+    def _queried_elsewhere(self) -> str | None:
+        """How ``?!`` is answered now, if not with the address it was answered with while
+        finding it (None: it still is, or it never was, or other sensors share the line).
+        A sensor that answers no ``a!`` cannot be checked at its address after a restore;
+        its ``?!`` can. The eighteenth round's Arduino Due sensor (docs/kit.md) took
+        ``0A$!`` as address -12 (``'$' - '0'``), answered ``?!`` '-12' from then on and
+        nothing at '0': R-6.1-01, R-6.2-01/-05/-06/-07 FAILed and R-5.4-02 WARNed on the
+        silence of an address it no longer had."""
+        if self.shared or self.queried != self.address:
+            return None
+        ex = self.master.query_address()
+        body, _ = split_line(ex.reply_text)
+        if ex.answered and body == self.address:
+            return None
+        return f"'{escape(ex.reply_text)}'" if ex.answered else "by no one"
 
     def _discover_address_change(self) -> bool:
         changer = AddressChanger(self.master, self.address)

@@ -579,3 +579,47 @@ def test_a_basic_command_never_answered_still_fails_r_4_4_01():
         run_once("sim://?faults=undefined-measure-silent", keyword="test_every_basic_command")
     )
     assert found["R-4.4-01"]["verdict"] == "FAIL", found["R-4.4-01"]["findings"]
+
+
+@pytest.fixture
+def lost_without_acknowledging(monkeypatch):
+    """The simulated sensor as the eighteenth round's Arduino Due sensor (Samch458/SDI12-
+    sensor-and-data-logger, docs/kit.md) behaves: it answers no ``a!``; ``aAb!`` moves it
+    (its reply names the new address), after which it is at an address no command can name
+    (the sketch's ``deviceAddress = newAddr - '0'``: -12 for '$') and answers only ``?!``,
+    with '-12'. Its address change is not declared, so the tool tries it."""
+    from conformance.sensor.session import SensorSession
+
+    declared = SensorSession.feature
+    monkeypatch.setattr(
+        SensorSession,
+        "feature",
+        lambda self, name: None if name == "address_change" else declared(self, name),
+    )
+    usual = FaultSet.rewrite
+    moved = []
+
+    def rewrite(self, reply):
+        if reply.kind is ReplyKind.ACKNOWLEDGE:
+            return None
+        if moved:
+            return replace(reply, body="-12") if reply.kind is ReplyKind.ADDRESS else None
+        if reply.kind is ReplyKind.CHANGE_ADDRESS:
+            moved.append(reply.body)
+        return usual(self, reply)
+
+    monkeypatch.setattr(FaultSet, "rewrite", rewrite)
+
+
+def test_a_sensor_that_answers_no_a_and_is_lost_after_a_change_stops_the_run(
+    lost_without_acknowledging,
+):
+    """Its restore cannot be checked with a!; ?! answered '-12' now (it was '0') shows it
+    gone. Before, the run went on and R-6.1-01 FAILed "no reply although v1.4 makes them
+    mandatory" on the silence of an address it no longer had."""
+    data = run_once("sim://", keyword="test_change_address or test_identify_measurement_answered")
+    found = _verdicts(data)
+    assert found["R-6.1-01"]["verdict"] != "FAIL", found["R-6.1-01"]["findings"]
+    assert not data["run"]["complete"]
+    reason = data["run"]["stop_reason"]
+    assert "lost" in reason and "?! is answered '-12" in reason, reason

@@ -1,4 +1,11 @@
-/* sdi12-conform kit: Arduino's String, on the host (kept small: what SDI-12 sketches use). */
+/* sdi12-conform kit: Arduino's String, on the host (kept small: what SDI-12 sketches use).
+ *
+ * Sums are Arduino's: `a + b` is a StringSumHelper lvalue (the core's operator+ appends to
+ * its left operand, made a StringSumHelper, and returns a reference to it), so the common
+ * `sendResponse(String(addr) + reply + "\r\n")` binds to a library's `String&` parameter as
+ * on a board, and a character on the left (`'+' + value`) is that character, not its code
+ * (StringSumHelper(char)). `String(c)` is a one-character string, empty for NUL, as the
+ * core builds it through a C string. */
 #ifndef SDI12_KIT_WSTRING_H
 #define SDI12_KIT_WSTRING_H
 
@@ -11,7 +18,7 @@ class String {
   public:
     String(const char *text = "") : s_(text ? text : "") {}
     String(const std::string &text) : s_(text) {}
-    explicit String(char c) : s_(1, c) {}
+    explicit String(char c) : s_(c ? std::string(1, c) : std::string()) {}
     String(int value, unsigned char base = 10) : s_(format_long(value, base)) {}
     String(unsigned int value, unsigned char base = 10) : s_(format_ulong(value, base)) {}
     String(long value, unsigned char base = 10) : s_(format_long(value, base)) {}
@@ -35,10 +42,6 @@ class String {
     String &operator+=(unsigned long v) { s_ += format_ulong(v, 10); return *this; }
     bool concat(const String &other) { s_ += other.s_; return true; }
     bool concat(char c) { s_ += c; return true; }
-    friend String operator+(const String &a, const String &b) { return String(a.s_ + b.s_); }
-    friend String operator+(const String &a, const char *b) { return String(a.s_ + b); }
-    friend String operator+(const char *a, const String &b) { return String(a + b.s_); }
-    friend String operator+(const String &a, char b) { return String(a.s_ + b); }
 
     bool equals(const String &other) const { return s_ == other.s_; }
     bool operator==(const String &other) const { return s_ == other.s_; }
@@ -96,5 +99,41 @@ class String {
         return std::string(buf);
     }
 };
+
+
+/* Arduino's StringSumHelper: the left operand of a sum, appended to in place. */
+class StringSumHelper : public String {
+  public:
+    StringSumHelper(const String &s) : String(s) {}
+    StringSumHelper(const char *p) : String(p) {}
+    StringSumHelper(char c) : String(c) {}
+    StringSumHelper(unsigned char num) : String((unsigned int)num) {}
+    StringSumHelper(int num) : String(num) {}
+    StringSumHelper(unsigned int num) : String(num) {}
+    StringSumHelper(long num) : String(num) {}
+    StringSumHelper(unsigned long num) : String(num) {}
+    StringSumHelper(float num) : String(num) {}
+    StringSumHelper(double num) : String(num) {}
+};
+
+inline StringSumHelper &kit_sum(const StringSumHelper &lhs, const String &rhs) {
+    StringSumHelper &a = const_cast<StringSumHelper &>(lhs);
+    a += rhs;
+    return a;
+}
+inline StringSumHelper &operator+(const StringSumHelper &lhs, const String &rhs) { return kit_sum(lhs, rhs); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, const char *cstr) { return kit_sum(lhs, String(cstr)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, char c) {
+    StringSumHelper &a = const_cast<StringSumHelper &>(lhs);
+    a += c; /* concat(char): appended even when NUL, as the core's concat does */
+    return a;
+}
+inline StringSumHelper &operator+(const StringSumHelper &lhs, unsigned char num) { return kit_sum(lhs, String((unsigned int)num)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, int num) { return kit_sum(lhs, String(num)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, unsigned int num) { return kit_sum(lhs, String(num)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, long num) { return kit_sum(lhs, String(num)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, unsigned long num) { return kit_sum(lhs, String(num)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, float num) { return kit_sum(lhs, String(num)); }
+inline StringSumHelper &operator+(const StringSumHelper &lhs, double num) { return kit_sum(lhs, String(num)); }
 
 #endif
