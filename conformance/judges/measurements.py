@@ -6,6 +6,7 @@ they bear on; each case keeps the requirement IDs it names (one stimulus, many j
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import lru_cache
 
 from ..protocol.binary import parse_binary_packet
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
@@ -224,8 +225,7 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
                 tally.fail("R-5.1-02", dlabel, f"no reply to {where(ex)} after aHA!")
             silent = ex
             break
-        body, framing = split_line(ex.reply_text, crc_positions=3 if m.command.returns_crc else 0)
-        reply = parse_data_reply_for(body, m.command, expected_address=m.command.address)
+        body, framing, reply = _read_data_reply(ex.reply_text, m.command)
         tally.observe(dlabel, framing + reply.violations, ids=shown_reply_ids(m.command, reply))
         if reply.crc and not reply.crc_ok:
             undecide_uncompared_crc(reply, tally, dlabel)
@@ -268,6 +268,25 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     if m.command.kind is Kind.HIGH_VOLUME_ASCII:
         tally.observe(label, ids=["R-5.1-02"])
         _undecide_unread_high_volume(m, replies, tally, label)
+
+
+@lru_cache(maxsize=4096)
+def _read_data_reply_once(
+    reply_text: str, command: Command
+) -> tuple[str, tuple[Violation, ...], DataReply]:
+    body, framing = split_line(reply_text, crc_positions=3 if command.returns_crc else 0)
+    reply = parse_data_reply_for(body, command, expected_address=command.address)
+    return body, tuple(framing), reply
+
+
+def _read_data_reply(reply_text: str, command: Command) -> tuple[str, list[Violation], DataReply]:
+    """A D reply to the measurement ``command``: its body, framing violations and parse,
+    read once a process for each reply text and command (issue 22): every case that judges
+    measurements (:func:`judge`, some sixteen a run) reads the same shared ones again. All
+    three are pure functions of the text and the command; the reply (frozen, its lists
+    never changed by a judge) is shared, the framing list is the caller's own."""
+    body, framing, reply = _read_data_reply_once(reply_text, command)
+    return body, list(framing), reply
 
 
 def _undecide_unread_high_volume(

@@ -8,6 +8,7 @@ from typing import ClassVar
 
 from hypothesis import HealthCheck, Phase, seed, settings
 from hypothesis import strategies as st
+from hypothesis.core import failure_exceptions_to_catch, skip_exceptions_to_reraise
 from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
 
 from ..judges.exploration import Observation, judge
@@ -145,6 +146,30 @@ class _Explorer(RuleBasedStateMachine):
     def _observe_framing(self, ex: Exchange) -> None:
         self._observe(Observation("framing", ex.text, ex.reply_text, self.address))
 
+    def step(self, name: str, arguments: dict[str, object]) -> None:
+        """Send one step drawn for the rule ``name`` (:func:`_with_rules`)."""
+        getattr(self, "_" + name)(**arguments)
+
+    def _own_command(self, code: str) -> None:
+        self._own(code)
+
+    def _read_data(self, index: str) -> None:
+        self._own(f"D{index}")
+
+    def _foreign_command(self, other: str, code: str) -> None:
+        self._foreign(other, code)
+
+    def _malformed_command(self, junk: str) -> None:
+        self._malformed(junk)
+
+    def _brk(self) -> None:
+        self.sensor.master.send_break()
+        self._note("break")
+
+    def _pause(self, seconds: float) -> None:
+        self.sensor.listen(seconds)
+        self._note(f"pause {seconds * 1e3:.0f} ms")
+
     def teardown(self) -> None:
         self.record.log.append(" ; ".join(self.trail))
         if not self.record.breached:  # after a break, the sequence that broke it stays
@@ -157,8 +182,17 @@ def machine_class(
     marking: float | None,
     junk: st.SearchStrategy[str],
 ) -> type[RuleBasedStateMachine]:
-    """The state machine class for one run. Hypothesis orders rules by name and draws by
-    strategy, so the names and strategies here are the exploration's stimuli: keep them."""
+    """The state machine class for one run (its rules: :func:`_with_rules`)."""
+    machine = _with_rules(_Explorer, foreign_addresses(sensor), junk)
+    machine.sensor = sensor
+    machine.record = record
+    machine.marking = marking
+    return seed(SEED)(machine)
+
+
+def foreign_addresses(sensor: SensorSession) -> list[str]:
+    """The addresses the foreign commands go to (a strategy of the rules: part of a plan's
+    key, :func:`plan_for`)."""
     foreign = [a for a in "9zy" if a != sensor.address]
     if sensor.shared:  # never an address another sensor of the line answers at
         spare = "9zyxwv" + ADDRESS_CHARS[::-1]
@@ -166,39 +200,141 @@ def machine_class(
             a for a in dict.fromkeys(spare) if a != sensor.address and a not in sensor.others
         ]
         foreign = foreign[:3]
+    return foreign
 
-    class SensorMachine(_Explorer):
+
+def _with_rules(
+    base: type[RuleBasedStateMachine], foreign: list[str], junk: st.SearchStrategy[str]
+) -> type[RuleBasedStateMachine]:
+    """``base`` with the exploration's rules, each handing its drawn arguments to
+    ``base.step``: the one place of their names and strategies, so the machine that sends
+    (:class:`_Explorer`) and the one that only writes the draws down (:class:`_Recorder`)
+    draw alike. Hypothesis orders rules by name and draws by strategy, so the names and
+    strategies here are the exploration's stimuli: keep them."""
+
+    class SensorMachine(base):  # type: ignore[valid-type,misc]
         @rule(code=st.sampled_from(OWN))
         def own_command(self, code: str) -> None:
-            self._own(code)
+            self.step("own_command", {"code": code})
 
         @rule(index=st.sampled_from(("0", "0", "1")))
         def read_data(self, index: str) -> None:
             """D replies, the place where the CRC and buffer invariants bite."""
-            self._own(f"D{index}")
+            self.step("read_data", {"index": index})
 
         @rule(other=st.sampled_from(foreign), code=st.sampled_from(FOREIGN_FORMS))
         def foreign_command(self, other: str, code: str) -> None:
-            self._foreign(other, code)
+            self.step("foreign_command", {"other": other, "code": code})
 
         @rule(junk=junk)
         def malformed_command(self, junk: str) -> None:
-            self._malformed(junk)
+            self.step("malformed_command", {"junk": junk})
 
         @rule()
         def brk(self) -> None:
-            self.sensor.master.send_break()
-            self._note("break")
+            self.step("brk", {})
 
         @rule(seconds=st.sampled_from((0.01, 0.05, 0.12, 0.25)))
         def pause(self, seconds: float) -> None:
-            self.sensor.listen(seconds)
-            self._note(f"pause {seconds * 1e3:.0f} ms")
+            self.step("pause", {"seconds": seconds})
 
-    SensorMachine.sensor = sensor
-    SensorMachine.record = record
-    SensorMachine.marking = marking
-    return seed(SEED)(SensorMachine)
+    return SensorMachine
+
+
+#: one step of a plan: a rule's name and the arguments drawn for it
+Step = tuple[str, dict[str, object]]
+#: what a derandomised run draws: for each example hypothesis runs, its steps in order
+Plan = tuple[tuple[Step, ...], ...]
+
+
+class _Recorder(RuleBasedStateMachine):
+    """A machine that sends nothing: each example it is made for, the steps drawn
+    (:func:`plan_for`). Its rules are the exploration's (:func:`_with_rules`)."""
+
+    plans: ClassVar[list[list[Step]]]
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.steps: list[Step] = []
+        self.plans.append(self.steps)
+
+    def step(self, name: str, arguments: dict[str, object]) -> None:
+        self.steps.append((name, arguments))
+
+
+#: the plans drawn in this process: key -> (the junk strategy it was drawn with, the plan)
+_PLANS: dict[tuple[object, ...], tuple[object, Plan]] = {}
+
+
+def plan_for(foreign: list[str], junk: st.SearchStrategy[str], examples: int, steps: int) -> Plan:
+    """The steps a derandomised run of the exploration draws, drawn once a process for its
+    rules' strategies and settings. Nothing drawn depends on the sensor: the rules have no
+    preconditions, bundles or invariants, the strategies are fixed at the class, and the
+    settings (derandomised, generate phase only, no database, no deadline, health checks
+    off) leave hypothesis nothing else to read but whether an example raised, which only
+    ends the run (:func:`run_plan`). The caller holds hypothesis's draws still
+    (``no_local_constants``, ``no_database_key``)."""
+    key = (SEED, examples, steps, tuple(foreign), OWN, FOREIGN_FORMS, id(junk))
+    held = _PLANS.get(key)
+    if held is not None and held[0] is junk:
+        return held[1]
+    recorder = seed(SEED)(_with_rules(_Recorder, foreign, junk))
+    recorder.plans = []
+    try:
+        run_machine(recorder, examples, steps)
+        plan = tuple(tuple(steps_) for steps_ in recorder.plans)
+    finally:
+        del recorder.plans
+        release(recorder)
+    _PLANS[key] = (junk, plan)
+    return plan
+
+
+def forget_plans() -> None:
+    """Drop the plans drawn so far (tests that want hypothesis to draw again)."""
+    _PLANS.clear()
+
+
+def run_plan(machine: type[RuleBasedStateMachine], plan: Plan) -> None:
+    """Send ``plan`` with ``machine`` as hypothesis sends it (:func:`run_machine`): each
+    example a new machine, its steps, its teardown (also after a step raised). The first
+    example whose machine or step raises a failure ends the run, and, as hypothesis
+    replays a failing example once to report it, it runs again from a new machine up to
+    the step that raised (the replay's choices end there), and that step's exception, or
+    the first one where the replay raised none, goes out."""
+    for example in plan:
+        failed = _run_example(machine, example)
+        if failed is not None:
+            index, first = failed
+            again = _run_example(machine, example[: index + 1])
+            raise (again[1] if again is not None else first)
+
+
+def _run_example(
+    machine: type[RuleBasedStateMachine], steps: tuple[Step, ...]
+) -> tuple[int, BaseException] | None:
+    """One example of :func:`run_plan`: None, or the index of the step that raised a failure
+    (-1: the machine's making) and the exception. Hypothesis's own classes of exceptions:
+    a skip and anything not a failure (Ctrl-C) go straight out, after the teardown."""
+    failures, skips = failure_exceptions_to_catch(), skip_exceptions_to_reraise()
+    try:
+        made = machine()
+    except skips:
+        raise
+    except failures as exc:
+        return -1, exc
+    index = 0  # the step being sent
+    try:
+        for name, arguments in steps:
+            made.step(name, arguments)
+            index += 1
+    except skips:
+        raise
+    except failures as exc:
+        return index, exc
+    finally:
+        made.teardown()
+    return None
 
 
 def release(machine: type[RuleBasedStateMachine]) -> None:
