@@ -254,9 +254,16 @@ class SensorEmulator:
         run = self._run
         if run is not None and run.concurrent and b.foreign_aborts_concurrent:
             self._abort()
-        if b.standby_after_foreign and not b.answer_foreign:
+        if b.standby_after_foreign and not (b.answer_foreign or self._reads_foreign_tail()):
             self._awake = False  # R-7.0-14
             self._entered_standby()
+
+    def _reads_foreign_tail(self) -> bool:
+        """Whether a foreign command is heard to its '!' before the sensor goes to standby
+        (R-7.0-14): only to answer its tail (answer_trailing_address), never beside
+        answer_foreign, which keeps its own standby rule."""
+        b = self.behaviour
+        return b.answer_trailing_address and b.standby_after_foreign and not b.answer_foreign
 
     def _addressed(self, char: str) -> bool:
         if char in (self.address, "?"):
@@ -325,6 +332,9 @@ class SensorEmulator:
     # -- commands ----------------------------------------------------------------------------
     def _command(self, text: str, start: float, end: float, foreign: bool) -> None:
         b = self.behaviour
+        if foreign and self._reads_foreign_tail():
+            self._awake = False  # R-7.0-14, put off to the '!' by answer_trailing_address
+            self._entered_standby()
         try:
             cmd = parse_command(text)
         except CommandError:
@@ -338,6 +348,8 @@ class SensorEmulator:
                 self._dispatch(cmd, at)
                 if b.standby_after_foreign:
                     self._awake = False
+            elif b.answer_trailing_address and text[-2:-1] == self.address:
+                self._send(Reply(ReplyKind.ACKNOWLEDGE, self.address, command=cmd), at)
             return
         if cmd.address == "?" and cmd.kind is not Kind.QUERY_ADDRESS:
             return  # R-4.4.3-02: the wildcard is accepted only in ?!

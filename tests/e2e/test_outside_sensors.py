@@ -579,3 +579,28 @@ def test_a_basic_command_never_answered_still_fails_r_4_4_01():
         run_once("sim://?faults=undefined-measure-silent", keyword="test_every_basic_command")
     )
     assert found["R-4.4-01"]["verdict"] == "FAIL", found["R-4.4-01"]["findings"]
+
+
+def test_r_4_0_01_fails_a_sensor_that_answers_a_command_ending_in_its_address():
+    """The sixteenth round's lagopus sketch at '5' answers ``0M5!`` as ``5!``: its parser
+    starts over at its address. The foreign probes (a!, aI!, aM! at spare addresses, and the
+    exploration's D0 form at '0') never end in '5'; the probe ``zD5!`` does, and its answer
+    FAILs R-4.0-01 (passed before: nothing the suite sent ended in '5!')."""
+    found = _verdicts(
+        run_once(
+            "sim://?faults=answers-trailing-address&address=5",
+            keyword="test_foreign_addresses_are_ignored or test_exploration",
+        )
+    )
+    assert found["R-4.0-01"]["verdict"] == "FAIL"
+    details = " ".join(f["detail"] for f in found["R-4.0-01"]["findings"])
+    assert "zD5!" in details, details
+
+
+def test_the_probe_ending_in_the_address_is_silent_on_the_clean_sensor_at_a_letter():
+    """At a letter address the probe is a change of address (``zAb!``), a valid command for
+    'z' that no sensor holds: the clean sensor stays silent and R-4.0-01 PASSes on it."""
+    found = _verdicts(run_once("sim://?address=b", keyword="test_foreign_addresses_are_ignored"))
+    assert found["R-4.0-01"]["verdict"] == "PASS"
+    details = " ".join(f["detail"] for f in found["R-4.0-01"]["findings"])
+    assert "zAb!" in details, details
