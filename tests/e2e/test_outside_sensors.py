@@ -604,3 +604,21 @@ def test_the_probe_ending_in_the_address_is_silent_on_the_clean_sensor_at_a_lett
     assert found["R-4.0-01"]["verdict"] == "PASS"
     details = " ".join(f["detail"] for f in found["R-4.0-01"]["findings"])
     assert "zAb!" in details, details
+
+
+def test_answers_to_kept_queries_are_not_timed_as_replies(monkeypatch):
+    """The lagopus sketch's answers to the ?!s it kept through its boot came 1.50 ms after
+    the tool's 0!, '1<CR><LF>' here from the sim at '1': R-7.0-09 FAILed "1.50 ms, allowed
+    >= 7.93 ms" on them (the sketch's own 7.67 ms replies hid it there). They answer no
+    command of the tool's: not timed now, and the sim's 9 ms replies PASS."""
+    boots_late(monkeypatch, 1.45)
+    found = _verdicts(
+        run_once(
+            "sim://?faults=factory-address-not-zero",
+            keyword="test_acknowledge_active or test_response_start_window",
+        )
+    )
+    for rid in ("R-7.0-09", "R-7.0-10"):
+        assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])
+        detail = found[rid]["findings"][0]["detail"]
+        assert "9.00..9.00 ms" in detail, detail
