@@ -449,25 +449,17 @@ class SensorEmulator:
         if rewritten is None:
             return None
         b = self.behaviour
-        pause = (
-            (b.ident_pause_at, b.ident_pause)
-            if rewritten.kind is ReplyKind.IDENTIFICATION
-            else (0, 0.0)
-        )
+        pauses: tuple[tuple[int, float], ...] = ()
+        if rewritten.kind is ReplyKind.IDENTIFICATION and b.ident_pause:
+            pauses += ((b.ident_pause_at, b.ident_pause),)
         stray = b.stray_after_line_end
-        if (
-            stray is not None
-            and not pause[1]
-            and rewritten.kind in _STRAY_AFTER
-            and rewritten.end == CRLF
-        ):
+        if stray is not None and rewritten.kind in _STRAY_AFTER and rewritten.end == CRLF:
             # the stray character goes out in the same transmission, ``stray`` of marking
             # after the LF (a pause before its frame), so nothing can be scheduled between;
-            # a transmission takes one pause, and another fault's (ident-pause's) comes
-            # first: that reply goes without its stray, the aD<n>! replies still carry it
-            pause = (len(rewritten.text()), stray)
+            # beside another fault's pause in the reply (ident-pause's in aI!'s), both hold
+            pauses += ((len(rewritten.text()), stray),)
             rewritten = replace(rewritten, end=CRLF + b.stray_char)
-        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pause=pause)
+        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pauses=pauses)
 
     def _change_address(self, cmd: Command, at: float) -> None:
         old, new = self.address, cmd.new_address
