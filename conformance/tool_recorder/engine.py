@@ -41,7 +41,7 @@ from . import validity
 from .contention import HOLD_PREFIX, ApartSoFar, collisions, maybe_note_text
 from .hooks import Hooks
 from .policy import Policy
-from .records import IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
+from .records import CONTENTION, IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
 from .reply_end import Framing
 
 #: After this many holds that reached ``max_hold`` (a DUT that never goes quiet), later holds
@@ -547,7 +547,7 @@ class ToolRecorder:
             self.note_collisions()
             self._note_maybe_collided(break_event, sent, collided)
         if collided:  # the DUT talked over the command: it may not have heard it whole
-            state = f"invalid: bus contention ({len(collided)} characters during the command)"
+            state = f"{CONTENTION} ({len(collided)} characters during the command)"
         elif state is None:
             state = self._judge_reply(reply, command, address, command_end, framing, crc)
         if reply and not collided and command is not None and command.kind is Kind.ACKNOWLEDGE:
