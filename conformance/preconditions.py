@@ -189,6 +189,14 @@ def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     same way right after one of them."""
     if any(p.listening for p in probes):
         return None
+    met = [p.probe for p in probes if p.probe.maybe_collided]
+    if met and all(p.control is not None and p.control.answered for p in probes):
+        return Unmet(
+            "listening",
+            f"every probe maybe collided with the sensor's characters ({len(met)}), so it "
+            "may not have been heard and its silence shows nothing",
+            tuple(shown(ex) for ex in met[:3]),
+        )
     return Unmet(
         "listening",
         "the sensor answered none of the a! controls sent like its probes (one break, then "

@@ -65,6 +65,11 @@ class Behaviour:
     etx: bool = True  # ETX after the last line of multi-line text (R-4.4.13.1-01)
     # -- addressing --------------------------------------------------------------------------
     answer_foreign: bool = False  # answer a!/aI! for any address (breaks R-4.0-01)
+    #: Answer a command for another address whose character before '!' is this sensor's
+    #: address as if it were a! (breaks R-4.0-01): a parser fed one character at a time that
+    #: starts over at its address, as the lagopus sketch on EnviroDIY's library answers 0M5!
+    #: at '5' (docs/kit.md, sixteenth round).
+    answer_trailing_address: bool = False
     answer_query: bool = True
     apply_address_change: bool = True
     accept_any_new_address: bool = False  # take aA$! too (breaks R-4.3-04, decision A17)

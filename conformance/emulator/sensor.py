@@ -254,9 +254,16 @@ class SensorEmulator:
         run = self._run
         if run is not None and run.concurrent and b.foreign_aborts_concurrent:
             self._abort()
-        if b.standby_after_foreign and not b.answer_foreign:
+        if b.standby_after_foreign and not (b.answer_foreign or self._reads_foreign_tail()):
             self._awake = False  # R-7.0-14
             self._entered_standby()
+
+    def _reads_foreign_tail(self) -> bool:
+        """Whether a foreign command is heard to its '!' before the sensor goes to standby
+        (R-7.0-14): only to answer its tail (answer_trailing_address), never beside
+        answer_foreign, which keeps its own standby rule."""
+        b = self.behaviour
+        return b.answer_trailing_address and b.standby_after_foreign and not b.answer_foreign
 
     def _addressed(self, char: str) -> bool:
         if char in (self.address, "?"):
@@ -325,6 +332,9 @@ class SensorEmulator:
     # -- commands ----------------------------------------------------------------------------
     def _command(self, text: str, start: float, end: float, foreign: bool) -> None:
         b = self.behaviour
+        if foreign and self._reads_foreign_tail():
+            self._awake = False  # R-7.0-14, put off to the '!' by answer_trailing_address
+            self._entered_standby()
         try:
             cmd = parse_command(text)
         except CommandError:
@@ -338,6 +348,8 @@ class SensorEmulator:
                 self._dispatch(cmd, at)
                 if b.standby_after_foreign:
                     self._awake = False
+            elif b.answer_trailing_address and text[-2:-1] == self.address:
+                self._send(Reply(ReplyKind.ACKNOWLEDGE, self.address, command=cmd), at)
             return
         if cmd.address == "?" and cmd.kind is not Kind.QUERY_ADDRESS:
             return  # R-4.4.3-02: the wildcard is accepted only in ?!
@@ -437,25 +449,17 @@ class SensorEmulator:
         if rewritten is None:
             return None
         b = self.behaviour
-        pause = (
-            (b.ident_pause_at, b.ident_pause)
-            if rewritten.kind is ReplyKind.IDENTIFICATION
-            else (0, 0.0)
-        )
+        pauses: tuple[tuple[int, float], ...] = ()
+        if rewritten.kind is ReplyKind.IDENTIFICATION and b.ident_pause:
+            pauses += ((b.ident_pause_at, b.ident_pause),)
         stray = b.stray_after_line_end
-        if (
-            stray is not None
-            and not pause[1]
-            and rewritten.kind in _STRAY_AFTER
-            and rewritten.end == CRLF
-        ):
+        if stray is not None and rewritten.kind in _STRAY_AFTER and rewritten.end == CRLF:
             # the stray character goes out in the same transmission, ``stray`` of marking
             # after the LF (a pause before its frame), so nothing can be scheduled between;
-            # a transmission takes one pause, and another fault's (ident-pause's) comes
-            # first: that reply goes without its stray, the aD<n>! replies still carry it
-            pause = (len(rewritten.text()), stray)
+            # beside another fault's pause in the reply (ident-pause's in aI!'s), both hold
+            pauses += ((len(rewritten.text()), stray),)
             rewritten = replace(rewritten, end=CRLF + b.stray_char)
-        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pause=pause)
+        return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pauses=pauses)
 
     def _change_address(self, cmd: Command, at: float) -> None:
         old, new = self.address, cmd.new_address

@@ -25,13 +25,20 @@ class Transmission:
     gap: float
     sent: int = 0
     char_time: float = CHAR_TIME  # one frame; differs only for a sensor at the wrong baud rate
-    #: (index, s): extra marking before the frame at that index (a fault's pause in a reply)
-    pause: tuple[int, float] = (0, 0.0)
+    #: (index, s) each: extra marking before the frame at that index (a fault's pause in a
+    #: reply); several faults' pauses in one reply each hold the frames from theirs on (an
+    #: aI! reply with ident-pause's 4 ms inside and stray-after-line-end's 2 ms after its LF)
+    pauses: tuple[tuple[int, float], ...] = ()
+
+    def held(self, index: int) -> float:
+        """The marking the pauses add before the frame at ``index``: 0.0 with none, else
+        their sum (each pause's own value where it is the only one: the same floats as one)."""
+        if not self.pauses:
+            return 0.0
+        return sum(extra for at, extra in self.pauses if 0 < at <= index)
 
     def frame_start(self, index: int) -> float:
-        at, extra = self.pause
-        held = extra if 0 < at <= index else 0.0
-        return self.start + index * (self.char_time + self.gap) + held
+        return self.start + index * (self.char_time + self.gap) + self.held(index)
 
     def frame(self, index: int) -> Frame:
         return Frame(self.frame_start(index), self.wires[index], self.char_time)
@@ -48,12 +55,10 @@ class Transmission:
     def rest(self) -> Iterator[tuple[float, int, float]]:
         """``(start, wire, duration)`` of the frames not sent yet, in order: :meth:`frame`
         of each index from :attr:`sent` on (the same arithmetic, so the same floats)."""
-        at, extra = self.pause
         step = self.char_time + self.gap
-        start, wires, char_time = self.start, self.wires, self.char_time
+        start, wires, char_time, held = self.start, self.wires, self.char_time, self.held
         for index in range(self.sent, len(wires)):
-            held = extra if 0 < at <= index else 0.0
-            yield start + index * step + held, wires[index], char_time
+            yield start + index * step + held(index), wires[index], char_time
 
 
 class Transmitter:
@@ -72,13 +77,13 @@ class Transmitter:
         gap: float,
         char_time: float = CHAR_TIME,
         *,
-        pause: tuple[int, float] = (0, 0.0),
+        pauses: tuple[tuple[int, float], ...] = (),
     ) -> Transmission:
         wires = reply.wires()
         for other in self.queue:
             if other.start <= start < other.end + CHAR_TIME:
                 start = other.end + CHAR_TIME
-        item = Transmission(reply, start, wires, gap, char_time=char_time, pause=pause)
+        item = Transmission(reply, start, wires, gap, char_time=char_time, pauses=pauses)
         self._make_way(item)
         self.queue.append(item)
         self.queue.sort(key=lambda t: t.start)
@@ -123,7 +128,7 @@ class Transmitter:
         if not self.queue:
             return None
         item = self.queue[0]
-        if item.char_time + item.gap <= 0 or item.pause[1] < 0:
+        if item.char_time + item.gap <= 0 or any(extra < 0 for _, extra in item.pauses):
             return None
         return item.rest()
 

@@ -13,7 +13,8 @@ from ..transcript import Event, decode_7e1, escape
 def shown(ex: Exchange) -> str:
     """``0I! -> '0I13VENDOR..<CR><LF>'`` for evidence lines."""
     reply = escape(ex.reply_text) if ex.answered else "(silence)"
-    return f"{escape(ex.text)} -> '{reply}'"
+    note = " (maybe collided: sensor characters met the command)" if ex.maybe_collided else ""
+    return f"{escape(ex.text)} -> '{reply}'{note}"
 
 
 def cited(ex: Exchange) -> str:

@@ -143,7 +143,8 @@ def silent_while_listening(
     if unmet is not None:
         return unmet.finding(rid)
     heard = [p for p in probes if p.listening]
-    aside = len(probes) - len(heard)
+    met = sum(p.probe.maybe_collided for p in probes)
+    aside = len(probes) - len(heard) - met
     marking = heard[0].marking
     way = f" after {marking * 1e3:.0f} ms of marking" if marking is not None else ""
     return passed(
@@ -151,7 +152,8 @@ def silent_while_listening(
         f"stayed silent ({why}) to {len(heard)} command(s) sent once after a break{way}, "
         "each followed by an a! sent the same way that it answered: "
         + ", ".join(escape(p.probe.text) for p in heard)
-        + (f"; {aside} probe(s) set aside (their control went unanswered)" if aside else ""),
+        + (f"; {aside} probe(s) set aside (their control went unanswered)" if aside else "")
+        + (f"; {met} probe(s) set aside (maybe collided: may not have been heard)" if met else ""),
         decision=decision,
         evidence=[shown(p.probe) for p in heard[:3]],
         observed=2 * len(heard),

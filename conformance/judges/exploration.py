@@ -50,6 +50,7 @@ class Observation:
     address: str = ""  # framing: the sensor's address; foreign: the address commanded
     answered: bool = True  # foreign: whether anything answered
     marked: bool = False  # foreign: sent with a marking the sensor was shown to hear
+    collided: bool = False  # foreign: sensor characters met it (it may not have been heard)
     previous: str | None = None  # repeat: the D0 reply since the last measurement command
 
 
@@ -71,8 +72,10 @@ class Judgement:
 
 def _foreign(obs: Observation) -> Judgement:
     """Silence to another address counts only when the command went out the way the sensor
-    was shown to hear one (else silence says nothing); an answer always counts, and breaks."""
-    checked = ("R-4.0-01",) if obs.marked or obs.answered else ()
+    was shown to hear one and met none of its characters (else silence says nothing: it may
+    not have been heard); an answer always counts, and breaks."""
+    heard = obs.marked and not obs.collided
+    checked = ("R-4.0-01",) if heard or obs.answered else ()
     if not obs.answered:
         return Judgement(checked)
     message = (

@@ -12,12 +12,13 @@ from __future__ import annotations
 from math import copysign, isnan
 from operator import sub
 
-from ..protocol.commands import MEASUREMENT_KINDS, CommandError, parse_command
+from ..protocol.commands import ADDRESS_CHARS, MEASUREMENT_KINDS, CommandError, parse_command
 from ..protocol.responses import split_line
 from ..protocol.timing import (
     CHAR_TIME,
     INTER_CHAR_GAP_MAX,
     RESPONSE_START_MAX,
+    RESPONSE_START_MIN,
     TOLERANCE,
 )
 from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_bytes
@@ -101,7 +102,7 @@ def _start_observations(
     before: Segment | None = None
     for seg in segs:
         earlier, before = _unanswered_before(before, seg), seg
-        if not seg.reply or _reply_set_aside(seg):
+        if not seg.reply or _reply_set_aside(seg) or _not_a_reply_to(seg):
             continue
         delay = seg.reply[0].start - seg.command_end
         u = stamps.between(seg.command[-1].start, seg.reply[0].end)
@@ -151,6 +152,33 @@ def _reply_set_aside(seg: Segment) -> bool:
     command ended (a service request that met it) is no reply: the one after it is timed."""
     end = seg.command_end
     return any(e.start >= end for e in seg.contention)
+
+
+def _not_a_reply_to(seg: Segment) -> bool:
+    """Whether what follows the command is no reply to it, so its start says nothing of how
+    soon the sensor answers: a run the sensor had under way when the command ended (its
+    first character follows, within a character gap, one that started before the end), or
+    one that names another address than the command's sooner than any reply may start
+    (R-7.0-09's 7.93 ms): an answer to something sent before, which cannot have been begun
+    for this command. The sixteenth outside round's sketch answered the two ?! it had kept
+    through its boot 1.50 ms after the tool's first 0!, '5<CR><LF>' from a sensor at '5':
+    R-7.0-09/-10 counted "1.50..7.67 ms" over it (docs/kit.md)."""
+    first = seg.reply[0]
+    end = seg.command_end
+    under_way = any(
+        e.start < end and first.start - e.end <= INTER_CHAR_GAP_MAX + TOLERANCE
+        for e in seg.contention
+    )
+    if under_way:
+        return True
+    address = expected_reply_address(seg.text)
+    named = chr(first.char7)
+    return (
+        address is not None
+        and named != address
+        and named in ADDRESS_CHARS
+        and first.start - end < RESPONSE_START_MIN
+    )
 
 
 def _text(seg: Segment) -> str:

@@ -113,7 +113,13 @@ class _Explorer(RuleBasedStateMachine):
         marked = self.marking is not None
         self._observe(
             Observation(
-                "foreign", ex.text, ex.reply_text, other, answered=ex.answered, marked=marked
+                "foreign",
+                ex.text,
+                ex.reply_text,
+                other,
+                answered=ex.answered,
+                marked=marked,
+                collided=ex.maybe_collided,
             )
         )
 

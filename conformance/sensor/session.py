@@ -85,7 +85,10 @@ class HeardProbe:
 
     @property
     def listening(self) -> bool:
-        return self.control is not None and self.control.answered
+        """The control was answered and the probe met no sensor characters: a probe that
+        may have collided (a stray character just before its break, within the stamps'
+        uncertainty) may not have been heard, so its silence shows nothing."""
+        return self.control is not None and self.control.answered and not self.probe.maybe_collided
 
     @property
     def exchanges(self) -> list[Exchange]:

@@ -26,6 +26,10 @@ from ..view.runs import runs
 
 #: Start of the NOTE text that marks a collision.
 COLLISION_PREFIX = "collision: "
+#: Start of the NOTE text that marks a transmission that met DUT characters only within the
+#: stamps' uncertainty: the engine read them as begun before its command ended, the stamps
+#: cannot say whether they overlapped (no :data:`COLLISION_PREFIX` note for it).
+MAYBE_PREFIX = "maybe collided: "
 #: Start of the NOTE text that says the tool stopped holding for a DUT that kept talking.
 HOLD_PREFIX = "listen before talk: "
 #: Tool events closer than this belong to one transmission (a break, its marking, the
@@ -53,6 +57,19 @@ class Collision:
             f"{len(self.dut)} DUT characters (t={first.start:.4f}..{last.end:.4f} s); "
             "no DUT finding rests on them"
         )
+
+
+def maybe_note_text(tool: list[Event], dut: list[Event], uncertainty: float) -> str:
+    """The NOTE for a transmission whose stamps met ``dut`` only within ``uncertainty``
+    (s): whatever answered it, or its silence, may not be the command's."""
+    what = "break" if tool[0].kind is EventKind.BREAK else "command"
+    first, last = dut[0], dut[-1]
+    return (
+        f"{MAYBE_PREFIX}the tool's {what} at t={tool[0].start:.4f} s met {len(dut)} DUT "
+        f"characters (t={first.start:.4f}..{last.end:.4f} s) within the stamps' "
+        f"±{uncertainty * 1e3:.2f} ms: the sensor may not have heard it whole; its reply or "
+        "silence is not taken as its answer"
+    )
 
 
 def _overlap(a: Event, b: Event) -> bool:

@@ -19,6 +19,8 @@ OK = "ok"
 NO_REPLY = "no reply"
 IDLE = "idle"  # the reply started, then the line marked too long before CR LF / packet end
 TOO_LONG = "too long"  # max_reply_chars reached: a babbling device
+#: How an attempt's reason starts where sensor characters met its command (engine, view)
+CONTENTION = "invalid: bus contention"
 INVALID = "invalid"  # prefix; the full reason is "invalid: <why>"
 
 
@@ -122,6 +124,15 @@ class Exchange:
     def answered(self) -> bool:
         """The DUT sent something for some attempt (valid or not)."""
         return bool(self.reply_events)
+
+    @property
+    def maybe_collided(self) -> bool:
+        """The judged attempt met sensor characters that started before its command ended
+        (the engine's and the view's "bus contention"): the sensor may not have heard the
+        command whole. On a link whose stamps are uncertain by milliseconds, a stray
+        character just before the transmission is one (over RFC 2217, fault
+        stray-after-line-end: a break at 0.14..1.18 ms before the '#' ended, 9 of 267)."""
+        return self.judged.reason.startswith(CONTENTION)
 
     @property
     def ok(self) -> bool:

@@ -30,7 +30,7 @@ from ..protocol.timing import CHAR_TIME, TOLERANCE
 from ..tool_recorder import validity
 from ..tool_recorder.engine import reads_on, take_values
 from ..tool_recorder.policy import Policy
-from ..tool_recorder.records import IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
+from ..tool_recorder.records import CONTENTION, IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
 from ..transcript import Event, decode_8n1, text_end
 from .segments import TranscriptView, Transmission
 
@@ -150,7 +150,7 @@ def _attempt(
     heard = [e for e in t.heard if e.start >= t.end]
     reply = _framed(t, heard, policy)
     if stray:
-        reason = f"invalid: bus contention ({len(stray)} characters during the command)"
+        reason = f"{CONTENTION} ({len(stray)} characters during the command)"
     elif not reply:
         reason = NO_REPLY
     elif not _complete(t, reply):

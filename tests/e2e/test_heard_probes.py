@@ -160,3 +160,32 @@ def test_total_silence_is_still_no_device():
     emulator.behaviour = replace(emulator.behaviour, break_threshold=1.0)
     with pytest.raises(NoDeviceAnswered, match="100 ms"):
         SensorSession(link, address="0").discover()
+
+
+def _maybe_collided(ex):
+    """``ex`` as the engine records a probe whose break met a sensor character within the
+    stamps' uncertainty (over RFC 2217, fault stray-after-line-end: a '#' ending 0.14..1.18
+    ms after the break began, ±5 ms stamps)."""
+    from conformance.tool_recorder.records import CONTENTION
+
+    attempt = replace(ex.attempts[-1], reason=f"{CONTENTION} (1 characters during the command)")
+    return replace(ex, attempts=[*ex.attempts[:-1], attempt])
+
+
+def test_silence_to_a_probe_that_maybe_collided_is_no_evidence():
+    """R-4.0-01 PASSed "stayed silent ... to 1 command(s)" on a foreign probe the sensor may
+    not have heard (its break met the sensor's stray character); now it is set aside and,
+    alone, leaves the rule INCONCLUSIVE, the evidence saying "maybe collided"."""
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    silent = _maybe_collided(sensor.master.raw("9!", break_first=True))
+    answered = sensor.master.raw("0!", break_first=True)
+    finding = silent_while_listening("R-4.0-01", [HeardProbe(silent, answered, 9e-3)], "another")
+    assert finding.verdict is Verdict.INCONCLUSIVE, finding.detail  # PASS before
+    assert silent.maybe_collided and not answered.maybe_collided
+    assert "maybe collided" in finding.detail and "maybe collided" in " ".join(finding.evidence)
+    clean = sensor.master.raw("8!", break_first=True)
+    probes = [HeardProbe(silent, answered, 9e-3), HeardProbe(clean, answered, 9e-3)]
+    finding = silent_while_listening("R-4.0-01", probes, "another")
+    assert finding.verdict is Verdict.PASS and finding.observed == 2
+    assert "1 probe(s) set aside (maybe collided" in finding.detail, finding.detail

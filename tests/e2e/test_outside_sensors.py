@@ -623,3 +623,46 @@ def test_a_sensor_that_answers_no_a_and_is_lost_after_a_change_stops_the_run(
     assert not data["run"]["complete"]
     reason = data["run"]["stop_reason"]
     assert "lost" in reason and "?! is answered '-12" in reason, reason
+
+
+def test_r_4_0_01_fails_a_sensor_that_answers_a_command_ending_in_its_address():
+    """The sixteenth round's lagopus sketch at '5' answers ``0M5!`` as ``5!``: its parser
+    starts over at its address. The foreign probes (a!, aI!, aM! at spare addresses, and the
+    exploration's D0 form at '0') never end in '5'; the probe ``zD5!`` does, and its answer
+    FAILs R-4.0-01 (passed before: nothing the suite sent ended in '5!')."""
+    found = _verdicts(
+        run_once(
+            "sim://?faults=answers-trailing-address&address=5",
+            keyword="test_foreign_addresses_are_ignored or test_exploration",
+        )
+    )
+    assert found["R-4.0-01"]["verdict"] == "FAIL"
+    details = " ".join(f["detail"] for f in found["R-4.0-01"]["findings"])
+    assert "zD5!" in details, details
+
+
+def test_the_probe_ending_in_the_address_is_silent_on_the_clean_sensor_at_a_letter():
+    """At a letter address the probe is a change of address (``zAb!``), a valid command for
+    'z' that no sensor holds: the clean sensor stays silent and R-4.0-01 PASSes on it."""
+    found = _verdicts(run_once("sim://?address=b", keyword="test_foreign_addresses_are_ignored"))
+    assert found["R-4.0-01"]["verdict"] == "PASS"
+    details = " ".join(f["detail"] for f in found["R-4.0-01"]["findings"])
+    assert "zAb!" in details, details
+
+
+def test_answers_to_kept_queries_are_not_timed_as_replies(monkeypatch):
+    """The lagopus sketch's answers to the ?!s it kept through its boot came 1.50 ms after
+    the tool's 0!, '1<CR><LF>' here from the sim at '1': R-7.0-09 FAILed "1.50 ms, allowed
+    >= 7.93 ms" on them (the sketch's own 7.67 ms replies hid it there). They answer no
+    command of the tool's: not timed now, and the sim's 9 ms replies PASS."""
+    boots_late(monkeypatch, 1.45)
+    found = _verdicts(
+        run_once(
+            "sim://?faults=factory-address-not-zero",
+            keyword="test_acknowledge_active or test_response_start_window",
+        )
+    )
+    for rid in ("R-7.0-09", "R-7.0-10"):
+        assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])
+        detail = found[rid]["findings"][0]["detail"]
+        assert "9.00..9.00 ms" in detail, detail

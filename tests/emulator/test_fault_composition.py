@@ -216,6 +216,23 @@ def test_a_service_request_due_during_a_reply_keeps_the_sensors_character_gap():
     assert min(answer.gaps) == pytest.approx(3e-3)
 
 
+def test_an_identify_reply_carries_both_faults_pauses():
+    """ident-pause beside stray-after-line-end: the transmission scheduler took one pause per
+    reply, so stop 48 sent aI!'s reply with ident-pause's 4 ms and without its stray '#'.
+    Now it takes a list: the 4 ms before the seventh character and the '#' 2 ms after the
+    LF, both in the one transmission; aD0!'s reply still has only its stray."""
+    rig = Rig(faults=("ident-pause", "stray-after-line-end"))
+    answer = rig.ask("0I!")
+    assert answer.text.endswith("\r\n#")
+    assert answer.gaps[5] == pytest.approx(4e-3)
+    assert answer.gaps[-1] == pytest.approx(2e-3)
+    others = [g for i, g in enumerate(answer.gaps) if i not in (5, len(answer.gaps) - 1)]
+    assert all(g == pytest.approx(0.0) for g in others)
+    data = rig.ask("0D0!")
+    assert data.text.endswith("\r\n#") and data.gaps[-1] == pytest.approx(2e-3)
+    assert all(g == pytest.approx(0.0) for g in data.gaps[:-1])
+
+
 def test_a_semicolon_in_units_spares_records_another_fault_left_without_units():
     """metadata-missing-units beside metadata-semicolon-in-field (seed 4138, with
     ignores-query): aM!'s records have no units field to put the ';' in, and the rewrite

@@ -379,6 +379,13 @@ def check_answers_foreign_address(rig: Rig) -> None:
     assert silent(rig.ask("0!", brk=False))  # still goes to standby after it
 
 
+def check_answers_trailing_address(rig: Rig) -> None:
+    assert rig.ask("zD0!").text == "0\r\n"
+    assert rig.ask("9R0!").text == "0\r\n"
+    assert silent(rig.ask("zD1!"))
+    assert silent(rig.ask("0!", brk=False))  # still goes to standby after it
+
+
 def check_ignores_query(rig: Rig) -> None:
     assert silent(rig.ask("?!"))
     assert rig.ask("0!").text == "0\r\n"
@@ -651,6 +658,7 @@ CHECKS: dict[str, Callable[[Rig], None]] = {
     "data-lost-after-standby": check_data_lost_after_standby,
     "identify-clears-buffer": check_identify_clears_buffer,
     "answers-foreign-address": check_answers_foreign_address,
+    "answers-trailing-address": check_answers_trailing_address,
     "ignores-query": check_ignores_query,
     "address-change-not-applied": check_address_change_not_applied,
     "answers-old-address": check_answers_old_address,

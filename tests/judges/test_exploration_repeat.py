@@ -51,3 +51,14 @@ def test_r_4_2_03_framing_of_replies_is_a_partial_pass():
     found = {f.requirement: f for f in held_findings([framed], 10)}
     assert found["R-4.2-03"].verdict is Verdict.PASS and found["R-4.2-03"].partial
     assert not found["R-4.3-01"].partial
+
+
+def test_silence_to_a_foreign_command_that_maybe_collided_is_no_check():
+    """R-4.0-01's exploration check counted silence to a foreign command sent the way the
+    sensor hears one even where sensor characters met it (it may not have been heard)."""
+    from conformance.judges.exploration import Observation, checks
+
+    heard = Observation("foreign", "9I!", "", "9", answered=False, marked=True)
+    met = Observation("foreign", "9I!", "", "9", answered=False, marked=True, collided=True)
+    assert checks([heard])["R-4.0-01"] == 1
+    assert checks([met])["R-4.0-01"] == 0

@@ -80,3 +80,70 @@ def test_a_reply_after_a_service_request_that_met_the_command_is_still_timed():
     assert seg.contention and all(e.start < seg.command_end for e in seg.contention)
     findings = judge_response_start([seg], 0.0)
     assert _verdict("R-7.0-10", findings) is Verdict.PASS
+
+
+#: The sixteenth outside round's lagopus sketch at '5' (docs/kit.md): it kept the tool's ?!s
+#: through its boot and answered them, '5<CR><LF>' twice, 1.50 ms after the tool's first 0!;
+#: then a 5! answered 9 ms after it. The stamps are that run's (r6), the last exchange made up.
+BOOT_ANSWERS = [
+    ("tool", 1.4903333, 1.4986667, "0"),
+    ("tool", 1.4986667, 1.5070000, "!"),
+    ("dut", 1.508501, 1.516799, "5"),
+    ("dut", 1.516801, 1.525121, "\r"),
+    ("dut", 1.525121, 1.533441, "\n"),
+    ("dut", 1.541941, 1.550203, "5"),
+    ("dut", 1.550209, 1.558529, "\r"),
+    ("dut", 1.558529, 1.566849, "\n"),
+    ("tool", 1.700000, 1.708333, "5"),
+    ("tool", 1.708333, 1.716667, "!"),
+    ("dut", 1.725667, 1.734000, "5"),
+    ("dut", 1.734000, 1.742333, "\r"),
+    ("dut", 1.742333, 1.750667, "\n"),
+]
+
+
+def test_an_answer_naming_another_address_sooner_than_any_reply_is_not_timed():
+    """R-7.0-09 counted '5<CR><LF>' 1.50 ms after 0! as a reply to it ("477 replies,
+    1.50..7.67 ms"): an answer to the ?!s kept through the boot, begun before 0! could have
+    been heard. Only 5!'s reply is timed now (it FAILed on the 1.50 ms before)."""
+    findings = judge_response_start(segments(_events(BOOT_ANSWERS)), 0.0)
+    early = next(f for f in findings if f.requirement == "R-7.0-09")
+    assert early.verdict is Verdict.PASS, early.detail
+    assert "1 reply" in early.detail and "1.50" not in early.detail, early.detail
+
+
+def test_a_reply_naming_another_address_in_the_reply_window_is_still_timed():
+    """A reply in the window that names another address (wrong-reply-address's D replies)
+    is timed as before: R-4.3-01 judges its address, R-7.0-10 its start."""
+    rows = [
+        ("tool", 1.000, 1.00833, "0"),
+        ("tool", 1.00833, 1.01667, "!"),
+        ("dut", 1.03667, 1.045, "1"),
+        ("dut", 1.045, 1.05333, "\r"),
+        ("dut", 1.05333, 1.06167, "\n"),
+    ]
+    findings = judge_response_start(segments(_events(rows)), 0.0)
+    assert _verdict("R-7.0-10", findings) is Verdict.FAIL  # 20.00 ms
+
+
+def test_a_run_under_way_when_the_command_ended_is_not_timed_as_its_reply():
+    """A sensor already talking when the command ended, two lines back to back: the first
+    met the command (every character of it started before the end: contention), the second
+    follows its LF with no marking, so it was under way then, no reply begun 0.67 ms after
+    the command (R-7.0-09 FAILed on it)."""
+    rows = [
+        ("tool", 1.000, 1.00833, "0"),
+        ("tool", 1.00833, 1.01667, "D"),
+        ("tool", 1.01667, 1.025, "0"),
+        ("tool", 1.025, 1.03333, "!"),
+        ("dut", 1.00833, 1.01667, "0"),
+        ("dut", 1.01667, 1.025, "\r"),
+        ("dut", 1.025, 1.03333, "\n"),
+        ("dut", 1.034, 1.04233, "0"),
+        ("dut", 1.04233, 1.05067, "\r"),
+        ("dut", 1.05067, 1.059, "\n"),
+    ]
+    (seg,) = segments(_events(rows))
+    assert "".join(chr(e.wire & 0x7F) for e in seg.reply) == "0\r\n"  # the premise
+    findings = judge_response_start([seg], 0.0)
+    assert _verdict("R-7.0-09", findings) is not Verdict.FAIL

@@ -68,9 +68,10 @@ def test_the_clean_emulator_is_the_same_both_ways(monkeypatch) -> None:
 
 def test_the_rest_of_a_transmission_is_each_frame_in_turn() -> None:
     reply = Reply(ReplyKind.DATA, "0+1.25+3.5")
-    for gap, pause, char_time in [(0.0, (0, 0.0), 8.33e-3), (1.7e-3, (4, 0.3), 8.33e-3),
-                                  (0.4e-3, (1, 0.011), 9.1e-3)]:  # fmt: skip
-        item = Transmission(reply, 1.234567, reply.wires(), gap, char_time=char_time, pause=pause)
+    for gap, pauses, char_time in [(0.0, (), 8.33e-3), (1.7e-3, ((4, 0.3),), 8.33e-3),
+                                   (0.4e-3, ((1, 0.011),), 9.1e-3),
+                                   (0.0, ((2, 0.004), (7, 0.002)), 8.33e-3)]:  # fmt: skip
+        item = Transmission(reply, 1.234567, reply.wires(), gap, char_time=char_time, pauses=pauses)
         for sent in range(len(item.wires)):
             item.sent = sent
             expected = [item.frame(i) for i in range(sent, len(item.wires))]
@@ -84,7 +85,7 @@ def test_frames_whose_ends_might_fall_are_asked_one_by_one() -> None:
     tx.schedule(reply, 1.0, gap=-0.009)
     assert tx.ahead() is None
     tx = Transmitter()
-    tx.schedule(reply, 1.0, gap=0.0, pause=(2, -0.001))
+    tx.schedule(reply, 1.0, gap=0.0, pauses=((2, -0.001),))
     assert tx.ahead() is None
     tx = Transmitter()
     assert tx.ahead() is None
@@ -96,7 +97,7 @@ def test_popping_a_run_is_popping_each_frame() -> None:
     reply = Reply(ReplyKind.DATA, "0+1.5")
     one, many = Transmitter(), Transmitter()
     for tx in (one, many):
-        tx.schedule(reply, 0.5, gap=0.001, pause=(3, 0.02))
+        tx.schedule(reply, 0.5, gap=0.001, pauses=((3, 0.02),))
         tx.schedule(reply, 2.0, gap=0.0)
     for _ in range(4):
         frame, _item = one.pop_frame()
@@ -118,7 +119,7 @@ class _Talker:
     def __init__(self) -> None:
         self.tx = Transmitter()
         self.tx.schedule(Reply(ReplyKind.DATA, "0+1.5+2.25"), 0.010, gap=0.0004)
-        self.tx.schedule(Reply(ReplyKind.DATA, "0+3"), 0.050, gap=0.0, pause=(3, 0.045))
+        self.tx.schedule(Reply(ReplyKind.DATA, "0+3"), 0.050, gap=0.0, pauses=((3, 0.045),))
         self.tx.schedule(Reply(ReplyKind.DATA, "0+77.125"), 0.500, gap=0.021)
         self.tx.schedule(Reply(ReplyKind.SERVICE_REQUEST, "0"), 0.900, gap=0.0)
 

@@ -5,6 +5,7 @@ transcript and is counted, never evidence against the DUT."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import pytest
 
@@ -167,3 +168,25 @@ def test_the_prompt_service_request_firmware_runs_clean_with_no_collision(tmp_pa
     assert collisions(events) == [] and collision_notes(events) == []
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert f"{link['talk_holds']} transmissions held until the DUT was quiet; 0 collisions" in page
+
+
+def test_a_transmission_that_met_dut_characters_within_the_stamps_leaves_a_note():
+    """Over RFC 2217 with fault stray-after-line-end (±5 ms stamps) the next command began
+    0.1..1.2 ms before the stray '#' ended, 106 of 267 times: the engine read the '#' as
+    begun before the command ended (invalid: bus contention, a retry) but no overlap beyond
+    the stamps' uncertainty showed, so no collision NOTE was made and the transcript said
+    nothing. Now a "maybe collided" NOTE; none where a collision NOTE covers it."""
+    from conformance.tool_recorder.contention import MAYBE_PREFIX
+
+    master, _ = rig(ScriptedSensor({"0!": ["0\r\n"]}))
+    master.link.info = replace(master.link.info, timing_uncertainty=5e-3)
+    stray = Event(EventKind.CHAR, DUT, 1.0000, 1.0 + CHAR_TIME, wire=0x23, uncertainty=5e-3)
+    command = [_char(TOOL, 1.0 + CHAR_TIME - 1.2e-3, uncertainty=5e-3)]
+    master._note_maybe_collided(None, command, [stray])
+    notes = [e.text for e in master.link.transcript.events if e.kind is EventKind.NOTE]
+    said = [n for n in notes if n.startswith(MAYBE_PREFIX)]
+    assert len(said) == 1 and "±5.00 ms" in said[0] and "1 DUT characters" in said[0], notes
+    master._collided.add((command[0].start, command[0].end))  # a collision NOTE made for it
+    master._note_maybe_collided(None, command, [stray])
+    notes = [e.text for e in master.link.transcript.events if e.kind is EventKind.NOTE]
+    assert len([n for n in notes if n.startswith(MAYBE_PREFIX)]) == 1

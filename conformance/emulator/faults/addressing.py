@@ -84,6 +84,14 @@ COVERAGE: tuple[Fault, ...] = (
         settings={"wildcard_answer": True},
     ),
     Fault(
+        "answers-trailing-address",
+        "A command for another address whose character before '!' is this sensor's address"
+        " (zD0! at '0') is answered as a! (a parser fed one character at a time that starts"
+        " over at its address: the lagopus sketch on EnviroDIY's library, sixteenth round).",
+        ("R-4.0-01",),
+        settings={"answer_trailing_address": True},
+    ),
+    Fault(
         "address-change-deaf-2s",
         "After aAb! the sensor ignores every command for 2 s (1 s is allowed).",
         ("R-4.4.4-02",),
