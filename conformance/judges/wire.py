@@ -66,7 +66,7 @@ def judge_response_start(
     """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply, each
     with the uncertainty of the stamps it rests on (the command's last, the reply's first)."""
     stamps = stamp_uncertainty(uncertainty)
-    early, late = _start_observations(segs, stamps)
+    early, late, _ = _start_observations(segs, stamps)
     real = stamps.local is not None
     return [
         combine_local("R-7.0-09", early, "reply", real_time=real),
@@ -80,7 +80,7 @@ def starts_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty
     stamps = stamp_uncertainty(uncertainty)
     if stamps.local is None:  # a virtual clock: nothing to confirm (to_confirm)
         return []
-    early, late = _start_observations(segs, stamps)
+    early, late, _ = _start_observations(segs, stamps)
     both = to_confirm(early, real_time=True) + to_confirm(late, real_time=True)
     return list(dict.fromkeys(both))
 
@@ -95,11 +95,12 @@ LATE_WINDOW = Window(
 
 
 def _start_observations(
-    segs: list[Segment], stamps: StampUncertainty
-) -> tuple[list[Observation], list[Observation]]:
+    segs: list[Segment], stamps: StampUncertainty, before: Segment | None = None
+) -> tuple[list[Observation], list[Observation], Segment | None]:
+    """R-7.0-09's and R-7.0-10's observations of ``segs``, and the last segment (which
+    ``before`` carries into the next window's: its reply may be late, after the cut)."""
     early: list[Observation] = []
     late: list[Observation] = []
-    before: Segment | None = None
     for seg in segs:
         earlier, before = _unanswered_before(before, seg), seg
         if not seg.reply or _reply_set_aside(seg) or _not_a_reply_to(seg):
@@ -121,7 +122,7 @@ def _start_observations(
             if earlier is not None and window.inside(delay) != window.inside(lagged):
                 continue
             out.append((Measured(window, delay, u, where), tainted, place))
-    return early, late
+    return early, late, before
 
 
 def _unanswered_before(before: Segment | None, seg: Segment) -> Segment | None:
@@ -389,16 +390,19 @@ class ResponseStarts:
     """:func:`judge_response_start` over a recording read a window at a time (issue 22's
     windowed judge): each window's segments :meth:`add`-ed in order, the findings those of
     the whole recording's segments (each reply's delay is its own segment's: the windows'
-    observations in order are the whole run's)."""
+    observations in order are the whole run's; the last segment is carried, since a reply
+    after a cut may be the late reply of an unanswered command before it)."""
 
     def __init__(self, uncertainty: float | StampUncertainty) -> None:
         self.stamps = stamp_uncertainty(uncertainty)
         self.early: list[Observation] = []
         self.late: list[Observation] = []
+        #: the last segment added: an unanswered command whose late reply may open the next
+        self.last: Segment | None = None
 
     def add(self, segs: list[Segment]) -> None:
         """The replies of ``segs`` (the next window's segments)."""
-        early, late = _start_observations(segs, self.stamps)
+        early, late, self.last = _start_observations(segs, self.stamps, self.last)
         self.early += early
         self.late += late
 

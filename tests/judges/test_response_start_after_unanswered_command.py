@@ -9,7 +9,7 @@ are that run's (`sim`-free: the firmware's on the kit), as stamped."""
 
 from __future__ import annotations
 
-from conformance.judges.wire import judge_response_start
+from conformance.judges.wire import ResponseStarts, judge_response_start
 from conformance.transcript import Event, EventKind, to_wire_7e1
 from conformance.verdicts import Verdict
 from conformance.view.runs import segments
@@ -66,3 +66,18 @@ def test_a_reply_that_cannot_answer_the_command_before_is_timed_as_before():
     rows = _send("tool", 1.0, "9!") + _send("tool", 1.1, "0!") + _send("dut", 1.1257, "0\r\n")
     late = _finding("R-7.0-10", judge_response_start(segments(_events(rows)), 0.0))
     assert late.verdict is Verdict.PASS
+
+
+def test_a_window_cut_between_the_unanswered_command_and_its_reply_reads_the_same():
+    """Judged a window at a time (``ResponseStarts``, issue 22), the cut may fall after the
+    unanswered try: the next window's reply is read against it as in the whole run (before,
+    each window started afresh and R-7.0-10 PASSed on the retry's 11.35 ms again)."""
+    rows = RETRIED + _send("tool", 66.5, "0!") + _send("dut", 66.5257, "0\r\n")
+    segs = segments(_events(rows))
+    whole = judge_response_start(segs, 0.0)
+    assert _finding("R-7.0-10", whole).verdict is Verdict.PASS  # 0! in time; the retry not
+    for cut in range(len(segs) + 1):
+        starts = ResponseStarts(0.0)
+        starts.add(segs[:cut])
+        starts.add(segs[cut:])
+        assert starts.findings() == whole, cut
