@@ -301,6 +301,13 @@ class _Tally:
         self.glitches += d.kind == "glitch"
         self.partial += d.kind == "partial"
 
+    def certified(self, chars: int, framing: int, parity: int, glitches: int) -> None:
+        """Add the counts the bulk loop kept for its certified frames."""
+        self.chars += chars
+        self.framing_errors += framing
+        self.parity_errors += parity
+        self.glitches += glitches
+
     def store(self, out: CaptureDecode) -> None:
         out.chars, out.breaks, out.pulses, out.glitches = (
             self.chars, self.breaks, self.pulses, self.glitches,
@@ -333,8 +340,8 @@ def _collect_batches(
     problems, tally = out.problems, _Tally(out)
     add, baud_error = out.events.append, out.baud_error_pct.append
     nan = float("nan")
-    chars = framing_errors = parity_errors = glitches = 0  # the certified frames'
-    matched = 0  # TX events matched since Marks was last told
+    # the certified frames' counts; TX events matched since Marks was last told
+    chars = framing_errors = parity_errors = glitches = matched = 0
     char, bus, event = EventKind.CHAR, origin, full_event
     mark = marks.origin if marks is not None and marks.start else None
     # Marks.origin spelt out for the certified frames (a call each cost what it saved)
@@ -351,22 +358,15 @@ def _collect_batches(
                 s, w = st[x], wi[x]  # type: ignore[index]
                 if into is not None:
                     add(char, s, w)
-                elif n_tx:
-                    while j < n_tx and tx_start[j] < s - tol:
-                        j += 1
-                    if (
-                        j < n_tx
-                        and abs(tx_start[j] - s) <= tol
-                        and tx_kind[j] is char
-                        and tx_wire[j] == w
-                    ):
-                        j += 1
-                        matched += 1
-                        add(event(char, recorder, s, en[x], w, "", unc, None))  # type: ignore[index]
-                    else:
-                        add(event(char, bus, s, en[x], w, "", unc, None))  # type: ignore[index]
                 else:
-                    add(event(char, bus, s, en[x], w, "", unc, None))  # type: ignore[index]
+                    o = bus
+                    if n_tx:
+                        while j < n_tx and tx_start[j] < s - tol:
+                            j += 1
+                        hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
+                        if hit and tx_kind[j] is char:
+                            o, j, matched = recorder, j + 1, matched + 1
+                    add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
                 chars += 1
                 e = err[x]  # type: ignore[index]
                 baud_error(nan if e is None else e)
@@ -383,10 +383,8 @@ def _collect_batches(
                     tally.item(d)
                     continue
                 o = bus
-                if mark is not None:
-                    marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
-                    o, matched = mark(ev.kind, ev.start, ev.wire, bus), 0
-                    j = marks.at  # type: ignore[union-attr]
+                if marks is not None and mark is not None:
+                    o, j, matched = marks.resumed(j, matched, ev.kind, ev.start, ev.wire, bus)
                 if o != BUS:
                     u, du = ev.uncertainty, ev.duration_uncertainty
                     ev = event(ev.kind, o, ev.start, ev.end, ev.wire, ev.text, u, du)
@@ -394,10 +392,7 @@ def _collect_batches(
             tally.item(d)
     if mark is not None:
         marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
-    tally.chars += chars
-    tally.framing_errors += framing_errors
-    tally.parity_errors += parity_errors
-    tally.glitches += glitches
+    tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
 
 
@@ -518,6 +513,14 @@ class Marks:
             return RECORDER_ORIGIN
         self.at = j
         return other
+
+    def resumed(
+        self, at: int, matched: int, kind: EventKind, start: float, wire: int, other: str
+    ) -> tuple[str, int, int]:
+        """:meth:`origin` from a loop that keeps the place (``at``) and the matches since it
+        last told (``matched``) itself: the origin, the place after, no match untold."""
+        self.at, self.matched = at, self.matched + matched
+        return self.origin(kind, start, wire, other), self.at, 0
 
     def unseen(self) -> int:
         """How many TX events were not seen on the bus."""
