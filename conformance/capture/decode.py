@@ -184,7 +184,13 @@ def _decode_channel(
     invert: bool | None,
     how: DecodeSettings,
     origin: str = BUS,
+    marks: Marks | None = None,
+    into: Marks | None = None,
 ) -> CaptureDecode:
+    """One channel decoded. ``marks``: the recorder's TX channel, its characters and breaks
+    giving the events they match :data:`RECORDER_ORIGIN` as they are made (the others get
+    ``origin``); ``into``: this is that TX channel, its characters and breaks put there,
+    no event made (BULK only)."""
     baud, framing, edge_error = how.baud, how.framing, how.edge_error
     edges = read_edges(path, channel, fmt)
     glitch = GlitchFilter(how.glitch_filter * edges.tick_rate)
@@ -234,11 +240,15 @@ def _decode_channel(
     if BULK:
         sync_s = SYNC_BITS * (edges.tick_rate / baud) / edges.tick_rate  # as uart.decode has it
         batches = decode_batches(chain(taken, chunks), **line)
-        _collect_batches(batches, out, sync_s, edges.t0, origin)
+        if marks is not None:
+            marks.tolerance = 0.5 / baud + 2 * uncertainty  # merge_tx's, if not widened
+        _collect_batches(batches, out, sync_s, edges.t0, origin, marks, into)
     else:
         _collect(decode(chain(taken, chunks), **line), out)
     _filtered(out, glitch, how.glitch_filter)
-    _check_plausible(out, _estimated_baud(prefix, edges.tick_rate), framing, force=how.force)
+    held = into is not None and bool(into.start)
+    est = _estimated_baud(prefix, edges.tick_rate)
+    _check_plausible(out, est, framing, force=how.force, held=held)
     return out
 
 
@@ -291,6 +301,13 @@ class _Tally:
         self.glitches += d.kind == "glitch"
         self.partial += d.kind == "partial"
 
+    def certified(self, chars: int, framing: int, parity: int, glitches: int) -> None:
+        """Add the counts the bulk loop kept for its certified frames."""
+        self.chars += chars
+        self.framing_errors += framing
+        self.parity_errors += parity
+        self.glitches += glitches
+
     def store(self, out: CaptureDecode) -> None:
         out.chars, out.breaks, out.pulses, out.glitches = (
             self.chars, self.breaks, self.pulses, self.glitches,
@@ -300,13 +317,21 @@ class _Tally:
 
 
 def _collect_batches(
-    batches: Iterator[Batch], out: CaptureDecode, sync_s: float, t0: float, origin: str = BUS
+    batches: Iterator[Batch],
+    out: CaptureDecode,
+    sync_s: float,
+    t0: float,
+    origin: str = BUS,
+    marks: Marks | None = None,
+    into: Marks | None = None,
 ) -> None:
     """:func:`_collect` of :func:`~.uart.decode`'s items as :func:`~.uart_bulk.decode_batches`
     gives them: a certified frame's event is made from the batch's lists, without a
     :class:`~.uart.Decoded` (made only for a problem); the first :data:`~.uart.HOLD_FRAMES`
     items, all that :func:`~.uart._synchronised` looks at, go through it as items. The
-    events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's)."""
+    events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's),
+    or :data:`RECORDER_ORIGIN` where ``marks`` matches them (:meth:`Marks.origin`); with
+    ``into``, no event is made: each one's start, kind and wire go there."""
     unc = out.uncertainty_s
     head: list[Batch] = []  # the batches holding the first HOLD_FRAMES items
     while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
@@ -315,15 +340,33 @@ def _collect_batches(
     problems, tally = out.problems, _Tally(out)
     add, baud_error = out.events.append, out.baud_error_pct.append
     nan = float("nan")
-    chars = framing_errors = parity_errors = glitches = 0  # the certified frames'
+    # the certified frames' counts; TX events matched since Marks was last told
+    chars = framing_errors = parity_errors = glitches = matched = 0
     char, bus, event = EventKind.CHAR, origin, full_event
+    mark = marks.origin if marks is not None and marks.start else None
+    # Marks.origin spelt out for the certified frames (a call each cost what it saved)
+    tx_start, tx_kind, tx_wire = (marks.start, marks.kind, marks.wire) if mark else ([], [], [])
+    n_tx, tol, j, recorder = len(tx_start), marks.tolerance if mark else 0.0, 0, RECORDER_ORIGIN
+    if into is not None:
+        add = into.add
     for b in chain(head, batches):
         st, en, wi, fe, pe, err, gl = (
             b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
         )  # fmt: skip
         for x in b.order:
             if x.__class__ is int:
-                add(event(char, bus, st[x], en[x], wi[x], "", unc, None))  # type: ignore[index]
+                s, w = st[x], wi[x]  # type: ignore[index]
+                if into is not None:
+                    add(char, s, w)
+                else:
+                    o = bus
+                    if n_tx:
+                        while j < n_tx and tx_start[j] < s - tol:
+                            j += 1
+                        hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
+                        if hit and tx_kind[j] is char:
+                            o, j, matched = recorder, j + 1, matched + 1
+                    add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
                 chars += 1
                 e = err[x]  # type: ignore[index]
                 baud_error(nan if e is None else e)
@@ -335,15 +378,21 @@ def _collect_batches(
                 continue
             d: Decoded = x  # type: ignore[assignment]
             if (ev := d.event) is not None:
-                if origin != BUS:
+                if into is not None:
+                    add(ev.kind, ev.start, ev.wire)
+                    tally.item(d)
+                    continue
+                o = bus
+                if marks is not None and mark is not None:
+                    o, j, matched = marks.resumed(j, matched, ev.kind, ev.start, ev.wire, bus)
+                if o != BUS:
                     u, du = ev.uncertainty, ev.duration_uncertainty
-                    ev = event(ev.kind, bus, ev.start, ev.end, ev.wire, ev.text, u, du)
+                    ev = event(ev.kind, o, ev.start, ev.end, ev.wire, ev.text, u, du)
                 add(ev)
             tally.item(d)
-    tally.chars += chars
-    tally.framing_errors += framing_errors
-    tally.parity_errors += parity_errors
-    tally.glitches += glitches
+    if mark is not None:
+        marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
+    tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
 
 
@@ -367,13 +416,19 @@ def _synchronise_head(batches: list[Batch], unc: float, sync_s: float, t0: float
 
 
 def _check_plausible(
-    out: CaptureDecode, est: float | None, framing: Framing, *, force: bool = False
+    out: CaptureDecode,
+    est: float | None,
+    framing: Framing,
+    *,
+    force: bool = False,
+    held: bool = False,
 ) -> None:
     """Refuse a decode that is mostly errors (a wrong bit rate, framing or channel, rather
     than a noisy line: ``est`` is the bit rate the shortest pulses suggest) or holds no
     event at all, since judging it would only report the user's mistake as the device's.
     ``force``: a decode that is mostly errors is judged anyway, the refusal kept in
-    ``out.forced_past`` for the notes (one with no event at all still cannot be)."""
+    ``out.forced_past`` for the notes (one with no event at all still cannot be).
+    ``held``: its events were held as :class:`Marks`, not made (some were)."""
     path, baud = out.path, out.baud
     # spikes on an idle field cable are noise, not a sign of a wrong bit rate: what tells is
     # frames that do not read, or a capture that is mostly pulses too short for a bit
@@ -392,7 +447,7 @@ def _check_plausible(
         if not force:
             raise CaptureError(path, why + " (--force judges it anyway)")
         out.forced_past = why
-    if not out.events:
+    if not out.events and not held:
         raise CaptureError(
             path, f"channel {out.channel!r} holds only glitches: no frame or break to decode"
         )
@@ -402,41 +457,85 @@ def merge_tx(bus: list[Event], tx: list[Event], tolerance: float) -> tuple[list[
     """The bus events with origin :data:`RECORDER_ORIGIN` where the recorder's TX channel shows the
     same character or break starting within ``tolerance`` seconds, else :data:`SENSOR_ORIGIN`; and
     how many TX events were not seen on the bus."""
-    event = full_event
+    marks = Marks.of(tx, tolerance)
+    origin, event = marks.origin, full_event
     out = [
-        event(e.kind, SENSOR_ORIGIN, e.start, e.end, e.wire, e.text, e.uncertainty,
-              e.duration_uncertainty)
+        event(e.kind, origin(e.kind, e.start, e.wire, SENSOR_ORIGIN), e.start, e.end, e.wire,
+              e.text, e.uncertainty, e.duration_uncertainty)
         for e in bus
     ]  # fmt: skip
-    return out, _mark_recorder(out, tx, tolerance)
+    return out, marks.unseen()
 
 
-def _mark_recorder(bus: list[Event], tx: list[Event], tolerance: float) -> int:
-    """:func:`merge_tx` of bus events with origin :data:`SENSOR_ORIGIN` already, in place (the
-    one matching rule of both): only the events it gives :data:`RECORDER_ORIGIN` are made
-    again (the others are already what it makes); how many TX events were not seen on the bus."""
-    j = 0
-    n_tx = len(tx)
-    matched = 0
-    char, event = EventKind.CHAR, full_event
-    for i, ev in enumerate(bus):
-        start = ev.start
-        while j < n_tx and tx[j].start < start - tolerance:
+@dataclass
+class Marks:
+    """The recorder's TX channel as the bus is matched against it (:func:`merge_tx`'s one
+    rule): its characters' and breaks' starts, kinds and wires in order, the tolerance, and
+    the matching's place. A bus decode with a TX channel decodes the TX first into one
+    (no event made of it) and gives each bus event its origin as it is made: each event
+    made once, where the TX channel's events were made too, and the recorder's bus events
+    made again after a second pass over the bus (~10^4 events a fault-matrix row, issue 22)."""
+
+    start: list[float] = field(default_factory=list)
+    kind: list[EventKind] = field(default_factory=list)
+    wire: list[int] = field(default_factory=list)
+    tolerance: float = 0.0
+    at: int = 0  # the first TX event neither matched nor passed
+    matched: int = 0
+
+    @classmethod
+    def of(cls, events: list[Event], tolerance: float) -> Marks:
+        marks = cls(tolerance=tolerance)
+        for e in events:
+            marks.add(e.kind, e.start, e.wire)
+        return marks
+
+    def add(self, kind: EventKind, start: float, wire: int) -> None:
+        self.start.append(start)
+        self.kind.append(kind)
+        self.wire.append(wire)
+
+    def origin(self, kind: EventKind, start: float, wire: int, other: str) -> str:
+        """The origin of the next bus event (in bus order): :data:`RECORDER_ORIGIN` if the
+        first TX event not yet matched or passed starts within the tolerance of it and is
+        the same character or break (it is then matched), else ``other``; TX events that
+        start more than the tolerance before it are passed."""
+        starts, j, n, tol = self.start, self.at, len(self.start), self.tolerance
+        while j < n and starts[j] < start - tol:
             j += 1
-        if j < n_tx:
-            t = tx[j]
-            if (
-                abs(t.start - start) <= tolerance
-                and t.kind is ev.kind
-                and (ev.kind is not char or t.wire == ev.wire)
-            ):
-                du = ev.duration_uncertainty
-                bus[i] = event(
-                    ev.kind, RECORDER_ORIGIN, start, ev.end, ev.wire, ev.text, ev.uncertainty, du
-                )
-                matched += 1
-                j += 1
-    return n_tx - matched
+        if (
+            j < n
+            and abs(starts[j] - start) <= tol
+            and self.kind[j] is kind
+            and (kind is not EventKind.CHAR or self.wire[j] == wire)
+        ):
+            self.at, self.matched = j + 1, self.matched + 1
+            return RECORDER_ORIGIN
+        self.at = j
+        return other
+
+    def resumed(
+        self, at: int, matched: int, kind: EventKind, start: float, wire: int, other: str
+    ) -> tuple[str, int, int]:
+        """:meth:`origin` from a loop that keeps the place (``at``) and the matches since it
+        last told (``matched``) itself: the origin, the place after, no match untold."""
+        self.at, self.matched = at, self.matched + matched
+        return self.origin(kind, start, wire, other), self.at, 0
+
+    def unseen(self) -> int:
+        """How many TX events were not seen on the bus."""
+        return len(self.start) - self.matched
+
+    def again(self, bus: list[Event], tolerance: float) -> list[Event]:
+        """``bus`` matched anew at ``tolerance`` (the bus's stamps were widened after it was
+        matched: a rare glitch-filtered capture): :func:`merge_tx` of it."""
+        self.tolerance, self.at, self.matched = tolerance, 0, 0
+        origin, event = self.origin, full_event
+        return [
+            event(e.kind, origin(e.kind, e.start, e.wire, SENSOR_ORIGIN), e.start, e.end,
+                  e.wire, e.text, e.uncertainty, e.duration_uncertainty)
+            for e in bus
+        ]  # fmt: skip
 
 
 #: the last capture decoded, by file identity and settings: ``judge`` decodes a capture to
@@ -513,22 +612,49 @@ def _decode_capture(
     fmt = sniff(path)
     if fmt == "jsonl":
         raise CaptureError(path, "a transcript, not a capture: read it with read_transcript_jsonl")
-    # in bulk, a bus merged with a TX channel is decoded as the sensors' (SENSOR_ORIGIN) and
-    # only the recorder's events are made again (_mark_recorder), not every one
-    merged = tx_channel is not None and BULK
-    out = _decode_channel(path, fmt, channel, invert, how, SENSOR_ORIGIN if merged else BUS)
-    if tx_channel is None:
-        return out
-    if tx_channel == out.channel:
-        raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
-    tx = _decode_channel(path, fmt, tx_channel, None, how)
-    tolerance = 0.5 / baud + 2 * out.uncertainty_s
-    if merged:
-        unseen = _mark_recorder(out.events, tx.events, tolerance)
+    if tx_channel is not None and BULK:
+        out, tx, unseen = _decode_merged(path, fmt, channel, tx_channel, invert, how)
     else:
+        out = _decode_channel(path, fmt, channel, invert, how)
+        if tx_channel is None:
+            return out
+        if tx_channel == out.channel:
+            raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
+        tx = _decode_channel(path, fmt, tx_channel, None, how)
+        tolerance = 0.5 / baud + 2 * out.uncertainty_s
         out.events, unseen = merge_tx(out.events, tx.events, tolerance)
     out.tx_channel = tx.channel
     out.notes.append(f"TX channel {tx.channel!r}: {tx.polarity} polarity")
     if unseen:
         out.notes.append(f"{unseen} events on the TX channel were not seen on the bus")
     return out
+
+
+def _decode_merged(
+    path: str,
+    fmt: str,
+    channel: str | None,
+    tx_channel: str,
+    invert: bool | None,
+    how: DecodeSettings,
+) -> tuple[CaptureDecode, CaptureDecode, int]:
+    """The bus decoded with the recorder's TX channel in bulk: the TX first, into
+    :class:`Marks` (no event made of it), then the bus, each event made once with its
+    origin (:data:`SENSOR_ORIGIN`, :data:`RECORDER_ORIGIN` where the TX matches it). What
+    :func:`merge_tx` of the two decodes gives, and the same errors first: the bus's, that
+    the TX channel is the bus's, then the TX's. Also how many TX events the bus lacks."""
+    marks = Marks()
+    try:
+        tx: CaptureDecode | None = _decode_channel(path, fmt, tx_channel, None, how, into=marks)
+        failed: CaptureError | None = None
+    except CaptureError as exc:
+        tx, failed = None, exc
+    out = _decode_channel(path, fmt, channel, invert, how, SENSOR_ORIGIN, marks=marks)
+    if tx_channel == out.channel:
+        raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
+    if failed is not None or tx is None:
+        raise failed or CaptureError(path, f"TX channel {tx_channel!r} not decoded")
+    tolerance = 0.5 / how.baud + 2 * out.uncertainty_s
+    if tolerance != marks.tolerance:  # the bus's stamps were widened (_filtered)
+        out.events = marks.again(out.events, tolerance)
+    return out, tx, marks.unseen()

@@ -11,13 +11,14 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
+from operator import attrgetter
 
 import numpy as np
 
 from ..transcript import TOOL, Event, EventKind
 from .comments import capture_comment
 from .held_sr import hold_sr
-from .levels import edge_array
+from .levels import edge_array, wire_columns
 from .writers import Channel, write_csv, write_sr, write_vcd
 
 DEFAULT_SAMPLE_RATE = 100_000.0
@@ -71,20 +72,30 @@ def export_events(
         raise ValueError(f"export format {fmt!r}: expected one of {', '.join(EXPORT_FORMATS)}")
     if sample_rate <= 0:
         raise ValueError("sample rate must be positive")
-    wire = sorted(
-        (e for e in events if e.kind in (EventKind.CHAR, EventKind.BREAK)), key=lambda e: e.start
-    )
+    columns = wire_columns(events)
+    wire = columns.events if columns is not None else _sorted_wire(events)
     if not wire:
         raise ValueError("no characters or breaks to export")
     first = wire[0].start
     t0 = 0.0 if LEAD <= first < 1.0 else first - LEAD  # keep a clock that starts near zero
-    end = max(e.end for e in wire) + TRAIL
+    end = (float(columns.end.max()) if columns is not None else max(e.end for e in wire)) + TRAIL
     total = round((end - t0) * sample_rate)
     idle = 0 if line_polarity else 1
-    channels = [Channel(BUS_CHANNEL, idle, _edges(wire, sample_rate, t0, fmt))]
+    if columns is not None:  # the columns read once for both channels
+        edges = [columns.edges(sample_rate, t0)]
+        if tool_channel:
+            origins = np.array(list(map(attrgetter("origin"), wire)), dtype=object)
+            edges.append(columns.edges(sample_rate, t0, origins == TOOL))
+    else:
+        edges = [edge_array(wire, sample_rate, t0)]
+        if tool_channel:
+            edges.append(edge_array([e for e in wire if e.origin == TOOL], sample_rate, t0))
+    # an array for a .sr (written in bulk), Python ints for the text formats (written an
+    # edge at a time)
+    ticks = edges if fmt == "sr" else [e.tolist() for e in edges]
+    channels = [Channel(BUS_CHANNEL, idle, ticks[0])]
     if tool_channel:
-        tool = [e for e in wire if e.origin == TOOL]
-        channels.append(Channel(TOOL_CHANNEL, idle, _edges(tool, sample_rate, t0, fmt)))
+        channels.append(Channel(TOOL_CHANNEL, idle, ticks[1]))
     # a CSV keeps the transcript's clock, so its notes keep their own times
     comment = capture_comment(
         notes, 0.0 if fmt == "csv" else t0, BUS_CHANNEL, TOOL_CHANNEL if tool_channel else None
@@ -106,8 +117,9 @@ def export_events(
     )
 
 
-def _edges(events: list[Event], rate: float, t0: float, fmt: str) -> np.ndarray | list[int]:
-    """A channel's toggle ticks: the array itself for a .sr (written in bulk), Python ints
-    for the text formats (written an edge at a time)."""
-    ticks = edge_array(events, rate, t0)
-    return ticks if fmt == "sr" else ticks.tolist()
+def _sorted_wire(events: Sequence[Event]) -> list[Event]:
+    """The characters and breaks of ``events`` by start (stable), one at a time: the
+    events :func:`~.levels.wire_columns` does not take."""
+    return sorted(
+        (e for e in events if e.kind in (EventKind.CHAR, EventKind.BREAK)), key=lambda e: e.start
+    )

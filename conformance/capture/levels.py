@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from operator import attrgetter
 
 import numpy as np
 
@@ -113,11 +115,100 @@ def edge_array(events: Sequence[Event], rate: float, t0: float) -> np.ndarray:
     a rate under 1 kHz)."""
     chars = [e for e in events if e.kind is EventKind.CHAR]
     breaks = [e for e in events if e.kind is EventKind.BREAK and e.end > e.start]
-    starts = np.array([e.start for e in events if e.kind in _WIRE_KINDS], dtype=np.float64)
-    cs = np.array([e.start for e in chars], dtype=np.float64)
-    ce = np.array([e.end for e in chars], dtype=np.float64)
-    bs = np.array([e.start for e in breaks], dtype=np.float64)
-    be = np.array([e.end for e in breaks], dtype=np.float64)
+    ticks = _bulk_edges(
+        np.array([e.start for e in events if e.kind in _WIRE_KINDS], dtype=np.float64),
+        np.array([e.start for e in chars], dtype=np.float64),
+        np.array([e.end for e in chars], dtype=np.float64),
+        np.array([e.wire & 0xFF for e in chars], dtype=np.intp),
+        np.array([e.start for e in breaks], dtype=np.float64),
+        np.array([e.end for e in breaks], dtype=np.float64),
+        rate,
+        t0,
+    )
+    return np.fromiter(edges_of(events, rate, t0), dtype=np.int64) if ticks is None else ticks
+
+
+@dataclass(frozen=True)
+class WireColumns:
+    """A transcript's characters and breaks (``events``, stably sorted by start) as the
+    columns :func:`edge_array` reads of them, read once for every channel an export
+    makes of them (:func:`wire_columns`)."""
+
+    events: list[Event]
+    start: np.ndarray
+    end: np.ndarray
+    wire: np.ndarray
+    is_char: np.ndarray
+    is_break: np.ndarray
+
+    def edges(self, rate: float, t0: float, among: np.ndarray | None = None) -> np.ndarray:
+        """:func:`edge_array` of the events (``among``: of those where it is True), the
+        columns masked rather than read again."""
+        start, end, is_char, is_break = self.start, self.end, self.is_char, self.is_break
+        if among is not None:
+            start, end, is_char, is_break = (
+                start[among],
+                end[among],
+                is_char[among],
+                is_break[among],
+            )
+        wire = self.wire if among is None else self.wire[among]
+        breaks = is_break & (end > start)
+        ticks = _bulk_edges(
+            start, start[is_char], end[is_char], wire[is_char], start[breaks], end[breaks], rate, t0
+        )
+        if ticks is not None:
+            return ticks
+        events = self.events if among is None else [self.events[i] for i in np.flatnonzero(among)]
+        return np.fromiter(edges_of(events, rate, t0), dtype=np.int64)
+
+
+def wire_columns(events: Iterable[Event]) -> WireColumns | None:
+    """The characters and breaks of ``events`` sorted by start as ``sorted(..., key=start)``
+    sorts them (stable), with their columns; None (the caller sorts and reads them event
+    by event) unless every start and end is a Python float and none is NaN, which Python
+    and numpy would order apart."""
+    wire = [e for e in events if e.kind in _WIRE_KINDS]
+    starts, ends = list(map(_START, wire)), list(map(_END, wire))
+    if not wire or set(map(type, starts)) != {float} or set(map(type, ends)) != {float}:
+        return None
+    start, end = np.array(starts, dtype=np.float64), np.array(ends, dtype=np.float64)
+    if np.isnan(start).any() or np.isnan(end).any():
+        return None
+    if start.size > 1 and (np.diff(start) < 0).any():
+        order = np.argsort(start, kind="stable")
+        wire = [wire[i] for i in order.tolist()]
+        start, end = start[order], end[order]
+    kind_list = list(map(_KIND, wire))
+    if set(map(type, kind_list)) != {EventKind}:  # == below is then ``is``
+        return None
+    kinds = np.array(kind_list, dtype=object)
+    return WireColumns(
+        wire,
+        start,
+        end,
+        np.array(list(map(_WIRE, wire)), dtype=np.int64) & 0xFF,
+        kinds == EventKind.CHAR,
+        kinds == EventKind.BREAK,
+    )
+
+
+_START, _END, _KIND, _WIRE = (attrgetter(n) for n in ("start", "end", "kind", "wire"))
+
+
+def _bulk_edges(
+    starts: np.ndarray,
+    cs: np.ndarray,
+    ce: np.ndarray,
+    wires: np.ndarray,
+    bs: np.ndarray,
+    be: np.ndarray,
+    rate: float,
+    t0: float,
+) -> np.ndarray | None:
+    """:func:`edge_array`'s bulk union from the wire events' starts, the characters'
+    starts, ends and low wire bytes and the (non-empty) breaks' starts and ends; None
+    where it falls back."""
     dur = ce - cs
     if (
         rate < 1000
@@ -125,10 +216,9 @@ def edge_array(events: Sequence[Event], rate: float, t0: float) -> np.ndarray:
         or (starts.size and (np.diff(starts) < 0).any())
         or (dur.size and not ((dur >= 0).all() and (dur < _BULK_CHAR_MAX).all()))
     ):
-        return np.fromiter(edges_of(events, rate, t0), dtype=np.int64)
-    wires = np.array([e.wire & 0xFF for e in chars], dtype=np.intp)
+        return None
     counts = _RUN_COUNT[wires]
-    owner = np.repeat(np.arange(len(chars)), counts)
+    owner = np.repeat(np.arange(cs.size), counts)
     first = np.cumsum(counts) - counts  # each character's first interval
     run = np.repeat(_RUN_FIRST[wires], counts) + (np.arange(owner.size) - np.repeat(first, counts))
     bit = dur / FRAME_BITS
