@@ -88,10 +88,14 @@ def silent(
 
     Silence is only evidence from a sensor that was shown to listen: ``baseline`` is the
     exchange (or exchanges) in which it answered its own address; if it answered none of
-    them, a mute device would "pass", so the verdict is INCONCLUSIVE."""
+    them, a mute device would "pass", so the verdict is INCONCLUSIVE. A command that maybe
+    collided (sensor characters met it within the stamps' uncertainty) may not have been
+    heard, so its silence is set aside, as :func:`silent_while_listening` does for the
+    one-shot probes; an answer counts whatever met the command."""
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
     answered = [ex for ex in exchanges if ex.answered]
+    met = [ex for ex in exchanges if not ex.answered and ex.maybe_collided]
     if answered:
         make = warned if should else failed
         return make(
@@ -108,12 +112,21 @@ def silent(
             + ", ".join(escape(ex.text) for ex in controls)
             + " either, so its silence here shows nothing",
         )
+    heard = [ex for ex in exchanges if ex.answered or not ex.maybe_collided]
+    aside = f"{len(met)} command(s) set aside (maybe collided: may not have been heard)"
+    if not heard:
+        return inconclusive(
+            rid,
+            f"every command maybe collided with the sensor's characters; {aside}",
+            evidence=[shown(ex) for ex in met[:3]],
+        )
     return passed(
         rid,
-        f"stayed silent ({why}) to {len(exchanges)} command(s): "
-        + ", ".join(escape(e.text) for e in exchanges),
+        f"stayed silent ({why}) to {len(heard)} command(s): "
+        + ", ".join(escape(e.text) for e in heard)
+        + (f"; {aside}" if met else ""),
         decision=decision,
-        observed=len(exchanges),
+        observed=len(heard),
     )
 
 

@@ -546,7 +546,10 @@ def test_standby_after_100ms(sensor, case):
     # asleep by then too (standby-after-108ms + deaf-after-service-request behind
     # --echo --usb-latency 16 beside two CPU burners: silent at 119-137 ms ±15 ms, PASSed,
     # where the sim, probing at 101.9 ms, FAILs it)
-    latest = probes[0][1] + u
+    # timed from the earliest probe that counts: one that maybe collided is set aside by
+    # judge.silent, and the 115 ms probe alone does not resolve the limit
+    counted = [idle for ex, idle in probes if ex.answered or not ex.maybe_collided]
+    latest = min(counted, default=probes[0][1]) + u
     if found.verdict is Verdict.PASS and latest > STANDBY_MARKING + TOLERANCE + STANDBY_RESOLUTION:
         found = inconclusive(
             "R-7.0-15",
