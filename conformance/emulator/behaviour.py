@@ -49,6 +49,9 @@ class Behaviour:
     # -- transmitting ------------------------------------------------------------------------
     reply_delay: float = REPLY_DELAY
     char_gap: float = 0.0  # marking between reply characters (R-7.0-12)
+    #: Hear no command between a command and the start of its reply: a firmware blocked in
+    #: delay() before it replies (the Arduino Due sensor, docs/kit.md eighteenth round)
+    deaf_until_reply: bool = False
     #: Extra marking before one character of every aI! reply (R-7.0-12): a firmware that
     #: pauses at the same point of the same reply, as it fetches the next field, say.
     ident_pause: float = 0.0

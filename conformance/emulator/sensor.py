@@ -362,6 +362,8 @@ class SensorEmulator:
             self._abort()  # R-4.4.7.1-01 (and M/V heard without a break)
         self._dispatch(cmd, at)
         self._last_command = cmd
+        if b.deaf_until_reply:
+            self._quiet_until = max(self._quiet_until, at)
 
     def _dispatch(self, cmd: Command, at: float) -> None:
         a = cmd.address if cmd.address != "?" else self.address

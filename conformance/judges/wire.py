@@ -55,6 +55,7 @@ __all__ = [
     "reply_gaps",
     "runs",
     "segments",
+    "starts_after_a_retry",
     "starts_to_confirm",
 ]
 
@@ -83,6 +84,31 @@ def starts_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty
     early, late, _ = _start_observations(segs, stamps)
     both = to_confirm(early, real_time=True) + to_confirm(late, real_time=True)
     return list(dict.fromkeys(both))
+
+
+def starts_after_a_retry(segs: list[Segment], uncertainty: float | StampUncertainty) -> bool:
+    """Whether R-7.0-10 is left with no reply to judge because every reply it might time
+    began after a retry, read in time from the retry and late from the unanswered try before
+    it (:func:`_unanswered_before`): a sensor plainly late (the Arduino Due sensor's delay(80)
+    before every reply, docs/kit.md eighteenth round) is then INCONCLUSIVE. The case sends
+    one command once, with no retry, to time a reply from that command alone
+    (:meth:`~conformance.sensor.session.SensorSession.late_start_probe`); a run with any
+    reply R-7.0-10 times (every clean run) sends nothing more."""
+    stamps = stamp_uncertainty(uncertainty)
+    _, late, _ = _start_observations(segs, stamps)
+    if late:
+        return False
+    before: Segment | None = None
+    for seg in segs:
+        earlier, before = _unanswered_before(before, seg), seg
+        if earlier is None or _reply_set_aside(seg) or _not_a_reply_to(seg):
+            continue
+        start = seg.reply[0].start
+        if LATE_WINDOW.inside(start - seg.command_end) != LATE_WINDOW.inside(
+            start - earlier.command_end
+        ):
+            return True
+    return False
 
 
 #: R-7.0-09 and R-7.0-10, against which every reply's start is judged

@@ -130,6 +130,9 @@ HEARING_MARKINGS = (9e-3, 25e-3, 50e-3, 85e-3, 120e-3)
 #: echo, a stalled host) is sent again rather than judged (issue 18), at most PROBE_TRIES times;
 #: so is a timed probe of a case that landed outside the window it aimed at (:meth:`aim`).
 PROBE_LATE = 20e-3  # s
+#: How long (s) :meth:`SensorSession.late_start_probe` listens after its one ``a!``: far past
+#: any reply the recorder's retry 55 ms after a try would have met (the Due sensor's 80 ms)
+LATE_START_LISTEN = 1.0
 PROBE_TRIES = 5
 
 
@@ -573,6 +576,27 @@ class SensorSession(Session):
             "deviation in its reply recurs at the same place",
         )
         return [self.master.transact(command) for _ in range(times)]
+
+    def late_start_probe(self) -> Exchange:
+        """``a!`` sent once after a break from standby, then :data:`LATE_START_LISTEN` s of
+        listening with no retry, once a run: a reply that begins after it can only be its
+        reply, timed from it alone (the whole-run cut places it after the command). For a
+        sensor whose every reply began after the recorder's retry, in time from the retry
+        and late from the try before (R-7.0-10 undecided, :func:`~conformance.judges.wire.
+        starts_after_a_retry`); an answered ``a!`` changes nothing in the sensor."""
+
+        def send() -> Exchange:
+            self.link.transcript.note(
+                self.link.now(),
+                f"late-start probe: {self.address}! sent once after a break with no retry, "
+                f"listened {LATE_START_LISTEN:.1f} s, to time a reply that began after a retry",
+            )
+            self.idle(self.standby_idle())
+            ex = self.master.raw(f"{self.address}!", break_first=True)
+            self.listen(LATE_START_LISTEN)
+            return ex
+
+        return self.once("late-start-probe", send)
 
     def listen(self, duration: float) -> list[Event]:
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""

@@ -524,6 +524,21 @@ def check_response_too_late(rig: Rig) -> None:
     assert rig.ask("0!").delay > RESPONSE_START_MAX + TOLERANCE
 
 
+def check_replies_after_retry(rig: Rig) -> None:
+    """80 ms late, and deaf until then: a retry 55 ms after the try draws no second reply,
+    so the one reply begins 8 ms after the retry's '!'."""
+    ack = rig.ask("0!", timeout=0.2)
+    assert ack.delay == pytest.approx(80e-3) and decode_7e1(ack.events) == "0\r\n"
+    rig.wake()
+    first = rig.send("0!")
+    rig.wait(55e-3 - (rig.now - first[-1].end))
+    retry = rig.send("0!")
+    heard = rig.listen(0.3)
+    assert decode_7e1(heard) == "0\r\n"  # one reply: the retry went unheard
+    assert heard[0].start - first[-1].end == pytest.approx(80e-3)
+    assert 0 < heard[0].start - retry[-1].end < RESPONSE_START_MAX
+
+
 def check_inter_char_gap(rig: Rig) -> None:
     assert min(rig.ask("0I!").gaps) == pytest.approx(3e-3)
 
@@ -684,6 +699,7 @@ CHECKS: dict[str, Callable[[Rig], None]] = {
     "binary-fewer-values": check_binary_fewer_values,
     "response-too-early": check_response_too_early,
     "response-too-late": check_response_too_late,
+    "replies-after-retry": check_replies_after_retry,
     "inter-char-gap": check_inter_char_gap,
     "ignores-short-breaks": check_ignores_short_breaks,
     "wakes-on-short-spacing": check_wakes_on_short_spacing,

@@ -21,6 +21,16 @@ TIMING: tuple[Fault, ...] = (
         settings={"reply_delay": 20e-3},
     ),
     Fault(
+        "replies-after-retry",
+        "Replies start 80 ms after the command's last stop bit (limit 15.40 ms), as an Arduino"
+        " Due sensor with delay(80) before every reply (docs/kit.md, eighteenth round): the"
+        " recorder's retry, 55 ms after an unanswered try, has ended before the reply begins,"
+        " which is 8 ms after the retry and 80 ms after the first try; a command heard before"
+        " the reply starts (the retry) goes unheard, the firmware being blocked in delay().",
+        ("R-7.0-10",),
+        settings={"reply_delay": 80e-3, "deaf_until_reply": True},
+    ),
+    Fault(
         "inter-char-gap",
         "3 ms of marking between reply characters (limit 1.66 ms)."
         " No two reply characters come back to back, so the bit rate cannot be told from the"
