@@ -541,6 +541,10 @@ def _cut(
     pending: Event | None = None
     current: Transmission | None = None
     is_command = False  # current.is_command, kept as its characters come (asked per event)
+    # the last character was its '!': its own address next is the command sent again at once
+    # (a logger reading its own echo as an invalid reply retries 0 ms after the '!', the
+    # nineteenth round), not more of it; '0M!!' and '0M!<CR><LF>' stay one
+    after_bang = False
     last_heard: Event | None = None  # the sensors' last character so far
     char, brk, add_char = EventKind.CHAR, EventKind.BREAK, chars.append  # asked per event
     for e, own in zip(ordered, mine, strict=True):
@@ -553,16 +557,21 @@ def _cut(
                 if current is not None and current.heard and current.heard[-1] is last_heard:
                     current.cut_by = e if _cut_into(last_heard, e) is not None else None
                 pending, current = e, None
-            elif current is None or (is_command and e.start - current.end >= NEW_COMMAND):
+            elif (
+                current is None
+                or (is_command and e.start - current.end >= NEW_COMMAND)
+                or (after_bang and e.wire & 0x7F == current.chars[0].wire & 0x7F)
+            ):
                 current = Transmission(pending, [e], part=part, cut=_cut_into(last_heard, e))
                 transmissions.append(current)
                 pending = None
-                is_command = e.wire & 0x7F == _BANG
+                is_command = after_bang = e.wire & 0x7F == _BANG
             else:
                 current.chars.append(e)
                 # CR LF after the '!' keep it a command (Transmission.stem)
                 bits = e.wire & 0x7F
-                is_command = bits == _BANG or (is_command and bits in _LINE_ENDS)
+                after_bang = bits == _BANG
+                is_command = after_bang or (is_command and bits in _LINE_ENDS)
         elif kind is char:
             last_heard = e
             if current is not None:

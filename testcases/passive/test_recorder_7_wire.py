@@ -43,7 +43,7 @@ def test_break_when_due(heard_recorder, case):
 def test_command_text(heard_recorder, case):
     """Recorded commands are printable, start with an address and end with their only '!'."""
     case.expect("printable ASCII; the address first; '!' last and nowhere else")
-    judged(case, judge_command_text(heard_recorder.view))
+    judged(case, judge_command_text(heard_recorder.view, heard_recorder.uncertainty))
 
 
 @requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")

@@ -49,7 +49,7 @@ def test_break_when_due(recorder, case):
 def test_command_text(recorder, case):
     """Commands are printable, start with an address and end with their only '!'."""
     case.expect("printable ASCII; the address first; '!' last and nowhere else")
-    case.extend(judge_command_text(_everything(recorder, case)))
+    case.extend(judge_command_text(_everything(recorder, case), recorder.uncertainty))
 
 
 @requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")

@@ -71,6 +71,7 @@ aC!/aCC! only.
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import pytest
@@ -666,3 +667,34 @@ def test_answers_to_kept_queries_are_not_timed_as_replies(monkeypatch):
         assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])
         detail = found[rid]["findings"][0]["detail"]
         assert "9.00..9.00 ms" in detail, detail
+
+
+@pytest.fixture
+def indexed_commands_without_bang(monkeypatch):
+    """The nineteenth round's logger (lixpaulian/dacq's sdi12_dr at 0507134) builds ``aMn!``
+    and ``aCn!`` as ``0M1``: no '!' (``buff[3] = use_crc ? ... : '\\0'``). Unanswered, it sends
+    the same text again 50 ms later without a break, as any retry."""
+    from conformance.tool_recorder import engine
+
+    encode = engine.encode_7e1
+    indexed = re.compile(r"^.[MC][1-9]!$")
+    monkeypatch.setattr(
+        engine, "encode_7e1", lambda text: encode(text[:-1] if indexed.match(text) else text)
+    )
+
+
+def test_retries_of_a_command_without_its_bang_are_not_one_command_r_7_0_13(
+    indexed_commands_without_bang,
+):
+    """The wire shows ``0M1`` then ``0M1`` again after the retry's marking: R-7.0-13 FAILed
+    "marking between command characters: 50.00 ms [in 0M10M10M1]", as if the tries were one
+    command. A sensor drops a partial command after 8.33 ms of marking (App. B): whether that
+    gap is inside a command the wire does not say (INCONCLUSIVE); the missing '!' is
+    R-4.4-04's FAIL either way, and the golden recorder's own gaps still PASS."""
+    keyword = "test_every_basic_command_and_family or test_command_text or test_character_timing"
+    found = _verdicts(run_once("sim", role="recorder", keyword=keyword))
+    assert found["R-4.4-04"]["verdict"] == "FAIL", found["R-4.4-04"]["findings"]
+    assert "0M10M1" in found["R-4.4-04"]["findings"][0]["detail"]
+    gaps = found["R-7.0-13"]
+    assert gaps["verdict"] == "INCONCLUSIVE", gaps["findings"]
+    assert "before any '!'" in gaps["findings"][0]["detail"], gaps["findings"]

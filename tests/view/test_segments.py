@@ -313,3 +313,19 @@ def test_a_sensor_shown_at_an_address_is_judged_there_not_at_its_own():
     sensor's: '9!' answered with its first address '0' still FAILs R-4.3-01."""
     moved = [("9!", "9\r\n"), ("9!", "0\r\n")]
     assert _framing_of(moved, own="0") is Verdict.FAIL
+
+
+def test_a_command_sent_again_at_its_bang_is_a_new_transmission():
+    """The nineteenth round's logger (lixpaulian/dacq's sdi12_dr) behind an echoing
+    interface reads its own echo as an invalid reply and sends the command again at once:
+    ``0M!0M!0M!`` back to back. Read as one transmission, the retries were not seen: R-7.2-01
+    FAILed "sent again only after a new break (a new sequence, not a retry)" on a recorder
+    that retried 0 ms after each '!' (R-7.2-02's FAIL). The command's address right after its
+    '!' starts the next transmission; '0M!!' and '0M!<CR><LF>' stay one (R-4.4-04 sees them)."""
+    texts = [t.text for t in read_view(_chars(TOOL, "0M!0M!0M!", 0.0)).transmissions]
+    assert texts == ["0M!", "0M!", "0M!"]
+    assert [t.text for t in read_view(_chars(TOOL, "0M!!", 0.0)).transmissions] == ["0M!!"]
+    crlf = read_view(_chars(TOOL, "0M!\r\n", 0.0)).transmissions
+    assert [t.text for t in crlf] == ["0M!\r\n"]
+    # another address at once is still part of the one before
+    assert [t.text for t in read_view(_chars(TOOL, "0M!1M!", 0.0)).transmissions] == ["0M!1M!"]

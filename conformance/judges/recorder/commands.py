@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from ...protocol.commands import ADDRESS_CHARS
 from ...protocol.timing import CHAR_TIME, INTER_CHAR_GAP_MAX, TOLERANCE
-from ...transcript import escape
+from ...transcript import Event, escape
 from ...verdicts import Finding, Verdict
-from ...view.segments import TranscriptView, Transmission
+from ...view.segments import NEW_COMMAND, TranscriptView, Transmission
 from ..tally import Tally
 from ..timing import MeasuredIn, Repeats, Window
 from ..wire import judge_frame_lengths, judge_rate
@@ -19,10 +19,29 @@ COMMAND_GAP = Window(
 )
 
 
-def judge_command_text(line: TranscriptView) -> list[Finding]:
-    """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else; R-4.3-01
-    the first character is the address (``?`` only in ``?!``)."""
-    judge = CommandText()
+_BANG = ord("!")
+
+
+def _dropped(
+    gap: float, uncertainty: float, bang_seen: bool, s: Transmission, a: Event, b: Event
+) -> bool:
+    """Whether a sensor ends the partial command at this gap between a recorder's
+    characters: 8.33 ms (-0.40) of marking with no ``!`` before it in the transmission (App.
+    B, R-AppB-01). What follows is a new try as much as more of the same command (a library
+    that never writes the ``!`` and retries: ``0M1`` 50 ms ``0M1``, nineteenth round): the
+    text before the gap is an unterminated command (R-4.4-04), and whether the gap is inside
+    a command, which R-7.0-13 limits, the wire does not say. A gap a sensor talked in is no
+    marking: a retry over a reply that the line held back (R-7.2-06 drags R-7.0-13)."""
+    if bang_seen or gap - uncertainty < NEW_COMMAND:
+        return False
+    return not any(h.end > a.end and h.start < b.start for h in s.heard)
+
+
+def judge_command_text(line: TranscriptView, uncertainty: float = 0.0) -> list[Finding]:
+    """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else, and no
+    part a sensor drops for want of it (:func:`_dropped`); R-4.3-01 the first character is
+    the address (``?`` only in ``?!``)."""
+    judge = CommandText(uncertainty)
     judge.add(line)
     return judge.findings()
 
@@ -32,8 +51,9 @@ class CommandText:
     window's view :meth:`add`-ed in order, the findings those of the whole view. It keeps
     the tally's labels (one short string a command), none of a window's events."""
 
-    def __init__(self) -> None:
+    def __init__(self, uncertainty: float = 0.0) -> None:
         self.tally = Tally(("R-4.2-01", "R-4.4-04", "R-4.3-01"))
+        self.uncertainty = uncertainty
 
     def add(self, line: TranscriptView) -> None:
         """The commands of ``line`` (the next window of the recording)."""
@@ -48,9 +68,29 @@ class CommandText:
                 )
             if not text.endswith("!") or "!" in text[:-1]:
                 tally.fail("R-4.4-04", where, "'!' is not exactly the last character")
+            else:
+                self._unterminated_part(s)
             first = text[:1]
             if not (first in ADDRESS_CHARS or text == "?!"):
                 tally.fail("R-4.3-01", where, f"starts with {escape(first)}, not an address")
+
+    def _unterminated_part(self, s: Transmission) -> None:
+        """R-4.4-04 for text that ends in its only ``!`` but whose first part a sensor
+        dropped (:func:`_dropped`): ``0M1`` 50 ms ``0M1`` 50 ms ``0MC!``."""
+        chars = s.chars
+        for i, (a, b) in enumerate(zip(chars, chars[1:], strict=False)):
+            gap = b.start - a.end
+            if _dropped(gap, own_uncertainty(self.uncertainty, a, b), False, s, a, b):
+                part = escape("".join(chr(e.wire & 0x7F) for e in chars[: i + 1]))
+                self.tally.fail(
+                    "R-4.4-04",
+                    escape(s.text),
+                    f"'{part}' then {gap * 1e3:.2f} ms of marking with no '!': a sensor "
+                    "drops it there (App. B)",
+                )
+                return
+            if a.wire & 0x7F == _BANG:
+                return
 
     def findings(self) -> list[Finding]:
         """R-4.2-01, R-4.4-04 and R-4.3-01 over everything added."""
@@ -85,15 +125,24 @@ class CharacterGaps:
         self.leaning_count = 0
         # a gap equal to one judged before is that interval again (its first one: Repeats)
         self._judged: Repeats[MeasuredIn] = Repeats()
+        # gaps a sensor ends a partial command at, in text with no '!' at all: how many,
+        # the first (gap, transmission)
+        self.dropped = 0
+        self.first_dropped: tuple[float, Transmission] | None = None
 
     def add(self, line: TranscriptView) -> None:
         """The command character gaps of ``line`` (the next window of the recording)."""
         uncertainty, found, judged = self.uncertainty, self.found, self._judged
         for s in line.transmissions:
             chars = s.chars
+            bang_seen = False
             for a, b in zip(chars, chars[1:], strict=False):
                 gap = b.start - a.end
                 u = own_uncertainty(uncertainty, a, b)
+                bang_seen = bang_seen or a.wire & 0x7F == _BANG
+                if _dropped(gap, u, bang_seen, s, a, b):
+                    self._keep_dropped(gap, s)
+                    continue
                 found.append(
                     judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s))
                 )
@@ -101,6 +150,32 @@ class CharacterGaps:
                     self.leaning_count += 1
                     if len(self.leaning) < LEANING_SHOWN:
                         self.leaning.append((gap, s))
+
+    def _keep_dropped(self, gap: float, s: Transmission) -> None:
+        """A gap a sensor ends the partial command at (:func:`_dropped`): not judged as
+        inside a command; the first and how many kept for :meth:`_undecided`."""
+        self.dropped += 1
+        if self.first_dropped is None:
+            self.first_dropped = (gap, s)
+
+    def _undecided(self) -> list[Finding]:
+        """R-7.0-13 INCONCLUSIVE for the gaps :meth:`_dropped` kept out (a FAIL of a gap
+        judged still wins: see :func:`combine`)."""
+        if self.first_dropped is None:
+            return []
+        gap, s = self.first_dropped
+        return [
+            Finding(
+                "R-7.0-13",
+                Verdict.INCONCLUSIVE,
+                f"{self.dropped} gap(s) of 7.93 ms or more before any '!' (the first "
+                f"{gap * 1e3:.2f} ms in {s.at()}): a sensor drops the partial command there "
+                "(App. B), so each may be a gap inside a command or one after an "
+                "unterminated try; R-4.4-04 judges their text",
+                evidence=[f"in {s.at()}"],
+                observed=self.dropped,
+            )
+        ]
 
     def findings(self) -> list[Finding]:
         """R-7.0-13 and R-7.0-01 over everything added."""
@@ -127,7 +202,9 @@ class CharacterGaps:
             )
         else:
             tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
-        return [combine("R-7.0-13", found, "character gap"), tol]
+        undecided = self._undecided()
+        judged = [*found, *undecided] if undecided else found
+        return [combine("R-7.0-13", judged, "character gap"), tol]
 
 
 def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:

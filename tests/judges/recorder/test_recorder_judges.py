@@ -100,6 +100,42 @@ def test_character_gaps_have_no_tolerance():
     assert wide["R-7.0-01"].verdict is Verdict.PASS
 
 
+def test_unterminated_retries_are_not_one_command_R_7_0_13():
+    """lixpaulian/dacq's sdi12_dr (nineteenth round) builds ``0M1`` with no ``!`` and retries
+    it 50 ms later without a break: the wire shows ``0M1`` 50 ms ``0M1``. A sensor drops a
+    partial command after 8.33 ms of marking (App. B), so the gap may be between two tries:
+    R-7.0-13 cannot FAIL on it (it did: "50.00 ms in 0M10M1"), R-4.4-04 FAILs either way."""
+    w = Wire().brk().rec("0M1").idle(50).rec("0M1").idle(50).rec("0M1")
+    gaps = by_id(judge_character_gaps(w.view(), 0.0))
+    assert gaps["R-7.0-13"].verdict is Verdict.INCONCLUSIVE
+    assert "2 gap(s)" in gaps["R-7.0-13"].detail and "50.00 ms" in gaps["R-7.0-13"].detail
+    assert by_id(judge_command_text(w.view()))["R-4.4-04"].verdict is Verdict.FAIL
+    # a gap a sensor still holds the command over still FAILs, as does one after a '!'
+    short = Wire().brk().rec("0M1").idle(7.5).rec("0M1")
+    assert by_id(judge_character_gaps(short.view(), 0.0))["R-7.0-13"].verdict is Verdict.FAIL
+    after = Wire().brk().rec("0M!").idle(2.0).rec("x")
+    assert by_id(judge_character_gaps(after.view(), 0.0))["R-7.0-13"].verdict is Verdict.FAIL
+    # the last try terminated: its text alone passes R-4.4-04, the tries before it do not
+    ended = Wire().brk().rec("0M1").idle(50).rec("0M1").idle(50).rec("0MC!")
+    assert by_id(judge_character_gaps(ended.view(), 0.0))["R-7.0-13"].verdict is (
+        Verdict.INCONCLUSIVE
+    )
+    text = by_id(judge_command_text(ended.view()))["R-4.4-04"]
+    assert text.verdict is Verdict.FAIL and "'0M1' then 50.00 ms" in text.detail, text.detail
+    # a gap a sensor talked in is no marking (a retry the line held back behind a reply)
+    held = Wire().brk().rec("0").sensor("0+1.0", delay_ms=0.0).rec("D0!").view()
+    assert by_id(judge_character_gaps(held, 0.0))["R-7.0-13"].verdict is Verdict.FAIL
+    assert by_id(judge_command_text(held))["R-4.4-04"].verdict is Verdict.PASS
+    # a wait for '!' a sensor has dropped the command in: one of the two rules FAILs it
+    bang = Wire().brk().rec("0M").idle(50).rec("!")
+    assert by_id(judge_command_text(bang.view()))["R-4.4-04"].verdict is Verdict.FAIL
+    # a gap judged elsewhere in the run wins over the undecided one
+    both = Wire().brk().rec("0M!", gap_ms=3.0).idle(200).brk().rec("0M1").idle(50).rec("0M1")
+    assert by_id(judge_character_gaps(both.view(), 0.0))["R-7.0-13"].verdict is Verdict.FAIL
+    fine = Wire().brk().rec("0M!").idle(200).brk().rec("0M1").idle(50).rec("0M1")
+    assert by_id(judge_character_gaps(fine.view(), 0.0))["R-7.0-13"].verdict is Verdict.INCONCLUSIVE
+
+
 def test_break_needed_for_a_new_address_and_after_87_ms():
     ok = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("0I!").view()
     assert by_id(judge_break_rules(ok, 0.0))["R-7.0-17"].verdict is Verdict.PASS
