@@ -279,13 +279,9 @@ def test_a_sensor_at_another_address_is_named_not_sent_to_its_reply_format():
     assert "reply format" not in said and "Check wiring" not in said, said
 
 
-@pytest.fixture
-def lost_after_address_change(monkeypatch):
-    """The simulated sensor as the twelfth round's PIC firmware (RxTx1200/SDI-12_slave,
-    docs/kit.md) behaves: ``aAb!`` moves it, its reply names a third address (the firmware
-    answers with the EEPROM's first slot, '0' to 'jA9!'), and from then on it answers nothing
-    anywhere (it takes only lowercase letters as addresses, so at '9' it is deaf). Its address
-    change is not declared (an exec: firmware with no declaration), so the tool tries it."""
+def _address_change_undeclared(monkeypatch) -> None:
+    """The DUT's declaration says nothing of ``aAb!`` (an exec: firmware with none), so the
+    tool tries the change."""
     from conformance.sensor.session import SensorSession
 
     declared = SensorSession.feature
@@ -294,6 +290,16 @@ def lost_after_address_change(monkeypatch):
         "feature",
         lambda self, name: None if name == "address_change" else declared(self, name),
     )
+
+
+@pytest.fixture
+def lost_after_address_change(monkeypatch):
+    """The simulated sensor as the twelfth round's PIC firmware (RxTx1200/SDI-12_slave,
+    docs/kit.md) behaves: ``aAb!`` moves it, its reply names a third address (the firmware
+    answers with the EEPROM's first slot, '0' to 'jA9!'), and from then on it answers nothing
+    anywhere (it takes only lowercase letters as addresses, so at '9' it is deaf). Its address
+    change is not declared (an exec: firmware with no declaration), so the tool tries it."""
+    _address_change_undeclared(monkeypatch)
     usual = FaultSet.rewrite
     moved = []
 
@@ -589,14 +595,7 @@ def lost_without_acknowledging(monkeypatch):
     (its reply names the new address), after which it is at an address no command can name
     (the sketch's ``deviceAddress = newAddr - '0'``: -12 for '$') and answers only ``?!``,
     with '-12'. Its address change is not declared, so the tool tries it."""
-    from conformance.sensor.session import SensorSession
-
-    declared = SensorSession.feature
-    monkeypatch.setattr(
-        SensorSession,
-        "feature",
-        lambda self, name: None if name == "address_change" else declared(self, name),
-    )
+    _address_change_undeclared(monkeypatch)
     usual = FaultSet.rewrite
     moved = []
 
