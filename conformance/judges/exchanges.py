@@ -188,6 +188,20 @@ def late_shown(ex: Exchange) -> str:
     return f"{escape(ex.text)} -> late '{escape(text[: text.find(chr(10)) + 1] or text)}'"
 
 
+def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
+    """An unanswered ``ex`` whose reply came after the tool stopped listening (it ran into the
+    retries: a sensor whose every reply starts 80 ms late, deaf until then) is no "got no
+    reply": undecided for ``ids`` on ``tally`` (INCONCLUSIVE unless something else FAILs them;
+    R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL."""
+    if ex.answered or not late_reply(ex):
+        return False
+    label = escape(ex.text)
+    why = f"answered only after the reply window: {late_shown(ex)} (R-7.0-10 judges its timing)"
+    for rid in ids:
+        tally.undecide(rid, label, why)
+    return True
+
+
 def answered(
     rid: str,
     exchanges: Iterable[Exchange],
@@ -243,6 +257,8 @@ def continuous(
     for _index, pair in sorted(exchanges.items()):
         for ex in pair:
             label = escape(ex.text)
+            if undecided_if_late(tally, ex, ["R-4.4.8.1-01"]):
+                continue
             if not ex.answered or ex.command is None:
                 tally.fail("R-4.4.8.1-01", label, f"{label} got no reply")
                 continue

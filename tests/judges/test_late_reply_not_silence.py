@@ -1,0 +1,96 @@
+"""A reply that came after the tool's retries is no "got no reply" (R-4.4.8.1-01, R-6.2-01,
+R-6.2-05, R-6.2-07): a sensor whose every reply starts 80 ms after its command and which is
+deaf until then (fault replies-after-retry, an Arduino Due's ``delay(80)``) answers into the
+retry, which the engine sets aside as bus contention; the reply is there on the wire, late.
+Its lateness is R-7.0-10's: these rules are INCONCLUSIVE, and a truly silent sensor still
+FAILs them."""
+
+from __future__ import annotations
+
+from conformance.judges import exchanges as xjudge
+from conformance.judges import metadata
+from conformance.protocol.commands import parse_command
+from conformance.protocol.timing import CHAR_TIME
+from conformance.tool_recorder.records import NO_REPLY, Attempt, Exchange
+from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.verdicts import Finding, Verdict
+
+
+def _chars(text: str, start: float, origin: str) -> list[Event]:
+    return [
+        Event(
+            EventKind.CHAR,
+            origin,
+            start + i * CHAR_TIME,
+            start + (i + 1) * CHAR_TIME,
+            wire=to_wire_7e1(ord(c)),
+        )
+        for i, c in enumerate(text)
+    ]
+
+
+def _unanswered(command: str, late: str, t: float = 0.0) -> Exchange:
+    """Three tries of ``command`` none answered in its window; ``late`` (if any) arrives
+    80 ms after the first, during the retry, and is kept as the retries' stray characters."""
+    attempts = []
+    for retry in range(3):
+        cmd = _chars(command, t, TOOL)
+        stray = _chars(late, t - 0.01, DUT) if retry == 1 and late else []
+        attempts.append(Attempt(None, cmd, [], NO_REPLY, cmd[-1].end + 0.03, 0, retry, stray))
+        t = cmd[-1].end + 0.05
+    return Exchange(parse_command(command), command, attempts)
+
+
+def _by_rule(findings: list[Finding]) -> dict[str, Finding]:
+    return {f.requirement: f for f in findings}
+
+
+def test_r_4_4_8_1_01_continuous_reply_after_the_retries_is_inconclusive() -> None:
+    pair = (_unanswered("0RC0!", "0+22.1+45.6Hxm\r\n"), _unanswered("0RC0!", "0+22.1Hxm\r\n"))
+    found = _by_rule(xjudge.continuous({0: pair}, ["R-4.4.8.1-01"]))["R-4.4.8.1-01"]
+    assert found.verdict is Verdict.INCONCLUSIVE, found.detail
+    assert "answered only after the reply window" in found.detail
+    assert "got no reply" not in found.detail
+
+
+def test_r_4_4_8_1_01_silent_continuous_still_fails() -> None:
+    pair = (_unanswered("0RC0!", ""), _unanswered("0RC0!", ""))
+    found = _by_rule(xjudge.continuous({0: pair}, ["R-4.4.8.1-01"]))["R-4.4.8.1-01"]
+    assert found.verdict is Verdict.FAIL
+    assert "got no reply" in found.detail
+
+
+IDS = ("R-6.2-01", "R-6.2-05", "R-6.2-07")
+
+
+def test_r_6_2_01_05_07_metadata_replies_after_the_retries_are_inconclusive() -> None:
+    items = [
+        (_unanswered("0IM_001!", "0,TA,degC;\r\n"), False, True),
+        (_unanswered("0IM_004!", "0\r\n"), False, False),
+    ]
+    found = _by_rule(metadata.records(items, IDS))
+    for rid in IDS:
+        assert found[rid].verdict is Verdict.INCONCLUSIVE, (rid, found[rid].detail)
+        assert "answered only after the reply window" in found[rid].detail
+        assert "got no reply" not in found[rid].detail
+
+
+def test_r_6_2_01_05_07_silent_metadata_still_fails() -> None:
+    items = [
+        (_unanswered("0IM_001!", ""), False, True),
+        (_unanswered("0IM_004!", ""), False, False),
+    ]
+    found = _by_rule(metadata.records(items, IDS))
+    for rid in IDS:
+        assert found[rid].verdict is Verdict.FAIL, (rid, found[rid].detail)
+
+
+def test_r_6_2_01_one_late_one_silent_still_fails() -> None:
+    """A late reply does not hide another command's silence."""
+    items = [
+        (_unanswered("0IM_001!", "0,TA,degC;\r\n"), False, True),
+        (_unanswered("0IM_002!", ""), False, True),
+    ]
+    found = _by_rule(metadata.records(items, IDS))
+    assert found["R-6.2-01"].verdict is Verdict.FAIL
+    assert "0IM_002!" in found["R-6.2-01"].detail
