@@ -94,3 +94,15 @@ def test_r_6_2_01_one_late_one_silent_still_fails() -> None:
     found = _by_rule(metadata.records(items, IDS))
     assert found["R-6.2-01"].verdict is Verdict.FAIL
     assert "0IM_002!" in found["R-6.2-01"].detail
+
+
+def test_r_4_4_4_01_address_change_answered_after_the_retries_is_inconclusive() -> None:
+    """Seen on the whole sim run with replies-after-retry: '9<CR><LF>' began during the
+    retry of 0A9!, and R-4.4.4-01 FAILed '0A9! got no reply'."""
+    from testcases.sensor.test_4_4_basic import unanswered_change
+
+    found = unanswered_change(_unanswered("0A9!", "9\r\n"), "0A9!", "restored", [])
+    assert found.verdict is Verdict.INCONCLUSIVE, found.detail
+    assert "late '9<CR><LF>'" in found.detail
+    silent = unanswered_change(_unanswered("0A9!", ""), "0A9!", "restored", ["t=0"])
+    assert silent.verdict is Verdict.FAIL and "0A9! got no reply" in silent.detail
