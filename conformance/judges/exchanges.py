@@ -202,6 +202,22 @@ def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     return True
 
 
+def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
+    """INCONCLUSIVE for ``rid`` if ``ex`` went unanswered in its windows but its reply came
+    after them (:func:`late_reply`): the rule asks for ``what`` of a reply the tool did not
+    take, so silence is no evidence against it (R-7.0-10 judges the timing). None otherwise:
+    a silent or answered exchange is the caller's to judge."""
+    if ex.answered or not late_reply(ex):
+        return None
+    return inconclusive(
+        rid,
+        f"{what}: answered only after the reply window: {late_shown(ex)} "
+        "(R-7.0-10 judges its timing)",
+        evidence=cite([ex]),
+        observed=1,
+    )
+
+
 def answered(
     rid: str,
     exchanges: Iterable[Exchange],

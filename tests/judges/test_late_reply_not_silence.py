@@ -7,13 +7,19 @@ FAILs them."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
+from conformance.case import Case
 from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata
+from conformance.preconditions import declared_on
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
+from conformance.results import CaseRecord
 from conformance.tool_recorder.records import NO_REPLY, Attempt, Exchange
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
+from testcases.sensor.test_5_high_volume import test_high_volume_optional as high_volume_case
 
 
 def _chars(text: str, start: float, origin: str) -> list[Event]:
@@ -106,3 +112,40 @@ def test_r_4_4_4_01_address_change_answered_after_the_retries_is_inconclusive() 
     assert "late '9<CR><LF>'" in found.detail
     silent = unanswered_change(_unanswered("0A9!", ""), "0A9!", "restored", ["t=0"])
     assert silent.verdict is Verdict.FAIL and "0A9! got no reply" in silent.detail
+
+
+def test_late_only_names_the_late_reply_and_leaves_silence_alone() -> None:
+    """R-4.4.5-03, R-4.4.8.1-02 and R-5.4-02 ask what a reply holds: one that came after the
+    retries was not read, so they are INCONCLUSIVE, not "gave no values: '(silence)'"."""
+    late = xjudge.late_only("R-4.4.8.1-02", _unanswered("0R1!", "0+1013.25\r\n"), "R1 alone")
+    assert late is not None and late.verdict is Verdict.INCONCLUSIVE
+    assert "late '0+1013.25<CR><LF>'" in late.detail
+    assert xjudge.late_only("R-4.4.8.1-02", _unanswered("0R1!", ""), "R1 alone") is None
+
+
+class _HighVolumeSensor:
+    """aHA!/aHB! as the replies-after-retry sensor met them in the whole run."""
+
+    def __init__(self, late: dict[str, str]) -> None:
+        self.late = late
+
+    def measurement(self, code: str) -> SimpleNamespace:
+        return SimpleNamespace(start=_unanswered(f"0{code}!", self.late[code]))
+
+
+def _r_5_4_02(late: dict[str, str]) -> Finding:
+    record = CaseRecord("hv", "hv", ("R-5.4-02",))
+    case = Case(record, preconditions=declared_on(high_volume_case, ("R-5.4-02",)))
+    high_volume_case(_HighVolumeSensor(late), case)
+    return _by_rule(record.findings)["R-5.4-02"]
+
+
+def test_r_5_4_02_high_volume_answered_after_the_retries_is_inconclusive() -> None:
+    found = _r_5_4_02({"HA": "0006120\r\n", "HB": "0006120\r\n"})
+    assert found.verdict is Verdict.INCONCLUSIVE, found.detail
+    assert "(silence)" not in found.detail
+
+
+def test_r_5_4_02_silent_high_volume_still_warns() -> None:
+    found = _r_5_4_02({"HA": "", "HB": "0006120\r\n"})
+    assert found.verdict is Verdict.WARN and "0HA! -> '(silence)'" in found.detail, found.detail
