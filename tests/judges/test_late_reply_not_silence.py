@@ -20,6 +20,7 @@ from conformance.tool_recorder.records import NO_REPLY, Attempt, Exchange
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
 from testcases.sensor.test_5_high_volume import test_high_volume_optional as high_volume_case
+from testcases.sensor.test_6_metadata import test_continuous_metadata as continuous_metadata_case
 
 
 def _chars(text: str, start: float, origin: str) -> list[Event]:
@@ -149,3 +150,42 @@ def test_r_5_4_02_high_volume_answered_after_the_retries_is_inconclusive() -> No
 def test_r_5_4_02_silent_high_volume_still_warns() -> None:
     found = _r_5_4_02({"HA": "", "HB": "0006120\r\n"})
     assert found.verdict is Verdict.WARN and "0HA! -> '(silence)'" in found.detail, found.detail
+
+
+def _answered(command: str, reply: str, t: float = 0.0) -> Exchange:
+    cmd = _chars(command, t, TOOL)
+    rep = _chars(reply, cmd[-1].end + 0.009, DUT)
+    return Exchange(parse_command(command), command, [Attempt(None, cmd, rep, "ok", rep[-1].end)])
+
+
+class _ContinuousMetadataSensor:
+    """aR0! answered in time; each aIR0_001!/aIRC0_001! answered only after the retries (the
+    whole replies-after-retry run: R-6.2-06 FAILed 'no record for 0IR0_001!')."""
+
+    def __init__(self, record: str) -> None:
+        self.record = record
+
+    def exchange(self, code: str) -> Exchange:
+        if code == "R0":
+            return _answered("0R0!", "0+22.1\r\n")
+        if code.startswith("I"):
+            return _unanswered(f"0{code}!", self.record)
+        return _answered(f"0{code}!", "0\r\n")
+
+
+def _r_6_2_06(record: str) -> Finding:
+    record_ = CaseRecord("irn", "irn", ("R-6.2-06",))
+    case = Case(record_, preconditions=declared_on(continuous_metadata_case, ("R-6.2-06",)))
+    continuous_metadata_case(_ContinuousMetadataSensor(record), case)
+    return _by_rule(record_.findings)["R-6.2-06"]
+
+
+def test_r_6_2_06_continuous_metadata_after_the_retries_is_inconclusive() -> None:
+    found = _r_6_2_06("0,TA,degC;\r\n")
+    assert found.verdict is Verdict.INCONCLUSIVE, found.detail
+    assert "no record for" not in found.detail
+
+
+def test_r_6_2_06_silent_continuous_metadata_still_fails() -> None:
+    found = _r_6_2_06("")
+    assert found.verdict is Verdict.FAIL and "no record for 0IR0_001!" in found.detail
