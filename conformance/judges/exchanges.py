@@ -37,6 +37,7 @@ from .cite import cite, cited, heard, shown
 from .measurements import shown_reply_ids, undecide_uncompared_crc
 from .support import text_instead_of_values
 from .tally import Tally
+from .wire import EARLY_WINDOW
 
 
 def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Finding:
@@ -200,6 +201,25 @@ def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     for rid in ids:
         tally.undecide(rid, label, why)
     return True
+
+
+def first_answered_late(ex: Exchange) -> str:
+    """What may be the first transmission's late reply ('' if nothing): the first try went
+    unanswered and either the retries met DUT characters (:func:`late_reply`) or the retry's
+    reply began too soon after it (under R-7.0-09's 7.93 ms) to answer it, so it began in
+    answer to the try before. A sensor that waits 80 ms and is deaf until then answered
+    the first aD0! after a service request 0 ms after the retry (truth11): "no reply" to the
+    first aD0! was false. A reply timely to the retry is the retry's: ''."""
+    first, judged = ex.attempts[0], ex.judged
+    if first.reply_events or len(ex.attempts) < 2:
+        return ""
+    if text := late_reply(ex):
+        return text
+    if judged is first or not judged.reply_events or judged.command_end is None:
+        return ""
+    if EARLY_WINDOW.inside(judged.reply_events[0].start - judged.command_end):
+        return ""
+    return decode_7e1(judged.reply_events)
 
 
 def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:

@@ -16,11 +16,14 @@ from conformance.preconditions import declared_on
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
 from conformance.results import CaseRecord
-from conformance.tool_recorder.records import NO_REPLY, Attempt, Exchange
+from conformance.tool_recorder.records import NO_REPLY, Attempt, Exchange, Measurement
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
 from testcases.sensor.test_5_high_volume import test_high_volume_optional as high_volume_case
 from testcases.sensor.test_6_metadata import test_continuous_metadata as continuous_metadata_case
+from testcases.sensor.test_7_timing import (
+    test_data_after_service_request_without_break as sr_case,
+)
 
 
 def _chars(text: str, start: float, origin: str) -> list[Event]:
@@ -189,3 +192,55 @@ def test_r_6_2_06_continuous_metadata_after_the_retries_is_inconclusive() -> Non
 def test_r_6_2_06_silent_continuous_metadata_still_fails() -> None:
     found = _r_6_2_06("")
     assert found.verdict is Verdict.FAIL and "no record for 0IR0_001!" in found.detail
+
+
+def _d0_after_service_request(reply_after_retry: float) -> Measurement:
+    """0M! with a service request ending at 1.0 s; 0D0! 9 ms later unanswered, its retry
+    (no break) answered ``reply_after_retry`` s after the retry's end."""
+    start = _answered("0M!", "00013\r\n")
+    m = Measurement(start.command, start, ttt=1, count=3)
+    m.service_request_end = 1.0
+    first = _chars("0D0!", 1.009, TOOL)
+    retry = _chars("0D0!", first[-1].end + 0.055, TOOL)
+    reply = _chars("0+1+2+3\r\n", retry[-1].end + reply_after_retry, DUT)
+    m.data.append(
+        Exchange(
+            parse_command("0D0!"),
+            "0D0!",
+            [
+                Attempt(None, first, [], NO_REPLY, first[-1].end + 0.03, 0, 0),
+                Attempt(None, retry, reply, "ok", reply[-1].end, 0, 1),
+            ],
+        )
+    )
+    return m
+
+
+class _ServiceRequestSensor:
+    uncertainty = 0.0
+
+    def __init__(self, m: Measurement) -> None:
+        self.m = m
+
+    def defined(self, _codes: tuple[str, ...]) -> list[Measurement]:
+        return [self.m]
+
+
+def _r_7_1_02(reply_after_retry: float) -> Finding:
+    record = CaseRecord("sr", "sr", ("R-7.1-02",))
+    case = Case(record, preconditions=declared_on(sr_case, ("R-7.1-02",)))
+    sr_case(_ServiceRequestSensor(_d0_after_service_request(reply_after_retry)), case)
+    return _by_rule(record.findings)["R-7.1-02"]
+
+
+def test_r_7_1_02_reply_at_the_retry_may_be_the_first_d0s_late_reply() -> None:
+    """The whole replies-after-retry run: the reply began 0 ms after the retry (80 ms after
+    the first aD0!), and R-7.1-02 FAILed 'no reply'."""
+    found = _r_7_1_02(0.0)
+    assert found.verdict is Verdict.INCONCLUSIVE, found.detail
+    assert "answered only after its reply window" in found.detail
+
+
+def test_r_7_1_02_a_retry_answered_in_time_is_the_retrys_and_still_fails() -> None:
+    found = _r_7_1_02(0.009)
+    assert found.verdict is Verdict.FAIL and "no reply" in found.detail, found.detail
