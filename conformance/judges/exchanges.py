@@ -37,6 +37,7 @@ from .cite import cite, cited, heard, shown
 from .measurements import shown_reply_ids, undecide_uncompared_crc
 from .support import text_instead_of_values
 from .tally import Tally
+from .wire import EARLY_WINDOW
 
 
 def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Finding:
@@ -188,6 +189,55 @@ def late_shown(ex: Exchange) -> str:
     return f"{escape(ex.text)} -> late '{escape(text[: text.find(chr(10)) + 1] or text)}'"
 
 
+def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
+    """An unanswered ``ex`` whose reply came after the tool stopped listening (it ran into the
+    retries: a sensor whose every reply starts 80 ms late, deaf until then) is no "got no
+    reply": undecided for ``ids`` on ``tally`` (INCONCLUSIVE unless something else FAILs them;
+    R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL."""
+    if ex.answered or not late_reply(ex):
+        return False
+    label = escape(ex.text)
+    why = f"answered only after the reply window: {late_shown(ex)} (R-7.0-10 judges its timing)"
+    for rid in ids:
+        tally.undecide(rid, label, why)
+    return True
+
+
+def first_answered_late(ex: Exchange) -> str:
+    """What may be the first transmission's late reply ('' if nothing): the first try went
+    unanswered and either the retries met DUT characters (:func:`late_reply`) or the retry's
+    reply began too soon after it (under R-7.0-09's 7.93 ms) to answer it, so it began in
+    answer to the try before. A sensor that waits 80 ms and is deaf until then answered
+    the first aD0! after a service request 0 ms after the retry (truth11): "no reply" to the
+    first aD0! was false. A reply timely to the retry is the retry's: ''."""
+    first, judged = ex.attempts[0], ex.judged
+    if first.reply_events or len(ex.attempts) < 2:
+        return ""
+    if text := late_reply(ex):
+        return text
+    if judged is first or not judged.reply_events or judged.command_end is None:
+        return ""
+    if EARLY_WINDOW.inside(judged.reply_events[0].start - judged.command_end):
+        return ""
+    return decode_7e1(judged.reply_events)
+
+
+def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
+    """INCONCLUSIVE for ``rid`` if ``ex`` went unanswered in its windows but its reply came
+    after them (:func:`late_reply`): the rule asks for ``what`` of a reply the tool did not
+    take, so silence is no evidence against it (R-7.0-10 judges the timing). None otherwise:
+    a silent or answered exchange is the caller's to judge."""
+    if ex.answered or not late_reply(ex):
+        return None
+    return inconclusive(
+        rid,
+        f"{what}: answered only after the reply window: {late_shown(ex)} "
+        "(R-7.0-10 judges its timing)",
+        evidence=cite([ex]),
+        observed=1,
+    )
+
+
 def answered(
     rid: str,
     exchanges: Iterable[Exchange],
@@ -243,6 +293,8 @@ def continuous(
     for _index, pair in sorted(exchanges.items()):
         for ex in pair:
             label = escape(ex.text)
+            if undecided_if_late(tally, ex, ["R-4.4.8.1-01"]):
+                continue
             if not ex.answered or ex.command is None:
                 tally.fail("R-4.4.8.1-01", label, f"{label} got no reply")
                 continue

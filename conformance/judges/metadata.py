@@ -9,6 +9,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
+from .exchanges import undecided_if_late
 from .tally import Tally
 
 SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
@@ -92,6 +93,11 @@ def records(
     unconfirmed: list[Exchange] = []
     for ex, crc, valid in exchanges:
         label = escape(ex.text)
+        count_rule = [] if valid is None else ["R-6.2-07" if valid else "R-6.2-05"]
+        if undecided_if_late(tally, ex, ["R-6.2-01", *count_rule]):
+            if valid is None:
+                unconfirmed.append(ex)
+            continue
         if not ex.answered:
             if valid is None:
                 unconfirmed.append(ex)

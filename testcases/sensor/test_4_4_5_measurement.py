@@ -6,7 +6,7 @@ import pytest
 
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
-from conformance.judges.exchanges import cite, cited, heard, shown
+from conformance.judges.exchanges import cite, cited, heard, late_only, shown
 from conformance.judges.support import empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
@@ -105,7 +105,10 @@ def test_ttt_zero(sensor, case):
             )
         )
     body, _ = split_line(d0.reply_text)
-    if d0.answered and len(body) > 1 and body[1] in "+-":
+    late = late_only("R-4.4.5-03", d0, "aD0! right after ttt = 000")
+    if late is not None:
+        case.add(late)
+    elif d0.answered and len(body) > 1 and body[1] in "+-":
         case.add(passed("R-4.4.5-03", f"data ready at once: {shown(d0)}", observed=1))
     else:
         case.add(

@@ -10,7 +10,8 @@ from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import check_change_address_reply, split_line
 from conformance.protocol.timing import ADDRESS_CHANGE_QUIET, TOLERANCE
 from conformance.sensor.address_change import AddressChanger
-from conformance.verdicts import failed, inconclusive, passed
+from conformance.tool_recorder.records import Exchange
+from conformance.verdicts import Finding, failed, inconclusive, passed
 
 requirements = pytest.mark.requirements
 
@@ -64,6 +65,21 @@ def test_every_basic_command_is_answered(sensor, case):
     # a reply heard after the window is R-7.0-10's deviation, not silence (a late '00001' to
     # 0M1!..0M9! FAILed "no reply although it is a basic command")
     case.add(judge.answered("R-4.4-01", exchanges, "it is a basic command", late_is_reply=True))
+
+
+def unanswered_change(request: Exchange, sent: str, note: str, evidence: list[str]) -> Finding:
+    """R-4.4.4-01 on an ``aAb!`` none of whose tries was answered in its window: FAIL if the
+    sensor stayed silent, INCONCLUSIVE if its reply came after the retries (a sensor whose
+    every reply starts 80 ms late answered '9<CR><LF>' into the retry: R-7.0-10's deviation,
+    and "got no reply" was false, truth11)."""
+    if judge.late_reply(request):
+        return inconclusive(
+            "R-4.4.4-01",
+            f"answered only after the reply window: {judge.late_shown(request)} "
+            f"(R-7.0-10 judges its timing; {note})",
+            evidence=evidence,
+        )
+    return failed("R-4.4.4-01", f"{sent} got no reply ({note})", evidence=evidence, observed=1)
 
 
 @requirements("R-4.4.4-01", "R-4.4.4-02", "R-4.4.4-03")
@@ -124,14 +140,7 @@ def test_change_address(sensor, case):
     )
     request = [judge.cited(outcome.request)]
     if not outcome.request.answered:
-        case.add(
-            failed(
-                "R-4.4.4-01",
-                f"{original}A{target}! got no reply ({note})",
-                evidence=request,
-                observed=1,
-            )
-        )
+        case.add(unanswered_change(outcome.request, f"{original}A{target}!", note, request))
     elif problems or not outcome.took:
         msg = "; ".join(v.message for v in problems) or "the sensor kept its old address"
         case.add(failed("R-4.4.4-01", f"{msg} ({note})", evidence=request, observed=1))

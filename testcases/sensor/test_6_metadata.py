@@ -289,6 +289,8 @@ def test_continuous_metadata(sensor, case):
             label = f"aI{code}_nnn!"
             tally.observe(label)
             last = seq[-1]
+            if xjudge.undecided_if_late(tally, last, ["R-6.2-06"]):
+                continue  # its reply came after the retries: R-7.0-10's, not a missing one
             if len(seq) == 1:
                 tally.fail("R-6.2-06", label, f"no record for {escape(seq[0].text)}")
             elif not last.answered:

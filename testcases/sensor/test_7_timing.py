@@ -24,7 +24,7 @@ from conformance.protocol.timing import (
     WAKE_LIMIT,
 )
 from conformance.sensor.session import PROBE_TRIES
-from conformance.transcript import TOOL, EventKind, decode_7e1
+from conformance.transcript import TOOL, EventKind, decode_7e1, escape
 from conformance.verdicts import Verdict, failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
@@ -684,6 +684,16 @@ def test_data_after_service_request_without_break(sensor, case):
     if first.break_event is not None or gap + sensor.uncertainty >= NO_BREAK_WINDOW:
         case.add(
             inconclusive("R-7.1-02", "the tool's aD0! was not sent within 87 ms without a break")
+        )
+    elif not first.reply_events and (late := judge.first_answered_late(d0)):
+        case.add(
+            inconclusive(
+                "R-7.1-02",
+                f"aD0! {gap * 1e3:.2f} ms after the service request, no break: answered only "
+                f"after its reply window ('{escape(late)}', met by the retry; R-7.0-10 "
+                "judges its timing)",
+                evidence=[judge.cited(d0)],
+            )
         )
     elif first.reply_events:
         case.add(

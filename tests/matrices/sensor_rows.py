@@ -34,11 +34,13 @@ AWAITING_JUDGES: dict[str, str] = {
     "replies-after-retry": (
         "every reply 80 ms after its command, deaf until then (the Due sensor's delay(80)): "
         "R-7.0-10 FAILs true (through the late-start probe where every reply came after a "
-        "retry), but the one-shot probes listen 30 ms and read its late replies as silence, "
-        "and a multi-line reply met by the retries is cut into stray lines: 21 more FAIL/WARN "
-        "(R-4.4.4-01 'got no reply', R-4.2-02 '<ETX>', R-7.0-05/-07/-16, R-7.1-02 ...) and 21 "
-        "INCONCLUSIVE against the clean row; which of them the sensor truly breaks is not "
-        "sorted out yet (truth10)"
+        "retry). Replies met by the retries are INCONCLUSIVE, not 'got no reply', since truth11 "
+        "(R-4.4.4-01, R-4.4.5-03, R-4.4.8.1-01/-02, R-5.4-02, R-6.2-01/-05/-06/-07, R-7.1-02). "
+        "Left: 10 more FAIL and 1 WARN: the one-shot probes listen 30 ms and the late reply is "
+        "read only by the next transaction (R-7.0-05/-07/-16), the multi-line 0XHELP! reply cut "
+        "by the retries into stray lines (R-4.2-02/-03, R-4.3-01, R-7.0-12), R-4.3-03, "
+        "R-4.4.5.1-03, R-4.4.7-05, WARN R-4.4.5.1-02; which of them the sensor truly breaks "
+        "is not sorted out yet (truth10, truth11)"
     ),
 }
 
