@@ -70,6 +70,18 @@ def test_r_4_4_8_1_01_silent_continuous_still_fails() -> None:
     assert "got no reply" in found.detail
 
 
+def test_r_4_4_12_02_03_crc_of_a_continuous_reply_after_the_retries_is_not_judged() -> None:
+    """A late aRCn! reply without its CRC (continuous-crc-missing + replies-after-retry, seed
+    4262) was skipped, so R-4.4.12-02 PASSed on the D replies alone: now undecided, counted
+    against their PASS; likewise R-4.4.12-03 for a late aRn!."""
+    pair = (_unanswered("0R0!", "0+22.1\r\n"), _unanswered("0RC0!", "0+22.1\r\n"))
+    ids = ["R-4.4.8.1-01", "R-4.4.12-02", "R-4.4.12-03"]
+    found = _by_rule(xjudge.continuous({0: pair}, ids))
+    for rid, command in (("R-4.4.12-02", "0RC0!"), ("R-4.4.12-03", "0R0!")):
+        assert found[rid].verdict is Verdict.INCONCLUSIVE, found[rid].detail
+        assert f"{command} -> late" in found[rid].detail, found[rid].detail
+
+
 IDS = ("R-6.2-01", "R-6.2-05", "R-6.2-07")
 
 
