@@ -189,17 +189,26 @@ def late_shown(ex: Exchange) -> str:
     return f"{escape(ex.text)} -> late '{escape(text[: text.find(chr(10)) + 1] or text)}'"
 
 
+def late_answer(ex: Exchange) -> str:
+    """``answered only after the reply window: 0M1! -> late '00001<CR><LF>'`` for an
+    ``ex`` unanswered in its windows whose reply came after them (:func:`late_reply`), ''
+    otherwise: the one wording of the rules that leave such a reply to R-7.0-10."""
+    if ex.answered or not late_reply(ex):
+        return ""
+    return f"answered only after the reply window: {late_shown(ex)}"
+
+
 def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     """An unanswered ``ex`` whose reply came after the tool stopped listening (it ran into the
     retries: a sensor whose every reply starts 80 ms late, deaf until then) is no "got no
     reply": undecided for ``ids`` on ``tally`` (INCONCLUSIVE unless something else FAILs them;
     R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL."""
-    if ex.answered or not late_reply(ex):
+    late = late_answer(ex)
+    if not late:
         return False
     label = escape(ex.text)
-    why = f"answered only after the reply window: {late_shown(ex)} (R-7.0-10 judges its timing)"
     for rid in ids:
-        tally.undecide(rid, label, why)
+        tally.undecide(rid, label, f"{late} (R-7.0-10 judges its timing)")
     return True
 
 
@@ -227,12 +236,12 @@ def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
     after them (:func:`late_reply`): the rule asks for ``what`` of a reply the tool did not
     take, so silence is no evidence against it (R-7.0-10 judges the timing). None otherwise:
     a silent or answered exchange is the caller's to judge."""
-    if ex.answered or not late_reply(ex):
+    late = late_answer(ex)
+    if not late:
         return None
     return inconclusive(
         rid,
-        f"{what}: answered only after the reply window: {late_shown(ex)} "
-        "(R-7.0-10 judges its timing)",
+        f"{what}: {late} (R-7.0-10 judges its timing)",
         evidence=cite([ex]),
         observed=1,
     )

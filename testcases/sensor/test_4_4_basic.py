@@ -72,12 +72,9 @@ def unanswered_change(request: Exchange, sent: str, note: str, evidence: list[st
     sensor stayed silent, INCONCLUSIVE if its reply came after the retries (a sensor whose
     every reply starts 80 ms late answered '9<CR><LF>' into the retry: R-7.0-10's deviation,
     and "got no reply" was false, truth11)."""
-    if judge.late_reply(request):
+    if late := judge.late_answer(request):
         return inconclusive(
-            "R-4.4.4-01",
-            f"answered only after the reply window: {judge.late_shown(request)} "
-            f"(R-7.0-10 judges its timing; {note})",
-            evidence=evidence,
+            "R-4.4.4-01", f"{late} (R-7.0-10 judges its timing; {note})", evidence=evidence
         )
     return failed("R-4.4.4-01", f"{sent} got no reply ({note})", evidence=evidence, observed=1)
 

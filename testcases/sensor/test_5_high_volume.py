@@ -80,9 +80,10 @@ def test_high_volume_optional(sensor, case):
     starts = [sensor.measurement(c).start for c in ("HA", "HB")]
     case.evidence("aHA!, aHB!", starts)
     odd = []
-    late = [f for f in (xjudge.late_only("R-5.4-02", ex, ex.text) for ex in starts) if f]
-    for ex in starts:
-        if xjudge.late_reply(ex) and not ex.answered:
+    read = [(ex, xjudge.late_only("R-5.4-02", ex, ex.text)) for ex in starts]
+    late = [f for _, f in read if f]
+    for ex, late_finding in read:
+        if late_finding:
             continue  # late: R-7.0-10's, its content unread
         body, _ = split_line(ex.reply_text)
         if not ex.answered or (body[4:7] == "000" and body[1:] != "000000") or _text_reply(ex):
