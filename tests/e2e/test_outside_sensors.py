@@ -697,3 +697,36 @@ def test_retries_of_a_command_without_its_bang_are_not_one_command_r_7_0_13(
     gaps = found["R-7.0-13"]
     assert gaps["verdict"] == "INCONCLUSIVE", gaps["findings"]
     assert "before any '!'" in gaps["findings"][0]["detail"], gaps["findings"]
+
+
+@pytest.fixture
+def acknowledges_before_data(monkeypatch):
+    """The golden recorder, ``a!`` sent to the sensor before its first D command, after ttt or
+    the service request: the twentieth round's logger (jmpmscorp/esp-sdi-12) makes its device
+    handle with ``sdi12_new_dev``, which sends ``a!``, the first time it meets an address."""
+    from conformance.tool_recorder.engine import ToolRecorder
+
+    collect = ToolRecorder.collect
+
+    def acknowledging(self, m, **kw):
+        if m.count and not m.data:
+            self.acknowledge(m.command.address)
+        return collect(self, m, **kw)
+
+    monkeypatch.setattr(ToolRecorder, "collect", acknowledging)
+
+
+def test_an_acknowledge_between_a_measurement_and_its_data_is_no_collection_given_up(
+    acknowledges_before_data,
+):
+    """R-4.4.7-08 FAILed "read none of the 5 values", R-4.4.8-05 "stopped after the reply with
+    0 of 3 values", R-4.4-02 "logged 5 value(s), the sensor sent 0", R-4.4.5-05 "no aD0! after
+    the measurement" on a recorder that read every value (the sensor keeps its data until
+    another measurement, 4.4.5 and 4.4.7)."""
+    keyword = (
+        "test_concurrent_measurements or test_data_continuation or "
+        "test_logged_values_are_the_values_sent or test_waiting_for_the_service_request"
+    )
+    found = _verdicts(run_once("sim", role="recorder", keyword=keyword))
+    for rid in ("R-4.4.7-08", "R-4.4.8-05", "R-4.4-02", "R-4.4.5-05"):
+        assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])

@@ -107,6 +107,8 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
             if t.data_index is not None:
                 data.append((t, problems[j]))
                 continue
+            if tc is not None and tc.kind in KEEPS_DATA and t.start >= _finished(s, ttt, sr):
+                continue  # the data stay the sensor's to give (4.4.5, 4.4.7)
             if tc is not None and tc.starts_measurement:
                 nxt = t
             left = True
@@ -130,6 +132,22 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
             )
         )
     return taken
+
+
+#: Commands that neither return data via D0 nor change the address: after a measurement has
+#: finished, the sensor "must retain the measured data in memory until it receives another
+#: M, C or V command, or another command that returns data via the D0 command" (4.4.5,
+#: 4.4.7), so a recorder that sends one of these (esp-sdi-12's device API sends ``a!`` the
+#: first time it meets an address, docs/kit.md) is still in the measurement. Before it has
+#: finished, a valid command to the sensor aborts a concurrent one (4.4.7.1).
+KEEPS_DATA = frozenset({Kind.ACKNOWLEDGE, Kind.IDENTIFY, Kind.IDENTIFY_MEASUREMENT, Kind.METADATA})
+
+
+def _finished(s: Transmission, ttt: int, sr: float | None) -> float:
+    """When the measurement ``s`` started was over: its service request, else ttt after its
+    reply (the sensor's own promise of when its data are ready)."""
+    ready = s.reply[-1].end + ttt
+    return ready if sr is None else min(sr, ready)
 
 
 def _after_the_job(line: TranscriptView, s: Transmission) -> bool:

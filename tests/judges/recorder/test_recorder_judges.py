@@ -523,3 +523,28 @@ def test_a_reply_after_the_recorder_ended_its_job_owes_no_values_r_4_4_8_05():
     view.ended_parts = {0: end + 0.010}
     found = judge_data_collection(observed_measurements(view, 0.0))
     assert found[0].verdict is Verdict.FAIL and "0 of 4 values" in found[0].detail
+
+
+def test_an_acknowledge_after_the_measurement_ended_leaves_its_data_owed_r_4_4_7_08():
+    """jmpmscorp/esp-sdi-12 (twentieth round, docs/kit.md): its device API sends ``a!`` the
+    first time it meets an address, here after ttt and before ``aD0!``. The sensor keeps its
+    data until another measurement or a command returning data via D0 (4.4.5, 4.4.7), and the
+    wire showed all five values read; R-4.4.7-08 FAILed "read none of the 5 values" and
+    R-4.4.8-05 "stopped after the reply with 0 of 5 values". An ``a!`` before ttt (which
+    aborts a concurrent measurement, 4.4.7.1) still ends the collection."""
+    values = "0-5.00-3.75-2.50-1.25+0.00\r\n"
+    after = Wire().brk().rec("0C!").sensor("000205\r\n").idle(2100)
+    after = after.brk().rec("0!").sensor("0\r\n").brk().rec("0D0!").sensor(values)
+    taken = observed_measurements(after.view(), 0.0)
+    found = by_id(judge_concurrent_storage(taken, ("0C!",)) + judge_data_collection(taken))
+    assert found["R-4.4.7-08"].verdict is Verdict.PASS, found["R-4.4.7-08"].detail
+    assert found["R-4.4.8-05"].verdict is Verdict.PASS, found["R-4.4.8-05"].detail
+    measured = Wire().brk().rec("0M!").sensor("00023\r\n").idle(300).sensor("0\r\n")
+    measured = measured.brk().rec("0I!").sensor("014CONFORM EMU001100SN0001\r\n")
+    measured = measured.brk().rec("0D0!").sensor("0+22.15+1013.2+45.7\r\n")
+    found = by_id(judge_data_collection(observed_measurements(measured.view(), 0.0)))
+    assert found["R-4.4.8-05"].verdict is Verdict.PASS, found["R-4.4.8-05"].detail
+    early = Wire().brk().rec("0C!").sensor("000205\r\n").idle(500)
+    early = early.brk().rec("0!").sensor("0\r\n").brk().rec("0D0!").sensor("0\r\n")
+    found = judge_concurrent_storage(observed_measurements(early.view(), 0.0), ("0C!",))
+    assert Verdict.FAIL in [f.verdict for f in found if f.requirement == "R-4.4.7-08"]
