@@ -26,7 +26,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
-from .support import text_instead_of_values, unreadable_count
+from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wire import runs
 
@@ -530,6 +530,10 @@ class Measurements:
             # no count to hold to 1..9 (measure-ttt-two-digits beside measure-count-zero
             # PASSed R-4.4.5-02 on 21 replies none of which gave a count, seed 4066)
             tally.undecide("R-4.4.5-02", where(m), "its reply gives no readable count")
+        if text_instead_of_start(m) and "R-4.4.7-02" in _reply_ids(m):
+            # 'aUNKN' to aC! starts no measurement to call real or not (R-4.4.7-08 FAILs the
+            # missing support); "conforms" was said of joembedded's sketch (docs/kit.md)
+            tally.undecide("R-4.4.7-02", where(m), "its reply is text, no measurement started")
         wait_violations(m, tally, chatter)
         data_violations(m, tally)
 

@@ -59,6 +59,16 @@ def serves_measurement(m: Measurement) -> bool:
     return m.start.answered and m.count is not None and m.count > 0 and m.ttt is not None
 
 
+def text_instead_of_start(m: Measurement) -> bool:
+    """A start reply with no digit after the address (``aUNKN``, or the bare ``a`` of an
+    a! answer): no atttn(n) tried, so no measurement started and the command is not served,
+    however its form is judged (joembedded's SDI_12_slave answered aC! '0UNKN', docs/kit.md)."""
+    if not m.start.answered:
+        return False
+    rest = split_line(m.start.reply_text)[0][1:]
+    return not any(c.isdigit() for c in rest)
+
+
 def unreadable_count(m: Measurement) -> bool:
     """The start reply answered in digits that give no count (``0023`` to ``aM!``: a ttt of
     two digits), so no D command followed it: values the sensor may hold there were never

@@ -7,7 +7,11 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
-from conformance.judges.support import empty_data_reply, serves_measurement
+from conformance.judges.support import (
+    empty_data_reply,
+    serves_measurement,
+    text_instead_of_start,
+)
 from conformance.protocol.commands import C_FAMILY
 from conformance.protocol.responses import split_line
 from conformance.verdicts import failed, inconclusive, passed, warned
@@ -49,9 +53,13 @@ def test_concurrent_supported(sensor, case):
     m = sensor.measurement("C")
     case.evidence("aC!", m.start)
     # a malformed reply still answers aC! (R-4.4.7-01 judges its form); a00000 does not,
-    # nor a malformed one whose every reading is zero values (a000000: a 3-digit zero count)
+    # nor a malformed one whose every reading is zero values (a000000: a 3-digit zero count),
+    # nor text with no digit (aUNKN)
     zero = m.start.answered and (m.count == 0 or (m.count is None and _all_zero(m.start)))
-    tried = not zero and (serves_measurement(m) or (m.start.answered and m.count is None))
+    text = text_instead_of_start(m)  # 'aUNKN': the sensor says it does not know aC!
+    tried = (
+        not zero and not text and (serves_measurement(m) or (m.start.answered and m.count is None))
+    )
     if tried and m.start.reply_text[:1] == sensor.address:
         case.add(
             passed("R-4.4.7-08", f"aC! answered '{xjudge.escape(m.start.reply_text)}'", observed=1)

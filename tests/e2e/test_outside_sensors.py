@@ -730,3 +730,35 @@ def test_an_acknowledge_between_a_measurement_and_its_data_is_no_collection_give
     found = _verdicts(run_once("sim", role="recorder", keyword=keyword))
     for rid in ("R-4.4.7-08", "R-4.4.8-05", "R-4.4-02", "R-4.4.5-05"):
         assert found[rid]["verdict"] == "PASS", (rid, found[rid]["findings"])
+
+
+@pytest.fixture
+def concurrent_answered_unkn(monkeypatch):
+    """The simulated sensor answering every aC!-type command 'aUNKN' (joembedded's
+    SDI_12_slave sketch, twentieth round: concurrent measurement taken out, its parser's
+    ``default: responseStr = "UNKN"``)."""
+    from conformance.protocol.commands import Kind
+
+    usual = FaultSet.rewrite
+
+    def rewrite(self, reply):
+        cmd = reply.command
+        if cmd is not None and cmd.kind is Kind.CONCURRENT and reply.kind is ReplyKind.START:
+            return replace(reply, kind=ReplyKind.CHATTER, body=cmd.address + "UNKN", crc=False)
+        return usual(self, reply)
+
+    monkeypatch.setattr(FaultSet, "rewrite", rewrite)
+
+
+def test_text_to_ac_is_no_support_r_4_4_7_08(concurrent_answered_unkn):
+    """R-4.4.7-08 (a v1.2+ sensor supports aC!) PASSed "aC! answered '0UNKN<CR><LF>'" and
+    R-4.4.7-02 (aC! starts a real measurement) "conforms (2 checked: 0C!, 0CC!)" on a sensor
+    whose answer says it does not know the command. Text of its own is no support
+    (judges.support): R-4.4.7-08 FAILs, R-4.4.7-02 has no measurement to judge."""
+    found = _verdicts(
+        run_once("sim://", keyword="test_concurrent_reply or test_concurrent_supported")
+    )
+    assert found["R-4.4.7-08"]["verdict"] == "FAIL", found["R-4.4.7-08"]["findings"]
+    assert "not supported: 0C! -> '0UNKN" in found["R-4.4.7-08"]["findings"][0]["detail"]
+    assert found["R-4.4.7-02"]["verdict"] == "INCONCLUSIVE", found["R-4.4.7-02"]["findings"]
+    assert found["R-4.4.7-01"]["verdict"] == "FAIL"  # the form, as before
