@@ -7,10 +7,14 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
-from conformance.judges.support import serves_continuous, unreadable_count
+from conformance.judges.support import (
+    serves_continuous,
+    text_instead_of_start,
+    unreadable_count,
+)
 from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.results import counted
-from conformance.verdicts import Finding, Verdict, inconclusive, passed, warned
+from conformance.verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 
 requirements = pytest.mark.requirements
 CRC_CODES = tuple(c for c in M_FAMILY + C_FAMILY if c[:2] in ("MC", "CC"))
@@ -63,14 +67,27 @@ def _crc_served(sensor, case) -> None:
 def test_crc_commands_supported(sensor, case):
     """A sensor claiming v1.3 or later answers aMC!, aMC1..9!, aCC!, aCC1..9! and aRC0..9!."""
     case.expect("a reply to each CRC-variant command")
-    exchanges = [sensor.measurement(c).start for c in CRC_CODES]
-    exchanges += [sensor.exchange(f"RC{i}") for i in range(10)]
+    ms = [sensor.measurement(c) for c in CRC_CODES]
+    exchanges = [m.start for m in ms] + [sensor.exchange(f"RC{i}") for i in range(10)]
     case.evidence("CRC-variant commands", exchanges)
     case.add(
         xjudge.answered(
             "R-4.4.12-01", exchanges, "CRC variants are mandatory from v1.3", late_is_reply=True
         )
     )
+    # plain aMC!/aCC! are always defined: 'aUNKN' to one is the sensor saying it does not
+    # know it (joembedded's sketch, docs/kit.md). An undefined aMCn!/aCCn! group's text is
+    # R-4.4.9-02's, an aRCn!'s R-4.4.8.1-03's.
+    text = [m.start for m in ms if m.command.group == 0 and text_instead_of_start(m)]
+    if text:
+        case.add(
+            failed(
+                "R-4.4.12-01",
+                "not supported: " + "; ".join(xjudge.shown(ex) for ex in text),
+                evidence=xjudge.cite(text),
+                observed=len(text),
+            )
+        )
 
 
 @requirements("R-4.4.12-02", "R-4.4.12-03")

@@ -67,6 +67,12 @@ device at the assumed address now; ?! is asked again and its answer taken
 (``SensorSession._answered_here``). Its parser answers aCn! with its a! reply, and R-4.4.7-02
 (aC! measures for real) PASSed on those while aC! and aCC! were silent: it is judged on plain
 aC!/aCC! only.
+
+The twentieth: an ESP-IDF logger library (jmpmscorp/esp-sdi-12) sends a! the first time it
+meets an address, between aC! and aD0!: the recorder judges took that for the end of the
+measurement and FAILed R-4.4.7-08, R-4.4.8-05 and R-4.4-02 on values read on the wire. A sensor
+sketch (joembedded/SDI_12_slave) answers every aC...! '0UNKN': R-4.4.7-08 and R-4.4.12-01
+(support of aC! and aCC!) PASSed on that text.
 """
 
 from __future__ import annotations
@@ -762,3 +768,14 @@ def test_text_to_ac_is_no_support_r_4_4_7_08(concurrent_answered_unkn):
     assert "not supported: 0C! -> '0UNKN" in found["R-4.4.7-08"]["findings"][0]["detail"]
     assert found["R-4.4.7-02"]["verdict"] == "INCONCLUSIVE", found["R-4.4.7-02"]["findings"]
     assert found["R-4.4.7-01"]["verdict"] == "FAIL"  # the form, as before
+
+
+def test_text_to_acc_is_no_crc_support_r_4_4_12_01(concurrent_answered_unkn):
+    """R-4.4.12-01 (a v1.3 sensor supports aMC!, aCC!, ...) PASSed "answered (CRC variants
+    are mandatory from v1.3)" with aCC! among the replies, answered '0UNKN'. Plain aMC!/aCC!
+    are always defined: text to one is no support. (Text to an undefined aMCn!/aCCn! group
+    or to an aRCn! stays the form rules' business: R-4.4.9-02, R-4.4.8.1-03.)"""
+    found = _verdicts(run_once("sim://", keyword="test_crc_commands_supported"))
+    rule = found["R-4.4.12-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert "0CC! -> '0UNKN" in " ".join(f["detail"] for f in rule["findings"]), rule["findings"]
