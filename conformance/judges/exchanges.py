@@ -247,6 +247,26 @@ def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
     )
 
 
+def late_among(rid: str, exchanges: Iterable[Exchange], what: str) -> Finding | None:
+    """INCONCLUSIVE for ``rid`` if any of ``exchanges`` was answered only after its reply
+    window (:func:`late_answer`), None otherwise: a measurement whose start or D reply ran
+    into the retries delivered values the tool did not take, so a count short of the
+    undisturbed one (``what``) is no evidence that it lost them. The replies-after-retry
+    sensor's aD0! after an abort and after a break and zI! came 80 ms late, its values cut by
+    the retry: "after the abort M delivered 0 values" and "C delivered 0 values after a break
+    and zI!" were false FAILs (truth12)."""
+    exchanges = list(exchanges)
+    late = [text for ex in exchanges if (text := late_answer(ex))]
+    if not late:
+        return None
+    return inconclusive(
+        rid,
+        f"{what}, but " + "; ".join(late[:3]) + " (R-7.0-10 judges its timing)",
+        evidence=cite([ex for ex in exchanges if late_answer(ex)]),
+        observed=len(late),
+    )
+
+
 def answered(
     rid: str,
     exchanges: Iterable[Exchange],

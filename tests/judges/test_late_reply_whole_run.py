@@ -1,0 +1,36 @@
+"""The whole sim run of a sensor whose every reply starts 80 ms after its command and which is
+deaf until then (fault replies-after-retry, an Arduino Due's ``delay(80)``): truth12's rules,
+each a FAIL or WARN before that said "no reply", "0 values" or "broken framing" where a whole
+reply came late. Each is now INCONCLUSIVE naming the late reply (R-7.0-10 FAILs its timing)
+or judged on what the sensor truly sent; the single-fault rows that declare these rules keep
+them exact (tests/matrices)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.conduct import run_once
+
+
+@pytest.fixture(scope="module")
+def late_run() -> dict[str, dict]:
+    data = run_once("sim://?faults=replies-after-retry")
+    return {r["id"]: r for r in data["requirements"]}
+
+
+def _worst(result: dict) -> dict:
+    return next(f for f in result["findings"] if f["verdict"] == result["verdict"])
+
+
+@pytest.mark.parametrize("rid", ["R-4.4.5.1-02", "R-4.4.5.1-03", "R-4.4.7-05"])
+def test_late_d_reply_after_an_abort_or_a_break_is_no_lost_data(late_run, rid) -> None:
+    """R-4.4.5.1-02/-03, R-4.4.7-05: the aD0! reply ran into the retry, its values (or none)
+    late: 'after the abort M delivered 0 values, 3 before it', 'C delivered 0 values after a
+    break and zI!' (FAIL) and 'D0 ... -> (silence)' (WARN) before."""
+    result = late_run[rid]
+    assert result["verdict"] == "INCONCLUSIVE", result["findings"]
+    assert "0D0! -> late '" in _worst(result)["detail"]
+
+
+def test_r_7_0_10_still_fails(late_run) -> None:
+    assert late_run["R-7.0-10"]["verdict"] == "FAIL"
