@@ -34,3 +34,18 @@ def test_late_d_reply_after_an_abort_or_a_break_is_no_lost_data(late_run, rid) -
 
 def test_r_7_0_10_still_fails(late_run) -> None:
     assert late_run["R-7.0-10"]["verdict"] == "FAIL"
+
+
+@pytest.mark.parametrize("rid", ["R-4.2-02", "R-4.2-03", "R-4.3-01"])
+def test_late_multiline_reply_the_retry_met_is_not_framed(late_run, rid) -> None:
+    """0XHELP!'s reply, 80 ms late, met the retry; its lines after it were framed as sent
+    unasked: "later, after 0XHELP!: reply '<ETX>'" FAILed these before."""
+    result = late_run[rid]
+    assert result["verdict"] == "INCONCLUSIVE", result["findings"]
+    assert "rest of multi-line text" in _worst(result)["detail"]
+
+
+def test_r_7_0_12_gaps_between_the_late_multiline_reply_s_lines_pass(late_run) -> None:
+    """The 6.67 ms between two lines of that reply FAILed R-7.0-12 before; every character
+    gap of this sensor is 0 ms."""
+    assert late_run["R-7.0-12"]["verdict"] == "PASS", late_run["R-7.0-12"]["findings"]
