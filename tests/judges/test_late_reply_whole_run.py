@@ -49,3 +49,11 @@ def test_r_7_0_12_gaps_between_the_late_multiline_reply_s_lines_pass(late_run) -
     """The 6.67 ms between two lines of that reply FAILed R-7.0-12 before; every character
     gap of this sensor is 0 ms."""
     assert late_run["R-7.0-12"]["verdict"] == "PASS", late_run["R-7.0-12"]["findings"]
+
+
+def test_r_4_3_03_address_change_answered_late_is_not_refused(late_run) -> None:
+    """0A1!'s '1<CR><LF>' came 80 ms late, into the retry: 'refused or lost address(es) 1'
+    FAILed before."""
+    result = late_run["R-4.3-03"]
+    assert result["verdict"] == "INCONCLUSIVE", result["findings"]
+    assert "0A1! -> late '1<CR><LF>'" in _worst(result)["detail"]
