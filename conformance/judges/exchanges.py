@@ -179,8 +179,10 @@ def late_reply(ex: Exchange) -> str:
     its next try ('' if nothing): a late reply, R-7.0-10's deviation, not silence. A Pico
     firmware reads its RTD for 30 ms before it answers ``aM1!``; its '00001' came 32 ms after
     each try, and "no reply although silence does not comply" was false (docs/kit.md,
-    fifteenth round)."""
-    return decode_7e1([e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT])
+    fifteenth round). For a one-shot command, what a longer listen heard after its window
+    (``heard_late``, truth12)."""
+    strays = [e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT]
+    return decode_7e1(strays + [e for e in ex.heard_late if e.origin == DUT])
 
 
 def late_shown(ex: Exchange) -> str:

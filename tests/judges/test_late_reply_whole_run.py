@@ -57,3 +57,21 @@ def test_r_4_3_03_address_change_answered_late_is_not_refused(late_run) -> None:
     result = late_run["R-4.3-03"]
     assert result["verdict"] == "INCONCLUSIVE", result["findings"]
     assert "0A1! -> late '1<CR><LF>'" in _worst(result)["detail"]
+
+
+@pytest.mark.parametrize(
+    ("rid", "late"),
+    [("R-7.0-05", "0! -> late"), ("R-7.0-07", "0! -> late"), ("R-7.0-16", "0I! -> late")],
+)
+def test_one_shot_probe_answered_late_is_no_silence(late_run, rid, late) -> None:
+    """The probes are sent once and were listened to 30 ms: 'no reply' FAILed these before;
+    from a sensor seen late they are listened to that long (SensorSession.hear_late)."""
+    result = late_run[rid]
+    assert result["verdict"] == "INCONCLUSIVE", result["findings"]
+    assert late in _worst(result)["detail"]
+
+
+def test_only_r_7_0_10_fails(late_run) -> None:
+    """What this sensor truly breaks: R-7.0-10, nothing else FAILs or WARNs."""
+    bad = {rid for rid, r in late_run.items() if r["verdict"] in ("FAIL", "WARN")}
+    assert bad == {"R-7.0-10"}
