@@ -611,7 +611,10 @@ class SensorSession(Session):
         end = ex.attempts[0].command_end if ex.attempts else None
         if ex.answered or late is None or end is None:
             return ex
-        heard = self.link.receive(max(end + late + CHAR_TIME, self.link.now()), until=bool)
+        # the start was measured between two stamps, and the reply's is one more: twice the
+        # link's uncertainty past it (none on the sim)
+        until = end + late + CHAR_TIME + 2 * self.uncertainty
+        heard = self.link.receive(max(until, self.link.now()), until=bool)
         if heard and heard[-1].char7 != LF:  # the rest of it, to its LF or a pause
             heard += self.link.receive(
                 heard[-1].end + LATE_START_LISTEN,
