@@ -806,6 +806,7 @@ class Framing:
         self.started: str | None = None  # the address of the last reply starting a measurement
         self.shown: str | None = None  # the address the last reply beginning with its own showed
         self._pending: Segment | None = None  # the last segment added, not judged yet
+        self._open_text = False  # multi-line text a command talked over, its ETX not yet seen
 
     def add(self, segs: list[Segment]) -> None:
         """The replies and later lines of ``segs`` (the next window's segments)."""
@@ -834,8 +835,10 @@ class Framing:
         tool_cut = cut and not seg.reply_ended and not seg.later  # the tool spoke over it
         reply = [seg.reply] if seg.reply and not seg.binary_reply and not tool_cut else []
         chunks = reply + later
-        # the rest of multi-line text the command talked over, to its ETX: not framed
-        hidden = talked_through(seg)
+        # the rest of multi-line text the command talked over, to its ETX: not framed; so is
+        # what the next command talked over before that ETX (a long line met the next retry)
+        met = bool(seg.contention) and seg.contention[0].start < seg.command_end
+        hidden = self._open_text = talked_through(seg) or (self._open_text and met)
         for n, chunk in enumerate(chunks):
             is_reply = n == 0 and bool(reply)
             label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
@@ -848,7 +851,7 @@ class Framing:
                     f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
                 )
             if hidden:  # the rest of a multi-line text the command talked over
-                hidden = chunk[-1].char7 != ETX
+                hidden = self._open_text = chunk[-1].char7 != ETX
                 why = (
                     f"'{escape(text[:40])}' is the rest of multi-line text the sensor began "
                     "during the command (a late reply the tool's retry talked over; R-7.0-10 "

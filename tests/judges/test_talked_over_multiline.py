@@ -72,3 +72,31 @@ def test_multiline_text_ended_inside_the_command_leaves_later_lines_framed() -> 
     seg = _talked_over("0\x02A\r\n\x03", ["\x03"])
     assert not wire.talked_through(seg)
     assert _by_rule(wire.judge_framing([seg], 0.0, own="0"))["R-4.2-02"].verdict is Verdict.FAIL
+
+
+def _next_retry(first: Segment, line: str, rest: str, *, met: bool) -> Segment:
+    """The next 0XHELP! after ``first``; ``line`` meets it (``met``) or comes after it."""
+    command = _chars(TOOL, "0XHELP!", first.later[-1].end + 0.055)
+    heard = _chars(DUT, line, command[3].start if met else command[-1].end + 0.1)
+    later = _chars(DUT, rest, heard[-1].end + LINE_GAP)
+    if met:
+        return Segment(None, command, later=later, contention=heard, text="0XHELP!")
+    return Segment(None, command, later=heard + later, text="0XHELP!")
+
+
+def test_r_4_2_02_text_talked_over_by_two_retries_is_not_framed() -> None:
+    """multiline-long-line + replies-after-retry (seeds 4500..): the 80-character line met
+    the next retry and the ETX came after it, framed alone: R-4.2-02/-03, R-4.3-01 FAILed."""
+    first = _talked_over("0\x02CONFORM EMU001\r\n", ["aXSN! serial\r\n"])
+    second = _next_retry(first, "L" * 80 + "\r\n", "\x03", met=True)
+    found = _by_rule(wire.judge_framing([first, second], 0.0, own="0"))
+    for rid in ("R-4.2-02", "R-4.2-03", "R-4.3-01"):
+        assert found[rid].verdict is Verdict.INCONCLUSIVE, (rid, found[rid].detail)
+
+
+def test_r_4_2_02_an_etx_after_a_command_no_text_met_is_framed() -> None:
+    first = _talked_over("0\x02CONFORM EMU001\r\n", ["aXSN! serial\r\n"])
+    second = _next_retry(first, "L\r\n", "\x03", met=False)
+    assert _by_rule(wire.judge_framing([first, second], 0.0, own="0"))["R-4.2-02"].verdict is (
+        Verdict.FAIL
+    )
