@@ -89,19 +89,21 @@ def silent(
 
     Silence is only evidence from a sensor that was shown to listen: ``baseline`` is the
     exchange (or exchanges) in which it answered its own address; if it answered none of
-    them, a mute device would "pass", so the verdict is INCONCLUSIVE. A command that maybe
+    them, a mute device would "pass", so the verdict is INCONCLUSIVE. A one-shot command
+    answered after its window (:func:`heard_late`) was answered. A command that maybe
     collided (sensor characters met it within the stamps' uncertainty) may not have been
     heard, so its silence is set aside, as :func:`silent_while_listening` does for the
     one-shot probes; an answer counts whatever met the command."""
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
-    answered = [ex for ex in exchanges if ex.answered]
+    answered = [ex for ex in exchanges if ex.answered or heard_late(ex)]
     met = [ex for ex in exchanges if not ex.answered and ex.maybe_collided]
     if answered:
         make = warned if should else failed
         return make(
             rid,
-            f"answered although {why}: " + "; ".join(shown(e) for e in answered[:3]),
+            f"answered although {why}: "
+            + "; ".join(shown(e) if e.answered else late_shown(e) for e in answered[:3]),
             evidence=cite(answered),
             decision=decision,
             observed=len(exchanges),
@@ -172,6 +174,15 @@ def silent_while_listening(
         evidence=[shown(p.probe) for p in heard[:3]],
         observed=2 * len(heard),
     )
+
+
+def heard_late(ex: Exchange) -> bool:
+    """Whether a one-shot ``ex`` unanswered in its window drew a reply the longer listen for
+    a sensor seen late heard (``ex.heard_late``): an answer all the same, to a command that
+    was sent once with nothing after it. standby-ignored + replies-after-retry answered
+    R-7.0-15's a! 101.90 ms after a reply, 80 ms late, and the rule PASSed "stayed silent"
+    (truth12)."""
+    return not ex.answered and any(e.origin == DUT for e in ex.heard_late)
 
 
 def late_reply(ex: Exchange) -> str:

@@ -11,6 +11,7 @@ is named (INCONCLUSIVE) and silence stays silence. A sensor never seen late is n
 
 from __future__ import annotations
 
+from conformance.conduct import run_once
 from conformance.emulator import sim_sensor
 from conformance.judges import exchanges as xjudge
 from conformance.protocol.timing import CHAR_TIME
@@ -90,3 +91,21 @@ def test_silence_from_the_late_sensor_stays_a_fail() -> None:
     assert ex.heard_late == []
     found = xjudge.answered("R-7.0-07", [ex], "90 ms", first_attempt=True, late_is_reply=True)
     assert found.verdict is Verdict.FAIL
+
+
+def test_r_7_0_15_late_answer_to_a_standby_probe_is_an_answer() -> None:
+    """standby-ignored + replies-after-retry (a pair drawing replies-after-retry, seeds
+    4500..4757): the a! 101.90 ms after a reply was answered 80 ms late and R-7.0-15 PASSed
+    'stayed silent' (a false PASS); now FAIL naming the late answer."""
+    data = run_once(
+        "sim://?faults=replies-after-retry,standby-ignored", keyword="test_standby_after_100ms"
+    )
+    found = next(r for r in data["requirements"] if r["id"] == "R-7.0-15")
+    assert found["verdict"] == "FAIL", found["findings"]
+    assert "0! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
+
+
+def test_r_7_0_15_late_sensor_that_sleeps_still_passes() -> None:
+    data = run_once("sim://?faults=replies-after-retry", keyword="test_standby_after_100ms")
+    found = next(r for r in data["requirements"] if r["id"] == "R-7.0-15")
+    assert found["verdict"] == "PASS", found["findings"]
