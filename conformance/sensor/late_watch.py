@@ -27,8 +27,17 @@ class LateStartWatch:
     """The latest reply start seen after an unanswered try, from the try (s), or None."""
 
     def __init__(self) -> None:
-        self.start: float | None = None
+        self._start: float | None = None
+        self._early = False  # a first try answered sooner than R-7.0-09's 7.93 ms
         self._previous: tuple[Attempt, str] | None = None
+
+    @property
+    def start(self) -> float | None:
+        """The latest start seen (s), None if none, or if the sensor was seen answering a
+        first try too soon: then a retry's reply begun too soon is its own (the sim's
+        response-too-early sensor answers 5 ms after every command: read as the late reply
+        to an unanswered try before it, its standby probes were listened to for nothing)."""
+        return None if self._early else self._start
 
     def note(self, attempt: Attempt, text: str) -> None:
         """``attempt`` of the command ``text`` as the engine made it. After an unanswered try,
@@ -39,21 +48,24 @@ class LateStartWatch:
         # (a retry: the same command again with no break; the engine numbers its tries
         # only once the hook has returned)
         previous, self._previous = self._previous, (attempt, text)
-        if previous is None or previous[1] != text or attempt.break_event is not None:
-            return
-        previous = previous[0]
-        if previous.reply_events:
-            return
-        end, retry_end = previous.command_end, attempt.command_end
-        heard = [e for e in attempt.stray_events if e.origin == DUT]
         reply = attempt.reply_events
-        if not heard and reply and retry_end is not None:
-            heard = [] if EARLY_WINDOW.inside(reply[0].start - retry_end) else reply
+        sent_end = attempt.command_end
+        if previous is None or previous[1] != text or attempt.break_event is not None:
+            if reply and sent_end is not None:  # a first try: answered too soon?
+                self._early |= not EARLY_WINDOW.inside(reply[0].start - sent_end)
+            return
+        before = previous[0]
+        end = before.command_end
+        if before.reply_events:
+            return
+        heard = [e for e in attempt.stray_events if e.origin == DUT]
+        if not heard and reply and sent_end is not None:
+            heard = [] if EARLY_WINDOW.inside(reply[0].start - sent_end) else reply
         if end is None or not heard or heard[0].start <= end:
             return
         address = expected_reply_address(text)
         if address is not None and heard[0].char7 != ord(address[0]):
             return
         late = heard[0].start - end
-        if late <= LATE_START_MAX and (self.start is None or late > self.start):
-            self.start = late
+        if late <= LATE_START_MAX and (self._start is None or late > self._start):
+            self._start = late

@@ -59,6 +59,17 @@ def test_a_new_sequence_after_a_break_shows_nothing() -> None:
     assert _tries("013CONFORM\r\n", 0.0, brk=True).start is None
 
 
+def test_a_sensor_seen_answering_too_soon_is_not_taken_for_late() -> None:
+    """response-too-early answers every command 5 ms after it: a retry's reply 5 ms after
+    it is its own, not the late reply to the try before (its standby probes were listened
+    to for nothing: the run's transcript changed, its verdicts not)."""
+    watch = _tries("013CONFORM\r\n", 0.0)
+    first = _chars("0!", 1.0, TOOL)
+    watch.note(Attempt(None, first, _chars("0\r\n", first[-1].end + 5e-3, DUT), OK, 1.1), "0!")
+    assert watch.start is None
+    assert _session("response-too-early").master.watch.late.start is None
+
+
 def _session(*faults: str) -> SensorSession:
     _, link, _ = sim_sensor(faults=faults)
     sensor = SensorSession(link, address="0")
