@@ -28,16 +28,19 @@ class LateStartWatch:
 
     def __init__(self) -> None:
         self._start: float | None = None
-        self._early = False  # a first try answered sooner than R-7.0-09's 7.93 ms
+        self._late = 0  # unanswered tries whose reply came late, as above
+        self._early = 0  # first tries answered sooner than R-7.0-09's 7.93 ms
         self._previous: tuple[Attempt, str] | None = None
 
     @property
     def start(self) -> float | None:
-        """The latest start seen (s), None if none, or if the sensor was seen answering a
-        first try too soon: then a retry's reply begun too soon is its own (the sim's
+        """The latest start seen (s), None if none, or if the sensor answered first tries too
+        soon as often: then a retry's reply begun too soon is its own (the sim's
         response-too-early sensor answers 5 ms after every command: read as the late reply
-        to an unanswered try before it, its standby probes were listened to for nothing)."""
-        return None if self._early else self._start
+        to an unanswered try before it, its standby probes were listened to for nothing).
+        Counted, not any: a late sensor's reply that lands just after the next command is
+        "too soon" too (answers-foreign-address + replies-after-retry, seed 4500..)."""
+        return self._start if self._late > self._early else None
 
     def note(self, attempt: Attempt, text: str) -> None:
         """``attempt`` of the command ``text`` as the engine made it. After an unanswered try,
@@ -52,7 +55,7 @@ class LateStartWatch:
         sent_end = attempt.command_end
         if previous is None or previous[1] != text or attempt.break_event is not None:
             if reply and sent_end is not None:  # a first try: answered too soon?
-                self._early |= not EARLY_WINDOW.inside(reply[0].start - sent_end)
+                self._early += not EARLY_WINDOW.inside(reply[0].start - sent_end)
             return
         before = previous[0]
         end = before.command_end
@@ -67,5 +70,6 @@ class LateStartWatch:
         if address is not None and heard[0].char7 != ord(address[0]):
             return
         late = heard[0].start - end
-        if late <= LATE_START_MAX and (self._start is None or late > self._start):
-            self._start = late
+        if late <= LATE_START_MAX:
+            self._late += 1
+            self._start = late if self._start is None else max(self._start, late)
