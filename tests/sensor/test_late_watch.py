@@ -120,3 +120,16 @@ def test_r_7_0_15_late_sensor_that_sleeps_still_passes() -> None:
     data = run_once("sim://?faults=replies-after-retry", keyword="test_standby_after_100ms")
     found = next(r for r in data["requirements"] if r["id"] == "R-7.0-15")
     assert found["verdict"] == "PASS", found["findings"]
+
+
+def test_one_reply_landing_just_after_the_next_command_does_not_hide_a_late_sensor() -> None:
+    """answers-foreign-address + replies-after-retry: a late reply that lands just after the
+    next command reads as a first try answered too soon; two late replies outweigh it."""
+    watch = _tries("013CONFORM\r\n", 0.0)
+    first = _chars("0M!", 1.0, TOOL)
+    watch.note(Attempt(None, first, [], NO_REPLY, 1.1), "0M!")
+    retry = _chars("0M!", first[-1].end + 0.055, TOOL)
+    watch.note(Attempt(None, retry, _chars("00011\r\n", retry[-1].end, DUT), OK, 1.3), "0M!")
+    early = _chars("0!", 2.0, TOOL)
+    watch.note(Attempt(None, early, _chars("0\r\n", early[-1].end + 5e-3, DUT), OK, 2.1), "0!")
+    assert watch.start is not None and abs(watch.start - 0.080) < 1e-9
