@@ -89,19 +89,21 @@ def silent(
 
     Silence is only evidence from a sensor that was shown to listen: ``baseline`` is the
     exchange (or exchanges) in which it answered its own address; if it answered none of
-    them, a mute device would "pass", so the verdict is INCONCLUSIVE. A command that maybe
+    them, a mute device would "pass", so the verdict is INCONCLUSIVE. A one-shot command
+    answered after its window (:func:`heard_late`) was answered. A command that maybe
     collided (sensor characters met it within the stamps' uncertainty) may not have been
     heard, so its silence is set aside, as :func:`silent_while_listening` does for the
     one-shot probes; an answer counts whatever met the command."""
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
-    answered = [ex for ex in exchanges if ex.answered]
+    answered = [ex for ex in exchanges if ex.answered or heard_late(ex)]
     met = [ex for ex in exchanges if not ex.answered and ex.maybe_collided]
     if answered:
         make = warned if should else failed
         return make(
             rid,
-            f"answered although {why}: " + "; ".join(shown(e) for e in answered[:3]),
+            f"answered although {why}: "
+            + "; ".join(shown(e) if e.answered else late_shown(e) for e in answered[:3]),
             evidence=cite(answered),
             decision=decision,
             observed=len(exchanges),
@@ -174,13 +176,24 @@ def silent_while_listening(
     )
 
 
+def heard_late(ex: Exchange) -> bool:
+    """Whether a one-shot ``ex`` unanswered in its window drew a reply the longer listen for
+    a sensor seen late heard (``ex.heard_late``): an answer all the same, to a command that
+    was sent once with nothing after it. standby-ignored + replies-after-retry answered
+    R-7.0-15's a! 101.90 ms after a reply, 80 ms late, and the rule PASSed "stayed silent"
+    (truth12)."""
+    return not ex.answered and any(e.origin == DUT for e in ex.heard_late)
+
+
 def late_reply(ex: Exchange) -> str:
     """What the DUT sent after the tool had stopped listening for a try of ``ex`` and before
     its next try ('' if nothing): a late reply, R-7.0-10's deviation, not silence. A Pico
     firmware reads its RTD for 30 ms before it answers ``aM1!``; its '00001' came 32 ms after
     each try, and "no reply although silence does not comply" was false (docs/kit.md,
-    fifteenth round)."""
-    return decode_7e1([e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT])
+    fifteenth round). For a one-shot command, what a longer listen heard after its window
+    (``heard_late``, truth12)."""
+    strays = [e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT]
+    return decode_7e1(strays + [e for e in ex.heard_late if e.origin == DUT])
 
 
 def late_shown(ex: Exchange) -> str:
@@ -244,6 +257,26 @@ def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
         f"{what}: {late} (R-7.0-10 judges its timing)",
         evidence=cite([ex]),
         observed=1,
+    )
+
+
+def late_among(rid: str, exchanges: Iterable[Exchange], what: str) -> Finding | None:
+    """INCONCLUSIVE for ``rid`` if any of ``exchanges`` was answered only after its reply
+    window (:func:`late_answer`), None otherwise: a measurement whose start or D reply ran
+    into the retries delivered values the tool did not take, so a count short of the
+    undisturbed one (``what``) is no evidence that it lost them. The replies-after-retry
+    sensor's aD0! after an abort and after a break and zI! came 80 ms late, its values cut by
+    the retry: "after the abort M delivered 0 values" and "C delivered 0 values after a break
+    and zI!" were false FAILs (truth12)."""
+    exchanges = list(exchanges)
+    late = [text for ex in exchanges if (text := late_answer(ex))]
+    if not late:
+        return None
+    return inconclusive(
+        rid,
+        f"{what}, but " + "; ".join(late[:3]) + " (R-7.0-10 judges its timing)",
+        evidence=cite([ex for ex in exchanges if late_answer(ex)]),
+        observed=len(late),
     )
 
 

@@ -13,6 +13,7 @@ from math import copysign, isnan
 from operator import sub
 
 from ..protocol.commands import ADDRESS_CHARS, MEASUREMENT_KINDS, CommandError, parse_command
+from ..protocol.framing import ETX, STX
 from ..protocol.responses import split_line
 from ..protocol.timing import (
     CHAR_TIME,
@@ -208,6 +209,24 @@ def _not_a_reply_to(seg: Segment) -> bool:
     )
 
 
+def talked_through(seg: Segment) -> bool:
+    """Whether the command talked over multi-line text the sensor had begun: the characters
+    that met it (``contention``) start ``a<STX>`` and hold no ETX yet, so what follows the
+    command up to the ETX is the rest of that text, a late reply to an earlier try that the
+    retry met (the replies-after-retry sensor answered 0XHELP! 80 ms late: its first line met
+    the retry and its other lines came after it). Neither its framing nor the gaps between
+    its lines are a reply's of this command to judge (truth12: R-4.2-02/-03 and R-4.3-01
+    FAILed "later, after 0XHELP!: reply '<ETX>'", R-7.0-12 the 6.67 ms between two of its
+    lines, R-4.4.13.1-03's to judge)."""
+    met = seg.contention
+    return (
+        len(met) > 1
+        and met[0].start < seg.command_end
+        and met[1].char7 == STX
+        and all(e.char7 != ETX for e in met)
+    )
+
+
 def _text(seg: Segment) -> str:
     """All the sensor sent after the command, as text: part of an observation's place (one
     C pass over the characters, :func:`~conformance.transcript.text7`)."""
@@ -244,7 +263,8 @@ def _cut_gaps(segs: list[Segment]) -> list[Gap]:
             continue
         text = _text(seg)
         where = f"in reply to {escape(seg.text)}"
-        multiline = seg.multiline
+        # the rest of multi-line text the command talked over: its lines may pause between
+        multiline = seg.multiline or talked_through(seg)
         first = 0  # index of the run's first character in all the sensor sent after it
         # the whole reply, however long a gap inside it: a gap is R-7.0-12's evidence
         for run in [seg.reply, *runs(seg.later)]:
@@ -786,6 +806,7 @@ class Framing:
         self.started: str | None = None  # the address of the last reply starting a measurement
         self.shown: str | None = None  # the address the last reply beginning with its own showed
         self._pending: Segment | None = None  # the last segment added, not judged yet
+        self._open_text = False  # multi-line text a command talked over, its ETX not yet seen
 
     def add(self, segs: list[Segment]) -> None:
         """The replies and later lines of ``segs`` (the next window's segments)."""
@@ -814,6 +835,10 @@ class Framing:
         tool_cut = cut and not seg.reply_ended and not seg.later  # the tool spoke over it
         reply = [seg.reply] if seg.reply and not seg.binary_reply and not tool_cut else []
         chunks = reply + later
+        # the rest of multi-line text the command talked over, to its ETX: not framed; so is
+        # what the next command talked over before that ETX (a long line met the next retry)
+        met = bool(seg.contention) and seg.contention[0].start < seg.command_end
+        hidden = self._open_text = talked_through(seg) or (self._open_text and met)
         for n, chunk in enumerate(chunks):
             is_reply = n == 0 and bool(reply)
             label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
@@ -825,6 +850,16 @@ class Framing:
                     label,
                     f"{len(bad)} character(s) with wrong parity, first 0x{bad[0].wire:02X}",
                 )
+            if hidden:  # the rest of a multi-line text the command talked over
+                hidden = self._open_text = chunk[-1].char7 != ETX
+                why = (
+                    f"'{escape(text[:40])}' is the rest of multi-line text the sensor began "
+                    "during the command (a late reply the tool's retry talked over; R-7.0-10 "
+                    "judges its timing): not framed as a reply"
+                )
+                for rid in ("R-4.2-02", "R-4.2-03", "R-4.3-01"):
+                    tally.undecide(rid, label, why)
+                continue
             if seg.multiline and is_reply:  # decision A10: each line is framed on its own
                 lines = text.replace("\x02", "", 1).rstrip("\x03").split("\r\n")
                 for line in lines[:-1]:

@@ -18,15 +18,18 @@ from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
-from ..transcript import decode_7e1
+from ..transcript import SEVEN_BITS, decode_7e1
+from .late_watch import LateStartWatch
 
 
 class BufferWatchHooks(Hooks):
     """Engine hooks that change nothing and note, per address, the last command sent and the
-    characters of its reply (``last_sent``)."""
+    characters of its reply (``last_sent``), and how late a reply was seen to start
+    (``late``, :class:`~.late_watch.LateStartWatch`)."""
 
     def __init__(self) -> None:
         self.last_sent: dict[str, tuple[Command | None, str]] = {}
+        self.late = LateStartWatch()  # how late a reply was seen to start (one-shot probes)
 
     def attempt(
         self,
@@ -40,6 +43,7 @@ class BufferWatchHooks(Hooks):
         attempt = proceed()
         reply = decode_7e1(attempt.reply_events)
         self.last_sent[address] = (command, reply)
+        self.late.note(attempt, wire.translate(SEVEN_BITS).decode("latin-1"))
         return attempt
 
 

@@ -31,8 +31,9 @@ from ..protocol.commands import (
     Kind,
     parse_command,
 )
+from ..protocol.framing import LF
 from ..protocol.responses import Identification, parse_ident, split_line
-from ..protocol.timing import STANDBY_MARKING, TOLERANCE, WAKE_LIMIT
+from ..protocol.timing import CHAR_TIME, STANDBY_MARKING, TOLERANCE, WAKE_LIMIT
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import TOOL, Event, EventKind, decode_7e1, escape
@@ -597,6 +598,31 @@ class SensorSession(Session):
             return ex
 
         return self.once("late-start-probe", send)
+
+    def hear_late(self, ex: Exchange) -> Exchange:
+        """A one-shot ``ex`` (sent once, no retry) left unanswered, from a sensor seen to
+        start its replies late (:class:`~.late_watch.LateStartWatch`): listen until that
+        start (and a character) past its command, bounded by
+        :data:`~.late_watch.LATE_START_MAX`, and keep what came as ``ex.heard_late``: its
+        late reply, which the 30 ms window missed and the next transmission broke off
+        (R-7.0-07's probe read "no reply" from the replies-after-retry sensor, truth12).
+        Silence through it is silence; a sensor never seen late is not waited for."""
+        late = self.master.watch.late.start
+        end = ex.attempts[0].command_end if ex.attempts else None
+        if ex.answered or late is None or end is None:
+            return ex
+        # the start was measured between two stamps, and the reply's is one more: twice the
+        # link's uncertainty past it (none on the sim)
+        until = end + late + CHAR_TIME + 2 * self.uncertainty
+        heard = self.link.receive(max(until, self.link.now()), until=bool)
+        if heard and heard[-1].char7 != LF:  # the rest of it, to its LF or a pause
+            heard += self.link.receive(
+                heard[-1].end + LATE_START_LISTEN,
+                until=lambda got: got[-1].char7 == LF,
+                idle=self.master.policy.reply_idle,
+            )
+        ex.heard_late = heard
+        return ex
 
     def listen(self, duration: float) -> list[Event]:
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""

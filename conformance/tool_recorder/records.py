@@ -68,6 +68,10 @@ class Exchange:
     attempts: list[Attempt]
     binary: bool = False
     expect_reply: bool = True
+    #: DUT characters heard after a one-shot command's reply window, by a longer listen for a
+    #: sensor seen to start its replies late (:meth:`~conformance.sensor.session.
+    #: SensorSession.hear_late`): its late reply, never taken for the reply
+    heard_late: list[Event] = field(default_factory=list)
 
     @property
     def last(self) -> Attempt:

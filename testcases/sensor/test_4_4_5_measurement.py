@@ -6,7 +6,7 @@ import pytest
 
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
-from conformance.judges.exchanges import cite, cited, heard, late_only, shown
+from conformance.judges.exchanges import cite, cited, heard, late_among, late_only, shown
 from conformance.judges.support import empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
@@ -324,6 +324,8 @@ def test_break_aborts_measurement(sensor, case):
                 observed=len(ds),
             )
         )
+    elif late := late_only("R-4.4.5.1-02", full, "D0 after the abort should hold no values"):
+        case.add(late)  # its values (or none) came after the window, cut by the retries
     else:
         case.add(
             warned(
@@ -337,7 +339,15 @@ def test_break_aborts_measurement(sensor, case):
     # heard without another break: the first transmission or a retry of the same sequence
     # (a sensor slow to wake after the break is R-7.0-05/07's business, not this rule's)
     unbroken = [a for a in again.start.attempts if a.sequence == 0]
-    if not again.start.answered:
+    late = late_among(
+        "R-4.4.5.1-03",
+        [again.start, *again.data],
+        f"after the abort {code} delivered {again.value_count} values, "
+        f"{target.value_count} before it",
+    )
+    if late is not None and again.value_count < target.value_count:
+        case.add(late)
+    elif not again.start.answered:
         case.add(
             failed(
                 "R-4.4.5.1-03",

@@ -123,6 +123,13 @@ def test_concurrent_survives_break_and_other_traffic(sensor, case):
                 observed=m.value_count,  # none delivered undisturbed either: nothing to judge
             )
         )
+    elif late := xjudge.late_among(
+        "R-4.4.7-05",
+        [m.start, *m.data],
+        f"{code} delivered {m.value_count} values after a break and {other}I!, "
+        f"{target.value_count} undisturbed",
+    ):
+        case.add(late)
     else:
         case.add(
             failed(

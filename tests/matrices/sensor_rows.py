@@ -30,19 +30,7 @@ FAST_FAULTS = {"response-too-late"}
 
 #: Faults whose row the judges do not yet get exact, with what goes wrong: strict, so the row
 #: must be taken out of here the moment the judges are fixed (issue 18, part 5).
-AWAITING_JUDGES: dict[str, str] = {
-    "replies-after-retry": (
-        "every reply 80 ms after its command, deaf until then (the Due sensor's delay(80)): "
-        "R-7.0-10 FAILs true (through the late-start probe where every reply came after a "
-        "retry). Replies met by the retries are INCONCLUSIVE, not 'got no reply', since truth11 "
-        "(R-4.4.4-01, R-4.4.5-03, R-4.4.8.1-01/-02, R-5.4-02, R-6.2-01/-05/-06/-07, R-7.1-02). "
-        "Left: 10 more FAIL and 1 WARN: the one-shot probes listen 30 ms and the late reply is "
-        "read only by the next transaction (R-7.0-05/-07/-16), the multi-line 0XHELP! reply cut "
-        "by the retries into stray lines (R-4.2-02/-03, R-4.3-01, R-7.0-12), R-4.3-03, "
-        "R-4.4.5.1-03, R-4.4.7-05, WARN R-4.4.5.1-02; which of them the sensor truly breaks "
-        "is not sorted out yet (truth10, truth11)"
-    ),
-}
+AWAITING_JUDGES: dict[str, str] = {}
 
 
 def shard_faults(shard: int) -> list[str]:
