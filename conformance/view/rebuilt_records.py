@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from operator import attrgetter, sub
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
@@ -33,6 +34,9 @@ from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import CONTENTION, IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
 from ..transcript import Event, decode_8n1, text_end
 from .segments import TranscriptView, Transmission
+
+_START = attrgetter("start")
+_END = attrgetter("end")
 
 
 @dataclass
@@ -147,7 +151,8 @@ def _attempt(
     uncertainty: float,
 ) -> Attempt:
     stray = list(t.contention)
-    heard = [e for e in t.heard if e.start >= t.end]
+    end = t.end
+    heard = [e for e in t.heard if e.start >= end]
     reply = _framed(t, heard, policy)
     if stray:
         reason = f"{CONTENTION} ({len(stray)} characters during the command)"
@@ -179,6 +184,10 @@ def _framed(t: Transmission, heard: list[Event], policy: Policy) -> list[Event]:
     if not heard or heard[0].start - t.end > policy.first_char_timeout:
         return []
     framed = t.reply
+    if len(framed) < 2 or max(map(sub, map(_START, framed[1:]), map(_END, framed))) <= (
+        policy.reply_idle
+    ):
+        return framed  # no gap longer than the idle: nothing cut (one C pass over the gaps)
     for i in range(1, len(framed)):
         multiline_gap = framed[i - 1].char7 == 0x0A
         if not multiline_gap and framed[i].start - framed[i - 1].end > policy.reply_idle:

@@ -35,7 +35,17 @@ from ..protocol.timing import (
     MULTILINE_GAP_MAX,
     TOLERANCE,
 )
-from ..transcript import COLLISION, TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
+from ..transcript import (
+    COLLISION,
+    SEVEN_BITS,
+    TOOL,
+    Event,
+    EventKind,
+    decode_7e1,
+    decode_8n1,
+    escape,
+    wire_bytes,
+)
 from .direction import iter_directions
 from .sides import BUS, RECORDER, SENSOR, expected_reply_address
 
@@ -52,6 +62,7 @@ _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
 #: transmission holds characters only, so its text ends in ``!`` when its last one is ``!``
 _BANG = ord("!")
 _LINE_ENDS = (0x0D, 0x0A)  # CR, LF
+_LF_BYTE = bytes([LF])
 _START = attrgetter("start")  # events in time order
 _TEXT = attrgetter("text")
 _ORIGIN = attrgetter("origin")
@@ -202,6 +213,13 @@ class Transmission:
             length = packet_length(decode_8n1(heard))
             return _first(heard, length) if length is not None else heard
         text = len(heard) > 1 and heard[1].char7 == STX
+        if not text:
+            # a one-line reply ends at its first LF: found in one C pass over the wire bytes
+            # (asked of every stimulus's records, some 900 a run: issue 22)
+            wires = wire_bytes(heard)
+            if wires is not None:
+                i = wires.translate(SEVEN_BITS).find(_LF_BYTE)
+                return heard if i < 0 else _first(heard, i + 1)
         for i, e in enumerate(heard):
             if text and e.char7 == ETX:
                 return _first(heard, i + 1)
