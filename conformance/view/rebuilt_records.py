@@ -73,9 +73,24 @@ def rebuild_records(
     ``carried``: whether each address's last measurement asked for a CRC, from before
     ``view`` (a window of a longer recording, :mod:`.windows`): a data reply read long after
     its measurement is judged by it. Updated in place with ``view``'s, for the next window."""
+    return records_of(
+        view.transmissions, policy, uncertainty=uncertainty, only=only, carried=carried
+    )
+
+
+def records_of(
+    transmissions: list[Transmission],
+    policy: Policy | None = None,
+    *,
+    uncertainty: float = 0.0,
+    only: str | None = None,
+    carried: dict[str, bool] | None = None,
+) -> Rebuilt:
+    """:func:`rebuild_records` of a view's ``transmissions``, all it reads of the view: a
+    live session hands the transmissions of its one cut (:mod:`.live_cut`)."""
     policy = policy or Policy()
     source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
-    exchanges = list(_exchanges(view, policy, uncertainty, only, source, carried))
+    exchanges = list(_exchanges(transmissions, policy, uncertainty, only, source, carried))
     open_: list[Measurement] = []
     measurements = _measurements(exchanges, source, policy, open_)
     return Rebuilt([x for x in exchanges if x is not None], measurements, open_)
@@ -88,19 +103,19 @@ def rebuilt_exchanges(
     held by nobody else: what reads every sensor's exchanges once (the sensors on a bus,
     their characters' decode quality) then holds one exchange at a time, not an hour's
     capture's 15 MB of them."""
-    found = _exchanges(view, policy or Policy(), uncertainty, None, {})
+    found = _exchanges(view.transmissions, policy or Policy(), uncertainty, None, {})
     return (x for x in found if x is not None)
 
 
 def _exchanges(
-    view: TranscriptView,
+    transmissions: list[Transmission],
     policy: Policy,
     uncertainty: float,
     only: str | None,
     source: dict[int, Transmission],
     crc_pending: dict[str, bool] | None = None,
 ) -> Iterator[Exchange | None]:
-    """The exchanges of ``view`` in wire order, each once its last attempt is in (of the
+    """The exchanges of ``transmissions`` in wire order, each once its last attempt is in (of the
     sensor at ``only``, with a None where other sensors' exchanges came between); fills
     ``source`` (id of each attempt -> its transmission) and ``crc_pending`` (address ->
     whether its last measurement asked for a CRC; what came before ``view`` if given)."""
@@ -108,7 +123,7 @@ def _exchanges(
         crc_pending = {}
     last: Exchange | None = None  # the last exchange, None when it is another sensor's
     begun = False
-    for t in view.transmissions:
+    for t in transmissions:
         if only is not None and t.text[:1] != only:
             if last is not None or not begun:
                 if last is not None:
@@ -296,4 +311,4 @@ def _collects(ex: Exchange | None, m: Measurement) -> bool:
     )
 
 
-__all__ = ["Rebuilt", "rebuild_records", "rebuilt_exchanges"]
+__all__ = ["Rebuilt", "rebuild_records", "rebuilt_exchanges", "records_of"]
