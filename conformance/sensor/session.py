@@ -37,7 +37,8 @@ from ..protocol.timing import CHAR_TIME, STANDBY_MARKING, TOLERANCE, WAKE_LIMIT
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import TOOL, Event, EventKind, decode_7e1, escape
-from ..view.rebuilt_records import Rebuilt, rebuild_records
+from ..view.live_cut import Mark, live_cut
+from ..view.rebuilt_records import Rebuilt, rebuild_records, records_of
 from ..view.segments import read_view
 from .address_change import AddressChanger, Trial
 from .buffer_watch import WatchedToolRecorder
@@ -436,9 +437,9 @@ class SensorSession(Session):
         return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
 
     def fresh_exchange(self, code: str, *, binary: bool | None = None, **kw: Any) -> Exchange:
-        first = len(self.link.transcript)
+        mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
         made = self.master.transact(self.command(code), binary=binary, **kw)
-        seen = self._rebuilt(first).exchanges
+        seen = self._rebuilt(mark).exchanges
         return self._as_seen(made, seen[0] if len(seen) == 1 else None)
 
     def measurement(self, code: str) -> Measurement:
@@ -469,17 +470,25 @@ class SensorSession(Session):
         return [self.fresh_exchange(f"DB{i}") for i in probes]
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
-        first = len(self.link.transcript)
+        mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
         made = self.master.measure(self.command(code), **kw)
-        seen = self._rebuilt(first).measurements
+        seen = self._rebuilt(mark).measurements
         return self._as_seen(made, seen[0] if len(seen) == 1 else None)
 
     # -- what the cases judge: the stimulus as the wire shows it -------------------------------
-    def _rebuilt(self, first: int) -> Rebuilt:
+    def _rebuilt(self, mark: Mark) -> Rebuilt:
         """The records the role-neutral view rebuilds from what the stimulus left on the wire
-        (the same view offline judging reads), with the tool recorder's own policy."""
-        events = self.link.transcript.since(first)
-        return rebuild_records(read_view(events), self.master.policy, uncertainty=self.uncertainty)
+        since ``mark`` (the same view offline judging reads), with the tool recorder's own
+        policy."""
+        transcript = self.link.transcript
+        # the transmissions of the run's one cut (live_cut), where they are what a cut of
+        # these events alone gives; else these events cut on their own
+        shared = live_cut(transcript).since(transcript.events, mark)
+        policy, uncertainty = self.master.policy, self.uncertainty
+        if shared is None:
+            view = read_view(transcript.since(mark.first))
+            return rebuild_records(view, policy, uncertainty=uncertainty)
+        return records_of(shared, policy, uncertainty=uncertainty)
 
     def _as_seen(self, made: R, seen: R | None) -> R:
         """The view's record of a stimulus, which the cases judge, so a live run's verdicts

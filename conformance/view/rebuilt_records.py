@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from operator import attrgetter, sub
 
 from ..protocol.binary import packet_length
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Command, Kind
@@ -33,6 +34,9 @@ from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import CONTENTION, IDLE, NO_REPLY, OK, Attempt, Exchange, Measurement
 from ..transcript import Event, decode_8n1, text_end
 from .segments import TranscriptView, Transmission
+
+_START = attrgetter("start")
+_END = attrgetter("end")
 
 
 @dataclass
@@ -69,9 +73,24 @@ def rebuild_records(
     ``carried``: whether each address's last measurement asked for a CRC, from before
     ``view`` (a window of a longer recording, :mod:`.windows`): a data reply read long after
     its measurement is judged by it. Updated in place with ``view``'s, for the next window."""
+    return records_of(
+        view.transmissions, policy, uncertainty=uncertainty, only=only, carried=carried
+    )
+
+
+def records_of(
+    transmissions: list[Transmission],
+    policy: Policy | None = None,
+    *,
+    uncertainty: float = 0.0,
+    only: str | None = None,
+    carried: dict[str, bool] | None = None,
+) -> Rebuilt:
+    """:func:`rebuild_records` of a view's ``transmissions``, all it reads of the view: a
+    live session hands the transmissions of its one cut (:mod:`.live_cut`)."""
     policy = policy or Policy()
     source: dict[int, Transmission] = {}  # id(attempt) -> the transmission it was
-    exchanges = list(_exchanges(view, policy, uncertainty, only, source, carried))
+    exchanges = list(_exchanges(transmissions, policy, uncertainty, only, source, carried))
     open_: list[Measurement] = []
     measurements = _measurements(exchanges, source, policy, open_)
     return Rebuilt([x for x in exchanges if x is not None], measurements, open_)
@@ -84,19 +103,19 @@ def rebuilt_exchanges(
     held by nobody else: what reads every sensor's exchanges once (the sensors on a bus,
     their characters' decode quality) then holds one exchange at a time, not an hour's
     capture's 15 MB of them."""
-    found = _exchanges(view, policy or Policy(), uncertainty, None, {})
+    found = _exchanges(view.transmissions, policy or Policy(), uncertainty, None, {})
     return (x for x in found if x is not None)
 
 
 def _exchanges(
-    view: TranscriptView,
+    transmissions: list[Transmission],
     policy: Policy,
     uncertainty: float,
     only: str | None,
     source: dict[int, Transmission],
     crc_pending: dict[str, bool] | None = None,
 ) -> Iterator[Exchange | None]:
-    """The exchanges of ``view`` in wire order, each once its last attempt is in (of the
+    """The exchanges of ``transmissions`` in wire order, each once its last attempt is in (of the
     sensor at ``only``, with a None where other sensors' exchanges came between); fills
     ``source`` (id of each attempt -> its transmission) and ``crc_pending`` (address ->
     whether its last measurement asked for a CRC; what came before ``view`` if given)."""
@@ -104,7 +123,7 @@ def _exchanges(
         crc_pending = {}
     last: Exchange | None = None  # the last exchange, None when it is another sensor's
     begun = False
-    for t in view.transmissions:
+    for t in transmissions:
         if only is not None and t.text[:1] != only:
             if last is not None or not begun:
                 if last is not None:
@@ -147,7 +166,8 @@ def _attempt(
     uncertainty: float,
 ) -> Attempt:
     stray = list(t.contention)
-    heard = [e for e in t.heard if e.start >= t.end]
+    end = t.end
+    heard = [e for e in t.heard if e.start >= end]
     reply = _framed(t, heard, policy)
     if stray:
         reason = f"{CONTENTION} ({len(stray)} characters during the command)"
@@ -179,6 +199,10 @@ def _framed(t: Transmission, heard: list[Event], policy: Policy) -> list[Event]:
     if not heard or heard[0].start - t.end > policy.first_char_timeout:
         return []
     framed = t.reply
+    if len(framed) < 2 or max(map(sub, map(_START, framed[1:]), map(_END, framed))) <= (
+        policy.reply_idle
+    ):
+        return framed  # no gap longer than the idle: nothing cut (one C pass over the gaps)
     for i in range(1, len(framed)):
         multiline_gap = framed[i - 1].char7 == 0x0A
         if not multiline_gap and framed[i].start - framed[i - 1].end > policy.reply_idle:
@@ -287,4 +311,4 @@ def _collects(ex: Exchange | None, m: Measurement) -> bool:
     )
 
 
-__all__ = ["Rebuilt", "rebuild_records", "rebuilt_exchanges"]
+__all__ = ["Rebuilt", "rebuild_records", "rebuilt_exchanges", "records_of"]

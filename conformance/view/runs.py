@@ -166,9 +166,18 @@ def transcript_view(transcript: Transcript) -> TranscriptView:
     """:func:`~.segments.read_view` of a run's whole transcript, cut once per length (a
     transcript is append-only). A passive judgement's records, the whole-run cases' segments
     and the report's evidence all read this one cut: an hour's capture cut again for each
-    took seconds (the direction inference and the segmentation over 10^5 events)."""
+    took seconds (the direction inference and the segmentation over 10^5 events). A live
+    run's transcript that a session cuts as it grows (:mod:`.live_cut`) gives that cut's
+    view, the same, without cutting every event again."""
     events = transcript.events
-    return memo(transcript, "_view", len(events), lambda: read_view(events))
+    live = transcript.__dict__.get("_live_cut")
+
+    def cut() -> TranscriptView:
+        if live is not None and live.advance(events):
+            return live.view()
+        return read_view(events)
+
+    return memo(transcript, "_view", len(events), cut)
 
 
 def transcript_segments(transcript: Transcript) -> Segments:

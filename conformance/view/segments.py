@@ -35,7 +35,17 @@ from ..protocol.timing import (
     MULTILINE_GAP_MAX,
     TOLERANCE,
 )
-from ..transcript import COLLISION, TOOL, Event, EventKind, decode_7e1, decode_8n1, escape
+from ..transcript import (
+    COLLISION,
+    SEVEN_BITS,
+    TOOL,
+    Event,
+    EventKind,
+    decode_7e1,
+    decode_8n1,
+    escape,
+    wire_bytes,
+)
 from .direction import iter_directions
 from .sides import BUS, RECORDER, SENSOR, expected_reply_address
 
@@ -52,6 +62,7 @@ _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
 #: transmission holds characters only, so its text ends in ``!`` when its last one is ``!``
 _BANG = ord("!")
 _LINE_ENDS = (0x0D, 0x0A)  # CR, LF
+_LF_BYTE = bytes([LF])
 _START = attrgetter("start")  # events in time order
 _TEXT = attrgetter("text")
 _ORIGIN = attrgetter("origin")
@@ -202,6 +213,13 @@ class Transmission:
             length = packet_length(decode_8n1(heard))
             return _first(heard, length) if length is not None else heard
         text = len(heard) > 1 and heard[1].char7 == STX
+        if not text:
+            # a one-line reply ends at its first LF: found in one C pass over the wire bytes
+            # (asked of every stimulus's records, some 900 a run: issue 22)
+            wires = wire_bytes(heard)
+            if wires is not None:
+                i = wires.translate(SEVEN_BITS).find(_LF_BYTE)
+                return heard if i < 0 else _first(heard, i + 1)
         for i, e in enumerate(heard):
             if text and e.char7 == ETX:
                 return _first(heard, i + 1)
@@ -534,51 +552,77 @@ def _cut(
 ) -> TranscriptView:
     """:func:`read_view`'s cut of ``ordered``, ``mine`` saying of each event in turn whether
     the recorder sent it."""
-    transmissions: list[Transmission] = []
-    breaks: list[Event] = []
-    chars: list[Event] = []
-    unanswerable: list[Event] = []
-    pending: Event | None = None
-    current: Transmission | None = None
-    is_command = False  # current.is_command, kept as its characters come (asked per event)
-    # the last character was its '!': its own address next is the command sent again at once
-    # (a logger reading its own echo as an invalid reply retries 0 ms after the '!', the
-    # nineteenth round), not more of it; '0M!!' and '0M!<CR><LF>' stay one
-    after_bang = False
-    last_heard: Event | None = None  # the sensors' last character so far
-    char, brk, add_char = EventKind.CHAR, EventKind.BREAK, chars.append  # asked per event
-    for e, own in zip(ordered, mine, strict=True):
-        kind = e.kind
-        if kind is char:
-            add_char(e)
-        if own:
-            if kind is brk:
-                breaks.append(e)
-                if current is not None and current.heard and current.heard[-1] is last_heard:
-                    current.cut_by = e if _cut_into(last_heard, e) is not None else None
-                pending, current = e, None
-            elif (
-                current is None
-                or (is_command and e.start - current.end >= NEW_COMMAND)
-                or (after_bang and e.wire & 0x7F == current.chars[0].wire & 0x7F)
-            ):
-                current = Transmission(pending, [e], part=part, cut=_cut_into(last_heard, e))
-                transmissions.append(current)
-                pending = None
-                is_command = after_bang = e.wire & 0x7F == _BANG
-            else:
-                current.chars.append(e)
-                # CR LF after the '!' keep it a command (Transmission.stem)
-                bits = e.wire & 0x7F
-                after_bang = bits == _BANG
-                is_command = after_bang or (is_command and bits in _LINE_ENDS)
-        elif kind is char:
-            last_heard = e
-            if current is not None:
-                current.heard.append(e)
-            else:
-                unanswerable.append(e)
-    return TranscriptView(transmissions, breaks, chars, unanswerable, undirected)
+    cut = Cut(part)
+    cut.feed(ordered, mine)
+    return TranscriptView(cut.transmissions, cut.breaks, cut.chars, cut.unanswerable, undirected)
+
+
+class Cut:
+    """:func:`read_view`'s cut, kept between batches of events: fed events in time order,
+    its lists are what one cut of all of them gives (the cut reads each event once, in
+    order, with what it holds of the ones before). A live run's transcript is cut as it
+    grows (:mod:`.live_cut`): each stimulus's records and the whole-run cases read the one
+    cut rather than each cutting the wire again (issue 22)."""
+
+    def __init__(self, part: int = 0) -> None:
+        self.part = part
+        self.transmissions: list[Transmission] = []
+        self.breaks: list[Event] = []
+        self.chars: list[Event] = []  # every character, both sides, in time order
+        self.unanswerable: list[Event] = []
+        self._pending: Event | None = None  # the recorder's break no character followed yet
+        self._current: Transmission | None = None
+        # current.is_command, kept as its characters come (asked per event)
+        self._is_command = False
+        # the last character was its '!': its own address next is the command sent again at
+        # once (a logger reading its own echo as an invalid reply retries 0 ms after the '!',
+        # the nineteenth round), not more of it; '0M!!' and '0M!<CR><LF>' stay one
+        self._after_bang = False
+        self._last_heard: Event | None = None  # the sensors' last character so far
+
+    def feed(self, ordered: Iterable[Event], mine: Iterable[bool]) -> None:
+        """Cut ``ordered`` (the events after those fed before, in time order), ``mine``
+        saying of each in turn whether the recorder sent it. The state lives in locals while
+        the loop runs (asked per event) and is kept at its end."""
+        transmissions, breaks, unanswerable, part = (
+            self.transmissions, self.breaks, self.unanswerable, self.part,
+        )  # fmt: skip
+        pending, current = self._pending, self._current
+        is_command, after_bang, last_heard = self._is_command, self._after_bang, self._last_heard
+        char, brk, add_char = EventKind.CHAR, EventKind.BREAK, self.chars.append
+        for e, own in zip(ordered, mine, strict=True):
+            kind = e.kind
+            if kind is char:
+                add_char(e)
+            if own:
+                if kind is brk:
+                    breaks.append(e)
+                    if current is not None and current.heard and current.heard[-1] is last_heard:
+                        current.cut_by = e if _cut_into(last_heard, e) is not None else None
+                    pending, current = e, None
+                elif (
+                    current is None
+                    or (is_command and e.start - current.end >= NEW_COMMAND)
+                    or (after_bang and e.wire & 0x7F == current.chars[0].wire & 0x7F)
+                ):
+                    current = Transmission(pending, [e], part=part, cut=_cut_into(last_heard, e))
+                    transmissions.append(current)
+                    pending = None
+                    is_command = after_bang = e.wire & 0x7F == _BANG
+                else:
+                    current.chars.append(e)
+                    # CR LF after the '!' keep it a command (Transmission.stem)
+                    bits = e.wire & 0x7F
+                    after_bang = bits == _BANG
+                    is_command = after_bang or (is_command and bits in _LINE_ENDS)
+            elif kind is char:
+                last_heard = e
+                if current is not None:
+                    current.heard.append(e)
+                else:
+                    unanswerable.append(e)
+        self._pending, self._current = pending, current
+        self._is_command, self._after_bang, self._last_heard = is_command, after_bang, last_heard
 
 
 def _cut_into(last: Event | None, first: Event) -> Event | None:
