@@ -13,15 +13,18 @@ events in the same windows). Then, over the streamed windows, each window's view
 let go (``tests/support/windowed_judges.py``): the sensors on the bus (``SensorsOn``: the
 same addresses and identifications), each sensor's decode-quality note (``Quality``: the
 same counts, min, median and max), each sensor's reply timing and framing
-(``ResponseStarts``, ``ReplyGaps``, ``ReplyBitRate``, ``Framing``) and the recorder's wire
-rules (``Breaks``, ``BreakRules``, ``CommandText``, ``CharacterGaps``, ``CommandBitRate``):
-every finding, detail and evidence must be the whole
-view's. Prints the windows, the largest, and the CPU of the whole cut, of the streamed one
-and of the recorder's wire rules judged both ways; exits 1 on any difference. The same
+(``ResponseStarts``, ``ReplyGaps``, ``ReplyBitRate``, ``Framing``), the recorder's wire
+rules (``Breaks``, ``BreakRules``, ``CommandText``, ``CharacterGaps``, ``CommandBitRate``)
+and its measurement, retry and address rules (``ObservedMeasurements``, ``Retries``,
+``Addresses``): every finding, detail and evidence must be the whole view's. Prints the
+windows, the largest, and the CPU of the whole cut, of the streamed one and of the
+recorder's rules judged both ways; exits 1 on any difference. The same
 checks as ``tests/view/test_windows.py``, ``tests/offline/test_sensors_on_windowed.py``,
 ``tests/offline/test_decode_quality_windowed.py``,
 ``tests/judges/test_windowed_sensor_timing.py``, ``tests/judges/test_windowed_framing.py`` and
-``tests/judges/recorder/test_windowed_wire.py`` (the fields compared are
+``tests/judges/recorder/test_windowed_wire.py``,
+``test_windowed_observed_measurements.py``, ``test_windowed_retries.py`` and
+``test_windowed_addresses.py`` (the fields compared are
 ``tests/support/records_alike.py``'s), on a recording too long for a test.
 """
 
@@ -49,6 +52,8 @@ from tests.support.records_alike import records_fields, view_differences  # noqa
 from tests.support.windowed_judges import (  # noqa: E402
     qualities,
     qualities_windowed,
+    recorder_measurements,
+    recorder_measurements_windowed,
     recorder_wire,
     recorder_wire_windowed,
     sensor_timing,
@@ -85,6 +90,14 @@ def check(path: str) -> bool:
     windowed_cpu = time.process_time() - cpu
     if found != expected:
         wrong.append("recorder wire findings")
+    cpu = time.process_time()
+    expected = recorder_measurements(whole, u)
+    measure_cpu = time.process_time() - cpu
+    cpu = time.process_time()
+    found = recorder_measurements_windowed(stream_windows(iter(events), uncertainty=u), u)
+    measure_windowed_cpu = time.process_time() - cpu
+    if found != expected:
+        wrong.append("recorder measurement, retry and address findings")
     if sensors_streamed(events, u) != sensors_on(rebuild_records(whole, uncertainty=u).exchanges):
         wrong.append("sensors on the bus")
     if sensor_timing_windowed(stream_windows(iter(events), uncertainty=u), u) != sensor_timing(
@@ -98,12 +111,15 @@ def check(path: str) -> bool:
         f"{path}: {len(events)} events, {len(whole.transmissions)} transmissions, "
         f"{len(windows)} windows (largest {max(map(len, windows), default=0)} events); "
         f"whole cut {whole_cpu:.2f} s CPU, streamed {stream_cpu:.2f} s; recorder wire rules "
-        f"judged whole {judge_cpu:.2f} s, streamed and windowed {windowed_cpu:.2f} s; "
+        f"judged whole {judge_cpu:.2f} s, streamed and windowed {windowed_cpu:.2f} s; its "
+        f"measurement, retry and address rules whole {measure_cpu:.2f} s, streamed and "
+        f"windowed {measure_windowed_cpu:.2f} s; "
         + (
             "differs: " + ", ".join(wrong)
             if wrong
             else "views, records, streamed windows, sensors, decode-quality notes, sensors' "
-            "reply timing and framing and recorder wire findings equal"
+            "reply timing and framing, recorder wire, measurement, retry and address findings "
+            "equal"
         )
     )
     return not wrong

@@ -3,7 +3,8 @@
 A windowed judge reads an hour's capture a window at a time and lets each window's events and
 view go once it is read. A cut is only safe where the bus is idle in the sense the records
 need: the window's first transmission begins with a break (a new sequence: the recorder woke
-the line), no sensor frame was still going when it began, it is no retry of the transmission
+the line), no sensor frame was still going when it began (nor when its break began: a break
+over a reply is known only beside that reply), it is no retry of the transmission
 before it (same text: :func:`~.rebuilt_records.rebuild_records` makes both one exchange), and
 it falls inside no exchange (its retries) and no measurement, from the measurement command to
 its last data command. A measurement's records depend on nothing after its last data
@@ -72,8 +73,16 @@ def _span(
 
 
 def _opens(before: Transmission, t: Transmission) -> bool:
-    """``t`` begins a new sequence that nothing of ``before`` runs into."""
-    return t.break_event is not None and t.cut is None and t.text != before.text
+    """``t`` begins a new sequence that nothing of ``before`` runs into: nor does ``t``'s
+    break cut into ``before``'s reply (:attr:`Transmission.cut_by`): a window that began
+    there would leave ``before``'s view without the break, its reply read as the sensor's
+    invalid one instead of one the recorder cut (``judges.recorder.replies.cut_off``)."""
+    return (
+        t.break_event is not None
+        and t.cut is None
+        and before.cut_by is None
+        and t.text != before.text
+    )
 
 
 def window_events(

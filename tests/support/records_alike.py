@@ -51,7 +51,7 @@ def records_fields(rebuilt: list[Rebuilt]) -> tuple[list[Any], list[Any]]:
 
 
 def _transmission_fields(t: Transmission) -> tuple[Any, ...]:
-    return (t.break_event, t.chars, t.heard, t.cut, t.text)
+    return (t.break_event, t.chars, t.heard, t.cut, t.cut_by, t.text)
 
 
 def view_differences(whole: TranscriptView, parts: list[TranscriptView]) -> list[str]:

@@ -1,4 +1,5 @@
-"""The recorder's wire rules (``testcases/passive/test_recorder_7_wire.py``'s judges), each
+"""The recorder's wire rules (``testcases/passive/test_recorder_7_wire.py``'s judges) and
+measurement, retry and address rules (``test_recorder_4_4_measurement.py``'s), each
 sensor's reply timing and framing (``test_sensor_7_wire.py``'s response start, character
 gaps, bit rate and framing) and
 each sensor's decode-quality note over a whole recording and over its windows, each window's
@@ -17,6 +18,8 @@ from conformance.judges.recorder.breaks import (
     judge_break_rules,
     judge_breaks,
 )
+from conformance.judges.recorder.capabilities import Addresses, judge_addresses
+from conformance.judges.recorder.collection import judge_data_collection, judge_high_volume
 from conformance.judges.recorder.commands import (
     CharacterGaps,
     CommandBitRate,
@@ -25,6 +28,13 @@ from conformance.judges.recorder.commands import (
     judge_command_bit_rate,
     judge_command_text,
 )
+from conformance.judges.recorder.measurements import (
+    ObservedMeasurement,
+    ObservedMeasurements,
+    observed_measurements,
+)
+from conformance.judges.recorder.retries import Retries, judge_retries
+from conformance.judges.recorder.waits import judge_concurrent_waits, judge_measure_waits
 from conformance.judges.wire import (
     Framing,
     ReplyBitRate,
@@ -75,6 +85,45 @@ def recorder_wire_windowed(windows: Iterable[list[Event]], uncertainty: float) -
         *text.findings(),
         *gaps.findings(),
         rate.finding(),
+    ]
+
+
+def recorder_measurements(view: TranscriptView, uncertainty: float) -> list[Finding]:
+    """The whole view's findings of ``testcases/passive/test_recorder_4_4_measurement.py``'s
+    judges: the measurements' waits, concurrent waits, data collection and high-volume
+    data (over :func:`observed_measurements`), the retries and the addresses polled."""
+    taken = observed_measurements(view, uncertainty)
+    return [
+        *_over_measurements(taken, uncertainty),
+        *judge_retries(view, uncertainty),
+        *judge_addresses(view, uncertainty),
+    ]
+
+
+def recorder_measurements_windowed(
+    windows: Iterable[list[Event]], uncertainty: float
+) -> list[Finding]:
+    """The same findings from ``windows`` (in order), each window's view read alone and
+    let go: :class:`ObservedMeasurements`, :class:`Retries` and :class:`Addresses`."""
+    taken = ObservedMeasurements(uncertainty)
+    retries, addresses = Retries(uncertainty), Addresses(uncertainty)
+    for window in windows:
+        view = read_view(window)
+        for judge in (taken, retries, addresses):
+            judge.add(view)
+    return [
+        *_over_measurements(taken.measurements(), uncertainty),
+        *retries.findings(),
+        *addresses.findings(),
+    ]
+
+
+def _over_measurements(taken: list[ObservedMeasurement], uncertainty: float) -> list[Finding]:
+    return [
+        *judge_measure_waits(taken, uncertainty),
+        *judge_concurrent_waits(taken, uncertainty),
+        *judge_data_collection(taken),
+        *judge_high_volume(taken, True),
     ]
 
 

@@ -7,7 +7,8 @@ The cases a wrong cut or merge gets wrong: a concurrent measurement pending acro
 idle gap and another sensor's exchange (R-4.4.7-05: a cut at the gap loses its data), an
 aM! whose data another sensor's exchange ends (R-4.4.5-06), a data reply read again long
 after its aMC! (R-4.4.12-01's CRC: the expectation is carried across the cut), retries
-(R-7.2-01: a retry is no window's start), and a whole bus's identify and concurrent round."""
+(R-7.2-01: a retry is no window's start), a break that cut into a reply (R-7.2-06: no
+window's start either), and a whole bus's identify and concurrent round."""
 
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ from dataclasses import replace
 
 import pytest
 
-from conformance.transcript import EventKind
+from conformance.protocol.timing import CHAR_TIME
+from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
 from conformance.view.rebuilt_records import rebuild_records
 from conformance.view.segments import read_view
 from conformance.view.windows import (
@@ -157,6 +159,34 @@ def test_a_retry_never_starts_a_window():
     for i in starts[1:]:
         assert view.transmissions[i].text != view.transmissions[i - 1].text
     _check(events, min_windows=1)
+
+
+def _sent(events: list[Event], t: float, text: str) -> float:
+    """``text``'s characters from ``t`` on, back to back; gives where they end."""
+    for c in text:
+        events.append(Event(EventKind.CHAR, BUS, t, t + CHAR_TIME, wire=to_wire_7e1(ord(c))))
+        t += CHAR_TIME
+    return t
+
+
+def _woken(events: list[Event], t: float, command: str) -> float:
+    """A break, the marking after it and ``command``; gives where the command ends."""
+    events.append(Event(EventKind.BREAK, BUS, t, t + 0.0125))
+    return _sent(events, t + 0.0125 + 0.009, command) + 0.009
+
+
+def test_a_break_that_cut_into_a_reply_starts_no_window():
+    """The recorder breaks into ``0I!``'s reply 1 ms after its seventh character (a poll
+    timeout shorter than the reply) and asks ``1I!``: the break is known to have cut the
+    reply only beside it (``cut_by``); a window starting there read the reply alone as the
+    sensor's invalid one (R-7.2-05 due), where the whole says the recorder cut it."""
+    events: list[Event] = []
+    t = _sent(events, _woken(events, 0.05, "0I!"), "014CONF") + 0.001
+    t = _sent(events, _woken(events, t, "1I!"), "114CONFORM EMU001100\r\n") + 0.2
+    t = _sent(events, _woken(events, t, "3I!"), "314CONFORM EMU001100\r\n")
+    whole = read_view(events)
+    assert whole.transmissions[0].cut_by is events[11]  # the break before 1I!
+    assert _check(events) == [0, 2]
 
 
 @pytest.mark.parametrize("code", ["C", "CC", "M", "MC"])

@@ -14,9 +14,9 @@ from ...view.segments import TranscriptView
 from ..reply_validity import STX
 from ..tally import Tally
 from ..timing import judge_window
-from .common import CUT_SHORT, combine, record_of
+from .common import CUT_SHORT, Record, combine, record_of
 from .measurements import collection_end, observed_measurements
-from .replies import cut_off, first_answered
+from .replies import crc_context, cut_off, first_answered, reply_problem
 
 
 def judge_commands_issued(
@@ -89,54 +89,100 @@ def judge_commands_issued(
 def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-4.3-03: the recorder polls every address 0-9 (an address it polled that never drew a
     valid reply from the played sensors is undecided, as in :func:`judge_commands_issued`).
-    R-4.3-04 (MAY): letters as addresses."""
-    polled = {s.address for s in first_answered(line, uncertainty).values()}
-    digits = [a for a in "0123456789" if a not in polled]
-    tried = {s.address for s in line.transmissions}
-    unsent = [a for a in digits if a not in tried]
-    cut_job = bool(line.cut_parts)
-    r3 = (
-        Finding(
+    R-4.3-04 (MAY): letters as addresses. (One :meth:`Addresses.add` of the whole view: the
+    windowed judge's code path.)"""
+    judge = Addresses(uncertainty)
+    judge.add(line)
+    return judge.findings()
+
+
+#: The polls R-4.3-03's evidence cites, by the address never validly answered.
+_POLLS = [f"{a}!" for a in "0123456789"]
+#: Commands to what is no address that R-4.3-04's evidence quotes (the first ones).
+_FOREIGN_CITED = 8
+
+
+class Addresses:
+    """:func:`judge_addresses` of a recording given a window's view at a time (issue 22's
+    windowed judge). Carried: the addresses that drew a valid reply (each transmission's
+    reply judged with its address's CRC expectation carried, :func:`~.replies.crc_context`)
+    and those sent to, whether the tool cut a job (``cut_parts``), the evidence of the polls
+    (:class:`~.common.Record`), and of the commands to what is no address their count and
+    first few: sets and counts, no transmission."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self._crc: dict[str, bool] = {}
+        self._polled: set[str] = set()
+        self._tried: set[str] = set()
+        self._cut_job = False
+        self._record = Record(_POLLS)
+        self._foreign: set[str] = set()
+        self._foreign_at: list[str] = []
+        self._foreign_count = 0
+
+    def add(self, line: TranscriptView) -> None:
+        """Take the next window's view."""
+        crc = crc_context(line, self._crc)
+        for i, s in enumerate(line.transmissions):
+            self._tried.add(s.address)
+            if s.address not in self._polled and reply_problem(s, crc[i], self.uncertainty) is None:
+                self._polled.add(s.address)
+            if s.is_command and s.address not in ADDRESS_CHARS and s.address != "?":
+                self._foreign.add(s.address)
+                self._foreign_count += 1
+                if len(self._foreign_at) < _FOREIGN_CITED:
+                    self._foreign_at.append(s.at())
+        self._cut_job = self._cut_job or bool(line.cut_parts)
+        self._record.add(line.transmissions)
+
+    def findings(self) -> list[Finding]:
+        """R-4.3-03's and R-4.3-04's findings of the recording so far."""
+        return [self._polls(), self._letters()]
+
+    def _polls(self) -> Finding:
+        digits = [a for a in "0123456789" if a not in self._polled]
+        if not digits:
+            return Finding(
+                "R-4.3-03",
+                Verdict.PASS,
+                "sensors at 0-9 each polled and answered",
+                observed=len(self._polled),
+            )
+        unsent = [a for a in digits if a not in self._tried]
+        return Finding(
             "R-4.3-03",
-            Verdict.FAIL if unsent and not cut_job else Verdict.INCONCLUSIVE,
+            Verdict.FAIL if unsent and not self._cut_job else Verdict.INCONCLUSIVE,
             "addresses never polled successfully: "
             + ", ".join(digits)
             + ("" if unsent else " (each was polled, never validly answered)")
-            + (f" ({CUT_SHORT})" if unsent and cut_job else ""),
-            evidence=record_of(line.transmissions, [f"{a}!" for a in digits]),
-            observed=len(line.transmissions),
+            + (f" ({CUT_SHORT})" if unsent and self._cut_job else ""),
+            evidence=self._record.evidence([f"{a}!" for a in digits]),
+            observed=self._record.count,
         )
-        if digits
-        else Finding(
-            "R-4.3-03",
-            Verdict.PASS,
-            "sensors at 0-9 each polled and answered",
-            observed=len(polled),
+
+    def _letters(self) -> Finding:
+        letters = sorted(a for a in self._polled if a.isalpha())
+        if self._foreign:  # a MAY rule: the Finding caps this at WARN
+            shown = ", ".join(f"'{escape(a)}'" for a in sorted(self._foreign))
+            return Finding(
+                "R-4.3-04",
+                Verdict.FAIL,
+                f"addressed {shown}, not an address",
+                decision="A17",
+                evidence=list(self._foreign_at),
+                observed=self._foreign_count,
+            )
+        if letters:
+            return Finding(
+                "R-4.3-04",
+                Verdict.PASS,
+                f"letter addresses used: {' '.join(letters)}",
+                observed=len(letters),
+            )
+        return Finding(
+            "R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)"
         )
-    )
-    letters = sorted(a for a in polled if a.isalpha())
-    commands = [s for s in line.transmissions if s.is_command]  # R-4.4-04 judges the rest
-    foreign = sorted({s.address for s in commands if s.address not in ADDRESS_CHARS} - {"?"})
-    if foreign:  # a MAY rule: the Finding caps this at WARN
-        shown = ", ".join(f"'{escape(a)}'" for a in foreign)
-        r4 = Finding(
-            "R-4.3-04",
-            Verdict.FAIL,
-            f"addressed {shown}, not an address",
-            decision="A17",
-            evidence=[s.at() for s in commands if s.address in foreign][:8],
-            observed=sum(1 for s in commands if s.address in foreign),
-        )
-    elif letters:
-        r4 = Finding(
-            "R-4.3-04",
-            Verdict.PASS,
-            f"letter addresses used: {' '.join(letters)}",
-            observed=len(letters),
-        )
-    else:
-        r4 = Finding("R-4.3-04", Verdict.NA, "the recorder did not use letter addresses (optional)")
-    return [r3, r4]
 
 
 def judge_transparent(

@@ -42,21 +42,57 @@ SR_KINDS = SERVICE_REQUEST_KINDS
 def record_of(transmissions: list[Transmission], texts: list[str] | None = None) -> list[str]:
     """Evidence for a finding about what the recorder did not do (issue 18): the transmissions
     of ``texts`` it made (each with its time), or, if it made none of them, the span of what
-    it did transmit, which is the observation the absence rests on."""
-    wanted = set(texts or [])
-    cited = [t.at() for t in transmissions if t.text in wanted]
-    if cited:
-        return cited[:8]
-    if not transmissions:
-        return ["the recorder transmitted nothing"]
-    first, last = transmissions[0], transmissions[-1]
-    sent = sorted({escape(t.text) for t in transmissions})
-    return [
-        f"{len(transmissions)} transmissions from t={first.first_char:.3f} s to "
-        f"t={last.first_char:.3f} s, of {len(sent)} kinds: "
-        + " ".join(sent[:20])
-        + (" ..." if len(sent) > 20 else "")
-    ]
+    it did transmit, which is the observation the absence rests on (one
+    :meth:`Record.add`: the windowed judges' code path)."""
+    record = Record(texts or [])
+    record.add(transmissions)
+    return record.evidence(texts or [])
+
+
+class Record:
+    """:func:`record_of` of a recording given a window's transmissions at a time (issue 22's
+    windowed judge), for any of the ``candidates`` texts, the finding choosing which at the
+    end (R-4.3-03 cites the polls of the addresses no valid reply answered, known only
+    then): carried, each candidate's first :data:`CITED` transmissions (with their place in
+    the recording), the count of transmissions, the first and the last one's time and the
+    distinct texts sent, not the transmissions."""
+
+    CITED = 8
+
+    def __init__(self, candidates: Sequence[str]) -> None:
+        self._cited: dict[str, list[tuple[int, str]]] = {t: [] for t in candidates}
+        self.count = 0  # transmissions so far
+        self._first: float | None = None
+        self._last: float | None = None
+        self._sent: set[str] = set()
+
+    def add(self, transmissions: Sequence[Transmission]) -> None:
+        """Take the next window's transmissions."""
+        for i, t in enumerate(transmissions, self.count):
+            cited = self._cited.get(t.text)
+            if cited is not None and len(cited) < self.CITED:
+                cited.append((i, t.at()))
+            self._sent.add(t.text)
+        if transmissions:
+            if self._first is None:
+                self._first = transmissions[0].first_char
+            self._last = transmissions[-1].first_char
+        self.count += len(transmissions)
+
+    def evidence(self, texts: Sequence[str]) -> list[str]:
+        """The evidence for ``texts`` (candidates given at the start)."""
+        cited = sorted(c for t in set(texts) for c in self._cited[t])
+        if cited:
+            return [at for _, at in cited[: self.CITED]]
+        if not self.count:
+            return ["the recorder transmitted nothing"]
+        sent = sorted({escape(t) for t in self._sent})
+        return [
+            f"{self.count} transmissions from t={self._first:.3f} s to "
+            f"t={self._last:.3f} s, of {len(sent)} kinds: "
+            + " ".join(sent[:20])
+            + (" ..." if len(sent) > 20 else "")
+        ]
 
 
 def own_uncertainty(uncertainty: float, *events: Event) -> float:

@@ -3,7 +3,7 @@ valid ``atttn``-type reply, the service request, and the data transmissions that
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...protocol.binary import DataType, parse_binary_packet
 from ...protocol.commands import Command, Kind
@@ -76,62 +76,140 @@ def service_request_end(events: list[Event], address: str) -> float | None:
 
 
 def observed_measurements(line: TranscriptView, uncertainty: float) -> list[ObservedMeasurement]:
-    """Every measurement the recorder started with a valid ``atttn``-type reply."""
-    crc = crc_context(line)
-    problems = [reply_problem(s, crc[i], uncertainty) for i, s in enumerate(line.transmissions)]
-    taken: list[ObservedMeasurement] = []
-    for i, s in enumerate(line.transmissions):
+    """Every measurement the recorder started with a valid ``atttn``-type reply (one
+    :meth:`ObservedMeasurements.add` of the whole view: the windowed judge's code path)."""
+    taken = ObservedMeasurements(uncertainty)
+    taken.add(line)
+    return taken.measurements()
+
+
+@dataclass
+class _Following:
+    """A measurement whose transmissions are still being followed: its data, the
+    transmissions to other sensors since it began and the next measurement command to its
+    sensor so far, until a transmission of another part or a non-data one to its sensor
+    ends it (or the recording does)."""
+
+    index: int
+    start: Transmission
+    command: Command
+    ttt: int
+    count: int
+    service_request_end: float | None
+    data: list[tuple[Transmission, ReplyProblem | None]] = field(default_factory=list)
+    others: list[Transmission] = field(default_factory=list)
+    next_start: Transmission | None = None
+
+    def follow(self, t: Transmission, problem: ReplyProblem | None) -> bool | None:
+        """Take ``t``, the next transmission on the line: None while the measurement goes
+        on, else whether the recorder turned to something else at its address (True) or the
+        part ended (False)."""
+        if t.part != self.start.part:
+            return False
+        if t.address != self.command.address:
+            self.others.append(t)
+            return None
+        if t.data_index is not None:
+            self.data.append((t, problem))
+            return None
+        tc = t.command
+        if tc is not None and tc.kind in KEEPS_DATA and t.start >= self.finished():
+            return None  # the data stay the sensor's to give (4.4.5, 4.4.7)
+        if tc is not None and tc.starts_measurement:
+            self.next_start = t
+        return True
+
+    def finished(self) -> float:
+        """When the measurement was over: its service request, else ttt after its reply
+        (the sensor's own promise of when its data are ready)."""
+        ready = self.start.reply[-1].end + self.ttt
+        sr = self.service_request_end
+        return ready if sr is None else min(sr, ready)
+
+    def taken(self, cut_at: float | None) -> ObservedMeasurement:
+        """What was followed, as the judges read it (``cut_at``: see
+        :attr:`ObservedMeasurement.cut_at`)."""
+        others = self.others
+        if self.data:
+            last = self.data[-1][0]
+            others = [o for o in others if o.start < last.end]
+        s = self.start
+        return ObservedMeasurement(
+            self.index, s, self.command, self.ttt, self.count, s.reply[-1].end,
+            self.service_request_end, self.data, self.next_start, others, cut_at,
+        )  # fmt: skip
+
+
+class ObservedMeasurements:
+    """:func:`observed_measurements` of a recording given a window at a time (issue 22's
+    windowed judge): :meth:`add` each window's view in order, then :meth:`measurements`.
+    A measurement looks past its window (its sensor's next command may come windows later,
+    and the transmissions to other sensors until then are its ``others``), so each one is
+    followed over the windows after it until something ends it; carried besides: each
+    address's CRC expectation (:func:`~.replies.crc_context`), the transmissions of the
+    windows before (each measurement's ``index`` is its place in the whole recording) and
+    the parts the tool cut or ended (:attr:`TranscriptView.cut_parts`, ``ended_parts``:
+    from a run's notes, which a window of a capture has none of)."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self._crc: dict[str, bool] = {}
+        self._before = 0  # transmissions in the windows before
+        self._cut_parts: dict[int, float] = {}
+        self._ended_parts: dict[int, float] = {}
+        self._taken: list[ObservedMeasurement | _Following] = []  # in the order begun
+        self._following: list[int] = []  # where in _taken those still followed are
+
+    def add(self, line: TranscriptView) -> None:
+        """Take the next window's view."""
+        self._cut_parts.update(line.cut_parts)
+        self._ended_parts.update(line.ended_parts)
+        crc = crc_context(line, self._crc)
+        for i, s in enumerate(line.transmissions):
+            problem = reply_problem(s, crc[i], self.uncertainty)
+            still: list[int] = []
+            for k in self._following:
+                m = self._taken[k]
+                assert isinstance(m, _Following)
+                left = m.follow(s, problem)
+                if left is None:
+                    still.append(k)
+                else:
+                    self._taken[k] = m.taken(None if left else self._cut_parts.get(m.start.part))
+            self._following = still
+            begun = self._begun(s, problem, self._before + i)
+            if begun is not None:
+                self._following.append(len(self._taken))
+                self._taken.append(begun)
+        self._before += len(line.transmissions)
+
+    def _begun(
+        self, s: Transmission, problem: ReplyProblem | None, index: int
+    ) -> _Following | None:
+        """The measurement ``s`` started (None: it started none the recorder heard)."""
         cmd = s.command
-        if cmd is None or not cmd.starts_measurement or problems[i] is not None:
-            continue
-        if _after_the_job(line, s):
-            continue  # the recorder had ended its job: it never heard this reply
+        if cmd is None or not cmd.starts_measurement or problem is not None:
+            return None
+        end = self._ended_parts.get(s.part)
+        if end is not None and s.reply and s.reply[0].start >= end:
+            # the recorder had ended its job (ended_parts): it never heard this reply, so it
+            # owed none of its values (the retry rules judge a command given up on;
+            # R-4.4.8-05 would blame a collection never begun)
+            return None
         body, _ = split_line(decode_7e1(s.reply))
         parsed = parse_measurement_reply_for(body, cmd)
         if parsed.ttt is None or parsed.count is None:
-            continue
-        ttt, count = parsed.ttt, parsed.count
+            return None
         sr = service_request_end(s.after, cmd.address)
-        data: list[tuple[Transmission, ReplyProblem | None]] = []
-        others: list[Transmission] = []
-        nxt: Transmission | None = None
-        left = False  # the recorder turned to something else at this address
-        for j in range(i + 1, len(line.transmissions)):
-            t = line.transmissions[j]
-            if t.part != s.part:
-                break
-            if t.address != cmd.address:
-                others.append(t)
-                continue
-            tc = t.command
-            if t.data_index is not None:
-                data.append((t, problems[j]))
-                continue
-            if tc is not None and tc.kind in KEEPS_DATA and t.start >= _finished(s, ttt, sr):
-                continue  # the data stay the sensor's to give (4.4.5, 4.4.7)
-            if tc is not None and tc.starts_measurement:
-                nxt = t
-            left = True
-            break
-        if data:
-            last = data[-1][0]
-            others = [o for o in others if o.start < last.end]
-        taken.append(
-            ObservedMeasurement(
-                i,
-                s,
-                cmd,
-                ttt,
-                count,
-                s.reply[-1].end,
-                sr,
-                data,
-                nxt,
-                others,
-                None if left else line.cut_parts.get(s.part),
-            )
-        )
-    return taken
+        return _Following(index, s, cmd, parsed.ttt, parsed.count, sr)
+
+    def measurements(self) -> list[ObservedMeasurement]:
+        """Every measurement of the recording so far, in the order begun: those still
+        followed end with it (cut where the tool cut their part)."""
+        return [
+            m if isinstance(m, ObservedMeasurement) else m.taken(self._cut_parts.get(m.start.part))
+            for m in self._taken
+        ]
 
 
 #: Commands that neither return data via D0 nor change the address: after a measurement has
@@ -141,21 +219,6 @@ def observed_measurements(line: TranscriptView, uncertainty: float) -> list[Obse
 #: first time it meets an address, docs/kit.md) is still in the measurement. Before it has
 #: finished, a valid command to the sensor aborts a concurrent one (4.4.7.1).
 KEEPS_DATA = frozenset({Kind.ACKNOWLEDGE, Kind.IDENTIFY, Kind.IDENTIFY_MEASUREMENT, Kind.METADATA})
-
-
-def _finished(s: Transmission, ttt: int, sr: float | None) -> float:
-    """When the measurement ``s`` started was over: its service request, else ttt after its
-    reply (the sensor's own promise of when its data are ready)."""
-    ready = s.reply[-1].end + ttt
-    return ready if sr is None else min(sr, ready)
-
-
-def _after_the_job(line: TranscriptView, s: Transmission) -> bool:
-    """Whether ``s``'s reply began after the recorder ended its job (``ended_parts``): a
-    measurement it never heard announced, so it owed none of its values (the retry rules
-    judge a command given up on; R-4.4.8-05 would blame a collection never begun)."""
-    end = line.ended_parts.get(s.part)
-    return end is not None and bool(s.reply) and s.reply[0].start >= end
 
 
 def collection_end(m: ObservedMeasurement) -> tuple[Transmission | None, ReplyProblem | None, bool]:

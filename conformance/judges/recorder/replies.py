@@ -51,9 +51,15 @@ def cut_off(sent: Transmission) -> ReplyProblem | None:
     )
 
 
-def crc_context(line: TranscriptView) -> dict[int, bool | None]:
-    """For each transmission index: whether its reply carries a CRC (D after MC, CC, HA...)."""
-    pending: dict[str, bool] = {}
+def crc_context(
+    line: TranscriptView, pending: dict[str, bool] | None = None
+) -> dict[int, bool | None]:
+    """For each transmission index: whether its reply carries a CRC (D after MC, CC, HA...).
+    ``pending``: whether each address's last measurement asked for one, as the windows
+    before ``line`` left it (a data reply read long after its measurement is judged by it);
+    updated in place, so a windowed judge carries it to the next window (None: none
+    before)."""
+    pending = {} if pending is None else pending
     result: dict[int, bool | None] = {}
     for i, s in enumerate(line.transmissions):
         cmd = s.command

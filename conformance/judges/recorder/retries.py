@@ -11,6 +11,7 @@ after a long poll timeout, must not pass "implements retries")."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ...protocol.timing import (
@@ -106,28 +107,68 @@ class RetryGroup:
 
 
 def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
-    crc = crc_context(line)
-    out: list[RetryGroup] = []
-    for i, s in enumerate(line.transmissions):
-        if not s.is_command:  # CR LF after the '!' aside (Transmission.stem)
-            continue  # no command, so no reply to retry for; R-4.4-04 judges its text
-        problem = reply_problem(s, crc[i], uncertainty)
-        if problem is not None and problem.reason is Reason.CUT:
-            problem = None  # the recorder's own break cut it: no reply of the sensor's to retry
-        attempt = Try(s, problem)
-        last = out[-1].attempts[-1] if out else None
-        if (
-            last is not None
-            and last.sent.part == s.part
-            and last.sent.stem == s.stem
-            and (last.problem is not None)
-        ):
-            before = line.previous_activity(s)
-            attempt.quiet = s.first_char - (last.sent.end if before is None else before)
-            out[-1].attempts.append(attempt)
-        else:
-            out.append(RetryGroup(s.stem, [attempt]))
-    return out
+    """Every command's tries, in order (one :meth:`RetryGroups.add` of the whole view)."""
+    groups = RetryGroups(uncertainty)
+    found = [group for group, _ in groups.add(line)]
+    return found + [group for group, _ in groups.close()]
+
+
+#: The view a try of a group was read from (:class:`RetryGroups`).
+LineOf = Callable[[Try], TranscriptView]
+
+
+class RetryGroups:
+    """:func:`retry_groups` of a recording given a window's view at a time (issue 22's
+    windowed judge): :meth:`add` gives each group once the command after it shows it done,
+    with the view each of its tries came from (a group may span windows: the same command
+    again after a break, its reply invalid; each of its sequences lies in one window, every
+    window beginning with a break); :meth:`close` the last. Carried: each address's CRC
+    expectation (:func:`~.replies.crc_context`) and the group still open."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self._crc: dict[str, bool] = {}
+        self._open: RetryGroup | None = None
+        self._views: list[TranscriptView] = []  # the open group's, one per try
+
+    def add(self, line: TranscriptView) -> Iterator[tuple[RetryGroup, LineOf]]:
+        """Take the next window's view; the groups it shows done."""
+        crc = crc_context(line, self._crc)
+        for i, s in enumerate(line.transmissions):
+            if not s.is_command:  # CR LF after the '!' aside (Transmission.stem)
+                continue  # no command, so no reply to retry for; R-4.4-04 judges its text
+            problem = reply_problem(s, crc[i], self.uncertainty)
+            if problem is not None and problem.reason is Reason.CUT:
+                problem = None  # the recorder's own break cut it: no sensor reply to retry for
+            attempt = Try(s, problem)
+            group = self._open
+            last = group.attempts[-1] if group is not None else None
+            if (
+                group is not None
+                and last is not None
+                and last.sent.part == s.part
+                and last.sent.stem == s.stem
+                and (last.problem is not None)
+            ):
+                before = line.previous_activity(s)
+                attempt.quiet = s.first_char - (last.sent.end if before is None else before)
+                group.attempts.append(attempt)
+            else:
+                yield from self.close()
+                self._open = RetryGroup(s.stem, [attempt])
+            self._views.append(line)
+
+    def close(self) -> Iterator[tuple[RetryGroup, LineOf]]:
+        """The group still open, done (the recording, or the command after it, ended it)."""
+        if self._open is None:
+            return
+        group, views = self._open, self._views
+        self._open, self._views = None, []
+
+        def line_of(a: Try) -> TranscriptView:
+            return views[next(k for k, b in enumerate(group.attempts) if b is a)]
+
+        yield group, line_of
 
 
 def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
@@ -138,32 +179,64 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
     (SHOULD) three sequences before giving up, judged only where a sequence held a retry;
     R-7.2-05 every missing or invalid reply triggered a retry; R-7.2-06 the retry waited for
     the invalid reply to end."""
-    acc = _RetryEvidence(Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05")))
-    for group in retry_groups(line, uncertainty):
-        if all(a.problem is None for a in group.attempts):
-            continue
-        _judge_group(line, group, uncertainty, acc)
-    resent, restarted = cut_replies(line, uncertainty)
-    acc.ends.extend(resent)
-    acc.restarted.extend(restarted)
-    tally = acc.tally
-    for rid in tally.ids:
-        tally.decision(rid, RETRY_DECISION)
-    ok = {
-        "R-7.2-01": f"retried without a break within {RETRY_MAX * 1e3:.0f} ms of the line going "
-        f"quiet (decision {RETRY_DECISION})",
-        "R-7.2-04": "a break+command+retries sequence that drew no valid reply was repeated",
-        "R-7.2-05": "retried as due",
-    }
-    found = [
-        *tally.findings(ok),
-        combine("R-7.2-02", acc.window, "retry after no reply"),
-        combine("R-7.2-03", acc.third, "unanswered sequence"),
-        _waited(acc.ends, acc.restarted),
-    ]
-    for f in found[len(tally.ids) :]:
-        f.decision = RETRY_DECISION
-    return found
+    judge = Retries(uncertainty)
+    judge.add(line)
+    return judge.findings()
+
+
+class Retries:
+    """:func:`judge_retries` of a recording given a window's view at a time (issue 22's
+    windowed judge; the whole-run function is one :meth:`add`): each command's tries judged
+    once :class:`RetryGroups` gives them done, each window's cut replies
+    (:func:`cut_replies`: a cut reply and the break that cut it are in one window,
+    :func:`~conformance.view.windows.window_starts`); carried: what :class:`RetryGroups`
+    carries and the findings gathered (the tally's counts and labels, each retry's timing
+    finding, the cuts). :meth:`findings` once, at the end."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        self._groups = RetryGroups(uncertainty)
+        self._resent: list[Finding] = []  # R-7.2-06's FAILs of cut_replies
+        self._restarted: list[str] = []  # and the cuts it only names
+        self._acc = _RetryEvidence(Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05")))
+
+    def add(self, line: TranscriptView) -> None:
+        """Take the next window's view."""
+        self._judge(self._groups.add(line))
+        resent, restarted = cut_replies(line, self.uncertainty)
+        self._resent += resent
+        self._restarted += restarted
+
+    def _judge(self, done: Iterable[tuple[RetryGroup, LineOf]]) -> None:
+        for group, line_of in done:
+            if all(a.problem is None for a in group.attempts):
+                continue
+            _judge_group(line_of, group, self.uncertainty, self._acc)
+
+    def findings(self) -> list[Finding]:
+        """Section 7.2's findings of the recording."""
+        self._judge(self._groups.close())
+        acc = self._acc
+        acc.ends.extend(self._resent)
+        acc.restarted.extend(self._restarted)
+        tally = acc.tally
+        for rid in tally.ids:
+            tally.decision(rid, RETRY_DECISION)
+        ok = {
+            "R-7.2-01": f"retried without a break within {RETRY_MAX * 1e3:.0f} ms of the line "
+            f"going quiet (decision {RETRY_DECISION})",
+            "R-7.2-04": "a break+command+retries sequence that drew no valid reply was repeated",
+            "R-7.2-05": "retried as due",
+        }
+        found = [
+            *tally.findings(ok),
+            combine("R-7.2-02", acc.window, "retry after no reply"),
+            combine("R-7.2-03", acc.third, "unanswered sequence"),
+            _waited(acc.ends, acc.restarted),
+        ]
+        for f in found[len(tally.ids) :]:
+            f.decision = RETRY_DECISION
+        return found
 
 
 @dataclass
@@ -180,9 +253,10 @@ class _RetryEvidence:
 
 
 def _judge_group(
-    line: TranscriptView, group: RetryGroup, uncertainty: float, acc: _RetryEvidence
+    line_of: LineOf, group: RetryGroup, uncertainty: float, acc: _RetryEvidence
 ) -> None:
-    """One command's tries, at least one unanswered or invalid, into ``acc``."""
+    """One command's tries, at least one unanswered or invalid, into ``acc``; ``line_of``:
+    the view each try was read from (a sequence's tries share one)."""
     where = escape(group.text)
     acc.tally.observe(where, ids=["R-7.2-05"])
     # Given up, as opposed to accepted: silence cannot be mistaken for a valid reply, and
@@ -194,6 +268,7 @@ def _judge_group(
     sequences = group.sequences()
     for n, seq in enumerate(sequences):
         later = sequences[n + 1][0] if n + 1 < len(sequences) else None
+        line = line_of(seq[0])
         _judge_tries(line, seq, later, where, uncertainty, acc)
         if any(a.problem is None for a in seq) or not gave_up:
             continue
