@@ -78,7 +78,8 @@ The twenty-first: an Arduino Due sensor (ShadmanKroos' ENG-20009 sketch) answers
 and any '?' command with its address: the '0' for the ?I! probe came 14 ms after the 0A1!
 sent next, which it never heard, and R-4.3-03 FAILed "refused or lost address(es) 1". A change
 reply that may be the late reply of the unanswered command before it is asked again
-(``address_change.may_be_late_reply_to``).
+(``address_change.may_be_late_reply_to``). Its silent aD0!s PASSed R-4.4.8-04 and its aI!
+text to aIM! PASSed R-6.1-01.
 """
 
 from __future__ import annotations
@@ -868,3 +869,34 @@ def test_a_silent_d0_is_no_values_returned_r_4_4_8_04(data_never_answered):
     assert found["R-4.4.8-04"]["verdict"] == "INCONCLUSIVE", found["R-4.4.8-04"]["findings"]
     assert "no reply to 0D0!" in found["R-4.4.8-04"]["findings"][0]["detail"]
     assert found["R-4.4.8-03"]["verdict"] == "FAIL"
+
+
+@pytest.fixture
+def identify_measurement_answered_with_ident(monkeypatch):
+    """The simulated sensor answering every aI<m>! with its aI! identification (the
+    twenty-first round's Due sketch: ``input.charAt(1) == "I"`` answers any 0I...!)."""
+    from conformance.emulator.sensor import SensorEmulator
+    from conformance.protocol.commands import Kind, parse_command
+
+    usual = SensorEmulator._dispatch
+
+    def _dispatch(self, cmd, at):
+        if cmd.kind is Kind.IDENTIFY_MEASUREMENT:
+            cmd = parse_command(f"{cmd.address}I!")
+        usual(self, cmd, at)
+
+    monkeypatch.setattr(SensorEmulator, "_dispatch", _dispatch)
+
+
+def test_the_identification_to_aim_is_no_answer_r_6_1_01(identify_measurement_answered_with_ident):
+    """R-6.1-01 (a v1.4 sensor answers aIM!, aIMC!, ...) PASSed "answered" with the sensor's
+    aI! text to each; R-6.1-02 FAILed the form. That text can be no atttn: not served."""
+    found = _verdicts(run_once("sim://", keyword="test_identify_measurement_answered"))
+    rule = found["R-6.1-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert "answered with its aI! identification" in rule["findings"][0]["detail"]
+
+
+def test_identify_measurement_replies_still_pass_r_6_1_01():
+    found = _verdicts(run_once("sim://", keyword="test_identify_measurement_answered"))
+    assert found["R-6.1-01"]["verdict"] == "PASS", found["R-6.1-01"]["findings"]
