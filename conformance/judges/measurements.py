@@ -237,6 +237,15 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     seq = check_data_sequence(replies, m.count, limit)
     _drop_split_fragments(replies, seq, tally, label)
     _undecide_cut_at_silence(m, replies, silent, tally, label)
+    if not replies and silent is not None:
+        # D0 itself went unanswered: whether it returns values is unread, no conformance
+        # (an Arduino Due sketch with no D0 branch, twenty-first round: R-4.4.8-04 PASSed
+        # "conforms (19 checked)" on nineteen silent aD0!s; R-4.4.8-01 FAILs the silence)
+        tally.undecide(
+            "R-4.4.8-04",
+            f"{label} {where(silent)}",
+            f"no reply to {where(silent)}: whether D0 returns values is unread",
+        )
     tally.observe(
         label,
         seq,

@@ -89,6 +89,9 @@ class ToolRecorder:
         #: to an ``a!`` probe (a wake-up, a poll at a new address) is evidence only from a
         #: sensor shown to answer ``a!`` at all (:func:`~conformance.preconditions.acknowledges`).
         self.acknowledged: set[str] = set()
+        #: The last exchange sent (by :meth:`transact` or :meth:`raw`): a reply that comes
+        #: after the next command may be this one's, late (:mod:`..sensor.address_change`).
+        self.last_exchange: Exchange | None = None
 
     # -- single commands -------------------------------------------------------------------
     def transact(
@@ -139,7 +142,9 @@ class ToolRecorder:
                 exchange.attempts.append(attempt)
                 if attempt.ok:
                     self._note_accepted(command)
+                    self.last_exchange = exchange
                     return exchange
+        self.last_exchange = exchange
         return exchange
 
     def raw(
@@ -182,7 +187,9 @@ class ToolRecorder:
             marking=marking,
             collide=collide,
         )
-        return Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
+        exchange = Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
+        self.last_exchange = exchange
+        return exchange
 
     def send_break(self, marking: float | None = None, *, collide: bool = False) -> Event:
         """A break of ``policy.break_duration`` then ``policy.post_break_marking`` (or

@@ -39,9 +39,31 @@ def test_identify_measurement_answered(sensor, case):
     case.expect("a reply to each of the 43 identify forms")
     exchanges = [identify(sensor, code) for code in DESCRIBED]
     case.evidence("identify-measurement commands", exchanges)
+    ident = sensor.exchange("I")
+    echoed = [ex for ex in exchanges if _is_identification(ex, ident)]
+    if echoed:
+        # its aI! text to aIM!: a parser that matched the 'I' alone, no identify-measurement
+        # served (the twenty-first round's Due sketch answered all 43 so)
+        case.add(
+            failed(
+                "R-6.1-01",
+                "answered with its aI! identification, not a measurement's reply: "
+                + ", ".join(xjudge.shown(e) for e in echoed[:4])
+                + (f" (+{len(echoed) - 4} more)" if len(echoed) > 4 else ""),
+                evidence=xjudge.cite([*echoed, ident]),
+                observed=len(exchanges),
+            )
+        )
+        return
     case.add(
         xjudge.answered("R-6.1-01", exchanges, "v1.4 makes them mandatory", late_is_reply=True)
     )
+
+
+def _is_identification(ex, ident) -> bool:
+    """Whether ``ex`` (an identify-measurement command) drew the sensor's ``aI!`` reply: an
+    ``atttn`` can never be that text, so the command was not served."""
+    return ex.answered and ident.answered and ex.reply_text == ident.reply_text
 
 
 @requirements("R-6.1-02")

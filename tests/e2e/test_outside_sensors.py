@@ -73,6 +73,13 @@ meets an address, between aC! and aD0!: the recorder judges took that for the en
 measurement and FAILed R-4.4.7-08, R-4.4.8-05 and R-4.4-02 on values read on the wire. A sensor
 sketch (joembedded/SDI_12_slave) answers every aC...! '0UNKN': R-4.4.7-08 and R-4.4.12-01
 (support of aC! and aCC!) PASSed on that text.
+
+The twenty-first: an Arduino Due sensor (ShadmanKroos' ENG-20009 sketch) answers 100 ms late,
+and any '?' command with its address: the '0' for the ?I! probe came 14 ms after the 0A1!
+sent next, which it never heard, and R-4.3-03 FAILed "refused or lost address(es) 1". A change
+reply that may be the late reply of the unanswered command before it is asked again
+(``address_change.may_be_late_reply_to``). Its silent aD0!s PASSed R-4.4.8-04 and its aI!
+text to aIM! PASSed R-6.1-01.
 """
 
 from __future__ import annotations
@@ -779,3 +786,117 @@ def test_text_to_acc_is_no_crc_support_r_4_4_12_01(concurrent_answered_unkn):
     rule = found["R-4.4.12-01"]
     assert rule["verdict"] == "FAIL", rule["findings"]
     assert "0CC! -> '0UNKN" in " ".join(f["detail"] for f in rule["findings"]), rule["findings"]
+
+
+@pytest.fixture
+def wildcard_answered_late(monkeypatch):
+    """The simulated sensor as the twenty-first round's Arduino Due sensor (ShadmanKroos'
+    ENG-20009 sketch, docs/kit.md): no ``a!``, and any command starting with '?' answered
+    with its address 100 ms after the '!', deaf meanwhile (the sketch's ``delay(100)`` in
+    ``SDI12Send``) and through a break (a blocked firmware hears none)."""
+    from conformance.emulator.replies import Reply
+    from conformance.emulator.sensor import SensorEmulator
+
+    late = []
+    usual_command, usual_break = SensorEmulator._command, SensorEmulator.on_break
+
+    def _command(self, text, start, end, foreign):
+        if text.startswith("?") and text != "?!" and start >= self._quiet_until:
+            sent = self._send(Reply(ReplyKind.ADDRESS, self.address), end + 0.1)
+            late.append(sent)
+            self._quiet_until = max(self._quiet_until, sent.end)
+            return
+        usual_command(self, text, start, end, foreign)
+
+    def on_break(self, start, end):
+        keep = [t for t in self._tx.queue if t.sent == 0 and any(t is x for x in late)]
+        usual_break(self, start, end)
+        self._tx.queue += [t for t in keep if not any(t is q for q in self._tx.queue)]
+
+    monkeypatch.setattr(SensorEmulator, "_command", _command)
+    monkeypatch.setattr(SensorEmulator, "on_break", on_break)
+    usual = FaultSet.rewrite
+    monkeypatch.setattr(
+        FaultSet,
+        "rewrite",
+        lambda self, reply: None if reply.kind is ReplyKind.ACKNOWLEDGE else usual(self, reply),
+    )
+
+
+def test_a_late_reply_to_the_probe_before_is_no_refused_address_r_4_3_03(wildcard_answered_late):
+    """The '0' for the ?I! probe came 14 ms after the 0A1! sent next, which the sensor never
+    heard: R-4.3-03 FAILed "refused or lost address(es) 1". A change that did not take, whose
+    reply may be the command before's late one, is asked again (``address_change.
+    may_be_late_reply_to``): the sweep goes on, and with no a! at the new addresses to show
+    them R-4.3-03 is INCONCLUSIVE."""
+    data = run_once(
+        "sim://",
+        keyword="test_identification or test_wildcard_with_other_commands or test_address_range",
+    )
+    rule = _verdicts(data)["R-4.3-03"]
+    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+
+
+def test_a_refusal_after_an_unanswered_probe_still_fails_r_4_3_03(wildcard_answered_late):
+    """Asked again, a sensor whose change reply names its old address still says so: the
+    re-ask turns no such reply into anything else (fault address-change-wrong-reply, the
+    same late probe before the sweep's first change)."""
+    data = run_once(
+        "sim://?faults=address-change-wrong-reply",
+        keyword="test_identification or test_wildcard_with_other_commands or test_address_range",
+    )
+    rule = _verdicts(data)["R-4.3-03"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+
+
+@pytest.fixture
+def data_never_answered(monkeypatch):
+    """The simulated sensor silent to every aDn! (the twenty-first round's Due sketch has
+    a D1 branch and no D0)."""
+    usual = FaultSet.rewrite
+    monkeypatch.setattr(
+        FaultSet,
+        "rewrite",
+        lambda self, reply: None if reply.kind is ReplyKind.DATA else usual(self, reply),
+    )
+
+
+def test_a_silent_d0_is_no_values_returned_r_4_4_8_04(data_never_answered):
+    """R-4.4.8-04 (aD0! returns at least one value when values were announced) PASSed
+    "conforms (12 checked)" with every aD0! unanswered. Its silence is R-4.4.8-01's FAIL;
+    whether D0 returns values is unread: INCONCLUSIVE, and R-4.4.8-03 still FAILs."""
+    found = _verdicts(run_once("sim://", keyword="test_announced_values_delivered"))
+    assert found["R-4.4.8-04"]["verdict"] == "INCONCLUSIVE", found["R-4.4.8-04"]["findings"]
+    assert "no reply to 0D0!" in found["R-4.4.8-04"]["findings"][0]["detail"]
+    assert found["R-4.4.8-03"]["verdict"] == "FAIL"
+
+
+@pytest.fixture
+def identify_measurement_answered_with_ident(monkeypatch):
+    """The simulated sensor answering every aI<m>! with its aI! identification (the
+    twenty-first round's Due sketch: ``input.charAt(1) == "I"`` answers any 0I...!)."""
+    from conformance.emulator.sensor import SensorEmulator
+    from conformance.protocol.commands import Kind, parse_command
+
+    usual = SensorEmulator._dispatch
+
+    def _dispatch(self, cmd, at):
+        if cmd.kind is Kind.IDENTIFY_MEASUREMENT:
+            cmd = parse_command(f"{cmd.address}I!")
+        usual(self, cmd, at)
+
+    monkeypatch.setattr(SensorEmulator, "_dispatch", _dispatch)
+
+
+def test_the_identification_to_aim_is_no_answer_r_6_1_01(identify_measurement_answered_with_ident):
+    """R-6.1-01 (a v1.4 sensor answers aIM!, aIMC!, ...) PASSed "answered" with the sensor's
+    aI! text to each; R-6.1-02 FAILed the form. That text can be no atttn: not served."""
+    found = _verdicts(run_once("sim://", keyword="test_identify_measurement_answered"))
+    rule = found["R-6.1-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert "answered with its aI! identification" in rule["findings"][0]["detail"]
+
+
+def test_identify_measurement_replies_still_pass_r_6_1_01():
+    found = _verdicts(run_once("sim://", keyword="test_identify_measurement_answered"))
+    assert found["R-6.1-01"]["verdict"] == "PASS", found["R-6.1-01"]["findings"]
