@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from ...protocol.timing import (
     CHAR_TIME,
+    RESPONSE_START_MAX,
     RETRY_AFTER_BREAK,
     RETRY_MAX,
     RETRY_MIN,
@@ -114,6 +115,8 @@ def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
         problem = reply_problem(s, crc[i], uncertainty)
         if problem is not None and problem.reason is Reason.CUT:
             problem = None  # the recorder's own break cut it: no reply of the sensor's to retry
+        elif problem is NO_REPLY and _window_taken(line, i, uncertainty):
+            problem = None
         attempt = Try(s, problem)
         last = out[-1].attempts[-1] if out else None
         if (
@@ -128,6 +131,24 @@ def retry_groups(line: TranscriptView, uncertainty: float) -> list[RetryGroup]:
         else:
             out.append(RetryGroup(s.stem, [attempt]))
     return out
+
+
+def _window_taken(line: TranscriptView, i: int, uncertainty: float) -> bool:
+    """Whether the recorder sent another command, without a break, before a reply to
+    transmission ``i`` could have begun (R-7.0-10's 15 ms, +0.40): ``0M!`` and at once
+    ``1M!``. It never waited for a reply, so there was no "no reply" to retry for (R-7.2-01
+    FAILed "after no reply to 0M!: not sent again"); R-7.0-17 FAILs the missing break. The
+    same command again is a retry, timed by R-7.2-02 (0 ms: a FAIL)."""
+    transmissions = line.transmissions
+    if i + 1 >= len(transmissions):
+        return False
+    s, nxt = transmissions[i], transmissions[i + 1]
+    return (
+        nxt.part == s.part
+        and nxt.break_event is None
+        and nxt.stem != s.stem
+        and nxt.first_char - s.end < RESPONSE_START_MAX + TOLERANCE + uncertainty
+    )
 
 
 def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:

@@ -156,6 +156,24 @@ def test_a_new_address_right_after_a_bang_is_a_command_without_a_break_R_7_0_17_
     assert by_id(judge_command_text(broken))["R-4.4-04"].verdict is Verdict.PASS
 
 
+def test_a_command_the_recorder_did_not_wait_on_is_no_unanswered_try_R_7_2_01():
+    """``0M!`` and at once ``1M!``: the recorder never waited for 0M!'s reply (R-7.0-17
+    FAILs the missing break), so there was no "no reply" to retry for; R-7.2-01 and
+    R-7.2-05 FAILed "after no reply to 0M!: not sent again". 1M!, waited on and never
+    answered nor sent again, still FAILs them; the same command at once is still a retry
+    (R-7.2-02 FAILs its 0 ms)."""
+    w = Wire().brk().rec("0M!1M!").idle(100).brk().rec("0!").sensor("0\r\n").view()
+    found = by_id(judge_retries(w, 0.0))
+    for rid in ("R-7.2-01", "R-7.2-05"):
+        assert found[rid].verdict is Verdict.FAIL, found[rid].detail
+        assert "0M!" not in found[rid].detail and "1M!" in found[rid].detail, found[rid].detail
+    # a reply window left open (16 ms and more) before another command: 0M! unanswered as before
+    waited = Wire().brk().rec("0M!").idle(16.0).rec("1M!").idle(100).brk().rec("0!").view()
+    assert "0M!" in by_id(judge_retries(waited, 0.0))["R-7.2-01"].detail
+    again = by_id(judge_retries(Wire().brk().rec("0M!0M!0M!").idle(100).view(), 0.0))
+    assert again["R-7.2-02"].verdict is Verdict.FAIL and "0.00 ms" in again["R-7.2-02"].detail
+
+
 def test_break_needed_for_a_new_address_and_after_87_ms():
     ok = Wire().brk().rec("0!").sensor("0\r\n").idle(20).rec("0I!").view()
     assert by_id(judge_break_rules(ok, 0.0))["R-7.0-17"].verdict is Verdict.PASS
