@@ -22,8 +22,9 @@ from types import MappingProxyType
 from typing import Any, Protocol
 
 from .judges.cite import cited, heard, shown
+from .judges.reply_validity import check_reply
 from .judges.support import serves_measurement
-from .protocol.timing import STANDBY_MARKING, TOLERANCE
+from .protocol.timing import CHAR_TIME, STANDBY_MARKING, TOLERANCE
 from .tool_recorder.records import Exchange, Measurement
 from .transcript import TOOL, Event, decode_7e1, escape
 from .verdicts import Finding, inconclusive, not_applicable
@@ -190,7 +191,7 @@ def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     if any(p.listening for p in probes):
         return None
     met = [p.probe for p in probes if p.probe.maybe_collided]
-    if met and all(p.control is not None and p.control.answered for p in probes):
+    if met and all(p.control is not None and shows_listening(p.control) for p in probes):
         return Unmet(
             "listening",
             f"every probe maybe collided with the sensor's characters ({len(met)}), so it "
@@ -200,7 +201,8 @@ def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     return Unmet(
         "listening",
         "the sensor answered none of the a! controls sent like its probes (one break, then "
-        f"once), so its silence to {len(probes)} probe(s) shows nothing",
+        f"once), so its silence to {len(probes)} probe(s) shows nothing"
+        + collided_answers(p.control for p in probes if p.control is not None),
         tuple(shown(p.probe) for p in probes[:3]),
     )
 
@@ -367,16 +369,56 @@ def silence_listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     return listening(probes)
 
 
+def shows_listening(control: Exchange) -> bool:
+    """Whether ``control`` (a command at the sensor's own address) shows the sensor was
+    listening: it was answered, and its answer is no talk-over. Where the judged attempt
+    maybe collided (sensor characters met it, :attr:`Exchange.maybe_collided`), what came
+    after may be the rest of the stray characters that met it (a stray burst read across the
+    command's end within the stamps' uncertainty), not an answer: it shows listening only if
+    it is a valid reply to the control by the judges' rules (:func:`check_reply`, each
+    character's own stamp uncertainty allowed in its gaps)."""
+    if not control.answered:
+        return False
+    if not control.maybe_collided:
+        return True
+    judged = control.judged
+    events = judged.reply_events
+    end = judged.command_end
+    slack = max(e.uncertainty for e in events)
+    problem = check_reply(
+        control.command,
+        events,
+        address=control.text[:1],
+        command_end=events[0].start if end is None else end,
+        gap_limit=CHAR_TIME + TOLERANCE + slack,
+        crc_expected=None,
+    )
+    return problem is None
+
+
+def collided_answers(controls: Iterable[Exchange]) -> str:
+    """For a detail: the answers :func:`shows_listening` set aside, if any."""
+    aside = sum(ex.answered and not shows_listening(ex) for ex in controls)
+    if not aside:
+        return ""
+    return (
+        f" ({aside} answer(s) set aside: maybe collided, and no valid reply, so possibly "
+        "the characters that met the command)"
+    )
+
+
 def answered_control(controls: Sequence[Exchange], what: str) -> Unmet | None:
     """Silence is evidence only from a sensor shown listening: one of ``controls`` (its own
-    address, asked the same way) was answered."""
-    if any(ex.answered for ex in controls):
+    address, asked the same way) was answered (:func:`shows_listening`: not by what may be
+    the stray characters that met it)."""
+    if any(shows_listening(ex) for ex in controls):
         return None
     return Unmet(
         "listening",
         "the sensor answered none of its own-address controls ("
         + ", ".join(escape(ex.text) for ex in controls)
-        + f"), so its silence {what} shows nothing",
+        + f"), so its silence {what} shows nothing"
+        + collided_answers(controls),
         tuple(cited(ex) for ex in controls[:3]),
     )
 

@@ -31,7 +31,7 @@ __all__ = [
     "passed",
     "warned",
 ]
-from ..preconditions import ControlledProbe, listening
+from ..preconditions import ControlledProbe, collided_answers, listening, shows_listening
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .cite import cite, cited, heard, shown
 from .measurements import shown_reply_ids, undecide_uncompared_crc
@@ -93,7 +93,8 @@ def silent(
     answered after its window (:func:`heard_late`) was answered. A command that maybe
     collided (sensor characters met it within the stamps' uncertainty) may not have been
     heard, so its silence is set aside, as :func:`silent_while_listening` does for the
-    one-shot probes; an answer counts whatever met the command."""
+    one-shot probes; an answer counts whatever met the command. A control that maybe
+    collided shows listening only by a valid reply (:func:`shows_listening`)."""
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
     answered = [ex for ex in exchanges if ex.answered or heard_late(ex)]
@@ -108,12 +109,13 @@ def silent(
             decision=decision,
             observed=len(exchanges),
         )
-    if not any(ex.answered for ex in controls):
+    if not any(shows_listening(ex) for ex in controls):
         return inconclusive(
             rid,
             "the sensor answered none of "
             + ", ".join(escape(ex.text) for ex in controls)
-            + " either, so its silence here shows nothing",
+            + " either, so its silence here shows nothing"
+            + collided_answers(controls),
         )
     heard = [ex for ex in exchanges if ex.answered or not ex.maybe_collided]
     aside = f"{len(met)} command(s) set aside (maybe collided: may not have been heard)"

@@ -803,6 +803,25 @@ def judge_framing(
     return framing.findings()
 
 
+def maybe_met(seg: Segment, nxt: Segment, uncertainty: float) -> bool:
+    """Whether the tool's next transmission ``nxt`` (its break, else its first character)
+    may have met the last character the sensors sent after ``seg``: that character started
+    before it and ended less than the stamps' uncertainty before it began, or after (the
+    engine's "maybe collided" NOTE, :func:`~conformance.tool_recorder.contention.
+    maybe_note_text`). The view places such a character in ``seg`` (it started first), not
+    in ``nxt``'s contention, and :class:`Framing` took it for the sensor's text: a stray '#'
+    that the tool's break began 1 ms before the end of, on ±5 ms stamps (RFC 2217), FAILed
+    R-4.1-02 on a parity error the break may have made, and R-4.2-03/R-4.3-01 on a character
+    the break may have garbled. On exact stamps only a real overlap counts (a sim bus
+    never makes one)."""
+    heard = seg.later or seg.reply
+    if not heard:
+        return False
+    last = heard[-1]
+    start = (nxt.break_event or nxt.command[0]).start
+    return last.start < start < last.end + max(uncertainty, last.uncertainty)
+
+
 class Framing:
     """:func:`judge_framing` over a recording read a window at a time (issue 22's windowed
     judge): each window's segments :meth:`add`-ed in order, the findings those of the whole
@@ -825,8 +844,10 @@ class Framing:
     def add(self, segs: list[Segment]) -> None:
         """The replies and later lines of ``segs`` (the next window's segments)."""
         for seg in segs:
-            if self._pending is not None:
-                self._judge(self._pending, cut=bool(seg.contention))
+            pending = self._pending
+            if pending is not None:
+                cut = bool(seg.contention) or maybe_met(pending, seg, self.stamps.base)
+                self._judge(pending, cut=cut)
             self._pending = seg
 
     def findings(self) -> list[Finding]:

@@ -19,7 +19,7 @@ from ..dut import DutClaim, Session, sensor_claim
 from ..judges.support import empty_data_reply, first_filled
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
-from ..preconditions import Unmet, acknowledges
+from ..preconditions import Unmet, acknowledges, shows_listening
 from ..protocol import commands as cmd
 from ..protocol.commands import (
     ADDRESS_CHARS,
@@ -87,10 +87,12 @@ class HeardProbe:
 
     @property
     def listening(self) -> bool:
-        """The control was answered and the probe met no sensor characters: a probe that
-        may have collided (a stray character just before its break, within the stamps'
-        uncertainty) may not have been heard, so its silence shows nothing."""
-        return self.control is not None and self.control.answered and not self.probe.maybe_collided
+        """The control was answered (:func:`shows_listening`: by a valid reply where it
+        maybe collided itself) and the probe met no sensor characters: a probe that may have
+        collided (a stray character just before its break, within the stamps' uncertainty)
+        may not have been heard, so its silence shows nothing."""
+        control = self.control
+        return control is not None and shows_listening(control) and not self.probe.maybe_collided
 
     @property
     def exchanges(self) -> list[Exchange]:

@@ -63,6 +63,9 @@ _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
 _BANG = ord("!")
 _LINE_ENDS = (0x0D, 0x0A)  # CR, LF
 _LF_BYTE = bytes([LF])
+#: what a command begins with (an address, or ``?`` of ``?!``): right after a ``!`` it is the
+#: next command's first character (:meth:`Cut.feed`)
+_COMMAND_STARTS = frozenset(map(ord, ADDRESS_CHARS + "?"))
 _START = attrgetter("start")  # events in time order
 _TEXT = attrgetter("text")
 _ORIGIN = attrgetter("origin")
@@ -574,9 +577,12 @@ class Cut:
         self._current: Transmission | None = None
         # current.is_command, kept as its characters come (asked per event)
         self._is_command = False
-        # the last character was its '!': its own address next is the command sent again at
-        # once (a logger reading its own echo as an invalid reply retries 0 ms after the '!',
-        # the nineteenth round), not more of it; '0M!!' and '0M!<CR><LF>' stay one
+        # the last character was its '!', which ends a command (4.4, R-4.4-04): an address
+        # (or '?') next is the next command sent at once, not more of it. Its own address:
+        # the command sent again (a logger reading its own echo as an invalid reply retries
+        # 0 ms after the '!', the nineteenth round); another: a new sensor addressed with no
+        # break (R-7.0-17 judges it; one transmission, '0M!1M!' FAILed R-4.4-04 and hid the
+        # missing break). '0M!!' and '0M!<CR><LF>' stay one
         self._after_bang = False
         self._last_heard: Event | None = None  # the sensors' last character so far
 
@@ -603,7 +609,13 @@ class Cut:
                 elif (
                     current is None
                     or (is_command and e.start - current.end >= NEW_COMMAND)
-                    or (after_bang and e.wire & 0x7F == current.chars[0].wire & 0x7F)
+                    or (
+                        after_bang
+                        and (
+                            e.wire & 0x7F in _COMMAND_STARTS
+                            or e.wire & 0x7F == current.chars[0].wire & 0x7F
+                        )
+                    )
                 ):
                     current = Transmission(pending, [e], part=part, cut=_cut_into(last_heard, e))
                     transmissions.append(current)

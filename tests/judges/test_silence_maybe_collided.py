@@ -12,8 +12,11 @@ import pytest
 from conformance.conduct import run_once
 from conformance.emulator import sim_sensor
 from conformance.judges.exchanges import silent
-from conformance.sensor.session import SensorSession
+from conformance.preconditions import answered_control, listening, shows_listening
+from conformance.protocol.timing import CHAR_TIME
+from conformance.sensor.session import HeardProbe, SensorSession
 from conformance.tool_recorder.records import CONTENTION, Exchange
+from conformance.transcript import DUT, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Verdict
 
 
@@ -58,3 +61,52 @@ def test_the_standby_cases_leave_silence_that_maybe_collided_undecided(monkeypat
     assert _verdict(run_once("sim://", keyword=keyword), rid) == "PASS"
     monkeypatch.setattr(Exchange, "maybe_collided", property(lambda ex: not ex.answered))
     assert _verdict(run_once("sim://", keyword=keyword), rid) == "INCONCLUSIVE"
+
+
+def _met_by_strays(ex, text: str):
+    """``ex`` (an answered control) as the engine records it where sensor characters met
+    its command and what came after them is ``text``: the rest of a stray burst read past
+    the command's end (stamps uncertain by milliseconds), or a reply."""
+    judged = ex.judged
+    t = judged.command_end + 9e-3
+    heard = []
+    for c in text:
+        heard.append(Event(EventKind.CHAR, DUT, t, t + CHAR_TIME, wire=to_wire_7e1(ord(c))))
+        t += CHAR_TIME
+    attempt = replace(
+        judged, reply_events=heard, reason=f"{CONTENTION} (1 characters during the command)"
+    )
+    return replace(ex, attempts=[attempt])
+
+
+@pytest.mark.parametrize("rid", ["R-7.0-03", "R-7.0-14", "R-AppB-01"])
+def test_a_control_answered_only_by_what_met_it_shows_no_listening(rid):
+    """A control whose own attempt maybe collided counted as answered whatever came back:
+    the "reply" may be the stray characters that met it, so silence to the probe PASSed
+    on a sensor never shown listening. Now such a control shows listening only with a
+    valid reply to it ('0<CR><LF>' to 0!); '##' or another command's reply does not."""
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    control = sensor.master.raw("0!", break_first=True)
+    probe = sensor.master.raw("1!", break_first=True)
+    assert control.answered and not probe.answered
+    for text in ("##", "0+1.23\r\n", "1\r\n"):
+        stray = _met_by_strays(control, text)
+        assert stray.maybe_collided and stray.answered
+        assert not shows_listening(stray), text
+        unmet = answered_control([stray], "to the probe")
+        assert unmet is not None and unmet.code == "listening", text  # None before
+        assert not HeardProbe(probe, stray, 9e-3).listening, text  # True before
+        found = silent(rid, [probe], "it was asleep", baseline=stray)
+        assert found.verdict is Verdict.INCONCLUSIVE, (text, found.detail)  # PASS before
+        assert "maybe collided" in found.detail, found.detail
+        heard = listening([HeardProbe(probe, stray, 9e-3)])
+        assert heard is not None and "answered none" in heard.detail, heard.detail
+    # its valid reply still shows the sensor listening, whatever met the command
+    valid = _met_by_strays(control, "0\r\n")
+    assert valid.maybe_collided and shows_listening(valid)
+    assert answered_control([valid], "to the probe") is None
+    assert HeardProbe(probe, valid, 9e-3).listening
+    assert silent(rid, [probe], "it was asleep", baseline=valid).verdict is Verdict.PASS
+    # a control that met nothing: as before
+    assert shows_listening(control) and answered_control([control], "to the probe") is None

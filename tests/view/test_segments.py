@@ -327,5 +327,26 @@ def test_a_command_sent_again_at_its_bang_is_a_new_transmission():
     assert [t.text for t in read_view(_chars(TOOL, "0M!!", 0.0)).transmissions] == ["0M!!"]
     crlf = read_view(_chars(TOOL, "0M!\r\n", 0.0)).transmissions
     assert [t.text for t in crlf] == ["0M!\r\n"]
-    # another address at once is still part of the one before
-    assert [t.text for t in read_view(_chars(TOOL, "0M!1M!", 0.0)).transmissions] == ["0M!1M!"]
+    # another address at once is the next command too (below)
+    split = read_view(_chars(TOOL, "0M!1M!", 0.0)).transmissions
+    assert [t.text for t in split] == ["0M!", "1M!"]
+
+
+def test_another_address_right_after_a_bang_is_the_next_command():
+    """A command ends at its '!' (4.4, R-4.4-04), so an address (or the '?' of '?!') right
+    after it begins the next command, whatever the sensor it names: a recorder that sends
+    ``0M!`` and at once ``1M!`` addressed a new sensor with no break (R-7.0-17's FAIL). Read
+    as one transmission, '0M!1M!' FAILed R-4.4-04 ("'!' is not exactly the last character")
+    and R-7.0-17 saw no command without a break. What cannot begin a command stays part of
+    the one before: '0M!$' (R-4.4-04 still sees it), '0M!!', '0M!<CR><LF>'."""
+    for text, cut in [
+        ("0M!1M!", ["0M!", "1M!"]),
+        ("0M!a!", ["0M!", "a!"]),
+        ("0M!?!", ["0M!", "?!"]),
+        ("0M!1M!2D0!", ["0M!", "1M!", "2D0!"]),
+        ("0M!$", ["0M!$"]),
+    ]:
+        assert [t.text for t in read_view(_chars(TOOL, text, 0.0)).transmissions] == cut, text
+    # a few ms of marking between them (less than a new command's 7.93 ms): the same cut
+    gapped = _chars(TOOL, "0M!", 0.0) + _chars(TOOL, "1M!", 3 * CHAR_TIME + 0.004)
+    assert [t.text for t in read_view(gapped).transmissions] == ["0M!", "1M!"]

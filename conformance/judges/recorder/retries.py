@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 from ...protocol.timing import (
     CHAR_TIME,
+    RESPONSE_START_MAX,
     RETRY_AFTER_BREAK,
     RETRY_MAX,
     RETRY_MIN,
@@ -140,6 +141,8 @@ class RetryGroups:
             problem = reply_problem(s, crc[i], self.uncertainty)
             if problem is not None and problem.reason is Reason.CUT:
                 problem = None  # the recorder's own break cut it: no sensor reply to retry for
+            elif problem is NO_REPLY and _window_taken(line, i, self.uncertainty):
+                problem = None  # it never waited for a reply (the next command came at once)
             attempt = Try(s, problem)
             group = self._open
             last = group.attempts[-1] if group is not None else None
@@ -169,6 +172,24 @@ class RetryGroups:
             return views[next(k for k, b in enumerate(group.attempts) if b is a)]
 
         yield group, line_of
+
+
+def _window_taken(line: TranscriptView, i: int, uncertainty: float) -> bool:
+    """Whether the recorder sent another command, without a break, before a reply to
+    transmission ``i`` could have begun (R-7.0-10's 15 ms, +0.40): ``0M!`` and at once
+    ``1M!``. It never waited for a reply, so there was no "no reply" to retry for (R-7.2-01
+    FAILed "after no reply to 0M!: not sent again"); R-7.0-17 FAILs the missing break. The
+    same command again is a retry, timed by R-7.2-02 (0 ms: a FAIL)."""
+    transmissions = line.transmissions
+    if i + 1 >= len(transmissions):
+        return False
+    s, nxt = transmissions[i], transmissions[i + 1]
+    return (
+        nxt.part == s.part
+        and nxt.break_event is None
+        and nxt.stem != s.stem
+        and nxt.first_char - s.end < RESPONSE_START_MAX + TOLERANCE + uncertainty
+    )
 
 
 def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:

@@ -113,7 +113,7 @@ def test_unterminated_retries_are_not_one_command_R_7_0_13():
     # a gap a sensor still holds the command over still FAILs, as does one after a '!'
     short = Wire().brk().rec("0M1").idle(7.5).rec("0M1")
     assert by_id(judge_character_gaps(short.view(), 0.0))["R-7.0-13"].verdict is Verdict.FAIL
-    after = Wire().brk().rec("0M!").idle(2.0).rec("x")
+    after = Wire().brk().rec("0M!").idle(2.0).rec("$")
     assert by_id(judge_character_gaps(after.view(), 0.0))["R-7.0-13"].verdict is Verdict.FAIL
     # the last try terminated: its text alone passes R-4.4-04, the tries before it do not
     ended = Wire().brk().rec("0M1").idle(50).rec("0M1").idle(50).rec("0MC!")
@@ -134,6 +134,44 @@ def test_unterminated_retries_are_not_one_command_R_7_0_13():
     assert by_id(judge_character_gaps(both.view(), 0.0))["R-7.0-13"].verdict is Verdict.FAIL
     fine = Wire().brk().rec("0M!").idle(200).brk().rec("0M1").idle(50).rec("0M1")
     assert by_id(judge_character_gaps(fine.view(), 0.0))["R-7.0-13"].verdict is Verdict.INCONCLUSIVE
+
+
+def test_a_new_address_right_after_a_bang_is_a_command_without_a_break_R_7_0_17_R_4_4_04():
+    """A recorder that sends ``0M!`` and at once ``1M!`` sent two commands, each ending in
+    its only '!' (4.4), the second to a new sensor with no break. Read as one transmission
+    '0M!1M!', R-4.4-04 FAILed "'!' is not exactly the last character" and R-7.0-17 PASSed
+    "all 2 commands were sent after a break" (a false PASS); the gap between them was judged
+    as one inside a command (R-7.0-13)."""
+    w = Wire().brk().rec("0M!1M!").idle(100).brk().rec("0!").sensor("0\r\n").view()
+    assert by_id(judge_command_text(w))["R-4.4-04"].verdict is Verdict.PASS
+    due = by_id(judge_break_rules(w, 0.0))["R-7.0-17"]
+    assert due.verdict is Verdict.FAIL and "no break before 1M!" in due.detail, due.detail
+    # a few ms of marking between them (under the 7.93 ms a new command needs): the same
+    gapped = Wire().brk().rec("0M!").idle(3.0).rec("1M!").view()
+    assert by_id(judge_break_rules(gapped, 0.0))["R-7.0-17"].verdict is Verdict.FAIL
+    assert by_id(judge_character_gaps(gapped, 0.0))["R-7.0-13"].verdict is Verdict.PASS
+    # a break between them: both conform, as before
+    broken = Wire().brk().rec("0M!").idle(20).brk().rec("1M!").view()
+    assert by_id(judge_break_rules(broken, 0.0))["R-7.0-17"].verdict is Verdict.PASS
+    assert by_id(judge_command_text(broken))["R-4.4-04"].verdict is Verdict.PASS
+
+
+def test_a_command_the_recorder_did_not_wait_on_is_no_unanswered_try_R_7_2_01():
+    """``0M!`` and at once ``1M!``: the recorder never waited for 0M!'s reply (R-7.0-17
+    FAILs the missing break), so there was no "no reply" to retry for; R-7.2-01 and
+    R-7.2-05 FAILed "after no reply to 0M!: not sent again". 1M!, waited on and never
+    answered nor sent again, still FAILs them; the same command at once is still a retry
+    (R-7.2-02 FAILs its 0 ms)."""
+    w = Wire().brk().rec("0M!1M!").idle(100).brk().rec("0!").sensor("0\r\n").view()
+    found = by_id(judge_retries(w, 0.0))
+    for rid in ("R-7.2-01", "R-7.2-05"):
+        assert found[rid].verdict is Verdict.FAIL, found[rid].detail
+        assert "0M!" not in found[rid].detail and "1M!" in found[rid].detail, found[rid].detail
+    # a reply window left open (16 ms and more) before another command: 0M! unanswered as before
+    waited = Wire().brk().rec("0M!").idle(16.0).rec("1M!").idle(100).brk().rec("0!").view()
+    assert "0M!" in by_id(judge_retries(waited, 0.0))["R-7.2-01"].detail
+    again = by_id(judge_retries(Wire().brk().rec("0M!0M!0M!").idle(100).view(), 0.0))
+    assert again["R-7.2-02"].verdict is Verdict.FAIL and "0.00 ms" in again["R-7.2-02"].detail
 
 
 def test_break_needed_for_a_new_address_and_after_87_ms():
