@@ -19,13 +19,15 @@ from bisect import bisect_left
 from collections.abc import Iterator
 from itertools import compress, repeat
 from operator import attrgetter, eq, is_
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..links.base import LinkError
 from ..protocol.timing import BIT_TIME, CHAR_TIME
 from ..sim.bus import Frame
 from ..transcript import TOOL, Event, EventKind, escape
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: a frame's start meaning "as soon as the line is free" (the bus starts a frame at the later
 #: of its start and the end of what is on the line)
@@ -187,6 +189,8 @@ def _touching_each(
 
 
 def _column(events: list[Event], name: str) -> np.ndarray:
+    import numpy as np
+
     return np.fromiter(map(attrgetter(name), events), np.float64, len(events))
 
 
@@ -199,7 +203,10 @@ def _worked_out(
     order (by start, then end: sorting would leave it as it is) with no NaN stamp (whose
     comparisons sorting and the arrays would read apart); else None. A decoded capture's
     events come in order (one channel's frames follow each other), and building its
-    replay event by event was ~16 ms of a fault-matrix row (issue 22)."""
+    replay event by event was ~16 ms of a fault-matrix row (issue 22). numpy is imported
+    here: a sensor run loads this module (the plugin names its errors), not numpy."""
+    import numpy as np
+
     with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
         return _in_arrays(wire, *(_column(wire, k) for k in ("start", "end", "uncertainty")))
 
@@ -208,6 +215,8 @@ def _in_arrays(
     wire: list[Event], s: np.ndarray, e: np.ndarray, u: np.ndarray
 ) -> tuple[list[Event], list[Event], list[int], list[tuple[bool, bool]]] | None:
     """:func:`_worked_out` given the events' starts, ends and uncertainties."""
+    import numpy as np
+
     if np.isnan(s).any() or np.isnan(e).any():
         return None
     if not ((s[1:] > s[:-1]) | ((s[1:] == s[:-1]) & (e[1:] >= e[:-1]))).all():
