@@ -113,3 +113,16 @@ def test_the_module_sorts_only_when_it_must(monkeypatch):
     assert sorts == []
     RecordedSensor(events[::-1])
     assert len(sorts) == len(events)
+
+
+def test_a_reply_starting_with_the_one_before_does_not_follow_it():
+    """Two reply characters starting together: the second does not go back to back from
+    the first (only a reply that started before counts), as event by event."""
+    events = [
+        Event(EventKind.CHAR, TOOL, 0.0, 0.4, 0x30),
+        Event(EventKind.CHAR, DUT, 0.5, 0.5, 0x31),
+        Event(EventKind.CHAR, DUT, 0.5, 0.6, 0x32),
+    ]
+    assert _worked_out(events) is not None
+    assert state(RecordedSensor(events)) == event_by_event(events)
+    assert RecordedSensor(events)._touching == [(False, False), (False, False)]
