@@ -17,12 +17,17 @@ from __future__ import annotations
 
 from bisect import bisect_left
 from collections.abc import Iterator
-from operator import attrgetter
+from itertools import compress, repeat
+from operator import attrgetter, eq, is_
+from typing import TYPE_CHECKING
 
 from ..links.base import LinkError
 from ..protocol.timing import BIT_TIME, CHAR_TIME
 from ..sim.bus import Frame
 from ..transcript import TOOL, Event, EventKind, escape
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: a frame's start meaning "as soon as the line is free" (the bus starts a frame at the later
 #: of its start and the end of what is on the line)
@@ -31,6 +36,7 @@ LINE_FREE = float("-inf")
 
 #: a recording's wire events in the order the replay follows them (C-level: 10^4 a run)
 _START_END = attrgetter("start", "end")
+_ORIGIN, _KIND = attrgetter("origin"), attrgetter("kind")
 
 #: how every divergence's message starts (a report's stop reason names it)
 DIVERGED = "replay diverged"
@@ -51,14 +57,21 @@ class RecordedSensor:
     name = "recording"
 
     def __init__(self, events: list[Event]) -> None:
-        wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=_START_END)
-        self.tool = [e for e in wire if e.origin == TOOL]
-        self.replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
-        # how many tool events the recording has before each reply character starts (the
-        # tool's starts never decrease: they are sorted with the rest)
-        starts = [e.start for e in self.tool]
-        self._needs: list[int] = [bisect_left(starts, reply.start) for reply in self.replies]
-        self._touching = _touching_each(self.tool, self.replies, self._needs)
+        wire = [e for e in events if e.kind is not EventKind.NOTE]
+        self._needs: list[int]
+        self._touching: list[tuple[bool, bool]]
+        found = _worked_out(wire)
+        if found is not None:  # in order and no NaN: worked out over arrays
+            self.tool, self.replies, self._needs, self._touching = found
+        else:
+            wire.sort(key=_START_END)
+            self.tool = [e for e in wire if e.origin == TOOL]
+            self.replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
+            # how many tool events the recording has before each reply character starts
+            # (the tool's starts never decrease: they are sorted with the rest)
+            starts = [e.start for e in self.tool]
+            self._needs = [bisect_left(starts, reply.start) for reply in self.replies]
+            self._touching = _touching_each(self.tool, self.replies, self._needs)
         self.heard = 0  # tool events matched so far
         self.next_reply = 0
         self.offset = 0.0  # now minus recorded time, at the last matched tool event
@@ -173,6 +186,68 @@ def _touching_each(
         )
         last = reply
     return out
+
+
+def _column(events: list[Event], name: str) -> np.ndarray:
+    import numpy as np
+
+    return np.fromiter(map(attrgetter(name), events), np.float64, len(events))
+
+
+def _worked_out(
+    wire: list[Event],
+) -> tuple[list[Event], list[Event], list[int], list[tuple[bool, bool]]] | None:
+    """The tool's events, the reply characters, the replay's ``_needs`` (``bisect_left`` of
+    each reply's start among the tool's starts) and :func:`_touching_each`, over arrays (the
+    same comparisons and sums of the same floats), when ``wire`` is already in the replay's
+    order (by start, then end: sorting would leave it as it is) with no NaN stamp (whose
+    comparisons sorting and the arrays would read apart); else None. A decoded capture's
+    events come in order (one channel's frames follow each other), and building its
+    replay event by event was ~16 ms of a fault-matrix row (issue 22). numpy is imported
+    here: a sensor run loads this module (the plugin names its errors), not numpy."""
+    import numpy as np
+
+    with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
+        return _in_arrays(wire, *(_column(wire, k) for k in ("start", "end", "uncertainty")))
+
+
+def _in_arrays(
+    wire: list[Event], s: np.ndarray, e: np.ndarray, u: np.ndarray
+) -> tuple[list[Event], list[Event], list[int], list[tuple[bool, bool]]] | None:
+    """:func:`_worked_out` given the events' starts, ends and uncertainties."""
+    import numpy as np
+
+    if np.isnan(s).any() or np.isnan(e).any():
+        return None
+    if not ((s[1:] > s[:-1]) | ((s[1:] == s[:-1]) & (e[1:] >= e[:-1]))).all():
+        return None
+    n = len(wire)
+    is_tool = np.fromiter(map(eq, map(_ORIGIN, wire), repeat(TOOL)), bool, n)
+    is_char = np.fromiter(map(is_, map(_KIND, wire), repeat(EventKind.CHAR)), bool, n)
+    is_reply = ~is_tool & is_char
+    tool = list(compress(wire, is_tool.tolist()))
+    replies = list(compress(wire, is_reply.tolist()))
+    if not replies:
+        return tool, replies, [], []
+    ts, te, tu = s[is_tool], e[is_tool], u[is_tool]
+    rs, re, ru = s[is_reply], e[is_reply], u[is_reply]
+    need = np.searchsorted(ts, rs, "left")
+    # the tool's last matched event before each reply (need - 1), padded for need == 0
+    has_tool = need > 0
+    te_before = np.concatenate(([0.0], te))[need]
+    tu_before = np.concatenate(([0.0], tu))[need]
+    # the previous reply character, if it started before this one
+    has_prev = np.zeros(rs.size, dtype=bool)
+    has_prev[1:] = rs[:-1] < rs[1:]
+    re_prev = np.concatenate(([0.0], re[:-1]))
+    ru_prev = np.concatenate(([0.0], ru[:-1]))
+    use_prev = has_prev & (~has_tool | (re_prev > te_before))
+    before_end = np.where(use_prev, re_prev, te_before)
+    before_u = np.where(use_prev, ru_prev, tu_before)
+    first = (use_prev | has_tool) & (np.abs(rs - before_end) <= ru + before_u)
+    second = has_prev & (np.abs(rs - re_prev) <= ru + ru_prev)
+    touching = list(zip(first.tolist(), second.tolist(), strict=True))
+    return tool, replies, need.tolist(), touching
 
 
 def same_action(recorded: Event, kind: EventKind, wire: int, length: float) -> bool:
