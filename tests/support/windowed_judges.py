@@ -58,6 +58,30 @@ from conformance.verdicts import Finding
 from conformance.view.rebuilt_records import rebuild_records, rebuilt_exchanges
 from conformance.view.runs import Segment
 from conformance.view.segments import TranscriptView, read_view
+from conformance.view.windows import stream_windows, window_events, window_starts
+
+
+def at_every_break(events: list[Event]) -> list[list[Event]]:
+    """``events`` cut before every break: finer than any cut :func:`window_starts` makes
+    (which never cuts inside a measurement, nor between two transmissions of one command),
+    so what one window leaves the next shows."""
+    windows: list[list[Event]] = []
+    for e in sorted(events, key=lambda e: e.start):
+        if e.kind is EventKind.BREAK or not windows:
+            windows.append([])
+        windows[-1].append(e)
+    return windows
+
+
+def product_cuts(events: list[Event], uncertainty: float) -> list[list[list[Event]]]:
+    """The windows the product cuts ``events`` into: :func:`window_starts`' cut of the whole
+    view, and :func:`stream_windows` as the events come."""
+    view = read_view(events)
+    ordered = sorted(events, key=lambda e: e.start)
+    return [
+        list(window_events(events, view, window_starts(view))),
+        list(stream_windows(iter(ordered), uncertainty=uncertainty)),
+    ]
 
 
 def recorder_wire(view: TranscriptView, uncertainty: float) -> list[Finding]:

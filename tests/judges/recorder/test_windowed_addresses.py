@@ -13,22 +13,13 @@ from __future__ import annotations
 
 from conformance.judges.recorder.capabilities import Addresses, judge_addresses
 from conformance.judges.recorder.common import record_of
-from conformance.transcript import Event, EventKind
+from conformance.transcript import Event
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import read_view
-from conformance.view.windows import stream_windows, window_events, window_starts
 from tests.support.bus_of_sensors import ADDRESSES, as_heard, bus_of_sensors, concurrent_round
+from tests.support.windowed_judges import at_every_break, product_cuts
 
 U = 1e-6  # a 1 MHz capture's stamps
-
-
-def _at_every_break(events: list[Event]) -> list[list[Event]]:
-    windows: list[list[Event]] = []
-    for e in sorted(events, key=lambda e: e.start):
-        if e.kind is EventKind.BREAK or not windows:
-            windows.append([])
-        windows[-1].append(e)
-    return windows
 
 
 def _windowed(windows: list[list[Event]]) -> list[Finding]:
@@ -40,13 +31,7 @@ def _windowed(windows: list[list[Event]]) -> list[Finding]:
 
 def _all_cuts(events: list[Event]) -> list[list[list[Event]]]:
     """The windows :func:`window_starts` cuts, streamed, and a cut at every break."""
-    view = read_view(events)
-    ordered = sorted(events, key=lambda e: e.start)
-    return [
-        list(window_events(events, view, window_starts(view))),
-        list(stream_windows(iter(ordered), uncertainty=U)),
-        _at_every_break(events),
-    ]
+    return [*product_cuts(events, U), at_every_break(events)]
 
 
 def test_a_bus_rounds_addresses_judge_as_the_whole_recording():

@@ -22,24 +22,13 @@ from conformance.judges.recorder.measurements import (
 )
 from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.judges.reply_validity import Reason
-from conformance.transcript import Event, EventKind
+from conformance.transcript import Event
 from conformance.view.segments import read_view
 from conformance.view.windows import stream_windows, window_events, window_starts
 from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+from tests.support.windowed_judges import at_every_break
 
 U = 1e-6  # a 1 MHz capture's stamps
-
-
-def _at_every_break(events: list[Event]) -> list[list[Event]]:
-    """``events`` cut before every break: finer than :func:`window_starts`' cut, which never
-    cuts inside a measurement's own exchanges but does between its last data command and
-    its sensor's next command."""
-    windows: list[list[Event]] = []
-    for e in sorted(events, key=lambda e: e.start):
-        if e.kind is EventKind.BREAK or not windows:
-            windows.append([])
-        windows[-1].append(e)
-    return windows
 
 
 def _windowed(windows: list[list[Event]]) -> list[ObservedMeasurement]:
@@ -110,7 +99,7 @@ def test_windows_give_the_whole_recordings_measurements(events, whole):
 
 def test_a_cut_at_every_break_gives_the_whole_recordings_measurements(events, whole):
     """Each measurement's data, others and next start in windows of their own."""
-    windows = _at_every_break(events)
+    windows = at_every_break(events)
     assert len(windows) == 9
     assert _windowed(windows) == whole
 
@@ -139,5 +128,5 @@ def test_a_data_reply_read_again_is_judged_by_its_measurements_crc():
 
 def test_the_waits_judged_from_windows_are_the_whole_recordings(events, whole):
     """R-4.4.5-04..07 over the windowed measurements: the same findings."""
-    windowed = _windowed(_at_every_break(events))
+    windowed = _windowed(at_every_break(events))
     assert judge_measure_waits(windowed, U) == judge_measure_waits(whole, U)

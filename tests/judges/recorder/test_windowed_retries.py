@@ -16,31 +16,10 @@ from conformance.protocol.timing import CHAR_TIME
 from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import read_view
-from conformance.view.windows import stream_windows, window_events, window_starts
 from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+from tests.support.windowed_judges import at_every_break, product_cuts
 
 U = 1e-6  # a 1 MHz capture's stamps
-
-
-def _at_every_break(events: list[Event]) -> list[list[Event]]:
-    """``events`` cut before every break: finer than :func:`window_starts`' cut, which
-    never cuts between two transmissions of one command, so a command's sequences fall in
-    windows of their own."""
-    windows: list[list[Event]] = []
-    for e in sorted(events, key=lambda e: e.start):
-        if e.kind is EventKind.BREAK or not windows:
-            windows.append([])
-        windows[-1].append(e)
-    return windows
-
-
-def _cuts(events: list[Event]) -> list[list[list[Event]]]:
-    view = read_view(events)
-    ordered = sorted(events, key=lambda e: e.start)
-    return [
-        list(window_events(events, view, window_starts(view))),
-        list(stream_windows(iter(ordered), uncertainty=U)),
-    ]
 
 
 def _windowed(windows: list[list[Event]]) -> list[Finding]:
@@ -72,10 +51,10 @@ def test_a_commands_sequences_in_windows_of_their_own_judge_as_the_whole():
     assert found["R-7.2-04"].verdict is Verdict.PASS
     assert found["R-7.2-03"].verdict is Verdict.PASS and found["R-7.2-03"].observed == 9
     assert found["R-7.2-05"].verdict is Verdict.PASS and found["R-7.2-05"].observed == 3
-    windows = _at_every_break(events)
+    windows = at_every_break(events)
     assert len(windows) == 13  # 0I! four times, 5!, 6!, 7! three sequences each
     assert _windowed(windows) == whole
-    for windows in _cuts(events):
+    for windows in product_cuts(events, U):
         assert len(windows) == 7
         assert _windowed(windows) == whole
 
@@ -104,7 +83,7 @@ def test_a_reply_cut_in_an_early_window_fails_as_in_the_whole():
     whole = judge_retries(read_view(events), U)
     r6 = _by_rule(whole)["R-7.2-06"]
     assert r6.verdict is Verdict.FAIL and "did not wait for the response" in r6.detail
-    for windows in _cuts(events):
+    for windows in product_cuts(events, U):
         assert len(windows) == 3
         assert _windowed(windows) == whole
 
@@ -125,9 +104,9 @@ def test_invalid_replies_retried_over_windows_judge_as_the_whole():
     found = _by_rule(whole)
     assert found["R-7.2-06"].verdict is Verdict.PASS and found["R-7.2-06"].observed == 12
     assert found["R-7.2-05"].observed == 2  # both 0D0! groups, the one read again too
-    windows = _at_every_break(events)
+    windows = at_every_break(events)
     assert len(windows) == 8
     assert _windowed(windows) == whole
-    for windows in _cuts(events):
+    for windows in product_cuts(events, U):
         assert len(windows) == 3
         assert _windowed(windows) == whole

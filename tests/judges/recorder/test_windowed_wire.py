@@ -20,7 +20,7 @@ from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import TranscriptView, read_view
 from conformance.view.windows import stream_windows, window_events, window_starts
 from tests.support.bus_of_sensors import ADDRESSES, as_heard, bus_of_sensors, concurrent_round
-from tests.support.windowed_judges import recorder_wire, recorder_wire_windowed
+from tests.support.windowed_judges import at_every_break, recorder_wire, recorder_wire_windowed
 
 U = 1e-6  # a 1 MHz capture's stamps
 
@@ -31,17 +31,6 @@ def _whole(view: TranscriptView) -> list[Finding]:
 
 def _windowed(windows: list[list[Event]]) -> list[Finding]:
     return recorder_wire_windowed(windows, U)
-
-
-def _at_every_break(events: list[Event]) -> list[list[Event]]:
-    """``events`` cut before every break: finer than any cut :func:`window_starts` makes
-    (which never cuts inside a measurement), so what one window leaves the next shows."""
-    windows: list[list[Event]] = []
-    for e in sorted(events, key=lambda e: e.start):
-        if e.kind is EventKind.BREAK or not windows:
-            windows.append([])
-        windows[-1].append(e)
-    return windows
 
 
 def _by_rule(findings: list[Finding]) -> dict[str, Finding]:
@@ -90,7 +79,7 @@ def test_a_short_break_in_the_first_window_is_the_whole_runs_worst():
     whole = read_view(events)
     expected = _by_rule(_whole(whole))["R-7.0-02"]
     assert expected.verdict is Verdict.FAIL
-    assert _by_rule(_windowed(_at_every_break(events)))["R-7.0-02"] == expected
+    assert _by_rule(_windowed(at_every_break(events)))["R-7.0-02"] == expected
 
 
 def test_leaning_gaps_in_two_windows_are_counted_together():
@@ -105,7 +94,7 @@ def test_leaning_gaps_in_two_windows_are_counted_together():
     expected = _by_rule(_whole(whole))
     assert expected["R-7.0-01"].verdict is Verdict.FAIL
     assert "(2 such gap(s))" in expected["R-7.0-01"].detail
-    got = _by_rule(_windowed(_at_every_break(events)))
+    got = _by_rule(_windowed(at_every_break(events)))
     assert got["R-7.0-01"] == expected["R-7.0-01"]
     assert got["R-7.0-13"] == expected["R-7.0-13"]
     assert got["R-4.1-01"] == expected["R-4.1-01"]
@@ -128,7 +117,7 @@ def test_a_service_request_in_the_window_before_its_d0_is_carried():
     expected = _by_rule(_whole(read_view(events)))["R-7.1-01"]
     assert expected.verdict is Verdict.PASS
     assert "after the service request" in expected.detail
-    windows = _at_every_break(events)
+    windows = at_every_break(events)
     assert any(read_view(w).transmissions[0].text == "0D0!" for w in windows)
     assert _by_rule(_windowed(windows))["R-7.1-01"] == expected
 
@@ -166,4 +155,4 @@ def test_the_shortest_command_spacing_of_an_early_window_is_the_whole_runs():
     spacings = sum(len(t.chars) - 1 for t in whole.transmissions)
     assert expected.detail.endswith(f"over {spacings} spacings")
     assert expected.evidence == [f"in {whole.transmissions[0].at()}"]
-    assert _by_rule(_windowed(_at_every_break(events)))["R-4.1-01"] == expected
+    assert _by_rule(_windowed(at_every_break(events)))["R-4.1-01"] == expected
