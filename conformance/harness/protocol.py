@@ -188,11 +188,13 @@ def parse_heard(text: str, count: int) -> tuple[int, str]:
     return int(parts[1]), parts[2]
 
 
-def _time(field: str, text: str) -> int:
+def _time(field: str, text: str, *, bounded: bool = True) -> int:
+    """A time field (us). ``bounded``: beyond :data:`MAX_TIME_US` is a harness counting
+    wrong; a ``wait`` is not bounded (see :func:`parse_plan`)."""
     if not field.isdigit():
         raise HarnessProtocolError(f"time {field!r} is not a whole number of microseconds", text)
     value = int(field)
-    if value > MAX_TIME_US:
+    if bounded and value > MAX_TIME_US:
         raise HarnessProtocolError("time beyond 10^12 us (units wrong?)", text)
     return value
 
@@ -270,8 +272,12 @@ def parse_plan(
     told after the frame ends, so a plan made before it for a time inside that frame is held
     back by it, and repeating it is right; ``since`` (the reported frame's START) is then
     the earliest start accepted. A ``wait`` must be later than ``now`` (else the harness
-    would be woken forever without time passing). A version-2 harness may add a ``tx``'s
-    duration and is held to the clock for ``tx`` as for ``brk`` (:func:`_parse_tx`)."""
+    would be woken forever without time passing), and may be any later time: it only promises
+    nothing before T, so a firmware's long sleep (a uint32_t of milliseconds read from a reply
+    that never came: 49.7 days) is what it says, ended by the job's budget or the next event,
+    not a harness counting wrong as a ``tx``/``brk`` that far out is. A version-2 harness may
+    add a ``tx``'s duration and is held to the clock for ``tx`` as for ``brk``
+    (:func:`_parse_tx`)."""
     floor = now if since is None else min(now, since)
     parts = text.split(" ")
     if parts[0] == PlanKind.TX and version >= 2:
@@ -300,7 +306,7 @@ def parse_plan(
             raise HarnessProtocolError("break ends before it starts (or before now)", text)
         return Plan(kind, start=start, end=end)
     if kind is PlanKind.WAIT:
-        start = _time(parts[1], text)
+        start = _time(parts[1], text, bounded=False)
         if start <= now:
             raise HarnessProtocolError(f"wait time is not after now ({now} us)", text)
         return Plan(kind, start=start)

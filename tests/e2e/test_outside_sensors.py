@@ -80,6 +80,12 @@ sent next, which it never heard, and R-4.3-03 FAILed "refused or lost address(es
 reply that may be the late reply of the unanswered command before it is asked again
 (``address_change.may_be_late_reply_to``). Its silent aD0!s PASSed R-4.4.8-04 and its aI!
 text to aIM! PASSed R-6.1-01.
+
+The twenty-second: an STM32 logger (davemortek/stm32-sdi-12) sends aM0!, which no sensor
+answers, and reads ttt from the empty reply, ``(response[1] - 48) * 100000 + ...``: a
+HAL_Delay of 4289639296 ms. Its harness said so, ``wait 4289644352000``, and the run stopped
+"time beyond 10^12 us (units wrong?)" with every later case ERROR. A ``wait`` is a long
+sleep (the job's budget ends it); only ``tx``/``brk`` times keep the bound.
 """
 
 from __future__ import annotations
@@ -900,3 +906,56 @@ def test_the_identification_to_aim_is_no_answer_r_6_1_01(identify_measurement_an
 def test_identify_measurement_replies_still_pass_r_6_1_01():
     found = _verdicts(run_once("sim://", keyword="test_identify_measurement_answered"))
     assert found["R-6.1-01"]["verdict"] == "PASS", found["R-6.1-01"]["findings"]
+
+
+#: A recorder harness that sends ``aM0!`` after each job's break, then sleeps for the uint32_t
+#: milliseconds its firmware read from the missing reply (the twenty-second round's logger).
+_SLEEPS_FOREVER = r"""
+import sys
+
+def say(line):
+    sys.stdout.write(line + "\n")
+    sys.stdout.flush()
+
+def wire(c):
+    b = ord(c)
+    return b | (0x80 if bin(b).count("1") % 2 else 0)
+
+text, sent, deadline = "", 0, 0
+for line in sys.stdin:
+    word, *f = line.split()
+    if word == "bye":
+        break
+    if word == "hello":
+        say("hello 1 sleeps-forever")
+    elif word == "job":
+        now, text, sent = int(f[0]), f[2][0] + "M0!", 0
+        say(f"brk {now} {now + 13000}")
+    elif word == "break":
+        say(f"tx {int(f[1]) + 8000} {wire(text[0]):02x}")
+    elif word == "sent":
+        sent += 1
+        end = int(f[1])
+        if sent < len(text):
+            say(f"tx {end} {wire(text[sent]):02x}")
+        else:
+            deadline = end + 4289639296000
+            say(f"wait {deadline}")
+    else:  # a reply heard, or the sleep's end: sleep on (a new job starts the next command)
+        say(f"wait {max(deadline, int(f[1]) + 1)}")
+"""
+
+
+def test_a_recorder_asleep_for_49_days_is_judged_not_stopped_r_7_2_01(tmp_path):
+    """``wait 4289644352000`` stopped the run, ERROR and INCOMPLETE; the job now ends at its
+    budget and the recorder is judged on what it sent: R-7.2-01 FAILs (aM0! unanswered, never
+    sent again), the rules about the job that never ended stay undecided."""
+    import sys
+
+    harness = tmp_path / "sleeps.py"
+    harness.write_text(_SLEEPS_FOREVER)
+    found = run_once(f"exec:{sys.executable} {harness}", role="recorder", keyword="test_retries")
+    assert found["summary"]["verdict"] == "NON-COMPLIANT", found["summary"]
+    rules = _verdicts(found)
+    assert rules["R-7.2-01"]["verdict"] == "FAIL", rules["R-7.2-01"]["findings"]
+    assert any("0M0!" in f["detail"] for f in rules["R-7.2-01"]["findings"])

@@ -165,3 +165,19 @@ def test_a_version_2_tx_in_the_past_is_a_harness_error():
     # a new plan inside the frame just reported transmits before the line is idle
     with pytest.raises(HarnessProtocolError, match="wait for the line to be idle"):
         proto.parse_plan("tx 4200 30 8330", Role.SENSOR, now=13333, since=4000, version=2)
+
+
+@pytest.mark.parametrize("role", [Role.SENSOR, Role.RECORDER])
+def test_a_wait_beyond_10_12_us_is_a_long_sleep_not_a_harness_error_r_7_2_01(role):
+    """The twenty-second round's logger (davemortek/stm32-sdi-12) reads ttt from a reply that
+    never came, ``(response[1] - 48) * 100000 + ...`` into a uint32_t: a HAL_Delay of
+    4289639296 ms, ``wait 4289644352000``. The run stopped "time beyond 10^12 us (units
+    wrong?)", every later case ERROR, on a harness that said truly what its firmware does. A
+    ``wait`` only promises nothing before T (the job's budget or the next event comes first);
+    a ``tx``/``brk`` time that far out is still a harness counting wrong."""
+    huge = 4289644352000
+    assert proto.parse_plan(f"wait {huge}", role, now=5000) == Plan(PlanKind.WAIT, start=huge)
+    with pytest.raises(HarnessProtocolError, match="beyond 10"):
+        proto.parse_plan(f"tx {huge} 30", role, now=5000)
+    with pytest.raises(HarnessProtocolError, match="beyond 10"):
+        proto.parse_plan(f"brk 5000 {huge}", Role.RECORDER, now=5000)
