@@ -376,9 +376,11 @@ def shows_listening(control: Exchange) -> bool:
     after may be the rest of the stray characters that met it (a stray burst read across the
     command's end within the stamps' uncertainty), not an answer: it shows listening only if
     it is a valid reply to the control by the judges' rules (:func:`check_reply`, each
-    character's own stamp uncertainty allowed in its gaps)."""
+    character's own stamp uncertainty allowed in its gaps). A one-shot control unanswered in
+    its window whose late reply the longer listen for a sensor seen late heard
+    (:attr:`Exchange.heard_late`, :meth:`SensorSession.hear_late`) shows it listening too."""
     if not control.answered:
-        return False
+        return any(e.origin != TOOL for e in control.heard_late)
     if not control.maybe_collided:
         return True
     judged = control.judged
