@@ -172,3 +172,17 @@ def test_r_7_0_14_late_answer_after_a_foreign_command_is_an_answer() -> None:
     assert "0! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
     alone = _row("replies-after-retry", keyword, "R-7.0-14")
     assert alone["verdict"] == "PASS", alone["findings"]  # INCONCLUSIVE before
+
+
+def test_r_7_0_14_late_reply_to_the_foreign_command_is_no_answer_to_the_probe() -> None:
+    """answers-foreign-address + replies-after-retry: the sensor's late 'z<CR><LF>' to z!
+    came over the a! sent after it (heard by the longer listen): read as 0!'s late answer,
+    R-7.0-14 FAILed "0! -> late 'z<CR><LF>'" (with 82d2f2b); it names another address, and
+    the probe, sent while the sensor was busy, may not have been heard: INCONCLUSIVE."""
+    found = _row(
+        "replies-after-retry,answers-foreign-address",
+        "test_standby_after_foreign_command",
+        "R-7.0-14",
+    )
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
+    assert "naming another address" in found["findings"][0]["detail"]
