@@ -376,9 +376,11 @@ def shows_listening(control: Exchange) -> bool:
     after may be the rest of the stray characters that met it (a stray burst read across the
     command's end within the stamps' uncertainty), not an answer: it shows listening only if
     it is a valid reply to the control by the judges' rules (:func:`check_reply`, each
-    character's own stamp uncertainty allowed in its gaps)."""
+    character's own stamp uncertainty allowed in its gaps). A one-shot control unanswered in
+    its window whose late reply the longer listen for a sensor seen late heard
+    (:attr:`Exchange.heard_late`, :meth:`SensorSession.hear_late`) shows it listening too."""
     if not control.answered:
-        return False
+        return any(e.origin != TOOL for e in control.heard_late)
     if not control.maybe_collided:
         return True
     judged = control.judged
@@ -427,25 +429,30 @@ def acknowledges(probes: Sequence[Exchange], acknowledged: bool, address: str) -
     """Silence to an ``a!`` probe shows something only from a sensor that answers ``a!``:
     ``acknowledged``, one of its ``a!`` at ``address`` drew a reply (valid or not) somewhere
     in the run. A sensor that answers its other commands but never ``a!`` (R-4.4.1-01 FAILs that)
-    says nothing about waking or about an address by not answering one."""
-    if acknowledged or any(ex.answered for ex in probes):
+    says nothing about waking or about an address by not answering one. An ``a!`` of
+    ``probes`` that maybe collided counts only with a valid reply (:func:`shows_listening`):
+    what came after the characters that met it may be their rest, not an answer (the
+    engine's ``acknowledged`` already leaves out an ``a!`` its characters met)."""
+    if acknowledged or any(shows_listening(ex) for ex in probes):
         return None
     return Unmet(
         "listening",
         f"the sensor answered no {address}! anywhere in the run (R-4.4.1-01), so its silence "
-        "to the a! probe shows nothing",
+        "to the a! probe shows nothing" + collided_answers(probes),
         tuple(cited(ex) for ex in probes[:2]),
     )
 
 
 def woke(wakes: Sequence[Exchange]) -> Unmet | None:
     """The sensor was shown awake: it answered one of the wake-up ``a!`` (break, a!,
-    retries) sent before the probes whose silence or answer is judged."""
-    if any(ex.answered for ex in wakes):
+    retries) sent before the probes whose silence or answer is judged. A wake-up whose
+    judged attempt maybe collided counts only with a valid reply (:func:`shows_listening`):
+    what came after the characters that met it may be their rest, not an answer."""
+    if any(shows_listening(ex) for ex in wakes):
         return None
     return Unmet(
         "awake",
-        "the sensor did not answer the wake-up a!",
+        "the sensor did not answer the wake-up a!" + collided_answers(wakes),
         tuple(cited(ex) for ex in wakes[:2]),
     )
 

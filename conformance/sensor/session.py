@@ -802,8 +802,10 @@ class SensorSession(Session):
         """The controls for silence to ``a!`` ``probes``: whether the sensor answers ``a!`` at
         all (:func:`~conformance.preconditions.acknowledges`). None are needed when a probe
         was answered or an ``a!`` at its address drew a reply earlier in the run; else one
-        ``a!`` now, after a break and with retries, as a recorder wakes a sensor."""
-        if any(ex.answered for ex in probes) or self.address in self.master.acknowledged:
+        ``a!`` now, after a break and with retries, as a recorder wakes a sensor. A probe
+        answered only by what may be the characters that met it (:func:`shows_listening`)
+        needs the control too."""
+        if any(shows_listening(ex) for ex in probes) or self.address in self.master.acknowledged:
             return []
         return [self.master.transact(f"{self.address}!", force_break=True)]
 

@@ -137,6 +137,12 @@ def _exchanges(
         attempt = _attempt(t, command, binary, crc, policy, uncertainty)
         source[id(attempt)] = t
         if last is not None and last.text == t.text and not last.ok and command is not None:
+            # what the sensor sent after the try before stopped being listened to, before
+            # this retry: queued before it went out, a stray of this attempt, as the engine
+            # records it (a reply 290 ms late between two retry sequences, docs/kit.md's
+            # twenty-first round, read as no reply at all by exchanges.late_reply)
+            before = source[id(last.last)].heard
+            attempt.stray_events[:0] = [e for e in before if e.start >= last.last.end]
             retries = [a for a in last.attempts if a.sequence == last.last.sequence]
             if t.break_event is None:
                 attempt.sequence, attempt.retry = last.last.sequence, len(retries)

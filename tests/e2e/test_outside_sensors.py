@@ -959,3 +959,66 @@ def test_a_recorder_asleep_for_49_days_is_judged_not_stopped_r_7_2_01(tmp_path):
     rules = _verdicts(found)
     assert rules["R-7.2-01"]["verdict"] == "FAIL", rules["R-7.2-01"]["findings"]
     assert any("0M0!" in f["detail"] for f in rules["R-7.2-01"]["findings"])
+
+
+@pytest.fixture
+def plain_measure_answered_very_late(monkeypatch):
+    """The simulated sensor as the twenty-first round's Due sketch answers ``0M!`` (docs/kit.md):
+    its 190 ms ``performReading()`` and ``delay(100)`` put the start reply 280 ms after the
+    '!', past the tool's first retry sequence and before the next one's break; deaf meanwhile,
+    and its queued reply kept through a break (a blocked firmware hears none)."""
+    from conformance.emulator.sensor import SensorEmulator
+    from conformance.protocol.commands import Kind
+
+    late = []
+    usual_send, usual_break = SensorEmulator._send, SensorEmulator.on_break
+
+    def _send(self, reply, at):
+        cmd = reply.command
+        plain = cmd is not None and cmd.kind is Kind.MEASURE and cmd.group == 0 and not cmd.crc
+        if reply.kind is not ReplyKind.START or not plain:
+            return usual_send(self, reply, at)
+        sent = usual_send(self, reply, at + 0.28)
+        if sent is not None:
+            late.append(sent)
+            self._quiet_until = max(self._quiet_until, sent.end)
+        return sent
+
+    def on_break(self, start, end):
+        keep = [t for t in self._tx.queue if t.sent == 0 and any(t is x for x in late)]
+        usual_break(self, start, end)
+        self._tx.queue += [t for t in keep if not any(t is q for q in self._tx.queue)]
+
+    monkeypatch.setattr(SensorEmulator, "_send", _send)
+    monkeypatch.setattr(SensorEmulator, "on_break", on_break)
+
+
+def test_a_reply_between_retry_sequences_is_no_unanswered_command_r_4_4_01(
+    plain_measure_answered_very_late,
+):
+    """'00023' to 0M!, 280 ms late, came after the first retry sequence's last window and
+    before the next sequence's break: the view kept it in no attempt (the engine has it as the
+    next try's stray), so R-4.4-01 FAILed "no reply although it is a basic command: 0M!"
+    (docs/kit.md, twenty-first round, hedged "a consequence of R-7.0-10"). The view now keeps
+    it as the retry's stray (view.rebuilt_records), and the rule is INCONCLUSIVE naming it."""
+    found = _verdicts(run_once("sim://", keyword="test_every_basic_command_is_answered"))
+    row = found["R-4.4-01"]
+    assert row["verdict"] == "INCONCLUSIVE", row["findings"]  # FAIL before
+    details = " ".join(f["detail"] for f in row["findings"])
+    assert "0M! -> late '00023<CR><LF>'" in details, details
+    assert "no reply" not in details, details
+
+
+def test_a_command_truly_unanswered_beside_a_late_one_still_fails_r_4_4_01(
+    plain_measure_answered_very_late,
+):
+    """A late 0M! leaves the silence of the rest to FAIL R-4.4-01: only the silent ones are
+    listed (undefined-measure-silent: 0M3!.. never answered)."""
+    found = _verdicts(
+        run_once("sim://?faults=undefined-measure-silent", keyword="test_every_basic_command")
+    )
+    row = found["R-4.4-01"]
+    assert row["verdict"] == "FAIL", row["findings"]
+    details = " ".join(f["detail"] for f in row["findings"])
+    assert "no reply although it is a basic command" in details and "0M3!" in details, details
+    assert "0M!;" not in details and not details.rstrip().endswith("0M!"), details

@@ -12,7 +12,13 @@ import pytest
 from conformance.conduct import run_once
 from conformance.emulator import sim_sensor
 from conformance.judges.exchanges import silent
-from conformance.preconditions import answered_control, listening, shows_listening
+from conformance.preconditions import (
+    acknowledges,
+    answered_control,
+    listening,
+    shows_listening,
+    woke,
+)
 from conformance.protocol.timing import CHAR_TIME
 from conformance.sensor.session import HeardProbe, SensorSession
 from conformance.tool_recorder.records import CONTENTION, Exchange
@@ -110,3 +116,47 @@ def test_a_control_answered_only_by_what_met_it_shows_no_listening(rid):
     assert silent(rid, [probe], "it was asleep", baseline=valid).verdict is Verdict.PASS
     # a control that met nothing: as before
     assert shows_listening(control) and answered_control([control], "to the probe") is None
+
+
+@pytest.mark.parametrize("rid", ["R-7.0-14", "R-7.0-15", "R-7.0-16"])
+def test_a_wake_up_answered_only_by_what_met_it_shows_no_sensor_awake(rid):
+    """preconditions.woke (the wake-up a! of R-7.0-14/-15/-16) took any answer as the sensor
+    shown awake, even where the wake-up's own attempt maybe collided and what came after
+    may be the rest of the stray characters: the probes' silence was then judged. Now, as
+    for the controls (shows_listening), such a wake-up counts only with a valid reply."""
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    wake = sensor.master.transact("0!", force_break=True)
+    assert woke([wake]) is None
+    for text in ("##", "0+1.23\r\n", "1\r\n"):
+        stray = _met_by_strays(wake, text)
+        unmet = woke([stray])
+        assert unmet is not None and unmet.code == "awake", (rid, text)  # None before
+        assert "1 answer(s) set aside" in unmet.detail, unmet.detail
+        assert woke([stray, wake]) is None  # another wake-up answered cleanly: awake
+    assert woke([_met_by_strays(wake, "0\r\n")]) is None  # its valid reply: awake
+
+
+@pytest.mark.parametrize("rid", ["R-4.3-04", "R-7.0-04", "R-7.0-05", "R-7.0-07", "R-4.4.4-01"])
+def test_an_a_probe_answered_only_by_what_met_it_shows_no_acknowledgement(rid):
+    """preconditions.acknowledges took any answered a! among the probes as the sensor
+    answering a! at all; one whose own attempt maybe collided may have been answered by the
+    rest of the characters that met it. It counts now only with a valid reply, and
+    SensorSession.acknowledgement sends its a! control for it (it sent none before)."""
+    _, link, _ = sim_sensor()
+    sensor = SensorSession(link, address="0")
+    probe = sensor.master.raw("0!", break_first=True)
+    assert acknowledges([probe], False, "0") is None
+    for text in ("##", "0+1.23\r\n", "1\r\n"):
+        stray = _met_by_strays(probe, text)
+        unmet = acknowledges([stray], False, "0")
+        assert unmet is not None and unmet.code == "listening", (rid, text)  # None before
+        assert "1 answer(s) set aside" in unmet.detail, unmet.detail
+        assert acknowledges([stray], True, "0") is None  # an a! answered elsewhere: as before
+        sensor.master.acknowledged.discard("0")
+        controls = sensor.acknowledgement([stray])
+        assert len(controls) == 1 and controls[0].answered, text  # [] before
+    valid = _met_by_strays(probe, "0\r\n")
+    assert acknowledges([valid], False, "0") is None
+    sensor.master.acknowledged.discard("0")
+    assert sensor.acknowledgement([valid]) == []

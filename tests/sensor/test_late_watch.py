@@ -133,3 +133,56 @@ def test_one_reply_landing_just_after_the_next_command_does_not_hide_a_late_sens
     early = _chars("0!", 2.0, TOOL)
     watch.note(Attempt(None, early, _chars("0\r\n", early[-1].end + 5e-3, DUT), OK, 2.1), "0!")
     assert watch.start is not None and abs(watch.start - 0.080) < 1e-9
+
+
+def _row(faults: str, keyword: str, rid: str) -> dict:
+    data = run_once(f"sim://?faults={faults}", keyword=keyword)
+    return next(r for r in data["requirements"] if r["id"] == rid)
+
+
+def test_r_7_0_03_late_answer_after_the_short_pulse_is_an_answer() -> None:
+    """wakes-on-short-spacing + replies-after-retry: the a! after the 5 ms pulse and its
+    control (a! after a 13 ms break) were each answered 80 ms late; neither was listened to
+    that long, so R-7.0-03 was INCONCLUSIVE 'answered none of its own-address controls' on
+    a sensor that wakes on the pulse. Both now listen as R-7.0-15's probes do
+    (SensorSession.hear_late): FAIL naming the late answer."""
+    found = _row(
+        "replies-after-retry,wakes-on-short-spacing",
+        "test_short_spacing_is_not_a_break",
+        "R-7.0-03",
+    )
+    assert found["verdict"] == "FAIL", found["findings"]  # INCONCLUSIVE before
+    assert "0! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
+
+
+def test_r_7_0_03_late_sensor_silent_after_the_short_pulse_passes() -> None:
+    """replies-after-retry alone: silence through the longer listen, and the control's late
+    answer shows the sensor listening: PASS (INCONCLUSIVE before)."""
+    found = _row("replies-after-retry", "test_short_spacing_is_not_a_break", "R-7.0-03")
+    assert found["verdict"] == "PASS", found["findings"]
+
+
+def test_r_7_0_14_late_answer_after_a_foreign_command_is_an_answer() -> None:
+    """stays-awake-after-foreign + replies-after-retry: the a! after z! and the control a!
+    were answered 80 ms late: R-7.0-14 was INCONCLUSIVE 'answered none of 0! either'; now
+    FAIL naming the late answer, and PASS on replies-after-retry alone."""
+    keyword = "test_standby_after_foreign_command"
+    found = _row("replies-after-retry,stays-awake-after-foreign", keyword, "R-7.0-14")
+    assert found["verdict"] == "FAIL", found["findings"]  # INCONCLUSIVE before
+    assert "0! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
+    alone = _row("replies-after-retry", keyword, "R-7.0-14")
+    assert alone["verdict"] == "PASS", alone["findings"]  # INCONCLUSIVE before
+
+
+def test_r_7_0_14_late_reply_to_the_foreign_command_is_no_answer_to_the_probe() -> None:
+    """answers-foreign-address + replies-after-retry: the sensor's late 'z<CR><LF>' to z!
+    came over the a! sent after it (heard by the longer listen): read as 0!'s late answer,
+    R-7.0-14 FAILed "0! -> late 'z<CR><LF>'" (with 82d2f2b); it names another address, and
+    the probe, sent while the sensor was busy, may not have been heard: INCONCLUSIVE."""
+    found = _row(
+        "replies-after-retry,answers-foreign-address",
+        "test_standby_after_foreign_command",
+        "R-7.0-14",
+    )
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
+    assert "naming another address" in found["findings"][0]["detail"]

@@ -40,12 +40,11 @@ LATE_REPLY_UNDECIDED = (
     "R-4.2-02",
     "R-4.2-03",
     "R-4.3-01",
-    # silence rules whose control, an a! sent once like the probe, was answered late
+    # silence rules whose control, an a! sent once like the probe, was answered late (R-7.0-03's
+    # and R-7.0-14's probes and controls are listened to that long: SensorSession.hear_late)
     "R-4.0-01",
     "R-4.3-04",
     "R-4.4.3-02",
-    "R-7.0-03",
-    "R-7.0-14",
     "R-AppB-01",
     # nothing to judge: the replies they rest on (a started measurement, metadata records,
     # extended text) were not taken
