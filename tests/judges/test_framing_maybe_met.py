@@ -14,27 +14,12 @@ from __future__ import annotations
 import pytest
 
 from conformance.judges import wire
-from conformance.protocol.timing import CHAR_TIME
-from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Verdict
 from conformance.view.runs import segments
+from tests.support.hand_events import chars
 
 U = 5e-3  # the stamps' uncertainty (RFC 2217)
-
-
-def _chars(origin: str, text: str, start: float, *, parity: bool = True, u: float = U):
-    flip = 0 if parity else 0x80
-    return [
-        Event(
-            EventKind.CHAR,
-            origin,
-            start + k * CHAR_TIME,
-            start + (k + 1) * CHAR_TIME,
-            wire=to_wire_7e1(ord(c)) ^ flip,
-            uncertainty=u,
-        )
-        for k, c in enumerate(text)
-    ]
 
 
 def _two_polls(stray_end_after_break: float, u: float = U) -> list[Event]:
@@ -42,13 +27,13 @@ def _two_polls(stray_end_after_break: float, u: float = U) -> list[Event]:
     tool's next break beginning ``stray_end_after_break`` before the '#' ended (negative:
     after), then 0! and its reply again."""
     events = [Event(EventKind.BREAK, TOOL, 0.0, 0.013, uncertainty=u)]
-    events += (cmd := _chars(TOOL, "0!", 0.022, u=u))
-    events += (rep := _chars(DUT, "0\r\n", cmd[-1].end + 9e-3, u=u))
-    events += (stray := _chars(DUT, "#", rep[-1].end + 2e-3, parity=False, u=u))
+    events += (cmd := chars(TOOL, "0!", 0.022, uncertainty=u))
+    events += (rep := chars(DUT, "0\r\n", cmd[-1].end + 9e-3, uncertainty=u))
+    events += (stray := chars(DUT, "#", rep[-1].end + 2e-3, parity=False, uncertainty=u))
     at = stray[-1].end - stray_end_after_break
     events.append(Event(EventKind.BREAK, TOOL, at, at + 0.013, uncertainty=u))
-    events += (cmd := _chars(TOOL, "0!", at + 0.022, u=u))
-    events += _chars(DUT, "0\r\n", cmd[-1].end + 9e-3, u=u)
+    events += (cmd := chars(TOOL, "0!", at + 0.022, uncertainty=u))
+    events += chars(DUT, "0\r\n", cmd[-1].end + 9e-3, uncertainty=u)
     return events
 
 

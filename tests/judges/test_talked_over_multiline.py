@@ -9,30 +9,22 @@ framed."""
 from __future__ import annotations
 
 from conformance.judges import wire
-from conformance.protocol.timing import CHAR_TIME
-from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.transcript import DUT, TOOL
 from conformance.verdicts import Verdict
 from conformance.view.runs import Segment
+from tests.support.hand_events import chars
 
 LINE_GAP = 6.667e-3  # the emulator's pause between lines of multi-line text
-
-
-def _chars(origin: str, text: str, start: float) -> list[Event]:
-    return [
-        Event(EventKind.CHAR, origin, start + k * CHAR_TIME, start + (k + 1) * CHAR_TIME,
-              wire=to_wire_7e1(ord(c)))
-        for k, c in enumerate(text)
-    ]  # fmt: skip
 
 
 def _talked_over(first_line: str, rest: list[str]) -> Segment:
     """0XHELP! whose first three characters met ``first_line`` (already under way), the
     other ``rest`` lines after it, each ``LINE_GAP`` after the one before."""
-    command = _chars(TOOL, "0XHELP!", 0.0)
-    met = _chars(DUT, first_line, command[3].start)
+    command = chars(TOOL, "0XHELP!", 0.0)
+    met = chars(DUT, first_line, command[3].start)
     later, at = [], max(command[-1].end, met[-1].end) + LINE_GAP
     for line in rest:
-        later += _chars(DUT, line, at)
+        later += chars(DUT, line, at)
         at = later[-1].end + LINE_GAP
     return Segment(None, command, later=later, contention=met, text="0XHELP!")
 
@@ -76,9 +68,9 @@ def test_multiline_text_ended_inside_the_command_leaves_later_lines_framed() -> 
 
 def _next_retry(first: Segment, line: str, rest: str, *, met: bool) -> Segment:
     """The next 0XHELP! after ``first``; ``line`` meets it (``met``) or comes after it."""
-    command = _chars(TOOL, "0XHELP!", first.later[-1].end + 0.055)
-    heard = _chars(DUT, line, command[3].start if met else command[-1].end + 0.1)
-    later = _chars(DUT, rest, heard[-1].end + LINE_GAP)
+    command = chars(TOOL, "0XHELP!", first.later[-1].end + 0.055)
+    heard = chars(DUT, line, command[3].start if met else command[-1].end + 0.1)
+    later = chars(DUT, rest, heard[-1].end + LINE_GAP)
     if met:
         return Segment(None, command, later=later, contention=heard, text="0XHELP!")
     return Segment(None, command, later=heard + later, text="0XHELP!")

@@ -14,30 +14,22 @@ from __future__ import annotations
 from conformance.conduct import run_once
 from conformance.emulator import sim_sensor
 from conformance.judges import exchanges as xjudge
-from conformance.protocol.timing import CHAR_TIME
 from conformance.sensor.late_watch import LateStartWatch
 from conformance.sensor.session import SensorSession
 from conformance.tool_recorder.records import NO_REPLY, OK, Attempt
-from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Verdict
-
-
-def _chars(text: str, start: float, origin: str) -> list[Event]:
-    return [
-        Event(EventKind.CHAR, origin, start + i * CHAR_TIME, start + (i + 1) * CHAR_TIME,
-              wire=to_wire_7e1(ord(c)))
-        for i, c in enumerate(text)
-    ]  # fmt: skip
+from tests.support.hand_events import chars
 
 
 def _tries(reply: str, after_retry: float, *, brk: bool = False) -> LateStartWatch:
     """0I! unanswered, then again 55 ms later whose reply began ``after_retry`` s after it."""
     watch = LateStartWatch()
-    first = _chars("0I!", 0.0, TOOL)
+    first = chars(TOOL, "0I!", 0.0)
     watch.note(Attempt(None, first, [], NO_REPLY, first[-1].end + 0.03), "0I!")
-    retry = _chars("0I!", first[-1].end + 0.055, TOOL)
+    retry = chars(TOOL, "0I!", first[-1].end + 0.055)
     brk_event = Event(EventKind.BREAK, TOOL, retry[0].start - 0.02, retry[0].start - 0.01)
-    heard = _chars(reply, retry[-1].end + after_retry, DUT)
+    heard = chars(DUT, reply, retry[-1].end + after_retry)
     watch.note(Attempt(brk_event if brk else None, retry, heard, OK, heard[-1].end), "0I!")
     return watch
 
@@ -64,8 +56,8 @@ def test_a_sensor_seen_answering_too_soon_is_not_taken_for_late() -> None:
     it is its own, not the late reply to the try before (its standby probes were listened
     to for nothing: the run's transcript changed, its verdicts not)."""
     watch = _tries("013CONFORM\r\n", 0.0)
-    first = _chars("0!", 1.0, TOOL)
-    watch.note(Attempt(None, first, _chars("0\r\n", first[-1].end + 5e-3, DUT), OK, 1.1), "0!")
+    first = chars(TOOL, "0!", 1.0)
+    watch.note(Attempt(None, first, chars(DUT, "0\r\n", first[-1].end + 5e-3), OK, 1.1), "0!")
     assert watch.start is None
     assert _session("response-too-early").master.watch.late.start is None
 
@@ -126,12 +118,12 @@ def test_one_reply_landing_just_after_the_next_command_does_not_hide_a_late_sens
     """answers-foreign-address + replies-after-retry: a late reply that lands just after the
     next command reads as a first try answered too soon; two late replies outweigh it."""
     watch = _tries("013CONFORM\r\n", 0.0)
-    first = _chars("0M!", 1.0, TOOL)
+    first = chars(TOOL, "0M!", 1.0)
     watch.note(Attempt(None, first, [], NO_REPLY, 1.1), "0M!")
-    retry = _chars("0M!", first[-1].end + 0.055, TOOL)
-    watch.note(Attempt(None, retry, _chars("00011\r\n", retry[-1].end, DUT), OK, 1.3), "0M!")
-    early = _chars("0!", 2.0, TOOL)
-    watch.note(Attempt(None, early, _chars("0\r\n", early[-1].end + 5e-3, DUT), OK, 2.1), "0!")
+    retry = chars(TOOL, "0M!", first[-1].end + 0.055)
+    watch.note(Attempt(None, retry, chars(DUT, "00011\r\n", retry[-1].end), OK, 1.3), "0M!")
+    early = chars(TOOL, "0!", 2.0)
+    watch.note(Attempt(None, early, chars(DUT, "0\r\n", early[-1].end + 5e-3), OK, 2.1), "0!")
     assert watch.start is not None and abs(watch.start - 0.080) < 1e-9
 
 

@@ -16,8 +16,7 @@ from dataclasses import replace
 
 import pytest
 
-from conformance.protocol.timing import CHAR_TIME
-from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
+from conformance.transcript import Event, EventKind
 from conformance.view.rebuilt_records import rebuild_records
 from conformance.view.segments import read_view
 from conformance.view.windows import (
@@ -34,6 +33,7 @@ from tests.support.bus_of_sensors import (
     measured_past_another,
     start,
 )
+from tests.support.hand_events import sent, woken
 from tests.support.records_alike import records_fields, view_differences
 
 IDLE = 30.0  # s of silence: far past the standby time (100 ms), as a field logger idles
@@ -161,29 +161,15 @@ def test_a_retry_never_starts_a_window():
     _check(events, min_windows=1)
 
 
-def _sent(events: list[Event], t: float, text: str) -> float:
-    """``text``'s characters from ``t`` on, back to back; gives where they end."""
-    for c in text:
-        events.append(Event(EventKind.CHAR, BUS, t, t + CHAR_TIME, wire=to_wire_7e1(ord(c))))
-        t += CHAR_TIME
-    return t
-
-
-def _woken(events: list[Event], t: float, command: str) -> float:
-    """A break, the marking after it and ``command``; gives where the command ends."""
-    events.append(Event(EventKind.BREAK, BUS, t, t + 0.0125))
-    return _sent(events, t + 0.0125 + 0.009, command) + 0.009
-
-
 def test_a_break_that_cut_into_a_reply_starts_no_window():
     """The recorder breaks into ``0I!``'s reply 1 ms after its seventh character (a poll
     timeout shorter than the reply) and asks ``1I!``: the break is known to have cut the
     reply only beside it (``cut_by``); a window starting there read the reply alone as the
     sensor's invalid one (R-7.2-05 due), where the whole says the recorder cut it."""
     events: list[Event] = []
-    t = _sent(events, _woken(events, 0.05, "0I!"), "014CONF") + 0.001
-    t = _sent(events, _woken(events, t, "1I!"), "114CONFORM EMU001100\r\n") + 0.2
-    t = _sent(events, _woken(events, t, "3I!"), "314CONFORM EMU001100\r\n")
+    t = sent(events, woken(events, 0.05, "0I!"), "014CONF") + 0.001
+    t = sent(events, woken(events, t, "1I!"), "114CONFORM EMU001100\r\n") + 0.2
+    t = sent(events, woken(events, t, "3I!"), "314CONFORM EMU001100\r\n")
     whole = read_view(events)
     assert whole.transmissions[0].cut_by is events[11]  # the break before 1I!
     assert _check(events) == [0, 2]

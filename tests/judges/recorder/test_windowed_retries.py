@@ -12,11 +12,11 @@ into (R-7.2-06's FAIL) in a window before the last."""
 from __future__ import annotations
 
 from conformance.judges.recorder.retries import Retries, judge_retries
-from conformance.protocol.timing import CHAR_TIME
-from conformance.transcript import BUS, Event, EventKind, to_wire_7e1
+from conformance.transcript import Event
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import read_view
 from tests.support.bus_of_sensors import as_heard, bus_of_sensors, start
+from tests.support.hand_events import sent, woken
 from tests.support.windowed_judges import at_every_break, product_cuts
 
 U = 1e-6  # a 1 MHz capture's stamps
@@ -59,27 +59,15 @@ def test_a_commands_sequences_in_windows_of_their_own_judge_as_the_whole():
         assert _windowed(windows) == whole
 
 
-def _sent(events: list[Event], t: float, text: str) -> float:
-    for c in text:
-        events.append(Event(EventKind.CHAR, BUS, t, t + CHAR_TIME, wire=to_wire_7e1(ord(c))))
-        t += CHAR_TIME
-    return t
-
-
-def _woken(events: list[Event], t: float, command: str) -> float:
-    events.append(Event(EventKind.BREAK, BUS, t, t + 0.0125))
-    return _sent(events, t + 0.0125 + 0.009, command) + 0.009
-
-
 def test_a_reply_cut_in_an_early_window_fails_as_in_the_whole():
     """The recorder breaks into ``0I!``'s reply after seven characters and sends ``0I!``
     again (R-7.2-06 FAIL: it did not wait for the response to complete), then asks 1I! and
     3I!, each a window of its own: the FAIL stands from the first window."""
     events: list[Event] = []
-    t = _sent(events, _woken(events, 0.05, "0I!"), "014CONF") + 0.001
-    t = _sent(events, _woken(events, t, "0I!"), "014CONFORM EMU001100\r\n") + 0.2
-    t = _sent(events, _woken(events, t, "1I!"), "114CONFORM EMU001100\r\n") + 0.2
-    _sent(events, _woken(events, t, "3I!"), "314CONFORM EMU001100\r\n")
+    t = sent(events, woken(events, 0.05, "0I!"), "014CONF") + 0.001
+    t = sent(events, woken(events, t, "0I!"), "014CONFORM EMU001100\r\n") + 0.2
+    t = sent(events, woken(events, t, "1I!"), "114CONFORM EMU001100\r\n") + 0.2
+    sent(events, woken(events, t, "3I!"), "314CONFORM EMU001100\r\n")
     whole = judge_retries(read_view(events), U)
     r6 = _by_rule(whole)["R-7.2-06"]
     assert r6.verdict is Verdict.FAIL and "did not wait for the response" in r6.detail
