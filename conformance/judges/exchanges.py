@@ -270,14 +270,13 @@ def late_among(rid: str, exchanges: Iterable[Exchange], what: str) -> Finding | 
     sensor's aD0! after an abort and after a break and zI! came 80 ms late, its values cut by
     the retry: "after the abort M delivered 0 values" and "C delivered 0 values after a break
     and zI!" were false FAILs (truth12)."""
-    exchanges = list(exchanges)
-    late = [text for ex in exchanges if (text := late_answer(ex))]
+    late = [(ex, text) for ex in exchanges if (text := late_answer(ex))]
     if not late:
         return None
     return inconclusive(
         rid,
-        f"{what}, but " + "; ".join(late[:3]) + " (R-7.0-10 judges its timing)",
-        evidence=cite([ex for ex in exchanges if late_answer(ex)]),
+        f"{what}, but " + "; ".join(text for _, text in late[:3]) + " (R-7.0-10 judges its timing)",
+        evidence=cite([ex for ex, _ in late]),
         observed=len(late),
     )
 
