@@ -66,8 +66,10 @@ class AddressChanger:
         self.restored: bool | None = None
         self.tried: list[str] = []  # addresses the sensor may have been moved to
         self.unclear = False  # a move away drew no reply, or one naming another address
+        self.settled: str | None = None  # an unchecked move back no change has followed since
 
     def change(self, new: str, *, wait_for_answer: bool = True) -> ChangeOutcome:
+        self.settled = None
         if new != self.original:
             self.tried.append(new)
         before = self.master.last_exchange
@@ -106,7 +108,13 @@ class AddressChanger:
     def restore(self) -> str:
         """Put the sensor back at its original address and check that it answers there;
         returns a note for the report. A change whose reply was unclear may still have
-        happened, so every address tried is asked to move back until the original answers."""
+        happened, so every address tried is asked to move back until the original answers.
+        A restore that moved the sensor back by its reply alone (it answers no ``a!``) is not
+        done again while no change followed: asked again with ``a!``, it could only go
+        unanswered; the address sweep's closing restore did, sent ``1A0!`` to a sensor at '0'
+        and reported "COULD NOT restore" (docs/kit.md, twenty-third round)."""
+        if self.settled is not None and self.current == self.original:
+            return self.settled
         back = None
         if self.current != self.original:
             back = self.change(self.original, wait_for_answer=False)
@@ -119,10 +127,11 @@ class AddressChanger:
             # a sensor that answers no a! anywhere cannot be checked that way: its reply is
             # all there is (restored stays None: unchecked, so an address sweep stops)
             self.current, self.restored = self.original, None
-            return (
+            self.settled = (
                 f"address moved back to '{self.original}' by its reply to "
                 f"{back.request.text} (not checked: the sensor answers no a! anywhere)"
             )
+            return self.settled
         for tried in dict.fromkeys(self.tried):
             if tried == self.original:
                 continue

@@ -872,14 +872,23 @@ class SensorSession(Session):
         answered ``a!`` earlier in the run and now at none of the addresses tried is lost:
         every later case would judge the silence of an address it no longer has (a PIC
         firmware that took '9' answers only lowercase letters; R-7.0-07 FAILed "no reply 90
-        ms after the break" on it), so :attr:`lost` says why and the run stops."""
+        ms after the break" on it), so :attr:`lost` says why and the run stops. One that answers
+        no ``a!`` and still answers ``?!`` with its address is there: "COULD NOT restore" was
+        false for the twenty-third round's Due sensor, which refused ``0A$!`` by silence."""
         note = changer.restore()
-        self.address_notes.append(note)
         if changer.restored is False and self.lost is None:
             if self.master.acknowledged:
                 self.lost = note
             elif (elsewhere := self._queried_elsewhere()) is not None:
                 self.lost = f"{note}; ?! is answered {elsewhere} now"
+            elif self.queried == self.address and not self.shared:
+                # ?! still names it: where a! (never answered) cannot find it, ?! does
+                changer.restored = None
+                note = (
+                    f"address '{self.address}' after the restore: ?! answered '{self.address}' "
+                    f"(not checked with a!: the sensor answers no a! anywhere)"
+                )
+        self.address_notes.append(note)
         return note
 
     def _queried_elsewhere(self) -> str | None:

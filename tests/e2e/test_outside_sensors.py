@@ -86,16 +86,25 @@ answers, and reads ttt from the empty reply, ``(response[1] - 48) * 100000 + ...
 HAL_Delay of 4289639296 ms. Its harness said so, ``wait 4289644352000``, and the run stopped
 "time beyond 10^12 us (units wrong?)" with every later case ERROR. A ``wait`` is a long
 sleep (the job's budget ends it); only ``tx``/``brk`` times keep the bound.
+
+The twenty-third: an Arduino Due sensor (Riley-Tuckett/SDI-12SensorProject) answers only
+``?!`` and ``aAb!`` (no ``a!``). The address sweep's restore after '1' said "moved back to '0'
+by its reply to 1A0! (not checked)", then the sweep's closing restore asked again, with
+``a!``, which it never answers, sent ``1A0!`` to a sensor at '0' and reported "COULD NOT
+restore the address"; its silence to ``0A$!`` (it refuses '$') was reported the same way, though
+``?!`` still answered '0'. A restore no change has followed since is not done again, and a
+sensor that answers no ``a!`` is found at its address by ``?!``.
 """
 
 from __future__ import annotations
 
+import json
 import re
 from dataclasses import replace
 
 import pytest
 
-from conformance.conduct import run_once
+from conformance.conduct import run_into, run_once
 from conformance.emulator.faults import FaultSet
 from conformance.emulator.replies import ReplyKind
 from conformance.harness.device import HarnessBus
@@ -1022,3 +1031,22 @@ def test_a_command_truly_unanswered_beside_a_late_one_still_fails_r_4_4_01(
     details = " ".join(f["detail"] for f in row["findings"])
     assert "no reply although it is a basic command" in details and "0M3!" in details, details
     assert "0M!;" not in details and not details.rstrip().endswith("0M!"), details
+
+
+def test_a_sensor_that_answers_no_a_is_not_reported_unrestored(a_never_answered, tmp_path):
+    """The twenty-third round's Due sensor (no a!, aAb! answered): the address sweep moved it
+    to '1' and back ('0' to 1A0!); its closing restore sent 1A0! again to a sensor at '0' and
+    reported "COULD NOT restore the address ... (tried moving it back from 1)", and the refused
+    0A$! "... (tried moving it back from $)", though ?! answered '0' throughout."""
+    data = run_into(tmp_path, "sim://", keyword="test_address_range")
+    notes = data["dut"]["address_notes"]
+    assert notes and not any("COULD NOT" in note for note in notes), notes
+    assert any("moved back to '0' by its reply to 1A0!" in note for note in notes), notes
+    assert any("?! answered '0'" in note for note in notes), notes
+    tool = []
+    for line in (tmp_path / "transcript.jsonl").read_text().splitlines():
+        if '"origin": "tool"' in line and '"kind": "char"' in line:
+            tool.append(chr(json.loads(line)["wire"] & 0x7F))
+    sent = re.findall(r"[^!]*!", "".join(tool))
+    first = sent.index("1A0!")
+    assert "1A0!" not in sent[first + 1 :], sent[first:]  # once answered '0', never again
