@@ -428,6 +428,30 @@ def test_transparent_commands_pass_unchanged():
     assert found["R-4.4.14-01"].verdict is Verdict.FAIL
 
 
+def test_an_extended_command_never_sent_is_no_form_fail_r_4_4_13_03():
+    """The twenty-third round's STM32 logger library (ilhamahendra14/STM32L4xx_SDI-12, docs/
+    kit.md) sends a! and aI! of a transparent job and cannot send 0XSN! at all: R-4.4.13-03
+    (an extended command starts with its address and ends with '!') FAILed "not on the wire as
+    typed (sent instead: '0!', '0I!')", commands it was asked for and sent as typed. No
+    extended command was on the wire: its form is undecided; R-4.4.14-02 FAILs the absence."""
+    w = Wire().brk().rec("0!").sensor("0\r\n").idle(20).brk().rec("0I!").sensor("013EMU\r\n")
+    found = by_id(judge_transparent(w.view(), ["0!", "0I!", "0XSN!"], 0.0, None))
+    assert found["R-4.4.14-02"].verdict is Verdict.FAIL, found["R-4.4.14-02"].detail
+    assert found["R-4.4.13-03"].verdict is Verdict.INCONCLUSIVE, found["R-4.4.13-03"].detail
+    for rid in ("R-4.4.14-02", "R-4.4.13-03"):
+        assert "sent instead" not in found[rid].detail, found[rid].detail
+        assert "0XSN!: never sent" in found[rid].detail, found[rid].detail
+    # a recorder's own a! to another address is no extended command changed on its way
+    woke = w.idle(20).brk().rec("1!")
+    found = by_id(judge_transparent(woke.view(), ["0!", "0I!", "0XSN!"], 0.0, None))
+    assert found["R-4.4.13-03"].verdict is Verdict.INCONCLUSIVE, found["R-4.4.13-03"].detail
+    # one sent without its address (transparent-drops-address) still FAILs the form
+    dropped = woke.idle(20).brk().rec("XSN!").view()
+    found = by_id(judge_transparent(dropped, ["0!", "0I!", "0XSN!"], 0.0, None))
+    assert found["R-4.4.13-03"].verdict is Verdict.FAIL, found["R-4.4.13-03"].detail
+    assert "'XSN!'" in found["R-4.4.13-03"].detail
+
+
 def test_addresses():
     w = Wire()
     for a in "012345678":
