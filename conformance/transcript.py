@@ -33,6 +33,12 @@ BUS = "bus"
 #: tool's own characters: two talkers on the line. It is contention evidence, never the DUT's
 #: reply text, and never cuts a reply (issue 18).
 COLLISION = "collision"
+#: The ``text`` of a recorder's break that the line held back: a recorder harness asked for it
+#: while a played sensor's character was on the line, heard that character instead and asked
+#: again after it. Where it ended is where the line put it, not where the recorder's own timing
+#: had it (on a wire the break goes over the character), so the recorder's marking after it
+#: cannot FAIL R-7.0-06 (docs/kit.md, twenty-second round).
+HELD_BACK = "held back"
 
 
 #: even parity of every 7-bit character (a table: every received character is checked)

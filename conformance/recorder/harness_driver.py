@@ -11,7 +11,7 @@ read the golden recorder's.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..harness import protocol as proto
 from ..harness.channel import Channel, HarnessError
@@ -21,7 +21,7 @@ from ..links.base import Link
 from ..links.errors import PortUnavailable
 from ..recorder_jobs import RecorderOutput, Request
 from ..sim.bus import SimBus, earliest_frame
-from ..transcript import Event
+from ..transcript import HELD_BACK, Event
 from .job_time import JobBudget, JobTimeout
 
 #: Bus time one job may take when the session states no budget (:mod:`..recorder.job_time`).
@@ -99,6 +99,7 @@ class HarnessRecorder:
         the ``cannot`` reason (None: the harness did not say it cannot). A harness still
         busy when the budget runs out is cut there (:class:`JobTimeout`)."""
         limit = link.now() + budget.seconds
+        held = False  # its break was held back for a sensor's character (:func:`_holds_back`)
         while plan.kind not in (PlanKind.DONE, PlanKind.CANNOT):
             if plan.kind is PlanKind.IDLE:
                 deadline = link.now() + IDLE_END
@@ -116,6 +117,7 @@ class HarnessRecorder:
             heard = link.receive(deadline, until=_first)
             if heard:
                 got = heard[0]
+                held = plan.kind is PlanKind.BRK and (held or _holds_back(plan, got))
                 message = _quiet(channel, link, limit, proto.heard(got.wire, got.start, got.end))
                 plan = channel.plan(message, Role.RECORDER, got.end, got.start)
                 continue
@@ -128,12 +130,43 @@ class HarnessRecorder:
                 message = proto.sent(done.wire, done.start, done.end)
             else:  # BRK
                 made = link.send_break(proto.seconds(plan.end) - link.now())
+                if held or _moved(plan, made):
+                    _mark_held_back(link, made)
                 message = proto.line_break(made.start, made.end)
+            held = False
             message = _quiet(channel, link, limit, message)
             plan = channel.plan(message, Role.RECORDER, link.now())
         if plan.kind is PlanKind.CANNOT:
             return "cannot" + (f" {plan.reason}" if plan.reason else ""), plan.reason
         return "done", None
+
+
+def _holds_back(plan: Plan, got: Event) -> bool:
+    """Whether the played sensor's character ``got``, heard before the break ``plan`` went
+    out, was on the line at the break's start: the line gave it the line, and the break the
+    harness plans next is this one held back, not a new decision. On a wire the recorder's
+    break goes over the character (it drives the line regardless), so the end the line gives
+    it is not the one the recorder's own timing had (docs/kit.md, twenty-second round)."""
+    return got.end > proto.seconds(plan.start)
+
+
+def _moved(plan: Plan, made: Event) -> bool:
+    """Whether the line began the break ``made`` later than ``plan`` asked (past the slack a
+    plan for "now" has, :data:`~..harness.protocol.PAST_SLACK_US`): a played sensor's
+    character planned for the same instant took the line first and the break followed it
+    whole (:meth:`~..sim.bus.SimBus.tool_break`; the twenty-second round's library began its
+    break for ``0IM!`` where the sensor's 51st character of ``0XHELP!`` text began)."""
+    return made.start > proto.seconds(plan.start + proto.PAST_SLACK_US)
+
+
+def _mark_held_back(link: Link, made: Event) -> None:
+    """``made``, the break the line held back, marked :data:`~..transcript.HELD_BACK` in the
+    transcript where it stands (the devices that talked on under it come after it)."""
+    events = link.transcript.events
+    for i in range(len(events) - 1, -1, -1):
+        if events[i] is made:
+            events[i] = replace(made, text=HELD_BACK)
+            return
 
 
 def _quiet(channel: Channel, link: Link, limit: float, message: str) -> str:

@@ -173,6 +173,30 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
         " after the line's last activity and R-7.0-17 holds on the wire (seed 50).",
         removes=("R-7.0-17",),
     ),
+    Interaction(
+        frozenset({"ignores-service-request", "interleaves-measurements", "late-d0-without-break"}),
+        "ignores-service-request waits the whole ttt and sends aD0! after a break, so"
+        " late-d0-without-break's skipped break is left over; beside it alone the next"
+        " command takes it (1M! to a new sensor in two-sensors: R-7.0-17). Here"
+        " interleaves-measurements sends 1M! before 0D0! (after a break), and each skip falls on"
+        " a command that needs no break (the same sensor, within 87 ms: 8 skips, at 2.417 s,"
+        " 286.145 s ...): R-7.0-17 holds on the wire ('62 commands without a break,"
+        " 9.00..45.00 ms', seed 5).",
+        removes=("R-7.0-17",),
+    ),
+    # masked: with every try after a break unheard, no measurement with values past D0 runs
+    *(
+        Interaction(
+            frozenset({never, "short-marking", "stops-after-d0"}),
+            f"{_UNHEARD} and {never} never retries without a break, so d0-to-d2's 0M2!,"
+            " concurrent-99's 0C9! and aHA!/aHB! are never answered (three break+command"
+            " tries each, logged {'0M2!': []}): no measurement whose values go past D0 reaches"
+            " stops-after-d0, and R-4.4.8-05 holds on the six that ran, each whole in D0"
+            " (0M1!, 0MC!, 0V!, 0C!, 0C1!, 0CC!; seed 1).",
+            removes=("R-4.4.8-05",),
+        )
+        for never in ("no-retries", "retries-with-break")
+    ),
     # masked: breaks-over-long-reply never retries without a break (all pairs, stop 48)
     *(
         Interaction(

@@ -1,9 +1,13 @@
-"""Judges of the recorder's breaks: their length and the marking after them (R-7.0-02/06),
-and when a break is due (R-7.0-17, R-7.1-01)."""
+"""Judges of the recorder's breaks: their length and the marking after them (R-7.0-02/06;
+after a break the line held back, :func:`_after_held_back`), and when a break is due
+(R-7.0-17, R-7.1-01)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
+from ...transcript import HELD_BACK
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
 from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
@@ -56,16 +60,16 @@ class Breaks:
             )
         seen = self._markings_seen
         for s in line.transmissions:
-            if s.break_event is None:
+            brk = s.break_event
+            if brk is None:
                 continue
-            marking = s.first_char - s.break_event.end
-            u = max(
-                own_uncertainty(uncertainty, s.chars[0]), s.break_event.duration_uncertainty or 0.0
+            marking = s.first_char - brk.end
+            u = max(own_uncertainty(uncertainty, s.chars[0]), brk.duration_uncertainty or 0.0)
+            judged = seen.first(marking, u) or seen.keep(
+                MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"])
             )
-            self.markings.append(
-                seen.first(marking, u)
-                or seen.keep(MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"]))
-            )
+            held = brk.text == HELD_BACK and judged.verdict is not Verdict.PASS
+            self.markings.append(_after_held_back(judged, s) if held else judged)
 
     def findings(self) -> list[Finding]:
         """R-7.0-02 and R-7.0-06 over everything added."""
@@ -73,6 +77,25 @@ class Breaks:
             combine("R-7.0-02", self.lengths, "break"),
             combine("R-7.0-06", self.markings, "marking"),
         ]
+
+
+def _after_held_back(judged: MeasuredAsJudged, s: Transmission) -> Finding:
+    """A marking short of R-7.0-06 after a break the line held back (:data:`HELD_BACK`):
+    INCONCLUSIVE. The line moved the break's end later than the recorder asked, and a
+    recorder that times its command from its own clock (a 1 ms tick, a deadline set when it
+    began the break) marks less after the moved end than it would on a wire, where its break
+    goes over the sensor's character; how much less is not known. One that holds still
+    PASSes: the break only ever moves later, so the command comes no nearer to it on a wire."""
+    return replace(
+        judged.finding,
+        verdict=Verdict.INCONCLUSIVE,
+        detail=(
+            f"{judged.detail}; after a break the line held back for a sensor's character (the"
+            " recorder asked for it while the character was on the line): where the"
+            " recorder's own timing puts its command after its break on a wire is not known"
+        ),
+        evidence=[f"before {s.at()}"],
+    )
 
 
 def judge_break_rules(line: TranscriptView, uncertainty: float) -> list[Finding]:
