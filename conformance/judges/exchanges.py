@@ -21,6 +21,7 @@ from ..tool_recorder.records import Exchange
 from ..transcript import decode_7e1, escape
 
 __all__ = [
+    "answered_late",
     "ascii_crc",
     "heard_late",
     "late_answer",
@@ -39,7 +40,14 @@ __all__ = [
 from ..preconditions import ControlledProbe, collided_answers, listening, shows_listening
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .cite import cite, cited, heard, shown
-from .late_before import heard_late, late_answer, late_elsewhere, late_reply, late_shown
+from .late_before import (
+    answered_late,
+    heard_late,
+    late_answer,
+    late_elsewhere,
+    late_reply,
+    late_shown,
+)
 from .measurements import shown_reply_ids, undecide_uncompared_crc
 from .support import text_instead_of_values
 from .tally import Tally
@@ -191,8 +199,9 @@ def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     """An unanswered ``ex`` whose reply came after the tool stopped listening (it ran into the
     retries: a sensor whose every reply starts 80 ms late, deaf until then) is no "got no
     reply": undecided for ``ids`` on ``tally`` (INCONCLUSIVE unless something else FAILs them;
-    R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL."""
-    late = late_answer(ex)
+    R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL. So is
+    one answered with what may be the command before's late reply (:func:`answered_late`)."""
+    late = answered_late(ex)
     if not late:
         return False
     label = escape(ex.text)
@@ -224,8 +233,9 @@ def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
     """INCONCLUSIVE for ``rid`` if ``ex`` went unanswered in its windows but its reply came
     after them (:func:`late_reply`): the rule asks for ``what`` of a reply the tool did not
     take, so silence is no evidence against it (R-7.0-10 judges the timing). None otherwise:
-    a silent or answered exchange is the caller's to judge."""
-    late = late_answer(ex)
+    a silent or answered exchange is the caller's to judge; one answered with what may be the
+    command before's late reply is not (:func:`answered_late`)."""
+    late = answered_late(ex)
     if not late:
         return None
     return inconclusive(
@@ -244,7 +254,7 @@ def late_among(rid: str, exchanges: Iterable[Exchange], what: str) -> Finding | 
     sensor's aD0! after an abort and after a break and zI! came 80 ms late, its values cut by
     the retry: "after the abort M delivered 0 values" and "C delivered 0 values after a break
     and zI!" were false FAILs (truth12)."""
-    late = [(ex, text) for ex in exchanges if (text := late_answer(ex))]
+    late = [(ex, text) for ex in exchanges if (text := answered_late(ex))]
     if not late:
         return None
     return inconclusive(

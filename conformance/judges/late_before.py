@@ -102,3 +102,11 @@ def late_elsewhere(ex: Exchange) -> str:
     if not heard or address is None or heard[0].char7 == ord(address[0]):
         return ""
     return decode_7e1(heard)
+
+
+def answered_late(ex: Exchange) -> str:
+    """How ``ex``'s reply came late ('' if it did not): unanswered in its windows with its
+    reply after them (:func:`late_answer`), or answered with what may be the command
+    before's late reply (:func:`earlier_reply`). The one test of the rules that leave a late
+    reply to R-7.0-10 (late_only, late_among, undecided_if_late, the D replies)."""
+    return late_answer(ex) if not ex.answered else earlier_reply(ex)

@@ -26,7 +26,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
-from .late_before import earlier_reply, late_answer
+from .late_before import answered_late, earlier_reply
 from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wire import runs
@@ -220,7 +220,7 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     silent = late = None
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
-        if taken_late := late_data_reply(ex):
+        if taken_late := answered_late(ex):
             # its reply came after the tool stopped listening, or the one taken may be the D
             # before's: no silence, no count cut short, no values of its own to judge
             # (replies-after-retry + wrong-crc: "0C9! 0D6!: no reply to 0D6!" and "60 values
@@ -290,13 +290,6 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     if m.command.kind is Kind.HIGH_VOLUME_ASCII:
         tally.observe(label, ids=["R-5.1-02"])
         _undecide_unread_high_volume(m, replies, tally, label)
-
-
-def late_data_reply(ex: Exchange) -> str:
-    """How a D exchange's reply came late ('' if it did not): unanswered in its windows with
-    its reply after them (:func:`~.exchanges.late_answer`), or answered with what may be the
-    command before's late reply (:func:`~.late_before.earlier_reply`)."""
-    return late_answer(ex) if not ex.answered else earlier_reply(ex)
 
 
 @lru_cache(maxsize=4096)

@@ -14,11 +14,14 @@ from __future__ import annotations
 
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as mjudge
+from conformance.judges import wire
 from conformance.judges.late_before import earlier_reply, heard_late, late_elsewhere
+from conformance.judges.metadata import identify_matches
 from conformance.protocol import commands as cmds
 from conformance.tool_recorder.records import NO_REPLY, OK, Attempt, Exchange, Measurement
-from conformance.transcript import DUT, TOOL
+from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Verdict
+from conformance.view.runs import segments
 from tests.support.hand_events import chars
 
 LATE = 0.080  # the sensor's reply start after the command it heard
@@ -136,3 +139,40 @@ def test_a_late_reply_with_the_probe_s_address_is_its_answer() -> None:
     assert heard_late(ex) and late_elsewhere(ex) == ""
     control = _exchange("0!", 1.0, "0\r\n")
     assert xjudge.silent("R-7.0-15", [ex], "in standby", baseline=control).verdict is Verdict.FAIL
+
+
+def _foreign_then_own(reply: str) -> list[Event]:
+    """z! unanswered at 0 s, then 0! 30 ms after it, and ``reply`` 80 ms after z! ended (33 ms
+    after 0!): answers-foreign-address + replies-after-retry's R-7.0-14 probe on the wire."""
+    events = [Event(EventKind.BREAK, TOOL, 0.0, 0.013)]
+    events += (z := chars(TOOL, "z!", 0.022))
+    events += chars(TOOL, "0!", z[-1].end + 0.030)
+    events += chars(DUT, reply, z[-1].end + LATE)
+    return events
+
+
+def test_r_4_3_01_a_reply_naming_the_unanswered_command_before_is_not_judged_as_this_one_s():
+    found = {f.requirement: f for f in wire.judge_framing(segments(_foreign_then_own("z\r\n")))}
+    assert found["R-4.3-01"].verdict is Verdict.INCONCLUSIVE, found["R-4.3-01"]  # FAIL before
+    assert "may be z!'s late reply" in found["R-4.3-01"].detail
+    # a reply naming neither command is still a wrong address
+    found = {f.requirement: f for f in wire.judge_framing(segments(_foreign_then_own("5\r\n")))}
+    assert found["R-4.3-01"].verdict is Verdict.FAIL
+
+
+def test_r_6_1_02_an_identify_reply_that_may_be_the_command_before_s_is_not_compared() -> None:
+    ident = _after_unanswered("0M!", "0IM1!", "00019\r\n")  # 0M!'s count, late
+    start = _exchange("0M1!", 1.0, "00012\r\n")
+    m = Measurement(start.command, start)
+    (found,) = identify_matches([(ident, m)])
+    assert found.verdict is Verdict.INCONCLUSIVE, found  # FAIL "announces 9 values" before
+    assert "may be 0M!'s late reply" in found.detail
+
+
+def test_r_4_4_8_1_02_a_continuous_reply_that_is_an_identification_is_not_r1_s() -> None:
+    """ident-bad-version + replies-after-retry: aI!'s late reply taken by aR1! FAILed "R1
+    without the lower indices first gave no values: 0R1! -> '0V4CONFORM...'"."""
+    ex = _after_unanswered("0I!", "0R1!", "0V4CONFORM EMU001100SN0001\r\n")
+    found = xjudge.late_only("R-4.4.8.1-02", ex, "R1 without the lower indices first")
+    assert found is not None and found.verdict is Verdict.INCONCLUSIVE  # None before: FAIL
+    assert "may be 0I!'s late reply" in found.detail
