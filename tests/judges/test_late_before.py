@@ -15,6 +15,7 @@ from __future__ import annotations
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as mjudge
 from conformance.judges import wire
+from conformance.judges.extended import extended_replies
 from conformance.judges.late_before import earlier_reply, heard_late, late_elsewhere
 from conformance.judges.metadata import identify_matches
 from conformance.protocol import commands as cmds
@@ -176,3 +177,14 @@ def test_r_4_4_8_1_02_a_continuous_reply_that_is_an_identification_is_not_r1_s()
     found = xjudge.late_only("R-4.4.8.1-02", ex, "R1 without the lower indices first")
     assert found is not None and found.verdict is Verdict.INCONCLUSIVE  # None before: FAIL
     assert "may be 0I!'s late reply" in found.detail
+
+
+def test_r_4_4_13_01_an_extended_reply_that_may_be_the_command_before_s_is_not_judged() -> None:
+    """answers-foreign-address + replies-after-retry: 0XSN!'s reply '0EMU-0001', 80 ms after
+    its retry, was taken by 0XHELP!: R-4.4.13-01/-02 PASSed "conforms (1 checked: 0XHELP!)"
+    on another command's words."""
+    ex = _after_unanswered("0XSN!", "0XHELP!", "0EMU-0001\r\n")
+    found = {f.requirement: f for f in extended_replies([ex], "0")}
+    for rid in ("R-4.4.13-01", "R-4.4.13-02"):  # PASS before
+        assert found[rid].verdict is Verdict.INCONCLUSIVE, found[rid]
+        assert "may be 0XSN!'s late reply" in found[rid].detail
