@@ -25,8 +25,8 @@ from ..view.sides import expected_reply_address
 
 def earlier_reply(ex: Exchange) -> str:
     """'' unless the reply ``ex`` took may be ``ex.late_before``'s, late: it began after that
-    command's last try, within the 87 ms ``LateStartWatch`` believes a late start, with the
-    address that command's reply carries, and its words do not make it ``ex``'s alone. Then
+    command's last try, within the 87 ms ``LateStartWatch`` believes a late start, naming
+    no address of ``ex``'s alone, and its words do not make it ``ex``'s alone. Then
     the wording a finding gives: ``'<reply>' to 0MC1! may be 0D0!'s late reply (80.00 ms
     after it)``."""
     before = ex.late_before
@@ -36,8 +36,11 @@ def earlier_reply(ex: Exchange) -> str:
     lag = reply[0].start - before.last.command_end
     if not 0 < lag <= NO_BREAK_WINDOW:
         return ""
-    address = expected_reply_address(before.text)
-    if address is not None and reply[0].char7 != ord(address[0]):
+    # a reply naming this command's address and not the earlier one's is this one's; one
+    # naming neither is no evidence either way (wrong-reply-address: D replies from '1')
+    named = chr(reply[0].char7)
+    address, own_address = expected_reply_address(before.text), expected_reply_address(ex.text)
+    if address is not None and named != address and named == own_address:
         return ""
     text = ex.reply_text
     own = ex.command is not None and fits_shape(ex.command, text)

@@ -188,3 +188,13 @@ def test_r_4_4_13_01_an_extended_reply_that_may_be_the_command_before_s_is_not_j
     for rid in ("R-4.4.13-01", "R-4.4.13-02"):  # PASS before
         assert found[rid].verdict is Verdict.INCONCLUSIVE, found[rid]
         assert "may be 0XSN!'s late reply" in found[rid].detail
+
+
+def test_r_4_4_5_01_a_late_reply_naming_neither_address_is_still_doubted() -> None:
+    """wrong-reply-address + replies-after-retry: 0D0!'s late reply from '1' taken by 0MC1!
+    FAILed R-4.4.5-01 "reply '1+22.15...' does not have the form atttn"."""
+    ex = _after_unanswered("0D0!", "0MC1!", "1+22.15+1013.2+45.7K\x7fQ\r\n")
+    assert "0D0!'s late reply" in earlier_reply(ex)
+    m = Measurement(ex.command, ex)
+    found = {f.requirement: f for f in mjudge.judge([m], ["R-4.4.5-01"], "14")}
+    assert found["R-4.4.5-01"].verdict is Verdict.INCONCLUSIVE, found  # FAIL before
