@@ -924,23 +924,32 @@ class Framing:
             allowed = _expected_addresses(
                 expected, self.started if not is_reply else None, self.shown, self.own
             )
-            if expected and body[:1] not in allowed and is_reply and earlier is not None:
-                # it names the unanswered command before, whose late reply it may be (a
-                # sensor 80 ms late answered z! over the 0! after it: 'z<CR><LF>' FAILed as
-                # 0!'s, answers-foreign-address + replies-after-retry, truth15)
-                tally.undecide(
-                    "R-4.3-01",
-                    label,
-                    f"'{escape(text)}' may be {escape(earlier.text)}'s late reply "
-                    "(R-7.0-10 judges its timing)",
-                )
-            elif expected and body[:1] not in allowed:
-                tally.fail(
-                    "R-4.3-01",
-                    label,
-                    f"reply '{escape(text)}' starts with "
-                    f"'{escape(body[:1])}', not the address '{expected}'",
-                )
+            if expected and body[:1] not in allowed:
+                named = body[:1]
+                _wrong_address(tally, label, text, named, expected, earlier if is_reply else None)
+
+
+def _wrong_address(
+    tally: Tally, label: str, text: str, named: str, expected: str, earlier: Segment | None
+) -> None:
+    """R-4.3-01 for a reply ``text`` whose body starts with ``named``, not ``expected``: a FAIL, or
+    undecided where a reply names the unanswered command before it (``earlier``,
+    :func:`_unanswered_before`), whose late reply it may be (a sensor 80 ms late answered z!
+    over the 0! after it: 'z<CR><LF>' FAILed as 0!'s, answers-foreign-address +
+    replies-after-retry, truth15)."""
+    if earlier is not None:
+        tally.undecide(
+            "R-4.3-01",
+            label,
+            f"'{escape(text)}' may be {escape(earlier.text)}'s late reply "
+            "(R-7.0-10 judges its timing)",
+        )
+        return
+    tally.fail(
+        "R-4.3-01",
+        label,
+        f"reply '{escape(text)}' starts with '{escape(named)}', not the address '{expected}'",
+    )
 
 
 def _expected_addresses(
