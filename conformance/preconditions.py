@@ -22,6 +22,7 @@ from types import MappingProxyType
 from typing import Any, Protocol
 
 from .judges.cite import cited, heard, shown
+from .judges.late_before import heard_late
 from .judges.reply_validity import check_reply
 from .judges.support import serves_measurement
 from .protocol.timing import CHAR_TIME, STANDBY_MARKING, TOLERANCE
@@ -380,7 +381,7 @@ def shows_listening(control: Exchange) -> bool:
     its window whose late reply the longer listen for a sensor seen late heard
     (:attr:`Exchange.heard_late`, :meth:`SensorSession.hear_late`) shows it listening too."""
     if not control.answered:
-        return any(e.origin != TOOL for e in control.heard_late)
+        return heard_late(control)  # a late reply naming another address is not its answer
     if not control.maybe_collided:
         return True
     judged = control.judged

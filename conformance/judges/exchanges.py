@@ -18,10 +18,16 @@ from ..protocol.responses import (
 )
 from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
-from ..transcript import DUT, decode_7e1, escape
+from ..transcript import decode_7e1, escape
 
 __all__ = [
+    "answered_late",
     "ascii_crc",
+    "heard_late",
+    "late_answer",
+    "late_elsewhere",
+    "late_reply",
+    "late_shown",
     "cite",
     "cited",
     "escape",
@@ -34,6 +40,14 @@ __all__ = [
 from ..preconditions import ControlledProbe, collided_answers, listening, shows_listening
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .cite import cite, cited, heard, shown
+from .late_before import (
+    answered_late,
+    heard_late,
+    late_answer,
+    late_elsewhere,
+    late_reply,
+    late_shown,
+)
 from .measurements import shown_reply_ids, undecide_uncompared_crc
 from .support import text_instead_of_values
 from .tally import Tally
@@ -98,7 +112,7 @@ def silent(
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
     answered = [ex for ex in exchanges if ex.answered or heard_late(ex)]
-    met = [ex for ex in exchanges if not ex.answered and ex.maybe_collided]
+    met = [ex for ex in exchanges if not ex.answered and (ex.maybe_collided or late_elsewhere(ex))]
     if answered:
         make = warned if should else failed
         return make(
@@ -117,8 +131,11 @@ def silent(
             + " either, so its silence here shows nothing"
             + collided_answers(controls),
         )
-    heard = [ex for ex in exchanges if ex.answered or not ex.maybe_collided]
-    aside = f"{len(met)} command(s) set aside (maybe collided: may not have been heard)"
+    heard = [ex for ex in exchanges if ex.answered or ex not in met]
+    aside = (
+        f"{len(met)} command(s) set aside (maybe collided, or a late reply naming another "
+        "address came over it: may not have been heard)"
+    )
     if not heard:
         return inconclusive(
             rid,
@@ -178,47 +195,13 @@ def silent_while_listening(
     )
 
 
-def heard_late(ex: Exchange) -> bool:
-    """Whether a one-shot ``ex`` unanswered in its window drew a reply the longer listen for
-    a sensor seen late heard (``ex.heard_late``): an answer all the same, to a command that
-    was sent once with nothing after it. standby-ignored + replies-after-retry answered
-    R-7.0-15's a! 101.90 ms after a reply, 80 ms late, and the rule PASSed "stayed silent"
-    (truth12)."""
-    return not ex.answered and any(e.origin == DUT for e in ex.heard_late)
-
-
-def late_reply(ex: Exchange) -> str:
-    """What the DUT sent after the tool had stopped listening for a try of ``ex`` and before
-    its next try ('' if nothing): a late reply, R-7.0-10's deviation, not silence. A Pico
-    firmware reads its RTD for 30 ms before it answers ``aM1!``; its '00001' came 32 ms after
-    each try, and "no reply although silence does not comply" was false (docs/kit.md,
-    fifteenth round). For a one-shot command, what a longer listen heard after its window
-    (``heard_late``, truth12)."""
-    strays = [e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT]
-    return decode_7e1(strays + [e for e in ex.heard_late if e.origin == DUT])
-
-
-def late_shown(ex: Exchange) -> str:
-    """``0M1! -> late '00001<CR><LF>'``: the command and the first line of its late reply."""
-    text = late_reply(ex)
-    return f"{escape(ex.text)} -> late '{escape(text[: text.find(chr(10)) + 1] or text)}'"
-
-
-def late_answer(ex: Exchange) -> str:
-    """``answered only after the reply window: 0M1! -> late '00001<CR><LF>'`` for an
-    ``ex`` unanswered in its windows whose reply came after them (:func:`late_reply`), ''
-    otherwise: the one wording of the rules that leave such a reply to R-7.0-10."""
-    if ex.answered or not late_reply(ex):
-        return ""
-    return f"answered only after the reply window: {late_shown(ex)}"
-
-
 def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     """An unanswered ``ex`` whose reply came after the tool stopped listening (it ran into the
     retries: a sensor whose every reply starts 80 ms late, deaf until then) is no "got no
     reply": undecided for ``ids`` on ``tally`` (INCONCLUSIVE unless something else FAILs them;
-    R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL."""
-    late = late_answer(ex)
+    R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL. So is
+    one answered with what may be the command before's late reply (:func:`answered_late`)."""
+    late = answered_late(ex)
     if not late:
         return False
     label = escape(ex.text)
@@ -250,8 +233,9 @@ def late_only(rid: str, ex: Exchange, what: str) -> Finding | None:
     """INCONCLUSIVE for ``rid`` if ``ex`` went unanswered in its windows but its reply came
     after them (:func:`late_reply`): the rule asks for ``what`` of a reply the tool did not
     take, so silence is no evidence against it (R-7.0-10 judges the timing). None otherwise:
-    a silent or answered exchange is the caller's to judge."""
-    late = late_answer(ex)
+    a silent or answered exchange is the caller's to judge; one answered with what may be the
+    command before's late reply is not (:func:`answered_late`)."""
+    late = answered_late(ex)
     if not late:
         return None
     return inconclusive(
@@ -270,7 +254,7 @@ def late_among(rid: str, exchanges: Iterable[Exchange], what: str) -> Finding | 
     sensor's aD0! after an abort and after a break and zI! came 80 ms late, its values cut by
     the retry: "after the abort M delivered 0 values" and "C delivered 0 values after a break
     and zI!" were false FAILs (truth12)."""
-    late = [(ex, text) for ex in exchanges if (text := late_answer(ex))]
+    late = [(ex, text) for ex in exchanges if (text := answered_late(ex))]
     if not late:
         return None
     return inconclusive(

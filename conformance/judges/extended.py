@@ -8,6 +8,7 @@ from ..protocol.values import VALUES_MAX
 from ..tool_recorder.records import Exchange
 from ..transcript import Event, escape
 from ..verdicts import Finding
+from .late_before import answered_late
 from .tally import Tally
 from .timing import judge_window
 
@@ -22,6 +23,13 @@ def extended_replies(exchanges: list[Exchange], address: str) -> list[Finding]:
     tally = Tally(("R-4.4.13-01", "R-4.4.13-02"))
     for ex in exchanges:
         label = escape(ex.text)
+        if late := answered_late(ex):
+            # a reply after the window, or one that may be the command before's: no reply of
+            # this command's to judge (0XSN!'s late reply, 80 ms after its retry, was taken
+            # by the 0XHELP! after it, answers-foreign-address + replies-after-retry, truth15)
+            for rid in tally.ids:
+                tally.undecide(rid, label, f"{late} (R-7.0-10 judges its timing)")
+            continue
         if not ex.answered:
             continue  # an extended command may be unknown to the sensor: silence is allowed
         # only a command the sensor answers shows that it implements that name

@@ -26,6 +26,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
+from .late_before import answered_late, earlier_reply
 from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wire import runs
@@ -216,9 +217,19 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         return
     replies: list[DataReply] = []
     limit = expected_value_limit(m.command)
-    silent = None
+    silent = late = None
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
+        if taken_late := answered_late(ex):
+            # its reply came after the tool stopped listening, or the one taken may be the D
+            # before's: no silence, no count cut short, no values of its own to judge
+            # (replies-after-retry + wrong-crc: "0C9! 0D6!: no reply to 0D6!" and "60 values
+            # were returned for 99 announced" FAILed on a D6 whose reply met the retry, truth15)
+            hv = ["R-5.1-02"] if m.command.kind is Kind.HIGH_VOLUME_ASCII else []
+            for rid in ("R-4.4.8-01", "R-4.4.8-03", *hv):
+                tally.undecide(rid, dlabel, f"{taken_late} (R-7.0-10 judges its timing)")
+            silent = late = ex
+            break
         if not ex.answered:
             tally.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
             if m.command.kind is Kind.HIGH_VOLUME_ASCII:
@@ -235,6 +246,8 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
             # as silence there is (high-volume-stops-at-d9 + unknown-command-text PASSed)
             tally.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
     seq = check_data_sequence(replies, m.count, limit)
+    if late is not None:  # the count was cut at a late reply, not at silence
+        seq = [v for v in seq if v.requirement != "R-4.4.8-03"]
     _drop_split_fragments(replies, seq, tally, label)
     _undecide_cut_at_silence(m, replies, silent, tally, label)
     if not replies and silent is not None:
@@ -530,6 +543,12 @@ class Measurements:
 
     def _judge(self, m: Measurement, chatter: frozenset[str]) -> None:
         tally = self.tally
+        if earlier := earlier_reply(m.start):
+            # the reply taken may be the command before's, late: no words of this start's
+            # to judge, nor values it announced (replies-after-retry + wrong-crc, truth15)
+            for rid in tally.ids:
+                tally.undecide(rid, where(m), f"{earlier} (R-7.0-10 judges its timing)")
+            return
         tally.observe(
             where(m),
             reply_violations(m, self.version),

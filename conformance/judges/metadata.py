@@ -9,7 +9,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
-from .exchanges import undecided_if_late
+from .exchanges import answered_late, undecided_if_late
 from .tally import Tally
 
 SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
@@ -23,6 +23,11 @@ def identify_matches(pairs: list[tuple[Exchange, Measurement]]) -> list[Finding]
     for ident, m in pairs:
         label = escape(ident.text)
         if not ident.answered or not m.start.answered or ident.command is None:
+            continue
+        if late := answered_late(ident) or answered_late(m.start):
+            # the reply taken may be the command before's: two counts of different
+            # commands compared (answers-foreign-address + replies-after-retry, truth15)
+            tally.undecide("R-6.1-02", label, f"{late} (R-7.0-10 judges its timing)")
             continue
         a, _ = split_line(ident.reply_text)
         b, _ = split_line(m.start.reply_text)

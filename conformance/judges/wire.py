@@ -840,6 +840,7 @@ class Framing:
         self.shown: str | None = None  # the address the last reply beginning with its own showed
         self._pending: Segment | None = None  # the last segment added, not judged yet
         self._open_text = False  # multi-line text a command talked over, its ETX not yet seen
+        self._before: Segment | None = None  # the last segment judged
 
     def add(self, segs: list[Segment]) -> None:
         """The replies and later lines of ``segs`` (the next window's segments)."""
@@ -860,6 +861,7 @@ class Framing:
     def _judge(self, seg: Segment, *, cut: bool) -> None:
         """One segment; ``cut``: the next transmission's contention met what followed it."""
         tally = self.tally
+        earlier, self._before = _unanswered_before(self._before, seg), seg
         if seg.reply:
             self.last_address = last_address = seg.reply[0].char7
             if _starts_measurement(seg.text):
@@ -923,12 +925,31 @@ class Framing:
                 expected, self.started if not is_reply else None, self.shown, self.own
             )
             if expected and body[:1] not in allowed:
-                tally.fail(
-                    "R-4.3-01",
-                    label,
-                    f"reply '{escape(text)}' starts with "
-                    f"'{escape(body[:1])}', not the address '{expected}'",
-                )
+                named = body[:1]
+                _wrong_address(tally, label, text, named, expected, earlier if is_reply else None)
+
+
+def _wrong_address(
+    tally: Tally, label: str, text: str, named: str, expected: str, earlier: Segment | None
+) -> None:
+    """R-4.3-01 for a reply ``text`` whose body starts with ``named``, not ``expected``: a FAIL, or
+    undecided where a reply names the unanswered command before it (``earlier``,
+    :func:`_unanswered_before`), whose late reply it may be (a sensor 80 ms late answered z!
+    over the 0! after it: 'z<CR><LF>' FAILed as 0!'s, answers-foreign-address +
+    replies-after-retry, truth15)."""
+    if earlier is not None:
+        tally.undecide(
+            "R-4.3-01",
+            label,
+            f"'{escape(text)}' may be {escape(earlier.text)}'s late reply "
+            "(R-7.0-10 judges its timing)",
+        )
+        return
+    tally.fail(
+        "R-4.3-01",
+        label,
+        f"reply '{escape(text)}' starts with '{escape(named)}', not the address '{expected}'",
+    )
 
 
 def _expected_addresses(

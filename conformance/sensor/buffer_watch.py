@@ -10,6 +10,7 @@ explicitly; this watch lets the session say "already filled" without sending any
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 from ..links.base import Link
 from ..protocol.commands import Command, Kind
@@ -17,7 +18,7 @@ from ..protocol.responses import holds_values
 from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
-from ..tool_recorder.records import Attempt
+from ..tool_recorder.records import Attempt, Exchange
 from ..transcript import SEVEN_BITS, decode_7e1
 from .late_watch import LateStartWatch
 
@@ -54,6 +55,33 @@ class WatchedToolRecorder(ToolRecorder):
         self.watch = BufferWatchHooks()
         super().__init__(link, policy, address=address, hooks=self.watch)
         self.last_sent = self.watch.last_sent
+
+    def transact(self, command: Command | str, **kw: Any) -> Exchange:
+        """The engine's exchange, linked to the one before it where that may have answered
+        late (:meth:`_link_late_before`); measurements' starts and D reads come here too."""
+        before = self.last_exchange
+        return self._link_late_before(before, super().transact(command, **kw))
+
+    def raw(self, text: str | bytes, **kw: Any) -> Exchange:
+        """The engine's one-shot exchange, linked as :meth:`transact`'s are."""
+        before = self.last_exchange
+        return self._link_late_before(before, super().raw(text, **kw))
+
+    def _link_late_before(self, before: Exchange | None, ex: Exchange) -> Exchange:
+        """Set ``ex.late_before`` to ``before`` where its last try drew no reply and the
+        sensor has been seen to start its replies late (``watch.late``): a reply ``ex`` took
+        may then be ``before``'s, the sensor deaf to ``ex`` until it had answered (the
+        replies-after-retry sensor's late aD0! reply was read as aMC1!'s, "does not have the
+        form atttn", beside wrong-crc, truth15). A sensor never seen late links nothing."""
+        if (
+            before is not None
+            and before is not ex
+            and before.attempts
+            and not before.last.reply_events
+            and self.watch.late.start is not None
+        ):
+            ex.late_before = before
+        return ex
 
     def buffer_holds_values(self, address: str) -> bool:
         """The last command sent to ``address`` was an ASCII D read answered with values:

@@ -14,13 +14,14 @@ evidence again; a sensor never seen late costs nothing.
 from __future__ import annotations
 
 from ..judges.wire import EARLY_WINDOW
+from ..protocol.timing import NO_BREAK_WINDOW
 from ..tool_recorder.records import Attempt
 from ..transcript import DUT
 from ..view.sides import expected_reply_address
 
 #: The latest start (s) believed: beyond the 87 ms a recorder may wait before it must break
 #: again, a start is no reply to a try the retry followed 55 ms after it.
-LATE_START_MAX = 0.087
+LATE_START_MAX = NO_BREAK_WINDOW
 
 
 class LateStartWatch:

@@ -499,6 +499,7 @@ class SensorSession(Session):
         tool recorder's record stands and the run's assumptions say so: never a silent
         difference."""
         if seen is not None and same_reading(made, seen):
+            _carry_late_before(made, seen)
             return seen
         self.view_disagreements += 1
         note = (
@@ -1063,6 +1064,17 @@ def same_reading(made: Exchange | Measurement, seen: Exchange | Measurement) -> 
             and all(map(_same_exchange, made.data, seen.data))
         )
     return False
+
+
+def _carry_late_before(made: Exchange | Measurement, seen: Exchange | Measurement) -> None:
+    """The engine's ``late_before`` links (:meth:`~.buffer_watch.WatchedToolRecorder.
+    _link_late_before`) onto the view's record of the same stimulus: the wire alone, cut at
+    the stimulus, has no command before it."""
+    if isinstance(made, Exchange) and isinstance(seen, Exchange):
+        seen.late_before = made.late_before
+    elif isinstance(made, Measurement) and isinstance(seen, Measurement):
+        for a, b in zip((made.start, *made.data), (seen.start, *seen.data), strict=True):
+            b.late_before = a.late_before
 
 
 def _unanswered_break_end(events: list[Event], lookback: int = 4000) -> float | None:

@@ -72,6 +72,11 @@ class Exchange:
     #: sensor seen to start its replies late (:meth:`~conformance.sensor.session.
     #: SensorSession.hear_late`): its late reply, never taken for the reply
     heard_late: list[Event] = field(default_factory=list)
+    #: The command sent just before this one when its last try drew no reply and the sensor
+    #: had been seen to start its replies late (set by the sensor session's engine,
+    #: :class:`~conformance.sensor.buffer_watch.WatchedToolRecorder`): a reply this exchange
+    #: took may be that command's, late (:func:`~conformance.judges.late_before.earlier_reply`)
+    late_before: Exchange | None = field(default=None, repr=False, compare=False)
 
     @property
     def last(self) -> Attempt:

@@ -154,6 +154,23 @@ def _shape_problem(command: Command, body: str, crc_expected: bool | None) -> st
     return None  # extended commands: address and CR LF are all the standard fixes
 
 
+def fits_shape(command: Command, text: str) -> bool:
+    """Whether the line ``text`` is loosely a reply to ``command``: its address and the shape
+    of its family as the engine accepts it (:func:`_shape_problem`), a CRC's value aside (a
+    D or R reply's CRC is cut where it reads as one). Which of two commands a reply that
+    began after both answers is decided by its words (judges.late_before)."""
+    body = strip_crlf(text)
+    if not text.endswith(CRLF) or not body:
+        return False
+    expected = _reply_address(command)
+    if expected is not None and body[0] != expected:
+        return False
+    crc: bool | None = None
+    if command.kind in (Kind.DATA, Kind.CONTINUOUS):
+        body, crc = split_crc(body, None)[0], False
+    return _shape_problem(command, body, crc) is None
+
+
 #: the replies :func:`check_ascii` judged last, by what it was asked: (the events, why)
 _JUDGED: dict[tuple[object, ...], tuple[list[Event], str | None]] = {}
 _JUDGED_MAX = 64  # cleared when full: the tool recorder's attempts of a stimulus or two

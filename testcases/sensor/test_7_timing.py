@@ -470,8 +470,7 @@ def test_standby_after_foreign_command(sensor, case):
         f"a!, then {other}! and a! with no break; a!, then a! as late with no break",
         [awake, foreign, ex, again, control],
     )
-    late = judge.late_reply(ex) if judge.heard_late(ex) else ""
-    if late and not late.startswith(sensor.address):
+    if late := judge.late_elsewhere(ex):
         # the late reply names another address: the sensor's late answer to b!, begun over
         # the a! it was busy for (replies-after-retry + answers-foreign-address: 'z<CR><LF>'
         # read as 0!'s late answer FAILed R-7.0-14), so the probe may not have been heard

@@ -179,3 +179,19 @@ def test_cli_refuses_no_combinations():
     from conformance import cli
 
     assert cli.main(["matrix", "--combinations", "0"]) == 4
+
+
+def test_a_pass_on_a_rule_a_member_leaves_undecided_unbroken_stands():
+    """replies-after-retry leaves R-4.3-03 INCONCLUSIVE (its 80 ms replies run into the
+    retries) but does not break it: beside wrong-crc every address 0-9 was answered on the
+    wire, and the PASS was counted a missed FAIL (truth15). Declared by the other member
+    too, the PASS is still missed; a rule the member breaks is missed whatever it says."""
+    declared = {"late": (("R-7",), ("R-2",)), "b": (("R-3",), ()), "c": (("R-3",), ("R-2",))}
+    unbroken = {"late": ("R-2", "R-7")}
+    data = verdicts(R_7="FAIL", R_2="PASS", R_3="FAIL")
+    assert check(("late", "b"), declared, data, unbroken=unbroken).clean
+    assert not check(("late", "b"), declared, data, unbroken={}).clean  # before truth15
+    row = check(("c", "late"), declared, data, unbroken=unbroken)
+    assert [f.requirement for f in row.missed] == ["R-2"]
+    row = check(("late", "b"), declared, verdicts(R_7="PASS", R_3="FAIL"), unbroken=unbroken)
+    assert [f.requirement for f in row.missed] == ["R-7"]

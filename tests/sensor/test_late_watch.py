@@ -178,3 +178,15 @@ def test_r_7_0_14_late_reply_to_the_foreign_command_is_no_answer_to_the_probe() 
     )
     assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
     assert "naming another address" in found["findings"][0]["detail"]
+
+
+def test_r_4_4_6_03_the_late_reply_to_the_ttt_zero_start_is_no_service_request() -> None:
+    """partial-command-accepted + replies-after-retry + service-request-extra-chars: 0M1!'s
+    '00002' came 80 ms late, in the 0.5 s listened to for a service request: R-4.4.6-03
+    FAILed "sent '00002' after '' announced ttt = 000" (truth15); no start reply was taken,
+    so nothing announced ttt = 000 this time: INCONCLUSIVE naming the late reply."""
+    faults = "partial-command-accepted,replies-after-retry,service-request-extra-chars"
+    data = run_once(f"sim://?faults={faults}")  # the whole run: its timing brings it about
+    found = next(r for r in data["requirements"] if r["id"] == "R-4.4.6-03")
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
+    assert "0M1! -> late '00002<CR><LF>'" in found["findings"][0]["detail"]

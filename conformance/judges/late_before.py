@@ -1,0 +1,115 @@
+"""A reply that may be the command before's, late: which command a reply answers.
+
+A sensor whose every reply starts 80 ms after its command and that is deaf until then (an
+Arduino Due sensor's ``delay(80)``, fault replies-after-retry) answers a command the tool
+gave up on after its window while the tool sends the next one, which it never hears: that
+reply lands in the next command's window and reads as its answer. Beside wrong-crc, 0D0!'s
+retry went unanswered, its reply came 80 ms later, 8.33 ms after 0MC1!, and R-4.4.5-01 FAILed
+"0MC1!: reply '0+22.15+1013.2+45.7DOm' does not have the form atttn" (truth15). The engine
+links such an exchange to the unanswered one before it (``Exchange.late_before``, only from
+a sensor seen to start its replies late); :func:`earlier_reply` says whether the reply taken
+may be that one's. The words decide where they can: a reply shaped as this command's and not
+as the earlier one's is this command's; otherwise it may be (or, shaped as the earlier one's
+only, is) the earlier's, and a rule on this command's reply is undecided, never a FAIL on
+another command's words.
+"""
+
+from __future__ import annotations
+
+from ..protocol.timing import NO_BREAK_WINDOW
+from ..tool_recorder.records import Exchange
+from ..tool_recorder.validity import fits_shape
+from ..transcript import DUT, decode_7e1, escape
+from ..view.sides import expected_reply_address
+
+
+def earlier_reply(ex: Exchange) -> str:
+    """'' unless the reply ``ex`` took may be ``ex.late_before``'s, late: it began after that
+    command's last try, within the 87 ms ``LateStartWatch`` believes a late start, naming
+    no address of ``ex``'s alone, and its words do not make it ``ex``'s alone. Then
+    the wording a finding gives: ``'<reply>' to 0MC1! may be 0D0!'s late reply (80.00 ms
+    after it)``."""
+    before = ex.late_before
+    if before is None or not ex.answered or before.last.command_end is None:
+        return ""
+    reply = ex.reply_events
+    lag = reply[0].start - before.last.command_end
+    if not 0 < lag <= NO_BREAK_WINDOW:
+        return ""
+    # a reply naming this command's address and not the earlier one's is this one's; one
+    # naming neither is no evidence either way (wrong-reply-address: D replies from '1')
+    named = chr(reply[0].char7)
+    address, own_address = expected_reply_address(before.text), expected_reply_address(ex.text)
+    if address is not None and named != address and named == own_address:
+        return ""
+    text = ex.reply_text
+    own = ex.command is not None and fits_shape(ex.command, text)
+    theirs = before.command is not None and fits_shape(before.command, text)
+    if own and not theirs:
+        return ""
+    how = "is" if theirs and not own else "may be"
+    return (
+        f"'{escape(text)}' to {escape(ex.text)} {how} {escape(before.text)}'s late reply "
+        f"({lag * 1e3:.2f} ms after it)"
+    )
+
+
+def late_reply(ex: Exchange) -> str:
+    """What the DUT sent after the tool had stopped listening for a try of ``ex`` and before
+    its next try ('' if nothing): a late reply, R-7.0-10's deviation, not silence. A Pico
+    firmware reads its RTD for 30 ms before it answers ``aM1!``; its '00001' came 32 ms after
+    each try, and "no reply although silence does not comply" was false (docs/kit.md,
+    fifteenth round). For a one-shot command, what a longer listen heard after its window
+    (``heard_late``, truth12)."""
+    strays = [e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT]
+    return decode_7e1(strays + [e for e in ex.heard_late if e.origin == DUT])
+
+
+def late_shown(ex: Exchange) -> str:
+    """``0M1! -> late '00001<CR><LF>'``: the command and the first line of its late reply."""
+    text = late_reply(ex)
+    return f"{escape(ex.text)} -> late '{escape(text[: text.find(chr(10)) + 1] or text)}'"
+
+
+def late_answer(ex: Exchange) -> str:
+    """``answered only after the reply window: 0M1! -> late '00001<CR><LF>'`` for an
+    ``ex`` unanswered in its windows whose reply came after them (:func:`late_reply`), ''
+    otherwise: the one wording of the rules that leave such a reply to R-7.0-10."""
+    if ex.answered or not late_reply(ex):
+        return ""
+    return f"answered only after the reply window: {late_shown(ex)}"
+
+
+def heard_late(ex: Exchange) -> bool:
+    """Whether a one-shot ``ex`` unanswered in its window drew a reply the longer listen for
+    a sensor seen late heard (``ex.heard_late``): an answer all the same, to a command that
+    was sent once with nothing after it. standby-ignored + replies-after-retry answered
+    R-7.0-15's a! 101.90 ms after a reply, 80 ms late, and the rule PASSed "stayed silent"
+    (truth12). Not where it names another address (:func:`late_elsewhere`): that is no
+    answer to ``ex``."""
+    heard = any(e.origin == DUT for e in ex.heard_late)
+    return not ex.answered and heard and not late_elsewhere(ex)
+
+
+def late_elsewhere(ex: Exchange) -> str:
+    """What a one-shot ``ex``'s longer listen heard ('' if nothing) when it names another
+    address than ``ex``'s reply would: the sensor's late reply to a command before it, begun
+    over ``ex``, which it may not have heard; neither an answer to ``ex`` nor silence
+    (replies-after-retry + answers-foreign-address: 'z<CR><LF>' to zI!, heard after 0!,
+    FAILed R-7.0-14; only that rule checked the address, truth15 made it the one rule of
+    every reader of ``heard_late``)."""
+    if ex.answered:
+        return ""
+    heard = [e for e in ex.heard_late if e.origin == DUT]
+    address = expected_reply_address(ex.text)
+    if not heard or address is None or heard[0].char7 == ord(address[0]):
+        return ""
+    return decode_7e1(heard)
+
+
+def answered_late(ex: Exchange) -> str:
+    """How ``ex``'s reply came late ('' if it did not): unanswered in its windows with its
+    reply after them (:func:`late_answer`), or answered with what may be the command
+    before's late reply (:func:`earlier_reply`). The one test of the rules that leave a late
+    reply to R-7.0-10 (late_only, late_among, undecided_if_late, the D replies)."""
+    return late_answer(ex) if not ex.answered else earlier_reply(ex)
