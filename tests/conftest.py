@@ -14,7 +14,10 @@ session on a long module started last.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+import re
+from collections.abc import Iterable, Sequence
+from functools import cache
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, settings
@@ -107,6 +110,48 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """The longest modules first (the comment above :data:`WAITING` says why): CI's xdist
     workers take whole modules in collection order (``.ci/test``, ``--no-loadscope-reorder``)."""
     items[:] = longest_first(items)
+
+
+# CI's real-time sessions (.ci/test) collect only the modules that name a marker of TIMED as
+# a word (``grep -lw``, test_*.py files): collecting the whole suite to run its 62 timed
+# tests cost each of those three pytest processes 4.1 s of CPU (10.4 s on a clean clone's
+# cold caches), the 28 modules 1.3 s (2.8 s); two of the three run at normal priority beside
+# the niced session, the third alone at the end. A timed test in a module that does not name its
+# marker (one imported from elsewhere) would never run there: every session that deselects
+# one fails at once instead (the niced session and the default selection deselect them all).
+
+#: The markers whose tests .ci/test runs in sessions of their own.
+TIMED = ("realtime", "quiet")
+_NAMES_TIMED = re.compile(r"\b(?:" + "|".join(TIMED) + r")\b")
+
+
+@cache
+def names_a_timed_marker(path: Path) -> bool:
+    """Whether .ci/test's grep lists ``path``: a ``test_*.py`` file naming a TIMED marker."""
+    if not path.name.startswith("test_") or path.suffix != ".py":
+        return False
+    return bool(_NAMES_TIMED.search(path.read_text(encoding="utf-8")))
+
+
+def unlisted_timed(items: Iterable[pytest.Item]) -> list[str]:
+    """Node ids of the timed tests among ``items`` whose module .ci/test's real-time sessions
+    would not collect."""
+    return [
+        item.nodeid
+        for item in items
+        if any(item.get_closest_marker(name) for name in TIMED)
+        and not names_a_timed_marker(item.path)
+    ]
+
+
+def pytest_deselected(items: Sequence[pytest.Item]) -> None:
+    lost = unlisted_timed(items)
+    if lost:
+        raise pytest.UsageError(
+            "timed tests in modules that do not name their marker (.ci/test's real-time "
+            "sessions collect only modules that name 'realtime' or 'quiet'; name it there): "
+            + ", ".join(lost)
+        )
 
 
 #: The phrase every busy-machine skip reason carries (with its measured figure after it).

@@ -84,3 +84,21 @@ def test_the_longest_modules_are_collected_first_and_nothing_else_moves(pytester
     ids = [line for line in result.stdout.lines if "::test_" in line]
     expected = [FIRST[0], FIRST[2], *by_name]
     assert ids == [f"{m}::{t}" for m in expected for t in ("test_one", "test_two")], ids
+
+
+def test_a_timed_test_in_a_module_not_naming_its_marker_fails_the_session(pytester):
+    """.ci/test's real-time sessions collect only the modules that name ``realtime`` or
+    ``quiet`` (tests/conftest.py, TIMED): a real-time test marked from elsewhere would never
+    run there, so a session that deselects one stops with a usage error naming it."""
+    pytester.makeconftest(CONFTEST.read_text(encoding="utf-8"))
+    pytester.makepyfile(
+        marks="import pytest\n\nLINE = pytest.mark.realtime\n",
+        test_hidden="from marks import LINE\n\npytestmark = LINE\n\n"
+        "def test_on_a_line():\n    pass\n",
+        test_named="import pytest\n\n@pytest.mark.realtime\ndef test_named():\n    pass\n\n"
+        "def test_plain():\n    pass\n",
+    )
+    result = pytester.runpytest("-q", "-p", "no:xdist", "-m", "not realtime")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR, result.stdout.str()
+    result.stderr.fnmatch_lines(["*do not name their marker*test_hidden.py::test_on_a_line"])
+    assert "test_named.py::test_named" not in result.stderr.str()

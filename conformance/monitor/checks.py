@@ -87,11 +87,15 @@ def command_flags(text: str, ctx: Context, events: list[Event]) -> list[Flag]:
     return flags
 
 
-def reply_flags(text: str, ctx: Context, events: list[Event]) -> list[Flag]:
-    """A sensor's line: its timing after the command and its format for that command."""
+def reply_flags(
+    text: str, ctx: Context, events: list[Event], run_uncertainty: float = 0.0
+) -> list[Flag]:
+    """A sensor's line: its timing after the command and its format for that command.
+    ``run_uncertainty`` (s): what the run measures its stamps to be worth, beside the
+    figure the stamps carry (the final judging uses the larger: so does the flag)."""
     flags = parity_flags(events)
     if ctx.command_end is not None and not ctx.answered and ctx.command_last is not None:
-        flags += _timing_flags(ctx.command_last, events[0])
+        flags += _timing_flags(ctx.command_last, events[0], run_uncertainty)
     first_line = not ctx.answered
     ctx.answered = True
     if not first_line or not ctx.command_text or len(text) > 1 and text[1] == chr(STX):
@@ -114,11 +118,12 @@ def unsolicited_flags(text: str, events: list[Event]) -> list[Flag]:
     return parity_flags(events) + [Flag(v.requirement, v.message) for v in framing]
 
 
-def _timing_flags(command_last: Event, first: Event) -> list[Flag]:
+def _timing_flags(command_last: Event, first: Event, run_uncertainty: float = 0.0) -> list[Flag]:
     """R-7.0-09/10 where the stamps decide it: a start that may be within the window given
-    their uncertainty is no flag (the judging at the end weighs it with the whole run)."""
+    their uncertainty, or the run's measured one, is no flag (the judging at the end weighs
+    it with the whole run)."""
     delay = first.start - command_last.end
-    u = max(command_last.uncertainty, first.uncertainty)
+    u = max(command_last.uncertainty, first.uncertainty, run_uncertainty)
     flags: list[Flag] = []
     for req, low, high, says in (
         ("R-7.0-09", CHAR_TIME, None, "earlier than 7.93 ms"),

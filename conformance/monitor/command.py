@@ -228,7 +228,7 @@ def _watch(
 ) -> tuple[str, int, bool]:
     """Show and record the bus until stopped; returns why it failed ("" if it did not), how
     many breaks and characters were heard, and whether Ctrl-C stopped it."""
-    tracker = LineTracker()
+    tracker = LineTracker(between=link.uncertainty_between)  # the run's measured figure too
     view = _LiveView(console, link.name)
     failure = ""
     link.transcript.note(link.now(), f"monitor: {LISTEN_ONLY}; port {link.name}")

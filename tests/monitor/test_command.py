@@ -192,6 +192,70 @@ def test_a_batch_the_host_stamped_back_to_back_neither_splits_a_command_nor_flag
     assert len(batched) >= 4  # the batch carries what its stamps may be off by
 
 
+def _late_reply_bus(reply_uncertainty: float, earlier_uncertainty: float) -> Bus:
+    """An exchange whose stamps carry ``earlier_uncertainty``, then ``0I!`` answered 21.28 ms
+    after its last stop bit (the start CI's monitor flagged), stamped with
+    ``reply_uncertainty``."""
+    bus = Bus(earlier_uncertainty)
+    bus.brk()
+    bus.send("0!")
+    bus.send("0\r\n", 9e-3)
+    bus.u = reply_uncertainty
+    bus.send("0I!", 30e-3)
+    bus.send("014HOSTILE HOSTL1001\r\n", 21.28e-3)
+    return bus
+
+
+def test_r_7_0_10_live_flag_judges_with_the_largest_uncertainty_the_run_carries():
+    """CI's quiet session once showed "!! R-7.0-10: reply started 21.28 ms (±5.00)" on the
+    reference emulator: the reply's stamps carried the declared ±5 ms, the run (as judged at
+    the end, the largest figure any event carries) ±30.1 ms, and the verdict found no FAIL.
+    The live flag weighs the start with what the run carries too."""
+    excused = shown(_late_reply_bus(5e-3, 30.1e-3))
+    reply = next(line for line in excused if line.text.startswith("014"))
+    assert reply.flags == (), reply.plain()
+    # the same start on a run whose stamps are all worth ±5 ms is still flagged
+    flagged = shown(_late_reply_bus(5e-3, 5e-3))
+    reply = next(line for line in flagged if line.text.startswith("014"))
+    assert [f.requirement for f in reply.flags] == ["R-7.0-10"], reply.plain()
+    assert "(\u00b15.00)" in reply.plain()
+
+
+def test_r_7_0_10_live_flag_judges_with_what_the_link_measured_over_the_gap():
+    """A burst seen after a reply's first byte was stamped shows that byte was held back: its
+    stamp carries the declared floor, the link's meter the taint (``uncertainty_between``),
+    which the flag uses once the line is shown; without that taint the start is flagged."""
+    link = open_listen_link("loop://")
+    try:
+        wire = [to_wire_7e1(ord(c)) for c in "0I!014HOSTILE HOSTL1001\r\n"]
+        t = 1.0
+        for k in range(3):  # the command, on time
+            link._arrived(bytes([wire[k]]), t + (k + 1) * CHAR_TIME + 0.5e-3)
+        command_end = t + 3 * CHAR_TIME
+        first = command_end + 21.28e-3 + CHAR_TIME  # its first byte, read late and alone
+        link._arrived(bytes([wire[3]]), first)
+        link._arrived(bytes(wire[4:6]), first + 2e-3)  # two more at once: the first was held
+        for k, byte in enumerate(wire[6:], start=1):  # the rest at the wire's pace
+            link._arrived(bytes([byte]), first + 2e-3 + k * CHAR_TIME)
+        events = link.heard_since(0)
+        assert events[3].uncertainty < 10e-3  # stamped before the burst showed the hold-up
+        measured = LineTracker(between=link.uncertainty_between)
+        measured.add(events)
+        lines = measured.poll(events[-1].end + 1.0, final=True)
+        assert [(line.who.rstrip("?"), line.text[:3]) for line in lines] == [
+            ("recorder", "0I!"),
+            ("sensor", "014"),
+        ], [line.plain() for line in lines]
+        assert not any(f.requirement == "R-7.0-10" for f in lines[1].flags), lines[1].plain()
+        assert link.uncertainty_between(command_end, events[3].start) > 10e-3
+    finally:
+        link.close()
+    stamps_only = LineTracker()
+    stamps_only.add(events[:4])  # the burst's own stamps aside: only the held-back byte's
+    lines = stamps_only.poll(events[-1].end + 1.0, final=True)
+    assert "R-7.0-10" in [f.requirement for f in lines[-1].flags], lines[-1].plain()
+
+
 # -- the emulator's tap ------------------------------------------------------------------------
 @pytest.fixture
 def tapped():
