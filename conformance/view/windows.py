@@ -40,6 +40,15 @@ from .segments import TranscriptView, Transmission, read_view
 
 _START = attrgetter("start")  # the view's order (read_view sorts by start, stably)
 
+#: :func:`stream_windows` asks where the held events may be cut at every this many breaks,
+#: not at each: a busy bus's window is one sequence, so asking at each break read every
+#: window's view and records twice (it and the next one held), in a windowed judge's pass
+#: over an hour's capture more than the judges themselves; asked every 16th, each is read
+#: about 16/15 times, and the windows given out are the same (where a window may begin
+#: depends on nothing after the next window's first transmission, which a later ask holds
+#: too), at most 16 windows later and no more events held than 16 sequences
+SETTLE_BREAKS = 16
+
 
 def window_starts(view: TranscriptView, records: Rebuilt | None = None) -> list[int]:
     """The indices of ``view``'s transmissions where a window may begin (the first, 0,
@@ -116,15 +125,20 @@ def stream_windows(
     again: a long open stretch costs a rebuild a break, the price of a bounded hold. The CRC
     expectations the windows before leave (:func:`rebuild_windowed`) move no cut: they judge
     only data replies of measurements begun before the held events, none of the held ones'
-    data, and two transmissions of one text in a row are never cut apart anyway."""
+    data, and two transmissions of one text in a row are never cut apart anyway. The held
+    events are asked where they may be cut at every :data:`SETTLE_BREAKS`-th break."""
     held: list[Event] = []
+    breaks = 0  # the breaks held since the held events were last settled
     for e in events:
         if e.kind is EventKind.NOTE:
             continue
         if held and e.start < held[-1].start:
             raise ValueError(f"events out of order at {e.start!r}: windows need them by start")
         if e.kind is EventKind.BREAK and held:  # the transmission before it is complete
-            yield from _settled(held, policy, uncertainty, final=False)
+            breaks += 1
+            if breaks >= SETTLE_BREAKS:
+                yield from _settled(held, policy, uncertainty, final=False)
+                breaks = 0
         held.append(e)
     if held:
         yield from _settled(held, policy, uncertainty, final=True)
@@ -185,4 +199,10 @@ def rebuild_windowed(
         yield rebuild_records(part, policy, uncertainty=uncertainty, only=only, carried=carried)
 
 
-__all__ = ["rebuild_windowed", "stream_windows", "window_events", "window_starts"]
+__all__ = [
+    "SETTLE_BREAKS",
+    "rebuild_windowed",
+    "stream_windows",
+    "window_events",
+    "window_starts",
+]

@@ -229,3 +229,34 @@ def test_streamed_events_out_of_order_are_refused():
     events = sorted(as_heard(bus), key=lambda e: e.start)
     with pytest.raises(ValueError, match="out of order"):
         list(stream_windows([events[1], events[0]]))
+
+
+def test_streamed_windows_read_each_event_about_once(monkeypatch):
+    """Where the held events may be cut is asked at every ``SETTLE_BREAKS``-th break, not at
+    each: a bus of one sequence a window read every window's view twice (it, then it with the
+    next one held), which cost a windowed judge's pass over an hour's capture more than its
+    judges. The windows are the same as the whole view's cut, and one asked at every break."""
+    from conformance.view import windows
+
+    bus, recorder = bus_of_sensors("013")
+    for _ in range(20):
+        for a in "013":
+            recorder.identify(a)
+    events = sorted(as_heard(bus), key=lambda e: e.start)
+    read = 0
+    original = windows.read_view
+
+    def counted(held):  # type: ignore[no-untyped-def]
+        nonlocal read
+        read += len(held)
+        return original(held)
+
+    monkeypatch.setattr(windows, "read_view", counted)
+    given = list(stream_windows(iter(events)))
+    assert len(given) == 60
+    assert read <= 1.2 * len(events)  # each asked at every break: 2.0 times
+    monkeypatch.setattr(windows, "read_view", original)
+    view = read_view(events)
+    assert given == list(window_events(events, view, window_starts(view)))
+    monkeypatch.setattr(windows, "SETTLE_BREAKS", 1)
+    assert list(stream_windows(iter(events))) == given
