@@ -5,8 +5,10 @@ Every judge the passive recorder cases call (``testcases/passive/test_recorder_7
 the findings, which are the whole view's (each fold's whole-run function is one ``add``).
 :func:`recorder_findings` feeds them all in one pass over the windows
 :func:`~conformance.view.windows.stream_windows` cuts from the recording's events as they
-come, each window's view read from its own events alone and let go once every fold has
-taken it; the cases read their findings from the result (made once per loaded recording).
+come, each window's view read from its own events alone (the directions the cut inferred
+over them kept: :func:`~conformance.view.windows.stream_window_views`) and let go once
+every fold has taken it; the cases read their findings from the result (made once per
+loaded recording).
 So the recorder's run reads no whole-run view: what it holds of the recording is one
 window's view at a time and what the folds carry (counts, the first few citations, one
 observation per distinct value, the measurements the rules judge).
@@ -27,8 +29,8 @@ from ..judges.recorder.measurements import ObservedMeasurement, ObservedMeasurem
 from ..judges.recorder.retries import Retries
 from ..transcript import Event, EventKind
 from ..verdicts import Finding
-from ..view.segments import memo, read_view
-from ..view.windows import stream_windows
+from ..view.segments import TranscriptView, memo, read_view
+from ..view.windows import stream_window_views
 
 if TYPE_CHECKING:
     from ..replay.recording_link import RecordingLink
@@ -55,16 +57,21 @@ class RecorderFindings:
 
 def judge_windows(windows: Iterable[list[Event]], uncertainty: float) -> RecorderFindings:
     """Every fold fed each of ``windows`` (in order, together a recording's events), each
-    window's view read alone and let go. No window at all (a recording with no events)
-    is judged as the whole-run functions judge an empty view: one empty window."""
+    window's view read alone and let go."""
+    return judge_views((read_view(w) for w in windows), uncertainty)
+
+
+def judge_views(views: Iterable[TranscriptView], uncertainty: float) -> RecorderFindings:
+    """Every fold fed each of ``views`` (each window's, read alone, in order), each let go
+    once every fold has taken it. No window at all (a recording with no events) is judged
+    as the whole-run functions judge an empty view: one empty window."""
     breaks, rules = Breaks(uncertainty), BreakRules(uncertainty)
     text, gaps = CommandText(uncertainty), CharacterGaps(uncertainty)
     rate, taken = CommandBitRate(uncertainty), ObservedMeasurements(uncertainty)
     retries, addresses = Retries(uncertainty), Addresses(uncertainty)
     folds = (breaks, rules, text, gaps, rate, taken, retries, addresses)
     count = 0
-    for window in windows:
-        view = read_view(window)
+    for view in views:
         for fold in folds:
             fold.add(view)
         count += 1
@@ -100,10 +107,16 @@ def recorder_findings(link: RecordingLink) -> RecorderFindings:
     events = link.transcript.events
 
     def judge() -> RecorderFindings:
-        windows = stream_windows(by_start(events), uncertainty=link.uncertainty)
-        return judge_windows(windows, link.uncertainty)
+        cut = stream_window_views(by_start(events), uncertainty=link.uncertainty)
+        return judge_views((view for _window, view in cut), link.uncertainty)
 
     return memo(link, "_recorder_findings", len(events), judge)
 
 
-__all__ = ["RecorderFindings", "by_start", "judge_windows", "recorder_findings"]
+__all__ = [
+    "RecorderFindings",
+    "by_start",
+    "judge_views",
+    "judge_windows",
+    "recorder_findings",
+]

@@ -36,7 +36,7 @@ from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
 from ..transcript import Event, EventKind
 from .rebuilt_records import Rebuilt, rebuild_records
-from .segments import TranscriptView, Transmission, read_view
+from .segments import TranscriptView, Transmission, read_sides, read_view, sided_view
 
 _START = attrgetter("start")  # the view's order (read_view sorts by start, stably)
 
@@ -127,6 +127,27 @@ def stream_windows(
     only data replies of measurements begun before the held events, none of the held ones'
     data, and two transmissions of one text in a row are never cut apart anyway. The held
     events are asked where they may be cut at every :data:`SETTLE_BREAKS`-th break."""
+    return (window for window, _codes in _cut_windows(events, policy, uncertainty))
+
+
+def stream_window_views(
+    events: Iterable[Event], policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Iterator[tuple[list[Event], TranscriptView]]:
+    """:func:`stream_windows`' windows, each with its view, the one
+    :func:`~.segments.read_view` reads of the window alone, which a windowed judge reads.
+    Where the directions were inferred (origin ``bus``), the cut inferred them once over
+    the held events it read, and since the inference starts over at every window's first
+    break, a window's sides are those: its view is cut with them
+    (:func:`~.segments.sided_view`), not inferred a second time."""
+    for window, codes in _cut_windows(events, policy, uncertainty):
+        yield window, read_view(window) if codes is None else sided_view(window, codes)
+
+
+def _cut_windows(
+    events: Iterable[Event], policy: Policy | None, uncertainty: float
+) -> Iterator[tuple[list[Event], bytearray | None]]:
+    """:func:`stream_windows`' windows, each with its events' inferred sides (None: the
+    origins gave them)."""
     held: list[Event] = []
     breaks = 0  # the breaks held since the held events were last settled
     for e in events:
@@ -150,12 +171,13 @@ def _settled(
     uncertainty: float,
     *,
     final: bool,
-) -> Iterator[list[Event]]:
+) -> Iterator[tuple[list[Event], bytearray | None]]:
     """The windows of ``held`` that nothing to come can change, taken out of it (all of
-    them when ``final``)."""
-    view = read_view(held)
+    them when ``final``), each with its events' sides as the held events' view inferred
+    them (None: the origins gave them)."""
+    view, codes = read_sides(held)
     if final and not view.transmissions:  # nothing the recorder sent: one window
-        yield held[:]
+        yield held[:], codes
         held.clear()
         return
     records = rebuild_records(view, policy, uncertainty=uncertainty)
@@ -169,7 +191,7 @@ def _settled(
     taken = 0
     for i in starts[1:]:
         end = len(held) if i == len(view.transmissions) else _position(held, view, i, taken)
-        yield held[taken:end]
+        yield held[taken:end], None if codes is None else codes[taken:end]
         taken = end
     del held[:taken]
 
@@ -202,6 +224,7 @@ def rebuild_windowed(
 __all__ = [
     "SETTLE_BREAKS",
     "rebuild_windowed",
+    "stream_window_views",
     "stream_windows",
     "window_events",
     "window_starts",

@@ -151,14 +151,14 @@ def test_the_passive_recorder_cases_read_the_windowed_findings(tmp_path, monkeyp
     path = tmp_path / "bus.jsonl"
     write_recording(path, [replace(e, origin="bus") for e in events])
     made: list[int] = []
-    original = recorder_windows.judge_windows
+    original = recorder_windows.judge_views
 
-    def counted(windows, uncertainty):  # type: ignore[no-untyped-def]
-        found = original(windows, uncertainty)
+    def counted(views, uncertainty):  # type: ignore[no-untyped-def]
+        found = original(views, uncertainty)
         made.append(found.windows)
         return found
 
-    monkeypatch.setattr(recorder_windows, "judge_windows", counted)
+    monkeypatch.setattr(recorder_windows, "judge_views", counted)
     code = main(["judge", str(path), "--role", "recorder", "--report-dir", str(tmp_path / "r")])
     assert code in (0, 1, 2)
     assert len(made) == 1 and made[0] > 3
