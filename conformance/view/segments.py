@@ -502,6 +502,27 @@ def read_view(
     return _cut(ordered, mine, part, undirected)
 
 
+def read_sides(events: list[Event]) -> tuple[TranscriptView, bytearray | None]:
+    """:func:`read_view` of ``events`` (by start already, no notes: a windowed cut's held
+    events) and, where it inferred the directions (origin :data:`BUS`), each event's side as
+    a byte (:data:`_SIDE_CODES`) in ``events``' order, which :func:`sided_view` cuts a run
+    of them with again without inferring them afresh (None: the origins gave them)."""
+    if BUS not in map(_ORIGIN, events):
+        return read_view(events), None
+    ordered = sorted(events, key=_START)
+    codes = _codes(ordered)
+    return sided_view(ordered, codes), codes
+
+
+def sided_view(events: list[Event], codes: bytearray) -> TranscriptView:
+    """:func:`read_view` of ``events`` (by start, no notes), their sides given (``codes``,
+    :func:`read_sides`' of the events they were read among): the view read of them alone
+    where the direction inference starts over at their first event (a window's first
+    break: :mod:`.windows`), without inferring them again."""
+    placed, undirected, mine = _split_by_side(events, codes)
+    return _cut(placed, mine, 0, undirected)
+
+
 #: a side as one byte, for :func:`_inferred` (None: the protocol does not settle it)
 _SIDE_CODES = {RECORDER: 0, SENSOR: 1, None: 2}
 
@@ -514,6 +535,11 @@ def _inferred(ordered: list[Event]) -> tuple[list[Event], list[Event], list[bool
     kept, in ``ordered``'s order, when the directions come in that order (by start, then
     end: nearly always); else a map by event, as every event had before (an hour's capture:
     340,000 pairs and a dict entry each, 25 MB at the peak of its judging)."""
+    return _split_by_side(ordered, _codes(ordered))
+
+
+def _codes(ordered: list[Event]) -> bytearray:
+    """Each of ``ordered``'s inferred sides as a byte (:func:`_inferred`)."""
     codes = bytearray()
     same: list[Event] = []  # the events so far with the last one's stamps
     for i, (e, d) in enumerate(iter_directions(ordered)):
@@ -525,7 +551,7 @@ def _inferred(ordered: list[Event]) -> tuple[list[Event], list[Event], list[bool
             break
         same.append(e)
         codes.append(_SIDE_CODES[d.side])
-    return _split_by_side(ordered, codes)
+    return codes
 
 
 def _sides_by_event(ordered: list[Event]) -> list[str | None]:

@@ -36,9 +36,18 @@ from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
 from ..transcript import Event, EventKind
 from .rebuilt_records import Rebuilt, rebuild_records
-from .segments import TranscriptView, Transmission, read_view
+from .segments import TranscriptView, Transmission, read_sides, read_view, sided_view
 
 _START = attrgetter("start")  # the view's order (read_view sorts by start, stably)
+
+#: :func:`stream_windows` asks where the held events may be cut at every this many breaks,
+#: not at each: a busy bus's window is one sequence, so asking at each break read every
+#: window's view and records twice (it and the next one held), in a windowed judge's pass
+#: over an hour's capture more than the judges themselves; asked every 16th, each is read
+#: about 16/15 times, and the windows given out are the same (where a window may begin
+#: depends on nothing after the next window's first transmission, which a later ask holds
+#: too), at most 16 windows later and no more events held than 16 sequences
+SETTLE_BREAKS = 16
 
 
 def window_starts(view: TranscriptView, records: Rebuilt | None = None) -> list[int]:
@@ -116,15 +125,41 @@ def stream_windows(
     again: a long open stretch costs a rebuild a break, the price of a bounded hold. The CRC
     expectations the windows before leave (:func:`rebuild_windowed`) move no cut: they judge
     only data replies of measurements begun before the held events, none of the held ones'
-    data, and two transmissions of one text in a row are never cut apart anyway."""
+    data, and two transmissions of one text in a row are never cut apart anyway. The held
+    events are asked where they may be cut at every :data:`SETTLE_BREAKS`-th break."""
+    return (window for window, _codes in _cut_windows(events, policy, uncertainty))
+
+
+def stream_window_views(
+    events: Iterable[Event], policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Iterator[tuple[list[Event], TranscriptView]]:
+    """:func:`stream_windows`' windows, each with its view, the one
+    :func:`~.segments.read_view` reads of the window alone, which a windowed judge reads.
+    Where the directions were inferred (origin ``bus``), the cut inferred them once over
+    the held events it read, and since the inference starts over at every window's first
+    break, a window's sides are those: its view is cut with them
+    (:func:`~.segments.sided_view`), not inferred a second time."""
+    for window, codes in _cut_windows(events, policy, uncertainty):
+        yield window, read_view(window) if codes is None else sided_view(window, codes)
+
+
+def _cut_windows(
+    events: Iterable[Event], policy: Policy | None, uncertainty: float
+) -> Iterator[tuple[list[Event], bytearray | None]]:
+    """:func:`stream_windows`' windows, each with its events' inferred sides (None: the
+    origins gave them)."""
     held: list[Event] = []
+    breaks = 0  # the breaks held since the held events were last settled
     for e in events:
         if e.kind is EventKind.NOTE:
             continue
         if held and e.start < held[-1].start:
             raise ValueError(f"events out of order at {e.start!r}: windows need them by start")
         if e.kind is EventKind.BREAK and held:  # the transmission before it is complete
-            yield from _settled(held, policy, uncertainty, final=False)
+            breaks += 1
+            if breaks >= SETTLE_BREAKS:
+                yield from _settled(held, policy, uncertainty, final=False)
+                breaks = 0
         held.append(e)
     if held:
         yield from _settled(held, policy, uncertainty, final=True)
@@ -136,12 +171,13 @@ def _settled(
     uncertainty: float,
     *,
     final: bool,
-) -> Iterator[list[Event]]:
+) -> Iterator[tuple[list[Event], bytearray | None]]:
     """The windows of ``held`` that nothing to come can change, taken out of it (all of
-    them when ``final``)."""
-    view = read_view(held)
+    them when ``final``), each with its events' sides as the held events' view inferred
+    them (None: the origins gave them)."""
+    view, codes = read_sides(held)
     if final and not view.transmissions:  # nothing the recorder sent: one window
-        yield held[:]
+        yield held[:], codes
         held.clear()
         return
     records = rebuild_records(view, policy, uncertainty=uncertainty)
@@ -155,7 +191,7 @@ def _settled(
     taken = 0
     for i in starts[1:]:
         end = len(held) if i == len(view.transmissions) else _position(held, view, i, taken)
-        yield held[taken:end]
+        yield held[taken:end], None if codes is None else codes[taken:end]
         taken = end
     del held[:taken]
 
@@ -185,4 +221,11 @@ def rebuild_windowed(
         yield rebuild_records(part, policy, uncertainty=uncertainty, only=only, carried=carried)
 
 
-__all__ = ["rebuild_windowed", "stream_windows", "window_events", "window_starts"]
+__all__ = [
+    "SETTLE_BREAKS",
+    "rebuild_windowed",
+    "stream_window_views",
+    "stream_windows",
+    "window_events",
+    "window_starts",
+]

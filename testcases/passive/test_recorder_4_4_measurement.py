@@ -6,13 +6,10 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges.recorder.capabilities import judge_addresses
 from conformance.judges.recorder.collection import judge_data_collection, judge_high_volume
-from conformance.judges.recorder.measurements import observed_measurements
-from conformance.judges.recorder.retries import judge_retries
 from conformance.judges.recorder.waits import judge_concurrent_waits, judge_measure_waits
+from conformance.offline.recorder_windows import recorder_findings
 from conformance.verdicts import Verdict
-from conformance.view.segments import memo
 
 from ._helpers import judged, judged_only, unseen_rule
 
@@ -20,11 +17,10 @@ requirements = pytest.mark.requirements
 
 
 def _taken(heard):
-    """The recorder's measurements, found once per view: four cases judge the same ones (an
-    hour's recording takes seconds to walk)."""
-    view, u = heard.view, heard.uncertainty
-    key = (len(view.transmissions), len(view.chars), u)
-    return list(memo(view, "_observed_measurements", key, lambda: observed_measurements(view, u)))
+    """The recorder's measurements, found once over the recording's windows
+    (:func:`~conformance.offline.recorder_windows.recorder_findings`): four cases judge
+    the same ones."""
+    return list(recorder_findings(heard.link).measurements)
 
 
 @requirements("R-4.4.5-04", "R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07")
@@ -71,7 +67,7 @@ def test_high_volume(heard_recorder, case):
 def test_retries(heard_recorder, case):
     """Recorded retries after no reply or an invalid one come inside the section 7.2 windows."""
     case.expect("retry 16.67-87 ms after an unanswered command; up to three sequences")
-    judged(case, judge_retries(heard_recorder.view, heard_recorder.uncertainty))
+    judged(case, recorder_findings(heard_recorder.link).retries)
 
 
 @requirements("R-4.3-03", "R-4.3-04")
@@ -80,7 +76,7 @@ def test_addresses(heard_recorder, case):
     """Sensors at 0-9 polled (a PASS only when the recording shows all ten answering);
     anything addressed is an address."""
     case.expect("a valid exchange with each of the sensors at 0..9; only valid addresses")
-    for f in judge_addresses(heard_recorder.view, heard_recorder.uncertainty):
+    for f in recorder_findings(heard_recorder.link).addresses:
         if f.requirement == "R-4.3-03" and f.verdict is not Verdict.PASS:
             unseen_rule(case, "R-4.3-03", f"polls that answered at {f.detail.split(': ', 1)[-1]}")
         elif f.requirement == "R-4.3-04" and f.verdict is Verdict.NA:

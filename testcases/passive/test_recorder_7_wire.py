@@ -6,13 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
-from conformance.judges.recorder.commands import (
-    judge_character_gaps,
-    judge_command_bit_rate,
-    judge_command_text,
-)
 from conformance.links.base import NO_BIT_TIMING
+from conformance.offline.recorder_windows import recorder_findings
 from conformance.verdicts import inconclusive
 
 from ._helpers import judged, judged_only
@@ -25,7 +20,7 @@ requirements = pytest.mark.requirements
 def test_breaks(heard_recorder, case):
     """Every recorded break lasts at least 12 ms and is followed by 8.33 ms of marking."""
     case.expect("break >= 12 ms (-0.40); marking before the command >= 8.33 ms (-0.40)")
-    judged(case, judge_breaks(heard_recorder.view, heard_recorder.uncertainty))
+    judged(case, recorder_findings(heard_recorder.link).breaks)
 
 
 @requirements("R-7.0-17", "R-7.1-01")
@@ -34,8 +29,7 @@ def test_break_when_due(heard_recorder, case):
     """A break before every command to a new sensor, after more than 87 ms of marking, and
     before an aD0! that comes more than 87 ms after a service request."""
     case.expect("commands without a break only to the same sensor within 87 ms (+0.40)")
-    found = judge_break_rules(heard_recorder.view, heard_recorder.uncertainty)
-    judged_only(case, found, *case.requirements)
+    judged_only(case, recorder_findings(heard_recorder.link).break_rules, *case.requirements)
 
 
 @requirements("R-4.2-01", "R-4.4-04", "R-4.3-01")
@@ -43,7 +37,7 @@ def test_break_when_due(heard_recorder, case):
 def test_command_text(heard_recorder, case):
     """Recorded commands are printable, start with an address and end with their only '!'."""
     case.expect("printable ASCII; the address first; '!' last and nowhere else")
-    judged(case, judge_command_text(heard_recorder.view, heard_recorder.uncertainty))
+    judged(case, recorder_findings(heard_recorder.link).command_text)
 
 
 @requirements("R-7.0-13", "R-7.0-01", "R-4.1-01")
@@ -51,9 +45,9 @@ def test_command_text(heard_recorder, case):
 def test_character_timing(heard_recorder, case):
     """At most 1.66 ms between command characters, at 1200 baud."""
     case.expect("every gap inside a command <= 1.66 ms; characters one 8.33 ms frame apart")
-    view, u = heard_recorder.view, heard_recorder.uncertainty
-    judged(case, judge_character_gaps(view, u))
+    found = recorder_findings(heard_recorder.link)
+    judged(case, found.character_gaps)
     if heard_recorder.link.info.bit_timing:
-        judged(case, [judge_command_bit_rate(view, u)])
+        judged(case, [found.command_bit_rate])
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))

@@ -1,0 +1,122 @@
+"""The passive recorder cases' judges run over the recording a window at a time (issue 22).
+
+Every judge the passive recorder cases call (``testcases/passive/test_recorder_7_wire.py``,
+``test_recorder_4_4_measurement.py``) is a fold: ``add`` each window's view in order, then
+the findings, which are the whole view's (each fold's whole-run function is one ``add``).
+:func:`recorder_findings` feeds them all in one pass over the windows
+:func:`~conformance.view.windows.stream_windows` cuts from the recording's events as they
+come, each window's view read from its own events alone (the directions the cut inferred
+over them kept: :func:`~conformance.view.windows.stream_window_views`) and let go once
+every fold has taken it; the cases read their findings from the result (made once per
+loaded recording).
+So the recorder's run reads no whole-run view: what it holds of the recording is one
+window's view at a time and what the folds carry (counts, the first few citations, one
+observation per distinct value, the measurements the rules judge).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from itertools import pairwise
+from operator import attrgetter
+from typing import TYPE_CHECKING
+
+from ..judges.recorder.breaks import BreakRules, Breaks
+from ..judges.recorder.capabilities import Addresses
+from ..judges.recorder.commands import CharacterGaps, CommandBitRate, CommandText
+from ..judges.recorder.measurements import ObservedMeasurement, ObservedMeasurements
+from ..judges.recorder.retries import Retries
+from ..transcript import Event, EventKind
+from ..verdicts import Finding
+from ..view.segments import TranscriptView, memo, read_view
+from ..view.windows import stream_window_views
+
+if TYPE_CHECKING:
+    from ..replay.recording_link import RecordingLink
+
+
+@dataclass(frozen=True)
+class RecorderFindings:
+    """What the passive recorder cases judge, each as its whole-run function gives it:
+    ``judge_breaks``, ``judge_break_rules``, ``judge_command_text``,
+    ``judge_character_gaps``, ``judge_command_bit_rate``, ``observed_measurements`` (the
+    four measurement cases judge them), ``judge_retries`` and ``judge_addresses``; and how
+    many windows the recording was read in."""
+
+    breaks: list[Finding]
+    break_rules: list[Finding]
+    command_text: list[Finding]
+    character_gaps: list[Finding]
+    command_bit_rate: Finding
+    measurements: list[ObservedMeasurement]
+    retries: list[Finding]
+    addresses: list[Finding]
+    windows: int
+
+
+def judge_windows(windows: Iterable[list[Event]], uncertainty: float) -> RecorderFindings:
+    """Every fold fed each of ``windows`` (in order, together a recording's events), each
+    window's view read alone and let go."""
+    return judge_views((read_view(w) for w in windows), uncertainty)
+
+
+def judge_views(views: Iterable[TranscriptView], uncertainty: float) -> RecorderFindings:
+    """Every fold fed each of ``views`` (each window's, read alone, in order), each let go
+    once every fold has taken it. No window at all (a recording with no events) is judged
+    as the whole-run functions judge an empty view: one empty window."""
+    breaks, rules = Breaks(uncertainty), BreakRules(uncertainty)
+    text, gaps = CommandText(uncertainty), CharacterGaps(uncertainty)
+    rate, taken = CommandBitRate(uncertainty), ObservedMeasurements(uncertainty)
+    retries, addresses = Retries(uncertainty), Addresses(uncertainty)
+    folds = (breaks, rules, text, gaps, rate, taken, retries, addresses)
+    count = 0
+    for view in views:
+        for fold in folds:
+            fold.add(view)
+        count += 1
+    if not count:
+        view = read_view([])
+        for fold in folds:
+            fold.add(view)
+    return RecorderFindings(
+        breaks.findings(), rules.findings(), text.findings(), gaps.findings(),
+        rate.finding(), taken.measurements(), retries.findings(), addresses.findings(),
+        count,
+    )  # fmt: skip
+
+
+def by_start(events: Sequence[Event]) -> Iterator[Event]:
+    """``events`` without their notes, in the order a view reads them (by start, stably,
+    as :func:`~conformance.view.segments.read_view` sorts them), which
+    :func:`~conformance.view.windows.stream_windows` needs: a capture's decode gives them
+    so already (no copy made); a transcript whose stamps go back somewhere is sorted."""
+    if all(a.start <= b.start for a, b in pairwise(_plain(events))):
+        return _plain(events)
+    return iter(sorted(_plain(events), key=attrgetter("start")))
+
+
+def _plain(events: Sequence[Event]) -> Iterator[Event]:
+    """``events`` without their notes (a view reads none)."""
+    return (e for e in events if e.kind is not EventKind.NOTE)
+
+
+def recorder_findings(link: RecordingLink) -> RecorderFindings:
+    """:func:`judge_windows` over the windows of ``link``'s recording, made once per
+    loaded recording (every recorder case reads it)."""
+    events = link.transcript.events
+
+    def judge() -> RecorderFindings:
+        cut = stream_window_views(by_start(events), uncertainty=link.uncertainty)
+        return judge_views((view for _window, view in cut), link.uncertainty)
+
+    return memo(link, "_recorder_findings", len(events), judge)
+
+
+__all__ = [
+    "RecorderFindings",
+    "by_start",
+    "judge_views",
+    "judge_windows",
+    "recorder_findings",
+]
