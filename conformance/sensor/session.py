@@ -58,6 +58,9 @@ class Sweep:
     #: Of ``refused``: the addresses the sensor took (its reply named them) and then answered
     #: no ``b!`` poll at: lost, or a sensor that answers no ``a!`` anywhere.
     unanswered: list[str] = field(default_factory=list)
+    #: The addresses a sensor that answers no ``a!`` was shown at by what it does answer:
+    #: ``?!`` named the address and the move back from it was answered (not in ``refused``).
+    heard: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -927,22 +930,54 @@ class SensorSession(Session):
     def address_sweep(self, targets: str) -> Sweep:
         """Change to each address in ``targets`` and back; restore whatever happens."""
         changer = AddressChanger(self.master, self.address)
-        refused, unanswered = [], []
+        refused, unanswered, heard = [], [], []
         try:
             for target in targets:
                 if target == self.address:
                     continue
                 outcome = changer.change(target)
-                if not outcome.took or outcome.answered_after is None:
-                    refused.append(target)
+                at_target = None
                 if outcome.took and outcome.answered_after is None:
-                    unanswered.append(target)
+                    at_target = self._queried_at(changer, target)
                 note = changer.restore()
-                if not changer.restored:
+                moved_back = at_target is not None and self._heard_back(changer)
+                if moved_back:
+                    heard.append(target)
+                else:
+                    if not outcome.took or outcome.answered_after is None:
+                        refused.append(target)
+                    if outcome.took and outcome.answered_after is None:
+                        unanswered.append(target)
+                if not changer.restored and not moved_back:
                     break
         finally:
             note = self.restore(changer)
-        return Sweep(changer.exchanges, refused, note, unanswered)
+        return Sweep(changer.exchanges, refused, note, unanswered, heard)
+
+    def _queried_at(self, changer: AddressChanger, target: str) -> Exchange | None:
+        """For a sensor that answers no ``a!`` (none answered in the run), alone on the line,
+        which took ``target`` by its reply and answered no ``b!`` poll: ``?!``, answered with
+        ``target`` (the exchange), or None. The twenty-third round's Due sensor (docs/kit.md)
+        takes every address 0-9 and answers only ``?!`` and ``aAb!``: the sweep stopped after
+        '1' and R-4.3-03 stayed INCONCLUSIVE on the silence of a! it never answers."""
+        if self.master.acknowledged or self.shared or self.queried != self.address:
+            return None
+        ex = self.master.query_address()
+        changer.exchanges.append(ex)
+        body, _ = split_line(ex.reply_text)
+        return ex if ex.answered and body == target else None
+
+    def _heard_back(self, changer: AddressChanger) -> bool:
+        """Whether the restore just made moved the sensor back by a command at the address it
+        was shown at (its ``bAa!`` answered with the original address: it heard a command
+        there) and ``?!`` names the original address again: then the sweep goes on, though
+        no ``a!`` could check the restore."""
+        if changer.settled is None:
+            return False  # checked with a!, or not moved back: the sweep decides as before
+        ex = self.master.query_address()
+        changer.exchanges.append(ex)
+        body, _ = split_line(ex.reply_text)
+        return ex.answered and body == self.address
 
     def try_invalid_address(self, bad: str) -> InvalidAddressAttempt:
         """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it."""

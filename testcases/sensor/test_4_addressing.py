@@ -227,10 +227,17 @@ def test_address_range(sensor, case):
             )
         )
     else:
+        shown = "answered there"
+        if sweep.heard:
+            # it answers no a!: ?! named each address and its move back from there was answered
+            shown = (
+                f"answered there ({', '.join(sweep.heard)}: ?! named the address and the "
+                "move back from it was answered; the sensor answers no a! anywhere)"
+            )
         case.add(
             passed(
                 "R-4.3-03",
-                f"accepted every address 0-9 and answered there; {sweep.restore_note}",
+                f"accepted every address 0-9 and {shown}; {sweep.restore_note}",
                 observed=len(sweep.exchanges),
             )
         )

@@ -121,7 +121,8 @@ A_PROBES = (
     "test_marking_after_break"
 )
 #: The rules those cases judged on the silence of a sensor that answers no a!.
-ON_A_SILENCE = ("R-4.3-03", "R-4.4.4-03", "R-7.0-04", "R-7.0-05", "R-7.0-07")
+#: (R-4.3-03 is not among them: a sensor that answers ?! and aAb! is judged on those replies.)
+ON_A_SILENCE = ("R-4.4.4-03", "R-7.0-04", "R-7.0-05", "R-7.0-07")
 
 
 def _verdicts(data: dict) -> dict[str, dict]:
@@ -842,14 +843,15 @@ def test_a_late_reply_to_the_probe_before_is_no_refused_address_r_4_3_03(wildcar
     """The '0' for the ?I! probe came 14 ms after the 0A1! sent next, which the sensor never
     heard: R-4.3-03 FAILed "refused or lost address(es) 1". A change that did not take, whose
     reply may be the command before's late one, is asked again (``address_change.
-    may_be_late_reply_to``): the sweep goes on, and with no a! at the new addresses to show
-    them R-4.3-03 is INCONCLUSIVE."""
+    may_be_late_reply_to``): the sweep goes on, and with ?! naming each new address and the
+    move back from it answered (it answers no a!) R-4.3-03 PASSes."""
     data = run_once(
         "sim://",
         keyword="test_identification or test_wildcard_with_other_commands or test_address_range",
     )
     rule = _verdicts(data)["R-4.3-03"]
-    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+    assert rule["verdict"] == "PASS", rule["findings"]
+    assert "?! named the address" in rule["findings"][0]["detail"], rule["findings"]
 
 
 def test_a_refusal_after_an_unanswered_probe_still_fails_r_4_3_03(wildcard_answered_late):
@@ -1041,7 +1043,8 @@ def test_a_sensor_that_answers_no_a_is_not_reported_unrestored(a_never_answered,
     data = run_into(tmp_path, "sim://", keyword="test_address_range")
     notes = data["dut"]["address_notes"]
     assert notes and not any("COULD NOT" in note for note in notes), notes
-    assert any("moved back to '0' by its reply to 1A0!" in note for note in notes), notes
+    # the sweep goes on to '9' (its ?! and move-back replies show each address): the last
+    assert any("moved back to '0' by its reply to 9A0!" in note for note in notes), notes
     assert any("?! answered '0'" in note for note in notes), notes
     tool = []
     for line in (tmp_path / "transcript.jsonl").read_text().splitlines():
@@ -1050,3 +1053,36 @@ def test_a_sensor_that_answers_no_a_is_not_reported_unrestored(a_never_answered,
     sent = re.findall(r"[^!]*!", "".join(tool))
     first = sent.index("1A0!")
     assert "1A0!" not in sent[first + 1 :], sent[first:]  # once answered '0', never again
+
+
+def test_a_sensor_that_answers_no_a_is_judged_on_its_other_replies_r_4_3_03(
+    a_never_answered, tmp_path
+):
+    """The twenty-third round's Due sensor takes every address 0-9 and answers only ?! and
+    aAb!: the sweep stopped after '1' (its move back could not be checked with a!) and
+    R-4.3-03 stayed INCONCLUSIVE, though its reply to 1A0! showed it heard a command at '1'.
+    Now ?! naming each new address and the move back answered from there are the proof, and
+    the sweep goes on to '9'."""
+    data = run_into(tmp_path, "sim://", keyword="test_address_range")
+    rule = _verdicts(data)["R-4.3-03"]
+    assert rule["verdict"] == "PASS", rule["findings"]
+    detail = rule["findings"][0]["detail"]
+    assert "1, 2, 3, 4, 5, 6, 7, 8, 9: ?! named the address" in detail, detail
+    assert not any("COULD NOT" in note for note in data["dut"]["address_notes"])
+    tool = []
+    for line in (tmp_path / "transcript.jsonl").read_text().splitlines():
+        if '"origin": "tool"' in line and '"kind": "char"' in line:
+            tool.append(chr(json.loads(line)["wire"] & 0x7F))
+    sent = re.findall(r"[^!]*!", "".join(tool))
+    for b in "123456789":  # each move followed by ?! and the move back from there
+        at = sent.index(f"0A{b}!")
+        assert "?!" in sent[at:] and f"{b}A0!" in sent[at:], (b, sent[at:])
+
+
+def test_a_sensor_that_answers_no_a_and_stays_put_is_no_r_4_3_03_pass(a_never_answered):
+    """Its replies alone are no proof: one that answers 0A1! with '1' but keeps '0' (fault
+    address-change-not-applied) names '0' to ?!, so the silence of a! stays no evidence and
+    R-4.3-03 stays INCONCLUSIVE, never PASS."""
+    data = run_once("sim://?faults=address-change-not-applied", keyword="test_address_range")
+    rule = _verdicts(data)["R-4.3-03"]
+    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]

@@ -52,6 +52,10 @@ def judge_commands_issued(
         # sensor side is the tool's, so "never answered" alone read as the tool's failure.
         unsent = [t for t in missing if t not in sent]
         unanswered = [t for t in missing if t in sent]
+        # on the wire with more after its '!' (the STM32 logger's NUL terminator after 0A5!,
+        # docs/kit.md twenty-third round): sent, malformed (R-4.2-01/R-4.4-04 judge the form)
+        garbled = _sent_with_more(unsent, sent)
+        unsent = [t for t in unsent if t not in garbled]
         # a reply the recorder's own break cut into was never heard whole, by its doing
         cut = {s.text for s in line.transmissions if cut_off(s) is not None}
         cut_short = [t for t in unanswered if t in cut]
@@ -59,6 +63,11 @@ def judge_commands_issued(
         if unsent:
             said = CUT_SHORT if cut_job else "never sent"
             parts.append(f"{said}: " + ", ".join(escape(t) for t in unsent))
+        if garbled:
+            parts.append(
+                "sent with more after its '!' (its form is R-4.2-01's and R-4.4-04's): "
+                + ", ".join(escape(w) for w in garbled.values())
+            )
         if unanswered:
             parts.append(
                 "sent but never answered validly: " + ", ".join(escape(t) for t in unanswered)
@@ -74,7 +83,7 @@ def judge_commands_issued(
             rid,
             Verdict.FAIL if (unsent and not cut_job) or stopped else Verdict.INCONCLUSIVE,
             "; ".join(parts),
-            evidence=record_of(line.transmissions, missing)
+            evidence=record_of(line.transmissions, missing + list(garbled.values()))
             + [m.start.at() for t, m in taken.items() if t in asked and len(m.values()) < m.count],
             observed=len(line.transmissions),
         )
@@ -84,6 +93,20 @@ def judge_commands_issued(
         f"{len(asked)} commands issued and answered: " + " ".join(escape(t) for t in asked),
         observed=len(asked),
     )
+
+
+def _sent_with_more(unsent: Sequence[str], sent: set[str]) -> dict[str, str]:
+    """Of the commands ``unsent`` (no transmission is the text alone), those a transmission
+    begins with, by the first such transmission's text (sorted, so the same each run): the
+    recorder put them on the wire with more after the ``!``. "Never sent" was false for the
+    twenty-third round's STM32 logger, whose ``0A5!<0x00>`` the played sensor answered."""
+    found: dict[str, str] = {}
+    for text in unsent:
+        if text.endswith("!"):
+            longer = sorted(s for s in sent if s.startswith(text) and len(s) > len(text))
+            if longer:
+                found[text] = longer[0]
+    return found
 
 
 def judge_addresses(line: TranscriptView, uncertainty: float) -> list[Finding]:

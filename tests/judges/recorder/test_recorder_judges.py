@@ -610,3 +610,23 @@ def test_an_acknowledge_after_the_measurement_ended_leaves_its_data_owed_r_4_4_7
     early = early.brk().rec("0!").sensor("0\r\n").brk().rec("0D0!").sensor("0\r\n")
     found = judge_concurrent_storage(observed_measurements(early.view(), 0.0), ("0C!",))
     assert Verdict.FAIL in [f.verdict for f in found if f.requirement == "R-4.4.7-08"]
+
+
+def test_a_command_sent_with_a_nul_after_its_bang_is_not_never_sent_r_4_4_02():
+    """Twenty-third round's STM32 logger (ilhamahendra14/STM32L4xx_SDI-12) sends 0A5! and 5A0!
+    with the NUL terminator of their char arrays after the '!' (R-4.2-01/R-4.4-04 FAIL it
+    rightly), and the played sensor answered them: R-4.4-02 listed them "never sent". They
+    are sent, malformed; the FAIL stands on the commands truly unsent (0V!)."""
+    w = Wire().brk().rec("0!").sensor("0\r\n").idle(20)
+    w = w.brk().rec("0A5!\x00").sensor("5\r\n").idle(1100)
+    w = w.brk().rec("5A0!\x00").sensor("0\r\n").idle(1100)
+    found = judge_commands_issued(w.view(), ["0!", "0A5!", "5A0!", "0V!"], 0.0)
+    assert found.verdict is Verdict.FAIL, found
+    assert found.detail == (
+        "never sent: 0V!; sent with more after its '!' (its form is R-4.2-01's and "
+        "R-4.4-04's): 0A5!<0x00>, 5A0!<0x00>"
+    ), found.detail
+    # with every other command sent, the malformed ones alone decide nothing here
+    found = judge_commands_issued(w.view(), ["0!", "0A5!", "5A0!"], 0.0)
+    assert found.verdict is Verdict.INCONCLUSIVE, found
+    assert "never sent" not in found.detail, found.detail
