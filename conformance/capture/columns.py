@@ -13,7 +13,7 @@ made (``tests/capture/test_wire_columns.py``).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from itertools import compress
 
@@ -36,6 +36,11 @@ class WireColumns:
 
     def __len__(self) -> int:
         return len(self.start)
+
+    def appenders(self) -> tuple[Callable, Callable, Callable, Callable]:
+        """The appends of a certified character's four columns (start, end, wire,
+        origin), for a decoder's loop to bind once."""
+        return self.start.append, self.end.append, self.wire.append, self.origin.append
 
     def add_made(self, event: Event) -> None:
         """An event the decoder made itself (a break, a pulse, a frame read alone)."""

@@ -346,16 +346,11 @@ def _collect_batches(
     events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's),
     or :data:`RECORDER_ORIGIN` where ``marks`` matches them (:meth:`Marks.origin`); with
     ``into``, no event is made: each one's start, kind and wire go there; with
-    ``out.columns``, none either: each one's start, end, wire and origin go there (an
-    event the decoder made itself, whole)."""
-    unc = out.uncertainty_s
-    head: list[Batch] = []  # the batches holding the first HOLD_FRAMES items
-    while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
-        head.append(b)
-    _synchronise_head(head, unc, sync_s, t0)
+    ``out.columns``, none either (:meth:`.WireColumns.appenders`)."""
+    unc, nan = out.uncertainty_s, float("nan")
+    head = _synchronised_head(batches, unc, sync_s, t0)
     problems, tally = out.problems, _Tally(out)
     add, baud_error = out.events.append, out.baud_error_pct.append
-    nan = float("nan")
     # the certified frames' counts; TX events matched since Marks was last told
     chars = framing_errors = parity_errors = glitches = matched = 0
     char, bus, event = EventKind.CHAR, origin, full_event
@@ -365,12 +360,8 @@ def _collect_batches(
     n_tx, tol, j, recorder = len(tx_start), marks.tolerance if mark else 0.0, 0, RECORDER_ORIGIN
     if into is not None:
         add = into.add
-    cols = out.columns
-    if cols is not None:
-        add = cols.add_made
-        put_s, put_e, put_w, put_o = (
-            cols.start.append, cols.end.append, cols.wire.append, cols.origin.append,
-        )  # fmt: skip
+    if (cols := out.columns) is not None:
+        add, (put_s, put_e, put_w, put_o) = cols.add_made, cols.appenders()
     for b in chain(head, batches):
         st, en, wi, fe, pe, err, gl = (
             b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
@@ -390,11 +381,8 @@ def _collect_batches(
                             o, j, matched = recorder, j + 1, matched + 1
                     if cols is None:
                         add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
-                    else:
-                        put_s(s)
-                        put_e(en[x])  # type: ignore[index]
-                        put_w(w)
-                        put_o(o)
+                    else:  # four columns, no event
+                        put_s(s), put_e(en[x]), put_w(w), put_o(o)  # type: ignore[index]
                 chars += 1
                 e = err[x]  # type: ignore[index]
                 baud_error(nan if e is None else e)
@@ -422,6 +410,18 @@ def _collect_batches(
         marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
     tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
+
+
+def _synchronised_head(
+    batches: Iterator[Batch], unc: float, sync_s: float, t0: float
+) -> list[Batch]:
+    """The batches holding the first :data:`~.uart.HOLD_FRAMES` items, taken from
+    ``batches`` and :func:`_synchronise_head`-ed."""
+    head: list[Batch] = []
+    while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
+        head.append(b)
+    _synchronise_head(head, unc, sync_s, t0)
+    return head
 
 
 def _synchronise_head(batches: list[Batch], unc: float, sync_s: float, t0: float) -> None:
