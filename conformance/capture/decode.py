@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 from itertools import chain
 
 from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
+from .columns import WireColumns
 from .edges import Edges
 from .errors import CaptureError
 from .formats import read_edges, sniff
@@ -78,6 +79,9 @@ class CaptureDecode:
     filtered_beside_edges: int = 0
     #: the plausibility check's refusal, overridden by ``force`` (None: not refused)
     forced_past: str | None = None
+    #: the events as columns (``decode_capture(..., columns=True)``), ``events`` then empty:
+    #: :meth:`event_list` gives them either way
+    columns: WireColumns | None = None
     baud_error_pct: array = field(default_factory=lambda: array("f"))
     problems: list[Decoded] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -87,6 +91,10 @@ class CaptureDecode:
         """``"uart"`` (idles high: TTL side of a transceiver) or ``"line"`` (the SDI-12 wire
         itself, idles low)."""
         return "line" if self.inverted else "uart"
+
+    def event_list(self) -> list[Event]:
+        """The events, made from :attr:`columns` when the decode kept them so."""
+        return self.columns.events() if self.columns is not None else self.events
 
     def baud_error_summary(self) -> tuple[float, float, float] | None:
         """(min, median, max) of the per-frame bit-rate error in %, or None."""
@@ -186,11 +194,13 @@ def _decode_channel(
     origin: str = BUS,
     marks: Marks | None = None,
     into: Marks | None = None,
+    columns: bool = False,
 ) -> CaptureDecode:
     """One channel decoded. ``marks``: the recorder's TX channel, its characters and breaks
     giving the events they match :data:`RECORDER_ORIGIN` as they are made (the others get
     ``origin``); ``into``: this is that TX channel, its characters and breaks put there,
-    no event made (BULK only)."""
+    no event made (BULK only); ``columns``: the events kept as :class:`.WireColumns`
+    (BULK only), none made."""
     baud, framing, edge_error = how.baud, how.framing, how.edge_error
     edges = read_edges(path, channel, fmt)
     glitch = GlitchFilter(how.glitch_filter * edges.tick_rate)
@@ -242,6 +252,8 @@ def _decode_channel(
         batches = decode_batches(chain(taken, chunks), **line)
         if marks is not None:
             marks.tolerance = 0.5 / baud + 2 * uncertainty  # merge_tx's, if not widened
+        if columns and into is None:
+            out.columns = WireColumns(uncertainty)
         _collect_batches(batches, out, sync_s, edges.t0, origin, marks, into)
     else:
         _collect(decode(chain(taken, chunks), **line), out)
@@ -259,6 +271,8 @@ def _filtered(out: CaptureDecode, glitch: GlitchFilter, width: float) -> None:
     out.glitch_filter_s, out.filtered = width, glitch.removed
     out.filtered_beside_edges = glitch.beside_edges
     if glitch.beside_edges:
+        if out.columns is not None:  # rare: the events made, and widened as before
+            out.events, out.columns = out.columns.events(), None
         out.uncertainty_s += width
         out.events = [replace(e, uncertainty=e.uncertainty + width) for e in out.events]
 
@@ -331,15 +345,12 @@ def _collect_batches(
     items, all that :func:`~.uart._synchronised` looks at, go through it as items. The
     events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's),
     or :data:`RECORDER_ORIGIN` where ``marks`` matches them (:meth:`Marks.origin`); with
-    ``into``, no event is made: each one's start, kind and wire go there."""
-    unc = out.uncertainty_s
-    head: list[Batch] = []  # the batches holding the first HOLD_FRAMES items
-    while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
-        head.append(b)
-    _synchronise_head(head, unc, sync_s, t0)
+    ``into``, no event is made: each one's start, kind and wire go there; with
+    ``out.columns``, none either (:meth:`.WireColumns.appenders`)."""
+    unc, nan = out.uncertainty_s, float("nan")
+    head = _synchronised_head(batches, unc, sync_s, t0)
     problems, tally = out.problems, _Tally(out)
     add, baud_error = out.events.append, out.baud_error_pct.append
-    nan = float("nan")
     # the certified frames' counts; TX events matched since Marks was last told
     chars = framing_errors = parity_errors = glitches = matched = 0
     char, bus, event = EventKind.CHAR, origin, full_event
@@ -349,6 +360,8 @@ def _collect_batches(
     n_tx, tol, j, recorder = len(tx_start), marks.tolerance if mark else 0.0, 0, RECORDER_ORIGIN
     if into is not None:
         add = into.add
+    if (cols := out.columns) is not None:
+        add, (put_s, put_e, put_w, put_o) = cols.add_made, cols.appenders()
     for b in chain(head, batches):
         st, en, wi, fe, pe, err, gl = (
             b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
@@ -366,7 +379,10 @@ def _collect_batches(
                         hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
                         if hit and tx_kind[j] is char:
                             o, j, matched = recorder, j + 1, matched + 1
-                    add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
+                    if cols is None:
+                        add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
+                    else:  # four columns, no event
+                        put_s(s), put_e(en[x]), put_w(w), put_o(o)  # type: ignore[index]
                 chars += 1
                 e = err[x]  # type: ignore[index]
                 baud_error(nan if e is None else e)
@@ -394,6 +410,18 @@ def _collect_batches(
         marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
     tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
+
+
+def _synchronised_head(
+    batches: Iterator[Batch], unc: float, sync_s: float, t0: float
+) -> list[Batch]:
+    """The batches holding the first :data:`~.uart.HOLD_FRAMES` items, taken from
+    ``batches`` and :func:`_synchronise_head`-ed."""
+    head: list[Batch] = []
+    while sum(len(b.order) for b in head) < HOLD_FRAMES and (b := next(batches, None)):
+        head.append(b)
+    _synchronise_head(head, unc, sync_s, t0)
+    return head
 
 
 def _synchronise_head(batches: list[Batch], unc: float, sync_s: float, t0: float) -> None:
@@ -447,7 +475,7 @@ def _check_plausible(
         if not force:
             raise CaptureError(path, why + " (--force judges it anyway)")
         out.forced_past = why
-    if not out.events and not held:
+    if not out.events and not out.columns and not held:
         raise CaptureError(
             path, f"channel {out.channel!r} holds only glitches: no frame or break to decode"
         )
@@ -556,6 +584,7 @@ def decode_capture(
     glitch_filter: float | None = None,
     force: bool = False,
     keep: bool = True,
+    columns: bool = False,
 ) -> CaptureDecode:
     """Decode ``channel`` of the capture at ``path`` (format detected by content).
 
@@ -568,7 +597,10 @@ def decode_capture(
     ``force``: judge a decode the plausibility check would refuse (the refusal is kept).
     ``keep`` False: the caller holds the decode for as long as it is needed (a recording
     loaded for judging), so the one kept is handed over, not copied, and no longer kept (an
-    hour's capture: two lists of 357,000 events fewer held while it is judged)."""
+    hour's capture: two lists of 357,000 events fewer held while it is judged).
+    ``columns``: with ``tx_channel``, the events are kept as :attr:`CaptureDecode.columns`
+    (no event made; ``events`` empty), for a caller that reads them so (a fault-matrix
+    row's replay); such a decode is neither kept nor taken from the one kept."""
     global _LAST
     path = str(path)
     if glitch_filter is None:
@@ -581,6 +613,8 @@ def decode_capture(
         )  # fmt: skip
     except OSError:
         key = None  # the decoding below says what is wrong with the file
+    if columns:
+        key = None
     if key is not None and _LAST is not None and _LAST[0] == key:
         kept = _LAST[1]
         if not keep:
@@ -592,7 +626,7 @@ def decode_capture(
     except ValueError as exc:
         raise CaptureError(path, str(exc)) from None
     how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force)
-    out = _decode_capture(path, channel, tx_channel, invert, how)
+    out = _decode_capture(path, channel, tx_channel, invert, how, columns)
     give_back_freed_heap()  # the decoder's transients, whatever pages they were left on
     if key is not None and keep:
         _LAST = (key, replace(out, events=list(out.events), notes=list(out.notes)))
@@ -605,6 +639,7 @@ def _decode_capture(
     tx_channel: str | None,
     invert: bool | None,
     how: DecodeSettings,
+    columns: bool = False,
 ) -> CaptureDecode:
     baud = how.baud
     if baud <= 0:
@@ -613,7 +648,7 @@ def _decode_capture(
     if fmt == "jsonl":
         raise CaptureError(path, "a transcript, not a capture: read it with read_transcript_jsonl")
     if tx_channel is not None and BULK:
-        out, tx, unseen = _decode_merged(path, fmt, channel, tx_channel, invert, how)
+        out, tx, unseen = _decode_merged(path, fmt, channel, tx_channel, invert, how, columns)
     else:
         out = _decode_channel(path, fmt, channel, invert, how)
         if tx_channel is None:
@@ -637,24 +672,30 @@ def _decode_merged(
     tx_channel: str,
     invert: bool | None,
     how: DecodeSettings,
+    columns: bool = False,
 ) -> tuple[CaptureDecode, CaptureDecode, int]:
     """The bus decoded with the recorder's TX channel in bulk: the TX first, into
     :class:`Marks` (no event made of it), then the bus, each event made once with its
     origin (:data:`SENSOR_ORIGIN`, :data:`RECORDER_ORIGIN` where the TX matches it). What
     :func:`merge_tx` of the two decodes gives, and the same errors first: the bus's, that
-    the TX channel is the bus's, then the TX's. Also how many TX events the bus lacks."""
+    the TX channel is the bus's, then the TX's. Also how many TX events the bus lacks.
+    ``columns``: the bus's events kept as columns (:class:`.WireColumns`)."""
     marks = Marks()
     try:
         tx: CaptureDecode | None = _decode_channel(path, fmt, tx_channel, None, how, into=marks)
         failed: CaptureError | None = None
     except CaptureError as exc:
         tx, failed = None, exc
-    out = _decode_channel(path, fmt, channel, invert, how, SENSOR_ORIGIN, marks=marks)
+    out = _decode_channel(
+        path, fmt, channel, invert, how, SENSOR_ORIGIN, marks=marks, columns=columns
+    )
     if tx_channel == out.channel:
         raise CaptureError(path, f"the TX channel {tx_channel!r} is the bus channel itself")
     if failed is not None or tx is None:
         raise failed or CaptureError(path, f"TX channel {tx_channel!r} not decoded")
     tolerance = 0.5 / how.baud + 2 * out.uncertainty_s
     if tolerance != marks.tolerance:  # the bus's stamps were widened (_filtered)
+        if out.columns is not None:
+            out.events, out.columns = out.columns.events(), None
         out.events = marks.again(out.events, tolerance)
     return out, tx, marks.unseen()

@@ -34,6 +34,7 @@ from ..replay.link import VIRTUAL_KINDS
 from ..replay.recording import (
     Recording,
     RecordingError,
+    hold_capture,
     hold_recording,
     options_in,
     read_recording,
@@ -223,7 +224,8 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace, in_memory: bool =
         notes = meta.notes
     options = options_in(notes)
     tool_tx = tool_channel(meta, args, found.path) if options else None
-    decoded = decode(found.path, args, tool_tx)
+    # held in memory, the decode's characters stay columns: the replay reads those alone
+    decoded = decode(found.path, args, tool_tx, columns=in_memory and bool(options))
     found.notes.extend(describe_decode(decoded))
     if not options:
         found.notes.append("judged passively: the capture does not say which run it is of")
@@ -231,7 +233,10 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace, in_memory: bool =
     found.run_role = str(options.get("role", "sensor"))
     if tool_tx and found.run_role == "sensor":
         args.tx_channel = tool_tx  # the tool was the recorder: its TX is the recorder's
-    events, unsettled = directed(decoded.events)
+    columns = decoded.columns
+    if columns is not None and BUS in columns.origin:  # directions to infer: events needed
+        decoded.events, decoded.columns, columns = columns.events(), None, None
+    events, unsettled = directed(decoded.events) if columns is None else ([], 0)
     if unsettled:
         found.notes.append(
             f"judged passively: the protocol does not settle who sent {unsettled} of the "
@@ -240,16 +245,22 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace, in_memory: bool =
         return
     report_dir = run_folder(args.report_dir, str(options.get("role", "sensor")))
     decoded_path = report_dir / "capture.jsonl"
-    decoded_events = sorted([*notes, *events], key=lambda e: e.start)
-    # held only where the events are what the file would read back as (write_recording's rule)
-    kept = in_memory and all(map(plain_fields, decoded_events))
     try:  # nothing is written into a folder another live run holds (issue 19)
         check_report_dir(report_dir)
-        if kept:
-            hold_recording(decoded_path, decoded_events)
-        else:
-            with held(report_dir):
-                write_recording(decoded_path, decoded_events)
+        # columns are held as they are where they stand for the events exactly, else made
+        kept = columns is not None and hold_capture(decoded_path, notes, columns)
+        if not kept:
+            if columns is not None:
+                events = columns.events()
+            decoded_events = sorted([*notes, *events], key=lambda e: e.start)
+            # held only where the events are what the file would read back as
+            # (write_recording's rule)
+            kept = in_memory and all(map(plain_fields, decoded_events))
+            if kept:
+                hold_recording(decoded_path, decoded_events)
+            else:
+                with held(report_dir):
+                    write_recording(decoded_path, decoded_events)
     except UsageError as exc:
         raise JudgeError(str(exc)) from None
     recording = read_recording(decoded_path)
@@ -306,9 +317,12 @@ def has_channel(path: Path, name: str) -> bool:
         return False
 
 
-def decode(path: Path, args: argparse.Namespace, tx_channel: str | None = None) -> CaptureDecode:
+def decode(
+    path: Path, args: argparse.Namespace, tx_channel: str | None = None, columns: bool = False
+) -> CaptureDecode:
     """``path`` decoded; ``tx_channel``: the tool's own TX (default ``--tx-channel``), whose
-    characters are the tool's (origin ``tool``, whatever side it played)."""
+    characters are the tool's (origin ``tool``, whatever side it played); ``columns``: its
+    events kept as columns (:attr:`CaptureDecode.columns`), none made."""
     try:
         return decode_capture(
             str(path),
@@ -318,6 +332,7 @@ def decode(path: Path, args: argparse.Namespace, tx_channel: str | None = None) 
             baud=args.baud,
             glitch_filter=glitch_filter(args.glitch_filter_us),
             force=args.force,
+            columns=columns,
         )
     except CaptureError as exc:
         raise JudgeError(str(exc)) from None

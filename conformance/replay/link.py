@@ -51,7 +51,10 @@ def recorded_info(recording: Recording) -> LinkInfo:
 def replayed_info(recording: Recording) -> LinkInfo:
     """The link info a replay reports: the recorded one's capabilities, named a replay."""
     base = recorded_info(recording)
-    stamped = max((e.uncertainty for e in recording.events), default=0.0)
+    held = recording.held.largest_uncertainty() if recording.held is not None else None
+    stamped = (
+        held if held is not None else max((e.uncertainty for e in recording.events), default=0.0)
+    )
     return LinkInfo(
         kind="replay of " + base.kind.removeprefix("replay of "),
         can_break=base.can_break,
@@ -76,7 +79,17 @@ class ReplayLink(SimLink):
 
 def open_sensor_replay(port: str) -> tuple[ReplayLink, Recording]:
     recording = read_recording(replay_path(port))
-    return ReplayLink(recording, RecordedSensor(recording.events)), recording
+    return ReplayLink(recording, recorded_sensor(recording)), recording
+
+
+def recorded_sensor(recording: Recording) -> RecordedSensor:
+    """The recording's sensor: a decoded capture held as columns gives it its columns (no
+    reply character made an event, issue 22), anything else its events."""
+    if recording.held is not None:
+        sensor = RecordedSensor.of_columns(recording.held.wire)
+        if sensor is not None:
+            return sensor
+    return RecordedSensor(recording.events)
 
 
 def open_recorder_replay(port: str) -> Recording:

@@ -10,16 +10,21 @@ transcript and the command line fill in what they can.
 
 from __future__ import annotations
 
+import heapq
 import json
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from operator import attrgetter
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..capture.errors import CaptureError
 from ..capture.transcript_io import read_transcript_jsonl
 from ..transcript import TOOL, Event, EventKind, Transcript
+
+if TYPE_CHECKING:
+    from ..capture.columns import WireColumns
 
 #: Prefix of the NOTE that carries the run's options (first line of a transcript).
 OPTIONS_NOTE = "run-options "
@@ -29,14 +34,35 @@ class RecordingError(ValueError):
     """A recording that cannot be judged; the message names the file and what is wrong."""
 
 
-@dataclass
 class Recording:
-    """The events of one saved run and what is known of how it was made."""
+    """The events of one saved run and what is known of how it was made: ``options`` the
+    RunOptions fields as saved, ``verdicts`` the verdicts.json beside it (when there is one),
+    ``held`` a decoded capture held as columns (:func:`hold_capture`), whose events are
+    made only when :attr:`events` is read (a replay reads the columns)."""
 
-    path: Path
-    events: list[Event]
-    options: dict[str, Any] = field(default_factory=dict)  # RunOptions fields, as saved
-    verdicts: dict[str, Any] | None = None  # verdicts.json beside it, when there is one
+    def __init__(
+        self,
+        path: Path,
+        events: list[Event] | None,
+        options: dict[str, Any] | None = None,
+        verdicts: dict[str, Any] | None = None,
+        held: HeldCapture | None = None,
+    ) -> None:
+        if events is None and held is None:
+            raise ValueError("a recording needs its events or its held capture")
+        self.path = path
+        self._events = events
+        self.options: dict[str, Any] = {} if options is None else options
+        self.verdicts = verdicts
+        self.held = held
+
+    @property
+    def events(self) -> list[Event]:
+        """Every event, notes too, in the file's order."""
+        if self._events is None:
+            assert self.held is not None
+            self._events = self.held.events()
+        return self._events
 
     @property
     def role(self) -> str | None:
@@ -72,6 +98,11 @@ def read_recording(path: str | Path) -> Recording:
     """Read a run's transcript (a ``transcript.jsonl`` or the run folder holding it)."""
     file = transcript_path(Path(path))
     held = _HELD.get(str(file.resolve())) if _HELD else None
+    if isinstance(held, HeldCapture):
+        options = _options_of(file, held.notes)
+        if not len(held.wire):
+            raise RecordingError(f"{file}: no bus events in it: nothing to judge")
+        return Recording(file, None, options, _verdicts_beside(file), held=held)
     if held is not None:
         events = list(held)
     elif not file.exists():
@@ -81,14 +112,18 @@ def read_recording(path: str | Path) -> Recording:
             events = _read_events(file)
         except CaptureError as exc:
             raise RecordingError(str(exc)) from None
-    options: dict[str, Any] = {}
-    for number, event in enumerate(events, 1):
-        if event.kind is EventKind.NOTE and event.text.startswith(OPTIONS_NOTE):
-            options = _options_from(file, number, event.text[len(OPTIONS_NOTE) :])
-            break
+    options = _options_of(file, events)
     if not any(e.kind is not EventKind.NOTE for e in events):
         raise RecordingError(f"{file}: no bus events in it: nothing to judge")
     return Recording(file, events, options, _verdicts_beside(file))
+
+
+def _options_of(file: Path, events: list[Event]) -> dict[str, Any]:
+    """The options of the first run-options note among ``events`` ({}: none)."""
+    for number, event in enumerate(events, 1):
+        if event.kind is EventKind.NOTE and event.text.startswith(OPTIONS_NOTE):
+            return _options_from(file, number, event.text[len(OPTIONS_NOTE) :])
+    return {}
 
 
 #: the last few transcripts read, by (path, mtime, size): one judging reads its recording up
@@ -115,8 +150,41 @@ def _keep(key: tuple[str, int, int], events: tuple[Event, ...]) -> None:
     _READ[key] = events
 
 
-#: recordings handed over in memory (:func:`hold_recording`), by the file they stand for
-_HELD: dict[str, tuple[Event, ...]] = {}
+_START = attrgetter("start")
+
+
+@dataclass
+class HeldCapture:
+    """A decoded capture handed to its replay in memory as columns (:func:`hold_capture`):
+    its run's notes, sorted by start, and the decoded events (no note among them), their
+    starts never decreasing. Its events are the notes and the decoded events sorted by
+    start, the notes first among equal starts: ``sorted([*notes, *decoded], key=start)``,
+    what ``judge`` writes as the capture's ``capture.jsonl``."""
+
+    notes: list[Event]
+    wire: WireColumns
+
+    def events(self) -> list[Event]:
+        """The notes and the decoded events, made, in the file's order."""
+        return list(heapq.merge(self.notes, self.wire.events(), key=_START))
+
+    def largest_uncertainty(self) -> float | None:
+        """The largest uncertainty any event carries, when it is a positive number (which
+        one of equal values is then immaterial); None: read it from :meth:`events`."""
+        wire = self.wire
+        values = [n.uncertainty for n in self.notes]
+        values += [e.uncertainty for e in wire.made.values()]
+        if len(wire.made) < len(wire):
+            values.append(wire.uncertainty)  # every certified character's
+        if not values or any(v != v for v in values):
+            return None  # a NaN's place among the events decides max()
+        found = max(values)
+        return found if found > 0 else None
+
+
+#: recordings handed over in memory (:func:`hold_recording`, :func:`hold_capture`), by the
+#: file they stand for
+_HELD: dict[str, tuple[Event, ...] | HeldCapture] = {}
 
 
 def hold_recording(path: Path, events: list[Event]) -> None:
@@ -125,6 +193,23 @@ def hold_recording(path: Path, events: list[Event]) -> None:
     deleted (a fault-matrix row's round trip, issue 22: writing its 10^4..10^5 lines was 3%
     of the row's CPU). A user's ``judge`` writes its capture.jsonl, as before."""
     _HELD[str(transcript_path(Path(path)).resolve())] = tuple(events)
+
+
+def hold_capture(path: Path, notes: list[Event], wire: WireColumns) -> bool:
+    """:func:`hold_recording` of a decoded capture whose events are kept as columns (issue
+    22: a fault-matrix row's ~2*10^4 characters, whose replay reads only the columns),
+    ``notes`` its run's notes: held, and True, when the recording is what
+    ``hold_recording(path, sorted([*notes, *wire.events()], key=start))`` would hold (every
+    field of the plain type a file reads back as, the decoded starts in order, no NaN
+    start among the notes); else nothing is held and False (the caller makes the events)."""
+    if not (wire.in_start_order() and wire.plain()):
+        return False
+    from ..transcript import plain_fields
+
+    if not all(n.start == n.start and plain_fields(n) for n in notes):
+        return False
+    _HELD[str(transcript_path(Path(path)).resolve())] = HeldCapture(sorted(notes, key=_START), wire)
+    return True
 
 
 @contextmanager

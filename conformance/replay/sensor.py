@@ -29,6 +29,8 @@ from ..transcript import TOOL, Event, EventKind, escape
 if TYPE_CHECKING:
     import numpy as np
 
+    from ..capture.columns import WireColumns
+
 #: a frame's start meaning "as soon as the line is free" (the bus starts a frame at the later
 #: of its start and the end of what is on the line)
 LINE_FREE = float("-inf")
@@ -62,16 +64,84 @@ class RecordedSensor:
         self._touching: list[tuple[bool, bool]]
         found = _worked_out(wire)
         if found is not None:  # in order and no NaN: worked out over arrays
-            self.tool, self.replies, self._needs, self._touching = found
+            tool, replies, self._needs, self._touching, columns = found
         else:
             wire.sort(key=_START_END)
-            self.tool = [e for e in wire if e.origin == TOOL]
-            self.replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
+            tool = [e for e in wire if e.origin == TOOL]
+            replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
             # how many tool events the recording has before each reply character starts
             # (the tool's starts never decrease: they are sorted with the rest)
-            starts = [e.start for e in self.tool]
-            self._needs = [bisect_left(starts, reply.start) for reply in self.replies]
-            self._touching = _touching_each(self.tool, self.replies, self._needs)
+            starts = [e.start for e in tool]
+            self._needs = [bisect_left(starts, reply.start) for reply in replies]
+            self._touching = _touching_each(tool, replies, self._needs)
+            columns = _reply_columns(replies)
+        self._tool: list[Event] | None = tool
+        self._replies: list[Event] | None = replies
+        kinds, wires, ends = [e.kind for e in tool], [e.wire for e in tool], [e.end for e in tool]
+        self._start((kinds, wires, ends), columns)
+
+    @classmethod
+    def of_columns(cls, wire: WireColumns) -> RecordedSensor | None:
+        """The recorded sensor of a decoded capture's events kept as columns (in decode
+        order, no note among them), the reply characters never made events (issue 22:
+        ~2*10^4 a fault-matrix row): what ``RecordedSensor(wire.events())`` is, when the
+        columns are in its order with no NaN stamp (:func:`_worked_out`'s condition);
+        else None (the caller makes the events)."""
+        import numpy as np
+
+        s, e = np.array(wire.start, np.float64), np.array(wire.end, np.float64)
+        u = np.array(wire.uncertainties(), np.float64)
+        is_tool = np.array([o == TOOL for o in wire.origin], bool)
+        kinds = wire.kinds()
+        is_char = np.fromiter(map(is_, kinds, repeat(EventKind.CHAR)), bool, len(kinds))
+        with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
+            found = _from_arrays(s, e, u, is_tool, is_char)
+            if found is None:
+                return None
+            is_reply, needs, touching = found
+            columns = _array_columns(s, e, is_reply, wire.wire)
+            tool_mask = is_tool.tolist()
+            tool_ends = e[is_tool].tolist()
+        sensor = cls.__new__(cls)
+        sensor._needs, sensor._touching = needs, touching
+        sensor._tool = sensor._replies = None
+        sensor._made_of = (wire, tool_mask, is_reply.tolist())
+        tool_columns = (
+            list(compress(kinds, tool_mask)),
+            list(compress(wire.wire, tool_mask)),
+            tool_ends,
+        )
+        sensor._start(tool_columns, columns)
+        return sensor
+
+    @property
+    def tool(self) -> list[Event]:
+        """The recording's tool events, in the replay's order (made from the columns when
+        the sensor was built from them: the replay reads a divergence's alone)."""
+        if self._tool is None:
+            wire, keep, _ = self._made_of
+            self._tool = wire.events_at(keep)
+        return self._tool
+
+    @property
+    def replies(self) -> list[Event]:
+        """The recording's reply characters, in the replay's order (made from the columns
+        when the sensor was built from them: the replay itself reads only the columns)."""
+        if self._replies is None:
+            wire, _, keep = self._made_of
+            self._replies = wire.events_at(keep)
+        return self._replies
+
+    def _start(
+        self,
+        tool: tuple[list[EventKind], list[int], list[float]],
+        replies: tuple[list[float], list[int], list[float]],
+    ) -> None:
+        """The replay's state at its start; ``tool``: each tool event's kind, byte and end,
+        ``replies``: each reply character's start, byte and length (end - start), all the
+        replay reads of them."""
+        self._tool_kind, self._tool_wire, self._tool_end = tool
+        self._reply_start, self._reply_wire, self._reply_length = replies
         self.heard = 0  # tool events matched so far
         self.next_reply = 0
         self.offset = 0.0  # now minus recorded time, at the last matched tool event
@@ -87,20 +157,21 @@ class RecordedSensor:
         self._match(EventKind.CHAR, wire, end)
 
     def _match(self, kind: EventKind, wire: int, end: float, length: float = 0.0) -> None:
-        if self.heard >= len(self.tool):
+        heard = self.heard
+        if heard >= len(self._tool_end):
             raise RecordingEnded(
                 f"the recording ends at {end:.3f} s, before its run did (cut short?): the "
                 f"tool sent {_describe(kind, wire)} there and nothing more was recorded"
             )
-        expected = self.tool[self.heard]
-        if not same_action(expected, kind, wire, length):
+        if not _same(self._tool_kind[heard], self._tool_wire[heard], kind, wire, length):
+            expected = self.tool[heard]
             raise ReplayDiverged(
                 f"{DIVERGED} at {end:.3f} s (recorded {expected.start:.3f} s): the tool "
                 f"sent {_describe(kind, wire)}, the recording has "
                 f"{_describe(expected.kind, expected.wire)}"
             )
-        self.heard += 1
-        self.offset = end - expected.end
+        self.heard = heard + 1
+        self.offset = end - self._tool_end[heard]
 
     # -- what the recording says the sensor did -------------------------------------------------
     def next_frame(self) -> Frame | None:
@@ -113,19 +184,18 @@ class RecordedSensor:
 
     def _next_frame(self) -> Frame | None:
         k = self.next_reply
-        if k >= len(self.replies):
+        if k >= len(self._reply_start):
             return None
         need = self._needs[k]
         if need > self.heard:
             return None  # its question has not been asked yet
-        reply = self.replies[k]
         if self._touching[k][self.heard > need]:
             # back to back with what was on the line before it, within what the recording can
             # tell (a capture's edges sit on its sample grid): it goes the moment the line is
             # free, so it wins the line against the tool's next frame, as recorded (else the
             # order of frames that touch could turn on a few microseconds of quantization)
-            return Frame(LINE_FREE, reply.wire, reply.end - reply.start)
-        return Frame(reply.start + self.offset, reply.wire, reply.end - reply.start)
+            return Frame(LINE_FREE, self._reply_wire[k], self._reply_length[k])
+        return Frame(self._reply_start[k] + self.offset, self._reply_wire[k], self._reply_length[k])
 
     def pop_frame(self) -> Frame:
         frame = self.next_frame()
@@ -140,17 +210,17 @@ class RecordedSensor:
         heard, in order (what one offers depends only on ``heard``, which only the tool's
         events move, and on its own index). None when none is due, as ``next_frame`` says."""
         k = self.next_reply
-        if k >= len(self.replies) or self._needs[k] > self.heard:
+        if k >= len(self._reply_start) or self._needs[k] > self.heard:
             return None
         return self._due(k, self.heard, self.offset)
 
     def _due(self, k: int, heard: int, offset: float) -> Iterator[tuple[float, int, float]]:
-        replies, needs, touching = self.replies, self._needs, self._touching
-        count = len(replies)
+        needs, touching = self._needs, self._touching
+        starts, wires, lengths = self._reply_start, self._reply_wire, self._reply_length
+        count = len(starts)
         while k < count and needs[k] <= heard:
-            reply = replies[k]
-            start = LINE_FREE if touching[k][heard > needs[k]] else reply.start + offset
-            yield start, reply.wire, reply.end - reply.start
+            start = LINE_FREE if touching[k][heard > needs[k]] else starts[k] + offset
+            yield start, wires[k], lengths[k]
             k += 1
 
     def pop_frames(self, count: int) -> None:
@@ -194,9 +264,29 @@ def _column(events: list[Event], name: str) -> np.ndarray:
     return np.fromiter(map(attrgetter(name), events), np.float64, len(events))
 
 
-def _worked_out(
-    wire: list[Event],
-) -> tuple[list[Event], list[Event], list[int], list[tuple[bool, bool]]] | None:
+def _reply_columns(replies: list[Event]) -> tuple[list[float], list[int], list[float]]:
+    """Each reply character's start, byte and length (end - start)."""
+    return [r.start for r in replies], [r.wire for r in replies], [r.end - r.start for r in replies]
+
+
+def _array_columns(
+    s: np.ndarray, e: np.ndarray, is_reply: np.ndarray, wire: list[int]
+) -> tuple[list[float], list[int], list[float]]:
+    """:func:`_reply_columns` from the recording's columns (the same floats: float64
+    subtraction is Python's)."""
+    rs, re = s[is_reply], e[is_reply]
+    return rs.tolist(), list(compress(wire, is_reply.tolist())), (re - rs).tolist()
+
+
+#: what :func:`_worked_out` gives: the tool's events, the reply characters, the needs, the
+#: back-to-back flags and the reply columns (:func:`_reply_columns`)
+WorkedOut = tuple[
+    list[Event], list[Event], list[int], list[tuple[bool, bool]],
+    tuple[list[float], list[int], list[float]],
+]  # fmt: skip
+
+
+def _worked_out(wire: list[Event]) -> WorkedOut | None:
     """The tool's events, the reply characters, the replay's ``_needs`` (``bisect_left`` of
     each reply's start among the tool's starts) and :func:`_touching_each`, over arrays (the
     same comparisons and sums of the same floats), when ``wire`` is already in the replay's
@@ -211,24 +301,40 @@ def _worked_out(
         return _in_arrays(wire, *(_column(wire, k) for k in ("start", "end", "uncertainty")))
 
 
-def _in_arrays(
-    wire: list[Event], s: np.ndarray, e: np.ndarray, u: np.ndarray
-) -> tuple[list[Event], list[Event], list[int], list[tuple[bool, bool]]] | None:
+def _in_arrays(wire: list[Event], s: np.ndarray, e: np.ndarray, u: np.ndarray) -> WorkedOut | None:
     """:func:`_worked_out` given the events' starts, ends and uncertainties."""
+    import numpy as np
+
+    n = len(wire)
+    is_tool = np.fromiter(map(eq, map(_ORIGIN, wire), repeat(TOOL)), bool, n)
+    is_char = np.fromiter(map(is_, map(_KIND, wire), repeat(EventKind.CHAR)), bool, n)
+    found = _from_arrays(s, e, u, is_tool, is_char)
+    if found is None:
+        return None
+    is_reply, needs, touching = found
+    tool = list(compress(wire, is_tool.tolist()))
+    replies = list(compress(wire, is_reply.tolist()))
+    wires = [r.wire for r in replies]
+    rs, re = s[is_reply], e[is_reply]
+    return tool, replies, needs, touching, (rs.tolist(), wires, (re - rs).tolist())
+
+
+def _from_arrays(
+    s: np.ndarray, e: np.ndarray, u: np.ndarray, is_tool: np.ndarray, is_char: np.ndarray
+) -> tuple[np.ndarray, list[int], list[tuple[bool, bool]]] | None:
+    """The reply characters (a mask), the needs and the back-to-back flags of events in
+    the replay's order given as columns (starts, ends, uncertainties, which are the
+    tool's, which are characters); None when they are not in that order or a stamp is
+    NaN (:func:`_worked_out`)."""
     import numpy as np
 
     if np.isnan(s).any() or np.isnan(e).any():
         return None
     if not ((s[1:] > s[:-1]) | ((s[1:] == s[:-1]) & (e[1:] >= e[:-1]))).all():
         return None
-    n = len(wire)
-    is_tool = np.fromiter(map(eq, map(_ORIGIN, wire), repeat(TOOL)), bool, n)
-    is_char = np.fromiter(map(is_, map(_KIND, wire), repeat(EventKind.CHAR)), bool, n)
     is_reply = ~is_tool & is_char
-    tool = list(compress(wire, is_tool.tolist()))
-    replies = list(compress(wire, is_reply.tolist()))
-    if not replies:
-        return tool, replies, [], []
+    if not is_reply.any():
+        return is_reply, [], []
     ts, te, tu = s[is_tool], e[is_tool], u[is_tool]
     rs, re, ru = s[is_reply], e[is_reply], u[is_reply]
     need = np.searchsorted(ts, rs, "left")
@@ -247,20 +353,27 @@ def _in_arrays(
     first = (use_prev | has_tool) & (np.abs(rs - before_end) <= ru + before_u)
     second = has_prev & (np.abs(rs - re_prev) <= ru + ru_prev)
     touching = list(zip(first.tolist(), second.tolist(), strict=True))
-    return tool, replies, need.tolist(), touching
+    return is_reply, need.tolist(), touching
 
 
 def same_action(recorded: Event, kind: EventKind, wire: int, length: float) -> bool:
     """Whether the tool's break or character is the recorded one. A spacing shorter than a
     frame (a probe below the break threshold) is, on a captured wire, indistinguishable from
     a character whose low bits are the spacing: a capture decoder reports it as one."""
+    return _same(recorded.kind, recorded.wire, kind, wire, length)
+
+
+def _same(
+    recorded_kind: EventKind, recorded_wire: int, kind: EventKind, wire: int, length: float
+) -> bool:
+    """:func:`same_action` given the recorded event's kind and byte."""
     if kind is EventKind.CHAR:
-        return recorded.kind is EventKind.CHAR and recorded.wire == wire
-    if recorded.kind is EventKind.BREAK:
+        return recorded_kind is EventKind.CHAR and recorded_wire == wire
+    if recorded_kind is EventKind.BREAK:
         return True
     if length >= CHAR_TIME:
         return False
-    low = recorded.wire & 0xFF
+    low = recorded_wire & 0xFF
     spacing_bits = 1 + ((low & -low).bit_length() - 1 if low else 8)  # start bit + zeros
     return abs(spacing_bits - length / BIT_TIME) <= 1.0
 

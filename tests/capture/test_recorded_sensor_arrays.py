@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conformance.capture import decode_capture
+from conformance.capture.columns import WireColumns
 from conformance.capture.export import TOOL_CHANNEL, export_events
 from conformance.replay import sensor as sensor_module
 from conformance.replay.sensor import _START_END, RecordedSensor, _touching_each, _worked_out
@@ -22,18 +23,22 @@ from conformance.transcript import DUT, TOOL, Event, EventKind
 from tests.support.capture_digest import traffic
 
 
-def event_by_event(events: list[Event]) -> tuple[list, list, list[int], list]:
-    """What :class:`RecordedSensor` worked out before the arrays, step by step."""
+def event_by_event(events: list[Event]) -> tuple[list, list, list[int], list, list]:
+    """What :class:`RecordedSensor` worked out before the arrays, step by step, and what its
+    replay reads of each reply (start, byte, length; floats by repr: NaN too)."""
     wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=_START_END)
     tool = [e for e in wire if e.origin == TOOL]
     replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
     starts = [e.start for e in tool]
     needs = [bisect_left(starts, r.start) for r in replies]
-    return tool, replies, needs, _touching_each(tool, replies, needs)
+    read = [(repr(r.start), r.wire, repr(r.end - r.start)) for r in replies]
+    return tool, replies, needs, _touching_each(tool, replies, needs), read
 
 
-def state(sensor: RecordedSensor) -> tuple[list, list, list[int], list]:
-    return sensor.tool, sensor.replies, sensor._needs, sensor._touching
+def state(sensor: RecordedSensor) -> tuple[list, list, list[int], list, list]:
+    starts, wires, lengths = sensor._reply_start, sensor._reply_wire, sensor._reply_length
+    read = [(repr(s), w, repr(n)) for s, w, n in zip(starts, wires, lengths, strict=True)]
+    return sensor.tool, sensor.replies, sensor._needs, sensor._touching, read
 
 
 def test_a_decoded_capture_takes_the_arrays_and_gives_the_same(tmp_path):
@@ -45,7 +50,7 @@ def test_a_decoded_capture_takes_the_arrays_and_gives_the_same(tmp_path):
     found = _worked_out([e for e in events if e.kind is not EventKind.NOTE])
     assert found is not None
     assert len(found[1]) > 500 and any(t for t, _ in found[3]) and any(p for _, p in found[3])
-    assert list(found) == list(event_by_event(events))
+    assert list(found[:4]) == list(event_by_event(events))[:4]
     assert state(RecordedSensor(events)) == event_by_event(events)
 
 
@@ -126,3 +131,55 @@ def test_a_reply_starting_with_the_one_before_does_not_follow_it():
     assert _worked_out(events) is not None
     assert state(RecordedSensor(events)) == event_by_event(events)
     assert RecordedSensor(events)._touching == [(False, False), (False, False)]
+
+
+def as_columns(events: list[Event]) -> WireColumns:
+    """``events`` (notes left out) as a decoder keeps them in columns: a character with no
+    text, no duration uncertainty and the common uncertainty as four entries, anything
+    else whole."""
+    wire = [e for e in events if e.kind is not EventKind.NOTE]
+    common = wire[0].uncertainty if wire else 0.0
+    cols = WireColumns(common)
+    for e in wire:
+        if (
+            e.kind is EventKind.CHAR
+            and e.text == ""
+            and e.duration_uncertainty is None
+            and e.uncertainty is common
+        ):
+            cols.start.append(e.start)
+            cols.end.append(e.end)
+            cols.wire.append(e.wire)
+            cols.origin.append(e.origin)
+        else:
+            cols.add_made(e)
+    return cols
+
+
+@settings(max_examples=400, deadline=None)
+@given(recordings())
+def test_columns_give_the_recorded_sensor_of_the_events(events):
+    """The thirteenth matrix round: a decoded capture's columns give the sensor its events
+    give (the same tool events, reply characters, needs, back-to-back flags and what the
+    replay reads of each reply), or None exactly where the events are not read as arrays."""
+    cols = as_columns(events)
+    assert cols.events() == [e for e in events if e.kind is not EventKind.NOTE]
+    sensor = RecordedSensor.of_columns(cols)
+    wire = [e for e in events if e.kind is not EventKind.NOTE]
+    assert (sensor is None) == (_worked_out(wire) is None)
+    if sensor is not None:
+        assert state(sensor) == event_by_event(events) == state(RecordedSensor(events))
+
+
+def test_a_decoded_captures_columns_give_its_sensor(tmp_path):
+    """A hostile bus's capture decoded into columns: the sensor its events give, the
+    reply characters never made (until asked for)."""
+    path = tmp_path / "run.sr"
+    export_events(traffic(7, seconds=20.0), str(path), "sr", tool_channel=True)
+    decoded = decode_capture(str(path), tx_channel=TOOL_CHANNEL, columns=True)
+    assert decoded.columns is not None
+    sensor = RecordedSensor.of_columns(decoded.columns)
+    assert sensor is not None and sensor._replies is None
+    events = decoded.columns.events()
+    assert len(sensor._reply_start) > 500
+    assert state(sensor) == event_by_event(events) == state(RecordedSensor(events))

@@ -15,6 +15,7 @@ import pytest
 import conformance.offline.judge as judge
 import conformance.replay.recording as recording
 from conformance.capture import held_sr
+from conformance.capture.columns import WireColumns
 from conformance.capture.export import export_events
 from conformance.conduct import conduct
 from conformance.matrices import roundtrip
@@ -84,6 +85,7 @@ def test_events_a_file_would_not_read_back_as_are_written(
     _data, events = live
     capture = _capture(events, tmp_path)
     monkeypatch.setattr(judge, "plain_fields", lambda e: False)  # as for an int time
+    monkeypatch.setattr(WireColumns, "plain", lambda self: False)  # the columns' check too
     with recording.held_recordings():
         found = judge.plan([str(capture), "--report-dir", str(tmp_path / "a")], in_memory=True)
         assert recording._HELD == {}
@@ -103,3 +105,33 @@ def test_a_held_recording_reads_as_its_file_would_until_let_go(tmp_path: Path):
         assert not path.exists()
     with pytest.raises(RecordingError, match="no such file"):
         read_recording(path)
+
+
+def test_the_held_capture_is_the_users_capture_jsonl(live, tmp_path: Path):
+    """The thirteenth matrix round: the round trip holds its decoded capture as columns
+    (no event made per character); read back, it is the capture.jsonl a user's ``judge``
+    writes, event for event, and it gives the replay the sensor and link that file gives."""
+    from conformance.replay.link import recorded_sensor, replayed_info
+    from conformance.replay.sensor import RecordedSensor
+
+    _data, events = live
+    capture = _capture(events, tmp_path)
+    judge.plan([str(capture), "--report-dir", str(tmp_path / "user")])
+    written = read_recording(tmp_path / "user" / "capture.jsonl")
+    with recording.held_recordings():
+        found = judge.plan([str(capture), "--report-dir", str(tmp_path / "m")], in_memory=True)
+        assert found.replay is not None
+        held = read_recording(tmp_path / "m" / "capture.jsonl")
+        assert held.held is not None and held._events is None
+        assert held.options == written.options
+        assert replayed_info(held) == replayed_info(written)
+        sensor = recorded_sensor(held)
+        assert sensor._replies is None and sensor._tool is None  # columns, no events
+        assert held.events == written.events
+    user = RecordedSensor(written.events)
+    assert (sensor.tool, sensor.replies) == (user.tool, user.replies)
+    assert (sensor._needs, sensor._touching) == (user._needs, user._touching)
+    for name in ("kind", "wire", "end"):
+        assert getattr(sensor, f"_tool_{name}") == getattr(user, f"_tool_{name}")
+    for name in ("start", "wire", "length"):
+        assert getattr(sensor, f"_reply_{name}") == getattr(user, f"_reply_{name}")
