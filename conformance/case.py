@@ -187,5 +187,11 @@ def events_of(record: Any) -> list[Event]:
         # (asked of a whole run's events, too: in C, not a generator step per event)
         if all(map(isinstance, record, repeat(Event))):
             return list(record)
-        return sorted((e for r in record for e in events_of(r)), key=_START)
+        # each record's events joined in turn by extend (C), then one stable sort: the
+        # order a generator step per event gave (a case's evidence of ~300 exchanges)
+        found = []
+        for r in record:
+            found += events_of(r)
+        found.sort(key=_START)
+        return found
     raise TypeError(f"no events in {type(record).__name__}")

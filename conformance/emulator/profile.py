@@ -13,11 +13,11 @@ profile defines the CRC key itself (which only a fault should do, R-4.4.12-04).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from ..protocol.binary import DataType
-from ..protocol.commands import ADDRESS_CHARS, Command
+from ..protocol.commands import ADDRESS_CHARS, Command, measurement_code_of
 from ..protocol.values import format_value
 from ..protocol.version import V13, V14, VERSIONS
 
@@ -90,7 +90,8 @@ def measurement_key(command: Command, *, crc: bool = False) -> str:
     """The profile key of the measurement ``command`` starts, describes or reads (``M1``...):
     its measurement code, with the C of a CRC twin only when ``crc`` asks for it."""
     target = command.target if command.target is not None else command
-    return replace(target, crc=crc and target.crc).measurement_code
+    # the code of ``replace(target, crc=crc and target.crc)``, without making that command
+    return measurement_code_of(target.kind, crc and target.crc, target.group)
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,10 @@ class Transmission:
         return sum(extra for at, extra in self.pauses if 0 < at <= index)
 
     def frame_start(self, index: int) -> float:
-        return self.start + index * (self.char_time + self.gap) + self.held(index)
+        start = self.start + index * (self.char_time + self.gap)
+        # + held(index): 0.0 with no pauses, added as the constant rather than called per
+        # frame (the same float: x + 0.0, a -0.0 made 0.0 as before)
+        return start + self.held(index) if self.pauses else start + 0.0
 
     def frame(self, index: int) -> Frame:
         return Frame(self.frame_start(index), self.wires[index], self.char_time)
@@ -57,6 +60,10 @@ class Transmission:
         of each index from :attr:`sent` on (the same arithmetic, so the same floats)."""
         step = self.char_time + self.gap
         start, wires, char_time, held = self.start, self.wires, self.char_time, self.held
+        if not self.pauses:  # held(index) is 0.0 for each: added, not called (frame_start)
+            for index in range(self.sent, len(wires)):
+                yield start + index * step + 0.0, wires[index], char_time
+            return
         for index in range(self.sent, len(wires)):
             yield start + index * step + held(index), wires[index], char_time
 

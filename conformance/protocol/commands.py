@@ -92,6 +92,27 @@ class CommandError(ValueError):
         self.reason = reason
 
 
+def measurement_code_of(kind: Kind, crc: bool, group: int) -> str:
+    """:attr:`Command.measurement_code` of a command of ``kind`` with ``crc`` and ``group``:
+    asked of the same command with another CRC flag (the emulator's profile key, per
+    exchange) without making that command."""
+    c = "C" if crc else ""
+    match kind:
+        case Kind.MEASURE:
+            return "M" + c + (str(group) if group else "")
+        case Kind.CONCURRENT:
+            return "C" + c + (str(group) if group else "")
+        case Kind.VERIFY:
+            return "V"
+        case Kind.HIGH_VOLUME_ASCII:
+            return "HA"
+        case Kind.HIGH_VOLUME_BINARY:
+            return "HB"
+        case Kind.CONTINUOUS:
+            return "R" + c + str(group)
+    raise ValueError(f"{kind} has no measurement code")
+
+
 @dataclass(frozen=True)
 class Command:
     """One SDI-12 command.
@@ -138,21 +159,7 @@ class Command:
 
     def _measurement_code(self) -> str:
         """``M``, ``MC3``, ``CC``, ``HA``, ``R0``, ``RC5``: the letters after the address."""
-        crc = "C" if self.crc else ""
-        match self.kind:
-            case Kind.MEASURE:
-                return "M" + crc + (str(self.group) if self.group else "")
-            case Kind.CONCURRENT:
-                return "C" + crc + (str(self.group) if self.group else "")
-            case Kind.VERIFY:
-                return "V"
-            case Kind.HIGH_VOLUME_ASCII:
-                return "HA"
-            case Kind.HIGH_VOLUME_BINARY:
-                return "HB"
-            case Kind.CONTINUOUS:
-                return "R" + crc + str(self.group)
-        raise ValueError(f"{self.kind} has no measurement code")
+        return measurement_code_of(self.kind, self.crc, self.group)
 
     @property
     def code(self) -> str:

@@ -14,7 +14,7 @@ bus only ever asks for the *next* character and commits it once its time has com
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -69,7 +69,9 @@ class PlansFrames(Protocol):
         """``(start, wire, duration)`` of the characters :meth:`BusDevice.next_frame` would
         offer one after the other, each after the one before was committed, as long as the
         device hears nothing (the rest of one planned transmission: a later one may start
-        elsewhere). None where it cannot tell; then the bus asks frame by frame."""
+        elsewhere). None where it cannot tell; then the bus asks frame by frame. Worked out
+        from the device's own plan alone: the bus keeps its clock aside while it draws them
+        (:meth:`SimLink._kept_run`)."""
 
     def pop_frames(self, count: int) -> None:
         """Commit the first ``count`` of :meth:`frames_ahead`: what ``count`` calls of
@@ -327,8 +329,10 @@ class SimLink(Link):
             held = len(line.before)
             last = got[-1] if got else line.before[-1] if line.before else None
             last7 = -1 if last is None else last.wire & 0x7F
-        taken = 0
+        already = len(got)
         try:
+            if keep is not None:
+                return self._kept_run(frames, got, limit, deadline, until, idle, line, keep)
             for start, wire, duration in frames:
                 if start >= limit:
                     return False, limit
@@ -345,12 +349,7 @@ class SimLink(Link):
                 set_text(made, "")
                 set_u(made, 0.0)
                 set_du(made, None)
-                if keep is not None:
-                    keep(made)
-                    event = made
-                else:
-                    event = add(made)
-                taken += 1
+                event = add(made)
                 if end > now:
                     clock.now = end
                 got.append(event)
@@ -366,5 +365,70 @@ class SimLink(Link):
                     limit = later if later < deadline else deadline  # min(deadline, later)
             return None, limit
         finally:
-            if taken:
-                device.pop_frames(taken)
+            if len(got) > already:
+                device.pop_frames(len(got) - already)
+
+    def _kept_run(
+        self,
+        frames: Iterator[tuple[float, int, float]],
+        got: list[Event],
+        limit: float,
+        deadline: float,
+        until: StopCondition | None,
+        idle: float | None,
+        line: LineEnd | None,
+        keep: Callable[[Event], None],
+    ) -> tuple[bool | None, float]:
+        """:meth:`_take_run`'s loop where the transcript's own add keeps each event as it
+        is (``keep``: its list's append), so the event made is the event kept: its wire and
+        end are read from the locals they were set from, and the clock is kept in a local
+        while the loop runs, written back before anything outside it may read it (``until``)
+        and when the loop ends. Nothing else runs meanwhile (the device's plan is
+        arithmetic on its transmission), so the clock, events and limits are the same."""
+        clock = self.bus.clock
+        char = EventKind.CHAR
+        set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
+        room = last7 = 0
+        if line is not None:
+            # LineEnd inline: ``before`` and ``got`` reach ``most``, or the last two are CR LF
+            room = line.most - len(line.before)
+            last = got[-1] if got else line.before[-1] if line.before else None
+            last7 = -1 if last is None else last.wire & 0x7F
+        now = clock.now
+        try:
+            for start, wire, duration in frames:
+                if start >= limit:
+                    return False, limit
+                if start < now:  # max(start, now), spelt out
+                    start = now
+                end = start + duration
+                made = new_event(Event)
+                set_kind(made, char)
+                set_origin(made, DUT)
+                set_start(made, start)
+                set_end(made, end)
+                set_wire(made, wire)
+                set_text(made, "")
+                set_u(made, 0.0)
+                set_du(made, None)
+                keep(made)
+                if end > now:
+                    now = end
+                got.append(made)
+                if line is not None:
+                    wire7 = wire & 0x7F
+                    if len(got) >= room or (last7 == 0x0D and wire7 == 0x0A):
+                        return True, limit
+                    last7 = wire7
+                elif until is not None:
+                    clock.now = now
+                    stop = until(got)
+                    now = clock.now
+                    if stop:
+                        return True, limit
+                if idle is not None:
+                    later = end + idle
+                    limit = later if later < deadline else deadline  # min(deadline, later)
+            return None, limit
+        finally:
+            clock.now = now

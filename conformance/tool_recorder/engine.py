@@ -12,6 +12,8 @@ deadline so a silent or babbling device can never hang it.
 from __future__ import annotations
 
 import contextlib
+from itertools import repeat
+from operator import attrgetter, is_
 
 from ..links.base import Link
 from ..links.errors import BreakUnsupported
@@ -92,6 +94,8 @@ class ToolRecorder:
         #: The last exchange sent (by :meth:`transact` or :meth:`raw`): a reply that comes
         #: after the next command may be this one's, late (:mod:`..sensor.address_change`).
         self.last_exchange: Exchange | None = None
+        #: the policy the framings were made for, and each kind of reply's (:meth:`_framing`)
+        self._framings: tuple[Policy | None, dict[tuple[bool, bool], Framing]] = (None, {})
 
     # -- single commands -------------------------------------------------------------------
     def transact(
@@ -540,14 +544,8 @@ class ToolRecorder:
         break_event, sent, stray = self._transmit(wire, address, brk, gap, marking, collide)
         self._closed_reply_end = None
         command_end = sent[-1].end if sent else self.link.now()
-        p = self.policy
-        framing = Framing(
-            idle=p.reply_idle,
-            max_chars=p.max_binary_bytes if binary else p.max_reply_chars,
-            binary=binary,
-            multiline=not binary and (command is None or command.kind is Kind.EXTENDED),
-            max_text_chars=p.max_text_chars,
-            line_wait=p.line_wait,
+        framing = self._framing(
+            binary, not binary and (command is None or command.kind is Kind.EXTENDED)
         )
         reply, state, collided = self._listen(command_end, framing)
         if collided:
@@ -564,6 +562,21 @@ class ToolRecorder:
         return Attempt(
             break_event, sent, reply, state, self.link.now(), stray_events=stray + collided
         )
+
+    def _framing(self, binary: bool, multiline: bool) -> Framing:
+        """:func:`framing_for` this engine's policy, made once per policy object and kind
+        of reply rather than per attempt (a frozen dataclass's ``__init__`` sets each field
+        by name; a fault-matrix row makes some 3,000 attempts). Policy and Framing are
+        frozen; a case that gives the engine another policy gets framings of its own."""
+        policy, made = self._framings
+        if policy is not self.policy:
+            policy, made = self.policy, {}
+            self._framings = (policy, made)
+        key = (binary, multiline)
+        framing = made.get(key)
+        if framing is None:
+            framing = made[key] = framing_for(policy, binary, multiline)
+        return framing
 
     def _listen(
         self, command_end: float, framing: Framing
@@ -710,6 +723,20 @@ CLOSED_BY_LINE_END = frozenset(
 )
 
 
+def framing_for(policy: Policy, binary: bool, multiline: bool) -> Framing:
+    """How the tool recorder frames a reply under ``policy`` (binary: an 8N1 packet;
+    multiline: a reply that may be a multi-line text)."""
+    p = policy
+    return Framing(
+        idle=p.reply_idle,
+        max_chars=p.max_binary_bytes if binary else p.max_reply_chars,
+        binary=binary,
+        multiline=multiline,
+        max_text_chars=p.max_text_chars,
+        line_wait=p.line_wait,
+    )
+
+
 def closes_exchange(command: Command | None, reply: list[Event]) -> bool:
     """Whether ``reply``, read to its CR LF, leaves nothing a rule reads on the line after it,
     so the tool may transmit once the turnaround is over without the look for a character
@@ -724,8 +751,13 @@ def closes_exchange(command: Command | None, reply: list[Event]) -> bool:
         command is not None
         and command.kind in CLOSED_BY_LINE_END
         and validity.ends_line(reply)
-        and all(e.kind is EventKind.CHAR for e in reply)
+        # every one a character (``kind is CHAR``), read in C rather than a generator
+        # step per character of every reply
+        and all(map(is_, map(_KIND, reply), repeat(EventKind.CHAR)))
     )
+
+
+_KIND = attrgetter("kind")
 
 
 def _own_break_last(link: Link) -> bool:
@@ -752,10 +784,14 @@ class _LastDutChar:
         if self.seen and (len(events) < self.seen or events[self.seen - 1] is not self._last):
             self.seen, self.end = 0, float("-inf")  # not only appended to: read it all again
         char = EventKind.CHAR
-        for k in range(self.seen, len(events)):
+        # the last of the new events that is a DUT character, looked for from the end (what
+        # the forward pass kept in the end: each such end overwrote the one before); a reply
+        # read ends in its own characters, so the look stops at once
+        for k in range(len(events) - 1, self.seen - 1, -1):
             event = events[k]
             if event.kind is char and event.origin != TOOL:
                 self.end = event.end
+                break
         self.seen = len(events)
         self._last = events[-1] if events else None
         return self.end

@@ -24,10 +24,10 @@ events would give:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from itertools import repeat
 from math import inf
 from operator import attrgetter, eq, ge
+from typing import NamedTuple
 
 from ..transcript import TOOL, Event, EventKind, Transcript
 from .segments import Cut, TranscriptView, Transmission
@@ -119,10 +119,11 @@ class LiveCut:
         return began
 
 
-@dataclass(frozen=True)
-class Mark:
+class Mark(NamedTuple):
     """:meth:`LiveCut.mark`: the transcript's length where a stimulus began and, where the
-    cut held every event to there (``cut``), its state then."""
+    cut held every event to there (``cut``), its state then. A named tuple: made once per
+    stimulus, read by name, never changed (a frozen dataclass set its seven fields one
+    ``object.__setattr__`` call at a time)."""
 
     first: int
     cut: bool = False
