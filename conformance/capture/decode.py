@@ -32,6 +32,12 @@ PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 #: in one polarity, with not one bad frame or glitch, while the other polarity reads worse,
 #: before its choice is taken without decoding the rest of the first block both ways
 SHORT_PROBE_CLEAN = 64
+#: A polarity's lead in clean frames that outweighs the idle level: edges read the wrong way
+#: round pass a 7E1 frame's parity and stop bit often enough by chance that on a capture of a
+#: handful of characters (two breaks and two characters: the wrong way reads three clean
+#: ones, the right way two, the breaks counting for neither) a lead of one frame is chance,
+#: and the level the capture starts at (the line's idle) decides instead.
+CLEAN_LEAD = 1
 MIN_BAD = 8  # fewer bad frames than this are reported, never taken for a wrong bit rate
 #: Glitches per decoded frame above which a capture is mostly pulses too short for a bit:
 #: with the shortest pulses off the bit rate, a wrong bit rate rather than a noisy line
@@ -133,8 +139,8 @@ def _clean_winner(decoded: dict[bool, list[Decoded]]) -> bool | None:
 def _choose_polarity(
     edges: Edges, prefix: list[int], baud: float, framing: Framing
 ) -> tuple[bool, str]:
-    """Decode the first edges both ways; the polarity that gives clean frames wins, the
-    starting level (idle) decides a tie.
+    """Decode the first edges both ways; the polarity that gives more clean frames (by more
+    than :data:`CLEAN_LEAD`) wins, the starting level (idle) decides a closer call.
 
     The first :data:`PROBE_EDGES` edges are tried first (a sigrok block holds tens of
     thousands: decoding all of them twice was most of a short capture's probe); only when
@@ -158,7 +164,7 @@ def _choose_polarity(
         inv: _score(list(items([prefix], invert=inv, framing=framing, **kw)))
         for inv in (False, True)
     }
-    if scores[False] != scores[True]:
+    if abs(scores[False] - scores[True]) > CLEAN_LEAD:
         inv = scores[True] > scores[False]
         return inv, f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames"
     inv = edges.initial_level == 0
