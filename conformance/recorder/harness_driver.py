@@ -134,8 +134,9 @@ class HarnessRecorder:
                     _mark_held_back(link, made)
                 message = proto.line_break(made.start, made.end)
             held = False
-            message = _quiet(channel, link, limit, message)
-            plan = channel.plan(message, Role.RECORDER, link.now())
+            now = made.end if plan.kind is PlanKind.BRK else link.now()  # see _quiet
+            message = _quiet(channel, link, limit, message, now)
+            plan = channel.plan(message, Role.RECORDER, now)
         if plan.kind is PlanKind.CANNOT:
             return "cannot" + (f" {plan.reason}" if plan.reason else ""), plan.reason
         return "done", None
@@ -169,16 +170,30 @@ def _mark_held_back(link: Link, made: Event) -> None:
             return
 
 
-def _quiet(channel: Channel, link: Link, limit: float, message: str) -> str:
+def _quiet(
+    channel: Channel, link: Link, limit: float, message: str, now: float | None = None
+) -> str:
     """``message`` with its QUIET field for a ``batch`` harness on the sim bus: nothing
     starts on the line before the played sensors' next character (each knows it: they are
     sans-I/O) or the job's cut at ``limit``, unless the harness transmits first; so it wakes
-    itself for its waits until then (a logger sketch polling for a service request)."""
+    itself for its waits until then (a logger sketch polling for a service request).
+
+    ``now``: the message's time (default: the link's clock). A break is told at its END
+    (docs/harness-protocol.md), though the link's clock may be later: a played sensor that
+    was talking went on under it (the sim bus commits its character whole), and that
+    character, not yet told, comes next as a ``char``; no promise reaches past its start.
+    (The twenty-fourth round's ATtiny logger restarted at a reply's first edge and broke
+    again while the sensor talked: its answer, a wait from the break's end, was checked
+    against the end of that untold character, "not after now", an ERROR that stopped the
+    run.)"""
     bus = getattr(link, "bus", None)
     if proto.BATCH not in channel.features or not isinstance(bus, SimBus):
         return message
     nxt = earliest_frame(bus.devices)
-    return proto.with_quiet(message, limit if nxt is None else min(limit, nxt[1].start), link.now())
+    quiet = limit if nxt is None else min(limit, nxt[1].start)
+    if bus.rx:
+        quiet = min(quiet, bus.rx[0].start)
+    return proto.with_quiet(message, quiet, link.now() if now is None else now)
 
 
 def _transmit(link: Link, plan: Plan) -> Event:

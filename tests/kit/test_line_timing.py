@@ -126,3 +126,26 @@ def test_a_break_timed_by_polling_micros_is_rebuilt(kit_build):
         assert end.kind == "done"
     finally:
         channel.close()
+
+
+def test_a_break_begun_inside_a_reply_keeps_its_start_then_goes_out_whole(kit_build):
+    """A sketch that breaks at the first edge of a reply (the twenty-fourth round's ATtiny
+    logger): its break, begun inside the character just told, is planned from where it
+    began (the protocol's one exception: the tool holds it back and marks it so); told the
+    reply's next character instead, the break lies wholly inside the line's characters and
+    goes out whole from there, 12.1 ms. Before: 'brk 1008333 1012101' (the start moved, the
+    tool never told), then 'brk 1016666 1012101', a break ending before it starts."""
+    channel = ChildChannel(str(kit_build(SKETCHES / "break_on_reply")))
+    try:
+        channel.greet(Role.RECORDER)
+        plan = parse_plan(channel.ask("job 0 measure 0M!"), Role.RECORDER, 0, version=2)
+        assert plan.kind == "idle"
+        told = "char 1000000 1008333 30"
+        plan = parse_plan(channel.ask(told), Role.RECORDER, 1008333, 1000000, version=2)
+        assert plan.kind == "brk" and 1000000 <= plan.start <= 1000000 + TOLERANCE_US
+        assert plan.end - plan.start == 12100
+        told = "char 1008333 1016666 30"
+        again = parse_plan(channel.ask(told), Role.RECORDER, 1016666, 1008333, version=2)
+        assert (again.kind, again.start, again.end) == ("brk", 1016666, 1016666 + 12100)
+    finally:
+        channel.close()

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
-from ...transcript import HELD_BACK
+from ...transcript import HELD_BACK, Event
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
 from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
@@ -52,12 +52,11 @@ class Breaks:
         seen = self._lengths_seen
         for b in line.breaks:
             length, u = b.duration, max(uncertainty, b.duration_uncertainty or 0.0)
-            self.lengths.append(
-                seen.first(length, u)
-                or seen.keep(
-                    MeasuredAsJudged(BREAK_LENGTH, length, u, [f"break at t={b.start:.3f} s"])
-                )
+            judged = seen.first(length, u) or seen.keep(
+                MeasuredAsJudged(BREAK_LENGTH, length, u, [f"break at t={b.start:.3f} s"])
             )
+            held = b.text == HELD_BACK and judged.verdict is not Verdict.PASS
+            self.lengths.append(_held_back_short(judged, b) if held else judged)
         seen = self._markings_seen
         for s in line.transmissions:
             brk = s.break_event
@@ -77,6 +76,26 @@ class Breaks:
             combine("R-7.0-02", self.lengths, "break"),
             combine("R-7.0-06", self.markings, "marking"),
         ]
+
+
+def _held_back_short(judged: MeasuredAsJudged, b: Event) -> Finding:
+    """A break the line held back (:data:`HELD_BACK`) that came out short of R-7.0-02:
+    INCONCLUSIVE. The recorder began it while a sensor's character was on the line, and the
+    line began it when that character ended and ended it where the recorder did (the kit keeps
+    a break's end): its length on the line is less than the recorder held it, by how much
+    the line does not say (the twenty-fourth round's ATtiny logger held 12.1 ms from inside a
+    reply's character; the line kept 3.77 ms of it, and R-7.0-02 FAILed). One that holds
+    still PASSes: holding back only ever shortens it."""
+    return replace(
+        judged.finding,
+        verdict=Verdict.INCONCLUSIVE,
+        detail=(
+            f"{judged.detail}; a break the line held back for a sensor's character (the"
+            " recorder began it while the character was on the line): the line began it"
+            " later than the recorder did, so how long the recorder held it is not known"
+        ),
+        evidence=[f"break at t={b.start:.3f} s"],
+    )
 
 
 def _after_held_back(judged: MeasuredAsJudged, s: Transmission) -> Finding:

@@ -37,6 +37,18 @@ def _dropped(
     return not any(h.end > a.end and h.start < b.start for h in s.heard)
 
 
+def _cut_while_sent(line: TranscriptView, s: Transmission) -> bool:
+    """Whether the tool cut ``s``'s job at its budget while ``s`` was still being sent: no
+    ``!`` in it yet, and the cut came before a sensor would have dropped it as a partial
+    command (App. B). What it had not sent by then it may yet have sent: whether ``!`` came
+    last is not known (the twenty-fourth round's ATtiny logger was cut after '0XM=G', and
+    R-4.4-04 FAILed "'!' is not exactly the last character")."""
+    cut = line.cut_parts.get(s.part)
+    if cut is None or "!" in s.text or not s.chars:
+        return False
+    return -1e-6 <= cut - s.chars[-1].end < NEW_COMMAND
+
+
 def judge_command_text(line: TranscriptView, uncertainty: float = 0.0) -> list[Finding]:
     """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else, and no
     part a sensor drops for want of it (:func:`_dropped`); R-4.3-01 the first character is
@@ -61,12 +73,19 @@ class CommandText:
         for s in line.transmissions:
             text, where = s.text, escape(s.text)
             bad = [c for c in text if not 0x20 <= ord(c) <= 0x7E]
-            tally.observe(where, ids=["R-4.2-01", "R-4.4-04", "R-4.3-01"])
+            cut = _cut_while_sent(line, s)
+            if cut:
+                # its end is the tool's cut, not the recorder's: the rest was still to come
+                tally.observe(where, ids=["R-4.2-01", "R-4.3-01"])
+            else:
+                tally.observe(where, ids=["R-4.2-01", "R-4.4-04", "R-4.3-01"])
             if bad:
                 tally.fail(
                     "R-4.2-01", where, f"non-printable {escape(''.join(bad))} in the command"
                 )
-            if not text.endswith("!") or "!" in text[:-1]:
+            if cut:
+                pass
+            elif not text.endswith("!") or "!" in text[:-1]:
                 tally.fail("R-4.4-04", where, "'!' is not exactly the last character")
             else:
                 self._unterminated_part(s)

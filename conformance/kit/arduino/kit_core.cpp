@@ -62,6 +62,7 @@ const int PINS = 256;
 us_t vt = 0;           /* the sketch's clock, on the tool's time line */
 us_t boot = 0;         /* when the board came up: micros() counts from here (a recorder's job) */
 us_t horizon = 0;      /* the tool's now: the line is known up to here */
+us_t told_start = -1;  /* the START of the tool's frame or break the last message told (-1: none) */
 us_t quiet = 0;        /* nothing from the tool starts before this (0: not told) */
 us_t woke_to = 0;      /* the latest time the sketch woke itself to since the last message */
 bool recorder = false; /* the role the tool asked for */
@@ -88,7 +89,12 @@ bool ints_on = true, in_isr = false, isr_pending = false;
 bool did_something = false, read_clock = false;
 
 /* transmitting: the rebuilt frames and breaks, waiting for the tool */
-struct Out { char kind; us_t start, end; int wire; };
+struct Out {
+    char kind;
+    us_t start, end;
+    int wire;
+    us_t length = 0; /* a break's own length, as the sketch held it */
+};
 std::deque<Out> out;
 bool composing = false, holding_break = false;
 us_t frame_start = 0, close_at = NEVER;
@@ -210,7 +216,7 @@ void line_write(int before, int level) {
                 fail("the sketch held the line spacing for %lld us from %lld us: a sensor "
                      "cannot send a break (the harness protocol has no break from a sensor)",
                      vt - frame_start, frame_start);
-            out.push_back({'b', frame_start, vt, 0});
+            out.push_back({'b', frame_start, vt, 0, vt - frame_start});
             composing = holding_break = false;
             writes.clear();
         }
@@ -356,8 +362,22 @@ std::string plan_line() {
                     "last character or break (until %lld us): both cannot be on the line, "
                     "it goes out from %lld us\n", o.kind == 'b' ? "break" : "frame", o.start,
                     horizon, horizon);
-            if (o.kind == 't') o.end += horizon - o.start;
-            o.start = horizon;
+            if (o.kind == 't') {
+                o.end += horizon - o.start;
+                o.start = horizon;
+            } else {
+                /* a break that ended inside the tool's characters goes out whole, its own
+                 * length from there (the twenty-fourth round's ATtiny logger broke again
+                 * under a sensor's reply: the end kept, 'brk' ended before it began) */
+                if (o.end <= horizon) {
+                    o.end = horizon + o.length;
+                    fprintf(stderr, "sdi12-kit: that break ended inside the line's characters: "
+                            "it goes out whole, %lld us from %lld us\n", o.length, horizon);
+                }
+                /* begun inside the frame just told, it keeps its START (the protocol's one
+                 * exception): the tool begins it when the line is free and marks it held back */
+                if (told_start < 0 || o.start < told_start) o.start = horizon;
+            }
         }
         if (o.kind == 'b') snprintf(line, sizeof line, "brk %lld %lld", o.start, o.end);
         else snprintf(line, sizeof line, "tx %lld %02x %lld", o.start, o.wire, o.end - o.start);
@@ -406,6 +426,7 @@ void hear_chars(const char *fields) {
         fields += used;
         heard++;
         add_tool_frame(start, end, (int)wire);
+        told_start = start;
         if (end > horizon) horizon = end;
         bool last = sscanf(fields, "%lld", &next) != 1;
         quiet = last ? 0 : next;
@@ -544,6 +565,7 @@ int main(void) {
         }
         us_t now;
         quiet = woke_to = 0; /* each message says its own */
+        told_start = -1;
         if (strcmp(word, "chars") == 0) {
             hear_chars(line + strlen("chars"));
             continue;
@@ -557,12 +579,14 @@ int main(void) {
             } else {
                 edges.push_back({a, 1});
                 edges.push_back({b, 0});
+                told_start = a;
             }
             if (sscanf(line, "%*s %*lld %*lld %lld", &c) == 1) quiet = c; /* break S E QUIET */
             now = b;
         } else if (strcmp(word, "char") == 0 &&
                    sscanf(line, "%*s %lld %lld %x", &a, &b, &byte_value) == 3) {
             add_tool_frame(a, b, (int)byte_value);
+            told_start = a;
             if (sscanf(line, "%*s %*lld %*lld %*x %lld", &c) == 1) quiet = c; /* char S E XX QUIET */
             now = b;
         } else if (strcmp(word, "sent") == 0 && sscanf(line, "%*s %lld %lld %x", &a, &b, &byte_value) == 3) {
