@@ -62,6 +62,12 @@ def suite_args(
         # pytest-benchmark, hypothesis's own...) is imported or can change the run, and
         # finding and loading them all cost about 0.1 s of each run
         "--disable-plugin-autoload",
+        # no conftest.py either: pytest otherwise loads the one in the working folder and in
+        # each of its ``test*`` folders (a project's tests/conftest.py, with its hooks,
+        # fixtures and the plugins it names) into the judged run, which then depends on
+        # where the tool was started; the suite has none of its own. ~5 ms of each run
+        # started from a checkout (tests/test_conduct.py)
+        "--noconftest",
         "-p", "conformance.plugin",
         "-p", "no:cacheprovider",
         "-p", "no:unraisableexception",  # its gc passes at the end cost ~0.3 s a run

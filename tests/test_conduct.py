@@ -120,3 +120,44 @@ def test_a_finished_run_is_freed_by_reference_counting(tmp_path):
     finally:
         if was_on:
             gc.enable()
+
+
+#: a conftest.py that would change a judged run it were loaded into: it says it was loaded,
+#: drops every case and fails any that is left
+MEDDLING_CONFTEST = """
+import pathlib
+import pytest
+
+pathlib.Path({mark!r}).write_text("loaded")
+
+
+@pytest.fixture(autouse=True)
+def meddle():
+    raise RuntimeError("a project's conftest.py reached the judged run")
+
+
+def pytest_collection_modifyitems(items):
+    items.clear()
+"""
+
+
+@pytest.mark.parametrize("where", [".", "tests", "testing"])
+def test_a_project_conftest_where_the_tool_starts_is_not_loaded(monkeypatch, tmp_path, where):
+    """The judged run loads no conftest.py (``--noconftest``): pytest would otherwise load
+    the one in the working folder and in each ``test*`` folder beside it (a checkout's
+    ``tests/conftest.py``), and a project's hooks and autouse fixtures would change the
+    verdicts of a run started there (as this one's would: every case dropped or failed)."""
+    start, mark = tmp_path / "project", tmp_path / "loaded"
+    (start / where).mkdir(parents=True, exist_ok=True)
+    (start / where / "conftest.py").write_text(MEDDLING_CONFTEST.format(mark=str(mark)))
+    monkeypatch.chdir(start)
+    out = tmp_path / "out"
+    out.mkdir()
+    options = RunOptions(port="sim", report_dir=str(out), keyword="test_query_address")
+    result = conduct(options, html=False, rootdir=out, files=())
+    assert not mark.exists(), f"{where}/conftest.py was loaded into the judged run"
+    assert result.run is not None and result.pytest_code == 0
+    lines = result.run.verdict_lines()
+    assert lines is not None
+    judged = {r["id"]: r["verdict"] for r in lines["requirements"] if r["verdict"] != "N/A"}
+    assert judged == {"R-4.4.3-01": "PASS"}

@@ -16,6 +16,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from itertools import chain
 
+import numpy as np
+
 from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .columns import WireColumns
 from .edges import Edges
@@ -172,6 +174,24 @@ def _choose_polarity(
 
 
 def _estimated_baud(prefix: list[int], tick_rate: float) -> float | None:
+    """The bit rate the shortest pulses of ``prefix`` suggest: a low percentile of the
+    rising gaps between edges (one bit, not a glitch), the element ``sorted`` would put at
+    ``len // 20``, found by a partial sort in numpy (a row's two channels sorted ~8,000 gaps
+    each in Python, ~3 ms of a fault-matrix row); :func:`_estimated_baud_sorted` for ticks
+    numpy does not hold as int64 (floats, or ints past its range)."""
+    ticks = np.array(prefix)
+    if ticks.dtype != np.int64:
+        return _estimated_baud_sorted(prefix, tick_rate)
+    gaps = np.diff(ticks)
+    runs = gaps[gaps > 0]
+    if runs.size < 8:
+        return None
+    k = runs.size // 20
+    return tick_rate / int(np.partition(runs, k)[k])
+
+
+def _estimated_baud_sorted(prefix: list[int], tick_rate: float) -> float | None:
+    """:func:`_estimated_baud` by a full sort in Python (any int)."""
     runs = sorted(b - a for a, b in zip(prefix, prefix[1:], strict=False) if b > a)
     if len(runs) < 8:
         return None

@@ -85,3 +85,14 @@ def test_columns_plain_and_order_checks():
     assert not cols.in_start_order() and cols.kinds()[2] is EventKind.BREAK
     cols.start[0] = 0  # an int stamp reads back as a float: not plain
     assert not cols.plain()
+
+
+@pytest.mark.parametrize(
+    "starts",
+    [[], [1.0], [0.0, 0.0, 1.0], [0.0, 2.0, 1.0], [0.0, float("nan"), 1.0], [float("nan")],
+     [-0.0, 0.0, 0.0], [3.0, 2.0], [0.0, 1.0, float("inf")]],
+)  # fmt: skip
+def test_start_order_is_each_start_at_most_the_next(starts):
+    """``in_start_order`` compares in C what a pairwise ``<=`` compares (NaN in no order)."""
+    cols = WireColumns(0.0, start=list(starts))
+    assert cols.in_start_order() == all(a <= b for a, b in zip(starts, starts[1:], strict=False))
