@@ -876,6 +876,9 @@ class Framing:
         # what the next command talked over before that ETX (a long line met the next retry)
         met = bool(seg.contention) and seg.contention[0].start < seg.command_end
         hidden = self._open_text = talked_through(seg) or (self._open_text and met)
+        if reply and _packet_late(tally, seg, earlier):
+            chunks = later
+            reply = []
         for n, chunk in enumerate(chunks):
             is_reply = n == 0 and bool(reply)
             label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
@@ -927,6 +930,26 @@ class Framing:
             if expected and body[:1] not in allowed:
                 named = body[:1]
                 _wrong_address(tally, label, text, named, expected, earlier if is_reply else None)
+
+
+def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None) -> bool:
+    """Whether ``seg``'s reply may be the binary packet of the unanswered aDBn! before it
+    (``earlier``, :func:`_unanswered_before`), late: an 8N1 packet, neither printable nor
+    ended by CR LF, so no reply's framing to judge; the rules it would judge undecided on
+    ``tally``. A sensor 80 ms late, deaf until it answers, sent 0DB999!'s empty packet
+    '0<0x00><0x00><0x00><0x0F><0x00>' 30 ms into the 0M! after it: R-4.2-02/-03 FAILed "reply to
+    0M!" beside never-standby, partial-command-accepted and stays-awake-after-foreign
+    (replies-after-retry, truth18)."""
+    if earlier is None or not earlier.binary_reply:
+        return False
+    label = f"reply to {escape(seg.text)}"
+    why = (
+        f"may be {escape(earlier.text)}'s late binary packet, not framed as a reply "
+        "(R-7.0-10 judges its timing)"
+    )
+    for rid in ("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"):
+        tally.undecide(rid, label, why)
+    return True
 
 
 def _wrong_address(
