@@ -135,6 +135,7 @@ def _shown_asleep(sensor, case):
     (linked to R-7.0-15, the rule a sensor that never sleeps breaks)."""
     idle = _asleep(sensor)
     check = sensor.master.raw(f"{sensor.address}!", break_first=False)
+    sensor.hear_late(check)  # from a sensor seen late: a late answer shows it awake
     unmet = precondition.standby(check, idle)
     if case.requires("standby", unmet):
         return check
