@@ -74,10 +74,10 @@ def taken_next(ex: Exchange) -> list[Event]:
     """The reply the command sent next took on its first try if it is ``ex``'s, late ([]
     if not): ``ex``'s last try drew no reply, the reply began within the 87 ms
     ``LateStartWatch`` believes a late start after it, names the address ``ex``'s would,
-    and either began before the next command (queued, or met by it) or is shaped as
-    ``ex``'s reply and not as the next command's (the words decide, so no late start need
-    have been seen: :func:`earlier_reply` reads the same from the other side, "is 0D0!'s
-    late reply")."""
+    is shaped as ``ex``'s reply, and either began before the next command (queued) or is
+    not shaped as the next command's (the words decide, so no late start need have been
+    seen: :func:`earlier_reply` reads the same from the other side, "is 0D0!'s late
+    reply")."""
     end = ex.last.command_end if ex.attempts else None
     if not ex.next_sent or end is None or ex.last.reply_events or ex.command is None:
         return []
@@ -94,11 +94,13 @@ def taken_next(ex: Exchange) -> list[Event]:
     address = expected_reply_address(ex.text)
     if address is not None and chr(reply[0].char7) != address:
         return []
+    text = decode_7e1(reply)
+    if not fits_shape(ex.command, text):
+        return []
     if reply[0].start < first.start:  # begun before the next command: no answer to it
         return reply
-    text = decode_7e1(reply)
     own = after.command is not None and fits_shape(after.command, text)
-    return reply if fits_shape(ex.command, text) and not own else []
+    return [] if own else reply
 
 
 def late_shown(ex: Exchange) -> str:
