@@ -97,3 +97,15 @@ def test_r_5_2_06_a_silent_probe_or_a_wrong_packet_still_fails() -> None:
 def test_r_5_2_06_empty_packets_in_their_windows_pass() -> None:
     probes = [_probe(t, 0.0, reply=EMPTY) for t in ("0DB5!", "0DB999!")]
     assert judge_empty_packets(probes, "0").verdict is Verdict.PASS
+
+
+def test_a_timely_reply_after_a_silent_adbn_is_the_command_s_own() -> None:
+    """binary-no-empty-packet: 0DB999! went unanswered and the 0M! after it was answered in
+    its window; that reply is 0M!'s, framed as ever (INCONCLUSIVE in the first try of this
+    change, from the snapshot): a bad one still FAILs."""
+    events = [Event(EventKind.BREAK, TOOL, 0.0, 0.013)]
+    events += (db := chars(TOOL, "0DB999!", 0.022))
+    events += (m := chars(TOOL, "0M!", db[-1].end + 0.030))
+    events += chars(DUT, "00\x0123\r\n", m[-1].end + 0.009)
+    found = {f.requirement: f for f in wire.judge_framing(segments(events))}
+    assert found["R-4.2-02"].verdict is Verdict.FAIL, found["R-4.2-02"]
