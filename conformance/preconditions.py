@@ -22,7 +22,7 @@ from types import MappingProxyType
 from typing import Any, Protocol
 
 from .judges.cite import cited, heard, shown
-from .judges.late_before import heard_late
+from .judges.late_before import heard_late, late_shown
 from .judges.reply_validity import check_reply
 from .judges.support import serves_measurement
 from .protocol.timing import CHAR_TIME, STANDBY_MARKING, TOLERANCE
@@ -236,14 +236,18 @@ def awake(marking: float, uncertainty: float) -> Unmet | None:
 
 def standby(check: Exchange, marking: float) -> Unmet | None:
     """The sensor is in standby when it ignored ``check``, an ``a!`` sent without a break
-    after ``marking`` s of marking; one that answered it never sleeps (R-7.0-15)."""
-    if not check.answered:
+    after ``marking`` s of marking; one that answered it never sleeps (R-7.0-15). So does
+    one that answered it late (``check.heard_late``, :func:`heard_late`): never-standby +
+    replies-after-retry's '0<CR><LF>' came 80 ms after the check, past its window, and the
+    sensor that never sleeps was taken as asleep (R-7.0-04 judged, truth18)."""
+    if not check.answered and not heard_late(check):
         return None
+    answer = shown(check) if check.answered else late_shown(check)
     return Unmet(
         "standby",
         "the sensor was not shown in standby (it answered a! without a break after "
-        f"{marking * 1e3:.0f} ms of marking: {shown(check)})",
-        (shown(check),),
+        f"{marking * 1e3:.0f} ms of marking: {answer})",
+        (answer,),
         consequence_of="R-7.0-15",
     )
 

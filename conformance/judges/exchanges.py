@@ -42,6 +42,7 @@ from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .cite import cite, cited, heard, shown
 from .late_before import (
     answered_late,
+    earlier_reply,
     heard_late,
     late_answer,
     late_elsewhere,
@@ -107,12 +108,21 @@ def silent(
     answered after its window (:func:`heard_late`) was answered. A command that maybe
     collided (sensor characters met it within the stamps' uncertainty) may not have been
     heard, so its silence is set aside, as :func:`silent_while_listening` does for the
-    one-shot probes; an answer counts whatever met the command. A control that maybe
+    one-shot probes; an answer counts whatever met the command. So is one whose reply may be
+    the unanswered command before's, late (:func:`earlier_reply`): a sensor 80 ms late and
+    deaf until it answers sent the retry before R-7.0-15's probe its '0<CR><LF>' 3 ms after
+    the probe, which it never heard (parity-error or ack-trailing-space + replies-after-retry:
+    "answered although 101.90 ms ... put it in standby", truth18). A control that maybe
     collided shows listening only by a valid reply (:func:`shows_listening`)."""
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
-    answered = [ex for ex in exchanges if ex.answered or heard_late(ex)]
-    met = [ex for ex in exchanges if not ex.answered and (ex.maybe_collided or late_elsewhere(ex))]
+    earlier = [ex for ex in exchanges if earlier_reply(ex)]
+    answered = [
+        ex for ex in exchanges if (ex.answered or heard_late(ex)) and not _among(ex, earlier)
+    ]
+    met = earlier + [
+        ex for ex in exchanges if not ex.answered and (ex.maybe_collided or late_elsewhere(ex))
+    ]
     if answered:
         make = warned if should else failed
         return make(
@@ -131,10 +141,11 @@ def silent(
             + " either, so its silence here shows nothing"
             + collided_answers(controls),
         )
-    heard = [ex for ex in exchanges if ex.answered or ex not in met]
+    heard = [ex for ex in exchanges if not _among(ex, met)]
     aside = (
         f"{len(met)} command(s) set aside (maybe collided, or a late reply naming another "
-        "address came over it: may not have been heard)"
+        "address or maybe the command before's came over it: may not have been heard)"
+        + "".join(f"; {earlier_reply(ex)}" for ex in earlier[:2])
     )
     if not heard:
         return inconclusive(
@@ -150,6 +161,11 @@ def silent(
         decision=decision,
         observed=len(heard),
     )
+
+
+def _among(ex: Exchange, exchanges: Iterable[Exchange]) -> bool:
+    """Whether ``ex`` is one of ``exchanges`` (by identity: records compare by value)."""
+    return any(ex is other for other in exchanges)
 
 
 def silent_while_listening(

@@ -19,7 +19,7 @@ from __future__ import annotations
 from ..protocol.timing import NO_BREAK_WINDOW
 from ..tool_recorder.records import Exchange
 from ..tool_recorder.validity import fits_shape
-from ..transcript import DUT, decode_7e1, escape
+from ..transcript import DUT, Event, decode_7e1, escape
 from ..view.sides import expected_reply_address
 
 
@@ -60,9 +60,47 @@ def late_reply(ex: Exchange) -> str:
     firmware reads its RTD for 30 ms before it answers ``aM1!``; its '00001' came 32 ms after
     each try, and "no reply although silence does not comply" was false (docs/kit.md,
     fifteenth round). For a one-shot command, what a longer listen heard after its window
-    (``heard_late``, truth12)."""
+    (``heard_late``, truth12). Or what the command sent next took that is this one's late
+    reply (:func:`taken_next`): the replies-after-retry sensor
+    beside slow-wake met 0D0!'s tries only after each break's 110 ms wake-up, and its
+    reply to the last came 80 ms later, in 0C1!'s window: "0C! 0D0!: no reply to 0D0!"
+    FAILed R-4.4.8-01 (truth18)."""
     strays = [e for a in ex.attempts[1:] for e in a.stray_events if e.origin == DUT]
-    return decode_7e1(strays + [e for e in ex.heard_late if e.origin == DUT])
+    heard = strays + [e for e in ex.heard_late if e.origin == DUT]
+    return decode_7e1(heard or taken_next(ex))
+
+
+def taken_next(ex: Exchange) -> list[Event]:
+    """The reply the command sent next took on its first try if it is ``ex``'s, late ([]
+    if not): ``ex``'s last try drew no reply, the reply began within the 87 ms
+    ``LateStartWatch`` believes a late start after it, names the address ``ex``'s would,
+    is shaped as ``ex``'s reply, and either began before the next command (queued) or is
+    not shaped as the next command's (the words decide, so no late start need have been
+    seen: :func:`earlier_reply` reads the same from the other side, "is 0D0!'s late
+    reply")."""
+    end = ex.last.command_end if ex.attempts else None
+    if not ex.next_sent or end is None or ex.last.reply_events or ex.command is None:
+        return []
+    after = ex.next_sent[0]
+    if not after.attempts:
+        return []
+    first = after.attempts[0]
+    reply = sorted(
+        (e for e in (*first.stray_events, *first.reply_events) if e.origin == DUT),
+        key=lambda e: e.start,
+    )
+    if not reply or not 0 < reply[0].start - end <= NO_BREAK_WINDOW:
+        return []
+    address = expected_reply_address(ex.text)
+    if address is not None and chr(reply[0].char7) != address:
+        return []
+    text = decode_7e1(reply)
+    if not fits_shape(ex.command, text):
+        return []
+    if reply[0].start < first.start:  # begun before the next command: no answer to it
+        return reply
+    own = after.command is not None and fits_shape(after.command, text)
+    return [] if own else reply
 
 
 def late_shown(ex: Exchange) -> str:

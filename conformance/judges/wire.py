@@ -18,6 +18,7 @@ from ..protocol.responses import split_line
 from ..protocol.timing import (
     CHAR_TIME,
     INTER_CHAR_GAP_MAX,
+    NO_BREAK_WINDOW,
     RESPONSE_START_MAX,
     RESPONSE_START_MIN,
     TOLERANCE,
@@ -876,6 +877,9 @@ class Framing:
         # what the next command talked over before that ETX (a long line met the next retry)
         met = bool(seg.contention) and seg.contention[0].start < seg.command_end
         hidden = self._open_text = talked_through(seg) or (self._open_text and met)
+        if reply and _packet_late(tally, seg, earlier, self.stamps.base):
+            chunks = later
+            reply = []
         for n, chunk in enumerate(chunks):
             is_reply = n == 0 and bool(reply)
             label = f"{'reply to' if is_reply else 'later, after'} {escape(seg.text)}"
@@ -927,6 +931,34 @@ class Framing:
             if expected and body[:1] not in allowed:
                 named = body[:1]
                 _wrong_address(tally, label, text, named, expected, earlier if is_reply else None)
+
+
+def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertainty: float) -> bool:
+    """Whether ``seg``'s reply may be the binary packet of the unanswered aDBn! before it
+    (``earlier``, :func:`_unanswered_before`), late: begun too late to be a timely answer to
+    ``seg``'s command (past R-7.0-10's 15.40 ms and the stamps' ``uncertainty``) and within
+    the 87 ms a late start is believed after the aDBn!. An 8N1 packet is neither printable
+    nor ended by CR LF, so no reply's framing to judge; the rules it would judge undecided
+    on ``tally``. A sensor 80 ms late, deaf until it answers, sent 0DB999!'s empty packet
+    '0<0x00><0x00><0x00><0x0F><0x00>' 25 ms after the 0M! after it: R-4.2-02/-03 FAILed "reply
+    to 0M!" beside never-standby, partial-command-accepted and stays-awake-after-foreign
+    (replies-after-retry, truth18). A timely reply after a silent aDBn! is its own
+    (binary-no-empty-packet)."""
+    if earlier is None or not earlier.binary_reply:
+        return False
+    start = seg.reply[0].start
+    if start - seg.command_end <= RESPONSE_START_MAX + TOLERANCE + uncertainty:
+        return False
+    if not 0 < start - earlier.command_end <= NO_BREAK_WINDOW:
+        return False
+    label = f"reply to {escape(seg.text)}"
+    why = (
+        f"may be {escape(earlier.text)}'s late binary packet, not framed as a reply "
+        "(R-7.0-10 judges its timing)"
+    )
+    for rid in ("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"):
+        tally.undecide(rid, label, why)
+    return True
 
 
 def _wrong_address(

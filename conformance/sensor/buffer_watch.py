@@ -73,13 +73,10 @@ class WatchedToolRecorder(ToolRecorder):
         may then be ``before``'s, the sensor deaf to ``ex`` until it had answered (the
         replies-after-retry sensor's late aD0! reply was read as aMC1!'s, "does not have the
         form atttn", beside wrong-crc, truth15). A sensor never seen late links nothing."""
-        if (
-            before is not None
-            and before is not ex
-            and before.attempts
-            and not before.last.reply_events
-            and self.watch.late.start is not None
-        ):
+        if before is None or before is ex or not before.attempts:
+            return ex
+        before.next_sent[:] = [ex]  # its words may show ex took its late reply (taken_next)
+        if not before.last.reply_events and self.watch.late.start is not None:
             ex.late_before = before
         return ex
 

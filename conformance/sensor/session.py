@@ -1104,12 +1104,16 @@ def same_reading(made: Exchange | Measurement, seen: Exchange | Measurement) -> 
 def _carry_late_before(made: Exchange | Measurement, seen: Exchange | Measurement) -> None:
     """The engine's ``late_before`` links (:meth:`~.buffer_watch.WatchedToolRecorder.
     _link_late_before`) onto the view's record of the same stimulus: the wire alone, cut at
-    the stimulus, has no command before it."""
+    the stimulus, has no command before it, nor after it (``next_sent``)."""
     if isinstance(made, Exchange) and isinstance(seen, Exchange):
-        seen.late_before = made.late_before
+        pairs = [(made, seen)]
     elif isinstance(made, Measurement) and isinstance(seen, Measurement):
-        for a, b in zip((made.start, *made.data), (seen.start, *seen.data), strict=True):
-            b.late_before = a.late_before
+        pairs = list(zip((made.start, *made.data), (seen.start, *seen.data), strict=True))
+    else:
+        return
+    for a, b in pairs:
+        b.late_before = a.late_before
+        b.next_sent = a.next_sent  # shared: the engine fills it when it sends the next one
 
 
 def _unanswered_break_end(events: list[Event], lookback: int = 4000) -> float | None:

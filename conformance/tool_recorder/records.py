@@ -77,6 +77,11 @@ class Exchange:
     #: :class:`~conformance.sensor.buffer_watch.WatchedToolRecorder`): a reply this exchange
     #: took may be that command's, late (:func:`~conformance.judges.late_before.earlier_reply`)
     late_before: Exchange | None = field(default=None, repr=False, compare=False)
+    #: The command the sensor session's engine sent next, once it is: a list shared with the
+    #: view's record of this stimulus, so the record judged learns of it too. A reply that
+    #: command took shaped as this one's, begun soon after this one's unanswered last try,
+    #: is this one's late reply (:func:`~conformance.judges.late_before.taken_next`)
+    next_sent: list[Exchange] = field(default_factory=list, repr=False, compare=False)
 
     @property
     def last(self) -> Attempt:

@@ -106,6 +106,20 @@ def test_ttt_zero(sensor, case):
                 evidence=[cited(start)],
             )
         )
+    elif not start.answered:
+        # no start reply, so no ttt = 000 to hold what followed to: replies-after-retry +
+        # slow-wake's 0M1! met its tries only after each break's 110 ms wake-up, and its
+        # '00002' came 80 ms after the last: "sent '00002' after '' announced ttt = 000"
+        # FAILed (truth18)
+        then = f"; then '{escape(decode_7e1(quiet))}'" if quiet else ""
+        case.add(
+            inconclusive(
+                "R-4.4.6-03",
+                f"no reply to {escape(start.text)} this time{then}: no ttt = 000 announced to hold "
+                "what followed to",
+                evidence=[cited(start)] + ([heard(quiet, "then, unasked")] if quiet else []),
+            )
+        )
     elif quiet:
         case.add(
             failed(
@@ -128,6 +142,17 @@ def test_ttt_zero(sensor, case):
     late = late_only("R-4.4.5-03", d0, "aD0! right after ttt = 000")
     if late is not None:
         case.add(late)
+    elif not start.answered and not (d0.answered and len(body) > 1 and body[1] in "+-"):
+        # no measurement shown started this time: an empty or unanswered aD0! after it
+        # says nothing of data ready at once (the same 0M1!'s 0D0!, met only after each
+        # break's wake-up, FAILed "gave no values: 0D0! -> '(silence)'", truth18)
+        case.add(
+            inconclusive(
+                "R-4.4.5-03",
+                f"aD0! after {escape(start.text)}, which drew no reply this time: {shown(d0)}",
+                evidence=[cited(start), cited(d0)],
+            )
+        )
     elif d0.answered and len(body) > 1 and body[1] in "+-":
         case.add(passed("R-4.4.5-03", f"data ready at once: {shown(d0)}", observed=1))
     else:

@@ -9,8 +9,8 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
+from conformance.judges.empty_packet import judge_empty_packets
 from conformance.judges.support import holds_values
-from conformance.protocol.binary import parse_binary_packet
 from conformance.protocol.responses import split_line
 from conformance.sensor.session import shows_support
 from conformance.verdicts import failed, inconclusive, passed, warned
@@ -147,28 +147,7 @@ def test_empty_packet_past_data(sensor, case):
     # read right after the shared aHB! measurement: the DB indices refer to the latest one
     exchanges = sensor.packets_past_data()
     case.evidence("aDBn! past the data", exchanges)
-    bad = []
-    for ex in exchanges:
-        packet = parse_binary_packet(ex.reply_bytes, expected_address=sensor.address)
-        if not (ex.answered and packet.is_empty and len(ex.reply_bytes) == 6):  # CRC: R-5.2-03
-            bad.append((ex, f"{ex.text} returned '{ex.reply_bytes.hex(' ') or '(nothing)'}'"))
-    if bad:
-        case.add(
-            failed(
-                "R-5.2-06",
-                "; ".join(line for _, line in bad) + ", not the empty packet",
-                evidence=[f"t={ex.start:.4f} s: {line}" for ex, line in bad],
-                observed=len(exchanges),
-            )
-        )
-    else:
-        case.add(
-            passed(
-                "R-5.2-06",
-                "empty packet for " + ", ".join(ex.text for ex in exchanges),
-                observed=len(exchanges),
-            )
-        )
+    case.add(judge_empty_packets(exchanges, sensor.address))
 
 
 def _in_part(marking: float | None, what: str) -> precondition.Unmet | None:

@@ -16,7 +16,7 @@ from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as mjudge
 from conformance.judges import wire
 from conformance.judges.extended import extended_replies
-from conformance.judges.late_before import earlier_reply, heard_late, late_elsewhere
+from conformance.judges.late_before import earlier_reply, heard_late, late_elsewhere, late_reply
 from conformance.judges.metadata import identify_matches
 from conformance.protocol import commands as cmds
 from conformance.tool_recorder.records import NO_REPLY, OK, Attempt, Exchange, Measurement
@@ -198,3 +198,46 @@ def test_r_4_4_5_01_a_late_reply_naming_neither_address_is_still_doubted() -> No
     m = Measurement(ex.command, ex)
     found = {f.requirement: f for f in mjudge.judge([m], ["R-4.4.5-01"], "14")}
     assert found["R-4.4.5-01"].verdict is Verdict.INCONCLUSIVE, found  # FAIL before
+
+
+def _unanswered_then(text: str, next_text: str, reply: str, before_next: bool = False):
+    """``text`` unanswered at 0 s, then ``next_text`` 30 ms after its window (or, with
+    ``before_next``, 120 ms after it), and ``reply`` 80 ms after ``text`` ended: taken by
+    ``next_text``'s first try, or queued before it; linked as the session's engine links."""
+    ex = _exchange(text, 0.0)
+    end = ex.last.command_end
+    assert end is not None
+    after = _exchange(next_text, end + (0.120 if before_next else 0.030))
+    got = chars(DUT, reply, end + LATE)
+    if before_next:
+        after.attempts[0].stray_events = got
+    else:
+        after.attempts[0].reply_events = got
+        after.attempts[0].reason = OK
+    ex.next_sent[:] = [after]
+    return ex
+
+
+def test_r_4_4_8_01_a_d_reply_taken_by_the_next_start_is_the_d_s_late_reply() -> None:
+    """replies-after-retry + slow-wake (truth18): 0D0!'s tries were met only after each
+    break's 110 ms wake-up, its reply to the last came 80 ms later, in 0C1!'s window:
+    "0C! 0D0!: no reply to 0D0!" FAILed R-4.4.8-01 and "0 values for 20" R-4.4.8-03."""
+    d0 = _unanswered_then("0D0!", "0C1!", "0-5.00-3.75\r\n")
+    assert late_reply(d0) == "0-5.00-3.75\r\n"
+    start = _exchange("0C!", -3.0, "000320\r\n")
+    m = Measurement(start.command, start, data=[d0], count=20, ttt=3)
+    found = {f.requirement: f for f in mjudge.judge([m], ["R-4.4.8-01", "R-4.4.8-03"], "14")}
+    for rid in ("R-4.4.8-01", "R-4.4.8-03"):
+        assert found[rid].verdict is Verdict.INCONCLUSIVE, found[rid]  # FAIL before
+        assert "answered only after the reply window" in found[rid].detail
+
+
+def test_a_reply_shaped_as_the_next_command_s_is_its_own() -> None:
+    """A reply the next command took in its window, shaped as its answer and not as the
+    unanswered command's, is the next command's: the silence before it stays silence."""
+    d0 = _unanswered_then("0D0!", "0C1!", "000320\r\n")
+    assert late_reply(d0) == ""
+    # an ack shaped as both is the next a!'s own answer; one queued before it went out is
+    # no answer to it, whatever its shape
+    assert late_reply(_unanswered_then("?!", "0!", "0\r\n")) == ""
+    assert late_reply(_unanswered_then("?!", "0!", "0\r\n", before_next=True)) == "0\r\n"

@@ -1,0 +1,61 @@
+"""Rows of the replies-after-retry pairs (truth18), each run on the one case that judges it.
+
+The replies-after-retry sensor (every reply 80 ms after its command, deaf until then)
+beside another fault: a reply that came late, or may be the command before's, is neither
+silence nor this command's answer. Each test fails on 832cfdc (the verdict before named).
+"""
+
+from __future__ import annotations
+
+from conformance.conduct import run_once
+
+KEYWORD_7_0_04 = "test_break_just_over_12ms_wakes"
+
+
+def _row(faults: str, keyword: str, rid: str) -> dict:
+    data = run_once(f"sim://?faults={faults}", keyword=keyword)
+    return next(r for r in data["requirements"] if r["id"] == rid)
+
+
+def test_r_7_0_04_late_answers_to_the_tries_after_the_break_are_answers() -> None:
+    """late-address-after-break + replies-after-retry: each a! after the 12.6 ms break was
+    answered 80 ms later, between the tries: "no reply to a! or 2 retries" FAILed. The last
+    try is listened to as a late sensor's one-shot probes are (SensorSession.hear_late)."""
+    found = _row("late-address-after-break,replies-after-retry", KEYWORD_7_0_04, "R-7.0-04")
+    assert found["verdict"] == "PASS", found["findings"]  # FAIL before
+    assert "0! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
+
+
+def test_r_7_0_04_a_sensor_answering_the_check_late_is_not_shown_asleep() -> None:
+    """never-standby + replies-after-retry: the a! without a break that shows the sensor in
+    standby was answered 80 ms later, past its window, and the sensor that never sleeps was
+    taken as asleep (R-7.0-04 FAILed "no reply to a! or 2 retries"): the check is listened
+    to as a late sensor's one-shots are, and the standby precondition is not met."""
+    found = _row("never-standby,replies-after-retry", KEYWORD_7_0_04, "R-7.0-04")
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
+    assert "not shown in standby" in found["findings"][0]["detail"]
+    assert "0! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
+
+
+def test_r_7_0_15_a_probe_answered_with_the_retry_s_late_reply_is_set_aside() -> None:
+    """parity-error + replies-after-retry: the wake-up a!'s invalid reply drew a retry whose
+    reply came 3 ms after the standby probe: "answered although 101.90 ms ... put it in
+    standby" FAILed; that probe is set aside, the one silent after 115 ms PASSes."""
+    found = _row("parity-error,replies-after-retry", "test_standby_after_100ms", "R-7.0-15")
+    assert found["verdict"] == "PASS", found["findings"]  # FAIL before
+    assert "may be 0!'s late reply" in found["findings"][0]["detail"]
+
+
+def test_r_4_4_6_03_and_4_4_5_03_after_a_start_that_drew_no_reply_are_undecided() -> None:
+    """replies-after-retry + slow-wake (the whole run: its timing brings it about): 0M1!'s
+    tries met the sensor only after each break's 110 ms wake-up and its '00002' came 80 ms
+    after the last, in the 0.5 s listened to for a service request: R-4.4.6-03 FAILed "sent
+    '00002<CR><LF>' after '' announced ttt = 000" and R-4.4.5-03 "aD0! right after ttt = 000
+    gave no values: 0D0! -> '(silence)'". No start reply, no ttt = 000 announced, no
+    measurement shown started: INCONCLUSIVE, each naming it."""
+    data = run_once("sim://?faults=replies-after-retry,slow-wake")
+    found = {r["id"]: r for r in data["requirements"]}
+    for rid in ("R-4.4.6-03", "R-4.4.5-03"):
+        assert found[rid]["verdict"] == "INCONCLUSIVE", found[rid]["findings"]  # FAIL before
+        assert "0M1!" in found[rid]["findings"][0]["detail"]
+        assert "this time" in found[rid]["findings"][0]["detail"]
