@@ -384,24 +384,32 @@ class _GapsAlike:
 
     def __init__(self, base: float) -> None:
         self.base = base
-        self.judged: dict[tuple[float, str], int] = {}  # -> its index in distinct
+        #: where -> gap -> its index in distinct: what a ``(gap, where)`` key found, asked
+        #: per gap without a key tuple made and hashed (a reply's gaps come together, so
+        #: the place's own dict is looked up once per reply, not per gap)
+        self.judged: dict[str, dict[float, int]] = {}
         self.observed = Observed()
 
     def add(self, gaps: list[Gap]) -> None:
         base, judged, observed = self.base, self.judged, self.observed
         distinct, counts = observed.distinct, observed.counts
         add, new, once = observed.append, distinct.append, counts.append
+        last: str | None = None  # the place of the gap before (its dict is ``here``)
+        here: dict[float, int] = {}
         for gap, where, _a, _b, place in gaps:
+            if where is not last:
+                here = judged.setdefault(where, {})
+                last = where
             if not gap and copysign(1.0, gap) < 0:  # judged apart, as _observe_gaps does
                 measured = Measured(GAP_WINDOW, gap, base, [where])
                 new(measured)
                 once(1)
                 add((measured, False, place))
                 continue
-            i = judged.get((gap, where))
+            i = here.get(gap)
             if i is None:
                 measured = Measured(GAP_WINDOW, gap, base, [where])
-                judged[(gap, where)] = len(distinct)
+                here[gap] = len(distinct)
                 new(measured)
                 once(1)
             else:

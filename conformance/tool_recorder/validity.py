@@ -16,10 +16,20 @@ from ..protocol.binary import EMPTY_LEN, DataType, packet_length, type_size
 from ..protocol.commands import ADDRESS_CHARS, Command, Kind, count_digits
 from ..protocol.crc import ASCII_CRC_LEN, ascii_crc, binary_crc, is_crc_char
 from ..protocol.framing import CR, CRLF, LF, TEXT_END, crc_tail, strip_crlf, unprintable
-from ..transcript import Event, decode_7e1, decode_8n1, escape
+from ..transcript import (
+    GOOD_PARITY,
+    SEVEN_BITS,
+    Event,
+    EventKind,
+    decode_7e1,
+    decode_8n1,
+    escape,
+    wire_bytes,
+)
 
 _TYPE_CODES = frozenset(int(t) for t in DataType)  # R-5.2.1-01: codes above 10 are invalid
 _VALUES = re.compile(r"([+-][0-9.]+)*")
+_CHAR = EventKind.CHAR
 
 __all__ = [
     "check_ascii",
@@ -219,16 +229,22 @@ def _ascii_problem(
     """:func:`check_ascii`, worked out."""
     if events and events[0].start < command_end:
         return "bus contention (reply started during the command)"
-    bad = next((i for i, e in enumerate(events) if not e.parity_ok), None)
-    if bad is not None:
-        return f"parity error in character {bad + 1}"
+    wires = wire_bytes(events)
+    # every frame's parity in one C pass where each wire is a byte (GOOD_PARITY: the wire
+    # bits of the 7E1 characters whose parity holds); the first bad one found as before
+    if wires is None or wires.translate(None, GOOD_PARITY):
+        bad = next((i for i, e in enumerate(events) if not e.parity_ok), None)
+        if bad is not None:
+            return f"parity error in character {bad + 1}"
     for i in range(1, len(events)):
         if multiline and events[i - 1].char7 == LF:
             continue  # between lines: up to 150 ms (R-4.4.13.1-03), judged elsewhere
         gap = events[i].start - events[i - 1].end
         if gap > gap_limit:
             return f"{gap * 1e3:.2f} ms of marking inside the reply"
-    text = decode_7e1(events)
+    # the text: those wire bytes' seven bits where every event is a character (a reply
+    # nearly always), else decoded character by character
+    text = _chars_text(events, wires)
     if multiline:
         return _text_problem(text, address if command is None else command.address)
     if not text.endswith(CRLF):
@@ -247,6 +263,18 @@ def _ascii_problem(
     if expected is not None and body[0] != expected:
         return f"reply from address {escape(body[0])}, expected {escape(expected)}"
     return _shape_problem(command, body, crc_expected) if command is not None else None
+
+
+def _chars_text(events: list[Event], wires: bytes | None) -> str:
+    """``decode_7e1(events)`` read from their ``wires`` (:func:`wire_bytes`) where every
+    event is a character: the text of a reply's frames, parity stripped."""
+    if wires is not None:
+        for e in events:  # (a plain loop: all() over a generator costs twice as much)
+            if e.kind is not _CHAR:
+                break
+        else:
+            return wires.translate(SEVEN_BITS).decode("ascii")
+    return decode_7e1(events)
 
 
 def _text_problem(text: str, address: str) -> str | None:

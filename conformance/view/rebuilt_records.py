@@ -173,8 +173,9 @@ def _attempt(
 ) -> Attempt:
     stray = list(t.contention)
     end = t.end
-    heard = [e for e in t.heard if e.start >= end]
-    reply = _framed(t, heard, policy)
+    # the first character heard after the command ended: all the framing asks of them
+    first = next((e for e in t.heard if e.start >= end), None)
+    reply = _framed(t, first, policy)
     if stray:
         reason = f"{CONTENTION} ({len(stray)} characters during the command)"
     elif not reply:
@@ -199,10 +200,11 @@ def _attempt(
     return Attempt(t.break_event, list(t.chars), reply, reason, end, stray_events=stray)
 
 
-def _framed(t: Transmission, heard: list[Event], policy: Policy) -> list[Event]:
-    """The reply as the tool recorder frames it: the first character within its
-    first-character timeout, then the protocol's framing, cut where the line idled."""
-    if not heard or heard[0].start - t.end > policy.first_char_timeout:
+def _framed(t: Transmission, first: Event | None, policy: Policy) -> list[Event]:
+    """The reply as the tool recorder frames it: the first character heard after the
+    command (``first``) within its first-character timeout, then the protocol's framing,
+    cut where the line idled."""
+    if first is None or first.start - t.end > policy.first_char_timeout:
         return []
     framed = t.reply
     if len(framed) < 2 or max(map(sub, map(_START, framed[1:]), map(_END, framed))) <= (

@@ -23,7 +23,7 @@ from ..protocol.binary import packet_length
 from ..protocol.commands import Kind
 from ..protocol.framing import ETX, LF, STX
 from ..protocol.timing import NO_BREAK_WINDOW
-from ..transcript import Event, Transcript, decode_8n1
+from ..transcript import SEVEN_BITS, Event, Transcript, decode_8n1, wire_bytes
 from .segments import IsRecorder, TranscriptView, Transmission, memo, read_view
 
 T = TypeVar("T")
@@ -34,6 +34,7 @@ GapUncertainty = Callable[[float, float], float]
 REPLY_SEARCH = NO_BREAK_WINDOW  # a sensor run starting later than this is not a reply
 RUN_GAP = 0.05  # unsolicited characters closer than this belong to one run (evidence only)
 LINE_RUN_GAP = 1.0  # a late next line of multi-line text still belongs to its reply
+_LF_BYTE = bytes([LF])
 
 
 @dataclass
@@ -73,7 +74,8 @@ class Segment:
 
     @classmethod
     def of(cls, t: Transmission) -> Segment:
-        cmd = t.command if t.is_command else None
+        is_command = t.is_command  # (asked once: it reads the text's stem each time)
+        cmd = t.command if is_command else None
         seg = cls(
             t.break_event,
             list(t.chars),
@@ -81,13 +83,14 @@ class Segment:
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
         )
         heard = t.heard
-        if not t.is_command:  # asked once, not per character heard
+        if not is_command:  # asked once, not per character heard
             seg.contention.extend(heard)  # not a reply: it met the command
             return seg
-        clash = {id(e) for e in t.contention}
-        if not clash:
+        contention = t.contention
+        if not contention:  # nearly always: no set of none made
             _place_all(seg, heard)
             return seg
+        clash = {id(e) for e in contention}
         for e in heard:
             if id(e) in clash:
                 seg.contention.append(e)  # not a reply: it met the command (or its tail did)
@@ -116,11 +119,22 @@ def _place_all(seg: Segment, heard: list[Event]) -> None:
     if reply[-1].wire & 0x7F == LF:  # ended: the rest is later
         seg.later.extend(heard[i:])
         return
-    j = i
-    while j < n and heard[j].wire & 0x7F != LF:
-        j += 1
+    j = _first_lf(heard, i)
     reply.extend(heard[i : j + 1])  # up to and with its LF (all of it when none came)
     seg.later.extend(heard[j + 1 :])
+
+
+def _first_lf(heard: list[Event], i: int) -> int:
+    """The index of the first LF (7 bits) among ``heard[i:]``, or ``len(heard)`` when none
+    came: found in one C pass over their wire bytes where each wire is a byte."""
+    wires = wire_bytes(heard[i:])
+    if wires is not None:
+        k = wires.translate(SEVEN_BITS).find(_LF_BYTE)
+        return len(heard) if k < 0 else i + k
+    n = len(heard)
+    while i < n and heard[i].wire & 0x7F != LF:
+        i += 1
+    return i
 
 
 def _place(seg: Segment, e: Event) -> None:

@@ -89,7 +89,12 @@ def test_reply_and_its_idle_cut_as_the_plain_loops_give(seed) -> None:
         t = _transmission(rng, policy)
         assert t.reply == _plain_reply(t)
         heard = [e for e in t.heard if e.start >= t.end]
-        assert rebuilt_records._framed(t, heard, policy) == _plain_framed(t, heard, policy)
+        first = heard[0] if heard else None
+        assert rebuilt_records._framed(t, first, policy) == _plain_framed(t, heard, policy)
+        # the stimulus's attempt frames the characters heard after the command (matrix14:
+        # the first of them found, not all of them listed)
+        attempt = rebuilt_records._attempt(t, t.command, False, None, policy, 0.0)
+        assert attempt.reply_events == _plain_framed(t, heard, policy)
 
 
 def test_the_shapes_are_covered() -> None:
@@ -103,10 +108,33 @@ def test_the_shapes_are_covered() -> None:
             t = _transmission(rng, policy)
             reply = t.reply
             heard = [e for e in t.heard if e.start >= t.end]
-            framed = rebuilt_records._framed(t, heard, policy)
+            framed = rebuilt_records._framed(t, heard[0] if heard else None, policy)
             seen.add("cut at LF" if len(reply) < len(t.heard) else "whole")
             if framed and len(framed) < len(reply):
                 seen.add("cut at idle")
             if any(isinstance(e.wire, int) and e.wire > 0xFF for e in t.heard):
                 seen.add("no byte")
     assert seen >= {"cut at LF", "whole", "cut at idle", "no byte"}
+
+
+@pytest.mark.parametrize("late", [False, True])
+def test_the_attempt_frames_what_came_after_the_command(late) -> None:
+    """A character heard while the command went out (contention) is not the reply's first:
+    the attempt frames the characters heard after the command ended, as when it listed them
+    all (matrix14: the first of them is found instead); their first past the first-character
+    timeout is no reply, however soon the early one came."""
+    policy = Policy()
+    command = [
+        Event(EventKind.CHAR, TOOL, i * CHAR, (i + 1) * CHAR, wire=to_wire_7e1(ord(c)))
+        for i, c in enumerate("0M!")
+    ]
+    early = Event(EventKind.CHAR, DUT, CHAR, 2 * CHAR, wire=to_wire_7e1(ord("0")))
+    start = command[-1].end + (policy.first_char_timeout + 0.005 if late else 0.009)
+    reply = [
+        Event(EventKind.CHAR, DUT, start + i * CHAR, start + (i + 1) * CHAR, to_wire_7e1(ord(c)))
+        for i, c in enumerate("00011\r\n")
+    ]
+    t = Transmission(None, command, [early, *reply])
+    attempt = rebuilt_records._attempt(t, t.command, False, None, policy, 0.0)
+    assert attempt.reply_events == _plain_framed(t, reply, policy) == ([] if late else reply)
+    assert attempt.stray_events == [early] and not attempt.ok
