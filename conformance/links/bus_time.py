@@ -35,13 +35,13 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from heapq import merge
 from itertools import islice
-from math import inf, isfinite
+from math import isfinite
 from operator import attrgetter, itemgetter
 
 from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..protocol.responses import measurement_digits, parse_measurement_reply
 from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
-from ..transcript import TOOL, Event, EventKind, decode_7e1
+from ..transcript import TOOL, Event, EventKind, decode_7e1, in_start_order
 
 
 @dataclass(frozen=True)
@@ -64,7 +64,7 @@ class BusTime:
 
 
 def bus_time(events: Iterable[Event]) -> BusTime:
-    wire = _in_start_order(events)
+    wire = in_start_order(events)
     if not wire:
         return BusTime(0.0, 0.0, 0, 0)
     brk = EventKind.BREAK
@@ -79,25 +79,6 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     else:  # a time that is no number, or a break ending before it began: as it always was
         lower = _sweep(sorted([*_own_spans(wire), *_gaps(wire), *waits]))
     return BusTime(lower, wire[-1].end - wire[0].start, frames, breaks)
-
-
-def _in_start_order(events: Iterable[Event]) -> list[Event]:
-    """The events on the wire (no note) sorted stably by start: ``events`` itself when it is
-    a list already so (a capture's, a link's: one pass, no copy), else a sorted copy. A
-    copy and its sort's keys were two lists of every event made for the first report of a
-    passive judgement (issue 22: ~6 MB at an hour of a busy capture)."""
-    if isinstance(events, list):
-        note, last = EventKind.NOTE, -inf
-        for e in events:
-            start = e.start
-            if e.kind is note or not last <= start:
-                break
-            last = start
-        else:
-            return events
-    wire = [e for e in events if e.kind is not EventKind.NOTE]
-    wire.sort(key=attrgetter("start"))
-    return wire
 
 
 def uncounted(events: Iterable[Event]) -> list[tuple[float, float]]:

@@ -44,6 +44,7 @@ from ..transcript import (
     decode_7e1,
     decode_8n1,
     escape,
+    in_start_order,
     wire_bytes,
 )
 from .direction import iter_directions
@@ -489,7 +490,7 @@ def read_view(
     inferred from the protocol (:func:`~conformance.view.direction.infer_directions`);
     characters it cannot place are kept apart in ``undirected``.
     """
-    ordered = _by_start(events)
+    ordered = in_start_order(events)
     undirected: list[Event] = []
     mine: Iterable[bool]
     if is_recorder is not None:
@@ -499,23 +500,6 @@ def read_view(
     else:
         mine = map(eq, map(_ORIGIN, ordered), repeat(TOOL))  # on_tool_link of each, in C
     return _cut(ordered, mine, part, undirected)
-
-
-def _by_start(events: Iterable[Event]) -> list[Event]:
-    """``events`` but notes sorted stably by start: the list itself where it is one so
-    already (a capture's: one pass, no copy; no caller changes it), else a sorted copy (a
-    copy and its sort's keys were two lists of every event at the peak of an hour's capture
-    loaded, ~6 MB)."""
-    note = EventKind.NOTE
-    if isinstance(events, list):
-        last = None
-        for e in events:
-            if e.kind is note or (last is not None and e.start < last):
-                break
-            last = e.start
-        else:
-            return events
-    return sorted([e for e in events if e.kind is not note], key=_START)
 
 
 def read_sides(events: list[Event]) -> tuple[TranscriptView, bytearray | None]:

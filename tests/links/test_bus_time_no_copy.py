@@ -7,8 +7,9 @@ from __future__ import annotations
 import random
 import tracemalloc
 
-from conformance.links.bus_time import _in_start_order, bus_time
+from conformance.links.bus_time import bus_time
 from conformance.transcript import BUS, DUT, TOOL, Event, EventKind
+from conformance.transcript import in_start_order as _in_start_order
 
 
 def _events(n: int) -> list[Event]:

@@ -14,8 +14,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from conformance.transcript import BUS, DUT, TOOL, Event, EventKind
+from conformance.transcript import in_start_order as _by_start
 from conformance.view.direction import by_start_and_end, infer_directions, iter_directions
-from conformance.view.segments import _by_start, read_view
+from conformance.view.segments import read_view
 
 stamp = st.sampled_from([0.0, 0.001, 0.001, 0.0125, 0.02, 1.5, math.nan, -0.0])
 event = st.builds(
