@@ -295,11 +295,27 @@ def _cut_gaps(segs: list[Segment]) -> list[Gap]:
     return gaps
 
 
+#: How many segments :func:`judge_gaps` cuts the gaps of at once from a plain list: a few
+#: hundred gaps held at a time, not the whole recording's.
+SEGMENTS_AT_ONCE = 64
+
+
 def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[Finding]:
     """R-7.0-12: at most 1.66 ms of marking between characters (no tolerance), and R-7.0-01:
     a gap inside the ±0.40 ms band above 1.66 ms uses a tolerance the rule does not grant.
-    Each gap carries the uncertainty of the two stamps it rests on."""
+    Each gap carries the uncertainty of the two stamps it rests on.
+
+    A recording's segments (a plain list: the passive runs) are judged
+    :data:`SEGMENTS_AT_ONCE` at a time through :class:`ReplyGaps`, the same findings, so
+    that no list of every gap is made (an hour of a busy bus: 25,000 a sensor, ~4 MB);
+    a run's :class:`~conformance.view.runs.Segments` keep their observations for
+    :func:`gaps_to_confirm`, which reads the same."""
     stamps = stamp_uncertainty(uncertainty)
+    if not isinstance(segs, Segments):
+        gaps = ReplyGaps(stamps)
+        for k in range(0, len(segs), SEGMENTS_AT_ONCE):
+            gaps.add(segs[k : k + SEGMENTS_AT_ONCE])
+        return gaps.findings()
     gap_finding = combine_local(
         "R-7.0-12",
         _gap_observations(segs, stamps),
@@ -393,7 +409,7 @@ class _GapsAlike:
     def add(self, gaps: list[Gap]) -> None:
         base, judged, observed = self.base, self.judged, self.observed
         distinct, counts = observed.distinct, observed.counts
-        add, new, once = observed.append, distinct.append, counts.append
+        observe, new, once = observed.observe, distinct.append, counts.append
         last: str | None = None  # the place of the gap before (its dict is ``here``)
         here: dict[float, int] = {}
         for gap, where, _a, _b, place in gaps:
@@ -401,21 +417,18 @@ class _GapsAlike:
                 here = judged.setdefault(where, {})
                 last = where
             if not gap and copysign(1.0, gap) < 0:  # judged apart, as _observe_gaps does
-                measured = Measured(GAP_WINDOW, gap, base, [where])
-                new(measured)
+                observe(len(distinct), place)
+                new(Measured(GAP_WINDOW, gap, base, [where]))
                 once(1)
-                add((measured, False, place))
                 continue
             i = here.get(gap)
             if i is None:
-                measured = Measured(GAP_WINDOW, gap, base, [where])
-                here[gap] = len(distinct)
-                new(measured)
+                i = here[gap] = len(distinct)
+                new(Measured(GAP_WINDOW, gap, base, [where]))
                 once(1)
             else:
-                measured = distinct[i]
                 counts[i] += 1
-            add((measured, False, place))
+            observe(i, place)
 
 
 def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:

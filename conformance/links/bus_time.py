@@ -41,7 +41,7 @@ from operator import attrgetter, itemgetter
 from ..protocol.commands import Command, CommandError, Kind, parse_command
 from ..protocol.responses import measurement_digits, parse_measurement_reply
 from ..protocol.timing import CHAR_TIME, MARKING_AFTER_BREAK, RELEASE_LINE, RETRY_MIN
-from ..transcript import TOOL, Event, EventKind, decode_7e1
+from ..transcript import TOOL, Event, EventKind, decode_7e1, in_start_order
 
 
 @dataclass(frozen=True)
@@ -64,10 +64,9 @@ class BusTime:
 
 
 def bus_time(events: Iterable[Event]) -> BusTime:
-    wire = [e for e in events if e.kind is not EventKind.NOTE]
+    wire = in_start_order(events)
     if not wire:
         return BusTime(0.0, 0.0, 0, 0)
-    wire.sort(key=attrgetter("start"))
     brk = EventKind.BREAK
     breaks = sum(1 for e in wire if e.kind is brk)
     frames = len(wire) - breaks

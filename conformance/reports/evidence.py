@@ -25,11 +25,11 @@ from __future__ import annotations
 
 import math
 import re
-from array import array
 from bisect import bisect_left
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
-from operator import le
+from itertools import islice
+from operator import attrgetter
 from typing import Any
 
 from ..results import CaseRecord
@@ -163,52 +163,63 @@ class Positions:
     """Where each event lies in a transcript's ``events`` (a list the link may still be
     appending to): the first index of an event equal to it, as a dict from every event to
     its first index gave. A transcript in time order (every one a capture or a link makes)
-    is searched by bisection over its start times, 8 bytes an event in an array, where the
-    dict took some 90 (an hour's capture: 357,000 events, 32 MB held by every report of a
-    passive judgement); one out of order, or with a start that is not a finite number, is
-    indexed by the dict as before. ``tests/reports/test_evidence_positions.py`` holds the two to
-    the same answers."""
+    is searched by bisection over the events themselves by their start times (``ordered``),
+    nothing held an event, where the dict took some 90 bytes (an hour's capture: 357,000
+    events, 32 MB held by every report of a passive judgement) and an array of the start
+    times 8, with two lists of every start made to fill it (issue 22: ~9 MB at the first
+    report of an hour's capture); one out of order, or with a start that is not a finite
+    number, is indexed by the dict as before. ``tests/reports/test_evidence_positions.py``
+    holds the two to the same answers."""
 
     def __init__(self, events: Sequence[Event]) -> None:
         self.events = events
-        self.starts: array[float] | None = array("d")
+        #: the events indexed so far are in start order, every start a finite number
+        self.ordered = True
         self.first: dict[Event, int] = {}
         self._indexed = 0
 
     def index(self) -> None:
         """Take in the events appended since the last call."""
         events, at = self.events, self._indexed
-        if self.starts is not None:
-            new = [e.start for e in events[at:]]
-            last = self.starts[-1] if self.starts else -math.inf
-            if all(map(math.isfinite, new)) and all(map(le, [last, *new], new)):
-                self.starts.extend(new)
+        if self.ordered:
+            last = events[at - 1].start if at else -math.inf
+            isfinite = math.isfinite
+            for e in islice(events, at, None):
+                start = e.start
+                if not (isfinite(start) and last <= start):
+                    break
+                last = start
+            else:
                 self._indexed = len(events)
                 return
-            self.starts, at = None, 0  # out of order: the dict, from the first event
+            self.ordered, at = False, 0  # out of order: the dict, from the first event
         for i in range(at, len(events)):
             self.first.setdefault(events[i], i)
         self._indexed = len(events)
 
     def of(self, events: Iterable[Event]) -> Iterator[int]:
         """The position of each of ``events`` found among those indexed (the rest left out)."""
-        if self.starts is None:
+        if not self.ordered:
             first = self.first
             return (first[e] for e in events if e in first)
-        starts, indexed = self.starts, self.events
-        found = (_first_at(starts, indexed, e) for e in events)
+        indexed, count = self.events, self._indexed
+        found = (_first_at(indexed, count, e) for e in events)
         return (i for i in found if i is not None)
 
 
-def _first_at(starts: array[float], events: Sequence[Event], e: Event) -> int | None:
-    """The first index among ``events`` (in time order, ``starts`` their start times) of an
-    event equal to ``e``: equal events start at the same time."""
-    i = bisect_left(starts, e.start)
-    while i < len(starts) and starts[i] == e.start:
+def _first_at(events: Sequence[Event], count: int, e: Event) -> int | None:
+    """The first index among the first ``count`` of ``events`` (in start order) of an event
+    equal to ``e``: equal events start at the same time."""
+    start = e.start
+    i = bisect_left(events, start, 0, count, key=_start_of)
+    while i < count and events[i].start == start:
         if events[i] is e or events[i] == e:
             return i
         i += 1
     return None
+
+
+_start_of = attrgetter("start")
 
 
 class Locator:

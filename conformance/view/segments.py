@@ -44,6 +44,7 @@ from ..transcript import (
     decode_7e1,
     decode_8n1,
     escape,
+    in_start_order,
     wire_bytes,
 )
 from .direction import iter_directions
@@ -489,8 +490,7 @@ def read_view(
     inferred from the protocol (:func:`~conformance.view.direction.infer_directions`);
     characters it cannot place are kept apart in ``undirected``.
     """
-    note = EventKind.NOTE
-    ordered = sorted([e for e in events if e.kind is not note], key=_START)
+    ordered = in_start_order(events)
     undirected: list[Event] = []
     mine: Iterable[bool]
     if is_recorder is not None:

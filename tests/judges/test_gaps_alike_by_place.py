@@ -38,7 +38,8 @@ def gap_parts(draw):
 
 
 class _TupleKeyed(wire._GapsAlike):
-    """The grouping before this round, word for word: a ``(gap, where)`` key per gap."""
+    """The grouping before this round: a ``(gap, where)`` key per gap (held as
+    :class:`~conformance.judges.timing.Observed` now holds its observations)."""
 
     def __init__(self, base: float) -> None:
         super().__init__(base)
@@ -47,24 +48,21 @@ class _TupleKeyed(wire._GapsAlike):
     def add(self, gaps) -> None:
         base, judged, observed = self.base, self.judged, self.observed
         distinct, counts = observed.distinct, observed.counts
-        add, new, once = observed.append, distinct.append, counts.append
+        observe, new, once = observed.observe, distinct.append, counts.append
         for gap, where, _a, _b, place in gaps:
             if not gap and copysign(1.0, gap) < 0:
-                measured = Measured(wire.GAP_WINDOW, gap, base, [where])
-                new(measured)
+                observe(len(distinct), place)
+                new(Measured(wire.GAP_WINDOW, gap, base, [where]))
                 once(1)
-                add((measured, False, place))
                 continue
             i = judged.get((gap, where))
             if i is None:
-                measured = Measured(wire.GAP_WINDOW, gap, base, [where])
-                judged[(gap, where)] = len(distinct)
-                new(measured)
+                i = judged[(gap, where)] = len(distinct)
+                new(Measured(wire.GAP_WINDOW, gap, base, [where]))
                 once(1)
             else:
-                measured = distinct[i]
                 counts[i] += 1
-            add((measured, False, place))
+            observe(i, place)
 
 
 def _said(m: Measured) -> tuple:
@@ -99,8 +97,14 @@ def test_a_place_that_comes_back_finds_its_gaps():
     first, other = "in reply to 0D0!", "in reply to 0M!"
     again = "".join(["in reply to ", "0D0!"])
     assert again == first and again is not first
-    gaps = [(1e-3, first, None, None, 0), (1e-3, other, None, None, 1)]
-    gaps += [(1e-3, again, None, None, 2), (copy(-0.0), again, None, None, 3)]
+    gaps = [
+        (1e-3, first, None, None, ("0D0!", "0+1", 0)),
+        (1e-3, other, None, None, ("0M!", "0", 0)),
+    ]
+    gaps += [
+        (1e-3, again, None, None, ("0D0!", "0+1", 1)),
+        (copy(-0.0), again, None, None, ("0D0!", "0+1", 2)),
+    ]
     observed = _grouped(wire._GapsAlike, [gaps], 0.0)
     assert observed.counts == [2, 1, 1]  # first and again one gap; -0.0 judged apart
     assert observed[2][0] is observed[0][0]

@@ -18,7 +18,7 @@ from conformance.judges.timing import StampUncertainty
 from conformance.judges.wire import ReplyGaps, ResponseStarts, judge_gaps, judge_response_start
 from conformance.transcript import Event
 from conformance.verdicts import Finding, Verdict
-from conformance.view.runs import Segment
+from conformance.view.runs import Segment, Segments
 from conformance.view.segments import read_view
 from conformance.view.windows import window_events, window_starts
 from tests.support.bus_of_sensors import ADDRESSES, as_heard, bus_of_sensors
@@ -33,7 +33,7 @@ def _segments(events: list[Event]) -> list[Segment]:
 
 
 def _whole(events: list[Event], u) -> list[Finding]:
-    segs = _segments(events)
+    segs = Segments(_segments(events))  # judge_gaps' one pass (a plain list is cut in parts)
     return [*judge_response_start(segs, u), *judge_gaps(segs, u)]
 
 
