@@ -113,6 +113,7 @@ from conformance.recorder.golden import GoldenRecorder
 from conformance.sim.bus import Frame
 from conformance.transcript import COLLISION, DUT
 from conformance.view.runs import segments
+from tests.support.harness_script import PRELUDE
 
 #: The cases that probe with a! (and R-4.4.1-01's own).
 A_PROBES = (
@@ -921,17 +922,9 @@ def test_identify_measurement_replies_still_pass_r_6_1_01():
 
 #: A recorder harness that sends ``aM0!`` after each job's break, then sleeps for the uint32_t
 #: milliseconds its firmware read from the missing reply (the twenty-second round's logger).
-_SLEEPS_FOREVER = r"""
-import sys
-
-def say(line):
-    sys.stdout.write(line + "\n")
-    sys.stdout.flush()
-
-def wire(c):
-    b = ord(c)
-    return b | (0x80 if bin(b).count("1") % 2 else 0)
-
+_SLEEPS_FOREVER = (
+    PRELUDE
+    + r"""
 text, sent, deadline = "", 0, 0
 for line in sys.stdin:
     word, *f = line.split()
@@ -955,6 +948,7 @@ for line in sys.stdin:
     else:  # a reply heard, or the sleep's end: sleep on (a new job starts the next command)
         say(f"wait {max(deadline, int(f[1]) + 1)}")
 """
+)
 
 
 def test_a_recorder_asleep_for_49_days_is_judged_not_stopped_r_7_2_01(tmp_path):

@@ -25,22 +25,15 @@ from conformance.recorder.job_time import JobBudget
 from conformance.sim.bus import SimBus
 from conformance.transcript import TOOL, Event, EventKind, Transcript
 from conformance.verdicts import Verdict
+from tests.support.harness_script import PRELUDE
 
 #: A version-1 recorder harness: its job's first command after a 12.5 ms break and 8.4 ms of
 #: marking; at the reply's first character it begins its break again from that character's
 #: end (as the firmware's restart does, 12.1 ms from where it began driving), then marks in
 #: 20 us steps from the break's end, as told, and is done at the next message after them.
-_BREAKS_OVER_THE_REPLY = r"""
-import sys
-
-def say(line):
-    sys.stdout.write(line + "\n")
-    sys.stdout.flush()
-
-def wire(c):
-    b = ord(c)
-    return b | (0x80 if bin(b).count("1") % 2 else 0)
-
+_BREAKS_OVER_THE_REPLY = (
+    PRELUDE
+    + r"""
 cmd, sent, at, phase = "", 0, 0, ""
 told = []
 for line in sys.stdin:
@@ -75,6 +68,7 @@ for line in sys.stdin:
     else:
         say("idle")
 """
+)
 
 
 def test_a_break_a_reply_runs_on_under_is_told_at_its_end(tmp_path):

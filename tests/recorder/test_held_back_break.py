@@ -27,6 +27,7 @@ from conformance.recorder.job_time import JobBudget
 from conformance.transcript import HELD_BACK, TOOL, Event, EventKind, Transcript, to_wire_7e1
 from conformance.verdicts import Verdict
 from conformance.view.segments import read_view
+from tests.support.harness_script import PRELUDE
 
 #: A recorder harness whose timing runs from the break it asked for, as a firmware's does that
 #: counts its marking from where it began its break (an absolute deadline; the kit's HAL glue
@@ -36,16 +37,10 @@ from conformance.view.segments import read_view
 #: reply's next character; hearing a character instead of its break, it asks for the whole
 #: break again from that character's end (the C kit's ``sdi12_kit_break``). ``ASKED`` in the
 #: environment: ask for the break after the reply has ended instead (nothing holds it back).
-_ASKS_FROM_ITS_OWN_BREAK = r"""
-import os, sys
-
-def say(line):
-    sys.stdout.write(line + "\n")
-    sys.stdout.flush()
-
-def wire(c):
-    b = ord(c)
-    return b | (0x80 if bin(b).count("1") % 2 else 0)
+_ASKS_FROM_ITS_OWN_BREAK = (
+    PRELUDE
+    + r"""
+import os
 
 late = bool(os.environ.get("ASKED"))
 cmds, i, tries, sent, phase, asked_end, at = [], 0, 0, 0, "", 0, 0
@@ -107,6 +102,7 @@ for line in sys.stdin:
     else:
         say("idle")
 """
+)
 
 
 def _run(tmp_path, monkeypatch, asked_late: bool = False) -> tuple[dict, list[dict]]:
