@@ -6,7 +6,7 @@ import pytest
 
 from conformance import preconditions as precondition
 from conformance.judges import measurements as judge
-from conformance.judges.exchanges import cite, shown
+from conformance.judges.exchanges import cite, late_among, shown
 from conformance.judges.support import first_filled
 from conformance.protocol.commands import C_FAMILY, M_FAMILY
 from conformance.protocol.responses import (
@@ -48,6 +48,14 @@ def test_announced_values_delivered(sensor, case):
     )
     case.extend(judge.judge(ms, case.requirements, sensor.version))
     case.extend(judge.unread_data(sensor.family(ASCII_FAMILIES + ("HA",)), case.requirements))
+    # a start answered only after its reply window and not read as 'atttn' (its count
+    # unknown) is a measurement the rule could not follow: the others' PASS is not the whole
+    # sensor's (replies-after-retry + high-volume-two-digit-count, seed 4900: 0HA!'s late
+    # reply unread, R-4.4.8-03/04 PASSed on the eight others while 0HA! breaks them alone)
+    unread = [m.start for m in sensor.family(ASCII_FAMILIES + ("HA",)) if m.count is None]
+    for rid in case.requirements:
+        if late := late_among(rid, unread, "not every start's count was read"):
+            case.add(late)
 
 
 @requirements("R-4.4.8.3-01", "R-4.4.8.3-02", "R-4.4.8.3-03")

@@ -58,6 +58,23 @@ LATE_REPLY_UNDECIDED = (
     "R-6.2-04",
     "R-6.2.1-01",
     "R-6.2.2-01",
+    # aHA! and aHB! answered only late, their counts unread: high volume not shown absent
+    # (undecided, not N/A), and the count rules' starts not all read (aMC1!...)
+    "R-4.1-03",
+    "R-4.4.8-03",
+    "R-4.4.8-04",
+    "R-5.1-01",
+    "R-5.1-02",
+    "R-5.1-03",
+    "R-5.2-01",
+    "R-5.2-02",
+    "R-5.2-03",
+    "R-5.2-04",
+    "R-5.2-05",
+    "R-5.2-06",
+    "R-5.2-07",
+    "R-5.2.1-01",
+    "R-5.3-01",
 )
 
 #: Timing.
