@@ -381,6 +381,8 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("answers-foreign-address", "replies-after-retry"),
     ("late-address-after-break", "replies-after-retry"),
     ("parity-error", "replies-after-retry"),
+    # 0HA!'s late reply unread: R-4.4.8-03/-04 PASSed on the starts read (seed 4900)
+    ("high-volume-two-digit-count", "replies-after-retry"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
