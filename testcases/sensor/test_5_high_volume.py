@@ -180,8 +180,8 @@ def test_high_volume_is_concurrent(sensor, case):
     and other traffic, aborted by a valid command to the sensor itself."""
     case.expect("no SR; all values after a break + foreign command; none after an own aI!")
     codes = [c for c in ("HA", "HB") if sensor.supports(c)]
-    late = [] if codes else [sensor.measurement(c).start for c in ("HA", "HB")]
-    if late := [(ex, text) for ex in late if (text := xjudge.answered_late(ex))]:
+    starts = [] if codes else [sensor.measurement(c).start for c in ("HA", "HB")]
+    if late := [(ex, text) for ex in starts if (text := xjudge.answered_late(ex))]:
         # not shown absent: the starts were answered only after their window, unread
         case.requires(
             "supported",
