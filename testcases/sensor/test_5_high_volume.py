@@ -29,6 +29,27 @@ def _text_reply(ex) -> bool:
     return ex.answered and bool(body[1:]) and not any(c.isdigit() for c in body[1:])
 
 
+def _support_undecided_if_late(case, starts, prefix: str = "") -> bool:
+    """Whether any of the high-volume ``starts`` was answered only after its window (its
+    reply unread: no "no values" was seen), which leaves support undecided: the precondition
+    unmet as INCONCLUSIVE, not N/A (replies-after-retry: R-5.1-01 N/A "not supported" where
+    0HA!'s reply was only late, and beside high-volume-two-digit-count the count rules' PASS
+    hid 0HA!'s, seed 4900)."""
+    late = [(ex, text) for ex in starts if (text := xjudge.answered_late(ex))]
+    if not late:
+        return False
+    case.requires(
+        "supported",
+        precondition.shown_supported(
+            False,
+            prefix + "; ".join(text for _, text in late) + " (R-7.0-10 judges its timing), so"
+            " whether the sensor has high volume is undecided",
+            [xjudge.cited(ex) for ex, _ in late],
+        ),
+    )
+    return True
+
+
 def _unsupported(case, sensor, code):
     """N/A only for a well-formed 'no values' reply; a malformed reply is judged as support,
     but text with no digit ('aUNKN', seed 4167) leaves support undecided. A sensor declared
@@ -63,19 +84,7 @@ def _unsupported(case, sensor, code):
             only=[r for r in case.requirements if r != FORMAT_RULE[code]],
         )
         return True
-    if late := xjudge.answered_late(m.start):
-        # its reply came after the window, unread: no "no values" was seen (replies-after-
-        # retry: R-5.1-01 N/A "not supported" where 0HA!'s reply was only late, and beside
-        # high-volume-two-digit-count the count rules' PASS hid 0HA!'s, seed 4900)
-        case.requires(
-            "supported",
-            precondition.shown_supported(
-                False,
-                f"a{code}!: {late} (R-7.0-10 judges its timing), so whether the sensor has"
-                " high volume is undecided",
-                [xjudge.cited(m.start)],
-            ),
-        )
+    if _support_undecided_if_late(case, [m.start], f"a{code}!: "):
         return True
     case.requires(
         "supported",
@@ -180,18 +189,8 @@ def test_high_volume_is_concurrent(sensor, case):
     and other traffic, aborted by a valid command to the sensor itself."""
     case.expect("no SR; all values after a break + foreign command; none after an own aI!")
     codes = [c for c in ("HA", "HB") if sensor.supports(c)]
-    starts = [] if codes else [sensor.measurement(c).start for c in ("HA", "HB")]
-    if late := [(ex, text) for ex in starts if (text := xjudge.answered_late(ex))]:
-        # not shown absent: the starts were answered only after their window, unread
-        case.requires(
-            "supported",
-            precondition.shown_supported(
-                False,
-                "; ".join(text for _, text in late) + " (R-7.0-10 judges its timing), so"
-                " whether the sensor has high volume is undecided",
-                [xjudge.cited(ex) for ex, _ in late],
-            ),
-        )
+    starts = [sensor.measurement(c).start for c in ("HA", "HB")]
+    if not codes and _support_undecided_if_late(case, starts):
         return
     if not case.requires("supported", precondition.served(bool(codes), "no high-volume support")):
         return
