@@ -53,7 +53,9 @@ class Role(StrEnum):
 
 class PlanKind(StrEnum):
     TX = "tx"  # transmit one character at ``start``
-    BRK = "brk"  # hold a break from ``start`` to ``end`` (recorder harnesses only)
+    #: hold a break from ``start`` to ``end``: a recorder's, or a sensor holding the line
+    #: spacing for a break's length (some firmware "wakes" the line before every reply)
+    BRK = "brk"
     WAIT = "wait"  # nothing before ``start``; tell me when it comes
     IDLE = "idle"  # nothing until something happens on the line
     DONE = "done"  # the job is finished (recorder harnesses only)
@@ -277,7 +279,10 @@ def parse_plan(
     that never came: 49.7 days) is what it says, ended by the job's budget or the next event,
     not a harness counting wrong as a ``tx``/``brk`` that far out is. A version-2 harness may
     add a ``tx``'s duration and is held to the clock for ``tx`` as for ``brk``
-    (:func:`_parse_tx`)."""
+    (:func:`_parse_tx`). A sensor harness may plan a ``brk`` too (an extension: it used to
+    be an ERROR, so no harness that worked sends it): firmware that holds the line spacing
+    for a break's length before its reply (the 2013 Arduino-SDI-12 library's
+    ``wakeSensors()`` in a sensor sketch) is put on the line as it does it, not stopped."""
     floor = now if since is None else min(now, since)
     parts = text.split(" ")
     if parts[0] == PlanKind.TX and version >= 2:
@@ -292,7 +297,7 @@ def parse_plan(
     if len(parts) != _FIELDS[word]:
         raise HarnessProtocolError(f"'{word}' takes {_FIELDS[word] - 1} field(s)", text)
     kind = PlanKind(word)
-    if role is Role.SENSOR and kind in (PlanKind.BRK, PlanKind.DONE):
+    if role is Role.SENSOR and kind is PlanKind.DONE:
         raise HarnessProtocolError(f"'{word}' is for recorder harnesses only", text)
     if kind is PlanKind.TX:
         # a character planned in the past goes out as soon as the line lets it (harnesses

@@ -17,11 +17,12 @@ import pytest
 
 from conformance.conduct import run_once
 from conformance.harness.channel import ChildChannel, HarnessError
-from conformance.harness.device import open_sensor_harness
+from conformance.harness.device import SENSOR_BREAK, open_sensor_harness
 from conformance.harness.protocol import Role
 from conformance.links.errors import PortUnavailable
 from conformance.ports import open_port
 from conformance.results import CaseRecord
+from conformance.transcript import DUT, EventKind
 from conformance.verdicts import Finding, Verdict
 from tests.support.paths import ROOT
 
@@ -516,3 +517,51 @@ def test_a_version_2_harness_answering_in_the_past_is_an_error_naming_the_line(t
         assert "'tx 7333 30 8330'" in str(err.value)
     finally:
         link.close()
+
+
+SENSOR_BRK = textwrap.dedent(
+    """
+    import sys
+    log = open(sys.argv[1], "w")
+    for line in sys.stdin:
+        log.write(line)
+        log.flush()
+        word, *fields = line.split()
+        if word == "hello":
+            print("hello 1 breaks-first", flush=True)
+        elif word == "char" and fields[2] == "21":  # '!': hold the line 12.1 ms, 8.4 ms on
+            end = int(fields[1])
+            print(f"brk {end + 8400} {end + 8400 + 12100}", flush=True)
+        elif word == "break" and int(fields[1]) > 0:  # its own, told back: '0' CR LF
+            print(f"tx {int(fields[1]) + 8400} 30", flush=True)
+        elif word == "sent" and fields[2] != "0a":
+            print(f"tx {fields[1]} {'8d' if fields[2] == '30' else '0a'}", flush=True)
+        elif word != "bye":
+            print("idle", flush=True)
+    """
+)
+
+
+def test_a_sensor_harness_may_hold_the_line_spacing_before_its_reply(tmp_path):
+    """``brk`` from a sensor harness (the protocol's extension; before, "'brk' is for
+    recorder harnesses only", an ERROR and no verdict): the break goes in the transcript
+    as the sensor's (origin DUT, :data:`SENSOR_BREAK`), where the harness put it, the
+    harness is told it back as ``break S E`` as a recorder is, and the reply after it is
+    read as the tool's characters; the break itself is no character of the reply."""
+    script, log = tmp_path / "brk.py", tmp_path / "messages.txt"
+    script.write_text(SENSOR_BRK)
+    link = open_sensor_harness(f"exec:{sys.executable} {script} {log}")
+    try:
+        sent = link.write(bytes([0x30, 0x21]))
+        got = link.receive(link.now() + 0.1)
+    finally:
+        link.close()
+    end = sent[-1].end
+    assert [e.wire for e in got] == [0x30, 0x8D, 0x0A]
+    breaks = [e for e in link.transcript.events if e.kind is EventKind.BREAK]
+    assert [(b.origin, b.text) for b in breaks] == [(DUT, SENSOR_BREAK)]
+    assert breaks[0].start == pytest.approx(end + 8400e-6, abs=1e-6)
+    assert breaks[0].duration == pytest.approx(12100e-6, abs=1e-6)
+    assert got[0].start == pytest.approx(breaks[0].end + 8400e-6, abs=1e-6)
+    told = [line.split() for line in log.read_text().splitlines()]
+    assert ["break", str(round(breaks[0].start * 1e6)), str(round(breaks[0].end * 1e6))] in told

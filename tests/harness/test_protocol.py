@@ -22,6 +22,9 @@ from conformance.harness.protocol import HarnessProtocolError, Plan, PlanKind, R
         ("idle", Role.SENSOR, Plan(PlanKind.IDLE)),
         ("brk 5000 17500", Role.RECORDER, Plan(PlanKind.BRK, start=5000, end=17500)),
         ("done", Role.RECORDER, Plan(PlanKind.DONE)),
+        # a sensor that holds the line spacing before its reply (was "recorder harnesses
+        # only", an ERROR: the extension leaves every harness that worked unchanged)
+        ("brk 6000 17500", Role.SENSOR, Plan(PlanKind.BRK, start=6000, end=17500)),
     ],
 )
 def test_well_formed_plans(text, role, plan):
@@ -52,7 +55,9 @@ def test_well_formed_plans(text, role, plan):
         ("brk 4000 16500", Role.RECORDER, "1000 us before now"),
         ("wait 5000", Role.SENSOR, "not after now"),
         ("wait 10", Role.SENSOR, "not after now"),
-        ("brk 6000 17500", Role.SENSOR, "recorder harnesses only"),
+        # a sensor's break is held to the clock as a recorder's is
+        ("brk 4000 16500", Role.SENSOR, "1000 us before now"),
+        ("brk 6000 6000", Role.SENSOR, "ends before it starts"),
         ("done", Role.SENSOR, "recorder harnesses only"),
         ("brk 6000 6000", Role.RECORDER, "ends before it starts"),
         ("brk 0 4000", Role.RECORDER, "5000 us before now"),

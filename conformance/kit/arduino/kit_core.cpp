@@ -212,10 +212,8 @@ void line_write(int before, int level) {
     double k = (double)(vt - frame_start) / NOMINAL_BIT;
     if (holding_break) {
         if (level == 0) {
-            if (!recorder)
-                fail("the sketch held the line spacing for %lld us from %lld us: a sensor "
-                     "cannot send a break (the harness protocol has no break from a sensor)",
-                     vt - frame_start, frame_start);
+            /* a sensor's too: `brk` from a sensor harness (the protocol's extension for
+             * firmware that holds the line spacing before its reply, docs/kit.md) */
             out.push_back({'b', frame_start, vt, 0, vt - frame_start});
             composing = holding_break = false;
             writes.clear();
