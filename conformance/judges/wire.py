@@ -160,11 +160,35 @@ def _start_observations(
                 f"{where[0]} (or to {escape(earlier.text)} before it, "
                 f"{lagged * 1e3:.2f} ms after that one)"
             ]
+        spacing = _spacing_before_reply(seg)
         for window, out in ((EARLY_WINDOW, early), (LATE_WINDOW, late)):
-            if earlier is not None and window.inside(delay) != window.inside(lagged):
-                continue
-            out.append((Measured(window, delay, u, where), tainted, place))
+            measured, said = delay, where
+            if window is EARLY_WINDOW and spacing is not None:
+                # the sensor drove the line spacing first: R-7.0-09's marking ended there
+                measured = max(spacing.start, seg.command_end) - seg.command_end
+                said = [
+                    f"{where[0]}: the sensor held the line spacing from {measured * 1e3:.2f} ms "
+                    f"after the command, {spacing.duration * 1e3:.2f} ms (a break), before "
+                    f"its reply at {delay * 1e3:.2f} ms"
+                ]
+            if earlier is not None:
+                other = measured + seg.command_end - earlier.command_end
+                if window.inside(measured) != window.inside(other):
+                    continue
+            out.append((Measured(window, measured, u, said), tainted, place))
     return early, late, before
+
+
+def _spacing_before_reply(seg: Segment) -> Event | None:
+    """The sensor's first break (:attr:`Segment.sensor_breaks`) on the line after the command
+    ended and begun before its reply's first character: the first spacing the sensor put on the
+    line, where its 8.33 ms of marking (R-7.0-09) ended, whatever its reply's first start
+    bit says. The twenty-fourth round's sketch "wakes the sensors" (12.1 ms of spacing)
+    0.00 ms after every command, then marks 8.4 ms and replies 20.06 ms after it: R-7.0-09
+    PASSed on the 20.06 ms, though a UART would read a start bit at 0.00 ms."""
+    first = seg.reply[0].start
+    end = seg.command_end
+    return next((b for b in seg.sensor_breaks if b.end > end and b.start < first), None)
 
 
 def _unanswered_before(before: Segment | None, seg: Segment) -> Segment | None:

@@ -1121,8 +1121,8 @@ def _unanswered_break_end(events: list[Event], lookback: int = 4000) -> float | 
     ``lookback`` events), else None: a sensor that answered since is awake, whatever it
     needed to wake."""
     for e in reversed(events[-lookback:]):
-        if e.kind is EventKind.BREAK:
+        if e.kind is EventKind.BREAK and e.origin == TOOL:
             return e.end
-        if e.kind is EventKind.CHAR and e.origin != TOOL:
+        if e.kind is not EventKind.NOTE and e.origin != TOOL:  # a sensor's break is its own
             return None
     return None

@@ -48,6 +48,8 @@ class Segment:
     contention: list[Event] = field(default_factory=list)  # a sensor talked over the command
     text: str = ""
     binary_reply: bool = False  # replies to aDBn! are 8N1 packets (no 7E1, no CR LF)
+    #: the sensor's breaks after the command (:attr:`Transmission.sensor_breaks`)
+    sensor_breaks: tuple[Event, ...] = ()
 
     @property
     def command_end(self) -> float:
@@ -81,6 +83,7 @@ class Segment:
             list(t.chars),
             text=t.text,
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
+            sensor_breaks=t.sensor_breaks,
         )
         heard = t.heard
         if not is_command:  # asked once, not per character heard

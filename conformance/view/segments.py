@@ -105,6 +105,11 @@ class Transmission:
     #: invalid reply of the sensor's (a logger whose poll timeout is shorter than a long
     #: reply, the fourteenth round's MicroPython driver).
     cut_by: Event | None = None
+    #: The sensors' breaks after this transmission, until the recorder acted again: the line
+    #: held spacing by a sensor (a harness's ``brk``: firmware that "wakes" the line before
+    #: its reply). No character of any reply; what R-7.0-09 reads as the first spacing the
+    #: sensor put on the line after the command (a UART would take it for a start bit).
+    sensor_breaks: tuple[Event, ...] = ()
 
     def __post_init__(self) -> None:
         # every derived value :func:`memo` keeps here, named up front in one order: the
@@ -659,6 +664,8 @@ class Cut:
                     current.heard.append(e)
                 else:
                     unanswerable.append(e)
+            elif current is not None:  # a sensor's break (rare: a tuple made anew is enough)
+                current.sensor_breaks += (e,)
         self._pending, self._current = pending, current
         self._is_command, self._after_bang, self._last_heard = is_command, after_bang, last_heard
 

@@ -34,10 +34,11 @@ UNREACHABLE = " (a link stamped to ±{u:.2f} ms cannot show 8.33 ms of marking f
 
 
 def _break_of(sensor, ex):
-    """The break event just before the probe's command (hand-made, so from the transcript)."""
+    """The tool's break just before the probe's command (hand-made, so from the transcript;
+    a sensor's own break, a harness's ``brk``, is not it)."""
     first = ex.attempts[0].command_events[0]
     for e in reversed(sensor.link.transcript.events):
-        if e.kind is EventKind.BREAK and e.end <= first.start:
+        if e.kind is EventKind.BREAK and e.origin == TOOL and e.end <= first.start:
             return e
     return None
 
