@@ -39,6 +39,7 @@ def uart_sensor(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         ("clean", [], sources),
         ("tx-gap", ["-DFAULT_TX_GAP"], sources),
         ("order", [], probe),
+        ("order-break", ["-DBREAK_BETWEEN"], probe),
     ):
         binary = out / f"uart-{name}"
         command = [compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", f"-I{C_DIR}", *flags]
@@ -86,6 +87,31 @@ def test_callbacks_come_in_line_order(uart_sensor):
         "tx-done 45333",
         "rx 31 parity 58333",
     ]
+
+
+def test_a_send_break_goes_out_between_the_bytes_around_it(uart_sensor):
+    """``sdi12_uart_break`` (a sensor's break: the protocol's ``brk`` from a sensor): after
+    the byte written before it, before the one written after; told back as ``break S E``,
+    which is the UART's own (no on_break), and tx-done once all of it went out."""
+    answers, log = converse(
+        uart_sensor["order-break"],
+        [
+            "break 0 12000",
+            "time 25000",
+            "sent 25000 33333 41",
+            "break 33333 45433",  # its own break, told back
+            "sent 45433 53767 42",
+        ],
+    )
+    assert answers == [
+        "uart-order",
+        "wait 25000",
+        "tx 25000 41",
+        "brk 33333 45433",
+        "tx 45433 42",
+        "idle",
+    ]
+    assert log.split("\n")[:3] == ["break 0 12000", "timer 25000 now 25000", "tx-done 53767"]
 
 
 #: "0!" heard, then its reply told as sent (docs/harness-protocol.md's sensor session)

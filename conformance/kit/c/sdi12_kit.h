@@ -25,19 +25,24 @@
 typedef long long sdi12_us;
 
 /* -- a sensor as event handlers -------------------------------------------------------- */
-enum sdi12_plan_kind { SDI12_IDLE, SDI12_TX, SDI12_WAIT };
+enum sdi12_plan_kind { SDI12_IDLE, SDI12_TX, SDI12_WAIT, SDI12_BRK };
 
 struct sdi12_plan {
     enum sdi12_plan_kind kind;
-    sdi12_us at;        /* SDI12_TX: the character's start; SDI12_WAIT: when to look again */
+    sdi12_us at;        /* SDI12_TX: the character's start; SDI12_WAIT: when to look again;
+                           SDI12_BRK: when the sensor begins holding the line spacing */
     unsigned char wire; /* SDI12_TX: 7 data bits, even parity in bit 7 (sdi12_kit_wire) */
+    sdi12_us until;     /* SDI12_BRK: the break's end (firmware that "wakes" the line before
+                           its reply); on_sent is called when it has gone out */
 };
 
 struct sdi12_sensor {
     const char *name;                                                  /* shown in the report */
     void (*on_break)(sdi12_us start, sdi12_us end);                    /* spacing, any length */
     void (*on_char)(unsigned char wire, sdi12_us start, sdi12_us end); /* another's character */
-    void (*on_sent)(sdi12_us start, sdi12_us end);                     /* the planned one went */
+    void (*on_sent)(sdi12_us start, sdi12_us end);                     /* the planned one went
+                                                                          (a character or a
+                                                                          break) */
     struct sdi12_plan (*plan)(sdi12_us now);                           /* what comes next */
 };
 
@@ -82,6 +87,10 @@ struct sdi12_uart {
 /* From a handler: put `c` in the tx buffer (the UART adds even parity). A byte written while
  * one is going out follows it back to back; into an empty buffer it starts now. 0: full. */
 int sdi12_uart_write(char c);
+/* From a handler: hold the line spacing for `duration` (the UART's send-break), after the
+ * bytes already in the tx buffer; bytes written after it follow it. on_tx_done comes when the
+ * buffer and the break are done. One break at a time: 0 if one is pending. */
+int sdi12_uart_break(sdi12_us duration);
 /* From a handler: the one-shot timer fires at `at` (on_timer); a later call re-arms it,
  * at < 0 stops it. Virtual time waits for it: a firmware delay is a timer. */
 void sdi12_uart_timer(sdi12_us at);
@@ -157,10 +166,18 @@ static const char *sdi12_kit_event(const char *name, const char *version, sdi12_
     return word;
 }
 
+/* the end of the break the sensor planned last (-1: none): told back as `break S E` */
+static sdi12_us sdi12_kit_own_break = -1;
+
 /* the sensor's plan at the kit's clock, as its answer line */
 static void sdi12_kit_plan_line(const struct sdi12_sensor *sensor, char *line, size_t size) {
     struct sdi12_plan p = sensor->plan(sdi12_kit_clock);
-    if (p.kind == SDI12_TX)
+    sdi12_us from = p.at > sdi12_kit_clock ? p.at : sdi12_kit_clock;
+    sdi12_kit_own_break = -1;
+    if (p.kind == SDI12_BRK && p.until > from) {
+        snprintf(line, size, "brk %lld %lld", from, p.until);
+        sdi12_kit_own_break = p.until;
+    } else if (p.kind == SDI12_TX)
         snprintf(line, size, "tx %lld %02x", p.at > sdi12_kit_clock ? p.at : sdi12_kit_clock, p.wire);
     else if (p.kind == SDI12_WAIT && p.at > sdi12_kit_clock) snprintf(line, size, "wait %lld", p.at);
     else snprintf(line, size, "idle");
@@ -207,7 +224,8 @@ int sdi12_kit_sensor(const struct sdi12_sensor *sensor) {
             sdi12_kit_say(line);
             continue;
         }
-        if (strcmp(word, "break") == 0) sensor->on_break(a, b);
+        if (strcmp(word, "break") == 0 && b == sdi12_kit_own_break) sensor->on_sent(a, b);
+        else if (strcmp(word, "break") == 0) sensor->on_break(a, b);
         else if (strcmp(word, "char") == 0) sensor->on_char((unsigned char)byte, a, b);
         else if (strcmp(word, "sent") == 0) sensor->on_sent(a, b);
         sdi12_kit_plan_line(sensor, line, sizeof line);
@@ -300,6 +318,16 @@ int sdi12_kit_recorder(const char *name, sdi12_job job) {
 static unsigned char sdi12_uart_tx[256]; /* wire bytes; indices wrap at 256 */
 static unsigned char sdi12_uart_head, sdi12_uart_count;
 static sdi12_us sdi12_uart_alarm = -1;
+/* a break asked for: its length (0: none), the bytes ahead of it, its end once planned */
+static sdi12_us sdi12_uart_brk_len, sdi12_uart_brk_end = -1;
+static int sdi12_uart_brk_ahead;
+
+int sdi12_uart_break(sdi12_us duration) {
+    if (sdi12_uart_brk_len || duration <= 0) return 0;
+    sdi12_uart_brk_len = duration;
+    sdi12_uart_brk_ahead = sdi12_uart_count;
+    return 1;
+}
 
 int sdi12_uart_write(char c) {
     if (sdi12_uart_count == 255) return 0;
@@ -333,17 +361,24 @@ int sdi12_kit_uart(const struct sdi12_uart *uart) {
         unsigned byte;
         const char *word = sdi12_kit_event(uart->name, "1", &a, &b, &byte);
         sdi12_uart_fire(uart, from, sdi12_kit_clock);
-        if (strcmp(word, "break") == 0) {
+        if (strcmp(word, "break") == 0 && sdi12_uart_brk_len && b == sdi12_uart_brk_end) {
+            sdi12_uart_brk_len = 0, sdi12_uart_brk_end = -1; /* its own break went out */
+            if (!sdi12_uart_count && uart->on_tx_done) uart->on_tx_done(b);
+        } else if (strcmp(word, "break") == 0) {
             uart->on_break(a, b);
         } else if (strcmp(word, "char") == 0) {
             int c = (int)(byte & 0x7f);
             uart->on_rx(sdi12_kit_parity_ok(byte) ? c : c | SDI12_UART_PARITY_ERROR, b);
         } else if (strcmp(word, "sent") == 0 && sdi12_uart_count) {
             sdi12_uart_head++, sdi12_uart_count--;
-            if (!sdi12_uart_count && uart->on_tx_done) uart->on_tx_done(b);
+            if (sdi12_uart_brk_len && sdi12_uart_brk_ahead) sdi12_uart_brk_ahead--;
+            else if (!sdi12_uart_count && uart->on_tx_done) uart->on_tx_done(b);
         }
         sdi12_uart_fire(uart, sdi12_kit_clock, sdi12_kit_clock);
-        if (sdi12_uart_count) /* the UART sends what it holds, from now */
+        if (sdi12_uart_brk_len && !sdi12_uart_brk_ahead) { /* its break, from now */
+            sdi12_uart_brk_end = sdi12_kit_clock + sdi12_uart_brk_len;
+            snprintf(line, sizeof line, "brk %lld %lld", sdi12_kit_clock, sdi12_uart_brk_end);
+        } else if (sdi12_uart_count) /* the UART sends what it holds, from now */
             snprintf(line, sizeof line, "tx %lld %02x", sdi12_kit_clock, sdi12_uart_tx[sdi12_uart_head]);
         else if (sdi12_uart_alarm >= 0) snprintf(line, sizeof line, "wait %lld", sdi12_uart_alarm);
         else snprintf(line, sizeof line, "idle");

@@ -1,6 +1,7 @@
 /* A probe for the C kit's UART adapter (tests/kit/test_c_uart.py): it logs every callback
  * with its time on stderr. A break arms the timer for 25 ms; the timer writes "AB" in one go
- * (two bytes into the tx buffer); a character with a parity error is logged as such. */
+ * (two bytes into the tx buffer; with -DBREAK_BETWEEN a 12.1 ms send-break between them); a
+ * character with a parity error is logged as such. */
 #define SDI12_KIT_IMPLEMENTATION
 #include <stdio.h>
 
@@ -21,6 +22,9 @@ static void on_tx_done(sdi12_us stamp) { fprintf(stderr, "tx-done %lld\n", stamp
 static void on_timer(sdi12_us now) {
     fprintf(stderr, "timer %lld now %lld\n", now, sdi12_kit_now());
     sdi12_uart_write('A');
+#ifdef BREAK_BETWEEN
+    if (!sdi12_uart_break(12100)) fprintf(stderr, "break refused\n");
+#endif
     sdi12_uart_write('B');
 }
 
