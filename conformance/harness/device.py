@@ -9,38 +9,17 @@ the wire.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ..links.base import LinkInfo
 from ..links.errors import PortUnavailable
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
 from ..protocol.timing import CHAR_TIME
 from ..results import CaseRecord
-from ..sim.bus import Frame, SimBus, SimLink, VirtualClock
-from ..transcript import DUT, TOOL, Event, EventKind
+from ..sim.bus import BreakFrame, Frame, SimBus, SimLink, VirtualClock
+from ..transcript import TOOL, Event, EventKind
 from ..verdicts import Verdict
 from . import protocol as proto
 from .channel import Channel, ChildChannel, HarnessError, SocketChannel
 from .protocol import Plan, PlanKind, Role
-
-#: The text a sensor harness's break carries in the transcript (an event of kind BREAK whose
-#: origin is the sensor's: the tool's own breaks are origin ``tool``).
-SENSOR_BREAK = "the sensor held the line spacing (a break)"
-
-
-@dataclass(frozen=True)
-class BreakFrame(Frame):
-    """A sensor harness's ``brk``: the line held spacing from ``start`` to ``end`` (s).
-    ``duration`` is its planned length: a break the line could only begin later (the tool's
-    character was still on it) keeps its planned END, as a recorder's held-back break does,
-    or, planned to end before the line was free, its whole length from there."""
-
-    end: float = 0.0
-
-    def placed(self, now: float) -> tuple[float, float]:
-        """Its start and end on the line, the clock at ``now`` when it is committed."""
-        start = max(self.start, now)
-        return start, self.end if self.end > start else start + self.duration
 
 
 class HarnessDevice:
@@ -166,25 +145,6 @@ class HarnessBus(SimBus):
         nxt = self._next()
         if nxt is not None and nxt[1].start <= at:
             self.clashed = end
-
-    def _commit(self, device, frame: Frame) -> Event:  # noqa: ANN001 - as SimBus._commit
-        """As :meth:`SimBus._commit`; a sensor harness's break (:class:`BreakFrame`) goes in
-        the transcript as a BREAK of the sensor's origin, the line spacing from its start to
-        its end: what the sensor did, for the judges to see (a UART-based recorder would read
-        it as a NUL with a framing error, then nothing until the line marks again)."""
-        if not isinstance(frame, BreakFrame):
-            return super()._commit(device, frame)
-        start, end = frame.placed(self.clock.now)
-        device.pop_frame()
-        if self.clashed is not None and frame.start <= self.clashed:
-            self.clashed = None  # the break was what wanted the line under the tool's own
-        origin = DUT if len(self.devices) == 1 else device.name
-        event = self.transcript.add(Event(EventKind.BREAK, origin, start, end, text=SENSOR_BREAK))
-        for other in self.devices:
-            if other is not device:
-                other.on_break(start, end)
-        self.clock.advance_to(end)
-        return event
 
     def tool_break(self, duration: float, at: float | None = None) -> Event:
         self.advance(self.clock.now if at is None else at)

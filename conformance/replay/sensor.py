@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from ..links.base import LinkError
 from ..protocol.timing import BIT_TIME, CHAR_TIME
-from ..sim.bus import Frame
+from ..sim.bus import SENSOR_BREAK, BreakFrame, Frame
 from ..transcript import TOOL, Event, EventKind, escape
 
 if TYPE_CHECKING:
@@ -68,7 +68,7 @@ class RecordedSensor:
         else:
             wire.sort(key=_START_END)
             tool = [e for e in wire if e.origin == TOOL]
-            replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
+            replies = [e for e in wire if e.origin != TOOL and _played(e)]
             # how many tool events the recording has before each reply character starts
             # (the tool's starts never decrease: they are sorted with the rest)
             starts = [e.start for e in tool]
@@ -77,6 +77,10 @@ class RecordedSensor:
             columns = _reply_columns(replies)
         self._tool: list[Event] | None = tool
         self._replies: list[Event] | None = replies
+        #: which of the replies are the sensor's breaks (a harness's ``brk``, recorded)
+        self._breaks = frozenset(
+            compress(range(len(replies)), map(is_, map(_KIND, replies), repeat(EventKind.BREAK)))
+        )
         kinds, wires, ends = [e.kind for e in tool], [e.wire for e in tool], [e.end for e in tool]
         self._start((kinds, wires, ends), columns)
 
@@ -94,6 +98,8 @@ class RecordedSensor:
         is_tool = np.array([o == TOOL for o in wire.origin], bool)
         kinds = wire.kinds()
         is_char = np.fromiter(map(is_, kinds, repeat(EventKind.CHAR)), bool, len(kinds))
+        if any(e.kind is not EventKind.CHAR and _played(e) for e in wire.made.values()):
+            return None  # a sensor's break (a harness's brk, recorded): played from the events
         with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
             found = _from_arrays(s, e, u, is_tool, is_char)
             if found is None:
@@ -103,6 +109,7 @@ class RecordedSensor:
             tool_mask = is_tool.tolist()
             tool_ends = e[is_tool].tolist()
         sensor = cls.__new__(cls)
+        sensor._breaks = frozenset()
         sensor._needs, sensor._touching = needs, touching
         sensor._tool = sensor._replies = None
         sensor._made_of = (wire, tool_mask, is_reply.tolist())
@@ -194,8 +201,13 @@ class RecordedSensor:
             # tell (a capture's edges sit on its sample grid): it goes the moment the line is
             # free, so it wins the line against the tool's next frame, as recorded (else the
             # order of frames that touch could turn on a few microseconds of quantization)
-            return Frame(LINE_FREE, self._reply_wire[k], self._reply_length[k])
-        return Frame(self._reply_start[k] + self.offset, self._reply_wire[k], self._reply_length[k])
+            start = LINE_FREE
+        else:
+            start = self._reply_start[k] + self.offset
+        if k in self._breaks:  # the sensor's break, as long as it was recorded
+            length = self._reply_length[k]
+            return BreakFrame(start, 0, length, 0.0 if start == LINE_FREE else start + length)
+        return Frame(start, self._reply_wire[k], self._reply_length[k])
 
     def pop_frame(self) -> Frame:
         frame = self.next_frame()
@@ -210,7 +222,7 @@ class RecordedSensor:
         heard, in order (what one offers depends only on ``heard``, which only the tool's
         events move, and on its own index). None when none is due, as ``next_frame`` says."""
         k = self.next_reply
-        if k >= len(self._reply_start) or self._needs[k] > self.heard:
+        if k >= len(self._reply_start) or self._needs[k] > self.heard or k in self._breaks:
             return None
         return self._due(k, self.heard, self.offset)
 
@@ -218,7 +230,8 @@ class RecordedSensor:
         needs, touching = self._needs, self._touching
         starts, wires, lengths = self._reply_start, self._reply_wire, self._reply_length
         count = len(starts)
-        while k < count and needs[k] <= heard:
+        breaks = self._breaks
+        while k < count and needs[k] <= heard and k not in breaks:
             start = LINE_FREE if touching[k][heard > needs[k]] else starts[k] + offset
             yield start, wires[k], lengths[k]
             k += 1
@@ -308,6 +321,8 @@ def _in_arrays(wire: list[Event], s: np.ndarray, e: np.ndarray, u: np.ndarray) -
     n = len(wire)
     is_tool = np.fromiter(map(eq, map(_ORIGIN, wire), repeat(TOOL)), bool, n)
     is_char = np.fromiter(map(is_, map(_KIND, wire), repeat(EventKind.CHAR)), bool, n)
+    for i in np.flatnonzero(~(is_tool | is_char)).tolist():
+        is_char[i] = _played(wire[i])  # a sensor's break is played as its replies are
     found = _from_arrays(s, e, u, is_tool, is_char)
     if found is None:
         return None
@@ -354,6 +369,12 @@ def _from_arrays(
     second = has_prev & (np.abs(rs - re_prev) <= ru + ru_prev)
     touching = list(zip(first.tolist(), second.tolist(), strict=True))
     return is_reply, need.tolist(), touching
+
+
+def _played(e: Event) -> bool:
+    """Whether the sensor's event ``e`` is one the replay plays: a character, or its break
+    (:data:`~conformance.sim.bus.SENSOR_BREAK`, a harness's ``brk``)."""
+    return e.kind is EventKind.CHAR or (e.kind is EventKind.BREAK and e.text == SENSOR_BREAK)
 
 
 def same_action(recorded: Event, kind: EventKind, wire: int, length: float) -> bool:

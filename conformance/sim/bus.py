@@ -43,6 +43,28 @@ class Frame:
     duration: float = CHAR_TIME  # one 10-bit frame; a device at the wrong baud rate differs
 
 
+#: The text a sensor's break carries in the transcript (an event of kind BREAK whose origin is
+#: the sensor's; the tool's own breaks are origin ``tool``).
+SENSOR_BREAK = "the sensor held the line spacing (a break)"
+
+
+@dataclass(frozen=True)
+class BreakFrame(Frame):
+    """A device's break: the line held spacing from ``start`` to ``end`` (s), offered as a
+    frame (a sensor harness's ``brk``: firmware that "wakes" the line before its reply; a
+    recording of one, replayed). ``duration`` is its planned length: a break the line could
+    only begin later (the tool's character was still on it) keeps its planned END, as a
+    recorder's held-back break does, or, planned to end before the line was free, its whole
+    length from there."""
+
+    end: float = 0.0
+
+    def placed(self, now: float) -> tuple[float, float]:
+        """Its start and end on the line, the clock at ``now`` when it is committed."""
+        start = max(self.start, now)
+        return start, self.end if self.end > start else start + self.duration
+
+
 class BusDevice(Protocol):
     """A simulated device (sensor emulator, or a simulated recorder)."""
 
@@ -161,6 +183,8 @@ class SimBus:
         return self._commit(*nxt)
 
     def _commit(self, device: BusDevice, frame: Frame) -> Event:
+        if type(frame) is BreakFrame:
+            return self._commit_break(device, frame)
         device.pop_frame()
         start = max(frame.start, self.clock.now)
         end = start + frame.duration
@@ -177,6 +201,23 @@ class SimBus:
                 other.on_char(frame.wire, start, end)
         self.clock.advance_to(end)
         self.rx.append(event)
+        return event
+
+    def _commit_break(self, device: BusDevice, frame: BreakFrame) -> Event:
+        """A device's break (:class:`BreakFrame`) in the transcript as a BREAK of its origin,
+        the line spacing from its start to its end: what the sensor did, for the judges to
+        see (a UART-based recorder would read it as a NUL with a framing error, then nothing
+        until the line marks again); the other devices hear it as a break."""
+        start, end = frame.placed(self.clock.now)
+        device.pop_frame()
+        if self.clashed is not None and frame.start <= self.clashed:
+            self.clashed = None  # the break was what wanted the line under the tool's own
+        origin = DUT if len(self.devices) == 1 else device.name
+        event = self.transcript.add(Event(EventKind.BREAK, origin, start, end, text=SENSOR_BREAK))
+        for other in self.devices:
+            if other is not device:
+                other.on_break(start, end)
+        self.clock.advance_to(end)
         return event
 
     # tool-side actions

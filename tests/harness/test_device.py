@@ -17,11 +17,13 @@ import pytest
 
 from conformance.conduct import run_once
 from conformance.harness.channel import ChildChannel, HarnessError
-from conformance.harness.device import SENSOR_BREAK, open_sensor_harness
+from conformance.harness.device import open_sensor_harness
 from conformance.harness.protocol import Role
 from conformance.links.errors import PortUnavailable
 from conformance.ports import open_port
+from conformance.replay.sensor import RecordedSensor
 from conformance.results import CaseRecord
+from conformance.sim.bus import SENSOR_BREAK, SimBus, SimLink
 from conformance.transcript import DUT, EventKind
 from conformance.verdicts import Finding, Verdict
 from tests.support.paths import ROOT
@@ -565,3 +567,31 @@ def test_a_sensor_harness_may_hold_the_line_spacing_before_its_reply(tmp_path):
     assert got[0].start == pytest.approx(breaks[0].end + 8400e-6, abs=1e-6)
     told = [line.split() for line in log.read_text().splitlines()]
     assert ["break", str(round(breaks[0].start * 1e6)), str(round(breaks[0].end * 1e6))] in told
+
+
+def test_a_sensors_break_is_replayed_where_it_was_recorded(tmp_path):
+    """A saved run's replay plays the sensor's break too (``judge``/``verify`` of the run):
+    before, the replay offered the reply characters alone, the break was gone from the
+    replayed line, and R-7.0-09 came out other than recorded (verify: 17 problems on the
+    twenty-fifth round's AgriApps run)."""
+    script = tmp_path / "brk.py"
+    script.write_text(SENSOR_BRK)
+    link = open_sensor_harness(f"exec:{sys.executable} {script} {tmp_path / 'log.txt'}")
+    try:
+        link.send_break(0.0125)
+        link.wait_until(link.now() + 0.009)
+        link.write(b"0!")
+        link.receive(link.now() + 0.1)
+    finally:
+        link.close()
+    recorded = [e for e in link.transcript.events if e.kind is not EventKind.NOTE]
+    replay = SimLink(SimBus([RecordedSensor(recorded)]))
+    replay.send_break(0.0125)
+    replay.wait_until(replay.now() + 0.009)
+    replay.write(b"0!")
+    replay.receive(replay.now() + 0.1)
+    again = [e for e in replay.transcript.events if e.kind is not EventKind.NOTE]
+    assert [(e.kind, e.origin, e.start, e.end, e.wire, e.text) for e in again] == [
+        (e.kind, e.origin, e.start, e.end, e.wire, e.text) for e in recorded
+    ]
+    assert any(e.kind is EventKind.BREAK and e.origin == DUT for e in again)

@@ -8,8 +8,8 @@ R-7.0-10 still times the reply's first character (a break is no character of it)
 
 from __future__ import annotations
 
-from conformance.harness.device import SENSOR_BREAK
 from conformance.judges.wire import judge_response_start
+from conformance.sim.bus import SENSOR_BREAK
 from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Verdict
 from conformance.view.runs import segments

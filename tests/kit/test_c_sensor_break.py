@@ -10,8 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from conformance.harness.device import SENSOR_BREAK, open_sensor_harness
+from conformance.harness.device import open_sensor_harness
 from conformance.kit import C_DIR
+from conformance.sim.bus import SENSOR_BREAK
 from conformance.transcript import DUT, EventKind
 from tests.kit.conftest import c_compiler
 
