@@ -10,8 +10,9 @@ of both list lengths kept per derived list, a copy of the heard list as its repl
 list each for the contention and what came after), 1,100 on 689a849's successor. Issue
 22's round on branch ``window11``: 884, where base-s58 measured 1,150 in the same run: each
 derived value kept as it is beside its family's count (two small ints a transmission), not
-in a ``(count, value)`` tuple of its own (five, 56 bytes each). The events are made before
-and not counted.
+in a ``(count, value)`` tuple of its own (five, 56 bytes each); then 832 with equal texts
+held once (interned: the bus repeats ten commands). The events are made before and not
+counted.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from conformance.transcript import BUS
 from conformance.view.segments import read_view
 
 BENCH = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
-BYTES_PER_TRANSMISSION = 1_000  # 884 measured (window11); base-s58 1,150, 689a849 1,924
+BYTES_PER_TRANSMISSION = 950  # 832 measured (window11); base-s58 1,150, 689a849 1,924
 
 
 def busy_events(seconds: float):
@@ -104,3 +105,13 @@ def test_a_text_that_parses_as_no_command_is_parsed_once(monkeypatch):
     monkeypatch.setattr(segments, "parse_command", counted)
     assert [t.command for _ in range(5)] == [None] * 5
     assert calls == ["0D0"]
+
+
+def test_equal_texts_are_held_once():
+    """The bus's repeated commands: one string each, however many transmissions send it."""
+    view = read_view(busy_events(20))
+    by_text: dict[str, set[int]] = {}
+    for t in view.transmissions:
+        by_text.setdefault(t.text, set()).add(id(t.text))
+    assert len(view.transmissions) > 2 * len(by_text)
+    assert all(len(ids) == 1 for ids in by_text.values()), by_text
