@@ -78,6 +78,13 @@ class Decoded:
     marking_before: float | None = None
 
 
+def character_problems(problems: Iterable[Decoded]) -> list[Decoded]:
+    """The problems of characters among ``problems`` (a decode's: a framing or parity
+    error, a glitch inside), all a judgement reads of them (the decode-quality notes); the
+    breaks and pulses among them are counted apart and are events too."""
+    return [p for p in problems if p.kind == "char" and p.event is not None]
+
+
 #: Frame shapes (a frame's edges relative to its start bit, and the bit time it is read with)
 #: whose reading is kept: a bus repeats the same few hundred shapes, and reading one again is
 #: most of a decode's time (an hour at 1 MHz: millions of frames). Kept per line and process

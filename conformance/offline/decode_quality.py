@@ -18,6 +18,7 @@ from itertools import islice
 from operator import le
 from typing import Any
 
+from ..capture.uart import character_problems
 from ..tool_recorder.records import Exchange
 from ..transcript import Event, EventKind
 
@@ -85,11 +86,7 @@ def problems_by_character(decoded: Any) -> dict[tuple[float, int], Any]:
     start and byte of their character, not its identity: a decode that widened its stamps
     (the glitch filter beside an edge) holds new events, its problems the ones it first
     read."""
-    return {
-        (p.event.start, p.event.wire): p
-        for p in decoded.problems
-        if p.kind == "char" and p.event is not None
-    }
+    return {(p.event.start, p.event.wire): p for p in character_problems(decoded.problems)}
 
 
 class Quality:

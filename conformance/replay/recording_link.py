@@ -175,6 +175,7 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
         )  # fmt: skip
         return RecordingLink(spec, info, Transcript(list(recording.events)), uncertainty, notes)
     from ..capture import decode_capture  # the decoder (and numpy) only for a capture
+    from ..capture.uart import character_problems
 
     try:
         decoded = decode_capture(
@@ -192,6 +193,10 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
     # the decode's own list becomes the transcript's (nothing reads a loaded capture's
     # ``decoded.events`` again): an hour's capture held one list of its events, not two
     events, decoded.events = decoded.events, []
+    # of the decode's problems a judgement reads its characters' alone (the decode-quality
+    # notes): a busy bus's every break was one more object held to the end (issue 22: an
+    # hour's 14,875, 1.9 MB); a new list, since a decode kept for another caller shares it
+    decoded.problems = character_problems(decoded.problems)
     info = LinkInfo(
         kind=f"capture {decoded.format}", can_break=False,
         timing_uncertainty=decoded.uncertainty_s,
