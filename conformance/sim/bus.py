@@ -240,6 +240,8 @@ class SimBus:
 class SimLink(Link):
     """The tool's end of a :class:`SimBus`."""
 
+    reads_line_at_once = True  # receive's idle counts from a LineEnd's before (Link)
+
     def __init__(self, bus: SimBus) -> None:
         self.bus = bus
         self.transcript = bus.transcript
@@ -272,6 +274,9 @@ class SimLink(Link):
         got: list[Event] = []
         bus = self.bus
         rx = bus.rx  # the bus's one queue (cleared in place, never replaced): per character
+        # the line's characters before this read: the idle counts from the last of them
+        # until one of the read's own has come (reads_line_at_once)
+        before = until.before if idle is not None and type(until) is LineEnd else None
         while True:
             if rx:
                 got.append(rx.popleft())
@@ -279,8 +284,10 @@ class SimLink(Link):
                     return got
                 continue
             limit = deadline
-            if idle is not None and got:
-                limit = min(limit, got[-1].end + idle)
+            if idle is not None:
+                last = got[-1] if got else before[-1] if before else None
+                if last is not None:
+                    limit = min(limit, last.end + idle)
             run = bus.planned_run()
             if run is not None:
                 ended, limit = self._take_run(run, got, limit, deadline, until, idle)
