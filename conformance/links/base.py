@@ -144,6 +144,14 @@ class Link(BusEnd):
     deadline, so a silent or babbling device can never hang the tool.
     """
 
+    #: This class's ``receive``, given ``idle`` and a :class:`LineEnd` whose ``before`` holds
+    #: characters, counts the idle from the last of those until one of its own has come, so
+    #: the rest of a one-line reply is one call (the tool recorder's read,
+    #: :meth:`~conformance.tool_recorder.engine.ToolRecorder._listen`) instead of one a
+    #: window of ``idle`` (issue 22: ~6 characters a call, 4.6 calls a reply). Read off the
+    #: class, so a wrapper that forwards attributes to a link does not pass it on.
+    reads_line_at_once: bool = False
+
     @abstractmethod
     def send_break(self, duration: float, *, exact: bool = False) -> Event:
         """Hold spacing for ``duration`` s; return the break as achieved.

@@ -15,7 +15,7 @@ import contextlib
 from itertools import repeat
 from operator import attrgetter, is_
 
-from ..links.base import Link
+from ..links.base import LineEnd, Link
 from ..links.errors import BreakUnsupported
 from ..protocol import commands as cmds
 from ..protocol.commands import (
@@ -45,6 +45,7 @@ from .hooks import Hooks
 from .policy import Policy
 from .records import CONTENTION, IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
 from .reply_end import Framing
+from .validity import ends_line
 
 #: After this many holds that reached ``max_hold`` (a DUT that never goes quiet), later holds
 #: are bounded by the turnaround: waiting a second before every command of the run would
@@ -602,6 +603,11 @@ class ToolRecorder:
             return [], NO_REPLY, collided
         deadline = framing.deadline(first[0])
         chars = first
+        if getattr(type(self.link), "reads_line_at_once", False) and not (
+            framing.binary or framing.multiline
+        ):
+            reply, state = self._rest_of_line(chars, deadline, framing)
+            return reply, state, collided
         while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
             # Each read ends a window after the last character so far: the link's own idle
             # rule only starts once that read has received something.
@@ -618,6 +624,26 @@ class ToolRecorder:
         if framing.finished(chars):
             return chars, None, collided
         return chars, TOO_LONG if len(chars) >= framing.limit(chars) else IDLE, collided
+
+    def _rest_of_line(
+        self, chars: list[Event], deadline: float, framing: Framing
+    ) -> tuple[list[Event], str | None]:
+        """:meth:`_listen`'s loop for a one-line 7E1 reply on a link that
+        :attr:`~conformance.links.base.Link.reads_line_at_once`: one read to the CR LF, the
+        reply's limit, the marking of ``framing.idle`` after a character or ``deadline``,
+        what the loop's reads of one idle window each came to (each began a window after
+        the last character so far, and its idle rule after each of its own: a character is
+        taken exactly when it starts within ``idle`` of the one before and before
+        ``deadline``, however the reads are cut). Returns the characters and the reason
+        (None: complete, to be checked)."""
+        limit = framing.max_chars
+        if not (ends_line(chars) or len(chars) >= limit):
+            chars = chars + self.link.receive(
+                deadline, until=LineEnd(chars, limit), idle=framing.idle
+            )
+        if ends_line(chars):
+            return chars, None
+        return chars, TOO_LONG if len(chars) >= limit else IDLE
 
     def _judge_reply(
         self,

@@ -290,6 +290,25 @@ def test_a_command_with_gaps_and_a_restamping_transcript_is_written_as_before(
     assert written(False) == written(True)
 
 
+def _windowed(link: SimLink, deadline: float, stop: object, idle: float) -> list:
+    """A ``LineEnd`` read on from characters before it, as the tool recorder's loop read one
+    before ``reads_line_at_once``: a receive per ``idle`` window after the last character
+    so far, its stop a plain function called per character. What the sim link's one read
+    (the idle counted from ``stop.before``'s last) must come to."""
+    from conformance.links.base import LineEnd
+
+    got: list = []
+    while True:
+        before = stop.before + got  # type: ignore[attr-defined]
+        window = LineEnd(before, stop.most)  # type: ignore[attr-defined]
+        more = link.receive(
+            min(deadline, before[-1].end + idle), until=lambda g, s=window: s(g), idle=idle
+        )
+        got += more
+        if not more or window(more):
+            return got
+
+
 def _line_reads(inline: bool, restamp: bool = False) -> list:
     """Reads of ``_Talker``'s replies each stopped by a ``LineEnd`` (as the tool recorder
     reads a one-line reply), checked inline by the sim link's run (``inline``) or called
@@ -315,8 +334,12 @@ def _line_reads(inline: bool, restamp: bool = False) -> list:
         if fresh:
             before = []
         stop = LineEnd(list(before), most)
-        until = stop if inline else (lambda got, stop=stop: stop(got))
-        got = link.receive(link.now() + ahead, until=until, idle=idle)
+        if inline:
+            got = link.receive(link.now() + ahead, until=stop, idle=idle)
+        elif idle is not None and before:
+            got = _windowed(link, link.now() + ahead, stop, idle)
+        else:
+            got = link.receive(link.now() + ahead, until=lambda g, s=stop: s(g), idle=idle)
         before += got
         found.append(([(e.start, e.end, e.wire) for e in got], link.now()))
     return [found, list(link.transcript.events)]
