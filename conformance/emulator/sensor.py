@@ -175,6 +175,7 @@ class SensorEmulator:
 
     def on_char(self, wire: int, start: float, end: float) -> None:
         b = self.behaviour
+        self._tx.line_taken_until(end)  # a frame of ours planned inside it waits for it
         report = self._report
         if report is not None and report.sent == 0:
             # the firmware reports an aborted measurement only to a line left quiet

@@ -104,10 +104,34 @@ class Transmitter:
         marking the sensor puts between its characters (an ``inter-char-gap`` sensor's 3 ms)."""
         end = item.end
         for other in sorted(self.queue, key=lambda t: t.start):
-            if other.sent == 0 and item.start <= other.start < end + CHAR_TIME:
+            if (
+                other is not item
+                and other.sent == 0
+                and item.start <= other.start < end + CHAR_TIME
+            ):
                 other.start = end + CHAR_TIME
                 end = other.end
                 self._offered = None  # its frames are not where they were offered
+
+    def line_taken_until(self, end: float) -> None:
+        """Another talker's character held the one wire until ``end``: the bus sends this
+        device's next frame, if planned before then, at ``end``. A sensor that puts marking
+        between its characters (a gap or a pause) keeps it after that frame, so the rest of
+        the transmission moves with it, and what waits for it moves after it (as
+        :meth:`_make_way`). Without this the frames that fell due meanwhile went out back to
+        back at the bus's ``max(start, now)``, an ``inter-char-gap`` sensor's reply that met a
+        retry showing 8.33 ms spacings it never sends (truth19). A reply without marking
+        goes out back to back either way: it is left as planned (the same frames)."""
+        if not self.queue:
+            return
+        item = self.queue[0]
+        if not item.gap and not item.pauses:
+            return
+        late = end - item.frame_start(item.sent)
+        if late > 0:
+            item.start += late
+            self._offered = None  # its frames are not where they were offered
+            self._make_way(item)
 
     def cancel(self, keep: Callable[[Transmission], bool] | None = None) -> None:
         """Drop pending output (all of it, or what ``keep`` rejects)."""

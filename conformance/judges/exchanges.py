@@ -50,7 +50,7 @@ from .late_before import (
     late_shown,
 )
 from .measurements import shown_reply_ids, undecide_uncompared_crc
-from .support import text_instead_of_values
+from .support import serves_continuous, text_instead_of_values
 from .tally import Tally
 from .wire import EARLY_WINDOW
 
@@ -332,15 +332,23 @@ def continuous(
     """R0..R9 / RC0..RC9 replies: format like D replies, <=75 characters, CRC on RC, and the
     empty reply for an index the sensor does not serve (R-4.4.8.1-01/-03)."""
     tally = Tally(ids)
-    unsupported = 0
+    unsupported = unread = 0
     for _index, pair in sorted(exchanges.items()):
+        # an index whose other command returned values is served: the empty-reply rule is
+        # not this pair's; else a late reply may be the unsupported index's, unread
+        served = any(serves_continuous(ex) for ex in pair)
         for ex in pair:
             label = escape(ex.text)
             # a late reply's CRC (or its absence) is not judged either: it may be cut by the
             # retries; undecided, so the D replies' PASS does not stand for it (seed 4262,
-            # continuous-crc-missing + replies-after-retry: R-4.4.12-02 PASSed on 0MC!/0CC!)
+            # continuous-crc-missing + replies-after-retry: R-4.4.12-02 PASSed on 0MC!/0CC!).
+            # Nor is its empty form: replies-after-retry's aRC2!..aRC9! came only late, and
+            # R-4.4.8.1-03 PASSed "conforms (8 checked: 0R2!..0R9!)" beside
+            # unsupported-rc-without-crc, whose deviation is in those replies (truth19)
             crc_rule = "R-4.4.12-02" if ex.command is not None and ex.command.crc else "R-4.4.12-03"
-            if undecided_if_late(tally, ex, ["R-4.4.8.1-01", crc_rule]):
+            empty_rule = [] if served else ["R-4.4.8.1-03"]
+            if undecided_if_late(tally, ex, ["R-4.4.8.1-01", crc_rule, *empty_rule]):
+                unread += bool(empty_rule)
                 continue
             if not ex.answered or ex.command is None:
                 tally.fail("R-4.4.8.1-01", label, f"{label} got no reply")
@@ -382,7 +390,7 @@ def continuous(
                 check_data_sequence([reply], len(reply.values), VALUES_MAX),
                 ids=["R-4.4.8.3-01"] if "R-4.4.8.3-01" in tally.ids else [],
             )
-    if not unsupported:
+    if not unsupported and not unread:
         tally.not_applicable("R-4.4.8.1-03", "every R0..R9 returned values; no unsupported index")
     return tally.findings()
 

@@ -383,6 +383,10 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("parity-error", "replies-after-retry"),
     # 0HA!'s late reply unread: R-4.4.8-03/-04 PASSed on the starts read (seed 4900)
     ("high-volume-two-digit-count", "replies-after-retry"),
+    # (truth19) the sim's one wire sent the late reply's frames that fell due under the
+    # retry back to back: inter-char-gap's 3 ms gaps vanished (R-4.1-01 PASSed on 8.33 ms
+    # spacings) and the reply came back shuffled with the retry (8 false FAILs)
+    ("inter-char-gap", "replies-after-retry"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

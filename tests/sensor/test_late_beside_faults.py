@@ -91,3 +91,15 @@ def test_r_4_4_8_03_counts_of_late_starts_unread_are_not_a_pass() -> None:
         assert any(
             "not every start's count was read" in f["detail"] for f in found[rid]["findings"]
         )
+
+
+def test_r_4_4_8_1_03_unsupported_crc_forms_answered_late_are_not_a_pass() -> None:
+    """unsupported-rc-without-crc + replies-after-retry (truth19; continuous-over-75 beside
+    them, seed 5000-5030's triples, the same): aRC2!..aRC9!, the fault's own replies, came
+    only after the reply window, and the empty-reply rule PASSed "conforms (8 checked: 0R2!,
+    ..., 0R9!)" on the plain ones: a missed FAIL. INCONCLUSIVE, naming the late replies."""
+    found = _row(
+        "replies-after-retry,unsupported-rc-without-crc", "test_continuous_replies", "R-4.4.8.1-03"
+    )
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # PASS before
+    assert "0RC2! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
