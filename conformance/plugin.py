@@ -304,6 +304,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         config.stash[OWN_GUARD] = True
     if PACE not in config.stash:
         config.stash[PACE] = gc_pace.slow_down()  # the suite is loaded: the run starts
+    give_case_records(config, items)
+
+
+def give_case_records(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """A fresh :class:`CaseRecord` on every conformance case among ``items``, for the run
+    about to start (one session judging many runs gives each its own: ``many_runs``)."""
     for item in items:
         marker = item.get_closest_marker("requirements")
         if marker is None:
@@ -427,6 +433,14 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if RUN in session.config.stash:  # else each run was finished as it ended (many_runs)
+        finish_run(session, exitstatus)
+
+
+def finish_run(session: pytest.Session, exitstatus: int) -> None:
+    """The run's end once its cases are done or it was stopped (``exitstatus``: pytest's for
+    the session, or the run's own in a session judging many): decide, write the reports,
+    close the link."""
     run = run_of(session.config)
     guarded = GUARD.installed
     late_interrupt = guarded and GUARD.close()  # from here on Ctrl-C cannot change the run
@@ -460,13 +474,19 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     pace = config.stash.get(PACE, None)
     if pace is not None:
         gc_pace.restore(pace)
-    locked = config.stash.get(LOCKED, None)
-    if locked is not None:
-        report_folder.release(locked)
+    release_report_folder(config)
     if config.stash.get(OWN_GUARD, False):
         GUARD.uninstall()
         GUARD.reset()
     detach_run(config)
+
+
+def release_report_folder(config: pytest.Config) -> None:
+    """Let go of the report folder :func:`check_reports_writable` took for the run."""
+    locked = config.stash.get(LOCKED, None)
+    if locked is not None:
+        report_folder.release(locked)
+        del config.stash[LOCKED]
 
 
 def detach_run(config: pytest.Config) -> None:
