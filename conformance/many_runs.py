@@ -39,6 +39,9 @@ import pytest
 
 from . import plugin
 from .interrupts import GUARD
+from .options import UsageError, check_values
+from .ports import PortError
+from .preflight import check_role_options
 from .report_folder import run_folder
 from .run import ConformanceRun, GivenOptions, RunOptions
 from .suite import suite_args
@@ -87,13 +90,16 @@ class ManyRuns(Generic[T]):
     ) -> bool:
         """Whether a run asked for with these arguments is one this session can judge as
         a session of its own would: the same cases kept, no report page, no output, no
-        other plugin."""
+        other plugin, options the plugin's configure takes (a refusal, or a declaration to
+        read, is left to a session of its own: its errors are that session's)."""
         return (
             self.session is not None
             and plugin.RUN not in self.session.config.stash  # not inside another run
             and cases in (None, f"testcases.{options.role}")
             and not (html or terminal or plugins or html_aside)
+            and options.declaration is None
             and selection_key(options) == selection_key(self.template)
+            and _usable(options)
         )
 
     @pytest.hookimpl(tryfirst=True)
@@ -171,6 +177,18 @@ class ManyRuns(Generic[T]):
         if session.testsfailed:
             return int(pytest.ExitCode.TESTS_FAILED)
         return int(pytest.ExitCode.OK if items else pytest.ExitCode.NO_TESTS_COLLECTED)
+
+
+def _usable(options: RunOptions) -> bool:
+    """Whether the plugin's configure takes ``options`` (its checks, as it makes them)."""
+    try:
+        check_values(vars(options), plugin=True)
+        check_role_options(
+            options.role, options.trigger, options.address, options.sweep, options.job_timeout
+        )
+    except (UsageError, PortError):
+        return False
+    return True
 
 
 def serving(

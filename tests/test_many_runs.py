@@ -118,3 +118,16 @@ def test_matrix_rows_made_in_batches_are_the_rows_made_alone():
     assert run_rows(items, row_through_capture, 1, role="sensor") == alone
     assert run_rows(items, row_through_capture, 2, role="sensor") == alone
     assert all(row.exact for row in alone)
+
+
+def test_a_run_its_options_refuse_gets_a_session_of_its_own(tmp_path):
+    def refused(folder: Path) -> tuple[bool, int, bool]:
+        folder.mkdir()
+        given = RunOptions(port="sim", address="!!", report_dir=str(folder))
+        served = many_runs.serving(given, None, False, False, (), False) is not None
+        result = conduct(given, html=False, rootdir=folder, files=())
+        return served, result.pytest_code, result.run is None
+
+    alone = refused(tmp_path / "alone")
+    assert many_runs.judged_in_one_session(lambda: refused(tmp_path / "together")) == alone
+    assert alone == (False, int(pytest.ExitCode.USAGE_ERROR), True)
