@@ -84,6 +84,7 @@ class Phases:
 
 try:  # a tree whose matrix judges its rows' runs in one pytest session
     import conformance.many_runs as many_runs
+    import conformance.many_runs_plugin as many_runs_plugin
 except ImportError:
     many_runs = None
 # an older tree has no such module, but an editable install's finder may supply another's
@@ -92,14 +93,14 @@ if many_runs is not None and Path(many_runs.__file__).parent != own:
     many_runs = None
 shared = Phases()
 if many_runs is not None:
-    run_items = many_runs.ManyRuns._run_items
+    run_items = many_runs_plugin._run_items
     def timed_items(session):
         t = now()
         try:
             return run_items(session)
         finally:
             shared.t["loop"] = now() - t
-    many_runs.ManyRuns._run_items = staticmethod(timed_items)
+    many_runs_plugin._run_items = timed_items
 
 conduct = sensor_matrix.conduct
 def timed_conduct(options, **kw):
