@@ -17,7 +17,13 @@ row's ``time.process_time`` into:
 - ``live.cases``, ``replay.cases``: the case functions themselves (stimulus and judging);
 - ``export``: the run's events to the held ``.sr`` capture; ``plan``: its decode and the
   replay's options (``offline.judge.plan``);
-- ``rest``: the row less all of those (events read back, verdicts compared, folders).
+- ``rest``: the row less all of those (events read back, verdicts compared, folders; in a
+  tree that judges a batch of runs in one pytest session, ``conformance.many_runs``, as the
+  matrices do, that session's start and end, shared by the rows).
+
+In such a tree the rows are made in one session as ``fault_matrix`` makes a batch, and a
+run's ``session`` is what its run costs outside the items' protocol (its records, report
+folder, finish).
 
 and the cases that cost most (both halves together). Figures are ms of CPU per row. A
 benchmark, not a test: the instrumentation (a pytest plugin and three wrapped functions)
@@ -35,6 +41,7 @@ from tree_process import start_in_tree
 
 ONE_TREE = r"""
 import json, sys, time
+from pathlib import Path
 import pytest
 import conformance.capture.export as export_module
 import conformance.matrices.roundtrip as roundtrip
@@ -75,11 +82,39 @@ class Phases:
             self.t["calls"] += spent
             cases[pyfuncitem.name] = cases.get(pyfuncitem.name, 0.0) + spent
 
+try:  # a tree whose matrix judges its rows' runs in one pytest session
+    import conformance.many_runs as many_runs
+    import conformance.many_runs_plugin as many_runs_plugin
+except ImportError:
+    many_runs = None
+# an older tree has no such module, but an editable install's finder may supply another's
+own = Path(judge_module.__file__).parents[1]
+if many_runs is not None and Path(many_runs.__file__).parent != own:
+    many_runs = None
+shared = Phases()
+if many_runs is not None:
+    run_items = many_runs_plugin._run_items
+    def timed_items(session):
+        t = now()
+        try:
+            return run_items(session)
+        finally:
+            shared.t["loop"] = now() - t
+    many_runs_plugin._run_items = timed_items
+
 conduct = sensor_matrix.conduct
 def timed_conduct(options, **kw):
     half = "live" if str(options.port).startswith("sim") else "replay"
-    phases = Phases()
-    kw["plugins"] = [*kw.get("plugins", ()), phases]
+    serving = many_runs is not None and many_runs._SERVING is not None
+    if serving:  # the session's own plugin, its figures cleared for this run
+        config = many_runs._SERVING.session.config
+        if not config.pluginmanager.is_registered(shared):
+            config.pluginmanager.register(shared)
+        phases = shared
+        phases.t = {"setup": 0.0, "calls": 0.0}
+    else:
+        phases = Phases()
+        kw["plugins"] = [*kw.get("plugins", ()), phases]
     t = now()
     result = conduct(options, **kw)
     total, t = now() - t, phases.t
@@ -108,9 +143,10 @@ def item(name):
     return (name, tuple(spec.violates), getattr(spec, "version", None) or "14", ())
 roundtrip.row_through_capture(item(names[0]))  # imports and first-use caches: not counted
 acc.clear(); cases.clear()
-exact, t = 0, now()
-for name in names:
-    exact += roundtrip.row_through_capture(item(name)).exact
+t = now()
+def rows():
+    return sum(roundtrip.row_through_capture(item(name)).exact for name in names)
+exact = rows() if many_runs is None else many_runs.judged_in_one_session(rows)
 total = now() - t
 n = len(names)
 phases = {k.replace("export_events", "export"): round(v / n * 1e3, 1) for k, v in acc.items()}

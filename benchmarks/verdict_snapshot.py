@@ -7,6 +7,10 @@ and the tool version. Run it from each tree and diff the folders::
     PYTHONPATH=OLD python benchmarks/verdict_snapshot.py /tmp/snap-old
     PYTHONPATH=NEW python benchmarks/verdict_snapshot.py /tmp/snap-new
     diff -r /tmp/snap-old /tmp/snap-new
+
+``--one-session``: the sensor runs are judged a batch at a time in one pytest session
+(``conformance.many_runs``, as the fault matrices judge theirs), the recorder runs each in a
+session of its own: the snapshot must not change either.
 """
 
 from __future__ import annotations
@@ -68,6 +72,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out", type=Path)
     parser.add_argument("--processes", type=int, default=2)
     parser.add_argument("--only", nargs="*", help="names (as the files are named) to run")
+    parser.add_argument(
+        "--one-session", action="store_true", help="sensor runs a batch at a time in one session"
+    )
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     runs = [i for i in items() if not args.only or i[0] in args.only]
@@ -80,6 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         partial(snap, out=str(args.out)),
         args.processes,
         lambda done, total, name: print(f"{done}/{total} {name}", file=sys.stderr),
+        **({"role": "sensor"} if args.one_session else {}),
     )
     return 0
 

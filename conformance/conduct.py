@@ -67,6 +67,11 @@ def conduct(
     """
     import pytest
 
+    from .many_runs import serving
+
+    shared = serving(options, cases, html, terminal or verbose, tuple(plugins), html_aside)
+    if shared is not None:  # a batch of runs judged in one pytest session (many_runs)
+        return shared.judge(options, files)
     report_dir = run_folder(options.report_dir, options.role)
     options = replace(options, report_dir=str(report_dir))
     argv = suite_args(

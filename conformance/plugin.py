@@ -78,6 +78,8 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "bus: a bus case, run only when the DUT shares its line with other sensors"
     )
+    if not config.pluginmanager.has_plugin("sdi12-run-fixtures"):
+        config.pluginmanager.register(RunFixtures(config), "sdi12-run-fixtures")
     if not config.pluginmanager.has_plugin("sdi12-whole-run-last"):
         config.pluginmanager.register(whole_run.WholeRunLast(), "sdi12-whole-run-last")
     options = RunOptions.from_config(config)
@@ -110,9 +112,36 @@ def run_of(config: pytest.Config) -> ConformanceRun:
     return config.stash[RUN]
 
 
-@pytest.fixture(scope="session")
-def sdi12_run(request: pytest.FixtureRequest) -> ConformanceRun:
-    return run_of(request.config)
+class RunFixtures:
+    """A pytest plugin object, one a session: the ``sdi12_run`` and ``case`` fixtures, taken
+    from the session's config and the case being run rather than from ``request``. pytest
+    9 makes a new fixture definition for ``request`` (reading a lambda's signature, 40-60 us)
+    each time a fixture that takes it is looked up, cached or not: four a case when these
+    took it (``case`` three times, ``sdi12_run`` once through ``sensor``), ~30 ms of a
+    fault-matrix row's two runs (issue 22)."""
+
+    def __init__(self, config: pytest.Config) -> None:
+        self.config = config
+        self.item: pytest.Item | None = None  # the case being run
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_protocol(self, item: pytest.Item):
+        self.item = item
+        try:
+            return (yield)
+        finally:
+            self.item = None
+
+    @pytest.fixture(scope="session")
+    def sdi12_run(self) -> ConformanceRun:
+        return run_of(self.config)
+
+    @pytest.fixture
+    def case(self, sdi12_run: ConformanceRun) -> Case:
+        """Record findings and evidence for the requirements the case's marker names."""
+        if self.item is None:
+            raise pytest.UsageError("`case` is a fixture of a case, asked for while it runs")
+        return case_of(self.item, sdi12_run)
 
 
 @pytest.fixture(scope="session")
@@ -139,13 +168,12 @@ def sensor(sdi12_run: ConformanceRun) -> SensorSession:
         sdi12_run.cut_short(str(exc), EXIT_INTERNAL, shown=f"link error: {exc}")
 
 
-@pytest.fixture
-def case(request: pytest.FixtureRequest, sdi12_run: ConformanceRun) -> Case:
-    """Record findings and evidence for the requirements the case's marker names."""
-    record = request.node.stash.get(CASE, None)
+def case_of(node: pytest.Item, sdi12_run: ConformanceRun) -> Case:
+    """The ``case`` fixture's value for the case ``node``."""
+    record = node.stash.get(CASE, None)
     if record is None:
-        raise pytest.UsageError(f"{request.node.nodeid} uses `case` without @requirements")
-    lacking = missing_capabilities(request.node, sdi12_run)
+        raise pytest.UsageError(f"{node.nodeid} uses `case` without @requirements")
+    lacking = missing_capabilities(node, sdi12_run)
     if lacking:  # the link cannot do what the case needs: an honest INCONCLUSIVE, not a verdict
         reason = f"the {sdi12_run.link.info.kind} link cannot {' or '.join(lacking)}"
         for rid in record.requirements:
@@ -154,9 +182,9 @@ def case(request: pytest.FixtureRequest, sdi12_run: ConformanceRun) -> Case:
         sdi12_run.cases.append(record)
         pytest.skip(f"INCONCLUSIVE: {reason}")
     try:
-        declared = preconditions.declared(request.node, record.requirements)
+        declared = preconditions.declared(node, record.requirements)
     except preconditions.PreconditionError as exc:
-        raise pytest.UsageError(f"{request.node.nodeid}: {exc}") from None
+        raise pytest.UsageError(f"{node.nodeid}: {exc}") from None
     return Case(record, version=lambda: sdi12_run.dut_version, preconditions=declared)
 
 
@@ -304,6 +332,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         config.stash[OWN_GUARD] = True
     if PACE not in config.stash:
         config.stash[PACE] = gc_pace.slow_down()  # the suite is loaded: the run starts
+    give_case_records(config, items)
+
+
+def give_case_records(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """A fresh :class:`CaseRecord` on every conformance case among ``items``, for the run
+    about to start (one session judging many runs gives each its own: ``many_runs``)."""
     for item in items:
         marker = item.get_closest_marker("requirements")
         if marker is None:
@@ -427,6 +461,14 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if RUN in session.config.stash:  # else each run was finished as it ended (many_runs)
+        finish_run(session, exitstatus)
+
+
+def finish_run(session: pytest.Session, exitstatus: int) -> None:
+    """The run's end once its cases are done or it was stopped (``exitstatus``: pytest's for
+    the session, or the run's own in a session judging many): decide, write the reports,
+    close the link."""
     run = run_of(session.config)
     guarded = GUARD.installed
     late_interrupt = guarded and GUARD.close()  # from here on Ctrl-C cannot change the run
@@ -460,13 +502,19 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     pace = config.stash.get(PACE, None)
     if pace is not None:
         gc_pace.restore(pace)
-    locked = config.stash.get(LOCKED, None)
-    if locked is not None:
-        report_folder.release(locked)
+    release_report_folder(config)
     if config.stash.get(OWN_GUARD, False):
         GUARD.uninstall()
         GUARD.reset()
     detach_run(config)
+
+
+def release_report_folder(config: pytest.Config) -> None:
+    """Let go of the report folder :func:`check_reports_writable` took for the run."""
+    locked = config.stash.get(LOCKED, None)
+    if locked is not None:
+        report_folder.release(locked)
+        del config.stash[LOCKED]
 
 
 def detach_run(config: pytest.Config) -> None:

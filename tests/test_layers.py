@@ -76,6 +76,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
         (
             "run",
             "conduct",
+            "many_runs",
             "offline",
             "options",
             "preflight",
@@ -92,7 +93,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     # what a run is rendered as: console, HTML, verdicts.json
     ("reports", ("reports", "run_notes")),
     # pytest's side: options, fixtures, hooks that turn findings into outcomes and reports
-    ("plugin", ("plugin",)),
+    ("plugin", ("plugin", "many_runs_plugin")),
     # the command line: the main command and the subcommands that render as they go
     ("cli", ("cli", "commands", "rack")),
 )

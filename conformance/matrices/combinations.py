@@ -211,7 +211,7 @@ def combination_matrix(
 ) -> list[ComboRow]:
     """One row per combination, ``processes`` at a time (spawned workers, like
     :func:`conformance.matrices.sensor_matrix.fault_matrix`)."""
-    return run_rows(combinations, combo_row, processes, progress)
+    return run_rows(combinations, combo_row, processes, progress, role="sensor")
 
 
 #: The CI selection: 27 pairs (seed 18) and 9 triples (seed 19), prefixes of the lists the

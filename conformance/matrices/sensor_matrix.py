@@ -12,6 +12,7 @@ import multiprocessing
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -179,7 +180,12 @@ def fault_matrix(
         (n, tuple(FAULTS[n].violates), getattr(FAULTS[n], "version", None) or V14, ())
         for n in names
     ]
-    return run_rows(items, row, processes, progress)
+    return run_rows(items, row, processes, progress, role="sensor")
+
+
+#: rows a worker makes in one pytest session at most (fewer when the rows are few: every
+#: worker should get about three batches, so none is left alone with a long last one)
+BATCH = 8
 
 
 def run_rows(
@@ -187,10 +193,13 @@ def run_rows(
     make: Callable[[ItemT], RowT],
     processes: int,
     progress: Callable[[int, int, RowT], None] | None = None,
+    role: str | None = None,
 ) -> list[RowT]:
-    """``make(item)`` for each item, ``processes`` at a time in spawned workers (each run is
-    a whole pytest session: a fresh process keeps runs apart), in the items' order;
-    ``progress(done, total, row)`` hears of each row as it arrives."""
+    """``make(item)`` for each item, ``processes`` at a time in spawned workers (a fresh
+    process keeps runs apart), in the items' order; ``progress(done, total, row)`` hears of
+    each row as it arrives. ``role``: the rows' ``role`` runs are judged a batch of rows at
+    a time in one pytest session (:func:`conformance.many_runs.judged_in_one_session`:
+    collected once, not once a run); None: each run a session of its own."""
     rows: list[RowT] = []
 
     def keep(made: RowT) -> None:
@@ -200,11 +209,33 @@ def run_rows(
 
     processes = min(processes, len(items))  # a worker for no row costs a whole start-up
     if processes <= 1:
-        for item in items:
-            keep(make(item))
+        if role is None:
+            for item in items:
+                keep(make(item))
+        else:
+            from ..many_runs import judged_in_one_session
+
+            judged_in_one_session(lambda: [keep(make(item)) for item in items], role)
         return rows
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(processes) as pool:
-        for made in pool.imap(make, items, chunksize=1):
-            keep(made)
+        if role is None:
+            for made in pool.imap(make, items, chunksize=1):
+                keep(made)
+            return rows
+        size = max(1, min(BATCH, len(items) // (3 * processes)))
+        batches = [list(items[i : i + size]) for i in range(0, len(items), size)]
+        for batch in pool.imap(partial(rows_in_one_session, make, role), batches, chunksize=1):
+            for made in batch:
+                keep(made)
     return rows
+
+
+def rows_in_one_session(
+    make: Callable[[ItemT], RowT], role: str, items: Sequence[ItemT]
+) -> list[RowT]:
+    """``make(item)`` for each item, their ``role`` runs judged in one pytest session (a
+    worker's batch in :func:`run_rows`)."""
+    from ..many_runs import judged_in_one_session
+
+    return judged_in_one_session(lambda: [make(item) for item in items], role)

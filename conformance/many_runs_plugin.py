@@ -1,0 +1,102 @@
+"""The session's side of :mod:`conformance.many_runs`: a pytest plugin (named with ``-p`` by
+:func:`~conformance.many_runs.judged_in_one_session`) whose run-test loop calls the batch's
+work and judges, as runs of their own, the runs the work conducts (that module's docstring
+says how a run is reset and ended)."""
+
+from __future__ import annotations
+
+from copy import deepcopy
+from dataclasses import replace
+
+import pytest
+
+from . import many_runs, plugin
+from .conduct import RunResult
+from .interrupts import GUARD
+from .report_folder import run_folder
+from .run import ConformanceRun, RunOptions, given_options
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtestloop(session: pytest.Session) -> bool | None:
+    config = session.config
+    batch = next(
+        (p for p in config.pluginmanager.get_plugins() if isinstance(p, many_runs.Batch)), None
+    )
+    given = given_options(config)
+    if batch is None or given is None:
+        return None  # not a batch's session
+    if session.testsfailed or config.option.collectonly:
+        return None  # pytest's own loop says why; the work runs with sessions of its own
+    selection = deepcopy(plugin.run_of(config).selection)
+    plugin.release_report_folder(config)
+    plugin.detach_run(config)  # the template run: never run, the items' records dropped
+    batch.run(ManyRuns(session, given.options, selection))
+    return True
+
+
+class ManyRuns:
+    """The session judging runs while its batch's work lasts (a
+    :class:`conformance.many_runs.Server`)."""
+
+    def __init__(self, session: pytest.Session, template: RunOptions, selection: object) -> None:
+        self.session = session
+        self.template = template
+        self.selection = selection  # what the collection kept and left out
+
+    def idle(self) -> bool:
+        return plugin.RUN not in self.session.config.stash
+
+    def judge(self, options: RunOptions, files: tuple[str, ...] | None) -> RunResult:
+        """One run in this session, as :func:`conformance.conduct.conduct` would make it in
+        a session of its own with ``html=False`` and nothing printed."""
+        session = self.session
+        config = session.config
+        report_dir = run_folder(options.report_dir, options.role)
+        options = replace(options, report_dir=str(report_dir))
+        run = ConformanceRun(options)
+        run.report_files = files
+        run.selection = deepcopy(self.selection)  # type: ignore[assignment]
+        config.stash[plugin.RUN] = run
+        try:
+            try:
+                plugin.check_reports_writable(config)
+            except pytest.UsageError:  # as a session's collection stops: no case, no verdict
+                return RunResult(int(pytest.ExitCode.USAGE_ERROR), report_dir, run)
+            if GUARD.requested:  # Ctrl-C between two runs: the batch stops here
+                raise KeyboardInterrupt
+            GUARD.reset()  # the last run's end closed it
+            plugin.give_case_records(config, session.items)
+            code = _run_items(session)
+            plugin.finish_run(session, code)
+            session._setupstate.teardown_exact(None)  # after a pytest.exit: as pytest's end
+            return RunResult(code, report_dir, run)
+        finally:
+            plugin.release_report_folder(config)
+            plugin.detach_run(config)
+
+
+def _run_items(session: pytest.Session) -> int:
+    """pytest's run-test loop over the session's items and the exit status pytest's session
+    would have ended with."""
+    session.testsfailed = 0
+    session.shouldstop = session.shouldfail = False
+    items = session.items
+    try:
+        for i, item in enumerate(items):
+            nextitem = items[i + 1] if i + 1 < len(items) else None
+            item.config.hook.pytest_runtest_protocol(item=item, nextitem=nextitem)
+            if session.shouldfail:
+                raise session.Failed(session.shouldfail)
+            if session.shouldstop:
+                raise session.Interrupted(session.shouldstop)
+    except session.Failed:
+        return int(pytest.ExitCode.TESTS_FAILED)
+    except (session.Interrupted, pytest.exit.Exception) as exc:
+        excinfo = pytest.ExceptionInfo.from_exception(exc)
+        session.config.hook.pytest_keyboard_interrupt(excinfo=excinfo)
+        returncode = getattr(exc, "returncode", None)
+        return int(pytest.ExitCode.INTERRUPTED if returncode is None else returncode)
+    if session.testsfailed:
+        return int(pytest.ExitCode.TESTS_FAILED)
+    return int(pytest.ExitCode.OK if items else pytest.ExitCode.NO_TESTS_COLLECTED)
