@@ -93,6 +93,7 @@ def _run_items(session: pytest.Session) -> int:
     except session.Failed:
         return int(pytest.ExitCode.TESTS_FAILED)
     except (session.Interrupted, pytest.exit.Exception) as exc:
+        _forget_request(items[i])  # the item the exit came out of
         excinfo = pytest.ExceptionInfo.from_exception(exc)
         session.config.hook.pytest_keyboard_interrupt(excinfo=excinfo)
         returncode = getattr(exc, "returncode", None)
@@ -100,3 +101,14 @@ def _run_items(session: pytest.Session) -> int:
     if session.testsfailed:
         return int(pytest.ExitCode.TESTS_FAILED)
     return int(pytest.ExitCode.OK if items else pytest.ExitCode.NO_TESTS_COLLECTED)
+
+
+def _forget_request(item: pytest.Item) -> None:
+    """What pytest's runtest protocol does at its end, which a ``pytest.exit`` inside it
+    skipped: the item's request and fixture values let go. Kept, the cut-short run's request
+    went on serving the item in the next run (its fixtures the old run's): a version-1.3 run
+    after a run stopped by "no device answered" ordered its measurements otherwise and left
+    R-4.4.12-01 unjudged (tests/test_many_runs.py)."""
+    if hasattr(item, "_request"):
+        item._request = False  # type: ignore[attr-defined]
+        item.funcargs = None  # type: ignore[attr-defined]
