@@ -98,8 +98,10 @@ class RecordedSensor:
         is_tool = np.array([o == TOOL for o in wire.origin], bool)
         kinds = wire.kinds()
         is_char = np.fromiter(map(is_, kinds, repeat(EventKind.CHAR)), bool, len(kinds))
-        if any(e.kind is not EventKind.CHAR and _played(e) for e in wire.made.values()):
-            return None  # a sensor's break (a harness's brk, recorded): played from the events
+        # the sensor's breaks (made events: a decoder makes each break) are played as its
+        # characters are, each where its column is among the replies
+        breaks = [i for i, m in wire.made.items() if m.kind is not EventKind.CHAR and _played(m)]
+        is_char[breaks] = True
         with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
             found = _from_arrays(s, e, u, is_tool, is_char)
             if found is None:
@@ -110,6 +112,9 @@ class RecordedSensor:
             tool_ends = e[is_tool].tolist()
         sensor = cls.__new__(cls)
         sensor._breaks = frozenset()
+        if breaks:
+            place = np.cumsum(is_reply) - 1  # each column's index among the replies
+            sensor._breaks = frozenset(int(place[i]) for i in breaks if is_reply[i])
         sensor._needs, sensor._touching = needs, touching
         sensor._tool = sensor._replies = None
         sensor._made_of = (wire, tool_mask, is_reply.tolist())
