@@ -48,6 +48,13 @@ class Behaviour:
     standby_after_service_request: bool = False  # True breaks R-7.1-02
     # -- transmitting ------------------------------------------------------------------------
     reply_delay: float = REPLY_DELAY
+    #: Spacing (s) the sensor holds from the command's end before its reply to it (0: none),
+    #: the reply's first start bit still ``reply_delay`` after the command's end: firmware
+    #: that "wakes the sensors" before every reply as a data recorder would (the 2013
+    #: Arduino-SDI-12 library's ``sendCommand`` -> ``wakeSensors()``, 12.1 ms: docs/kit.md,
+    #: twenty-fourth and twenty-fifth rounds). Only a reply's first line (multi-line text's
+    #: later lines and service requests answer no command just ended).
+    break_before_reply: float = 0.0
     char_gap: float = 0.0  # marking between reply characters (R-7.0-12)
     #: Hear no command between a command and the start of its reply: a firmware blocked in
     #: delay() before it replies (the Arduino Due sensor, docs/kit.md eighteenth round)

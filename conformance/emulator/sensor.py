@@ -106,6 +106,9 @@ class SensorEmulator:
         self._replied_last = False  # the last thing on the line was this sensor's own
         self._report: Transmission | None = None  # only a faulty sensor sets it (abort_reply)
         self._overheard = ""  # the last two characters heard (a bus fault's CR LF)
+        #: the command whose reply went out after a break of the sensor's own (only a faulty
+        #: sensor sets it: break_before_reply): its later lines follow without one
+        self._spaced_for: Command | None = None
 
     # -- introspection (tests, CLI) ----------------------------------------------------------
     @property
@@ -462,6 +465,21 @@ class SensorEmulator:
             # beside another fault's pause in the reply (ident-pause's in aI!'s), both hold
             pauses += ((len(rewritten.text()), stray),)
             rewritten = replace(rewritten, end=CRLF + b.stray_char)
+        spacing = b.break_before_reply
+        if spacing and reply.command is not None and reply.command is not self._spaced_for:
+            # the first line of its reply to a command: the break from the command's end
+            # (``at`` is reply_delay after it), the rest of reply_delay marking
+            self._spaced_for = reply.command
+            marking = max(b.reply_delay - spacing, 0.0)
+            return self._tx.schedule(
+                rewritten,
+                at,
+                b.char_gap,
+                b.char_time,
+                pauses=pauses,
+                spacing=spacing,
+                marking=marking,
+            )
         return self._tx.schedule(rewritten, at, b.char_gap, b.char_time, pauses=pauses)
 
     def _change_address(self, cmd: Command, at: float) -> None:

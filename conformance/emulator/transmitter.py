@@ -11,7 +11,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from ..protocol.timing import CHAR_TIME
-from ..sim.bus import Frame
+from ..sim.bus import BreakFrame, Frame
 from .replies import Reply, ReplyKind
 
 
@@ -29,6 +29,28 @@ class Transmission:
     #: reply); several faults' pauses in one reply each hold the frames from theirs on (an
     #: aI! reply with ident-pause's 4 ms inside and stray-after-line-end's 2 ms after its LF)
     pauses: tuple[tuple[int, float], ...] = ()
+    #: A break of the sensor's own before the first frame (s of spacing, 0.0: none), then
+    #: ``marking`` (s) before that frame: the line is the transmission's from
+    #: :attr:`begin`. Offered as a :class:`~conformance.sim.bus.BreakFrame` ahead of the
+    #: characters (the sim bus puts it in the transcript as the sensor's BREAK).
+    spacing: float = 0.0
+    marking: float = 0.0
+    spaced: bool = False  # the break has gone out
+
+    @property
+    def lead(self) -> float:
+        """The line time taken before the first frame: the break and the marking after it."""
+        return self.spacing + self.marking if self.spacing else 0.0
+
+    @property
+    def begin(self) -> float:
+        """Where the transmission takes the line: its break's start, else its first frame's."""
+        return self.start - self.lead if self.spacing else self.start
+
+    def spacing_frame(self) -> BreakFrame:
+        """The break before the first frame, as the bus takes it."""
+        end = self.start - self.marking
+        return BreakFrame(end - self.spacing, 0, self.spacing, end)
 
     def held(self, index: int) -> float:
         """The marking the pauses add before the frame at ``index``: 0.0 with none, else
@@ -85,12 +107,27 @@ class Transmitter:
         char_time: float = CHAR_TIME,
         *,
         pauses: tuple[tuple[int, float], ...] = (),
+        spacing: float = 0.0,
+        marking: float = 0.0,
     ) -> Transmission:
+        """``reply`` to go out at ``start`` (its first frame), or after the transmissions
+        already on the line then; ``spacing``: a break of the sensor's before it, ending
+        ``marking`` before its first frame (:attr:`Transmission.spacing`)."""
         wires = reply.wires()
+        lead = spacing + marking if spacing else 0.0
         for other in self.queue:
-            if other.start <= start < other.end + CHAR_TIME:
-                start = other.end + CHAR_TIME
-        item = Transmission(reply, start, wires, gap, char_time=char_time, pauses=pauses)
+            if other.begin <= start - lead < other.end + CHAR_TIME:
+                start = other.end + CHAR_TIME + lead
+        item = Transmission(
+            reply,
+            start,
+            wires,
+            gap,
+            char_time=char_time,
+            pauses=pauses,
+            spacing=spacing,
+            marking=marking,
+        )
         self._make_way(item)
         self.queue.append(item)
         self.queue.sort(key=lambda t: t.start)
@@ -107,9 +144,10 @@ class Transmitter:
             if (
                 other is not item
                 and other.sent == 0
-                and item.start <= other.start < end + CHAR_TIME
+                and not other.spaced
+                and item.begin <= other.begin < end + CHAR_TIME
             ):
-                other.start = end + CHAR_TIME
+                other.start = end + CHAR_TIME + other.lead
                 end = other.end
                 self._offered = None  # its frames are not where they were offered
 
@@ -147,6 +185,8 @@ class Transmitter:
         offered = self._offered
         if offered is not None and offered[0] is item and offered[1] == item.sent:
             return offered[2]  # a transmission is never changed once scheduled
+        if item.spacing and not item.spaced:
+            return item.spacing_frame()  # its break first (not kept: offered until taken)
         frame = item.frame(item.sent)
         self._offered = (item, item.sent, frame)
         return frame
@@ -154,13 +194,16 @@ class Transmitter:
     def ahead(self) -> Iterator[tuple[float, int, float]] | None:
         """The frames :meth:`next_frame` would offer one after the other while nothing
         changes the queue: the rest of its first transmission (``sim.bus.PlansFrames``).
-        None when there is none, or when its frames' ends might not rise (a gap or pause
-        shorter than nothing), which :meth:`pop_frames` relies on."""
+        None when there is none, when its frames' ends might not rise (a gap or pause
+        shorter than nothing), which :meth:`pop_frames` relies on, or while its break is
+        still to go (a frame of another kind)."""
         if not self.queue:
             return None
         item = self.queue[0]
         if item.char_time + item.gap <= 0 or any(extra < 0 for _, extra in item.pauses):
             return None
+        if item.spacing and not item.spaced:
+            return None  # its break goes first, frame by frame (the bus's BreakFrame)
         return item.rest()
 
     def pop_frames(self, count: int) -> tuple[float, Transmission]:
@@ -178,6 +221,9 @@ class Transmitter:
         item = self.queue[0]
         frame = self.next_frame()
         assert frame is not None
+        if type(frame) is BreakFrame:
+            item.spaced = True  # its characters follow
+            return frame, item
         item.sent += 1
         if item.done:
             self.queue.pop(0)

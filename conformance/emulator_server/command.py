@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import signal
 import threading
+from typing import TYPE_CHECKING
 
 from ..exits import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
 from ..links.priority import EMULATED_LINE, quick_gil_handover, realtime_priority
@@ -22,6 +23,9 @@ from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
 from .shared_line import SharedLine
 from .tap import TapServer, parse_tap
+
+if TYPE_CHECKING:
+    from ..emulator import SensorEmulator
 
 PORT_MAX = 65535
 
@@ -123,7 +127,7 @@ def make_device(version: str, address: str, faults: str) -> object:
 
     query = {"version": version, "address": address, "faults": faults}
     spec = parse_sim("sim://?" + urlencode(query))
-    return SensorEmulator(sim_profile(spec), spec.faults)
+    return _without_own_breaks([SensorEmulator(sim_profile(spec), spec.faults)])[0]
 
 
 def make_bus(version: str, sensors: str, faults: str) -> SharedLine:
@@ -134,7 +138,26 @@ def make_bus(version: str, sensors: str, faults: str) -> SharedLine:
     from ..ports import bus_emulators
 
     query = {"version": version, "sensors": sensors, "faults": faults}
-    return SharedLine(bus_emulators(parse_sim("sim://?" + urlencode(query))))
+    return SharedLine(_without_own_breaks(bus_emulators(parse_sim("sim://?" + urlencode(query)))))
+
+
+def _without_own_breaks(devices: list[SensorEmulator]) -> list[SensorEmulator]:
+    """``devices``, or :class:`PortError` naming a fault that breaks before its reply
+    (``break-before-reply``): the real-time line sends a device's frames as bytes, and a
+    sensor's break (a ``BreakFrame``) would go out as a NUL character; only ``sim`` puts it on
+    the line as spacing."""
+    from ..emulator import FAULTS
+
+    for device in devices:
+        if device.behaviour.break_before_reply:
+            named = ", ".join(
+                f for f in device.faults.names if FAULTS[f].settings.get("break_before_reply")
+            )
+            raise PortError(
+                f"fault {named}: a sensor's own break is not served on a real-time line "
+                "(it would go out as a NUL character); run it on --port sim"
+            )
+    return devices
 
 
 def serving_what(args: argparse.Namespace, bench: BenchModel) -> tuple[object, str]:

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 from ..links.base import LinkError
 from ..protocol.timing import BIT_TIME, CHAR_TIME
 from ..sim.bus import SENSOR_BREAK, BreakFrame, Frame
-from ..transcript import TOOL, Event, EventKind, escape
+from ..transcript import DUT, TOOL, Event, EventKind, escape
 
 if TYPE_CHECKING:
     import numpy as np
@@ -98,8 +98,10 @@ class RecordedSensor:
         is_tool = np.array([o == TOOL for o in wire.origin], bool)
         kinds = wire.kinds()
         is_char = np.fromiter(map(is_, kinds, repeat(EventKind.CHAR)), bool, len(kinds))
-        if any(e.kind is not EventKind.CHAR and _played(e) for e in wire.made.values()):
-            return None  # a sensor's break (a harness's brk, recorded): played from the events
+        # the sensor's breaks (made events: a decoder makes each break) are played as its
+        # characters are, each where its column is among the replies
+        breaks = [i for i, m in wire.made.items() if m.kind is not EventKind.CHAR and _played(m)]
+        is_char[breaks] = True
         with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
             found = _from_arrays(s, e, u, is_tool, is_char)
             if found is None:
@@ -110,6 +112,9 @@ class RecordedSensor:
             tool_ends = e[is_tool].tolist()
         sensor = cls.__new__(cls)
         sensor._breaks = frozenset()
+        if breaks:
+            place = np.cumsum(is_reply) - 1  # each column's index among the replies
+            sensor._breaks = frozenset(int(place[i]) for i in breaks if is_reply[i])
         sensor._needs, sensor._touching = needs, touching
         sensor._tool = sensor._replies = None
         sensor._made_of = (wire, tool_mask, is_reply.tolist())
@@ -373,8 +378,14 @@ def _from_arrays(
 
 def _played(e: Event) -> bool:
     """Whether the sensor's event ``e`` is one the replay plays: a character, or its break
-    (:data:`~conformance.sim.bus.SENSOR_BREAK`, a harness's ``brk``)."""
-    return e.kind is EventKind.CHAR or (e.kind is EventKind.BREAK and e.text == SENSOR_BREAK)
+    (:data:`~conformance.sim.bus.SENSOR_BREAK`, a harness's ``brk`` or an emulator's
+    ``break-before-reply``; in a decoded capture, spacing on the bus its recorder's TX
+    channel does not show, origin :data:`~conformance.transcript.DUT`, whatever its length
+    made its text: a capture of such a run replayed without it PASSed R-7.0-09 on a reply
+    20.5 ms after the command that the live run FAILed at 0.00 ms)."""
+    return e.kind is EventKind.CHAR or (
+        e.kind is EventKind.BREAK and (e.text == SENSOR_BREAK or e.origin == DUT)
+    )
 
 
 def same_action(recorded: Event, kind: EventKind, wire: int, length: float) -> bool:

@@ -19,26 +19,38 @@ from conformance.capture.columns import WireColumns
 from conformance.capture.export import TOOL_CHANNEL, export_events
 from conformance.replay import sensor as sensor_module
 from conformance.replay.sensor import _START_END, RecordedSensor, _touching_each, _worked_out
+from conformance.sim.bus import SENSOR_BREAK
 from conformance.transcript import DUT, TOOL, Event, EventKind
 from tests.support.capture_digest import traffic
 
 
-def event_by_event(events: list[Event]) -> tuple[list, list, list[int], list, list]:
+def played(e: Event) -> bool:
+    """A sensor's event the replay plays: a character, or a break of the sensor's (a sim
+    bus's, text :data:`SENSOR_BREAK`; a decoded capture's, origin DUT: spacing the
+    recorder's TX channel does not show)."""
+    return e.kind is EventKind.CHAR or (
+        e.kind is EventKind.BREAK and (e.text == SENSOR_BREAK or e.origin == DUT)
+    )
+
+
+def event_by_event(events: list[Event]) -> tuple[list, list, list[int], list, list, list]:
     """What :class:`RecordedSensor` worked out before the arrays, step by step, and what its
     replay reads of each reply (start, byte, length; floats by repr: NaN too)."""
     wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=_START_END)
     tool = [e for e in wire if e.origin == TOOL]
-    replies = [e for e in wire if e.origin != TOOL and e.kind is EventKind.CHAR]
+    replies = [e for e in wire if e.origin != TOOL and played(e)]
     starts = [e.start for e in tool]
     needs = [bisect_left(starts, r.start) for r in replies]
     read = [(repr(r.start), r.wire, repr(r.end - r.start)) for r in replies]
-    return tool, replies, needs, _touching_each(tool, replies, needs), read
+    breaks = [i for i, r in enumerate(replies) if r.kind is EventKind.BREAK]
+    return tool, replies, needs, _touching_each(tool, replies, needs), read, breaks
 
 
-def state(sensor: RecordedSensor) -> tuple[list, list, list[int], list, list]:
+def state(sensor: RecordedSensor) -> tuple[list, list, list[int], list, list, list]:
     starts, wires, lengths = sensor._reply_start, sensor._reply_wire, sensor._reply_length
     read = [(repr(s), w, repr(n)) for s, w, n in zip(starts, wires, lengths, strict=True)]
-    return sensor.tool, sensor.replies, sensor._needs, sensor._touching, read
+    breaks = sorted(sensor._breaks)  # which replies it plays as the sensor's breaks
+    return sensor.tool, sensor.replies, sensor._needs, sensor._touching, read, breaks
 
 
 def test_a_decoded_capture_takes_the_arrays_and_gives_the_same(tmp_path):

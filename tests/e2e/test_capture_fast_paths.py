@@ -22,7 +22,7 @@ from conformance.capture.writers import Channel
 from conformance.replay import recording
 from conformance.replay.recording import read_recording, write_recording
 from conformance.replay.sensor import LINE_FREE, RecordedSensor
-from conformance.sim.bus import Frame
+from conformance.sim.bus import BreakFrame, Frame
 from conformance.transcript import (
     DUT,
     TOOL,
@@ -319,7 +319,10 @@ def offer_worked_out(sensor: RecordedSensor) -> Frame | None:
         reply.uncertainty + before.uncertainty
     ):
         start = LINE_FREE
-    return Frame(start, reply.wire, reply.end - reply.start)
+    length = reply.end - reply.start
+    if reply.kind is EventKind.BREAK:  # the sensor's break, played as spacing that long
+        return BreakFrame(start, 0, length, 0.0 if start == LINE_FREE else start + length)
+    return Frame(start, reply.wire, length)
 
 
 @pytest.mark.parametrize(("seed", "uncertainty"), [(3, 0.0), (7, 0.0), (7, 1e-5), (8, 2e-3)])
@@ -370,11 +373,12 @@ def test_on_a_tie_the_tools_event_is_the_one_before_a_reply():
 
 def offered_one_by_one(sensor: RecordedSensor) -> list[tuple[float, int, float]]:
     """What :meth:`RecordedSensor.next_frame` offers frame after frame, each popped, while
-    the tool sends nothing: the straightforward reading of ``frames_ahead``. Works on a copy
-    (the sensor itself is left as it was)."""
+    the tool sends nothing, up to the sensor's next break (played frame by frame: the bus
+    commits a ``BreakFrame`` as spacing): the straightforward reading of ``frames_ahead``.
+    Works on a copy (the sensor itself is left as it was)."""
     twin = copy.copy(sensor)
     offered = []
-    while (frame := twin.next_frame()) is not None:
+    while (frame := twin.next_frame()) is not None and type(frame) is not BreakFrame:
         offered.append((frame.start, frame.wire, frame.duration))
         twin.pop_frame()
     return offered
@@ -393,20 +397,30 @@ def test_the_replayed_sensors_planned_replies_are_its_offers_in_turn(seed, uncer
     assert sensor._needs == [sum(t.start < r.start for t in tool) for r in sensor.replies]
     planned = popped = 0
     for n, e in enumerate([*tool, None]):
-        expected = offered_one_by_one(sensor)
-        ahead = sensor.frames_ahead()
-        assert (ahead is None) == (not expected)
-        if ahead is not None and (n % 3 or e is None):
-            got = list(ahead)
-            assert got == expected
-            take = len(got) if n % 2 or e is None else (len(got) + 1) // 2
-            twin = copy.copy(sensor)
-            for _ in range(take):
-                twin.pop_frame()
-            sensor.pop_frames(take)
-            assert (sensor.next_reply, sensor.next_frame()) == (twin.next_reply, twin.next_frame())
-            planned += take
-            popped += take
+        while True:  # once, or at the end until nothing is due
+            if n % 3 or e is None:
+                while type(sensor.next_frame()) is BreakFrame:  # the bus commits it alone
+                    sensor.pop_frame()
+                    popped += 1
+            expected = offered_one_by_one(sensor)
+            ahead = sensor.frames_ahead()
+            assert (ahead is None) == (not expected)
+            if ahead is not None and (n % 3 or e is None):
+                got = list(ahead)
+                assert got == expected
+                take = len(got) if n % 2 or e is None else (len(got) + 1) // 2
+                twin = copy.copy(sensor)
+                for _ in range(take):
+                    twin.pop_frame()
+                sensor.pop_frames(take)
+                assert (sensor.next_reply, sensor.next_frame()) == (
+                    twin.next_reply,
+                    twin.next_frame(),
+                )
+                planned += take
+                popped += take
+            if e is not None or ahead is None:
+                break
         if e is None:
             break
         shift = (n % 7 - 3) * 1e-4  # the tool now late, now early

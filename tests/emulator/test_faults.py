@@ -24,7 +24,8 @@ from conformance.protocol.responses import (
     parse_metadata_reply,
 )
 from conformance.protocol.timing import RESPONSE_START_MAX, RESPONSE_START_MIN, TOLERANCE
-from conformance.transcript import Event, decode_7e1
+from conformance.sim.bus import SENSOR_BREAK
+from conformance.transcript import DUT, TOOL, Event, EventKind, decode_7e1
 from tests.emulator.test_sensor import Answer, Rig
 
 M_VALUES = "+22.15+1013.2+45.7"
@@ -1014,6 +1015,41 @@ CHECKS.update(
         "answers-foreign-reply": check_answers_foreign_reply,
     }
 )
+
+
+def _sensor_breaks(rig: Rig, since: float) -> list[Event]:
+    """The sensor's breaks on the line from ``since`` (origin not the tool's)."""
+    return [
+        e
+        for e in rig.link.transcript.events
+        if e.kind is EventKind.BREAK and e.origin != TOOL and e.start >= since
+    ]
+
+
+def check_break_before_reply(rig: Rig) -> None:
+    """R-7.0-09, R-7.0-10: 12.1 ms of the sensor's own spacing from the command's end, 8.4 ms
+    of marking, then the reply 20.5 ms after the command; multi-line text's first line only
+    (its later lines answer no command just ended), no break with nothing to answer."""
+    for command in ("0!", "0I!"):
+        answer = rig.ask(command)
+        breaks = _sensor_breaks(rig, answer.command_end)
+        assert len(breaks) == 1
+        own = breaks[0]
+        assert own.origin == DUT and own.text == SENSOR_BREAK
+        assert own.start == pytest.approx(answer.command_end)
+        assert own.duration == pytest.approx(12.1e-3)
+        assert answer.delay == pytest.approx(20.5e-3)
+        assert answer.events[0].start - own.end == pytest.approx(8.4e-3)
+    rig.wake()
+    help_end = rig.send("0XHELP!")[-1].end
+    lines = decode_7e1(rig.listen(1.0, idle=0.1))
+    assert lines.count("\r\n") >= 2  # several lines, one break before the first
+    assert len(_sensor_breaks(rig, help_end)) == 1
+    silent_end = rig.ask("0XNONE!").command_end  # served by none: silence, and no break
+    assert _sensor_breaks(rig, silent_end) == []
+
+
+CHECKS["break-before-reply"] = check_break_before_reply
 
 
 def test_every_fault_has_a_check():

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 import serial
 
-from conformance.emulator_server.command import emulate_main, make_device
+from conformance.emulator_server.command import emulate_main, make_bus, make_device
 from conformance.emulator_server.process import EmulatorProcess
 from conformance.emulator_server.realtime import RealTimeLine
 from conformance.emulator_server.servers import TcpEmulatorServer, serve_serial
@@ -116,6 +116,16 @@ def test_make_device_takes_the_sim_url_parameters():
     assert device.address == "5" and not device.profile.v14
     with pytest.raises(PortError):
         make_device("1.4", "0", "no-such-fault")
+
+
+def test_a_sensors_own_break_is_refused_on_the_real_time_line():
+    """break-before-reply's break is a BreakFrame, which the real-time line would send as a
+    NUL byte: ``emulate`` refuses the fault (one sensor, or any sensor of a bus) by name."""
+    with pytest.raises(PortError, match="break-before-reply: a sensor's own break"):
+        make_device("1.4", "0", "break-before-reply")
+    with pytest.raises(PortError, match="break-before-reply"):
+        make_bus("1.4", "0,1:break-before-reply", "")
+    assert make_bus("1.4", "0,1", "wrong-crc").devices
 
 
 class _BatchingUart:

@@ -260,3 +260,20 @@ BOUNDARIES: tuple[Fault, ...] = (
         settings={"standby_marking": 108e-3},
     ),
 )
+
+
+#: A break from the sensor (docs/kit.md, twenty-fifth round): what the sim bus's sensor break
+#: (``sim.bus.BreakFrame``) shows in a fault-matrix row.
+SENSOR_BREAK: tuple[Fault, ...] = (
+    Fault(
+        "break-before-reply",
+        "The sensor holds the line spacing 12.1 ms from the end of every command it answers"
+        " (a break of its own), marks 8.4 ms and replies 20.5 ms after the command, as the"
+        " 2013 Arduino-SDI-12 library's sendCommand -> wakeSensors() does on a sensor built"
+        " as a recorder (the AgriApps sketch, docs/kit.md twenty-fifth round): no 8.33 ms"
+        " of marking before its first spacing (R-7.0-09, a recorder's UART reads a start"
+        " bit there) and its reply's first start bit past 15.40 ms (R-7.0-10).",
+        ("R-7.0-09", "R-7.0-10"),
+        settings={"break_before_reply": 12.1e-3, "reply_delay": 20.5e-3},
+    ),
+)
