@@ -15,19 +15,7 @@ from conformance.conduct import conduct
 from conformance.matrices.roundtrip import judged_events, live_run, row_through_capture
 from conformance.matrices.sensor_matrix import fault_port, run_rows
 from conformance.run import RunOptions
-
-#: what differs between any two runs of the same port: clocks and the tool's own CPU
-VOLATILE = frozenset(("started", "finished", "duration_s", "wall_s", "cpu_s", "manifest"))
-
-
-def steady(data: object) -> object:
-    """``data`` (a verdicts document) without its :data:`VOLATILE` keys."""
-    if isinstance(data, dict):
-        return {k: steady(v) for k, v in data.items() if k not in VOLATILE}
-    if isinstance(data, list):
-        return [steady(v) for v in data]
-    return data
-
+from tests.support.steady_verdicts import steady
 
 #: a run cut short before any case (no device at address 7), a fault of version 1.3, a
 #: fault's run, a clean run: each after the others in one session

@@ -34,6 +34,7 @@ from conformance.transcript import (
 )
 from tests.support.capture_digest import traffic  # noqa: E402
 from tests.support.shared_runs import copied_run  # noqa: E402
+from tests.support.steady_verdicts import steady  # noqa: E402
 
 RATES = st.sampled_from([1_000.0, 48_000.0, 100_000.0, 625_000.0, 1_000_000.0, 500.0])
 
@@ -465,16 +466,3 @@ def test_a_capture_replayed_in_planned_runs_is_the_replay_frame_by_frame(
         result = conduct(replace(found.replay, report_dir=str(again)), html=False, rootdir=again)
         replays.append((list(result.run.link.transcript.events), steady(result.document)))
     assert replays[0][0] and replays[0] == replays[1]
-
-
-#: what differs between two runs of the same thing: wall-clock stamps and the manifest's hashes
-VOLATILE = frozenset(("started", "finished", "duration_s", "wall_s", "cpu_s", "manifest"))
-
-
-def steady(data: object) -> object:
-    """``data`` (a verdicts.json document) without its :data:`VOLATILE` keys."""
-    if isinstance(data, dict):
-        return {k: steady(v) for k, v in data.items() if k not in VOLATILE}
-    if isinstance(data, list):
-        return [steady(v) for v in data]
-    return data
