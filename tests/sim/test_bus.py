@@ -15,6 +15,7 @@ from conformance.emulator.transmitter import Transmission, Transmitter
 from conformance.sim.bus import SimBus, SimLink
 from tests.emulator.test_faults import CHECKS
 from tests.emulator.test_sensor import Rig
+from tests.support.transmitter_device import TransmitterDevice
 
 
 def _frame_by_frame(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -111,35 +112,15 @@ def test_popping_a_run_is_popping_each_frame() -> None:
     assert item.done and len(many.queue) == 1 and one.next_frame() == many.next_frame()
 
 
-class _Talker:
+class _Talker(TransmitterDevice):
     """A device that only talks: its planned replies, offered either way."""
 
-    name = "dut"
-
     def __init__(self) -> None:
-        self.tx = Transmitter()
+        super().__init__()
         self.tx.schedule(Reply(ReplyKind.DATA, "0+1.5+2.25"), 0.010, gap=0.0004)
         self.tx.schedule(Reply(ReplyKind.DATA, "0+3"), 0.050, gap=0.0, pauses=((3, 0.045),))
         self.tx.schedule(Reply(ReplyKind.DATA, "0+77.125"), 0.500, gap=0.021)
         self.tx.schedule(Reply(ReplyKind.SERVICE_REQUEST, "0"), 0.900, gap=0.0)
-
-    def on_break(self, start: float, end: float) -> None:
-        pass
-
-    def on_char(self, wire: int, start: float, end: float) -> None:
-        pass
-
-    def next_frame(self):  # noqa: ANN201 - as BusDevice
-        return self.tx.next_frame()
-
-    def pop_frame(self):  # noqa: ANN201 - as BusDevice
-        return self.tx.pop_frame()[0]
-
-    def frames_ahead(self):  # noqa: ANN201 - as PlansFrames
-        return self.tx.ahead()
-
-    def pop_frames(self, count: int) -> None:
-        self.tx.pop_frames(count)
 
 
 READS = [  # (how far the deadline lies, stop after how many characters, idle)

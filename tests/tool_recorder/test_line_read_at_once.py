@@ -13,13 +13,13 @@ import pytest
 from conformance.emulator import FAULTS, default_profile
 from conformance.emulator.replies import Reply, ReplyKind
 from conformance.emulator.sim import sim_sensor
-from conformance.emulator.transmitter import Transmitter
 from conformance.links.base import LineEnd
 from conformance.protocol import commands as cmds
 from conformance.recorder.job_time import JobBudget, JobLink
 from conformance.sim.bus import SimBus, SimLink
 from conformance.tool_recorder import ToolRecorder
 from conformance.tool_recorder.policy import Policy
+from tests.support.transmitter_device import TransmitterDevice
 
 #: the one-line replies a run reads most, a multi-line and a binary one beside them
 SCRIPT = ("0!", "0I!", "0IM_001!", "0IMC_002!", "0R0!", "0RC0!", "0XHELP!", "?!", "0V!")
@@ -72,35 +72,18 @@ def test_a_link_that_does_not_say_so_is_read_window_by_window() -> None:
     assert ToolRecorder(timed).transact("0I!").ok  # type: ignore[arg-type]
 
 
-class _Pausing:
+class _Pausing(TransmitterDevice):
     """A device that answers every command ending in '!' with ``text`` 10 ms after it, with
     ``pauses`` ((index, s) each: marking added before that character)."""
 
-    name = "dut"
-
     def __init__(self, text: str, pauses: tuple[tuple[int, float], ...]) -> None:
-        self.tx = Transmitter()
+        super().__init__()
         self.text, self.pauses = text, pauses
-
-    def on_break(self, start: float, end: float) -> None:
-        pass
 
     def on_char(self, wire: int, start: float, end: float) -> None:
         if wire & 0x7F == ord("!"):
             reply = Reply(ReplyKind.DATA, self.text)
             self.tx.schedule(reply, end + 0.010, gap=0.0, pauses=self.pauses)
-
-    def next_frame(self):  # noqa: ANN201 - as BusDevice
-        return self.tx.next_frame()
-
-    def pop_frame(self):  # noqa: ANN201 - as BusDevice
-        return self.tx.pop_frame()[0]
-
-    def frames_ahead(self):  # noqa: ANN201 - as PlansFrames
-        return self.tx.ahead()
-
-    def pop_frames(self, count: int) -> None:
-        self.tx.pop_frames(count)
 
 
 IDLE = Policy().reply_idle  # the marking after which a one-line reply's read stops
