@@ -67,3 +67,15 @@ def test_a_recorder_retry_over_a_reply_is_the_root_of_its_broken_command():
     verdicts = {r["id"]: r for r in data["requirements"]}
     assert verdicts["R-7.0-13"]["consequence_of"] == "R-7.2-06"
     assert _first_rows(data)[:2] == ["R-7.2-06", "R-7.0-13"]
+
+
+def test_a_sensors_break_before_its_reply_is_its_own_root_not_a_late_replys():
+    """break-before-reply: the sensor's break right after the command ends R-7.0-09's marking
+    (FAIL) and its reply comes at 20.5 ms (R-7.0-10 FAIL). The R-7.0-09 FAIL does not come
+    from a late reply running into a retry, so it names no root."""
+    data = run_once("sim://?faults=break-before-reply")
+    verdicts = {r["id"]: r for r in data["requirements"]}
+    assert verdicts["R-7.0-09"]["verdict"] == "FAIL"
+    assert verdicts["R-7.0-10"]["verdict"] == "FAIL"
+    assert verdicts["R-7.0-09"]["consequence_of"] is None
+    assert not any("consequence of" in f["detail"] for f in verdicts["R-7.0-09"]["findings"])
