@@ -1,0 +1,46 @@
+"""``benchmarks/loaded_holdings.py``, what a loaded recording holds and who holds its events
+(issue 22), read against what was written: the busy bus's characters and breaks counted
+apart, every event's holders counted, each family's bytes those of its objects."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+from conformance.capture import export_events
+from conformance.transcript import EventKind
+
+BENCHMARKS = Path(__file__).parents[2] / "benchmarks"
+
+
+def _load(name: str) -> ModuleType:
+    spec = importlib.util.spec_from_file_location(f"{name}_bench", BENCHMARKS / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_families_count_what_the_capture_holds(tmp_path: Path):
+    events = _load("capture_decode").busy_bus(20.0)
+    capture = tmp_path / "busy.sr"
+    export_events(events, str(capture), sample_rate=1e6)
+    found = _load("loaded_holdings").holdings(str(capture))
+    chars = sum(e.kind is EventKind.CHAR for e in events)
+    assert found["event_counts"] == {"char": chars, "break": len(events) - chars}
+    assert found["events"] == len(events)
+    assert sum(found["holders"].values()) == len(events)
+    # an event's object (its slots and GC header), each family the sum of its objects'
+    one = sys.getsizeof(events[0])
+    assert found["event_objects_mb"]["char"] * 1e6 == pytest.approx(chars * one)
+    # every start and end, a start equal to the end before it sharing its object
+    assert len(events) < found["stamps"] <= 2 * len(events)
+    assert found["lists_mb"]["transcript"] * 1e6 >= 8 * len(events)
+    # the view's transmissions hold every character, its breaks every recorder's break: no
+    # event is held by the transcript's list alone
+    assert found["freed_with_list"] == 0
+    assert found["transmissions"] == len(events) - chars
