@@ -3,6 +3,7 @@ compiler): ``kit_build(sketch, libs, defines)`` returns the binary, cached by it
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 from collections.abc import Callable
@@ -14,6 +15,7 @@ from conformance.harness.channel import ChildChannel
 from conformance.harness.protocol import Role, parse_plan
 from conformance.kit.build import ArduinoBuild, build_arduino, find_compiler
 from tests.support.paths import ROOT
+from tests.support.shared_runs import common_folder
 
 ARDUINO = ROOT / "examples" / "arduino"
 SENSOR = ARDUINO / "sdi12_sensor"
@@ -28,10 +30,17 @@ Build = Callable[..., Path]
 @pytest.fixture(scope="session")
 def kit_builds(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The session's build folder (skipped without a compiler): a sketch built once with
-    the same flags, by a fixture or by the kit subcommand given ``--build-dir``, is reused."""
+    the same flags, by a fixture or by the kit subcommand given ``--build-dir``, is reused.
+    Under pytest-xdist the workers share it (tests/support/shared_runs.py's common folder):
+    the sensor and logger sketches, each about 3 s of a compiler's CPU, were built again by
+    every worker that took a module using them (test_kit_batch beside test_arduino_sensor
+    and test_arduino_logger). The kit's build is safe to share: keyed by a digest of its
+    sources and flags, renamed into place once whole."""
     if find_compiler() is None:
         pytest.skip("no C++ compiler (c++, g++ or clang++): the kit cannot build a sketch")
-    return tmp_path_factory.mktemp("kit-builds")
+    folder = common_folder(tmp_path_factory) / "kit-builds"
+    folder.mkdir(exist_ok=True)
+    return folder
 
 
 def build_dir(folder: Path, sketch: Path, defines: tuple[str, ...] = ()) -> Path:
@@ -42,7 +51,10 @@ def build_dir(folder: Path, sketch: Path, defines: tuple[str, ...] = ()) -> Path
 def kit_build(kit_builds: Path) -> Build:
     def build(sketch: Path, libs: tuple[Path, ...] = (), defines: tuple[str, ...] = ()) -> Path:
         where = build_dir(kit_builds, sketch, defines)
-        return build_arduino(ArduinoBuild(sketch, libs, defines, build_dir=where))
+        # one worker compiles a sketch, any other that wants it meanwhile waits and reuses it
+        with open(kit_builds / f"{where.name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
+            return build_arduino(ArduinoBuild(sketch, libs, defines, build_dir=where))
 
     return build
 

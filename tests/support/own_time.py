@@ -23,11 +23,12 @@ from pathlib import Path
 SCHEDSTAT = Path("/proc/thread-self/schedstat")
 
 
-def _runnable() -> float:
-    """Seconds this thread has spent runnable but not running (0 where the kernel does not
-    say: the wall time is then the figure, as before)."""
+def runnable(schedstat: Path = SCHEDSTAT) -> float:
+    """Seconds a thread has spent runnable but not running (0 where the kernel does not
+    say: the wall time is then the figure, as before): this thread's by default, or another
+    task's given its ``/proc/PID/schedstat`` (a child process's main thread)."""
     try:
-        _on_cpu, waiting, _slices = SCHEDSTAT.read_text().split()
+        _on_cpu, waiting, _slices = schedstat.read_text().split()
     except (OSError, ValueError):
         return 0.0
     return int(waiting) / 1e9
@@ -54,9 +55,9 @@ def own_time() -> Iterator[OwnTime]:
     processes counts as this thread's waiting for it (blocked), theirs queueing included:
     use it where the code under test runs on the calling thread."""
     took = OwnTime()
-    wall, queued = time.perf_counter(), _runnable()
+    wall, queued = time.perf_counter(), runnable()
     try:
         yield took
     finally:
         took.wall = time.perf_counter() - wall
-        took.queued = _runnable() - queued
+        took.queued = runnable() - queued
