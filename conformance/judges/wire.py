@@ -498,34 +498,41 @@ class _GapsAlike:
         in C, grouped by value (few distinct ones a reply) and observed at once
         (:meth:`~.timing.Observed.observe_run`): the same observations, distinct objects in
         the same order and counts (issue 22, matrix19: R-7.0-12's gaps were 8% of a
-        fault-matrix row, a Python call and a tuple a character). A run whose gaps hold a
-        zero (a negative one is judged apart), a NaN, or pauses between lines of multi-line
-        text is taken one gap at a time, as before."""
+        fault-matrix row, a Python call and a tuple a character). A run whose gaps may hold a
+        negative zero (judged apart), a NaN, or pauses between lines of multi-line
+        text is taken one gap at a time, as before (a zero gap is no such one: a simulated
+        sensor's characters come back to back)."""
         base, judged, observed = self.base, self.judged, self.observed
         distinct, counts = observed.distinct, observed.counts
+        taken: list[int] = []  # the picks of the runs taken at once, counted at the end
         for seg, where, text, multiline in _placed(segs):
             reply = (seg.text, text)
             here = judged.setdefault(where, {})
             for first, run in _placed_runs(seg):
                 if len(run) < 2:
                     continue
-                values = list(map(sub, map(_START, run[1:]), map(_END, run)))
+                starts = list(map(_START, run[1:]))
+                values = list(map(sub, starts, map(_END, run)))
                 total = sum(values)
-                if multiline or total != total or 0.0 in values:
+                # a gap is a negative zero only where its character starts at -0.0
+                if multiline or total != total or 0.0 in starts:
                     gaps = _run_gaps(run, first, where, reply, multiline)
                     self.add(gaps)
                     tolerance.add(gaps)
                     continue
-                for gap in dict.fromkeys(values):  # the new ones, where they first come
-                    if gap not in here:
-                        here[gap] = len(distinct)
-                        distinct.append(Measured(GAP_WINDOW, gap, base, [where]))
-                        counts.append(0)
+                fresh = dict.fromkeys(values)
+                if not here.keys() >= fresh.keys():  # new ones, judged where they first come
+                    for gap in fresh:
+                        if gap not in here:
+                            here[gap] = len(distinct)
+                            distinct.append(Measured(GAP_WINDOW, gap, base, [where]))
+                            counts.append(0)
                 picks = list(map(here.__getitem__, values))
-                for i, n in Counter(picks).items():
-                    counts[i] += n
+                taken += picks
                 observed.observe_run(picks, reply, first + 1)
                 tolerance.add_values(values, where)
+        for i, n in Counter(taken).items():
+            counts[i] += n
 
 
 def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
