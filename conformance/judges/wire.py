@@ -360,7 +360,10 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
     :data:`SEGMENTS_AT_ONCE` at a time through :class:`ReplyGaps`, the same findings, so
     that no list of every gap is made (an hour of a busy bus: 25,000 a sensor, ~4 MB);
     a run's :class:`~conformance.view.runs.Segments` keep their observations for
-    :func:`gaps_to_confirm`, which reads the same."""
+    :func:`gaps_to_confirm`, which reads the same, where the stamps have a local
+    irregularity (a host-stamped link); on one uncertainty for every gap they are judged
+    through :class:`ReplyGaps` too, in one part, each run's gaps at once
+    (:meth:`_GapsAlike.add_segments`)."""
     stamps = stamp_uncertainty(uncertainty)
     if not isinstance(segs, Segments) or _alike(stamps):
         # on one uncertainty for every gap (a virtual clock, a capture's grid) nothing is
@@ -497,7 +500,7 @@ class _GapsAlike:
         the gaps listed one tuple each: each run's gaps are taken as one list of values made
         in C, grouped by value (few distinct ones a reply) and observed at once
         (:meth:`~.timing.Observed.observe_run`): the same observations, distinct objects in
-        the same order and counts (issue 22, matrix19: R-7.0-12's gaps were 8% of a
+        the same order and counts (issue 22, matrix19: R-7.0-12's gaps were ~4% of a
         fault-matrix row, a Python call and a tuple a character). A run whose gaps may hold a
         negative zero (judged apart), a NaN, or pauses between lines of multi-line
         text is taken one gap at a time, as before (a zero gap is no such one: a simulated
