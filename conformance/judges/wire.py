@@ -9,8 +9,11 @@ chatter) (:class:`~conformance.view.runs.Segment`).
 
 from __future__ import annotations
 
+from collections import Counter
+from collections.abc import Iterable, Iterator
+from itertools import repeat
 from math import copysign, isnan
-from operator import sub
+from operator import attrgetter, sub
 
 from ..protocol.commands import ADDRESS_CHARS, MEASUREMENT_KINDS, CommandError, parse_command
 from ..protocol.framing import ETX, STX
@@ -41,6 +44,9 @@ from .timing import (
     sustained,
     to_confirm,
 )
+
+_START = attrgetter("start")
+_END = attrgetter("end")
 
 # The cut these judges read lives in the shared view; re-exported for the timing diagram
 # (reports/) and the sensor measurement judges, which import it from here.
@@ -296,26 +302,47 @@ def _cut_gaps(segs: list[Segment]) -> list[Gap]:
     """Each gap with its place: the command and the index of the character after the gap
     among everything the sensor sent after it (where a device's own gap recurs)."""
     gaps: list[Gap] = []
-    add = gaps.append
+    for seg, where, text, multiline in _placed(segs):
+        for first, run in _placed_runs(seg):
+            gaps += _run_gaps(run, first, where, (seg.text, text), multiline)
+    return gaps
+
+
+def _placed(segs: list[Segment]) -> Iterator[tuple[Segment, str, str, bool]]:
+    """Each segment the sensor sent anything in, with what places its gaps: the evidence
+    line, all it sent after the command as text, and whether the pauses after its LFs are
+    between lines of multi-line text (R-4.4.13.1-03's 150 ms, not a gap), which is so too
+    for the rest of multi-line text the command talked over."""
     for seg in segs:
-        if not seg.reply and not seg.later:
-            continue
-        text = _text(seg)
-        where = f"in reply to {escape(seg.text)}"
-        # the rest of multi-line text the command talked over: its lines may pause between
-        multiline = seg.multiline or talked_through(seg)
-        first = 0  # index of the run's first character in all the sensor sent after it
-        # the whole reply, however long a gap inside it: a gap is R-7.0-12's evidence
-        for run in [seg.reply, *runs(seg.later)]:
-            k = first
-            a = None
-            for b in run:
-                if a is not None and not (multiline and a.char7 == 0x0A):
-                    # (between lines of multi-line text: R-4.4.13.1-03's 150 ms)
-                    add((b.start - a.end, where, a, b, (seg.text, text, k)))
-                a = b
-                k += 1
-            first += len(run)
+        if seg.reply or seg.later:
+            multiline = seg.multiline or talked_through(seg)
+            yield seg, f"in reply to {escape(seg.text)}", _text(seg), multiline
+
+
+def _placed_runs(seg: Segment) -> Iterator[tuple[int, list[Event]]]:
+    """The segment's runs of characters (the whole reply, however long a gap inside it: a
+    gap is R-7.0-12's evidence; then each run of what came later), each with the index of
+    its first character in all the sensor sent after the command."""
+    first = 0
+    for run in [seg.reply, *runs(seg.later)]:
+        yield first, run
+        first += len(run)
+
+
+def _run_gaps(
+    run: list[Event], first: int, where: str, reply: tuple[str, str], multiline: bool
+) -> list[Gap]:
+    """The gaps between consecutive characters of one run (:func:`_placed_runs`), one by
+    one, each placed at the index of the character after it."""
+    gaps: list[Gap] = []
+    add = gaps.append
+    k = first
+    a = None
+    for b in run:
+        if a is not None and not (multiline and a.char7 == 0x0A):
+            add((b.start - a.end, where, a, b, (*reply, k)))
+        a = b
+        k += 1
     return gaps
 
 
@@ -333,12 +360,19 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
     :data:`SEGMENTS_AT_ONCE` at a time through :class:`ReplyGaps`, the same findings, so
     that no list of every gap is made (an hour of a busy bus: 25,000 a sensor, ~4 MB);
     a run's :class:`~conformance.view.runs.Segments` keep their observations for
-    :func:`gaps_to_confirm`, which reads the same."""
+    :func:`gaps_to_confirm`, which reads the same, where the stamps have a local
+    irregularity (a host-stamped link); on one uncertainty for every gap they are judged
+    through :class:`ReplyGaps` too, in one part, each run's gaps at once
+    (:meth:`_GapsAlike.add_segments`)."""
     stamps = stamp_uncertainty(uncertainty)
-    if not isinstance(segs, Segments):
+    if not isinstance(segs, Segments) or _alike(stamps):
+        # on one uncertainty for every gap (a virtual clock, a capture's grid) nothing is
+        # confirmed (gaps_to_confirm): a run's segments kept no observations for it either
+        # and are judged the same way in one part (issue 22, matrix19)
         gaps = ReplyGaps(stamps)
-        for k in range(0, len(segs), SEGMENTS_AT_ONCE):
-            gaps.add(segs[k : k + SEGMENTS_AT_ONCE])
+        at_once = SEGMENTS_AT_ONCE if not isinstance(segs, Segments) else len(segs) or 1
+        for k in range(0, len(segs), at_once):
+            gaps.add(segs[k : k + at_once])
         return gaps.findings()
     gap_finding = combine_local(
         "R-7.0-12",
@@ -378,10 +412,17 @@ def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observa
     the reply to one command (a simulated sensor's are exact; a real link's stamps are
     quantised), and equal gaps judge alike: each distinct ``(gap, uncertainty, where)`` is
     judged once and its :class:`~.timing.Measured` stands for every gap of that value."""
-    base = stamps.base
-    if stamps.local is None and not (not base and copysign(1.0, base) < 0):
-        return _observe_gaps_alike(_gaps(segs), base)
+    if _alike(stamps):
+        return _observe_gaps_alike(_gaps(segs), stamps.base)
     return _observe_each(_gaps(segs), stamps, {})
+
+
+def _alike(stamps: StampUncertainty) -> bool:
+    """Whether every gap has the stamps' one uncertainty ``base`` (no local irregularity), a
+    plain one (a negative zero is judged apart): the gaps are then judged grouped by value
+    (:class:`_GapsAlike`)."""
+    base = stamps.base
+    return stamps.local is None and not (not base and copysign(1.0, base) < 0)
 
 
 def _observe_each(
@@ -454,6 +495,48 @@ class _GapsAlike:
                 counts[i] += 1
             observe(i, place)
 
+    def add_segments(self, segs: list[Segment], tolerance: _ToleranceUse) -> None:
+        """:meth:`add` of :func:`_cut_gaps`' gaps of ``segs``, and ``tolerance``'s, without
+        the gaps listed one tuple each: each run's gaps are taken as one list of values made
+        in C, grouped by value (few distinct ones a reply) and observed at once
+        (:meth:`~.timing.Observed.observe_run`): the same observations, distinct objects in
+        the same order and counts (issue 22, matrix19: R-7.0-12's gaps were ~4% of a
+        fault-matrix row, a Python call and a tuple a character). A run whose gaps may hold a
+        negative zero (judged apart), a NaN, or pauses between lines of multi-line
+        text is taken one gap at a time, as before (a zero gap is no such one: a simulated
+        sensor's characters come back to back)."""
+        base, judged, observed = self.base, self.judged, self.observed
+        distinct, counts = observed.distinct, observed.counts
+        taken: list[int] = []  # the picks of the runs taken at once, counted at the end
+        for seg, where, text, multiline in _placed(segs):
+            reply = (seg.text, text)
+            here = judged.setdefault(where, {})
+            for first, run in _placed_runs(seg):
+                if len(run) < 2:
+                    continue
+                starts = list(map(_START, run[1:]))
+                values = list(map(sub, starts, map(_END, run)))
+                total = sum(values)
+                # a gap is a negative zero only where its character starts at -0.0
+                if multiline or total != total or 0.0 in starts:
+                    gaps = _run_gaps(run, first, where, reply, multiline)
+                    self.add(gaps)
+                    tolerance.add(gaps)
+                    continue
+                fresh = dict.fromkeys(values)
+                if not here.keys() >= fresh.keys():  # new ones, judged where they first come
+                    for gap in fresh:
+                        if gap not in here:
+                            here[gap] = len(distinct)
+                            distinct.append(Measured(GAP_WINDOW, gap, base, [where]))
+                            counts.append(0)
+                picks = list(map(here.__getitem__, values))
+                taken += picks
+                observed.observe_run(picks, reply, first + 1)
+                tolerance.add_values(values, where)
+        for i, n in Counter(taken).items():
+            counts[i] += n
+
 
 def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
     """R-7.0-01 for the one limit without tolerance: a gap surely inside (1.66, 2.06] ms leans
@@ -477,16 +560,28 @@ class _ToleranceUse:
         self.count = 0
 
     def add(self, gaps: list[Gap]) -> None:
+        self._in_band((g, w) for g, w, _a, _b, _p in gaps)
+        self.count += len(gaps)
+
+    def add_values(self, values: list[float], where: str) -> None:
+        """:meth:`add` of gaps of these values, all at ``where`` (none a NaN): the run's
+        largest tells at once that none is in or near the band, as nearly always."""
+        top, uncertainty = max(values), self.uncertainty
+        if top + uncertainty > INTER_CHAR_GAP_MAX or top - uncertainty > INTER_CHAR_GAP_MAX:
+            self._in_band(zip(values, repeat(where)))
+        self.count += len(values)
+
+    def _in_band(self, gaps: Iterable[tuple[float, str]]) -> None:
+        """Keeps the ``(gap, where)`` surely and those maybe in the band."""
         uncertainty, sure, maybe = self.uncertainty, self.sure, self.maybe
         band_lo, band_hi = INTER_CHAR_GAP_MAX, INTER_CHAR_GAP_MAX + TOLERANCE
-        for g, w, _a, _b, _p in gaps:
+        for g, w in gaps:
             if g + uncertainty <= band_lo and g - uncertainty <= band_lo:
                 continue  # below the band either way (nearly every gap)
             if g - uncertainty > band_lo and g + uncertainty <= band_hi:
                 sure.append((g, w))
             if g + uncertainty > band_lo and g - uncertainty <= band_hi:
                 maybe.append((g, w))
-        self.count += len(gaps)
 
     def finding(self) -> Finding:
         return _tolerance_finding(self.sure, self.maybe, self.count, self.uncertainty)
@@ -532,22 +627,18 @@ class ReplyGaps:
     def __init__(self, uncertainty: float | StampUncertainty) -> None:
         self.stamps = stamps = stamp_uncertainty(uncertainty)
         base = stamps.base
-        self._alike = (
-            _GapsAlike(base)
-            if stamps.local is None and not (not base and copysign(1.0, base) < 0)
-            else None
-        )
+        self._alike = _GapsAlike(base) if _alike(stamps) else None
         self._each: list[Observation] = []
         self._judged: dict[tuple[float, float, str], Measured] = {}
         self._tolerance = _ToleranceUse(base)
 
     def add(self, segs: list[Segment]) -> None:
         """The reply character gaps of ``segs`` (the next window's segments)."""
-        gaps = _cut_gaps(segs)
         if self._alike is not None:
-            self._alike.add(gaps)
-        else:
-            self._each += _observe_each(gaps, self.stamps, self._judged)
+            self._alike.add_segments(segs, self._tolerance)
+            return
+        gaps = _cut_gaps(segs)
+        self._each += _observe_each(gaps, self.stamps, self._judged)
         self._tolerance.add(gaps)
 
     def findings(self) -> list[Finding]:

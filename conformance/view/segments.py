@@ -86,7 +86,7 @@ T = TypeVar("T")
 #: valid while one count stays what it was when they were made (kept under the family's
 #: ``_at`` name): what its characters give (``len(chars)``) and what its characters and
 #: those heard give (their lengths' sum, :meth:`Transmission._of_growth`)
-_OF_CHARS = ("_text", "_command")
+_OF_CHARS = ("_text", "_command", "_binary")
 _OF_GROWTH = ("_contention", "_reply", "_after")
 #: a derived value not made yet (None is one: the command of a text that parses as none)
 _UNMADE: Any = object()
@@ -236,7 +236,16 @@ class Transmission:
 
     @property
     def binary(self) -> bool:
-        """The reply is an 8N1 packet (``aDBn!``): no 7E1, no CR LF."""
+        """The reply is an 8N1 packet (``aDBn!``): no 7E1, no CR LF. Kept per length, as
+        ``text`` is: asked twice of every attempt a stimulus's records rebuild (its reply's
+        framing and whether it is complete), each a match of the stem."""
+        d = self.__dict__
+        binary = d["_binary"]
+        if binary is _UNMADE or d["_chars_at"] != len(self.chars):
+            binary = self._kept("_binary", "_chars_at", len(self.chars), _OF_CHARS, self._packet)
+        return binary
+
+    def _packet(self) -> bool:
         d = self.data_index
         return d is not None and d[0]
 
@@ -258,11 +267,14 @@ class Transmission:
         return list(self._of_growth("_reply", self._framed_reply))
 
     def _framed_reply(self) -> list[Event]:
-        clash = {id(e) for e in self.contention}
+        met = self._of_growth("_contention", self._collided)  # read, not copied
         # every character heard, nearly always (no contention, nothing after the reply's
         # end): kept as the transmission's own list, not a copy (``reply`` hands out copies,
         # and the key it is kept under changes if the list grows)
-        heard = [e for e in self.heard if id(e) not in clash] if clash else self.heard
+        heard = self.heard
+        if met:
+            clash = {id(e) for e in met}
+            heard = [e for e in heard if id(e) not in clash]
         if self.binary:
             length = packet_length(decode_8n1(heard))
             return _first(heard, length) if length is not None else heard
