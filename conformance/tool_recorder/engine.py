@@ -37,7 +37,15 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..protocol.values import continues_split_value, split_values
-from ..transcript import TOOL, Event, EventKind, encode_7e1, text_end, to_wire_7e1
+from ..transcript import (
+    TOOL,
+    Event,
+    EventKind,
+    decode_7e1,
+    encode_7e1,
+    text_end,
+    to_wire_7e1,
+)
 from ..view.segments import continues_frame
 from . import validity
 from .contention import HOLD_PREFIX, ApartSoFar, collisions, maybe_note_text
@@ -549,20 +557,27 @@ class ToolRecorder:
             binary, not binary and (command is None or command.kind is Kind.EXTENDED)
         )
         reply, state, collided = self._listen(command_end, framing)
+        text: str | None = None
         if collided:
             self.note_collisions()
             self._note_maybe_collided(break_event, sent, collided)
         if collided:  # the DUT talked over the command: it may not have heard it whole
             state = f"{CONTENTION} ({len(collided)} characters during the command)"
         elif state is None:
-            state = self._judge_reply(reply, command, address, command_end, framing, crc)
+            # the reply's text, decoded once: the check reads it, and the attempt carries it
+            # to every later reader (Attempt.reply_text)
+            text = None if framing.binary else decode_7e1(reply)
+            state = self._judge_reply(reply, command, address, command_end, framing, crc, text)
         if reply and not collided and command is not None and command.kind is Kind.ACKNOWLEDGE:
             self.acknowledged.add(address)
         if not collided and not framing.is_text(reply) and closes_exchange(command, reply):
             self._closed_reply_end = reply[-1].end
-        return Attempt(
+        attempt = Attempt(
             break_event, sent, reply, state, self.link.now(), stray_events=stray + collided
         )
+        if text is not None:
+            attempt.knows_reply_text(text)
+        return attempt
 
     def _framing(self, binary: bool, multiline: bool) -> Framing:
         """:func:`framing_for` this engine's policy, made once per policy object and kind
@@ -653,7 +668,10 @@ class ToolRecorder:
         command_end: float,
         framing: Framing,
         crc: bool | None,
+        text: str | None = None,
     ) -> str:
+        """OK, or why the finished ``reply`` is invalid (:mod:`.validity`); ``text``: its
+        ``decode_7e1`` where the caller has it."""
         if framing.binary:
             why = validity.check_packet(reply, address=address, command_end=command_end)
         else:
@@ -666,6 +684,7 @@ class ToolRecorder:
                 gap_limit=gap_limit,
                 crc_expected=crc,
                 multiline=framing.is_text(reply),
+                text=text,
             )
         return OK if why is None else f"invalid: {why}"
 

@@ -1,0 +1,124 @@
+"""Issue 22, matrix18: a reply's text decoded once and carried with it. The engine decodes
+each 7E1 reply it judges once, checks it from that text (``validity.check_ascii(text=...)``)
+and leaves the text on the attempt (``Attempt.reply_text``), which every later reader asks
+(the buffer watch, ``Exchange.reply_text`` and the judges through it). The text carried is
+``decode_7e1`` of the reply's events at every moment, also after the list grew in place
+or was replaced; and a one-line reply's marking is compared in C (``_first_long_gap``),
+finding the gap the pair-by-pair loop found, NaN stamps included."""
+
+from __future__ import annotations
+
+import math
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conformance.protocol import commands as cmds
+from conformance.protocol.framing import LF
+from conformance.tool_recorder import ToolRecorder, validity
+from conformance.tool_recorder.records import Attempt, Exchange
+from conformance.transcript import DUT, TOOL, Event, EventKind, decode_7e1, to_wire_7e1
+from tests.support.hand_events import chars
+
+CHAR = 8.333e-3
+
+
+def _old_first_long_gap(events: list[Event], gap_limit: float, multiline: bool) -> float | None:
+    """validity._ascii_problem's gap loop before matrix18, word for word (its gap)."""
+    for i in range(1, len(events)):
+        if multiline and events[i - 1].char7 == LF:
+            continue
+        gap = events[i].start - events[i - 1].end
+        if gap > gap_limit:
+            return gap
+    return None
+
+
+gaps = st.sampled_from([0.0, 0.0, 0.0, 1e-3, 0.00873, 0.009, 0.2, -1e-3, math.nan, math.inf])
+
+
+@settings(max_examples=800, deadline=None)
+@given(
+    st.lists(st.tuples(gaps, st.sampled_from("0+1\r\n\x02")), max_size=9),
+    st.sampled_from([0.00873, 0.0104]),
+    st.booleans(),
+)
+def test_first_long_gap_as_the_loop(spec, gap_limit, multiline):
+    events, t = [], 0.02
+    for gap, c in spec:
+        t += gap
+        events.append(Event(EventKind.CHAR, DUT, t, t + CHAR, to_wire_7e1(ord(c))))
+        t = t + CHAR if not math.isnan(t) else 0.5
+    found = validity._first_long_gap(events, gap_limit, multiline)
+    old = _old_first_long_gap(events, gap_limit, multiline)
+    assert found == old or (found is not None and old is not None and math.isnan(found + old))
+
+
+def test_the_first_long_gap_of_several():
+    events = chars(DUT, "0+1\r\n", 0.02)
+    moved = [events[0], *(replace_start(e, e.start + 0.02) for e in events[1:3])]
+    moved += [replace_start(e, e.start + 0.05) for e in events[3:]]
+    assert validity._first_long_gap(moved, 0.0104, False) == _old_first_long_gap(
+        moved, 0.0104, False
+    )
+    assert abs(validity._first_long_gap(moved, 0.0104, False) - 0.02) < 1e-12
+
+
+def replace_start(e: Event, start: float) -> Event:
+    return Event(e.kind, e.origin, start, start + (e.end - e.start), e.wire)
+
+
+def test_check_ascii_given_the_text_answers_as_without():
+    command = cmds.parse_command("0D0!")
+    for text in ("0+1\r\n", "0+1", "1+1\r\n", "0+1.2.3\r\n"):
+        events = chars(DUT, text, 0.02)
+        args = dict(address="0", command_end=0.01, gap_limit=0.0104, crc_expected=False)
+        without = validity._ascii_problem(command, events, "0", 0.01, 0.0104, False, False)
+        given_text = validity._ascii_problem(
+            command, events, "0", 0.01, 0.0104, False, False, decode_7e1(events)
+        )
+        assert given_text == without
+        assert validity.check_ascii(command, events, **args, text=text) == without
+
+
+def _attempt(events: list[Event]) -> Attempt:
+    sent = chars(TOOL, "0D0!", 0.0)
+    return Attempt(None, sent, events, "ok", 1.0)
+
+
+def test_attempt_reply_text_follows_its_events():
+    events = chars(DUT, "0+1", 0.02)
+    attempt = _attempt(events)
+    assert attempt.reply_text == "0+1"
+    attempt.reply_events += chars(DUT, "\r\n", 0.05)  # grown in place (a golden recorder)
+    assert attempt.reply_text == "0+1\r\n"
+    attempt.reply_events = chars(DUT, "0+22\r\n", 0.02)  # replaced whole
+    assert attempt.reply_text == "0+22\r\n"
+    attempt.knows_reply_text("0+22\r\n")
+    attempt.reply_events.append(Event(EventKind.BREAK, DUT, 0.1, 0.2))  # no character
+    assert attempt.reply_text == decode_7e1(attempt.reply_events) == "0+22\r\n"
+    attempt.reply_events.append(chars(DUT, "x", 0.3)[0])
+    assert attempt.reply_text == "0+22\r\nx"
+    empty = _attempt([])
+    assert empty.reply_text == ""
+    exchange = Exchange(cmds.parse_command("0D0!"), "0D0!", [empty, attempt])
+    assert exchange.reply_text == decode_7e1(exchange.reply_events)
+
+
+def test_the_engine_carries_each_reply_as_decoded():
+    """Every attempt of a run of commands against the emulator, clean and with faults that
+    spoil replies (parity, CRC, marking), carries its events' decode_7e1."""
+    from conformance.emulator import sim_sensor
+
+    for faults in ((), ("parity-error",), ("wrong-crc",), ("inter-char-gap",)):
+        _, link, _ = sim_sensor(faults=faults)
+        master = ToolRecorder(link)
+        exchanges = [master.acknowledge(), master.identify()]
+        m = master.measure(cmds.measure("0", crc=True))
+        exchanges += [m.start, *m.data]
+        exchanges.append(master.transact("0XHELP!"))
+        attempts = [a for ex in exchanges for a in ex.attempts]
+        assert any(a.reply_events for a in attempts)
+        for attempt in attempts:
+            assert "_text" in attempt.__dict__ or not attempt.reply_events or not attempt.ok
+            assert attempt.reply_text == decode_7e1(attempt.reply_events)
