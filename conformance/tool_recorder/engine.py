@@ -604,6 +604,16 @@ class ToolRecorder:
         ended: they collided with it (a late reply to an earlier transmission, say) and are
         never this command's answer. Every read has a deadline."""
         deadline = command_end + self.policy.first_char_timeout
+        one_line = not (framing.binary or framing.multiline)
+        line_at_once = getattr(type(self.link), "reads_line_at_once", False)
+        if one_line and line_at_once and self.link.now() >= command_end:
+            # a sim link reads a one-line reply in one pass (SimLink.receive_line): what
+            # began after the clock began after the command, so nothing collided with it
+            line = getattr(self.link, "receive_line", None)
+            got = None if line is None else line(deadline, framing.deadline, framing.max_chars,
+                                                 framing.idle)  # fmt: skip
+            if got is not None:
+                return got, self._line_state(got, framing), []
         collided: list[Event] = []
         first = self.link.receive(deadline, until=lambda got: True)
         slack = self.link.info.timing_uncertainty
@@ -618,9 +628,7 @@ class ToolRecorder:
             return [], NO_REPLY, collided
         deadline = framing.deadline(first[0])
         chars = first
-        if getattr(type(self.link), "reads_line_at_once", False) and not (
-            framing.binary or framing.multiline
-        ):
+        if line_at_once and one_line:
             reply, state = self._rest_of_line(chars, deadline, framing)
             return reply, state, collided
         while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
@@ -656,9 +664,17 @@ class ToolRecorder:
             chars = chars + self.link.receive(
                 deadline, until=LineEnd(chars, limit), idle=framing.idle
             )
+        return chars, self._line_state(chars, framing)
+
+    @staticmethod
+    def _line_state(chars: list[Event], framing: Framing) -> str | None:
+        """Why a one-line 7E1 reply read to its end stopped: NO_REPLY (no character),
+        None (its CR LF: complete, to be checked), TOO_LONG (the reply's limit) or IDLE."""
+        if not chars:
+            return NO_REPLY
         if ends_line(chars):
-            return chars, None
-        return chars, TOO_LONG if len(chars) >= limit else IDLE
+            return None
+        return TOO_LONG if len(chars) >= framing.max_chars else IDLE
 
     def _judge_reply(
         self,
