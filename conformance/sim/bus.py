@@ -399,10 +399,11 @@ class SimLink(Link):
         some 2,000 a fault-matrix row). Returns the characters of both reads together (none:
         no character began before ``deadline``), or None, having done nothing, where the
         reads cannot go so (characters already queued, a bus that commits frame by frame,
-        a transcript that keeps events its own way): the caller then reads as usual."""
+        a transcript that keeps events its own way, a receive of the link's own): the
+        caller then reads as usual."""
         bus = self.bus
-        if bus.rx or type(self).receive is not SimLink.receive:
-            return None
+        if bus.rx or type(self).receive is not SimLink.receive or "receive" in vars(self):
+            return None  # (a receive of its own, a wrapped one included, reads as it will)
         transcript = bus.transcript
         if type(transcript).add is not Transcript.add or "add" in vars(transcript):
             return None

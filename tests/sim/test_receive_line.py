@@ -115,3 +115,12 @@ def test_as_the_two_reads_at_every_stop(text, most, deadline, gap):
         return got, link.now(), list(link.transcript.events), link.bus.devices[0].next_frame()
 
     assert read(True) == read(False)
+
+
+def test_gives_way_to_a_receive_of_its_own():
+    """A link whose receive is wrapped (a test counting reads) reads through it."""
+    _, link, _ = sim_sensor()
+    _reply(link, "0\r\n", 0.01)
+    link.receive = link.receive  # type: ignore[method-assign]
+    assert link.receive_line(1.0, lambda e: 2.0, 80, 0.01) is None
+    assert link.transcript.events == []
