@@ -11,8 +11,6 @@ retries a merely imperfect reply nor accepts garbage as data.
 from __future__ import annotations
 
 import re
-from itertools import islice, repeat
-from operator import attrgetter, gt, sub
 
 from ..protocol.binary import EMPTY_LEN, DataType, packet_length, type_size
 from ..protocol.commands import ADDRESS_CHARS, Command, Kind, count_digits
@@ -247,9 +245,12 @@ def _ascii_problem(
         bad = next((i for i, e in enumerate(events) if not e.parity_ok), None)
         if bad is not None:
             return f"parity error in character {bad + 1}"
-    gap = _first_long_gap(events, gap_limit, multiline)
-    if gap is not None:
-        return f"{gap * 1e3:.2f} ms of marking inside the reply"
+    for i in range(1, len(events)):
+        if multiline and events[i - 1].char7 == LF:
+            continue  # between lines: up to 150 ms (R-4.4.13.1-03), judged elsewhere
+        gap = events[i].start - events[i - 1].end
+        if gap > gap_limit:
+            return f"{gap * 1e3:.2f} ms of marking inside the reply"
     # the text: those wire bytes' seven bits where every event is a character (a reply
     # nearly always), else decoded character by character
     if text is None:
@@ -272,31 +273,6 @@ def _ascii_problem(
     if expected is not None and body[0] != expected:
         return f"reply from address {escape(body[0])}, expected {escape(expected)}"
     return _shape_problem(command, body, crc_expected) if command is not None else None
-
-
-def _first_long_gap(events: list[Event], gap_limit: float, multiline: bool) -> float | None:
-    """The first marking between two characters of a reply longer than ``gap_limit`` (s),
-    or None; in a multi-line text not after an LF (between lines: up to 150 ms,
-    R-4.4.13.1-03, judged elsewhere). A one-line reply's gaps are compared in C (the same
-    subtractions and comparisons, a NaN never longer), the loop run only to find the one
-    that is: every reply the engine reads is checked so (issue 22, matrix18)."""
-    if not multiline:
-        if len(events) < 2:
-            return None
-        gaps = list(map(sub, map(_START, islice(events, 1, None)), map(_END, events)))
-        if not any(map(gt, gaps, repeat(gap_limit))):
-            return None
-        return next(gap for gap in gaps if gap > gap_limit)
-    for i in range(1, len(events)):
-        if events[i - 1].char7 == LF:
-            continue
-        gap = events[i].start - events[i - 1].end
-        if gap > gap_limit:
-            return gap
-    return None
-
-
-_START, _END = attrgetter("start"), attrgetter("end")
 
 
 def _chars_text(events: list[Event], wires: bytes | None) -> str:

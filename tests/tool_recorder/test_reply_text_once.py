@@ -3,69 +3,20 @@ each 7E1 reply it judges once, checks it from that text (``validity.check_ascii(
 and leaves the text on the attempt (``Attempt.reply_text``), which every later reader asks
 (the buffer watch, ``Exchange.reply_text`` and the judges through it). The text carried is
 ``decode_7e1`` of the reply's events at every moment, also after the list grew in place
-or was replaced; and a one-line reply's marking is compared in C (``_first_long_gap``),
-finding the gap the pair-by-pair loop found, NaN stamps included."""
+or was replaced."""
 
 from __future__ import annotations
-
-import math
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conformance.protocol import commands as cmds
-from conformance.protocol.framing import LF
 from conformance.tool_recorder import ToolRecorder, validity
 from conformance.tool_recorder.records import Attempt, Exchange
-from conformance.transcript import DUT, TOOL, Event, EventKind, decode_7e1, to_wire_7e1
+from conformance.transcript import DUT, TOOL, Event, EventKind, decode_7e1
 from tests.support.hand_events import chars
 
 CHAR = 8.333e-3
-
-
-def _old_first_long_gap(events: list[Event], gap_limit: float, multiline: bool) -> float | None:
-    """validity._ascii_problem's gap loop before matrix18, word for word (its gap)."""
-    for i in range(1, len(events)):
-        if multiline and events[i - 1].char7 == LF:
-            continue
-        gap = events[i].start - events[i - 1].end
-        if gap > gap_limit:
-            return gap
-    return None
-
-
-gaps = st.sampled_from([0.0, 0.0, 0.0, 1e-3, 0.00873, 0.009, 0.2, -1e-3, math.nan, math.inf])
-
-
-@settings(max_examples=800, deadline=None)
-@given(
-    st.lists(st.tuples(gaps, st.sampled_from("0+1\r\n\x02")), max_size=9),
-    st.sampled_from([0.00873, 0.0104]),
-    st.booleans(),
-)
-def test_first_long_gap_as_the_loop(spec, gap_limit, multiline):
-    events, t = [], 0.02
-    for gap, c in spec:
-        t += gap
-        events.append(Event(EventKind.CHAR, DUT, t, t + CHAR, to_wire_7e1(ord(c))))
-        t = t + CHAR if not math.isnan(t) else 0.5
-    found = validity._first_long_gap(events, gap_limit, multiline)
-    old = _old_first_long_gap(events, gap_limit, multiline)
-    assert found == old or (found is not None and old is not None and math.isnan(found + old))
-
-
-def test_the_first_long_gap_of_several():
-    events = chars(DUT, "0+1\r\n", 0.02)
-    moved = [events[0], *(replace_start(e, e.start + 0.02) for e in events[1:3])]
-    moved += [replace_start(e, e.start + 0.05) for e in events[3:]]
-    assert validity._first_long_gap(moved, 0.0104, False) == _old_first_long_gap(
-        moved, 0.0104, False
-    )
-    assert abs(validity._first_long_gap(moved, 0.0104, False) - 0.02) < 1e-12
-
-
-def replace_start(e: Event, start: float) -> Event:
-    return Event(e.kind, e.origin, start, start + (e.end - e.start), e.wire)
 
 
 def test_check_ascii_given_the_text_answers_as_without():
