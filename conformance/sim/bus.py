@@ -435,17 +435,42 @@ class SimLink(Link):
         # the second read: its limit from the first character (receive's idle rule), then
         # on through the same planned run, as _kept_run goes with a LineEnd of [first]
         rest = rest_deadline(first)
-        limit = min(rest, first.end + idle)
-        room, last7 = most, wire & 0x7F
+        waited = None  # where the read's limit stopped it (the clock goes there)
+        try:
+            waited, ended = self._rest_of_run(frames, got, rest, most, idle, now)
+        finally:
+            device.pop_frames(len(got))
+            if waited is not None:  # receive's end at its limit: the line marked till then
+                clock.advance_to(max(waited, clock.now))
+        if ended:
+            return got
+        # that transmission is all on the wire: the second read goes on as receive does
+        return got + self.receive(rest, until=LineEnd(got, most), idle=idle)
+
+    def _rest_of_run(
+        self,
+        frames: Iterator[tuple[float, int, float]],
+        got: list[Event],
+        rest: float,
+        most: int,
+        idle: float,
+        now: float,
+    ) -> tuple[float | None, bool]:
+        """:meth:`receive_line`'s second read over the planned run ``frames``, after the
+        first character ``got[0]``, the clock at ``now`` (written back when it ends): the
+        characters into ``got`` (and the transcript) as :meth:`_kept_run` takes them with
+        ``LineEnd([first], most)``, the limit ``rest`` and ``idle``. Returns the limit that
+        stopped it (None: none did) and whether the read is over (False: the run ran out)."""
+        clock = self.bus.clock
+        keep = self.bus.transcript.events.append
+        limit = min(rest, got[0].end + idle)
+        room, last7 = most, got[0].wire & 0x7F
         char = EventKind.CHAR
         set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
-        keep = transcript.events.append
-        waited = None  # where the read's limit stopped it (the clock goes there)
         try:
             for start, wire, duration in frames:
                 if start >= limit:
-                    waited = limit
-                    return got
+                    return limit, True
                 if start < now:
                     start = now
                 end = start + duration
@@ -464,17 +489,13 @@ class SimLink(Link):
                 got.append(made)
                 wire7 = wire & 0x7F
                 if len(got) >= room or (last7 == 0x0D and wire7 == 0x0A):
-                    return got
+                    return None, True
                 last7 = wire7
                 later = end + idle
                 limit = later if later < rest else rest  # min(rest, later)
+            return None, False
         finally:
             clock.now = now
-            device.pop_frames(len(got))
-            if waited is not None:  # receive's end at its limit: the line marked till then
-                clock.advance_to(max(waited, clock.now))
-        # that transmission is all on the wire: the second read goes on as receive does
-        return got + self.receive(rest, until=LineEnd(got, most), idle=idle)
 
     def _take_run(
         self,
