@@ -186,8 +186,13 @@ class Command:
         return self._measurement_code()
 
     def text(self) -> str:
-        """Canonical wire text, e.g. ``0MC1!``."""
-        return f"{self.address}{self.code}!"
+        """Canonical wire text, e.g. ``0MC1!``. Made once per command object (it is frozen,
+        and a parsed text gives the same object again): the tool recorder asks it of every
+        command it sends, some 1,400 a fault-matrix row (issue 22, matrix18)."""
+        made = self.__dict__.get("_text")
+        if made is None:
+            made = self.__dict__["_text"] = f"{self.address}{self.code}!"
+        return made
 
     def encode(self) -> bytes:
         return self.text().encode("ascii")

@@ -19,7 +19,7 @@ from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt, Exchange
-from ..transcript import SEVEN_BITS, decode_7e1
+from ..transcript import SEVEN_BITS
 from .late_watch import LateStartWatch
 
 
@@ -42,7 +42,7 @@ class BufferWatchHooks(Hooks):
     ) -> Attempt:
         """The engine's attempt, noted."""
         attempt = proceed()
-        reply = decode_7e1(attempt.reply_events)
+        reply = attempt.reply_text  # decoded once, by the engine (Attempt.reply_text)
         self.last_sent[address] = (command, reply)
         self.late.note(attempt, wire.translate(SEVEN_BITS).decode("latin-1"))
         return attempt

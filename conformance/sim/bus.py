@@ -383,6 +383,120 @@ class SimLink(Link):
             bus.clock.advance_to(max(limit, bus.clock.now))
             return got
 
+    def receive_line(
+        self,
+        deadline: float,
+        rest_deadline: Callable[[Event], float],
+        most: int,
+        idle: float,
+    ) -> list[Event] | None:
+        """A one-line reply's two reads in one pass over the lone device's planned run:
+        ``receive(deadline, until=<any character>)`` for its first character, then, where
+        that is not the reply already, ``receive(rest_deadline(first), until=LineEnd([first],
+        most), idle=idle)`` for the rest (the tool recorder's read of a one-line 7E1 reply,
+        ``ToolRecorder._listen``), with the same events, stamps, clock and device's state
+        (issue 22, matrix18: a second read, its planned run and its device's offer per reply,
+        some 2,000 a fault-matrix row). Returns the characters of both reads together (none:
+        no character began before ``deadline``), or None, having done nothing, where the
+        reads cannot go so (characters already queued, a bus that commits frame by frame,
+        a transcript that keeps events its own way, a receive of the link's own): the
+        caller then reads as usual."""
+        bus = self.bus
+        if bus.rx or type(self).receive is not SimLink.receive or "receive" in vars(self):
+            return None  # (a receive of its own, a wrapped one included, reads as it will)
+        transcript = bus.transcript
+        if type(transcript).add is not Transcript.add or "add" in vars(transcript):
+            return None
+        run = bus.planned_run()
+        if run is None:
+            return None
+        device, frames = run
+        clock = bus.clock
+        now = clock.now
+        for start, wire, duration in frames:
+            if start >= deadline:  # the first read's run stopped at its limit
+                clock.advance_to(max(deadline, now))
+                return []
+            if start < now:  # max(start, now), spelt out (SimLink._kept_run)
+                start = now
+            end = start + duration
+            first = wire_event(EventKind.CHAR, DUT, start, end, wire)
+            transcript.events.append(first)
+            if end > now:
+                now = end
+            break
+        else:
+            return None  # no frame offered after all: nothing done, read as usual
+        got = [first]
+        if most <= 1:  # the reply is at its limit already: no second read
+            clock.now = now
+            device.pop_frames(1)
+            return got
+        # the second read: its limit from the first character (receive's idle rule), then
+        # on through the same planned run, as _kept_run goes with a LineEnd of [first]
+        rest = rest_deadline(first)
+        waited = None  # where the read's limit stopped it (the clock goes there)
+        try:
+            waited, ended = self._rest_of_run(frames, got, rest, most, idle, now)
+        finally:
+            device.pop_frames(len(got))
+            if waited is not None:  # receive's end at its limit: the line marked till then
+                clock.advance_to(max(waited, clock.now))
+        if ended:
+            return got
+        # that transmission is all on the wire: the second read goes on as receive does
+        return got + self.receive(rest, until=LineEnd(got, most), idle=idle)
+
+    def _rest_of_run(
+        self,
+        frames: Iterator[tuple[float, int, float]],
+        got: list[Event],
+        rest: float,
+        most: int,
+        idle: float,
+        now: float,
+    ) -> tuple[float | None, bool]:
+        """:meth:`receive_line`'s second read over the planned run ``frames``, after the
+        first character ``got[0]``, the clock at ``now`` (written back when it ends): the
+        characters into ``got`` (and the transcript) as :meth:`_kept_run` takes them with
+        ``LineEnd([first], most)``, the limit ``rest`` and ``idle``. Returns the limit that
+        stopped it (None: none did) and whether the read is over (False: the run ran out)."""
+        clock = self.bus.clock
+        keep = self.bus.transcript.events.append
+        limit = min(rest, got[0].end + idle)
+        room, last7 = most, got[0].wire & 0x7F
+        char = EventKind.CHAR
+        set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
+        try:
+            for start, wire, duration in frames:
+                if start >= limit:
+                    return limit, True
+                if start < now:
+                    start = now
+                end = start + duration
+                made = new_event(Event)
+                set_kind(made, char)
+                set_origin(made, DUT)
+                set_start(made, start)
+                set_end(made, end)
+                set_wire(made, wire)
+                set_text(made, "")
+                set_u(made, 0.0)
+                set_du(made, None)
+                keep(made)
+                if end > now:
+                    now = end
+                got.append(made)
+                wire7 = wire & 0x7F
+                if len(got) >= room or (last7 == 0x0D and wire7 == 0x0A):
+                    return None, True
+                last7 = wire7
+                later = end + idle
+                limit = later if later < rest else rest  # min(rest, later)
+            return None, False
+        finally:
+            clock.now = now
+
     def _take_run(
         self,
         run: tuple[PlansFrames, Iterator[tuple[float, int, float]]],

@@ -37,7 +37,15 @@ from ..protocol.timing import (
     TOLERANCE,
 )
 from ..protocol.values import continues_split_value, split_values
-from ..transcript import TOOL, Event, EventKind, encode_7e1, text_end, to_wire_7e1
+from ..transcript import (
+    TOOL,
+    Event,
+    EventKind,
+    decode_7e1,
+    encode_7e1,
+    text_end,
+    to_wire_7e1,
+)
 from ..view.segments import continues_frame
 from . import validity
 from .contention import HOLD_PREFIX, ApartSoFar, collisions, maybe_note_text
@@ -549,20 +557,27 @@ class ToolRecorder:
             binary, not binary and (command is None or command.kind is Kind.EXTENDED)
         )
         reply, state, collided = self._listen(command_end, framing)
+        text: str | None = None
         if collided:
             self.note_collisions()
             self._note_maybe_collided(break_event, sent, collided)
         if collided:  # the DUT talked over the command: it may not have heard it whole
             state = f"{CONTENTION} ({len(collided)} characters during the command)"
         elif state is None:
-            state = self._judge_reply(reply, command, address, command_end, framing, crc)
+            # the reply's text, decoded once: the check reads it, and the attempt carries it
+            # to every later reader (Attempt.reply_text)
+            text = None if framing.binary else decode_7e1(reply)
+            state = self._judge_reply(reply, command, address, command_end, framing, crc, text)
         if reply and not collided and command is not None and command.kind is Kind.ACKNOWLEDGE:
             self.acknowledged.add(address)
         if not collided and not framing.is_text(reply) and closes_exchange(command, reply):
             self._closed_reply_end = reply[-1].end
-        return Attempt(
+        attempt = Attempt(
             break_event, sent, reply, state, self.link.now(), stray_events=stray + collided
         )
+        if text is not None:
+            attempt.knows_reply_text(text)
+        return attempt
 
     def _framing(self, binary: bool, multiline: bool) -> Framing:
         """:func:`framing_for` this engine's policy, made once per policy object and kind
@@ -589,6 +604,16 @@ class ToolRecorder:
         ended: they collided with it (a late reply to an earlier transmission, say) and are
         never this command's answer. Every read has a deadline."""
         deadline = command_end + self.policy.first_char_timeout
+        one_line = not (framing.binary or framing.multiline)
+        line_at_once = getattr(type(self.link), "reads_line_at_once", False)
+        if one_line and line_at_once and self.link.now() >= command_end:
+            # a sim link reads a one-line reply in one pass (SimLink.receive_line): what
+            # began after the clock began after the command, so nothing collided with it
+            line = getattr(self.link, "receive_line", None)
+            got = None if line is None else line(deadline, framing.deadline, framing.max_chars,
+                                                 framing.idle)  # fmt: skip
+            if got is not None:
+                return got, self._line_state(got, framing), []
         collided: list[Event] = []
         first = self.link.receive(deadline, until=lambda got: True)
         slack = self.link.info.timing_uncertainty
@@ -603,9 +628,7 @@ class ToolRecorder:
             return [], NO_REPLY, collided
         deadline = framing.deadline(first[0])
         chars = first
-        if getattr(type(self.link), "reads_line_at_once", False) and not (
-            framing.binary or framing.multiline
-        ):
+        if line_at_once and one_line:
             reply, state = self._rest_of_line(chars, deadline, framing)
             return reply, state, collided
         while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
@@ -641,9 +664,17 @@ class ToolRecorder:
             chars = chars + self.link.receive(
                 deadline, until=LineEnd(chars, limit), idle=framing.idle
             )
+        return chars, self._line_state(chars, framing)
+
+    @staticmethod
+    def _line_state(chars: list[Event], framing: Framing) -> str | None:
+        """Why a one-line 7E1 reply read to its end stopped: NO_REPLY (no character),
+        None (its CR LF: complete, to be checked), TOO_LONG (the reply's limit) or IDLE."""
+        if not chars:
+            return NO_REPLY
         if ends_line(chars):
-            return chars, None
-        return chars, TOO_LONG if len(chars) >= limit else IDLE
+            return None
+        return TOO_LONG if len(chars) >= framing.max_chars else IDLE
 
     def _judge_reply(
         self,
@@ -653,7 +684,10 @@ class ToolRecorder:
         command_end: float,
         framing: Framing,
         crc: bool | None,
+        text: str | None = None,
     ) -> str:
+        """OK, or why the finished ``reply`` is invalid (:mod:`.validity`); ``text``: its
+        ``decode_7e1`` where the caller has it."""
         if framing.binary:
             why = validity.check_packet(reply, address=address, command_end=command_end)
         else:
@@ -666,6 +700,7 @@ class ToolRecorder:
                 gap_limit=gap_limit,
                 crc_expected=crc,
                 multiline=framing.is_text(reply),
+                text=text,
             )
         return OK if why is None else f"invalid: {why}"
 

@@ -58,6 +58,31 @@ class Attempt:
             return self.break_event.start
         return self.command_events[0].start if self.command_events else self.end
 
+    @property
+    def reply_text(self) -> str:
+        """``decode_7e1(self.reply_events)``, decoded once per reply rather than by each
+        reader (the engine's validity check, the buffer watch, every judge asking an
+        exchange's ``reply_text``: some 4 decodes a reply, issue 22, matrix18). Kept with
+        the list it was read from, its length and its last event: a reply only ever grows
+        by appending (a golden recorder reads on into it), or is replaced whole."""
+        events = self.reply_events
+        made = self.__dict__.get("_text")
+        if (
+            made is None
+            or made[0] is not events
+            or made[1] != len(events)
+            or (events and made[2] is not events[-1])
+        ):
+            made = (events, len(events), events[-1] if events else None, decode_7e1(events))
+            self.__dict__["_text"] = made
+        return made[3]
+
+    def knows_reply_text(self, text: str) -> None:
+        """Keep ``text``, which its maker read as ``decode_7e1(self.reply_events)``, as
+        :attr:`reply_text` (the engine's validity check decoded it already)."""
+        events = self.reply_events
+        self.__dict__["_text"] = (events, len(events), events[-1] if events else None, text)
+
 
 @dataclass
 class Exchange:
@@ -127,7 +152,7 @@ class Exchange:
     @property
     def reply_text(self) -> str:
         """The judged attempt's reply as 7-bit text, CR LF included (parity stripped)."""
-        return decode_7e1(self.reply_events)
+        return self.judged.reply_text
 
     @property
     def reply_bytes(self) -> bytes:
@@ -218,7 +243,7 @@ def _values_held(attempt: Attempt, binary: bool) -> int:
     characters cut off; a packet's as its size and type give them)."""
     if binary:
         return packet_value_count(decode_8n1(attempt.reply_events))
-    text = data_values_text(decode_7e1(attempt.reply_events), False)
+    text = data_values_text(attempt.reply_text, False)
     return len(split_values(salvaged_values_text(text)))
 
 

@@ -14,7 +14,7 @@ import re
 
 from ..protocol.binary import EMPTY_LEN, DataType, packet_length, type_size
 from ..protocol.commands import ADDRESS_CHARS, Command, Kind, count_digits
-from ..protocol.crc import ASCII_CRC_LEN, ascii_crc, binary_crc, is_crc_char
+from ..protocol.crc import ASCII_CRC_LEN, ascii_crc, binary_crc
 from ..protocol.framing import CR, CRLF, LF, TEXT_END, crc_tail, strip_crlf, unprintable
 from ..transcript import (
     GOOD_PARITY,
@@ -30,6 +30,9 @@ from ..transcript import (
 _TYPE_CODES = frozenset(int(t) for t in DataType)  # R-5.2.1-01: codes above 10 are invalid
 _VALUES = re.compile(r"([+-][0-9.]+)*")
 _CHAR = EventKind.CHAR
+#: a character an ASCII CRC may hold (``is_crc_char``: 0x40..0x7F), searched for in C rather
+#: than asked of each character of every D reply without a CRC (issue 22, matrix18)
+_CRC_CHAR = re.compile("[\x40-\x7f]")
 
 __all__ = [
     "check_ascii",
@@ -120,7 +123,7 @@ def _reply_address(command: Command) -> str | None:
 def _crc_problem(body: str, crc_expected: bool | None) -> str | None:
     checked, crc = split_crc(body, crc_expected)
     if crc is None:
-        if crc_expected is False and any(is_crc_char(c) for c in body[1:]):
+        if crc_expected is False and _CRC_CHAR.search(body, 1) is not None:
             return "unexpected CRC characters"
         return None
     if len(body) <= ASCII_CRC_LEN:
@@ -195,11 +198,14 @@ def check_ascii(
     gap_limit: float,
     crc_expected: bool | None = None,
     multiline: bool = False,
+    text: str | None = None,
 ) -> str | None:
     """Why a finished 7E1 reply is invalid (R-7.2-05), or None if the engine accepts it.
 
     ``address`` is used when the command could not be parsed (raw probes). ``multiline``:
     an ``a<STX>...<CR><LF><ETX>`` text, where the pauses between lines are allowed.
+    ``text``: ``decode_7e1(events)`` where the caller has it already (the engine decodes
+    a reply once and carries the text with it, :attr:`Attempt.reply_text`).
 
     A pure function of its arguments, asked twice about nearly every reply of a sensor run:
     by the tool recorder as it reads the reply, then by the view's records of the stimulus
@@ -210,7 +216,9 @@ def check_ascii(
     kept = _JUDGED.get(key)
     if kept is not None and kept[0] == events:
         return kept[1]
-    why = _ascii_problem(command, events, address, command_end, gap_limit, crc_expected, multiline)
+    why = _ascii_problem(
+        command, events, address, command_end, gap_limit, crc_expected, multiline, text
+    )
     if len(_JUDGED) >= _JUDGED_MAX:
         _JUDGED.clear()
     _JUDGED[key] = (list(events), why)
@@ -225,6 +233,7 @@ def _ascii_problem(
     gap_limit: float,
     crc_expected: bool | None,
     multiline: bool,
+    text: str | None = None,
 ) -> str | None:
     """:func:`check_ascii`, worked out."""
     if events and events[0].start < command_end:
@@ -244,7 +253,8 @@ def _ascii_problem(
             return f"{gap * 1e3:.2f} ms of marking inside the reply"
     # the text: those wire bytes' seven bits where every event is a character (a reply
     # nearly always), else decoded character by character
-    text = _chars_text(events, wires)
+    if text is None:
+        text = _chars_text(events, wires)
     if multiline:
         return _text_problem(text, address if command is None else command.address)
     if not text.endswith(CRLF):

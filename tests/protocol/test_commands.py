@@ -245,3 +245,26 @@ def test_random_bytes_raise_only_command_error(data: bytes) -> None:
     except CommandError:
         return
     assert command.encode() == data
+
+
+def _text_made(command: Command) -> str:
+    """Command.text() worked out, as before matrix18 kept it on the command."""
+    return f"{command.address}{command.code}!"
+
+
+@pytest.mark.parametrize("command", ALL_FORMS, ids=[x.text() for x in ALL_FORMS])
+def test_text_kept_is_the_text_made(command: Command) -> None:
+    """Issue 22, matrix18: a command's text is made once and kept on it (frozen); asked
+    again, after an address change (a new command), and after a pickle round trip, it is
+    the text the command's fields make, and it leaves equality and hashing alone."""
+    import pickle
+
+    assert command.text() == _text_made(command)
+    assert command.text() is command.text()  # kept
+    moved = command.with_address("7")
+    assert moved.text() == _text_made(moved) and moved.text().startswith("7")
+    again = pickle.loads(pickle.dumps(command))
+    assert again == command and hash(again) == hash(command)
+    assert again.text() == _text_made(again)
+    fresh = Command(**{f: getattr(command, f) for f in command.__dataclass_fields__})
+    assert fresh == command and hash(fresh) == hash(command)
