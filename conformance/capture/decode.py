@@ -27,7 +27,6 @@ from .glitch_filter import DEFAULT_BITS, GlitchFilter
 from .heap import give_back_freed_heap
 from .uart import HOLD_FRAMES, SYNC_BITS, Decoded, Framing, _synchronised, decode
 from .uart_bulk import Batch, decode_batches
-from .uart_bulk import decode as decode_bulk
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 #: Clean characters the short polarity probe (the first :data:`PROBE_EDGES` edges) must read
@@ -112,30 +111,66 @@ class CaptureDecode:
         return min(vals), statistics.median(vals), max(vals)
 
 
-def _score(decoded: list[Decoded]) -> int:
-    good = sum(d.kind == "char" and not (d.framing_error or d.parity_error) for d in decoded)
-    bad = sum(
-        (d.kind == "char" and (d.framing_error or d.parity_error)) or d.kind == "glitch"
-        for d in decoded
-    )
-    return good - bad
+#: what a probe needs of each decoded item: a clean character, a character with a framing or
+#: parity error, a glitch, or anything else (a break, a spacing pulse, a partial frame)
+OTHER, CLEAN, BAD_CHAR, GLITCH = 0, 1, 2, 3
 
 
-def _clean_winner(decoded: dict[bool, list[Decoded]]) -> bool | None:
-    """The polarity whose decode of the short probe is beyond doubt: at least
-    :data:`SHORT_PROBE_CLEAN` clean characters and no bad frame or glitch (the last item
-    aside: the probe's cut may fall inside a frame), while the other scores lower. None:
-    not decisive, the whole first block decides."""
-    for inv, items in decoded.items():
-        body = items[:-1]
-        clean = sum(d.kind == "char" for d in body)
-        bad = any(
-            d.kind == "glitch" or (d.kind == "char" and (d.framing_error or d.parity_error))
-            for d in body
-        )
+def _code(d: Decoded) -> int:
+    """``d``'s probe code (:data:`CLEAN`, :data:`BAD_CHAR`, :data:`GLITCH`, :data:`OTHER`)."""
+    if d.kind == "char":
+        return BAD_CHAR if d.framing_error or d.parity_error else CLEAN
+    return GLITCH if d.kind == "glitch" else OTHER
+
+
+def _score(codes: list[int]) -> int:
+    """Clean characters less bad ones and glitches, of items given by their probe codes."""
+    return codes.count(CLEAN) - codes.count(BAD_CHAR) - codes.count(GLITCH)
+
+
+def _clean_winner(decoded: dict[bool, list[int]]) -> bool | None:
+    """The polarity whose decode of the short probe (its items' probe codes) is beyond
+    doubt: at least :data:`SHORT_PROBE_CLEAN` clean characters and no bad frame or glitch
+    (the last item aside: the probe's cut may fall inside a frame), while the other scores
+    lower. None: not decisive, the whole first block decides."""
+    for inv, codes in decoded.items():
+        body = codes[:-1]
+        clean = body.count(CLEAN) + body.count(BAD_CHAR)
+        bad = BAD_CHAR in body or GLITCH in body
         if clean >= SHORT_PROBE_CLEAN and not bad and _score(body) > _score(decoded[not inv][:-1]):
             return inv
     return None
+
+
+def _probe_codes(
+    edges: list[int],
+    *,
+    initial_level: int,
+    tick_rate: float,
+    baud: float,
+    invert: bool,
+    framing: Framing,
+) -> list[int]:
+    """The probe codes of what ``decode([edges], ...)`` gives (t0 0, no uncertainty), item
+    for item, without making an event or item of each certified frame: the bulk decoder's
+    batches, their first :data:`~.uart.HOLD_FRAMES` items synchronised as
+    :func:`_collect_batches` does, each certified frame's code read from its batch's
+    lists (the probe decodes 2,000 edges both ways on each channel of a capture)."""
+    kw = dict(initial_level=initial_level, tick_rate=tick_rate, baud=baud, invert=invert)
+    if not BULK:
+        return [_code(d) for d in decode([edges], framing=framing, **kw)]
+    batches = list(decode_batches([edges], framing=framing, **kw))
+    _synchronise_head(batches, 0.0, SYNC_BITS * (tick_rate / baud) / tick_rate, 0.0)
+    codes: list[int] = []
+    add = codes.append
+    for b in batches:
+        fe, pe = b.framing_error, b.parity_error
+        for x in b.order:
+            if x.__class__ is int:
+                add(BAD_CHAR if fe[x] or pe[x] else CLEAN)  # type: ignore[index]
+            else:
+                add(_code(x))  # type: ignore[arg-type]
+    return codes
 
 
 def _choose_polarity(
@@ -148,13 +183,13 @@ def _choose_polarity(
     thousands: decoding all of them twice was most of a short capture's probe); only when
     they read cleanly one way (:func:`_clean_winner`) is that taken, anything less clear is
     decided on the whole ``prefix`` as before (``tests/capture/test_polarity_probe.py``
-    holds a capture whose first edges alone would pick the wrong polarity)."""
+    holds a capture whose first edges alone would pick the wrong polarity). Each way's
+    items are read as probe codes (:func:`_probe_codes`), none made."""
     kw = dict(initial_level=edges.initial_level, tick_rate=edges.tick_rate, baud=baud)
-    items = decode_bulk if BULK else decode
     if len(prefix) > PROBE_EDGES:
         short = prefix[:PROBE_EDGES]
         tried = {
-            inv: list(items([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
+            inv: _probe_codes(short, invert=inv, framing=framing, **kw) for inv in (False, True)
         }
         inv = _clean_winner(tried)
         if inv is not None:
@@ -163,7 +198,7 @@ def _choose_polarity(
                 f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames",
             )
     scores = {
-        inv: _score(list(items([prefix], invert=inv, framing=framing, **kw)))
+        inv: _score(_probe_codes(prefix, invert=inv, framing=framing, **kw))
         for inv in (False, True)
     }
     if abs(scores[False] - scores[True]) > CLEAN_LEAD:
