@@ -12,9 +12,11 @@ from __future__ import annotations
 import os
 import statistics
 from array import array
+from bisect import bisect_left
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
-from itertools import chain
+from itertools import chain, compress, count, repeat
+from operator import is_not
 
 import numpy as np
 
@@ -423,54 +425,159 @@ def _collect_batches(
         add = into.add
     if (cols := out.columns) is not None:
         add, (put_s, put_e, put_w, put_o) = cols.add_made, cols.appenders()
+    stretched = cols is not None or into is not None
+    tx = _TxArrays.of(marks) if stretched and n_tx else None
     for b in chain(head, batches):
         st, en, wi, fe, pe, err, gl = (
             b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
         )  # fmt: skip
-        for x in b.order:
-            if x.__class__ is int:
-                s, w = st[x], wi[x]  # type: ignore[index]
+        for part in _stretches(b.order) if stretched else (b.order,):
+            if part.__class__ is range:  # a stretch of certified frames, taken whole
+                p, q = part.start, part.stop
                 if into is not None:
-                    add(char, s, w)
+                    into.start.extend(st[p:q])
+                    into.kind.extend([char] * (q - p))
+                    into.wire.extend(wi[p:q])
                 else:
-                    o = bus
-                    if n_tx:
-                        while j < n_tx and tx_start[j] < s - tol:
-                            j += 1
-                        hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
-                        if hit and tx_kind[j] is char:
-                            o, j, matched = recorder, j + 1, matched + 1
-                    if cols is None:
-                        add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
-                    else:  # four columns, no event
-                        put_s(s), put_e(en[x]), put_w(w), put_o(o)  # type: ignore[index]
-                chars += 1
-                e = err[x]  # type: ignore[index]
-                baud_error(nan if e is None else e)
-                if fe[x] or pe[x] or gl[x]:  # type: ignore[index]
-                    framing_errors += fe[x]  # type: ignore[index]
-                    parity_errors += pe[x]  # type: ignore[index]
-                    glitches += gl[x]  # type: ignore[index]
-                    problems.append(b.item(x, unc))  # type: ignore[arg-type]
-                continue
-            d: Decoded = x  # type: ignore[assignment]
-            if (ev := d.event) is not None:
-                if into is not None:
-                    add(ev.kind, ev.start, ev.wire)
-                    tally.item(d)
+                    found = _origins(tx, b, p, q, j, tol, bus) if n_tx else ([bus] * (q - p), j, 0)
+                    if found is None:  # the TX matching does not reduce to a search: one by one
+                        part = list(part)
+                    else:
+                        origins, j, hits = found
+                        matched += hits
+                        cols.start.extend(st[p:q])  # type: ignore[union-attr]
+                        cols.end.extend(en[p:q])  # type: ignore[union-attr]
+                        cols.wire.extend(wi[p:q])  # type: ignore[union-attr]
+                        cols.origin.extend(origins)  # type: ignore[union-attr]
+                if part.__class__ is range:
+                    chars += q - p
+                    out.baud_error_pct.extend(b.err_nan[p:q])
+                    flagged = b.flagged
+                    for x in flagged[bisect_left(flagged, p) : bisect_left(flagged, q)]:
+                        framing_errors += fe[x]
+                        parity_errors += pe[x]
+                        glitches += gl[x]
+                        problems.append(b.item(x, unc))
                     continue
-                o = bus
-                if marks is not None and mark is not None:
-                    o, j, matched = marks.resumed(j, matched, ev.kind, ev.start, ev.wire, bus)
-                if o != BUS:
-                    u, du = ev.uncertainty, ev.duration_uncertainty
-                    ev = event(ev.kind, o, ev.start, ev.end, ev.wire, ev.text, u, du)
-                add(ev)
-            tally.item(d)
+            for x in part:
+                if x.__class__ is int:
+                    s, w = st[x], wi[x]  # type: ignore[index]
+                    if into is not None:
+                        add(char, s, w)
+                    else:
+                        o = bus
+                        if n_tx:
+                            while j < n_tx and tx_start[j] < s - tol:
+                                j += 1
+                            hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
+                            if hit and tx_kind[j] is char:
+                                o, j, matched = recorder, j + 1, matched + 1
+                        if cols is None:
+                            add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
+                        else:  # four columns, no event
+                            put_s(s), put_e(en[x]), put_w(w), put_o(o)  # type: ignore[index]
+                    chars += 1
+                    e = err[x]  # type: ignore[index]
+                    baud_error(nan if e is None else e)
+                    if fe[x] or pe[x] or gl[x]:  # type: ignore[index]
+                        framing_errors += fe[x]  # type: ignore[index]
+                        parity_errors += pe[x]  # type: ignore[index]
+                        glitches += gl[x]  # type: ignore[index]
+                        problems.append(b.item(x, unc))  # type: ignore[arg-type]
+                    continue
+                d: Decoded = x  # type: ignore[assignment]
+                if (ev := d.event) is not None:
+                    if into is not None:
+                        add(ev.kind, ev.start, ev.wire)
+                        tally.item(d)
+                        continue
+                    o = bus
+                    if marks is not None and mark is not None:
+                        o, j, matched = marks.resumed(j, matched, ev.kind, ev.start, ev.wire, bus)
+                    if o != BUS:
+                        u, du = ev.uncertainty, ev.duration_uncertainty
+                        ev = event(ev.kind, o, ev.start, ev.end, ev.wire, ev.text, u, du)
+                    add(ev)
+                tally.item(d)
     if mark is not None:
         marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
     tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
+
+
+#: certified frames in a row, at least, that are taken whole (:func:`_stretches`): below
+#: it numpy's fixed cost per call is more than a step per frame
+STRETCH_MIN = 16
+
+
+def _stretches(order: list) -> Iterator[list | range]:
+    """A batch's items in order as stretches: each run of at least :data:`STRETCH_MIN`
+    certified frames with consecutive indices as the ``range`` of them, everything else
+    as lists of items (a certified frame's index or a decoder's item)."""
+    # the decoder's own items' places, found in C: most of a batch is certified frames
+    made = list(compress(count(), map(is_not, map(type, order), repeat(int))))
+    at = 0
+    for k in [*made, len(order)]:
+        if k - at >= STRETCH_MIN and order[k - 1] - order[at] == k - 1 - at:
+            yield range(order[at], order[k - 1] + 1)  # indices rise by one from order[at]
+        elif k > at:
+            yield order[at:k]
+        if k < len(order):
+            yield order[k : k + 1]
+        at = k + 1
+
+
+@dataclass(frozen=True)
+class _TxArrays:
+    """The TX channel's marks as arrays (starts, wires, whether a character), for a
+    stretch of bus frames matched at once (:func:`_origins`); None of a TX channel whose
+    starts are not in order (a search needs them so)."""
+
+    start: np.ndarray
+    wire: np.ndarray
+    char: np.ndarray
+
+    @classmethod
+    def of(cls, marks: Marks | None) -> _TxArrays | None:
+        if marks is None or not marks.start:
+            return None
+        start = np.array(marks.start, dtype=np.float64)
+        if start.size > 1 and not (start[1:] >= start[:-1]).all():
+            return None
+        char = EventKind.CHAR
+        return cls(
+            start, np.array(marks.wire, dtype=np.int64), np.array([k is char for k in marks.kind])
+        )
+
+
+def _origins(
+    tx: _TxArrays | None, b: Batch, p: int, q: int, j: int, tol: float, other: str
+) -> tuple[list[str], int, int] | None:
+    """The origins :meth:`Marks.origin`'s walk gives certified frames ``p..q-1`` of ``b``
+    from TX place ``j``, the place after and the matches, found by one search: each frame's
+    place is the first TX start not before its own start less ``tol`` (what the walk passes
+    to), unless the place after the frame before is past it; None when that happens (a TX
+    event within reach of two frames) or there are no arrays: the caller walks."""
+    if tx is None or b.start_array is None or b.wire_array is None:
+        return None
+    starts, n = b.start_array[p:q], tx.start.size
+    at = np.searchsorted(tx.start, starts - tol, "left")
+    if at[0] < j:
+        return None
+    near = np.minimum(at, n - 1)
+    hit = (
+        (at < n)
+        & (np.abs(tx.start[near] - starts) <= tol)
+        & (tx.wire[near] == b.wire_array[p:q])
+        & tx.char[near]
+    )
+    if at.size > 1 and not (at[1:] >= at[:-1] + hit[:-1]).all():
+        return None
+    origins = [other] * (q - p)
+    hits = np.flatnonzero(hit).tolist()
+    for i in hits:
+        origins[i] = RECORDER_ORIGIN
+    return origins, int(at[-1] + hit[-1]), len(hits)
 
 
 def _synchronised_head(

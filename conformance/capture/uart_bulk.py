@@ -35,6 +35,7 @@ from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from functools import cache
+from math import isnan
 
 import numpy as np
 
@@ -86,6 +87,14 @@ class Batch:
     start_ticks: list[int] = field(default_factory=list)
     before: list[float | None] = field(default_factory=list)
     tick_rate: float = 1.0
+    #: the certified frames' starts and wires as arrays, for a stretch of them taken whole
+    #: (:func:`~.decode._collect_batches`); None: not kept
+    start_array: np.ndarray | None = None
+    wire_array: np.ndarray | None = None
+    #: the certified frames with a framing or parity error or a glitch, in order
+    flagged: list[int] = field(default_factory=list)
+    #: ``err`` with NaN for None (the bit-rate errors as a decode lists them)
+    err_nan: list[float] = field(default_factory=list)
 
     def marking(self, p: int) -> float | None:
         """The marking before certified frame ``p``, as the scan works it out (s)."""
@@ -437,14 +446,19 @@ class _Certified:
         self.end_ticks = end.tolist()
         self.framing_error = framing_error.tolist()
         tick_rate, t0 = line.tick_rate, line.t0
+        start_s = t0 + s / tick_rate
         self.batch = Batch(
             [],
-            *_stamps(t0 + s / tick_rate, t0 + end / tick_rate),
+            *_stamps(start_s, t0 + end / tick_rate),
             wire.tolist(),
             self.framing_error,
             parity_error.tolist(),
-            _nan_as_none(err),
+            _nan_as_none(err_nan := err.tolist()),
             glitches.tolist(),
+            start_array=start_s,
+            wire_array=wire,
+            flagged=np.flatnonzero(framing_error | parity_error | (glitches > 0)).tolist(),
+            err_nan=err_nan,
         )
 
 
@@ -489,12 +503,14 @@ def _centre_levels(
     return np.cumsum(hist[:, :nbits], axis=1) & 1
 
 
-def _nan_as_none(values: np.ndarray) -> list[float | None]:
-    """``values`` as a list, None for each NaN (the reference's "no fit"), found by numpy
-    rather than a Python comparison of every frame's value."""
-    out: list[float | None] = values.tolist()
-    for i in np.flatnonzero(np.isnan(values)).tolist():
-        out[i] = None
+def _nan_as_none(values: list[float]) -> list[float | None]:
+    """``values`` with None for each NaN (the reference's "no fit"), found by a C loop
+    (``map``) rather than a Python comparison of every frame's value; a new list."""
+    out: list[float | None] = list(values)
+    if set(map(isnan, values)) != {False}:
+        for i, v in enumerate(values):
+            if v != v:
+                out[i] = None
     return out
 
 

@@ -96,7 +96,9 @@ def test_parity_table_is_the_framings_check(text):
 
 
 def test_nan_as_none():
-    values = np.array([1.5, np.nan, -0.0, np.nan])
+    values = [1.5, float("nan"), -0.0, float("nan")]
     got = uart_bulk._nan_as_none(values)
+    assert values[1] != values[1]  # the list given is left as it was
+    assert uart_bulk._nan_as_none([]) == [] and uart_bulk._nan_as_none([2.0]) == [2.0]
     assert got[0] == 1.5 and got[1] is None and got[3] is None
     assert str(got[2]) == "-0.0"
