@@ -402,14 +402,10 @@ def _collect_batches(
     marks: Marks | None = None,
     into: Marks | None = None,
 ) -> None:
-    """:func:`_collect` of :func:`~.uart.decode`'s items as :func:`~.uart_bulk.decode_batches`
-    gives them: a certified frame's event is made from the batch's lists, without a
-    :class:`~.uart.Decoded` (made only for a problem); the first :data:`~.uart.HOLD_FRAMES`
-    items, all that :func:`~.uart._synchronised` looks at, go through it as items. The
-    events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's),
-    or :data:`RECORDER_ORIGIN` where ``marks`` matches them (:meth:`Marks.origin`); with
-    ``into``, no event is made: each one's start, kind and wire go there; with
-    ``out.columns``, none either (:meth:`.WireColumns.appenders`)."""
+    """:func:`_collect` of :func:`~.uart_bulk.decode_batches`' items (the first
+    :data:`~.uart.HOLD_FRAMES` :func:`~.uart._synchronised`); origin ``origin``, or
+    :data:`RECORDER_ORIGIN` where ``marks`` matches; ``into`` or ``out.columns``: no event
+    made, the fields go there (:func:`_stretch`: a stretch of certified frames whole)."""
     unc, nan = out.uncertainty_s, float("nan")
     head = _synchronised_head(batches, unc, sync_s, t0)
     problems, tally = out.problems, _Tally(out)
@@ -418,47 +414,21 @@ def _collect_batches(
     chars = framing_errors = parity_errors = glitches = matched = 0
     char, bus, event = EventKind.CHAR, origin, full_event
     mark = marks.origin if marks is not None and marks.start else None
-    # Marks.origin spelt out for the certified frames (a call each cost what it saved)
     tx_start, tx_kind, tx_wire = (marks.start, marks.kind, marks.wire) if mark else ([], [], [])
     n_tx, tol, j, recorder = len(tx_start), marks.tolerance if mark else 0.0, 0, RECORDER_ORIGIN
-    if into is not None:
-        add = into.add
+    add = into.add if into is not None else add
     if (cols := out.columns) is not None:
         add, (put_s, put_e, put_w, put_o) = cols.add_made, cols.appenders()
     stretched = cols is not None or into is not None
     tx = _TxArrays.of(marks) if stretched and n_tx else None
     for b in chain(head, batches):
-        st, en, wi, fe, pe, err, gl = (
-            b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
-        )  # fmt: skip
+        st, en, wi, err = b.start, b.end, b.wire, b.err
+        fe, pe, gl = b.framing_error, b.parity_error, b.glitches
         for part in _stretches(b.order) if stretched else (b.order,):
-            if part.__class__ is range:  # a stretch of certified frames, taken whole
-                p, q = part.start, part.stop
-                if into is not None:
-                    into.start.extend(st[p:q])
-                    into.kind.extend([char] * (q - p))
-                    into.wire.extend(wi[p:q])
-                else:
-                    found = _origins(tx, b, p, q, j, tol, bus) if n_tx else ([bus] * (q - p), j, 0)
-                    if found is None:  # the TX matching does not reduce to a search: one by one
-                        part = list(part)
-                    else:
-                        origins, j, hits = found
-                        matched += hits
-                        cols.start.extend(st[p:q])  # type: ignore[union-attr]
-                        cols.end.extend(en[p:q])  # type: ignore[union-attr]
-                        cols.wire.extend(wi[p:q])  # type: ignore[union-attr]
-                        cols.origin.extend(origins)  # type: ignore[union-attr]
-                if part.__class__ is range:
-                    chars += q - p
-                    out.baud_error_pct.extend(b.err_nan[p:q])
-                    flagged = b.flagged
-                    for x in flagged[bisect_left(flagged, p) : bisect_left(flagged, q)]:
-                        framing_errors += fe[x]
-                        parity_errors += pe[x]
-                        glitches += gl[x]
-                        problems.append(b.item(x, unc))
-                    continue
+            taken = _stretch(b, part, out, tally, into, tx, n_tx > 0, j, tol, bus)
+            if taken is not None:  # a stretch of certified frames, taken whole
+                j, matched = taken[0], matched + taken[1]
+                continue
             for x in part:
                 if x.__class__ is int:
                     s, w = st[x], wi[x]  # type: ignore[index]
@@ -503,6 +473,52 @@ def _collect_batches(
         marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
     tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
+
+
+def _stretch(
+    b: Batch,
+    part: range | list,
+    out: CaptureDecode,
+    tally: _Tally,
+    into: Marks | None,
+    tx: _TxArrays | None,
+    matching: bool,
+    j: int,
+    tol: float,
+    other: str,
+) -> tuple[int, int] | None:
+    """Certified frames ``part`` of ``b`` taken whole by :func:`_collect_batches`: into
+    ``into`` (the TX channel's marks) or ``out.columns`` (``matching``: their origins by
+    :func:`_origins` from ``tx``, the TX's arrays; else all ``other``), their bit-rate
+    errors and problems into ``out``, their counts into ``tally``. Gives the TX place
+    after them and the TX events they matched; None when the TX matching must walk them
+    one by one (nothing taken)."""
+    if part.__class__ is not range:
+        return None  # items one by one
+    p, q = part.start, part.stop
+    st, en, wi, cols = b.start, b.end, b.wire, out.columns
+    hits = 0
+    if into is not None:
+        into.start.extend(st[p:q])
+        into.kind.extend([EventKind.CHAR] * (q - p))
+        into.wire.extend(wi[p:q])
+    elif cols is not None:
+        found = _origins(tx, b, p, q, j, tol, other) if matching else ([other] * (q - p), j, 0)
+        if found is None:
+            return None
+        origins, j, hits = found
+        cols.start.extend(st[p:q])
+        cols.end.extend(en[p:q])
+        cols.wire.extend(wi[p:q])
+        cols.origin.extend(origins)
+    out.baud_error_pct.extend(b.err_nan[p:q])
+    fe, pe, gl, flagged = b.framing_error, b.parity_error, b.glitches, b.flagged
+    f = pa = g = 0
+    for x in flagged[bisect_left(flagged, p) : bisect_left(flagged, q)]:
+        f, pa, g = f + fe[x], pa + pe[x], g + gl[x]
+        out.problems.append(b.item(x, out.uncertainty_s))
+    tally.certified(q - p, f, pa, g)
+    return j, hits
 
 
 #: certified frames in a row, at least, that are taken whole (:func:`_stretches`): below
