@@ -12,9 +12,11 @@ from __future__ import annotations
 import os
 import statistics
 from array import array
+from bisect import bisect_left
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
-from itertools import chain
+from itertools import chain, compress, count, repeat
+from operator import is_not
 
 import numpy as np
 
@@ -27,7 +29,6 @@ from .glitch_filter import DEFAULT_BITS, GlitchFilter
 from .heap import give_back_freed_heap
 from .uart import HOLD_FRAMES, SYNC_BITS, Decoded, Framing, _synchronised, decode
 from .uart_bulk import Batch, decode_batches
-from .uart_bulk import decode as decode_bulk
 
 PROBE_EDGES = 2000  # edges decoded both ways to choose the polarity
 #: Clean characters the short polarity probe (the first :data:`PROBE_EDGES` edges) must read
@@ -112,30 +113,66 @@ class CaptureDecode:
         return min(vals), statistics.median(vals), max(vals)
 
 
-def _score(decoded: list[Decoded]) -> int:
-    good = sum(d.kind == "char" and not (d.framing_error or d.parity_error) for d in decoded)
-    bad = sum(
-        (d.kind == "char" and (d.framing_error or d.parity_error)) or d.kind == "glitch"
-        for d in decoded
-    )
-    return good - bad
+#: what a probe needs of each decoded item: a clean character, a character with a framing or
+#: parity error, a glitch, or anything else (a break, a spacing pulse, a partial frame)
+OTHER, CLEAN, BAD_CHAR, GLITCH = 0, 1, 2, 3
 
 
-def _clean_winner(decoded: dict[bool, list[Decoded]]) -> bool | None:
-    """The polarity whose decode of the short probe is beyond doubt: at least
-    :data:`SHORT_PROBE_CLEAN` clean characters and no bad frame or glitch (the last item
-    aside: the probe's cut may fall inside a frame), while the other scores lower. None:
-    not decisive, the whole first block decides."""
-    for inv, items in decoded.items():
-        body = items[:-1]
-        clean = sum(d.kind == "char" for d in body)
-        bad = any(
-            d.kind == "glitch" or (d.kind == "char" and (d.framing_error or d.parity_error))
-            for d in body
-        )
+def _code(d: Decoded) -> int:
+    """``d``'s probe code (:data:`CLEAN`, :data:`BAD_CHAR`, :data:`GLITCH`, :data:`OTHER`)."""
+    if d.kind == "char":
+        return BAD_CHAR if d.framing_error or d.parity_error else CLEAN
+    return GLITCH if d.kind == "glitch" else OTHER
+
+
+def _score(codes: list[int]) -> int:
+    """Clean characters less bad ones and glitches, of items given by their probe codes."""
+    return codes.count(CLEAN) - codes.count(BAD_CHAR) - codes.count(GLITCH)
+
+
+def _clean_winner(decoded: dict[bool, list[int]]) -> bool | None:
+    """The polarity whose decode of the short probe (its items' probe codes) is beyond
+    doubt: at least :data:`SHORT_PROBE_CLEAN` clean characters and no bad frame or glitch
+    (the last item aside: the probe's cut may fall inside a frame), while the other scores
+    lower. None: not decisive, the whole first block decides."""
+    for inv, codes in decoded.items():
+        body = codes[:-1]
+        clean = body.count(CLEAN) + body.count(BAD_CHAR)
+        bad = BAD_CHAR in body or GLITCH in body
         if clean >= SHORT_PROBE_CLEAN and not bad and _score(body) > _score(decoded[not inv][:-1]):
             return inv
     return None
+
+
+def _probe_codes(
+    edges: list[int],
+    *,
+    initial_level: int,
+    tick_rate: float,
+    baud: float,
+    invert: bool,
+    framing: Framing,
+) -> list[int]:
+    """The probe codes of what ``decode([edges], ...)`` gives (t0 0, no uncertainty), item
+    for item, without making an event or item of each certified frame: the bulk decoder's
+    batches, their first :data:`~.uart.HOLD_FRAMES` items synchronised as
+    :func:`_collect_batches` does, each certified frame's code read from its batch's
+    lists (the probe decodes 2,000 edges both ways on each channel of a capture)."""
+    kw = dict(initial_level=initial_level, tick_rate=tick_rate, baud=baud, invert=invert)
+    if not BULK:
+        return [_code(d) for d in decode([edges], framing=framing, **kw)]
+    batches = list(decode_batches([edges], framing=framing, **kw))
+    _synchronise_head(batches, 0.0, SYNC_BITS * (tick_rate / baud) / tick_rate, 0.0)
+    codes: list[int] = []
+    add = codes.append
+    for b in batches:
+        fe, pe = b.framing_error, b.parity_error
+        for x in b.order:
+            if x.__class__ is int:
+                add(BAD_CHAR if fe[x] or pe[x] else CLEAN)  # type: ignore[index]
+            else:
+                add(_code(x))  # type: ignore[arg-type]
+    return codes
 
 
 def _choose_polarity(
@@ -148,13 +185,13 @@ def _choose_polarity(
     thousands: decoding all of them twice was most of a short capture's probe); only when
     they read cleanly one way (:func:`_clean_winner`) is that taken, anything less clear is
     decided on the whole ``prefix`` as before (``tests/capture/test_polarity_probe.py``
-    holds a capture whose first edges alone would pick the wrong polarity)."""
+    holds a capture whose first edges alone would pick the wrong polarity). Each way's
+    items are read as probe codes (:func:`_probe_codes`), none made."""
     kw = dict(initial_level=edges.initial_level, tick_rate=edges.tick_rate, baud=baud)
-    items = decode_bulk if BULK else decode
     if len(prefix) > PROBE_EDGES:
         short = prefix[:PROBE_EDGES]
         tried = {
-            inv: list(items([short], invert=inv, framing=framing, **kw)) for inv in (False, True)
+            inv: _probe_codes(short, invert=inv, framing=framing, **kw) for inv in (False, True)
         }
         inv = _clean_winner(tried)
         if inv is not None:
@@ -163,7 +200,7 @@ def _choose_polarity(
                 f"polarity {'line (inverted)' if inv else 'UART'} detected from clean frames",
             )
     scores = {
-        inv: _score(list(items([prefix], invert=inv, framing=framing, **kw)))
+        inv: _score(_probe_codes(prefix, invert=inv, framing=framing, **kw))
         for inv in (False, True)
     }
     if abs(scores[False] - scores[True]) > CLEAN_LEAD:
@@ -365,14 +402,10 @@ def _collect_batches(
     marks: Marks | None = None,
     into: Marks | None = None,
 ) -> None:
-    """:func:`_collect` of :func:`~.uart.decode`'s items as :func:`~.uart_bulk.decode_batches`
-    gives them: a certified frame's event is made from the batch's lists, without a
-    :class:`~.uart.Decoded` (made only for a problem); the first :data:`~.uart.HOLD_FRAMES`
-    items, all that :func:`~.uart._synchronised` looks at, go through it as items. The
-    events get ``origin`` (the items' own keep :data:`~.transcript.BUS`, as the decoder's),
-    or :data:`RECORDER_ORIGIN` where ``marks`` matches them (:meth:`Marks.origin`); with
-    ``into``, no event is made: each one's start, kind and wire go there; with
-    ``out.columns``, none either (:meth:`.WireColumns.appenders`)."""
+    """:func:`_collect` of :func:`~.uart_bulk.decode_batches`' items (the first
+    :data:`~.uart.HOLD_FRAMES` :func:`~.uart._synchronised`); origin ``origin``, or
+    :data:`RECORDER_ORIGIN` where ``marks`` matches; ``into`` or ``out.columns``: no event
+    made, the fields go there (:func:`_stretch`: a stretch of certified frames whole)."""
     unc, nan = out.uncertainty_s, float("nan")
     head = _synchronised_head(batches, unc, sync_s, t0)
     problems, tally = out.problems, _Tally(out)
@@ -381,61 +414,186 @@ def _collect_batches(
     chars = framing_errors = parity_errors = glitches = matched = 0
     char, bus, event = EventKind.CHAR, origin, full_event
     mark = marks.origin if marks is not None and marks.start else None
-    # Marks.origin spelt out for the certified frames (a call each cost what it saved)
     tx_start, tx_kind, tx_wire = (marks.start, marks.kind, marks.wire) if mark else ([], [], [])
     n_tx, tol, j, recorder = len(tx_start), marks.tolerance if mark else 0.0, 0, RECORDER_ORIGIN
-    if into is not None:
-        add = into.add
+    add = into.add if into is not None else add
     if (cols := out.columns) is not None:
         add, (put_s, put_e, put_w, put_o) = cols.add_made, cols.appenders()
+    stretched = cols is not None or into is not None
+    tx = _TxArrays.of(marks) if stretched and n_tx else None
     for b in chain(head, batches):
-        st, en, wi, fe, pe, err, gl = (
-            b.start, b.end, b.wire, b.framing_error, b.parity_error, b.err, b.glitches,
-        )  # fmt: skip
-        for x in b.order:
-            if x.__class__ is int:
-                s, w = st[x], wi[x]  # type: ignore[index]
-                if into is not None:
-                    add(char, s, w)
-                else:
-                    o = bus
-                    if n_tx:
-                        while j < n_tx and tx_start[j] < s - tol:
-                            j += 1
-                        hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
-                        if hit and tx_kind[j] is char:
-                            o, j, matched = recorder, j + 1, matched + 1
-                    if cols is None:
-                        add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
-                    else:  # four columns, no event
-                        put_s(s), put_e(en[x]), put_w(w), put_o(o)  # type: ignore[index]
-                chars += 1
-                e = err[x]  # type: ignore[index]
-                baud_error(nan if e is None else e)
-                if fe[x] or pe[x] or gl[x]:  # type: ignore[index]
-                    framing_errors += fe[x]  # type: ignore[index]
-                    parity_errors += pe[x]  # type: ignore[index]
-                    glitches += gl[x]  # type: ignore[index]
-                    problems.append(b.item(x, unc))  # type: ignore[arg-type]
+        st, en, wi, err = b.start, b.end, b.wire, b.err
+        fe, pe, gl = b.framing_error, b.parity_error, b.glitches
+        for part in _stretches(b.order) if stretched else (b.order,):
+            taken = _stretch(b, part, out, tally, into, tx, n_tx > 0, j, tol, bus)
+            if taken is not None:  # a stretch of certified frames, taken whole
+                j, matched = taken[0], matched + taken[1]
                 continue
-            d: Decoded = x  # type: ignore[assignment]
-            if (ev := d.event) is not None:
-                if into is not None:
-                    add(ev.kind, ev.start, ev.wire)
-                    tally.item(d)
+            for x in part:
+                if x.__class__ is int:
+                    s, w = st[x], wi[x]  # type: ignore[index]
+                    if into is not None:
+                        add(char, s, w)
+                    else:
+                        o = bus
+                        if n_tx:
+                            while j < n_tx and tx_start[j] < s - tol:
+                                j += 1
+                            hit = j < n_tx and abs(tx_start[j] - s) <= tol and tx_wire[j] == w
+                            if hit and tx_kind[j] is char:
+                                o, j, matched = recorder, j + 1, matched + 1
+                        if cols is None:
+                            add(event(char, o, s, en[x], w, "", unc, None))  # type: ignore[index]
+                        else:  # four columns, no event
+                            put_s(s), put_e(en[x]), put_w(w), put_o(o)  # type: ignore[index]
+                    chars += 1
+                    e = err[x]  # type: ignore[index]
+                    baud_error(nan if e is None else e)
+                    if fe[x] or pe[x] or gl[x]:  # type: ignore[index]
+                        framing_errors += fe[x]  # type: ignore[index]
+                        parity_errors += pe[x]  # type: ignore[index]
+                        glitches += gl[x]  # type: ignore[index]
+                        problems.append(b.item(x, unc))  # type: ignore[arg-type]
                     continue
-                o = bus
-                if marks is not None and mark is not None:
-                    o, j, matched = marks.resumed(j, matched, ev.kind, ev.start, ev.wire, bus)
-                if o != BUS:
-                    u, du = ev.uncertainty, ev.duration_uncertainty
-                    ev = event(ev.kind, o, ev.start, ev.end, ev.wire, ev.text, u, du)
-                add(ev)
-            tally.item(d)
+                d: Decoded = x  # type: ignore[assignment]
+                if (ev := d.event) is not None:
+                    if into is not None:
+                        add(ev.kind, ev.start, ev.wire)
+                        tally.item(d)
+                        continue
+                    o = bus
+                    if marks is not None and mark is not None:
+                        o, j, matched = marks.resumed(j, matched, ev.kind, ev.start, ev.wire, bus)
+                    if o != BUS:
+                        u, du = ev.uncertainty, ev.duration_uncertainty
+                        ev = event(ev.kind, o, ev.start, ev.end, ev.wire, ev.text, u, du)
+                    add(ev)
+                tally.item(d)
     if mark is not None:
         marks.at, marks.matched = j, marks.matched + matched  # type: ignore[union-attr]
     tally.certified(chars, framing_errors, parity_errors, glitches)
     tally.store(out)
+
+
+def _stretch(
+    b: Batch,
+    part: range | list,
+    out: CaptureDecode,
+    tally: _Tally,
+    into: Marks | None,
+    tx: _TxArrays | None,
+    matching: bool,
+    j: int,
+    tol: float,
+    other: str,
+) -> tuple[int, int] | None:
+    """Certified frames ``part`` of ``b`` taken whole by :func:`_collect_batches`: into
+    ``into`` (the TX channel's marks) or ``out.columns`` (``matching``: their origins by
+    :func:`_origins` from ``tx``, the TX's arrays; else all ``other``), their bit-rate
+    errors and problems into ``out``, their counts into ``tally``. Gives the TX place
+    after them and the TX events they matched; None when the TX matching must walk them
+    one by one (nothing taken)."""
+    if part.__class__ is not range:
+        return None  # items one by one
+    p, q = part.start, part.stop
+    st, en, wi, cols = b.start, b.end, b.wire, out.columns
+    hits = 0
+    if into is not None:
+        into.start.extend(st[p:q])
+        into.kind.extend([EventKind.CHAR] * (q - p))
+        into.wire.extend(wi[p:q])
+    elif cols is not None:
+        found = _origins(tx, b, p, q, j, tol, other) if matching else ([other] * (q - p), j, 0)
+        if found is None:
+            return None
+        origins, j, hits = found
+        cols.start.extend(st[p:q])
+        cols.end.extend(en[p:q])
+        cols.wire.extend(wi[p:q])
+        cols.origin.extend(origins)
+    out.baud_error_pct.extend(b.err_nan[p:q])
+    fe, pe, gl, flagged = b.framing_error, b.parity_error, b.glitches, b.flagged
+    f = pa = g = 0
+    for x in flagged[bisect_left(flagged, p) : bisect_left(flagged, q)]:
+        f, pa, g = f + fe[x], pa + pe[x], g + gl[x]
+        out.problems.append(b.item(x, out.uncertainty_s))
+    tally.certified(q - p, f, pa, g)
+    return j, hits
+
+
+#: certified frames in a row, at least, that are taken whole (:func:`_stretches`): below
+#: it numpy's fixed cost per call is more than a step per frame
+STRETCH_MIN = 16
+
+
+def _stretches(order: list) -> Iterator[list | range]:
+    """A batch's items in order as stretches: each run of at least :data:`STRETCH_MIN`
+    certified frames with consecutive indices as the ``range`` of them, everything else
+    as lists of items (a certified frame's index or a decoder's item)."""
+    # the decoder's own items' places, found in C: most of a batch is certified frames
+    made = list(compress(count(), map(is_not, map(type, order), repeat(int))))
+    at = 0
+    for k in [*made, len(order)]:
+        if k - at >= STRETCH_MIN and order[k - 1] - order[at] == k - 1 - at:
+            yield range(order[at], order[k - 1] + 1)  # indices rise by one from order[at]
+        elif k > at:
+            yield order[at:k]
+        if k < len(order):
+            yield order[k : k + 1]
+        at = k + 1
+
+
+@dataclass(frozen=True)
+class _TxArrays:
+    """The TX channel's marks as arrays (starts, wires, whether a character), for a
+    stretch of bus frames matched at once (:func:`_origins`); None of a TX channel whose
+    starts are not in order (a search needs them so)."""
+
+    start: np.ndarray
+    wire: np.ndarray
+    char: np.ndarray
+
+    @classmethod
+    def of(cls, marks: Marks | None) -> _TxArrays | None:
+        if marks is None or not marks.start:
+            return None
+        start = np.array(marks.start, dtype=np.float64)
+        if start.size > 1 and not (start[1:] >= start[:-1]).all():
+            return None
+        char = EventKind.CHAR
+        return cls(
+            start, np.array(marks.wire, dtype=np.int64), np.array([k is char for k in marks.kind])
+        )
+
+
+def _origins(
+    tx: _TxArrays | None, b: Batch, p: int, q: int, j: int, tol: float, other: str
+) -> tuple[list[str], int, int] | None:
+    """The origins :meth:`Marks.origin`'s walk gives certified frames ``p..q-1`` of ``b``
+    from TX place ``j``, the place after and the matches, found by one search: each frame's
+    place is the first TX start not before its own start less ``tol`` (what the walk passes
+    to), unless the place after the frame before is past it; None when that happens (a TX
+    event within reach of two frames) or there are no arrays: the caller walks."""
+    if tx is None or b.start_array is None or b.wire_array is None:
+        return None
+    starts, n = b.start_array[p:q], tx.start.size
+    at = np.searchsorted(tx.start, starts - tol, "left")
+    if at[0] < j:
+        return None
+    near = np.minimum(at, n - 1)
+    hit = (
+        (at < n)
+        & (np.abs(tx.start[near] - starts) <= tol)
+        & (tx.wire[near] == b.wire_array[p:q])
+        & tx.char[near]
+    )
+    if at.size > 1 and not (at[1:] >= at[:-1] + hit[:-1]).all():
+        return None
+    origins = [other] * (q - p)
+    hits = np.flatnonzero(hit).tolist()
+    for i in hits:
+        origins[i] = RECORDER_ORIGIN
+    return origins, int(at[-1] + hit[-1]), len(hits)
 
 
 def _synchronised_head(

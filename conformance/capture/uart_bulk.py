@@ -34,6 +34,8 @@ from __future__ import annotations
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
+from functools import cache
+from math import isnan
 
 import numpy as np
 
@@ -85,6 +87,14 @@ class Batch:
     start_ticks: list[int] = field(default_factory=list)
     before: list[float | None] = field(default_factory=list)
     tick_rate: float = 1.0
+    #: the certified frames' starts and wires as arrays, for a stretch of them taken whole
+    #: (:func:`~.decode._collect_batches`); None: not kept
+    start_array: np.ndarray | None = None
+    wire_array: np.ndarray | None = None
+    #: the certified frames with a framing or parity error or a glitch, in order
+    flagged: list[int] = field(default_factory=list)
+    #: ``err`` with NaN for None (the bit-rate errors as a decode lists them)
+    err_nan: list[float] = field(default_factory=list)
 
     def marking(self, p: int) -> float | None:
         """The marking before certified frame ``p``, as the scan works it out (s)."""
@@ -412,13 +422,10 @@ class _Certified:
         moved, err = _fitted(e - s[owner], ~glitch_edge, owner, first, m_frames, line)
         ok = ~moved & (after < n)  # an edge after the stop bit: not the capture's last frame
         # bits at their centres
-        centres = sf[:, None] + (np.arange(nbits) + 0.5) * T
-        count = np.searchsorted(Wf, centres, "right") - (starts + 1)[:, None]
-        bits = (count & 1).astype(np.int64)
-        wire = (bits[:, 1:9] << np.arange(8)).sum(axis=1)
+        bits = _centre_levels(Wf[at], sf, owner, m_frames, T, nbits)
+        wire = _BYTE_WEIGHTS @ bits[:, 1:9].T if m_frames else np.zeros(0, dtype=np.int64)
         framing_error = bits[:, nbits - 1] == 0
-        parity = np.array([not line.framing.parity_ok(w) for w in range(256)])
-        parity_error = parity[wire & 0xFF]
+        parity_error = _parity_errors(line.framing)[wire & 0xFF]
         short = gap < half
         short_before = np.zeros(owner.size, dtype=bool)
         if owner.size:
@@ -439,15 +446,72 @@ class _Certified:
         self.end_ticks = end.tolist()
         self.framing_error = framing_error.tolist()
         tick_rate, t0 = line.tick_rate, line.t0
+        start_s = t0 + s / tick_rate
         self.batch = Batch(
             [],
-            *_stamps(t0 + s / tick_rate, t0 + end / tick_rate),
+            *_stamps(start_s, t0 + end / tick_rate),
             wire.tolist(),
             self.framing_error,
             parity_error.tolist(),
-            [None if v != v else v for v in err.tolist()],
+            _nan_as_none(err_nan := err.tolist()),
             glitches.tolist(),
+            start_array=start_s,
+            wire_array=wire,
+            flagged=np.flatnonzero(framing_error | parity_error | (glitches > 0)).tolist(),
+            err_nan=err_nan,
         )
+
+
+#: a frame's eight bits between start and stop (bits 1..8), least significant first, as the
+#: wire byte's weights
+_BYTE_WEIGHTS = 1 << np.arange(8, dtype=np.int64)
+
+
+@cache
+def _parity_errors(framing: Framing) -> np.ndarray:
+    """Per wire byte, whether ``framing``'s parity check fails it (a table of 256, made once
+    per framing: it was made again for every window, 256 Python calls each)."""
+    return np.array([not framing.parity_ok(w) for w in range(256)])
+
+
+def _centre_levels(
+    edge_at: np.ndarray,
+    sf: np.ndarray,
+    owner: np.ndarray,
+    m_frames: int,
+    T: float,
+    nbits: int,
+) -> np.ndarray:
+    """Each frame's ``nbits`` bits as read at their centres (``sf + (k + 0.5) * T``): the
+    parity of the count of its inner edges (``edge_at``: their ticks as floats, ``owner``:
+    their frame) at or before each centre, which is what a ``searchsorted`` of every centre
+    in the window's edges counts (the frame's window, 1.1 frames, holds every edge up to the
+    stop bit's centre). Each edge's first centre at or past it is estimated by a division
+    and settled by comparing with the centres themselves, computed as those are; the counts
+    are then cumulative sums of a per-frame histogram (one pass over the inner edges instead
+    of a binary search per bit: ~10^5 searches a fault-matrix row)."""
+    base = sf[owner]
+    k = np.clip(np.floor((edge_at - base) / T - 0.5).astype(np.int64) + 1, 0, nbits)
+    while True:  # the estimate is off by at most one, by the division's rounding
+        down = (k > 0) & (edge_at <= base + ((k - 1) + 0.5) * T)
+        up = (k < nbits) & (edge_at > base + (k + 0.5) * T)
+        if not (down.any() or up.any()):
+            break
+        k = k - down + up
+    width = nbits + 1  # the last column: edges past the stop bit's centre
+    hist = np.bincount(owner * width + k, minlength=m_frames * width).reshape(m_frames, width)
+    return np.cumsum(hist[:, :nbits], axis=1) & 1
+
+
+def _nan_as_none(values: list[float]) -> list[float | None]:
+    """``values`` with None for each NaN (the reference's "no fit"), found by a C loop
+    (``map``) rather than a Python comparison of every frame's value; a new list."""
+    out: list[float | None] = list(values)
+    if set(map(isnan, values)) != {False}:
+        for i, v in enumerate(values):
+            if v != v:
+                out[i] = None
+    return out
 
 
 def _stamps(starts: np.ndarray, ends: np.ndarray) -> tuple[list[float], list[float]]:

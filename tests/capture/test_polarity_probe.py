@@ -7,11 +7,14 @@ in either polarity, where the short probe decides and agrees with the whole bloc
 from __future__ import annotations
 
 import pytest
+from hypothesis import HealthCheck, given, settings
 
 from conformance.capture import decode as capture_decode
+from conformance.capture import uart_bulk
 from conformance.capture.edges import Edges
 from conformance.capture.uart import Framing
 from conformance.transcript import to_wire_7e1
+from tests.capture.test_uart_bulk import streams
 
 RATE = 100_000.0  # ticks per second, as the export writes
 BIT = RATE / 1200
@@ -47,11 +50,12 @@ def short_scores(edges: list[int], initial_level: int) -> dict[bool, int]:
     short = edges[: capture_decode.PROBE_EDGES]
     return {
         inv: capture_decode._score(
-            list(
-                capture_decode.decode(
+            [
+                capture_decode._code(d)
+                for d in capture_decode.decode(
                     [short], initial_level=initial_level, tick_rate=RATE, baud=1200, invert=inv
                 )
-            )
+            ]
         )
         for inv in (False, True)
     }
@@ -61,11 +65,12 @@ def full_choice(edges: list[int], initial_level: int) -> bool:
     """The whole-block choice, as the probe made it before its short path."""
     scores = {
         inv: capture_decode._score(
-            list(
-                capture_decode.decode(
+            [
+                capture_decode._code(d)
+                for d in capture_decode.decode(
                     [edges], initial_level=initial_level, tick_rate=RATE, baud=1200, invert=inv
                 )
-            )
+            ]
         )
         for inv in (False, True)
     }
@@ -107,7 +112,7 @@ def test_clean_traffic_is_decided_by_the_short_probe_as_the_whole_block_decides(
     whole = full_choice(edges, initial_level)
     assert whole is (initial_level == 0)
     seen: list[int] = []
-    name = "decode_bulk" if capture_decode.BULK else "decode"  # the decoder the probe uses
+    name = "decode_batches" if capture_decode.BULK else "decode"  # the decoder the probe uses
     real_decode = getattr(capture_decode, name)
 
     def counting(chunks, **kw):
@@ -120,3 +125,20 @@ def test_clean_traffic_is_decided_by_the_short_probe_as_the_whole_block_decides(
     assert inverted is whole
     assert "detected from clean frames" in why
     assert seen == [capture_decode.PROBE_EDGES] * 2  # the whole block never decoded twice
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(streams())
+def test_probe_codes_are_the_decoded_items_codes(found):
+    """The probe's codes, read from the bulk decoder's batches without an item made of each
+    certified frame, are those of the items the decoder gives (as the probe decodes: t0 0,
+    no uncertainty), item for item, in bulk and by the reference decoder."""
+    chunks, kw = found
+    edges = [e for c in chunks for e in c]
+    line = {k: kw[k] for k in ("initial_level", "tick_rate", "baud", "invert", "framing")}
+    items = uart_bulk.decode([list(edges)], **line)
+    expected = [capture_decode._code(d) for d in items]
+    assert capture_decode._probe_codes(list(edges), **line) == expected
+    assert [capture_decode._code(d) for d in capture_decode.decode([list(edges)], **line)] == (
+        expected
+    )
