@@ -457,45 +457,17 @@ class SimLink(Link):
         now: float,
     ) -> tuple[float | None, bool]:
         """:meth:`receive_line`'s second read over the planned run ``frames``, after the
-        first character ``got[0]``, the clock at ``now`` (written back when it ends): the
-        characters into ``got`` (and the transcript) as :meth:`_kept_run` takes them with
-        ``LineEnd([first], most)``, the limit ``rest`` and ``idle``. Returns the limit that
-        stopped it (None: none did) and whether the read is over (False: the run ran out)."""
-        clock = self.bus.clock
-        keep = self.bus.transcript.events.append
+        first character ``got[0]``, the clock at ``now``: :meth:`_kept_run` with
+        ``LineEnd([first], most)`` (its ``got`` holding the first already), the limit
+        ``rest`` and ``idle``. Returns the limit that stopped it (None: none did) and
+        whether the read is over (False: the run ran out)."""
+        self.bus.clock.now = now
         limit = min(rest, got[0].end + idle)
-        room, last7 = most, got[0].wire & 0x7F
-        char = EventKind.CHAR
-        set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
-        try:
-            for start, wire, duration in frames:
-                if start >= limit:
-                    return limit, True
-                if start < now:
-                    start = now
-                end = start + duration
-                made = new_event(Event)
-                set_kind(made, char)
-                set_origin(made, DUT)
-                set_start(made, start)
-                set_end(made, end)
-                set_wire(made, wire)
-                set_text(made, "")
-                set_u(made, 0.0)
-                set_du(made, None)
-                keep(made)
-                if end > now:
-                    now = end
-                got.append(made)
-                wire7 = wire & 0x7F
-                if len(got) >= room or (last7 == 0x0D and wire7 == 0x0A):
-                    return None, True
-                last7 = wire7
-                later = end + idle
-                limit = later if later < rest else rest  # min(rest, later)
-            return None, False
-        finally:
-            clock.now = now
+        keep = self.bus.transcript.events.append
+        stop, limit = self._kept_run(frames, got, limit, rest, None, idle, LineEnd([], most), keep)
+        if stop is None:
+            return None, False  # the run is all sent
+        return (None if stop else limit), True
 
     def _take_run(
         self,
