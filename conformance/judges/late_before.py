@@ -16,7 +16,7 @@ another command's words.
 
 from __future__ import annotations
 
-from ..protocol.timing import NO_BREAK_WINDOW
+from ..protocol.timing import NO_BREAK_WINDOW, RESPONSE_START_MIN
 from ..tool_recorder.records import Exchange
 from ..tool_recorder.validity import fits_shape
 from ..transcript import DUT, Event, decode_7e1, escape
@@ -151,3 +151,26 @@ def answered_late(ex: Exchange) -> str:
     before's late reply (:func:`earlier_reply`). The one test of the rules that leave a late
     reply to R-7.0-10 (late_only, late_among, undecided_if_late, the D replies)."""
     return late_answer(ex) if not ex.answered else earlier_reply(ex)
+
+
+def service_request_too_soon(ex: Exchange) -> str:
+    """'' unless the reply ``ex`` took is a bare ``a<CR><LF>`` (a service request's words)
+    begun sooner after the command than R-7.0-09 lets any answer begin: a sensor that sends
+    a service request on its own (after ttt = 000, say) puts it on the line whenever it is
+    ready, and one due while the tool's command was still on the line comes right after
+    it. Read as the command's reply, an empty aD0! after values were announced FAILed
+    R-4.4.8-03/-04 ("0 values were returned for 2 announced") while the real D0 reply, with
+    its values, came 8 ms later (service-request-after-ttt-zero + inter-char-gap). Whether
+    it answers the command is unread; R-7.0-09 judges its timing. Else the wording a
+    finding gives."""
+    if not ex.answered or not ex.attempts or ex.last.command_end is None:
+        return ""
+    reply = ex.reply_events
+    lead = reply[0].start - ex.last.command_end
+    text = ex.reply_text
+    if lead >= RESPONSE_START_MIN or len(text) != 3 or not text.endswith("\r\n"):
+        return ""
+    return (
+        f"'{escape(text)}' to {escape(ex.text)} began {lead * 1e3:.2f} ms after it, too soon "
+        "to answer it, and has a service request's words"
+    )

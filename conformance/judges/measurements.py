@@ -26,7 +26,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
-from .late_before import answered_late, earlier_reply
+from .late_before import answered_late, earlier_reply, service_request_too_soon
 from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wire import runs
@@ -217,7 +217,7 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         return
     replies: list[DataReply] = []
     limit = expected_value_limit(m.command)
-    silent = late = None
+    silent = late = too_soon = None
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
         if taken_late := answered_late(ex):
@@ -229,6 +229,12 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
             for rid in ("R-4.4.8-01", "R-4.4.8-03", *hv):
                 tally.undecide(rid, dlabel, f"{taken_late} (R-7.0-10 judges its timing)")
             silent = late = ex
+            break
+        if m.count and (soon := service_request_too_soon(ex)):
+            # values announced, and what came may be a service request, not this D's reply
+            for rid in ("R-4.4.8-01", "R-4.4.8-03", "R-4.4.8-04"):
+                tally.undecide(rid, dlabel, f"{soon} (R-7.0-09 judges its timing)")
+            silent = late = too_soon = ex
             break
         if not ex.answered:
             tally.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
@@ -250,7 +256,7 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         seq = [v for v in seq if v.requirement != "R-4.4.8-03"]
     _drop_split_fragments(replies, seq, tally, label)
     _undecide_cut_at_silence(m, replies, silent, tally, label)
-    if not replies and silent is not None:
+    if not replies and silent is not None and too_soon is None:
         # D0 itself went unanswered: whether it returns values is unread, no conformance
         # (an Arduino Due sketch with no D0 branch, twenty-first round: R-4.4.8-04 PASSed
         # "conforms (19 checked)" on nineteen silent aD0!s; R-4.4.8-01 FAILs the silence)
