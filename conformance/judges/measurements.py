@@ -220,21 +220,9 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     silent = late = too_soon = None
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
-        if taken_late := answered_late(ex):
-            # its reply came after the tool stopped listening, or the one taken may be the D
-            # before's: no silence, no count cut short, no values of its own to judge
-            # (replies-after-retry + wrong-crc: "0C9! 0D6!: no reply to 0D6!" and "60 values
-            # were returned for 99 announced" FAILed on a D6 whose reply met the retry, truth15)
-            hv = ["R-5.1-02"] if m.command.kind is Kind.HIGH_VOLUME_ASCII else []
-            for rid in ("R-4.4.8-01", "R-4.4.8-03", *hv):
-                tally.undecide(rid, dlabel, f"{taken_late} (R-7.0-10 judges its timing)")
+        if how := _not_this_ds_reply(m, ex, tally, dlabel):
             silent = late = ex
-            break
-        if m.count and (soon := service_request_too_soon(ex)):
-            # values announced, and what came may be a service request, not this D's reply
-            for rid in ("R-4.4.8-01", "R-4.4.8-03", "R-4.4.8-04"):
-                tally.undecide(rid, dlabel, f"{soon} (R-7.0-09 judges its timing)")
-            silent = late = too_soon = ex
+            too_soon = ex if how == "soon" else too_soon
             break
         if not ex.answered:
             tally.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
@@ -296,6 +284,27 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     if m.command.kind is Kind.HIGH_VOLUME_ASCII:
         tally.observe(label, ids=["R-5.1-02"])
         _undecide_unread_high_volume(m, replies, tally, label)
+
+
+def _not_this_ds_reply(m: Measurement, ex: Exchange, tally: Tally, dlabel: str) -> str:
+    """'' unless what the D exchange ``ex`` took may not be its reply, its rules undecided
+    then: "late" (the reply came after the tool stopped listening, or the one taken may be
+    the D before's) or "soon" (a service request's words begun too soon to answer it)."""
+    if taken_late := answered_late(ex):
+        # its reply came after the tool stopped listening, or the one taken may be the D
+        # before's: no silence, no count cut short, no values of its own to judge
+        # (replies-after-retry + wrong-crc: "0C9! 0D6!: no reply to 0D6!" and "60 values
+        # were returned for 99 announced" FAILed on a D6 whose reply met the retry, truth15)
+        hv = ["R-5.1-02"] if m.command.kind is Kind.HIGH_VOLUME_ASCII else []
+        for rid in ("R-4.4.8-01", "R-4.4.8-03", *hv):
+            tally.undecide(rid, dlabel, f"{taken_late} (R-7.0-10 judges its timing)")
+        return "late"
+    if m.count and (soon := service_request_too_soon(ex)):
+        # values announced, and what came may be a service request, not this D's reply
+        for rid in ("R-4.4.8-01", "R-4.4.8-03", "R-4.4.8-04"):
+            tally.undecide(rid, dlabel, f"{soon} (R-7.0-09 judges its timing)")
+        return "soon"
+    return ""
 
 
 @lru_cache(maxsize=4096)
