@@ -6,6 +6,8 @@ bytes, low byte first, for high-volume binary packets (R-5.2-03).
 
 from __future__ import annotations
 
+import re
+
 ASCII_CRC_LEN = 3  # R-4.4.12-06: three characters after the last value
 
 
@@ -65,6 +67,15 @@ def binary_crc(packet: bytes) -> bytes:
     return encode_binary(crc16(packet))
 
 
+#: the range of an ASCII CRC's characters: 0x40..0x7F; no value character (``+-.0-9``) is
+#: in it
+CRC_CHAR_FIRST, CRC_CHAR_LAST = 0x40, 0x7F
+#: one character of that range, for searching a whole text in C (a D reply without a CRC
+#: checked for stray CRC characters) rather than asking :func:`is_crc_char` of each
+CRC_CHAR = re.compile(f"[{chr(CRC_CHAR_FIRST)}-{chr(CRC_CHAR_LAST)}]")
+
+
 def is_crc_char(char: str) -> bool:
-    """CRC characters are 0x40..0x7F; no value character (``+-.0-9``) is in that range."""
-    return len(char) == 1 and 0x40 <= ord(char) <= 0x7F
+    """Whether ``char`` is one character of an ASCII CRC's range (:data:`CRC_CHAR_FIRST`..
+    :data:`CRC_CHAR_LAST`)."""
+    return len(char) == 1 and CRC_CHAR_FIRST <= ord(char) <= CRC_CHAR_LAST

@@ -14,7 +14,7 @@ import re
 
 from ..protocol.binary import EMPTY_LEN, DataType, packet_length, type_size
 from ..protocol.commands import ADDRESS_CHARS, Command, Kind, count_digits
-from ..protocol.crc import ASCII_CRC_LEN, ascii_crc, binary_crc
+from ..protocol.crc import ASCII_CRC_LEN, CRC_CHAR, ascii_crc, binary_crc
 from ..protocol.framing import CR, CRLF, LF, TEXT_END, crc_tail, strip_crlf, unprintable
 from ..transcript import (
     GOOD_PARITY,
@@ -30,9 +30,6 @@ from ..transcript import (
 _TYPE_CODES = frozenset(int(t) for t in DataType)  # R-5.2.1-01: codes above 10 are invalid
 _VALUES = re.compile(r"([+-][0-9.]+)*")
 _CHAR = EventKind.CHAR
-#: a character an ASCII CRC may hold (``is_crc_char``: 0x40..0x7F), searched for in C rather
-#: than asked of each character of every D reply without a CRC (issue 22, matrix18)
-_CRC_CHAR = re.compile("[\x40-\x7f]")
 
 __all__ = [
     "check_ascii",
@@ -123,7 +120,7 @@ def _reply_address(command: Command) -> str | None:
 def _crc_problem(body: str, crc_expected: bool | None) -> str | None:
     checked, crc = split_crc(body, crc_expected)
     if crc is None:
-        if crc_expected is False and _CRC_CHAR.search(body, 1) is not None:
+        if crc_expected is False and CRC_CHAR.search(body, 1) is not None:
             return "unexpected CRC characters"
         return None
     if len(body) <= ASCII_CRC_LEN:

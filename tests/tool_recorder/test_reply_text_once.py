@@ -81,9 +81,9 @@ def test_crc_characters_searched_as_asked_one_by_one(body):
     """``_crc_problem`` finds a CRC character in a reply that should have none by a search
     in C (matrix18); it finds one exactly when ``is_crc_char`` says so of a character after
     the address, in any text (past 7 bits too)."""
-    from conformance.protocol.crc import is_crc_char
+    from conformance.protocol.crc import CRC_CHAR, is_crc_char
 
-    found = validity._CRC_CHAR.search(body, 1) is not None
+    found = CRC_CHAR.search(body, 1) is not None
     assert found == any(is_crc_char(c) for c in body[1:])
     problem = validity._crc_problem(body, False)
     assert (problem == "unexpected CRC characters") == found
