@@ -320,6 +320,11 @@ class SimBus:
         return events
 
 
+def _at_any_character(got: list[Event]) -> bool:
+    """The stop of a read that wants only its first character (``receive``'s ``until``)."""
+    return True
+
+
 class SimLink(Link):
     """The tool's end of a :class:`SimBus`."""
 
@@ -412,22 +417,17 @@ class SimLink(Link):
             return None
         device, frames = run
         clock = bus.clock
-        now = clock.now
-        for start, wire, duration in frames:
-            if start >= deadline:  # the first read's run stopped at its limit
-                clock.advance_to(max(deadline, now))
-                return []
-            if start < now:  # max(start, now), spelt out (SimLink._kept_run)
-                start = now
-            end = start + duration
-            first = wire_event(EventKind.CHAR, DUT, start, end, wire)
-            transcript.events.append(first)
-            if end > now:
-                now = end
-            break
-        else:
-            return None  # no frame offered after all: nothing done, read as usual
-        got = [first]
+        # the first read: _kept_run stopping at any character, the limit the deadline
+        got: list[Event] = []
+        keep = transcript.events.append
+        first_only = _at_any_character
+        stop, _ = self._kept_run(frames, got, deadline, deadline, first_only, None, None, keep)
+        if not got:
+            if stop is None:
+                return None  # no frame offered after all: nothing done, read as usual
+            clock.advance_to(max(deadline, clock.now))  # the run stopped at its limit
+            return []
+        first, now = got[0], clock.now
         if most <= 1:  # the reply is at its limit already: no second read
             clock.now = now
             device.pop_frames(1)
