@@ -74,8 +74,11 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     if _well_formed(wire):
         # each event's own span and the marking before it come in start order: merged as
         # they are made, never held (an hour's capture: 700,000 spans, 40 MB as a list)
-        spans = merge(_own_spans(wire), _gaps(wire), sorted(waits), key=itemgetter(0))
-        lower = _sweep(spans)
+        if _ends_after_starts(wire):  # in one loop (heapq.merge: 60% of bus_time's CPU)
+            lower = _sweep(_spans_in_order(wire, sorted(waits)))
+        else:
+            spans = merge(_own_spans(wire), _gaps(wire), sorted(waits), key=itemgetter(0))
+            lower = _sweep(spans)
     else:  # a time that is no number, or a break ending before it began: as it always was
         lower = _sweep(sorted([*_own_spans(wire), *_gaps(wire), *waits]))
     return BusTime(lower, wire[-1].end - wire[0].start, frames, breaks)
@@ -121,6 +124,47 @@ def _gaps(wire: list[Event]) -> Iterator[tuple[float, float]]:
             yield previous_end, previous_end + _forced_gap(previous, e, start - previous_end)
         if e.end >= previous_end:
             previous, previous_end = e, e.end
+
+
+def _ends_after_starts(wire: list[Event]) -> bool:
+    """Whether no event ends before it starts: then the marking before an event starts at or
+    after every earlier event's start (it starts at the latest end so far) and before the
+    event's own, which is what lets :func:`_spans_in_order` place it without a merge."""
+    return all(e.end >= e.start for e in wire)
+
+
+def _spans_in_order(
+    wire: list[Event], waits: list[tuple[float, float]]
+) -> Iterator[tuple[float, float]]:
+    """``merge(_own_spans(wire), _gaps(wire), waits, key=itemgetter(0))``, the same spans in
+    the same order, ties included, made in one loop: for a well-formed ``wire`` in start
+    order whose events end no earlier than they start (:func:`_ends_after_starts`), and
+    ``waits`` sorted. The marking before an event comes after every earlier event's own
+    span (it starts at the latest end so far, on a tie the own span first as merge puts
+    its first stream first) and before the event's own (which starts after it); a wait
+    goes out before the first span starting later than it, after those starting with it
+    (``tests/links/test_bus_time_merged.py`` compares the two on random traffic)."""
+    brk = EventKind.BREAK
+    rest = iter(waits)
+    wait = next(rest, None)
+    previous: Event | None = None
+    previous_end = 0.0
+    for e in wire:
+        start = e.start
+        if previous is not None and start > previous_end:
+            while wait is not None and wait[0] < previous_end:
+                yield wait
+                wait = next(rest, None)
+            yield previous_end, previous_end + _forced_gap(previous, e, start - previous_end)
+        while wait is not None and wait[0] < start:
+            yield wait
+            wait = next(rest, None)
+        yield (start, e.end + MARKING_AFTER_BREAK) if e.kind is brk else (start, start + CHAR_TIME)
+        if previous is None or e.end >= previous_end:
+            previous, previous_end = e, e.end
+    if wait is not None:
+        yield wait
+        yield from rest
 
 
 def _well_formed(wire: list[Event]) -> bool:

@@ -13,7 +13,6 @@ DUT goes through :func:`html.escape`: the device is untrusted (design.md 7).
 
 from __future__ import annotations
 
-import sys
 from array import array
 from bisect import bisect_left, bisect_right
 from collections.abc import Iterable, Sequence
@@ -516,15 +515,6 @@ def _measures(seg: Segment) -> list[float]:
     return out
 
 
-#: from this many intervals a :class:`MeasureIndex` keeps each distinct value once, with the
-#: first segment that holds it (:func:`_first_owners`), where a shorter one keeps every
-#: interval sorted; only where numpy is loaded already, which is to say where a capture was
-#: decoded (an hour's capture: 535,000 intervals of a few thousand distinct values). A
-#: simulated run keeps its arrays as before (a wrong-crc run's 145,000 intervals), read in
-#: one pass.
-NUMPY_FROM = 50_000
-
-
 def _first_owners(each: Iterable[list[float]]) -> tuple[dict[float, int] | None, int]:
     """Each distinct value of ``each`` segment's intervals with the first segment holding
     it, and how many intervals there were; None for the values if one is a NaN. Read as
@@ -556,22 +546,27 @@ class MeasureIndex:
         cut: Sequence[Segment] = (),
         *,
         measures: Iterable[list[float]] = (),
-        numpy_from: int | None = None,
+        every_interval: bool = False,
     ):
         """``measures``: each segment's intervals, given instead of ``cut`` (for tests);
-        ``numpy_from``: from how many intervals each distinct value is kept once (default
-        :data:`NUMPY_FROM`, where numpy is loaded; tests set it to compare both ways)."""
+        ``every_interval``: every interval kept, sorted, not each distinct value once (tests
+        compare both ways)."""
         #: kept as arrays, 16 bytes an interval where lists of floats and ints took 40 and
         #: more: the index outlives the report that built it (an hour's capture: 535,000
-        #: intervals, held through every later run of a passive judgement); a long one
-        #: keeps each distinct value once, with its first segment (:func:`_first_owners`)
+        #: intervals, held through every later run of a passive judgement). Each distinct
+        #: value is kept once, with its first segment (:func:`_first_owners`): :meth:`nearest`
+        #: reads no other owner of an equal run. That was done only from 50,000 intervals
+        #: where numpy was loaded (a gate left from when numpy's argsort made that order);
+        #: a simulated run's 33,000 intervals are 27 distinct values, and sorting them all
+        #: was 16-20 ms of the page's renderer (issue 22). With a NaN, every interval, sorted
+        #: as the (value, segment) pairs were.
         self.values: array[float] = array("d")
         self.owners: array[int] = array("q")
         if not cut:
             measures = list(measures)  # read twice below, perhaps
-        if numpy_from is not None or "numpy" in sys.modules:
-            first, count = _first_owners(map(_measures, cut) if cut else measures)
-            if first is not None and count >= (NUMPY_FROM if numpy_from is None else numpy_from):
+        if not every_interval:
+            first, _ = _first_owners(map(_measures, cut) if cut else measures)
+            if first is not None:
                 ordered = sorted(first)  # distinct: no two equal, so no order among equals
                 self.values.extend(ordered)
                 self.owners.extend(map(first.__getitem__, ordered))

@@ -16,13 +16,16 @@ import getpass
 import os
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from functools import partial
 from types import ModuleType
 
 from .. import gc_pace
 from ..judges.exploration import IDS as IDS  # the cases import it from here
+from . import exploration_plans
 from .exploration_record import Exploration
+from .exploration_steps import foreign_addresses, plain_machine, release_attributes, run_plan
 from .session import SensorSession
 
 __all__ = ["IDS", "Exploration", "explore"]
@@ -37,8 +40,12 @@ def __getattr__(name: str) -> object:
     if name != "JUNK":
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     junk_strategy = _machine_module().junk_strategy
-    globals()["JUNK"] = junk = junk_strategy()
+    globals()["JUNK"] = _MADE["JUNK"] = junk = junk_strategy()
     return junk
+
+
+#: the junk strategy this module made (a caller may put another in ``JUNK``)
+_MADE: dict[str, object] = {}
 
 
 #: hypothesis's switch for its entry-point plugins (``hypothesis.entry_points.run``)
@@ -53,7 +60,9 @@ def _machine_module() -> ModuleType:
     none also read every installed distribution's entry points (4 ms with 28 of them).
     Where hypothesis is already loaded (a pytest session with its plugin), nothing changes;
     the variable is the user's again once the import is done."""
+    global _DRAWS_ALONE
     if "hypothesis" in sys.modules or NO_PLUGINS in os.environ:
+        _DRAWS_ALONE = _DRAWS_ALONE or "hypothesis" not in sys.modules
         from . import exploration_machine
 
         return exploration_machine
@@ -62,7 +71,14 @@ def _machine_module() -> ModuleType:
         from . import exploration_machine
     finally:
         os.environ.pop(NO_PLUGINS, None)
+    _DRAWS_ALONE = True
     return exploration_machine
+
+
+#: whether this process's hypothesis was loaded by :func:`_machine_module` without the
+#: environment's plugins: only its draws are stored for later processes
+#: (:mod:`.exploration_plans`)
+_DRAWS_ALONE = False
 
 
 def explore(
@@ -73,32 +89,22 @@ def explore(
 
     ``planned``: the steps hypothesis draws are drawn once a process (``plan_for``: they
     depend on no reply) and sent as hypothesis sends them (``run_plan``), not drawn again
-    each run; issue 22, about three quarters of the case's CPU in a fault-matrix row.
-    ``planned=False`` runs hypothesis with the sending machine, as before (the tests prove
-    the two alike on every fault)."""
-    gc_pace.freeze_for_libraries()  # hypothesis's one gc.collect() walks only what it made
-    machine_module = _machine_module()  # hypothesis: loaded here
-    machine_class, run_machine = machine_module.machine_class, machine_module.run_machine
-    release, plan_for, run_plan = (
-        machine_module.release,
-        machine_module.plan_for,
-        machine_module.run_plan,
-    )
-
+    each run; issue 22, about three quarters of the case's CPU in a fault-matrix row. A plan
+    an earlier process stored (:mod:`.exploration_plans`) is sent without hypothesis, which
+    is then never loaded. ``planned=False`` runs hypothesis with the sending machine, as
+    before (the tests prove the three alike on every fault)."""
     record = Exploration()
-    junk = globals()["JUNK"] if "JUNK" in globals() else __getattr__("JUNK")  # or a caller's
-    # foreign commands go out the way the sensor was shown to hear a one-shot a! (found
-    # before the machine starts, so finding it disturbs no sequence); a sensor shown to hear
-    # none leaves their silence uncounted
-    machine = machine_class(sensor, record, sensor.hearing_marking(), junk)
-    keep_hypothesis_out_of_the_working_folder()
+    key = _plan_key(sensor, examples, steps) if planned else None
+    stored = exploration_plans.STORE.load(key) if key is not None else None
+    if stored is not None:
+        # foreign commands go out the way the sensor was shown to hear a one-shot a!
+        plain = plain_machine(sensor, record, sensor.hearing_marking())
+        machine, release = plain, release_attributes
+        send: Callable[[], None] = partial(run_plan, plain, stored)
+    else:
+        machine, release, send = _with_hypothesis(sensor, record, examples, steps, planned, key)
     try:
-        with no_local_constants(), no_database_key():
-            if planned:
-                foreign = machine_module.foreign_addresses(sensor)
-                run_plan(machine, plan_for(foreign, junk, examples, steps))
-            else:
-                run_machine(machine, examples, steps)
+        send()
     except BaseException as exc:  # hypothesis may wrap the failure; a breach recorded stands
         if record.broken is None or isinstance(exc, KeyboardInterrupt):
             raise
@@ -107,9 +113,53 @@ def explore(
     return record
 
 
+def _plan_key(sensor: SensorSession, examples: int, steps: int) -> str | None:
+    """The key of the plan this run may send from the store: None when the junk strategy is
+    a caller's (only the exploration's own is stored)."""
+    if "JUNK" in globals() and globals()["JUNK"] is not _MADE.get("JUNK"):
+        return None
+    return exploration_plans.plan_key(foreign_addresses(sensor), examples, steps)
+
+
+def _with_hypothesis(
+    sensor: SensorSession,
+    record: Exploration,
+    examples: int,
+    steps: int,
+    planned: bool,
+    key: str | None,
+) -> tuple[type, Callable[[type], None], Callable[[], None]]:
+    """The machine of a run with hypothesis loaded, how to release it, and the run (a plan
+    it draws under ``key`` is stored for later processes where :func:`_machine_module`
+    loaded hypothesis without the environment's plugins)."""
+    gc_pace.freeze_for_libraries()  # hypothesis's one gc.collect() walks only what it made
+    machine_module = _machine_module()  # hypothesis: loaded here
+    junk = globals()["JUNK"] if "JUNK" in globals() else __getattr__("JUNK")  # or a caller's
+    # foreign commands go out the way the sensor was shown to hear a one-shot a! (found
+    # before the machine starts, so finding it disturbs no sequence); a sensor shown to hear
+    # none leaves their silence uncounted
+    machine = machine_module.machine_class(sensor, record, sensor.hearing_marking(), junk)
+    keep_hypothesis_out_of_the_working_folder()
+
+    def send() -> None:
+        with no_local_constants(), no_database_key():
+            if not planned:
+                machine_module.run_machine(machine, examples, steps)
+                return
+            foreign = machine_module.foreign_addresses(sensor)
+            plan = machine_module.plan_for(foreign, junk, examples, steps)
+            if key is not None and _DRAWS_ALONE:
+                exploration_plans.quietly_store(key, plan)
+            machine_module.run_plan(machine, plan)
+
+    return machine, machine_module.release, send
+
+
 def forget_plans() -> None:
-    """Drop the exploration plans this process has drawn (tests that want hypothesis to
-    draw afresh); nothing to drop where no exploration ran."""
+    """Drop the exploration plans this process has drawn, and send no stored plan from now
+    on (tests that want hypothesis to draw afresh); nothing to drop where no exploration
+    ran."""
+    exploration_plans.send_nothing_stored()
     if "conformance.sensor.exploration_machine" in sys.modules:
         sys.modules["conformance.sensor.exploration_machine"].forget_plans()
 

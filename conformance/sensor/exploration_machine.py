@@ -11,23 +11,18 @@ from hypothesis import strategies as st
 from hypothesis.core import failure_exceptions_to_catch, skip_exceptions_to_reraise
 from hypothesis.stateful import RuleBasedStateMachine, rule, run_state_machine_as_test
 
-from ..judges.exploration import Observation, judge
-from ..protocol.commands import ADDRESS_CHARS
-from ..protocol.responses import split_line
-from ..tool_recorder.records import Exchange
-from ..transcript import escape
-from .address_change import AddressChanger
-from .exploration_record import (
-    FOREIGN_FORMS,
-    MAX_WAIT_OUT,
-    OWN,
-    SEED,
-    Exploration,
-    InvariantBroken,
-    harmless,
-    moved_by_malformed,
+from .exploration_record import FOREIGN_FORMS, OWN, SEED, Exploration, harmless
+from .exploration_steps import (
+    ExplorerSteps,
+    Plan,
+    Step,
+    foreign_addresses,
+    release_attributes,
 )
+from .exploration_steps import run_plan as send_plan
 from .session import SensorSession
+
+__all__ = ["foreign_addresses", "machine_class", "plan_for", "release", "run_machine", "run_plan"]
 
 
 def junk_strategy() -> st.SearchStrategy[str]:
@@ -37,149 +32,9 @@ def junk_strategy() -> st.SearchStrategy[str]:
     ).filter(harmless)
 
 
-class _Explorer(RuleBasedStateMachine):
-    """The stimuli and records behind the rules of :func:`machine_class`'s class (the rules
-    themselves are made per run: their strategies depend on the sensor's address and on the
-    module's JUNK at the time of the run, handed in as ``junk``)."""
-
-    sensor: ClassVar[SensorSession]
-    record: ClassVar[Exploration]
-    marking: ClassVar[float | None]  # the marking foreign commands go out with
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.address = self.sensor.address
-        self.trail: list[str] = []
-        self.last_d0: str | None = None  # D0 reply since the last measurement command
-        self.sensor.master.send_break()
-
-    def _observe(self, observation: Observation) -> None:
-        """Record one checked step and end the example if the judges find it broke an
-        invariant. The failing sequence is kept at the first breach: hypothesis replays a
-        failing example to confirm it, and a real device, whose state moved on, may then
-        behave otherwise (hypothesis calls that flaky); the first observation stands."""
-        self.record.observations.append(observation)
-        breach = judge(observation).breach
-        if breach is None:
-            return
-        if not self.record.breached:
-            self.record.breached = True
-            self.record.failing_sequence = list(self.trail)
-        raise InvariantBroken(breach.requirement, breach.message)
-
-    def _wait_out(self, ex: Exchange) -> None:
-        """A concurrent measurement runs on after its reply: wait its announced time, so
-        anything it sends then (a faulty service request) lands in a pause of its own and
-        is judged by the concurrent cases, not taken for the reply to the next step."""
-        body, _ = split_line(ex.reply_text)
-        ttt = body[1:4]
-        if ttt.isdigit() and int(ttt) > 0:
-            heard = self.sensor.listen(min(int(ttt), MAX_WAIT_OUT) + 0.05)
-            self._note(f"wait {ttt} s" + (" (heard something)" if heard else ""))
-
-    def _note(self, text: str) -> None:
-        self.trail.append(text)
-        self.record.steps += 1
-
-    def _send(self, code: str) -> Exchange:
-        ex = self.sensor.master.transact(f"{self.address}{code}!")
-        self.record.exchanges.append(ex)
-        self._note(f"{escape(ex.text)} -> '{escape(ex.reply_text)}'")
-        return ex
-
-    def _own(self, code: str) -> None:
-        """A command to the sensor's own address; its reply's framing, CRC and D0 repeat
-        are observed (only an answered one: silence is judged by the other cases)."""
-        ex = self._send(code)
-        if code[:1] in ("M", "C", "V", "H"):
-            self.last_d0 = None  # a new measurement may change the data
-        if not ex.answered:
-            return
-        if code in ("C", "CC"):
-            self._wait_out(ex)
-        self._observe_framing(ex)
-        if code.startswith("D"):
-            self._observe(Observation("crc", ex.text, ex.reply_text))
-        if code == "D0":
-            previous = self.last_d0
-            self._observe(Observation("repeat", ex.text, ex.reply_text, previous=previous))
-            self.last_d0 = ex.reply_text
-
-    def _foreign(self, other: str, code: str) -> None:
-        """A command to another address, sent the way the sensor was shown to hear."""
-        ex = self.sensor.master.raw(f"{other}{code}!", break_first=True, marking=self.marking)
-        self.record.exchanges.append(ex)
-        self._note(f"{escape(ex.text)} (foreign) -> '{escape(ex.reply_text)}'")
-        marked = self.marking is not None
-        self._observe(
-            Observation(
-                "foreign",
-                ex.text,
-                ex.reply_text,
-                other,
-                answered=ex.answered,
-                marked=marked,
-                collided=ex.maybe_collided,
-            )
-        )
-
-    def _malformed(self, junk: str) -> None:
-        """A malformed command: silence or any well-framed reply is fine (decision A12)."""
-        ex = self.sensor.master.raw(f"{self.address}{junk}!", break_first=None)
-        self.record.exchanges.append(ex)
-        self._note(f"{escape(ex.text)} (malformed?) -> '{escape(ex.reply_text)}'")
-        if ex.answered:
-            moved = moved_by_malformed(junk, ex.reply_text, self.address)
-            if moved is not None:
-                self._follow_address_change(moved)
-                return
-            self._observe_framing(ex)
-            # junk can spell a real command ("M", or "-7!0MC" ending in one): whatever
-            # the sensor accepted may have started a measurement
-            self.last_d0 = None
-
-    def _follow_address_change(self, moved: str) -> None:
-        """The sensor read the malformed command as ``aAb!`` and now answers at
-        ``moved``: informative under decision A12, not a reply from the wrong address;
-        put it back, so every later step talks to the address it has."""
-        changer = AddressChanger(self.sensor.master, self.address)
-        changer.current = moved
-        changer.tried.append(moved)
-        note = self.sensor.restore(changer)
-        self.record.exchanges += changer.exchanges
-        self._note(f"taken as a change to address '{moved}' (decision A12); {note}")
-
-    def _observe_framing(self, ex: Exchange) -> None:
-        self._observe(Observation("framing", ex.text, ex.reply_text, self.address))
-
-    def step(self, name: str, arguments: dict[str, object]) -> None:
-        """Send one step drawn for the rule ``name`` (:func:`_with_rules`)."""
-        getattr(self, "_" + name)(**arguments)
-
-    def _own_command(self, code: str) -> None:
-        self._own(code)
-
-    def _read_data(self, index: str) -> None:
-        self._own(f"D{index}")
-
-    def _foreign_command(self, other: str, code: str) -> None:
-        self._foreign(other, code)
-
-    def _malformed_command(self, junk: str) -> None:
-        self._malformed(junk)
-
-    def _brk(self) -> None:
-        self.sensor.master.send_break()
-        self._note("break")
-
-    def _pause(self, seconds: float) -> None:
-        self.sensor.listen(seconds)
-        self._note(f"pause {seconds * 1e3:.0f} ms")
-
-    def teardown(self) -> None:
-        self.record.log.append(" ; ".join(self.trail))
-        if not self.record.breached:  # after a break, the sequence that broke it stays
-            self.record.failing_sequence = list(self.trail)
+class _Explorer(ExplorerSteps, RuleBasedStateMachine):
+    """The exploration's steps (:class:`~.exploration_steps.ExplorerSteps`) as hypothesis's
+    state machine: the base of :func:`machine_class`'s class, whose rules hypothesis draws."""
 
 
 def machine_class(
@@ -194,19 +49,6 @@ def machine_class(
     machine.record = record
     machine.marking = marking
     return seed(SEED)(machine)
-
-
-def foreign_addresses(sensor: SensorSession) -> list[str]:
-    """The addresses the foreign commands go to (a strategy of the rules: part of a plan's
-    key, :func:`plan_for`)."""
-    foreign = [a for a in "9zy" if a != sensor.address]
-    if sensor.shared:  # never an address another sensor of the line answers at
-        spare = "9zyxwv" + ADDRESS_CHARS[::-1]
-        foreign = [
-            a for a in dict.fromkeys(spare) if a != sensor.address and a not in sensor.others
-        ]
-        foreign = foreign[:3]
-    return foreign
 
 
 def _with_rules(
@@ -245,12 +87,6 @@ def _with_rules(
             self.step("pause", {"seconds": seconds})
 
     return SensorMachine
-
-
-#: one step of a plan: a rule's name and the arguments drawn for it
-Step = tuple[str, dict[str, object]]
-#: what a derandomised run draws: for each example hypothesis runs, its steps in order
-Plan = tuple[tuple[Step, ...], ...]
 
 
 class _Recorder(RuleBasedStateMachine):
@@ -302,45 +138,9 @@ def forget_plans() -> None:
 
 
 def run_plan(machine: type[RuleBasedStateMachine], plan: Plan) -> None:
-    """Send ``plan`` with ``machine`` as hypothesis sends it (:func:`run_machine`): each
-    example a new machine, its steps, its teardown (also after a step raised). The first
-    example whose machine or step raises a failure ends the run, and, as hypothesis
-    replays a failing example once to report it, it runs again from a new machine up to
-    the step that raised (the replay's choices end there), and that step's exception, or
-    the first one where the replay raised none, goes out."""
-    for example in plan:
-        failed = _run_example(machine, example)
-        if failed is not None:
-            index, first = failed
-            again = _run_example(machine, example[: index + 1])
-            raise (again[1] if again is not None else first)
-
-
-def _run_example(
-    machine: type[RuleBasedStateMachine], steps: tuple[Step, ...]
-) -> tuple[int, BaseException] | None:
-    """One example of :func:`run_plan`: None, or the index of the step that raised a failure
-    (-1: the machine's making) and the exception. Hypothesis's own classes of exceptions:
-    a skip and anything not a failure (Ctrl-C) go straight out, after the teardown."""
-    failures, skips = failure_exceptions_to_catch(), skip_exceptions_to_reraise()
-    try:
-        made = machine()
-    except skips:
-        raise
-    except failures as exc:
-        return -1, exc
-    index = 0  # the step being sent
-    try:
-        for name, arguments in steps:
-            made.step(name, arguments)
-            index += 1
-    except skips:
-        raise
-    except failures as exc:
-        return index, exc
-    finally:
-        made.teardown()
-    return None
+    """Send ``plan`` with ``machine`` as hypothesis sends it, with hypothesis's own classes of
+    exceptions (:func:`.exploration_steps.run_plan`)."""
+    send_plan(machine, plan, failure_exceptions_to_catch, skip_exceptions_to_reraise)
 
 
 def release(machine: type[RuleBasedStateMachine]) -> None:
@@ -352,9 +152,7 @@ def release(machine: type[RuleBasedStateMachine]) -> None:
     objects (some 100 MB against wrong-crc) a run, which its collections then walked again
     and again. The class's own attributes are dropped (nothing reads them after the run) and
     hypothesis's entry for it, where this hypothesis keeps one."""
-    for name in ("sensor", "record", "marking"):
-        if name in vars(machine):
-            delattr(machine, name)
+    release_attributes(machine)
     kept = getattr(RuleBasedStateMachine, "_setup_state_per_class", None)
     if isinstance(kept, dict):
         kept.pop(machine, None)

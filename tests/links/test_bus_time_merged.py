@@ -112,3 +112,58 @@ def test_a_time_that_is_no_number_takes_the_sorted_way():
     assert not module._well_formed(events)
     found, expected = bus_time(events).lower_bound, sorted_lower_bound(events)
     assert found == expected or (found != found and expected != expected)
+
+
+def _spans_merged(wire: list[Event]) -> list[tuple[float, float]]:
+    """What bus_time merged before :func:`~bus_time._spans_in_order`: heapq.merge of the
+    three streams."""
+    from heapq import merge
+    from operator import itemgetter
+
+    waits = sorted(module._announced_waits(wire))
+    return list(merge(module._own_spans(wire), module._gaps(wire), waits, key=itemgetter(0)))
+
+
+@given(traffic(), st.lists(st.sampled_from([0.0, 0.001, CHAR_TIME]), max_size=30))
+def test_the_spans_in_one_loop_are_the_merged_ones_in_their_order(events, shorter):
+    """The one-loop spans are heapq.merge's, element for element and in its order (ties
+    included), also where events end where they start or overlap the next; where one ends
+    before it starts the merge is kept, and either way the bound is the sorted one."""
+    events = [
+        Event(e.kind, e.origin, e.start, e.start + shorter[i], e.wire) if i < len(shorter) else e
+        for i, e in enumerate(events)
+    ]
+    wire = sorted((e for e in events if e.kind is not EventKind.NOTE), key=attrgetter("start"))
+    if wire and module._well_formed(wire) and module._ends_after_starts(wire):
+        waits = sorted(module._announced_waits(wire))
+        assert list(module._spans_in_order(wire, waits)) == _spans_merged(wire)
+    assert bus_time(events).lower_bound == sorted_lower_bound(events)
+
+
+def test_an_event_ending_before_it_starts_is_merged_as_before():
+    events = [
+        Event(EventKind.CHAR, TOOL, 0.0, CHAR_TIME, to_wire_7e1(ord("0"))),
+        Event(EventKind.CHAR, DUT, 0.05, 0.04, to_wire_7e1(ord("0"))),  # ends before it began
+        Event(EventKind.CHAR, DUT, 0.045, 0.06, to_wire_7e1(ord("1"))),
+    ]
+    wire = sorted(events, key=attrgetter("start"))
+    assert module._well_formed(wire) and not module._ends_after_starts(wire)
+    assert bus_time(events).lower_bound == sorted_lower_bound(events)
+
+
+def test_a_simulated_run_s_spans_are_the_merged_ones() -> None:
+    """A whole simulated run (measurements, waits, breaks, retries) in one loop and merged."""
+    import tempfile
+    from pathlib import Path
+
+    from conformance.conduct import run_into
+    from conformance.replay.recording import read_recording
+    from conformance.transcript import in_start_order
+
+    with tempfile.TemporaryDirectory() as tmp:
+        run_into(Path(tmp), "sim://?faults=wrong-crc", keyword="measurement or crc")
+        events = read_recording(Path(tmp) / "transcript.jsonl").events
+    wire = in_start_order(events)
+    assert len(wire) > 1000 and module._ends_after_starts(wire)
+    waits = sorted(module._announced_waits(wire))
+    assert waits and list(module._spans_in_order(wire, waits)) == _spans_merged(wire)

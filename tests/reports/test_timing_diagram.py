@@ -43,6 +43,18 @@ def test_equal_values_and_equally_near_distinct_values_give_the_first_segment():
         assert MeasureIndex(measures=per_segment).nearest(-far) == scan(per_segment, -far)
 
 
+def test_an_index_of_any_length_keeps_each_distinct_value_once():
+    """A simulated run's 33,000 intervals are a few dozen values: the index holds those, each
+    with its first segment (it kept and sorted every interval below 50,000, or without numpy
+    loaded: 16-20 ms of the page's renderer); with a NaN, every interval, as the sort gave."""
+    index = MeasureIndex(measures=[[8.33] * 3, [8.33, 1.0], [-0.0, 0.0]])
+    assert list(index.values) == [-0.0, 1.0, 8.33] and list(index.owners) == [2, 1, 0]
+    assert str(index.values[0]) == "-0.0"  # the first spelling of the equal zeros
+    nan = float("nan")
+    with_nan = MeasureIndex(measures=[[8.33, nan], [8.33]])
+    assert len(with_nan.values) == 3 and sorted(with_nan.owners) == [0, 0, 1]
+
+
 def test_no_interval_no_segment():
     assert MeasureIndex(measures=[[], []]).nearest(8.0) is None
     assert MeasureIndex(measures=[[], [9.0]]).nearest(8.0) == 1
@@ -63,14 +75,14 @@ def first_of_runs(index: MeasureIndex) -> tuple[list[float], list[int]]:
     st.lists(st.lists(value, max_size=4), max_size=80),  # past numpy's insertion sort
     st.lists(st.floats(-5, 20) | value, max_size=6),
 )
-def test_numpy_orders_the_index_as_the_sort_does(
+def test_the_distinct_values_order_the_index_as_the_sort_does(
     per_segment: list[list[float]], targets: list[float]
 ):
-    """A long recording's index is ordered by numpy's stable argsort (NUMPY_FROM): the
-    arrays of Python's stable sort of a short one, to the sign of a zero, with each run of
-    equal values kept as its first only; both answer every target as the scan does."""
-    plain = MeasureIndex(measures=per_segment, numpy_from=10**9)
-    fast = MeasureIndex(measures=per_segment, numpy_from=0)
+    """The index keeps each distinct value once with its first segment: the arrays of
+    Python's stable sort of every interval, to the sign of a zero, with each run of equal
+    values kept as its first only; both answer every target as the scan does."""
+    plain = MeasureIndex(measures=per_segment, every_interval=True)
+    fast = MeasureIndex(measures=per_segment)
     values, owners = first_of_runs(plain)
     assert fast.values.tobytes() == array("d", values).tobytes()
     assert list(fast.owners) == owners
@@ -80,16 +92,16 @@ def test_numpy_orders_the_index_as_the_sort_does(
 
 
 def test_a_long_index_imports_no_numpy_for_its_order():
-    """Past NUMPY_FROM the index is ordered by numpy only where numpy is loaded already (a
-    capture's decoding): a simulated run of 145,000 intervals (sim://?faults=wrong-crc) paid
-    more for the import than the order saved. Both orders are the same (the test above)."""
+    """A long index loads no numpy for its order: a simulated run of 145,000 intervals
+    (sim://?faults=wrong-crc) paid more for the import than numpy's order saved. Both orders
+    are the same (the test above)."""
     import subprocess
     import sys
 
     script = (
         "import sys\n"
-        "from conformance.reports.timing_diagram import NUMPY_FROM, MeasureIndex\n"
-        "segments = [[float(i % 97), float(i % 13)] for i in range(NUMPY_FROM)]\n"
+        "from conformance.reports.timing_diagram import MeasureIndex\n"
+        "segments = [[float(i % 97), float(i % 13)] for i in range(50_000)]\n"
         "MeasureIndex(measures=segments)\n"
         "print('numpy' in sys.modules)\n"
     )
@@ -111,7 +123,7 @@ def test_a_long_index_is_built_without_an_array_of_every_interval():
     tracemalloc.start()
     try:
         before, _ = tracemalloc.get_traced_memory()
-        index = MeasureIndex(measures=per_segment, numpy_from=0)
+        index = MeasureIndex(measures=per_segment)
         _, peak = tracemalloc.get_traced_memory()
     finally:
         tracemalloc.stop()
