@@ -149,7 +149,8 @@ def _start_observations(
     ``before`` carries into the next window's: its reply may be late, after the cut)."""
     early: list[Observation] = []
     late: list[Observation] = []
-    for seg in segs:
+    texts = _texts(segs)
+    for k, seg in enumerate(segs):
         earlier, before = _unanswered_before(before, seg), seg
         if not seg.reply or _reply_set_aside(seg) or _not_a_reply_to(seg):
             continue
@@ -159,7 +160,7 @@ def _start_observations(
         # the evidence line is made when a finding shows this reply (_StartWhere), not for
         # each of the run's ~900 replies (issue 22, matrix23)
         where = _StartWhere(seg, earlier)
-        place: Place = (seg.text, _text(seg), 0)
+        place: Place = (seg.text, _text(seg) if texts is None else texts[k], 0)
         spacing = _spacing_before_reply(seg)
         for window, out in ((EARLY_WINDOW, early), (LATE_WINDOW, late)):
             measured, said = delay, where
@@ -305,6 +306,18 @@ def _text(seg: Segment) -> str:
     return text7(seg.reply + seg.later)
 
 
+def _texts(segs: list[Segment]) -> list[str] | None:
+    """Each segment's :func:`_text` ('' where the sensor sent nothing), made once per
+    :class:`Segments`: R-7.0-09/-10's places and R-7.0-12's read the same text of every
+    reply of a run, and each made it again (issue 22, matrix23). None for a plain list (a
+    window of a recording): its callers make each text as they go."""
+    if not isinstance(segs, Segments):
+        return None
+    return segs.derived(
+        "_wire_texts", None, lambda: [_text(s) if s.reply or s.later else "" for s in segs]
+    )
+
+
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     """Every marking gap between consecutive characters of one DUT run, with its context."""
     return [(gap, where) for gap, where, _a, _b, _p in _gaps(segs)]
@@ -340,10 +353,12 @@ def _placed(segs: list[Segment]) -> Iterator[tuple[Segment, str, str, bool]]:
     line, all it sent after the command as text, and whether the pauses after its LFs are
     between lines of multi-line text (R-4.4.13.1-03's 150 ms, not a gap), which is so too
     for the rest of multi-line text the command talked over."""
-    for seg in segs:
+    texts = _texts(segs)
+    for k, seg in enumerate(segs):
         if seg.reply or seg.later:
             multiline = seg.multiline or talked_through(seg)
-            yield seg, f"in reply to {escape(seg.text)}", _text(seg), multiline
+            text = _text(seg) if texts is None else texts[k]
+            yield seg, f"in reply to {escape(seg.text)}", text, multiline
 
 
 def _placed_runs(seg: Segment) -> Iterator[tuple[int, list[Event]]]:
@@ -397,9 +412,11 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
         # confirmed (gaps_to_confirm): a run's segments kept no observations for it either
         # and are judged the same way in one part (issue 22, matrix19)
         gaps = ReplyGaps(stamps)
-        at_once = SEGMENTS_AT_ONCE if not isinstance(segs, Segments) else len(segs) or 1
-        for k in range(0, len(segs), at_once):
-            gaps.add(segs[k : k + at_once])
+        if isinstance(segs, Segments):  # in one part, the Segments themselves (_texts)
+            gaps.add(segs)
+        else:
+            for k in range(0, len(segs), SEGMENTS_AT_ONCE):
+                gaps.add(segs[k : k + SEGMENTS_AT_ONCE])
         return gaps.findings()
     gap_finding = combine_local(
         "R-7.0-12",

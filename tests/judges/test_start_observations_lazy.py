@@ -23,7 +23,7 @@ from conformance.judges.timing import Measured, StampUncertainty
 from conformance.judges.wire import EARLY_WINDOW, LATE_WINDOW
 from conformance.protocol.timing import CHAR_TIME
 from conformance.transcript import DUT, TOOL, Event, EventKind, escape, to_wire_7e1
-from conformance.view.runs import Segment
+from conformance.view.runs import Segment, Segments
 
 
 def _old_start_observations(segs, stamps, before=None):
@@ -171,3 +171,41 @@ def test_the_pass_margin_is_margin_ms_inside() -> None:
         assert timing._margin_inside_ms(lo, hi, measured) == timing._margin_ms(
             lo, hi, measured, False
         )
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize(
+    "stamps",
+    [StampUncertainty(0.0), StampUncertainty(0.1e-3, lambda a, b: 0.3e-3 if a > 5 else 0.0)],
+)
+def test_the_shared_texts_judge_as_a_plain_list(seed, stamps) -> None:
+    """R-7.0-09/-10 and R-7.0-12/-01 over a run's Segments (each reply's text made once,
+    ``wire._texts``; the gaps judged in one part, the Segments themselves) find what the
+    same segments as a plain list find (each text made as it goes, the gaps 64 segments at
+    a time)."""
+    segs = _segments(150, random.Random(seed))
+    shared = Segments(segs)
+    for judge in (wire.judge_response_start, wire.judge_gaps):
+        assert [asdict(f) for f in judge(shared, stamps)] == [
+            asdict(f) for f in judge(list(segs), stamps)
+        ]
+    assert wire.starts_to_confirm(shared, stamps) == wire.starts_to_confirm(list(segs), stamps)
+    assert wire.gaps_to_confirm(shared, stamps) == wire.gaps_to_confirm(list(segs), stamps)
+
+
+def test_a_reply_text_is_made_once_for_both_rules(monkeypatch) -> None:
+    """The case's order (starts, then gaps) over one Segments makes each text once."""
+    made = []
+    inner = wire._text
+
+    def counted(seg):
+        made.append(seg)
+        return inner(seg)
+
+    monkeypatch.setattr(wire, "_text", counted)
+    segs = Segments(_segments(100, random.Random(2)))
+    wire.starts_after_a_retry(segs, StampUncertainty(0.0))
+    wire.judge_response_start(segs, StampUncertainty(0.0))
+    wire.judge_gaps(segs, StampUncertainty(0.0))
+    sent = [s for s in segs if s.reply or s.later]
+    assert len(made) == len(sent) == len({id(s) for s in made})
