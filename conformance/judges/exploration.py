@@ -145,9 +145,25 @@ _JUDGES: dict[str, Callable[[Observation], Judgement]] = {
 }
 
 
+#: How many judgements :func:`judge` keeps (a few hundred distinct observations a run)
+JUDGED_MAX = 4096
+_JUDGED: dict[Observation, Judgement] = {}
+
+
 def judge(obs: Observation) -> Judgement:
-    """The judgement of one observation (pure: the same record always judges the same)."""
-    return _JUDGES[obs.check](obs)
+    """The judgement of one observation (pure: the same record always judges the same).
+
+    Kept, and given again for an equal record: each observation is judged as the
+    exploration makes it, then again by every reader of the run (``Exploration.broken``,
+    :func:`held_findings`' breach and count), and a fault-matrix row judges the same run
+    again through its capture (issue 22, matrix23: six judgements an observation, a CRC
+    parsed in each). The table is emptied when full, as ``parse_command``'s is."""
+    judged = _JUDGED.get(obs)
+    if judged is None:
+        if len(_JUDGED) >= JUDGED_MAX:
+            _JUDGED.clear()
+        judged = _JUDGED[obs] = _JUDGES[obs.check](obs)
+    return judged
 
 
 def first_breach(observations: Iterable[Observation]) -> Breach | None:

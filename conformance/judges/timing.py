@@ -675,6 +675,17 @@ def _margin_ms(lo: float | None, hi: float | None, measured: float, outside: boo
     return None if nearest is None else round(nearest * 1e3, 3)
 
 
+def _margin_inside_ms(lo: float | None, hi: float | None, measured: float) -> float | None:
+    """``_margin_ms(lo, hi, measured, False)`` without its loop over a tuple of edges: asked
+    for every interval a run judges surely inside (a run's ~900 reply starts twice and its
+    distinct character gaps, issue 22, matrix23); the nearer edge, the first on a tie."""
+    if lo is None:
+        return None if hi is None else round(abs(hi - measured) * 1e3, 3)
+    if hi is None:
+        return round(abs(measured - lo) * 1e3, 3)
+    return round(min(abs(measured - lo), abs(hi - measured)) * 1e3, 3)
+
+
 class Measured:
     """One interval judged against a :class:`Window`, standing in for its :class:`Finding`
     among the observations :func:`combine` and :func:`combine_local` aggregate: they read
@@ -689,7 +700,11 @@ class Measured:
     observed = 1  # one measured interval between two observed wire events
 
     def __init__(
-        self, window: Window, measured: float, uncertainty: float, evidence: list[str] | None
+        self,
+        window: Window,
+        measured: float,
+        uncertainty: float,
+        evidence: list[str] | Callable[[], list[str]] | None,
     ) -> None:
         lo, hi = window.lo, window.hi
         self._window = window
@@ -702,7 +717,7 @@ class Measured:
             hi is None or measured + uncertainty <= hi
         ):  # surely inside, as nearly every one is: _window_verdict's PASS, without the call
             self.verdict = Verdict.PASS
-            self.margin_ms = _margin_ms(lo, hi, measured, False)
+            self.margin_ms = _margin_inside_ms(lo, hi, measured)
             return
         verdict, outside = _window_verdict(lo, hi, measured, uncertainty, window.should)
         if verdict is Verdict.FAIL or verdict is Verdict.WARN:
@@ -719,8 +734,12 @@ class Measured:
         return self._finding
 
     def _evidence(self) -> list[str] | None:
-        """The evidence lines its finding gets (:class:`MeasuredIn` makes them when asked)."""
-        return self.evidence_lines
+        """The evidence lines its finding gets: the list given, or what the callable given
+        makes, asked only when the finding is built (a reply's start is measured for every
+        reply of a run, its line read for the few a verdict shows: ``judges/wire``);
+        :class:`MeasuredIn` makes its own when asked."""
+        lines = self.evidence_lines
+        return lines() if callable(lines) else lines
 
     @property
     def requirement(self) -> str:

@@ -149,23 +149,18 @@ def _start_observations(
     ``before`` carries into the next window's: its reply may be late, after the cut)."""
     early: list[Observation] = []
     late: list[Observation] = []
-    for seg in segs:
+    texts = _texts(segs)
+    for k, seg in enumerate(segs):
         earlier, before = _unanswered_before(before, seg), seg
         if not seg.reply or _reply_set_aside(seg) or _not_a_reply_to(seg):
             continue
         delay = seg.reply[0].start - seg.command_end
         u = stamps.between(seg.command[-1].start, seg.reply[0].end)
         tainted = u > stamps.base
-        where = [f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"]
-        place: Place = (seg.text, _text(seg), 0)
-        if earlier is not None:
-            # the reply may answer the unanswered command before this one, late: it counts
-            # only where both readings give the same answer
-            lagged = seg.reply[0].start - earlier.command_end
-            where = [
-                f"{where[0]} (or to {escape(earlier.text)} before it, "
-                f"{lagged * 1e3:.2f} ms after that one)"
-            ]
+        # the evidence line is made when a finding shows this reply (_StartWhere), not for
+        # each of the run's ~900 replies (issue 22, matrix23)
+        where = _StartWhere(seg, earlier)
+        place: Place = (seg.text, _text(seg) if texts is None else texts[k], 0)
         spacing = _spacing_before_reply(seg)
         for window, out in ((EARLY_WINDOW, early), (LATE_WINDOW, late)):
             measured, said = delay, where
@@ -173,9 +168,9 @@ def _start_observations(
                 # the sensor drove the line spacing first: R-7.0-09's marking ended there
                 measured = max(spacing.start, seg.command_end) - seg.command_end
                 said = [
-                    f"{where[0]}: the sensor held the line spacing from {measured * 1e3:.2f} ms "
-                    f"after the command, {spacing.duration * 1e3:.2f} ms (a break), before "
-                    f"its reply at {delay * 1e3:.2f} ms"
+                    f"{where()[0]}: the sensor held the line spacing from "
+                    f"{measured * 1e3:.2f} ms after the command, {spacing.duration * 1e3:.2f} "
+                    f"ms (a break), before its reply at {delay * 1e3:.2f} ms"
                 ]
             if earlier is not None:
                 other = measured + seg.command_end - earlier.command_end
@@ -185,6 +180,33 @@ def _start_observations(
     return early, late, before
 
 
+class _StartWhere:
+    """The evidence line of a reply's start (:func:`_start_observations`), made when first
+    asked (the finding of a FAIL or WARN at once, else of the few a verdict shows) and then
+    the same list; the reply may answer the unanswered command ``earlier`` before it, late
+    (:func:`_unanswered_before`): it counts only where both readings give the same answer."""
+
+    __slots__ = ("earlier", "lines", "seg")
+
+    def __init__(self, seg: Segment, earlier: Segment | None) -> None:
+        self.seg = seg
+        self.earlier = earlier
+        self.lines: list[str] | None = None
+
+    def __call__(self) -> list[str]:
+        if self.lines is None:
+            seg, earlier = self.seg, self.earlier
+            line = f"reply to {escape(seg.text)} at t={seg.command_end:.4f} s"
+            if earlier is not None:
+                lagged = seg.reply[0].start - earlier.command_end
+                line = (
+                    f"{line} (or to {escape(earlier.text)} before it, "
+                    f"{lagged * 1e3:.2f} ms after that one)"
+                )
+            self.lines = [line]
+        return self.lines
+
+
 def _spacing_before_reply(seg: Segment) -> Event | None:
     """The sensor's first break (:attr:`Segment.sensor_breaks`) on the line after the command
     ended and begun before its reply's first character: the first spacing the sensor put on the
@@ -192,9 +214,12 @@ def _spacing_before_reply(seg: Segment) -> Event | None:
     bit says. The twenty-fourth round's sketch "wakes the sensors" (12.1 ms of spacing)
     0.00 ms after every command, then marks 8.4 ms and replies 20.06 ms after it: R-7.0-09
     PASSed on the 20.06 ms, though a UART would read a start bit at 0.00 ms."""
+    breaks = seg.sensor_breaks
+    if not breaks:  # nearly always: no generator made for none
+        return None
     first = seg.reply[0].start
     end = seg.command_end
-    return next((b for b in seg.sensor_breaks if b.end > end and b.start < first), None)
+    return next((b for b in breaks if b.end > end and b.start < first), None)
 
 
 def _unanswered_before(before: Segment | None, seg: Segment) -> Segment | None:
@@ -223,8 +248,11 @@ def _reply_set_aside(seg: Segment) -> bool:
     16``): a reply '0<CR><LF>' set aside left the stray '#' a sensor sent after its LF timed
     as the reply, 39.83 ms, a false R-7.0-10 FAIL. A character that started before the
     command ended (a service request that met it) is no reply: the one after it is timed."""
+    met = seg.contention
+    if not met:  # nearly always: no generator made for none
+        return False
     end = seg.command_end
-    return any(e.start >= end for e in seg.contention)
+    return any(e.start >= end for e in met)
 
 
 def _not_a_reply_to(seg: Segment) -> bool:
@@ -238,9 +266,9 @@ def _not_a_reply_to(seg: Segment) -> bool:
     R-7.0-09/-10 counted "1.50..7.67 ms" over it (docs/kit.md)."""
     first = seg.reply[0]
     end = seg.command_end
-    under_way = any(
-        e.start < end and first.start - e.end <= INTER_CHAR_GAP_MAX + TOLERANCE
-        for e in seg.contention
+    met = seg.contention
+    under_way = bool(met) and any(  # nothing met the command, nearly always: no generator
+        e.start < end and first.start - e.end <= INTER_CHAR_GAP_MAX + TOLERANCE for e in met
     )
     if under_way:
         return True
@@ -278,6 +306,18 @@ def _text(seg: Segment) -> str:
     return text7(seg.reply + seg.later)
 
 
+def _texts(segs: list[Segment]) -> list[str] | None:
+    """Each segment's :func:`_text` ('' where the sensor sent nothing), made once per
+    :class:`Segments`: R-7.0-09/-10's places and R-7.0-12's read the same text of every
+    reply of a run, and each made it again (issue 22, matrix23). None for a plain list (a
+    window of a recording): its callers make each text as they go."""
+    if not isinstance(segs, Segments):
+        return None
+    return segs.derived(
+        "_wire_texts", None, lambda: [_text(s) if s.reply or s.later else "" for s in segs]
+    )
+
+
 def reply_gaps(segs: list[Segment]) -> list[tuple[float, str]]:
     """Every marking gap between consecutive characters of one DUT run, with its context."""
     return [(gap, where) for gap, where, _a, _b, _p in _gaps(segs)]
@@ -313,10 +353,12 @@ def _placed(segs: list[Segment]) -> Iterator[tuple[Segment, str, str, bool]]:
     line, all it sent after the command as text, and whether the pauses after its LFs are
     between lines of multi-line text (R-4.4.13.1-03's 150 ms, not a gap), which is so too
     for the rest of multi-line text the command talked over."""
-    for seg in segs:
+    texts = _texts(segs)
+    for k, seg in enumerate(segs):
         if seg.reply or seg.later:
             multiline = seg.multiline or talked_through(seg)
-            yield seg, f"in reply to {escape(seg.text)}", _text(seg), multiline
+            text = _text(seg) if texts is None else texts[k]
+            yield seg, f"in reply to {escape(seg.text)}", text, multiline
 
 
 def _placed_runs(seg: Segment) -> Iterator[tuple[int, list[Event]]]:
@@ -370,9 +412,11 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
         # confirmed (gaps_to_confirm): a run's segments kept no observations for it either
         # and are judged the same way in one part (issue 22, matrix19)
         gaps = ReplyGaps(stamps)
-        at_once = SEGMENTS_AT_ONCE if not isinstance(segs, Segments) else len(segs) or 1
-        for k in range(0, len(segs), at_once):
-            gaps.add(segs[k : k + at_once])
+        if isinstance(segs, Segments):  # in one part, the Segments themselves (_texts)
+            gaps.add(segs)
+        else:
+            for k in range(0, len(segs), SEGMENTS_AT_ONCE):
+                gaps.add(segs[k : k + SEGMENTS_AT_ONCE])
         return gaps.findings()
     gap_finding = combine_local(
         "R-7.0-12",
