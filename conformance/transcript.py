@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
 from math import copysign, isfinite
@@ -126,12 +126,50 @@ class Event:
         return self.uncertainty
 
 
-_new = object.__new__
-_SET = tuple(Event.__dict__[name].__set__ for name in Event.__slots__)  # each field's slot
-#: what :func:`full_event` makes an event with (an object without ``__init__``, then each
-#: slot's setter in field order), for a loop that spells it out (the sim bus's reply run)
-EVENT_SLOTS = _SET
-new_event = _new
+class _Unfrozen:
+    """:class:`Event`'s slots, set by a plain ``__init__`` (a ``STORE_ATTR`` per slot, which
+    Python 3.11 specialises), the object made an :class:`Event` by its last line: what
+    :func:`full_event` makes. The frozen dataclass's own ``__init__`` sets each field through
+    ``object.__setattr__`` by name, and an object made bare with each slot's setter called
+    (this module's way until matrix21) was a call per field: ~1.1 us a character against
+    ~0.5 us so, 10^4 to 10^5 a sim run's half and again its capture's decode (issue 22). The
+    two classes have the same slots in the same order on the same base, which is exactly
+    when Python lets an object's class be changed; the object is then an Event like any
+    other, frozen from there on (``tests/sim/test_bus.py`` holds it to the constructor field
+    by field)."""
+
+    __slots__ = Event.__slots__
+
+    def __init__(
+        self,
+        kind: EventKind,
+        origin: str,
+        start: float,
+        end: float,
+        wire: int,
+        text: str,
+        uncertainty: float,
+        duration_uncertainty: float | None,
+    ) -> None:
+        self.kind = kind
+        self.origin = origin
+        self.start = start
+        self.end = end
+        self.wire = wire
+        self.text = text
+        self.uncertainty = uncertainty
+        self.duration_uncertainty = duration_uncertainty
+        self.__class__ = Event  # type: ignore[assignment]
+
+
+#: ``full_event(kind, origin, start, end, wire, text, uncertainty, duration_uncertainty)``:
+#: ``Event(kind, origin, start, end, wire, text, uncertainty, duration_uncertainty)`` made
+#: without the frozen dataclass's ``__init__`` (:class:`_Unfrozen`), every slot set: the sim
+#: bus (:func:`wire_event`, its reply and command runs), a capture's decoder and its TX merge
+#: make one per character, 10^4 to 10^5 a run, 10^6 an hour's capture. The class itself, not
+#: a function calling it: the call in between was a fifth of the cost.
+full_event: Callable[[EventKind, str, float, float, int, str, float, float | None], Event]
+full_event = _Unfrozen  # type: ignore[assignment]
 
 
 def wire_event(kind: EventKind, origin: str, start: float, end: float, wire: int = 0) -> Event:
@@ -139,34 +177,6 @@ def wire_event(kind: EventKind, origin: str, start: float, end: float, wire: int
     by :func:`full_event` (no frozen ``__init__``): the sim bus makes one per character, 10^4
     to 10^5 a run (``tests/sim/test_bus.py`` holds it to the constructor field by field)."""
     return full_event(kind, origin, start, end, wire, "", 0.0, None)
-
-
-def full_event(
-    kind: EventKind,
-    origin: str,
-    start: float,
-    end: float,
-    wire: int,
-    text: str,
-    uncertainty: float,
-    duration_uncertainty: float | None,
-) -> Event:
-    """``Event(kind, origin, start, end, wire, text, uncertainty, duration_uncertainty)``
-    made without the frozen dataclass's ``__init__`` (a ``setattr`` by name per field, two
-    thirds of the cost), every slot set: the sim bus (:func:`wire_event`), a capture's
-    decoder and its TX merge make one per character, 10^4 to 10^5 a run, 10^6 an hour's
-    capture."""
-    event = _new(Event)
-    set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = _SET
-    set_kind(event, kind)
-    set_origin(event, origin)
-    set_start(event, start)
-    set_end(event, end)
-    set_wire(event, wire)
-    set_text(event, text)
-    set_u(event, uncertainty)
-    set_du(event, duration_uncertainty)
-    return event
 
 
 def in_start_order(events: Iterable[Event]) -> list[Event]:

@@ -23,13 +23,11 @@ from ..protocol.timing import CHAR_TIME
 from ..transcript import (
     COLLISION,
     DUT,
-    EVENT_SLOTS,
     TOOL,
     Event,
     EventKind,
     Transcript,
     full_event,
-    new_event,
     wire_event,
 )
 
@@ -291,7 +289,6 @@ class SimBus:
         clock = self.clock
         add = self.transcript.add
         char = EventKind.CHAR
-        set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
         events: list[Event] = []
         time = start
         for wire in wires:
@@ -302,15 +299,7 @@ class SimBus:
             if time > now:
                 clock.now = now = time
             end = now + CHAR_TIME
-            made = new_event(Event)
-            set_kind(made, char)
-            set_origin(made, TOOL)
-            set_start(made, now)
-            set_end(made, end)
-            set_wire(made, wire)
-            set_text(made, "")
-            set_u(made, 0.0)
-            set_du(made, None)
+            made = full_event(char, TOOL, now, end, wire, "", 0.0, None)
             event = add(made)
             hear(wire, now, end)
             if end > clock.now:
@@ -494,9 +483,8 @@ class SimLink(Link):
             else None
         )
         char = EventKind.CHAR
-        # wire_event spelt out (its slots set in place): a run's 10^4..10^5 characters each
-        # went through two calls more
-        set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
+        # full_event called in place (not wire_event): a run's 10^4..10^5 characters each
+        # went through a call more
         # a one-line reply's stop (LineEnd) checked here, not called after each character:
         # the characters before this read's and the 7 bits of the last one so far
         line = until if type(until) is LineEnd else None
@@ -516,15 +504,7 @@ class SimLink(Link):
                 if start < now:  # max(start, now), spelt out
                     start = now
                 end = start + duration
-                made = new_event(Event)
-                set_kind(made, char)
-                set_origin(made, DUT)
-                set_start(made, start)
-                set_end(made, end)
-                set_wire(made, wire)
-                set_text(made, "")
-                set_u(made, 0.0)
-                set_du(made, None)
+                made = full_event(char, DUT, start, end, wire, "", 0.0, None)
                 event = add(made)
                 if end > now:
                     clock.now = end
@@ -563,7 +543,6 @@ class SimLink(Link):
         arithmetic on its transmission), so the clock, events and limits are the same."""
         clock = self.bus.clock
         char = EventKind.CHAR
-        set_kind, set_origin, set_start, set_end, set_wire, set_text, set_u, set_du = EVENT_SLOTS
         room = last7 = 0
         if line is not None:
             # LineEnd inline: ``before`` and ``got`` reach ``most``, or the last two are CR LF
@@ -578,15 +557,7 @@ class SimLink(Link):
                 if start < now:  # max(start, now), spelt out
                     start = now
                 end = start + duration
-                made = new_event(Event)
-                set_kind(made, char)
-                set_origin(made, DUT)
-                set_start(made, start)
-                set_end(made, end)
-                set_wire(made, wire)
-                set_text(made, "")
-                set_u(made, 0.0)
-                set_du(made, None)
+                made = full_event(char, DUT, start, end, wire, "", 0.0, None)
                 keep(made)
                 if end > now:
                     now = end

@@ -181,8 +181,9 @@ def fits_shape(command: Command, text: str) -> bool:
     return _shape_problem(command, body, crc) is None
 
 
-#: the replies :func:`check_ascii` judged last, by what it was asked: (the events, why)
-_JUDGED: dict[tuple[object, ...], tuple[list[Event], str | None]] = {}
+#: the replies :func:`check_ascii` judged last, by what it was asked (the command by its
+#: ``id``): (that command, the events, why)
+_JUDGED: dict[tuple[object, ...], tuple[Command | None, list[Event], str | None]] = {}
 _JUDGED_MAX = 64  # cleared when full: the tool recorder's attempts of a stimulus or two
 
 
@@ -207,18 +208,23 @@ def check_ascii(
     A pure function of its arguments, asked twice about nearly every reply of a sensor run:
     by the tool recorder as it reads the reply, then by the view's records of the stimulus
     (``view.rebuilt_records``), the same characters with the same command, so the answers
-    to the last few questions are kept (the events compared, not only their number).
+    to the last few questions are kept (the events compared, not only their number). The
+    command is known by its identity (both ask with the object :func:`parse_command` keeps
+    for the text): a frozen dataclass's hash is worked out anew at every look, a metadata
+    command's with its target's, three times a reply (matrix21); an equal command made
+    apart is only a question asked afresh, and the command kept with the answer is the one
+    asked about (an ``id`` may be reused once its object is gone).
     """
-    key = (command, address, command_end, gap_limit, crc_expected, multiline, len(events))
+    key = (id(command), address, command_end, gap_limit, crc_expected, multiline, len(events))
     kept = _JUDGED.get(key)
-    if kept is not None and kept[0] == events:
-        return kept[1]
+    if kept is not None and kept[0] is command and kept[1] == events:
+        return kept[2]
     why = _ascii_problem(
         command, events, address, command_end, gap_limit, crc_expected, multiline, text
     )
     if len(_JUDGED) >= _JUDGED_MAX:
         _JUDGED.clear()
-    _JUDGED[key] = (list(events), why)
+    _JUDGED[key] = (command, list(events), why)
     return why
 
 

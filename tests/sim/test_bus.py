@@ -193,6 +193,39 @@ def test_a_wire_event_is_the_event_its_constructor_makes() -> None:
         fast.start = 0.0  # type: ignore[misc]
 
 
+def test_a_full_event_is_an_event_like_any_other() -> None:
+    """transcript.full_event makes an :class:`_Unfrozen` object and turns it into an Event
+    (matrix21): what it gives must be the constructor's event in every way a reader can
+    tell, every field set, its type Event itself, frozen, equal and hashed alike, and the
+    same after a pickle round trip and a copy (a rack worker's results cross processes)."""
+    import copy
+    import dataclasses
+    import pickle
+    import random
+
+    from conformance.transcript import TOOL, Event, EventKind, full_event
+
+    fields = dataclasses.fields(Event)
+    rng = random.Random(21)
+    for _ in range(500):
+        args = (rng.choice(list(EventKind)), rng.choice([TOOL, "dut", "bus"]), rng.random(),
+                rng.random() + 1.0, rng.randrange(512), rng.choice(["", "collision", "x"]),
+                rng.choice([0.0, rng.random() * 1e-3]), rng.choice([None, 0.0, 2e-4]))  # fmt: skip
+        fast, made = full_event(*args), Event(*args)
+        assert type(fast) is Event and isinstance(fast, Event)
+        assert fast == made and hash(fast) == hash(made) and repr(fast) == repr(made)
+        for f in fields:
+            assert getattr(fast, f.name) == getattr(made, f.name)
+            assert type(getattr(fast, f.name)) is type(getattr(made, f.name))
+        again = pickle.loads(pickle.dumps(fast))
+        assert type(again) is Event and again == made
+        assert copy.copy(fast) == made and copy.deepcopy(fast) == made
+        assert fast.to_json() == made.to_json()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.start = 0.0  # type: ignore[misc]
+    assert not hasattr(fast, "__dict__")  # the slots only, as the constructor's
+
+
 def _one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
     """The tool's characters placed as ``SimLink.write`` placed them before ``tool_run``:
     each by :meth:`SimBus.tool_char`, the next ``gap`` after the end of the kept event."""

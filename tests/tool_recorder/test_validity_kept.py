@@ -4,6 +4,8 @@ given again only for the same question about the same characters (compared, not 
 
 from __future__ import annotations
 
+import dataclasses
+
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -36,6 +38,7 @@ questions = st.tuples(
     st.sampled_from([0.009, 0.011]),  # command end
     st.sampled_from([None, True, False]),  # crc expected
     st.booleans(),  # the same list asked again, or a copy
+    st.booleans(),  # the command object parse_command keeps, or an equal one made apart
 )
 
 
@@ -43,7 +46,9 @@ questions = st.tuples(
 @given(st.lists(questions, min_size=1, max_size=40))
 def test_kept_answers_are_the_answers(asked):
     validity._JUDGED.clear()
-    for command, text, start, gap, flip, end, crc, copy in asked:
+    for command, text, start, gap, flip, end, crc, copy, apart in asked:
+        if apart and command is not None:
+            command = dataclasses.replace(command)  # equal, not the same object
         events = _reply(text, start, gap, flip)
         if copy:
             events = list(events)
@@ -79,3 +84,18 @@ def test_the_views_records_ask_nothing_new(monkeypatch):
     ex = session.exchange("I")
     assert ex.ok and ex.reply_text.startswith("0")
     assert len(worked) == 1
+
+
+def test_an_answer_kept_for_a_command_gone_is_not_given_to_another():
+    """The kept answers know a command by its ``id``: one made after the first is gone may
+    get its ``id``, and must not get its answer (the command kept beside it is compared)."""
+    validity._JUDGED.clear()
+    kw = dict(address="0", command_end=0.009, gap_limit=0.00873)
+    reply = _reply("0+1\r\n", 0.02, 0.0, None)
+    first = dataclasses.replace(parse_command("0M!"))  # answered atttn: '0+1' is no such reply
+    assert validity.check_ascii(first, reply, **kw) is not None
+    (key,) = validity._JUDGED
+    # a D command under the first one's id, as a new object at its address would be
+    other = parse_command("0D0!")
+    validity._JUDGED[(id(other), *key[1:])] = validity._JUDGED.pop(key)
+    assert validity.check_ascii(other, reply, **kw) is None  # worked out: a D reply is fine
