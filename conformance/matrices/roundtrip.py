@@ -19,7 +19,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from .. import gc_pace
 from ..conduct import conduct
 from ..run import ConformanceRun
 from ..transcript import Event, EventKind, plain_fields
@@ -79,9 +78,6 @@ def _judged_export(events: list[Event], name: str, work: Path) -> dict:
 
     capture = work / "run.sr"
     again = work / "capture"
-    # at a run's pace (gc_pace): the live run's 10^4..10^5 events are held meanwhile, and the
-    # collector's default pace walked them about twice a row (~4 ms of its CPU, issue 22)
-    pace = gc_pace.slow_down()
     try:
         notes = [e for e in events if e.kind is EventKind.NOTE]
         export_events(events, str(capture), "sr", tool_channel=True, notes=notes, hold=True)
@@ -89,8 +85,6 @@ def _judged_export(events: list[Event], name: str, work: Path) -> dict:
         found = plan([str(capture), "--report-dir", str(again)], in_memory=True)
     except (CaptureError, JudgeError, ValueError) as exc:
         raise RoundTripError(f"{name}: {exc}") from None
-    finally:
-        gc_pace.restore(pace)
     if found.replay is None:
         raise RoundTripError(f"{name}: its capture would be judged passively: {found.notes}")
     result = conduct(

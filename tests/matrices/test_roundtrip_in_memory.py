@@ -14,7 +14,6 @@ import pytest
 
 import conformance.offline.judge as judge
 import conformance.replay.recording as recording
-from conformance.capture import export as export_module
 from conformance.capture import held_sr
 from conformance.capture.columns import WireColumns
 from conformance.capture.export import export_events
@@ -136,36 +135,3 @@ def test_the_held_capture_is_the_users_capture_jsonl(live, tmp_path: Path):
         assert getattr(sensor, f"_tool_{name}") == getattr(user, f"_tool_{name}")
     for name in ("start", "wire", "length"):
         assert getattr(sensor, f"_reply_{name}") == getattr(user, f"_reply_{name}")
-
-
-def test_the_capture_is_exported_and_decoded_at_a_runs_pace(live, tmp_path: Path, monkeypatch):
-    """The export and the decode run at a run's collector pace (gc_pace.RUN_THRESHOLDS,
-    what exists frozen: the live run's events are held meanwhile and the default pace
-    walked them about twice a row), and the caller's pace is back afterwards, the verdicts
-    the live run's."""
-    import gc
-
-    from conformance import gc_pace
-
-    seen = []
-    real_plan, real_export = judge.plan, export_module.export_events
-
-    def plan(*args, **kwargs):
-        seen.append(("plan", gc.get_threshold(), gc.get_freeze_count() > 0))
-        return real_plan(*args, **kwargs)
-
-    def export(*args, **kwargs):
-        seen.append(("export", gc.get_threshold(), gc.get_freeze_count() > 0))
-        return real_export(*args, **kwargs)
-
-    monkeypatch.setattr(judge, "plan", plan)
-    monkeypatch.setattr(export_module, "export_events", export)
-    before = gc.get_threshold()
-    data, events = live
-    again = roundtrip.judged_events(events, "live", tmp_path)
-    assert seen == [
-        ("export", gc_pace.RUN_THRESHOLDS, True),
-        ("plan", gc_pace.RUN_THRESHOLDS, True),
-    ]
-    assert gc.get_threshold() == before
-    assert roundtrip.verdict_changes(data, again) == ()
