@@ -267,7 +267,7 @@ def _decode_channel(
     baud, framing, edge_error = how.baud, how.framing, how.edge_error
     edges = read_edges(path, channel, fmt)
     glitch = GlitchFilter(how.glitch_filter * edges.tick_rate)
-    chunks = iter(glitch(edges.chunks))
+    chunks = iter(glitch(edges.chunks, edges.min_gap))
     prefix: list[int] = []
     taken: list[list[int]] = []
     while len(prefix) < PROBE_EDGES and (chunk := next(chunks, None)) is not None:

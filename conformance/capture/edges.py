@@ -46,6 +46,10 @@ class Edges:
     t0: float = 0.0  # seconds at tick 0
     end: Callable[[], int | None] = field(default=lambda: None)
     notes: list[str] = field(default_factory=list)
+    #: the least distance between two consecutive edges of the whole stream, when the
+    #: reader knows it before the chunks are read (a held session: its ticks are one array,
+    #: :mod:`.held_sr`); None: not known (the glitch filter searches each chunk)
+    min_gap: int | None = None
 
     def time(self, tick: float) -> float:
         return self.t0 + tick / self.tick_rate

@@ -120,6 +120,7 @@ def held_edges(path: str, channel: str | None, block: int) -> Edges | None:
         chunks=(c.tolist() for c in chunks),
         end=lambda: total or None,
         notes=notes,
+        min_gap=int(np.diff(ticks).min()) if ticks.size > 1 else None,
     )
 
 
