@@ -21,9 +21,9 @@ import pytest
 from conformance.judges import timing, wire
 from conformance.judges.timing import Measured, StampUncertainty
 from conformance.judges.wire import EARLY_WINDOW, LATE_WINDOW
-from conformance.protocol.timing import CHAR_TIME
-from conformance.transcript import DUT, TOOL, Event, EventKind, escape, to_wire_7e1
+from conformance.transcript import DUT, TOOL, Event, EventKind, escape
 from conformance.view.runs import Segment, Segments
+from tests.support.hand_events import chars
 
 
 def _old_start_observations(segs, stamps, before=None):
@@ -62,19 +62,6 @@ def _old_start_observations(segs, stamps, before=None):
     return early, late, before
 
 
-def _chars(origin: str, t: float, text: str) -> list[Event]:
-    return [
-        Event(
-            EventKind.CHAR,
-            origin,
-            t + i * CHAR_TIME,
-            t + (i + 1) * CHAR_TIME,
-            wire=to_wire_7e1(ord(c)),
-        )
-        for i, c in enumerate(text)
-    ]
-
-
 def _segments(n: int, rng: random.Random) -> list[Segment]:
     """Drawn segments: the command's reply after a delay around both windows' edges, now
     and then none (the next may be its late reply), another address first, a contention,
@@ -82,16 +69,16 @@ def _segments(n: int, rng: random.Random) -> list[Segment]:
     segs, t = [], 0.0
     for k in range(n):
         text = rng.choice(["0!", "0M!", "0D0!", "1I!", "?!", "0A1!"])
-        command = _chars(TOOL, t, text)
+        command = chars(TOOL, text, t)
         end = command[-1].end
         delay = rng.choice([0.0, 0.5e-3, 7.9e-3, 8.33e-3, 12e-3, 15.4e-3, 15.6e-3, 0.09])
         delay += rng.uniform(-0.3e-3, 0.3e-3)
         first = rng.choice(["0", "0", "0", "1", "5"])
-        reply = [] if rng.random() < 0.2 else _chars(DUT, end + delay, first + "+1\r\n")
-        later = _chars(DUT, end + 0.4, "0\r\n") if rng.random() < 0.1 else []
+        reply = [] if rng.random() < 0.2 else chars(DUT, first + "+1\r\n", end + delay)
+        later = chars(DUT, "0\r\n", end + 0.4) if rng.random() < 0.1 else []
         contention = []
         if rng.random() < 0.15:
-            contention = _chars(DUT, end + rng.uniform(-0.02, 0.005), "x")
+            contention = chars(DUT, "x", end + rng.uniform(-0.02, 0.005))
         breaks: tuple[Event, ...] = ()
         if rng.random() < 0.15:
             start = end + rng.uniform(-0.002, 0.01)
