@@ -75,3 +75,18 @@ def test_only_r_7_0_10_fails(late_run) -> None:
     """What this sensor truly breaks: R-7.0-10, nothing else FAILs or WARNs."""
     bad = {rid for rid, r in late_run.items() if r["verdict"] in ("FAIL", "WARN")}
     assert bad == {"R-7.0-10"}
+
+
+def test_high_volume_answered_late_is_undecided_not_absent(late_run) -> None:
+    """0HA! and 0HB! were answered 80 ms late, their replies unread, and the high-volume
+    rules were N/A "aHA! announced no values: high-volume HA not supported" (R-5.1-01,
+    R-5.2-01) or "no high-volume support" (R-5.3-01): absence shown by a reply never read
+    (the whole run: its order brings it about). Support is undecided: INCONCLUSIVE naming the
+    late reply. (Moved from tests/sensor/test_late_beside_faults.py, which made this same
+    run a second time for it; fails on 832cfdc.)"""
+    for rid in ("R-5.1-01", "R-5.2-01", "R-5.3-01"):
+        result = late_run[rid]
+        assert result["verdict"] == "INCONCLUSIVE", result["findings"]  # N/A before
+        assert "0HA! -> late" in result["findings"][0]["detail"] or (
+            "0HB! -> late" in result["findings"][0]["detail"]
+        )
