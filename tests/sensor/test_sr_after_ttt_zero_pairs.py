@@ -29,3 +29,24 @@ def test_r_4_4_6_03_silence_after_a_request_taken_for_the_start_is_no_pass(late_
     found = late_pair["R-4.4.6-03"]
     assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # PASS before
     assert "no ttt = 000 announced" in found["findings"][0]["detail"]
+
+
+def test_r_4_4_5_01_a_request_taken_too_soon_for_the_start_is_undecided(late_pair) -> None:
+    """0MC1!'s '00002' met its retry; the request after it came 0.00 ms after the next try:
+    "0MC1!: reply '0' does not have the form atttn" FAILed."""
+    found = late_pair["R-4.4.5-01"]
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
+    assert "too soon to answer it, and has a service request's words" in str(found["findings"])
+
+
+def test_r_4_4_8_04_a_request_taken_late_for_d0_is_no_empty_reply(late_pair) -> None:
+    """0M1!'s request came 29.33 ms after 0D0!, past the window a reply begins in; D0's values
+    came 80 ms after it: "D0 returned no values although 2 were announced" FAILed."""
+    found = late_pair["R-4.4.8-04"]
+    assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # FAIL before
+    assert "past the window a reply begins in" in str(found["findings"])
+
+
+def test_r_7_0_09_does_not_time_the_request_as_a_reply(late_pair) -> None:
+    found = late_pair["R-7.0-09"]
+    assert found["verdict"] == "PASS", found["findings"]  # FAIL before ('0.00 ms')
