@@ -17,7 +17,7 @@ another command's words.
 from __future__ import annotations
 
 from ..protocol.timing import NO_BREAK_WINDOW, RESPONSE_START_MAX, RESPONSE_START_MIN, TOLERANCE
-from ..tool_recorder.records import Exchange
+from ..tool_recorder.records import Attempt, Exchange
 from ..tool_recorder.validity import fits_shape
 from ..transcript import DUT, Event, decode_7e1, escape
 from ..view.sides import expected_reply_address
@@ -89,7 +89,7 @@ def taken_next(ex: Exchange) -> list[Event]:
         (e for e in (*first.stray_events, *first.reply_events) if e.origin == DUT),
         key=lambda e: e.start,
     )
-    if not reply or not 0 < reply[0].start - end <= NO_BREAK_WINDOW:
+    if not reply or not 0 < _due(reply[0], first) - end <= NO_BREAK_WINDOW:
         return []
     address = expected_reply_address(ex.text)
     if address is not None and chr(reply[0].char7) != address:
@@ -101,6 +101,24 @@ def taken_next(ex: Exchange) -> list[Event]:
         return reply
     own = after.command is not None and fits_shape(after.command, text)
     return [] if own else reply
+
+
+def _due(char: Event, attempt: Attempt) -> float:
+    """When the sensor's ``char`` may have fallen due: its start, or, where it began the moment
+    one of ``attempt``'s command characters ended, that character's start. The sim bus holds
+    a sensor frame that falls due under the tool's character to its end (a sensor that waits
+    for the line to be free does the same): the replies-after-retry sensor beside slow-wake
+    answered 0C9!'s 0D0! 80 ms after its last try, under 0IMC_001!'s seventh character, and
+    its '0' began 88.33 ms after the try, past the 87 ms a late start is believed within:
+    "0C9! 0D0!: no reply to 0D0!" FAILed R-4.4.8-01 (truth19)."""
+    for e in attempt.command_events:
+        if e.start < char.start and abs(char.start - e.end) <= _SAME_INSTANT:
+            return e.start
+    return char.start
+
+
+#: stamps this close are one instant (the sim's clock sums character times)
+_SAME_INSTANT = 1e-6
 
 
 def late_shown(ex: Exchange) -> str:
