@@ -16,8 +16,8 @@ another command's words.
 
 from __future__ import annotations
 
-from ..protocol.timing import NO_BREAK_WINDOW, RESPONSE_START_MIN
-from ..tool_recorder.records import Exchange
+from ..protocol.timing import NO_BREAK_WINDOW, RESPONSE_START_MAX, RESPONSE_START_MIN, TOLERANCE
+from ..tool_recorder.records import Attempt, Exchange
 from ..tool_recorder.validity import fits_shape
 from ..transcript import DUT, Event, decode_7e1, escape
 from ..view.sides import expected_reply_address
@@ -89,7 +89,7 @@ def taken_next(ex: Exchange) -> list[Event]:
         (e for e in (*first.stray_events, *first.reply_events) if e.origin == DUT),
         key=lambda e: e.start,
     )
-    if not reply or not 0 < reply[0].start - end <= NO_BREAK_WINDOW:
+    if not reply or not 0 < _due(reply[0], first) - end <= NO_BREAK_WINDOW:
         return []
     address = expected_reply_address(ex.text)
     if address is not None and chr(reply[0].char7) != address:
@@ -101,6 +101,24 @@ def taken_next(ex: Exchange) -> list[Event]:
         return reply
     own = after.command is not None and fits_shape(after.command, text)
     return [] if own else reply
+
+
+def _due(char: Event, attempt: Attempt) -> float:
+    """When the sensor's ``char`` may have fallen due: its start, or, where it began the moment
+    one of ``attempt``'s command characters ended, that character's start. The sim bus holds
+    a sensor frame that falls due under the tool's character to its end (a sensor that waits
+    for the line to be free does the same): the replies-after-retry sensor beside slow-wake
+    answered 0C9!'s 0D0! 80 ms after its last try, under 0IMC_001!'s seventh character, and
+    its '0' began 88.33 ms after the try, past the 87 ms a late start is believed within:
+    "0C9! 0D0!: no reply to 0D0!" FAILed R-4.4.8-01 (truth19)."""
+    for e in attempt.command_events:
+        if e.start < char.start and abs(char.start - e.end) <= _SAME_INSTANT:
+            return e.start
+    return char.start
+
+
+#: stamps this close are one instant (the sim's clock sums character times)
+_SAME_INSTANT = 1e-6
 
 
 def late_shown(ex: Exchange) -> str:
@@ -161,16 +179,39 @@ def service_request_too_soon(ex: Exchange) -> str:
     it. Read as the command's reply, an empty aD0! after values were announced FAILed
     R-4.4.8-03/-04 ("0 values were returned for 2 announced") while the real D0 reply, with
     its values, came 8 ms later (service-request-after-ttt-zero + inter-char-gap). Whether
-    it answers the command is unread; R-7.0-09 judges its timing. Else the wording a
-    finding gives."""
-    if not ex.answered or not ex.attempts or ex.last.command_end is None:
-        return ""
-    reply = ex.reply_events
-    lead = reply[0].start - ex.last.command_end
-    text = ex.reply_text
-    if lead >= RESPONSE_START_MIN or len(text) != 3 or not text.endswith("\r\n"):
+    it answers the command is unread. Else the wording a finding gives."""
+    lead = _bare_request_lead(ex)
+    if lead is None or lead >= RESPONSE_START_MIN:
         return ""
     return (
-        f"'{escape(text)}' to {escape(ex.text)} began {lead * 1e3:.2f} ms after it, too soon "
-        "to answer it, and has a service request's words"
+        f"'{escape(ex.reply_text)}' to {escape(ex.text)} began {lead * 1e3:.2f} ms after it, "
+        "too soon to answer it, and has a service request's words"
     )
+
+
+def service_request_too_late(ex: Exchange) -> str:
+    """'' unless the reply ``ex`` took is a bare ``a<CR><LF>`` begun after R-7.0-10's window
+    (15.40 ms), in the longer listen of a patient recorder: a reply that late may as well be
+    a service request the sensor sent on its own. replies-after-retry beside
+    service-request-after-ttt-zero: 0M1!'s '00002' met the retry, the request after it came
+    29.33 ms after the 0D0! that followed, and R-4.4.8-04 FAILed "D0 returned no values
+    although 2 were announced" while D0's values came 80 ms after it (truth19). Else the
+    wording a finding gives."""
+    lead = _bare_request_lead(ex)
+    if lead is None or lead <= RESPONSE_START_MAX + TOLERANCE:
+        return ""
+    return (
+        f"'{escape(ex.reply_text)}' to {escape(ex.text)} began {lead * 1e3:.2f} ms after it, "
+        "past the window a reply begins in, and has a service request's words"
+    )
+
+
+def _bare_request_lead(ex: Exchange) -> float | None:
+    """How long after its command the reply ``ex`` took began, where that reply is a bare
+    ``a<CR><LF>`` (a service request's words); None otherwise."""
+    if not ex.answered or not ex.attempts or ex.last.command_end is None:
+        return None
+    text = ex.reply_text
+    if len(text) != 3 or not text.endswith("\r\n"):
+        return None
+    return ex.reply_events[0].start - ex.last.command_end

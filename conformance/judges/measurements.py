@@ -26,7 +26,12 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, decode_7e1, escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
-from .late_before import answered_late, earlier_reply, service_request_too_soon
+from .late_before import (
+    answered_late,
+    earlier_reply,
+    service_request_too_late,
+    service_request_too_soon,
+)
 from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wire import runs
@@ -299,12 +304,24 @@ def _not_this_ds_reply(m: Measurement, ex: Exchange, tally: Tally, dlabel: str) 
         for rid in ("R-4.4.8-01", "R-4.4.8-03", *hv):
             tally.undecide(rid, dlabel, f"{taken_late} (R-7.0-10 judges its timing)")
         return "late"
-    if m.count and (soon := service_request_too_soon(ex)):
+    if m.count and (soon := service_request_too_soon(ex) or _request_owed_late(m, ex)):
         # values announced, and what came may be a service request, not this D's reply
         for rid in ("R-4.4.8-01", "R-4.4.8-03", "R-4.4.8-04"):
-            tally.undecide(rid, dlabel, f"{soon} (R-7.0-09 judges its timing)")
+            tally.undecide(rid, dlabel, soon)
         return "soon"
     return ""
+
+
+def _request_owed_late(m: Measurement, ex: Exchange) -> str:
+    """:func:`service_request_too_late` of the D exchange ``ex`` where ``m`` may still be
+    followed by a service request: a start that raises one (M family, V) whose wait held
+    none exact (after ttt = 000 a faulty sensor sends it when the D command is out)."""
+    if not raises_sr(m):
+        return ""
+    waited = [decode_7e1(run) for run in runs(list(m.waited_events))]
+    if service_request(m.command.address) in waited:
+        return ""
+    return service_request_too_late(ex)
 
 
 @lru_cache(maxsize=4096)
@@ -563,6 +580,14 @@ class Measurements:
             # to judge, nor values it announced (replies-after-retry + wrong-crc, truth15)
             for rid in tally.ids:
                 tally.undecide(rid, where(m), f"{earlier} (R-7.0-10 judges its timing)")
+            return
+        if soon := service_request_too_soon(m.start):
+            # a service request's words begun before any reply may: no start reply's words
+            # to judge (replies-after-retry + service-request-after-ttt-zero: 0MC1!'s '00002'
+            # met its retry, the request after it came 0 ms after the next try, and R-4.4.5-01
+            # FAILed "0MC1!: reply '0' does not have the form atttn", truth19)
+            for rid in tally.ids:
+                tally.undecide(rid, where(m), soon)
             return
         tally.observe(
             where(m),

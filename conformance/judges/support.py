@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from ..protocol.binary import parse_binary_packet
 from ..protocol.crc import is_crc_char
-from ..protocol.responses import split_line
+from ..protocol.responses import parse_measurement_reply_for, split_line
 from ..protocol.values import check_value, split_values
 from ..tool_recorder.records import Exchange, Measurement
 
@@ -109,3 +109,17 @@ def holds_values(ex: Exchange, binary: bool = False) -> bool:
     if binary:
         return parse_binary_packet(ex.reply_bytes).size > 0
     return not empty_data_reply(ex)
+
+
+def announced_ttt(ex: Exchange) -> int | None:
+    """The ttt the start reply ``ex`` took announces, read as the command's ``atttn``-type
+    reply (None where it gives none: no reply, text, or digits that do not read as one).
+    A rule on what follows a ttt (R-4.4.6-03: no service request after ttt = 000) holds the
+    sensor to the reply it gave this time, not to one an earlier run of the command gave:
+    replies-after-retry beside service-request-after-ttt-zero took the request '0<CR><LF>'
+    for 0M1!'s reply, and "no service request in 0.5 s after 0M1! -> '0<CR><LF>'" PASSed
+    R-4.4.6-03 on a sensor that sends one (truth19)."""
+    if not ex.answered or ex.command is None:
+        return None
+    body = split_line(ex.reply_text)[0]
+    return parse_measurement_reply_for(body, ex.command, expected_address=ex.command.address).ttt

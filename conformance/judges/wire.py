@@ -26,6 +26,7 @@ from ..protocol.timing import (
     RESPONSE_START_MIN,
     TOLERANCE,
 )
+from ..tool_recorder.validity import fits_shape
 from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_bytes
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, Segments, frames, runs, segments
@@ -279,7 +280,33 @@ def _not_a_reply_to(seg: Segment) -> bool:
         and named != address
         and named in ADDRESS_CHARS
         and first.start - end < RESPONSE_START_MIN
-    )
+    ) or _request_not_reply(seg, address)
+
+
+def _request_not_reply(seg: Segment, address: str | None) -> bool:
+    """Whether what follows the command is a service request's bare words ``a<CR><LF>``,
+    begun sooner than any reply may (R-7.0-09's 7.93 ms), that are no reply to it: not
+    shaped as its reply, or followed by a line that is. A sensor sends its request when it
+    is ready; one due while the tool's command was on the line follows it at once, and a
+    request is no response, whose marking R-7.0-09 times. service-request-after-ttt-zero
+    beside inter-char-gap: '0<CR><LF>' 0.00 ms after 0D0!, D0's values 8 ms after it;
+    beside replies-after-retry: 0.00 ms after 0MC1!'s retry, its '00002' heard over the try
+    before: R-7.0-09 FAILed "0.00 ms" on both (truth19). A sensor whose own reply is those
+    words (``a!``, an empty D reply) with no reply of the command's shape after them is
+    timed as before."""
+    reply = seg.reply
+    if address is None or len(reply) != 3 or reply[0].start - seg.command_end >= RESPONSE_START_MIN:
+        return False
+    text = text7(reply)
+    if text != address + "\r\n":
+        return False
+    try:
+        command = parse_command(seg.text)
+    except CommandError:
+        return False
+    if not fits_shape(command, text):
+        return True
+    return any(fits_shape(command, text7(run)) for run in runs(seg.later))
 
 
 def talked_through(seg: Segment) -> bool:

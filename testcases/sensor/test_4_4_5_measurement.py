@@ -15,7 +15,7 @@ from conformance.judges.exchanges import (
     late_only,
     shown,
 )
-from conformance.judges.support import empty_data_reply, first_filled
+from conformance.judges.support import announced_ttt, empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.protocol.responses import is_service_request, split_line
@@ -120,6 +120,18 @@ def test_ttt_zero(sensor, case):
                 evidence=[cited(start)] + ([heard(quiet, "then, unasked")] if quiet else []),
             )
         )
+    elif announced_ttt(start) != 0:
+        # this time's reply announced no ttt = 000 (a service request's '0<CR><LF>' taken for
+        # 0M1!'s reply, replies-after-retry beside service-request-after-ttt-zero: "no service
+        # request in 0.5 s after 0M1! -> '0<CR><LF>'" PASSed, truth19): nothing to hold what
+        # followed, or its silence, to
+        case.add(
+            inconclusive(
+                "R-4.4.6-03",
+                f"{shown(start)} this time, no ttt = 000 announced to hold what followed to",
+                evidence=[cited(start)] + ([heard(quiet, "then, unasked")] if quiet else []),
+            )
+        )
     elif quiet:
         case.add(
             failed(
@@ -135,7 +147,7 @@ def test_ttt_zero(sensor, case):
             passed(
                 "R-4.4.6-03",
                 f"no service request in {grace:.1f} s after {shown(start)}",
-                observed=int(start.answered),  # silence after no reply says nothing
+                observed=1,
             )
         )
     body, _ = split_line(d0.reply_text)

@@ -274,10 +274,10 @@ def check_identify_sends_service_request(rig: Rig) -> None:
 
 
 def test_an_identify_service_request_due_during_a_command_follows_it_at_once():
-    """R-7.0-09, which interactions.py lets identify-sends-service-request break beside any
-    partner: with this fault alone, a command whose last character is on the line when the
+    """With this fault alone, a command whose last character is on the line when the
     wrongly owed request falls due is followed by that request 0 ms after its end, then by
-    its own reply (seeds 4120, 4142, 4156 saw it where partners moved the schedule)."""
+    its own reply (seeds 4120, 4142, 4156 saw it where partners moved the schedule; a
+    request is no reply, so R-7.0-09 does not time it: judges.wire._request_not_reply)."""
 
     def after_identify() -> Rig:
         rig = Rig(faults=("identify-sends-service-request",))

@@ -200,17 +200,6 @@ INTERACTIONS: tuple[Interaction, ...] = (
         removes=("R-4.4.8-03",),
     ),
     Interaction(
-        frozenset({"identify-sends-service-request"}),
-        "the service request an identify command wrongly owes is sent when its ttt runs out,"
-        " whatever the bus is doing: when the tool's command is on the line then, the sensor"
-        " sends '0<CR><LF>' the moment the command ends, 0 ms after it (R-7.0-09 broken on the"
-        " wire; tests/emulator/test_faults.py shows it with this fault alone). Alone the run's"
-        " schedule never lands a command there; any partner that moves it may: partial-"
-        "command-accepted (seed 4120, 0ICC1!), fast-baud (seed 4142, 0IC2! ends at 381.983 s,"
-        " '0' starts then), measure-ttt-two-digits (seed 4156, 0ICC! at 153.070 s).",
-        adds=("R-7.0-09",),
-    ),
-    Interaction(
         frozenset({"late-service-request", "ttt-overstated"}),
         "every service request is held until 0.25 s past the announced ttt, so the 1.5 s"
         " readiness ttt-overstated gives is never on the wire: aM!'s request comes after its"
