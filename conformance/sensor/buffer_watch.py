@@ -81,10 +81,16 @@ class WatchedToolRecorder(ToolRecorder):
         each sequence, after the break's 110 ms wake-up; the last one's reply came 80 ms
         after it, and "no reply although it is a basic command: ?!" FAILed R-4.4-01, "after
         the abort M got no reply" R-4.4.5.1-03 (truth20). A sensor never seen late, or one
-        that answered, is not waited for."""
+        that answered, is not waited for; nor an extended command (below)."""
         late = self.watch.late.start
         end = ex.last.command_end if ex.attempts else None
         if ex.answered or ex.heard_late or late is None or end is None or not ex.expect_reply:
+            return ex
+        if ex.command is None or ex.command.kind is Kind.EXTENDED:
+            # a multi-line text's first line is no end of it: the next command met the rest
+            # as before, which the wire judge reads as the rest of a late reply talked over
+            # (without this, aXHELP!'s later lines were read as 0M1!'s reply: R-4.2-02/-03,
+            # R-4.3-01 FAILed beside never-standby, partial-command-accepted, ...)
             return ex
         until = end + late + CHAR_TIME + 2 * self.link.info.timing_uncertainty
         heard = self.link.receive(max(until, self.link.now()), until=bool)
