@@ -12,11 +12,8 @@ from .model import Fault
 #: is broken (truth10-12).
 LATE_REPLY_UNDECIDED = (
     # a reply the rule asks for came only after the reply window (met by the retry, or heard
-    # by a one-shot probe's longer listen): no "no reply", no lost data, no refused address.
-    # Not R-4.3-03 since truth20: the engine listens past an exchange whose every try went
-    # unanswered (WatchedToolRecorder._hear_late_reply), so the late reply is over before the
-    # next command, which the sensor then hears: the sweep's aAb! and b! are answered on the
-    # retry with the first try's reply, and R-4.3-03 PASSes on those replies
+    # by a one-shot probe's longer listen): no "no reply", no lost data, no refused address
+    "R-4.3-03",
     "R-4.4-01",
     "R-4.4.4-01",
     "R-4.4.5-03",
