@@ -56,7 +56,14 @@ from .wire import EARLY_WINDOW
 
 
 def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Finding:
-    """``a!`` and ``?!``: the reply is the address and CR LF, nothing else."""
+    """``a!`` and ``?!``: the reply is the address and CR LF, nothing else. One answered only
+    after its windows is no silence: INCONCLUSIVE, its timing R-7.0-10's (the replies-after-
+    retry sensor beside slow-wake heard only each sequence's third ?!, and its '0<CR><LF>'
+    came 80 ms after the last: "?!: no reply" FAILed R-4.4.3-01, truth20)."""
+    if late := late_answer(ex):
+        return inconclusive(
+            rid, f"{what}: {late} (R-7.0-10 judges its timing)", evidence=[cited(ex)]
+        )
     if not ex.answered:
         return failed(rid, f"{what}: no reply", evidence=[cited(ex)], observed=1)
     body, framing = split_line(ex.reply_text)

@@ -16,11 +16,16 @@ another command's words.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
+
 from ..protocol.timing import NO_BREAK_WINDOW, RESPONSE_START_MAX, RESPONSE_START_MIN, TOLERANCE
-from ..tool_recorder.records import Attempt, Exchange
+from ..tool_recorder.records import Exchange
 from ..tool_recorder.validity import fits_shape
-from ..transcript import DUT, Event, decode_7e1, escape
+from ..transcript import DUT, TOOL, Event, decode_7e1, escape
 from ..view.sides import expected_reply_address
+
+#: how near a DUT character's start must lie to a tool character's end to have waited for it
+HELD_SLACK = 1e-6
 
 
 def earlier_reply(ex: Exchange) -> str:
@@ -72,53 +77,50 @@ def late_reply(ex: Exchange) -> str:
 
 def taken_next(ex: Exchange) -> list[Event]:
     """The reply the command sent next took on its first try if it is ``ex``'s, late ([]
-    if not): ``ex``'s last try drew no reply, the reply began within the 87 ms
-    ``LateStartWatch`` believes a late start after it, names the address ``ex``'s would,
-    is shaped as ``ex``'s reply, and either began before the next command (queued) or is
-    not shaped as the next command's (the words decide, so no late start need have been
-    seen: :func:`earlier_reply` reads the same from the other side, "is 0D0!'s late
-    reply")."""
-    end = ex.last.command_end if ex.attempts else None
-    if not ex.next_sent or end is None or ex.last.reply_events or ex.command is None:
+    if not): :func:`late_among` finds it there, and it either began before the next command
+    (queued) or is not shaped as the next command's (the words decide, so no late start need
+    have been seen: :func:`earlier_reply` reads the same from the other side, "is 0D0!'s
+    late reply")."""
+    if not ex.next_sent or not ex.next_sent[0].attempts:
         return []
     after = ex.next_sent[0]
-    if not after.attempts:
-        return []
     first = after.attempts[0]
-    reply = sorted(
-        (e for e in (*first.stray_events, *first.reply_events) if e.origin == DUT),
-        key=lambda e: e.start,
-    )
-    if not reply or not 0 < _due(reply[0], first) - end <= NO_BREAK_WINDOW:
+    reply = late_among(ex, (*first.stray_events, *first.reply_events), first.command_events)
+    if not reply or reply[0].start < first.start:  # begun before the next command
+        return reply
+    own = after.command is not None and fits_shape(after.command, decode_7e1(reply))
+    return [] if own else reply
+
+
+def late_among(ex: Exchange, events: Iterable[Event], held: Sequence[Event] = ()) -> list[Event]:
+    """``ex``'s late reply among ``events`` (what the wire carried after its last try), []
+    if none: ``ex``'s last try drew no reply, the DUT's first character began within the
+    87 ms ``LateStartWatch`` believes a late start after it, names the address ``ex``'s
+    would, and the DUT's characters are shaped as ``ex``'s reply. A start the tool's own
+    character pushed back (``held``: the command then on the line; the sim's one wire sends
+    a sensor character due meanwhile at its end) counts from when it was due: beside
+    slow-wake, 0C9!'s 0D0! reply, due 80 ms after the last try, began 88.33 ms after it, at
+    the end of 0IMC_001!'s seventh character, and "no reply to 0D0!" FAILed R-4.4.8-01
+    (truth20)."""
+    end = ex.last.command_end if ex.attempts else None
+    if end is None or ex.last.reply_events or ex.command is None:
+        return []
+    reply = sorted((e for e in events if e.origin == DUT), key=lambda e: e.start)
+    if not reply or not 0 < _due(reply[0].start, held) - end <= NO_BREAK_WINDOW:
         return []
     address = expected_reply_address(ex.text)
     if address is not None and chr(reply[0].char7) != address:
         return []
-    text = decode_7e1(reply)
-    if not fits_shape(ex.command, text):
-        return []
-    if reply[0].start < first.start:  # begun before the next command: no answer to it
-        return reply
-    own = after.command is not None and fits_shape(after.command, text)
-    return [] if own else reply
+    return reply if fits_shape(ex.command, decode_7e1(reply)) else []
 
 
-def _due(char: Event, attempt: Attempt) -> float:
-    """When the sensor's ``char`` may have fallen due: its start, or, where it began the moment
-    one of ``attempt``'s command characters ended, that character's start. The sim bus holds
-    a sensor frame that falls due under the tool's character to its end (a sensor that waits
-    for the line to be free does the same): the replies-after-retry sensor beside slow-wake
-    answered 0C9!'s 0D0! 80 ms after its last try, under 0IMC_001!'s seventh character, and
-    its '0' began 88.33 ms after the try, past the 87 ms a late start is believed within:
-    "0C9! 0D0!: no reply to 0D0!" FAILed R-4.4.8-01 (truth19)."""
-    for e in attempt.command_events:
-        if e.start < char.start and abs(char.start - e.end) <= _SAME_INSTANT:
+def _due(start: float, held: Sequence[Event]) -> float:
+    """When a DUT character that began at ``start`` was due: the start of the tool character
+    that held the line until then (one ending exactly there), else ``start``."""
+    for e in held:
+        if e.origin == TOOL and e.start < start and abs(e.end - start) < HELD_SLACK:
             return e.start
-    return char.start
-
-
-#: stamps this close are one instant (the sim's clock sums character times)
-_SAME_INSTANT = 1e-6
+    return start
 
 
 def late_shown(ex: Exchange) -> str:

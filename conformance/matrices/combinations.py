@@ -393,6 +393,11 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # retry back to back: inter-char-gap's 3 ms gaps vanished (R-4.1-01 PASSed on 8.33 ms
     # spacings) and the reply came back shuffled with the retry (8 false FAILs)
     ("inter-char-gap", "replies-after-retry"),
+    # (truth20) beside slow-wake only each sequence's third try was heard, its reply 80 ms
+    # after the last: ?!, the M after the abort and 0C9!'s 0D0! (held 88.33 ms by the next
+    # command's character) were judged unanswered (4 false FAILs), and the restore, reading
+    # no answer, stopped the run; past it R-4.4.3-01, R-4.3-03 and R-4.4.12-04 were false too
+    ("replies-after-retry", "slow-wake"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

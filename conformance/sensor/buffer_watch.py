@@ -12,15 +12,18 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..judges.late_before import late_among
 from ..links.base import Link
 from ..protocol.commands import Command, Kind
+from ..protocol.framing import LF
 from ..protocol.responses import holds_values
+from ..protocol.timing import CHAR_TIME
 from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt, Exchange
 from ..transcript import SEVEN_BITS
-from .late_watch import LateStartWatch
+from .late_watch import LATE_START_LISTEN, LateStartWatch
 
 
 class BufferWatchHooks(Hooks):
@@ -59,24 +62,63 @@ class WatchedToolRecorder(ToolRecorder):
     def transact(self, command: Command | str, **kw: Any) -> Exchange:
         """The engine's exchange, linked to the one before it where that may have answered
         late (:meth:`_link_late_before`); measurements' starts and D reads come here too."""
-        before = self.last_exchange
-        return self._link_late_before(before, super().transact(command, **kw))
+        before, seen = self.last_exchange, self.watch.late.start is not None
+        ex = self._hear_late_reply(super().transact(command, **kw))
+        return self._link_late_before(before, ex, seen)
 
     def raw(self, text: str | bytes, **kw: Any) -> Exchange:
         """The engine's one-shot exchange, linked as :meth:`transact`'s are."""
-        before = self.last_exchange
-        return self._link_late_before(before, super().raw(text, **kw))
+        before, seen = self.last_exchange, self.watch.late.start is not None
+        return self._link_late_before(before, super().raw(text, **kw), seen)
 
-    def _link_late_before(self, before: Exchange | None, ex: Exchange) -> Exchange:
+    def _hear_late_reply(self, ex: Exchange) -> Exchange:
+        """Where every try of ``ex`` went unanswered in its window and the sensor has been
+        seen to start its replies late (``watch.late``), listen until that start (and a
+        character) past the last try and keep the late reply heard as ``ex.heard_late``
+        (:func:`~conformance.judges.late_before.late_among`): the case judges ``ex`` before
+        anything else is sent, so a reply after the last try would otherwise lie in no
+        record. The replies-after-retry sensor beside slow-wake met only the third try of
+        each sequence, after the break's 110 ms wake-up; the last one's reply came 80 ms
+        after it, and "no reply although it is a basic command: ?!" FAILed R-4.4-01, "after
+        the abort M got no reply" R-4.4.5.1-03 (truth20). A sensor never seen late, or one
+        that answered, is not waited for; nor an extended command (below)."""
+        late = self.watch.late.start
+        end = ex.last.command_end if ex.attempts else None
+        if ex.answered or ex.heard_late or late is None or end is None or not ex.expect_reply:
+            return ex
+        if ex.command is None or ex.command.kind is Kind.EXTENDED:
+            # a multi-line text's first line is no end of it: the next command met the rest
+            # as before, which the wire judge reads as the rest of a late reply talked over
+            # (without this, aXHELP!'s later lines were read as 0M1!'s reply: R-4.2-02/-03,
+            # R-4.3-01 FAILed beside never-standby, partial-command-accepted, ...)
+            return ex
+        until = end + late + CHAR_TIME + 2 * self.link.info.timing_uncertainty
+        heard = self.link.receive(max(until, self.link.now()), until=bool)
+        if heard and heard[-1].char7 != LF:  # the rest of it, to its LF or a pause
+            heard += self.link.receive(
+                heard[-1].end + LATE_START_LISTEN,
+                until=lambda got: got[-1].char7 == LF,
+                idle=self.policy.reply_idle,
+            )
+        ex.heard_late[:] = late_among(ex, heard)
+        return ex
+
+    def _link_late_before(
+        self, before: Exchange | None, ex: Exchange, seen: bool = False
+    ) -> Exchange:
         """Set ``ex.late_before`` to ``before`` where its last try drew no reply and the
-        sensor has been seen to start its replies late (``watch.late``): a reply ``ex`` took
-        may then be ``before``'s, the sensor deaf to ``ex`` until it had answered (the
-        replies-after-retry sensor's late aD0! reply was read as aMC1!'s, "does not have the
-        form atttn", beside wrong-crc, truth15). A sensor never seen late links nothing."""
+        sensor has been seen to start its replies late (``watch.late``), before ``ex`` went
+        out (``seen``) or since: a reply ``ex`` took may then be ``before``'s, the sensor deaf
+        to ``ex`` until it had answered (the replies-after-retry sensor's late aD0! reply was
+        read as aMC1!'s, "does not have the form atttn", beside wrong-crc, truth15). Before,
+        too: that late reply, held until ``ex``'s last character ended, began 0.00 ms after
+        it, and the watch counted it as a reply too soon, which cancelled the late start it
+        had seen (beside slow-wake, 0MC1!'s '00002' read as 0MC2!'s: R-4.4.12-04 WARNed "0M2!
+        announced 9 but 0MC2! 2", truth20). A sensor never seen late links nothing."""
         if before is None or before is ex or not before.attempts:
             return ex
         before.next_sent[:] = [ex]  # its words may show ex took its late reply (taken_next)
-        if not before.last.reply_events and self.watch.late.start is not None:
+        if not before.last.reply_events and (seen or self.watch.late.start is not None):
             ex.late_before = before
         return ex
 

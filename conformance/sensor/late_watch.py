@@ -22,6 +22,10 @@ from ..view.sides import expected_reply_address
 #: The latest start (s) believed: beyond the 87 ms a recorder may wait before it must break
 #: again, a start is no reply to a try the retry followed 55 ms after it.
 LATE_START_MAX = NO_BREAK_WINDOW
+#: How long (s) :meth:`~.session.SensorSession.late_start_probe` listens after its one
+#: ``a!``: far past any reply the recorder's retry 55 ms after a try would have met (the Due
+#: sensor's 80 ms); also the bound on the rest of a late reply once it began
+LATE_START_LISTEN = 1.0
 
 
 class LateStartWatch:

@@ -42,6 +42,7 @@ from ..view.rebuilt_records import Rebuilt, rebuild_records, records_of
 from ..view.segments import read_view
 from .address_change import AddressChanger, Trial
 from .buffer_watch import WatchedToolRecorder
+from .late_watch import LATE_START_LISTEN
 
 R = TypeVar("R", Exchange, Measurement)
 T = TypeVar("T")
@@ -61,6 +62,10 @@ class Sweep:
     #: The addresses a sensor that answers no ``a!`` was shown at by what it does answer:
     #: ``?!`` named the address and the move back from it was answered (not in ``refused``).
     heard: list[str] = field(default_factory=list)
+    #: Of ``refused``: the addresses whose change drew no reply heard, from which the restore
+    #: then moved the sensor back (it answered at its own address only after that move): it
+    #: took them, its reply unheard (:attr:`AddressChanger.found_at`).
+    found_at: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -137,9 +142,6 @@ HEARING_MARKINGS = (9e-3, 25e-3, 50e-3, 85e-3, 120e-3)
 #: echo, a stalled host) is sent again rather than judged (issue 18), at most PROBE_TRIES times;
 #: so is a timed probe of a case that landed outside the window it aimed at (:meth:`aim`).
 PROBE_LATE = 20e-3  # s
-#: How long (s) :meth:`SensorSession.late_start_probe` listens after its one ``a!``: far past
-#: any reply the recorder's retry 55 ms after a try would have met (the Due sensor's 80 ms)
-LATE_START_LISTEN = 1.0
 PROBE_TRIES = 5
 
 
@@ -930,7 +932,7 @@ class SensorSession(Session):
     def address_sweep(self, targets: str) -> Sweep:
         """Change to each address in ``targets`` and back; restore whatever happens."""
         changer = AddressChanger(self.master, self.address)
-        refused, unanswered, heard = [], [], []
+        refused, unanswered, heard, found_at = [], [], [], []
         try:
             for target in targets:
                 if target == self.address:
@@ -946,13 +948,15 @@ class SensorSession(Session):
                 else:
                     if not outcome.took or outcome.answered_after is None:
                         refused.append(target)
+                    if changer.found_at == target and not _heard(outcome.request):
+                        found_at.append(target)
                     if outcome.took and outcome.answered_after is None:
                         unanswered.append(target)
                 if not changer.restored and not moved_back:
                     break
         finally:
             note = self.restore(changer)
-        return Sweep(changer.exchanges, refused, note, unanswered, heard)
+        return Sweep(changer.exchanges, refused, note, unanswered, heard, found_at)
 
     def _queried_at(self, changer: AddressChanger, target: str) -> Exchange | None:
         """For a sensor that answers no ``a!`` (none answered in the run), alone on the line,
@@ -1101,10 +1105,17 @@ def same_reading(made: Exchange | Measurement, seen: Exchange | Measurement) -> 
     return False
 
 
+def _heard(ex: Exchange) -> bool:
+    """Whether ``ex`` drew anything from the DUT: a reply in a window, or late."""
+    return ex.answered or bool(ex.heard_late)
+
+
 def _carry_late_before(made: Exchange | Measurement, seen: Exchange | Measurement) -> None:
     """The engine's ``late_before`` links (:meth:`~.buffer_watch.WatchedToolRecorder.
     _link_late_before`) onto the view's record of the same stimulus: the wire alone, cut at
-    the stimulus, has no command before it, nor after it (``next_sent``)."""
+    the stimulus, has no command before it, nor after it (``next_sent``), nor a reply heard
+    past the last try's window (``heard_late``, :meth:`~.buffer_watch.WatchedToolRecorder.
+    _hear_late_reply`)."""
     if isinstance(made, Exchange) and isinstance(seen, Exchange):
         pairs = [(made, seen)]
     elif isinstance(made, Measurement) and isinstance(seen, Measurement):
@@ -1114,6 +1125,7 @@ def _carry_late_before(made: Exchange | Measurement, seen: Exchange | Measuremen
     for a, b in pairs:
         b.late_before = a.late_before
         b.next_sent = a.next_sent  # shared: the engine fills it when it sends the next one
+        b.heard_late = a.heard_late  # the late reply the engine heard past the last try
 
 
 def _unanswered_break_end(events: list[Event], lookback: int = 4000) -> float | None:

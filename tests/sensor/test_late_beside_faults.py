@@ -57,10 +57,13 @@ def test_r_4_4_6_03_and_4_4_5_03_after_a_start_that_drew_no_reply_are_undecided(
     measurement shown started: INCONCLUSIVE, each naming it."""
     data = run_once("sim://?faults=replies-after-retry,slow-wake")
     found = {r["id"]: r for r in data["requirements"]}
+    # since truth20 the engine listens past an exchange whose every try went unanswered
+    # until the late reply is over, so the sensor hears the next command: 0M1! is answered
+    # '00002' in its window, and R-4.4.6-03 PASSes "no service request in 0.5 s" (the
+    # sensor keeps the rule); neither rule FAILs on another command's reply
     for rid in ("R-4.4.6-03", "R-4.4.5-03"):
-        assert found[rid]["verdict"] == "INCONCLUSIVE", found[rid]["findings"]  # FAIL before
-        assert "0M1!" in found[rid]["findings"][0]["detail"]
-        assert "this time" in found[rid]["findings"][0]["detail"]
+        assert found[rid]["verdict"] in ("PASS", "INCONCLUSIVE"), found[rid]["findings"]
+        assert "0M1!" in found[rid]["findings"][0]["detail"] or found[rid]["verdict"] != "PASS"
 
 
 def test_r_4_4_8_03_counts_of_late_starts_unread_are_not_a_pass() -> None:
@@ -90,3 +93,23 @@ def test_r_4_4_8_1_03_unsupported_crc_forms_answered_late_are_not_a_pass() -> No
     )
     assert found["verdict"] == "INCONCLUSIVE", found["findings"]  # PASS before
     assert "0RC2! -> late '0<CR><LF>'" in found["findings"][0]["detail"]
+
+
+def test_replies_after_the_last_try_beside_slow_wake_are_late_not_silence() -> None:
+    """replies-after-retry + slow-wake (the whole run: its timing brings it about): each
+    sequence's third try alone was heard, after the break's 110 ms wake-up, and the reply to
+    the last came 80 ms after it, in no record (truth20). R-4.4-01 FAILed "no reply although
+    it is a basic command: ?!", R-4.4.5.1-03 "after the abort M got no reply", R-4.4.8-01
+    "0C9! 0D0!: no reply to 0D0!" (its reply held 88.33 ms by 0IMC_001!'s character),
+    R-4.4.8-03 "0 values were returned for 99 announced"; the restore, reading no answer,
+    stopped the run at the address change. Past it, R-4.4.3-01 ("?!: no reply"), R-4.3-03
+    ("refused or lost address(es)") and R-4.4.12-04 ("0M2! announced 9 but 0MC2! 2": 0MC1!'s
+    late '00002') were false too, and R-7.0-15's case raised on a wake-up answered late."""
+    data = run_once("sim://?faults=replies-after-retry,slow-wake")
+    found = {r["id"]: r for r in data["requirements"]}
+    assert not (data.get("run") or {}).get("stop_reason"), data["run"]  # stopped before
+    for rid in ("R-4.4-01", "R-4.4.5.1-03", "R-4.4.8-01", "R-4.4.8-03", "R-4.4.3-01"):
+        assert found[rid]["verdict"] == "INCONCLUSIVE", found[rid]["findings"]
+    assert "?! -> late '0<CR><LF>'" in found["R-4.4.3-01"]["findings"][0]["detail"]
+    for rid in ("R-4.3-03", "R-4.4.12-04", "R-7.0-15"):
+        assert found[rid]["verdict"] not in ("FAIL", "WARN", "ERROR"), found[rid]["findings"]
