@@ -221,13 +221,9 @@ def _nested(record: Any) -> list[Event]:
         return []
     if isinstance(record, Event):
         return [record]
-    if isinstance(record, Exchange):
+    if isinstance(record, Exchange):  # its attempts' events joined as events_of joins them
         found: list[Event] = []
-        for a in record.attempts:
-            found += a.stray_events
-            if a.break_event is not None:
-                found.append(a.break_event)
-            found += a.command_events + a.reply_events
+        _join(record, found)
         return sorted(found, key=_START)
     if isinstance(record, Measurement):
         found = _nested(record.start) + list(record.waited_events)

@@ -92,12 +92,18 @@ def known_chatter(measurements: Iterable[Measurement]) -> frozenset[str]:
     for m in measurements:
         if not (raises_sr(m) and m.ttt and m.start.answered):
             continue
-        texts = [decode_7e1(run) for run in runs(list(m.waited_events))]
+        texts = _waited_lines(m)
         request = service_request(m.command.address)
         if request in texts:
             before = texts[: texts.index(request)]
             found.update(t for t in before if _sr_shaped(t, m.command.address))
     return frozenset(found)
+
+
+def _waited_lines(m: Measurement) -> list[str]:
+    """The text of each run of characters ``m``'s wait held (where its service request, its
+    chatter or nothing is)."""
+    return [decode_7e1(run) for run in runs(list(m.waited_events))]
 
 
 def _sr_shaped(text: str, address: str) -> bool:
@@ -318,8 +324,7 @@ def _request_owed_late(m: Measurement, ex: Exchange) -> str:
     none exact (after ttt = 000 a faulty sensor sends it when the D command is out)."""
     if not raises_sr(m):
         return ""
-    waited = [decode_7e1(run) for run in runs(list(m.waited_events))]
-    if service_request(m.command.address) in waited:
+    if service_request(m.command.address) in _waited_lines(m):
         return ""
     return service_request_too_late(ex)
 
@@ -614,7 +619,7 @@ def _waits_on_chatter(m: Measurement, chatter: frozenset[str]) -> bool:
     if m.ttt is None or not m.start.answered or not (raises_sr(m) and m.ttt > 0):
         return False
     address = m.command.address
-    texts = [decode_7e1(run) for run in runs(list(m.waited_events))]
+    texts = _waited_lines(m)
     if service_request(address) in texts:
         return False
     return any(_sr_shaped(t, address) and t not in chatter for t in texts)
