@@ -94,14 +94,9 @@ class RecordedSensor:
         import numpy as np
 
         s, e = np.array(wire.start, np.float64), np.array(wire.end, np.float64)
-        u = np.array(wire.uncertainties(), np.float64)
-        is_tool = np.array([o == TOOL for o in wire.origin], bool)
+        u, is_char, breaks = _made_columns(wire, len(s))
+        is_tool = np.fromiter(map(eq, wire.origin, repeat(TOOL)), bool, len(s))
         kinds = wire.kinds()
-        is_char = np.fromiter(map(is_, kinds, repeat(EventKind.CHAR)), bool, len(kinds))
-        # the sensor's breaks (made events: a decoder makes each break) are played as its
-        # characters are, each where its column is among the replies
-        breaks = [i for i, m in wire.made.items() if m.kind is not EventKind.CHAR and _played(m)]
-        is_char[breaks] = True
         with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
             found = _from_arrays(s, e, u, is_tool, is_char)
             if found is None:
@@ -274,6 +269,28 @@ def _touching_each(
         )
         last = reply
     return out
+
+
+def _made_columns(wire: WireColumns, n: int) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """Each of the ``n`` columns' uncertainty and whether the replay plays it as a character,
+    and the sensor's breaks among them: a certified character has the columns' common
+    uncertainty and is one, so only the decoder's own events (``made``, a few hundred of a
+    row's ~2*10^4) are looked at (issue 22, matrix24: the uncertainty and kind of every
+    column listed and each read into an array was ~4 ms of a fault-matrix row). A break
+    (a decoder makes each one) is played where it is the sensor's (:func:`_played`)."""
+    import numpy as np
+
+    u = np.full(n, wire.uncertainty, np.float64)
+    is_char = np.ones(n, bool)
+    breaks: list[int] = []
+    for i, m in wire.made.items():
+        u[i] = m.uncertainty
+        if m.kind is not EventKind.CHAR:
+            played = _played(m)
+            is_char[i] = played
+            if played:
+                breaks.append(i)
+    return u, is_char, breaks
 
 
 def _column(events: list[Event], name: str) -> np.ndarray:

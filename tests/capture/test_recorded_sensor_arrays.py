@@ -206,3 +206,25 @@ def test_a_decoded_captures_columns_give_its_sensor(tmp_path):
     events = decoded.columns.events()
     assert len(sensor._reply_start) > 500
     assert state(sensor) == event_by_event(events) == state(RecordedSensor(events))
+
+
+def listed_columns(cols: WireColumns) -> tuple[list, list, list[int]]:
+    """What ``of_columns`` read before matrix24: every column's uncertainty and kind listed
+    (:meth:`WireColumns.uncertainties`, :meth:`WireColumns.kinds`), a character or a break
+    the replay plays, the breaks among the decoder's own events."""
+    kinds = cols.kinds()
+    is_char = [k is EventKind.CHAR for k in kinds]
+    breaks = [i for i, m in cols.made.items() if m.kind is not EventKind.CHAR and played(m)]
+    for i in breaks:
+        is_char[i] = True
+    return [repr(u) for u in cols.uncertainties()], is_char, breaks
+
+
+@settings(max_examples=300, deadline=None)
+@given(recordings())
+def test_made_columns_are_the_listed_ones(events):
+    """matrix24: the columns' uncertainties, characters and breaks worked out from the
+    decoder's own events alone are those listed column by column (NaN by repr)."""
+    cols = as_columns(events)
+    u, is_char, breaks = sensor_module._made_columns(cols, len(cols))
+    assert ([repr(x) for x in u.tolist()], is_char.tolist(), breaks) == listed_columns(cols)
