@@ -1083,7 +1083,10 @@ class Framing:
         # the rest of multi-line text the command talked over, to its ETX: not framed; so is
         # what the next command talked over before that ETX (a long line met the next retry)
         met = bool(seg.contention) and seg.contention[0].start < seg.command_end
-        hidden = self._open_text = talked_through(seg) or (self._open_text and met)
+        still_open = self._open_text  # its ETX not seen yet, only silent commands since
+        hidden = self._open_text = talked_through(seg) or (still_open and met)
+        if still_open and not (seg.reply or seg.later or seg.contention):
+            self._open_text = True  # a silent command: the text may still go on after it
         if reply and _packet_late(tally, seg, earlier, self.stamps.base):
             chunks = later
             reply = []
@@ -1137,7 +1140,15 @@ class Framing:
             )
             if expected and body[:1] not in allowed:
                 named = body[:1]
-                _wrong_address(tally, label, text, named, expected, earlier if is_reply else None)
+                _wrong_address(
+                    tally,
+                    label,
+                    text,
+                    named,
+                    expected,
+                    earlier if is_reply else None,
+                    open_text=still_open and is_reply,
+                )
 
 
 def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertainty: float) -> bool:
@@ -1169,13 +1180,33 @@ def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertaint
 
 
 def _wrong_address(
-    tally: Tally, label: str, text: str, named: str, expected: str, earlier: Segment | None
+    tally: Tally,
+    label: str,
+    text: str,
+    named: str,
+    expected: str,
+    earlier: Segment | None,
+    *,
+    open_text: bool = False,
 ) -> None:
     """R-4.3-01 for a reply ``text`` whose body starts with ``named``, not ``expected``: a FAIL, or
     undecided where a reply names the unanswered command before it (``earlier``,
     :func:`_unanswered_before`), whose late reply it may be (a sensor 80 ms late answered z!
     over the 0! after it: 'z<CR><LF>' FAILed as 0!'s, answers-foreign-address +
-    replies-after-retry, truth15)."""
+    replies-after-retry, truth15); or where it may be the next line of multi-line text a
+    command talked over whose ETX has not come, only silent commands between (``open_text``):
+    a line of that text need not start with the address. replies-after-retry beside
+    multiline-slow-lines: 0XHELP!'s first line met the retry, the next 0XHELP! went unheard,
+    and the second line 'aXSN! serial number; ...', 200 ms after the first, came in 0M1!'s
+    listen: R-4.3-01 FAILed "reply to 0M1! starts with 'a'" (truth21)."""
+    if open_text:
+        tally.undecide(
+            "R-4.3-01",
+            label,
+            f"'{escape(text)}' may be the next line of multi-line text the sensor began "
+            "earlier (no ETX heard yet; R-7.0-10 judges its timing)",
+        )
+        return
     if earlier is not None:
         tally.undecide(
             "R-4.3-01",
