@@ -1080,13 +1080,7 @@ class Framing:
         tool_cut = cut and not seg.reply_ended and not seg.later  # the tool spoke over it
         reply = [seg.reply] if seg.reply and not seg.binary_reply and not tool_cut else []
         chunks = reply + later
-        # the rest of multi-line text the command talked over, to its ETX: not framed; so is
-        # what the next command talked over before that ETX (a long line met the next retry)
-        met = bool(seg.contention) and seg.contention[0].start < seg.command_end
-        still_open = self._open_text  # its ETX not seen yet, only silent commands since
-        hidden = self._open_text = talked_through(seg) or (still_open and met)
-        if still_open and not (seg.reply or seg.later or seg.contention):
-            self._open_text = True  # a silent command: the text may still go on after it
+        still_open, hidden = self._open_text, self._hides(seg)
         if reply and _packet_late(tally, seg, earlier, self.stamps.base):
             chunks = later
             reply = []
@@ -1139,16 +1133,21 @@ class Framing:
                 expected, self.started if not is_reply else None, self.shown, self.own
             )
             if expected and body[:1] not in allowed:
-                named = body[:1]
-                _wrong_address(
-                    tally,
-                    label,
-                    text,
-                    named,
-                    expected,
-                    earlier if is_reply else None,
-                    open_text=still_open and is_reply,
-                )
+                rest = still_open and is_reply  # maybe the next line of open text
+                earlier_one = earlier if is_reply else None
+                _wrong_address(tally, label, text, body[:1], expected, earlier_one, open_text=rest)
+
+    def _hides(self, seg: Segment) -> bool:
+        """Whether ``seg``'s text is the rest of multi-line text a command talked over, to
+        its ETX (not framed); so is what the next command talked over before that ETX (a
+        long line met the next retry). The text stays open (``_open_text``) through a
+        command the sensor sent nothing after: it may still go on past it."""
+        met = bool(seg.contention) and seg.contention[0].start < seg.command_end
+        still_open = self._open_text
+        hidden = self._open_text = talked_through(seg) or (still_open and met)
+        if still_open and not (seg.reply or seg.later or seg.contention):
+            self._open_text = True  # a silent command: the text may still go on after it
+        return hidden
 
 
 def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertainty: float) -> bool:

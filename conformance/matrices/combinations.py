@@ -63,10 +63,13 @@ class ComboRow:
     missed: tuple[Finding, ...]  # PASS on a requirement a member removed
     errors: tuple[Finding, ...] = ()
     cpu_s: float = 0.0
+    #: why the members cannot be one sensor (:func:`~conformance.emulator.faults.conflicts`),
+    #: '' if they can: such a row is not run, and is INCONCLUSIVE, neither clean nor an ERROR
+    refused: str = ""
 
     @property
     def clean(self) -> bool:
-        return not (self.unexpected or self.missed or self.errors)
+        return not (self.unexpected or self.missed or self.errors or self.refused)
 
     def explain(self) -> str:
         parts = [
@@ -78,6 +81,8 @@ class ComboRow:
             )
             if found
         ]
+        if self.refused:
+            parts.append(f"INCONCLUSIVE, not run: cannot be one sensor ({self.refused})")
         return ",".join(self.faults) + ": " + ("; ".join(parts) or "clean")
 
 
@@ -201,9 +206,18 @@ def declared_for(faults: Iterable[str]) -> dict[str, tuple[tuple[str, ...], tupl
 
 
 def combo_row(faults: tuple[str, ...]) -> ComboRow:
-    """Run the sensor suite in this process against the combination and check it."""
+    """Run the sensor suite in this process against the combination and check it. Members
+    that cannot be one sensor (two set one knob apart: replies-after-retry's 80 ms reply
+    delay and response-too-early's 5 ms) are not run: the sim refuses them, and the row was
+    an ERROR (INCOMPLETE) although the tool did not fail; it is INCONCLUSIVE, naming why
+    (truth21: replies-after-retry beside break-before-reply, response-too-early and
+    response-too-late, all three setting ``reply_delay``)."""
     import time
 
+    from ..emulator.faults import conflicts
+
+    if reasons := conflicts(faults):
+        return ComboRow(faults, "INCONCLUSIVE", (), (), refused="; ".join(reasons))
     start = time.process_time()
     data = matrix_verdicts(combo_port(faults))
     cpu = time.process_time() - start
