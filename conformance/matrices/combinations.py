@@ -412,6 +412,16 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # command's character) were judged unanswered (4 false FAILs), and the restore, reading
     # no answer, stopped the run; past it R-4.4.3-01, R-4.3-03 and R-4.4.12-04 were false too
     ("replies-after-retry", "slow-wake"),
+    # (truth21) the same sensor beside four more: multiline-slow-lines' second help line,
+    # 200 ms after the first, heard in 0M1!'s listen (R-4.3-01 "starts with 'a'");
+    # answers-old-address took the exploration's 9M!, whose late reply a break cut, and the
+    # emptied D0 FAILed R-4.4.5-10; the retention case PASSed two late D reads as identical
+    # silences (continuous-overwrites-data's R-4.4.5-10), and test_crc_presence's PASS stood
+    # alone where aIMC_001! was answered only late (metadata-crc-sticks' R-4.4.12-03)
+    ("multiline-slow-lines", "replies-after-retry"),
+    ("answers-old-address", "replies-after-retry"),
+    ("continuous-overwrites-data", "replies-after-retry"),
+    ("metadata-crc-sticks", "replies-after-retry"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
