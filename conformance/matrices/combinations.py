@@ -205,19 +205,32 @@ def declared_for(faults: Iterable[str]) -> dict[str, tuple[tuple[str, ...], tupl
     return {f: (tuple(FAULTS[f].violates), tuple(FAULTS[f].inconclusive)) for f in faults}
 
 
+def cannot_be_one_sensor(faults: tuple[str, ...]) -> str:
+    """Why the sim refuses :func:`combo_port` of ``faults`` ('' if it takes it): the check
+    the sim port itself makes before it builds the sensor (``ports.sim_profile``)."""
+    from ..links.errors import PortError
+    from ..ports import parse_sim, sim_profile
+
+    try:
+        sim_profile(parse_sim(combo_port(faults)))
+    except PortError as exc:
+        return str(exc)
+    return ""
+
+
 def combo_row(faults: tuple[str, ...]) -> ComboRow:
     """Run the sensor suite in this process against the combination and check it. Members
     that cannot be one sensor (two set one knob apart: replies-after-retry's 80 ms reply
     delay and response-too-early's 5 ms) are not run: the sim refuses them, and the row was
     an ERROR (INCOMPLETE) although the tool did not fail; it is INCONCLUSIVE, naming why
     (truth21: replies-after-retry beside break-before-reply, response-too-early and
-    response-too-late, all three setting ``reply_delay``)."""
+    response-too-late, all three setting ``reply_delay``), or where a member needs what the
+    version's profile lacks (multiline-slow-lines needs aXHELP!, which the v1.3 profile
+    v13-concurrent-over-20 runs in has not)."""
     import time
 
-    from ..emulator.faults import conflicts
-
-    if reasons := conflicts(faults):
-        return ComboRow(faults, "INCONCLUSIVE", (), (), refused="; ".join(reasons))
+    if reason := cannot_be_one_sensor(faults):
+        return ComboRow(faults, "INCONCLUSIVE", (), (), refused=reason)
     start = time.process_time()
     data = matrix_verdicts(combo_port(faults))
     cpu = time.process_time() - start

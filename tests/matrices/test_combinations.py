@@ -221,3 +221,7 @@ def test_members_that_cannot_be_one_sensor_are_an_inconclusive_row_not_an_error(
         assert row.verdict == "INCONCLUSIVE" and not row.errors and not row.clean, row
         assert "both set reply_delay" in row.refused
         assert "INCONCLUSIVE, not run: cannot be one sensor" in row.explain()
+    # a member that needs what the version's profile lacks: refused by the sim alike
+    row = combo_row(("multiline-slow-lines", "v13-concurrent-over-20"))
+    assert row.verdict == "INCONCLUSIVE" and not row.errors and not row.clean, row
+    assert "needs XHELP, which a v1.3 sensor does not have" in row.refused
