@@ -600,6 +600,8 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
         if r.clean:
             continue
         console.print(",".join(r.faults), markup=False, highlight=False)
+        if r.refused:
+            console.print(f"  INCONCLUSIVE, not run: {r.refused}", markup=False, highlight=False)
         for label, found in (
             ("unexpected", r.unexpected),
             ("missed FAIL", r.missed),
@@ -615,9 +617,11 @@ def _combination_matrix(args: argparse.Namespace, console: Console) -> int:
     missed = sum(len(r.missed) for r in rows)
     errors = sum(len(r.errors) for r in rows)
     clean = sum(r.clean for r in rows)
+    refused = sum(bool(r.refused) for r in rows)
     console.print(
         f"{clean}/{len(rows)} combinations clean; {unexpected} unexpected FAIL/WARN, "
         f"{missed} missed FAIL, {errors} ERROR"
+        + (f", {refused} INCONCLUSIVE (cannot be one sensor, not run)" if refused else "")
     )
     return EXIT_COMPLIANT if clean == len(rows) else EXIT_NON_COMPLIANT
 

@@ -1080,10 +1080,7 @@ class Framing:
         tool_cut = cut and not seg.reply_ended and not seg.later  # the tool spoke over it
         reply = [seg.reply] if seg.reply and not seg.binary_reply and not tool_cut else []
         chunks = reply + later
-        # the rest of multi-line text the command talked over, to its ETX: not framed; so is
-        # what the next command talked over before that ETX (a long line met the next retry)
-        met = bool(seg.contention) and seg.contention[0].start < seg.command_end
-        hidden = self._open_text = talked_through(seg) or (self._open_text and met)
+        still_open, hidden = self._open_text, self._hides(seg)
         if reply and _packet_late(tally, seg, earlier, self.stamps.base):
             chunks = later
             reply = []
@@ -1136,8 +1133,21 @@ class Framing:
                 expected, self.started if not is_reply else None, self.shown, self.own
             )
             if expected and body[:1] not in allowed:
-                named = body[:1]
-                _wrong_address(tally, label, text, named, expected, earlier if is_reply else None)
+                rest = still_open and is_reply  # maybe the next line of open text
+                earlier_one = earlier if is_reply else None
+                _wrong_address(tally, label, text, body[:1], expected, earlier_one, open_text=rest)
+
+    def _hides(self, seg: Segment) -> bool:
+        """Whether ``seg``'s text is the rest of multi-line text a command talked over, to
+        its ETX (not framed); so is what the next command talked over before that ETX (a
+        long line met the next retry). The text stays open (``_open_text``) through a
+        command the sensor sent nothing after: it may still go on past it."""
+        met = bool(seg.contention) and seg.contention[0].start < seg.command_end
+        still_open = self._open_text
+        hidden = self._open_text = talked_through(seg) or (still_open and met)
+        if still_open and not (seg.reply or seg.later or seg.contention):
+            self._open_text = True  # a silent command: the text may still go on after it
+        return hidden
 
 
 def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertainty: float) -> bool:
@@ -1169,13 +1179,33 @@ def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertaint
 
 
 def _wrong_address(
-    tally: Tally, label: str, text: str, named: str, expected: str, earlier: Segment | None
+    tally: Tally,
+    label: str,
+    text: str,
+    named: str,
+    expected: str,
+    earlier: Segment | None,
+    *,
+    open_text: bool = False,
 ) -> None:
     """R-4.3-01 for a reply ``text`` whose body starts with ``named``, not ``expected``: a FAIL, or
     undecided where a reply names the unanswered command before it (``earlier``,
     :func:`_unanswered_before`), whose late reply it may be (a sensor 80 ms late answered z!
     over the 0! after it: 'z<CR><LF>' FAILed as 0!'s, answers-foreign-address +
-    replies-after-retry, truth15)."""
+    replies-after-retry, truth15); or where it may be the next line of multi-line text a
+    command talked over whose ETX has not come, only silent commands between (``open_text``):
+    a line of that text need not start with the address. replies-after-retry beside
+    multiline-slow-lines: 0XHELP!'s first line met the retry, the next 0XHELP! went unheard,
+    and the second line 'aXSN! serial number; ...', 200 ms after the first, came in 0M1!'s
+    listen: R-4.3-01 FAILed "reply to 0M1! starts with 'a'" (truth21)."""
+    if open_text:
+        tally.undecide(
+            "R-4.3-01",
+            label,
+            f"'{escape(text)}' may be the next line of multi-line text the sensor began "
+            "earlier (no ETX heard yet; R-7.0-10 judges its timing)",
+        )
+        return
     if earlier is not None:
         tally.undecide(
             "R-4.3-01",

@@ -33,6 +33,10 @@ Plan = tuple[tuple[Step, ...], ...]
 #: the rules' names (``exploration_machine._with_rules``): the steps a plan may hold
 RULES = ("brk", "foreign_command", "malformed_command", "own_command", "pause", "read_data")
 
+#: the commands (their first letter after the address) that start a measurement: aM!, aMC!,
+#: aC!, aCC!, aV!, aHA!, aHB!, each of which may change what D0 reads
+MEASURING = ("M", "C", "V", "H")
+
 
 class ExplorerSteps:
     """The stimuli and records behind the exploration's rules: each step a rule draws is sent
@@ -50,6 +54,7 @@ class ExplorerSteps:
         self.address = self.sensor.address
         self.trail: list[str] = []
         self.last_d0: str | None = None  # D0 reply since the last measurement command
+        self.unheard = ""  # a foreign measurement command since then, silent but maybe taken
         self.sensor.master.send_break()
 
     def _observe(self, observation: Observation) -> None:
@@ -90,8 +95,9 @@ class ExplorerSteps:
         """A command to the sensor's own address; its reply's framing, CRC and D0 repeat
         are observed (only an answered one: silence is judged by the other cases)."""
         ex = self._send(code)
-        if code[:1] in ("M", "C", "V", "H"):
+        if code[:1] in MEASURING:
             self.last_d0 = None  # a new measurement may change the data
+            self.unheard = ""
         if not ex.answered:
             return
         if code in ("C", "CC"):
@@ -100,9 +106,11 @@ class ExplorerSteps:
         if code.startswith("D"):
             self._observe(Observation("crc", ex.text, ex.reply_text))
         if code == "D0":
-            previous = self.last_d0
-            self._observe(Observation("repeat", ex.text, ex.reply_text, previous=previous))
-            self.last_d0 = ex.reply_text
+            previous, unheard = self.last_d0, self.unheard
+            self._observe(
+                Observation("repeat", ex.text, ex.reply_text, previous=previous, unheard=unheard)
+            )
+            self.last_d0, self.unheard = ex.reply_text, ""
 
     def _foreign(self, other: str, code: str) -> None:
         """A command to another address, sent the way the sensor was shown to hear."""
@@ -110,6 +118,8 @@ class ExplorerSteps:
         self.record.exchanges.append(ex)
         self._note(f"{escape(ex.text)} (foreign) -> '{escape(ex.reply_text)}'")
         marked = self.marking is not None
+        if code[:1] in MEASURING and not ex.answered and self._late():
+            self.unheard = ex.text  # a reply would have come late: silence shows nothing
         self._observe(
             Observation(
                 "foreign",
@@ -121,6 +131,11 @@ class ExplorerSteps:
                 collided=ex.maybe_collided,
             )
         )
+
+    def _late(self) -> bool:
+        """Whether the sensor has been seen to start its replies late: silence in the reply
+        window then shows no command went unheard."""
+        return self.sensor.master.watch.late.start is not None
 
     def _malformed(self, junk: str) -> None:
         """A malformed command: silence or any well-framed reply is fine (decision A12)."""
@@ -135,7 +150,7 @@ class ExplorerSteps:
             self._observe_framing(ex)
             # junk can spell a real command ("M", or "-7!0MC" ending in one): whatever
             # the sensor accepted may have started a measurement
-            self.last_d0 = None
+            self.last_d0, self.unheard = None, ""
 
     def _follow_address_change(self, moved: str) -> None:
         """The sensor read the malformed command as ``aAb!`` and now answers at

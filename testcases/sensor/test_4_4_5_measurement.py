@@ -15,6 +15,7 @@ from conformance.judges.exchanges import (
     late_only,
     shown,
 )
+from conformance.judges.retention import retained
 from conformance.judges.support import announced_ttt, empty_data_reply, first_filled
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
@@ -209,7 +210,6 @@ def test_data_retained(sensor, case):
     if not case.requires("buffered", precondition.buffered(m, "M-type or concurrent measurement")):
         return
     fresh = sensor.fresh_measurement(m.command.text()[1:-1])
-    before = [ex.reply_text for ex in fresh.data]
     sensor.to_standby()  # standby
     sensor.master.send_break()
     pokes = [sensor.fresh_exchange(code) for code in ("I", "", "R0", "RC0")]
@@ -219,28 +219,7 @@ def test_data_retained(sensor, case):
         "measurement, then break/standby/aI!/a!/aR0!/aRC0!, then the D commands again",
         [fresh, *pokes, *again],
     )
-    after = [ex.reply_text for ex in again]
-    if before != after:
-        diff = next(
-            i for i, (x, y) in enumerate(zip(before, after + [""] * 10, strict=False)) if x != y
-        )
-        case.add(
-            failed(
-                "R-4.4.5-10",
-                f"D{diff} changed from '{escape(before[diff])}' to "
-                f"'{escape(after[diff]) if diff < len(after) else '(nothing)'}'",
-                evidence=cite(fresh.data[diff : diff + 1] + again[diff : diff + 1]),
-                observed=len(before),
-            )
-        )
-    else:
-        case.add(
-            passed(
-                "R-4.4.5-10",
-                f"{len(after)} D replies identical after break, standby and aI!/a!/aR0!/aRC0!",
-                observed=len(after),
-            )
-        )
+    case.add(retained(fresh.data, again))
 
 
 @pytest.mark.needs("break", "unsolicited")

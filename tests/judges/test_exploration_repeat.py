@@ -62,3 +62,14 @@ def test_silence_to_a_foreign_command_that_maybe_collided_is_no_check():
     met = Observation("foreign", "9I!", "", "9", answered=False, marked=True, collided=True)
     assert checks([heard])["R-4.0-01"] == 1
     assert checks([met])["R-4.0-01"] == 0
+
+
+def test_lost_values_after_a_foreign_measurement_a_late_sensor_may_have_taken_are_no_check():
+    """answers-old-address + replies-after-retry (truth21): 9M!, to the address the sensor
+    had been moved from and still answers at, started a measurement whose reply, 80 ms
+    late, the next break cut; D0 then read '0<CR><LF>' and R-4.4.5-10 FAILed. Whether the
+    data were lost or replaced by that measurement is R-4.0-01's question: no check."""
+    lost = Observation("repeat", "0D0!", "0\r\n", previous="0+1.5-2\r\n", unheard="9M!")
+    assert judge(lost) == judge(Observation("repeat", "0D0!", "0\r\n", previous=None))
+    kept = Observation("repeat", "0D0!", "0+1.5-2\r\n", previous="0+1.5-2\r\n", unheard="9M!")
+    assert judge(kept).checked == ("R-4.4.5-10",) and judge(kept).breach is None

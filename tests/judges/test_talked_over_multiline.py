@@ -92,3 +92,39 @@ def test_r_4_2_02_an_etx_after_a_command_no_text_met_is_framed() -> None:
     assert _by_rule(wire.judge_framing([first, second], 0.0, own="0"))["R-4.2-02"].verdict is (
         Verdict.FAIL
     )
+
+
+def _slow_second_line(first_line_end: str) -> list[Segment]:
+    """0XHELP! whose retry met the help text's first line (its end ``first_line_end`` after
+    the command), then 0XHELP! unheard 55 ms later, then 0M1! 88 ms after that, whose listen
+    hears the text's second line 200 ms after the first (the replies-after-retry sensor
+    beside multiline-slow-lines)."""
+    talked = _talked_over("0\x02CONFORM\r\n", [])
+    rest = chars(DUT, first_line_end, talked.command_end + LINE_GAP)
+    first = Segment(None, talked.command, later=rest, contention=talked.contention, text="0XHELP!")
+    silent = chars(TOOL, "0XHELP!", rest[-1].end + 0.055)
+    command = chars(TOOL, "0M1!", silent[-1].end + 0.088)
+    line = chars(DUT, "aXSN! serial number\r\n", rest[-1].end + 0.2)
+    return [
+        first,
+        Segment(None, silent, text="0XHELP!"),
+        Segment(None, command, reply=line, text="0M1!"),
+    ]
+
+
+def test_r_4_3_01_slow_next_line_after_a_silent_retry_is_undecided() -> None:
+    """multiline-slow-lines + replies-after-retry (truth21): the first line of 0XHELP!'s help
+    text met the retry, the next 0XHELP! went unheard, and the second line, 200 ms after the
+    first, came in 0M1!'s listen: R-4.3-01 FAILed "reply to 0M1!: reply 'aXSN! serial
+    number; ...' starts with 'a', not the address '0'". Its address is undecided: a line
+    of that text need not start with it."""
+    found = _by_rule(wire.judge_framing(_slow_second_line("EMU001 x\r\n"), 0.0, own="0"))
+    assert found["R-4.3-01"].verdict is Verdict.INCONCLUSIVE, found["R-4.3-01"].detail
+    assert "next line of multi-line text" in found["R-4.3-01"].detail
+
+
+def test_r_4_3_01_wrong_address_after_ended_text_still_fails() -> None:
+    """The same wire with the text's ETX heard before the silent retry: the reply to 0M1!
+    is the sensor's own, and starting with 'a' FAILs R-4.3-01."""
+    segs = _slow_second_line("EMU001 x\r\n\x03")
+    assert _by_rule(wire.judge_framing(segs, 0.0, own="0"))["R-4.3-01"].verdict is Verdict.FAIL

@@ -207,3 +207,21 @@ def test_a_combination_runs_in_the_version_a_member_names():
         "&version=1.3"
     )  # 1.4 before
     assert combo_port(("inter-char-gap", "service-request-after-ttt-zero")).endswith("&version=1.4")
+
+
+def test_members_that_cannot_be_one_sensor_are_an_inconclusive_row_not_an_error():
+    """replies-after-retry beside response-too-early, response-too-late or
+    break-before-reply: both set reply_delay, the sim refuses the port, and the row was an
+    ERROR (INCOMPLETE) although the tool did not fail (truth21). Not run: INCONCLUSIVE,
+    naming why, and never clean."""
+    from conformance.matrices.combinations import combo_row
+
+    for other in ("break-before-reply", "response-too-early", "response-too-late"):
+        row = combo_row(("replies-after-retry", other))
+        assert row.verdict == "INCONCLUSIVE" and not row.errors and not row.clean, row
+        assert "both set reply_delay" in row.refused
+        assert "INCONCLUSIVE, not run: cannot be one sensor" in row.explain()
+    # a member that needs what the version's profile lacks: refused by the sim alike
+    row = combo_row(("multiline-slow-lines", "v13-concurrent-over-20"))
+    assert row.verdict == "INCONCLUSIVE" and not row.errors and not row.clean, row
+    assert "needs XHELP, which a v1.3 sensor does not have" in row.refused
