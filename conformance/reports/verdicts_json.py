@@ -11,12 +11,12 @@ from pathlib import Path
 from typing import Any
 
 from ..dut import DutClaim
-from ..links.bus_time import bus_time
+from ..links.bus_time import bus_time_again
 from ..protocol.version import format_version
 from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL_IDENTITY, ConformanceRun
-from ..transcript import TOOL, Event, EventKind, escape
+from ..transcript import TOOL, Event, EventKind, escape, write_jsonl
 from ..view.segments import memo
 from .evidence import WireRef, wire_refs
 from .margins import distribution_json, margins_json
@@ -67,11 +67,12 @@ def bus_block(run: ConformanceRun) -> dict[str, Any]:
     link = run.link
     if link is None:
         return {"bus_lower_bound_s": None, "wall_s": None, "efficiency": None}
-    events = link.transcript.events
-    # kept on the transcript: each run of a passive judgement reads the one recording
+    # kept on the transcript: each run of a passive judgement reads the one recording, its
+    # events read again as they come (no list of them: issue 22)
     figures: dict[str, Any] = memo(
-        link.transcript, "_bus_time", len(events), lambda: bus_time(events)
-    ).to_json()
+        link.transcript, "_bus_time", len(link.transcript),
+        lambda: bus_time_again(link.events_again),
+    ).to_json()  # fmt: skip
     elapsed = link.now()
     figures["link_clock_s"] = round(elapsed, 3)
     figures["wall_s"] = None if link.info.virtual_time else round(elapsed, 3)
@@ -207,7 +208,10 @@ def write_transcript(run: ConformanceRun, directory: Path) -> Path:
             # judgement writes the one recording: 43 MB an hour of a busy bus, 3 s to format)
             shutil.copyfile(written[1], path)
         else:
-            write_recording(path, transcript.events, keep=run.link.keeps_written_reading)
+            if run.link.keeps_written_reading:
+                write_recording(path, transcript.events)
+            else:  # written as the events come again: no list of them (issue 22)
+                write_jsonl(str(path), run.link.events_again())
             transcript.__dict__["_written_to"] = (len(transcript), path)
     else:
         path.write_text("", encoding="utf-8")
