@@ -101,6 +101,10 @@ class BusEnd(ABC):
     #: recording's is not (nothing reads a passive judgement's copy back, and an hour's
     #: capture kept it as a tuple of its 357,000 events through every later report set)
     keeps_written_reading: bool = True
+    #: the reports read this bus end's events through :meth:`events_again` alone, never as
+    #: the transcript's list (a recording judged passively, which does not grow: issue 22,
+    #: a step towards a recording that is streamed from its file, not held)
+    reads_again: bool = False
 
     @abstractmethod
     def now(self) -> float: ...

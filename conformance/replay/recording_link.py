@@ -128,6 +128,7 @@ class RecordingLink(BusEnd):
     notes: list[str] = field(default_factory=list)
     decoded: CaptureDecode | None = None  # a capture's decode figures (for the notes)
     keeps_written_reading = False  # its report transcripts are not read back (BusEnd)
+    reads_again = True  # its reports read its events through events_again (BusEnd)
 
     @property
     def host_stamped(self) -> bool:

@@ -16,9 +16,9 @@ from ..protocol.version import format_version
 from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL_IDENTITY, ConformanceRun
-from ..transcript import TOOL, Event, EventKind, escape, write_jsonl
+from ..transcript import TOOL, EventKind, escape, write_jsonl
 from ..view.segments import memo
-from .evidence import WireRef, wire_refs
+from .evidence import Locator, WireRef, locator_of, wire_refs
 from .margins import distribution_json, margins_json
 from .plan import PLAN_FILE, read_plan
 from .sweep_chart import sweeps_block
@@ -94,8 +94,9 @@ def plan_block(directory: Path) -> dict[str, Any] | None:
 
 def build(run: ConformanceRun) -> dict[str, Any]:
     results = run.results or []
-    events = run.link.transcript.events if run.link is not None else None
-    refs = wire_refs(run.cases, run.link.transcript) if run.link is not None else {}
+    # the run's events read through its locator: a recording's as they come again (issue 22)
+    locator = locator_of(run.link) if run.link is not None else None
+    refs = wire_refs(run.cases, run.link) if run.link is not None else {}
     return {
         "schema": SCHEMA,
         "tool": dict(TOOL_IDENTITY),
@@ -146,7 +147,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "description": c.description,
                 # what the case itself put on the bus: the run beside its plan (issue 24)
                 "bus_s": None if c.bus_s is None else round(c.bus_s, 3),
-                "sent": sent_by(events, c.added) if events is not None else [],
+                "sent": sent_by(locator, c.added) if locator is not None else [],
             }
             for c in run.cases
         ],
@@ -154,14 +155,14 @@ def build(run: ConformanceRun) -> dict[str, Any]:
     }
 
 
-def sent_by(events: list[Event], added: tuple[int, int] | None) -> list[dict[str, Any]]:
-    """The commands the tool sent in ``events[added]``, in first-sent order, each with how
-    often; ``breaks`` counts the breaks in front of them."""
+def sent_by(locator: Locator, added: tuple[int, int] | None) -> list[dict[str, Any]]:
+    """The commands the tool sent in the run's events ``added`` (``locator`` reads them), in
+    first-sent order, each with how often; ``breaks`` counts the breaks in front of them."""
     if added is None:
         return []
     counts: dict[str, dict[str, Any]] = {}
     text, broke = "", False
-    for e in events[added[0] : added[1]]:
+    for e in locator.slice(*added):
         if e.origin != TOOL:
             continue
         if e.kind is EventKind.BREAK:
