@@ -14,6 +14,7 @@ import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
+from itertools import islice
 from math import copysign, isfinite
 from operator import attrgetter
 from typing import Any
@@ -296,40 +297,48 @@ class Transcript:
         return self.events[index:]
 
     def write_jsonl(self, path: str) -> bool:
-        """One :func:`json_line` per event. Returns whether every event had
-        :func:`plain_fields`, which each line asks anyway (a caller keeping what it wrote as
-        its own reading needs to know, and asking again cost a second pass over 10^5)."""
-        plain = True
-        shown = _LastEnd()
-        parts: dict[tuple[object, ...], tuple[str, str]] = {}  # _line_parts by the fields
-        with open(path, "w", encoding="utf-8") as fh:
-            # written a block of lines at a time: an hour's capture is 43 MB of lines, which
-            # formatted whole before writing were the peak of a passive judgement's memory
-            for at in range(0, len(self.events), WRITE_BLOCK):
-                lines: list[str] = []
-                add = lines.append
-                for e in self.events[at : at + WRITE_BLOCK]:
-                    if not plain_fields(e):
-                        plain = False
-                        add(json.dumps(e.to_json()) + "\n")
-                        continue
-                    u, du = e.uncertainty, e.duration_uncertainty
-                    key = (e.kind, e.origin, e.wire, e.text, u, du)
-                    found = parts.get(key)
-                    # a negative zero is equal to 0.0 as a key, but written apart
-                    signed = (not u and copysign(1.0, u) < 0) or (
-                        du is not None and not du and copysign(1.0, du) < 0
-                    )
-                    if found is None or signed or not isfinite(e.start + e.end):
-                        add(_plain_line(e, shown))
-                        if found is None and not signed and isfinite(u + (du or 0.0)):
-                            parts[key] = _line_parts(e)
-                        continue
-                    start, end = shown.times(e.start, e.end)
-                    head, tail = found
-                    add(f'{head}{start}, "end": {end}{tail}')
-                fh.writelines(lines)
-        return plain
+        """One :func:`json_line` per event (:func:`write_jsonl`)."""
+        return write_jsonl(path, self.events)
+
+
+def write_jsonl(path: str, events: Iterable[Event]) -> bool:
+    """One :func:`json_line` per event of ``events``, read once in order (a list, or a
+    recording's events streamed from its first: issue 22, a passive run's transcript file
+    written with no list of the recording's events). Returns whether every event had
+    :func:`plain_fields`, which each line asks anyway (a caller keeping what it wrote as its
+    own reading needs to know, and asking again cost a second pass over 10^5)."""
+    plain = True
+    shown = _LastEnd()
+    parts: dict[tuple[object, ...], tuple[str, str]] = {}  # _line_parts by the fields
+    them = iter(events)
+    with open(path, "w", encoding="utf-8") as fh:
+        # written a block of lines at a time: an hour's capture is 43 MB of lines, which
+        # formatted whole before writing were the peak of a passive judgement's memory
+        while block := list(islice(them, WRITE_BLOCK)):
+            lines: list[str] = []
+            add = lines.append
+            for e in block:
+                if not plain_fields(e):
+                    plain = False
+                    add(json.dumps(e.to_json()) + "\n")
+                    continue
+                u, du = e.uncertainty, e.duration_uncertainty
+                key = (e.kind, e.origin, e.wire, e.text, u, du)
+                found = parts.get(key)
+                # a negative zero is equal to 0.0 as a key, but written apart
+                signed = (not u and copysign(1.0, u) < 0) or (
+                    du is not None and not du and copysign(1.0, du) < 0
+                )
+                if found is None or signed or not isfinite(e.start + e.end):
+                    add(_plain_line(e, shown))
+                    if found is None and not signed and isfinite(u + (du or 0.0)):
+                        parts[key] = _line_parts(e)
+                    continue
+                start, end = shown.times(e.start, e.end)
+                head, tail = found
+                add(f'{head}{start}, "end": {end}{tail}')
+            fh.writelines(lines)
+    return plain
 
 
 #: lines of a transcript formatted before they are written (bounded memory, few writes)

@@ -8,7 +8,7 @@ Every link records into one :class:`~conformance.transcript.Transcript`. The too
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -101,9 +101,21 @@ class BusEnd(ABC):
     #: recording's is not (nothing reads a passive judgement's copy back, and an hour's
     #: capture kept it as a tuple of its 357,000 events through every later report set)
     keeps_written_reading: bool = True
+    #: the reports read this bus end's events through :meth:`events_again` alone, never as
+    #: the transcript's list (a recording judged passively, which does not grow: issue 22,
+    #: a step towards a recording that is streamed from its file, not held)
+    reads_again: bool = False
 
     @abstractmethod
     def now(self) -> float: ...
+
+    def events_again(self) -> Iterator[Event]:
+        """Every event of this bus end from its first, in recorded order, read afresh at each
+        call: what a report reads the whole run through (the transcript file, the bus time,
+        where the findings' evidence lies), so that a bus end whose record is a recording
+        can give its events again as they come rather than hold them (issue 22). Here: the
+        transcript's list, read in order."""
+        return iter(self.transcript.events)
 
     def close(self) -> None:  # noqa: B027 - optional for bus ends without resources
         """Release the port."""

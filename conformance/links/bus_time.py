@@ -31,7 +31,7 @@ scheduling latency) is the tool's overhead.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from heapq import merge
 from itertools import islice
@@ -82,6 +82,67 @@ def bus_time(events: Iterable[Event]) -> BusTime:
     else:  # a time that is no number, or a break ending before it began: as it always was
         lower = _sweep(sorted([*_own_spans(wire), *_gaps(wire), *waits]))
     return BusTime(lower, wire[-1].end - wire[0].start, frames, breaks)
+
+
+def bus_time_again(again: Callable[[], Iterable[Event]]) -> BusTime:
+    """:func:`bus_time` of the events ``again()`` gives (each call: the same events from the
+    first, in recorded order), read twice as they come and never held: a passive run's bus
+    time with no list of the recording's events (issue 22). The first read checks what lets
+    the events stand for :func:`bus_time`'s own list, counts them and finds the announced
+    waits, the second sweeps the spans, each what :func:`bus_time` does with that list;
+    events out of start order, or not well formed (a time that is no
+    number, a break ending before it began, an event ending before it starts), are read
+    into a list and given to :func:`bus_time`. ``tests/links/test_bus_time_again.py``
+    holds the two to the same figures."""
+    seen = _Seen()
+    waits = _announced_waits(seen.watch(again()))  # type: ignore[arg-type]
+    if not seen.plain:
+        return bus_time(list(again()))
+    if seen.first is None or seen.last is None:
+        return BusTime(0.0, 0.0, 0, 0)
+    lower = _sweep(_spans_in_order(_wire_of(again()), sorted(waits)))  # type: ignore[arg-type]
+    return BusTime(lower, seen.last.end - seen.first.start, seen.frames, seen.breaks)
+
+
+class _Seen:
+    """What one read of the events found: whether they are in start order, notes aside,
+    well formed and ending no earlier than they start (:func:`in_start_order` then gives
+    them as they come, :func:`_well_formed` and :func:`_ends_after_starts` hold), how many
+    frames and breaks, the first and the last."""
+
+    def __init__(self) -> None:
+        self.plain = True
+        self.frames = self.breaks = 0
+        self.first: Event | None = None
+        self.last: Event | None = None
+
+    def watch(self, events: Iterable[Event]) -> Iterator[Event]:
+        """``events`` without their notes, each looked at as it passes."""
+        brk = EventKind.BREAK
+        last = None
+        for e in _wire_of(events):
+            start, end = e.start, e.end
+            if (
+                (last is not None and start < last)
+                or not (isfinite(start) and isfinite(end))
+                or end < start
+            ):
+                self.plain = False
+            last = start
+            if e.kind is brk:
+                self.breaks += 1
+            else:
+                self.frames += 1
+            if self.first is None:
+                self.first = e
+            self.last = e
+            yield e
+
+
+def _wire_of(events: Iterable[Event]) -> Iterator[Event]:
+    """``events`` without their notes."""
+    note = EventKind.NOTE
+    return (e for e in events if e.kind is not note)
 
 
 def uncounted(events: Iterable[Event]) -> list[tuple[float, float]]:

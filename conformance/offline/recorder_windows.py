@@ -16,7 +16,7 @@ observation per distinct value, the measurements the rules judge).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 from operator import attrgetter
@@ -91,9 +91,17 @@ def by_start(events: Sequence[Event]) -> Iterator[Event]:
     as :func:`~conformance.view.segments.read_view` sorts them), which
     :func:`~conformance.view.windows.stream_windows` needs: a capture's decode gives them
     so already (no copy made); a transcript whose stamps go back somewhere is sorted."""
-    if all(a.start <= b.start for a, b in pairwise(_plain(events))):
-        return _plain(events)
-    return iter(sorted(_plain(events), key=attrgetter("start")))
+    return by_start_again(lambda: iter(events))
+
+
+def by_start_again(again: Callable[[], Iterable[Event]]) -> Iterator[Event]:
+    """:func:`by_start` of the events ``again()`` gives (every event from the first, in
+    recorded order, at each call), read as they come: once to see whether they are in
+    order, then once more as the windows are cut (issue 22: the recorder's run reads no
+    list of a recording's events); sorted into a list only where they are not."""
+    if all(a.start <= b.start for a, b in pairwise(_plain(again()))):
+        return _plain(again())
+    return iter(sorted(_plain(again()), key=attrgetter("start")))
 
 
 def _plain(events: Sequence[Event]) -> Iterator[Event]:
@@ -104,18 +112,19 @@ def _plain(events: Sequence[Event]) -> Iterator[Event]:
 def recorder_findings(link: RecordingLink) -> RecorderFindings:
     """:func:`judge_windows` over the windows of ``link``'s recording, made once per
     loaded recording (every recorder case reads it)."""
-    events = link.transcript.events
 
     def judge() -> RecorderFindings:
-        cut = stream_window_views(by_start(events), uncertainty=link.uncertainty)
+        events = by_start_again(link.events_again)  # no list of them read (issue 22)
+        cut = stream_window_views(events, uncertainty=link.uncertainty)
         return judge_views((view for _window, view in cut), link.uncertainty)
 
-    return memo(link, "_recorder_findings", len(events), judge)
+    return memo(link, "_recorder_findings", len(link.transcript), judge)
 
 
 __all__ = [
     "RecorderFindings",
     "by_start",
+    "by_start_again",
     "judge_views",
     "judge_windows",
     "recorder_findings",

@@ -128,6 +128,7 @@ class RecordingLink(BusEnd):
     notes: list[str] = field(default_factory=list)
     decoded: CaptureDecode | None = None  # a capture's decode figures (for the notes)
     keeps_written_reading = False  # its report transcripts are not read back (BusEnd)
+    reads_again = True  # its reports read its events through events_again (BusEnd)
 
     @property
     def host_stamped(self) -> bool:
@@ -139,10 +140,10 @@ class RecordingLink(BusEnd):
     def now(self) -> float:
         """The recording's last moment: asked once per case and per report, and an hour's
         capture holds 10^6 events, so it is kept while the transcript keeps its length."""
-        events = self.transcript.events
+        count = len(self.transcript)
         kept = self.__dict__.get("_latest_end")
-        if kept is None or kept[0] != len(events):
-            kept = (len(events), max((e.end for e in events), default=0.0))
+        if kept is None or kept[0] != count:  # read as the events come again (issue 22)
+            kept = (count, max((e.end for e in self.events_again()), default=0.0))
             self.__dict__["_latest_end"] = kept
         return kept[1]
 

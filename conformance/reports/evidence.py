@@ -26,17 +26,20 @@ from __future__ import annotations
 import math
 import re
 from bisect import bisect_left
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from itertools import islice
 from operator import attrgetter
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..results import CaseRecord
 from ..transcript import Event, EventKind, Transcript
 from ..verdicts import Finding, Verdict
 from ..view.runs import LazyCut, Segment, segments, whole_cut
 from ..view.segments import memo
+
+if TYPE_CHECKING:
+    from ..links.base import BusEnd
 
 #: the verdicts a reader must be able to check against the wire
 NEEDS_EVIDENCE = (Verdict.FAIL, Verdict.WARN, Verdict.INCONCLUSIVE)
@@ -222,17 +225,93 @@ def _first_at(events: Sequence[Event], count: int, e: Event) -> int | None:
 _start_of = attrgetter("start")
 
 
+class StreamedPositions:
+    """:class:`Positions` of a recording read again as its events come (``again()``: every
+    event from the first, in recorded order), for exactly the events asked about: one read
+    for those not placed before, stopped once each is found, nothing held of the rest
+    (issue 22: a passive run's reports need no list of the recording's events). Each is
+    placed at the first index of an event equal to it, as the dict from every event to its
+    first index placed it (an equal event has an equal start, so only the events whose
+    start is one asked about are compared); a recording does not grow, so what a read found
+    or did not find stands. ``tests/reports/test_evidence_streamed.py`` holds it to
+    :class:`Positions`."""
+
+    def __init__(self, again: Callable[[], Iterable[Event]]) -> None:
+        self.again = again
+        self.first: dict[Event, int] = {}  # the events placed so far
+        self.at: dict[int, Event] = {}  # and which is at each of their positions
+        self.absent: set[Event] = set()  # asked about, and in no position
+        self.reads = 0
+
+    def index(self) -> None:
+        """Nothing to take in: a recording does not grow."""
+
+    def of(self, events: Iterable[Event]) -> Iterator[int]:
+        """The position of each of ``events`` (those in none left out)."""
+        events = list(events)
+        first, absent = self.first, self.absent
+        new = dict.fromkeys(e for e in events if e not in first and e not in absent)
+        if new:
+            self._place(new)
+        return (first[e] for e in events if e in first)
+
+    def _place(self, wanted: dict[Event, None]) -> None:
+        """One read, up to the last of ``wanted`` found: each one's first position."""
+        self.reads += 1
+        starts = {e.start for e in wanted}
+        left = len(wanted)
+        first, at = self.first, self.at
+        for i, e in enumerate(self.again()):
+            if e.start in starts and e in wanted and e not in first:
+                first[e], at[i] = i, e
+                left -= 1
+                if not left:
+                    break
+        self.absent.update(e for e in wanted if e not in first)
+
+
 class Locator:
     """Finds the exchange behind each finding in one run's transcript ``events`` (a list the
-    link may still be appending to: positions are indexed as it grows)."""
+    link may still be appending to: positions are indexed as it grows), or in a recording
+    read again as its events come (:meth:`streamed`)."""
 
     def __init__(self, events: Sequence[Event], transcript: Transcript | None = None) -> None:
         """``transcript``: the one ``events`` belongs to, whose whole cut
         (:func:`~..view.runs.transcript_segments`) stands for a search of all its events."""
         self.events = events
         self.transcript = transcript
-        self.position = Positions(events)
+        self.position: Positions | StreamedPositions = Positions(events)
+        self.again: Callable[[], Iterable[Event]] | None = None
         self._cuts: dict[tuple[int, int], Sequence[Segment]] = {}
+
+    @classmethod
+    def streamed(cls, again: Callable[[], Iterable[Event]], transcript: Transcript) -> Locator:
+        """The locator of a recording (``transcript``, which does not grow) that reads its
+        events only through ``again()`` (every event from the first, in order): the
+        positions of the events it places and the stretches it cuts, each read as the
+        events come, no list of them all (issue 22); the same answers as a locator over
+        the list (``tests/reports/test_evidence_streamed.py``)."""
+        locator = cls([], transcript)
+        locator.again, locator.position = again, StreamedPositions(again)
+        return locator
+
+    def count(self) -> int:
+        """How many events the run's transcript holds."""
+        if self.again is not None and self.transcript is not None:
+            return len(self.transcript)
+        return len(self.events)
+
+    def slice(self, lo: int, hi: int) -> list[Event]:
+        """Events ``lo..hi-1`` (read as they come, for a streamed locator)."""
+        if self.again is None:
+            return list(self.events[lo:hi])
+        return list(islice(self.again(), lo, hi)) if lo < hi else []
+
+    def _at(self, placed: list[int]) -> list[Event]:
+        """The events at positions ``placed`` (each one this locator placed)."""
+        if isinstance(self.position, StreamedPositions):
+            return [self.position.at[i] for i in placed]
+        return [self.events[i] for i in placed]
 
     def _index(self) -> None:
         self.position.index()
@@ -244,8 +323,8 @@ class Locator:
         if key not in self._cuts:
             if len(self._cuts) > 64:
                 self._cuts.clear()
-            whole = self.transcript is not None and lo == 0 and hi == len(self.events)
-            cut = whole_cut(self.transcript) if whole else segments(self.events[lo:hi])
+            whole = self.transcript is not None and lo == 0 and hi == self.count()
+            cut = whole_cut(self.transcript) if whole else segments(self.slice(lo, hi))
             if isinstance(cut, LazyCut):  # a command's segment: a transmission with characters
                 self._cuts[key] = LazyCut([t for t in cut.transmissions if t.chars])
             else:
@@ -254,7 +333,7 @@ class Locator:
 
     def _ref(self, events: Sequence[Event], exchange: str | None, how: str) -> WireRef | None:
         placed = sorted(self.position.of(events))
-        wire = [self.events[i] for i in placed if self.events[i].kind is not EventKind.NOTE]
+        wire = [e for e in self._at(placed) if e.kind is not EventKind.NOTE]
         if not wire:
             return None
         return WireRef(
@@ -284,7 +363,7 @@ class Locator:
     def locate(self, finding: Finding, record: CaseRecord) -> WireRef | None:
         """The exchange ``finding`` (of ``record``'s case) rests on, or None (no wire)."""
         self._index()
-        lo, hi = record.window if record.window else (0, len(self.events))
+        lo, hi = record.window if record.window else (0, self.count())
         attached = sorted(set(self.position.of(e for _, evs in record.evidence for e in evs)))
         pools = []
         if attached:
@@ -299,22 +378,28 @@ class Locator:
                 events = [e for seg in chain for e in _exchange_events(seg)]
                 return self._ref(events, " ".join(seg.text or "" for seg in chain), how)
         # no exchange named or measured: the case's own traffic (none known: no reference)
-        own = self.events[lo:hi] if record.window else []
-        return self._ref(own or [self.events[i] for i in attached], None, "case")
+        own = self.slice(lo, hi) if record.window else []
+        return self._ref(own or self._at(attached), None, "case")
 
 
-def locator_of(transcript: Transcript) -> Locator:
-    """The one locator of a transcript, shared by every report that places findings on it
-    (verdicts.json and report.html, and each run of a passive judgement, which all read the
-    one loaded recording): a cut of an hour's capture takes seconds, and each report made
-    its own, 2 per run and 11 runs for a bus of ten sensors. Its cuts stay true as the
-    transcript grows, since a transcript is append-only."""
-    return memo(transcript, "_locator", None, lambda: Locator(transcript.events, transcript))
+def locator_of(link: BusEnd) -> Locator:
+    """The one locator of a bus end's transcript, shared by every report that places
+    findings on it (verdicts.json and report.html, and each run of a passive judgement,
+    which all read the one loaded recording): a cut of an hour's capture takes seconds, and
+    each report made its own, 2 per run and 11 runs for a bus of ten sensors. Its cuts stay
+    true as the transcript grows, since a transcript is append-only. A recording's
+    (``link.reads_again``) reads its events again as they come (:meth:`Locator.streamed`)."""
+    transcript = link.transcript
+    if link.reads_again:
+        make = lambda: Locator.streamed(link.events_again, transcript)  # noqa: E731
+    else:
+        make = lambda: Locator(transcript.events, transcript)  # noqa: E731
+    return memo(transcript, "_locator", None, make)
 
 
-def wire_refs(cases: Sequence[CaseRecord], transcript: Transcript) -> dict[int, WireRef]:
+def wire_refs(cases: Sequence[CaseRecord], link: BusEnd) -> dict[int, WireRef]:
     """``id(finding)`` -> its reference, for every finding that needs evidence."""
-    locator = locator_of(transcript)
+    locator = locator_of(link)
     found: dict[int, WireRef] = {}
     for record in cases:
         for f in record.findings:

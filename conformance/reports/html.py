@@ -13,6 +13,7 @@ the DUT goes through :func:`html.escape` (design.md 7: the device is untrusted).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from html import escape
 from typing import TYPE_CHECKING, Any
 
@@ -494,12 +495,23 @@ CONTEXT_LINES = 2  # wire lines shown before and after the exchange a finding re
 CASE_EXCERPT = 24  # events of a case's whole traffic shown (the rest: transcript.jsonl)
 
 
-def where_html(findings: list[Finding], ref: WireRef, events: list[Event], timing: bool) -> str:
+def where_html(findings: list[Finding], ref: WireRef, events: Sequence[Event], timing: bool) -> str:
     """The wire lines around the exchange ``findings`` rest on, with times, that exchange
     highlighted (and drawn, for a timing case): the FAIL is shown where it happened."""
+    lo = max(0, ref.first - 60)
+    return where_html_around(findings, ref, list(events[lo : ref.last + 61]), lo, timing)
+
+
+def where_html_around(
+    findings: list[Finding], ref: WireRef, around: list[Event], lo: int, timing: bool
+) -> str:
+    """:func:`where_html` from the events it shows alone: ``around``, the transcript's
+    events ``lo..ref.last+60`` (up to 60 before the exchange, as many after), which a
+    recording read again as it comes gives without a list of every event (issue 22)."""
     worst = max((f.verdict for f in findings), key=lambda v: v.rank)
     rids = ", ".join(dict.fromkeys(f.requirement for f in findings))
-    span = events[ref.first : ref.last + 1]
+    first, last = ref.first - lo, ref.last + 1 - lo
+    span = around[first:last]
     if ref.exchange is None:
         what = "the case's own traffic (no single exchange named or measured)"
         shown = span[:CASE_EXCERPT]
@@ -508,8 +520,8 @@ def where_html(findings: list[Finding], ref: WireRef, events: list[Event], timin
         marked: frozenset[Event] = frozenset()
     else:
         what = f"the exchange {wire_escape(ref.exchange)} (found by {ref.how})"
-        before = _group(events[max(0, ref.first - 60) : ref.first])[-CONTEXT_LINES:]
-        after = _group(events[ref.last + 1 : ref.last + 61])[:CONTEXT_LINES]
+        before = _group(around[:first])[-CONTEXT_LINES:]
+        after = _group(around[last:])[:CONTEXT_LINES]
         shown = [e for g in before for e in g] + span + [e for g in after for e in g]
         tail = ""
         marked = frozenset(span)
@@ -689,8 +701,7 @@ class HtmlReportPlugin:
         """Per exchange, the FAIL/WARN/INCONCLUSIVE findings of the case resting on it."""
         if self.run.link is None:
             return ""
-        events = self.run.link.transcript.events
-        locator = locator_of(self.run.link.transcript)
+        locator = locator_of(self.run.link)
         grouped: dict[WireRef, list[Finding]] = {}
         for f in record.findings:
             if f.verdict in NEEDS_EVIDENCE:
@@ -698,7 +709,11 @@ class HtmlReportPlugin:
                 if ref is not None:
                     grouped.setdefault(ref, []).append(f)
         timing = is_timing_case(record)
-        return "".join(where_html(fs, ref, events, timing) for ref, fs in grouped.items())
+        return "".join(
+            where_html_around(fs, ref, locator.slice(lo, ref.last + 61), lo, timing)
+            for ref, fs in grouped.items()
+            for lo in (max(0, ref.first - 60),)
+        )
 
     def _derived(self, record: CaseRecord) -> tuple[str, list[Event]] | None:
         """For a timing case without evidence, the run's exchange behind its worst finding."""

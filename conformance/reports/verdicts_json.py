@@ -11,14 +11,14 @@ from pathlib import Path
 from typing import Any
 
 from ..dut import DutClaim
-from ..links.bus_time import bus_time
+from ..links.bus_time import bus_time_again
 from ..protocol.version import format_version
 from ..replay.recording import write_recording
 from ..results import counts
 from ..run import TOOL_IDENTITY, ConformanceRun
-from ..transcript import TOOL, Event, EventKind, escape
+from ..transcript import TOOL, EventKind, escape, write_jsonl
 from ..view.segments import memo
-from .evidence import WireRef, wire_refs
+from .evidence import Locator, WireRef, locator_of, wire_refs
 from .margins import distribution_json, margins_json
 from .plan import PLAN_FILE, read_plan
 from .sweep_chart import sweeps_block
@@ -67,11 +67,12 @@ def bus_block(run: ConformanceRun) -> dict[str, Any]:
     link = run.link
     if link is None:
         return {"bus_lower_bound_s": None, "wall_s": None, "efficiency": None}
-    events = link.transcript.events
-    # kept on the transcript: each run of a passive judgement reads the one recording
+    # kept on the transcript: each run of a passive judgement reads the one recording, its
+    # events read again as they come (no list of them: issue 22)
     figures: dict[str, Any] = memo(
-        link.transcript, "_bus_time", len(events), lambda: bus_time(events)
-    ).to_json()
+        link.transcript, "_bus_time", len(link.transcript),
+        lambda: bus_time_again(link.events_again),
+    ).to_json()  # fmt: skip
     elapsed = link.now()
     figures["link_clock_s"] = round(elapsed, 3)
     figures["wall_s"] = None if link.info.virtual_time else round(elapsed, 3)
@@ -93,8 +94,9 @@ def plan_block(directory: Path) -> dict[str, Any] | None:
 
 def build(run: ConformanceRun) -> dict[str, Any]:
     results = run.results or []
-    events = run.link.transcript.events if run.link is not None else None
-    refs = wire_refs(run.cases, run.link.transcript) if run.link is not None else {}
+    # the run's events read through its locator: a recording's as they come again (issue 22)
+    locator = locator_of(run.link) if run.link is not None else None
+    refs = wire_refs(run.cases, run.link) if run.link is not None else {}
     return {
         "schema": SCHEMA,
         "tool": dict(TOOL_IDENTITY),
@@ -145,7 +147,7 @@ def build(run: ConformanceRun) -> dict[str, Any]:
                 "description": c.description,
                 # what the case itself put on the bus: the run beside its plan (issue 24)
                 "bus_s": None if c.bus_s is None else round(c.bus_s, 3),
-                "sent": sent_by(events, c.added) if events is not None else [],
+                "sent": sent_by(locator, c.added) if locator is not None else [],
             }
             for c in run.cases
         ],
@@ -153,14 +155,14 @@ def build(run: ConformanceRun) -> dict[str, Any]:
     }
 
 
-def sent_by(events: list[Event], added: tuple[int, int] | None) -> list[dict[str, Any]]:
-    """The commands the tool sent in ``events[added]``, in first-sent order, each with how
-    often; ``breaks`` counts the breaks in front of them."""
+def sent_by(locator: Locator, added: tuple[int, int] | None) -> list[dict[str, Any]]:
+    """The commands the tool sent in the run's events ``added`` (``locator`` reads them), in
+    first-sent order, each with how often; ``breaks`` counts the breaks in front of them."""
     if added is None:
         return []
     counts: dict[str, dict[str, Any]] = {}
     text, broke = "", False
-    for e in events[added[0] : added[1]]:
+    for e in locator.slice(*added):
         if e.origin != TOOL:
             continue
         if e.kind is EventKind.BREAK:
@@ -207,7 +209,10 @@ def write_transcript(run: ConformanceRun, directory: Path) -> Path:
             # judgement writes the one recording: 43 MB an hour of a busy bus, 3 s to format)
             shutil.copyfile(written[1], path)
         else:
-            write_recording(path, transcript.events, keep=run.link.keeps_written_reading)
+            if run.link.keeps_written_reading:
+                write_recording(path, transcript.events)
+            else:  # written as the events come again: no list of them (issue 22)
+                write_jsonl(str(path), run.link.events_again())
             transcript.__dict__["_written_to"] = (len(transcript), path)
     else:
         path.write_text("", encoding="utf-8")

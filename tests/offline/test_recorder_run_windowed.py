@@ -162,3 +162,19 @@ def test_the_passive_recorder_cases_read_the_windowed_findings(tmp_path, monkeyp
     code = main(["judge", str(path), "--role", "recorder", "--report-dir", str(tmp_path / "r")])
     assert code in (0, 1, 2)
     assert len(made) == 1 and made[0] > 3
+
+
+def test_the_recorder_run_reads_no_list_of_the_recording(monkeypatch):
+    """Issue 22: the recorder's findings come from the recording's events read again as
+    they come (``events_again``), in order and out of it; the transcript's list may be
+    counted and nothing else. The findings are the list's (the whole view's)."""
+    from tests.reports.test_evidence_streamed import Unlisted
+
+    events = _bus()
+    moved = list(events)
+    i = next(i for i, e in enumerate(moved) if e.kind is EventKind.BREAK and i > 40)
+    moved[i], moved[i + 1] = moved[i + 1], moved[i]
+    for given in (events, moved):
+        link = _link(Unlisted(given))
+        monkeypatch.setattr(link, "events_again", lambda given=given: iter(given))
+        assert _alike(recorder_findings(link), _whole(given))
