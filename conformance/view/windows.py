@@ -140,7 +140,22 @@ def stream_window_views(
     break, a window's sides are those: its view is cut with them
     (:func:`~.segments.sided_view`), not inferred a second time."""
     for window, codes in _cut_windows(events, policy, uncertainty):
-        yield window, read_view(window) if codes is None else sided_view(window, codes)
+        yield window, window_view(window, codes)
+
+
+def stream_window_sides(
+    events: Iterable[Event], policy: Policy | None = None, *, uncertainty: float = 0.0
+) -> Iterator[tuple[list[Event], bytearray | None]]:
+    """:func:`stream_windows`' windows, each with its events' sides as the cut inferred them
+    (None: the origins gave them): what a judge that reads some windows again later keeps
+    (one byte an event) to read each one's view again (:func:`window_view`) the same."""
+    return _cut_windows(events, policy, uncertainty)
+
+
+def window_view(window: list[Event], codes: bytearray | None) -> TranscriptView:
+    """The view of ``window`` (one of :func:`stream_window_sides`'), cut with the sides
+    ``codes`` gives where the directions were inferred: :func:`stream_window_views`' view."""
+    return read_view(window) if codes is None else sided_view(window, codes)
 
 
 def _cut_windows(
@@ -224,8 +239,10 @@ def rebuild_windowed(
 __all__ = [
     "SETTLE_BREAKS",
     "rebuild_windowed",
+    "stream_window_sides",
     "stream_window_views",
     "stream_windows",
     "window_events",
     "window_starts",
+    "window_view",
 ]
