@@ -1,11 +1,9 @@
-"""What a recording shows, read once for the passive cases: the role-neutral view, the tool
-recorder's records rebuilt from it, the rule set, and the notes a reader of the verdicts needs.
-
-:class:`HeardSensors` (sensor rules, on what the sensors sent) and :class:`HeardRecorder`
-(recorder rules, on what the recorder sent) stand where the live sessions stand for the
-reports: ``verdicts.json``'s ``dut`` block reads the same attributes (address, identity,
-version, assumptions), so the passive run's reports have the live run's shape.
-"""
+"""The whole-run path of the passive sensor session, ``conformance/offline/heard.py`` as
+base-s61 had it (its memo keys renamed ``_oracle_*`` so that it shares nothing with the
+package's on one loaded recording): the oracle ``tests/offline/test_sensor_windows.py``
+judges the windowed sessions (``conformance.offline.sensor_windows``) against. It cuts the
+whole view, the whole run's segments and records, as the product did before issue 22's
+windowed sensor run."""
 
 from __future__ import annotations
 
@@ -22,8 +20,14 @@ from conformance.declaration import normalise_version
 from conformance.dut import DutClaim, Session, sensor_claim
 from conformance.judges.exchanges import identification
 from conformance.judges.timing import StampUncertainty
+from conformance.offline.decode_quality import decode_quality, rate_of, sensor_characters
 from conformance.preconditions import NOT_SEEN as _NOT_SEEN
-from conformance.protocol.commands import ADDRESS_CHARS, CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
+from conformance.protocol.commands import (
+    ADDRESS_CHARS,
+    CONCURRENT_KINDS,
+    SERVICE_REQUEST_KINDS,
+    Kind,
+)
 from conformance.protocol.responses import Identification
 from conformance.protocol.values import split_values
 from conformance.protocol.version import V14, VERSIONS, format_version, is_v14
@@ -34,7 +38,6 @@ from conformance.transcript import Event
 from conformance.view.rebuilt_records import Rebuilt, rebuild_records, rebuilt_exchanges
 from conformance.view.runs import Segment, transcript_segments, transcript_view
 from conformance.view.segments import TranscriptView, Transmission, memo
-from conformance.offline.decode_quality import decode_quality, rate_of, sensor_characters
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3
@@ -52,7 +55,7 @@ def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     that the wire does not settle (direction, framing), with the first few reasons."""
     notes = list(link.notes)
     if link.decoded is not None:
-        from conformance.offline.judge import describe_decode  # the capture side, only for a capture
+        from conformance.offline.judge import describe_decode  # a capture's side
 
         notes += describe_decode(link.decoded)
     found = view.ambiguities()
@@ -234,7 +237,9 @@ def _per_sensor(link: RecordingLink, address: str | None = None) -> _PerSensor:
     an hour) from the first sensor's run to the end; a run reads its own sensor's only.
     Made again if :func:`release_records` let them go: they are a pure function of the
     recording."""
-    mine = memo(link, "_oracle_per_sensor", len(link.transcript.events), lambda: _PerSensor({}, {}, {}))
+    mine = memo(
+        link, "_oracle_per_sensor", len(link.transcript.events), lambda: _PerSensor({}, {}, {})
+    )
     if address is not None and address not in mine.exchanges:
         view = transcript_view(link.transcript)
         rebuilt = rebuild_records(view, uncertainty=link.uncertainty, only=address)
@@ -332,7 +337,9 @@ def _characters_by_sensor(link: RecordingLink) -> dict[str, list[Event]]:
 def _shared_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     """:func:`recording_notes`, made once per loaded recording (each run gets its own list)."""
     return list(
-        memo(link, "_oracle_notes", len(link.transcript.events), lambda: recording_notes(link, view))
+        memo(
+            link, "_oracle_notes", len(link.transcript.events), lambda: recording_notes(link, view)
+        )
     )
 
 
