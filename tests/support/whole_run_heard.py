@@ -3,36 +3,36 @@ base-s61 had it (its memo keys renamed ``_oracle_*`` so that it shares nothing w
 package's on one loaded recording): the oracle ``tests/offline/test_sensor_windows.py``
 judges the windowed sessions (``conformance.offline.sensor_windows``) against. It cuts the
 whole view, the whole run's segments and records, as the product did before issue 22's
-windowed sensor run."""
+windowed sensor run. What is no whole-run matter it takes from the package (the session's
+base class, the sensors-on fold, a measurement's ``collected``), each a function of what it
+is given alone."""
 
 from __future__ import annotations
 
 import math
 import re
 from bisect import bisect_left
-from collections.abc import Collection, Iterable, Iterator
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass, field
 from itertools import islice, takewhile
 from operator import le
 from typing import Protocol, TypeVar
 
 from conformance.declaration import normalise_version
-from conformance.dut import DutClaim, Session, sensor_claim
+from conformance.dut import DutClaim, sensor_claim
 from conformance.judges.exchanges import identification
-from conformance.judges.timing import StampUncertainty
+from conformance.offline.bus_sensors import BusSensor, sensors_on
 from conformance.offline.decode_quality import decode_quality, rate_of, sensor_characters
+from conformance.offline.heard import Heard
+from conformance.offline.sensor_windows import collected
 from conformance.preconditions import NOT_SEEN as _NOT_SEEN
 from conformance.protocol.commands import (
-    ADDRESS_CHARS,
     CONCURRENT_KINDS,
     SERVICE_REQUEST_KINDS,
     Kind,
 )
-from conformance.protocol.responses import Identification
-from conformance.protocol.values import split_values
-from conformance.protocol.version import V14, VERSIONS, format_version, is_v14
+from conformance.protocol.version import VERSIONS, format_version
 from conformance.replay.recording_link import RecordingLink
-from conformance.tool_recorder import validity
 from conformance.tool_recorder.records import Exchange, Measurement
 from conformance.transcript import Event
 from conformance.view.rebuilt_records import Rebuilt, rebuild_records, rebuilt_exchanges
@@ -41,9 +41,6 @@ from conformance.view.segments import TranscriptView, Transmission, memo
 
 #: ambiguity reasons quoted in the notes (the count is always given)
 AMBIGUITIES_SHOWN = 3
-LAST_INDEX = 9  # aD9!: the last data command after aM!/aC!
-LAST_HV_INDEX = 999  # aD999!/aDB999!: the last after aHA!/aHB!
-EMPTY_PACKET = 6  # bytes of a binary packet holding no value (address, size, type, CRC)
 #: What a rule whose stimulus the recording lacks is told (INCONCLUSIVE, never PASS): the
 #: wording of the ``heard`` precondition (conformance/preconditions.py), re-exported here.
 NOT_SEEN = _NOT_SEEN
@@ -67,110 +64,6 @@ def recording_notes(link: RecordingLink, view: TranscriptView) -> list[str]:
     else:
         notes.append("no ambiguous split in the recording (every direction and reply is clear)")
     return notes
-
-
-@dataclass
-class Heard(Session):
-    """What both roles' passive cases share: the recording and its view."""
-
-    link: RecordingLink
-    view: TranscriptView
-    forced_version: str | None = None
-    assumptions: list[str] = field(default_factory=list)
-    address: str | None = None
-    identity: Identification | None = None
-    ident_exchange: Exchange | None = None
-    address_notes: list[str] = field(default_factory=list)
-    #: every sensor on the bus (``--address`` or not), for ``verdicts.json``'s ``duts``
-    on_bus: list[BusSensor] = field(default_factory=list)
-
-    def bus_sensors(self) -> list[tuple[str, DutClaim]]:
-        return [(s.address, s.claim()) for s in self.on_bus]
-
-    @property
-    def uncertainty(self) -> float:
-        return self.link.uncertainty
-
-    @property
-    def stamp_uncertainty(self) -> StampUncertainty:
-        """The recording's uncertainty; for a host-stamped transcript also a (flat) local
-        figure, which makes the timing judges treat it as the real-time link it was: a rare
-        deviation among many conforming observations may be a stall of the recording host,
-        decided by where it falls, and INCONCLUSIVE when that cannot tell (a recording cannot
-        be probed again). A monitor's transcript FAILed R-7.0-12 on one stalled stamp."""
-        u = self.link.uncertainty
-        if self.link.host_stamped:
-            return StampUncertainty(u, local=lambda _start, _end: u)
-        return StampUncertainty(u)
-
-    @property
-    def version(self) -> str:
-        """The rule set: --sdi-version > the ``ll`` of an ``aI!`` reply seen > v1.4 (said)."""
-        if self.forced_version:
-            return self.forced_version
-        if self.identity is not None and self.identity.version in VERSIONS:
-            return self.identity.version
-        return V14
-
-    @property
-    def is_v14(self) -> bool:
-        return is_v14(self.version)
-
-
-@dataclass(frozen=True)
-class BusSensor:
-    """A sensor the recording shows answering: its address and its ``aI!`` reply, if one
-    was heard (``identity``: parsed; ``reply``: as heard)."""
-
-    address: str
-    identity: Identification | None = None
-    reply: str | None = None
-
-    def claim(self) -> DutClaim:
-        version = self.identity.version if self.identity is not None else None
-        return DutClaim(self.identity, self.reply, version if version in VERSIONS else None)
-
-
-def sensors_on(exchanges: Iterable[Exchange]) -> list[BusSensor]:
-    """The sensors whose replies the recording holds, in address order. A sensor is known by
-    the address it first answered at: an accepted ``aAb!`` moves it, not a new sensor (a
-    sensor run moves its DUT and back), so its later replies at ``b`` are its own."""
-    found = SensorsOn()
-    found.add(exchanges)
-    return found.sensors()
-
-
-class SensorsOn:
-    """:func:`sensors_on` of a recording read a window at a time (issue 22's windowed
-    judge): each window's exchanges :meth:`add`-ed in order, the sensors those of the whole
-    recording's exchanges. Carried across windows: where each moved sensor answers now, and
-    each sensor heard (with its first valid ``aI!`` reply), nothing of a window's events."""
-
-    def __init__(self) -> None:
-        self.moved: dict[str, str] = {}  # address now -> the address it was first heard at
-        self.seen: dict[str, BusSensor] = {}
-
-    def add(self, exchanges: Iterable[Exchange]) -> None:
-        """The exchanges of the next window of the recording, in order."""
-        moved, seen = self.moved, self.seen
-        for ex in exchanges:
-            said = ex.reply_text[:1] if ex.answered else ""
-            if not said or said not in ADDRESS_CHARS or ex.command is None:
-                continue
-            if ex.command.kind is Kind.CHANGE_ADDRESS and said == ex.command.new_address:
-                moved[said] = moved.get(ex.command.address, ex.command.address)
-                continue
-            home = moved.get(said, said)
-            if home not in seen:
-                seen[home] = BusSensor(home)
-            if ex.command.kind is Kind.IDENTIFY and seen[home].identity is None:
-                ident, _ = identification(ex, said)
-                if ident is not None and ident.version in VERSIONS:
-                    seen[home] = BusSensor(home, ident, ex.reply_text)
-
-    def sensors(self) -> list[BusSensor]:
-        """The sensors heard so far, in address order."""
-        return [self.seen[a] for a in sorted(self.seen, key=ADDRESS_CHARS.index)]
 
 
 @dataclass
@@ -462,34 +355,9 @@ def disturbance(m: Measurement, view: TranscriptView) -> str | None:
     if first.address != m.command.address or index is None or index[1] != 0:
         # the records follow a measurement's data only while nothing else comes between
         return first.text
-    if not _collected(m):
+    if not collected(m):
         return "the recorder stopped asking for data while values were due"
     return None
-
-
-def _collected(m: Measurement) -> bool:
-    """Whether the recorder asked until the sensor had no more to give (every announced
-    value in, an empty reply or packet, or the last index), as the tool recorder does: a
-    recorder that stopped sooner leaves the count rules without their stimulus."""
-    if not m.data or m.count is None:
-        return False
-    last = m.data[-1]
-    if not last.answered:
-        return True  # a silent data command: the sensor's doing, judged as such
-    if m.binary:
-        if m.binary_value_count >= m.count:
-            return True
-        return (
-            len(last.reply_bytes) <= EMPTY_PACKET
-            or last.command is None
-            or (last.command.index is not None and last.command.index >= LAST_HV_INDEX)
-        )
-    if m.value_count >= m.count:
-        return True
-    text = validity.data_values_text(last.reply_text, m.command.returns_crc)
-    index = last.command.index if last.command is not None else None
-    limit = LAST_HV_INDEX if m.command.kind is Kind.HIGH_VOLUME_ASCII else LAST_INDEX
-    return not split_values(text) or (index is not None and index >= limit)
 
 
 def _identify(heard: HeardSensors) -> None:
