@@ -30,7 +30,6 @@ from ..judges.recorder.retries import Retries
 from ..transcript import Event, EventKind
 from ..verdicts import Finding
 from ..view.segments import TranscriptView, memo, read_view
-from ..view.windows import stream_window_views
 
 if TYPE_CHECKING:
     from ..replay.recording_link import RecordingLink
@@ -110,15 +109,18 @@ def _plain(events: Sequence[Event]) -> Iterator[Event]:
 
 
 def recorder_findings(link: RecordingLink) -> RecorderFindings:
-    """:func:`judge_windows` over the windows of ``link``'s recording, made once per
-    loaded recording (every recorder case reads it)."""
+    """:func:`judge_views` over the windows of ``link``'s recording, made once per loaded
+    recording (every recorder case reads it): the windows the bus pass cut
+    (:func:`~.sensor_windows.bus_windows`, which the sensors on the bus and the notes read
+    too), each window's view read again from its events and the sides the cut inferred,
+    the views :func:`~conformance.view.windows.stream_window_views` gives (not cut again)."""
+    from .sensor_windows import bus_windows
 
     def judge() -> RecorderFindings:
-        events = by_start_again(link.events_again)  # no list of them read (issue 22)
-        cut = stream_window_views(events, uncertainty=link.uncertainty)
-        return judge_views((view for _window, view in cut), link.uncertainty)
+        bus = bus_windows(link)
+        return judge_views(map(bus.view, range(len(bus))), link.uncertainty)
 
-    return memo(link, "_recorder_findings", len(link.transcript), judge)
+    return memo(link, "_recorder_findings", len(link.transcript.events), judge)
 
 
 __all__ = [

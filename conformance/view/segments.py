@@ -465,23 +465,37 @@ class TranscriptView:
         return list(self._sorted("_ambiguities", self._find_ambiguities))
 
     def _find_ambiguities(self) -> list[Ambiguity]:
-        found: list[Ambiguity] = []
-        for e in self.undirected:
-            found.append(Ambiguity("direction unknown: no protocol cue", e.start, (e,)))
+        found = [undirected_ambiguity(e) for e in self.undirected]
         if self.unanswerable:
-            first = self.unanswerable[0]
-            found.append(
-                Ambiguity(
-                    f"{len(self.unanswerable)} sensor character(s) with no command to answer "
-                    "(before any command, or right after a break)",
-                    first.start,
-                    tuple(self.unanswerable),
-                )
-            )
+            found.append(unanswerable_ambiguity(self.unanswerable, len(self.unanswerable)))
+        found += self.transmission_ambiguities()
+        return sorted(found, key=lambda a: a.at)
+
+    def transmission_ambiguities(self) -> list[Ambiguity]:
+        """The ambiguities of the view's transmissions (their replies' splits), in order:
+        those of :meth:`ambiguities` that each window of a recording read alone gives as
+        the whole view does (issue 22's windowed notes)."""
         requests = {id(e) for sr in self.service_requests() for e in sr.events}
+        found: list[Ambiguity] = []
         for t in self.transmissions:
             found += _transmission_ambiguities(t, requests)
-        return sorted(found, key=lambda a: a.at)
+        return found
+
+
+def undirected_ambiguity(e: Event) -> Ambiguity:
+    """The ambiguity of a character whose direction the protocol does not settle."""
+    return Ambiguity("direction unknown: no protocol cue", e.start, (e,))
+
+
+def unanswerable_ambiguity(unanswerable: Sequence[Event], count: int) -> Ambiguity:
+    """The one ambiguity of a view's ``count`` sensor characters with no command to answer,
+    at the first of them (``unanswerable``: those of them kept, the first among them)."""
+    return Ambiguity(
+        f"{count} sensor character(s) with no command to answer "
+        "(before any command, or right after a break)",
+        unanswerable[0].start,
+        tuple(unanswerable),
+    )
 
 
 def _transmission_ambiguities(t: Transmission, requests: set[int]) -> list[Ambiguity]:

@@ -1,6 +1,6 @@
 """A passive judgement of a bus lets each sensor's rebuilt records go once that sensor is
 judged, and all of them before the recorder's run (issue 22, bounded memory): the recorder
-rules read the view only, and keeping every sensor's records to the end held them all at
+rules read none of them, and keeping every sensor's records to the end held them all at
 that run's peak. What is released is a pure function of the recording, so a run that asks
 for it again gets it rebuilt, the same: never fewer records, never other notes."""
 
@@ -32,16 +32,16 @@ def test_released_records_are_the_same_when_asked_again(capture: Path):
     link = _load(capture)
     before = {a: heard.hear_sensors(link, a, None) for a in "0369"}
     heard.release_records(link, keep={"6"})
-    assert "_heard_records" not in link.__dict__  # the whole lists let go
-    mine = link.__dict__["_per_sensor"][1]
-    assert set(mine.exchanges) == {"6"}
+    mine = link.__dict__["_sensor_records"][1]
+    assert set(mine) == {"6"}
     for a, session in before.items():  # kept or rebuilt, each the same
         again = heard.hear_sensors(link, a, None)
         assert _records(again) == _records(session) and again.exchanges
         assert again.assumptions == session.assumptions
         assert again.on_bus == session.on_bus
     recorder = heard.hear_recorder(link, None)
-    assert recorder.view is before["0"].view  # the one cut, never made again
+    assert recorder.view is None and before["0"].view is None
+    assert "_view" not in link.transcript.__dict__  # no whole-run view was ever cut
 
 
 def test_a_late_quality_note_is_the_one_made_with_the_others(capture: Path):
@@ -49,7 +49,7 @@ def test_a_late_quality_note_is_the_one_made_with_the_others(capture: Path):
     its note made alone: the same words."""
     whole = heard.hear_sensors(_load(capture), "4", None).assumptions
     link = _load(capture)
-    heard._per_sensor(link)
+    heard.sensors_records(link, "0")
     heard.release_records(link, keep=set())
     assert heard.hear_sensors(link, "4", None).assumptions == whole
 
@@ -71,7 +71,7 @@ def test_a_judgement_holds_no_sensor_records_at_the_recorder_run(
         if job.role == "recorder":
             link = _LOADED[port]
             seen["held"] = sorted(k for k in link.__dict__ if k in ("_heard_records",))
-            seen["shares"] = sorted(link.__dict__["_per_sensor"][1].exchanges)
+            seen["shares"] = sorted(link.__dict__["_sensor_records"][1])
             gc.collect()
             seen["alive"] = sum(1 for o in gc.get_objects() if _of(o, link))
         return run_role(job, port, args, console)
@@ -101,8 +101,8 @@ def test_a_sensors_run_holds_no_other_sensors_records(
 
     def hearing(link, address, version):
         session = hear(link, address, version)
-        mine = link.__dict__["_per_sensor"][1]
-        held[address] = ("_heard_records" in link.__dict__, sorted(mine.exchanges))
+        mine = link.__dict__["_sensor_records"][1]
+        held[address] = ("_heard_records" in link.__dict__, sorted(mine))
         return session
 
     monkeypatch.setattr(heard, "hear_sensors", hearing)
