@@ -398,6 +398,11 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     # command's character) were judged unanswered (4 false FAILs), and the restore, reading
     # no answer, stopped the run; past it R-4.4.3-01, R-4.3-03 and R-4.4.12-04 were false too
     ("replies-after-retry", "slow-wake"),
+    # (truth22, seed 6200 with metadata-semicolon-in-field) R-5.3-01 PASSed beside
+    # buffer-cleared-after-read, which declares it undecided: aHA!'s pages past D9 are never
+    # read, so its buffer is never emptied and the control read shows values up to the
+    # abort; a true PASS on the wire, declared (interactions: the pair removes it)
+    ("buffer-cleared-after-read", "high-volume-stops-at-d9"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
