@@ -1055,7 +1055,11 @@ class Framing:
         for seg in segs:
             pending = self._pending
             if pending is not None:
-                cut = bool(seg.contention) or maybe_met(pending, seg, self.stamps.base)
+                cut = (
+                    bool(seg.contention)
+                    or pending.met_by is not None
+                    or maybe_met(pending, seg, self.stamps.base)
+                )
                 self._judge(pending, cut=cut)
             self._pending = seg
 

@@ -435,6 +435,15 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("answers-old-address", "replies-after-retry"),
     ("continuous-overwrites-data", "replies-after-retry"),
     ("metadata-crc-sticks", "replies-after-retry"),
+    # (truth22, seed 6200 with metadata-semicolon-in-field) R-5.3-01 PASSed beside
+    # buffer-cleared-after-read, which declares it undecided: aHA!'s pages past D9 are never
+    # read, so its buffer is never emptied and the control read shows values up to the
+    # abort; a true PASS on the wire, declared (interactions: the pair removes it)
+    ("buffer-cleared-after-read", "high-volume-stops-at-d9"),
+    # (truth22, seed 6202) a 0! poll's retried try went unanswered and its late '0<CR><LF>'
+    # landed in 0A2!'s window, read as a refusal naming the old address: "refused or lost
+    # address(es) 2" FAILed R-4.3-03 (the sweep took only replies after the window as late)
+    ("concurrent-zero", "parity-error", "replies-after-retry"),
 )
 
 CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (

@@ -50,6 +50,8 @@ class Segment:
     binary_reply: bool = False  # replies to aDBn! are 8N1 packets (no 7E1, no CR LF)
     #: the sensor's breaks after the command (:attr:`Transmission.sensor_breaks`)
     sensor_breaks: tuple[Event, ...] = ()
+    #: the recorder's break that met the reply still coming (:attr:`Transmission.met_by`)
+    met_by: Event | None = None
 
     @property
     def command_end(self) -> float:
@@ -84,6 +86,7 @@ class Segment:
             text=t.text,
             binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
             sensor_breaks=t.sensor_breaks,
+            met_by=t.met_by,
         )
         heard = t.heard
         if not is_command:  # asked once, not per character heard

@@ -117,6 +117,11 @@ class Transmission:
     #: its reply). No character of any reply; what R-7.0-09 reads as the first spacing the
     #: sensor put on the line after the command (a UART would take it for a start bit).
     sensor_breaks: tuple[Event, ...] = ()
+    #: The recorder's own break that sensor characters were heard inside while this
+    #: transmission's reply was still open (no LF): the break met the reply still coming,
+    #: whatever gap the stamps show before it (:func:`_met_by_break`). Not :attr:`cut_by`,
+    #: which the recorder-role judges read for a break begun within a character of it.
+    met_by: Event | None = None
 
     def __post_init__(self) -> None:
         # every derived value kept here, named up front in one order: the instances'
@@ -735,10 +740,28 @@ class Cut:
                     current.heard.append(e)
                 else:
                     unanswerable.append(e)
+                    if pending is not None and transmissions:
+                        _met_by_break(transmissions[-1], pending, e)
             elif current is not None:  # a sensor's break (rare: a tuple made anew is enough)
                 current.sensor_breaks += (e,)
         self._pending, self._current = pending, current
         self._is_command, self._after_bang, self._last_heard = is_command, after_bang, last_heard
+
+
+def _met_by_break(before: Transmission, brk: Event, e: Event) -> None:
+    """Set ``before.met_by`` to the recorder's break ``brk`` where the sensors' character
+    ``e``, heard after it began and before any character followed it, began inside it and
+    ``before``'s reply was still open (its last character no LF): the break met a reply
+    still coming, whatever gap the stamps show before it. Behind an echoing interface with
+    0..2 ms jitter, on a loaded host, slow-wake's '0,XH,mV,channel 107;...' to 0IHA_107!
+    reached the tool as '0,X', 74 ms of nothing, then the rest in a burst: the tool's retry
+    break met 'H,mV,chann', and R-4.2-03 FAILed "reply '0,X' does not end with CR LF"
+    (truth22)."""
+    heard = before.heard
+    if before.met_by is not None or not heard or heard[-1].char7 == LF:
+        return
+    if brk.start <= e.start < brk.end + max(e.uncertainty, brk.uncertainty):
+        before.met_by = brk
 
 
 def _cut_into(last: Event | None, first: Event) -> Event | None:

@@ -167,6 +167,21 @@ def _about(ex: Exchange, address: str, sweep: Sweep) -> bool:
     return f"A{address}!" in ex.text or (address in sweep.unanswered and ex.text == f"{address}!")
 
 
+def _late_refusals(refused: list[str], asked: list[Exchange], sweep: Sweep) -> set[str]:
+    """Of ``refused``, the addresses whose change, or poll there, was answered late
+    (:func:`~conformance.judges.late_before.answered_late`): its reply came only after the
+    reply window (it ran into the retries: replies-after-retry's '1<CR><LF>' to 0A1!), or
+    the reply it took may be the command before's, late. Such a change was not shown
+    refused, nor an address shown lost: R-7.0-10's deviation. Beside parity-error and
+    concurrent-zero, the third try of a 0! (its second try's reply, a bad-parity LF, was
+    retried) went unanswered and its '0<CR><LF>' came 80 ms later, in 0A2!'s window: read
+    as 0A2!'s answer naming the old address, "refused or lost address(es) 2" FAILed
+    R-4.3-03 though the restore found the sensor at '2' (seed 6202, truth22)."""
+    return {
+        r for r in refused if any(judge.answered_late(ex) for ex in asked if _about(ex, r, sweep))
+    }
+
+
 def _took_unheard(rid: str, found: list[str], asked: list[Exchange]) -> Finding:
     """INCONCLUSIVE for the addresses the sensor took with no reply heard: the restore found
     it there (it answered at its own address only after the move back from each). The
@@ -217,12 +232,7 @@ def test_address_range(sensor, case):
         pass  # "lost" rests on silence to a!, which this sensor never answers
     elif refused:
         asked = [ex for ex in sweep.exchanges if any(_about(ex, r, sweep) for r in refused)]
-        # a change whose reply came only after the reply window (it ran into the retries:
-        # replies-after-retry's '1<CR><LF>' to 0A1!) was not refused, nor an address taken
-        # whose b! polls were answered only late lost: R-7.0-10's deviation
-        late = {
-            r for r in refused if any(judge.late_answer(ex) for ex in asked if _about(ex, r, sweep))
-        }
+        late = _late_refusals(refused, asked, sweep)
         found = [r for r in refused if r in sweep.found_at and r not in late]
         if found and set(refused) <= late | set(found):
             case.add(_took_unheard("R-4.3-03", found, asked))
