@@ -594,6 +594,12 @@ class Measurements:
             for rid in tally.ids:
                 tally.undecide(rid, where(m), soon)
             return
+        if not m.start.answered and (late := answered_late(m.start)):
+            # its reply came only after the window: its form is unread, so the other starts'
+            # PASS does not stand for it (unknown-command-text's text to 0C1!..0C9! came only
+            # late beside replies-after-retry: R-4.4.7-01 PASSed "2 checked: 0C!, 0CC!")
+            for rid in _reply_ids(m):
+                tally.undecide(rid, where(m), f"{late} (R-7.0-10 judges its timing)")
         tally.observe(
             where(m),
             reply_violations(m, self.version),

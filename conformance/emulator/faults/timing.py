@@ -29,6 +29,10 @@ LATE_REPLY_UNDECIDED = (
     # plain D reply after it read in its window (truth21)
     "R-4.4.5-10",
     "R-4.4.12-03",
+    # aMC1!..aMC9! and aCC1!..aCC9! answered only late: their start replies' form unread, so
+    # the starts read in their windows do not PASS it for them (stop 56)
+    "R-4.4.5-01",
+    "R-4.4.7-01",
     "R-4.4.9-01",
     "R-4.4.10-01",
     "R-4.4.12-01",
