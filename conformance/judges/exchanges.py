@@ -52,6 +52,7 @@ from .late_before import (
 from .measurements import shown_reply_ids, undecide_uncompared_crc
 from .support import serves_continuous, text_instead_of_values
 from .tally import Tally
+from .wake_heard import unheard
 from .wire import EARLY_WINDOW
 
 
@@ -64,6 +65,8 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
         return inconclusive(
             rid, f"{what}: {late} (R-7.0-10 judges its timing)", evidence=[cited(ex)]
         )
+    if why := unheard(ex):
+        return inconclusive(rid, f"{what}: {why}", evidence=[cited(ex)])
     if not ex.answered:
         return failed(rid, f"{what}: no reply", evidence=[cited(ex)], observed=1)
     body, framing = split_line(ex.reply_text)
@@ -81,6 +84,8 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
 
 def identification(ex: Exchange, address: str) -> tuple[Identification | None, list[Finding]]:
     ids = ("R-4.4.2-01", "R-4.4.2-02")
+    if why := unheard(ex):
+        return None, [inconclusive(rid, why, evidence=[cited(ex)]) for rid in ids]
     if not ex.answered:
         return None, [
             failed(rid, "aI! got no reply", evidence=[cited(ex)], observed=1) for rid in ids
@@ -223,13 +228,16 @@ def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     retries: a sensor whose every reply starts 80 ms late, deaf until then) is no "got no
     reply": undecided for ``ids`` on ``tally`` (INCONCLUSIVE unless something else FAILs them;
     R-7.0-10 judges the timing). True when it was; a silent exchange is left to FAIL. So is
-    one answered with what may be the command before's late reply (:func:`answered_late`)."""
+    one answered with what may be the command before's late reply (:func:`answered_late`).
+    And one no try of which went when the sensor must have been awake to hear it
+    (:func:`~conformance.judges.wake_heard.unheard`: each soon after a break of its own)."""
     late = answered_late(ex)
-    if not late:
+    why = f"{late} (R-7.0-10 judges its timing)" if late else unheard(ex)
+    if not why:
         return False
     label = escape(ex.text)
     for rid in ids:
-        tally.undecide(rid, label, f"{late} (R-7.0-10 judges its timing)")
+        tally.undecide(rid, label, why)
     return True
 
 
@@ -306,7 +314,17 @@ def answered(
         if not (ex.attempts[0].reply_events if first_attempt else ex.answered)
     ]
     late = [ex for ex in missing if late_is_reply and late_reply(ex)]
-    missing = [ex for ex in missing if ex not in late]
+    # silence to tries none of which the sensor was awake to hear is no evidence; a rule on
+    # the first transmission is about that wake-up itself
+    deaf = [ex for ex in missing if ex not in late and not first_attempt and unheard(ex)]
+    missing = [ex for ex in missing if ex not in late and ex not in deaf]
+    if deaf and not missing:
+        return inconclusive(
+            rid,
+            "; ".join(unheard(e) for e in deaf[:3]),
+            evidence=cite(deaf),
+            observed=len(deaf),
+        )
     if late and not missing:
         return inconclusive(
             rid,

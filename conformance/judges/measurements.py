@@ -34,6 +34,7 @@ from .late_before import (
 )
 from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
+from .wake_heard import unheard
 from .wire import runs
 
 SR_MARGIN_MIN = 1.0  # s: R-4.4.5-09 margin always tolerated (SR transmission, clock drift)
@@ -301,14 +302,17 @@ def _not_this_ds_reply(m: Measurement, ex: Exchange, tally: Tally, dlabel: str) 
     """'' unless what the D exchange ``ex`` took may not be its reply, its rules undecided
     then: "late" (the reply came after the tool stopped listening, or the one taken may be
     the D before's) or "soon" (a service request's words begun too soon to answer it)."""
-    if taken_late := answered_late(ex):
+    taken_late = answered_late(ex)
+    why = f"{taken_late} (R-7.0-10 judges its timing)" if taken_late else unheard(ex)
+    if why:
         # its reply came after the tool stopped listening, or the one taken may be the D
         # before's: no silence, no count cut short, no values of its own to judge
         # (replies-after-retry + wrong-crc: "0C9! 0D6!: no reply to 0D6!" and "60 values
-        # were returned for 99 announced" FAILed on a D6 whose reply met the retry, truth15)
+        # were returned for 99 announced" FAILed on a D6 whose reply met the retry, truth15);
+        # nor silence to tries the sensor was not awake to hear (:func:`unheard`, truth23)
         hv = ["R-5.1-02"] if m.command.kind is Kind.HIGH_VOLUME_ASCII else []
         for rid in ("R-4.4.8-01", "R-4.4.8-03", *hv):
-            tally.undecide(rid, dlabel, f"{taken_late} (R-7.0-10 judges its timing)")
+            tally.undecide(rid, dlabel, why)
         return "late"
     if m.count and (soon := service_request_too_soon(ex) or _request_owed_late(m, ex)):
         # values announced, and what came may be a service request, not this D's reply

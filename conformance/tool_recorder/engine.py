@@ -727,7 +727,7 @@ class ToolRecorder:
         p = self.policy
         prev = exchange.last
         assert prev.command_end is not None
-        base = prev.reply_events[-1].end if prev.reply_events else prev.end
+        base = prev.reply_events[-1].end if prev.reply_events else _timed_out(prev, p)
         time = max(prev.command_end + RETRY_MIN + p.window_margin, base + p.retry_gap)
         if not prev.reply_events:
             time = min(time, prev.command_end + RETRY_MAX - p.window_margin)
@@ -737,6 +737,28 @@ class ToolRecorder:
         if is_last and not any(a.command_events[0].start > wake for a in retries):
             time = max(time, wake)
         return max(time, self.link.now())
+
+
+#: how far past its first-character deadline a silent try's read may end and still count
+#: from its own end (float rounding, a virtual clock's exact stop)
+READ_OVERSHOOT_SLACK = 1e-6
+
+
+def _timed_out(prev: Attempt, p: Policy) -> float:
+    """Where a try that drew no reply stopped listening, for the retry gap to count from:
+    its first-character deadline, not the end of a read that a real link let run past it.
+    Over RFC 2217 behind a jittery echoing link on a loaded host a silent read ended 15-25
+    ms past its 30 ms deadline; counted from there, each retry came back more than 87 ms
+    after the command, the break rule put a break in front of every one, and a sensor that
+    needs up to 100 ms after a break (R-7.0-07) heard no try at all (truth23: slow-wake's
+    '0IM_000! got no reply', 9 tries, each 9-20 ms after a break of its own). A try whose read
+    went on through characters that met it (``stray_events``: a late reply colliding with
+    it) keeps its read's end: the retry waits for them."""
+    assert prev.command_end is not None
+    due = prev.command_end + p.first_char_timeout
+    if prev.stray_events or prev.end - due <= READ_OVERSHOOT_SLACK:
+        return prev.end  # it read on through characters that met the command: after them
+    return due
 
 
 def _raises_sr(command: Command) -> bool:

@@ -17,6 +17,7 @@ from conformance.judges.exchanges import (
 )
 from conformance.judges.retention import retained
 from conformance.judges.support import announced_ttt, empty_data_reply, first_filled
+from conformance.judges.wake_heard import first_sequence_unheard, unheard
 from conformance.judges.wire import runs
 from conformance.protocol.commands import C_FAMILY, HV_FAMILY, M_FAMILY
 from conformance.protocol.responses import is_service_request, split_line
@@ -383,6 +384,12 @@ def test_break_aborts_measurement(sensor, case):
     )
     if late is not None and again.value_count < target.value_count:
         case.add(late)
+    elif why := unheard(again.start, brk2) or first_sequence_unheard(again.start, brk2):
+        case.add(
+            inconclusive(
+                "R-4.4.5.1-03", why, evidence=[f"t={brk2.start:.4f} s: break", cited(again.start)]
+            )
+        )
     elif not again.start.answered:
         case.add(
             failed(
