@@ -18,7 +18,7 @@ more than those tries' marking after a break (:func:`wake_shown`).
 from __future__ import annotations
 
 from ..protocol.timing import TOLERANCE, WAKE_LIMIT
-from ..tool_recorder.records import Attempt, Exchange
+from ..tool_recorder.records import CONTENTION, Attempt, Exchange
 from ..transcript import Event, escape
 
 #: marking after a break (s) under which a compliant sensor may still be waking (R-7.0-07)
@@ -70,21 +70,28 @@ def unheard(ex: Exchange, brk: Event | None = None) -> str:
     retries, and every try began less than :func:`wake_shown` after the break before it (the
     upper end of its uncertainty included), so none went when the sensor must have been awake
     to hear it. A try with no break before it in ``ex`` (nor ``brk``) went while the
-    sensor was awake from before, as the engine's break rule judged: evidence."""
+    sensor was awake from before, as the engine's break rule judged: evidence. A try the
+    sensor's characters met (bus contention) is neither silence nor an answer: set aside, as
+    the engine sets it aside (slow-wake behind the jittery link: the tool's own 0IMC3! came
+    back stalled 58 ms inside, the sensor's '00000' met its echo, the four retries each
+    went 11-16 ms after a break of their own, and R-6.1-01 FAILed "no reply", truth23)."""
     if ex.answered or len(ex.attempts) < 2 or any(a.reply_events for a in ex.attempts):
         return ""
     tries = markings(ex, brk)
-    known = [m for _, m, _ in tries if m is not None]
-    if not tries or len(known) < len(tries):
+    quiet = [(a, m, u) for a, m, u in tries if not a.reason.startswith(CONTENTION)]
+    if not quiet:
         return ""
     need = wake_shown(ex, brk)
-    if any(m is not None and m - u >= need for _, m, u in tries):
+    if any(m is None or m - u >= need for _, m, u in quiet):
         return ""
+    known = [m for _, m, _ in quiet if m is not None]
     lo, hi = min(known) * 1e3, max(known) * 1e3
+    met = len(tries) - len(quiet)
+    aside = f" ({met} more met by the sensor's characters)" if met else ""
     return (
-        f"{escape(ex.text)}: none of its {len(tries)} tries went when the sensor must have been"
-        f" awake: each began {lo:.2f}-{hi:.2f} ms after the break before it, under the "
-        f"{need * 1e3:.1f} ms a sensor may need to wake (R-7.0-07 judges that), so its "
+        f"{escape(ex.text)}: none of its {len(quiet)} tries{aside} went when the sensor must"
+        f" have been awake: each began {lo:.2f}-{hi:.2f} ms after the break before it, under"
+        f" the {need * 1e3:.1f} ms a sensor may need to wake (R-7.0-07 judges that), so its "
         "silence shows nothing"
     )
 
@@ -111,4 +118,31 @@ def first_sequence_unheard(ex: Exchange, brk: Event) -> str:
         f"{escape(ex.text)}'s tries without a break of their own began {shown} ms after the "
         f"aborting break, under the {need * 1e3:.1f} ms this sensor was shown to need to wake"
         " (R-7.0-07 judges that), so their silence shows nothing of the abort"
+    )
+
+
+def woken_unheard(tries: list[Exchange], brk: Event, uncertainty: float) -> str:
+    """Why silence to ``tries`` (single transmissions after ``brk``, none behind a break of
+    its own) does not show that ``brk`` failed to wake the sensor ('' when it does): none
+    began surely more than 100.4 ms after the break (a woken sensor may need that long,
+    R-7.0-07) and surely less than 100 ms (-0.4) after the line's previous activity (the
+    try before, where a woken sensor is back in standby, R-7.0-15). slow-wake behind the
+    jittery echoing link: the case's retries, meant 40 and 60 ms after the try before, went
+    225 and 253 ms after it on the loaded host, and R-7.0-04 FAILed "no reply to a! or 2
+    retries after a 12.61 ms break" (truth23)."""
+    before = brk.end
+    seen = []
+    for ex in tries:
+        first = ex.attempts[0].command_events if ex.attempts else []
+        if not first:
+            return ""
+        start = first[0].start
+        woke, idle = start - brk.end, start - before
+        seen.append(f"{woke * 1e3:.2f} ms after the break, {idle * 1e3:.2f} ms after the last")
+        if woke - uncertainty >= WAKE_NEED and idle + uncertainty < WAKE_LIMIT - TOLERANCE:
+            return ""
+        before = first[-1].end
+    return (
+        "no try went while a sensor woken by the break must have been listening (over 100.4 "
+        "ms after it, under 99.6 ms after the line's last activity): " + "; ".join(seen)
     )

@@ -14,6 +14,7 @@ import pytest
 from conformance import preconditions as precondition
 from conformance.judges import exchanges as judge
 from conformance.judges.timing import not_listening
+from conformance.judges.wake_heard import woken_unheard
 from conformance.protocol.timing import (
     BREAK_ALWAYS,
     BREAK_NEVER,
@@ -307,6 +308,8 @@ def test_break_just_over_12ms_wakes(sensor, case):
                 observed=len(tries),
             )
         )
+    elif why := woken_unheard(tries, brk, sensor.uncertainty):
+        case.add(inconclusive("R-7.0-04", why, evidence=judge.cite(tries)))
     else:
         case.add(
             failed(

@@ -12,10 +12,15 @@ from __future__ import annotations
 
 from conformance.judges import exchanges as xjudge
 from conformance.judges import metadata
-from conformance.judges.wake_heard import first_sequence_unheard, unheard, wake_shown
+from conformance.judges.wake_heard import (
+    first_sequence_unheard,
+    unheard,
+    wake_shown,
+    woken_unheard,
+)
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
-from conformance.tool_recorder.records import NO_REPLY, OK, Attempt, Exchange
+from conformance.tool_recorder.records import CONTENTION, NO_REPLY, OK, Attempt, Exchange
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from conformance.verdicts import Finding, Verdict
 
@@ -183,3 +188,56 @@ def test_abort_m_answered_in_the_first_sequence_needs_nothing() -> None:
     brk2, ex = _after_abort(0.2088)
     ex.attempts[2].reply_events = list(ex.attempts[5].reply_events)
     assert first_sequence_unheard(ex, brk2) == ""
+
+
+def test_a_try_met_by_the_sensors_characters_is_set_aside() -> None:
+    """0IMC3!'s own echo stalled 58 ms inside, the sensor's '00000' met it (contention), and
+    the four retries each went 11-16 ms after a break of their own: R-6.1-01 FAILed."""
+    ex = _exchange(
+        "0IMC3!",
+        [(None, 152.5565, 0, 0)]
+        + [
+            (b, b + d, 1 + i // 3, i % 3)
+            for i, (b, d) in enumerate(
+                [(152.8012, 0.0114), (152.9999, 0.0163), (153.1836, 0.0108), (153.3787, 0.0119)]
+            )
+        ],
+    )
+    first = ex.attempts[0]
+    first.reason = CONTENTION + " (3 characters during the command)"
+    first.stray_events = _chars("00000\r\n", 152.6610, DUT)
+    found = xjudge.answered("R-6.1-01", [ex], "v1.4 makes them mandatory", late_is_reply=True)
+    assert found.verdict is Verdict.INCONCLUSIVE, found.detail
+    assert "none of its 4 tries (1 more met by the sensor's characters)" in found.detail
+    first.reason = NO_REPLY  # the same first try, quiet: the engine judged the sensor awake
+    first.stray_events = []
+    assert xjudge.answered("R-6.1-01", [ex], "mandatory").verdict is Verdict.FAIL
+
+
+def _one_shots(starts: list[float]) -> list[Exchange]:
+    return [
+        Exchange(
+            parse_command("0!"),
+            "0!",
+            [Attempt(None, _chars("0!", t, TOOL), [], NO_REPLY, t + 0.05)],
+        )
+        for t in starts
+    ]
+
+
+def test_a_wake_up_retried_too_late_shows_nothing() -> None:
+    """R-7.0-04's retries, meant 40 and 60 ms after the try before, went 225 and 253 ms after
+    it on the loaded host: a sensor woken by the break may be in standby again by then."""
+    brk = _break(349.9651)
+    why = woken_unheard(_one_shots([349.9783, 350.2038, 350.4563]), brk, 3.6e-3)
+    assert why.startswith("no try went while a sensor woken by the break must have been")
+    assert "238.70 ms after the break" in why
+
+
+def test_a_wake_up_retried_in_time_is_evidence() -> None:
+    """The sim's schedule: 13 ms after the break, then 40 and 60 ms after each try's end."""
+    brk = _break(10.0)
+    starts = [10.013]
+    starts.append(starts[-1] + 2 * CHAR_TIME + 0.04)
+    starts.append(starts[-1] + 2 * CHAR_TIME + 0.06)
+    assert woken_unheard(_one_shots(starts), brk, 0.0) == ""
