@@ -682,6 +682,18 @@ def _standby_after_a_break(sensor, case, edge: float):
         return None
     if control.answered or judge.heard_late(control):
         return ex, _marking_after_break(sensor, ex)
+    if ex.answered or judge.heard_late(ex):
+        # awake past 100 ms after a break, or only then awake: neither a FAIL nor room for
+        # the probes after a reply to PASS alone (they may be silent for another reason)
+        marking = _marking_after_break(sensor, ex) or 0.0
+        case.add(
+            inconclusive(
+                "R-7.0-15",
+                f"a! {marking * 1e3:.2f} ms after a break was answered, the control 77 ms "
+                "after one was not: the sensor may only then have woken (R-7.0-07)",
+                evidence=judge.cite([control, ex]),
+            )
+        )
     return None
 
 

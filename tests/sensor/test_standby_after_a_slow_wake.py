@@ -21,7 +21,8 @@ def _loose(faults: str):
 
 
 def test_a_slow_waker_answering_just_past_the_limit_after_a_break_is_no_fail():
-    assert case_verdict(_loose("slow-wake"), standby_case, "R-7.0-15") is not Verdict.FAIL
+    verdict = case_verdict(_loose("slow-wake"), standby_case, "R-7.0-15")
+    assert verdict is Verdict.INCONCLUSIVE  # not a FAIL, nor a PASS on the other probes
 
 
 def test_a_sensor_awake_past_the_limit_still_fails():
