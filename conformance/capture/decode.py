@@ -20,6 +20,7 @@ from operator import is_not
 
 import numpy as np
 
+from ..event_store import CompactEvents
 from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .columns import WireColumns
 from .edges import Edges
@@ -239,13 +240,23 @@ def _estimated_baud_sorted(prefix: list[int], tick_rate: float) -> float | None:
 class DecodeSettings:
     """How a channel is decoded beyond its format: the line's bit rate and framing, an extra
     edge error of the analyzer's input (s), the glitch filter's width (s; 0: off) and
-    whether a decode the plausibility check refuses is judged anyway (``force``)."""
+    whether a decode the plausibility check refuses is judged anyway (``force``);
+    ``compact``: the bus's events kept in a :class:`~conformance.event_store.CompactEvents`
+    as they are made (a recording loaded for judging: issue 22), not a list."""
 
     baud: float
     framing: Framing
     edge_error: float = 0.0
     glitch_filter: float = 0.0
     force: bool = False
+    compact: bool = False
+
+
+def _events_of(how: DecodeSettings, made: bool) -> list[Event]:
+    """A channel's decode's events: a :class:`~conformance.event_store.CompactEvents` where
+    ``how.compact`` asks for one and the channel's events are ``made`` (not a TX channel's
+    marks, nor columns), else a list."""
+    return CompactEvents() if how.compact and made else []  # type: ignore[return-value]
 
 
 def _decode_channel(
@@ -288,7 +299,7 @@ def _decode_channel(
     out = CaptureDecode(
         path=path,
         format=fmt,
-        events=[],
+        events=_events_of(how, into is None and not columns),
         uncertainty_s=uncertainty,
         inverted=inverted,
         polarity_detected=invert is None,
@@ -769,6 +780,7 @@ def decode_capture(
     force: bool = False,
     keep: bool = True,
     columns: bool = False,
+    compact: bool = False,
 ) -> CaptureDecode:
     """Decode ``channel`` of the capture at ``path`` (format detected by content).
 
@@ -784,7 +796,10 @@ def decode_capture(
     hour's capture: two lists of 357,000 events fewer held while it is judged).
     ``columns``: with ``tx_channel``, the events are kept as :attr:`CaptureDecode.columns`
     (no event made; ``events`` empty), for a caller that reads them so (a fault-matrix
-    row's replay); such a decode is neither kept nor taken from the one kept."""
+    row's replay); such a decode is neither kept nor taken from the one kept. ``compact``:
+    the events kept in a :class:`~conformance.event_store.CompactEvents` as they are made
+    (:class:`~conformance.event_store.NotCompact` if one cannot be: decode again without);
+    neither kept nor taken from the one kept either."""
     global _LAST
     path = str(path)
     if glitch_filter is None:
@@ -797,7 +812,7 @@ def decode_capture(
         )  # fmt: skip
     except OSError:
         key = None  # the decoding below says what is wrong with the file
-    if columns:
+    if columns or compact:
         key = None
     if key is not None and _LAST is not None and _LAST[0] == key:
         kept = _LAST[1]
@@ -809,7 +824,7 @@ def decode_capture(
         frame_format = Framing.parse(framing)
     except ValueError as exc:
         raise CaptureError(path, str(exc)) from None
-    how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force)
+    how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force, compact)
     out = _decode_capture(path, channel, tx_channel, invert, how, columns)
     give_back_freed_heap()  # the decoder's transients, whatever pages they were left on
     if key is not None and keep:
