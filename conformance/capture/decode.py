@@ -20,7 +20,7 @@ from operator import is_not
 
 import numpy as np
 
-from ..event_store import CompactEvents
+from ..event_store import CompactEvents, NotCompact
 from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .columns import WireColumns
 from .edges import Edges
@@ -798,8 +798,8 @@ def decode_capture(
     (no event made; ``events`` empty), for a caller that reads them so (a fault-matrix
     row's replay); such a decode is neither kept nor taken from the one kept. ``compact``:
     the events kept in a :class:`~conformance.event_store.CompactEvents` as they are made
-    (:class:`~conformance.event_store.NotCompact` if one cannot be: decode again without);
-    neither kept nor taken from the one kept either."""
+    (a list where one cannot be: decoded again so); the one kept shares it (nothing appends
+    to a decode's events once made), and one kept as a list is given as it is."""
     global _LAST
     path = str(path)
     if glitch_filter is None:
@@ -812,24 +812,35 @@ def decode_capture(
         )  # fmt: skip
     except OSError:
         key = None  # the decoding below says what is wrong with the file
-    if columns or compact:
+    if columns:
         key = None
     if key is not None and _LAST is not None and _LAST[0] == key:
         kept = _LAST[1]
         if not keep:
             _LAST = None
             return kept
-        return replace(kept, events=list(kept.events), notes=list(kept.notes))
+        return replace(kept, events=_copied(kept.events, compact), notes=list(kept.notes))
     try:
         frame_format = Framing.parse(framing)
     except ValueError as exc:
         raise CaptureError(path, str(exc)) from None
     how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force, compact)
-    out = _decode_capture(path, channel, tx_channel, invert, how, columns)
+    try:
+        out = _decode_capture(path, channel, tx_channel, invert, how, columns)
+    except NotCompact:  # an event the store cannot hold (rare): the events as a list
+        out = _decode_capture(path, channel, tx_channel, invert, replace(how, compact=False))
     give_back_freed_heap()  # the decoder's transients, whatever pages they were left on
     if key is not None and keep:
-        _LAST = (key, replace(out, events=list(out.events), notes=list(out.notes)))
+        _LAST = (key, replace(out, events=_copied(out.events, compact), notes=list(out.notes)))
     return out
+
+
+def _copied(events: list[Event], compact: bool) -> list[Event]:
+    """A decode's events for a second holder: a compact store shared where ``compact`` (a
+    store is not appended to once its decode is made), else a list of them."""
+    if compact and isinstance(events, CompactEvents):
+        return events
+    return list(events)
 
 
 def _decode_capture(

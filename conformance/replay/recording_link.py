@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..capture.errors import CaptureError
-from ..event_store import CompactEvents, NotCompact
+from ..event_store import CompactEvents
 from ..links.base import BusEnd, LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
@@ -195,26 +195,21 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
 
 
 def _decoded(spec: RecordingSpec) -> CaptureDecode:
-    """The capture decoded, its events kept compact as they are made (decoded again into a
-    list in the rare case one cannot be: :class:`~conformance.event_store.NotCompact`)."""
+    """The capture decoded, its events kept compact as they are made (a list in the rare
+    case one cannot be), or the decode the command line made of it, taken over."""
     from ..capture import decode_capture  # the decoder (and numpy) only for a capture
 
-    for compact in (True, False):
-        try:
-            return decode_capture(
-                spec.path, channel=spec.channel, tx_channel=spec.tx_channel,
-                invert=spec.invert, baud=spec.baud,
-                glitch_filter=None if spec.glitch_filter_us is None
-                else spec.glitch_filter_us * 1e-6,
-                force=spec.force,
-                keep=False,  # this link holds it while it is judged
-                compact=compact,
-            )  # fmt: skip
-        except NotCompact:
-            continue
-        except CaptureError as exc:
-            raise PortError(str(exc)) from None
-    raise AssertionError("unreachable: the second decode keeps a list")
+    try:
+        return decode_capture(
+            spec.path, channel=spec.channel, tx_channel=spec.tx_channel, invert=spec.invert,
+            baud=spec.baud,
+            glitch_filter=None if spec.glitch_filter_us is None else spec.glitch_filter_us * 1e-6,
+            force=spec.force,
+            keep=False,  # this link holds it while it is judged
+            compact=True,
+        )  # fmt: skip
+    except CaptureError as exc:
+        raise PortError(str(exc)) from None
 
 
 def stored(events: Sequence[Event]) -> Transcript:

@@ -288,9 +288,7 @@ class WindowedTransmissions(Sequence[Transmission]):
 
     def with_chars(self) -> WindowedTransmissions:
         """The same, with characters only (``[t for t in self if t.chars]``)."""
-        return WindowedTransmissions(
-            self.view_of, self.before, self.chars_before, chars_only=True
-        )
+        return WindowedTransmissions(self.view_of, self.before, self.chars_before, chars_only=True)
 
     def _counts(self) -> Sequence[int]:
         return self.chars_before if self.chars_only else self.before
