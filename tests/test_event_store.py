@@ -83,10 +83,33 @@ def test_wide_wires_and_many_kinds_of_fields():
     stored.append(Event(EventKind.CHAR, DUT, 400.0, 401.0, wire=1000))
     store = CompactEvents.of(stored)
     assert store is not None
-    assert store.which.typecode == "I" and store.wires.typecode == "q"
+    assert store.typecodes() == ("I", "q")
     assert list(store) == stored
     with pytest.raises(IndexError):
         store[len(stored)]
+
+
+def test_events_across_chunks(monkeypatch: pytest.MonkeyPatch):
+    """A store of several chunks (:data:`~conformance.event_store.CHUNK` made small here)
+    reads back the same events whole, item by item and in slices across chunks."""
+    import conformance.event_store as event_store
+
+    monkeypatch.setattr(event_store, "CHUNK", 7)
+    stored = [
+        Event(EventKind.CHAR, BUS, i * 0.01, i * 0.01 + 0.008, wire=i % 256) for i in range(50)
+    ]
+    stored[33] = Event(EventKind.BREAK, TOOL, 0.33, 0.34, text="held back")
+    store = CompactEvents.of(stored)
+    assert store is not None and len(store.starts) == 8
+    assert list(store) == stored and len(store) == 50
+    assert [store[i] for i in range(50)] == stored
+    for lo, hi, step in ((0, 50, 1), (5, 23, 1), (6, 8, 1), (13, 14, 1), (3, 40, 3), (40, 2, -4)):
+        assert store[lo:hi:step] == stored[lo:hi:step]
+    assert store.in_start_order() and not store.has_kind(EventKind.NOTE)
+    stored[21] = Event(EventKind.CHAR, BUS, 0.0, 0.001)  # back in time, a chunk's first
+    shuffled = CompactEvents.of(stored)
+    assert shuffled is not None and not shuffled.in_start_order()
+    assert store.nbytes() == 18 * 50
 
 
 def test_a_loaded_capture_keeps_its_decode_s_events_compact(tmp_path):
