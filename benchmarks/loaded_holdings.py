@@ -18,6 +18,11 @@ reference count less that list's and this script's own). Where every event has o
 more, dropping the transcript's list (or storing the transcript's events as arrays, an
 event made when read) frees that list alone, 8 bytes an event, not the events: the view
 holds them too. ``freed_with_list`` counts the events that list alone holds.
+
+Since branch window15 a loaded recording keeps its events in a
+:class:`~conformance.event_store.CompactEvents` (18 bytes an event, each made again when
+read) and a judgement cuts no whole view: for such a recording the figures are the store's
+bytes and the counts (``store_mb``, ``event_counts``), no event being held as an object.
 """
 
 from __future__ import annotations
@@ -28,6 +33,8 @@ import json
 import sys
 from collections import Counter
 from typing import Any
+
+from conformance.event_store import CompactEvents
 
 KB_PER_MB = 1024
 MB = 1e6
@@ -63,6 +70,10 @@ def holdings(path: str, fmt: str = "sr") -> dict[str, Any]:
     give_back_freed_heap()
     loaded = rss_mb()
     events = link.transcript.events
+    if isinstance(events, CompactEvents):
+        found = stored_holdings(path, events, before, loaded)
+        forget(port)
+        return found
     view = transcript_view(link.transcript)  # the cut no_traffic made (memoised)
     size = sys.getsizeof
     by_kind: Counter[str] = Counter()
@@ -108,9 +119,33 @@ def holdings(path: str, fmt: str = "sr") -> dict[str, Any]:
     }
 
 
+def stored_holdings(
+    path: str, events: CompactEvents, before: float, loaded: float
+) -> dict[str, Any]:
+    """:func:`holdings` of a recording whose events are in a compact store: its bytes and
+    the events' counts by kind (none of them held as an object)."""
+    count = Counter(str(e.kind) for e in events)
+    return {
+        "recording": path,
+        "events": len(events),
+        "rss_before_mb": before,
+        "rss_loaded_mb": loaded,
+        "event_counts": dict(count),
+        "store_mb": events.nbytes() / MB,
+    }
+
+
 def show(found: dict[str, Any]) -> None:
     """The figures, a line a family."""
     n = found["events"]
+    if "store_mb" in found:
+        print(f"{found['recording']}: {n} events, {found['event_counts']}")
+        print(f"  RSS {found['rss_before_mb']:.1f} MB before loading, {found['rss_loaded_mb']:.1f}")
+        print(
+            f"  compact store: {found['store_mb']:.2f} MB ({found['store_mb'] * MB / n:.0f} "
+            "bytes an event), no event held as an object"
+        )
+        return
     objects = sum(found["event_objects_mb"].values())
     lists = sum(found["lists_mb"].values())
     print(f"{found['recording']}: {n} events, {found['transmissions']} transmissions")

@@ -39,6 +39,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "dataclass_code",
             "protocol",
             "transcript",
+            "event_store",
         ),
     ),
     # the requirements, what is declared about the DUT, what a recorder under test is asked

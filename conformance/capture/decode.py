@@ -20,6 +20,7 @@ from operator import is_not
 
 import numpy as np
 
+from ..event_store import CompactEvents, NotCompact
 from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .columns import WireColumns
 from .edges import Edges
@@ -239,13 +240,23 @@ def _estimated_baud_sorted(prefix: list[int], tick_rate: float) -> float | None:
 class DecodeSettings:
     """How a channel is decoded beyond its format: the line's bit rate and framing, an extra
     edge error of the analyzer's input (s), the glitch filter's width (s; 0: off) and
-    whether a decode the plausibility check refuses is judged anyway (``force``)."""
+    whether a decode the plausibility check refuses is judged anyway (``force``);
+    ``compact``: the bus's events kept in a :class:`~conformance.event_store.CompactEvents`
+    as they are made (a recording loaded for judging: issue 22), not a list."""
 
     baud: float
     framing: Framing
     edge_error: float = 0.0
     glitch_filter: float = 0.0
     force: bool = False
+    compact: bool = False
+
+
+def _events_of(how: DecodeSettings, made: bool) -> list[Event]:
+    """A channel's decode's events: a :class:`~conformance.event_store.CompactEvents` where
+    ``how.compact`` asks for one and the channel's events are ``made`` (not a TX channel's
+    marks, nor columns), else a list."""
+    return CompactEvents() if how.compact and made else []  # type: ignore[return-value]
 
 
 def _decode_channel(
@@ -288,7 +299,7 @@ def _decode_channel(
     out = CaptureDecode(
         path=path,
         format=fmt,
-        events=[],
+        events=_events_of(how, into is None and not columns),
         uncertainty_s=uncertainty,
         inverted=inverted,
         polarity_detected=invert is None,
@@ -769,6 +780,7 @@ def decode_capture(
     force: bool = False,
     keep: bool = True,
     columns: bool = False,
+    compact: bool = False,
 ) -> CaptureDecode:
     """Decode ``channel`` of the capture at ``path`` (format detected by content).
 
@@ -784,7 +796,10 @@ def decode_capture(
     hour's capture: two lists of 357,000 events fewer held while it is judged).
     ``columns``: with ``tx_channel``, the events are kept as :attr:`CaptureDecode.columns`
     (no event made; ``events`` empty), for a caller that reads them so (a fault-matrix
-    row's replay); such a decode is neither kept nor taken from the one kept."""
+    row's replay); such a decode is neither kept nor taken from the one kept. ``compact``:
+    the events kept in a :class:`~conformance.event_store.CompactEvents` as they are made
+    (a list where one cannot be: decoded again so); the one kept shares it (nothing appends
+    to a decode's events once made), and one kept as a list is given as it is."""
     global _LAST
     path = str(path)
     if glitch_filter is None:
@@ -804,17 +819,28 @@ def decode_capture(
         if not keep:
             _LAST = None
             return kept
-        return replace(kept, events=list(kept.events), notes=list(kept.notes))
+        return replace(kept, events=_copied(kept.events, compact), notes=list(kept.notes))
     try:
         frame_format = Framing.parse(framing)
     except ValueError as exc:
         raise CaptureError(path, str(exc)) from None
-    how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force)
-    out = _decode_capture(path, channel, tx_channel, invert, how, columns)
+    how = DecodeSettings(baud, frame_format, edge_error, glitch_filter, force, compact)
+    try:
+        out = _decode_capture(path, channel, tx_channel, invert, how, columns)
+    except NotCompact:  # an event the store cannot hold (rare): the events as a list
+        out = _decode_capture(path, channel, tx_channel, invert, replace(how, compact=False))
     give_back_freed_heap()  # the decoder's transients, whatever pages they were left on
     if key is not None and keep:
-        _LAST = (key, replace(out, events=list(out.events), notes=list(out.notes)))
+        _LAST = (key, replace(out, events=_copied(out.events, compact), notes=list(out.notes)))
     return out
+
+
+def _copied(events: list[Event], compact: bool) -> list[Event]:
+    """A decode's events for a second holder: a compact store shared where ``compact`` (a
+    store is not appended to once its decode is made), else a list of them."""
+    if compact and isinstance(events, CompactEvents):
+        return events
+    return list(events)
 
 
 def _decode_capture(

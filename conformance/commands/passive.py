@@ -67,20 +67,6 @@ def no_traffic(port: str) -> str | None:
     return said
 
 
-def cut_for_reports(port: str) -> None:
-    """The whole recording's view, cut once before the runs for the reports alone: no
-    passive case reads it (the sensor and recorder runs read the bus pass's windows,
-    :mod:`~conformance.offline.sensor_windows`), but the reports' evidence search and timing
-    diagrams still do (``conformance.reports``: the next step of issue 22). Cut here, where
-    the heap is compact, not in the first run's report: there it raised an hour's busy
-    capture's peak from 129 to 136 MB (the same view, in a heap the run had fragmented).
-    To go once the reports read no whole-run view."""
-    from ..offline.fixtures import recording_of
-    from ..view.runs import transcript_view
-
-    transcript_view(recording_of(port).transcript)
-
-
 def error(text: str) -> None:
     """One line on stderr, as the CLI's errors are (never on stdout, where results go)."""
     from rich.console import Console
@@ -154,8 +140,7 @@ def judge_passively(args: PassiveJob, console: Console) -> int:
         forget(port)
         error(f"error: {why}")
         return EXIT_USAGE
-    cut_for_reports(port)
-    give_back_freed_heap()  # the bus pass and the view's cut made and let go of more than kept
+    give_back_freed_heap()  # the bus pass made and let go of more than it kept
     roles = ROLES if args.role == "both" else (args.role,)
     jobs = role_jobs(roles, run_folder(args.report_dir, "passive"), args, port)
     sensors = [j.address for j in jobs if j.of_bus]

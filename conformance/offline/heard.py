@@ -22,7 +22,7 @@ from ..protocol.responses import Identification
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..replay.recording_link import RecordingLink
 from ..tool_recorder.records import Exchange, Measurement
-from ..view.segments import TranscriptView, memo
+from ..view.segments import memo
 from .bus_sensors import BusSensor, SensorsOn, sensors_on
 from .sensor_windows import (
     AMBIGUITIES_SHOWN,
@@ -61,11 +61,10 @@ def recording_notes(link: RecordingLink, bus: BusWindows) -> list[str]:
 
 @dataclass
 class Heard(Session):
-    """What both roles' passive cases share: the recording (and a view of it: None, since
-    neither role's cases read the whole recording's view, issue 22)."""
+    """What both roles' passive cases share: the recording (no view of it: neither role's
+    cases nor the reports read the whole recording's view, issue 22)."""
 
     link: RecordingLink
-    view: TranscriptView | None
     forced_version: str | None = None
     assumptions: list[str] = field(default_factory=list)
     address: str | None = None
@@ -196,7 +195,6 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
     records = sensors_records(link, address)
     heard = HeardSensors(
         link,
-        None,
         forced_version=normalise_version(version) if version else None,
         address=address,
         exchanges=list(records.exchanges),
@@ -252,7 +250,6 @@ def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
     :func:`~.recorder_windows.recorder_findings`), the notes and sensors of the bus pass."""
     heard = HeardRecorder(
         link,
-        None,
         forced_version=normalise_version(version) if version else None,
         on_bus=bus_sensors(link),
     )

@@ -225,7 +225,9 @@ def capture_replay(found: JudgePlan, args: argparse.Namespace, in_memory: bool =
     options = options_in(notes)
     tool_tx = tool_channel(meta, args, found.path) if options else None
     # held in memory, the decode's characters stay columns: the replay reads those alone
-    decoded = decode(found.path, args, tool_tx, columns=in_memory and bool(options))
+    # judged passively (no run's options), its events compact: the loader takes this decode
+    columns = in_memory and bool(options)
+    decoded = decode(found.path, args, tool_tx, columns=columns, compact=not options)
     found.notes.extend(describe_decode(decoded))
     if not options:
         found.notes.append("judged passively: the capture does not say which run it is of")
@@ -318,11 +320,17 @@ def has_channel(path: Path, name: str) -> bool:
 
 
 def decode(
-    path: Path, args: argparse.Namespace, tx_channel: str | None = None, columns: bool = False
+    path: Path,
+    args: argparse.Namespace,
+    tx_channel: str | None = None,
+    columns: bool = False,
+    compact: bool = False,
 ) -> CaptureDecode:
     """``path`` decoded; ``tx_channel``: the tool's own TX (default ``--tx-channel``), whose
     characters are the tool's (origin ``tool``, whatever side it played); ``columns``: its
-    events kept as columns (:attr:`CaptureDecode.columns`), none made."""
+    events kept as columns (:attr:`CaptureDecode.columns`), none made; ``compact``: kept in
+    a :class:`~conformance.event_store.CompactEvents` (the passive judgement's loader takes
+    this decode over: issue 22)."""
     try:
         return decode_capture(
             str(path),
@@ -333,6 +341,7 @@ def decode(
             glitch_filter=glitch_filter(args.glitch_filter_us),
             force=args.force,
             columns=columns,
+            compact=compact,
         )
     except CaptureError as exc:
         raise JudgeError(str(exc)) from None

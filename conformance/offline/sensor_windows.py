@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
+from ..event_store import CompactEvents
 from ..judges.timing import StampUncertainty
 from ..judges.wire import Framing, ReplyBitRate, ReplyGaps, ResponseStarts
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
@@ -52,7 +53,7 @@ from ..view.segments import (
     unanswerable_ambiguity,
     undirected_ambiguity,
 )
-from ..view.windows import stream_window_sides, window_view
+from ..view.windows import WindowedTransmissions, stream_window_sides, window_view
 from .bus_sensors import BusSensor, SensorsOn
 from .decode_quality import CharRates, Quality, problems_by_character, sensor_characters
 
@@ -80,7 +81,11 @@ def stamp_uncertainty_of(link: RecordingLink) -> StampUncertainty:
 
 def ordered_plain(events: Sequence[Event]) -> Sequence[Event]:
     """``events`` without notes, by start (stably, as a view reads them): ``events``
-    itself where it is so already (a capture's decode: no copy), else a sorted list."""
+    itself where it is so already (a capture's decode: no copy; a compact store asked
+    without making its events), else a sorted list."""
+    compact = isinstance(events, CompactEvents)
+    if compact and not events.has_kind(EventKind.NOTE) and events.in_start_order():
+        return events
     plain = events
     if any(e.kind is EventKind.NOTE for e in events):
         plain = [e for e in events if e.kind is not EventKind.NOTE]
@@ -173,6 +178,15 @@ class BusWindows:
     kinds: frozenset[Kind]  # the kinds of the commands the recorder sent (no_traffic's)
     qualities: dict[str, str | None] = field(default_factory=dict)
     all_quality: str | None = None
+    #: how many of the whole view's transmissions come before each window (and after the
+    #: last), all of them and those with characters (:meth:`transmissions`)
+    before: array = field(default_factory=lambda: array("q", [0]))
+    chars_before: array = field(default_factory=lambda: array("q", [0]))
+
+    def transmissions(self) -> WindowedTransmissions:
+        """The whole view's transmissions, read from the windows as they are asked for
+        (the reports' search of the whole run: :func:`~conformance.view.runs.whole_cut`)."""
+        return WindowedTransmissions(self.view, self.before, self.chars_before)
 
     def __len__(self) -> int:
         return len(self.bounds) - 1
@@ -207,13 +221,22 @@ class BusWindows:
 def bus_windows(link: RecordingLink) -> BusWindows:
     """The bus pass over ``link``'s recording, made once per loaded recording (the sensor
     runs, the recorder's and the check that the recording holds SDI-12 traffic read it)."""
-    return memo(link, "_bus_windows", len(link.transcript.events), lambda: _read_bus(link))
+    transcript = link.transcript
+
+    def read() -> BusWindows:
+        bus = _read_bus(link)
+        # the reports' search of the whole run reads these windows, not a whole view
+        transcript.__dict__["_whole_transmissions"] = (len(transcript), bus.transmissions)
+        return bus
+
+    return memo(link, "_bus_windows", len(transcript.events), read)
 
 
 def _read_bus(link: RecordingLink) -> BusWindows:
     events = ordered_plain(link.transcript.events)
     u = link.uncertainty
     bounds, codes, sided = array("q", [0]), bytearray(), bytearray()
+    before, chars_before = array("q", [0]), array("q", [0])
     windows_of: dict[str, array] = {}
     sensors, ambiguities, carried = SensorsOn(), Ambiguities(AMBIGUITIES_SHOWN), {}
     kinds: set[Kind] = set()
@@ -224,6 +247,8 @@ def _read_bus(link: RecordingLink) -> BusWindows:
         sided.append(sides is not None)
         codes += sides if sides is not None else bytes(len(window))
         view = window_view(window, sides)
+        before.append(before[-1] + len(view.transmissions))
+        chars_before.append(chars_before[-1] + sum(1 for t in view.transmissions if t.chars))
         for first in {t.text[:1] for t in view.transmissions}:
             windows_of.setdefault(first, array("q")).append(i)
         kinds.update(t.command.kind for t in view.transmissions if t.command is not None)
@@ -238,7 +263,7 @@ def _read_bus(link: RecordingLink) -> BusWindows:
         codes = bytearray()  # the origins gave every side: nothing to keep
     found = BusWindows(
         events, bounds, codes, sided, windows_of, sensors.sensors(), ambiguities.found(),
-        frozenset(kinds),
+        frozenset(kinds), before=before, chars_before=chars_before,
     )  # fmt: skip
     if qualities is not None:
         baud = link.decoded.baud

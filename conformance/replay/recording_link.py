@@ -10,16 +10,18 @@ polarity, the stamps' uncertainty). Passive judging reads it through
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..capture.errors import CaptureError
+from ..event_store import CompactEvents
 from ..links.base import BusEnd, LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
-from ..transcript import EventKind, Transcript
+from ..transcript import Event, EventKind, Transcript
 from .recording import RecordingError, read_recording
 
 if TYPE_CHECKING:
@@ -174,25 +176,12 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
             bit_timing=_bit_timing(recording.options),
             frame_lengths=bool((recording.options.get("link") or {}).get("frame_lengths")),
         )  # fmt: skip
-        return RecordingLink(spec, info, Transcript(list(recording.events)), uncertainty, notes)
-    from ..capture import decode_capture  # the decoder (and numpy) only for a capture
+        return RecordingLink(spec, info, stored(recording.events), uncertainty, notes)
     from ..capture.uart import character_problems
 
-    try:
-        decoded = decode_capture(
-            spec.path,
-            channel=spec.channel,
-            tx_channel=spec.tx_channel,
-            invert=spec.invert,
-            baud=spec.baud,
-            glitch_filter=None if spec.glitch_filter_us is None else spec.glitch_filter_us * 1e-6,
-            force=spec.force,
-            keep=False,  # this link holds it while it is judged
-        )
-    except CaptureError as exc:
-        raise PortError(str(exc)) from None
-    # the decode's own list becomes the transcript's (nothing reads a loaded capture's
-    # ``decoded.events`` again): an hour's capture held one list of its events, not two
+    decoded = _decoded(spec)
+    # the decode's own events become the transcript's (nothing reads a loaded capture's
+    # ``decoded.events`` again): an hour's capture held them once, not twice
     events, decoded.events = decoded.events, []
     # of the decode's problems a judgement reads its characters' alone (the decode-quality
     # notes): a busy bus's every break was one more object held to the end (issue 22: an
@@ -202,7 +191,36 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
         kind=f"capture {decoded.format}", can_break=False,
         timing_uncertainty=decoded.uncertainty_s,
     )  # fmt: skip
-    return RecordingLink(spec, info, Transcript(events), decoded.uncertainty_s, decoded=decoded)
+    return RecordingLink(spec, info, stored(events), decoded.uncertainty_s, decoded=decoded)
+
+
+def _decoded(spec: RecordingSpec) -> CaptureDecode:
+    """The capture decoded, its events kept compact as they are made (a list in the rare
+    case one cannot be), or the decode the command line made of it, taken over."""
+    from ..capture import decode_capture  # the decoder (and numpy) only for a capture
+
+    try:
+        return decode_capture(
+            spec.path, channel=spec.channel, tx_channel=spec.tx_channel, invert=spec.invert,
+            baud=spec.baud,
+            glitch_filter=None if spec.glitch_filter_us is None else spec.glitch_filter_us * 1e-6,
+            force=spec.force,
+            keep=False,  # this link holds it while it is judged
+            compact=True,
+        )  # fmt: skip
+    except CaptureError as exc:
+        raise PortError(str(exc)) from None
+
+
+def stored(events: Sequence[Event]) -> Transcript:
+    """The transcript of a loaded recording: its events in a
+    :class:`~conformance.event_store.CompactEvents` (18 bytes an event where the objects
+    and their list took ~160: issue 22), each made again as it is read; a list where one
+    of them cannot be stored so."""
+    if isinstance(events, CompactEvents):
+        return Transcript(events)  # type: ignore[arg-type]
+    store = CompactEvents.of(events)
+    return Transcript(list(events) if store is None else store)  # type: ignore[arg-type]
 
 
 def _bit_timing(options: dict) -> bool:

@@ -101,6 +101,15 @@ def _chain(line: str, segs: Sequence[Segment]) -> list[Segment] | None:
     return chain
 
 
+def _with_chars(transmissions: Sequence[Any]) -> Sequence[Any]:
+    """The transmissions with characters: read window by window where they are a
+    recording's windows' (:class:`~..view.windows.WindowedTransmissions`), not listed."""
+    with_chars = getattr(transmissions, "with_chars", None)
+    if with_chars is not None:
+        return with_chars()
+    return [t for t in transmissions if t.chars]
+
+
 def _texts(segs: Sequence[Segment]) -> list[str]:
     """The segments' texts, read without making the segments of a :class:`LazyCut`."""
     return segs.texts() if isinstance(segs, LazyCut) else [s.text for s in segs]
@@ -326,7 +335,7 @@ class Locator:
             whole = self.transcript is not None and lo == 0 and hi == self.count()
             cut = whole_cut(self.transcript) if whole else segments(self.slice(lo, hi))
             if isinstance(cut, LazyCut):  # a command's segment: a transmission with characters
-                self._cuts[key] = LazyCut([t for t in cut.transmissions if t.chars])
+                self._cuts[key] = LazyCut(_with_chars(cut.transmissions))
             else:
                 self._cuts[key] = [s for s in cut if s.command]
         return self._cuts[key]

@@ -255,6 +255,11 @@ def whole_cut(transcript: Transcript) -> Segments | LazyCut:
     held = transcript.__dict__.get("_segments")
     if held is not None and held[0] == len(transcript.events):
         return held[1]
+    windowed = transcript.__dict__.get("_whole_transmissions")
+    if windowed is not None and windowed[0] == len(transcript.events):
+        # a loaded recording's windows (its bus pass): the whole view's transmissions read
+        # window by window, no whole view cut (issue 22)
+        return LazyCut(windowed[1]())
     return LazyCut(transcript_view(transcript).transmissions)
 
 

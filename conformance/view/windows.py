@@ -29,8 +29,10 @@ direction is, never which side it gives).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from bisect import bisect_right
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from operator import attrgetter
+from typing import overload
 
 from ..tool_recorder.policy import Policy
 from ..tool_recorder.records import Attempt
@@ -259,3 +261,64 @@ __all__ = [
     "window_starts",
     "window_view",
 ]
+
+
+class WindowedTransmissions(Sequence[Transmission]):
+    """The transmissions of a whole recording's view, read from its windows' views (each
+    window's view its own, read again when asked: ``view_of(w)``), none held but the last
+    window read: what a report's search of the whole run reads
+    (:func:`~.runs.whole_cut`, issue 22: the whole view held every event of an hour's
+    capture through every run). A window's transmissions are the whole view's of that
+    window (see the module's docstring), so item ``i`` equals the whole view's
+    (``tests/offline/test_windowed_transmissions.py``). ``before``: how many of them come
+    before each window (one more item than windows: the last is the count);
+    ``chars_only``: only those with characters (a command's, what the reports search)."""
+
+    def __init__(
+        self,
+        view_of: Callable[[int], TranscriptView],
+        before: Sequence[int],
+        chars_before: Sequence[int],
+        *,
+        chars_only: bool = False,
+    ) -> None:
+        self.view_of, self.before, self.chars_before = view_of, before, chars_before
+        self.chars_only = chars_only
+        self._last: tuple[int, list[Transmission]] | None = None
+
+    def with_chars(self) -> WindowedTransmissions:
+        """The same, with characters only (``[t for t in self if t.chars]``)."""
+        return WindowedTransmissions(self.view_of, self.before, self.chars_before, chars_only=True)
+
+    def _counts(self) -> Sequence[int]:
+        return self.chars_before if self.chars_only else self.before
+
+    def __len__(self) -> int:
+        return self._counts()[-1]
+
+    def _window(self, w: int) -> list[Transmission]:
+        if self._last is None or self._last[0] != w:
+            ts = self.view_of(w).transmissions
+            self._last = (w, [t for t in ts if t.chars] if self.chars_only else list(ts))
+        return self._last[1]
+
+    @overload
+    def __getitem__(self, i: int) -> Transmission: ...
+    @overload
+    def __getitem__(self, i: slice) -> list[Transmission]: ...
+    def __getitem__(self, i: int | slice) -> Transmission | list[Transmission]:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        if i < 0:
+            i += len(self)
+        if not 0 <= i < len(self):
+            raise IndexError("transmission index out of range")
+        counts = self._counts()
+        w = bisect_right(counts, i) - 1
+        return self._window(w)[i - counts[w]]
+
+    def __iter__(self) -> Iterator[Transmission]:
+        counts = self._counts()
+        for w in range(len(counts) - 1):
+            if counts[w + 1] > counts[w]:
+                yield from self._window(w)

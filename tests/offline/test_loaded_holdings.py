@@ -25,11 +25,32 @@ def _load(name: str) -> ModuleType:
     return module
 
 
-def test_families_count_what_the_capture_holds(tmp_path: Path):
+def test_a_loaded_capture_holds_its_events_in_a_store(tmp_path: Path):
+    """Since window15: no event of a loaded capture is held as an object, the store holds
+    18 bytes an event."""
     events = _load("capture_decode").busy_bus(20.0)
     capture = tmp_path / "busy.sr"
     export_events(events, str(capture), sample_rate=1e6)
     found = _load("loaded_holdings").holdings(str(capture))
+    chars = sum(e.kind is EventKind.CHAR for e in events)
+    assert found["event_counts"] == {"char": chars, "break": len(events) - chars}
+    assert found["events"] == len(events)
+    assert found["store_mb"] * 1e6 == 18 * len(events)
+
+
+def test_families_count_what_a_listed_recording_holds(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+):
+    """A recording loaded as a list of events (the loader's way where the store refuses an
+    event), the families as window12 counted them."""
+    from conformance.event_store import CompactEvents
+    from conformance.replay.recording import write_recording
+
+    monkeypatch.setattr(CompactEvents, "of", classmethod(lambda cls, events: None))
+    events = _load("capture_decode").busy_bus(20.0)
+    recording = tmp_path / "busy.jsonl"
+    write_recording(recording, events)
+    found = _load("loaded_holdings").holdings(str(recording), "jsonl")
     chars = sum(e.kind is EventKind.CHAR for e in events)
     assert found["event_counts"] == {"char": chars, "break": len(events) - chars}
     assert found["events"] == len(events)

@@ -22,7 +22,7 @@ from conformance.offline import heard
 from conformance.replay.recording import read_recording, write_recording
 from conformance.replay.recording_link import load_recording, parse_recording, recording_port
 from conformance.tool_recorder.records import Exchange, Measurement
-from conformance.transcript import BUS
+from conformance.transcript import BUS, Transcript
 from tests.offline.test_judge_memory import busy_capture
 from tests.support import whole_run_heard as oracle
 from tests.support.bus_of_sensors import record
@@ -32,6 +32,14 @@ SHARED = Path("/work/shared/captures")
 
 def _load(path: Path, kind: str):
     return load_recording(parse_recording(recording_port(str(path), kind)))
+
+
+def _listed(link):
+    """The oracle's recording as base-s61 held it: its events one list of objects (a compact
+    store, ``conformance.event_store``, makes them again at each read, and the whole-run
+    path found a character's decode figures by identity in a second read of the list)."""
+    link.transcript = Transcript(list(link.transcript.events))
+    return link
 
 
 def _exchange(x: Exchange) -> tuple:
@@ -81,7 +89,7 @@ def _compare(path: Path, kind: str, extra: tuple[str | None, ...] = ()) -> int:
     nobody answered at, judged both ways on loads of their own (nothing shared); both
     loads must fail alike where one does. The addresses compared."""
     try:
-        old_link, new_link = _load(path, kind), _load(path, kind)
+        old_link, new_link = _listed(_load(path, kind)), _load(path, kind)
     except PortError as exc:
         with pytest.raises(PortError, match=str(exc)[:40]):
             _load(path, kind)

@@ -74,6 +74,7 @@ class HeardSensors(Heard):
     exchanges: list[Exchange] = field(default_factory=list)
     measurements: list[Measurement] = field(default_factory=list)
     segments: list[Segment] = field(default_factory=list)
+    view: TranscriptView | None = None  # the whole view (the product's sessions hold none)
 
     def of_kind(self, *kinds: Kind, whole: bool = False) -> list[Measurement]:
         """The recorded measurements of ``kinds``; ``whole``: only those the recorder let
@@ -94,6 +95,8 @@ class HeardSensors(Heard):
 @dataclass
 class HeardRecorder(Heard):
     """The recorder rules read the whole bus (``--address`` does not narrow them)."""
+
+    view: TranscriptView | None = None  # the whole view (the product's sessions hold none)
 
 
 def heard_records(link: RecordingLink) -> tuple[TranscriptView, Rebuilt]:
@@ -258,7 +261,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         segments = list(mine.segments.get(address, ()))
     heard = HeardSensors(
         link,
-        view,
+        view=view,
         forced_version=normalise_version(version) if version else None,
         address=address,
         exchanges=exchanges,
@@ -385,7 +388,7 @@ def hear_recorder(link: RecordingLink, version: str | None) -> HeardRecorder:
     view = transcript_view(link.transcript)  # the recorder rules read no rebuilt record
     heard = HeardRecorder(
         link,
-        view,
+        view=view,
         forced_version=normalise_version(version) if version else None,
         on_bus=_bus_sensors(link),
     )
