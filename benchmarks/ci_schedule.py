@@ -132,12 +132,22 @@ def main() -> None:
     parser.add_argument("cpu", type=Path, help="CI_CPU_DIR of a measured session")
     parser.add_argument("old", type=Path, help="the tree before (xdist's default order)")
     parser.add_argument("new", type=Path, help="the tree after (its collection order)")
+    parser.add_argument(
+        "--old-in-collection-order", action="store_true",
+        help="play the old tree's queue in its collection order too (both trees run "
+        "--no-loadscope-reorder, as .ci/test has since stop 37)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--rt-cpu", type=float, default=97.0,
+        help="CPU seconds of the real-time session beside it (served first)",
+    )  # fmt: skip
     args = parser.parse_args()
     cpu = module_cpu(args.cpu)
     print(f"{len(cpu)} modules, {sum(cpu.values()):.0f} s of CPU")
     started = time.monotonic()
-    for name, tree, by_count in (("old", args.old, True), ("new", args.new, False)):
-        span, idle = makespan(queue(collected(tree), by_count), cpu)
+    old_by_count = not args.old_in_collection_order
+    for name, tree, by_count in (("old", args.old, old_by_count), ("new", args.new, False)):
+        span, idle = makespan(queue(collected(tree), by_count), cpu, rt_cpu=args.rt_cpu)
         print(f"{name} ({tree}): {span:.0f} s, {idle:.0f} core-seconds idle")
     print(f"(modelled in {time.monotonic() - started:.0f} s)")
 

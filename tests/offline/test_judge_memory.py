@@ -78,9 +78,12 @@ import json
 import os
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 MB_PER_MINUTE = 0.75  # 0.33 measured on branch window15 (base-s62 1.21), + 0.4 of noise.
 # Before: 1.55 (window11 1.15, base-s58 1.28); 1.65 (window10 1.26, base-s57 1.40); 1.90,
@@ -124,17 +127,59 @@ def judged_peak(capture: Path, reports: Path) -> float:
     return float(found["peak_mb"])
 
 
+def growth_of(short: float, long: float) -> float:
+    """MB a minute of capture between the two lengths' peaks."""
+    return (long - short) / (LONG - SHORT)
+
+
+def lowest_long_peak(short: float, judge_long: Callable[[int], float], times: int = 2) -> float:
+    """The lower of ``times`` judgements of the long capture, judged only while they are
+    needed: once one of them is within :data:`MB_PER_MINUTE`, the lower of all of them is
+    too (it is at most that one), so the test's verdict is the one the lower of all would
+    give. The short capture is not cut like this: its lower peak makes the slope steeper.
+    A passing run judges the 14 minutes once (~7 s of CPU in CI, issue 22's ci9 round)."""
+    lowest = judge_long(0)
+    for i in range(1, times):
+        if growth_of(short, lowest) <= MB_PER_MINUTE:
+            break
+        lowest = min(lowest, judge_long(i))
+    return lowest
+
+
 @pytest.mark.slow
 def test_peak_memory_grows_at_most_its_figure_with_the_capture(tmp_path: Path):
     peaks = {}
-    for minutes, times in ((SHORT, 2), (LONG, 2)):
-        capture = tmp_path / f"busy{minutes:g}.sr"
-        busy_capture(capture, minutes)
-        peaks[minutes] = min(
-            judged_peak(capture, tmp_path / f"reports{minutes:g}-{i}") for i in range(times)
-        )
-    growth = (peaks[LONG] - peaks[SHORT]) / (LONG - SHORT)
+    for minutes in (SHORT, LONG):
+        busy_capture(tmp_path / f"busy{minutes:g}.sr", minutes)
+
+    def judged(minutes: float, i: int) -> float:
+        return judged_peak(tmp_path / f"busy{minutes:g}.sr", tmp_path / f"reports{minutes:g}-{i}")
+
+    peaks[SHORT] = min(judged(SHORT, i) for i in range(2))
+    peaks[LONG] = lowest_long_peak(peaks[SHORT], lambda i: judged(LONG, i))
+    growth = growth_of(peaks[SHORT], peaks[LONG])
     assert growth <= MB_PER_MINUTE, (
         f"peak RSS {peaks[SHORT]:.0f} MB at {SHORT:g} min, {peaks[LONG]:.0f} MB at {LONG:g} "
         f"min: {growth:.2f} MB a minute of capture, more than {MB_PER_MINUTE}"
     )
+
+
+@given(
+    short=st.floats(40, 120),
+    longs=st.lists(st.floats(40, 160), min_size=1, max_size=4),
+)
+def test_judging_the_long_capture_lazily_gives_the_verdict_of_all_its_runs(short, longs):
+    """:func:`lowest_long_peak`'s verdict is the lower of every judgement's (the test's
+    verdict before the ci9 round, every run judged), and it judges past the first only when
+    that one is over the limit."""
+    judged: list[int] = []
+
+    def judge(i: int) -> float:
+        judged.append(i)
+        return longs[i]
+
+    lazy = lowest_long_peak(short, judge, times=len(longs))
+    every = min(longs)
+    assert (growth_of(short, lazy) <= MB_PER_MINUTE) == (growth_of(short, every) <= MB_PER_MINUTE)
+    assert judged == list(range(len(judged)))  # in order, none twice
+    assert (len(judged) == 1) == (growth_of(short, longs[0]) <= MB_PER_MINUTE or len(longs) == 1)

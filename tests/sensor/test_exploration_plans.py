@@ -6,6 +6,7 @@ draws afresh; and a whole ``--port sim`` process with a stored plan loads no hyp
 
 from __future__ import annotations
 
+import functools
 import json
 import subprocess
 import sys
@@ -64,17 +65,53 @@ def test_the_exceptions_are_hypothesis_s() -> None:
     assert len(exploration_steps.skip_exceptions()) >= 1  # pytest's Skipped, in this process
 
 
+@functools.cache
+def hypothesis_s(port: str) -> tuple[object, ...]:
+    """What hypothesis driving the sending machine sends, records and judges against
+    ``port``: the reference of both tests below, made once a process (issue 22's ci9 round:
+    each of the ~130 faults made it twice, once in each test, in two modules; a derandomised
+    exploration is the same every time in a process, which
+    :func:`test_hypothesis_s_run_is_the_same_made_again_beside_a_stored_plan` holds)."""
+    return _run(port, planned=False)
+
+
+def _port(fault: str) -> str:
+    return f"sim://?faults={fault}" if fault else "sim"
+
+
+@pytest.mark.parametrize("fault", ["", *SENSOR_FAULTS])
+def test_planned_exploration_is_hypothesis_s_R_4_0_01_R_4_3_01(fault: str) -> None:
+    """A plan drawn afresh in this process (round 8; in test_exploration_plan.py before)."""
+    port = _port(fault)
+    exploration.forget_plans()
+    assert _run(port, planned=True) == hypothesis_s(port)
+
+
+@pytest.mark.parametrize("fault", ["", "answers-foreign-address", "wrong-crc"])
+def test_hypothesis_s_run_is_the_same_made_again_beside_a_stored_plan(
+    fault: str, store: PlanStore
+) -> None:
+    """The kept reference is the one each test made for itself before: made again after a
+    planned run and with a stored plan in place, it is equal."""
+    port = _port(fault)
+    kept = hypothesis_s(port)
+    exploration.forget_plans()
+    _run(port, planned=True)
+    _store_the_plan_of(port, store)
+    assert _run(port, planned=False) == kept
+
+
 @pytest.mark.parametrize("fault", ["", *SENSOR_FAULTS])
 def test_a_stored_plan_sends_what_hypothesis_sends_R_4_0_01_R_4_3_01(
     fault: str, store: PlanStore, monkeypatch
 ) -> None:
-    port = f"sim://?faults={fault}" if fault else "sim"
+    port = _port(fault)
     _store_the_plan_of(port, store)
-    hypothesis_s = _run(port, planned=False)
+    hypothesis_s_ = hypothesis_s(port)
     machine = exploration._machine_module()
     monkeypatch.setattr(machine, "plan_for", lambda *a: pytest.fail("drew a stored plan"))
     monkeypatch.setattr(machine, "machine_class", lambda *a: pytest.fail("made hypothesis's"))
-    assert _run(port, planned=True) == hypothesis_s
+    assert _run(port, planned=True) == hypothesis_s_
 
 
 def test_a_planned_run_stores_its_plan_once_hypothesis_is_its_own(store, monkeypatch) -> None:
