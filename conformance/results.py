@@ -12,6 +12,11 @@ from .selection import NOT_SELECTED
 from .transcript import Event
 from .verdicts import Finding, Verdict, inconclusive, worst
 
+#: the verdicts each finding is asked about, as module constants: a member read off the enum goes
+#: through its metaclass's ``__getattr__`` hook on Python 3.11 (issue 22, matrix25: ~0.13 us a look)
+_PASS, _INCONCLUSIVE = Verdict.PASS, Verdict.INCONCLUSIVE
+_WARN_OR_FAIL = (Verdict.WARN, Verdict.FAIL)
+
 COMPLIANT = "COMPLIANT"
 NON_COMPLIANT = "NON-COMPLIANT"
 INCOMPLETE = "INCOMPLETE"
@@ -110,7 +115,7 @@ def unreached(finding: Finding) -> bool:
     """An INCONCLUSIVE that rests on no observation: the case could not reach the rule (an
     exploration stopped early, a precondition failed). Unlike one over observations (an
     uncertainty straddling a limit), it says nothing against what another case judged."""
-    return finding.verdict is Verdict.INCONCLUSIVE and finding.observed == 0
+    return finding.verdict is _INCONCLUSIVE and finding.observed == 0
 
 
 def decides(finding: Finding) -> bool:
@@ -119,9 +124,9 @@ def decides(finding: Finding) -> bool:
     not have shown it there (seed 4197: the exploration's one repeated D0 PASSed R-4.4.5-10
     while continuous-overwrites-data empties the buffer at aRn!, which the retention case,
     whose precondition no M-type measurement met, was built to send)."""
-    if finding.verdict is Verdict.PASS:
+    if finding.verdict is _PASS:
         return not finding.partial
-    return finding.verdict in (Verdict.WARN, Verdict.FAIL)
+    return finding.verdict in _WARN_OR_FAIL
 
 
 def counted(findings: list[Finding]) -> list[Finding]:

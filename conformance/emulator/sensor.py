@@ -58,6 +58,12 @@ from .transmitter import Transmission, Transmitter
 #: The replies :attr:`Behaviour.stray_after_line_end` follows: two that close their exchange
 #: at their CR LF (``engine.closes_exchange``), a data page and the identification.
 _STRAY_AFTER = frozenset({ReplyKind.DATA, ReplyKind.IDENTIFICATION})
+#: the command kinds every command is dispatched by, as module constants (``_dispatch``)
+_ACKNOWLEDGE, _QUERY_ADDRESS, _IDENTIFY = Kind.ACKNOWLEDGE, Kind.QUERY_ADDRESS, Kind.IDENTIFY
+_CHANGE_ADDRESS, _DATA, _BINARY_DATA = Kind.CHANGE_ADDRESS, Kind.DATA, Kind.BINARY_DATA
+_CONTINUOUS, _IDENTIFY_MEASUREMENT = Kind.CONTINUOUS, Kind.IDENTIFY_MEASUREMENT
+_METADATA, _EXTENDED = Kind.METADATA, Kind.EXTENDED
+_SERVICE_REQUEST, _CHATTER = ReplyKind.SERVICE_REQUEST, ReplyKind.CHATTER  # (``_sent``)
 _MAX_COMMAND = 64  # a command longer than this is noise; drop it rather than grow forever
 
 
@@ -296,9 +302,9 @@ class SensorEmulator:
         self._replied_last = True
         if item.done:
             kind = item.reply.kind
-            if kind is ReplyKind.SERVICE_REQUEST:
+            if kind is _SERVICE_REQUEST:
                 self._awake = not self.behaviour.standby_after_service_request
-            elif kind is not ReplyKind.CHATTER and self.behaviour.standby_after_reply:
+            elif kind is not _CHATTER and self.behaviour.standby_after_reply:
                 self._awake = False
 
     # -- measurement bookkeeping -------------------------------------------------------------
@@ -355,9 +361,9 @@ class SensorEmulator:
             elif b.answer_trailing_address and text[-2:-1] == self.address:
                 self._send(Reply(ReplyKind.ACKNOWLEDGE, self.address, command=cmd), at)
             return
-        if cmd.address == "?" and cmd.kind is not Kind.QUERY_ADDRESS:
+        if cmd.address == "?" and cmd.kind is not _QUERY_ADDRESS:
             return  # R-4.4.3-02: the wildcard is accepted only in ?!
-        if cmd.kind is Kind.QUERY_ADDRESS and not b.answer_query:
+        if cmd.kind is _QUERY_ADDRESS and not b.answer_query:
             return
         if not self.profile.v14 and cmd.kind in V14_ONLY_KINDS:
             return  # a v1.3 sensor does not know the command: silence
@@ -370,37 +376,41 @@ class SensorEmulator:
             self._quiet_until = max(self._quiet_until, at)
 
     def _dispatch(self, cmd: Command, at: float) -> None:
+        # the command's kind compared (``==``, as a ``match`` on ``case Kind.X`` compares)
+        # with module constants: a ``case Kind.X`` reads the member off the enum, through its
+        # metaclass's ``__getattr__`` hook on Python 3.11, at every case tried (issue 22,
+        # matrix25: a metadata command tried nine)
         a = cmd.address if cmd.address != "?" else self.address
-        match cmd.kind:
-            case Kind.ACKNOWLEDGE:
-                self._send(Reply(ReplyKind.ACKNOWLEDGE, a, command=cmd), at)
-            case Kind.QUERY_ADDRESS:
-                self._send(Reply(ReplyKind.ADDRESS, a, command=cmd), at)
-            case Kind.IDENTIFY:
-                body = a + self.profile.identification()
-                self._send(Reply(ReplyKind.IDENTIFICATION, body, command=cmd), at)
-            case Kind.CHANGE_ADDRESS:
-                self._change_address(cmd, at)
-            case Kind.DATA:
-                self._data_reply(cmd, at)
-            case Kind.BINARY_DATA:
-                self._binary_reply(cmd, at)
-            case Kind.CONTINUOUS:
-                self._continuous(cmd, at)
-            case Kind.IDENTIFY_MEASUREMENT:
-                self._identify_measurement(cmd, at)
-            case Kind.METADATA:
-                self._metadata(cmd, at)
-            case Kind.EXTENDED:
-                text = self.profile.extended.get(cmd.body)
-                if text is not None and "\n" in text:
-                    self._multiline(cmd, a, text.split("\n"), at)
-                elif text is not None:
-                    self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
-                else:
-                    self._unknown(cmd, at)
-            case _:
-                self._start_measurement(cmd, at)
+        kind = cmd.kind
+        if kind == _ACKNOWLEDGE:
+            self._send(Reply(ReplyKind.ACKNOWLEDGE, a, command=cmd), at)
+        elif kind == _QUERY_ADDRESS:
+            self._send(Reply(ReplyKind.ADDRESS, a, command=cmd), at)
+        elif kind == _IDENTIFY:
+            body = a + self.profile.identification()
+            self._send(Reply(ReplyKind.IDENTIFICATION, body, command=cmd), at)
+        elif kind == _CHANGE_ADDRESS:
+            self._change_address(cmd, at)
+        elif kind == _DATA:
+            self._data_reply(cmd, at)
+        elif kind == _BINARY_DATA:
+            self._binary_reply(cmd, at)
+        elif kind == _CONTINUOUS:
+            self._continuous(cmd, at)
+        elif kind == _IDENTIFY_MEASUREMENT:
+            self._identify_measurement(cmd, at)
+        elif kind == _METADATA:
+            self._metadata(cmd, at)
+        elif kind == _EXTENDED:
+            text = self.profile.extended.get(cmd.body)
+            if text is not None and "\n" in text:
+                self._multiline(cmd, a, text.split("\n"), at)
+            elif text is not None:
+                self._send(Reply(ReplyKind.EXTENDED, a + text, command=cmd), at)
+            else:
+                self._unknown(cmd, at)
+        else:
+            self._start_measurement(cmd, at)
 
     def _non_command(self, text: str, end: float, foreign: bool) -> None:
         """What only a faulty sensor does with text that is not a command: take a character

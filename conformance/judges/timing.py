@@ -23,6 +23,11 @@ from ..verdicts import MAX_TICKS, Distribution, Finding, Verdict
 
 EPSILON = 1e-9  # s: a value exactly on a limit is inside it, whatever float rounding says
 
+#: the verdicts the measurements compare with, as module constants: a member read off the
+#: enum on Python 3.11 goes through its metaclass's ``__getattr__`` hook (issue 22, matrix25:
+#: ~0.13 us a look, every measured interval of a run looked three times)
+_PASS, _WARN, _FAIL, _INCONCLUSIVE = Verdict.PASS, Verdict.WARN, Verdict.FAIL, Verdict.INCONCLUSIVE
+
 
 def not_listening(rid: str, marking: float, uncertainty: float) -> Finding | None:
     """The precondition of a silence-based FAIL on a wake-up or break rule (issue 18,
@@ -105,7 +110,7 @@ def deviation_pattern(observed: list[tuple[Finding | Measured, Place | None]]) -
     for finding, place in observed:
         seen = counts.setdefault(place, [0, 0])
         seen[1] += 1
-        seen[0] += finding.verdict is Verdict.FAIL
+        seen[0] += finding.verdict is _FAIL
     recurring, stalls, unconfirmed = {}, {}, {}
     for place, (bad, total) in counts.items():
         if not bad:
@@ -132,14 +137,14 @@ def to_confirm(observed: list[Observation], *, real_time: bool = True) -> list[s
     if not real_time:
         return []
     kept = [(f, p) for f, tainted, p in _places(observed) if not _aside(f, tainted)]
-    failing = sum(f.verdict is Verdict.FAIL for f, _ in kept)
+    failing = sum(f.verdict is _FAIL for f, _ in kept)
     if not failing or failing == len(kept) or sustained(failing, len(kept)):
         return []
     return deviation_pattern(kept).commands
 
 
 def _aside(f: Finding, tainted: bool) -> bool:
-    return tainted and f.verdict is Verdict.INCONCLUSIVE
+    return tainted and f.verdict is _INCONCLUSIVE
 
 
 def _where(place: Place) -> str:
@@ -189,11 +194,8 @@ def combine_local(
         f"stamps near them were irregular (±{worst_aside:.2f} ms there)"
     )
     if aside and not kept:
-        return Finding(rid, Verdict.INCONCLUSIVE, f"every {what} undecided; {note}")
-    if type(kept) is Alike:
-        failing = kept.failing()
-    else:
-        failing = sum(f.verdict is Verdict.FAIL for f in kept)
+        return Finding(rid, _INCONCLUSIVE, f"every {what} undecided; {note}")
+    failing = kept.failing() if type(kept) is Alike else sum(f.verdict is _FAIL for f in kept)
     isolated = real_time and failing and failing < len(kept) and not sustained(failing, len(kept))
     if isolated:
         places = [o[2] if len(o) > 2 else None for o in observed if not _aside(o[0], o[1])]  # type: ignore[misc]
@@ -219,9 +221,9 @@ def _by_place(
 ) -> Finding:
     """The few deviations of :func:`combine_local` on a real-time link, decided by place."""
     pattern = deviation_pattern(kept)
-    failing = [f for f, _ in kept if f.verdict is Verdict.FAIL]
+    failing = [f for f, _ in kept if f.verdict is _FAIL]
     if pattern.recurring:
-        device = [f for f, p in kept if f.verdict is not Verdict.FAIL or p in pattern.recurring]
+        device = [f for f, p in kept if f.verdict is not _FAIL or p in pattern.recurring]
         found = combine(rid, device, what, smallest_is_worst=smallest_is_worst)
         said = "; ".join(
             f"{bad} of {total} at {_where(p)}" for p, (bad, total) in pattern.recurring.items()
@@ -235,7 +237,7 @@ def _by_place(
             found.detail += f"; {others} other deviating {plural(what)} not counted"
         return found
     if not pattern.unconfirmed:
-        rest = [f for f, _ in kept if f.verdict is not Verdict.FAIL]
+        rest = [f for f, _ in kept if f.verdict is not _FAIL]
         found = combine(rid, rest, what, smallest_is_worst=smallest_is_worst)
         lone = failing[0]
         said = "; ".join(
@@ -248,12 +250,12 @@ def _by_place(
         )
         return found
     lone = failing[0]
-    others = [f for f, _ in kept if f.verdict is not Verdict.FAIL]
+    others = [f for f, _ in kept if f.verdict is not _FAIL]
     rest = combine(rid, others, what, smallest_is_worst=smallest_is_worst)
     where = f" [{lone.evidence[0]}]" if lone.evidence else ""
     return Finding(
         rid,
-        Verdict.INCONCLUSIVE,
+        _INCONCLUSIVE,
         f"{len(failing)} of {len(kept)} {plural(what)} deviate, such as: {lone.detail}"
         f"{where}; the others conform ({rest.detail}). Deviations this rare on a "
         "real-time link may be stalls of the host, not of the device, and they were not "
@@ -322,7 +324,7 @@ class Window:
         detail = (
             f"{self.what}: {measured * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} ms, allowed {limit}"
         )
-        if verdict is Verdict.INCONCLUSIVE:
+        if verdict is _INCONCLUSIVE:
             detail += " (the uncertainty straddles the limit)"
         limit_ms = (hi if hi is not None else lo) or 0.0
         return Finding(
@@ -509,7 +511,7 @@ class Alike(Sequence["Measured"]):
     def failing(self) -> int:
         """How many of them FAIL."""
         return sum(c for m, c in zip(self.distinct, self.counts, strict=True)
-                   if m.verdict is Verdict.FAIL)  # fmt: skip
+                   if m.verdict is _FAIL)  # fmt: skip
 
     def grouped(self) -> tuple[Window, list[Measured], list[int]] | None:
         """:func:`_grouped` of the findings, from the groups: the same answer."""
@@ -656,10 +658,10 @@ def _window_verdict(
     inside = (lo is None or m_lo >= lo) and (hi is None or m_hi <= hi)
     outside = (lo is not None and m_hi < lo) or (hi is not None and m_lo > hi)
     if inside:
-        return Verdict.PASS, outside
+        return _PASS, outside
     if outside:
-        return (Verdict.WARN if should else Verdict.FAIL), outside
-    return Verdict.INCONCLUSIVE, outside
+        return (_WARN if should else _FAIL), outside
+    return _INCONCLUSIVE, outside
 
 
 def _margin_ms(lo: float | None, hi: float | None, measured: float, outside: bool) -> float | None:
@@ -716,11 +718,11 @@ class Measured:
         if (lo is None or measured - uncertainty >= lo) and (
             hi is None or measured + uncertainty <= hi
         ):  # surely inside, as nearly every one is: _window_verdict's PASS, without the call
-            self.verdict = Verdict.PASS
+            self.verdict = _PASS
             self.margin_ms = _margin_inside_ms(lo, hi, measured)
             return
         verdict, outside = _window_verdict(lo, hi, measured, uncertainty, window.should)
-        if verdict is Verdict.FAIL or verdict is Verdict.WARN:
+        if verdict is _FAIL or verdict is _WARN:
             self._finding = window.judge(measured, uncertainty, self._evidence())
             verdict = self._finding.verdict
         self.verdict = verdict
@@ -844,13 +846,13 @@ def recheck(findings: list[Finding], uncertainty: float) -> int:
     for f in findings:
         if f.margin_ms is None or f.uncertainty_ms is None or u_ms <= f.uncertainty_ms:
             continue
-        if f.verdict not in (Verdict.PASS, Verdict.WARN, Verdict.FAIL) or f.margin_ms > u_ms:
+        if f.verdict not in (_PASS, _WARN, _FAIL) or f.margin_ms > u_ms:
             continue
         f.detail += (
             f" — but the link's measured uncertainty grew to ±{u_ms:.2f} ms later in the run, "
             f"more than this {f.margin_ms:.2f} ms margin: not decided"
         )
-        f.verdict = Verdict.INCONCLUSIVE
+        f.verdict = _INCONCLUSIVE
         f.uncertainty_ms = round(u_ms, 3)
         changed += 1
     return changed
@@ -864,14 +866,14 @@ def undecide_after_late_line(findings: list[Finding], late: float, allowed: floa
     many changed."""
     changed = 0
     for f in findings:
-        if f.verdict not in (Verdict.FAIL, Verdict.WARN):
+        if f.verdict not in (_FAIL, _WARN):
             continue
         f.detail += (
             f" — but the served line fell {late * 1e3:.1f} ms behind its schedule in this run "
             f"(more than {allowed * 1e3:.0f} ms: the host was too busy), so the played sensors "
             "may have answered late and the recorder may have reacted to that: not decided"
         )
-        f.verdict = Verdict.INCONCLUSIVE
+        f.verdict = _INCONCLUSIVE
         changed += 1
     return changed
 
@@ -932,7 +934,7 @@ def combine(
     equals, the largest measurement, or the smallest for minimum limits such as a break's
     length), with the range of all of them, so a reader sees one line per rule."""
     if not findings:
-        return Finding(rid, Verdict.INCONCLUSIVE, f"no {what} was observed")
+        return Finding(rid, _INCONCLUSIVE, f"no {what} was observed")
     sign = -1 if smallest_is_worst else 1
     # each object once, in the order it first comes (a run's character gaps: tens of
     # thousands, a few hundred distinct): the first of the largest is the same either way
@@ -950,9 +952,9 @@ def combine(
     values = [f.measured_ms for f in distinct if f.measured_ms is not None]
     count = counted(len(findings), what)
     span = f"{count}, {min(values):.2f}..{max(values):.2f} ms" if values else ""
-    if worst.verdict is Verdict.PASS and ", allowed " in worst.detail:
+    if worst.verdict is _PASS and ", allowed " in worst.detail:
         detail = f"{span}; all inside the limit ({worst.detail.split(', allowed ')[-1]})"
-    elif worst.verdict is Verdict.PASS:
+    elif worst.verdict is _PASS:
         detail = f"{count} observed; {span + '; ' if span else ''}{worst.detail}"
     else:
         parts = [worst.detail]
@@ -966,7 +968,7 @@ def combine(
     margin = None
     if margins and len(margins) == len(same):
         # every PASS must hold; for a FAIL, one that holds is enough
-        margin = max(margins) if worst.verdict in (Verdict.FAIL, Verdict.WARN) else min(margins)
+        margin = max(margins) if worst.verdict in (_FAIL, _WARN) else min(margins)
     return Finding(
         rid,
         worst.verdict,

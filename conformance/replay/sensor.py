@@ -40,6 +40,11 @@ LINE_FREE = float("-inf")
 _START_END = attrgetter("start", "end")
 _ORIGIN, _KIND = attrgetter("origin"), attrgetter("kind")
 
+#: the kinds the replay asks of every tool event, as module constants: an enum member read
+#: off its class goes through the metaclass's ``__getattr__`` hook on Python 3.11 (issue 22,
+#: matrix25: ~0.13 us a look, some 10^5 looks a fault-matrix row in all)
+_CHAR, _BREAK = EventKind.CHAR, EventKind.BREAK
+
 #: how every divergence's message starts (a report's stop reason names it)
 DIVERGED = "replay diverged"
 
@@ -158,10 +163,10 @@ class RecordedSensor:
 
     # -- what the tool does -------------------------------------------------------------------
     def on_break(self, start: float, end: float) -> None:
-        self._match(EventKind.BREAK, 0, end, end - start)
+        self._match(_BREAK, 0, end, end - start)
 
     def on_char(self, wire: int, start: float, end: float) -> None:
-        self._match(EventKind.CHAR, wire, end)
+        self._match(_CHAR, wire, end)
 
     def _match(self, kind: EventKind, wire: int, end: float, length: float = 0.0) -> None:
         heard = self.heard
@@ -416,9 +421,9 @@ def _same(
     recorded_kind: EventKind, recorded_wire: int, kind: EventKind, wire: int, length: float
 ) -> bool:
     """:func:`same_action` given the recorded event's kind and byte."""
-    if kind is EventKind.CHAR:
-        return recorded_kind is EventKind.CHAR and recorded_wire == wire
-    if recorded_kind is EventKind.BREAK:
+    if kind is _CHAR:
+        return recorded_kind is _CHAR and recorded_wire == wire
+    if recorded_kind is _BREAK:
         return True
     if length >= CHAR_TIME:
         return False

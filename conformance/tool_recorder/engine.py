@@ -129,8 +129,8 @@ class ToolRecorder:
             command = cmds.parse_command(command)
         text = command.text()
         if binary is None:
-            binary = command.kind is Kind.BINARY_DATA
-        if crc is None and command.kind in (Kind.DATA, Kind.BINARY_DATA):
+            binary = command.kind is _BINARY_DATA
+        if crc is None and command.kind in _DATA_KINDS:
             crc = self._crc_pending.get(command.address)
         wire = encode_7e1(text)
         exchange = Exchange(command, text, [], binary=binary, expect_reply=expect_reply)
@@ -554,7 +554,7 @@ class ToolRecorder:
         self._closed_reply_end = None
         command_end = sent[-1].end if sent else self.link.now()
         framing = self._framing(
-            binary, not binary and (command is None or command.kind is Kind.EXTENDED)
+            binary, not binary and (command is None or command.kind is _EXTENDED)
         )
         reply, state, collided = self._listen(command_end, framing)
         text: str | None = None
@@ -568,7 +568,7 @@ class ToolRecorder:
             # to every later reader (Attempt.reply_text)
             text = None if framing.binary else decode_7e1(reply)
             state = self._judge_reply(reply, command, address, command_end, framing, crc, text)
-        if reply and not collided and command is not None and command.kind is Kind.ACKNOWLEDGE:
+        if reply and not collided and command is not None and command.kind is _ACKNOWLEDGE:
             self.acknowledged.add(address)
         if not collided and not framing.is_text(reply) and closes_exchange(command, reply):
             self._closed_reply_end = reply[-1].end
@@ -836,18 +836,24 @@ def closes_exchange(command: Command | None, reply: list[Event]) -> bool:
         and validity.ends_line(reply)
         # every one a character (``kind is CHAR``), read in C rather than a generator
         # step per character of every reply
-        and all(map(is_, map(_KIND, reply), repeat(EventKind.CHAR)))
+        and all(map(is_, map(_KIND, reply), repeat(_CHAR)))
     )
 
 
 _KIND = attrgetter("kind")
+#: the kinds every attempt asks about, as module constants: a member read off the enum goes
+#: through its metaclass's ``__getattr__`` hook on Python 3.11 (issue 22, matrix25: ~0.13 us
+#: a look, some ten looks an attempt)
+_CHAR, _NOTE, _BREAK = EventKind.CHAR, EventKind.NOTE, EventKind.BREAK
+_BINARY_DATA, _EXTENDED, _ACKNOWLEDGE = Kind.BINARY_DATA, Kind.EXTENDED, Kind.ACKNOWLEDGE
+_DATA_KINDS = (Kind.DATA, Kind.BINARY_DATA)
 
 
 def _own_break_last(link: Link) -> bool:
     """Whether the last thing on the wire is the tool's own break (its marking follows)."""
     for event in reversed(link.transcript.events):
-        if event.kind is not EventKind.NOTE:
-            return event.kind is EventKind.BREAK and event.origin == TOOL
+        if event.kind is not _NOTE:
+            return event.kind is _BREAK and event.origin == TOOL
     return False
 
 
@@ -866,7 +872,7 @@ class _LastDutChar:
         """The end of the last DUT character in ``events`` (-inf: none yet)."""
         if self.seen and (len(events) < self.seen or events[self.seen - 1] is not self._last):
             self.seen, self.end = 0, float("-inf")  # not only appended to: read it all again
-        char = EventKind.CHAR
+        char = _CHAR
         # the last of the new events that is a DUT character, looked for from the end (what
         # the forward pass kept in the end: each such end overwrote the one before); a reply
         # read ends in its own characters, so the look stops at once

@@ -26,6 +26,10 @@ from ..protocol.timing import NO_BREAK_WINDOW
 from ..transcript import SEVEN_BITS, Event, Transcript, decode_8n1, wire_bytes
 from .segments import IsRecorder, TranscriptView, Transmission, memo, read_view
 
+#: a module constant (:meth:`Segment.of`): a member read off the enum goes through its metaclass's
+#: ``__getattr__`` hook on Python 3.11 (issue 22, matrix25: ~0.13 us a look)
+_BINARY_DATA = Kind.BINARY_DATA
+
 T = TypeVar("T")
 
 #: How a gap's stamps are worth where it lies: ``(start, end) -> uncertainty`` (s).
@@ -84,7 +88,7 @@ class Segment:
             t.break_event,
             list(t.chars),
             text=t.text,
-            binary_reply=cmd is not None and cmd.kind is Kind.BINARY_DATA,
+            binary_reply=cmd is not None and cmd.kind is _BINARY_DATA,
             sensor_breaks=t.sensor_breaks,
             met_by=t.met_by,
         )

@@ -667,6 +667,11 @@ def _cut(
     return TranscriptView(cut.transmissions, cut.breaks, cut.chars, cut.unanswerable, undirected)
 
 
+#: the kinds :meth:`Cut.feed` reads per event, as module constants: a member read off the enum goes
+#: through its metaclass's ``__getattr__`` hook on Python 3.11 (issue 22, matrix25: ~0.13 us a look)
+_CHAR, _BREAK = EventKind.CHAR, EventKind.BREAK
+
+
 class Cut:
     """:func:`read_view`'s cut, kept between batches of events: fed events in time order,
     its lists are what one cut of all of them gives (the cut reads each event once, in
@@ -702,7 +707,7 @@ class Cut:
         )  # fmt: skip
         pending, current = self._pending, self._current
         is_command, after_bang, last_heard = self._is_command, self._after_bang, self._last_heard
-        char, brk, add_char = EventKind.CHAR, EventKind.BREAK, self.chars.append
+        char, brk, add_char = _CHAR, _BREAK, self.chars.append
         for e, own in zip(ordered, mine, strict=True):
             kind = e.kind
             if kind is char:
