@@ -150,11 +150,15 @@ FORMAT: tuple[Fault, ...] = (
     ),
     Fault(
         "ident-bad-version",
-        "aI! gives the SDI-12 version as 'V4' instead of two digits.",
+        "aI! gives the SDI-12 version as 'V4' instead of two digits."
+        " The tool retries that reply, its later tries after breaks of its own, so the aI!"
+        " sent into a running concurrent measurement cannot be told from those breaks as what"
+        " aborted it (R-4.4.7.1-01/02).",
         ("R-4.4.2-02",),
         rewrite=only(
             [ReplyKind.IDENTIFICATION], lambda r: replace(r, body=r.body[0] + "V4" + r.body[3:])
         ),
+        inconclusive=("R-4.4.7.1-01", "R-4.4.7.1-02"),
     ),
     Fault(
         "ack-trailing-space",

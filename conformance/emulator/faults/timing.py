@@ -190,10 +190,12 @@ TIMING: tuple[Fault, ...] = (
         "no-follow-up-without-break",
         "After each reply the sensor needs a break again (follow-ups within 87 ms fail)."
         " Its silence to a! after a command for another address is then no sign of that"
-        " command's standby (R-7.0-14: the control a! sent as late is unanswered too).",
+        " command's standby (R-7.0-14: the control a! sent as late is unanswered too)."
+        " Its aI! into a running concurrent measurement is answered only after a break of"
+        " the tool's, which may as well be what aborted it (R-4.4.7.1-01/02).",
         ("R-7.0-16",),
         settings={"standby_after_reply": True},
-        inconclusive=("R-7.0-14",),
+        inconclusive=("R-7.0-14", "R-4.4.7.1-01", "R-4.4.7.1-02"),
     ),
     Fault(
         "deaf-after-service-request",
@@ -248,10 +250,12 @@ BOUNDARIES: tuple[Fault, ...] = (
         "standby-after-40ms",
         "The sensor drops to standby 40 ms after its last reply, not 100 ms: a follow-up "
         "without a break at 40..87 ms goes unanswered, so its silence to a! after a command"
-        " for another address shows no standby of that command's (R-7.0-14).",
+        " for another address shows no standby of that command's (R-7.0-14). Its aI! into a"
+        " running concurrent measurement is answered only after a break of the tool's, which"
+        " may as well be what aborted it (R-4.4.7.1-01/02).",
         ("R-7.0-16",),
         settings={"standby_after_reply_marking": 40e-3},
-        inconclusive=("R-7.0-14",),
+        inconclusive=("R-7.0-14", "R-4.4.7.1-01", "R-4.4.7.1-02"),
     ),
     Fault(
         "standby-after-60ms",
