@@ -210,9 +210,10 @@ def test_own_command_aborts_concurrent(sensor, case):
         )
         return
     if woke := [a.break_event for a in poke.attempts if a.break_event is not None]:
-        # the tool's own break (a retry of an unaccepted aI! reply) went while the measurement
-        # ran: an empty D0 may be that break's abort, not the command's (seed 5700:
-        # break-aborts-concurrent + concurrent-not-aborted + ident-bad-version PASSed here)
+        # a break of the tool's own before a try of aI! (a retry of an unaccepted reply, or a
+        # sensor that needed waking): an empty D0 may be that break's abort, not the
+        # command's (seed 5700: break-aborts-concurrent + concurrent-not-aborted +
+        # ident-bad-version PASSed here)
         why = (
             f"{code} gave no values after {sensor.address}I!, but {len(woke)} of its tries "
             f"went after a break of the tool's own (first at {woke[0].start:.3f} s): the "
