@@ -21,24 +21,11 @@ from conformance.judges.wake_heard import (
 from conformance.protocol.commands import parse_command
 from conformance.protocol.timing import CHAR_TIME
 from conformance.tool_recorder.records import CONTENTION, NO_REPLY, OK, Attempt, Exchange
-from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.transcript import DUT, TOOL, Event, EventKind
 from conformance.verdicts import Finding, Verdict
+from tests.support.hand_events import chars
 
 BREAK = 13e-3
-
-
-def _chars(text: str, start: float, origin: str, u: float = 0.0) -> list[Event]:
-    return [
-        Event(
-            EventKind.CHAR,
-            origin,
-            start + i * CHAR_TIME,
-            start + (i + 1) * CHAR_TIME,
-            wire=to_wire_7e1(ord(c)),
-            uncertainty=u,
-        )
-        for i, c in enumerate(text)
-    ]
 
 
 def _break(end: float, u: float = 0.0) -> Event:
@@ -50,9 +37,9 @@ def _exchange(command: str, tries: list[tuple[float | None, float, int, int]], r
     index of the try answered '0\\r\\n'-like text (None: none)."""
     attempts = []
     for i, (brk, start, sequence, retry) in enumerate(tries):
-        cmd = _chars(command, start, TOOL)
+        cmd = chars(TOOL, command, start)
         answered = reply is not None and i == reply
-        got = _chars(f"{command[0]}\r\n", cmd[-1].end + 0.01, DUT) if answered else []
+        got = chars(DUT, f"{command[0]}\r\n", cmd[-1].end + 0.01) if answered else []
         end = (got[-1].end if got else cmd[-1].end + 0.03) + 0.001
         a = Attempt(
             None if brk is None else _break(brk),
@@ -119,12 +106,12 @@ def test_the_uncertainty_of_the_stamps_counts_against_the_wake_up() -> None:
     """A retry 105 ms after its break, stamped to ±5 ms, is not surely past 100.4 ms."""
     brk = _break(10.0, u=5e-3)
     tries = [
-        Attempt(brk, _chars("0!", 10.009, TOOL, 5e-3), [], NO_REPLY, 10.07, 0, 0),
-        Attempt(None, _chars("0!", 10.105, TOOL, 5e-3), [], NO_REPLY, 10.16, 0, 1),
+        Attempt(brk, chars(TOOL, "0!", 10.009, uncertainty=5e-3), [], NO_REPLY, 10.07, 0, 0),
+        Attempt(None, chars(TOOL, "0!", 10.105, uncertainty=5e-3), [], NO_REPLY, 10.16, 0, 1),
     ]
     ex = Exchange(parse_command("0!"), "0!", tries)
     assert "none of its 2 tries" in unheard(ex)
-    tries[1].command_events[:] = _chars("0!", 10.106, TOOL, 0.0)
+    tries[1].command_events[:] = chars(TOOL, "0!", 10.106)
     tries[0].break_event = _break(10.0)
     assert unheard(ex) == ""
 
@@ -205,7 +192,7 @@ def test_a_try_met_by_the_sensors_characters_is_set_aside() -> None:
     )
     first = ex.attempts[0]
     first.reason = CONTENTION + " (3 characters during the command)"
-    first.stray_events = _chars("00000\r\n", 152.6610, DUT)
+    first.stray_events = chars(DUT, "00000\r\n", 152.6610)
     found = xjudge.answered("R-6.1-01", [ex], "v1.4 makes them mandatory", late_is_reply=True)
     assert found.verdict is Verdict.INCONCLUSIVE, found.detail
     assert "none of its 4 tries (1 more met by the sensor's characters)" in found.detail
@@ -219,7 +206,7 @@ def _one_shots(starts: list[float]) -> list[Exchange]:
         Exchange(
             parse_command("0!"),
             "0!",
-            [Attempt(None, _chars("0!", t, TOOL), [], NO_REPLY, t + 0.05)],
+            [Attempt(None, chars(TOOL, "0!", t), [], NO_REPLY, t + 0.05)],
         )
         for t in starts
     ]
