@@ -65,6 +65,9 @@ _CONTINUOUS, _IDENTIFY_MEASUREMENT = Kind.CONTINUOUS, Kind.IDENTIFY_MEASUREMENT
 _METADATA, _EXTENDED = Kind.METADATA, Kind.EXTENDED
 _SERVICE_REQUEST, _CHATTER = ReplyKind.SERVICE_REQUEST, ReplyKind.CHATTER  # (``_sent``)
 _MAX_COMMAND = 64  # a command longer than this is noise; drop it rather than grow forever
+#: a 7-bit character's text and even parity bit, looked up per character heard (``on_char``)
+_CHR7 = tuple(map(chr, range(0x80)))
+_PARITY = tuple(map(parity_bit, range(0x80)))
 
 
 class SensorEmulator:
@@ -183,28 +186,50 @@ class SensorEmulator:
         self._overheard = ""
 
     def on_char(self, wire: int, start: float, end: float) -> None:
+        # Heard once per tool character (some 5,500 a fault-matrix row, issue 22), so the
+        # calls it made per character are spelt out here: ``_tx.line_taken_until`` only
+        # where something is planned (it returns at once on an empty queue), ``_settle``,
+        # ``_hear``, ``max`` (as ``max(a, b)`` picks: ``b`` only if ``b > a``) and
+        # ``parity_bit``; the same state changes in the same order.
         b = self.behaviour
-        self._tx.line_taken_until(end)  # a frame of ours planned inside it waits for it
+        tx = self._tx
+        if tx.queue:
+            tx.line_taken_until(end)  # a frame of ours planned inside it waits for it
         report = self._report
         if report is not None and report.sent == 0:
             # the firmware reports an aborted measurement only to a line left quiet
             self._tx.cancel(lambda t: t is not report)
             self._report = None
-        self._settle(start)
+        run = self._run
+        if run is not None and run.ready_at <= start:  # _settle(start)
+            self._data = complete(run, b)
+            self._run = None
         if b.foreign_reply_aborts_concurrent or b.answer_foreign_reply:
-            self._overhear(chr(wire & 0x7F), end)
+            self._overhear(_CHR7[wire & 0x7F], end)
         previous = self._last_activity
-        heard = self._hear(start)
-        self._last_activity = max(self._last_activity, end)
+        # _hear(start): the idle rules at a start bit
+        wake_at = self._wake_at
+        if start < wake_at:
+            heard = False  # still waking up after the break
+        else:
+            reference = wake_at if wake_at > previous else previous
+            if self._awake and start - reference >= self._standby_limit:
+                self._awake = False  # R-7.0-15: 100 ms of marking
+                self._entered_standby()
+            heard = self._awake
+        last = self._last_activity
+        if end > last:
+            self._last_activity = end
         self._replied_last = False
         if not heard:
             self._buf = []
             return
         char7 = wire & 0x7F
-        char = chr(char7)
-        if self._buf and start - self._buf_end >= b.partial_gap:
-            self._buf = []  # R-AppB-01: marking inside a command drops it
-        if not self._buf:
+        char = _CHR7[char7]
+        buf = self._buf
+        if buf and start - self._buf_end >= b.partial_gap:
+            buf = self._buf = []  # R-AppB-01: marking inside a command drops it
+        if not buf:
             # a sensor that woke up while characters were flowing has caught the tail of a
             # command: like after a break, it needs marking before it takes an address
             mid_stream = self._waking and start - previous < b.address_marking
@@ -212,9 +237,10 @@ class SensorEmulator:
             self._begin_command(char, start, mid_stream)
             if not self._awake:
                 return
-        self._buf.append(char)
+            buf = self._buf
+        buf.append(char)
         self._buf_end = end
-        if (wire >> 7) != parity_bit(char7):
+        if (wire >> 7) != _PARITY[char7]:
             self._buf_invalid = True  # a parity error spoils the command
         if char == COMMAND_END:
             text, invalid, begun = "".join(self._buf), self._buf_invalid, self._buf_start

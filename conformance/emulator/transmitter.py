@@ -114,6 +114,22 @@ class Transmitter:
         already on the line then; ``spacing``: a break of the sensor's before it, ending
         ``marking`` before its first frame (:attr:`Transmission.spacing`)."""
         wires = reply.wires()
+        if not self.queue:
+            # nothing planned (a reply to a command, nearly always): nothing to wait for or
+            # move out of its way, and a queue of one is in order (what the loop, _make_way
+            # and the sort below come to then)
+            item = Transmission(
+                reply,
+                start,
+                wires,
+                gap,
+                char_time=char_time,
+                pauses=pauses,
+                spacing=spacing,
+                marking=marking,
+            )
+            self.queue.append(item)
+            return item
         lead = spacing + marking if spacing else 0.0
         for other in self.queue:
             if other.begin <= start - lead < other.end + CHAR_TIME:
