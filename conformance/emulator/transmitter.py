@@ -114,26 +114,12 @@ class Transmitter:
         already on the line then; ``spacing``: a break of the sensor's before it, ending
         ``marking`` before its first frame (:attr:`Transmission.spacing`)."""
         wires = reply.wires()
-        if not self.queue:
-            # nothing planned (a reply to a command, nearly always): nothing to wait for or
-            # move out of its way, and a queue of one is in order (what the loop, _make_way
-            # and the sort below come to then)
-            item = Transmission(
-                reply,
-                start,
-                wires,
-                gap,
-                char_time=char_time,
-                pauses=pauses,
-                spacing=spacing,
-                marking=marking,
-            )
-            self.queue.append(item)
-            return item
-        lead = spacing + marking if spacing else 0.0
-        for other in self.queue:
-            if other.begin <= start - lead < other.end + CHAR_TIME:
-                start = other.end + CHAR_TIME + lead
+        queue = self.queue
+        if queue:  # (rare: nearly always nothing is planned, nothing to wait for)
+            lead = spacing + marking if spacing else 0.0
+            for other in queue:
+                if other.begin <= start - lead < other.end + CHAR_TIME:
+                    start = other.end + CHAR_TIME + lead
         item = Transmission(
             reply,
             start,
@@ -144,6 +130,11 @@ class Transmitter:
             spacing=spacing,
             marking=marking,
         )
+        if not queue:
+            # nothing to move out of its way, and a queue of one is in order (what
+            # _make_way and the sort below come to then)
+            queue.append(item)
+            return item
         self._make_way(item)
         self.queue.append(item)
         self.queue.sort(key=lambda t: t.start)
