@@ -171,3 +171,19 @@ def test_every_stimulus_of_a_sim_run_reads_what_its_own_cut_gives(fault, tmp_pat
         live_run(tmp_path / "live", f"sim://?faults={fault}" if fault else "sim://")
     assert compared["shared"] > 300  # the one cut is what nearly every stimulus reads
     assert views and all(a == b for a, b in views)
+
+
+def test_notes_among_the_events_fed_are_left_out_as_read_view_leaves_them() -> None:
+    """The events fed after a look are the transcript's own slice unless a NOTE is among
+    them (live27): then they are fed without it, as ``read_view`` cuts them; either way the
+    cut is ``read_view``'s, and a stimulus whose events hold a NOTE reads the one cut."""
+    events: list[Event] = [_break(0.0), *_chars(TOOL, 0.02, "0!"), *_chars(DUT, 0.05, "0\r\n")]
+    cut = LiveCut()
+    note = Event(EventKind.NOTE, TOOL, 0.25, 0.25, text="a collision")
+    more = [_break(0.2), *_chars(TOOL, 0.22, "0I!"), note, *_chars(DUT, 0.26, "013TEST\r\n")]
+    shared = _stimulus(cut, events, more)
+    assert shared is not None and len(shared) == 1
+    assert _shapes(shared) == _shapes(read_view(more).transmissions)
+    more = [*_chars(TOOL, 0.6, "0!"), *_chars(DUT, 0.63, "0\r\n")]  # no NOTE: the slice
+    assert _shapes(_stimulus(cut, events, more)) == _shapes(read_view(more).transmissions)
+    assert _shapes(cut.view().transmissions) == _shapes(read_view(events).transmissions)
