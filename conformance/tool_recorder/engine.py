@@ -47,7 +47,7 @@ from ..transcript import (
     to_wire_7e1,
 )
 from ..view.segments import continues_frame
-from . import validity
+from . import cut_read, validity
 from .contention import HOLD_PREFIX, ApartSoFar, collisions, maybe_note_text
 from .hooks import Hooks
 from .policy import Policy
@@ -103,6 +103,9 @@ class ToolRecorder:
         #: The last exchange sent (by :meth:`transact` or :meth:`raw`): a reply that comes
         #: after the next command may be this one's, late (:mod:`..sensor.address_change`).
         self.last_exchange: Exchange | None = None
+        #: the last attempt, if its read ended IDLE on a link whose deliveries may lag: the
+        #: next try's first characters may be its rest (:mod:`.cut_read`)
+        self._cut: cut_read.CutRead | None = None
         #: the policy the framings were made for, and each kind of reply's (:meth:`_framing`)
         self._framings: tuple[Policy | None, dict[tuple[bool, bool], Framing]] = (None, {})
 
@@ -153,6 +156,8 @@ class ToolRecorder:
                 )
                 attempt.sequence, attempt.retry = sequence, retry
                 exchange.attempts.append(attempt)
+                if self._cut is not None:  # this attempt's read was cut (cut_read)
+                    self._cut.exchange = exchange
                 if attempt.ok:
                     self._note_accepted(command)
                     self.last_exchange = exchange
@@ -201,6 +206,8 @@ class ToolRecorder:
             collide=collide,
         )
         exchange = Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
+        if self._cut is not None:  # this attempt's read was cut (cut_read)
+            self._cut.exchange = exchange
         self.last_exchange = exchange
         return exchange
 
@@ -557,6 +564,11 @@ class ToolRecorder:
             binary, not binary and (command is None or command.kind is _EXTENDED)
         )
         reply, state, collided = self._listen(command_end, framing)
+        mending, self._cut = self._cut, None
+        if mending is not None:  # the rest of a reply a stall cut comes before this one
+            stray = mending.mend(stray)
+            if not stray and collided:
+                collided = mending.mend_met(collided, break_event or (sent[0] if sent else None))
         text: str | None = None
         if collided:
             self.note_collisions()
@@ -577,7 +589,30 @@ class ToolRecorder:
         )
         if text is not None:
             attempt.knows_reply_text(text)
+        if state == IDLE:
+            self._cut = cut_read.cut(
+                attempt,
+                framing,
+                self.link,
+                judge=lambda chars: self._judge_again(
+                    chars, command, address, command_end, framing, crc
+                ),
+            )
         return attempt
+
+    def _judge_again(
+        self,
+        reply: list[Event],
+        command: Command | None,
+        address: str,
+        command_end: float,
+        framing: Framing,
+        crc: bool | None,
+    ) -> tuple[str, str | None]:
+        """:meth:`_judge_reply` of a reply mended after its read was cut
+        (:mod:`.cut_read`), with the text it decoded (None: a binary packet)."""
+        text = None if framing.binary else decode_7e1(reply)
+        return self._judge_reply(reply, command, address, command_end, framing, crc, text), text
 
     def _framing(self, binary: bool, multiline: bool) -> Framing:
         """:func:`framing_for` this engine's policy, made once per policy object and kind

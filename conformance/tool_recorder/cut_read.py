@@ -1,0 +1,136 @@
+"""A reply the engine's read cut at a delivery stall, mended from the characters that came late.
+
+On a real link the engine's read of a reply ends when no character has *arrived* for the
+framing's idle window (and the link's latency bound) after the last one. On a loaded host a
+delivery can stall longer than that (truth23: behind ``emulate --echo --jitter 2`` at load ~22,
+0IHB_010!'s record was read as ``'0,XB, ,sa'``, 9 of its 32 characters): the read ends, the try
+is taken as cut off (IDLE) and retried, and when the rest arrives its stamps put it right behind
+the ninth character, back to back as the wire carried it (a burst is laid back to back after
+the previous frame, :func:`~conformance.links.stamps.chunk_frames`). The transcript then holds
+the reply whole while the record judged holds the cut one: R-6.2-02 FAILed "does not end with
+';'" for a sensor whose only fault was its CRC.
+
+The rest comes in the next try's read: queued before it went out (its ``stray`` characters),
+or after, stamped before its command ended (its collided characters). Those of them that the
+stamps place inside the cut read's windows, one after the other, as the read itself would have
+taken them, are the cut reply's: they are added to it and it is judged again, and they are
+neither the next try's strays nor a collision with it. The rule is the read's own (and the
+view's, which cuts a rebuilt reply where the stamps idle, :mod:`conformance.view.rebuilt_records`),
+so a reply that really paused past the window stays cut, as it always was. Only links whose
+deliveries can lag their stamps (not virtual-time ones) are mended; the residue, a rest that
+arrives after the next try's reply has begun, stays as before.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from ..links.base import Link
+from ..transcript import Event
+from .records import IDLE, TOO_LONG, Attempt, Exchange
+from .reply_end import Framing
+
+
+@dataclass
+class CutRead:
+    """An attempt whose read ended IDLE on a link whose deliveries may lag (:func:`cut`).
+
+    ``judge`` checks a finished reply as the engine does (OK or ``invalid: why``) and gives
+    its text where it decoded it (None: binary)."""
+
+    attempt: Attempt
+    framing: Framing
+    link: Link
+    judge: Callable[[list[Event]], tuple[str, str | None]]
+    #: the exchange the attempt belongs to, once known: its cached choice of the judged
+    #: attempt is dropped when the reply grows
+    exchange: Exchange | None = field(default=None, repr=False)
+
+    def continuation(self, chars: list[Event]) -> int:
+        """How many of ``chars`` (in arrival order) continue the cut reply: each began
+        inside the read's window after the one before (its idle, or the next line's wait in
+        a multi-line text) and before the read's hard bound, and the reply was not complete
+        or at its limit yet."""
+        framing = self.framing
+        reply = self.attempt.reply_events
+        if not reply:
+            return 0
+        hard = framing.deadline(reply[0])
+        have = list(reply)
+        taken = 0
+        for char in chars:
+            if framing.finished(have) or len(have) >= framing.limit(have):
+                break
+            if char.start >= min(hard, have[-1].end + framing.window(have)):
+                break
+            have.append(char)
+            taken += 1
+        return taken
+
+    def mend(self, chars: list[Event]) -> list[Event]:
+        """Add the leading ``chars`` that continue the cut reply to it, judge it again, and
+        return the rest (none taken: ``chars`` as they were)."""
+        taken = self.continuation(chars)
+        if not taken:
+            return chars
+        attempt, framing = self.attempt, self.framing
+        reply = attempt.reply_events + chars[:taken]
+        if taken == len(chars):  # all of it was the rest, which may still be coming
+            reply = self._read_on(reply)
+        attempt.reply_events = reply
+        if framing.finished(reply) or framing.at_line_end(reply):
+            reason, text = self.judge(reply)
+            attempt.reason = reason
+            if text is not None:
+                attempt.knows_reply_text(text)
+        else:
+            attempt.reason = TOO_LONG if len(reply) >= framing.limit(reply) else IDLE
+        if self.exchange is not None:
+            self.exchange.__dict__.pop("_judged", None)
+        return chars[taken:]
+
+    def _read_on(self, reply: list[Event]) -> list[Event]:
+        """The cut read's loop (:meth:`ToolRecorder._listen`'s), taken up again after the
+        rest so far: each read ends a window after the last character, until the reply is
+        complete, at its limit, or the line marks."""
+        framing, link = self.framing, self.link
+        hard = framing.deadline(reply[0])
+        while not (framing.finished(reply) or len(reply) >= framing.limit(reply)):
+            more = link.receive(
+                min(hard, reply[-1].end + framing.window(reply)),
+                until=framing.stop_for(reply),
+                idle=framing.idle,
+            )
+            if not more:
+                break
+            reply = reply + more
+        return reply
+
+    def mend_met(self, collided: list[Event], first: Event | None) -> list[Event]:
+        """:meth:`mend` of the characters that met the next try's transmission (``first``:
+        its break or first character): the rest of the cut reply is no collision of that
+        try's when the stamps put all of it before the try began, and stays one (the
+        whole list, so the try is judged as met) when it ran on into it: the DUT was still
+        talking when the tool, blind to it, sent the try."""
+        rest = self.mend(collided)
+        taken = len(collided) - len(rest)
+        if taken and first is not None and collided[taken - 1].end > first.start:
+            return collided
+        return rest
+
+
+def cut(
+    attempt: Attempt,
+    framing: Framing,
+    link: Link,
+    *,
+    judge: Callable[[list[Event]], tuple[str, str | None]],
+) -> CutRead | None:
+    """The attempt to mend from the next try's characters: one whose read ended IDLE with a
+    reply begun, on a link whose deliveries may lag their stamps (None otherwise: on a
+    virtual clock every character is delivered at its stamp, so the read's end is the
+    line's)."""
+    if link.info.virtual_time or attempt.reason != IDLE or not attempt.reply_events:
+        return None
+    return CutRead(attempt, framing, link, judge)
