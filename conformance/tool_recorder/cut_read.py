@@ -27,7 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from ..links.base import Link
-from ..transcript import Event
+from ..transcript import Event, decode_7e1
 from .records import IDLE, TOO_LONG, Attempt, Exchange
 from .reply_end import Framing
 
@@ -36,13 +36,13 @@ from .reply_end import Framing
 class CutRead:
     """An attempt whose read ended IDLE on a link whose deliveries may lag (:func:`cut`).
 
-    ``judge`` checks a finished reply as the engine does (OK or ``invalid: why``) and gives
-    its text where it decoded it (None: binary)."""
+    ``judge`` checks a finished reply, given its text (None: a binary packet), as the
+    engine does: OK or ``invalid: why``."""
 
     attempt: Attempt
     framing: Framing
     link: Link
-    judge: Callable[[list[Event]], tuple[str, str | None]]
+    judge: Callable[[list[Event], str | None], str]
     #: the exchange the attempt belongs to, once known: its cached choice of the judged
     #: attempt is dropped when the reply grows
     exchange: Exchange | None = field(default=None, repr=False)
@@ -68,20 +68,22 @@ class CutRead:
             taken += 1
         return taken
 
-    def mend(self, chars: list[Event]) -> list[Event]:
+    def mend(self, chars: list[Event], *, read_on: bool = False) -> list[Event]:
         """Add the leading ``chars`` that continue the cut reply to it, judge it again, and
-        return the rest (none taken: ``chars`` as they were)."""
+        return the rest (none taken: ``chars`` as they were). ``read_on``: where all of
+        them were its rest and nothing was read after them (the next try drew no reply of
+        its own), read on as the cut read would have, for the rest still coming."""
         taken = self.continuation(chars)
         if not taken:
             return chars
         attempt, framing = self.attempt, self.framing
         reply = attempt.reply_events + chars[:taken]
-        if taken == len(chars):  # all of it was the rest, which may still be coming
+        if read_on and taken == len(chars):  # all of it the rest: more may be coming
             reply = self._read_on(reply)
         attempt.reply_events = reply
         if framing.finished(reply) or framing.at_line_end(reply):
-            reason, text = self.judge(reply)
-            attempt.reason = reason
+            text = None if framing.binary else decode_7e1(reply)
+            attempt.reason = self.judge(reply, text)
             if text is not None:
                 attempt.knows_reply_text(text)
         else:
@@ -107,13 +109,15 @@ class CutRead:
             reply = reply + more
         return reply
 
-    def mend_met(self, collided: list[Event], first: Event | None) -> list[Event]:
+    def mend_met(
+        self, collided: list[Event], first: Event | None, *, read_on: bool = False
+    ) -> list[Event]:
         """:meth:`mend` of the characters that met the next try's transmission (``first``:
         its break or first character): the rest of the cut reply is no collision of that
         try's when the stamps put all of it before the try began, and stays one (the
         whole list, so the try is judged as met) when it ran on into it: the DUT was still
         talking when the tool, blind to it, sent the try."""
-        rest = self.mend(collided)
+        rest = self.mend(collided, read_on=read_on)
         taken = len(collided) - len(rest)
         if taken and first is not None and collided[taken - 1].end > first.start:
             return collided
@@ -125,7 +129,7 @@ def cut(
     framing: Framing,
     link: Link,
     *,
-    judge: Callable[[list[Event]], tuple[str, str | None]],
+    judge: Callable[[list[Event], str | None], str],
 ) -> CutRead | None:
     """The attempt to mend from the next try's characters: one whose read ended IDLE with a
     reply begun, on a link whose deliveries may lag their stamps (None otherwise: on a

@@ -568,7 +568,8 @@ class ToolRecorder:
         if mending is not None:  # the rest of a reply a stall cut comes before this one
             stray = mending.mend(stray)
             if not stray and collided:
-                collided = mending.mend_met(collided, break_event or (sent[0] if sent else None))
+                first_sent = break_event or (sent[0] if sent else None)
+                collided = mending.mend_met(collided, first_sent, read_on=not reply)
         text: str | None = None
         if collided:
             self.note_collisions()
@@ -594,25 +595,11 @@ class ToolRecorder:
                 attempt,
                 framing,
                 self.link,
-                judge=lambda chars: self._judge_again(
-                    chars, command, address, command_end, framing, crc
+                judge=lambda chars, text: self._judge_reply(
+                    chars, command, address, command_end, framing, crc, text
                 ),
             )
         return attempt
-
-    def _judge_again(
-        self,
-        reply: list[Event],
-        command: Command | None,
-        address: str,
-        command_end: float,
-        framing: Framing,
-        crc: bool | None,
-    ) -> tuple[str, str | None]:
-        """:meth:`_judge_reply` of a reply mended after its read was cut
-        (:mod:`.cut_read`), with the text it decoded (None: a binary packet)."""
-        text = None if framing.binary else decode_7e1(reply)
-        return self._judge_reply(reply, command, address, command_end, framing, crc, text), text
 
     def _framing(self, binary: bool, multiline: bool) -> Framing:
         """:func:`framing_for` this engine's policy, made once per policy object and kind

@@ -155,7 +155,7 @@ class _Quiet:
 def _cut(reply: list[Event]) -> cut_read.CutRead:
     attempt = Attempt(None, [], reply, IDLE, reply[-1].end + 0.06)
     framing = framing_for(Policy(), False, False)
-    made = cut_read.cut(attempt, framing, _Quiet(), judge=lambda chars: (OK, None))
+    made = cut_read.cut(attempt, framing, _Quiet(), judge=lambda chars, text: OK)
     assert made is not None
     return made
 
@@ -202,4 +202,4 @@ def test_a_virtual_clock_is_never_mended():
     reply = _chars(RECORD[:SHOWN], 1.0)
     attempt = Attempt(None, [], reply, IDLE, reply[-1].end + 0.06)
     framing = framing_for(Policy(), False, False)
-    assert cut_read.cut(attempt, framing, _Quiet(True), judge=lambda c: (OK, None)) is None
+    assert cut_read.cut(attempt, framing, _Quiet(True), judge=lambda c, t: OK) is None
