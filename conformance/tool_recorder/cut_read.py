@@ -31,6 +31,13 @@ from ..transcript import Event, decode_7e1
 from .records import IDLE, TOO_LONG, Attempt, Exchange
 from .reply_end import Framing
 
+#: the NOTE a mended reply leaves where its rest begins (the count of characters added
+#: follows): the report shows why characters read in a later try belong to this one
+STALL_NOTE = (
+    "the read of the reply before ended at a delivery stall; characters that came after it, "
+    "stamped inside its windows, were added to it: "
+)
+
 
 @dataclass
 class CutRead:
@@ -77,6 +84,7 @@ class CutRead:
         if not taken:
             return chars
         attempt, framing = self.attempt, self.framing
+        taken_before = len(attempt.reply_events)
         reply = attempt.reply_events + chars[:taken]
         if read_on and taken == len(chars):  # all of it the rest: more may be coming
             reply = self._read_on(reply)
@@ -90,6 +98,7 @@ class CutRead:
             attempt.reason = TOO_LONG if len(reply) >= framing.limit(reply) else IDLE
         if self.exchange is not None:
             self.exchange.__dict__.pop("_judged", None)
+        self.link.transcript.note(chars[0].start, f"{STALL_NOTE}{len(reply) - taken_before}")
         return chars[taken:]
 
     def _read_on(self, reply: list[Event]) -> list[Event]:

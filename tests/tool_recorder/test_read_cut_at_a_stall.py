@@ -26,7 +26,7 @@ from conformance.tool_recorder import cut_read
 from conformance.tool_recorder.engine import ToolRecorder, framing_for
 from conformance.tool_recorder.policy import Policy
 from conformance.tool_recorder.records import CONTENTION, IDLE, OK, Attempt
-from conformance.transcript import DUT, Event, EventKind, to_wire_7e1
+from conformance.transcript import DUT, Event, EventKind, Transcript, to_wire_7e1
 from conformance.verdicts import Verdict
 
 BODY = "0,RH,%,relative humidity;"
@@ -127,6 +127,8 @@ def test_a_record_cut_at_a_delivery_stall_is_judged_whole():
     assert ex.reply_text == RECORD
     assert ex.attempts[0].reason == OK
     assert nxt.attempts[0].reason.startswith(CONTENTION)
+    notes = [e.text for e in engine.link.transcript.events if e.kind is EventKind.NOTE]
+    assert f"{cut_read.STALL_NOTE}{len(RECORD) - SHOWN}" in notes
     findings = {f.requirement: f for f in records([(ex, True, True)], ("R-6.2-02",))}
     assert findings["R-6.2-02"].verdict is Verdict.PASS
 
@@ -147,6 +149,7 @@ class _Quiet:
 
     def __init__(self, virtual_time: bool = False) -> None:
         self.info = LinkInfo(kind="serial", virtual_time=virtual_time)
+        self.transcript = Transcript()
 
     def receive(self, deadline, until=None, idle=None) -> list[Event]:
         return []
