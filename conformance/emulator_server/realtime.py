@@ -204,6 +204,7 @@ class RealTimeLine:
                     self._push(deliver, lambda s=start: self._echo_spacing(s))
                 if self._taps:
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._tap_held(s))
+                if self.bench.echo or self._taps:
                     self._cond.notify()  # due before the break ends: wake the line for it
 
     def break_off(self, at: float | None = None, doubt: float = 0.0) -> None:
