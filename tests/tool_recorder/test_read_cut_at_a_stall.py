@@ -28,6 +28,7 @@ from conformance.tool_recorder.policy import Policy
 from conformance.tool_recorder.records import CONTENTION, IDLE, OK, Attempt
 from conformance.transcript import DUT, Event, EventKind, Transcript, to_wire_7e1
 from conformance.verdicts import Verdict
+from tests.support.hand_events import chars
 
 BODY = "0,RH,%,relative humidity;"
 RECORD = BODY + ascii_crc(BODY) + "\r\n"  # 32 characters, as 0IHB_010!'s was
@@ -133,15 +134,11 @@ def test_a_record_cut_at_a_delivery_stall_is_judged_whole():
     assert findings["R-6.2-02"].verdict is Verdict.PASS
 
 
-def _chars(text: str, start: float, gaps: dict[int, float] | None = None) -> list[Event]:
-    """DUT characters of ``text`` back to back from ``start``, ``gaps`` (index -> s) of
-    marking before some."""
-    out, at = [], start
-    for k, c in enumerate(text):
-        at += (gaps or {}).get(k, 0.0)
-        out.append(Event(EventKind.CHAR, DUT, at, at + CHAR_TIME, wire=to_wire_7e1(ord(c))))
-        at += CHAR_TIME
-    return out
+def _record(gap: float = 0.0) -> list[Event]:
+    """RECORD's characters from t = 1 s, back to back but for ``gap`` s of marking after
+    the ``SHOWN``-th."""
+    head = chars(DUT, RECORD[:SHOWN], 1.0)
+    return head + chars(DUT, RECORD[SHOWN:], head[-1].end + gap)
 
 
 class _Quiet:
@@ -168,7 +165,7 @@ def _cut(reply: list[Event], tainted: float = 0.0) -> cut_read.CutRead:
 
 
 def test_the_rest_inside_the_windows_is_taken_and_the_reply_judged_again():
-    whole = _chars(RECORD, 1.0)
+    whole = _record()
     cut = _cut(whole[:SHOWN])
     assert cut.mend(whole[SHOWN:]) == []
     assert cut.attempt.reply_events == whole
@@ -178,7 +175,7 @@ def test_the_rest_inside_the_windows_is_taken_and_the_reply_judged_again():
 def test_a_reply_that_paused_past_the_idle_window_stays_cut():
     """The rule is the read's own: a sensor that really stopped for 60 ms mid-reply (more
     than the 50 ms idle) is not joined to what it sent after, nor to a later reply."""
-    paused = _chars(RECORD, 1.0, gaps={SHOWN: 0.06})
+    paused = _record(0.06)
     cut = _cut(paused[:SHOWN])
     rest = paused[SHOWN:]
     assert cut.mend(rest) is rest
@@ -190,7 +187,7 @@ def test_a_gap_the_stamps_cannot_show_is_no_cut():
     laid to end at its arrival, 60 ms after the cut character by its stamps, which the
     link says are worth 15 ms there (the marking before a burst): the rest may have begun
     inside the window, and is taken. Worth 5 ms, they show a gap past it: cut."""
-    paused = _chars(RECORD, 1.0, gaps={SHOWN: 0.06})
+    paused = _record(0.06)
     assert _cut(paused[:SHOWN], tainted=5e-3).mend(paused[SHOWN:]) == paused[SHOWN:]
     cut = _cut(paused[:SHOWN], tainted=15e-3)
     assert cut.mend(paused[SHOWN:]) == []
@@ -200,13 +197,13 @@ def test_a_gap_the_stamps_cannot_show_is_no_cut():
 def test_what_follows_the_rest_stays_the_next_tries():
     """Only the reply's rest, up to its CR LF, is taken; a character after it (the next
     reply's, a stray) stays where it was read."""
-    whole = _chars(RECORD + "0", 1.0)
+    whole = _record() + chars(DUT, "0", _record()[-1].end)
     cut = _cut(whole[:SHOWN])
     assert cut.mend(whole[SHOWN:]) == whole[-1:]
 
 
 def test_the_rest_that_ran_into_the_next_try_keeps_that_try_met():
-    whole = _chars(RECORD, 1.0)
+    whole = _record()
     cut = _cut(whole[:SHOWN])
     rest = whole[SHOWN:]
     command = Event(EventKind.CHAR, "tool", rest[3].start, rest[3].end, wire=0x30)
@@ -218,7 +215,7 @@ def test_the_rest_that_ran_into_the_next_try_keeps_that_try_met():
 
 
 def test_a_virtual_clock_is_never_mended():
-    reply = _chars(RECORD[:SHOWN], 1.0)
+    reply = chars(DUT, RECORD[:SHOWN], 1.0)
     attempt = Attempt(None, [], reply, IDLE, reply[-1].end + 0.06)
     framing = framing_for(Policy(), False, False)
     assert cut_read.cut(attempt, framing, _Quiet(True), judge=lambda c, t: OK) is None
