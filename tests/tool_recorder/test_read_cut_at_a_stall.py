@@ -144,22 +144,18 @@ def _record(gap: float = 0.0) -> list[Event]:
 class _Quiet:
     """A link that delivers nothing more (the rule's tests hand it the characters)."""
 
-    def __init__(self, virtual_time: bool = False, tainted: float = 0.0) -> None:
+    def __init__(self, virtual_time: bool = False) -> None:
         self.info = LinkInfo(kind="serial", virtual_time=virtual_time)
         self.transcript = Transcript()
-        self.tainted = tainted  # what the stamps are worth between two characters (s)
-
-    def uncertainty_between(self, start: float, end: float) -> float:
-        return self.tainted
 
     def receive(self, deadline, until=None, idle=None) -> list[Event]:
         return []
 
 
-def _cut(reply: list[Event], tainted: float = 0.0) -> cut_read.CutRead:
+def _cut(reply: list[Event]) -> cut_read.CutRead:
     attempt = Attempt(None, [], reply, IDLE, reply[-1].end + 0.06)
     framing = framing_for(Policy(), False, False)
-    made = cut_read.cut(attempt, framing, _Quiet(tainted=tainted), judge=lambda chars, text: OK)
+    made = cut_read.cut(attempt, framing, _Quiet(), judge=lambda chars, text: OK)
     assert made is not None
     return made
 
@@ -180,18 +176,6 @@ def test_a_reply_that_paused_past_the_idle_window_stays_cut():
     rest = paused[SHOWN:]
     assert cut.mend(rest) is rest
     assert cut.attempt.reason == IDLE and len(cut.attempt.reply_events) == SHOWN
-
-
-def test_a_gap_the_stamps_cannot_show_is_no_cut():
-    """A stall longer than the window and the rest together: the rest came in one burst
-    laid to end at its arrival, 60 ms after the cut character by its stamps, which the
-    link says are worth 15 ms there (the marking before a burst): the rest may have begun
-    inside the window, and is taken. Worth 5 ms, they show a gap past it: cut."""
-    paused = _record(0.06)
-    assert _cut(paused[:SHOWN], tainted=5e-3).mend(paused[SHOWN:]) == paused[SHOWN:]
-    cut = _cut(paused[:SHOWN], tainted=15e-3)
-    assert cut.mend(paused[SHOWN:]) == []
-    assert cut.attempt.reply_events == paused
 
 
 def test_what_follows_the_rest_stays_the_next_tries():
