@@ -20,6 +20,7 @@ import heapq
 import itertools
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from math import inf
@@ -41,6 +42,7 @@ SPIN = 0.0008  # s: poll the last stretch before a due time instead of oversleep
 RT_SPIN = 0.0001  # s: the same with a real-time class, whose sleeps end within microseconds
 LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counted as late
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
+SPACINGS_KEPT = 4  # the recorder's breaks whose length an echo still due may ask for
 
 
 @runtime_checkable
@@ -109,7 +111,9 @@ class RealTimeLine:
         self._tool_free = -inf  # end of the recorder's last frame on the emulated wire
         self._break_start: float | None = None
         self._break_doubt = 0.0  # how far (s) the held break's start may be off (a batch)
-        self._last_spacing = (inf, inf)  # (start, end) of the recorder's last break
+        # the recorder's last few breaks, (start, end): an echo delivered after the next
+        # break began still reads its own spacing's length
+        self._spacings: deque[tuple[float, float]] = deque(maxlen=SPACINGS_KEPT)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="sdi12-emulated-line", daemon=True)
         self.frames_sent = 0
@@ -193,9 +197,14 @@ class RealTimeLine:
                 self._break_start = start = max(at, self._tool_free)
                 self._break_doubt = doubt
                 if self.bench.echo:  # a receiver reads spacing at its stop-bit sample
-                    self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._echo_spacing(s))
+                    # its delivery is placed now, in wire order: placed when the line's thread
+                    # came to the sample, a late thread (or a batch of the recorder's break
+                    # and command read together) put it behind the command's own echo
+                    deliver = self._delivery.time(start + SAMPLE_STOP / BAUD)
+                    self._push(deliver, lambda s=start: self._echo_spacing(s))
                 if self._taps:
                     self._push(start + SAMPLE_STOP / BAUD, lambda s=start: self._tap_held(s))
+                if self.bench.echo or self._taps:
                     self._cond.notify()  # due before the break ends: wake the line for it
 
     def break_off(self, at: float | None = None, doubt: float = 0.0) -> None:
@@ -209,7 +218,7 @@ class RealTimeLine:
                 return
             end = max(at, start)
             self._tool_free = end
-            self._last_spacing = (start, end)
+            self._spacings.append((start, end))
             room = max(doubt, self._break_doubt)
             device = self.device
             if room > 0 and isinstance(device, WeighsBreaks):
@@ -221,17 +230,20 @@ class RealTimeLine:
     def _echo_spacing(self, start: float) -> None:
         """The echo of the spacing that began at ``start``, read at its stop-bit sample: a
         0x00 if the line still spaces (or spaced long enough), else the byte a short pulse
-        makes. Runs on the line's thread at the sample time."""
+        makes. Runs on the line's thread at the delivery :meth:`break_on` placed in wire
+        order, which is never before the sample."""
         heard = spacing_as_received(self._spacing_length(start))
         if heard is not None:
-            self._push(self._delivery.time(self.now()), lambda b=heard[0]: self._emit(b, True))
+            self._emit(heard[0], True)
 
     def _spacing_length(self, start: float) -> float:
         """How long the spacing that began at ``start`` has lasted (line's thread)."""
         if self._break_start == start:
             return self.now() - start
-        s, e = self._last_spacing
-        return e - s if s == start else 0.0
+        for s, e in self._spacings:
+            if s == start:
+                return e - s
+        return 0.0
 
     def _tap_held(self, start: float) -> None:
         """The taps read a held break (SET_CONTROL) at its stop-bit sample, as a UART does."""

@@ -17,6 +17,11 @@ from collections import deque
 from dataclasses import dataclass
 from enum import StrEnum
 
+#: s: spacing this long reads as 0x00 at 1200 baud (a framing error: 8.5 bit times), so a
+#: break's echo still owed behind the DUT's bytes is that byte and no other: '@', 'p' and
+#: '|' with their parity are zero-prefix bytes too, and a reply's CRC may hold them
+BREAK_READ = 8.5 / 1200
+
 
 class EchoMode(StrEnum):
     AUTO = "auto"
@@ -61,6 +66,9 @@ class EchoTracker:
         self._held: list[Heard] = []  # matched while auto has not decided yet
         self._window: list[tuple[int, float]] = []  # received while a decided echo is due
         self._chars_expected = 0  # characters in the transmission that decides auto
+        #: a break whose echo was still due when a byte of the DUT's came first (its late
+        #: reply, delivered behind a stall, or one the break met): the echo comes behind it
+        self._owed: Expected | None = None
         self.collisions = 0
         self.missing = 0
 
@@ -77,6 +85,8 @@ class EchoTracker:
         """The tool is about to send ``items``."""
         if not self.listening:
             return
+        if any(e.byte is None for e in items):
+            self._owed = None  # a new break: the one before's echo is no longer awaited
         self._pending.extend(items)
         if not self.decided:
             self._chars_expected += sum(1 for e in items if e.byte is not None)
@@ -85,12 +95,21 @@ class EchoTracker:
         """Sort one received byte; returns what to record now, in order (bytes held while
         auto decides, or while a decided echo is still coming back, come out together once
         they are sorted)."""
+        owed = self._owed
+        if owed is not None and byte == 0x00 and not self._window:
+            # the break's echo, behind the DUT's bytes that came before it (truth25: under
+            # host stalls a late reply's rest came between a break and its echo, and the
+            # echo was recorded as a 0x00 of the DUT's, ahead of the next reply)
+            self._owed = None
+            return [Heard("tool", byte, end, owed)]
         while self._pending and self.listening:
             want = self._pending[0]
             if want.byte is None:  # spacing: echoed as a zero-prefix byte, or not at all
                 self._pending.popleft()
                 if is_spacing_echo(byte):
                     return self._matched(Heard("tool", byte, end, want))
+                if self.decided and want.frame >= BREAK_READ:  # its 0x00 may come behind
+                    self._owed = want
                 continue
             if not self.decided:
                 if byte == want.byte:
@@ -114,6 +133,7 @@ class EchoTracker:
         """The time for the pending echoes is over: notes on what never came back (and, for
         auto, the decision)."""
         notes: list[str] = []
+        self._owed = None
         if self._window:
             self._held = self._sort_window()
         missing = [e for e in self._pending if e.byte is not None]
@@ -178,6 +198,8 @@ class EchoTracker:
             first < pos < last and pos not in at for pos in range(len(window))
         )
         out: list[Heard] = []
+        if found:  # the tool's characters came back: a break's echo is no longer due
+            self._owed = None
         for pos, (byte, end) in enumerate(window):
             if pos in at:
                 out.append(Heard("tool", byte, end, expected[at[pos]]))

@@ -47,7 +47,7 @@ from ..transcript import (
     to_wire_7e1,
 )
 from ..view.segments import continues_frame
-from . import validity
+from . import cut_read, validity
 from .contention import HOLD_PREFIX, ApartSoFar, collisions, maybe_note_text
 from .hooks import Hooks
 from .policy import Policy
@@ -103,6 +103,9 @@ class ToolRecorder:
         #: The last exchange sent (by :meth:`transact` or :meth:`raw`): a reply that comes
         #: after the next command may be this one's, late (:mod:`..sensor.address_change`).
         self.last_exchange: Exchange | None = None
+        #: the last attempt, if its read ended IDLE on a link whose deliveries may lag: the
+        #: next try's first characters may be its rest (:mod:`.cut_read`)
+        self._cut: cut_read.CutRead | None = None
         #: the policy the framings were made for, and each kind of reply's (:meth:`_framing`)
         self._framings: tuple[Policy | None, dict[tuple[bool, bool], Framing]] = (None, {})
 
@@ -153,6 +156,8 @@ class ToolRecorder:
                 )
                 attempt.sequence, attempt.retry = sequence, retry
                 exchange.attempts.append(attempt)
+                if self._cut is not None:  # this attempt's read was cut (cut_read)
+                    self._cut.exchange = exchange
                 if attempt.ok:
                     self._note_accepted(command)
                     self.last_exchange = exchange
@@ -201,6 +206,8 @@ class ToolRecorder:
             collide=collide,
         )
         exchange = Exchange(command, shown, [attempt], binary=binary, expect_reply=False)
+        if self._cut is not None:  # this attempt's read was cut (cut_read)
+            self._cut.exchange = exchange
         self.last_exchange = exchange
         return exchange
 
@@ -557,6 +564,12 @@ class ToolRecorder:
             binary, not binary and (command is None or command.kind is _EXTENDED)
         )
         reply, state, collided = self._listen(command_end, framing)
+        mending, self._cut = self._cut, None
+        if mending is not None:  # the rest of a reply a stall cut comes before this one
+            stray = mending.mend(stray)
+            if not stray and collided:
+                first_sent = break_event or (sent[0] if sent else None)
+                collided = mending.mend_met(collided, first_sent, read_on=not reply)
         text: str | None = None
         if collided:
             self.note_collisions()
@@ -577,6 +590,15 @@ class ToolRecorder:
         )
         if text is not None:
             attempt.knows_reply_text(text)
+        if state == IDLE:
+            self._cut = cut_read.cut(
+                attempt,
+                framing,
+                self.link,
+                judge=lambda chars, text: self._judge_reply(
+                    chars, command, address, command_end, framing, crc, text
+                ),
+            )
         return attempt
 
     def _framing(self, binary: bool, multiline: bool) -> Framing:

@@ -202,3 +202,38 @@ def test_a_served_line_that_fell_behind_leaves_no_fail_standing():
     assert failed.verdict is warned.verdict is Verdict.INCONCLUSIVE
     assert passed.verdict is Verdict.PASS  # what the recorder did right stays right
     assert "fell 7.8 ms behind" in failed.detail
+
+
+# -- a break's echo behind the DUT's bytes (truth25) -----------------------------------------
+BREAK = Expected(None, 13e-3)
+
+
+def test_a_break_echo_behind_the_dut_s_late_bytes_is_still_the_tool_s():
+    """Under host stalls the rest of a late reply reached the host between the tool's break
+    and the break's 0x00: the 0x00 was recorded as the DUT's, ahead of the next reply."""
+    tracker = EchoTracker(EchoMode.ON)
+    tracker.expect([BREAK])
+    late = [to_wire_7e1(ord(c)) for c in "5;\r\n"]
+    assert feed(tracker, [*late, 0x00]) == [("dut", b) for b in late] + [("tool", 0x00)]
+    tracker.expect(chars("0I!"))
+    assert feed(tracker, CMD) == [("tool", b) for b in CMD]
+
+
+def test_an_owed_break_echo_is_only_a_nul():
+    """'@' with its parity (0xC0) reads like a short spacing pulse, and a reply's CRC may
+    hold it: behind the DUT's bytes only the 0x00 a break makes is taken for its echo."""
+    tracker = EchoTracker(EchoMode.ON)
+    tracker.expect([BREAK])
+    crc = [to_wire_7e1(ord(c)) for c in "1@Jw"]
+    assert crc[1] == 0xC0 and is_spacing_echo(0xC0)
+    assert feed(tracker, crc) == [("dut", b) for b in crc]
+
+
+def test_a_nul_after_the_command_s_echo_is_the_dut_s():
+    """A real interface reads the line in wire order: a 0x00 after the echo of the command
+    that followed the break is no echo of that break."""
+    tracker = EchoTracker(EchoMode.ON)
+    tracker.expect([BREAK])
+    tracker.expect(chars("2I!"))
+    two_i = [to_wire_7e1(ord(c)) for c in "2I!"]
+    assert feed(tracker, [*two_i, 0x00]) == [("tool", b) for b in two_i] + [("dut", 0x00)]
