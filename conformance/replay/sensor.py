@@ -394,8 +394,20 @@ def _from_arrays(
     before_u = np.where(use_prev, ru_prev, tu_before)
     first = (use_prev | has_tool) & (np.abs(rs - before_end) <= ru + before_u)
     second = has_prev & (np.abs(rs - re_prev) <= ru + ru_prev)
-    touching = list(zip(first.tolist(), second.tolist(), strict=True))
-    return is_reply, need.tolist(), touching
+    return is_reply, need.tolist(), _pairs(first, second)
+
+
+#: the four back-to-back flag pairs, shared by every reply (:func:`_pairs`)
+_PAIRS = ((False, False), (False, True), (True, False), (True, True))
+
+
+def _pairs(first: np.ndarray, second: np.ndarray) -> list[tuple[bool, bool]]:
+    """``list(zip(first, second))`` as Python bools, each pair one of :data:`_PAIRS`
+    rather than a tuple of its own: a decoded capture has ~2*10^4 replies (issue 22, replay27:
+    making and later freeing a tuple each was ~1% of a fault-matrix row's capture half)."""
+    import numpy as np
+
+    return [_PAIRS[i] for i in (first.astype(np.intp) * 2 + second).tolist()]
 
 
 def _played(e: Event) -> bool:
