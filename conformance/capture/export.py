@@ -11,7 +11,8 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from operator import attrgetter
+from itertools import repeat
+from operator import attrgetter, eq
 
 import numpy as np
 
@@ -27,6 +28,7 @@ TRAIL = 0.020  # marking after the last one
 BUS_CHANNEL = "SDI12"
 TOOL_CHANNEL = "TOOL_TX"
 EXPORT_FORMATS = ("sr", "vcd", "csv")
+_ORIGIN = attrgetter("origin")
 
 
 @dataclass(frozen=True)
@@ -84,8 +86,8 @@ def export_events(
     if columns is not None:  # the columns read once for both channels
         edges = [columns.edges(sample_rate, t0)]
         if tool_channel:
-            origins = np.array(list(map(attrgetter("origin"), wire)), dtype=object)
-            edges.append(columns.edges(sample_rate, t0, origins == TOOL))
+            mine = np.fromiter(map(eq, map(_ORIGIN, wire), repeat(TOOL)), bool, len(wire))
+            edges.append(columns.edges(sample_rate, t0, mine))
     else:
         edges = [edge_array(wire, sample_rate, t0)]
         if tool_channel:

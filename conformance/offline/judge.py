@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass, field, replace
+from functools import cache
 from pathlib import Path
 
 from ..capture import (
@@ -158,6 +159,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+@cache
+def _parser() -> argparse.ArgumentParser:
+    """:func:`build_parser`'s parser, built once a process: parsing leaves a parser as it
+    was, and building its 16 options was ~1 ms of each fault-matrix row's round trip, whose
+    :func:`plan` parses a judge command line per row (issue 22, replay27)."""
+    return build_parser()
+
+
 #: the files a run folder holds beside its recording, which ``judge`` is sometimes given
 RUN_REPORTS = frozenset({"verdicts.json", "junit.xml", "report.html"})
 
@@ -167,7 +176,7 @@ def plan(argv: list[str], *, in_memory: bool = False) -> JudgePlan:
     ``in_memory``: a capture's decoding is not written to capture.jsonl but held for its
     replay (:func:`~conformance.replay.recording.hold_recording`; the caller lets it go with
     :func:`~conformance.replay.recording.held_recordings`): the fault matrix's round trip."""
-    args = build_parser().parse_args(argv)
+    args = _parser().parse_args(argv)
     path = Path(args.file)
     if path.is_dir():
         path = transcript_path(path)

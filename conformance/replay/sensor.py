@@ -101,7 +101,6 @@ class RecordedSensor:
         s, e = np.array(wire.start, np.float64), np.array(wire.end, np.float64)
         u, is_char, breaks = _made_columns(wire, len(s))
         is_tool = np.fromiter(map(eq, wire.origin, repeat(TOOL)), bool, len(s))
-        kinds = wire.kinds()
         with np.errstate(invalid="ignore"):  # inf - inf is NaN, and compares false
             found = _from_arrays(s, e, u, is_tool, is_char)
             if found is None:
@@ -119,7 +118,7 @@ class RecordedSensor:
         sensor._tool = sensor._replies = None
         sensor._made_of = (wire, tool_mask, is_reply.tolist())
         tool_columns = (
-            list(compress(kinds, tool_mask)),
+            _tool_kinds(wire, is_tool, len(tool_ends)),
             list(compress(wire.wire, tool_mask)),
             tool_ends,
         )
@@ -298,6 +297,22 @@ def _made_columns(wire: WireColumns, n: int) -> tuple[np.ndarray, np.ndarray, li
     return u, is_char, breaks
 
 
+def _tool_kinds(wire: WireColumns, is_tool: np.ndarray, count: int) -> list[EventKind]:
+    """The kinds of the ``count`` tool events among the columns (``is_tool``), in order:
+    ``compress(wire.kinds(), is_tool)`` without every column's kind listed first (a
+    certified character's is CHAR; only the decoder's own events, a few hundred of a
+    fault-matrix row's ~2*10^4 columns, have another: issue 22, replay27)."""
+    import numpy as np
+
+    kinds = [EventKind.CHAR] * count
+    if wire.made:
+        place = np.cumsum(is_tool) - 1  # each column's index among the tool's
+        for i, m in wire.made.items():
+            if is_tool[i]:
+                kinds[place[i]] = m.kind
+    return kinds
+
+
 def _column(events: list[Event], name: str) -> np.ndarray:
     import numpy as np
 
@@ -394,8 +409,20 @@ def _from_arrays(
     before_u = np.where(use_prev, ru_prev, tu_before)
     first = (use_prev | has_tool) & (np.abs(rs - before_end) <= ru + before_u)
     second = has_prev & (np.abs(rs - re_prev) <= ru + ru_prev)
-    touching = list(zip(first.tolist(), second.tolist(), strict=True))
-    return is_reply, need.tolist(), touching
+    return is_reply, need.tolist(), _pairs(first, second)
+
+
+#: the four back-to-back flag pairs, shared by every reply (:func:`_pairs`)
+_PAIRS = ((False, False), (False, True), (True, False), (True, True))
+
+
+def _pairs(first: np.ndarray, second: np.ndarray) -> list[tuple[bool, bool]]:
+    """``list(zip(first, second))`` as Python bools, each pair one of :data:`_PAIRS`
+    rather than a tuple of its own: a decoded capture has ~2*10^4 replies (issue 22, replay27:
+    making and later freeing a tuple each was ~1% of a fault-matrix row's capture half)."""
+    import numpy as np
+
+    return [_PAIRS[i] for i in (first.astype(np.intp) * 2 + second).tolist()]
 
 
 def _played(e: Event) -> bool:
