@@ -90,6 +90,19 @@ def test_command_text():
     assert ctrl["R-4.2-01"].verdict is Verdict.FAIL
 
 
+def test_address_query_with_a_nul_after_its_bang_is_addressed_r_4_3_01():
+    """An STM32 HAL logger (HarveyBates/stm32-projects, twenty-sixth round) sends each
+    command with the NUL that ends its C string: ``?!<NUL>``. The NUL is R-4.2-01's and
+    R-4.4-04's FAIL; R-4.3-01 FAILed "starts with ?, not an address" on the query's
+    wildcard. A '?' that is not ``?!`` still FAILs R-4.3-01, with or without the NUL."""
+    query = by_id(judge_command_text(Wire().brk().rec("?!\x00").view()))
+    assert query["R-4.2-01"].verdict is query["R-4.4-04"].verdict is Verdict.FAIL
+    assert query["R-4.3-01"].verdict is Verdict.PASS, query["R-4.3-01"].detail
+    for text in ("?M!\x00", "?M!", "?\x00!"):
+        wild = by_id(judge_command_text(Wire().brk().rec(text).view()))
+        assert wild["R-4.3-01"].verdict is Verdict.FAIL, text
+
+
 def test_character_gaps_have_no_tolerance():
     ok = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.5).view(), 0.0))
     assert ok["R-7.0-13"].verdict is ok["R-7.0-01"].verdict is Verdict.PASS
