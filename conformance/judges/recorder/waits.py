@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from ...protocol.commands import CONCURRENT_KINDS
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
+from ...view.segments import Transmission
 from ..tally import Tally
 from ..timing import judge_window
 from .common import (
@@ -89,6 +90,12 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
                 )
             )
         tally.observe(where, ids=["R-4.4.5-05"])
+        if _not_d0(first):
+            tally.fail(
+                "R-4.4.5-05",
+                where,
+                f"the first data command after the measurement was {escape(first.stem)}, not aD0!",
+            )
         trigger = sr if sr is not None and sr <= ready else ready
         delay = first.start - trigger
         if delay > REACTION:
@@ -152,3 +159,11 @@ def _no_data_command(
             f"the tool cut the job at its budget {waited:.3f} s after {what}, before an "
             f"aD0! was due (within {REACTION} s, decision {REACTION_DECISION})",
         )
+
+
+def _not_d0(first: Transmission) -> bool:
+    """The measurement's first data command asks for a later index than 0: no aD0! was
+    issued (an STM32 HAL logger whose aD0! went out on the other pin, HarveyBates/
+    stm32-projects: its aD1! PASSed R-4.4.5-05 "aD0! within 0.5 s of ... ttt")."""
+    d = first.data_index
+    return d is not None and d[1] != 0

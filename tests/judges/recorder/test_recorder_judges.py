@@ -215,6 +215,40 @@ def test_no_traffic_to_other_sensors_during_a_measurement():
     assert found["R-4.4.5-07"].verdict is Verdict.FAIL
 
 
+def test_a_first_data_command_past_d0_is_no_d0_r_4_4_5_05():
+    """An STM32 HAL logger (HarveyBates/stm32-projects, twenty-sixth round) keeps its USART's
+    pins swapped after a reply that filled its buffer, so its aD0! goes out on the other pin:
+    the wire shows a bare break, then aD1!..aD8!. R-4.4.5-05 PASSed "aD0! within 0.5 s of the
+    service request or ttt" on the aD1!; no aD0! was issued."""
+    w = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(9).brk().idle(30)
+    w.brk().rec("0D1!").sensor("0\r\n")
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))["R-4.4.5-05"]
+    assert found.verdict is Verdict.FAIL, found.detail
+    assert "0D1!, not aD0!" in found.detail
+    # aD0! at the same moment: the reaction rule PASSes as before
+    w = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(9).brk().rec("0D0!")
+    w.sensor("0+1+2+3\r\n")
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))["R-4.4.5-05"]
+    assert found.verdict is Verdict.PASS, found.detail
+
+
+def test_a_command_with_a_nul_after_its_bang_is_the_command_a_sensor_answers():
+    """The same logger sends each command's C string with its NUL (``0M!<NUL>``); the played
+    sensor answers at the ``!``, as a sensor does. The view took the text for no command: its
+    measurements, retries and logged values went unjudged ("nothing was observed") or FAILed
+    "logged, the command never sent". R-4.2-01 and R-4.4-04 still FAIL the NUL."""
+    w = Wire().brk().rec("0M!\x00").sensor("00013\r\n", delay_ms=1.0)
+    w.sensor("0\r\n", delay_ms=300).idle(9).rec("0D0!\x00").sensor("0+1+2+3\r\n", delay_ms=1.0)
+    view = w.view()
+    assert [s.stem for s in view.transmissions] == ["0M!", "0D0!"]
+    taken = observed_measurements(view, 0.0)
+    assert len(taken) == 1 and taken[0].values() == ["+1", "+2", "+3"]
+    text = by_id(judge_command_text(view))
+    assert text["R-4.2-01"].verdict is text["R-4.4-04"].verdict is Verdict.FAIL
+    # a NUL before the '!' keeps the text whole: no command
+    assert Wire().brk().rec("0M\x00!").view().transmissions[0].stem == "0M\x00!"
+
+
 def test_d0_before_ttt_and_late_reaction():
     early = _measurement(Wire()).idle(500).brk().rec("0D0!").sensor("0+1+2+3\r\n")
     found = by_id(judge_measure_waits(observed_measurements(early.view(), 0.0), 0.0))
