@@ -94,6 +94,11 @@ by its reply to 1A0! (not checked)", then the sweep's closing restore asked agai
 restore the address"; its silence to ``0A$!`` (it refuses '$') was reported the same way, though
 ``?!`` still answered '0'. A restore no change has followed since is not done again, and a
 sensor that answers no ``a!`` is found at its address by ``?!``.
+
+The twenty-sixth: an STM32 HAL logger (HarveyBates/stm32-projects) sends each command with its
+C string's NUL (``0M!<NUL>``): the view took it for no command though the played sensor answered
+at the ``!``, so its measurements and retries went unjudged; now NULs after the ``!`` keep it a
+command (``Transmission.stem``), and its aD1! in place of a lost aD0! FAILs R-4.4.5-05.
 """
 
 from __future__ import annotations
