@@ -89,23 +89,37 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
                     observed=1,
                 )
             )
-        tally.observe(where, ids=["R-4.4.5-05"])
-        if _not_d0(first):
-            tally.fail(
-                "R-4.4.5-05",
-                where,
-                f"the first data command after the measurement was {escape(first.stem)}, not aD0!",
-            )
-        trigger = sr if sr is not None and sr <= ready else ready
-        delay = first.start - trigger
-        if delay > REACTION:
-            what = "the service request" if trigger == sr else "ttt"
-            tally.fail("R-4.4.5-05", where, beyond_reaction(delay, what), warning=True)
-        if trigger != sr and first.break_event is None:
-            tally.fail("R-4.4.5-05", where, "aD0! after ttt ran out, without a break first")
+        _judge_reaction(tally, m, first, where, sr, ready)
     tally.decision("R-4.4.5-05", REACTION_DECISION)
     ok = {"R-4.4.5-05": f"aD0! within {REACTION} s of the service request or ttt (decision T1)"}
     return [combine("R-4.4.5-04", early, "wait for data"), *tally.findings(ok)]
+
+
+def _judge_reaction(
+    tally: Tally,
+    m: ObservedMeasurement,
+    first: Transmission,
+    where: str,
+    sr: float | None,
+    ready: float,
+) -> None:
+    """R-4.4.5-05 for a measurement with ttt > 0 and a data command after it: that command is
+    aD0! (:func:`_not_d0`), within the reaction allowance of the service request or ttt,
+    and after a break when ttt ran out."""
+    tally.observe(where, ids=["R-4.4.5-05"])
+    if _not_d0(first):
+        tally.fail(
+            "R-4.4.5-05",
+            where,
+            f"the first data command after the measurement was {escape(first.stem)}, not aD0!",
+        )
+    trigger = sr if sr is not None and sr <= ready else ready
+    delay = first.start - trigger
+    if delay > REACTION:
+        what = "the service request" if trigger == sr else "ttt"
+        tally.fail("R-4.4.5-05", where, beyond_reaction(delay, what), warning=True)
+    if trigger != sr and first.break_event is None:
+        tally.fail("R-4.4.5-05", where, "aD0! after ttt ran out, without a break first")
 
 
 def judge_concurrent_waits(
