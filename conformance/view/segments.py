@@ -63,7 +63,8 @@ _DATA = re.compile(r"^(.)D(B?)([0-9]+)!$")
 #: ``current.is_command`` as :func:`read_view` keeps it per character: a recorder's
 #: transmission holds characters only, so its text ends in ``!`` when its last one is ``!``
 _BANG = ord("!")
-_LINE_ENDS = (0x0D, 0x0A)  # CR, LF
+#: what may follow a command's ``!`` and keep it one (:attr:`Transmission.stem`)
+_AFTER_BANG = (0x0D, 0x0A, 0x00)  # CR, LF, a C string's NUL
 _LF_BYTE = bytes([LF])
 #: what a command begins with (an address, or ``?`` of ``?!``): right after a ``!`` it is the
 #: next command's first character (:meth:`Cut.feed`)
@@ -202,12 +203,14 @@ class Transmission:
     @property
     def stem(self) -> str:
         """The command as a sensor takes it: the text up to its ``!`` where only line ends
-        (CR, LF) follow (a PC logger that ends each command with CR LF, lories'
-        Sdi12Connector: a sensor answers at the ``!``, and its values were "logged, the
-        command never sent"), else the whole text. R-4.2-01 and R-4.4-04 judge ``text``."""
+        (CR, LF) or NULs follow (a PC logger that ends each command with CR LF, lories'
+        Sdi12Connector; STM32 HAL loggers that send a command's C string with its NUL,
+        HarveyBates/stm32-projects: a sensor answers at the ``!``, and values logged were
+        "logged, the command never sent", measurements and retries unjudged), else the
+        whole text. R-4.2-01 and R-4.4-04 judge ``text``."""
         text = self.text
         bang = text.find("!")
-        if 0 <= bang < len(text) - 1 and not text[bang + 1 :].strip("\r\n"):
+        if 0 <= bang < len(text) - 1 and not text[bang + 1 :].strip("\r\n\x00"):
             return text[: bang + 1]
         return text
 
@@ -735,10 +738,10 @@ class Cut:
                     is_command = after_bang = e.wire & 0x7F == _BANG
                 else:
                     current.chars.append(e)
-                    # CR LF after the '!' keep it a command (Transmission.stem)
+                    # CR LF or NUL after the '!' keep it a command (Transmission.stem)
                     bits = e.wire & 0x7F
                     after_bang = bits == _BANG
-                    is_command = after_bang or (is_command and bits in _LINE_ENDS)
+                    is_command = after_bang or (is_command and bits in _AFTER_BANG)
             elif kind is char:
                 last_heard = e
                 if current is not None:

@@ -94,6 +94,11 @@ by its reply to 1A0! (not checked)", then the sweep's closing restore asked agai
 restore the address"; its silence to ``0A$!`` (it refuses '$') was reported the same way, though
 ``?!`` still answered '0'. A restore no change has followed since is not done again, and a
 sensor that answers no ``a!`` is found at its address by ``?!``.
+
+The twenty-sixth: an STM32 HAL logger (HarveyBates/stm32-projects) sends each command with its
+C string's NUL (``0M!<NUL>``): the view took it for no command though the played sensor answered
+at the ``!``, so its measurements and retries went unjudged; now NULs after the ``!`` keep it a
+command (``Transmission.stem``), and its aD1! in place of a lost aD0! FAILs R-4.4.5-05.
 """
 
 from __future__ import annotations
@@ -1080,3 +1085,86 @@ def test_a_sensor_that_answers_no_a_and_stays_put_is_no_r_4_3_03_pass(a_never_an
     data = run_once("sim://?faults=address-change-not-applied", keyword="test_address_range")
     rule = _verdicts(data)["R-4.3-03"]
     assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+
+
+#: A recorder harness that behaves as the twenty-sixth round's STM32 HAL logger does
+#: (HarveyBates/stm32-projects, docs/kit.md; not its code): each command goes out with the
+#: NUL of its C string; the USART stays swapped after a receive that filled its buffer, so
+#: the next command leaves on the other pin (its break on the line, its characters not);
+#: ``aM!`` is followed at once by ``aD0!``..``aD8!`` until as many signs as ``n`` came.
+_SENDS_ITS_NUL = (
+    PRELUDE
+    + r"""
+now, swapped = 0, False
+
+def ask(line):
+    global now
+    say(line)
+    word, *f = sys.stdin.readline().split()
+    if word in ("break", "sent", "char", "time", "job"):
+        now = int(f[0] if word in ("time", "job") else f[1])
+    return word, f
+
+def idle(until):
+    while now < until and ask(f"wait {until}")[0] == "char":
+        pass
+
+def query(text, size):
+    global swapped
+    ask(f"brk {now} {now + 13000}")
+    idle(now + 9000)
+    for c in text + "\0":
+        if swapped:
+            idle(now + 8333)
+        else:
+            ask(f"tx {now} {wire(c):02x}")
+    swapped, got, deadline = True, "", now + 381000
+    while len(got) < size:
+        word, f = ask(f"wait {deadline}")
+        if word != "char" or now > deadline:
+            swapped = False
+            break
+        got += chr(int(f[2], 16) & 0x7F)
+    return got
+
+sys.stdin.readline()  # hello
+word, f = ask("hello 1 sends-its-nul")
+cmds = f[2:] if f[1] == "measure" else []
+for cmd in cmds if cmds and all(c[1:] == "M!" for c in cmds) else []:
+    n = query(cmd, 7)[4:5]
+    data = ""
+    for i in range(9):
+        data += query(f"{cmd[0]}D{i}!", 75)
+        if n.isdigit() and data.count("+") + data.count("-") == int(n):
+            break
+    say(" ".join(["log", cmd] + re.findall(r"[+-][0-9.]+", data)))
+say("done" if cmds and all(c[1:] == "M!" for c in cmds) else "cannot aM! jobs only")
+sys.stdin.readline()  # bye
+"""
+).replace("import sys", "import re\nimport sys", 1)
+
+
+@pytest.mark.slow
+def test_a_recorder_that_sends_each_command_with_its_nul_is_judged_r_4_4_5_05(tmp_path):
+    """The STM32 HAL logger's commands (``0M!<NUL>``) were no commands to the view, though the
+    played sensor answered them: its measurements went unjudged ("nothing was observed").
+    Now the flow is judged: its aD0!, sent on the other pin, never reached the line, and its
+    aD1! 0.44 s after ``00023`` (no service request, ttt 2 s) FAILs R-4.4.5-04 and R-4.4.5-05
+    (which PASSed "aD0! within 0.5 s" on an aD1!: tests/judges/recorder); the NULs still
+    FAIL R-4.2-01 and R-4.4-04."""
+    import sys
+
+    harness = tmp_path / "sends_its_nul.py"
+    harness.write_text(_SENDS_ITS_NUL)
+    found = run_once(
+        f"exec:{sys.executable} {harness}",
+        role="recorder",
+        keyword="test_waiting_for_the_service_request or test_command_text",
+    )
+    rules = _verdicts(found)
+    assert rules["R-4.2-01"]["verdict"] == rules["R-4.4-04"]["verdict"] == "FAIL"
+    assert rules["R-4.3-01"]["verdict"] == "PASS", rules["R-4.3-01"]["findings"]
+    waited = rules["R-4.4.5-05"]
+    assert waited["verdict"] == "FAIL", waited["findings"]
+    assert any("0D1!, not aD0!" in f["detail"] for f in waited["findings"])
+    assert rules["R-4.4.5-04"]["verdict"] == "FAIL", rules["R-4.4.5-04"]["findings"]

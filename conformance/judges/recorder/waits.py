@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from ...protocol.commands import CONCURRENT_KINDS
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
+from ...view.segments import Transmission
 from ..tally import Tally
 from ..timing import judge_window
 from .common import (
@@ -88,17 +89,37 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
                     observed=1,
                 )
             )
-        tally.observe(where, ids=["R-4.4.5-05"])
-        trigger = sr if sr is not None and sr <= ready else ready
-        delay = first.start - trigger
-        if delay > REACTION:
-            what = "the service request" if trigger == sr else "ttt"
-            tally.fail("R-4.4.5-05", where, beyond_reaction(delay, what), warning=True)
-        if trigger != sr and first.break_event is None:
-            tally.fail("R-4.4.5-05", where, "aD0! after ttt ran out, without a break first")
+        _judge_reaction(tally, m, first, where, sr, ready)
     tally.decision("R-4.4.5-05", REACTION_DECISION)
     ok = {"R-4.4.5-05": f"aD0! within {REACTION} s of the service request or ttt (decision T1)"}
     return [combine("R-4.4.5-04", early, "wait for data"), *tally.findings(ok)]
+
+
+def _judge_reaction(
+    tally: Tally,
+    m: ObservedMeasurement,
+    first: Transmission,
+    where: str,
+    sr: float | None,
+    ready: float,
+) -> None:
+    """R-4.4.5-05 for a measurement with ttt > 0 and a data command after it: that command is
+    aD0! (:func:`_not_d0`), within the reaction allowance of the service request or ttt,
+    and after a break when ttt ran out."""
+    tally.observe(where, ids=["R-4.4.5-05"])
+    if _not_d0(first):
+        tally.fail(
+            "R-4.4.5-05",
+            where,
+            f"the first data command after the measurement was {escape(first.stem)}, not aD0!",
+        )
+    trigger = sr if sr is not None and sr <= ready else ready
+    delay = first.start - trigger
+    if delay > REACTION:
+        what = "the service request" if trigger == sr else "ttt"
+        tally.fail("R-4.4.5-05", where, beyond_reaction(delay, what), warning=True)
+    if trigger != sr and first.break_event is None:
+        tally.fail("R-4.4.5-05", where, "aD0! after ttt ran out, without a break first")
 
 
 def judge_concurrent_waits(
@@ -152,3 +173,11 @@ def _no_data_command(
             f"the tool cut the job at its budget {waited:.3f} s after {what}, before an "
             f"aD0! was due (within {REACTION} s, decision {REACTION_DECISION})",
         )
+
+
+def _not_d0(first: Transmission) -> bool:
+    """The measurement's first data command asks for a later index than 0: no aD0! was
+    issued (an STM32 HAL logger whose aD0! went out on the other pin, HarveyBates/
+    stm32-projects: its aD1! PASSed R-4.4.5-05 "aD0! within 0.5 s of ... ttt")."""
+    d = first.data_index
+    return d is not None and d[1] != 0

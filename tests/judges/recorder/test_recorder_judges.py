@@ -90,6 +90,19 @@ def test_command_text():
     assert ctrl["R-4.2-01"].verdict is Verdict.FAIL
 
 
+def test_address_query_with_a_nul_after_its_bang_is_addressed_r_4_3_01():
+    """An STM32 HAL logger (HarveyBates/stm32-projects, twenty-sixth round) sends each
+    command with the NUL that ends its C string: ``?!<NUL>``. The NUL is R-4.2-01's and
+    R-4.4-04's FAIL; R-4.3-01 FAILed "starts with ?, not an address" on the query's
+    wildcard. A '?' that is not ``?!`` still FAILs R-4.3-01, with or without the NUL."""
+    query = by_id(judge_command_text(Wire().brk().rec("?!\x00").view()))
+    assert query["R-4.2-01"].verdict is query["R-4.4-04"].verdict is Verdict.FAIL
+    assert query["R-4.3-01"].verdict is Verdict.PASS, query["R-4.3-01"].detail
+    for text in ("?M!\x00", "?M!", "?\x00!"):
+        wild = by_id(judge_command_text(Wire().brk().rec(text).view()))
+        assert wild["R-4.3-01"].verdict is Verdict.FAIL, text
+
+
 def test_character_gaps_have_no_tolerance():
     ok = by_id(judge_character_gaps(Wire().brk().rec("0M!", gap_ms=1.5).view(), 0.0))
     assert ok["R-7.0-13"].verdict is ok["R-7.0-01"].verdict is Verdict.PASS
@@ -200,6 +213,40 @@ def test_no_traffic_to_other_sensors_during_a_measurement():
     assert found["R-4.4.5-06"].verdict is Verdict.FAIL
     # the recorder also took the line while the service request could still come
     assert found["R-4.4.5-07"].verdict is Verdict.FAIL
+
+
+def test_a_first_data_command_past_d0_is_no_d0_r_4_4_5_05():
+    """An STM32 HAL logger (HarveyBates/stm32-projects, twenty-sixth round) keeps its USART's
+    pins swapped after a reply that filled its buffer, so its aD0! goes out on the other pin:
+    the wire shows a bare break, then aD1!..aD8!. R-4.4.5-05 PASSed "aD0! within 0.5 s of the
+    service request or ttt" on the aD1!; no aD0! was issued."""
+    w = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(9).brk().idle(30)
+    w.brk().rec("0D1!").sensor("0\r\n")
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))["R-4.4.5-05"]
+    assert found.verdict is Verdict.FAIL, found.detail
+    assert "0D1!, not aD0!" in found.detail
+    # aD0! at the same moment: the reaction rule PASSes as before
+    w = _measurement(Wire()).sensor("0\r\n", delay_ms=300).idle(9).brk().rec("0D0!")
+    w.sensor("0+1+2+3\r\n")
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))["R-4.4.5-05"]
+    assert found.verdict is Verdict.PASS, found.detail
+
+
+def test_a_command_with_a_nul_after_its_bang_is_the_command_a_sensor_answers():
+    """The same logger sends each command's C string with its NUL (``0M!<NUL>``); the played
+    sensor answers at the ``!``, as a sensor does. The view took the text for no command: its
+    measurements, retries and logged values went unjudged ("nothing was observed") or FAILed
+    "logged, the command never sent". R-4.2-01 and R-4.4-04 still FAIL the NUL."""
+    w = Wire().brk().rec("0M!\x00").sensor("00013\r\n", delay_ms=1.0)
+    w.sensor("0\r\n", delay_ms=300).idle(9).rec("0D0!\x00").sensor("0+1+2+3\r\n", delay_ms=1.0)
+    view = w.view()
+    assert [s.stem for s in view.transmissions] == ["0M!", "0D0!"]
+    taken = observed_measurements(view, 0.0)
+    assert len(taken) == 1 and taken[0].values() == ["+1", "+2", "+3"]
+    text = by_id(judge_command_text(view))
+    assert text["R-4.2-01"].verdict is text["R-4.4-04"].verdict is Verdict.FAIL
+    # a NUL before the '!' keeps the text whole: no command
+    assert Wire().brk().rec("0M\x00!").view().transmissions[0].stem == "0M\x00!"
 
 
 def test_d0_before_ttt_and_late_reaction():
