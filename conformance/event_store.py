@@ -123,6 +123,22 @@ class Column:
             last.extend(items[i : i + room])  # type: ignore[union-attr]
             i += room
 
+    def open_chunk(self) -> int:
+        """Room for more in the last chunk (a new one begun, the full one spilled, if it has
+        none): how many items it takes still."""
+        chunks = self._chunks
+        if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
+            self._new_chunk()
+        return CHUNK - len(chunks[-1])  # type: ignore[arg-type]
+
+    def last(self) -> array:
+        """The chunk items are appended to (:meth:`open_chunk` first)."""
+        return self._chunks[-1]  # type: ignore[return-value]
+
+    def is_spilled(self, c: int) -> bool:
+        """Whether chunk ``c`` was written out."""
+        return self._chunks[c] is None
+
     def _new_chunk(self) -> None:
         if self._chunks:
             self._spill_last()
@@ -256,7 +272,17 @@ class CompactEvents(Sequence[Event]):
     about one chunk in RAM whatever the recording's length (issue 22: an hour's busy
     capture, 6.4 MB of columns, judged in the memory ten minutes take)."""
 
-    __slots__ = ("starts", "ends", "wires", "which", "fields", "_known", "_columns")
+    __slots__ = (
+        "starts",
+        "ends",
+        "wires",
+        "which",
+        "fields",
+        "_known",
+        "_columns",
+        "_room",
+        "_put",
+    )
 
     def __init__(self) -> None:
         spill = Spill()
@@ -265,6 +291,10 @@ class CompactEvents(Sequence[Event]):
         self.wires = Column("B", spill)  # widened to "q" where a wire does not fit a byte
         self.which = Column("B", spill)  # the index into ``fields``, widened to "I" past 256
         self._columns = (self.which, self.starts, self.ends, self.wires)
+        #: appends left before a chunk is full, and the current chunks' ``append`` s (an
+        #: event stored without a call of ours a column: the decoder's 357,000 an hour)
+        self._room = 0
+        self._put: tuple = ()
         self.fields: list[Fields] = []
         self._known: dict[Fields, int] = {}
 
@@ -302,12 +332,19 @@ class CompactEvents(Sequence[Event]):
             self.fields.append(key)
             if at == 256:
                 self.which.widen("I")
+                self._room = 0  # as for the wires below
         if self.wires.typecode == "B" and not 0 <= wire < 256:
             self.wires.widen("q")
-        self.starts.append(start)
-        self.ends.append(end)
-        self.wires.append(wire)
-        self.which.append(at)
+            self._room = 0  # the appenders of the arrays the widening replaced: made again
+        if not self._room:
+            self._room = min(column.open_chunk() for column in self._columns)
+            self._put = tuple(column.last().append for column in self._columns)
+        self._room -= 1
+        put_which, put_start, put_end, put_wire = self._put
+        put_which(at)
+        put_start(start)
+        put_end(end)
+        put_wire(wire)
         return True
 
     def __len__(self) -> int:
@@ -356,11 +393,17 @@ class CompactEvents(Sequence[Event]):
                 yield self[i]
             return
         lo, hi = positions.start, positions.stop
-        parts = [c.parts(lo, hi) for c in self._columns]
-        for which, starts, ends, wires in zip(*parts, strict=True):
-            for w, start, end, wire in zip(which, starts, ends, wires, strict=True):
+        columns, spilled = self._columns, self.starts.is_spilled
+        while lo < hi:
+            c, j = divmod(lo, CHUNK)
+            k = min(CHUNK, j + hi - lo)
+            if spilled(c):  # a block at a time
+                k = min(k, (j // BLOCK + 1) * BLOCK)
+            parts = [column.part(c, j, k) for column in columns]
+            for w, start, end, wire in zip(*parts, strict=True):
                 kind, origin, text, u, du = fields[w]
                 yield event(kind, origin, start, end, wire, text, u, du)
+            lo += k - j
 
     def has_kind(self, kind: EventKind) -> bool:
         """Whether some event is of ``kind`` (no event made)."""
