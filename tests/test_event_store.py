@@ -168,3 +168,24 @@ def test_a_loaded_capture_keeps_its_decode_s_events_compact(tmp_path):
     assert list(link.transcript.events) == listed
     assert list(link.events_again()) == listed
     assert link.transcript.events.nbytes() == 18 * len(listed)
+
+
+def test_a_capture_decoded_compact_writes_out_its_events_and_rates(tmp_path, monkeypatch):
+    """A compact decode's store and bit-rate errors (:class:`~conformance.event_store.Column`)
+    spilled chunk by chunk (chunks made small here) read back as the list decode's."""
+    import conformance.event_store as event_store
+    from conformance.capture import decode_capture
+    from tests.offline.test_judge_memory import busy_capture
+
+    monkeypatch.setattr(event_store, "CHUNK", 500)
+    monkeypatch.setattr(event_store, "BLOCK", 64)
+    path = tmp_path / "busy.sr"
+    busy_capture(path, 0.2)
+    listed = decode_capture(str(path), keep=False)
+    compact = decode_capture(str(path), keep=False, compact=True)
+    events, rates = compact.events, compact.baud_error_pct
+    assert isinstance(events, CompactEvents) and events.spilled() >= 2
+    assert isinstance(rates, event_store.Column) and rates.spilled() >= 2
+    assert list(events) == listed.events and len(rates) == len(listed.baud_error_pct)
+    assert [repr(x) for x in rates] == [repr(x) for x in listed.baud_error_pct]
+    assert compact.baud_error_summary() == listed.baud_error_summary()
