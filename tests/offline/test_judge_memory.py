@@ -79,8 +79,8 @@ runs. The limit comes down to 0.60, the measured figure and the same 0.4 of nois
 passes it: this round's cuts have their own tests, ``tests/test_event_store.py``'s spilled
 chunks and ``tests/offline/test_rate_tally.py``). Between 10 and 60 minutes
 (``benchmarks/compare.py --only capture``, base-s64 and this tree alternated, two runs each,
-twice): 63 and 70-71 MB against 63 and 78-79, 0.16 against 0.32 MB a minute, the hour's CPU
-14.8 against 14.7 s (0.99x; 1.02x and 0.94x at 10 minutes, at a load of 10-13). What
+twice): 63 and 70-71 MB against 63 and 78-79, 0.16 against 0.31 MB a minute, the hour's CPU
+14.8 and 13.7 s against 14.7 and 13.1 (0.99x, 0.96x; 1.02x and 0.94x at 10 minutes). What
 still grows: each sensor's exchanges and measurements, held for its run (its tenth of the
 events made as objects, ~150 bytes each: 4.3 MB traced at an hour against 0.9 at 10
 minutes), and the bus pass's bounds, sides and windows (~40 bytes a window and 1 an event).
