@@ -23,10 +23,12 @@ unequal to itself once made again, which equality could not place.
 
 from __future__ import annotations
 
+import os
+import tempfile
 from array import array
 from collections.abc import Iterable, Iterator, Sequence
 from math import copysign, isfinite
-from typing import overload
+from typing import IO, overload
 
 from .transcript import Event, EventKind, full_event
 
@@ -36,6 +38,225 @@ _WIDE = 2**63  # the widest wire a ``q`` array holds
 _INF = float("inf")
 #: events a chunk of the columns holds (2**16: 512 KiB a column of stamps)
 CHUNK = 1 << 16
+#: items a read of a spilled chunk brings back at once (and a column keeps, its last read)
+BLOCK = 1 << 12
+
+
+class Spill:
+    """A temporary file the full chunks of columns are written to (issue 22's bounded
+    memory: an hour's store no longer held in RAM), opened at the first chunk written and
+    deleted by the system once closed (the last column holding it let go, or the process
+    ended). Read back by position (``os.pread`` where the system has it: a reader in a
+    forked process does not move another's place in the file)."""
+
+    __slots__ = ("_file", "_size")
+
+    def __init__(self) -> None:
+        self._file: IO[bytes] | None = None
+        self._size = 0
+
+    def write(self, data: array) -> int | None:
+        """``data`` written after what is there; its place, or None when no temporary file
+        can be written (the caller keeps the chunk in RAM)."""
+        try:
+            if self._file is None:
+                self._file = tempfile.TemporaryFile(prefix="sdi12-events-")  # noqa: SIM115 (held)
+            at = self._size
+            self._file.seek(at)
+            self._file.write(data.tobytes())
+            self._file.flush()
+        except OSError:
+            return None
+        self._size = at + data.itemsize * len(data)
+        return at
+
+    def read(self, typecode: str, at: int, count: int) -> array:
+        """``count`` items of ``typecode`` written at ``at``."""
+        assert self._file is not None
+        out = array(typecode)
+        n = out.itemsize * count
+        if hasattr(os, "pread"):
+            data = os.pread(self._file.fileno(), n, at)
+        else:  # pragma: no cover - systems without pread (Windows)
+            self._file.seek(at)
+            data = self._file.read(n)
+        out.frombytes(data)
+        return out
+
+    def nbytes(self) -> int:
+        """The bytes written (on disk, not in RAM)."""
+        return self._size
+
+
+class Column:
+    """An append-only column of numbers (``array`` typecodes) in chunks of :data:`CHUNK`
+    items; each full chunk is written to a :class:`Spill` and let go, so what a column
+    holds in RAM is its last chunk and the last :data:`BLOCK` items read back, whatever
+    its length. Read by item, by slice (an ``array``) and in blocks. ``widen`` changes the
+    typecode of what comes (the chunks in RAM converted; a spilled chunk keeps its own)."""
+
+    __slots__ = ("typecode", "spill", "_chunks", "_spilled", "_cached")
+
+    def __init__(self, typecode: str, spill: Spill | None = None) -> None:
+        self.typecode = typecode
+        self.spill = spill if spill is not None else Spill()
+        #: the chunks in order: an array in RAM, or None where it was spilled
+        self._chunks: list[array | None] = []
+        #: per chunk: (typecode, place in the spill, length) where it was spilled
+        self._spilled: dict[int, tuple[str, int, int]] = {}
+        self._cached: tuple[int, int, array] | None = None  # (chunk, block, items)
+
+    def append(self, x: float) -> None:
+        chunks = self._chunks
+        if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
+            self._new_chunk()
+        chunks[-1].append(x)  # type: ignore[union-attr]
+
+    def extend(self, xs: Iterable[float]) -> None:
+        """Append ``xs`` in order (a chunk's room filled at a time)."""
+        items, i, chunks = array(self.typecode, xs), 0, self._chunks
+        while i < len(items):
+            if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
+                self._new_chunk()
+            last = chunks[-1]
+            room = CHUNK - len(last)  # type: ignore[arg-type]
+            last.extend(items[i : i + room])  # type: ignore[union-attr]
+            i += room
+
+    def open_chunk(self) -> int:
+        """Room for more in the last chunk (a new one begun, the full one spilled, if it has
+        none): how many items it takes still."""
+        chunks = self._chunks
+        if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
+            self._new_chunk()
+        return CHUNK - len(chunks[-1])  # type: ignore[arg-type]
+
+    def last(self) -> array:
+        """The chunk items are appended to (:meth:`open_chunk` first)."""
+        return self._chunks[-1]  # type: ignore[return-value]
+
+    def is_spilled(self, c: int) -> bool:
+        """Whether chunk ``c`` was written out."""
+        return self._chunks[c] is None
+
+    def _new_chunk(self) -> None:
+        if self._chunks:
+            self._spill_last()
+        self._chunks.append(array(self.typecode))
+
+    def _spill_last(self) -> None:
+        c, full = len(self._chunks) - 1, self._chunks[-1]
+        assert full is not None
+        at = self.spill.write(full)
+        if at is not None:
+            self._spilled[c] = (full.typecode, at, len(full))
+            self._chunks[c] = None
+
+    def widen(self, typecode: str) -> None:
+        """What comes is of ``typecode`` (wider): the chunks in RAM converted."""
+        self.typecode = typecode
+        self._chunks = [c if c is None else array(typecode, c) for c in self._chunks]
+        self._cached = None
+
+    def __len__(self) -> int:
+        chunks = self._chunks
+        if not chunks:
+            return 0
+        last = chunks[-1]
+        return (len(chunks) - 1) * CHUNK + (len(last) if last is not None else CHUNK)
+
+    def chunk_count(self) -> int:
+        return len(self._chunks)
+
+    def spilled(self) -> int:
+        """How many chunks were written out."""
+        return len(self._spilled)
+
+    def _block(self, c: int, b: int) -> array:
+        """Block ``b`` of spilled chunk ``c`` (kept until another is read)."""
+        cached = self._cached
+        if cached is not None and cached[0] == c and cached[1] == b:
+            return cached[2]
+        typecode, at, n = self._spilled[c]
+        lo = b * BLOCK
+        hi = min(n, lo + BLOCK)
+        size = array(typecode).itemsize
+        items = self.spill.read(typecode, at + lo * size, hi - lo)
+        self._cached = (c, b, items)
+        return items
+
+    def part(self, c: int, j: int, k: int) -> array:
+        """Items ``j:k`` of chunk ``c`` (an array: a slice of a chunk in RAM, read back from
+        the spill where it was written, a block at a time)."""
+        chunk = self._chunks[c]
+        if chunk is not None:
+            return chunk[j:k]
+        b, hi_b = j // BLOCK, (k - 1) // BLOCK
+        if b == hi_b:
+            block = self._block(c, b)
+            return block[j - b * BLOCK : k - b * BLOCK]
+        typecode, at, _ = self._spilled[c]
+        size = array(typecode).itemsize
+        return self.spill.read(typecode, at + j * size, k - j)
+
+    def item(self, c: int, j: int) -> float:
+        chunk = self._chunks[c]
+        if chunk is not None:
+            return chunk[j]
+        b = j // BLOCK
+        return self._block(c, b)[j - b * BLOCK]
+
+    @overload
+    def __getitem__(self, i: int) -> float: ...
+    @overload
+    def __getitem__(self, i: slice) -> array: ...
+    def __getitem__(self, i: int | slice) -> float | array:
+        n = len(self)
+        if isinstance(i, slice):
+            positions = range(n)[i]
+            if positions.step != 1:
+                return array(self.typecode, [self[k] for k in positions])
+            return self.read(positions.start, positions.stop)
+        if i < 0:
+            i += n
+        if not 0 <= i < n:
+            raise IndexError("column index out of range")
+        c, j = divmod(i, CHUNK)
+        return self.item(c, j)
+
+    def read(self, lo: int, hi: int) -> array:
+        """Items ``lo:hi`` (0 <= lo, hi <= len) as one array of the column's typecode."""
+        out = array(self.typecode)
+        for part in self.parts(lo, hi):
+            out.extend(part if part.typecode == out.typecode else array(out.typecode, part))
+        return out
+
+    def parts(self, lo: int, hi: int) -> Iterator[array]:
+        """Items ``lo:hi`` as arrays in order, none longer than a chunk's or a block's."""
+        while lo < hi:
+            c, j = divmod(lo, CHUNK)
+            k = min(CHUNK, j + hi - lo)
+            if self._chunks[c] is None:
+                k = min(k, (j // BLOCK + 1) * BLOCK)
+            yield self.part(c, j, k)
+            lo += k - j
+
+    def __iter__(self) -> Iterator[float]:
+        for part in self.parts(0, len(self)):
+            yield from part
+
+    def nbytes(self) -> int:
+        """The items' size wherever held (RAM and spill)."""
+        ram = sum(a.itemsize * len(a) for a in self._chunks if a is not None)
+        spilled = sum(array(t).itemsize * n for t, _, n in self._spilled.values())
+        return ram + spilled
+
+    def resident_nbytes(self) -> int:
+        """The items' size held in RAM (the last chunk, any chunk that could not be
+        spilled, the block last read)."""
+        ram = sum(a.itemsize * len(a) for a in self._chunks if a is not None)
+        cached = self._cached[2] if self._cached is not None else None
+        return ram + (cached.itemsize * len(cached) if cached is not None else 0)
 
 
 class NotCompact(ValueError):
@@ -45,19 +266,35 @@ class NotCompact(ValueError):
 class CompactEvents(Sequence[Event]):
     """Events in recorded order as parallel columns (see the module's docstring): a
     read-only sequence; an item or a slice read makes its events again. The columns are
-    kept in chunks of :data:`CHUNK` events: a column grown whole by appending was copied
-    each time its block moved (both copies held at that moment: the decode of an hour's
-    capture peaked ~6 MB higher), a chunk is at most one chunk's copy."""
+    :class:`Column` s sharing one :class:`Spill`: in chunks of :data:`CHUNK` events (a
+    column grown whole by appending was copied each time its block moved), each full chunk
+    written to a temporary file and read back a block at a time, so that the store holds
+    about one chunk in RAM whatever the recording's length (issue 22: an hour's busy
+    capture, 6.4 MB of columns, judged in the memory ten minutes take)."""
 
-    __slots__ = ("starts", "ends", "wires", "which", "fields", "_known", "_wire", "_which")
+    __slots__ = (
+        "starts",
+        "ends",
+        "wires",
+        "which",
+        "fields",
+        "_known",
+        "_columns",
+        "_room",
+        "_put",
+    )
 
     def __init__(self) -> None:
-        self.starts: list[array] = []
-        self.ends: list[array] = []
-        self.wires: list[array] = []
-        self.which: list[array] = []
-        self._wire = "B"  # widened to "q" where a wire does not fit a byte
-        self._which = "B"  # the index into ``fields``, widened to "I" past 256
+        spill = Spill()
+        self.starts = Column("d", spill)
+        self.ends = Column("d", spill)
+        self.wires = Column("B", spill)  # widened to "q" where a wire does not fit a byte
+        self.which = Column("B", spill)  # the index into ``fields``, widened to "I" past 256
+        self._columns = (self.which, self.starts, self.ends, self.wires)
+        #: appends left before a chunk is full, and the current chunks' ``append`` s (an
+        #: event stored without a call of ours a column: the decoder's 357,000 an hour)
+        self._room = 0
+        self._put: tuple = ()
         self.fields: list[Fields] = []
         self._known: dict[Fields, int] = {}
 
@@ -94,28 +331,36 @@ class CompactEvents(Sequence[Event]):
             at = self._known[key] = len(self.fields)
             self.fields.append(key)
             if at == 256:
-                self._which = "I"
-                self.which = [array("I", c) for c in self.which]
-        if self._wire == "B" and not 0 <= wire < 256:
-            self._wire = "q"
-            self.wires = [array("q", c) for c in self.wires]
-        if not self.starts or len(self.starts[-1]) == CHUNK:
-            self.starts.append(array("d"))
-            self.ends.append(array("d"))
-            self.wires.append(array(self._wire))
-            self.which.append(array(self._which))
-        self.starts[-1].append(start)
-        self.ends[-1].append(end)
-        self.wires[-1].append(wire)
-        self.which[-1].append(at)
+                self.which.widen("I")
+                self._room = 0  # as for the wires below
+        if self.wires.typecode == "B" and not 0 <= wire < 256:
+            self.wires.widen("q")
+            self._room = 0  # the appenders of the arrays the widening replaced: made again
+        if not self._room:
+            self._room = min(column.open_chunk() for column in self._columns)
+            self._put = tuple(column.last().append for column in self._columns)
+        self._room -= 1
+        put_which, put_start, put_end, put_wire = self._put
+        put_which(at)
+        put_start(start)
+        put_end(end)
+        put_wire(wire)
         return True
 
     def __len__(self) -> int:
-        return (len(self.starts) - 1) * CHUNK + len(self.starts[-1]) if self.starts else 0
+        return len(self.starts)
 
     def typecodes(self) -> tuple[str, str]:
         """The columns' widths: the fields' index and the wires (``array`` typecodes)."""
-        return self._which, self._wire
+        return self.which.typecode, self.wires.typecode
+
+    def chunk_count(self) -> int:
+        """How many chunks the columns are in."""
+        return self.starts.chunk_count()
+
+    def spilled(self) -> int:
+        """How many chunks were written out to the temporary file."""
+        return self.starts.spilled()
 
     @overload
     def __getitem__(self, i: int) -> Event: ...
@@ -130,28 +375,32 @@ class CompactEvents(Sequence[Event]):
         if not 0 <= i < n:
             raise IndexError("event index out of range")
         c, j = divmod(i, CHUNK)
-        kind, origin, text, u, du = self.fields[self.which[c][j]]
+        kind, origin, text, u, du = self.fields[self.which.item(c, j)]  # type: ignore[index]
         return full_event(
-            kind, origin, self.starts[c][j], self.ends[c][j], self.wires[c][j], text, u, du
-        )
+            kind, origin, self.starts.item(c, j), self.ends.item(c, j), self.wires.item(c, j),
+            text, u, du,
+        )  # fmt: skip
 
     def __iter__(self) -> Iterator[Event]:
         return self._made(range(len(self)))
 
     def _made(self, positions: range) -> Iterator[Event]:
-        """The events at ``positions`` (a range), made as they are read: a chunk's columns
-        read together where the range steps by one."""
+        """The events at ``positions`` (a range), made as they are read: the columns'
+        parts read together where the range steps by one."""
         fields, event = self.fields, full_event
         if positions.step != 1:
             for i in positions:
                 yield self[i]
             return
         lo, hi = positions.start, positions.stop
+        columns, spilled = self._columns, self.starts.is_spilled
         while lo < hi:
             c, j = divmod(lo, CHUNK)
             k = min(CHUNK, j + hi - lo)
-            columns = (self.which[c][j:k], self.starts[c][j:k], self.ends[c][j:k])
-            for w, start, end, wire in zip(*columns, self.wires[c][j:k], strict=True):
+            if spilled(c):  # a block at a time
+                k = min(k, (j // BLOCK + 1) * BLOCK)
+            parts = [column.part(c, j, k) for column in columns]
+            for w, start, end, wire in zip(*parts, strict=True):
                 kind, origin, text, u, du = fields[w]
                 yield event(kind, origin, start, end, wire, text, u, du)
             lo += k - j
@@ -159,23 +408,27 @@ class CompactEvents(Sequence[Event]):
     def has_kind(self, kind: EventKind) -> bool:
         """Whether some event is of ``kind`` (no event made)."""
         wanted = {i for i, f in enumerate(self.fields) if f[0] is kind}
-        return bool(wanted) and any(w in wanted for c in self.which for w in c)
+        return bool(wanted) and any(w in wanted for w in self.which)
 
     def in_start_order(self) -> bool:
         """Whether every start is at or after the one before (no event made)."""
         last = -_INF
-        for chunk in self.starts:
-            if chunk and chunk[0] < last:
+        for part in self.starts.parts(0, len(self)):
+            if part and part[0] < last:
                 return False
-            if not all(chunk[i - 1] <= chunk[i] for i in range(1, len(chunk))):
+            if not all(part[i - 1] <= part[i] for i in range(1, len(part))):
                 return False
-            last = chunk[-1] if chunk else last
+            last = part[-1] if part else last
         return True
 
     def nbytes(self) -> int:
-        """The columns' own size (bytes): what the store holds an event."""
-        columns = (*self.starts, *self.ends, *self.wires, *self.which)
-        return sum(a.itemsize * len(a) for a in columns)
+        """The columns' own size (bytes): what the store holds an event, in RAM or spilled."""
+        return sum(c.nbytes() for c in self._columns)
+
+    def resident_nbytes(self) -> int:
+        """What of the columns is in RAM (bytes): about a chunk and a block read back,
+        whatever the store's length."""
+        return sum(c.resident_nbytes() for c in self._columns)
 
 
 def _exact(a: Fields, b: Fields) -> bool:
@@ -190,4 +443,4 @@ def _exact(a: Fields, b: Fields) -> bool:
     return True
 
 
-__all__ = ["CompactEvents", "NotCompact"]
+__all__ = ["Column", "CompactEvents", "NotCompact", "Spill"]

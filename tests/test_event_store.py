@@ -90,19 +90,24 @@ def test_wide_wires_and_many_kinds_of_fields():
 
 
 def test_events_across_chunks(monkeypatch: pytest.MonkeyPatch):
-    """A store of several chunks (:data:`~conformance.event_store.CHUNK` made small here)
-    reads back the same events whole, item by item and in slices across chunks."""
+    """A store of several chunks (:data:`~conformance.event_store.CHUNK` and the blocks read
+    back, :data:`~conformance.event_store.BLOCK`, made small here) reads back the same events
+    whole, item by item and in slices across chunks and blocks, every full chunk spilled to
+    the temporary file (the last one in RAM)."""
     import conformance.event_store as event_store
 
     monkeypatch.setattr(event_store, "CHUNK", 7)
+    monkeypatch.setattr(event_store, "BLOCK", 3)
     stored = [
         Event(EventKind.CHAR, BUS, i * 0.01, i * 0.01 + 0.008, wire=i % 256) for i in range(50)
     ]
     stored[33] = Event(EventKind.BREAK, TOOL, 0.33, 0.34, text="held back")
     store = CompactEvents.of(stored)
-    assert store is not None and len(store.starts) == 8
+    assert store is not None and store.chunk_count() == 8 and store.spilled() == 7
+    assert store.resident_nbytes() <= 18 * (7 + 3)  # the last chunk and one block of each
     assert list(store) == stored and len(store) == 50
     assert [store[i] for i in range(50)] == stored
+    assert [store[i] for i in reversed(range(50))] == stored[::-1]
     for lo, hi, step in ((0, 50, 1), (5, 23, 1), (6, 8, 1), (13, 14, 1), (3, 40, 3), (40, 2, -4)):
         assert store[lo:hi:step] == stored[lo:hi:step]
     assert store.in_start_order() and not store.has_kind(EventKind.NOTE)
@@ -110,6 +115,44 @@ def test_events_across_chunks(monkeypatch: pytest.MonkeyPatch):
     shuffled = CompactEvents.of(stored)
     assert shuffled is not None and not shuffled.in_start_order()
     assert store.nbytes() == 18 * 50
+
+
+def test_spilled_chunks_read_back_after_the_columns_widen(monkeypatch: pytest.MonkeyPatch):
+    """Chunks written out before a wire wider than a byte or the 257th distinct fields
+    read back with their own widths beside the wider chunks after them."""
+    import conformance.event_store as event_store
+
+    monkeypatch.setattr(event_store, "CHUNK", 5)
+    monkeypatch.setattr(event_store, "BLOCK", 2)
+    stored = [Event(EventKind.CHAR, BUS, i * 0.01, i * 0.01 + 0.008, wire=i) for i in range(12)]
+    stored += [Event(EventKind.NOTE, TOOL, 1.0 + i, 1.0 + i, text=f"n{i}") for i in range(300)]
+    stored.append(Event(EventKind.CHAR, DUT, 400.0, 401.0, wire=70000))
+    store = CompactEvents.of(stored)
+    assert store is not None and store.typecodes() == ("I", "q") and store.spilled() == 62
+    assert list(store) == stored
+    assert [store[i] for i in range(len(stored))] == stored
+    assert store[3:40] == stored[3:40] and store[-9:] == stored[-9:]
+    assert store.has_kind(EventKind.NOTE) and store.in_start_order()
+
+
+def test_a_column_reads_back_what_was_appended(monkeypatch: pytest.MonkeyPatch):
+    """:class:`~conformance.event_store.Column` (a decode's bit-rate errors): items,
+    slices and iteration across spilled chunks and blocks; NaN kept."""
+    import conformance.event_store as event_store
+
+    monkeypatch.setattr(event_store, "CHUNK", 6)
+    monkeypatch.setattr(event_store, "BLOCK", 4)
+    column = event_store.Column("f")
+    values = [float("nan") if i % 7 == 3 else i / 8 for i in range(40)]
+    column.extend(values)
+    same = [repr(v) for v in values]
+    assert len(column) == 40 and column.spilled() == 6
+    assert [repr(v) for v in column] == same
+    assert [repr(column[i]) for i in range(-40, 0)] == same
+    for lo, hi, step in ((0, 40, 1), (5, 23, 1), (11, 13, 1), (3, 3, 1), (2, 39, 5)):
+        assert [repr(v) for v in column[lo:hi:step]] == same[lo:hi:step]
+    with pytest.raises(IndexError):
+        column[40]
 
 
 def test_a_loaded_capture_keeps_its_decode_s_events_compact(tmp_path):
@@ -125,3 +168,24 @@ def test_a_loaded_capture_keeps_its_decode_s_events_compact(tmp_path):
     assert list(link.transcript.events) == listed
     assert list(link.events_again()) == listed
     assert link.transcript.events.nbytes() == 18 * len(listed)
+
+
+def test_a_capture_decoded_compact_writes_out_its_events_and_rates(tmp_path, monkeypatch):
+    """A compact decode's store and bit-rate errors (:class:`~conformance.event_store.Column`)
+    spilled chunk by chunk (chunks made small here) read back as the list decode's."""
+    import conformance.event_store as event_store
+    from conformance.capture import decode_capture
+    from tests.offline.test_judge_memory import busy_capture
+
+    monkeypatch.setattr(event_store, "CHUNK", 500)
+    monkeypatch.setattr(event_store, "BLOCK", 64)
+    path = tmp_path / "busy.sr"
+    busy_capture(path, 0.2)
+    listed = decode_capture(str(path), keep=False)
+    compact = decode_capture(str(path), keep=False, compact=True)
+    events, rates = compact.events, compact.baud_error_pct
+    assert isinstance(events, CompactEvents) and events.spilled() >= 2
+    assert isinstance(rates, event_store.Column) and rates.spilled() >= 2
+    assert list(events) == listed.events and len(rates) == len(listed.baud_error_pct)
+    assert [repr(x) for x in rates] == [repr(x) for x in listed.baud_error_pct]
+    assert compact.baud_error_summary() == listed.baud_error_summary()

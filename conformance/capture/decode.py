@@ -20,7 +20,7 @@ from operator import is_not
 
 import numpy as np
 
-from ..event_store import CompactEvents, NotCompact
+from ..event_store import Column, CompactEvents, NotCompact
 from ..transcript import BUS, DUT, TOOL, Event, EventKind, full_event
 from .columns import WireColumns
 from .edges import Edges
@@ -59,7 +59,9 @@ class CaptureDecode:
     """What a capture holds, decoded. ``problems``: every break, pulse, glitch and frame with
     a framing or parity error or glitches, in time order (clean characters are counted, not
     kept twice); ``baud_error_pct``: each character's measured bit-rate error, in event order
-    (NaN where its edges could not tell)."""
+    (NaN where its edges could not tell): a :class:`~conformance.event_store.Column` where
+    the events are kept compact (written out a chunk at a time: an hour's 342,000 characters
+    are not held in RAM while the capture is judged, issue 22), else an array."""
 
     path: str
     format: str
@@ -92,7 +94,7 @@ class CaptureDecode:
     #: the events as columns (``decode_capture(..., columns=True)``), ``events`` then empty:
     #: :meth:`event_list` gives them either way
     columns: WireColumns | None = None
-    baud_error_pct: array = field(default_factory=lambda: array("f"))
+    baud_error_pct: array | Column = field(default_factory=lambda: array("f"))
     problems: list[Decoded] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
@@ -259,6 +261,13 @@ def _events_of(how: DecodeSettings, made: bool) -> list[Event]:
     return CompactEvents() if how.compact and made else []  # type: ignore[return-value]
 
 
+def _rates_of(how: DecodeSettings, made: bool) -> array | Column:
+    """A channel's decode's bit-rate errors: a :class:`~conformance.event_store.Column`
+    (its full chunks written out, not held) beside a compact store of its events
+    (:func:`_events_of`), else an array."""
+    return Column("f") if how.compact and made else array("f")
+
+
 def _decode_channel(
     path: str,
     fmt: str,
@@ -300,6 +309,7 @@ def _decode_channel(
         path=path,
         format=fmt,
         events=_events_of(how, into is None and not columns),
+        baud_error_pct=_rates_of(how, into is None and not columns),
         uncertainty_s=uncertainty,
         inverted=inverted,
         polarity_detected=invert is None,

@@ -15,6 +15,7 @@ from array import array
 from bisect import bisect_left
 from collections.abc import Iterable, Sequence
 from itertools import islice
+from math import copysign
 from operator import le
 from typing import Any
 
@@ -89,15 +90,78 @@ def problems_by_character(decoded: Any) -> dict[tuple[float, int], Any]:
     return {(p.event.start, p.event.wire): p for p in character_problems(decoded.problems)}
 
 
+class RateTally:
+    """Measured bit-rate errors, for their min, median and max as ``min``,
+    ``statistics.median`` and ``max`` of the list of them give those (the very floats): each
+    distinct value and how often it came, in memory that grows with the distinct values,
+    not the characters (a decode's errors are float32 ratios of whole sample counts: a few
+    hundred distinct values in an hour's busy capture, issue 22). Past :data:`DISTINCT`
+    values, or at a ``-0.0`` (equal to ``0.0``, printed apart: which one a median or a min
+    gives depends on their order), the values are listed in order instead, as they were."""
+
+    #: distinct values a tally keeps before it lists them
+    DISTINCT = 4096
+
+    def __init__(self) -> None:
+        self.counts: dict[float, int] = {}
+        self.listed: array | None = None  # the values in order, once a tally will not do
+
+    def extend(self, values: list[float]) -> None:
+        """More values (no NaN)."""
+        if self.listed is None:
+            counts = self.counts
+            for i, v in enumerate(values):
+                if v == 0.0 and copysign(1.0, v) < 0:
+                    self._list()
+                    values = values[i:]
+                    break
+                counts[v] = counts.get(v, 0) + 1
+            else:
+                if len(counts) > self.DISTINCT:
+                    self._list()
+                return
+        self.listed.extend(values)  # type: ignore[union-attr]
+
+    def _list(self) -> None:
+        """From here on the values in order: those so far sorted (each 0.0 then came
+        before any ``-0.0``, so the order among equal values a sort keeps is theirs)."""
+        self.listed = array("d", [v for v in sorted(self.counts) for _ in range(self.counts[v])])
+        self.counts = {}
+
+    def __bool__(self) -> bool:
+        return bool(self.counts) or bool(self.listed)
+
+    def summary(self) -> tuple[float, float, float]:
+        """(min, median, max) of the values (there are some)."""
+        if self.listed is not None:
+            values = self.listed
+            return min(values), statistics.median(values), max(values)
+        ordered = sorted(self.counts)
+        n = sum(self.counts.values())
+        below, low_mid, mid = 0, None, None
+        for v in ordered:  # the values at sorted positions (n - 1) // 2 and n // 2
+            below += self.counts[v]
+            if low_mid is None and below > (n - 1) // 2:
+                low_mid = v
+            if below > n // 2:
+                mid = v
+                break
+        assert low_mid is not None and mid is not None
+        median = mid if n % 2 else (low_mid + mid) / 2
+        return ordered[0], median, ordered[-1]
+
+
 class Quality:
     """One sensor's decode figures gathered a part of the recording at a time (issue 22's
     windowed judge: each window's characters of the sensor :meth:`add`-ed as they come), the
     note :func:`decode_quality` gives all of them at once. It keeps counts and the measured
-    bit-rate errors (8 bytes a character, for the median), never the characters."""
+    bit-rate errors as a :class:`RateTally` (it kept 8 bytes a character, for the median:
+    an hour's busy capture held 5.5 MB of them while its bus pass ran), never the
+    characters."""
 
     def __init__(self) -> None:
         self.chars = self.parity = self.framing = self.glitched = 0
-        self.measured = array("d")
+        self.measured = RateTally()
 
     def add(
         self, chars: list[Event], error: CharRates, broken: dict[tuple[float, int], Any]
@@ -117,7 +181,7 @@ class Quality:
             return None
         rate, measured = "bit rate not measurable", self.measured
         if measured:
-            low, mid, high = min(measured), statistics.median(measured), max(measured)
+            low, mid, high = measured.summary()
             rate = f"bit rate {low:+.2f}..{high:+.2f} % off {baud:g} baud (median {mid:+.2f} %)"
         return (
             f"decode quality of {who}: {self.chars} character(s), {rate}; {self.parity} with a "
