@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable
+from dataclasses import dataclass
 
 from ..transcript import Event, EventKind
 
@@ -46,3 +47,44 @@ def stalled_ms(events: Iterable[Event]) -> float:
             if found is not None:
                 longest = max(longest, float(found.group(1)))
     return longest
+
+
+#: how far (s) before a stall's measured length a read it held up may have begun: the
+#: reader's own poll and the engine's idle window, after which a held-up read ends cut
+REACH = 0.05
+
+
+@dataclass(frozen=True)
+class Stall:
+    """A host stall read back from its NOTE: the reads ``start``..``end`` (s) may have been
+    held up by it (its measured length, reached back by :data:`REACH`)."""
+
+    start: float
+    end: float
+    ms: float
+
+    def overlaps(self, start: float, end: float) -> bool:
+        return start <= self.end and end >= self.start
+
+    def why(self) -> str:
+        return f"the tool's host stalled {self.ms:.0f} ms during this read"
+
+
+def stalls(events: Iterable[Event]) -> list[Stall]:
+    """Every host stall the NOTEs among ``events`` report, in their order."""
+    found = []
+    for event in events:
+        if event.kind is _NOTE and event.text.startswith(HOST_STALL_NOTE):
+            got = _MS.match(event.text)
+            if got is not None:
+                ms = float(got.group(1))
+                found.append(Stall(event.start - ms / 1e3 - REACH, event.start, ms))
+    return found
+
+
+def stalled_over(found: list[Stall], start: float, end: float) -> Stall | None:
+    """The first of ``found`` that may have held up a read between ``start`` and ``end``."""
+    for stall in found:
+        if stall.overlaps(start, end):
+            return stall
+    return None
