@@ -32,8 +32,7 @@ def _stalling(
 ):
     """Make the first ``takes`` calls of the session's engine's ``method`` (``transact``
     or ``measure``, whose own exchanges go through ``transact`` unstalled) stalled: a
-    host-stall note among their events and (``cut``) the first try read IDLE; returns the
-    list each call's record is appended to."""
+    host-stall note among their events and (``cut``) the first try read IDLE; returns the list each call's record is appended to."""
     master = session.master
     made: list = []
 
