@@ -19,7 +19,6 @@ from ..dut import DutClaim, Session, sensor_claim
 from ..judges.support import empty_data_reply, first_filled
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
-from ..links.host_stall import stalled_ms
 from ..preconditions import Unmet, acknowledges, shows_listening
 from ..protocol import commands as cmd
 from ..protocol.commands import (
@@ -36,7 +35,7 @@ from ..protocol.framing import LF
 from ..protocol.responses import Identification, parse_ident, split_line
 from ..protocol.timing import CHAR_TIME, STANDBY_MARKING, TOLERANCE, WAKE_LIMIT
 from ..protocol.version import V14, VERSIONS, format_version, is_v14
-from ..tool_recorder.records import Attempt, Exchange, Measurement
+from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import TOOL, Event, EventKind, decode_7e1, escape
 from ..view.live_cut import Mark, live_cut
 from ..view.rebuilt_records import Rebuilt, rebuild_records, records_of
@@ -162,10 +161,6 @@ REPROBE_KINDS = frozenset(
 
 #: The high-volume data index read past any measurement's data (R-5.2-06).
 PAST_DATA_INDEX = 999
-#: how many times a stimulus the tool's own host stalled on is sent again (:meth:`_retake`)
-RETAKES = 2
-#: the commands sent again then: all but the address change, which a second send undoes
-RETAKE_KINDS = frozenset(Kind) - {Kind.CHANGE_ADDRESS}
 
 #: Breaks (s) tried before a device that ignored the usual 13 ms break is called absent.
 LONGER_BREAKS = (30e-3, 60e-3, 100e-3)
@@ -203,7 +198,6 @@ class SensorSession(Session):
         self.address_trial: Trial | None = None
         self._cache: dict[Any, Any] = {}
         self.view_disagreements = 0  # stimuli whose view record differed (see _as_seen)
-        self.host_retakes = 0  # stimuli sent again after a host stall (see _retake)
         #: the measurement codes a family may be tried with (None: all; a profile's groups)
         self.groups: frozenset[str] | None = None
         #: every sensor on the line with its aI! reply, when the DUT is not alone on it
@@ -450,41 +444,10 @@ class SensorSession(Session):
         return self.once(("x", code), lambda: self.fresh_exchange(code, binary=binary))
 
     def fresh_exchange(self, code: str, *, binary: bool | None = None, **kw: Any) -> Exchange:
-        command = self.command(code)
-        for take in range(RETAKES + 1):
-            mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
-            made = self.master.transact(command, binary=binary, **kw)
-            seen = self._rebuilt(mark).exchanges
-            judged = self._as_seen(made, seen[0] if len(seen) == 1 else None)
-            if not self._retake(command, mark, take, (made, judged)):
-                return judged
-        return judged
-
-    def _retake(
-        self, command: Command, mark: Mark, take: int, records: tuple[Exchange | Measurement, ...]
-    ) -> bool:
-        """Whether to send a stimulus again because the tool's own host stalled while it
-        went (:mod:`~conformance.links.host_stall`): the link noted a stall among its events
-        and some try of it was not accepted, so the read may have been cut and its stamps
-        moved by the host, not the DUT (truth26: 6 FAIL + 1 WARN for a clean emulator under
-        80-200 ms pauses). Only a command that changes nothing in the sensor is sent again
-        (not ``aAb!``), at most :data:`RETAKES` times; the last take stands, the run's
-        assumptions say how many were taken again."""
-        if take >= RETAKES or command.kind not in RETAKE_KINDS:
-            return False
-        if all(attempt.ok for record in records for attempt in _attempts(record)):
-            return False
-        stalled = stalled_ms(self.link.transcript.since(mark.first))
-        if not stalled:
-            return False
-        self.host_retakes += 1
-        note = (
-            f"{self.host_retakes} stimulus(es) sent again: the tool's host stalled (up to "
-            f"{stalled:.0f} ms) while a try of theirs was read"
-        )
-        self.assumptions[:] = [a for a in self.assumptions if "the tool's host stalled" not in a]
-        self.assumptions.append(note)
-        return True
+        mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
+        made = self.master.transact(self.command(code), binary=binary, **kw)
+        seen = self._rebuilt(mark).exchanges
+        return self._as_seen(made, seen[0] if len(seen) == 1 else None)
 
     def measurement(self, code: str) -> Measurement:
         """The cached full measurement for ``"M"``, ``"MC"``, ``"C9"``, ``"HA"``, ``"HB"``..."""
@@ -514,15 +477,10 @@ class SensorSession(Session):
         return [self.fresh_exchange(f"DB{i}") for i in probes]
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
-        command = self.command(code)
-        for take in range(RETAKES + 1):
-            mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
-            made = self.master.measure(command, **kw)
-            seen = self._rebuilt(mark).measurements
-            judged = self._as_seen(made, seen[0] if len(seen) == 1 else None)
-            if not self._retake(command, mark, take, (made, judged)):
-                return judged
-        return judged
+        mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
+        made = self.master.measure(self.command(code), **kw)
+        seen = self._rebuilt(mark).measurements
+        return self._as_seen(made, seen[0] if len(seen) == 1 else None)
 
     # -- what the cases judge: the stimulus as the wire shows it -------------------------------
     def _rebuilt(self, mark: Mark) -> Rebuilt:
@@ -1180,13 +1138,3 @@ def _unanswered_break_end(events: list[Event], lookback: int = 4000) -> float | 
         if e.kind is not EventKind.NOTE and e.origin != TOOL:  # a sensor's break is its own
             return None
     return None
-
-
-def _attempts(record: Exchange | Measurement) -> Iterator[Attempt]:
-    """Every try of an exchange, or of a measurement's start and data commands."""
-    if isinstance(record, Exchange):
-        yield from record.attempts
-        return
-    yield from record.start.attempts
-    for exchange in record.data:
-        yield from exchange.attempts
