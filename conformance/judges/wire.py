@@ -1054,8 +1054,8 @@ class Framing:
         self.stamps = stamp_uncertainty(uncertainty)
         self.own = own
         #: the tool's host stalls: a segment one may have held up is framed by stamps the
-        #: host moved (a read cut, the rest a late burst), so what it shows against the
-        #: rules a split decides is INCONCLUSIVE, never FAIL (:class:`_StalledTally`)
+        #: host moved (a read cut, the rest a late burst), so a violation it shows is
+        #: INCONCLUSIVE with the stall named, never FAIL (:class:`_StalledTally`)
         self.stalls = stalls or []
         self.tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
         self.last_address: int | None = None
@@ -1175,9 +1175,12 @@ class Framing:
         return hidden
 
 
-#: the framing rules a split of characters into a reply and later lines decides: the split
-#: follows the stamps, which a stall of the tool's host moves
-_SPLIT_RULES = frozenset({"R-4.2-03", "R-4.3-01"})
+#: the framing rules a stall of the tool's host may break for a sensor that kept them: the
+#: split of its characters into a reply and later lines follows stamps the stall moved
+#: (R-4.2-03, R-4.3-01), and a binary packet's rest split off by it is read as 7E1 text
+#: (R-4.1-02, R-4.2-02: under 80-200 ms pauses "later, after 0DB7!: 2 character(s) with
+#: wrong parity" for a clean emulator)
+_SPLIT_RULES = frozenset({"R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"})
 
 
 class _StalledTally:

@@ -1,5 +1,6 @@
 """A reply the tool's own host stalled over is no framing evidence against the sensor
-(R-4.2-03, R-4.3-01): its split into a reply and later lines follows stamps the host moved
+(R-4.1-02, R-4.2-02, R-4.2-03, R-4.3-01): its split into a reply and later lines follows
+stamps the host moved
 (conformance.links.host_stall, truth26).
 
 Behind RFC 2217 with the tool's process paused 80-200 ms every 0.3-0.9 s, a clean emulator's
@@ -57,7 +58,7 @@ def test_a_reply_the_host_stalled_over_is_inconclusive_with_the_stall_named():
     assert found["R-4.2-03"].verdict is Verdict.INCONCLUSIVE
     assert "the tool's host stalled 160 ms during this read" in found["R-4.2-03"].detail
     assert found["R-4.3-01"].verdict is Verdict.INCONCLUSIVE
-    # parity and printable characters do not follow the split: judged as ever
+    # what conforms is judged as ever
     assert found["R-4.1-02"].verdict is Verdict.PASS
     assert found["R-4.2-02"].verdict is Verdict.PASS
 
@@ -68,3 +69,26 @@ def test_a_stall_long_before_the_reply_changes_nothing():
     found = _framing([early, *events])
     assert found["R-4.2-03"].verdict is Verdict.FAIL
     assert found["R-4.3-01"].verdict is Verdict.FAIL
+
+
+def test_bytes_after_a_reply_under_a_stall_are_no_parity_fail():
+    """Bytes that came after a reply, split off by the stall as 'later' text (under 80-200 ms
+    pauses the rest of an aDB7! packet: "2 character(s) with wrong parity, first 0x10" for a
+    clean emulator): R-4.1-02 and R-4.2-02 FAIL without the stall's note, not with it."""
+    events = [Event(EventKind.BREAK, TOOL, 0.0, 0.013, uncertainty=U)]
+    events += (cmd := chars(TOOL, "0D0!", 0.022, uncertainty=U))
+    events += (rep := chars(DUT, REPLY, cmd[-1].end + 9e-3, uncertainty=U))
+    at = rep[-1].end + 0.2
+    for k, byte in enumerate([0x10, 0x00, 0x08, 0x8D, 0x0A]):
+        start = at + k * 8.33e-3
+        events.append(Event(EventKind.CHAR, DUT, start, start + 8.33e-3, wire=byte, uncertainty=U))
+    found = _framing(events)
+    stalled = _framing([*events, _note_after(events[-1], 0.18)])
+    assert found["R-4.1-02"].verdict is found["R-4.2-02"].verdict is Verdict.FAIL
+    assert not any(f.verdict is Verdict.FAIL for f in stalled.values())
+    assert stalled["R-4.1-02"].verdict is Verdict.INCONCLUSIVE
+
+
+def _note_after(last: Event, stall: float) -> Event:
+    note = host_stall.note_text(stall)
+    return Event(EventKind.NOTE, TOOL, last.end, last.end, text=note)
