@@ -8,7 +8,7 @@ window although the device never idled, and the late burst's stamps show a gap t
 never had (truth25: 6 FAIL + 1 WARN for a clean emulator under 80-200 ms pauses).
 
 The link (I/O) writes what it measured as a NOTE (:func:`note_text`); whoever judges a
-stimulus reads the stall back from the transcript's events alone (:func:`stalled_ms`), so a
+stimulus reads the stalls back from the transcript's events alone (:func:`stalls`), so a
 saved transcript tells the same story as the live run.
 """
 
@@ -31,22 +31,11 @@ _NOTE = EventKind.NOTE
 
 
 def note_text(stall: float) -> str:
-    """The NOTE for a stall of ``stall`` s (its length first, so :func:`stalled_ms` reads it)."""
+    """The NOTE for a stall of ``stall`` s (its length first, so :func:`stalls` reads it)."""
     return (
         f"{HOST_STALL_NOTE}{stall * 1e3:.1f} ms (the link's reader thread came back that much "
         "later than its read's timeout): reads and stamps around it are the host's, not the DUT's"
     )
-
-
-def stalled_ms(events: Iterable[Event]) -> float:
-    """The longest host stall (ms) the NOTEs among ``events`` report; 0.0 where none does."""
-    longest = 0.0
-    for event in events:
-        if event.kind is _NOTE and event.text.startswith(HOST_STALL_NOTE):
-            found = _MS.match(event.text)
-            if found is not None:
-                longest = max(longest, float(found.group(1)))
-    return longest
 
 
 #: how far (s) before a stall's measured length a read it held up may have begun: the

@@ -64,6 +64,11 @@ def _run(stall: float) -> SerialLink:
     return link
 
 
+def _longest(link: SerialLink) -> float:
+    """The longest host stall (ms) the link noted; 0.0 where none."""
+    return max((s.ms for s in host_stall.stalls(link.transcript.events)), default=0.0)
+
+
 def _notes(link: SerialLink) -> list[Event]:
     return [e for e in link.transcript.events if e.kind is EventKind.NOTE]
 
@@ -80,7 +85,7 @@ def test_a_reader_back_late_by_a_pause_notes_the_host_stall_after_its_burst():
     assert events.index(stalls[0]) > events.index(chars[-1])
     assert stalls[0].start == pytest.approx(chars[-1].end, abs=1e-9)
     # the reader may be scheduled late besides: at least the pause, not much more
-    assert 110 <= host_stall.stalled_ms(link.transcript.events) < 400
+    assert 110 <= _longest(link) < 400
 
 
 @pytest.mark.realtime
@@ -88,15 +93,20 @@ def test_reads_on_time_note_no_pause_s_stall():
     """A burst handed back without a pause is no stall of the host (the stamps' business,
     :mod:`conformance.links.meter`): no note of one anywhere near the other test's pause."""
     link = _run(stall=0.0)
-    assert host_stall.stalled_ms(link.transcript.events) < 100
+    assert _longest(link) < 100
 
 
-def test_the_longest_stall_is_read_back_from_the_notes_alone():
+def test_the_stalls_are_read_back_from_the_notes_alone():
     events = [
         Event(EventKind.NOTE, "tool", 1.0, 1.0, text=host_stall.note_text(0.0831)),
         Event(EventKind.NOTE, "tool", 2.0, 2.0, text="something else: 900.0 ms"),
         Event(EventKind.NOTE, "tool", 3.0, 3.0, text=host_stall.note_text(0.1502)),
     ]
-    assert host_stall.stalled_ms(events) == pytest.approx(150.2)
-    assert host_stall.stalled_ms(events[:2]) == pytest.approx(83.1)
-    assert host_stall.stalled_ms(events[1:2]) == 0.0
+    found = host_stall.stalls(events)
+    assert [s.ms for s in found] == [pytest.approx(83.1), pytest.approx(150.2)]
+    # each reaches back over its length and the read's reach, to its note
+    assert found[1].end == 3.0
+    assert found[1].start == pytest.approx(3.0 - 0.1502 - host_stall.REACH)
+    assert found[1].overlaps(2.8, 2.9) and not found[1].overlaps(2.0, 2.5)
+    assert host_stall.stalled_over(found, 2.8, 2.9) is found[1]
+    assert host_stall.stalls(events[1:2]) == []
