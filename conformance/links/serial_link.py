@@ -36,6 +36,8 @@ from .breaks import BaudPulse, BreakMaker, PulseRefused
 from .driver_enable import Direction, TimedRelease
 from .echo import EchoMode, EchoTracker, Expected, Heard
 from .errors import BreakUnsupported, PortVanished
+from .host_stall import STALL_MIN
+from .host_stall import note_text as stall_note
 from .meter import ECHO_FLOOR, TimingMeter
 from .priority import READER, quick_gil_handover, realtime_priority
 from .stamps import chunk_frames, overlap
@@ -137,6 +139,7 @@ class SerialLink(Link):
     def _read_loop(self) -> None:
         self.realtime_priority = realtime_priority(READER)
         port = self.port
+        back = time.perf_counter_ns()  # when the last read returned
         while not self._closing.is_set():
             asked = time.perf_counter_ns()
             try:
@@ -148,10 +151,15 @@ class SerialLink(Link):
                         self._cond.notify_all()
                 return
             arrival = time.perf_counter_ns()
+            # no read returns later than its timeout after the last one came back unless the
+            # whole process was held up: the host stalled (host_stall), said after what came
+            stall = (arrival - back) / 1e9 - READ_POLL
+            back = arrival
             if not data:  # a timed-out read: how late did the thread get back?
                 overrun = (arrival - asked) / 1e9 - READ_POLL
                 if 0 < overrun < 10 * READ_POLL:
                     self.meter.reader_lag.add(overrun, "idle read")
+                self._host_stalled(stall, arrival)
                 continue
             stamps = self._tape.take(len(data)) if self._tape is not None else None
             if stamps is not None:
@@ -159,6 +167,14 @@ class SerialLink(Link):
                 self._arrived(data, self._stamp(arrival), [self._stamp(s) for s in stamps])
             else:
                 self._arrived(data, self._stamp(arrival))
+            self._host_stalled(stall, arrival)
+
+    def _host_stalled(self, stall: float, arrival: int) -> None:
+        """Note a stall of the tool's own host (:mod:`.host_stall`) of ``stall`` s that
+        ended at ``arrival`` (ns), after the characters it held back."""
+        if stall > STALL_MIN:
+            with self._cond:
+                self.transcript.note(self._stamp(arrival), stall_note(stall))
 
     def _arrived(self, data: bytes, arrival: float, stamps: list[float] | None = None) -> None:
         """Bytes read at ``arrival`` (``stamps``: the kernel's, one per byte, if known)."""

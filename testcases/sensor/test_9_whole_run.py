@@ -13,6 +13,7 @@ import pytest
 
 from conformance import preconditions as precondition
 from conformance.judges import wire
+from conformance.links import host_stall
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
 from conformance.view.runs import Segments, transcript_segments
@@ -86,7 +87,10 @@ def test_reply_framing(sensor, case):
         case.add(wire.judge_reply_bit_rate(segs, sensor.stamp_uncertainty))
     else:
         case.add(inconclusive("R-4.1-01", NO_BIT_TIMING))
-    case.extend(wire.judge_framing(segs, sensor.stamp_uncertainty, own=sensor.address))
+    stalled = host_stall.stalls(sensor.link.transcript.events)  # the link's notes
+    case.extend(
+        wire.judge_framing(segs, sensor.stamp_uncertainty, own=sensor.address, stalls=stalled)
+    )
     # replies are judged against the address the sensor answered at (cached: no new traffic)
     ack = sensor.exchange("")
     case.requires("address", precondition.answers_at(ack, sensor.address, "a! at it got no reply"))

@@ -1,0 +1,79 @@
+"""The tool's own host stalling, as the link measured it and the transcript says it.
+
+When the tool's process is held up (a loaded host, a paused process, a USB stall of the
+host's own making) every thread of it stops together: the link's reader thread comes back
+from a read with a timeout of ``READ_POLL`` much later than that timeout allows, and what
+arrived meanwhile is delivered at once. The engine's read of a reply then ends at the idle
+window although the device never idled, and the late burst's stamps show a gap the wire
+never had (truth25: 6 FAIL + 1 WARN for a clean emulator under 80-200 ms pauses).
+
+The link (I/O) writes what it measured as a NOTE (:func:`note_text`); whoever judges a
+stimulus reads the stalls back from the transcript's events alone (:func:`stalls`), so a
+saved transcript tells the same story as the live run.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from ..transcript import Event, EventKind
+
+#: the start of the NOTE a link leaves where its reader thread came back late
+HOST_STALL_NOTE = "the tool's host stalled "
+#: below this (s) a late reader is ordinary scheduling, covered by the stamps' measured worth
+#: (:mod:`.meter`); above it a read may have been cut by the stall and its stamps moved
+STALL_MIN = 0.03
+
+_MS = re.compile(re.escape(HOST_STALL_NOTE) + r"(\d+(?:\.\d+)?) ms")
+_NOTE = EventKind.NOTE
+
+
+def note_text(stall: float) -> str:
+    """The NOTE for a stall of ``stall`` s (its length first, so :func:`stalls` reads it)."""
+    return (
+        f"{HOST_STALL_NOTE}{stall * 1e3:.1f} ms (the link's reader thread came back that much "
+        "later than its read's timeout): reads and stamps around it are the host's, not the DUT's"
+    )
+
+
+#: how far (s) before a stall's measured length a read it held up may have begun: the
+#: reader's own poll and the engine's idle window, after which a held-up read ends cut
+REACH = 0.05
+
+
+@dataclass(frozen=True)
+class Stall:
+    """A host stall read back from its NOTE: the reads ``start``..``end`` (s) may have been
+    held up by it (its measured length, reached back by :data:`REACH`)."""
+
+    start: float
+    end: float
+    ms: float
+
+    def overlaps(self, start: float, end: float) -> bool:
+        return start <= self.end and end >= self.start
+
+    def why(self) -> str:
+        return f"the tool's host stalled {self.ms:.0f} ms during this read"
+
+
+def stalls(events: Iterable[Event]) -> list[Stall]:
+    """Every host stall the NOTEs among ``events`` report, in their order."""
+    found = []
+    for event in events:
+        if event.kind is _NOTE and event.text.startswith(HOST_STALL_NOTE):
+            got = _MS.match(event.text)
+            if got is not None:
+                ms = float(got.group(1))
+                found.append(Stall(event.start - ms / 1e3 - REACH, event.start, ms))
+    return found
+
+
+def stalled_over(found: list[Stall], start: float, end: float) -> Stall | None:
+    """The first of ``found`` that may have held up a read between ``start`` and ``end``."""
+    for stall in found:
+        if stall.overlaps(start, end):
+            return stall
+    return None
