@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from ..links.base import Link
 from ..transcript import Event, decode_7e1
 from .records import IDLE, TOO_LONG, Attempt, Exchange
-from .reply_end import Framing
+from .reply_end import Framing, read_rest
 
 #: the NOTE a mended reply leaves where its rest begins (the count of characters added
 #: follows): the report shows why characters read in a later try belong to this one
@@ -91,7 +91,8 @@ class CutRead:
         taken_before = len(attempt.reply_events)
         reply = attempt.reply_events + chars[:taken]
         if read_on and taken == len(chars):  # all of it the rest: more may be coming
-            reply = self._read_on(reply)
+            # as the cut read would have (the engine's loop)
+            reply = read_rest(self.link, framing, reply, framing.deadline(reply[0]))
         attempt.reply_events = reply
         if framing.finished(reply) or framing.at_line_end(reply):
             text = None if framing.binary else decode_7e1(reply)
@@ -104,23 +105,6 @@ class CutRead:
             self.exchange.__dict__.pop("_judged", None)
         self.link.transcript.note(chars[0].start, f"{STALL_NOTE}{len(reply) - taken_before}")
         return chars[taken:]
-
-    def _read_on(self, reply: list[Event]) -> list[Event]:
-        """The cut read's loop (:meth:`ToolRecorder._listen`'s), taken up again after the
-        rest so far: each read ends a window after the last character, until the reply is
-        complete, at its limit, or the line marks."""
-        framing, link = self.framing, self.link
-        hard = framing.deadline(reply[0])
-        while not (framing.finished(reply) or len(reply) >= framing.limit(reply)):
-            more = link.receive(
-                min(hard, reply[-1].end + framing.window(reply)),
-                until=framing.stop_for(reply),
-                idle=framing.idle,
-            )
-            if not more:
-                break
-            reply = reply + more
-        return reply
 
     def mend_met(
         self, collided: list[Event], first: Event | None, *, read_on: bool = False

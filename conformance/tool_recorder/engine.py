@@ -52,7 +52,7 @@ from .contention import HOLD_PREFIX, ApartSoFar, collisions, maybe_note_text
 from .hooks import Hooks
 from .policy import Policy
 from .records import CONTENTION, IDLE, NO_REPLY, OK, TOO_LONG, Attempt, Exchange, Measurement
-from .reply_end import Framing
+from .reply_end import Framing, read_rest
 from .validity import ends_line
 
 #: After this many holds that reached ``max_hold`` (a DUT that never goes quiet), later holds
@@ -653,22 +653,14 @@ class ToolRecorder:
         if line_at_once and one_line:
             reply, state = self._rest_of_line(chars, deadline, framing)
             return reply, state, collided
-        while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
-            # Each read ends a window after the last character so far: the link's own idle
-            # rule only starts once that read has received something.
-            more = self.link.receive(
-                min(deadline, chars[-1].end + framing.window(chars)),
-                until=framing.stop_for(chars),
-                idle=framing.idle,
-            )
-            if not more:
-                if framing.at_line_end(chars):
-                    return chars, None, collided  # no next line within 150 ms: complete
-                break
-            chars = chars + more
+        chars = read_rest(self.link, framing, chars, deadline)
         if framing.finished(chars):
             return chars, None, collided
-        return chars, TOO_LONG if len(chars) >= framing.limit(chars) else IDLE, collided
+        if len(chars) >= framing.limit(chars):
+            return chars, TOO_LONG, collided
+        if framing.at_line_end(chars):
+            return chars, None, collided  # no next line within 150 ms: complete
+        return chars, IDLE, collided
 
     def _rest_of_line(
         self, chars: list[Event], deadline: float, framing: Framing

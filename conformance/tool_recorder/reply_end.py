@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import partial
 
-from ..links.base import LineEnd, StopCondition
+from ..links.base import LineEnd, Link, StopCondition
 from ..protocol.binary import packet_length
 from ..protocol.framing import CR, ETX, LF, is_text
 from ..protocol.timing import MULTILINE_GAP_MAX, TOLERANCE
@@ -89,6 +89,25 @@ class Framing:
         """Hard bound for a DUT that trickles characters just inside each window."""
         per_char = first.duration + max(self.idle, self.line_wait if self.multiline else 0.0)
         return first.start + max(self.max_chars, self.max_text_chars) * per_char
+
+
+def read_rest(link: Link, framing: Framing, chars: list[Event], deadline: float) -> list[Event]:
+    """``chars`` (a reply begun) read on through ``link`` until the reply is complete, at its
+    limit, or no character starts within the framing's window after the last one (or before
+    ``deadline``, its hard bound): the engine's read loop, one for all three framings, and
+    the one a reply mended after a delivery stall reads on with (:mod:`.cut_read`). Each
+    read ends a window after the last character so far: the link's own idle rule only
+    starts once that read has received something."""
+    while not (framing.finished(chars) or len(chars) >= framing.limit(chars)):
+        more = link.receive(
+            min(deadline, chars[-1].end + framing.window(chars)),
+            until=framing.stop_for(chars),
+            idle=framing.idle,
+        )
+        if not more:
+            break
+        chars = chars + more
+    return chars
 
 
 def _head(chars: list[Event]) -> bytes:

@@ -49,15 +49,6 @@ def _cut_while_sent(line: TranscriptView, s: Transmission) -> bool:
     return -1e-6 <= cut - s.chars[-1].end < NEW_COMMAND
 
 
-def _up_to_bang(text: str) -> str:
-    """``text`` up to its first ``!``: the address query ``?!`` with more after its ``!`` (an
-    STM32 HAL logger, HarveyBates/stm32-projects, sends each command's C string with its NUL,
-    ``?!<NUL>``) is addressed as ``?!`` is; what follows is R-4.2-01's and R-4.4-04's (R-4.3-01
-    FAILed "starts with ?, not an address")."""
-    bang = text.find("!")
-    return text if bang < 0 else text[: bang + 1]
-
-
 def judge_command_text(line: TranscriptView, uncertainty: float = 0.0) -> list[Finding]:
     """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else, and no
     part a sensor drops for want of it (:func:`_dropped`); R-4.3-01 the first character is
@@ -99,7 +90,11 @@ class CommandText:
             else:
                 self._unterminated_part(s)
             first = text[:1]
-            if not (first in ADDRESS_CHARS or _up_to_bang(text) == "?!"):
+            # the address query with more after its ``!`` is addressed as ``?!`` is (an STM32
+            # HAL logger, HarveyBates/stm32-projects, sends each command's C string with its
+            # NUL, ``?!<NUL>``: R-4.3-01 FAILed "starts with ?"); the rest is R-4.2-01's and
+            # R-4.4-04's
+            if not (first in ADDRESS_CHARS or text.startswith("?!")):
                 tally.fail("R-4.3-01", where, f"starts with {escape(first)}, not an address")
 
     def _unterminated_part(self, s: Transmission) -> None:
