@@ -19,6 +19,7 @@ import pytest
 from conformance.judges.metadata import records
 from conformance.links.base import LinkInfo
 from conformance.links.echo import EchoMode
+from conformance.links.host_stall import HOST_STALL_NOTE
 from conformance.links.serial_link import SerialLink
 from conformance.protocol.crc import ascii_crc
 from conformance.protocol.timing import CHAR_TIME
@@ -28,12 +29,16 @@ from conformance.tool_recorder.policy import Policy
 from conformance.tool_recorder.records import CONTENTION, IDLE, OK, Attempt
 from conformance.transcript import DUT, Event, EventKind, Transcript, to_wire_7e1
 from conformance.verdicts import Verdict
+from tests.conftest import BUSY
 from tests.support.hand_events import chars
 
 BODY = "0,RH,%,relative humidity;"
 RECORD = BODY + ascii_crc(BODY) + "\r\n"  # 32 characters, as 0IHB_010!'s was
 SHOWN = 9  # characters delivered before the stall ('0,RH,%,re')
 REPLY_DELAY = 9e-3
+#: a delivery (or the link's reader) later than this (s) is the host's, not the port's stall:
+#: the read's windows are then moved by the host and the test cannot say what it checks
+LATE = 0.01
 
 
 class _StallingPort:
@@ -50,6 +55,7 @@ class _StallingPort:
         self._chunks: queue.Queue[bytes] = queue.Queue()
         self._busy_until = 0.0  # the sensor's last stop bit on the line
         self._timers: list[threading.Thread] = []
+        self.late = 0.0  # the most (s) a delivery came after its schedule: the host's doing
 
     @property
     def in_waiting(self) -> int:
@@ -91,6 +97,7 @@ class _StallingPort:
             while time.perf_counter() < at:
                 time.sleep(max(0.0, min(at - time.perf_counter(), 0.001)))
             self._chunks.put(wires[k : k + n])
+            self.late = max(self.late, time.perf_counter() - at)
             k += n
 
     def close(self) -> None:
@@ -119,6 +126,14 @@ def test_a_record_cut_at_a_delivery_stall_is_judged_whole():
         engine.link.wait(0.2)  # the rest of the record's characters into the transcript
     finally:
         engine.link.close()
+    port = engine.link.port
+    events = engine.link.transcript.events
+    stalled = [e for e in events if e.kind is EventKind.NOTE and HOST_STALL_NOTE in e.text]
+    if port.late > LATE or stalled:  # CI saw '' for the reply at a load of 4 workers on 2 cores
+        pytest.skip(
+            f"{BUSY}: the port's deliveries came up to {port.late * 1e3:.0f} ms after their "
+            f"schedule; host stalls noted: {len(stalled)}"
+        )
     transcript = "".join(
         chr(e.char7)
         for e in engine.link.transcript.events
