@@ -349,3 +349,23 @@ def test_a_harness_flooding_log_lines_is_stopped(tmp_path):
     session = RecorderSession(_log_harness(tmp_path, ["log 0M! +1"] * (proto.MAX_LOG_LINES + 1)))
     with pytest.raises(HarnessError, match="more than 1000 log lines in one job"):
         session.run("service-request")
+
+
+def test_a_measurement_never_collected_is_not_logged_as_sent_r_4_4_02():
+    """R3 IoT's Zephyr SDI-12 master (twenty-seventh round, docs/kit.md) parses the ``atttn``
+    reply to ``aMC!`` as if it carried a CRC, rejects the valid ``00023``, asks for no data
+    and logs nothing: "logged as sent" PASSed R-4.4-02 on it, the sensor having "sent" no
+    values only because none were asked for (a logger that drops every measurement after its
+    reply PASSed R-4.4-02 so). Nothing logged for a measurement never collected is not an
+    observation; values logged for one are still a FAIL, and a measurement of no values
+    (``a0000``) logged empty is still one."""
+    from tests.judges.recorder.test_recorder_judges import Wire, by_id
+
+    dropped = Wire().brk().rec("0MC!").sensor("00023\r\n").view()
+    nothing = by_id(judge_logged_values(dropped, [LogReport("p", {"0MC!": []})], 0.0))
+    assert nothing["R-4.4-02"].verdict is Verdict.INCONCLUSIVE, nothing["R-4.4-02"].detail
+    made_up = by_id(judge_logged_values(dropped, [LogReport("p", {"0MC!": ["+1.5"]})], 0.0))
+    assert made_up["R-4.4-02"].verdict is Verdict.FAIL
+    empty = Wire().brk().rec("0M!").sensor("00000\r\n").view()
+    none_due = by_id(judge_logged_values(empty, [LogReport("p", {"0M!": []})], 0.0))
+    assert none_due["R-4.4-02"].verdict is Verdict.PASS
