@@ -113,6 +113,7 @@ from conformance.conduct import run_into, run_once
 from conformance.emulator.faults import FaultSet
 from conformance.emulator.replies import ReplyKind
 from conformance.harness.device import HarnessBus
+from conformance.protocol.commands import Kind
 from conformance.protocol.timing import CHAR_TIME
 from conformance.recorder.golden import GoldenRecorder
 from conformance.sim.bus import Frame
@@ -1168,3 +1169,38 @@ def test_a_recorder_that_sends_each_command_with_its_nul_is_judged_r_4_4_5_05(tm
     assert waited["verdict"] == "FAIL", waited["findings"]
     assert any("0D1!, not aD0!" in f["detail"] for f in waited["findings"])
     assert rules["R-4.4.5-04"]["verdict"] == "FAIL", rules["R-4.4.5-04"]["findings"]
+
+
+@pytest.fixture
+def drops_every_mc(monkeypatch):
+    """The golden recorder, every aMC! dropped after its valid ``atttn`` reply: no wait, no
+    data command, nothing logged (R3 IoT's Zephyr SDI-12 master, twenty-seventh round,
+    docs/kit.md: it parses the reply to aMC! as if it carried a CRC and rejects it)."""
+    from conformance.tool_recorder.engine import ToolRecorder
+
+    measure = ToolRecorder.measure
+
+    def dropping(self, command, *, collect=True, wait="auto"):
+        if command.returns_crc and command.kind is Kind.MEASURE:
+            return measure(self, command, collect=False, wait="none")
+        return measure(self, command, collect=collect, wait=wait)
+
+    monkeypatch.setattr(ToolRecorder, "measure", dropping)
+
+
+def test_a_measurement_dropped_after_its_reply_is_not_logged_as_sent(drops_every_mc):
+    """'logged as sent' counted the dropped aMC! (nothing asked for, nothing logged) as a
+    check of R-4.4-02; the drop itself is R-4.4.5-05's FAIL in the families scenario."""
+    found = _verdicts(
+        run_once(
+            "sim",
+            role="recorder",
+            keyword="test_logged_values_are_the_values_sent or test_waiting_for_the_service_request",
+        )
+    )
+    logged = " ".join(f["detail"] for f in found["R-4.4-02"]["findings"])
+    assert "0MC!" not in logged, logged
+    assert found["R-4.4-02"]["verdict"] == "PASS", found["R-4.4-02"]["findings"]
+    waited = found["R-4.4.5-05"]
+    assert waited["verdict"] == "FAIL", waited["findings"]
+    assert any("0MC!" in f["detail"] and "no aD0!" in f["detail"] for f in waited["findings"])
