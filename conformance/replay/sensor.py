@@ -15,7 +15,7 @@ run with that said, instead of inventing answers.
 
 from __future__ import annotations
 
-from bisect import bisect_left, bisect_right
+from bisect import bisect_left
 from collections.abc import Iterator
 from itertools import compress, repeat
 from operator import attrgetter, eq, is_
@@ -67,10 +67,9 @@ class RecordedSensor:
         wire = [e for e in events if e.kind is not EventKind.NOTE]
         self._needs: list[int]
         self._touching: list[tuple[bool, bool]]
-        self._flags: Flags | None = None
         found = _worked_out(wire)
         if found is not None:  # in order and no NaN: worked out over arrays
-            tool, replies, self._needs, self._touching, columns, self._flags = found
+            tool, replies, self._needs, self._touching, columns = found
         else:
             wire.sort(key=_START_END)
             tool = [e for e in wire if e.origin == TOOL]
@@ -106,7 +105,7 @@ class RecordedSensor:
             found = _from_arrays(s, e, u, is_tool, is_char)
             if found is None:
                 return None
-            is_reply, needs, touching, flags = found
+            is_reply, needs, touching = found
             columns = _array_columns(s, e, is_reply, wire.wire)
             tool_mask = is_tool.tolist()
             tool_ends = e[is_tool].tolist()
@@ -115,7 +114,7 @@ class RecordedSensor:
         if breaks:
             place = np.cumsum(is_reply) - 1  # each column's index among the replies
             sensor._breaks = frozenset(int(place[i]) for i in breaks if is_reply[i])
-        sensor._needs, sensor._touching, sensor._flags = needs, touching, flags
+        sensor._needs, sensor._touching = needs, touching
         sensor._tool = sensor._replies = None
         sensor._made_of = (wire, tool_mask, is_reply.tolist())
         tool_columns = (
@@ -154,11 +153,6 @@ class RecordedSensor:
         replay reads of them."""
         self._tool_kind, self._tool_wire, self._tool_end = tool
         self._reply_start, self._reply_wire, self._reply_length = replies
-        self._spans = (
-            None
-            if self._flags is None
-            else _ReplySpans.of(self._needs, self._flags, self._breaks, replies)
-        )
         self.heard = 0  # tool events matched so far
         self.next_reply = 0
         self.offset = 0.0  # now minus recorded time, at the last matched tool event
@@ -173,8 +167,8 @@ class RecordedSensor:
     def on_char(self, wire: int, start: float, end: float) -> None:
         heard = self.heard
         # the usual case spelt out: the recording's next tool event is this character
-        # (:meth:`_match` and :func:`_same` say the same; a fault-matrix row's replay hears
-        # some 5,000 characters, issue 22)
+        # (what :meth:`_match` and :func:`_same` decide; a fault-matrix row's replay hears
+        # some 5,000 characters, issue 22: ~0.7% of its capture half)
         if (
             heard < len(self._tool_end)
             and self._tool_kind[heard] is _CHAR
@@ -246,8 +240,6 @@ class RecordedSensor:
         k = self.next_reply
         if k >= len(self._reply_start) or self._needs[k] > self.heard or k in self._breaks:
             return None
-        if self._spans is not None:
-            return self._spans.run(k, self.heard, self.offset)
         return self._due(k, self.heard, self.offset)
 
     def _due(self, k: int, heard: int, offset: float) -> Iterator[tuple[float, int, float]]:
@@ -264,69 +256,6 @@ class RecordedSensor:
         """Commit the first ``count`` of :meth:`frames_ahead`, as ``count`` :meth:`pop_frame`
         calls would (the offer kept for the bus is keyed by the reply index: it moves on)."""
         self.next_reply += count
-
-
-class _ReplySpans:
-    """The reply characters as :meth:`RecordedSensor.frames_ahead` offers them, worked out
-    once for the whole recording: each one's start in the two cases of its back-to-back
-    flags (:data:`LINE_FREE` where it touches), so a run of due replies is two slices
-    shifted by the offset, zipped with their bytes and lengths, rather than a generator step
-    with four look-ups per character (a fault-matrix row's replay offers some 20,000).
-
-    A run from reply ``k`` with ``heard`` tool events matched is the replies whose needs are
-    at most ``heard`` (needs never decrease: the replies and the tool's events are in start
-    order), up to the first of the sensor's breaks (offered by :meth:`~RecordedSensor.next_frame`
-    alone); those that need fewer than ``heard`` have had the tool go on past their start
-    (the flags' second case), the rest the first case (:func:`_touching_each`). The starts are
-    the same float sums as :meth:`RecordedSensor._due`'s (``start + offset`` in float64, and
-    ``-inf + offset`` is ``-inf``)."""
-
-    __slots__ = ("needs", "breaks", "asked", "passed", "wires", "lengths")
-
-    def __init__(
-        self,
-        needs: list[int],
-        breaks: list[int],
-        asked: np.ndarray,
-        passed: np.ndarray,
-        wires: list[int],
-        lengths: list[float],
-    ) -> None:
-        self.needs, self.breaks = needs, breaks
-        self.asked, self.passed = asked, passed  # starts, flags' first and second case
-        self.wires, self.lengths = wires, lengths
-
-    @classmethod
-    def of(
-        cls,
-        needs: list[int],
-        flags: Flags,
-        breaks: frozenset[int],
-        replies: tuple[list[float], list[int], list[float]],
-    ) -> _ReplySpans:
-        """The spans of a recording's replies worked out over arrays (:func:`_from_arrays`:
-        in order, so the needs never decrease), its flags' two cases ``flags``."""
-        import numpy as np
-
-        starts, wires, lengths = replies
-        start = np.array(starts, np.float64)
-        asked = np.where(flags[0], LINE_FREE, start)
-        passed = np.where(flags[1], LINE_FREE, start)
-        return cls(needs, sorted(breaks), asked, passed, wires, lengths)
-
-    def run(self, k: int, heard: int, offset: float) -> Iterator[tuple[float, int, float]]:
-        """``(start, wire, duration)`` of the replies due from ``k`` (its need met, not a
-        break), as :meth:`RecordedSensor._due` gives them."""
-        needs, breaks = self.needs, self.breaks
-        j = bisect_right(needs, heard, k)
-        b = bisect_left(breaks, k)
-        if b < len(breaks) and breaks[b] < j:
-            j = breaks[b]
-        m = bisect_left(needs, heard, k, j)  # [k, m): the tool went on past them
-        starts = (self.passed[k:m] + offset).tolist() if m > k else []
-        if j > m:
-            starts += (self.asked[m:j] + offset).tolist()
-        return zip(starts, self.wires[k:j], self.lengths[k:j])  # noqa: B905 (same lengths)
 
 
 def _touching_each(
@@ -417,14 +346,11 @@ def _array_columns(
 
 
 #: what :func:`_worked_out` gives: the tool's events, the reply characters, the needs, the
-#: back-to-back flags, the reply columns (:func:`_reply_columns`) and the flags as arrays
+#: back-to-back flags and the reply columns (:func:`_reply_columns`)
 WorkedOut = tuple[
     list[Event], list[Event], list[int], list[tuple[bool, bool]],
-    tuple[list[float], list[int], list[float]], "Flags",
+    tuple[list[float], list[int], list[float]],
 ]  # fmt: skip
-
-#: the back-to-back flags' two cases as boolean arrays (:func:`_from_arrays`)
-Flags = tuple["np.ndarray", "np.ndarray"]
 
 
 def _worked_out(wire: list[Event]) -> WorkedOut | None:
@@ -454,21 +380,21 @@ def _in_arrays(wire: list[Event], s: np.ndarray, e: np.ndarray, u: np.ndarray) -
     found = _from_arrays(s, e, u, is_tool, is_char)
     if found is None:
         return None
-    is_reply, needs, touching, flags = found
+    is_reply, needs, touching = found
     tool = list(compress(wire, is_tool.tolist()))
     replies = list(compress(wire, is_reply.tolist()))
     wires = [r.wire for r in replies]
     rs, re = s[is_reply], e[is_reply]
-    return tool, replies, needs, touching, (rs.tolist(), wires, (re - rs).tolist()), flags
+    return tool, replies, needs, touching, (rs.tolist(), wires, (re - rs).tolist())
 
 
 def _from_arrays(
     s: np.ndarray, e: np.ndarray, u: np.ndarray, is_tool: np.ndarray, is_char: np.ndarray
-) -> tuple[np.ndarray, list[int], list[tuple[bool, bool]], Flags] | None:
+) -> tuple[np.ndarray, list[int], list[tuple[bool, bool]]] | None:
     """The reply characters (a mask), the needs and the back-to-back flags of events in
     the replay's order given as columns (starts, ends, uncertainties, which are the
-    tool's, which are characters), the flags also as their two arrays; None when they are
-    not in that order or a stamp is NaN (:func:`_worked_out`)."""
+    tool's, which are characters); None when they are not in that order or a stamp is
+    NaN (:func:`_worked_out`)."""
     import numpy as np
 
     if np.isnan(s).any() or np.isnan(e).any():
@@ -477,7 +403,7 @@ def _from_arrays(
         return None
     is_reply = ~is_tool & is_char
     if not is_reply.any():
-        return is_reply, [], [], (is_reply[:0], is_reply[:0])
+        return is_reply, [], []
     ts, te, tu = s[is_tool], e[is_tool], u[is_tool]
     rs, re, ru = s[is_reply], e[is_reply], u[is_reply]
     need = np.searchsorted(ts, rs, "left")
@@ -495,7 +421,7 @@ def _from_arrays(
     before_u = np.where(use_prev, ru_prev, tu_before)
     first = (use_prev | has_tool) & (np.abs(rs - before_end) <= ru + before_u)
     second = has_prev & (np.abs(rs - re_prev) <= ru + ru_prev)
-    return is_reply, need.tolist(), _pairs(first, second), (first, second)
+    return is_reply, need.tolist(), _pairs(first, second)
 
 
 #: the four back-to-back flag pairs, shared by every reply (:func:`_pairs`)
