@@ -165,6 +165,18 @@ class RecordedSensor:
         self._match(_BREAK, 0, end, end - start)
 
     def on_char(self, wire: int, start: float, end: float) -> None:
+        heard = self.heard
+        # the usual case spelt out: the recording's next tool event is this character
+        # (what :meth:`_match` and :func:`_same` decide; a fault-matrix row's replay hears
+        # some 5,000 characters, issue 22: ~0.7% of its capture half)
+        if (
+            heard < len(self._tool_end)
+            and self._tool_kind[heard] is _CHAR
+            and self._tool_wire[heard] == wire
+        ):
+            self.heard = heard + 1
+            self.offset = end - self._tool_end[heard]
+            return
         self._match(_CHAR, wire, end)
 
     def _match(self, kind: EventKind, wire: int, end: float, length: float = 0.0) -> None:
