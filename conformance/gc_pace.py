@@ -89,6 +89,29 @@ def restore(pace: Pace) -> None:
 
 
 @contextmanager
+def one_row() -> Iterator[None]:
+    """The collector paused while a matrix's row is made, and the row's cyclic garbage
+    collected when it ends (:func:`~conformance.matrices.sensor_matrix.paced_row`): a row,
+    a run or two over the simulated bus, allocates some 10^5 objects that live until its end
+    (the runs' events, records, observations) and leaves a few hundred in cycles. Paced by
+    allocations (:data:`RUN_THRESHOLDS`), the collector walked the survivors of every 20,000
+    of them, 7 young collections a row: ~4.5% of the sensor matrix's CPU (issue 22). Collected
+    once a row instead, it walks only what outlived the row (the row's own objects are freed
+    by their counts first). What a row holds at its peak grows by its cyclic garbage alone
+    (~500 objects). A process whose collector is off (the CLI's own,
+    :func:`never_in_this_process`) is left so."""
+    if not gc.isenabled():
+        yield
+        return
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.enable()
+        gc.collect()
+
+
+@contextmanager
 def runs_over_held_data() -> Iterator[Callable[[], None]]:
     """Several runs in turn over data loaded once (a passive judgement: a recording's events,
     view and records, then one run per sensor on the bus and one for the recorder). Yields
