@@ -97,9 +97,11 @@ def one_row() -> Iterator[None]:
     allocations (:data:`RUN_THRESHOLDS`), the collector walked the survivors of every 20,000
     of them, 7 young collections a row: ~4.5% of the sensor matrix's CPU (issue 22). Collected
     once a row instead, it walks only what outlived the row (the row's own objects are freed
-    by their counts first). What a row holds at its peak grows by its cyclic garbage alone
-    (~500 objects). A process whose collector is off (the CLI's own,
-    :func:`never_in_this_process`) is left so."""
+    by their counts first: ``many_runs_plugin`` lets a FAIL's traceback go, which held its
+    run in a cycle), and what outlived it is frozen with what the run's start froze. What a
+    row holds at its peak grows by its cyclic garbage alone (a few dozen objects). A
+    process whose collector is off (the CLI's own, :func:`never_in_this_process`) is left
+    so."""
     if not gc.isenabled():
         yield
         return
@@ -109,6 +111,11 @@ def one_row() -> Iterator[None]:
     finally:
         gc.enable()
         gc.collect()
+        if gc.get_freeze_count():
+            # what outlived the row (the caches it filled) is not walked again at the next
+            # row's end: frozen with what the run's start froze (:func:`slow_down`), and
+            # thawed with it (4 ms a row); where nothing was frozen, nothing would thaw it
+            gc.freeze()
 
 
 @contextmanager

@@ -68,6 +68,23 @@ def test_one_row_leaves_a_collector_that_is_off_off():
             gc.enable()
 
 
+def test_what_outlives_a_row_is_frozen_only_beside_what_a_run_froze(collector_on):
+    gc.collect()
+    assert gc.get_freeze_count() == 0
+    kept = []
+    with gc_pace.one_row():
+        kept.append(_Node())
+    assert gc.get_freeze_count() == 0  # nothing frozen before: nothing would thaw it
+    gc.freeze()  # as slow_down does at a run's start
+    try:
+        before = gc.get_freeze_count()
+        with gc_pace.one_row():
+            kept.append(_Node())
+        assert gc.get_freeze_count() > before  # the row's survivor with them
+    finally:
+        gc.unfreeze()
+
+
 def test_a_row_raising_still_has_the_collector_back(collector_on):
     def fails(item: int) -> int:
         raise ValueError(item)
