@@ -19,7 +19,8 @@ row's ``time.process_time`` into:
   replay's options (``offline.judge.plan``);
 - ``rest``: the row less all of those (events read back, verdicts compared, folders; in a
   tree that judges a batch of runs in one pytest session, ``conformance.many_runs``, as the
-  matrices do, that session's start and end, shared by the rows).
+  matrices do, that session's start and end, shared by the rows; the rows are then made by
+  ``sensor_matrix.run_rows`` as the matrix makes them, with its collector pacing).
 
 In such a tree the rows are made in one session as ``fault_matrix`` makes a batch, and a
 run's ``session`` is what its run costs outside the items' protocol (its records, report
@@ -146,7 +147,12 @@ acc.clear(); cases.clear()
 t = now()
 def rows():
     return sum(roundtrip.row_through_capture(item(name)).exact for name in names)
-exact = rows() if many_runs is None else many_runs.judged_in_one_session(rows)
+if many_runs is None:
+    exact = rows()
+else:  # as the matrix makes its rows (run_rows: a batch's session, each row as it paces it)
+    made = sensor_matrix.run_rows([item(n) for n in names], roundtrip.row_through_capture, 1,
+                                  role="sensor")
+    exact = sum(row.exact for row in made)
 total = now() - t
 n = len(names)
 phases = {k.replace("export_events", "export"): round(v / n * 1e3, 1) for k, v in acc.items()}

@@ -89,6 +89,36 @@ def restore(pace: Pace) -> None:
 
 
 @contextmanager
+def one_row() -> Iterator[None]:
+    """The collector paused while a matrix's row is made, and the row's cyclic garbage
+    collected when it ends (:func:`~conformance.matrices.sensor_matrix.paced_row`): a row,
+    a run or two over the simulated bus, allocates some 10^5 objects that live until its end
+    (the runs' events, records, observations) and leaves a few hundred in cycles. Paced by
+    allocations (:data:`RUN_THRESHOLDS`), the collector walked the survivors of every 20,000
+    of them, 7 young collections a row: ~4.5% of the sensor matrix's CPU (issue 22). Collected
+    once a row instead, it walks only what outlived the row (the row's own objects are freed
+    by their counts first: ``many_runs_plugin`` lets a FAIL's traceback go, which held its
+    run in a cycle), and what outlived it is frozen with what the run's start froze. What a
+    row holds at its peak grows by its cyclic garbage alone (a few dozen objects). A
+    process whose collector is off (the CLI's own, :func:`never_in_this_process`) is left
+    so."""
+    if not gc.isenabled():
+        yield
+        return
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.enable()
+        gc.collect()
+        if gc.get_freeze_count():
+            # what outlived the row (the caches it filled) is not walked again at the next
+            # row's end: frozen with what the run's start froze (:func:`slow_down`), and
+            # thawed with it (4 ms a row); where nothing was frozen, nothing would thaw it
+            gc.freeze()
+
+
+@contextmanager
 def runs_over_held_data() -> Iterator[Callable[[], None]]:
     """Several runs in turn over data loaded once (a passive judgement: a recording's events,
     view and records, then one run per sensor on the bus and one for the recorder). Yields

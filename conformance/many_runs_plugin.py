@@ -5,8 +5,10 @@ says how a run is reset and ended)."""
 
 from __future__ import annotations
 
+import traceback
 from copy import deepcopy
 from dataclasses import replace
+from types import TracebackType
 
 import pytest
 
@@ -33,6 +35,40 @@ def pytest_runtestloop(session: pytest.Session) -> bool | None:
     plugin.detach_run(config)  # the template run: never run, the items' records dropped
     batch.run(ManyRuns(session, given.options, selection))
     return True
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo) -> pytest.TestReport:
+    """The report as every other plugin makes it (this wrapper is the outermost), then the
+    case's exception let go (:func:`_let_go`): the report holds what it says of it already.
+
+    Kept, the exception is a cycle (the frame that caught it, pytest's
+    ``CallInfo.from_call``, holds it; its traceback holds that frame), and that frame holds
+    the frames that called it (``f_back``) up to this batch's ``judge``, whose ``run`` holds
+    the run's link, session and every event: a matrix row's FAIL held its whole run so,
+    ~10^5 objects a row that the collector walked as survivors while the batch lasted and
+    freed only at a full collection (issue 22, :func:`conformance.gc_pace.one_row`). Let
+    go, the run is freed by its counts when its fixtures are torn down. ``call.excinfo`` is
+    read after this hook only by ``pytest_exception_interact`` (the debugger's, whose plugin
+    a judged run never loads, and faulthandler's, which cancels a timeout the suite never
+    sets)."""
+    report = yield
+    if call.excinfo is not None:
+        _let_go(call.excinfo.tb)
+        call.excinfo = None
+    return report
+
+
+def _let_go(tb: TracebackType | None) -> None:
+    """Each frame of ``tb`` cleared (``traceback.clear_frames``: the one that caught the
+    exception no longer holds it) and its ``f_locals`` read again: on Python 3.11 a frame
+    keeps the dict of its locals the last reading made (pytest reads each frame's for
+    ``__tracebackhide__`` as it makes the report), which clearing leaves as it was; read
+    again, it loses what was cleared."""
+    traceback.clear_frames(tb)
+    while tb is not None:
+        tb.tb_frame.f_locals  # noqa: B018 (the reading is the point)
+        tb = tb.tb_next
 
 
 class ManyRuns:

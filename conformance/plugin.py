@@ -185,7 +185,12 @@ def case_of(node: pytest.Item, sdi12_run: ConformanceRun) -> Case:
         declared = preconditions.declared(node, record.requirements)
     except preconditions.PreconditionError as exc:
         raise pytest.UsageError(f"{node.nodeid}: {exc}") from None
-    return Case(record, version=lambda: sdi12_run.dut_version, preconditions=declared)
+    return Case(
+        record,
+        version=lambda: sdi12_run.dut_version,
+        preconditions=declared,
+        evidence_events=sdi12_run.report_files != (),  # no report file: no reader of them
+    )
 
 
 #: ``@pytest.mark.needs(...)`` names -> (LinkInfo attribute, what a reader is told it lacks)

@@ -16,6 +16,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any, TypeVar
 
+from .. import gc_pace
 from ..conduct import NoVerdicts, conduct
 from ..protocol.version import V14, format_version
 from ..run import ConformanceRun, RunOptions
@@ -208,6 +209,7 @@ def run_rows(
             progress(len(rows), len(items), made)
 
     processes = min(processes, len(items))  # a worker for no row costs a whole start-up
+    make = partial(paced_row, make)  # the collector once a row (gc_pace.one_row)
     if processes <= 1:
         if role is None:
             for item in items:
@@ -229,6 +231,13 @@ def run_rows(
             for made in batch:
                 keep(made)
     return rows
+
+
+def paced_row(make: Callable[[ItemT], RowT], item: ItemT) -> RowT:
+    """``make(item)`` with the collector paused, the row's cyclic garbage collected at its
+    end (:func:`conformance.gc_pace.one_row`): what :func:`run_rows` makes each row with."""
+    with gc_pace.one_row():
+        return make(item)
 
 
 def rows_in_one_session(

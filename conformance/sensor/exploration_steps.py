@@ -270,7 +270,10 @@ def run_plan(
         if failed is not None:
             index, first = failed
             again = _run_example(machine, example[: index + 1], failures, skips)
-            raise (again[1] if again is not None else first)
+            try:
+                raise (again[1] if again is not None else first)
+            finally:  # the exception's traceback holds this frame: not the frame it
+                del failed, first, again  # (a cycle, and through it the run: issue 22)
 
 
 def _run_example(

@@ -166,8 +166,16 @@ class Exchange:
 
     @property
     def answered(self) -> bool:
-        """The DUT sent something for some attempt (valid or not)."""
-        return bool(self.reply_events)
+        """The DUT sent something for some attempt (valid or not): ``bool(self.reply_events)``
+        read off the attempts, since :attr:`judged` is an answered attempt whenever one is
+        (asked ~6,000 times a fault-matrix row, each a walk through ``judged``; issue 22)."""
+        attempts = self.attempts
+        if not attempts:
+            return bool(self.reply_events)  # (raises as judged does)
+        for attempt in attempts:  # noqa: SIM110 (a plain loop: any() over a generator costs more)
+            if attempt.reply_events:
+                return True
+        return False
 
     @property
     def maybe_collided(self) -> bool:
