@@ -1,0 +1,62 @@
+"""The bus pass's own records of the windows (issue 22's bounded memory,
+``offline.sensor_windows.BusWindows``): each event's inferred side in a column whose full
+chunks are written out (``conformance.event_store.Column``: an hour's 357,000 sides were a
+bytearray of 0.36 MB), and the per-window numbers (where each begins, the transmissions
+before it, the windows of each sensor) 4 bytes each, widened only past 2**32 - 1. The
+windows read again must be the windows the cut gave, spilled or not."""
+
+from __future__ import annotations
+
+from array import array
+from pathlib import Path
+
+import pytest
+
+from conformance import event_store
+from conformance.offline.sensor_windows import bus_windows, counted, ordered_plain
+from conformance.replay.recording_link import load_recording, parse_recording, recording_port
+from conformance.view.windows import stream_window_sides, window_view
+from tests.offline.test_judge_memory import busy_capture
+
+
+def test_counted_appends_in_four_bytes_and_widens_past_them():
+    small = counted(array("I", [0]), 7)
+    assert small.typecode == "I" and list(small) == [0, 7]
+    top = counted(small, 2**32 - 1)
+    assert top is small and top[-1] == 2**32 - 1
+    wide = counted(top, 2**32)
+    assert wide.typecode == "q" and list(wide) == [0, 7, 2**32 - 1, 2**32]
+
+
+def _shape(view) -> list[tuple]:
+    """The transmissions (what the recorder sent, what the sensors were heard to send after
+    it) and the events no side could be given."""
+    sent = [
+        (t.text, [e.start for e in t.chars], [e.start for e in t.heard]) for t in view.transmissions
+    ]
+    return [*sent, [e.start for e in view.undirected]]
+
+
+def test_the_sides_spill_and_every_window_reads_again_as_cut(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+):
+    monkeypatch.setattr(event_store, "CHUNK", 512)
+    monkeypatch.setattr(event_store, "BLOCK", 64)
+    path = tmp_path / "busy.sr"
+    busy_capture(path, 0.5)
+    link = load_recording(parse_recording(recording_port(str(path), "sr")))
+    bus = bus_windows(link)
+    assert bus.codes is not None  # one wire: every side inferred
+    assert len(bus.codes) == len(bus.events) > 4 * 512
+    assert bus.codes.spilled() >= 4
+    assert bus.codes.resident_nbytes() <= 512 + 64
+    for numbers in (bus.bounds, bus.before, bus.chars_before, *bus.windows_of.values()):
+        assert numbers.itemsize == 4
+    cut = list(
+        stream_window_sides(
+            iter(ordered_plain(link.transcript.events)), uncertainty=link.uncertainty
+        )
+    )
+    assert len(cut) == len(bus) > 10
+    for i, (window, sides) in enumerate(cut):
+        assert _shape(bus.view(i)) == _shape(window_view(window, sides))
