@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
-from ..event_store import Column, CompactEvents
+from ..event_store import CHUNK, Column, CompactEvents
 from ..judges.timing import StampUncertainty
 from ..judges.wire import Framing, ReplyBitRate, ReplyGaps, ResponseStarts
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
@@ -179,13 +179,23 @@ def counted(numbers: array, n: int) -> array:
     return numbers
 
 
+def _zeros(codes: Column, count: int) -> None:
+    """``count`` zero bytes appended to ``codes``, a chunk's worth at a time."""
+    while count > 0:
+        n = min(count, CHUNK)
+        codes.extend(bytes(n))
+        count -= n
+
+
 @dataclass
 class BusWindows:
     """The bus pass over a loaded recording (see the module's docstring)."""
 
     events: Sequence[Event]  # the plain events in the order the windows cut them
     bounds: array  # window i is events[bounds[i]:bounds[i + 1]]
-    codes: Column | None  # each event's inferred side where its window's were inferred
+    #: each event's inferred side where its window's were inferred (None: the origins gave
+    #: every side; else 0 for the events of a window whose sides were given)
+    codes: Column | None
     sided: bytearray  # per window: 1 where the cut inferred its sides (``codes`` hold them)
     windows_of: dict[str, array]  # a text's first character -> the windows holding it
     sensors: list[BusSensor]
@@ -250,7 +260,8 @@ def bus_windows(link: RecordingLink) -> BusWindows:
 def _read_bus(link: RecordingLink) -> BusWindows:
     events = ordered_plain(link.transcript.events)
     u = link.uncertainty
-    bounds, codes, sided = array("I", [0]), Column("B"), bytearray()
+    bounds, sided = array("I", [0]), bytearray()
+    codes: Column | None = None  # made at the first window whose sides were inferred
     before, chars_before = array("I", [0]), array("I", [0])
     windows_of: dict[str, array] = {}
     sensors, ambiguities, carried = SensorsOn(), Ambiguities(AMBIGUITIES_SHOWN), {}
@@ -260,7 +271,11 @@ def _read_bus(link: RecordingLink) -> BusWindows:
         i = len(bounds) - 1
         bounds = counted(bounds, bounds[-1] + len(window))
         sided.append(sides is not None)
-        codes.extend(sides if sides is not None else bytes(len(window)))
+        if sides is not None and codes is None:
+            codes = Column("B")
+            _zeros(codes, bounds[-2])  # the windows before: their sides were given
+        if codes is not None:
+            codes.extend(sides if sides is not None else bytes(len(window)))
         view = window_view(window, sides)
         before = counted(before, before[-1] + len(view.transmissions))
         with_chars = sum(1 for t in view.transmissions if t.chars)
@@ -275,9 +290,8 @@ def _read_bus(link: RecordingLink) -> BusWindows:
             qualities.add(window, exchanges)
     if bounds[-1] != len(events):
         raise AssertionError("the windows do not hold the recording's events one for one")
-    sides_kept = codes if any(sided) else None  # None: the origins gave every side
     found = BusWindows(
-        events, bounds, sides_kept, sided, windows_of, sensors.sensors(), ambiguities.found(),
+        events, bounds, codes, sided, windows_of, sensors.sensors(), ambiguities.found(),
         frozenset(kinds), before=before, chars_before=chars_before,
     )  # fmt: skip
     if qualities is not None:

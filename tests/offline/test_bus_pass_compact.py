@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from conformance import event_store
+from conformance.offline import sensor_windows
 from conformance.offline.sensor_windows import bus_windows, counted, ordered_plain
 from conformance.replay.recording_link import load_recording, parse_recording, recording_port
 from conformance.view.windows import stream_window_sides, window_view
@@ -57,6 +58,38 @@ def test_the_sides_spill_and_every_window_reads_again_as_cut(
             iter(ordered_plain(link.transcript.events)), uncertainty=link.uncertainty
         )
     )
+    assert len(cut) == len(bus) > 10
+    for i, (window, sides) in enumerate(cut):
+        assert _shape(bus.view(i)) == _shape(window_view(window, sides))
+
+
+@pytest.mark.parametrize("given", [3, None])
+def test_windows_whose_sides_were_given_read_again_as_cut(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, given: int | None
+):
+    """The first ``given`` windows' sides given by their origins (None: every window's), as
+    where a recording's events carry their side: no side is kept for them, and the windows
+    after them read again with their own sides, not their neighbours'."""
+    monkeypatch.setattr(event_store, "CHUNK", 512)
+    monkeypatch.setattr(event_store, "BLOCK", 64)
+    cut: list = []
+    stream = sensor_windows.stream_window_sides
+
+    def some_given(events, uncertainty):
+        for i, (window, sides) in enumerate(stream(events, uncertainty=uncertainty)):
+            cut.append((window, None if given is None or i < given else sides))
+            yield cut[-1]
+
+    monkeypatch.setattr(sensor_windows, "stream_window_sides", some_given)
+    path = tmp_path / "busy.sr"
+    busy_capture(path, 0.5)
+    link = load_recording(parse_recording(recording_port(str(path), "sr")))
+    bus = bus_windows(link)
+    if given is None:
+        assert bus.codes is None
+    else:
+        assert bus.codes is not None and len(bus.codes) == len(bus.events)
+        assert not any(bus.codes[: bus.bounds[given]])
     assert len(cut) == len(bus) > 10
     for i, (window, sides) in enumerate(cut):
         assert _shape(bus.view(i)) == _shape(window_view(window, sides))
