@@ -219,7 +219,7 @@ class BusWindows:
     def view(self, i: int) -> TranscriptView:
         """Window ``i``'s view, read again as the cut read it."""
         lo, hi = self.bounds[i], self.bounds[i + 1]
-        sides = self.codes[lo:hi] if self.codes is not None and self.sided[i] else None
+        sides = self.codes.read(lo, hi) if self.codes is not None and self.sided[i] else None
         return window_view(list(self.events[lo:hi]), sides)  # type: ignore[arg-type]
 
     def read(self, address: str | None, more: Callable[[], bool]) -> Iterator[TranscriptView]:
