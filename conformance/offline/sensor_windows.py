@@ -11,7 +11,7 @@ records:
   (:class:`~.decode_quality.Quality`), and the ambiguous splits of the notes (a count and
   the first few, :class:`Ambiguities`). Kept of the windows to read them again: where each
   begins, how many transmissions come before it and which windows hold a transmission to
-  each sensor (4 bytes each a window, :func:`counted`), and their events' inferred sides
+  each sensor (4 bytes each a window, :func:`count_typecode`), and their events' inferred sides
   (1 byte an event, in a :class:`~conformance.event_store.Column` whose full chunks are
   written to a temporary file: an hour's 357,000 sides held 0.36 MB);
 - the **sensor pass** (:func:`sensor_records`, once per sensor's run): the windows that hold
@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
-from ..event_store import CHUNK, Column, CompactEvents
+from ..event_store import BLOCK, CHUNK, Column, CompactEvents
 from ..judges.timing import StampUncertainty
 from ..judges.wire import Framing, ReplyBitRate, ReplyGaps, ResponseStarts
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
@@ -166,25 +166,48 @@ class Qualities:
             self.all.add(chars, rates, self.broken)
 
 
-def counted(numbers: array, n: int) -> array:
-    """``numbers`` with ``n`` appended: a count or an index of the bus pass (4 bytes each,
-    half what they took as ``q``: an hour's windows, ~15,000, hold four such numbers each),
-    the array widened to 8 bytes if one ever passes 2**32 - 1 (the same array returned
-    otherwise)."""
-    try:
-        numbers.append(n)
-    except OverflowError:
-        numbers = array("q", numbers)
-        numbers.append(n)
-    return numbers
+def count_typecode(most: int) -> str:
+    """The ``array`` typecode for the bus pass's counts and indices, none above ``most`` (the
+    recording's events: no window, window index or transmission count is more): 4 bytes,
+    half what ``q`` took (an hour's windows, ~15,000, hold four such numbers each), 8 only
+    past 2**32 - 1."""
+    return "I" if most < 2**32 else "q"
 
 
-def _zeros(codes: Column, count: int) -> None:
-    """``count`` zero bytes appended to ``codes``, a chunk's worth at a time."""
-    while count > 0:
-        n = min(count, CHUNK)
-        codes.extend(bytes(n))
-        count -= n
+class Sides:
+    """Each event's inferred side as the bus pass cuts the windows (see the module's
+    docstring): a :class:`~conformance.event_store.Column` begun at the first window whose
+    sides were inferred (zeros for the events before it, whose sides were given), appended
+    to a :data:`~conformance.event_store.BLOCK` at a time (a window's few bytes each one
+    call of the column's cost 0.1 s of an hour's bus pass)."""
+
+    def __init__(self) -> None:
+        self.column: Column | None = None
+        self.pending = bytearray()
+
+    def add(self, before: int, sides: bytearray | None, count: int) -> None:
+        """The next window's ``count`` events' sides (None: given), ``before`` events
+        before it."""
+        if sides is not None and self.column is None:
+            self.column = Column("B")
+            self._flush(bytes(before))
+        if self.column is not None:
+            self.pending += sides if sides is not None else bytes(count)
+            if len(self.pending) >= BLOCK:
+                self._flush(self.pending)
+                self.pending = bytearray()
+
+    def _flush(self, data: bytes | bytearray) -> None:
+        assert self.column is not None
+        for at in range(0, len(data), CHUNK):
+            self.column.extend(data[at : at + CHUNK])
+
+    def done(self) -> Column | None:
+        """The column (None: every side was given), all appended."""
+        if self.column is not None and self.pending:
+            self._flush(self.pending)
+            self.pending = bytearray()
+        return self.column
 
 
 @dataclass
@@ -260,28 +283,23 @@ def bus_windows(link: RecordingLink) -> BusWindows:
 def _read_bus(link: RecordingLink) -> BusWindows:
     events = ordered_plain(link.transcript.events)
     u = link.uncertainty
-    bounds, sided = array("I", [0]), bytearray()
-    codes: Column | None = None  # made at the first window whose sides were inferred
-    before, chars_before = array("I", [0]), array("I", [0])
+    code = count_typecode(len(events))
+    bounds, codes, sided = array(code, [0]), Sides(), bytearray()
+    before, chars_before = array(code, [0]), array(code, [0])
     windows_of: dict[str, array] = {}
     sensors, ambiguities, carried = SensorsOn(), Ambiguities(AMBIGUITIES_SHOWN), {}
     kinds: set[Kind] = set()
     qualities = Qualities(link.decoded) if link.decoded is not None else None
     for window, sides in stream_window_sides(iter(events), uncertainty=u):
         i = len(bounds) - 1
-        bounds = counted(bounds, bounds[-1] + len(window))
+        codes.add(bounds[-1], sides, len(window))
+        bounds.append(bounds[-1] + len(window))
         sided.append(sides is not None)
-        if sides is not None and codes is None:
-            codes = Column("B")
-            _zeros(codes, bounds[-2])  # the windows before: their sides were given
-        if codes is not None:
-            codes.extend(sides if sides is not None else bytes(len(window)))
         view = window_view(window, sides)
-        before = counted(before, before[-1] + len(view.transmissions))
-        with_chars = sum(1 for t in view.transmissions if t.chars)
-        chars_before = counted(chars_before, chars_before[-1] + with_chars)
+        before.append(before[-1] + len(view.transmissions))
+        chars_before.append(chars_before[-1] + sum(1 for t in view.transmissions if t.chars))
         for first in {t.text[:1] for t in view.transmissions}:
-            windows_of[first] = counted(windows_of.get(first, array("I")), i)
+            windows_of.setdefault(first, array(code)).append(i)
         kinds.update(t.command.kind for t in view.transmissions if t.command is not None)
         exchanges = rebuild_records(view, uncertainty=u, carried=carried).exchanges
         sensors.add(exchanges)
@@ -291,7 +309,7 @@ def _read_bus(link: RecordingLink) -> BusWindows:
     if bounds[-1] != len(events):
         raise AssertionError("the windows do not hold the recording's events one for one")
     found = BusWindows(
-        events, bounds, codes, sided, windows_of, sensors.sensors(), ambiguities.found(),
+        events, bounds, codes.done(), sided, windows_of, sensors.sensors(), ambiguities.found(),
         frozenset(kinds), before=before, chars_before=chars_before,
     )  # fmt: skip
     if qualities is not None:
