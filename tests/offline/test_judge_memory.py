@@ -92,16 +92,16 @@ the lower of each 0.225 and 0.234 MB a minute in two runs; base-s65, the tree be
 60.4-60.5 and 63.4-63.6, 0.252 and 0.250, in the same alternated runs. The cut is 0.2 MB at
 14 minutes, inside this test's noise (memory17 read base-s65's code at 0.20): the limit
 stays 0.60 (the measured figure and the same 0.4 of noise would be 0.63). Between 10 and 60
-minutes the bus pass's held bytes went from 0.85 MB to 0.28 at an hour (0.14 to 0.10 at
-10 minutes). What still grows (traced at 60 against 10 minutes, at the last sensor's run):
-the sensor's exchanges and measurements, 5.2 MB more (its 35,000 events as objects, 4.3 MB of them, 150 bytes each
-with their two stamps; the attempts, replies and exchanges 0.9). The loaded state traces the
-same bytes at both lengths (19.7 MB in pymalloc blocks), but the decode leaves 4 more of
-pymalloc's 1 MiB arenas held by a few long-lived blocks (310 empty pools against 77, RSS 3
-MB higher); the first sensor's records fill those pools (75 empty at both lengths after
-its run), so they add nothing to the peak while the records are held as objects:
-``malloc_trim`` after every run was measured too (no lower peak: those pools are not
-malloc's).
+minutes the bus pass's held bytes went from 0.85 MB to 0.28 at an hour (0.14 to 0.10 at 10
+minutes). What still grows (traced at 60 against 10 minutes, at the last sensor's run): the
+sensor's exchanges and measurements, 5.2 MB more (its 35,000 events as objects, 4.3 MB of
+them, 150 bytes each with their two stamps; the attempts, replies and exchanges 0.9). The
+loaded state traces the same bytes at both lengths (19.7 MB in pymalloc blocks), but the
+decode leaves 4 more of pymalloc's 1 MiB arenas held by a few long-lived blocks (310 empty
+pools against 77, RSS 3 MB higher); the first sensor's records fill those pools (75 empty at
+both lengths after its run), so they add nothing to the peak while the records are held as
+objects: ``malloc_trim`` after every run was measured too (no lower peak: those pools are
+not malloc's).
 """
 
 from __future__ import annotations
