@@ -190,7 +190,8 @@ class Sides:
         before it."""
         if sides is not None and self.column is None:
             self.column = Column("B")
-            self._flush(bytes(before))
+            for at in range(0, before, CHUNK):  # a chunk's zeros at a time
+                self.column.extend(bytes(min(CHUNK, before - at)))
         if self.column is not None:
             self.pending += sides if sides is not None else bytes(count)
             if len(self.pending) >= BLOCK:
