@@ -225,7 +225,20 @@ class Column:
         return self.item(c, j)
 
     def read(self, lo: int, hi: int) -> array:
-        """Items ``lo:hi`` (0 <= lo, hi <= len) as one array of the column's typecode."""
+        """Items ``lo:hi`` (0 <= lo, hi <= len) as one array of the column's typecode: the
+        one part they lie in where they do (a window's sides, read at every view of it
+        again: :class:`~conformance.offline.sensor_windows.BusWindows`), else the parts
+        joined."""
+        c, j = divmod(lo, CHUNK)
+        k = j + hi - lo
+        if (
+            lo < hi
+            and k <= CHUNK
+            and (self._chunks[c] is not None or j // BLOCK == (k - 1) // BLOCK)
+        ):
+            part = self.part(c, j, k)
+            if part.typecode == self.typecode:
+                return part
         out = array(self.typecode)
         for part in self.parts(lo, hi):
             out.extend(part if part.typecode == out.typecode else array(out.typecode, part))

@@ -189,3 +189,25 @@ def test_a_capture_decoded_compact_writes_out_its_events_and_rates(tmp_path, mon
     assert list(events) == listed.events and len(rates) == len(listed.baud_error_pct)
     assert [repr(x) for x in rates] == [repr(x) for x in listed.baud_error_pct]
     assert compact.baud_error_summary() == listed.baud_error_summary()
+
+
+def test_a_column_reads_every_range_as_appended_across_a_widening(
+    monkeypatch: pytest.MonkeyPatch,
+):
+    """:meth:`~conformance.event_store.Column.read` of every range: those inside one block
+    or one chunk in RAM (given as that part) and those across several (joined) alike, in the
+    column's typecode even where a chunk was spilled before it widened."""
+    import conformance.event_store as event_store
+
+    monkeypatch.setattr(event_store, "CHUNK", 6)
+    monkeypatch.setattr(event_store, "BLOCK", 4)
+    column = event_store.Column("B")
+    column.extend(range(14))
+    column.widen("I")
+    column.extend(range(300, 310))
+    values = [*range(14), *range(300, 310)]
+    assert column.spilled() == 3
+    for lo in range(len(values) + 1):
+        for hi in range(lo, len(values) + 1):
+            got = column.read(lo, hi)
+            assert got.typecode == "I" and list(got) == values[lo:hi], (lo, hi)

@@ -10,8 +10,10 @@ records:
   (:class:`~.bus_sensors.SensorsOn`), each sensor's decode quality and all of them together
   (:class:`~.decode_quality.Quality`), and the ambiguous splits of the notes (a count and
   the first few, :class:`Ambiguities`). Kept of the windows to read them again: where each
-  begins (8 bytes a window), their events' inferred sides (1 byte an event) and which
-  windows hold a transmission to each sensor;
+  begins, how many transmissions come before it and which windows hold a transmission to
+  each sensor (4 bytes each a window, :func:`count_typecode`), and their events' inferred sides
+  (1 byte an event, in a :class:`~conformance.event_store.Column` whose full chunks are
+  written to a temporary file: an hour's 357,000 sides held 0.36 MB);
 - the **sensor pass** (:func:`sensor_records`, once per sensor's run): the windows that hold
   a transmission to that sensor read again (every window when no address narrows the run),
   and those after a measurement of it whose disturbance the next traffic decides
@@ -34,7 +36,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
-from ..event_store import CompactEvents
+from ..event_store import BLOCK, CHUNK, Column, CompactEvents
 from ..judges.timing import StampUncertainty
 from ..judges.wire import Framing, ReplyBitRate, ReplyGaps, ResponseStarts
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
@@ -164,13 +166,60 @@ class Qualities:
             self.all.add(chars, rates, self.broken)
 
 
+def count_typecode(most: int) -> str:
+    """The ``array`` typecode for the bus pass's counts and indices, none above ``most`` (the
+    recording's events: no window, window index or transmission count is more): 4 bytes,
+    half what ``q`` took (an hour's windows, ~15,000, hold four such numbers each), 8 only
+    past 2**32 - 1."""
+    return "I" if most < 2**32 else "q"
+
+
+class Sides:
+    """Each event's inferred side as the bus pass cuts the windows (see the module's
+    docstring): a :class:`~conformance.event_store.Column` begun at the first window whose
+    sides were inferred (zeros for the events before it, whose sides were given), appended
+    to a :data:`~conformance.event_store.BLOCK` at a time (a window's few bytes each one
+    call of the column's cost 0.1 s of an hour's bus pass)."""
+
+    def __init__(self) -> None:
+        self.column: Column | None = None
+        self.pending = bytearray()
+
+    def add(self, before: int, sides: bytearray | None, count: int) -> None:
+        """The next window's ``count`` events' sides (None: given), ``before`` events
+        before it."""
+        if sides is not None and self.column is None:
+            self.column = Column("B")
+            for at in range(0, before, CHUNK):  # a chunk's zeros at a time
+                self.column.extend(bytes(min(CHUNK, before - at)))
+        if self.column is not None:
+            self.pending += sides if sides is not None else bytes(count)
+            if len(self.pending) >= BLOCK:
+                self._flush(self.pending)
+                self.pending = bytearray()
+
+    def _flush(self, data: bytes | bytearray) -> None:
+        assert self.column is not None
+        for at in range(0, len(data), CHUNK):
+            self.column.extend(data[at : at + CHUNK])
+
+    def done(self) -> Column | None:
+        """The column (None: every side was given), all appended."""
+        if self.column is not None and self.pending:
+            self._flush(self.pending)
+            self.pending = bytearray()
+        return self.column
+
+
 @dataclass
 class BusWindows:
     """The bus pass over a loaded recording (see the module's docstring)."""
 
     events: Sequence[Event]  # the plain events in the order the windows cut them
     bounds: array  # window i is events[bounds[i]:bounds[i + 1]]
-    codes: bytearray  # each event's inferred side where its window's were inferred
+    #: each event's inferred side where its window's were inferred (None: the origins gave
+    #: every side; else 0 for the events of a window whose sides were given)
+    codes: Column | None
     sided: bytearray  # per window: 1 where the cut inferred its sides (``codes`` hold them)
     windows_of: dict[str, array]  # a text's first character -> the windows holding it
     sensors: list[BusSensor]
@@ -194,8 +243,8 @@ class BusWindows:
     def view(self, i: int) -> TranscriptView:
         """Window ``i``'s view, read again as the cut read it."""
         lo, hi = self.bounds[i], self.bounds[i + 1]
-        sides = self.codes[lo:hi] if self.sided[i] else None
-        return window_view(list(self.events[lo:hi]), sides)
+        sides = self.codes.read(lo, hi) if self.codes is not None and self.sided[i] else None
+        return window_view(list(self.events[lo:hi]), sides)  # type: ignore[arg-type]
 
     def read(self, address: str | None, more: Callable[[], bool]) -> Iterator[TranscriptView]:
         """The views of the windows holding a transmission whose text begins with
@@ -204,7 +253,7 @@ class BusWindows:
         if address is None:
             yield from map(self.view, range(len(self)))
             return
-        mine = self.windows_of.get(address, array("q"))
+        mine = self.windows_of.get(address, array("I"))
         i = j = 0
         while i < len(self):
             if j < len(mine) and mine[j] == i:
@@ -235,22 +284,23 @@ def bus_windows(link: RecordingLink) -> BusWindows:
 def _read_bus(link: RecordingLink) -> BusWindows:
     events = ordered_plain(link.transcript.events)
     u = link.uncertainty
-    bounds, codes, sided = array("q", [0]), bytearray(), bytearray()
-    before, chars_before = array("q", [0]), array("q", [0])
+    code = count_typecode(len(events))
+    bounds, codes, sided = array(code, [0]), Sides(), bytearray()
+    before, chars_before = array(code, [0]), array(code, [0])
     windows_of: dict[str, array] = {}
     sensors, ambiguities, carried = SensorsOn(), Ambiguities(AMBIGUITIES_SHOWN), {}
     kinds: set[Kind] = set()
     qualities = Qualities(link.decoded) if link.decoded is not None else None
     for window, sides in stream_window_sides(iter(events), uncertainty=u):
         i = len(bounds) - 1
+        codes.add(bounds[-1], sides, len(window))
         bounds.append(bounds[-1] + len(window))
         sided.append(sides is not None)
-        codes += sides if sides is not None else bytes(len(window))
         view = window_view(window, sides)
         before.append(before[-1] + len(view.transmissions))
         chars_before.append(chars_before[-1] + sum(1 for t in view.transmissions if t.chars))
         for first in {t.text[:1] for t in view.transmissions}:
-            windows_of.setdefault(first, array("q")).append(i)
+            windows_of.setdefault(first, array(code)).append(i)
         kinds.update(t.command.kind for t in view.transmissions if t.command is not None)
         exchanges = rebuild_records(view, uncertainty=u, carried=carried).exchanges
         sensors.add(exchanges)
@@ -259,10 +309,8 @@ def _read_bus(link: RecordingLink) -> BusWindows:
             qualities.add(window, exchanges)
     if bounds[-1] != len(events):
         raise AssertionError("the windows do not hold the recording's events one for one")
-    if not any(sided):
-        codes = bytearray()  # the origins gave every side: nothing to keep
     found = BusWindows(
-        events, bounds, codes, sided, windows_of, sensors.sensors(), ambiguities.found(),
+        events, bounds, codes.done(), sided, windows_of, sensors.sensors(), ambiguities.found(),
         frozenset(kinds), before=before, chars_before=chars_before,
     )  # fmt: skip
     if qualities is not None:
