@@ -256,3 +256,22 @@ def test_r_7_1_02_reply_at_the_retry_may_be_the_first_d0s_late_reply() -> None:
 def test_r_7_1_02_a_retry_answered_in_time_is_the_retrys_and_still_fails() -> None:
     found = _r_7_1_02(0.009)
     assert found.verdict is Verdict.FAIL and "no reply" in found.detail, found.detail
+
+
+def test_r_4_4_2_01_identification_answered_after_the_retries_is_inconclusive() -> None:
+    """replies-after-retry + parity-error behind ``emulate --echo --usb-latency 16``: the
+    late '014CONFORM...' met the retry, was set aside as contention, and "aI! got no reply"
+    FAILed R-4.4.2-01/-02, which the sim's exact stamps never showed (outside28)."""
+    ex = _unanswered("0I!", "014CONFORM EMU001100SN0001\r\n")
+    ident, findings = xjudge.identification(ex, "0")
+    assert ident is None
+    for rid, found in _by_rule(findings).items():
+        assert found.verdict is Verdict.INCONCLUSIVE, (rid, found.detail)
+        assert "answered only after the reply window" in found.detail
+        assert "got no reply" not in found.detail
+
+
+def test_r_4_4_2_01_silent_identification_still_fails() -> None:
+    _, findings = xjudge.identification(_unanswered("0I!", ""), "0")
+    assert [f.verdict for f in findings] == [Verdict.FAIL, Verdict.FAIL]
+    assert all("aI! got no reply" in f.detail for f in findings)
