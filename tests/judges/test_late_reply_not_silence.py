@@ -275,3 +275,34 @@ def test_r_4_4_2_01_silent_identification_still_fails() -> None:
     _, findings = xjudge.identification(_unanswered("0I!", ""), "0")
     assert [f.verdict for f in findings] == [Verdict.FAIL, Verdict.FAIL]
     assert all("aI! got no reply" in f.detail for f in findings)
+
+
+def _binary_findings(late: str) -> dict[str, Finding]:
+    """0HB! answered '0002033', its 0DB0! unanswered in three windows, ``late`` (if any) its
+    packet met by the retry; R-5.2-02 and R-5.2-07 as the binary data judge leaves them."""
+    from conformance.judges.measurements import data_violations
+    from conformance.judges.tally import Tally
+
+    start = _answered("0HB!", "0002033\r\n")
+    m = Measurement(start.command, start, ttt=2, count=33)
+    m.data.append(_unanswered("0DB0!", late, t=3.0))
+    tally = Tally(("R-5.2-02", "R-5.2-07"))
+    data_violations(m, tally)
+    return _by_rule(tally.findings())
+
+
+def test_r_5_2_02_binary_packet_after_the_retries_is_inconclusive() -> None:
+    """replies-after-retry + parity-error behind ``emulate --echo --usb-latency 16``: 0DB0!'s
+    packet came 80 ms late, met the retry and was set aside as contention; "no packet
+    returned for 0DB0!" FAILed R-5.2-02, where the sim's stamps left it INCONCLUSIVE
+    (outside28)."""
+    found = _binary_findings("0\x04\x00\x01\x00\x7f\x00\x7f#\x04")
+    assert found["R-5.2-02"].verdict is Verdict.INCONCLUSIVE, found["R-5.2-02"].detail
+    assert "answered only after the reply window" in found["R-5.2-02"].detail
+    assert found["R-5.2-07"].verdict is Verdict.INCONCLUSIVE, found["R-5.2-07"].detail
+
+
+def test_r_5_2_02_silent_binary_data_still_fails() -> None:
+    found = _binary_findings("")
+    assert found["R-5.2-02"].verdict is Verdict.FAIL
+    assert "no packet returned for 0DB0!" in found["R-5.2-02"].detail
