@@ -27,6 +27,7 @@ from conformance.protocol.timing import (
 from conformance.sensor.session import PROBE_TRIES
 from conformance.tool_recorder.records import Exchange
 from conformance.transcript import (
+    DUT,
     SEVEN_BITS,
     TOOL,
     EventKind,
@@ -554,6 +555,26 @@ def _after_marking(sensor, last_end: float, marking: float, text: str):
     return ex, _marking_before(ex, last_end)
 
 
+def _marking_since_sensor(exchanges, probe) -> float:
+    """The marking before ``probe``'s command counted from the last sensor character any of
+    ``exchanges`` (the wake-up, the probe) heard begun before it: their tries' replies,
+    stray characters and late listens (inf: none). A wake-up answered late, its last try's
+    reply begun 71 ms after it, is no quiet line: replies-after-retry + parity-error behind
+    an echoing 16 ms USB link answered a probe "150.91 ms after a reply", sent while that
+    reply's LF was still on the line, and R-7.0-15 FAILed (outside28)."""
+    start = probe.attempts[0].command_events[0].start
+    ends = [
+        e.end
+        for ex in exchanges
+        for e in [
+            *ex.heard_late,
+            *(c for a in ex.attempts for c in a.reply_events + a.stray_events),
+        ]
+        if e.origin == DUT and e.start < start
+    ]
+    return start - max(ends) if ends else float("inf")
+
+
 @requirements("R-7.0-15")
 @pytest.mark.preconditions("awake")
 def test_standby_after_100ms(sensor, case):
@@ -575,6 +596,7 @@ def test_standby_after_100ms(sensor, case):
                 sensor, first.judged.reply_events[-1].end, marking, f"{sensor.address}!"
             )
             sensor.hear_late(ex)  # from a sensor seen late: a late answer is an answer
+            idle = min(idle, _marking_since_sensor([first, ex], ex))
             case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
             return first, ex, idle
 
