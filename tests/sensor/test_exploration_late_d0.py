@@ -13,25 +13,13 @@ from types import SimpleNamespace
 import pytest
 
 from conformance.judges.exploration import Observation, judge
-from conformance.protocol import commands as cmds
 from conformance.sensor.exploration_record import Exploration, InvariantBroken
 from conformance.sensor.exploration_steps import ExplorerSteps
-from conformance.tool_recorder.records import NO_REPLY, OK, Attempt, Exchange
-from conformance.transcript import DUT, TOOL
-from tests.support.hand_events import chars
+from conformance.tool_recorder.records import Exchange
+from tests.judges.test_late_before import _after_unanswered, _exchange
 
-LATE = 0.080
 HELD = "0-5.00-3.75+1.25\r\n"  # what D0 read before
 D1 = "0+12.50+13.75\r\n"  # D1's reply, 80 ms late
-
-
-def _exchange(text: str, t: float, reply: str = "", delay: float = 0.009) -> Exchange:
-    sent = chars(TOOL, text, t)
-    got = chars(DUT, reply, sent[-1].end + delay) if reply else []
-    end = got[-1].end if got else sent[-1].end + 0.03
-    return Exchange(
-        cmds.parse_command(text), text, [Attempt(None, sent, got, OK if got else NO_REPLY, end)]
-    )
 
 
 def _steps(replies: list[Exchange]) -> ExplorerSteps:
@@ -48,17 +36,13 @@ def _steps(replies: list[Exchange]) -> ExplorerSteps:
 
 
 def _late_d1_then_d0() -> list[Exchange]:
-    """0D0! answered HELD; 0D1! unanswered; 0D0! 30 ms after its window, taking D1's reply
-    begun 80 ms after 0D1! ended (linked as the session's engine links a late sensor's)."""
-    first = _exchange("0D0!", 0.0, HELD)
-    before = _exchange("0D1!", 1.0)
-    end = before.last.command_end
-    assert end is not None
-    ex = _exchange("0D0!", end + 0.030)
-    ex.attempts[0].reply_events = chars(DUT, D1, end + LATE)
-    ex.attempts[0].reason = OK
-    ex.late_before = before
-    return [first, before, ex]
+    """0D0! answered HELD at -1 s; 0D1! unanswered at 0 s; 0D0! 30 ms after its window,
+    taking D1's reply begun 80 ms after 0D1! ended (linked as the session's engine links a
+    late sensor's: ``_after_unanswered``)."""
+    first = _exchange("0D0!", -1.0, HELD)
+    ex = _after_unanswered("0D1!", "0D0!", D1)
+    assert ex.late_before is not None
+    return [first, ex.late_before, ex]
 
 
 def test_a_d0_that_took_the_d1_before_s_late_reply_is_no_repeat_check() -> None:
