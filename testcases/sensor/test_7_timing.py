@@ -27,7 +27,6 @@ from conformance.protocol.timing import (
 from conformance.sensor.session import PROBE_TRIES
 from conformance.tool_recorder.records import Exchange
 from conformance.transcript import (
-    DUT,
     SEVEN_BITS,
     TOOL,
     EventKind,
@@ -556,21 +555,24 @@ def _after_marking(sensor, last_end: float, marking: float, text: str):
 
 
 def _marking_since_sensor(exchanges, probe) -> float:
-    """The marking before ``probe``'s command counted from the last sensor character any of
-    ``exchanges`` (the wake-up, the probe) heard begun before it: their tries' replies,
-    stray characters and late listens (inf: none). A wake-up answered late, its last try's
-    reply begun 71 ms after it, is no quiet line: replies-after-retry + parity-error behind
-    an echoing 16 ms USB link answered a probe "150.91 ms after a reply", sent while that
-    reply's LF was still on the line, and R-7.0-15 FAILed (outside28)."""
+    """The marking before ``probe``'s command counted from the last character on the line
+    any of ``exchanges`` (the wake-up, the probe) holds begun before it: their tries'
+    commands, replies, stray characters and late listens (inf: none). The judged reply is
+    not always the last: replies-after-retry + parity-error + no-recovery-after-abort behind
+    ``emulate --echo --usb-latency 16`` took the wake-up's reply from its second try, its
+    third try's late '0<CR><LF>' was still on the line when the probe went "150.91 ms after a
+    reply"; behind ``--echo --jitter 2`` a third try went 73 ms before the probe, "115.94 ms
+    after a reply", and the sensor answered it into the probe; R-7.0-15 FAILed "answered
+    although ... put it in standby" both times (outside28)."""
     start = probe.attempts[0].command_events[0].start
     ends = [
         e.end
         for ex in exchanges
         for e in [
             *ex.heard_late,
-            *(c for a in ex.attempts for c in a.reply_events + a.stray_events),
+            *(c for a in ex.attempts for c in a.command_events + a.reply_events + a.stray_events),
         ]
-        if e.origin == DUT and e.start < start
+        if e.start < start
     ]
     return start - max(ends) if ends else float("inf")
 

@@ -1,4 +1,4 @@
-"""R-7.0-15's marking counts from the last sensor character the wake-up or the probe heard,
+"""R-7.0-15's marking counts from the last character on the line the wake-up or the probe holds,
 not from the wake-up's judged reply alone (outside28): replies-after-retry + parity-error +
 no-recovery-after-abort behind ``emulate --echo --usb-latency 16``. The wake-up 0!'s reply
 (80 ms late) met its retry; its third try was answered 71 ms after it, past its window, and
@@ -15,19 +15,21 @@ from testcases.sensor.test_7_timing import _marking_since_sensor
 from tests.support.hand_events import chars
 
 
-def _wake_up(late_third: bool) -> Exchange:
-    """0! at 0 s, its reply taken at 0.104 s (met the retry), a third try at 0.160 s whose
-    late reply (``late_third``) begins 0.256 s and ends 0.281 s."""
+def _wake_up(third: str) -> Exchange:
+    """0! at 0 s, its reply taken at 0.104 s (met the retry); ``third``: "none" (no third
+    try), "silent" (a third try at 0.160 s, unanswered) or "late" (that try's late reply
+    begins 0.256 s and ends 0.281 s)."""
     first = chars(TOOL, "0!", 0.0)
     retry = chars(TOOL, "0!", 0.080)
     reply = chars(DUT, "0\r\n", 0.104)
-    third = chars(TOOL, "0!", 0.160)
-    late = chars(DUT, "0\r\n", 0.256) if late_third else []
     attempts = [
         Attempt(None, first, [], NO_REPLY, first[-1].end + 0.03, 0, 0),
         Attempt(None, retry, reply, OK, reply[-1].end, 0, 1),
-        Attempt(None, third, [], NO_REPLY, third[-1].end + 0.03, 0, 2, late),
     ]
+    if third != "none":
+        sent = chars(TOOL, "0!", 0.160)
+        late = chars(DUT, "0\r\n", 0.256) if third == "late" else []
+        attempts.append(Attempt(None, sent, [], NO_REPLY, sent[-1].end + 0.03, 0, 2, late))
     return Exchange(cmds.parse_command("0!"), "0!", attempts)
 
 
@@ -37,12 +39,12 @@ def _probe(at: float) -> Exchange:
 
 
 def test_a_late_reply_after_the_judged_one_ends_the_quiet() -> None:
-    wake, probe = _wake_up(late_third=True), _probe(0.280)
+    wake, probe = _wake_up("late"), _probe(0.280)
     assert _marking_since_sensor([wake, probe], probe) < 0.0  # the LF still on the line
 
 
 def test_a_quiet_line_counts_from_the_reply() -> None:
-    wake, probe = _wake_up(late_third=False), _probe(0.230)
+    wake, probe = _wake_up("none"), _probe(0.230)
     assert abs(_marking_since_sensor([wake, probe], probe) - (0.230 - (0.104 + 3 * 0.00833))) < 1e-3
 
 
@@ -53,5 +55,13 @@ def test_characters_met_by_the_probe_count_when_begun_before_it() -> None:
     probe = Exchange(
         cmds.parse_command("0!"), "0!", [Attempt(None, sent, [], NO_REPLY, 0.35, 0, 0, met)]
     )
-    wake = _wake_up(late_third=False)
+    wake = _wake_up("none")
     assert _marking_since_sensor([wake, probe], probe) < 0.0
+
+
+def test_a_later_try_of_the_wake_up_ends_the_quiet() -> None:
+    """Behind ``--echo --jitter 2`` a third try went 73 ms before the probe, "115.94 ms after
+    a reply": the line's activity is the tool's command too, and the sensor answered it."""
+    wake, probe = _wake_up("silent"), _probe(0.2505)
+    third_end = wake.attempts[2].command_events[-1].end
+    assert abs(_marking_since_sensor([wake, probe], probe) - (0.2505 - third_end)) < 1e-9
