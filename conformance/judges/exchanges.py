@@ -83,7 +83,14 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
 
 
 def identification(ex: Exchange, address: str) -> tuple[Identification | None, list[Finding]]:
+    """R-4.4.2-01/-02 on ``aI!``. One answered only after its windows is no silence:
+    INCONCLUSIVE, its timing R-7.0-10's (replies-after-retry + parity-error behind an echoing
+    16 ms USB link: the late reply met the retry and was set aside as contention, and "aI! got
+    no reply" FAILed both rules, outside28)."""
     ids = ("R-4.4.2-01", "R-4.4.2-02")
+    if late := late_answer(ex):
+        why = f"{late} (R-7.0-10 judges its timing)"
+        return None, [inconclusive(rid, why, evidence=[cited(ex)]) for rid in ids]
     if why := unheard(ex):
         return None, [inconclusive(rid, why, evidence=[cited(ex)]) for rid in ids]
     if not ex.answered:

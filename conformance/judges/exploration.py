@@ -55,6 +55,8 @@ class Observation:
     #: repeat: a foreign measurement command sent since ``previous`` whose silence shows
     #: nothing (the sensor was seen to start its replies late): it may have been taken
     unheard: str = ""
+    #: repeat: the reply taken may be an earlier command's, late (``late_before.answered_late``)
+    late: str = ""
 
 
 @dataclass(frozen=True)
@@ -134,7 +136,11 @@ def _repeat(obs: Observation) -> Judgement:
     data. answers-old-address + replies-after-retry: 9M!, to the address the sensor had
     been moved from and still answers at, started a measurement whose reply, 80 ms late,
     the next break cut; D0 then read '0<CR><LF>' and R-4.4.5-10 FAILed (truth21)."""
-    if obs.previous is None or not holds_values(obs.previous):
+    if obs.previous is None or not holds_values(obs.previous) or obs.late:
+        # a reply taken that may be an earlier command's, late, is no read of D0 at all
+        # (replies-after-retry + parity-error behind an echoing 16 ms USB link: 0D1!'s
+        # late '0+12.50...' taken by the 0D0! after it FAILed "D0 gave ..., then ...",
+        # outside28)
         return Judgement(())
     checked = ("R-4.4.5-10",)
     if obs.reply == obs.previous:

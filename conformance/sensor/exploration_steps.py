@@ -12,6 +12,7 @@ from collections.abc import Callable
 from typing import ClassVar
 
 from ..judges.exploration import Observation, judge
+from ..judges.late_before import answered_late
 from ..protocol.commands import ADDRESS_CHARS
 from ..protocol.responses import split_line
 from ..tool_recorder.records import Exchange
@@ -106,11 +107,14 @@ class ExplorerSteps:
         if code.startswith("D"):
             self._observe(Observation("crc", ex.text, ex.reply_text))
         if code == "D0":
-            previous, unheard = self.last_d0, self.unheard
+            previous, unheard, late = self.last_d0, self.unheard, answered_late(ex)
             self._observe(
-                Observation("repeat", ex.text, ex.reply_text, previous=previous, unheard=unheard)
+                Observation(
+                    "repeat", ex.text, ex.reply_text, previous=previous, unheard=unheard, late=late
+                )
             )
-            self.last_d0, self.unheard = ex.reply_text, ""
+            if not late:  # a reply that may be an earlier command's is no D0 to compare with
+                self.last_d0, self.unheard = ex.reply_text, ""
 
     def _foreign(self, other: str, code: str) -> None:
         """A command to another address, sent the way the sensor was shown to hear."""

@@ -256,3 +256,53 @@ def test_r_7_1_02_reply_at_the_retry_may_be_the_first_d0s_late_reply() -> None:
 def test_r_7_1_02_a_retry_answered_in_time_is_the_retrys_and_still_fails() -> None:
     found = _r_7_1_02(0.009)
     assert found.verdict is Verdict.FAIL and "no reply" in found.detail, found.detail
+
+
+def test_r_4_4_2_01_identification_answered_after_the_retries_is_inconclusive() -> None:
+    """replies-after-retry + parity-error behind ``emulate --echo --usb-latency 16``: the
+    late '014CONFORM...' met the retry, was set aside as contention, and "aI! got no reply"
+    FAILed R-4.4.2-01/-02, which the sim's exact stamps never showed (outside28)."""
+    ex = _unanswered("0I!", "014CONFORM EMU001100SN0001\r\n")
+    ident, findings = xjudge.identification(ex, "0")
+    assert ident is None
+    for rid, found in _by_rule(findings).items():
+        assert found.verdict is Verdict.INCONCLUSIVE, (rid, found.detail)
+        assert "answered only after the reply window" in found.detail
+        assert "got no reply" not in found.detail
+
+
+def test_r_4_4_2_01_silent_identification_still_fails() -> None:
+    _, findings = xjudge.identification(_unanswered("0I!", ""), "0")
+    assert [f.verdict for f in findings] == [Verdict.FAIL, Verdict.FAIL]
+    assert all("aI! got no reply" in f.detail for f in findings)
+
+
+def _binary_findings(late: str) -> dict[str, Finding]:
+    """0HB! answered '0002033', its 0DB0! unanswered in three windows, ``late`` (if any) its
+    packet met by the retry; R-5.2-02 and R-5.2-07 as the binary data judge leaves them."""
+    from conformance.judges.measurements import data_violations
+    from conformance.judges.tally import Tally
+
+    start = _answered("0HB!", "0002033\r\n")
+    m = Measurement(start.command, start, ttt=2, count=33)
+    m.data.append(_unanswered("0DB0!", late, t=3.0))
+    tally = Tally(("R-5.2-02", "R-5.2-07"))
+    data_violations(m, tally)
+    return _by_rule(tally.findings())
+
+
+def test_r_5_2_02_binary_packet_after_the_retries_is_inconclusive() -> None:
+    """replies-after-retry + parity-error behind ``emulate --echo --usb-latency 16``: 0DB0!'s
+    packet came 80 ms late, met the retry and was set aside as contention; "no packet
+    returned for 0DB0!" FAILed R-5.2-02, where the sim's stamps left it INCONCLUSIVE
+    (outside28)."""
+    found = _binary_findings("0\x04\x00\x01\x00\x7f\x00\x7f#\x04")
+    assert found["R-5.2-02"].verdict is Verdict.INCONCLUSIVE, found["R-5.2-02"].detail
+    assert "answered only after the reply window" in found["R-5.2-02"].detail
+    assert found["R-5.2-07"].verdict is Verdict.INCONCLUSIVE, found["R-5.2-07"].detail
+
+
+def test_r_5_2_02_silent_binary_data_still_fails() -> None:
+    found = _binary_findings("")
+    assert found["R-5.2-02"].verdict is Verdict.FAIL
+    assert "no packet returned for 0DB0!" in found["R-5.2-02"].detail
