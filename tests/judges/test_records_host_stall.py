@@ -13,6 +13,8 @@ with the stall elsewhere, the judges FAIL or WARN as ever."""
 
 from __future__ import annotations
 
+import pytest
+
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
 from conformance.judges.exploration import Observation, held_findings
@@ -76,16 +78,6 @@ def _crc_cut(stalled: bool) -> Bus:
     return bus
 
 
-def test_a_crc_cut_by_a_stall_is_inconclusive():
-    found = _judged(_crc_cut(True), "R-4.4.12-02")["R-4.4.12-02"]
-    assert found.verdict is Verdict.INCONCLUSIVE
-    assert "lacks the 3-character CRC" in found.detail and WHY in found.detail
-
-
-def test_the_same_crc_missing_without_a_stall_fails():
-    assert _judged(_crc_cut(False), "R-4.4.12-02")["R-4.4.12-02"].verdict is Verdict.FAIL
-
-
 def _high_volume(stalled: bool) -> Bus:
     """aHA! for four values; D0's reply cut before its CRC, D1 whole."""
     bus = Bus()
@@ -95,14 +87,22 @@ def _high_volume(stalled: bool) -> Bus:
     return bus
 
 
-def test_a_high_volume_reply_cut_by_a_stall_is_inconclusive():
-    found = _judged(_high_volume(True), "R-5.1-03")["R-5.1-03"]
+#: a D reply whose CRC the cut took, after aMC! (R-4.4.12-02) and aHA! (R-5.1-03)
+CRC_CUTS = pytest.mark.parametrize(
+    ("build", "rid"), [(_crc_cut, "R-4.4.12-02"), (_high_volume, "R-5.1-03")]
+)
+
+
+@CRC_CUTS
+def test_a_crc_cut_by_a_stall_is_inconclusive(build, rid):
+    found = _judged(build(True), rid)[rid]
     assert found.verdict is Verdict.INCONCLUSIVE
-    assert WHY in found.detail
+    assert "lacks the 3-character CRC" in found.detail and WHY in found.detail
 
 
-def test_the_high_volume_reply_without_a_stall_fails():
-    assert _judged(_high_volume(False), "R-5.1-03")["R-5.1-03"].verdict is Verdict.FAIL
+@CRC_CUTS
+def test_the_same_crc_missing_without_a_stall_fails(build, rid):
+    assert _judged(build(False), rid)[rid].verdict is Verdict.FAIL
 
 
 def _values_cut(stalled: bool) -> Bus:
