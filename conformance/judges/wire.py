@@ -1055,7 +1055,7 @@ class Framing:
         self.own = own
         #: the tool's host stalls: a segment one may have held up is framed by stamps the
         #: host moved (a read cut, the rest a late burst), so a violation it shows is
-        #: INCONCLUSIVE with the stall named, never FAIL (:class:`~.tally.StalledTally`)
+        #: INCONCLUSIVE with the stall named, never FAIL (:class:`~.stalled.StalledTally`)
         self.stalls = stalls or []
         self.tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
         self.last_address: int | None = None
