@@ -55,15 +55,19 @@ def through_stall(tally: Tally, stall: Stall | None) -> Tally:
     return tally if stall is None else StalledTally(tally, stall.why())
 
 
-def unless_stalled(finding: Finding, exchanges: Iterable[Exchange]) -> Finding:
+def unless_stalled(
+    finding: Finding, exchanges: Iterable[Exchange], *, together: bool = False
+) -> Finding:
     """``finding``, or where it FAILs or WARNs and the reads of ``exchanges`` (those showing
     what it found) were all stalled, the same INCONCLUSIVE with the (first) stall named: for
     a judge that gives a finding of its own rather than a tally's. One read outside any
-    stall that shows it, and the finding stands."""
+    stall that shows it, and the finding stands. ``together``: what it found rests on the
+    reads together (values counted over several replies), so one stalled read undecides it."""
     if finding.verdict not in (Verdict.FAIL, Verdict.WARN):
         return finding
     stalls = [ex.stall for ex in exchanges]
-    if not stalls or None in stalls:
+    held = [stall for stall in stalls if stall is not None]
+    if not held or (len(held) < len(stalls) and not together):
         return finding
-    why = stalls[0].why() if stalls[0] is not None else ""
+    why = held[0].why()
     return replace(finding, verdict=Verdict.INCONCLUSIVE, detail=f"{finding.detail}, but {why}")

@@ -17,6 +17,7 @@ import pytest
 
 from conformance.judges import exchanges as xjudge
 from conformance.judges import measurements as judge
+from conformance.judges import metadata
 from conformance.judges.exploration import Observation, held_findings
 from conformance.judges.exploration import judge as explore_judge
 from conformance.links import host_stall
@@ -187,3 +188,28 @@ def test_the_exploration_s_breach_in_a_stalled_read_is_inconclusive():
     assert "does not end in CR LF" in found["R-4.2-03"].detail and WHY in found["R-4.2-03"].detail
     unstalled = Observation("framing", "0D0!", "0-5.00-3.75+", "0")
     assert explore_judge(unstalled).breach is not None
+
+
+def _one_exchange(command: str, reply: str, stalled: bool):
+    bus = Bus()
+    bus.exchange(command, reply, stalled=stalled)
+    info = LinkInfo(kind="transcript", can_break=True, timing_uncertainty=U)
+    link = RecordingLink(RecordingSpec("t.jsonl", "jsonl"), info, Transcript(bus.events), U)
+    (ex,) = sensor_records(link, bus_windows(link), "0").exchanges
+    return ex
+
+
+def test_a_metadata_record_cut_by_a_stall_is_inconclusive():
+    """wrong-crc under the pauses FAILed R-6.2-02 "0ICC_020!: reply '0,TW,' lacks the CRC"
+    and R-6.2.2-01 "reply '0,' has no units field": records cut by the pause."""
+    ids = ("R-6.2-01", "R-6.2-02", "R-6.2.2-01")
+    for stalled in (True, False):
+        ex = _one_exchange("0ICC_020!", "0,TW,", stalled)
+        found = {f.requirement: f for f in metadata.records([(ex, True, True)], ids)}
+        verdicts = {found[rid].verdict for rid in ids}
+        if stalled:
+            assert not verdicts & {Verdict.FAIL, Verdict.WARN}, found
+            assert found["R-6.2-02"].verdict is Verdict.INCONCLUSIVE
+            assert WHY in found["R-6.2-02"].detail
+        else:
+            assert Verdict.FAIL in verdicts
