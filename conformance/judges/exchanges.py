@@ -50,6 +50,7 @@ from .late_before import (
     late_shown,
 )
 from .measurements import shown_reply_ids, undecide_uncompared_crc
+from .stalled import through_stall, unless_stalled
 from .support import serves_continuous, text_instead_of_values
 from .tally import Tally
 from .wake_heard import unheard
@@ -68,17 +69,19 @@ def reply_only_address(ex: Exchange, expected: str, rid: str, what: str) -> Find
     if why := unheard(ex):
         return inconclusive(rid, f"{what}: {why}", evidence=[cited(ex)])
     if not ex.answered:
-        return failed(rid, f"{what}: no reply", evidence=[cited(ex)], observed=1)
+        no_reply = failed(rid, f"{what}: no reply", evidence=[cited(ex)], observed=1)
+        return unless_stalled(no_reply, [ex])
     body, framing = split_line(ex.reply_text)
     problems = [v for v in framing if v.requirement == "R-4.2-03"]
     problems += check_address_reply(body, expected, rid)
     if problems:
-        return failed(
+        wrong = failed(
             rid,
             f"{what}: " + "; ".join(v.message for v in problems),
             evidence=[cited(ex)],
             observed=1,
         )
+        return unless_stalled(wrong, [ex])
     return passed(rid, f"{what}: '{escape(ex.reply_text)}'", evidence=[shown(ex)], observed=1)
 
 
@@ -95,12 +98,15 @@ def identification(ex: Exchange, address: str) -> tuple[Identification | None, l
         return None, [inconclusive(rid, why, evidence=[cited(ex)]) for rid in ids]
     if not ex.answered:
         return None, [
-            failed(rid, "aI! got no reply", evidence=[cited(ex)], observed=1) for rid in ids
+            unless_stalled(failed(rid, "aI! got no reply", evidence=[cited(ex)], observed=1), [ex])
+            for rid in ids
         ]
     body, framing = split_line(ex.reply_text)
     ident = parse_ident(body, expected_address=address)
     tally = Tally(ids)
-    tally.observe(escape(ex.text), [v for v in ident.violations + framing if v.requirement in ids])
+    through_stall(tally, ex.stall).observe(
+        escape(ex.text), [v for v in ident.violations + framing if v.requirement in ids]
+    )
     ok = {
         "R-4.4.2-01": f"fields: version '{ident.version}', vendor '{escape(ident.vendor)}', "
         f"model '{escape(ident.model)}', sensor version "
@@ -248,6 +254,13 @@ def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     return True
 
 
+def _stalled(ex: Exchange, first_attempt: bool = False) -> str:
+    """``0M!: the tool's host stalled 150 ms during this read`` where it stalled over the read
+    of the try judged (the first, with ``first_attempt``): a silence it explains; else ''."""
+    stall = ex.attempts[0].stall if first_attempt else ex.stall
+    return f"{escape(ex.text)}: {stall.why()}" if stall is not None else ""
+
+
 def first_answered_late(ex: Exchange) -> str:
     """What may be the first transmission's late reply ('' if nothing): the first try went
     unanswered and either the retries met DUT characters (:func:`late_reply`) or the retry's
@@ -324,11 +337,14 @@ def answered(
     # silence to tries none of which the sensor was awake to hear is no evidence; a rule on
     # the first transmission is about that wake-up itself
     deaf = [ex for ex in missing if ex not in late and not first_attempt and unheard(ex)]
+    # and silence to the try judged whose read the host stalled over is the host's (truth27)
+    read: dict[int, str] = {id(ex): _stalled(ex, first_attempt) for ex in missing}
+    deaf += [ex for ex in missing if ex not in late and ex not in deaf and read[id(ex)]]
     missing = [ex for ex in missing if ex not in late and ex not in deaf]
     if deaf and not missing:
         return inconclusive(
             rid,
-            "; ".join(unheard(e) for e in deaf[:3]),
+            "; ".join(unheard(e) or read[id(e)] for e in deaf[:3]),
             evidence=cite(deaf),
             observed=len(deaf),
         )
@@ -382,14 +398,15 @@ def continuous(
             if undecided_if_late(tally, ex, ["R-4.4.8.1-01", crc_rule, *empty_rule]):
                 unread += bool(empty_rule)
                 continue
+            here = through_stall(tally, ex.stall)  # what a stalled read shows is undecided
             if not ex.answered or ex.command is None:
-                tally.fail("R-4.4.8.1-01", label, f"{label} got no reply")
+                here.fail("R-4.4.8.1-01", label, f"{label} got no reply")
                 continue
             crc = ex.command.crc
             if text_instead_of_values(ex, crc):
                 # no values and no CRC to judge: only the empty-reply rule speaks
                 unsupported += 1
-                tally.fail(
+                here.fail(
                     "R-4.4.8.1-03",
                     label,
                     f"unsupported {label} answered '{escape(ex.reply_text)}' (text, not "
@@ -399,7 +416,7 @@ def continuous(
             body, framing = split_line(ex.reply_text, crc_positions=3 if crc else 0)
             reply = parse_data_reply_for(body, ex.command, expected_address=ex.command.address)
             ids_here = [i for i in shown_reply_ids(ex.command, reply) if i != "R-4.4.8-01"]
-            tally.observe(
+            here.observe(
                 label,
                 framing + [v for v in reply.violations if v.requirement != "R-4.4.8-01"],
                 ids=ids_here + ["R-4.4.8.1-01"],
@@ -411,13 +428,13 @@ def continuous(
                 tally.observe(label, ids=["R-4.4.8.1-03"])
                 expected = 1 + (3 if crc else 0)
                 if len(body) != expected:  # its CRC's value is R-4.4.12-05's business
-                    tally.fail(
+                    here.fail(
                         "R-4.4.8.1-03",
                         label,
                         f"unsupported {label} answered '{escape(ex.reply_text)}', not "
                         f"'a{'<CRC>' if crc else ''}<CR><LF>'",
                     )
-            tally.observe(
+            here.observe(
                 label,
                 check_data_sequence([reply], len(reply.values), VALUES_MAX),
                 ids=["R-4.4.8.3-01"] if "R-4.4.8.3-01" in tally.ids else [],

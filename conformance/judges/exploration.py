@@ -18,6 +18,7 @@ from ..protocol.crc import is_crc_char
 from ..protocol.responses import holds_values, parse_data_reply, split_line
 from ..transcript import escape
 from ..verdicts import Finding, failed, inconclusive, passed
+from .cite import listed
 from .measurements import uncompared_crc
 
 #: The requirements the exploration judges, in the order their findings are reported.
@@ -57,6 +58,9 @@ class Observation:
     unheard: str = ""
     #: repeat: the reply taken may be an earlier command's, late (``late_before.answered_late``)
     late: str = ""
+    #: the reply's read was held up by a stall of the tool's own host (its
+    #: :meth:`~conformance.links.host_stall.Stall.why`): what it shows may be the host's
+    stalled: str = ""
 
 
 @dataclass(frozen=True)
@@ -73,6 +77,10 @@ class Judgement:
 
     checked: tuple[str, ...]
     breach: Breach | None = None
+    #: what would have been a breach, seen in a read the tool's host stalled over: the rule
+    #: is INCONCLUSIVE for it (unless another observation breaks it), and the exploration
+    #: goes on (truth27: a clean emulator FAILed R-4.2-03 on a reply the pause cut)
+    undecided: Breach | None = None
 
 
 def _foreign(obs: Observation) -> Judgement:
@@ -178,7 +186,12 @@ def judge(obs: Observation) -> Judgement:
     if judged is None:
         if len(_JUDGED) >= JUDGED_MAX:
             _JUDGED.clear()
-        judged = _JUDGED[obs] = _JUDGES[obs.check](obs)
+        judged = _JUDGES[obs.check](obs)
+        if obs.stalled and judged.breach is not None:
+            b = judged.breach
+            held = Breach(b.requirement, f"{b.message}, but {obs.stalled}")
+            judged = Judgement((), undecided=held)
+        _JUDGED[obs] = judged
     return judged
 
 
@@ -219,11 +232,18 @@ def held_findings(observations: Sequence[Observation], steps: int) -> list[Findi
     step exercised (the broken one has its FAIL from :func:`broken_finding`)."""
     breach = first_breach(observations)
     counted = checks(observations)
+    undecided: dict[str, list[str]] = {}
+    for obs in observations:
+        if (held := judge(obs).undecided) is not None:
+            undecided.setdefault(held.requirement, []).append(held.message)
     out: list[Finding] = []
     for rid in IDS:
         if breach is not None and rid == breach.requirement:
             continue
-        if counted[rid]:
+        if rid in undecided:  # never a PASS beside what a stalled read may have hidden
+            said = undecided[rid]
+            out.append(inconclusive(rid, listed(said), observed=counted[rid] + len(said)))
+        elif counted[rid]:
             detail = f"held over {counted[rid]} checks in {steps} random steps"
             out.append(passed(rid, detail, observed=counted[rid], partial=rid in PARTIAL))
         else:

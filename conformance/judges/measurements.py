@@ -33,6 +33,7 @@ from .late_before import (
     service_request_too_late,
     service_request_too_soon,
 )
+from .stalled import through_stall
 from .support import text_instead_of_start, text_instead_of_values, unreadable_count
 from .tally import Tally
 from .wake_heard import unheard
@@ -231,27 +232,35 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
     replies: list[DataReply] = []
     limit = expected_value_limit(m.command)
     silent = late = too_soon = None
+    whole = tally  # the tally of the values as a whole, seen through their reads' stalls
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
+        # a reply the host stalled over may be cut, its rest taken for a retry's: what its
+        # read shows is undecided, never FAIL (truth27), and so is what the values as a
+        # whole show with it among them (their count, a value's split or room)
+        here = through_stall(tally, ex.stall)
+        if whole is tally:
+            whole = here
         if how := _not_this_ds_reply(m, ex, tally, dlabel):
             silent = late = ex
             too_soon = ex if how == "soon" else too_soon
             break
         if not ex.answered:
-            tally.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
+            here.fail("R-4.4.8-01", dlabel, f"no reply to {where(ex)}")
             if m.command.kind is Kind.HIGH_VOLUME_ASCII:
-                tally.fail("R-5.1-02", dlabel, f"no reply to {where(ex)} after aHA!")
+                here.fail("R-5.1-02", dlabel, f"no reply to {where(ex)} after aHA!")
             silent = ex
             break
         body, framing, reply = _read_data_reply(ex.reply_text, m.command)
-        tally.observe(dlabel, framing + reply.violations, ids=shown_reply_ids(m.command, reply))
+        here.observe(dlabel, framing + reply.violations, ids=shown_reply_ids(m.command, reply))
         if reply.crc and not reply.crc_ok:
             undecide_uncompared_crc(reply, tally, dlabel)
         replies.append(reply)
         if _refuses_high_index(m, ex):
             # (seed 4090) 'aUNKN' to aD10! is the sensor saying it does not serve the index:
             # as silence there is (high-volume-stops-at-d9 + unknown-command-text PASSed)
-            tally.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
+            here.fail("R-5.1-02", dlabel, f"{where(ex)} after aHA! answered '{escape(body)}'")
+    tally = whole
     seq = check_data_sequence(replies, m.count, limit)
     if late is not None:  # the count was cut at a late reply, not at silence
         seq = [v for v in seq if v.requirement != "R-4.4.8-03"]
@@ -486,6 +495,7 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
     total = 0
     ids = ["R-5.2-02", "R-5.2-03", "R-5.2-04", "R-5.2-05", "R-5.2.1-01", "R-4.1-03"]
     countable = True
+    whole = tally  # seen through the first stall over a packet's read (as ASCII data's)
     for ex in m.data:
         dlabel = f"{label} {where(ex)}"
         if late := late_answer(ex):
@@ -496,6 +506,9 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
             for rid in ("R-5.2-02", "R-5.2-07"):
                 tally.undecide(rid, dlabel, f"{late} (R-7.0-10 judges its timing)")
             return
+        here = through_stall(tally, ex.stall)
+        if whole is tally:
+            whole = here
         if not ex.answered:
             if not countable:
                 # (seed 4088) read on past a packet whose values could not be counted, so
@@ -508,13 +521,13 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
                     " before it could not be counted",
                 )
             elif total < m.count:
-                tally.fail("R-5.2-02", dlabel, f"no packet returned for {where(ex)}")
+                here.fail("R-5.2-02", dlabel, f"no packet returned for {where(ex)}")
             return
         packet = parse_binary_packet(ex.reply_bytes, expected_address=m.command.address)
         if packet.payload_known:
-            tally.observe(dlabel, packet.violations, ids=ids)
+            here.observe(dlabel, packet.violations, ids=ids)
         else:
-            tally.observe(dlabel, packet.violations, ids=[i for i in ids if i != "R-5.2-05"])
+            here.observe(dlabel, packet.violations, ids=[i for i in ids if i != "R-5.2-05"])
             tally.undecide(
                 "R-5.2-05",
                 dlabel,
@@ -534,9 +547,9 @@ def _binary_violations(m: Measurement, tally: Tally) -> None:
                 rid, label, f"no packet held a payload of the {m.count} values announced"
             )
     if countable:
-        tally.observe(label, ids=["R-5.2-07"])
+        whole.observe(label, ids=["R-5.2-07"])
         if total != m.count:
-            tally.fail("R-5.2-07", label, f"packets held {total} values for {m.count} announced")
+            whole.fail("R-5.2-07", label, f"packets held {total} values for {m.count} announced")
 
 
 def judge(
@@ -613,7 +626,7 @@ class Measurements:
             # late beside replies-after-retry: R-4.4.7-01 PASSed "2 checked: 0C!, 0CC!")
             for rid in _reply_ids(m):
                 tally.undecide(rid, where(m), f"{late} (R-7.0-10 judges its timing)")
-        tally.observe(
+        through_stall(tally, m.start.stall).observe(
             where(m),
             reply_violations(m, self.version),
             ids=[i for i in _reply_ids(m) if m.start.answered],

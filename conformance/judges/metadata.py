@@ -10,6 +10,7 @@ from ..transcript import escape
 from ..verdicts import Finding, inconclusive
 from .cite import cite, listed, shown
 from .exchanges import answered_late, undecided_if_late
+from .stalled import through_stall
 from .tally import Tally
 
 SHORT_ID = re.compile(r"[A-Za-z0-9_.+\-/ ]{1,8}")  # R-6.2.1-01: SHEF code or a short identifier
@@ -35,15 +36,17 @@ def identify_matches(pairs: list[tuple[Exchange, Measurement]]) -> list[Finding]
         pb = parse_measurement_reply_for(b, m.command)
         if pb.violations:
             continue  # the measurement's own reply is malformed: its rule judges that
-        tally.observe(label)
+        # either read stalled over by the tool's host: what the two show is undecided
+        here = through_stall(tally, ident.stall or m.start.stall)
+        here.observe(label)
         if pa.violations or len(a) != len(b):
-            tally.fail(
+            here.fail(
                 "R-6.1-02", label, f"'{escape(a)}' is not shaped like {m.command}'s '{escape(b)}'"
             )
         elif pa.count != pb.count:
-            tally.fail("R-6.1-02", label, f"announces {pa.count} values, {m.command} {pb.count}")
+            here.fail("R-6.1-02", label, f"announces {pa.count} values, {m.command} {pb.count}")
         elif pa.ttt != pb.ttt:
-            tally.fail(
+            here.fail(
                 "R-6.1-02", label, f"ttt {pa.ttt} differs from {m.command}'s {pb.ttt}", warning=True
             )
     return tally.findings("same reply as the measurement command")
@@ -94,15 +97,16 @@ def records(
     None: inside a count only the identify reply announced (its measurement gave none), where
     a missing record may as well be that count's fault (R-6.1-02, which has no measurement
     reply to compare it with): R-6.2-07 is INCONCLUSIVE there, never FAIL."""
-    tally = Tally(ids)
+    whole = Tally(ids)  # ``tally``: the same, seen through each record's read (a stall)
     unconfirmed: list[Exchange] = []
     for ex, crc, valid in exchanges:
         label = escape(ex.text)
         count_rule = [] if valid is None else ["R-6.2-07" if valid else "R-6.2-05"]
-        if undecided_if_late(tally, ex, ["R-6.2-01", *count_rule]):
+        if undecided_if_late(whole, ex, ["R-6.2-01", *count_rule]):
             if valid is None:
                 unconfirmed.append(ex)
             continue
+        tally = through_stall(whole, ex.stall)  # what a stalled read shows is undecided
         if not ex.answered:
             if valid is None:
                 unconfirmed.append(ex)
@@ -149,7 +153,7 @@ def records(
                     f"invalid index answered '{escape(body)}' instead "
                     f"of 'a{'<CRC>' if crc else ''}<CR><LF>'",
                 )
-    return tally.findings() + _unconfirmed(unconfirmed, ids)
+    return whole.findings() + _unconfirmed(unconfirmed, ids)
 
 
 def _unconfirmed(missing: list[Exchange], ids: tuple[str, ...]) -> list[Finding]:

@@ -27,12 +27,12 @@ from ..protocol.timing import (
     RESPONSE_START_MIN,
     TOLERANCE,
 )
-from ..protocol.values import Violation
 from ..tool_recorder.validity import fits_shape
 from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_bytes
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, Segments, frames, runs, segments
 from ..view.sides import expected_reply_address
+from .stalled import through_stall
 from .tally import Tally
 from .timing import (
     Measured,
@@ -1055,7 +1055,7 @@ class Framing:
         self.own = own
         #: the tool's host stalls: a segment one may have held up is framed by stamps the
         #: host moved (a read cut, the rest a late burst), so a violation it shows is
-        #: INCONCLUSIVE with the stall named, never FAIL (:class:`_StalledTally`)
+        #: INCONCLUSIVE with the stall named, never FAIL (:class:`~.stalled.StalledTally`)
         self.stalls = stalls or []
         self.tally = Tally(("R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"))
         self.last_address: int | None = None
@@ -1087,13 +1087,12 @@ class Framing:
 
     def _judge(self, seg: Segment, *, cut: bool) -> None:
         """One segment; ``cut``: the next transmission's contention met what followed it."""
-        tally: Tally | _StalledTally = self.tally
+        tally = self.tally
         if self.stalls:
             heard = seg.later or seg.reply or seg.contention
             end = heard[-1].end if heard else seg.command_end
-            stall = stalled_over(self.stalls, (seg.break_event or seg.command[0]).start, end)
-            if stall is not None:
-                tally = _StalledTally(self.tally, stall.why())
+            start = (seg.break_event or seg.command[0]).start
+            tally = through_stall(tally, stalled_over(self.stalls, start, end))
         earlier, self._before = _unanswered_before(self._before, seg), seg
         if seg.reply:
             self.last_address = last_address = seg.reply[0].char7
@@ -1173,43 +1172,6 @@ class Framing:
         if still_open and not (seg.reply or seg.later or seg.contention):
             self._open_text = True  # a silent command: the text may still go on after it
         return hidden
-
-
-#: the framing rules a stall of the tool's host may break for a sensor that kept them: the
-#: split of its characters into a reply and later lines follows stamps the stall moved
-#: (R-4.2-03, R-4.3-01), and a binary packet's rest split off by it is read as 7E1 text
-#: (R-4.1-02, R-4.2-02: under 80-200 ms pauses "later, after 0DB7!: 2 character(s) with
-#: wrong parity" for a clean emulator)
-_SPLIT_RULES = frozenset({"R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01"})
-
-
-class _StalledTally:
-    """A :class:`Tally` for a segment the tool's host stalled over: a violation of a rule in
-    :data:`_SPLIT_RULES` leaves the rule undecided with the stall named (the host, not the
-    DUT, may have cut the read: truth26, a clean emulator FAILed "does not end in CR LF" and
-    "later, after 0D1!: ... not the address" under 80-200 ms pauses); everything else, and
-    what conforms, is the tally's as ever."""
-
-    def __init__(self, tally: Tally, why: str) -> None:
-        self.tally = tally
-        self.why = why
-
-    def observe(
-        self, where: str, violations: Iterable[Violation] = (), ids: Iterable[str] | None = None
-    ) -> None:
-        kept = []
-        for v in violations:
-            if v.requirement in _SPLIT_RULES:
-                self.tally.undecide(v.requirement, where, f"{v.message}, but {self.why}")
-            else:
-                kept.append(v)
-        self.tally.observe(where, kept, ids)
-
-    def fail(self, rid: str, where: str, message: str, *, warning: bool = False) -> None:
-        self.observe(where, [Violation(rid, message, warning)], ids=[rid])
-
-    def __getattr__(self, name: str):
-        return getattr(self.tally, name)
 
 
 def _packet_late(tally: Tally, seg: Segment, earlier: Segment | None, uncertainty: float) -> bool:

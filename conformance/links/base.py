@@ -148,6 +148,10 @@ class BusEnd(ABC):
         """The tail of what a harness program wrote to stderr; None without a harness."""
         return None
 
+    def reader_caught_up(self) -> None:  # noqa: B027 - only a link with a reader thread
+        """Return once whatever this bus end has to note of its own host's stalls is in its
+        transcript (:mod:`.host_stall`): a stimulus's records are marked from those notes."""
+
     def check_records(self, cases: list[CaseRecord]) -> None:  # noqa: B027 - optional
         """Vouch for the records before the verdicts are drawn (a harness, whose answers
         could have fallen out of step, checks them at the end); raises LinkError if not."""

@@ -49,6 +49,9 @@ ECHO_WAIT_AUTO = 0.1  # s: the same while auto has not decided (a silent DUT cos
 BURST_MARGIN = 0.5e-3  # s: arrivals this much closer than latency jitter explains are a burst
 RELEASE_MARGIN = 0.2e-3  # s: after the last stop bit before the driver is released
 RELEASE_WAIT = 0.5  # s: longest wait for the timer thread's release
+#: s: the longest a stimulus waits for an overdue reader thread to note a stall (it resumes with
+#: the rest of the process; a reader still not back after this is not held up by a stall)
+CATCH_UP = 0.25
 TURNAROUND_LIMIT = RESPONSE_START_MIN / 2  # s: a later release may swallow a reply's start
 
 
@@ -105,6 +108,8 @@ class SerialLink(Link):
         self.echo = EchoTracker(echo)
         self.meter.echo = self.echo.echoes
         self._switch_interval = quick_gil_handover()
+        #: when the reader thread last finished a turn (perf_counter ns), its stall noted
+        self._reader_back = time.perf_counter_ns()
         self._reader = threading.Thread(target=self._read_loop, name=f"sdi12-rx {self.name}")
         self._reader.daemon = True
         self._reader.start()
@@ -160,6 +165,7 @@ class SerialLink(Link):
                 if 0 < overrun < 10 * READ_POLL:
                     self.meter.reader_lag.add(overrun, "idle read")
                 self._host_stalled(stall, arrival)
+                self._reader_back = arrival
                 continue
             stamps = self._tape.take(len(data)) if self._tape is not None else None
             if stamps is not None:
@@ -168,6 +174,21 @@ class SerialLink(Link):
             else:
                 self._arrived(data, self._stamp(arrival))
             self._host_stalled(stall, arrival)
+            self._reader_back = arrival
+
+    def reader_caught_up(self) -> None:
+        """Wait, where the reader thread is overdue (no turn of it finished within its read's
+        timeout and :data:`~.host_stall.STALL_MIN`: the process was held up and the reader
+        has not run since), until it is back, its note of the stall written. After a pause
+        every thread resumes together, and the engine's read, cut by it, may hand its record
+        over before the reader has said the host stalled (truth27). Not overdue: no wait; at
+        most :data:`CATCH_UP` s."""
+        overdue = int((READ_POLL + STALL_MIN) * 1e9)
+        deadline = time.perf_counter_ns() + int(CATCH_UP * 1e9)
+        while self._reader.is_alive() and time.perf_counter_ns() - self._reader_back > overdue:
+            if time.perf_counter_ns() > deadline:
+                return
+            time.sleep(0.001)
 
     def _host_stalled(self, stall: float, arrival: int) -> None:
         """Note a stall of the tool's own host (:mod:`.host_stall`) of ``stall`` s that

@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING
 from ..event_store import BLOCK, CHUNK, Column, CompactEvents
 from ..judges.timing import StampUncertainty
 from ..judges.wire import Framing, ReplyBitRate, ReplyGaps, ResponseStarts
+from ..links import host_stall
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
 from ..protocol.values import split_values
 from ..tool_recorder import validity
@@ -337,13 +338,17 @@ class SensorRecords:
 def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) -> SensorRecords:
     """The sensor pass for ``address`` (None: every sensor together)."""
     u, stamps = link.uncertainty, stamp_uncertainty_of(link)
+    # the tool's host stalls a run of this tool noted (a capture has none): the framing and
+    # every record whose read one may have held up are read as the live run reads them
+    stalls = host_stall.stalls_since(link.transcript.events, 0)
     starts, gaps = ResponseStarts(stamps), ReplyGaps(stamps)
-    rate, framing = ReplyBitRate(stamps), Framing(stamps)
+    rate, framing = ReplyBitRate(stamps), Framing(stamps, stalls=stalls)
     disturbed, carried = Disturbances(), {}
     exchanges: list[Exchange] = []
     measurements: list[Measurement] = []
     for view in bus.read(address, disturbed.waiting):
         rebuilt = rebuild_records(view, uncertainty=u, only=address, carried=carried)
+        host_stall.mark_reads(rebuilt.exchanges, stalls)
         disturbed.add(view, rebuilt.measurements)
         segs = [Segment.of(t) for t in view.transmissions if address in (None, t.text[:1])]
         for fold in (starts, gaps, rate, framing):

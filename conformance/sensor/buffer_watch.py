@@ -9,10 +9,11 @@ explicitly; this watch lets the session say "already filled" without sending any
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from ..judges.late_before import late_among
+from ..links import host_stall
 from ..links.base import Link
 from ..protocol.commands import Command, Kind
 from ..protocol.framing import LF
@@ -65,15 +66,30 @@ class WatchedToolRecorder(ToolRecorder):
 
     def transact(self, command: Command | str, **kw: Any) -> Exchange:
         """The engine's exchange, linked to the one before it where that may have answered
-        late (:meth:`_link_late_before`); measurements' starts and D reads come here too."""
+        late (:meth:`_link_late_before`), its reads marked where the host stalled over them
+        (:meth:`mark_stalls`); measurements' starts and D reads come here too."""
         before, seen = self.last_exchange, self.watch.late.start is not None
+        first = len(self.link.transcript.events)
         ex = self._hear_late_reply(super().transact(command, **kw))
+        self.mark_stalls([ex], first)
         return self._link_late_before(before, ex, seen)
 
     def raw(self, text: str | bytes, **kw: Any) -> Exchange:
-        """The engine's one-shot exchange, linked as :meth:`transact`'s are."""
+        """The engine's one-shot exchange, linked and marked as :meth:`transact`'s are."""
         before, seen = self.last_exchange, self.watch.late.start is not None
-        return self._link_late_before(before, super().raw(text, **kw), seen)
+        first = len(self.link.transcript.events)
+        ex = super().raw(text, **kw)
+        self.mark_stalls([ex], first)
+        return self._link_late_before(before, ex, seen)
+
+    def mark_stalls(self, exchanges: Iterable[Exchange | None], first: int) -> None:
+        """Mark the attempts of ``exchanges`` whose reads a stall of the tool's own host may
+        have held up (:func:`~conformance.links.host_stall.mark_reads`), from the link's
+        notes since its transcript's event ``first`` (the stimulus began there), once the
+        link has noted what it had to (its reader thread resumes with the engine)."""
+        self.link.reader_caught_up()
+        found = host_stall.stalls_since(self.link.transcript.events, first)
+        host_stall.mark_reads(exchanges, found)
 
     def _hear_late_reply(self, ex: Exchange) -> Exchange:
         """Where every try of ``ex`` went unanswered in its window and the sensor has been

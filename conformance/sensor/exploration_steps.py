@@ -104,17 +104,26 @@ class ExplorerSteps:
         if code in ("C", "CC"):
             self._wait_out(ex)
         self._observe_framing(ex)
+        stalled = _stalled(ex)
         if code.startswith("D"):
-            self._observe(Observation("crc", ex.text, ex.reply_text))
+            self._observe(Observation("crc", ex.text, ex.reply_text, stalled=stalled))
         if code == "D0":
             previous, unheard, late = self.last_d0, self.unheard, answered_late(ex)
             self._observe(
                 Observation(
-                    "repeat", ex.text, ex.reply_text, previous=previous, unheard=unheard, late=late
+                    "repeat",
+                    ex.text,
+                    ex.reply_text,
+                    previous=previous,
+                    unheard=unheard,
+                    late=late,
+                    stalled=stalled,
                 )
             )
             if not late:  # a reply that may be an earlier command's is no D0 to compare with
-                self.last_d0, self.unheard = ex.reply_text, ""
+                # a reply the host stalled over may be cut: no D0 to hold the next one to
+                self.last_d0 = None if stalled else ex.reply_text
+                self.unheard = ""
 
     def _foreign(self, other: str, code: str) -> None:
         """A command to another address, sent the way the sensor was shown to hear."""
@@ -133,6 +142,7 @@ class ExplorerSteps:
                 answered=ex.answered,
                 marked=marked,
                 collided=ex.maybe_collided,
+                stalled=_stalled(ex),
             )
         )
 
@@ -168,7 +178,9 @@ class ExplorerSteps:
         self._note(f"taken as a change to address '{moved}' (decision A12); {note}")
 
     def _observe_framing(self, ex: Exchange) -> None:
-        self._observe(Observation("framing", ex.text, ex.reply_text, self.address))
+        self._observe(
+            Observation("framing", ex.text, ex.reply_text, self.address, stalled=_stalled(ex))
+        )
 
     def step(self, name: str, arguments: dict[str, object]) -> None:
         """Send one step drawn for the rule ``name`` (:func:`_with_rules`)."""
@@ -308,3 +320,9 @@ def _run_example(
     finally:
         made.teardown()
     return None
+
+
+def _stalled(ex: Exchange) -> str:
+    """Why what ``ex``'s reply shows may be the host's: its read was held up by a stall of the
+    tool's own host (:attr:`~conformance.tool_recorder.records.Exchange.stall`); else ''."""
+    return ex.stall.why() if ex.stall is not None else ""

@@ -494,8 +494,13 @@ class SensorSession(Session):
         policy, uncertainty = self.master.policy, self.uncertainty
         if shared is None:
             view = read_view(transcript.since(mark.first))
-            return rebuild_records(view, policy, uncertainty=uncertainty)
-        return records_of(shared, policy, uncertainty=uncertainty)
+            rebuilt = rebuild_records(view, policy, uncertainty=uncertainty)
+        else:
+            rebuilt = records_of(shared, policy, uncertainty=uncertainty)
+        # reads the host stalled over, as the engine's own records are marked (the same
+        # notes: the engine has waited for the link to write them)
+        self.master.mark_stalls(rebuilt.exchanges, mark.first)
+        return rebuilt
 
     def _as_seen(self, made: R, seen: R | None) -> R:
         """The view's record of a stimulus, which the cases judge, so a live run's verdicts

@@ -8,11 +8,15 @@ the records alone, and so that a misbehaving sensor leaves evidence instead of a
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from ..protocol.commands import Command, Kind
 from ..protocol.values import split_values
 from ..transcript import Event, decode_7e1, decode_8n1
 from .validity import data_values_text, packet_value_count, salvaged_values_text
+
+if TYPE_CHECKING:
+    from ..links.host_stall import Stall
 
 # Reasons an attempt ended. "invalid: <why>" carries the engine's own (loose) reason.
 #: the kinds records are asked about, as module constants: a member read off the enum goes through
@@ -47,6 +51,10 @@ class Attempt:
     sequence: int = 0
     retry: int = 0
     stray_events: list[Event] = field(default_factory=list)
+    #: a stall of the tool's own host that may have held up this attempt's read (its reply
+    #: cut, its rest a late burst): set from the transcript's notes by
+    #: :func:`~conformance.links.host_stall.mark_reads`, None where none was noted
+    stall: Stall | None = field(default=None, repr=False, compare=False)
 
     @property
     def ok(self) -> bool:
@@ -153,6 +161,12 @@ class Exchange:
     @property
     def reply_events(self) -> list[Event]:
         return self.judged.reply_events
+
+    @property
+    def stall(self) -> Stall | None:
+        """The host stall that may have held up the read of the reply judged (:attr:`judged`):
+        what it shows may be the host's doing, not the DUT's (truth27)."""
+        return self.judged.stall
 
     @property
     def reply_text(self) -> str:

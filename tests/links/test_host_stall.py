@@ -110,3 +110,28 @@ def test_the_stalls_are_read_back_from_the_notes_alone():
     assert found[1].overlaps(2.8, 2.9) and not found[1].overlaps(2.0, 2.5)
     assert host_stall.stalled_over(found, 2.8, 2.9) is found[1]
     assert host_stall.stalls(events[1:2]) == []
+
+
+@pytest.mark.realtime  # the reader is held up by wall-clock time
+def test_a_stimulus_waits_for_an_overdue_reader_to_note_its_stall():
+    """After a pause every thread resumes together: the engine may hand over a record its
+    read cut before the reader has said the host stalled (truth27). ``reader_caught_up``
+    waits for an overdue reader (here held 150 ms in its read), so the note is in the
+    transcript when the stimulus's records are marked from it; a reader on time costs
+    nothing."""
+    burst = bytes(to_wire_7e1(ord(c)) for c in "0+1.5\r\n")
+    port = _PausedPort(burst, 0.15)
+    info = LinkInfo(kind="serial", can_break=False, timing_uncertainty=2.5e-3)
+    link = SerialLink(port, info, None, echo=EchoMode.OFF)  # type: ignore[arg-type]
+    try:
+        time.sleep(3 * READ_POLL)
+        begun = time.perf_counter()
+        link.reader_caught_up()  # on time: at once
+        assert time.perf_counter() - begun < 0.01
+        port.release.set()
+        time.sleep(READ_POLL + 0.08)  # the reader is overdue now, its note not written
+        assert not host_stall.stalls(link.transcript.events)
+        link.reader_caught_up()
+        assert host_stall.stalls(link.transcript.events)
+    finally:
+        link.close()
