@@ -44,6 +44,18 @@ from .suite import suite_args
 
 T = TypeVar("T")
 
+#: pytest's plugins a batch's session blocks beyond the suite's own
+#: (:data:`conformance.suite.UNUSED_PYTEST_PLUGINS`): ``skipping`` acts only on a case
+#: marked ``skip``, ``skipif`` or ``xfail`` or calling ``pytest.xfail``, which no case of the
+#: suite is (a session whose cases carry such a mark judges no run: each is a session of its
+#: own, :func:`conformance.many_runs_plugin.pytest_runtestloop`); kept, it evaluated those
+#: marks and wrapped each phase of each case (~3 hook calls a case, 62 cases a run). A run
+#: of one's own (the CLI, ``pytest --pyargs testcases``) keeps it.
+BATCH_BLOCKED = ("skipping",)
+
+#: the marks ``skipping`` acts on: a case carrying one is judged in a session of its own
+SKIPPING_MARKS = ("skip", "skipif", "xfail")
+
 
 class Server(Protocol):
     """The session judging runs (:class:`conformance.many_runs_plugin.ManyRuns`)."""
@@ -147,7 +159,8 @@ def judged_in_one_session(work: Callable[[], T], role: str = "sensor") -> T:
         given = GivenOptions(RunOptions(port="sim", role=role, report_dir=tmp))
         given.files = ()
         args = suite_args(f"testcases.{role}", Path(tmp), html=False)
-        pytest.main([*args, "-p", "conformance.many_runs_plugin"], plugins=[batch, given])
+        blocked = [arg for name in BATCH_BLOCKED for arg in ("-p", f"no:{name}")]
+        pytest.main([*args, *blocked, "-p", "conformance.many_runs_plugin"], plugins=[batch, given])
     if batch.error is not None:
         raise batch.error
     if not batch.started:

@@ -6,6 +6,7 @@ says how a run is reset and ended)."""
 from __future__ import annotations
 
 import traceback
+from contextlib import AbstractContextManager, nullcontext
 from copy import deepcopy
 from dataclasses import replace
 from types import TracebackType
@@ -33,6 +34,8 @@ def pytest_runtestloop(session: pytest.Session) -> bool | None:
     selection = deepcopy(plugin.run_of(config).selection)
     plugin.release_report_folder(config)
     plugin.detach_run(config)  # the template run: never run, the items' records dropped
+    if any(item.get_closest_marker(m) for item in session.items for m in many_runs.SKIPPING_MARKS):
+        return True  # not judged here (many_runs.BATCH_BLOCKED): the work runs as it is
     batch.run(ManyRuns(session, given.options, selection))
     return True
 
@@ -114,14 +117,42 @@ class ManyRuns:
 
 def _run_items(session: pytest.Session) -> int:
     """pytest's run-test loop over the session's items and the exit status pytest's session
-    would have ended with."""
+    would have ended with, the run's warnings caught as its cases' are (:func:`_warnings`)."""
+    config = session.config
+    caught = config.pluginmanager.get_plugin("warnings")
+    with _warnings(config, caught):
+        return _run_protocols(session, caught)
+
+
+def _warnings(config: pytest.Config, caught: object | None) -> AbstractContextManager[None]:
+    """pytest's warnings plugin's catch around each case (its filters: the suite's
+    ``filterwarnings``, ``-W``, pytest's deprecations as errors, each warning recorded to
+    ``pytest_warning_recorded``) taken once around a whole run: the same filters over the
+    same cases (no case carries a ``filterwarnings`` mark, and nothing of the suite changes
+    a filter), a warning recorded with the run's empty node id rather than its case's
+    (recorded to no reader: a batch's session has no terminal and no report files), and
+    ~2 hook calls and a ``warnings.catch_warnings`` less a case. None if the plugin is
+    blocked (nothing caught, as in a session without it)."""
+    if caught is None:
+        return nullcontext()
+    from _pytest.warnings import catch_warnings_for_item
+
+    return catch_warnings_for_item(config, config.hook, when="runtest", item=None)
+
+
+def _run_protocols(session: pytest.Session, caught: object | None) -> int:
+    """The loop of :func:`_run_items`, each item's runtest protocol run by every plugin but
+    the warnings plugin (``caught``: caught around the run instead)."""
     session.testsfailed = 0
     session.shouldstop = session.shouldfail = False
     items = session.items
+    hook = session.config.pluginmanager.subset_hook_caller(
+        "pytest_runtest_protocol", [caught] if caught is not None else []
+    )
     try:
         for i, item in enumerate(items):
             nextitem = items[i + 1] if i + 1 < len(items) else None
-            item.config.hook.pytest_runtest_protocol(item=item, nextitem=nextitem)
+            hook(item=item, nextitem=nextitem)
             if session.shouldfail:
                 raise session.Failed(session.shouldfail)
             if session.shouldstop:
