@@ -288,24 +288,28 @@ def _ascii_violations(m: Measurement, tally: Tally) -> None:
         ],
     )
     if m.count >= 1 and m.aborted_by is None:
-        if replies and not replies[0].values:
-            tally.fail(
-                "R-4.4.8-04", label, f"D0 returned no values although {m.count} were announced"
-            )
-        seen_empty = None
-        for i, r in enumerate(replies):
-            if not r.values and seen_empty is None:
-                seen_empty = i
-            elif r.values and seen_empty is not None:
-                tally.fail(
-                    "R-4.4.8.3-02",
-                    label,
-                    f"D{seen_empty} was empty but D{i} returned values: groups out of order",
-                )
-                break
+        _empty_groups(m, replies, tally, label)
     if m.command.kind is Kind.HIGH_VOLUME_ASCII:
         tally.observe(label, ids=["R-5.1-02"])
         _undecide_unread_high_volume(m, replies, tally, label)
+
+
+def _empty_groups(m: Measurement, replies: list[DataReply], tally: Tally, label: str) -> None:
+    """R-4.4.8-04 (D0 empty although values were announced) and R-4.4.8.3-02 (an empty
+    group before one with values) over a measurement's data replies as read."""
+    if replies and not replies[0].values:
+        tally.fail("R-4.4.8-04", label, f"D0 returned no values although {m.count} were announced")
+    seen_empty = None
+    for i, r in enumerate(replies):
+        if not r.values and seen_empty is None:
+            seen_empty = i
+        elif r.values and seen_empty is not None:
+            tally.fail(
+                "R-4.4.8.3-02",
+                label,
+                f"D{seen_empty} was empty but D{i} returned values: groups out of order",
+            )
+            break
 
 
 def _not_this_ds_reply(m: Measurement, ex: Exchange, tally: Tally, dlabel: str) -> str:

@@ -18,12 +18,8 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from operator import attrgetter
-from typing import TYPE_CHECKING
 
 from ..transcript import Event, EventKind
-
-if TYPE_CHECKING:
-    from ..tool_recorder.records import Attempt, Exchange
 
 #: the start of the NOTE a link leaves where its reader thread came back late
 HOST_STALL_NOTE = "the tool's host stalled "
@@ -94,33 +90,3 @@ def stalled_over(found: list[Stall], start: float, end: float) -> Stall | None:
         if stall.overlaps(start, end):
             return stall
     return None
-
-
-def read_stall(attempt: Attempt, found: list[Stall]) -> Stall | None:
-    """The one decision of whether an attempt's read was stalled (truth27): the first of
-    ``found`` that may have held up its listening, from its break (else its command) to
-    when the listening ended (``Attempt.end``; a record rebuilt from the wire: its reply's
-    end, or the first-character timeout). A reply read then may be cut, its rest a late
-    burst taken for later text, a retry's reply or nothing: what it shows is the host's."""
-    return stalled_over(found, attempt.start, attempt.end) if found else None
-
-
-def mark_reads(exchanges: Iterable[Exchange | None], found: list[Stall]) -> None:
-    """Set ``Attempt.stall`` (:func:`read_stall`) on every attempt of ``exchanges`` that has
-    none yet (a None among them, another sensor's place in a rebuilt list, is passed over):
-    what every judge of the records reads, live (the session's stimuli) and offline (a
-    recording's windows) alike. ``found`` is first narrowed to the stalls over the span of
-    the attempts (a window of a recording of a stalled run holds tens of attempts, the
-    recording hundreds of stalls)."""
-    if not found:
-        return
-    attempts = [a for ex in exchanges if ex is not None for a in ex.attempts]
-    if not attempts:
-        return
-    first, last = min(a.start for a in attempts), max(a.end for a in attempts)
-    near = [stall for stall in found if stall.overlaps(first, last)]
-    if not near:
-        return
-    for attempt in attempts:
-        if attempt.stall is None:
-            attempt.stall = read_stall(attempt, near)

@@ -42,7 +42,7 @@ from ..judges.wire import Framing, ReplyBitRate, ReplyGaps, ResponseStarts
 from ..links import host_stall
 from ..protocol.commands import CONCURRENT_KINDS, SERVICE_REQUEST_KINDS, Kind
 from ..protocol.values import split_values
-from ..tool_recorder import validity
+from ..tool_recorder import stalled_reads, validity
 from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import Event, EventKind
 from ..verdicts import Finding
@@ -348,7 +348,7 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     measurements: list[Measurement] = []
     for view in bus.read(address, disturbed.waiting):
         rebuilt = rebuild_records(view, uncertainty=u, only=address, carried=carried)
-        host_stall.mark_reads(rebuilt.exchanges, stalls)
+        stalled_reads.mark_reads(rebuilt.exchanges, stalls)
         disturbed.add(view, rebuilt.measurements)
         segs = [Segment.of(t) for t in view.transmissions if address in (None, t.text[:1])]
         for fold in (starts, gaps, rate, framing):

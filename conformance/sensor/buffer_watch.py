@@ -19,6 +19,7 @@ from ..protocol.commands import Command, Kind
 from ..protocol.framing import LF
 from ..protocol.responses import holds_values
 from ..protocol.timing import CHAR_TIME
+from ..tool_recorder import stalled_reads
 from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
@@ -84,12 +85,12 @@ class WatchedToolRecorder(ToolRecorder):
 
     def mark_stalls(self, exchanges: Iterable[Exchange | None], first: int) -> None:
         """Mark the attempts of ``exchanges`` whose reads a stall of the tool's own host may
-        have held up (:func:`~conformance.links.host_stall.mark_reads`), from the link's
+        have held up (:func:`~conformance.tool_recorder.stalled_reads.mark_reads`), from the link's
         notes since its transcript's event ``first`` (the stimulus began there), once the
         link has noted what it had to (its reader thread resumes with the engine)."""
         self.link.reader_caught_up()
         found = host_stall.stalls_since(self.link.transcript.events, first)
-        host_stall.mark_reads(exchanges, found)
+        stalled_reads.mark_reads(exchanges, found)
 
     def _hear_late_reply(self, ex: Exchange) -> Exchange:
         """Where every try of ``ex`` went unanswered in its window and the sensor has been

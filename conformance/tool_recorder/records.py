@@ -53,7 +53,7 @@ class Attempt:
     stray_events: list[Event] = field(default_factory=list)
     #: a stall of the tool's own host that may have held up this attempt's read (its reply
     #: cut, its rest a late burst): set from the transcript's notes by
-    #: :func:`~conformance.links.host_stall.mark_reads`, None where none was noted
+    #: :func:`~conformance.tool_recorder.stalled_reads.mark_reads`, None where none was noted
     stall: Stall | None = field(default=None, repr=False, compare=False)
 
     @property
