@@ -33,13 +33,21 @@ def earlier_reply(ex: Exchange) -> str:
     command's last try, within the 87 ms ``LateStartWatch`` believes a late start, naming
     no address of ``ex``'s alone, and its words do not make it ``ex``'s alone. Then
     the wording a finding gives: ``'<reply>' to 0MC1! may be 0D0!'s late reply (80.00 ms
-    after it)``."""
+    after it)``.
+
+    The 87 ms count from when the reply was due (:func:`_due`: a start ``ex``'s own command
+    held back), widened by the stamps' uncertainty (none on a link in virtual time): behind
+    ``--echo --jitter 2`` (±1.96 ms) 0D0!'s late reply, held by 0C! on the line, began 96 ms
+    after 0D0!'s last try, 0.00 ms after 0C! ended, and R-4.4.7-01 FAILed "0C!: reply
+    '0+1+0+12.6' does not have the form atttnn" (truth28)."""
     before = ex.late_before
     if before is None or not ex.answered or before.last.command_end is None:
         return ""
     reply = ex.reply_events
+    slack = 2 * max(reply[0].uncertainty, before.last.command_events[-1].uncertainty)
     lag = reply[0].start - before.last.command_end
-    if not 0 < lag <= NO_BREAK_WINDOW:
+    due = _due(reply[0].start, ex.judged.command_events, HELD_SLACK + slack)
+    if lag <= 0 or due - before.last.command_end > NO_BREAK_WINDOW + slack:
         return ""
     # a reply naming this command's address and not the earlier one's is this one's; one
     # naming neither is no evidence either way (wrong-reply-address: D replies from '1')
@@ -114,11 +122,11 @@ def late_among(ex: Exchange, events: Iterable[Event], held: Sequence[Event] = ()
     return reply if fits_shape(ex.command, decode_7e1(reply)) else []
 
 
-def _due(start: float, held: Sequence[Event]) -> float:
+def _due(start: float, held: Sequence[Event], slack: float = HELD_SLACK) -> float:
     """When a DUT character that began at ``start`` was due: the start of the tool character
-    that held the line until then (one ending exactly there), else ``start``."""
+    that held the line until then (one ending there, within ``slack``), else ``start``."""
     for e in held:
-        if e.origin == TOOL and e.start < start and abs(e.end - start) < HELD_SLACK:
+        if e.origin == TOOL and e.start < start and abs(e.end - start) < slack:
             return e.start
     return start
 

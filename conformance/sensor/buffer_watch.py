@@ -23,7 +23,7 @@ from ..tool_recorder import stalled_reads
 from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
-from ..tool_recorder.records import Attempt, Exchange
+from ..tool_recorder.records import CONTENTION, Attempt, Exchange
 from ..transcript import SEVEN_BITS
 from .late_watch import LATE_START_LISTEN, LateStartWatch
 
@@ -135,11 +135,17 @@ class WatchedToolRecorder(ToolRecorder):
         too: that late reply, held until ``ex``'s last character ended, began 0.00 ms after
         it, and the watch counted it as a reply too soon, which cancelled the late start it
         had seen (beside slow-wake, 0MC1!'s '00002' read as 0MC2!'s: R-4.4.12-04 WARNed "0M2!
-        announced 9 but 0MC2! 2", truth20). A sensor never seen late links nothing."""
+        announced 9 but 0MC2! 2", truth20). A last try whose reply characters met it (bus
+        contention: the sensor's answer to the try before) drew no reply of its own either:
+        behind ``--echo --jitter 2`` 0D0!'s last try met its previous try's reply, its own
+        late reply was taken by 0C! and read as 0C!'s (truth28). A sensor never seen late
+        links nothing."""
         if before is None or before is ex or not before.attempts:
             return ex
         before.next_sent[:] = [ex]  # its words may show ex took its late reply (taken_next)
-        if not before.last.reply_events and (seen or self.watch.late.start is not None):
+        last = before.last
+        quiet = not last.reply_events or last.reason.startswith(CONTENTION)
+        if quiet and (seen or self.watch.late.start is not None):
             ex.late_before = before
         return ex
 
