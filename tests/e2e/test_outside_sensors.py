@@ -1198,3 +1198,15 @@ def test_a_measurement_dropped_after_its_reply_is_not_logged_as_sent(drops_every
     waited = found["R-4.4.5-05"]
     assert waited["verdict"] == "FAIL", waited["findings"]
     assert any("0MC!" in f["detail"] and "no aD0!" in f["detail"] for f in waited["findings"])
+
+
+def test_silent_numbered_groups_are_not_called_defined_r_4_4_8_03():
+    """A mock sensor sketch on EnviroDIY's API (twenty-ninth round, docs/kit.md) answers no
+    aMn!: R-4.4.8-03's N/A said "(every one is defined)" of groups that were never answered.
+    Said of the answered ones only; a sensor that answers every group keeps the old text."""
+    keyword = "test_undefined_group_leaves_no_old_values"
+    silent = _verdicts(run_once("sim://?faults=undefined-measure-silent", keyword=keyword))
+    [finding] = silent["R-4.4.8-03"]["findings"]
+    assert finding["verdict"] == "N/A"
+    assert finding["detail"] == "no aMn! group answers 'a0000' (those answered are defined)"
+    assert "(every one is defined)" not in finding["detail"]
