@@ -1210,3 +1210,56 @@ def test_silent_numbered_groups_are_not_called_defined_r_4_4_8_03():
     assert finding["verdict"] == "N/A"
     assert finding["detail"] == "no aMn! group answers 'a0000' (those answered are defined)"
     assert "(every one is defined)" not in finding["detail"]
+
+
+@pytest.fixture
+def hung_by_an_early_command(monkeypatch):
+    """The simulated sensor hung as the uOS++ SDI-12 sensor is (twenty-ninth round,
+    docs/kit.md): a character heard less than 8.33 ms after a break (R-7.0-05's probe, a
+    command 2 ms after one) leaves it deaf to characters and breaks for 5 s (its protocol
+    thread waits for a marking its '!' interrupt switched off, until the 5 s virtual
+    watchdog resets the board)."""
+    from conformance.emulator.sensor import SensorEmulator
+    from conformance.protocol.timing import MARKING_AFTER_BREAK
+
+    on_char, on_break = SensorEmulator.on_char, SensorEmulator.on_break
+
+    def hear(self, wire, start, end):
+        if start < getattr(self, "_hung_until", float("-inf")):
+            return
+        if self._break_end is not None and start - self._break_end < MARKING_AFTER_BREAK:
+            self._hung_until = start + 5.0
+            return
+        on_char(self, wire, start, end)
+
+    def brk(self, start, end):
+        if start >= getattr(self, "_hung_until", float("-inf")):
+            on_break(self, start, end)
+
+    monkeypatch.setattr(SensorEmulator, "on_char", hear)
+    monkeypatch.setattr(SensorEmulator, "on_break", brk)
+
+
+WAKE_CASES = "test_marking_after_break or test_ready_within_100ms_of_break"
+
+
+def test_a_sensor_hung_by_an_early_command_is_not_failed_for_a_slow_wake_r_7_0_07(
+    hung_by_an_early_command,
+):
+    """The uOS++ sensor answered R-7.0-05's probes as due (silent to the command 2 ms after
+    the break), then nothing for 5 s: R-7.0-07 FAILed "no reply on the first transmission
+    although the command began 90.00 ms after the break" on that hang, with no control. The
+    case now sends a! the usual way after a silent probe: unanswered too, R-7.0-07 is not
+    decided on the silence (slow-wake, its control answered, still FAILs: the test above)."""
+    rule = _verdicts(run_once("sim://", keyword=WAKE_CASES))["R-7.0-07"]
+    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+    detail = " ".join(f["detail"] for f in rule["findings"])
+    assert "answered neither the probe nor the control 0!" in detail, detail
+
+
+def test_a_sensor_slow_to_wake_still_fails_r_7_0_07_beside_r_7_0_05():
+    """The control after a silent R-7.0-07 probe is answered by a sensor merely slow to
+    wake (110 ms): the FAIL stands, with R-7.0-05's case run before it as above."""
+    rule = _verdicts(run_once("sim://?faults=slow-wake", keyword=WAKE_CASES))["R-7.0-07"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert "no reply on the first transmission" in rule["findings"][0]["detail"]
