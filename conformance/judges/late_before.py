@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from ..protocol.timing import NO_BREAK_WINDOW, RESPONSE_START_MAX, RESPONSE_START_MIN, TOLERANCE
-from ..tool_recorder.records import Exchange
+from ..tool_recorder.records import Attempt, Exchange
 from ..tool_recorder.validity import fits_shape
 from ..transcript import DUT, TOOL, Event, decode_7e1, escape
 from ..view.sides import expected_reply_address
@@ -46,8 +46,7 @@ def earlier_reply(ex: Exchange) -> str:
     reply = ex.reply_events
     slack = 2 * max(reply[0].uncertainty, before.last.command_events[-1].uncertainty)
     lag = reply[0].start - before.last.command_end
-    due = _due(reply[0].start, ex.judged.command_events, HELD_SLACK + slack)
-    if lag <= 0 or due - before.last.command_end > NO_BREAK_WINDOW + slack:
+    if not late_start_after(reply[0].start, ex.judged.command_events, before.last, slack):
         return ""
     # a reply naming this command's address and not the earlier one's is this one's; one
     # naming neither is no evidence either way (wrong-reply-address: D replies from '1')
@@ -65,6 +64,17 @@ def earlier_reply(ex: Exchange) -> str:
         f"'{escape(text)}' to {escape(ex.text)} {how} {escape(before.text)}'s late reply "
         f"({lag * 1e3:.2f} ms after it)"
     )
+
+
+def late_start_after(start: float, held: Sequence[Event], try_: Attempt, slack: float) -> bool:
+    """Whether a DUT reply begun at ``start`` can be a late start after the try ``try_``:
+    after its command, within the 87 ms ``LateStartWatch`` believes a late start, counted
+    from when the reply was due (:func:`_due`: a start the tool's ``held`` characters pushed
+    back), widened by ``slack`` (the stamps' uncertainty)."""
+    end = try_.command_end
+    if end is None or start <= end:
+        return False
+    return _due(start, held, HELD_SLACK + slack) - end <= NO_BREAK_WINDOW + slack
 
 
 def late_reply(ex: Exchange) -> str:

@@ -496,8 +496,8 @@ def test_ready_within_100ms_of_break(sensor, case):
     )
     if (
         case.requires("awake", late if aimed.landed is None else None)
-        and case.requires("awake", _not_answering(sensor, ex))
         and case.requires("listening", sensor.acknowledges([ex]))
+        and case.requires("awake", _not_answering(sensor, ex))
     ):
         case.add(
             judge.answered(

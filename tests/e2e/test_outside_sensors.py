@@ -1263,3 +1263,30 @@ def test_a_sensor_slow_to_wake_still_fails_r_7_0_07_beside_r_7_0_05():
     rule = _verdicts(run_once("sim://?faults=slow-wake", keyword=WAKE_CASES))["R-7.0-07"]
     assert rule["verdict"] == "FAIL", rule["findings"]
     assert "no reply on the first transmission" in rule["findings"][0]["detail"]
+
+
+SR_CASE = "test_data_after_service_request_without_break"
+
+
+def test_an_early_reply_after_a_break_is_no_late_reply_to_the_try_before_r_7_1_02():
+    """The uOS++ sensor answers every command 7.67..8.35 ms after it (R-7.0-09's FAIL) and
+    leaves its receiver off after its service request: aD0! 9 ms after it and the retries
+    went unheard, the try after a break was answered 7.7 ms after it, and R-7.1-02 was
+    INCONCLUSIVE "answered only after its reply window ... met by the retry": a reply too
+    soon for its try was taken for the try before's, begun 93 ms after that one. Only one
+    begun within the 87 ms of a late start (from when it was due) is now; here the sensor
+    replying early (response-too-early) and deaf after its service request FAILs."""
+    found = _verdicts(
+        run_once("sim://?faults=response-too-early,deaf-after-service-request", keyword=SR_CASE)
+    )
+    rule = found["R-7.1-02"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert rule["findings"][0]["detail"].endswith("no break: no reply")
+
+
+def test_a_reply_met_by_the_retry_is_still_the_try_befores_r_7_1_02():
+    """replies-after-retry answers 80 ms after each try, its reply held back by the retry on
+    the line: still the first aD0!'s late reply, not decided (the matrix row's own)."""
+    rule = _verdicts(run_once("sim://?faults=replies-after-retry", keyword=SR_CASE))["R-7.1-02"]
+    assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
+    assert "met by the retry" in rule["findings"][0]["detail"]
