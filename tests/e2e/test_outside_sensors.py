@@ -99,6 +99,12 @@ The twenty-sixth: an STM32 HAL logger (HarveyBates/stm32-projects) sends each co
 C string's NUL (``0M!<NUL>``): the view took it for no command though the played sensor answered
 at the ``!``, so its measurements and retries went unjudged; now NULs after the ``!`` keep it a
 command (``Transmission.stem``), and its aD1! in place of a lost aD0! FAILs R-4.4.5-05.
+
+The twenty-ninth: the uOS++ RTOS sensor hangs for 5 s after R-7.0-05's command 2 ms after a
+break, and R-7.0-07 FAILed on the hang (the case now sends a control a! after a silent
+probe); its early reply to aD0! after a break, 93 ms after the try before, was taken for that
+try's late reply (R-7.1-02 undecided where it FAILs); a mock sensor sketch silent to aMn!
+had its groups called "defined" (R-4.4.8-03's N/A).
 """
 
 from __future__ import annotations
