@@ -78,6 +78,9 @@ class InvalidAddressAttempt:
     #: an ``a!`` at the old address sent the same way right after it was answered: the
     #: sensor was listening, so its silence to ``aA<bad>!`` is a refusal, not deafness
     listening: bool = True
+    #: that ``a!`` (None: none was sent), the evidence of a "not listening": ``exchanges``
+    #: end with the restore's, whose last may be answered on a later try (outside29)
+    control: Exchange | None = None
 
 
 @dataclass
@@ -1003,7 +1006,7 @@ class SensorSession(Session):
             changer.unclear = changer.unclear or accepted
         finally:
             self.restore(changer)
-        return InvalidAddressAttempt(changer.exchanges, accepted, heard.listening)
+        return InvalidAddressAttempt(changer.exchanges, accepted, heard.listening, heard.control)
 
     def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
         """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and

@@ -292,7 +292,7 @@ def test_address_range(sensor, case):
             "it answered none of the address changes to 0-9 either, so refusing '$' shows nothing",
         )
     elif not bad.accepted and not bad.listening:
-        control = bad.exchanges[-1:] if len(bad.exchanges) > 1 else []
+        control = [bad.control] if bad.control is not None else []
         deaf = precondition.Unmet(
             "listening",
             "the a! sent like aA$! (one break, then once) got no reply, so the silence "

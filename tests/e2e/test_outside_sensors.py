@@ -1296,3 +1296,30 @@ def test_a_reply_met_by_the_retry_is_still_the_try_befores_r_7_1_02():
     rule = _verdicts(run_once("sim://?faults=replies-after-retry", keyword=SR_CASE))["R-7.1-02"]
     assert rule["verdict"] == "INCONCLUSIVE", rule["findings"]
     assert "met by the retry" in rule["findings"][0]["detail"]
+
+
+@pytest.fixture
+def address_control_unheard(monkeypatch):
+    """The a! sent like aA$! goes to '9', where nobody answers: the control is silent, and
+    the address is checked again afterwards (the restore), as after the uOS++ sensor's
+    unheard control (its receiver off for 100 ms after a reply)."""
+    from conformance.sensor.session import SensorSession
+
+    heard = SensorSession.heard_probe
+
+    def probe(self, text, *, control_address=None):
+        return heard(self, text, control_address="9")
+
+    monkeypatch.setattr(SensorSession, "heard_probe", probe)
+
+
+def test_an_unanswered_address_control_is_the_evidence_it_cites_r_4_3_04(address_control_unheard):
+    """R-4.3-04's "the a! sent like aA$! ... got no reply" cited the last exchange of the
+    attempt, the restore's a! answered '0<CR><LF>' (uOS++ sensor, twenty-ninth round): the
+    evidence said the opposite of the detail. It cites the control now."""
+    rule = _verdicts(run_once("sim://", keyword="test_address_range"))["R-4.3-04"]
+    [finding] = rule["findings"]
+    assert finding["verdict"] == "INCONCLUSIVE", finding
+    assert "got no reply" in finding["detail"]
+    [line] = finding["evidence"]
+    assert line.endswith("9! -> '(silence)'"), line
