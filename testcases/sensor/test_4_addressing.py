@@ -292,12 +292,14 @@ def test_address_range(sensor, case):
             "it answered none of the address changes to 0-9 either, so refusing '$' shows nothing",
         )
     elif not bad.accepted and not bad.listening:
-        control = [bad.control] if bad.control is not None else []
+        if bad.control is None:  # no marking made it answer a one-shot a!: none was sent
+            why = "no one-shot a! after a break was answered, so no control went like aA$!"
+        else:
+            why = "the a! sent like aA$! (one break, then once) got no reply"
         deaf = precondition.Unmet(
             "listening",
-            "the a! sent like aA$! (one break, then once) got no reply, so the silence "
-            "to aA$! shows nothing",
-            tuple(judge.cite(control)),
+            f"{why}, so the silence to aA$! shows nothing",
+            tuple(judge.cite([bad.control] if bad.control is not None else [])),
         )
     if not case.requires("listening", deaf, only=("R-4.3-04",)):
         pass  # refusing '$' shows nothing from a sensor not shown listening

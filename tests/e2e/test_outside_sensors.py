@@ -1323,3 +1323,14 @@ def test_an_unanswered_address_control_is_the_evidence_it_cites_r_4_3_04(address
     assert "got no reply" in finding["detail"]
     [line] = finding["evidence"]
     assert line.endswith("9! -> '(silence)'"), line
+
+
+def test_no_control_sent_is_not_called_unanswered_r_4_3_04():
+    """replies-after-retry answers no one-shot a! in its window (every reply 80 ms late), so
+    no marking is found and aA$! goes without a control: "the a! sent like aA$! ... got no
+    reply" spoke of an a! never sent (and cited the restore's, answered)."""
+    rule = _verdicts(run_once("sim://?faults=replies-after-retry", keyword="test_address_range"))
+    [finding] = rule["R-4.3-04"]["findings"]
+    assert finding["verdict"] == "INCONCLUSIVE", finding
+    assert "no one-shot a! after a break was answered" in finding["detail"], finding["detail"]
+    assert finding["evidence"] == []
