@@ -293,7 +293,7 @@ def test_address_range(sensor, case):
         )
     elif not bad.accepted and not bad.listening:
         if bad.control is None:  # no marking made it answer a one-shot a!: none was sent
-            why = "no one-shot a! after a break was answered, so no control went like aA$!"
+            why = "no one-shot a! after a break was answered, and no control went like aA$!"
         else:
             why = "the a! sent like aA$! (one break, then once) got no reply"
         deaf = precondition.Unmet(
