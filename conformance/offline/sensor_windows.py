@@ -59,6 +59,7 @@ from ..view.segments import (
 from ..view.windows import WindowedTransmissions, stream_window_sides, window_view
 from .bus_sensors import BusSensor, SensorsOn
 from .decode_quality import CharRates, Quality, problems_by_character, sensor_characters
+from .stored_records import Positions, store_records
 
 if TYPE_CHECKING:
     from ..replay.recording_link import RecordingLink
@@ -243,16 +244,35 @@ class BusWindows:
 
     def view(self, i: int) -> TranscriptView:
         """Window ``i``'s view, read again as the cut read it."""
+        return self.placed(i)[1]
+
+    def placed(self, i: int) -> tuple[Positions | None, TranscriptView]:
+        """Window ``i``'s view, read again as the cut read it, and where its events are in
+        the store (None where the events are not a compact store's: no positions to keep)."""
         lo, hi = self.bounds[i], self.bounds[i + 1]
         sides = self.codes.read(lo, hi) if self.codes is not None and self.sided[i] else None
-        return window_view(list(self.events[lo:hi]), sides)  # type: ignore[arg-type]
+        window = list(self.events[lo:hi])
+        view = window_view(window, sides)  # type: ignore[arg-type]
+        if not isinstance(self.events, CompactEvents):
+            return None, view
+        return Positions(self.events, lo, window), view
 
     def read(self, address: str | None, more: Callable[[], bool]) -> Iterator[TranscriptView]:
         """The views of the windows holding a transmission whose text begins with
         ``address`` (every window for None), in order, and of each window after one while
         ``more()`` says the next traffic, whoever it is to, is still wanted."""
+        return map(self.view, self.indices(address, more))
+
+    def read_placed(
+        self, address: str | None, more: Callable[[], bool]
+    ) -> Iterator[tuple[Positions | None, TranscriptView]]:
+        """:meth:`read`'s views, each with where its events are (:meth:`placed`)."""
+        return map(self.placed, self.indices(address, more))
+
+    def indices(self, address: str | None, more: Callable[[], bool]) -> Iterator[int]:
+        """The windows :meth:`read` reads, in order."""
         if address is None:
-            yield from map(self.view, range(len(self)))
+            yield from range(len(self))
             return
         mine = self.windows_of.get(address, array("I"))
         i = j = 0
@@ -264,7 +284,7 @@ class BusWindows:
                     return
                 i = mine[j]
                 continue
-            yield self.view(i)
+            yield i
             i += 1
 
 
@@ -346,13 +366,15 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     disturbed, carried = Disturbances(), {}
     exchanges: list[Exchange] = []
     measurements: list[Measurement] = []
-    for view in bus.read(address, disturbed.waiting):
+    for positions, view in bus.read_placed(address, disturbed.waiting):
         rebuilt = rebuild_records(view, uncertainty=u, only=address, carried=carried)
         stalled_reads.mark_reads(rebuilt.exchanges, stalls)
         disturbed.add(view, rebuilt.measurements)
         segs = [Segment.of(t) for t in view.transmissions if address in (None, t.text[:1])]
         for fold in (starts, gaps, rate, framing):
             fold.add(segs)
+        if positions is not None:  # held for the run as positions, not objects
+            store_records(positions, rebuilt.exchanges, rebuilt.measurements)
         exchanges += rebuilt.exchanges
         measurements += rebuilt.measurements
     disturbed.finish()
