@@ -1,11 +1,13 @@
-"""A sensor pass's records hold their events as positions into the loaded store (issue 22,
-memory19: ``offline.stored_records``): no event object is held by a sensor's exchanges and
-measurements for its run (an hour's busy capture: ~35,000 a sensor, 4.3 MB), and every
-record reads as the same pass over the same events held as a list reads it."""
+"""A sensor pass holds no event object for its run (issue 22, memory19): its records hold
+their events as positions into the loaded store (``offline.stored_records``), every record
+reading as the same pass over the same events held as a list reads it, and the reply-start
+fold holds no segment (``judges.wire._StartWhere``). Together they held a sensor's ~35,000
+events of an hour's busy capture as objects to the end of its run (5 MB)."""
 
 from __future__ import annotations
 
 import dataclasses
+import gc
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -13,10 +15,13 @@ import pytest
 
 from conformance import event_store
 from conformance.event_store import CompactEvents, StoredEvents
+from conformance.judges.wire import ResponseStarts
 from conformance.offline.sensor_windows import bus_windows, sensor_records
 from conformance.replay.recording_link import load_recording, parse_recording, recording_port
 from conformance.tool_recorder.records import Exchange, Measurement
 from conformance.transcript import Event
+from conformance.verdicts import Verdict
+from conformance.view.runs import Segment
 from tests.offline.test_judge_memory import busy_capture
 from tests.support.bus_of_sensors import record
 
@@ -84,3 +89,33 @@ def test_records_hold_positions_and_read_as_listed_ones(
     ]
     for found in ("response_start", "gaps", "bit_rate", "framing"):
         assert getattr(stored, found) == getattr(listed, found)
+
+
+def _events_alive() -> int:
+    gc.collect()
+    return sum(1 for o in gc.get_objects() if type(o) is Event)
+
+
+def test_the_reply_start_fold_holds_no_segment(tmp_path: Path):
+    """R-7.0-09/-10's fold over a whole capture read a window at a time keeps each reply's
+    observation, whose evidence line is made when asked: it held the reply's segment for
+    that (its command's and reply's events as objects, to the end of the sensor's run:
+    5 MB of an hour's sensor). Now the few values the line reads; the line the same."""
+    path = _busy(tmp_path)
+    link = load_recording(parse_recording(recording_port(str(path), "sr")))
+    bus = bus_windows(link)
+    starts = ResponseStarts(link.uncertainty)
+    before = _events_alive()
+    replies = 0
+    for view in bus.read("2", lambda: False):
+        segs = [Segment.of(t) for t in view.transmissions if t.text[:1] == "2"]
+        replies += sum(1 for s in segs if s.reply)
+        starts.add(segs)
+        del segs, view
+    assert replies > 10
+    # the last segment is carried (a reply after the cut may be its late one): its events
+    assert _events_alive() - before <= 40
+    found = starts.findings()
+    assert found[0].verdict == found[1].verdict == Verdict.PASS
+    lines = [line for f in found for line in f.evidence]
+    assert lines and all(line.startswith("reply to 2D0! at t=") for line in lines)
