@@ -360,7 +360,7 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     u, stamps = link.uncertainty, stamp_uncertainty_of(link)
     # the tool's host stalls a run of this tool noted (a capture has none): the framing and
     # every record whose read one may have held up are read as the live run reads them
-    stalls = host_stall.stalls_since(link.transcript.events, 0)
+    stalls = noted_stalls(link.transcript.events)
     starts, gaps = ResponseStarts(stamps), ReplyGaps(stamps)
     rate, framing = ReplyBitRate(stamps), Framing(stamps, stalls=stalls)
     disturbed, carried = Disturbances(), {}
@@ -382,6 +382,16 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
         exchanges, measurements, starts.findings(), gaps.findings(), rate.finding(),
         framing.findings(),
     )  # fmt: skip
+
+
+def noted_stalls(events: Sequence[Event]) -> list[host_stall.Stall]:
+    """:func:`~conformance.links.host_stall.stalls_since` the recording's start, asked of a
+    compact store's fields first: a store holding no note holds no stall, and looking for
+    one made each of its events (an hour's capture: 357,000, 0.12 s of CPU each sensor's
+    run)."""
+    if isinstance(events, CompactEvents) and not events.has_kind(EventKind.NOTE):
+        return []
+    return host_stall.stalls_since(events, 0)  # type: ignore[arg-type]
 
 
 class Disturbances:
