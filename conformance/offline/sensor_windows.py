@@ -21,7 +21,9 @@ records:
   expectations carried), its segments fed to the reply timing and framing folds
   (``judges.wire.ResponseStarts``, ``ReplyGaps``, ``ReplyBitRate``, ``Framing``). Kept:
   the sensor's exchanges and measurements (what the measurement, data, identification and
-  extended cases judge, each measurement's ``aborted_by`` set) and the folds' findings.
+  extended cases judge, each measurement's ``aborted_by`` set), their events held as
+  positions into the loaded store once their window is read (:mod:`.stored_records`: no
+  event of the run held as an object), and the folds' findings.
 
 Every finding, note and record is the whole-run path's (``tests/offline/
 test_sensor_windows.py`` runs that path, kept in ``tests/support/whole_run_heard.py``, as
