@@ -382,7 +382,7 @@ class CompactEvents(Sequence[Event]):
     def __getitem__(self, i: int | slice) -> Event | list[Event]:
         n = len(self)
         if isinstance(i, slice):
-            return list(self._made(range(n)[i]))
+            return list(self.made(range(n)[i]))
         if i < 0:
             i += n
         if not 0 <= i < n:
@@ -395,9 +395,9 @@ class CompactEvents(Sequence[Event]):
         )  # fmt: skip
 
     def __iter__(self) -> Iterator[Event]:
-        return self._made(range(len(self)))
+        return self.made(range(len(self)))
 
-    def _made(self, positions: range) -> Iterator[Event]:
+    def made(self, positions: range) -> Iterator[Event]:
         """The events at ``positions`` (a range), made as they are read: the columns'
         parts read together where the range steps by one."""
         fields, event = self.fields, full_event
@@ -444,6 +444,78 @@ class CompactEvents(Sequence[Event]):
         return sum(c.resident_nbytes() for c in self._columns)
 
 
+class StoredEvents(Sequence[Event]):
+    """Some of a :class:`CompactEvents`' events, by their positions in it, made again at
+    each read: what a record's list of events (a command's characters, a reply's) holds
+    once its window's events are let go (issue 22: a sensor's run kept its exchanges'
+    ~35,000 events of an hour's capture as objects, 4.3 MB, while its cases judged them;
+    here a run of positions takes ~90 bytes, whatever its length).
+
+    Read-only (a record's list is not changed once made: the caller keeps a list where it
+    may be). Reads as the list it stands for does: by item and slice (a list), in order,
+    ``==`` to a list or another sequence of equal events, ``+`` a list. Its events are new
+    objects at each read, so nothing may hold one of them for the same as another read's
+    (an attempt's reply text is kept with the sequence itself: ``Attempt.reply_text``)."""
+
+    __slots__ = ("store", "lo", "n", "at")
+
+    def __init__(self, store: CompactEvents, positions: Sequence[int]) -> None:
+        self.store = store
+        n = len(positions)
+        lo = positions[0] if n else 0
+        # a run of consecutive positions (nearly always) held as its first and length
+        runs = (
+            n == 0
+            or positions[-1] - lo == n - 1
+            and all(b - a == 1 for a, b in zip(positions, positions[1:], strict=False))
+        )
+        self.lo, self.n = lo, n
+        self.at: array | None = None
+        if not runs:
+            self.at = array("I" if max(positions) < 2**32 else "q", positions)
+
+    def positions(self) -> Sequence[int]:
+        """The events' positions in the store, in order."""
+        return range(self.lo, self.lo + self.n) if self.at is None else self.at
+
+    def __len__(self) -> int:
+        return self.n
+
+    @overload
+    def __getitem__(self, i: int) -> Event: ...
+    @overload
+    def __getitem__(self, i: slice) -> list[Event]: ...
+    def __getitem__(self, i: int | slice) -> Event | list[Event]:
+        if isinstance(i, slice):
+            return list(self._made(self.positions()[i]))
+        return self.store[self.positions()[i]]
+
+    def __iter__(self) -> Iterator[Event]:
+        return self._made(self.positions())
+
+    def _made(self, positions: Sequence[int]) -> Iterator[Event]:
+        if isinstance(positions, range) and positions.step == 1:
+            return self.store.made(positions)
+        store = self.store
+        return (store[k] for k in positions)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, (list, tuple, StoredEvents)):
+            return NotImplemented
+        return len(self) == len(other) and all(a == b for a, b in zip(self, other, strict=True))
+
+    __hash__ = None  # type: ignore[assignment]  # (a list's is None too)
+
+    def __add__(self, other: Iterable[Event]) -> list[Event]:
+        return [*self, *other]
+
+    def __radd__(self, other: Iterable[Event]) -> list[Event]:
+        return [*other, *self]
+
+    def __repr__(self) -> str:
+        return repr(list(self))
+
+
 def _exact(a: Fields, b: Fields) -> bool:
     """Whether the equal fields ``a`` and ``b`` are also of one type and sign each, so that
     an event made with ``a`` prints as one made with ``b`` (``0`` and ``0.0`` are equal and
@@ -456,4 +528,4 @@ def _exact(a: Fields, b: Fields) -> bool:
     return True
 
 
-__all__ = ["Column", "CompactEvents", "NotCompact", "Spill"]
+__all__ = ["Column", "CompactEvents", "NotCompact", "Spill", "StoredEvents"]

@@ -7,6 +7,7 @@ the records alone, and so that a misbehaving sensor leaves evidence instead of a
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -77,16 +78,15 @@ class Attempt:
         reader (the engine's validity check, the buffer watch, every judge asking an
         exchange's ``reply_text``: some 4 decodes a reply, issue 22, matrix18). Kept with
         the list it was read from, its length and its last event: a reply only ever grows
-        by appending (a golden recorder reads on into it), or is replaced whole."""
+        by appending (a golden recorder reads on into it), or is replaced whole. Only a list
+        grows: any other sequence (a passive run's ``event_store.StoredEvents``, whose
+        events are made at each read) is its own key, no event of it held."""
         events = self.reply_events
         made = self.__dict__.get("_text")
-        if (
-            made is None
-            or made[0] is not events
-            or made[1] != len(events)
-            or (events and made[2] is not events[-1])
-        ):
-            made = (events, len(events), events[-1] if events else None, decode_7e1(events))
+        if made is None or made[0] is not events or (type(events) is list and (
+            made[1] != len(events) or (events and made[2] is not events[-1])
+        )):  # fmt: skip
+            made = (events, len(events), _last(events), decode_7e1(events))
             self.__dict__["_text"] = made
         return made[3]
 
@@ -94,7 +94,12 @@ class Attempt:
         """Keep ``text``, which its maker read as ``decode_7e1(self.reply_events)``, as
         :attr:`reply_text` (the engine's validity check decoded it already)."""
         events = self.reply_events
-        self.__dict__["_text"] = (events, len(events), events[-1] if events else None, text)
+        self.__dict__["_text"] = (events, len(events), _last(events), text)
+
+
+def _last(events: Sequence[Event]) -> Event | None:
+    """The last of a reply's events, kept to tell a list grown (:attr:`Attempt.reply_text`)."""
+    return events[-1] if events and type(events) is list else None
 
 
 @dataclass
