@@ -82,6 +82,4 @@ def stalled_interval(measured: Finding | Measured, stall: Stall) -> Finding:
     (:func:`~.timing.combine_local`, which names the stall and asks for that place to be
     observed again, :func:`~.timing.to_confirm`)."""
     found = measured.finding if isinstance(measured, Measured) else measured
-    return replace(
-        found, verdict=Verdict.INCONCLUSIVE, detail=f"{found.detail}, but {stall.why()}"
-    )
+    return replace(found, verdict=Verdict.INCONCLUSIVE, detail=f"{found.detail}, but {stall.why()}")

@@ -8,8 +8,8 @@ PASS only when the whole interval ``measured +/- uncertainty`` lies inside the a
 from __future__ import annotations
 
 from array import array
-from collections import Counter
 from bisect import bisect_right
+from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property

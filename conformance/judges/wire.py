@@ -570,10 +570,12 @@ def _observe_each(
             measured = judged.get(key)
             if measured is None:
                 measured = judged[key] = Measured(GAP_WINDOW, gap, u, [where])
+        held = None
         if stalls and measured.verdict is not Verdict.PASS:
-            if (held := _across_stall(measured, stalls, a.start, b.end, place)) is not None:
-                add(held)
-                continue
+            held = _across_stall(measured, stalls, a.start, b.end, place)
+        if held is not None:
+            add(held)
+            continue
         add((measured, u > base, place))
     return observed
 

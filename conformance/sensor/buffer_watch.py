@@ -14,8 +14,8 @@ from typing import Any
 
 from ..judges.late_before import late_among
 from ..links import host_stall
-from ..links.host_stall import Stall
 from ..links.base import Link
+from ..links.host_stall import Stall
 from ..protocol.commands import Command, Kind
 from ..protocol.framing import LF
 from ..protocol.responses import holds_values
