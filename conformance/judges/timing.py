@@ -148,7 +148,9 @@ def to_confirm(observed: list[Observation], *, real_time: bool = True) -> list[s
     stalled = [p[0] for p in _stalled_unconfirmed(placed) if p is not None]
     kept = [(f, p) for f, tainted, p in placed if not _aside(f, tainted)]
     failing = sum(f.verdict is _FAIL for f, _ in kept)
-    if not failing or failing == len(kept) or sustained(failing, len(kept)):
+    if failing and (failing == len(kept) or sustained(failing, len(kept))):
+        return []  # a FAIL on what was read outside any stall: nothing a repeat would change
+    if not failing:
         return list(dict.fromkeys(stalled))
     return list(dict.fromkeys(deviation_pattern(kept).commands + stalled))
 

@@ -210,3 +210,18 @@ def test_recorded_gaps_across_stalls_are_not_a_fail():
 def test_recorded_gaps_outside_any_stall_fail():
     found = _by_rule(_long_gaps_recorded(True).recorded(noted=False).gaps)["R-7.0-12"]
     assert found.verdict is Verdict.FAIL and WHY not in found.detail
+
+
+def test_no_stalled_start_is_observed_again_where_the_rest_fail():
+    """Every reply late outside the stalls (response-too-late under pauses): the rule FAILs
+    whatever a repeat of the stalled one shows; the paused run re-probed them all."""
+    run = Run()
+    for _ in range(3):
+        run.exchange("0!", "0\r\n", delay=0.020)
+    run.exchange("0I!", "014CONFORM EMULATOR1.0\r\n", delay=0.030, stalled=True)
+    stamps = StampUncertainty(U, local=lambda _s, _e: U)
+    stalls = host_stall.stalls(run.events)
+    assert wire.starts_to_confirm(segments(run.events), stamps, stalls) == []
+    found = run.findings(wire.judge_response_start, stamps)["R-7.0-10"]
+    assert found.verdict is Verdict.FAIL
+    assert "1 reply set aside, read across a stall" in found.detail
