@@ -192,3 +192,29 @@ def test_a_stall_early_in_the_wait_changes_nothing():
     run.t = reply_end + 1.2
     run.exchange("0D0!", "0+1+2\r\n")
     assert _wait_rule(run.recorded(), "R-4.4.6-02").verdict is Verdict.FAIL
+
+
+def test_the_stall_notes_are_read_once_per_stimulus(monkeypatch):
+    """The engine's records and the view's of one stimulus ask the notes since its first
+    event with nothing added between: read once; a note added since is read."""
+    from types import SimpleNamespace
+
+    from conformance.sensor import buffer_watch
+    from conformance.sensor.buffer_watch import WatchedToolRecorder
+
+    reads = []
+    real = host_stall.stalls_since
+    monkeypatch.setattr(
+        buffer_watch.host_stall,
+        "stalls_since",
+        lambda ev, first: reads.append(first) or real(ev, first),
+    )
+    run = Run()
+    run.exchange("0D0!", VALUES, stalled=True)
+    link = SimpleNamespace(transcript=Transcript(run.events), reader_caught_up=lambda: None)
+    engine = SimpleNamespace(link=link, _stalls_read=((0, -1, -1), []))
+    first = WatchedToolRecorder._stalls_since(engine, 0)  # type: ignore[arg-type]
+    assert WatchedToolRecorder._stalls_since(engine, 0) is first and len(first) == 1  # type: ignore[arg-type]
+    link.transcript.note(run.t, host_stall.note_text(STALL))
+    assert len(WatchedToolRecorder._stalls_since(engine, 0)) == 2  # type: ignore[arg-type]
+    assert reads == [0, 0]
