@@ -1,4 +1,11 @@
-"""Judges for extended commands (4.4.13) and multi-line text (4.4.13.1, decision A10)."""
+"""Judges for extended commands (4.4.13) and multi-line text (4.4.13.1, decision A10).
+
+A reply whose read the tool's own host stalled over (:attr:`~conformance.tool_recorder.
+records.Exchange.stall`) may be cut, its rest a late burst, and its stamps moved by the
+stall: what its framing, line lengths and the marking between its lines show is the host's,
+INCONCLUSIVE with the stall named (:mod:`.stalled`, truth29); a reply outside any stall is
+judged as ever.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +16,7 @@ from ..tool_recorder.records import Exchange
 from ..transcript import Event, escape
 from ..verdicts import Finding
 from .late_before import answered_late
+from .stalled import through_stall, unless_stalled
 from .tally import Tally
 from .timing import judge_window
 
@@ -39,7 +47,7 @@ def extended_replies(exchanges: list[Exchange], address: str) -> list[Finding]:
         tally.observe(label, ids=["R-4.4.13-01"])
         text = ex.reply_text.rstrip("\x03") if is_multiline(ex) else ex.reply_text
         if not text.startswith(address) or not text.endswith("\r\n"):
-            tally.fail(
+            through_stall(tally, ex.stall).fail(
                 "R-4.4.13-01",
                 label,
                 f"reply '{escape(ex.reply_text)}' does not run from the address to CR LF",
@@ -64,10 +72,11 @@ def multiline(exchanges: list[Exchange], address: str, uncertainty: float) -> li
     for ex in exchanges:
         label = escape(ex.text)
         tally.observe(label)
+        here = through_stall(tally, ex.stall)  # what a stalled read shows is undecided
         events = ex.reply_events
         text = ex.reply_text
         if not (text.startswith(address + "\x02") and text.endswith("\r\n\x03")):
-            tally.fail(
+            here.fail(
                 "R-4.4.13.1-01",
                 label,
                 f"reply '{escape(text[:20])}...{escape(text[-6:])}' is not framed "
@@ -79,23 +88,22 @@ def multiline(exchanges: list[Exchange], address: str, uncertainty: float) -> li
             if n == 1:
                 content = content[2:]  # address and STX do not count
             if len(content) > LINE_MAX:
-                tally.fail(
+                here.fail(
                     "R-4.4.13.1-02",
                     label,
                     f"line {n} has {len(content)} characters (at most {LINE_MAX})",
                 )
             # character gaps inside a line are the general rule's (R-7.0-12, whole run)
         for before, after in zip(body_lines, body_lines[1:], strict=False):
-            timing.append(
-                judge_window(
-                    "R-4.4.13.1-03",
-                    "marking between lines",
-                    after[0].start - before[-1].end,
-                    uncertainty,
-                    high=MULTILINE_GAP_MAX,
-                    evidence=[label],
-                )
+            between = judge_window(
+                "R-4.4.13.1-03",
+                "marking between lines",
+                after[0].start - before[-1].end,
+                uncertainty,
+                high=MULTILINE_GAP_MAX,
+                evidence=[label],
             )
+            timing.append(unless_stalled(between, [ex]))
     findings = tally.findings()
     worst = max(timing, key=lambda f: f.verdict.rank, default=None)
     if worst is not None:

@@ -5,7 +5,9 @@ The case sends; this judges. A pair of reads is compared only where both drew a 
 their own in the window: a D read the tool gave up on (its reply late, met by the retry, or
 maybe the command before's) has no reply to compare, and two such reads "identical" as two
 silences PASSed the rule beside continuous-overwrites-data, whose aR0! empties the buffer
-(replies-after-retry: every reply 80 ms late, truth21).
+(replies-after-retry: every reply 80 ms late, truth21). Nor is a pair that differs where
+either read was held up by a stall of the tool's own host (truth29): a cut reply differs
+from a whole one, and the host's doing is no lost buffer (INCONCLUSIVE, the stall named).
 """
 
 from __future__ import annotations
@@ -15,9 +17,10 @@ from collections.abc import Sequence
 from ..protocol.responses import holds_values
 from ..tool_recorder.records import Exchange
 from ..transcript import escape
-from ..verdicts import Finding, failed, inconclusive, passed
+from ..verdicts import Finding, Verdict, failed, inconclusive, passed
 from .cite import cite, listed, shown
 from .late_before import answered_late
+from .stalled import unless_stalled
 
 RULE = "R-4.4.5-10"
 
@@ -30,18 +33,24 @@ def _unread(ex: Exchange) -> bool:
 def retained(before: Sequence[Exchange], again: Sequence[Exchange]) -> Finding:
     """R-4.4.5-10 over the D reads ``before`` and the same reads ``again``: FAIL where a
     pair both read differs (or a read is missing ``again``), INCONCLUSIVE where a pair was
-    not both read or nothing read before held values (a lost buffer would change nothing),
-    PASS otherwise."""
+    not both read, differs only where the tool's host stalled over either read
+    (:func:`~.stalled.unless_stalled`), or nothing read before held values (a lost buffer
+    would change nothing), PASS otherwise."""
     pairs = list(zip(before, again, strict=False))
+    held: Finding | None = None  # the first change seen only in a read the host stalled over
     for n, (first, second) in enumerate(pairs):
         if _unread(first) or _unread(second) or first.reply_text == second.reply_text:
             continue
-        return failed(
+        changed = failed(
             RULE,
             f"D{n} changed from '{escape(first.reply_text)}' to '{escape(second.reply_text)}'",
             evidence=cite([first, second]),
             observed=len(before),
         )
+        changed = unless_stalled(changed, [first, second], together=True)
+        if changed.verdict is Verdict.FAIL:
+            return changed
+        held = held or changed
     if len(again) < len(before):
         missing = before[len(again)]
         return failed(
@@ -50,6 +59,8 @@ def retained(before: Sequence[Exchange], again: Sequence[Exchange]) -> Finding:
             evidence=cite([missing]),
             observed=len(before),
         )
+    if held is not None:
+        return held
     unread = [ex for pair in pairs for ex in pair if _unread(ex)]
     if unread:
         detail = f"{listed([answered_late(ex) or shown(ex) for ex in unread])}: not compared"

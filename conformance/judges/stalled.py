@@ -21,6 +21,7 @@ from ..protocol.values import Violation
 from ..tool_recorder.records import Exchange
 from ..verdicts import Finding, Verdict
 from .tally import Tally
+from .timing import Measured
 
 
 class StalledTally(Tally):
@@ -69,5 +70,26 @@ def unless_stalled(
     held = [stall for stall in stalls if stall is not None]
     if not held or (len(held) < len(stalls) and not together):
         return finding
-    why = held[0].why()
-    return replace(finding, verdict=Verdict.INCONCLUSIVE, detail=f"{finding.detail}, but {why}")
+    return held_by(finding, held[0])
+
+
+def held_by(finding: Finding, stall: Stall | None) -> Finding:
+    """``finding``, or where it FAILs or WARNs on what ``stall`` (a stall of the tool's own
+    host over the stamps or the read it rests on) may have moved or cut, the same
+    INCONCLUSIVE with the stall named: a finding that rests on one such record (a
+    measurement's wait, :attr:`~conformance.tool_recorder.records.Measurement.wait_stall`)."""
+    if stall is None or finding.verdict not in (Verdict.FAIL, Verdict.WARN):
+        return finding
+    detail = f"{finding.detail}, but {stall.why()}"
+    return replace(finding, verdict=Verdict.INCONCLUSIVE, detail=detail)
+
+
+def stalled_interval(measured: Finding | Measured, stall: Stall) -> Finding:
+    """A deviating interval whose stamps ``stall`` may have moved (truth29: a character the
+    tool's host held back is stamped at the late burst that delivers it, a reply start late,
+    a gap long): INCONCLUSIVE with the stall named. The whole-run timing judges set it
+    aside as they set aside an interval the link's irregular stamps leave undecided
+    (:func:`~.timing.combine_local`, which names the stall and asks for that place to be
+    observed again, :func:`~.timing.to_confirm`)."""
+    found = measured.finding if isinstance(measured, Measured) else measured
+    return replace(found, verdict=Verdict.INCONCLUSIVE, detail=f"{found.detail}, but {stall.why()}")

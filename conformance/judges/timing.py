@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from array import array
 from bisect import bisect_right
+from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -17,6 +18,7 @@ from math import copysign
 from statistics import median
 from typing import Generic, Protocol, TypeVar
 
+from ..links.host_stall import Stall
 from ..preconditions import awake
 from ..protocol.timing import STANDBY_MARKING, TOLERANCE
 from ..verdicts import MAX_TICKS, Distribution, Finding, Verdict
@@ -75,8 +77,12 @@ REPROBE_TIMES = 10
 #: and the position in that reply (a character index; 0 for the reply's start). None: no
 #: place known.
 Place = tuple[str, str, int]
-#: One judged observation: a :class:`Finding`, or a :class:`Measured` that builds it on demand.
-Observation = tuple["Finding | Measured", bool] | tuple["Finding | Measured", bool, Place | None]
+#: One judged observation: a :class:`Finding`, or a :class:`Measured` that builds it on demand;
+#: whether it is tainted (a local irregularity of the stamps, or the host stall read across)
+Observation = (
+    tuple["Finding | Measured", "bool | Stall"]
+    | tuple["Finding | Measured", "bool | Stall", Place | None]
+)
 
 
 def sustained(deviating: int, total: int) -> bool:
@@ -133,17 +139,38 @@ def _places(observed: list[Observation]) -> list[tuple[Finding | Measured, bool,
 def to_confirm(observed: list[Observation], *, real_time: bool = True) -> list[str]:
     """The commands whose replies hold a rare deviation :func:`combine_local` cannot yet
     place: the session sends each again (:data:`REPROBE_TIMES`) and the judge runs again over
-    the repeats. Empty on a virtual clock, or when the deviations are not rare."""
+    the repeats. Empty on a virtual clock, or when the deviations are not rare. And those
+    whose reply deviated only across a stall of the tool's own host, where that reply was not
+    observed outside one often enough to stand for it (:func:`_stalled_unconfirmed`)."""
     if not real_time:
         return []
-    kept = [(f, p) for f, tainted, p in _places(observed) if not _aside(f, tainted)]
+    placed = _places(observed)
+    stalled = [p[0] for p in _stalled_unconfirmed(placed) if p is not None]
+    kept = [(f, p) for f, tainted, p in placed if not _aside(f, tainted)]
     failing = sum(f.verdict is _FAIL for f, _ in kept)
-    if not failing or failing == len(kept) or sustained(failing, len(kept)):
+    if failing and (failing == len(kept) or sustained(failing, len(kept))):
+        return []  # a FAIL on what was read outside any stall: nothing a repeat would change
+    if not failing:
+        return list(dict.fromkeys(stalled))
+    return list(dict.fromkeys(deviation_pattern(kept).commands + stalled))
+
+
+def _stalled_unconfirmed(
+    placed: list[tuple[Finding | Measured, bool | Stall, Place | None]],
+) -> list[Place | None]:
+    """The places of the deviations set aside as read across a stall of the tool's own host
+    (an observation tainted by its :class:`~conformance.links.host_stall.Stall`,
+    :func:`~.stalled.stalled_interval`) that the observations kept there, outside any
+    stall, are too few (:data:`CONFIRM_OBSERVATIONS`) to stand for: a device late at that
+    one reply alone would otherwise PASS for the stall's sake (truth29)."""
+    held = [p for f, t, p in placed if type(t) is Stall and _aside(f, t)]
+    if not held:
         return []
-    return deviation_pattern(kept).commands
+    seen = Counter(p for f, t, p in placed if not _aside(f, t))
+    return [p for p in dict.fromkeys(held) if p is None or seen[p] < CONFIRM_OBSERVATIONS]
 
 
-def _aside(f: Finding, tainted: bool) -> bool:
+def _aside(f: Finding | Measured, tainted: bool | Stall) -> bool:
     return tainted and f.verdict is _INCONCLUSIVE
 
 
@@ -167,6 +194,11 @@ def combine_local(
     - An observation that the irregularity alone left undecided says nothing about the DUT:
       it is set aside (and counted in the detail) instead of making the whole rule
       INCONCLUSIVE. If every observation was set aside the rule stays INCONCLUSIVE.
+    - So is a deviation whose stamps a noted stall of the tool's own host may have moved
+      (tainted by that :class:`~conformance.links.host_stall.Stall`:
+      :func:`~.stalled.stalled_interval`), the stall named; where the observations kept at
+      its place are too few to stand for it, a PASS is INCONCLUSIVE (truth29) and the
+      session observes that reply again (:func:`to_confirm`).
     - On a real-time link (``real_time``) a host that stalls can make a stamp late with no
       trace around it (the last character of a reply has no successor to show it); a few
       deviating observations among many that conform are therefore decided by where they
@@ -181,18 +213,17 @@ def combine_local(
     # a virtual clock): then every one is kept, as one slice; the places are wanted only by
     # the few deviations of a real-time link (_by_place), and gathered only then
     kept: Sequence[Finding | Measured]
+    stalled: list[Place | None] = []  # the places a stall alone leaves unconfirmed
+    note = ""
     if type(observed) is Observed:  # none tainted, grouped as they were made
         kept, aside = Alike(observed), []
     elif any(o[1] for o in observed):
         kept = [o[0] for o in observed if not _aside(o[0], o[1])]
         aside = [o[0] for o in observed if _aside(o[0], o[1])]
+        note = _aside_note(observed, what)
+        stalled = _stalled_unconfirmed(_places(observed))
     else:
         kept, aside = [o[0] for o in observed], []
-    worst_aside = max((f.uncertainty_ms or 0.0 for f in aside), default=0.0)
-    note = (
-        f"{counted(len(aside), what)} set aside: the link's "
-        f"stamps near them were irregular (±{worst_aside:.2f} ms there)"
-    )
     if aside and not kept:
         return Finding(rid, _INCONCLUSIVE, f"every {what} undecided; {note}")
     failing = kept.failing() if type(kept) is Alike else sum(f.verdict is _FAIL for f in kept)
@@ -204,12 +235,52 @@ def combine_local(
         found = combine(rid, kept, what, smallest_is_worst=smallest_is_worst)
     if aside:
         found.detail += f"; {note}"
+    if stalled and found.verdict is _PASS:
+        found = _unconfirmed_across_stall(found, stalled, what)
     # the figures the verdict rests on (combine() drew them already when it saw them all);
     # what the link's irregular stamps set aside is counted
     if isolated:
         found.distribution = distribution(kept)
     if found.distribution is not None:
         found.distribution.set_aside = len(aside)
+    return found
+
+
+def _aside_note(observed: list[Observation], what: str) -> str:
+    """What :func:`combine_local` says of the observations it set aside: those the link's
+    irregular stamps left undecided, and those read across a stall of the tool's own host
+    (tainted by the :class:`~conformance.links.host_stall.Stall`), the first named."""
+    aside = [(o[0], o[1]) for o in observed if _aside(o[0], o[1])]
+    irregular = [f for f, t in aside if type(t) is not Stall]
+    held = [f for f, t in aside if type(t) is Stall]
+    notes = []
+    if irregular:
+        worst_aside = max((f.uncertainty_ms or 0.0 for f in irregular), default=0.0)
+        notes.append(
+            f"{counted(len(irregular), what)} set aside: the link's "
+            f"stamps near them were irregular (±{worst_aside:.2f} ms there)"
+        )
+    if held:
+        first = held[0]
+        where = f" [{first.evidence[0]}]" if first.evidence else ""
+        notes.append(
+            f"{counted(len(held), what)} set aside, read across a stall of the tool's own "
+            f"host, such as: {first.detail}{where}"
+        )
+    return "; ".join(notes)
+
+
+def _unconfirmed_across_stall(found: Finding, places: list[Place | None], what: str) -> Finding:
+    """``found`` (a PASS) INCONCLUSIVE: a deviation read across a host stall is at
+    ``places`` the conforming observations there do not show often enough to stand for
+    (:func:`_stalled_unconfirmed`)."""
+    said = ", ".join(_where(p) if p is not None else "an unplaced one" for p in places[:3])
+    found.verdict = _INCONCLUSIVE
+    found.detail += (
+        f"; but the deviating {plural(what)} read across a stall of the tool's host at "
+        f"{said} were not observed outside a stall often enough "
+        f"({CONFIRM_OBSERVATIONS} times) to tell: not decided"
+    )
     return found
 
 

@@ -32,7 +32,7 @@ from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_byt
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, Segments, frames, runs, segments
 from ..view.sides import expected_reply_address
-from .stalled import through_stall
+from .stalled import stalled_interval, through_stall
 from .tally import Tally
 from .timing import (
     Measured,
@@ -49,6 +49,9 @@ from .timing import (
 )
 
 _START = attrgetter("start")
+#: what an interval read across a host stall is held for (a violation it shows is the
+#: stall's); one the stamps' uncertainty leaves undecided is undecided as ever
+_DEVIATING = (Verdict.FAIL, Verdict.WARN)
 _END = attrgetter("end")
 
 # The cut these judges read lives in the shared view; re-exported for the timing diagram
@@ -73,12 +76,15 @@ __all__ = [
 
 # -- timing ---------------------------------------------------------------------------------
 def judge_response_start(
-    segs: list[Segment], uncertainty: float | StampUncertainty
+    segs: list[Segment], uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
 ) -> list[Finding]:
     """R-7.0-09 (not before 7.93 ms) and R-7.0-10 (within 15.40 ms) for every reply, each
-    with the uncertainty of the stamps it rests on (the command's last, the reply's first)."""
+    with the uncertainty of the stamps it rests on (the command's last, the reply's first).
+    ``stalls``: the tool's own host stalls the link noted (:func:`~conformance.links.
+    host_stall.stalls`): a reply start that deviates across one is set aside, the stall
+    named (:func:`~.stalled.stalled_interval`, truth29)."""
     stamps = stamp_uncertainty(uncertainty)
-    early, late = _starts(segs, stamps)
+    early, late = _starts(segs, stamps, stalls)
     real = stamps.local is not None
     return [
         combine_local("R-7.0-09", early, "reply", real_time=real),
@@ -86,18 +92,22 @@ def judge_response_start(
     ]
 
 
-def starts_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[str]:
+def starts_to_confirm(
+    segs: list[Segment], uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
+) -> list[str]:
     """The commands whose replies :func:`judge_response_start` wants observed again: rare
     deviations on a real-time link not yet placed (:func:`~.timing.to_confirm`)."""
     stamps = stamp_uncertainty(uncertainty)
     if stamps.local is None:  # a virtual clock: nothing to confirm (to_confirm)
         return []
-    early, late = _starts(segs, stamps)
+    early, late = _starts(segs, stamps, stalls)
     both = to_confirm(early, real_time=True) + to_confirm(late, real_time=True)
     return list(dict.fromkeys(both))
 
 
-def starts_after_a_retry(segs: list[Segment], uncertainty: float | StampUncertainty) -> bool:
+def starts_after_a_retry(
+    segs: list[Segment], uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
+) -> bool:
     """Whether R-7.0-10 is left with no reply to judge because every reply it might time
     began after a retry, read in time from the retry and late from the unanswered try before
     it (:func:`_unanswered_before`): a sensor plainly late (the Arduino Due sensor's delay(80)
@@ -106,7 +116,7 @@ def starts_after_a_retry(segs: list[Segment], uncertainty: float | StampUncertai
     (:meth:`~conformance.sensor.session.SensorSession.late_start_probe`); a run with any
     reply R-7.0-10 times (every clean run) sends nothing more."""
     stamps = stamp_uncertainty(uncertainty)
-    _, late = _starts(segs, stamps)
+    _, late = _starts(segs, stamps, stalls)
     if late:
         return False
     before: Segment | None = None
@@ -132,7 +142,7 @@ LATE_WINDOW = Window(
 
 
 def _starts(
-    segs: list[Segment], stamps: StampUncertainty
+    segs: list[Segment], stamps: StampUncertainty, stalls: list[Stall] | None = None
 ) -> tuple[list[Observation], list[Observation]]:
     """R-7.0-09's and R-7.0-10's observations of a whole run's ``segs``, once per
     :class:`Segments` and stamps: test_response_start_window asks
@@ -141,15 +151,25 @@ def _starts(
     the run again (issue 22: some 1,500 replies a fault-matrix row, twice). Nobody changes
     the lists: the judges read them."""
     if isinstance(segs, Segments):
-        return segs.derived("_wire_starts", stamps, lambda: _start_observations(segs, stamps)[:2])
-    return _start_observations(segs, stamps)[:2]
+        return segs.derived(
+            "_wire_starts",
+            (stamps, tuple(stalls or ())),
+            lambda: _start_observations(segs, stamps, stalls=stalls)[:2],
+        )
+    return _start_observations(segs, stamps, stalls=stalls)[:2]
 
 
 def _start_observations(
-    segs: list[Segment], stamps: StampUncertainty, before: Segment | None = None
+    segs: list[Segment],
+    stamps: StampUncertainty,
+    before: Segment | None = None,
+    stalls: list[Stall] | None = None,
 ) -> tuple[list[Observation], list[Observation], Segment | None]:
     """R-7.0-09's and R-7.0-10's observations of ``segs``, and the last segment (which
-    ``before`` carries into the next window's: its reply may be late, after the cut)."""
+    ``before`` carries into the next window's: its reply may be late, after the cut). A
+    start that deviates where one of ``stalls`` (the tool's host's) may have moved its
+    stamps, from the command's last character to the reply's first, is that stall's
+    (:func:`_across_stall`)."""
     early: list[Observation] = []
     late: list[Observation] = []
     texts = _texts(segs)
@@ -179,8 +199,28 @@ def _start_observations(
                 other = measured + seg.command_end - earlier.command_end
                 if window.inside(measured) != window.inside(other):
                     continue
-            out.append((Measured(window, measured, u, said), tainted, place))
+            judged = Measured(window, measured, u, said)
+            if stalls and judged.verdict in _DEVIATING:
+                span = (seg.command[-1].start, seg.reply[0].end)
+                if (held := _across_stall(judged, stalls, *span, place)) is not None:
+                    out.append(held)
+                    continue
+            out.append((judged, tainted, place))
     return early, late, before
+
+
+def _across_stall(
+    judged: Measured, stalls: list[Stall], start: float, end: float, place: Place
+) -> Observation | None:
+    """The observation of a deviating interval (a FAIL or WARN) whose stamps,
+    ``start``..``end``, one of ``stalls`` may have moved (a character the host held back is
+    stamped at the burst that delivers it): INCONCLUSIVE naming the stall, tainted by it,
+    so :func:`~.timing.combine_local` sets it aside and asks for its place again (truth29).
+    None: outside every stall, judged as ever. (One the stamps' uncertainty leaves
+    undecided is not held: a clean run under 80-200 ms pauses re-probed some 40 commands
+    for those, and its R-7.0-09 came out INCONCLUSIVE where base-s66 PASSed.)"""
+    stall = stalled_over(stalls, start, end)
+    return None if stall is None else (stalled_interval(judged, stall), stall, place)
 
 
 class _StartWhere:
@@ -426,7 +466,9 @@ def _run_gaps(
 SEGMENTS_AT_ONCE = 64
 
 
-def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[Finding]:
+def judge_gaps(
+    segs: list[Segment], uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
+) -> list[Finding]:
     """R-7.0-12: at most 1.66 ms of marking between characters (no tolerance), and R-7.0-01:
     a gap inside the ±0.40 ms band above 1.66 ms uses a tolerance the rule does not grant.
     Each gap carries the uncertainty of the two stamps it rests on.
@@ -438,13 +480,14 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
     :func:`gaps_to_confirm`, which reads the same, where the stamps have a local
     irregularity (a host-stamped link); on one uncertainty for every gap they are judged
     through :class:`ReplyGaps` too, in one part, each run's gaps at once
-    (:meth:`_GapsAlike.add_segments`)."""
+    (:meth:`_GapsAlike.add_segments`). ``stalls``: the tool's own host stalls the link
+    noted: a gap that deviates across one is set aside, the stall named (truth29)."""
     stamps = stamp_uncertainty(uncertainty)
-    if not isinstance(segs, Segments) or _alike(stamps):
+    if not isinstance(segs, Segments) or (_alike(stamps) and not stalls):
         # on one uncertainty for every gap (a virtual clock, a capture's grid) nothing is
         # confirmed (gaps_to_confirm): a run's segments kept no observations for it either
         # and are judged the same way in one part (issue 22, matrix19)
-        gaps = ReplyGaps(stamps)
+        gaps = ReplyGaps(stamps, stalls)
         if isinstance(segs, Segments):  # in one part, the Segments themselves (_texts)
             gaps.add(segs)
         else:
@@ -453,7 +496,7 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
         return gaps.findings()
     gap_finding = combine_local(
         "R-7.0-12",
-        _gap_observations(segs, stamps),
+        _gap_observations(segs, stamps, stalls),
         "character gap",
         real_time=stamps.local is not None,
     )
@@ -461,13 +504,15 @@ def judge_gaps(segs: list[Segment], uncertainty: float | StampUncertainty) -> li
     return [gap_finding, tolerance_finding]
 
 
-def gaps_to_confirm(segs: list[Segment], uncertainty: float | StampUncertainty) -> list[str]:
+def gaps_to_confirm(
+    segs: list[Segment], uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
+) -> list[str]:
     """The commands whose replies :func:`judge_gaps` wants observed again: rare deviating
     gaps on a real-time link not yet placed (:func:`~.timing.to_confirm`)."""
     stamps = stamp_uncertainty(uncertainty)
     if stamps.local is None:  # a virtual clock: nothing to confirm (to_confirm)
         return []
-    return to_confirm(_gap_observations(segs, stamps), real_time=True)
+    return to_confirm(_gap_observations(segs, stamps, stalls), real_time=True)
 
 
 #: R-7.0-12's limit, against which every character gap of a run is judged
@@ -476,22 +521,31 @@ GAP_WINDOW = Window(
 )
 
 
-def _gap_observations(segs: list[Segment], stamps: StampUncertainty) -> list[Observation]:
-    """Every gap judged (:data:`GAP_WINDOW`), once per :class:`Segments` and stamps: the
-    rule's judge and its confirmation probe read the same observations."""
+def _gap_observations(
+    segs: list[Segment], stamps: StampUncertainty, stalls: list[Stall] | None = None
+) -> list[Observation]:
+    """Every gap judged (:data:`GAP_WINDOW`), once per :class:`Segments`, stamps and
+    stalls: the rule's judge and its confirmation probe read the same observations."""
     if isinstance(segs, Segments):
-        return segs.derived("_wire_gap_observations", stamps, lambda: _observe_gaps(segs, stamps))
-    return _observe_gaps(segs, stamps)
+        return segs.derived(
+            "_wire_gap_observations",
+            (stamps, tuple(stalls or ())),
+            lambda: _observe_gaps(segs, stamps, stalls),
+        )
+    return _observe_gaps(segs, stamps, stalls)
 
 
-def _observe_gaps(segs: list[Segment], stamps: StampUncertainty) -> list[Observation]:
+def _observe_gaps(
+    segs: list[Segment], stamps: StampUncertainty, stalls: list[Stall] | None = None
+) -> list[Observation]:
     """Each gap judged against :data:`GAP_WINDOW`. A run's gaps take few distinct values in
     the reply to one command (a simulated sensor's are exact; a real link's stamps are
     quantised), and equal gaps judge alike: each distinct ``(gap, uncertainty, where)`` is
-    judged once and its :class:`~.timing.Measured` stands for every gap of that value."""
-    if _alike(stamps):
+    judged once and its :class:`~.timing.Measured` stands for every gap of that value. A
+    gap that deviates across one of ``stalls`` is that stall's (:func:`_across_stall`)."""
+    if _alike(stamps) and not stalls:
         return _observe_gaps_alike(_gaps(segs), stamps.base)
-    return _observe_each(_gaps(segs), stamps, {})
+    return _observe_each(_gaps(segs), stamps, {}, stalls)
 
 
 def _alike(stamps: StampUncertainty) -> bool:
@@ -503,10 +557,14 @@ def _alike(stamps: StampUncertainty) -> bool:
 
 
 def _observe_each(
-    gaps: list[Gap], stamps: StampUncertainty, judged: dict[tuple[float, float, str], Measured]
+    gaps: list[Gap],
+    stamps: StampUncertainty,
+    judged: dict[tuple[float, float, str], Measured],
+    stalls: list[Stall] | None = None,
 ) -> list[Observation]:
-    """:func:`_observe_gaps`' observations one by one (stamps with a local irregularity),
-    ``judged``: the distinct gaps judged so far (:class:`ReplyGaps` carries it)."""
+    """:func:`_observe_gaps`' observations one by one (stamps with a local irregularity, or
+    the host stalls ``stalls`` to read them through), ``judged``: the distinct gaps judged
+    so far (:class:`ReplyGaps` carries it)."""
     base = stamps.base
     observed: list[Observation] = []
     add = observed.append
@@ -521,6 +579,12 @@ def _observe_each(
             measured = judged.get(key)
             if measured is None:
                 measured = judged[key] = Measured(GAP_WINDOW, gap, u, [where])
+        held = None
+        if stalls and measured.verdict in _DEVIATING:
+            held = _across_stall(measured, stalls, a.start, b.end, place)
+        if held is not None:
+            add(held)
+            continue
         add((measured, u > base, place))
     return observed
 
@@ -671,8 +735,11 @@ class ResponseStarts:
     observations in order are the whole run's; the last segment is carried, since a reply
     after a cut may be the late reply of an unanswered command before it)."""
 
-    def __init__(self, uncertainty: float | StampUncertainty) -> None:
+    def __init__(
+        self, uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
+    ) -> None:
         self.stamps = stamp_uncertainty(uncertainty)
+        self.stalls = stalls  # the tool's host stalls, as judge_response_start reads them
         self.early: list[Observation] = []
         self.late: list[Observation] = []
         #: the last segment added: an unanswered command whose late reply may open the next
@@ -680,7 +747,7 @@ class ResponseStarts:
 
     def add(self, segs: list[Segment]) -> None:
         """The replies of ``segs`` (the next window's segments)."""
-        early, late, self.last = _start_observations(segs, self.stamps, self.last)
+        early, late, self.last = _start_observations(segs, self.stamps, self.last, self.stalls)
         self.early += early
         self.late += late
 
@@ -701,10 +768,13 @@ class ReplyGaps:
     the distinct gaps judged so far (each judged once, counted) and R-7.0-01's gaps in or
     maybe in the tolerance band with the count of all."""
 
-    def __init__(self, uncertainty: float | StampUncertainty) -> None:
+    def __init__(
+        self, uncertainty: float | StampUncertainty, stalls: list[Stall] | None = None
+    ) -> None:
         self.stamps = stamps = stamp_uncertainty(uncertainty)
+        self.stalls = stalls  # the tool's host stalls, as judge_gaps reads them
         base = stamps.base
-        self._alike = _GapsAlike(base) if _alike(stamps) else None
+        self._alike = _GapsAlike(base) if _alike(stamps) and not stalls else None
         self._each: list[Observation] = []
         self._judged: dict[tuple[float, float, str], Measured] = {}
         self._tolerance = _ToleranceUse(base)
@@ -715,7 +785,7 @@ class ReplyGaps:
             self._alike.add_segments(segs, self._tolerance)
             return
         gaps = _cut_gaps(segs)
-        self._each += _observe_each(gaps, self.stamps, self._judged)
+        self._each += _observe_each(gaps, self.stamps, self._judged, self.stalls)
         self._tolerance.add(gaps)
 
     def findings(self) -> list[Finding]:

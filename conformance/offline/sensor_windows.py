@@ -363,7 +363,7 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     # the tool's host stalls a run of this tool noted (a capture has none): the framing and
     # every record whose read one may have held up are read as the live run reads them
     stalls = noted_stalls(link.transcript.events)
-    starts, gaps = ResponseStarts(stamps), ReplyGaps(stamps)
+    starts, gaps = ResponseStarts(stamps, stalls), ReplyGaps(stamps, stalls)
     rate, framing = ReplyBitRate(stamps), Framing(stamps, stalls=stalls)
     disturbed, carried = Disturbances(), {}
     exchanges: list[Exchange] = []
@@ -371,6 +371,7 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     for positions, view in bus.read_placed(address, disturbed.waiting):
         rebuilt = rebuild_records(view, uncertainty=u, only=address, carried=carried)
         stalled_reads.mark_reads(rebuilt.exchanges, stalls)
+        stalled_reads.mark_waits(rebuilt.measurements, stalls)
         disturbed.add(view, rebuilt.measurements)
         segs = [Segment.of(t) for t in view.transmissions if address in (None, t.text[:1])]
         for fold in (starts, gaps, rate, framing):

@@ -15,6 +15,7 @@ from typing import Any
 from ..judges.late_before import late_among
 from ..links import host_stall
 from ..links.base import Link
+from ..links.host_stall import Stall
 from ..protocol.commands import Command, Kind
 from ..protocol.framing import LF
 from ..protocol.responses import holds_values
@@ -23,7 +24,7 @@ from ..tool_recorder import stalled_reads
 from ..tool_recorder.engine import ToolRecorder
 from ..tool_recorder.hooks import Engine, Hooks
 from ..tool_recorder.policy import Policy
-from ..tool_recorder.records import CONTENTION, Attempt, Exchange
+from ..tool_recorder.records import CONTENTION, Attempt, Exchange, Measurement
 from ..transcript import SEVEN_BITS
 from .late_watch import LATE_START_LISTEN, LateStartWatch
 
@@ -64,6 +65,9 @@ class WatchedToolRecorder(ToolRecorder):
         self.watch = BufferWatchHooks()
         super().__init__(link, policy, address=address, hooks=self.watch)
         self.last_sent = self.watch.last_sent
+        #: the last :meth:`_stalls_since` asked: (transcript's list, first, length) and what
+        #: it found
+        self._stalls_read: tuple[tuple[int, int, int], list[Stall]] = ((0, -1, -1), [])
 
     def transact(self, command: Command | str, **kw: Any) -> Exchange:
         """The engine's exchange, linked to the one before it where that may have answered
@@ -83,14 +87,32 @@ class WatchedToolRecorder(ToolRecorder):
         self.mark_stalls([ex], first)
         return self._link_late_before(before, ex, seen)
 
-    def mark_stalls(self, exchanges: Iterable[Exchange | None], first: int) -> None:
+    def mark_stalls(
+        self,
+        exchanges: Iterable[Exchange | None],
+        first: int,
+        measurements: Iterable[Measurement] = (),
+    ) -> None:
         """Mark the attempts of ``exchanges`` whose reads a stall of the tool's own host may
-        have held up (:func:`~conformance.tool_recorder.stalled_reads.mark_reads`), from the link's
-        notes since its transcript's event ``first`` (the stimulus began there), once the
-        link has noted what it had to (its reader thread resumes with the engine)."""
-        self.link.reader_caught_up()
-        found = host_stall.stalls_since(self.link.transcript.events, first)
+        have held up (:func:`~conformance.tool_recorder.stalled_reads.mark_reads`), and the
+        waits of ``measurements`` it may have cut (:func:`~conformance.tool_recorder.
+        stalled_reads.mark_waits`), from the link's notes since its transcript's event
+        ``first`` (the stimulus began there), once the link has noted what it had to (its
+        reader thread resumes with the engine)."""
+        found = self._stalls_since(first)
         stalled_reads.mark_reads(exchanges, found)
+        stalled_reads.mark_waits(measurements, found)
+
+    def _stalls_since(self, first: int) -> list[Stall]:
+        """:func:`~conformance.links.host_stall.stalls_since` of the link's transcript, read
+        once per stimulus: the engine's records and the view's rebuilt ones of the same
+        stimulus ask it with the same ``first`` and no event added between (truth29)."""
+        self.link.reader_caught_up()
+        events = self.link.transcript.events
+        key = (id(events), first, len(events))
+        if self._stalls_read[0] != key:
+            self._stalls_read = (key, host_stall.stalls_since(events, first))
+        return self._stalls_read[1]
 
     def _hear_late_reply(self, ex: Exchange) -> Exchange:
         """Where every try of ``ex`` went unanswered in its window and the sensor has been

@@ -103,8 +103,8 @@ class ExplorerSteps:
             return
         if code in ("C", "CC"):
             self._wait_out(ex)
-        self._observe_framing(ex)
-        stalled = _stalled(ex)
+        stalled = _stalled(ex)  # read once for the framing, CRC and repeat observations
+        self._observe_framing(ex, stalled)
         if code.startswith("D"):
             self._observe(Observation("crc", ex.text, ex.reply_text, stalled=stalled))
         if code == "D0":
@@ -177,10 +177,11 @@ class ExplorerSteps:
         self.record.exchanges += changer.exchanges
         self._note(f"taken as a change to address '{moved}' (decision A12); {note}")
 
-    def _observe_framing(self, ex: Exchange) -> None:
-        self._observe(
-            Observation("framing", ex.text, ex.reply_text, self.address, stalled=_stalled(ex))
-        )
+    def _observe_framing(self, ex: Exchange, stalled: str | None = None) -> None:
+        """The framing of ``ex``'s reply; ``stalled``: :func:`_stalled` of it, where the
+        caller read it already."""
+        why = _stalled(ex) if stalled is None else stalled
+        self._observe(Observation("framing", ex.text, ex.reply_text, self.address, stalled=why))
 
     def step(self, name: str, arguments: dict[str, object]) -> None:
         """Send one step drawn for the rule ``name`` (:func:`_with_rules`)."""

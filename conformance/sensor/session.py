@@ -483,6 +483,7 @@ class SensorSession(Session):
         mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
         made = self.master.measure(self.command(code), **kw)
         seen = self._rebuilt(mark).measurements
+        self.master.mark_stalls((), mark.first, [made])  # its wait, as the view's (_rebuilt)
         return self._as_seen(made, seen[0] if len(seen) == 1 else None)
 
     # -- what the cases judge: the stimulus as the wire shows it -------------------------------
@@ -502,7 +503,7 @@ class SensorSession(Session):
             rebuilt = records_of(shared, policy, uncertainty=uncertainty)
         # reads the host stalled over, as the engine's own records are marked (the same
         # notes: the engine has waited for the link to write them)
-        self.master.mark_stalls(rebuilt.exchanges, mark.first)
+        self.master.mark_stalls(rebuilt.exchanges, mark.first, rebuilt.measurements)
         return rebuilt
 
     def _as_seen(self, made: R, seen: R | None) -> R:

@@ -300,6 +300,9 @@ class Measurement:
     packets: list[bytes] = field(default_factory=list)
     binary_value_count: int = 0
     aborted_by: str | None = None
+    #: a stall of the tool's own host that may have cut, misdated or hidden the service
+    #: request of the wait (:func:`~conformance.tool_recorder.stalled_reads.wait_stall`)
+    wait_stall: Stall | None = field(default=None, repr=False, compare=False)
 
     @property
     def binary(self) -> bool:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from ..links.host_stall import Stall, stalled_over
-from .records import Attempt, Exchange
+from .records import Attempt, Exchange, Measurement
 
 
 def read_stall(attempt: Attempt, found: list[Stall]) -> Stall | None:
@@ -41,3 +41,31 @@ def mark_reads(exchanges: Iterable[Exchange | None], found: list[Stall]) -> None
     for attempt in attempts:
         if attempt.stall is None:
             attempt.stall = read_stall(attempt, near)
+
+
+def wait_stall(m: Measurement, found: list[Stall]) -> Stall | None:
+    """The first of ``found`` that may have cut, misdated or hidden ``m``'s service request
+    (truth29): one over the wait's characters, from the first the sensor sent after the
+    ``atttn`` reply (else the wait's end) to the end of the wait (its first D read's start;
+    else its last character, or ttt). Characters the sensor sent during a stall are stamped
+    at the late burst that delivers them: a service request split into two runs, or dated
+    past ttt; one delivered after the wait ended lies in the D read's record, not the
+    wait's. A stall earlier in a wait, before any character of it, moves nothing."""
+    if not found or m.reply_end is None or m.ttt is None:
+        return None
+    waited = m.waited_events
+    if m.data:
+        end = m.data[0].start
+    else:
+        end = max(m.reply_end + m.ttt, waited[-1].end if waited else m.reply_end)
+    return stalled_over(found, waited[0].start if waited else end, end)
+
+
+def mark_waits(measurements: Iterable[Measurement], found: list[Stall]) -> None:
+    """Set ``Measurement.wait_stall`` (:func:`wait_stall`) on each of ``measurements``
+    that has none yet, as :func:`mark_reads` marks their reads."""
+    if not found:
+        return
+    for m in measurements:
+        if m.wait_stall is None:
+            m.wait_stall = wait_stall(m, found)

@@ -33,12 +33,21 @@ def _segments(sensor):
     return Segments(s for s in segs if s.text[:1] == sensor.address)
 
 
+def _stalls(sensor):
+    """The tool's own host stalls the link noted (:func:`~conformance.links.host_stall.
+    stalls`); none on a virtual clock (its transcript is not read for them)."""
+    if sensor.link.info.virtual_time:
+        return []
+    return host_stall.stalls(sensor.link.transcript.events)
+
+
 def _confirmed(sensor, case, wanted):
-    """The run's segments, after re-probing the commands ``wanted(segments, stamps)`` names:
-    a rare deviation on a real-time link is observed again with the same command before the
-    judge decides it or sets it aside (issue 18); the repeats are the case's evidence."""
+    """The run's segments, after re-probing the commands ``wanted(segments, stamps,
+    stalls)`` names: a rare deviation on a real-time link, or one read across a stall of
+    the tool's host, is observed again with the same command before the judge decides it
+    or sets it aside (issue 18, truth29); the repeats are the case's evidence."""
     segs = _segments(sensor)
-    again = wanted(segs, sensor.stamp_uncertainty)
+    again = wanted(segs, sensor.stamp_uncertainty, _stalls(sensor))
     repeats = sensor.reprobe(again) if again else []
     if not repeats:
         return segs
@@ -52,12 +61,13 @@ def test_response_start_window(sensor, case):
     """Every reply's first start bit comes 7.93 to 15.40 ms after the command's last stop bit."""
     case.expect("8.33 ms (-0.40) <= delay <= 15.0 ms (+0.40), for every reply of the run")
     segs = _confirmed(sensor, case, wire.starts_to_confirm)
-    if wire.starts_after_a_retry(segs, sensor.stamp_uncertainty):
+    stalls = _stalls(sensor)
+    if wire.starts_after_a_retry(segs, sensor.stamp_uncertainty, stalls):
         # every reply began after a retry: one a! sent once, with no retry, times it alone
         probe = sensor.late_start_probe()
         case.evidence("every reply began after a retry: a! sent once, no retry, 1 s", [probe])
-        segs = _segments(sensor)
-    case.extend(wire.judge_response_start(segs, sensor.stamp_uncertainty))
+        segs, stalls = _segments(sensor), _stalls(sensor)
+    case.extend(wire.judge_response_start(segs, sensor.stamp_uncertainty, stalls))
 
 
 @requirements("R-7.0-12", "R-7.0-01")
@@ -66,7 +76,7 @@ def test_character_gaps(sensor, case):
     """No more than 1.66 ms of marking between the characters of a reply (no tolerance)."""
     case.expect("every inter-character gap of every reply <= 1.66 ms")
     segs = _confirmed(sensor, case, wire.gaps_to_confirm)
-    case.extend(wire.judge_gaps(segs, sensor.stamp_uncertainty))
+    case.extend(wire.judge_gaps(segs, sensor.stamp_uncertainty, _stalls(sensor)))
 
 
 @requirements("R-4.1-01", "R-4.1-02", "R-4.2-02", "R-4.2-03", "R-4.3-01")
