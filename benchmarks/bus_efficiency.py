@@ -42,6 +42,7 @@ import argparse
 import bisect
 import json
 import os
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -53,7 +54,10 @@ import conformance
 from conformance.capture.transcript_io import read_transcript_jsonl
 from conformance.emulator_server.process import EmulatorProcess
 from conformance.links.bus_time import bus_time, uncounted
-from conformance.transcript import TOOL, Event, EventKind, decode_7e1
+from conformance.transcript import TOOL, Event, EventKind, decode_7e1, write_jsonl
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from wire_tap import TapRecorder, wire_figures  # noqa: E402
 
 #: an uncounted stretch this long is listening on purpose (a wait, a probe's idle marking),
 #: not the turnaround, look and read grace around one exchange
@@ -66,9 +70,27 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--faults", default="", help="emulator faults (default: clean)")
     p.add_argument("--keep", help="write the reports here instead of a temporary folder")
     p.add_argument(
+        "--bench",
+        default="",
+        metavar="ARGS",
+        help='serve the emulator behind these bench models, e.g. "--echo --usb-latency 16"',
+    )
+    p.add_argument(
+        "--listen",
+        default="127.0.0.1:0",
+        metavar="HOST:PORT",
+        help="where the emulator serves (default: a free loopback port)",
+    )
+    p.add_argument(
         "--attribute",
         metavar="DIR",
         help="no run: sort the wall beyond the lower bound of a kept run by its causes",
+    )
+    p.add_argument(
+        "--wire",
+        metavar="HOST:PORT",
+        help="also serve the line on a tap there and give the run's figures on the line's own "
+        "clock (wire_tap.py: the bound without the receive path's stamps, the adapter floor)",
     )
     args = p.parse_args(argv)
     if args.attribute:
@@ -84,7 +106,15 @@ def main(argv: list[str] | None = None) -> int:
     os.chdir(Path(conformance.__file__).resolve().parents[1])
     load_before = os.getloadavg()
     extra = ["--faults", args.faults] if args.faults else []
+    # EmulatorProcess listens on a free port; a later --listen wins in emulate's parser
+    extra += ["--listen", args.listen, *shlex.split(args.bench)]
+    if args.wire:
+        extra += ["--tap", f"socket://{args.wire}"]
+    tap = None
     with EmulatorProcess(*extra) as emulator:
+        if args.wire:
+            host, port = args.wire.rsplit(":", 1)
+            tap = TapRecorder(host, int(port))
         command = [
             sys.executable,
             "-m",
@@ -99,6 +129,7 @@ def main(argv: list[str] | None = None) -> int:
         started = time.monotonic()
         proc = subprocess.run(command, capture_output=True, text=True)
         process_s = time.monotonic() - started
+        heard = tap.stop() if tap is not None else []
     verdicts = out / "verdicts.json"
     if not verdicts.exists():
         print(proc.stdout + proc.stderr)
@@ -112,8 +143,16 @@ def main(argv: list[str] | None = None) -> int:
     print(f"wall time (link)     {bus['wall_s']:.1f} s")
     print(f"efficiency           {bus['efficiency']:.3f} (lower bound / wall time)")
     print(f"whole process        {process_s:.1f} s (pytest start-up and reports included)")
+    if args.bench:
+        print(f"bench models         {args.bench}")
     print(f"load average         {_load(load_before)} before, {_load(os.getloadavg())} after")
     print(f"reports              {out}")
+    if tap is not None:
+        events = read_transcript_jsonl(str(out / "transcript.jsonl"))
+        wire = wire_figures(events, heard)
+        print(wire.text(bus["bus_lower_bound_s"]))
+        write_jsonl(str(out / "wire.jsonl"), wire.placed)
+        print(f"                     the events on the line's clock: {out / 'wire.jsonl'}")
     return 0
 
 

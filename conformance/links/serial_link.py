@@ -64,6 +64,10 @@ def precise_sleep_until(clock_now, target: float) -> None:
         time.sleep(left - SPIN if left > 2 * SPIN else 0)
 
 
+#: pushed frames whose arrival :meth:`SerialLink.received_by` keeps (the last reply's, with room)
+PUSHED_KEPT = 64
+
+
 class SerialLink(Link):
     """The tool's end of a real bus reached through ``port`` (an open pyserial port)."""
 
@@ -98,6 +102,9 @@ class SerialLink(Link):
         # (floor before it, marking its stamps showed before it, arrival) of the last chunk
         self._previous_chunk = (0.0, 0.0, float("-inf"))
         self._last_origin = ""  # who sent the last frame recorded ("tool": its echo)
+        # stamp end -> arrival of the last few frames the no-overlap rule placed after their
+        # arrival (received_by): only those, and only the latest, are ever asked about
+        self._pushed: dict[float, float] = {}
         self._tx_free = 0.0  # end of the tool's last frame on the wire
         self._failure: BaseException | None = None
         self._closing = threading.Event()
@@ -202,9 +209,30 @@ class SerialLink(Link):
         with self._cond:
             for chunk, at in _chunks(data, stamps or [arrival] * len(data)):
                 for byte, end in zip(chunk, self._frame_ends(chunk, at), strict=True):
+                    if end > at:
+                        self._note_pushed(end, at)
                     for heard in self.echo.heard(byte, end):
                         self._record(heard)
             self._cond.notify_all()
+
+    def _note_pushed(self, end: float, arrival: float) -> None:
+        """Keep that the frame stamped to end at ``end`` had reached the host at ``arrival``
+        (caller holds the lock); the oldest go once :data:`PUSHED_KEPT` are kept."""
+        pushed = self._pushed
+        pushed[end] = arrival
+        if len(pushed) > PUSHED_KEPT:
+            del pushed[next(iter(pushed))]
+
+    def received_by(self, end: float) -> float:
+        """The latest the received character whose stamp ends at ``end`` can have ended on
+        the wire: a byte is whole on the wire before the host has it, so where the
+        no-overlap rule (:func:`~.stamps.chunk_frames`) placed its frame after its arrival,
+        the arrival; else the stamp's end. Behind a 16 ms latency timer the replies come two
+        characters a tick, 16.67 ms of frames in 16 ms, and the rule pushed a reply's last
+        character 0-16 ms past its arrival (issue 22, usb12): a turnaround counted from
+        that stamp waited that much more than the sensor's release (R-7.0-11) asks."""
+        with self._cond:
+            return min(end, self._pushed.get(end, end))
 
     def _frame_ends(self, chunk: bytes, arrival: float) -> list[float]:
         """Stop-bit ends of bytes that reached the host together, and what that shows about
