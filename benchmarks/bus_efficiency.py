@@ -149,7 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"reports              {out}")
     if tap is not None:
         events = read_transcript_jsonl(str(out / "transcript.jsonl"))
-        wire = wire_figures(events, heard)
+        wire = wire_figures(events, heard, _usb_latency(args.bench))
         print(wire.text(bus["bus_lower_bound_s"]))
         write_jsonl(str(out / "wire.jsonl"), wire.placed)
         print(f"                     the events on the line's clock: {out / 'wire.jsonl'}")
@@ -239,6 +239,17 @@ def _commands(wire: list[Event]) -> list[tuple[float, str]]:
                 found.append((current[0].start, decode_7e1(current)))
                 current = []
     return found
+
+
+def _usb_latency(bench: str) -> float:
+    """The latency-timer period (s) ``--usb-latency MS`` in ``bench`` gives emulate; 0."""
+    words = shlex.split(bench)
+    for k, word in enumerate(words):
+        if word == "--usb-latency" and k + 1 < len(words):
+            return float(words[k + 1]) / 1e3
+        if word.startswith("--usb-latency="):
+            return float(word.split("=", 1)[1]) / 1e3
+    return 0.0
 
 
 def _load(averages: tuple[float, float, float]) -> str:

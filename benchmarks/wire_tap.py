@@ -16,13 +16,17 @@ events at the time the line carried it, and gives two figures beside ``run.bus``
   gives the sensor to release the line (R-7.0-11). A recorder behind the adapter sees the
   last character only when the adapter delivers it, so it cannot start its next
   transmission sooner than ``max(7.5 ms, delivery lateness)`` after the character ended.
+  The delivery is the model's: the first tick of a free-running latency timer at or after
+  the stop bit (:func:`_tick_phase` finds the ticks).
 
 Neither is ``run.bus``: both need the tap, which no real bench has.
 """
 
 from __future__ import annotations
 
+import math
 import socket
+import statistics
 import threading
 import time
 from dataclasses import dataclass
@@ -34,6 +38,8 @@ from conformance.transcript import TOOL, Event, EventKind
 
 #: where the tap reads a break after it began (s): a UART samples the stop bit 9.5 bits in
 BREAK_HEARD = SAMPLE_STOP / BAUD
+#: bins of a latency-timer period in which :func:`_tick_phase` counts the stamps' phases
+PHASE_BINS = 160
 #: how far the alignment looks ahead for the next equal byte when the two sequences differ
 RESYNC = 8
 
@@ -139,36 +145,35 @@ class WireFigures:
         )
 
 
-def wire_figures(events: list[Event], heard: list[tuple[float, int]]) -> WireFigures:
-    """The tool's events (a transcript) placed on the line's clock, and their figures."""
+def wire_figures(
+    events: list[Event], heard: list[tuple[float, int]], tick: float = 0.0
+) -> WireFigures:
+    """The tool's events (a transcript) placed on the line's clock, and their figures;
+    ``tick``: the bench's latency-timer period (s; 0: none, the floor is the bound)."""
     recorded = [e for e in events if e.kind is not EventKind.NOTE]
     pairs = align(recorded, heard)
     placed: list[Event] = []
-    delivered: dict[int, float] = {}  # id of a placed DUT char -> its stamp in the tool's clock
-    offsets: list[float] = []
+    host_breaks: list[float] = []  # the tool's clock less the tap's, at each host-timed break
     for e, at in pairs:
         if e.kind is EventKind.BREAK:
             start = at - BREAK_HEARD
             moved = Event(e.kind, e.origin, start, start + e.duration, wire=e.wire, text=e.text)
+            if "timed by the host" in e.text:
+                host_breaks.append(e.start - start)
         else:
             moved = Event(e.kind, e.origin, at - CHAR_TIME, at, wire=e.wire)
-            if e.origin != TOOL:
-                offsets.append(e.end - at)
-                delivered[id(moved)] = e.end
         placed.append(moved)
     placed.sort(key=lambda e: e.start)
     if not placed:
         return WireFigures(0, len(recorded), 0.0, 0.0, 0.0, 0, 0.0, 0.0)
-    # the tool's clock less the tap's: a character the adapter passed on at once (its stop
-    # bit just before a latency-timer tick) arrived as it ended; over thousands, the least
-    offset = min(offsets) if offsets else 0.0
     spans = [*_own_spans(placed), *_gaps(placed), *_announced_waits(placed)]
     bound = _sweep(sorted(spans))
+    phase = _tick_phase(recorded, host_breaks, tick)
     extra: list[tuple[float, float]] = []
     lateness: list[float] = []
     for a, b in zip(placed, placed[1:], strict=False):
-        if a.origin != TOOL and a.kind is EventKind.CHAR and b.origin == TOOL:
-            late = delivered[id(a)] - offset - a.end
+        if phase is not None and a.origin != TOOL and a.kind is EventKind.CHAR and b.origin == TOOL:
+            late = phase + math.ceil((a.end - phase) / tick) * tick - a.end
             lateness.append(late)
             if late > RELEASE_LINE:
                 extra.append((a.end + RELEASE_LINE, a.end + min(late, b.start - a.end)))
@@ -184,3 +189,22 @@ def wire_figures(events: list[Event], heard: list[tuple[float, int]]) -> WireFig
         lateness_worst=max(lateness, default=0.0),
         placed=tuple(placed),
     )
+
+
+def _tick_phase(recorded: list[Event], host_breaks: list[float], tick: float) -> float | None:
+    """Where (s, on the tap's clock, modulo ``tick``) the bench's free-running latency timer
+    ticks, so each reply character's delivery is the first tick at or after its stop bit
+    (``emulator_server.bench.Delivery``). The ticks on the tool's clock: the commonest
+    phase of its reply characters' stamp ends (a character the no-overlap rule did not move
+    is stamped at its arrival, a tick); the two clocks' offset: the median over the
+    host-timed breaks, whose stamps are the tool's own clock at the break's start. None
+    without a tick or a break to tie the clocks."""
+    if tick <= 0 or not host_breaks:
+        return None
+    bins = [0] * PHASE_BINS
+    for e in recorded:
+        if e.kind is EventKind.CHAR and e.origin != TOOL:
+            bins[int(e.end % tick / tick * PHASE_BINS) % PHASE_BINS] += 1
+    commonest = max(range(PHASE_BINS), key=bins.__getitem__)
+    on_tool_clock = (commonest + 0.5) * tick / PHASE_BINS
+    return (on_tool_clock - statistics.median(host_breaks)) % tick
