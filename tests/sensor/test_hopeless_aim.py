@@ -74,8 +74,9 @@ def test_a_command_90_ms_after_the_break_that_cannot_show_100_goes_out_once(tmp_
     finding, breaks, missed = _ready(tmp_path, "--timing-uncertainty-ms", "15.4")
     assert finding["verdict"] == "INCONCLUSIVE"
     assert "none of" not in finding["detail"]
-    assert "cannot show a command 90 ms after a break to be within 100 ms: one try" in (
-        finding["detail"]
+    assert (
+        "cannot show a command 90 ms after a break to be within 100 ms: one try"
+        in (finding["detail"])
     )
     assert missed == 1  # one try, noted as missed, and no more
     _, exact_breaks, exact_missed = _ready(tmp_path / "exact")
