@@ -143,6 +143,18 @@ class SerialLink(Link):
         :meth:`timing_uncertainty` where the run saw its stamps irregular near them."""
         return self.meter.between(start, end)
 
+    def read_grace(self) -> float:
+        """How long past its limit a read waits for characters stamped as started by then
+        (s). A byte's stamp ends at its arrival or later (:func:`~.stamps.chunk_frames`), so
+        its frame starts at most a frame, or a chunk's frames, before the host had it: the
+        character time, and the declared floor or the longest batch seen, whichever is
+        larger (for bytes the kernel stamped that the reader thread has not handed over yet,
+        or that came several to a stamp). Not the link's latency bound (the worst write to
+        echo): that is how late a byte arrives after its stop bit, which its arrival stamp
+        already carries; behind a 16 ms latency timer it made every read that ran to its
+        deadline wait 11 ms more than the stamps could ever count (issue 22, usb12)."""
+        return CHAR_TIME + max(self.info.timing_uncertainty, self.meter.batches.value)
+
     def latency_bound(self) -> float:
         """How long a byte may take to reach the reader after its stop bit (s)."""
         return max(self.info.timing_uncertainty, self.meter.round_trip.value)
@@ -616,12 +628,11 @@ class SerialLink(Link):
     def receive(
         self, deadline: float, until: StopCondition | None = None, idle: float | None = None
     ) -> list[Event]:
-        """As :meth:`Link.receive`. A byte is seen only after its stop bit (and the link's
-        latency), so a read whose limit lies ahead waits one frame plus the latency bound
-        past it for characters that started in time; one whose limit has already passed
-        returns what is queued at once."""
+        """As :meth:`Link.receive`. A byte is seen only after its stop bit, so a read whose
+        limit lies ahead waits :meth:`read_grace` past it for characters that started in
+        time; one whose limit has already passed returns what is queued at once."""
         got: list[Event] = []
-        grace = CHAR_TIME + self.latency_bound()
+        grace = self.read_grace()
         waits = deadline > self.now()
         with self._cond:
             while True:
