@@ -7,7 +7,15 @@ would need for the same exchanges: frames, breaks, the marking after them, the s
 delays and announced measurement times) next to the wall time the run took, and their ratio.
 
     python benchmarks/bus_efficiency.py [-k EXPR] [--faults NAME,...] [--keep DIR]
+    python benchmarks/bus_efficiency.py --bench "--echo --usb-latency 16" --wire 127.0.0.1:4803
     python benchmarks/bus_efficiency.py --attribute DIR   (a kept run: where the rest went)
+
+``--bench ARGS`` serves the emulator behind ``emulate``'s bench models (an echoing interface
+behind an FTDI-style 16 ms latency timer, above), ``--listen HOST:PORT`` where it serves,
+``--wire HOST:PORT`` also serves the line on an ``emulate --tap`` there and prints the run on
+the line's own clock beside ``run.bus`` (``wire_tap.py``: the bound without the receive
+path's stamps, and the adapter floor, the bound plus what the latency timer's delivery of
+each answered reply's last character added past the 7.5 ms the bound gives the sensor).
 
 Takes about as long as the suite's bus time (roughly five minutes for every case). The wall
 time counts everything the run did on the link's clock: the bus span (first to last event on
