@@ -105,6 +105,7 @@ class SerialLink(Link):
         # stamp end -> arrival of the last few frames the no-overlap rule placed after their
         # arrival (received_by): only those, and only the latest, are ever asked about
         self._pushed: dict[float, float] = {}
+        self._widest_chunk = 1  # the most bytes seen under one arrival stamp (read_grace)
         self._tx_free = 0.0  # end of the tool's last frame on the wire
         self._failure: BaseException | None = None
         self._closing = threading.Event()
@@ -146,14 +147,16 @@ class SerialLink(Link):
     def read_grace(self) -> float:
         """How long past its limit a read waits for characters stamped as started by then
         (s). A byte's stamp ends at its arrival or later (:func:`~.stamps.chunk_frames`), so
-        its frame starts at most a frame, or a chunk's frames, before the host had it: the
-        character time, and the declared floor or the longest batch seen, whichever is
-        larger (for bytes the kernel stamped that the reader thread has not handed over yet,
-        or that came several to a stamp). Not the link's latency bound (the worst write to
-        echo): that is how late a byte arrives after its stop bit, which its arrival stamp
-        already carries; behind a 16 ms latency timer it made every read that ran to its
-        deadline wait 11 ms more than the stamps could ever count (issue 22, usb12)."""
-        return CHAR_TIME + max(self.info.timing_uncertainty, self.meter.batches.value)
+        the first of k bytes that came under one stamp starts at most k frames before the
+        host had it: the frames of the most bytes seen under one stamp, and the declared
+        floor for a byte the kernel has stamped that the reader thread has not handed over
+        yet. Not the link's latency bound (the worst write to echo): that is how late a
+        byte arrives after its stop bit, which its arrival stamp already carries; behind a
+        16 ms latency timer it made every read that ran to its deadline wait 16.4 ms where
+        the stamps need a frame, or two where two bytes ever came under one stamp (issue
+        22, usb12). Bytes that came in a burst, each under its own stamp, are a frame each:
+        they widen the stamps' uncertainty, not this."""
+        return self._widest_chunk * CHAR_TIME + self.info.timing_uncertainty
 
     def latency_bound(self) -> float:
         """How long a byte may take to reach the reader after its stop bit (s)."""
@@ -263,6 +266,7 @@ class SerialLink(Link):
         # by the run's regular figure; beyond it they are evidence of their own
         jitter = max(self.meter.regular(), ECHO_FLOOR)
         if count > 1:
+            self._widest_chunk = max(self._widest_chunk, count)
             hidden = (count - 1) * CHAR_TIME
             self.meter.batches.add(hidden, f"{count} bytes at once")
             self.meter.taint(
