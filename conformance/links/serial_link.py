@@ -152,9 +152,9 @@ class SerialLink(Link):
         floor for a byte the kernel has stamped that the reader thread has not handed over
         yet. Not the link's latency bound (the worst write to echo): that is how late a
         byte arrives after its stop bit, which its arrival stamp already carries; behind a
-        16 ms latency timer it made every read that ran to its deadline wait 16.4 ms where
-        the stamps need a frame, or two where two bytes ever came under one stamp (issue
-        22, usb12). Bytes that came in a burst, each under its own stamp, are a frame each:
+        16 ms latency timer it made the grace of every read that ran to its deadline 24.7
+        ms where the stamps need 13.3 (21.7 where two bytes ever came under one stamp;
+        issue 22, usb12). Bytes that came in a burst, each under its own stamp, are a frame each:
         they widen the stamps' uncertainty, not this."""
         return self._widest_chunk * CHAR_TIME + self.info.timing_uncertainty
 
