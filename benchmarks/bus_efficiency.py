@@ -7,7 +7,15 @@ would need for the same exchanges: frames, breaks, the marking after them, the s
 delays and announced measurement times) next to the wall time the run took, and their ratio.
 
     python benchmarks/bus_efficiency.py [-k EXPR] [--faults NAME,...] [--keep DIR]
+    python benchmarks/bus_efficiency.py --bench "--echo --usb-latency 16" --wire 127.0.0.1:4803
     python benchmarks/bus_efficiency.py --attribute DIR   (a kept run: where the rest went)
+
+``--bench ARGS`` serves the emulator behind ``emulate``'s bench models (an echoing interface
+behind an FTDI-style 16 ms latency timer, above), ``--listen HOST:PORT`` where it serves,
+``--wire HOST:PORT`` also serves the line on an ``emulate --tap`` there and prints the run on
+the line's own clock beside ``run.bus`` (``wire_tap.py``: the bound without the receive
+path's stamps, and the adapter floor, the bound plus what the latency timer's delivery of
+each answered reply's last character added past the 7.5 ms the bound gives the sensor).
 
 Takes about as long as the suite's bus time (roughly five minutes for every case). The wall
 time counts everything the run did on the link's clock: the bus span (first to last event on
@@ -42,6 +50,7 @@ import argparse
 import bisect
 import json
 import os
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -53,7 +62,10 @@ import conformance
 from conformance.capture.transcript_io import read_transcript_jsonl
 from conformance.emulator_server.process import EmulatorProcess
 from conformance.links.bus_time import bus_time, uncounted
-from conformance.transcript import TOOL, Event, EventKind, decode_7e1
+from conformance.transcript import TOOL, Event, EventKind, decode_7e1, write_jsonl
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from wire_tap import TapRecorder, wire_figures  # noqa: E402
 
 #: an uncounted stretch this long is listening on purpose (a wait, a probe's idle marking),
 #: not the turnaround, look and read grace around one exchange
@@ -66,9 +78,27 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--faults", default="", help="emulator faults (default: clean)")
     p.add_argument("--keep", help="write the reports here instead of a temporary folder")
     p.add_argument(
+        "--bench",
+        default="",
+        metavar="ARGS",
+        help='serve the emulator behind these bench models, e.g. "--echo --usb-latency 16"',
+    )
+    p.add_argument(
+        "--listen",
+        default="127.0.0.1:0",
+        metavar="HOST:PORT",
+        help="where the emulator serves (default: a free loopback port)",
+    )
+    p.add_argument(
         "--attribute",
         metavar="DIR",
         help="no run: sort the wall beyond the lower bound of a kept run by its causes",
+    )
+    p.add_argument(
+        "--wire",
+        metavar="HOST:PORT",
+        help="also serve the line on a tap there and give the run's figures on the line's own "
+        "clock (wire_tap.py: the bound without the receive path's stamps, the adapter floor)",
     )
     args = p.parse_args(argv)
     if args.attribute:
@@ -84,7 +114,15 @@ def main(argv: list[str] | None = None) -> int:
     os.chdir(Path(conformance.__file__).resolve().parents[1])
     load_before = os.getloadavg()
     extra = ["--faults", args.faults] if args.faults else []
+    # EmulatorProcess listens on a free port; a later --listen wins in emulate's parser
+    extra += ["--listen", args.listen, *shlex.split(args.bench)]
+    if args.wire:
+        extra += ["--tap", f"socket://{args.wire}"]
+    tap = None
     with EmulatorProcess(*extra) as emulator:
+        if args.wire:
+            host, port = args.wire.rsplit(":", 1)
+            tap = TapRecorder(host, int(port))
         command = [
             sys.executable,
             "-m",
@@ -99,6 +137,7 @@ def main(argv: list[str] | None = None) -> int:
         started = time.monotonic()
         proc = subprocess.run(command, capture_output=True, text=True)
         process_s = time.monotonic() - started
+        heard = tap.stop() if tap is not None else []
     verdicts = out / "verdicts.json"
     if not verdicts.exists():
         print(proc.stdout + proc.stderr)
@@ -112,8 +151,16 @@ def main(argv: list[str] | None = None) -> int:
     print(f"wall time (link)     {bus['wall_s']:.1f} s")
     print(f"efficiency           {bus['efficiency']:.3f} (lower bound / wall time)")
     print(f"whole process        {process_s:.1f} s (pytest start-up and reports included)")
+    if args.bench:
+        print(f"bench models         {args.bench}")
     print(f"load average         {_load(load_before)} before, {_load(os.getloadavg())} after")
     print(f"reports              {out}")
+    if tap is not None:
+        events = read_transcript_jsonl(str(out / "transcript.jsonl"))
+        wire = wire_figures(events, heard, _usb_latency(args.bench))
+        print(wire.text(bus["bus_lower_bound_s"]))
+        write_jsonl(str(out / "wire.jsonl"), wire.placed)
+        print(f"                     the events on the line's clock: {out / 'wire.jsonl'}")
     return 0
 
 
@@ -200,6 +247,17 @@ def _commands(wire: list[Event]) -> list[tuple[float, str]]:
                 found.append((current[0].start, decode_7e1(current)))
                 current = []
     return found
+
+
+def _usb_latency(bench: str) -> float:
+    """The latency-timer period (s) ``--usb-latency MS`` in ``bench`` gives emulate; 0."""
+    words = shlex.split(bench)
+    for k, word in enumerate(words):
+        if word == "--usb-latency" and k + 1 < len(words):
+            return float(words[k + 1]) / 1e3
+        if word.startswith("--usb-latency="):
+            return float(word.split("=", 1)[1]) / 1e3
+    return 0.0
 
 
 def _load(averages: tuple[float, float, float]) -> str:

@@ -210,5 +210,11 @@ class Link(BusEnd):
                 return event.end
         return float("-inf")
 
+    def received_by(self, end: float) -> float:
+        """The latest the received character whose stamp ends at ``end`` can have ended on
+        the wire: its stamp's end here. A real link whose stamps may be placed after the
+        host already had the byte says less (:meth:`SerialLink.received_by`)."""
+        return end
+
     def char_time(self) -> float:
         return CHAR_TIME

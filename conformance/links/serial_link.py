@@ -64,6 +64,10 @@ def precise_sleep_until(clock_now, target: float) -> None:
         time.sleep(left - SPIN if left > 2 * SPIN else 0)
 
 
+#: pushed frames whose arrival :meth:`SerialLink.received_by` keeps (the last reply's, with room)
+PUSHED_KEPT = 64
+
+
 class SerialLink(Link):
     """The tool's end of a real bus reached through ``port`` (an open pyserial port)."""
 
@@ -98,6 +102,10 @@ class SerialLink(Link):
         # (floor before it, marking its stamps showed before it, arrival) of the last chunk
         self._previous_chunk = (0.0, 0.0, float("-inf"))
         self._last_origin = ""  # who sent the last frame recorded ("tool": its echo)
+        # stamp end -> arrival of the last few frames the no-overlap rule placed after their
+        # arrival (received_by): only those, and only the latest, are ever asked about
+        self._pushed: dict[float, float] = {}
+        self._widest_chunk = 1  # the most bytes seen under one arrival stamp (read_grace)
         self._tx_free = 0.0  # end of the tool's last frame on the wire
         self._failure: BaseException | None = None
         self._closing = threading.Event()
@@ -135,6 +143,20 @@ class SerialLink(Link):
         """What a measurement between two instants is worth (s): more than
         :meth:`timing_uncertainty` where the run saw its stamps irregular near them."""
         return self.meter.between(start, end)
+
+    def read_grace(self) -> float:
+        """How long past its limit a read waits for characters stamped as started by then
+        (s). A byte's stamp ends at its arrival or later (:func:`~.stamps.chunk_frames`), so
+        the first of k bytes that came under one stamp starts at most k frames before the
+        host had it: the frames of the most bytes seen under one stamp, and the declared
+        floor for a byte the kernel has stamped that the reader thread has not handed over
+        yet. Not the link's latency bound (the worst write to echo): that is how late a
+        byte arrives after its stop bit, which its arrival stamp already carries; behind a
+        16 ms latency timer it made the grace of every read that ran to its deadline 24.7
+        ms where the stamps need 13.3 (21.7 where two bytes ever came under one stamp;
+        issue 22, usb12). Bytes that came in a burst, each under its own stamp, are a frame each:
+        they widen the stamps' uncertainty, not this."""
+        return self._widest_chunk * CHAR_TIME + self.info.timing_uncertainty
 
     def latency_bound(self) -> float:
         """How long a byte may take to reach the reader after its stop bit (s)."""
@@ -202,9 +224,30 @@ class SerialLink(Link):
         with self._cond:
             for chunk, at in _chunks(data, stamps or [arrival] * len(data)):
                 for byte, end in zip(chunk, self._frame_ends(chunk, at), strict=True):
+                    if end > at:
+                        self._note_pushed(end, at)
                     for heard in self.echo.heard(byte, end):
                         self._record(heard)
             self._cond.notify_all()
+
+    def _note_pushed(self, end: float, arrival: float) -> None:
+        """Keep that the frame stamped to end at ``end`` had reached the host at ``arrival``
+        (caller holds the lock); the oldest go once :data:`PUSHED_KEPT` are kept."""
+        pushed = self._pushed
+        pushed[end] = arrival
+        if len(pushed) > PUSHED_KEPT:
+            del pushed[next(iter(pushed))]
+
+    def received_by(self, end: float) -> float:
+        """The latest the received character whose stamp ends at ``end`` can have ended on
+        the wire: a byte is whole on the wire before the host has it, so where the
+        no-overlap rule (:func:`~.stamps.chunk_frames`) placed its frame after its arrival,
+        the arrival; else the stamp's end. Behind a 16 ms latency timer the replies come two
+        characters a tick, 16.67 ms of frames in 16 ms, and the rule pushed a reply's last
+        character 0-16 ms past its arrival (issue 22, usb12): a turnaround counted from
+        that stamp waited that much more than the sensor's release (R-7.0-11) asks."""
+        with self._cond:
+            return min(end, self._pushed.get(end, end))
 
     def _frame_ends(self, chunk: bytes, arrival: float) -> list[float]:
         """Stop-bit ends of bytes that reached the host together, and what that shows about
@@ -223,6 +266,7 @@ class SerialLink(Link):
         # by the run's regular figure; beyond it they are evidence of their own
         jitter = max(self.meter.regular(), ECHO_FLOOR)
         if count > 1:
+            self._widest_chunk = max(self._widest_chunk, count)
             hidden = (count - 1) * CHAR_TIME
             self.meter.batches.add(hidden, f"{count} bytes at once")
             self.meter.taint(
@@ -588,12 +632,11 @@ class SerialLink(Link):
     def receive(
         self, deadline: float, until: StopCondition | None = None, idle: float | None = None
     ) -> list[Event]:
-        """As :meth:`Link.receive`. A byte is seen only after its stop bit (and the link's
-        latency), so a read whose limit lies ahead waits one frame plus the latency bound
-        past it for characters that started in time; one whose limit has already passed
-        returns what is queued at once."""
+        """As :meth:`Link.receive`. A byte is seen only after its stop bit, so a read whose
+        limit lies ahead waits :meth:`read_grace` past it for characters that started in
+        time; one whose limit has already passed returns what is queued at once."""
         got: list[Event] = []
-        grace = CHAR_TIME + self.latency_bound()
+        grace = self.read_grace()
         waits = deadline > self.now()
         with self._cond:
             while True:

@@ -474,8 +474,14 @@ class ToolRecorder:
 
     def _earliest_transmit(self, look: float = 0.0) -> float:
         """Now, or later if the DUT may still hold the line after its last character (and
-        ``look`` past that, for characters the link delivers late)."""
+        ``look`` past that, for characters the link delivers late). Without a look (a reply
+        that closed its exchange, or the tool's own break last) the turnaround counts from
+        the latest the character can have ended on the wire (:meth:`Link.received_by`),
+        which a real link's stamp may lie past; with one, from the stamp, as the look's
+        figure was drawn from the stamps."""
         last_dut = self._dut_end.after(self.link.transcript.events)
+        if not look:
+            last_dut = self.link.received_by(last_dut)
         return max(self.link.now(), last_dut + self.policy.turnaround + look)
 
     def _needs_break(self, address: str, at: float) -> bool:

@@ -42,6 +42,14 @@ requirements = pytest.mark.requirements
 pytestmark = pytest.mark.needs("break")
 OK_MARKING = 9e-3  # s: the marking after a break R-7.0-05's answered probe aims at
 UNREACHABLE = " (a link stamped to ±{u:.2f} ms cannot show 8.33 ms of marking from 9: one try)"
+#: R-7.0-07's probe: a break of READY_BREAK, then READY_MARKING of marking, so the command's
+#: start bit comes 90 ms after the break began
+READY_BREAK = 13e-3
+READY_MARKING = 77e-3
+NOT_WITHIN = (
+    " (a link stamped to ±{u:.2f} ms cannot show a command 90 ms after a break to be within"
+    " 100 ms: one try)"
+)
 
 
 def _break_of(sensor, ex):
@@ -480,10 +488,18 @@ def test_ready_within_100ms_of_break(sensor, case):
             return f"a! began {since * 1e3:.2f} ms after the break, not surely within 100 ms"
         return None
 
+    # Stamped more loosely than 100.4 - 90 ms, the link can never show a command sent 90 ms
+    # after the break to have begun within 100 ms, however well it lands: a second try could
+    # land only by luck of the stamps, and behind a 16 ms latency timer each of four more
+    # landed at the same 102.1 ms (about 1.2 s of a real run; issue 22, usb12): one goes out
+    hopeless = READY_BREAK + READY_MARKING + sensor.uncertainty > WAKE_LIMIT + TOLERANCE
     aimed = sensor.aim(
         "a! 90 ms after a break",
-        lambda _n: sensor.probe(f"{sensor.address}!", break_s=13e-3, marking_s=77e-3, standby=True),
+        lambda _n: sensor.probe(
+            f"{sensor.address}!", break_s=READY_BREAK, marking_s=READY_MARKING, standby=True
+        ),
         miss,
+        tries=1 if hopeless else PROBE_TRIES,
     )
     ex = sensor.hear_late(aimed.last)  # from a sensor seen late: its late reply is no silence
     brk = _break_of(sensor, ex)
@@ -492,7 +508,8 @@ def test_ready_within_100ms_of_break(sensor, case):
     late = precondition.Unmet(
         "awake",
         f"command began {since * 1e3:.2f} ms after the break, not surely within 100 ms"
-        + aimed.missed,
+        + aimed.missed
+        + (NOT_WITHIN.format(u=sensor.uncertainty * 1e3) if hopeless else ""),
         (f"t={brk.start:.4f} s: break", judge.cited(ex)),
     )
     if (
