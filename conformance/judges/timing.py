@@ -460,8 +460,9 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
     if grouped is not None:
         return _distribution_of_one_window(*grouped, len(observations))
     tallied = _tallied(observations)
-    if tallied is not None:
-        return _distribution_of_tallies(tallied)
+    figured = None if tallied is None else _distribution_of_tallies(tallied)
+    if figured is not None:
+        return figured
     values: list[float] = []  # s
     slacks: list[float] = []  # s
     uncertainties: list[float] = []  # s
