@@ -586,13 +586,7 @@ def _distribution_of_tallies(tallies: list[tuple[_Seconds, int]]) -> Distributio
     distinct = list(counts)
     n = sum(counts.values())
     values_sorted, at = _sorted_positions(distinct, [counts[v] for v in distinct])
-    positions: Iterable[int]
-    if n > MAX_TICKS:  # evenly through the sorted values: min and max kept
-        step = (n - 1) / (MAX_TICKS - 1)
-        positions = [round(i * step) for i in range(MAX_TICKS)]
-    else:
-        positions = range(n)
-    ticks = [at(p) for p in positions]
+    ticks = [at(p) for p in _tick_positions(n)]
     us = list(u_counts)
     u_at = _sorted_positions(us, [u_counts[u] for u in us])[1]
     low, high = next(iter(edges)) if len(edges) == 1 else (None, None)
@@ -766,13 +760,7 @@ def _distribution_of_one_window(
     counts (:func:`_sorted_positions`)."""
     lo, hi = window.lo, window.hi
     values, at = _sorted_positions([m.measured for m in distinct], counts)
-    positions: Iterable[int]
-    if count > MAX_TICKS:  # evenly through the sorted values: min and max kept
-        step = (count - 1) / (MAX_TICKS - 1)
-        positions = [round(i * step) for i in range(MAX_TICKS)]
-    else:
-        positions = range(count)
-    ticks = [at(p) for p in positions]
+    ticks = [at(p) for p in _tick_positions(count)]
     mid = _median_of_positions(at, count)
     u_mid = _median_of_positions(
         _sorted_positions([m.uncertainty for m in distinct], counts)[1], count
@@ -790,6 +778,15 @@ def _distribution_of_one_window(
         values_ms=[_ms(v) or 0.0 for v in ticks],
         slack_ms=[_ms(_slack(lo, hi, v)) or 0.0 for v in ticks],
     )
+
+
+def _tick_positions(count: int) -> Iterable[int]:
+    """The sorted positions a distribution of ``count`` values shows: every one, or
+    :data:`MAX_TICKS` evenly through them (min and max kept)."""
+    if count > MAX_TICKS:
+        step = (count - 1) / (MAX_TICKS - 1)
+        return [round(i * step) for i in range(MAX_TICKS)]
+    return range(count)
 
 
 def _sorted_positions(
