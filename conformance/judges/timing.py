@@ -459,6 +459,10 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
     grouped = _grouped(observations)
     if grouped is not None:
         return _distribution_of_one_window(*grouped, len(observations))
+    tallied = _tallied(observations)
+    figured = None if tallied is None else _distribution_of_tallies(tallied)
+    if figured is not None:
+        return figured
     values: list[float] = []  # s
     slacks: list[float] = []  # s
     uncertainties: list[float] = []  # s
@@ -519,6 +523,85 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
         mixed_limits=len(edges) > 1,
         values_ms=[_ms(values[i]) or 0.0 for i in kept],
         slack_ms=[_ms(slacks[i]) or 0.0 for i in kept],
+    )
+
+
+#: :func:`_tallied` gives up past this many distinct objects (then one by one is as small)
+TALLIED_MAX = 4096
+
+
+def _tallied(observations: Sequence[Finding | Measured]) -> list[tuple[_Seconds, int]] | None:
+    """``observations`` as each distinct object's figures (:data:`_Seconds`; left out where
+    it has no distribution) and how often it comes, in the order each first comes: what
+    :func:`distribution` reads one by one where the objects are not all plain
+    :class:`Measured` against one window (the recorder's breaks and command character gaps,
+    :class:`MeasuredAsJudged`: an hour's 180,000 gaps made three lists, a sort order and a
+    median's copy of that length, 7 MB at the recorder run's peak, memory20). None past
+    :data:`TALLIED_MAX` distinct objects."""
+    times: dict[int, int] = {}
+    made: dict[int, _Seconds | None] = {}
+    for o in observations:
+        k = id(o)
+        n = times.get(k)
+        if n is not None:
+            times[k] = n + 1
+            continue
+        if len(times) == TALLIED_MAX:
+            return None
+        times[k] = 1
+        if type(o) is Measured:
+            lo, hi = o._window.lo, o._window.hi
+            m = o.measured
+            made[k] = ([m], [_slack(lo, hi, m)], (_ms(lo), _ms(hi)), o.uncertainty, 1)
+        else:
+            d = o.distribution
+            made[k] = None if d is None else _in_seconds(d)
+    return [(f, times[k]) for k, f in made.items() if f is not None]
+
+
+def _distribution_of_tallies(tallies: list[tuple[_Seconds, int]]) -> Distribution | None:
+    """:func:`distribution` of figures each ``times`` over (:func:`_tallied`): the same
+    figures as one by one, worked out from each distinct value and how often it comes (the
+    sorted position found by the running counts, :func:`_sorted_positions`). One by one
+    picks, among equal values, the slack of the first in the observations' order; here
+    every equal value must have one slack (one window), else None (one by one then), as
+    where a figure is not a number."""
+    counts: dict[float, int] = {}  # value (s) -> how many
+    slack_of: dict[float, float] = {}
+    u_counts: dict[float, int] = {}  # uncertainty (s) -> how many
+    edges: set[tuple[float | None, float | None]] = set()
+    count = 0
+    for (values, slacks, d_edges, u, d_count), times in tallies:
+        if u != u:
+            return None
+        edges.add(d_edges)
+        u_counts[u] = u_counts.get(u, 0) + times
+        count += d_count * times
+        for v, s in zip(values, slacks, strict=True):
+            if v != v or s != s or slack_of.setdefault(v, s) != s:
+                return None
+            counts[v] = counts.get(v, 0) + times
+    if not counts:
+        return None
+    distinct = list(counts)
+    n = sum(counts.values())
+    values_sorted, at = _sorted_positions(distinct, [counts[v] for v in distinct])
+    ticks = [at(p) for p in _tick_positions(n)]
+    us = list(u_counts)
+    u_at = _sorted_positions(us, [u_counts[u] for u in us])[1]
+    low, high = next(iter(edges)) if len(edges) == 1 else (None, None)
+    return Distribution(
+        count,
+        _ms(values_sorted[0]) or 0.0,
+        _ms(_median_of_positions(at, n)) or 0.0,
+        _ms(values_sorted[-1]) or 0.0,
+        low,
+        high,
+        _ms(_median_of_positions(u_at, sum(u_counts.values()))) or 0.0,
+        _ms(min(slack_of.values())) or 0.0,
+        mixed_limits=len(edges) > 1,
+        values_ms=[_ms(v) or 0.0 for v in ticks],
+        slack_ms=[_ms(slack_of[v]) or 0.0 for v in ticks],
     )
 
 
@@ -677,13 +760,7 @@ def _distribution_of_one_window(
     counts (:func:`_sorted_positions`)."""
     lo, hi = window.lo, window.hi
     values, at = _sorted_positions([m.measured for m in distinct], counts)
-    positions: Iterable[int]
-    if count > MAX_TICKS:  # evenly through the sorted values: min and max kept
-        step = (count - 1) / (MAX_TICKS - 1)
-        positions = [round(i * step) for i in range(MAX_TICKS)]
-    else:
-        positions = range(count)
-    ticks = [at(p) for p in positions]
+    ticks = [at(p) for p in _tick_positions(count)]
     mid = _median_of_positions(at, count)
     u_mid = _median_of_positions(
         _sorted_positions([m.uncertainty for m in distinct], counts)[1], count
@@ -701,6 +778,15 @@ def _distribution_of_one_window(
         values_ms=[_ms(v) or 0.0 for v in ticks],
         slack_ms=[_ms(_slack(lo, hi, v)) or 0.0 for v in ticks],
     )
+
+
+def _tick_positions(count: int) -> Iterable[int]:
+    """The sorted positions a distribution of ``count`` values shows: every one, or
+    :data:`MAX_TICKS` evenly through them (min and max kept)."""
+    if count > MAX_TICKS:
+        step = (count - 1) / (MAX_TICKS - 1)
+        return [round(i * step) for i in range(MAX_TICKS)]
+    return range(count)
 
 
 def _sorted_positions(
