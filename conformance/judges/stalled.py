@@ -87,9 +87,9 @@ def held_by(finding: Finding, stall: Stall | None) -> Finding:
 def stalled_interval(measured: Finding | Measured, stall: Stall) -> Finding:
     """A deviating interval whose stamps ``stall`` may have moved (truth29: a character the
     tool's host held back is stamped at the late burst that delivers it, a reply start late,
-    a gap long): INCONCLUSIVE with the stall named. The whole-run timing judges set it
+    a gap long; a FAIL or WARN, as :func:`held_by` takes): INCONCLUSIVE with the stall
+    named. The whole-run timing judges set it
     aside as they set aside an interval the link's irregular stamps leave undecided
     (:func:`~.timing.combine_local`, which names the stall and asks for that place to be
     observed again, :func:`~.timing.to_confirm`)."""
-    found = measured.finding if isinstance(measured, Measured) else measured
-    return replace(found, verdict=Verdict.INCONCLUSIVE, detail=f"{found.detail}, but {stall.why()}")
+    return held_by(measured.finding if isinstance(measured, Measured) else measured, stall)

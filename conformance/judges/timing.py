@@ -499,11 +499,7 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
     if not values:
         return None
     order = sorted(range(len(values)), key=values.__getitem__)
-    if len(order) > MAX_TICKS:  # evenly through the sorted values: min and max kept
-        step = (len(order) - 1) / (MAX_TICKS - 1)
-        kept = [order[round(i * step)] for i in range(MAX_TICKS)]
-    else:
-        kept = order
+    kept = [order[p] for p in _tick_positions(len(order))]
     low, high = next(iter(edges)) if len(edges) == 1 else (None, None)
     middle = len(order) // 2
     mid = (
