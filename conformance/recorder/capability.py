@@ -280,10 +280,11 @@ class Capabilities:
         that absence, so that the "declared absent ... does not excuse it" note belongs on
         it. A FAIL naming only commands the declaration allows (values logged wrong from
         ``0M2!``) is about something else: the note would blame the absence for it. A finding
-        that names no command, or cuts its list short, keeps the note."""
+        that names no command, or cuts its list short, keeps the note; a list cut short in
+        the detail whose rest the evidence keeps (a tally's ``also:`` lines) is read whole."""
         text = " ".join([finding.detail, *finding.evidence])
         named = _COMMAND_TEXT.findall(text)
-        if not named or "more)" in text or any(c.startswith("addresses") for c in cited):
+        if not named or _cut_short(finding) or any(c.startswith("addresses") for c in cited):
             return True
         for word in named:
             try:
@@ -298,6 +299,16 @@ class Capabilities:
         return False
 
 
+def _cut_short(finding: Finding) -> bool:
+    """Whether the detail's list ends ``(+N more)`` with fewer than N of the rest kept as
+    ``also:`` evidence lines (``judges.tally``): what it leaves out may name any command."""
+    hidden = sum(int(n) for n in _MORE.findall(finding.detail))
+    kept = sum(1 for line in finding.evidence if line.startswith("also: "))
+    return kept < hidden
+
+
+#: a list cut short in a detail (``judges.cite.listed``, ``exchanges``)
+_MORE = re.compile(r"\(\+(\d+) more\)")
 #: command text as findings quote it (``0M2!``, ``0XHELP!``, ``aHA!``)
 _COMMAND_TEXT = re.compile(r"(?<![\w!])[0-9A-Za-z?][0-9A-Za-z_?]*!")
 

@@ -320,3 +320,40 @@ def test_the_note_stays_where_a_finding_names_a_declared_absent_command(tmp_path
     ]
     caps.apply(findings, sent=set())
     assert ["declared absent" in f.detail for f in findings] == [True, False, True, True]
+
+
+def test_a_tally_list_cut_short_is_read_whole_from_its_evidence(tmp_path):
+    """An ESP-IDF logger library (K0I05's esp_sdi12_master, thirtieth round, docs/kit.md)
+    cuts the last digit off every value but the last and logs nothing when a service request
+    comes: R-4.4-02's logged-values FAIL listed 20 measurements, "(+17 more)" in its detail,
+    and kept the "declared absent (aMC! ...) ... does not excuse it" note of a v1.3
+    declaration without CRC, though every command it names (in the detail and in the
+    tally's ``also:`` evidence lines) was declared present. A list whose rest the evidence
+    does not keep still keeps the note, and so does one whose ``also:`` lines name 0MC!."""
+    from conformance.judges.tally import Tally
+    from conformance.recorder.capability import Capabilities
+
+    path = write(tmp_path, 'sdi12_version = "1.3"\n[recorder]\ncrc = false\n')
+    caps = Capabilities(load_declaration(path), "13")
+
+    def tallied(*commands: str) -> Finding:
+        tally = Tally(["R-4.4-02"])
+        for i, command in enumerate(commands):
+            tally.fail("R-4.4-02", f"s{i}: {command}", f"value 1 logged as 22.{i}: digits cut off")
+        (finding,) = tally.findings()
+        return finding
+
+    allowed = tallied("0M!", "0M1!", "0C!", "0M2!", "1C!", "0C9!")
+    hidden_absent = tallied("0M!", "0M1!", "0C!", "0M2!", "0MC!")
+    untold = Finding(
+        "R-4.4-02",
+        Verdict.FAIL,
+        "never answered validly: 0M!, 0M1! (+2 more)",
+        evidence=["the run"],
+        observed=1,
+    )
+    assert "(+3 more)" in allowed.detail and "(+2 more)" in hidden_absent.detail
+    caps.apply([allowed, hidden_absent, untold], sent=set())
+    assert "declared absent" not in allowed.detail, allowed.detail
+    assert "declared absent" in hidden_absent.detail
+    assert "declared absent" in untold.detail
