@@ -1334,3 +1334,122 @@ def test_no_control_sent_is_not_called_unanswered_r_4_3_04():
     assert finding["verdict"] == "INCONCLUSIVE", finding
     assert "no one-shot a! after a break was answered" in finding["detail"], finding["detail"]
     assert finding["evidence"] == []
+
+
+#: The thirtieth round (docs/kit.md): an ESP-IDF logger library (K0I05/ESP32-S3_SDI12's
+#: esp_sdi12_master, MIT) behind the C kit. A look-alike of its ways, not its code: every
+#: command a 12.5 ms break, 8.33 ms of marking and the command, the reply read up to its CR
+#: within 917 ms from what the UART buffered since the last read (so a service request heard
+#: while it sleeps ttt + 0.5 s is read as aD0!'s reply, "a<CR>", and taken for an abort: the
+#: whole measurement is tried again, three times); ttt kept in 8 bits (260 s is 4 s); each
+#: value but the last loses its last character to an off-by-one in the token scan.
+_ESP_MASTER = (
+    PRELUDE
+    + r"""
+now, pending = 0, ""
+
+def ask(line):
+    global now
+    say(line)
+    word, *f = sys.stdin.readline().split()
+    if word in ("break", "sent", "char", "time", "job"):
+        now = int(f[0] if word in ("time", "job") else f[1])
+    return word, f
+
+def hear(until, keep=True):
+    global pending
+    while now < until:
+        word, f = ask(f"wait {until}")
+        if word != "char":
+            break
+        if keep:
+            pending += chr(int(f[2], 16) & 0x7F)
+
+def command(text):
+    global pending
+    ask(f"brk {now} {now + 12500}")
+    hear(now + 8333, keep=False)
+    for c in text:
+        ask(f"tx {now} {wire(c):02x}")
+    got, pending, deadline = pending, "", now + 916670
+    while "\r" not in got and now < deadline:
+        word, f = ask(f"wait {deadline}")
+        if word != "char":
+            break
+        got += chr(int(f[2], 16) & 0x7F)
+    hear(now + 183000, keep=False)  # the read's last 100 ms, then the flush
+    hear(now + 90000)  # buffered for the next read
+    return got[: got.index("\r")] if "\r" in got else None
+
+def values(reply):
+    tokens = re.findall(r"[+-][^+-]*", reply)
+    return [t[:-1] for t in tokens[:-1]] + tokens[-1:]
+
+def measure(cmd):
+    for _ in range(3):
+        reply = command(cmd)
+        if reply and reply[0] == cmd[0] and reply[1:4].isdigit():
+            ttt, n = int(reply[1:4]) % 256, int(reply[4:] or 0)
+            hear(now + ttt * 1000000 + 500000)
+            got = []
+            for i in range(10):
+                data = command(f"{cmd[0]}D{i}!")
+                if data is None or len(data) < 3:
+                    break
+                got += values(data)
+                if len(got) >= n:
+                    return got
+        hear(now + 115000)
+    return []
+
+sys.stdin.readline()  # hello
+word, f = ask("hello 1 esp-master-alike")
+task, cmds = f[1], f[2:]
+lacking = []
+for cmd in cmds:
+    if task in ("measure", "concurrent"):
+        if re.fullmatch(r"\w[MC][1-9]?!", cmd):
+            line = f"log {cmd}"
+            for v in ["%.7g" % float(v) for v in measure(cmd)]:
+                if len(line) + 1 + len(v) > 200:
+                    say(line)
+                    line = f"log {cmd}"
+                line += " " + v
+            say(line)
+        else:
+            lacking.append(cmd)
+    else:
+        command(cmd)
+say("cannot " + " ".join(lacking) if lacking else "done")
+sys.stdin.readline()  # bye
+"""
+).replace("import sys", "import re\nimport sys", 1)
+
+
+@pytest.mark.slow
+def test_a_logger_that_cuts_digits_is_not_told_its_absent_crc_excuses_nothing(tmp_path):
+    """With a v1.3 declaration without CRC, R-4.4-02's FAIL on the values it logged wrong
+    (digits cut off, nothing logged where a service request came) listed more measurements
+    than its detail shows ("(+N more)") and so kept the "declared absent (aMC! ...) ... does
+    not excuse it" note of the aMC! it was never asked for here: every command its tally
+    names was declared present. The measurement flow's true FAILs stand: aD0! 4.8 s after
+    ``02603`` (ttt 260 s kept in 8 bits) is R-4.4.5-04's."""
+    import sys
+
+    harness = tmp_path / "esp_master_alike.py"
+    harness.write_text(_ESP_MASTER)
+    declared = tmp_path / "esp.toml"
+    declared.write_text('sdi12_version = "1.3"\n[recorder]\ncrc = false\n', encoding="utf-8")
+    found = run_once(
+        f"exec:{sys.executable} {harness}",
+        role="recorder",
+        keyword=FLOW_CASES,
+        declaration=str(declared),
+    )
+    rules = _verdicts(found)
+    logged = [f["detail"] for f in rules["R-4.4-02"]["findings"] if "digits cut off" in f["detail"]]
+    assert logged and "more)" in logged[0], rules["R-4.4-02"]["findings"]
+    assert not any("declared absent" in d for d in logged), logged
+    waited = rules["R-4.4.5-04"]
+    assert waited["verdict"] == "FAIL", waited["findings"]
+    assert any("ttt=260" in f["detail"] for f in waited["findings"]), waited["findings"]
