@@ -56,6 +56,10 @@ DRAGS: dict[str, tuple[tuple[str, ...], str]] = {
     ),
     # recorder role
     "R-7.2-06": (("R-7.0-13",), "a retry that talks over a reply comes apart on the line"),
+    "R-7.0-02": (
+        ("R-7.0-17", "R-7.1-01"),
+        "spacing too short to be a break leaves the command after it without one",
+    ),
     "R-7.1-01": (("R-7.0-17",), "a late aD0! without a break is also a command without one"),
     "R-4.4.5-06": (
         ("R-4.4.5-05", "R-4.4.5-07"),

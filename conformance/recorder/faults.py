@@ -748,8 +748,9 @@ _FAULTS = (
     ),
     RecorderFault(
         "short-break",
-        "Breaks last 10 ms (at least 12 ms are due).",
-        ("R-7.0-02",),
+        "Breaks last 10 ms (at least 12 ms are due): spacing too short to be a break, so its "
+        "commands go without one (R-7.0-17).",
+        ("R-7.0-02", "R-7.0-17"),
         Parts(policy={"break_duration": 10e-3}),
     ),
     RecorderFault(

@@ -159,7 +159,8 @@ class BreakRules:
         for s in line.transmissions:
             if previous is not None and previous.part != s.part:
                 previous = None  # a new scenario: the line was idle and the sensors are new
-            if s.break_event is None:
+            short = _too_short(s.break_event, uncertainty)
+            if s.break_event is None or short:
                 where = [f"before {s.at()}"]
                 if previous is None or previous.address != s.address:
                     who = "no earlier command" if previous is None else f"last was {previous.text}"
@@ -167,23 +168,24 @@ class BreakRules:
                         Finding(
                             "R-7.0-17",
                             Verdict.FAIL,
-                            f"no break before {s.at()}, a new sensor ({who})",
+                            f"no break before {s.at()}, a new sensor ({who}){short}",
                             evidence=where,
                             observed=1,
                         )
                     )
-                else:
+                else:  # timed from the line's activity before it (before the short spacing)
                     quiet = s.first_char - (self._previous_activity(line, s) or float("-inf"))
-                    rule17.append(
-                        judge_window(
-                            "R-7.0-17",
-                            "marking before a command sent without a break",
-                            quiet,
-                            own_uncertainty(uncertainty, s.chars[0], previous.chars[-1]),
-                            high=NO_BREAK_WINDOW,
-                            evidence=where,
-                        )
+                    judged = judge_window(
+                        "R-7.0-17",
+                        "marking before a command sent without a break",
+                        quiet,
+                        own_uncertainty(uncertainty, s.chars[0], previous.chars[-1]),
+                        high=NO_BREAK_WINDOW,
+                        evidence=where,
                     )
+                    if short and judged.verdict is not Verdict.PASS:
+                        judged.detail += short
+                    rule17.append(judged)
                 if previous is not None and _follows_service_request(previous, s):
                     sr_end = service_request_end(previous.after, s.address)
                     assert sr_end is not None
@@ -221,6 +223,23 @@ class BreakRules:
             ),
             combine("R-7.1-01", self.rule71, "aD0! after a service request"),
         ]
+
+
+def _too_short(event: Event | None, uncertainty: float) -> str:
+    """A note (``""``: none) for spacing before a command too short to be a break whatever the
+    uncertainty (R-7.0-02 FAILs its length): no break for R-7.0-17 either, as a sensor need
+    not take spacing under 12 ms for one (section 7.0; an STM32 HAL logger's send-break
+    request holds 10 bits, 8.33 ms, and its sensors never woke)."""
+    if event is None or event.duration >= BREAK_MIN or event.text == HELD_BACK:
+        return ""  # a break, or one the line held back (how long it was held is not known)
+    u = max(uncertainty, event.duration_uncertainty or 0.0)
+    judged = MeasuredAsJudged(BREAK_LENGTH, event.duration, u, [f"break at t={event.start:.3f} s"])
+    if judged.verdict is not Verdict.FAIL:
+        return ""
+    return (
+        f" (the spacing before it, {event.duration * 1e3:.2f} ms, is too short to be a break:"
+        " R-7.0-02)"
+    )
 
 
 def _all_broke(commands: int) -> str:

@@ -197,6 +197,27 @@ def test_break_needed_for_a_new_address_and_after_87_ms():
     assert found.verdict is Verdict.FAIL and found.measured_ms == 95.0
 
 
+def test_spacing_too_short_to_be_a_break_is_no_break_r_7_0_17():
+    """An STM32 HAL logger (the thirtieth round's, docs/kit.md) sends its 'break' with the
+    USART's send-break request: 10 low bits, 8.33 ms, then 1.67 ms of stop bits and the
+    command. R-7.0-02 FAILed the length, but R-7.0-17 PASSed "all 11 commands were sent
+    after a break" on spacing no sensor need take for one (its played sensors never woke).
+    Spacing R-7.0-02 FAILs is no break here either; one whose length the stamps leave
+    undecided (12 ms at +-1 ms) still counts, and a real break still PASSes."""
+    short = Wire().brk(8.33, 1.67).rec("0M!").idle(200).brk(8.33, 1.67).rec("1M!").view()
+    found = by_id(judge_break_rules(short, 0.0))["R-7.0-17"]
+    assert found.verdict is Verdict.FAIL, found.detail
+    assert "no break before 0M!" in found.detail and "too short to be a break" in found.detail
+    # the same sensor after 200 ms: timed from the activity before the spacing, not after it
+    again = Wire().brk().rec("0!").sensor("0\r\n").idle(200).brk(8.33, 1.67).rec("0I!").view()
+    late = [f for f in judge_break_rules(again, 0.0) if f.requirement == "R-7.0-17"][0]
+    assert late.verdict is Verdict.FAIL and "too short to be a break" in late.detail, late.detail
+    unsure = Wire().brk(12.0).rec("0M!").view()
+    assert by_id(judge_break_rules(unsure, 1e-3))["R-7.0-17"].verdict is Verdict.PASS
+    real = Wire().brk(12.5, 8.5).rec("0M!").idle(200).brk(12.5, 8.5).rec("1M!").view()
+    assert by_id(judge_break_rules(real, 0.0))["R-7.0-17"].verdict is Verdict.PASS
+
+
 def _measurement(wire: Wire, address: str = "0", code: str = "M") -> Wire:
     wire.brk().rec(f"{address}{code}!")
     return wire.sensor(f"{address}0013\r\n", origin=f"sensor{address}")
