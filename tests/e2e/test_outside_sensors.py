@@ -125,7 +125,7 @@ from conformance.recorder.golden import GoldenRecorder
 from conformance.sim.bus import Frame
 from conformance.transcript import COLLISION, DUT
 from conformance.view.runs import segments
-from tests.support.harness_script import PRELUDE
+from tests.support.harness_script import ASK, PRELUDE
 
 #: The cases that probe with a! (and R-4.4.1-01's own).
 A_PROBES = (
@@ -1101,16 +1101,9 @@ def test_a_sensor_that_answers_no_a_and_stays_put_is_no_r_4_3_03_pass(a_never_an
 #: ``aM!`` is followed at once by ``aD0!``..``aD8!`` until as many signs as ``n`` came.
 _SENDS_ITS_NUL = (
     PRELUDE
+    + ASK
     + r"""
 now, swapped = 0, False
-
-def ask(line):
-    global now
-    say(line)
-    word, *f = sys.stdin.readline().split()
-    if word in ("break", "sent", "char", "time", "job"):
-        now = int(f[0] if word in ("time", "job") else f[1])
-    return word, f
 
 def idle(until):
     while now < until and ask(f"wait {until}")[0] == "char":
@@ -1345,16 +1338,9 @@ def test_no_control_sent_is_not_called_unanswered_r_4_3_04():
 #: value but the last loses its last character to an off-by-one in the token scan.
 _ESP_MASTER = (
     PRELUDE
+    + ASK
     + r"""
 now, pending = 0, ""
-
-def ask(line):
-    global now
-    say(line)
-    word, *f = sys.stdin.readline().split()
-    if word in ("break", "sent", "char", "time", "job"):
-        now = int(f[0] if word in ("time", "job") else f[1])
-    return word, f
 
 def hear(until, keep=True):
     global pending
