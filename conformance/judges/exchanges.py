@@ -185,11 +185,16 @@ def silent(
     unheld = len(met) - len(held)
     aside = "; ".join(
         ([_set_aside(unheld, earlier)] if unheld or not held else [])
-        + [f"{escape(ex.text)} set aside: {stall.why()}" for ex, stall in held[:2]]
+        + [
+            f"{late_shown(ex) if heard_late(ex) and not ex.answered else shown(ex)}"
+            f" set aside: {stall.why()}"
+            for ex, stall in held[:2]
+        ]
     )
     if not heard:
         what = "every command maybe collided with the sensor's characters; "
-        what = what if unheld or not held else ""
+        if held and not unheld:
+            what = f"no command outside a stall of the tool's host ({why}): "
         return inconclusive(rid, what + aside, evidence=[shown(ex) for ex in met[:3]])
     return passed(
         rid,
