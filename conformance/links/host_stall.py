@@ -15,7 +15,7 @@ saved transcript tells the same story as the live run.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from operator import attrgetter
 
@@ -82,6 +82,19 @@ def stalls_since(events: list[Event], first: int) -> list[Stall]:
     if _NOTE not in map(_KIND, new):
         return []
     return stalls(new)
+
+
+def noted_since_activity(events: Sequence[Event]) -> bool:
+    """Whether the NOTE of a host stall follows the line's last activity (a character or a
+    break) among ``events``: that activity's stamp may be the late burst's that delivered
+    it (the link notes the stall after the burst), so the marking since it may be longer
+    than the stamps say (truth30). Only the NOTEs after it are looked at: a few at most."""
+    for event in reversed(events):
+        if event.kind is not _NOTE:
+            return False
+        if event.text.startswith(HOST_STALL_NOTE):
+            return True
+    return False
 
 
 def stalled_over(found: list[Stall], start: float, end: float) -> Stall | None:
