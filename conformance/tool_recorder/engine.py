@@ -17,7 +17,7 @@ from operator import attrgetter, is_
 
 from ..links.base import LineEnd, Link
 from ..links.errors import BreakUnsupported
-from ..links.host_stall import noted_since_activity
+from ..links.host_stall import noted_since_activity, settled_at
 from ..protocol import commands as cmds
 from ..protocol.commands import (
     DATA_INDEX_MAX,
@@ -244,6 +244,11 @@ class ToolRecorder:
         self.note_collisions()
         if collide:
             return self.link.now()
+        settled = settled_at(self.link.transcript.events)
+        if settled is not None and settled > self.link.now():
+            # what a stall of the tool's host just held back is still arriving: the reply
+            # its read cut may be going on (truth30, host_stall.AFTER)
+            self.link.wait_until(settled)
         look = self.look_before_transmit()
         self.link.wait_until(self._earliest_transmit(look))
         began = self.link.now()

@@ -51,3 +51,23 @@ def test_only_the_notes_after_the_last_activity_count():
     assert host_stall.noted_since_activity([*events, noted, other])
     assert not host_stall.noted_since_activity([noted, *events, other])
     assert not host_stall.noted_since_activity([])
+
+
+def _sent_after_note(noted: bool) -> float:
+    """How long after the last reply the tool's next command began (its break, if any),
+    ``noted``: the link's NOTE of a stall right after that reply (the reader's first turn
+    after the pause, the reply's rest maybe still on its way)."""
+    master, _ = rig(ScriptedSensor({"0!": ["0\r\n"], "0I!": ["013CONFORM EMULATOR1.0\r\n"]}))
+    first = master.transact("0!")
+    end = first.judged.reply_events[-1].end
+    if noted:
+        master.link.transcript.note(master.link.now(), host_stall.note_text(0.15))
+    nxt = master.transact("0I!").attempts[0]
+    return (nxt.break_event or nxt.command_events[0]).start - end
+
+
+def test_the_next_transmission_waits_for_what_a_stall_held_back():
+    """A retry sent 0.4 ms after the NOTE met the rest of the reply the stall had cut
+    (R-4.3-01 FAILed a clean emulator, base-s67): it now waits AFTER past the NOTE."""
+    assert _sent_after_note(True) >= host_stall.AFTER
+    assert _sent_after_note(False) < host_stall.AFTER  # outside any stall, as soon as ever
