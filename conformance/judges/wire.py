@@ -731,11 +731,11 @@ class _ToleranceUse:
         self.count += len(gaps)
 
     def _unstalled(self, gaps: list[Gap]) -> list[Gap]:
-        """``gaps`` but those in or maybe in the band (the few: most lie well below it, a
-        gap surely past it is R-7.0-12's) across a stall of the tool's own host, kept in
-        :attr:`held`; they are still counted."""
+        """``gaps`` but those surely in the band (the few: most lie well below it; one
+        only maybe in it is INCONCLUSIVE anyway, one surely past it R-7.0-12's) across a
+        stall of the tool's own host, kept in :attr:`held`; they are still counted."""
         u, stalls = self.uncertainty, self.stalls
-        floor, top = INTER_CHAR_GAP_MAX - u, INTER_CHAR_GAP_MAX + TOLERANCE + u
+        floor, top = INTER_CHAR_GAP_MAX + u, INTER_CHAR_GAP_MAX + TOLERANCE - u
         kept: list[Gap] = []
         for gap in gaps:
             g, w, a, b, _p = gap
@@ -849,9 +849,9 @@ def _tolerance_finding(
     held: list[tuple[float, str, Stall]] | None = None,
 ) -> Finding:
     """R-7.0-01's finding from the ``(gap, where)`` surely and possibly inside the band, out
-    of ``count`` gaps judged (:func:`_judge_tolerance_use`); ``held``: those in or maybe in
-    it whose stamps a stall of the tool's own host may have moved, with the stall
-    (truth30): INCONCLUSIVE naming it unless a gap outside every stall FAILs the rule."""
+    of ``count`` gaps judged (:func:`_judge_tolerance_use`); ``held``: those surely in it
+    whose stamps a stall of the tool's own host may have moved, with the stall (truth30):
+    INCONCLUSIVE naming it unless a gap outside every stall FAILs the rule."""
     if sure:
         return _leaning(sure, count, uncertainty)
     if held:
