@@ -183,14 +183,7 @@ def silent(
         )
     heard = [ex for ex in exchanges if not _among(ex, met)]
     unheld = len(met) - len(held)
-    aside = "; ".join(
-        ([_set_aside(unheld, earlier)] if unheld or not held else [])
-        + [
-            f"{late_shown(ex) if heard_late(ex) and not ex.answered else shown(ex)}"
-            f" set aside: {stall.why()}"
-            for ex, stall in held[:2]
-        ]
-    )
+    aside = _set_aside(unheld, earlier, held)
     if not heard:
         what = "every command maybe collided with the sensor's characters; "
         if held and not unheld:
@@ -206,14 +199,21 @@ def silent(
     )
 
 
-def _set_aside(count: int, earlier: list[Exchange]) -> str:
-    """Why :func:`silent` set ``count`` commands aside (not for a host stall), the first
-    ``earlier`` replies (:func:`earlier_reply`) shown."""
-    return (
+def _set_aside(count: int, earlier: list[Exchange], held: list[tuple[Exchange, Stall]]) -> str:
+    """Why :func:`silent` set commands aside: ``count`` maybe collided or met by a late
+    reply (the first ``earlier`` replies, :func:`earlier_reply`, shown), and the ``held``
+    ones a stall of the tool's host was over, each with its stall (the first two)."""
+    unheld = (
         f"{count} command(s) set aside (maybe collided, or a late reply naming another "
         "address or maybe the command before's came over it: may not have been heard)"
         + "".join(f"; {earlier_reply(ex)}" for ex in earlier[:2])
     )
+    stalled = [
+        f"{late_shown(ex) if heard_late(ex) and not ex.answered else shown(ex)}"
+        f" set aside: {stall.why()}"
+        for ex, stall in held[:2]
+    ]
+    return "; ".join(([unheld] if count or not held else []) + stalled)
 
 
 def _among(ex: Exchange, exchanges: Iterable[Exchange]) -> bool:
