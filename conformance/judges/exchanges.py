@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from ..case import events_of
+from ..links.host_stall import Stall
 from ..protocol.crc import ascii_crc
 from ..protocol.responses import (
     Identification,
@@ -125,6 +126,7 @@ def silent(
     baseline: Exchange | Iterable[Exchange],
     should: bool = False,
     decision: str | None = None,
+    stalled: Sequence[Stall | None] = (),
 ) -> Finding:
     """Each exchange must have drawn no reply (foreign address, standby, partial command).
 
@@ -139,15 +141,27 @@ def silent(
     deaf until it answers sent the retry before R-7.0-15's probe its '0<CR><LF>' 3 ms after
     the probe, which it never heard (parity-error or ack-trailing-space + replies-after-retry:
     "answered although 101.90 ms ... put it in standby", truth18). A control that maybe
-    collided shows listening only by a valid reply (:func:`shows_listening`)."""
+    collided shows listening only by a valid reply (:func:`shows_listening`).
+
+    ``stalled``: per exchange, a stall of the tool's own host over its decisive span (from
+    what its marking counts from to the end of its read: :meth:`~conformance.sensor.
+    session.SensorSession.stalled_since`), or None. Such a probe is no evidence either way
+    (truth30): its answer may be another's reply read late, its silence a probe moved past
+    the limit or a cut read; it is set aside with the stall named, and a rule left with no
+    probe outside every stall is INCONCLUSIVE."""
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
+    held = [(ex, stall) for ex, stall in zip(exchanges, stalled, strict=False) if stall]
     earlier = [ex for ex in exchanges if earlier_reply(ex)]
-    answered = [
-        ex for ex in exchanges if (ex.answered or heard_late(ex)) and not _among(ex, earlier)
-    ]
-    met = earlier + [
-        ex for ex in exchanges if not ex.answered and (ex.maybe_collided or late_elsewhere(ex))
+    aside = earlier + [ex for ex, _ in held]
+    answered = [ex for ex in exchanges if (ex.answered or heard_late(ex)) and not _among(ex, aside)]
+    stalled_out = [ex for ex, _ in held]
+    met = aside + [
+        ex
+        for ex in exchanges
+        if not ex.answered
+        and (ex.maybe_collided or late_elsewhere(ex))
+        and not _among(ex, stalled_out)
     ]
     if answered:
         make = warned if should else failed
@@ -168,17 +182,13 @@ def silent(
             + collided_answers(controls),
         )
     heard = [ex for ex in exchanges if not _among(ex, met)]
-    aside = (
-        f"{len(met)} command(s) set aside (maybe collided, or a late reply naming another "
-        "address or maybe the command before's came over it: may not have been heard)"
-        + "".join(f"; {earlier_reply(ex)}" for ex in earlier[:2])
-    )
+    unheld = len(met) - len(held)
+    aside = _set_aside(unheld, earlier, held)
     if not heard:
-        return inconclusive(
-            rid,
-            f"every command maybe collided with the sensor's characters; {aside}",
-            evidence=[shown(ex) for ex in met[:3]],
-        )
+        what = "every command maybe collided with the sensor's characters; "
+        if held and not unheld:
+            what = f"no command outside a stall of the tool's host ({why}): "
+        return inconclusive(rid, what + aside, evidence=[shown(ex) for ex in met[:3]])
     return passed(
         rid,
         f"stayed silent ({why}) to {len(heard)} command(s): "
@@ -187,6 +197,23 @@ def silent(
         decision=decision,
         observed=len(heard),
     )
+
+
+def _set_aside(count: int, earlier: list[Exchange], held: list[tuple[Exchange, Stall]]) -> str:
+    """Why :func:`silent` set commands aside: ``count`` maybe collided or met by a late
+    reply (the first ``earlier`` replies, :func:`earlier_reply`, shown), and the ``held``
+    ones a stall of the tool's host was over, each with its stall (the first two)."""
+    unheld = (
+        f"{count} command(s) set aside (maybe collided, or a late reply naming another "
+        "address or maybe the command before's came over it: may not have been heard)"
+        + "".join(f"; {earlier_reply(ex)}" for ex in earlier[:2])
+    )
+    stalled = [
+        f"{late_shown(ex) if heard_late(ex) and not ex.answered else shown(ex)}"
+        f" set aside: {stall.why()}"
+        for ex, stall in held[:2]
+    ]
+    return "; ".join(([unheld] if count or not held else []) + stalled)
 
 
 def _among(ex: Exchange, exchanges: Iterable[Exchange]) -> bool:

@@ -23,6 +23,9 @@ from ..verdicts import Finding, Verdict
 from .tally import Tally
 from .timing import Measured
 
+_DEVIATING = (Verdict.FAIL, Verdict.WARN)
+_EITHER_WAY = (Verdict.FAIL, Verdict.WARN, Verdict.PASS)
+
 
 class StalledTally(Tally):
     """``tally`` seen through a stall of the tool's own host over the read of the record
@@ -73,12 +76,16 @@ def unless_stalled(
     return held_by(finding, held[0])
 
 
-def held_by(finding: Finding, stall: Stall | None) -> Finding:
+def held_by(finding: Finding, stall: Stall | None, *, either_way: bool = False) -> Finding:
     """``finding``, or where it FAILs or WARNs on what ``stall`` (a stall of the tool's own
     host over the stamps or the read it rests on) may have moved or cut, the same
     INCONCLUSIVE with the stall named: a finding that rests on one such record (a
-    measurement's wait, :attr:`~conformance.tool_recorder.records.Measurement.wait_stall`)."""
-    if stall is None or finding.verdict not in (Verdict.FAIL, Verdict.WARN):
+    measurement's wait, :attr:`~conformance.tool_recorder.records.Measurement.wait_stall`).
+    ``either_way``: a PASS too, for a finding on silence (truth30: a standby probe the stall
+    moved past the 100 ms, or whose answer it cut, is silent for the host's reasons; the
+    product's rule is that silence is evidence only from a sensor shown listening then)."""
+    held = _EITHER_WAY if either_way else _DEVIATING
+    if stall is None or finding.verdict not in held:
         return finding
     detail = f"{finding.detail}, but {stall.why()}"
     return replace(finding, verdict=Verdict.INCONCLUSIVE, detail=detail)

@@ -500,7 +500,7 @@ def judge_gaps(
         "character gap",
         real_time=stamps.local is not None,
     )
-    tolerance_finding = _judge_tolerance_use(_gaps(segs), stamps.base)
+    tolerance_finding = _judge_tolerance_use(_gaps(segs), stamps.base, stalls)
     return [gap_finding, tolerance_finding]
 
 
@@ -679,13 +679,34 @@ class _GapsAlike:
             counts[i] += n
 
 
-def _judge_tolerance_use(gaps: list[Gap], uncertainty: float) -> Finding:
+def _leaning(sure: list[tuple[float, str]], count: int, uncertainty: float) -> Finding:
+    """R-7.0-01's FAIL: the ``(gap, where)`` surely inside the band, out of ``count``."""
+    gap, _where = sure[0]
+    return Finding(
+        "R-7.0-01",
+        Verdict.FAIL,
+        f"gap of {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} relies on the ±0.40 ms "
+        f"tolerance, which the 1.66 ms character gap does not have ({len(sure)} such "
+        "gap(s))",
+        evidence=[where for _, where in sure[:5]],
+        observed=count,
+        measured_ms=round(gap * 1e3, 3),
+        limit_ms=INTER_CHAR_GAP_MAX * 1e3,
+        uncertainty_ms=round(uncertainty * 1e3, 3),
+    )
+
+
+def _judge_tolerance_use(
+    gaps: list[Gap], uncertainty: float, stalls: list[Stall] | None = None
+) -> Finding:
     """R-7.0-01 for the one limit without tolerance: a gap surely inside (1.66, 2.06] ms leans
     on a ±0.40 ms the rule does not grant (FAIL); one that only might be there, given the
     link's uncertainty, is INCONCLUSIVE; a gap surely beyond 2.06 ms is R-7.0-12's alone.
     One pass over the gaps (:func:`_gaps`: tens of thousands a run), nearly all below the
-    band, where neither test can hold."""
-    use = _ToleranceUse(uncertainty)
+    band, where neither test can hold. A gap across one of ``stalls`` (the tool's own host
+    stalled: the characters it held back are stamped at the burst that delivers them, so
+    the gap before them is the host's) is held, not judged (truth30)."""
+    use = _ToleranceUse(uncertainty, stalls)
     use.add(gaps)
     return use.finding()
 
@@ -694,15 +715,38 @@ class _ToleranceUse:
     """:func:`_judge_tolerance_use` of gaps given a part at a time (:class:`ReplyGaps`):
     the gaps in or maybe in the band, and how many gaps, carried from part to part."""
 
-    def __init__(self, uncertainty: float) -> None:
+    def __init__(self, uncertainty: float, stalls: list[Stall] | None = None) -> None:
         self.uncertainty = uncertainty
+        self.stalls = stalls
         self.sure: list[tuple[float, str]] = []
         self.maybe: list[tuple[float, str]] = []
+        #: gaps in or maybe in the band across a stall of the tool's host, with the stall
+        self.held: list[tuple[float, str, Stall]] = []
         self.count = 0
 
     def add(self, gaps: list[Gap]) -> None:
+        if self.stalls:
+            gaps = self._unstalled(gaps)
         self._in_band((g, w) for g, w, _a, _b, _p in gaps)
         self.count += len(gaps)
+
+    def _unstalled(self, gaps: list[Gap]) -> list[Gap]:
+        """``gaps`` but those surely in the band (the few: most lie well below it; one
+        only maybe in it is INCONCLUSIVE anyway, one surely past it R-7.0-12's) across a
+        stall of the tool's own host, kept in :attr:`held`; they are still counted."""
+        u, stalls = self.uncertainty, self.stalls
+        floor, top = INTER_CHAR_GAP_MAX + u, INTER_CHAR_GAP_MAX + TOLERANCE - u
+        kept: list[Gap] = []
+        for gap in gaps:
+            g, w, a, b, _p = gap
+            band = floor < g <= top
+            stall = stalled_over(stalls, a.start, b.end) if band and stalls else None
+            if stall is None:
+                kept.append(gap)
+            else:
+                self.held.append((g, w, stall))
+                self.count += 1
+        return kept
 
     def add_values(self, values: list[float], where: str) -> None:
         """:meth:`add` of gaps of these values, all at ``where`` (none a NaN): the run's
@@ -725,7 +769,7 @@ class _ToleranceUse:
                 maybe.append((g, w))
 
     def finding(self) -> Finding:
-        return _tolerance_finding(self.sure, self.maybe, self.count, self.uncertainty)
+        return _tolerance_finding(self.sure, self.maybe, self.count, self.uncertainty, self.held)
 
 
 class ResponseStarts:
@@ -777,7 +821,7 @@ class ReplyGaps:
         self._alike = _GapsAlike(base) if _alike(stamps) and not stalls else None
         self._each: list[Observation] = []
         self._judged: dict[tuple[float, float, str], Measured] = {}
-        self._tolerance = _ToleranceUse(base)
+        self._tolerance = _ToleranceUse(base, stalls)
 
     def add(self, segs: list[Segment]) -> None:
         """The reply character gaps of ``segs`` (the next window's segments)."""
@@ -798,24 +842,21 @@ class ReplyGaps:
 
 
 def _tolerance_finding(
-    sure: list[tuple[float, str]], maybe: list[tuple[float, str]], count: int, uncertainty: float
+    sure: list[tuple[float, str]],
+    maybe: list[tuple[float, str]],
+    count: int,
+    uncertainty: float,
+    held: list[tuple[float, str, Stall]] | None = None,
 ) -> Finding:
     """R-7.0-01's finding from the ``(gap, where)`` surely and possibly inside the band, out
-    of ``count`` gaps judged (:func:`_judge_tolerance_use`)."""
+    of ``count`` gaps judged (:func:`_judge_tolerance_use`); ``held``: those surely in it
+    whose stamps a stall of the tool's own host may have moved, with the stall (truth30):
+    INCONCLUSIVE naming it unless a gap outside every stall FAILs the rule."""
     if sure:
-        gap, where = sure[0]
-        return Finding(
-            "R-7.0-01",
-            Verdict.FAIL,
-            f"gap of {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} relies on the ±0.40 ms "
-            f"tolerance, which the 1.66 ms character gap does not have ({len(sure)} such "
-            "gap(s))",
-            evidence=[where for _, where in sure[:5]],
-            observed=count,
-            measured_ms=round(gap * 1e3, 3),
-            limit_ms=INTER_CHAR_GAP_MAX * 1e3,
-            uncertainty_ms=round(uncertainty * 1e3, 3),
-        )
+        return _leaning(sure, count, uncertainty)
+    if held:
+        gap, where, stall = held[0]
+        return stalled_interval(_leaning([(gap, where)], count, uncertainty), stall)
     if maybe:
         gap, where = maybe[0]
         return Finding(

@@ -15,7 +15,7 @@ saved transcript tells the same story as the live run.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from operator import attrgetter
 
@@ -43,12 +43,23 @@ def note_text(stall: float) -> str:
 #: how far (s) before a stall's measured length a read it held up may have begun: the
 #: reader's own poll and the engine's idle window, after which a held-up read ends cut
 REACH = 0.05
+#: how long (s) after a stall's NOTE what it held back may still be arriving, and what the
+#: tool did meanwhile was decided without it (truth30): the reader's first turn after the
+#: pause may come back empty, the port's own thread (RFC 2217's) not yet having queued the
+#: bytes; the engine, resumed with it, saw a quiet line, sent its retry's break 0.4 ms
+#: after the NOTE into the rest of the reply, and the reply to the retry read as the text
+#: the break talked over, its tail '5<CR><LF>' as a line of its own: R-4.3-01 FAILed a clean
+#: emulator (base-s67, the tool paused 80-200 ms every 0.3-0.9 s)
+AFTER = 0.03
+#: how many events before a stimulus :func:`stalls_since` looks at for such a NOTE
+LOOK_BACK = 8
 
 
 @dataclass(frozen=True)
 class Stall:
     """A host stall read back from its NOTE: the reads ``start``..``end`` (s) may have been
-    held up by it (its measured length, reached back by :data:`REACH`)."""
+    held up by it (its measured length, reached back by :data:`REACH`, and on by
+    :data:`AFTER` past the NOTE)."""
 
     start: float
     end: float
@@ -69,19 +80,50 @@ def stalls(events: Iterable[Event]) -> list[Stall]:
             got = _MS.match(event.text)
             if got is not None:
                 ms = float(got.group(1))
-                found.append(Stall(event.start - ms / 1e3 - REACH, event.start, ms))
+                found.append(Stall(event.start - ms / 1e3 - REACH, event.start + AFTER, ms))
     return found
 
 
 def stalls_since(events: list[Event], first: int) -> list[Stall]:
     """:func:`stalls` of ``events[first:]``: the stalls that may have held up a stimulus
     begun at event ``first`` (each is noted after the burst it held back, so a stall
-    overlapping it is noted after it began). Looked for in C first: most stimuli hold no
-    NOTE at all, and a run makes a thousand of them."""
+    overlapping it is noted after it began; or just before it: a stimulus begun within
+    :data:`AFTER` of a stall's NOTE may have been sent into what it still held back, so the
+    few events before ``first`` are looked at too). Looked for in C first: most stimuli
+    hold no NOTE at all, and a run makes a thousand of them."""
+    if first and first < len(events):
+        began = events[first].start - AFTER
+        back = max(0, first - LOOK_BACK)
+        before = [e for e in events[back:first] if e.kind is _NOTE and e.start >= began]
+        first = events.index(before[0], back) if before else first
     new = events[first:] if first else events
     if _NOTE not in map(_KIND, new):
         return []
     return stalls(new)
+
+
+def settled_at(events: Sequence[Event]) -> float | None:
+    """When what the latest stall among the last :data:`LOOK_BACK` of ``events`` held back
+    has surely arrived (its NOTE and :data:`AFTER`), or None where none is among them: the
+    tool's next transmission waits for it, not to talk into a reply the stall cut whose
+    rest is still on its way (truth30)."""
+    for event in reversed(events[-LOOK_BACK:]):
+        if event.kind is _NOTE and event.text.startswith(HOST_STALL_NOTE):
+            return event.start + AFTER
+    return None
+
+
+def noted_since_activity(events: Sequence[Event]) -> bool:
+    """Whether the NOTE of a host stall follows the line's last activity (a character or a
+    break) among ``events``: that activity's stamp may be the late burst's that delivered
+    it (the link notes the stall after the burst), so the marking since it may be longer
+    than the stamps say (truth30). Only the NOTEs after it are looked at: a few at most."""
+    for event in reversed(events):
+        if event.kind is not _NOTE:
+            return False
+        if event.text.startswith(HOST_STALL_NOTE):
+            return True
+    return False
 
 
 def stalled_over(found: list[Stall], start: float, end: float) -> Stall | None:

@@ -65,7 +65,7 @@ class WatchedToolRecorder(ToolRecorder):
         self.watch = BufferWatchHooks()
         super().__init__(link, policy, address=address, hooks=self.watch)
         self.last_sent = self.watch.last_sent
-        #: the last :meth:`_stalls_since` asked: (transcript's list, first, length) and what
+        #: the last :meth:`stalls_since` asked: (transcript's list, first, length) and what
         #: it found
         self._stalls_read: tuple[tuple[int, int, int], list[Stall]] = ((0, -1, -1), [])
 
@@ -99,14 +99,16 @@ class WatchedToolRecorder(ToolRecorder):
         stalled_reads.mark_waits`), from the link's notes since its transcript's event
         ``first`` (the stimulus began there), once the link has noted what it had to (its
         reader thread resumes with the engine)."""
-        found = self._stalls_since(first)
+        found = self.stalls_since(first)
         stalled_reads.mark_reads(exchanges, found)
         stalled_reads.mark_waits(measurements, found)
 
-    def _stalls_since(self, first: int) -> list[Stall]:
+    def stalls_since(self, first: int) -> list[Stall]:
         """:func:`~conformance.links.host_stall.stalls_since` of the link's transcript, read
         once per stimulus: the engine's records and the view's rebuilt ones of the same
-        stimulus ask it with the same ``first`` and no event added between (truth29)."""
+        stimulus ask it with the same ``first`` and no event added between (truth29); a
+        timed probe's case asks it over its probe's whole span (truth30,
+        :meth:`~conformance.sensor.session.SensorSession.stalled_since`)."""
         self.link.reader_caught_up()
         events = self.link.transcript.events
         key = (id(events), first, len(events))

@@ -19,6 +19,7 @@ from ..dut import DutClaim, Session, sensor_claim
 from ..judges.support import empty_data_reply, first_filled
 from ..judges.timing import REPROBE_TIMES, StampUncertainty
 from ..links.base import Link
+from ..links.host_stall import Stall, stalled_over
 from ..preconditions import Unmet, acknowledges, shows_listening
 from ..protocol import commands as cmd
 from ..protocol.commands import (
@@ -649,6 +650,18 @@ class SensorSession(Session):
             )
         ex.heard_late = heard
         return ex
+
+    def stalled_since(self, first: int, start: float) -> Stall | None:
+        """The first stall of the tool's own host noted since transcript event ``first`` that
+        may have held up the line's reading from ``start`` until now (truth30): a timed
+        probe's decisive span, from the reply or break its marking counts from to the end of
+        its read. :attr:`~conformance.tool_recorder.records.Attempt.stall` marks each read
+        alone; a standby probe rests on the span between them too: a reply stamped late by
+        the burst that delivered it makes the marking before the probe look shorter than the
+        sensor saw (silence at 150 ms taken for silence at 101.9), a break's end stamped
+        before the host let go of the line makes it look longer, and a cut read hides the
+        answer. What the probe shows there is the host's, either way."""
+        return stalled_over(self.master.stalls_since(first), start, self.link.now())
 
     def listen(self, duration: float) -> list[Event]:
         """Keep the line marking for ``duration`` s and return what the DUT sent meanwhile."""

@@ -17,6 +17,7 @@ from operator import attrgetter, is_
 
 from ..links.base import LineEnd, Link
 from ..links.errors import BreakUnsupported
+from ..links.host_stall import noted_since_activity, settled_at
 from ..protocol import commands as cmds
 from ..protocol.commands import (
     DATA_INDEX_MAX,
@@ -243,6 +244,11 @@ class ToolRecorder:
         self.note_collisions()
         if collide:
             return self.link.now()
+        settled = settled_at(self.link.transcript.events)
+        if settled is not None and settled > self.link.now():
+            # what a stall of the tool's host just held back is still arriving: the reply
+            # its read cut may be going on (truth30, host_stall.AFTER)
+            self.link.wait_until(settled)
         look = self.look_before_transmit()
         self.link.wait_until(self._earliest_transmit(look))
         began = self.link.now()
@@ -491,11 +497,19 @@ class ToolRecorder:
         )
 
     def _usual_needs_break(self, address: str, at: float) -> bool:
-        """R-7.0-17 / R-7.1-01: break for a new address or after > 87 ms of marking."""
+        """R-7.0-17 / R-7.1-01: break for a new address or after > 87 ms of marking; and
+        where the link noted a stall of the tool's own host after the line's last activity
+        (:func:`~conformance.links.host_stall.noted_since_activity`), whose stamp may then be
+        the late burst's: a service request the stall held back reads as just ended, and
+        ``aD0!`` sent "within 87 ms" of it without a break may find the sensor asleep for
+        100 ms already, its silence then taken for the sensor's (truth30)."""
         if self.last_address is None or address != self.last_address:
             return True
         window = NO_BREAK_WINDOW - self.policy.window_margin - self.link.info.timing_uncertainty
-        return at - self.link.last_activity() > window
+        if at - self.link.last_activity() > window:
+            return True
+        self.link.reader_caught_up()
+        return noted_since_activity(self.link.transcript.events)
 
     def _transmit(
         self,

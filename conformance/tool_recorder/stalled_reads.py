@@ -50,15 +50,18 @@ def wait_stall(m: Measurement, found: list[Stall]) -> Stall | None:
     else its last character, or ttt). Characters the sensor sent during a stall are stamped
     at the late burst that delivers them: a service request split into two runs, or dated
     past ttt; one delivered after the wait ended lies in the D read's record, not the
-    wait's. A stall earlier in a wait, before any character of it, moves nothing."""
+    wait's. A stall earlier in a wait, before any character of it, moves nothing. With no
+    character in it, the wait is looked at from ttt on (truth30): a stall over the engine's
+    deadline leaves a request delivered in its burst queued past it, read as the D
+    command's stray characters, and the record "no service request" (its NOTE is written
+    as the reader resumes, before the engine's break for D0, so the D read's start alone
+    missed it)."""
     if not found or m.reply_end is None or m.ttt is None:
         return None
     waited = m.waited_events
-    if m.data:
-        end = m.data[0].start
-    else:
-        end = max(m.reply_end + m.ttt, waited[-1].end if waited else m.reply_end)
-    return stalled_over(found, waited[0].start if waited else end, end)
+    ready = m.reply_end + m.ttt
+    end = m.data[0].start if m.data else max(ready, waited[-1].end if waited else m.reply_end)
+    return stalled_over(found, waited[0].start if waited else min(ready, end), end)
 
 
 def mark_waits(measurements: Iterable[Measurement], found: list[Stall]) -> None:

@@ -537,30 +537,53 @@ def test_standby_after_foreign_command(sensor, case):
         "a! answered; then, with no break, b! (another sensor) and a!: silence; and a! "
         "answered when sent as late after a reply, with no b! between (the control)"
     )
-    awake = _awake(sensor)
+    other = sensor.foreign_address()
+
+    def attempt(_n):
+        first = len(sensor.link.transcript.events)
+        awake = _awake(sensor)
+        if not awake.answered:
+            return awake, None, None, None, None, None
+        sensor.listen(0.02)
+        foreign = sensor.master.raw(f"{other}!", break_first=False)
+        ex = sensor.hear_late(sensor.master.raw(f"{sensor.address}!", break_first=False))
+        since = awake.judged.reply_events[-1].end
+        stall = sensor.stalled_since(first, since)  # from the reply b!'s marking counts from
+        # the control: a! as long after a reply, with no b! before it. A sensor silent to it
+        # is silent to an unbroken follow-up anyway (it needs a break after every reply, or
+        # sleeps early), so its silence after b! shows no standby (never-standby PASSed beside
+        # no-follow-up-without-break, seed 4064)
+        gap = _marking_before(ex, since)
+        first = len(sensor.link.transcript.events)
+        again = _awake(sensor)
+        control, control_stall = again, None
+        if again.answered:
+            control = sensor.hear_late(
+                _after_marking(
+                    sensor, again.judged.reply_events[-1].end, gap, f"{sensor.address}!"
+                )[0]
+            )
+            control_stall = sensor.stalled_since(first, again.judged.reply_events[-1].end)
+        case.evidence(
+            f"a!, then {other}! and a! with no break; a!, then a! as late with no break",
+            [awake, foreign, ex, again, control],
+        )
+        return awake, foreign, ex, control, stall, control_stall
+
+    def miss(sent):
+        # a stall of the tool's host from the reply the probe's marking counts from to the
+        # end of its read (or of the control's, which only a silent probe rests on) leaves
+        # the probe no evidence either way: sent again (truth30)
+        _awake_ex, _foreign, ex, _control, stall, control_stall = sent
+        if ex is None:
+            return None  # the wake-up went unanswered: judged below, not aimed again
+        held = stall or (control_stall if not ex.answered else None)
+        return f"a stall of the tool's host over it: {held.why()}" if held else None
+
+    aimed = sensor.aim(f"{other}! then {sensor.address}! with no break", attempt, miss)
+    awake, foreign, ex, control, stall, control_stall = aimed.last
     if not case.requires("awake", precondition.woke([awake])):
         return
-    other = sensor.foreign_address()
-    sensor.listen(0.02)
-    foreign = sensor.master.raw(f"{other}!", break_first=False)
-    ex = sensor.hear_late(sensor.master.raw(f"{sensor.address}!", break_first=False))
-    # the control: a! as long after a reply, with no b! before it. A sensor silent to it
-    # is silent to an unbroken follow-up anyway (it needs a break after every reply, or
-    # sleeps early), so its silence after b! shows no standby (never-standby PASSed beside
-    # no-follow-up-without-break, seed 4064)
-    gap = _marking_before(ex, awake.judged.reply_events[-1].end) if awake.answered else 0.0
-    again = _awake(sensor)
-    control = (
-        sensor.hear_late(
-            _after_marking(sensor, again.judged.reply_events[-1].end, gap, f"{sensor.address}!")[0]
-        )
-        if again.answered
-        else again
-    )
-    case.evidence(
-        f"a!, then {other}! and a! with no break; a!, then a! as late with no break",
-        [awake, foreign, ex, again, control],
-    )
     if late := judge.late_elsewhere(ex):
         # the late reply names another address: the sensor's late answer to b!, begun over
         # the a! it was busy for (replies-after-retry + answers-foreign-address: 'z<CR><LF>'
@@ -574,7 +597,12 @@ def test_standby_after_foreign_command(sensor, case):
             )
         )
         return
-    case.add(judge.silent("R-7.0-14", [ex], f"{other}! sent it to standby", baseline=control))
+    found = judge.silent(
+        "R-7.0-14", [ex], f"{other}! sent it to standby", baseline=control, stalled=[stall]
+    )
+    if found.verdict is Verdict.PASS:  # silence counts beside a control outside any stall
+        found = held_by(found, control_stall, either_way=True)
+    case.add(found)
 
 
 #: How far inside a limit a boundary probe aims, beyond the tolerance and twice the link's
@@ -629,31 +657,38 @@ def test_standby_after_100ms(sensor, case):
     case.expect(
         f"silence to a! sent {edge * 1e3:.1f} ms and 115 ms after the last reply, without a break"
     )
-    probes, wakes = [], []
+    probes, wakes, stalled = [], [], []
     for marking in (edge, 0.115):
 
         def attempt(_n, marking=marking):
+            at = len(sensor.link.transcript.events)
             first = _awake(sensor)
             if not first.answered:
-                return first, None, None
-            ex, idle = _after_marking(
-                sensor, first.judged.reply_events[-1].end, marking, f"{sensor.address}!"
-            )
+                return first, None, None, None
+            since = first.judged.reply_events[-1].end
+            ex, idle = _after_marking(sensor, since, marking, f"{sensor.address}!")
             sensor.hear_late(ex)  # from a sensor seen late: a late answer is an answer
             idle = min(idle, _marking_since_sensor([first, ex], ex))
             case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
-            return first, ex, idle
+            return first, ex, idle, sensor.stalled_since(at, since)
 
-        def miss(sent):
-            _first, _ex, idle = sent
+        def off_window(sent):
+            _first, _ex, idle, _stall = sent
             if idle is None:
                 return "the wake-up a! went unanswered"
             if idle - u <= STANDBY_MARKING + TOLERANCE:
                 return f"a! went out after {idle * 1e3:.2f} ms of marking, not surely over 100.4"
             return None
 
+        def miss(sent):
+            # a probe the tool's host stalled over, from the reply its marking counts from to
+            # the end of its read, is no evidence either way: sent again (truth30)
+            stall = sent[3]
+            held = f"a stall of the tool's host over it: {stall.why()}" if stall else None
+            return off_window(sent) or held
+
         aimed = sensor.aim(f"a! after {marking * 1e3:.1f} ms of marking", attempt, miss)
-        first, ex, idle = aimed.last
+        first, ex, idle, stall = aimed.last
         wakes.append(first)
         if idle is None:
             # a wake-up answered only after its windows shows the sensor awake but gives no
@@ -665,7 +700,7 @@ def test_standby_after_100ms(sensor, case):
             )
             case.requires("awake", replace(unmet, detail=unmet.detail + aimed.missed))
             return
-        if aimed.landed is None:
+        if aimed.landed is None and off_window(aimed.last) is not None:
             case.add(
                 inconclusive(
                     "R-7.0-15",
@@ -674,17 +709,21 @@ def test_standby_after_100ms(sensor, case):
             )
             return
         probes.append((ex, idle))
+        stalled.append(stall)  # None where it landed: only the last of tries all stalled
     case.requires("awake", precondition.woke(wakes))
     shown = " and ".join(f"{idle * 1e3:.2f} ms" for _, idle in probes) + " after a reply"
     heard_break = _standby_after_a_break(sensor, case, edge)
     if heard_break is not None:
-        probes.append(heard_break)
-        shown += f", {heard_break[1] * 1e3:.2f} ms after a break,"
+        ex, idle, stall = heard_break
+        probes.append((ex, idle))
+        stalled.append(stall)
+        shown += f", {idle * 1e3:.2f} ms after a break,"
     found = judge.silent(
         "R-7.0-15",
         [ex for ex, _ in probes],
         f"{shown} of marking put it in standby",
         baseline=wakes,
+        stalled=stalled,
     )
     # silence shows standby only by the time the probe went out: probed as late as the
     # link's uncertainty forces (2u past the limit), a sensor awake a few ms too long is
@@ -693,15 +732,21 @@ def test_standby_after_100ms(sensor, case):
     # where the sim, probing at 101.9 ms, FAILs it)
     # timed from the earliest probe that counts: one that maybe collided is set aside by
     # judge.silent, and the 115 ms probe alone does not resolve the limit
-    counted = [idle for ex, idle in probes if ex.answered or not ex.maybe_collided]
+    # and outside every stall (truth30): a stalled edge probe resolves nothing either
+    counted = [
+        idle
+        for (ex, idle), stall in zip(probes, stalled, strict=True)
+        if (ex.answered or not ex.maybe_collided) and stall is None
+    ]
     latest = min(counted, default=probes[0][1]) + u
     if found.verdict is Verdict.PASS and latest > STANDBY_MARKING + TOLERANCE + STANDBY_RESOLUTION:
+        held = next((f"; {stall.why()}" for stall in stalled if stall), "")
         found = inconclusive(
             "R-7.0-15",
             f"silent, but {shown} of marking (±{u * 1e3:.2f} ms): standby by"
             f" {(STANDBY_MARKING + TOLERANCE) * 1e3:.1f} ms is not resolved, only by"
             f" {latest * 1e3:.1f} ms (the tool vouches for"
-            f" {STANDBY_RESOLUTION * 1e3:.1f} ms past the limit)",
+            f" {STANDBY_RESOLUTION * 1e3:.1f} ms past the limit){held}",
             observed=found.observed,
         )
     case.add(found)
@@ -717,8 +762,11 @@ def _standby_after_a_break(sensor, case, edge: float):
     past 100 ms may only then have woken, its slowness R-7.0-07's deviation, not a stay
     awake past the limit (slow-wake behind ``emulate --echo --jitter 2`` answered the probe
     110.08 ms after a break, at its 110 ms wake-up, and R-7.0-15 FAILed "answered although
-    ... 110.08 ms after a break", truth23). Returns (exchange, marking) or None when it does
-    not count."""
+    ... 110.08 ms after a break", truth23). Returns (exchange, marking, the stall of the
+    tool's host over it if every try met one) or None when it does not count. A stall from
+    the break to the end of the probe's read sends it again (truth30): the break's end is
+    stamped before the host lets go of the line, so a pause between them leaves the sensor
+    less marking than the stamps show; a cut read hides its answer."""
 
     def after_break(marking_s):
         return lambda _n: sensor.probe(
@@ -728,15 +776,27 @@ def _standby_after_a_break(sensor, case, edge: float):
             standby=True,
         )
 
-    def miss(ex):
-        idle = _marking_after_break(sensor, ex)
+    def probe(n):
+        at = len(sensor.link.transcript.events)
+        ex = sensor.hear_late(after_break(edge)(n))  # a late answer is an answer
+        brk = _break_of(sensor, ex)
+        since = brk.start if brk is not None else ex.attempts[0].start
+        return ex, sensor.stalled_since(at, since)
+
+    def off_window(sent):
+        idle = _marking_after_break(sensor, sent[0])
         if idle is None or idle - sensor.uncertainty <= STANDBY_MARKING + TOLERANCE:
             return "a! after a break did not go out surely past 100.4 ms of marking"
         return None
 
+    def miss(sent):
+        stall = sent[1]
+        held = f"a stall of the tool's host over it: {stall.why()}" if stall else None
+        return off_window(sent) or held
+
     control = sensor.hear_late(after_break(77e-3)(0))
-    aimed = sensor.aim(f"a! {edge * 1e3:.1f} ms after a break", after_break(edge), miss)
-    ex = sensor.hear_late(aimed.last)  # from a sensor seen late: a late answer is an answer
+    aimed = sensor.aim(f"a! {edge * 1e3:.1f} ms after a break", probe, miss)
+    ex, stall = aimed.last
     case.evidence(
         "break, 77 ms marking, a! (control); break, marking past 100 ms, a!",
         [
@@ -744,11 +804,11 @@ def _standby_after_a_break(sensor, case, edge: float):
             ex,
         ],
     )
-    if aimed.landed is None:
+    if aimed.landed is None and off_window(aimed.last) is not None:
         return None
     if control.answered or judge.heard_late(control):
-        return ex, _marking_after_break(sensor, ex)
-    if ex.answered or judge.heard_late(ex):
+        return ex, _marking_after_break(sensor, ex), stall
+    if stall is None and (ex.answered or judge.heard_late(ex)):
         # awake past 100 ms after a break, or only then awake: neither a FAIL nor room for
         # the probes after a reply to PASS alone (they may be silent for another reason)
         marking = _marking_after_break(sensor, ex) or 0.0

@@ -213,8 +213,8 @@ def test_the_stall_notes_are_read_once_per_stimulus(monkeypatch):
     run.exchange("0D0!", VALUES, stalled=True)
     link = SimpleNamespace(transcript=Transcript(run.events), reader_caught_up=lambda: None)
     engine = SimpleNamespace(link=link, _stalls_read=((0, -1, -1), []))
-    first = WatchedToolRecorder._stalls_since(engine, 0)  # type: ignore[arg-type]
-    assert WatchedToolRecorder._stalls_since(engine, 0) is first and len(first) == 1  # type: ignore[arg-type]
+    first = WatchedToolRecorder.stalls_since(engine, 0)  # type: ignore[arg-type]
+    assert WatchedToolRecorder.stalls_since(engine, 0) is first and len(first) == 1  # type: ignore[arg-type]
     link.transcript.note(run.t, host_stall.note_text(STALL))
-    assert len(WatchedToolRecorder._stalls_since(engine, 0)) == 2  # type: ignore[arg-type]
+    assert len(WatchedToolRecorder.stalls_since(engine, 0)) == 2  # type: ignore[arg-type]
     assert reads == [0, 0]

@@ -105,7 +105,7 @@ def test_the_stalls_are_read_back_from_the_notes_alone():
     found = host_stall.stalls(events)
     assert [s.ms for s in found] == [pytest.approx(83.1), pytest.approx(150.2)]
     # each reaches back over its length and the read's reach, to its note
-    assert found[1].end == 3.0
+    assert found[1].end == 3.0 + host_stall.AFTER  # and on past it (truth30)
     assert found[1].start == pytest.approx(3.0 - 0.1502 - host_stall.REACH)
     assert found[1].overlaps(2.8, 2.9) and not found[1].overlaps(2.0, 2.5)
     assert host_stall.stalled_over(found, 2.8, 2.9) is found[1]
