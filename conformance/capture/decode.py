@@ -58,7 +58,8 @@ SENSOR_ORIGIN = DUT  # origin of the rest of the bus
 class CaptureDecode:
     """What a capture holds, decoded. ``problems``: every break, pulse, glitch and frame with
     a framing or parity error or glitches, in time order (clean characters are counted, not
-    kept twice); ``baud_error_pct``: each character's measured bit-rate error, in event order
+    kept twice), or only those frames where :attr:`characters_problems_only`;
+    ``baud_error_pct``: each character's measured bit-rate error, in event order
     (NaN where its edges could not tell): a :class:`~conformance.event_store.Column` where
     the events are kept compact (written out a chunk at a time: an hour's 342,000 characters
     are not held in RAM while the capture is judged, issue 22), else an array."""
@@ -97,6 +98,13 @@ class CaptureDecode:
     baud_error_pct: array | Column = field(default_factory=lambda: array("f"))
     problems: list[Decoded] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    #: ``problems`` holds the characters' alone (:func:`~.uart.character_problems`, all a
+    #: judgement reads of them): a decode kept compact for judging (issue 22). Its breaks,
+    #: pulses, glitches and cut frames are counted and, but for the last two, events; none
+    #: is held as an item while the capture is decoded: a busy bus's every break was one
+    #: (an hour's 14,875, ~4.5 MB with their events and stamps at two hours), the decode's
+    #: one transient that grew with the capture, whose pages it left behind
+    characters_problems_only: bool = False
 
     @property
     def polarity(self) -> str:
@@ -319,6 +327,7 @@ def _decode_channel(
         baud=baud,
         framing=str(framing),
         notes=notes,
+        characters_problems_only=how.compact,
     )
     line = dict(
         initial_level=edges.initial_level,
@@ -379,6 +388,7 @@ class _Tally:
 
     def __init__(self, out: CaptureDecode) -> None:
         self.problems, self.baud_error = out.problems, out.baud_error_pct.append
+        self.every = not out.characters_problems_only  # else the characters' problems alone
         self.chars = self.framing_errors = self.parity_errors = self.glitches = 0
         self.breaks = self.pulses = self.partial = 0
 
@@ -393,7 +403,8 @@ class _Tally:
             if d.framing_error or d.parity_error or d.glitches:
                 self.problems.append(d)
             return
-        self.problems.append(d)
+        if self.every:
+            self.problems.append(d)
         self.breaks += d.kind == "break"
         self.pulses += d.kind == "pulse"
         self.glitches += d.kind == "glitch"
@@ -808,8 +819,11 @@ def decode_capture(
     (no event made; ``events`` empty), for a caller that reads them so (a fault-matrix
     row's replay); such a decode is neither kept nor taken from the one kept. ``compact``:
     the events kept in a :class:`~conformance.event_store.CompactEvents` as they are made
-    (a list where one cannot be: decoded again so); the one kept shares it (nothing appends
-    to a decode's events once made), and one kept as a list is given as it is."""
+    (a list where one cannot be: decoded again so), and of its problems the characters'
+    alone (:attr:`CaptureDecode.characters_problems_only`); the one kept shares it (nothing
+    appends to a decode's events once made), and one kept as a list is given as it is. A
+    kept decode with its characters' problems alone is given to a compact caller alone
+    (another decodes again: it may read every problem)."""
     global _LAST
     path = str(path)
     if glitch_filter is None:
@@ -824,7 +838,13 @@ def decode_capture(
         key = None  # the decoding below says what is wrong with the file
     if columns:
         key = None
-    if key is not None and _LAST is not None and _LAST[0] == key:
+    # a decode that kept its characters' problems alone serves a compact caller alone
+    if (
+        key is not None
+        and _LAST is not None
+        and _LAST[0] == key
+        and (compact or not _LAST[1].characters_problems_only)
+    ):
         kept = _LAST[1]
         if not keep:
             _LAST = None
