@@ -89,11 +89,30 @@ def test_the_adapter_floor_adds_the_delivery_past_the_release_time():
     assert 0.0 <= figures.lateness_worst <= TICK
 
 
+def test_the_delivery_floor_counts_the_sensor_s_release_from_the_delivery():
+    """A recorder that sees the line only through the adapter gives the sensor its 7.5 ms
+    from the delivery: the whole lateness is added after each answered reply (up to the
+    next transmission), not only what passes 7.5 ms."""
+    module = tap_module()
+    line = _line()
+    figures = module.wire_figures(_as_the_tool_stamped(line), _heard(line, module), TICK)
+    added = 0.0
+    for a, b in zip(line, line[1:], strict=False):
+        if a.origin == DUT and b.origin == TOOL:
+            late = _delivered(a.end) - a.end
+            added += max(0.0, min(RELEASE_LINE + late, b.start - a.end) - RELEASE_LINE)
+    # each turnaround's lateness is off by up to half a bin of the fitted phase
+    half_bin = TICK / module.PHASE_BINS / 2
+    assert figures.delivery_floor - figures.bound == pytest.approx(added, abs=8 * half_bin)
+    assert figures.delivery_floor > figures.adapter_floor
+
+
 def test_without_a_latency_timer_the_floor_is_the_bound():
     module = tap_module()
     line = _line()
     figures = module.wire_figures(_as_the_tool_stamped(line), _heard(line, module))
     assert figures.adapter_floor == figures.bound and figures.turnarounds == 0
+    assert figures.delivery_floor == figures.bound
 
 
 def test_alignment_skips_what_only_one_side_has():
