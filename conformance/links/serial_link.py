@@ -43,8 +43,8 @@ from .priority import READER, quick_gil_handover, realtime_priority
 from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
-#: s: how often a read past its stamps' grace looks whether the reader thread is back in its
-#: read (:meth:`SerialLink._handed_over`), instead of waiting out the declared floor
+#: s: how often a read past the frames its stamps need looks whether the reader thread is back
+#: in its read (:meth:`SerialLink._handed_over`), instead of waiting out the declared floor
 HANDOVER_POLL = 0.5e-3
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
 ECHO_WAIT = 0.5  # s: beyond the latency bound, how long a known echo may take to come back
@@ -165,21 +165,22 @@ class SerialLink(Link):
         return self._widest_chunk * CHAR_TIME + self.info.timing_uncertainty
 
     def _handed_over(self, limit: float, now: float) -> bool:
-        """Whether nothing the reader thread has yet to hand over can be stamped as started
-        before ``limit``, at ``now`` (taken before this call; caller holds the lock): the
-        stamps are the reader's own (no kernel tape), it is blocked in the port's read, and
-        ``now`` is a widest chunk's frames past ``limit``. A byte not handed over yet is then
-        stamped when that read returns, after ``now``, and its frame starts at most its
-        chunk's frames before its stamp (:func:`~.stamps.chunk_frames`): after ``limit``.
-        The declared floor in :meth:`read_grace` is for a stamp the reader took (or the
-        kernel's) but has not handed over; with the reader back in its read there is none,
-        and waiting it out made every read that ran to its deadline (a command nobody
-        answered, a wait for a service request, a window for silence) 5 ms longer over RFC
-        2217 (issue 22, usb13). With a kernel tape the stamps are the kernel's, older than the
-        read that returns them: the floor stays."""
+        """Whether a read whose limit is ``limit`` may end at ``now`` (taken before this call;
+        caller holds the lock) short of :meth:`read_grace`: the stamps are the reader
+        thread's own (no kernel tape), it is blocked in the port's read, and ``now`` lies a
+        frame more than the widest chunk's frames past ``limit``. A byte not handed over yet
+        is then stamped when that read returns, after ``now``, and the first of a chunk of
+        k bytes starts k frames before its stamp (:func:`~.stamps.chunk_frames`): after
+        ``limit`` for any chunk up to one byte wider than the widest seen, all that the
+        whole grace covers where its declared floor is a frame or less. Where the floor is
+        longer (16 ms for a USB serial device the driver does not put in low-latency mode,
+        10 ms over a remote network) waiting it out made every read that ran to its deadline
+        (a command nobody answered, a wait for a service request, a window for silence) that
+        much longer than the stamps need (issue 22, usb13). With a kernel tape the stamps
+        are the kernel's, older than the read that returns them: the floor stays."""
         return (
             self._tape is None
-            and now >= limit + self._widest_chunk * CHAR_TIME
+            and now >= limit + (self._widest_chunk + 1) * CHAR_TIME
             and self._in_read
             and not self._closing.is_set()
         )
@@ -687,7 +688,7 @@ class SerialLink(Link):
                 if self._handed_over(limit, now):
                     return got
                 self._check()
-                frames = self._widest_chunk * CHAR_TIME
+                frames = (self._widest_chunk + 1) * CHAR_TIME
                 if now < limit + frames:
                     self._cond.wait(min(limit + frames - now, 0.1))
                 else:  # the reader is handing a read over: look again shortly
