@@ -78,7 +78,7 @@ def _past(link: SerialLink, deadline: float) -> float:
     return link.now() - deadline
 
 
-def test_an_idle_read_ends_a_frame_past_its_limit_not_the_floor_later():
+def test_an_idle_read_does_not_wait_out_the_declared_floor():
     link = _open(_TimedPort())
     try:
         assert link.read_grace() == pytest.approx(CHAR_TIME + FLOOR)
