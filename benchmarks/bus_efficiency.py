@@ -9,6 +9,7 @@ delays and announced measurement times) next to the wall time the run took, and 
     python benchmarks/bus_efficiency.py [-k EXPR] [--faults NAME,...] [--keep DIR]
     python benchmarks/bus_efficiency.py --bench "--echo --usb-latency 16" --wire 127.0.0.1:4803
     python benchmarks/bus_efficiency.py --attribute DIR   (a kept run: where the rest went)
+    python benchmarks/bus_efficiency.py --attribute DIR --on-wire   (the same on the line's clock)
 
 ``--tool ARGS`` adds options to the tool's run (``--timing-uncertainty-ms 16``: the floor a USB
 serial device the driver does not put in low-latency mode declares). ``--bench ARGS`` serves
@@ -103,6 +104,11 @@ def main(argv: list[str] | None = None) -> int:
         help="no run: sort the wall beyond the lower bound of a kept run by its causes",
     )
     p.add_argument(
+        "--on-wire",
+        action="store_true",
+        help="with --attribute: the line's clock (wire.jsonl of a --wire run), not the tool's",
+    )
+    p.add_argument(
         "--wire",
         metavar="HOST:PORT",
         help="also serve the line on a tap there and give the run's figures on the line's own "
@@ -110,7 +116,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = p.parse_args(argv)
     if args.attribute:
-        events = read_transcript_jsonl(str(Path(args.attribute) / "transcript.jsonl"))
+        kept = "wire.jsonl" if args.on_wire else "transcript.jsonl"
+        events = read_transcript_jsonl(str(Path(args.attribute) / kept))
         print(attribution(events))
         verdicts = Path(args.attribute) / "verdicts.json"
         if verdicts.exists():
