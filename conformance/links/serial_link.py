@@ -688,11 +688,12 @@ class SerialLink(Link):
                 if self._handed_over(limit, now):
                     return got
                 self._check()
-                frames = (self._widest_chunk + 1) * CHAR_TIME
-                if now < limit + frames:
-                    self._cond.wait(min(limit + frames - now, 0.1))
-                else:  # the reader is handing a read over: look again shortly
-                    self._cond.wait(min(limit + grace - now, HANDOVER_POLL))
+                wake = limit + grace
+                if self._tape is None:  # the reader's own stamps: the hand-over may end it
+                    frames = limit + (self._widest_chunk + 1) * CHAR_TIME
+                    # past the frames the reader is handing a read over: look again shortly
+                    wake = min(wake, frames if now < frames else now + HANDOVER_POLL)
+                self._cond.wait(min(wake - now, 0.1))
 
     def _break_methods(self) -> str:
         """How this link makes line states, for the report."""

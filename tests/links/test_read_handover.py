@@ -98,6 +98,26 @@ def test_with_a_kernel_tape_the_floor_stays():
     assert overrun >= CHAR_TIME + FLOOR - 1e-3
 
 
+@pytest.mark.parametrize("tape", [None, object()])
+def test_a_floor_under_a_frame_still_ends_the_read_at_its_grace(tape):
+    """Where the declared floor is less than a frame (2 ms: a low-latency serial device) the
+    whole grace ends sooner than the frames the hand-over waits for: the read ends at the
+    grace, with or without a kernel tape (a first version slept to the frames first: 3.3 ms
+    more on every read that ran to its deadline over RFC 2217)."""
+    port = _TimedPort(kernel_stamps=tape)
+    info = LinkInfo(kind="serial", can_break=False, timing_uncertainty=2e-3)
+    link = SerialLink(port, info, None, echo=EchoMode.OFF)  # type: ignore[arg-type]
+    port.clock = lambda: link.now()
+    time.sleep(2 * READ_POLL)
+    try:
+        grace = link.read_grace()
+        overrun = min(_past(link, link.now() + 20e-3) for _ in range(3))
+    finally:
+        link.close()
+    assert grace == pytest.approx(CHAR_TIME + 2e-3)
+    assert grace - 1e-4 <= overrun < (grace + 2 * CHAR_TIME) / 2
+
+
 @pytest.mark.parametrize("count", [1, 2])
 @pytest.mark.parametrize("handover", [0.0, 3e-3, 12e-3])
 @pytest.mark.parametrize("early", [1e-3, 4e-3])
