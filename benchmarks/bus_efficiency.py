@@ -11,10 +11,11 @@ delays and announced measurement times) next to the wall time the run took, and 
     python benchmarks/bus_efficiency.py --attribute DIR   (a kept run: where the rest went)
     python benchmarks/bus_efficiency.py --attribute DIR --on-wire   (the same on the line's clock)
 
-``--tool ARGS`` adds options to the tool's run (``--timing-uncertainty-ms 16``: the floor a USB
-serial device the driver does not put in low-latency mode declares). ``--bench ARGS`` serves
-the emulator behind ``emulate``'s bench models (an echoing interface behind an FTDI-style 16
-ms latency timer, above), ``--listen HOST:PORT`` where it serves,
+``--tool ARGS`` adds options to the tool's run (``--timing-uncertainty-ms 16``: it widens the
+stamps' uncertainty, not the link's declared floor; ``benchmarks/reader_stamps`` sets that
+for a run). ``--bench ARGS`` serves the emulator behind ``emulate``'s bench models (an
+echoing interface behind an FTDI-style 16 ms latency timer, above), ``--listen HOST:PORT``
+where it serves,
 ``--wire HOST:PORT`` also serves the line on an ``emulate --tap`` there and prints the run on
 the line's own clock beside ``run.bus`` (``wire_tap.py``: the bound without the receive
 path's stamps, and the adapter floor, the bound plus what the latency timer's delivery of
