@@ -7,7 +7,8 @@ USB serial device the driver does not put in low-latency mode: 16). Put this fol
     USB13_FLOOR_MS=16 PYTHONPATH=benchmarks/reader_stamps python benchmarks/bus_efficiency.py \\
         --bench "--echo --usb-latency 16" --wire 127.0.0.1:4803
 
-(issue 22, usb13: the read hand-over, ``SerialLink._handed_over``, acts only on such links).
+(issue 22, usb13: a read that ends once the reader thread is back in its read, tried and
+reverted, acted only on such links; README's ``### usb13``).
 """
 
 from __future__ import annotations

@@ -43,9 +43,6 @@ from .priority import READER, quick_gil_handover, realtime_priority
 from .stamps import chunk_frames, overlap
 
 READ_POLL = 0.02  # s: the reader thread's read timeout, so it notices close() promptly
-#: s: how often a read past the frames its stamps need looks whether the reader thread is back
-#: in its read (:meth:`SerialLink._handed_over`), instead of waiting out the declared floor
-HANDOVER_POLL = 0.5e-3
 SPIN = 0.0008  # s: the last stretch of a timed wait is polled, not slept (sleep overshoots)
 ECHO_WAIT = 0.5  # s: beyond the latency bound, how long a known echo may take to come back
 ECHO_WAIT_AUTO = 0.1  # s: the same while auto has not decided (a silent DUT costs it once)
@@ -109,9 +106,6 @@ class SerialLink(Link):
         # arrival (received_by): only those, and only the latest, are ever asked about
         self._pushed: dict[float, float] = {}
         self._widest_chunk = 1  # the most bytes seen under one arrival stamp (read_grace)
-        # the reader thread is blocked in the port's read and has stamped nothing it has not
-        # handed over (cleared before it stamps what the read returned): _handed_over
-        self._in_read = False
         self._tx_free = 0.0  # end of the tool's last frame on the wire
         self._failure: BaseException | None = None
         self._closing = threading.Event()
@@ -164,27 +158,6 @@ class SerialLink(Link):
         they widen the stamps' uncertainty, not this."""
         return self._widest_chunk * CHAR_TIME + self.info.timing_uncertainty
 
-    def _handed_over(self, limit: float, now: float) -> bool:
-        """Whether a read whose limit is ``limit`` may end at ``now`` (taken before this call;
-        caller holds the lock) short of :meth:`read_grace`: the stamps are the reader
-        thread's own (no kernel tape), it is blocked in the port's read, and ``now`` lies a
-        frame more than the widest chunk's frames past ``limit``. A byte not handed over yet
-        is then stamped when that read returns, after ``now``, and the first of a chunk of
-        k bytes starts k frames before its stamp (:func:`~.stamps.chunk_frames`): after
-        ``limit`` for any chunk up to one byte wider than the widest seen, all that the
-        whole grace covers where its declared floor is a frame or less. Where the floor is
-        longer (16 ms for a USB serial device the driver does not put in low-latency mode,
-        10 ms over a remote network) waiting it out made every read that ran to its deadline
-        (a command nobody answered, a wait for a service request, a window for silence) that
-        much longer than the stamps need (issue 22, usb13). With a kernel tape the stamps
-        are the kernel's, older than the read that returns them: the floor stays."""
-        return (
-            self._tape is None
-            and now >= limit + (self._widest_chunk + 1) * CHAR_TIME
-            and self._in_read
-            and not self._closing.is_set()
-        )
-
     def latency_bound(self) -> float:
         """How long a byte may take to reach the reader after its stop bit (s)."""
         return max(self.info.timing_uncertainty, self.meter.round_trip.value)
@@ -196,17 +169,14 @@ class SerialLink(Link):
         back = time.perf_counter_ns()  # when the last read returned
         while not self._closing.is_set():
             asked = time.perf_counter_ns()
-            self._in_read = True
             try:
                 data = port.read(max(1, port.in_waiting))
             except Exception as exc:  # pyserial raises SerialException, OSError, TypeError...
-                self._in_read = False
                 if not self._closing.is_set():
                     with self._cond:
                         self._failure = exc
                         self._cond.notify_all()
                 return
-            self._in_read = False  # before the stamp: see _handed_over
             arrival = time.perf_counter_ns()
             # no read returns later than its timeout after the last one came back unless the
             # whole process was held up: the host stalled (host_stall), said after what came
@@ -664,9 +634,7 @@ class SerialLink(Link):
     ) -> list[Event]:
         """As :meth:`Link.receive`. A byte is seen only after its stop bit, so a read whose
         limit lies ahead waits :meth:`read_grace` past it for characters that started in
-        time, or less once nothing the reader has yet to hand over can have started by
-        then (:meth:`_handed_over`); one whose limit has already passed returns what is
-        queued at once."""
+        time; one whose limit has already passed returns what is queued at once."""
         got: list[Event] = []
         grace = self.read_grace()
         waits = deadline > self.now()
@@ -685,15 +653,8 @@ class SerialLink(Link):
                 now = self.now()
                 if later_char_queued or not waits or now >= limit + grace:
                     return got
-                if self._handed_over(limit, now):
-                    return got
                 self._check()
-                wake = limit + grace
-                if self._tape is None:  # the reader's own stamps: the hand-over may end it
-                    frames = limit + (self._widest_chunk + 1) * CHAR_TIME
-                    # past the frames the reader is handing a read over: look again shortly
-                    wake = min(wake, frames if now < frames else now + HANDOVER_POLL)
-                self._cond.wait(min(wake - now, 0.1))
+                self._cond.wait(min(limit + grace - now, 0.1))
 
     def _break_methods(self) -> str:
         """How this link makes line states, for the report."""
