@@ -9,9 +9,13 @@ delays and announced measurement times) next to the wall time the run took, and 
     python benchmarks/bus_efficiency.py [-k EXPR] [--faults NAME,...] [--keep DIR]
     python benchmarks/bus_efficiency.py --bench "--echo --usb-latency 16" --wire 127.0.0.1:4803
     python benchmarks/bus_efficiency.py --attribute DIR   (a kept run: where the rest went)
+    python benchmarks/bus_efficiency.py --attribute DIR --on-wire   (the same on the line's clock)
 
-``--bench ARGS`` serves the emulator behind ``emulate``'s bench models (an echoing interface
-behind an FTDI-style 16 ms latency timer, above), ``--listen HOST:PORT`` where it serves,
+``--tool ARGS`` adds options to the tool's run (``--timing-uncertainty-ms 16``: it widens the
+stamps' uncertainty, not the link's declared floor; ``benchmarks/reader_stamps`` sets that
+for a run). ``--bench ARGS`` serves the emulator behind ``emulate``'s bench models (an
+echoing interface behind an FTDI-style 16 ms latency timer, above), ``--listen HOST:PORT``
+where it serves,
 ``--wire HOST:PORT`` also serves the line on an ``emulate --tap`` there and prints the run on
 the line's own clock beside ``run.bus`` (``wire_tap.py``: the bound without the receive
 path's stamps, and the adapter floor, the bound plus what the latency timer's delivery of
@@ -90,9 +94,20 @@ def main(argv: list[str] | None = None) -> int:
         help="where the emulator serves (default: a free loopback port)",
     )
     p.add_argument(
+        "--tool",
+        default="",
+        metavar="ARGS",
+        help='more options for the tool\'s run, e.g. "--timing-uncertainty-ms 16"',
+    )
+    p.add_argument(
         "--attribute",
         metavar="DIR",
         help="no run: sort the wall beyond the lower bound of a kept run by its causes",
+    )
+    p.add_argument(
+        "--on-wire",
+        action="store_true",
+        help="with --attribute: the line's clock (wire.jsonl of a --wire run), not the tool's",
     )
     p.add_argument(
         "--wire",
@@ -102,7 +117,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = p.parse_args(argv)
     if args.attribute:
-        events = read_transcript_jsonl(str(Path(args.attribute) / "transcript.jsonl"))
+        kept = "wire.jsonl" if args.on_wire else "transcript.jsonl"
+        events = read_transcript_jsonl(str(Path(args.attribute) / kept))
         print(attribution(events))
         verdicts = Path(args.attribute) / "verdicts.json"
         if verdicts.exists():
@@ -134,6 +150,7 @@ def main(argv: list[str] | None = None) -> int:
         ]
         if args.keyword:
             command += ["-k", args.keyword]
+        command += shlex.split(args.tool)
         started = time.monotonic()
         proc = subprocess.run(command, capture_output=True, text=True)
         process_s = time.monotonic() - started
@@ -153,6 +170,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"whole process        {process_s:.1f} s (pytest start-up and reports included)")
     if args.bench:
         print(f"bench models         {args.bench}")
+    if args.tool:
+        print(f"tool options         {args.tool}")
     print(f"load average         {_load(load_before)} before, {_load(os.getloadavg())} after")
     print(f"reports              {out}")
     if tap is not None:

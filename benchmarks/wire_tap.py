@@ -18,6 +18,13 @@ events at the time the line carried it, and gives two figures beside ``run.bus``
   transmission sooner than ``max(7.5 ms, delivery lateness)`` after the character ended.
   The delivery is the model's: the first tick of a free-running latency timer at or after
   the stop bit (:func:`_tick_phase` finds the ticks).
+- the **delivery floor**: that bound plus, after each reply character the tool answered,
+  the whole of the delivery's lateness. The adapter floor is a recorder's that knew where
+  on the line the character ended; one that sees the line only through the adapter does not
+  (the character may have ended just before the tick that delivered it), so it gives the
+  sensor its 7.5 ms from the delivery, not from the stop bit, as the tool does
+  (``Link.received_by``). No recorder that keeps R-7.0-11 behind such an adapter, without a
+  model of its timer, turns around sooner (issue 22, usb13).
 
 Neither is ``run.bus``: both need the tap, which no real bench has.
 """
@@ -125,6 +132,7 @@ class WireFigures:
     bound: float  # the lower bound on the line's times
     span: float
     adapter_floor: float  # the bound plus the adapter's delivery beyond the release time
+    delivery_floor: float  # the bound plus the whole delivery lateness of answered replies
     turnarounds: int  # reply characters the tool answered
     lateness_mean: float  # delivery lateness of those characters
     lateness_worst: float
@@ -141,6 +149,8 @@ class WireFigures:
                 f"adapter floor        {self.adapter_floor:.1f} s (+ delivery past 7.5 ms "
                 f"after {self.turnarounds} answered replies: lateness mean "
                 f"{self.lateness_mean * 1e3:.1f} ms, worst {self.lateness_worst * 1e3:.1f} ms)",
+                f"delivery floor       {self.delivery_floor:.1f} s (+ the whole lateness: "
+                "the sensor's 7.5 ms counted from the delivery)",
             ]
         )
 
@@ -165,11 +175,12 @@ def wire_figures(
         placed.append(moved)
     placed.sort(key=lambda e: e.start)
     if not placed:
-        return WireFigures(0, len(recorded), 0.0, 0.0, 0.0, 0, 0.0, 0.0)
+        return WireFigures(0, len(recorded), 0.0, 0.0, 0.0, 0.0, 0, 0.0, 0.0)
     spans = [*_own_spans(placed), *_gaps(placed), *_announced_waits(placed)]
     bound = _sweep(sorted(spans))
     phase = _tick_phase(recorded, host_breaks, tick)
     extra: list[tuple[float, float]] = []
+    blind: list[tuple[float, float]] = []  # the same, the 7.5 ms counted from the delivery
     lateness: list[float] = []
     for a, b in zip(placed, placed[1:], strict=False):
         if phase is not None and a.origin != TOOL and a.kind is EventKind.CHAR and b.origin == TOOL:
@@ -177,6 +188,10 @@ def wire_figures(
             lateness.append(late)
             if late > RELEASE_LINE:
                 extra.append((a.end + RELEASE_LINE, a.end + min(late, b.start - a.end)))
+            if late > 0:
+                blind.append(
+                    (a.end + RELEASE_LINE, a.end + min(RELEASE_LINE + late, b.start - a.end))
+                )
     floor = _sweep(sorted([*spans, *extra]))
     return WireFigures(
         matched=len(placed),
@@ -184,6 +199,7 @@ def wire_figures(
         bound=bound,
         span=placed[-1].end - placed[0].start,
         adapter_floor=floor,
+        delivery_floor=_sweep(sorted([*spans, *blind])),
         turnarounds=len(lateness),
         lateness_mean=sum(lateness) / len(lateness) if lateness else 0.0,
         lateness_worst=max(lateness, default=0.0),

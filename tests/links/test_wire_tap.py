@@ -75,18 +75,41 @@ def test_the_tool_events_go_back_to_the_line_and_the_bound_is_the_line_s():
     assert figures.span == pytest.approx(line[-1].end - line[0].start)
 
 
-def test_the_adapter_floor_adds_the_delivery_past_the_release_time():
-    module = tap_module()
-    line = _line()
-    figures = module.wire_figures(_as_the_tool_stamped(line), _heard(line, module), TICK)
+def _added(line: list[Event], release_from_delivery: bool) -> float:
+    """What the adapter's delivery adds after each answered reply on ``line``: past the 7.5
+    ms the bound gives the sensor, counted from the stop bit (the adapter floor) or from
+    the delivery (the delivery floor), up to the next transmission."""
     added = 0.0
     for a, b in zip(line, line[1:], strict=False):
         if a.origin == DUT and b.origin == TOOL:
             late = _delivered(a.end) - a.end
-            added += max(0.0, min(late, b.start - a.end) - RELEASE_LINE)
+            held = RELEASE_LINE + late if release_from_delivery else late
+            added += max(0.0, min(held, b.start - a.end) - RELEASE_LINE)
+    return added
+
+
+def test_the_adapter_floor_adds_the_delivery_past_the_release_time():
+    module = tap_module()
+    line = _line()
+    figures = module.wire_figures(_as_the_tool_stamped(line), _heard(line, module), TICK)
+    added = _added(line, release_from_delivery=False)
     assert added > 0  # some replies came later than 7.5 ms
     assert figures.adapter_floor - figures.bound == pytest.approx(added, abs=2e-4)
     assert 0.0 <= figures.lateness_worst <= TICK
+
+
+def test_the_delivery_floor_counts_the_sensor_s_release_from_the_delivery():
+    """A recorder that sees the line only through the adapter gives the sensor its 7.5 ms
+    from the delivery: the whole lateness is added after each answered reply (up to the
+    next transmission), not only what passes 7.5 ms."""
+    module = tap_module()
+    line = _line()
+    figures = module.wire_figures(_as_the_tool_stamped(line), _heard(line, module), TICK)
+    added = _added(line, release_from_delivery=True)
+    # each turnaround's lateness is off by up to half a bin of the fitted phase
+    half_bin = TICK / module.PHASE_BINS / 2
+    assert figures.delivery_floor - figures.bound == pytest.approx(added, abs=8 * half_bin)
+    assert figures.delivery_floor > figures.adapter_floor
 
 
 def test_without_a_latency_timer_the_floor_is_the_bound():
@@ -94,6 +117,7 @@ def test_without_a_latency_timer_the_floor_is_the_bound():
     line = _line()
     figures = module.wire_figures(_as_the_tool_stamped(line), _heard(line, module))
     assert figures.adapter_floor == figures.bound and figures.turnarounds == 0
+    assert figures.delivery_floor == figures.bound
 
 
 def test_alignment_skips_what_only_one_side_has():
