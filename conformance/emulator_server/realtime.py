@@ -65,6 +65,20 @@ class WeighsChars(Protocol):
         """``on_char(wire, start, end)`` for a character that may lie ``doubt`` s from there."""
 
 
+@runtime_checkable
+class Wakes(Protocol):
+    """A device that asks to be woken at a time with nothing else on the line first (a sensor
+    harness that answered ``wait T``, :mod:`.harness`): the line tells it the time then, as
+    :class:`~conformance.harness.device.HarnessBus` does on the virtual clock."""
+
+    @property
+    def wake_at(self) -> float | None:
+        """When it wants to be woken (None: not before something happens on the line)."""
+
+    def wake(self, now: float) -> None:
+        """The line's clock got to ``now`` (its ``wake_at``) with nothing on the line first."""
+
+
 @dataclass(frozen=True)
 class LineTally:
     """The line's counts at one moment (:meth:`RealTimeLine.mark`), so a log can report a
@@ -95,6 +109,7 @@ class RealTimeLine:
         deliver_at_end: bool = True,
         clock: Callable[[], float] = time.perf_counter,
         bench: BenchModel | None = None,
+        on_failure: Callable[[BaseException], None] | None = None,
     ) -> None:
         self.device = device
         self.bench = bench or BenchModel()
@@ -118,6 +133,11 @@ class RealTimeLine:
         self._thread = threading.Thread(target=self._run, name="sdi12-emulated-line", daemon=True)
         self.frames_sent = 0
         self.errors: list[BaseException] = []
+        # told (on the line's thread, once) when the device failed and the line stopped: a
+        # served harness that broke the protocol must stop the server, not leave it serving
+        # a line that no longer answers
+        self._on_failure = on_failure
+        self._wakes = isinstance(device, Wakes)  # asked once: the check is slow, the line fast
         # how far behind its own schedule the line committed device frames: on a machine too
         # busy to keep real time the emulated sensor's timing is not what it planned
         self.worst_lateness = 0.0
@@ -306,6 +326,15 @@ class RealTimeLine:
         heapq.heappush(self._due, _Due(when, next(self._seq), action))
 
     def _run(self) -> None:
+        try:
+            self._keep_time()
+        except Exception as exc:  # a device failure must not kill the line silently
+            self.errors.append(exc)
+            if self._on_failure is None:
+                raise
+            self._on_failure(exc)
+
+    def _keep_time(self) -> None:
         self.realtime_priority = realtime_priority(EMULATED_LINE)
         spin = RT_SPIN if self.realtime_priority else SPIN  # a spinning RT thread starves others
         while not self._stop.is_set():
@@ -320,44 +349,48 @@ class RealTimeLine:
             self._step()
 
     def _next_due(self) -> float:
-        """When the line next has something to do (device frame start or a queued action)."""
+        """When the line next has something to do (device frame start, a queued action, or
+        the device's wake-up)."""
         frame = self.device.next_frame()
         nxt = frame.start if frame is not None else inf
         if self._due:
             nxt = min(nxt, self._due[0].time)
-        return nxt
+        return min(nxt, self._wake_at())
+
+    def _wake_at(self) -> float:
+        when = self.device.wake_at if self._wakes else None  # type: ignore[attr-defined]
+        return inf if when is None else when
 
     def _step(self) -> None:
         """Do the earliest due thing: deliver a recorder event, or commit a device frame."""
         with self._cond:
             frame = self.device.next_frame()
-            queued = self._due[0] if self._due else None
-            try:
-                if queued is not None and (frame is None or queued.time <= frame.start):
-                    if queued.time > self.now():
-                        return
-                    heapq.heappop(self._due)
-                    queued.action()
-                    return
-                if frame is None or frame.start > self.now():
-                    return
-                self.device.pop_frame()
-                lateness = self.now() - frame.start
-                self.worst_lateness = max(self.worst_lateness, lateness)
-                self._stretch_worst = max(self._stretch_worst, lateness)
-                self.late_frames += lateness > LATE_NOTICE
-                if self.bench.require_rts and self._rts:
-                    self.lost_frames += 1  # the recorder's driver still holds the line
-                    return
-                if self._taps:  # on the wire it is whole at its stop bit, whatever the bench
-                    self._push(frame.start + frame.duration, lambda w=frame.wire: self._tap(w))
-                deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
-                if self._deliver_at_end:
-                    deliver = self._delivery.time(deliver)
-                self._push(deliver, lambda w=frame.wire: self._emit(w))
-            except Exception as exc:  # a device bug must not kill the line silently
-                self.errors.append(exc)
-                raise
+            queued = self._due[0].time if self._due else inf
+            start = frame.start if frame is not None else inf
+            wake = self._wake_at()
+            if min(queued, start, wake) > self.now():
+                return
+            if queued <= min(start, wake):  # a recorder event first, as on the virtual clock
+                heapq.heappop(self._due).action()
+                return
+            if wake <= start:  # a character due at the wake-up waits for the told plan
+                self.device.wake(wake)  # type: ignore[attr-defined]
+                return
+            assert frame is not None  # the earliest due thing, and due
+            self.device.pop_frame()
+            lateness = self.now() - frame.start
+            self.worst_lateness = max(self.worst_lateness, lateness)
+            self._stretch_worst = max(self._stretch_worst, lateness)
+            self.late_frames += lateness > LATE_NOTICE
+            if self.bench.require_rts and self._rts:
+                self.lost_frames += 1  # the recorder's driver still holds the line
+                return
+            if self._taps:  # on the wire it is whole at its stop bit, whatever the bench
+                self._push(frame.start + frame.duration, lambda w=frame.wire: self._tap(w))
+            deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
+            if self._deliver_at_end:
+                deliver = self._delivery.time(deliver)
+            self._push(deliver, lambda w=frame.wire: self._emit(w))
 
     def _emit(self, wire: int, echo: bool = False) -> None:
         self.frames_sent += not echo
