@@ -124,6 +124,12 @@ class RealTimeLine:
         self._due: list[_Due] = []
         self._seq = itertools.count()
         self._tool_free = -inf  # end of the recorder's last frame on the emulated wire
+        # a device told the time (:class:`Wakes`): the last time it was told; the recorder's
+        # frames are laid no earlier, so the device never hears of the past after it
+        self._told = -inf
+        # starts of the recorder's frames laid on the wire but not yet told (each is told at
+        # its end): a device is not woken at or past one, as on the virtual clock
+        self._untold: deque[float] = deque()
         self._break_start: float | None = None
         self._break_doubt = 0.0  # how far (s) the held break's start may be off (a batch)
         # the recorder's last few breaks, (start, end): an echo delivered after the next
@@ -185,21 +191,36 @@ class RealTimeLine:
                 return
             frame = 10 / baud if baud else CHAR_TIME
             for wire in data:
-                start = max(at, self._tool_free)
+                start = max(at, self._tool_free, self._told)
                 end = start + frame
                 self._tool_free = end
                 if abs(baud - BAUD) <= BAUD * 0.02:
-                    self._push(end, self._char(wire, start, end, doubt))
+                    self._push_told(start, end, self._char(wire, start, end, doubt))
                     if self._taps:
                         self._push(end, lambda w=wire: self._tap(w))
                 else:
                     for a, b in spacing_runs(wire, baud):
                         s, e = start + a, start + b
-                        self._push(e, lambda s=s, e=e: self.device.on_break(s, e))
+                        self._push_told(s, e, lambda s=s, e=e: self.device.on_break(s, e))
                         self._tap_spacing(s, e - s)
                 if self.bench.echo:  # the recorder's receiver, at its own rate, reads it back
                     self._push(self._delivery.time(end), lambda w=wire: self._emit(w, echo=True))
             self._cond.notify()
+
+    def _push_told(self, start: float, end: float, tell: Callable[[], None]) -> None:
+        """Queue ``tell`` (the device hearing a recorder frame from ``start``) for ``end``; a
+        device is not woken at or after ``start`` until it has been told (caller holds the
+        lock)."""
+        if not self._wakes:
+            self._push(end, tell)
+            return
+        self._untold.append(start)
+
+        def told() -> None:
+            self._untold.popleft()
+            tell()
+
+        self._push(end, told)
 
     def _char(self, wire: int, start: float, end: float, doubt: float) -> Callable[[], None]:
         """The device hearing one recorder character, with its doubt where it weighs one."""
@@ -214,7 +235,7 @@ class RealTimeLine:
         at = self.now() if at is None else at
         with self._cond:
             if self._break_start is None and self._rts:
-                self._break_start = start = max(at, self._tool_free)
+                self._break_start = start = max(at, self._tool_free, self._told)
                 self._break_doubt = doubt
                 if self.bench.echo:  # a receiver reads spacing at its stop-bit sample
                     # its delivery is placed now, in wire order: placed when the line's thread
@@ -242,9 +263,9 @@ class RealTimeLine:
             room = max(doubt, self._break_doubt)
             device = self.device
             if room > 0 and isinstance(device, WeighsBreaks):
-                self._push(end, lambda s=start, e=end: device.on_break_within(s, e, room))
+                self._push_told(start, end, lambda: device.on_break_within(start, end, room))
             else:
-                self._push(end, lambda s=start, e=end: device.on_break(s, e))
+                self._push_told(start, end, lambda: device.on_break(start, end))
             self._cond.notify()
 
     def _echo_spacing(self, start: float) -> None:
@@ -358,8 +379,18 @@ class RealTimeLine:
         return min(nxt, self._wake_at())
 
     def _wake_at(self) -> float:
+        """When to wake the device: never at or past the start of a recorder frame it has not
+        been told yet (a held break, a character on the wire), since being told ``time T``
+        says nothing happened before T. It hears of the frame at its end and plans anew, as
+        :class:`~conformance.harness.device.HarnessBus` does on the virtual clock."""
         when = self.device.wake_at if self._wakes else None  # type: ignore[attr-defined]
-        return inf if when is None else when
+        if when is None:
+            return inf
+        if self._break_start is not None and when > self._break_start:
+            return inf
+        if self._untold and when >= self._untold[0]:
+            return inf
+        return when
 
     def _step(self) -> None:
         """Do the earliest due thing: deliver a recorder event, or commit a device frame."""
@@ -374,6 +405,7 @@ class RealTimeLine:
                 heapq.heappop(self._due).action()
                 return
             if wake <= start:  # a character due at the wake-up waits for the told plan
+                self._told = wake
                 self.device.wake(wake)  # type: ignore[attr-defined]
                 return
             assert frame is not None  # the earliest due thing, and due

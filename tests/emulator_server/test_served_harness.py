@@ -132,6 +132,46 @@ def test_a_wake_up_due_is_not_told_before_a_recorder_event_due_first():
     assert [word for word, _ in alarm.told] == ["char", "time"]
 
 
+class _Ticker(_Alarm):
+    """A device woken every millisecond (a firmware's tick, as the uOS++ sensor's): it logs
+    each message's time, the start of the frame a ``char``/``break`` reports."""
+
+    def wake(self, now: float) -> None:
+        self.told.append(("time", now))
+        self.wake_at = now + 1e-3
+
+    def on_break(self, start: float, end: float) -> None:
+        self.told.append(("break", start))
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        self.told.append(("char", start))
+
+
+def test_a_ticking_device_never_hears_of_the_past():
+    """bench31: the uOS++ sensor, served, never answered after its first reply: a held break
+    was told at its end after ``time T`` messages for T inside it (the wakes ran on while the
+    break's message waited in the queue), so the firmware heard of a break that began before
+    the time it had been told. Now no wake is told at or past the start of a recorder frame
+    not yet told, and a frame stamped before the last time told is laid from it."""
+    clock = LineClock()
+    ticker = _Ticker(clock() + 1e-3)
+    line = RealTimeLine(ticker, lambda _d: None, clock=clock).start()
+    try:
+        time.sleep(0.01)
+        line.break_on()
+        time.sleep(0.02)
+        line.break_off()
+        time.sleep(0.005)
+        line.tool_bytes(b"0", at=clock() - 0.004)  # stamped 4 ms ago: ticks told since
+        time.sleep(0.03)
+    finally:
+        line.stop()
+    times = [at for _, at in ticker.told]
+    assert [w for w, _ in ticker.told].count("break") == 1
+    assert "char" in [w for w, _ in ticker.told]
+    assert times == sorted(times), ticker.told
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
