@@ -28,7 +28,7 @@ from typing import Protocol, runtime_checkable
 
 from ..links.priority import EMULATED_LINE, realtime_priority
 from ..protocol.timing import CHAR_TIME
-from ..sim.bus import BusDevice
+from ..sim.bus import BusDevice, Frame
 from .bench import (
     BAUD,
     SAMPLE_STOP,
@@ -195,7 +195,10 @@ class RealTimeLine:
                 end = start + frame
                 self._tool_free = end
                 if abs(baud - BAUD) <= BAUD * 0.02:
-                    self._push_told(start, end, self._char(wire, start, end, doubt))
+                    if self._wakes:
+                        self._push_told(start, end, self._char(wire, start, end, doubt))
+                    else:
+                        self._push(end, self._char(wire, start, end, doubt))
                     if self._taps:
                         self._push(end, lambda w=wire: self._tap(w))
                 else:
@@ -209,8 +212,8 @@ class RealTimeLine:
 
     def _push_told(self, start: float, end: float, tell: Callable[[], None]) -> None:
         """Queue ``tell`` (the device hearing a recorder frame from ``start``) for ``end``; a
-        device is not woken at or after ``start`` until it has been told (caller holds the
-        lock)."""
+        device that is woken (:class:`Wakes`) is not woken at or after ``start`` until it has
+        been told (caller holds the lock)."""
         if not self._wakes:
             self._push(end, tell)
             return
@@ -376,14 +379,14 @@ class RealTimeLine:
         nxt = frame.start if frame is not None else inf
         if self._due:
             nxt = min(nxt, self._due[0].time)
-        return min(nxt, self._wake_at())
+        return min(nxt, self._wake_at()) if self._wakes else nxt
 
     def _wake_at(self) -> float:
         """When to wake the device: never at or past the start of a recorder frame it has not
         been told yet (a held break, a character on the wire), since being told ``time T``
         says nothing happened before T. It hears of the frame at its end and plans anew, as
         :class:`~conformance.harness.device.HarnessBus` does on the virtual clock."""
-        when = self.device.wake_at if self._wakes else None  # type: ignore[attr-defined]
+        when = self.device.wake_at  # type: ignore[attr-defined]
         if when is None:
             return inf
         if self._break_start is not None and when > self._break_start:
@@ -392,23 +395,36 @@ class RealTimeLine:
             return inf
         return when
 
+    def _woken(self, frame: Frame | None, queued: _Due | None) -> bool:
+        """Wake the device if its wake-up is due and the earliest thing due: a recorder event
+        at the same time goes first, a character of its own due then waits for the plan it
+        gives on being woken (as on the virtual clock). Whether it did (line's lock held)."""
+        wake = self._wake_at()
+        if wake > self.now():
+            return False
+        if queued is not None and queued.time <= wake:
+            return False
+        if frame is not None and frame.start < wake:
+            return False
+        self._told = wake
+        self.device.wake(wake)  # type: ignore[attr-defined]
+        return True
+
     def _step(self) -> None:
         """Do the earliest due thing: deliver a recorder event, or commit a device frame."""
         with self._cond:
             frame = self.device.next_frame()
-            queued = self._due[0].time if self._due else inf
-            start = frame.start if frame is not None else inf
-            wake = self._wake_at()
-            if min(queued, start, wake) > self.now():
+            queued = self._due[0] if self._due else None
+            if self._wakes and self._woken(frame, queued):
                 return
-            if queued <= min(start, wake):  # a recorder event first, as on the virtual clock
-                heapq.heappop(self._due).action()
+            if queued is not None and (frame is None or queued.time <= frame.start):
+                if queued.time > self.now():
+                    return
+                heapq.heappop(self._due)
+                queued.action()
                 return
-            if wake <= start:  # a character due at the wake-up waits for the told plan
-                self._told = wake
-                self.device.wake(wake)  # type: ignore[attr-defined]
+            if frame is None or frame.start > self.now():
                 return
-            assert frame is not None  # the earliest due thing, and due
             self.device.pop_frame()
             lateness = self.now() - frame.start
             self.worst_lateness = max(self.worst_lateness, lateness)
