@@ -36,8 +36,9 @@ PORT_MAX = 65535
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sdi12-conform emulate",
-        description="Serve the reference SDI-12 sensor emulator in real time (1200 baud "
-        "pacing, section 7 timing) on a TCP port or a serial port.",
+        description="Serve the reference SDI-12 sensor emulator, or a sensor harness "
+        "(--harness), in real time (1200 baud pacing, section 7 timing) on a TCP port or a "
+        "serial port.",
         epilog="examples:\n"
         "  sdi12-conform emulate --listen 127.0.0.1:4001\n"
         "  sdi12-conform --port rfc2217://127.0.0.1:4001     (in another shell)\n"
