@@ -218,7 +218,8 @@ def _served_harness(
         raise PortError(f"{', '.join(given)} shape the reference sensor: not with --harness")
     device = open_served_harness(args.harness, clock)
     return device, (
-        f"sensor harness {device.harness_name!r} ({args.harness}), bench: {bench.describe()}"
+        f"sensor harness {device.harness_name!r} ({args.harness}, real-time priority "
+        f"{'on' if device.realtime_priority else 'off'}), bench: {bench.describe()}"
     )
 
 

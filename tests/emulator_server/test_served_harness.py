@@ -8,6 +8,7 @@ that no longer answers.
 
 from __future__ import annotations
 
+import os
 import sys
 import threading
 import time
@@ -22,6 +23,7 @@ from conformance.emulator_server.process import EmulatorProcess
 from conformance.emulator_server.realtime import RealTimeLine
 from conformance.emulator_server.servers import TcpEmulatorServer
 from conformance.links.factory import open_real_link
+from conformance.links.priority import SERVED_FIRMWARE
 from conformance.ports import PortError
 from conformance.protocol import commands as cmds
 from conformance.protocol.timing import CHAR_TIME
@@ -170,6 +172,23 @@ def test_a_ticking_device_never_hears_of_the_past():
     assert [w for w, _ in ticker.told].count("break") == 1
     assert "char" in [w for w, _ in ticker.told]
     assert times == sorted(times), ticker.told
+
+
+def test_the_served_firmware_runs_in_a_real_time_class_where_the_line_may():
+    """bench31: beside two CPU burners an ordinary harness process answered the uOS++
+    sensor's tick wake-ups late, and its reply began 31.44 ms after the command (R-7.0-10
+    FAILed on the serving machine's account). The firmware is on the line's critical path:
+    it gets a real-time class just below the line's, where the OS grants one."""
+    device = open_served_harness(EXAMPLE, LineClock())
+    try:
+        pid = device.channel.proc.pid  # type: ignore[attr-defined]
+        policy = os.sched_getscheduler(pid) & ~getattr(os, "SCHED_RESET_ON_FORK", 0)
+        if not device.realtime_priority:
+            pytest.skip("the OS grants no real-time class here")
+        assert policy == os.SCHED_RR
+        assert os.sched_getparam(pid).sched_priority == SERVED_FIRMWARE
+    finally:
+        device.close()
 
 
 @pytest.mark.parametrize(
