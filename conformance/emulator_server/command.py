@@ -80,9 +80,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--harness",
         metavar="exec:PROGRAM|unix:PATH",
         default=None,
-        help="serve this sensor harness (docs/harness-protocol.md, as --port exec: runs it) "
-        "instead of the reference sensor, on the wall clock and through the bench models "
-        "(not with --version, --address, --sensors, --faults)",
+        help="serve this sensor harness (docs/harness-protocol.md) instead of the reference "
+        "sensor, in real time behind the bench models (not with --version, --address, ...)",
     )
     bench = p.add_argument_group(
         "bench models (what a real interface between recorder and line does; default: none)"
