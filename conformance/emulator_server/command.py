@@ -5,7 +5,9 @@ of a ``sim://`` URL) either as an RFC 2217 server on a TCP port, as raw bytes on
 (what ``socket://`` speaks; no breaks), or on a serial port. A recorder, or this tool with
 ``--port rfc2217://HOST:PORT``, then talks to it as to a sensor on a bus. With ``--sensors
 0,1:FAULT,3`` (the ``sensors=`` of a ``sim://`` URL) several emulators share the one served line
-(:mod:`.shared_line`), for ``--address all`` runs over a real-time link.
+(:mod:`.shared_line`), for ``--address all`` runs over a real-time link. With ``--harness
+exec:PROGRAM`` the served sensor is an outside sensor harness instead (:mod:`.harness`): other
+people's firmware reached through the bench models, as a bench reaches it.
 """
 
 from __future__ import annotations
@@ -15,10 +17,11 @@ import signal
 import threading
 from typing import TYPE_CHECKING
 
-from ..exits import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
+from ..exits import EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
 from ..links.priority import EMULATED_LINE, quick_gil_handover, realtime_priority
 from ..ports import PortError, parse_sim, sim_profile
 from .bench import BenchModel
+from .harness import LineClock, ServedHarness, open_served_harness
 from .realtime import RealTimeLine
 from .servers import TcpEmulatorServer, serve_serial
 from .shared_line import SharedLine
@@ -33,15 +36,18 @@ PORT_MAX = 65535
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sdi12-conform emulate",
-        description="Serve the reference SDI-12 sensor emulator in real time (1200 baud "
-        "pacing, section 7 timing) on a TCP port or a serial port.",
+        description="Serve the reference SDI-12 sensor emulator, or a sensor harness "
+        "(--harness), in real time (1200 baud pacing, section 7 timing) on a TCP port or a "
+        "serial port.",
         epilog="examples:\n"
         "  sdi12-conform emulate --listen 127.0.0.1:4001\n"
         "  sdi12-conform --port rfc2217://127.0.0.1:4001     (in another shell)\n"
         "  sdi12-conform emulate --listen 127.0.0.1:4001 --faults no-service-request\n"
         "  sdi12-conform emulate --serial /dev/ttyUSB1 --version 1.3 --address 5\n"
         "  sdi12-conform emulate --listen 127.0.0.1:4001 --sensors 0,1:answers-foreign-reply,3\n"
-        "  sdi12-conform --port rfc2217://127.0.0.1:4001 --address all  (a bus of three)",
+        "  sdi12-conform --port rfc2217://127.0.0.1:4001 --address all  (a bus of three)\n"
+        "  sdi12-conform emulate --listen 127.0.0.1:4001 --harness 'exec:./sensor_harness' "
+        "--echo --usb-latency 16",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     where = p.add_mutually_exclusive_group(required=True)
@@ -70,6 +76,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--version apply to every one (not with --address)",
     )
     p.add_argument("--faults", default="", help="comma-separated fault names (see `faults`)")
+    p.add_argument(
+        "--harness",
+        metavar="exec:PROGRAM|unix:PATH",
+        default=None,
+        help="serve this sensor harness (docs/harness-protocol.md) instead of the reference "
+        "sensor, in real time behind the bench models (not with --version, --address, ...)",
+    )
     bench = p.add_argument_group(
         "bench models (what a real interface between recorder and line does; default: none)"
     )
@@ -160,9 +173,14 @@ def _without_own_breaks(devices: list[SensorEmulator]) -> list[SensorEmulator]:
     return devices
 
 
-def serving_what(args: argparse.Namespace, bench: BenchModel) -> tuple[object, str]:
-    """The device the options ask for (one sensor, or a :class:`SharedLine` of several) and
-    the words the server's first line says it with (raises :class:`PortError`)."""
+def serving_what(
+    args: argparse.Namespace, bench: BenchModel, clock: LineClock | None = None
+) -> tuple[object, str]:
+    """The device the options ask for (one sensor, a :class:`SharedLine` of several, or a
+    :class:`ServedHarness` on ``clock``) and the words the server's first line says it with
+    (raises :class:`PortError`)."""
+    if args.harness is not None:
+        return _served_harness(args, bench, clock or LineClock())
     faults = args.faults or "none"
     if args.sensors is not None:
         if args.address is not None:
@@ -177,6 +195,30 @@ def serving_what(args: argparse.Namespace, bench: BenchModel) -> tuple[object, s
     return device, (
         f"reference sensor v{args.sdi_version}, address {address}, faults: {faults}, "
         f"bench: {bench.describe()}"
+    )
+
+
+def _served_harness(
+    args: argparse.Namespace, bench: BenchModel, clock: LineClock
+) -> tuple[ServedHarness, str]:
+    """The sensor harness ``--harness`` names, started and greeted (options that shape the
+    reference sensor do not apply to it: a usage error, not ignored)."""
+    given = [
+        flag
+        for flag, value in (
+            ("--sensors", args.sensors),
+            ("--address", args.address),
+            ("--faults", args.faults or None),
+            ("--version", None if args.sdi_version == "1.4" else args.sdi_version),
+        )
+        if value is not None
+    ]
+    if given:
+        raise PortError(f"{', '.join(given)} shape the reference sensor: not with --harness")
+    device = open_served_harness(args.harness, clock)
+    return device, (
+        f"sensor harness {device.harness_name!r} ({args.harness}, real-time priority "
+        f"{'on' if device.realtime_priority else 'off'}), bench: {bench.describe()}"
     )
 
 
@@ -199,17 +241,35 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
         args = build_parser().parse_args(argv)
     except SystemExit as exc:
         return EXIT_OK if exc.code == 0 else EXIT_USAGE
+    clock = LineClock()
     try:
         bench = bench_model(args)
-        device, what = serving_what(args, bench)
         if args.raw and not args.listen:
             raise PortError("--raw applies to --listen only")
         tap_at = parse_tap(args.tap) if args.tap else None
         if args.listen:
             _host_port(args.listen)  # a port out of range is a usage error, before serving
+        device, what = serving_what(args, bench, clock)  # last: it may start a harness
     except PortError as exc:
         print_line(f"error: {exc}")
         return EXIT_USAGE
+    try:
+        return _serve(device, args, what, print_line, bench, tap_at, clock)
+    finally:
+        if isinstance(device, ServedHarness):
+            device.close()
+
+
+def _serve(
+    device: object,
+    args: argparse.Namespace,
+    what: str,
+    print_line,
+    bench: BenchModel,
+    tap_at: tuple[str, int] | None,
+    clock: LineClock,
+) -> int:
+    """Serve ``device`` as the options ask until stopped; the exit code."""
     # the line's thread must get the interpreter back at once when a frame is due, and no
     # thread of the server may be preempted while it holds the lock the line needs
     quick_gil_handover()  # for the life of the process
@@ -223,8 +283,8 @@ def emulate_main(argv: list[str], print_line=_say) -> int:
             return EXIT_USAGE
     try:
         if args.listen:
-            return _serve_tcp(device, args, what, print_line, bench, tap)
-        return _serve_port(device, args.serial, what, print_line, tap)
+            return _serve_tcp(device, args, what, print_line, bench, tap, clock)
+        return _serve_port(device, args.serial, what, print_line, tap, clock)
     finally:
         if tap is not None:
             tap.stop()
@@ -237,14 +297,21 @@ def _serve_tcp(
     print_line,
     bench: BenchModel,
     tap: TapServer | None = None,
+    clock: LineClock | None = None,
 ) -> int:
     try:
         host, port = _host_port(args.listen)
-        line = RealTimeLine(device, lambda _data: None, bench=bench)  # type: ignore[arg-type]
+        line = RealTimeLine(
+            device,  # type: ignore[arg-type]
+            lambda _data: None,
+            bench=bench,
+            clock=clock or LineClock(),
+            on_failure=lambda _exc: server.stop(),  # a failed device stops the server
+        )
         if tap is not None:
             line.add_tap(tap.send)
-        line.start()
         server = TcpEmulatorServer(line, host, port, rfc2217_protocol=not args.raw, log=print_line)
+        line.start()
     except (PortError, OSError) as exc:
         print_line(f"error: cannot listen on {args.listen}: {exc}")
         return EXIT_USAGE
@@ -258,11 +325,25 @@ def _serve_tcp(
         code = EXIT_INTERRUPTED
     finally:
         line.stop()
-    return code
+    return _failed(line, print_line) or code
+
+
+def _failed(line: RealTimeLine, print_line) -> int:
+    """EXIT_INTERNAL, said, if the line's device failed (a served harness broke the
+    protocol, crashed or hung: the server stopped for it); else 0."""
+    if not line.errors:
+        return 0
+    print_line(f"error: the served device failed, the server stopped: {line.errors[0]}")
+    return EXIT_INTERNAL
 
 
 def _serve_port(
-    device: object, port_name: str, what: str, print_line, tap: TapServer | None = None
+    device: object,
+    port_name: str,
+    what: str,
+    print_line,
+    tap: TapServer | None = None,
+    clock: LineClock | None = None,
 ) -> int:
     import serial
 
@@ -271,11 +352,17 @@ def _serve_port(
     except (serial.SerialException, OSError, ValueError) as exc:
         print_line(f"error: cannot open {port_name}: {exc}")
         return EXIT_USAGE
-    line = RealTimeLine(device, port.write, deliver_at_end=False)  # type: ignore[arg-type]
+    stopped = threading.Event()
+    line = RealTimeLine(
+        device,  # type: ignore[arg-type]
+        port.write,
+        deliver_at_end=False,
+        clock=clock or LineClock(),
+        on_failure=lambda _exc: stopped.set(),
+    )
     if tap is not None:
         line.add_tap(tap.send)
     line.start()
-    stopped = threading.Event()
     _stop_on_sigterm(stopped.set)
     print_line(f"serving the {what} on {port_name} at 1200 baud (Ctrl-C stops){_tapped(tap)}")
     code = EXIT_OK
@@ -289,7 +376,7 @@ def _serve_port(
     finally:
         line.stop()
         port.close()
-    return code
+    return _failed(line, print_line) or code
 
 
 def _tapped(tap: TapServer | None) -> str:

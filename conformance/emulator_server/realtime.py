@@ -28,7 +28,7 @@ from typing import Protocol, runtime_checkable
 
 from ..links.priority import EMULATED_LINE, realtime_priority
 from ..protocol.timing import CHAR_TIME
-from ..sim.bus import BusDevice
+from ..sim.bus import BusDevice, Frame
 from .bench import (
     BAUD,
     SAMPLE_STOP,
@@ -65,6 +65,20 @@ class WeighsChars(Protocol):
         """``on_char(wire, start, end)`` for a character that may lie ``doubt`` s from there."""
 
 
+@runtime_checkable
+class Wakes(Protocol):
+    """A device that asks to be woken at a time with nothing else on the line first (a sensor
+    harness that answered ``wait T``, :mod:`.harness`): the line tells it the time then, as
+    :class:`~conformance.harness.device.HarnessBus` does on the virtual clock."""
+
+    @property
+    def wake_at(self) -> float | None:
+        """When it wants to be woken (None: not before something happens on the line)."""
+
+    def wake(self, now: float) -> None:
+        """The line's clock got to ``now`` (its ``wake_at``) with nothing on the line first."""
+
+
 @dataclass(frozen=True)
 class LineTally:
     """The line's counts at one moment (:meth:`RealTimeLine.mark`), so a log can report a
@@ -95,6 +109,7 @@ class RealTimeLine:
         deliver_at_end: bool = True,
         clock: Callable[[], float] = time.perf_counter,
         bench: BenchModel | None = None,
+        on_failure: Callable[[BaseException], None] | None = None,
     ) -> None:
         self.device = device
         self.bench = bench or BenchModel()
@@ -109,6 +124,12 @@ class RealTimeLine:
         self._due: list[_Due] = []
         self._seq = itertools.count()
         self._tool_free = -inf  # end of the recorder's last frame on the emulated wire
+        # a device told the time (:class:`Wakes`): the last time it was told; the recorder's
+        # frames are laid no earlier, so the device never hears of the past after it
+        self._told = -inf
+        # starts of the recorder's frames laid on the wire but not yet told (each is told at
+        # its end): a device is not woken at or past one, as on the virtual clock
+        self._untold: deque[float] = deque()
         self._break_start: float | None = None
         self._break_doubt = 0.0  # how far (s) the held break's start may be off (a batch)
         # the recorder's last few breaks, (start, end): an echo delivered after the next
@@ -118,6 +139,11 @@ class RealTimeLine:
         self._thread = threading.Thread(target=self._run, name="sdi12-emulated-line", daemon=True)
         self.frames_sent = 0
         self.errors: list[BaseException] = []
+        # told (on the line's thread, once) when the device failed and the line stopped: a
+        # served harness that broke the protocol must stop the server, not leave it serving
+        # a line that no longer answers
+        self._on_failure = on_failure
+        self._wakes = isinstance(device, Wakes)  # asked once: the check is slow, the line fast
         # how far behind its own schedule the line committed device frames: on a machine too
         # busy to keep real time the emulated sensor's timing is not what it planned
         self.worst_lateness = 0.0
@@ -165,21 +191,39 @@ class RealTimeLine:
                 return
             frame = 10 / baud if baud else CHAR_TIME
             for wire in data:
-                start = max(at, self._tool_free)
+                start = max(at, self._tool_free, self._told)
                 end = start + frame
                 self._tool_free = end
                 if abs(baud - BAUD) <= BAUD * 0.02:
-                    self._push(end, self._char(wire, start, end, doubt))
+                    if self._wakes:
+                        self._push_told(start, end, self._char(wire, start, end, doubt))
+                    else:
+                        self._push(end, self._char(wire, start, end, doubt))
                     if self._taps:
                         self._push(end, lambda w=wire: self._tap(w))
                 else:
                     for a, b in spacing_runs(wire, baud):
                         s, e = start + a, start + b
-                        self._push(e, lambda s=s, e=e: self.device.on_break(s, e))
+                        self._push_told(s, e, lambda s=s, e=e: self.device.on_break(s, e))
                         self._tap_spacing(s, e - s)
                 if self.bench.echo:  # the recorder's receiver, at its own rate, reads it back
                     self._push(self._delivery.time(end), lambda w=wire: self._emit(w, echo=True))
             self._cond.notify()
+
+    def _push_told(self, start: float, end: float, tell: Callable[[], None]) -> None:
+        """Queue ``tell`` (the device hearing a recorder frame from ``start``) for ``end``; a
+        device that is woken (:class:`Wakes`) is not woken at or after ``start`` until it has
+        been told (caller holds the lock)."""
+        if not self._wakes:
+            self._push(end, tell)
+            return
+        self._untold.append(start)
+
+        def told() -> None:
+            self._untold.popleft()
+            tell()
+
+        self._push(end, told)
 
     def _char(self, wire: int, start: float, end: float, doubt: float) -> Callable[[], None]:
         """The device hearing one recorder character, with its doubt where it weighs one."""
@@ -194,7 +238,7 @@ class RealTimeLine:
         at = self.now() if at is None else at
         with self._cond:
             if self._break_start is None and self._rts:
-                self._break_start = start = max(at, self._tool_free)
+                self._break_start = start = max(at, self._tool_free, self._told)
                 self._break_doubt = doubt
                 if self.bench.echo:  # a receiver reads spacing at its stop-bit sample
                     # its delivery is placed now, in wire order: placed when the line's thread
@@ -222,9 +266,9 @@ class RealTimeLine:
             room = max(doubt, self._break_doubt)
             device = self.device
             if room > 0 and isinstance(device, WeighsBreaks):
-                self._push(end, lambda s=start, e=end: device.on_break_within(s, e, room))
+                self._push_told(start, end, lambda: device.on_break_within(start, end, room))
             else:
-                self._push(end, lambda s=start, e=end: device.on_break(s, e))
+                self._push_told(start, end, lambda: device.on_break(start, end))
             self._cond.notify()
 
     def _echo_spacing(self, start: float) -> None:
@@ -306,6 +350,15 @@ class RealTimeLine:
         heapq.heappush(self._due, _Due(when, next(self._seq), action))
 
     def _run(self) -> None:
+        try:
+            self._keep_time()
+        except Exception as exc:  # a device failure must not kill the line silently
+            self.errors.append(exc)
+            if self._on_failure is None:
+                raise
+            self._on_failure(exc)
+
+    def _keep_time(self) -> None:
         self.realtime_priority = realtime_priority(EMULATED_LINE)
         spin = RT_SPIN if self.realtime_priority else SPIN  # a spinning RT thread starves others
         while not self._stop.is_set():
@@ -320,44 +373,72 @@ class RealTimeLine:
             self._step()
 
     def _next_due(self) -> float:
-        """When the line next has something to do (device frame start or a queued action)."""
+        """When the line next has something to do (device frame start, a queued action, or
+        the device's wake-up)."""
         frame = self.device.next_frame()
         nxt = frame.start if frame is not None else inf
         if self._due:
             nxt = min(nxt, self._due[0].time)
-        return nxt
+        return min(nxt, self._wake_at()) if self._wakes else nxt
+
+    def _wake_at(self) -> float:
+        """When to wake the device: never at or past the start of a recorder frame it has not
+        been told yet (a held break, a character on the wire), since being told ``time T``
+        says nothing happened before T. It hears of the frame at its end and plans anew, as
+        :class:`~conformance.harness.device.HarnessBus` does on the virtual clock."""
+        when = self.device.wake_at  # type: ignore[attr-defined]
+        if when is None:
+            return inf
+        if self._break_start is not None and when > self._break_start:
+            return inf
+        if self._untold and when >= self._untold[0]:
+            return inf
+        return when
+
+    def _woken(self, frame: Frame | None, queued: _Due | None) -> bool:
+        """Wake the device if its wake-up is due and the earliest thing due: a recorder event
+        at the same time goes first, a character of its own due then waits for the plan it
+        gives on being woken (as on the virtual clock). Whether it did (line's lock held)."""
+        wake = self._wake_at()
+        if wake > self.now():
+            return False
+        if queued is not None and queued.time <= wake:
+            return False
+        if frame is not None and frame.start < wake:
+            return False
+        self._told = wake
+        self.device.wake(wake)  # type: ignore[attr-defined]
+        return True
 
     def _step(self) -> None:
         """Do the earliest due thing: deliver a recorder event, or commit a device frame."""
         with self._cond:
             frame = self.device.next_frame()
             queued = self._due[0] if self._due else None
-            try:
-                if queued is not None and (frame is None or queued.time <= frame.start):
-                    if queued.time > self.now():
-                        return
-                    heapq.heappop(self._due)
-                    queued.action()
+            if self._wakes and self._woken(frame, queued):
+                return
+            if queued is not None and (frame is None or queued.time <= frame.start):
+                if queued.time > self.now():
                     return
-                if frame is None or frame.start > self.now():
-                    return
-                self.device.pop_frame()
-                lateness = self.now() - frame.start
-                self.worst_lateness = max(self.worst_lateness, lateness)
-                self._stretch_worst = max(self._stretch_worst, lateness)
-                self.late_frames += lateness > LATE_NOTICE
-                if self.bench.require_rts and self._rts:
-                    self.lost_frames += 1  # the recorder's driver still holds the line
-                    return
-                if self._taps:  # on the wire it is whole at its stop bit, whatever the bench
-                    self._push(frame.start + frame.duration, lambda w=frame.wire: self._tap(w))
-                deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
-                if self._deliver_at_end:
-                    deliver = self._delivery.time(deliver)
-                self._push(deliver, lambda w=frame.wire: self._emit(w))
-            except Exception as exc:  # a device bug must not kill the line silently
-                self.errors.append(exc)
-                raise
+                heapq.heappop(self._due)
+                queued.action()
+                return
+            if frame is None or frame.start > self.now():
+                return
+            self.device.pop_frame()
+            lateness = self.now() - frame.start
+            self.worst_lateness = max(self.worst_lateness, lateness)
+            self._stretch_worst = max(self._stretch_worst, lateness)
+            self.late_frames += lateness > LATE_NOTICE
+            if self.bench.require_rts and self._rts:
+                self.lost_frames += 1  # the recorder's driver still holds the line
+                return
+            if self._taps:  # on the wire it is whole at its stop bit, whatever the bench
+                self._push(frame.start + frame.duration, lambda w=frame.wire: self._tap(w))
+            deliver = frame.start + (frame.duration if self._deliver_at_end else 0.0)
+            if self._deliver_at_end:
+                deliver = self._delivery.time(deliver)
+            self._push(deliver, lambda w=frame.wire: self._emit(w))
 
     def _emit(self, wire: int, echo: bool = False) -> None:
         self.frames_sent += not echo

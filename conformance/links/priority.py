@@ -24,6 +24,11 @@ import sys
 # thread busy computing would otherwise hold the CPU for a whole round-robin slice (100 ms).
 READER = 20
 EMULATED_LINE = 30
+# A sensor harness served on an emulated line (``emulate --harness``) is the sensor's own
+# firmware: its answers are on the line's critical path (a reply goes out only once it has
+# planned it), so it runs just below the line, above the tool's readers. It mostly sleeps
+# on its input, as the threads given a class here must.
+SERVED_FIRMWARE = EMULATED_LINE - 1
 # The GIL hand-over interval while a real-time thread runs in the process (Python's default,
 # 5 ms, lets a computing thread keep a reader or an emulated line waiting that long).
 SWITCH_INTERVAL = 2e-4
@@ -37,15 +42,16 @@ def quick_gil_handover() -> float:
     return previous
 
 
-def realtime_priority(priority: int = READER) -> bool:
-    """Give the calling thread SCHED_RR; False where the OS refuses (or has no such thing)."""
+def realtime_priority(priority: int = READER, pid: int = 0) -> bool:
+    """Give the calling thread (or the process ``pid``) SCHED_RR; False where the OS refuses
+    (or has no such thing)."""
     setter = getattr(os, "sched_setscheduler", None)
     policy = getattr(os, "SCHED_RR", None)
     if setter is None or policy is None:
         return False
     policy |= getattr(os, "SCHED_RESET_ON_FORK", 0)  # a child process starts ordinary
     try:
-        setter(0, policy, os.sched_param(priority))
+        setter(pid, policy, os.sched_param(priority))
     except (OSError, AttributeError):
         return False
     return True
