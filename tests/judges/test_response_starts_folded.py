@@ -16,9 +16,9 @@ from conformance.judges import wire
 from conformance.judges.stalled import stalled_interval
 from conformance.judges.timing import Measured, StampUncertainty, Window, combine_local
 from conformance.links.host_stall import Stall
-from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
+from conformance.transcript import Event
+from tests.judges.test_start_observations_shared import _exchange
 
-CHAR = 8.33e-3
 EARLY = Window("R-7.0-09", "reply start", low=7.93e-3)
 LATE = Window("R-7.0-10", "reply start", high=15e-3)
 STALL = Stall(0.0, 1.0, 120.0)
@@ -63,22 +63,6 @@ def test_folded_findings_are_the_one_by_one_findings(drawn, placed, real_time, w
     found = combine_local(rid, folded.observed(), "reply", real_time=real_time)
     assert _same(found) == _same(one_by_one)
     assert found.evidence == one_by_one.evidence  # the reply cited
-
-
-def _chars(origin: str, t: float, text: str) -> list[Event]:
-    return [
-        Event(EventKind.CHAR, origin, t + i * CHAR, t + (i + 1) * CHAR, wire=to_wire_7e1(ord(c)))
-        for i, c in enumerate(text)
-    ]
-
-
-def _exchange(t: float, command: str, delay: float | None, reply: str) -> list[Event]:
-    events = [Event(EventKind.BREAK, TOOL, t, t + 0.013)]
-    sent = _chars(TOOL, t + 0.03, command)
-    events += sent
-    if delay is not None:
-        events += _chars(DUT, sent[-1].end + delay, reply)
-    return events
 
 
 def _windows(exchanges: list[tuple[str, float | None, str]], per: int):
