@@ -542,18 +542,20 @@ def test_standby_after_foreign_command(sensor, case):
     def attempt(_n):
         first = len(sensor.link.transcript.events)
         awake = _awake(sensor)
-        if not awake.answered:
+        if precondition.woke([awake]) is not None:
             return awake, None, None, None, None, None
         sensor.listen(0.02)
         foreign = sensor.master.raw(f"{other}!", break_first=False)
         ex = sensor.hear_late(sensor.master.raw(f"{sensor.address}!", break_first=False))
-        since = awake.judged.reply_events[-1].end
+        # shown listening by a reply that came late (replies-after-retry + slow-wake): no
+        # judged reply to count b!'s marking from, so any stall since the wake-up counts
+        since = awake.judged.reply_events[-1].end if awake.answered else 0.0
         stall = sensor.stalled_since(first, since)  # from the reply b!'s marking counts from
         # the control: a! as long after a reply, with no b! before it. A sensor silent to it
         # is silent to an unbroken follow-up anyway (it needs a break after every reply, or
         # sleeps early), so its silence after b! shows no standby (never-standby PASSed beside
         # no-follow-up-without-break, seed 4064)
-        gap = _marking_before(ex, since)
+        gap = _marking_before(ex, since) if awake.answered else 0.0
         first = len(sensor.link.transcript.events)
         again = _awake(sensor)
         control, control_stall = again, None
@@ -576,7 +578,7 @@ def test_standby_after_foreign_command(sensor, case):
         # the probe no evidence either way: sent again (truth30)
         _awake_ex, _foreign, ex, _control, stall, control_stall = sent
         if ex is None:
-            return None  # the wake-up went unanswered: judged below, not aimed again
+            return None  # the wake-up shown no listening: judged below, not aimed again
         held = stall or (control_stall if not ex.answered else None)
         return f"a stall of the tool's host over it: {held.why()}" if held else None
 
