@@ -195,10 +195,7 @@ class RealTimeLine:
                 end = start + frame
                 self._tool_free = end
                 if abs(baud - BAUD) <= BAUD * 0.02:
-                    if self._wakes:
-                        self._push_told(start, end, self._char(wire, start, end, doubt))
-                    else:
-                        self._push(end, self._char(wire, start, end, doubt))
+                    self._push_told(start, end, self._char(wire, start, end, doubt))
                     if self._taps:
                         self._push(end, lambda w=wire: self._tap(w))
                 else:

@@ -152,10 +152,10 @@ def silent(
     exchanges = list(exchanges)
     controls = [baseline] if isinstance(baseline, Exchange) else list(baseline)
     held = [(ex, stall) for ex, stall in zip(exchanges, stalled, strict=False) if stall]
-    earlier = [ex for ex in exchanges if earlier_reply(ex)]
-    aside = earlier + [ex for ex, _ in held]
-    answered = [ex for ex in exchanges if (ex.answered or heard_late(ex)) and not _among(ex, aside)]
     stalled_out = [ex for ex, _ in held]
+    earlier = [ex for ex in exchanges if earlier_reply(ex)]
+    aside = earlier + stalled_out
+    answered = [ex for ex in exchanges if (ex.answered or heard_late(ex)) and not _among(ex, aside)]
     met = aside + [
         ex
         for ex in exchanges

@@ -93,9 +93,10 @@ def stalls_since(events: list[Event], first: int) -> list[Stall]:
     hold no NOTE at all, and a run makes a thousand of them."""
     if first and first < len(events):
         began = events[first].start - AFTER
-        back = max(0, first - LOOK_BACK)
-        before = [e for e in events[back:first] if e.kind is _NOTE and e.start >= began]
-        first = events.index(before[0], back) if before else first
+        for i in range(max(0, first - LOOK_BACK), first):
+            if events[i].kind is _NOTE and events[i].start >= began:
+                first = i  # the earliest such NOTE
+                break
     new = events[first:] if first else events
     if _NOTE not in map(_KIND, new):
         return []
