@@ -62,8 +62,9 @@ def test_identify_measurement_answered(sensor, case):
 
 
 def _is_identification(ex, ident) -> bool:
-    """Whether ``ex`` (an identify-measurement command) drew the sensor's ``aI!`` reply: an
-    ``atttn`` can never be that text, so the command was not served."""
+    """Whether ``ex`` (an identify-measurement or metadata command) drew the sensor's ``aI!``
+    reply: an ``atttn`` or a record (``a,`` ...) can never be that text, so the command was
+    not served."""
     return ex.answered and ident.answered and ex.reply_text == ident.reply_text
 
 
@@ -263,6 +264,22 @@ def test_parameter_metadata(sensor, case):
         return
     case.extend(judge.records(plan, case.requirements))
     case.extend(judge.uncounted_groups(unread, case.requirements))
+    # its aI! text to aIM_001!: a parser that matched the 'I' alone served no metadata
+    # command, however its framing reads (outside31: an EnviroDIY-based test slave answered
+    # all 30 so, and R-6.2-01 PASSed "conforms (30 checked)")
+    ident = sensor.exchange("I")
+    echoed = [ex for ex, _, _ in plan if _is_identification(ex, ident)]
+    if echoed:
+        case.add(
+            failed(
+                "R-6.2-01",
+                "answered with its aI! identification, not a metadata record: "
+                + ", ".join(xjudge.shown(e) for e in echoed[:4])
+                + (f" (+{len(echoed) - 4} more)" if len(echoed) > 4 else ""),
+                evidence=xjudge.cite([*echoed, ident]),
+                observed=len(plan),
+            )
+        )
 
 
 @requirements("R-6.2-05")

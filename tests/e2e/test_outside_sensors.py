@@ -932,6 +932,41 @@ def test_identify_measurement_replies_still_pass_r_6_1_01():
     assert found["R-6.1-01"]["verdict"] == "PASS", found["R-6.1-01"]["findings"]
 
 
+@pytest.fixture
+def metadata_answered_with_ident(monkeypatch):
+    """The simulated sensor answering every aI<m>_nnn! with its aI! identification
+    (outside31: a test slave on EnviroDIY's slave API, whose parser reads only the 'I')."""
+    from conformance.emulator.sensor import SensorEmulator
+    from conformance.protocol.commands import parse_command
+
+    usual = SensorEmulator._dispatch
+
+    def _dispatch(self, cmd, at):
+        if cmd.kind is Kind.METADATA:
+            cmd = parse_command(f"{cmd.address}I!")
+        usual(self, cmd, at)
+
+    monkeypatch.setattr(SensorEmulator, "_dispatch", _dispatch)
+
+
+def test_the_identification_to_a_metadata_command_is_no_record_r_6_2_01(
+    metadata_answered_with_ident,
+):
+    """R-6.2-01 (the sensor serves aIM_nnn! as a metadata command) PASSed "conforms (30
+    checked)" with the sensor's aI! text to each, while R-6.2-02 FAILed their form: the
+    command was never served as metadata. Now FAIL, naming the identification."""
+    found = _verdicts(run_once("sim://", keyword="test_parameter_metadata"))
+    rule = found["R-6.2-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert any("answered with its aI! identification" in f["detail"] for f in rule["findings"])
+    assert found["R-6.2-02"]["verdict"] == "FAIL"
+
+
+def test_metadata_records_still_pass_r_6_2_01():
+    found = _verdicts(run_once("sim://", keyword="test_parameter_metadata"))
+    assert found["R-6.2-01"]["verdict"] == "PASS", found["R-6.2-01"]["findings"]
+
+
 #: A recorder harness that sends ``aM0!`` after each job's break, then sleeps for the uint32_t
 #: milliseconds its firmware read from the missing reply (the twenty-second round's logger).
 _SLEEPS_FOREVER = (

@@ -7,7 +7,9 @@
 #ifndef SDI12_KIT_PRINT_H
 #define SDI12_KIT_PRINT_H
 
+#include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -41,6 +43,16 @@ class Print {
     size_t print(long v, int base = DEC) { return print(String(v, (unsigned char)base)); }
     size_t print(unsigned long v, int base = DEC) { return print(String(v, (unsigned char)base)); }
     size_t print(double v, int decimals = 2) { return print(String(v, (unsigned char)decimals)); }
+    /* The ESP32 and SAMD cores' printf (AVR's has none): formatted into a buffer, then
+     * written as print does; a longer text is cut at 255 characters. */
+    size_t printf(const char *format, ...) __attribute__((format(printf, 2, 3))) {
+        char buf[256];
+        va_list args;
+        va_start(args, format);
+        vsnprintf(buf, sizeof buf, format, args);
+        va_end(args);
+        return write(buf);
+    }
     size_t println() { return write("\r\n"); }
     template <class T>
     size_t println(const T &v) { size_t n = print(v); return n + println(); }

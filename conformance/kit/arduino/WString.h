@@ -78,6 +78,18 @@ class String {
     long toInt() const { return strtol(s_.c_str(), nullptr, 10); }
     float toFloat() const { return strtof(s_.c_str(), nullptr); }
     double toDouble() const { return strtod(s_.c_str(), nullptr); }
+    /* Arduino's copy into a C buffer: at most size - 1 characters from index, then NUL
+     * (a sketch that formats its reply as a String and hands a char[] to a C helper). */
+    void getBytes(unsigned char *buf, unsigned int size, unsigned int index = 0) const {
+        if (!buf || !size) return;
+        unsigned int n = index < s_.size() ? (unsigned int)s_.size() - index : 0;
+        if (n > size - 1) n = size - 1;
+        if (n) memcpy(buf, s_.data() + index, n);
+        buf[n] = 0;
+    }
+    void toCharArray(char *buf, unsigned int size, unsigned int index = 0) const {
+        getBytes((unsigned char *)buf, size, index);
+    }
 
   private:
     std::string s_;
