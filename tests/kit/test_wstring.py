@@ -28,6 +28,13 @@ from conformance.kit.build import find_compiler
 PROGRAM = r"""
 #include <stdio.h>
 #include "WString.h"
+#include "Print.h"
+
+/* a Print that keeps what it was given (as Serial does on stderr) */
+struct Kept : public Print {
+    String text;
+    size_t write(uint8_t c) override { text += (char)c; return 1; }
+};
 
 static String sent;
 static void send_response(String &resp) { sent = resp; }  /* a library's String& parameter */
@@ -50,6 +57,14 @@ int main() {
     printf("mixed=[%s]\n", mixed.c_str());
     String left = "T: " + String(address) + reply;
     printf("left=[%s]\n", left.c_str());
+    char copy[8];
+    String("0+1.11-2.22").toCharArray(copy, sizeof copy);  /* cut to size - 1, NUL ended */
+    printf("copied=[%s]\n", copy);
+    String("0I!").toCharArray(copy, sizeof copy, 1);
+    printf("from1=[%s]\n", copy);
+    Kept kept;
+    kept.printf("resp: %s %d 0x%x", "0+1", 42, 10);
+    printf("printed=[%s]\n", kept.text.c_str());
     return 0;
 }
 """
@@ -88,3 +103,14 @@ def test_a_character_on_the_left_of_a_sum_is_that_character(output):
 def test_a_nul_character_makes_an_empty_string(output):
     assert output["nul"] == "0"
     assert output["command"] == "[AI] len=2 first=65"
+
+
+def test_to_char_array_copies_at_most_size_less_one_then_nul(output):
+    """Found running outside31's EnviroDIY-API slave sketch (docs/kit.md): it formats its
+    reply as a String and hands ``toCharArray``'s copy to its C CRC helper."""
+    assert output["copied"] == "[0+1.11-]"
+    assert output["from1"] == "[I!]"
+
+
+def test_print_printf_formats_as_the_esp32_and_samd_cores_do(output):
+    assert output["printed"] == "[resp: 0+1 42 0xa]"
