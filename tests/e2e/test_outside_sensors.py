@@ -105,6 +105,10 @@ break, and R-7.0-07 FAILed on the hang (the case now sends a control a! after a 
 probe); its early reply to aD0! after a break, 93 ms after the try before, was taken for that
 try's late reply (R-7.1-02 undecided where it FAILs); a mock sensor sketch silent to aMn!
 had its groups called "defined" (R-4.4.8-03's N/A).
+
+The thirty-first: a test slave on EnviroDIY's slave API whose parser reads only the 'I'
+answered every ``aIM_nnn!`` with its ``aI!`` identification, and R-6.2-01 PASSed "conforms (30
+checked)" (now FAIL, as R-6.1-01 already did for ``aIM!``).
 """
 
 from __future__ import annotations
