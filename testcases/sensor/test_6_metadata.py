@@ -40,24 +40,33 @@ def test_identify_measurement_answered(sensor, case):
     case.expect("a reply to each of the 43 identify forms")
     exchanges = [identify(sensor, code) for code in DESCRIBED]
     case.evidence("identify-measurement commands", exchanges)
-    ident = sensor.exchange("I")
-    echoed = [ex for ex in exchanges if _is_identification(ex, ident)]
-    if echoed:
-        # its aI! text to aIM!: a parser that matched the 'I' alone, no identify-measurement
-        # served (the twenty-first round's Due sketch answered all 43 so)
-        case.add(
-            failed(
-                "R-6.1-01",
-                "answered with its aI! identification, not a measurement's reply: "
-                + ", ".join(xjudge.shown(e) for e in echoed[:4])
-                + (f" (+{len(echoed) - 4} more)" if len(echoed) > 4 else ""),
-                evidence=xjudge.cite([*echoed, ident]),
-                observed=len(exchanges),
-            )
-        )
+    # its aI! text to aIM!: a parser that matched the 'I' alone, no identify-measurement
+    # served (the twenty-first round's Due sketch answered all 43 so)
+    echoed = _identification_echoed(
+        "R-6.1-01", exchanges, sensor.exchange("I"), "a measurement's reply"
+    )
+    if echoed is not None:
+        case.add(echoed)
         return
     case.add(
         xjudge.answered("R-6.1-01", exchanges, "v1.4 makes them mandatory", late_is_reply=True)
+    )
+
+
+def _identification_echoed(rule: str, exchanges: list, ident, served: str):
+    """FAIL ``rule`` where any of ``exchanges`` drew the sensor's ``aI!`` reply (``ident``):
+    those commands were not served as ``served`` names, whatever the text's framing; None
+    where none did."""
+    echoed = [ex for ex in exchanges if _is_identification(ex, ident)]
+    if not echoed:
+        return None
+    return failed(
+        rule,
+        f"answered with its aI! identification, not {served}: "
+        + ", ".join(xjudge.shown(e) for e in echoed[:4])
+        + (f" (+{len(echoed) - 4} more)" if len(echoed) > 4 else ""),
+        evidence=xjudge.cite([*echoed, ident]),
+        observed=len(exchanges),
     )
 
 
@@ -267,19 +276,10 @@ def test_parameter_metadata(sensor, case):
     # its aI! text to aIM_001!: a parser that matched the 'I' alone served no metadata
     # command, however its framing reads (outside31: an EnviroDIY-based test slave answered
     # all 30 so, and R-6.2-01 PASSed "conforms (30 checked)")
-    ident = sensor.exchange("I")
-    echoed = [ex for ex, _, _ in plan if _is_identification(ex, ident)]
-    if echoed:
-        case.add(
-            failed(
-                "R-6.2-01",
-                "answered with its aI! identification, not a metadata record: "
-                + ", ".join(xjudge.shown(e) for e in echoed[:4])
-                + (f" (+{len(echoed) - 4} more)" if len(echoed) > 4 else ""),
-                evidence=xjudge.cite([*echoed, ident]),
-                observed=len(plan),
-            )
-        )
+    commands = [ex for ex, _, _ in plan]
+    echoed = _identification_echoed("R-6.2-01", commands, sensor.exchange("I"), "a metadata record")
+    if echoed is not None:
+        case.add(echoed)
 
 
 @requirements("R-6.2-05")

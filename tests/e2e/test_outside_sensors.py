@@ -905,21 +905,27 @@ def test_a_silent_d0_is_no_values_returned_r_4_4_8_04(data_never_answered):
     assert found["R-4.4.8-03"]["verdict"] == "FAIL"
 
 
-@pytest.fixture
-def identify_measurement_answered_with_ident(monkeypatch):
-    """The simulated sensor answering every aI<m>! with its aI! identification (the
-    twenty-first round's Due sketch: ``input.charAt(1) == "I"`` answers any 0I...!)."""
+def _answer_with_ident(monkeypatch, kind: Kind) -> None:
+    """The simulated sensor answering every command of ``kind`` with its aI! identification,
+    as a parser that reads only the 'I' does."""
     from conformance.emulator.sensor import SensorEmulator
-    from conformance.protocol.commands import Kind, parse_command
+    from conformance.protocol.commands import parse_command
 
     usual = SensorEmulator._dispatch
 
     def _dispatch(self, cmd, at):
-        if cmd.kind is Kind.IDENTIFY_MEASUREMENT:
+        if cmd.kind is kind:
             cmd = parse_command(f"{cmd.address}I!")
         usual(self, cmd, at)
 
     monkeypatch.setattr(SensorEmulator, "_dispatch", _dispatch)
+
+
+@pytest.fixture
+def identify_measurement_answered_with_ident(monkeypatch):
+    """aI<m>! answered with the aI! identification (the twenty-first round's Due sketch:
+    ``input.charAt(1) == "I"`` answers any 0I...!)."""
+    _answer_with_ident(monkeypatch, Kind.IDENTIFY_MEASUREMENT)
 
 
 def test_the_identification_to_aim_is_no_answer_r_6_1_01(identify_measurement_answered_with_ident):
@@ -938,19 +944,9 @@ def test_identify_measurement_replies_still_pass_r_6_1_01():
 
 @pytest.fixture
 def metadata_answered_with_ident(monkeypatch):
-    """The simulated sensor answering every aI<m>_nnn! with its aI! identification
-    (outside31: a test slave on EnviroDIY's slave API, whose parser reads only the 'I')."""
-    from conformance.emulator.sensor import SensorEmulator
-    from conformance.protocol.commands import parse_command
-
-    usual = SensorEmulator._dispatch
-
-    def _dispatch(self, cmd, at):
-        if cmd.kind is Kind.METADATA:
-            cmd = parse_command(f"{cmd.address}I!")
-        usual(self, cmd, at)
-
-    monkeypatch.setattr(SensorEmulator, "_dispatch", _dispatch)
+    """aI<m>_nnn! answered with the aI! identification (outside31: a test slave on
+    EnviroDIY's slave API, whose parser reads only the 'I')."""
+    _answer_with_ident(monkeypatch, Kind.METADATA)
 
 
 def test_the_identification_to_a_metadata_command_is_no_record_r_6_2_01(
