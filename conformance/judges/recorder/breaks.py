@@ -12,7 +12,7 @@ from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...transcript import HELD_BACK, Event
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..stalled import stalled_interval
+from ..stalled import held_by, stalled_interval
 from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
 from .common import SR_KINDS, combine, own_uncertainty
 from .measurements import service_request_end
@@ -91,7 +91,7 @@ class Breaks:
 
 
 def _across(
-    stalls: Sequence[Stall], judged: MeasuredAsJudged | Finding, start: float, end: float
+    stalls: Sequence[Stall], judged: MeasuredAsJudged, start: float, end: float
 ) -> MeasuredAsJudged | Finding:
     """``judged`` (the interval ``start``..``end``), or where it deviates across a stall of
     the tool's own host noted there, INCONCLUSIVE naming it (truth32: the stall moved its
@@ -100,6 +100,12 @@ def _across(
         return judged
     stall = stalled_over(stalls, start, end)
     return judged if stall is None else stalled_interval(judged, stall)
+
+
+def _held(stalls: Sequence[Stall], finding: Finding, start: float, end: float) -> Finding:
+    """``finding``, or where it FAILs or WARNs and a noted stall of the tool's own host
+    covers ``start``..``end``, INCONCLUSIVE naming it (:func:`_across` of a finding)."""
+    return held_by(finding, stalled_over(stalls, start, end)) if stalls else finding
 
 
 def _held_back_short(judged: MeasuredAsJudged, b: Event) -> Finding:
@@ -191,15 +197,20 @@ class BreakRules:
                 where = [f"before {s.at()}"]
                 if previous is None or previous.address != s.address:
                     who = "no earlier command" if previous is None else f"last was {previous.text}"
-                    rule17.append(
-                        Finding(
-                            "R-7.0-17",
-                            Verdict.FAIL,
-                            f"no break before {s.at()}, a new sensor ({who}){short}",
-                            evidence=where,
-                            observed=1,
-                        )
+                    missing = Finding(
+                        "R-7.0-17",
+                        Verdict.FAIL,
+                        f"no break before {s.at()}, a new sensor ({who}){short}",
+                        evidence=where,
+                        observed=1,
                     )
+                    # spacing too short to be a break, read across a stall: the recorder's
+                    # break and its end came in one late read (truth32: a 0.00 ms break
+                    # laid with the command the stall held back); no spacing at all stands
+                    brk = s.break_event
+                    if brk is not None and short:
+                        missing = _held(stalls, missing, brk.start, brk.end)
+                    rule17.append(missing)
                 else:  # timed from the line's activity before it (before the short spacing)
                     began = self._previous_activity(line, s) or float("-inf")
                     quiet = s.first_char - began
@@ -213,7 +224,7 @@ class BreakRules:
                     )
                     if short and judged.verdict is not Verdict.PASS:
                         judged.detail += short
-                    rule17.append(_across(stalls, judged, began, s.first_char))
+                    rule17.append(_held(stalls, judged, began, s.first_char))
                 if previous is not None and _follows_service_request(previous, s):
                     sr_end = service_request_end(previous.after, s.address)
                     assert sr_end is not None
@@ -225,7 +236,7 @@ class BreakRules:
                         high=NO_BREAK_WINDOW,
                         evidence=where,
                     )
-                    rule71.append(_across(stalls, judged, sr_end, s.first_char))
+                    rule71.append(_held(stalls, judged, sr_end, s.first_char))
             elif previous is not None and _follows_service_request(previous, s):
                 rule71.append(
                     Finding(

@@ -128,6 +128,19 @@ def test_marking_before_a_command_without_a_break_across_a_stall_is_held_r_7_0_1
     assert by_id(judge_break_rules(clean.view(), 0.0))["R-7.0-17"].verdict is Verdict.PASS
 
 
+def test_a_break_laid_with_no_length_across_a_stall_is_held_r_7_0_17():
+    """truth32's paused run (a recorder outside the tool): the stall held back the
+    recorder's retries, its break and its next command, which came in one late read; the
+    break was laid 0.00 ms long, too short to be one, and R-7.0-17 FAILed "no break before
+    5A0!, a new sensor". A break is no gap in the stamps: none at all still FAILs."""
+    w = Stalling().brk().rec("0A5!").idle(20).brk(0.0, 9.0).stall(180).rec("5A0!")
+    found = by_id(judge_break_rules(w.view(), 0.0))["R-7.0-17"]
+    _held(found)
+    assert "too short to be a break" in found.detail
+    far = _far(Stalling().brk().rec("0A5!").idle(20).brk(0.0, 9.0).rec("5A0!"))
+    assert by_id(judge_break_rules(far.view(), 0.0))["R-7.0-17"].verdict is Verdict.FAIL
+
+
 def _after_service_request(stalled: bool) -> Stalling:
     w = Stalling().brk().rec("0M!").sensor("00011\r\n").sensor("0\r\n", delay_ms=600)
     w.idle(120)
