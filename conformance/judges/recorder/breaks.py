@@ -7,15 +7,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from ...links.host_stall import Stall, stalled_over
+from ...links.host_stall import Stall
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...transcript import HELD_BACK, Event
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..stalled import held_by, stalled_interval
 from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
 from .common import SR_KINDS, combine, own_uncertainty
 from .measurements import service_request_end
+from .stalls import hold
 
 #: R-7.0-02's and R-7.0-06's windows, worked out once for the many breaks of a recording
 BREAK_LENGTH = Window("R-7.0-02", "break length", low=BREAK_MIN)
@@ -65,7 +65,7 @@ class Breaks:
             if held:
                 self.lengths.append(_held_back_short(judged, b))
             else:
-                self.lengths.append(_across(stalls, judged, b.start, b.end))
+                self.lengths.append(hold(stalls, judged, b.start, b.end))
         seen = self._markings_seen
         for s in line.transmissions:
             brk = s.break_event
@@ -80,7 +80,7 @@ class Breaks:
             if held:
                 self.markings.append(_after_held_back(judged, s))
             else:
-                self.markings.append(_across(stalls, judged, brk.end, s.first_char))
+                self.markings.append(hold(stalls, judged, brk.end, s.first_char))
 
     def findings(self) -> list[Finding]:
         """R-7.0-02 and R-7.0-06 over everything added."""
@@ -88,24 +88,6 @@ class Breaks:
             combine("R-7.0-02", self.lengths, "break"),
             combine("R-7.0-06", self.markings, "marking"),
         ]
-
-
-def _across(
-    stalls: Sequence[Stall], judged: MeasuredAsJudged, start: float, end: float
-) -> MeasuredAsJudged | Finding:
-    """``judged`` (the interval ``start``..``end``), or where it deviates across a stall of
-    the tool's own host noted there, INCONCLUSIVE naming it (truth32: the stall moved its
-    stamps, or held up an in-process recorder with the host); as before outside any."""
-    if not stalls or judged.verdict not in (Verdict.FAIL, Verdict.WARN):
-        return judged
-    stall = stalled_over(stalls, start, end)
-    return judged if stall is None else stalled_interval(judged, stall)
-
-
-def _held(stalls: Sequence[Stall], finding: Finding, start: float, end: float) -> Finding:
-    """``finding``, or where it FAILs or WARNs and a noted stall of the tool's own host
-    covers ``start``..``end``, INCONCLUSIVE naming it (:func:`_across` of a finding)."""
-    return held_by(finding, stalled_over(stalls, start, end)) if stalls else finding
 
 
 def _held_back_short(judged: MeasuredAsJudged, b: Event) -> Finding:
@@ -209,7 +191,7 @@ class BreakRules:
                     # laid with the command the stall held back); no spacing at all stands
                     brk = s.break_event
                     if brk is not None and short:
-                        missing = _held(stalls, missing, brk.start, brk.end)
+                        missing = hold(stalls, missing, brk.start, brk.end)
                     rule17.append(missing)
                 else:  # timed from the line's activity before it (before the short spacing)
                     began = self._previous_activity(line, s) or float("-inf")
@@ -224,7 +206,7 @@ class BreakRules:
                     )
                     if short and judged.verdict is not Verdict.PASS:
                         judged.detail += short
-                    rule17.append(_held(stalls, judged, began, s.first_char))
+                    rule17.append(hold(stalls, judged, began, s.first_char, NO_BREAK_WINDOW))
                 if previous is not None and _follows_service_request(previous, s):
                     sr_end = service_request_end(previous.after, s.address)
                     assert sr_end is not None
@@ -236,7 +218,7 @@ class BreakRules:
                         high=NO_BREAK_WINDOW,
                         evidence=where,
                     )
-                    rule71.append(_held(stalls, judged, sr_end, s.first_char))
+                    rule71.append(hold(stalls, judged, sr_end, s.first_char, NO_BREAK_WINDOW))
             elif previous is not None and _follows_service_request(previous, s):
                 rule71.append(
                     Finding(

@@ -11,11 +11,12 @@ from ...protocol.timing import CHAR_TIME, INTER_CHAR_GAP_MAX, TOLERANCE
 from ...transcript import Event, escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import NEW_COMMAND, TranscriptView, Transmission
-from ..stalled import held_by, stalled_interval, through_stall
+from ..stalled import held_by
 from ..tally import Tally
 from ..timing import MeasuredIn, Repeats, Window
 from ..wire import judge_frame_lengths, judge_rate
 from .common import combine, own_uncertainty
+from .stalls import hold
 
 #: R-7.0-13's window, worked out once for the many gaps of a recording
 COMMAND_GAP = Window(
@@ -24,7 +25,6 @@ COMMAND_GAP = Window(
 
 
 _BANG = ord("!")
-_DEVIATING = (Verdict.FAIL, Verdict.WARN)
 
 
 def _dropped(
@@ -111,16 +111,26 @@ class CommandText:
         chars = s.chars
         for i, (a, b) in enumerate(zip(chars, chars[1:], strict=False)):
             gap = b.start - a.end
-            if _dropped(gap, own_uncertainty(self.uncertainty, a, b), False, s, a, b):
+            u = own_uncertainty(self.uncertainty, a, b)
+            if _dropped(gap, u, False, s, a, b):
                 part = escape("".join(chr(e.wire & 0x7F) for e in chars[: i + 1]))
-                # a gap the tool's host stalled across: its own doing, or its stamps' (truth32)
-                stall = stalled_over(self._stalls, a.start, b.end) if self._stalls else None
-                through_stall(self.tally, stall).fail(
+                where = escape(s.text)
+                dropped = Finding(
                     "R-4.4-04",
-                    escape(s.text),
+                    Verdict.FAIL,
                     f"'{part}' then {gap * 1e3:.2f} ms of marking with no '!': a sensor "
                     "drops it there (App. B)",
+                    measured_ms=gap * 1e3,
+                    uncertainty_ms=u * 1e3,
+                    evidence=[where],
+                    observed=1,
                 )
+                # a gap the tool's host stalled across: its own doing, or its stamps' (truth32)
+                held = hold(self._stalls, dropped, a.start, b.end, NEW_COMMAND)
+                if held.verdict is Verdict.FAIL:
+                    self.tally.fail("R-4.4-04", where, dropped.detail)
+                else:
+                    self.tally.undecide("R-4.4-04", where, held.detail)
                 return
             if a.wire & 0x7F == _BANG:
                 return
@@ -184,14 +194,9 @@ class CharacterGaps:
                 m = judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s))
                 # a gap the tool's host stalled across (truth32): its stamps, or an
                 # in-process recorder held up with the host, are the host's doing
-                stall = stalled_over(stalls, a.start, b.end) if stalls else None
-                if stall is None:
-                    found.append(m)
-                elif m.verdict in _DEVIATING:
-                    found.append(stalled_interval(m, stall))
-                else:
-                    found.append(m)
+                found.append(hold(stalls, m, a.start, b.end, INTER_CHAR_GAP_MAX) if stalls else m)
                 if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
+                    stall = stalled_over(stalls, a.start, b.end) if stalls else None
                     if stall is not None:
                         if self.leaning_stalled is None:
                             self.leaning_stalled = (gap, s, stall)

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
-from ...links.host_stall import Stall, stalled_over
+from ...links.host_stall import Stall
 from ...protocol.timing import (
     CHAR_TIME,
     RESPONSE_START_MAX,
@@ -28,12 +28,12 @@ from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
 from ..reply_validity import NO_REPLY, STX, Reason, ReplyProblem
-from ..stalled import held_by
 from ..tally import Tally
 from ..timing import judge_window
 from .common import combine, own_uncertainty
 from .logged import same_values
 from .replies import crc_context, cut_off, reply_problem
+from .stalls import hold
 
 #: Marking after which a sensor is in standby (R-7.0-15, +0.40 ms): a command sent again
 #: without a break after longer than this is not a retry but a new try without its break.
@@ -280,13 +280,14 @@ class _RetryEvidence:
     #: the tool's host stalls noted in the recording (truth32)
     stalls: Sequence[Stall] = ()
 
-    def across(self, finding: Finding, start: float, end: float) -> Finding:
+    def across(
+        self, finding: Finding, start: float, end: float, high: float | None = None
+    ) -> Finding:
         """``finding`` on the line between ``start`` and ``end``, or where it FAILs or
-        WARNs and a noted stall of the tool's host covers some of that, INCONCLUSIVE naming
-        it (the stall moved the stamps there, held up the played sensor's reply, or an
-        in-process recorder with the host); as before outside any stall."""
-        stalls = self.stalls
-        return held_by(finding, stalled_over(stalls, start, end)) if stalls else finding
+        WARNs across noted stalls of the tool's host that can account for it (:func:`.stalls.
+        hold`: they held up the played sensor's reply, an in-process recorder, or the
+        stamps), INCONCLUSIVE naming the first; as before outside any stall."""
+        return hold(self.stalls, finding, start, end, high)
 
 
 def _judge_group(
@@ -366,7 +367,7 @@ def _judge_tries(
                     high=RETRY_MAX,
                     evidence=[nxt.sent.at()],
                 )
-                acc.window.append(acc.across(judged, a.sent.start, nxt.sent.first_char))
+                acc.window.append(acc.across(judged, a.sent.start, nxt.sent.first_char, RETRY_MAX))
             elif k == 0:
                 missing = Finding(
                     "R-7.2-02",
@@ -487,8 +488,7 @@ def cut_replies(
                 observed=1,
             )
             # a reply the tool's host stalled over (truth32): held back, its rest late
-            stall = stalled_over(stalls, s.start, brk.end) if stalls else None
-            failed.append(held_by(found, stall))
+            failed.append(hold(stalls, found, s.start, brk.end))
         else:
             named.append(f"{cut} (after {s.at()}): a new sequence, not a retry")
     return failed, named

@@ -22,6 +22,17 @@ enough that the recorder broke into it; R-7.2-06 FAILed on it).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TypeVar
+
+from ...links.host_stall import REACH, Stall
+from ...verdicts import Finding, Verdict
+from ..stalled import stalled_interval
+from ..timing import Measured
+
+J = TypeVar("J", Finding, Measured)
+_DEVIATING = (Verdict.FAIL, Verdict.WARN)
+
 #: the rules whose judges read the stalls and measure the recorder's own timing alone
 READ_STALLS = frozenset(
     {
@@ -34,3 +45,44 @@ READ_STALLS = frozenset(
         "R-7.1-01",  # breaks.BreakRules: aD0! without a break after the service request
     }
 )
+
+
+def hold(
+    stalls: Sequence[Stall],
+    judged: J,
+    start: float,
+    end: float,
+    high: float | None = None,
+) -> J | Finding:
+    """``judged`` (a finding on the line between ``start`` and ``end``), or where it FAILs
+    or WARNs across noted stalls of the tool's own host that can account for it, the same
+    INCONCLUSIVE naming the first (:func:`~conformance.judges.stalled.stalled_interval`).
+
+    A stall compresses what it held back into one late read (a break, a marking, a gap
+    read shorter, down to nothing), so any deviation of that kind across one is held. It
+    stretches an interval (a paused in-process recorder, a reply it held back) by at most
+    its own length: an interval over ``high`` (s) by more than the stalls over it may have
+    added (each its measured length and :data:`~conformance.links.host_stall.REACH`),
+    beyond its uncertainty, still FAILs (a recorder that sends aD0! without a break 2 s
+    after ttt is not excused by the 150 ms stall inside those 2 s)."""
+    if not stalls or judged.verdict not in _DEVIATING:
+        return judged
+    over = [stall for stall in stalls if stall.overlaps(start, end)]
+    if not over:
+        return judged
+    if high is not None:
+        measured, uncertainty = _figures(judged)
+        if measured is not None and measured > high:
+            added = sum(stall.ms / 1e3 + REACH for stall in over)
+            if measured - added - uncertainty > high:
+                return judged
+    return stalled_interval(judged, over[0])
+
+
+def _figures(judged: Finding | Measured) -> tuple[float | None, float]:
+    """The measured interval and its uncertainty (s) of ``judged``."""
+    if isinstance(judged, Measured):
+        return judged.measured, judged.uncertainty
+    if judged.measured_ms is None:
+        return None, 0.0
+    return judged.measured_ms / 1e3, (judged.uncertainty_ms or 0.0) / 1e3

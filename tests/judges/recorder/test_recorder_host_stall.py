@@ -284,3 +284,23 @@ def test_the_guard_leaves_a_line_that_kept_time(late: float):
     run = SimpleNamespace(session=session, cases=[SimpleNamespace(findings=[f])])
     ConformanceRun._guard_served_line(run)  # type: ignore[arg-type]
     assert f.verdict is Verdict.FAIL
+
+
+# -- what a stall can account for --------------------------------------------------------------
+
+
+def test_marking_longer_than_the_stalls_inside_it_can_explain_still_fails_r_7_0_17():
+    """no-break-after-87ms under the pauses: aD0! without a break 2 s after ttt, with a
+    stall of 150 ms (and its reach) inside those 2 s: the recorder's own 1.8 s stand."""
+    w = Stalling().brk().rec("0!").sensor("0\r\n").idle(1000).stall(150).idle(1000).rec("0D0!")
+    found = by_id(judge_break_rules(w.view(), 0.0))["R-7.0-17"]
+    assert found.verdict is Verdict.FAIL and STALLED not in found.detail
+    # the same with stalls that add up to what can stretch 300 ms to over 87 ms: held
+    w = Stalling().brk().rec("0!").sensor("0\r\n").idle(150).stall(150).idle(150).stall(150)
+    _held(by_id(judge_break_rules(w.rec("0I!").view(), 0.0))["R-7.0-17"])
+
+
+def test_a_command_part_dropped_longer_than_a_stall_can_explain_still_fails_r_4_4_04():
+    w = Stalling().brk().rec("0M").idle(1000).stall(150).idle(1000).rec("!")
+    found = by_id(judge_command_text(w.view(), 0.0))["R-4.4-04"]
+    assert found.verdict is Verdict.FAIL and STALLED not in found.detail
