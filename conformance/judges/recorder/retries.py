@@ -347,6 +347,7 @@ def _judge_tries(
         if a.problem is None:
             continue
         nxt = seq[k + 1] if k + 1 < len(seq) else None
+        began = _quiet_from(line, a) if acc.stalls else a.sent.start
         if nxt is None and len(seq) < 3:
             acc.tally.fail(
                 "R-7.2-05",
@@ -367,7 +368,7 @@ def _judge_tries(
                     high=RETRY_MAX,
                     evidence=[nxt.sent.at()],
                 )
-                acc.window.append(acc.across(judged, a.sent.start, nxt.sent.first_char, RETRY_MAX))
+                acc.window.append(acc.across(judged, began, nxt.sent.first_char, RETRY_MAX))
             elif k == 0:
                 missing = Finding(
                     "R-7.2-02",
@@ -380,12 +381,21 @@ def _judge_tries(
                 # the wait for the reply and what the recorder did instead: a stall there
                 # may have held the reply back (or the recorder, in the tool's process)
                 until = later.sent.first_char if later is not None else a.sent.end + STANDBY
-                acc.window.append(acc.across(missing, a.sent.start, until))
+                acc.window.append(acc.across(missing, began, until))
         elif nxt is not None and nxt.in_window(uncertainty):
             judged = _retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty)
-            acc.ends.append(acc.across(judged, a.sent.start, nxt.sent.first_char))
+            acc.ends.append(acc.across(judged, began, nxt.sent.first_char))
         elif nxt is None and later is not None:
             acc.restarted.append(f"{a.after()}: {a.instead(later)}")
+
+
+def _quiet_from(line: TranscriptView, a: Try) -> float:
+    """Where the marking before try ``a`` began (the line's last activity before it): a
+    stall there (truth32) decides how long the sensor had been left alone when the try came,
+    and so whether it was awake to answer it (the in-process recorder, paused past the
+    sensor's 100 ms, sent its aD2! to a sensor asleep; no reply, then a break)."""
+    before = line.previous_activity(a.sent)
+    return a.sent.start if before is None else before
 
 
 def _judge_given_up(
@@ -403,7 +413,7 @@ def _judge_given_up(
             observed=len(seq),
         )
         # the sequence's tries and the wait after its last (its reply, a retry due)
-        acc.third.append(acc.across(few, seq[0].sent.start, seq[-1].sent.end + STANDBY))
+        acc.third.append(acc.across(few, _quiet_from(line, seq[0]), seq[-1].sent.end + STANDBY))
         return
     brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
     if brk is not None:

@@ -304,3 +304,22 @@ def test_a_command_part_dropped_longer_than_a_stall_can_explain_still_fails_r_4_
     w = Stalling().brk().rec("0M").idle(1000).stall(150).idle(1000).rec("!")
     found = by_id(judge_command_text(w.view(), 0.0))["R-4.4-04"]
     assert found.verdict is Verdict.FAIL and STALLED not in found.detail
+
+
+def _asleep(stalled: bool) -> Stalling:
+    """truth32's paused run, in-process golden recorder: the reply to 0D1! ended, the tool's
+    process (the recorder with it) stalled 130 ms, 0D2! went 136 ms later without a break to
+    a sensor gone to standby, no reply, then a break and 0D2! again."""
+    w = Stalling().brk().rec("0D1!").sensor("0+1\r\n").idle(98)
+    if stalled:
+        w.stall(130)
+    w.idle(38).rec("0D2!").idle(35).brk().rec("0D2!").sensor("0+2\r\n")
+    return w if stalled else _far(w)
+
+
+def test_no_retry_to_a_try_a_stall_sent_to_a_sleeping_sensor_is_held_r_7_2_02_r_7_2_03():
+    found = by_id(judge_retries(_asleep(True).view(), 0.0))
+    _held(found["R-7.2-02"])
+    _held(found["R-7.2-03"])
+    far = by_id(judge_retries(_asleep(False).view(), 0.0))
+    assert far["R-7.2-02"].verdict is far["R-7.2-03"].verdict is Verdict.FAIL
