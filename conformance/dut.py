@@ -64,6 +64,11 @@ class Session(Protocol):
         the tool keeps no such line."""
         return 0.0
 
+    def unexplained_lateness(self) -> float:
+        """:meth:`worst_lateness` of the frames due outside every stall of the tool's host
+        the line noted (truth32): what no note explains."""
+        return self.worst_lateness()
+
 
 def sensor_claim(
     identity: Identification | None,

@@ -308,11 +308,18 @@ class ConformanceRun:
             return  # nothing fell behind: every line but a served one (and its package's
             # servers stay unloaded, as the rest of a run needs none of them)
         from .emulator_server.realtime import LATE_NOTICE
+        from .judges.recorder.stalls import READ_STALLS
 
         if late <= LATE_NOTICE:
             return
+        # lateness the line's own stall notes explain all of: the rules whose judges read
+        # those notes (each deviation a noted stall covers held, naming it) stand as judged
+        explained = self.session.unexplained_lateness() <= LATE_NOTICE  # type: ignore[union-attr]
         for case in self.cases:
-            undecide_after_late_line(case.findings, late, LATE_NOTICE)
+            findings = case.findings
+            if explained:
+                findings = [f for f in findings if f.requirement not in READ_STALLS]
+            undecide_after_late_line(findings, late, LATE_NOTICE)
 
     def report_dir(self) -> Path:
         """The run's folder: the one named, or a new one of its own (never another run's)."""

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from math import inf
 from typing import Protocol, runtime_checkable
 
+from ..links.host_stall import AFTER, REACH, STALL_MIN
 from ..links.priority import EMULATED_LINE, realtime_priority
 from ..protocol.timing import CHAR_TIME
 from ..sim.bus import BusDevice, Frame
@@ -43,6 +44,7 @@ RT_SPIN = 0.0001  # s: the same with a real-time class, whose sleeps end within 
 LATE_NOTICE = 2e-3  # s: a frame committed later than this behind plan is counted as late
 MAX_IDLE_WAIT = 0.05  # s: the thread re-checks its stop flag at least this often
 SPACINGS_KEPT = 4  # the recorder's breaks whose length an echo still due may ask for
+STALLS_KEPT = 8  # the latest noted stalls a late frame's planned start is looked up in
 
 
 @runtime_checkable
@@ -110,6 +112,7 @@ class RealTimeLine:
         clock: Callable[[], float] = time.perf_counter,
         bench: BenchModel | None = None,
         on_failure: Callable[[BaseException], None] | None = None,
+        on_stall: Callable[[float], None] | None = None,
     ) -> None:
         self.device = device
         self.bench = bench or BenchModel()
@@ -149,6 +152,17 @@ class RealTimeLine:
         self.worst_lateness = 0.0
         self.late_frames = 0  # committed more than LATE_NOTICE after their planned start
         self._stretch_worst = 0.0  # worst lateness since the last mark()
+        # told (on the line's thread) the length (s) of each stall of this process the line's
+        # thread measured (it came back that much later than it planned): the served line
+        # notes it in its transcript (:mod:`~conformance.links.host_stall`), whose judges then
+        # read what it held up as the host's, not the recorder's (truth32)
+        self._on_stall = on_stall
+        # the noted stalls' spans (s, s): a frame due inside one went out late because of it
+        self._stalls: deque[tuple[float, float]] = deque(maxlen=STALLS_KEPT)
+        #: the worst lateness of a frame due outside every noted stall (what no note explains)
+        self.unexplained_lateness = 0.0
+        self.stalls_noted = 0
+        self._expected = inf  # when the line's thread planned to run again at the latest
         # listeners on the line itself (``emulate --tap``): every character on the wire, the
         # recorder's and the sensor's, at its stop bit, as a UART on the bus would read it
         self._taps: list[Callable[[bytes], None]] = []
@@ -329,6 +343,11 @@ class RealTimeLine:
         )
         if lost:
             text += f"; {lost} sensor frames lost under the recorder's raised RTS"
+        if self._on_stall is not None:
+            text += (
+                f"; {self.stalls_noted} stalls of this process noted since the line started,"
+                f" the worst lateness outside them {self.unexplained_lateness * 1e3:.1f} ms"
+            )
         return text
 
     def start(self) -> RealTimeLine:
@@ -360,14 +379,40 @@ class RealTimeLine:
         spin = RT_SPIN if self.realtime_priority else SPIN  # a spinning RT thread starves others
         while not self._stop.is_set():
             with self._cond:
-                nxt = self._next_due()
                 now = self.now()
+                self._back(now)
+                nxt = self._next_due()
                 if nxt > now + spin:
-                    self._cond.wait(min(nxt - now - spin, MAX_IDLE_WAIT))
+                    timeout = min(nxt - now - spin, MAX_IDLE_WAIT)
+                    self._expected = now + timeout  # back by then at the latest
+                    self._cond.wait(timeout)
                     continue
+            self._expected = max(nxt, now)
             while self.now() < nxt:
                 time.sleep(0)
+            self._back(self.now())  # its next turn comes right after the step
             self._step()
+
+    def _back(self, now: float) -> None:
+        """The line's thread runs again at ``now``, planned to by ``_expected`` (the end of
+        its wait, the frame it spun for, the step it began): where it came back more than
+        :data:`~conformance.links.host_stall.STALL_MIN` later, the whole process was held
+        up (a loaded host, a paused process): noted (:meth:`_stalled`)."""
+        if self._on_stall is None:
+            return
+        stall = now - self._expected
+        self._expected = now
+        if stall > STALL_MIN:
+            self._stalled(stall, now)
+
+    def _stalled(self, stall: float, now: float) -> None:
+        """A stall of this process of ``stall`` s that ended by ``now``: told to
+        ``on_stall`` and kept, so the frames it made late are known to be its doing."""
+        # the span its note covers (host_stall.Stall): what was due in it, or just after it
+        # while the line caught up, went out late for the stall
+        self._stalls.append((now - stall - REACH, now + AFTER))
+        self.stalls_noted += 1
+        self._on_stall(stall)  # type: ignore[misc]
 
     def _next_due(self) -> float:
         """When the line next has something to do (device frame start, a queued action, or
@@ -427,6 +472,11 @@ class RealTimeLine:
             self.worst_lateness = max(self.worst_lateness, lateness)
             self._stretch_worst = max(self._stretch_worst, lateness)
             self.late_frames += lateness > LATE_NOTICE
+            if lateness > LATE_NOTICE and not self._stalled_at(frame.start):
+                if lateness > STALL_MIN and self._on_stall is not None:
+                    self._stalled(lateness, self.now())  # held up where no turn showed it
+                else:
+                    self.unexplained_lateness = max(self.unexplained_lateness, lateness)
             if self.bench.require_rts and self._rts:
                 self.lost_frames += 1  # the recorder's driver still holds the line
                 return
@@ -436,6 +486,10 @@ class RealTimeLine:
             if self._deliver_at_end:
                 deliver = self._delivery.time(deliver)
             self._push(deliver, lambda w=frame.wire: self._emit(w))
+
+    def _stalled_at(self, when: float) -> bool:
+        """Whether a noted stall of this process spans ``when`` (a frame's planned start)."""
+        return any(start <= when <= end for start, end in self._stalls)
 
     def _emit(self, wire: int, echo: bool = False) -> None:
         self.frames_sent += not echo

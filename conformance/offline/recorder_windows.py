@@ -27,6 +27,7 @@ from ..judges.recorder.capabilities import Addresses
 from ..judges.recorder.commands import CharacterGaps, CommandBitRate, CommandText
 from ..judges.recorder.measurements import ObservedMeasurement, ObservedMeasurements
 from ..judges.recorder.retries import Retries
+from ..links.host_stall import Stall
 from ..transcript import Event, EventKind
 from ..verdicts import Finding
 from ..view.segments import TranscriptView, memo, read_view
@@ -54,20 +55,26 @@ class RecorderFindings:
     windows: int
 
 
-def judge_windows(windows: Iterable[list[Event]], uncertainty: float) -> RecorderFindings:
+def judge_windows(
+    windows: Iterable[list[Event]], uncertainty: float, stalls: Sequence[Stall] = ()
+) -> RecorderFindings:
     """Every fold fed each of ``windows`` (in order, together a recording's events), each
     window's view read alone and let go."""
-    return judge_views((read_view(w) for w in windows), uncertainty)
+    return judge_views((read_view(w) for w in windows), uncertainty, stalls)
 
 
-def judge_views(views: Iterable[TranscriptView], uncertainty: float) -> RecorderFindings:
+def judge_views(
+    views: Iterable[TranscriptView], uncertainty: float, stalls: Sequence[Stall] = ()
+) -> RecorderFindings:
     """Every fold fed each of ``views`` (each window's, read alone, in order), each let go
     once every fold has taken it. No window at all (a recording with no events) is judged
-    as the whole-run functions judge an empty view: one empty window."""
-    breaks, rules = Breaks(uncertainty), BreakRules(uncertainty)
-    text, gaps = CommandText(uncertainty), CharacterGaps(uncertainty)
+    as the whole-run functions judge an empty view: one empty window. ``stalls``: the tool's
+    host stalls noted in the recording (a window's view holds no notes), which the folds
+    that read them hold deviations across (truth32)."""
+    breaks, rules = Breaks(uncertainty, stalls), BreakRules(uncertainty, stalls)
+    text, gaps = CommandText(uncertainty, stalls), CharacterGaps(uncertainty, stalls)
     rate, taken = CommandBitRate(uncertainty), ObservedMeasurements(uncertainty)
-    retries, addresses = Retries(uncertainty), Addresses(uncertainty)
+    retries, addresses = Retries(uncertainty, stalls), Addresses(uncertainty)
     folds = (breaks, rules, text, gaps, rate, taken, retries, addresses)
     count = 0
     for view in views:
@@ -114,11 +121,12 @@ def recorder_findings(link: RecordingLink) -> RecorderFindings:
     (:func:`~.sensor_windows.bus_windows`, which the sensors on the bus and the notes read
     too), each window's view read again from its events and the sides the cut inferred,
     the views :func:`~conformance.view.windows.stream_window_views` gives (not cut again)."""
-    from .sensor_windows import bus_windows
+    from .sensor_windows import bus_windows, noted_stalls
 
     def judge() -> RecorderFindings:
         bus = bus_windows(link)
-        return judge_views(map(bus.view, range(len(bus))), link.uncertainty)
+        stalls = noted_stalls(link.transcript.events)
+        return judge_views(map(bus.view, range(len(bus))), link.uncertainty, stalls)
 
     return memo(link, "_recorder_findings", len(link.transcript.events), judge)
 

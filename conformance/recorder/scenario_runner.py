@@ -149,6 +149,11 @@ class RecorderSession(Session):
         """How far the served line fell behind its schedule (s; 0 on the sim bus)."""
         return self.served.line.worst_lateness if self.served is not None else 0.0
 
+    def unexplained_lateness(self) -> float:
+        """How far the served line fell behind its schedule for frames due outside every
+        stall of this process it noted (s; 0 on the sim bus)."""
+        return self.served.line.unexplained_lateness if self.served is not None else 0.0
+
     @property
     def bus(self) -> SimBus:
         """The virtual-time bus the played sensors go on (not on a served line)."""

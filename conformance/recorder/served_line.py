@@ -31,6 +31,7 @@ from ..emulator_server.realtime import RealTimeLine
 from ..emulator_server.servers import TcpEmulatorServer
 from ..links.base import BusEnd, LinkInfo
 from ..links.factory import LOCAL_NET_UNCERTAINTY, REMOTE_NET_UNCERTAINTY, _is_loopback
+from ..links.host_stall import note_text as stall_note
 from ..links.priority import quick_gil_handover
 from ..ports import PortError
 from ..sim.bus import BusDevice, Frame, earliest_frame
@@ -209,7 +210,9 @@ class ServedLine(BusEnd):
         self.info = LinkInfo(kind=SCHEME, can_break=True, timing_uncertainty=uncertainty)
         self._t0 = time.perf_counter()
         self.bus = PlayedBus(uncertainty, self.now)
-        self.line = RealTimeLine(self.bus, lambda _data: None, clock=self.now)
+        self.line = RealTimeLine(
+            self.bus, lambda _data: None, clock=self.now, on_stall=self._stalled
+        )
         self.log: list[str] = []
         try:
             self.server = TcpEmulatorServer(self.line, host, spec.port, log=self.log.append)
@@ -238,6 +241,13 @@ class ServedLine(BusEnd):
 
     def note(self, text: str) -> None:
         self.bus.add(Event(EventKind.NOTE, TOOL, self.now(), self.now(), text=text))
+
+    def _stalled(self, stall: float) -> None:
+        """The line's thread came back ``stall`` s late: this process was held up, the played
+        sensors with it (and an in-process recorder). Noted as the serial link notes its
+        reader's (:mod:`~conformance.links.host_stall`), so the recorder judges read what it
+        held up as the tool's host's doing, not the recorder's (truth32)."""
+        self.note(stall_note(stall))
 
     def settle(self, longest: float) -> None:
         """Wait (at most ``longest`` s) until the line has been quiet for :data:`QUIET` and no

@@ -22,11 +22,12 @@ import re
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
-from itertools import repeat
-from operator import attrgetter, eq
+from itertools import compress, repeat
+from operator import attrgetter, eq, is_
 from sys import intern
 from typing import Any, TypeVar
 
+from ..links.host_stall import Stall, stalled_over, stalls
 from ..protocol.binary import packet_length
 from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, parse_command
 from ..protocol.framing import ETX, LF, STX
@@ -72,6 +73,8 @@ _COMMAND_STARTS = frozenset(map(ord, ADDRESS_CHARS + "?"))
 _START = attrgetter("start")  # events in time order
 _TEXT = attrgetter("text")
 _ORIGIN = attrgetter("origin")
+_KIND = attrgetter("kind")
+_NOTE = EventKind.NOTE
 
 
 def on_tool_link(event: Event) -> bool:
@@ -412,6 +415,15 @@ class TranscriptView:
     #: parts whose job the recorder ended itself (done or cannot), with the line time it did:
     #: a reply that began after it was never heard by the recorder in that job
     ended_parts: dict[int, float] = field(default_factory=dict)
+    #: stalls of the tool's own host its link noted among the recording's events
+    #: (:func:`~conformance.links.host_stall.stalls`): what they may have held up is the
+    #: host's doing, not the recorder's (truth32)
+    stalls: list[Stall] = field(default_factory=list)
+
+    def stalled_over(self, start: float, end: float) -> Stall | None:
+        """The first noted stall that may have held up the line between ``start`` and
+        ``end`` (:func:`~conformance.links.host_stall.stalled_over`), None for most views."""
+        return stalled_over(self.stalls, start, end) if self.stalls else None
 
     @property
     def commands(self) -> list[Transmission]:
@@ -574,6 +586,10 @@ def read_view(
     inferred from the protocol (:func:`~conformance.view.direction.infer_directions`);
     characters it cannot place are kept apart in ``undirected``.
     """
+    if not isinstance(events, list):
+        events = list(events)  # read twice: its notes, then its events by start
+    # the notes of the tool's host stalls (its link's, or a served line's): most have none
+    noted = stalls(compress(events, map(is_, map(_KIND, events), repeat(_NOTE))))
     ordered = in_start_order(events)
     undirected: list[Event] = []
     mine: Iterable[bool]
@@ -583,7 +599,9 @@ def read_view(
         ordered, undirected, mine = _inferred(ordered)
     else:
         mine = map(eq, map(_ORIGIN, ordered), repeat(TOOL))  # on_tool_link of each, in C
-    return _cut(ordered, mine, part, undirected)
+    view = _cut(ordered, mine, part, undirected)
+    view.stalls = noted
+    return view
 
 
 def read_sides(events: list[Event]) -> tuple[TranscriptView, bytearray | None]:
@@ -790,6 +808,7 @@ def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:
         [c for v in views for c in v.chars],
         [c for v in views for c in v.unanswerable],
         [c for v in views for c in v.undirected],
+        stalls=[stall for v in views for stall in v.stalls],
     )
 
 

@@ -153,8 +153,8 @@ def test_the_passive_recorder_cases_read_the_windowed_findings(tmp_path, monkeyp
     made: list[int] = []
     original = recorder_windows.judge_views
 
-    def counted(views, uncertainty):  # type: ignore[no-untyped-def]
-        found = original(views, uncertainty)
+    def counted(views, uncertainty, *stalls):  # type: ignore[no-untyped-def]
+        found = original(views, uncertainty, *stalls)
         made.append(found.windows)
         return found
 

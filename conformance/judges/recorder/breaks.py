@@ -4,8 +4,10 @@ after a break the line held back, :func:`_after_held_back`), and when a break is
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
+from ...links.host_stall import Stall
 from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...transcript import HELD_BACK, Event
 from ...verdicts import Finding, Verdict
@@ -13,6 +15,7 @@ from ...view.segments import TranscriptView, Transmission
 from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
 from .common import SR_KINDS, combine, own_uncertainty
 from .measurements import service_request_end
+from .stalls import hold
 
 #: R-7.0-02's and R-7.0-06's windows, worked out once for the many breaks of a recording
 BREAK_LENGTH = Window("R-7.0-02", "break length", low=BREAK_MIN)
@@ -22,7 +25,7 @@ MARKING = Window("R-7.0-06", "marking after the break", low=MARKING_AFTER_BREAK)
 def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-02: every break lasts at least 12 ms. R-7.0-06: after a break the recorder marks
     at least 8.33 ms before the first start bit of its command (both ±0.40 ms)."""
-    judge = Breaks(uncertainty)
+    judge = Breaks(uncertainty, line.stalls)
     judge.add(line)
     return judge.findings()
 
@@ -33,10 +36,12 @@ class Breaks:
     What it keeps across windows is one observation per distinct length and marking
     (:class:`~..timing.Repeats`), never a window's events."""
 
-    def __init__(self, uncertainty: float) -> None:
+    def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
         self.uncertainty = uncertainty
-        self.lengths: list[MeasuredAsJudged] = []
-        self.markings: list[MeasuredAsJudged] = []
+        #: the tool's host stalls noted in the recording (a window's view holds none)
+        self.stalls = list(stalls)
+        self.lengths: list[MeasuredAsJudged | Finding] = []
+        self.markings: list[MeasuredAsJudged | Finding] = []
         self._lengths_seen: Repeats[MeasuredAsJudged] = Repeats()
         self._markings_seen: Repeats[MeasuredAsJudged] = Repeats()
 
@@ -49,6 +54,7 @@ class Breaks:
         # an interval equal to one judged before is that one again (Repeats), so the breaks
         # hold one object per distinct length and marking
         uncertainty = self.uncertainty
+        stalls = self.stalls or line.stalls
         seen = self._lengths_seen
         for b in line.breaks:
             length, u = b.duration, max(uncertainty, b.duration_uncertainty or 0.0)
@@ -56,7 +62,10 @@ class Breaks:
                 MeasuredAsJudged(BREAK_LENGTH, length, u, [f"break at t={b.start:.3f} s"])
             )
             held = b.text == HELD_BACK and judged.verdict is not Verdict.PASS
-            self.lengths.append(_held_back_short(judged, b) if held else judged)
+            if held:
+                self.lengths.append(_held_back_short(judged, b))
+            else:
+                self.lengths.append(hold(stalls, judged, b.start, b.end))
         seen = self._markings_seen
         for s in line.transmissions:
             brk = s.break_event
@@ -68,7 +77,10 @@ class Breaks:
                 MeasuredAsJudged(MARKING, marking, u, [f"before {s.at()}"])
             )
             held = brk.text == HELD_BACK and judged.verdict is not Verdict.PASS
-            self.markings.append(_after_held_back(judged, s) if held else judged)
+            if held:
+                self.markings.append(_after_held_back(judged, s))
+            else:
+                self.markings.append(hold(stalls, judged, brk.end, s.first_char))
 
     def findings(self) -> list[Finding]:
         """R-7.0-02 and R-7.0-06 over everything added."""
@@ -121,7 +133,7 @@ def judge_break_rules(line: TranscriptView, uncertainty: float) -> list[Finding]
     """R-7.0-17: a break before every command to a different sensor than the last one, or after
     more than 87 ms of marking. R-7.1-01: ``aD0!`` without a break only within 87 ms of the
     service request."""
-    judge = BreakRules(uncertainty)
+    judge = BreakRules(uncertainty, line.stalls)
     judge.add(line)
     return judge.findings()
 
@@ -134,8 +146,10 @@ class BreakRules:
     window before (a command sent without a break first in its window is timed from the
     line's last activity there) and the count of commands (R-7.0-17's PASS says how many)."""
 
-    def __init__(self, uncertainty: float) -> None:
+    def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
         self.uncertainty = uncertainty
+        #: the tool's host stalls noted in the recording (a window's view holds none)
+        self.stalls = list(stalls)
         self.rule17: list[Finding] = []
         self.rule71: list[Finding] = []
         self.previous: Transmission | None = None
@@ -155,6 +169,7 @@ class BreakRules:
     def add(self, line: TranscriptView) -> None:
         """The commands of ``line`` (the next window of the recording)."""
         uncertainty, rule17, rule71 = self.uncertainty, self.rule17, self.rule71
+        stalls = self.stalls or line.stalls
         previous = self.previous
         for s in line.transmissions:
             if previous is not None and previous.part != s.part:
@@ -164,17 +179,23 @@ class BreakRules:
                 where = [f"before {s.at()}"]
                 if previous is None or previous.address != s.address:
                     who = "no earlier command" if previous is None else f"last was {previous.text}"
-                    rule17.append(
-                        Finding(
-                            "R-7.0-17",
-                            Verdict.FAIL,
-                            f"no break before {s.at()}, a new sensor ({who}){short}",
-                            evidence=where,
-                            observed=1,
-                        )
+                    missing = Finding(
+                        "R-7.0-17",
+                        Verdict.FAIL,
+                        f"no break before {s.at()}, a new sensor ({who}){short}",
+                        evidence=where,
+                        observed=1,
                     )
+                    # spacing too short to be a break, read across a stall: the recorder's
+                    # break and its end came in one late read (truth32: a 0.00 ms break
+                    # laid with the command the stall held back); no spacing at all stands
+                    brk = s.break_event
+                    if brk is not None and short:
+                        missing = hold(stalls, missing, brk.start, brk.end)
+                    rule17.append(missing)
                 else:  # timed from the line's activity before it (before the short spacing)
-                    quiet = s.first_char - (self._previous_activity(line, s) or float("-inf"))
+                    began = self._previous_activity(line, s) or float("-inf")
+                    quiet = s.first_char - began
                     judged = judge_window(
                         "R-7.0-17",
                         "marking before a command sent without a break",
@@ -185,20 +206,19 @@ class BreakRules:
                     )
                     if short and judged.verdict is not Verdict.PASS:
                         judged.detail += short
-                    rule17.append(judged)
+                    rule17.append(hold(stalls, judged, began, s.first_char, NO_BREAK_WINDOW))
                 if previous is not None and _follows_service_request(previous, s):
                     sr_end = service_request_end(previous.after, s.address)
                     assert sr_end is not None
-                    rule71.append(
-                        judge_window(
-                            "R-7.1-01",
-                            "aD0! without a break after the service request",
-                            s.first_char - sr_end,
-                            own_uncertainty(uncertainty, s.chars[0]),
-                            high=NO_BREAK_WINDOW,
-                            evidence=where,
-                        )
+                    judged = judge_window(
+                        "R-7.1-01",
+                        "aD0! without a break after the service request",
+                        s.first_char - sr_end,
+                        own_uncertainty(uncertainty, s.chars[0]),
+                        high=NO_BREAK_WINDOW,
+                        evidence=where,
                     )
+                    rule71.append(hold(stalls, judged, sr_end, s.first_char, NO_BREAK_WINDOW))
             elif previous is not None and _follows_service_request(previous, s):
                 rule71.append(
                     Finding(

@@ -3,15 +3,20 @@ the gaps between them (R-7.0-13, R-7.0-01); their bit rate (R-4.1-01)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+from ...links.host_stall import Stall, stalled_over
 from ...protocol.commands import ADDRESS_CHARS
 from ...protocol.timing import CHAR_TIME, INTER_CHAR_GAP_MAX, TOLERANCE
 from ...transcript import Event, escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import NEW_COMMAND, TranscriptView, Transmission
+from ..stalled import held_by
 from ..tally import Tally
 from ..timing import MeasuredIn, Repeats, Window
 from ..wire import judge_frame_lengths, judge_rate
 from .common import combine, own_uncertainty
+from .stalls import hold
 
 #: R-7.0-13's window, worked out once for the many gaps of a recording
 COMMAND_GAP = Window(
@@ -53,7 +58,7 @@ def judge_command_text(line: TranscriptView, uncertainty: float = 0.0) -> list[F
     """R-4.2-01 printable command characters; R-4.4-04 ``!`` last and nowhere else, and no
     part a sensor drops for want of it (:func:`_dropped`); R-4.3-01 the first character is
     the address (``?`` only in ``?!``)."""
-    judge = CommandText(uncertainty)
+    judge = CommandText(uncertainty, line.stalls)
     judge.add(line)
     return judge.findings()
 
@@ -63,13 +68,16 @@ class CommandText:
     window's view :meth:`add`-ed in order, the findings those of the whole view. It keeps
     the tally's labels (one short string a command), none of a window's events."""
 
-    def __init__(self, uncertainty: float = 0.0) -> None:
+    def __init__(self, uncertainty: float = 0.0, stalls: Sequence[Stall] = ()) -> None:
         self.tally = Tally(("R-4.2-01", "R-4.4-04", "R-4.3-01"))
         self.uncertainty = uncertainty
+        #: the tool's host stalls noted in the recording (a window's view holds none)
+        self.stalls = list(stalls)
 
     def add(self, line: TranscriptView) -> None:
         """The commands of ``line`` (the next window of the recording)."""
         tally = self.tally
+        self._stalls = self.stalls or line.stalls
         for s in line.transmissions:
             text, where = s.text, escape(s.text)
             bad = [c for c in text if not 0x20 <= ord(c) <= 0x7E]
@@ -103,14 +111,26 @@ class CommandText:
         chars = s.chars
         for i, (a, b) in enumerate(zip(chars, chars[1:], strict=False)):
             gap = b.start - a.end
-            if _dropped(gap, own_uncertainty(self.uncertainty, a, b), False, s, a, b):
+            u = own_uncertainty(self.uncertainty, a, b)
+            if _dropped(gap, u, False, s, a, b):
                 part = escape("".join(chr(e.wire & 0x7F) for e in chars[: i + 1]))
-                self.tally.fail(
+                where = escape(s.text)
+                dropped = Finding(
                     "R-4.4-04",
-                    escape(s.text),
+                    Verdict.FAIL,
                     f"'{part}' then {gap * 1e3:.2f} ms of marking with no '!': a sensor "
                     "drops it there (App. B)",
+                    measured_ms=gap * 1e3,
+                    uncertainty_ms=u * 1e3,
+                    evidence=[where],
+                    observed=1,
                 )
+                # a gap the tool's host stalled across: its own doing, or its stamps' (truth32)
+                held = hold(self._stalls, dropped, a.start, b.end, NEW_COMMAND)
+                if held.verdict is Verdict.FAIL:
+                    self.tally.fail("R-4.4-04", where, dropped.detail)
+                else:
+                    self.tally.undecide("R-4.4-04", where, held.detail)
                 return
             if a.wire & 0x7F == _BANG:
                 return
@@ -123,7 +143,7 @@ class CommandText:
 def judge_character_gaps(line: TranscriptView, uncertainty: float) -> list[Finding]:
     """R-7.0-13: at most 1.66 ms of marking between the characters of a command (no
     tolerance); R-7.0-01: no gap leans on the ±0.40 ms that this limit does not have."""
-    judge = CharacterGaps(uncertainty)
+    judge = CharacterGaps(uncertainty, line.stalls)
     judge.add(line)
     return judge.findings()
 
@@ -139,11 +159,15 @@ class CharacterGaps:
     holding the one transmission its evidence names) and, of the gaps inside the tolerance
     band, the first few R-7.0-01 quotes and how many there were."""
 
-    def __init__(self, uncertainty: float) -> None:
+    def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
         self.uncertainty = uncertainty
+        #: the tool's host stalls noted in the recording (a window's view holds none)
+        self.stalls = list(stalls)
         # one judged interval each, its finding (and evidence line) made only where the
         # verdict shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
-        self.found: list[MeasuredIn] = []
+        self.found: list[MeasuredIn | Finding] = []
+        # the first gap inside the tolerance band a noted stall covers, and its stall
+        self.leaning_stalled: tuple[float, Transmission, Stall] | None = None
         self.leaning: list[tuple[float, Transmission]] = []  # the first LEANING_SHOWN
         self.leaning_count = 0
         # a gap equal to one judged before is that interval again (its first one: Repeats)
@@ -156,6 +180,7 @@ class CharacterGaps:
     def add(self, line: TranscriptView) -> None:
         """The command character gaps of ``line`` (the next window of the recording)."""
         uncertainty, found, judged = self.uncertainty, self.found, self._judged
+        stalls = self.stalls or line.stalls
         for s in line.transmissions:
             chars = s.chars
             bang_seen = False
@@ -166,10 +191,16 @@ class CharacterGaps:
                 if _dropped(gap, u, bang_seen, s, a, b):
                     self._keep_dropped(gap, s)
                     continue
-                found.append(
-                    judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s))
-                )
+                m = judged.first(gap, u) or judged.keep(MeasuredIn(COMMAND_GAP, gap, u, s))
+                # a gap the tool's host stalled across (truth32): its stamps, or an
+                # in-process recorder held up with the host, are the host's doing
+                found.append(hold(stalls, m, a.start, b.end, INTER_CHAR_GAP_MAX) if stalls else m)
                 if INTER_CHAR_GAP_MAX < gap <= INTER_CHAR_GAP_MAX + TOLERANCE:
+                    stall = stalled_over(stalls, a.start, b.end) if stalls else None
+                    if stall is not None:
+                        if self.leaning_stalled is None:
+                            self.leaning_stalled = (gap, s, stall)
+                        continue
                     self.leaning_count += 1
                     if len(self.leaning) < LEANING_SHOWN:
                         self.leaning.append((gap, s))
@@ -205,16 +236,10 @@ class CharacterGaps:
         found, leaning = self.found, self.leaning
         if leaning:
             gap, s = leaning[0]
-            tol = Finding(
-                "R-7.0-01",
-                Verdict.FAIL,
-                f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which "
-                f"the 1.66 ms character gap does not have ({self.leaning_count} such gap(s))",
-                measured_ms=round(gap * 1e3, 3),
-                limit_ms=INTER_CHAR_GAP_MAX * 1e3,
-                evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in leaning],
-                observed=len(found),
-            )
+            tol = _leaning(gap, s, leaning, self.leaning_count, len(found))
+        elif self.leaning_stalled is not None:
+            gap, s, stall = self.leaning_stalled
+            tol = held_by(_leaning(gap, s, [(gap, s)], 1, len(found)), stall)
         elif found:
             tol = Finding(
                 "R-7.0-01",
@@ -228,6 +253,23 @@ class CharacterGaps:
         undecided = self._undecided()
         judged = [*found, *undecided] if undecided else found
         return [combine("R-7.0-13", judged, "character gap"), tol]
+
+
+def _leaning(
+    gap: float, s: Transmission, shown: list[tuple[float, Transmission]], count: int, of: int
+) -> Finding:
+    """R-7.0-01's FAIL: the first of ``count`` gaps inside the tolerance band the 1.66 ms
+    limit does not have (``gap`` in ``s``; ``shown`` quoted), of ``of`` gaps judged."""
+    return Finding(
+        "R-7.0-01",
+        Verdict.FAIL,
+        f"a {gap * 1e3:.2f} ms gap in {s.at()} relies on the ±0.40 ms tolerance, which "
+        f"the 1.66 ms character gap does not have ({count} such gap(s))",
+        measured_ms=round(gap * 1e3, 3),
+        limit_ms=INTER_CHAR_GAP_MAX * 1e3,
+        evidence=[f"{g * 1e3:.2f} ms gap in {t.at()}" for g, t in shown],
+        observed=of,
+    )
 
 
 def judge_command_bit_rate(line: TranscriptView, uncertainty: float) -> Finding:

@@ -11,9 +11,10 @@ after a long poll timeout, must not pass "implements retries")."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
+from ...links.host_stall import Stall
 from ...protocol.timing import (
     CHAR_TIME,
     RESPONSE_START_MAX,
@@ -32,6 +33,7 @@ from ..timing import judge_window
 from .common import combine, own_uncertainty
 from .logged import same_values
 from .replies import crc_context, cut_off, reply_problem
+from .stalls import hold
 
 #: Marking after which a sensor is in standby (R-7.0-15, +0.40 ms): a command sent again
 #: without a break after longer than this is not a retry but a new try without its break.
@@ -200,7 +202,7 @@ def judge_retries(line: TranscriptView, uncertainty: float) -> list[Finding]:
     (SHOULD) three sequences before giving up, judged only where a sequence held a retry;
     R-7.2-05 every missing or invalid reply triggered a retry; R-7.2-06 the retry waited for
     the invalid reply to end."""
-    judge = Retries(uncertainty)
+    judge = Retries(uncertainty, line.stalls)
     judge.add(line)
     return judge.findings()
 
@@ -214,17 +216,21 @@ class Retries:
     carries and the findings gathered (the tally's counts and labels, each retry's timing
     finding, the cuts). :meth:`findings` once, at the end."""
 
-    def __init__(self, uncertainty: float) -> None:
+    def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
         self.uncertainty = uncertainty
         self._groups = RetryGroups(uncertainty)
         self._resent: list[Finding] = []  # R-7.2-06's FAILs of cut_replies
         self._restarted: list[str] = []  # and the cuts it only names
         self._acc = _RetryEvidence(Tally(("R-7.2-01", "R-7.2-04", "R-7.2-05")))
+        #: the tool's host stalls noted in the recording (a window's view holds none)
+        self._acc.stalls = list(stalls)
 
     def add(self, line: TranscriptView) -> None:
         """Take the next window's view."""
+        acc = self._acc
+        acc.stalls = acc.stalls or line.stalls
         self._judge(self._groups.add(line))
-        resent, restarted = cut_replies(line, self.uncertainty)
+        resent, restarted = cut_replies(line, self.uncertainty, acc.stalls)
         self._resent += resent
         self._restarted += restarted
 
@@ -271,6 +277,17 @@ class _RetryEvidence:
     ends: list[Finding] = field(default_factory=list)  # R-7.2-06
     #: invalid replies followed by a new sequence, not a retry (R-7.2-06's INCONCLUSIVE)
     restarted: list[str] = field(default_factory=list)
+    #: the tool's host stalls noted in the recording (truth32)
+    stalls: Sequence[Stall] = ()
+
+    def across(
+        self, finding: Finding, start: float, end: float, high: float | None = None
+    ) -> Finding:
+        """``finding`` on the line between ``start`` and ``end``, or where it FAILs or
+        WARNs across noted stalls of the tool's host that can account for it (:func:`.stalls.
+        hold`: they held up the played sensor's reply, an in-process recorder, or the
+        stamps), INCONCLUSIVE naming the first; as before outside any stall."""
+        return hold(self.stalls, finding, start, end, high)
 
 
 def _judge_group(
@@ -293,7 +310,7 @@ def _judge_group(
         _judge_tries(line, seq, later, where, uncertainty, acc)
         if any(a.problem is None for a in seq) or not gave_up:
             continue
-        _judge_given_up(line, seq, f"{where} sequence {n + 1}", uncertainty, acc.third)
+        _judge_given_up(line, seq, f"{where} sequence {n + 1}", uncertainty, acc)
     _judge_repeated(acc.tally, group, where, sequences, real, gave_up)
 
 
@@ -330,6 +347,7 @@ def _judge_tries(
         if a.problem is None:
             continue
         nxt = seq[k + 1] if k + 1 < len(seq) else None
+        began = _quiet_from(line, a) if acc.stalls else a.sent.start
         if nxt is None and len(seq) < 3:
             acc.tally.fail(
                 "R-7.2-05",
@@ -341,64 +359,74 @@ def _judge_tries(
         # command (the recorder talked over them) leave that window undecided
         if a.problem is NO_REPLY and not a.sent.contention:
             if nxt is not None:
-                acc.window.append(
-                    judge_window(
-                        "R-7.2-02",
-                        "retry after no reply",
-                        nxt.sent.first_char - a.sent.end,
-                        own_uncertainty(uncertainty, a.sent.chars[-1], nxt.sent.chars[0]),
-                        low=RETRY_MIN,
-                        high=RETRY_MAX,
-                        evidence=[nxt.sent.at()],
-                    )
+                judged = judge_window(
+                    "R-7.2-02",
+                    "retry after no reply",
+                    nxt.sent.first_char - a.sent.end,
+                    own_uncertainty(uncertainty, a.sent.chars[-1], nxt.sent.chars[0]),
+                    low=RETRY_MIN,
+                    high=RETRY_MAX,
+                    evidence=[nxt.sent.at()],
                 )
+                acc.window.append(acc.across(judged, began, nxt.sent.first_char, RETRY_MAX))
             elif k == 0:
-                acc.window.append(
-                    Finding(
-                        "R-7.2-02",
-                        Verdict.FAIL,
-                        f"no retry without a break after no reply to {a.sent.at()}: "
-                        f"{a.instead(later)}",
-                        evidence=[a.sent.at()]
-                        + ([f"next: {later.sent.at()}"] if later is not None else []),
-                        observed=1,
-                    )
+                missing = Finding(
+                    "R-7.2-02",
+                    Verdict.FAIL,
+                    f"no retry without a break after no reply to {a.sent.at()}: {a.instead(later)}",
+                    evidence=[a.sent.at()]
+                    + ([f"next: {later.sent.at()}"] if later is not None else []),
+                    observed=1,
                 )
+                # the wait for the reply and what the recorder did instead: a stall there
+                # may have held the reply back (or the recorder, in the tool's process)
+                until = later.sent.first_char if later is not None else a.sent.end + STANDBY
+                acc.window.append(acc.across(missing, began, until))
         elif nxt is not None and nxt.in_window(uncertainty):
-            acc.ends.append(_retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty))
+            judged = _retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty)
+            acc.ends.append(acc.across(judged, began, nxt.sent.first_char))
         elif nxt is None and later is not None:
             acc.restarted.append(f"{a.after()}: {a.instead(later)}")
 
 
+def _quiet_from(line: TranscriptView, a: Try) -> float:
+    """Where the marking before try ``a`` began (the line's last activity before it): a
+    stall there (truth32) decides how long the sensor had been left alone when the try came,
+    and so whether it was awake to answer it (the in-process recorder, paused past the
+    sensor's 100 ms, sent its aD2! to a sensor asleep; no reply, then a break)."""
+    before = line.previous_activity(a.sent)
+    return a.sent.start if before is None else before
+
+
 def _judge_given_up(
-    line: TranscriptView, seq: list[Try], label: str, uncertainty: float, third: list[Finding]
+    line: TranscriptView, seq: list[Try], label: str, uncertainty: float, acc: _RetryEvidence
 ) -> None:
     """R-7.2-03 over a sequence that never drew a valid reply: two retries, the latest more
     than 100 ms after the break."""
     retries = seq[1:]
     if len(retries) < 2:
-        third.append(
-            Finding(
-                "R-7.2-03",
-                Verdict.FAIL,
-                f"{label}: {len(retries)} retries, then no more",
-                evidence=[a.sent.at() for a in seq],
-                observed=len(seq),
-            )
+        few = Finding(
+            "R-7.2-03",
+            Verdict.FAIL,
+            f"{label}: {len(retries)} retries, then no more",
+            evidence=[a.sent.at() for a in seq],
+            observed=len(seq),
         )
+        # the sequence's tries and the wait after its last (its reply, a retry due)
+        acc.third.append(acc.across(few, _quiet_from(line, seq[0]), seq[-1].sent.end + STANDBY))
         return
     brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
     if brk is not None:
-        third.append(
-            judge_window(
-                "R-7.2-03",
-                "latest retry after the end of the break",
-                max(r.sent.first_char for r in retries) - brk.end,
-                uncertainty,
-                low=RETRY_AFTER_BREAK,
-                evidence=[label],
-            )
+        latest = max(r.sent.first_char for r in retries)
+        judged = judge_window(
+            "R-7.2-03",
+            "latest retry after the end of the break",
+            latest - brk.end,
+            uncertainty,
+            low=RETRY_AFTER_BREAK,
+            evidence=[label],
         )
+        acc.third.append(acc.across(judged, brk.start, latest))
 
 
 def _judge_repeated(
@@ -429,7 +457,9 @@ def _judge_repeated(
         )
 
 
-def cut_replies(line: TranscriptView, uncertainty: float) -> tuple[list[Finding], list[str]]:
+def cut_replies(
+    line: TranscriptView, uncertainty: float, stalls: Sequence[Stall] = ()
+) -> tuple[list[Finding], list[str]]:
     """Replies the recorder's own break cut into (:func:`.replies.cut_off`): no invalid
     reply of the sensor's, so no retry was due (R-7.2-01, -03, -05 leave them out). Where
     the same command followed that break (the command sent again) over a single-line reply
@@ -459,16 +489,16 @@ def cut_replies(line: TranscriptView, uncertainty: float) -> tuple[list[Finding]
             and not (len(s.reply) > 1 and s.reply[1].char7 == STX)
             and early
         ):
-            failed.append(
-                Finding(
-                    "R-7.2-06",
-                    Verdict.FAIL,
-                    f"{cut}, and sent {escape(nxt.text)} again after it: it did not wait for"
-                    " the response to complete",
-                    evidence=[s.at(), nxt.at()],
-                    observed=1,
-                )
+            found = Finding(
+                "R-7.2-06",
+                Verdict.FAIL,
+                f"{cut}, and sent {escape(nxt.text)} again after it: it did not wait for"
+                " the response to complete",
+                evidence=[s.at(), nxt.at()],
+                observed=1,
             )
+            # a reply the tool's host stalled over (truth32): held back, its rest late
+            failed.append(hold(stalls, found, s.start, brk.end))
         else:
             named.append(f"{cut} (after {s.at()}): a new sequence, not a retry")
     return failed, named
@@ -479,7 +509,7 @@ def judge_breaks_over_replies(line: TranscriptView, uncertainty: float) -> list[
     the scenarios :func:`judge_retries` does not read, whose long replies a recorder with a
     short receive buffer or poll breaks into (breaks-over-long-reply: aHA!'s and aC9!'s
     75-character D replies)."""
-    return cut_replies(line, uncertainty)[0]
+    return cut_replies(line, uncertainty, line.stalls)[0]
 
 
 def _waited(ends: list[Finding], restarted: list[str]) -> Finding:

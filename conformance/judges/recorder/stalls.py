@@ -1,0 +1,88 @@
+"""The recorder rules whose findings stand where the served line's lateness is its stalls'
+(truth32).
+
+A stall of the tool's process (a loaded host, a paused process) moves what the served line
+or a listening link stamped around it, and on a served line it holds up the played sensors
+and an in-process recorder with it: a gap inside a command, a break's length or the marking
+before a command that spans one is the host's doing as much as the recorder's. The judges
+of the recorder's own timing read the noted stalls (:attr:`~conformance.view.segments.
+TranscriptView.stalls`) and hold a deviation whose decisive interval one covers, naming it
+(:func:`~conformance.judges.stalled.stalled_interval`, :func:`~conformance.judges.stalled.
+held_by`); outside every stall they judge as before. What they measure is the recorder's
+own doing alone, so where every late frame of a served run fell inside a noted stall the
+served line's whole-run guard (``ConformanceRun._guard_served_line``) leaves their findings
+as judged.
+
+The retry judges (R-7.2-02, -03, -06) hold what a noted stall covers too, but stay under
+the guard: a retry answers the played sensor's replies, and a stall's disorder outlives
+its window there (truth32's reproduction: a reply held back 135 ms met the in-process
+recorder's retry, and the sensor's next reply, 115 ms after the stall's note, began late
+enough that the recorder broke into it; R-7.2-06 FAILed on it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TypeVar
+
+from ...links.host_stall import REACH, Stall
+from ...verdicts import Finding, Verdict
+from ..stalled import stalled_interval
+from ..timing import Measured
+
+J = TypeVar("J", Finding, Measured)
+_DEVIATING = (Verdict.FAIL, Verdict.WARN)
+
+#: the rules whose judges read the stalls and measure the recorder's own timing alone
+READ_STALLS = frozenset(
+    {
+        "R-7.0-01",  # commands.CharacterGaps: a gap in the tolerance band across a stall
+        "R-7.0-13",  # commands.CharacterGaps: a gap inside a command across a stall
+        "R-4.4-04",  # commands.CommandText: a command's part 'dropped' at a gap across one
+        "R-7.0-02",  # breaks.Breaks: a break's length
+        "R-7.0-06",  # breaks.Breaks: the marking after a break
+        "R-7.0-17",  # breaks.BreakRules: the marking before a command sent without a break
+        "R-7.1-01",  # breaks.BreakRules: aD0! without a break after the service request
+    }
+)
+
+
+def hold(
+    stalls: Sequence[Stall],
+    judged: J,
+    start: float,
+    end: float,
+    high: float | None = None,
+) -> J | Finding:
+    """``judged`` (a finding on the line between ``start`` and ``end``), or where it FAILs
+    or WARNs across noted stalls of the tool's own host that can account for it, the same
+    INCONCLUSIVE naming the first (:func:`~conformance.judges.stalled.stalled_interval`).
+
+    A stall compresses what it held back into one late read (a break, a marking, a gap
+    read shorter, down to nothing), so any deviation of that kind across one is held. It
+    stretches an interval (a paused in-process recorder, a reply it held back) by at most
+    its own length: an interval over ``high`` (s) by more than the stalls over it may have
+    added (each its measured length and :data:`~conformance.links.host_stall.REACH`),
+    beyond its uncertainty, still FAILs (a recorder that sends aD0! without a break 2 s
+    after ttt is not excused by the 150 ms stall inside those 2 s)."""
+    if not stalls or judged.verdict not in _DEVIATING:
+        return judged
+    over = [stall for stall in stalls if stall.overlaps(start, end)]
+    if not over:
+        return judged
+    if high is not None:
+        measured, uncertainty = _figures(judged)
+        if measured is not None and measured > high:
+            added = sum(stall.ms / 1e3 + REACH for stall in over)
+            if measured - added - uncertainty > high:
+                return judged
+    return stalled_interval(judged, over[0])
+
+
+def _figures(judged: Finding | Measured) -> tuple[float | None, float]:
+    """The measured interval and its uncertainty (s) of ``judged``."""
+    if isinstance(judged, Measured):
+        return judged.measured, judged.uncertainty
+    if judged.measured_ms is None:
+        return None, 0.0
+    return judged.measured_ms / 1e3, (judged.uncertainty_ms or 0.0) / 1e3

@@ -1,0 +1,83 @@
+"""The real-time line notes a stall of its own process (truth32): its thread came back more
+than ``host_stall.STALL_MIN`` later than it planned (the end of a wait, the frame it spun for,
+the step it began), or committed a frame that late where no turn showed it. A frame made
+late inside a noted stall is the stall's; only lateness outside every noted stall is left
+for the served line's whole-run guard. Driven turn by turn on a clock the test sets."""
+
+from __future__ import annotations
+
+from conformance.emulator_server.realtime import RealTimeLine
+from conformance.sim.bus import Frame
+
+
+class OneFrame:
+    """A device with one frame to send at ``start``."""
+
+    def __init__(self, start: float) -> None:
+        self.frames = [Frame(start, 0x30)]
+
+    def next_frame(self) -> Frame | None:
+        return self.frames[0] if self.frames else None
+
+    def pop_frame(self) -> Frame:
+        return self.frames.pop(0)
+
+    def on_char(self, wire: int, start: float, end: float) -> None:
+        pass
+
+    def on_break(self, start: float, end: float) -> None:
+        pass
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.t = 0.0
+
+    def __call__(self) -> float:
+        return self.t
+
+
+def _line(start: float) -> tuple[RealTimeLine, Clock, list[float]]:
+    clock, noted = Clock(), []
+    line = RealTimeLine(OneFrame(start), lambda _b: None, clock=clock, on_stall=noted.append)
+    return line, clock, noted
+
+
+def test_a_turn_back_late_is_noted_and_the_frame_it_made_late_is_explained():
+    line, clock, noted = _line(1.0)
+    line._expected = 0.95  # a wait planned to end at 0.95 s
+    clock.t = 1.10  # the thread came back 150 ms late
+    line._back(clock.t)
+    assert [round(s, 3) for s in noted] == [0.15]
+    line._step()  # the frame due at 1.0 s went out 100 ms late: the stall's
+    assert line.worst_lateness > 0.09
+    assert line.unexplained_lateness == 0.0
+    assert "1 stalls of this process noted" in line.timekeeping()
+
+
+def test_a_turn_back_on_time_notes_nothing_and_lateness_outside_a_stall_is_unexplained():
+    line, clock, noted = _line(1.0)
+    line._expected = 1.0
+    clock.t = 1.005
+    line._back(clock.t)
+    line._step()  # 5 ms late, no stall: the guard's to judge, as before
+    assert noted == []
+    assert round(line.unexplained_lateness, 3) == 0.005
+
+
+def test_a_frame_late_past_the_stall_minimum_where_no_turn_showed_it_is_a_stall():
+    line, clock, noted = _line(1.0)
+    clock.t = 1.2
+    line._step()  # held up inside a step: no turn measured it, the frame's lateness does
+    assert [round(s, 3) for s in noted] == [0.2]
+    assert line.unexplained_lateness == 0.0
+
+
+def test_a_line_without_a_listener_keeps_its_figures_as_before():
+    clock = Clock()
+    line = RealTimeLine(OneFrame(1.0), lambda _b: None, clock=clock)
+    clock.t = 1.2
+    line._back(clock.t)
+    line._step()
+    assert round(line.worst_lateness, 3) == 0.2
+    assert "stalls of this process" not in line.timekeeping()
