@@ -876,7 +876,7 @@ _FAULTS = (
     RecorderFault(
         "ttt-8-bit",
         "Keeps the announced ttt in 8 bits (ttt % 256): told ttt = 260 s it waits 4 s, then "
-        "sends a break and aD0! before the service request (which comes after 5 s) and long "
+        "sends a break and aD0! before the service request (which comes after 6 s) and long "
         "before ttt, taking the line while that request could still come.",
         ("R-4.4.5-04", "R-4.4.5-07"),
         Parts(hooks=EightBitTttHooks, recorder=EightBitTttRecorder),

@@ -97,6 +97,15 @@ RECORDER_INTERACTIONS: tuple[Interaction, ...] = (
         adds=("R-7.1-01",),
     ),
     Interaction(
+        frozenset({"ignores-service-request", "short-break"}),
+        "ignores-service-request sends aD0! only after the whole ttt, 749 ms and more after"
+        " the service request, and short-break's 10 ms of spacing before it is no break"
+        " (R-7.0-02): aD0! long after the request with no break (R-7.1-01, true on the wire;"
+        " seed 7501, outside32). Alone the first breaks 12 ms and the second sends aD0! at"
+        " once.",
+        adds=("R-7.1-01",),
+    ),
+    Interaction(
         frozenset({"ignores-service-request", "late-d0-without-break"}),
         "ignores-service-request waits the whole ttt and sends aD0! after a break, so the"
         " unbroken aD0! 95 ms after the service request never goes out: R-7.1-01 holds on"

@@ -33,9 +33,12 @@ def _s(address: str = "0", **kw: object) -> SensorSpec:
 
 
 #: ttt of ``ttt-over-255`` and when its service request comes: a recorder keeping ttt in
-#: 8 bits waits 260 % 256 = 4 s and asks for aD0! before the request (real time: 5 s, cheap)
+#: 8 bits waits 260 % 256 = 4 s and asks for aD0! before the request (real time: 6 s, cheap).
+#: 6 s, not 5: EnviroDIY's d_simple_logger keeps ttt in a ``uint8_t`` and waits a second
+#: more, ``(wait + 1) * 1000`` ms from 0.1 s after the command, so 5.1 s: with the request
+#: at 5 s it heard the request first and passed (outside32)
 LONG_TTT = 260
-LONG_TTT_READY = 5.0
+LONG_TTT_READY = 6.0
 #: When ``reply-at-window-edge``'s sensor starts each reply: 15.0 ms after the command's stop
 #: bit, inside the 15.40 ms a sensor may take (R-7.0-10)
 EDGE_REPLY = 15.0e-3

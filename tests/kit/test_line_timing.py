@@ -99,6 +99,34 @@ def test_a_stuck_transmitter_stops_the_kit_with_a_message(kit_build):
         channel.close()
 
 
+def test_a_pin_driven_before_it_became_the_data_pin_stops_the_kit(kit_build):
+    """A sketch that breaks on pin 5 and only then attaches its interrupt there (EnviroDIY's
+    library listens only after its first command): with no --pin the kit learned the data
+    pin too late and kept the break off the line, so the tool heard nothing of a command a
+    board sends (outside32: every job's first command of EnviroDIY's d_simple_logger, judged
+    "never sent"). The kit now stops naming the pin; given the pin, the break goes out."""
+    channel = ChildChannel(str(kit_build(SKETCHES / "late_data_pin")))
+    try:
+        channel.greet(Role.RECORDER)
+        with pytest.raises(HarnessError, match="closed its output"):
+            plan = parse_plan(channel.ask("job 0 measure 0M!"), Role.RECORDER, 0, version=2)
+            while plan.kind == "wait":
+                plan = parse_plan(channel.ask(f"time {plan.start}"), Role.RECORDER, plan.start)
+        assert "exit status 3" in channel.status()
+        assert "pin 5 drove the line spacing at 0 us" in channel.stderr_tail()
+        assert "--pin 5" in channel.stderr_tail()
+    finally:
+        channel.close()
+    channel = ChildChannel(str(kit_build(SKETCHES / "late_data_pin", defines=("KIT_DATA_PIN=5",))))
+    try:
+        channel.greet(Role.RECORDER)
+        plan = parse_plan(channel.ask("job 0 measure 0M!"), Role.RECORDER, 0, version=2)
+        assert plan.kind == "brk" and plan.start == 0
+        assert 12300 <= plan.end <= 12300 + TOLERANCE_US
+    finally:
+        channel.close()
+
+
 def test_a_break_timed_by_polling_micros_is_rebuilt(kit_build):
     """A sketch that ends its break when micros() says so, from loop(): held 12.5 ms (plus
     the loop's own microseconds), told as one brk, then done."""

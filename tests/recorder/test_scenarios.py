@@ -46,7 +46,7 @@ def test_ttt_over_255_sensor_and_the_golden_recorder(golden):
     start, d0 = line.transmissions[0], line.transmissions[1]
     assert start.text == "0M!" and bytes(e.wire & 0x7F for e in start.reply) == b"02603\r\n"
     assert LONG_TTT > 255 and LONG_TTT % 256 < LONG_TTT_READY < LONG_TTT
-    # the golden recorder waits for the service request, 5 s after the reply
+    # the golden recorder waits for the service request, 6 s after the reply
     waited = d0.start - start.reply[-1].end
     assert LONG_TTT_READY <= waited < LONG_TTT_READY + 0.1
     assert run.output.logged["0M!"] == ["+22.15", "+1013.2", "+45.7"]
@@ -63,6 +63,19 @@ def test_eight_bit_ttt_is_judged_early():
     w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
     found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
     assert found["R-4.4.5-04"].verdict is Verdict.PASS
+
+
+def test_eight_bit_ttt_with_a_second_of_slack_is_judged_early():
+    """EnviroDIY's d_simple_logger (outside32) reads ttt into a ``uint8_t`` and waits
+    ``(wait + 1) * 1000`` ms from 0.1 s after its command: 5.1 s for ttt = 260. With the
+    scenario's service request at 5 s it heard the request first and R-4.4.5-04 PASSed;
+    the request now comes later than such a wait, so its aD0! comes first and FAILs."""
+    waited_ms = round(((LONG_TTT % 256) + 1 + 0.1) * 1000)
+    w = Wire().brk().rec("0M!").sensor("02603\r\n").idle(waited_ms).brk().rec("0D0!")
+    w.sensor("0\r\n")
+    assert waited_ms < LONG_TTT_READY * 1000  # the request would still have been due
+    found = by_id(judge_measure_waits(observed_measurements(w.view(), 0.0), 0.0))
+    assert found["R-4.4.5-04"].verdict is Verdict.FAIL
 
 
 def test_concurrent_ttt_zero_sensor_and_the_golden_recorder(golden):

@@ -76,6 +76,9 @@ bool started = false;
 /* pins */
 int pin_mode[PINS], pin_out[PINS];
 int data_pin = KIT_DATA_PIN;
+/* when each pin was first driven spacing while no data pin was known yet (-1: never): a pin
+ * that attachInterrupt names the data pin afterwards had those writes kept off the line */
+us_t spaced_unknown[PINS];
 int tool_level = 0; /* 1 while the tool holds the line spacing */
 struct Edge { us_t t; int level; };
 std::deque<Edge> edges; /* the tool's edges, known up to the horizon */
@@ -458,16 +461,25 @@ void delayMicroseconds(unsigned int us) {
 }
 void yield(void) {}
 
+/* A pin driven spacing before the data pin is known: remembered, in case it is the one. */
+void note_unknown_drive(uint8_t pin) {
+    if (data_pin < 0 && pin_mode[pin] == OUTPUT && pin_out[pin] == HIGH &&
+        spaced_unknown[pin] < 0)
+        spaced_unknown[pin] = vt;
+}
+
 void pinMode(uint8_t pin, uint8_t mode) {
     int before = sketch_drive();
     pin_mode[pin] = mode;
     did_something = true;
+    note_unknown_drive(pin);
     if (pin == data_pin && before != sketch_drive()) line_write(before, sketch_drive());
 }
 void digitalWrite(uint8_t pin, uint8_t value) {
     int before = sketch_drive();
     pin_out[pin] = value ? HIGH : LOW;
     did_something = true;
+    note_unknown_drive(pin);
     if (pin == data_pin && pin_mode[pin] == OUTPUT) line_write(before, sketch_drive());
 }
 int digitalRead(uint8_t pin) {
@@ -482,7 +494,17 @@ int analogRead(uint8_t pin) {
     return 512;
 }
 void attachInterrupt(uint8_t interrupt, void (*handler)(void), int mode) {
-    if (data_pin < 0) data_pin = interrupt;
+    if (data_pin < 0) {
+        /* The sketch drove this pin before it listened on it (EnviroDIY's library attaches
+         * its interrupt only after its first command): those writes were kept off the line,
+         * so what the tool heard is not what a board would have sent. Stop, never judge. */
+        if (spaced_unknown[interrupt] >= 0)
+            fail("pin %d drove the line spacing at %lld us, before attachInterrupt named it "
+                 "the data pin: those writes were not on the line; give the data pin "
+                 "(--pin %d, -D KIT_DATA_PIN=%d)", interrupt, spaced_unknown[interrupt],
+                 interrupt, interrupt);
+        data_pin = interrupt;
+    }
     if (interrupt != data_pin) return; /* the kit models the data pin only */
     isr = handler;
     isr_mode = mode;
@@ -548,6 +570,7 @@ String HardwareSerial::readStringUntil(char terminator) {
 /* ---- the harness loop ---- */
 int main(void) {
     signal(SIGPIPE, SIG_IGN);
+    for (us_t &at : spaced_unknown) at = -1;
     char line[512], word[16], role[16];
     long long a, b, c;
     unsigned byte_value;
