@@ -721,8 +721,10 @@ class Observed(Sequence["tuple[Measured, bool, Place | None]"]):
     the indexes were 12 bytes a gap, 24 a reply, and the places held every distinct reply
     text of the run). Read one by one it gives each distinct object ``counts`` times in the
     order each first came, each place None: what :func:`distribution` reads of them does
-    not depend on their order (its one-by-one path sorts a NaN last, where it stood it sorted
-    by where it stood), so its findings are those of the observations as they came."""
+    not depend on their order (its one-by-one path sorts a NaN last, :func:`_nan_last`), so
+    the findings are those of the observations as they came. Only where no observation can
+    be tainted either: a tainted one turns :class:`~.wire._FoldedStarts` into the list in
+    order, which a counted fold no longer has."""
 
     __slots__ = ("_at", "_n", "_picks", "_replies", "_replies_seen", "_spots", "counts",
                  "distinct")  # fmt: skip
