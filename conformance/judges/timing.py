@@ -13,7 +13,7 @@ from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from itertools import accumulate
+from itertools import accumulate, chain, repeat
 from math import copysign
 from statistics import median
 from typing import Generic, Protocol, TypeVar
@@ -498,7 +498,14 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
             count += d_count
     if not values:
         return None
-    order = sorted(range(len(values)), key=values.__getitem__)
+    total = sum(values) + sum(slacks) + sum(uncertainties)
+    if total != total:  # a NaN among them (or infinities that cancel): each sorted last
+        order = sorted(range(len(values)), key=lambda i: _nan_last(values[i]))
+        least_slack = min(slacks, key=_nan_last)
+        u_mid = _median_nan_last(uncertainties)
+    else:
+        order = sorted(range(len(values)), key=values.__getitem__)
+        least_slack, u_mid = min(slacks), median(uncertainties)
     kept = [order[p] for p in _tick_positions(len(order))]
     low, high = next(iter(edges)) if len(edges) == 1 else (None, None)
     middle = len(order) // 2
@@ -514,12 +521,29 @@ def distribution(observations: Sequence[Finding | Measured]) -> Distribution | N
         _ms(values[order[-1]]) or 0.0,
         low,
         high,
-        _ms(median(uncertainties)) or 0.0,  # typical: a few stamps near a stall are far wider
-        _ms(min(slacks)) or 0.0,
+        _ms(u_mid) or 0.0,  # typical: a few stamps near a stall are far wider
+        _ms(least_slack) or 0.0,
         mixed_limits=len(edges) > 1,
         values_ms=[_ms(values[i]) or 0.0 for i in kept],
         slack_ms=[_ms(slacks[i]) or 0.0 for i in kept],
     )
+
+
+def _nan_last(v: float) -> tuple[bool, float]:
+    """A sort key that puts a NaN after every number, the NaNs in the order they came: a
+    distribution of observations that hold one is then a function of their values, not of
+    their order (``sorted`` compares a NaN false with everything, so it stayed where the
+    order put it and moved the others around it), which a fold that counts them without
+    their order (:class:`Observed` not placed) must give the same. Without a NaN the order
+    is ``sorted``'s own."""
+    return (v != v, v)
+
+
+def _median_nan_last(values: list[float]) -> float:
+    """``statistics.median`` of ``values`` sorted by :func:`_nan_last`."""
+    ordered = sorted(values, key=_nan_last)
+    middle = len(ordered) // 2
+    return ordered[middle] if len(ordered) % 2 else (ordered[middle - 1] + ordered[middle]) / 2
 
 
 #: :func:`_tallied` gives up past this many distinct objects (then one by one is as small)
@@ -651,6 +675,8 @@ class Alike(Sequence["Measured"]):
 
     def __getitem__(self, i):  # type: ignore[no-untyped-def,override]
         picks, distinct = self._observed._picks, self.distinct
+        if picks is None:  # counted: in the order each first came (Observed)
+            return list(self)[i]
         if isinstance(i, slice):
             return [distinct[k] for k in picks[i]]
         return distinct[picks[i]]
@@ -686,51 +712,84 @@ class Observed(Sequence["tuple[Measured, bool, Place | None]"]):
     list of a tuple and a place tuple each ~5 MB): each observation is the index of its
     object in ``distinct``, and its place the index of its ``(command, reply)`` among those
     seen with the character's index, 12 bytes in three arrays; read one by one it gives the
-    same tuples (equal places, the same objects)."""
+    same tuples (equal places, the same objects).
 
-    __slots__ = ("_at", "_picks", "_replies", "_replies_seen", "_spots", "counts", "distinct")
+    Not ``placed`` (counted): where nothing reads the observations' places or order, only
+    the groups (a recording judged on one uncertainty for every stamp, with no stalls of the
+    tool's host: :func:`combine_local` then reads neither, since it decides no deviation by
+    place and sets none aside), nothing is held per observation but their number (memory24:
+    the indexes were 12 bytes a gap, 24 a reply, and the places held every distinct reply
+    text of the run). Read one by one it gives each distinct object ``counts`` times in the
+    order each first came, each place None: what :func:`distribution` reads of them does
+    not depend on their order (its one-by-one path sorts a NaN last, :func:`_nan_last`), so
+    the findings are those of the observations as they came. Only where no observation can
+    be tainted either: a tainted one turns :class:`~.wire._FoldedStarts` into the list in
+    order, which a counted fold no longer has."""
 
-    def __init__(self) -> None:
+    __slots__ = ("_at", "_n", "_picks", "_replies", "_replies_seen", "_spots", "counts",
+                 "distinct")  # fmt: skip
+
+    def __init__(self, placed: bool = True) -> None:
         self.distinct: list[Measured] = []
         self.counts: list[int] = []
-        self._picks = array("I")  # each observation's index in distinct
-        self._spots = array("I")  # each observation's index in _replies
-        self._at = array("I")  # each observation's character index (a place's third part)
+        self._n = 0  # how many observations (the arrays' length where placed)
+        # each observation's index in distinct, its index in _replies and its character
+        # index (a place's third part); None: counted, not placed
+        self._picks = array("I") if placed else None
+        self._spots = array("I") if placed else None
+        self._at = array("I") if placed else None
         self._replies: list[tuple[str, str] | None] = []
         self._replies_seen: dict[tuple[str, str] | None, int] = {}
 
-    def observe(self, i: int, place: Place | None) -> None:
-        """One more observation: ``distinct[i]`` at ``place``."""
-        reply = None if place is None else (place[0], place[1])
+    @property
+    def placed(self) -> bool:
+        """Whether each observation's place (and order) is held, not only counted."""
+        return self._picks is not None
+
+    def _spot(self, reply: tuple[str, str] | None) -> int:
         spot = self._replies_seen.get(reply)
         if spot is None:
             spot = self._replies_seen[reply] = len(self._replies)
             self._replies.append(reply)
+        return spot
+
+    def observe(self, i: int, place: Place | None) -> None:
+        """One more observation: ``distinct[i]`` at ``place`` (not held where counted; the
+        caller counts it in ``counts``)."""
+        self._n += 1
+        if self._picks is None:
+            return
         self._picks.append(i)
-        self._spots.append(spot)
-        self._at.append(0 if place is None else place[2])
+        self._spots.append(self._spot(None if place is None else (place[0], place[1])))  # type: ignore[union-attr]
+        self._at.append(0 if place is None else place[2])  # type: ignore[union-attr]
 
     def observe_run(self, picks: list[int], reply: tuple[str, str], first: int) -> None:
         """:meth:`observe` of ``distinct[i]`` for each ``i`` of ``picks``, at places
         ``(*reply, first)``, ``(*reply, first + 1)``..: a reply's consecutive character gaps
         taken at once (issue 22, matrix19: the arrays extended in C, not a call a gap, some
         20,000 a run)."""
-        spot = self._replies_seen.get(reply)
-        if spot is None:
-            spot = self._replies_seen[reply] = len(self._replies)
-            self._replies.append(reply)
         n = len(picks)
+        self._n += n
+        if self._picks is None:
+            return
+        spot = self._spot(reply)
         self._picks.fromlist(picks)
-        self._spots.fromlist([spot] * n)
-        self._at.fromlist(list(range(first, first + n)))
+        self._spots.fromlist([spot] * n)  # type: ignore[union-attr]
+        self._at.fromlist(list(range(first, first + n)))  # type: ignore[union-attr]
 
     def __len__(self) -> int:
-        return len(self._picks)
+        return self._n
 
     def _one(self, n: int) -> tuple[Measured, bool, Place | None]:
-        reply = self._replies[self._spots[n]]
-        place = None if reply is None else (reply[0], reply[1], self._at[n])
+        if self._picks is None:
+            return self._counted()[n], False, None
+        reply = self._replies[self._spots[n]]  # type: ignore[index]
+        place = None if reply is None else (reply[0], reply[1], self._at[n])  # type: ignore[index]
         return self.distinct[self._picks[n]], False, place
+
+    def _counted(self) -> list[Measured]:
+        """Counted: each distinct object ``counts`` times, in the order each first came."""
+        return list(self.findings())
 
     def __getitem__(self, n):  # type: ignore[no-untyped-def,override]
         if isinstance(n, slice):
@@ -738,11 +797,16 @@ class Observed(Sequence["tuple[Measured, bool, Place | None]"]):
         return self._one(range(len(self))[n])
 
     def __iter__(self) -> Iterator[tuple[Measured, bool, Place | None]]:
+        if self._picks is None:
+            return ((m, False, None) for m in self.findings())
         return (self._one(n) for n in range(len(self)))
 
     def findings(self) -> Iterator[Measured]:
-        """Each observation's object, in order (no place made)."""
+        """Each observation's object, in order (no place made); counted: each distinct
+        object ``counts`` times, in the order each first came."""
         distinct = self.distinct
+        if self._picks is None:
+            return chain.from_iterable(map(repeat, distinct, self.counts))
         return (distinct[i] for i in self._picks)
 
 

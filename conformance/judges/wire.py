@@ -603,15 +603,18 @@ def _observe_gaps_alike(gaps: list[Gap], base: float) -> Observed:
 
 class _GapsAlike:
     """:func:`_observe_gaps_alike` of gaps given a part at a time (:class:`ReplyGaps`, a
-    window at a time): the distinct gaps judged so far carried from part to part."""
+    window at a time): the distinct gaps judged so far carried from part to part.
+    ``placed``: whether the observations keep their places and order (:class:`~.timing.
+    Observed`); :class:`ReplyGaps` keeps neither, which on one uncertainty for every gap
+    and no stalls of the tool's host nobody reads (memory24)."""
 
-    def __init__(self, base: float) -> None:
+    def __init__(self, base: float, placed: bool = True) -> None:
         self.base = base
         #: where -> gap -> its index in distinct: what a ``(gap, where)`` key found, asked
         #: per gap without a key tuple made and hashed (a reply's gaps come together, so
         #: the place's own dict is looked up once per reply, not per gap)
         self.judged: dict[str, dict[float, int]] = {}
-        self.observed = Observed()
+        self.observed = Observed(placed)
 
     def add(self, gaps: list[Gap]) -> None:
         base, judged, observed = self.base, self.judged, self.observed
@@ -680,16 +683,25 @@ class _GapsAlike:
             counts[i] += n
 
 
-def _leaning(sure: list[tuple[float, str]], count: int, uncertainty: float) -> Finding:
-    """R-7.0-01's FAIL: the ``(gap, where)`` surely inside the band, out of ``count``."""
+#: how many of the gaps surely inside R-7.0-01's band its FAIL names (its evidence)
+NAMED_LEANING = 5
+
+
+def _leaning(
+    sure: list[tuple[float, str]], count: int, uncertainty: float, such: int | None = None
+) -> Finding:
+    """R-7.0-01's FAIL: the ``(gap, where)`` surely inside the band (the first
+    :data:`NAMED_LEANING` are read; ``such``: how many there are, ``len(sure)`` if None),
+    out of ``count``."""
     gap, _where = sure[0]
+    such = len(sure) if such is None else such
     return Finding(
         "R-7.0-01",
         Verdict.FAIL,
         f"gap of {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} relies on the ±0.40 ms "
-        f"tolerance, which the 1.66 ms character gap does not have ({len(sure)} such "
+        f"tolerance, which the 1.66 ms character gap does not have ({such} such "
         "gap(s))",
-        evidence=[where for _, where in sure[:5]],
+        evidence=[where for _, where in sure[:NAMED_LEANING]],
         observed=count,
         measured_ms=round(gap * 1e3, 3),
         limit_ms=INTER_CHAR_GAP_MAX * 1e3,
@@ -714,14 +726,20 @@ def _judge_tolerance_use(
 
 class _ToleranceUse:
     """:func:`_judge_tolerance_use` of gaps given a part at a time (:class:`ReplyGaps`):
-    the gaps in or maybe in the band, and how many gaps, carried from part to part."""
+    the gaps in or maybe in the band, and how many gaps, carried from part to part. Of
+    those in the band only the few the finding names are kept (the first
+    :data:`NAMED_LEANING` surely in it, the first maybe in it, the first held across a
+    stall) and how many there are: a bus whose device leans on the tolerance at every
+    reply held a tuple a gap to the end (memory24)."""
 
     def __init__(self, uncertainty: float, stalls: list[Stall] | None = None) -> None:
         self.uncertainty = uncertainty
         self.stalls = stalls
         self.sure: list[tuple[float, str]] = []
         self.maybe: list[tuple[float, str]] = []
+        self.sure_count = self.maybe_count = 0  # how many, where the lists keep the first
         #: gaps in or maybe in the band across a stall of the tool's host, with the stall
+        #: (the first: the finding names it)
         self.held: list[tuple[float, str, Stall]] = []
         self.count = 0
 
@@ -745,7 +763,8 @@ class _ToleranceUse:
             if stall is None:
                 kept.append(gap)
             else:
-                self.held.append((g, w, stall))
+                if not self.held:
+                    self.held.append((g, w, stall))
                 self.count += 1
         return kept
 
@@ -765,12 +784,23 @@ class _ToleranceUse:
             if g + uncertainty <= band_lo and g - uncertainty <= band_lo:
                 continue  # below the band either way (nearly every gap)
             if g - uncertainty > band_lo and g + uncertainty <= band_hi:
-                sure.append((g, w))
+                self.sure_count += 1
+                if len(sure) < NAMED_LEANING:
+                    sure.append((g, w))
             if g + uncertainty > band_lo and g - uncertainty <= band_hi:
-                maybe.append((g, w))
+                self.maybe_count += 1
+                if not maybe:
+                    maybe.append((g, w))
 
     def finding(self) -> Finding:
-        return _tolerance_finding(self.sure, self.maybe, self.count, self.uncertainty, self.held)
+        return _tolerance_finding(
+            self.sure,
+            self.maybe,
+            self.count,
+            self.uncertainty,
+            self.held,
+            such=(self.sure_count, self.maybe_count),
+        )
 
 
 class ResponseStarts:
@@ -818,13 +848,18 @@ class _FoldedStarts:
     ~650 bytes a reply (issue 22, memory21: 0.97 MB of a sensor's pass at an hour). The
     first tainted observation (the link's irregular stamps, a stall of the tool's host)
     turns it into the list one by one, the folded ones read out in order: those are rare,
-    and :func:`~.timing.combine_local` reads them each with its own taint and place."""
+    and :func:`~.timing.combine_local` reads them each with its own taint and place.
+
+    Not ``placed`` (a virtual clock or a capture's grid, no stalls of the tool's host: no
+    observation can be tainted and no place or order is read) each reply is counted, not
+    indexed (:class:`~.timing.Observed` not placed: the indexes were 12 bytes a reply a
+    rule, memory24): what is held is bounded by the distinct values."""
 
     __slots__ = ("_each", "_index", "_observed", "_placed", "_repeats")
 
     def __init__(self, placed: bool) -> None:
         self._placed = placed  # whether the places are kept (else each is None)
-        self._observed = Observed()
+        self._observed = Observed(placed)
         self._repeats: Repeats[Measured] = Repeats()
         self._index: dict[int, int] = {}  # id of a distinct object -> its index
         self._each: list[Observation] | None = None  # one by one, once one is tainted
@@ -870,7 +905,9 @@ class ReplyGaps:
         self.stamps = stamps = stamp_uncertainty(uncertainty)
         self.stalls = stalls  # the tool's host stalls, as judge_gaps reads them
         base = stamps.base
-        self._alike = _GapsAlike(base) if _alike(stamps) and not stalls else None
+        # on one uncertainty and no stalls, combine_local reads no gap's place or order
+        # (real_time is False: none is decided by place, none set aside): counted
+        self._alike = _GapsAlike(base, placed=False) if _alike(stamps) and not stalls else None
         self._each: list[Observation] = []
         self._judged: dict[tuple[float, float, str], Measured] = {}
         self._tolerance = _ToleranceUse(base, stalls)
@@ -899,13 +936,17 @@ def _tolerance_finding(
     count: int,
     uncertainty: float,
     held: list[tuple[float, str, Stall]] | None = None,
+    such: tuple[int, int] | None = None,
 ) -> Finding:
     """R-7.0-01's finding from the ``(gap, where)`` surely and possibly inside the band, out
     of ``count`` gaps judged (:func:`_judge_tolerance_use`); ``held``: those surely in it
     whose stamps a stall of the tool's own host may have moved, with the stall (truth30):
-    INCONCLUSIVE naming it unless a gap outside every stall FAILs the rule."""
+    INCONCLUSIVE naming it unless a gap outside every stall FAILs the rule. ``such``: how
+    many are surely and maybe in the band, where the lists hold only the first few
+    (:class:`_ToleranceUse`); None: all of them."""
+    n_sure, n_maybe = (len(sure), len(maybe)) if such is None else such
     if sure:
-        return _leaning(sure, count, uncertainty)
+        return _leaning(sure, count, uncertainty, n_sure)
     if held:
         gap, where, stall = held[0]
         return stalled_interval(_leaning([(gap, where)], count, uncertainty), stall)
@@ -914,7 +955,7 @@ def _tolerance_finding(
         return Finding(
             "R-7.0-01",
             Verdict.INCONCLUSIVE,
-            f"{len(maybe)} gap(s) such as {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} may lie "
+            f"{n_maybe} gap(s) such as {gap * 1e3:.2f} ms ± {uncertainty * 1e3:.2f} may lie "
             "in the 1.66..2.06 ms band, where no tolerance applies",
             evidence=[where],
             measured_ms=round(gap * 1e3, 3),

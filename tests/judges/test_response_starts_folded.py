@@ -8,15 +8,19 @@ from __future__ import annotations
 
 import tracemalloc
 from dataclasses import asdict
+from math import isnan
+from statistics import median
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conformance.judges import wire
+from conformance.judges import timing, wire
 from conformance.judges.stalled import stalled_interval
 from conformance.judges.timing import Measured, StampUncertainty, Window, combine_local
 from conformance.links.host_stall import Stall
-from conformance.transcript import Event
+from conformance.transcript import DUT, Event, EventKind, to_wire_7e1
+from conformance.view.runs import Segment
 from tests.judges.test_start_observations_shared import _exchange
 
 EARLY = Window("R-7.0-09", "reply start", low=7.93e-3)
@@ -142,3 +146,161 @@ def test_held_memory_does_not_grow_by_the_reply() -> None:
     verdicts = [f.verdict.name for f in starts.findings()]
     assert verdicts == ["PASS", "PASS"]
     assert starts.findings()[0].observed == 3000
+
+
+# -- counted, not indexed (memory24) --------------------------------------------------------
+# Where no place or order is read (one uncertainty for every stamp, no stalls of the tool's
+# host) the folds count each reply and gap instead of indexing it: the findings are still
+# those of the observations one by one, in every field.
+
+
+def _gap_findings_one_by_one(segs, stamps) -> list:
+    """R-7.0-12 and R-7.0-01 as judge_gaps' list path judges them: every gap observed, in
+    order, with its place (``_observe_each``); every gap in or maybe in R-7.0-01's band
+    listed (``_two_passes``)."""
+    from tests.judges.test_tolerance_use_one_pass import _two_passes
+
+    gaps = wire._cut_gaps(segs)
+    observed = wire._observe_each(gaps, stamps, {})
+    return [
+        combine_local("R-7.0-12", observed, "character gap", real_time=False),
+        _two_passes([(g, w) for g, w, *_ in gaps], stamps.base),
+    ]
+
+
+@settings(max_examples=120, deadline=None)
+@given(
+    st.randoms(use_true_random=False),
+    st.integers(1, 40),
+    st.integers(1, 9),
+    st.sampled_from([0.0, 0.02, 0.2]),
+    st.sampled_from([0.0, 1e-6, 0.3e-3]),
+)
+def test_counted_gaps_are_the_gaps_one_by_one(rng, n, per, odd, base) -> None:
+    """ReplyGaps a window at a time, counted (zero gaps, negative zeros, NaN stamps,
+    multi-line text, later runs, gaps in and past the band): the one-by-one findings."""
+    from tests.judges.test_gaps_by_run import _negative_zero, _segments
+
+    segs = _segments(n, rng, odd)
+    if odd:
+        segs[n // 2 : n // 2] = [_negative_zero("0D0!"), _negative_zero("1D0!")]
+    stamps = StampUncertainty(base)
+    gaps = wire.ReplyGaps(stamps)
+    for k in range(0, len(segs), per):
+        gaps.add(segs[k : k + per])
+    assert not gaps._alike.observed.placed  # counted, not indexed
+    expected = _gap_findings_one_by_one(segs, stamps)
+    assert [_same(f) for f in gaps.findings()] == [_same(f) for f in expected]
+
+
+measured_values = st.sampled_from([0.0084, 0.010, 0.005, 0.018, -0.0, 0.0, float("nan")]) | (
+    st.floats(-1e-3, 30e-3, allow_nan=False)
+)
+
+
+def _one_by_one(observations):
+    """``timing.distribution`` on its one-by-one path (neither grouped nor tallied)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(timing, "_grouped", lambda _o: None)
+        mp.setattr(timing, "_tallied", lambda _o: None)
+        return timing.distribution(observations)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.tuples(measured_values, uncertainties), min_size=1, max_size=60),
+    st.randoms(use_true_random=False),
+    st.sampled_from([EARLY, LATE]),
+)
+def test_a_distribution_one_by_one_is_that_of_its_values_not_their_order(
+    drawn, rng, window
+) -> None:
+    """A counted fold gives each value back as often as it came, not in the order it came:
+    the one-by-one distribution must not depend on that order, NaNs among them (sorted
+    last; ``sorted`` left a NaN where it stood and moved the others around it). Without a
+    NaN it is what ``sorted``, ``min`` and ``statistics.median`` give, as before."""
+    observed = [Measured(window, v, u, []) for v, u in drawn]
+    shuffled = list(observed)
+    rng.shuffle(shuffled)
+    found = _one_by_one(observed)
+    assert repr(found) == repr(_one_by_one(shuffled))
+    if not any(isnan(v) or isnan(u) for v, u in drawn):
+        values = sorted(v for v, _u in drawn)
+        slacks = [timing._slack(window.lo, window.hi, v) for v, _u in drawn]
+        assert found.min_ms == (timing._ms(values[0]) or 0.0)
+        assert found.max_ms == (timing._ms(values[-1]) or 0.0)
+        assert found.median_ms == (timing._ms(median(values)) or 0.0)
+        assert found.uncertainty_ms == (timing._ms(median(u for _v, u in drawn)) or 0.0)
+        assert found.margin_ms == (timing._ms(min(slacks)) or 0.0)
+
+
+def _held(feed) -> list[int]:
+    """Bytes held (tracemalloc) at each point ``feed`` yields, from before it starts."""
+    held = []
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        for _ in feed:
+            held.append(tracemalloc.get_traced_memory()[0] - before)
+    finally:
+        tracemalloc.stop()
+    return held
+
+
+def test_counted_replies_hold_no_more_after_20000() -> None:
+    """20,000 replies of three delays on a capture's grid (no stalls), 50 a window: what
+    the two rules hold does not grow with the replies past the first 2,000 (base-s68
+    indexed each, 12 bytes a reply a rule: ~0.43 MB more by 20,000)."""
+    starts = wire.ResponseStarts(StampUncertainty(1e-5))
+
+    def feed():
+        drawn = [("0M!", (0.0084, 0.010, 0.012)[k % 3], "00011\r\n") for k in range(20_000)]
+        for k, segs in enumerate(_windows(drawn, 50)):
+            starts.add(segs)
+            if (k + 1) * 50 in (2_000, 20_000):
+                yield
+
+    early, late = _held(feed())
+    assert late - early < 20_000, (early, late)
+    found = starts.findings()
+    assert [f.verdict.name for f in found] == ["PASS", "PASS"]
+    assert found[0].observed == found[1].observed == 20_000
+    assert found[1].distribution.count == 20_000
+
+
+def _exact_replies(n: int) -> list[Segment]:
+    """``n`` replies of 20 characters, each from a whole second, the characters 2**-7 s long
+    and apart by 2**-12 or 2**-11 s: times a float holds exactly, so the gaps take three
+    values however long the recording (as a capture's sample grid gives a few)."""
+    segs = []
+    for k in range(n):
+        t, chars = float(k), []
+        for i, c in enumerate("0+1.23-45.6+7.8912\r\n"):
+            chars.append(Event(EventKind.CHAR, DUT, t, t + 2**-7, wire=to_wire_7e1(ord(c))))
+            t += 2**-7 + (2**-12, 2**-11, 0.0)[(i + k) % 3]
+        segs.append(Segment(None, [], chars, text=f"{k % 3}D0!"))
+    return segs
+
+
+def test_counted_gaps_hold_no_more_after_20000() -> None:
+    """20,000 character gaps of three values (1,100 replies, 64 a window): what R-7.0-12
+    holds does not grow with the gaps past the first 2,000 (base-s68 indexed each: 12
+    bytes a gap, ~0.2 MB more by 20,000)."""
+    segs = _exact_replies(1_100)
+    gaps = wire.ReplyGaps(StampUncertainty(1e-5))
+
+    def feed():
+        fed = 0
+        for k in range(0, len(segs), 64):
+            gaps.add(segs[k : k + 64])
+            before, fed = fed, len(gaps._alike.observed)
+            if before < 2_000 <= fed:
+                yield
+        yield
+
+    early, late = _held(feed())
+    assert late - early < 20_000, (early, late)
+    found = gaps.findings()
+    assert len(gaps._alike.observed.distinct) == 9  # three values at each of three commands
+    assert found[0].observed == found[0].distribution.count == 1_100 * 19
+    assert [f.verdict.name for f in found] == ["PASS", "PASS"]
