@@ -490,6 +490,14 @@ class SensorSession(Session):
         self.remeasured.append(m)
         return m
 
+    def measure_as_sent(self, command: Command) -> Measurement:
+        """``command`` measured by the engine at once, its record the engine's (a case that
+        times it against its own break: no view cut), kept in :attr:`remeasured` as
+        :meth:`fresh_measurement`'s are."""
+        m = self.master.measure(command)
+        self.remeasured.append(m)
+        return m
+
     def _measure(self, code: str, **kw: Any) -> Measurement:
         mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
         made = self.master.measure(self.command(code), **kw)
