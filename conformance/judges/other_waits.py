@@ -29,16 +29,12 @@ from ..verdicts import Finding, Verdict, inconclusive, not_applicable
 from .measurements import judge
 
 #: The rules a measurement's wait is judged on (:func:`~conformance.judges.measurements.
-#: wait_violations`), less R-5.3-01 (a high-volume measurement's, whose case needs breaks).
-WAIT_IDS = (
-    "R-4.4.6-01",
-    "R-4.4.6-02",
-    "R-4.4.6-04",
-    "R-4.4.5-08",
-    "R-4.4.5-09",
-    "R-4.4.6-05",
-    "R-4.4.7-04",
-)
+#: wait_violations`), less R-5.3-01 (a high-volume measurement's, whose case needs breaks):
+#: an M-type measurement's service request, as ``test_service_request`` judges it ...
+SERVICE_REQUEST_IDS = ("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "R-4.4.5-09")
+#: ... and the quiet of a concurrent one, as the concurrent cases judge it
+QUIET_IDS = ("R-4.4.6-05", "R-4.4.7-04")
+WAIT_IDS = SERVICE_REQUEST_IDS + QUIET_IDS
 
 WHAT = "the measurements other cases made again"
 

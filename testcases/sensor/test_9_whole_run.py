@@ -113,7 +113,9 @@ def test_reply_framing(sensor, case):
 def test_service_requests_of_every_measurement(sensor, case):
     """The service-request rules over every measurement a case made again (outside the
     cached ones their own cases judge): a late, malformed or missing request there, or talk
-    before it, is the sensor's as much (truth31)."""
+    before it, is the sensor's as much; none after a concurrent one (truth31). One case for
+    both kinds: the rules of the kind no case made again are N/A, which changes no verdict
+    of their own cases (a case of the concurrent rules alone was N/A in every clean run)."""
     case.expect(
         "exactly 'a<CR><LF>', complete within ttt s of the reply, nothing before it, after "
         "every M-type measurement with ttt > 0 the run made; none after a concurrent one"

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from conformance.case import Case
 from conformance.judges import measurements as judge
-from conformance.judges.other_waits import WAIT_IDS, judge_other_waits
+from conformance.judges.other_waits import QUIET_IDS, WAIT_IDS, judge_other_waits
 from conformance.ports import open_sim, parse_sim
 from conformance.preconditions import declared_on
 from conformance.results import CaseRecord, counted, partial_only
@@ -33,6 +33,7 @@ def _session(faults: str = "") -> SensorSession:
 
 
 def _case(session: SensorSession) -> dict[str, Finding]:
+    """The whole-run case's findings over ``session``'s measurements made again."""
     record = CaseRecord("every-wait", "every-wait", WAIT_IDS)
     every_wait_case(session, Case(record, preconditions=declared_on(every_wait_case, WAIT_IDS)))
     return {f.requirement: f for f in record.findings}
@@ -70,7 +71,8 @@ def test_the_clean_sensor_measured_again_passes_in_part():
     found = _case(session)
     assert found["R-4.4.6-04"].verdict is Verdict.PASS
     assert found["R-4.4.6-04"].partial  # it speaks for these measurements, not the rule
-    assert found["R-4.4.7-04"].verdict is Verdict.NA  # no concurrent measurement made again
+    # no concurrent measurement made again: N/A, which leaves their own cases' verdicts
+    assert {found[rid].verdict for rid in QUIET_IDS} == {Verdict.NA}
     assert [m.command.text() for m in session.remeasured] == ["0M!"]
 
 
@@ -89,6 +91,7 @@ def test_no_measurement_made_again_is_no_verdict():
     assert not session.remeasured
     found = _case(session)
     assert {f.verdict for f in found.values()} == {Verdict.NA}
+    assert set(found) == set(WAIT_IDS)
     owner = passed("R-4.4.6-04", "conforms", observed=5)
     assert _rule([owner, found["R-4.4.6-04"]]) is Verdict.PASS
 
@@ -128,3 +131,15 @@ def test_a_should_rule_warns_never_fails():
     ms = run.recorded(noted=False).measurements
     (found,) = judge_other_waits(ms, ["R-4.4.5-09"], "14")
     assert found.verdict is Verdict.WARN, found.detail
+
+
+def test_a_service_request_after_a_concurrent_measurement_made_again_fails():
+    """aC! measured again on a sensor that requests service after concurrent measurements:
+    R-4.4.6-05 and R-4.4.7-04 FAIL; the clean sensor's PASS in part; the service-request
+    rules, with no M-type measurement made again, N/A."""
+    for faults, verdict in (("concurrent-service-request", Verdict.FAIL), ("", Verdict.PASS)):
+        session = _session(faults)
+        session.fresh_measurement("C")
+        found = _case(session)
+        assert {found[rid].verdict for rid in QUIET_IDS} == {verdict}, found
+        assert {f.verdict for r, f in found.items() if r not in QUIET_IDS} == {Verdict.NA}
