@@ -494,7 +494,9 @@ class SensorSession(Session):
         """``command`` measured by the engine at once, its record the engine's (a case that
         times it against its own break: no view cut), kept in :attr:`remeasured` as
         :meth:`fresh_measurement`'s are."""
+        first = len(self.link.transcript.events)
         m = self.master.measure(command)
+        self.master.mark_stalls((), first, [m])  # its wait, as fresh_measurement's
         self.remeasured.append(m)
         return m
 

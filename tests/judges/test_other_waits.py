@@ -10,6 +10,7 @@ from __future__ import annotations
 from conformance.case import Case
 from conformance.judges import measurements as judge
 from conformance.judges.other_waits import QUIET_IDS, WAIT_IDS, judge_other_waits
+from conformance.links.host_stall import Stall
 from conformance.ports import open_sim, parse_sim
 from conformance.preconditions import declared_on
 from conformance.results import CaseRecord, counted, partial_only
@@ -143,3 +144,32 @@ def test_a_service_request_after_a_concurrent_measurement_made_again_fails():
         found = _case(session)
         assert {found[rid].verdict for rid in QUIET_IDS} == {verdict}, found
         assert {f.verdict for r, f in found.items() if r not in QUIET_IDS} == {Verdict.NA}
+
+
+def test_the_abort_case_s_measurement_is_kept_with_its_wait_marked(monkeypatch):
+    """``measure_as_sent`` (test_break_aborts_measurement's aM! right after its break) keeps
+    the engine's record, its wait marked from the link's stall notes as a fresh
+    measurement's is: a request late across a stall there is undecided, never a FAIL."""
+    session = _session(LATE_AGAIN)
+    session.measurement("M")
+    first, began = len(session.link.transcript.events), session.link.now()
+    asked: list[int] = []
+
+    def stalls(since: int) -> list[Stall]:
+        """A stall over the whole measurement, noted for the wait's marking alone (the
+        engine's own reads, marked as they are made, read the notes since their own
+        exchange: none there)."""
+        asked.append(since)
+        return [Stall(began, session.link.now(), 150.0)] if since == first else []
+
+    monkeypatch.setattr(session.master, "stalls_since", stalls)
+    m = session.measure_as_sent(session.command("M"))
+    assert session.remeasured == [m] and first in asked
+    assert m.wait_stall is not None
+    found = _case(session)["R-4.4.6-04"]
+    assert found.verdict is Verdict.INCONCLUSIVE and found.observed == 0, found.detail
+    assert "stalled" in found.detail
+    monkeypatch.undo()
+    session.remeasured.clear()
+    session.measure_as_sent(session.command("M"))  # no stall noted: the late request FAILs
+    assert _case(session)["R-4.4.6-04"].verdict is Verdict.FAIL
