@@ -96,6 +96,10 @@ class Behaviour:
     #: into it.
     announce_ttt: int | None = None
     service_request_late: float | None = None  # send it this long after ttt instead
+    #: Send it this long after ttt instead, but only for an M/V command this sensor has
+    #: measured before since power-up: the first of each is in time (a late request the
+    #: run's cached measurements never see, only the cases that measure again: truth31).
+    service_request_late_repeated: float | None = None
     service_request_on_ttt_zero: bool = False
     service_request_on_concurrent: bool = False
     service_request_on_identify: bool = False

@@ -111,6 +111,7 @@ class SensorEmulator:
         self._data: DataSet | None = None
         self._previous: DataSet | None = None
         self._last_command: Command | None = None
+        self._measured: set[str] = set()  # M/V commands started before (a faulty sensor's)
         self._crc_stuck = False  # only a faulty sensor sets it (metadata_crc_sticks)
         self._replied_last = False  # the last thing on the line was this sensor's own
         self._report: Transmission | None = None  # only a faulty sensor sets it (abort_reply)
@@ -582,10 +583,24 @@ class SensorEmulator:
         sr_at = run.ready_at
         if b.service_request_late is not None and cmd.kind in SERVICE_REQUEST_KINDS:
             sr_at = sent.end + spec.ttt + b.service_request_late
+        if (late := self._late_when_repeated(cmd)) is not None:
+            sr_at = sent.end + spec.ttt + late
         if b.chatter_before_service_request:
             chatter = Reply(ReplyKind.CHATTER, cmd.address + "BUSY", source=cmd)
             self._send(chatter, (sent.end + run.ready_at) / 2)
         self._service_request(cmd, sr_at)
+
+    def _late_when_repeated(self, cmd: Command) -> float | None:
+        """How long after ttt a faulty sensor sends the service request of an M/V command it
+        has measured before (``service_request_late_repeated``); None: when it is ready."""
+        late = self.behaviour.service_request_late_repeated
+        if late is None or cmd.kind not in SERVICE_REQUEST_KINDS:
+            return None
+        key = cmd.text()
+        if key not in self._measured:
+            self._measured.add(key)
+            return None
+        return late
 
     def _timed(self, cmd: Command, spec: MeasurementSpec | None) -> MeasurementSpec | None:
         """``spec`` with the ttt the behaviour announces (``announce_ttt``) for an M/V

@@ -202,6 +202,9 @@ class SensorSession(Session):
         self.address_trial: Trial | None = None
         self._cache: dict[Any, Any] = {}
         self.view_disagreements = 0  # stimuli whose view record differed (see _as_seen)
+        #: every measurement a case made anew, outside the cache (:meth:`fresh_measurement`):
+        #: the wait rules' cases judge the cached ones, the whole-run case these (truth31)
+        self.remeasured: list[Measurement] = []
         #: the measurement codes a family may be tried with (None: all; a profile's groups)
         self.groups: frozenset[str] | None = None
         #: every sensor on the line with its aI! reply, when the DUT is not alone on it
@@ -460,7 +463,7 @@ class SensorSession(Session):
     def _shared_measurement(self, code: str) -> Measurement:
         """A cached measurement as it is made, with what must follow it at once: after
         ``aHB!`` the reads past its packets (:meth:`packets_past_data`)."""
-        m = self.fresh_measurement(code)
+        m = self._measure(code)
         if code == "HB" and self.link.info.binary and shows_support(m):
             self._cache[("past-data", code)] = self._read_past_data(m)
         return m
@@ -481,6 +484,23 @@ class SensorSession(Session):
         return [self.fresh_exchange(f"DB{i}") for i in probes]
 
     def fresh_measurement(self, code: str, **kw: Any) -> Measurement:
+        """The measurement ``code`` made anew, kept in :attr:`remeasured`: a late or
+        malformed service request here is the sensor's as much as in the cached one."""
+        m = self._measure(code, **kw)
+        self.remeasured.append(m)
+        return m
+
+    def measure_as_sent(self, command: Command) -> Measurement:
+        """``command`` measured by the engine at once, its record the engine's (a case that
+        times it against its own break: no view cut), kept in :attr:`remeasured` as
+        :meth:`fresh_measurement`'s are."""
+        first = len(self.link.transcript.events)
+        m = self.master.measure(command)
+        self.master.mark_stalls((), first, [m])  # its wait, as fresh_measurement's
+        self.remeasured.append(m)
+        return m
+
+    def _measure(self, code: str, **kw: Any) -> Measurement:
         mark = live_cut(self.link.transcript).mark(self.link.transcript.events)
         made = self.master.measure(self.command(code), **kw)
         seen = self._rebuilt(mark).measurements

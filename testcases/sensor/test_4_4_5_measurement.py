@@ -260,7 +260,7 @@ def test_break_aborts_measurement(sensor, case):
     start2 = sensor.fresh_exchange(code)  # abort again, and this time start anew after it
     before2 = sensor.listen(min(0.05, target.ttt / 10))
     brk2 = sensor.master.send_break()
-    again = sensor.master.measure(target.command)  # within 87 ms: no second break
+    again = sensor.measure_as_sent(target.command)  # within 87 ms: no second break
     full = next((d for d in ds if not (d.answered and empty_data_reply(d))), None)
     # an empty D0 shows the abort emptied the buffer only where the buffer held values up
     # to it: a sensor that empties it once its pages were read, at the break after that or

@@ -1,5 +1,6 @@
 """Rules judged over every reply of the run: character framing and printability, CR LF
-endings, the responding address, response start window, character gaps.
+endings, the responding address, response start window, character gaps; and the
+service-request rules over every measurement the run made again.
 
 These cases are ``whole_run``: the plugin runs them after every other case, whatever order
 or selection the run was given, so they judge everything the run sent. Each first asks for the
@@ -12,7 +13,7 @@ from __future__ import annotations
 import pytest
 
 from conformance import preconditions as precondition
-from conformance.judges import wire
+from conformance.judges import other_waits, wire
 from conformance.links import host_stall
 from conformance.links.base import NO_BIT_TIMING
 from conformance.verdicts import inconclusive
@@ -104,3 +105,21 @@ def test_reply_framing(sensor, case):
     # replies are judged against the address the sensor answered at (cached: no new traffic)
     ack = sensor.exchange("")
     case.requires("address", precondition.answers_at(ack, sensor.address, "a! at it got no reply"))
+
+
+@pytest.mark.needs("unsolicited")
+@requirements(*other_waits.WAIT_IDS)
+@pytest.mark.preconditions("none")
+def test_service_requests_of_every_measurement(sensor, case):
+    """The service-request rules over every measurement a case made again (outside the
+    cached ones their own cases judge): a late, malformed or missing request there, or talk
+    before it, is the sensor's as much; none after a concurrent one (truth31). One case for
+    both kinds: the rules of the kind no case made again are N/A, which changes no verdict
+    of their own cases (a case of the concurrent rules alone was N/A in every clean run)."""
+    case.expect(
+        "exactly 'a<CR><LF>', complete within ttt s of the reply, nothing before it, after "
+        "every M-type measurement with ttt > 0 the run made; none after a concurrent one"
+    )
+    ms = sensor.remeasured
+    case.evidence("measurements made again by other cases", ms)
+    case.extend(other_waits.judge_other_waits(ms, case.requirements, sensor.version))

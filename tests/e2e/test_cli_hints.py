@@ -148,8 +148,10 @@ def test_a_req_says_why_it_judged_more_and_a_forced_version_says_it_differs(caps
         "--report-dir", str(tmp_path),
     )  # fmt: skip
     flat = " ".join(text.split())
-    assert "--req R-4.4.6-02 names 1 requirement(s); 5 were judged" in flat, text
-    assert "also judge 4 other(s)" in flat and "a case runs whole" in flat
+    # test_service_request's five, and the two of concurrent measurements the whole-run
+    # case over every measurement made again judges beside them (truth31)
+    assert "--req R-4.4.6-02 names 1 requirement(s); 7 were judged" in flat, text
+    assert "also judge 6 other(s)" in flat and "a case runs whole" in flat
     assert "--sdi-version 1.4 judged the device by the v1.4 rules, but its aI! reports v1.3" in flat
 
 

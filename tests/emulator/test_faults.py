@@ -245,6 +245,16 @@ def check_late_service_request(rig: Rig) -> None:
     assert rig.ask("0D0!", brk=False).body == "0" + M_VALUES
 
 
+def check_late_service_request_when_repeated(rig: Rig) -> None:
+    """The first aM! since power-up requests in time (before its 2 s), the second late."""
+    start, follow = rig.measure("0M!")
+    assert decode_7e1(follow) == "0\r\n"
+    assert follow[-1].end - start.events[-1].end < 2.0
+    start, follow = rig.measure("0M!")
+    assert decode_7e1(follow) == "0\r\n"
+    assert follow[-1].end - start.events[-1].end > 2.0
+
+
 def check_service_request_after_ttt_zero(rig: Rig) -> None:
     rig.wake()
     rig.send("0M1!")
@@ -657,6 +667,7 @@ CHECKS: dict[str, Callable[[Rig], None]] = {
     "binary-crc-big-endian": check_binary_crc_big_endian,
     "no-service-request": check_no_service_request,
     "late-service-request": check_late_service_request,
+    "late-service-request-when-repeated": check_late_service_request_when_repeated,
     "service-request-after-ttt-zero": check_service_request_after_ttt_zero,
     "concurrent-service-request": check_concurrent_service_request,
     "service-request-extra-chars": check_service_request_extra_chars,

@@ -95,6 +95,14 @@ SERVICE_REQUESTS: tuple[Fault, ...] = (
         settings={"service_request_late": 0.25},
     ),
     Fault(
+        "late-service-request-when-repeated",
+        "An M/V command measured before since power-up sends its service request 0.25 s"
+        " after ttt expired; the first of each comes in time (only a case that measures"
+        " again sees it late: truth31).",
+        ("R-4.4.6-04",),
+        settings={"service_request_late_repeated": 0.25},
+    ),
+    Fault(
         "service-request-after-ttt-zero",
         "M/V answered with ttt = 000 still send a service request right after the reply.",
         ("R-4.4.6-03",),
