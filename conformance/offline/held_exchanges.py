@@ -12,8 +12,9 @@ measurements, whose own exchanges they read through them.
 
 Here an exchange whose parts are all plain is held as a row of numbers: which distinct
 (text, command, binary, expect_reply) it has (4 bytes) and where its attempts begin (4);
-each attempt where its break, command and reply are in the store, how many characters,
-which reason, its end (exactly the float) and its sequence and retry (~30 bytes). A case
+each attempt where its break, command and reply are in the store (4 each), how many
+characters (2 each), which reason (2), its end (8, exactly the float) and its sequence and
+retry (1 each): 36 bytes an exchange of one try (``tests/offline/test_held_exchanges.py``). A case
 that reads it gets an ``Exchange`` equal, field for field, to the one the pass made; while
 it holds it, reading it again gives the same object (a weak cache), so identity within a
 case is kept. Kept as objects: the exchanges a measurement holds (a measurement's start and
@@ -35,9 +36,11 @@ from ..tool_recorder.records import Attempt, Exchange
 from ..transcript import Event
 from .stored_records import Positions
 
+#: the most characters a row's command or reply holds, and the most tries it counts (its
+#: columns' widths: 2 bytes and 1; a longer one is held as the object)
+_MOST_CHARS, _MOST_TRIES = 2**16 - 1, 2**8 - 1
 #: (text, command, binary, expect_reply): what exchanges of one command share
 Shape = tuple[str, object, bool, bool]
-_NO_KIND = None  # an exchange whose text parsed as no command
 
 
 class HeldExchanges(Sequence[Exchange]):
@@ -57,9 +60,9 @@ class HeldExchanges(Sequence[Exchange]):
         # per attempt: break position + 1 (0: none), command and reply runs, reason, end,
         # sequence and retry
         self.brk, self.cmd, self.rep = array(code), array(code), array(code)
-        self.cmd_n, self.rep_n = array("I"), array("I")
+        self.cmd_n, self.rep_n = array("H"), array("H")
         self.reason, self.end = array("H"), array("d")
-        self.sequence, self.retry = array("I"), array("I")
+        self.sequence, self.retry = array("B"), array("B")
         self.kept: dict[int, Exchange] = {}  # by index: held as the object
         self._made: weakref.WeakValueDictionary[int, Exchange] = weakref.WeakValueDictionary()
 
@@ -121,7 +124,9 @@ class HeldExchanges(Sequence[Exchange]):
                 if at is None:
                     return None
                 brk = at + 1
-            if cmd is None or rep is None:
+            if cmd is None or rep is None or max(cmd[1], rep[1]) > _MOST_CHARS:
+                return None
+            if max(a.sequence, a.retry) > _MOST_TRIES or len(self.reasons) > _MOST_CHARS:
                 return None
             rows.append((brk, cmd, rep, self._reason(a.reason), a.end, a.sequence, a.retry))
         return rows
