@@ -111,11 +111,11 @@ class HeldExchanges(Sequence[Exchange]):
         docstring)."""
         if x.heard_late or x.late_before is not None or x.next_sent:
             return None
-        if set(x.__dict__) - _EXCHANGE_FIELDS:
+        if not _EXCHANGE_FIELDS.issuperset(x.__dict__):
             return None
         rows = []
         for a in x.attempts:
-            if a.stall is not None or a.stray_events or set(a.__dict__) - _ATTEMPT_FIELDS:
+            if a.stall is not None or a.stray_events or not _ATTEMPT_FIELDS.issuperset(a.__dict__):
                 return None
             cmd, rep = _run(positions, a.command_events), _run(positions, a.reply_events)
             brk = 0
