@@ -23,7 +23,9 @@ records:
   the sensor's exchanges and measurements (what the measurement, data, identification and
   extended cases judge, each measurement's ``aborted_by`` set), their events held as
   positions into the loaded store once their window is read (:mod:`.stored_records`: no
-  event of the run held as an object), and the folds' findings.
+  event of the run held as an object), each exchange outside a measurement then a row of
+  numbers made again when a case reads it (:mod:`.held_exchanges`, ~36 bytes, not ~1.3 KB),
+  and the folds' findings.
 
 Every finding, note and record is the whole-run path's (``tests/offline/
 test_sensor_windows.py`` runs that path, kept in ``tests/support/whole_run_heard.py``, as
