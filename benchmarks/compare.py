@@ -1,6 +1,7 @@
 """Issue 22's figures for two checkouts side by side, in one run, as ratios.
 
-Run: ``python benchmarks/compare.py OLD NEW [--runs N] [--only FIGURE ...] [--minutes M]``,
+Run: ``python benchmarks/compare.py OLD NEW [--runs N] [--only FIGURE ...] [--minutes M]
+[--capture PATH]``,
 OLD and NEW folders holding checkouts (``git worktree add`` or ``git archive`` of a commit).
 Every figure is one fresh child process per measurement, started the way a user starts it
 (``python -m conformance.cli ...`` with ``PYTHONPATH`` the tree, bytecode caching on as in
@@ -80,8 +81,11 @@ def build_exec_example(tree: Path, work: Path) -> Path:
     return out
 
 
-def figures(tree: Path, work: Path, minutes: float) -> dict[str, Callable[[], list[str]]]:
-    """Each figure's command for ``tree`` (built lazily: only the figures asked for)."""
+def figures(
+    tree: Path, work: Path, minutes: float, made: Path | None = None
+) -> dict[str, Callable[[], list[str]]]:
+    """Each figure's command for ``tree`` (built lazily: only the figures asked for);
+    ``made``: the capture the ``capture`` figure judges (else one of ``minutes`` is made)."""
     reports = str(work / "reports")
 
     def exec_c() -> list[str]:
@@ -99,7 +103,8 @@ def figures(tree: Path, work: Path, minutes: float) -> dict[str, Callable[[], li
                    "--lib", str(library), "--report-dir", reports)  # fmt: skip
 
     def capture() -> list[str]:
-        return cli("judge", str(capture_file(work.parent, minutes)), "--report-dir", reports)
+        judged = made if made is not None else capture_file(work.parent, minutes)
+        return cli("judge", str(judged), "--report-dir", reports)
 
     return {
         "sim": lambda: cli("--port", "sim", "--report-dir", reports),
@@ -132,13 +137,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=3, help="measurements per tree and figure")
     parser.add_argument("--only", nargs="+", metavar="FIGURE", help="these figures only")
     parser.add_argument("--minutes", type=float, default=10.0, help="capture length")
+    parser.add_argument(
+        "--capture", type=Path, help="judge this capture (one made before: not made again)"
+    )
     args = parser.parse_args(argv)
     trees = [args.old.resolve(), args.new.resolve()]
     with tempfile.TemporaryDirectory(prefix="sdi12-compare-") as tmp:
         works = {tree: Path(tmp) / f"tree{n}" for n, tree in enumerate(trees)}
         for work in works.values():
             work.mkdir()
-        per_tree = {tree: figures(tree, works[tree], args.minutes) for tree in trees}
+        made = args.capture.resolve() if args.capture is not None else None
+        per_tree = {tree: figures(tree, works[tree], args.minutes, made) for tree in trees}
         names = args.only or list(per_tree[trees[0]])
         unknown = sorted(set(names) - set(per_tree[trees[0]]))
         if unknown:

@@ -474,6 +474,15 @@ class StoredEvents(Sequence[Event]):
         if not runs:
             self.at = array("I" if max(positions) < 2**32 else "q", positions)
 
+    @classmethod
+    def run(cls, store: CompactEvents, lo: int, n: int) -> StoredEvents:
+        """The ``n`` events from position ``lo`` on (a run, as one made of ``range(lo, lo +
+        n)`` holds it; the positions not walked): a held record's list made again
+        (:class:`~conformance.offline.held_exchanges.HeldExchanges`)."""
+        made = cls.__new__(cls)
+        made.store, made.lo, made.n, made.at = store, lo, n, None
+        return made
+
     def positions(self) -> Sequence[int]:
         """The events' positions in the store, in order."""
         return range(self.lo, self.lo + self.n) if self.at is None else self.at

@@ -9,7 +9,7 @@ version, assumptions), so the passive run's reports have the live run's shape.
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 
 from ..declaration import normalise_version
@@ -24,6 +24,7 @@ from ..replay.recording_link import RecordingLink
 from ..tool_recorder.records import Exchange, Measurement
 from ..view.segments import memo
 from .bus_sensors import BusSensor, SensorsOn, sensors_on
+from .held_exchanges import HeldExchanges
 from .sensor_windows import (
     AMBIGUITIES_SHOWN,
     BusWindows,
@@ -110,7 +111,8 @@ class HeardSensors(Heard):
     sensor ``address`` only, when one was given), and its replies' timing and framing
     findings (``records``: the sensor pass, :func:`~.sensor_windows.sensor_records`)."""
 
-    exchanges: list[Exchange] = field(default_factory=list)
+    #: a list, or the sensor pass's held exchanges (:mod:`.held_exchanges`, read-only)
+    exchanges: Sequence[Exchange] = field(default_factory=list)
     measurements: list[Measurement] = field(default_factory=list)
     records: SensorRecords | None = None
 
@@ -124,6 +126,10 @@ class HeardSensors(Heard):
         ]
 
     def exchanges_of(self, *kinds: Kind) -> list[Exchange]:
+        """The recorded exchanges whose command is of ``kinds``, in order (of held exchanges,
+        only those made)."""
+        if isinstance(self.exchanges, HeldExchanges):
+            return self.exchanges.of_kinds(kinds)
         return [x for x in self.exchanges if x.command is not None and x.command.kind in kinds]
 
     def claim(self) -> DutClaim:
@@ -197,7 +203,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         link,
         forced_version=normalise_version(version) if version else None,
         address=address,
-        exchanges=list(records.exchanges),
+        exchanges=records.exchanges,  # (read-only: no copy)
         measurements=list(records.measurements),
         records=records,
         on_bus=list(bus.sensors),

@@ -23,7 +23,9 @@ records:
   the sensor's exchanges and measurements (what the measurement, data, identification and
   extended cases judge, each measurement's ``aborted_by`` set), their events held as
   positions into the loaded store once their window is read (:mod:`.stored_records`: no
-  event of the run held as an object), and the folds' findings.
+  event of the run held as an object), each exchange outside a measurement then a row of
+  numbers made again when a case reads it (:mod:`.held_exchanges`, ~36 bytes, not ~1.3 KB),
+  and the folds' findings.
 
 Every finding, note and record is the whole-run path's (``tests/offline/
 test_sensor_windows.py`` runs that path, kept in ``tests/support/whole_run_heard.py``, as
@@ -33,7 +35,7 @@ the oracle on the shared captures, busy-bus captures and recordings with sensor 
 from __future__ import annotations
 
 from array import array
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from itertools import pairwise
 from typing import TYPE_CHECKING
@@ -61,6 +63,7 @@ from ..view.segments import (
 from ..view.windows import WindowedTransmissions, stream_window_sides, window_view
 from .bus_sensors import BusSensor, SensorsOn
 from .decode_quality import CharRates, Quality, problems_by_character, sensor_characters
+from .held_exchanges import HeldExchanges
 from .stored_records import Positions, store_records
 
 if TYPE_CHECKING:
@@ -349,7 +352,8 @@ class SensorRecords:
     measurements (``aborted_by`` set) and its replies' timing and framing findings
     (R-7.0-09/-10, R-7.0-12 with R-7.0-01, R-4.1-01, R-4.1-02/-4.2-02/-4.2-03/-4.3-01)."""
 
-    exchanges: list[Exchange]
+    #: held as rows, each made again when read (:mod:`.held_exchanges`)
+    exchanges: Sequence[Exchange]
     measurements: list[Measurement]
     response_start: list[Finding]
     gaps: list[Finding]
@@ -366,7 +370,8 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     starts, gaps = ResponseStarts(stamps, stalls), ReplyGaps(stamps, stalls)
     rate, framing = ReplyBitRate(stamps), Framing(stamps, stalls=stalls)
     disturbed, carried = Disturbances(), {}
-    exchanges: list[Exchange] = []
+    events = link.transcript.events
+    exchanges = HeldExchanges(events if isinstance(events, CompactEvents) else None)
     measurements: list[Measurement] = []
     for positions, view in bus.read_placed(address, disturbed.waiting):
         rebuilt = rebuild_records(view, uncertainty=u, only=address, carried=carried)
@@ -378,13 +383,19 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
             fold.add(segs)
         if positions is not None:  # held for the run as positions, not objects
             store_records(positions, rebuilt.exchanges, rebuilt.measurements)
-        exchanges += rebuilt.exchanges
+        exchanges.add(positions, rebuilt.exchanges, measured(rebuilt.measurements))
         measurements += rebuilt.measurements
     disturbed.finish()
     return SensorRecords(
         exchanges, measurements, starts.findings(), gaps.findings(), rate.finding(),
         framing.findings(),
     )  # fmt: skip
+
+
+def measured(measurements: Iterable[Measurement]) -> set[int]:
+    """The ids of the exchanges ``measurements`` hold (each one's start and data): kept as the
+    objects in a sensor's held exchanges, the very ones its measurements read."""
+    return {id(x) for m in measurements for x in (m.start, *m.data)}
 
 
 def noted_stalls(events: Sequence[Event]) -> list[host_stall.Stall]:
