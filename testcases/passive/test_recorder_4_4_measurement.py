@@ -30,7 +30,8 @@ def test_waiting_for_the_service_request(heard_recorder, case):
     then asks for aD0! at once, and talks to no other sensor until the data are in."""
     case.expect("aD0! not before the service request / ttt; within 0.5 s after it")
     u = heard_recorder.uncertainty
-    judged(case, judge_measure_waits(_taken(heard_recorder), u))
+    found = recorder_findings(heard_recorder.link)
+    judged(case, judge_measure_waits(found.measurements, u, found.stalls))
 
 
 @requirements("R-4.4.7-06")

@@ -1,10 +1,16 @@
 """Judges of how the recorder waits for data: the service request or ttt, the line left
-alone, no early data command (R-4.4.5-04..07, R-4.4.7-06)."""
+alone, no early data command (R-4.4.5-04..07, R-4.4.7-06).
+
+A measurement the recorder tried again instead of collecting (no aD0!, the same command
+next) across a noted stall of the tool's host is undecided naming the stall (truth33): the
+played sensor's reply went out late, or an in-process recorder was paused over it, and a
+recorder that gave up on a reply it did not get in time tried again as it must."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ...links.host_stall import Stall, stalled_over
 from ...protocol.commands import CONCURRENT_KINDS
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
@@ -21,11 +27,14 @@ from .common import (
 from .measurements import ObservedMeasurement
 
 
-def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float) -> list[Finding]:
+def judge_measure_waits(
+    taken: Sequence[ObservedMeasurement], uncertainty: float, stalls: Sequence[Stall] = ()
+) -> list[Finding]:
     """For aM!-type measurements with ttt > 0: R-4.4.5-04 no aD0! before the service request
     or ttt; R-4.4.5-07 the line left alone while waiting; R-4.4.5-05 aD0! promptly when the
     service request comes or ttt runs out (then after a break), and at once for ttt = 0
-    (SHOULD); R-4.4.5-06 no traffic to other sensors until the data are in."""
+    (SHOULD); R-4.4.5-06 no traffic to other sensors until the data are in. ``stalls``: the
+    tool's host stalls noted in the recording (:func:`_no_data_command`)."""
     early: list[Finding] = []
     tally = Tally(("R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07"))
     for m in taken:
@@ -67,7 +76,7 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
                 f"reply, while a service request could still come",
             )
         if first is None:
-            _no_data_command(tally, m, where, ready, uncertainty)
+            _no_data_command(tally, m, where, ready, uncertainty, stalls)
             continue
         if sr is None or sr > first.start:
             early.append(
@@ -145,14 +154,29 @@ def judge_concurrent_waits(
 
 
 def _no_data_command(
-    tally: Tally, m: ObservedMeasurement, where: str, ready: float, uncertainty: float
+    tally: Tally,
+    m: ObservedMeasurement,
+    where: str,
+    ready: float,
+    uncertainty: float,
+    stalls: Sequence[Stall] = (),
 ) -> None:
     """R-4.4.5-05 for a measurement after which no aD0! came: a FAIL when the recorder moved on
-    or ended its job. When the tool cut the job at its budget with the recorder still in this
+    or ended its job; undecided, naming the stall, when it sent the same command again
+    (nothing else between) across a noted stall of the tool's host (:func:`_tried_again`).
+    When the tool cut the job at its budget with the recorder still in this
     measurement: a FAIL when the cut came past the allowance after the service request or ttt
     (no aD0! at all where one was due: not a late one, which decision T1 makes a WARN);
     undecided when it came before an aD0! was due, which says nothing."""
     if m.cut_at is None:
+        stall = _tried_again(m, stalls)
+        if stall is not None:
+            tally.undecide(
+                "R-4.4.5-05",
+                where,
+                f"no aD0! after the measurement (its command sent again), but {stall.why()}",
+            )
+            return
         tally.fail("R-4.4.5-05", where, "no aD0! after the measurement")
         return
     sr = m.service_request_end
@@ -173,6 +197,18 @@ def _no_data_command(
             f"the tool cut the job at its budget {waited:.3f} s after {what}, before an "
             f"aD0! was due (within {REACTION} s, decision {REACTION_DECISION})",
         )
+
+
+def _tried_again(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None:
+    """The first noted stall between ``m``'s command and the recorder sending that command
+    again with nothing between (a new try: it took the reply for missing), None where it
+    did something else or no stall lies between. truth32's paused clean runs: the played
+    sensor's reply went out 150 ms late, or the in-process recorder was paused as it came,
+    and the recorder tried again over or after it; a reply taken in time is no such case."""
+    again = m.next_start
+    if not stalls or again is None or m.others or again.text != m.start.text:
+        return None
+    return stalled_over(list(stalls), m.start.start, again.start)
 
 
 def _not_d0(first: Transmission) -> bool:

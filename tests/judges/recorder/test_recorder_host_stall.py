@@ -15,7 +15,9 @@ import pytest
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
+from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_retries
+from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.links.host_stall import note_text
 from conformance.transcript import TOOL, Event, EventKind
 from conformance.verdicts import Finding, Verdict
@@ -323,3 +325,51 @@ def test_no_retry_to_a_try_a_stall_sent_to_a_sleeping_sensor_is_held_r_7_2_02_r_
     _held(found["R-7.2-03"])
     far = by_id(judge_retries(_asleep(False).view(), 0.0))
     assert far["R-7.2-02"].verdict is far["R-7.2-03"].verdict is Verdict.FAIL
+
+
+# -- the wait for data: R-4.4.5-05 -------------------------------------------------------------
+
+
+def _measure_tried_again(stalled: bool, reply_ms: float = 150.0) -> Stalling:
+    """truth32's paused clean run (in-process golden recorder): the played sensor's reply to
+    0M! went out ``reply_ms`` late, the recorder had given up on it and sent 0M! again with a
+    break over it; the first 0M! read "no aD0! after the measurement"."""
+    w = Stalling().brk().rec("0M!").sensor("00023\r\n", delay_ms=reply_ms)
+    if stalled:
+        w.stall(160)
+    w.brk().rec("0M!").sensor("00023\r\n").sensor("0\r\n", delay_ms=300)
+    w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
+    return w if stalled else _far(w)
+
+
+def _waits(w: Stalling) -> dict[str, Finding]:
+    view = w.view()
+    return by_id(judge_measure_waits(observed_measurements(view, 0.0), 0.0, view.stalls))
+
+
+def test_a_measurement_tried_again_across_a_stall_is_held_r_4_4_5_05():
+    found = _waits(_measure_tried_again(True))["R-4.4.5-05"]
+    _held(found)
+    assert "no aD0! after the measurement" in found.detail
+    assert _waits(_measure_tried_again(False))["R-4.4.5-05"].verdict is Verdict.FAIL
+    # without the stalls given, judged as before
+    view = _measure_tried_again(True).view()
+    plain = by_id(judge_measure_waits(observed_measurements(view, 0.0), 0.0))["R-4.4.5-05"]
+    assert plain.verdict is Verdict.FAIL
+
+
+def test_a_measurement_given_up_for_another_command_across_a_stall_still_fails_r_4_4_5_05():
+    """A recorder that turns to another command after the reply (no new try of the
+    measurement) is not excused by a stall: nothing it did waited on a late reply."""
+    w = Stalling().brk().rec("0M!").sensor("00023\r\n").stall(120)
+    w.idle(50).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    assert _waits(w)["R-4.4.5-05"].verdict is Verdict.FAIL
+
+
+def test_a_missing_break_after_ttt_across_a_stall_still_fails_r_4_4_5_05():
+    """aD0! after ttt without a break is the recorder's choice, which a stall does not make
+    (truth32's faulty runs, ``no-break-after-87ms``: R-4.4.5-05 FAILed there and still does)."""
+    w = Stalling().brk().rec("0M!").sensor("00013\r\n").idle(1000).stall(120).idle(10)
+    w.rec("0D0!").sensor("0+1+2+3\r\n")
+    found = _waits(w)["R-4.4.5-05"]
+    assert found.verdict is Verdict.FAIL and "without a break" in found.detail
