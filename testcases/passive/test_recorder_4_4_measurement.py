@@ -49,7 +49,8 @@ def test_data_continuation(heard_recorder, case):
     """D0, D1, D2... until every announced value is in; the measurement again after an empty
     D reply."""
     case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
-    judged(case, judge_data_collection(_taken(heard_recorder)))
+    found = recorder_findings(heard_recorder.link)
+    judged(case, judge_data_collection(found.measurements, found.stalls))
 
 
 @requirements("R-5.1-04", "R-5.2-08")

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Collection, Sequence
 
+from ...links.host_stall import Stall
 from ...protocol.binary import parse_binary_packet
 from ...protocol.commands import CommandError, Kind, parse_command
 from ...transcript import decode_8n1, escape
@@ -14,13 +15,19 @@ from ...view.segments import Transmission
 from ..tally import Tally
 from .common import CUT_SHORT, MIN_CONCURRENT_STORE
 from .measurements import ObservedMeasurement, collection_end, read_past_empty
+from .stalls import over_collection, tried_again
 
 
-def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]:
+def judge_data_collection(
+    taken: Sequence[ObservedMeasurement], stalls: Sequence[Stall] = ()
+) -> list[Finding]:
     """R-4.4.8-05: aD0!, aD1!, ... in order until every announced value is in; after a valid
     empty reply the measurement is issued again. A collection that ended on a reply the
     recorder found invalid is left to the retry rules (section 7.2), unless a valid empty
-    reply before it was read past without the measurement issued again."""
+    reply before it was read past without the measurement issued again. One that stopped
+    short across a noted stall of the tool's host (``stalls``) is undecided naming it, where
+    the stall can account for it (:func:`.stalls.tried_again`, :func:`.stalls.
+    over_collection`, truth33)."""
     tally = Tally(("R-4.4.8-05",))
     for m in taken:
         if m.kind is Kind.HIGH_VOLUME_BINARY or not m.count:
@@ -60,7 +67,12 @@ def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]
                 )
             continue
         stop = escape(last.text) if last is not None else "the reply"
-        tally.fail("R-4.4.8-05", where, f"stopped after {stop} with {have} of {m.count} values")
+        short = f"stopped after {stop} with {have} of {m.count} values"
+        stall = over_collection(m, stalls) if m.data else tried_again(m, stalls)
+        if stall is not None:
+            tally.undecide("R-4.4.8-05", where, f"{short}, but {stall.why()}")
+            continue
+        tally.fail("R-4.4.8-05", where, short)
     return tally.findings("every announced value collected in order")
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ...links.host_stall import Stall, stalled_over
+from ...links.host_stall import Stall
 from ...protocol.commands import CONCURRENT_KINDS
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
@@ -25,6 +25,7 @@ from .common import (
     combine,
 )
 from .measurements import ObservedMeasurement
+from .stalls import tried_again
 
 
 def judge_measure_waits(
@@ -163,13 +164,13 @@ def _no_data_command(
 ) -> None:
     """R-4.4.5-05 for a measurement after which no aD0! came: a FAIL when the recorder moved on
     or ended its job; undecided, naming the stall, when it sent the same command again
-    (nothing else between) across a noted stall of the tool's host (:func:`_tried_again`).
+    (nothing else between) across a noted stall of the tool's host (:func:`.stalls.tried_again`).
     When the tool cut the job at its budget with the recorder still in this
     measurement: a FAIL when the cut came past the allowance after the service request or ttt
     (no aD0! at all where one was due: not a late one, which decision T1 makes a WARN);
     undecided when it came before an aD0! was due, which says nothing."""
     if m.cut_at is None:
-        stall = _tried_again(m, stalls)
+        stall = tried_again(m, stalls)
         if stall is not None:
             tally.undecide(
                 "R-4.4.5-05",
@@ -197,18 +198,6 @@ def _no_data_command(
             f"the tool cut the job at its budget {waited:.3f} s after {what}, before an "
             f"aD0! was due (within {REACTION} s, decision {REACTION_DECISION})",
         )
-
-
-def _tried_again(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None:
-    """The first noted stall between ``m``'s command and the recorder sending that command
-    again with nothing between (a new try: it took the reply for missing), None where it
-    did something else or no stall lies between. truth32's paused clean runs: the played
-    sensor's reply went out 150 ms late, or the in-process recorder was paused as it came,
-    and the recorder tried again over or after it; a reply taken in time is no such case."""
-    again = m.next_start
-    if not stalls or again is None or m.others or again.text != m.start.text:
-        return None
-    return stalled_over(list(stalls), m.start.start, again.start)
 
 
 def _not_d0(first: Transmission) -> bool:

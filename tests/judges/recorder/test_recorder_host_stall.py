@@ -14,11 +14,13 @@ from types import SimpleNamespace
 import pytest
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
+from conformance.judges.recorder.collection import judge_data_collection
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_retries
 from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.links.host_stall import note_text
+from conformance.offline.recorder_windows import judge_views
 from conformance.transcript import TOOL, Event, EventKind
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import merge_views
@@ -231,7 +233,6 @@ def test_the_passive_folds_read_the_recordings_stalls():
     """A window's view holds no notes: the recording's stalls go to the folds."""
     from conformance.judges.recorder.commands import CharacterGaps
     from conformance.links.host_stall import stalls
-    from conformance.offline.recorder_windows import judge_views
     from conformance.view.segments import read_view
 
     events = _gap_in_command(3.0, True).events
@@ -373,3 +374,55 @@ def test_a_missing_break_after_ttt_across_a_stall_still_fails_r_4_4_5_05():
     w.rec("0D0!").sensor("0+1+2+3\r\n")
     found = _waits(w)["R-4.4.5-05"]
     assert found.verdict is Verdict.FAIL and "without a break" in found.detail
+
+
+# -- data collection: R-4.4.8-05 ---------------------------------------------------------------
+
+
+def _collection(w: Stalling) -> Finding:
+    view = w.view()
+    return by_id(judge_data_collection(observed_measurements(view, 0.0), view.stalls))["R-4.4.8-05"]
+
+
+def test_a_measurement_tried_again_across_a_stall_is_held_r_4_4_8_05():
+    """The same run: R-4.4.8-05 read "0M!: stopped after the reply with 0 of 3 values"."""
+    found = _collection(_measure_tried_again(True))
+    _held(found)
+    assert "stopped after the reply with 0 of 3 values" in found.detail
+    assert _collection(_measure_tried_again(False)).verdict is Verdict.FAIL
+
+
+def _stopped_short(stalled: bool) -> Stalling:
+    """0M2! (9 values), D0 and D1 read, then another command: "stopped after 0D1! with
+    6 of 9 values". Stalled: D1's reply came in across a noted stall (truth32's paused clean
+    run: D1's and D2's replies met the recorder's retries, the recorder logged all 9)."""
+    w = Stalling().brk().rec("0M2!").sensor("00029\r\n").sensor("0\r\n", delay_ms=300)
+    w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n").idle(9).rec("0D1!")
+    w.sensor("0+4+5+6\r\n", delay_ms=150 if stalled else 9.0)
+    if stalled:
+        w.stall(140)
+    w.idle(100).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    return w if stalled else _far(w)
+
+
+def test_a_collection_stopped_short_across_a_stall_is_held_r_4_4_8_05():
+    found = _collection(_stopped_short(True))
+    _held(found)
+    assert "stopped after 0D1! with 6 of 9 values" in found.detail
+    assert _collection(_stopped_short(False)).verdict is Verdict.FAIL
+
+
+def test_a_collection_stopped_short_with_the_stall_before_it_still_fails_r_4_4_8_05():
+    """A stall over the measurement's reply, before its data were asked for, says nothing
+    of the values counted: stopping short is the recorder's doing."""
+    w = Stalling().brk().rec("0M2!").sensor("00029\r\n").stall(80)
+    w.sensor("0\r\n", delay_ms=300).idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
+    w.idle(100).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    assert _collection(w).verdict is Verdict.FAIL
+
+
+def test_the_passive_findings_carry_the_recordings_stalls():
+    """The passive measurement cases read them from :func:`recorder_findings`."""
+    w = _measure_tried_again(True)
+    found = judge_views([w.view()], 0.0, w.view().stalls)
+    assert found.stalls == tuple(w.view().stalls) and len(found.stalls) == 1
