@@ -60,7 +60,8 @@ def test_high_volume(heard_recorder, case):
     value (or the empty packet) is in. (Whether a v1.4 recorder issues both, R-5.4-01, is a
     question of what it can do, not of what one recording shows: not judged here.)"""
     case.expect("0D10!..0D14! (never 0D010!); DB0..DBn read, then stop")
-    found = judge_high_volume(_taken(heard_recorder), heard_recorder.is_v14)
+    held = recorder_findings(heard_recorder.link)
+    found = judge_high_volume(held.measurements, heard_recorder.is_v14, stalls=held.stalls)
     judged_only(case, found, *case.requirements)
 
 

@@ -14,13 +14,14 @@ from types import SimpleNamespace
 import pytest
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
-from conformance.judges.recorder.collection import judge_data_collection
+from conformance.judges.recorder.collection import judge_data_collection, judge_high_volume
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_retries
 from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.links.host_stall import note_text
 from conformance.offline.recorder_windows import judge_views
+from conformance.protocol.crc import ascii_crc
 from conformance.transcript import TOOL, Event, EventKind
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import merge_views
@@ -426,3 +427,34 @@ def test_the_passive_findings_carry_the_recordings_stalls():
     w = _measure_tried_again(True)
     found = judge_views([w.view()], 0.0, w.view().stalls)
     assert found.stalls == tuple(w.view().stalls) and len(found.stalls) == 1
+
+
+# -- high-volume collection: R-5.1-04 ----------------------------------------------------------
+
+
+def _high_volume_short(stalled: bool) -> Stalling:
+    """0HA! (33 values), D0 read, its D1's reply across a noted stall, then another
+    command: "stopped at 0D1! with 6 of 33 values" (truth32's paused runs: "0HA!: stopped at
+    0D0! with 8 of 120 values", its replies met by the recorder's retries)."""
+    w = Stalling().brk().rec("0HA!").sensor("0002033\r\n").idle(2100).brk().rec("0D0!")
+    w.sensor(f"{_crc('0+1+2+3')}\r\n").idle(9).rec("0D1!").sensor(f"{_crc('0+4+5+6')}\r\n")
+    if stalled:
+        w.stall(140)
+    w.idle(100).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    return w if stalled else _far(w)
+
+
+def _crc(text: str) -> str:
+    return text + ascii_crc(text)
+
+
+def test_a_high_volume_collection_stopped_short_across_a_stall_is_held_r_5_1_04():
+    def judged(w: Stalling) -> Finding:
+        view = w.view()
+        taken = observed_measurements(view, 0.0)
+        return by_id(judge_high_volume(taken, True, stalls=view.stalls))["R-5.1-04"]
+
+    found = judged(_high_volume_short(True))
+    _held(found)
+    assert "with 6 of 33 values" in found.detail
+    assert judged(_high_volume_short(False)).verdict is Verdict.FAIL
