@@ -29,6 +29,7 @@ from ...links.host_stall import REACH, Stall, stalled_over
 from ...verdicts import Finding, Verdict
 from ..stalled import stalled_interval
 from ..timing import Measured
+from .common import REACTION
 
 if TYPE_CHECKING:
     from .measurements import ObservedMeasurement
@@ -92,17 +93,21 @@ def _figures(judged: Finding | Measured) -> tuple[float | None, float]:
 
 
 def tried_again(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None:
-    """The first noted stall between ``m``'s command and the recorder sending that command
-    again with nothing between (a new try: it took the reply for missing), None where it
-    did something else or no stall lies between (truth33). truth32's paused clean runs: the
-    played sensor's reply went out 150 ms late, or the in-process recorder was paused as it
-    came, and the recorder tried again over or after it; "no aD0!" (R-4.4.5-05) and "0 of 3
-    values" (R-4.4.8-05) were the host's doing. A recorder that turns to anything else
-    after the reply is not excused."""
+    """The first noted stall over ``m``'s command and its reply, where the recorder sent that
+    command again next (nothing between; a new try: it took the reply for missing) within
+    :data:`~.common.REACTION` of the stall's end; None otherwise (truth33). truth32's paused
+    clean runs: the played sensor's reply went out 150 ms late, or the in-process recorder
+    was paused as it came, and the recorder tried again 0-230 ms after it; "no aD0!"
+    (R-4.4.5-05) and "0 of 3 values" (R-4.4.8-05) were the host's doing. A recorder that
+    turns to anything else after the reply, or sends the command again long after the
+    stall, is not excused."""
     again = m.next_start
     if not stalls or again is None or m.others or again.text != m.start.text:
         return None
-    return stalled_over(list(stalls), m.start.start, again.start)
+    stall = stalled_over(list(stalls), m.start.start, m.reply_end)
+    if stall is None or again.start > stall.end + REACTION:
+        return None
+    return stall
 
 
 def over_collection(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None:

@@ -360,6 +360,15 @@ def test_a_measurement_tried_again_across_a_stall_is_held_r_4_4_5_05():
     assert plain.verdict is Verdict.FAIL
 
 
+def test_a_measurement_sent_again_long_after_a_stall_still_fails_r_4_4_5_05():
+    """The same command again 2 s after the stall over its reply is the recorder's doing."""
+    w = Stalling().brk().rec("0M!").sensor("00023\r\n").stall(120).idle(2000)
+    w.brk().rec("0M!").sensor("00023\r\n").sensor("0\r\n", delay_ms=300)
+    w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
+    assert _waits(w)["R-4.4.5-05"].verdict is Verdict.FAIL
+    assert _collection(w).verdict is Verdict.FAIL
+
+
 def test_a_measurement_given_up_for_another_command_across_a_stall_still_fails_r_4_4_5_05():
     """A recorder that turns to another command after the reply (no new try of the
     measurement) is not excused by a stall: nothing it did waited on a late reply."""
