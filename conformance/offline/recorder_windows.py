@@ -42,7 +42,8 @@ class RecorderFindings:
     ``judge_breaks``, ``judge_break_rules``, ``judge_command_text``,
     ``judge_character_gaps``, ``judge_command_bit_rate``, ``observed_measurements`` (the
     four measurement cases judge them), ``judge_retries`` and ``judge_addresses``; and how
-    many windows the recording was read in."""
+    many windows the recording was read in; the tool's host stalls noted in the recording,
+    which the measurement cases' judges read too (truth33)."""
 
     breaks: list[Finding]
     break_rules: list[Finding]
@@ -53,6 +54,7 @@ class RecorderFindings:
     retries: list[Finding]
     addresses: list[Finding]
     windows: int
+    stalls: tuple[Stall, ...] = ()
 
 
 def judge_windows(
@@ -88,7 +90,7 @@ def judge_views(
     return RecorderFindings(
         breaks.findings(), rules.findings(), text.findings(), gaps.findings(),
         rate.finding(), taken.measurements(), retries.findings(), addresses.findings(),
-        count,
+        count, tuple(stalls),
     )  # fmt: skip
 
 

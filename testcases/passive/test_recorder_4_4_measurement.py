@@ -30,7 +30,8 @@ def test_waiting_for_the_service_request(heard_recorder, case):
     then asks for aD0! at once, and talks to no other sensor until the data are in."""
     case.expect("aD0! not before the service request / ttt; within 0.5 s after it")
     u = heard_recorder.uncertainty
-    judged(case, judge_measure_waits(_taken(heard_recorder), u))
+    found = recorder_findings(heard_recorder.link)
+    judged(case, judge_measure_waits(found.measurements, u, found.stalls))
 
 
 @requirements("R-4.4.7-06")
@@ -48,7 +49,8 @@ def test_data_continuation(heard_recorder, case):
     """D0, D1, D2... until every announced value is in; the measurement again after an empty
     D reply."""
     case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
-    judged(case, judge_data_collection(_taken(heard_recorder)))
+    found = recorder_findings(heard_recorder.link)
+    judged(case, judge_data_collection(found.measurements, found.stalls))
 
 
 @requirements("R-5.1-04", "R-5.2-08")
@@ -58,7 +60,8 @@ def test_high_volume(heard_recorder, case):
     value (or the empty packet) is in. (Whether a v1.4 recorder issues both, R-5.4-01, is a
     question of what it can do, not of what one recording shows: not judged here.)"""
     case.expect("0D10!..0D14! (never 0D010!); DB0..DBn read, then stop")
-    found = judge_high_volume(_taken(heard_recorder), heard_recorder.is_v14)
+    held = recorder_findings(heard_recorder.link)
+    found = judge_high_volume(held.measurements, heard_recorder.is_v14, stalls=held.stalls)
     judged_only(case, found, *case.requirements)
 
 

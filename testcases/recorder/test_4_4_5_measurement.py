@@ -34,7 +34,7 @@ def test_waiting_for_the_service_request(recorder, case):
     )
     line = line_of(recorder, case, *WAIT_SCENARIOS)
     taken = observed_measurements(line, recorder.uncertainty)
-    case.extend(judge_measure_waits(taken, recorder.uncertainty))
+    case.extend(judge_measure_waits(taken, recorder.uncertainty, line.stalls))
 
 
 @requirements("R-7.1-01")

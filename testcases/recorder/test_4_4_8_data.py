@@ -27,4 +27,5 @@ def test_data_continuation(recorder, case):
         "families",
     )
     line = line_of(recorder, case, *names)
-    case.extend(judge_data_collection(observed_measurements(line, recorder.uncertainty)))
+    taken = observed_measurements(line, recorder.uncertainty)
+    case.extend(judge_data_collection(taken, line.stalls))

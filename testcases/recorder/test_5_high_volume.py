@@ -23,4 +23,5 @@ def test_high_volume(recorder, case):
         return
     taken = observed_measurements(line, recorder.uncertainty)
     sent = {s.text for s in line.transmissions}
-    case.extend(judge_high_volume(taken, recorder.is_v14, sent, cut=bool(line.cut_parts)))
+    cut = bool(line.cut_parts)
+    case.extend(judge_high_volume(taken, recorder.is_v14, sent, cut, line.stalls))

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Collection, Sequence
 
+from ...links.host_stall import Stall
 from ...protocol.binary import parse_binary_packet
 from ...protocol.commands import CommandError, Kind, parse_command
 from ...transcript import decode_8n1, escape
@@ -14,13 +15,19 @@ from ...view.segments import Transmission
 from ..tally import Tally
 from .common import CUT_SHORT, MIN_CONCURRENT_STORE
 from .measurements import ObservedMeasurement, collection_end, read_past_empty
+from .stalls import over_collection, tried_again
 
 
-def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]:
+def judge_data_collection(
+    taken: Sequence[ObservedMeasurement], stalls: Sequence[Stall] = ()
+) -> list[Finding]:
     """R-4.4.8-05: aD0!, aD1!, ... in order until every announced value is in; after a valid
     empty reply the measurement is issued again. A collection that ended on a reply the
     recorder found invalid is left to the retry rules (section 7.2), unless a valid empty
-    reply before it was read past without the measurement issued again."""
+    reply before it was read past without the measurement issued again. One that stopped
+    short across a noted stall of the tool's host (``stalls``) is undecided naming it, where
+    the stall can account for it (:func:`.stalls.tried_again`, :func:`.stalls.
+    over_collection`, truth33)."""
     tally = Tally(("R-4.4.8-05",))
     for m in taken:
         if m.kind is Kind.HIGH_VOLUME_BINARY or not m.count:
@@ -60,7 +67,8 @@ def judge_data_collection(taken: Sequence[ObservedMeasurement]) -> list[Finding]
                 )
             continue
         stop = escape(last.text) if last is not None else "the reply"
-        tally.fail("R-4.4.8-05", where, f"stopped after {stop} with {have} of {m.count} values")
+        short = f"stopped after {stop} with {have} of {m.count} values"
+        _stopped_short(tally, "R-4.4.8-05", m, where, short, stalls)
     return tally.findings("every announced value collected in order")
 
 
@@ -140,6 +148,25 @@ def _issued_again(m: ObservedMeasurement) -> bool:
     return not m.data and m.next_start is not None and m.next_start.text == m.start.text
 
 
+def _stopped_short(
+    tally: Tally,
+    rid: str,
+    m: ObservedMeasurement,
+    where: str,
+    short: str,
+    stalls: Sequence[Stall],
+) -> None:
+    """``rid`` FAILs ``short`` (a collection of ``m`` that stopped before every value was
+    in), or is undecided naming the stall where a noted stall of the tool's host can account
+    for it (:func:`.stalls.over_collection` over its data, :func:`.stalls.tried_again` where
+    none came: truth33)."""
+    stall = over_collection(m, stalls) if m.data else tried_again(m, stalls)
+    if stall is not None:
+        tally.undecide(rid, where, f"{short}, but {stall.why()}")
+    else:
+        tally.fail(rid, where, short)
+
+
 def _ended_on_problem(m: ObservedMeasurement) -> bool:
     return collection_end(m)[1] is not None
 
@@ -149,13 +176,16 @@ def judge_high_volume(
     is_v14: bool,
     sent: Collection[str] = (),
     cut: bool = False,
+    stalls: Sequence[Stall] = (),
 ) -> list[Finding]:
     """R-5.1-04: after aHA! data commands go past aD9! as needed, without leading zeros.
     R-5.2-08: after aHB! aDBn! commands in 7E1, packets checked, collection stops at the empty
     packet or once every value is in. R-5.4-01: a v1.4 recorder issues aHA! and aHB! and reads
     their data back; one it sent (``sent``: the texts it transmitted) that no valid reply
     answered leaves the reading back unseen (undecided, not a FAIL); so does one not sent in a
-    view with a job cut at its budget (``cut``), and a collection that cut left unfinished."""
+    view with a job cut at its budget (``cut``), and a collection that cut left unfinished.
+    A collection stopped short across a noted stall of the tool's host (``stalls``) is
+    undecided naming it (:func:`_stopped_short`)."""
     tally = Tally(("R-5.1-04", "R-5.2-08", "R-5.4-01"))
     used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
     unheard: set[Kind] = set()  # started, its collection ended on a D command unanswered
@@ -180,19 +210,17 @@ def judge_high_volume(
                 tally.fail(rid, where, "a DB command was not sent in 7E1 (parity)")
             last, problem, empty = collection_end(m)
             if problem is None and have < m.count and not empty and m.cut_at is None:
-                tally.fail(rid, where, f"stopped with {have} of {m.count} values, no empty packet")
+                short = f"stopped with {have} of {m.count} values, no empty packet"
+                _stopped_short(tally, rid, m, where, short, stalls)
             extra = _after_done(m)
             if extra:
                 tally.fail(rid, where, f"{escape(extra.text)} sent after every value was in")
         else:
             last, problem, _ = collection_end(m)
             if problem is None and have < m.count and m.cut_at is None:
-                tally.fail(
-                    rid,
-                    where,
-                    f"stopped at {escape(last.text) if last else 'D0'} with "
-                    f"{have} of {m.count} values",
-                )
+                stop = escape(last.text) if last else "D0"
+                short = f"stopped at {stop} with {have} of {m.count} values"
+                _stopped_short(tally, rid, m, where, short, stalls)
     if is_v14:
         for kind, ok in used.items():
             tally.observe(kind.value.replace("a", "", 1), ids=["R-5.4-01"])

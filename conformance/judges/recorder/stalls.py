@@ -23,12 +23,16 @@ enough that the recorder broke into it; R-7.2-06 FAILed on it).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
-from ...links.host_stall import REACH, Stall
+from ...links.host_stall import REACH, Stall, stalled_over
 from ...verdicts import Finding, Verdict
 from ..stalled import stalled_interval
 from ..timing import Measured
+from .common import REACTION
+
+if TYPE_CHECKING:
+    from .measurements import ObservedMeasurement
 
 J = TypeVar("J", Finding, Measured)
 _DEVIATING = (Verdict.FAIL, Verdict.WARN)
@@ -86,3 +90,34 @@ def _figures(judged: Finding | Measured) -> tuple[float | None, float]:
     if judged.measured_ms is None:
         return None, 0.0
     return judged.measured_ms / 1e3, (judged.uncertainty_ms or 0.0) / 1e3
+
+
+def tried_again(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None:
+    """The first noted stall over ``m``'s command and its reply, where the recorder sent that
+    command again next (nothing between; a new try: it took the reply for missing) within
+    :data:`~.common.REACTION` of the stall's end; None otherwise (truth33). truth32's paused
+    clean runs: the played sensor's reply went out 150 ms late, or the in-process recorder
+    was paused as it came, and the recorder tried again 0-230 ms after it; "no aD0!"
+    (R-4.4.5-05) and "0 of 3 values" (R-4.4.8-05) were the host's doing. A recorder that
+    turns to anything else after the reply, or sends the command again long after the
+    stall, is not excused."""
+    again = m.next_start
+    if not stalls or again is None or m.others or again.text != m.start.text:
+        return None
+    stall = stalled_over(list(stalls), m.start.start, m.reply_end)
+    if stall is None or again.start > stall.end + REACTION:
+        return None
+    return stall
+
+
+def over_collection(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None:
+    """The first noted stall over ``m``'s data exchanges, from its first data command to the
+    end of what its last one heard, None where none is (truth33): a reply held back meets
+    the recorder's retry and what the view reads of it is garbled (truth32's paused clean
+    run: 0M2!'s D1 and D2 replies collided with retries, "stopped after 0D2! with 6 of 9
+    values" though the recorder logged all 9), so the values counted are not the recorder's."""
+    if not stalls or not m.data:
+        return None
+    last = m.data[-1][0]
+    end = last.heard[-1].end if last.heard else last.end
+    return stalled_over(list(stalls), m.data[0][0].start, end)

@@ -1,10 +1,16 @@
 """Judges of how the recorder waits for data: the service request or ttt, the line left
-alone, no early data command (R-4.4.5-04..07, R-4.4.7-06)."""
+alone, no early data command (R-4.4.5-04..07, R-4.4.7-06).
+
+A measurement the recorder tried again instead of collecting (no aD0!, the same command
+next) across a noted stall of the tool's host is undecided naming the stall (truth33): the
+played sensor's reply went out late, or an in-process recorder was paused over it, and a
+recorder that gave up on a reply it did not get in time tried again as it must."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ...links.host_stall import Stall
 from ...protocol.commands import CONCURRENT_KINDS
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
@@ -19,13 +25,17 @@ from .common import (
     combine,
 )
 from .measurements import ObservedMeasurement
+from .stalls import tried_again
 
 
-def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float) -> list[Finding]:
+def judge_measure_waits(
+    taken: Sequence[ObservedMeasurement], uncertainty: float, stalls: Sequence[Stall] = ()
+) -> list[Finding]:
     """For aM!-type measurements with ttt > 0: R-4.4.5-04 no aD0! before the service request
     or ttt; R-4.4.5-07 the line left alone while waiting; R-4.4.5-05 aD0! promptly when the
     service request comes or ttt runs out (then after a break), and at once for ttt = 0
-    (SHOULD); R-4.4.5-06 no traffic to other sensors until the data are in."""
+    (SHOULD); R-4.4.5-06 no traffic to other sensors until the data are in. ``stalls``: the
+    tool's host stalls noted in the recording (:func:`_no_data_command`)."""
     early: list[Finding] = []
     tally = Tally(("R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07"))
     for m in taken:
@@ -67,7 +77,7 @@ def judge_measure_waits(taken: Sequence[ObservedMeasurement], uncertainty: float
                 f"reply, while a service request could still come",
             )
         if first is None:
-            _no_data_command(tally, m, where, ready, uncertainty)
+            _no_data_command(tally, m, where, ready, uncertainty, stalls)
             continue
         if sr is None or sr > first.start:
             early.append(
@@ -145,14 +155,29 @@ def judge_concurrent_waits(
 
 
 def _no_data_command(
-    tally: Tally, m: ObservedMeasurement, where: str, ready: float, uncertainty: float
+    tally: Tally,
+    m: ObservedMeasurement,
+    where: str,
+    ready: float,
+    uncertainty: float,
+    stalls: Sequence[Stall] = (),
 ) -> None:
     """R-4.4.5-05 for a measurement after which no aD0! came: a FAIL when the recorder moved on
-    or ended its job. When the tool cut the job at its budget with the recorder still in this
+    or ended its job; undecided, naming the stall, when it sent the same command again
+    (nothing else between) across a noted stall of the tool's host (:func:`.stalls.tried_again`).
+    When the tool cut the job at its budget with the recorder still in this
     measurement: a FAIL when the cut came past the allowance after the service request or ttt
     (no aD0! at all where one was due: not a late one, which decision T1 makes a WARN);
     undecided when it came before an aD0! was due, which says nothing."""
     if m.cut_at is None:
+        stall = tried_again(m, stalls)
+        if stall is not None:
+            tally.undecide(
+                "R-4.4.5-05",
+                where,
+                f"no aD0! after the measurement (its command sent again), but {stall.why()}",
+            )
+            return
         tally.fail("R-4.4.5-05", where, "no aD0! after the measurement")
         return
     sr = m.service_request_end

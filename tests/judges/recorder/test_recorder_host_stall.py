@@ -14,9 +14,14 @@ from types import SimpleNamespace
 import pytest
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
+from conformance.judges.recorder.collection import judge_data_collection, judge_high_volume
 from conformance.judges.recorder.commands import judge_character_gaps, judge_command_text
+from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_retries
+from conformance.judges.recorder.waits import judge_measure_waits
 from conformance.links.host_stall import note_text
+from conformance.offline.recorder_windows import judge_views
+from conformance.protocol.crc import ascii_crc
 from conformance.transcript import TOOL, Event, EventKind
 from conformance.verdicts import Finding, Verdict
 from conformance.view.segments import merge_views
@@ -229,7 +234,6 @@ def test_the_passive_folds_read_the_recordings_stalls():
     """A window's view holds no notes: the recording's stalls go to the folds."""
     from conformance.judges.recorder.commands import CharacterGaps
     from conformance.links.host_stall import stalls
-    from conformance.offline.recorder_windows import judge_views
     from conformance.view.segments import read_view
 
     events = _gap_in_command(3.0, True).events
@@ -323,3 +327,143 @@ def test_no_retry_to_a_try_a_stall_sent_to_a_sleeping_sensor_is_held_r_7_2_02_r_
     _held(found["R-7.2-03"])
     far = by_id(judge_retries(_asleep(False).view(), 0.0))
     assert far["R-7.2-02"].verdict is far["R-7.2-03"].verdict is Verdict.FAIL
+
+
+# -- the wait for data: R-4.4.5-05 -------------------------------------------------------------
+
+
+def _measure_tried_again(stalled: bool, reply_ms: float = 150.0) -> Stalling:
+    """truth32's paused clean run (in-process golden recorder): the played sensor's reply to
+    0M! went out ``reply_ms`` late, the recorder had given up on it and sent 0M! again with a
+    break over it; the first 0M! read "no aD0! after the measurement"."""
+    w = Stalling().brk().rec("0M!").sensor("00023\r\n", delay_ms=reply_ms)
+    if stalled:
+        w.stall(160)
+    w.brk().rec("0M!").sensor("00023\r\n").sensor("0\r\n", delay_ms=300)
+    w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
+    return w if stalled else _far(w)
+
+
+def _waits(w: Stalling) -> dict[str, Finding]:
+    view = w.view()
+    return by_id(judge_measure_waits(observed_measurements(view, 0.0), 0.0, view.stalls))
+
+
+def test_a_measurement_tried_again_across_a_stall_is_held_r_4_4_5_05():
+    found = _waits(_measure_tried_again(True))["R-4.4.5-05"]
+    _held(found)
+    assert "no aD0! after the measurement" in found.detail
+    assert _waits(_measure_tried_again(False))["R-4.4.5-05"].verdict is Verdict.FAIL
+    # without the stalls given, judged as before
+    view = _measure_tried_again(True).view()
+    plain = by_id(judge_measure_waits(observed_measurements(view, 0.0), 0.0))["R-4.4.5-05"]
+    assert plain.verdict is Verdict.FAIL
+
+
+def test_a_measurement_sent_again_long_after_a_stall_still_fails_r_4_4_5_05():
+    """The same command again 2 s after the stall over its reply is the recorder's doing."""
+    w = Stalling().brk().rec("0M!").sensor("00023\r\n").stall(120).idle(2000)
+    w.brk().rec("0M!").sensor("00023\r\n").sensor("0\r\n", delay_ms=300)
+    w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
+    assert _waits(w)["R-4.4.5-05"].verdict is Verdict.FAIL
+    assert _collection(w).verdict is Verdict.FAIL
+
+
+def test_a_measurement_given_up_for_another_command_across_a_stall_still_fails_r_4_4_5_05():
+    """A recorder that turns to another command after the reply (no new try of the
+    measurement) is not excused by a stall: nothing it did waited on a late reply."""
+    w = Stalling().brk().rec("0M!").sensor("00023\r\n").stall(120)
+    w.idle(50).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    assert _waits(w)["R-4.4.5-05"].verdict is Verdict.FAIL
+
+
+def test_a_missing_break_after_ttt_across_a_stall_still_fails_r_4_4_5_05():
+    """aD0! after ttt without a break is the recorder's choice, which a stall does not make
+    (truth32's faulty runs, ``no-break-after-87ms``: R-4.4.5-05 FAILed there and still does)."""
+    w = Stalling().brk().rec("0M!").sensor("00013\r\n").idle(1000).stall(120).idle(10)
+    w.rec("0D0!").sensor("0+1+2+3\r\n")
+    found = _waits(w)["R-4.4.5-05"]
+    assert found.verdict is Verdict.FAIL and "without a break" in found.detail
+
+
+# -- data collection: R-4.4.8-05 ---------------------------------------------------------------
+
+
+def _collection(w: Stalling) -> Finding:
+    view = w.view()
+    return by_id(judge_data_collection(observed_measurements(view, 0.0), view.stalls))["R-4.4.8-05"]
+
+
+def test_a_measurement_tried_again_across_a_stall_is_held_r_4_4_8_05():
+    """The same run: R-4.4.8-05 read "0M!: stopped after the reply with 0 of 3 values"."""
+    found = _collection(_measure_tried_again(True))
+    _held(found)
+    assert "stopped after the reply with 0 of 3 values" in found.detail
+    assert _collection(_measure_tried_again(False)).verdict is Verdict.FAIL
+
+
+def _stopped_short(stalled: bool) -> Stalling:
+    """0M2! (9 values), D0 and D1 read, then another command: "stopped after 0D1! with
+    6 of 9 values". Stalled: D1's reply came in across a noted stall (truth32's paused clean
+    run: D1's and D2's replies met the recorder's retries, the recorder logged all 9)."""
+    w = Stalling().brk().rec("0M2!").sensor("00029\r\n").sensor("0\r\n", delay_ms=300)
+    w.idle(9).rec("0D0!").sensor("0+1+2+3\r\n").idle(9).rec("0D1!")
+    w.sensor("0+4+5+6\r\n", delay_ms=150 if stalled else 9.0)
+    if stalled:
+        w.stall(140)
+    w.idle(100).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    return w if stalled else _far(w)
+
+
+def test_a_collection_stopped_short_across_a_stall_is_held_r_4_4_8_05():
+    found = _collection(_stopped_short(True))
+    _held(found)
+    assert "stopped after 0D1! with 6 of 9 values" in found.detail
+    assert _collection(_stopped_short(False)).verdict is Verdict.FAIL
+
+
+def test_a_collection_stopped_short_with_the_stall_before_it_still_fails_r_4_4_8_05():
+    """A stall over the measurement's reply, before its data were asked for, says nothing
+    of the values counted: stopping short is the recorder's doing."""
+    w = Stalling().brk().rec("0M2!").sensor("00029\r\n").stall(80)
+    w.sensor("0\r\n", delay_ms=300).idle(9).rec("0D0!").sensor("0+1+2+3\r\n")
+    w.idle(100).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    assert _collection(w).verdict is Verdict.FAIL
+
+
+def test_the_passive_findings_carry_the_recordings_stalls():
+    """The passive measurement cases read them from :func:`recorder_findings`."""
+    w = _measure_tried_again(True)
+    found = judge_views([w.view()], 0.0, w.view().stalls)
+    assert found.stalls == tuple(w.view().stalls) and len(found.stalls) == 1
+
+
+# -- high-volume collection: R-5.1-04 ----------------------------------------------------------
+
+
+def _high_volume_short(stalled: bool) -> Stalling:
+    """0HA! (33 values), D0 read, its D1's reply across a noted stall, then another
+    command: "stopped at 0D1! with 6 of 33 values" (truth32's paused runs: "0HA!: stopped at
+    0D0! with 8 of 120 values", its replies met by the recorder's retries)."""
+    w = Stalling().brk().rec("0HA!").sensor("0002033\r\n").idle(2100).brk().rec("0D0!")
+    w.sensor(f"{_crc('0+1+2+3')}\r\n").idle(9).rec("0D1!").sensor(f"{_crc('0+4+5+6')}\r\n")
+    if stalled:
+        w.stall(140)
+    w.idle(100).brk().rec("0I!").sensor("013CONFORM EMU001 1.0\r\n")
+    return w if stalled else _far(w)
+
+
+def _crc(text: str) -> str:
+    return text + ascii_crc(text)
+
+
+def test_a_high_volume_collection_stopped_short_across_a_stall_is_held_r_5_1_04():
+    def judged(w: Stalling) -> Finding:
+        view = w.view()
+        taken = observed_measurements(view, 0.0)
+        return by_id(judge_high_volume(taken, True, stalls=view.stalls))["R-5.1-04"]
+
+    found = judged(_high_volume_short(True))
+    _held(found)
+    assert "with 6 of 33 values" in found.detail
+    assert judged(_high_volume_short(False)).verdict is Verdict.FAIL
