@@ -120,6 +120,10 @@ def test_service_requests_of_every_measurement(sensor, case):
         "exactly 'a<CR><LF>', complete within ttt s of the reply, nothing before it, after "
         "every M-type measurement with ttt > 0 the run made; none after a concurrent one"
     )
+    if not sensor.remeasured and sensor.defined(("M",)):
+        # a partial run (-k, --req) that left out every case measuring again: one of its own,
+        # so the case judges what a full run gives it (CI: alone it was N/A, PASS in full)
+        sensor.fresh_measurement("M")
     ms = sensor.remeasured
     case.evidence("measurements made again by other cases", ms)
     case.extend(other_waits.judge_other_waits(ms, case.requirements, sensor.version))

@@ -260,7 +260,13 @@ def test_select_by_requirement_id_or_clause(tmp_path, wanted):
     else:
         clause = [r for r in data["requirements"] if r["clause"].startswith("4.4.12")]
         assert clause and all(r["selected"] for r in clause if r["testable"])
-    assert all(r["verdict"] == "PASS" for r in chosen if r["findings"][0]["test"])
+    judged = [r for r in chosen if r["findings"][0]["test"]]
+    # a selected case may carry kin rules the partial run made nothing for (truth31's case of
+    # every measurement made again: the concurrent quiet without a concurrent one): N/A
+    whole_run = "test_9_whole_run::test_service_requests_of_every_measurement"
+    for r in judged:
+        only_kin = all(f["test"].endswith(whole_run) for f in r["findings"])
+        assert r["verdict"] == "PASS" or (r["verdict"] == "N/A" and only_kin), r
     assert data["run"]["selection"] == f"--req {wanted}"
 
 
