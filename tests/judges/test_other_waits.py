@@ -87,14 +87,28 @@ def test_a_partial_pass_alone_does_not_pass_the_rule():
 
 
 def test_no_measurement_made_again_is_no_verdict():
+    (none,) = judge_other_waits([], ["R-4.4.6-04"], "14")
+    assert none.verdict is Verdict.NA
+    owner = passed("R-4.4.6-04", "conforms", observed=5)
+    assert _rule([owner, none]) is Verdict.PASS
+
+
+def test_a_partial_run_that_measured_nothing_again_measures_once_itself():
+    """-k test_9_whole_run or --req: no case measured again, so the case makes one aM! of its
+    own and judges it as a full run's case judges the others' (CI: alone it was N/A, PASS
+    in the full run); the concurrent quiet stays N/A (no concurrent one made)."""
     session = _session()
     session.measurement("M")  # cached: the owner's, not this case's
     assert not session.remeasured
     found = _case(session)
-    assert {f.verdict for f in found.values()} == {Verdict.NA}
-    assert set(found) == set(WAIT_IDS)
+    assert [m.command.text() for m in session.remeasured] == ["0M!"]
+    assert {found[rid].verdict for rid in QUIET_IDS} == {Verdict.NA}
+    assert {f.verdict for r, f in found.items() if r not in QUIET_IDS} == {Verdict.PASS}
+    assert all(f.partial for r, f in found.items() if r not in QUIET_IDS)
     owner = passed("R-4.4.6-04", "conforms", observed=5)
     assert _rule([owner, found["R-4.4.6-04"]]) is Verdict.PASS
+    late = _session("late-service-request")  # a late request in its own aM! FAILs
+    assert _case(late)["R-4.4.6-04"].verdict is Verdict.FAIL
 
 
 def test_a_late_request_across_a_stall_leaves_the_owner_s_pass():
