@@ -676,7 +676,9 @@ class Alike(Sequence["Measured"]):
     def __getitem__(self, i):  # type: ignore[no-untyped-def,override]
         picks, distinct = self._observed._picks, self.distinct
         if picks is None:  # counted: in the order each first came (Observed)
-            return list(self)[i]
+            if isinstance(i, slice):
+                return list(self)[i]
+            return self._observed.counted_at(range(len(self))[i])
         if isinstance(i, slice):
             return [distinct[k] for k in picks[i]]
         return distinct[picks[i]]
@@ -782,14 +784,20 @@ class Observed(Sequence["tuple[Measured, bool, Place | None]"]):
 
     def _one(self, n: int) -> tuple[Measured, bool, Place | None]:
         if self._picks is None:
-            return self._counted()[n], False, None
+            return self.counted_at(n), False, None
         reply = self._replies[self._spots[n]]  # type: ignore[index]
         place = None if reply is None else (reply[0], reply[1], self._at[n])  # type: ignore[index]
         return self.distinct[self._picks[n]], False, place
 
-    def _counted(self) -> list[Measured]:
-        """Counted: each distinct object ``counts`` times, in the order each first came."""
-        return list(self.findings())
+    def counted_at(self, n: int) -> Measured:
+        """Counted: the ``n``-th (0 <= n < len) of the objects each ``counts`` times in the
+        order each first came, found by walking the counts (the distinct ones, not every
+        observation: a list of them made per index was quadratic over a loop)."""
+        for m, count in zip(self.distinct, self.counts, strict=True):
+            if n < count:
+                return m
+            n -= count
+        raise IndexError("observation index out of range")
 
     def __getitem__(self, n):  # type: ignore[no-untyped-def,override]
         if isinstance(n, slice):

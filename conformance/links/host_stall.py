@@ -127,7 +127,7 @@ def noted_since_activity(events: Sequence[Event]) -> bool:
     return False
 
 
-def stalled_over(found: list[Stall], start: float, end: float) -> Stall | None:
+def stalled_over(found: Iterable[Stall], start: float, end: float) -> Stall | None:
     """The first of ``found`` that may have held up a read between ``start`` and ``end``."""
     for stall in found:
         if stall.overlaps(start, end):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -68,3 +69,26 @@ def test_r_7_0_12_alike_reads_as_the_findings_one_by_one(gaps, base):
         assert alike[-1] is findings[-1]
     assert _seen(distribution(alike)) == _seen(distribution(findings))
     assert _seen(combine("R-7.0-12", alike, "gap")) == _seen(combine("R-7.0-12", findings, "gap"))
+
+
+@given(st.lists(st.integers(1, 4), max_size=6))
+def test_a_counted_fold_reads_by_index_as_in_order(counts):
+    """Observed not placed (memory24), and its Alike: by index, negative index and slice, the
+    objects each ``counts`` times in the order each first came, as iterating gives them."""
+    observed = Observed(placed=False)
+    for k, count in enumerate(counts):
+        observed.distinct.append(f"m{k}")  # type: ignore[arg-type]
+        observed.counts.append(count)
+        for _ in range(count):
+            observed.observe(k, None)
+    alike, one_by_one = Alike(observed), list(observed)
+    assert [o[0] for o in one_by_one] == [f"m{k}" for k, c in enumerate(counts) for _ in range(c)]
+    n = len(one_by_one)
+    for i in [*range(n), *range(-n, 0)]:
+        assert observed[i] == one_by_one[i] and alike[i] == one_by_one[i][0]
+    assert observed[1:-1] == one_by_one[1:-1] and alike[::2] == [o[0] for o in one_by_one][::2]
+    for bad in (n, -n - 1):
+        with pytest.raises(IndexError):
+            observed[bad]
+        with pytest.raises(IndexError):
+            alike[bad]

@@ -104,7 +104,7 @@ def tried_again(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | None
     again = m.next_start
     if not stalls or again is None or m.others or again.text != m.start.text:
         return None
-    stall = stalled_over(list(stalls), m.start.start, m.reply_end)
+    stall = stalled_over(stalls, m.start.start, m.reply_end)
     if stall is None or again.start > stall.end + REACTION:
         return None
     return stall
@@ -120,4 +120,4 @@ def over_collection(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | 
         return None
     last = m.data[-1][0]
     end = last.heard[-1].end if last.heard else last.end
-    return stalled_over(list(stalls), m.data[0][0].start, end)
+    return stalled_over(stalls, m.data[0][0].start, end)
