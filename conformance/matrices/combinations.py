@@ -259,6 +259,9 @@ REGRESSIONS: tuple[tuple[str, ...], ...] = (
     ("abort-keeps-old-data", "measure-count-zero"),
     # R-7.0-15 probed only after a reply, where a sensor that sleeps early is silent anyway
     ("extended-not-x", "standby-after-108ms", "standby-after-60ms"),
+    # (seed 7800, outside33) the same silence stood alone where the probe after a break went
+    # unheard (slow-wake): it counts only beside a! answered at 85 ms after a reply
+    ("slow-wake", "standby-after-60ms", "standby-ignored"),
     ("crc-wrong-encoding", "never-standby", "standby-after-40ms"),
     # extended-not-x's renaming undid extended-no-crlf's rewrite (emulator composition)
     ("break-aborts-concurrent", "extended-no-crlf", "extended-not-x"),

@@ -751,7 +751,62 @@ def test_standby_after_100ms(sensor, case):
             f" {STANDBY_RESOLUTION * 1e3:.1f} ms past the limit){held}",
             observed=found.observed,
         )
+    if found.verdict is Verdict.PASS and heard_break is None:
+        found = _awake_near_the_limit(sensor, case, found, shown)
     case.add(found)
+
+
+def _awake_near_the_limit(sensor, case, found: Finding, shown: str) -> Finding:
+    """R-7.0-15's PASS on the probes after a reply alone (the one after a break did not
+    count: a sensor slow to hear after a break, or a link that cannot aim it there) stands
+    only if the sensor is shown awake near the limit after a reply: a! answered at R-7.0-16's
+    edge (87 ms less the tolerance, twice the uncertainty and a margin), so its silence past
+    100.4 ms puts its standby between the two. A sensor silent there too sleeps early after
+    its replies (R-7.0-16's deviation), and its silence past the limit shows nothing of the
+    limit: slow-wake + standby-after-60ms + standby-ignored, a sensor that never sleeps after
+    other marking, PASSed on its silence 101.90 and 115.00 ms after a reply while the probe
+    after a break went unheard (outside33, combination seed 7800)."""
+    u = sensor.uncertainty
+    edge = NO_BREAK_WINDOW - TOLERANCE - 2 * u - EDGE_MARGIN
+
+    def attempt(_n):
+        at = len(sensor.link.transcript.events)
+        first = _awake(sensor)
+        if not first.answered:
+            return first, None, None, None
+        since = first.judged.reply_events[-1].end
+        ex, idle = _after_marking(sensor, since, edge, f"{sensor.address}!")
+        sensor.hear_late(ex)  # from a sensor seen late: a late answer is an answer
+        case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
+        return first, ex, idle, sensor.stalled_since(at, since)
+
+    def miss(sent):
+        _first, ex, idle, stall = sent
+        if ex is None:
+            return "the wake-up a! went unanswered"
+        if stall is not None:
+            return f"a stall of the tool's host over it: {stall.why()}"
+        if idle + u >= NO_BREAK_WINDOW - TOLERANCE:
+            return f"a! went out after {idle * 1e3:.2f} ms of marking, not surely under 87 ms"
+        return None
+
+    aimed = sensor.aim(f"a! after {edge * 1e3:.1f} ms of marking", attempt, miss)
+    first, ex, idle, _stall = aimed.last
+    if ex is not None and (ex.answered or judge.heard_late(ex)):
+        return found
+    why = (
+        "the a! to wake it before the control went unanswered"
+        if ex is None
+        else f"a! {idle * 1e3:.2f} ms after a reply went unanswered too (asleep before 87 ms)"
+    )
+    return inconclusive(
+        "R-7.0-15",
+        f"silent to a! {shown}, but {why}, and the probe after a break did not count:"
+        " its standby by 100.4 ms is not shown apart from an early one after its replies"
+        f"{aimed.missed}",
+        evidence=judge.cite([first] if ex is None else [first, ex]),
+        observed=found.observed,
+    )
 
 
 def _standby_after_a_break(sensor, case, edge: float):
