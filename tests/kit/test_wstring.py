@@ -62,6 +62,8 @@ int main() {
     printf("copied=[%s]\n", copy);
     String("0I!").toCharArray(copy, sizeof copy, 1);
     printf("from1=[%s]\n", copy);
+    printf("order=%d%d%d%d cmp=%d\n", String("0") < String("1"), String("a") > String("Z"),
+           String("1") <= String("1"), String("10") >= String("9"), String("b").compareTo("a") > 0);
     Kept kept;
     kept.printf("resp: %s %d 0x%x", "0+1", 42, 10);
     printf("printed=[%s]\n", kept.text.c_str());
@@ -114,3 +116,10 @@ def test_to_char_array_copies_at_most_size_less_one_then_nul(output):
 
 def test_print_printf_formats_as_the_esp32_and_samd_cores_do(output):
     assert output["printed"] == "[resp: 0+1 42 0xa]"
+
+
+def test_strings_order_as_the_cores_compare_to_does(output):
+    """Found running cropsteering/OS-SDI12 (outside33, docs/kit.md): it keys a
+    ``std::map<String, uint16_t>`` by address, which needs ``operator<``; the kit's String had
+    none and the sketch did not compile."""
+    assert output["order"] == "1110 cmp=1"  # "10" < "9": text, not numbers

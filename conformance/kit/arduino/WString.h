@@ -48,6 +48,13 @@ class String {
     bool operator==(const char *text) const { return s_ == text; }
     bool operator!=(const String &other) const { return s_ != other.s_; }
     bool operator!=(const char *text) const { return s_ != text; }
+    /* the cores' ordering (compareTo: strcmp of the texts), so a String keys a std::map
+     * (cropsteering/OS-SDI12 keeps its sensors' D counts in a std::map<String, uint16_t>) */
+    int compareTo(const String &other) const { return strcmp(s_.c_str(), other.s_.c_str()); }
+    bool operator<(const String &other) const { return compareTo(other) < 0; }
+    bool operator>(const String &other) const { return compareTo(other) > 0; }
+    bool operator<=(const String &other) const { return compareTo(other) <= 0; }
+    bool operator>=(const String &other) const { return compareTo(other) >= 0; }
     bool startsWith(const String &prefix) const { return s_.compare(0, prefix.s_.size(), prefix.s_) == 0; }
     bool endsWith(const String &suffix) const {
         return s_.size() >= suffix.s_.size() &&
