@@ -649,6 +649,24 @@ def _marking_since_sensor(exchanges, probe) -> float:
     return start - max(ends) if ends else float("inf")
 
 
+def _a_after_a_reply(sensor, case, marking: float):
+    """Wake the sensor (:func:`_awake`), then send ``a!`` with no break once ``marking`` s of
+    marking followed its reply; returns (the wake-up, the probe, the marking the probe had
+    since the sensor's last character, the stall of the tool's host since the wake-up's
+    reply), the last three None when the wake-up went unanswered. R-7.0-15's probes past the
+    limit and its control just inside R-7.0-16's window are both made this way."""
+    at = len(sensor.link.transcript.events)
+    first = _awake(sensor)
+    if not first.answered:
+        return first, None, None, None
+    since = first.judged.reply_events[-1].end
+    ex, idle = _after_marking(sensor, since, marking, f"{sensor.address}!")
+    sensor.hear_late(ex)  # from a sensor seen late: a late answer is an answer
+    idle = min(idle, _marking_since_sensor([first, ex], ex))
+    case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
+    return first, ex, idle, sensor.stalled_since(at, since)
+
+
 @requirements("R-7.0-15")
 @pytest.mark.preconditions("awake")
 def test_standby_after_100ms(sensor, case):
@@ -663,16 +681,7 @@ def test_standby_after_100ms(sensor, case):
     for marking in (edge, 0.115):
 
         def attempt(_n, marking=marking):
-            at = len(sensor.link.transcript.events)
-            first = _awake(sensor)
-            if not first.answered:
-                return first, None, None, None
-            since = first.judged.reply_events[-1].end
-            ex, idle = _after_marking(sensor, since, marking, f"{sensor.address}!")
-            sensor.hear_late(ex)  # from a sensor seen late: a late answer is an answer
-            idle = min(idle, _marking_since_sensor([first, ex], ex))
-            case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
-            return first, ex, idle, sensor.stalled_since(at, since)
+            return _a_after_a_reply(sensor, case, marking)
 
         def off_window(sent):
             _first, _ex, idle, _stall = sent
@@ -770,15 +779,7 @@ def _awake_near_the_limit(sensor, case, found: Finding, shown: str) -> Finding:
     edge = NO_BREAK_WINDOW - TOLERANCE - 2 * u - EDGE_MARGIN
 
     def attempt(_n):
-        at = len(sensor.link.transcript.events)
-        first = _awake(sensor)
-        if not first.answered:
-            return first, None, None, None
-        since = first.judged.reply_events[-1].end
-        ex, idle = _after_marking(sensor, since, edge, f"{sensor.address}!")
-        sensor.hear_late(ex)  # from a sensor seen late: a late answer is an answer
-        case.evidence(f"a!, {idle * 1e3:.2f} ms of marking, a! with no break", [first, ex])
-        return first, ex, idle, sensor.stalled_since(at, since)
+        return _a_after_a_reply(sensor, case, edge)
 
     def miss(sent):
         _first, ex, idle, stall = sent
