@@ -301,24 +301,33 @@ class ConformanceRun:
 
     def _guard_served_line(self) -> None:
         """Recorder role on a served line (``rfc2217-serve://``): if the line this tool kept
-        in real time fell behind its schedule, no FAIL or WARN of the run can be trusted to
-        be the recorder's own (a false FAIL is what a busy host would otherwise give)."""
+        in real time fell behind its schedule where no note of it says so, no FAIL or WARN of
+        the run can be trusted to be the recorder's own (a false FAIL is what a busy host
+        would otherwise give). Where the line noted every late frame (truth34: it notes
+        them all), only what the notes can explain is held: the rules whose judges read
+        them stand as judged, and the rest of a case stands where none of its scenarios
+        lies near a note (:func:`~.judges.recorder.stalls.late_near`)."""
         late = self.session.worst_lateness() if self.session is not None else 0.0
         if late <= 0.0:
             return  # nothing fell behind: every line but a served one (and its package's
             # servers stay unloaded, as the rest of a run needs none of them)
         from .emulator_server.realtime import LATE_NOTICE
-        from .judges.recorder.stalls import READ_STALLS
+        from .judges.recorder.stalls import READ_STALLS, late_near
 
         if late <= LATE_NOTICE:
             return
         # lateness the line's own stall notes explain all of: the rules whose judges read
         # those notes (each deviation a noted stall covers held, naming it) stand as judged
-        explained = self.session.unexplained_lateness() <= LATE_NOTICE  # type: ignore[union-attr]
+        session = self.session
+        assert session is not None
+        explained = session.unexplained_lateness() <= LATE_NOTICE
+        stalls = session.noted_stalls() if explained else []
         for case in self.cases:
             findings = case.findings
             if explained:
                 findings = [f for f in findings if f.requirement not in READ_STALLS]
+                if not late_near(case.evidence, stalls):
+                    continue
             undecide_after_late_line(findings, late, LATE_NOTICE)
 
     def report_dir(self) -> Path:
