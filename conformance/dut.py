@@ -70,6 +70,11 @@ class Session(Protocol):
         the line noted (truth32): what no note explains."""
         return self.worst_lateness()
 
+    def recorder_in_process(self) -> bool:
+        """Whether the recorder judged acts through this tool's process (its golden recorder,
+        a harness it drives): a stall of the tool's host holds it up too (truth34)."""
+        return True
+
     def noted_stalls(self) -> list[Stall]:
         """The stalls of the tool's host that such a line noted in its transcript (truth34):
         none where the tool keeps no such line."""

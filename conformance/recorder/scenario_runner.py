@@ -155,6 +155,11 @@ class RecorderSession(Session):
         stall of this process it noted (s; 0 on the sim bus)."""
         return self.served.line.unexplained_lateness if self.served is not None else 0.0
 
+    def recorder_in_process(self) -> bool:
+        """Whether the recorder acts through this process (not one that connects to the
+        served line itself): the host's stalls of this process hold it up too (truth34)."""
+        return not self.driver.needs_real_time
+
     def noted_stalls(self) -> list[Stall]:
         """The stalls of this process the served line noted (truth32; every frame it sent
         late since truth34), in its transcript's order; none on the sim bus."""

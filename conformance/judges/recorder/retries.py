@@ -309,7 +309,7 @@ class _RetryEvidence:
         span = (0.0, 0.0)
         if self.stalls:
             end = _decided_by(first) if until is None else until
-            span = (_unsettled_from(line, first), end)
+            span = (_unsettled_from(line, first.sent), end)
         fail_unless_stalled(self.tally, self.stalls, rid, where, message, span, warning=warning)
 
 
@@ -381,7 +381,7 @@ def _judge_tries(
         if a.problem is None:
             continue
         nxt = seq[k + 1] if k + 1 < len(seq) else None
-        began = _quiet_from(line, a) if acc.stalls else a.sent.start
+        began = _unsettled_from(line, a.sent) if acc.stalls else a.sent.start
         if nxt is None and len(seq) < 3:
             acc.fail(
                 "R-7.2-05",
@@ -426,32 +426,26 @@ def _judge_tries(
             acc.restarted.append(f"{a.after()}: {a.instead(later)}")
 
 
-def _quiet_from(line: TranscriptView, a: Try) -> float:
-    """Where the marking before try ``a`` began (the line's last activity before it): a
-    stall there (truth32) decides how long the sensor had been left alone when the try came,
-    and so whether it was awake to answer it (the in-process recorder, paused past the
-    sensor's 100 ms, sent its aD2! to a sensor asleep; no reply, then a break)."""
-    before = line.previous_activity(a.sent)
-    return a.sent.start if before is None else before
-
-
-def _unsettled_from(line: TranscriptView, a: Try) -> float:
-    """The earliest moment a stall of the tool's host could have disturbed what try ``a``
-    shows (truth34: its disorder outlives its noted span). A try after a break: the break
-    (it wakes the sensor whatever came before). Without one: the marking before it
-    (:func:`_quiet_from`) and the played sensor's standby before it (a reply the stall held
-    back went out late, but the sensor counts its marking from when it planned it: new1's
-    0DB3! 26 ms after a stall's reach drew nothing, nor its retry, the sensor asleep by its
-    own clock). And where the sensor was still sending as the try began (a reply the stall
-    held back met it), the start of the transmission whose reply that was."""
-    sent = a.sent
-    # a break wakes the sensor whatever came before it; without one, its own clock decides
-    start = sent.start if sent.break_event else min(_quiet_from(line, a), sent.start - STANDBY)
-    before = _previous(line, sent)
-    if before is not None and (
+def _unsettled_from(line: TranscriptView, sent: Transmission) -> float:
+    """The earliest moment a stall of the tool's host could have disturbed what the try
+    ``sent`` shows (truth34: its disorder outlives its noted span): where the marking before
+    it began (truth32: a stall there decides how long the sensor had been left alone when
+    the try came, so whether it was awake to answer), or the standby before it, whichever
+    is earlier. The played
+    sensor counts its marking from when it planned its last frame, which a stall sent late
+    (new1's 0DB3! 26 ms after a stall's reach drew nothing, nor its retry: the sensor asleep
+    by its own clock); a paused in-process recorder comes back to what it had planned
+    (base0's break and 5A0!, 0M! at 0.03 ms past a stall's reach: its break for a sensor it
+    had left past standby). And where the sensor was still sending as the try began (a
+    reply the stall held back met it), from the start of the transmission whose reply that
+    was."""
+    before = line.previous_activity(sent)
+    start = min(sent.start if before is None else before, sent.start - STANDBY)
+    previous = _previous(line, sent)
+    if previous is not None and (
         sent.cut is not None or line.sensor_chars_between(sent.start - CHAR_TIME, sent.end)
     ):
-        start = min(start, before.start)
+        start = min(start, previous.start)
     return start
 
 
@@ -485,7 +479,7 @@ def _first_unstalled(line_of: LineOf, tries: Sequence[Try], stalls: Sequence[Sta
         if a.problem is None:  # the group's last try, answered: nothing to retry for
             continue
         until = tries[k + 1].sent.first_char if k + 1 < len(tries) else _decided_by(a)
-        if stalled_over(stalls, _unsettled_from(line_of(a), a), until) is None:
+        if stalled_over(stalls, _unsettled_from(line_of(a), a.sent), until) is None:
             return k
     return 0
 
@@ -506,7 +500,8 @@ def _judge_given_up(
         )
         # the sequence's tries and the wait after its last (its reply, a retry due); a
         # stall's disorder reaches back past the marking before the first (truth34)
-        acc.third.append(acc.across(few, _unsettled_from(line, seq[0]), _decided_by(seq[-1])))
+        began = _unsettled_from(line, seq[0].sent)
+        acc.third.append(acc.across(few, began, _decided_by(seq[-1])))
         return
     brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
     if brk is not None:
@@ -598,8 +593,10 @@ def cut_replies(
                 evidence=[s.at(), nxt.at()],
                 observed=1,
             )
-            # a reply the tool's host stalled over (truth32): held back, its rest late
-            failed.append(hold(stalls, found, s.start, brk.end))
+            # a reply the tool's host stalled over (truth32): held back, its rest late; or
+            # one a stall's disorder reached (truth34: :func:`_unsettled_from`)
+            began = _unsettled_from(line, s) if stalls else s.start
+            failed.append(hold(stalls, found, began, brk.end))
         else:
             named.append(f"{cut} (after {s.at()}): a new sequence, not a retry")
     return failed, named

@@ -262,6 +262,7 @@ def _guarded(unexplained: float) -> list[Finding]:
         worst_lateness=lambda: 0.150,
         unexplained_lateness=lambda: unexplained,
         noted_stalls=lambda: [],
+        recorder_in_process=lambda: False,  # its own process: the stalls are the tool's
     )
     # a case that names no scenario slice: held wherever the line was late (truth34)
     run = SimpleNamespace(session=session, cases=[SimpleNamespace(findings=findings, evidence=[])])

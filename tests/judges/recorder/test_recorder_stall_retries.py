@@ -71,7 +71,8 @@ def test_a_new_sequence_after_a_reply_a_stall_broke_up_is_held_r_7_2_01_05():
 
 
 def test_one_unretried_reply_outside_every_stall_still_fails_beside_a_held_one():
-    w = _unanswered(True).brk().rec("0D1!").idle(600)  # 0D1! unanswered, no stall near
+    w = _unanswered(True).brk().rec("0!").sensor("0\r\n").idle(20)  # answered, after it
+    w.brk().rec("0D1!").idle(600)  # 0D1! unanswered, no stall near
     found = _retries(w)
     for rid in RETRY_RULES:
         assert found[rid].verdict in (Verdict.FAIL, Verdict.WARN), (rid, found[rid].detail)
@@ -148,10 +149,12 @@ def test_a_long_reply_a_stall_broke_up_late_is_held_r_7_2_03_05():
 
 
 def test_a_sequence_given_up_well_after_a_stall_still_fails_r_7_2_03():
-    """The sensor's standby and a reply still coming are all a stall's disorder reaches:
-    a try 300 ms after it, on a quiet line, given up after one retry, still FAILs."""
+    """The marking before a try, the sensor's standby and a reply still coming are all a
+    stall's disorder reaches: a sequence after an answered exchange 300 ms after the stall,
+    given up after one retry, still FAILs."""
     w = Stalling().brk().rec("0D1!").sensor("0+1\r\n").stall(150).idle(300)
-    w.brk().rec("0D2!").idle(45).rec("0D2!").idle(400)
+    w.brk().rec("0D2!").sensor("0+2\r\n").idle(20)
+    w.brk().rec("0D3!").idle(45).rec("0D3!").idle(400)
     found = _retries(w)
     assert found["R-7.2-03"].verdict is Verdict.FAIL and STALLED not in found["R-7.2-03"].detail
 
@@ -202,7 +205,9 @@ def _slice(start: float, end: float) -> list[Event]:
     ]
 
 
-def _guard(noted: list[Event], cases: list[list[tuple[str, list[Event]]]]) -> list[list[Finding]]:
+def _guard(
+    noted: list[Event], cases: list[list[tuple[str, list[Event]]]], in_process: bool = False
+) -> list[list[Finding]]:
     """The guard over cases whose evidence is ``cases`` (each a FAIL of a stall-blind rule
     and one of a rule whose judge reads the notes), the line's notes ``noted``."""
     from conformance.run import ConformanceRun
@@ -220,6 +225,7 @@ def _guard(noted: list[Event], cases: list[list[tuple[str, list[Event]]]]) -> li
         worst_lateness=lambda: 0.150,
         unexplained_lateness=lambda: 0.0,
         noted_stalls=lambda: stalls(noted),
+        recorder_in_process=lambda: in_process,
     )
     run = SimpleNamespace(
         session=session,
@@ -241,3 +247,14 @@ def test_the_guard_holds_a_case_only_where_a_note_lies_near_its_scenarios():
     assert kept[0].verdict is Verdict.FAIL  # a faulty recorder's FAIL far from any late frame
     for findings in (held_near, held_after, kept, held_whole):
         assert findings[1].verdict is Verdict.FAIL  # its judge read the notes
+
+
+def test_the_guard_holds_every_rule_near_a_note_for_a_recorder_in_the_tools_process():
+    """An in-process recorder's threads are held up with the tool's, noted or not (base-s69's
+    paused clean run: a 1.15 ms break 184 ms after a note, R-7.0-02): near a note nothing
+    of its case stands; far from every note its case stands whole."""
+    near = [("scenario a: x", _slice(10.0, 12.0))]
+    far = [("scenario c: z", _slice(20.0, 22.0))]
+    held, kept = _guard([_note(11.0)], [near, far], in_process=True)
+    assert {f.verdict for f in held} == {Verdict.INCONCLUSIVE}
+    assert {f.verdict for f in kept} == {Verdict.FAIL}
