@@ -295,21 +295,24 @@ class _RetryEvidence:
         where: str,
         message: str,
         line: TranscriptView,
-        first: Try,
+        tries: tuple[Try, Try],
         until: float | None = None,
         *,
         warning: bool = False,
     ) -> None:
         """A tallied FAIL (a WARN with ``warning``) of ``rid`` that rests on the tries from
-        ``first`` (read from ``line``) to the recorder's decision at ``until`` (default: the
-        standby after what ``first`` heard), or where a noted stall of the tool's host lies
-        over that stretch, the observation undecided naming it (truth34: the reply it held
-        back read invalid, or a paused in-process recorder missed its window; a stall's
-        disorder reaches back to :func:`_unsettled_from`)."""
+        the first of ``tries`` (read from ``line``) to the last and the recorder's decision
+        after it (:func:`_decided_by`; or the next try at ``until``, if sooner), or where a
+        noted stall of the tool's host lies over that stretch, the observation undecided
+        naming it (truth34: the reply it held back read invalid, or a paused in-process
+        recorder missed its window; a stall's disorder reaches back to
+        :func:`_unsettled_from`). What came after the decision is no part of it: a recorder
+        that waits out a 1 s poll timeout instead of retrying had its chance first."""
         span = (0.0, 0.0)
         if self.stalls:
-            end = _decided_by(first) if until is None else until
-            span = (_unsettled_from(line, first.sent), end)
+            first, last = tries
+            end = _decided_by(last)
+            span = (_unsettled_from(line, first.sent), end if until is None else min(until, end))
         fail_unless_stalled(self.tally, self.stalls, rid, where, message, span, warning=warning)
 
 
@@ -357,7 +360,8 @@ def _judge_retried(
         nxt = tries[k + 1] if k + 1 < len(tries) else None
         a = tries[k]
         until = nxt.sent.first_char if nxt is not None else None
-        acc.fail("R-7.2-01", where, f"{a.after()}: {a.instead(nxt)}", line_of(a), a, until)
+        message = f"{a.after()}: {a.instead(nxt)}"
+        acc.fail("R-7.2-01", where, message, line_of(a), (a, a), until)
     elif gave_up:
         tally.unobservable(
             "R-7.2-01",
@@ -389,7 +393,7 @@ def _judge_tries(
                 f"{a.problem} at {a.sent.at()}, then "
                 + ("a new sequence, not a retry" if later is not None else "no retry"),
                 line,
-                seq[0],  # no break since: the sensor's state (asleep, say) is the sequence's
+                (seq[0], a),  # no break since: the sensor's state (asleep, say) is the sequence's
                 later.sent.first_char if later is not None else None,
             )
         # "no reply" times a retry from a quiet line: sensor characters that met the
@@ -417,7 +421,10 @@ def _judge_tries(
                 )
                 # the wait for the reply and what the recorder did instead: a stall there
                 # may have held the reply back (or the recorder, in the tool's process)
-                until = later.sent.first_char if later is not None else a.sent.end + STANDBY
+                # (no further than the decision the recorder owed it: truth34)
+                until = _decided_by(a)
+                if later is not None:
+                    until = min(until, later.sent.first_char)
                 acc.window.append(acc.across(missing, began, until))
         elif nxt is not None and nxt.in_window(uncertainty):
             judged = _retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty)
@@ -478,7 +485,9 @@ def _first_unstalled(line_of: LineOf, tries: Sequence[Try], stalls: Sequence[Sta
     for k, a in enumerate(tries):
         if a.problem is None:  # the group's last try, answered: nothing to retry for
             continue
-        until = tries[k + 1].sent.first_char if k + 1 < len(tries) else _decided_by(a)
+        until = _decided_by(a)
+        if k + 1 < len(tries):
+            until = min(until, tries[k + 1].sent.first_char)
         if stalled_over(stalls, _unsettled_from(line_of(a), a.sent), until) is None:
             return k
     return 0
@@ -539,8 +548,7 @@ def _judge_repeated(
             where,
             f"gave up after {len(sequences)} break+command+retries sequence(s)",
             line_of(first),
-            first,
-            _decided_by(last),
+            (first, last),
             warning=True,
         )
     elif len(sequences) > 1 and (repeated or (not group.succeeded and real)):

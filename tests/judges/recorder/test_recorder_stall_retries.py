@@ -258,3 +258,16 @@ def test_the_guard_holds_every_rule_near_a_note_for_a_recorder_in_the_tools_proc
     held, kept = _guard([_note(11.0)], [near, far], in_process=True)
     assert {f.verdict for f in held} == {Verdict.INCONCLUSIVE}
     assert {f.verdict for f in kept} == {Verdict.FAIL}
+
+
+def test_no_retry_then_a_poll_timeout_with_a_stall_in_it_still_fails_r_7_2_01_05():
+    """no-retries under the pauses (truth34's newR): the recorder waits out a 1 s poll
+    timeout, then a new sequence; a stall 500 ms into that wait came after the retry it owed
+    (the standby after the unanswered try), so "not retried" stands. (R-7.2-04's "gave up
+    after 2 sequences" rests on the group's whole span, the stall inside it: held.)"""
+    w = Stalling().brk().rec("0D0!").idle(500).stall(120).idle(500).brk().rec("0D0!")
+    found = _retries(w.idle(600))
+    _held(found["R-7.2-04"])
+    for rid in ("R-7.2-01", "R-7.2-05"):
+        assert found[rid].verdict in (Verdict.FAIL, Verdict.WARN), (rid, found[rid].detail)
+        assert STALLED not in found[rid].detail
