@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
-from ...links.host_stall import Stall, stalled_over
+from ...links.host_stall import REACH, Stall, stalled_over
 from ...protocol.timing import (
     CHAR_TIME,
     RESPONSE_START_MAX,
@@ -312,7 +312,7 @@ class _RetryEvidence:
         if self.stalls:
             first, last = tries
             end = _decided_by(last)
-            span = (_unsettled_from(line, first.sent), end if until is None else min(until, end))
+            span = (_unsettled_from(line, first), end if until is None else min(until, end))
         fail_unless_stalled(self.tally, self.stalls, rid, where, message, span, warning=warning)
 
 
@@ -385,7 +385,7 @@ def _judge_tries(
         if a.problem is None:
             continue
         nxt = seq[k + 1] if k + 1 < len(seq) else None
-        began = _unsettled_from(line, a.sent) if acc.stalls else a.sent.start
+        began = _unsettled_from(line, a) if acc.stalls else a.sent.start
         if nxt is None and len(seq) < 3:
             acc.fail(
                 "R-7.2-05",
@@ -433,27 +433,44 @@ def _judge_tries(
             acc.restarted.append(f"{a.after()}: {a.instead(later)}")
 
 
-def _unsettled_from(line: TranscriptView, sent: Transmission) -> float:
-    """The earliest moment a stall of the tool's host could have disturbed what the try
-    ``sent`` shows (truth34: its disorder outlives its noted span): where the marking before
-    it began (truth32: a stall there decides how long the sensor had been left alone when
-    the try came, so whether it was awake to answer), or the standby before it, whichever
-    is earlier. The played
-    sensor counts its marking from when it planned its last frame, which a stall sent late
-    (new1's 0DB3! 26 ms after a stall's reach drew nothing, nor its retry: the sensor asleep
-    by its own clock); a paused in-process recorder comes back to what it had planned
-    (base0's break and 5A0!, 0M! at 0.03 ms past a stall's reach: its break for a sensor it
-    had left past standby). And where the sensor was still sending as the try began (a
-    reply the stall held back met it), from the start of the transmission whose reply that
-    was."""
-    before = line.previous_activity(sent)
-    start = min(sent.start if before is None else before, sent.start - STANDBY)
-    previous = _previous(line, sent)
-    if previous is not None and (
-        sent.cut is not None or line.sensor_chars_between(sent.start - CHAR_TIME, sent.end)
-    ):
+def _unsettled_from(line: TranscriptView, a: Try) -> float:
+    """The earliest moment a stall of the tool's host could have disturbed what try ``a``
+    shows (truth34: its disorder outlives its noted span). Where it drew no reply: where
+    the marking before it began (truth32: a stall there decides how long the sensor had been
+    left alone, so whether it was awake to answer, and a paused in-process recorder came
+    back to begin anew with a break, new1's 0M! at 101.667 s), or the standby before it,
+    whichever is earlier (the played sensor counts its marking from when it planned its
+    last frame, which a stall sent late: new1's 0DB3! 26 ms after a stall's reach drew
+    nothing, nor its retry; base0's 5A0! and 0M! just past one). A reply, however invalid,
+    shows the sensor was awake: from the try itself. Where the sensor was still sending as
+    the try began (a reply the stall held back met it), from the start of the transmission
+    whose reply that was (:data:`MET_CHAIN`). And :data:`~conformance.links.host_stall.REACH`
+    before all that: a paused in-process recorder acts as it comes back, just past the
+    note's reach (newF's retry 0.03 ms past it, then a reply it talked over)."""
+    sent = a.sent
+    start = sent.start
+    if a.problem is NO_REPLY:
+        before = line.previous_activity(sent)
+        start = min(start if before is None else before, start - STANDBY)
+    met = sent
+    for _ in range(MET_CHAIN):  # a held-back reply may meet several tries in turn
+        previous = _previous(line, met)
+        if previous is None or not _talked_over(line, met):
+            break
+        met = previous
         start = min(start, previous.start)
-    return start
+    return start - REACH
+
+
+#: how many tries back :func:`_unsettled_from` follows a reply still coming as each began
+#: (truth32's newF3: a stall held 0DB8!'s packet back, the paused recorder's retry met it
+#: and 0DB9! the rest, 250 ms after the stall's reach)
+MET_CHAIN = 3
+
+
+def _talked_over(line: TranscriptView, sent: Transmission) -> bool:
+    """Whether the sensor was still sending as ``sent`` began (a reply it talked over)."""
+    return sent.cut is not None or bool(line.sensor_chars_between(sent.start - CHAR_TIME, sent.end))
 
 
 def _decided_by(a: Try) -> float:
@@ -488,7 +505,7 @@ def _first_unstalled(line_of: LineOf, tries: Sequence[Try], stalls: Sequence[Sta
         until = _decided_by(a)
         if k + 1 < len(tries):
             until = min(until, tries[k + 1].sent.first_char)
-        if stalled_over(stalls, _unsettled_from(line_of(a), a.sent), until) is None:
+        if stalled_over(stalls, _unsettled_from(line_of(a), a), until) is None:
             return k
     return 0
 
@@ -509,7 +526,7 @@ def _judge_given_up(
         )
         # the sequence's tries and the wait after its last (its reply, a retry due); a
         # stall's disorder reaches back past the marking before the first (truth34)
-        began = _unsettled_from(line, seq[0].sent)
+        began = _unsettled_from(line, seq[0])
         acc.third.append(acc.across(few, began, _decided_by(seq[-1])))
         return
     brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
@@ -603,7 +620,7 @@ def cut_replies(
             )
             # a reply the tool's host stalled over (truth32): held back, its rest late; or
             # one a stall's disorder reached (truth34: :func:`_unsettled_from`)
-            began = _unsettled_from(line, s) if stalls else s.start
+            began = _unsettled_from(line, Try(s, NO_REPLY)) if stalls else s.start
             failed.append(hold(stalls, found, began, brk.end))
         else:
             named.append(f"{cut} (after {s.at()}): a new sequence, not a retry")
