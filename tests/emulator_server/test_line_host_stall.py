@@ -96,3 +96,38 @@ def test_a_line_without_a_listener_keeps_its_figures_as_before():
     assert round(line.worst_lateness, 3) == 0.2
     assert round(line.unexplained_lateness, 3) == 0.2
     assert "stalls of this process" not in line.timekeeping()
+
+
+class Breaks(OneFrame):
+    """:class:`OneFrame` that keeps the breaks it hears, with the room the line gives them."""
+
+    def __init__(self) -> None:
+        super().__init__(99.0)
+        self.breaks: list[tuple[float, float, float]] = []
+
+    def on_break_within(self, start: float, end: float, room: float) -> None:
+        self.breaks.append((start, end, room))
+
+
+def test_a_break_laid_behind_a_burst_carries_the_shift_as_its_room():
+    """truth34's paused external run: the recorder's bytes and its break came in one late
+    burst; the line laid the break behind the bytes still on its wire, after its end had
+    arrived: a 0.00 ms break, and R-7.0-02 and R-7.0-06 FAILed. Its place and length are
+    known only to that shift: the room goes with it (the judges add it to the stamps')."""
+    clock, device = Clock(), Breaks()
+    line = RealTimeLine(device, lambda _b: None, clock=clock)
+    line.tool_bytes(b"0D0!0D0!", at=1.0, doubt=0.0)  # 8 frames: the wire busy to 1.0667 s
+    line.break_on(at=1.001)
+    line.break_off(at=1.002)
+    clock.t = 2.0
+    for _ in range(20):
+        line._step()
+    start, end, room = device.breaks[0]
+    assert end - start == 0.0 and room >= start - 1.002 > 0.06
+    clean = Breaks()
+    line = RealTimeLine(clean, lambda _b: None, clock=clock)
+    line.break_on(at=1.0)
+    line.break_off(at=1.013)
+    for _ in range(5):
+        line._step()
+    assert clean.breaks == []  # a break laid where it came: no room, heard as before
