@@ -307,15 +307,16 @@ class ConformanceRun:
         them all), only what the notes can explain is held: a case stands where none of its
         scenarios lies near a note (:func:`~.judges.recorder.stalls.late_near`); in one that
         does, the rules whose judges read the notes stand as judged for a recorder in a
-        process of its own, and nothing does for one in the tool's process, whose every
-        thread the host held up, noted or not (base-s69's paused clean run: a 1.15 ms break
-        184 ms after a note)."""
+        process of its own, and for one in the tool's process, whose threads the host held
+        up around a stall where nothing notes it (base-s69's paused clean run: a 1.15 ms
+        break 184 ms after a note), only where what they name lies far from every note
+        (:func:`~.judges.recorder.stalls.stamped_far`)."""
         late = self.session.worst_lateness() if self.session is not None else 0.0
         if late <= 0.0:
             return  # nothing fell behind: every line but a served one (and its package's
             # servers stay unloaded, as the rest of a run needs none of them)
         from .emulator_server.realtime import LATE_NOTICE
-        from .judges.recorder.stalls import READ_STALLS, late_near
+        from .judges.recorder.stalls import READ_STALLS, late_near, stamped_far
 
         if late <= LATE_NOTICE:
             return
@@ -332,6 +333,12 @@ class ConformanceRun:
                 continue
             if apart:
                 findings = [f for f in findings if f.requirement not in READ_STALLS]
+            elif explained:  # in the tool's process: only what stands far from every note
+                findings = [
+                    f
+                    for f in findings
+                    if f.requirement not in READ_STALLS or not stamped_far(f, stalls)
+                ]
             undecide_after_late_line(findings, late, LATE_NOTICE)
 
     def report_dir(self) -> Path:
