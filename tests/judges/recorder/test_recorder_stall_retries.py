@@ -278,3 +278,16 @@ def test_the_guard_holds_an_in_process_recorders_deviations_near_a_note():
 
     assert one("2005.70 ms [before 0D0! at t=43.521 s]").verdict is Verdict.FAIL
     assert one("1.15 ms [break at t=11.300 s]").verdict is Verdict.INCONCLUSIVE
+
+
+def test_no_retry_then_a_poll_timeout_with_a_stall_in_it_still_fails_r_7_2_01_05():
+    """no-retries under the pauses (truth34's newR): the recorder waits out a 1 s poll
+    timeout, then a new sequence; a stall 500 ms into that wait came after the retry it owed
+    (the standby after the unanswered try), so "not retried" stands. (R-7.2-04's "gave up
+    after 2 sequences" rests on the group's whole span, the stall inside it: held.)"""
+    w = Stalling().brk().rec("0D0!").idle(500).stall(120).idle(500).brk().rec("0D0!")
+    found = _retries(w.idle(600))
+    _held(found["R-7.2-04"])
+    for rid in ("R-7.2-01", "R-7.2-05"):
+        assert found[rid].verdict is Verdict.FAIL, (rid, found[rid].detail)
+        assert STALLED not in found[rid].detail
