@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
+    from .links.host_stall import Stall
     from .protocol.responses import Identification
     from .results import CaseRecord
     from .tool_recorder.records import Exchange
@@ -68,6 +69,16 @@ class Session(Protocol):
         """:meth:`worst_lateness` of the frames due outside every stall of the tool's host
         the line noted (truth32): what no note explains."""
         return self.worst_lateness()
+
+    def recorder_in_process(self) -> bool:
+        """Whether the recorder judged acts through this tool's process (its golden recorder,
+        a harness it drives): a stall of the tool's host holds it up too (truth34)."""
+        return True
+
+    def noted_stalls(self) -> list[Stall]:
+        """The stalls of the tool's host that such a line noted in its transcript (truth34):
+        none where the tool keeps no such line."""
+        return []
 
 
 def sensor_claim(

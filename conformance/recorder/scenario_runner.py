@@ -24,6 +24,7 @@ from ..declaration import Declaration
 from ..dut import Session
 from ..harness.channel import STDERR_TAIL
 from ..links.base import LinkError
+from ..links.host_stall import Stall, stalls
 from ..links.registry import PortOptions
 from ..protocol.version import V14, format_version, is_v14
 from ..recorder_jobs import RecorderOutput, Request
@@ -153,6 +154,16 @@ class RecorderSession(Session):
         """How far the served line fell behind its schedule for frames due outside every
         stall of this process it noted (s; 0 on the sim bus)."""
         return self.served.line.unexplained_lateness if self.served is not None else 0.0
+
+    def recorder_in_process(self) -> bool:
+        """Whether the recorder acts through this process (not one that connects to the
+        served line itself): the host's stalls of this process hold it up too (truth34)."""
+        return not self.driver.needs_real_time
+
+    def noted_stalls(self) -> list[Stall]:
+        """The stalls of this process the served line noted (truth32; every frame it sent
+        late since truth34), in its transcript's order; none on the sim bus."""
+        return stalls(self.served.transcript.events) if self.served is not None else []
 
     @property
     def bus(self) -> SimBus:

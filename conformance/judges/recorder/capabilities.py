@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ...protocol.commands import ADDRESS_CHARS, CommandError, Kind, parse_command
-from ...protocol.timing import MULTILINE_GAP_MAX
+from ...protocol.timing import MULTILINE_GAP_MAX, STANDBY_MARKING
 from ...transcript import decode_7e1, escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView
@@ -17,6 +17,7 @@ from ..timing import judge_window
 from .common import CUT_SHORT, Record, combine, record_of
 from .measurements import collection_end, observed_measurements
 from .replies import crc_context, cut_off, first_answered, reply_problem
+from .stalls import fail_unless_stalled
 
 
 def judge_commands_issued(
@@ -261,17 +262,30 @@ def judge_transparent(
                     unchanged.fail(rid, where, missing)
             continue
         mechanism.observe(where)  # only a command that went out shows how it went out
-        first = matching[0]
+        first, last = matching[0], matching[-1]
+        stalls = line.stalls  # the tool's host's (truth34): a break it laid with the command
+        # as one late read, a reply it held back or cut, are its doing, not the recorder's
         if first.break_event is None:
-            mechanism.fail("R-4.4.14-01", where, "sent without a break to wake the bus")
+            fail_unless_stalled(
+                mechanism,
+                stalls,
+                "R-4.4.14-01",
+                where,
+                "sent without a break to wake the bus",
+                (first.first_char - STANDBY_MARKING, first.end),
+            )
         if relayed is not None:
             got = relayed.get(text)
-            want = decode_7e1(matching[-1].reply)
+            want = decode_7e1(last.reply)
             if got is not None and got != want:
-                mechanism.fail(
+                heard = last.heard
+                fail_unless_stalled(
+                    mechanism,
+                    stalls,
                     "R-4.4.14-01",
                     where,
                     f"relayed '{escape(got[:40])}', the sensor sent '{escape(want[:40])}'",
+                    (first.start, heard[-1].end if heard else last.end),
                 )
     through = "passed through"
     if relayed is None:  # the wire shows the break and the command, not what the host got

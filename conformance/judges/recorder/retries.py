@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
-from ...links.host_stall import Stall
+from ...links.host_stall import REACH, Stall, stalled_over
 from ...protocol.timing import (
     CHAR_TIME,
     RESPONSE_START_MAX,
@@ -26,14 +26,14 @@ from ...protocol.timing import (
 )
 from ...transcript import escape
 from ...verdicts import Finding, Verdict
-from ...view.segments import TranscriptView, Transmission
+from ...view.segments import TranscriptView, Transmission, memo
 from ..reply_validity import NO_REPLY, STX, Reason, ReplyProblem
 from ..tally import Tally
 from ..timing import judge_window
 from .common import combine, own_uncertainty
 from .logged import same_values
 from .replies import crc_context, cut_off, reply_problem
-from .stalls import hold
+from .stalls import fail_unless_stalled, hold
 
 #: Marking after which a sensor is in standby (R-7.0-15, +0.40 ms): a command sent again
 #: without a break after longer than this is not a retry but a new try without its break.
@@ -289,6 +289,32 @@ class _RetryEvidence:
         stamps), INCONCLUSIVE naming the first; as before outside any stall."""
         return hold(self.stalls, finding, start, end, high)
 
+    def fail(
+        self,
+        rid: str,
+        where: str,
+        message: str,
+        line: TranscriptView,
+        tries: tuple[Try, Try],
+        until: float | None = None,
+        *,
+        warning: bool = False,
+    ) -> None:
+        """A tallied FAIL (a WARN with ``warning``) of ``rid`` that rests on the tries from
+        the first of ``tries`` (read from ``line``) to the last and the recorder's decision
+        after it (:func:`_decided_by`; or the next try at ``until``, if sooner), or where a
+        noted stall of the tool's host lies over that stretch, the observation undecided
+        naming it (truth34: the reply it held back read invalid, or a paused in-process
+        recorder missed its window; a stall's disorder reaches back to
+        :func:`_unsettled_from`). What came after the decision is no part of it: a recorder
+        that waits out a 1 s poll timeout instead of retrying had its chance first."""
+        span = (0.0, 0.0)
+        if self.stalls:
+            first, last = tries
+            end = _decided_by(last)
+            span = (_unsettled_from(line, first), end if until is None else min(until, end))
+        fail_unless_stalled(self.tally, self.stalls, rid, where, message, span, warning=warning)
+
 
 def _judge_group(
     line_of: LineOf, group: RetryGroup, uncertainty: float, acc: _RetryEvidence
@@ -302,7 +328,7 @@ def _judge_group(
     # sent once may have been accepted: that is R-7.2-05's (and R-4.4.12-07's) finding.
     gave_up = group.attempts[-1].problem is NO_REPLY or len(group.attempts) > 1
     real = group.real_retries(uncertainty)
-    _judge_retried(acc.tally, group, where, real, gave_up)
+    _judge_retried(line_of, group, where, real, gave_up, acc)
     sequences = group.sequences()
     for n, seq in enumerate(sequences):
         later = sequences[n + 1][0] if n + 1 < len(sequences) else None
@@ -311,19 +337,31 @@ def _judge_group(
         if any(a.problem is None for a in seq) or not gave_up:
             continue
         _judge_given_up(line, seq, f"{where} sequence {n + 1}", uncertainty, acc)
-    _judge_repeated(acc.tally, group, where, sequences, real, gave_up)
+    _judge_repeated(line_of, group, where, sequences, real, gave_up, acc)
 
 
 def _judge_retried(
-    tally: Tally, group: RetryGroup, where: str, real: list[Try], gave_up: bool
+    line_of: LineOf,
+    group: RetryGroup,
+    where: str,
+    real: list[Try],
+    gave_up: bool,
+    acc: _RetryEvidence,
 ) -> None:
-    """R-7.2-01: a PASS only from a retry inside the window, a FAIL where none was tried."""
+    """R-7.2-01: a PASS only from a retry inside the window, a FAIL where none was tried
+    (named at the first try whose reply and the recorder's answer to it no noted stall of
+    the tool's host lies over; where one lies over every such try, undecided: truth34)."""
+    tally = acc.tally
     if real:
         tally.observe(where, ids=["R-7.2-01"])
     elif gave_up and not any(a.retry for a in group.attempts):
-        nxt = group.attempts[1] if len(group.attempts) > 1 else None
-        first = group.attempts[0]
-        tally.fail("R-7.2-01", where, f"{first.after()}: {first.instead(nxt)}")
+        tries = group.attempts
+        k = _first_unstalled(line_of, tries, acc.stalls)
+        nxt = tries[k + 1] if k + 1 < len(tries) else None
+        a = tries[k]
+        until = nxt.sent.first_char if nxt is not None else None
+        message = f"{a.after()}: {a.instead(nxt)}"
+        acc.fail("R-7.2-01", where, message, line_of(a), (a, a), until)
     elif gave_up:
         tally.unobservable(
             "R-7.2-01",
@@ -347,13 +385,16 @@ def _judge_tries(
         if a.problem is None:
             continue
         nxt = seq[k + 1] if k + 1 < len(seq) else None
-        began = _quiet_from(line, a) if acc.stalls else a.sent.start
+        began = _unsettled_from(line, a) if acc.stalls else a.sent.start
         if nxt is None and len(seq) < 3:
-            acc.tally.fail(
+            acc.fail(
                 "R-7.2-05",
                 where,
                 f"{a.problem} at {a.sent.at()}, then "
                 + ("a new sequence, not a retry" if later is not None else "no retry"),
+                line,
+                (seq[0], a),  # no break since: the sensor's state (asleep, say) is the sequence's
+                later.sent.first_char if later is not None else None,
             )
         # "no reply" times a retry from a quiet line: sensor characters that met the
         # command (the recorder talked over them) leave that window undecided
@@ -380,7 +421,10 @@ def _judge_tries(
                 )
                 # the wait for the reply and what the recorder did instead: a stall there
                 # may have held the reply back (or the recorder, in the tool's process)
-                until = later.sent.first_char if later is not None else a.sent.end + STANDBY
+                # (no further than the decision the recorder owed it: truth34)
+                until = _decided_by(a)
+                if later is not None:
+                    until = min(until, later.sent.first_char)
                 acc.window.append(acc.across(missing, began, until))
         elif nxt is not None and nxt.in_window(uncertainty):
             judged = _retry_after_reply(line, a.sent, nxt.sent, a.problem, uncertainty)
@@ -389,13 +433,81 @@ def _judge_tries(
             acc.restarted.append(f"{a.after()}: {a.instead(later)}")
 
 
-def _quiet_from(line: TranscriptView, a: Try) -> float:
-    """Where the marking before try ``a`` began (the line's last activity before it): a
-    stall there (truth32) decides how long the sensor had been left alone when the try came,
-    and so whether it was awake to answer it (the in-process recorder, paused past the
-    sensor's 100 ms, sent its aD2! to a sensor asleep; no reply, then a break)."""
-    before = line.previous_activity(a.sent)
-    return a.sent.start if before is None else before
+def _unsettled_from(line: TranscriptView, a: Try) -> float:
+    """The earliest moment a stall of the tool's host could have disturbed what try ``a``
+    shows (truth34: its disorder outlives its noted span). Where it drew no reply: where
+    the marking before it began (truth32: a stall there decides how long the sensor had been
+    left alone, so whether it was awake to answer, and a paused in-process recorder came
+    back to begin anew with a break, new1's 0M! at 101.667 s), or the standby before it,
+    whichever is earlier (the played sensor counts its marking from when it planned its
+    last frame, which a stall sent late: new1's 0DB3! 26 ms after a stall's reach drew
+    nothing, nor its retry; base0's 5A0! and 0M! just past one). A reply, however invalid,
+    shows the sensor was awake: from the try itself. Where the sensor was still sending as
+    the try began (a reply the stall held back met it), from the start of the transmission
+    whose reply that was (:data:`MET_CHAIN`). And :data:`~conformance.links.host_stall.REACH`
+    before all that: a paused in-process recorder acts as it comes back, just past the
+    note's reach (newF's retry 0.03 ms past it, then a reply it talked over)."""
+    sent = a.sent
+    start = sent.start
+    if a.problem is NO_REPLY:
+        before = line.previous_activity(sent)
+        start = min(start if before is None else before, start - STANDBY)
+    met = sent
+    for _ in range(MET_CHAIN):  # a held-back reply may meet several tries in turn
+        previous = _previous(line, met)
+        if previous is None or not _talked_over(line, met):
+            break
+        met = previous
+        start = min(start, previous.start)
+    return start - REACH
+
+
+#: how many tries back :func:`_unsettled_from` follows a reply still coming as each began
+#: (truth32's newF3: a stall held 0DB8!'s packet back, the paused recorder's retry met it
+#: and 0DB9! the rest, 250 ms after the stall's reach)
+MET_CHAIN = 3
+
+
+def _talked_over(line: TranscriptView, sent: Transmission) -> bool:
+    """Whether the sensor was still sending as ``sent`` began (a reply it talked over)."""
+    return sent.cut is not None or bool(line.sensor_chars_between(sent.start - CHAR_TIME, sent.end))
+
+
+def _decided_by(a: Try) -> float:
+    """When the recorder had to have acted on try ``a``: the standby after the last thing it
+    heard (its reply, or the command itself)."""
+    heard = a.sent.heard
+    return max(a.sent.end, heard[-1].end if heard else a.sent.end) + STANDBY
+
+
+def _previous(line: TranscriptView, sent: Transmission) -> Transmission | None:
+    """The transmission before ``sent`` in ``line`` (None for its first)."""
+    transmissions = line.transmissions
+    index = memo(
+        line,
+        "_retry_index",
+        len(transmissions),
+        lambda: {id(t): i for i, t in enumerate(transmissions)},
+    )
+    i = index.get(id(sent))
+    return transmissions[i - 1] if i else None
+
+
+def _first_unstalled(line_of: LineOf, tries: Sequence[Try], stalls: Sequence[Stall]) -> int:
+    """The index of the first of ``tries`` (each unanswered or invalid, none retried) whose
+    stretch, from :func:`_unsettled_from` to the next try (or :func:`_decided_by`), no noted
+    stall lies over; 0 where one lies over each (or none is noted)."""
+    if not stalls:
+        return 0
+    for k, a in enumerate(tries):
+        if a.problem is None:  # the group's last try, answered: nothing to retry for
+            continue
+        until = _decided_by(a)
+        if k + 1 < len(tries):
+            until = min(until, tries[k + 1].sent.first_char)
+        if stalled_over(stalls, _unsettled_from(line_of(a), a), until) is None:
+            return k
+    return 0
 
 
 def _judge_given_up(
@@ -412,8 +524,10 @@ def _judge_given_up(
             evidence=[a.sent.at() for a in seq],
             observed=len(seq),
         )
-        # the sequence's tries and the wait after its last (its reply, a retry due)
-        acc.third.append(acc.across(few, _quiet_from(line, seq[0]), seq[-1].sent.end + STANDBY))
+        # the sequence's tries and the wait after its last (its reply, a retry due); a
+        # stall's disorder reaches back past the marking before the first (truth34)
+        began = _unsettled_from(line, seq[0])
+        acc.third.append(acc.across(few, began, _decided_by(seq[-1])))
         return
     brk = seq[0].sent.break_event or line.last_break_before(seq[0].sent)
     if brk is not None:
@@ -430,21 +544,28 @@ def _judge_given_up(
 
 
 def _judge_repeated(
-    tally: Tally,
+    line_of: LineOf,
     group: RetryGroup,
     where: str,
     sequences: list[list[Try]],
     real: list[Try],
     gave_up: bool,
+    acc: _RetryEvidence,
 ) -> None:
     """R-7.2-04 is about repeating a whole break+command+retries sequence: repeats of a
-    break and the command alone hold no retry and are no evidence for it either way."""
+    break and the command alone hold no retry and are no evidence for it either way. "Gave
+    up" rests on every try of the group reading unanswered or invalid: a noted stall over
+    any of them (or the wait after the last) leaves it undecided (truth34)."""
+    tally = acc.tally
     repeated = any(a in real for seq in sequences[:-1] for a in seq)
     if not group.succeeded and gave_up and len(sequences) < 3:
-        tally.fail(
+        first, last = group.attempts[0], group.attempts[-1]
+        acc.fail(
             "R-7.2-04",
             where,
             f"gave up after {len(sequences)} break+command+retries sequence(s)",
+            line_of(first),
+            (first, last),
             warning=True,
         )
     elif len(sequences) > 1 and (repeated or (not group.succeeded and real)):
@@ -497,8 +618,10 @@ def cut_replies(
                 evidence=[s.at(), nxt.at()],
                 observed=1,
             )
-            # a reply the tool's host stalled over (truth32): held back, its rest late
-            failed.append(hold(stalls, found, s.start, brk.end))
+            # a reply the tool's host stalled over (truth32): held back, its rest late; or
+            # one a stall's disorder reached (truth34: :func:`_unsettled_from`)
+            began = _unsettled_from(line, Try(s, NO_REPLY)) if stalls else s.start
+            failed.append(hold(stalls, found, began, brk.end))
         else:
             named.append(f"{cut} (after {s.at()}): a new sequence, not a retry")
     return failed, named

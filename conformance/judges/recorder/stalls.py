@@ -13,21 +13,25 @@ own doing alone, so where every late frame of a served run fell inside a noted s
 served line's whole-run guard (``ConformanceRun._guard_served_line``) leaves their findings
 as judged.
 
-The retry judges (R-7.2-02, -03, -06) hold what a noted stall covers too, but stay under
-the guard: a retry answers the played sensor's replies, and a stall's disorder outlives
-its window there (truth32's reproduction: a reply held back 135 ms met the in-process
+The retry judges (R-7.2-02, -06) hold what a noted stall covers too, but stay under the
+guard: a retry answers the played sensor's replies, and a stall's disorder outlives its
+window there (truth32's reproduction: a reply held back 135 ms met the in-process
 recorder's retry, and the sensor's next reply, 115 ms after the stall's note, began late
-enough that the recorder broke into it; R-7.2-06 FAILed on it).
+enough that the recorder broke into it; R-7.2-06 FAILed on it). R-7.2-01, -03, -04 and -05
+read that disorder (truth34: from the sensor's standby before a try, or the reply it met
+still coming, to the standby after what the try heard) and stand as judged.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, TypeVar
 
 from ...links.host_stall import REACH, Stall, stalled_over
+from ...transcript import Event
 from ...verdicts import Finding, Verdict
 from ..stalled import stalled_interval
+from ..tally import Tally
 from ..timing import Measured
 from .common import REACTION
 
@@ -47,6 +51,14 @@ READ_STALLS = frozenset(
         "R-7.0-06",  # breaks.Breaks: the marking after a break
         "R-7.0-17",  # breaks.BreakRules: the marking before a command sent without a break
         "R-7.1-01",  # breaks.BreakRules: aD0! without a break after the service request
+        # truth34: the retry rules whose judges read a stall's disorder past its span (the
+        # sensor's standby before a try, a reply held back still coming, the standby after
+        # what a try heard: retries._unsettled_from, _decided_by)
+        "R-7.2-01",  # retries: "not sent again", "only after a new break"
+        "R-7.2-03",  # retries: "n retries, then no more"
+        "R-7.2-04",  # retries: "gave up after n sequences"
+        "R-7.2-05",  # retries: "then a new sequence" / "then no retry"
+        "R-4.4.14-01",  # capabilities.judge_transparent: the break, the reply relayed
     }
 )
 
@@ -121,3 +133,66 @@ def over_collection(m: ObservedMeasurement, stalls: Sequence[Stall]) -> Stall | 
     last = m.data[-1][0]
     end = last.heard[-1].end if last.heard else last.end
     return stalled_over(stalls, m.data[0][0].start, end)
+
+
+def fail_unless_stalled(
+    tally: Tally,
+    stalls: Sequence[Stall],
+    rid: str,
+    where: str,
+    message: str,
+    span: tuple[float, float],
+    *,
+    warning: bool = False,
+) -> None:
+    """``tally.fail`` of ``rid`` at ``where``, or where a noted stall of the tool's host
+    overlaps ``span`` (s, s: the stretch of line the deviation rests on, from the first
+    moment a stall could have disturbed it to the recorder's decision), the same observation
+    left undecided naming the stall (truth34): a tallied rule's counterpart of :func:`hold`.
+    A rule whose judges tally needs it for each observation, not for the combined finding:
+    one deviation outside every stall still FAILs it."""
+    stall = stalled_over(stalls, *span) if stalls else None
+    if stall is None:
+        tally.fail(rid, where, message, warning=warning)
+    else:
+        tally.undecide(rid, where, f"{message}, but {stall.why()}")
+
+
+#: the start of the title a recorder case gives each scenario slice it judged
+SCENARIO_TITLE = "scenario "
+
+
+def late_near(evidence: Iterable[tuple[str, Sequence[Event]]], stalls: Sequence[Stall]) -> bool:
+    """Whether what a case judged may have been disturbed by the served line's noted
+    lateness (truth34: the line notes every frame it sent late, so the notes are all of
+    it): a noted stall lies over one of the scenario slices in its ``evidence``, or within
+    :data:`~.common.REACTION` before one (its disorder outlives its span: a reply held
+    back, a sensor asleep by its own clock). A case that names no scenario slice judged
+    what it cannot show here: True, held as the whole run was before."""
+    spans = [
+        (events[0].start, max(e.end for e in events))
+        for title, events in evidence
+        if title.startswith(SCENARIO_TITLE) and events
+    ]
+    if not spans:
+        return True
+    return any(stalled_over(stalls, start - REACTION, end) for start, end in spans)
+
+
+#: how far (s) from every noted stall a deviation of an in-process recorder must lie for the
+#: served line's guard to let a rule whose judge reads the stalls stand: the host holds up
+#: its threads around a stall too, where nothing notes it (base-s69's paused clean run: a
+#: 1.15 ms break 184 ms after a note)
+NEAR = 1.0
+
+
+def stamped_far(finding: Finding, stalls: Sequence[Stall]) -> bool:
+    """Whether every place ``finding`` names (its ``t=... s`` stamps, in its detail and
+    evidence) lies more than :data:`NEAR` from every noted stall; False where it names none
+    (truth34: no-break-after-87ms' "2005.70 ms before 0D0! at t=43.521 s", 38 s from the
+    run's one note, stands; a deviation beside a stall does not)."""
+    from ...reports.evidence import STAMP
+
+    texts = (finding.detail, *finding.evidence)
+    times = [float(t) for text in texts for t in STAMP.findall(text)]
+    return bool(times) and all(stalled_over(stalls, t - NEAR, t + NEAR) is None for t in times)

@@ -259,9 +259,13 @@ def _guarded(unexplained: float) -> list[Finding]:
         Finding("R-4.4-02", Verdict.FAIL, "logged 3 of 4 values", evidence=["l"], observed=1),
     ]
     session = SimpleNamespace(
-        worst_lateness=lambda: 0.150, unexplained_lateness=lambda: unexplained
+        worst_lateness=lambda: 0.150,
+        unexplained_lateness=lambda: unexplained,
+        noted_stalls=lambda: [],
+        recorder_in_process=lambda: False,  # its own process: the stalls are the tool's
     )
-    run = SimpleNamespace(session=session, cases=[SimpleNamespace(findings=findings)])
+    # a case that names no scenario slice: held wherever the line was late (truth34)
+    run = SimpleNamespace(session=session, cases=[SimpleNamespace(findings=findings, evidence=[])])
     ConformanceRun._guard_served_line(run)  # type: ignore[arg-type]
     return findings
 
