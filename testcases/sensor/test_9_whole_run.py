@@ -120,7 +120,7 @@ def test_service_requests_of_every_measurement(sensor, case):
         "exactly 'a<CR><LF>', complete within ttt s of the reply, nothing before it, after "
         "every M-type measurement with ttt > 0 the run made; none after a concurrent one"
     )
-    ms = _remeasured(sensor)
+    ms = _remeasured(sensor) + sensor.disturbed
     case.evidence("measurements made again by other cases", ms)
     case.extend(other_waits.judge_other_waits(ms, case.requirements, sensor.version))
 
