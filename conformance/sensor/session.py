@@ -1064,8 +1064,9 @@ class SensorSession(Session):
             poke = self.master.raw(disturb, break_first=True, marking=marking)
         if m.reply_end is not None and m.ttt:
             self.link.wait_until(m.reply_end + m.ttt + self.master.policy.ttt_margin)
-            self.link.reader_caught_up()
-            self._keep_disturbed_wait(m, poke, self.link.transcript.events[waited:])
+            if disturb[:1] != self.address:  # aI! to itself aborts it: no wait left after
+                self.link.reader_caught_up()
+                self._keep_disturbed_wait(m, poke, self.link.transcript.events[waited:])
         self.master.collect(m, force_break=True)
         if self.disturbed and self.disturbed[-1] is m:
             self.master.mark_stalls((), first, [m])  # its wait, as a fresh measurement's
@@ -1073,11 +1074,14 @@ class SensorSession(Session):
 
     def _keep_disturbed_wait(self, m: Measurement, poke: Exchange, events: list[Event]) -> None:
         """Keep in :attr:`disturbed` the part of ``m``'s wait the whole-run wait case can
-        judge (truth35): what the sensor sent (``events``) in runs begun
-        :data:`~.late_watch.LATE_START_LISTEN` past the disturbance ``poke`` (its reply,
-        however late, is the poke's by design, not the measurement's talk), where that part
-        still reaches the measurement's ready time (ttt): a service request after a
-        concurrent measurement comes then."""
+        judge (truth35), for a disturbance ``poke`` to another address (the measurement
+        goes on through it, R-4.4.7-05; one to the sensor itself aborts it, and what the
+        sensor sends after that abort is the abort rules' to judge: abort-sends-zero-reply's
+        'a0000<CR><LF>' there is no concurrent measurement's service request): what the
+        sensor sent (``events``) in runs begun :data:`~.late_watch.LATE_START_LISTEN` past
+        the poke (a reply to it, however late, is the poke's, not the measurement's talk),
+        where that part still reaches the measurement's ready time (ttt): a service request
+        after a concurrent measurement comes then."""
         ends = [e.end for a in poke.attempts for e in (*a.command_events, *a.reply_events)]
         if m.reply_end is None or not m.ttt or not ends:
             return
