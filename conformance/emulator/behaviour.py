@@ -137,6 +137,10 @@ class Behaviour:
     pack_slack: int = 0  # values left out of each full M/V reply (R-4.4.8.3-03)
     split_values: bool = False  # fill M/V replies to the limit, cutting a value
     drop_all_values: bool = False  # a completed measurement holds no values
+    #: An M command (the M family) this sensor has measured before since power-up announces
+    #: its count in full but leaves its last value out of the data; the first of each
+    #: delivers all (a short count only the cases that measure again see: truth35).
+    fewer_values_repeated: bool = False
     max_data_index: int = HIGH_VOLUME_DATA_INDEX_MAX  # highest D index served after HA
     groups_from_d1: bool = False  # M/V data start at D1, D0 empty (R-4.4.8.3-02)
     # -- other commands ----------------------------------------------------------------------

@@ -112,6 +112,8 @@ class SensorEmulator:
         self._previous: DataSet | None = None
         self._last_command: Command | None = None
         self._measured: set[str] = set()  # M/V commands started before (a faulty sensor's)
+        #: per M command, whether its last start ran to completion (a faulty sensor's)
+        self._completed: dict[str, bool] = {}
         self._crc_stuck = False  # only a faulty sensor sets it (metadata_crc_sticks)
         self._replied_last = False  # the last thing on the line was this sensor's own
         self._report: Transmission | None = None  # only a faulty sensor sets it (abort_reply)
@@ -203,8 +205,7 @@ class SensorEmulator:
             self._report = None
         run = self._run
         if run is not None and run.ready_at <= start:  # _settle(start)
-            self._data = complete(run, b)
-            self._run = None
+            self._complete(run)
         if b.foreign_reply_aborts_concurrent or b.answer_foreign_reply:
             self._overhear(_CHR7[wire & 0x7F], end)
         previous = self._last_activity
@@ -339,8 +340,14 @@ class SensorEmulator:
         """Turn a running measurement into data once its ready time has passed."""
         run = self._run
         if run is not None and run.ready_at <= now:
-            self._data = complete(run, self.behaviour)
-            self._run = None
+            self._complete(run)
+
+    def _complete(self, run: Run) -> None:
+        """``run`` finished: its data in the buffer, nothing running."""
+        self._data = complete(run, self.behaviour)
+        self._run = None
+        if self.behaviour.fewer_values_repeated:
+            self._completed[run.command.text()] = True
 
     def _abort(self) -> None:
         run = self._run
@@ -559,6 +566,7 @@ class SensorEmulator:
         sent = self._send(self._start_reply(cmd, cmd, spec, ReplyKind.START), at)
         if sent is None:
             return
+        spec = self._short_when_repeated(cmd, spec)  # announced in full, delivered short
         if spec is None and b.undefined_group_keeps_data:
             return  # a faulty sensor: the undefined group leaves the old data readable
         self._previous = self._data
@@ -569,7 +577,7 @@ class SensorEmulator:
             delay = min(delay, quick)  # a quirk: ready long before ttt
         run = Run(cmd, spec, sent.end + delay)
         if spec is None or spec.ttt == 0:
-            self._data = complete(run, b)  # R-4.4.5-03: ready at once
+            self._complete(run)  # R-4.4.5-03: ready at once
             sr_kind = cmd.kind in SERVICE_REQUEST_KINDS
             if spec is not None and sr_kind and b.service_request_on_ttt_zero:
                 self._service_request(cmd, sent.end + b.reply_delay)
@@ -601,6 +609,23 @@ class SensorEmulator:
             self._measured.add(key)
             return None
         return late
+
+    def _short_when_repeated(
+        self, cmd: Command, spec: MeasurementSpec | None
+    ) -> MeasurementSpec | None:
+        """``spec``, or for an M command (the M family: aM!, aMC!, aMn!...) of two or more
+        values whose last start since power-up ran to completion, the same count announced
+        and its last value left out of the data (``fewer_values_repeated``, a faulty
+        sensor's). The first of each delivers all, and so does one started after its last
+        start was aborted (a break's abort case compares that one with the first, under its
+        own rule): only a case that measures again sees the count fall short (truth35)."""
+        if not self.behaviour.fewer_values_repeated or spec is None:
+            return spec
+        if cmd.kind is not Kind.MEASURE or len(spec.values) < 2:
+            return spec
+        key = cmd.text()
+        again, self._completed[key] = self._completed.get(key, False), False
+        return replace(spec, values=spec.values[:-1], announced=spec.count) if again else spec
 
     def _timed(self, cmd: Command, spec: MeasurementSpec | None) -> MeasurementSpec | None:
         """``spec`` with the ttt the behaviour announces (``announce_ttt``) for an M/V

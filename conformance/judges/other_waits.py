@@ -17,6 +17,14 @@ a SHOULD rule a WARN), and adds what it finds beside the owners' findings:
   rule: INCONCLUSIVE with ``observed`` 0, which the owners' judgment outweighs
   (:func:`~conformance.results.counted`) and which stands where none judged;
 - nothing to judge (no such measurement): N/A, which changes no owner's verdict.
+
+The data rules (:data:`DATA_IDS`) are weighed the same way over the same measurements
+(truth35): the cases that own them judge the cached measurements' D replies alone, so a
+sensor whose data went wrong only when measured again (one value fewer than announced the
+second time) PASSed them. Each D reply keeps the data judge's preconditions
+(:func:`~conformance.judges.measurements.data_violations`): a reply heard to a D command
+of that measurement's collection; one that may be another's (a late reply, the D before's,
+a service request begun too soon) is undecided; a stall of the host over its read too.
 """
 
 from __future__ import annotations
@@ -26,7 +34,7 @@ from dataclasses import replace
 
 from ..tool_recorder.records import Measurement
 from ..verdicts import Finding, Verdict, inconclusive, not_applicable
-from .measurements import judge
+from .measurements import judge, unread_data
 
 #: The rules a measurement's wait is judged on (:func:`~conformance.judges.measurements.
 #: wait_violations`), less R-5.3-01 (a high-volume measurement's, whose case needs breaks):
@@ -35,6 +43,27 @@ SERVICE_REQUEST_IDS = ("R-4.4.6-01", "R-4.4.6-02", "R-4.4.6-04", "R-4.4.5-08", "
 #: ... and the quiet of a concurrent one, as the concurrent cases judge it
 QUIET_IDS = ("R-4.4.6-05", "R-4.4.7-04")
 WAIT_IDS = SERVICE_REQUEST_IDS + QUIET_IDS
+#: The rules over an ASCII measurement's D replies, as the data and CRC cases judge the
+#: cached ones (``test_data_replies``, ``test_announced_values_delivered``,
+#: ``test_value_grouping``, ``test_crc_presence``, ``test_crc_value_and_encoding``): their
+#: form and values (R-4.4.8-01, -02), the values part's length (R-4.4-05), the count adding
+#: up (R-4.4.8-03), a D0 with values (R-4.4.8-04), the grouping (R-4.4.8.3-01..03), the
+#: CRC where asked for and not elsewhere (R-4.4.12-02, -03), its value and encoding
+#: (R-4.4.12-05, -06)
+DATA_IDS = (
+    "R-4.4.8-01",
+    "R-4.4.8-02",
+    "R-4.4-05",
+    "R-4.4.8-03",
+    "R-4.4.8-04",
+    "R-4.4.8.3-01",
+    "R-4.4.8.3-02",
+    "R-4.4.8.3-03",
+    "R-4.4.12-02",
+    "R-4.4.12-03",
+    "R-4.4.12-05",
+    "R-4.4.12-06",
+)
 
 WHAT = "the measurements other cases made again"
 
@@ -47,6 +76,16 @@ def judge_other_waits(
     if not measurements:
         return [not_applicable(rid, f"{WHAT}: none was made") for rid in ids]
     return [_weighed(f) for f in judge(measurements, ids, version)]
+
+
+def judge_other_data(
+    measurements: Sequence[Measurement], ids: Sequence[str], version: str
+) -> list[Finding]:
+    """:func:`judge_other_waits` for the data rules: beside each rule's findings, where a
+    start reply gave no readable count (its D replies never asked for), the rule undecided
+    there (:func:`~conformance.judges.measurements.unread_data`), weighed as the rest."""
+    found = judge_other_waits(measurements, ids, version)
+    return found + [_weighed(f) for f in unread_data(measurements, ids)]
 
 
 def _weighed(f: Finding) -> Finding:

@@ -40,6 +40,7 @@ from ..tool_recorder.records import Exchange, Measurement
 from ..transcript import TOOL, Event, EventKind, decode_7e1, escape
 from ..view.live_cut import Mark, live_cut
 from ..view.rebuilt_records import Rebuilt, rebuild_records, records_of
+from ..view.runs import runs
 from ..view.segments import read_view
 from .address_change import AddressChanger, Trial
 from .buffer_watch import WatchedToolRecorder
@@ -205,6 +206,10 @@ class SensorSession(Session):
         #: every measurement a case made anew, outside the cache (:meth:`fresh_measurement`):
         #: the wait rules' cases judge the cached ones, the whole-run case these (truth31)
         self.remeasured: list[Measurement] = []
+        #: the concurrent measurements a case disturbed on purpose (:meth:`disturbed_
+        #: measurement`), each with the part of its wait past the disturbance: the whole-run
+        #: wait case judges their quiet there (truth35)
+        self.disturbed: list[Measurement] = []
         #: the measurement codes a family may be tried with (None: all; a profile's groups)
         self.groups: frozenset[str] | None = None
         #: every sensor on the line with its aI! reply, when the DUT is not alone on it
@@ -1049,7 +1054,9 @@ class SensorSession(Session):
         the proof); one for another address is sent once, after a break with the marking the
         sensor was shown to hear (:meth:`hearing_marking`; none known: the default)."""
         marking = self.hearing_marking()  # found before the measurement: its a! would abort it
+        first = len(self.link.transcript.events)
         m = self.master.measure(command, collect=False, wait="none")
+        waited = len(self.link.transcript.events)
         self.listen(0.05)
         if disturb[:1] == self.address:
             poke = self.master.transact(disturb)
@@ -1057,8 +1064,34 @@ class SensorSession(Session):
             poke = self.master.raw(disturb, break_first=True, marking=marking)
         if m.reply_end is not None and m.ttt:
             self.link.wait_until(m.reply_end + m.ttt + self.master.policy.ttt_margin)
+            if disturb[:1] != self.address:  # aI! to itself aborts it: no wait left after
+                self.link.reader_caught_up()
+                self._keep_disturbed_wait(m, poke, self.link.transcript.events[waited:])
         self.master.collect(m, force_break=True)
+        if self.disturbed and self.disturbed[-1] is m:
+            self.master.mark_stalls((), first, [m])  # its wait, as a fresh measurement's
         return m, poke
+
+    def _keep_disturbed_wait(self, m: Measurement, poke: Exchange, events: list[Event]) -> None:
+        """Keep in :attr:`disturbed` the part of ``m``'s wait the whole-run wait case can
+        judge (truth35), for a disturbance ``poke`` to another address (the measurement
+        goes on through it, R-4.4.7-05; one to the sensor itself aborts it, and what the
+        sensor sends after that abort is the abort rules' to judge: abort-sends-zero-reply's
+        'a0000<CR><LF>' there is no concurrent measurement's service request): what the
+        sensor sent (``events``) in runs begun :data:`~.late_watch.LATE_START_LISTEN` past
+        the poke (a reply to it, however late, is the poke's, not the measurement's talk),
+        where that part still reaches the measurement's ready time (ttt): a service request
+        after a concurrent measurement comes then."""
+        ends = [e.end for a in poke.attempts for e in (*a.command_events, *a.reply_events)]
+        if m.reply_end is None or not m.ttt or not ends:
+            return
+        after = max(ends) + LATE_START_LISTEN
+        if after >= m.reply_end + m.ttt:
+            return  # the poke's reply window covers the time the measurement is ready
+        dut = [e for e in events if e.kind is EventKind.CHAR and e.origin != TOOL]
+        kept = [e for run in runs(dut) if run[0].start >= after for e in run]
+        m.waited_events = kept
+        self.disturbed.append(m)
 
     def family(self, codes: tuple[str, ...]) -> list[Measurement]:
         """Cached measurements for every command code of a family (``M_FAMILY``...); under a

@@ -1,6 +1,6 @@
 """Rules judged over every reply of the run: character framing and printability, CR LF
 endings, the responding address, response start window, character gaps; and the
-service-request rules over every measurement the run made again.
+service-request and data rules over every measurement the run made again.
 
 These cases are ``whole_run``: the plugin runs them after every other case, whatever order
 or selection the run was given, so they judge everything the run sent. Each first asks for the
@@ -120,10 +120,32 @@ def test_service_requests_of_every_measurement(sensor, case):
         "exactly 'a<CR><LF>', complete within ttt s of the reply, nothing before it, after "
         "every M-type measurement with ttt > 0 the run made; none after a concurrent one"
     )
-    if not sensor.remeasured and sensor.defined(("M",)):
-        # a partial run (-k, --req) that left out every case measuring again: one of its own,
-        # so the case judges what a full run gives it (CI: alone it was N/A, PASS in full)
-        sensor.fresh_measurement("M")
-    ms = sensor.remeasured
+    ms = _remeasured(sensor) + sensor.disturbed
     case.evidence("measurements made again by other cases", ms)
     case.extend(other_waits.judge_other_waits(ms, case.requirements, sensor.version))
+
+
+@requirements(*other_waits.DATA_IDS)
+@pytest.mark.preconditions("none")
+def test_data_of_every_measurement(sensor, case):
+    """The data rules over every measurement a case made again (outside the cached ones
+    their own cases judge): a D reply malformed, a count short or a CRC wrong there is the
+    sensor's as much (truth35: one value fewer than announced only when measured again
+    PASSed R-4.4.8-03). A rule no such measurement bears on (no CRC asked for again) is N/A,
+    which changes no verdict of its own cases."""
+    case.expect(
+        "'a<values>[<CRC>]<CR><LF>' to every D command of every measurement the run made, "
+        "the values adding up to the count announced, D0 not empty, the CRC where asked for"
+    )
+    ms = _remeasured(sensor)
+    case.evidence("measurements made again by other cases", ms)
+    case.extend(other_waits.judge_other_data(ms, case.requirements, sensor.version))
+
+
+def _remeasured(sensor):
+    """The measurements the run's cases made again; in a partial run (-k, --req) that left
+    out every case measuring again, one aM! of the whole-run cases' own, so they judge what
+    a full run gives them (CI: alone the wait case was N/A, PASS in full)."""
+    if not sensor.remeasured and sensor.defined(("M",)):
+        sensor.fresh_measurement("M")
+    return sensor.remeasured

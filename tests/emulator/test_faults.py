@@ -255,6 +255,21 @@ def check_late_service_request_when_repeated(rig: Rig) -> None:
     assert follow[-1].end - start.events[-1].end > 2.0
 
 
+def check_fewer_values_when_repeated(rig: Rig) -> None:
+    """aM! delivers its three values the first time; started again after that one completed,
+    it still announces three and delivers two; started after an aborted start, all three."""
+    start, _ = rig.measure("0M!")
+    assert start.body == "00023"
+    assert rig.ask("0D0!").body == "0" + M_VALUES
+    start, _ = rig.measure("0M!")
+    assert start.body == "00023"
+    assert rig.ask("0D0!").body == "0+22.15+1013.2"
+    rig.ask("0M!")  # the break before the D0 aborts it
+    assert rig.ask("0D0!").body == "0"
+    rig.measure("0M!")
+    assert rig.ask("0D0!").body == "0" + M_VALUES
+
+
 def check_service_request_after_ttt_zero(rig: Rig) -> None:
     rig.wake()
     rig.send("0M1!")
@@ -668,6 +683,7 @@ CHECKS: dict[str, Callable[[Rig], None]] = {
     "no-service-request": check_no_service_request,
     "late-service-request": check_late_service_request,
     "late-service-request-when-repeated": check_late_service_request_when_repeated,
+    "fewer-values-when-repeated": check_fewer_values_when_repeated,
     "service-request-after-ttt-zero": check_service_request_after_ttt_zero,
     "concurrent-service-request": check_concurrent_service_request,
     "service-request-extra-chars": check_service_request_extra_chars,

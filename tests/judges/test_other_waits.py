@@ -15,7 +15,7 @@ from conformance.ports import open_sim, parse_sim
 from conformance.preconditions import declared_on
 from conformance.results import CaseRecord, counted, partial_only
 from conformance.sensor.session import SensorSession
-from conformance.transcript import TOOL, Event, EventKind
+from conformance.transcript import TOOL, Event, EventKind, decode_7e1
 from conformance.verdicts import Finding, Verdict, passed, worst
 from testcases.sensor.test_9_whole_run import (
     test_service_requests_of_every_measurement as every_wait_case,
@@ -187,3 +187,43 @@ def test_the_abort_case_s_measurement_is_kept_with_its_wait_marked(monkeypatch):
     session.remeasured.clear()
     session.measure_as_sent(session.command("M"))  # no stall noted: the late request FAILs
     assert _case(session)["R-4.4.6-04"].verdict is Verdict.FAIL
+
+
+def _disturbed(faults: str, own: bool) -> SensorSession:
+    """``faults``' session after aC! disturbed by aI! to itself (``own``) or to another
+    address, as the concurrent cases disturb it."""
+    session = _session(faults)
+    poke = f"{session.address if own else session.foreign_address()}I!"
+    session.disturbed_measurement(session.command("C"), poke)
+    return session
+
+
+def test_a_request_after_a_disturbed_concurrent_measurement_fails():
+    """truth35: the wait of a concurrent measurement disturbed by a command to another
+    address, past the poke's reply window, is judged too: concurrent-service-request's
+    request there FAILs R-4.4.6-05 and R-4.4.7-04; the clean sensor's quiet PASSes in part.
+    aI! to the sensor itself aborts the measurement: nothing of it is kept (after that abort
+    abort-sends-zero-reply's unasked 'a0000<CR><LF>' is the abort rules' to judge)."""
+    bad = _disturbed("concurrent-service-request", False)
+    (m,) = bad.disturbed
+    assert decode_7e1(m.waited_events) == "0\r\n"
+    found = _case(bad)
+    assert {found[rid].verdict for rid in QUIET_IDS} == {Verdict.FAIL}, found
+    clean = _disturbed("", False)
+    (m,) = clean.disturbed
+    assert m.waited_events == [] and m.data
+    found = _case(clean)
+    assert {found[rid].verdict for rid in QUIET_IDS} == {Verdict.PASS}, found
+    assert all(found[rid].partial for rid in QUIET_IDS)
+    for faults in ("", "abort-sends-zero-reply", "concurrent-service-request"):
+        assert _disturbed(faults, True).disturbed == []
+
+
+def test_a_disturbance_whose_reply_window_covers_ttt_leaves_the_wait_unjudged(monkeypatch):
+    """Where the poke's reply window (LATE_START_LISTEN past it) reaches the time the
+    measurement is ready, what came there may be the poke's: the measurement is not kept."""
+    monkeypatch.setattr("conformance.sensor.session.LATE_START_LISTEN", 60.0)
+    session = _disturbed("concurrent-service-request", False)
+    assert session.disturbed == []
+    found = _case(session)
+    assert {found[rid].verdict for rid in QUIET_IDS} == {Verdict.NA}

@@ -243,6 +243,15 @@ COUNTS: tuple[Fault, ...] = (
         replaces="the count aM! announces against the values it delivers",
     ),
     Fault(
+        "fewer-values-when-repeated",
+        "An M command (aM!, aMC!, aMn!...) of two or more values measured before since"
+        " power-up announces its count in full and delivers one value fewer; the first of"
+        " each delivers all (only a case that measures again sees the count fall short:"
+        " truth35).",
+        ("R-4.4.8-03",),
+        settings={"fewer_values_repeated": True},
+    ),
+    Fault(
         "more-values-than-announced",
         "aM! announces 3 values but D returns 4.",
         ("R-4.4.8-03",),
