@@ -1487,4 +1487,3 @@ def test_a_sensor_that_answers_no_a_has_its_replies_framing_judged_r_4_3_01(a_ne
     rule = found["R-4.3-01"]
     assert rule["verdict"] == "FAIL", rule["findings"]
     assert "not the address '0'" in rule["findings"][0]["detail"]
-
