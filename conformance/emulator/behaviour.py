@@ -39,6 +39,10 @@ class Behaviour:
     address_marking: float = MARKING_AFTER_BREAK - TOLERANCE
     # Time after a break before the sensor can see start bits at all (R-7.0-07 allows 100 ms).
     wake_delay: float = 0.0
+    #: ``wake_delay`` after every second break only (the first, third ... wake at once): a
+    #: firmware whose slow wake-up depends on a state the breaks toggle (a regulator, a
+    #: sleep mode entered every other time)
+    wake_every_other: bool = False
     # Marking inside a command that drops it (R-AppB-01), again at the lower tolerance edge.
     partial_gap: float = PARTIAL_COMMAND_GAP - TOLERANCE
     standby_marking: float = STANDBY_MARKING  # R-7.0-15

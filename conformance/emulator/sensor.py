@@ -98,6 +98,7 @@ class SensorEmulator:
         self._last_activity = -inf
         self._wake_at = -inf
         self._waking = False  # woke up after a delay and has not taken a command yet
+        self._breaks = 0  # breaks heard: which of them the slow wake of every other one takes
         self._break_end: float | None = None
         self._buf: list[str] = []
         self._buf_start = 0.0
@@ -180,8 +181,10 @@ class SensorEmulator:
         if b.clear_on_break_after_read and data is not None and data.fully_read:
             self._data = data.emptied()
         self._awake = True
-        self._wake_at = end + b.wake_delay
-        self._waking = b.wake_delay > 0
+        self._breaks += 1
+        delay = 0.0 if b.wake_every_other and self._breaks % 2 else b.wake_delay
+        self._wake_at = end + delay
+        self._waking = delay > 0
         self._break_end = end
         self._last_activity = end
         self._replied_last = False

@@ -601,7 +601,13 @@ class ToolRecorder:
             # to every later reader (Attempt.reply_text)
             text = None if framing.binary else decode_7e1(reply)
             state = self._judge_reply(reply, command, address, command_end, framing, crc, text)
-        if reply and not collided and command is not None and command.kind is _ACKNOWLEDGE:
+        if (
+            reply
+            and not collided
+            and command is not None
+            and command.kind is _ACKNOWLEDGE
+            and not carries_values(decode_7e1(reply) if text is None else text)
+        ):
             self.acknowledged.add(address)
         if not collided and not framing.is_text(reply) and closes_exchange(command, reply):
             self._closed_reply_end = reply[-1].end
@@ -930,6 +936,17 @@ def reads_on(m: Measurement, policy: Policy) -> bool:
         and m.aborted_by is None
         and validity.reads_past_packet(m.packets, m.count or 0)
     )
+
+
+def carries_values(text: str) -> bool:
+    """Whether a reply to ``a!`` carries signed values after its address (``0+1013.25``):
+    no acknowledgement, valid or not, does; a sensor's data line sent late, or a second line
+    of the command before's reply, does. Such a reply is no sign the sensor answers ``a!``
+    (:attr:`ToolRecorder.acknowledged`): an ENG20009 Due sketch (docs/kit.md, thirty-fourth
+    round) that answers no ``a!`` sent its ``aR2!``'s second line 3 ms after an ``a!``, and
+    the silence to ``a!`` at a new address then FAILed R-4.4.4-03 and stopped the run."""
+    first = text.split("\r", 1)[0][1:]
+    return any(first[i] in "+-" and first[i + 1 : i + 2].isdigit() for i in range(len(first)))
 
 
 def take_values(m: Measurement, exchange: Exchange, crc: bool) -> bool:

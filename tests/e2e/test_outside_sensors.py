@@ -1474,3 +1474,16 @@ def test_a_logger_that_cuts_digits_is_not_told_its_absent_crc_excuses_nothing(tm
     waited = rules["R-4.4.5-04"]
     assert waited["verdict"] == "FAIL", waited["findings"]
     assert any("ttt=260" in f["detail"] for f in waited["findings"]), waited["findings"]
+
+
+def test_a_sensor_that_answers_no_a_has_its_replies_framing_judged_r_4_3_01(a_never_answered):
+    """The thirty-fourth round's ENG20009 Due sketch answers no a!, but its measurements at
+    '0', and sends lines such as 'FINAL DATA @2<CR><LF>': the whole-run framing case asked a!
+    alone whether the sensor was at its address, left R-4.3-01 undecided, and the rule PASSed
+    on the exploration's checks. A measurement answered at the address shows it there (the
+    sensor here starts its D replies with '1': INCONCLUSIVE "a! at it got no reply" at
+    base-s69)."""
+    found = _verdicts(run_once("sim://?faults=wrong-reply-address", keyword="test_reply_framing"))
+    rule = found["R-4.3-01"]
+    assert rule["verdict"] == "FAIL", rule["findings"]
+    assert "not the address '0'" in rule["findings"][0]["detail"]

@@ -604,6 +604,16 @@ def check_slow_wake(rig: Rig) -> None:
     assert decode_7e1(rig.listen()) == "0\r\n"
 
 
+def check_slow_wake_every_other(rig: Rig) -> None:
+    for late in (False, True, False, True):  # breaks 1..4: the second and fourth are slow
+        rig.wake(marking=0.095)
+        rig.send("0!")
+        if late:
+            assert rig.listen(timeout=0.02) == []
+            rig.send("0!")  # awake by now, as after any slow wake
+        assert decode_7e1(rig.listen()) == "0\r\n"
+
+
 def check_standby_ignored(rig: Rig) -> None:
     rig.ask("0!")
     rig.wait(1.0)
@@ -734,6 +744,7 @@ CHECKS: dict[str, Callable[[Rig], None]] = {
     "early-address": check_early_address,
     "late-address-after-break": check_late_address_after_break,
     "slow-wake": check_slow_wake,
+    "slow-wake-every-other": check_slow_wake_every_other,
     "standby-ignored": check_standby_ignored,
     "no-follow-up-without-break": check_no_follow_up_without_break,
     "deaf-after-service-request": check_deaf_after_service_request,

@@ -181,6 +181,17 @@ TIMING: tuple[Fault, ...] = (
         inconclusive=("R-7.0-03", "R-AppB-01"),
     ),
     Fault(
+        "slow-wake-every-other",
+        "After every second break the sensor needs 110 ms before it can see a start bit;"
+        " after the others it wakes at once (it wakes late only every other time). Each"
+        " wake-up rule probes two wakes in a row, one of which is slow.",
+        ("R-7.0-07", "R-7.0-05"),
+        settings={"wake_delay": 110e-3, "wake_every_other": True},
+        # the controls sent "one break, then once" beside these probes land on slow wakes
+        inconclusive=("R-4.3-04", "R-4.4.3-02", "R-AppB-01"),
+        masks={"slow-wake": "slow-wake is the same slow wake after every break, not every other"},
+    ),
+    Fault(
         "standby-ignored",
         "The sensor never drops to standby by itself: it answers after any marking.",
         ("R-7.0-15",),
