@@ -4,10 +4,15 @@ judges and the case object use, cite the wire the same way without importing eit
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Sequence
 
 from ..tool_recorder.records import Exchange
 from ..transcript import Event, decode_7e1, escape
+
+#: an evidence line's time on the link clock, as :func:`cited` and the judges write it
+#: ("t=1.2345 s"); read back by the reports and by the served line's guard
+STAMP = re.compile(r"\bt=(\d+(?:\.\d+)?) ?s\b")
 
 
 def shown(ex: Exchange) -> str:

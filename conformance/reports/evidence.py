@@ -32,6 +32,7 @@ from itertools import islice
 from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
+from ..judges.cite import STAMP
 from ..results import CaseRecord
 from ..transcript import Event, EventKind, Transcript
 from ..verdicts import Finding, Verdict
@@ -45,7 +46,6 @@ if TYPE_CHECKING:
 NEEDS_EVIDENCE = (Verdict.FAIL, Verdict.WARN, Verdict.INCONCLUSIVE)
 MEASURE_MATCH_MS = 0.05  # a measured value matches an interval this close (rounding)
 LATER_SHOWN = 40  # characters after a reply kept in an exchange (what the line did next)
-STAMP = re.compile(r"\bt=(\d+(?:\.\d+)?) ?s\b")  # an evidence line's time on the link clock
 COMMAND = re.compile(r"[0-9A-Za-z?]\w*!")  # text naming a command, e.g. "reply to 0D3!"
 #: a line (or a detail's part before ':') that is a sequence of commands, "0MC! 0D0!"
 CHAIN = re.compile(r"^\s*((?:[0-9A-Za-z?]\w*!\s+)+[0-9A-Za-z?]\w*!)\s*(?::|$)")

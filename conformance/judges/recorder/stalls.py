@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, TypeVar
 from ...links.host_stall import REACH, Stall, stalled_over
 from ...transcript import Event
 from ...verdicts import Finding, Verdict
+from ..cite import STAMP
 from ..stalled import stalled_interval
 from ..tally import Tally
 from ..timing import Measured
@@ -191,8 +192,6 @@ def stamped_far(finding: Finding, stalls: Sequence[Stall]) -> bool:
     evidence) lies more than :data:`NEAR` from every noted stall; False where it names none
     (truth34: no-break-after-87ms' "2005.70 ms before 0D0! at t=43.521 s", 38 s from the
     run's one note, stands; a deviation beside a stall does not)."""
-    from ...reports.evidence import STAMP
-
     texts = (finding.detail, *finding.evidence)
     times = [float(t) for text in texts for t in STAMP.findall(text)]
     return bool(times) and all(stalled_over(stalls, t - NEAR, t + NEAR) is None for t in times)
