@@ -62,9 +62,7 @@ def _cycle() -> tuple[list[Event], float]:
     recorder.measure(parse_command("2HA!"))
     recorder.transact(f"{RETRYING}I!")  # answered only at its retry
     recorder.measure(parse_command(f"{RETRYING}M1!"))
-    events = [
-        replace(e, origin=BUS) for e in bus.transcript.events if e.kind is not EventKind.NOTE
-    ]
+    events = [replace(e, origin=BUS) for e in bus.transcript.events if e.kind is not EventKind.NOTE]
     first = events[0].start
     events = [replace(e, start=e.start - first, end=e.end - first) for e in events]
     return events, max(e.end for e in events) + BETWEEN
