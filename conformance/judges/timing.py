@@ -693,8 +693,8 @@ class Alike(Sequence["Measured"]):
 
     def grouped(self) -> tuple[Window, list[Measured], list[int]] | None:
         """:func:`_grouped` of the findings, from the groups: the same answer."""
-        if not self.distinct:
-            return None
+        if not self.distinct or type(self.distinct[0]) is not Measured:
+            return None  # (a finding among them, counted: timing.Counted)
         window = self.distinct[0]._window
         for m in self.distinct:
             if type(m) is not Measured or m._window is not window:
