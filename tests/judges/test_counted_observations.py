@@ -146,9 +146,7 @@ def test_listed_folds_give_the_counted_findings(monkeypatch):
             events.append(Event(EventKind.BREAK, TOOL, t, t + 0.0118 + (n % 5) * 2e-4))
             t += 0.0125 + 0.0083 + (n % 2) * 1e-4
             for c in f"{(n + w) % 10}M!":
-                events.append(
-                    Event(EventKind.CHAR, TOOL, t, t + 8.33e-3, wire=to_wire_7e1(ord(c)))
-                )
+                events.append(Event(EventKind.CHAR, TOOL, t, t + 8.33e-3, wire=to_wire_7e1(ord(c))))
                 t += 8.33e-3 + (n % 7) * 3e-4
             t += 0.1
         views.append(read_view(events))
