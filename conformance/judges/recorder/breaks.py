@@ -12,7 +12,7 @@ from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...transcript import HELD_BACK, Event
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
+from ..timing import Counted, MeasuredAsJudged, Repeats, Window, judge_window
 from .common import SR_KINDS, combine, own_uncertainty
 from .measurements import service_request_end
 from .stalls import hold
@@ -34,14 +34,16 @@ class Breaks:
     """:func:`judge_breaks` over a recording read a window at a time (issue 22): each
     window's view :meth:`add`-ed in order, the findings those of the whole recording's view.
     What it keeps across windows is one observation per distinct length and marking
-    (:class:`~..timing.Repeats`), never a window's events."""
+    (:class:`~..timing.Repeats`) and how often each came (:class:`~..timing.Counted`),
+    never a window's events nor anything an observation."""
 
     def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
         self.uncertainty = uncertainty
         #: the tool's host stalls noted in the recording (a window's view holds none)
         self.stalls = list(stalls)
-        self.lengths: list[MeasuredAsJudged | Finding] = []
-        self.markings: list[MeasuredAsJudged | Finding] = []
+        # each judged interval counted by object, not listed (:class:`~..timing.Counted`)
+        self.lengths = Counted()
+        self.markings = Counted()
         self._lengths_seen: Repeats[MeasuredAsJudged] = Repeats()
         self._markings_seen: Repeats[MeasuredAsJudged] = Repeats()
 
@@ -85,8 +87,8 @@ class Breaks:
     def findings(self) -> list[Finding]:
         """R-7.0-02 and R-7.0-06 over everything added."""
         return [
-            combine("R-7.0-02", self.lengths, "break"),
-            combine("R-7.0-06", self.markings, "marking"),
+            combine("R-7.0-02", self.lengths.alike(), "break"),
+            combine("R-7.0-06", self.markings.alike(), "marking"),
         ]
 
 

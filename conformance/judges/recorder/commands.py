@@ -13,7 +13,7 @@ from ...verdicts import Finding, Verdict
 from ...view.segments import NEW_COMMAND, TranscriptView, Transmission
 from ..stalled import held_by
 from ..tally import Tally
-from ..timing import MeasuredIn, Repeats, Window
+from ..timing import Counted, MeasuredIn, Repeats, Window
 from ..wire import judge_frame_lengths, judge_rate
 from .common import combine, own_uncertainty
 from .stalls import hold
@@ -156,7 +156,8 @@ class CharacterGaps:
     """:func:`judge_character_gaps` over a recording read a window at a time (issue 22):
     each window's view :meth:`add`-ed in order, the findings those of the whole view. Kept
     across windows: one judged interval per distinct gap (:class:`~..timing.Repeats`, each
-    holding the one transmission its evidence names) and, of the gaps inside the tolerance
+    holding the one transmission its evidence names) and how often each came
+    (:class:`~..timing.Counted`) and, of the gaps inside the tolerance
     band, the first few R-7.0-01 quotes and how many there were."""
 
     def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
@@ -164,8 +165,9 @@ class CharacterGaps:
         #: the tool's host stalls noted in the recording (a window's view holds none)
         self.stalls = list(stalls)
         # one judged interval each, its finding (and evidence line) made only where the
-        # verdict shows it; the few gaps inside the tolerance band kept apart for R-7.0-01
-        self.found: list[MeasuredIn | Finding] = []
+        # verdict shows it, counted by object (not a list a gap: Counted); the few gaps
+        # inside the tolerance band kept apart for R-7.0-01
+        self.found = Counted()
         # the first gap inside the tolerance band a noted stall covers, and its stall
         self.leaning_stalled: tuple[float, Transmission, Stall] | None = None
         self.leaning: list[tuple[float, Transmission]] = []  # the first LEANING_SHOWN
@@ -251,7 +253,9 @@ class CharacterGaps:
         else:
             tol = Finding("R-7.0-01", Verdict.INCONCLUSIVE, "no multi-character command observed")
         undecided = self._undecided()
-        judged = [*found, *undecided] if undecided else found
+        alike = found.alike()
+        # listed one by one only with a dropped gap's INCONCLUSIVE (rare), after every gap
+        judged = [*alike, *undecided] if undecided else alike
         return [combine("R-7.0-13", judged, "character gap"), tol]
 
 
