@@ -168,10 +168,15 @@ class ControlledProbe(Protocol):
     """A one-off probe and the ``a!`` control sent the same way right after it."""
 
     probe: Exchange
+    control: Exchange | None
+    recheck: Exchange | None  # the control again after one more break (silent probes)
     marking: float | None
 
     @property
     def listening(self) -> bool: ...
+
+    @property
+    def woke_differently(self) -> bool: ...
 
 
 def alone(others: Iterable[str], what: str) -> Unmet | None:
@@ -191,6 +196,19 @@ def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     same way right after one of them."""
     if any(p.listening for p in probes):
         return None
+    if varied := [p for p in probes if p.woke_differently]:
+        return Unmet(
+            "listening",
+            "the sensor answered the a! sent like the probe (one break, then once) after one "
+            "break and not after the next: it wakes differently from break to break "
+            f"(R-7.0-05), so its silence to {len(probes)} probe(s) shows nothing",
+            tuple(
+                shown(ex)
+                for p in varied[:2]
+                for ex in (p.probe, p.control, p.recheck)
+                if ex is not None
+            ),
+        )
     met = [p.probe for p in probes if p.probe.maybe_collided]
     if met and all(p.control is not None and shows_listening(p.control) for p in probes):
         return Unmet(

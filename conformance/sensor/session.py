@@ -83,6 +83,8 @@ class InvalidAddressAttempt:
     #: that ``a!`` (None: none was sent), the evidence of a "not listening": ``exchanges``
     #: end with the restore's, whose last may be answered on a later try (outside29)
     control: Exchange | None = None
+    #: the same ``a!`` after one more break (:attr:`HeardProbe.recheck`; None: none went)
+    recheck: Exchange | None = None
 
 
 @dataclass
@@ -97,19 +99,37 @@ class HeardProbe:
     probe: Exchange
     control: Exchange | None  # None: no marking made the sensor hear a one-shot a!
     marking: float | None
+    #: the same a! after the break after the control's, sent where the probe was silent and
+    #: the control answered: the probe's wake-up and the control's are two breaks, and a
+    #: sensor that wakes late after every second one (slow-wake-every-other) missed the probe
+    #: and answered the control (truth36). Two answered wakes in a row show it hears every one.
+    recheck: Exchange | None = None
 
     @property
     def listening(self) -> bool:
         """The control was answered (:func:`shows_listening`: by a valid reply where it
-        maybe collided itself) and the probe met no sensor characters: a probe that may have
-        collided (a stray character just before its break, within the stamps' uncertainty)
-        may not have been heard, so its silence shows nothing."""
+        maybe collided itself), and so was the recheck where one went, and the probe met no
+        sensor characters: a probe that may have collided (a stray character just before
+        its break, within the stamps' uncertainty) may not have been heard, so its silence
+        shows nothing."""
         control = self.control
-        return control is not None and shows_listening(control) and not self.probe.maybe_collided
+        return (
+            control is not None
+            and shows_listening(control)
+            and not self.woke_differently
+            and not self.probe.maybe_collided
+        )
+
+    @property
+    def woke_differently(self) -> bool:
+        """The control was answered, the recheck after the next break not: the sensor hears
+        a one-shot a! after some breaks only, so the probe's break shows nothing of it."""
+        return self.recheck is not None and not shows_listening(self.recheck)
 
     @property
     def exchanges(self) -> list[Exchange]:
-        return [self.probe] + ([self.control] if self.control is not None else [])
+        sent = [self.probe, self.control, self.recheck]
+        return [ex for ex in sent if ex is not None]
 
 
 @dataclass
@@ -871,14 +891,20 @@ class SensorSession(Session):
 
     def heard_probe(self, text: str, *, control_address: str | None = None) -> HeardProbe:
         """Send ``text`` once after a break with :meth:`hearing_marking`, then the control:
-        ``a!`` (at ``control_address``, default the sensor's) sent the same way."""
+        ``a!`` (at ``control_address``, default the sensor's) sent the same way, and where
+        the probe was silent and the control answered, the same ``a!`` after one more break
+        (:attr:`HeardProbe.recheck`)."""
         marking = self.hearing_marking()
         probe = self.master.raw(text, break_first=True, marking=marking)
         control = None
+        recheck = None
         if marking is not None:
             address = control_address or self.address
             control = self.master.raw(f"{address}!", break_first=True, marking=marking)
-        return HeardProbe(probe, control, marking)
+            if not probe.answered and shows_listening(control):
+                # the silence is judged on the control: one more wake shows it is every wake's
+                recheck = self.master.raw(f"{address}!", break_first=True, marking=marking)
+        return HeardProbe(probe, control, marking, recheck)
 
     # -- address changes (always restored) -------------------------------------------------
     def address_change_supported(self) -> bool:
@@ -1045,7 +1071,9 @@ class SensorSession(Session):
             changer.unclear = changer.unclear or accepted
         finally:
             self.restore(changer)
-        return InvalidAddressAttempt(changer.exchanges, accepted, heard.listening, heard.control)
+        return InvalidAddressAttempt(
+            changer.exchanges, accepted, heard.listening, heard.control, heard.recheck
+        )
 
     def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
         """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and
