@@ -448,6 +448,24 @@ def answered_control(controls: Sequence[Exchange], what: str) -> Unmet | None:
     )
 
 
+def answered_at_each_wake(controls: Sequence[Exchange], what: str) -> Unmet | None:
+    """:func:`answered_control` for ``controls`` sent the same way after breaks in a row:
+    every one must be answered. A sensor answered after one break and not after the next
+    wakes differently from break to break (slow-wake-every-other), so the probe's break
+    shows nothing of it: its control was answered after another break (truth36)."""
+    unmet = answered_control(controls, what)
+    if unmet is not None or all(shows_listening(ex) for ex in controls):
+        return unmet
+    return Unmet(
+        "listening",
+        "the sensor answered its own-address control ("
+        + escape(controls[0].text)
+        + ") after one break and not after the next: it wakes differently from break to "
+        f"break (R-7.0-05), so its silence {what} shows nothing",
+        tuple(cited(ex) for ex in controls[:3]),
+    )
+
+
 def acknowledges(probes: Sequence[Exchange], acknowledged: bool, address: str) -> Unmet | None:
     """Silence to an ``a!`` probe shows something only from a sensor that answers ``a!``:
     ``acknowledged``, one of its ``a!`` at ``address`` drew a reply (valid or not) somewhere

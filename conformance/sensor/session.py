@@ -85,6 +85,8 @@ class InvalidAddressAttempt:
     control: Exchange | None = None
     #: the same ``a!`` after one more break (:attr:`HeardProbe.recheck`; None: none went)
     recheck: Exchange | None = None
+    #: taken by a late reply: one naming the address came after the probe's window
+    late: bool = False
 
 
 @dataclass
@@ -1057,8 +1059,13 @@ class SensorSession(Session):
         return ex.answered and body == self.address
 
     def try_invalid_address(self, bad: str) -> InvalidAddressAttempt:
-        """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it."""
+        """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it.
+        A reply naming ``bad`` that came late (in a later command's window: the control's,
+        the restore's) says it moved as well: the restore then asks ``bad`` to move back,
+        though the original answers ``a!`` (a sensor that answers ``a!`` anywhere was left
+        at '$' and judged there, seed 7900: seven false FAILs), and it took ``bad``."""
         changer = AddressChanger(self.master, self.address)
+        first = len(self.link.transcript.events)
         try:
             changer.tried.append(bad)  # if it took the bad address, restore moves it back
             heard = self.heard_probe(f"{self.address}A{bad}!")
@@ -1071,9 +1078,25 @@ class SensorSession(Session):
             changer.unclear = changer.unclear or accepted
         finally:
             self.restore(changer)
+        late = not accepted and self._named_since(first, bad)
+        if late:
+            changer.unclear = True
+            self.restore(changer)
         return InvalidAddressAttempt(
-            changer.exchanges, accepted, heard.listening, heard.control, heard.recheck
+            changer.exchanges,
+            accepted or late,
+            heard.listening,
+            heard.control,
+            heard.recheck,
+            late=late,
         )
+
+    def _named_since(self, first: int, address: str) -> bool:
+        """Whether the sensor sent a reply naming ``address`` (a run of its characters that
+        begins ``address<CR>``) in the transcript from event ``first`` on."""
+        events = self.link.transcript.events[first:]
+        dut = [e for e in events if e.kind is EventKind.CHAR and e.origin != TOOL]
+        return any(decode_7e1(run).startswith(f"{address}\r") for run in runs(dut))
 
     def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
         """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and

@@ -312,7 +312,9 @@ def test_address_range(sensor, case):
         case.add(
             failed(
                 "R-4.3-04",
-                "took '$' as its address (decision A17: only 0-9, A-Z, a-z)",
+                "took '$' as its address"
+                + (" (its reply '$<CR><LF>' came late, after its window)" if bad.late else "")
+                + " (decision A17: only 0-9, A-Z, a-z)",
                 decision="A17",
                 evidence=judge.cite(bad.exchanges),
                 observed=len(bad.exchanges),
