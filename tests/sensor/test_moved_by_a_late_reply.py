@@ -18,6 +18,8 @@ from conformance.emulator import sim_sensor
 from conformance.sensor.session import SensorSession
 
 TRIPLE = "accepts-invalid-address,answers-foreign-address,replies-after-retry"
+KEYWORD = "test_address_range or test_response_start_window or "
+KEYWORD += "test_identify_measurement_answered"
 
 
 def test_the_late_reply_says_it_took_the_address_and_the_restore_moves_it_back():
@@ -40,7 +42,7 @@ def test_the_clean_sensor_refuses_with_no_late_reply_and_no_move_back():
 def test_the_triple_judges_r_4_3_04_and_no_foreign_rule():
     data = run_once(
         f"sim://?faults={TRIPLE}",
-        keyword="test_address_range or test_response_start_window or test_identify_measurement_answered",
+        keyword=KEYWORD,
     )
     found = {r["id"]: r["verdict"] for r in data["requirements"]}
     assert found["R-4.3-04"] == "WARN"  # INCONCLUSIVE before (its probe's control was late)
