@@ -168,10 +168,15 @@ class ControlledProbe(Protocol):
     """A one-off probe and the ``a!`` control sent the same way right after it."""
 
     probe: Exchange
+    control: Exchange | None
+    recheck: Exchange | None  # the control again after one more break (silent probes)
     marking: float | None
 
     @property
     def listening(self) -> bool: ...
+
+    @property
+    def woke_differently(self) -> bool: ...
 
 
 def alone(others: Iterable[str], what: str) -> Unmet | None:
@@ -191,6 +196,19 @@ def listening(probes: Sequence[ControlledProbe]) -> Unmet | None:
     same way right after one of them."""
     if any(p.listening for p in probes):
         return None
+    if varied := [p for p in probes if p.woke_differently]:
+        return Unmet(
+            "listening",
+            "the sensor answered the a! sent like the probe (one break, then once) after one "
+            "break and not after the next: it wakes differently from break to break "
+            f"(R-7.0-05), so its silence to {len(probes)} probe(s) shows nothing",
+            tuple(
+                shown(ex)
+                for p in varied[:2]
+                for ex in (p.probe, p.control, p.recheck)
+                if ex is not None
+            ),
+        )
     met = [p.probe for p in probes if p.probe.maybe_collided]
     if met and all(p.control is not None and shows_listening(p.control) for p in probes):
         return Unmet(
@@ -426,6 +444,24 @@ def answered_control(controls: Sequence[Exchange], what: str) -> Unmet | None:
         + ", ".join(escape(ex.text) for ex in controls)
         + f"), so its silence {what} shows nothing"
         + collided_answers(controls),
+        tuple(cited(ex) for ex in controls[:3]),
+    )
+
+
+def answered_at_each_wake(controls: Sequence[Exchange], what: str) -> Unmet | None:
+    """:func:`answered_control` for ``controls`` sent the same way after breaks in a row:
+    every one must be answered. A sensor answered after one break and not after the next
+    wakes differently from break to break (slow-wake-every-other), so the probe's break
+    shows nothing of it: its control was answered after another break (truth36)."""
+    unmet = answered_control(controls, what)
+    if unmet is not None or all(shows_listening(ex) for ex in controls):
+        return unmet
+    return Unmet(
+        "listening",
+        "the sensor answered its own-address control ("
+        + escape(controls[0].text)
+        + ") after one break and not after the next: it wakes differently from break to "
+        f"break (R-7.0-05), so its silence {what} shows nothing",
         tuple(cited(ex) for ex in controls[:3]),
     )
 

@@ -254,13 +254,14 @@ def silent_while_listening(
     return passed(
         rid,
         f"stayed silent ({why}) to {len(heard)} command(s) sent once after a break{way}, "
-        "each followed by an a! sent the same way that it answered: "
+        "each followed by an a! sent the same way that it answered (and again after the "
+        "next break): "
         + ", ".join(escape(p.probe.text) for p in heard)
         + (f"; {aside} probe(s) set aside (their control went unanswered)" if aside else "")
         + (f"; {met} probe(s) set aside (maybe collided: may not have been heard)" if met else ""),
         decision=decision,
         evidence=[shown(p.probe) for p in heard[:3]],
-        observed=2 * len(heard),
+        observed=sum(len(p.exchanges) for p in heard),
     )
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Iterable, Iterator
+from dataclasses import replace
 from itertools import repeat
 from math import copysign, isnan
 from operator import attrgetter, sub
@@ -122,7 +123,8 @@ def starts_after_a_retry(
         return False
     before: Segment | None = None
     for seg in segs:
-        earlier, before = _unanswered_before(before, seg), seg
+        earlier = _unanswered_before(before, seg)
+        before = _carried(earlier, seg)
         if earlier is None or _reply_set_aside(seg) or _not_a_reply_to(seg):
             continue
         start = seg.reply[0].start
@@ -175,7 +177,8 @@ def _start_observations(
     late: list[Observation] = []
     texts = _texts(segs)
     for k, seg in enumerate(segs):
-        earlier, before = _unanswered_before(before, seg), seg
+        earlier = _unanswered_before(before, seg)
+        before = _carried(earlier, seg)
         if not seg.reply or _reply_set_aside(seg) or _not_a_reply_to(seg):
             continue
         delay = seg.reply[0].start - seg.command_end
@@ -287,6 +290,22 @@ def _unanswered_before(before: Segment | None, seg: Segment) -> Segment | None:
     if address is not None and seg.reply[0].char7 != ord(address[0]):
         return None
     return before
+
+
+def _carried(earlier: Segment | None, seg: Segment) -> Segment:
+    """What the next segment's :func:`_unanswered_before` reads as the command before it:
+    ``seg``, or, where ``seg``'s reply may be ``earlier``'s late reply and names another
+    address than ``seg``'s command asks (so it is not ``seg``'s), ``seg`` as unanswered: the
+    reply after the next command may be ``seg``'s own, late. Seed 7900 (accepts-invalid-
+    address + answers-foreign-address + replies-after-retry): '$<CR><LF>' answering
+    ``0A$!`` 80 ms late came 33 ms into the ``0!`` after it, and that ``0!``'s '0<CR><LF>',
+    held behind it, began as the next ``0!`` ended: R-7.0-09 FAILed "0.00 ms" (truth36)."""
+    if earlier is None or not seg.reply:
+        return seg
+    address = expected_reply_address(seg.text)
+    if address is None or seg.reply[0].char7 == ord(address[0]):
+        return seg
+    return replace(seg, reply=[])
 
 
 def _reply_set_aside(seg: Segment) -> bool:
@@ -1301,7 +1320,8 @@ class Framing:
             end = heard[-1].end if heard else seg.command_end
             start = (seg.break_event or seg.command[0]).start
             tally = through_stall(tally, stalled_over(self.stalls, start, end))
-        earlier, self._before = _unanswered_before(self._before, seg), seg
+        earlier = _unanswered_before(self._before, seg)
+        self._before = _carried(earlier, seg)
         if seg.reply:
             self.last_address = last_address = seg.reply[0].char7
             if _starts_measurement(seg.text):

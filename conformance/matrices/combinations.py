@@ -462,13 +462,4 @@ CI_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 
 #: CI combinations the measurement found unexplained, each with its diagnosed class: the
 #: tests expect them to fail (strictly), so a fix of the class shows and shrinks this list.
-KNOWN_OPEN: dict[tuple[str, ...], str] = {
-    # (outside34) the one-shot probes aA$! and ?I! went after breaks the sensor woke from
-    # 110 ms late (unheard), their a! controls after the next breaks, which it woke from at
-    # once (answered): R-4.3-04 and R-4.4.3-02 PASS on silence to probes it never heard. A
-    # control at one break shows nothing of another break's wake-up; not fixed (docs/kit.md,
-    # thirty-fourth round)
-    ("concurrent-three-digit-count", "ident-pause", "slow-wake-every-other"): (
-        "a control after one break taken for the wake-up of another (slow-wake-every-other)"
-    ),
-}
+KNOWN_OPEN: dict[tuple[str, ...], str] = {}

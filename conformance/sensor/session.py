@@ -83,6 +83,10 @@ class InvalidAddressAttempt:
     #: that ``a!`` (None: none was sent), the evidence of a "not listening": ``exchanges``
     #: end with the restore's, whose last may be answered on a later try (outside29)
     control: Exchange | None = None
+    #: the same ``a!`` after one more break (:attr:`HeardProbe.recheck`; None: none went)
+    recheck: Exchange | None = None
+    #: taken by a late reply: one naming the address came after the probe's window
+    late: bool = False
 
 
 @dataclass
@@ -97,19 +101,37 @@ class HeardProbe:
     probe: Exchange
     control: Exchange | None  # None: no marking made the sensor hear a one-shot a!
     marking: float | None
+    #: the same a! after the break after the control's, sent where the probe was silent and
+    #: the control answered: the probe's wake-up and the control's are two breaks, and a
+    #: sensor that wakes late after every second one (slow-wake-every-other) missed the probe
+    #: and answered the control (truth36). Two answered wakes in a row show it hears every one.
+    recheck: Exchange | None = None
 
     @property
     def listening(self) -> bool:
         """The control was answered (:func:`shows_listening`: by a valid reply where it
-        maybe collided itself) and the probe met no sensor characters: a probe that may have
-        collided (a stray character just before its break, within the stamps' uncertainty)
-        may not have been heard, so its silence shows nothing."""
+        maybe collided itself), and so was the recheck where one went, and the probe met no
+        sensor characters: a probe that may have collided (a stray character just before
+        its break, within the stamps' uncertainty) may not have been heard, so its silence
+        shows nothing."""
         control = self.control
-        return control is not None and shows_listening(control) and not self.probe.maybe_collided
+        return (
+            control is not None
+            and shows_listening(control)
+            and not self.woke_differently
+            and not self.probe.maybe_collided
+        )
+
+    @property
+    def woke_differently(self) -> bool:
+        """The control was answered, the recheck after the next break not: the sensor hears
+        a one-shot a! after some breaks only, so the probe's break shows nothing of it."""
+        return self.recheck is not None and not shows_listening(self.recheck)
 
     @property
     def exchanges(self) -> list[Exchange]:
-        return [self.probe] + ([self.control] if self.control is not None else [])
+        sent = [self.probe, self.control, self.recheck]
+        return [ex for ex in sent if ex is not None]
 
 
 @dataclass
@@ -871,14 +893,20 @@ class SensorSession(Session):
 
     def heard_probe(self, text: str, *, control_address: str | None = None) -> HeardProbe:
         """Send ``text`` once after a break with :meth:`hearing_marking`, then the control:
-        ``a!`` (at ``control_address``, default the sensor's) sent the same way."""
+        ``a!`` (at ``control_address``, default the sensor's) sent the same way, and where
+        the probe was silent and the control answered, the same ``a!`` after one more break
+        (:attr:`HeardProbe.recheck`)."""
         marking = self.hearing_marking()
         probe = self.master.raw(text, break_first=True, marking=marking)
         control = None
+        recheck = None
         if marking is not None:
             address = control_address or self.address
             control = self.master.raw(f"{address}!", break_first=True, marking=marking)
-        return HeardProbe(probe, control, marking)
+            if not probe.answered and shows_listening(control):
+                # the silence is judged on the control: one more wake shows it is every wake's
+                recheck = self.master.raw(f"{address}!", break_first=True, marking=marking)
+        return HeardProbe(probe, control, marking, recheck)
 
     # -- address changes (always restored) -------------------------------------------------
     def address_change_supported(self) -> bool:
@@ -1031,8 +1059,13 @@ class SensorSession(Session):
         return ex.answered and body == self.address
 
     def try_invalid_address(self, bad: str) -> InvalidAddressAttempt:
-        """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it."""
+        """Send ``aA<bad>!`` (raw: the grammar refuses it) and see whether the sensor took it.
+        A reply naming ``bad`` that came late (in a later command's window: the control's,
+        the restore's) says it moved as well: the restore then asks ``bad`` to move back,
+        though the original answers ``a!`` (a sensor that answers ``a!`` anywhere was left
+        at '$' and judged there, seed 7900: seven false FAILs), and it took ``bad``."""
         changer = AddressChanger(self.master, self.address)
+        first = len(self.link.transcript.events)
         try:
             changer.tried.append(bad)  # if it took the bad address, restore moves it back
             heard = self.heard_probe(f"{self.address}A{bad}!")
@@ -1045,7 +1078,25 @@ class SensorSession(Session):
             changer.unclear = changer.unclear or accepted
         finally:
             self.restore(changer)
-        return InvalidAddressAttempt(changer.exchanges, accepted, heard.listening, heard.control)
+        late = not accepted and self._named_since(first, bad)
+        if late:
+            changer.unclear = True
+            self.restore(changer)
+        return InvalidAddressAttempt(
+            changer.exchanges,
+            accepted or late,
+            heard.listening,
+            heard.control,
+            heard.recheck,
+            late=late,
+        )
+
+    def _named_since(self, first: int, address: str) -> bool:
+        """Whether the sensor sent a reply naming ``address`` (a run of its characters that
+        begins ``address<CR>``) in the transcript from event ``first`` on."""
+        events = self.link.transcript.events[first:]
+        dut = [e for e in events if e.kind is EventKind.CHAR and e.origin != TOOL]
+        return any(decode_7e1(run).startswith(f"{address}\r") for run in runs(dut))
 
     def disturbed_measurement(self, command: Command, disturb: str) -> tuple[Measurement, Exchange]:
         """Start ``command``, send ``disturb`` while it runs, wait out ttt, then break and

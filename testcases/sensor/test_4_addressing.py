@@ -294,12 +294,17 @@ def test_address_range(sensor, case):
     elif not bad.accepted and not bad.listening:
         if bad.control is None:  # no marking made it answer a one-shot a!: none was sent
             why = "no one-shot a! after a break was answered, and no control went like aA$!"
+        elif bad.recheck is not None and precondition.shows_listening(bad.control):
+            why = (
+                "the a! sent like aA$! (one break, then once) was answered, the same a! after "
+                "the next break not: the sensor wakes differently from break to break"
+            )
         else:
             why = "the a! sent like aA$! (one break, then once) got no reply"
         deaf = precondition.Unmet(
             "listening",
             f"{why}, so the silence to aA$! shows nothing",
-            tuple(judge.cite([bad.control] if bad.control is not None else [])),
+            tuple(judge.cite([ex for ex in (bad.control, bad.recheck) if ex is not None])),
         )
     if not case.requires("listening", deaf, only=("R-4.3-04",)):
         pass  # refusing '$' shows nothing from a sensor not shown listening
@@ -307,7 +312,9 @@ def test_address_range(sensor, case):
         case.add(
             failed(
                 "R-4.3-04",
-                "took '$' as its address (decision A17: only 0-9, A-Z, a-z)",
+                "took '$' as its address"
+                + (" (its reply '$<CR><LF>' came late, after its window)" if bad.late else "")
+                + " (decision A17: only 0-9, A-Z, a-z)",
                 decision="A17",
                 evidence=judge.cite(bad.exchanges),
                 observed=len(bad.exchanges),
@@ -317,7 +324,8 @@ def test_address_range(sensor, case):
         case.add(
             passed(
                 "R-4.3-04",
-                f"refused '$' as an address (and answered the a! sent the same way after it); "
+                f"refused '$' as an address (and answered the a! sent the same way after it, and "
+                "again after the next break); "
                 f"{len(ADDRESS_CHARS)} characters are addresses",
                 decision="A17",
                 observed=len(bad.exchanges),

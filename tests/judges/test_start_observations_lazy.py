@@ -27,10 +27,13 @@ from tests.support.hand_events import chars
 
 
 def _old_start_observations(segs, stamps, before=None):
-    """``_start_observations`` as it was before matrix23 (the line made for every reply)."""
+    """``_start_observations`` as it was before matrix23 (the line made for every reply),
+    with truth36's :func:`wire._carried` (a reply naming another address than its command's,
+    after an unanswered command, leaves its command unanswered for the next)."""
     early, late = [], []
     for seg in segs:
-        earlier, before = wire._unanswered_before(before, seg), seg
+        earlier = wire._unanswered_before(before, seg)
+        before = wire._carried(earlier, seg)
         if not seg.reply or wire._reply_set_aside(seg) or wire._not_a_reply_to(seg):
             continue
         delay = seg.reply[0].start - seg.command_end
