@@ -12,25 +12,16 @@ import sys
 import pytest
 
 from conformance.conduct import run_once
+from tests.support.harness_script import PRELUDE
 
 #: ?! answered, aRn!/aRCn! a start line then its data, aDn! its data, every line 105 ms
 #: after the one before (or the command), the receiver off from the '!' to the last line's
 #: end; index 0 has three values, 1 and 2 one, the rest 'NO DATA @n', 'FINAL DATA @2', '0'
-LINES_SENSOR = r'''
-import sys
-
-import pytest
-
-def say(line):
-    sys.stdout.write(line + "\n")
-    sys.stdout.flush()
-
-def wire(c):
-    b = ord(c)
-    return b | (0x80 if bin(b).count("1") % 2 else 0)
-
+LINES_SENSOR = (
+    PRELUDE
+    + r'''
 CHAR = 8333  # us, one 10-bit frame at 1200 baud
-DELAY = 105000  # every line: delay(100) first, its receiver off meanwhile
+DELAY = 105000  # every line: a delay first (the sketch's 100 ms), its receiver off meanwhile
 VALUES = "0+21.72+45.50+1013.46"
 
 def replies(cmd):
@@ -77,6 +68,7 @@ for line in sys.stdin:
             text = ""
     say(plan())
 '''
+)
 
 
 @pytest.mark.slow  # a harness process and a case's run: seconds beside a loaded machine
