@@ -41,6 +41,7 @@ __all__ = [
 from ..preconditions import ControlledProbe, collided_answers, listening, shows_listening
 from ..verdicts import Finding, Verdict, failed, inconclusive, passed, warned
 from .cite import cite, cited, heard, shown
+from .continued_talk import SET_ASIDE
 from .late_before import (
     answered_late,
     earlier_reply,
@@ -274,7 +275,8 @@ def undecided_if_late(tally: Tally, ex: Exchange, ids: Iterable[str]) -> bool:
     And one no try of which went when the sensor must have been awake to hear it
     (:func:`~conformance.judges.wake_heard.unheard`: each soon after a break of its own)."""
     late = answered_late(ex)
-    why = f"{late} (R-7.0-10 judges its timing)" if late else unheard(ex)
+    timed = late and not late.endswith(SET_ASIDE)  # a talk's next line is no late reply
+    why = (f"{late} (R-7.0-10 judges its timing)" if timed else late) or unheard(ex)
     if not why:
         return False
     label = escape(ex.text)

@@ -23,6 +23,7 @@ from ..tool_recorder.records import Attempt, Exchange
 from ..tool_recorder.validity import fits_shape
 from ..transcript import DUT, TOOL, Event, decode_7e1, escape
 from ..view.sides import expected_reply_address
+from .continued_talk import continued_talk
 
 #: how near a DUT character's start must lie to a tool character's end to have waited for it
 HELD_SLACK = 1e-6
@@ -186,9 +187,12 @@ def late_elsewhere(ex: Exchange) -> str:
 def answered_late(ex: Exchange) -> str:
     """How ``ex``'s reply came late ('' if it did not): unanswered in its windows with its
     reply after them (:func:`late_answer`), or answered with what may be the command
-    before's late reply (:func:`earlier_reply`). The one test of the rules that leave a late
+    before's late reply (:func:`earlier_reply`) or the next line of a talk set aside before
+    it (:func:`~.continued_talk.continued_talk`). The one test of the rules that leave a late
     reply to R-7.0-10 (late_only, late_among, undecided_if_late, the D replies)."""
-    return late_answer(ex) if not ex.answered else earlier_reply(ex)
+    if not ex.answered:
+        return late_answer(ex)
+    return earlier_reply(ex) or continued_talk(ex)
 
 
 def service_request_too_soon(ex: Exchange) -> str:

@@ -33,6 +33,7 @@ from ..transcript import GOOD_PARITY, SEVEN_BITS, Event, escape, text7, wire_byt
 from ..verdicts import Finding, Verdict
 from ..view.runs import Segment, Segments, frames, runs, segments
 from ..view.sides import expected_reply_address
+from .continued_talk import segment_continues
 from .stalled import stalled_interval, through_stall
 from .tally import Tally
 from .timing import (
@@ -177,10 +178,15 @@ def _start_observations(
     late: list[Observation] = []
     texts = _texts(segs)
     for k, seg in enumerate(segs):
+        prev = before
         earlier = _unanswered_before(before, seg)
         before = _carried(earlier, seg)
         if not seg.reply or _reply_set_aside(seg) or _not_a_reply_to(seg):
             continue
+        if (seg.contention or (prev is not None and prev.contention)) and segment_continues(
+            prev, seg
+        ):
+            continue  # the next line of a talk set aside: no reply to this command
         delay = seg.reply[0].start - seg.command_end
         u = stamps.between(seg.command[-1].start, seg.reply[0].end)
         tainted = u > stamps.base

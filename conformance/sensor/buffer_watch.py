@@ -167,6 +167,7 @@ class WatchedToolRecorder(ToolRecorder):
         if before is None or before is ex or not before.attempts:
             return ex
         before.next_sent[:] = [ex]  # its words may show ex took its late reply (taken_next)
+        ex.sent_before = before  # a talk set aside over its last try may go on (truth37)
         last = before.last
         quiet = not last.reply_events or last.reason.startswith(CONTENTION)
         if quiet and (seen or self.watch.late.start is not None):

@@ -1250,6 +1250,7 @@ def _carry_late_before(made: Exchange | Measurement, seen: Exchange | Measuremen
         return
     for a, b in pairs:
         b.late_before = a.late_before
+        b.sent_before = a.sent_before  # the talk set aside before it (continued_talk)
         b.next_sent = a.next_sent  # shared: the engine fills it when it sends the next one
         b.heard_late = a.heard_late  # the late reply the engine heard past the last try
 

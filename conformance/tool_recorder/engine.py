@@ -39,6 +39,7 @@ from ..protocol.timing import (
 )
 from ..protocol.values import continues_split_value, split_values
 from ..transcript import (
+    COLLISION,
     TOOL,
     Event,
     EventKind,
@@ -667,6 +668,12 @@ class ToolRecorder:
         slack = self.link.info.timing_uncertainty
         while first and (
             first[0].start < command_end
+            # a character the bus held behind the command it wanted the line during (a
+            # harness's frame planned inside the tool's: marked COLLISION): it met the
+            # command too, whatever its stamp (view.segments._collided_each's rule). Taken as
+            # the reply, a values line of the aR0! before, due while its retry was on the
+            # line, PASSed R-4.4.8.1-01 for 0R0! (outside34's ENG20009 Due sketch, truth37)
+            or first[0].text == COLLISION
             # its tail, up to its LF (the view's rule, so the live read and the judges agree)
             or (collided and continues_frame(collided[-1], first[0], command_end, slack))
         ):

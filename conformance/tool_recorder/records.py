@@ -125,6 +125,10 @@ class Exchange:
     #: command took shaped as this one's, begun soon after this one's unanswered last try,
     #: is this one's late reply (:func:`~conformance.judges.late_before.taken_next`)
     next_sent: list[Exchange] = field(default_factory=list, repr=False, compare=False)
+    #: The command the sensor session's engine sent just before this one (set with
+    #: ``next_sent``): a line the sensor sent over its last try, set aside as no reply, may
+    #: go on into this one's window (:func:`~conformance.judges.continued_talk.continued_talk`)
+    sent_before: Exchange | None = field(default=None, repr=False, compare=False)
 
     @property
     def last(self) -> Attempt:
