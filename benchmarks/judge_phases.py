@@ -116,7 +116,6 @@ def judge(capture: str, reports: str) -> tuple[int, list[dict[str, Any]], float]
     import io
 
     from conformance.cli import main
-
     from conformance.commands import passive
     from conformance.offline import judge as judge_module
 
