@@ -54,8 +54,8 @@ def parse_samplerate(text: str) -> float:
 class Members:
     """A session's sample members in order, each where the archive holds it (the fields
     :meth:`zipfile.ZipFile.open` reads of a :class:`zipfile.ZipInfo`: its header's place,
-    compression, sizes, CRC and flags) as numbers, ~40 bytes a member where its ZipInfo and
-    the archive's index of it took ~580 (issue 22: a long capture's directory grew with it,
+    compression, sizes, CRC and flags) as numbers, ~60 bytes a member where its ZipInfo and
+    the archive's index of it took ~560 (issue 22: a long capture's directory grew with it,
     held while it was decoded). Its ZipInfo is made again when it is read (:meth:`info`);
     its name too, from ``prefix`` and its number (kept as names where one does not read
     back so: ``logic-1-01``)."""
