@@ -1,7 +1,9 @@
 """Where a passive judgement's memory goes, phase by phase: what is resident once the
 recording is loaded and read (decode, view, the pre-scans of the sensors on the bus), and for
 each run of the passive cases (one per sensor of a bus, then the recorder's) the resident
-memory before it, its own peak and what it leaves behind, with its CPU.
+memory before it, its own peak and what it leaves behind, with its CPU; the loading's own
+steps too (the decode, the bus pass that checks the recording holds SDI-12 traffic), each
+with its own peak.
 
     MALLOC_ARENA_MAX=1 python benchmarks/judge_phases.py CAPTURE REPORTS [--json]
 
@@ -43,6 +45,34 @@ def reset_peak() -> None:
         refs.write("5")
 
 
+def measured_step(
+    phases: list[dict[str, Any]], module: Any, name: str, label: str
+) -> Callable[[], None]:
+    """Wrap ``module.name`` (a step of the loading: the decode, the bus pass) so each call
+    appends its figures to ``phases``: the resident memory before and after it and its own
+    peak (the high-water mark reset just before it); gives the function that undoes it."""
+    original = getattr(module, name)
+
+    def step(*args, **kwargs):  # type: ignore[no-untyped-def]
+        before = status_mb("VmRSS")
+        reset_peak()
+        cpu = time.process_time()
+        result = original(*args, **kwargs)
+        phases.append(
+            {
+                "phase": label,
+                "rss_before_mb": before,
+                "peak_mb": status_mb("VmHWM"),
+                "rss_after_mb": status_mb("VmRSS"),
+                "cpu_s": round(time.process_time() - cpu, 3),
+            }
+        )
+        return result
+
+    setattr(module, name, step)
+    return lambda: setattr(module, name, original)
+
+
 def measured_runs(phases: list[dict[str, Any]]) -> Callable[[], None]:
     """Wrap the passive judgement's per-run call so each run appends its figures to
     ``phases`` (the first one also the loading's); gives the function that undoes it."""
@@ -52,8 +82,11 @@ def measured_runs(phases: list[dict[str, Any]]) -> Callable[[], None]:
 
     def run_role(job, port, args, console):  # type: ignore[no-untyped-def]
         before = status_mb("VmRSS")
-        if not phases:  # the decode, the view and the pre-scans: everything before a run
-            phases.append({"phase": "loaded", "rss_mb": before, "peak_mb": status_mb("VmHWM")})
+        if not any(p_["phase"].startswith("run ") for p_ in phases):
+            # the decode, the bus pass and the pre-scans: everything before a run (its peak
+            # the highest since the last step measured, or since the process began)
+            peak = max([status_mb("VmHWM")] + [p_["peak_mb"] for p_ in phases])
+            phases.append({"phase": "loaded", "rss_mb": before, "peak_mb": peak})
         reset_peak()
         cpu = time.process_time()
         result = original(job, port, args, console)
@@ -83,9 +116,15 @@ def judge(capture: str, reports: str) -> tuple[int, list[dict[str, Any]], float]
     import io
 
     from conformance.cli import main
+    from conformance.commands import passive
+    from conformance.offline import judge as judge_module
 
     phases: list[dict[str, Any]] = []
-    undo = measured_runs(phases)
+    undos = [
+        measured_step(phases, judge_module, "decode", "decode"),
+        measured_step(phases, passive, "no_traffic", "bus pass"),
+        measured_runs(phases),
+    ]
     cpu = time.process_time()
     try:
         with contextlib.redirect_stdout(io.StringIO()):
@@ -93,7 +132,8 @@ def judge(capture: str, reports: str) -> tuple[int, list[dict[str, Any]], float]
     except SystemExit as exc:
         code = int(exc.code or 0)
     finally:
-        undo()
+        for undo in undos:
+            undo()
     return code, phases, time.process_time() - cpu
 
 

@@ -108,28 +108,56 @@ class Column:
 
     def append(self, x: float) -> None:
         chunks = self._chunks
-        if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
-            self._new_chunk()
+        if not chunks or chunks[-1] is None or len(chunks[-1]) >= CHUNK:
+            self._open_last()
         chunks[-1].append(x)  # type: ignore[union-attr]
 
     def extend(self, xs: Iterable[float]) -> None:
         """Append ``xs`` in order (a chunk's room filled at a time)."""
-        items, i, chunks = array(self.typecode, xs), 0, self._chunks
+        items, i = array(self.typecode, xs), 0
         while i < len(items):
-            if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
-                self._new_chunk()
-            last = chunks[-1]
-            room = CHUNK - len(last)  # type: ignore[arg-type]
-            last.extend(items[i : i + room])  # type: ignore[union-attr]
+            last = self._open_last()
+            room = CHUNK - len(last)
+            last.extend(items[i : i + room])
             i += room
 
     def open_chunk(self) -> int:
         """Room for more in the last chunk (a new one begun, the full one spilled, if it has
-        none): how many items it takes still."""
+        none; a sealed one read back): how many items it takes still."""
+        return CHUNK - len(self._open_last())
+
+    def _open_last(self) -> array:
+        """The chunk in RAM items are appended to: the last one, read back if :meth:`seal`
+        wrote it out before it was full, or a new one where it is full (spilled)."""
         chunks = self._chunks
-        if not chunks or len(chunks[-1]) >= CHUNK:  # type: ignore[arg-type]
+        if chunks and chunks[-1] is None and self._spilled[len(chunks) - 1][2] < CHUNK:
+            self._read_back_last()
+        if not chunks or chunks[-1] is None or len(chunks[-1]) >= CHUNK:
             self._new_chunk()
-        return CHUNK - len(chunks[-1])  # type: ignore[arg-type]
+        return chunks[-1]  # type: ignore[return-value]
+
+    def seal(self) -> bool:
+        """Write the last chunk out though it is not full (issue 22: what is appended to a
+        column ends with it, a recording's store once decoded, a pass's per-window numbers
+        once the pass is done; the last chunk, up to :data:`CHUNK` items, was the one part
+        of a column held in RAM however long, so a loaded recording held between nothing and
+        a chunk of each column by where its length fell). Read as before, a block at a
+        time; appending after it reads the chunk back first (:meth:`_open_last`). Whether
+        it was written out (False: nothing to write, or no temporary file could be)."""
+        chunks = self._chunks
+        if not chunks or chunks[-1] is None or not len(chunks[-1]):
+            return False
+        self._spill_last()
+        return chunks[-1] is None
+
+    def _read_back_last(self) -> None:
+        """The sealed last chunk in RAM again, of the column's typecode (:meth:`seal`)."""
+        c = len(self._chunks) - 1
+        typecode, at, n = self._spilled.pop(c)
+        items = self.spill.read(typecode, at, n)
+        self._chunks[c] = items if typecode == self.typecode else array(self.typecode, items)
+        if self._cached is not None and self._cached[0] == c:
+            self._cached = None
 
     def last(self) -> array:
         """The chunk items are appended to (:meth:`open_chunk` first)."""
@@ -140,7 +168,7 @@ class Column:
         return self._chunks[c] is None
 
     def _new_chunk(self) -> None:
-        if self._chunks:
+        if self._chunks and self._chunks[-1] is not None:
             self._spill_last()
         self._chunks.append(array(self.typecode))
 
@@ -163,7 +191,8 @@ class Column:
         if not chunks:
             return 0
         last = chunks[-1]
-        return (len(chunks) - 1) * CHUNK + (len(last) if last is not None else CHUNK)
+        n = len(last) if last is not None else self._spilled[len(chunks) - 1][2]
+        return (len(chunks) - 1) * CHUNK + n
 
     def chunk_count(self) -> int:
         return len(self._chunks)
@@ -362,6 +391,27 @@ class CompactEvents(Sequence[Event]):
 
     def __len__(self) -> int:
         return len(self.starts)
+
+    def seal(self) -> bool:
+        """A store already written out (longer than a chunk) has its last chunk written out
+        too, though not full (:meth:`Column.seal`): a recording once loaded then holds none
+        of its events in RAM but the block last read (issue 22: that chunk, up to 1.1 MB of
+        columns, was held by where the recording's length fell: an hour's busy capture held
+        0.5 MB of it, four hours' 0.9). A store of one chunk stays in RAM (a short
+        recording: no temporary file, at most a chunk). Storing more after it reads the last
+        chunks back. Whether it was sealed."""
+        if not self.spilled():
+            return False
+        for column in self._columns:
+            column.seal()
+        self._room, self._put = 0, ()
+        return True
+
+    @property
+    def spill(self) -> Spill:
+        """The temporary file the columns are written to (what else a loaded recording
+        writes out shares it: :mod:`conformance.offline.bus_indexes`)."""
+        return self.starts.spill
 
     def typecodes(self) -> tuple[str, str]:
         """The columns' widths: the fields' index and the wires (``array`` typecodes)."""

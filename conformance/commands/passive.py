@@ -42,14 +42,14 @@ ROLES = ("sensor", "recorder")
 def no_traffic(port: str) -> str | None:
     """Why the recording holds nothing to judge (None: it holds SDI-12 traffic)."""
     from ..offline.fixtures import recording_of
-    from ..offline.sensor_windows import bus_windows
+    from ..offline.heard import bus_of
 
     link = recording_of(port)
     events = link.transcript.events
     # the commands' kinds from the bus pass every later step reads (no whole-run view: one
     # held from here held ~12 MB at an hour's capture to the end, issue 22), and whether a
     # break was heard, asked before any list of the events is made
-    kinds = bus_windows(link).kinds
+    kinds = bus_of(link).kinds
     # any text ending in '!' parses as an extended command: alone it is no sign of SDI-12
     if any(k is not Kind.EXTENDED for k in kinds) or (
         kinds and any(e.kind is EventKind.BREAK for e in events)

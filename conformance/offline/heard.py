@@ -23,6 +23,7 @@ from ..protocol.version import V14, VERSIONS, format_version, is_v14
 from ..replay.recording_link import RecordingLink
 from ..tool_recorder.records import Exchange, Measurement
 from ..view.segments import memo
+from .bus_indexes import spill_indexes
 from .bus_sensors import BusSensor, SensorsOn, sensors_on
 from .held_exchanges import HeldExchanges
 from .sensor_windows import (
@@ -156,8 +157,11 @@ def sensors_records(link: RecordingLink, address: str | None) -> SensorRecords:
 def bus_of(link: RecordingLink) -> BusWindows:
     """The bus pass over ``link``'s recording (:func:`~.sensor_windows.bus_windows`), made
     once per loaded recording: the sensors on the bus, their decode-quality notes, the
-    ambiguous splits and where the windows are."""
-    return bus_windows(link)
+    ambiguous splits and where the windows are (written out with the recording's events
+    once the pass is done: :mod:`.bus_indexes`)."""
+    bus = bus_windows(link)
+    spill_indexes(bus)
+    return bus
 
 
 def release_records(link: RecordingLink, keep: Collection[str]) -> None:

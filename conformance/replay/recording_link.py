@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..capture.errors import CaptureError
-from ..event_store import CompactEvents
+from ..event_store import Column, CompactEvents
 from ..links.base import BusEnd, LinkInfo
 from ..links.errors import PortError
 from ..links.registry import LinkKind, OpenedPort, PortOptions, register
@@ -187,6 +187,9 @@ def load_recording(spec: RecordingSpec) -> RecordingLink:
     # notes): a busy bus's every break was one more object held to the end (issue 22: an
     # hour's 14,875, 1.9 MB); a new list, since a decode kept for another caller shares it
     decoded.problems = character_problems(decoded.problems)
+    rates = decoded.baud_error_pct
+    if isinstance(rates, Column) and rates.spilled():  # as its events (:func:`stored`)
+        rates.seal()
     info = LinkInfo(
         kind=f"capture {decoded.format}", can_break=False,
         timing_uncertainty=decoded.uncertainty_s,
@@ -217,10 +220,11 @@ def stored(events: Sequence[Event]) -> Transcript:
     :class:`~conformance.event_store.CompactEvents` (18 bytes an event where the objects
     and their list took ~160: issue 22), each made again as it is read; a list where one
     of them cannot be stored so."""
-    if isinstance(events, CompactEvents):
-        return Transcript(events)  # type: ignore[arg-type]
-    store = CompactEvents.of(events)
-    return Transcript(list(events) if store is None else store)  # type: ignore[arg-type]
+    store = events if isinstance(events, CompactEvents) else CompactEvents.of(events)
+    if store is None:
+        return Transcript(list(events))
+    store.seal()  # loaded: a long one's last chunk written out too (none of it held whole)
+    return Transcript(store)  # type: ignore[arg-type]
 
 
 def _bit_timing(options: dict) -> bool:

@@ -24,7 +24,6 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from itertools import compress, repeat
 from operator import attrgetter, eq, is_
-from sys import intern
 from typing import Any, TypeVar
 
 from ..links.host_stall import Stall, stalled_over, stalls
@@ -180,10 +179,10 @@ class Transmission:
         return text
 
     def _decoded(self) -> str:
-        # interned: a bus repeats a few commands (an hour of a busy one, ~15,000
+        # one object a text: a bus repeats a few commands (an hour of a busy one, ~15,000
         # transmissions, 10 texts), each held once instead of once a transmission (53 bytes
-        # each); a text no other holds is freed as any string is
-        return intern(decode_7e1(self.chars))
+        # each)
+        return one_text(decode_7e1(self.chars))
 
     @property
     def address(self) -> str:
@@ -810,6 +809,29 @@ def merge_views(views: Sequence[TranscriptView]) -> TranscriptView:
         [c for v in views for c in v.undirected],
         stalls=[stall for v in views for stall in v.stalls],
     )
+
+
+#: the most texts :func:`one_text` keeps (a bus's few commands: cleared when full)
+TEXTS_MAX = 1024
+_TEXTS: dict[str, str] = {}
+
+
+def one_text(text: str) -> str:
+    """The one object kept for ``text`` (``text`` itself, the first time). Not
+    :func:`sys.intern`: a window's transmissions are let go with it (issue 22), and with
+    them the last reference to each interned text, which left the interpreter's table of
+    interned strings; every window read again put its texts back as new entries, and that
+    table, which reuses no entry until it is rebuilt, was rebuilt every few thousand
+    windows at whatever size its live strings asked for then: a four-hour capture's
+    loading ended with a table twice an hour's (1.9 MB against 0.96). Here the texts stay
+    (at most :data:`TEXTS_MAX`, a bus's commands: all are let go when it is full)."""
+    kept = _TEXTS.get(text)
+    if kept is not None:
+        return kept
+    if len(_TEXTS) >= TEXTS_MAX:
+        _TEXTS.clear()
+    _TEXTS[text] = text
+    return text
 
 
 def memo(owner: object, name: str, key: object, build: Callable[[], T]) -> T:
