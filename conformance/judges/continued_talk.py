@@ -25,6 +25,19 @@ from ..transcript import DUT, Event, EventKind, decode_7e1, escape
 from ..view.runs import Segment
 
 
+def _sent_before(ex: Exchange) -> Exchange | None:
+    """The command sent before ``ex``, where it is still held: the engine links it weakly
+    (a proxy, so the chain of a run's exchanges makes no reference cycle)."""
+    sent = ex.sent_before
+    if sent is None:
+        return None
+    try:
+        sent.attempts  # noqa: B018 (a dead proxy raises here)
+    except ReferenceError:
+        return None
+    return sent
+
+
 def continued_talk(ex: Exchange) -> str:
     """'' unless the reply ``ex`` took may be the next line of a talk set aside before it
     (:func:`next_line_of`): a line the sensor sent over the try before the one that drew the
@@ -40,8 +53,8 @@ def continued_talk(ex: Exchange) -> str:
     before: tuple[Attempt, Exchange] | None = None
     if index > 0:
         before = (ex.attempts[index - 1], ex)
-    elif ex.sent_before is not None and ex.sent_before.attempts:
-        before = (ex.sent_before.last, ex.sent_before)
+    elif (sent := _sent_before(ex)) is not None and sent.attempts:
+        before = (sent.last, sent)
     own = [e for e in judged.stray_events if e.start < reply[0].start]
     if own or before is None:
         owner, aside = ex, own

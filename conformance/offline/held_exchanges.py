@@ -109,7 +109,7 @@ class HeldExchanges(Sequence[Exchange]):
     def _rows(self, positions: Positions, x: Exchange) -> list[tuple] | None:
         """``x``'s attempts as rows, None where a part of it is not plain (see the module's
         docstring)."""
-        if x.heard_late or x.late_before is not None or x.next_sent:
+        if x.heard_late or x.late_before is not None or x.next_sent or x.sent_before is not None:
             return None
         if not _EXCHANGE_FIELDS.issuperset(x.__dict__):
             return None
@@ -228,7 +228,7 @@ class HeldExchanges(Sequence[Exchange]):
 #: their fields and the caches their properties make again (``_judged``, ``_text``)
 _EXCHANGE_FIELDS = frozenset(
     ("command", "text", "attempts", "binary", "expect_reply", "heard_late", "late_before")
-) | {"next_sent", "_judged"}
+) | {"next_sent", "_judged", "sent_before"}
 _ATTEMPT_FIELDS = frozenset(
     ("break_event", "command_events", "reply_events", "reason", "end", "sequence", "retry")
 ) | {"stray_events", "stall", "_text"}

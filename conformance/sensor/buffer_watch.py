@@ -9,6 +9,7 @@ explicitly; this watch lets the session say "already filled" without sending any
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -167,7 +168,9 @@ class WatchedToolRecorder(ToolRecorder):
         if before is None or before is ex or not before.attempts:
             return ex
         before.next_sent[:] = [ex]  # its words may show ex took its late reply (taken_next)
-        ex.sent_before = before  # a talk set aside over its last try may go on (truth37)
+        # a talk set aside over its last try may go on (truth37); weakly, as next_sent
+        # links forward: two strong links made a cycle of every exchange a live run sent
+        ex.sent_before = weakref.proxy(before)
         last = before.last
         quiet = not last.reply_events or last.reason.startswith(CONTENTION)
         if quiet and (seen or self.watch.late.start is not None):
