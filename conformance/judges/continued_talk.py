@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ..protocol.commands import Command, CommandError, parse_command
+from ..protocol.commands import Command, command_or_none
 from ..protocol.framing import LF
 from ..protocol.timing import MULTILINE_GAP_MAX
 from ..tool_recorder.records import Attempt, Exchange
@@ -110,11 +110,7 @@ def segment_continues(before: Segment | None, seg: Segment) -> bool:
     aside = own or (before.contention if before is not None else [])
     if not aside:
         return False
-    try:
-        command: Command | None = parse_command(owner.text)
-    except CommandError:
-        command = None
-    return next_line_of(aside, command, seg.reply[0]) is not None
+    return next_line_of(aside, command_or_none(owner.text), seg.reply[0]) is not None
 
 
 def _last_line(chars: list[Event]) -> list[Event]:

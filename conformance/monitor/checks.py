@@ -18,9 +18,8 @@ from ..judges.timing import judge_window
 from ..protocol.commands import (
     MEASUREMENT_KINDS,
     Command,
-    CommandError,
     Kind,
-    parse_command,
+    command_or_none,
 )
 from ..protocol.framing import STX
 from ..protocol.responses import (
@@ -80,7 +79,7 @@ def command_flags(text: str, ctx: Context, events: list[Event]) -> list[Flag]:
     ctx.command_text, ctx.answered = text, False
     ctx.command_end, ctx.command_last = events[-1].end, events[-1]
     flags = parity_flags(events)
-    command = _parse(text)
+    command = command_or_none(text)
     if command is not None and command.kind in MEASUREMENT_KINDS:
         assert ctx.measurements is not None
         ctx.measurements[text[0]] = command
@@ -100,7 +99,7 @@ def reply_flags(
     ctx.answered = True
     if not first_line or not ctx.command_text or len(text) > 1 and text[1] == chr(STX):
         return flags  # a later line (multi-line text, a service request): framing only
-    command = _parse(ctx.command_text)
+    command = command_or_none(ctx.command_text)
     if command is None:
         return flags
     if command.kind is Kind.BINARY_DATA:
@@ -190,10 +189,3 @@ def _crc_due(command: Command, ctx: Context) -> bool:
         assert ctx.measurements is not None
         target = ctx.measurements.get(command.address, command)
     return bool(getattr(target, "returns_crc", False))
-
-
-def _parse(text: str) -> Command | None:
-    try:
-        return parse_command(text)
-    except CommandError:
-        return None

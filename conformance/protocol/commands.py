@@ -369,6 +369,15 @@ def parse_command(text: str | bytes, *, allow_wildcard: bool = False) -> Command
     return found  # type: ignore[return-value]
 
 
+def command_or_none(text: str) -> Command | None:
+    """:func:`parse_command`'s command, None where ``text`` is no valid command (its reason
+    dropped): for readers that only ask which command a text is, if any."""
+    try:
+        return parse_command(text)
+    except CommandError:
+        return None
+
+
 def _parse_text(text: str, allow_wildcard: bool) -> Command:
     """:func:`parse_command` of a text it has not seen (the grammar itself)."""
     if not text:

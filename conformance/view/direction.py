@@ -18,7 +18,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 
 from ..protocol.binary import packet_length
-from ..protocol.commands import ADDRESS_CHARS, Command, CommandError, Kind, parse_command
+from ..protocol.commands import ADDRESS_CHARS, Kind, command_or_none
 from ..protocol.framing import STX
 from ..protocol.responses import parse_measurement_reply_for, split_line
 from ..protocol.timing import (
@@ -287,7 +287,7 @@ def _advance(s: _State, run: list[Event], d: Direction) -> None:
 
 def _note_announcement(s: _State) -> None:
     """An ``atttn``-type reply to a measurement: a service request may follow after ttt."""
-    command = _parse(s.reply_to)
+    command = command_or_none(s.reply_to)
     if command is None or not command.starts_measurement or not _message_done(s):
         return
     body, _ = split_line(decode_7e1(s.reply))
@@ -320,15 +320,8 @@ def _looks_like_command(text: str) -> bool:
 
 
 def _binary_command(text: str) -> bool:
-    command = _parse(text)
+    command = command_or_none(text)
     return command is not None and command.kind is Kind.BINARY_DATA
-
-
-def _parse(text: str) -> Command | None:
-    try:
-        return parse_command(text)
-    except CommandError:
-        return None
 
 
 def _ms(seconds: float) -> str:
