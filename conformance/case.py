@@ -20,7 +20,7 @@ from .catalog import requirement
 from .protocol.version import format_version
 from .results import CaseRecord
 from .tool_recorder.records import Exchange, Measurement
-from .transcript import Event
+from .transcript import Event, EventKind
 from .verdicts import Finding, Verdict, not_applicable
 
 if TYPE_CHECKING:
@@ -42,11 +42,15 @@ class Case:
         preconditions: Declaration | None = None,
         *,
         evidence_events: bool = True,
+        evidence_limit: int | None = None,
     ) -> None:
         self.record = record
         #: whether :meth:`evidence` keeps the events behind a record (False: its label
         #: alone, for a run that writes no report file, the only reader of the events)
         self.evidence_events = evidence_events
+        #: how many events :meth:`evidence` keeps of one record at most (None: all), for a
+        #: judged recording, whose evidence of "every measurement" grows with its length
+        self.evidence_limit = evidence_limit
         self._version = version  # callable returning "13"/"14"/None, resolved lazily
         self.preconditions = preconditions  # None: the case declared nothing
         self._blocked: dict[str, Unmet] = {}  # requirement -> the precondition that failed
@@ -163,12 +167,41 @@ class Case:
         the run writes no report file (a matrix row's runs: only the report files read the
         events) the label is attached with no events, the record's kind checked as
         :func:`events_of` checks it (a case handing something else is the same ERROR):
-        joining and sorting ~10^5 events a row was ~1% of its CPU (issue 22)."""
+        joining and sorting ~10^5 events a row was ~1% of its CPU (issue 22). Past
+        :attr:`evidence_limit` events, only the first exchanges up to it are kept and the
+        label says how many of how many (:func:`head_of`)."""
         if self.evidence_events:
-            self.record.evidence.append((label, events_of(record)))
+            events = events_of(record)
+            limit = self.evidence_limit
+            if limit is not None and len(events) > limit:
+                kept = head_of(events, limit)
+                label = (
+                    f"{label} (the first {len(kept)} of {len(events)} events, up to "
+                    f"t={kept[-1].end:.4f} s; the recording holds the rest)"
+                )
+                self.record.evidence_beyond.append(events[-1])
+                events = kept
+            self.record.evidence.append((label, events))
         else:
             _check_kinds(record)
             self.record.evidence.append((label, []))
+
+
+def head_of(events: list[Event], limit: int) -> list[Event]:
+    """The first of ``events`` (in time order) up to ``limit`` of them, cut before the last
+    break among them so no exchange is shown in part (all ``limit`` where none is past the
+    first). Why: a judged recording's evidence of every measurement of an hour held ~10^5
+    events per case until the report was written, and the report listed them all (issue 22);
+    the first exchanges show what the case saw, the recording holds the rest."""
+    if len(events) <= limit:
+        return events
+    head = events[:limit]
+    if events[limit].kind is EventKind.BREAK:
+        return head  # the next exchange starts just past the limit
+    for i in range(len(head) - 1, 0, -1):
+        if head[i].kind is EventKind.BREAK:
+            return head[:i]
+    return head
 
 
 def _voided(unmet: Unmet) -> tuple[Verdict, ...]:

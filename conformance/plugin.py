@@ -168,6 +168,12 @@ def sensor(sdi12_run: ConformanceRun) -> SensorSession:
         sdi12_run.cut_short(str(exc), EXIT_INTERNAL, shown=f"link error: {exc}")
 
 
+#: How many events a case keeps of one piece of its evidence when it judges a recording
+#: (:attr:`~.case.Case.evidence_limit`): some 20 to 40 exchanges, what a reader of the
+#: report looks at; a live run's evidence is what its own stimuli made, kept whole.
+RECORDING_EVIDENCE = 1000
+
+
 def case_of(node: pytest.Item, sdi12_run: ConformanceRun) -> Case:
     """The ``case`` fixture's value for the case ``node``."""
     record = node.stash.get(CASE, None)
@@ -190,6 +196,7 @@ def case_of(node: pytest.Item, sdi12_run: ConformanceRun) -> Case:
         version=lambda: sdi12_run.dut_version,
         preconditions=declared,
         evidence_events=sdi12_run.report_files != (),  # no report file: no reader of them
+        evidence_limit=RECORDING_EVIDENCE if getattr(sdi12_run.link, "reads_again", 0) else None,
     )
 
 

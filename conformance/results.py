@@ -45,6 +45,16 @@ class CaseRecord:
     #: ``window``) and the time it took on the link's clock: what a plan compares with
     added: tuple[int, int] | None = None
     bus_s: float | None = None
+    #: the last event of each piece of :attr:`evidence` kept only in part (a judged
+    #: recording's first exchanges, :attr:`~.case.Case.evidence_limit`): with them the
+    #: reports place the case on the whole stretch it judged, and look for its findings'
+    #: exchanges in the whole recording (:meth:`~.reports.evidence.Locator.locate`)
+    evidence_beyond: list[Event] = field(default_factory=list)
+
+    @property
+    def evidence_whole(self) -> bool:
+        """Whether every piece of :attr:`evidence` holds all its events."""
+        return not self.evidence_beyond
 
     def summarise(self) -> Verdict:
         self.verdict = worst((f.verdict for f in self.findings), default=Verdict.ERROR)

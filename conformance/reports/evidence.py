@@ -234,6 +234,17 @@ def _first_at(events: Sequence[Event], count: int, e: Event) -> int | None:
 _start_of = attrgetter("start")
 
 
+#: The most events a recording's locator cuts into segments for one search: a finding whose
+#: case attached evidence spread wider is searched for in the whole recording's cut, which
+#: is read window by window (:class:`~..view.runs.LazyCut`), not made whole: a cut held ~1.5
+#: KB an event, and a case's evidence of every measurement spread over the whole recording
+#: (issue 22: 48 MB kept at 30 minutes of a measuring bus).
+WIDE_POOL = 20_000
+#: How many of its cuts a recording's locator keeps (a live run's: 64), each up to
+#: :data:`WIDE_POOL` events: they are kept for the reports of every run of the judgement.
+STREAMED_CUTS = 4
+
+
 class StreamedPositions:
     """:class:`Positions` of a recording read again as its events come (``again()``: every
     event from the first, in recorded order), for exactly the events asked about: one read
@@ -330,7 +341,7 @@ class Locator:
         takes a fifth of a second)."""
         key = (lo, hi)
         if key not in self._cuts:
-            if len(self._cuts) > 64:
+            if len(self._cuts) > (STREAMED_CUTS if self.again is not None else 64):
                 self._cuts.clear()
             whole = self.transcript is not None and lo == 0 and hi == self.count()
             cut = whole_cut(self.transcript) if whole else segments(self.slice(lo, hi))
@@ -373,10 +384,17 @@ class Locator:
         """The exchange ``finding`` (of ``record``'s case) rests on, or None (no wire)."""
         self._index()
         lo, hi = record.window if record.window else (0, self.count())
-        attached = sorted(set(self.position.of(e for _, evs in record.evidence for e in evs)))
+        held = [e for _, evs in record.evidence for e in evs] + record.evidence_beyond
+        attached = sorted(set(self.position.of(held)))
         pools = []
         if attached:
-            pools.append((attached[0], attached[-1] + 1))
+            first, last = attached[0], attached[-1] + 1
+            wide = self.again is not None and last - first > WIDE_POOL
+            if wide or not record.evidence_whole:
+                # a recording's whole cut (read as it comes), not a wide stretch cut whole
+                # nor the first exchanges of the evidence alone (the rest not attached)
+                first, last = 0, self.count()
+            pools.append((first, last))
         pools.append((lo, hi))
         if lo > 0 and COMMAND.search(" ".join([*finding.evidence, finding.detail])):
             pools.append((0, hi))  # a reply the session cached from an earlier case
