@@ -499,7 +499,17 @@ def where_html(findings: list[Finding], ref: WireRef, events: Sequence[Event], t
     """The wire lines around the exchange ``findings`` rest on, with times, that exchange
     highlighted (and drawn, for a timing case): the FAIL is shown where it happened."""
     lo = max(0, ref.first - 60)
-    return where_html_around(findings, ref, list(events[lo : ref.last + 61]), lo, timing)
+    return where_html_around(findings, ref, list(events[lo : around_end(ref)]), lo, timing)
+
+
+def around_end(ref: WireRef) -> int:
+    """Where the events :func:`where_html_around` reads for ``ref`` end: 60 past its
+    exchange, or for a case's own traffic (no exchange) the first :data:`CASE_EXCERPT` of
+    it, all it shows: a judged recording's case may span the whole recording (issue 22:
+    reading it all for the excerpt made 10^5 events at 30 minutes of a measuring bus)."""
+    if ref.exchange is None:
+        return min(ref.last + 61, ref.first + CASE_EXCERPT)
+    return ref.last + 61
 
 
 def where_html_around(
@@ -507,7 +517,8 @@ def where_html_around(
 ) -> str:
     """:func:`where_html` from the events it shows alone: ``around``, the transcript's
     events ``lo..ref.last+60`` (up to 60 before the exchange, as many after), which a
-    recording read again as it comes gives without a list of every event (issue 22)."""
+    recording read again as it comes gives without a list of every event (issue 22); for a
+    case's own traffic, up to :func:`around_end` (its first :data:`CASE_EXCERPT` events)."""
     worst = max((f.verdict for f in findings), key=lambda v: v.rank)
     rids = ", ".join(dict.fromkeys(f.requirement for f in findings))
     first, last = ref.first - lo, ref.last + 1 - lo
@@ -515,7 +526,7 @@ def where_html_around(
     if ref.exchange is None:
         what = "the case's own traffic (no single exchange named or measured)"
         shown = span[:CASE_EXCERPT]
-        more = len(span) - len(shown)
+        more = ref.last + 1 - ref.first - len(shown)  # the span's events past those shown
         tail = f"; {more} more events in transcript.jsonl" if more > 0 else ""
         marked: frozenset[Event] = frozenset()
     else:
@@ -710,7 +721,7 @@ class HtmlReportPlugin:
                     grouped.setdefault(ref, []).append(f)
         timing = is_timing_case(record)
         return "".join(
-            where_html_around(fs, ref, locator.slice(lo, ref.last + 61), lo, timing)
+            where_html_around(fs, ref, locator.slice(lo, around_end(ref)), lo, timing)
             for ref, fs in grouped.items()
             for lo in (max(0, ref.first - 60),)
         )

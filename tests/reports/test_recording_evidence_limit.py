@@ -164,3 +164,24 @@ def test_the_locator_cuts_no_stretch_of_a_recording_wider_than_its_limit(recorde
     assert cuts and all(hi - lo <= 10 or (lo, hi) == (0, count) for lo, hi in cuts)
     assert any((lo, hi) == (0, count) for lo, hi in cuts)  # the wide ones: the whole cut
     assert placed == placed_before  # every finding placed still
+
+
+def test_a_case_s_own_traffic_is_shown_from_its_first_events_alone():
+    """The where block of a finding resting on a case's own traffic (no exchange) shows its
+    first CASE_EXCERPT events and counts the rest: it reads no more of the recording than
+    those, and says what reading its whole stretch said."""
+    from conformance.reports.evidence import WireRef
+    from conformance.reports.html import CASE_EXCERPT, around_end, where_html_around
+    from conformance.verdicts import Finding, Verdict
+
+    events = _exchanges(40)
+    f = Finding("R-4.4.12-02", Verdict.INCONCLUSIVE, "nothing observed")
+    ref = WireRef(70, 200, events[70].start, events[200].end, None, "case")
+    lo = max(0, ref.first - 60)
+    assert around_end(ref) == ref.first + CASE_EXCERPT
+    whole = where_html_around([f], ref, events[lo : ref.last + 61], lo, False)
+    part = where_html_around([f], ref, events[lo : around_end(ref)], lo, False)
+    assert part == whole
+    assert f"{200 + 1 - 70 - CASE_EXCERPT} more events in transcript.jsonl" in part
+    exchange = WireRef(70, 75, events[70].start, events[75].end, "0M!", "command")
+    assert around_end(exchange) == 75 + 61  # an exchange's: 60 events past it, as before
