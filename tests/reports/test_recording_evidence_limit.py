@@ -185,3 +185,26 @@ def test_a_case_s_own_traffic_is_shown_from_its_first_events_alone():
     assert f"{200 + 1 - 70 - CASE_EXCERPT} more events in transcript.jsonl" in part
     exchange = WireRef(70, 75, events[70].start, events[75].end, "0M!", "command")
     assert around_end(exchange) == 75 + 61  # an exchange's: 60 events past it, as before
+
+
+def test_the_head_of_a_record_s_events_is_events_of_s_without_the_list():
+    """events_head: the first n of events_of, its count and last, for records of several
+    parts whose events interleave in time (concurrent measurements), equal starts kept in
+    join order, a list of events as it is, and a NaN start (events_of's own order)."""
+    from conformance.case import events_head, events_of
+    from conformance.tool_recorder.records import Attempt, Exchange
+
+    def exchange(t: float, n: int) -> Exchange:
+        evs = _exchange(t, n)
+        attempt = Attempt(evs[0], evs[1:2], evs[2:], reason="", end=evs[-1].end)
+        return Exchange(command=None, text="0M!", attempts=[attempt])
+
+    records = [exchange(t, n) for t, n in ((0.0, 9), (0.05, 4), (0.05, 6), (3.0, 5), (0.01, 3))]
+    whole = events_of(records)
+    for n in (1, 5, 12, len(whole), len(whole) + 3):
+        assert events_head(records, n) == (whole[:n], len(whole), whole[-1])
+    shuffled = _exchanges(3)[::-1]  # events alone, out of order: kept as given
+    assert events_head(shuffled, 4) == (shuffled[:4], len(shuffled), shuffled[-1])
+    assert events_head(None, 4) == ([], 0, None)
+    odd = [exchange(0.0, 3), exchange(float("nan"), 2)]
+    assert events_head(odd, 3)[0] == events_of(odd)[:3]
