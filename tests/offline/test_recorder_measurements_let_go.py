@@ -31,6 +31,7 @@ from conformance.judges.recorder.measurements import (
     ObservedMeasurements,
     observed_measurements,
 )
+from conformance.judges.recorder.retries import Retries
 from conformance.judges.recorder.waits import (
     ConcurrentWaits,
     MeasureWaits,
@@ -207,3 +208,22 @@ def test_the_break_rules_hold_an_object_per_distinct_interval(bus):
     rule17, rule71 = held.findings()
     assert rule17.verdict is Verdict.PASS and rule17.observed == len(held.rule17)
     assert rule71.verdict is Verdict.PASS and rule71.observed == len(held.rule71)
+
+
+def test_the_retry_waits_hold_an_object_per_distinct_wait(bus):
+    """R-7.2-02's retries after no reply (the sensor that answers only a retry) held as one
+    object per distinct wait give the findings of a finding per retry, which the fold still
+    makes where noted stalls are (one that no retry is near)."""
+    far = Stall(-10.0, -9.0, 1.0)
+    held, each = Retries(U), Retries(U, [far])
+    for window in _windows(bus):
+        view = read_view(window)
+        held.add(view)
+        each.add(view)
+    assert held.findings() == each.findings()
+    waits, every = held._acc.window, each._acc.window
+    assert len(every) == len(set(map(id, every))) >= 3
+    assert len(waits) == len(every) > len(set(map(id, waits)))
+    by_rule = {f.requirement: f for f in held.findings()}
+    assert by_rule["R-7.2-02"].verdict is Verdict.PASS
+    assert by_rule["R-7.2-02"].observed == len(waits)
