@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.judges.recorder.collection import judge_data_collection, judge_high_volume
-from conformance.judges.recorder.waits import judge_concurrent_waits, judge_measure_waits
 from conformance.offline.recorder_windows import recorder_findings
 from conformance.verdicts import Verdict
 
@@ -16,22 +14,13 @@ from ._helpers import judged, judged_only, unseen_rule
 requirements = pytest.mark.requirements
 
 
-def _taken(heard):
-    """The recorder's measurements, found once over the recording's windows
-    (:func:`~conformance.offline.recorder_windows.recorder_findings`): four cases judge
-    the same ones."""
-    return list(recorder_findings(heard.link).measurements)
-
-
 @requirements("R-4.4.5-04", "R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07")
 @pytest.mark.preconditions("heard")
 def test_waiting_for_the_service_request(heard_recorder, case):
     """After 'atttn' the recorder leaves the line alone until the service request or ttt,
     then asks for aD0! at once, and talks to no other sensor until the data are in."""
     case.expect("aD0! not before the service request / ttt; within 0.5 s after it")
-    u = heard_recorder.uncertainty
-    found = recorder_findings(heard_recorder.link)
-    judged(case, judge_measure_waits(found.measurements, u, found.stalls))
+    judged(case, recorder_findings(heard_recorder.link).measure_waits)
 
 
 @requirements("R-4.4.7-06")
@@ -39,8 +28,7 @@ def test_waiting_for_the_service_request(heard_recorder, case):
 def test_concurrent_waits(heard_recorder, case):
     """After a concurrent reply, no data command to that sensor before ttt."""
     case.expect("first data command to each sensor at least ttt after its 'atttnn' reply")
-    u = heard_recorder.uncertainty
-    judged(case, judge_concurrent_waits(_taken(heard_recorder), u))
+    judged(case, recorder_findings(heard_recorder.link).concurrent_waits)
 
 
 @requirements("R-4.4.8-05")
@@ -49,8 +37,7 @@ def test_data_continuation(heard_recorder, case):
     """D0, D1, D2... until every announced value is in; the measurement again after an empty
     D reply."""
     case.expect("D indices in order until the count is reached; after 'a<CR><LF>', aM! again")
-    found = recorder_findings(heard_recorder.link)
-    judged(case, judge_data_collection(found.measurements, found.stalls))
+    judged(case, recorder_findings(heard_recorder.link).data_collection)
 
 
 @requirements("R-5.1-04", "R-5.2-08")
@@ -60,8 +47,7 @@ def test_high_volume(heard_recorder, case):
     value (or the empty packet) is in. (Whether a v1.4 recorder issues both, R-5.4-01, is a
     question of what it can do, not of what one recording shows: not judged here.)"""
     case.expect("0D10!..0D14! (never 0D010!); DB0..DBn read, then stop")
-    held = recorder_findings(heard_recorder.link)
-    found = judge_high_volume(held.measurements, heard_recorder.is_v14, stalls=held.stalls)
+    found = recorder_findings(heard_recorder.link).high_volume  # is_v14 reads only R-5.4-01
     judged_only(case, found, *case.requirements)
 
 

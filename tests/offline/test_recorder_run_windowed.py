@@ -20,6 +20,7 @@ import pytest
 
 from conformance.judges.recorder.breaks import judge_break_rules, judge_breaks
 from conformance.judges.recorder.capabilities import judge_addresses
+from conformance.judges.recorder.collection import judge_data_collection, judge_high_volume
 from conformance.judges.recorder.commands import (
     judge_character_gaps,
     judge_command_bit_rate,
@@ -27,6 +28,7 @@ from conformance.judges.recorder.commands import (
 )
 from conformance.judges.recorder.measurements import observed_measurements
 from conformance.judges.recorder.retries import judge_retries
+from conformance.judges.recorder.waits import judge_concurrent_waits, judge_measure_waits
 from conformance.links.base import LinkInfo
 from conformance.offline import recorder_windows
 from conformance.offline.recorder_windows import (
@@ -47,17 +49,23 @@ U = 1e-6  # a 1 MHz capture's stamps
 
 
 def _whole(events: list[Event]) -> RecorderFindings:
-    """The findings the passive recorder cases made before, from the whole view."""
+    """The findings the passive recorder cases made before, from the whole view: the
+    measurement rules' whole-list functions over :func:`observed_measurements`."""
     view = read_view(events)
+    taken = observed_measurements(view, U)
     return RecorderFindings(
         judge_breaks(view, U), judge_break_rules(view, U), judge_command_text(view, U),
         judge_character_gaps(view, U), judge_command_bit_rate(view, U),
-        observed_measurements(view, U), judge_retries(view, U), judge_addresses(view, U), 1,
+        judge_measure_waits(taken, U), judge_concurrent_waits(taken, U),
+        judge_data_collection(taken),
+        [f for f in judge_high_volume(taken, True) if f.requirement != "R-5.4-01"],
+        judge_retries(view, U), judge_addresses(view, U), 1, len(taken),
     )  # fmt: skip
 
 
 def _alike(found: RecorderFindings, whole: RecorderFindings) -> bool:
-    """Every finding (detail, evidence) and measurement the same; the window count apart."""
+    """Every finding (detail, evidence) and the count of measurements the same; the window
+    count apart."""
     return replace(found, windows=1) == whole
 
 
@@ -89,7 +97,7 @@ def test_the_recorder_run_judges_the_windows_as_the_whole_view():
     by_rule = {f.requirement: f for f in whole.retries}
     assert by_rule["R-7.2-06"].verdict is Verdict.PASS and by_rule["R-7.2-06"].observed > 3
     assert by_rule["R-7.2-05"].observed >= 2  # both 0D0! groups, the one read again too
-    assert len(whole.measurements) == 2
+    assert whole.measured == 2
     found = recorder_findings(_link(events))
     assert found.windows > 3  # the evidence above lies across the cuts
     assert _alike(found, whole)

@@ -12,7 +12,7 @@ from ...protocol.timing import BREAK_MIN, MARKING_AFTER_BREAK, NO_BREAK_WINDOW
 from ...transcript import HELD_BACK, Event
 from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission
-from ..timing import Counted, MeasuredAsJudged, Repeats, Window, judge_window
+from ..timing import Counted, MeasuredAsJudged, Repeats, Window
 from .common import SR_KINDS, combine, own_uncertainty
 from .measurements import service_request_end
 from .stalls import hold
@@ -20,6 +20,12 @@ from .stalls import hold
 #: R-7.0-02's and R-7.0-06's windows, worked out once for the many breaks of a recording
 BREAK_LENGTH = Window("R-7.0-02", "break length", low=BREAK_MIN)
 MARKING = Window("R-7.0-06", "marking after the break", low=MARKING_AFTER_BREAK)
+#: R-7.0-17's window for a command to the same sensor without a break, R-7.1-01's for aD0!
+#: without one after the service request (:class:`BreakRules`)
+QUIET = Window("R-7.0-17", "marking before a command sent without a break", high=NO_BREAK_WINDOW)
+AFTER_REQUEST = Window(
+    "R-7.1-01", "aD0! without a break after the service request", high=NO_BREAK_WINDOW
+)
 
 
 def judge_breaks(line: TranscriptView, uncertainty: float) -> list[Finding]:
@@ -146,14 +152,24 @@ class BreakRules:
     Carried from window to window: the transmission before (R-7.0-17 asks whether the next
     command is to the same sensor, R-7.1-01 whether it follows a service request), the
     window before (a command sent without a break first in its window is timed from the
-    line's last activity there) and the count of commands (R-7.0-17's PASS says how many)."""
+    line's last activity there) and the count of commands (R-7.0-17's PASS says how many).
+    Each command sent without a break is judged as one object per distinct interval
+    (:class:`~..timing.MeasuredAsJudged`, :class:`~..timing.Repeats`), and a break after
+    a service request as its first PASS again, kept in the order judged: a pointer a
+    command, where a whole finding each was (memory27: a measuring bus's aD0! commands,
+    ~50 kB a minute). Across a noted stall of the tool's host, or after spacing too short
+    for a break, each is its own finding as before (:func:`~.stalls.hold` names the stall
+    with that command's evidence; the short spacing's note is added to it)."""
 
     def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
         self.uncertainty = uncertainty
         #: the tool's host stalls noted in the recording (a window's view holds none)
         self.stalls = list(stalls)
-        self.rule17: list[Finding] = []
-        self.rule71: list[Finding] = []
+        self.rule17: list[Finding | MeasuredAsJudged] = []
+        self.rule71: list[Finding | MeasuredAsJudged] = []
+        self._quiet_seen: Repeats[MeasuredAsJudged] = Repeats()
+        self._after_request_seen: Repeats[MeasuredAsJudged] = Repeats()
+        self._broke_after_request: Finding | None = None  # R-7.1-01's first PASS of a break
         self.previous: Transmission | None = None
         self.commands = 0
         #: the window before, for a command sent without a break first in its window: where
@@ -198,38 +214,36 @@ class BreakRules:
                 else:  # timed from the line's activity before it (before the short spacing)
                     began = self._previous_activity(line, s) or float("-inf")
                     quiet = s.first_char - began
-                    judged = judge_window(
-                        "R-7.0-17",
-                        "marking before a command sent without a break",
-                        quiet,
-                        own_uncertainty(uncertainty, s.chars[0], previous.chars[-1]),
-                        high=NO_BREAK_WINDOW,
-                        evidence=where,
-                    )
-                    if short and judged.verdict is not Verdict.PASS:
-                        judged.detail += short
-                    rule17.append(hold(stalls, judged, began, s.first_char, NO_BREAK_WINDOW))
+                    u = own_uncertainty(uncertainty, s.chars[0], previous.chars[-1])
+                    if stalls or short:
+                        judged = QUIET.judge(quiet, u, where)
+                        if short and judged.verdict is not Verdict.PASS:
+                            judged.detail += short
+                        rule17.append(hold(stalls, judged, began, s.first_char, NO_BREAK_WINDOW))
+                    else:
+                        rule17.append(_once(self._quiet_seen, QUIET, quiet, u, where))
                 if previous is not None and _follows_service_request(previous, s):
                     sr_end = service_request_end(previous.after, s.address)
                     assert sr_end is not None
-                    judged = judge_window(
-                        "R-7.1-01",
-                        "aD0! without a break after the service request",
-                        s.first_char - sr_end,
-                        own_uncertainty(uncertainty, s.chars[0]),
-                        high=NO_BREAK_WINDOW,
-                        evidence=where,
-                    )
-                    rule71.append(hold(stalls, judged, sr_end, s.first_char, NO_BREAK_WINDOW))
+                    waited, u = s.first_char - sr_end, own_uncertainty(uncertainty, s.chars[0])
+                    if stalls:
+                        judged = AFTER_REQUEST.judge(waited, u, where)
+                        rule71.append(hold(stalls, judged, sr_end, s.first_char, NO_BREAK_WINDOW))
+                    else:
+                        seen = self._after_request_seen
+                        rule71.append(_once(seen, AFTER_REQUEST, waited, u, where))
             elif previous is not None and _follows_service_request(previous, s):
-                rule71.append(
-                    Finding(
+                # only the first one's detail is ever shown (a PASS with no figure is the
+                # worst of the PASSes, and the first of the worst is shown): the rest count
+                broke = self._broke_after_request
+                if broke is None:
+                    broke = self._broke_after_request = Finding(
                         "R-7.1-01",
                         Verdict.PASS,
                         f"a break before {s.at()} after the service request",
                         observed=1,
                     )
-                )
+                rule71.append(broke)
             previous = s
         self.previous = previous
         self.commands += len(line.transmissions)
@@ -245,6 +259,14 @@ class BreakRules:
             ),
             combine("R-7.1-01", self.rule71, "aD0! after a service request"),
         ]
+
+
+def _once(
+    seen: Repeats[MeasuredAsJudged], window: Window, measured: float, u: float, where: list[str]
+) -> MeasuredAsJudged:
+    """``measured`` judged against ``window``: the first interval equal to it judged before
+    (whose evidence a verdict shows: the first of the worst), else a new one kept."""
+    return seen.first(measured, u) or seen.keep(MeasuredAsJudged(window, measured, u, where))
 
 
 def _too_short(event: Event | None, uncertainty: float) -> str:

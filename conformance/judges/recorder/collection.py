@@ -27,21 +27,39 @@ def judge_data_collection(
     reply before it was read past without the measurement issued again. One that stopped
     short across a noted stall of the tool's host (``stalls``) is undecided naming it, where
     the stall can account for it (:func:`.stalls.tried_again`, :func:`.stalls.
-    over_collection`, truth33)."""
-    tally = Tally(("R-4.4.8-05",))
+    over_collection`, truth33). One :class:`DataCollection` given each of ``taken`` in
+    order."""
+    collection = DataCollection(stalls)
     for m in taken:
+        collection.take(m)
+    return collection.findings()
+
+
+class DataCollection:
+    """:func:`judge_data_collection` of measurements given one at a time (issue 22,
+    memory27: the recorder pass hands each one over once it is over and forgets it):
+    :meth:`take` each in the order begun, then :meth:`findings`; what it holds is the
+    tally, never a measurement."""
+
+    def __init__(self, stalls: Sequence[Stall] = ()) -> None:
+        self.stalls = stalls
+        self.tally = Tally(("R-4.4.8-05",))
+
+    def take(self, m: ObservedMeasurement) -> None:
+        """The next measurement, in the order begun."""
         if m.kind is Kind.HIGH_VOLUME_BINARY or not m.count:
-            continue
+            return
+        tally = self.tally
         where = escape(m.start.text)
         tally.observe(where)
         indices = [d[1] for s, _ in m.data if (d := s.data_index) is not None]
         order = [i for n, i in enumerate(indices) if n == 0 or indices[n - 1] != i]
         if order != list(range(len(order))):
             tally.fail("R-4.4.8-05", where, f"data indices went {order}, not 0, 1, 2, ...")
-            continue
+            return
         have = len(m.values())
         if have >= m.count:
-            continue
+            return
         last, problem, empty = collection_end(m)
         past = read_past_empty(m) if problem is not None else None
         if past is not None and (m.next_start is None or m.next_start.text != m.start.text):
@@ -51,12 +69,12 @@ def judge_data_collection(
                 f"{escape(past.text)} came back empty and the measurement was not issued "
                 f"again (the recorder read on, to {escape(last.text) if last else '?'})",
             )
-            continue
+            return
         if problem is not None:
-            continue
+            return
         if m.cut_at is not None:
             tally.undecide("R-4.4.8-05", where, _cut_with(have, m))
-            continue
+            return
         if empty:
             if m.next_start is None or m.next_start.text != m.start.text:
                 tally.fail(
@@ -65,11 +83,14 @@ def judge_data_collection(
                     f"{escape(last.text) if last else 'aD0!'} came back empty and the "
                     "measurement was not issued again",
                 )
-            continue
+            return
         stop = escape(last.text) if last is not None else "the reply"
         short = f"stopped after {stop} with {have} of {m.count} values"
-        _stopped_short(tally, "R-4.4.8-05", m, where, short, stalls)
-    return tally.findings("every announced value collected in order")
+        _stopped_short(tally, "R-4.4.8-05", m, where, short, self.stalls)
+
+    def findings(self) -> list[Finding]:
+        """R-4.4.8-05 over every measurement taken."""
+        return self.tally.findings("every announced value collected in order")
 
 
 def judge_concurrent_storage(
@@ -185,18 +206,41 @@ def judge_high_volume(
     answered leaves the reading back unseen (undecided, not a FAIL); so does one not sent in a
     view with a job cut at its budget (``cut``), and a collection that cut left unfinished.
     A collection stopped short across a noted stall of the tool's host (``stalls``) is
-    undecided naming it (:func:`_stopped_short`)."""
-    tally = Tally(("R-5.1-04", "R-5.2-08", "R-5.4-01"))
-    used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
-    unheard: set[Kind] = set()  # started, its collection ended on a D command unanswered
+    undecided naming it (:func:`_stopped_short`). One :class:`HighVolume` given each of
+    ``taken`` in order."""
+    high_volume = HighVolume(stalls)
     for m in taken:
+        high_volume.take(m)
+    return high_volume.findings(is_v14, sent, cut)
+
+
+class HighVolume:
+    """:func:`judge_high_volume` of measurements given one at a time (as
+    :class:`DataCollection`): :meth:`take` each in the order begun, then :meth:`findings`
+    (R-5.4-01 reads only what the high-volume measurements left, and whether the recorder
+    claims v1.4, asked at the end), or :meth:`collections` (R-5.1-04 and R-5.2-08 alone,
+    which that claim does not touch: what a recording shows). What it holds is the
+    R-5.1-04 / R-5.2-08 tally and, per high-volume kind, whether any was taken, whether its
+    data were read and whether it ended unheard."""
+
+    def __init__(self, stalls: Sequence[Stall] = ()) -> None:
+        self.stalls = stalls
+        self.tally = Tally(("R-5.1-04", "R-5.2-08"))
+        self.used = {Kind.HIGH_VOLUME_ASCII: False, Kind.HIGH_VOLUME_BINARY: False}
+        self.unheard: set[Kind] = set()  # started, its collection ended on a D command unanswered
+        self.taken: set[Kind] = set()  # started (a valid reply)
+
+    def take(self, m: ObservedMeasurement) -> None:
+        """The next measurement, in the order begun."""
+        used, tally = self.used, self.tally
         if m.kind not in used:
-            continue
+            return
+        self.taken.add(m.kind)
         where = escape(m.start.text)
         have = len(m.values())
         used[m.kind] = used[m.kind] or have > 0
         if not have and _ended_on_problem(m):
-            unheard.add(m.kind)
+            self.unheard.add(m.kind)
         rid = "R-5.1-04" if m.kind is Kind.HIGH_VOLUME_ASCII else "R-5.2-08"
         tally.observe(where, ids=[rid])
         if m.cut_at is not None and have < m.count:
@@ -211,7 +255,7 @@ def judge_high_volume(
             last, problem, empty = collection_end(m)
             if problem is None and have < m.count and not empty and m.cut_at is None:
                 short = f"stopped with {have} of {m.count} values, no empty packet"
-                _stopped_short(tally, rid, m, where, short, stalls)
+                _stopped_short(tally, rid, m, where, short, self.stalls)
             extra = _after_done(m)
             if extra:
                 tally.fail(rid, where, f"{escape(extra.text)} sent after every value was in")
@@ -220,26 +264,43 @@ def judge_high_volume(
             if problem is None and have < m.count and m.cut_at is None:
                 stop = escape(last.text) if last else "D0"
                 short = f"stopped at {stop} with {have} of {m.count} values"
-                _stopped_short(tally, rid, m, where, short, stalls)
-    if is_v14:
-        for kind, ok in used.items():
-            tally.observe(kind.value.replace("a", "", 1), ids=["R-5.4-01"])
-            if ok:
-                continue
-            if kind in unheard or (
-                any(_kind_of(text) is kind for text in sent)
-                and not any(m.kind is kind for m in taken)
-            ):
-                tally.undecide(
-                    "R-5.4-01", str(kind), f"{kind} sent, its data never validly answered"
-                )
-            elif cut:
-                tally.undecide("R-5.4-01", str(kind), f"{kind}: {CUT_SHORT}, or its data not read")
-            else:
-                tally.fail("R-5.4-01", str(kind), f"{kind} was not issued or its data not read")
-    else:
-        tally.not_applicable("R-5.4-01", "the recorder does not claim v1.4")
-    return tally.findings("conforms")
+                _stopped_short(tally, rid, m, where, short, self.stalls)
+
+    def findings(
+        self, is_v14: bool, sent: Collection[str] = (), cut: bool = False
+    ) -> list[Finding]:
+        """R-5.1-04, R-5.2-08 and R-5.4-01 over every measurement taken (``is_v14``,
+        ``sent``, ``cut``: :func:`judge_high_volume`'s); asked again, the same."""
+        return [*self.collections(), *self._v14(is_v14, sent, cut)]
+
+    def collections(self) -> list[Finding]:
+        """R-5.1-04 and R-5.2-08 over every measurement taken."""
+        return self.tally.findings("conforms")
+
+    def _v14(self, is_v14: bool, sent: Collection[str], cut: bool) -> list[Finding]:
+        """R-5.4-01 (each rule of a :class:`Tally` is found from its own observations
+        alone: this one's tally apart gives what one tally of the three gave)."""
+        tally = Tally(("R-5.4-01",))
+        if is_v14:
+            for kind, ok in self.used.items():
+                tally.observe(kind.value.replace("a", "", 1), ids=["R-5.4-01"])
+                if ok:
+                    continue
+                if kind in self.unheard or (
+                    any(_kind_of(text) is kind for text in sent) and kind not in self.taken
+                ):
+                    tally.undecide(
+                        "R-5.4-01", str(kind), f"{kind} sent, its data never validly answered"
+                    )
+                elif cut:
+                    tally.undecide(
+                        "R-5.4-01", str(kind), f"{kind}: {CUT_SHORT}, or its data not read"
+                    )
+                else:
+                    tally.fail("R-5.4-01", str(kind), f"{kind} was not issued or its data not read")
+        else:
+            tally.not_applicable("R-5.4-01", "the recorder does not claim v1.4")
+        return tally.findings("conforms")
 
 
 def _kind_of(text: str) -> Kind | None:

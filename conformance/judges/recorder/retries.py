@@ -29,7 +29,7 @@ from ...verdicts import Finding, Verdict
 from ...view.segments import TranscriptView, Transmission, memo
 from ..reply_validity import NO_REPLY, STX, Reason, ReplyProblem
 from ..tally import Tally
-from ..timing import judge_window
+from ..timing import MeasuredAsJudged, Repeats, Window, judge_window
 from .common import combine, own_uncertainty
 from .logged import same_values
 from .replies import crc_context, cut_off, reply_problem
@@ -40,6 +40,8 @@ from .stalls import fail_unless_stalled, hold
 STANDBY = STANDBY_MARKING + TOLERANCE
 #: Latest start of a retry (R-7.2-02: 87 ms, +0.40 ms) that a PASS may rest on.
 WINDOW = RETRY_MAX + TOLERANCE
+#: R-7.2-02's window for a retry after no reply (16.67-87 ms after the command)
+RETRY_WAIT = Window("R-7.2-02", "retry after no reply", low=RETRY_MIN, high=RETRY_MAX)
 #: The catalog decision that says what counts as a retry (and cites these two figures).
 RETRY_DECISION = "T2"
 #: The longest single-line reply a sensor may give (address, 75 value characters after aHA!,
@@ -272,7 +274,10 @@ class _RetryEvidence:
     requirements, and the findings of the ones combined from windows of their own."""
 
     tally: Tally
-    window: list[Finding] = field(default_factory=list)  # R-7.2-02
+    window: list[Finding | MeasuredAsJudged] = field(default_factory=list)  # R-7.2-02
+    #: R-7.2-02's retries after no reply judged where no stall is noted, each distinct wait
+    #: once (:class:`~..timing.Repeats`: a pointer a retry in ``window``, memory27)
+    window_seen: Repeats[MeasuredAsJudged] = field(default_factory=Repeats)
     third: list[Finding] = field(default_factory=list)  # R-7.2-03
     ends: list[Finding] = field(default_factory=list)  # R-7.2-06
     #: invalid replies followed by a new sequence, not a retry (R-7.2-06's INCONCLUSIVE)
@@ -400,16 +405,17 @@ def _judge_tries(
         # command (the recorder talked over them) leave that window undecided
         if a.problem is NO_REPLY and not a.sent.contention:
             if nxt is not None:
-                judged = judge_window(
-                    "R-7.2-02",
-                    "retry after no reply",
-                    nxt.sent.first_char - a.sent.end,
-                    own_uncertainty(uncertainty, a.sent.chars[-1], nxt.sent.chars[0]),
-                    low=RETRY_MIN,
-                    high=RETRY_MAX,
-                    evidence=[nxt.sent.at()],
-                )
-                acc.window.append(acc.across(judged, began, nxt.sent.first_char, RETRY_MAX))
+                waited = nxt.sent.first_char - a.sent.end
+                u = own_uncertainty(uncertainty, a.sent.chars[-1], nxt.sent.chars[0])
+                if acc.stalls:  # each its own finding, as hold names a stall with its evidence
+                    judged = RETRY_WAIT.judge(waited, u, [nxt.sent.at()])
+                    acc.window.append(acc.across(judged, began, nxt.sent.first_char, RETRY_MAX))
+                else:  # one object per distinct wait (the first's evidence is shown)
+                    seen = acc.window_seen
+                    acc.window.append(
+                        seen.first(waited, u)
+                        or seen.keep(MeasuredAsJudged(RETRY_WAIT, waited, u, [nxt.sent.at()]))
+                    )
             elif k == 0:
                 missing = Finding(
                     "R-7.2-02",

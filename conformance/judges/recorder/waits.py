@@ -8,7 +8,7 @@ recorder that gave up on a reply it did not get in time tried again as it must."
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from ...links.host_stall import Stall
 from ...protocol.commands import CONCURRENT_KINDS
@@ -16,7 +16,7 @@ from ...transcript import escape
 from ...verdicts import Finding, Verdict
 from ...view.segments import Transmission
 from ..tally import Tally
-from ..timing import judge_window
+from ..timing import MeasuredAsJudged, Repeats, Window
 from .common import (
     REACTION,
     REACTION_DECISION,
@@ -35,12 +35,65 @@ def judge_measure_waits(
     or ttt; R-4.4.5-07 the line left alone while waiting; R-4.4.5-05 aD0! promptly when the
     service request comes or ttt runs out (then after a break), and at once for ttt = 0
     (SHOULD); R-4.4.5-06 no traffic to other sensors until the data are in. ``stalls``: the
-    tool's host stalls noted in the recording (:func:`_no_data_command`)."""
-    early: list[Finding] = []
-    tally = Tally(("R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07"))
+    tool's host stalls noted in the recording (:func:`_no_data_command`). One
+    :class:`MeasureWaits` given each of ``taken`` in order."""
+    waits = MeasureWaits(uncertainty, stalls)
     for m in taken:
+        waits.take(m)
+    return waits.findings()
+
+
+class Waits:
+    """One rule's waits after a measurement's reply, each judged against a window whose low
+    limit is the measurement's ttt (:func:`~..timing.judge_window`), as the
+    :class:`~..timing.MeasuredAsJudged` that aggregates as its finding does, one object per
+    distinct interval of each ttt (:class:`~..timing.Repeats`: the first's evidence is
+    the one a verdict shows), kept in the order judged (:func:`combine` and its
+    distribution read them so: a pointer a measurement)."""
+
+    def __init__(self, requirement: str, what: str) -> None:
+        self.requirement, self.what = requirement, what
+        self.judged: list[Finding | MeasuredAsJudged] = []
+        self._by_ttt: dict[int, tuple[Window, Repeats[MeasuredAsJudged]]] = {}
+
+    def judge(
+        self, measured: float, uncertainty: float, ttt: int, evidence: Callable[[], str]
+    ) -> None:
+        """One wait of ``measured`` s after a reply that announced ``ttt``; ``evidence``
+        makes its line (asked only for the first of its value)."""
+        held = self._by_ttt.get(ttt)
+        if held is None:
+            window = Window(self.requirement, self.what, low=float(ttt))
+            held = self._by_ttt[ttt] = (window, Repeats())
+        window, seen = held
+        judged = seen.first(measured, uncertainty) or seen.keep(
+            MeasuredAsJudged(window, measured, uncertainty, [evidence()])
+        )
+        self.judged.append(judged)
+
+
+class MeasureWaits:
+    """:func:`judge_measure_waits` of measurements given one at a time (issue 22, memory27:
+    the recorder pass hands each one over once it is over and forgets it): :meth:`take`
+    each in the order begun, then :meth:`findings`. What it holds across them is the
+    tally (counts, the first labels, the violations) and the R-4.4.5-04 waits
+    (:class:`Waits`), never a measurement."""
+
+    def __init__(self, uncertainty: float, stalls: Sequence[Stall] = ()) -> None:
+        self.uncertainty = uncertainty
+        self.stalls = stalls
+        self.tally = Tally(("R-4.4.5-05", "R-4.4.5-06", "R-4.4.5-07"))
+        self.tally.decision("R-4.4.5-05", REACTION_DECISION)
+        self.early = Waits(
+            "R-4.4.5-04", "aD0! (or its break) after the reply, with no service request before it"
+        )
+        self._after_request: dict[str, Finding] = {}  # each label's PASS, made once
+
+    def take(self, m: ObservedMeasurement) -> None:
+        """The next measurement, in the order begun."""
         if m.kind not in SR_KINDS:
-            continue
+            return
+        tally = self.tally
         where = escape(m.start.text)
         tally.observe(where, ids=["R-4.4.5-06"])
         for other in m.others:
@@ -61,7 +114,7 @@ def judge_measure_waits(
                     beyond_reaction(first.start - m.reply_end, "ttt = 000"),
                     warning=True,
                 )
-            continue
+            return
         ready = m.reply_end + m.ttt
         sr = m.service_request_end if m.service_request_end is not None else None
         waited_until = min(sr, ready) if sr is not None else ready
@@ -77,32 +130,32 @@ def judge_measure_waits(
                 f"reply, while a service request could still come",
             )
         if first is None:
-            _no_data_command(tally, m, where, ready, uncertainty, stalls)
-            continue
+            _no_data_command(tally, m, where, ready, self.uncertainty, self.stalls)
+            return
         if sr is None or sr > first.start:
-            early.append(
-                judge_window(
-                    "R-4.4.5-04",
-                    "aD0! (or its break) after the reply, with no service request before it",
-                    first.start - m.reply_end,
-                    uncertainty,
-                    low=float(m.ttt),
-                    evidence=[f"{first.at()} after {where} announced ttt={m.ttt}"],
-                )
+            self.early.judge(
+                first.start - m.reply_end,
+                self.uncertainty,
+                m.ttt,
+                lambda: f"{first.at()} after {where} announced ttt={m.ttt}",
             )
         else:
-            early.append(
-                Finding(
+            passed = self._after_request.get(where)
+            if passed is None:
+                passed = self._after_request[where] = Finding(
                     "R-4.4.5-04",
                     Verdict.PASS,
                     f"aD0! only after the service request ({where})",
                     observed=1,
                 )
-            )
+            self.early.judged.append(passed)
         _judge_reaction(tally, m, first, where, sr, ready)
-    tally.decision("R-4.4.5-05", REACTION_DECISION)
-    ok = {"R-4.4.5-05": f"aD0! within {REACTION} s of the service request or ttt (decision T1)"}
-    return [combine("R-4.4.5-04", early, "wait for data"), *tally.findings(ok)]
+
+    def findings(self) -> list[Finding]:
+        """R-4.4.5-04..07 over every measurement taken."""
+        ok = {"R-4.4.5-05": f"aD0! within {REACTION} s of the service request or ttt (decision T1)"}
+        early = combine("R-4.4.5-04", self.early.judged, "wait for data")
+        return [early, *self.tally.findings(ok)]
 
 
 def _judge_reaction(
@@ -136,22 +189,38 @@ def judge_concurrent_waits(
     taken: Sequence[ObservedMeasurement], uncertainty: float
 ) -> list[Finding]:
     """R-4.4.7-06: after a concurrent reply with ttt > 0, no data command to that sensor before
-    ttt (talking to other sensors meanwhile is allowed)."""
-    found = []
+    ttt (talking to other sensors meanwhile is allowed). One :class:`ConcurrentWaits` given
+    each of ``taken`` in order."""
+    waits = ConcurrentWaits(uncertainty)
     for m in taken:
-        if m.kind not in CONCURRENT_KINDS or not m.ttt or m.first_data is None:
-            continue
-        found.append(
-            judge_window(
-                "R-4.4.7-06",
-                "first data command (or its break) after the concurrent reply",
-                m.first_data.start - m.reply_end,
-                uncertainty,
-                low=float(m.ttt),
-                evidence=[f"{m.first_data.at()} after {escape(m.start.text)} (ttt={m.ttt})"],
-            )
+        waits.take(m)
+    return waits.findings()
+
+
+class ConcurrentWaits:
+    """:func:`judge_concurrent_waits` of measurements given one at a time (as
+    :class:`MeasureWaits`): what it holds is the waits (:class:`Waits`)."""
+
+    def __init__(self, uncertainty: float) -> None:
+        self.uncertainty = uncertainty
+        what = "first data command (or its break) after the concurrent reply"
+        self.waits = Waits("R-4.4.7-06", what)
+
+    def take(self, m: ObservedMeasurement) -> None:
+        """The next measurement, in the order begun."""
+        first = m.first_data
+        if m.kind not in CONCURRENT_KINDS or not m.ttt or first is None:
+            return
+        self.waits.judge(
+            first.start - m.reply_end,
+            self.uncertainty,
+            m.ttt,
+            lambda: f"{first.at()} after {escape(m.start.text)} (ttt={m.ttt})",
         )
-    return [combine("R-4.4.7-06", found, "concurrent wait")]
+
+    def findings(self) -> list[Finding]:
+        """R-4.4.7-06 over every measurement taken."""
+        return [combine("R-4.4.7-06", self.waits.judged, "concurrent wait")]
 
 
 def _no_data_command(
