@@ -230,19 +230,20 @@ def events_head(record: Any, n: int) -> tuple[list[Event], int, Event | None]:
 
 def head_of(events: list[Event], limit: int) -> list[Event]:
     """The first of ``events`` (in time order) up to ``limit`` of them, cut before the last
-    break among them so no exchange is shown in part (all ``limit`` where none is past the
-    first). Why: a judged recording's evidence of every measurement of an hour held ~10^5
-    events per case until the report was written, and the report listed them all (issue 22);
-    the first exchanges show what the case saw, the recording holds the rest."""
+    break among them so no exchange is shown in part, where that keeps half of them or more
+    (else all ``limit``: one exchange, a long binary packet, would leave a handful). Why: a
+    judged recording's evidence of every measurement of an hour held ~10^5 events per case
+    until the report was written, and the report listed them all (issue 22); the first
+    exchanges show what the case saw, the recording holds the rest."""
     if len(events) <= limit:
         return events
     head = events[:limit]
     if events[limit].kind is EventKind.BREAK:
         return head  # the next exchange starts just past the limit
-    for i in range(len(head) - 1, 0, -1):
+    for i in range(len(head) - 1, limit // 2 - 1, -1):
         if head[i].kind is EventKind.BREAK:
             return head[:i]
-    return head
+    return head  # an exchange longer than half the limit (a binary packet): shown in part
 
 
 def _voided(unmet: Unmet) -> tuple[Verdict, ...]:

@@ -42,6 +42,14 @@ def test_a_head_with_no_break_past_its_first_event_is_cut_at_the_limit():
     assert head_of(events, 20) == events[:20]
 
 
+def test_an_exchange_longer_than_half_the_limit_is_shown_in_part():
+    """A short command then a long binary packet: cutting before the packet's exchange
+    would keep 6 of 40 events; all 40 are kept, the packet shown in part."""
+    events = _exchange(0.0, 5) + _exchange(1.0, 100)
+    assert head_of(events, 40) == events[:40]
+    assert head_of(events, 12) == events[:6]  # the break at 6 is at half the limit: cut
+
+
 def test_a_case_keeps_at_most_its_limit_and_says_so():
     events = _exchanges(10)
     record = CaseRecord(nodeid="x::y", name="y", requirements=("R-4.4.12-05",))
