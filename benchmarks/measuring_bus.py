@@ -14,7 +14,7 @@ its sensor before its data; a high-volume binary ``aHB!`` and ASCII ``aHA!`` rea
     python benchmarks/measuring_bus.py --minutes 60 --keep /tmp/measuring-60.sr
 
 writes the capture (sigrok, 1 MHz) as ``capture_decode.py --keep`` does; ``tests/offline/
-test_measuring_pass_memory.py`` reads :func:`measuring_bus` as a transcript.
+test_recorder_measurements_let_go.py`` reads :func:`measuring_bus` as a transcript.
 """
 
 from __future__ import annotations
