@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 from types import ModuleType
+from typing import TypeVar
 
 import pytest
 
@@ -189,18 +190,29 @@ def test_the_recorder_pass_holds_no_finished_measurement(bench, monkeypatch):
     assert held_long == held_short <= per_cycle
 
 
+T = TypeVar("T")
+
+#: a stall of the tool's host that no interval of the bus is near: the folds given it keep a
+#: finding each (:func:`~conformance.judges.recorder.stalls.hold` leaves each as it is)
+FAR = Stall(-10.0, -9.0, 1.0)
+
+
+def _fed_both(held: T, each: T, bus: object) -> tuple[T, T]:
+    """Both folds fed every window's view of ``bus``, in order."""
+    for window in _windows(bus):
+        view = read_view(window)
+        held.add(view)  # type: ignore[attr-defined]
+        each.add(view)  # type: ignore[attr-defined]
+    return held, each
+
+
 def test_the_break_rules_hold_an_object_per_distinct_interval(bus):
     """R-7.0-17 (a command to the same sensor without a break) and R-7.1-01 (aD0! after the
     service request) held as one object per distinct interval (and a break after a service
     request as its first PASS again) give the findings of a finding per command, which the
     fold still makes where noted stalls of the tool's host are (one here that no interval
     is near: :func:`~conformance.judges.recorder.stalls.hold` leaves each as it is)."""
-    far = Stall(-10.0, -9.0, 1.0)
-    held, each = BreakRules(U), BreakRules(U, [far])
-    for window in _windows(bus):
-        view = read_view(window)
-        held.add(view)
-        each.add(view)
+    held, each = _fed_both(BreakRules(U), BreakRules(U, [FAR]), bus)
     assert held.findings() == each.findings()
     assert len(each.rule17) == len(set(map(id, each.rule17))) > 3
     assert len(held.rule17) == len(each.rule17) > len(set(map(id, held.rule17)))
@@ -214,12 +226,7 @@ def test_the_retry_waits_hold_an_object_per_distinct_wait(bus):
     """R-7.2-02's retries after no reply (the sensor that answers only a retry) held as one
     object per distinct wait give the findings of a finding per retry, which the fold still
     makes where noted stalls are (one that no retry is near)."""
-    far = Stall(-10.0, -9.0, 1.0)
-    held, each = Retries(U), Retries(U, [far])
-    for window in _windows(bus):
-        view = read_view(window)
-        held.add(view)
-        each.add(view)
+    held, each = _fed_both(Retries(U), Retries(U, [FAR]), bus)
     assert held.findings() == each.findings()
     waits, every = held._acc.window, each._acc.window
     assert len(every) == len(set(map(id, every))) >= 3
