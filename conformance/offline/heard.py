@@ -26,6 +26,7 @@ from ..view.segments import memo
 from .bus_indexes import spill_indexes
 from .bus_sensors import BusSensor, SensorsOn, sensors_on
 from .held_exchanges import HeldExchanges
+from .held_measurements import HeldMeasurements
 from .sensor_windows import (
     AMBIGUITIES_SHOWN,
     BusWindows,
@@ -114,12 +115,16 @@ class HeardSensors(Heard):
 
     #: a list, or the sensor pass's held exchanges (:mod:`.held_exchanges`, read-only)
     exchanges: Sequence[Exchange] = field(default_factory=list)
-    measurements: list[Measurement] = field(default_factory=list)
+    #: a list, or the sensor pass's held measurements (:mod:`.held_measurements`, read-only)
+    measurements: Sequence[Measurement] = field(default_factory=list)
     records: SensorRecords | None = None
 
     def of_kind(self, *kinds: Kind, whole: bool = False) -> list[Measurement]:
         """The recorded measurements of ``kinds``; ``whole``: only those the recorder let
-        run to their data (their wait and data rules are judged only on those)."""
+        run to their data (their wait and data rules are judged only on those). Of held
+        measurements, only those made."""
+        if isinstance(self.measurements, HeldMeasurements):
+            return self.measurements.of_kinds(kinds, whole)
         return [
             m
             for m in self.measurements
@@ -208,7 +213,7 @@ def hear_sensors(link: RecordingLink, address: str | None, version: str | None) 
         forced_version=normalise_version(version) if version else None,
         address=address,
         exchanges=records.exchanges,  # (read-only: no copy)
-        measurements=list(records.measurements),
+        measurements=records.measurements,  # (read-only: no copy)
         records=records,
         on_bus=list(bus.sensors),
     )

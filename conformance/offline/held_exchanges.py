@@ -17,9 +17,11 @@ characters (2 each), which reason (2), its end (8, exactly the float) and its se
 retry (1 each): 36 bytes an exchange of one try (``tests/offline/test_held_exchanges.py``). A case
 that reads it gets an ``Exchange`` equal, field for field, to the one the pass made; while
 it holds it, reading it again gives the same object (a weak cache), so identity within a
-case is kept. Kept as objects: the exchanges a measurement holds (a measurement's start and
-data are the very exchanges of the list), and any with a part a row cannot say (a stall of
-the tool's host, stray or late characters, events not one run of the store's, a late
+case is kept. Kept as objects: the exchanges a measurement holds while that measurement is
+an object (a measurement's start and data are the very exchanges of the list: their rows are
+made too, and once the measurement is a row itself, :mod:`.held_measurements`, they are let
+go, :meth:`HeldExchanges.release`), and any with a part a row cannot say (a stall of the
+tool's host, stray or late characters, events not one run of the store's, a late
 neighbour): what reads them gets the pass's objects as before.
 """
 
@@ -64,6 +66,10 @@ class HeldExchanges(Sequence[Exchange]):
         self.reason, self.end = array("H"), array("d")
         self.sequence, self.retry = array("B"), array("B")
         self.kept: dict[int, Exchange] = {}  # by index: held as the object
+        #: by index: a measurement's, its rows made too, held as the object until that
+        #: measurement is held as a row (:meth:`release`) or for good where it cannot be
+        self.held_for: dict[int, Exchange] = {}
+        self._index_of: dict[int, int] = {}  # id of each of ``held_for`` -> its index
         self._made: weakref.WeakValueDictionary[int, Exchange] = weakref.WeakValueDictionary()
 
     # -- held by the pass --------------------------------------------------------------
@@ -71,18 +77,22 @@ class HeldExchanges(Sequence[Exchange]):
         self, positions: Positions | None, exchanges: Iterable[Exchange], keep: Collection[int]
     ) -> None:
         """A window's exchanges, in order, after :func:`~.stored_records.store_records`;
-        those whose ``id`` is in ``keep`` (a measurement's) held as the objects."""
+        those whose ``id`` is in ``keep`` (a measurement's) also held as the objects while
+        their measurement is (:meth:`release`)."""
         for x in exchanges:
             i = len(self.shape)
             shape = self._shape(x)
             rows = None
-            if positions is not None and id(x) not in keep and shape is not None:
+            if positions is not None and shape is not None:
                 rows = self._rows(positions, x)
             if shape is None or rows is None:
                 self.kept[i] = x
                 shape = self._loose_shape(x)
             else:
                 self._append_rows(rows)
+                if id(x) in keep:
+                    self.held_for[i] = x
+                    self._index_of[id(x)] = i
             self.shape.append(shape)
             self.first.append(len(self.end))
 
@@ -150,6 +160,20 @@ class HeldExchanges(Sequence[Exchange]):
             self.sequence.append(sequence)
             self.retry.append(retry)
 
+    def index_of(self, x: Exchange) -> int | None:
+        """The index of ``x``, a measurement's exchange held as the object with its rows
+        made (None: held for good as the object, or not one of these)."""
+        return self._index_of.get(id(x))
+
+    def release(self, i: int) -> None:
+        """Exchange ``i`` (a measurement's, :meth:`index_of`) no longer held as the object:
+        its measurement is now a row pointing at it. Read again, it is the same object while
+        anything holds it (the weak cache), else made again of its rows."""
+        x = self.held_for.pop(i, None)
+        if x is not None:
+            del self._index_of[id(x)]
+            self._made[i] = x
+
     # -- read by the cases -------------------------------------------------------------
     def __len__(self) -> int:
         return len(self.shape)
@@ -190,6 +214,9 @@ class HeldExchanges(Sequence[Exchange]):
 
     def _exchange(self, i: int) -> Exchange:
         kept = self.kept.get(i)
+        if kept is not None:
+            return kept
+        kept = self.held_for.get(i)
         if kept is not None:
             return kept
         made = self._made.get(i)

@@ -25,7 +25,9 @@ records:
   positions into the loaded store once their window is read (:mod:`.stored_records`: no
   event of the run held as an object), each exchange outside a measurement then a row of
   numbers made again when a case reads it (:mod:`.held_exchanges`, ~36 bytes, not ~1.3 KB),
-  and the folds' findings.
+  each measurement once its ``aborted_by`` is decided a row too, pointing at its exchanges'
+  (:mod:`.held_measurements`: its exchanges then let go as objects), and the folds'
+  findings.
 
 Every finding, note and record is the whole-run path's (``tests/offline/
 test_sensor_windows.py`` runs that path, kept in ``tests/support/whole_run_heard.py``, as
@@ -64,6 +66,7 @@ from ..view.windows import WindowedTransmissions, stream_window_sides, window_vi
 from .bus_sensors import BusSensor, SensorsOn
 from .decode_quality import CharRates, Quality, problems_by_character, sensor_characters
 from .held_exchanges import HeldExchanges
+from .held_measurements import HeldMeasurements
 from .stored_records import Positions, store_records
 
 if TYPE_CHECKING:
@@ -354,7 +357,8 @@ class SensorRecords:
 
     #: held as rows, each made again when read (:mod:`.held_exchanges`)
     exchanges: Sequence[Exchange]
-    measurements: list[Measurement]
+    #: held as rows once decided, each made again when read (:mod:`.held_measurements`)
+    measurements: Sequence[Measurement]
     response_start: list[Finding]
     gaps: list[Finding]
     bit_rate: Finding
@@ -372,7 +376,7 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
     disturbed, carried = Disturbances(), {}
     events = link.transcript.events
     exchanges = HeldExchanges(events if isinstance(events, CompactEvents) else None)
-    measurements: list[Measurement] = []
+    measurements = HeldMeasurements(exchanges)
     for positions, view in bus.read_placed(address, disturbed.waiting):
         rebuilt = rebuild_records(view, uncertainty=u, only=address, carried=carried)
         stalled_reads.mark_reads(rebuilt.exchanges, stalls)
@@ -384,8 +388,10 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
         if positions is not None:  # held for the run as positions, not objects
             store_records(positions, rebuilt.exchanges, rebuilt.measurements)
         exchanges.add(positions, rebuilt.exchanges, measured(rebuilt.measurements))
-        measurements += rebuilt.measurements
+        measurements.add(rebuilt.measurements)
+        measurements.settle({id(w.m) for w in disturbed.watched})
     disturbed.finish()
+    measurements.settle(())
     return SensorRecords(
         exchanges, measurements, starts.findings(), gaps.findings(), rate.finding(),
         framing.findings(),
@@ -394,7 +400,8 @@ def sensor_records(link: RecordingLink, bus: BusWindows, address: str | None) ->
 
 def measured(measurements: Iterable[Measurement]) -> set[int]:
     """The ids of the exchanges ``measurements`` hold (each one's start and data): kept as the
-    objects in a sensor's held exchanges, the very ones its measurements read."""
+    objects in a sensor's held exchanges, the very ones its measurements read, while those
+    measurements are (:mod:`.held_measurements`)."""
     return {id(x) for m in measurements for x in (m.start, *m.data)}
 
 
