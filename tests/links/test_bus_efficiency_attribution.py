@@ -3,23 +3,17 @@ lower bound went, by cause, from its transcript alone."""
 
 from __future__ import annotations
 
-import importlib.util
 import re
-from pathlib import Path
 
 from conformance.links.bus_time import bus_time, uncounted
 from conformance.protocol.timing import RELEASE_LINE, RETRY_MIN
 from conformance.transcript import DUT, TOOL
 from tests.links.test_bus_time import Wire
+from tests.support.paths import benchmark
 
 
 def bench_module():
-    path = Path(__file__).parents[2] / "benchmarks" / "bus_efficiency.py"
-    spec = importlib.util.spec_from_file_location("bus_efficiency_bench", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("bus_efficiency")
 
 
 def test_each_uncounted_stretch_goes_to_the_cause_the_wire_shows():

@@ -18,18 +18,12 @@ from conformance.links.bus_time import BusTime, bus_time, bus_time_again
 from conformance.protocol.timing import CHAR_TIME
 from conformance.transcript import DUT, TOOL, Event, EventKind, to_wire_7e1
 from tests.links.test_bus_time_merged import traffic
+from tests.support.paths import benchmark
 
 
 def busy_bus(seconds: float) -> list[Event]:
     """The benchmark's busy bus (``benchmarks/capture_decode.busy_bus``)."""
-    import importlib.util
-
-    path = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
-    spec = importlib.util.spec_from_file_location("capture_decode_bench", path)
-    assert spec is not None and spec.loader is not None
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
-    return bench.busy_bus(seconds)
+    return benchmark("capture_decode").busy_bus(seconds)
 
 
 def same(a: BusTime, b: BusTime) -> bool:
@@ -86,7 +80,6 @@ def test_a_busy_bus_in_three_reads_and_no_list(monkeypatch):
 def test_a_sim_run_with_measurements_and_notes():
     """A whole simulated run's transcript (notes among its events, announced waits)."""
     import tempfile
-    from pathlib import Path
 
     from conformance.conduct import run_into
     from conformance.replay.recording import read_recording

@@ -5,11 +5,8 @@ past the 7.5 ms the bound gives the sensor)."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 from dataclasses import replace
-from pathlib import Path
 
 import pytest
 
@@ -17,6 +14,7 @@ from conformance.links.bus_time import bus_time
 from conformance.protocol.timing import RELEASE_LINE
 from conformance.transcript import DUT, TOOL, Event, EventKind
 from tests.links.test_bus_time import Wire
+from tests.support.paths import benchmark
 
 TICK = 16e-3
 PHASE = 5.3e-3  # where the latency timer ticks on the tap's clock, modulo TICK
@@ -24,13 +22,7 @@ OFFSET = 100.0  # the tool's clock less the tap's
 
 
 def tap_module():
-    path = Path(__file__).parents[2] / "benchmarks" / "wire_tap.py"
-    spec = importlib.util.spec_from_file_location("wire_tap_bench", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("wire_tap")
 
 
 def _delivered(end: float) -> float:

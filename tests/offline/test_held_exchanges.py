@@ -8,7 +8,6 @@ hold a few tens of bytes each, not the ~1.3 KB each an object took (memory21).""
 from __future__ import annotations
 
 import gc
-import importlib.util
 import tracemalloc
 from pathlib import Path
 
@@ -27,8 +26,8 @@ from conformance.replay.recording_link import load_recording, parse_recording, r
 from conformance.tool_recorder.records import OK, Attempt, Exchange
 from conformance.transcript import BUS, DUT, TOOL, Event, EventKind, Transcript
 from tests.support.bus_of_sensors import record
+from tests.support.paths import benchmark
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "capture_decode.py"
 #: bytes an exchange of one try may hold as a row (36, the arrays' room to grow besides)
 ROW_BYTES = 100
 
@@ -93,11 +92,7 @@ def test_bus_recordings_rows_make_the_pass_exchanges(tmp_path: Path, kwargs: dic
 
 
 def _busy(path: Path, seconds: float) -> Path:
-    spec = importlib.util.spec_from_file_location("capture_decode_bench", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    write_recording(path, Transcript(module.busy_bus(seconds)))
+    write_recording(path, Transcript(benchmark("capture_decode").busy_bus(seconds)))
     return path
 
 

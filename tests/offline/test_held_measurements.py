@@ -13,7 +13,6 @@ and aHA! read past aD9!, a retried sensor), laid end to end."""
 from __future__ import annotations
 
 import gc
-import importlib.util
 import tracemalloc
 from pathlib import Path
 from types import ModuleType
@@ -28,17 +27,12 @@ from conformance.replay.recording import write_recording
 from conformance.replay.recording_link import load_recording, parse_recording, recording_port
 from conformance.tool_recorder.records import Measurement
 from conformance.transcript import Transcript
-
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "measuring_bus.py"
+from tests.support.paths import benchmark
 
 
 @pytest.fixture(scope="module")
 def bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("measuring_bus_bench", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("measuring_bus")
 
 
 def _recording(bench: ModuleType, path: Path, cycles: int) -> Path:

@@ -4,25 +4,16 @@ apart, every event's holders counted, each family's bytes those of its objects."
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 
 from conformance.capture import export_events
 from conformance.transcript import EventKind
+from tests.support.paths import benchmark
 
-BENCHMARKS = Path(__file__).parents[2] / "benchmarks"
-
-
-def _load(name: str) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(f"{name}_bench", BENCHMARKS / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+_load = benchmark
 
 
 def test_a_loaded_capture_holds_its_events_in_a_store(tmp_path: Path):

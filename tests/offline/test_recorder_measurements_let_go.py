@@ -13,8 +13,6 @@ and aHA! read past aD9!, a retried sensor), laid end to end."""
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 from types import ModuleType
 from typing import TypeVar
 
@@ -48,23 +46,15 @@ from conformance.transcript import Event, escape
 from conformance.verdicts import Verdict
 from conformance.view.segments import read_view
 from conformance.view.windows import stream_windows
+from tests.support.paths import benchmark
 from tests.support.windowed_judges import at_every_break
 
 U = 1e-6  # the capture's 1 MHz stamps
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "measuring_bus.py"
-
-
-def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("measuring_bus_bench", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(scope="module")
 def bench() -> ModuleType:
-    return _bench()
+    return benchmark("measuring_bus")
 
 
 @pytest.fixture(scope="module")

@@ -10,11 +10,9 @@ times, and measured values on, near and off the segments' intervals."""
 
 from __future__ import annotations
 
-import importlib.util
 import random
 from dataclasses import replace
 from itertools import pairwise
-from pathlib import Path
 
 import pytest
 
@@ -24,16 +22,11 @@ from conformance.results import CaseRecord
 from conformance.transcript import DUT, Event, Transcript
 from conformance.verdicts import Finding, Verdict
 from conformance.view.runs import LazyCut, transcript_segments, transcript_view, whole_cut
-
-BENCH = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
+from tests.support.paths import benchmark
 
 
 def _busy_bus(seconds: float) -> list[Event]:
-    spec = importlib.util.spec_from_file_location("capture_decode_bench", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.busy_bus(seconds)
+    return benchmark("capture_decode").busy_bus(seconds)
 
 
 def _events(seed: int) -> list[Event]:

@@ -17,25 +17,19 @@ counted.
 
 from __future__ import annotations
 
-import importlib.util
 import tracemalloc
 from dataclasses import replace
-from pathlib import Path
 
 from conformance.transcript import BUS
 from conformance.view.segments import read_view
+from tests.support.paths import benchmark
 
-BENCH = Path(__file__).parents[2] / "benchmarks" / "capture_decode.py"
 BYTES_PER_TRANSMISSION = 950  # 832 measured (window11); base-s58 1,150, 689a849 1,924
 
 
 def busy_events(seconds: float):
     """The capture benchmark's busy bus, every event undirected as a capture's are."""
-    spec = importlib.util.spec_from_file_location("capture_decode_bench", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return [replace(e, origin=BUS) for e in module.busy_bus(seconds)]
+    return [replace(e, origin=BUS) for e in benchmark("capture_decode").busy_bus(seconds)]
 
 
 def test_a_judged_views_size_per_transmission_stays_under_its_figure():
