@@ -198,34 +198,29 @@ def events_head(record: Any, n: int) -> tuple[list[Event], int, Event | None]:
     made at once to keep 1000). A list's records are joined one at a time and the first
     ``n`` kept as they come (by start, then join order: what the stable sort gives). Where a
     start is NaN, :func:`events_of` itself (its order is the parts')."""
-    if record is None or (
+    alone = record is None or (
         isinstance(record, (list, tuple)) and all(map(isinstance, record, repeat(Event)))
-    ):
-        events = events_of(record)  # events alone: as they are (they are held already)
-        return events[:n], len(events), events[-1] if events else None
-    parts = record if isinstance(record, (list, tuple)) else [record]
-    seen = 0
-    total = 0.0
-    heads: list[tuple[float, int, Event]] = []
-    last: tuple[float, int, Event] | None = None
-    for part in parts:
-        found: list[Event] = []
-        _join(part, found)
-        for e in found:
-            total += e.start
-            key = (e.start, seen, e)
-            if last is None or key[:2] >= last[:2]:
-                last = key
-            if len(heads) < n:
-                heapq.heappush(heads, (-e.start, -seen, e))
-            elif (e.start, seen) < (-heads[0][0], -heads[0][1]):
-                heapq.heapreplace(heads, (-e.start, -seen, e))
-            seen += 1
-    if not isfinite(total):
-        events = events_of(record)
-        return events[:n], len(events), events[-1] if events else None
-    first = [e for _, _, e in sorted(heads, key=lambda h: (-h[0], -h[1]))]
-    return first, seen, None if last is None else last[2]
+    )  # events alone: as they are (they are held already)
+    if not alone:
+        seen, total = 0, 0.0
+        heads: list[tuple[float, int, Event]] = []  # (-start, -seen): the latest on top
+        last: Event | None = None
+        for part in record if isinstance(record, (list, tuple)) else [record]:
+            found: list[Event] = []
+            _join(part, found)
+            for e in found:
+                total += e.start
+                if last is None or e.start >= last.start:
+                    last = e  # the sort's last: the greatest start, the last joined of it
+                if len(heads) < n:
+                    heapq.heappush(heads, (-e.start, -seen, e))
+                elif e.start < -heads[0][0]:  # (an equal start joined later is not before)
+                    heapq.heapreplace(heads, (-e.start, -seen, e))
+                seen += 1
+        if isfinite(total):
+            return [e for _, _, e in sorted(heads, reverse=True)], seen, last
+    events = events_of(record)
+    return events[:n], len(events), events[-1] if events else None
 
 
 def head_of(events: list[Event], limit: int) -> list[Event]:
